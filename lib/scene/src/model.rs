@@ -1,0 +1,205 @@
+//! The evaluated scene: what the tracer consumes.
+//!
+//! Conventions: right-handed world, +Y up, metres; cameras look down their local -Z with +Y up
+//! (glTF). Colours are linear RGB. Matrices are column-major `glam::Mat4`.
+
+use glam::{Mat4, Vec2, Vec3};
+use pis_format::{DimensionKind, ObjectRole};
+
+/// A loaded scene: static content plus the parameter space that animates it.
+#[derive(Clone, Debug)]
+pub struct Scene {
+    /// Short name (the scene directory name, or `name` in scene.toml).
+    pub name: String,
+    /// Image size in pixels (width, height).
+    pub resolution: (u32, u32),
+    /// Camera samples per pixel.
+    pub spp: u32,
+    /// Renderable objects (one per glTF node that has a mesh), in glTF node order.
+    pub objects: Vec<SceneObject>,
+    pub materials: Vec<Material>,
+    /// Decoded textures referenced by materials.
+    pub textures: Vec<TextureImage>,
+    pub space: ParameterSpace,
+}
+
+/// One renderable object. Its mesh is in object space; [`Frame::instances`] places it.
+#[derive(Clone, Debug)]
+pub struct SceneObject {
+    pub name: String,
+    /// Inferred from the material (transmission → refractive, metallic or low roughness →
+    /// reflective, else diffuse) unless scene.toml overrides it.
+    pub role: ObjectRole,
+    pub primitives: Vec<Primitive>,
+}
+
+/// A triangle list with one material.
+#[derive(Clone, Debug)]
+pub struct Primitive {
+    pub positions: Vec<Vec3>,
+    /// Unit normals, one per vertex (generated flat if the glTF has none).
+    pub normals: Vec<Vec3>,
+    /// Texture coordinates (TEXCOORD_0), one per vertex; zeros if the glTF has none.
+    pub uvs: Vec<Vec2>,
+    /// Triangle list, three indices per triangle.
+    pub indices: Vec<u32>,
+    /// Index into [`Scene::materials`].
+    pub material: usize,
+}
+
+/// glTF PBR metallic-roughness with KHR_materials_transmission, _ior, _volume, _specular,
+/// and emission (KHR_materials_emissive_strength folded into `emissive`).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Material {
+    pub name: String,
+    /// Linear RGBA base colour factor.
+    pub base_color: [f32; 4],
+    /// Index into [`Scene::textures`], sampled with TEXCOORD_0 and multiplied by `base_color`.
+    pub base_color_texture: Option<usize>,
+    pub metallic: f32,
+    pub roughness: f32,
+    /// Emitted radiance (linear RGB, strength applied).
+    pub emissive: [f32; 3],
+    /// KHR_materials_transmission factor (0 opaque .. 1 fully transmissive).
+    pub transmission: f32,
+    /// KHR_materials_ior (default 1.5).
+    pub ior: f32,
+    /// KHR_materials_volume: attenuation distance (f32::INFINITY = no absorption) and colour.
+    pub attenuation_distance: f32,
+    pub attenuation_color: [f32; 3],
+    /// KHR_materials_specular factor and colour (defaults 1 and white).
+    pub specular: f32,
+    pub specular_color: [f32; 3],
+}
+
+impl Default for Material {
+    fn default() -> Self {
+        Material {
+            name: String::new(),
+            base_color: [1.0; 4],
+            base_color_texture: None,
+            metallic: 1.0,
+            roughness: 1.0,
+            emissive: [0.0; 3],
+            transmission: 0.0,
+            ior: 1.5,
+            attenuation_distance: f32::INFINITY,
+            attenuation_color: [1.0; 3],
+            specular: 1.0,
+            specular_color: [1.0; 3],
+        }
+    }
+}
+
+/// A decoded texture in linear RGBA f32, rows top to bottom (glTF UV (0,0) is the top-left).
+#[derive(Clone, Debug)]
+pub struct TextureImage {
+    pub width: u32,
+    pub height: u32,
+    pub texels: Vec<[f32; 4]>,
+}
+
+/// The parameter space: named dimensions, each with its samples.
+#[derive(Clone, Debug, Default)]
+pub struct ParameterSpace {
+    pub dims: Vec<Dimension>,
+}
+
+impl ParameterSpace {
+    /// Number of parameter points (product of the sample counts).
+    pub fn point_count(&self) -> usize {
+        self.dims.iter().map(|d| d.samples() as usize).product()
+    }
+
+    /// Sample indices of the point with linear index `index`; the last dimension varies fastest.
+    pub fn point(&self, mut index: usize) -> Vec<u32> {
+        let mut out = vec![0; self.dims.len()];
+        for (k, d) in self.dims.iter().enumerate().rev() {
+            let n = d.samples() as usize;
+            out[k] = (index % n) as u32;
+            index /= n;
+        }
+        out
+    }
+}
+
+/// One dimension of the parameter space.
+#[derive(Clone, Debug)]
+pub struct Dimension {
+    pub name: String,
+    pub kind: DimensionKind,
+    /// True when the dimension wraps around (a full orbit).
+    pub periodic: bool,
+    /// Unit of `values` ("deg", "s", "" ...).
+    pub unit: String,
+    /// The value of every sample, strictly increasing.
+    pub values: Vec<f32>,
+    pub driver: Driver,
+}
+
+impl Dimension {
+    pub fn samples(&self) -> u32 {
+        self.values.len() as u32
+    }
+}
+
+/// What a dimension drives.
+#[derive(Clone, Debug)]
+pub enum Driver {
+    /// The camera orbits `target` at `radius` and `elevation` (degrees); the sample value is
+    /// the azimuth in degrees.
+    Orbit { target: Vec3, radius: f32, elevation_deg: f32 },
+    /// A named glTF animation; the sample value is the time in seconds.
+    Animation { animation: String },
+    /// A named light moves along a polyline (world space); the sample value is the path
+    /// parameter in [0, 1] (arc-length).
+    LightPath { light: String, path: Vec<Vec3> },
+}
+
+/// Everything that varies over the parameter space, evaluated at one point.
+#[derive(Clone, Debug)]
+pub struct Frame {
+    pub camera: Camera,
+    pub lights: Vec<Light>,
+    /// One per [`Scene::objects`] entry, same order.
+    pub instances: Vec<Instance>,
+}
+
+/// A perspective camera.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Camera {
+    /// Rigid camera-to-world transform (camera looks down local -Z, +Y up).
+    pub world_from_camera: Mat4,
+    /// Vertical field of view in radians.
+    pub yfov: f32,
+    pub znear: f32,
+    /// f32::INFINITY when the glTF camera has no far plane.
+    pub zfar: f32,
+}
+
+/// A light from KHR_lights_punctual, placed in the world.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Light {
+    pub name: String,
+    pub kind: LightKind,
+    /// Linear RGB colour times intensity (W/sr-like units for point/spot, lux for directional).
+    pub radiance: [f32; 3],
+    /// Sphere radius for area lights and soft shadows (glTF extras `radius`), 0 = point.
+    pub radius: f32,
+    pub position: Vec3,
+    /// Direction the light points to (unit), for spot and directional lights.
+    pub direction: Vec3,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum LightKind {
+    Point,
+    Spot { inner_cone: f32, outer_cone: f32 },
+    Directional,
+}
+
+/// An object placed in the world at one parameter point.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Instance {
+    pub world_from_object: Mat4,
+}
