@@ -73,3 +73,513 @@ impl ObjectRole {
         }
     }
 }
+
+/// A container: everything a `.pis` file holds. `S` is how level images are held: owned
+/// [`Codestream`]s when building or fully loaded, [`StreamRef`]s (offsets into the file) when
+/// opened for random access.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Container<S = Codestream> {
+    pub space: ParameterSpace,
+    pub cameras: CameraTable,
+    pub objects: Vec<Object<S>>,
+    pub provenance: Option<Provenance>,
+}
+
+/// The parameter space (chunk `PSPC`).
+#[derive(Clone, Debug, PartialEq, Default)]
+pub struct ParameterSpace {
+    pub dims: Vec<Dimension>,
+}
+
+impl ParameterSpace {
+    /// Number of parameter points.
+    pub fn point_count(&self) -> u64 {
+        self.dims.iter().map(|d| d.values.len() as u64).product()
+    }
+
+    /// Number of entries of a table that depends on the dimensions in `mask`.
+    pub fn table_len(&self, mask: DepMask) -> u64 {
+        mask.dims().filter_map(|k| self.dims.get(k)).map(|d| d.values.len() as u64).product()
+    }
+
+    /// Index into a table that depends on `mask`, for the point with sample indices `point`
+    /// (row-major over the masked dimensions, the last one fastest).
+    pub fn table_index(&self, mask: DepMask, point: &[u32]) -> usize {
+        let mut index = 0usize;
+        for k in mask.dims() {
+            index = index * self.dims[k].values.len() + point[k] as usize;
+        }
+        index
+    }
+
+    /// Sample indices of the point with linear index `index` (the last dimension fastest).
+    pub fn point(&self, mut index: u64) -> Vec<u32> {
+        let mut out = vec![0; self.dims.len()];
+        for (k, d) in self.dims.iter().enumerate().rev() {
+            let n = d.values.len() as u64;
+            out[k] = (index % n) as u32;
+            index /= n;
+        }
+        out
+    }
+
+    /// Sample indices nearest to the continuous values `values` (one per dimension).
+    pub fn nearest(&self, values: &[f32]) -> Vec<u32> {
+        self.dims
+            .iter()
+            .zip(values)
+            .map(|(d, v)| {
+                let mut best = 0;
+                for (i, s) in d.values.iter().enumerate() {
+                    if (s - v).abs() < (d.values[best] - v).abs() {
+                        best = i;
+                    }
+                }
+                best as u32
+            })
+            .collect()
+    }
+}
+
+/// One named dimension of the parameter space.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Dimension {
+    pub name: String,
+    pub kind: DimensionKind,
+    /// The dimension wraps around (its last sample neighbours its first).
+    pub periodic: bool,
+    /// Unit of the sample values ("deg", "s", ...), may be empty.
+    pub unit: String,
+    /// Parameter-space block size along this dimension (section 4.1).
+    pub block_size: u32,
+    /// The value of every sample, strictly increasing.
+    pub values: Vec<f32>,
+}
+
+/// A set of dimensions a table depends on: bit k set = depends on dimension k.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Default)]
+pub struct DepMask(pub u32);
+
+impl DepMask {
+    pub const NONE: DepMask = DepMask(0);
+
+    pub fn of(dims: &[usize]) -> Self {
+        DepMask(dims.iter().fold(0, |m, &k| m | (1 << k)))
+    }
+
+    /// The dimension indices in the mask, ascending.
+    pub fn dims(self) -> impl Iterator<Item = usize> {
+        (0..32).filter(move |k| self.0 & (1 << k) != 0)
+    }
+
+    pub fn count(self) -> usize {
+        self.0.count_ones() as usize
+    }
+
+    pub fn contains(self, k: usize) -> bool {
+        k < 32 && self.0 & (1 << k) != 0
+    }
+}
+
+/// The cameras of the view samples (chunk `CAMS`).
+#[derive(Clone, Debug, PartialEq)]
+pub struct CameraTable {
+    /// Size of the ray-traced images, in pixels.
+    pub width: u32,
+    pub height: u32,
+    /// The dimensions the camera depends on (usually the view dimensions).
+    pub depends_on: DepMask,
+    /// One camera per combination of the masked dimensions' samples.
+    pub cameras: Vec<Camera>,
+}
+
+/// A perspective camera looking down its local -Z with +Y up.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Camera {
+    /// Rigid camera-to-world transform, 3 rows × 4 columns, row-major.
+    pub world_from_camera: [f32; 12],
+    /// Vertical field of view, radians, in (0, π).
+    pub yfov: f32,
+    pub znear: f32,
+    /// May be +∞.
+    pub zfar: f32,
+}
+
+/// The 3×4 identity transform.
+pub const IDENTITY_3X4: [f32; 12] = [1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0];
+
+/// One object: geometry, role, shading constants and its texture layers.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Object<S = Codestream> {
+    pub name: String,
+    pub role: ObjectRole,
+    pub shading: Shading,
+    /// Block origin offset per dimension (section 4.7, staggering); each < the block size.
+    pub stagger: Vec<u32>,
+    /// Rigid object-to-world transforms, one per combination of the masked dimensions.
+    pub transforms: TransformTable,
+    pub mesh: Mesh,
+    pub layers: Vec<Layer<S>>,
+}
+
+/// Constants the player needs to shade an object.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Shading {
+    /// Reflectance at normal incidence (Schlick's F0), linear RGB in [0, 1].
+    pub f0: [f32; 3],
+    /// Index of refraction (≥ 1).
+    pub ior: f32,
+    /// Beer–Lambert absorption coefficients per unit length, linear RGB, ≥ 0.
+    pub absorption: [f32; 3],
+}
+
+impl Default for Shading {
+    fn default() -> Self {
+        Shading { f0: [0.04; 3], ior: 1.5, absorption: [0.0; 3] }
+    }
+}
+
+/// Object-to-world transforms over the parameter space.
+#[derive(Clone, Debug, PartialEq)]
+pub struct TransformTable {
+    pub depends_on: DepMask,
+    /// 3 rows × 4 columns, row-major.
+    pub transforms: Vec<[f32; 12]>,
+}
+
+impl TransformTable {
+    /// A static object.
+    pub fn fixed(t: [f32; 12]) -> Self {
+        TransformTable { depends_on: DepMask::NONE, transforms: vec![t] }
+    }
+}
+
+/// A triangle mesh in object space (chunk `MESH`).
+#[derive(Clone, Debug, PartialEq, Default)]
+pub struct Mesh {
+    pub positions: Vec<[f32; 3]>,
+    pub normals: Option<Vec<[f32; 3]>>,
+    pub texcoords: Option<Vec<[f32; 2]>>,
+    /// Triangle list.
+    pub indices: Vec<u32>,
+}
+
+/// What a layer holds (SPEC.md, table "Layer kinds").
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum LayerKind {
+    /// View-independent radiance of the first diffuse interaction.
+    Diffuse = 0,
+    /// View-dependent radiance on the surface.
+    Specular = 1,
+    /// Reflectance texture that multiplies a lighting layer (fig. 4.8).
+    Albedo = 2,
+    /// Incident lighting that an albedo layer multiplies.
+    Lighting = 3,
+    /// Local environment-map shell (self-reflections), with alpha.
+    EnvLocal = 4,
+    /// Distant environment-map shell.
+    EnvDistant = 5,
+    /// One shell of a lens object's layered environment map.
+    EnvShell = 6,
+}
+
+impl LayerKind {
+    pub const ALL: [LayerKind; 7] = [
+        LayerKind::Diffuse,
+        LayerKind::Specular,
+        LayerKind::Albedo,
+        LayerKind::Lighting,
+        LayerKind::EnvLocal,
+        LayerKind::EnvDistant,
+        LayerKind::EnvShell,
+    ];
+
+    pub fn from_code(code: u8) -> Option<Self> {
+        Self::ALL.get(code as usize).copied()
+    }
+
+    pub fn code(self) -> u8 {
+        self as u8
+    }
+
+    pub fn name(self) -> &'static str {
+        match self {
+            LayerKind::Diffuse => "diffuse",
+            LayerKind::Specular => "specular",
+            LayerKind::Albedo => "albedo",
+            LayerKind::Lighting => "lighting",
+            LayerKind::EnvLocal => "env_local",
+            LayerKind::EnvDistant => "env_distant",
+            LayerKind::EnvShell => "env_shell",
+        }
+    }
+
+    /// True for the kinds drawn through an environment-map shell.
+    pub fn is_shell(self) -> bool {
+        matches!(self, LayerKind::EnvLocal | LayerKind::EnvDistant | LayerKind::EnvShell)
+    }
+}
+
+/// Which term of the shading model a layer contributes to (SPEC.md, "Combining layers").
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Term {
+    /// Surface textures, summed (or multiplied) in order.
+    Surface = 0,
+    /// Reflection term: shells composited "over", modulated by Fresnel.
+    Reflection = 1,
+    /// Refraction term of a lens object: shells composited "over", modulated by
+    /// transmission and absorption.
+    Refraction = 2,
+}
+
+impl Term {
+    pub fn from_code(code: u8) -> Option<Self> {
+        [Term::Surface, Term::Reflection, Term::Refraction].get(code as usize).copied()
+    }
+
+    pub fn name(self) -> &'static str {
+        match self {
+            Term::Surface => "surface",
+            Term::Reflection => "reflection",
+            Term::Refraction => "refraction",
+        }
+    }
+}
+
+/// How a layer joins the running result of its term.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Combine {
+    Add = 0,
+    Multiply = 1,
+    /// Porter–Duff "over" with straight alpha: this layer over the layers after it.
+    Over = 2,
+}
+
+impl Combine {
+    pub fn from_code(code: u8) -> Option<Self> {
+        [Combine::Add, Combine::Multiply, Combine::Over].get(code as usize).copied()
+    }
+
+    pub fn name(self) -> &'static str {
+        match self {
+            Combine::Add => "add",
+            Combine::Multiply => "multiply",
+            Combine::Over => "over",
+        }
+    }
+}
+
+/// Which MIP levels a level image holds (SPEC.md, "MIP levels").
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum MipMode {
+    /// The finest level only; the player rebuilds the chain by decimation (section 3.6).
+    Decimated = 0,
+    /// The whole chain; levels below the finest are stored as residuals from the decimated
+    /// finest level (section 5.8.1).
+    Stored = 1,
+}
+
+impl MipMode {
+    pub fn from_code(code: u8) -> Option<Self> {
+        [MipMode::Decimated, MipMode::Stored].get(code as usize).copied()
+    }
+
+    pub fn name(self) -> &'static str {
+        match self {
+            MipMode::Decimated => "decimated",
+            MipMode::Stored => "stored",
+        }
+    }
+}
+
+/// How texels reach the screen: through the mesh's texture coordinates, or through an
+/// environment-map shell.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Mapping {
+    Surface = 0,
+    Shell = 1,
+}
+
+impl Mapping {
+    pub fn from_code(code: u8) -> Option<Self> {
+        [Mapping::Surface, Mapping::Shell].get(code as usize).copied()
+    }
+
+    pub fn name(self) -> &'static str {
+        match self {
+            Mapping::Surface => "surface",
+            Mapping::Shell => "shell",
+        }
+    }
+}
+
+/// One texture field of an object: a parameterized texture or environment-map shell.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Layer<S = Codestream> {
+    pub kind: LayerKind,
+    pub mapping: Mapping,
+    /// 3 (RGB) or 4 (RGBA, straight alpha; shells only).
+    pub channels: u8,
+    pub mip_mode: MipMode,
+    pub term: Term,
+    /// Position within the term: surface layers apply in increasing order; shells composite
+    /// from order 0 (nearest) outwards.
+    pub order: u8,
+    pub combine: Combine,
+    /// Stored values are γ(L) = sign(L)·|L|^(1/gamma); 1 means linear (section 4.6).
+    pub gamma: f32,
+    /// The dimensions this layer varies over; blocks tile only these.
+    pub depends_on: DepMask,
+    /// One per block of the layer's block grid, row-major (the last masked dimension fastest).
+    pub blocks: Vec<Block<S>>,
+}
+
+/// One parameter-space block of a layer: texture placement and its Laplacian pyramid.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Block<S = Codestream> {
+    /// Used texture size (non-power-of-two allowed); a shell's cube face is width × width.
+    pub width: u32,
+    pub height: u32,
+    pub placement: Placement,
+    /// Pyramid levels from the top (one sample) to the finest (the block's extent).
+    pub levels: Vec<Level<S>>,
+}
+
+/// Where a block's texture sits.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Placement {
+    /// Affine texture-coordinate transform (section 3.2):
+    /// s = a·u + b·v + e, t = c·u + d·v + f, as `[a, b, c, d, e, f]`; (s, t) in [0, 1]²
+    /// spans the used texture.
+    Surface { affine: [f32; 6] },
+    /// Environment-map shell geometry with its cube-map origin.
+    Shell { shape: ShellShape, origin: [f32; 3], params: [f32; 6] },
+}
+
+/// Environment-map shell geometry (SPEC.md, table "Shell shapes").
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum ShellShape {
+    /// params[0] = radius.
+    Sphere = 1,
+    /// params[0..3] = radii along x, y, z.
+    Ellipsoid = 2,
+    /// params[0..3] = min corner, params[3..6] = max corner (world space).
+    Box = 3,
+    /// Axis parallel to +Y through the origin: params[0] = radius, [1] = y min, [2] = y max.
+    Cylinder = 4,
+    /// A parallelogram: origin = corner, params[0..3] = edge s, params[3..6] = edge t.
+    Quad = 5,
+}
+
+impl ShellShape {
+    pub const ALL: [ShellShape; 5] =
+        [ShellShape::Sphere, ShellShape::Ellipsoid, ShellShape::Box, ShellShape::Cylinder, ShellShape::Quad];
+
+    pub fn from_code(code: u32) -> Option<Self> {
+        Self::ALL.into_iter().find(|s| *s as u32 == code)
+    }
+
+    pub fn name(self) -> &'static str {
+        match self {
+            ShellShape::Sphere => "sphere",
+            ShellShape::Ellipsoid => "ellipsoid",
+            ShellShape::Box => "box",
+            ShellShape::Cylinder => "cylinder",
+            ShellShape::Quad => "quad",
+        }
+    }
+
+    /// Number of texture faces: 6 cube faces, or 1 for a quad.
+    pub fn faces(self) -> u32 {
+        if self == ShellShape::Quad {
+            1
+        } else {
+            6
+        }
+    }
+}
+
+/// One level of a block's adaptive Laplacian pyramid (section 4.3).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Level<S = Codestream> {
+    /// Samples along each of the layer's dimensions at this level.
+    pub counts: Vec<u32>,
+    /// One level image per sample of this level, row-major.
+    pub images: Vec<S>,
+}
+
+/// An encoded level image held in memory.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Codestream {
+    pub codec: pis_codec::CodecId,
+    pub bytes: Vec<u8>,
+}
+
+/// Where an encoded level image lies in the file.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct StreamRef {
+    pub codec: pis_codec::CodecId,
+    /// Index of the `CSTR` chunk in the chunk table.
+    pub chunk: u32,
+    /// Byte offset within that chunk's payload.
+    pub offset: u64,
+    pub length: u32,
+    /// CRC-32 of the codestream bytes.
+    pub crc: u32,
+}
+
+/// Where the file came from (chunk `PROV`).
+#[derive(Clone, Debug, PartialEq, Default)]
+pub struct Provenance {
+    /// The tool and version that wrote the file.
+    pub tool: String,
+    /// The ray-traced set (or other source) it was made from.
+    pub source: String,
+    /// Size of the raw image set at 3 bytes per pixel (section 4.8), for compression ratios.
+    pub raw_image_bytes: u64,
+    /// Settings as key/value pairs, in the order the tool wrote them.
+    pub settings: Vec<(String, String)>,
+}
+
+impl<S> Container<S> {
+    /// The same container with every level image converted by `f` (in file order).
+    pub fn try_map<T, E>(&self, f: &mut impl FnMut(&S) -> Result<T, E>) -> Result<Container<T>, E> {
+        let mut objects = Vec::with_capacity(self.objects.len());
+        for o in &self.objects {
+            let mut layers = Vec::with_capacity(o.layers.len());
+            for l in &o.layers {
+                let mut blocks = Vec::with_capacity(l.blocks.len());
+                for b in &l.blocks {
+                    let mut levels = Vec::with_capacity(b.levels.len());
+                    for level in &b.levels {
+                        let images = level.images.iter().map(&mut *f).collect::<Result<Vec<_>, E>>()?;
+                        levels.push(Level { counts: level.counts.clone(), images });
+                    }
+                    blocks.push(Block { width: b.width, height: b.height, placement: b.placement, levels });
+                }
+                layers.push(Layer {
+                    kind: l.kind,
+                    mapping: l.mapping,
+                    channels: l.channels,
+                    mip_mode: l.mip_mode,
+                    term: l.term,
+                    order: l.order,
+                    combine: l.combine,
+                    gamma: l.gamma,
+                    depends_on: l.depends_on,
+                    blocks,
+                });
+            }
+            objects.push(Object {
+                name: o.name.clone(),
+                role: o.role,
+                shading: o.shading,
+                stagger: o.stagger.clone(),
+                transforms: o.transforms.clone(),
+                mesh: o.mesh.clone(),
+                layers,
+            });
+        }
+        Ok(Container { space: self.space.clone(), cameras: self.cameras.clone(), objects, provenance: self.provenance.clone() })
+    }
+}

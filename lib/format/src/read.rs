@@ -1,0 +1,373 @@
+//! The validating random-access reader.
+//!
+//! Opening a file reads the header, the chunk table and every metadata chunk (checksums
+//! verified), checks every rule of the spec that does not need the codestreams, and keeps the
+//! codestream references. Textures are then decoded on demand, reading only the codestreams
+//! on the pyramid path of the requested parameter point (each checksum-verified).
+//! Every count, offset and length is checked against the file size before anything is
+//! allocated for it.
+
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicU64, Ordering};
+
+use pis_codec::CodecError;
+
+use crate::binary::Cursor;
+use crate::blocks::{level_image_index, BlockGrid};
+use crate::chunk::{self, ChunkEntry, Header, HEADER_LEN, ENTRY_LEN};
+use crate::model::*;
+use crate::source::{FileSource, Source};
+use crate::texture::{LevelLayout, Texture};
+use crate::{checks, payload_read as pr, reconstruct, Error, Issue, Severity};
+
+/// An open `.pis` file.
+pub struct PisReader {
+    source: Box<dyn Source>,
+    path: PathBuf,
+    header: Header,
+    chunks: Vec<ChunkEntry>,
+    container: Container<StreamRef>,
+    reads: AtomicU64,
+    read_bytes: AtomicU64,
+}
+
+/// Codestream reads since the file was opened.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub struct ReadStats {
+    pub codestreams: u64,
+    pub bytes: u64,
+}
+
+/// What a structural pass over a file found.
+pub(crate) struct Loaded {
+    pub header: Option<Header>,
+    pub chunks: Vec<ChunkEntry>,
+    pub container: Option<Container<StreamRef>>,
+}
+
+impl PisReader {
+    /// Opens and checks `path`.
+    pub fn open(path: &Path) -> Result<Self, Error> {
+        let io = |source| Error::Io { path: path.to_path_buf(), source };
+        let file = std::fs::File::open(path).map_err(io)?;
+        let source = FileSource::new(file).map_err(io)?;
+        Self::from_source(Box::new(source), path.to_path_buf())
+    }
+
+    /// Opens a container held in memory.
+    pub fn from_bytes(bytes: Vec<u8>) -> Result<Self, Error> {
+        Self::from_source(Box::new(bytes), PathBuf::from("<memory>"))
+    }
+
+    fn from_source(source: Box<dyn Source>, path: PathBuf) -> Result<Self, Error> {
+        let mut issues = Vec::new();
+        let loaded = load(source.as_ref(), false, &mut issues);
+        if let Some(first) = issues.into_iter().find(|i| i.severity == Severity::Error) {
+            return Err(match first.id {
+                1001 => Error::Io { path, source: std::io::Error::other(first.detail) },
+                _ => Error::Invalid(first),
+            });
+        }
+        match (loaded.header, loaded.container) {
+            (Some(header), Some(container)) => Ok(PisReader {
+                source,
+                path,
+                header,
+                chunks: loaded.chunks,
+                container,
+                reads: AtomicU64::new(0),
+                read_bytes: AtomicU64::new(0),
+            }),
+            _ => Err(Error::Invalid(Issue::new(1001, "file could not be parsed"))),
+        }
+    }
+
+    pub fn path(&self) -> &Path {
+        &self.path
+    }
+
+    pub fn header(&self) -> &Header {
+        &self.header
+    }
+
+    pub fn chunks(&self) -> &[ChunkEntry] {
+        &self.chunks
+    }
+
+    pub fn len(&self) -> u64 {
+        self.source.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// The container, with codestreams as references into the file.
+    pub fn container(&self) -> &Container<StreamRef> {
+        &self.container
+    }
+
+    pub fn stats(&self) -> ReadStats {
+        ReadStats { codestreams: self.reads.load(Ordering::Relaxed), bytes: self.read_bytes.load(Ordering::Relaxed) }
+    }
+
+    /// The bytes of one codestream, checksum verified.
+    pub fn codestream(&self, r: &StreamRef) -> Result<Vec<u8>, Error> {
+        let entry = &self.chunks[r.chunk as usize];
+        let mut buf = vec![0; r.length as usize];
+        self.source
+            .read_at(entry.offset + r.offset, &mut buf)
+            .map_err(|source| Error::Io { path: self.path.clone(), source })?;
+        self.reads.fetch_add(1, Ordering::Relaxed);
+        self.read_bytes.fetch_add(r.length as u64, Ordering::Relaxed);
+        let crc = crc32fast::hash(&buf);
+        if crc != r.crc {
+            return Err(Error::Invalid(
+                Issue::new(8003, format!("stored {:#010x}, computed {crc:#010x}", r.crc))
+                    .in_chunk("CSTR", r.chunk as usize)
+                    .at(entry.offset + r.offset),
+            ));
+        }
+        Ok(buf)
+    }
+
+    /// Checks an (object, layer, point) request against the file.
+    fn request(&self, object: usize, layer: usize, point: &[u32]) -> Result<(), Error> {
+        let c = &self.container;
+        let o = c.objects.get(object).ok_or_else(|| {
+            Error::Request(format!("object {object} does not exist; the file has {}", c.objects.len()))
+        })?;
+        if layer >= o.layers.len() {
+            return Err(Error::Request(format!("object '{}' has {} layers, not {}", o.name, o.layers.len(), layer + 1)));
+        }
+        if point.len() != c.space.dims.len() {
+            return Err(Error::Request(format!("a point needs {} sample indices, got {}", c.space.dims.len(), point.len())));
+        }
+        for (k, (&s, d)) in point.iter().zip(&c.space.dims).enumerate() {
+            if s as usize >= d.values.len() {
+                return Err(Error::Request(format!(
+                    "sample {s} of dimension {k} '{}' does not exist; it has {}",
+                    d.name,
+                    d.values.len()
+                )));
+            }
+        }
+        Ok(())
+    }
+
+    /// The codestreams a texture at `point` is rebuilt from, top pyramid level first.
+    pub fn texture_path(&self, object: usize, layer: usize, point: &[u32]) -> Result<(usize, Vec<StreamRef>), Error> {
+        self.request(object, layer, point)?;
+        let o = &self.container.objects[object];
+        let l = &o.layers[layer];
+        let pos = BlockGrid::new(&self.container.space, l.depends_on, &o.stagger).locate(point);
+        let block = &l.blocks[pos.block];
+        let refs = block
+            .levels
+            .iter()
+            .map(|level| level.images[level_image_index(&level.counts, &pos.local, &pos.extent)])
+            .collect();
+        Ok((pos.block, refs))
+    }
+
+    /// Decodes the texture of layer `layer` of object `object` at parameter point `point`
+    /// (one sample index per dimension).
+    pub fn texture(&self, object: usize, layer: usize, point: &[u32]) -> Result<Texture, Error> {
+        let (bi, refs) = self.texture_path(object, layer, point)?;
+        let l = &self.container.objects[object].layers[layer];
+        let layout = LevelLayout::of(l, &l.blocks[bi]);
+        let planes = layout.planes();
+        let mut sum: Option<Vec<f32>> = None;
+        for (lv, r) in refs.iter().enumerate() {
+            let bytes = self.codestream(r)?;
+            let values = pis_codec::decode(r.codec, &planes, &bytes).map_err(|e| match e {
+                CodecError::NotSupported(c) => Error::NotSupported(format!("codec '{c}' (object {object}, layer {layer})")),
+                e => Error::Invalid(
+                    Issue::new(8005, format!("object {object} layer {layer} block {bi} level {lv}: {e}"))
+                        .in_chunk("CSTR", r.chunk as usize),
+                ),
+            })?;
+            match &mut sum {
+                None => sum = Some(values),
+                Some(acc) => acc.iter_mut().zip(&values).for_each(|(a, v)| *a += v),
+            }
+        }
+        let data = reconstruct::finish(l, &layout, sum.unwrap_or_default());
+        Ok(Texture { layout, data })
+    }
+
+    /// Reads every codestream into memory: the whole container, ready to re-encode or write.
+    pub fn load_all(&self) -> Result<Container<Codestream>, Error> {
+        self.container.try_map(&mut |r| Ok(Codestream { codec: r.codec, bytes: self.codestream(r)? }))
+    }
+}
+
+/// The structural pass shared by [`PisReader::open`] and `validate`: header, table, metadata
+/// chunks, model rules and codestream ranges. With `full`, also every checksum of chunks the
+/// reader otherwise reads lazily (`CSTR`, unknown chunks).
+pub(crate) fn load(src: &dyn Source, full: bool, issues: &mut Vec<Issue>) -> Loaded {
+    let mut out = Loaded { header: None, chunks: Vec::new(), container: None };
+    let len = src.len();
+    let mut head = vec![0u8; len.min(HEADER_LEN) as usize];
+    if let Err(e) = src.read_at(0, &mut head) {
+        issues.push(Issue::new(1001, e.to_string()));
+        return out;
+    }
+    let header = match chunk::parse_header(&head, len) {
+        Ok(h) => h,
+        Err(i) => {
+            issues.push(i);
+            return out;
+        }
+    };
+    // parse_header checked that the table fits in the file.
+    let mut table = vec![0u8; header.chunk_count as usize * ENTRY_LEN as usize];
+    if let Err(e) = src.read_at(HEADER_LEN, &mut table) {
+        issues.push(Issue::new(1001, e.to_string()));
+        return out;
+    }
+    let entries = chunk::parse_table(&head, &header, &table, issues);
+    let mut read = |at: u64, n: usize| {
+        let mut b = vec![0; n];
+        src.read_at(at, &mut b).ok().map(|_| b)
+    };
+    chunk::check_padding(&entries, &mut read, issues);
+    out.header = Some(header);
+
+    // Read and verify the chunks; parse the metadata ones.
+    let mut payloads: Vec<Option<Vec<u8>>> = vec![None; entries.len()];
+    let mut ok = true;
+    for (i, e) in entries.iter().enumerate() {
+        let in_bounds = e.offset.checked_add(e.length).is_some_and(|end| end <= len);
+        let is_meta = chunk::rule(e.fourcc).is_some_and(|r| r.fourcc != chunk::CSTR);
+        if !in_bounds || !(is_meta || full) {
+            ok &= in_bounds;
+            continue;
+        }
+        let Some(bytes) = read(e.offset, e.length as usize) else {
+            issues.push(Issue::new(1001, "read failed").in_chunk(&e.name(), i).at(e.offset));
+            ok = false;
+            continue;
+        };
+        let crc = crc32fast::hash(&bytes);
+        if crc != e.crc {
+            issues.push(
+                Issue::new(3004, format!("stored {:#010x}, computed {crc:#010x}", e.crc)).in_chunk(&e.name(), i).at(e.offset),
+            );
+            ok = false;
+            continue;
+        }
+        if is_meta {
+            payloads[i] = Some(bytes);
+        }
+    }
+    out.chunks = entries;
+    if !ok || issues.iter().any(|i| i.severity == Severity::Error) {
+        return out;
+    }
+    out.container = parse(&out.chunks, &payloads, issues);
+    out
+}
+
+fn parse(entries: &[ChunkEntry], payloads: &[Option<Vec<u8>>], issues: &mut Vec<Issue>) -> Option<Container<StreamRef>> {
+    let find = |f: chunk::FourCC| entries.iter().position(|e| e.fourcc == f);
+    let cursor = |i: usize| {
+        let e = &entries[i];
+        let malformed = chunk::rule(e.fourcc).map_or(3004, |r| r.malformed);
+        Cursor::new(payloads[i].as_deref().unwrap_or(&[]), e.offset, malformed, (chunk_name(e), i))
+    };
+    fn attempt<T>(r: Result<T, Issue>, issues: &mut Vec<Issue>) -> Option<T> {
+        r.map_err(|i| issues.push(i)).ok()
+    }
+
+    let (pspc, cams, objs, layr) = (find(chunk::PSPC)?, find(chunk::CAMS)?, find(chunk::OBJS)?, find(chunk::LAYR)?);
+    let space = attempt(pr::pspc(&mut cursor(pspc)), issues)?;
+    let cameras = attempt(pr::cams(&mut cursor(cams)), issues)?;
+    let mut objects = attempt(pr::objs(&mut cursor(objs), space.dims.len()), issues)?;
+    let mut has_mesh = vec![false; objects.len()];
+    for (i, e) in entries.iter().enumerate().filter(|(_, e)| e.fourcc == chunk::MESH) {
+        let (oi, mesh) = attempt(pr::mesh(&mut cursor(i)), issues)?;
+        match has_mesh.get_mut(oi as usize) {
+            Some(seen @ false) => {
+                *seen = true;
+                objects[oi as usize].mesh = mesh;
+            }
+            _ => {
+                issues.push(
+                    Issue::new(5201, format!("names object {oi}; {} objects, this one already meshed or missing", objects.len()))
+                        .in_chunk("MESH", i)
+                        .at(e.offset),
+                );
+                return None;
+            }
+        }
+    }
+    if let Some(oi) = has_mesh.iter().position(|&m| !m) {
+        issues.push(Issue::new(5202, format!("object {oi} '{}' has no MESH chunk", objects[oi].name)));
+        return None;
+    }
+    attempt(pr::layr(&mut cursor(layr), &mut objects), issues)?;
+    let provenance = match find(chunk::PROV) {
+        Some(i) => Some(attempt(pr::prov(&mut cursor(i)), issues)?),
+        None => None,
+    };
+    let container = Container { space, cameras, objects, provenance };
+
+    let before = issues.len();
+    for mut issue in checks::check(&container) {
+        // Name the chunk's index where its type occurs once.
+        if let Some((t, idx)) = &mut issue.chunk {
+            let matches: Vec<usize> = entries.iter().enumerate().filter(|(_, e)| chunk_name(e) == t).map(|(i, _)| i).collect();
+            if matches.len() == 1 {
+                *idx = matches[0];
+            }
+        }
+        issues.push(issue);
+    }
+    stream_ranges(entries, &container, issues);
+    (issues.len() == before).then_some(container)
+}
+
+fn chunk_name(e: &ChunkEntry) -> &'static str {
+    chunk::rule(e.fourcc).map_or("????", |r| match r.fourcc {
+        chunk::PSPC => "PSPC",
+        chunk::CAMS => "CAMS",
+        chunk::OBJS => "OBJS",
+        chunk::MESH => "MESH",
+        chunk::LAYR => "LAYR",
+        chunk::CSTR => "CSTR",
+        _ => "PROV",
+    })
+}
+
+/// Rules 8001 and 8002: every reference lies inside a `CSTR` chunk.
+fn stream_ranges(entries: &[ChunkEntry], c: &Container<StreamRef>, issues: &mut Vec<Issue>) {
+    for_each_ref(c, |what, r| {
+        match entries.get(r.chunk as usize) {
+            Some(e) if e.fourcc == chunk::CSTR => {
+                if r.offset.checked_add(r.length as u64).is_none_or(|end| end > e.length) {
+                    issues.push(
+                        Issue::new(8002, format!("{what}: {} bytes at {} in a chunk of {}", r.length, r.offset, e.length))
+                            .in_chunk("LAYR", usize::MAX),
+                    );
+                }
+            }
+            _ => issues.push(Issue::new(8001, format!("{what}: chunk {}", r.chunk)).in_chunk("LAYR", usize::MAX)),
+        }
+    });
+}
+
+/// Calls `f` with a description and each codestream reference, in file order.
+pub(crate) fn for_each_ref(c: &Container<StreamRef>, mut f: impl FnMut(String, &StreamRef)) {
+    for (oi, o) in c.objects.iter().enumerate() {
+        for (li, l) in o.layers.iter().enumerate() {
+            for (bi, b) in l.blocks.iter().enumerate() {
+                for (lv, level) in b.levels.iter().enumerate() {
+                    for (ii, r) in level.images.iter().enumerate() {
+                        f(format!("object {oi} layer {li} block {bi} level {lv} image {ii}"), r);
+                    }
+                }
+            }
+        }
+    }
+}

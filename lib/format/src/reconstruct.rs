@@ -1,0 +1,62 @@
+//! The steps after the pyramid sum (SPEC.md, "Reconstructing a texture"): inverse gamma,
+//! then MIP residuals.
+
+use crate::mip::{decimate, mip_size};
+use crate::model::{Layer, MipMode};
+use crate::texture::LevelLayout;
+
+/// Turns the sum of a block's level images into linear texture values.
+pub fn finish<S>(layer: &Layer<S>, layout: &LevelLayout, mut data: Vec<f32>) -> Vec<f32> {
+    if layer.gamma != 1.0 {
+        let g = layer.gamma;
+        data.iter_mut().for_each(|v| *v = v.signum() * v.abs().powf(g));
+    }
+    if layer.mip_mode == MipMode::Stored && layout.mips > 1 {
+        let c = layout.channels;
+        let mut start = 0;
+        for _ in 0..layout.faces {
+            let (w0, h0) = (layout.width, layout.height);
+            let len0 = (w0 * h0 * c) as usize;
+            let mut decimated = data[start..start + len0].to_vec();
+            let mut offset = start + len0;
+            for m in 1..layout.mips {
+                let (w, h) = mip_size(w0, h0, m - 1);
+                decimated = decimate(&decimated, w, h, c);
+                let plane = &mut data[offset..offset + decimated.len()];
+                plane.iter_mut().zip(&decimated).for_each(|(v, d)| *v += d);
+                offset += decimated.len();
+            }
+            start = offset;
+        }
+    }
+    data
+}
+
+/// The inverse of [`finish`] for writers: linear texture values to the values a pyramid
+/// encodes (gamma applied, MIP levels below the finest as residuals).
+pub fn prepare<S>(layer: &Layer<S>, layout: &LevelLayout, linear: &[f32]) -> Vec<f32> {
+    let mut data = linear.to_vec();
+    if layer.mip_mode == MipMode::Stored && layout.mips > 1 {
+        let c = layout.channels;
+        let mut start = 0;
+        for _ in 0..layout.faces {
+            let (w0, h0) = (layout.width, layout.height);
+            let len0 = (w0 * h0 * c) as usize;
+            let mut decimated = linear[start..start + len0].to_vec();
+            let mut offset = start + len0;
+            for m in 1..layout.mips {
+                let (w, h) = mip_size(w0, h0, m - 1);
+                decimated = decimate(&decimated, w, h, c);
+                let plane = &mut data[offset..offset + decimated.len()];
+                plane.iter_mut().zip(&decimated).for_each(|(v, d)| *v -= d);
+                offset += decimated.len();
+            }
+            start = offset;
+        }
+    }
+    if layer.gamma != 1.0 {
+        let inv = 1.0 / layer.gamma;
+        data.iter_mut().for_each(|v| *v = v.signum() * v.abs().powf(inv));
+    }
+    data
+}

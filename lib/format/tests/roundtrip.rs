@@ -1,0 +1,83 @@
+//! Write → read → compare, for the built-in samples.
+
+use pis_format::samples::{minimal, tiny};
+use pis_format::*;
+
+#[test]
+fn tiny_round_trips_through_bytes() {
+    let c = tiny().unwrap();
+    let bytes = to_bytes(&c).unwrap();
+    let r = PisReader::from_bytes(bytes.clone()).unwrap();
+    assert_eq!(r.len(), bytes.len() as u64);
+    assert_eq!(r.load_all().unwrap(), c);
+    // Writing what was read gives the same bytes.
+    assert_eq!(to_bytes(&r.load_all().unwrap()).unwrap(), bytes);
+}
+
+#[test]
+fn serialization_is_deterministic() {
+    assert_eq!(to_bytes(&tiny().unwrap()).unwrap(), to_bytes(&tiny().unwrap()).unwrap());
+}
+
+#[test]
+fn tiny_textures_decode_to_what_was_encoded() {
+    let r = PisReader::from_bytes(to_bytes(&tiny().unwrap()).unwrap()).unwrap();
+    // Diffuse (layer 0) varies with the light only: a brighter light gives brighter texels.
+    let dark = r.texture(0, 0, &[0, 0]).unwrap();
+    let bright = r.texture(0, 0, &[1, 1]).unwrap();
+    assert_eq!(dark, r.texture(0, 0, &[1, 0]).unwrap(), "diffuse must not depend on the view");
+    assert_eq!(dark.layout.width, 8);
+    // Texel (0,0) is a light checker square: 0.8 × (0.5 + 0.5·light) in red.
+    assert!((dark.data[0] - 0.4).abs() < 1e-5, "{}", dark.data[0]);
+    assert!((bright.data[0] - 0.8).abs() < 1e-5, "{}", bright.data[0]);
+    // The shell (layer 1) has 6 faces with 3 MIP levels each; green encodes the view.
+    let shell = r.texture(0, 1, &[1, 0]).unwrap();
+    assert_eq!((shell.layout.faces, shell.layout.mips), (6, 3));
+    assert!((shell.plane(2, 0)[1] - 0.4).abs() < 1e-6);
+    assert!((shell.plane(5, 2)[0] - 0.5).abs() < 1e-6, "{}", shell.plane(5, 2)[0]);
+    assert!((r.texture(0, 1, &[0, 1]).unwrap().plane(0, 0)[1] - 0.3).abs() < 1e-6);
+}
+
+#[test]
+fn a_texture_reads_only_its_pyramid_path() {
+    let r = PisReader::from_bytes(to_bytes(&tiny().unwrap()).unwrap()).unwrap();
+    r.texture(0, 0, &[0, 1]).unwrap();
+    assert_eq!(r.stats().codestreams, 2, "two pyramid levels");
+    r.texture(0, 1, &[1, 1]).unwrap();
+    assert_eq!(r.stats().codestreams, 3, "one level for a one-sample block");
+}
+
+#[test]
+fn bad_requests_are_errors() {
+    let r = PisReader::from_bytes(to_bytes(&tiny().unwrap()).unwrap()).unwrap();
+    assert!(matches!(r.texture(1, 0, &[0, 0]), Err(Error::Request(_))));
+    assert!(matches!(r.texture(0, 2, &[0, 0]), Err(Error::Request(_))));
+    assert!(matches!(r.texture(0, 0, &[0, 2]), Err(Error::Request(_))));
+    assert!(matches!(r.texture(0, 0, &[0]), Err(Error::Request(_))));
+}
+
+#[test]
+fn minimal_example_round_trips() {
+    let c = minimal().unwrap();
+    let r = PisReader::from_bytes(to_bytes(&c).unwrap()).unwrap();
+    let t = r.texture(0, 0, &[1]).unwrap();
+    assert_eq!(t.data, vec![1.0, 0.5, 0.25, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.5, 0.5, 0.5]);
+}
+
+#[test]
+fn atomic_write_leaves_no_partial_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("out.pis");
+    let n = write(&path, &tiny().unwrap()).unwrap();
+    assert_eq!(std::fs::metadata(&path).unwrap().len(), n);
+    // An invalid model is refused and the existing file is untouched.
+    let mut bad = tiny().unwrap();
+    bad.space.dims[0].block_size = 0;
+    assert!(matches!(write(&path, &bad), Err(Error::InvalidModel(_))));
+    assert_eq!(std::fs::metadata(&path).unwrap().len(), n);
+    // A missing folder is an I/O error, and nothing is created.
+    let missing = dir.path().join("no/such/dir/out.pis");
+    assert!(matches!(write(&missing, &tiny().unwrap()), Err(Error::Io { .. })));
+    let names: Vec<_> = std::fs::read_dir(dir.path()).unwrap().map(|e| e.unwrap().file_name()).collect();
+    assert_eq!(names, vec![std::ffi::OsString::from("out.pis")], "no temporary file left behind");
+}
