@@ -175,7 +175,10 @@ impl Sink {
 
     pub fn f32s(&mut self, v: &[f32], label: &str) {
         let b: Vec<u8> = v.iter().flat_map(|x| x.to_le_bytes()).collect();
-        self.raw(&b, || format!("{label} = {v:?}"));
+        self.raw(&b, || match v {
+            [one] => format!("{label} = {one:?}"),
+            _ => format!("{label} = {v:?}"),
+        });
     }
 
     pub fn zeros(&mut self, n: usize, label: &str) {

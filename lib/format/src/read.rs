@@ -187,6 +187,12 @@ impl PisReader {
                         .in_chunk("CSTR", r.chunk as usize),
                 ),
             })?;
+            if let Some(bad) = values.iter().position(|v| !v.is_finite()) {
+                return Err(Error::Invalid(
+                    Issue::new(8006, format!("object {object} layer {layer} block {bi} level {lv}: value {bad} is {}", values[bad]))
+                        .in_chunk("CSTR", r.chunk as usize),
+                ));
+            }
             match &mut sum {
                 None => sum = Some(values),
                 Some(acc) => acc.iter_mut().zip(&values).for_each(|(a, v)| *a += v),
