@@ -32,7 +32,12 @@ pub enum CodecId {
 }
 
 impl CodecId {
-    pub const ALL: [CodecId; 4] = [CodecId::Raw, CodecId::Lossless, CodecId::Wavelet, CodecId::Dct];
+    pub const ALL: [CodecId; 4] = [
+        CodecId::Raw,
+        CodecId::Lossless,
+        CodecId::Wavelet,
+        CodecId::Dct,
+    ];
 
     /// The id stored in the file.
     pub fn code(self) -> u16 {
@@ -70,10 +75,17 @@ impl std::fmt::Display for CodecId {
 }
 
 /// Encodes `values` (the concatenated planes) with `codec`.
-pub fn encode(codec: CodecId, planes: &[PlaneShape], values: &[f32]) -> Result<Vec<u8>, CodecError> {
+pub fn encode(
+    codec: CodecId,
+    planes: &[PlaneShape],
+    values: &[f32],
+) -> Result<Vec<u8>, CodecError> {
     let n = value_count(planes)?;
     if values.len() != n {
-        return Err(CodecError::Length { expected: n, found: values.len() });
+        return Err(CodecError::Length {
+            expected: n,
+            found: values.len(),
+        });
     }
     match codec {
         CodecId::Raw => Ok(raw::encode(values)),

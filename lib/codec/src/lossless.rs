@@ -19,7 +19,11 @@ pub fn encode(planes: &[PlaneShape], values: &[f32]) -> Vec<u8> {
     let mut start = 0;
     for p in planes {
         let len = (p.width * p.height * p.channels) as usize;
-        predict(p, &values[start..start + len], &mut residual[start..start + len]);
+        predict(
+            p,
+            &values[start..start + len],
+            &mut residual[start..start + len],
+        );
         start += len;
     }
     let mut shuffled = vec![0u8; 4 * n];
@@ -60,13 +64,22 @@ pub fn decode(planes: &[PlaneShape], n: usize, bytes: &[u8]) -> Result<Vec<f32>,
     // Grow with the data actually inflated: a forged shape cannot force a large allocation.
     let mut shuffled = Vec::new();
     let mut dec = DeflateDecoder::new(bytes).take(expected as u64 + 1);
-    dec.read_to_end(&mut shuffled).map_err(|e| CodecError::Corrupt(e.to_string()))?;
+    dec.read_to_end(&mut shuffled)
+        .map_err(|e| CodecError::Corrupt(e.to_string()))?;
     if shuffled.len() != expected {
-        return Err(CodecError::DecodedLength { expected, found: shuffled.len() });
+        return Err(CodecError::DecodedLength {
+            expected,
+            found: shuffled.len(),
+        });
     }
     let mut bits = vec![0u32; n];
     for (i, b) in bits.iter_mut().enumerate() {
-        *b = u32::from_be_bytes([shuffled[i], shuffled[n + i], shuffled[2 * n + i], shuffled[3 * n + i]]);
+        *b = u32::from_be_bytes([
+            shuffled[i],
+            shuffled[n + i],
+            shuffled[2 * n + i],
+            shuffled[3 * n + i],
+        ]);
     }
     let mut start = 0;
     for p in planes {

@@ -1,12 +1,18 @@
 use super::*;
 
 fn planes() -> Vec<PlaneShape> {
-    vec![PlaneShape::new(5, 3, 3), PlaneShape::new(3, 2, 4), PlaneShape::new(1, 1, 1)]
+    vec![
+        PlaneShape::new(5, 3, 3),
+        PlaneShape::new(3, 2, 4),
+        PlaneShape::new(1, 1, 1),
+    ]
 }
 
 fn values(n: usize) -> Vec<f32> {
     // Smooth data with a few special bit patterns that a lossy path would not keep.
-    let mut v: Vec<f32> = (0..n).map(|i| (i as f32 * 0.37).sin() * 3.0 + 0.25).collect();
+    let mut v: Vec<f32> = (0..n)
+        .map(|i| (i as f32 * 0.37).sin() * 3.0 + 0.25)
+        .collect();
     v[1] = -0.0;
     v[4] = f32::MIN_POSITIVE / 8.0; // subnormal
     v[7] = 1.0e30;
@@ -27,9 +33,16 @@ fn lossless_round_trips_every_bit() {
 #[test]
 fn lossless_compresses_smooth_data() {
     let p = [PlaneShape::new(64, 64, 3)];
-    let v: Vec<f32> = (0..64 * 64 * 3).map(|i| ((i / 3) % 64) as f32 / 64.0).collect();
+    let v: Vec<f32> = (0..64 * 64 * 3)
+        .map(|i| ((i / 3) % 64) as f32 / 64.0)
+        .collect();
     let bytes = encode(CodecId::Lossless, &p, &v).unwrap();
-    assert!(bytes.len() * 4 < v.len() * 4, "{} bytes for {} values", bytes.len(), v.len());
+    assert!(
+        bytes.len() * 4 < v.len() * 4,
+        "{} bytes for {} values",
+        bytes.len(),
+        v.len()
+    );
 }
 
 #[test]
@@ -39,7 +52,10 @@ fn raw_round_trips_and_checks_length() {
     let bytes = encode(CodecId::Raw, &p, &v).unwrap();
     assert_eq!(bytes.len(), v.len() * 4);
     assert_eq!(decode(CodecId::Raw, &p, &bytes).unwrap(), v);
-    assert!(matches!(decode(CodecId::Raw, &p, &bytes[1..]), Err(CodecError::DecodedLength { .. })));
+    assert!(matches!(
+        decode(CodecId::Raw, &p, &bytes[1..]),
+        Err(CodecError::DecodedLength { .. })
+    ));
 }
 
 #[test]
@@ -48,11 +64,17 @@ fn lossless_rejects_damaged_streams() {
     let v = values(value_count(&p).unwrap());
     let bytes = encode(CodecId::Lossless, &p, &v).unwrap();
     for cut in 0..bytes.len() {
-        assert!(decode(CodecId::Lossless, &p, &bytes[..cut]).is_err(), "truncated at {cut}");
+        assert!(
+            decode(CodecId::Lossless, &p, &bytes[..cut]).is_err(),
+            "truncated at {cut}"
+        );
     }
     // A stream for other shapes decodes to the wrong length.
     let small = [PlaneShape::new(2, 2, 1)];
-    assert!(matches!(decode(CodecId::Lossless, &small, &bytes), Err(CodecError::DecodedLength { .. })));
+    assert!(matches!(
+        decode(CodecId::Lossless, &small, &bytes),
+        Err(CodecError::DecodedLength { .. })
+    ));
 }
 
 #[test]
@@ -70,7 +92,13 @@ fn shapes_are_checked() {
     assert!(value_count(&[PlaneShape::new(0, 4, 3)]).is_err());
     assert!(value_count(&[PlaneShape::new(4, 4, 5)]).is_err());
     assert!(value_count(&[PlaneShape::new(u32::MAX, u32::MAX, 4); 8]).is_err());
-    assert_eq!(encode(CodecId::Raw, &[PlaneShape::new(2, 1, 1)], &[1.0]), Err(CodecError::Length { expected: 2, found: 1 }));
+    assert_eq!(
+        encode(CodecId::Raw, &[PlaneShape::new(2, 1, 1)], &[1.0]),
+        Err(CodecError::Length {
+            expected: 2,
+            found: 1
+        })
+    );
 }
 
 #[test]

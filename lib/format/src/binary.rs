@@ -17,7 +17,13 @@ pub struct Cursor<'a> {
 
 impl<'a> Cursor<'a> {
     pub fn new(data: &'a [u8], base: u64, malformed: u16, chunk: (&'a str, usize)) -> Self {
-        Cursor { data, pos: 0, base, malformed, chunk }
+        Cursor {
+            data,
+            pos: 0,
+            base,
+            malformed,
+            chunk,
+        }
     }
 
     /// Absolute file offset of the next byte.
@@ -31,14 +37,19 @@ impl<'a> Cursor<'a> {
 
     /// An issue located at the cursor.
     pub fn issue(&self, id: u16, detail: impl Into<String>) -> Issue {
-        Issue::new(id, detail).in_chunk(self.chunk.0, self.chunk.1).at(self.offset())
+        Issue::new(id, detail)
+            .in_chunk(self.chunk.0, self.chunk.1)
+            .at(self.offset())
     }
 
     fn take(&mut self, n: usize, what: &str) -> Result<&'a [u8], Issue> {
         if self.remaining() < n {
             return Err(self.issue(
                 self.malformed,
-                format!("payload ends after {} bytes; {what} needs {n} more", self.pos + self.remaining()),
+                format!(
+                    "payload ends after {} bytes; {what} needs {n} more",
+                    self.pos + self.remaining()
+                ),
             ));
         }
         let s = &self.data[self.pos..self.pos + n];
@@ -82,9 +93,11 @@ impl<'a> Cursor<'a> {
         let at = self.offset();
         let b = self.take(bytes, what)?;
         if b.iter().any(|&x| x != 0) {
-            return Err(Issue::new(3006, format!("{what} must be 0, found {b:02x?}"))
-                .in_chunk(self.chunk.0, self.chunk.1)
-                .at(at));
+            return Err(
+                Issue::new(3006, format!("{what} must be 0, found {b:02x?}"))
+                    .in_chunk(self.chunk.0, self.chunk.1)
+                    .at(at),
+            );
         }
         Ok(())
     }
@@ -95,7 +108,9 @@ impl<'a> Cursor<'a> {
         let at = self.offset();
         let b = self.take(n, what)?;
         String::from_utf8(b.to_vec()).map_err(|_| {
-            Issue::new(id, format!("{what} is not UTF-8")).in_chunk(self.chunk.0, self.chunk.1).at(at)
+            Issue::new(id, format!("{what} is not UTF-8"))
+                .in_chunk(self.chunk.0, self.chunk.1)
+                .at(at)
         })
     }
 
@@ -106,7 +121,10 @@ impl<'a> Cursor<'a> {
             Some(n) if n <= self.remaining() as u64 => Ok(count as usize),
             _ => Err(self.issue(
                 self.malformed,
-                format!("{count} {what} of {size} bytes do not fit in the {} bytes left", self.remaining()),
+                format!(
+                    "{count} {what} of {size} bytes do not fit in the {} bytes left",
+                    self.remaining()
+                ),
             )),
         }
     }
@@ -114,7 +132,10 @@ impl<'a> Cursor<'a> {
     /// The payload must end here.
     pub fn finish(&self) -> Result<(), Issue> {
         if self.remaining() != 0 {
-            return Err(self.issue(self.malformed, format!("{} bytes after the last field", self.remaining())));
+            return Err(self.issue(
+                self.malformed,
+                format!("{} bytes after the last field", self.remaining()),
+            ));
         }
         Ok(())
     }
@@ -137,7 +158,10 @@ pub struct Sink {
 
 impl Sink {
     pub fn new(labelled: bool) -> Self {
-        Sink { bytes: Vec::new(), spans: labelled.then(Vec::new) }
+        Sink {
+            bytes: Vec::new(),
+            spans: labelled.then(Vec::new),
+        }
     }
 
     pub fn len(&self) -> usize {
@@ -147,7 +171,11 @@ impl Sink {
     pub fn raw(&mut self, b: &[u8], label: impl FnOnce() -> String) {
         if let Some(spans) = &mut self.spans {
             if !b.is_empty() {
-                spans.push(Span { start: self.bytes.len(), len: b.len(), label: label() });
+                spans.push(Span {
+                    start: self.bytes.len(),
+                    len: b.len(),
+                    label: label(),
+                });
             }
         }
         self.bytes.extend_from_slice(b);
@@ -203,7 +231,10 @@ impl Sink {
     pub fn append(&mut self, other: Sink) {
         let base = self.bytes.len();
         if let (Some(mine), Some(theirs)) = (&mut self.spans, other.spans) {
-            mine.extend(theirs.into_iter().map(|s| Span { start: s.start + base, ..s }));
+            mine.extend(theirs.into_iter().map(|s| Span {
+                start: s.start + base,
+                ..s
+            }));
         }
         self.bytes.extend_from_slice(&other.bytes);
     }

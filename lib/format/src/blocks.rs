@@ -52,7 +52,12 @@ impl BlockGrid {
             .dims()
             .map(|k| {
                 let d = &space.dims[k];
-                Axis { dim: k, n: d.values.len() as u32, size: d.block_size, offset: stagger[k] }
+                Axis {
+                    dim: k,
+                    n: d.values.len() as u32,
+                    size: d.block_size,
+                    offset: stagger[k],
+                }
             })
             .collect();
         BlockGrid { axes }
@@ -71,7 +76,14 @@ impl BlockGrid {
     /// The extent (samples per masked dimension) of block `block`.
     pub fn extent(&self, block: usize) -> Vec<u32> {
         let coords = self.block_coords(block);
-        self.axes.iter().zip(coords).map(|(a, j)| { let (lo, hi) = a.range(j); hi - lo }).collect()
+        self.axes
+            .iter()
+            .zip(coords)
+            .map(|(a, j)| {
+                let (lo, hi) = a.range(j);
+                hi - lo
+            })
+            .collect()
     }
 
     fn block_coords(&self, mut block: usize) -> Vec<u32> {
@@ -97,7 +109,11 @@ impl BlockGrid {
             local.push(s - lo);
             extent.push(hi - lo);
         }
-        BlockPosition { block, local, extent }
+        BlockPosition {
+            block,
+            local,
+            extent,
+        }
     }
 }
 
@@ -157,9 +173,30 @@ mod tests {
         // Offset 3: blocks [0,5) [5,13) [13,19).
         let g = BlockGrid::new(&s, DepMask::of(&[0]), &[3]);
         assert_eq!(g.block_count(), 3);
-        assert_eq!(g.locate(&[4]), BlockPosition { block: 0, local: vec![4], extent: vec![5] });
-        assert_eq!(g.locate(&[5]), BlockPosition { block: 1, local: vec![0], extent: vec![8] });
-        assert_eq!(g.locate(&[18]), BlockPosition { block: 2, local: vec![5], extent: vec![6] });
+        assert_eq!(
+            g.locate(&[4]),
+            BlockPosition {
+                block: 0,
+                local: vec![4],
+                extent: vec![5]
+            }
+        );
+        assert_eq!(
+            g.locate(&[5]),
+            BlockPosition {
+                block: 1,
+                local: vec![0],
+                extent: vec![8]
+            }
+        );
+        assert_eq!(
+            g.locate(&[18]),
+            BlockPosition {
+                block: 2,
+                local: vec![5],
+                extent: vec![6]
+            }
+        );
     }
 
     #[test]

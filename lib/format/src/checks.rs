@@ -32,7 +32,10 @@ pub fn check<S>(c: &Container<S>) -> Vec<Issue> {
 
 fn chunk(i: Issue, fourcc: &str) -> Issue {
     // Chunk indices follow the writer's order; the reader re-tags with the real index.
-    Issue { chunk: Some((fourcc.to_string(), usize::MAX)), ..i }
+    Issue {
+        chunk: Some((fourcc.to_string(), usize::MAX)),
+        ..i
+    }
 }
 
 fn space(s: &ParameterSpace, out: &mut Vec<Issue>) {
@@ -45,19 +48,34 @@ fn space(s: &ParameterSpace, out: &mut Vec<Issue>) {
     let mut names = HashSet::new();
     for (k, d) in s.dims.iter().enumerate() {
         if d.name.is_empty() || !names.insert(d.name.as_str()) {
-            out.push(e(4002, format!("dimension {k} name {:?} is empty or repeated", d.name)));
+            out.push(e(
+                4002,
+                format!("dimension {k} name {:?} is empty or repeated", d.name),
+            ));
         }
         if d.values.is_empty() {
-            out.push(e(4004, format!("dimension {k} '{}' has no samples", d.name)));
+            out.push(e(
+                4004,
+                format!("dimension {k} '{}' has no samples", d.name),
+            ));
         }
         if d.block_size == 0 {
-            out.push(e(4005, format!("dimension {k} '{}' has block size 0", d.name)));
+            out.push(e(
+                4005,
+                format!("dimension {k} '{}' has block size 0", d.name),
+            ));
         }
         if d.values.iter().any(|v| !v.is_finite()) || d.values.windows(2).any(|w| w[1] <= w[0]) {
-            out.push(e(4006, format!("dimension {k} '{}' values {:?}", d.name, d.values)));
+            out.push(e(
+                4006,
+                format!("dimension {k} '{}' values {:?}", d.name, d.values),
+            ));
         }
     }
-    let points = s.dims.iter().try_fold(1u64, |p, d| p.checked_mul(d.values.len() as u64));
+    let points = s
+        .dims
+        .iter()
+        .try_fold(1u64, |p, d| p.checked_mul(d.values.len() as u64));
     if points.is_none_or(|p| p > MAX_POINTS) {
         out.push(e(4007, format!("more than {MAX_POINTS} points")));
     }
@@ -68,17 +86,34 @@ fn mask_ok(s: &ParameterSpace, mask: DepMask) -> bool {
 }
 
 /// Checks a table's mask and length (rules 5002 and 5001).
-fn table(s: &ParameterSpace, mask: DepMask, len: usize, what: &str, fourcc: &str, out: &mut Vec<Issue>) -> bool {
+fn table(
+    s: &ParameterSpace,
+    mask: DepMask,
+    len: usize,
+    what: &str,
+    fourcc: &str,
+    out: &mut Vec<Issue>,
+) -> bool {
     if !mask_ok(s, mask) {
         out.push(chunk(
-            Issue::new(5002, format!("{what} mask {:#x}, the space has {} dimensions", mask.0, s.dims.len())),
+            Issue::new(
+                5002,
+                format!(
+                    "{what} mask {:#x}, the space has {} dimensions",
+                    mask.0,
+                    s.dims.len()
+                ),
+            ),
             fourcc,
         ));
         return false;
     }
     let expected = s.table_len(mask);
     if len as u64 != expected {
-        out.push(chunk(Issue::new(5001, format!("{what}: {len} entries, expected {expected}")), fourcc));
+        out.push(chunk(
+            Issue::new(5001, format!("{what}: {len} entries, expected {expected}")),
+            fourcc,
+        ));
         return false;
     }
     true
@@ -93,18 +128,37 @@ fn rigid(m: &[f32; 12]) -> bool {
     let r = |i: usize| [m[4 * i] as f64, m[4 * i + 1] as f64, m[4 * i + 2] as f64];
     let dot = |a: [f64; 3], b: [f64; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
     let (a, b, c) = (r(0), r(1), r(2));
-    let det = a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0]) + a[2] * (b[0] * c[1] - b[1] * c[0]);
+    let det = a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0])
+        + a[2] * (b[0] * c[1] - b[1] * c[0]);
     let ok = |x: f64, want: f64| (x - want).abs() < 1e-3;
-    ok(dot(a, a), 1.0) && ok(dot(b, b), 1.0) && ok(dot(c, c), 1.0) && ok(dot(a, b), 0.0) && ok(dot(a, c), 0.0)
-        && ok(dot(b, c), 0.0) && ok(det, 1.0)
+    ok(dot(a, a), 1.0)
+        && ok(dot(b, b), 1.0)
+        && ok(dot(c, c), 1.0)
+        && ok(dot(a, b), 0.0)
+        && ok(dot(a, c), 0.0)
+        && ok(dot(b, c), 0.0)
+        && ok(det, 1.0)
 }
 
 fn cameras(s: &ParameterSpace, t: &CameraTable, out: &mut Vec<Issue>) {
     let e = |id, d: String| chunk(Issue::new(id, d), "CAMS");
     if t.width == 0 || t.height == 0 || t.width > MAX_IMAGE_SIDE || t.height > MAX_IMAGE_SIDE {
-        out.push(e(5004, format!("{}×{} pixels, each side must be 1 to {MAX_IMAGE_SIDE}", t.width, t.height)));
+        out.push(e(
+            5004,
+            format!(
+                "{}×{} pixels, each side must be 1 to {MAX_IMAGE_SIDE}",
+                t.width, t.height
+            ),
+        ));
     }
-    table(s, t.depends_on, t.cameras.len(), "camera table", "CAMS", out);
+    table(
+        s,
+        t.depends_on,
+        t.cameras.len(),
+        "camera table",
+        "CAMS",
+        out,
+    );
     for (i, c) in t.cameras.iter().enumerate() {
         let ok = finite(&c.world_from_camera)
             && rigid(&c.world_from_camera)
@@ -125,17 +179,26 @@ fn objects<S>(c: &Container<S>, out: &mut Vec<Issue>) {
     let s = &c.space;
     let n = c.objects.len();
     if n == 0 || n > 65535 {
-        out.push(chunk(Issue::new(5101, format!("{n} objects, expected 1 to 65535")), "OBJS"));
+        out.push(chunk(
+            Issue::new(5101, format!("{n} objects, expected 1 to 65535")),
+            "OBJS",
+        ));
     }
     let mut names = HashSet::new();
     for (oi, o) in c.objects.iter().enumerate() {
-        let e = |id, d: String| chunk(Issue::new(id, format!("object {oi} '{}': {d}", o.name)), "OBJS");
+        let e = |id, d: String| {
+            chunk(
+                Issue::new(id, format!("object {oi} '{}': {d}", o.name)),
+                "OBJS",
+            )
+        };
         if o.name.is_empty() || !names.insert(o.name.as_str()) {
             out.push(e(5102, "name is empty or repeated".into()));
         }
         let sh = &o.shading;
         let unit = |v: f32| v.is_finite() && (0.0..=1.0).contains(&v);
-        if !sh.f0.iter().all(|&v| unit(v)) || !(sh.ior.is_finite() && sh.ior >= 1.0)
+        if !sh.f0.iter().all(|&v| unit(v))
+            || !(sh.ior.is_finite() && sh.ior >= 1.0)
             || !sh.absorption.iter().all(|v| v.is_finite() && *v >= 0.0)
         {
             out.push(e(5104, format!("{sh:?}")));
@@ -143,14 +206,30 @@ fn objects<S>(c: &Container<S>, out: &mut Vec<Issue>) {
         let mut stagger_ok = o.stagger.len() == s.dims.len();
         for (k, (&off, d)) in o.stagger.iter().zip(&s.dims).enumerate() {
             if off >= d.block_size {
-                out.push(e(5105, format!("offset {off} along dimension {k} with block size {}", d.block_size)));
+                out.push(e(
+                    5105,
+                    format!(
+                        "offset {off} along dimension {k} with block size {}",
+                        d.block_size
+                    ),
+                ));
                 stagger_ok = false;
             }
         }
-        if table(s, o.transforms.depends_on, o.transforms.transforms.len(), &format!("object {oi} transforms"), "OBJS", out) {
+        if table(
+            s,
+            o.transforms.depends_on,
+            o.transforms.transforms.len(),
+            &format!("object {oi} transforms"),
+            "OBJS",
+            out,
+        ) {
             for (t, m) in o.transforms.transforms.iter().enumerate() {
                 if !finite(m) || !rigid(m) {
-                    out.push(e(5106, format!("transform {t} is not a finite rigid transform: {m:?}")));
+                    out.push(e(
+                        5106,
+                        format!("transform {t} is not a finite rigid transform: {m:?}"),
+                    ));
                 }
             }
         }
@@ -162,7 +241,12 @@ fn objects<S>(c: &Container<S>, out: &mut Vec<Issue>) {
 }
 
 fn mesh<S>(oi: usize, o: &Object<S>, out: &mut Vec<Issue>) {
-    let e = |id, d: String| chunk(Issue::new(id, format!("mesh of object {oi} '{}': {d}", o.name)), "MESH");
+    let e = |id, d: String| {
+        chunk(
+            Issue::new(id, format!("mesh of object {oi} '{}': {d}", o.name)),
+            "MESH",
+        )
+    };
     let m = &o.mesh;
     if m.positions.is_empty() {
         out.push(e(5202, "no vertices".into()));
@@ -171,16 +255,39 @@ fn mesh<S>(oi: usize, o: &Object<S>, out: &mut Vec<Issue>) {
     if m.indices.is_empty() || m.indices.len() % 3 != 0 {
         out.push(e(5203, format!("{} indices", m.indices.len())));
     }
-    if let Some(i) = m.indices.iter().position(|&i| i as usize >= m.positions.len()) {
-        out.push(e(5204, format!("index {i} is {}, there are {} vertices", m.indices[i], m.positions.len())));
+    if let Some(i) = m
+        .indices
+        .iter()
+        .position(|&i| i as usize >= m.positions.len())
+    {
+        out.push(e(
+            5204,
+            format!(
+                "index {i} is {}, there are {} vertices",
+                m.indices[i],
+                m.positions.len()
+            ),
+        ));
     }
     let all_finite = m.positions.iter().all(|p| finite(p))
-        && m.normals.as_ref().is_none_or(|n| n.iter().all(|p| finite(p)))
-        && m.texcoords.as_ref().is_none_or(|t| t.iter().all(|p| finite(p)));
-    let lengths = m.normals.as_ref().is_none_or(|n| n.len() == m.positions.len())
-        && m.texcoords.as_ref().is_none_or(|t| t.len() == m.positions.len());
+        && m.normals
+            .as_ref()
+            .is_none_or(|n| n.iter().all(|p| finite(p)))
+        && m.texcoords
+            .as_ref()
+            .is_none_or(|t| t.iter().all(|p| finite(p)));
+    let lengths = m
+        .normals
+        .as_ref()
+        .is_none_or(|n| n.len() == m.positions.len())
+        && m.texcoords
+            .as_ref()
+            .is_none_or(|t| t.len() == m.positions.len());
     if !all_finite || !lengths {
-        out.push(e(5205, "non-finite values, or attribute arrays of unequal length".into()));
+        out.push(e(
+            5205,
+            "non-finite values, or attribute arrays of unequal length".into(),
+        ));
     }
 }
 
@@ -188,7 +295,17 @@ fn layers<S>(s: &ParameterSpace, oi: usize, o: &Object<S>, out: &mut Vec<Issue>)
     let mut slots = HashSet::new();
     for (li, l) in o.layers.iter().enumerate() {
         let e = |id, d: String| {
-            chunk(Issue::new(id, format!("object {oi} '{}' layer {li} ({}): {d}", o.name, l.kind.name())), "LAYR")
+            chunk(
+                Issue::new(
+                    id,
+                    format!(
+                        "object {oi} '{}' layer {li} ({}): {d}",
+                        o.name,
+                        l.kind.name()
+                    ),
+                ),
+                "LAYR",
+            )
         };
         let surface = l.mapping == Mapping::Surface;
         let combo = if surface {
@@ -217,23 +334,44 @@ fn layers<S>(s: &ParameterSpace, oi: usize, o: &Object<S>, out: &mut Vec<Issue>)
                     l.combine.name(),
                     l.channels,
                     o.role.name(),
-                    if surface && o.mesh.texcoords.is_none() { " whose mesh has no texcoords" } else { "" }
+                    if surface && o.mesh.texcoords.is_none() {
+                        " whose mesh has no texcoords"
+                    } else {
+                        ""
+                    }
                 ),
             ));
         }
         if !slots.insert((l.term as u8, l.order)) {
-            out.push(e(6008, format!("term {} order {} is already used", l.term.name(), l.order)));
+            out.push(e(
+                6008,
+                format!("term {} order {} is already used", l.term.name(), l.order),
+            ));
         }
         if !(l.gamma.is_finite() && l.gamma > 0.0) {
             out.push(e(6004, format!("gamma {}", l.gamma)));
         }
         if !mask_ok(s, l.depends_on) {
-            out.push(e(5002, format!("mask {:#x}, the space has {} dimensions", l.depends_on.0, s.dims.len())));
+            out.push(e(
+                5002,
+                format!(
+                    "mask {:#x}, the space has {} dimensions",
+                    l.depends_on.0,
+                    s.dims.len()
+                ),
+            ));
             continue;
         }
         let grid = BlockGrid::new(s, l.depends_on, &o.stagger);
         if l.blocks.len() as u64 != grid.block_count() {
-            out.push(e(6005, format!("{} blocks, the grid has {}", l.blocks.len(), grid.block_count())));
+            out.push(e(
+                6005,
+                format!(
+                    "{} blocks, the grid has {}",
+                    l.blocks.len(),
+                    grid.block_count()
+                ),
+            ));
             continue;
         }
         for (bi, b) in l.blocks.iter().enumerate() {
@@ -242,13 +380,23 @@ fn layers<S>(s: &ParameterSpace, oi: usize, o: &Object<S>, out: &mut Vec<Issue>)
                 Placement::Shell { shape, .. } => shape == ShellShape::Quad || b.width == b.height,
                 Placement::Surface { .. } => true,
             };
-            if b.width == 0 || b.height == 0 || b.width > MAX_TEXTURE_SIDE || b.height > MAX_TEXTURE_SIDE || !square {
+            if b.width == 0
+                || b.height == 0
+                || b.width > MAX_TEXTURE_SIDE
+                || b.height > MAX_TEXTURE_SIDE
+                || !square
+            {
                 out.push(e(6006, format!("{}×{} texels", b.width, b.height)));
             }
             if let Some(why) = placement(&b.placement, l.mapping) {
                 out.push(e(6007, why));
             }
-            pyramid(&grid.extent(bi), l.depends_on.count(), &b.levels, &mut |id, d| out.push(e(id, d)));
+            pyramid(
+                &grid.extent(bi),
+                l.depends_on.count(),
+                &b.levels,
+                &mut |id, d| out.push(e(id, d)),
+            );
         }
     }
 }
@@ -257,41 +405,76 @@ fn placement(p: &Placement, mapping: Mapping) -> Option<String> {
     match (p, mapping) {
         (Placement::Surface { affine }, Mapping::Surface) => {
             let det = affine[0] * affine[3] - affine[1] * affine[2];
-            (!finite(affine) || det == 0.0 || !det.is_finite()).then(|| format!("affine {affine:?} is not invertible"))
+            (!finite(affine) || det == 0.0 || !det.is_finite())
+                .then(|| format!("affine {affine:?} is not invertible"))
         }
-        (Placement::Shell { shape, origin, params }, Mapping::Shell) => {
+        (
+            Placement::Shell {
+                shape,
+                origin,
+                params,
+            },
+            Mapping::Shell,
+        ) => {
             if !finite(origin) || !finite(params) {
                 return Some(format!("{} with non-finite values", shape.name()));
             }
             let p = params;
             let ok = match shape {
                 ShellShape::Sphere => p[0] > 0.0 && p[1..].iter().all(|&v| v == 0.0),
-                ShellShape::Ellipsoid => p[..3].iter().all(|&v| v > 0.0) && p[3..].iter().all(|&v| v == 0.0),
+                ShellShape::Ellipsoid => {
+                    p[..3].iter().all(|&v| v > 0.0) && p[3..].iter().all(|&v| v == 0.0)
+                }
                 ShellShape::Box => (0..3).all(|k| p[k] < origin[k] && origin[k] < p[k + 3]),
-                ShellShape::Cylinder => p[0] > 0.0 && p[1] < p[2] && p[3..].iter().all(|&v| v == 0.0),
+                ShellShape::Cylinder => {
+                    p[0] > 0.0 && p[1] < p[2] && p[3..].iter().all(|&v| v == 0.0)
+                }
                 ShellShape::Quad => {
                     let (u, v) = ([p[0], p[1], p[2]], [p[3], p[4], p[5]]);
-                    let c = [u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]];
+                    let c = [
+                        u[1] * v[2] - u[2] * v[1],
+                        u[2] * v[0] - u[0] * v[2],
+                        u[0] * v[1] - u[1] * v[0],
+                    ];
                     c.iter().any(|&x| x != 0.0)
                 }
             };
-            (!ok).then(|| format!("{} parameters {params:?} with origin {origin:?}", shape.name()))
+            (!ok).then(|| {
+                format!(
+                    "{} parameters {params:?} with origin {origin:?}",
+                    shape.name()
+                )
+            })
         }
-        (Placement::Surface { .. }, Mapping::Shell) => Some("a shell layer's block has no shell shape".into()),
-        (Placement::Shell { .. }, Mapping::Surface) => Some("a surface layer's block has a shell shape".into()),
+        (Placement::Surface { .. }, Mapping::Shell) => {
+            Some("a shell layer's block has no shell shape".into())
+        }
+        (Placement::Shell { .. }, Mapping::Surface) => {
+            Some("a surface layer's block has a shell shape".into())
+        }
     }
 }
 
 /// Rules 7001–7004 for one block's levels.
 fn pyramid<S>(extent: &[u32], dims: usize, levels: &[Level<S>], push: &mut dyn FnMut(u16, String)) {
     if levels.is_empty() || levels.len() > MAX_LEVELS {
-        push(7001, format!("{} levels, expected 1 to {MAX_LEVELS}", levels.len()));
+        push(
+            7001,
+            format!("{} levels, expected 1 to {MAX_LEVELS}", levels.len()),
+        );
         return;
     }
     for (lv, level) in levels.iter().enumerate() {
         let images: u64 = level.counts.iter().map(|&c| c as u64).product();
         if level.counts.len() != dims || level.images.len() as u64 != images {
-            push(7003, format!("level {lv} has {} counts and {} images", level.counts.len(), level.images.len()));
+            push(
+                7003,
+                format!(
+                    "level {lv} has {} counts and {} images",
+                    level.counts.len(),
+                    level.images.len()
+                ),
+            );
             return;
         }
     }
@@ -301,16 +484,38 @@ fn pyramid<S>(extent: &[u32], dims: usize, levels: &[Level<S>], push: &mut dyn F
     for (lv, w) in levels.windows(2).enumerate() {
         let bad = w[0].counts.iter().zip(&w[1].counts).any(|(a, b)| b < a);
         if bad {
-            push(7003, format!("level {} counts {:?} after {:?}", lv + 1, w[1].counts, w[0].counts));
+            push(
+                7003,
+                format!(
+                    "level {} counts {:?} after {:?}",
+                    lv + 1,
+                    w[1].counts,
+                    w[0].counts
+                ),
+            );
         }
     }
     for (lv, level) in levels.iter().enumerate() {
-        if level.counts.iter().zip(extent).any(|(&c, &e)| c == 0 || c > e) {
-            push(7003, format!("level {lv} counts {:?} for block extent {extent:?}", level.counts));
+        if level
+            .counts
+            .iter()
+            .zip(extent)
+            .any(|(&c, &e)| c == 0 || c > e)
+        {
+            push(
+                7003,
+                format!(
+                    "level {lv} counts {:?} for block extent {extent:?}",
+                    level.counts
+                ),
+            );
         }
     }
     let last = &levels[levels.len() - 1].counts;
     if last.as_slice() != extent {
-        push(7004, format!("finest level counts {last:?}, block extent {extent:?}"));
+        push(
+            7004,
+            format!("finest level counts {last:?}, block extent {extent:?}"),
+        );
     }
 }

@@ -37,13 +37,55 @@ pub struct ChunkRule {
 }
 
 pub const KNOWN: [ChunkRule; 7] = [
-    ChunkRule { fourcc: PSPC, required: true, min: 1, max: Some(1), malformed: 4000 },
-    ChunkRule { fourcc: CAMS, required: true, min: 1, max: Some(1), malformed: 5000 },
-    ChunkRule { fourcc: OBJS, required: true, min: 1, max: Some(1), malformed: 5100 },
-    ChunkRule { fourcc: MESH, required: true, min: 1, max: None, malformed: 5200 },
-    ChunkRule { fourcc: LAYR, required: true, min: 1, max: Some(1), malformed: 6000 },
-    ChunkRule { fourcc: CSTR, required: true, min: 0, max: None, malformed: 8002 },
-    ChunkRule { fourcc: PROV, required: false, min: 0, max: Some(1), malformed: 9000 },
+    ChunkRule {
+        fourcc: PSPC,
+        required: true,
+        min: 1,
+        max: Some(1),
+        malformed: 4000,
+    },
+    ChunkRule {
+        fourcc: CAMS,
+        required: true,
+        min: 1,
+        max: Some(1),
+        malformed: 5000,
+    },
+    ChunkRule {
+        fourcc: OBJS,
+        required: true,
+        min: 1,
+        max: Some(1),
+        malformed: 5100,
+    },
+    ChunkRule {
+        fourcc: MESH,
+        required: true,
+        min: 1,
+        max: None,
+        malformed: 5200,
+    },
+    ChunkRule {
+        fourcc: LAYR,
+        required: true,
+        min: 1,
+        max: Some(1),
+        malformed: 6000,
+    },
+    ChunkRule {
+        fourcc: CSTR,
+        required: true,
+        min: 0,
+        max: None,
+        malformed: 8002,
+    },
+    ChunkRule {
+        fourcc: PROV,
+        required: false,
+        min: 0,
+        max: Some(1),
+        malformed: 9000,
+    },
 ];
 
 pub fn rule(fourcc: FourCC) -> Option<&'static ChunkRule> {
@@ -52,7 +94,15 @@ pub fn rule(fourcc: FourCC) -> Option<&'static ChunkRule> {
 
 /// The chunk type as text (non-printable bytes escaped).
 pub fn fourcc_str(f: FourCC) -> String {
-    f.iter().map(|&b| if b.is_ascii_graphic() { (b as char).to_string() } else { format!("\\x{b:02x}") }).collect()
+    f.iter()
+        .map(|&b| {
+            if b.is_ascii_graphic() {
+                (b as char).to_string()
+            } else {
+                format!("\\x{b:02x}")
+            }
+        })
+        .collect()
 }
 
 /// The fixed 32-byte header.
@@ -94,10 +144,17 @@ impl ChunkEntry {
 /// trusted) are returned as `Err`.
 pub fn parse_header(b: &[u8], actual_len: u64) -> Result<Header, Issue> {
     if actual_len < HEADER_LEN || b.len() < HEADER_LEN as usize {
-        return Err(Issue::new(1002, format!("file has {actual_len} bytes, the header alone needs {HEADER_LEN}")));
+        return Err(Issue::new(
+            1002,
+            format!("file has {actual_len} bytes, the header alone needs {HEADER_LEN}"),
+        ));
     }
     if b[0..8] != MAGIC {
-        return Err(Issue::new(2001, format!("first 8 bytes are {:02x?}, expected {MAGIC:02x?}", &b[0..8])).at(0));
+        return Err(Issue::new(
+            2001,
+            format!("first 8 bytes are {:02x?}, expected {MAGIC:02x?}", &b[0..8]),
+        )
+        .at(0));
     }
     let u16_at = |o: usize| u16::from_le_bytes([b[o], b[o + 1]]);
     let u32_at = |o: usize| u32::from_le_bytes([b[o], b[o + 1], b[o + 2], b[o + 3]]);
@@ -110,19 +167,38 @@ pub fn parse_header(b: &[u8], actual_len: u64) -> Result<Header, Issue> {
         crc: u32_at(28),
     };
     if h.major != VERSION_MAJOR {
-        return Err(Issue::new(2002, format!("major version {}, this reader reads {VERSION_MAJOR}", h.major)).at(8));
+        return Err(Issue::new(
+            2002,
+            format!(
+                "major version {}, this reader reads {VERSION_MAJOR}",
+                h.major
+            ),
+        )
+        .at(8));
     }
     if h.file_length != actual_len {
         return Err(Issue::new(
             1003,
-            format!("header says {} bytes, the file has {actual_len} (truncated or extended)", h.file_length),
+            format!(
+                "header says {} bytes, the file has {actual_len} (truncated or extended)",
+                h.file_length
+            ),
         )
         .at(16));
     }
-    let table_end = (h.chunk_count as u64).checked_mul(ENTRY_LEN).and_then(|t| t.checked_add(HEADER_LEN));
+    let table_end = (h.chunk_count as u64)
+        .checked_mul(ENTRY_LEN)
+        .and_then(|t| t.checked_add(HEADER_LEN));
     match table_end {
         Some(end) if end <= actual_len => Ok(h),
-        _ => Err(Issue::new(2005, format!("{} chunk entries do not fit in {actual_len} bytes", h.chunk_count)).at(24)),
+        _ => Err(Issue::new(
+            2005,
+            format!(
+                "{} chunk entries do not fit in {actual_len} bytes",
+                h.chunk_count
+            ),
+        )
+        .at(24)),
     }
 }
 
@@ -136,13 +212,30 @@ pub fn header_crc(header: &[u8], table: &[u8]) -> u32 {
 
 /// Parses and checks the chunk table. Non-fatal issues (header flags, checksum, entry
 /// problems) are pushed to `issues`; every entry is returned so that `--chunks` can list it.
-pub fn parse_table(header_bytes: &[u8], h: &Header, table: &[u8], issues: &mut Vec<Issue>) -> Vec<ChunkEntry> {
+pub fn parse_table(
+    header_bytes: &[u8],
+    h: &Header,
+    table: &[u8],
+    issues: &mut Vec<Issue>,
+) -> Vec<ChunkEntry> {
     if h.flags != 0 {
-        issues.push(Issue::new(2003, format!("flags are {:#x}, version 1 defines none", h.flags)).at(12));
+        issues.push(
+            Issue::new(
+                2003,
+                format!("flags are {:#x}, version 1 defines none", h.flags),
+            )
+            .at(12),
+        );
     }
     let crc = header_crc(header_bytes, table);
     if crc != h.crc {
-        issues.push(Issue::new(2004, format!("stored {:#010x}, computed {crc:#010x}", h.crc)).at(28));
+        issues.push(
+            Issue::new(
+                2004,
+                format!("stored {:#010x}, computed {crc:#010x}", h.crc),
+            )
+            .at(28),
+        );
     }
     let mut entries = Vec::with_capacity(h.chunk_count as usize);
     let table_end = HEADER_LEN + h.chunk_count as u64 * ENTRY_LEN;
@@ -163,38 +256,65 @@ pub fn parse_table(header_bytes: &[u8], h: &Header, table: &[u8], issues: &mut V
             issues.push(tag(3006, format!("entry's reserved word is {reserved:#x}")).at(at + 28));
         }
         if entry.flags & !FLAG_REQUIRED != 0 {
-            issues.push(tag(3006, format!("flags {:#x} set undefined bits", entry.flags)).at(at + 4));
+            issues
+                .push(tag(3006, format!("flags {:#x} set undefined bits", entry.flags)).at(at + 4));
         }
         match rule(entry.fourcc) {
-            Some(r) if r.required != entry.required() => issues.push(tag(
-                3010,
-                format!("'{name}' must {}carry the required flag", if r.required { "" } else { "not " }),
-            )
-            .at(at + 4)),
-            None if entry.required() => {
-                issues.push(tag(3007, format!("chunk type '{name}' is not defined by version 1")).at(at))
-            }
+            Some(r) if r.required != entry.required() => issues.push(
+                tag(
+                    3010,
+                    format!(
+                        "'{name}' must {}carry the required flag",
+                        if r.required { "" } else { "not " }
+                    ),
+                )
+                .at(at + 4),
+            ),
+            None if entry.required() => issues.push(
+                tag(
+                    3007,
+                    format!("chunk type '{name}' is not defined by version 1"),
+                )
+                .at(at),
+            ),
             _ => {}
         }
         if entry.offset % ALIGN != 0 {
-            issues.push(tag(3001, format!("offset {} is not a multiple of {ALIGN}", entry.offset)).at(at + 8));
+            issues.push(
+                tag(
+                    3001,
+                    format!("offset {} is not a multiple of {ALIGN}", entry.offset),
+                )
+                .at(at + 8),
+            );
         }
-        if entry.offset.checked_add(entry.length).is_none_or(|end| end > h.file_length) {
-            issues.push(tag(
-                3002,
-                format!("{} bytes at offset {} end past the file's {} bytes", entry.length, entry.offset, h.file_length),
-            )
-            .at(at + 16));
+        if entry
+            .offset
+            .checked_add(entry.length)
+            .is_none_or(|end| end > h.file_length)
+        {
+            issues.push(
+                tag(
+                    3002,
+                    format!(
+                        "{} bytes at offset {} end past the file's {} bytes",
+                        entry.length, entry.offset, h.file_length
+                    ),
+                )
+                .at(at + 16),
+            );
         } else if entry.offset != prev_end.next_multiple_of(ALIGN) {
-            issues.push(tag(
-                3003,
-                format!(
+            issues.push(
+                tag(
+                    3003,
+                    format!(
                     "starts at {}; the previous data ends at {prev_end}, so it must start at {}",
                     entry.offset,
                     prev_end.next_multiple_of(ALIGN)
                 ),
-            )
-            .at(at + 8));
+                )
+                .at(at + 8),
+            );
             prev_end = prev_end.max(entry.end());
         } else {
             prev_end = entry.end();
@@ -202,7 +322,16 @@ pub fn parse_table(header_bytes: &[u8], h: &Header, table: &[u8], issues: &mut V
         entries.push(entry);
     }
     if issues.iter().all(|i| !(3001..=3003).contains(&i.id)) && prev_end != h.file_length {
-        issues.push(Issue::new(3011, format!("last chunk ends at {prev_end}, the file at {}", h.file_length)).at(prev_end));
+        issues.push(
+            Issue::new(
+                3011,
+                format!(
+                    "last chunk ends at {prev_end}, the file at {}",
+                    h.file_length
+                ),
+            )
+            .at(prev_end),
+        );
     }
     // Counts per known type.
     for r in &KNOWN {
@@ -212,20 +341,33 @@ pub fn parse_table(header_bytes: &[u8], h: &Header, table: &[u8], issues: &mut V
             issues.push(Issue::new(3008, format!("no '{name}' chunk")));
         }
         if r.max.is_some_and(|m| n > m) {
-            issues.push(Issue::new(3009, format!("{n} '{name}' chunks, at most {} allowed", r.max.unwrap_or(0))));
+            issues.push(Issue::new(
+                3009,
+                format!(
+                    "{n} '{name}' chunks, at most {} allowed",
+                    r.max.unwrap_or(0)
+                ),
+            ));
         }
     }
     entries
 }
 
 /// Checks the padding between the table and the first chunk and between chunks (all zero).
-pub fn check_padding(entries: &[ChunkEntry], read: &mut dyn FnMut(u64, usize) -> Option<Vec<u8>>, issues: &mut Vec<Issue>) {
+pub fn check_padding(
+    entries: &[ChunkEntry],
+    read: &mut dyn FnMut(u64, usize) -> Option<Vec<u8>>,
+    issues: &mut Vec<Issue>,
+) {
     let mut pos = HEADER_LEN + entries.len() as u64 * ENTRY_LEN;
     for e in entries {
         if e.offset > pos && e.offset - pos < ALIGN {
             if let Some(pad) = read(pos, (e.offset - pos) as usize) {
                 if let Some(k) = pad.iter().position(|&b| b != 0) {
-                    issues.push(Issue::new(3005, format!("padding byte is {:#04x}", pad[k])).at(pos + k as u64));
+                    issues.push(
+                        Issue::new(3005, format!("padding byte is {:#04x}", pad[k]))
+                            .at(pos + k as u64),
+                    );
                 }
             }
         }

@@ -28,11 +28,20 @@ pub struct Issue {
 
 impl Issue {
     pub fn new(id: u16, detail: impl Into<String>) -> Self {
-        Issue { id, severity: Severity::Error, chunk: None, offset: None, detail: detail.into() }
+        Issue {
+            id,
+            severity: Severity::Error,
+            chunk: None,
+            offset: None,
+            detail: detail.into(),
+        }
     }
 
     pub fn warning(id: u16, detail: impl Into<String>) -> Self {
-        Issue { severity: Severity::Warning, ..Issue::new(id, detail) }
+        Issue {
+            severity: Severity::Warning,
+            ..Issue::new(id, detail)
+        }
     }
 
     pub fn at(mut self, offset: u64) -> Self {
@@ -80,7 +89,10 @@ impl fmt::Display for Issue {
 pub const RULES: &[(u16, &str)] = &[
     (1001, "file cannot be read"),
     (1002, "file is shorter than the header"),
-    (1003, "file length in the header differs from the file's size"),
+    (
+        1003,
+        "file length in the header differs from the file's size",
+    ),
     (2001, "not a PIS file (bad magic)"),
     (2002, "unsupported major version"),
     (2003, "reserved header flags are set"),
@@ -88,7 +100,10 @@ pub const RULES: &[(u16, &str)] = &[
     (2005, "chunk table does not fit in the file"),
     (3001, "chunk offset is not a multiple of 8"),
     (3002, "chunk extends past the end of the file"),
-    (3003, "chunk does not start at the first multiple of 8 after the previous data"),
+    (
+        3003,
+        "chunk does not start at the first multiple of 8 after the previous data",
+    ),
     (3004, "chunk checksum mismatch"),
     (3005, "padding byte is not zero"),
     (3006, "reserved field is not zero"),
@@ -106,35 +121,62 @@ pub const RULES: &[(u16, &str)] = &[
     (4006, "sample values are not finite and strictly increasing"),
     (4007, "too many parameter points"),
     (5000, "CAMS payload is malformed"),
-    (5001, "table size differs from the product of its dimensions' sample counts"),
-    (5002, "dependency mask names a dimension that does not exist"),
-    (5003, "camera is not finite or not a valid perspective camera"),
+    (
+        5001,
+        "table size differs from the product of its dimensions' sample counts",
+    ),
+    (
+        5002,
+        "dependency mask names a dimension that does not exist",
+    ),
+    (
+        5003,
+        "camera is not finite or not a valid perspective camera",
+    ),
     (5004, "image size is zero or too large"),
     (5100, "OBJS payload is malformed"),
     (5101, "object count out of range"),
     (5102, "object name is empty, not UTF-8 or repeated"),
     (5103, "unknown object role"),
     (5104, "shading constants out of range"),
-    (5105, "staggered block origin is not less than the block size"),
+    (
+        5105,
+        "staggered block origin is not less than the block size",
+    ),
     (5106, "transform is not finite"),
     (5200, "MESH payload is malformed"),
-    (5201, "mesh names a missing object, or a second mesh names the same object"),
+    (
+        5201,
+        "mesh names a missing object, or a second mesh names the same object",
+    ),
     (5202, "object has no mesh"),
     (5203, "index count is zero or not a multiple of 3"),
     (5204, "vertex index out of range"),
     (5205, "vertex data is not finite"),
     (6000, "LAYR payload is malformed"),
     (6001, "layer names an object that does not exist"),
-    (6002, "unknown layer kind, mapping, mip mode, term or combine mode"),
+    (
+        6002,
+        "unknown layer kind, mapping, mip mode, term or combine mode",
+    ),
     (6003, "invalid combination of layer fields"),
     (6004, "gamma is not finite and positive"),
     (6005, "block count differs from the layer's block grid"),
-    (6006, "texture size is zero, too large, or a shell face is not square"),
+    (
+        6006,
+        "texture size is zero, too large, or a shell face is not square",
+    ),
     (6007, "block placement is invalid"),
-    (6008, "two shell layers of one object share a term and order"),
+    (
+        6008,
+        "two shell layers of one object share a term and order",
+    ),
     (7001, "level count out of range"),
     (7002, "top pyramid level holds more than one sample"),
-    (7003, "level sample counts decrease or exceed the block extent"),
+    (
+        7003,
+        "level sample counts decrease or exceed the block extent",
+    ),
     (7004, "finest level does not match the block extent"),
     (8001, "codestream reference names a chunk that is not CSTR"),
     (8002, "codestream lies outside its chunk"),
@@ -148,5 +190,9 @@ pub const RULES: &[(u16, &str)] = &[
 
 /// The short message of rule `id` ("unknown rule" for ids not in [`RULES`]).
 pub fn summary(id: u16) -> &'static str {
-    RULES.iter().find(|(i, _)| *i == id).map(|(_, m)| *m).unwrap_or("unknown rule")
+    RULES
+        .iter()
+        .find(|(i, _)| *i == id)
+        .map(|(_, m)| *m)
+        .unwrap_or("unknown rule")
 }

@@ -31,7 +31,8 @@ pub fn decimate(src: &[f32], width: u32, height: u32, channels: u32) -> Vec<f32>
             let (x0, x1) = (2 * i, (2 * i + 1).min(w - 1));
             for ch in 0..c {
                 let at = |x: usize, y: usize| src[(y * w + x) * c + ch];
-                out[(j * ow + i) * c + ch] = 0.25 * (at(x0, y0) + at(x1, y0) + at(x0, y1) + at(x1, y1));
+                out[(j * ow + i) * c + ch] =
+                    0.25 * (at(x0, y0) + at(x1, y0) + at(x0, y1) + at(x1, y1));
             }
         }
     }

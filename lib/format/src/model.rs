@@ -55,7 +55,11 @@ pub enum ObjectRole {
 }
 
 impl ObjectRole {
-    pub const ALL: [ObjectRole; 3] = [ObjectRole::Diffuse, ObjectRole::Reflective, ObjectRole::Refractive];
+    pub const ALL: [ObjectRole; 3] = [
+        ObjectRole::Diffuse,
+        ObjectRole::Reflective,
+        ObjectRole::Refractive,
+    ];
 
     pub fn from_code(code: u8) -> Option<Self> {
         Self::ALL.get(code as usize).copied()
@@ -99,7 +103,10 @@ impl ParameterSpace {
 
     /// Number of entries of a table that depends on the dimensions in `mask`.
     pub fn table_len(&self, mask: DepMask) -> u64 {
-        mask.dims().filter_map(|k| self.dims.get(k)).map(|d| d.values.len() as u64).product()
+        mask.dims()
+            .filter_map(|k| self.dims.get(k))
+            .map(|d| d.values.len() as u64)
+            .product()
     }
 
     /// Index into a table that depends on `mask`, for the point with sample indices `point`
@@ -235,7 +242,11 @@ pub struct Shading {
 
 impl Default for Shading {
     fn default() -> Self {
-        Shading { f0: [0.04; 3], ior: 1.5, absorption: [0.0; 3] }
+        Shading {
+            f0: [0.04; 3],
+            ior: 1.5,
+            absorption: [0.0; 3],
+        }
     }
 }
 
@@ -250,7 +261,10 @@ pub struct TransformTable {
 impl TransformTable {
     /// A static object.
     pub fn fixed(t: [f32; 12]) -> Self {
-        TransformTable { depends_on: DepMask::NONE, transforms: vec![t] }
+        TransformTable {
+            depends_on: DepMask::NONE,
+            transforms: vec![t],
+        }
     }
 }
 
@@ -316,7 +330,10 @@ impl LayerKind {
 
     /// True for the kinds drawn through an environment-map shell.
     pub fn is_shell(self) -> bool {
-        matches!(self, LayerKind::EnvLocal | LayerKind::EnvDistant | LayerKind::EnvShell)
+        matches!(
+            self,
+            LayerKind::EnvLocal | LayerKind::EnvDistant | LayerKind::EnvShell
+        )
     }
 }
 
@@ -334,7 +351,9 @@ pub enum Term {
 
 impl Term {
     pub fn from_code(code: u8) -> Option<Self> {
-        [Term::Surface, Term::Reflection, Term::Refraction].get(code as usize).copied()
+        [Term::Surface, Term::Reflection, Term::Refraction]
+            .get(code as usize)
+            .copied()
     }
 
     pub fn name(self) -> &'static str {
@@ -357,7 +376,9 @@ pub enum Combine {
 
 impl Combine {
     pub fn from_code(code: u8) -> Option<Self> {
-        [Combine::Add, Combine::Multiply, Combine::Over].get(code as usize).copied()
+        [Combine::Add, Combine::Multiply, Combine::Over]
+            .get(code as usize)
+            .copied()
     }
 
     pub fn name(self) -> &'static str {
@@ -381,7 +402,9 @@ pub enum MipMode {
 
 impl MipMode {
     pub fn from_code(code: u8) -> Option<Self> {
-        [MipMode::Decimated, MipMode::Stored].get(code as usize).copied()
+        [MipMode::Decimated, MipMode::Stored]
+            .get(code as usize)
+            .copied()
     }
 
     pub fn name(self) -> &'static str {
@@ -402,7 +425,9 @@ pub enum Mapping {
 
 impl Mapping {
     pub fn from_code(code: u8) -> Option<Self> {
-        [Mapping::Surface, Mapping::Shell].get(code as usize).copied()
+        [Mapping::Surface, Mapping::Shell]
+            .get(code as usize)
+            .copied()
     }
 
     pub fn name(self) -> &'static str {
@@ -453,7 +478,11 @@ pub enum Placement {
     /// spans the used texture.
     Surface { affine: [f32; 6] },
     /// Environment-map shell geometry with its cube-map origin.
-    Shell { shape: ShellShape, origin: [f32; 3], params: [f32; 6] },
+    Shell {
+        shape: ShellShape,
+        origin: [f32; 3],
+        params: [f32; 6],
+    },
 }
 
 /// Environment-map shell geometry (SPEC.md, table "Shell shapes").
@@ -472,8 +501,13 @@ pub enum ShellShape {
 }
 
 impl ShellShape {
-    pub const ALL: [ShellShape; 5] =
-        [ShellShape::Sphere, ShellShape::Ellipsoid, ShellShape::Box, ShellShape::Cylinder, ShellShape::Quad];
+    pub const ALL: [ShellShape; 5] = [
+        ShellShape::Sphere,
+        ShellShape::Ellipsoid,
+        ShellShape::Box,
+        ShellShape::Cylinder,
+        ShellShape::Quad,
+    ];
 
     pub fn from_code(code: u32) -> Option<Self> {
         Self::ALL.into_iter().find(|s| *s as u32 == code)
@@ -552,10 +586,22 @@ impl<S> Container<S> {
                 for b in &l.blocks {
                     let mut levels = Vec::with_capacity(b.levels.len());
                     for level in &b.levels {
-                        let images = level.images.iter().map(&mut *f).collect::<Result<Vec<_>, E>>()?;
-                        levels.push(Level { counts: level.counts.clone(), images });
+                        let images = level
+                            .images
+                            .iter()
+                            .map(&mut *f)
+                            .collect::<Result<Vec<_>, E>>()?;
+                        levels.push(Level {
+                            counts: level.counts.clone(),
+                            images,
+                        });
                     }
-                    blocks.push(Block { width: b.width, height: b.height, placement: b.placement, levels });
+                    blocks.push(Block {
+                        width: b.width,
+                        height: b.height,
+                        placement: b.placement,
+                        levels,
+                    });
                 }
                 layers.push(Layer {
                     kind: l.kind,
@@ -580,6 +626,11 @@ impl<S> Container<S> {
                 layers,
             });
         }
-        Ok(Container { space: self.space.clone(), cameras: self.cameras.clone(), objects, provenance: self.provenance.clone() })
+        Ok(Container {
+            space: self.space.clone(),
+            cameras: self.cameras.clone(),
+            objects,
+            provenance: self.provenance.clone(),
+        })
     }
 }

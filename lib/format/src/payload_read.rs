@@ -24,11 +24,19 @@ pub fn pspc(c: &mut Cursor) -> Result<ParameterSpace, Issue> {
         let unit = c.string(&format!("dimension {k} unit"), 4002)?;
         let at = c.offset();
         let kind_code = c.u8("kind")?;
-        let kind = DimensionKind::from_code(kind_code)
-            .ok_or_else(|| c.issue(4003, format!("dimension {k} kind {kind_code}; 0 to 4 are defined")).at(at))?;
+        let kind = DimensionKind::from_code(kind_code).ok_or_else(|| {
+            c.issue(
+                4003,
+                format!("dimension {k} kind {kind_code}; 0 to 4 are defined"),
+            )
+            .at(at)
+        })?;
         let flags = c.u8("flags")?;
         if flags & !1 != 0 {
-            return Err(c.issue(3006, format!("dimension {k} flags {flags:#x} set undefined bits")));
+            return Err(c.issue(
+                3006,
+                format!("dimension {k} flags {flags:#x} set undefined bits"),
+            ));
         }
         c.reserved(2, "reserved")?;
         let block_size = c.u32("block size")?;
@@ -38,7 +46,14 @@ pub fn pspc(c: &mut Cursor) -> Result<ParameterSpace, Issue> {
         for _ in 0..count {
             values.push(c.f32("sample value")?);
         }
-        dims.push(Dimension { name, kind, periodic: flags & 1 != 0, unit, block_size, values });
+        dims.push(Dimension {
+            name,
+            kind,
+            periodic: flags & 1 != 0,
+            unit,
+            block_size,
+            values,
+        });
     }
     c.finish()?;
     Ok(ParameterSpace { dims })
@@ -55,10 +70,20 @@ pub fn cams(c: &mut Cursor) -> Result<CameraTable, Issue> {
         let world_from_camera = c.f32s::<12>("world_from_camera")?;
         let [yfov, znear, zfar] = c.f32s::<3>("yfov, znear, zfar")?;
         c.reserved(4, "camera reserved")?;
-        cameras.push(Camera { world_from_camera, yfov, znear, zfar });
+        cameras.push(Camera {
+            world_from_camera,
+            yfov,
+            znear,
+            zfar,
+        });
     }
     c.finish()?;
-    Ok(CameraTable { width, height, depends_on, cameras })
+    Ok(CameraTable {
+        width,
+        height,
+        depends_on,
+        cameras,
+    })
 }
 
 /// Parses `OBJS`; meshes and layers are filled in from their own chunks.
@@ -75,8 +100,13 @@ pub fn objs(c: &mut Cursor, dim_count: usize) -> Result<Vec<Object<StreamRef>>, 
         let name = c.string(&format!("object {i} name"), 5102)?;
         let at = c.offset();
         let role_code = c.u8("role")?;
-        let role = ObjectRole::from_code(role_code)
-            .ok_or_else(|| c.issue(5103, format!("object {i} role {role_code}; 0 to 2 are defined")).at(at))?;
+        let role = ObjectRole::from_code(role_code).ok_or_else(|| {
+            c.issue(
+                5103,
+                format!("object {i} role {role_code}; 0 to 2 are defined"),
+            )
+            .at(at)
+        })?;
         c.reserved(3, "object reserved")?;
         let f0 = c.f32s::<3>("f0")?;
         let [ior] = c.f32s::<1>("ior")?;
@@ -95,9 +125,16 @@ pub fn objs(c: &mut Cursor, dim_count: usize) -> Result<Vec<Object<StreamRef>>, 
         objects.push(Object {
             name,
             role,
-            shading: Shading { f0, ior, absorption },
+            shading: Shading {
+                f0,
+                ior,
+                absorption,
+            },
             stagger,
-            transforms: TransformTable { depends_on, transforms },
+            transforms: TransformTable {
+                depends_on,
+                transforms,
+            },
             mesh: Mesh::default(),
             layers: Vec::new(),
         });
@@ -115,22 +152,42 @@ pub fn mesh(c: &mut Cursor) -> Result<(u32, Mesh), Issue> {
     if attrs & !(MESH_NORMALS | MESH_TEXCOORDS) != 0 {
         return Err(c.issue(3006, format!("attributes {attrs:#x} set undefined bits")));
     }
-    let per_vertex = 12 + if attrs & MESH_NORMALS != 0 { 12 } else { 0 } + if attrs & MESH_TEXCOORDS != 0 { 8 } else { 0 };
+    let per_vertex = 12
+        + if attrs & MESH_NORMALS != 0 { 12 } else { 0 }
+        + if attrs & MESH_TEXCOORDS != 0 { 8 } else { 0 };
     let vc = c.expect_records(vc as u64, per_vertex, "vertices")?;
     let read3 = |c: &mut Cursor, what: &str| -> Result<Vec<[f32; 3]>, Issue> {
         (0..vc).map(|_| c.f32s::<3>(what)).collect()
     };
     let positions = read3(c, "position")?;
-    let normals = if attrs & MESH_NORMALS != 0 { Some(read3(c, "normal")?) } else { None };
+    let normals = if attrs & MESH_NORMALS != 0 {
+        Some(read3(c, "normal")?)
+    } else {
+        None
+    };
     let texcoords = if attrs & MESH_TEXCOORDS != 0 {
-        Some((0..vc).map(|_| c.f32s::<2>("texcoord")).collect::<Result<Vec<_>, _>>()?)
+        Some(
+            (0..vc)
+                .map(|_| c.f32s::<2>("texcoord"))
+                .collect::<Result<Vec<_>, _>>()?,
+        )
     } else {
         None
     };
     let ic = c.expect_records(ic as u64, 4, "indices")?;
-    let indices = (0..ic).map(|_| c.u32("index")).collect::<Result<Vec<_>, _>>()?;
+    let indices = (0..ic)
+        .map(|_| c.u32("index"))
+        .collect::<Result<Vec<_>, _>>()?;
     c.finish()?;
-    Ok((object, Mesh { positions, normals, texcoords, indices }))
+    Ok((
+        object,
+        Mesh {
+            positions,
+            normals,
+            texcoords,
+            indices,
+        },
+    ))
 }
 
 /// Parses `LAYR` into the objects' layer lists.
@@ -141,7 +198,12 @@ pub fn layr(c: &mut Cursor, objects: &mut [Object<StreamRef>]) -> Result<(), Iss
         let at = c.offset();
         let oi = c.u32("object index")? as usize;
         if oi >= objects.len() {
-            return Err(c.issue(6001, format!("layer {li} names object {oi}; there are {}", objects.len())).at(at));
+            return Err(c
+                .issue(
+                    6001,
+                    format!("layer {li} names object {oi}; there are {}", objects.len()),
+                )
+                .at(at));
         }
         let codes_at = c.offset();
         let kind = c.u8("kind")?;
@@ -152,7 +214,10 @@ pub fn layr(c: &mut Cursor, objects: &mut [Object<StreamRef>]) -> Result<(), Iss
         let order = c.u8("order")?;
         let combine = c.u8("combine")?;
         c.reserved(1, "layer reserved")?;
-        let bad = |what: &str, v: u8| c.issue(6002, format!("layer {li} {what} {v} is not defined")).at(codes_at);
+        let bad = |what: &str, v: u8| {
+            c.issue(6002, format!("layer {li} {what} {v} is not defined"))
+                .at(codes_at)
+        };
         let kind = LayerKind::from_code(kind).ok_or_else(|| bad("kind", kind))?;
         let mapping = Mapping::from_code(mapping).ok_or_else(|| bad("mapping", mapping))?;
         let mip_mode = MipMode::from_code(mip).ok_or_else(|| bad("mip mode", mip))?;
@@ -171,10 +236,16 @@ pub fn layr(c: &mut Cursor, objects: &mut [Object<StreamRef>]) -> Result<(), Iss
             let shape = c.u32("shell shape")?;
             let values = c.f32s::<12>("placement values")?;
             let placement = if shape == 0 {
-                Placement::Surface { affine: values[0..6].try_into().expect("6 values") }
+                Placement::Surface {
+                    affine: values[0..6].try_into().expect("6 values"),
+                }
             } else {
                 let shape = ShellShape::from_code(shape).ok_or_else(|| {
-                    c.issue(6007, format!("layer {li} block {bi} shell shape {shape}; 0 to 5 are defined")).at(shape_at)
+                    c.issue(
+                        6007,
+                        format!("layer {li} block {bi} shell shape {shape}; 0 to 5 are defined"),
+                    )
+                    .at(shape_at)
                 })?;
                 Placement::Shell {
                     shape,
@@ -182,13 +253,25 @@ pub fn layr(c: &mut Cursor, objects: &mut [Object<StreamRef>]) -> Result<(), Iss
                     params: values[3..9].try_into().expect("6 values"),
                 }
             };
-            let unused = if shape == 0 { &values[6..] } else { &values[9..] };
+            let unused = if shape == 0 {
+                &values[6..]
+            } else {
+                &values[9..]
+            };
             if unused.iter().any(|v| v.to_bits() != 0) {
-                return Err(c.issue(3006, format!("layer {li} block {bi} unused placement values are not 0")).at(shape_at + 4));
+                return Err(c
+                    .issue(
+                        3006,
+                        format!("layer {li} block {bi} unused placement values are not 0"),
+                    )
+                    .at(shape_at + 4));
             }
             let lc = c.u32("level count")?;
             if lc == 0 || lc > 32 {
-                return Err(c.issue(7001, format!("layer {li} block {bi} has {lc} levels, expected 1 to 32")));
+                return Err(c.issue(
+                    7001,
+                    format!("layer {li} block {bi} has {lc} levels, expected 1 to 32"),
+                ));
             }
             let mut levels = Vec::with_capacity(lc as usize);
             for lv in 0..lc {
@@ -204,18 +287,34 @@ pub fn layr(c: &mut Cursor, objects: &mut [Object<StreamRef>]) -> Result<(), Iss
                 for _ in 0..ni {
                     let at = c.offset();
                     let code = c.u16("codec")?;
-                    let codec = CodecId::from_code(code)
-                        .ok_or_else(|| c.issue(8004, format!("codec id {code}; 0 to 3 are defined")).at(at))?;
+                    let codec = CodecId::from_code(code).ok_or_else(|| {
+                        c.issue(8004, format!("codec id {code}; 0 to 3 are defined"))
+                            .at(at)
+                    })?;
                     c.reserved(2, "reference reserved")?;
                     let chunk = c.u32("chunk index")?;
                     let offset = c.u64("offset")?;
                     let length = c.u32("length")?;
                     let crc = c.u32("crc32")?;
-                    refs.push(StreamRef { codec, chunk, offset, length, crc });
+                    refs.push(StreamRef {
+                        codec,
+                        chunk,
+                        offset,
+                        length,
+                        crc,
+                    });
                 }
-                levels.push(Level { counts, images: refs });
+                levels.push(Level {
+                    counts,
+                    images: refs,
+                });
             }
-            blocks.push(Block { width, height, placement, levels });
+            blocks.push(Block {
+                width,
+                height,
+                placement,
+                levels,
+            });
         }
         objects[oi].layers.push(Layer {
             kind,
@@ -246,5 +345,10 @@ pub fn prov(c: &mut Cursor) -> Result<Provenance, Issue> {
         settings.push((k, v));
     }
     c.finish()?;
-    Ok(Provenance { tool, source, raw_image_bytes, settings })
+    Ok(Provenance {
+        tool,
+        source,
+        raw_image_bytes,
+        settings,
+    })
 }

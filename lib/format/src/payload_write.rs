@@ -26,8 +26,14 @@ pub fn cams(s: &mut Sink, t: &CameraTable) {
     s.u32(t.depends_on.0, "dependency mask");
     s.u32(t.cameras.len() as u32, "camera count");
     for (i, c) in t.cameras.iter().enumerate() {
-        s.f32s(&c.world_from_camera, &format!("camera {i} world_from_camera"));
-        s.f32s(&[c.yfov, c.znear, c.zfar], &format!("camera {i} yfov, znear, zfar"));
+        s.f32s(
+            &c.world_from_camera,
+            &format!("camera {i} world_from_camera"),
+        );
+        s.f32s(
+            &[c.yfov, c.znear, c.zfar],
+            &format!("camera {i} yfov, znear, zfar"),
+        );
         s.zeros(4, &format!("camera {i} reserved"));
     }
 }
@@ -45,8 +51,14 @@ pub fn objs<S>(s: &mut Sink, objects: &[Object<S>]) {
         for (k, off) in o.stagger.iter().enumerate() {
             s.u32(*off, &format!("{p} block origin offset, dimension {k}"));
         }
-        s.u32(o.transforms.depends_on.0, &format!("{p} transform dependency mask"));
-        s.u32(o.transforms.transforms.len() as u32, &format!("{p} transform count"));
+        s.u32(
+            o.transforms.depends_on.0,
+            &format!("{p} transform dependency mask"),
+        );
+        s.u32(
+            o.transforms.transforms.len() as u32,
+            &format!("{p} transform count"),
+        );
         for (t, m) in o.transforms.transforms.iter().enumerate() {
             s.f32s(m, &format!("{p} world_from_object {t}"));
         }
@@ -58,7 +70,8 @@ pub const MESH_NORMALS: u32 = 1;
 pub const MESH_TEXCOORDS: u32 = 2;
 
 pub fn mesh(s: &mut Sink, object: u32, m: &Mesh) {
-    let attrs = m.normals.as_ref().map_or(0, |_| MESH_NORMALS) | m.texcoords.as_ref().map_or(0, |_| MESH_TEXCOORDS);
+    let attrs = m.normals.as_ref().map_or(0, |_| MESH_NORMALS)
+        | m.texcoords.as_ref().map_or(0, |_| MESH_TEXCOORDS);
     s.u32(object, "object index");
     s.u32(m.positions.len() as u32, "vertex count");
     s.u32(m.indices.len() as u32, "index count");
@@ -85,12 +98,21 @@ pub fn layr<S>(s: &mut Sink, objects: &[Object<S>], mut stream_ref: impl FnMut(&
             let p = format!("layer {li}");
             s.u32(oi as u32, &format!("{p} object index"));
             s.u8(l.kind.code(), &format!("{p} kind ({})", l.kind.name()));
-            s.u8(l.mapping as u8, &format!("{p} mapping ({})", l.mapping.name()));
+            s.u8(
+                l.mapping as u8,
+                &format!("{p} mapping ({})", l.mapping.name()),
+            );
             s.u8(l.channels, &format!("{p} channels"));
-            s.u8(l.mip_mode as u8, &format!("{p} mip mode ({})", l.mip_mode.name()));
+            s.u8(
+                l.mip_mode as u8,
+                &format!("{p} mip mode ({})", l.mip_mode.name()),
+            );
             s.u8(l.term as u8, &format!("{p} term ({})", l.term.name()));
             s.u8(l.order, &format!("{p} order"));
-            s.u8(l.combine as u8, &format!("{p} combine ({})", l.combine.name()));
+            s.u8(
+                l.combine as u8,
+                &format!("{p} combine ({})", l.combine.name()),
+            );
             s.zeros(1, &format!("{p} reserved"));
             s.f32s(&[l.gamma], &format!("{p} gamma"));
             s.u32(l.depends_on.0, &format!("{p} dependency mask"));
@@ -105,7 +127,11 @@ pub fn layr<S>(s: &mut Sink, objects: &[Object<S>], mut stream_ref: impl FnMut(&
                         s.f32s(&affine, &format!("{p} affine a b c d e f"));
                         s.zeros(24, &format!("{p} unused placement values"));
                     }
-                    Placement::Shell { shape, origin, params } => {
+                    Placement::Shell {
+                        shape,
+                        origin,
+                        params,
+                    } => {
                         s.u32(shape as u32, &format!("{p} shell shape ({})", shape.name()));
                         s.f32s(&origin, &format!("{p} shell origin"));
                         s.f32s(&params, &format!("{p} shell parameters"));

@@ -14,7 +14,7 @@ use pis_codec::CodecError;
 
 use crate::binary::Cursor;
 use crate::blocks::{level_image_index, BlockGrid};
-use crate::chunk::{self, ChunkEntry, Header, HEADER_LEN, ENTRY_LEN};
+use crate::chunk::{self, ChunkEntry, Header, ENTRY_LEN, HEADER_LEN};
 use crate::model::*;
 use crate::source::{FileSource, Source};
 use crate::texture::{LevelLayout, Texture};
@@ -48,7 +48,10 @@ pub(crate) struct Loaded {
 impl PisReader {
     /// Opens and checks `path`.
     pub fn open(path: &Path) -> Result<Self, Error> {
-        let io = |source| Error::Io { path: path.to_path_buf(), source };
+        let io = |source| Error::Io {
+            path: path.to_path_buf(),
+            source,
+        };
         let file = std::fs::File::open(path).map_err(io)?;
         let source = FileSource::new(file).map_err(io)?;
         Self::from_source(Box::new(source), path.to_path_buf())
@@ -64,7 +67,10 @@ impl PisReader {
         let loaded = load(source.as_ref(), false, &mut issues);
         if let Some(first) = issues.into_iter().find(|i| i.severity == Severity::Error) {
             return Err(match first.id {
-                1001 => Error::Io { path, source: std::io::Error::other(first.detail) },
+                1001 => Error::Io {
+                    path,
+                    source: std::io::Error::other(first.detail),
+                },
                 _ => Error::Invalid(first),
             });
         }
@@ -108,7 +114,10 @@ impl PisReader {
     }
 
     pub fn stats(&self) -> ReadStats {
-        ReadStats { codestreams: self.reads.load(Ordering::Relaxed), bytes: self.read_bytes.load(Ordering::Relaxed) }
+        ReadStats {
+            codestreams: self.reads.load(Ordering::Relaxed),
+            bytes: self.read_bytes.load(Ordering::Relaxed),
+        }
     }
 
     /// The bytes of one codestream, checksum verified.
@@ -117,15 +126,22 @@ impl PisReader {
         let mut buf = vec![0; r.length as usize];
         self.source
             .read_at(entry.offset + r.offset, &mut buf)
-            .map_err(|source| Error::Io { path: self.path.clone(), source })?;
+            .map_err(|source| Error::Io {
+                path: self.path.clone(),
+                source,
+            })?;
         self.reads.fetch_add(1, Ordering::Relaxed);
-        self.read_bytes.fetch_add(r.length as u64, Ordering::Relaxed);
+        self.read_bytes
+            .fetch_add(r.length as u64, Ordering::Relaxed);
         let crc = crc32fast::hash(&buf);
         if crc != r.crc {
             return Err(Error::Invalid(
-                Issue::new(8003, format!("stored {:#010x}, computed {crc:#010x}", r.crc))
-                    .in_chunk("CSTR", r.chunk as usize)
-                    .at(entry.offset + r.offset),
+                Issue::new(
+                    8003,
+                    format!("stored {:#010x}, computed {crc:#010x}", r.crc),
+                )
+                .in_chunk("CSTR", r.chunk as usize)
+                .at(entry.offset + r.offset),
             ));
         }
         Ok(buf)
@@ -135,13 +151,25 @@ impl PisReader {
     fn request(&self, object: usize, layer: usize, point: &[u32]) -> Result<(), Error> {
         let c = &self.container;
         let o = c.objects.get(object).ok_or_else(|| {
-            Error::Request(format!("object {object} does not exist; the file has {}", c.objects.len()))
+            Error::Request(format!(
+                "object {object} does not exist; the file has {}",
+                c.objects.len()
+            ))
         })?;
         if layer >= o.layers.len() {
-            return Err(Error::Request(format!("object '{}' has {} layers, not {}", o.name, o.layers.len(), layer + 1)));
+            return Err(Error::Request(format!(
+                "object '{}' has {} layers, not {}",
+                o.name,
+                o.layers.len(),
+                layer + 1
+            )));
         }
         if point.len() != c.space.dims.len() {
-            return Err(Error::Request(format!("a point needs {} sample indices, got {}", c.space.dims.len(), point.len())));
+            return Err(Error::Request(format!(
+                "a point needs {} sample indices, got {}",
+                c.space.dims.len(),
+                point.len()
+            )));
         }
         for (k, (&s, d)) in point.iter().zip(&c.space.dims).enumerate() {
             if s as usize >= d.values.len() {
@@ -156,7 +184,12 @@ impl PisReader {
     }
 
     /// The codestreams a texture at `point` is rebuilt from, top pyramid level first.
-    pub fn texture_path(&self, object: usize, layer: usize, point: &[u32]) -> Result<(usize, Vec<StreamRef>), Error> {
+    pub fn texture_path(
+        &self,
+        object: usize,
+        layer: usize,
+        point: &[u32],
+    ) -> Result<(usize, Vec<StreamRef>), Error> {
         self.request(object, layer, point)?;
         let o = &self.container.objects[object];
         let l = &o.layers[layer];
@@ -181,10 +214,15 @@ impl PisReader {
         for (lv, r) in refs.iter().enumerate() {
             let bytes = self.codestream(r)?;
             let values = pis_codec::decode(r.codec, &planes, &bytes).map_err(|e| match e {
-                CodecError::NotSupported(c) => Error::NotSupported(format!("codec '{c}' (object {object}, layer {layer})")),
+                CodecError::NotSupported(c) => {
+                    Error::NotSupported(format!("codec '{c}' (object {object}, layer {layer})"))
+                }
                 e => Error::Invalid(
-                    Issue::new(8005, format!("object {object} layer {layer} block {bi} level {lv}: {e}"))
-                        .in_chunk("CSTR", r.chunk as usize),
+                    Issue::new(
+                        8005,
+                        format!("object {object} layer {layer} block {bi} level {lv}: {e}"),
+                    )
+                    .in_chunk("CSTR", r.chunk as usize),
                 ),
             })?;
             if let Some(bad) = values.iter().position(|v| !v.is_finite()) {
@@ -204,7 +242,12 @@ impl PisReader {
 
     /// Reads every codestream into memory: the whole container, ready to re-encode or write.
     pub fn load_all(&self) -> Result<Container<Codestream>, Error> {
-        self.container.try_map(&mut |r| Ok(Codestream { codec: r.codec, bytes: self.codestream(r)? }))
+        self.container.try_map(&mut |r| {
+            Ok(Codestream {
+                codec: r.codec,
+                bytes: self.codestream(r)?,
+            })
+        })
     }
 }
 
@@ -212,7 +255,11 @@ impl PisReader {
 /// chunks, model rules and codestream ranges. With `full`, also every checksum of chunks the
 /// reader otherwise reads lazily (`CSTR`, unknown chunks).
 pub(crate) fn load(src: &dyn Source, full: bool, issues: &mut Vec<Issue>) -> Loaded {
-    let mut out = Loaded { header: None, chunks: Vec::new(), container: None };
+    let mut out = Loaded {
+        header: None,
+        chunks: Vec::new(),
+        container: None,
+    };
     let len = src.len();
     let mut head = vec![0u8; len.min(HEADER_LEN) as usize];
     if let Err(e) = src.read_at(0, &mut head) {
@@ -251,14 +298,23 @@ pub(crate) fn load(src: &dyn Source, full: bool, issues: &mut Vec<Issue>) -> Loa
             continue;
         }
         let Some(bytes) = read(e.offset, e.length as usize) else {
-            issues.push(Issue::new(1001, "read failed").in_chunk(&e.name(), i).at(e.offset));
+            issues.push(
+                Issue::new(1001, "read failed")
+                    .in_chunk(&e.name(), i)
+                    .at(e.offset),
+            );
             ok = false;
             continue;
         };
         let crc = crc32fast::hash(&bytes);
         if crc != e.crc {
             issues.push(
-                Issue::new(3004, format!("stored {:#010x}, computed {crc:#010x}", e.crc)).in_chunk(&e.name(), i).at(e.offset),
+                Issue::new(
+                    3004,
+                    format!("stored {:#010x}, computed {crc:#010x}", e.crc),
+                )
+                .in_chunk(&e.name(), i)
+                .at(e.offset),
             );
             ok = false;
             continue;
@@ -275,23 +331,41 @@ pub(crate) fn load(src: &dyn Source, full: bool, issues: &mut Vec<Issue>) -> Loa
     out
 }
 
-fn parse(entries: &[ChunkEntry], payloads: &[Option<Vec<u8>>], issues: &mut Vec<Issue>) -> Option<Container<StreamRef>> {
+fn parse(
+    entries: &[ChunkEntry],
+    payloads: &[Option<Vec<u8>>],
+    issues: &mut Vec<Issue>,
+) -> Option<Container<StreamRef>> {
     let find = |f: chunk::FourCC| entries.iter().position(|e| e.fourcc == f);
     let cursor = |i: usize| {
         let e = &entries[i];
         let malformed = chunk::rule(e.fourcc).map_or(3004, |r| r.malformed);
-        Cursor::new(payloads[i].as_deref().unwrap_or(&[]), e.offset, malformed, (chunk_name(e), i))
+        Cursor::new(
+            payloads[i].as_deref().unwrap_or(&[]),
+            e.offset,
+            malformed,
+            (chunk_name(e), i),
+        )
     };
     fn attempt<T>(r: Result<T, Issue>, issues: &mut Vec<Issue>) -> Option<T> {
         r.map_err(|i| issues.push(i)).ok()
     }
 
-    let (pspc, cams, objs, layr) = (find(chunk::PSPC)?, find(chunk::CAMS)?, find(chunk::OBJS)?, find(chunk::LAYR)?);
+    let (pspc, cams, objs, layr) = (
+        find(chunk::PSPC)?,
+        find(chunk::CAMS)?,
+        find(chunk::OBJS)?,
+        find(chunk::LAYR)?,
+    );
     let space = attempt(pr::pspc(&mut cursor(pspc)), issues)?;
     let cameras = attempt(pr::cams(&mut cursor(cams)), issues)?;
     let mut objects = attempt(pr::objs(&mut cursor(objs), space.dims.len()), issues)?;
     let mut has_mesh = vec![false; objects.len()];
-    for (i, e) in entries.iter().enumerate().filter(|(_, e)| e.fourcc == chunk::MESH) {
+    for (i, e) in entries
+        .iter()
+        .enumerate()
+        .filter(|(_, e)| e.fourcc == chunk::MESH)
+    {
         let (oi, mesh) = attempt(pr::mesh(&mut cursor(i)), issues)?;
         match has_mesh.get_mut(oi as usize) {
             Some(seen @ false) => {
@@ -300,16 +374,25 @@ fn parse(entries: &[ChunkEntry], payloads: &[Option<Vec<u8>>], issues: &mut Vec<
             }
             _ => {
                 issues.push(
-                    Issue::new(5201, format!("names object {oi}; {} objects, this one already meshed or missing", objects.len()))
-                        .in_chunk("MESH", i)
-                        .at(e.offset),
+                    Issue::new(
+                        5201,
+                        format!(
+                            "names object {oi}; {} objects, this one already meshed or missing",
+                            objects.len()
+                        ),
+                    )
+                    .in_chunk("MESH", i)
+                    .at(e.offset),
                 );
                 return None;
             }
         }
     }
     if let Some(oi) = has_mesh.iter().position(|&m| !m) {
-        issues.push(Issue::new(5202, format!("object {oi} '{}' has no MESH chunk", objects[oi].name)));
+        issues.push(Issue::new(
+            5202,
+            format!("object {oi} '{}' has no MESH chunk", objects[oi].name),
+        ));
         return None;
     }
     attempt(pr::layr(&mut cursor(layr), &mut objects), issues)?;
@@ -317,13 +400,23 @@ fn parse(entries: &[ChunkEntry], payloads: &[Option<Vec<u8>>], issues: &mut Vec<
         Some(i) => Some(attempt(pr::prov(&mut cursor(i)), issues)?),
         None => None,
     };
-    let container = Container { space, cameras, objects, provenance };
+    let container = Container {
+        space,
+        cameras,
+        objects,
+        provenance,
+    };
 
     let before = issues.len();
     for mut issue in checks::check(&container) {
         // Name the chunk's index where its type occurs once.
         if let Some((t, idx)) = &mut issue.chunk {
-            let matches: Vec<usize> = entries.iter().enumerate().filter(|(_, e)| chunk_name(e) == t).map(|(i, _)| i).collect();
+            let matches: Vec<usize> = entries
+                .iter()
+                .enumerate()
+                .filter(|(_, e)| chunk_name(e) == t)
+                .map(|(i, _)| i)
+                .collect();
             if matches.len() == 1 {
                 *idx = matches[0];
             }
@@ -348,18 +441,27 @@ fn chunk_name(e: &ChunkEntry) -> &'static str {
 
 /// Rules 8001 and 8002: every reference lies inside a `CSTR` chunk.
 fn stream_ranges(entries: &[ChunkEntry], c: &Container<StreamRef>, issues: &mut Vec<Issue>) {
-    for_each_ref(c, |what, r| {
-        match entries.get(r.chunk as usize) {
-            Some(e) if e.fourcc == chunk::CSTR => {
-                if r.offset.checked_add(r.length as u64).is_none_or(|end| end > e.length) {
-                    issues.push(
-                        Issue::new(8002, format!("{what}: {} bytes at {} in a chunk of {}", r.length, r.offset, e.length))
-                            .in_chunk("LAYR", usize::MAX),
-                    );
-                }
+    for_each_ref(c, |what, r| match entries.get(r.chunk as usize) {
+        Some(e) if e.fourcc == chunk::CSTR => {
+            if r.offset
+                .checked_add(r.length as u64)
+                .is_none_or(|end| end > e.length)
+            {
+                issues.push(
+                    Issue::new(
+                        8002,
+                        format!(
+                            "{what}: {} bytes at {} in a chunk of {}",
+                            r.length, r.offset, e.length
+                        ),
+                    )
+                    .in_chunk("LAYR", usize::MAX),
+                );
             }
-            _ => issues.push(Issue::new(8001, format!("{what}: chunk {}", r.chunk)).in_chunk("LAYR", usize::MAX)),
         }
+        _ => issues.push(
+            Issue::new(8001, format!("{what}: chunk {}", r.chunk)).in_chunk("LAYR", usize::MAX),
+        ),
     });
 }
 
@@ -370,7 +472,10 @@ pub(crate) fn for_each_ref(c: &Container<StreamRef>, mut f: impl FnMut(String, &
             for (bi, b) in l.blocks.iter().enumerate() {
                 for (lv, level) in b.levels.iter().enumerate() {
                     for (ii, r) in level.images.iter().enumerate() {
-                        f(format!("object {oi} layer {li} block {bi} level {lv} image {ii}"), r);
+                        f(
+                            format!("object {oi} layer {li} block {bi} level {lv} image {ii}"),
+                            r,
+                        );
                     }
                 }
             }

@@ -9,7 +9,8 @@ use crate::texture::LevelLayout;
 pub fn finish<S>(layer: &Layer<S>, layout: &LevelLayout, mut data: Vec<f32>) -> Vec<f32> {
     if layer.gamma != 1.0 {
         let g = layer.gamma;
-        data.iter_mut().for_each(|v| *v = v.signum() * v.abs().powf(g));
+        data.iter_mut()
+            .for_each(|v| *v = v.signum() * v.abs().powf(g));
     }
     if layer.mip_mode == MipMode::Stored && layout.mips > 1 {
         let c = layout.channels;
@@ -56,7 +57,8 @@ pub fn prepare<S>(layer: &Layer<S>, layout: &LevelLayout, linear: &[f32]) -> Vec
     }
     if layer.gamma != 1.0 {
         let inv = 1.0 / layer.gamma;
-        data.iter_mut().for_each(|v| *v = v.signum() * v.abs().powf(inv));
+        data.iter_mut()
+            .for_each(|v| *v = v.signum() * v.abs().powf(inv));
     }
     data
 }

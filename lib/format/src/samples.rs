@@ -36,17 +36,33 @@ pub fn encode_block(
         for (s, local) in locals.iter().enumerate() {
             let m = level_image_index(counts, local, extent);
             members[m].push(s);
-            means[m].iter_mut().zip(&prepared[s]).for_each(|(a, v)| *a += *v as f64);
+            means[m]
+                .iter_mut()
+                .zip(&prepared[s])
+                .for_each(|(a, v)| *a += *v as f64);
         }
-        let mut level = Level { counts: counts.clone(), images: Vec::with_capacity(images) };
+        let mut level = Level {
+            counts: counts.clone(),
+            images: Vec::with_capacity(images),
+        };
         for (m, sum) in means.iter().enumerate() {
-            let first = *members[m].first().ok_or_else(|| Error::Request(format!("level {counts:?} image {m} covers no sample")))?;
+            let first = *members[m].first().ok_or_else(|| {
+                Error::Request(format!("level {counts:?} image {m} covers no sample"))
+            })?;
             let k = members[m].len() as f64;
-            let residual: Vec<f32> = sum.iter().zip(&above[first]).map(|(s, a)| (s / k) as f32 - a).collect();
+            let residual: Vec<f32> = sum
+                .iter()
+                .zip(&above[first])
+                .map(|(s, a)| (s / k) as f32 - a)
+                .collect();
             for &s in &members[m] {
-                above[s].iter_mut().zip(&residual).for_each(|(a, r)| *a += r);
+                above[s]
+                    .iter_mut()
+                    .zip(&residual)
+                    .for_each(|(a, r)| *a += r);
             }
-            let bytes = pis_codec::encode(codec, &planes, &residual).map_err(|e| Error::Request(e.to_string()))?;
+            let bytes = pis_codec::encode(codec, &planes, &residual)
+                .map_err(|e| Error::Request(e.to_string()))?;
             level.images.push(Codestream { codec, bytes });
         }
         block.levels.push(level);
@@ -72,7 +88,12 @@ pub fn rotate_y_translate(deg: f32, t: [f32; 3]) -> [f32; 12] {
 /// A camera orbiting the origin at distance `r`, `deg` degrees about +Y, looking at it.
 fn orbit_camera(deg: f32, r: f32) -> Camera {
     let (s, c) = deg.to_radians().sin_cos();
-    Camera { world_from_camera: rotate_y_translate(deg, [r * s, 0.0, r * c]), yfov: 0.8, znear: 0.1, zfar: 100.0 }
+    Camera {
+        world_from_camera: rotate_y_translate(deg, [r * s, 0.0, r * c]),
+        yfov: 0.8,
+        znear: 0.1,
+        zfar: 100.0,
+    }
 }
 
 /// The spec's worked example: one dimension of 2 view samples, one diffuse quad with one
@@ -95,13 +116,25 @@ pub fn minimal() -> Result<Container, Error> {
         cameras: vec![orbit_camera(0.0, 2.0), orbit_camera(10.0, 2.0)],
     };
     let mesh = Mesh {
-        positions: vec![[-0.5, -0.5, 0.0], [0.5, -0.5, 0.0], [0.5, 0.5, 0.0], [-0.5, 0.5, 0.0]],
+        positions: vec![
+            [-0.5, -0.5, 0.0],
+            [0.5, -0.5, 0.0],
+            [0.5, 0.5, 0.0],
+            [-0.5, 0.5, 0.0],
+        ],
         normals: None,
         texcoords: Some(vec![[0.0, 1.0], [1.0, 1.0], [1.0, 0.0], [0.0, 0.0]]),
         indices: vec![0, 1, 2, 0, 2, 3],
     };
     let layer = surface_layer(LayerKind::Diffuse, 0, DepMask::NONE, 1.0);
-    let block = Block { width: 2, height: 2, placement: Placement::Surface { affine: [1.0, 0.0, 0.0, 1.0, 0.0, 0.0] }, levels: vec![] };
+    let block = Block {
+        width: 2,
+        height: 2,
+        placement: Placement::Surface {
+            affine: [1.0, 0.0, 0.0, 1.0, 0.0, 0.0],
+        },
+        levels: vec![],
+    };
     let texels = vec![1.0, 0.5, 0.25, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.5, 0.5, 0.5];
     let block = encode_block(&layer, block, &[], &[vec![]], &[texels], CodecId::Raw)?;
     let object = Object {
@@ -111,7 +144,10 @@ pub fn minimal() -> Result<Container, Error> {
         stagger: vec![0],
         transforms: TransformTable::fixed(IDENTITY_3X4),
         mesh,
-        layers: vec![Layer { blocks: vec![block], ..layer }],
+        layers: vec![Layer {
+            blocks: vec![block],
+            ..layer
+        }],
     };
     Ok(Container {
         space,
@@ -143,14 +179,22 @@ fn surface_layer(kind: LayerKind, order: u8, depends_on: DepMask, gamma: f32) ->
 
 /// A UV sphere of radius `r` (longitude × latitude segments) with normals and texcoords.
 pub fn uv_sphere(r: f32, lon: u32, lat: u32) -> Mesh {
-    let mut m = Mesh { normals: Some(vec![]), texcoords: Some(vec![]), ..Default::default() };
+    let mut m = Mesh {
+        normals: Some(vec![]),
+        texcoords: Some(vec![]),
+        ..Default::default()
+    };
     for j in 0..=lat {
         let v = j as f32 / lat as f32;
         let theta = v * std::f32::consts::PI;
         for i in 0..=lon {
             let u = i as f32 / lon as f32;
             let phi = u * std::f32::consts::TAU;
-            let n = [theta.sin() * phi.cos(), theta.cos(), theta.sin() * phi.sin()];
+            let n = [
+                theta.sin() * phi.cos(),
+                theta.cos(),
+                theta.sin() * phi.sin(),
+            ];
             m.positions.push([n[0] * r, n[1] * r, n[2] * r]);
             m.normals.as_mut().expect("set above").push(n);
             m.texcoords.as_mut().expect("set above").push([u, v]);
@@ -180,7 +224,10 @@ pub fn tiny() -> Result<Container, Error> {
         values,
     };
     let space = ParameterSpace {
-        dims: vec![dim("view", DimensionKind::View, "deg", vec![0.0, 5.0]), dim("light", DimensionKind::Light, "", vec![0.0, 1.0])],
+        dims: vec![
+            dim("view", DimensionKind::View, "deg", vec![0.0, 5.0]),
+            dim("light", DimensionKind::Light, "", vec![0.0, 1.0]),
+        ],
     };
     let cameras = CameraTable {
         width: 32,
@@ -205,9 +252,26 @@ pub fn tiny() -> Result<Container, Error> {
         }
         t
     };
-    let block = Block { width: w, height: h, placement: Placement::Surface { affine: [1.0, 0.0, 0.0, 1.0, 0.0, 0.0] }, levels: vec![] };
-    let block = encode_block(&diffuse, block, &[2], &[vec![1], vec![2]], &[texture(0), texture(1)], codec)?;
-    let diffuse = Layer { blocks: vec![block], ..diffuse };
+    let block = Block {
+        width: w,
+        height: h,
+        placement: Placement::Surface {
+            affine: [1.0, 0.0, 0.0, 1.0, 0.0, 0.0],
+        },
+        levels: vec![],
+    };
+    let block = encode_block(
+        &diffuse,
+        block,
+        &[2],
+        &[vec![1], vec![2]],
+        &[texture(0), texture(1)],
+        codec,
+    )?;
+    let diffuse = Layer {
+        blocks: vec![block],
+        ..diffuse
+    };
 
     // Distant shell: a sphere of radius 4, 4×4 faces with their MIP chain, over `view`,
     // whose block origin is staggered by 1: two blocks of one sample each.
@@ -230,7 +294,11 @@ pub fn tiny() -> Result<Container, Error> {
         let block = Block {
             width: 4,
             height: 4,
-            placement: Placement::Shell { shape: ShellShape::Sphere, origin: [0.0; 3], params: [4.0, 0.0, 0.0, 0.0, 0.0, 0.0] },
+            placement: Placement::Shell {
+                shape: ShellShape::Sphere,
+                origin: [0.0; 3],
+                params: [4.0, 0.0, 0.0, 0.0, 0.0, 0.0],
+            },
             levels: vec![],
         };
         let layout = LevelLayout::of(&shell, &block);
@@ -244,14 +312,25 @@ pub fn tiny() -> Result<Container, Error> {
                 }
             }
         }
-        blocks.push(encode_block(&shell, block, &grid.extent(b), &[vec![1]], &[values], codec)?);
+        blocks.push(encode_block(
+            &shell,
+            block,
+            &grid.extent(b),
+            &[vec![1]],
+            &[values],
+            codec,
+        )?);
     }
     let shell = Layer { blocks, ..shell };
 
     let object = Object {
         name: "ball".into(),
         role: ObjectRole::Reflective,
-        shading: Shading { f0: [0.9, 0.85, 0.8], ior: 1.5, absorption: [0.0; 3] },
+        shading: Shading {
+            f0: [0.9, 0.85, 0.8],
+            ior: 1.5,
+            absorption: [0.0; 3],
+        },
         stagger,
         transforms: TransformTable::fixed(IDENTITY_3X4),
         mesh: uv_sphere(1.0, 8, 6),
@@ -265,7 +344,10 @@ pub fn tiny() -> Result<Container, Error> {
             tool: format!("pis-format {}", env!("CARGO_PKG_VERSION")),
             source: "generated by pis_format::samples::tiny".into(),
             raw_image_bytes: 4 * 32 * 24 * 3,
-            settings: vec![("codec".into(), "lossless".into()), ("block".into(), "2x2".into())],
+            settings: vec![
+                ("codec".into(), "lossless".into()),
+                ("block".into(), "2x2".into()),
+            ],
         }),
     })
 }

@@ -19,7 +19,10 @@ pub struct FileSource {
 impl FileSource {
     pub fn new(file: File) -> io::Result<Self> {
         let len = file.metadata()?.len();
-        Ok(FileSource { file: Mutex::new(file), len })
+        Ok(FileSource {
+            file: Mutex::new(file),
+            len,
+        })
     }
 }
 
@@ -29,7 +32,10 @@ impl Source for FileSource {
     }
 
     fn read_at(&self, offset: u64, buf: &mut [u8]) -> io::Result<()> {
-        let mut f = self.file.lock().map_err(|_| io::Error::other("file lock poisoned"))?;
+        let mut f = self
+            .file
+            .lock()
+            .map_err(|_| io::Error::other("file lock poisoned"))?;
         f.seek(SeekFrom::Start(offset))?;
         f.read_exact(buf)
     }
@@ -41,7 +47,8 @@ impl Source for Vec<u8> {
     }
 
     fn read_at(&self, offset: u64, buf: &mut [u8]) -> io::Result<()> {
-        let start = usize::try_from(offset).map_err(|_| io::Error::from(io::ErrorKind::UnexpectedEof))?;
+        let start =
+            usize::try_from(offset).map_err(|_| io::Error::from(io::ErrorKind::UnexpectedEof))?;
         let src = start
             .checked_add(buf.len())
             .and_then(|end| self.get(start..end))

@@ -27,7 +27,13 @@ impl LevelLayout {
             MipMode::Decimated => 1,
             MipMode::Stored => mip_count(block.width, block.height),
         };
-        LevelLayout { width: block.width, height: block.height, channels: layer.channels as u32, faces, mips }
+        LevelLayout {
+            width: block.width,
+            height: block.height,
+            channels: layer.channels as u32,
+            faces,
+            mips,
+        }
     }
 
     pub fn planes(&self) -> Vec<PlaneShape> {
@@ -55,7 +61,10 @@ impl Texture {
     pub fn plane(&self, face: u32, mip: u32) -> &[f32] {
         let planes = self.layout.planes();
         let idx = (face * self.layout.mips + mip) as usize;
-        let start: usize = planes[..idx].iter().map(|p| (p.width * p.height * p.channels) as usize).sum();
+        let start: usize = planes[..idx]
+            .iter()
+            .map(|p| (p.width * p.height * p.channels) as usize)
+            .sum();
         let p = planes[idx];
         &self.data[start..start + (p.width * p.height * p.channels) as usize]
     }

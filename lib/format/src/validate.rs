@@ -30,7 +30,10 @@ impl Validation {
 pub fn validate_file(path: &Path) -> Validation {
     match std::fs::File::open(path).and_then(FileSource::new) {
         Ok(src) => validate_source(&src),
-        Err(e) => Validation { issues: vec![Issue::new(1001, format!("{}: {e}", path.display()))], ..Default::default() },
+        Err(e) => Validation {
+            issues: vec![Issue::new(1001, format!("{}: {e}", path.display()))],
+            ..Default::default()
+        },
     }
 }
 
@@ -75,10 +78,20 @@ fn validate_source(src: &dyn Source) -> Validation {
             k += 1;
         });
     }
-    Validation { issues, chunks: loaded.chunks, chunk_crc_ok }
+    Validation {
+        issues,
+        chunks: loaded.chunks,
+        chunk_crc_ok,
+    }
 }
 
-fn check_stream(src: &dyn Source, chunks: &[ChunkEntry], r: &StreamRef, layout: &LevelLayout, what: &str) -> Option<Issue> {
+fn check_stream(
+    src: &dyn Source,
+    chunks: &[ChunkEntry],
+    r: &StreamRef,
+    layout: &LevelLayout,
+    what: &str,
+) -> Option<Issue> {
     let e = &chunks[r.chunk as usize];
     let at = e.offset + r.offset;
     let tag = |i: Issue| i.in_chunk("CSTR", r.chunk as usize).at(at);
@@ -88,16 +101,23 @@ fn check_stream(src: &dyn Source, chunks: &[ChunkEntry], r: &StreamRef, layout: 
     }
     let crc = crc32fast::hash(&bytes);
     if crc != r.crc {
-        return Some(tag(Issue::new(8003, format!("{what}: stored {:#010x}, computed {crc:#010x}", r.crc))));
+        return Some(tag(Issue::new(
+            8003,
+            format!("{what}: stored {:#010x}, computed {crc:#010x}", r.crc),
+        )));
     }
     match pis_codec::decode(r.codec, &layout.planes(), &bytes) {
         Ok(values) => {
             let bad = values.iter().position(|v| !v.is_finite())?;
-            Some(tag(Issue::new(8006, format!("{what}: value {bad} is {}", values[bad]))))
+            Some(tag(Issue::new(
+                8006,
+                format!("{what}: value {bad} is {}", values[bad]),
+            )))
         }
-        Err(CodecError::NotSupported(c)) => {
-            Some(tag(Issue::warning(8007, format!("{what}: codec '{c}' cannot be checked by this build"))))
-        }
+        Err(CodecError::NotSupported(c)) => Some(tag(Issue::warning(
+            8007,
+            format!("{what}: codec '{c}' cannot be checked by this build"),
+        ))),
         Err(err) => Some(tag(Issue::new(8005, format!("{what}: {err}")))),
     }
 }

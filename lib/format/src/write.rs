@@ -6,7 +6,9 @@ use std::io::Write;
 use std::path::Path;
 
 use crate::binary::{Sink, Span};
-use crate::chunk::{self, FourCC, ALIGN, ENTRY_LEN, HEADER_LEN, MAGIC, VERSION_MAJOR, VERSION_MINOR};
+use crate::chunk::{
+    self, FourCC, ALIGN, ENTRY_LEN, HEADER_LEN, MAGIC, VERSION_MAJOR, VERSION_MINOR,
+};
 use crate::model::{Codestream, Container, StreamRef};
 use crate::{checks, payload_write as pw, Error};
 
@@ -37,12 +39,19 @@ pub fn write(path: &Path, c: &Container) -> Result<u64, Error> {
 
 /// Writes `bytes` to `path` through a temporary file and a rename.
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), Error> {
-    let io = |source| Error::Io { path: path.to_path_buf(), source };
+    let io = |source| Error::Io {
+        path: path.to_path_buf(),
+        source,
+    };
     let dir = match path.parent() {
         Some(d) if !d.as_os_str().is_empty() => d,
         _ => Path::new("."),
     };
-    let mut tmp = tempfile::Builder::new().prefix(".pis-").suffix(".tmp").tempfile_in(dir).map_err(io)?;
+    let mut tmp = tempfile::Builder::new()
+        .prefix(".pis-")
+        .suffix(".tmp")
+        .tempfile_in(dir)
+        .map_err(io)?;
     tmp.write_all(bytes).map_err(io)?;
     tmp.as_file().sync_all().map_err(io)?;
     tmp.persist(path).map_err(|e| io(e.error))?;
@@ -58,9 +67,19 @@ fn serialize(c: &Container, labelled: bool) -> Result<Sink, Error> {
     if let Some(issue) = checks::check(c).into_iter().next() {
         return Err(Error::InvalidModel(issue));
     }
-    for r in c.objects.iter().flat_map(|o| &o.layers).flat_map(|l| &l.blocks).flat_map(|b| &b.levels).flat_map(|l| &l.images) {
+    for r in c
+        .objects
+        .iter()
+        .flat_map(|o| &o.layers)
+        .flat_map(|l| &l.blocks)
+        .flat_map(|b| &b.levels)
+        .flat_map(|l| &l.images)
+    {
         if u32::try_from(r.bytes.len()).is_err() {
-            return Err(Error::Request(format!("a codestream of {} bytes exceeds 4 GiB", r.bytes.len())));
+            return Err(Error::Request(format!(
+                "a codestream of {} bytes exceeds 4 GiB",
+                r.bytes.len()
+            )));
         }
     }
     Ok(serialize_inner(c, labelled))
@@ -95,8 +114,15 @@ fn serialize_inner(c: &Container, labelled: bool) -> Sink {
         }
     }
     let mut next = refs.into_iter();
-    chunks.push(chunk(chunk::LAYR, &mut |s| pw::layr(s, &c.objects, |_| next.next().expect("one reference per image"))));
-    chunks.push(Chunk { fourcc: chunk::CSTR, payload: cstr });
+    chunks.push(chunk(chunk::LAYR, &mut |s| {
+        pw::layr(s, &c.objects, |_| {
+            next.next().expect("one reference per image")
+        })
+    }));
+    chunks.push(Chunk {
+        fourcc: chunk::CSTR,
+        payload: cstr,
+    });
     if let Some(p) = &c.provenance {
         chunks.push(chunk(chunk::PROV, &mut |s| pw::prov(s, p)));
     }
@@ -105,8 +131,20 @@ fn serialize_inner(c: &Container, labelled: bool) -> Sink {
 
 fn place(cstr: &mut Sink, chunk: u32, img: &Codestream) -> StreamRef {
     let length = img.bytes.len() as u32; // checked by `serialize`
-    let r = StreamRef { codec: img.codec, chunk, offset: cstr.len() as u64, length, crc: crc32fast::hash(&img.bytes) };
-    cstr.raw(&img.bytes, || format!("codestream ({}, {} bytes)", img.codec.name(), img.bytes.len()));
+    let r = StreamRef {
+        codec: img.codec,
+        chunk,
+        offset: cstr.len() as u64,
+        length,
+        crc: crc32fast::hash(&img.bytes),
+    };
+    cstr.raw(&img.bytes, || {
+        format!(
+            "codestream ({}, {} bytes)",
+            img.codec.name(),
+            img.bytes.len()
+        )
+    });
     r
 }
 
@@ -153,7 +191,8 @@ fn assemble(chunks: Vec<Chunk>, labelled: bool) -> Sink {
                 s.label = format!("file length = {len}");
             }
             if s.start == 28 {
-                s.label = format!("header crc32 (of bytes 0..28 and the chunk table) = {crc:#010x}");
+                s.label =
+                    format!("header crc32 (of bytes 0..28 and the chunk table) = {crc:#010x}");
             }
         }
     }

@@ -44,7 +44,9 @@ static ALLOC: Tracking = Tracking;
 /// Opens `bytes` and, if that works, decodes every layer at every point. Returns whether
 /// every step succeeded.
 fn read_everything(bytes: &[u8]) -> bool {
-    let Ok(r) = PisReader::from_bytes(bytes.to_vec()) else { return false };
+    let Ok(r) = PisReader::from_bytes(bytes.to_vec()) else {
+        return false;
+    };
     let c = r.container();
     let mut ok = true;
     for p in 0..c.space.point_count() {
@@ -125,7 +127,10 @@ fn mutate(rng: &mut Rng, good: &[u8]) -> Vec<u8> {
 
 #[test]
 fn damaged_files_give_errors_never_panics() {
-    for good in [to_bytes(&tiny().unwrap()).unwrap(), to_bytes(&minimal().unwrap()).unwrap()] {
+    for good in [
+        to_bytes(&tiny().unwrap()).unwrap(),
+        to_bytes(&minimal().unwrap()).unwrap(),
+    ] {
         assert!(read_everything(&good));
 
         // Every single flipped byte is caught by validation, and by the reader at the latest
@@ -133,7 +138,10 @@ fn damaged_files_give_errors_never_panics() {
         for at in 0..good.len() {
             let mut b = good.clone();
             b[at] ^= 0x5a;
-            assert!(!validate_bytes(b.clone()).is_valid(), "flip at {at} not detected");
+            assert!(
+                !validate_bytes(b.clone()).is_valid(),
+                "flip at {at} not detected"
+            );
             assert!(!read_everything(&b), "flip at {at} read back without error");
         }
 
@@ -141,8 +149,13 @@ fn damaged_files_give_errors_never_panics() {
         for len in 0..good.len() {
             let report = validate_bytes(good[..len].to_vec());
             assert!(!report.is_valid(), "truncation to {len} not detected");
-            let err = PisReader::from_bytes(good[..len].to_vec()).err().expect("truncated file opened");
-            assert!(matches!(err.issue().map(|i| i.id), Some(1002 | 1003)), "truncation to {len}: {err}");
+            let err = PisReader::from_bytes(good[..len].to_vec())
+                .err()
+                .expect("truncated file opened");
+            assert!(
+                matches!(err.issue().map(|i| i.id), Some(1002 | 1003)),
+                "truncation to {len}: {err}"
+            );
         }
 
         // Random mutations: errors or valid files, no panic, bounded allocations.
@@ -158,10 +171,17 @@ fn damaged_files_give_errors_never_panics() {
         }
         TRACK.store(false, Ordering::Relaxed);
         // Resealed mutations must get past the checksums into the payload rules.
-        assert!(deep > 300, "only {deep} mutations reached the payload parsers");
+        assert!(
+            deep > 300,
+            "only {deep} mutations reached the payload parsers"
+        );
         let largest = LARGEST.load(Ordering::Relaxed);
         // Decoded textures may exceed the file (DEFLATE can expand up to ~1032:1); anything
         // beyond that would be an allocation sized by an unchecked field.
-        assert!(largest <= 1032 * good.len() + (1 << 16), "largest allocation {largest} bytes for a {}-byte file", good.len());
+        assert!(
+            largest <= 1032 * good.len() + (1 << 16),
+            "largest allocation {largest} bytes for a {}-byte file",
+            good.len()
+        );
     }
 }

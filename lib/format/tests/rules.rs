@@ -94,7 +94,10 @@ fn cases() -> Vec<(u16, Vec<u8>)> {
     let mut v: Vec<(u16, Vec<u8>)> = Vec::new();
     let t = || File::tiny();
     let good = t().bytes;
-    let chunks = PisReader::from_bytes(good.clone()).unwrap().chunks().to_vec();
+    let chunks = PisReader::from_bytes(good.clone())
+        .unwrap()
+        .chunks()
+        .to_vec();
     let idx = |f: &[u8; 4]| chunks.iter().position(|e| &e.fourcc == f).unwrap();
     let (prov, cstr) = (idx(b"PROV"), idx(b"CSTR"));
 
@@ -102,14 +105,45 @@ fn cases() -> Vec<(u16, Vec<u8>)> {
     v.push((1002, good[..20].to_vec()));
     v.push((1003, good[..good.len() - 1].to_vec()));
     // 2xxx
-    v.push((2001, { let mut b = good.clone(); b[1] = b'X'; b }));
-    v.push((2002, { let mut b = good.clone(); b[8] = 2; b }));
-    v.push((2003, { let mut b = good.clone(); b[12] = 1; reseal(&mut b); b }));
-    v.push((2004, { let mut b = good.clone(); b[28] ^= 0xff; b }));
-    v.push((2005, { let mut b = good.clone(); b[24..28].copy_from_slice(&1000u32.to_le_bytes()); b }));
+    v.push((2001, {
+        let mut b = good.clone();
+        b[1] = b'X';
+        b
+    }));
+    v.push((2002, {
+        let mut b = good.clone();
+        b[8] = 2;
+        b
+    }));
+    v.push((2003, {
+        let mut b = good.clone();
+        b[12] = 1;
+        reseal(&mut b);
+        b
+    }));
+    v.push((2004, {
+        let mut b = good.clone();
+        b[28] ^= 0xff;
+        b
+    }));
+    v.push((2005, {
+        let mut b = good.clone();
+        b[24..28].copy_from_slice(&1000u32.to_le_bytes());
+        b
+    }));
     // 3xxx
-    v.push((3001, { let mut b = good.clone(); b[entry(prov) + 8] += 1; reseal(&mut b); b }));
-    v.push((3002, { let mut b = good.clone(); b[entry(prov) + 16..entry(prov) + 24].copy_from_slice(&u64::MAX.to_le_bytes()); reseal(&mut b); b }));
+    v.push((3001, {
+        let mut b = good.clone();
+        b[entry(prov) + 8] += 1;
+        reseal(&mut b);
+        b
+    }));
+    v.push((3002, {
+        let mut b = good.clone();
+        b[entry(prov) + 16..entry(prov) + 24].copy_from_slice(&u64::MAX.to_le_bytes());
+        reseal(&mut b);
+        b
+    }));
     v.push((3003, {
         // Move the last chunk 8 bytes on, leaving a gap.
         let mut b = good.clone();
@@ -124,21 +158,59 @@ fn cases() -> Vec<(u16, Vec<u8>)> {
         reseal(&mut b);
         b
     }));
-    v.push((3004, { let mut b = good.clone(); let at = t().at("dimension 0 block size"); b[at] ^= 1; b }));
+    v.push((3004, {
+        let mut b = good.clone();
+        let at = t().at("dimension 0 block size");
+        b[at] ^= 1;
+        b
+    }));
     v.push((3005, {
         let f = t();
-        let pad = f.spans.iter().find(|s| s.label.starts_with("padding") && s.len > 0).expect("a padded chunk");
+        let pad = f
+            .spans
+            .iter()
+            .find(|s| s.label.starts_with("padding") && s.len > 0)
+            .expect("a padded chunk");
         let mut b = f.bytes.clone();
         b[pad.start] = 7;
         reseal(&mut b);
         b
     }));
     v.push((3006, t().set_u32("reserved", 5).reseal()));
-    v.push((3007, { let mut b = good.clone(); b[entry(prov)..entry(prov) + 4].copy_from_slice(b"ZZZZ"); b[entry(prov) + 4] = 1; reseal(&mut b); b }));
-    v.push((3008, { let mut b = good.clone(); b[entry(0)..entry(0) + 4].copy_from_slice(b"ZZZZ"); b[entry(0) + 4] = 0; reseal(&mut b); b }));
-    v.push((3009, { let mut b = good.clone(); b[entry(prov)..entry(prov) + 4].copy_from_slice(b"CAMS"); b[entry(prov) + 4] = 1; reseal(&mut b); b }));
-    v.push((3010, { let mut b = good.clone(); b[entry(prov) + 4] = 1; reseal(&mut b); b }));
-    v.push((3011, { let mut b = good.clone(); b.extend([0; 8]); set_file_length(&mut b); reseal(&mut b); b }));
+    v.push((3007, {
+        let mut b = good.clone();
+        b[entry(prov)..entry(prov) + 4].copy_from_slice(b"ZZZZ");
+        b[entry(prov) + 4] = 1;
+        reseal(&mut b);
+        b
+    }));
+    v.push((3008, {
+        let mut b = good.clone();
+        b[entry(0)..entry(0) + 4].copy_from_slice(b"ZZZZ");
+        b[entry(0) + 4] = 0;
+        reseal(&mut b);
+        b
+    }));
+    v.push((3009, {
+        let mut b = good.clone();
+        b[entry(prov)..entry(prov) + 4].copy_from_slice(b"CAMS");
+        b[entry(prov) + 4] = 1;
+        reseal(&mut b);
+        b
+    }));
+    v.push((3010, {
+        let mut b = good.clone();
+        b[entry(prov) + 4] = 1;
+        reseal(&mut b);
+        b
+    }));
+    v.push((3011, {
+        let mut b = good.clone();
+        b.extend([0; 8]);
+        set_file_length(&mut b);
+        reseal(&mut b);
+        b
+    }));
     // 4xxx
     v.push((4000, t().set_u32("dimension count", 3).reseal()));
     v.push((4001, t().set_u32("dimension count", 9).reseal()));
@@ -146,14 +218,25 @@ fn cases() -> Vec<(u16, Vec<u8>)> {
     v.push((4003, t().set_u8("dimension 0 kind", 9).reseal()));
     v.push((4004, unchecked(|c| c.space.dims[1].values.clear())));
     v.push((4005, t().set_u32("dimension 0 block size", 0).reseal()));
-    v.push((4006, t().set_f32("dimension 0 sample values", f32::NAN).reseal()));
-    v.push((4007, unchecked(|c| {
-        c.space.dims[0].values = (0..5000).map(|i| i as f32).collect();
-        c.space.dims[1].values = (0..5000).map(|i| i as f32).collect();
-    })));
+    v.push((
+        4006,
+        t().set_f32("dimension 0 sample values", f32::NAN).reseal(),
+    ));
+    v.push((
+        4007,
+        unchecked(|c| {
+            c.space.dims[0].values = (0..5000).map(|i| i as f32).collect();
+            c.space.dims[1].values = (0..5000).map(|i| i as f32).collect();
+        }),
+    ));
     // 5xxx
     v.push((5000, t().set_u32("camera count", 3).reseal()));
-    v.push((5001, unchecked(|c| { c.cameras.cameras.pop(); })));
+    v.push((
+        5001,
+        unchecked(|c| {
+            c.cameras.cameras.pop();
+        }),
+    ));
     v.push((5002, t().set_u32("dependency mask", 0b100).reseal()));
     v.push((5003, t().set_f32("camera 0 yfov", 0.0).reseal()));
     v.push((5004, t().set_u32("image width", 0).reseal()));
@@ -161,9 +244,22 @@ fn cases() -> Vec<(u16, Vec<u8>)> {
     v.push((5101, t().set_u32("object count", 0).reseal()));
     v.push((5102, t().set_bytes("object 0 name =", &[0xc3]).reseal()));
     v.push((5103, t().set_u8("object 0 role", 7).reseal()));
-    v.push((5104, { let mut f = t(); let at = f.at("object 0 ior"); f.bytes[at..at + 4].copy_from_slice(&0.5f32.to_le_bytes()); f.reseal() }));
-    v.push((5105, t().set_u32("object 0 block origin offset, dimension 0", 2).reseal()));
-    v.push((5106, t().set_f32("object 0 world_from_object 0", f32::INFINITY).reseal()));
+    v.push((5104, {
+        let mut f = t();
+        let at = f.at("object 0 ior");
+        f.bytes[at..at + 4].copy_from_slice(&0.5f32.to_le_bytes());
+        f.reseal()
+    }));
+    v.push((
+        5105,
+        t().set_u32("object 0 block origin offset, dimension 0", 2)
+            .reseal(),
+    ));
+    v.push((
+        5106,
+        t().set_f32("object 0 world_from_object 0", f32::INFINITY)
+            .reseal(),
+    ));
     v.push((5200, t().set_u32("vertex count", 1000).reseal()));
     v.push((5201, t().set_u32("object index", 4).reseal()));
     v.push((5202, {
@@ -174,13 +270,22 @@ fn cases() -> Vec<(u16, Vec<u8>)> {
         let mut b = to_bytes(&c).unwrap();
         // The second MESH chunk becomes an unknown optional chunk: object 1 has no mesh.
         let r = PisReader::from_bytes(b.clone()).unwrap();
-        let i = r.chunks().iter().rposition(|e| &e.fourcc == b"MESH").unwrap();
+        let i = r
+            .chunks()
+            .iter()
+            .rposition(|e| &e.fourcc == b"MESH")
+            .unwrap();
         b[entry(i)..entry(i) + 4].copy_from_slice(b"XMSH");
         b[entry(i) + 4] = 0;
         reseal(&mut b);
         b
     }));
-    v.push((5203, unchecked(|c| { c.objects[0].mesh.indices.pop(); })));
+    v.push((
+        5203,
+        unchecked(|c| {
+            c.objects[0].mesh.indices.pop();
+        }),
+    ));
     v.push((5204, t().set_u32("indices", 9999).reseal()));
     v.push((5205, t().set_f32("positions", f32::NAN).reseal()));
     // 6xxx
@@ -189,37 +294,95 @@ fn cases() -> Vec<(u16, Vec<u8>)> {
     v.push((6002, t().set_u8("layer 0 kind", 20).reseal()));
     v.push((6003, t().set_u8("layer 0 channels", 4).reseal()));
     v.push((6004, t().set_f32("layer 0 gamma", -1.0).reseal()));
-    v.push((6005, unchecked(|c| { c.objects[0].layers[1].blocks.pop(); })));
+    v.push((
+        6005,
+        unchecked(|c| {
+            c.objects[0].layers[1].blocks.pop();
+        }),
+    ));
     v.push((6006, t().set_u32("layer 1 block 0 width", 5).reseal()));
-    v.push((6007, t().set_f32("layer 1 block 0 shell parameters", -4.0).reseal()));
-    v.push((6008, unchecked(|c| { let l = c.objects[0].layers[0].clone(); c.objects[0].layers.push(l); })));
+    v.push((
+        6007,
+        t().set_f32("layer 1 block 0 shell parameters", -4.0)
+            .reseal(),
+    ));
+    v.push((
+        6008,
+        unchecked(|c| {
+            let l = c.objects[0].layers[0].clone();
+            c.objects[0].layers.push(l);
+        }),
+    ));
     // 7xxx
     v.push((7001, t().set_u32("layer 0 block 0 level count", 0).reseal()));
-    v.push((7002, unchecked(|c| { let lv = &mut c.objects[0].layers[0].blocks[0].levels; lv[0] = lv[1].clone(); })));
-    v.push((7003, unchecked(|c| { let lv = &mut c.objects[0].layers[0].blocks[0].levels; let top = lv[0].clone(); lv.push(top); })));
-    v.push((7004, unchecked(|c| { c.objects[0].layers[0].blocks[0].levels.pop(); })));
+    v.push((
+        7002,
+        unchecked(|c| {
+            let lv = &mut c.objects[0].layers[0].blocks[0].levels;
+            lv[0] = lv[1].clone();
+        }),
+    ));
+    v.push((
+        7003,
+        unchecked(|c| {
+            let lv = &mut c.objects[0].layers[0].blocks[0].levels;
+            let top = lv[0].clone();
+            lv.push(top);
+        }),
+    ));
+    v.push((
+        7004,
+        unchecked(|c| {
+            c.objects[0].layers[0].blocks[0].levels.pop();
+        }),
+    ));
     // 8xxx
-    v.push((8001, t().set_u32("layer 0 block 0 level 0 image 0 chunk index", 0).reseal()));
-    v.push((8002, t().set_u32("layer 0 block 0 level 0 image 0 offset", 1 << 20).reseal()));
+    v.push((
+        8001,
+        t().set_u32("layer 0 block 0 level 0 image 0 chunk index", 0)
+            .reseal(),
+    ));
+    v.push((
+        8002,
+        t().set_u32("layer 0 block 0 level 0 image 0 offset", 1 << 20)
+            .reseal(),
+    ));
     v.push((8003, {
         let mut f = t();
         let at = f.at("codestream");
         f.bytes[at + 3] ^= 0x10;
         f.reseal()
     }));
-    v.push((8004, t().set_u16("layer 0 block 0 level 0 image 0 codec", 77).reseal()));
-    v.push((8005, t().set_u16("layer 0 block 0 level 0 image 0 codec", 0).reseal()));
+    v.push((
+        8004,
+        t().set_u16("layer 0 block 0 level 0 image 0 codec", 77)
+            .reseal(),
+    ));
+    v.push((
+        8005,
+        t().set_u16("layer 0 block 0 level 0 image 0 codec", 0)
+            .reseal(),
+    ));
     v.push((8006, {
         // A raw texel becomes NaN, with the codestream's own checksum updated.
         let mut f = File::of(&minimal().unwrap());
         let at = f.at("codestream");
         f.bytes[at..at + 4].copy_from_slice(&f32::NAN.to_le_bytes());
-        let span = f.spans.iter().find(|s| s.label.starts_with("codestream")).unwrap().clone();
+        let span = f
+            .spans
+            .iter()
+            .find(|s| s.label.starts_with("codestream"))
+            .unwrap()
+            .clone();
         let crc = crc32fast::hash(&f.bytes[span.start..span.start + span.len]);
         f.set_u32("layer 0 block 0 level 0 image 0 crc32", crc);
         f.reseal()
     }));
-    v.push((8007, t().set_u16("layer 0 block 0 level 0 image 0 codec", 2).reseal()));
+    v.push((
+        8007,
+        t().set_u16("layer 0 block 0 level 0 image 0 codec", 2)
+            .reseal(),
+    ));
     v.push((9000, t().set_u32("tool length", 1 << 30).reseal()));
     let _ = cstr;
     v
@@ -230,13 +393,31 @@ fn every_rule_is_detected_by_its_crafted_file() {
     for (id, bytes) in cases() {
         let report = validate_bytes(bytes.clone());
         let ids: Vec<u16> = report.issues.iter().map(|i| i.id).collect();
-        assert!(ids.contains(&id), "rule {id}: expected it among {:?}", report.issues);
-        let is_error = report.issues.iter().any(|i| i.id == id && i.severity == Severity::Error);
-        assert_eq!(report.is_valid(), !is_error, "rule {id}: {:?}", report.issues);
+        assert!(
+            ids.contains(&id),
+            "rule {id}: expected it among {:?}",
+            report.issues
+        );
+        let is_error = report
+            .issues
+            .iter()
+            .any(|i| i.id == id && i.severity == Severity::Error);
+        assert_eq!(
+            report.is_valid(),
+            !is_error,
+            "rule {id}: {:?}",
+            report.issues
+        );
         if is_error && ![8003, 8005, 8006].contains(&id) {
             // Open-time rules fail `open`; codestream rules fail when the texture is read.
-            let err = PisReader::from_bytes(bytes).err().unwrap_or_else(|| panic!("rule {id}: reader accepted the file"));
-            assert!(err.to_string().contains(&format!("error-{}", err.issue().map_or(0, |i| i.id))), "{err}");
+            let err = PisReader::from_bytes(bytes)
+                .err()
+                .unwrap_or_else(|| panic!("rule {id}: reader accepted the file"));
+            assert!(
+                err.to_string()
+                    .contains(&format!("error-{}", err.issue().map_or(0, |i| i.id))),
+                "{err}"
+            );
         } else if is_error {
             let r = PisReader::from_bytes(bytes).unwrap();
             let failed = (0..r.container().objects[0].layers.len()).any(|l| {
@@ -252,7 +433,11 @@ fn every_rule_is_detected_by_its_crafted_file() {
 fn every_rule_has_a_case() {
     let covered: BTreeSet<u16> = cases().iter().map(|(id, _)| *id).collect();
     // 1001 (unreadable file) is covered by `missing_file_is_an_io_issue`.
-    let all: BTreeSet<u16> = RULES.iter().map(|(id, _)| *id).filter(|&id| id != 1001).collect();
+    let all: BTreeSet<u16> = RULES
+        .iter()
+        .map(|(id, _)| *id)
+        .filter(|&id| id != 1001)
+        .collect();
     assert_eq!(covered, all);
 }
 
@@ -260,7 +445,10 @@ fn every_rule_has_a_case() {
 fn missing_file_is_an_io_issue() {
     let report = validate_file("/no/such/file.pis".as_ref());
     assert_eq!(report.issues[0].id, 1001);
-    assert!(matches!(PisReader::open("/no/such/file.pis".as_ref()), Err(Error::Io { .. })));
+    assert!(matches!(
+        PisReader::open("/no/such/file.pis".as_ref()),
+        Err(Error::Io { .. })
+    ));
 }
 
 #[test]

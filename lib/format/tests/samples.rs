@@ -8,7 +8,9 @@ use pis_format::samples::{minimal, tiny};
 use pis_format::{hexdump, to_bytes, to_bytes_labelled};
 
 fn repo(rel: &str) -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../..").join(rel)
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("../..")
+        .join(rel)
 }
 
 fn updating() -> bool {
@@ -35,7 +37,11 @@ fn spec_example_matches_the_writer() {
     check_file("format-spec/examples/minimal.pis", &bytes);
     let dump = hexdump::annotate(&bytes, &spans);
     check_file("format-spec/examples/minimal.hex", dump.as_bytes());
-    assert_eq!(hexdump::parse(&dump), bytes, "the dump's hex columns are the file");
+    assert_eq!(
+        hexdump::parse(&dump),
+        bytes,
+        "the dump's hex columns are the file"
+    );
     // Every byte is labelled exactly once, in order.
     let mut at = 0;
     for s in &spans {

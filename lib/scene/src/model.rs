@@ -148,7 +148,11 @@ impl Dimension {
 pub enum Driver {
     /// The camera orbits `target` at `radius` and `elevation` (degrees); the sample value is
     /// the azimuth in degrees.
-    Orbit { target: Vec3, radius: f32, elevation_deg: f32 },
+    Orbit {
+        target: Vec3,
+        radius: f32,
+        elevation_deg: f32,
+    },
     /// A named glTF animation; the sample value is the time in seconds.
     Animation { animation: String },
     /// A named light moves along a polyline (world space); the sample value is the path

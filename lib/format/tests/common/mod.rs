@@ -29,4 +29,3 @@ pub fn reseal(b: &mut [u8]) {
     let crc = header_crc(&b[..28], &b[32..table_end]);
     b[28..32].copy_from_slice(&crc.to_le_bytes());
 }
-

@@ -1,0 +1,6 @@
+//! What the PIS command-line tools share: exit codes, error reporting, and the pieces of
+//! each tool that are more than argument parsing.
+
+pub mod cli;
+pub mod images;
+pub mod inspect;

@@ -1,0 +1,198 @@
+//! pis-inspect on the bundled sample and on damaged copies of it.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn repo(rel: &str) -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("..")
+        .join(rel)
+}
+
+fn inspect(args: &[&str], file: &Path) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_pis-inspect"))
+        .args(args)
+        .arg(file)
+        .output()
+        .expect("pis-inspect runs")
+}
+
+fn text(b: &[u8]) -> String {
+    String::from_utf8_lossy(b).into_owned()
+}
+
+#[test]
+fn summary_names_what_the_file_holds() {
+    let out = inspect(&[], &repo("samples/tiny.pis"));
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+    let s = text(&out.stdout);
+    for needle in [
+        "2 dimensions, 4 points",
+        "ball (reflective)",
+        "env_distant",
+        "sphere shell",
+        "lossless",
+        "Compression ratio",
+    ] {
+        assert!(s.contains(needle), "missing {needle:?} in\n{s}");
+    }
+}
+
+#[test]
+fn json_has_the_documented_fields() {
+    let out = inspect(&["--json"], &repo("samples/tiny.pis"));
+    assert_eq!(out.status.code(), Some(0));
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("valid JSON");
+    let dims = v["dimensions"].as_array().unwrap();
+    assert_eq!(dims.len(), 2);
+    assert_eq!(dims[0]["name"], "view");
+    assert_eq!(dims[0]["kind"], "view");
+    assert_eq!(dims[0]["samples"], 2);
+    assert_eq!(dims[1]["kind"], "light");
+    let obj = &v["objects"][0];
+    assert_eq!(obj["name"], "ball");
+    assert_eq!(obj["role"], "reflective");
+    assert_eq!(obj["layers"].as_array().unwrap().len(), 2);
+    assert_eq!(obj["layers"][1]["shell"], "sphere");
+    let size = std::fs::metadata(repo("samples/tiny.pis")).unwrap().len();
+    assert_eq!(v["bytes"]["total"], size);
+    let parts: u64 = [
+        "header",
+        "parameter_space",
+        "cameras",
+        "objects",
+        "geometry",
+        "layer_index",
+        "codestreams",
+        "provenance",
+        "other",
+    ]
+    .iter()
+    .map(|k| v["bytes"][k].as_u64().unwrap())
+    .sum();
+    assert_eq!(parts, size, "the byte kinds add up to the file");
+    let ratio = v["ratio"].as_f64().unwrap();
+    assert!((ratio - (4.0 * 32.0 * 24.0 * 3.0) / size as f64).abs() < 1e-9);
+    assert!(v["ratio_without_geometry"].as_f64().unwrap() > ratio);
+}
+
+#[test]
+fn validate_accepts_the_sample() {
+    let out = inspect(&["--validate"], &repo("samples/tiny.pis"));
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}{}",
+        text(&out.stdout),
+        text(&out.stderr)
+    );
+    let out = inspect(&["--validate", "--json"], &repo("samples/tiny.pis"));
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["valid"], true);
+}
+
+#[test]
+fn validate_reports_numbered_errors_and_exits_3() {
+    let dir = tempfile::tempdir().unwrap();
+    let good = std::fs::read(repo("samples/tiny.pis")).unwrap();
+    // A flipped byte in the middle of the geometry: a chunk checksum mismatch.
+    let mut bad = good.clone();
+    bad[1000] ^= 0x20;
+    let path = dir.path().join("flipped.pis");
+    std::fs::write(&path, &bad).unwrap();
+    let out = inspect(&["--validate"], &path);
+    assert_eq!(out.status.code(), Some(3));
+    assert!(
+        text(&out.stdout).contains("error-3004"),
+        "{}",
+        text(&out.stdout)
+    );
+    // Truncated: a clear message, exit 3, for the summary too.
+    let path = dir.path().join("truncated.pis");
+    std::fs::write(&path, &good[..good.len() / 2]).unwrap();
+    let out = inspect(&[], &path);
+    assert_eq!(out.status.code(), Some(3));
+    let err = text(&out.stderr);
+    assert!(err.starts_with("pis-inspect: error-1003"), "{err}");
+    assert!(!err.contains("panicked"));
+}
+
+#[test]
+fn chunks_lists_offsets_and_checksums() {
+    let out = inspect(&["--chunks", "--json"], &repo("samples/tiny.pis"));
+    assert_eq!(out.status.code(), Some(0));
+    let rows: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let types: Vec<&str> = rows
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|r| r["type"].as_str().unwrap())
+        .collect();
+    assert_eq!(
+        types,
+        ["PSPC", "CAMS", "OBJS", "MESH", "LAYR", "CSTR", "PROV"]
+    );
+    assert!(rows
+        .as_array()
+        .unwrap()
+        .iter()
+        .all(|r| r["checksum"] == "ok"));
+}
+
+#[test]
+fn extract_writes_exr_and_png_per_texture_and_face() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = Command::new(env!("CARGO_BIN_EXE_pis-inspect"))
+        .args(["--extract"])
+        .arg(dir.path())
+        .args(["--at", "5,0.9"])
+        .arg(repo("samples/tiny.pis"))
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+    let mut names: Vec<String> = std::fs::read_dir(dir.path())
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    names.sort();
+    // One diffuse texture and six shell faces, each as EXR and PNG; no temporary files.
+    assert_eq!(names.len(), 14, "{names:?}");
+    assert!(names.contains(&"ball.0-diffuse.exr".to_string()));
+    assert!(names.contains(&"ball.1-env_distant.pz.png".to_string()));
+    // The EXR holds the decoded linear texture: texel (0,0) of the diffuse layer at light
+    // sample 1 is 0.8 × 1.0 in red.
+    let img = image_red(&dir.path().join("ball.0-diffuse.exr"));
+    assert!((img - 0.8).abs() < 1e-5, "{img}");
+    // A point with the wrong number of values is a usage error.
+    let out = Command::new(env!("CARGO_BIN_EXE_pis-inspect"))
+        .args(["--extract"])
+        .arg(dir.path())
+        .args(["--at", "5"])
+        .arg(repo("samples/tiny.pis"))
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(1));
+}
+
+fn image_red(path: &Path) -> f32 {
+    use exr::prelude::*;
+    let img = read_first_rgba_layer_from_file(
+        path,
+        |res, _| vec![vec![(0.0f32, 0.0f32, 0.0f32, 0.0f32); res.width()]; res.height()],
+        |px, pos, (r, g, b, a): (f32, f32, f32, f32)| px[pos.y()][pos.x()] = (r, g, b, a),
+    )
+    .unwrap();
+    img.layer_data.channel_data.pixels[0][0].0
+}
+
+#[test]
+fn missing_file_is_an_io_error() {
+    let out = inspect(&[], Path::new("/no/such.pis"));
+    assert_eq!(out.status.code(), Some(2));
+    assert!(text(&out.stderr).contains("/no/such.pis"));
+    let out = Command::new(env!("CARGO_BIN_EXE_pis-inspect"))
+        .arg("--bogus")
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(1));
+}
