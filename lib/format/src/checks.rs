@@ -403,7 +403,7 @@ fn layers<S>(s: &ParameterSpace, oi: usize, o: &Object<S>, out: &mut Vec<Issue>)
 
 fn placement(p: &Placement, mapping: Mapping) -> Option<String> {
     match (p, mapping) {
-        (Placement::Surface { affine }, Mapping::Surface) => {
+        (Placement::Surface { affine, .. }, Mapping::Surface) => {
             let det = affine[0] * affine[3] - affine[1] * affine[2];
             (!finite(affine) || det == 0.0 || !det.is_finite())
                 .then(|| format!("affine {affine:?} is not invertible"))

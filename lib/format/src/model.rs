@@ -459,6 +459,13 @@ pub struct Layer<S = Codestream> {
     pub blocks: Vec<Block<S>>,
 }
 
+impl Placement {
+    /// A surface placement with the given transform, clamped in both directions.
+    pub fn surface(affine: [f32; 6]) -> Self {
+        Placement::Surface { affine, repeat: [false; 2] }
+    }
+}
+
 /// One parameter-space block of a layer: texture placement and its Laplacian pyramid.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Block<S = Codestream> {
@@ -475,8 +482,9 @@ pub struct Block<S = Codestream> {
 pub enum Placement {
     /// Affine texture-coordinate transform (section 3.2):
     /// s = a·u + b·v + e, t = c·u + d·v + f, as `[a, b, c, d, e, f]`; (s, t) in [0, 1]²
-    /// spans the used texture.
-    Surface { affine: [f32; 6] },
+    /// spans the used texture. `repeat[0]` / `repeat[1]`: the texture wraps along s / t
+    /// (no branch cut was made there); otherwise it is clamped to its edge.
+    Surface { affine: [f32; 6], repeat: [bool; 2] },
     /// Environment-map shell geometry with its cube-map origin.
     Shell {
         shape: ShellShape,

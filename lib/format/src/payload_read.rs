@@ -233,11 +233,16 @@ pub fn layr(c: &mut Cursor, objects: &mut [Object<StreamRef>]) -> Result<(), Iss
             let width = c.u32("width")?;
             let height = c.u32("height")?;
             let shape_at = c.offset();
-            let shape = c.u32("shell shape")?;
+            let shape = c.u16("shell shape")? as u32;
+            let repeat = c.u16("repeat")?;
+            if repeat & !3 != 0 || (shape != 0 && repeat != 0) {
+                return Err(c.issue(3006, format!("layer {li} block {bi} repeat bits {repeat:#x}")).at(shape_at + 2));
+            }
             let values = c.f32s::<12>("placement values")?;
             let placement = if shape == 0 {
                 Placement::Surface {
                     affine: values[0..6].try_into().expect("6 values"),
+                    repeat: [repeat & 1 != 0, repeat & 2 != 0],
                 }
             } else {
                 let shape = ShellShape::from_code(shape).ok_or_else(|| {

@@ -122,8 +122,10 @@ pub fn layr<S>(s: &mut Sink, objects: &[Object<S>], mut stream_ref: impl FnMut(&
                 s.u32(b.width, &format!("{p} width"));
                 s.u32(b.height, &format!("{p} height"));
                 match b.placement {
-                    Placement::Surface { affine } => {
-                        s.u32(0, &format!("{p} shell shape (none)"));
+                    Placement::Surface { affine, repeat } => {
+                        s.u16(0, &format!("{p} shell shape (none)"));
+                        let bits = repeat[0] as u16 | (repeat[1] as u16) << 1;
+                        s.u16(bits, &format!("{p} repeat (1 = along s, 2 = along t)"));
                         s.f32s(&affine, &format!("{p} affine a b c d e f"));
                         s.zeros(24, &format!("{p} unused placement values"));
                     }
@@ -132,7 +134,8 @@ pub fn layr<S>(s: &mut Sink, objects: &[Object<S>], mut stream_ref: impl FnMut(&
                         origin,
                         params,
                     } => {
-                        s.u32(shape as u32, &format!("{p} shell shape ({})", shape.name()));
+                        s.u16(shape as u16, &format!("{p} shell shape ({})", shape.name()));
+                        s.u16(0, &format!("{p} repeat (none for shells)"));
                         s.f32s(&origin, &format!("{p} shell origin"));
                         s.f32s(&params, &format!("{p} shell parameters"));
                         s.zeros(12, &format!("{p} unused placement values"));

@@ -130,9 +130,7 @@ pub fn minimal() -> Result<Container, Error> {
     let block = Block {
         width: 2,
         height: 2,
-        placement: Placement::Surface {
-            affine: [1.0, 0.0, 0.0, 1.0, 0.0, 0.0],
-        },
+        placement: Placement::surface([1.0, 0.0, 0.0, 1.0, 0.0, 0.0]),
         levels: vec![],
     };
     let texels = vec![1.0, 0.5, 0.25, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.5, 0.5, 0.5];
@@ -255,9 +253,7 @@ pub fn tiny() -> Result<Container, Error> {
     let block = Block {
         width: w,
         height: h,
-        placement: Placement::Surface {
-            affine: [1.0, 0.0, 0.0, 1.0, 0.0, 0.0],
-        },
+        placement: Placement::surface([1.0, 0.0, 0.0, 1.0, 0.0, 0.0]),
         levels: vec![],
     };
     let block = encode_block(
