@@ -156,7 +156,7 @@ mod tests {
         let s = space(&[19], &[8]);
         for offset in 0..8 {
             let g = BlockGrid::new(&s, DepMask::of(&[0]), &[offset]);
-            let mut seen = vec![0; 19];
+            let mut seen = [0; 19];
             let mut total = 0;
             for b in 0..g.block_count() as usize {
                 total += g.extent(b)[0];

@@ -196,11 +196,10 @@ fn objects<S>(c: &Container<S>, out: &mut Vec<Issue>) {
             out.push(e(5102, "name is empty or repeated".into()));
         }
         let sh = &o.shading;
-        let unit = |v: f32| v.is_finite() && (0.0..=1.0).contains(&v);
-        if !sh.f0.iter().all(|&v| unit(v))
-            || !(sh.ior.is_finite() && sh.ior >= 1.0)
-            || !sh.absorption.iter().all(|v| v.is_finite() && *v >= 0.0)
-        {
+        let unit = |v: &f32| (0.0..=1.0).contains(v);
+        let ior_ok = sh.ior.is_finite() && sh.ior >= 1.0;
+        let absorption_ok = sh.absorption.iter().all(|v| v.is_finite() && *v >= 0.0);
+        if !(sh.f0.iter().all(unit) && ior_ok && absorption_ok) {
             out.push(e(5104, format!("{sh:?}")));
         }
         let mut stagger_ok = o.stagger.len() == s.dims.len();
