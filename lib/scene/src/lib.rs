@@ -11,6 +11,8 @@ mod frame;
 mod gltf_load;
 pub mod light_path;
 mod load;
+#[cfg(test)]
+mod load_tests;
 pub mod manifest;
 pub mod material;
 pub mod model;
