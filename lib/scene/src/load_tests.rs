@@ -99,7 +99,11 @@ impl Fixture {
         });
         edit(&mut doc, &mut bin);
         let dir = tempfile::tempdir().expect("temp dir");
-        std::fs::write(dir.path().join("scene.gltf"), serde_json::to_vec_pretty(&doc).expect("json")).expect("write");
+        std::fs::write(
+            dir.path().join("scene.gltf"),
+            serde_json::to_vec_pretty(&doc).expect("json"),
+        )
+        .expect("write");
         std::fs::write(dir.path().join("scene.bin"), &bin).expect("write");
         std::fs::write(dir.path().join("scene.toml"), toml).expect("write");
         Fixture { dir }
@@ -147,7 +151,11 @@ fn preset_and_overrides() {
     let s = load(&f.toml(), Some("paper")).unwrap();
     assert_eq!(s.resolution, (64, 48));
     assert_eq!(s.space.point_count(), 24);
-    let opts = LoadOptions { preset: Some("paper".into()), resolution: Some((10, 5)), spp: Some(9) };
+    let opts = LoadOptions {
+        preset: Some("paper".into()),
+        resolution: Some((10, 5)),
+        spp: Some(9),
+    };
     let s = load_with(&f.toml(), &opts).unwrap();
     assert_eq!((s.resolution, s.spp), ((10, 5), 9));
 }
@@ -168,9 +176,17 @@ fn frame_poses_animation_and_orbit() {
     // spin sample 1 (t = 1): 90° about +Y; the node keeps its translation.
     let frame = s.frame(&[1, 0]).unwrap();
     let m = frame.instances[0].world_from_object;
-    assert!(m.transform_point3(Vec3::X).distance(Vec3::new(1.0, 0.0, -1.0)) < 1e-5);
+    assert!(
+        m.transform_point3(Vec3::X)
+            .distance(Vec3::new(1.0, 0.0, -1.0))
+            < 1e-5
+    );
     let (_, r, _) = m.to_scale_rotation_translation();
-    assert!(r.dot(Quat::from_rotation_y(std::f32::consts::FRAC_PI_2)).abs() > 1.0 - 1e-6);
+    assert!(
+        r.dot(Quat::from_rotation_y(std::f32::consts::FRAC_PI_2))
+            .abs()
+            > 1.0 - 1e-6
+    );
     // The light stays at its node (hop is not a dimension).
     assert_eq!(frame.lights[0].position, Vec3::new(0.0, 2.0, 0.0));
     assert_eq!(frame.lights[0].name, "Lamp");
@@ -195,11 +211,20 @@ time = [0, 2]
     assert_eq!(s.space.dims[0].kind, crate::DimensionKind::Light);
     // No [camera]: the first glTF camera, at (0, 1, 5).
     let frame = s.frame(&[1]).unwrap();
-    assert_eq!(frame.camera.world_from_camera.transform_point3(Vec3::ZERO), Vec3::new(0.0, 1.0, 5.0));
+    assert_eq!(
+        frame.camera.world_from_camera.transform_point3(Vec3::ZERO),
+        Vec3::new(0.0, 1.0, 5.0)
+    );
     // STEP: t = 0.5 holds the first keyframe, t = 1.5 the second.
     assert_eq!(frame.lights[0].position, Vec3::new(0.0, 2.0, 0.0));
-    assert_eq!(s.frame(&[3]).unwrap().lights[0].position, Vec3::new(0.0, 3.0, 0.0));
-    assert_eq!(s.frame(&[4]).unwrap().lights[0].position, Vec3::new(0.0, 4.0, 0.0));
+    assert_eq!(
+        s.frame(&[3]).unwrap().lights[0].position,
+        Vec3::new(0.0, 3.0, 0.0)
+    );
+    assert_eq!(
+        s.frame(&[4]).unwrap().lights[0].position,
+        Vec3::new(0.0, 4.0, 0.0)
+    );
 }
 
 #[test]
@@ -221,15 +246,24 @@ path = [[-1, 3, 0], [1, 3, 0]]
     let f = Fixture::new(toml, |_, _| {});
     let s = load(&f.toml(), None).unwrap();
     assert_eq!(s.space.dims[0].kind, crate::DimensionKind::Light);
-    assert_eq!(s.frame(&[1]).unwrap().lights[0].position, Vec3::new(0.0, 3.0, 0.0));
-    assert_eq!(s.frame(&[2]).unwrap().lights[0].position, Vec3::new(1.0, 3.0, 0.0));
+    assert_eq!(
+        s.frame(&[1]).unwrap().lights[0].position,
+        Vec3::new(0.0, 3.0, 0.0)
+    );
+    assert_eq!(
+        s.frame(&[2]).unwrap().lights[0].position,
+        Vec3::new(1.0, 3.0, 0.0)
+    );
 }
 
 #[test]
 fn role_override() {
     let toml = format!("{TOML}\n[object.Tri]\nrole = \"diffuse\"\n");
     let f = Fixture::new(&toml, |_, _| {});
-    assert_eq!(load(&f.toml(), None).unwrap().objects[0].role, ObjectRole::Diffuse);
+    assert_eq!(
+        load(&f.toml(), None).unwrap().objects[0].role,
+        ObjectRole::Diffuse
+    );
 }
 
 #[test]
@@ -243,29 +277,53 @@ fn error_missing_scene_toml() {
 fn error_missing_gltf() {
     let f = Fixture::new(&TOML.replace("scene.gltf", "other.gltf"), |_, _| {});
     let err = load_err(&f);
-    assert!(matches!(err, SceneError::Io { .. }) && err.to_string().contains("other.gltf"), "{err}");
+    assert!(
+        matches!(err, SceneError::Io { .. }) && err.to_string().contains("other.gltf"),
+        "{err}"
+    );
 }
 
 #[test]
 fn error_missing_buffer() {
     let f = Fixture::new(TOML, |doc, _| doc["buffers"][0]["uri"] = json!("gone.bin"));
     let err = load_err(&f);
-    assert!(matches!(err, SceneError::Gltf { .. }) && err.to_string().contains("scene.gltf"), "{err}");
+    assert!(
+        matches!(err, SceneError::Gltf { .. }) && err.to_string().contains("scene.gltf"),
+        "{err}"
+    );
 }
 
 #[test]
 fn error_unknown_camera() {
     let f = Fixture::new(&TOML.replace("node = \"Cam\"", "node = \"Kam\""), |_, _| {});
     let err = load_err(&f);
-    assert!(matches!(err, SceneError::UnknownName { what: "camera", .. }), "{err}");
-    assert!(err.to_string().contains("camera.node") && err.to_string().contains("Cam"), "{err}");
+    assert!(
+        matches!(err, SceneError::UnknownName { what: "camera", .. }),
+        "{err}"
+    );
+    assert!(
+        err.to_string().contains("camera.node") && err.to_string().contains("Cam"),
+        "{err}"
+    );
 }
 
 #[test]
 fn error_unknown_animation() {
-    let f = Fixture::new(&TOML.replace("animation = \"spin\"", "animation = \"spun\""), |_, _| {});
+    let f = Fixture::new(
+        &TOML.replace("animation = \"spin\"", "animation = \"spun\""),
+        |_, _| {},
+    );
     let err = load_err(&f);
-    assert!(matches!(err, SceneError::UnknownName { what: "animation", .. }), "{err}");
+    assert!(
+        matches!(
+            err,
+            SceneError::UnknownName {
+                what: "animation",
+                ..
+            }
+        ),
+        "{err}"
+    );
     assert!(err.to_string().contains("dimension[0].animation"), "{err}");
 }
 
@@ -274,13 +332,22 @@ fn error_unknown_light() {
     let toml = "gltf = \"scene.gltf\"\nresolution = [8, 8]\nspp = 1\n[[dimension]]\nname = \"l\"\ndriver = \"light_path\"\nlight = \"Sun\"\nsamples = 2\npath = [[0, 0, 0]]\n";
     let f = Fixture::new(toml, |_, _| {});
     let err = load_err(&f);
-    assert!(matches!(err, SceneError::UnknownName { what: "light", .. }), "{err}");
+    assert!(
+        matches!(err, SceneError::UnknownName { what: "light", .. }),
+        "{err}"
+    );
 }
 
 #[test]
 fn error_unknown_object() {
-    let f = Fixture::new(&format!("{TOML}\n[object.Vase]\nrole = \"reflective\"\n"), |_, _| {});
-    assert!(matches!(load_err(&f), SceneError::UnknownName { what: "object", .. }));
+    let f = Fixture::new(
+        &format!("{TOML}\n[object.Vase]\nrole = \"reflective\"\n"),
+        |_, _| {},
+    );
+    assert!(matches!(
+        load_err(&f),
+        SceneError::UnknownName { what: "object", .. }
+    ));
 }
 
 #[test]
@@ -288,41 +355,66 @@ fn error_zero_samples() {
     let f = Fixture::new(&TOML.replace("samples = 4", "samples = 0"), |_, _| {});
     let err = load_err(&f);
     assert!(matches!(err, SceneError::ZeroSamples { .. }), "{err}");
-    assert!(err.to_string().contains("dimension[1].samples") && err.to_string().contains("view"), "{err}");
+    assert!(
+        err.to_string().contains("dimension[1].samples") && err.to_string().contains("view"),
+        "{err}"
+    );
 }
 
 #[test]
 fn error_unknown_toml_key() {
     let f = Fixture::new(&TOML.replace("spp = 2", "spp = 2\nspf = 3"), |_, _| {});
     let err = load_err(&f);
-    assert!(matches!(err, SceneError::Toml { .. }) && err.to_string().contains("spf"), "{err}");
+    assert!(
+        matches!(err, SceneError::Toml { .. }) && err.to_string().contains("spf"),
+        "{err}"
+    );
 }
 
 #[test]
 fn error_key_of_another_driver() {
-    let f = Fixture::new(&TOML.replace("radius = 4", "radius = 4\nanimation = \"spin\""), |_, _| {});
+    let f = Fixture::new(
+        &TOML.replace("radius = 4", "radius = 4\nanimation = \"spin\""),
+        |_, _| {},
+    );
     let err = load_err(&f);
     assert!(err.to_string().contains("dimension[1].animation"), "{err}");
 }
 
 #[test]
 fn error_nan_in_buffer() {
-    let f = Fixture::new(TOML, |_, bin| bin[12..16].copy_from_slice(&f32::NAN.to_le_bytes()));
+    let f = Fixture::new(TOML, |_, bin| {
+        bin[12..16].copy_from_slice(&f32::NAN.to_le_bytes())
+    });
     let err = load_err(&f);
-    assert!(matches!(err, SceneError::NonFinite { element: 1, .. }), "{err}");
-    assert!(err.to_string().contains("meshes[0].primitives[0].attributes.POSITION"), "{err}");
+    assert!(
+        matches!(err, SceneError::NonFinite { element: 1, .. }),
+        "{err}"
+    );
+    assert!(
+        err.to_string()
+            .contains("meshes[0].primitives[0].attributes.POSITION"),
+        "{err}"
+    );
 }
 
 #[test]
 fn error_inf_in_animation() {
-    let f = Fixture::new(TOML, |_, bin| bin[52..56].copy_from_slice(&f32::INFINITY.to_le_bytes()));
+    let f = Fixture::new(TOML, |_, bin| {
+        bin[52..56].copy_from_slice(&f32::INFINITY.to_le_bytes())
+    });
     let err = load_err(&f);
-    assert!(err.to_string().contains("animations[0].samplers[0].output"), "{err}");
+    assert!(
+        err.to_string().contains("animations[0].samplers[0].output"),
+        "{err}"
+    );
 }
 
 #[test]
 fn error_required_extension() {
-    let f = Fixture::new(TOML, |doc, _| doc["extensionsRequired"] = json!(["KHR_draco_mesh_compression"]));
+    let f = Fixture::new(TOML, |doc, _| {
+        doc["extensionsRequired"] = json!(["KHR_draco_mesh_compression"])
+    });
     let err = load_err(&f);
     assert!(matches!(err, SceneError::Unsupported { .. }), "{err}");
     assert!(err.to_string().contains("extensionsRequired"), "{err}");
@@ -330,31 +422,50 @@ fn error_required_extension() {
 
 #[test]
 fn error_non_triangle_primitive() {
-    let f = Fixture::new(TOML, |doc, _| doc["meshes"][0]["primitives"][0]["mode"] = json!(1));
+    let f = Fixture::new(TOML, |doc, _| {
+        doc["meshes"][0]["primitives"][0]["mode"] = json!(1)
+    });
     let err = load_err(&f);
     assert!(matches!(err, SceneError::Unsupported { .. }), "{err}");
-    assert!(err.to_string().contains("meshes[0].primitives[0].mode"), "{err}");
+    assert!(
+        err.to_string().contains("meshes[0].primitives[0].mode"),
+        "{err}"
+    );
 }
 
 #[test]
 fn error_point_out_of_range() {
     let f = Fixture::new(TOML, |_, _| {});
     let s = load(&f.toml(), None).unwrap();
-    assert!(matches!(s.frame(&[3, 0]), Err(SceneError::PointOutOfRange { .. })));
-    assert!(matches!(s.frame(&[0]), Err(SceneError::PointOutOfRange { .. })));
+    assert!(matches!(
+        s.frame(&[3, 0]),
+        Err(SceneError::PointOutOfRange { .. })
+    ));
+    assert!(matches!(
+        s.frame(&[0]),
+        Err(SceneError::PointOutOfRange { .. })
+    ));
 }
 
 #[test]
 fn error_unknown_preset() {
     let f = Fixture::new(TOML, |_, _| {});
     let err = load(&f.toml(), Some("huge")).unwrap_err();
-    assert!(matches!(err, SceneError::UnknownName { what: "preset", .. }) && err.to_string().contains("paper"), "{err}");
+    assert!(
+        matches!(err, SceneError::UnknownName { what: "preset", .. })
+            && err.to_string().contains("paper"),
+        "{err}"
+    );
 }
 
 #[test]
 fn hand_built_scene_has_identity_instances() {
     let mut s = crate::Scene::default();
-    s.objects.push(crate::SceneObject { name: "o".into(), role: ObjectRole::Diffuse, primitives: vec![] });
+    s.objects.push(crate::SceneObject {
+        name: "o".into(),
+        role: ObjectRole::Diffuse,
+        primitives: vec![],
+    });
     let frame = s.frame(&[]).unwrap();
     assert_eq!(frame.instances[0].world_from_object, glam::Mat4::IDENTITY);
 }
