@@ -99,8 +99,8 @@ pub fn room_materials(w: &mut GltfWriter, dir: &Path) -> io::Result<(usize, usiz
     )?;
     textures::wallpaper(
         &dir.join("wallpaper.png"),
-        64,
-        8,
+        128,
+        32,
         [96, 150, 96],
         [130, 180, 120],
     )?;

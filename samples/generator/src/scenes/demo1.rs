@@ -12,7 +12,7 @@ use crate::gltf_writer::{ChannelDesc, GltfWriter, Interp, MaterialDesc, NodeDesc
 
 /// Where the orbit looks and how it circles (shared with demo2).
 pub const TARGET: Vec3 = Vec3::new(0.0, 0.85, 0.0);
-pub const RADIUS: f32 = 2.2;
+pub const RADIUS: f32 = 1.7;
 pub const ELEVATION_DEG: f32 = 22.0;
 
 /// The table and its contents (vase, glass cup), the room, and the camera node; returns the
