@@ -61,6 +61,15 @@ impl Fixture {
         bin.extend(f32s(&times)); // 36..48
         bin.extend(f32s(&rotations)); // 48..96
         bin.extend(f32s(&hops)); // 96..132
+                                 // CUBICSPLINE translation keys (in-tangent, value, out-tangent) × 3.
+        let bob = [
+            0.0f32, 0.0, 0.0, /**/ 0.0, 0.0, 0.0, /**/ 1.0, 0.0,
+            0.0, // key 0: value 0, out 1
+            0.0, 0.0, 0.0, /**/ 1.0, 0.0, 0.0, /**/ 0.0, 0.0,
+            0.0, // key 1: in 0, value 1
+            0.0, 0.0, 0.0, /**/ 1.0, 0.0, 0.0, /**/ 0.0, 0.0, 0.0, // key 2: value 1
+        ];
+        bin.extend(f32s(&bob)); // 132..240
         let mut doc = json!({
             "asset": {"version": "2.0"},
             "extensionsUsed": ["KHR_lights_punctual"],
@@ -82,19 +91,23 @@ impl Fixture {
                 {"buffer": 0, "byteOffset": 0, "byteLength": 36},
                 {"buffer": 0, "byteOffset": 36, "byteLength": 12},
                 {"buffer": 0, "byteOffset": 48, "byteLength": 48},
-                {"buffer": 0, "byteOffset": 96, "byteLength": 36}
+                {"buffer": 0, "byteOffset": 96, "byteLength": 36},
+                {"buffer": 0, "byteOffset": 132, "byteLength": 108}
             ],
             "accessors": [
                 {"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3", "min": [0, 0, 0], "max": [1, 1, 0]},
                 {"bufferView": 1, "componentType": 5126, "count": 3, "type": "SCALAR", "min": [0], "max": [2]},
                 {"bufferView": 2, "componentType": 5126, "count": 3, "type": "VEC4"},
-                {"bufferView": 3, "componentType": 5126, "count": 3, "type": "VEC3"}
+                {"bufferView": 3, "componentType": 5126, "count": 3, "type": "VEC3"},
+                {"bufferView": 4, "componentType": 5126, "count": 9, "type": "VEC3"}
             ],
             "animations": [
                 {"name": "spin", "samplers": [{"input": 1, "output": 2, "interpolation": "LINEAR"}],
                  "channels": [{"sampler": 0, "target": {"node": 0, "path": "rotation"}}]},
                 {"name": "hop", "samplers": [{"input": 1, "output": 3, "interpolation": "STEP"}],
-                 "channels": [{"sampler": 0, "target": {"node": 2, "path": "translation"}}]}
+                 "channels": [{"sampler": 0, "target": {"node": 2, "path": "translation"}}]},
+                {"name": "bob", "samplers": [{"input": 1, "output": 4, "interpolation": "CUBICSPLINE"}],
+                 "channels": [{"sampler": 0, "target": {"node": 0, "path": "translation"}}]}
             ]
         });
         edit(&mut doc, &mut bin);
@@ -225,6 +238,67 @@ time = [0, 2]
         s.frame(&[4]).unwrap().lights[0].position,
         Vec3::new(0.0, 4.0, 0.0)
     );
+}
+
+#[test]
+fn cubic_spline_animation_through_gltf() {
+    let toml = r#"
+gltf = "scene.gltf"
+resolution = [8, 8]
+spp = 1
+[[dimension]]
+name = "bob"
+driver = "animation"
+animation = "bob"
+samples = 3
+time = [0, 1]
+"#;
+    let f = Fixture::new(toml, |_, _| {});
+    let s = load(&f.toml(), None).unwrap();
+    assert_eq!(s.space.dims[0].kind, crate::DimensionKind::Time);
+    // Hermite at s = 0.5, dt = 1: 0.125·m0 + 0.5·p1 = 0.125·1 + 0.5·1 = 0.625.
+    let x = |i: u32| {
+        s.frame(&[i]).unwrap().instances[0]
+            .world_from_object
+            .w_axis
+            .x
+    };
+    assert_eq!(x(0), 0.0);
+    assert!((x(1) - 0.625).abs() < 1e-6, "{}", x(1));
+    assert_eq!(x(2), 1.0);
+}
+
+#[test]
+fn loads_binary_gltf() {
+    let f = Fixture::new(&TOML.replace("scene.gltf", "scene.glb"), |_, _| {});
+    // Repack scene.gltf + scene.bin as a GLB: header, JSON chunk, BIN chunk (4-byte aligned).
+    let dir = f.dir.path();
+    let mut doc: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(dir.join("scene.gltf")).unwrap()).unwrap();
+    let mut bin = std::fs::read(dir.join("scene.bin")).unwrap();
+    doc["buffers"][0].as_object_mut().unwrap().remove("uri");
+    let mut json = serde_json::to_vec(&doc).unwrap();
+    while json.len() % 4 != 0 {
+        json.push(b' ');
+    }
+    while bin.len() % 4 != 0 {
+        bin.push(0);
+    }
+    let total = 12 + 8 + json.len() + 8 + bin.len();
+    let mut glb = Vec::new();
+    glb.extend(b"glTF");
+    glb.extend(2u32.to_le_bytes());
+    glb.extend((total as u32).to_le_bytes());
+    glb.extend((json.len() as u32).to_le_bytes());
+    glb.extend(b"JSON");
+    glb.extend(&json);
+    glb.extend((bin.len() as u32).to_le_bytes());
+    glb.extend(b"BIN\0");
+    glb.extend(&bin);
+    std::fs::write(dir.join("scene.glb"), glb).unwrap();
+    let s = load(&f.toml(), None).unwrap();
+    assert_eq!(s.objects[0].primitives[0].positions.len(), 3);
+    assert_eq!(s.space.point_count(), 12);
 }
 
 #[test]
