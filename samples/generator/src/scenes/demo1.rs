@@ -75,7 +75,7 @@ pub fn write(dir: &Path) -> io::Result<()> {
     let mut w = furnished_room(dir, -6.3)?;
 
     // The pendulum: a pivot node above the table swinging about +Z; the light hangs 0.5 m below.
-    let lamp = light_node(&mut w, "Lamp", 4.0, 0.08, Vec3::new(0.0, -0.5, 0.0), false);
+    let lamp = light_node(&mut w, "Lamp", 8.0, 0.08, Vec3::new(0.0, -0.5, 0.0), false);
     let pivot = w.add_node(
         NodeDesc {
             name: "Pendulum".into(),

@@ -26,7 +26,7 @@ pub fn write(dir: &Path) -> io::Result<()> {
         },
         true,
     );
-    light_node(&mut w, "Lamp", 4.0, 0.08, Vec3::new(0.3, 1.75, 0.2), true);
+    light_node(&mut w, "Lamp", 8.0, 0.08, Vec3::new(0.3, 1.75, 0.2), true);
 
     // One turn about +Y; the time is in degrees of rotation (keys every 120°, so each
     // LINEAR slerp takes the intended way round).

@@ -65,7 +65,7 @@ pub fn write(dir: &Path) -> io::Result<()> {
     let (walls, floor) = room(8.0, 5.0);
     object(&mut w, "Walls", &walls, wall_mat, Vec3::ZERO);
     object(&mut w, "Floor", &floor, floor_mat, Vec3::ZERO);
-    light_node(&mut w, "Lamp", 20.0, 0.15, Vec3::new(1.2, 3.2, 1.6), true);
+    light_node(&mut w, "Lamp", 40.0, 0.15, Vec3::new(1.2, 3.2, 1.6), true);
     camera_node(&mut w, 35.0, TARGET, 1.8, 15.0, 0.0);
     w.write(dir, "glass")?;
 

@@ -80,7 +80,7 @@ pub fn write(dir: &Path) -> io::Result<()> {
     let (walls, floor) = room(3.0, 3.0);
     object(&mut w, "Walls", &walls, wall_mat, Vec3::ZERO);
     object(&mut w, "Floor", &floor, floor_mat, Vec3::ZERO);
-    light_node(&mut w, "Lamp", 10.0, 0.1, Vec3::new(0.6, 2.6, 0.8), true);
+    light_node(&mut w, "Lamp", 16.0, 0.1, Vec3::new(0.6, 2.6, 0.8), true);
     camera_node(&mut w, 35.0, TARGET, 1.6, 20.0, 0.0);
     w.write(dir, "teapot-pem")?;
 
