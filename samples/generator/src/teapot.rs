@@ -149,9 +149,18 @@ pub fn teapot(
     mesh
 }
 
-/// All 32 patches.
+/// The flat ring that closes the gap between the lid's edge (radius 1.3) and the rim's
+/// inner edge (radius 1.4) at height 2.4, facing up; the patch data leaves it open.
+pub fn lid_seal(segments: usize, scale: f32, offset: Vec3) -> Mesh {
+    crate::mesh::lathe(&[vec![Vec2::new(1.4, 2.4), Vec2::new(1.3, 2.4)]], segments)
+        .scaled_translated(scale, offset)
+}
+
+/// All 32 patches plus the [`lid_seal`]: a closed-looking solid for glass.
 pub fn whole_teapot(grid: usize, scale: f32, offset: Vec3) -> Mesh {
-    teapot(0..32, grid, scale, offset)
+    let mut m = teapot(0..32, grid, scale, offset);
+    m.append(&lid_seal(4 * grid, scale, offset));
+    m
 }
 
 #[cfg(test)]
