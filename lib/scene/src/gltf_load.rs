@@ -128,12 +128,13 @@ pub(crate) fn read_gltf(path: &Path) -> Result<GltfScene, SceneError> {
     let mut default_material = None;
 
     // Objects: one per node with a mesh, in glTF node order.
+    let gltf_nodes: Vec<gltf::Node> = doc.nodes().collect();
     let mut objects = Vec::new();
     let mut by_gltf: Vec<(usize, usize)> = rig_index.iter().map(|(&g, &r)| (g, r)).collect();
     by_gltf.sort();
     let mut used_names: BTreeMap<String, usize> = BTreeMap::new();
     for &(g, r) in &by_gltf {
-        let Some(node) = doc.nodes().nth(g) else {
+        let Some(node) = gltf_nodes.get(g) else {
             continue;
         };
         let Some(mesh) = node.mesh() else { continue };
@@ -178,7 +179,7 @@ pub(crate) fn read_gltf(path: &Path) -> Result<GltfScene, SceneError> {
     // Lights and cameras on nodes.
     let mut cameras = Vec::new();
     for &(g, r) in &by_gltf {
-        let Some(node) = doc.nodes().nth(g) else {
+        let Some(node) = gltf_nodes.get(g) else {
             continue;
         };
         if let Some(light) = node.light() {
