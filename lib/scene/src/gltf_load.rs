@@ -7,6 +7,7 @@ use glam::{Quat, Vec2, Vec3, Vec4};
 use gltf::animation::util::ReadOutputs;
 use gltf::mesh::Mode;
 
+use crate::accessor_check::check_accessor;
 use crate::animation::{Animation, Channel, Interpolation, Sampler, TargetPath, Trs};
 use crate::material::{convert_material, infer_role};
 use crate::model::{LightKind, Material, Primitive, SceneObject, TextureImage};
@@ -36,6 +37,10 @@ pub(crate) struct GltfCamera {
 }
 
 /// Reads the glTF file at `path`, its buffers and its images.
+///
+/// Indices and accessors are checked before the gltf crate's readers see them; should the
+/// crate still panic on malformed data (its validation indexes unchecked in places), the
+/// panic becomes a [`SceneError::Gltf`].
 pub(crate) fn read_gltf(path: &Path) -> Result<GltfScene, SceneError> {
     if let Err(source) = std::fs::metadata(path) {
         return Err(SceneError::Io {
@@ -43,10 +48,60 @@ pub(crate) fn read_gltf(path: &Path) -> Result<GltfScene, SceneError> {
             source,
         });
     }
-    let (doc, buffers, images) = gltf::import(path).map_err(|e| import_error(path, e))?;
+    let read = || {
+        let (doc, buffers, images) = gltf::import(path).map_err(|e| import_error(path, e))?;
+        check_animation_indices(path, &doc)?;
+        convert(path, &doc, &buffers, &images)
+    };
+    std::panic::catch_unwind(read).unwrap_or_else(|panic| {
+        let what = panic
+            .downcast_ref::<&str>()
+            .map(|s| s.to_string())
+            .or_else(|| panic.downcast_ref::<String>().cloned())
+            .unwrap_or_default();
+        Err(SceneError::Gltf {
+            path: path.to_owned(),
+            message: format!("malformed data made the glTF reader fail: {what}"),
+        })
+    })
+}
+
+/// Animation channel targets and samplers are not validated by the gltf crate, whose
+/// accessors then panic; check them here.
+fn check_animation_indices(path: &Path, doc: &gltf::Document) -> Result<(), SceneError> {
+    let root = doc.as_json();
+    for (ai, a) in root.animations.iter().enumerate() {
+        for (ci, c) in a.channels.iter().enumerate() {
+            let field = format!("animations[{ai}].channels[{ci}]");
+            let node = c.target.node.value();
+            if node >= root.nodes.len() {
+                let msg = format!("node {node} does not exist");
+                return Err(SceneError::invalid(
+                    path,
+                    format!("{field}.target.node"),
+                    msg,
+                ));
+            }
+            let sampler = c.sampler.value();
+            if sampler >= a.samplers.len() {
+                let msg = format!("sampler {sampler} does not exist");
+                return Err(SceneError::invalid(path, format!("{field}.sampler"), msg));
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Converts an imported document (see [`read_gltf`]).
+fn convert(
+    path: &Path,
+    doc: &gltf::Document,
+    buffers: &[gltf::buffer::Data],
+    images: &[gltf::image::Data],
+) -> Result<GltfScene, SceneError> {
     let ctx = Ctx {
         path: path.to_owned(),
-        buffers: &buffers,
+        buffers,
     };
 
     let scene = doc
@@ -295,6 +350,34 @@ impl Ctx<'_> {
         material: usize,
         field: &str,
     ) -> Result<Primitive, SceneError> {
+        use gltf::accessor::{DataType as T, Dimensions as D};
+        use gltf::Semantic;
+        for (semantic, name, dims, types) in [
+            (Semantic::Positions, "POSITION", D::Vec3, &[T::F32][..]),
+            (Semantic::Normals, "NORMAL", D::Vec3, &[T::F32][..]),
+            (
+                Semantic::TexCoords(0),
+                "TEXCOORD_0",
+                D::Vec2,
+                &[T::F32, T::U8, T::U16][..],
+            ),
+        ] {
+            if let Some(a) = p.get(&semantic) {
+                let f = format!("{field}.attributes.{name}");
+                check_accessor(&self.path, &f, &a, self.buffers, &[dims], types)?;
+            }
+        }
+        if let Some(a) = p.indices() {
+            let f = format!("{field}.indices");
+            check_accessor(
+                &self.path,
+                &f,
+                &a,
+                self.buffers,
+                &[D::Scalar],
+                &[T::U8, T::U16, T::U32],
+            )?;
+        }
         let reader = p.reader(|b| self.buffers.get(b.index()).map(|d| &d.0[..]));
         let positions: Vec<[f32; 3]> = reader
             .read_positions()
@@ -445,12 +528,46 @@ impl Ctx<'_> {
             let Some(&node) = rig_index.get(&c.target().node().index()) else {
                 continue;
             };
-            let reader = c.reader(|b| self.buffers.get(b.index()).map(|d| &d.0[..]));
             let sfield = format!(
                 "animations[{}].samplers[{}]",
                 a.index(),
                 c.sampler().index()
             );
+            {
+                use gltf::accessor::{DataType as T, Dimensions as D};
+                use gltf::animation::Property;
+                let input = c.sampler().input();
+                check_accessor(
+                    &self.path,
+                    &format!("{sfield}.input"),
+                    &input,
+                    self.buffers,
+                    &[D::Scalar],
+                    &[T::F32],
+                )?;
+                let output = c.sampler().output();
+                let of = format!("{sfield}.output");
+                match c.target().property() {
+                    Property::Translation | Property::Scale => check_accessor(
+                        &self.path,
+                        &of,
+                        &output,
+                        self.buffers,
+                        &[D::Vec3],
+                        &[T::F32],
+                    )?,
+                    Property::Rotation => check_accessor(
+                        &self.path,
+                        &of,
+                        &output,
+                        self.buffers,
+                        &[D::Vec4],
+                        &[T::F32, T::I8, T::U8, T::I16, T::U16],
+                    )?,
+                    Property::MorphTargetWeights => {}
+                }
+            }
+            let reader = c.reader(|b| self.buffers.get(b.index()).map(|d| &d.0[..]));
             let times: Vec<f32> = reader
                 .read_inputs()
                 .ok_or_else(|| {

@@ -5,6 +5,7 @@
 //! calls [`load`] (or [`load_with`]) once and then [`Scene::frame`] per parameter point.
 //! scene.toml is documented key by key in docs/SCENE.md.
 
+mod accessor_check;
 pub mod animation;
 mod error;
 mod frame;

@@ -543,3 +543,105 @@ fn hand_built_scene_has_identity_instances() {
     let frame = s.frame(&[]).unwrap();
     assert_eq!(frame.instances[0].world_from_object, glam::Mat4::IDENTITY);
 }
+
+/// Damaged inputs must give an error (or load), never a panic: every numeric field of the
+/// glTF JSON set to a few hostile values, and the buffer truncated at every length.
+#[test]
+fn damaged_gltf_errors_without_panicking() {
+    fn numeric_paths(v: &serde_json::Value, path: Vec<String>, out: &mut Vec<Vec<String>>) {
+        match v {
+            serde_json::Value::Number(_) => out.push(path),
+            serde_json::Value::Array(a) => {
+                for (i, x) in a.iter().enumerate() {
+                    let mut p = path.clone();
+                    p.push(i.to_string());
+                    numeric_paths(x, p, out);
+                }
+            }
+            serde_json::Value::Object(o) => {
+                for (k, x) in o {
+                    let mut p = path.clone();
+                    p.push(k.clone());
+                    numeric_paths(x, p, out);
+                }
+            }
+            _ => {}
+        }
+    }
+    let base = Fixture::new(TOML, |_, _| {});
+    let doc: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(base.dir.path().join("scene.gltf")).unwrap())
+            .unwrap();
+    let mut paths = Vec::new();
+    numeric_paths(&doc, vec![], &mut paths);
+    for path in &paths {
+        for value in [
+            json!(0),
+            json!(1),
+            json!(7),
+            json!(1_000_000),
+            json!(-1),
+            json!(0.5),
+        ] {
+            let f = Fixture::new(TOML, |d, _| {
+                let mut slot = &mut *d;
+                for key in path {
+                    slot = match slot {
+                        serde_json::Value::Array(a) => &mut a[key.parse::<usize>().unwrap()],
+                        other => &mut other[key.as_str()],
+                    };
+                }
+                *slot = value.clone();
+            });
+            let result = std::panic::catch_unwind(|| {
+                load(&f.toml(), None).map(|s| s.frame_at(0).map(|_| ()))
+            });
+            assert!(result.is_ok(), "panic with {} = {value}", path.join("."));
+        }
+    }
+    let bin_len = std::fs::read(base.dir.path().join("scene.bin"))
+        .unwrap()
+        .len();
+    for len in 0..bin_len {
+        let f = Fixture::new(TOML, |_, bin| bin.truncate(len));
+        let result = std::panic::catch_unwind(|| load(&f.toml(), None).map(|_| ()));
+        assert!(result.is_ok(), "panic with the buffer cut to {len} bytes");
+    }
+}
+
+#[test]
+fn error_accessor_past_its_buffer_view() {
+    let f = Fixture::new(TOML, |doc, _| doc["accessors"][0]["count"] = json!(1000));
+    let err = load_err(&f);
+    let msg = err.to_string();
+    assert!(
+        msg.contains("meshes[0].primitives[0].attributes.POSITION (accessors[0])"),
+        "{msg}"
+    );
+    assert!(msg.contains("exceed buffer view 0"), "{msg}");
+}
+
+#[test]
+fn error_animation_target_node_missing() {
+    let f = Fixture::new(TOML, |doc, _| {
+        doc["animations"][0]["channels"][0]["target"]["node"] = json!(9)
+    });
+    let err = load_err(&f);
+    assert!(
+        err.to_string()
+            .contains("animations[0].channels[0].target.node"),
+        "{err}"
+    );
+}
+
+#[test]
+fn error_normal_accessor_of_wrong_type() {
+    let f = Fixture::new(TOML, |doc, _| {
+        doc["meshes"][0]["primitives"][0]["attributes"]["NORMAL"] = json!(1)
+    });
+    let err = load_err(&f);
+    assert!(
+        err.to_string().contains("expected [Vec3] of [F32]"),
+        "{err}"
+    );
+}

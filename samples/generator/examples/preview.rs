@@ -30,7 +30,14 @@ fn intersect(t: &Tri, o: Vec3, d: Vec3) -> Option<(f32, f32, f32)> {
     (u >= 0.0 && v >= 0.0 && u + v <= 1.0 && dist > 1e-4).then_some((dist, u, v))
 }
 
-fn trace(scene: &Scene, tris: &[Tri], lights: &[pis_scene::Light], o: Vec3, d: Vec3, depth: u32) -> Vec3 {
+fn trace(
+    scene: &Scene,
+    tris: &[Tri],
+    lights: &[pis_scene::Light],
+    o: Vec3,
+    d: Vec3,
+    depth: u32,
+) -> Vec3 {
     let mut best: Option<(f32, usize, f32, f32)> = None;
     for (k, t) in tris.iter().enumerate() {
         if let Some((dist, u, v)) = intersect(t, o, d) {
@@ -39,7 +46,9 @@ fn trace(scene: &Scene, tris: &[Tri], lights: &[pis_scene::Light], o: Vec3, d: V
             }
         }
     }
-    let Some((dist, k, u, v)) = best else { return Vec3::ZERO };
+    let Some((dist, k, u, v)) = best else {
+        return Vec3::ZERO;
+    };
     let t = &tris[k];
     let w = 1.0 - u - v;
     let p = o + d * dist;
@@ -55,8 +64,19 @@ fn trace(scene: &Scene, tris: &[Tri], lights: &[pis_scene::Light], o: Vec3, d: V
     }
     if depth < 2 && t.role != ObjectRole::Diffuse {
         let r = d - 2.0 * d.dot(n) * n;
-        let bounce = trace(scene, tris, lights, p + n * 1e-3 * r.dot(n).signum(), r, depth + 1);
-        return if t.role == ObjectRole::Refractive { bounce * Vec3::new(0.7, 0.8, 0.9) } else { bounce * 0.8 + albedo * 0.1 };
+        let bounce = trace(
+            scene,
+            tris,
+            lights,
+            p + n * 1e-3 * r.dot(n).signum(),
+            r,
+            depth + 1,
+        );
+        return if t.role == ObjectRole::Refractive {
+            bounce * Vec3::new(0.7, 0.8, 0.9)
+        } else {
+            bounce * 0.8 + albedo * 0.1
+        };
     }
     let mut lit = Vec3::splat(0.15);
     for l in lights {
@@ -70,8 +90,18 @@ fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let (toml, out) = (std::path::Path::new(&args[0]), &args[1]);
     let index: usize = args.get(2).and_then(|s| s.parse().ok()).unwrap_or(0);
-    let resolution = args.get(3).and_then(|s| s.split_once('x')).and_then(|(w, h)| Some((w.parse().ok()?, h.parse().ok()?)));
-    let scene = load_with(toml, &LoadOptions { resolution, ..LoadOptions::default() }).unwrap_or_else(|e| panic!("{e}"));
+    let resolution = args
+        .get(3)
+        .and_then(|s| s.split_once('x'))
+        .and_then(|(w, h)| Some((w.parse().ok()?, h.parse().ok()?)));
+    let scene = load_with(
+        toml,
+        &LoadOptions {
+            resolution,
+            ..LoadOptions::default()
+        },
+    )
+    .unwrap_or_else(|e| panic!("{e}"));
     let frame = scene.frame_at(index).unwrap_or_else(|e| panic!("{e}"));
     let mut tris = Vec::new();
     for (obj, inst) in scene.objects.iter().zip(&frame.instances) {
@@ -95,10 +125,16 @@ fn main() {
     let img = image::RgbImage::from_fn(w, h, |x, y| {
         let sx = (2.0 * (x as f32 + 0.5) / w as f32 - 1.0) * tan * w as f32 / h as f32;
         let sy = (1.0 - 2.0 * (y as f32 + 0.5) / h as f32) * tan;
-        let d = cam.world_from_camera.transform_vector3(Vec3::new(sx, sy, -1.0)).normalize();
+        let d = cam
+            .world_from_camera
+            .transform_vector3(Vec3::new(sx, sy, -1.0))
+            .normalize();
         let o = cam.world_from_camera.transform_point3(Vec3::ZERO);
         let c = trace(&scene, &tris, &frame.lights, o, d, 0);
-        image::Rgb(c.to_array().map(|v| (v.clamp(0.0, 1.0).powf(1.0 / 2.2) * 255.0) as u8))
+        image::Rgb(
+            c.to_array()
+                .map(|v| (v.clamp(0.0, 1.0).powf(1.0 / 2.2) * 255.0) as u8),
+        )
     });
     img.save(out).expect("write png");
     println!("{} triangles, wrote {out}", tris.len());

@@ -360,7 +360,10 @@ mod tests {
             for t in m.indices.chunks_exact(3) {
                 let [a, b, c] = [t[0], t[1], t[2]].map(|k| k as usize);
                 let face = (m.positions[b] - m.positions[a]).cross(m.positions[c] - m.positions[a]);
-                assert!(face.dot(m.normals[a] + m.normals[b] + m.normals[c]) >= 0.0, "{name}");
+                assert!(
+                    face.dot(m.normals[a] + m.normals[b] + m.normals[c]) >= 0.0,
+                    "{name}"
+                );
             }
         }
         let (walls, floor) = room(3.0, 3.0);
