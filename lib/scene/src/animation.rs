@@ -70,11 +70,17 @@ impl Animation {
 }
 
 impl Sampler {
+    /// Entry `i` of `values`; zero if a hand-built sampler has too few (the loader checks
+    /// that every keyframe has its values).
+    fn at(&self, i: usize) -> Vec4 {
+        self.values.get(i).copied().unwrap_or(Vec4::ZERO)
+    }
+
     /// The keyframe value `k` (the middle entry for cubic splines).
     fn value(&self, k: usize) -> Vec4 {
         match self.interpolation {
-            Interpolation::CubicSpline => self.values[3 * k + 1],
-            _ => self.values[k],
+            Interpolation::CubicSpline => self.at(3 * k + 1),
+            _ => self.at(k),
         }
     }
 
@@ -114,10 +120,10 @@ impl Sampler {
                 }
             }
             Interpolation::CubicSpline => {
-                let p0 = self.values[3 * k + 1];
-                let m0 = self.values[3 * k + 2] * dt; // out-tangent of k
-                let p1 = self.values[3 * (k + 1) + 1];
-                let m1 = self.values[3 * (k + 1)] * dt; // in-tangent of k + 1
+                let p0 = self.at(3 * k + 1);
+                let m0 = self.at(3 * k + 2) * dt; // out-tangent of k
+                let p1 = self.at(3 * (k + 1) + 1);
+                let m1 = self.at(3 * (k + 1)) * dt; // in-tangent of k + 1
                 let (s2, s3) = (s * s, s * s * s);
                 let v = p0 * (2.0 * s3 - 3.0 * s2 + 1.0)
                     + m0 * (s3 - 2.0 * s2 + s)
