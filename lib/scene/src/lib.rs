@@ -2,9 +2,43 @@
 //! parameter space, object roles), evaluated at any point of the parameter space.
 //!
 //! The types in [`model`] are the contract between scene loading and the tracer: the tracer
-//! consumes a [`Scene`] and, per parameter point, a [`Frame`].
+//! calls [`load`] (or [`load_with`]) once and then [`Scene::frame`] per parameter point.
+//! scene.toml is documented key by key in docs/SCENE.md.
+//!
+//! ```no_run
+//! use std::path::Path;
+//! use pis_scene::{load_with, LoadOptions};
+//!
+//! let options = LoadOptions { preset: Some("paper".into()), spp: Some(4), ..LoadOptions::default() };
+//! let scene = load_with(Path::new("samples/demo1/scene.toml"), &options)?;
+//! for index in 0..scene.space.point_count() {
+//!     let point = scene.space.point(index); // one sample index per dimension
+//!     let frame = scene.frame(&point)?; // camera, lights, one instance per object
+//!     let _eye = frame.camera.world_from_camera.w_axis;
+//! }
+//! # Ok::<(), pis_scene::SceneError>(())
+//! ```
 
+mod accessor_check;
+pub mod animation;
+mod error;
+mod frame;
+mod gltf_load;
+pub mod light_path;
+mod load;
+#[cfg(test)]
+mod load_tests;
+pub mod manifest;
+pub mod material;
 pub mod model;
+pub mod orbit;
+pub mod rig;
+mod space;
+pub mod texture;
 
+pub use error::SceneError;
+pub use load::{load, load_with, LoadOptions};
 pub use model::*;
 pub use pis_format::{DimensionKind, ObjectRole};
+pub use rig::Rig;
+pub use space::sample_values;
