@@ -1,0 +1,66 @@
+//! The render matrix A (thesis eq. 3.2): rows are the screen pixels an object covers,
+//! columns the texels of its texture's MIP pyramid, entries the filter weights with which the
+//! player blends texels into a pixel.
+
+use rayon::prelude::*;
+
+use crate::TextureLayout;
+
+/// A sparse n_s × n_t matrix in compressed-row form, with the pixel and coverage of each row.
+#[derive(Clone, Debug, PartialEq, Default)]
+pub struct RenderMatrix {
+    /// Screen size in pixels.
+    pub width: u32,
+    pub height: u32,
+    pub layout: TextureLayout,
+    /// Per row: the pixel index `y · width + x` (y = 0 is the top row).
+    pub pixels: Vec<u32>,
+    /// Per row: the fraction of the pixel the object covers (after the display filter).
+    pub coverage: Vec<f32>,
+    /// Row r's entries are `cols[row_start[r]..row_start[r + 1]]` / `vals[...]`.
+    pub row_start: Vec<u32>,
+    pub cols: Vec<u32>,
+    pub vals: Vec<f32>,
+}
+
+impl Default for TextureLayout {
+    fn default() -> Self {
+        TextureLayout { width: 1, height: 1, levels: 1 }
+    }
+}
+
+impl RenderMatrix {
+    /// n_s.
+    pub fn rows(&self) -> usize {
+        self.pixels.len()
+    }
+
+    /// n_t.
+    pub fn cols(&self) -> usize {
+        self.layout.texel_count()
+    }
+
+    pub fn row(&self, r: usize) -> (&[u32], &[f32]) {
+        let (a, b) = (self.row_start[r] as usize, self.row_start[r + 1] as usize);
+        (&self.cols[a..b], &self.vals[a..b])
+    }
+
+    /// y = A·x (parallel over rows).
+    pub fn mul(&self, x: &[f32], y: &mut [f32]) {
+        y.par_iter_mut().enumerate().for_each(|(r, out)| {
+            let (c, v) = self.row(r);
+            *out = c.iter().zip(v).map(|(&c, &v)| v * x[c as usize]).sum();
+        });
+    }
+
+    /// y = Aᵀ·x, summed in row order (deterministic).
+    pub fn mul_t(&self, x: &[f32], y: &mut [f32]) {
+        y.iter_mut().for_each(|v| *v = 0.0);
+        for r in 0..self.rows() {
+            let (c, v) = self.row(r);
+            for (&c, &v) in c.iter().zip(v) {
+                y[c as usize] += v * x[r];
+            }
+        }
+    }
+}
