@@ -1,0 +1,152 @@
+//! The two forms of the least-squares data term (thesis 3.5): the A form (eq. 3.4), which
+//! multiplies by A and Aᵀ every iteration, and the AᵀA form (eq. 3.5), which assembles the
+//! sparse n_t × n_t matrix AᵀA once and multiplies by it alone. The rule of thesis 3.5
+//! picks between them: AᵀA when `2·n_s ≥ K·n_t` (K = 4, the relative density of AᵀA).
+
+use rayon::prelude::*;
+
+use crate::cg::Quadratic;
+use crate::sparse::Csr;
+
+/// Which form of the normal equations the solver iterates on.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Form {
+    /// Products with A and Aᵀ (eq. 3.4); cost ∝ n_s.
+    A,
+    /// Products with the assembled AᵀA (eq. 3.5); cost ∝ n_t.
+    Normal,
+}
+
+/// K of thesis 3.5: how much denser AᵀA's rows are than A's.
+pub const DEFAULT_K: f64 = 4.0;
+
+impl Form {
+    /// The rule of thesis 3.5: the AᵀA form when `2·n_s ≥ K·n_t`.
+    pub fn choose(n_s: usize, n_t: usize, k: f64) -> Form {
+        if 2.0 * n_s as f64 >= k * n_t as f64 { Form::Normal } else { Form::A }
+    }
+}
+
+/// The data operator shared by the three colour channels.
+pub enum DataOperator {
+    A { a: Csr, at: Csr },
+    Normal { h: Csr, at: Csr },
+}
+
+impl DataOperator {
+    /// Builds the operator for `a` in the given form.
+    pub fn new(a: Csr, form: Form) -> DataOperator {
+        let at = a.transpose();
+        match form {
+            Form::A => DataOperator::A { a, at },
+            Form::Normal => {
+                let h = a.gram(&at);
+                DataOperator::Normal { h, at }
+            }
+        }
+    }
+
+    /// The right-hand side of one channel: Aᵀb (AᵀA form) or b itself, plus ‖b‖².
+    pub fn rhs(&self, b: Vec<f64>) -> ChannelRhs {
+        let bb = b.iter().map(|v| v * v).sum();
+        match self {
+            DataOperator::A { .. } => ChannelRhs { b, atb: vec![], bb },
+            DataOperator::Normal { at, .. } => {
+                let mut atb = vec![0.0; at.rows];
+                at.mul(&b, &mut atb);
+                ChannelRhs { b: vec![], atb, bb }
+            }
+        }
+    }
+
+    /// n_t.
+    pub fn cols(&self) -> usize {
+        match self {
+            DataOperator::A { at, .. } | DataOperator::Normal { at, .. } => at.rows,
+        }
+    }
+}
+
+/// One channel's data: b (A form) or Aᵀb (AᵀA form), and ‖b‖².
+pub struct ChannelRhs {
+    pub b: Vec<f64>,
+    pub atb: Vec<f64>,
+    pub bb: f64,
+}
+
+/// The pyramidal term λ‖Px‖² (eq. 3.9) with λ = ε_f·n_s/n_t.
+pub struct PyramidTerm {
+    pub lambda: f64,
+    pub p: Csr,
+    pub pt: Csr,
+}
+
+/// One channel's quadratic objective `‖Ax − b‖² + λ‖Px‖²`.
+pub struct ChannelProblem<'a> {
+    pub op: &'a DataOperator,
+    pub rhs: &'a ChannelRhs,
+    pub pyramid: Option<&'a PyramidTerm>,
+}
+
+fn dot(a: &[f64], b: &[f64]) -> f64 {
+    a.iter().zip(b).map(|(x, y)| x * y).sum()
+}
+
+impl Quadratic for ChannelProblem<'_> {
+    fn hess_mul(&self, p: &[f64], out: &mut [f64]) {
+        match self.op {
+            DataOperator::A { a, at } => {
+                let mut t = vec![0.0; a.rows];
+                a.mul(p, &mut t);
+                at.mul(&t, out);
+            }
+            DataOperator::Normal { h, .. } => h.mul(p, out),
+        }
+        if let Some(pt) = self.pyramid {
+            let mut t = vec![0.0; pt.p.rows];
+            pt.p.mul(p, &mut t);
+            let mut u = vec![0.0; out.len()];
+            pt.pt.mul(&t, &mut u);
+            out.par_iter_mut().zip(&u).for_each(|(o, u)| *o += pt.lambda * u);
+        }
+    }
+
+    fn value_gradient(&self, x: &[f64], grad: &mut [f64]) -> f64 {
+        let mut f = match self.op {
+            DataOperator::A { a, at } => {
+                let mut r = vec![0.0; a.rows];
+                a.mul(x, &mut r);
+                r.iter_mut().zip(&self.rhs.b).for_each(|(r, b)| *r -= b);
+                at.mul(&r, grad);
+                grad.iter_mut().for_each(|g| *g *= 2.0);
+                dot(&r, &r)
+            }
+            DataOperator::Normal { h, .. } => {
+                h.mul(x, grad);
+                let f = dot(x, grad) - 2.0 * dot(x, &self.rhs.atb) + self.rhs.bb;
+                grad.iter_mut().zip(&self.rhs.atb).for_each(|(g, c)| *g = 2.0 * (*g - c));
+                f.max(0.0)
+            }
+        };
+        if let Some(pt) = self.pyramid {
+            let mut t = vec![0.0; pt.p.rows];
+            pt.p.mul(x, &mut t);
+            let mut u = vec![0.0; grad.len()];
+            pt.pt.mul(&t, &mut u);
+            grad.iter_mut().zip(&u).for_each(|(g, u)| *g += 2.0 * pt.lambda * u);
+            f += pt.lambda * dot(&t, &t);
+        }
+        f
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_rule_of_thesis_3_5() {
+        assert_eq!(Form::choose(200, 100, 4.0), Form::Normal);
+        assert_eq!(Form::choose(199, 100, 4.0), Form::A);
+    }
+}

@@ -1,0 +1,272 @@
+//! Least-squares texture inference (thesis 3.5): the texture x minimizing
+//! `‖Ax − b‖² + range term (eq. 3.8) + pyramidal term (eq. 3.9)` per colour channel, the
+//! three channels sharing A.
+//!
+//! The vectors are f64 inside the solver (sums over ~10⁵ texels), the texture f32 outside.
+
+use std::time::Instant;
+
+use crate::cg::{self, CgReport, CgSettings};
+use crate::error::check_finite;
+use crate::normal_equations::{ChannelProblem, DataOperator, Form, PyramidTerm, DEFAULT_K};
+use crate::regularize::{barrier_d2, pyramid_operator, RangeRegularization};
+use crate::sparse::Csr;
+use crate::{CompileError, RenderMatrix, TextureLayout};
+
+/// Colour channels per texel and per pixel (RGB, interleaved).
+pub const CHANNELS: usize = 3;
+
+/// Which form of the normal equations to iterate on.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Default)]
+pub enum FormChoice {
+    /// The rule of thesis 3.5 with K = [`SolveSettings::k`].
+    #[default]
+    Auto,
+    /// Always this form.
+    Fixed(Form),
+}
+
+/// Solver settings; [`SolveSettings::default`] is plain least squares,
+/// [`SolveSettings::pyramidal`] the thesis's regularized setting.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SolveSettings {
+    /// ε_b of eq. 3.8 (0: no range term). The thesis used 1/32.
+    pub epsilon_b: f64,
+    /// ε_f of eq. 3.9 (0: no pyramidal term). The thesis used 0.1.
+    pub epsilon_f: f64,
+    /// The range [0, range_factor · max(b)] the range term keeps texels in.
+    pub range_factor: f64,
+    pub form: FormChoice,
+    /// K of the form rule.
+    pub k: f64,
+    pub cg: CgSettings,
+}
+
+impl Default for SolveSettings {
+    fn default() -> Self {
+        SolveSettings {
+            epsilon_b: 0.0,
+            epsilon_f: 0.0,
+            range_factor: 1.1,
+            form: FormChoice::Auto,
+            k: DEFAULT_K,
+            cg: CgSettings::default(),
+        }
+    }
+}
+
+impl SolveSettings {
+    /// Pyramidal regularization with ε_f = 0.1 (thesis 3.6): every texel defined.
+    pub fn pyramidal() -> Self {
+        SolveSettings { epsilon_f: 0.1, ..Default::default() }
+    }
+
+    /// Range regularization with ε_b = 1/32 (thesis 3.6).
+    pub fn range() -> Self {
+        SolveSettings { epsilon_b: 1.0 / 32.0, ..Default::default() }
+    }
+}
+
+/// A solved texture and how the solve went.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Solution {
+    pub layout: TextureLayout,
+    /// n_t texels × [`CHANNELS`], in the order of [`TextureLayout`].
+    pub texels: Vec<f32>,
+    pub form: Form,
+    /// Covered pixels (all views together for a view-independent solve).
+    pub n_s: usize,
+    pub n_t: usize,
+    /// CG iterations over the three channels together.
+    pub iterations: u32,
+    /// Per channel: iterations, objective history, convergence.
+    pub channels: Vec<CgReport>,
+    /// √(‖Ax − b‖² / (n_s · channels)): the data term's residual per pixel value.
+    pub residual_rms: f64,
+    /// ‖Ax − b‖ / ‖b‖.
+    pub residual_relative: f64,
+    /// Texels no pixel sees and no regularization reaches; they keep the initial value.
+    pub undefined: usize,
+    pub converged: bool,
+    pub solve_ms: f64,
+}
+
+/// One view's render matrix and its ray-traced pixels (`rows × 3`, interleaved RGB).
+#[derive(Clone, Copy, Debug)]
+pub struct View<'a> {
+    pub a: &'a RenderMatrix,
+    pub b: &'a [f32],
+}
+
+/// Solves for one object's texture at one parameter point. `initial` (n_t × 3) is a warm
+/// start, typically the solution at a neighbouring parameter sample of the same block
+/// (same texture layout); without one the solve starts from zero.
+pub fn solve(
+    a: &RenderMatrix,
+    b: &[f32],
+    initial: Option<&[f32]>,
+    settings: &SolveSettings,
+) -> Result<Solution, CompileError> {
+    solve_views(&[View { a, b }], initial, settings, false)
+}
+
+/// Solves one view-independent (diffuse) texture over all views at once (thesis eq. 3.7):
+/// the views' A matrices stacked, in the AᵀA form.
+pub fn solve_view_independent(
+    views: &[View<'_>],
+    initial: Option<&[f32]>,
+    settings: &SolveSettings,
+) -> Result<Solution, CompileError> {
+    solve_views(views, initial, settings, true)
+}
+
+fn solve_views(
+    views: &[View<'_>],
+    initial: Option<&[f32]>,
+    settings: &SolveSettings,
+    stacked: bool,
+) -> Result<Solution, CompileError> {
+    let start = Instant::now();
+    let first = views.first().ok_or_else(|| CompileError::Setting("no views to solve".into()))?;
+    let layout = first.a.layout;
+    check_settings(settings)?;
+    let mut parts = Vec::with_capacity(views.len());
+    for (k, v) in views.iter().enumerate() {
+        if v.a.layout != layout {
+            return Err(CompileError::Setting(format!(
+                "view {k}'s texture layout differs from view 0's")));
+        }
+        if v.b.len() != v.a.rows() * CHANNELS {
+            return Err(CompileError::Size {
+                what: format!("b of view {k} (covered pixels × 3)"),
+                expected: v.a.rows() * CHANNELS, found: v.b.len() });
+        }
+        check_finite("b", v.b)?;
+        parts.push(Csr::from_render_matrix(v.a)?);
+    }
+    let n_t = layout.texel_count();
+    if let Some(x0) = initial {
+        if x0.len() != n_t * CHANNELS {
+            return Err(CompileError::Size {
+                what: "initial guess (texels × 3)".into(), expected: n_t * CHANNELS, found: x0.len() });
+        }
+        check_finite("initial guess", x0)?;
+    }
+    let a = if parts.len() == 1 { parts.pop().expect("one part") } else { Csr::stack(&parts)? };
+    let n_s = a.rows;
+    let form = match settings.form {
+        FormChoice::Fixed(f) => f,
+        FormChoice::Auto if stacked => Form::Normal,
+        FormChoice::Auto => Form::choose(n_s, n_t, settings.k),
+    };
+    let col_norms = a.column_norms_squared();
+    let op = DataOperator::new(a, form);
+    let ratio = n_s as f64 / n_t.max(1) as f64;
+    let pyramid = (settings.epsilon_f > 0.0 && layout.levels > 1).then(|| {
+        let p = pyramid_operator(&layout);
+        let pt = p.transpose();
+        PyramidTerm { lambda: settings.epsilon_f * ratio, p, pt }
+    });
+    let b_all: Vec<f32> = views.iter().flat_map(|v| v.b.iter().copied()).collect();
+    let b_max = b_all.iter().fold(0.0f32, |m, &v| m.max(v)) as f64;
+    let range = (settings.epsilon_b > 0.0).then(|| {
+        RangeRegularization::new(settings.epsilon_b, n_s, n_t,
+                                 (settings.range_factor * b_max).max(1e-6))
+    });
+
+    // Jacobi preconditioner: the diagonal of AᵀA + λPᵀP + the barrier's curvature at ½.
+    let mut diag = col_norms.clone();
+    if let Some(pt) = &pyramid {
+        for (d, n) in diag.iter_mut().zip(pt.p.column_norms_squared()) {
+            *d += pt.lambda * n;
+        }
+    }
+    if let Some(r) = &range {
+        let c = r.scale * barrier_d2(0.5) / (r.range * r.range) * 0.5;
+        diag.iter_mut().for_each(|d| *d += c);
+    }
+    let positive: Vec<f64> = diag.iter().copied().filter(|&d| d > 0.0).collect();
+    let floor = if positive.is_empty() { 1.0 } else { positive.iter().sum::<f64>() / positive.len() as f64 };
+    let inv_diag: Vec<f64> = diag.iter().map(|&d| 1.0 / if d > 0.0 { d } else { floor }).collect();
+    let undefined = if pyramid.is_some() { 0 } else { col_norms.iter().filter(|&&d| d == 0.0).count() };
+
+    let mut texels = vec![0.0f32; n_t * CHANNELS];
+    let mut channels = Vec::with_capacity(CHANNELS);
+    let mut residual2 = 0.0;
+    let mut bb_total = 0.0;
+    for ch in 0..CHANNELS {
+        let b: Vec<f64> = b_all.iter().skip(ch).step_by(CHANNELS).map(|&v| v as f64).collect();
+        let rhs = op.rhs(b.clone());
+        let mut x: Vec<f64> = match initial {
+            Some(x0) => x0.iter().skip(ch).step_by(CHANNELS).map(|&v| v as f64).collect(),
+            None => vec![0.0; n_t],
+        };
+        if let Some(r) = &range {
+            r.clamp_inside(&mut x);
+        }
+        let problem = ChannelProblem { op: &op, rhs: &rhs, pyramid: pyramid.as_ref() };
+        let report = cg::minimize(&problem, range.as_ref(), &inv_diag, &mut x, &settings.cg);
+        residual2 += data_residual2(&op, &x, &b);
+        bb_total += rhs.bb;
+        for (t, &v) in x.iter().enumerate() {
+            texels[t * CHANNELS + ch] = v as f32;
+        }
+        channels.push(report);
+    }
+    Ok(Solution {
+        layout,
+        texels,
+        form,
+        n_s,
+        n_t,
+        iterations: channels.iter().map(|c| c.iterations).sum(),
+        converged: channels.iter().all(|c| c.converged),
+        channels,
+        residual_rms: (residual2 / (n_s.max(1) * CHANNELS) as f64).sqrt(),
+        residual_relative: if bb_total > 0.0 { (residual2 / bb_total).sqrt() } else { residual2.sqrt() },
+        undefined,
+        solve_ms: start.elapsed().as_secs_f64() * 1e3,
+    })
+}
+
+/// ‖Ax − b‖², from scratch.
+fn data_residual2(op: &DataOperator, x: &[f64], b: &[f64]) -> f64 {
+    let at = match op {
+        DataOperator::A { at, .. } | DataOperator::Normal { at, .. } => at,
+    };
+    // Ax through the transpose's columns: (Ax)_r = Σ_c A_rc x_c, gathered row by row.
+    let mut ax = vec![0.0; b.len()];
+    for c in 0..at.rows {
+        let (rows, vals) = at.row(c);
+        for (&r, &v) in rows.iter().zip(vals) {
+            ax[r as usize] += v * x[c];
+        }
+    }
+    ax.iter().zip(b).map(|(a, b)| (a - b) * (a - b)).sum()
+}
+
+fn check_settings(s: &SolveSettings) -> Result<(), CompileError> {
+    let ok = |v: f64| v.is_finite() && v >= 0.0;
+    if !ok(s.epsilon_b) || !ok(s.epsilon_f) {
+        return Err(CompileError::Setting(format!(
+            "ε_b = {} and ε_f = {} must be finite and ≥ 0", s.epsilon_b, s.epsilon_f)));
+    }
+    if !(s.range_factor.is_finite() && s.range_factor > 0.0) || !(s.k.is_finite() && s.k > 0.0) {
+        return Err(CompileError::Setting("range factor and K must be finite and > 0".into()));
+    }
+    Ok(())
+}
+
+/// Renders a texture through A: the n_s × 3 pixel values A·x (for PSNR against b).
+pub fn render(a: &RenderMatrix, texels: &[f32]) -> Vec<f32> {
+    let mut out = vec![0.0f32; a.rows() * CHANNELS];
+    for r in 0..a.rows() {
+        let (c, v) = a.row(r);
+        for (&c, &v) in c.iter().zip(v) {
+            for ch in 0..CHANNELS {
+                out[r * CHANNELS + ch] += v * texels[c as usize * CHANNELS + ch];
+            }
+        }
+    }
+    out
+}

@@ -1,0 +1,209 @@
+//! Tests of the least-squares solver on synthetic render matrices.
+
+use crate::normal_equations::Form;
+use crate::synthetic::warp_matrix;
+use crate::{
+    render, solve, solve_view_independent, CompileError, Filter, FormChoice, RenderMatrix,
+    SolveSettings, TextureLayout, View,
+};
+
+/// A smooth colourful texture over every level (level m a blurred version of level 0).
+fn texture(layout: &TextureLayout) -> Vec<f32> {
+    let mut x = Vec::with_capacity(layout.texel_count() * 3);
+    for m in 0..layout.levels {
+        let (w, h) = layout.level_size(m);
+        for j in 0..h {
+            for i in 0..w {
+                let (s, t) = ((i as f32 + 0.5) / w as f32, (j as f32 + 0.5) / h as f32);
+                let a = 1.0 / (1 + m) as f32;
+                x.push(0.5 + 0.4 * a * (9.0 * s).sin() * (7.0 * t).cos());
+                x.push(0.3 + 0.2 * s);
+                x.push(2.0 * t * t);
+            }
+        }
+    }
+    x
+}
+
+fn psnr(a: &[f32], b: &[f32]) -> f64 {
+    let peak = b.iter().fold(0.0f32, |m, &v| m.max(v)) as f64;
+    let mse = a.iter().zip(b).map(|(x, y)| ((x - y) as f64).powi(2)).sum::<f64>() / a.len() as f64;
+    10.0 * (peak * peak / mse.max(1e-300)).log10()
+}
+
+/// A view of a 16×12 texture on a 40×30 screen, rotated and slightly perspective.
+fn view(filter: Filter, shift: f64) -> (RenderMatrix, Vec<f32>) {
+    let layout = TextureLayout::full(16, 12);
+    let a = warp_matrix(40, 30, layout, filter, |x, y| {
+        let (x, y) = (x - 20.0 - shift, y - 15.0);
+        let w = 1.0 + 0.01 * x;
+        let s = 0.5 + (0.9 * x + 0.3 * y) / (36.0 * w);
+        let t = 0.5 + (-0.3 * x + 0.9 * y) / (26.0 * w);
+        ((0.0..1.0).contains(&s) && (0.0..1.0).contains(&t)).then_some((s, t))
+    });
+    let b = render(&a, &texture(&layout));
+    (a, b)
+}
+
+fn assert_monotone(sol: &crate::Solution) {
+    for ch in &sol.channels {
+        for w in ch.objective.windows(2) {
+            assert!(w[1] <= w[0], "objective rose from {} to {}", w[0], w[1]);
+        }
+        assert!(ch.objective.iter().all(|f| f.is_finite()));
+    }
+}
+
+#[test]
+fn recovers_an_exactly_representable_image_in_both_forms() {
+    let (a, b) = view(Filter::Bilinear, 0.0);
+    let mut previous: Option<Vec<f32>> = None;
+    for form in [Form::A, Form::Normal] {
+        let settings = SolveSettings { form: FormChoice::Fixed(form), ..Default::default() };
+        let sol = solve(&a, &b, None, &settings).unwrap();
+        assert_eq!(sol.form, form);
+        assert_monotone(&sol);
+        let p = psnr(&render(&a, &sol.texels), &b);
+        assert!(p > 60.0, "{form:?}: {p} dB, residual {}", sol.residual_rms);
+        assert!(sol.residual_rms < 1e-3);
+        if let Some(prev) = &previous {
+            assert!(psnr(&render(&a, prev), &render(&a, &sol.texels)) > 60.0);
+        }
+        previous = Some(sol.texels);
+    }
+}
+
+#[test]
+fn pyramidal_regularization_defines_every_texel_and_costs_little() {
+    let (a, mut b) = view(Filter::Trilinear, 0.0);
+    // deterministic noise, so neither solve can match b exactly (like a ray-traced layer)
+    for (k, v) in b.iter_mut().enumerate() {
+        *v += 0.02 * (((k * 2654435761) % 1000) as f32 / 1000.0 - 0.5);
+    }
+    let plain = solve(&a, &b, None, &SolveSettings::default()).unwrap();
+    assert!(plain.undefined > 0, "the unregularized trilinear solve leaves unseen texels");
+    let reg = solve(&a, &b, None, &SolveSettings::pyramidal()).unwrap();
+    assert_eq!(reg.undefined, 0);
+    assert!(reg.texels.iter().all(|v| v.is_finite()));
+    // every level holds values of the image's magnitude, not the zero start
+    let l = reg.layout;
+    let last = l.level_offset(l.levels - 1) * 3;
+    assert!(reg.texels[last..].iter().any(|&v| v > 0.1));
+    assert_monotone(&reg);
+    let (p0, p1) = (psnr(&render(&a, &plain.texels), &b), psnr(&render(&a, &reg.texels), &b));
+    // (the drop shrinks with ε_f: 0.3 dB at ε_f = 0.03, 0.06 dB at 0.01 on this view)
+    assert!(p0 - p1 < 2.0, "plain {p0} dB, pyramidal {p1} dB");
+}
+
+#[test]
+fn range_regularization_keeps_texels_in_range_and_never_raises_the_objective() {
+    let (a, mut b) = view(Filter::Trilinear, 0.0);
+    // a few outliers the texture cannot reproduce, pulling unconstrained texels out of range
+    for (k, v) in b.iter_mut().enumerate() {
+        if k % 37 == 0 {
+            *v += 1.5;
+        }
+    }
+    let settings = SolveSettings { epsilon_f: 0.1, ..SolveSettings::range() };
+    let sol = solve(&a, &b, None, &settings).unwrap();
+    assert_monotone(&sol);
+    let r = 1.1 * b.iter().fold(0.0f32, |m, &v| m.max(v));
+    let d = r / 512.0;
+    assert!(sol.texels.iter().all(|&v| v > -d && v < r + d));
+}
+
+#[test]
+fn unobserved_texels_grazing_views_tiny_coverage_and_half_off_screen_stay_finite() {
+    let layout = TextureLayout::full(32, 32);
+    let x = texture(&layout);
+    let cases: Vec<(&str, RenderMatrix)> = vec![
+        // grazing: t spans the texture over 2 rows of pixels
+        ("grazing", warp_matrix(40, 30, layout, Filter::Trilinear, |x, y| {
+            let (s, t) = (x / 40.0, (y - 14.0) / 2.0);
+            (0.0..1.0).contains(&t).then_some((s, t))
+        })),
+        ("tiny", warp_matrix(40, 30, layout, Filter::Trilinear, |x, y| {
+            (x < 2.0 && y < 2.0).then_some((0.3 + x * 0.01, 0.6 + y * 0.01))
+        })),
+        // the object's left half is off screen: only s ≥ ½ is seen
+        ("half-off-screen", warp_matrix(40, 30, layout, Filter::Trilinear, |x, y| {
+            Some((0.5 + x / 80.0, y / 30.0))
+        })),
+    ];
+    for (name, a) in cases {
+        let b = render(&a, &x);
+        for settings in [SolveSettings::default(), SolveSettings::pyramidal(),
+                         SolveSettings { epsilon_b: 1.0 / 32.0, ..SolveSettings::pyramidal() }] {
+            let sol = solve(&a, &b, None, &settings).unwrap();
+            assert!(sol.texels.iter().all(|v| v.is_finite()), "{name}");
+            assert!(sol.residual_rms.is_finite(), "{name}");
+            assert!(sol.residual_relative < 0.05, "{name}: residual {}", sol.residual_relative);
+            assert_monotone(&sol);
+        }
+    }
+}
+
+#[test]
+fn non_finite_inputs_are_rejected() {
+    let (mut a, mut b) = view(Filter::Bilinear, 0.0);
+    b[7] = f32::NAN;
+    let e = solve(&a, &b, None, &SolveSettings::default()).unwrap_err();
+    assert!(matches!(e, CompileError::NonFinite { index: 7, .. }), "{e}");
+    assert!(e.to_string().contains("b holds a non-finite value"));
+    b[7] = 0.0;
+    a.vals[3] = f32::INFINITY;
+    let e = solve(&a, &b, None, &SolveSettings::default()).unwrap_err();
+    assert!(matches!(e, CompileError::NonFinite { index: 3, .. }), "{e}");
+    a.vals[3] = 0.5;
+    let x0 = vec![f32::NEG_INFINITY; a.cols() * 3];
+    assert!(matches!(solve(&a, &b, Some(&x0), &SolveSettings::default()),
+                     Err(CompileError::NonFinite { .. })));
+    assert!(matches!(solve(&a, &b[1..], None, &SolveSettings::default()),
+                     Err(CompileError::Size { .. })));
+    a.cols[0] = a.cols() as u32;
+    assert!(matches!(solve(&a, &b, None, &SolveSettings::default()),
+                     Err(CompileError::Matrix(_))));
+}
+
+#[test]
+fn a_warm_start_from_a_neighbouring_sample_needs_fewer_iterations() {
+    let (a0, b0) = view(Filter::Trilinear, 0.0);
+    let (a1, b1) = view(Filter::Trilinear, 0.7);
+    let s = SolveSettings::pyramidal();
+    let first = solve(&a0, &b0, None, &s).unwrap();
+    let cold = solve(&a1, &b1, None, &s).unwrap();
+    let warm = solve(&a1, &b1, Some(&first.texels), &s).unwrap();
+    assert!(warm.iterations < cold.iterations, "warm {} cold {}", warm.iterations, cold.iterations);
+}
+
+#[test]
+fn a_view_independent_texture_is_solved_over_stacked_views() {
+    let layout = TextureLayout::full(16, 16);
+    let x = texture(&layout);
+    // each view sees one half of the texture
+    let left = warp_matrix(32, 32, layout, Filter::Bilinear, |x, y| Some((x / 64.0, y / 32.0)));
+    let right = warp_matrix(32, 32, layout, Filter::Bilinear, |x, y| Some((0.5 + x / 64.0, y / 32.0)));
+    let (bl, br) = (render(&left, &x), render(&right, &x));
+    let views = [View { a: &left, b: &bl }, View { a: &right, b: &br }];
+    let sol = solve_view_independent(&views, None, &SolveSettings::default()).unwrap();
+    assert_eq!(sol.form, Form::Normal);
+    assert_eq!(sol.n_s, 2 * 32 * 32);
+    assert!(psnr(&render(&left, &sol.texels), &bl) > 60.0);
+    assert!(psnr(&render(&right, &sol.texels), &br) > 60.0);
+    // level 0 is fully determined by the two views together
+    let n0 = 16 * 16 * 3;
+    assert!(psnr(&sol.texels[..n0], &x[..n0]) > 50.0);
+}
+
+#[test]
+fn solving_twice_gives_identical_bytes() {
+    let (a, b) = view(Filter::Trilinear, 0.3);
+    for form in [Form::A, Form::Normal] {
+        let s = SolveSettings { form: FormChoice::Fixed(form), ..SolveSettings::pyramidal() };
+        let one = solve(&a, &b, None, &s).unwrap();
+        let two = solve(&a, &b, None, &s).unwrap();
+        assert_eq!(one.texels, two.texels);
+        assert_eq!(one.iterations, two.iterations);
+    }
+}
+
