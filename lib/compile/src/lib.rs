@@ -20,6 +20,7 @@ pub mod sampler;
 pub mod solve;
 pub mod sparse;
 pub mod synthetic;
+pub mod texcoord;
 
 pub use error::CompileError;
 pub use layout::TextureLayout;

@@ -1,0 +1,227 @@
+//! Texture-coordinate and resolution optimization per object per parameter block (thesis
+//! 3.2):
+//!
+//! 1. branch cuts in wrapped dimensions ([`branch_cut`]);
+//! 2. the least-squares most-isometric linear map, eq. 3.1 ([`isometry`]);
+//! 3. 4. scaling until the texture→screen Jacobian's largest singular value is under a
+//!    threshold at every covered pixel ([`stretch`]);
+//! 5. the minimum-area bounding rectangle over discrete directions ([`bounding`]);
+//! 6. the used resolution, times a per-object reduction factor.
+//!
+//! Visibility comes from a minimal triangle-identifier z-buffer ([`visibility`]).
+//!
+//! The result is the affine transform of format-spec/SPEC.md 7.3:
+//! `s = a·u + b·v + e`, `t = c·u + d·v + f`, (s, t) ∈ [0, 1]² spanning the used texture.
+//! Where a branch cut was made the transform applies to the cut coordinates
+//! `w' = (w − w_cut) − ⌊w − w_cut⌋` ([`TexturePlacement::branch_cut`]), which the geometry
+//! handed to the player must carry.
+
+pub mod bounding;
+pub mod branch_cut;
+pub mod edges;
+pub mod isometry;
+pub mod stretch;
+pub mod visibility;
+
+use glam::{DMat2, DVec2, Vec2};
+
+use crate::CompileError;
+use edges::visible_edges;
+use isometry::EdgeTerm;
+pub use visibility::ViewGeometry;
+
+/// Settings of texture-coordinate optimization.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TexcoordSettings {
+    /// The largest texture→screen stretch allowed (thesis: 1.25).
+    pub max_stretch: f64,
+    /// Directions searched for the minimum-area rectangle over 90°.
+    pub directions: u32,
+    /// The object's resolution reduction factor (1: the optimal resolution; 0.5: half).
+    pub reduction: f64,
+    /// Largest used width or height (SPEC.md 7.3 allows 16384).
+    pub max_size: u32,
+}
+
+impl Default for TexcoordSettings {
+    fn default() -> Self {
+        TexcoordSettings { max_stretch: 1.25, directions: 90, reduction: 1.0, max_size: 16384 }
+    }
+}
+
+/// An object's mesh: per-vertex texture coordinates, triangles, and which texture
+/// dimensions are periodic (wrapping enabled).
+#[derive(Clone, Copy, Debug)]
+pub struct ObjectMesh<'a> {
+    pub name: &'a str,
+    pub uvs: &'a [Vec2],
+    pub indices: &'a [u32],
+    pub wrap: [bool; 2],
+}
+
+/// The texture placement of one object in one parameter block.
+#[derive(Clone, Debug, PartialEq)]
+pub struct TexturePlacement {
+    /// [a, b, c, d, e, f] of SPEC.md 7.3.
+    pub affine: [f32; 6],
+    /// Used texture size in texels.
+    pub width: u32,
+    pub height: u32,
+    /// Whether the texture wraps along s and t (a periodic dimension without a cut).
+    pub repeat: [bool; 2],
+    /// The branch cut position along u and v, where one was made.
+    pub branch_cut: [Option<f64>; 2],
+    /// The largest texture→screen stretch over the covered pixels after scaling, at the
+    /// optimal resolution (before the reduction factor).
+    pub stretch: f64,
+    /// Visible edges used over all views of the block.
+    pub visible_edges: usize,
+}
+
+impl TexturePlacement {
+    /// (s, t) of texture coordinate (u, v) (after any branch cut).
+    pub fn apply(&self, u: f32, v: f32) -> (f32, f32) {
+        let [a, b, c, d, e, f] = self.affine;
+        (a * u + b * v + e, c * u + d * v + f)
+    }
+}
+
+/// Chooses the affine texture transform and used resolution of `mesh` for the views of one
+/// parameter block (thesis 3.2). `views[k].clip` holds the mesh's clip-space vertices.
+/// An object no view sees gets a 1×1 texture.
+pub fn optimize_placement(
+    mesh: &ObjectMesh<'_>,
+    views: &[ViewGeometry],
+    settings: &TexcoordSettings,
+) -> Result<TexturePlacement, CompileError> {
+    let fail = |message: String| CompileError::Geometry { object: mesh.name.to_string(), message };
+    if mesh.indices.len() % 3 != 0 {
+        return Err(fail(format!("{} indices is not a whole number of triangles", mesh.indices.len())));
+    }
+    if let Some(&i) = mesh.indices.iter().find(|&&i| i as usize >= mesh.uvs.len()) {
+        return Err(fail(format!("index {i} past {} texture coordinates", mesh.uvs.len())));
+    }
+    for (k, v) in views.iter().enumerate() {
+        if v.clip.len() != mesh.uvs.len() {
+            return Err(fail(format!("view {k} has {} vertices, the mesh {}", v.clip.len(), mesh.uvs.len())));
+        }
+        if v.clip.iter().any(|c| !c.is_finite()) || mesh.uvs.iter().any(|u| !u.is_finite()) {
+            return Err(fail(format!("view {k}: non-finite vertex or texture coordinate")));
+        }
+    }
+    if !(settings.max_stretch > 0.0 && settings.reduction > 0.0 && settings.reduction.is_finite()) {
+        return Err(CompileError::Setting("max stretch and reduction must be > 0".into()));
+    }
+
+    // Step 1: branch cuts, from the visible edges' extents in the original coordinates.
+    let first: Vec<_> = views.iter().map(|v| visible_edges(v, mesh.uvs, mesh.indices)).collect();
+    let mut cut = [None, None];
+    let mut repeat = [false, false];
+    for dim in 0..2 {
+        if !mesh.wrap[dim] {
+            continue;
+        }
+        let extents: Vec<(f64, f64)> = first.iter().flat_map(|(e, _)| e.iter()).map(|e| {
+            let (p, q) = (e.uv[0][dim], e.uv[1][dim]);
+            (p.min(q), p.max(q))
+        }).collect();
+        cut[dim] = branch_cut::find_cut(&extents);
+        repeat[dim] = cut[dim].is_none();
+    }
+    let uvs: Vec<Vec2> = mesh.uvs.iter().map(|uv| {
+        let mut w = uv.as_dvec2();
+        for dim in 0..2 {
+            if let Some(c) = cut[dim] {
+                w[dim] = branch_cut::apply_cut(w[dim], c);
+            }
+        }
+        w.as_vec2()
+    }).collect();
+    let per_view: Vec<_> = if cut.iter().any(Option::is_some) {
+        views.iter().map(|v| visible_edges(v, &uvs, mesh.indices)).collect()
+    } else {
+        first
+    };
+    let edges: Vec<_> = per_view.iter().flat_map(|(e, _)| e.iter().copied()).collect();
+    if edges.is_empty() {
+        return Ok(TexturePlacement {
+            affine: [1.0, 0.0, 0.0, 1.0, 0.0, 0.0], width: 1, height: 1, repeat,
+            branch_cut: cut, stretch: 0.0, visible_edges: 0,
+        });
+    }
+
+    // Step 2: the most isometric linear map.
+    let scale_only = repeat[0] || repeat[1];
+    let terms: Vec<EdgeTerm> = edges.iter().map(|e| EdgeTerm {
+        screen_length: e.screen_length, duv: e.uv[1] - e.uv[0], weight: e.weight,
+    }).collect();
+    let r = isometry::most_isometric(&terms, scale_only);
+    let r = DMat2::from_cols(DVec2::new(r[0], r[2]), DVec2::new(r[1], r[3]));
+
+    // Steps 3–4: scale until the stretch is under the threshold at every covered pixel.
+    let mut jacobians = Vec::new();
+    for (view, (_, ids)) in views.iter().zip(&per_view) {
+        for (k, id) in ids.ids.iter().enumerate() {
+            let Some(t) = id else { continue };
+            let tri = &mesh.indices[3 * *t as usize..3 * *t as usize + 3];
+            let Some(sv) = visibility::screen_triangle(view, tri) else { continue };
+            let p = DVec2::new((k % view.width as usize) as f64 + 0.5, (k / view.width as usize) as f64 + 0.5);
+            let tuv = [uvs[tri[0] as usize], uvs[tri[1] as usize], uvs[tri[2] as usize]];
+            if let Some(j) = visibility::uv_jacobian(&sv, tuv, p) {
+                jacobians.push(j);
+            }
+        }
+    }
+    let (r, stretch) = stretch::limit_stretch(r, &jacobians, settings.max_stretch, scale_only);
+
+    // Step 5: the minimum-area rectangle (no rotation when a dimension wraps).
+    let points: Vec<DVec2> = edges.iter().flat_map(|e| [r * e.uv[0], r * e.uv[1]]).collect();
+    let (theta, mut lo, mut hi) = if scale_only {
+        let (lo, hi) = bounding::bounds(&points, 0.0);
+        (0.0, lo, hi)
+    } else {
+        bounding::min_area_rectangle(&points, settings.directions)
+    };
+    let m = DMat2::from_angle(-theta) * r;
+    for dim in 0..2 {
+        if repeat[dim] {
+            // A wrapped dimension keeps one whole period: s = u (or t = v).
+            let k = m.col(dim)[dim].abs();
+            lo[dim] = 0.0;
+            hi[dim] = k;
+        }
+    }
+
+    // Step 6: the used resolution.
+    let ext = hi - lo;
+    let size = |e: f64| ((e * settings.reduction).ceil().max(1.0) as u64).min(settings.max_size as u64) as u32;
+    let (width, height) = (size(ext.x), size(ext.y));
+    let mut affine = [0.0f64; 6];
+    for dim in 0..2 {
+        let e = if ext[dim] > 1e-12 { ext[dim] } else { 1.0 };
+        if repeat[dim] {
+            affine[2 * dim + dim] = 1.0;
+            continue;
+        }
+        // row `dim` of M, divided by the extent
+        affine[2 * dim] = m.col(0)[dim] / e;
+        affine[2 * dim + 1] = m.col(1)[dim] / e;
+        affine[4 + dim] = -lo[dim] / e;
+    }
+    let det = affine[0] * affine[3] - affine[1] * affine[2];
+    if !(det.is_finite() && det != 0.0) {
+        return Err(fail(format!("degenerate texture transform (determinant {det})")));
+    }
+    Ok(TexturePlacement {
+        affine: affine.map(|v| v as f32),
+        width,
+        height,
+        repeat,
+        branch_cut: cut,
+        stretch,
+        visible_edges: edges.len(),
+    })
+}
+
+#[cfg(test)]
+mod tests;
