@@ -2,32 +2,54 @@
 //! GPU pipeline that yields the render matrix A of an object at a parameter point, and the
 //! least-squares solver that finds the texture x with A·x ≈ b (the ray-traced layer).
 //!
-//! The types in `layout`, `matrix` and `sampler` are the contract between the hardware
-//! model (which builds [`RenderMatrix`]es analytically), the player's probe mode (which
-//! measures them through wgpu, in `pis-play`) and the solver (which consumes them).
+//! The types [`TextureLayout`], [`Sampler`] and [`RenderMatrix`] are the contract between
+//! the hardware model (which builds [`RenderMatrix`]es analytically: [`model::render_matrix`]),
+//! the player's probe mode (which measures them through wgpu, in `pis-play`) and the solver
+//! (which consumes them).
 //!
-//! The solver: [`solve`] (one view), [`solve_view_independent`] (eq. 3.7), settings in
-//! [`SolveSettings`]; `cg` (conjugate gradient with exact line search), `normal_equations`
-//! (the A and AᵀA forms), `regularize` (eqs. 3.8 and 3.9).
+//! The hardware model, stage by stage (each the twin of a function in the player's WGSL,
+//! `lib/play/src/textured.wgsl`): [`transform`] (vertex shader, clipping, viewport),
+//! [`raster`] (coverage with the top-left rule, depth), [`interpolate`] (perspective-correct
+//! (s, t) and fine derivatives), [`lod`] (the Vulkan LOD), [`filter`] (sampler weights),
+//! [`model`] (the render matrix), [`antialias`] (thesis 3.4.4).
+//!
+//! The solver (thesis 3.5): [`solve()`] (one view), [`solve_view_independent`] (eq. 3.7),
+//! settings in [`SolveSettings`]; [`cg`] (conjugate gradient with exact line search),
+//! [`normal_equations`] (the A and AᵀA forms), [`regularize`] (eqs. 3.8 and 3.9),
+//! [`sparse`] (deterministic parallel sparse products).
+//!
+//! Texture-coordinate optimization (thesis 3.2): [`texcoord`]. Render matrices for a known
+//! screen→texture map, for tests and benchmarks: [`synthetic`].
 
+pub mod antialias;
 pub mod cg;
 pub mod error;
+pub mod filter;
+pub mod interpolate;
 pub mod layout;
+pub mod lod;
 pub mod matrix;
+pub mod model;
 pub mod normal_equations;
+pub mod raster;
 pub mod regularize;
 pub mod sampler;
 pub mod solve;
 pub mod sparse;
 pub mod synthetic;
 pub mod texcoord;
+pub mod transform;
 
+pub use antialias::{antialias, DisplayFilter};
 pub use error::CompileError;
 pub use layout::TextureLayout;
 pub use matrix::RenderMatrix;
+pub use model::{render_matrix, scene_depth, ModelError, TexturedObject};
 pub use normal_equations::Form;
+pub use raster::DepthBuffer;
 pub use sampler::{Address, Filter, Sampler};
 pub use solve::{render, solve, solve_view_independent, FormChoice, Solution, SolveSettings, View};
+pub use transform::{DrawMesh, TextureTransform, Viewport};
 
 #[cfg(test)]
 mod solve_tests;

@@ -1,0 +1,140 @@
+//! Inference with antialiasing (thesis 3.4.4): A is built at a supersampled resolution (no
+//! antialiasing in the model), then its rows are filtered with the display filter — the ray
+//! tracer's truncated Gaussian (format-spec/RAYSET.md: w(d) = exp(−|d|²/2σ²) for |d| ≤ R,
+//! centred on the pixel centre, normalised) — and divided by the filtered coverage, so
+//! sub-pixels the object does not cover do not count.
+
+use std::collections::BTreeMap;
+
+use rayon::prelude::*;
+
+use crate::model::ModelError;
+use crate::RenderMatrix;
+
+/// The display filter of the ray-traced set (`set.json`: `filter.sigma_px`, `filter.radius_px`),
+/// in display pixels.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DisplayFilter {
+    pub sigma_px: f32,
+    pub radius_px: f32,
+}
+
+/// Filters a render matrix built at `factor`× the display resolution (in each dimension) down
+/// to display pixels: row p = Σ_k w_k · row_k / c_p over the covered sub-pixels k within the
+/// filter radius, with c_p = Σ_k w_k over those covered sub-pixels (weights normalised over
+/// all sub-pixels in the radius), the pixel's coverage. Pixels with c_p = 0 have no row.
+pub fn antialias(supersampled: &RenderMatrix, factor: u32, filter: DisplayFilter) -> Result<RenderMatrix, ModelError> {
+    let bad = !(filter.sigma_px > 0.0 && filter.sigma_px.is_finite() && filter.radius_px > 0.0 && filter.radius_px.is_finite());
+    if bad || factor == 0 || supersampled.width % factor != 0 || supersampled.height % factor != 0 {
+        return Err(ModelError::Filter { sigma: filter.sigma_px, radius: filter.radius_px, factor });
+    }
+    let (sw, sh) = (supersampled.width as i64, supersampled.height as i64);
+    let (w, h) = (supersampled.width / factor, supersampled.height / factor);
+    let f = factor as f64;
+    let (sigma, radius) = (filter.sigma_px as f64, filter.radius_px as f64);
+    // Sub-pixel index → row of the supersampled matrix.
+    let mut row_of = vec![u32::MAX; (sw * sh) as usize];
+    for (r, &p) in supersampled.pixels.iter().enumerate() {
+        row_of[p as usize] = r as u32;
+    }
+    // Candidate display pixels: those whose filter reaches a covered sub-pixel.
+    let reach = (radius * f).ceil() as i64 + 1;
+    let mut candidates: Vec<u32> = supersampled
+        .pixels
+        .iter()
+        .flat_map(|&p| {
+            let (sx, sy) = ((p as i64 % sw) / factor as i64, (p as i64 / sw) / factor as i64);
+            let r = reach / factor as i64 + 1;
+            (sy - r..=sy + r).flat_map(move |y| (sx - r..=sx + r).map(move |x| (x, y)))
+        })
+        .filter(|&(x, y)| x >= 0 && y >= 0 && x < w as i64 && y < h as i64)
+        .map(|(x, y)| (y * w as i64 + x) as u32)
+        .collect();
+    candidates.sort_unstable();
+    candidates.dedup();
+    let rows: Vec<(u32, f32, Vec<(u32, f32)>)> = candidates
+        .par_iter()
+        .filter_map(|&p| {
+            let (cx, cy) = ((p % w) as f64 + 0.5, (p / w) as f64 + 0.5);
+            let (x0, x1) = (((cx - radius) * f - 0.5).ceil() as i64, ((cx + radius) * f - 0.5).floor() as i64);
+            let (y0, y1) = (((cy - radius) * f - 0.5).ceil() as i64, ((cy + radius) * f - 0.5).floor() as i64);
+            let (mut total, mut covered) = (0.0f64, 0.0f64);
+            let mut acc: BTreeMap<u32, f64> = BTreeMap::new();
+            for sy in y0..=y1 {
+                for sx in x0..=x1 {
+                    let (dx, dy) = ((sx as f64 + 0.5) / f - cx, (sy as f64 + 0.5) / f - cy);
+                    let d2 = dx * dx + dy * dy;
+                    if d2 > radius * radius {
+                        continue;
+                    }
+                    let wk = (-d2 / (2.0 * sigma * sigma)).exp();
+                    total += wk;
+                    if sx < 0 || sy < 0 || sx >= sw || sy >= sh {
+                        continue;
+                    }
+                    let r = row_of[(sy * sw + sx) as usize];
+                    if r == u32::MAX {
+                        continue;
+                    }
+                    covered += wk;
+                    let (c, v) = supersampled.row(r as usize);
+                    for (&c, &v) in c.iter().zip(v) {
+                        *acc.entry(c).or_insert(0.0) += wk * v as f64;
+                    }
+                }
+            }
+            if covered <= 0.0 || total <= 0.0 {
+                return None;
+            }
+            let entries = acc.into_iter().map(|(c, v)| (c, (v / covered) as f32)).collect();
+            Some((p, (covered / total) as f32, entries))
+        })
+        .collect();
+    let mut out = RenderMatrix { width: w, height: h, layout: supersampled.layout, ..Default::default() };
+    out.row_start.push(0);
+    for (p, c, entries) in rows {
+        out.pixels.push(p);
+        out.coverage.push(c);
+        for (col, v) in entries {
+            out.cols.push(col);
+            out.vals.push(v);
+        }
+        out.row_start.push(out.cols.len() as u32);
+    }
+    Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::TextureLayout;
+
+    #[test]
+    fn half_covered_pixel_has_half_coverage_and_unit_rows() {
+        // 4×4 supersampled (factor 2 → 2×2): the left half of the sub-pixels are covered, all
+        // reading texel 0.
+        let layout = TextureLayout::full(1, 1);
+        let mut a = RenderMatrix { width: 4, height: 4, layout, ..Default::default() };
+        a.row_start.push(0);
+        for y in 0..4 {
+            for x in 0..2 {
+                a.pixels.push(y * 4 + x);
+                a.coverage.push(1.0);
+                a.cols.push(0);
+                a.vals.push(1.0);
+                a.row_start.push(a.cols.len() as u32);
+            }
+        }
+        let f = DisplayFilter { sigma_px: 0.5, radius_px: 0.5 };
+        let d = antialias(&a, 2, f).unwrap();
+        // Display pixels (0, y) fully covered; (1, y) not reached (radius 0.5 px).
+        assert_eq!(d.pixels, vec![0, 2]);
+        assert!(d.coverage.iter().all(|&c| (c - 1.0).abs() < 1e-6));
+        let wide = antialias(&a, 2, DisplayFilter { sigma_px: 0.5, radius_px: 1.5 }).unwrap();
+        assert_eq!(wide.pixels, vec![0, 1, 2, 3]);
+        assert!(wide.coverage[1] > 0.0 && wide.coverage[1] < 0.5);
+        for r in 0..wide.rows() {
+            assert!((wide.row(r).1.iter().sum::<f32>() - 1.0).abs() < 1e-6);
+        }
+    }
+}
