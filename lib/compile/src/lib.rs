@@ -22,6 +22,7 @@
 //! screen→texture map, for tests and benchmarks: [`synthetic`].
 
 pub mod antialias;
+pub mod baseline;
 pub mod cg;
 pub mod error;
 pub mod filter;
