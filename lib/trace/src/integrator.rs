@@ -1,0 +1,508 @@
+//! The distribution ray tracer: radiance along rays, and the segmented first hit that
+//! produces the per-object layers (thesis 3.1, 5.7, 6.2).
+
+use crate::bvh::{offset_origin, Hit, SceneGeometry, SurfacePoint};
+use crate::lights::{hit_light_sphere, sample_light};
+use crate::material::{fresnel_dielectric, reflect, refract, ShadingMaterial};
+use crate::sampling::{cosine_hemisphere, ggx_g1, ggx_half_vector, luminance, Rng};
+use crate::settings::TraceSettings;
+use glam::Vec3;
+use pis_scene::{Frame, ObjectRole, Scene};
+use std::f32::consts::PI;
+
+/// Per-path bookkeeping: ray counts and the fallback seed.
+#[derive(Clone, Debug, Default)]
+pub struct PathContext {
+    /// Rays traced (BVH queries, shadow rays included).
+    pub rays: u64,
+    /// Seed used instead of the surface point when coherence is off.
+    pub fallback_seed: u64,
+}
+
+/// The two terms of the greedy two-path model (thesis 6.2).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum GreedyTerm {
+    /// The path that starts with a reflection.
+    ReflectionFirst = 0,
+    /// The path that starts with a refraction.
+    RefractionFirst = 1,
+}
+
+/// A front-facing hit along a continued outgoing ray.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ContinuedHit {
+    /// Distance from the exit origin.
+    pub t: f32,
+    pub position: Vec3,
+    pub object: u32,
+    /// Radiance leaving the hit point towards the exit origin.
+    pub colour: Vec3,
+}
+
+/// One term of the greedy two-path model for one camera sample.
+#[derive(Clone, Debug, Default)]
+pub struct TermSample {
+    /// Product of the Fresnel coefficients and transparency attenuation along the path (F·G).
+    pub modulation: Vec3,
+    /// Radiance along the exit ray (T or R).
+    pub radiance: Vec3,
+    /// Where the path left the lens object: origin and unit direction; `None` when the path
+    /// does not exist (refraction-first under total internal reflection) or was cut.
+    pub exit: Option<(Vec3, Vec3)>,
+    /// Front-facing hits along the continued exit ray, nearest first (records only).
+    pub hits: Vec<ContinuedHit>,
+}
+
+/// Layers of a reflective object for one camera sample (thesis 5.7).
+#[derive(Clone, Copy, Debug, Default)]
+pub struct ReflectiveSample {
+    /// Fresnel modulation F(n·v) of the specular lobe.
+    pub fresnel: Vec3,
+    /// Incident specular radiance when the reflected ray hits the object again (else 0).
+    pub local: Vec3,
+    /// 1 when the reflected ray hits the object again, else 0.
+    pub local_alpha: f32,
+    /// Incident specular radiance with the object made transparent for the reflected ray.
+    pub distant: Vec3,
+}
+
+/// Everything one camera sample contributes.
+#[derive(Clone, Debug, Default)]
+pub struct CameraSample {
+    /// The object hit first, if any.
+    pub object: Option<u32>,
+    /// Full radiance (the gold standard).
+    pub combined: Vec3,
+    /// Radiance from the first diffuse interaction.
+    pub diffuse: Vec3,
+    /// Everything else (emission, specular reflection, transmission).
+    pub specular: Vec3,
+    pub reflective: Option<ReflectiveSample>,
+    /// The greedy terms, reflection-first then refraction-first, for refractive objects.
+    pub lens: Option<[TermSample; 2]>,
+}
+
+/// Traces rays in one evaluated scene.
+pub struct Integrator<'s> {
+    pub scene: &'s Scene,
+    pub frame: &'s Frame,
+    pub geometry: SceneGeometry<'s>,
+    pub settings: TraceSettings,
+    /// Coherent-sampling cell size actually used (0 = per pixel sample).
+    pub cell: f32,
+}
+
+impl<'s> Integrator<'s> {
+    /// Builds the geometry of `scene` at `frame`.
+    pub fn new(scene: &'s Scene, frame: &'s Frame, settings: &TraceSettings) -> Integrator<'s> {
+        let geometry = SceneGeometry::build(scene, frame);
+        let cell = match settings.coherence_cell {
+            Some(c) => c.max(0.0),
+            None => {
+                let diag = (geometry.bounds.1 - geometry.bounds.0).length();
+                if diag > 0.0 { diag / 4096.0 } else { 0.0 }
+            }
+        };
+        Integrator { scene, frame, geometry, settings: settings.clone(), cell }
+    }
+
+    fn rng_at(&self, sp: &SurfacePoint, depth: u32, ctx: &PathContext) -> Rng {
+        Rng::at_surface(sp.object_position, self.cell, sp.object, depth, ctx.fallback_seed)
+    }
+
+    fn material(&self, sp: &SurfacePoint) -> ShadingMaterial {
+        match self.scene.materials.get(sp.material) {
+            Some(m) => ShadingMaterial::at(self.scene, m, sp.uv),
+            None => ShadingMaterial::at(self.scene, &pis_scene::Material::default(), sp.uv),
+        }
+    }
+
+    /// Role of object `o`.
+    pub fn role(&self, o: u32) -> ObjectRole {
+        self.scene.objects.get(o as usize).map(|x| x.role).unwrap_or(ObjectRole::Diffuse)
+    }
+
+    /// Closest hit along a ray, counting it.
+    fn trace(&self, origin: Vec3, dir: Vec3, skip: Option<u32>, ctx: &mut PathContext) -> Option<Hit> {
+        ctx.rays += 1;
+        self.geometry.closest(origin, dir, f32::INFINITY, skip)
+    }
+
+    /// Radiance arriving at `origin` along `-dir`.
+    /// `sees_lights`: whether light spheres are visible to this ray (camera and specular rays;
+    /// diffuse bounces reach lights through next-event estimation instead).
+    pub fn radiance(
+        &self,
+        origin: Vec3,
+        dir: Vec3,
+        depth: u32,
+        diffuse_left: u32,
+        sees_lights: bool,
+        skip: Option<u32>,
+        ctx: &mut PathContext,
+    ) -> Vec3 {
+        if depth > self.settings.max_depth {
+            return Vec3::ZERO;
+        }
+        let hit = self.trace(origin, dir, skip, ctx);
+        self.radiance_from(hit, origin, dir, depth, diffuse_left, sees_lights, ctx)
+    }
+
+    /// Like [`Self::radiance`] for a ray whose closest hit is already known.
+    #[allow(clippy::too_many_arguments)]
+    fn radiance_from(
+        &self,
+        hit: Option<Hit>,
+        origin: Vec3,
+        dir: Vec3,
+        depth: u32,
+        diffuse_left: u32,
+        sees_lights: bool,
+        ctx: &mut PathContext,
+    ) -> Vec3 {
+        if sees_lights {
+            let tmax = hit.map_or(f32::INFINITY, |h| h.t);
+            if let Some((_, l)) = hit_light_sphere(&self.frame.lights, origin, dir, tmax) {
+                return l;
+            }
+        }
+        let Some(hit) = hit else { return Vec3::ZERO };
+        let sp = self.geometry.surface(&hit, origin, dir);
+        let m = self.material(&sp);
+        let absorb = self.absorption(&sp, &m, hit.t);
+        let mut rng = self.rng_at(&sp, depth, ctx);
+        absorb * (m.emission + self.scatter(&sp, &m, dir, depth, diffuse_left, &mut rng, ctx))
+    }
+
+    /// Beer attenuation of a segment of length `t` that ended at `sp` from inside.
+    fn absorption(&self, sp: &SurfacePoint, m: &ShadingMaterial, t: f32) -> Vec3 {
+        if !sp.front_face && m.transmission > 0.0 && m.sigma_a != Vec3::ZERO {
+            (-m.sigma_a * t).exp()
+        } else {
+            Vec3::ONE
+        }
+    }
+
+    /// One stochastic scattering event at `sp` for a ray arriving with direction `dir`.
+    #[allow(clippy::too_many_arguments)]
+    fn scatter(
+        &self,
+        sp: &SurfacePoint,
+        m: &ShadingMaterial,
+        dir: Vec3,
+        depth: u32,
+        diffuse_left: u32,
+        rng: &mut Rng,
+        ctx: &mut PathContext,
+    ) -> Vec3 {
+        let p_d = luminance(m.diffuse);
+        let rest = self.lobe_weights(sp, m, dir);
+        let total = p_d + rest.0 + rest.1;
+        if total <= 0.0 {
+            return Vec3::ZERO;
+        }
+        let u = rng.next_f32() * total;
+        if u < p_d {
+            self.diffuse(sp, m, depth, diffuse_left, rng, ctx) * (total / p_d)
+        } else {
+            self.scatter_nondiffuse(sp, m, dir, depth, diffuse_left, rng, ctx, Some((u - p_d, rest))) * (total / (rest.0 + rest.1))
+        }
+    }
+
+    /// Selection weights of the opaque specular and the transmission lobes.
+    fn lobe_weights(&self, sp: &SurfacePoint, m: &ShadingMaterial, dir: Vec3) -> (f32, f32) {
+        let cos_o = (-dir).dot(sp.normal).max(0.0);
+        let p_s = luminance(m.fresnel(cos_o)) * (1.0 - m.transmission);
+        (p_s, m.transmission)
+    }
+
+    /// The non-diffuse lobes at `sp`, one chosen stochastically; returns their estimated sum.
+    /// `choice` carries a uniform already drawn in [0, p_s + p_t) with the weights.
+    #[allow(clippy::too_many_arguments)]
+    fn scatter_nondiffuse(
+        &self,
+        sp: &SurfacePoint,
+        m: &ShadingMaterial,
+        dir: Vec3,
+        depth: u32,
+        diffuse_left: u32,
+        rng: &mut Rng,
+        ctx: &mut PathContext,
+        choice: Option<(f32, (f32, f32))>,
+    ) -> Vec3 {
+        let (u, (p_s, p_t)) = match choice {
+            Some(c) => c,
+            None => {
+                let w = self.lobe_weights(sp, m, dir);
+                (rng.next_f32() * (w.0 + w.1), w)
+            }
+        };
+        let total = p_s + p_t;
+        if total <= 0.0 || depth >= self.settings.max_depth {
+            return Vec3::ZERO;
+        }
+        if u < p_s {
+            let Some((d, f, g)) = self.sample_specular(sp, m, dir, rng) else { return Vec3::ZERO };
+            let o = offset_origin(sp.position, sp.geometric_normal, d);
+            let l = self.radiance(o, d, depth + 1, diffuse_left, true, None, ctx);
+            l * f * g * (1.0 - m.transmission) * (total / p_s)
+        } else {
+            self.dielectric(sp, m, dir, depth, diffuse_left, rng, ctx) * m.transmission * (total / p_t)
+        }
+    }
+
+    /// Next-event estimation plus the indirect bounce: radiance of the diffuse lobe.
+    fn diffuse(
+        &self,
+        sp: &SurfacePoint,
+        m: &ShadingMaterial,
+        depth: u32,
+        diffuse_left: u32,
+        rng: &mut Rng,
+        ctx: &mut PathContext,
+    ) -> Vec3 {
+        let n = sp.normal;
+        let mut direct = Vec3::ZERO;
+        for light in &self.frame.lights {
+            let Some(ls) = sample_light(light, sp.position, rng) else { continue };
+            let cos = n.dot(ls.direction);
+            if cos <= 0.0 || sp.geometric_normal.dot(ls.direction) <= 0.0 {
+                continue;
+            }
+            let o = offset_origin(sp.position, sp.geometric_normal, ls.direction);
+            ctx.rays += 1;
+            let tmax = if ls.distance.is_finite() { ls.distance * (1.0 - 1e-4) } else { f32::INFINITY };
+            if !self.geometry.occluded(o, ls.direction, tmax) {
+                direct += ls.weight * cos;
+            }
+        }
+        let mut indirect = Vec3::ZERO;
+        if diffuse_left > 0 && depth < self.settings.max_depth {
+            let mut d = cosine_hemisphere(rng.next_2d(), n);
+            // A direction below the geometric surface (shading normals differ from the
+            // facets) is mirrored back above it, keeping the lobe's energy.
+            let below = sp.geometric_normal.dot(d);
+            if below <= 0.0 {
+                d = (d - sp.geometric_normal * (2.0 * below)).normalize();
+            }
+            let o = offset_origin(sp.position, sp.geometric_normal, d);
+            indirect = self.radiance(o, d, depth + 1, diffuse_left - 1, false, None, ctx);
+        }
+        m.diffuse * (direct / PI + indirect)
+    }
+
+    /// Samples the opaque specular lobe: (direction, Fresnel, geometric weight), so that the
+    /// estimator of the reflected radiance is F · g · L(direction).
+    fn sample_specular(&self, sp: &SurfacePoint, m: &ShadingMaterial, dir: Vec3, rng: &mut Rng) -> Option<(Vec3, Vec3, f32)> {
+        let wo = -dir;
+        let n = sp.normal;
+        let cos_o = wo.dot(n);
+        if cos_o <= 0.0 {
+            return None;
+        }
+        if m.is_mirror() {
+            let r = reflect(dir, n);
+            return (r.dot(sp.geometric_normal) > 0.0).then(|| (r, m.fresnel(cos_o), 1.0));
+        }
+        let u = rng.next_2d();
+        let h = ggx_half_vector(u, n, m.alpha);
+        let r = reflect(dir, h);
+        let cos_r = r.dot(n);
+        let vh = wo.dot(h);
+        if cos_r <= 0.0 || vh <= 0.0 || r.dot(sp.geometric_normal) <= 0.0 {
+            return None;
+        }
+        let g = ggx_g1(cos_o, m.alpha) * ggx_g1(cos_r, m.alpha) * vh / (cos_o * n.dot(h).max(1e-6));
+        Some((r, m.fresnel(vh), g))
+    }
+
+    /// The smooth dielectric lobe: Fresnel-weighted choice of reflection or refraction.
+    #[allow(clippy::too_many_arguments)]
+    fn dielectric(
+        &self,
+        sp: &SurfacePoint,
+        m: &ShadingMaterial,
+        dir: Vec3,
+        depth: u32,
+        diffuse_left: u32,
+        rng: &mut Rng,
+        ctx: &mut PathContext,
+    ) -> Vec3 {
+        let (eta, n) = (if sp.front_face { 1.0 / m.ior } else { m.ior }, sp.normal);
+        let f = fresnel_dielectric(-dir.dot(n), eta);
+        let (d, w) = if rng.next_f32() < f {
+            (reflect(dir, n), Vec3::ONE)
+        } else {
+            match refract(dir, n, eta) {
+                Some(t) => (t, if sp.front_face { m.base } else { Vec3::ONE }),
+                None => (reflect(dir, n), Vec3::ONE),
+            }
+        };
+        let o = offset_origin(sp.position, sp.geometric_normal, d);
+        self.radiance(o, d, depth + 1, diffuse_left, true, None, ctx) * w
+    }
+
+    /// Traces one camera ray and segments its radiance (thesis 3.1, 5.7, 6.2).
+    /// `record` asks for the outgoing-ray records of refractive objects.
+    pub fn camera_sample(&self, origin: Vec3, dir: Vec3, record: bool, ctx: &mut PathContext) -> CameraSample {
+        let hit = self.trace(origin, dir, None, ctx);
+        let tmax = hit.map_or(f32::INFINITY, |h| h.t);
+        if let Some((_, l)) = hit_light_sphere(&self.frame.lights, origin, dir, tmax) {
+            return CameraSample { combined: l, ..Default::default() };
+        }
+        let Some(hit) = hit else { return CameraSample::default() };
+        let sp = self.geometry.surface(&hit, origin, dir);
+        let m = self.material(&sp);
+        let mut rng = self.rng_at(&sp, 0, ctx);
+        let diffuse_left = self.settings.diffuse_bounces.max(1);
+        let diffuse = if luminance(m.diffuse) > 0.0 {
+            self.diffuse(&sp, &m, 0, diffuse_left, &mut rng, ctx)
+        } else {
+            Vec3::ZERO
+        };
+        let mut out = CameraSample { object: Some(hit.object), diffuse, ..Default::default() };
+        let role = self.role(hit.object);
+        let mut specular = m.emission;
+        match role {
+            ObjectRole::Reflective => {
+                let (refl, contrib) = self.reflective_layers(&sp, &m, dir, hit.object, diffuse_left, &mut rng, ctx);
+                out.reflective = Some(refl);
+                specular += contrib;
+                if m.transmission > 0.0 {
+                    specular += self.dielectric(&sp, &m, dir, 0, diffuse_left, &mut rng, ctx) * m.transmission;
+                }
+            }
+            ObjectRole::Refractive => {
+                let terms = [GreedyTerm::ReflectionFirst, GreedyTerm::RefractionFirst]
+                    .map(|t| self.greedy_term(&sp, &m, dir, hit.object, t, record, diffuse_left, ctx));
+                out.lens = Some(terms);
+                specular += self.scatter_nondiffuse(&sp, &m, dir, 0, diffuse_left, &mut rng, ctx, None);
+            }
+            ObjectRole::Diffuse => {
+                specular += self.scatter_nondiffuse(&sp, &m, dir, 0, diffuse_left, &mut rng, ctx, None);
+            }
+        }
+        out.specular = specular;
+        out.combined = out.diffuse + out.specular;
+        out
+    }
+
+    /// Fresnel modulation and local/distant incident specular radiance at a reflective
+    /// object's first hit; also returns the specular reflection's contribution to the image.
+    #[allow(clippy::too_many_arguments)]
+    fn reflective_layers(
+        &self,
+        sp: &SurfacePoint,
+        m: &ShadingMaterial,
+        dir: Vec3,
+        object: u32,
+        diffuse_left: u32,
+        rng: &mut Rng,
+        ctx: &mut PathContext,
+    ) -> (ReflectiveSample, Vec3) {
+        let cos_o = (-dir).dot(sp.normal).max(0.0);
+        let opaque = 1.0 - m.transmission;
+        let mut s = ReflectiveSample { fresnel: m.fresnel(cos_o) * opaque, ..Default::default() };
+        let Some((d, f, g)) = self.sample_specular(sp, m, dir, rng) else { return (s, Vec3::ZERO) };
+        let o = offset_origin(sp.position, sp.geometric_normal, d);
+        let hit = self.trace(o, d, None, ctx);
+        let light_first = hit_light_sphere(&self.frame.lights, o, d, hit.map_or(f32::INFINITY, |h| h.t)).is_some();
+        let incident = self.radiance_from(hit, o, d, 1, diffuse_left, true, ctx) * g;
+        if !light_first && hit.is_some_and(|h| h.object == object) {
+            s.local = incident;
+            s.local_alpha = 1.0;
+            s.distant = self.radiance(o, d, 1, diffuse_left, true, Some(object), ctx) * g;
+        } else {
+            s.distant = incident;
+        }
+        (s, incident * f * opaque)
+    }
+
+    /// Follows one term of the greedy two-path model from the first hit on lens object
+    /// `object` until the path leaves the object (thesis 6.2, 6.3.1).
+    #[allow(clippy::too_many_arguments)]
+    fn greedy_term(
+        &self,
+        sp: &SurfacePoint,
+        m: &ShadingMaterial,
+        dir: Vec3,
+        object: u32,
+        term: GreedyTerm,
+        record: bool,
+        diffuse_left: u32,
+        ctx: &mut PathContext,
+    ) -> TermSample {
+        let mut out = TermSample::default();
+        let eta = if sp.front_face { 1.0 / m.ior } else { m.ior };
+        let f = fresnel_dielectric(-dir.dot(sp.normal), eta);
+        let (mut d, mut modulation) = match term {
+            GreedyTerm::ReflectionFirst => (reflect(dir, sp.normal), Vec3::splat(f)),
+            GreedyTerm::RefractionFirst => match refract(dir, sp.normal, eta) {
+                Some(t) => (t, Vec3::splat(1.0 - f) * if sp.front_face { m.base } else { Vec3::ONE }),
+                None => return out,
+            },
+        };
+        let (mut p, mut ng) = (sp.position, sp.geometric_normal);
+        for _ in 0..self.settings.max_depth {
+            let o = offset_origin(p, ng, d);
+            let hit = self.trace(o, d, None, ctx);
+            let light_first = hit_light_sphere(&self.frame.lights, o, d, hit.map_or(f32::INFINITY, |h| h.t)).is_some();
+            match hit {
+                Some(h) if h.object == object && !light_first => {
+                    let s2 = self.geometry.surface(&h, o, d);
+                    let m2 = self.material(&s2);
+                    modulation *= self.absorption(&s2, &m2, h.t);
+                    let eta2 = if s2.front_face { 1.0 / m2.ior } else { m2.ior };
+                    let f2 = fresnel_dielectric(-d.dot(s2.normal), eta2);
+                    let refracted = if f2 < 0.5 { refract(d, s2.normal, eta2) } else { None };
+                    match refracted {
+                        Some(t) => {
+                            modulation *= (1.0 - f2) * if s2.front_face { m2.base } else { Vec3::ONE };
+                            d = t;
+                        }
+                        None => {
+                            modulation *= f2;
+                            d = reflect(d, s2.normal);
+                        }
+                    }
+                    p = s2.position;
+                    ng = s2.geometric_normal;
+                }
+                _ => {
+                    out.radiance = self.radiance_from(hit, o, d, 1, diffuse_left, true, ctx);
+                    out.modulation = modulation;
+                    out.exit = Some((o, d));
+                    if record {
+                        out.hits = self.continued_hits(o, d, object, diffuse_left, ctx);
+                    }
+                    return out;
+                }
+            }
+        }
+        out
+    }
+
+    /// Every front-facing hit on environment geometry (not `object`) along a continued ray,
+    /// nearest first, with the radiance leaving each towards the ray origin (thesis 6.3.1).
+    fn continued_hits(&self, o: Vec3, d: Vec3, object: u32, diffuse_left: u32, ctx: &mut PathContext) -> Vec<ContinuedHit> {
+        ctx.rays += 1;
+        let mut hits = Vec::new();
+        for h in self.geometry.all_hits(o, d, f32::INFINITY) {
+            if hits.len() >= self.settings.max_record_hits as usize {
+                break;
+            }
+            if h.object == object {
+                continue;
+            }
+            let sp = self.geometry.surface(&h, o, d);
+            if !sp.front_face {
+                continue;
+            }
+            let m = self.material(&sp);
+            let mut rng = self.rng_at(&sp, 1, ctx);
+            let colour = m.emission + self.scatter(&sp, &m, d, 1, diffuse_left, &mut rng, ctx);
+            hits.push(ContinuedHit { t: h.t, position: sp.position, object: h.object, colour });
+        }
+        hits
+    }
+}
