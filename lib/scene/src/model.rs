@@ -6,8 +6,13 @@
 use glam::{Mat4, Vec2, Vec3};
 use pis_format::{DimensionKind, ObjectRole};
 
+use crate::rig::Rig;
+
 /// A loaded scene: static content plus the parameter space that animates it.
-#[derive(Clone, Debug)]
+///
+/// Build one with [`crate::load`]; a hand-built scene can start from `Scene::default()`
+/// (its [`Rig`] then places every object at the origin).
+#[derive(Clone, Debug, Default)]
 pub struct Scene {
     /// Short name (the scene directory name, or `name` in scene.toml).
     pub name: String,
@@ -21,6 +26,8 @@ pub struct Scene {
     /// Decoded textures referenced by materials.
     pub textures: Vec<TextureImage>,
     pub space: ParameterSpace,
+    /// Node hierarchy, camera, lights and animations: what [`Scene::frame`] poses.
+    pub rig: Rig,
 }
 
 /// One renderable object. Its mesh is in object space; [`Frame::instances`] places it.
@@ -120,6 +127,22 @@ impl ParameterSpace {
             index /= n;
         }
         out
+    }
+
+    /// The linear index of `point` (inverse of [`ParameterSpace::point`]), or `None` if it
+    /// has the wrong length or an index out of range.
+    pub fn index_of(&self, point: &[u32]) -> Option<usize> {
+        if point.len() != self.dims.len() {
+            return None;
+        }
+        let mut index = 0usize;
+        for (d, &i) in self.dims.iter().zip(point) {
+            if i >= d.samples() {
+                return None;
+            }
+            index = index * d.samples() as usize + i as usize;
+        }
+        Some(index)
     }
 }
 

@@ -1,0 +1,413 @@
+//! Reading a glTF 2.0 file (.gltf or .glb) into objects, materials, textures and the rig.
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+use glam::{Quat, Vec2, Vec3, Vec4};
+use gltf::animation::util::ReadOutputs;
+use gltf::mesh::Mode;
+
+use crate::animation::{Animation, Channel, Interpolation, Sampler, TargetPath, Trs};
+use crate::material::{convert_material, infer_role};
+use crate::model::{LightKind, Material, Primitive, SceneObject, TextureImage};
+use crate::rig::{LightRig, Node, Rig};
+use crate::SceneError;
+
+/// Everything read from the glTF, before scene.toml is applied.
+#[derive(Debug)]
+pub(crate) struct GltfScene {
+    pub objects: Vec<SceneObject>,
+    pub materials: Vec<Material>,
+    pub textures: Vec<TextureImage>,
+    pub rig: Rig,
+    /// glTF cameras attached to nodes: (index into `rig.nodes`, perspective parameters).
+    pub cameras: Vec<GltfCamera>,
+    /// Animations that cannot be sampled, with the field and reason (used only if referenced).
+    pub unsupported_animations: BTreeMap<String, (String, String)>,
+}
+
+/// A perspective glTF camera on a node.
+#[derive(Clone, Debug)]
+pub(crate) struct GltfCamera {
+    pub node: usize,
+    pub yfov: f32,
+    pub znear: f32,
+    pub zfar: Option<f32>,
+}
+
+/// Reads the glTF file at `path`, its buffers and its images.
+pub(crate) fn read_gltf(path: &Path) -> Result<GltfScene, SceneError> {
+    if let Err(source) = std::fs::metadata(path) {
+        return Err(SceneError::Io { path: path.to_owned(), source });
+    }
+    let (doc, buffers, images) = gltf::import(path).map_err(|e| import_error(path, e))?;
+    let ctx = Ctx { path: path.to_owned(), buffers: &buffers };
+
+    let scene = doc
+        .default_scene()
+        .or_else(|| doc.scenes().next())
+        .ok_or_else(|| SceneError::invalid(path, "scenes", "the glTF has no scene"))?;
+
+    // Nodes, depth-first from the scene roots, so that parents precede children.
+    let mut rig = Rig::default();
+    let mut rig_index: BTreeMap<usize, usize> = BTreeMap::new();
+    let mut stack: Vec<(gltf::Node, Option<usize>)> = scene.nodes().map(|n| (n, None)).collect();
+    stack.reverse();
+    while let Some((node, parent)) = stack.pop() {
+        if rig_index.contains_key(&node.index()) {
+            return Err(SceneError::invalid(
+                path,
+                format!("nodes[{}]", node.index()),
+                "node is reached twice (it has two parents or is part of a cycle)",
+            ));
+        }
+        let here = rig.nodes.len();
+        rig_index.insert(node.index(), here);
+        let (translation, rotation, scale) = node.transform().decomposed();
+        let local = Trs {
+            translation: Vec3::from(translation),
+            rotation: Quat::from_array(rotation).normalize(),
+            scale: Vec3::from(scale),
+        };
+        if !(local.translation.is_finite() && local.rotation.is_finite() && local.scale.is_finite()) {
+            return Err(SceneError::NonFinite { path: path.to_owned(), field: format!("nodes[{}]", node.index()), element: 0 });
+        }
+        rig.nodes.push(Node { name: node_name(&node), gltf_index: node.index(), parent, local });
+        for child in node.children().collect::<Vec<_>>().into_iter().rev() {
+            stack.push((child, Some(here)));
+        }
+    }
+
+    // Materials in glTF order; a default material is appended if a primitive has none.
+    let mut textures = Vec::new();
+    let mut texture_of_image: BTreeMap<usize, usize> = BTreeMap::new();
+    let mut materials = Vec::new();
+    for m in doc.materials() {
+        let mut mat = convert_material(&m);
+        if let Some(info) = m.pbr_metallic_roughness().base_color_texture() {
+            let field = format!("materials[{}].pbrMetallicRoughness.baseColorTexture", m.index().unwrap_or(0));
+            if info.tex_coord() != 0 {
+                return Err(SceneError::unsupported(path, format!("{field}.texCoord"), "texture coordinate sets other than TEXCOORD_0"));
+            }
+            let image = info.texture().source().index();
+            let data = images.get(image).ok_or_else(|| SceneError::invalid(path, &field, "image index out of range"))?;
+            let next = textures.len();
+            let t = *texture_of_image.entry(image).or_insert(next);
+            if t == next {
+                textures.push(crate::texture::decode(data, true));
+            }
+            mat.base_color_texture = Some(t);
+        }
+        materials.push(mat);
+    }
+    let mut default_material = None;
+
+    // Objects: one per node with a mesh, in glTF node order.
+    let mut objects = Vec::new();
+    let mut by_gltf: Vec<(usize, usize)> = rig_index.iter().map(|(&g, &r)| (g, r)).collect();
+    by_gltf.sort();
+    let mut used_names: BTreeMap<String, usize> = BTreeMap::new();
+    for &(g, r) in &by_gltf {
+        let Some(node) = doc.nodes().nth(g) else { continue };
+        let Some(mesh) = node.mesh() else { continue };
+        let mut primitives = Vec::new();
+        for p in mesh.primitives() {
+            let material = match p.material().index() {
+                Some(i) => i,
+                None => *default_material.get_or_insert_with(|| {
+                    materials.push(Material { name: "default".into(), ..Material::default() });
+                    materials.len() - 1
+                }),
+            };
+            let field = format!("meshes[{}].primitives[{}]", mesh.index(), p.index());
+            primitives.push(ctx.read_primitive(&p, material, &field)?);
+        }
+        let mats: Vec<&Material> = primitives.iter().filter_map(|p: &Primitive| materials.get(p.material)).collect();
+        let mut name = rig.nodes[r].name.clone();
+        if node.name().is_none() {
+            if let Some(mesh_name) = mesh.name() {
+                name = mesh_name.to_owned();
+            }
+        }
+        let count = used_names.entry(name.clone()).or_insert(0);
+        *count += 1;
+        if *count > 1 {
+            name = format!("{name}.{g}");
+        }
+        objects.push(SceneObject { name, role: infer_role(&mats), primitives });
+        rig.object_nodes.push(r);
+    }
+
+    // Lights and cameras on nodes.
+    let mut cameras = Vec::new();
+    for &(g, r) in &by_gltf {
+        let Some(node) = doc.nodes().nth(g) else { continue };
+        if let Some(light) = node.light() {
+            rig.lights.push(ctx.read_light(&light, &rig.nodes[r].name, r)?);
+        }
+        if let Some(camera) = node.camera() {
+            if let gltf::camera::Projection::Perspective(p) = camera.projection() {
+                cameras.push(GltfCamera { node: r, yfov: p.yfov(), znear: p.znear(), zfar: p.zfar() });
+            }
+        }
+    }
+
+    // Animations.
+    let mut unsupported_animations = BTreeMap::new();
+    for a in doc.animations() {
+        let name = a.name().map(str::to_owned).unwrap_or_else(|| format!("animation{}", a.index()));
+        match ctx.read_animation(&a, &name, &rig_index)? {
+            Ok(anim) => rig.animations.push(anim),
+            Err(why) => {
+                unsupported_animations.insert(name, why);
+            }
+        }
+    }
+
+    Ok(GltfScene { objects, materials, textures, rig, cameras, unsupported_animations })
+}
+
+/// Maps a gltf crate error to a [`SceneError`] that names the file.
+fn import_error(path: &Path, e: gltf::Error) -> SceneError {
+    match e {
+        gltf::Error::Validation(errors) => {
+            if let Some((p, _)) = errors.iter().find(|(p, _)| p.as_str().starts_with("extensionsRequired")) {
+                return SceneError::unsupported(path, p.as_str(), "required glTF extension is not supported by PIS");
+            }
+            let list: Vec<String> = errors.iter().map(|(p, err)| format!("{}: {err}", p.as_str())).collect();
+            SceneError::Gltf { path: path.to_owned(), message: list.join("; ") }
+        }
+        gltf::Error::Io(source) => SceneError::Gltf {
+            path: path.to_owned(),
+            message: format!("cannot read a buffer or image it references: {source}"),
+        },
+        other => SceneError::Gltf { path: path.to_owned(), message: other.to_string() },
+    }
+}
+
+fn node_name(node: &gltf::Node) -> String {
+    node.name().map(str::to_owned).unwrap_or_else(|| format!("node{}", node.index()))
+}
+
+/// What the readers need: the file (for errors) and the buffers.
+struct Ctx<'b> {
+    path: PathBuf,
+    buffers: &'b [gltf::buffer::Data],
+}
+
+impl Ctx<'_> {
+    fn non_finite(&self, field: String, element: usize) -> SceneError {
+        SceneError::NonFinite { path: self.path.clone(), field, element }
+    }
+
+    fn check_finite<const N: usize>(&self, values: &[[f32; N]], field: impl Fn() -> String) -> Result<(), SceneError> {
+        match values.iter().position(|v| v.iter().any(|x| !x.is_finite())) {
+            Some(i) => Err(self.non_finite(field(), i)),
+            None => Ok(()),
+        }
+    }
+
+    fn read_primitive(&self, p: &gltf::Primitive, material: usize, field: &str) -> Result<Primitive, SceneError> {
+        let reader = p.reader(|b| self.buffers.get(b.index()).map(|d| &d.0[..]));
+        let positions: Vec<[f32; 3]> = reader
+            .read_positions()
+            .ok_or_else(|| SceneError::invalid(&self.path, format!("{field}.attributes.POSITION"), "missing"))?
+            .collect();
+        self.check_finite(&positions, || format!("{field}.attributes.POSITION"))?;
+        let n = positions.len();
+        let normals: Option<Vec<[f32; 3]>> = reader.read_normals().map(|r| r.collect());
+        if let Some(ns) = &normals {
+            self.check_finite(ns, || format!("{field}.attributes.NORMAL"))?;
+            if ns.len() != n {
+                return Err(SceneError::invalid(&self.path, format!("{field}.attributes.NORMAL"), "count differs from POSITION"));
+            }
+        }
+        let uvs: Option<Vec<[f32; 2]>> = reader.read_tex_coords(0).map(|r| r.into_f32().collect());
+        if let Some(us) = &uvs {
+            self.check_finite(us, || format!("{field}.attributes.TEXCOORD_0"))?;
+            if us.len() != n {
+                return Err(SceneError::invalid(&self.path, format!("{field}.attributes.TEXCOORD_0"), "count differs from POSITION"));
+            }
+        }
+        let raw: Vec<u32> = match reader.read_indices() {
+            Some(r) => r.into_u32().collect(),
+            None => (0..n as u32).collect(),
+        };
+        if let Some(i) = raw.iter().position(|&i| i as usize >= n) {
+            return Err(SceneError::invalid(
+                &self.path,
+                format!("{field}.indices"),
+                format!("index {} at element {i} is out of range for {n} vertices", raw[i]),
+            ));
+        }
+        let indices = triangle_list(p.mode(), &raw)
+            .ok_or_else(|| SceneError::unsupported(&self.path, format!("{field}.mode"), format!("{:?} primitives (only triangles)", p.mode())))?;
+
+        let positions: Vec<Vec3> = positions.into_iter().map(Vec3::from).collect();
+        let uvs: Vec<Vec2> = match uvs {
+            Some(u) => u.into_iter().map(Vec2::from).collect(),
+            None => vec![Vec2::ZERO; n],
+        };
+        match normals {
+            Some(ns) => {
+                let smooth = smooth_normals(&positions, &indices);
+                let normals = ns
+                    .into_iter()
+                    .zip(smooth)
+                    .map(|(v, s)| Vec3::from(v).try_normalize().unwrap_or(s))
+                    .collect();
+                Ok(Primitive { positions, normals, uvs, indices, material })
+            }
+            None => Ok(flat_shaded(&positions, &uvs, &indices, material)),
+        }
+    }
+
+    fn read_light(&self, light: &gltf::khr_lights_punctual::Light, node_name: &str, node: usize) -> Result<LightRig, SceneError> {
+        use gltf::khr_lights_punctual::Kind;
+        let field = format!("extensions.KHR_lights_punctual.lights[{}]", light.index());
+        let kind = match light.kind() {
+            Kind::Point => LightKind::Point,
+            Kind::Directional => LightKind::Directional,
+            Kind::Spot { inner_cone_angle, outer_cone_angle } => {
+                LightKind::Spot { inner_cone: inner_cone_angle, outer_cone: outer_cone_angle }
+            }
+        };
+        let c = light.color();
+        let radiance = [c[0] * light.intensity(), c[1] * light.intensity(), c[2] * light.intensity()];
+        let mut radius = 0.0;
+        if let Some(raw) = light.extras() {
+            let value: serde_json::Value = serde_json::from_str(raw.get())
+                .map_err(|e| SceneError::invalid(&self.path, format!("{field}.extras"), e.to_string()))?;
+            if let Some(r) = value.get("radius") {
+                radius = r
+                    .as_f64()
+                    .filter(|r| r.is_finite() && *r >= 0.0)
+                    .ok_or_else(|| SceneError::invalid(&self.path, format!("{field}.extras.radius"), format!("expected a number ≥ 0, found {r}")))?
+                    as f32;
+            }
+        }
+        let name = light.name().unwrap_or(node_name).to_owned();
+        Ok(LightRig { name, node, kind, radiance, radius })
+    }
+
+    /// Reads an animation; the inner `Err` holds (field, reason) when it uses something PIS
+    /// cannot sample (morph-target weights), which matters only if a dimension uses it.
+    #[allow(clippy::type_complexity)]
+    fn read_animation(
+        &self,
+        a: &gltf::Animation,
+        name: &str,
+        rig_index: &BTreeMap<usize, usize>,
+    ) -> Result<Result<Animation, (String, String)>, SceneError> {
+        let mut channels = Vec::new();
+        for (ci, c) in a.channels().enumerate() {
+            let field = format!("animations[{}].channels[{ci}]", a.index());
+            let Some(&node) = rig_index.get(&c.target().node().index()) else { continue };
+            let reader = c.reader(|b| self.buffers.get(b.index()).map(|d| &d.0[..]));
+            let sfield = format!("animations[{}].samplers[{}]", a.index(), c.sampler().index());
+            let times: Vec<f32> = reader
+                .read_inputs()
+                .ok_or_else(|| SceneError::invalid(&self.path, format!("{sfield}.input"), "cannot read keyframe times"))?
+                .collect();
+            if let Some(i) = times.iter().position(|t| !t.is_finite()) {
+                return Err(self.non_finite(format!("{sfield}.input"), i));
+            }
+            if let Some(i) = times.windows(2).position(|w| w[1] <= w[0]) {
+                return Err(SceneError::invalid(&self.path, format!("{sfield}.input"), format!("times not strictly increasing at element {}", i + 1)));
+            }
+            let outputs = reader
+                .read_outputs()
+                .ok_or_else(|| SceneError::invalid(&self.path, format!("{sfield}.output"), "cannot read keyframe values"))?;
+            let (path, values): (TargetPath, Vec<Vec4>) = match outputs {
+                ReadOutputs::Translations(t) => (TargetPath::Translation, t.map(|v| Vec3::from(v).extend(0.0)).collect()),
+                ReadOutputs::Scales(s) => (TargetPath::Scale, s.map(|v| Vec3::from(v).extend(0.0)).collect()),
+                ReadOutputs::Rotations(r) => (TargetPath::Rotation, r.into_f32().map(Vec4::from).collect()),
+                ReadOutputs::MorphTargetWeights(_) => {
+                    return Ok(Err((format!("{field}.target.path"), "morph target weights cannot be animated".into())))
+                }
+            };
+            if let Some(i) = values.iter().position(|v| !v.is_finite()) {
+                return Err(self.non_finite(format!("{sfield}.output"), i));
+            }
+            let interpolation = match c.sampler().interpolation() {
+                gltf::animation::Interpolation::Step => Interpolation::Step,
+                gltf::animation::Interpolation::Linear => Interpolation::Linear,
+                gltf::animation::Interpolation::CubicSpline => Interpolation::CubicSpline,
+            };
+            let per_key = if interpolation == Interpolation::CubicSpline { 3 } else { 1 };
+            if values.len() != per_key * times.len() {
+                return Err(SceneError::invalid(
+                    &self.path,
+                    format!("{sfield}.output"),
+                    format!("{} values for {} keyframes ({:?} needs {per_key} per keyframe)", values.len(), times.len(), interpolation),
+                ));
+            }
+            channels.push(Channel { node, path, sampler: Sampler { interpolation, times, values } });
+        }
+        Ok(Ok(Animation { name: name.to_owned(), channels }))
+    }
+}
+
+/// Converts indices of any triangle mode to a triangle list; `None` for points and lines.
+fn triangle_list(mode: Mode, idx: &[u32]) -> Option<Vec<u32>> {
+    match mode {
+        Mode::Triangles => Some(idx[..idx.len() / 3 * 3].to_vec()),
+        Mode::TriangleStrip => Some(
+            (2..idx.len())
+                .flat_map(|i| if i % 2 == 0 { [idx[i - 2], idx[i - 1], idx[i]] } else { [idx[i - 1], idx[i - 2], idx[i]] })
+                .collect(),
+        ),
+        Mode::TriangleFan => Some((2..idx.len()).flat_map(|i| [idx[0], idx[i - 1], idx[i]]).collect()),
+        _ => None,
+    }
+}
+
+/// Area-weighted vertex normals (fallback for degenerate stored normals).
+fn smooth_normals(positions: &[Vec3], indices: &[u32]) -> Vec<Vec3> {
+    let mut acc = vec![Vec3::ZERO; positions.len()];
+    for t in indices.chunks_exact(3) {
+        let [a, b, c] = [t[0] as usize, t[1] as usize, t[2] as usize];
+        let n = (positions[b] - positions[a]).cross(positions[c] - positions[a]);
+        for v in [a, b, c] {
+            acc[v] += n;
+        }
+    }
+    acc.into_iter().map(|n| n.normalize_or(Vec3::Y)).collect()
+}
+
+/// Unshares vertices so each triangle gets its face normal (the glTF rule for missing normals).
+fn flat_shaded(positions: &[Vec3], uvs: &[Vec2], indices: &[u32], material: usize) -> Primitive {
+    let mut out = Primitive { positions: vec![], normals: vec![], uvs: vec![], indices: vec![], material };
+    for t in indices.chunks_exact(3) {
+        let [a, b, c] = [t[0] as usize, t[1] as usize, t[2] as usize];
+        let n = (positions[b] - positions[a]).cross(positions[c] - positions[a]).normalize_or(Vec3::Y);
+        for v in [a, b, c] {
+            out.indices.push(out.positions.len() as u32);
+            out.positions.push(positions[v]);
+            out.normals.push(n);
+            out.uvs.push(uvs[v]);
+        }
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn strips_and_fans_become_lists() {
+        assert_eq!(triangle_list(Mode::TriangleStrip, &[0, 1, 2, 3]), Some(vec![0, 1, 2, 2, 1, 3]));
+        assert_eq!(triangle_list(Mode::TriangleFan, &[0, 1, 2, 3]), Some(vec![0, 1, 2, 0, 2, 3]));
+        assert_eq!(triangle_list(Mode::Lines, &[0, 1]), None);
+    }
+
+    #[test]
+    fn flat_shading_unshares_vertices() {
+        let p = [Vec3::ZERO, Vec3::X, Vec3::Y, Vec3::Z];
+        let prim = flat_shaded(&p, &[Vec2::ZERO; 4], &[0, 1, 2, 0, 3, 1], 0);
+        assert_eq!(prim.positions.len(), 6);
+        assert_eq!(prim.normals[0], Vec3::Z);
+        assert_eq!(prim.normals[3], Vec3::Y);
+    }
+}

@@ -1,0 +1,360 @@
+//! Tests of [`crate::load`] and [`crate::Scene::frame`] on a small glTF written on the fly:
+//! a triangle (node `Tri`), a camera (`Cam`), a light (`Lamp`, radius 0.25) and two
+//! animations, `spin` (LINEAR rotation of `Tri`) and `hop` (STEP translation of `Lamp`).
+
+use std::path::{Path, PathBuf};
+
+use glam::{Quat, Vec3};
+use serde_json::json;
+
+use crate::{load, load_with, LoadOptions, ObjectRole, SceneError};
+
+struct Fixture {
+    dir: tempfile::TempDir,
+}
+
+const TOML: &str = r#"
+gltf = "scene.gltf"
+resolution = [32, 24]
+spp = 2
+
+[camera]
+node = "Cam"
+
+[[dimension]]
+name = "spin"
+driver = "animation"
+animation = "spin"
+kind = "object_motion"
+samples = 3
+
+[[dimension]]
+name = "view"
+driver = "orbit"
+samples = 4
+target = [0, 0.5, 0]
+radius = 4
+elevation_deg = 30
+azimuth_deg = [0, 90]
+
+[preset.paper]
+resolution = [64, 48]
+samples = { view = 8 }
+"#;
+
+fn f32s(v: &[f32]) -> Vec<u8> {
+    v.iter().flat_map(|x| x.to_le_bytes()).collect()
+}
+
+impl Fixture {
+    /// Writes the fixture; `edit` may change the glTF JSON and the buffer before writing.
+    fn new(toml: &str, edit: impl FnOnce(&mut serde_json::Value, &mut Vec<u8>)) -> Fixture {
+        let positions = [0.0f32, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0];
+        let times = [0.0f32, 1.0, 2.0];
+        let half = std::f32::consts::FRAC_PI_4; // rotations 0°, 90°, 180° about +Y
+        let rotations: Vec<f32> = [0.0, half, 2.0 * half]
+            .iter()
+            .flat_map(|h: &f32| [0.0, h.sin(), 0.0, h.cos()])
+            .collect();
+        let hops = [0.0f32, 2.0, 0.0, 0.0, 3.0, 0.0, 0.0, 4.0, 0.0];
+        let mut bin = f32s(&positions); // 0..36
+        bin.extend(f32s(&times)); // 36..48
+        bin.extend(f32s(&rotations)); // 48..96
+        bin.extend(f32s(&hops)); // 96..132
+        let mut doc = json!({
+            "asset": {"version": "2.0"},
+            "extensionsUsed": ["KHR_lights_punctual"],
+            "extensions": {"KHR_lights_punctual": {"lights": [
+                {"name": "Lamp", "type": "point", "color": [1, 0.5, 0.25], "intensity": 4, "extras": {"radius": 0.25}}
+            ]}},
+            "scene": 0,
+            "scenes": [{"nodes": [0, 1, 2]}],
+            "nodes": [
+                {"name": "Tri", "mesh": 0, "translation": [1, 0, 0]},
+                {"name": "Cam", "camera": 0, "translation": [0, 1, 5]},
+                {"name": "LampNode", "extensions": {"KHR_lights_punctual": {"light": 0}}, "translation": [0, 2, 0]}
+            ],
+            "cameras": [{"type": "perspective", "perspective": {"yfov": 0.8, "znear": 0.1}}],
+            "meshes": [{"primitives": [{"attributes": {"POSITION": 0}, "material": 0}]}],
+            "materials": [{"name": "chrome", "pbrMetallicRoughness": {"metallicFactor": 1.0, "roughnessFactor": 0.1}}],
+            "buffers": [{"uri": "scene.bin", "byteLength": bin.len()}],
+            "bufferViews": [
+                {"buffer": 0, "byteOffset": 0, "byteLength": 36},
+                {"buffer": 0, "byteOffset": 36, "byteLength": 12},
+                {"buffer": 0, "byteOffset": 48, "byteLength": 48},
+                {"buffer": 0, "byteOffset": 96, "byteLength": 36}
+            ],
+            "accessors": [
+                {"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3", "min": [0, 0, 0], "max": [1, 1, 0]},
+                {"bufferView": 1, "componentType": 5126, "count": 3, "type": "SCALAR", "min": [0], "max": [2]},
+                {"bufferView": 2, "componentType": 5126, "count": 3, "type": "VEC4"},
+                {"bufferView": 3, "componentType": 5126, "count": 3, "type": "VEC3"}
+            ],
+            "animations": [
+                {"name": "spin", "samplers": [{"input": 1, "output": 2, "interpolation": "LINEAR"}],
+                 "channels": [{"sampler": 0, "target": {"node": 0, "path": "rotation"}}]},
+                {"name": "hop", "samplers": [{"input": 1, "output": 3, "interpolation": "STEP"}],
+                 "channels": [{"sampler": 0, "target": {"node": 2, "path": "translation"}}]}
+            ]
+        });
+        edit(&mut doc, &mut bin);
+        let dir = tempfile::tempdir().expect("temp dir");
+        std::fs::write(dir.path().join("scene.gltf"), serde_json::to_vec_pretty(&doc).expect("json")).expect("write");
+        std::fs::write(dir.path().join("scene.bin"), &bin).expect("write");
+        std::fs::write(dir.path().join("scene.toml"), toml).expect("write");
+        Fixture { dir }
+    }
+
+    fn toml(&self) -> PathBuf {
+        self.dir.path().join("scene.toml")
+    }
+}
+
+fn load_err(f: &Fixture) -> SceneError {
+    match load(&f.toml(), None) {
+        Ok(_) => panic!("expected an error"),
+        Err(e) => e,
+    }
+}
+
+#[test]
+fn loads_objects_materials_lights_and_space() {
+    let f = Fixture::new(TOML, |_, _| {});
+    let s = load(&f.toml(), None).unwrap();
+    assert_eq!(s.resolution, (32, 24));
+    assert_eq!(s.spp, 2);
+    assert_eq!(s.objects.len(), 1);
+    assert_eq!(s.objects[0].name, "Tri");
+    assert_eq!(s.objects[0].role, ObjectRole::Reflective);
+    let prim = &s.objects[0].primitives[0];
+    assert_eq!(prim.indices.len(), 3);
+    assert_eq!(prim.normals[0], Vec3::Z); // generated flat
+    assert_eq!(s.materials[0].metallic, 1.0);
+    assert_eq!(s.space.dims.len(), 2);
+    assert_eq!(s.space.dims[0].kind, crate::DimensionKind::ObjectMotion);
+    assert_eq!(s.space.dims[0].values, vec![0.0, 1.0, 2.0]);
+    assert_eq!(s.space.dims[1].kind, crate::DimensionKind::View);
+    assert_eq!(s.space.dims[1].values, vec![0.0, 30.0, 60.0, 90.0]);
+    assert_eq!(s.space.point_count(), 12);
+    assert_eq!(s.rig.lights[0].radius, 0.25);
+    assert_eq!(s.rig.lights[0].radiance, [4.0, 2.0, 1.0]);
+    assert!((s.rig.camera.yfov - 0.8).abs() < 1e-6);
+}
+
+#[test]
+fn preset_and_overrides() {
+    let f = Fixture::new(TOML, |_, _| {});
+    let s = load(&f.toml(), Some("paper")).unwrap();
+    assert_eq!(s.resolution, (64, 48));
+    assert_eq!(s.space.point_count(), 24);
+    let opts = LoadOptions { preset: Some("paper".into()), resolution: Some((10, 5)), spp: Some(9) };
+    let s = load_with(&f.toml(), &opts).unwrap();
+    assert_eq!((s.resolution, s.spp), ((10, 5), 9));
+}
+
+#[test]
+fn frame_poses_animation_and_orbit() {
+    let f = Fixture::new(TOML, |_, _| {});
+    let s = load(&f.toml(), None).unwrap();
+    for index in 0..s.space.point_count() {
+        let point = s.space.point(index);
+        assert_eq!(s.space.index_of(&point), Some(index));
+        let frame = s.frame(&point).unwrap();
+        // The orbit camera looks at its target from 4 units away.
+        let cam = frame.camera.world_from_camera;
+        let local = cam.inverse().transform_point3(Vec3::new(0.0, 0.5, 0.0));
+        assert!(local.x.abs() < 1e-4 && local.y.abs() < 1e-4 && (local.z + 4.0).abs() < 1e-4);
+    }
+    // spin sample 1 (t = 1): 90° about +Y; the node keeps its translation.
+    let frame = s.frame(&[1, 0]).unwrap();
+    let m = frame.instances[0].world_from_object;
+    assert!(m.transform_point3(Vec3::X).distance(Vec3::new(1.0, 0.0, -1.0)) < 1e-5);
+    let (_, r, _) = m.to_scale_rotation_translation();
+    assert!(r.dot(Quat::from_rotation_y(std::f32::consts::FRAC_PI_2)).abs() > 1.0 - 1e-6);
+    // The light stays at its node (hop is not a dimension).
+    assert_eq!(frame.lights[0].position, Vec3::new(0.0, 2.0, 0.0));
+    assert_eq!(frame.lights[0].name, "Lamp");
+}
+
+#[test]
+fn camera_node_and_animated_light() {
+    let toml = r#"
+gltf = "scene.gltf"
+resolution = [8, 8]
+spp = 1
+[[dimension]]
+name = "hop"
+driver = "animation"
+animation = "hop"
+kind = "light"
+samples = 5
+time = [0, 2]
+"#;
+    let f = Fixture::new(toml, |_, _| {});
+    let s = load(&f.toml(), None).unwrap();
+    assert_eq!(s.space.dims[0].kind, crate::DimensionKind::Light);
+    // No [camera]: the first glTF camera, at (0, 1, 5).
+    let frame = s.frame(&[1]).unwrap();
+    assert_eq!(frame.camera.world_from_camera.transform_point3(Vec3::ZERO), Vec3::new(0.0, 1.0, 5.0));
+    // STEP: t = 0.5 holds the first keyframe, t = 1.5 the second.
+    assert_eq!(frame.lights[0].position, Vec3::new(0.0, 2.0, 0.0));
+    assert_eq!(s.frame(&[3]).unwrap().lights[0].position, Vec3::new(0.0, 3.0, 0.0));
+    assert_eq!(s.frame(&[4]).unwrap().lights[0].position, Vec3::new(0.0, 4.0, 0.0));
+}
+
+#[test]
+fn light_path_moves_the_light() {
+    let toml = r#"
+gltf = "scene.gltf"
+resolution = [8, 8]
+spp = 1
+[camera]
+eye = [0, 0, 3]
+target = [0, 0, 0]
+[[dimension]]
+name = "light"
+driver = "light_path"
+light = "Lamp"
+samples = 3
+path = [[-1, 3, 0], [1, 3, 0]]
+"#;
+    let f = Fixture::new(toml, |_, _| {});
+    let s = load(&f.toml(), None).unwrap();
+    assert_eq!(s.space.dims[0].kind, crate::DimensionKind::Light);
+    assert_eq!(s.frame(&[1]).unwrap().lights[0].position, Vec3::new(0.0, 3.0, 0.0));
+    assert_eq!(s.frame(&[2]).unwrap().lights[0].position, Vec3::new(1.0, 3.0, 0.0));
+}
+
+#[test]
+fn role_override() {
+    let toml = format!("{TOML}\n[object.Tri]\nrole = \"diffuse\"\n");
+    let f = Fixture::new(&toml, |_, _| {});
+    assert_eq!(load(&f.toml(), None).unwrap().objects[0].role, ObjectRole::Diffuse);
+}
+
+#[test]
+fn error_missing_scene_toml() {
+    let err = load(Path::new("/nonexistent/scene.toml"), None).unwrap_err();
+    assert!(matches!(err, SceneError::Io { .. }));
+    assert!(err.to_string().contains("/nonexistent/scene.toml"), "{err}");
+}
+
+#[test]
+fn error_missing_gltf() {
+    let f = Fixture::new(&TOML.replace("scene.gltf", "other.gltf"), |_, _| {});
+    let err = load_err(&f);
+    assert!(matches!(err, SceneError::Io { .. }) && err.to_string().contains("other.gltf"), "{err}");
+}
+
+#[test]
+fn error_missing_buffer() {
+    let f = Fixture::new(TOML, |doc, _| doc["buffers"][0]["uri"] = json!("gone.bin"));
+    let err = load_err(&f);
+    assert!(matches!(err, SceneError::Gltf { .. }) && err.to_string().contains("scene.gltf"), "{err}");
+}
+
+#[test]
+fn error_unknown_camera() {
+    let f = Fixture::new(&TOML.replace("node = \"Cam\"", "node = \"Kam\""), |_, _| {});
+    let err = load_err(&f);
+    assert!(matches!(err, SceneError::UnknownName { what: "camera", .. }), "{err}");
+    assert!(err.to_string().contains("camera.node") && err.to_string().contains("Cam"), "{err}");
+}
+
+#[test]
+fn error_unknown_animation() {
+    let f = Fixture::new(&TOML.replace("animation = \"spin\"", "animation = \"spun\""), |_, _| {});
+    let err = load_err(&f);
+    assert!(matches!(err, SceneError::UnknownName { what: "animation", .. }), "{err}");
+    assert!(err.to_string().contains("dimension[0].animation"), "{err}");
+}
+
+#[test]
+fn error_unknown_light() {
+    let toml = "gltf = \"scene.gltf\"\nresolution = [8, 8]\nspp = 1\n[[dimension]]\nname = \"l\"\ndriver = \"light_path\"\nlight = \"Sun\"\nsamples = 2\npath = [[0, 0, 0]]\n";
+    let f = Fixture::new(toml, |_, _| {});
+    let err = load_err(&f);
+    assert!(matches!(err, SceneError::UnknownName { what: "light", .. }), "{err}");
+}
+
+#[test]
+fn error_unknown_object() {
+    let f = Fixture::new(&format!("{TOML}\n[object.Vase]\nrole = \"reflective\"\n"), |_, _| {});
+    assert!(matches!(load_err(&f), SceneError::UnknownName { what: "object", .. }));
+}
+
+#[test]
+fn error_zero_samples() {
+    let f = Fixture::new(&TOML.replace("samples = 4", "samples = 0"), |_, _| {});
+    let err = load_err(&f);
+    assert!(matches!(err, SceneError::ZeroSamples { .. }), "{err}");
+    assert!(err.to_string().contains("dimension[1].samples") && err.to_string().contains("view"), "{err}");
+}
+
+#[test]
+fn error_unknown_toml_key() {
+    let f = Fixture::new(&TOML.replace("spp = 2", "spp = 2\nspf = 3"), |_, _| {});
+    let err = load_err(&f);
+    assert!(matches!(err, SceneError::Toml { .. }) && err.to_string().contains("spf"), "{err}");
+}
+
+#[test]
+fn error_key_of_another_driver() {
+    let f = Fixture::new(&TOML.replace("radius = 4", "radius = 4\nanimation = \"spin\""), |_, _| {});
+    let err = load_err(&f);
+    assert!(err.to_string().contains("dimension[1].animation"), "{err}");
+}
+
+#[test]
+fn error_nan_in_buffer() {
+    let f = Fixture::new(TOML, |_, bin| bin[12..16].copy_from_slice(&f32::NAN.to_le_bytes()));
+    let err = load_err(&f);
+    assert!(matches!(err, SceneError::NonFinite { element: 1, .. }), "{err}");
+    assert!(err.to_string().contains("meshes[0].primitives[0].attributes.POSITION"), "{err}");
+}
+
+#[test]
+fn error_inf_in_animation() {
+    let f = Fixture::new(TOML, |_, bin| bin[52..56].copy_from_slice(&f32::INFINITY.to_le_bytes()));
+    let err = load_err(&f);
+    assert!(err.to_string().contains("animations[0].samplers[0].output"), "{err}");
+}
+
+#[test]
+fn error_required_extension() {
+    let f = Fixture::new(TOML, |doc, _| doc["extensionsRequired"] = json!(["KHR_draco_mesh_compression"]));
+    let err = load_err(&f);
+    assert!(matches!(err, SceneError::Unsupported { .. }), "{err}");
+    assert!(err.to_string().contains("extensionsRequired"), "{err}");
+}
+
+#[test]
+fn error_non_triangle_primitive() {
+    let f = Fixture::new(TOML, |doc, _| doc["meshes"][0]["primitives"][0]["mode"] = json!(1));
+    let err = load_err(&f);
+    assert!(matches!(err, SceneError::Unsupported { .. }), "{err}");
+    assert!(err.to_string().contains("meshes[0].primitives[0].mode"), "{err}");
+}
+
+#[test]
+fn error_point_out_of_range() {
+    let f = Fixture::new(TOML, |_, _| {});
+    let s = load(&f.toml(), None).unwrap();
+    assert!(matches!(s.frame(&[3, 0]), Err(SceneError::PointOutOfRange { .. })));
+    assert!(matches!(s.frame(&[0]), Err(SceneError::PointOutOfRange { .. })));
+}
+
+#[test]
+fn error_unknown_preset() {
+    let f = Fixture::new(TOML, |_, _| {});
+    let err = load(&f.toml(), Some("huge")).unwrap_err();
+    assert!(matches!(err, SceneError::UnknownName { what: "preset", .. }) && err.to_string().contains("paper"), "{err}");
+}
+
+#[test]
+fn hand_built_scene_has_identity_instances() {
+    let mut s = crate::Scene::default();
+    s.objects.push(crate::SceneObject { name: "o".into(), role: ObjectRole::Diffuse, primitives: vec![] });
+    let frame = s.frame(&[]).unwrap();
+    assert_eq!(frame.instances[0].world_from_object, glam::Mat4::IDENTITY);
+}
