@@ -10,6 +10,9 @@ use glam::Vec3;
 use pis_scene::{Frame, ObjectRole, Scene};
 use std::f32::consts::PI;
 
+/// GGX alpha from which the opaque specular lobe samples lights explicitly.
+pub const NEE_ALPHA: f32 = 0.1;
+
 /// Per-path bookkeeping: ray counts and the fallback seed.
 #[derive(Clone, Debug, Default)]
 pub struct PathContext {
@@ -129,8 +132,10 @@ impl<'s> Integrator<'s> {
     }
 
     /// Radiance arriving at `origin` along `-dir`.
-    /// `sees_lights`: whether light spheres are visible to this ray (camera and specular rays;
-    /// diffuse bounces reach lights through next-event estimation instead).
+    /// `sees_lights`: whether light spheres are visible to this ray (camera and specular rays
+    /// of paths without a diffuse bounce; diffuse paths reach lights through next-event
+    /// estimation instead).
+    #[allow(clippy::too_many_arguments)]
     pub fn radiance(
         &self,
         origin: Vec3,
@@ -160,7 +165,9 @@ impl<'s> Integrator<'s> {
         sees_lights: bool,
         ctx: &mut PathContext,
     ) -> Vec3 {
-        if sees_lights {
+        // After a diffuse bounce light spheres are reached by next-event estimation only,
+        // also along later specular segments (no caustics through diffuse paths: no fireflies).
+        if sees_lights && diffuse_left >= self.settings.diffuse_bounces.max(1) {
             let tmax = hit.map_or(f32::INFINITY, |h| h.t);
             if let Some((_, l)) = hit_light_sphere(&self.frame.lights, origin, dir, tmax) {
                 return l;
@@ -242,10 +249,16 @@ impl<'s> Integrator<'s> {
             return Vec3::ZERO;
         }
         if u < p_s {
-            let Some((d, f, g)) = self.sample_specular(sp, m, dir, rng) else { return Vec3::ZERO };
+            // Rough lobes reach the lights by next-event estimation, their sampled rays do
+            // not see light spheres; glossy and mirror lobes see them along sampled rays.
+            let rough = m.alpha >= NEE_ALPHA;
+            let direct = if rough { self.specular_direct(sp, m, dir, rng, ctx) } else { Vec3::ZERO };
+            let Some((d, f, g)) = self.sample_specular(sp, m, dir, rng) else {
+                return direct * (1.0 - m.transmission) * (total / p_s);
+            };
             let o = offset_origin(sp.position, sp.geometric_normal, d);
-            let l = self.radiance(o, d, depth + 1, diffuse_left, true, None, ctx);
-            l * f * g * (1.0 - m.transmission) * (total / p_s)
+            let l = self.radiance(o, d, depth + 1, diffuse_left, !rough, None, ctx);
+            (direct + l * f * g) * (1.0 - m.transmission) * (total / p_s)
         } else {
             self.dielectric(sp, m, dir, depth, diffuse_left, rng, ctx) * m.transmission * (total / p_t)
         }
@@ -289,6 +302,38 @@ impl<'s> Integrator<'s> {
             indirect = self.radiance(o, d, depth + 1, diffuse_left - 1, false, None, ctx);
         }
         m.diffuse * (direct / PI + indirect)
+    }
+
+    /// Next-event estimation for the opaque GGX lobe: Σ lights f_s(v, l) L cos θ_l / pdf.
+    fn specular_direct(&self, sp: &SurfacePoint, m: &ShadingMaterial, dir: Vec3, rng: &mut Rng, ctx: &mut PathContext) -> Vec3 {
+        let (wo, n) = (-dir, sp.normal);
+        let cos_o = wo.dot(n);
+        if cos_o <= 0.0 {
+            return Vec3::ZERO;
+        }
+        let a2 = m.alpha * m.alpha;
+        let mut sum = Vec3::ZERO;
+        for light in &self.frame.lights {
+            let Some(ls) = sample_light(light, sp.position, rng) else { continue };
+            let l = ls.direction;
+            let cos_l = n.dot(l);
+            if cos_l <= 0.0 || sp.geometric_normal.dot(l) <= 0.0 {
+                continue;
+            }
+            let h = (wo + l).normalize();
+            let nh = n.dot(h).max(0.0);
+            let dd = nh * nh * (a2 - 1.0) + 1.0;
+            let d = a2 / (PI * dd * dd);
+            let g = ggx_g1(cos_o, m.alpha) * ggx_g1(cos_l, m.alpha);
+            let f = m.fresnel(wo.dot(h));
+            let o = offset_origin(sp.position, sp.geometric_normal, l);
+            ctx.rays += 1;
+            let tmax = if ls.distance.is_finite() { ls.distance * (1.0 - 1e-4) } else { f32::INFINITY };
+            if !self.geometry.occluded(o, l, tmax) {
+                sum += f * ls.weight * (d * g / (4.0 * cos_o));
+            }
+        }
+        sum
     }
 
     /// Samples the opaque specular lobe: (direction, Fresnel, geometric weight), so that the

@@ -51,7 +51,7 @@ pub fn sample_light(light: &Light, p: Vec3, rng: &mut Rng) -> Option<LightSample
         _ => {
             let to_light = light.position - p;
             let d2 = to_light.length_squared();
-            if !(d2 > 0.0) {
+            if d2.is_nan() || d2 <= 0.0 {
                 return None;
             }
             let dist = d2.sqrt();

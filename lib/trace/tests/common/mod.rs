@@ -116,6 +116,7 @@ pub fn scene(objects: Vec<SceneObject>, materials: Vec<Material>, res: (u32, u32
         materials,
         textures: vec![],
         space: ParameterSpace::default(),
+        ..Default::default()
     }
 }
 
