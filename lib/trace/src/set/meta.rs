@@ -1,6 +1,7 @@
 //! The contents of `set.json`.
 
 use crate::film::GaussianFilter;
+use crate::settings::TraceSettings;
 use serde::{Deserialize, Serialize};
 
 /// `set.json`: everything about a ray-traced set except the pixels.
@@ -18,12 +19,26 @@ pub struct SetMeta {
     pub spp: u32,
     /// The Gaussian reconstruction filter every layer was filtered with.
     pub filter: GaussianFilter,
+    /// Who rendered the set and how (informative; absent in sets from other renderers).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub renderer: Option<RendererMeta>,
     /// The parameter space, dimension order = order of `samples` in each point.
     pub space: Vec<DimensionMeta>,
     /// Objects in scene order; record and point `objects` indices refer to this list.
     pub objects: Vec<ObjectMeta>,
     /// Parameter points in linear-index order (last dimension fastest).
     pub points: Vec<PointMeta>,
+}
+
+/// The renderer that produced a set.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct RendererMeta {
+    /// `pis-trace`, `cycles` ...
+    pub name: String,
+    pub version: String,
+    /// pis-trace's settings.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub settings: Option<TraceSettings>,
 }
 
 /// One dimension of the parameter space.

@@ -99,6 +99,11 @@ impl SetWriter {
             resolution: [settings.resolution.0, settings.resolution.1],
             spp: settings.spp,
             filter: settings.filter,
+            renderer: Some(RendererMeta {
+                name: "pis-trace".into(),
+                version: env!("CARGO_PKG_VERSION").into(),
+                settings: Some(settings.clone()),
+            }),
             space,
             objects,
             points: Vec::new(),
