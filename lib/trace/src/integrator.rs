@@ -13,13 +13,25 @@ use std::f32::consts::PI;
 /// GGX alpha from which the opaque specular lobe samples lights explicitly.
 pub const NEE_ALPHA: f32 = 0.1;
 
-/// Per-path bookkeeping: ray counts and the fallback seed.
+/// Seed stream of the specular lobes at a camera ray's first hit (the depth slot of
+/// [`Rng::at_surface`]; paths use their depth, the first-hit irradiance depth 0).
+const FIRST_HIT_SPECULAR_STREAM: u32 = 0x8000_0000;
+
+/// Key of a surface cell: quantized object-space point, object, front or back side.
+pub type CellKey = (i64, i64, i64, u32, bool);
+
+/// Lobe weight (luminance) below which first-hit specular lobes are sampled by Russian roulette.
+pub const ROULETTE_WEIGHT: f32 = 0.25;
+
+/// Per-path bookkeeping: ray counts, the fallback seed and the first-hit irradiance cache.
 #[derive(Clone, Debug, Default)]
 pub struct PathContext {
     /// Rays traced (BVH queries, shadow rays included).
     pub rays: u64,
     /// Seed used instead of the surface point when coherence is off.
     pub fallback_seed: u64,
+    /// Irradiance / π per surface cell at first hits (one image row's worth).
+    pub irradiance_cache: std::collections::HashMap<CellKey, Vec3>,
 }
 
 /// The two terms of the greedy two-path model (thesis 6.2).
@@ -237,10 +249,18 @@ impl<'s> Integrator<'s> {
         ctx: &mut PathContext,
         choice: Option<(f32, (f32, f32))>,
     ) -> Vec3 {
+        let mut survival = 1.0;
         let (u, (p_s, p_t)) = match choice {
             Some(c) => c,
             None => {
+                // Called on its own (at a first hit, beside the diffuse lobe): weak lobes such
+                // as the 4 % reflection of a matte dielectric are continued by Russian
+                // roulette with probability ∝ their weight.
                 let w = self.lobe_weights(sp, m, dir);
+                survival = ((w.0 + w.1) / ROULETTE_WEIGHT).min(1.0);
+                if survival < 1.0 && rng.next_f32() >= survival {
+                    return Vec3::ZERO;
+                }
                 (rng.next_f32() * (w.0 + w.1), w)
             }
         };
@@ -248,6 +268,7 @@ impl<'s> Integrator<'s> {
         if total <= 0.0 || depth >= self.settings.max_depth {
             return Vec3::ZERO;
         }
+        let total = total / survival;
         if u < p_s {
             // Rough lobes reach the lights by next-event estimation, their sampled rays do
             // not see light spheres; glossy and mirror lobes see them along sampled rays.
@@ -264,7 +285,7 @@ impl<'s> Integrator<'s> {
         }
     }
 
-    /// Next-event estimation plus the indirect bounce: radiance of the diffuse lobe.
+    /// Radiance of the diffuse lobe: albedo × [`Self::irradiance`] with one sample.
     fn diffuse(
         &self,
         sp: &SurfacePoint,
@@ -274,34 +295,73 @@ impl<'s> Integrator<'s> {
         rng: &mut Rng,
         ctx: &mut PathContext,
     ) -> Vec3 {
+        m.diffuse * self.irradiance(sp, depth, diffuse_left, 1, rng, ctx)
+    }
+
+    /// Incident irradiance / π at `sp` (so that albedo × it is the diffuse radiance):
+    /// next-event estimation towards every light plus `diffuse_left > 0` an indirect bounce,
+    /// averaged over `samples` estimates.
+    fn irradiance(
+        &self,
+        sp: &SurfacePoint,
+        depth: u32,
+        diffuse_left: u32,
+        samples: u32,
+        rng: &mut Rng,
+        ctx: &mut PathContext,
+    ) -> Vec3 {
         let n = sp.normal;
         let mut direct = Vec3::ZERO;
-        for light in &self.frame.lights {
-            let Some(ls) = sample_light(light, sp.position, rng) else { continue };
-            let cos = n.dot(ls.direction);
-            if cos <= 0.0 || sp.geometric_normal.dot(ls.direction) <= 0.0 {
-                continue;
-            }
-            let o = offset_origin(sp.position, sp.geometric_normal, ls.direction);
-            ctx.rays += 1;
-            let tmax = if ls.distance.is_finite() { ls.distance * (1.0 - 1e-4) } else { f32::INFINITY };
-            if !self.geometry.occluded(o, ls.direction, tmax) {
-                direct += ls.weight * cos;
-            }
-        }
         let mut indirect = Vec3::ZERO;
-        if diffuse_left > 0 && depth < self.settings.max_depth {
-            let mut d = cosine_hemisphere(rng.next_2d(), n);
-            // A direction below the geometric surface (shading normals differ from the
-            // facets) is mirrored back above it, keeping the lobe's energy.
-            let below = sp.geometric_normal.dot(d);
-            if below <= 0.0 {
-                d = (d - sp.geometric_normal * (2.0 * below)).normalize();
+        for _ in 0..samples.max(1) {
+            for light in &self.frame.lights {
+                let Some(ls) = sample_light(light, sp.position, rng) else { continue };
+                let cos = n.dot(ls.direction);
+                if cos <= 0.0 || sp.geometric_normal.dot(ls.direction) <= 0.0 {
+                    continue;
+                }
+                let o = offset_origin(sp.position, sp.geometric_normal, ls.direction);
+                ctx.rays += 1;
+                let tmax = if ls.distance.is_finite() { ls.distance * (1.0 - 1e-4) } else { f32::INFINITY };
+                if !self.geometry.occluded(o, ls.direction, tmax) {
+                    direct += ls.weight * cos;
+                }
             }
-            let o = offset_origin(sp.position, sp.geometric_normal, d);
-            indirect = self.radiance(o, d, depth + 1, diffuse_left - 1, false, None, ctx);
+            if diffuse_left > 0 && depth < self.settings.max_depth {
+                let mut d = cosine_hemisphere(rng.next_2d(), n);
+                // A direction below the geometric surface (shading normals differ from the
+                // facets) is mirrored back above it, keeping the lobe's energy.
+                let below = sp.geometric_normal.dot(d);
+                if below <= 0.0 {
+                    d = (d - sp.geometric_normal * (2.0 * below)).normalize();
+                }
+                let o = offset_origin(sp.position, sp.geometric_normal, d);
+                indirect += self.radiance(o, d, depth + 1, diffuse_left - 1, false, None, ctx);
+            }
         }
-        m.diffuse * (direct / PI + indirect)
+        (direct / PI + indirect) / samples.max(1) as f32
+    }
+
+    /// Irradiance / π at a camera ray's first hit. With coherent sampling it is a function of
+    /// the surface cell: estimated once per cell (with `diffuse_samples` estimates seeded by
+    /// the cell) at the first point that reaches the cell, and reused by later camera samples
+    /// of the same image row (the cache lives in `ctx`, one per row, so the result does not
+    /// depend on the thread count).
+    fn first_irradiance(&self, sp: &SurfacePoint, diffuse_left: u32, ctx: &mut PathContext) -> Vec3 {
+        let samples = self.settings.diffuse_samples.max(1);
+        if self.cell <= 0.0 {
+            let mut rng = Rng::at_surface(sp.object_position, 0.0, sp.object, 0, ctx.fallback_seed);
+            return self.irradiance(sp, 0, diffuse_left, samples, &mut rng, ctx);
+        }
+        let q = (sp.object_position / self.cell).floor();
+        let key = (q.x as i64, q.y as i64, q.z as i64, sp.object, sp.front_face);
+        if let Some(&e) = ctx.irradiance_cache.get(&key) {
+            return e;
+        }
+        let mut rng = Rng::at_surface(sp.object_position, self.cell, sp.object, 0, ctx.fallback_seed);
+        let e = self.irradiance(sp, 0, diffuse_left, samples, &mut rng, ctx);
+        ctx.irradiance_cache.insert(key, e);
+        e
     }
 
     /// Next-event estimation for the opaque GGX lobe: Σ lights f_s(v, l) L cos θ_l / pdf.
@@ -375,6 +435,20 @@ impl<'s> Integrator<'s> {
     ) -> Vec3 {
         let (eta, n) = (if sp.front_face { 1.0 / m.ior } else { m.ior }, sp.normal);
         let f = fresnel_dielectric(-dir.dot(n), eta);
+        if depth == 0 && f < 1.0 {
+            // At a camera ray's first hit both children are traced (weights F and 1 − F),
+            // deeper interfaces choose one by Fresnel.
+            let r = reflect(dir, n);
+            let reflected = self.radiance(offset_origin(sp.position, sp.geometric_normal, r), r, 1, diffuse_left, true, None, ctx);
+            let refracted = match refract(dir, n, eta) {
+                Some(t) => {
+                    let o = offset_origin(sp.position, sp.geometric_normal, t);
+                    self.radiance(o, t, 1, diffuse_left, true, None, ctx) * if sp.front_face { m.base } else { Vec3::ONE }
+                }
+                None => reflected / f.max(1e-6) * (1.0 - f),
+            };
+            return reflected * f + refracted * (1.0 - f);
+        }
         let (d, w) = if rng.next_f32() < f {
             (reflect(dir, n), Vec3::ONE)
         } else {
@@ -398,13 +472,14 @@ impl<'s> Integrator<'s> {
         let Some(hit) = hit else { return CameraSample::default() };
         let sp = self.geometry.surface(&hit, origin, dir);
         let m = self.material(&sp);
-        let mut rng = self.rng_at(&sp, 0, ctx);
         let diffuse_left = self.settings.diffuse_bounces.max(1);
         let diffuse = if luminance(m.diffuse) > 0.0 {
-            self.diffuse(&sp, &m, 0, diffuse_left, &mut rng, ctx)
+            m.diffuse * self.first_irradiance(&sp, diffuse_left, ctx)
         } else {
             Vec3::ZERO
         };
+        // The specular lobes draw from their own stream of the surface point.
+        let mut rng = self.rng_at(&sp, FIRST_HIT_SPECULAR_STREAM, ctx);
         let mut out = CameraSample { object: Some(hit.object), diffuse, ..Default::default() };
         let role = self.role(hit.object);
         let mut specular = m.emission;

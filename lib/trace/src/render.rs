@@ -13,6 +13,9 @@ use pis_scene::{Frame, ObjectRole, Scene};
 use rayon::prelude::*;
 use std::time::Instant;
 
+/// Image rows per parallel work unit (they share the first-hit irradiance cache).
+pub const BAND_ROWS: u32 = 8;
+
 /// Counters of one render.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct RenderStats {
@@ -82,14 +85,23 @@ pub fn render_point(
     let build_seconds = t0.elapsed().as_secs_f64();
     let camera = PerspectiveCamera::new(&frame.camera, settings.resolution);
     let t1 = Instant::now();
-    let rows: Vec<(Vec<PixelAccum>, Vec<RayRecord>, u64)> = (0..h)
+    // Bands of rows are the parallel unit: each band renders its rows in order with one
+    // path context (and so one first-hit irradiance cache), so the result does not depend
+    // on how bands are spread over threads.
+    let bands: Vec<Vec<(Vec<PixelAccum>, Vec<RayRecord>, u64)>> = (0..h.div_ceil(BAND_ROWS))
         .into_par_iter()
-        .map(|y| {
-            let row = render_row(&integrator, &camera, settings, y);
-            row_done();
-            row
+        .map(|b| {
+            let mut ctx = PathContext::default();
+            (b * BAND_ROWS..((b + 1) * BAND_ROWS).min(h))
+                .map(|y| {
+                    let row = render_row(&integrator, &camera, settings, y, &mut ctx);
+                    row_done();
+                    row
+                })
+                .collect()
         })
         .collect();
+    let rows: Vec<(Vec<PixelAccum>, Vec<RayRecord>, u64)> = bands.into_iter().flatten().collect();
     let trace_seconds = t1.elapsed().as_secs_f64();
     let mut pixels = Vec::with_capacity(w as usize * h as usize);
     let mut records = Vec::new();
@@ -117,11 +129,12 @@ fn render_row(
     camera: &PerspectiveCamera,
     settings: &TraceSettings,
     y: u32,
+    ctx: &mut PathContext,
 ) -> (Vec<PixelAccum>, Vec<RayRecord>, u64) {
+    let rays_before = ctx.rays;
     let w = settings.resolution.0;
     let mut pixels = Vec::with_capacity(w as usize);
     let mut records = Vec::new();
-    let mut ctx = PathContext::default();
     for x in 0..w {
         let pixel_seed = hash_keys(&[x as u64, y as u64]);
         let shift = Rng::new(pixel_seed).next_2d();
@@ -132,7 +145,7 @@ fn render_row(
             let dir = camera.direction(pos);
             ctx.fallback_seed = hash_keys(&[pixel_seed, s as u64]);
             let record = s < settings.records_per_pixel;
-            let sample = integrator.camera_sample(camera.origin, dir, record, &mut ctx);
+            let sample = integrator.camera_sample(camera.origin, dir, record, ctx);
             if record {
                 if let (Some(o), Some(terms)) = (sample.object, &sample.lens) {
                     for (k, t) in terms.iter().enumerate() {
@@ -162,5 +175,5 @@ fn render_row(
         }
         pixels.push(acc);
     }
-    (pixels, records, ctx.rays)
+    (pixels, records, ctx.rays - rays_before)
 }

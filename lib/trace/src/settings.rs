@@ -16,6 +16,9 @@ pub struct TraceSettings {
     pub max_depth: u32,
     /// Indirect diffuse bounces after the first diffuse interaction (at least 1).
     pub diffuse_bounces: u32,
+    /// Irradiance estimates (light samples and indirect rays) per surface cell at camera
+    /// rays' first hits; the diffuse layer's noise falls with it.
+    pub diffuse_samples: u32,
     /// Cell size (world units, object space) of the quantized surface point that seeds
     /// shading; `None` picks 1/4096 of the scene's bounding-box diagonal; `Some(0.0)` seeds
     /// per pixel sample instead (no coherence across the parameter space).
@@ -36,6 +39,7 @@ impl TraceSettings {
             filter: GaussianFilter::default(),
             max_depth: 8,
             diffuse_bounces: 1,
+            diffuse_samples: 4,
             coherence_cell: None,
             records_per_pixel: 2,
             max_record_hits: 4,
