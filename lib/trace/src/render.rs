@@ -13,6 +13,9 @@ use pis_scene::{Frame, ObjectRole, Scene};
 use rayon::prelude::*;
 use std::time::Instant;
 
+/// One rendered row: pixel sums, ray records, rays traced.
+type RowResult = (Vec<PixelAccum>, Vec<RayRecord>, u64);
+
 /// Image rows per parallel work unit (they share the first-hit irradiance cache).
 pub const BAND_ROWS: u32 = 8;
 
@@ -88,7 +91,7 @@ pub fn render_point(
     // Bands of rows are the parallel unit: each band renders its rows in order with one
     // path context (and so one first-hit irradiance cache), so the result does not depend
     // on how bands are spread over threads.
-    let bands: Vec<Vec<(Vec<PixelAccum>, Vec<RayRecord>, u64)>> = (0..h.div_ceil(BAND_ROWS))
+    let bands: Vec<Vec<RowResult>> = (0..h.div_ceil(BAND_ROWS))
         .into_par_iter()
         .map(|b| {
             let mut ctx = PathContext::default();
@@ -101,7 +104,7 @@ pub fn render_point(
                 .collect()
         })
         .collect();
-    let rows: Vec<(Vec<PixelAccum>, Vec<RayRecord>, u64)> = bands.into_iter().flatten().collect();
+    let rows: Vec<RowResult> = bands.into_iter().flatten().collect();
     let trace_seconds = t1.elapsed().as_secs_f64();
     let mut pixels = Vec::with_capacity(w as usize * h as usize);
     let mut records = Vec::new();
@@ -130,7 +133,7 @@ fn render_row(
     settings: &TraceSettings,
     y: u32,
     ctx: &mut PathContext,
-) -> (Vec<PixelAccum>, Vec<RayRecord>, u64) {
+) -> RowResult {
     let rays_before = ctx.rays;
     let w = settings.resolution.0;
     let mut pixels = Vec::with_capacity(w as usize);
