@@ -54,6 +54,17 @@ pub fn decode_exr(bytes: &[u8], path: &Path) -> std::result::Result<PointImages,
             None => (String::new(), full.clone()),
         };
         let plane: Vec<f32> = ch.sample_data.values_as_f32().collect();
+        if plane.len() != size.0 * size.1 {
+            return Err(TraceError::Exr {
+                path: path.to_path_buf(),
+                message: format!(
+                    "channel {full} has {} samples for a {}x{} image (subsampled channels are not supported)",
+                    plane.len(),
+                    size.0,
+                    size.1
+                ),
+            });
+        }
         match layers.iter_mut().find(|l| l.name == layer) {
             Some(l) => {
                 l.channels.push(c);
