@@ -70,11 +70,17 @@ impl Animation {
 }
 
 impl Sampler {
+    /// Entry `i` of `values`; zero if a hand-built sampler has too few (the loader checks
+    /// that every keyframe has its values).
+    fn at(&self, i: usize) -> Vec4 {
+        self.values.get(i).copied().unwrap_or(Vec4::ZERO)
+    }
+
     /// The keyframe value `k` (the middle entry for cubic splines).
     fn value(&self, k: usize) -> Vec4 {
         match self.interpolation {
-            Interpolation::CubicSpline => self.values[3 * k + 1],
-            _ => self.values[k],
+            Interpolation::CubicSpline => self.at(3 * k + 1),
+            _ => self.at(k),
         }
     }
 
@@ -83,7 +89,11 @@ impl Sampler {
     pub fn sample(&self, t: f32, rotation: bool) -> Vec4 {
         let n = self.times.len();
         if n == 0 {
-            return if rotation { Vec4::new(0.0, 0.0, 0.0, 1.0) } else { Vec4::ZERO };
+            return if rotation {
+                Vec4::new(0.0, 0.0, 0.0, 1.0)
+            } else {
+                Vec4::ZERO
+            };
         }
         if n == 1 || t <= self.times[0] {
             return self.value(0);
@@ -101,17 +111,19 @@ impl Sampler {
             Interpolation::Linear => {
                 let (a, b) = (self.value(k), self.value(k + 1));
                 if rotation {
-                    let q = Quat::from_vec4(a).normalize().slerp(Quat::from_vec4(b).normalize(), s);
+                    let q = Quat::from_vec4(a)
+                        .normalize()
+                        .slerp(Quat::from_vec4(b).normalize(), s);
                     Vec4::from(q)
                 } else {
                     a.lerp(b, s)
                 }
             }
             Interpolation::CubicSpline => {
-                let p0 = self.values[3 * k + 1];
-                let m0 = self.values[3 * k + 2] * dt; // out-tangent of k
-                let p1 = self.values[3 * (k + 1) + 1];
-                let m1 = self.values[3 * (k + 1)] * dt; // in-tangent of k + 1
+                let p0 = self.at(3 * k + 1);
+                let m0 = self.at(3 * k + 2) * dt; // out-tangent of k
+                let p1 = self.at(3 * (k + 1) + 1);
+                let m1 = self.at(3 * (k + 1)) * dt; // in-tangent of k + 1
                 let (s2, s3) = (s * s, s * s * s);
                 let v = p0 * (2.0 * s3 - 3.0 * s2 + 1.0)
                     + m0 * (s3 - 2.0 * s2 + s)
@@ -137,7 +149,11 @@ pub struct Trs {
 
 impl Default for Trs {
     fn default() -> Self {
-        Trs { translation: Vec3::ZERO, rotation: Quat::IDENTITY, scale: Vec3::ONE }
+        Trs {
+            translation: Vec3::ZERO,
+            rotation: Quat::IDENTITY,
+            scale: Vec3::ONE,
+        }
     }
 }
 
@@ -152,9 +168,13 @@ impl Animation {
     /// Applies the animation at time `t` to the local transforms `locals` (indexed by node).
     pub fn apply(&self, t: f32, locals: &mut [Trs]) {
         for c in &self.channels {
-            let Some(local) = locals.get_mut(c.node) else { continue };
+            let Some(local) = locals.get_mut(c.node) else {
+                continue;
+            };
             match c.path {
-                TargetPath::Translation => local.translation = c.sampler.sample(t, false).truncate(),
+                TargetPath::Translation => {
+                    local.translation = c.sampler.sample(t, false).truncate()
+                }
                 TargetPath::Rotation => local.rotation = Quat::from_vec4(c.sampler.sample(t, true)),
                 TargetPath::Scale => local.scale = c.sampler.sample(t, false).truncate(),
             }
@@ -171,7 +191,11 @@ mod tests {
     }
 
     fn scalar(interpolation: Interpolation, times: &[f32], values: &[f32]) -> Sampler {
-        Sampler { interpolation, times: times.to_vec(), values: values.iter().map(|&v| Vec4::splat(v)).collect() }
+        Sampler {
+            interpolation,
+            times: times.to_vec(),
+            values: values.iter().map(|&v| Vec4::splat(v)).collect(),
+        }
     }
 
     #[test]
@@ -208,14 +232,21 @@ mod tests {
         assert!(q.angle_between(expected) < 1e-5, "{q:?} vs {expected:?}");
         // Hand-computed: sin(π/16), cos(π/16).
         let half = std::f32::consts::PI / 16.0;
-        assert!(close(Vec4::from(q), Vec4::new(0.0, half.sin(), 0.0, half.cos())));
+        assert!(close(
+            Vec4::from(q),
+            Vec4::new(0.0, half.sin(), 0.0, half.cos())
+        ));
     }
 
     #[test]
     fn linear_rotation_takes_the_short_way() {
         let q0 = Quat::from_rotation_z(0.1);
         let q1 = -Quat::from_rotation_z(0.3); // same rotation, opposite hemisphere
-        let s = Sampler { interpolation: Interpolation::Linear, times: vec![0.0, 1.0], values: vec![q0.into(), q1.into()] };
+        let s = Sampler {
+            interpolation: Interpolation::Linear,
+            times: vec![0.0, 1.0],
+            values: vec![q0.into(), q1.into()],
+        };
         let q = Quat::from_vec4(s.sample(0.5, true));
         assert!(q.angle_between(Quat::from_rotation_z(0.2)) < 1e-5);
     }
@@ -226,7 +257,11 @@ mod tests {
         // in-tangent a1 = -1. At t = 2 (s = 0.5): h00 = 0.5, h10 = 0.125, h01 = 0.5,
         // h11 = -0.125; m0 = 2·1 = 2, m1 = 2·(-1) = -2
         // → 0.5·0 + 0.125·2 + 0.5·2 + (-0.125)·(-2) = 1.5.
-        let s = scalar(Interpolation::CubicSpline, &[1.0, 3.0], &[9.0, 0.0, 1.0, -1.0, 2.0, 9.0]);
+        let s = scalar(
+            Interpolation::CubicSpline,
+            &[1.0, 3.0],
+            &[9.0, 0.0, 1.0, -1.0, 2.0, 9.0],
+        );
         assert!((s.sample(2.0, false).x - 1.5).abs() < 1e-6);
         // At s = 0.25: h00 = 0.84375, h10 = 0.140625, h01 = 0.15625, h11 = -0.046875
         // → 0 + 0.28125 + 0.3125 + 0.09375 = 0.6875.

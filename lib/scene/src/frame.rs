@@ -43,42 +43,72 @@ impl Scene {
                     };
                     a.apply(value, &mut locals);
                 }
-                Driver::Orbit { target, radius, elevation_deg } => {
+                Driver::Orbit {
+                    target,
+                    radius,
+                    elevation_deg,
+                } => {
                     orbit = Some(orbit_camera(*target, *radius, *elevation_deg, value));
                 }
-                Driver::LightPath { light, path } => moved_lights.push((light, point_on_path(path, value))),
+                Driver::LightPath { light, path } => {
+                    moved_lights.push((light, point_on_path(path, value)))
+                }
             }
         }
         let world = rig.world_transforms(&locals);
 
         let world_from_camera = match (orbit, &rig.camera.placement) {
             (Some(m), _) => m,
-            (None, CameraPlacement::Node(n)) => rigid_part(world.get(*n).copied().unwrap_or(Mat4::IDENTITY)),
+            (None, CameraPlacement::Node(n)) => {
+                rigid_part(world.get(*n).copied().unwrap_or(Mat4::IDENTITY))
+            }
             (None, CameraPlacement::Fixed(m)) => *m,
         };
-        let camera = Camera { world_from_camera, yfov: rig.camera.yfov, znear: rig.camera.znear, zfar: rig.camera.zfar };
+        let camera = Camera {
+            world_from_camera,
+            yfov: rig.camera.yfov,
+            znear: rig.camera.znear,
+            zfar: rig.camera.zfar,
+        };
 
         let lights = rig
             .lights
             .iter()
             .map(|l| {
-                let (mut position, direction) = light_pose(world.get(l.node).copied().unwrap_or(Mat4::IDENTITY));
+                let (mut position, direction) =
+                    light_pose(world.get(l.node).copied().unwrap_or(Mat4::IDENTITY));
                 let node_name = rig.nodes.get(l.node).map(|n| n.name.as_str());
                 for (name, p) in &moved_lights {
                     if **name == l.name || Some(name.as_str()) == node_name {
                         position = *p;
                     }
                 }
-                Light { name: l.name.clone(), kind: l.kind, radiance: l.radiance, radius: l.radius, position, direction }
+                Light {
+                    name: l.name.clone(),
+                    kind: l.kind,
+                    radiance: l.radiance,
+                    radius: l.radius,
+                    position,
+                    direction,
+                }
             })
             .collect();
 
         let instances = (0..self.objects.len())
             .map(|k| Instance {
-                world_from_object: rig.object_nodes.get(k).and_then(|&n| world.get(n)).copied().unwrap_or(Mat4::IDENTITY),
+                world_from_object: rig
+                    .object_nodes
+                    .get(k)
+                    .and_then(|&n| world.get(n))
+                    .copied()
+                    .unwrap_or(Mat4::IDENTITY),
             })
             .collect();
-        Ok(Frame { camera, lights, instances })
+        Ok(Frame {
+            camera,
+            lights,
+            instances,
+        })
     }
 
     /// [`Scene::frame`] at the point with linear index `index` ([`crate::ParameterSpace::point`]).

@@ -7,6 +7,7 @@ use glam::{Quat, Vec2, Vec3, Vec4};
 use gltf::animation::util::ReadOutputs;
 use gltf::mesh::Mode;
 
+use crate::accessor_check::check_accessor;
 use crate::animation::{Animation, Channel, Interpolation, Sampler, TargetPath, Trs};
 use crate::material::{convert_material, infer_role};
 use crate::model::{LightKind, Material, Primitive, SceneObject, TextureImage};
@@ -36,12 +37,72 @@ pub(crate) struct GltfCamera {
 }
 
 /// Reads the glTF file at `path`, its buffers and its images.
+///
+/// Indices and accessors are checked before the gltf crate's readers see them; should the
+/// crate still panic on malformed data (its validation indexes unchecked in places), the
+/// panic becomes a [`SceneError::Gltf`].
 pub(crate) fn read_gltf(path: &Path) -> Result<GltfScene, SceneError> {
     if let Err(source) = std::fs::metadata(path) {
-        return Err(SceneError::Io { path: path.to_owned(), source });
+        return Err(SceneError::Io {
+            path: path.to_owned(),
+            source,
+        });
     }
-    let (doc, buffers, images) = gltf::import(path).map_err(|e| import_error(path, e))?;
-    let ctx = Ctx { path: path.to_owned(), buffers: &buffers };
+    let read = || {
+        let (doc, buffers, images) = gltf::import(path).map_err(|e| import_error(path, e))?;
+        check_animation_indices(path, &doc)?;
+        convert(path, &doc, &buffers, &images)
+    };
+    std::panic::catch_unwind(read).unwrap_or_else(|panic| {
+        let what = panic
+            .downcast_ref::<&str>()
+            .map(|s| s.to_string())
+            .or_else(|| panic.downcast_ref::<String>().cloned())
+            .unwrap_or_default();
+        Err(SceneError::Gltf {
+            path: path.to_owned(),
+            message: format!("malformed data made the glTF reader fail: {what}"),
+        })
+    })
+}
+
+/// Animation channel targets and samplers are not validated by the gltf crate, whose
+/// accessors then panic; check them here.
+fn check_animation_indices(path: &Path, doc: &gltf::Document) -> Result<(), SceneError> {
+    let root = doc.as_json();
+    for (ai, a) in root.animations.iter().enumerate() {
+        for (ci, c) in a.channels.iter().enumerate() {
+            let field = format!("animations[{ai}].channels[{ci}]");
+            let node = c.target.node.value();
+            if node >= root.nodes.len() {
+                let msg = format!("node {node} does not exist");
+                return Err(SceneError::invalid(
+                    path,
+                    format!("{field}.target.node"),
+                    msg,
+                ));
+            }
+            let sampler = c.sampler.value();
+            if sampler >= a.samplers.len() {
+                let msg = format!("sampler {sampler} does not exist");
+                return Err(SceneError::invalid(path, format!("{field}.sampler"), msg));
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Converts an imported document (see [`read_gltf`]).
+fn convert(
+    path: &Path,
+    doc: &gltf::Document,
+    buffers: &[gltf::buffer::Data],
+    images: &[gltf::image::Data],
+) -> Result<GltfScene, SceneError> {
+    let ctx = Ctx {
+        path: path.to_owned(),
+        buffers,
+    };
 
     let scene = doc
         .default_scene()
@@ -69,10 +130,20 @@ pub(crate) fn read_gltf(path: &Path) -> Result<GltfScene, SceneError> {
             rotation: Quat::from_array(rotation).normalize(),
             scale: Vec3::from(scale),
         };
-        if !(local.translation.is_finite() && local.rotation.is_finite() && local.scale.is_finite()) {
-            return Err(SceneError::NonFinite { path: path.to_owned(), field: format!("nodes[{}]", node.index()), element: 0 });
+        if !(local.translation.is_finite() && local.rotation.is_finite() && local.scale.is_finite())
+        {
+            return Err(SceneError::NonFinite {
+                path: path.to_owned(),
+                field: format!("nodes[{}]", node.index()),
+                element: 0,
+            });
         }
-        rig.nodes.push(Node { name: node_name(&node), gltf_index: node.index(), parent, local });
+        rig.nodes.push(Node {
+            name: node_name(&node),
+            gltf_index: node.index(),
+            parent,
+            local,
+        });
         for child in node.children().collect::<Vec<_>>().into_iter().rev() {
             stack.push((child, Some(here)));
         }
@@ -85,12 +156,21 @@ pub(crate) fn read_gltf(path: &Path) -> Result<GltfScene, SceneError> {
     for m in doc.materials() {
         let mut mat = convert_material(&m);
         if let Some(info) = m.pbr_metallic_roughness().base_color_texture() {
-            let field = format!("materials[{}].pbrMetallicRoughness.baseColorTexture", m.index().unwrap_or(0));
+            let field = format!(
+                "materials[{}].pbrMetallicRoughness.baseColorTexture",
+                m.index().unwrap_or(0)
+            );
             if info.tex_coord() != 0 {
-                return Err(SceneError::unsupported(path, format!("{field}.texCoord"), "texture coordinate sets other than TEXCOORD_0"));
+                return Err(SceneError::unsupported(
+                    path,
+                    format!("{field}.texCoord"),
+                    "texture coordinate sets other than TEXCOORD_0",
+                ));
             }
             let image = info.texture().source().index();
-            let data = images.get(image).ok_or_else(|| SceneError::invalid(path, &field, "image index out of range"))?;
+            let data = images
+                .get(image)
+                .ok_or_else(|| SceneError::invalid(path, &field, "image index out of range"))?;
             let next = textures.len();
             let t = *texture_of_image.entry(image).or_insert(next);
             if t == next {
@@ -103,26 +183,35 @@ pub(crate) fn read_gltf(path: &Path) -> Result<GltfScene, SceneError> {
     let mut default_material = None;
 
     // Objects: one per node with a mesh, in glTF node order.
+    let gltf_nodes: Vec<gltf::Node> = doc.nodes().collect();
     let mut objects = Vec::new();
     let mut by_gltf: Vec<(usize, usize)> = rig_index.iter().map(|(&g, &r)| (g, r)).collect();
     by_gltf.sort();
     let mut used_names: BTreeMap<String, usize> = BTreeMap::new();
     for &(g, r) in &by_gltf {
-        let Some(node) = doc.nodes().nth(g) else { continue };
+        let Some(node) = gltf_nodes.get(g) else {
+            continue;
+        };
         let Some(mesh) = node.mesh() else { continue };
         let mut primitives = Vec::new();
         for p in mesh.primitives() {
             let material = match p.material().index() {
                 Some(i) => i,
                 None => *default_material.get_or_insert_with(|| {
-                    materials.push(Material { name: "default".into(), ..Material::default() });
+                    materials.push(Material {
+                        name: "default".into(),
+                        ..Material::default()
+                    });
                     materials.len() - 1
                 }),
             };
             let field = format!("meshes[{}].primitives[{}]", mesh.index(), p.index());
             primitives.push(ctx.read_primitive(&p, material, &field)?);
         }
-        let mats: Vec<&Material> = primitives.iter().filter_map(|p: &Primitive| materials.get(p.material)).collect();
+        let mats: Vec<&Material> = primitives
+            .iter()
+            .filter_map(|p: &Primitive| materials.get(p.material))
+            .collect();
         let mut name = rig.nodes[r].name.clone();
         if node.name().is_none() {
             if let Some(mesh_name) = mesh.name() {
@@ -134,20 +223,32 @@ pub(crate) fn read_gltf(path: &Path) -> Result<GltfScene, SceneError> {
         if *count > 1 {
             name = format!("{name}.{g}");
         }
-        objects.push(SceneObject { name, role: infer_role(&mats), primitives });
+        objects.push(SceneObject {
+            name,
+            role: infer_role(&mats),
+            primitives,
+        });
         rig.object_nodes.push(r);
     }
 
     // Lights and cameras on nodes.
     let mut cameras = Vec::new();
     for &(g, r) in &by_gltf {
-        let Some(node) = doc.nodes().nth(g) else { continue };
+        let Some(node) = gltf_nodes.get(g) else {
+            continue;
+        };
         if let Some(light) = node.light() {
-            rig.lights.push(ctx.read_light(&light, &rig.nodes[r].name, r)?);
+            rig.lights
+                .push(ctx.read_light(&light, &rig.nodes[r].name, r)?);
         }
         if let Some(camera) = node.camera() {
             if let gltf::camera::Projection::Perspective(p) = camera.projection() {
-                cameras.push(GltfCamera { node: r, yfov: p.yfov(), znear: p.znear(), zfar: p.zfar() });
+                cameras.push(GltfCamera {
+                    node: r,
+                    yfov: p.yfov(),
+                    znear: p.znear(),
+                    zfar: p.zfar(),
+                });
             }
         }
     }
@@ -155,7 +256,10 @@ pub(crate) fn read_gltf(path: &Path) -> Result<GltfScene, SceneError> {
     // Animations.
     let mut unsupported_animations = BTreeMap::new();
     for a in doc.animations() {
-        let name = a.name().map(str::to_owned).unwrap_or_else(|| format!("animation{}", a.index()));
+        let name = a
+            .name()
+            .map(str::to_owned)
+            .unwrap_or_else(|| format!("animation{}", a.index()));
         match ctx.read_animation(&a, &name, &rig_index)? {
             Ok(anim) => rig.animations.push(anim),
             Err(why) => {
@@ -164,29 +268,54 @@ pub(crate) fn read_gltf(path: &Path) -> Result<GltfScene, SceneError> {
         }
     }
 
-    Ok(GltfScene { objects, materials, textures, rig, cameras, unsupported_animations })
+    Ok(GltfScene {
+        objects,
+        materials,
+        textures,
+        rig,
+        cameras,
+        unsupported_animations,
+    })
 }
 
 /// Maps a gltf crate error to a [`SceneError`] that names the file.
 fn import_error(path: &Path, e: gltf::Error) -> SceneError {
     match e {
         gltf::Error::Validation(errors) => {
-            if let Some((p, _)) = errors.iter().find(|(p, _)| p.as_str().starts_with("extensionsRequired")) {
-                return SceneError::unsupported(path, p.as_str(), "required glTF extension is not supported by PIS");
+            if let Some((p, _)) = errors
+                .iter()
+                .find(|(p, _)| p.as_str().starts_with("extensionsRequired"))
+            {
+                return SceneError::unsupported(
+                    path,
+                    p.as_str(),
+                    "required glTF extension is not supported by PIS",
+                );
             }
-            let list: Vec<String> = errors.iter().map(|(p, err)| format!("{}: {err}", p.as_str())).collect();
-            SceneError::Gltf { path: path.to_owned(), message: list.join("; ") }
+            let list: Vec<String> = errors
+                .iter()
+                .map(|(p, err)| format!("{}: {err}", p.as_str()))
+                .collect();
+            SceneError::Gltf {
+                path: path.to_owned(),
+                message: list.join("; "),
+            }
         }
         gltf::Error::Io(source) => SceneError::Gltf {
             path: path.to_owned(),
             message: format!("cannot read a buffer or image it references: {source}"),
         },
-        other => SceneError::Gltf { path: path.to_owned(), message: other.to_string() },
+        other => SceneError::Gltf {
+            path: path.to_owned(),
+            message: other.to_string(),
+        },
     }
 }
 
 fn node_name(node: &gltf::Node) -> String {
-    node.name().map(str::to_owned).unwrap_or_else(|| format!("node{}", node.index()))
+    node.name()
+        .map(str::to_owned)
+        .unwrap_or_else(|| format!("node{}", node.index()))
 }
 
 /// What the readers need: the file (for errors) and the buffers.
@@ -197,21 +326,68 @@ struct Ctx<'b> {
 
 impl Ctx<'_> {
     fn non_finite(&self, field: String, element: usize) -> SceneError {
-        SceneError::NonFinite { path: self.path.clone(), field, element }
+        SceneError::NonFinite {
+            path: self.path.clone(),
+            field,
+            element,
+        }
     }
 
-    fn check_finite<const N: usize>(&self, values: &[[f32; N]], field: impl Fn() -> String) -> Result<(), SceneError> {
+    fn check_finite<const N: usize>(
+        &self,
+        values: &[[f32; N]],
+        field: impl Fn() -> String,
+    ) -> Result<(), SceneError> {
         match values.iter().position(|v| v.iter().any(|x| !x.is_finite())) {
             Some(i) => Err(self.non_finite(field(), i)),
             None => Ok(()),
         }
     }
 
-    fn read_primitive(&self, p: &gltf::Primitive, material: usize, field: &str) -> Result<Primitive, SceneError> {
+    fn read_primitive(
+        &self,
+        p: &gltf::Primitive,
+        material: usize,
+        field: &str,
+    ) -> Result<Primitive, SceneError> {
+        use gltf::accessor::{DataType as T, Dimensions as D};
+        use gltf::Semantic;
+        for (semantic, name, dims, types) in [
+            (Semantic::Positions, "POSITION", D::Vec3, &[T::F32][..]),
+            (Semantic::Normals, "NORMAL", D::Vec3, &[T::F32][..]),
+            (
+                Semantic::TexCoords(0),
+                "TEXCOORD_0",
+                D::Vec2,
+                &[T::F32, T::U8, T::U16][..],
+            ),
+        ] {
+            if let Some(a) = p.get(&semantic) {
+                let f = format!("{field}.attributes.{name}");
+                check_accessor(&self.path, &f, &a, self.buffers, &[dims], types)?;
+            }
+        }
+        if let Some(a) = p.indices() {
+            let f = format!("{field}.indices");
+            check_accessor(
+                &self.path,
+                &f,
+                &a,
+                self.buffers,
+                &[D::Scalar],
+                &[T::U8, T::U16, T::U32],
+            )?;
+        }
         let reader = p.reader(|b| self.buffers.get(b.index()).map(|d| &d.0[..]));
         let positions: Vec<[f32; 3]> = reader
             .read_positions()
-            .ok_or_else(|| SceneError::invalid(&self.path, format!("{field}.attributes.POSITION"), "missing"))?
+            .ok_or_else(|| {
+                SceneError::invalid(
+                    &self.path,
+                    format!("{field}.attributes.POSITION"),
+                    "missing",
+                )
+            })?
             .collect();
         self.check_finite(&positions, || format!("{field}.attributes.POSITION"))?;
         let n = positions.len();
@@ -219,14 +395,22 @@ impl Ctx<'_> {
         if let Some(ns) = &normals {
             self.check_finite(ns, || format!("{field}.attributes.NORMAL"))?;
             if ns.len() != n {
-                return Err(SceneError::invalid(&self.path, format!("{field}.attributes.NORMAL"), "count differs from POSITION"));
+                return Err(SceneError::invalid(
+                    &self.path,
+                    format!("{field}.attributes.NORMAL"),
+                    "count differs from POSITION",
+                ));
             }
         }
         let uvs: Option<Vec<[f32; 2]>> = reader.read_tex_coords(0).map(|r| r.into_f32().collect());
         if let Some(us) = &uvs {
             self.check_finite(us, || format!("{field}.attributes.TEXCOORD_0"))?;
             if us.len() != n {
-                return Err(SceneError::invalid(&self.path, format!("{field}.attributes.TEXCOORD_0"), "count differs from POSITION"));
+                return Err(SceneError::invalid(
+                    &self.path,
+                    format!("{field}.attributes.TEXCOORD_0"),
+                    "count differs from POSITION",
+                ));
             }
         }
         let raw: Vec<u32> = match reader.read_indices() {
@@ -237,11 +421,19 @@ impl Ctx<'_> {
             return Err(SceneError::invalid(
                 &self.path,
                 format!("{field}.indices"),
-                format!("index {} at element {i} is out of range for {n} vertices", raw[i]),
+                format!(
+                    "index {} at element {i} is out of range for {n} vertices",
+                    raw[i]
+                ),
             ));
         }
-        let indices = triangle_list(p.mode(), &raw)
-            .ok_or_else(|| SceneError::unsupported(&self.path, format!("{field}.mode"), format!("{:?} primitives (only triangles)", p.mode())))?;
+        let indices = triangle_list(p.mode(), &raw).ok_or_else(|| {
+            SceneError::unsupported(
+                &self.path,
+                format!("{field}.mode"),
+                format!("{:?} primitives (only triangles)", p.mode()),
+            )
+        })?;
 
         let positions: Vec<Vec3> = positions.into_iter().map(Vec3::from).collect();
         let uvs: Vec<Vec2> = match uvs {
@@ -256,38 +448,69 @@ impl Ctx<'_> {
                     .zip(smooth)
                     .map(|(v, s)| Vec3::from(v).try_normalize().unwrap_or(s))
                     .collect();
-                Ok(Primitive { positions, normals, uvs, indices, material })
+                Ok(Primitive {
+                    positions,
+                    normals,
+                    uvs,
+                    indices,
+                    material,
+                })
             }
             None => Ok(flat_shaded(&positions, &uvs, &indices, material)),
         }
     }
 
-    fn read_light(&self, light: &gltf::khr_lights_punctual::Light, node_name: &str, node: usize) -> Result<LightRig, SceneError> {
+    fn read_light(
+        &self,
+        light: &gltf::khr_lights_punctual::Light,
+        node_name: &str,
+        node: usize,
+    ) -> Result<LightRig, SceneError> {
         use gltf::khr_lights_punctual::Kind;
         let field = format!("extensions.KHR_lights_punctual.lights[{}]", light.index());
         let kind = match light.kind() {
             Kind::Point => LightKind::Point,
             Kind::Directional => LightKind::Directional,
-            Kind::Spot { inner_cone_angle, outer_cone_angle } => {
-                LightKind::Spot { inner_cone: inner_cone_angle, outer_cone: outer_cone_angle }
-            }
+            Kind::Spot {
+                inner_cone_angle,
+                outer_cone_angle,
+            } => LightKind::Spot {
+                inner_cone: inner_cone_angle,
+                outer_cone: outer_cone_angle,
+            },
         };
         let c = light.color();
-        let radiance = [c[0] * light.intensity(), c[1] * light.intensity(), c[2] * light.intensity()];
+        let radiance = [
+            c[0] * light.intensity(),
+            c[1] * light.intensity(),
+            c[2] * light.intensity(),
+        ];
         let mut radius = 0.0;
         if let Some(raw) = light.extras() {
-            let value: serde_json::Value = serde_json::from_str(raw.get())
-                .map_err(|e| SceneError::invalid(&self.path, format!("{field}.extras"), e.to_string()))?;
+            let value: serde_json::Value = serde_json::from_str(raw.get()).map_err(|e| {
+                SceneError::invalid(&self.path, format!("{field}.extras"), e.to_string())
+            })?;
             if let Some(r) = value.get("radius") {
                 radius = r
                     .as_f64()
                     .filter(|r| r.is_finite() && *r >= 0.0)
-                    .ok_or_else(|| SceneError::invalid(&self.path, format!("{field}.extras.radius"), format!("expected a number ≥ 0, found {r}")))?
-                    as f32;
+                    .ok_or_else(|| {
+                        SceneError::invalid(
+                            &self.path,
+                            format!("{field}.extras.radius"),
+                            format!("expected a number ≥ 0, found {r}"),
+                        )
+                    })? as f32;
             }
         }
         let name = light.name().unwrap_or(node_name).to_owned();
-        Ok(LightRig { name, node, kind, radiance, radius })
+        Ok(LightRig {
+            name,
+            node,
+            kind,
+            radiance,
+            radius,
+        })
     }
 
     /// Reads an animation; the inner `Err` holds (field, reason) when it uses something PIS
@@ -302,28 +525,93 @@ impl Ctx<'_> {
         let mut channels = Vec::new();
         for (ci, c) in a.channels().enumerate() {
             let field = format!("animations[{}].channels[{ci}]", a.index());
-            let Some(&node) = rig_index.get(&c.target().node().index()) else { continue };
+            let Some(&node) = rig_index.get(&c.target().node().index()) else {
+                continue;
+            };
+            let sfield = format!(
+                "animations[{}].samplers[{}]",
+                a.index(),
+                c.sampler().index()
+            );
+            {
+                use gltf::accessor::{DataType as T, Dimensions as D};
+                use gltf::animation::Property;
+                let input = c.sampler().input();
+                check_accessor(
+                    &self.path,
+                    &format!("{sfield}.input"),
+                    &input,
+                    self.buffers,
+                    &[D::Scalar],
+                    &[T::F32],
+                )?;
+                let output = c.sampler().output();
+                let of = format!("{sfield}.output");
+                match c.target().property() {
+                    Property::Translation | Property::Scale => check_accessor(
+                        &self.path,
+                        &of,
+                        &output,
+                        self.buffers,
+                        &[D::Vec3],
+                        &[T::F32],
+                    )?,
+                    Property::Rotation => check_accessor(
+                        &self.path,
+                        &of,
+                        &output,
+                        self.buffers,
+                        &[D::Vec4],
+                        &[T::F32, T::I8, T::U8, T::I16, T::U16],
+                    )?,
+                    Property::MorphTargetWeights => {}
+                }
+            }
             let reader = c.reader(|b| self.buffers.get(b.index()).map(|d| &d.0[..]));
-            let sfield = format!("animations[{}].samplers[{}]", a.index(), c.sampler().index());
             let times: Vec<f32> = reader
                 .read_inputs()
-                .ok_or_else(|| SceneError::invalid(&self.path, format!("{sfield}.input"), "cannot read keyframe times"))?
+                .ok_or_else(|| {
+                    SceneError::invalid(
+                        &self.path,
+                        format!("{sfield}.input"),
+                        "cannot read keyframe times",
+                    )
+                })?
                 .collect();
             if let Some(i) = times.iter().position(|t| !t.is_finite()) {
                 return Err(self.non_finite(format!("{sfield}.input"), i));
             }
             if let Some(i) = times.windows(2).position(|w| w[1] <= w[0]) {
-                return Err(SceneError::invalid(&self.path, format!("{sfield}.input"), format!("times not strictly increasing at element {}", i + 1)));
+                return Err(SceneError::invalid(
+                    &self.path,
+                    format!("{sfield}.input"),
+                    format!("times not strictly increasing at element {}", i + 1),
+                ));
             }
-            let outputs = reader
-                .read_outputs()
-                .ok_or_else(|| SceneError::invalid(&self.path, format!("{sfield}.output"), "cannot read keyframe values"))?;
+            let outputs = reader.read_outputs().ok_or_else(|| {
+                SceneError::invalid(
+                    &self.path,
+                    format!("{sfield}.output"),
+                    "cannot read keyframe values",
+                )
+            })?;
             let (path, values): (TargetPath, Vec<Vec4>) = match outputs {
-                ReadOutputs::Translations(t) => (TargetPath::Translation, t.map(|v| Vec3::from(v).extend(0.0)).collect()),
-                ReadOutputs::Scales(s) => (TargetPath::Scale, s.map(|v| Vec3::from(v).extend(0.0)).collect()),
-                ReadOutputs::Rotations(r) => (TargetPath::Rotation, r.into_f32().map(Vec4::from).collect()),
+                ReadOutputs::Translations(t) => (
+                    TargetPath::Translation,
+                    t.map(|v| Vec3::from(v).extend(0.0)).collect(),
+                ),
+                ReadOutputs::Scales(s) => (
+                    TargetPath::Scale,
+                    s.map(|v| Vec3::from(v).extend(0.0)).collect(),
+                ),
+                ReadOutputs::Rotations(r) => {
+                    (TargetPath::Rotation, r.into_f32().map(Vec4::from).collect())
+                }
                 ReadOutputs::MorphTargetWeights(_) => {
-                    return Ok(Err((format!("{field}.target.path"), "morph target weights cannot be animated".into())))
+                    return Ok(Err((
+                        format!("{field}.target.path"),
+                        "morph target weights cannot be animated".into(),
+                    )))
                 }
             };
             if let Some(i) = values.iter().position(|v| !v.is_finite()) {
@@ -334,17 +622,37 @@ impl Ctx<'_> {
                 gltf::animation::Interpolation::Linear => Interpolation::Linear,
                 gltf::animation::Interpolation::CubicSpline => Interpolation::CubicSpline,
             };
-            let per_key = if interpolation == Interpolation::CubicSpline { 3 } else { 1 };
+            let per_key = if interpolation == Interpolation::CubicSpline {
+                3
+            } else {
+                1
+            };
             if values.len() != per_key * times.len() {
                 return Err(SceneError::invalid(
                     &self.path,
                     format!("{sfield}.output"),
-                    format!("{} values for {} keyframes ({:?} needs {per_key} per keyframe)", values.len(), times.len(), interpolation),
+                    format!(
+                        "{} values for {} keyframes ({:?} needs {per_key} per keyframe)",
+                        values.len(),
+                        times.len(),
+                        interpolation
+                    ),
                 ));
             }
-            channels.push(Channel { node, path, sampler: Sampler { interpolation, times, values } });
+            channels.push(Channel {
+                node,
+                path,
+                sampler: Sampler {
+                    interpolation,
+                    times,
+                    values,
+                },
+            });
         }
-        Ok(Ok(Animation { name: name.to_owned(), channels }))
+        Ok(Ok(Animation {
+            name: name.to_owned(),
+            channels,
+        }))
     }
 }
 
@@ -354,10 +662,20 @@ fn triangle_list(mode: Mode, idx: &[u32]) -> Option<Vec<u32>> {
         Mode::Triangles => Some(idx[..idx.len() / 3 * 3].to_vec()),
         Mode::TriangleStrip => Some(
             (2..idx.len())
-                .flat_map(|i| if i % 2 == 0 { [idx[i - 2], idx[i - 1], idx[i]] } else { [idx[i - 1], idx[i - 2], idx[i]] })
+                .flat_map(|i| {
+                    if i % 2 == 0 {
+                        [idx[i - 2], idx[i - 1], idx[i]]
+                    } else {
+                        [idx[i - 1], idx[i - 2], idx[i]]
+                    }
+                })
                 .collect(),
         ),
-        Mode::TriangleFan => Some((2..idx.len()).flat_map(|i| [idx[0], idx[i - 1], idx[i]]).collect()),
+        Mode::TriangleFan => Some(
+            (2..idx.len())
+                .flat_map(|i| [idx[0], idx[i - 1], idx[i]])
+                .collect(),
+        ),
         _ => None,
     }
 }
@@ -377,10 +695,18 @@ fn smooth_normals(positions: &[Vec3], indices: &[u32]) -> Vec<Vec3> {
 
 /// Unshares vertices so each triangle gets its face normal (the glTF rule for missing normals).
 fn flat_shaded(positions: &[Vec3], uvs: &[Vec2], indices: &[u32], material: usize) -> Primitive {
-    let mut out = Primitive { positions: vec![], normals: vec![], uvs: vec![], indices: vec![], material };
+    let mut out = Primitive {
+        positions: vec![],
+        normals: vec![],
+        uvs: vec![],
+        indices: vec![],
+        material,
+    };
     for t in indices.chunks_exact(3) {
         let [a, b, c] = [t[0] as usize, t[1] as usize, t[2] as usize];
-        let n = (positions[b] - positions[a]).cross(positions[c] - positions[a]).normalize_or(Vec3::Y);
+        let n = (positions[b] - positions[a])
+            .cross(positions[c] - positions[a])
+            .normalize_or(Vec3::Y);
         for v in [a, b, c] {
             out.indices.push(out.positions.len() as u32);
             out.positions.push(positions[v]);
@@ -397,8 +723,14 @@ mod tests {
 
     #[test]
     fn strips_and_fans_become_lists() {
-        assert_eq!(triangle_list(Mode::TriangleStrip, &[0, 1, 2, 3]), Some(vec![0, 1, 2, 2, 1, 3]));
-        assert_eq!(triangle_list(Mode::TriangleFan, &[0, 1, 2, 3]), Some(vec![0, 1, 2, 0, 2, 3]));
+        assert_eq!(
+            triangle_list(Mode::TriangleStrip, &[0, 1, 2, 3]),
+            Some(vec![0, 1, 2, 2, 1, 3])
+        );
+        assert_eq!(
+            triangle_list(Mode::TriangleFan, &[0, 1, 2, 3]),
+            Some(vec![0, 1, 2, 0, 2, 3])
+        );
         assert_eq!(triangle_list(Mode::Lines, &[0, 1]), None);
     }
 

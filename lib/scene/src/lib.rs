@@ -4,7 +4,22 @@
 //! The types in [`model`] are the contract between scene loading and the tracer: the tracer
 //! calls [`load`] (or [`load_with`]) once and then [`Scene::frame`] per parameter point.
 //! scene.toml is documented key by key in docs/SCENE.md.
+//!
+//! ```no_run
+//! use std::path::Path;
+//! use pis_scene::{load_with, LoadOptions};
+//!
+//! let options = LoadOptions { preset: Some("paper".into()), spp: Some(4), ..LoadOptions::default() };
+//! let scene = load_with(Path::new("samples/demo1/scene.toml"), &options)?;
+//! for index in 0..scene.space.point_count() {
+//!     let point = scene.space.point(index); // one sample index per dimension
+//!     let frame = scene.frame(&point)?; // camera, lights, one instance per object
+//!     let _eye = frame.camera.world_from_camera.w_axis;
+//! }
+//! # Ok::<(), pis_scene::SceneError>(())
+//! ```
 
+mod accessor_check;
 pub mod animation;
 mod error;
 mod frame;

@@ -25,7 +25,13 @@ pub struct LoadOptions {
 
 /// Loads `scene.toml` at `path` (and the glTF it names) with an optional preset.
 pub fn load(path: &Path, preset: Option<&str>) -> Result<Scene, SceneError> {
-    load_with(path, &LoadOptions { preset: preset.map(str::to_owned), ..LoadOptions::default() })
+    load_with(
+        path,
+        &LoadOptions {
+            preset: preset.map(str::to_owned),
+            ..LoadOptions::default()
+        },
+    )
 }
 
 /// Loads `scene.toml` at `path` with the given overrides.
@@ -34,9 +40,15 @@ pub fn load_with(path: &Path, options: &LoadOptions) -> Result<Scene, SceneError
     if let Some(preset) = &options.preset {
         m.apply_preset(preset, path)?;
     }
-    let (width, height) = options.resolution.unwrap_or((m.resolution[0], m.resolution[1]));
+    let (width, height) = options
+        .resolution
+        .unwrap_or((m.resolution[0], m.resolution[1]));
     if width == 0 || height == 0 {
-        return Err(SceneError::invalid(path, "resolution", format!("{width}x{height} has a zero side")));
+        return Err(SceneError::invalid(
+            path,
+            "resolution",
+            format!("{width}x{height} has a zero side"),
+        ));
     }
     let spp = options.spp.unwrap_or(m.spp);
     if spp == 0 {
@@ -50,7 +62,13 @@ pub fn load_with(path: &Path, options: &LoadOptions) -> Result<Scene, SceneError
     for (name, spec) in &m.objects {
         let Some(obj) = g.objects.iter_mut().find(|o| &o.name == name) else {
             let known = g.objects.iter().map(|o| o.name.as_str());
-            return Err(SceneError::unknown(path, format!("object.{name}"), "object", name, known));
+            return Err(SceneError::unknown(
+                path,
+                format!("object.{name}"),
+                "object",
+                name,
+                known,
+            ));
         };
         if let Some(role) = spec.role {
             obj.role = match role {
@@ -62,10 +80,20 @@ pub fn load_with(path: &Path, options: &LoadOptions) -> Result<Scene, SceneError
     }
 
     let space = build_space(&m.dimensions, &g, path)?;
-    g.rig.camera = resolve_camera(&m, &g, path, space.dims.iter().any(|d| matches!(d.driver, crate::Driver::Orbit { .. })))?;
+    g.rig.camera = resolve_camera(
+        &m,
+        &g,
+        path,
+        space
+            .dims
+            .iter()
+            .any(|d| matches!(d.driver, crate::Driver::Orbit { .. })),
+    )?;
 
     let name = m.name.clone().unwrap_or_else(|| {
-        dir.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_else(|| "scene".to_owned())
+        dir.file_name()
+            .map(|n| n.to_string_lossy().into_owned())
+            .unwrap_or_else(|| "scene".to_owned())
     });
     Ok(Scene {
         name,
@@ -80,7 +108,12 @@ pub fn load_with(path: &Path, options: &LoadOptions) -> Result<Scene, SceneError
 }
 
 /// The camera from `[camera]`, else the first glTF camera, else (with an orbit) a placeholder.
-fn resolve_camera(m: &Manifest, g: &crate::gltf_load::GltfScene, path: &Path, has_orbit: bool) -> Result<CameraRig, SceneError> {
+fn resolve_camera(
+    m: &Manifest,
+    g: &crate::gltf_load::GltfScene,
+    path: &Path,
+    has_orbit: bool,
+) -> Result<CameraRig, SceneError> {
     let spec = m.camera.clone().unwrap_or_default();
     let mut rig = CameraRig::default();
     let mut gltf_camera = None;
@@ -88,21 +121,41 @@ fn resolve_camera(m: &Manifest, g: &crate::gltf_load::GltfScene, path: &Path, ha
         let found = g.cameras.iter().find(|c| &g.rig.nodes[c.node].name == name);
         let Some(c) = found else {
             let known = g.cameras.iter().map(|c| g.rig.nodes[c.node].name.as_str());
-            return Err(SceneError::unknown(path, "camera.node", "camera", name, known));
+            return Err(SceneError::unknown(
+                path,
+                "camera.node",
+                "camera",
+                name,
+                known,
+            ));
         };
         if spec.eye.is_some() || spec.target.is_some() {
-            return Err(SceneError::invalid(path, "camera.eye", "give either `node` or `eye`/`target`, not both"));
+            return Err(SceneError::invalid(
+                path,
+                "camera.eye",
+                "give either `node` or `eye`/`target`, not both",
+            ));
         }
         gltf_camera = Some(c);
     } else if let Some(eye) = spec.eye {
-        let target = spec.target.ok_or_else(|| SceneError::invalid(path, "camera.target", "required with `eye`"))?;
+        let target = spec
+            .target
+            .ok_or_else(|| SceneError::invalid(path, "camera.target", "required with `eye`"))?;
         let up = spec.up.map(Vec3::from).unwrap_or(Vec3::Y);
         if Vec3::from(eye) == Vec3::from(target) {
-            return Err(SceneError::invalid(path, "camera.target", "equals camera.eye"));
+            return Err(SceneError::invalid(
+                path,
+                "camera.target",
+                "equals camera.eye",
+            ));
         }
         rig.placement = CameraPlacement::Fixed(look_at(eye.into(), target.into(), up));
     } else if spec.target.is_some() {
-        return Err(SceneError::invalid(path, "camera.eye", "required with `target`"));
+        return Err(SceneError::invalid(
+            path,
+            "camera.eye",
+            "required with `target`",
+        ));
     } else if let Some(c) = g.cameras.first() {
         gltf_camera = Some(c);
     } else if !has_orbit {
@@ -120,7 +173,11 @@ fn resolve_camera(m: &Manifest, g: &crate::gltf_load::GltfScene, path: &Path, ha
     }
     if let Some(deg) = spec.yfov_deg {
         if !(deg > 0.0 && deg < 180.0) {
-            return Err(SceneError::invalid(path, "camera.yfov_deg", format!("must be in (0, 180), found {deg}")));
+            return Err(SceneError::invalid(
+                path,
+                "camera.yfov_deg",
+                format!("must be in (0, 180), found {deg}"),
+            ));
         }
         rig.yfov = deg.to_radians();
     }
@@ -131,7 +188,14 @@ fn resolve_camera(m: &Manifest, g: &crate::gltf_load::GltfScene, path: &Path, ha
         rig.zfar = z;
     }
     if !(rig.znear > 0.0 && rig.zfar > rig.znear) {
-        return Err(SceneError::invalid(path, "camera.znear", format!("need 0 < znear < zfar, found {} and {}", rig.znear, rig.zfar)));
+        return Err(SceneError::invalid(
+            path,
+            "camera.znear",
+            format!(
+                "need 0 < znear < zfar, found {} and {}",
+                rig.znear, rig.zfar
+            ),
+        ));
     }
     Ok(rig)
 }

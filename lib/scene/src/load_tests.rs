@@ -61,6 +61,15 @@ impl Fixture {
         bin.extend(f32s(&times)); // 36..48
         bin.extend(f32s(&rotations)); // 48..96
         bin.extend(f32s(&hops)); // 96..132
+                                 // CUBICSPLINE translation keys (in-tangent, value, out-tangent) × 3.
+        let bob = [
+            0.0f32, 0.0, 0.0, /**/ 0.0, 0.0, 0.0, /**/ 1.0, 0.0,
+            0.0, // key 0: value 0, out 1
+            0.0, 0.0, 0.0, /**/ 1.0, 0.0, 0.0, /**/ 0.0, 0.0,
+            0.0, // key 1: in 0, value 1
+            0.0, 0.0, 0.0, /**/ 1.0, 0.0, 0.0, /**/ 0.0, 0.0, 0.0, // key 2: value 1
+        ];
+        bin.extend(f32s(&bob)); // 132..240
         let mut doc = json!({
             "asset": {"version": "2.0"},
             "extensionsUsed": ["KHR_lights_punctual"],
@@ -82,24 +91,32 @@ impl Fixture {
                 {"buffer": 0, "byteOffset": 0, "byteLength": 36},
                 {"buffer": 0, "byteOffset": 36, "byteLength": 12},
                 {"buffer": 0, "byteOffset": 48, "byteLength": 48},
-                {"buffer": 0, "byteOffset": 96, "byteLength": 36}
+                {"buffer": 0, "byteOffset": 96, "byteLength": 36},
+                {"buffer": 0, "byteOffset": 132, "byteLength": 108}
             ],
             "accessors": [
                 {"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3", "min": [0, 0, 0], "max": [1, 1, 0]},
                 {"bufferView": 1, "componentType": 5126, "count": 3, "type": "SCALAR", "min": [0], "max": [2]},
                 {"bufferView": 2, "componentType": 5126, "count": 3, "type": "VEC4"},
-                {"bufferView": 3, "componentType": 5126, "count": 3, "type": "VEC3"}
+                {"bufferView": 3, "componentType": 5126, "count": 3, "type": "VEC3"},
+                {"bufferView": 4, "componentType": 5126, "count": 9, "type": "VEC3"}
             ],
             "animations": [
                 {"name": "spin", "samplers": [{"input": 1, "output": 2, "interpolation": "LINEAR"}],
                  "channels": [{"sampler": 0, "target": {"node": 0, "path": "rotation"}}]},
                 {"name": "hop", "samplers": [{"input": 1, "output": 3, "interpolation": "STEP"}],
-                 "channels": [{"sampler": 0, "target": {"node": 2, "path": "translation"}}]}
+                 "channels": [{"sampler": 0, "target": {"node": 2, "path": "translation"}}]},
+                {"name": "bob", "samplers": [{"input": 1, "output": 4, "interpolation": "CUBICSPLINE"}],
+                 "channels": [{"sampler": 0, "target": {"node": 0, "path": "translation"}}]}
             ]
         });
         edit(&mut doc, &mut bin);
         let dir = tempfile::tempdir().expect("temp dir");
-        std::fs::write(dir.path().join("scene.gltf"), serde_json::to_vec_pretty(&doc).expect("json")).expect("write");
+        std::fs::write(
+            dir.path().join("scene.gltf"),
+            serde_json::to_vec_pretty(&doc).expect("json"),
+        )
+        .expect("write");
         std::fs::write(dir.path().join("scene.bin"), &bin).expect("write");
         std::fs::write(dir.path().join("scene.toml"), toml).expect("write");
         Fixture { dir }
@@ -147,7 +164,11 @@ fn preset_and_overrides() {
     let s = load(&f.toml(), Some("paper")).unwrap();
     assert_eq!(s.resolution, (64, 48));
     assert_eq!(s.space.point_count(), 24);
-    let opts = LoadOptions { preset: Some("paper".into()), resolution: Some((10, 5)), spp: Some(9) };
+    let opts = LoadOptions {
+        preset: Some("paper".into()),
+        resolution: Some((10, 5)),
+        spp: Some(9),
+    };
     let s = load_with(&f.toml(), &opts).unwrap();
     assert_eq!((s.resolution, s.spp), ((10, 5), 9));
 }
@@ -168,9 +189,17 @@ fn frame_poses_animation_and_orbit() {
     // spin sample 1 (t = 1): 90° about +Y; the node keeps its translation.
     let frame = s.frame(&[1, 0]).unwrap();
     let m = frame.instances[0].world_from_object;
-    assert!(m.transform_point3(Vec3::X).distance(Vec3::new(1.0, 0.0, -1.0)) < 1e-5);
+    assert!(
+        m.transform_point3(Vec3::X)
+            .distance(Vec3::new(1.0, 0.0, -1.0))
+            < 1e-5
+    );
     let (_, r, _) = m.to_scale_rotation_translation();
-    assert!(r.dot(Quat::from_rotation_y(std::f32::consts::FRAC_PI_2)).abs() > 1.0 - 1e-6);
+    assert!(
+        r.dot(Quat::from_rotation_y(std::f32::consts::FRAC_PI_2))
+            .abs()
+            > 1.0 - 1e-6
+    );
     // The light stays at its node (hop is not a dimension).
     assert_eq!(frame.lights[0].position, Vec3::new(0.0, 2.0, 0.0));
     assert_eq!(frame.lights[0].name, "Lamp");
@@ -195,11 +224,81 @@ time = [0, 2]
     assert_eq!(s.space.dims[0].kind, crate::DimensionKind::Light);
     // No [camera]: the first glTF camera, at (0, 1, 5).
     let frame = s.frame(&[1]).unwrap();
-    assert_eq!(frame.camera.world_from_camera.transform_point3(Vec3::ZERO), Vec3::new(0.0, 1.0, 5.0));
+    assert_eq!(
+        frame.camera.world_from_camera.transform_point3(Vec3::ZERO),
+        Vec3::new(0.0, 1.0, 5.0)
+    );
     // STEP: t = 0.5 holds the first keyframe, t = 1.5 the second.
     assert_eq!(frame.lights[0].position, Vec3::new(0.0, 2.0, 0.0));
-    assert_eq!(s.frame(&[3]).unwrap().lights[0].position, Vec3::new(0.0, 3.0, 0.0));
-    assert_eq!(s.frame(&[4]).unwrap().lights[0].position, Vec3::new(0.0, 4.0, 0.0));
+    assert_eq!(
+        s.frame(&[3]).unwrap().lights[0].position,
+        Vec3::new(0.0, 3.0, 0.0)
+    );
+    assert_eq!(
+        s.frame(&[4]).unwrap().lights[0].position,
+        Vec3::new(0.0, 4.0, 0.0)
+    );
+}
+
+#[test]
+fn cubic_spline_animation_through_gltf() {
+    let toml = r#"
+gltf = "scene.gltf"
+resolution = [8, 8]
+spp = 1
+[[dimension]]
+name = "bob"
+driver = "animation"
+animation = "bob"
+samples = 3
+time = [0, 1]
+"#;
+    let f = Fixture::new(toml, |_, _| {});
+    let s = load(&f.toml(), None).unwrap();
+    assert_eq!(s.space.dims[0].kind, crate::DimensionKind::Time);
+    // Hermite at s = 0.5, dt = 1: 0.125·m0 + 0.5·p1 = 0.125·1 + 0.5·1 = 0.625.
+    let x = |i: u32| {
+        s.frame(&[i]).unwrap().instances[0]
+            .world_from_object
+            .w_axis
+            .x
+    };
+    assert_eq!(x(0), 0.0);
+    assert!((x(1) - 0.625).abs() < 1e-6, "{}", x(1));
+    assert_eq!(x(2), 1.0);
+}
+
+#[test]
+fn loads_binary_gltf() {
+    let f = Fixture::new(&TOML.replace("scene.gltf", "scene.glb"), |_, _| {});
+    // Repack scene.gltf + scene.bin as a GLB: header, JSON chunk, BIN chunk (4-byte aligned).
+    let dir = f.dir.path();
+    let mut doc: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(dir.join("scene.gltf")).unwrap()).unwrap();
+    let mut bin = std::fs::read(dir.join("scene.bin")).unwrap();
+    doc["buffers"][0].as_object_mut().unwrap().remove("uri");
+    let mut json = serde_json::to_vec(&doc).unwrap();
+    while json.len() % 4 != 0 {
+        json.push(b' ');
+    }
+    while bin.len() % 4 != 0 {
+        bin.push(0);
+    }
+    let total = 12 + 8 + json.len() + 8 + bin.len();
+    let mut glb = Vec::new();
+    glb.extend(b"glTF");
+    glb.extend(2u32.to_le_bytes());
+    glb.extend((total as u32).to_le_bytes());
+    glb.extend((json.len() as u32).to_le_bytes());
+    glb.extend(b"JSON");
+    glb.extend(&json);
+    glb.extend((bin.len() as u32).to_le_bytes());
+    glb.extend(b"BIN\0");
+    glb.extend(&bin);
+    std::fs::write(dir.join("scene.glb"), glb).unwrap();
+    let s = load(&f.toml(), None).unwrap();
+    assert_eq!(s.objects[0].primitives[0].positions.len(), 3);
+    assert_eq!(s.space.point_count(), 12);
 }
 
 #[test]
@@ -221,15 +320,24 @@ path = [[-1, 3, 0], [1, 3, 0]]
     let f = Fixture::new(toml, |_, _| {});
     let s = load(&f.toml(), None).unwrap();
     assert_eq!(s.space.dims[0].kind, crate::DimensionKind::Light);
-    assert_eq!(s.frame(&[1]).unwrap().lights[0].position, Vec3::new(0.0, 3.0, 0.0));
-    assert_eq!(s.frame(&[2]).unwrap().lights[0].position, Vec3::new(1.0, 3.0, 0.0));
+    assert_eq!(
+        s.frame(&[1]).unwrap().lights[0].position,
+        Vec3::new(0.0, 3.0, 0.0)
+    );
+    assert_eq!(
+        s.frame(&[2]).unwrap().lights[0].position,
+        Vec3::new(1.0, 3.0, 0.0)
+    );
 }
 
 #[test]
 fn role_override() {
     let toml = format!("{TOML}\n[object.Tri]\nrole = \"diffuse\"\n");
     let f = Fixture::new(&toml, |_, _| {});
-    assert_eq!(load(&f.toml(), None).unwrap().objects[0].role, ObjectRole::Diffuse);
+    assert_eq!(
+        load(&f.toml(), None).unwrap().objects[0].role,
+        ObjectRole::Diffuse
+    );
 }
 
 #[test]
@@ -243,29 +351,53 @@ fn error_missing_scene_toml() {
 fn error_missing_gltf() {
     let f = Fixture::new(&TOML.replace("scene.gltf", "other.gltf"), |_, _| {});
     let err = load_err(&f);
-    assert!(matches!(err, SceneError::Io { .. }) && err.to_string().contains("other.gltf"), "{err}");
+    assert!(
+        matches!(err, SceneError::Io { .. }) && err.to_string().contains("other.gltf"),
+        "{err}"
+    );
 }
 
 #[test]
 fn error_missing_buffer() {
     let f = Fixture::new(TOML, |doc, _| doc["buffers"][0]["uri"] = json!("gone.bin"));
     let err = load_err(&f);
-    assert!(matches!(err, SceneError::Gltf { .. }) && err.to_string().contains("scene.gltf"), "{err}");
+    assert!(
+        matches!(err, SceneError::Gltf { .. }) && err.to_string().contains("scene.gltf"),
+        "{err}"
+    );
 }
 
 #[test]
 fn error_unknown_camera() {
     let f = Fixture::new(&TOML.replace("node = \"Cam\"", "node = \"Kam\""), |_, _| {});
     let err = load_err(&f);
-    assert!(matches!(err, SceneError::UnknownName { what: "camera", .. }), "{err}");
-    assert!(err.to_string().contains("camera.node") && err.to_string().contains("Cam"), "{err}");
+    assert!(
+        matches!(err, SceneError::UnknownName { what: "camera", .. }),
+        "{err}"
+    );
+    assert!(
+        err.to_string().contains("camera.node") && err.to_string().contains("Cam"),
+        "{err}"
+    );
 }
 
 #[test]
 fn error_unknown_animation() {
-    let f = Fixture::new(&TOML.replace("animation = \"spin\"", "animation = \"spun\""), |_, _| {});
+    let f = Fixture::new(
+        &TOML.replace("animation = \"spin\"", "animation = \"spun\""),
+        |_, _| {},
+    );
     let err = load_err(&f);
-    assert!(matches!(err, SceneError::UnknownName { what: "animation", .. }), "{err}");
+    assert!(
+        matches!(
+            err,
+            SceneError::UnknownName {
+                what: "animation",
+                ..
+            }
+        ),
+        "{err}"
+    );
     assert!(err.to_string().contains("dimension[0].animation"), "{err}");
 }
 
@@ -274,13 +406,22 @@ fn error_unknown_light() {
     let toml = "gltf = \"scene.gltf\"\nresolution = [8, 8]\nspp = 1\n[[dimension]]\nname = \"l\"\ndriver = \"light_path\"\nlight = \"Sun\"\nsamples = 2\npath = [[0, 0, 0]]\n";
     let f = Fixture::new(toml, |_, _| {});
     let err = load_err(&f);
-    assert!(matches!(err, SceneError::UnknownName { what: "light", .. }), "{err}");
+    assert!(
+        matches!(err, SceneError::UnknownName { what: "light", .. }),
+        "{err}"
+    );
 }
 
 #[test]
 fn error_unknown_object() {
-    let f = Fixture::new(&format!("{TOML}\n[object.Vase]\nrole = \"reflective\"\n"), |_, _| {});
-    assert!(matches!(load_err(&f), SceneError::UnknownName { what: "object", .. }));
+    let f = Fixture::new(
+        &format!("{TOML}\n[object.Vase]\nrole = \"reflective\"\n"),
+        |_, _| {},
+    );
+    assert!(matches!(
+        load_err(&f),
+        SceneError::UnknownName { what: "object", .. }
+    ));
 }
 
 #[test]
@@ -288,41 +429,66 @@ fn error_zero_samples() {
     let f = Fixture::new(&TOML.replace("samples = 4", "samples = 0"), |_, _| {});
     let err = load_err(&f);
     assert!(matches!(err, SceneError::ZeroSamples { .. }), "{err}");
-    assert!(err.to_string().contains("dimension[1].samples") && err.to_string().contains("view"), "{err}");
+    assert!(
+        err.to_string().contains("dimension[1].samples") && err.to_string().contains("view"),
+        "{err}"
+    );
 }
 
 #[test]
 fn error_unknown_toml_key() {
     let f = Fixture::new(&TOML.replace("spp = 2", "spp = 2\nspf = 3"), |_, _| {});
     let err = load_err(&f);
-    assert!(matches!(err, SceneError::Toml { .. }) && err.to_string().contains("spf"), "{err}");
+    assert!(
+        matches!(err, SceneError::Toml { .. }) && err.to_string().contains("spf"),
+        "{err}"
+    );
 }
 
 #[test]
 fn error_key_of_another_driver() {
-    let f = Fixture::new(&TOML.replace("radius = 4", "radius = 4\nanimation = \"spin\""), |_, _| {});
+    let f = Fixture::new(
+        &TOML.replace("radius = 4", "radius = 4\nanimation = \"spin\""),
+        |_, _| {},
+    );
     let err = load_err(&f);
     assert!(err.to_string().contains("dimension[1].animation"), "{err}");
 }
 
 #[test]
 fn error_nan_in_buffer() {
-    let f = Fixture::new(TOML, |_, bin| bin[12..16].copy_from_slice(&f32::NAN.to_le_bytes()));
+    let f = Fixture::new(TOML, |_, bin| {
+        bin[12..16].copy_from_slice(&f32::NAN.to_le_bytes())
+    });
     let err = load_err(&f);
-    assert!(matches!(err, SceneError::NonFinite { element: 1, .. }), "{err}");
-    assert!(err.to_string().contains("meshes[0].primitives[0].attributes.POSITION"), "{err}");
+    assert!(
+        matches!(err, SceneError::NonFinite { element: 1, .. }),
+        "{err}"
+    );
+    assert!(
+        err.to_string()
+            .contains("meshes[0].primitives[0].attributes.POSITION"),
+        "{err}"
+    );
 }
 
 #[test]
 fn error_inf_in_animation() {
-    let f = Fixture::new(TOML, |_, bin| bin[52..56].copy_from_slice(&f32::INFINITY.to_le_bytes()));
+    let f = Fixture::new(TOML, |_, bin| {
+        bin[52..56].copy_from_slice(&f32::INFINITY.to_le_bytes())
+    });
     let err = load_err(&f);
-    assert!(err.to_string().contains("animations[0].samplers[0].output"), "{err}");
+    assert!(
+        err.to_string().contains("animations[0].samplers[0].output"),
+        "{err}"
+    );
 }
 
 #[test]
 fn error_required_extension() {
-    let f = Fixture::new(TOML, |doc, _| doc["extensionsRequired"] = json!(["KHR_draco_mesh_compression"]));
+    let f = Fixture::new(TOML, |doc, _| {
+        doc["extensionsRequired"] = json!(["KHR_draco_mesh_compression"])
+    });
     let err = load_err(&f);
     assert!(matches!(err, SceneError::Unsupported { .. }), "{err}");
     assert!(err.to_string().contains("extensionsRequired"), "{err}");
@@ -330,31 +496,152 @@ fn error_required_extension() {
 
 #[test]
 fn error_non_triangle_primitive() {
-    let f = Fixture::new(TOML, |doc, _| doc["meshes"][0]["primitives"][0]["mode"] = json!(1));
+    let f = Fixture::new(TOML, |doc, _| {
+        doc["meshes"][0]["primitives"][0]["mode"] = json!(1)
+    });
     let err = load_err(&f);
     assert!(matches!(err, SceneError::Unsupported { .. }), "{err}");
-    assert!(err.to_string().contains("meshes[0].primitives[0].mode"), "{err}");
+    assert!(
+        err.to_string().contains("meshes[0].primitives[0].mode"),
+        "{err}"
+    );
 }
 
 #[test]
 fn error_point_out_of_range() {
     let f = Fixture::new(TOML, |_, _| {});
     let s = load(&f.toml(), None).unwrap();
-    assert!(matches!(s.frame(&[3, 0]), Err(SceneError::PointOutOfRange { .. })));
-    assert!(matches!(s.frame(&[0]), Err(SceneError::PointOutOfRange { .. })));
+    assert!(matches!(
+        s.frame(&[3, 0]),
+        Err(SceneError::PointOutOfRange { .. })
+    ));
+    assert!(matches!(
+        s.frame(&[0]),
+        Err(SceneError::PointOutOfRange { .. })
+    ));
 }
 
 #[test]
 fn error_unknown_preset() {
     let f = Fixture::new(TOML, |_, _| {});
     let err = load(&f.toml(), Some("huge")).unwrap_err();
-    assert!(matches!(err, SceneError::UnknownName { what: "preset", .. }) && err.to_string().contains("paper"), "{err}");
+    assert!(
+        matches!(err, SceneError::UnknownName { what: "preset", .. })
+            && err.to_string().contains("paper"),
+        "{err}"
+    );
 }
 
 #[test]
 fn hand_built_scene_has_identity_instances() {
     let mut s = crate::Scene::default();
-    s.objects.push(crate::SceneObject { name: "o".into(), role: ObjectRole::Diffuse, primitives: vec![] });
+    s.objects.push(crate::SceneObject {
+        name: "o".into(),
+        role: ObjectRole::Diffuse,
+        primitives: vec![],
+    });
     let frame = s.frame(&[]).unwrap();
     assert_eq!(frame.instances[0].world_from_object, glam::Mat4::IDENTITY);
+}
+
+/// Damaged inputs must give an error (or load), never a panic: every numeric field of the
+/// glTF JSON set to a few hostile values, and the buffer truncated at every length.
+#[test]
+fn damaged_gltf_errors_without_panicking() {
+    fn numeric_paths(v: &serde_json::Value, path: Vec<String>, out: &mut Vec<Vec<String>>) {
+        match v {
+            serde_json::Value::Number(_) => out.push(path),
+            serde_json::Value::Array(a) => {
+                for (i, x) in a.iter().enumerate() {
+                    let mut p = path.clone();
+                    p.push(i.to_string());
+                    numeric_paths(x, p, out);
+                }
+            }
+            serde_json::Value::Object(o) => {
+                for (k, x) in o {
+                    let mut p = path.clone();
+                    p.push(k.clone());
+                    numeric_paths(x, p, out);
+                }
+            }
+            _ => {}
+        }
+    }
+    let base = Fixture::new(TOML, |_, _| {});
+    let doc: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(base.dir.path().join("scene.gltf")).unwrap())
+            .unwrap();
+    let mut paths = Vec::new();
+    numeric_paths(&doc, vec![], &mut paths);
+    for path in &paths {
+        for value in [
+            json!(0),
+            json!(1),
+            json!(7),
+            json!(1_000_000),
+            json!(-1),
+            json!(0.5),
+        ] {
+            let f = Fixture::new(TOML, |d, _| {
+                let mut slot = &mut *d;
+                for key in path {
+                    slot = match slot {
+                        serde_json::Value::Array(a) => &mut a[key.parse::<usize>().unwrap()],
+                        other => &mut other[key.as_str()],
+                    };
+                }
+                *slot = value.clone();
+            });
+            let result = std::panic::catch_unwind(|| {
+                load(&f.toml(), None).map(|s| s.frame_at(0).map(|_| ()))
+            });
+            assert!(result.is_ok(), "panic with {} = {value}", path.join("."));
+        }
+    }
+    let bin_len = std::fs::read(base.dir.path().join("scene.bin"))
+        .unwrap()
+        .len();
+    for len in 0..bin_len {
+        let f = Fixture::new(TOML, |_, bin| bin.truncate(len));
+        let result = std::panic::catch_unwind(|| load(&f.toml(), None).map(|_| ()));
+        assert!(result.is_ok(), "panic with the buffer cut to {len} bytes");
+    }
+}
+
+#[test]
+fn error_accessor_past_its_buffer_view() {
+    let f = Fixture::new(TOML, |doc, _| doc["accessors"][0]["count"] = json!(1000));
+    let err = load_err(&f);
+    let msg = err.to_string();
+    assert!(
+        msg.contains("meshes[0].primitives[0].attributes.POSITION (accessors[0])"),
+        "{msg}"
+    );
+    assert!(msg.contains("exceed buffer view 0"), "{msg}");
+}
+
+#[test]
+fn error_animation_target_node_missing() {
+    let f = Fixture::new(TOML, |doc, _| {
+        doc["animations"][0]["channels"][0]["target"]["node"] = json!(9)
+    });
+    let err = load_err(&f);
+    assert!(
+        err.to_string()
+            .contains("animations[0].channels[0].target.node"),
+        "{err}"
+    );
+}
+
+#[test]
+fn error_normal_accessor_of_wrong_type() {
+    let f = Fixture::new(TOML, |doc, _| {
+        doc["meshes"][0]["primitives"][0]["attributes"]["NORMAL"] = json!(1)
+    });
+    let err = load_err(&f);
+    assert!(
+        err.to_string().contains("expected [Vec3] of [F32]"),
+        "{err}"
+    );
 }

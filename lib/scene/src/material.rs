@@ -10,13 +10,19 @@ pub fn convert_material(m: &gltf::Material) -> Material {
     let strength = m.emissive_strength().unwrap_or(1.0);
     let e = m.emissive_factor();
     let mut mat = Material {
-        name: m.name().map(str::to_owned).unwrap_or_else(|| format!("material{}", m.index().unwrap_or(0))),
+        name: m
+            .name()
+            .map(str::to_owned)
+            .unwrap_or_else(|| format!("material{}", m.index().unwrap_or(0))),
         base_color: pbr.base_color_factor(),
         base_color_texture: None,
         metallic: pbr.metallic_factor(),
         roughness: pbr.roughness_factor(),
         emissive: [e[0] * strength, e[1] * strength, e[2] * strength],
-        transmission: m.transmission().map(|t| t.transmission_factor()).unwrap_or(0.0),
+        transmission: m
+            .transmission()
+            .map(|t| t.transmission_factor())
+            .unwrap_or(0.0),
         ior: m.ior().unwrap_or(1.5),
         ..Material::default()
     };
@@ -54,7 +60,11 @@ pub fn infer_role(materials: &[&Material]) -> ObjectRole {
         ObjectRole::Reflective => 1,
         ObjectRole::Refractive => 2,
     };
-    materials.iter().map(|m| material_role(m)).max_by_key(|r| rank(*r)).unwrap_or(ObjectRole::Diffuse)
+    materials
+        .iter()
+        .map(|m| material_role(m))
+        .max_by_key(|r| rank(*r))
+        .unwrap_or(ObjectRole::Diffuse)
 }
 
 #[cfg(test)]
@@ -62,7 +72,12 @@ mod tests {
     use super::*;
 
     fn mat(metallic: f32, roughness: f32, transmission: f32) -> Material {
-        Material { metallic, roughness, transmission, ..Material::default() }
+        Material {
+            metallic,
+            roughness,
+            transmission,
+            ..Material::default()
+        }
     }
 
     #[test]

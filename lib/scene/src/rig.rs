@@ -44,7 +44,12 @@ pub struct CameraRig {
 
 impl Default for CameraRig {
     fn default() -> Self {
-        CameraRig { placement: CameraPlacement::Fixed(Mat4::IDENTITY), yfov: 45f32.to_radians(), znear: 0.01, zfar: f32::INFINITY }
+        CameraRig {
+            placement: CameraPlacement::Fixed(Mat4::IDENTITY),
+            yfov: 45f32.to_radians(),
+            znear: 0.01,
+            zfar: f32::INFINITY,
+        }
     }
 }
 
@@ -105,7 +110,10 @@ pub fn rigid_part(m: Mat4) -> Mat4 {
 
 /// Position and pointing direction (local -Z) of a light node's world transform.
 pub fn light_pose(m: Mat4) -> (Vec3, Vec3) {
-    (m.transform_point3(Vec3::ZERO), m.transform_vector3(Vec3::NEG_Z).normalize_or(Vec3::NEG_Z))
+    (
+        m.transform_point3(Vec3::ZERO),
+        m.transform_vector3(Vec3::NEG_Z).normalize_or(Vec3::NEG_Z),
+    )
 }
 
 #[cfg(test)]
@@ -117,23 +125,43 @@ mod tests {
     fn world_transforms_compose_parent_first() {
         let rig = Rig {
             nodes: vec![
-                Node { name: "a".into(), gltf_index: 0, parent: None, local: Trs { translation: Vec3::X, ..Trs::default() } },
+                Node {
+                    name: "a".into(),
+                    gltf_index: 0,
+                    parent: None,
+                    local: Trs {
+                        translation: Vec3::X,
+                        ..Trs::default()
+                    },
+                },
                 Node {
                     name: "b".into(),
                     gltf_index: 1,
                     parent: Some(0),
-                    local: Trs { translation: Vec3::Y, rotation: Quat::from_rotation_z(1.0), scale: Vec3::ONE },
+                    local: Trs {
+                        translation: Vec3::Y,
+                        rotation: Quat::from_rotation_z(1.0),
+                        scale: Vec3::ONE,
+                    },
                 },
             ],
             ..Rig::default()
         };
         let w = rig.world_transforms(&rig.rest_pose());
-        assert!(w[1].transform_point3(Vec3::ZERO).distance(Vec3::new(1.0, 1.0, 0.0)) < 1e-6);
+        assert!(
+            w[1].transform_point3(Vec3::ZERO)
+                .distance(Vec3::new(1.0, 1.0, 0.0))
+                < 1e-6
+        );
     }
 
     #[test]
     fn rigid_part_removes_scale() {
-        let m = Mat4::from_scale_rotation_translation(Vec3::splat(3.0), Quat::from_rotation_y(0.5), Vec3::Z);
+        let m = Mat4::from_scale_rotation_translation(
+            Vec3::splat(3.0),
+            Quat::from_rotation_y(0.5),
+            Vec3::Z,
+        );
         let r = rigid_part(m);
         assert!((r.determinant() - 1.0).abs() < 1e-5);
         assert!(r.transform_point3(Vec3::ZERO).distance(Vec3::Z) < 1e-6);

@@ -27,16 +27,21 @@ pub fn decode(image: &Data, srgb: bool) -> TextureImage {
         Format::R8 | Format::R8G8 | Format::R8G8B8 | Format::R8G8B8A8 => {
             image.pixels.iter().map(|&b| b as f32 / 255.0).collect()
         }
-        Format::R16 | Format::R16G16 | Format::R16G16B16 | Format::R16G16B16A16 => {
-            image.pixels.chunks_exact(2).map(|b| u16::from_ne_bytes([b[0], b[1]]) as f32 / 65535.0).collect()
-        }
+        Format::R16 | Format::R16G16 | Format::R16G16B16 | Format::R16G16B16A16 => image
+            .pixels
+            .chunks_exact(2)
+            .map(|b| u16::from_ne_bytes([b[0], b[1]]) as f32 / 65535.0)
+            .collect(),
         Format::R32G32B32FLOAT | Format::R32G32B32A32FLOAT => image
             .pixels
             .chunks_exact(4)
             .map(|b| f32::from_ne_bytes([b[0], b[1], b[2], b[3]]))
             .collect(),
     };
-    let float = matches!(image.format, Format::R32G32B32FLOAT | Format::R32G32B32A32FLOAT);
+    let float = matches!(
+        image.format,
+        Format::R32G32B32FLOAT | Format::R32G32B32A32FLOAT
+    );
     let to_linear = |c: f32| if srgb && !float { srgb_to_linear(c) } else { c };
     let texels = raw
         .chunks_exact(channels)
@@ -48,7 +53,11 @@ pub fn decode(image: &Data, srgb: bool) -> TextureImage {
             [] => [0.0, 0.0, 0.0, 1.0],
         })
         .collect();
-    TextureImage { width: image.width, height: image.height, texels }
+    TextureImage {
+        width: image.width,
+        height: image.height,
+        texels,
+    }
 }
 
 #[cfg(test)]
@@ -65,7 +74,12 @@ mod tests {
 
     #[test]
     fn decodes_rgb8_to_linear_rgba() {
-        let data = Data { pixels: vec![255, 0, 128, 0, 0, 0], format: Format::R8G8B8, width: 2, height: 1 };
+        let data = Data {
+            pixels: vec![255, 0, 128, 0, 0, 0],
+            format: Format::R8G8B8,
+            width: 2,
+            height: 1,
+        };
         let t = decode(&data, true);
         assert_eq!(t.texels.len(), 2);
         assert!((t.texels[0][0] - 1.0).abs() < 1e-6);

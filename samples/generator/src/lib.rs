@@ -1,7 +1,26 @@
-//! The PIS sample scenes, generated procedurally: glTF (JSON + binary buffer) plus
-//! scene.toml for `demo1`, `demo2`, `teapot-pem` and `glass` (seed thesis, sections 4.8.1,
-//! 4.8.2, 5.10 and 6.5). `cargo run -p pis-samples --release -- samples/` regenerates them.
+//! The PIS sample scenes, generated procedurally: glTF (JSON + binary buffer + PNG
+//! textures) plus scene.toml for `demo1`, `demo2`, `teapot-pem` and `glass` (seed thesis,
+//! sections 4.8.1, 4.8.2, 5.10 and 6.5). `cargo run -p pis-samples --release -- samples/`
+//! regenerates them byte for byte.
 
+use std::io;
+use std::path::Path;
+
+pub mod gltf_writer;
 pub mod mesh;
+pub mod scenes;
 pub mod teapot;
 pub mod teapot_data;
+pub mod textures;
+
+/// The sample scene directory names, in generation order.
+pub const SAMPLES: [&str; 4] = ["demo1", "demo2", "teapot-pem", "glass"];
+
+/// Writes every sample scene into `root/<name>/`.
+pub fn generate_all(root: &Path) -> io::Result<()> {
+    scenes::demo1::write(&root.join("demo1"))?;
+    scenes::demo2::write(&root.join("demo2"))?;
+    scenes::teapot_pem::write(&root.join("teapot-pem"))?;
+    scenes::glass::write(&root.join("glass"))?;
+    Ok(())
+}

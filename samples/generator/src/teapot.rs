@@ -18,7 +18,12 @@ fn bernstein(t: f32) -> ([f32; 4], [f32; 4]) {
     let s = 1.0 - t;
     (
         [s * s * s, 3.0 * t * s * s, 3.0 * t * t * s, t * t * t],
-        [-3.0 * s * s, 3.0 * s * s - 6.0 * t * s, 6.0 * t * s - 3.0 * t * t, 3.0 * t * t],
+        [
+            -3.0 * s * s,
+            3.0 * s * s - 6.0 * t * s,
+            6.0 * t * s - 3.0 * t * t,
+            3.0 * t * t,
+        ],
     )
 }
 
@@ -119,7 +124,12 @@ fn tube_orientation(patch: usize) -> f32 {
 /// Tessellates the given patches on a `grid × grid` parameter grid each, scaled by `scale`
 /// and moved by `offset` (the data's base is at y = 0). UVs tile the patches into an atlas of
 /// 8 × 4 cells, one per patch, so every surface point has its own texel.
-pub fn teapot(patches: impl IntoIterator<Item = usize>, grid: usize, scale: f32, offset: Vec3) -> Mesh {
+pub fn teapot(
+    patches: impl IntoIterator<Item = usize>,
+    grid: usize,
+    scale: f32,
+    offset: Vec3,
+) -> Mesh {
     let mut mesh = Mesh::default();
     for patch in patches {
         let sign = if HANDLE.contains(&patch) || SPOUT.contains(&patch) {
@@ -139,9 +149,18 @@ pub fn teapot(patches: impl IntoIterator<Item = usize>, grid: usize, scale: f32,
     mesh
 }
 
-/// All 32 patches.
+/// The flat ring that closes the gap between the lid's edge (radius 1.3) and the rim's
+/// inner edge (radius 1.4) at height 2.4, facing up; the patch data leaves it open.
+pub fn lid_seal(segments: usize, scale: f32, offset: Vec3) -> Mesh {
+    crate::mesh::lathe(&[vec![Vec2::new(1.4, 2.4), Vec2::new(1.3, 2.4)]], segments)
+        .scaled_translated(scale, offset)
+}
+
+/// All 32 patches plus the [`lid_seal`]: a closed-looking solid for glass.
 pub fn whole_teapot(grid: usize, scale: f32, offset: Vec3) -> Mesh {
-    teapot(0..32, grid, scale, offset)
+    let mut m = teapot(0..32, grid, scale, offset);
+    m.append(&lid_seal(4 * grid, scale, offset));
+    m
 }
 
 #[cfg(test)]
@@ -151,11 +170,14 @@ mod tests {
     #[test]
     fn patches_join_and_span_the_known_extent() {
         let m = whole_teapot(4, 1.0, Vec3::ZERO);
-        assert_eq!(m.triangle_count() > 32 * 4 * 4, true);
+        assert!(m.triangle_count() > 32 * 4 * 4);
         let max = m.positions.iter().fold(Vec3::splat(-9.0), |a, p| a.max(*p));
         let min = m.positions.iter().fold(Vec3::splat(9.0), |a, p| a.min(*p));
         // Spout tip at x ≈ 3.4–3.5, handle at x = -3, lid knob at y = 3.15, base at y = 0.
-        assert!(max.y > 3.1 && max.y < 3.2 && min.y.abs() < 1e-6, "{min} {max}");
+        assert!(
+            max.y > 3.1 && max.y < 3.2 && min.y.abs() < 1e-6,
+            "{min} {max}"
+        );
         assert!(min.x < -2.9 && max.x > 3.3, "{min} {max}");
     }
 

@@ -4,6 +4,7 @@
 //! four along the patch's v direction) and 306 control points, z up, the body 3.15 units
 //! tall. Groups: rim 0–3, body 4–11, handle 12–15, spout 16–19, lid 20–27, bottom 28–31.
 
+#[rustfmt::skip]
 pub const TEAPOT_PATCHES: [[u16; 16]; 32] = [
     [0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15],
     [3, 16, 17, 18, 7, 19, 20, 21, 11, 22, 23, 24, 15, 25, 26, 27],
