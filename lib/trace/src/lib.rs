@@ -15,6 +15,7 @@ pub mod integrator;
 pub mod layers;
 pub mod lights;
 pub mod material;
+pub mod rays;
 pub mod records;
 pub mod render;
 pub mod run;
