@@ -3,4 +3,5 @@
 
 pub mod cli;
 pub mod images;
+pub mod infer;
 pub mod inspect;

@@ -3,8 +3,8 @@
 //!
 //! 1. branch cuts in wrapped dimensions ([`branch_cut`]);
 //! 2. the least-squares most-isometric linear map, eq. 3.1 ([`isometry`]);
-//! 3. 4. scaling until the texture→screen Jacobian's largest singular value is under a
-//!    threshold at every covered pixel ([`stretch`]);
+//! 3. and 4. scaling until the largest singular value of the texture→screen Jacobian is
+//!    under a threshold at every covered pixel ([`stretch`]);
 //! 5. the minimum-area bounding rectangle over discrete directions ([`bounding`]);
 //! 6. the used resolution, times a per-object reduction factor.
 //!

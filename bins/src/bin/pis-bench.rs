@@ -1,0 +1,110 @@
+//! pis-bench: measurements of the toolchain's stages.
+//!
+//! `pis-bench infer SET_DIR|scene.toml [--object NAME] [--at v1,v2] [--json]`: texture
+//! inference for one object at one parameter point, PSNR against the gold-standard layer for
+//! least squares (bilinear, trilinear, pyramidal) and the two baselines (thesis 3.6).
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use clap::{Parser, Subcommand};
+use pis::cli::{finish, parse, Exit, Failure, EXIT_CODES_HELP};
+use pis::infer::{infer, print_report, InferRequest};
+use pis_compile::SolveSettings;
+
+#[derive(Parser, Debug)]
+#[command(name = "pis-bench", version, about, after_help = EXIT_CODES_HELP)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand, Debug)]
+enum Command {
+    /// Texture inference against the gold standard at one parameter point.
+    Infer {
+        /// A ray-traced set directory, or a scene.toml to trace the point from.
+        input: PathBuf,
+        /// The object (default: the most specular one).
+        #[arg(long)]
+        object: Option<String>,
+        /// Parameter values, one per dimension (nearest sample); default: the middle sample.
+        #[arg(long, value_delimiter = ',', allow_hyphen_values = true)]
+        at: Option<Vec<f32>>,
+        /// scene.toml of a set (default: SET_DIR/scene.toml).
+        #[arg(long)]
+        scene: Option<PathBuf>,
+        /// Image size WIDTHxHEIGHT when tracing a scene.toml.
+        #[arg(long, value_parser = parse_resolution)]
+        resolution: Option<(u32, u32)>,
+        /// Samples per pixel when tracing a scene.toml.
+        #[arg(long)]
+        spp: Option<u32>,
+        /// A `[preset.NAME]` of scene.toml.
+        #[arg(long)]
+        preset: Option<String>,
+        /// Also time the inference of every object of the scene at this point.
+        #[arg(long)]
+        all_objects: bool,
+        /// Largest used texture side in texels.
+        #[arg(long, default_value_t = 1024)]
+        max_texture: u32,
+        /// ε_f of the pyramidal regularization (thesis: 0.1).
+        #[arg(long, default_value_t = 0.1)]
+        epsilon_f: f64,
+        /// Conjugate-gradient stopping tolerance (relative preconditioned gradient norm).
+        #[arg(long, default_value_t = 1e-4)]
+        tolerance: f64,
+        /// Conjugate-gradient iteration limit per colour channel.
+        #[arg(long, default_value_t = 400)]
+        max_iterations: u32,
+        /// Print the report as JSON on stdout.
+        #[arg(long)]
+        json: bool,
+    },
+}
+
+fn parse_resolution(s: &str) -> Result<(u32, u32), String> {
+    let (w, h) = s.split_once(['x', 'X']).ok_or_else(|| format!("expected WIDTHxHEIGHT, got {s:?}"))?;
+    let w: u32 = w.trim().parse().map_err(|_| format!("bad width in {s:?}"))?;
+    let h: u32 = h.trim().parse().map_err(|_| format!("bad height in {s:?}"))?;
+    if w == 0 || h == 0 {
+        return Err(format!("resolution {s:?} has a zero side"));
+    }
+    Ok((w, h))
+}
+
+fn run(cli: Cli) -> Result<Exit, Failure> {
+    match cli.command {
+        Command::Infer { input, object, at, scene, resolution, spp, preset, all_objects, max_texture, epsilon_f, tolerance, max_iterations, json } => {
+            if !input.exists() {
+                return Err(Failure::new(Exit::Io, anyhow::anyhow!("{} does not exist", input.display())));
+            }
+            if max_texture == 0 || max_texture > 16384 {
+                return Err(Failure::new(Exit::Usage, anyhow::anyhow!("--max-texture must be in 1..=16384")));
+            }
+            if !(epsilon_f.is_finite() && epsilon_f >= 0.0 && tolerance.is_finite() && tolerance > 0.0) {
+                return Err(Failure::new(Exit::Usage, anyhow::anyhow!("--epsilon-f must be ≥ 0 and --tolerance > 0")));
+            }
+            let mut solver = SolveSettings::default();
+            solver.cg.tolerance = tolerance;
+            solver.cg.max_iterations = max_iterations;
+            let req = InferRequest { input, scene, object, at, resolution, spp, preset, all_objects, max_texture, solver, epsilon_f };
+            let report = infer(&req).map_err(|e| Failure::new(Exit::Runtime, e))?;
+            print_report(&report, &mut std::io::stderr()).map_err(|e| Failure::new(Exit::Io, e))?;
+            if json {
+                let s = serde_json::to_string_pretty(&report).map_err(|e| Failure::new(Exit::Runtime, e))?;
+                println!("{s}");
+            }
+            Ok(Exit::Ok)
+        }
+    }
+}
+
+fn main() -> ExitCode {
+    let cli = match parse::<Cli>() {
+        Ok(c) => c,
+        Err(code) => return code,
+    };
+    finish("pis-bench", run(cli))
+}

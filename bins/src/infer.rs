@@ -1,0 +1,460 @@
+//! `pis-bench infer`: texture inference for one object at one parameter point, compared with
+//! the gold-standard layer (thesis 3.6). Least squares with bilinear and trilinear render
+//! matrices, with pyramidal regularization, and the two baselines (forward mapping, ray
+//! tracing into textures), each rendered through the hardware model.
+//!
+//! The gold standard b is the object's surface radiance, diffuse + specular layer (both
+//! divided by coverage), at the pixels the model rasterizes and the tracer covers. PSNR is
+//! measured on display values (linear radiance clamped to [0, 1], sRGB-encoded, peak 1), as
+//! the thesis compares 8-bit frames.
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use anyhow::{anyhow, bail, Context, Result};
+use glam::{Mat4, Vec3};
+use pis_compile::baseline::forward::forward_map;
+use pis_compile::baseline::traced::trace_into_texture;
+use pis_compile::baseline::LayerImage;
+use pis_compile::texcoord::{branch_cut::apply_cut, optimize_placement, ObjectMesh, TexcoordSettings, ViewGeometry};
+use pis_compile::{
+    render, render_matrix, scene_depth, solve, Address, DrawMesh, Filter, RenderMatrix, Sampler,
+    SolveSettings, TextureLayout, TextureTransform, TexturedObject, Viewport,
+};
+use pis_scene::{Frame, LoadOptions, Scene};
+use pis_trace::layers::LayerKind;
+use pis_trace::{PointImages, TraceSettings};
+use serde::Serialize;
+
+use crate::images::srgb_encode;
+
+/// What to infer.
+#[derive(Clone, Debug, Default)]
+pub struct InferRequest {
+    /// A ray-traced set directory or a scene.toml.
+    pub input: PathBuf,
+    /// scene.toml for a set (default: the set directory's scene.toml).
+    pub scene: Option<PathBuf>,
+    pub object: Option<String>,
+    /// One value per dimension; the nearest sample is used. Default: the middle sample.
+    pub at: Option<Vec<f32>>,
+    /// Tracing a scene.toml: image size and samples per pixel overrides.
+    pub resolution: Option<(u32, u32)>,
+    pub spp: Option<u32>,
+    pub preset: Option<String>,
+    /// Also time the inference (A matrix + pyramidal solve) of every object.
+    pub all_objects: bool,
+    /// Largest used texture side (the optimal resolution is clamped to it).
+    pub max_texture: u32,
+    /// The solver's settings for the plain least-squares solves; `ls-pyramidal` adds ε_f.
+    pub solver: SolveSettings,
+    /// ε_f of the pyramidal solve.
+    pub epsilon_f: f64,
+}
+
+/// One method's result.
+#[derive(Clone, Debug, Serialize)]
+pub struct MethodReport {
+    pub psnr_db: f64,
+    /// Rendered through wgpu: null where this build has no wgpu renderer.
+    pub psnr_db_wgpu: Option<f64>,
+    pub ms: f64,
+    pub iterations: Option<u32>,
+}
+
+/// Inference time of one object.
+#[derive(Clone, Debug, Serialize)]
+pub struct ObjectTiming {
+    pub object: String,
+    pub n_s: usize,
+    pub n_t: usize,
+    pub texture: [u32; 2],
+    pub texcoord_ms: f64,
+    pub matrix_ms: f64,
+    pub solve_ms: f64,
+    pub iterations: u32,
+    pub total_ms: f64,
+}
+
+/// The report (`--json` prints it).
+#[derive(Clone, Debug, Serialize)]
+pub struct InferReport {
+    pub object: String,
+    pub point: Vec<u32>,
+    pub values: Vec<f32>,
+    pub resolution: [u32; 2],
+    pub texture: [u32; 2],
+    pub repeat: [bool; 2],
+    pub methods: BTreeMap<String, MethodReport>,
+    /// The LS-trilinear solve.
+    pub solve_ms: f64,
+    pub iterations: u32,
+    pub n_s: usize,
+    pub n_t: usize,
+    pub trace_ms: f64,
+    pub texcoord_ms: f64,
+    pub matrix_ms: f64,
+    pub objects: Vec<ObjectTiming>,
+    pub notes: Vec<String>,
+}
+
+/// One object's mesh, all primitives merged.
+struct Mesh {
+    positions: Vec<[f32; 3]>,
+    uvs: Vec<[f32; 2]>,
+    indices: Vec<u32>,
+}
+
+fn merged_mesh(scene: &Scene, o: usize) -> Mesh {
+    let mut m = Mesh { positions: vec![], uvs: vec![], indices: vec![] };
+    for p in &scene.objects[o].primitives {
+        let base = m.positions.len() as u32;
+        m.positions.extend(p.positions.iter().map(|v| v.to_array()));
+        if p.uvs.len() == p.positions.len() {
+            m.uvs.extend(p.uvs.iter().map(|v| v.to_array()));
+        } else {
+            m.uvs.extend(std::iter::repeat_n([0.0, 0.0], p.positions.len()));
+        }
+        m.indices.extend(p.indices.iter().map(|i| i + base));
+    }
+    m
+}
+
+/// Whether the texture wraps along u / v: the mesh has a seam, vertices at u = 0 and u = 1
+/// (v = 0 and v = 1) at the same position.
+fn seam_wraps(mesh: &Mesh) -> [bool; 2] {
+    let mut out = [false; 2];
+    for (dim, flag) in out.iter_mut().enumerate() {
+        let key = |p: [f32; 3]| p.map(|c| (c * 1e4).round() as i64);
+        let lo: std::collections::BTreeSet<_> = mesh.positions.iter().zip(&mesh.uvs)
+            .filter(|(_, uv)| uv[dim].abs() < 1e-4).map(|(p, _)| key(*p)).collect();
+        let matches = mesh.positions.iter().zip(&mesh.uvs)
+            .filter(|(p, uv)| (uv[dim] - 1.0).abs() < 1e-4 && lo.contains(&key(**p))).count();
+        *flag = matches >= 2;
+    }
+    out
+}
+
+struct Point {
+    scene: Scene,
+    frame: Frame,
+    images: PointImages,
+    samples: Vec<u32>,
+    values: Vec<f32>,
+    settings: TraceSettings,
+    trace_ms: f64,
+}
+
+fn nearest_samples(scene: &Scene, at: Option<&[f32]>) -> Result<Vec<u32>> {
+    let dims = &scene.space.dims;
+    match at {
+        None => Ok(dims.iter().map(|d| d.samples() / 2).collect()),
+        Some(v) => {
+            if v.len() != dims.len() {
+                bail!("--at gives {} values, the parameter space has {} dimensions ({})", v.len(), dims.len(),
+                      dims.iter().map(|d| d.name.as_str()).collect::<Vec<_>>().join(", "));
+            }
+            Ok(dims.iter().zip(v).map(|(d, &x)| {
+                d.values.iter().enumerate()
+                    .min_by(|a, b| (a.1 - x).abs().total_cmp(&(b.1 - x).abs()))
+                    .map_or(0, |(i, _)| i as u32)
+            }).collect())
+        }
+    }
+}
+
+fn load_point(req: &InferRequest) -> Result<Point> {
+    let is_set = req.input.is_dir();
+    if is_set {
+        let set = pis_trace::set::RaySet::open(&req.input)?;
+        let scene_path = req.scene.clone().unwrap_or_else(|| req.input.join("scene.toml"));
+        let res = (set.meta.resolution[0], set.meta.resolution[1]);
+        let options = LoadOptions { resolution: Some(res), ..LoadOptions::default() };
+        let scene = pis_scene::load_with(&scene_path, &options)
+            .with_context(|| format!("loading {} (the set's scene; pass --scene)", scene_path.display()))?;
+        let samples = nearest_samples(&scene, req.at.as_deref())?;
+        let index = set.meta.points.iter().position(|p| p.samples == samples)
+            .ok_or_else(|| anyhow!("the set has no point at samples {samples:?}"))?;
+        let images = set.read_point(index)?;
+        let frame = scene.frame(&samples)?;
+        let values = set.meta.points[index].values.clone();
+        let mut settings = TraceSettings::new(res, set.meta.spp.max(1));
+        settings.filter = set.meta.filter;
+        Ok(Point { scene, frame, images, samples, values, settings, trace_ms: 0.0 })
+    } else {
+        let options = LoadOptions { preset: req.preset.clone(), resolution: req.resolution, spp: req.spp };
+        let scene = pis_scene::load_with(&req.input, &options)?;
+        let samples = nearest_samples(&scene, req.at.as_deref())?;
+        let frame = scene.frame(&samples)?;
+        let values = scene.space.dims.iter().zip(&samples).map(|(d, &s)| d.values[s as usize]).collect();
+        let settings = TraceSettings::new(scene.resolution, scene.spp);
+        let t = Instant::now();
+        let render = pis_trace::render_point(&scene, &frame, &settings, &|| {})?;
+        let trace_ms = t.elapsed().as_secs_f64() * 1e3;
+        Ok(Point { scene, frame, images: render.images, samples, values, settings, trace_ms })
+    }
+}
+
+/// Per pixel: coverage and the object's surface radiance (diffuse + specular).
+fn object_layer(images: &PointImages, channel: &str) -> Result<(Vec<f32>, Vec<f32>)> {
+    let get = |k: LayerKind| images.object_layer(channel, k)
+        .ok_or_else(|| anyhow!("the point has no {} layer for object {channel}", k.name()));
+    let cov = get(LayerKind::Coverage)?.channel("A").ok_or_else(|| anyhow!("coverage without A"))?.to_vec();
+    let (d, s) = (get(LayerKind::Diffuse)?, get(LayerKind::Specular)?);
+    let n = cov.len();
+    let mut rgb = vec![0.0f32; n * 3];
+    for (c, name) in ["R", "G", "B"].iter().enumerate() {
+        let (dp, sp) = (d.channel(name), s.channel(name));
+        for k in 0..n {
+            rgb[k * 3 + c] = dp.map_or(0.0, |p| p[k]) + sp.map_or(0.0, |p| p[k]);
+        }
+    }
+    Ok((cov, rgb))
+}
+
+fn display(v: f32) -> f64 {
+    srgb_encode(v.clamp(0.0, 1.0)) as f64
+}
+
+/// PSNR of display values, peak 1.
+pub fn psnr_display(a: &[f32], b: &[f32]) -> f64 {
+    let mse = a.iter().zip(b).map(|(x, y)| (display(*x) - display(*y)).powi(2)).sum::<f64>() / a.len().max(1) as f64;
+    10.0 * (1.0 / mse.max(1e-20)).log10()
+}
+
+/// Keeps the rows of A whose pixels the tracer covers; returns the reduced A and its b.
+fn restrict(a: &RenderMatrix, cov: &[f32], rgb: &[f32]) -> (RenderMatrix, Vec<f32>) {
+    let mut out = RenderMatrix { width: a.width, height: a.height, layout: a.layout, row_start: vec![0], ..Default::default() };
+    let mut b = Vec::new();
+    for r in 0..a.rows() {
+        let p = a.pixels[r] as usize;
+        if cov.get(p).is_none_or(|&c| c <= 0.0) {
+            continue;
+        }
+        let (c, v) = a.row(r);
+        out.cols.extend_from_slice(c);
+        out.vals.extend_from_slice(v);
+        out.row_start.push(out.cols.len() as u32);
+        out.pixels.push(a.pixels[r]);
+        out.coverage.push(a.coverage[r]);
+        b.extend_from_slice(&rgb[p * 3..p * 3 + 3]);
+    }
+    (out, b)
+}
+
+struct Prepared {
+    mesh_uvs: Vec<[f32; 2]>,
+    transform: TextureTransform,
+    layout: TextureLayout,
+    repeat: [bool; 2],
+    clip_from_object: Mat4,
+    texcoord_ms: f64,
+}
+
+fn prepare(pt: &Point, o: usize, mesh: &Mesh, max_texture: u32) -> Result<Prepared> {
+    let t = Instant::now();
+    let res = pt.settings.resolution;
+    let proj = pis_trace::camera::projection_matrix(&pt.frame.camera, res);
+    let clip_from_object = proj * pt.frame.camera.world_from_camera.inverse() * pt.frame.instances[o].world_from_object;
+    let view = ViewGeometry {
+        clip: mesh.positions.iter().map(|p| clip_from_object * Vec3::from(*p).extend(1.0)).collect(),
+        width: res.0,
+        height: res.1,
+    };
+    let uvs: Vec<glam::Vec2> = mesh.uvs.iter().map(|u| glam::Vec2::from(*u)).collect();
+    let name = &pt.scene.objects[o].name;
+    let om = ObjectMesh { name, uvs: &uvs, indices: &mesh.indices, wrap: seam_wraps(mesh) };
+    let settings = TexcoordSettings { max_size: max_texture, ..TexcoordSettings::default() };
+    let pl = optimize_placement(&om, &[view], &settings)?;
+    let mesh_uvs: Vec<[f32; 2]> = mesh.uvs.iter().map(|uv| {
+        let mut w = *uv;
+        for dim in 0..2 {
+            if let Some(c) = pl.branch_cut[dim] {
+                w[dim] = apply_cut(w[dim] as f64, c) as f32;
+            }
+        }
+        w
+    }).collect();
+    Ok(Prepared {
+        mesh_uvs,
+        transform: TextureTransform { values: pl.affine },
+        layout: TextureLayout::full(pl.width, pl.height),
+        repeat: pl.repeat,
+        clip_from_object,
+        texcoord_ms: t.elapsed().as_secs_f64() * 1e3,
+    })
+}
+
+fn sampler(filter: Filter, repeat: [bool; 2]) -> Sampler {
+    Sampler { filter, address: repeat.map(|r| if r { Address::Repeat } else { Address::ClampToEdge }) }
+}
+
+/// Runs the comparison.
+pub fn infer(req: &InferRequest) -> Result<InferReport> {
+    let pt = load_point(req)?;
+    let scene = &pt.scene;
+    let names = pis_trace::channel_names(scene);
+    let (w, h) = pt.settings.resolution;
+    let viewport = Viewport { width: w, height: h };
+    let meshes: Vec<Mesh> = (0..scene.objects.len()).map(|o| merged_mesh(scene, o)).collect();
+    let clip_from = |o: usize| {
+        pis_trace::camera::projection_matrix(&pt.frame.camera, (w, h))
+            * pt.frame.camera.world_from_camera.inverse() * pt.frame.instances[o].world_from_object
+    };
+    let draw: Vec<DrawMesh> = meshes.iter().enumerate().map(|(o, m)| DrawMesh {
+        positions: &m.positions, uvs: &m.uvs, indices: &m.indices, clip_from_object: clip_from(o),
+    }).collect();
+
+    // The object: named, or the most specular (largest specular share of its radiance).
+    let o = match &req.object {
+        Some(n) => scene.objects.iter().position(|x| &x.name == n).or_else(|| names.iter().position(|x| x == n))
+            .ok_or_else(|| anyhow!("no object {n:?}; the scene has {}", names.join(", ")))?,
+        None => {
+            let mut best = (f64::NEG_INFINITY, 0);
+            for (k, n) in names.iter().enumerate() {
+                let (Some(c), Some(d), Some(s)) = (
+                    pt.images.object_layer(n, LayerKind::Coverage).and_then(|l| l.channel("A")),
+                    pt.images.object_layer(n, LayerKind::Diffuse),
+                    pt.images.object_layer(n, LayerKind::Specular),
+                ) else { continue };
+                let (mut sd, mut ss) = (0.0f64, 0.0f64);
+                for (i, &cv) in c.iter().enumerate() {
+                    let (x, y) = (i as u32 % w, i as u32 / w);
+                    sd += cv as f64 * d.rgb(x, y).element_sum() as f64;
+                    ss += cv as f64 * s.rgb(x, y).element_sum() as f64;
+                }
+                let share = if sd + ss > 0.0 { ss / (sd + ss) } else { f64::NEG_INFINITY };
+                if share > best.0 {
+                    best = (share, k);
+                }
+            }
+            best.1
+        }
+    };
+    let (cov, rgb) = object_layer(&pt.images, &names[o])?;
+    let prep = prepare(&pt, o, &meshes[o], req.max_texture)?;
+    let t = Instant::now();
+    let occluders = scene_depth(viewport, &draw, Some(o))?;
+    let mut mesh_o = draw[o];
+    mesh_o.uvs = &prep.mesh_uvs;
+    let matrix = |filter| -> Result<RenderMatrix> {
+        let obj = TexturedObject { mesh: mesh_o, transform: prep.transform, layout: prep.layout, sampler: sampler(filter, prep.repeat) };
+        Ok(render_matrix(viewport, &obj, Some(&occluders))?)
+    };
+    let (a_bil, b) = restrict(&matrix(Filter::Bilinear)?, &cov, &rgb);
+    let (a_tri, _) = restrict(&matrix(Filter::Trilinear)?, &cov, &rgb);
+    let matrix_ms = t.elapsed().as_secs_f64() * 1e3;
+    if a_tri.rows() == 0 {
+        bail!("object {} covers no pixel at this point", names[o]);
+    }
+    let mut methods = BTreeMap::new();
+    let mut method = |name: &str, a: &RenderMatrix, x: &[f32], ms: f64, it: Option<u32>| {
+        let p = psnr_display(&render(a, x), &b);
+        methods.insert(name.to_string(), MethodReport { psnr_db: p, psnr_db_wgpu: None, ms, iterations: it });
+    };
+    let plain = req.solver;
+    let pyramidal = SolveSettings { epsilon_f: req.epsilon_f, ..req.solver };
+    let bil = solve(&a_bil, &b, None, &plain)?;
+    method("ls-bilinear", &a_bil, &bil.texels, bil.solve_ms, Some(bil.iterations));
+    let tri = solve(&a_tri, &b, None, &plain)?;
+    method("ls-trilinear", &a_tri, &tri.texels, tri.solve_ms, Some(tri.iterations));
+    let pyr = solve(&a_tri, &b, None, &pyramidal)?;
+    method("ls-pyramidal", &a_tri, &pyr.texels, pyr.solve_ms, Some(pyr.iterations));
+
+    // Baselines, rendered with trilinear filtering as the player would draw them.
+    let t = Instant::now();
+    let layer = LayerImage { width: w, height: h, rgb: rgb.clone(), covered: cov.iter().map(|&c| c > 0.0).collect() };
+    let fwd = forward_map(&mesh_o, &prep.transform, &layer, &prep.layout)?;
+    method("forward", &a_tri, &fwd, t.elapsed().as_secs_f64() * 1e3, None);
+    let t = Instant::now();
+    let eye = pt.frame.camera.world_from_camera.w_axis.truncate();
+    let mut trace_err = None;
+    let traced = trace_into_texture(&mesh_o, &prep.transform, pt.frame.instances[o].world_from_object, eye, &prep.layout, |rays| {
+        // Start just before the object point, so the object's own surface is what is seen
+        // (thesis 3.6: front- or back-facing, occluded or not).
+        let r: Vec<(Vec3, Vec3)> = rays.iter().map(|r| (r.origin + r.direction * (r.distance * 0.999), r.direction)).collect();
+        match pis_trace::rays::trace_rays(scene, &pt.frame, &pt.settings, &r, pt.settings.spp.max(1)) {
+            Ok(v) => v.iter().map(|x| (x.diffuse + x.specular).to_array()).collect(),
+            Err(e) => {
+                trace_err = Some(e);
+                vec![[0.0; 3]; rays.len()]
+            }
+        }
+    })?;
+    if let Some(e) = trace_err {
+        return Err(e.into());
+    }
+    method("traced", &a_tri, &traced, t.elapsed().as_secs_f64() * 1e3, None);
+
+    let mut objects = Vec::new();
+    if req.all_objects {
+        for k in 0..scene.objects.len() {
+            let t0 = Instant::now();
+            let Ok((cov_k, rgb_k)) = object_layer(&pt.images, &names[k]) else { continue };
+            let prep_k = prepare(&pt, k, &meshes[k], req.max_texture)?;
+            let t1 = Instant::now();
+            let occ = scene_depth(viewport, &draw, Some(k))?;
+            let mut m = draw[k];
+            m.uvs = &prep_k.mesh_uvs;
+            let obj = TexturedObject { mesh: m, transform: prep_k.transform, layout: prep_k.layout, sampler: sampler(Filter::Trilinear, prep_k.repeat) };
+            let (a, bk) = restrict(&render_matrix(viewport, &obj, Some(&occ))?, &cov_k, &rgb_k);
+            let matrix_ms = t1.elapsed().as_secs_f64() * 1e3;
+            if a.rows() == 0 {
+                continue;
+            }
+            let s = solve(&a, &bk, None, &pyramidal)?;
+            objects.push(ObjectTiming {
+                object: scene.objects[k].name.clone(), n_s: s.n_s, n_t: s.n_t,
+                texture: [prep_k.layout.width, prep_k.layout.height], texcoord_ms: prep_k.texcoord_ms,
+                matrix_ms, solve_ms: s.solve_ms, iterations: s.iterations,
+                total_ms: t0.elapsed().as_secs_f64() * 1e3,
+            });
+        }
+    }
+    let _ = prep.clip_from_object;
+    Ok(InferReport {
+        object: scene.objects[o].name.clone(),
+        point: pt.samples.clone(),
+        values: pt.values.clone(),
+        resolution: [w, h],
+        texture: [prep.layout.width, prep.layout.height],
+        repeat: prep.repeat,
+        methods,
+        solve_ms: tri.solve_ms,
+        iterations: tri.iterations,
+        n_s: tri.n_s,
+        n_t: tri.n_t,
+        trace_ms: pt.trace_ms,
+        texcoord_ms: prep.texcoord_ms,
+        matrix_ms,
+        objects,
+        notes: vec![
+            "psnr_db_wgpu is null: this build has no wgpu renderer of textured objects (pis-play)".into(),
+            "PSNR on display values: linear radiance clamped to [0, 1], sRGB-encoded, peak 1, over the object's covered pixels".into(),
+            "baselines are rendered with trilinear filtering".into(),
+        ],
+    })
+}
+
+/// Human-readable lines of the report (stderr).
+pub fn print_report(r: &InferReport, out: &mut impl std::io::Write) -> std::io::Result<()> {
+    writeln!(out, "object {} at point {:?} (values {:?}), {}x{}", r.object, r.point, r.values, r.resolution[0], r.resolution[1])?;
+    writeln!(out, "  texture {}x{} (repeat {:?}), n_s {}, n_t {}", r.texture[0], r.texture[1], r.repeat, r.n_s, r.n_t)?;
+    for (name, m) in &r.methods {
+        let it = m.iterations.map_or(String::new(), |i| format!(", {i} iterations"));
+        writeln!(out, "  {name:<13} {:6.2} dB   ({:.0} ms{it})", m.psnr_db, m.ms)?;
+    }
+    writeln!(out, "  trace {:.0} ms, texcoord {:.0} ms, matrices {:.0} ms, LS-trilinear solve {:.0} ms ({} iterations)",
+             r.trace_ms, r.texcoord_ms, r.matrix_ms, r.solve_ms, r.iterations)?;
+    for t in &r.objects {
+        writeln!(out, "  {:<10} {}x{} n_s {:6} n_t {:7}: texcoord {:5.0} ms, A {:5.0} ms, solve {:6.0} ms ({} it), total {:6.0} ms",
+                 t.object, t.texture[0], t.texture[1], t.n_s, t.n_t, t.texcoord_ms, t.matrix_ms, t.solve_ms, t.iterations, t.total_ms)?;
+    }
+    Ok(())
+}
+
+/// Used by the CLI to check paths before working.
+pub fn input_exists(p: &Path) -> bool {
+    p.exists()
+}
