@@ -6,6 +6,8 @@
 
 use std::time::Instant;
 
+use rayon::prelude::*;
+
 use crate::cg::{self, CgReport, CgSettings};
 use crate::error::check_finite;
 use crate::normal_equations::{ChannelProblem, DataOperator, Form, PyramidTerm, DEFAULT_K};
@@ -194,20 +196,29 @@ fn solve_views(
     let mut channels = Vec::with_capacity(CHANNELS);
     let mut residual2 = 0.0;
     let mut bb_total = 0.0;
-    for ch in 0..CHANNELS {
-        let b: Vec<f64> = b_all.iter().skip(ch).step_by(CHANNELS).map(|&v| v as f64).collect();
-        let rhs = op.rhs(b.clone());
-        let mut x: Vec<f64> = match initial {
-            Some(x0) => x0.iter().skip(ch).step_by(CHANNELS).map(|&v| v as f64).collect(),
-            None => vec![0.0; n_t],
-        };
-        if let Some(r) = &range {
-            r.clamp_inside(&mut x);
-        }
-        let problem = ChannelProblem { op: &op, rhs: &rhs, pyramid: pyramid.as_ref() };
-        let report = cg::minimize(&problem, range.as_ref(), &inv_diag, &mut x, &settings.cg);
-        residual2 += data_residual2(&op, &x, &b);
-        bb_total += rhs.bb;
+    // The channels are independent problems sharing A: solved concurrently (each result
+    // depends only on its own inputs, so the outcome does not depend on scheduling).
+    let results: Vec<(CgReport, Vec<f64>, f64, f64)> = (0..CHANNELS)
+        .into_par_iter()
+        .map(|ch| {
+            let b: Vec<f64> = b_all.iter().skip(ch).step_by(CHANNELS).map(|&v| v as f64).collect();
+            let rhs = op.rhs(b.clone());
+            let mut x: Vec<f64> = match initial {
+                Some(x0) => x0.iter().skip(ch).step_by(CHANNELS).map(|&v| v as f64).collect(),
+                None => vec![0.0; n_t],
+            };
+            if let Some(r) = &range {
+                r.clamp_inside(&mut x);
+            }
+            let problem = ChannelProblem { op: &op, rhs: &rhs, pyramid: pyramid.as_ref() };
+            let report = cg::minimize(&problem, range.as_ref(), &inv_diag, &mut x, &settings.cg);
+            let r2 = data_residual2(&op, &x, &b);
+            (report, x, r2, rhs.bb)
+        })
+        .collect();
+    for (ch, (report, x, r2, bb)) in results.into_iter().enumerate() {
+        residual2 += r2;
+        bb_total += bb;
         for (t, &v) in x.iter().enumerate() {
             texels[t * CHANNELS + ch] = v as f32;
         }

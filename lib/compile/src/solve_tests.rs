@@ -207,3 +207,4 @@ fn solving_twice_gives_identical_bytes() {
     }
 }
 
+
