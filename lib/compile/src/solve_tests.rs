@@ -208,3 +208,52 @@ fn solving_twice_gives_identical_bytes() {
 }
 
 
+
+/// A quad from the hardware model: positions in object space, uv = corners.
+fn model_matrix(positions: [[f32; 3]; 4], clip_from_object: glam::Mat4, layout: TextureLayout) -> RenderMatrix {
+    use crate::{render_matrix, Address, DrawMesh, Sampler, TextureTransform, TexturedObject, Viewport};
+    const UV: [[f32; 2]; 4] = [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]];
+    const IDX: [u32; 6] = [0, 1, 2, 0, 2, 3];
+    let object = TexturedObject {
+        mesh: DrawMesh { positions: &positions, uvs: &UV, indices: &IDX, clip_from_object },
+        transform: TextureTransform::IDENTITY,
+        layout,
+        sampler: Sampler { filter: Filter::Trilinear, address: [Address::ClampToEdge; 2] },
+    };
+    render_matrix(Viewport { width: 48, height: 36 }, &object, None).unwrap()
+}
+
+#[test]
+fn hardware_model_views_where_most_texels_are_unobserved_converge() {
+    use crate::transform::{look_at, perspective};
+    use glam::Vec3;
+    let layout = TextureLayout::full(32, 32);
+    let x = texture(&layout);
+    let proj = perspective(0.9, 48.0 / 36.0, 0.1, 100.0);
+    // wound counter-clockwise seen from above (+y)
+    let floor = [[-1.0, 0.0, -1.0], [-1.0, 0.0, 1.0], [1.0, 0.0, 1.0], [1.0, 0.0, -1.0]];
+    let cases = [
+        // the quad seen almost edge-on
+        ("grazing", floor, proj * look_at(Vec3::new(0.0, 0.3, 3.0), Vec3::ZERO, Vec3::Y)),
+        // far away: a few pixels
+        ("tiny", floor, proj * look_at(Vec3::new(0.0, 12.0, 16.0), Vec3::ZERO, Vec3::Y)),
+        // the camera looks past the quad's edge: its left half is off screen
+        ("half-off-screen", floor, proj * look_at(Vec3::new(-1.0, 2.0, 0.5), Vec3::new(-1.0, 0.0, 0.0), Vec3::Y)),
+    ];
+    for (name, p, m) in cases {
+        let a = model_matrix(p, m, layout);
+        assert!(a.rows() > 0, "{name}: the quad is visible");
+        let b = render(&a, &x);
+        for settings in [SolveSettings::default(), SolveSettings::pyramidal(),
+                         SolveSettings { epsilon_b: 1.0 / 32.0, ..SolveSettings::pyramidal() }] {
+            let sol = solve(&a, &b, None, &settings).unwrap();
+            assert!(sol.texels.iter().all(|v| v.is_finite()), "{name}");
+            assert!(sol.residual_rms.is_finite() && sol.residual_relative < 0.05,
+                    "{name}: residual {}", sol.residual_relative);
+            assert_monotone(&sol);
+            if settings.epsilon_f > 0.0 {
+                assert_eq!(sol.undefined, 0);
+            }
+        }
+    }
+}
