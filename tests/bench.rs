@@ -1,0 +1,51 @@
+//! pis-bench end to end: `infer` on samples/demo1 at a tiny size, its JSON report and its
+//! exit codes.
+
+use std::path::PathBuf;
+use std::process::{Command, Output};
+
+fn bench(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_pis-bench")).args(args).output().expect("pis-bench runs")
+}
+
+fn demo1() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../samples/demo1/scene.toml")
+}
+
+#[test]
+fn infer_reports_every_method_as_json() {
+    let scene = demo1();
+    if !scene.exists() {
+        return;
+    }
+    let out = bench(&["infer", scene.to_str().unwrap(), "--resolution", "64x48", "--spp", "1",
+                      "--object", "Vase", "--at", "0,0", "--json"]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("JSON on stdout");
+    assert_eq!(v["object"], "Vase");
+    for m in ["ls-bilinear", "ls-trilinear", "ls-pyramidal", "forward", "traced"] {
+        let psnr = v["methods"][m]["psnr_db"].as_f64().unwrap_or(f64::NAN);
+        assert!(psnr.is_finite() && psnr > 5.0, "{m}: {psnr}");
+        assert!(v["methods"][m]["psnr_db_wgpu"].is_null());
+    }
+    for k in ["solve_ms", "iterations", "n_s", "n_t"] {
+        assert!(v[k].as_f64().is_some(), "{k}");
+    }
+}
+
+#[test]
+fn infer_exit_codes() {
+    let out = bench(&["infer", "/no/such/scene.toml"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).starts_with("pis-bench: "));
+    let scene = demo1();
+    if scene.exists() {
+        let out = bench(&["infer", scene.to_str().unwrap(), "--resolution", "32x24", "--spp", "1", "--object", "Nope"]);
+        assert_eq!(out.status.code(), Some(4));
+        assert!(String::from_utf8_lossy(&out.stderr).contains("no object \"Nope\""));
+        let out = bench(&["infer", scene.to_str().unwrap(), "--at", "1"]);
+        assert_ne!(out.status.code(), Some(0));
+    }
+    let out = bench(&["infer"]);
+    assert_eq!(out.status.code(), Some(1));
+}
