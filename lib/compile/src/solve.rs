@@ -247,10 +247,10 @@ fn data_residual2(op: &DataOperator, x: &[f64], b: &[f64]) -> f64 {
     };
     // Ax through the transpose's columns: (Ax)_r = Σ_c A_rc x_c, gathered row by row.
     let mut ax = vec![0.0; b.len()];
-    for c in 0..at.rows {
+    for (c, &xc) in x.iter().enumerate().take(at.rows) {
         let (rows, vals) = at.row(c);
         for (&r, &v) in rows.iter().zip(vals) {
-            ax[r as usize] += v * x[c];
+            ax[r as usize] += v * xc;
         }
     }
     ax.iter().zip(b).map(|(a, b)| (a - b) * (a - b)).sum()
@@ -262,7 +262,7 @@ fn check_settings(s: &SolveSettings) -> Result<(), CompileError> {
         return Err(CompileError::Setting(format!(
             "ε_b = {} and ε_f = {} must be finite and ≥ 0", s.epsilon_b, s.epsilon_f)));
     }
-    if !(s.range_factor.is_finite() && s.range_factor > 0.0) || !(s.k.is_finite() && s.k > 0.0) {
+    if !(s.range_factor.is_finite() && s.range_factor > 0.0 && s.k.is_finite() && s.k > 0.0) {
         return Err(CompileError::Setting("range factor and K must be finite and > 0".into()));
     }
     Ok(())

@@ -15,7 +15,7 @@ pub fn max_stretch(r: DMat2, j: DMat2) -> Option<(f64, DVec2)> {
     let tr = p + s;
     let disc = ((p - s) * (p - s) + 4.0 * q * q).sqrt();
     let mu = 0.5 * (tr - disc);
-    if !(mu > 1e-300) || !mu.is_finite() {
+    if !(mu.is_finite() && mu > 1e-300) {
         return None;
     }
     // eigenvector of (p q; q s) for μ
