@@ -13,7 +13,7 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use anyhow::{anyhow, bail, Context, Result};
-use glam::{Mat4, Vec3};
+use glam::Vec3;
 use pis_compile::baseline::forward::forward_map;
 use pis_compile::baseline::traced::trace_into_texture;
 use pis_compile::baseline::LayerImage;
@@ -248,7 +248,6 @@ struct Prepared {
     transform: TextureTransform,
     layout: TextureLayout,
     repeat: [bool; 2],
-    clip_from_object: Mat4,
     texcoord_ms: f64,
 }
 
@@ -269,9 +268,9 @@ fn prepare(pt: &Point, o: usize, mesh: &Mesh, max_texture: u32) -> Result<Prepar
     let pl = optimize_placement(&om, &[view], &settings)?;
     let mesh_uvs: Vec<[f32; 2]> = mesh.uvs.iter().map(|uv| {
         let mut w = *uv;
-        for dim in 0..2 {
-            if let Some(c) = pl.branch_cut[dim] {
-                w[dim] = apply_cut(w[dim] as f64, c) as f32;
+        for (wd, cut) in w.iter_mut().zip(pl.branch_cut) {
+            if let Some(c) = cut {
+                *wd = apply_cut(*wd as f64, c) as f32;
             }
         }
         w
@@ -281,7 +280,6 @@ fn prepare(pt: &Point, o: usize, mesh: &Mesh, max_texture: u32) -> Result<Prepar
         transform: TextureTransform { values: pl.affine },
         layout: TextureLayout::full(pl.width, pl.height),
         repeat: pl.repeat,
-        clip_from_object,
         texcoord_ms: t.elapsed().as_secs_f64() * 1e3,
     })
 }
@@ -412,7 +410,6 @@ pub fn infer(req: &InferRequest) -> Result<InferReport> {
             });
         }
     }
-    let _ = prep.clip_from_object;
     Ok(InferReport {
         object: scene.objects[o].name.clone(),
         point: pt.samples.clone(),
