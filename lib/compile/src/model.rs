@@ -95,12 +95,17 @@ pub fn scene_depth(viewport: Viewport, meshes: &[DrawMesh], skip: Option<usize>)
     Ok(depth)
 }
 
+/// Checks what [`render_matrix`] checks before drawing (probe mode checks the same).
+pub fn render_matrix_inputs_ok(viewport: Viewport, object: &TexturedObject) -> Result<(), ModelError> {
+    check_mesh(&object.mesh)?;
+    check_inputs(viewport, &object.layout, &object.transform)
+}
+
 /// The render matrix A of `object` in `viewport`, its fragments tested against `occluders`
 /// (see [`scene_depth`]); every row has coverage 1 (no antialiasing: see
 /// [`crate::antialias`]). Rows are the visible pixels in increasing order.
 pub fn render_matrix(viewport: Viewport, object: &TexturedObject, occluders: Option<&DepthBuffer>) -> Result<RenderMatrix, ModelError> {
-    check_mesh(&object.mesh)?;
-    check_inputs(viewport, &object.layout, &object.transform)?;
+    render_matrix_inputs_ok(viewport, object)?;
     if let Some(o) = occluders {
         if o.viewport != viewport {
             return Err(ModelError::DepthSize { got: o.viewport, want: viewport });
