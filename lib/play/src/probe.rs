@@ -11,7 +11,8 @@
 //! Neighbourhoods of texels solved in parallel never overlap, so a pixel that reads an active
 //! texel reads exactly one, its red value is that texel's weight (float render target, no
 //! quantization) and its green and blue are the identifier unchanged (a filtered constant).
-//! 3 · S_x · S_y renderings (108 with clamping) give every column, independent of resolution.
+//! 3 · S_x · S_y renderings (108 with clamping; S_x · S_y = 36 for nearest and bilinear, which
+//! read level 0 only) give every column, independent of resolution.
 
 use std::collections::BTreeMap;
 
@@ -116,7 +117,9 @@ pub fn probe_render_matrix(gpu: &Gpu, pipeline: &TexturedPipeline, viewport: Vie
     let s = [spacing(address[0]), spacing(address[1])];
     let mut rows: BTreeMap<u32, BTreeMap<u32, f32>> = BTreeMap::new();
     let mut covered: Option<Vec<u32>> = None;
-    for p in 0..3.min(layout.levels) {
+    // Nearest and bilinear read level 0 only: one phase suffices.
+    let phases = if object.sampler.filter == pis_compile::Filter::Trilinear { 3.min(layout.levels) } else { 1 };
+    for p in 0..phases {
         for oy in 0..s[1] {
             for ox in 0..s[0] {
                 texture.upload(gpu, &probe_texture(&layout, address, p, [ox, oy]))?;
