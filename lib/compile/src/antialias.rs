@@ -4,8 +4,6 @@
 //! centred on the pixel centre, normalised) — and divided by the filtered coverage, so
 //! sub-pixels the object does not cover do not count.
 
-use std::collections::BTreeMap;
-
 use rayon::prelude::*;
 
 use crate::model::ModelError;
@@ -39,27 +37,25 @@ pub fn antialias(supersampled: &RenderMatrix, factor: u32, filter: DisplayFilter
     }
     // Candidate display pixels: those whose filter reaches a covered sub-pixel.
     let reach = (radius * f).ceil() as i64 + 1;
-    let mut candidates: Vec<u32> = supersampled
-        .pixels
-        .iter()
-        .flat_map(|&p| {
-            let (sx, sy) = ((p as i64 % sw) / factor as i64, (p as i64 / sw) / factor as i64);
-            let r = reach / factor as i64 + 1;
-            (sy - r..=sy + r).flat_map(move |y| (sx - r..=sx + r).map(move |x| (x, y)))
-        })
-        .filter(|&(x, y)| x >= 0 && y >= 0 && x < w as i64 && y < h as i64)
-        .map(|(x, y)| (y * w as i64 + x) as u32)
-        .collect();
-    candidates.sort_unstable();
-    candidates.dedup();
+    let mut reached = vec![false; w as usize * h as usize];
+    let r = reach / factor as i64 + 1;
+    for &p in &supersampled.pixels {
+        let (sx, sy) = ((p as i64 % sw) / factor as i64, (p as i64 / sw) / factor as i64);
+        for y in (sy - r).max(0)..=(sy + r).min(h as i64 - 1) {
+            for x in (sx - r).max(0)..=(sx + r).min(w as i64 - 1) {
+                reached[(y * w as i64 + x) as usize] = true;
+            }
+        }
+    }
+    let candidates: Vec<u32> = (0..reached.len() as u32).filter(|&p| reached[p as usize]).collect();
     let rows: Vec<(u32, f32, Vec<(u32, f32)>)> = candidates
         .par_iter()
-        .filter_map(|&p| {
+        .map_init(Vec::new, |acc: &mut Vec<(u32, f64)>, &p| {
+            acc.clear();
             let (cx, cy) = ((p % w) as f64 + 0.5, (p / w) as f64 + 0.5);
             let (x0, x1) = (((cx - radius) * f - 0.5).ceil() as i64, ((cx + radius) * f - 0.5).floor() as i64);
             let (y0, y1) = (((cy - radius) * f - 0.5).ceil() as i64, ((cy + radius) * f - 0.5).floor() as i64);
             let (mut total, mut covered) = (0.0f64, 0.0f64);
-            let mut acc: BTreeMap<u32, f64> = BTreeMap::new();
             for sy in y0..=y1 {
                 for sx in x0..=x1 {
                     let (dx, dy) = ((sx as f64 + 0.5) / f - cx, (sy as f64 + 0.5) / f - cy);
@@ -78,17 +74,28 @@ pub fn antialias(supersampled: &RenderMatrix, factor: u32, filter: DisplayFilter
                     }
                     covered += wk;
                     let (c, v) = supersampled.row(r as usize);
-                    for (&c, &v) in c.iter().zip(v) {
-                        *acc.entry(c).or_insert(0.0) += wk * v as f64;
-                    }
+                    acc.extend(c.iter().zip(v).map(|(&c, &v)| (c, wk * v as f64)));
                 }
             }
             if covered <= 0.0 || total <= 0.0 {
                 return None;
             }
-            let entries = acc.into_iter().map(|(c, v)| (c, (v / covered) as f32)).collect();
+            // Merge repeated columns (sub-pixels share texels), in column order.
+            acc.sort_unstable_by_key(|e| e.0);
+            let mut entries: Vec<(u32, f32)> = Vec::with_capacity(acc.len().min(64));
+            let mut k = 0;
+            while k < acc.len() {
+                let (c, mut v) = acc[k];
+                k += 1;
+                while k < acc.len() && acc[k].0 == c {
+                    v += acc[k].1;
+                    k += 1;
+                }
+                entries.push((c, (v / covered) as f32));
+            }
             Some((p, (covered / total) as f32, entries))
         })
+        .flatten()
         .collect();
     let mut out = RenderMatrix { width: w, height: h, layout: supersampled.layout, ..Default::default() };
     out.row_start.push(0);
