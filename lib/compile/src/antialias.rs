@@ -6,7 +6,8 @@
 
 use rayon::prelude::*;
 
-use crate::model::ModelError;
+use crate::model::{render_matrix, scene_depth, ModelError, TexturedObject};
+use crate::transform::{DrawMesh, Viewport};
 use crate::RenderMatrix;
 
 /// The display filter of the ray-traced set (`set.json`: `filter.sigma_px`, `filter.radius_px`),
@@ -111,6 +112,24 @@ pub fn antialias(supersampled: &RenderMatrix, factor: u32, filter: DisplayFilter
     Ok(out)
 }
 
+/// The antialiased render matrix of `object` at display resolution `viewport` (thesis 3.4.4):
+/// A at `factor`× the resolution, its fragments tested against the depth of `occluders` at
+/// that resolution, filtered with the display filter and divided by coverage.
+pub fn antialiased_render_matrix(
+    viewport: Viewport,
+    factor: u32,
+    filter: DisplayFilter,
+    object: &TexturedObject,
+    occluders: &[DrawMesh],
+) -> Result<RenderMatrix, ModelError> {
+    if factor == 0 || factor > 16 {
+        return Err(ModelError::Filter { sigma: filter.sigma_px, radius: filter.radius_px, factor });
+    }
+    let ss = Viewport { width: viewport.width.saturating_mul(factor), height: viewport.height.saturating_mul(factor) };
+    let depth = scene_depth(ss, occluders, None)?;
+    antialias(&render_matrix(ss, object, Some(&depth))?, factor, filter)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -142,6 +161,31 @@ mod tests {
         assert!(wide.coverage[1] > 0.0 && wide.coverage[1] < 0.5);
         for r in 0..wide.rows() {
             assert!((wide.row(r).1.iter().sum::<f32>() - 1.0).abs() < 1e-6);
+        }
+    }
+
+    #[test]
+    fn edge_pixels_get_fractional_coverage() {
+        use crate::{Address, Filter, Sampler, TextureTransform};
+        // A quad over the left 40 % of an 10×4 screen.
+        let positions = [[-1.0, 1.0, 0.5], [-0.2, 1.0, 0.5], [-0.2, -1.0, 0.5], [-1.0, -1.0, 0.5]];
+        let uvs = [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]];
+        let object = TexturedObject {
+            mesh: DrawMesh { positions: &positions, uvs: &uvs, indices: &[0, 1, 2, 0, 2, 3], clip_from_object: glam::Mat4::IDENTITY },
+            transform: TextureTransform::IDENTITY,
+            layout: TextureLayout::full(8, 8),
+            sampler: Sampler { filter: Filter::Trilinear, address: [Address::ClampToEdge; 2] },
+        };
+        let f = DisplayFilter { sigma_px: 0.5, radius_px: 1.5 };
+        let a = antialiased_render_matrix(Viewport { width: 10, height: 4 }, 4, f, &object, &[]).unwrap();
+        let cov = |x: u32, y: u32| a.pixels.iter().position(|&p| p == y * 10 + x).map(|r| a.coverage[r]).unwrap_or(0.0);
+        assert!(cov(1, 1) > 0.99, "{}", cov(1, 1));
+        // The edge x = 4 px runs between pixels 3 and 4: about half each side of the edge.
+        assert!(cov(3, 1) > 0.6 && cov(3, 1) < 1.0 && cov(4, 1) > 0.0 && cov(4, 1) < 0.4, "{} {}", cov(3, 1), cov(4, 1));
+        assert!((cov(3, 1) + cov(4, 1) - 1.0).abs() < 0.05);
+        assert_eq!(cov(7, 1), 0.0);
+        for r in 0..a.rows() {
+            assert!((a.row(r).1.iter().sum::<f32>() - 1.0).abs() < 1e-5);
         }
     }
 }

@@ -24,7 +24,7 @@ pub mod raster;
 pub mod sampler;
 pub mod transform;
 
-pub use antialias::{antialias, DisplayFilter};
+pub use antialias::{antialias, antialiased_render_matrix, DisplayFilter};
 pub use layout::TextureLayout;
 pub use matrix::RenderMatrix;
 pub use model::{render_matrix, scene_depth, ModelError, TexturedObject};

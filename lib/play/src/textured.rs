@@ -345,7 +345,7 @@ impl ObjectScene {
         if viewport.width == 0 || viewport.height == 0 || viewport.width > limit || viewport.height > limit {
             return Err(PlayError::TargetSize { width: viewport.width, height: viewport.height, limit });
         }
-        pis_compile::model::check_mesh(&object.mesh)?;
+        pis_compile::model::render_matrix_inputs_ok(viewport, object)?;
         for (axis, k, size) in [('s', 0, object.layout.width), ('t', 1, object.layout.height)] {
             if object.sampler.address[k] == Address::Repeat && !size.is_power_of_two() {
                 return Err(PlayError::RepeatSize { axis, size });
