@@ -10,6 +10,9 @@ use crate::model::{render_matrix, scene_depth, ModelError, TexturedObject};
 use crate::transform::{DrawMesh, Viewport};
 use crate::RenderMatrix;
 
+/// A display pixel's row: pixel, coverage, (column, weight) entries.
+type FilteredRow = (u32, f32, Vec<(u32, f32)>);
+
 /// The display filter of the ray-traced set (`set.json`: `filter.sigma_px`, `filter.radius_px`),
 /// in display pixels.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -49,7 +52,7 @@ pub fn antialias(supersampled: &RenderMatrix, factor: u32, filter: DisplayFilter
         }
     }
     let candidates: Vec<u32> = (0..reached.len() as u32).filter(|&p| reached[p as usize]).collect();
-    let rows: Vec<(u32, f32, Vec<(u32, f32)>)> = candidates
+    let rows: Vec<FilteredRow> = candidates
         .par_iter()
         .map_init(Vec::new, |acc: &mut Vec<(u32, f64)>, &p| {
             acc.clear();
