@@ -11,7 +11,7 @@
 //! `lib/play/src/textured.wgsl`): [`transform`] (vertex shader, clipping, viewport),
 //! [`raster`] (coverage with the top-left rule, depth), [`interpolate`] (perspective-correct
 //! (s, t) and fine derivatives), [`lod`] (the Vulkan LOD), [`filter`] (sampler weights),
-//! [`model`] (the render matrix), [`antialias`] (thesis 3.4.4).
+//! [`model`] (the render matrix), [`mod@antialias`] (thesis 3.4.4).
 
 pub mod antialias;
 pub mod filter;

@@ -103,7 +103,7 @@ pub fn render_matrix_inputs_ok(viewport: Viewport, object: &TexturedObject) -> R
 
 /// The render matrix A of `object` in `viewport`, its fragments tested against `occluders`
 /// (see [`scene_depth`]); every row has coverage 1 (no antialiasing: see
-/// [`crate::antialias`]). Rows are the visible pixels in increasing order.
+/// [`mod@crate::antialias`]). Rows are the visible pixels in increasing order.
 pub fn render_matrix(viewport: Viewport, object: &TexturedObject, occluders: Option<&DepthBuffer>) -> Result<RenderMatrix, ModelError> {
     render_matrix_inputs_ok(viewport, object)?;
     if let Some(o) = occluders {
