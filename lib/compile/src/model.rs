@@ -225,6 +225,30 @@ mod tests {
     }
 
     #[test]
+    fn objects_off_screen_behind_the_camera_or_degenerate_give_few_or_no_rows() {
+        let vp = Viewport { width: 32, height: 24 };
+        let proj = crate::transform::perspective(1.0, 4.0 / 3.0, 0.1, 100.0);
+        let layout = TextureLayout::full(16, 16);
+        // Behind the camera (z > 0 in view space), half off-screen, and edge-on.
+        let behind = [[-1.0, -1.0, 3.0], [1.0, -1.0, 3.0], [1.0, 1.0, 3.0], [-1.0, 1.0, 3.0]];
+        let half = [[0.0, -1.0, -3.0], [9.0, -1.0, -3.0], [9.0, 1.0, -3.0], [0.0, 1.0, -3.0]];
+        let edge_on = [[-1.0, 0.0, -2.0], [1.0, 0.0, -2.0], [1.0, 0.0, -4.0], [-1.0, 0.0, -4.0]];
+        let rows = |p: &[[f32; 3]]| {
+            let mut o = object(p, layout, Filter::Trilinear);
+            o.mesh.clip_from_object = proj;
+            render_matrix(vp, &o, None).unwrap().rows()
+        };
+        assert_eq!(rows(&behind), 0);
+        let h = rows(&half);
+        assert!(h > 0 && h < 32 * 24 / 2 + 24, "{h}");
+        assert_eq!(rows(&edge_on), 0);
+        // A non-finite matrix draws nothing rather than panicking.
+        let mut o = object(&half, layout, Filter::Trilinear);
+        o.mesh.clip_from_object = Mat4::from_cols_array(&[f32::NAN; 16]);
+        assert_eq!(render_matrix(vp, &o, None).unwrap().rows(), 0);
+    }
+
+    #[test]
     fn bad_inputs_are_errors() {
         let p = screen_quad();
         let vp = Viewport { width: 4, height: 4 };
