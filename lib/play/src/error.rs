@@ -13,8 +13,8 @@ pub enum PlayError {
     NoAdapter(String),
     #[error("the GPU adapter '{adapter}' refused a device: {message}")]
     Device { adapter: String, message: String },
-    #[error("the GPU adapter '{0}' cannot filter Rgba32Float textures (feature FLOAT32_FILTERABLE), which the player needs so that the hardware model stays exact")]
-    Float32Filterable(String),
+    #[error("probe mode needs Rgba32Float textures (texel identifiers up to 2^24), but the device '{0}' uses Rgba16Float (no FLOAT32_FILTERABLE, or half textures were asked for)")]
+    ProbeNeedsFloat32(String),
     #[error("repeat addressing along {axis} needs a power-of-two used texture size, got {size} (a wrapped dimension's size is chosen by texture-coordinate optimization)")]
     RepeatSize { axis: char, size: u32 },
     #[error("texture data has {got} values, the layout {width}×{height} with {levels} levels needs {want} (4 per texel)")]

@@ -12,7 +12,7 @@ pub mod probe;
 pub mod textured;
 
 pub use error::{PlayError, ADAPTER_HINT};
-pub use gpu::Gpu;
+pub use gpu::{Gpu, GpuOptions};
 pub use image::FloatImage;
 pub use probe::probe_render_matrix;
 pub use textured::{render_object, ObjectScene, ObjectTexture, TexturedPipeline};

@@ -110,6 +110,9 @@ fn probe_texture(layout: &TextureLayout, address: [Address; 2], p: u32, o: [u32;
 /// the pixels the object covers (alpha 1), coverage 1, columns sorted.
 pub fn probe_render_matrix(gpu: &Gpu, pipeline: &TexturedPipeline, viewport: Viewport, occluders: &[DrawMesh], object: &TexturedObject) -> Result<RenderMatrix, PlayError> {
     let layout = object.layout;
+    if gpu.texture_format != wgpu::TextureFormat::Rgba32Float {
+        return Err(PlayError::ProbeNeedsFloat32(gpu.info.name.clone()));
+    }
     pis_compile::model::render_matrix_inputs_ok(viewport, object)?;
     let scene = ObjectScene::new(gpu, pipeline, viewport, occluders, object)?;
     let texture = ObjectTexture::new(gpu, layout);

@@ -15,8 +15,10 @@
 //! used column and row, so clamp-to-edge on the allocated texture equals clamp-to-edge on the
 //! used region. Repeat addressing needs w (or h) to be a power of two (no padding).
 //!
-//! Textures are `Rgba32Float` (feature `FLOAT32_FILTERABLE`, see [`crate::Gpu::new`]): the
-//! values filtered are those the model's A multiplies, with no rounding to half floats.
+//! Textures are `Rgba32Float` where the adapter can filter it (feature `FLOAT32_FILTERABLE`,
+//! see [`crate::Gpu::texture_format`]): the values filtered are those the model's A
+//! multiplies. Elsewhere they are `Rgba16Float`, and texels are rounded to half floats on
+//! upload (model and GPU then differ by that rounding only: above 70 dB for values in [0, 1]).
 
 use bytemuck::{Pod, Zeroable};
 use pis_compile::filter::max_level;
@@ -27,8 +29,6 @@ use crate::error::PlayError;
 use crate::gpu::Gpu;
 use crate::image::FloatImage;
 
-/// Texture format of object textures.
-pub const TEXTURE_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
 /// Format of the offscreen render target.
 pub const TARGET_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
 /// Format of the depth buffer (the model's depth is f32 too).
@@ -99,7 +99,7 @@ impl ObjectTexture {
             mip_level_count: layout.levels,
             sample_count: 1,
             dimension: wgpu::TextureDimension::D2,
-            format: TEXTURE_FORMAT,
+            format: gpu.texture_format,
             usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
             view_formats: &[],
         });
@@ -109,7 +109,16 @@ impl ObjectTexture {
 
     /// Uploads every level: `rgba` holds 4 values per texel of the layout (its x order).
     pub fn upload(&self, gpu: &Gpu, rgba: &[f32]) -> Result<(), PlayError> {
+        let half = self.texture.format() == wgpu::TextureFormat::Rgba16Float;
         for (m, (w, h, img)) in gpu_levels(&self.layout, rgba)?.into_iter().enumerate() {
+            let halves: Vec<u16>;
+            let bytes: &[u8] = if half {
+                halves = img.iter().map(|&v| half::f16::from_f32(v).to_bits()).collect();
+                bytemuck::cast_slice(&halves)
+            } else {
+                bytemuck::cast_slice(&img)
+            };
+            let texel_bytes = if half { 8 } else { 16 };
             gpu.queue.write_texture(
                 wgpu::TexelCopyTextureInfo {
                     texture: &self.texture,
@@ -117,8 +126,8 @@ impl ObjectTexture {
                     origin: wgpu::Origin3d::ZERO,
                     aspect: wgpu::TextureAspect::All,
                 },
-                bytemuck::cast_slice(&img),
-                wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(w * 16), rows_per_image: Some(h) },
+                bytes,
+                wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(w * texel_bytes), rows_per_image: Some(h) },
                 wgpu::Extent3d { width: w, height: h, depth_or_array_layers: 1 },
             );
         }

@@ -23,7 +23,21 @@ const CLAMP: [Address; 2] = [Address::ClampToEdge; 2];
 #[test]
 fn model_matches_wgpu() {
     let Some(gpu) = gpu_or_skip("model_matches_wgpu") else { return };
-    let pipeline = TexturedPipeline::new(&gpu);
+    run_views(&gpu, "model_vs_wgpu");
+}
+
+/// The same with Rgba16Float textures (adapters without FLOAT32_FILTERABLE): the texels are
+/// rounded to half floats, the model is not, still ≥ 50 dB.
+#[test]
+fn model_matches_wgpu_with_half_float_textures() {
+    let options = pis_play::GpuOptions { half_textures: true };
+    let Some(gpu) = gpu_with_or_skip("model_matches_wgpu_with_half_float_textures", options) else { return };
+    run_views(&gpu, "model_vs_wgpu_half");
+}
+
+fn run_views(gpu: &pis_play::Gpu, test: &str) {
+    let gpu = gpu;
+    let pipeline = TexturedPipeline::new(gpu);
     let vp = Viewport { width: 200, height: 150 };
     let sphere = uv_sphere(48, 24);
     let occluder = quad(-2.0, -0.2, -2.0, -0.3, 1.3);
@@ -64,15 +78,15 @@ fn model_matches_wgpu() {
             let a = render_matrix(vp, &object, Some(&depth)).unwrap();
             let x = random_rgba(view.layout.texel_count(), 7);
             let want = predict(&a, &x);
-            let got = render_object(&gpu, &pipeline, vp, &[occ], &object, &x).unwrap();
+            let got = render_object(gpu, &pipeline, vp, &[occ], &object, &x).unwrap();
             let c = compare(&want, &got);
             let nnz = a.cols.len() as f64 / a.rows() as f64;
             eprintln!(
-                "{} {filter:?}: PSNR {:.2} dB over {} pixels, {} coverage mismatches, {nnz:.2} taps/row",
+                "{test} {} {filter:?}: PSNR {:.2} dB over {} pixels, {} coverage mismatches, {nnz:.2} taps/row",
                 view.name, c.psnr_db, c.both, c.coverage_mismatch
             );
             worst = worst.min(c.psnr_db);
-            let name = format!("model_vs_wgpu-{}-{filter:?}", view.name);
+            let name = format!("{test}-{}-{filter:?}", view.name);
             // Nearest is discontinuous: where (s, t) lies within float rounding of a texel
             // boundary, GPU and model may pick neighbouring texels (a few pixels per view).
             let threshold = if filter == Filter::Nearest { 40.0 } else { 50.0 };

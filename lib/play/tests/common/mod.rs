@@ -14,7 +14,12 @@ use pis_play::{FloatImage, Gpu};
 /// The GPU, or `None` with a printed reason when there is none and this is not CI. In CI
 /// (`CI=true`) a missing adapter fails the test.
 pub fn gpu_or_skip(test: &str) -> Option<Gpu> {
-    match Gpu::new() {
+    gpu_with_or_skip(test, pis_play::GpuOptions::default())
+}
+
+/// [`gpu_or_skip`] with options.
+pub fn gpu_with_or_skip(test: &str, options: pis_play::GpuOptions) -> Option<Gpu> {
+    match Gpu::with_options(options) {
         Ok(g) => {
             eprintln!("{test}: adapter {}", g.describe());
             Some(g)
