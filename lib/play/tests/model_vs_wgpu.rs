@@ -36,7 +36,6 @@ fn model_matches_wgpu_with_half_float_textures() {
 }
 
 fn run_views(gpu: &pis_play::Gpu, test: &str) {
-    let gpu = gpu;
     let pipeline = TexturedPipeline::new(gpu);
     let vp = Viewport { width: 200, height: 150 };
     let sphere = uv_sphere(48, 24);
