@@ -40,8 +40,8 @@ impl Taps {
     /// The taps sorted by column.
     pub fn sorted(&self) -> impl Iterator<Item = (u32, f32)> {
         let mut v: [(u32, f32); 8] = [(0, 0.0); 8];
-        for k in 0..self.len {
-            v[k] = (self.cols[k], self.weights[k]);
+        for (k, e) in v.iter_mut().enumerate().take(self.len) {
+            *e = (self.cols[k], self.weights[k]);
         }
         v[..self.len].sort_unstable_by_key(|p| p.0);
         v.into_iter().take(self.len)

@@ -12,6 +12,13 @@ pub struct TextureLayout {
     pub levels: u32,
 }
 
+impl Default for TextureLayout {
+    /// A single texel.
+    fn default() -> Self {
+        TextureLayout { width: 1, height: 1, levels: 1 }
+    }
+}
+
 impl TextureLayout {
     /// A texture with its whole MIP chain.
     pub fn full(width: u32, height: u32) -> Self {

@@ -11,7 +11,7 @@
 //! `lib/play/src/textured.wgsl`): [`transform`] (vertex shader, clipping, viewport),
 //! [`raster`] (coverage with the top-left rule, depth), [`interpolate`] (perspective-correct
 //! (s, t) and fine derivatives), [`lod`] (the Vulkan LOD), [`filter`] (sampler weights),
-//! [`model`] (the render matrix), [`antialias`] (thesis 3.4.4).
+//! [`model`] (the render matrix), [`mod@antialias`] (thesis 3.4.4).
 //!
 //! The solver (thesis 3.5): [`solve()`] (one view), [`solve_view_independent`] (eq. 3.7),
 //! settings in [`SolveSettings`]; [`cg`] (conjugate gradient with exact line search),
@@ -41,7 +41,7 @@ pub mod synthetic;
 pub mod texcoord;
 pub mod transform;
 
-pub use antialias::{antialias, DisplayFilter};
+pub use antialias::{antialias, antialiased_render_matrix, DisplayFilter};
 pub use error::CompileError;
 pub use layout::TextureLayout;
 pub use matrix::RenderMatrix;

@@ -23,12 +23,6 @@ pub struct RenderMatrix {
     pub vals: Vec<f32>,
 }
 
-impl Default for TextureLayout {
-    fn default() -> Self {
-        TextureLayout { width: 1, height: 1, levels: 1 }
-    }
-}
-
 impl RenderMatrix {
     /// n_s.
     pub fn rows(&self) -> usize {

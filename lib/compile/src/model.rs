@@ -95,12 +95,17 @@ pub fn scene_depth(viewport: Viewport, meshes: &[DrawMesh], skip: Option<usize>)
     Ok(depth)
 }
 
+/// Checks what [`render_matrix`] checks before drawing (probe mode checks the same).
+pub fn render_matrix_inputs_ok(viewport: Viewport, object: &TexturedObject) -> Result<(), ModelError> {
+    check_mesh(&object.mesh)?;
+    check_inputs(viewport, &object.layout, &object.transform)
+}
+
 /// The render matrix A of `object` in `viewport`, its fragments tested against `occluders`
 /// (see [`scene_depth`]); every row has coverage 1 (no antialiasing: see
-/// [`crate::antialias`]). Rows are the visible pixels in increasing order.
+/// [`mod@crate::antialias`]). Rows are the visible pixels in increasing order.
 pub fn render_matrix(viewport: Viewport, object: &TexturedObject, occluders: Option<&DepthBuffer>) -> Result<RenderMatrix, ModelError> {
-    check_mesh(&object.mesh)?;
-    check_inputs(viewport, &object.layout, &object.transform)?;
+    render_matrix_inputs_ok(viewport, object)?;
     if let Some(o) = occluders {
         if o.viewport != viewport {
             return Err(ModelError::DepthSize { got: o.viewport, want: viewport });
@@ -217,6 +222,30 @@ mod tests {
         }
         let mean = a.cols.len() as f64 / a.rows() as f64;
         assert!(mean > 4.0, "mean taps {mean}");
+    }
+
+    #[test]
+    fn objects_off_screen_behind_the_camera_or_degenerate_give_few_or_no_rows() {
+        let vp = Viewport { width: 32, height: 24 };
+        let proj = crate::transform::perspective(1.0, 4.0 / 3.0, 0.1, 100.0);
+        let layout = TextureLayout::full(16, 16);
+        // Behind the camera (z > 0 in view space), half off-screen, and edge-on.
+        let behind = [[-1.0, -1.0, 3.0], [1.0, -1.0, 3.0], [1.0, 1.0, 3.0], [-1.0, 1.0, 3.0]];
+        let half = [[0.0, -1.0, -3.0], [9.0, -1.0, -3.0], [9.0, 1.0, -3.0], [0.0, 1.0, -3.0]];
+        let edge_on = [[-1.0, 0.0, -2.0], [1.0, 0.0, -2.0], [1.0, 0.0, -4.0], [-1.0, 0.0, -4.0]];
+        let rows = |p: &[[f32; 3]]| {
+            let mut o = object(p, layout, Filter::Trilinear);
+            o.mesh.clip_from_object = proj;
+            render_matrix(vp, &o, None).unwrap().rows()
+        };
+        assert_eq!(rows(&behind), 0);
+        let h = rows(&half);
+        assert!(h > 0 && h < 32 * 24 / 2 + 24, "{h}");
+        assert_eq!(rows(&edge_on), 0);
+        // A non-finite matrix draws nothing rather than panicking.
+        let mut o = object(&half, layout, Filter::Trilinear);
+        o.mesh.clip_from_object = Mat4::from_cols_array(&[f32::NAN; 16]);
+        assert_eq!(render_matrix(vp, &o, None).unwrap().rows(), 0);
     }
 
     #[test]

@@ -1,0 +1,28 @@
+//! The player's errors.
+
+use thiserror::Error;
+
+/// How to get a GPU adapter on a machine without one.
+pub const ADAPTER_HINT: &str = "no GPU adapter found; on a machine without a GPU install Mesa's software \
+Vulkan driver (lavapipe): `apt-get install -y mesa-vulkan-drivers`";
+
+/// Why the player cannot draw.
+#[derive(Debug, Error)]
+pub enum PlayError {
+    #[error("{ADAPTER_HINT} ({0})")]
+    NoAdapter(String),
+    #[error("the GPU adapter '{adapter}' refused a device: {message}")]
+    Device { adapter: String, message: String },
+    #[error("probe mode needs Rgba32Float textures (texel identifiers up to 2^24), but the device '{0}' uses Rgba16Float (no FLOAT32_FILTERABLE, or half textures were asked for)")]
+    ProbeNeedsFloat32(String),
+    #[error("repeat addressing along {axis} needs a power-of-two used texture size, got {size} (a wrapped dimension's size is chosen by texture-coordinate optimization)")]
+    RepeatSize { axis: char, size: u32 },
+    #[error("texture data has {got} values, the layout {width}×{height} with {levels} levels needs {want} (4 per texel)")]
+    TextureData { got: usize, want: usize, width: u32, height: u32, levels: u32 },
+    #[error("render target {width}×{height} is empty or exceeds the adapter's limit {limit}")]
+    TargetSize { width: u32, height: u32, limit: u32 },
+    #[error("reading back the frame failed: {0}")]
+    Readback(String),
+    #[error(transparent)]
+    Model(#[from] pis_compile::ModelError),
+}

@@ -1,0 +1,70 @@
+// The player's textured-object pipeline. One function written twice: every function here has
+// a twin of the same name in pis-compile's hardware model, with the same order of operations
+// (texcoord: transform.rs; texture_lod: lod.rs; fine derivatives: interpolate.rs; the
+// sampler: filter.rs). Change both together.
+
+struct Uniforms {
+    // projection · view · world of the object.
+    clip_from_object: mat4x4<f32>,
+    // The block's affine texture transform (SPEC.md 7.3): (a, b, c, d) and (e, f).
+    affine_abcd: vec4<f32>,
+    affine_ef: vec2<f32>,
+    // Used size of level 0 in texels (w, h).
+    size: vec2<f32>,
+    // Used size / allocated size per axis: maps (s, t) ∈ [0, 1]² onto the used region.
+    scale: vec2<f32>,
+    // Largest level of detail: levels − 1 for trilinear, 0 for nearest and bilinear.
+    max_level: f32,
+    _pad: f32,
+};
+
+@group(0) @binding(0) var<uniform> u: Uniforms;
+@group(0) @binding(1) var tex: texture_2d<f32>;
+@group(0) @binding(2) var samp: sampler;
+
+struct VsOut {
+    @builtin(position) clip: vec4<f32>,
+    // (s, t), interpolated perspective-correct.
+    @location(0) st: vec2<f32>,
+};
+
+// s = a·u + b·v + e, t = c·u + d·v + f.
+fn texcoord(uv: vec2<f32>) -> vec2<f32> {
+    return vec2<f32>(
+        u.affine_abcd.x * uv.x + u.affine_abcd.y * uv.y + u.affine_ef.x,
+        u.affine_abcd.z * uv.x + u.affine_abcd.w * uv.y + u.affine_ef.y,
+    );
+}
+
+// The Vulkan LOD for isotropic filtering: λ = clamp(log2(max(ρx, ρy)), 0, max_level).
+fn texture_lod(ddx: vec2<f32>, ddy: vec2<f32>, size: vec2<f32>, max_level: f32) -> f32 {
+    let rho_x = sqrt((ddx.x * size.x) * (ddx.x * size.x) + (ddx.y * size.y) * (ddx.y * size.y));
+    let rho_y = sqrt((ddy.x * size.x) * (ddy.x * size.x) + (ddy.y * size.y) * (ddy.y * size.y));
+    let rho = max(max(rho_x, rho_y), 1e-30);
+    return clamp(log2(rho), 0.0, max(max_level, 0.0));
+}
+
+@vertex
+fn vs_main(@location(0) position: vec3<f32>, @location(1) uv: vec2<f32>) -> VsOut {
+    var out: VsOut;
+    out.clip = u.clip_from_object * vec4<f32>(position, 1.0);
+    out.st = texcoord(uv);
+    return out;
+}
+
+// Depth-only pass of the occluders.
+@vertex
+fn vs_depth(@location(0) position: vec3<f32>) -> @builtin(position) vec4<f32> {
+    return u.clip_from_object * vec4<f32>(position, 1.0);
+}
+
+@fragment
+fn fs_main(in: VsOut) -> @location(0) vec4<f32> {
+    // Fine derivatives: differences across the pixel's row and column of its 2×2 quad.
+    let ddx = dpdxFine(in.st);
+    let ddy = dpdyFine(in.st);
+    let lambda = texture_lod(ddx, ddy, u.size, u.max_level);
+    let c = textureSampleLevel(tex, samp, in.st * u.scale, lambda);
+    // Alpha 1 marks coverage.
+    return vec4<f32>(c.rgb, 1.0);
+}

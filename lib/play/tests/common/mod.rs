@@ -1,0 +1,159 @@
+//! Shared test scenes for the GPU tests: a UV sphere, an occluder, random textures, PSNR,
+//! and the adapter policy (fail in CI, skip locally).
+
+#![allow(dead_code)]
+
+use std::f32::consts::PI;
+use std::path::PathBuf;
+
+use glam::{Mat4, Vec3};
+use pis_compile::transform::{look_at, perspective};
+use pis_compile::{RenderMatrix, Viewport};
+use pis_play::{FloatImage, Gpu};
+
+/// The GPU, or `None` with a printed reason when there is none and this is not CI. In CI
+/// (`CI=true`) a missing adapter fails the test.
+pub fn gpu_or_skip(test: &str) -> Option<Gpu> {
+    gpu_with_or_skip(test, pis_play::GpuOptions::default())
+}
+
+/// [`gpu_or_skip`] with options.
+pub fn gpu_with_or_skip(test: &str, options: pis_play::GpuOptions) -> Option<Gpu> {
+    match Gpu::with_options(options) {
+        Ok(g) => {
+            eprintln!("{test}: adapter {}", g.describe());
+            Some(g)
+        }
+        Err(e) if std::env::var("CI").map(|v| v == "true").unwrap_or(false) => panic!("{test}: {e}"),
+        Err(e) => {
+            eprintln!("{test}: skipped: {e}");
+            None
+        }
+    }
+}
+
+/// A UV sphere of radius 1: u = longitude / 2π, v = colatitude / π (v = 0 at +y).
+pub struct Mesh {
+    pub positions: Vec<[f32; 3]>,
+    pub uvs: Vec<[f32; 2]>,
+    pub indices: Vec<u32>,
+}
+
+pub fn uv_sphere(slices: u32, stacks: u32) -> Mesh {
+    let mut m = Mesh { positions: vec![], uvs: vec![], indices: vec![] };
+    for j in 0..=stacks {
+        let v = j as f32 / stacks as f32;
+        let th = v * PI;
+        for i in 0..=slices {
+            let u = i as f32 / slices as f32;
+            let ph = u * 2.0 * PI;
+            m.positions.push([th.sin() * ph.cos(), th.cos(), -th.sin() * ph.sin()]);
+            m.uvs.push([u, v]);
+        }
+    }
+    let row = slices + 1;
+    for j in 0..stacks {
+        for i in 0..slices {
+            let (a, b, c, d) = (j * row + i, j * row + i + 1, (j + 1) * row + i + 1, (j + 1) * row + i);
+            m.indices.extend([a, b, c, a, c, d]);
+        }
+    }
+    m
+}
+
+/// A quad occluder in the plane z = `z`, x ∈ [x0, x1], y ∈ [y0, y1].
+pub fn quad(x0: f32, x1: f32, y0: f32, y1: f32, z: f32) -> Mesh {
+    Mesh {
+        positions: vec![[x0, y0, z], [x1, y0, z], [x1, y1, z], [x0, y1, z]],
+        uvs: vec![[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]],
+        indices: vec![0, 1, 2, 0, 2, 3],
+    }
+}
+
+/// A camera: clip-from-world of a perspective view at `eye` looking at `target`.
+pub fn camera(vp: Viewport, eye: [f32; 3], target: [f32; 3], fovy: f32) -> Mat4 {
+    perspective(fovy, vp.width as f32 / vp.height as f32, 0.1, 50.0) * look_at(Vec3::from(eye), Vec3::from(target), Vec3::Y)
+}
+
+/// Deterministic random values in [0, 1) (xorshift).
+pub fn random(n: usize, seed: u64) -> Vec<f32> {
+    let mut s = seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) | 1;
+    (0..n)
+        .map(|_| {
+            s ^= s << 13;
+            s ^= s >> 7;
+            s ^= s << 17;
+            (s >> 40) as f32 / (1u64 << 24) as f32
+        })
+        .collect()
+}
+
+/// An RGBA texture (4 values per texel, alpha 1) with independent random R, G, B.
+pub fn random_rgba(texels: usize, seed: u64) -> Vec<f32> {
+    let r = random(texels * 3, seed);
+    (0..texels).flat_map(|t| [r[3 * t], r[3 * t + 1], r[3 * t + 2], 1.0]).collect()
+}
+
+/// A·x per channel for an RGBA texture: the image the model predicts (alpha = coverage).
+pub fn predict(a: &RenderMatrix, rgba: &[f32]) -> FloatImage {
+    let mut img = FloatImage { width: a.width, height: a.height, rgba: vec![0.0; a.width as usize * a.height as usize * 4] };
+    for r in 0..a.rows() {
+        let (c, v) = a.row(r);
+        let p = a.pixels[r] as usize;
+        for ch in 0..3 {
+            img.rgba[4 * p + ch] = c.iter().zip(v).map(|(&c, &v)| v * rgba[4 * c as usize + ch]).sum();
+        }
+        img.rgba[4 * p + 3] = a.coverage[r];
+    }
+    img
+}
+
+/// The comparison of two renderings over the pixels both cover.
+#[derive(Debug)]
+pub struct Comparison {
+    pub psnr_db: f64,
+    pub both: usize,
+    /// Pixels covered in one rendering only.
+    pub coverage_mismatch: usize,
+}
+
+pub fn compare(want: &FloatImage, got: &FloatImage) -> Comparison {
+    let (mut se, mut n, mut mismatch) = (0.0f64, 0usize, 0usize);
+    for p in 0..(want.width * want.height) as usize {
+        let (a, b) = (want.pixel(p), got.pixel(p));
+        match (a[3] > 0.5, b[3] > 0.5) {
+            (true, true) => {
+                for ch in 0..3 {
+                    se += ((a[ch] - b[ch]) as f64).powi(2);
+                }
+                n += 3;
+            }
+            (false, false) => {}
+            _ => mismatch += 1,
+        }
+    }
+    let mse = se / n.max(1) as f64;
+    Comparison { psnr_db: if mse == 0.0 { f64::INFINITY } else { -10.0 * mse.log10() }, both: n / 3, coverage_mismatch: mismatch }
+}
+
+/// Writes `NAME-actual.png` (the GPU image) and `NAME-difference.png` (|want − got| × 64)
+/// into the test output folder; returns the folder.
+pub fn write_failure_images(name: &str, want: &FloatImage, got: &FloatImage) -> PathBuf {
+    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR"));
+    let to8 = |v: f32| (v.clamp(0.0, 1.0) * 255.0 + 0.5) as u8;
+    let (w, h) = (got.width, got.height);
+    let actual = image::RgbImage::from_fn(w, h, |x, y| {
+        let p = got.pixel((y * w + x) as usize);
+        image::Rgb([to8(p[0]), to8(p[1]), to8(p[2])])
+    });
+    let diff = image::RgbImage::from_fn(w, h, |x, y| {
+        let (a, b) = (want.pixel((y * w + x) as usize), got.pixel((y * w + x) as usize));
+        if (a[3] > 0.5) != (b[3] > 0.5) {
+            return image::Rgb([255, 0, 255]);
+        }
+        image::Rgb([0, 1, 2].map(|c| to8((a[c] - b[c]).abs() * 64.0)))
+    });
+    let _ = actual.save(dir.join(format!("{name}-actual.png")));
+    let _ = diff.save(dir.join(format!("{name}-difference.png")));
+    dir
+}
