@@ -19,7 +19,7 @@ fn infer_reports_every_method_as_json() {
         return;
     }
     let out = bench(&["infer", scene.to_str().unwrap(), "--resolution", "64x48", "--spp", "1",
-                      "--object", "Vase", "--at", "0,0", "--json"]);
+                      "--object", "Vase", "--at", "0,0", "--no-wgpu", "--json"]);
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("JSON on stdout");
     assert_eq!(v["object"], "Vase");
@@ -30,6 +30,29 @@ fn infer_reports_every_method_as_json() {
     }
     for k in ["solve_ms", "iterations", "n_s", "n_t"] {
         assert!(v[k].as_f64().is_some(), "{k}");
+    }
+}
+
+#[test]
+fn infer_renders_through_wgpu_where_an_adapter_exists() {
+    let scene = demo1();
+    if !scene.exists() {
+        return;
+    }
+    let out = bench(&["infer", scene.to_str().unwrap(), "--resolution", "64x48", "--spp", "1",
+                      "--object", "Vase", "--json"]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("JSON on stdout");
+    let notes = v["notes"].to_string();
+    for m in ["ls-bilinear", "ls-trilinear", "ls-pyramidal", "forward", "traced"] {
+        let w = &v["methods"][m]["psnr_db_wgpu"];
+        if notes.contains("rendered by pis-play") {
+            let (w, model) = (w.as_f64().unwrap_or(f64::NAN), v["methods"][m]["psnr_db"].as_f64().unwrap_or(f64::NAN));
+            // the player draws what the model predicts (one truth for the rendering math)
+            assert!(w > 5.0 && (w >= 35.0 || (w - model).abs() < 6.0), "{m}: wgpu {w} dB, model {model} dB");
+        } else {
+            assert!(w.is_null(), "{m}");
+        }
     }
 }
 

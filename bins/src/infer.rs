@@ -22,6 +22,7 @@ use pis_compile::{
     render, render_matrix, scene_depth, solve, Address, DrawMesh, Filter, RenderMatrix, Sampler,
     SolveSettings, TextureLayout, TextureTransform, TexturedObject, Viewport,
 };
+use pis_play::{render_object, Gpu, TexturedPipeline};
 use pis_scene::{Frame, LoadOptions, Scene};
 use pis_trace::layers::LayerKind;
 use pis_trace::{PointImages, TraceSettings};
@@ -51,6 +52,8 @@ pub struct InferRequest {
     pub solver: SolveSettings,
     /// ε_f of the pyramidal solve.
     pub epsilon_f: f64,
+    /// Also render every texture through the player's wgpu pipeline (pis-play).
+    pub wgpu: bool,
 }
 
 /// One method's result.
@@ -346,25 +349,50 @@ pub fn infer(req: &InferRequest) -> Result<InferReport> {
     if a_tri.rows() == 0 {
         bail!("object {} covers no pixel at this point", names[o]);
     }
+    // The player's pipeline, where an adapter exists (Mesa's lavapipe on a machine without
+    // a GPU).
+    let mut notes = Vec::new();
+    let gpu_state: Result<(Gpu, TexturedPipeline), String> = if req.wgpu {
+        Gpu::new().map(|g| { let p = TexturedPipeline::new(&g); (g, p) }).map_err(|e| e.to_string())
+    } else {
+        Err("not asked for (--no-wgpu)".into())
+    };
+    match &gpu_state {
+        Ok((g, _)) => notes.push(format!("psnr_db_wgpu: rendered by pis-play on {}", g.describe())),
+        Err(e) => notes.push(format!("psnr_db_wgpu is null: no wgpu rendering ({e})")),
+    }
+    let occluder_meshes: Vec<DrawMesh> = draw.iter().enumerate().filter(|(k, _)| *k != o).map(|(_, m)| *m).collect();
+    let wgpu_psnr = |a: &RenderMatrix, filter: Filter, x: &[f32]| -> Result<Option<f64>, String> {
+        let Ok((gpu, pipeline)) = gpu_state.as_ref() else { return Ok(None) };
+        let obj = TexturedObject { mesh: mesh_o, transform: prep.transform, layout: prep.layout, sampler: sampler(filter, prep.repeat) };
+        let rgba: Vec<f32> = x.chunks_exact(3).flat_map(|c| [c[0], c[1], c[2], 1.0]).collect();
+        let img = render_object(gpu, pipeline, viewport, &occluder_meshes, &obj, &rgba).map_err(|e| e.to_string())?;
+        let got: Vec<f32> = a.pixels.iter().flat_map(|&p| { let v = img.pixel(p as usize); [v[0], v[1], v[2]] }).collect();
+        Ok(Some(psnr_display(&got, &b)))
+    };
     let mut methods = BTreeMap::new();
-    let mut method = |name: &str, a: &RenderMatrix, x: &[f32], ms: f64, it: Option<u32>| {
+    let mut method = |name: &str, a: &RenderMatrix, filter: Filter, x: &[f32], ms: f64, it: Option<u32>| {
         let p = psnr_display(&render(a, x), &b);
-        methods.insert(name.to_string(), MethodReport { psnr_db: p, psnr_db_wgpu: None, ms, iterations: it });
+        let w = wgpu_psnr(a, filter, x).unwrap_or_else(|e| {
+            notes.push(format!("{name}: wgpu rendering failed: {e}"));
+            None
+        });
+        methods.insert(name.to_string(), MethodReport { psnr_db: p, psnr_db_wgpu: w, ms, iterations: it });
     };
     let plain = req.solver;
     let pyramidal = SolveSettings { epsilon_f: req.epsilon_f, ..req.solver };
     let bil = solve(&a_bil, &b, None, &plain)?;
-    method("ls-bilinear", &a_bil, &bil.texels, bil.solve_ms, Some(bil.iterations));
+    method("ls-bilinear", &a_bil, Filter::Bilinear, &bil.texels, bil.solve_ms, Some(bil.iterations));
     let tri = solve(&a_tri, &b, None, &plain)?;
-    method("ls-trilinear", &a_tri, &tri.texels, tri.solve_ms, Some(tri.iterations));
+    method("ls-trilinear", &a_tri, Filter::Trilinear, &tri.texels, tri.solve_ms, Some(tri.iterations));
     let pyr = solve(&a_tri, &b, None, &pyramidal)?;
-    method("ls-pyramidal", &a_tri, &pyr.texels, pyr.solve_ms, Some(pyr.iterations));
+    method("ls-pyramidal", &a_tri, Filter::Trilinear, &pyr.texels, pyr.solve_ms, Some(pyr.iterations));
 
     // Baselines, rendered with trilinear filtering as the player would draw them.
     let t = Instant::now();
     let layer = LayerImage { width: w, height: h, rgb: rgb.clone(), covered: cov.iter().map(|&c| c > 0.0).collect() };
     let fwd = forward_map(&mesh_o, &prep.transform, &layer, &prep.layout)?;
-    method("forward", &a_tri, &fwd, t.elapsed().as_secs_f64() * 1e3, None);
+    method("forward", &a_tri, Filter::Trilinear, &fwd, t.elapsed().as_secs_f64() * 1e3, None);
     let t = Instant::now();
     let eye = pt.frame.camera.world_from_camera.w_axis.truncate();
     let mut trace_err = None;
@@ -383,7 +411,7 @@ pub fn infer(req: &InferRequest) -> Result<InferReport> {
     if let Some(e) = trace_err {
         return Err(e.into());
     }
-    method("traced", &a_tri, &traced, t.elapsed().as_secs_f64() * 1e3, None);
+    method("traced", &a_tri, Filter::Trilinear, &traced, t.elapsed().as_secs_f64() * 1e3, None);
 
     let mut objects = Vec::new();
     if req.all_objects {
@@ -426,11 +454,10 @@ pub fn infer(req: &InferRequest) -> Result<InferReport> {
         texcoord_ms: prep.texcoord_ms,
         matrix_ms,
         objects,
-        notes: vec![
-            "psnr_db_wgpu is null: this build has no wgpu renderer of textured objects (pis-play)".into(),
+        notes: [notes, vec![
             "PSNR on display values: linear radiance clamped to [0, 1], sRGB-encoded, peak 1, over the object's covered pixels".into(),
             "baselines are rendered with trilinear filtering".into(),
-        ],
+        ]].concat(),
     })
 }
 
@@ -440,7 +467,11 @@ pub fn print_report(r: &InferReport, out: &mut impl std::io::Write) -> std::io::
     writeln!(out, "  texture {}x{} (repeat {:?}), n_s {}, n_t {}", r.texture[0], r.texture[1], r.repeat, r.n_s, r.n_t)?;
     for (name, m) in &r.methods {
         let it = m.iterations.map_or(String::new(), |i| format!(", {i} iterations"));
-        writeln!(out, "  {name:<13} {:6.2} dB   ({:.0} ms{it})", m.psnr_db, m.ms)?;
+        let w = m.psnr_db_wgpu.map_or("     -".to_string(), |p| format!("{p:6.2}"));
+        writeln!(out, "  {name:<13} model {:6.2} dB, wgpu {w} dB   ({:.0} ms{it})", m.psnr_db, m.ms)?;
+    }
+    for n in &r.notes {
+        writeln!(out, "  note: {n}")?;
     }
     writeln!(out, "  trace {:.0} ms, texcoord {:.0} ms, matrices {:.0} ms, LS-trilinear solve {:.0} ms ({} iterations)",
              r.trace_ms, r.texcoord_ms, r.matrix_ms, r.solve_ms, r.iterations)?;

@@ -58,6 +58,9 @@ enum Command {
         /// Conjugate-gradient iteration limit per colour channel.
         #[arg(long, default_value_t = 400)]
         max_iterations: u32,
+        /// Skip the renders through wgpu (pis-play); psnr_db_wgpu is then null.
+        #[arg(long)]
+        no_wgpu: bool,
         /// Print the report as JSON on stdout.
         #[arg(long)]
         json: bool,
@@ -76,7 +79,7 @@ fn parse_resolution(s: &str) -> Result<(u32, u32), String> {
 
 fn run(cli: Cli) -> Result<Exit, Failure> {
     match cli.command {
-        Command::Infer { input, object, at, scene, resolution, spp, preset, all_objects, max_texture, epsilon_f, tolerance, max_iterations, json } => {
+        Command::Infer { input, object, at, scene, resolution, spp, preset, all_objects, max_texture, epsilon_f, tolerance, max_iterations, no_wgpu, json } => {
             if !input.exists() {
                 return Err(Failure::new(Exit::Io, anyhow::anyhow!("{} does not exist", input.display())));
             }
@@ -89,7 +92,7 @@ fn run(cli: Cli) -> Result<Exit, Failure> {
             let mut solver = SolveSettings::default();
             solver.cg.tolerance = tolerance;
             solver.cg.max_iterations = max_iterations;
-            let req = InferRequest { input, scene, object, at, resolution, spp, preset, all_objects, max_texture, solver, epsilon_f };
+            let req = InferRequest { input, scene, object, at, resolution, spp, preset, all_objects, max_texture, solver, epsilon_f, wgpu: !no_wgpu };
             let report = infer(&req).map_err(|e| Failure::new(Exit::Runtime, e))?;
             print_report(&report, &mut std::io::stderr()).map_err(|e| Failure::new(Exit::Io, e))?;
             if json {
