@@ -64,7 +64,7 @@ pub struct ObjectMesh<'a> {
 pub struct TexturePlacement {
     /// [a, b, c, d, e, f] of SPEC.md 7.3.
     pub affine: [f32; 6],
-    /// Used texture size in texels.
+    /// Used texture size in texels; a power of two along a dimension that repeats.
     pub width: u32,
     pub height: u32,
     /// Whether the texture wraps along s and t (a periodic dimension without a cut).
@@ -195,7 +195,15 @@ pub fn optimize_placement(
     // Step 6: the used resolution.
     let ext = hi - lo;
     let size = |e: f64| ((e * settings.reduction).ceil().max(1.0) as u64).min(settings.max_size as u64) as u32;
-    let (width, height) = (size(ext.x), size(ext.y));
+    let (mut width, mut height) = (size(ext.x), size(ext.y));
+    // A wrapped dimension keeps repeat addressing, which the player supports only on a
+    // power-of-two used size (thesis 3.2: the next power of two above the optimum).
+    for (dim, side) in [&mut width, &mut height].into_iter().enumerate() {
+        if repeat[dim] {
+            let p = side.next_power_of_two();
+            *side = if p > settings.max_size { (settings.max_size + 1).next_power_of_two() / 2 } else { p };
+        }
+    }
     let mut affine = [0.0f64; 6];
     for dim in 0..2 {
         let e = if ext[dim] > 1e-12 { ext[dim] } else { 1.0 };
