@@ -72,3 +72,28 @@ fn infer_exit_codes() {
     let out = bench(&["infer"]);
     assert_eq!(out.status.code(), Some(1));
 }
+
+#[test]
+fn infer_reads_a_ray_traced_set() {
+    let scene = demo1();
+    if !scene.exists() {
+        return;
+    }
+    let dir = tempfile::tempdir().expect("temporary directory");
+    let set = dir.path().join("set");
+    let out = Command::new(env!("CARGO_BIN_EXE_pis-trace"))
+        .args([scene.to_str().unwrap(), "-o", set.to_str().unwrap(), "--resolution", "48x36", "--spp", "1"])
+        .output()
+        .expect("pis-trace runs");
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    // without --scene the set directory must hold scene.toml
+    let out = bench(&["infer", set.to_str().unwrap(), "--no-wgpu"]);
+    assert_eq!(out.status.code(), Some(4));
+    let out = bench(&["infer", set.to_str().unwrap(), "--scene", scene.to_str().unwrap(), "--object", "Walls",
+                      "--no-wgpu", "--json"]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("JSON on stdout");
+    assert_eq!(v["object"], "Walls");
+    assert_eq!(v["resolution"], serde_json::json!([48, 36]));
+    assert_eq!(v["trace_ms"], 0.0);
+}
