@@ -1,0 +1,182 @@
+//! Rendering one parameter point: camera samples over the Gaussian filter, rows in parallel,
+//! accumulated in a fixed order so the result is byte-identical for any thread count.
+
+use crate::camera::PerspectiveCamera;
+use crate::error::TraceError;
+use crate::integrator::{Integrator, PathContext};
+use crate::layers::{resolve, PixelAccum, PointImages};
+use crate::records::{RayRecord, RecordHit};
+use crate::sampling::{hash_keys, r2_point, Rng};
+use crate::settings::TraceSettings;
+use glam::Vec2;
+use pis_scene::{Frame, ObjectRole, Scene};
+use rayon::prelude::*;
+use std::time::Instant;
+
+/// One rendered row: pixel sums, ray records, rays traced.
+type RowResult = (Vec<PixelAccum>, Vec<RayRecord>, u64);
+
+/// Image rows per parallel work unit (they share the first-hit irradiance cache).
+pub const BAND_ROWS: u32 = 8;
+
+/// Counters of one render.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct RenderStats {
+    /// Primary rays.
+    pub camera_rays: u64,
+    /// All rays (primary, shadow, secondary).
+    pub total_rays: u64,
+    /// World triangles in the BVH.
+    pub triangles: u64,
+    /// Seconds spent building the BVH.
+    pub build_seconds: f64,
+    /// Seconds spent tracing.
+    pub trace_seconds: f64,
+}
+
+/// The result of rendering one parameter point.
+#[derive(Clone, Debug)]
+pub struct PointRender {
+    pub images: PointImages,
+    /// Outgoing-ray records of refractive lens objects, in pixel and sample order.
+    pub records: Vec<RayRecord>,
+    pub stats: RenderStats,
+}
+
+/// Channel-safe, unique object names: characters other than `[A-Za-z0-9_-]` become `_`,
+/// empty names become `object<i>`, and repeats get `_<i>` appended.
+pub fn channel_names(scene: &Scene) -> Vec<String> {
+    let mut out: Vec<String> = Vec::with_capacity(scene.objects.len());
+    for (i, o) in scene.objects.iter().enumerate() {
+        let mut s: String =
+            o.name.chars().map(|c| if c.is_ascii_alphanumeric() || c == '_' || c == '-' { c } else { '_' }).collect();
+        if s.is_empty() {
+            s = format!("object{i}");
+        }
+        if out.contains(&s) {
+            s = format!("{s}_{i}");
+        }
+        out.push(s);
+    }
+    out
+}
+
+/// Renders `scene` at `frame`. `row_done` is called once per finished image row (from any
+/// thread), for progress display. Runs on the current rayon pool.
+pub fn render_point(
+    scene: &Scene,
+    frame: &Frame,
+    settings: &TraceSettings,
+    row_done: &(dyn Fn() + Sync),
+) -> Result<PointRender, TraceError> {
+    let (w, h) = settings.resolution;
+    if w == 0 || h == 0 {
+        return Err(TraceError::InvalidInput(format!("resolution {w}x{h} has no pixels")));
+    }
+    if settings.spp == 0 {
+        return Err(TraceError::InvalidInput("0 samples per pixel".into()));
+    }
+    if frame.instances.len() != scene.objects.len() {
+        return Err(TraceError::InvalidInput(format!(
+            "frame places {} objects, the scene has {}",
+            frame.instances.len(),
+            scene.objects.len()
+        )));
+    }
+    let t0 = Instant::now();
+    let integrator = Integrator::new(scene, frame, settings);
+    let build_seconds = t0.elapsed().as_secs_f64();
+    let camera = PerspectiveCamera::new(&frame.camera, settings.resolution);
+    let t1 = Instant::now();
+    // Bands of rows are the parallel unit: each band renders its rows in order with one
+    // path context (and so one first-hit irradiance cache), so the result does not depend
+    // on how bands are spread over threads.
+    let bands: Vec<Vec<RowResult>> = (0..h.div_ceil(BAND_ROWS))
+        .into_par_iter()
+        .map(|b| {
+            let mut ctx = PathContext::default();
+            (b * BAND_ROWS..((b + 1) * BAND_ROWS).min(h))
+                .map(|y| {
+                    let row = render_row(&integrator, &camera, settings, y, &mut ctx);
+                    row_done();
+                    row
+                })
+                .collect()
+        })
+        .collect();
+    let rows: Vec<RowResult> = bands.into_iter().flatten().collect();
+    let trace_seconds = t1.elapsed().as_secs_f64();
+    let mut pixels = Vec::with_capacity(w as usize * h as usize);
+    let mut records = Vec::new();
+    let mut total_rays = 0;
+    for (p, r, n) in rows {
+        pixels.extend(p);
+        records.extend(r);
+        total_rays += n;
+    }
+    let names = channel_names(scene);
+    let objects: Vec<(String, ObjectRole)> = names.into_iter().zip(scene.objects.iter().map(|o| o.role)).collect();
+    let images = resolve(&pixels, w, h, &objects);
+    let stats = RenderStats {
+        camera_rays: w as u64 * h as u64 * settings.spp as u64,
+        total_rays,
+        triangles: integrator.geometry.triangle_count() as u64,
+        build_seconds,
+        trace_seconds,
+    };
+    Ok(PointRender { images, records, stats })
+}
+
+fn render_row(
+    integrator: &Integrator,
+    camera: &PerspectiveCamera,
+    settings: &TraceSettings,
+    y: u32,
+    ctx: &mut PathContext,
+) -> RowResult {
+    let rays_before = ctx.rays;
+    let w = settings.resolution.0;
+    let mut pixels = Vec::with_capacity(w as usize);
+    let mut records = Vec::new();
+    for x in 0..w {
+        let pixel_seed = hash_keys(&[x as u64, y as u64]);
+        let shift = Rng::new(pixel_seed).next_2d();
+        let mut acc = PixelAccum::default();
+        for s in 0..settings.spp {
+            let offset = settings.filter.sample_offset(r2_point(s, shift));
+            let pos = Vec2::new(x as f32 + 0.5, y as f32 + 0.5) + offset;
+            let dir = camera.direction(pos);
+            ctx.fallback_seed = hash_keys(&[pixel_seed, s as u64]);
+            let record = s < settings.records_per_pixel;
+            let sample = integrator.camera_sample(camera.origin, dir, record, ctx);
+            if record {
+                if let (Some(o), Some(terms)) = (sample.object, &sample.lens) {
+                    for (k, t) in terms.iter().enumerate() {
+                        let Some((eo, ed)) = t.exit else { continue };
+                        records.push(RayRecord {
+                            object: o,
+                            term: k as u8,
+                            pixel: pos.to_array(),
+                            exit_origin: eo.to_array(),
+                            exit_direction: ed.to_array(),
+                            modulation: t.modulation.to_array(),
+                            hits: t
+                                .hits
+                                .iter()
+                                .map(|h| RecordHit {
+                                    t: h.t,
+                                    position: h.position.to_array(),
+                                    object: h.object,
+                                    colour: h.colour.to_array(),
+                                })
+                                .collect(),
+                        });
+                    }
+                }
+            }
+            acc.add(&sample);
+        }
+        pixels.push(acc);
+    }
+    (pixels, records, ctx.rays - rays_before)
+}

@@ -1,0 +1,99 @@
+//! Rendering a whole ray-traced set: every parameter point of a scene, written as it is done.
+
+use crate::error::TraceError;
+use crate::render::render_point;
+use crate::set::SetWriter;
+use crate::settings::TraceSettings;
+use pis_scene::Scene;
+use serde::Serialize;
+use std::path::Path;
+use std::time::Instant;
+
+/// What a set render reports.
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+pub struct SetReport {
+    pub scene: String,
+    /// Parameter points rendered.
+    pub points: usize,
+    /// Parameter points the scene's space has.
+    pub points_in_space: usize,
+    pub resolution: [u32; 2],
+    pub spp: u32,
+    /// Worker threads.
+    pub threads: usize,
+    /// Largest number of world triangles of any point.
+    pub triangles: u64,
+    pub camera_rays: u64,
+    pub total_rays: u64,
+    /// Total rays per second of tracing (BVH builds and file writing excluded).
+    pub rays_per_second: f64,
+    /// Camera rays per second of tracing.
+    pub camera_rays_per_second: f64,
+    /// Wall-clock milliseconds per point, everything included.
+    pub ms_per_point: f64,
+    /// Milliseconds per point spent tracing.
+    pub trace_ms_per_point: f64,
+    pub seconds: f64,
+    /// Bytes written (EXRs, ray records, set.json).
+    pub output_bytes: u64,
+}
+
+/// Progress notifications from [`render_set`], called from worker threads.
+pub trait Progress: Sync {
+    /// A point starts (`index` in rendering order, of `count`).
+    fn point(&self, _index: usize, _count: usize) {}
+    /// One image row of the current point is done.
+    fn row(&self) {}
+}
+
+/// No progress display.
+pub struct NoProgress;
+impl Progress for NoProgress {}
+
+/// Renders the first `limit` points (all when `None`) of `scene` into the set directory
+/// `out`, one EXR (and ray-record file) per point as each finishes, then set.json.
+/// Runs on the current rayon pool.
+pub fn render_set(
+    scene: &Scene,
+    out: &Path,
+    settings: &TraceSettings,
+    limit: Option<usize>,
+    progress: &dyn Progress,
+) -> Result<SetReport, TraceError> {
+    let start = Instant::now();
+    let total_points = scene.space.point_count();
+    let count = limit.map_or(total_points, |l| l.min(total_points));
+    let mut writer = SetWriter::create(out, scene, settings)?;
+    let mut report = SetReport {
+        scene: scene.name.clone(),
+        points: count,
+        points_in_space: total_points,
+        resolution: [settings.resolution.0, settings.resolution.1],
+        spp: settings.spp,
+        threads: rayon::current_num_threads(),
+        ..Default::default()
+    };
+    let mut trace_seconds = 0.0;
+    for index in 0..count {
+        progress.point(index, count);
+        let point = scene.space.point(index);
+        let frame = scene.frame(&point)?;
+        let render = render_point(scene, &frame, settings, &|| progress.row())?;
+        report.output_bytes += writer.write_point(scene, index, &frame, &render)?;
+        report.camera_rays += render.stats.camera_rays;
+        report.total_rays += render.stats.total_rays;
+        report.triangles = report.triangles.max(render.stats.triangles);
+        trace_seconds += render.stats.trace_seconds;
+    }
+    report.output_bytes += writer.finish()?;
+    report.seconds = start.elapsed().as_secs_f64();
+    if trace_seconds > 0.0 {
+        report.rays_per_second = report.total_rays as f64 / trace_seconds;
+        report.camera_rays_per_second = report.camera_rays as f64 / trace_seconds;
+    }
+    if count > 0 {
+        report.ms_per_point = report.seconds * 1000.0 / count as f64;
+        report.trace_ms_per_point = trace_seconds * 1000.0 / count as f64;
+    }
+    Ok(report)
+}

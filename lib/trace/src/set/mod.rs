@@ -1,0 +1,19 @@
+//! The ray-traced set on disk (format-spec/RAYSET.md): `set.json`, one multi-layer OpenEXR
+//! per parameter point and little-endian ray-record side files.
+
+mod exr_io;
+mod meta;
+mod reader;
+mod writer;
+
+pub use exr_io::{decode_exr, encode_exr};
+pub use meta::*;
+pub use reader::RaySet;
+pub use writer::{write_atomic, SetWriter};
+
+/// Name of the metadata file inside a set directory.
+pub const SET_JSON: &str = "set.json";
+/// Value of `format` in set.json.
+pub const SET_FORMAT: &str = "pis-rayset";
+/// Value of `version` in set.json.
+pub const SET_VERSION: u32 = 1;

@@ -1,0 +1,207 @@
+//! Writing a ray-traced set. Every file is written to a temporary name and renamed into
+//! place, so an interrupted run never leaves a half-written file under a final name.
+
+use super::exr_io::encode_exr;
+use super::meta::*;
+use super::{SET_FORMAT, SET_JSON, SET_VERSION};
+use crate::camera::projection_matrix;
+use crate::error::TraceError;
+use crate::layers::LayerKind;
+use crate::records::encode_records;
+use crate::render::{channel_names, PointRender};
+use crate::settings::TraceSettings;
+use pis_scene::{DimensionKind, Driver, Frame, LightKind, ObjectRole, Scene};
+use std::fs;
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+/// Writes `bytes` to `path` atomically (temporary file in the same directory, then rename).
+pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), TraceError> {
+    let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
+    let tmp = path.with_file_name(format!(".{name}.tmp{}", std::process::id()));
+    let result = (|| {
+        let mut f = fs::File::create(&tmp)?;
+        f.write_all(bytes)?;
+        f.sync_all()?;
+        fs::rename(&tmp, path)
+    })();
+    if let Err(e) = result {
+        let _ = fs::remove_file(&tmp);
+        return Err(TraceError::io(path, e));
+    }
+    Ok(())
+}
+
+fn role_name(role: ObjectRole) -> &'static str {
+    match role {
+        ObjectRole::Diffuse => "diffuse",
+        ObjectRole::Reflective => "reflective",
+        ObjectRole::Refractive => "refractive",
+    }
+}
+
+fn kind_name(kind: DimensionKind) -> &'static str {
+    match kind {
+        DimensionKind::View => "view",
+        DimensionKind::Light => "light",
+        DimensionKind::ObjectMotion => "object_motion",
+        DimensionKind::Time => "time",
+        DimensionKind::Other => "other",
+    }
+}
+
+/// Writes a ray-traced set point by point, then `set.json`.
+pub struct SetWriter {
+    dir: PathBuf,
+    meta: SetMeta,
+    scene_lights: usize,
+}
+
+impl SetWriter {
+    /// Creates the directory `dir` (if needed) for a set of `scene` rendered with `settings`.
+    pub fn create(dir: &Path, scene: &Scene, settings: &TraceSettings) -> Result<SetWriter, TraceError> {
+        fs::create_dir_all(dir).map_err(|e| TraceError::io(dir, e))?;
+        let names = channel_names(scene);
+        let objects = scene
+            .objects
+            .iter()
+            .zip(names)
+            .map(|(o, channel_name)| ObjectMeta {
+                name: o.name.clone(),
+                channel_name,
+                role: role_name(o.role).into(),
+                layers: LayerKind::for_role(o.role).iter().map(|l| l.name().to_string()).collect(),
+                records: o.role == ObjectRole::Refractive,
+            })
+            .collect();
+        let space = scene
+            .space
+            .dims
+            .iter()
+            .map(|d| DimensionMeta {
+                name: d.name.clone(),
+                kind: kind_name(d.kind).into(),
+                driver: match d.driver {
+                    Driver::Orbit { .. } => "orbit",
+                    Driver::Animation { .. } => "animation",
+                    Driver::LightPath { .. } => "light_path",
+                }
+                .into(),
+                periodic: d.periodic,
+                unit: d.unit.clone(),
+                values: d.values.clone(),
+            })
+            .collect();
+        let meta = SetMeta {
+            format: SET_FORMAT.into(),
+            version: SET_VERSION,
+            scene: scene.name.clone(),
+            resolution: [settings.resolution.0, settings.resolution.1],
+            spp: settings.spp,
+            filter: settings.filter,
+            renderer: Some(RendererMeta {
+                name: "pis-trace".into(),
+                version: env!("CARGO_PKG_VERSION").into(),
+                settings: Some(settings.clone()),
+            }),
+            space,
+            objects,
+            points: Vec::new(),
+        };
+        Ok(SetWriter { dir: dir.to_path_buf(), meta, scene_lights: 0 })
+    }
+
+    /// The set directory.
+    pub fn dir(&self) -> &Path {
+        &self.dir
+    }
+
+    /// Writes the EXR (and ray records, when any object has them) of the point with linear
+    /// index `index` of `scene`, rendered at `frame`. Returns the bytes written.
+    pub fn write_point(
+        &mut self,
+        scene: &Scene,
+        index: usize,
+        frame: &Frame,
+        render: &PointRender,
+    ) -> Result<u64, TraceError> {
+        let samples = scene.space.point(index);
+        let values = samples
+            .iter()
+            .zip(&scene.space.dims)
+            .map(|(&s, d)| d.values.get(s as usize).copied().unwrap_or(f32::NAN))
+            .collect();
+        let image = format!("point_{index:05}.exr");
+        let path = self.dir.join(&image);
+        let exr = encode_exr(&render.images, &path)?;
+        write_atomic(&path, &exr)?;
+        let mut bytes = exr.len() as u64;
+        let rays = if self.meta.objects.iter().any(|o| o.records) {
+            let name = format!("point_{index:05}.rays.bin");
+            let data = encode_records(&render.records);
+            write_atomic(&self.dir.join(&name), &data)?;
+            bytes += data.len() as u64;
+            Some(name)
+        } else {
+            None
+        };
+        let res = (self.meta.resolution[0], self.meta.resolution[1]);
+        let cam = &frame.camera;
+        let point = PointMeta {
+            index,
+            samples,
+            values,
+            image,
+            rays,
+            camera: CameraMeta {
+                world_from_camera: cam.world_from_camera.to_cols_array(),
+                camera_from_world: cam.world_from_camera.inverse().to_cols_array(),
+                projection: projection_matrix(cam, res).to_cols_array(),
+                yfov: cam.yfov,
+                znear: cam.znear,
+                zfar: cam.zfar.is_finite().then_some(cam.zfar),
+            },
+            lights: frame
+                .lights
+                .iter()
+                .map(|l| LightMeta {
+                    name: l.name.clone(),
+                    kind: match l.kind {
+                        LightKind::Point => "point",
+                        LightKind::Spot { .. } => "spot",
+                        LightKind::Directional => "directional",
+                    }
+                    .into(),
+                    position: l.position.to_array(),
+                    direction: l.direction.to_array(),
+                    radiance: l.radiance,
+                    radius: l.radius,
+                })
+                .collect(),
+            objects: self
+                .meta
+                .objects
+                .iter()
+                .zip(&frame.instances)
+                .map(|(o, i)| ObjectStateMeta {
+                    name: o.channel_name.clone(),
+                    world_from_object: i.world_from_object.to_cols_array(),
+                })
+                .collect(),
+        };
+        self.scene_lights = self.scene_lights.max(frame.lights.len());
+        self.meta.points.retain(|p| p.index != index);
+        self.meta.points.push(point);
+        Ok(bytes)
+    }
+
+    /// Writes `set.json` (points sorted by index) and returns its size in bytes.
+    pub fn finish(mut self) -> Result<u64, TraceError> {
+        self.meta.points.sort_by_key(|p| p.index);
+        let path = self.dir.join(SET_JSON);
+        let json = serde_json::to_vec_pretty(&self.meta)
+            .map_err(|e| TraceError::InvalidInput(format!("cannot encode {}: {e}", path.display())))?;
+        write_atomic(&path, &json)?;
+        Ok(json.len() as u64)
+    }
+}

@@ -1,0 +1,48 @@
+//! Render settings.
+
+use crate::film::GaussianFilter;
+use serde::{Deserialize, Serialize};
+
+/// What a render does, beyond the scene itself.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct TraceSettings {
+    /// Image size in pixels (width, height).
+    pub resolution: (u32, u32),
+    /// Camera samples per pixel.
+    pub spp: u32,
+    /// Reconstruction filter, importance-sampled by the camera samples.
+    pub filter: GaussianFilter,
+    /// Longest path (number of scattering events) before a path is cut.
+    pub max_depth: u32,
+    /// Indirect diffuse bounces after the first diffuse interaction (at least 1).
+    pub diffuse_bounces: u32,
+    /// Irradiance estimates (light samples and indirect rays) per surface cell at camera
+    /// rays' first hits; the diffuse layer's noise falls with it.
+    pub diffuse_samples: u32,
+    /// Cell size (world units, object space) of the quantized surface point that seeds
+    /// shading; `None` picks 1/4096 of the scene's bounding-box diagonal; `Some(0.0)` seeds
+    /// per pixel sample instead (no coherence across the parameter space).
+    pub coherence_cell: Option<f32>,
+    /// Camera samples per pixel (the first ones) that write outgoing-ray records for
+    /// refractive lens objects.
+    pub records_per_pixel: u32,
+    /// Most front-facing hits recorded along one continued outgoing ray.
+    pub max_record_hits: u32,
+}
+
+impl TraceSettings {
+    /// Defaults for a render at `resolution` with `spp` samples per pixel.
+    pub fn new(resolution: (u32, u32), spp: u32) -> TraceSettings {
+        TraceSettings {
+            resolution,
+            spp,
+            filter: GaussianFilter::default(),
+            max_depth: 8,
+            diffuse_bounces: 1,
+            diffuse_samples: 4,
+            coherence_cell: None,
+            records_per_pixel: 2,
+            max_record_hits: 4,
+        }
+    }
+}

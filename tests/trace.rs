@@ -1,0 +1,208 @@
+//! pis-trace end to end: a tiny generated glTF scene, and samples/demo1 when present.
+
+use pis_trace::set::RaySet;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn trace(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_pis-trace")).args(args).output().expect("pis-trace runs")
+}
+
+fn text(b: &[u8]) -> String {
+    String::from_utf8_lossy(b).into_owned()
+}
+
+fn base64(bytes: &[u8]) -> String {
+    const T: &[u8; 64] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+    let mut s = String::new();
+    for c in bytes.chunks(3) {
+        let n = (c[0] as u32) << 16 | (*c.get(1).unwrap_or(&0) as u32) << 8 | *c.get(2).unwrap_or(&0) as u32;
+        for k in 0..4 {
+            if k <= c.len() {
+                s.push(T[(n >> (18 - 6 * k) & 63) as usize] as char);
+            } else {
+                s.push('=');
+            }
+        }
+    }
+    s
+}
+
+/// A floor, a mirror panel and a glass block lit by a sphere light, with a 2-sample orbit.
+fn tiny_scene(dir: &Path) -> PathBuf {
+    let quad = |c: [f32; 3], u: [f32; 3], v: [f32; 3]| -> Vec<f32> {
+        let mut p = Vec::new();
+        for (a, b) in [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)] {
+            for k in 0..3 {
+                p.push(c[k] + a * u[k] + b * v[k]);
+            }
+        }
+        p
+    };
+    let meshes = [
+        quad([0.0, 0.0, 0.0], [0.0, 0.0, 2.0], [2.0, 0.0, 0.0]),
+        quad([0.0, 0.6, -0.8], [0.6, 0.0, 0.0], [0.0, 0.6, 0.0]),
+        quad([0.5, 0.3, 0.3], [0.2, 0.0, 0.0], [0.0, 0.3, 0.0]),
+    ];
+    let mut buf = Vec::new();
+    let mut views = Vec::new();
+    let mut accessors = Vec::new();
+    for m in &meshes {
+        let off = buf.len();
+        for x in m {
+            buf.extend_from_slice(&x.to_le_bytes());
+        }
+        views.push(format!(r#"{{"buffer":0,"byteOffset":{off},"byteLength":48}}"#));
+        let (mut lo, mut hi) = ([f32::MAX; 3], [f32::MIN; 3]);
+        for v in m.chunks(3) {
+            for k in 0..3 {
+                lo[k] = lo[k].min(v[k]);
+                hi[k] = hi[k].max(v[k]);
+            }
+        }
+        accessors.push(format!(
+            r#"{{"bufferView":{},"componentType":5126,"count":4,"type":"VEC3","min":{lo:?},"max":{hi:?}}}"#,
+            views.len() - 1
+        ));
+        let off = buf.len();
+        for i in [0u16, 1, 2, 0, 2, 3] {
+            buf.extend_from_slice(&i.to_le_bytes());
+        }
+        views.push(format!(r#"{{"buffer":0,"byteOffset":{off},"byteLength":12}}"#));
+        accessors.push(format!(r#"{{"bufferView":{},"componentType":5123,"count":6,"type":"SCALAR"}}"#, views.len() - 1));
+    }
+    let gltf = format!(
+        r#"{{
+  "asset": {{"version": "2.0"}},
+  "extensionsUsed": ["KHR_lights_punctual", "KHR_materials_transmission"],
+  "extensions": {{"KHR_lights_punctual": {{"lights": [{{"name": "Key", "type": "point", "intensity": 6, "extras": {{"radius": 0.1}}}}]}}}},
+  "scene": 0,
+  "scenes": [{{"nodes": [0, 1, 2, 3]}}],
+  "nodes": [
+    {{"name": "Floor", "mesh": 0}},
+    {{"name": "Mirror", "mesh": 1}},
+    {{"name": "Glass", "mesh": 2}},
+    {{"name": "KeyNode", "translation": [0.5, 2.0, 1.0], "extensions": {{"KHR_lights_punctual": {{"light": 0}}}}}}
+  ],
+  "meshes": [
+    {{"primitives": [{{"attributes": {{"POSITION": 0}}, "indices": 1, "material": 0}}]}},
+    {{"primitives": [{{"attributes": {{"POSITION": 2}}, "indices": 3, "material": 1}}]}},
+    {{"primitives": [{{"attributes": {{"POSITION": 4}}, "indices": 5, "material": 2}}]}}
+  ],
+  "materials": [
+    {{"name": "Matte", "pbrMetallicRoughness": {{"baseColorFactor": [0.7, 0.6, 0.5, 1], "metallicFactor": 0, "roughnessFactor": 1}}}},
+    {{"name": "Chrome", "pbrMetallicRoughness": {{"metallicFactor": 1, "roughnessFactor": 0}}}},
+    {{"name": "Glass", "pbrMetallicRoughness": {{"metallicFactor": 0, "roughnessFactor": 0}}, "extensions": {{"KHR_materials_transmission": {{"transmissionFactor": 1}}}}}}
+  ],
+  "accessors": [{}],
+  "bufferViews": [{}],
+  "buffers": [{{"byteLength": {}, "uri": "data:application/octet-stream;base64,{}"}}]
+}}"#,
+        accessors.join(","),
+        views.join(","),
+        buf.len(),
+        base64(&buf)
+    );
+    std::fs::write(dir.join("tiny.gltf"), gltf).unwrap();
+    let toml = r#"name = "tiny"
+gltf = "tiny.gltf"
+resolution = [24, 16]
+spp = 2
+
+[[dimension]]
+name = "view"
+driver = "orbit"
+samples = 2
+target = [0, 0.3, 0]
+radius = 3
+elevation_deg = 25
+azimuth_deg = [-10, 10]
+"#;
+    let path = dir.join("scene.toml");
+    std::fs::write(&path, toml).unwrap();
+    path
+}
+
+fn dir_bytes(dir: &Path) -> Vec<(String, Vec<u8>)> {
+    let mut v: Vec<(String, Vec<u8>)> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| {
+            let e = e.unwrap();
+            (e.file_name().to_string_lossy().into_owned(), std::fs::read(e.path()).unwrap())
+        })
+        .collect();
+    v.sort();
+    v
+}
+
+#[test]
+fn traces_a_scene_into_a_set_deterministically() {
+    let tmp = tempfile::tempdir().unwrap();
+    let scene = tiny_scene(tmp.path());
+    let (a, b) = (tmp.path().join("a"), tmp.path().join("b"));
+    let out = trace(&[scene.to_str().unwrap(), "-o", a.to_str().unwrap(), "--json"]);
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+    let report: serde_json::Value = serde_json::from_slice(&out.stdout).expect("--json prints JSON");
+    assert_eq!(report["points"], 2);
+    assert!(report["rays_per_second"].as_f64().unwrap() > 0.0);
+    assert!(report["ms_per_point"].as_f64().unwrap() > 0.0);
+
+    let set = RaySet::open(&a).unwrap();
+    assert_eq!(set.meta.resolution, [24, 16]);
+    assert_eq!(set.len(), 2);
+    let roles: Vec<&str> = set.meta.objects.iter().map(|o| o.role.as_str()).collect();
+    assert_eq!(roles, ["diffuse", "reflective", "refractive"]);
+    let img = set.read_point(1).unwrap();
+    assert!(img.layer("object.Mirror.distant").is_some() && img.layer("object.Glass.refraction_confidence").is_some());
+    assert!(img.layer("combined").unwrap().planes[0].iter().any(|&v| v > 0.0));
+
+    let out = trace(&[scene.to_str().unwrap(), "-o", b.to_str().unwrap(), "--threads", "1"]);
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+    assert!(text(&out.stderr).contains("rays/s"));
+    assert_eq!(dir_bytes(&a), dir_bytes(&b), "a second run gives other bytes");
+}
+
+#[test]
+fn errors_have_documented_exit_codes() {
+    let tmp = tempfile::tempdir().unwrap();
+    let scene = tiny_scene(tmp.path());
+    let o = tmp.path().join("o");
+    let s = scene.to_str().unwrap();
+    let cases: [(&[&str], i32); 4] = [
+        (&[s, "-o", o.to_str().unwrap(), "--resolution", "12by8"], 1),
+        (&["missing/scene.toml", "-o", o.to_str().unwrap()], 2),
+        (&[s, "-o", o.to_str().unwrap(), "--preset", "nope"], 3),
+        (&[s, "-o", o.to_str().unwrap(), "--spp", "0"], 3),
+    ];
+    for (args, code) in cases {
+        let out = trace(args);
+        assert_eq!(out.status.code(), Some(code), "{args:?}: {}", text(&out.stderr));
+        if code != 1 {
+            let err = text(&out.stderr);
+            assert!(err.starts_with("pis-trace: ") && err.lines().count() == 1, "{err}");
+        }
+    }
+}
+
+/// The issue's acceptance run, once samples/demo1 is in the tree.
+#[test]
+fn demo1_at_80x60_gives_identical_bytes_twice() {
+    let scene = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../samples/demo1/scene.toml");
+    if !scene.exists() {
+        eprintln!("samples/demo1 is not in the tree; skipped");
+        return;
+    }
+    let tmp = tempfile::tempdir().unwrap();
+    let mut dirs = Vec::new();
+    for run in ["a", "b"] {
+        let d = tmp.path().join(run);
+        let out = trace(&[scene.to_str().unwrap(), "-o", d.to_str().unwrap(), "--resolution", "80x60", "--spp", "4"]);
+        assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+        dirs.push(d);
+    }
+    let set = RaySet::open(&dirs[0]).unwrap();
+    for i in 0..set.len() {
+        set.read_point(i).unwrap();
+    }
+    assert_eq!(dir_bytes(&dirs[0]), dir_bytes(&dirs[1]));
+}
