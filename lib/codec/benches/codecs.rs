@@ -58,8 +58,13 @@ fn main() {
     println!();
     println!("rate-distortion (decode MB/s of decoded f32 at that rate; PSNR for peak 1.0)");
     println!("target ratio   wavelet bytes  PSNR dB  dec MB/s    dct bytes  PSNR dB  dec MB/s");
-    let full = wavelet::encode_full(&planes, &values, wavelet::DEFAULT_LEVELS, wavelet::DEFAULT_BITS)
-        .expect("encode");
+    let full = wavelet::encode_full(
+        &planes,
+        &values,
+        wavelet::DEFAULT_LEVELS,
+        wavelet::DEFAULT_BITS,
+    )
+    .expect("encode");
     for ratio in [16usize, 48, 96, 192, 384, 768] {
         let budget = values.len() * 4 / ratio;
         let w = full.truncated(budget, &planes);
@@ -75,7 +80,13 @@ fn main() {
 }
 
 /// PSNR and decode speed of one codestream.
-fn measure(codec: CodecId, planes: &[PlaneShape], values: &[f32], bytes: &[u8], mb: f64) -> (f64, f64) {
+fn measure(
+    codec: CodecId,
+    planes: &[PlaneShape],
+    values: &[f32],
+    bytes: &[u8],
+    mb: f64,
+) -> (f64, f64) {
     if bytes.is_empty() {
         return (f64::NAN, f64::NAN);
     }

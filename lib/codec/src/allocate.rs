@@ -61,7 +61,11 @@ pub enum AllocError {
     #[error("item {0} has an empty rate-distortion curve")]
     EmptyCurve(usize),
     #[error("item {item} names object {object}, but there are {objects} areas")]
-    Object { item: usize, object: usize, objects: usize },
+    Object {
+        item: usize,
+        object: usize,
+        objects: usize,
+    },
     #[error("the smallest encodings need {needed} bytes, over the budget of {budget}")]
     Budget { needed: usize, budget: usize },
     #[error("PSNR {0} dB is out of reach of the curves")]
@@ -151,15 +155,21 @@ impl Problem {
     }
 
     /// The allocation meeting `target`.
-    fn solve(&self, target: Target, areas: &[f64], items: &[Item]) -> Result<Vec<usize>, AllocError> {
+    fn solve(
+        &self,
+        target: Target,
+        areas: &[f64],
+        items: &[Item],
+    ) -> Result<Vec<usize>, AllocError> {
         let all = vec![true; self.hulls.len()];
         let max_slope = self
             .hulls
             .iter()
             .zip(&self.gain)
             .flat_map(|(h, g)| {
-                h.windows(2)
-                    .map(move |w| (w[0].mse - w[1].mse) * g / (w[1].bytes - w[0].bytes).max(1) as f64)
+                h.windows(2).map(move |w| {
+                    (w[0].mse - w[1].mse) * g / (w[1].bytes - w[0].bytes).max(1) as f64
+                })
             })
             .fold(0.0f64, f64::max);
         // λ above every slope: the cheapest points; λ → 0: the richest points.
@@ -203,7 +213,11 @@ impl Problem {
     }
 
     fn mses(&self, pick: &[usize]) -> Vec<f64> {
-        self.hulls.iter().zip(pick).map(|(h, &k)| h[k].mse).collect()
+        self.hulls
+            .iter()
+            .zip(pick)
+            .map(|(h, &k)| h[k].mse)
+            .collect()
     }
 }
 
@@ -230,12 +244,19 @@ pub fn allocate(
             return Err(AllocError::EmptyCurve(i));
         }
         if it.object >= areas.len() {
-            return Err(AllocError::Object { item: i, object: it.object, objects: areas.len() });
+            return Err(AllocError::Object {
+                item: i,
+                object: it.object,
+                objects: areas.len(),
+            });
         }
     }
     let mut problem = Problem {
         hulls: items.iter().map(|it| convex_hull(&it.curve)).collect(),
-        gain: items.iter().map(|it| areas[it.object] * it.weight).collect(),
+        gain: items
+            .iter()
+            .map(|it| areas[it.object] * it.weight)
+            .collect(),
     };
     let mut pick = problem.solve(target, areas, items)?;
     if let Some(alpha) = alpha {
@@ -285,7 +306,12 @@ pub fn allocate(
         }
     }
     let mse = problem.mses(&pick);
-    let bytes: Vec<usize> = problem.hulls.iter().zip(&pick).map(|(h, &k)| h[k].bytes).collect();
+    let bytes: Vec<usize> = problem
+        .hulls
+        .iter()
+        .zip(&pick)
+        .map(|(h, &k)| h[k].bytes)
+        .collect();
     let (object_mse, screen) = screen_mse(&mse, items, areas);
     Ok(Allocation {
         total_bytes: bytes.iter().sum(),
@@ -306,7 +332,10 @@ mod tests {
             points: (0..=400)
                 .map(|k| {
                     let r = k * 8;
-                    RdPoint { bytes: r, mse: var * 2f64.powf(-2.0 * r as f64 / n) }
+                    RdPoint {
+                        bytes: r,
+                        mse: var * 2f64.powf(-2.0 * r as f64 / n),
+                    }
                 })
                 .collect(),
         }
@@ -314,11 +343,31 @@ mod tests {
 
     fn items() -> (Vec<Item>, Vec<f64>) {
         let items = vec![
-            Item { curve: curve(1.0, 400.0), object: 0, weight: 1.0 },
-            Item { curve: curve(0.1, 300.0), object: 0, weight: 0.5 },
-            Item { curve: curve(4.0, 800.0), object: 1, weight: 1.0 },
-            Item { curve: curve(0.01, 200.0), object: 2, weight: 1.0 },
-            Item { curve: curve(2.0, 600.0), object: 2, weight: 0.25 },
+            Item {
+                curve: curve(1.0, 400.0),
+                object: 0,
+                weight: 1.0,
+            },
+            Item {
+                curve: curve(0.1, 300.0),
+                object: 0,
+                weight: 0.5,
+            },
+            Item {
+                curve: curve(4.0, 800.0),
+                object: 1,
+                weight: 1.0,
+            },
+            Item {
+                curve: curve(0.01, 200.0),
+                object: 2,
+                weight: 1.0,
+            },
+            Item {
+                curve: curve(2.0, 600.0),
+                object: 2,
+                weight: 0.25,
+            },
         ];
         (items, vec![1000.0, 50.0, 300.0])
     }
@@ -332,7 +381,11 @@ mod tests {
         let per = budget / items.len();
         let uniform: Vec<f64> = items.iter().map(|it| it.curve.mse_at(per)).collect();
         let (_, uniform_screen) = screen_mse(&uniform, &items, &areas);
-        assert!(a.screen_mse < uniform_screen, "{} vs {uniform_screen}", a.screen_mse);
+        assert!(
+            a.screen_mse < uniform_screen,
+            "{} vs {uniform_screen}",
+            a.screen_mse
+        );
     }
 
     #[test]
@@ -340,7 +393,11 @@ mod tests {
         let (items, areas) = items();
         let free = allocate(&items, &areas, Target::Bytes(1500), None).unwrap();
         let mean = free.object_mse.iter().sum::<f64>() / 3.0;
-        assert!(free.object_mse.iter().any(|&e| e > 1.25 * mean), "{:?}", free.object_mse);
+        assert!(
+            free.object_mse.iter().any(|&e| e > 1.25 * mean),
+            "{:?}",
+            free.object_mse
+        );
         let a = allocate(&items, &areas, Target::Bytes(1500), Some(DEFAULT_ALPHA)).unwrap();
         assert!(a.total_bytes <= 1500);
         for &e in &a.object_mse {
@@ -352,12 +409,38 @@ mod tests {
     #[test]
     fn psnr_target_is_met_with_fewer_bytes_for_less_quality() {
         let (items, areas) = items();
-        let hi = allocate(&items, &areas, Target::Psnr { db: 30.0, peak: 1.0 }, None).unwrap();
-        let lo = allocate(&items, &areas, Target::Psnr { db: 20.0, peak: 1.0 }, None).unwrap();
+        let hi = allocate(
+            &items,
+            &areas,
+            Target::Psnr {
+                db: 30.0,
+                peak: 1.0,
+            },
+            None,
+        )
+        .unwrap();
+        let lo = allocate(
+            &items,
+            &areas,
+            Target::Psnr {
+                db: 20.0,
+                peak: 1.0,
+            },
+            None,
+        )
+        .unwrap();
         assert!(hi.screen_mse <= 1e-3 && lo.screen_mse <= 1e-2);
         assert!(lo.total_bytes < hi.total_bytes);
         assert!(matches!(
-            allocate(&items, &areas, Target::Psnr { db: 400.0, peak: 1.0 }, None),
+            allocate(
+                &items,
+                &areas,
+                Target::Psnr {
+                    db: 400.0,
+                    peak: 1.0
+                },
+                None
+            ),
             Err(AllocError::Unreachable(_))
         ));
     }
@@ -366,13 +449,28 @@ mod tests {
     fn hull_drops_points_above_it() {
         let c = RdCurve {
             points: vec![
-                RdPoint { bytes: 0, mse: 10.0 },
-                RdPoint { bytes: 10, mse: 9.5 },
-                RdPoint { bytes: 20, mse: 2.0 },
-                RdPoint { bytes: 30, mse: 1.0 },
+                RdPoint {
+                    bytes: 0,
+                    mse: 10.0,
+                },
+                RdPoint {
+                    bytes: 10,
+                    mse: 9.5,
+                },
+                RdPoint {
+                    bytes: 20,
+                    mse: 2.0,
+                },
+                RdPoint {
+                    bytes: 30,
+                    mse: 1.0,
+                },
             ],
         };
         let h = convex_hull(&c);
-        assert_eq!(h.iter().map(|p| p.bytes).collect::<Vec<_>>(), vec![0, 20, 30]);
+        assert_eq!(
+            h.iter().map(|p| p.bytes).collect::<Vec<_>>(),
+            vec![0, 20, 30]
+        );
     }
 }

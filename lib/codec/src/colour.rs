@@ -33,6 +33,7 @@ pub fn inverse(px: &mut [f32]) {
     }
 }
 
+#[allow(clippy::needless_range_loop)]
 /// Splits interleaved planes into one `w × h` array per (plane, channel), after the colour
 /// transform and with the per-channel `means` subtracted.
 pub fn split(
@@ -63,6 +64,7 @@ pub fn split(
     out
 }
 
+#[allow(clippy::needless_range_loop)]
 /// Inverse of [`split`]: writes the interleaved values.
 pub fn merge(
     planes: &[crate::PlaneShape],
@@ -89,6 +91,7 @@ pub fn merge(
     }
 }
 
+#[allow(clippy::needless_range_loop)]
 /// Per-channel means (after the colour transform) over all planes, as `f32`.
 pub fn means(planes: &[crate::PlaneShape], values: &[f32], colour: bool) -> [f32; 4] {
     let mut sum = [0.0f64; 4];

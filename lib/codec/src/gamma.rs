@@ -11,14 +11,18 @@
 pub fn compensate(values: &mut [f32], g: f32) {
     if g != 1.0 {
         let inv = 1.0 / g;
-        values.iter_mut().for_each(|v| *v = v.signum() * v.abs().powf(inv));
+        values
+            .iter_mut()
+            .for_each(|v| *v = v.signum() * v.abs().powf(inv));
     }
 }
 
 /// `sign(v) · |v|^g` in place: linear values from decoded, summed pyramid values.
 pub fn uncompensate(values: &mut [f32], g: f32) {
     if g != 1.0 {
-        values.iter_mut().for_each(|v| *v = v.signum() * v.abs().powf(g));
+        values
+            .iter_mut()
+            .for_each(|v| *v = v.signum() * v.abs().powf(g));
     }
 }
 
@@ -45,11 +49,17 @@ mod tests {
         for (a, b) in orig.iter().zip(&v) {
             assert!((a - b).abs() <= 1e-5 * a.abs().max(1.0));
         }
-        assert!(linear_mse(&orig, &{
-            let mut e = orig;
-            compensate(&mut e, 2.2);
-            e
-        }, 2.2) < 1e-9);
+        assert!(
+            linear_mse(
+                &orig,
+                &{
+                    let mut e = orig;
+                    compensate(&mut e, 2.2);
+                    e
+                },
+                2.2
+            ) < 1e-9
+        );
     }
 
     #[test]

@@ -101,7 +101,12 @@ pub trait LevelCodec: Sync {
     /// The id stored in the file.
     fn id(&self) -> CodecId;
     /// Encodes the concatenated planes; exact codecs ignore `rate`.
-    fn encode(&self, planes: &[PlaneShape], values: &[f32], rate: Rate) -> Result<Vec<u8>, CodecError>;
+    fn encode(
+        &self,
+        planes: &[PlaneShape],
+        values: &[f32],
+        rate: Rate,
+    ) -> Result<Vec<u8>, CodecError>;
     /// Decodes into the concatenated planes. Damaged input gives an error or an image, never
     /// a panic; memory is bounded by a small multiple of the size the shapes declare.
     fn decode(&self, planes: &[PlaneShape], bytes: &[u8]) -> Result<Vec<f32>, CodecError>;
@@ -111,7 +116,12 @@ pub trait LevelCodec: Sync {
     /// [`dct::CURVE_QUALITIES`], for exact codecs one point at zero error.
     fn rd_curve(&self, planes: &[PlaneShape], values: &[f32]) -> Result<RdCurve, CodecError> {
         let bytes = self.encode(planes, values, Rate::Default)?;
-        Ok(RdCurve { points: vec![RdPoint { bytes: bytes.len(), mse: 0.0 }] })
+        Ok(RdCurve {
+            points: vec![RdPoint {
+                bytes: bytes.len(),
+                mse: 0.0,
+            }],
+        })
     }
 }
 
@@ -123,7 +133,10 @@ struct DctCodec;
 fn check_len(planes: &[PlaneShape], values: &[f32]) -> Result<usize, CodecError> {
     let n = value_count(planes)?;
     if values.len() != n {
-        return Err(CodecError::Length { expected: n, found: values.len() });
+        return Err(CodecError::Length {
+            expected: n,
+            found: values.len(),
+        });
     }
     Ok(n)
 }
@@ -132,7 +145,12 @@ impl LevelCodec for RawCodec {
     fn id(&self) -> CodecId {
         CodecId::Raw
     }
-    fn encode(&self, planes: &[PlaneShape], values: &[f32], _: Rate) -> Result<Vec<u8>, CodecError> {
+    fn encode(
+        &self,
+        planes: &[PlaneShape],
+        values: &[f32],
+        _: Rate,
+    ) -> Result<Vec<u8>, CodecError> {
         check_len(planes, values)?;
         Ok(raw::encode(values))
     }
@@ -145,7 +163,12 @@ impl LevelCodec for LosslessCodec {
     fn id(&self) -> CodecId {
         CodecId::Lossless
     }
-    fn encode(&self, planes: &[PlaneShape], values: &[f32], _: Rate) -> Result<Vec<u8>, CodecError> {
+    fn encode(
+        &self,
+        planes: &[PlaneShape],
+        values: &[f32],
+        _: Rate,
+    ) -> Result<Vec<u8>, CodecError> {
         check_len(planes, values)?;
         Ok(lossless::encode(planes, values))
     }
@@ -158,15 +181,26 @@ impl LevelCodec for WaveletCodec {
     fn id(&self) -> CodecId {
         CodecId::Wavelet
     }
-    fn encode(&self, planes: &[PlaneShape], values: &[f32], rate: Rate) -> Result<Vec<u8>, CodecError> {
+    fn encode(
+        &self,
+        planes: &[PlaneShape],
+        values: &[f32],
+        rate: Rate,
+    ) -> Result<Vec<u8>, CodecError> {
         wavelet::encode(planes, values, rate)
     }
     fn decode(&self, planes: &[PlaneShape], bytes: &[u8]) -> Result<Vec<f32>, CodecError> {
         wavelet::decode(planes, bytes)
     }
     fn rd_curve(&self, planes: &[PlaneShape], values: &[f32]) -> Result<RdCurve, CodecError> {
-        let e = wavelet::encode_full(planes, values, wavelet::DEFAULT_LEVELS, wavelet::DEFAULT_BITS)?;
-        Ok(e.measured_curve(planes, values, wavelet::CURVE_POINTS)?.monotone())
+        let e = wavelet::encode_full(
+            planes,
+            values,
+            wavelet::DEFAULT_LEVELS,
+            wavelet::DEFAULT_BITS,
+        )?;
+        Ok(e.measured_curve(planes, values, wavelet::CURVE_POINTS)?
+            .monotone())
     }
 }
 
@@ -174,7 +208,12 @@ impl LevelCodec for DctCodec {
     fn id(&self) -> CodecId {
         CodecId::Dct
     }
-    fn encode(&self, planes: &[PlaneShape], values: &[f32], rate: Rate) -> Result<Vec<u8>, CodecError> {
+    fn encode(
+        &self,
+        planes: &[PlaneShape],
+        values: &[f32],
+        rate: Rate,
+    ) -> Result<Vec<u8>, CodecError> {
         dct::encode(planes, values, rate)
     }
     fn decode(&self, planes: &[PlaneShape], bytes: &[u8]) -> Result<Vec<f32>, CodecError> {
@@ -200,7 +239,11 @@ fn registered(id: CodecId) -> Result<&'static dyn LevelCodec, CodecError> {
 }
 
 /// Encodes `values` (the concatenated planes) with `codec` at its default rate.
-pub fn encode(codec: CodecId, planes: &[PlaneShape], values: &[f32]) -> Result<Vec<u8>, CodecError> {
+pub fn encode(
+    codec: CodecId,
+    planes: &[PlaneShape],
+    values: &[f32],
+) -> Result<Vec<u8>, CodecError> {
     encode_with(codec, planes, values, Rate::Default)
 }
 
@@ -222,7 +265,11 @@ pub fn decode(codec: CodecId, planes: &[PlaneShape], bytes: &[u8]) -> Result<Vec
 
 /// Mean squared error per value between two equally long slices.
 pub fn mse(a: &[f32], b: &[f32]) -> f64 {
-    let s: f64 = a.iter().zip(b).map(|(x, y)| (*x as f64 - *y as f64).powi(2)).sum();
+    let s: f64 = a
+        .iter()
+        .zip(b)
+        .map(|(x, y)| (*x as f64 - *y as f64).powi(2))
+        .sum();
     s / a.len().max(1) as f64
 }
 

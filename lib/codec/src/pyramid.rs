@@ -71,7 +71,9 @@ fn unflatten(mut i: usize, extent: &[u32]) -> Vec<u32> {
 
 fn check(extent: &[u32], samples: &[Vec<f32>]) -> Result<usize, CodecError> {
     if extent.contains(&0) {
-        return Err(CodecError::Input(format!("extent {extent:?} has an empty dimension")));
+        return Err(CodecError::Input(format!(
+            "extent {extent:?} has an empty dimension"
+        )));
     }
     let count: usize = extent.iter().map(|&e| e as usize).product();
     if samples.len() != count {
@@ -115,10 +117,18 @@ fn weights(c: u32, e: u32, filter: PyramidFilter) -> Vec<Vec<f64>> {
 }
 
 /// The filtered, subsampled targets of a level with `counts`.
-fn targets(extent: &[u32], samples: &[Vec<f32>], counts: &[u32], filter: PyramidFilter) -> Vec<Vec<f32>> {
+fn targets(
+    extent: &[u32],
+    samples: &[Vec<f32>],
+    counts: &[u32],
+    filter: PyramidFilter,
+) -> Vec<Vec<f32>> {
     let n = samples[0].len();
     let mut shape: Vec<usize> = extent.iter().map(|&e| e as usize).collect();
-    let mut data: Vec<Vec<f64>> = samples.iter().map(|s| s.iter().map(|&v| v as f64).collect()).collect();
+    let mut data: Vec<Vec<f64>> = samples
+        .iter()
+        .map(|s| s.iter().map(|&v| v as f64).collect())
+        .collect();
     for k in 0..extent.len() {
         if counts[k] == extent[k] {
             continue;
@@ -133,14 +143,18 @@ fn targets(extent: &[u32], samples: &[Vec<f32>], counts: &[u32], filter: Pyramid
             let base = (o / (stride * c)) * (stride * e) + o % stride;
             for (s, &wt) in w[j].iter().enumerate() {
                 if wt != 0.0 {
-                    img.iter_mut().zip(&data[base + s * stride]).for_each(|(a, v)| *a += wt * v);
+                    img.iter_mut()
+                        .zip(&data[base + s * stride])
+                        .for_each(|(a, v)| *a += wt * v);
                 }
             }
         }
         data = out;
         shape[k] = c;
     }
-    data.into_iter().map(|d| d.into_iter().map(|v| v as f32).collect()).collect()
+    data.into_iter()
+        .map(|d| d.into_iter().map(|v| v as f32).collect())
+        .collect()
 }
 
 /// Builds the pyramid with the given level counts (top first; the first must be all ones,
@@ -167,10 +181,16 @@ fn build_cached(
         && level_counts[0].iter().all(|&c| c == 1)
         && level_counts.last().map(Vec::as_slice) == Some(extent)
         && level_counts.iter().all(|c| c.len() == extent.len())
-        && level_counts.windows(2).all(|w| w[0].iter().zip(&w[1]).all(|(a, b)| a <= b))
-        && level_counts.iter().all(|c| c.iter().zip(extent).all(|(c, e)| *c >= 1 && c <= e));
+        && level_counts
+            .windows(2)
+            .all(|w| w[0].iter().zip(&w[1]).all(|(a, b)| a <= b))
+        && level_counts
+            .iter()
+            .all(|c| c.iter().zip(extent).all(|(c, e)| *c >= 1 && c <= e));
     if !valid {
-        return Err(CodecError::Input(format!("level counts {level_counts:?} for extent {extent:?}")));
+        return Err(CodecError::Input(format!(
+            "level counts {level_counts:?} for extent {extent:?}"
+        )));
     }
     let n = samples[0].len();
     let locals: Vec<Vec<u32>> = (0..samples.len()).map(|i| unflatten(i, extent)).collect();
@@ -199,10 +219,15 @@ fn build_cached(
                 .map(|(t, m)| {
                     let mut mean = vec![0.0f64; n];
                     for &s in m {
-                        mean.iter_mut().zip(&above[s]).for_each(|(a, v)| *a += *v as f64);
+                        mean.iter_mut()
+                            .zip(&above[s])
+                            .for_each(|(a, v)| *a += *v as f64);
                     }
                     let k = m.len().max(1) as f64;
-                    t.iter().zip(&mean).map(|(t, a)| t - (a / k) as f32).collect()
+                    t.iter()
+                        .zip(&mean)
+                        .map(|(t, a)| t - (a / k) as f32)
+                        .collect()
                 })
                 .collect()
         };
@@ -286,7 +311,12 @@ pub fn adaptive(
     let mut chosen = vec![extent.to_vec()];
     let mut score = |levels: &[Vec<u32>], cache: &mut HashMap<Vec<u32>, Vec<Vec<f32>>>| {
         let p = build_cached(extent, samples, levels, filter, cache)?;
-        let total: f64 = p.levels.iter().flat_map(|l| &l.images).map(|i| cost(i)).sum();
+        let total: f64 = p
+            .levels
+            .iter()
+            .flat_map(|l| &l.images)
+            .map(|i| cost(i))
+            .sum();
         Ok::<_, CodecError>((p, total))
     };
     let sequence = |chosen: &[Vec<u32>], next: &[u32]| {
@@ -299,7 +329,7 @@ pub fn adaptive(
         seq
     };
     if chosen[0] == ones {
-        return score(&[ones.clone()], &mut cache);
+        return score(std::slice::from_ref(&ones), &mut cache);
     }
     loop {
         let current = chosen.last().cloned().unwrap_or_default();
@@ -334,7 +364,9 @@ mod tests {
                     .map(|t| {
                         let a = l.first().copied().unwrap_or(0) as f32;
                         let b = l.get(1).copied().unwrap_or(0) as f32;
-                        (t as f32 * 0.3).sin() + 0.05 * a + if b as u32 % 2 == 0 { 0.5 } else { -0.5 }
+                        (t as f32 * 0.3).sin()
+                            + 0.05 * a
+                            + if b as u32 % 2 == 0 { 0.5 } else { -0.5 }
                     })
                     .collect()
             })
@@ -353,10 +385,16 @@ mod tests {
     #[test]
     fn exact_reconstruction_for_fixed_sequences() {
         for (extent, seq) in [
-            (vec![8, 8], vec![vec![1, 1], vec![2, 2], vec![4, 4], vec![8, 8]]),
+            (
+                vec![8, 8],
+                vec![vec![1, 1], vec![2, 2], vec![4, 4], vec![8, 8]],
+            ),
             (vec![8, 8], vec![vec![1, 1], vec![8, 1], vec![8, 8]]),
             (vec![5, 3], vec![vec![1, 1], vec![3, 2], vec![5, 3]]),
-            (vec![5, 3], vec![vec![1, 1], vec![2, 1], vec![3, 3], vec![5, 3]]),
+            (
+                vec![5, 3],
+                vec![vec![1, 1], vec![2, 1], vec![3, 3], vec![5, 3]],
+            ),
             (vec![7], vec![vec![1], vec![2], vec![4], vec![7]]),
             (vec![1], vec![vec![1]]),
         ] {
@@ -382,13 +420,20 @@ mod tests {
         let s = block(&[8, 8], 11);
         let (p, _) = adaptive(&[8, 8], &s, PyramidFilter::Box, l1_cost).unwrap();
         let below = &p.levels[p.levels.len() - 2].counts;
-        assert_eq!(below[1], 8, "{:?}", p.levels.iter().map(|l| &l.counts).collect::<Vec<_>>());
+        assert_eq!(
+            below[1],
+            8,
+            "{:?}",
+            p.levels.iter().map(|l| &l.counts).collect::<Vec<_>>()
+        );
     }
 
     #[test]
     fn index_rule_matches_the_spec_example() {
         // 5 samples, 2 level samples: floor(s·2/5) = 0,0,0,1,1.
-        let idx: Vec<usize> = (0..5).map(|s| level_image_index(&[2], &[s], &[5])).collect();
+        let idx: Vec<usize> = (0..5)
+            .map(|s| level_image_index(&[2], &[s], &[5]))
+            .collect();
         assert_eq!(idx, vec![0, 0, 0, 1, 1]);
     }
 

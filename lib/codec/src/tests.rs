@@ -133,7 +133,13 @@ fn texture(w: u32, h: u32, c: u32, offset: f32) -> Vec<f32> {
 
 #[test]
 fn lossy_codecs_round_trip_closely() {
-    for (w, h, c, offset) in [(64, 48, 3, 0.5), (37, 21, 4, 0.0), (5, 3, 1, -2.0), (1, 1, 3, 1.0), (9, 1, 3, 0.0)] {
+    for (w, h, c, offset) in [
+        (64, 48, 3, 0.5),
+        (37, 21, 4, 0.0),
+        (5, 3, 1, -2.0),
+        (1, 1, 3, 1.0),
+        (9, 1, 3, 0.0),
+    ] {
         let p = [PlaneShape::new(w, h, c)];
         let v = texture(w, h, c, offset);
         for id in [CodecId::Wavelet, CodecId::Dct] {
@@ -163,7 +169,10 @@ fn lossy_codecs_handle_several_planes() {
 fn lossy_codecs_refuse_non_finite_input() {
     let p = [PlaneShape::new(2, 1, 1)];
     for id in [CodecId::Wavelet, CodecId::Dct] {
-        assert!(matches!(encode(id, &p, &[1.0, f32::NAN]), Err(CodecError::Input(_))));
+        assert!(matches!(
+            encode(id, &p, &[1.0, f32::NAN]),
+            Err(CodecError::Input(_))
+        ));
     }
 }
 
@@ -210,7 +219,10 @@ fn wavelet_curve_decreases_and_matches_the_codec() {
     let v = texture(64, 64, 3, 0.5);
     let curve = codec(CodecId::Wavelet).unwrap().rd_curve(&p, &v).unwrap();
     assert!(curve.points.len() > 10);
-    assert!(curve.points.windows(2).all(|w| w[0].bytes < w[1].bytes && w[0].mse > w[1].mse));
+    assert!(curve
+        .points
+        .windows(2)
+        .all(|w| w[0].bytes < w[1].bytes && w[0].mse > w[1].mse));
     let full = encode(CodecId::Wavelet, &p, &v).unwrap();
     for pt in &curve.points {
         let back = decode(CodecId::Wavelet, &p, &full[..pt.bytes]).unwrap();
@@ -226,12 +238,18 @@ fn dct_budget_and_quality_order() {
     for q in [10, 50, 90] {
         let s = encode_with(CodecId::Dct, &p, &v, Rate::Quality(q)).unwrap();
         let m = mse(&v, &decode(CodecId::Dct, &p, &s).unwrap());
-        assert!(s.len() > prev.0 && m < prev.1, "q {q}: {} bytes, mse {m}", s.len());
+        assert!(
+            s.len() > prev.0 && m < prev.1,
+            "q {q}: {} bytes, mse {m}",
+            s.len()
+        );
         prev = (s.len(), m);
     }
     let s = encode_with(CodecId::Dct, &p, &v, Rate::Bytes(300)).unwrap();
     assert!(s.len() <= 300 && !s.is_empty());
-    assert!(encode_with(CodecId::Dct, &p, &v, Rate::Bytes(5)).unwrap().is_empty());
+    assert!(encode_with(CodecId::Dct, &p, &v, Rate::Bytes(5))
+        .unwrap()
+        .is_empty());
     let curve = codec(CodecId::Dct).unwrap().rd_curve(&p, &v).unwrap();
     assert!(curve.points.len() > 5);
 }

@@ -39,6 +39,7 @@ fn band(k: usize) -> usize {
 
 /// Exp-Golomb code of `v`: with `v + 1 = 2^p + r`, `p` one-bits (contexts by position)
 /// and a zero, then the `p` bits of `r`, most significant first, as direct bits.
+#[allow(clippy::needless_range_loop)]
 fn put_uint(enc: &mut Encoder, ctx: &mut [Context; MAX_PREFIX + 1], v: u32) {
     let x = v as u64 + 1;
     let p = 63 - x.leading_zeros() as usize;
@@ -67,6 +68,7 @@ fn get_uint(dec: &mut Decoder, ctx: &mut [Context; MAX_PREFIX + 1]) -> Option<u3
 }
 
 /// Codes one block of quantized coefficients (zig-zag order) given the previous DC.
+#[allow(clippy::needless_range_loop)]
 pub fn put_block(enc: &mut Encoder, ctx: &mut Contexts, q: &[i32; 64], prev_dc: i32) {
     let d = q[0].wrapping_sub(prev_dc);
     enc.bit(&mut ctx.dc_zero, d != 0);

@@ -20,14 +20,20 @@ pub fn header_len(planes: &[PlaneShape]) -> usize {
 }
 
 fn max_channels(planes: &[PlaneShape]) -> usize {
-    planes.iter().map(|p| p.channels as usize).max().unwrap_or(0)
+    planes
+        .iter()
+        .map(|p| p.channels as usize)
+        .max()
+        .unwrap_or(0)
 }
 
 /// The (width, height) of each (plane, channel) array in stream order.
 fn arrays(planes: &[PlaneShape]) -> Vec<(usize, usize)> {
     planes
         .iter()
-        .flat_map(|p| std::iter::repeat_n((p.width as usize, p.height as usize), p.channels as usize))
+        .flat_map(|p| {
+            std::iter::repeat_n((p.width as usize, p.height as usize), p.channels as usize)
+        })
         .collect()
 }
 
@@ -43,10 +49,17 @@ fn load_block(a: &[f32], w: usize, h: usize, bx: usize, by: usize, b: &mut [f32;
 }
 
 /// Encodes with quality `quality` (1..=100).
-pub fn encode_quality(planes: &[PlaneShape], values: &[f32], quality: u8) -> Result<Vec<u8>, CodecError> {
+pub fn encode_quality(
+    planes: &[PlaneShape],
+    values: &[f32],
+    quality: u8,
+) -> Result<Vec<u8>, CodecError> {
     let n = value_count(planes)?;
     if values.len() != n {
-        return Err(CodecError::Length { expected: n, found: values.len() });
+        return Err(CodecError::Length {
+            expected: n,
+            found: values.len(),
+        });
     }
     if let Some(i) = values.iter().position(|v| !v.is_finite()) {
         return Err(CodecError::Input(format!("value {i} is not finite")));
@@ -119,10 +132,16 @@ pub fn decode(planes: &[PlaneShape], bytes: &[u8]) -> Result<Vec<f32>, CodecErro
     }
     let hl = header_len(planes);
     if bytes.len() < hl {
-        return Err(CodecError::Corrupt(format!("{} bytes, shorter than the {hl}-byte header", bytes.len())));
+        return Err(CodecError::Corrupt(format!(
+            "{} bytes, shorter than the {hl}-byte header",
+            bytes.len()
+        )));
     }
     if bytes[0] != VERSION {
-        return Err(CodecError::Corrupt(format!("version {} is not 1", bytes[0])));
+        return Err(CodecError::Corrupt(format!(
+            "version {} is not 1",
+            bytes[0]
+        )));
     }
     let quality = bytes[1];
     if !(1..=100).contains(&quality) {
@@ -190,14 +209,24 @@ pub fn decode(planes: &[PlaneShape], bytes: &[u8]) -> Result<Vec<f32>, CodecErro
 pub const CURVE_QUALITIES: [u8; 14] = [2, 5, 10, 15, 20, 30, 40, 50, 60, 70, 80, 90, 95, 100];
 
 /// The measured rate–distortion curve: one encode and decode per quality.
-pub fn rd_curve(planes: &[PlaneShape], values: &[f32], qualities: &[u8]) -> Result<RdCurve, CodecError> {
+pub fn rd_curve(
+    planes: &[PlaneShape],
+    values: &[f32],
+    qualities: &[u8],
+) -> Result<RdCurve, CodecError> {
     let n = value_count(planes)?;
     let zero = values.iter().map(|v| (*v as f64).powi(2)).sum::<f64>() / n.max(1) as f64;
-    let mut points = vec![RdPoint { bytes: 0, mse: zero }];
+    let mut points = vec![RdPoint {
+        bytes: 0,
+        mse: zero,
+    }];
     for &q in qualities {
         let s = encode_quality(planes, values, q)?;
         let back = decode(planes, &s)?;
-        points.push(RdPoint { bytes: s.len(), mse: crate::mse(values, &back) });
+        points.push(RdPoint {
+            bytes: s.len(),
+            mse: crate::mse(values, &back),
+        });
     }
     Ok(RdCurve { points }.monotone())
 }

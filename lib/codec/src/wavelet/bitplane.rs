@@ -69,18 +69,19 @@ pub struct Checkpoint {
 /// Returns the body and the error after each prefix length where it changes.
 pub fn encode(bands: &[Band], a: &[f64], neg: &[bool], top: u32) -> (Vec<u8>, Vec<Checkpoint>) {
     let n = a.len();
-    let m: Vec<u32> = a.iter().map(|v| v.floor().min((1u64 << 31) as f64 - 1.0) as u32).collect();
+    let m: Vec<u32> = a
+        .iter()
+        .map(|v| v.floor().min((1u64 << 31) as f64 - 1.0) as u32)
+        .collect();
     let mut sig = vec![0u8; n];
     let mut enc = Encoder::new();
     let mut sctx = [Context::default(); SIG_CONTEXTS];
     let mut rctx = [Context::default(); 2];
     let mut error: f64 = a.iter().map(|v| v * v).sum();
     let mut trace = vec![Checkpoint { needed: 0, error }];
-    let record = |needed: u64, error: f64, trace: &mut Vec<Checkpoint>| {
-        match trace.last_mut() {
-            Some(last) if last.needed == needed => last.error = error,
-            _ => trace.push(Checkpoint { needed, error }),
-        }
+    let record = |needed: u64, error: f64, trace: &mut Vec<Checkpoint>| match trace.last_mut() {
+        Some(last) if last.needed == needed => last.error = error,
+        _ => trace.push(Checkpoint { needed, error }),
     };
     for p in (0..=top).rev() {
         let half = 0.5 * (1u64 << p) as f64;

@@ -166,7 +166,9 @@ mod tests {
     #[test]
     fn perfect_reconstruction_any_size() {
         for (w, h) in [(1, 1), (2, 2), (3, 5), (17, 9), (64, 33), (1, 7)] {
-            let orig: Vec<f32> = (0..w * h).map(|i| ((i * 7919) % 101) as f32 * 0.1 - 3.0).collect();
+            let orig: Vec<f32> = (0..w * h)
+                .map(|i| ((i * 7919) % 101) as f32 * 0.1 - 3.0)
+                .collect();
             let mut a = orig.clone();
             let l = plane_levels(w as u32, h as u32, 6);
             forward_2d(&mut a, w, h, l);

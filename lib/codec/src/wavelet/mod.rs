@@ -26,7 +26,11 @@ pub fn header_len(planes: &[PlaneShape]) -> usize {
 }
 
 fn max_channels(planes: &[PlaneShape]) -> usize {
-    planes.iter().map(|p| p.channels as usize).max().unwrap_or(0)
+    planes
+        .iter()
+        .map(|p| p.channels as usize)
+        .max()
+        .unwrap_or(0)
 }
 
 /// A full encode: the codestream and its rate–distortion curve (one point per prefix length
@@ -89,7 +93,10 @@ impl Encoded {
 
 /// The subbands of all (plane, channel) arrays in scan order, and the scale of each band
 /// (the square root of its 2D synthesis energy).
-fn layout(planes: &[PlaneShape], levels: u32) -> (Vec<Band>, Vec<f32>, Vec<(usize, usize, u32)>) {
+/// Width, height and decomposition levels of one (plane, channel) array.
+type ArrayShape = (usize, usize, u32);
+
+fn layout(planes: &[PlaneShape], levels: u32) -> (Vec<Band>, Vec<f32>, Vec<ArrayShape>) {
     let mut bands = Vec::new();
     let mut scales = Vec::new();
     let mut arrays = Vec::new();
@@ -159,7 +166,7 @@ fn layout(planes: &[PlaneShape], levels: u32) -> (Vec<Band>, Vec<f32>, Vec<(usiz
 /// Copies each band out of (or back into) the Mallat layout of its array.
 fn for_each_band_coef(
     bands: &[Band],
-    arrays: &[(usize, usize, u32)],
+    arrays: &[ArrayShape],
     mut f: impl FnMut(usize, usize, usize, usize),
 ) {
     // f(band index, array index, position in array, position in coefficient vector)
@@ -243,16 +250,35 @@ pub fn encode_full(
         let mean_mse = mse_of_means(planes, values, colour, &means);
         let curve = RdCurve {
             points: vec![
-                RdPoint { bytes: 0, mse: zero_mse },
-                RdPoint { bytes: hl, mse: mean_mse },
+                RdPoint {
+                    bytes: 0,
+                    mse: zero_mse,
+                },
+                RdPoint {
+                    bytes: hl,
+                    mse: mean_mse,
+                },
             ],
         };
-        return Ok(Encoded { bytes: header, curve });
+        return Ok(Encoded {
+            bytes: header,
+            curve,
+        });
     }
     let step = (peak / (1u64 << bits) as f32).max(f32::MIN_POSITIVE);
-    let a: Vec<f64> = coefs.iter().map(|c| (c.abs() as f64) / step as f64).collect();
-    let neg: Vec<bool> = coefs.iter().map(|c| c.is_sign_negative() && *c != 0.0).collect();
-    let max_m = a.iter().fold(0.0f64, |m, v| m.max(*v)).floor().min((1u64 << 31) as f64 - 1.0) as u32;
+    let a: Vec<f64> = coefs
+        .iter()
+        .map(|c| (c.abs() as f64) / step as f64)
+        .collect();
+    let neg: Vec<bool> = coefs
+        .iter()
+        .map(|c| c.is_sign_negative() && *c != 0.0)
+        .collect();
+    let max_m = a
+        .iter()
+        .fold(0.0f64, |m, v| m.max(*v))
+        .floor()
+        .min((1u64 << 31) as f64 - 1.0) as u32;
     let top = 31 - max_m.max(1).leading_zeros();
     header.push(top as u8);
     header.extend(step.to_le_bytes());
@@ -261,7 +287,10 @@ pub fn encode_full(
     }
     let (body, trace) = bitplane::encode(&bands, &a, &neg, top);
     let unit = (step as f64) * (step as f64) / n as f64;
-    let mut points = vec![RdPoint { bytes: 0, mse: zero_mse }];
+    let mut points = vec![RdPoint {
+        bytes: 0,
+        mse: zero_mse,
+    }];
     for c in trace {
         points.push(RdPoint {
             bytes: hl + c.needed as usize,
@@ -312,11 +341,16 @@ pub fn decode(planes: &[PlaneShape], bytes: &[u8]) -> Result<Vec<f32>, CodecErro
         )));
     }
     if bytes[0] != VERSION {
-        return Err(CodecError::Corrupt(format!("version {} is not 1", bytes[0])));
+        return Err(CodecError::Corrupt(format!(
+            "version {} is not 1",
+            bytes[0]
+        )));
     }
     let levels = bytes[1] as u32;
     if levels > MAX_LEVELS {
-        return Err(CodecError::Corrupt(format!("{levels} levels (at most {MAX_LEVELS})")));
+        return Err(CodecError::Corrupt(format!(
+            "{levels} levels (at most {MAX_LEVELS})"
+        )));
     }
     let colour = match bytes[2] {
         0 => false,
@@ -340,7 +374,10 @@ pub fn decode(planes: &[PlaneShape], bytes: &[u8]) -> Result<Vec<f32>, CodecErro
         }
     }
     let (bands, scales, arrays) = layout(planes, levels);
-    let mut chans: Vec<Vec<f32>> = arrays.iter().map(|&(w, h, _)| vec![0.0f32; w * h]).collect();
+    let mut chans: Vec<Vec<f32>> = arrays
+        .iter()
+        .map(|&(w, h, _)| vec![0.0f32; w * h])
+        .collect();
     if top != NO_PLANES {
         let dec = bitplane::decode(&bands, n, top as u32, &bytes[hl..]);
         for_each_band_coef(&bands, &arrays, |b, ai, pos, k| {
