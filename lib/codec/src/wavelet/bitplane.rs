@@ -1,12 +1,14 @@
 //! The embedded bit-plane coder of the `wavelet` codec (SPEC.md 11.4): set partitioning in the
 //! spirit of SPIHT, expressed as significance propagation. Bit-planes are coded from the top
-//! down; in each plane a *significance pass* visits every coefficient not yet significant, in
-//! scan order, and codes whether it becomes significant (context: its subband class, how many
-//! of its four neighbours and whether its parent in the next coarser subband of the same
-//! orientation are already significant), followed by its sign; then a *refinement pass* codes
-//! the next magnitude bit of every coefficient that was significant before this plane. Where
-//! SPIHT codes "this whole tree is insignificant" with one bit, the adaptive contexts code the
-//! same event for a few hundredths of a bit per coefficient.
+//! down. In each plane a *significance pass* visits each subband in 4×4 tiles: a tile with no
+//! significant coefficient yet first codes whether any of its coefficients becomes
+//! significant in this plane (one bit for 16 coefficients, the set-partitioning step; context:
+//! subband class and whether the parent tile is significant), and only then its coefficients
+//! one by one (context: subband class, how many of the four neighbours and whether the parent
+//! in the next coarser subband of the same orientation are already significant), each
+//! followed by its sign; the last coefficient of a tile that just became significant, after
+//! only zeros, is significant without a bit. Then a *refinement pass* codes the next
+//! magnitude bit of every coefficient that was significant before this plane.
 //!
 //! Each coded event (a coefficient becoming significant with its sign, or one refinement bit)
 //! is atomic for the decoder: it is applied only when all its bits were decoded, and the
@@ -31,6 +33,40 @@ pub struct Band {
 }
 
 const SIG_CONTEXTS: usize = 4 * 6;
+const TILE_CONTEXTS: usize = 4 * 2;
+/// Side of the tiles of the significance pass.
+pub const TILE: usize = 4;
+
+/// Index of each band's first tile in the tile state.
+fn tile_bases(bands: &[Band]) -> Vec<usize> {
+    let mut base = 0;
+    bands
+        .iter()
+        .map(|b| {
+            let here = base;
+            base += b.width.div_ceil(TILE) * b.height.div_ceil(TILE);
+            here
+        })
+        .collect()
+}
+
+#[inline]
+fn tile_context(
+    bands: &[Band],
+    bases: &[usize],
+    band: &Band,
+    tx: usize,
+    ty: usize,
+    tsig: &[bool],
+) -> usize {
+    let parent = band.parent.is_some_and(|p| {
+        let pb = &bands[p];
+        let (ptw, pth) = (pb.width.div_ceil(TILE), pb.height.div_ceil(TILE));
+        let (x, y) = ((tx / 2).min(ptw - 1), (ty / 2).min(pth - 1));
+        tsig[bases[p] + y * ptw + x]
+    });
+    band.class * 2 + parent as usize
+}
 
 #[inline]
 fn sig_context(bands: &[Band], band: &Band, x: usize, y: usize, i: usize, sig: &[u8]) -> usize {
@@ -74,6 +110,15 @@ pub fn encode(bands: &[Band], a: &[f64], neg: &[bool], top: u32) -> (Vec<u8>, Ve
         .map(|v| v.floor().min((1u64 << 31) as f64 - 1.0) as u32)
         .collect();
     let mut sig = vec![0u8; n];
+    let bases = tile_bases(bands);
+    let mut tsig = vec![
+        false;
+        bases.last().map_or(0, |&b| b)
+            + bands
+                .last()
+                .map_or(0, |b| b.width.div_ceil(TILE) * b.height.div_ceil(TILE))
+    ];
+    let mut tctx = [Context::default(); TILE_CONTEXTS];
     let mut enc = Encoder::new();
     let mut sctx = [Context::default(); SIG_CONTEXTS];
     let mut rctx = [Context::default(); 2];
@@ -85,23 +130,48 @@ pub fn encode(bands: &[Band], a: &[f64], neg: &[bool], top: u32) -> (Vec<u8>, Ve
     };
     for p in (0..=top).rev() {
         let half = 0.5 * (1u64 << p) as f64;
-        for band in bands {
-            for y in 0..band.height {
-                for x in 0..band.width {
-                    let i = band.offset + y * band.width + x;
-                    if sig[i] != 0 {
-                        continue;
+        for (b, band) in bands.iter().enumerate() {
+            let (w, tw) = (band.width, band.width.div_ceil(TILE));
+            for ty in 0..band.height.div_ceil(TILE) {
+                for tx in 0..tw {
+                    let t = bases[b] + ty * tw + tx;
+                    let (x0, y0) = (tx * TILE, ty * TILE);
+                    let (x1, y1) = ((x0 + TILE).min(w), (y0 + TILE).min(band.height));
+                    let mut fresh = false;
+                    if !tsig[t] {
+                        let any = (y0..y1)
+                            .any(|y| (x0..x1).any(|x| m[band.offset + y * w + x] >> p != 0));
+                        let c = tile_context(bands, &bases, band, tx, ty, &tsig);
+                        enc.bit(&mut tctx[c], any);
+                        if !any {
+                            continue;
+                        }
+                        tsig[t] = true;
+                        fresh = true;
                     }
-                    let c = sig_context(bands, band, x, y, i, &sig);
-                    let bit = (m[i] >> p) & 1 == 1;
-                    enc.bit(&mut sctx[c], bit);
-                    if bit {
-                        let needed = enc.bytes_needed_for_next();
-                        enc.direct(neg[i]);
-                        sig[i] = p as u8 + 1;
-                        let rec = 3.0 * half;
-                        error += (a[i] - rec).powi(2) - a[i] * a[i];
-                        record(needed, error, &mut trace);
+                    let last = (y1 - 1, x1 - 1);
+                    let mut only_zeros = true;
+                    for y in y0..y1 {
+                        for x in x0..x1 {
+                            let i = band.offset + y * w + x;
+                            if sig[i] != 0 {
+                                continue;
+                            }
+                            let bit = (m[i] >> p) & 1 == 1;
+                            if !(fresh && only_zeros && (y, x) == last) {
+                                let c = sig_context(bands, band, x, y, i, &sig);
+                                enc.bit(&mut sctx[c], bit);
+                            }
+                            if bit {
+                                only_zeros = false;
+                                let needed = enc.bytes_needed_for_next();
+                                enc.direct(neg[i]);
+                                sig[i] = p as u8 + 1;
+                                let rec = 3.0 * half;
+                                error += (a[i] - rec).powi(2) - a[i] * a[i];
+                                record(needed, error, &mut trace);
+                            }
+                        }
                     }
                 }
             }
@@ -157,28 +227,64 @@ pub fn decode(bands: &[Band], n: usize, top: u32, body: &[u8]) -> Decoded {
         mag: vec![0u32; n],
         low: vec![255u8; n],
     };
+    let bases = tile_bases(bands);
+    let mut tsig = vec![
+        false;
+        bases.last().map_or(0, |&b| b)
+            + bands
+                .last()
+                .map_or(0, |b| b.width.div_ceil(TILE) * b.height.div_ceil(TILE))
+    ];
+    let mut tctx = [Context::default(); TILE_CONTEXTS];
     let mut dec = Decoder::new(body);
     let mut sctx = [Context::default(); SIG_CONTEXTS];
     let mut rctx = [Context::default(); 2];
     'planes: for p in (0..=top).rev() {
-        for band in bands {
-            for y in 0..band.height {
-                for x in 0..band.width {
-                    let i = band.offset + y * band.width + x;
-                    if sig[i] != 0 {
-                        continue;
+        for (b, band) in bands.iter().enumerate() {
+            let (w, tw) = (band.width, band.width.div_ceil(TILE));
+            for ty in 0..band.height.div_ceil(TILE) {
+                for tx in 0..tw {
+                    let t = bases[b] + ty * tw + tx;
+                    let (x0, y0) = (tx * TILE, ty * TILE);
+                    let (x1, y1) = ((x0 + TILE).min(w), (y0 + TILE).min(band.height));
+                    let mut fresh = false;
+                    if !tsig[t] {
+                        let c = tile_context(bands, &bases, band, tx, ty, &tsig);
+                        match dec.bit(&mut tctx[c]) {
+                            None => break 'planes,
+                            Some(false) => continue,
+                            Some(true) => {
+                                tsig[t] = true;
+                                fresh = true;
+                            }
+                        }
                     }
-                    let c = sig_context(bands, band, x, y, i, &sig);
-                    match dec.bit(&mut sctx[c]) {
-                        None => break 'planes,
-                        Some(false) => {}
-                        Some(true) => {
-                            let Some(negative) = dec.direct() else {
-                                break 'planes;
+                    let last = (y1 - 1, x1 - 1);
+                    let mut only_zeros = true;
+                    for y in y0..y1 {
+                        for x in x0..x1 {
+                            let i = band.offset + y * w + x;
+                            if sig[i] != 0 {
+                                continue;
+                            }
+                            let bit = if fresh && only_zeros && (y, x) == last {
+                                true
+                            } else {
+                                let c = sig_context(bands, band, x, y, i, &sig);
+                                match dec.bit(&mut sctx[c]) {
+                                    None => break 'planes,
+                                    Some(bit) => bit,
+                                }
                             };
-                            sig[i] = p as u8 + 1;
-                            out.mag[i] = (1 << p) | ((negative as u32) << 31);
-                            out.low[i] = p as u8;
+                            if bit {
+                                only_zeros = false;
+                                let Some(negative) = dec.direct() else {
+                                    break 'planes;
+                                };
+                                sig[i] = p as u8 + 1;
+                                out.mag[i] = (1 << p) | ((negative as u32) << 31);
+                                out.low[i] = p as u8;
+                            }
                         }
                     }
                 }
