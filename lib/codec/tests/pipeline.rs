@@ -30,7 +30,10 @@ fn sample(a: u32, b: u32) -> Vec<f32> {
 }
 
 fn unflatten(i: usize, extent: &[u32]) -> Vec<u32> {
-    vec![(i / extent[1] as usize) as u32, (i % extent[1] as usize) as u32]
+    vec![
+        (i / extent[1] as usize) as u32,
+        (i % extent[1] as usize) as u32,
+    ]
 }
 
 #[test]
@@ -88,7 +91,11 @@ fn pyramid_allocation_and_decoding_agree() {
     );
     eprintln!(
         "levels {:?}: {} bytes of {budget}, measured {measured:.2} dB, predicted {predicted:.2} dB",
-        pyramid.levels.iter().map(|l| l.counts.clone()).collect::<Vec<_>>(),
+        pyramid
+            .levels
+            .iter()
+            .map(|l| l.counts.clone())
+            .collect::<Vec<_>>(),
         alloc.total_bytes
     );
     assert!(measured > 30.0, "{measured:.2} dB at 200:1");
@@ -102,6 +109,9 @@ fn check_levels(p: &Pyramid) {
     for level in &p.levels {
         let n: u32 = level.counts.iter().product();
         assert_eq!(level.images.len(), n as usize);
-        assert_eq!(level_image_index(&level.counts, &[7, 7], &p.extent), n as usize - 1);
+        assert_eq!(
+            level_image_index(&level.counts, &[7, 7], &p.extent),
+            n as usize - 1
+        );
     }
 }
