@@ -26,6 +26,28 @@ fn texture(w: u32, h: u32) -> Vec<f32> {
     v
 }
 
+/// Sharp edges without noise: 13-texel checker squares (not aligned with 8×8 blocks) over a
+/// radial gradient, as a
+/// textured surface with a highlight might give.
+fn edges(w: u32, h: u32) -> Vec<f32> {
+    let mut v = Vec::with_capacity((w * h * 3) as usize);
+    for y in 0..h {
+        for x in 0..w {
+            let check = if ((x + 5) / 13 + (y + 3) / 13) % 2 == 0 {
+                0.2
+            } else {
+                0.7
+            };
+            let (dx, dy) = (x as f32 / w as f32 - 0.4, y as f32 / h as f32 - 0.6);
+            let glow = 0.5 * (-(dx * dx + dy * dy) * 20.0).exp();
+            for c in 0..3 {
+                v.push(check * (0.7 + 0.15 * c as f32) + glow);
+            }
+        }
+    }
+    v
+}
+
 fn main() {
     let (w, h) = (512, 512);
     let planes = [PlaneShape::new(w, h, 3)];
@@ -55,27 +77,30 @@ fn main() {
         );
     }
 
-    println!();
-    println!("rate-distortion (decode MB/s of decoded f32 at that rate; PSNR for peak 1.0)");
-    println!("target ratio   wavelet bytes  PSNR dB  dec MB/s    dct bytes  PSNR dB  dec MB/s");
-    let full = wavelet::encode_full(
-        &planes,
-        &values,
-        wavelet::DEFAULT_LEVELS,
-        wavelet::DEFAULT_BITS,
-    )
-    .expect("encode");
-    for ratio in [16usize, 48, 96, 192, 384, 768] {
-        let budget = values.len() * 4 / ratio;
-        let w = full.truncated(budget, &planes);
-        let (wp, ws) = measure(CodecId::Wavelet, &planes, &values, w, mb);
-        let d = encode_with(CodecId::Dct, &planes, &values, Rate::Bytes(budget)).expect("encode");
-        let (dp, ds) = measure(CodecId::Dct, &planes, &values, &d, mb);
-        println!(
-            "{ratio:>12} {:>14} {wp:>8.2} {ws:>9.0} {:>12} {dp:>8.2} {ds:>9.0}",
-            w.len(),
-            d.len()
-        );
+    for (name, values) in [("smooth + noise", values), ("edges", edges(w, h))] {
+        println!();
+        println!("rate-distortion on '{name}' (decode MB/s of decoded f32 at that rate; PSNR for peak 1.0)");
+        println!("target ratio   wavelet bytes  PSNR dB  dec MB/s    dct bytes  PSNR dB  dec MB/s");
+        let full = wavelet::encode_full(
+            &planes,
+            &values,
+            wavelet::DEFAULT_LEVELS,
+            wavelet::DEFAULT_BITS,
+        )
+        .expect("encode");
+        for ratio in [16usize, 48, 96, 192, 384, 768] {
+            let budget = values.len() * 4 / ratio;
+            let w = full.truncated(budget, &planes);
+            let (wp, ws) = measure(CodecId::Wavelet, &planes, &values, w, mb);
+            let d =
+                encode_with(CodecId::Dct, &planes, &values, Rate::Bytes(budget)).expect("encode");
+            let (dp, ds) = measure(CodecId::Dct, &planes, &values, &d, mb);
+            println!(
+                "{ratio:>12} {:>14} {wp:>8.2} {ws:>9.0} {:>12} {dp:>8.2} {ds:>9.0}",
+                w.len(),
+                d.len()
+            );
+        }
     }
 }
 
