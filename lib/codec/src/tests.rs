@@ -312,3 +312,24 @@ fn lossy_decoders_with_forged_huge_shape_fail_or_stay_bounded() {
     let huge = [PlaneShape::new(16384, 16384, 4)];
     assert!(decode(CodecId::Dct, &huge, &s).is_err());
 }
+
+#[test]
+fn wavelet_truncations_of_mixed_planes_decode() {
+    // Planes of 3, 4 and 1 channels (colour transform on some, means for 4 channels).
+    let p = planes();
+    let v: Vec<f32> = values(value_count(&p).unwrap())
+        .into_iter()
+        .map(|x| x.clamp(-4.0, 4.0))
+        .collect();
+    let e = wavelet::encode_full(&p, &v, 5, 14).unwrap();
+    let hl = wavelet::header_len(&p);
+    assert_eq!(hl, 8 + 4 * 4);
+    let full = mse(&v, &decode(CodecId::Wavelet, &p, &e.bytes).unwrap());
+    let mut worst_prefix = 0.0f64;
+    for cut in hl..=e.bytes.len() {
+        let back = decode(CodecId::Wavelet, &p, &e.bytes[..cut]).unwrap();
+        assert_eq!(back.len(), v.len());
+        worst_prefix = worst_prefix.max(mse(&v, &back));
+    }
+    assert!(full < 1e-4 && full < worst_prefix, "{full} {worst_prefix}");
+}
