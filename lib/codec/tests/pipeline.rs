@@ -6,7 +6,7 @@
 use pis_codec::allocate::{allocate, Item, Target, DEFAULT_ALPHA};
 use pis_codec::pyramid::{adaptive, l1_cost, level_image_index, Pyramid, PyramidFilter};
 use pis_codec::wavelet;
-use pis_codec::{decode, mse, psnr, CodecId, PlaneShape, RdCurve};
+use pis_codec::{decode, encode_with, mse, psnr, CodecId, PlaneShape, Rate};
 
 const W: u32 = 32;
 const H: u32 = 24;
@@ -36,8 +36,9 @@ fn unflatten(i: usize, extent: &[u32]) -> Vec<u32> {
     ]
 }
 
-#[test]
-fn pyramid_allocation_and_decoding_agree() {
+/// Packs the block at `ratio`:1 with `codec` and returns (measured PSNR, predicted PSNR,
+/// bytes spent, budget, the pyramid).
+fn pack(codec: CodecId, ratio: usize) -> (f64, f64, usize, usize, Pyramid) {
     let extent = [8u32, 8];
     let samples: Vec<Vec<f32>> = (0..64)
         .map(|i| {
@@ -48,58 +49,84 @@ fn pyramid_allocation_and_decoding_agree() {
     let planes = [PlaneShape::new(W, H, 3)];
     let (pyramid, _) = adaptive(&extent, &samples, PyramidFilter::Gaussian, l1_cost).unwrap();
 
-    // One encode per level image; its measured curve; its weight in the block's MSE.
+    // Per level image: its curve (wavelet: one encode, decoded at 16 cuts; dct: measured at
+    // several qualities) and its weight in the block's MSE.
     let mut encoded = Vec::new();
     let mut items = Vec::new();
     for level in &pyramid.levels {
         let covered = 64 / level.images.len().max(1);
         for img in &level.images {
-            let e = wavelet::encode_full(&planes, img, 5, 16).unwrap();
-            let curve: RdCurve = e.measured_curve(&planes, img, 16).unwrap();
+            let curve = if codec == CodecId::Wavelet {
+                let e = wavelet::encode_full(&planes, img, 5, 16).unwrap();
+                let c = e.measured_curve(&planes, img, 16).unwrap();
+                encoded.push(Some(e));
+                c
+            } else {
+                encoded.push(None);
+                pis_codec::codec(codec)
+                    .unwrap()
+                    .rd_curve(&planes, img)
+                    .unwrap()
+            };
             items.push(Item {
                 curve,
                 object: 0,
                 weight: covered as f64 / 64.0,
             });
-            encoded.push(e);
         }
     }
     let raw: usize = samples.iter().map(|s| s.len() * 4).sum();
-    let budget = raw / 200;
+    let budget = raw / ratio;
     let alloc = allocate(&items, &[1.0], Target::Bytes(budget), Some(DEFAULT_ALPHA)).unwrap();
     assert!(alloc.total_bytes <= budget);
 
-    // Decode what the allocation keeps and rebuild every finest sample.
+    // Encode what the allocation grants, decode, and rebuild every finest sample.
     let mut k = 0;
+    let mut spent = 0;
     let mut decoded = pyramid.clone();
     for level in &mut decoded.levels {
         for img in &mut level.images {
-            let stream = encoded[k].truncated(alloc.bytes[k], &planes);
-            *img = decode(CodecId::Wavelet, &planes, stream).unwrap();
+            let stream = match &encoded[k] {
+                Some(e) => e.truncated(alloc.bytes[k], &planes).to_vec(),
+                None => encode_with(codec, &planes, img, Rate::Bytes(alloc.bytes[k])).unwrap(),
+            };
+            spent += stream.len();
+            *img = decode(codec, &planes, &stream).unwrap();
             k += 1;
         }
     }
+    assert!(spent <= budget);
     let mut err = 0.0;
     for (i, s) in samples.iter().enumerate() {
         err += mse(s, &decoded.sample(&unflatten(i, &extent)));
     }
     err /= 64.0;
-    let (measured, predicted) = (psnr(err, 1.0), psnr(alloc.screen_mse, 1.0));
-    assert!(
-        (measured - predicted).abs() < 1.5,
-        "measured {measured:.2} dB, predicted {predicted:.2} dB"
-    );
-    eprintln!(
-        "levels {:?}: {} bytes of {budget}, measured {measured:.2} dB, predicted {predicted:.2} dB",
-        pyramid
-            .levels
-            .iter()
-            .map(|l| l.counts.clone())
-            .collect::<Vec<_>>(),
-        alloc.total_bytes
-    );
-    assert!(measured > 30.0, "{measured:.2} dB at 200:1");
-    check_levels(&pyramid);
+    (
+        psnr(err, 1.0),
+        psnr(alloc.screen_mse, 1.0),
+        spent,
+        budget,
+        pyramid,
+    )
+}
+
+#[test]
+fn pyramid_allocation_and_decoding_agree() {
+    for codec in [CodecId::Wavelet, CodecId::Dct] {
+        for ratio in [100, 200] {
+            let (measured, predicted, spent, budget, pyramid) = pack(codec, ratio);
+            eprintln!(
+                "{codec} {ratio}:1 levels {:?}: {spent} bytes of {budget}, measured {measured:.2} dB, predicted {predicted:.2} dB",
+                pyramid.levels.iter().map(|l| l.counts.clone()).collect::<Vec<_>>(),
+            );
+            assert!(
+                (measured - predicted).abs() < 1.5,
+                "{codec}: measured {measured:.2} dB, predicted {predicted:.2} dB"
+            );
+            assert!(measured > 30.0, "{codec}: {measured:.2} dB at {ratio}:1");
+            check_levels(&pyramid);
+        }
+    }
 }
 
 fn check_levels(p: &Pyramid) {
