@@ -20,17 +20,13 @@ pub const DEFAULT_BITS: u32 = 16;
 pub const CURVE_POINTS: usize = 24;
 const NO_PLANES: u8 = 255;
 
-/// Header bytes of a codestream for `planes`: 8 + 4 per channel of the widest plane.
-pub fn header_len(planes: &[PlaneShape]) -> usize {
-    8 + 4 * max_channels(planes)
-}
+/// Header bytes of every codestream (no channel means: the low-pass band carries them, and
+/// a pyramid of small level images cannot afford 4 bytes per channel each).
+pub const HEADER_LEN: usize = 8;
 
-fn max_channels(planes: &[PlaneShape]) -> usize {
-    planes
-        .iter()
-        .map(|p| p.channels as usize)
-        .max()
-        .unwrap_or(0)
+/// Header bytes of a codestream for `planes` ([`HEADER_LEN`] whatever the planes).
+pub fn header_len(_planes: &[PlaneShape]) -> usize {
+    HEADER_LEN
 }
 
 /// A full encode: the codestream and its rate–distortion curve (one point per prefix length
@@ -40,7 +36,7 @@ fn max_channels(planes: &[PlaneShape]) -> usize {
 pub struct Encoded {
     pub bytes: Vec<u8>,
     /// `mse` per value of the decoded image when the stream is cut to `bytes`. The first
-    /// point is the empty stream (zeros), the second the bare header (the channel means).
+    /// point is the empty stream (zeros), the second the bare header (zeros as well).
     /// The errors are summed over weighted wavelet coefficients: CDF 9/7 is not orthogonal,
     /// so they are estimates (within a factor of about 1.5 at the coarsest cuts, closer as
     /// the rate grows), dense (every byte where the image changes) and free.
@@ -220,7 +216,7 @@ pub fn encode_full(
     let levels = levels.min(MAX_LEVELS);
     let bits = bits.clamp(1, 30);
     let colour = colour::applies(planes);
-    let means = colour::means(planes, values, colour);
+    let means = [0.0f32; 4];
     let mut chans = colour::split(planes, values, colour, &means);
     let (bands, scales, arrays) = layout(planes, levels);
     for (a, &(w, h, lev)) in chans.iter_mut().zip(&arrays) {
@@ -242,26 +238,12 @@ pub fn encode_full(
     let zero_mse = values.iter().map(|v| (*v as f64).powi(2)).sum::<f64>() / n as f64;
     let hl = header_len(planes);
     if peak == 0.0 {
-        header.push(NO_PLANES);
-        header.extend(1.0f32.to_le_bytes());
-        for m in &means[..max_channels(planes)] {
-            header.extend(m.to_le_bytes());
-        }
-        let mean_mse = mse_of_means(planes, values, colour, &means);
+        // Every value is 0: the empty stream says it.
         let curve = RdCurve {
-            points: vec![
-                RdPoint {
-                    bytes: 0,
-                    mse: zero_mse,
-                },
-                RdPoint {
-                    bytes: hl,
-                    mse: mean_mse,
-                },
-            ],
+            points: vec![RdPoint { bytes: 0, mse: 0.0 }],
         };
         return Ok(Encoded {
-            bytes: header,
+            bytes: Vec::new(),
             curve,
         });
     }
@@ -282,9 +264,6 @@ pub fn encode_full(
     let top = 31 - max_m.max(1).leading_zeros();
     header.push(top as u8);
     header.extend(step.to_le_bytes());
-    for m in &means[..max_channels(planes)] {
-        header.extend(m.to_le_bytes());
-    }
     let (body, trace) = bitplane::encode(&bands, &a, &neg, top);
     let unit = (step as f64) * (step as f64) / n as f64;
     let mut points = vec![RdPoint {
@@ -303,12 +282,6 @@ pub fn encode_full(
         bytes,
         curve: RdCurve { points },
     })
-}
-
-fn mse_of_means(planes: &[PlaneShape], values: &[f32], colour: bool, means: &[f32; 4]) -> f64 {
-    let split = colour::split(planes, values, colour, means);
-    let s: f64 = split.iter().flatten().map(|v| (*v as f64).powi(2)).sum();
-    s / values.len().max(1) as f64
 }
 
 /// Encodes with a [`Rate`].
@@ -365,14 +338,7 @@ pub fn decode(planes: &[PlaneShape], bytes: &[u8]) -> Result<Vec<f32>, CodecErro
     if !(step.is_finite() && step > 0.0) {
         return Err(CodecError::Corrupt(format!("step {step}")));
     }
-    let mut means = [0.0f32; 4];
-    for (k, m) in means.iter_mut().take(max_channels(planes)).enumerate() {
-        let o = 8 + 4 * k;
-        *m = f32::from_le_bytes([bytes[o], bytes[o + 1], bytes[o + 2], bytes[o + 3]]);
-        if !m.is_finite() {
-            return Err(CodecError::Corrupt(format!("channel {k} mean {m}")));
-        }
-    }
+    let means = [0.0f32; 4];
     let (bands, scales, arrays) = layout(planes, levels);
     // Working memory peaks at about 2.5 times the decoded size: 6 bytes of coefficient
     // state per value while decoding bit-planes, then 9 while filling the arrays.
