@@ -35,13 +35,8 @@ pub fn inverse(px: &mut [f32]) {
 
 #[allow(clippy::needless_range_loop)]
 /// Splits interleaved planes into one `w × h` array per (plane, channel), after the colour
-/// transform and with the per-channel `means` subtracted.
-pub fn split(
-    planes: &[crate::PlaneShape],
-    values: &[f32],
-    colour: bool,
-    means: &[f32; 4],
-) -> Vec<Vec<f32>> {
+/// transform when `colour` is set.
+pub fn split(planes: &[crate::PlaneShape], values: &[f32], colour: bool) -> Vec<Vec<f32>> {
     let mut out = Vec::new();
     let mut start = 0;
     for p in planes {
@@ -55,7 +50,7 @@ pub fn split(
                 forward(&mut px[..c]);
             }
             for k in 0..c {
-                chans[k][i] = px[k] - means[k];
+                chans[k][i] = px[k];
             }
         }
         start += n * c;
@@ -66,13 +61,7 @@ pub fn split(
 
 #[allow(clippy::needless_range_loop)]
 /// Inverse of [`split`]: writes the interleaved values.
-pub fn merge(
-    planes: &[crate::PlaneShape],
-    chans: &[Vec<f32>],
-    colour: bool,
-    means: &[f32; 4],
-    out: &mut Vec<f32>,
-) {
+pub fn merge(planes: &[crate::PlaneShape], chans: &[Vec<f32>], colour: bool, out: &mut Vec<f32>) {
     let mut idx = 0;
     for p in planes {
         let c = p.channels as usize;
@@ -80,7 +69,7 @@ pub fn merge(
         let mut px = [0.0f32; 4];
         for i in 0..n {
             for k in 0..c {
-                px[k] = chans[idx + k][i] + means[k];
+                px[k] = chans[idx + k][i];
             }
             if colour {
                 inverse(&mut px[..c]);
@@ -89,37 +78,6 @@ pub fn merge(
         }
         idx += c;
     }
-}
-
-#[allow(clippy::needless_range_loop)]
-/// Per-channel means (after the colour transform) over all planes, as `f32`.
-pub fn means(planes: &[crate::PlaneShape], values: &[f32], colour: bool) -> [f32; 4] {
-    let mut sum = [0.0f64; 4];
-    let mut count = [0usize; 4];
-    let mut start = 0;
-    for p in planes {
-        let c = p.channels as usize;
-        let n = (p.width * p.height) as usize;
-        let mut px = [0.0f32; 4];
-        for i in 0..n {
-            px[..c].copy_from_slice(&values[start + i * c..start + (i + 1) * c]);
-            if colour {
-                forward(&mut px[..c]);
-            }
-            for k in 0..c {
-                sum[k] += px[k] as f64;
-                count[k] += 1;
-            }
-        }
-        start += n * c;
-    }
-    let mut m = [0.0f32; 4];
-    for k in 0..4 {
-        if count[k] > 0 {
-            m[k] = (sum[k] / count[k] as f64) as f32;
-        }
-    }
-    m
 }
 
 /// True when the colour transform applies (some plane has 3 or 4 channels).

@@ -1,6 +1,6 @@
 //! Codec 3, `dct`: 8×8 block DCT, the JPEG matrix scaled by a quality factor, adaptive
-//! arithmetic coding (SPEC.md 11.5). Float input: the stream stores a unit (one step of the
-//! 8-bit scale the matrix was designed for) and the per-channel means.
+//! arithmetic coding (SPEC.md 11.5). Float input: the stream stores a unit, one step of the
+//! 8-bit scale the matrix was designed for: the range of the values over 255.
 
 pub mod entropy;
 pub mod quant;
@@ -14,17 +14,12 @@ pub const VERSION: u8 = 1;
 /// Quality of [`Rate::Default`].
 pub const DEFAULT_QUALITY: u8 = 75;
 
-/// Header bytes of a codestream for `planes`: 8 + 4 per channel of the widest plane.
-pub fn header_len(planes: &[PlaneShape]) -> usize {
-    8 + 4 * max_channels(planes)
-}
+/// Header bytes of every codestream.
+pub const HEADER_LEN: usize = 8;
 
-fn max_channels(planes: &[PlaneShape]) -> usize {
-    planes
-        .iter()
-        .map(|p| p.channels as usize)
-        .max()
-        .unwrap_or(0)
+/// Header bytes of a codestream for `planes` ([`HEADER_LEN`] whatever the planes).
+pub fn header_len(_planes: &[PlaneShape]) -> usize {
+    HEADER_LEN
 }
 
 /// The (width, height) of each (plane, channel) array in stream order.
@@ -66,18 +61,20 @@ pub fn encode_quality(
     }
     let quality = quality.clamp(1, 100);
     let colour = colour::applies(planes);
-    let means = colour::means(planes, values, colour);
-    let chans = colour::split(planes, values, colour, &means);
-    let peak = chans.iter().flatten().fold(0.0f32, |m, v| m.max(v.abs()));
-    if !peak.is_finite() {
+    let chans = colour::split(planes, values, colour);
+    let (lo, hi) = chans
+        .iter()
+        .flatten()
+        .fold((f32::INFINITY, f32::NEG_INFINITY), |(lo, hi), v| {
+            (lo.min(*v), hi.max(*v))
+        });
+    let range = hi - lo;
+    if !range.is_finite() {
         return Err(CodecError::Input("colour transform overflows f32".into()));
     }
-    let unit = (2.0 * peak / 255.0).max(f32::MIN_POSITIVE);
+    let unit = (range / 255.0).max(f32::MIN_POSITIVE);
     let mut out = vec![VERSION, quality, colour as u8, 0];
     out.extend(unit.to_le_bytes());
-    for m in &means[..max_channels(planes)] {
-        out.extend(m.to_le_bytes());
-    }
     let steps = quant::steps(quality, unit);
     let mut enc = Encoder::new();
     let mut ctx = entropy::Contexts::default();
@@ -159,14 +156,6 @@ pub fn decode(planes: &[PlaneShape], bytes: &[u8]) -> Result<Vec<f32>, CodecErro
     if !(unit.is_finite() && unit > 0.0) {
         return Err(CodecError::Corrupt(format!("unit {unit}")));
     }
-    let mut means = [0.0f32; 4];
-    for (k, m) in means.iter_mut().take(max_channels(planes)).enumerate() {
-        let o = 8 + 4 * k;
-        *m = f32::from_le_bytes([bytes[o], bytes[o + 1], bytes[o + 2], bytes[o + 3]]);
-        if !m.is_finite() {
-            return Err(CodecError::Corrupt(format!("channel {k} mean {m}")));
-        }
-    }
     let steps = quant::steps(quality, unit);
     let mut dec = Decoder::new(&bytes[hl..]);
     let mut ctx = entropy::Contexts::default();
@@ -198,7 +187,7 @@ pub fn decode(planes: &[PlaneShape], bytes: &[u8]) -> Result<Vec<f32>, CodecErro
         chans.push(a);
     }
     let mut out = Vec::with_capacity(n);
-    colour::merge(planes, &chans, colour, &means, &mut out);
+    colour::merge(planes, &chans, colour, &mut out);
     if out.iter().any(|v| !v.is_finite()) {
         return Err(CodecError::Corrupt("decoded values overflow f32".into()));
     }

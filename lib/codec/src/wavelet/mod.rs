@@ -216,8 +216,7 @@ pub fn encode_full(
     let levels = levels.min(MAX_LEVELS);
     let bits = bits.clamp(1, 30);
     let colour = colour::applies(planes);
-    let means = [0.0f32; 4];
-    let mut chans = colour::split(planes, values, colour, &means);
+    let mut chans = colour::split(planes, values, colour);
     let (bands, scales, arrays) = layout(planes, levels);
     for (a, &(w, h, lev)) in chans.iter_mut().zip(&arrays) {
         lifting::forward_2d(a, w, h, lev);
@@ -338,7 +337,6 @@ pub fn decode(planes: &[PlaneShape], bytes: &[u8]) -> Result<Vec<f32>, CodecErro
     if !(step.is_finite() && step > 0.0) {
         return Err(CodecError::Corrupt(format!("step {step}")));
     }
-    let means = [0.0f32; 4];
     let (bands, scales, arrays) = layout(planes, levels);
     // Working memory peaks at about 2.5 times the decoded size: 6 bytes of coefficient
     // state per value while decoding bit-planes, then 9 while filling the arrays.
@@ -356,7 +354,7 @@ pub fn decode(planes: &[PlaneShape], bytes: &[u8]) -> Result<Vec<f32>, CodecErro
         lifting::inverse_2d(a, w, h, lev);
     }
     let mut out = Vec::with_capacity(n);
-    colour::merge(planes, &chans, colour, &means, &mut out);
+    colour::merge(planes, &chans, colour, &mut out);
     if out.iter().any(|v| !v.is_finite()) {
         return Err(CodecError::Corrupt("decoded values overflow f32".into()));
     }
