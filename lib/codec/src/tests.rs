@@ -344,3 +344,31 @@ fn zero_images_cost_nothing() {
         assert_eq!(decode(id, &p, &[]).unwrap(), zeros);
     }
 }
+
+#[test]
+fn constant_and_offset_images_keep_their_level() {
+    let p = [PlaneShape::new(13, 11, 3)];
+    let n = 13 * 11 * 3;
+    let constant = vec![0.5f32; n];
+    let offset: Vec<f32> = (0..n).map(|i| 1000.0 + (i % 7) as f32 * 1e-3).collect();
+    // Large DC jumps between blocks: the top rows at +3·10⁴, the rest at −3·10⁴.
+    let mixed: Vec<f32> = (0..n)
+        .map(|i| if i < n / 3 { 3.0e4 } else { -3.0e4 })
+        .collect();
+    for (k, v) in [constant, offset, mixed].into_iter().enumerate() {
+        for id in [CodecId::Wavelet, CodecId::Dct] {
+            let s = encode_with(id, &p, &v, Rate::Quality(100)).unwrap();
+            let back = decode(id, &p, &s).unwrap();
+            let peak = v.iter().fold(0.0f32, |m, x| m.max(x.abs())) as f64;
+            let rel = mse(&v, &back).sqrt() / peak;
+            assert!(rel < 1e-3, "{id} case {k}: relative error {rel}");
+            // At the default rate the level (the mean) survives.
+            let back = decode(id, &p, &encode(id, &p, &v).unwrap()).unwrap();
+            let mean = |x: &[f32]| x.iter().map(|v| *v as f64).sum::<f64>() / x.len() as f64;
+            assert!(
+                (mean(&v) - mean(&back)).abs() < 1e-2 * peak,
+                "{id} case {k}"
+            );
+        }
+    }
+}

@@ -1,6 +1,7 @@
 //! Codec 3, `dct`: 8×8 block DCT, the JPEG matrix scaled by a quality factor, adaptive
 //! arithmetic coding (SPEC.md 11.5). Float input: the stream stores a unit, one step of the
-//! 8-bit scale the matrix was designed for: the range of the values over 255.
+//! 8-bit scale the matrix was designed for: the range of the values (at least 1/1024 of their
+//! largest magnitude) over 255.
 
 pub mod entropy;
 pub mod quant;
@@ -72,7 +73,10 @@ pub fn encode_quality(
     if !range.is_finite() {
         return Err(CodecError::Input("colour transform overflows f32".into()));
     }
-    let unit = (range / 255.0).max(f32::MIN_POSITIVE);
+    // The range, but no less than 1/1024 of the largest magnitude: a constant or nearly
+    // constant image keeps its level (its DC stays far below the quantizer's clamp).
+    let big = lo.abs().max(hi.abs());
+    let unit = (range.max(big / 1024.0) / 255.0).max(f32::MIN_POSITIVE);
     let mut out = vec![VERSION, quality, colour as u8, 0];
     out.extend(unit.to_le_bytes());
     let steps = quant::steps(quality, unit);
