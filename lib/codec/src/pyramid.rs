@@ -23,7 +23,7 @@
 
 use std::collections::HashMap;
 
-use crate::CodecError;
+use crate::{CodecError, CodecId, PlaneShape, Rate};
 
 /// How a level's target is filtered from the finest samples.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -295,6 +295,18 @@ pub fn l1_cost(image: &[f32]) -> f64 {
     image.iter().map(|v| v.abs() as f64).sum()
 }
 
+/// A rate score for [`adaptive`]: the bytes `codec` spends on a level image at `rate` (use a
+/// quality, not a byte budget, so that the score tells levels apart).
+pub fn codec_cost(
+    codec: CodecId,
+    planes: &[PlaneShape],
+    rate: Rate,
+) -> impl FnMut(&[f32]) -> f64 + '_ {
+    move |img| {
+        crate::encode_with(codec, planes, img, rate).map_or(f64::INFINITY, |b| b.len() as f64)
+    }
+}
+
 /// The adaptive pyramid: greedy choice of each level's counts (module docs) under `cost`, a
 /// rate (or rate–distortion) score of one level image, e.g. [`l1_cost`] or the byte count
 /// of an encode at a fixed quality. Returns the pyramid and its total cost.
@@ -426,6 +438,17 @@ mod tests {
             "{:?}",
             p.levels.iter().map(|l| &l.counts).collect::<Vec<_>>()
         );
+    }
+
+    #[test]
+    fn adaptive_with_a_codec_as_the_rate_score() {
+        let extent = [4u32, 4];
+        let s = block(&extent, 5 * 4 * 3);
+        let planes = [PlaneShape::new(5, 4, 3)];
+        let cost = codec_cost(CodecId::Dct, &planes, Rate::Quality(75));
+        let (p, total) = adaptive(&extent, &s, PyramidFilter::Gaussian, cost).unwrap();
+        assert_exact(&p, &s);
+        assert!(total > 0.0 && total.is_finite());
     }
 
     #[test]
