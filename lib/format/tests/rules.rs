@@ -313,6 +313,7 @@ fn cases() -> Vec<(u16, Vec<u8>)> {
             c.objects[0].layers.push(l);
         }),
     ));
+    v.push((6009, t().set_u32("layer 0 block 0 width", 16384).set_u32("layer 0 block 0 height", 16384).reseal()));
     // 7xxx
     v.push((7001, t().set_u32("layer 0 block 0 level count", 0).reseal()));
     v.push((
