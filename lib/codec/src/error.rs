@@ -15,6 +15,8 @@ pub enum CodecError {
     Length { expected: usize, found: usize },
     #[error("codestream decodes to {found} bytes, expected {expected}")]
     DecodedLength { expected: usize, found: usize },
+    #[error("cannot encode: {0}")]
+    Input(String),
     #[error("codestream is corrupt: {0}")]
     Corrupt(String),
 }

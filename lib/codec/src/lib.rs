@@ -6,16 +6,32 @@
 //! sequence as one `f32` slice; the plane shapes come from the container, never from the
 //! codestream, so a decoder cannot be told to allocate more than the container declares.
 //!
-//! Codec ids are part of the file format (format-spec/SPEC.md, "Codecs"). This crate
-//! implements `raw` (0) and `lossless` (1); `wavelet` (2) and `dct` (3) are reserved ids that
-//! decode to [`CodecError::NotSupported`] until they are implemented.
+//! Codec ids are part of the file format (format-spec/SPEC.md, "Codecs"). Every codec sits
+//! behind the [`LevelCodec`] trait and is found by id with [`codec`]: `raw` (0), `lossless`
+//! (1), `wavelet` (2: CDF 9/7 with an embedded bit-plane stream, [`wavelet`]) and `dct`
+//! (3: 8×8 block DCT, [`dct`]). The lossy codecs take a [`Rate`] and give a
+//! rate–distortion curve ([`RdCurve`]).
+//!
+//! Beside the codecs, the crate holds what turns a block of textures into level images and
+//! bytes: the adaptive Laplacian pyramid over parameter space ([`pyramid`], thesis 4.3),
+//! storage allocation by equal slopes ([`allocate`], thesis 4.5) and gamma compensation
+//! ([`gamma`], thesis 4.6).
 
+pub mod allocate;
+mod arith;
+mod colour;
+pub mod dct;
 mod error;
+pub mod gamma;
 mod lossless;
+pub mod pyramid;
 mod raw;
+mod rd;
 mod shape;
+pub mod wavelet;
 
 pub use error::CodecError;
+pub use rd::{Rate, RdCurve, RdPoint};
 pub use shape::{value_count, PlaneShape};
 
 /// The level-image codecs a container may name (SPEC.md, table "Codec ids").
@@ -25,9 +41,9 @@ pub enum CodecId {
     Raw,
     /// Exact: XOR prediction from the left (or upper) neighbour, byte planes, raw DEFLATE.
     Lossless,
-    /// Reserved: CDF 9/7 wavelet with an embedded set-partitioning bit stream.
+    /// CDF 9/7 wavelet with an embedded, arithmetic-coded bit-plane stream.
     Wavelet,
-    /// Reserved: 8×8 block DCT with a scaled quantization matrix.
+    /// 8×8 block DCT with a quantization matrix scaled by a quality factor.
     Dct,
 }
 
@@ -62,9 +78,14 @@ impl CodecId {
         }
     }
 
-    /// True when this build can decode the codec.
+    /// True when this build can decode the codec (every defined id in this build).
     pub fn is_supported(self) -> bool {
-        matches!(self, CodecId::Raw | CodecId::Lossless)
+        codec(self).is_some()
+    }
+
+    /// True for codecs whose decoded values differ from the encoded ones.
+    pub fn is_lossy(self) -> bool {
+        matches!(self, CodecId::Wavelet | CodecId::Dct)
     }
 }
 
@@ -74,12 +95,42 @@ impl std::fmt::Display for CodecId {
     }
 }
 
-/// Encodes `values` (the concatenated planes) with `codec`.
-pub fn encode(
-    codec: CodecId,
-    planes: &[PlaneShape],
-    values: &[f32],
-) -> Result<Vec<u8>, CodecError> {
+/// A level-image codec. Implementations check `values.len()` against the shapes, take
+/// signed float data, and never trust the codestream for sizes.
+pub trait LevelCodec: Sync {
+    /// The id stored in the file.
+    fn id(&self) -> CodecId;
+    /// Encodes the concatenated planes; exact codecs ignore `rate`.
+    fn encode(
+        &self,
+        planes: &[PlaneShape],
+        values: &[f32],
+        rate: Rate,
+    ) -> Result<Vec<u8>, CodecError>;
+    /// Decodes into the concatenated planes. Damaged input gives an error or an image, never
+    /// a panic; memory is bounded by a small multiple of the size the shapes declare.
+    fn decode(&self, planes: &[PlaneShape], bytes: &[u8]) -> Result<Vec<f32>, CodecError>;
+    /// Measured rate–distortion curve of `values`: for `wavelet` from one encode, decoded at
+    /// [`wavelet::CURVE_POINTS`] truncation points (the dense estimate of every truncation
+    /// point is [`wavelet::Encoded::curve`]), for `dct` at
+    /// [`dct::CURVE_QUALITIES`], for exact codecs one point at zero error.
+    fn rd_curve(&self, planes: &[PlaneShape], values: &[f32]) -> Result<RdCurve, CodecError> {
+        let bytes = self.encode(planes, values, Rate::Default)?;
+        Ok(RdCurve {
+            points: vec![RdPoint {
+                bytes: bytes.len(),
+                mse: 0.0,
+            }],
+        })
+    }
+}
+
+struct RawCodec;
+struct LosslessCodec;
+struct WaveletCodec;
+struct DctCodec;
+
+fn check_len(planes: &[PlaneShape], values: &[f32]) -> Result<usize, CodecError> {
     let n = value_count(planes)?;
     if values.len() != n {
         return Err(CodecError::Length {
@@ -87,22 +138,144 @@ pub fn encode(
             found: values.len(),
         });
     }
-    match codec {
-        CodecId::Raw => Ok(raw::encode(values)),
-        CodecId::Lossless => Ok(lossless::encode(planes, values)),
-        CodecId::Wavelet | CodecId::Dct => Err(CodecError::NotSupported(codec)),
+    Ok(n)
+}
+
+impl LevelCodec for RawCodec {
+    fn id(&self) -> CodecId {
+        CodecId::Raw
+    }
+    fn encode(
+        &self,
+        planes: &[PlaneShape],
+        values: &[f32],
+        _: Rate,
+    ) -> Result<Vec<u8>, CodecError> {
+        check_len(planes, values)?;
+        Ok(raw::encode(values))
+    }
+    fn decode(&self, planes: &[PlaneShape], bytes: &[u8]) -> Result<Vec<f32>, CodecError> {
+        raw::decode(value_count(planes)?, bytes)
     }
 }
 
-/// Decodes a codestream into the concatenated planes. The output never exceeds the size the
-/// shapes declare, and memory grows only as decoded bytes arrive.
-pub fn decode(codec: CodecId, planes: &[PlaneShape], bytes: &[u8]) -> Result<Vec<f32>, CodecError> {
-    let n = value_count(planes)?;
-    match codec {
-        CodecId::Raw => raw::decode(n, bytes),
-        CodecId::Lossless => lossless::decode(planes, n, bytes),
-        CodecId::Wavelet | CodecId::Dct => Err(CodecError::NotSupported(codec)),
+impl LevelCodec for LosslessCodec {
+    fn id(&self) -> CodecId {
+        CodecId::Lossless
     }
+    fn encode(
+        &self,
+        planes: &[PlaneShape],
+        values: &[f32],
+        _: Rate,
+    ) -> Result<Vec<u8>, CodecError> {
+        check_len(planes, values)?;
+        Ok(lossless::encode(planes, values))
+    }
+    fn decode(&self, planes: &[PlaneShape], bytes: &[u8]) -> Result<Vec<f32>, CodecError> {
+        lossless::decode(planes, value_count(planes)?, bytes)
+    }
+}
+
+impl LevelCodec for WaveletCodec {
+    fn id(&self) -> CodecId {
+        CodecId::Wavelet
+    }
+    fn encode(
+        &self,
+        planes: &[PlaneShape],
+        values: &[f32],
+        rate: Rate,
+    ) -> Result<Vec<u8>, CodecError> {
+        wavelet::encode(planes, values, rate)
+    }
+    fn decode(&self, planes: &[PlaneShape], bytes: &[u8]) -> Result<Vec<f32>, CodecError> {
+        wavelet::decode(planes, bytes)
+    }
+    fn rd_curve(&self, planes: &[PlaneShape], values: &[f32]) -> Result<RdCurve, CodecError> {
+        let e = wavelet::encode_full(
+            planes,
+            values,
+            wavelet::DEFAULT_LEVELS,
+            wavelet::DEFAULT_BITS,
+        )?;
+        Ok(e.measured_curve(planes, values, wavelet::CURVE_POINTS)?
+            .monotone())
+    }
+}
+
+impl LevelCodec for DctCodec {
+    fn id(&self) -> CodecId {
+        CodecId::Dct
+    }
+    fn encode(
+        &self,
+        planes: &[PlaneShape],
+        values: &[f32],
+        rate: Rate,
+    ) -> Result<Vec<u8>, CodecError> {
+        dct::encode(planes, values, rate)
+    }
+    fn decode(&self, planes: &[PlaneShape], bytes: &[u8]) -> Result<Vec<f32>, CodecError> {
+        dct::decode(planes, bytes)
+    }
+    fn rd_curve(&self, planes: &[PlaneShape], values: &[f32]) -> Result<RdCurve, CodecError> {
+        dct::rd_curve(planes, values, &dct::CURVE_QUALITIES)
+    }
+}
+
+/// The codec registered for `id`, or `None` when this build cannot decode it.
+pub fn codec(id: CodecId) -> Option<&'static dyn LevelCodec> {
+    match id {
+        CodecId::Raw => Some(&RawCodec),
+        CodecId::Lossless => Some(&LosslessCodec),
+        CodecId::Wavelet => Some(&WaveletCodec),
+        CodecId::Dct => Some(&DctCodec),
+    }
+}
+
+fn registered(id: CodecId) -> Result<&'static dyn LevelCodec, CodecError> {
+    codec(id).ok_or(CodecError::NotSupported(id))
+}
+
+/// Encodes `values` (the concatenated planes) with `codec` at its default rate.
+pub fn encode(
+    codec: CodecId,
+    planes: &[PlaneShape],
+    values: &[f32],
+) -> Result<Vec<u8>, CodecError> {
+    encode_with(codec, planes, values, Rate::Default)
+}
+
+/// Encodes `values` with `codec` at `rate`.
+pub fn encode_with(
+    codec: CodecId,
+    planes: &[PlaneShape],
+    values: &[f32],
+    rate: Rate,
+) -> Result<Vec<u8>, CodecError> {
+    registered(codec)?.encode(planes, values, rate)
+}
+
+/// Decodes a codestream into the concatenated planes. The output never exceeds the size the
+/// shapes declare.
+pub fn decode(codec: CodecId, planes: &[PlaneShape], bytes: &[u8]) -> Result<Vec<f32>, CodecError> {
+    registered(codec)?.decode(planes, bytes)
+}
+
+/// Mean squared error per value between two equally long slices.
+pub fn mse(a: &[f32], b: &[f32]) -> f64 {
+    let s: f64 = a
+        .iter()
+        .zip(b)
+        .map(|(x, y)| (*x as f64 - *y as f64).powi(2))
+        .sum();
+    s / a.len().max(1) as f64
+}
+
+/// PSNR in dB of a mean squared error for a signal peak.
+pub fn psnr(mse: f64, peak: f64) -> f64 {
+    10.0 * (peak * peak / mse.max(1e-300)).log10()
 }
 
 #[cfg(test)]

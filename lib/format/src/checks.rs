@@ -17,6 +17,30 @@ pub const MAX_TEXTURE_SIDE: u32 = 16384;
 /// Largest number of pyramid levels.
 pub const MAX_LEVELS: usize = 32;
 
+/// A level image may decode to at most this many times the file's length (rule 6009), so
+/// that no small file can make a reader allocate without bound.
+pub const MAX_EXPANSION: u64 = 1024;
+
+/// Rule 6009 for a file of `file_len` bytes: every level image's decoded size (4 bytes per
+/// value) is at most [`MAX_EXPANSION`] × `file_len`.
+pub fn decoded_sizes<S>(c: &Container<S>, file_len: u64) -> Option<Issue> {
+    let limit = MAX_EXPANSION.saturating_mul(file_len);
+    for (oi, o) in c.objects.iter().enumerate() {
+        for (li, l) in o.layers.iter().enumerate() {
+            for (bi, b) in l.blocks.iter().enumerate() {
+                let planes = crate::texture::LevelLayout::of(l, b).planes();
+                let bytes = pis_codec::value_count(&planes).map_or(u64::MAX, |n| n as u64 * 4);
+                if bytes > limit {
+                    let what = format!("object {oi} '{}' layer {li} block {bi}", o.name);
+                    let detail = format!("{what}: {bytes} bytes per level image; a {file_len}-byte file allows {limit}");
+                    return Some(chunk(Issue::new(6009, detail), "LAYR"));
+                }
+            }
+        }
+    }
+    None
+}
+
 /// Every rule broken by `c`, in chunk order. Later sections are checked only when the ones
 /// they build on hold (a layer's block grid needs a valid space).
 pub fn check<S>(c: &Container<S>) -> Vec<Issue> {

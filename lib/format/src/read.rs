@@ -327,13 +327,14 @@ pub(crate) fn load(src: &dyn Source, full: bool, issues: &mut Vec<Issue>) -> Loa
     if !ok || issues.iter().any(|i| i.severity == Severity::Error) {
         return out;
     }
-    out.container = parse(&out.chunks, &payloads, issues);
+    out.container = parse(&out.chunks, &payloads, len, issues);
     out
 }
 
 fn parse(
     entries: &[ChunkEntry],
     payloads: &[Option<Vec<u8>>],
+    file_len: u64,
     issues: &mut Vec<Issue>,
 ) -> Option<Container<StreamRef>> {
     let find = |f: chunk::FourCC| entries.iter().position(|e| e.fourcc == f);
@@ -424,6 +425,11 @@ fn parse(
         issues.push(issue);
     }
     stream_ranges(entries, &container, issues);
+    if issues.len() == before {
+        if let Some(issue) = checks::decoded_sizes(&container, file_len) {
+            issues.push(issue);
+        }
+    }
     (issues.len() == before).then_some(container)
 }
 

@@ -7,11 +7,7 @@ use crate::texture::LevelLayout;
 
 /// Turns the sum of a block's level images into linear texture values.
 pub fn finish<S>(layer: &Layer<S>, layout: &LevelLayout, mut data: Vec<f32>) -> Vec<f32> {
-    if layer.gamma != 1.0 {
-        let g = layer.gamma;
-        data.iter_mut()
-            .for_each(|v| *v = v.signum() * v.abs().powf(g));
-    }
+    pis_codec::gamma::uncompensate(&mut data, layer.gamma);
     if layer.mip_mode == MipMode::Stored && layout.mips > 1 {
         let c = layout.channels;
         let mut start = 0;
@@ -55,10 +51,6 @@ pub fn prepare<S>(layer: &Layer<S>, layout: &LevelLayout, linear: &[f32]) -> Vec
             start = offset;
         }
     }
-    if layer.gamma != 1.0 {
-        let inv = 1.0 / layer.gamma;
-        data.iter_mut()
-            .for_each(|v| *v = v.signum() * v.abs().powf(inv));
-    }
+    pis_codec::gamma::compensate(&mut data, layer.gamma);
     data
 }

@@ -82,7 +82,11 @@ fn serialize(c: &Container, labelled: bool) -> Result<Sink, Error> {
             )));
         }
     }
-    Ok(serialize_inner(c, labelled))
+    let sink = serialize_inner(c, labelled);
+    if let Some(issue) = checks::decoded_sizes(c, sink.len() as u64) {
+        return Err(Error::InvalidModel(issue));
+    }
+    Ok(sink)
 }
 
 fn serialize_inner(c: &Container, labelled: bool) -> Sink {

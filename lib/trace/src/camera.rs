@@ -84,4 +84,31 @@ mod tests {
         let q = pc.project(pc.origin + pc.direction(p) * 5.0).unwrap();
         assert!((p - q).length() < 1e-3);
     }
+
+    #[test]
+    fn projection_matrix_maps_points_to_the_pixels_rays_pass_through() {
+        for zfar in [50.0, f32::INFINITY] {
+            let eye = Vec3::new(0.3, 1.5, 2.0);
+            let f = (Vec3::new(0.0, 0.5, 0.0) - eye).normalize();
+            let r = f.cross(Vec3::Y).normalize();
+            let u = r.cross(f);
+            let cam = Camera {
+                world_from_camera: Mat4::from_cols(r.extend(0.0), u.extend(0.0), (-f).extend(0.0), eye.extend(1.0)),
+                yfov: 0.7,
+                znear: 0.1,
+                zfar,
+            };
+            let (w, h) = (80u32, 60u32);
+            let pc = PerspectiveCamera::new(&cam, (w, h));
+            let clip_from_world = projection_matrix(&cam, (w, h)) * cam.world_from_camera.inverse();
+            for (px, depth) in [(Vec2::new(3.25, 7.5), 1.0f32), (Vec2::new(70.0, 55.5), 4.0), (Vec2::new(40.0, 30.0), 20.0)] {
+                let p = pc.origin + pc.direction(px) * depth;
+                let c = clip_from_world * p.extend(1.0);
+                let ndc = c.truncate() / c.w;
+                let back = Vec2::new((ndc.x + 1.0) * 0.5 * w as f32, (1.0 - ndc.y) * 0.5 * h as f32);
+                assert!((back - px).length() < 1e-3, "{back} vs {px}");
+                assert!((0.0..=1.0).contains(&ndc.z), "depth {}", ndc.z);
+            }
+        }
+    }
 }

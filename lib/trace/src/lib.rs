@@ -6,6 +6,17 @@
 //! radiance for reflective objects, the two terms of the greedy two-path model with
 //! outgoing-ray records for refractive lens objects, and the combined gold-standard image.
 //! [`set`] writes and reads the result as a ray-traced set (format-spec/RAYSET.md).
+//!
+//! Entry points:
+//! - [`render_set`]: every point of a loaded scene (`pis_scene::load_with`) into a set
+//!   directory, one EXR (and ray-record file) per point as it finishes, then `set.json`.
+//! - [`render_point`]: one [`pis_scene::Frame`] into [`PointImages`] and ray records.
+//! - [`set::RaySet::open`], [`set::RaySet::read_point`], [`set::RaySet::read_records`]: read
+//!   a set back (what `pis-pack` consumes).
+//!
+//! Determinism: every random number comes from a hash of the surface point (or, with
+//! coherence off, of the pixel sample); work is split into fixed bands of rows and every sum
+//! runs in a fixed order, so the output is byte-identical for any thread count.
 
 pub mod bvh;
 pub mod camera;
