@@ -1,4 +1,4 @@
-//! Forward mapping (thesis 3.3, [Mar98]): every level-0 texel centre is mapped to the image
+//! Forward mapping (thesis 3.3, \[Mar98\]): every level-0 texel centre is mapped to the image
 //! and the object's layer is filtered there with a separable Lanczos-windowed sinc of
 //! half-width 4 pixels (widened where a texel covers more than a pixel). The layer's
 //! uncovered pixels are first filled by boundary reflection; texels that map nowhere on

@@ -1,4 +1,4 @@
-//! The least-squares most-isometric linear map (thesis eq. 3.1, after [Mai93]):
+//! The least-squares most-isometric linear map (thesis eq. 3.1, after \[Mai93\]):
 //!
 //! ```text
 //! f(R) = Σ_edges W_i · ((s_i − ‖R Δuv_i‖) / min(s_i, ‖R Δuv_i‖))²
