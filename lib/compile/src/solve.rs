@@ -269,6 +269,7 @@ fn check_settings(s: &SolveSettings) -> Result<(), CompileError> {
 }
 
 /// Renders a texture through A: the n_s × 3 pixel values A·x (for PSNR against b).
+/// `texels` holds n_t × 3 values in the order of [`TextureLayout`] (a shorter slice panics).
 pub fn render(a: &RenderMatrix, texels: &[f32]) -> Vec<f32> {
     let mut out = vec![0.0f32; a.rows() * CHANNELS];
     for r in 0..a.rows() {
