@@ -2,7 +2,7 @@
 //! (brute force, no acceleration), shades with base colour × (ambient + Lambert from each
 //! light, no shadows), follows one mirror bounce for reflective objects, and writes a PNG.
 //!
-//! `cargo run -p pis-samples --release --example preview -- samples/demo1/scene.toml out.png [POINT [WxH]]`
+//! `cargo run -p pis-samples --release --example scene_preview -- samples/demo1/scene.toml out.png [POINT [WxH]]`
 
 use glam::{Vec2, Vec3};
 use pis_scene::{load_with, LoadOptions, ObjectRole, Scene};

@@ -1,5 +1,5 @@
 //! Writes PNG previews (sRGB, clamped) of every layer of one point of a ray-traced set:
-//! `cargo run --release -p pis-trace --example preview -- SET_DIR POINT OUT_DIR`.
+//! `cargo run --release -p pis-trace --example set_preview -- SET_DIR POINT OUT_DIR`.
 
 use pis_trace::set::RaySet;
 use std::path::PathBuf;
