@@ -426,6 +426,11 @@ fn layers<S>(s: &ParameterSpace, oi: usize, o: &Object<S>, out: &mut Vec<Issue>)
 
 fn placement(p: &Placement, mapping: Mapping) -> Option<String> {
     match (p, mapping) {
+        (Placement::Surface { cut, .. }, Mapping::Surface)
+            if cut.iter().flatten().any(|c| !(0.0..1.0).contains(c)) =>
+        {
+            Some(format!("branch cuts {cut:?} must lie in [0, 1)"))
+        }
         (Placement::Surface { affine, .. }, Mapping::Surface) => {
             let det = affine[0] * affine[3] - affine[1] * affine[2];
             (!finite(affine) || det == 0.0 || !det.is_finite())

@@ -462,7 +462,11 @@ pub struct Layer<S = Codestream> {
 impl Placement {
     /// A surface placement with the given transform, clamped in both directions.
     pub fn surface(affine: [f32; 6]) -> Self {
-        Placement::Surface { affine, repeat: [false; 2] }
+        Placement::Surface {
+            affine,
+            repeat: [false; 2],
+            cut: [None; 2],
+        }
     }
 }
 
@@ -484,7 +488,13 @@ pub enum Placement {
     /// s = a·u + b·v + e, t = c·u + d·v + f, as `[a, b, c, d, e, f]`; (s, t) in [0, 1]²
     /// spans the used texture. `repeat[0]` / `repeat[1]`: the texture wraps along s / t
     /// (no branch cut was made there); otherwise it is clamped to its edge.
-    Surface { affine: [f32; 6], repeat: [bool; 2] },
+    /// `cut[0]` / `cut[1]`: a branch cut along u / v (thesis 3.2): before the affine
+    /// transform, each vertex's coordinate w becomes `(w − cut) − floor(w − cut)`.
+    Surface {
+        affine: [f32; 6],
+        repeat: [bool; 2],
+        cut: [Option<f32>; 2],
+    },
     /// Environment-map shell geometry with its cube-map origin.
     Shell {
         shape: ShellShape,

@@ -234,15 +234,24 @@ pub fn layr(c: &mut Cursor, objects: &mut [Object<StreamRef>]) -> Result<(), Iss
             let height = c.u32("height")?;
             let shape_at = c.offset();
             let shape = c.u16("shell shape")? as u32;
-            let repeat = c.u16("repeat")?;
-            if repeat & !3 != 0 || (shape != 0 && repeat != 0) {
-                return Err(c.issue(3006, format!("layer {li} block {bi} repeat bits {repeat:#x}")).at(shape_at + 2));
+            let flags = c.u16("placement flags")?;
+            if flags & !15 != 0 || (shape != 0 && flags != 0) {
+                return Err(c
+                    .issue(
+                        3006,
+                        format!("layer {li} block {bi} placement flags {flags:#x}"),
+                    )
+                    .at(shape_at + 2));
             }
             let values = c.f32s::<12>("placement values")?;
             let placement = if shape == 0 {
                 Placement::Surface {
                     affine: values[0..6].try_into().expect("6 values"),
-                    repeat: [repeat & 1 != 0, repeat & 2 != 0],
+                    repeat: [flags & 1 != 0, flags & 2 != 0],
+                    cut: [
+                        (flags & 4 != 0).then_some(values[6]),
+                        (flags & 8 != 0).then_some(values[7]),
+                    ],
                 }
             } else {
                 let shape = ShellShape::from_code(shape).ok_or_else(|| {
@@ -259,9 +268,17 @@ pub fn layr(c: &mut Cursor, objects: &mut [Object<StreamRef>]) -> Result<(), Iss
                 }
             };
             let unused = if shape == 0 {
-                &values[6..]
+                // A branch-cut slot without its flag is unused too.
+                let cuts = [
+                    (flags & 4 == 0).then_some(values[6]),
+                    (flags & 8 == 0).then_some(values[7]),
+                ];
+                cuts.into_iter()
+                    .flatten()
+                    .chain(values[8..].iter().copied())
+                    .collect::<Vec<f32>>()
             } else {
-                &values[9..]
+                values[9..].to_vec()
             };
             if unused.iter().any(|v| v.to_bits() != 0) {
                 return Err(c

@@ -122,12 +122,26 @@ pub fn layr<S>(s: &mut Sink, objects: &[Object<S>], mut stream_ref: impl FnMut(&
                 s.u32(b.width, &format!("{p} width"));
                 s.u32(b.height, &format!("{p} height"));
                 match b.placement {
-                    Placement::Surface { affine, repeat } => {
+                    Placement::Surface {
+                        affine,
+                        repeat,
+                        cut,
+                    } => {
                         s.u16(0, &format!("{p} shell shape (none)"));
-                        let bits = repeat[0] as u16 | (repeat[1] as u16) << 1;
-                        s.u16(bits, &format!("{p} repeat (1 = along s, 2 = along t)"));
+                        let bits = repeat[0] as u16
+                            | (repeat[1] as u16) << 1
+                            | (cut[0].is_some() as u16) << 2
+                            | (cut[1].is_some() as u16) << 3;
+                        s.u16(
+                            bits,
+                            &format!("{p} flags (1 repeat s, 2 repeat t, 4 cut u, 8 cut v)"),
+                        );
                         s.f32s(&affine, &format!("{p} affine a b c d e f"));
-                        s.zeros(24, &format!("{p} unused placement values"));
+                        s.f32s(
+                            &[cut[0].unwrap_or(0.0), cut[1].unwrap_or(0.0)],
+                            &format!("{p} branch cuts u, v"),
+                        );
+                        s.zeros(16, &format!("{p} unused placement values"));
                     }
                     Placement::Shell {
                         shape,
@@ -135,7 +149,7 @@ pub fn layr<S>(s: &mut Sink, objects: &[Object<S>], mut stream_ref: impl FnMut(&
                         params,
                     } => {
                         s.u16(shape as u16, &format!("{p} shell shape ({})", shape.name()));
-                        s.u16(0, &format!("{p} repeat (none for shells)"));
+                        s.u16(0, &format!("{p} flags (none for shells)"));
                         s.f32s(&origin, &format!("{p} shell origin"));
                         s.f32s(&params, &format!("{p} shell parameters"));
                         s.zeros(12, &format!("{p} unused placement values"));

@@ -105,3 +105,15 @@ fn atomic_write_leaves_no_partial_file() {
         "no temporary file left behind"
     );
 }
+
+#[test]
+fn branch_cuts_and_repeat_flags_round_trip() {
+    let mut c = tiny().unwrap();
+    c.objects[0].layers[0].blocks[0].placement = Placement::Surface {
+        affine: [2.0, 0.0, 0.0, 1.0, -0.5, 0.0],
+        repeat: [false, true],
+        cut: [Some(0.25), None],
+    };
+    let r = PisReader::from_bytes(to_bytes(&c).unwrap()).unwrap();
+    assert_eq!(r.load_all().unwrap(), c);
+}

@@ -313,7 +313,27 @@ fn cases() -> Vec<(u16, Vec<u8>)> {
             c.objects[0].layers.push(l);
         }),
     ));
-    v.push((6009, t().set_u32("layer 0 block 0 width", 16384).set_u32("layer 0 block 0 height", 16384).reseal()));
+    v.push((
+        6007,
+        unchecked(|c| {
+            c.objects[0].layers[0].blocks[0].placement = Placement::Surface {
+                affine: [1.0, 0.0, 0.0, 1.0, 0.0, 0.0],
+                repeat: [false; 2],
+                cut: [Some(1.5), None],
+            };
+        }),
+    ));
+    v.push((
+        3006,
+        t().set_f32("layer 0 block 0 branch cuts u, v", 0.5)
+            .reseal(),
+    ));
+    v.push((
+        6009,
+        t().set_u32("layer 0 block 0 width", 16384)
+            .set_u32("layer 0 block 0 height", 16384)
+            .reseal(),
+    ));
     // 7xxx
     v.push((7001, t().set_u32("layer 0 block 0 level count", 0).reseal()));
     v.push((

@@ -56,21 +56,45 @@ fn spec_lists_every_validation_rule() {
     let spec = std::fs::read_to_string(repo("format-spec/SPEC.md")).unwrap();
     for (id, message) in pis_format::issue::RULES {
         let row = format!("| {id} | {message} |");
-        assert!(spec.lines().any(|l| l == row), "SPEC.md lacks the row {row:?}");
+        assert!(
+            spec.lines().any(|l| l == row),
+            "SPEC.md lacks the row {row:?}"
+        );
     }
-    let rows = spec.lines().filter(|l| l.len() > 6 && l.starts_with("| ") && l[2..6].chars().all(|c| c.is_ascii_digit()) && l[6..].starts_with(" | ")).count();
-    assert_eq!(rows, pis_format::issue::RULES.len(), "SPEC.md lists rules the reader does not check");
+    let rows = spec
+        .lines()
+        .filter(|l| {
+            l.len() > 6
+                && l.starts_with("| ")
+                && l[2..6].chars().all(|c| c.is_ascii_digit())
+                && l[6..].starts_with(" | ")
+        })
+        .count();
+    assert_eq!(
+        rows,
+        pis_format::issue::RULES.len(),
+        "SPEC.md lists rules the reader does not check"
+    );
 }
 
 #[test]
 fn spec_excerpt_is_from_the_example_dump() {
     let spec = std::fs::read_to_string(repo("format-spec/SPEC.md")).unwrap();
     let dump = std::fs::read_to_string(repo("format-spec/examples/minimal.hex")).unwrap();
-    let section = spec.split("## 14. Worked example").nth(1).expect("section 14");
+    let section = spec
+        .split("## 14. Worked example")
+        .nth(1)
+        .expect("section 14");
     let excerpt = section.split("```").nth(1).expect("an excerpt");
-    let lines: Vec<&str> = excerpt.lines().filter(|l| !l.trim().is_empty() && l.trim() != "...").collect();
+    let lines: Vec<&str> = excerpt
+        .lines()
+        .filter(|l| !l.trim().is_empty() && l.trim() != "...")
+        .collect();
     assert!(lines.len() > 10);
     for l in lines {
-        assert!(dump.lines().any(|d| d == l), "excerpt line not in minimal.hex: {l:?}");
+        assert!(
+            dump.lines().any(|d| d == l),
+            "excerpt line not in minimal.hex: {l:?}"
+        );
     }
 }
