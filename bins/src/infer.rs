@@ -401,7 +401,7 @@ pub fn infer(req: &InferRequest) -> Result<InferReport> {
         Ok(Some(psnr_display(&got, &b)))
     };
     let mut methods = BTreeMap::new();
-    let mut kept: Vec<(String, Filter, Vec<f32>)> = Vec::new();
+    let mut kept: Vec<Kept> = Vec::new();
     let mut method = |name: &str, a: &RenderMatrix, filter: Filter, x: &[f32], ms: f64, it: Option<u32>| {
         let p = psnr_display(&render(a, x), &b);
         let w = wgpu_psnr(a, filter, x).unwrap_or_else(|e| {
@@ -457,7 +457,7 @@ pub fn infer(req: &InferRequest) -> Result<InferReport> {
 
     let mut neighbour_point = None;
     if req.neighbour {
-        let (np, psnrs) = neighbour_psnr(req, &pt, o, &meshes[o], &prep, &kept)?;
+        let (np, psnrs) = neighbour_psnr(req, &pt, o, &prep, &kept)?;
         for (name, p) in psnrs {
             if let Some(m) = methods.get_mut(&name) {
                 m.psnr_db_neighbour = Some(p);
@@ -515,6 +515,12 @@ pub fn infer(req: &InferRequest) -> Result<InferReport> {
     })
 }
 
+/// A solved texture: method name, the filter it is drawn with, n_t × 3 texels.
+type Kept = (String, Filter, Vec<f32>);
+
+/// The neighbouring point's samples and, per method, its PSNR there.
+type NeighbourPsnr = (Vec<u32>, Vec<(String, f64)>);
+
 /// The textures solved at `pt` drawn at the neighbouring view sample (the last parameter
 /// dimension one sample on, or back at the end; the placement and layout stay those of
 /// `pt`, as within a parameter block), each against the gold standard there.
@@ -522,14 +528,13 @@ fn neighbour_psnr(
     req: &InferRequest,
     pt: &Point,
     o: usize,
-    mesh: &Mesh,
     prep: &Prepared,
-    textures: &[(String, Filter, Vec<f32>)],
-) -> Result<(Vec<u32>, Vec<(String, f64)>)> {
+    textures: &[Kept],
+) -> Result<NeighbourPsnr> {
     let dims = &pt.scene.space.dims;
     let mut samples = pt.samples.clone();
     let last = dims.len().checked_sub(1).ok_or_else(|| anyhow!("the parameter space has no dimension"))?;
-    let n = dims[last].samples() as u32;
+    let n = dims[last].samples();
     if n < 2 {
         bail!("the last parameter dimension has one sample: no neighbouring view");
     }
@@ -546,7 +551,6 @@ fn neighbour_psnr(
         positions: &m.positions, uvs: &m.uvs, indices: &m.indices,
         clip_from_object: proj * view_from_world * q.frame.instances[k].world_from_object,
     }).collect();
-    let _ = mesh;
     draw[o].uvs = &prep.mesh_uvs;
     let (cov, rgb) = object_layer(&q.images, &names[o])?;
     let occ = scene_depth(viewport, &draw, Some(o))?;
