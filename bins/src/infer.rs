@@ -81,6 +81,9 @@ pub struct MethodReport {
     /// With `neighbour`: PSNR of this texture drawn at the neighbouring view sample
     /// (`InferReport::neighbour_point`) against the gold standard there (model).
     pub psnr_db_neighbour: Option<f64>,
+    /// Least-squares methods: whether every channel's CG met its tolerance (not stopped at
+    /// the iteration limit).
+    pub converged: Option<bool>,
 }
 
 /// Inference time of one object.
@@ -402,7 +405,8 @@ pub fn infer(req: &InferRequest) -> Result<InferReport> {
     };
     let mut methods = BTreeMap::new();
     let mut kept: Vec<Kept> = Vec::new();
-    let mut method = |name: &str, a: &RenderMatrix, filter: Filter, x: &[f32], ms: f64, it: Option<u32>| {
+    let mut method = |name: &str, a: &RenderMatrix, filter: Filter, x: &[f32], ms: f64, it: Option<(u32, bool)>| {
+        let (it, converged) = (it.map(|i| i.0), it.map(|i| i.1));
         let p = psnr_display(&render(a, x), &b);
         let w = wgpu_psnr(a, filter, x).unwrap_or_else(|e| {
             notes.push(format!("{name}: wgpu rendering failed: {e}"));
@@ -412,6 +416,7 @@ pub fn infer(req: &InferRequest) -> Result<InferReport> {
             psnr_db: p, psnr_db_wgpu: w, ms, iterations: it,
             texel_range: x.iter().fold([f32::INFINITY, f32::NEG_INFINITY], |r, &v| [r[0].min(v), r[1].max(v)]),
             psnr_db_neighbour: None,
+            converged,
         });
         kept.push((name.to_string(), filter, x.to_vec()));
     };
@@ -419,16 +424,16 @@ pub fn infer(req: &InferRequest) -> Result<InferReport> {
     let pyramidal = SolveSettings { epsilon_f: req.epsilon_f, epsilon_b: req.pyramidal_epsilon_b, ..req.solver };
     let unconstrained = SolveSettings { epsilon_b: 0.0, epsilon_f: 0.0, ..req.solver };
     let bil = solve(&a_bil, &b, None, &plain)?;
-    method("ls-bilinear", &a_bil, Filter::Bilinear, &bil.texels, bil.solve_ms, Some(bil.iterations));
+    method("ls-bilinear", &a_bil, Filter::Bilinear, &bil.texels, bil.solve_ms, Some((bil.iterations, bil.converged)));
     let tri = solve(&a_tri, &b, None, &plain)?;
-    method("ls-trilinear", &a_tri, Filter::Trilinear, &tri.texels, tri.solve_ms, Some(tri.iterations));
+    method("ls-trilinear", &a_tri, Filter::Trilinear, &tri.texels, tri.solve_ms, Some((tri.iterations, tri.converged)));
     if plain.epsilon_b > 0.0 {
         // Plain least squares without the constraint 0 ≤ x ≤ R of eq. 3.4: a diagnostic.
         let u = solve(&a_tri, &b, None, &unconstrained)?;
-        method("ls-trilinear-unconstrained", &a_tri, Filter::Trilinear, &u.texels, u.solve_ms, Some(u.iterations));
+        method("ls-trilinear-unconstrained", &a_tri, Filter::Trilinear, &u.texels, u.solve_ms, Some((u.iterations, u.converged)));
     }
     let pyr = solve(&a_tri, &b, None, &pyramidal)?;
-    method("ls-pyramidal", &a_tri, Filter::Trilinear, &pyr.texels, pyr.solve_ms, Some(pyr.iterations));
+    method("ls-pyramidal", &a_tri, Filter::Trilinear, &pyr.texels, pyr.solve_ms, Some((pyr.iterations, pyr.converged)));
 
     // Baselines, rendered with trilinear filtering as the player would draw them.
     let t = Instant::now();
@@ -571,7 +576,8 @@ pub fn print_report(r: &InferReport, out: &mut impl std::io::Write) -> std::io::
     writeln!(out, "object {} at point {:?} (values {:?}), {}x{}", r.object, r.point, r.values, r.resolution[0], r.resolution[1])?;
     writeln!(out, "  texture {}x{} (repeat {:?}), n_s {}, n_t {}", r.texture[0], r.texture[1], r.repeat, r.n_s, r.n_t)?;
     for (name, m) in &r.methods {
-        let it = m.iterations.map_or(String::new(), |i| format!(", {i} iterations"));
+        let it = m.iterations.map_or(String::new(), |i| format!(", {i} iterations{}",
+            if m.converged == Some(false) { ", not converged" } else { "" }));
         let w = m.psnr_db_wgpu.map_or("     -".to_string(), |p| format!("{p:6.2}"));
         let nb = m.psnr_db_neighbour.map_or(String::new(), |p| format!(", neighbour {p:6.2} dB"));
         writeln!(out, "  {name:<13} model {:6.2} dB, wgpu {w} dB{nb}   ({:.0} ms{it}; texels in [{:.3}, {:.3}])",
