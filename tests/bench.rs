@@ -97,3 +97,26 @@ fn infer_reads_a_ray_traced_set() {
     assert_eq!(v["resolution"], serde_json::json!([48, 36]));
     assert_eq!(v["trace_ms"], 0.0);
 }
+
+#[test]
+fn infer_reports_texel_ranges_and_the_neighbouring_view() {
+    let scene = demo1();
+    if !scene.exists() {
+        return;
+    }
+    let out = bench(&["infer", scene.to_str().unwrap(), "--resolution", "64x48", "--spp", "1",
+                      "--object", "Vase", "--at", "0,0", "--no-wgpu", "--json", "--neighbour",
+                      "--antialias", "2", "--epsilon-b", "0.03125"]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("JSON on stdout");
+    assert!(v["neighbour_point"].is_array());
+    for m in ["ls-bilinear", "ls-trilinear", "ls-trilinear-unconstrained", "ls-pyramidal", "forward", "traced"] {
+        let r = &v["methods"][m];
+        let n = r["psnr_db_neighbour"].as_f64().unwrap_or(f64::NAN);
+        assert!(n.is_finite(), "{m}: neighbour {n}");
+        let (lo, hi) = (r["texel_range"][0].as_f64().unwrap_or(f64::NAN), r["texel_range"][1].as_f64().unwrap_or(f64::NAN));
+        assert!(lo <= hi, "{m}: texel range [{lo}, {hi}]");
+    }
+    let out = bench(&["infer", scene.to_str().unwrap(), "--resolution", "32x24", "--spp", "1", "--antialias", "0"]);
+    assert_eq!(out.status.code(), Some(1), "--antialias 0 is a usage error");
+}

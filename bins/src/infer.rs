@@ -19,7 +19,7 @@ use pis_compile::baseline::traced::trace_into_texture;
 use pis_compile::baseline::LayerImage;
 use pis_compile::texcoord::{branch_cut::apply_cut, optimize_placement, ObjectMesh, TexcoordSettings, ViewGeometry};
 use pis_compile::{
-    render, render_matrix, scene_depth, solve, Address, DrawMesh, Filter, RenderMatrix, Sampler,
+    antialiased_render_matrix, render, render_matrix, scene_depth, DisplayFilter, solve, Address, DrawMesh, Filter, RenderMatrix, Sampler,
     SolveSettings, TextureLayout, TextureTransform, TexturedObject, Viewport,
 };
 use pis_play::{render_object, Gpu, TexturedPipeline};
@@ -52,8 +52,20 @@ pub struct InferRequest {
     pub solver: SolveSettings,
     /// ε_f of the pyramidal solve.
     pub epsilon_f: f64,
+    /// ε_b of the pyramidal solve (the plain solves take `solver.epsilon_b`).
+    pub pyramidal_epsilon_b: f64,
     /// Also render every texture through the player's wgpu pipeline (pis-play).
     pub wgpu: bool,
+    /// Inference with antialiasing (thesis 3.4.4): A built at this factor × the resolution
+    /// and filtered with the set's display filter, divided by coverage. 0 or 1: A at the
+    /// display resolution, pixel centres only.
+    pub antialias: u32,
+    /// Also measure every texture at the neighbouring view sample (same light): the texture
+    /// solved at this point, drawn there, against the gold standard there.
+    pub neighbour: bool,
+    /// The per-object resolution reduction factor of texture-coordinate optimization
+    /// (thesis 3.2; 1: the optimal resolution).
+    pub reduction: f64,
 }
 
 /// One method's result.
@@ -64,6 +76,14 @@ pub struct MethodReport {
     pub psnr_db_wgpu: Option<f64>,
     pub ms: f64,
     pub iterations: Option<u32>,
+    /// The smallest and largest texel value (all channels, all MIP levels).
+    pub texel_range: [f32; 2],
+    /// With `neighbour`: PSNR of this texture drawn at the neighbouring view sample
+    /// (`InferReport::neighbour_point`) against the gold standard there (model).
+    pub psnr_db_neighbour: Option<f64>,
+    /// Least-squares methods: whether every channel's CG met its tolerance (not stopped at
+    /// the iteration limit).
+    pub converged: Option<bool>,
 }
 
 /// Inference time of one object.
@@ -99,6 +119,8 @@ pub struct InferReport {
     pub texcoord_ms: f64,
     pub matrix_ms: f64,
     pub objects: Vec<ObjectTiming>,
+    /// With `neighbour`: the parameter point the textures were also drawn at.
+    pub neighbour_point: Option<Vec<u32>>,
     pub notes: Vec<String>,
 }
 
@@ -254,7 +276,7 @@ struct Prepared {
     texcoord_ms: f64,
 }
 
-fn prepare(pt: &Point, o: usize, mesh: &Mesh, max_texture: u32) -> Result<Prepared> {
+fn prepare(pt: &Point, o: usize, mesh: &Mesh, max_texture: u32, reduction: f64) -> Result<Prepared> {
     let t = Instant::now();
     let res = pt.settings.resolution;
     let proj = pis_trace::camera::projection_matrix(&pt.frame.camera, res);
@@ -267,7 +289,7 @@ fn prepare(pt: &Point, o: usize, mesh: &Mesh, max_texture: u32) -> Result<Prepar
     let uvs: Vec<glam::Vec2> = mesh.uvs.iter().map(|u| glam::Vec2::from(*u)).collect();
     let name = &pt.scene.objects[o].name;
     let om = ObjectMesh { name, uvs: &uvs, indices: &mesh.indices, wrap: seam_wraps(mesh) };
-    let settings = TexcoordSettings { max_size: max_texture, ..TexcoordSettings::default() };
+    let settings = TexcoordSettings { max_size: max_texture, reduction, ..TexcoordSettings::default() };
     let pl = optimize_placement(&om, &[view], &settings)?;
     let mesh_uvs: Vec<[f32; 2]> = mesh.uvs.iter().map(|uv| {
         let mut w = *uv;
@@ -334,14 +356,25 @@ pub fn infer(req: &InferRequest) -> Result<InferReport> {
         }
     };
     let (cov, rgb) = object_layer(&pt.images, &names[o])?;
-    let prep = prepare(&pt, o, &meshes[o], req.max_texture)?;
+    let reduction = if req.reduction > 0.0 { req.reduction } else { 1.0 };
+    let display_filter = DisplayFilter { sigma_px: pt.settings.filter.sigma_px, radius_px: pt.settings.filter.radius_px };
+    let all_but = |k: usize| -> Vec<DrawMesh> { draw.iter().enumerate().filter(|(j, _)| *j != k).map(|(_, m)| *m).collect() };
+    // A for one object: antialiased (thesis 3.4.4) or at pixel centres.
+    let build = |obj: &TexturedObject, k: usize, occ: &pis_compile::DepthBuffer| -> Result<RenderMatrix> {
+        Ok(if req.antialias > 1 {
+            antialiased_render_matrix(viewport, req.antialias, display_filter, obj, &all_but(k))?
+        } else {
+            render_matrix(viewport, obj, Some(occ))?
+        })
+    };
+    let prep = prepare(&pt, o, &meshes[o], req.max_texture, reduction)?;
     let t = Instant::now();
     let occluders = scene_depth(viewport, &draw, Some(o))?;
     let mut mesh_o = draw[o];
     mesh_o.uvs = &prep.mesh_uvs;
     let matrix = |filter| -> Result<RenderMatrix> {
         let obj = TexturedObject { mesh: mesh_o, transform: prep.transform, layout: prep.layout, sampler: sampler(filter, prep.repeat) };
-        Ok(render_matrix(viewport, &obj, Some(&occluders))?)
+        build(&obj, o, &occluders)
     };
     let (a_bil, b) = restrict(&matrix(Filter::Bilinear)?, &cov, &rgb);
     let (a_tri, _) = restrict(&matrix(Filter::Trilinear)?, &cov, &rgb);
@@ -371,22 +404,36 @@ pub fn infer(req: &InferRequest) -> Result<InferReport> {
         Ok(Some(psnr_display(&got, &b)))
     };
     let mut methods = BTreeMap::new();
-    let mut method = |name: &str, a: &RenderMatrix, filter: Filter, x: &[f32], ms: f64, it: Option<u32>| {
+    let mut kept: Vec<Kept> = Vec::new();
+    let mut method = |name: &str, a: &RenderMatrix, filter: Filter, x: &[f32], ms: f64, it: Option<(u32, bool)>| {
+        let (it, converged) = (it.map(|i| i.0), it.map(|i| i.1));
         let p = psnr_display(&render(a, x), &b);
         let w = wgpu_psnr(a, filter, x).unwrap_or_else(|e| {
             notes.push(format!("{name}: wgpu rendering failed: {e}"));
             None
         });
-        methods.insert(name.to_string(), MethodReport { psnr_db: p, psnr_db_wgpu: w, ms, iterations: it });
+        methods.insert(name.to_string(), MethodReport {
+            psnr_db: p, psnr_db_wgpu: w, ms, iterations: it,
+            texel_range: x.iter().fold([f32::INFINITY, f32::NEG_INFINITY], |r, &v| [r[0].min(v), r[1].max(v)]),
+            psnr_db_neighbour: None,
+            converged,
+        });
+        kept.push((name.to_string(), filter, x.to_vec()));
     };
     let plain = req.solver;
-    let pyramidal = SolveSettings { epsilon_f: req.epsilon_f, ..req.solver };
+    let pyramidal = SolveSettings { epsilon_f: req.epsilon_f, epsilon_b: req.pyramidal_epsilon_b, ..req.solver };
+    let unconstrained = SolveSettings { epsilon_b: 0.0, epsilon_f: 0.0, ..req.solver };
     let bil = solve(&a_bil, &b, None, &plain)?;
-    method("ls-bilinear", &a_bil, Filter::Bilinear, &bil.texels, bil.solve_ms, Some(bil.iterations));
+    method("ls-bilinear", &a_bil, Filter::Bilinear, &bil.texels, bil.solve_ms, Some((bil.iterations, bil.converged)));
     let tri = solve(&a_tri, &b, None, &plain)?;
-    method("ls-trilinear", &a_tri, Filter::Trilinear, &tri.texels, tri.solve_ms, Some(tri.iterations));
+    method("ls-trilinear", &a_tri, Filter::Trilinear, &tri.texels, tri.solve_ms, Some((tri.iterations, tri.converged)));
+    if plain.epsilon_b > 0.0 {
+        // Plain least squares without the constraint 0 ≤ x ≤ R of eq. 3.4: a diagnostic.
+        let u = solve(&a_tri, &b, None, &unconstrained)?;
+        method("ls-trilinear-unconstrained", &a_tri, Filter::Trilinear, &u.texels, u.solve_ms, Some((u.iterations, u.converged)));
+    }
     let pyr = solve(&a_tri, &b, None, &pyramidal)?;
-    method("ls-pyramidal", &a_tri, Filter::Trilinear, &pyr.texels, pyr.solve_ms, Some(pyr.iterations));
+    method("ls-pyramidal", &a_tri, Filter::Trilinear, &pyr.texels, pyr.solve_ms, Some((pyr.iterations, pyr.converged)));
 
     // Baselines, rendered with trilinear filtering as the player would draw them.
     let t = Instant::now();
@@ -413,18 +460,29 @@ pub fn infer(req: &InferRequest) -> Result<InferReport> {
     }
     method("traced", &a_tri, Filter::Trilinear, &traced, t.elapsed().as_secs_f64() * 1e3, None);
 
+    let mut neighbour_point = None;
+    if req.neighbour {
+        let (np, psnrs) = neighbour_psnr(req, &pt, o, &prep, &kept)?;
+        for (name, p) in psnrs {
+            if let Some(m) = methods.get_mut(&name) {
+                m.psnr_db_neighbour = Some(p);
+            }
+        }
+        neighbour_point = Some(np);
+    }
+
     let mut objects = Vec::new();
     if req.all_objects {
         for k in 0..scene.objects.len() {
             let t0 = Instant::now();
             let Ok((cov_k, rgb_k)) = object_layer(&pt.images, &names[k]) else { continue };
-            let prep_k = prepare(&pt, k, &meshes[k], req.max_texture)?;
+            let prep_k = prepare(&pt, k, &meshes[k], req.max_texture, reduction)?;
             let t1 = Instant::now();
             let occ = scene_depth(viewport, &draw, Some(k))?;
             let mut m = draw[k];
             m.uvs = &prep_k.mesh_uvs;
             let obj = TexturedObject { mesh: m, transform: prep_k.transform, layout: prep_k.layout, sampler: sampler(Filter::Trilinear, prep_k.repeat) };
-            let (a, bk) = restrict(&render_matrix(viewport, &obj, Some(&occ))?, &cov_k, &rgb_k);
+            let (a, bk) = restrict(&build(&obj, k, &occ)?, &cov_k, &rgb_k);
             let matrix_ms = t1.elapsed().as_secs_f64() * 1e3;
             if a.rows() == 0 {
                 continue;
@@ -454,6 +512,7 @@ pub fn infer(req: &InferRequest) -> Result<InferReport> {
         texcoord_ms: prep.texcoord_ms,
         matrix_ms,
         objects,
+        neighbour_point,
         notes: [notes, vec![
             "PSNR on display values: linear radiance clamped to [0, 1], sRGB-encoded, peak 1, over the object's covered pixels".into(),
             "baselines are rendered with trilinear filtering".into(),
@@ -461,17 +520,74 @@ pub fn infer(req: &InferRequest) -> Result<InferReport> {
     })
 }
 
+/// A solved texture: method name, the filter it is drawn with, n_t × 3 texels.
+type Kept = (String, Filter, Vec<f32>);
+
+/// The neighbouring point's samples and, per method, its PSNR there.
+type NeighbourPsnr = (Vec<u32>, Vec<(String, f64)>);
+
+/// The textures solved at `pt` drawn at the neighbouring view sample (the last parameter
+/// dimension one sample on, or back at the end; the placement and layout stay those of
+/// `pt`, as within a parameter block), each against the gold standard there.
+fn neighbour_psnr(
+    req: &InferRequest,
+    pt: &Point,
+    o: usize,
+    prep: &Prepared,
+    textures: &[Kept],
+) -> Result<NeighbourPsnr> {
+    let dims = &pt.scene.space.dims;
+    let mut samples = pt.samples.clone();
+    let last = dims.len().checked_sub(1).ok_or_else(|| anyhow!("the parameter space has no dimension"))?;
+    let n = dims[last].samples();
+    if n < 2 {
+        bail!("the last parameter dimension has one sample: no neighbouring view");
+    }
+    samples[last] = if samples[last] + 1 < n { samples[last] + 1 } else { samples[last] - 1 };
+    let at: Vec<f32> = dims.iter().zip(&samples).map(|(d, &s)| d.values[s as usize]).collect();
+    let q = load_point(&InferRequest { at: Some(at), ..req.clone() })?;
+    let names = pis_trace::channel_names(&q.scene);
+    let (w, h) = q.settings.resolution;
+    let viewport = Viewport { width: w, height: h };
+    let meshes: Vec<Mesh> = (0..q.scene.objects.len()).map(|k| merged_mesh(&q.scene, k)).collect();
+    let proj = pis_trace::camera::projection_matrix(&q.frame.camera, (w, h));
+    let view_from_world = q.frame.camera.world_from_camera.inverse();
+    let mut draw: Vec<DrawMesh> = meshes.iter().enumerate().map(|(k, m)| DrawMesh {
+        positions: &m.positions, uvs: &m.uvs, indices: &m.indices,
+        clip_from_object: proj * view_from_world * q.frame.instances[k].world_from_object,
+    }).collect();
+    draw[o].uvs = &prep.mesh_uvs;
+    let (cov, rgb) = object_layer(&q.images, &names[o])?;
+    let occ = scene_depth(viewport, &draw, Some(o))?;
+    let mut out = Vec::new();
+    for (name, filter, x) in textures {
+        let obj = TexturedObject { mesh: draw[o], transform: prep.transform, layout: prep.layout, sampler: sampler(*filter, prep.repeat) };
+        let (a, b) = restrict(&render_matrix(viewport, &obj, Some(&occ))?, &cov, &rgb);
+        if a.rows() == 0 {
+            bail!("object {} covers no pixel at the neighbouring point {samples:?}", names[o]);
+        }
+        out.push((name.clone(), psnr_display(&render(&a, x), &b)));
+    }
+    Ok((samples, out))
+}
+
 /// Human-readable lines of the report (stderr).
 pub fn print_report(r: &InferReport, out: &mut impl std::io::Write) -> std::io::Result<()> {
     writeln!(out, "object {} at point {:?} (values {:?}), {}x{}", r.object, r.point, r.values, r.resolution[0], r.resolution[1])?;
     writeln!(out, "  texture {}x{} (repeat {:?}), n_s {}, n_t {}", r.texture[0], r.texture[1], r.repeat, r.n_s, r.n_t)?;
     for (name, m) in &r.methods {
-        let it = m.iterations.map_or(String::new(), |i| format!(", {i} iterations"));
+        let it = m.iterations.map_or(String::new(), |i| format!(", {i} iterations{}",
+            if m.converged == Some(false) { ", not converged" } else { "" }));
         let w = m.psnr_db_wgpu.map_or("     -".to_string(), |p| format!("{p:6.2}"));
-        writeln!(out, "  {name:<13} model {:6.2} dB, wgpu {w} dB   ({:.0} ms{it})", m.psnr_db, m.ms)?;
+        let nb = m.psnr_db_neighbour.map_or(String::new(), |p| format!(", neighbour {p:6.2} dB"));
+        writeln!(out, "  {name:<13} model {:6.2} dB, wgpu {w} dB{nb}   ({:.0} ms{it}; texels in [{:.3}, {:.3}])",
+                 m.psnr_db, m.ms, m.texel_range[0], m.texel_range[1])?;
     }
     for n in &r.notes {
         writeln!(out, "  note: {n}")?;
+    }
+    if let Some(p) = &r.neighbour_point {
+        writeln!(out, "  neighbour: the textures drawn at point {p:?} (placement of this point), model")?;
     }
     writeln!(out, "  trace {:.0} ms, texcoord {:.0} ms, matrices {:.0} ms, LS-trilinear solve {:.0} ms ({} iterations)",
              r.trace_ms, r.texcoord_ms, r.matrix_ms, r.solve_ms, r.iterations)?;

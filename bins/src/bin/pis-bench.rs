@@ -52,12 +52,30 @@ enum Command {
         /// ε_f of the pyramidal regularization (thesis: 0.1).
         #[arg(long, default_value_t = 0.1)]
         epsilon_f: f64,
+        /// ε_b of the range regularization (eq. 3.8) of the plain LS solves (0: none, the
+        /// default; the thesis used 1/32). With ε_b > 0 the report adds
+        /// `ls-trilinear-unconstrained`.
+        #[arg(long, default_value_t = 0.0)]
+        epsilon_b: f64,
+        /// ε_b of the pyramidal solve (thesis: 0, the pyramidal term alone).
+        #[arg(long, default_value_t = 0.0)]
+        pyramidal_epsilon_b: f64,
         /// Conjugate-gradient stopping tolerance (relative preconditioned gradient norm).
         #[arg(long, default_value_t = 1e-4)]
         tolerance: f64,
         /// Conjugate-gradient iteration limit per colour channel.
         #[arg(long, default_value_t = 400)]
         max_iterations: u32,
+        /// Inference with antialiasing (thesis 3.4.4): A at N× the resolution, filtered with
+        /// the set's display filter (1: pixel centres only).
+        #[arg(long, default_value_t = 1)]
+        antialias: u32,
+        /// Also draw every texture at the neighbouring view sample and report its PSNR there.
+        #[arg(long)]
+        neighbour: bool,
+        /// Per-object texture resolution reduction factor (thesis 3.2; 1: optimal).
+        #[arg(long, default_value_t = 1.0)]
+        reduction: f64,
         /// Skip the renders through wgpu (pis-play); psnr_db_wgpu is then null.
         #[arg(long)]
         no_wgpu: bool,
@@ -79,7 +97,7 @@ fn parse_resolution(s: &str) -> Result<(u32, u32), String> {
 
 fn run(cli: Cli) -> Result<Exit, Failure> {
     match cli.command {
-        Command::Infer { input, object, at, scene, resolution, spp, preset, all_objects, max_texture, epsilon_f, tolerance, max_iterations, no_wgpu, json } => {
+        Command::Infer { input, object, at, scene, resolution, spp, preset, all_objects, max_texture, epsilon_f, epsilon_b, pyramidal_epsilon_b, tolerance, max_iterations, antialias, neighbour, reduction, no_wgpu, json } => {
             if !input.exists() {
                 return Err(Failure::new(Exit::Io, anyhow::anyhow!("{} does not exist", input.display())));
             }
@@ -89,10 +107,16 @@ fn run(cli: Cli) -> Result<Exit, Failure> {
             if !(epsilon_f.is_finite() && epsilon_f >= 0.0 && tolerance.is_finite() && tolerance > 0.0) {
                 return Err(Failure::new(Exit::Usage, anyhow::anyhow!("--epsilon-f must be ≥ 0 and --tolerance > 0")));
             }
-            let mut solver = SolveSettings::default();
+            if antialias == 0 || antialias > 16 || !(reduction.is_finite() && reduction > 0.0) {
+                return Err(Failure::new(Exit::Usage, anyhow::anyhow!("--antialias must be in 1..=16 and --reduction > 0")));
+            }
+            if !(epsilon_b.is_finite() && epsilon_b >= 0.0 && pyramidal_epsilon_b.is_finite() && pyramidal_epsilon_b >= 0.0) {
+                return Err(Failure::new(Exit::Usage, anyhow::anyhow!("--epsilon-b and --pyramidal-epsilon-b must be ≥ 0")));
+            }
+            let mut solver = SolveSettings { epsilon_b, ..SolveSettings::default() };
             solver.cg.tolerance = tolerance;
             solver.cg.max_iterations = max_iterations;
-            let req = InferRequest { input, scene, object, at, resolution, spp, preset, all_objects, max_texture, solver, epsilon_f, wgpu: !no_wgpu };
+            let req = InferRequest { input, scene, object, at, resolution, spp, preset, all_objects, max_texture, solver, epsilon_f, pyramidal_epsilon_b, wgpu: !no_wgpu, antialias, neighbour, reduction };
             let report = infer(&req).map_err(|e| Failure::new(Exit::Runtime, e))?;
             print_report(&report, &mut std::io::stderr()).map_err(|e| Failure::new(Exit::Io, e))?;
             if json {

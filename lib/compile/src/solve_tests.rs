@@ -257,3 +257,48 @@ fn hardware_model_views_where_most_texels_are_unobserved_converge() {
         }
     }
 }
+
+/// A 64×48 texture minified onto a 24×18 screen (≈ 7 texels per pixel, n_t ≫ n_s, as on
+/// demo1 at 320×240), seen with a slight perspective so pixels straddle MIP levels.
+fn minified_view(shift: f64) -> (RenderMatrix, Vec<f32>) {
+    let layout = TextureLayout::full(64, 48);
+    let a = warp_matrix(24, 18, layout, Filter::Trilinear, |x, y| {
+        let (x, y) = (x - 12.0 - shift, y - 9.0);
+        let w = 1.0 + 0.04 * y;
+        let s = 0.5 + (0.95 * x + 0.2 * y) / (25.0 * w);
+        let t = 0.5 + (-0.2 * x + 0.95 * y) / (19.0 * w);
+        ((0.0..1.0).contains(&s) && (0.0..1.0).contains(&t)).then_some((s, t))
+    });
+    let b = render(&a, &texture(&layout));
+    (a, b)
+}
+
+/// The pyramidal criterion (PSNR drop at the sampled view) was measured against plain least
+/// squares on systems with many more texels than pixels. There plain LS is ill-posed: it
+/// fits b (noise included) through near-null directions of A with texels far outside the
+/// image's range, and that texture fails at any other view. The pyramidal solve stays in
+/// range and is the better texture off the sample.
+#[test]
+fn unregularized_fit_with_more_texels_than_pixels_is_an_out_of_range_overfit() {
+    let (a, mut b) = minified_view(0.0);
+    for (k, v) in b.iter_mut().enumerate() {
+        *v += 0.02 * (((k * 2654435761) % 1000) as f32 / 1000.0 - 0.5);
+    }
+    assert!(a.layout.texel_count() > 4 * a.rows(), "n_t {} vs n_s {}", a.layout.texel_count(), a.rows());
+    let settings = |s: SolveSettings| SolveSettings { cg: crate::cg::CgSettings { tolerance: 1e-8, max_iterations: 5000, ..s.cg }, ..s };
+    let plain = solve(&a, &b, None, &settings(SolveSettings::default())).unwrap();
+    let reg = solve(&a, &b, None, &settings(SolveSettings::pyramidal())).unwrap();
+    assert_monotone(&reg);
+    let b_max = b.iter().fold(0.0f32, |m, &v| m.max(v.abs()));
+    let extent = |x: &[f32]| x.iter().fold(0.0f32, |m, &v| m.max(v.abs()));
+    let (p_plain, p_reg) = (psnr(&render(&a, &plain.texels), &b), psnr(&render(&a, &reg.texels), &b));
+    // a neighbouring view, against the noise-free truth there
+    let (a2, truth2) = minified_view(0.7);
+    let (q_plain, q_reg) = (psnr(&render(&a2, &plain.texels), &truth2), psnr(&render(&a2, &reg.texels), &truth2));
+    eprintln!("plain {p_plain:.1} dB (|x| ≤ {}), pyramidal {p_reg:.1} dB (|x| ≤ {}), b ≤ {b_max}; neighbour: plain {q_plain:.1}, pyramidal {q_reg:.1}",
+              extent(&plain.texels), extent(&reg.texels));
+    assert!(p_plain > p_reg, "plain LS fits the sample (noise included) closer");
+    assert!(extent(&reg.texels) < 1.5 * b_max, "pyramidal texels stay in the image's range");
+    assert!(extent(&plain.texels) > 3.0 * b_max, "plain LS leaves the range");
+    assert!(q_reg > q_plain + 3.0, "off the sample the pyramidal texture is the better one");
+}

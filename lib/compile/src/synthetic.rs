@@ -65,7 +65,10 @@ pub fn warp_matrix(
 /// Bilinear taps of level m at (s, t), clamp-to-edge, scaled by `weight`.
 fn bilinear(layout: &TextureLayout, m: u32, s: f64, t: f64, weight: f64, out: &mut Vec<(u32, f64)>) {
     let (w, h) = layout.level_size(m);
-    let (u, v) = (s * w as f64 - 0.5, t * h as f64 - 0.5);
+    // Texel coordinates of level m: u = s·w₀/2^m (crate::filter; on odd sizes the level's
+    // last texel, the replicated boundary, is only partly inside the used area).
+    let k = (1u64 << m) as f64;
+    let (u, v) = (s * layout.width as f64 / k - 0.5, t * layout.height as f64 / k - 0.5);
     let (i0, j0) = (u.floor(), v.floor());
     let (fu, fv) = (u - i0, v - j0);
     let ci = |i: f64| i.clamp(0.0, (w - 1) as f64) as u32;
@@ -73,6 +76,41 @@ fn bilinear(layout: &TextureLayout, m: u32, s: f64, t: f64, weight: f64, out: &m
     for (dj, wv) in [(0.0, 1.0 - fv), (1.0, fv)] {
         for (di, wu) in [(0.0, 1.0 - fu), (1.0, fu)] {
             out.push((layout.texel(m, ci(i0 + di), cj(j0 + dj)) as u32, weight * wu * wv));
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::filter::{self, Taps};
+    use crate::{Address, Sampler};
+
+    /// On odd sizes the synthetic matrices place coarse levels as the hardware model does
+    /// (u = s·w₀/2^m), so solver tests see the pyramid the player samples.
+    #[test]
+    fn synthetic_taps_match_the_hardware_model_on_odd_sizes() {
+        let layout = TextureLayout::full(5, 3);
+        let sampler = Sampler { filter: Filter::Bilinear, address: [Address::ClampToEdge; 2] };
+        for m in 0..layout.levels {
+            for k in 0..40 {
+                let st = [(k as f64 * 0.618) % 1.0, (k as f64 * 0.382) % 1.0];
+                let mut ours = Vec::new();
+                bilinear(&layout, m, st[0], st[1], 1.0, &mut ours);
+                let mut merged: std::collections::BTreeMap<u32, f64> = Default::default();
+                for (c, w) in ours {
+                    *merged.entry(c).or_default() += w;
+                }
+                let mut taps = Taps::default();
+                filter::bilinear(&layout, &sampler, m, st, 1.0, &mut taps);
+                let model: Vec<(u32, f32)> = taps.sorted().collect();
+                let ours: Vec<(u32, f64)> = merged.into_iter().filter(|(_, w)| *w != 0.0).collect();
+                assert_eq!(ours.len(), model.len(), "level {m} at {st:?}: {ours:?} vs {model:?}");
+                for ((c0, w0), (c1, w1)) in ours.iter().zip(&model) {
+                    assert_eq!(c0, c1);
+                    assert!((w0 - *w1 as f64).abs() < 1e-5, "level {m} at {st:?}: {ours:?} vs {model:?}");
+                }
+            }
         }
     }
 }

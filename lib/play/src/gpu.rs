@@ -22,6 +22,62 @@ pub struct GpuOptions {
     pub half_textures: bool,
 }
 
+/// Gives the process an `XDG_RUNTIME_DIR` where none is set, before the first wgpu instance
+/// is created: Mesa's Vulkan drivers print "error: XDG_RUNTIME_DIR is invalid or not set in
+/// the environment." otherwise (headless machines, containers, cron), which is noise for a
+/// player that never opens a window surface here.
+///
+/// The directory is private: `$TMPDIR/pis-runtime-UID`, mode 0700, owned by the process's
+/// user (a directory of that name owned by someone else, or readable by others, is not used;
+/// a fresh `pis-runtime-UID-PID` is made instead). Done once per process.
+///
+/// Thread safety: setting an environment variable races with threads that read the
+/// environment through libc at the same time. It runs once, before the instance (and so
+/// before any driver thread) exists; the callers create the `Gpu` before they start threads
+/// that read the environment. The variable is only set when it is absent, so an
+/// environment that provides it is untouched.
+fn ensure_runtime_dir() {
+    static ONCE: std::sync::Once = std::sync::Once::new();
+    ONCE.call_once(|| {
+        if std::env::var_os("XDG_RUNTIME_DIR").is_some_and(|v| !v.is_empty()) {
+            return;
+        }
+        if let Some(dir) = private_runtime_dir() {
+            // Edition 2021: `set_var` is a safe function; see the note above on threads.
+            std::env::set_var("XDG_RUNTIME_DIR", dir);
+        }
+    });
+}
+
+#[cfg(unix)]
+fn private_runtime_dir() -> Option<std::path::PathBuf> {
+    use std::os::unix::fs::{DirBuilderExt, MetadataExt, PermissionsExt};
+    let uid = std::fs::metadata("/proc/self").map(|m| m.uid()).ok();
+    let base = std::env::temp_dir();
+    let private = |p: &std::path::Path| {
+        std::fs::symlink_metadata(p).is_ok_and(|m| {
+            m.is_dir() && Some(m.uid()) == uid.or(Some(m.uid())) && m.permissions().mode() & 0o077 == 0
+        })
+    };
+    let mut candidates = Vec::new();
+    if let Some(u) = uid {
+        candidates.push(base.join(format!("pis-runtime-{u}")));
+    }
+    candidates.push(base.join(format!("pis-runtime-{}-{}", uid.unwrap_or(0), std::process::id())));
+    for dir in candidates {
+        let _ = std::fs::DirBuilder::new().mode(0o700).create(&dir);
+        if private(&dir) {
+            return Some(dir);
+        }
+    }
+    None
+}
+
+#[cfg(not(unix))]
+fn private_runtime_dir() -> Option<std::path::PathBuf> {
+    None
+}
+
 impl Gpu {
     /// Opens the default adapter (high-performance preference; Mesa's lavapipe on a machine
     /// without a GPU) with default options.
@@ -31,6 +87,7 @@ impl Gpu {
 
     /// Opens the default adapter.
     pub fn with_options(options: GpuOptions) -> Result<Gpu, PlayError> {
+        ensure_runtime_dir();
         let instance = wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
         let adapter = pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions {
             power_preference: wgpu::PowerPreference::HighPerformance,
