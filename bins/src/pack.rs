@@ -96,12 +96,15 @@ pub fn pack(req: &PackRequest) -> Result<PackReport, Failure> {
     let packed = encode::encode_all(&set, &inferred, req, &mut stages)?;
     let bytes = pis_format::write(&req.output, &packed.container)?;
     stages.done("write", &format!("{} ({bytes} bytes)", req.output.display()));
+    let quality = encode::predicted_psnr(&set, &inferred, &packed).map_err(|e| Failure::new(Exit::Runtime, e))?;
+    stages.done("predict", "decoded textures rendered through the hardware model");
+    // Lossless: the file's level images decode bit-exactly and the decoded textures equal
+    // the solved ones.
     let exact = if req.codec == CodecId::Lossless {
-        Some(encode::check_lossless(&req.output, &packed).map_err(|e| Failure::new(Exit::Runtime, e))?)
+        let levels = encode::check_lossless(&req.output, &packed).map_err(|e| Failure::new(Exit::Runtime, e))?;
+        Some(levels && quality.max_texel_error == 0.0)
     } else {
         None
     };
-    let quality = encode::predicted_psnr(&set, &inferred, &packed).map_err(|e| Failure::new(Exit::Runtime, e))?;
-    stages.done("predict", "decoded textures rendered through the hardware model");
     Ok(report::build(&set, &inferred, &packed, &quality, bytes, exact, req, stages))
 }

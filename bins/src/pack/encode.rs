@@ -187,7 +187,10 @@ pub(crate) fn encode_all(set: &LoadedSet, models: &[ObjectModel], req: &PackRequ
                 if samples.iter().any(Vec::is_empty) {
                     return Err(runtime(anyhow!("object {} layer {} block {b}: a sample has no texture", m.name, il.kind.name())));
                 }
-                let (pyr, _) = adaptive(&extent, &samples, PyramidFilter::Gaussian, l1_cost).map_err(|e| runtime(e.into()))?;
+                let (mut pyr, _) = adaptive(&extent, &samples, PyramidFilter::Gaussian, l1_cost).map_err(|e| runtime(e.into()))?;
+                if !req.codec.is_lossy() {
+                    exact_finest(&mut pyr, &samples, &extent);
+                }
                 let mut levels = Vec::new();
                 for (lv, level) in pyr.levels.iter().enumerate() {
                     let mut members = vec![0usize; level.images.len()];
@@ -283,6 +286,59 @@ pub(crate) fn encode_all(set: &LoadedSet, models: &[ObjectModel], req: &PackRequ
     }
     stages.done("encode", &format!("{} level images with {}", where_.len(), req.codec));
     Ok(Packed { container, blocks: blocks_out, overhead, layer_bytes, stagger: staggers })
+}
+
+/// Makes the finest level's residuals such that the decoder's f32 sum of the levels, top
+/// first, gives back every sample bit for bit: the residual `x − s` is nudged by a few ulps
+/// where rounding loses it; where no nudge works, the block falls back to a zero top level
+/// and the samples themselves.
+pub(crate) fn exact_finest(pyr: &mut pis_codec::pyramid::Pyramid, samples: &[Vec<f32>], extent: &[u32]) {
+    let n_levels = pyr.levels.len();
+    let ok = (|| {
+        let (coarse, finest) = pyr.levels.split_at_mut(n_levels.checked_sub(1)?);
+        let finest = finest.first_mut()?;
+        for (si, x) in samples.iter().enumerate() {
+            let local = unflatten(si, extent);
+            let mut sum = vec![0.0f32; x.len()];
+            for l in coarse.iter() {
+                let img = &l.images[level_image_index(&l.counts, &local, extent)];
+                sum.iter_mut().zip(img).for_each(|(a, v)| *a += v);
+            }
+            let fi = level_image_index(&finest.counts, &local, extent);
+            let r = &mut finest.images[fi];
+            for ((rv, &sv), &xv) in r.iter_mut().zip(&sum).zip(x) {
+                let mut c = xv - sv;
+                let mut k = 0;
+                while (sv + c).to_bits() != xv.to_bits() {
+                    k += 1;
+                    if k > 16 {
+                        return None;
+                    }
+                    let step = (k + 1) / 2;
+                    let base = xv - sv;
+                    c = if k % 2 == 1 { nudge(base, step as i32) } else { nudge(base, -(step as i32)) };
+                }
+                *rv = c;
+            }
+        }
+        Some(())
+    })();
+    if ok.is_none() && extent.iter().any(|&e| e > 1) {
+        let ones = vec![1u32; extent.len()];
+        let n = samples.first().map_or(0, Vec::len);
+        pyr.levels = vec![
+            pis_codec::pyramid::PyramidLevel { counts: ones, images: vec![vec![0.0; n]] },
+            pis_codec::pyramid::PyramidLevel { counts: extent.to_vec(), images: samples.to_vec() },
+        ];
+    }
+}
+
+fn nudge(v: f32, ulps: i32) -> f32 {
+    let mut x = v;
+    for _ in 0..ulps.unsigned_abs() {
+        x = if ulps > 0 { x.next_up() } else { x.next_down() };
+    }
+    x
 }
 
 /// Decoded linear textures (whole MIP chain, rebuilt by decimation as the player does), per

@@ -64,7 +64,7 @@ pub struct PackReport {
     /// Largest |decoded − solved| over the finest texels (linear).
     pub max_texel_error: f32,
     /// Lossless codec: every level image read back from the file decodes bit-exactly to
-    /// what was encoded.
+    /// what was encoded, and the decoded finest texels equal the solved ones bit for bit.
     pub lossless_exact: Option<bool>,
     pub objects: Vec<ObjectReport>,
     pub stage_ms: BTreeMap<String, f64>,
@@ -127,7 +127,7 @@ pub fn print_report(r: &PackReport, out: &mut impl std::io::Write) -> std::io::R
              r.bytes, r.texture_bytes, r.raw_image_bytes, r.ratio, r.ratio_without_geometry)?;
     writeln!(out, "  predicted PSNR {:.2} dB (textures as solved {:.2} dB)", r.psnr_db, r.psnr_db_solved)?;
     if let Some(e) = r.lossless_exact {
-        writeln!(out, "  lossless: level images read back bit-exactly: {e}; max texel error {:.3e}", r.max_texel_error)?;
+        writeln!(out, "  lossless: file decodes to the solved textures bit-exactly: {e} (max texel error {:.3e})", r.max_texel_error)?;
     }
     for o in &r.objects {
         let layers: Vec<String> = o.layer_bytes.iter().map(|(k, b)| format!("{k} {b}")).collect();
