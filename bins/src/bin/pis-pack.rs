@@ -27,7 +27,8 @@ struct Cli {
     /// geometry and tables come on top (the report gives both ratios).
     #[arg(long, conflicts_with = "psnr")]
     ratio: Option<f64>,
-    /// Target predicted PSNR in dB instead of a ratio.
+    /// Target PSNR in dB instead of a ratio: the coding PSNR of the stored (gamma-compensated)
+    /// textures, screen-area weighted; the predicted screen PSNR is also bounded by inference.
     #[arg(long)]
     psnr: Option<f64>,
     /// Level-image codec: wavelet, dct or lossless.

@@ -19,6 +19,12 @@ use super::input::LoadedSet;
 use super::{PackRequest, Stages};
 use crate::cli::{Exit, Failure};
 
+/// Linear textures of one layer, keyed like [`super::infer_layers::InferredLayer::textures`].
+pub(crate) type LayerTextures = std::collections::BTreeMap<Vec<u32>, Vec<f32>>;
+
+/// One pyramid level as coded: counts, the images as encoded, their codestreams.
+pub(crate) type CodedLevel = (Vec<u32>, Vec<Vec<f32>>, Vec<Vec<u8>>);
+
 /// One block of one layer as coded: which layer sample each block-local sample is, and the
 /// level images (gamma-compensated residuals) with their codestreams.
 pub(crate) struct PackedBlock {
@@ -26,7 +32,7 @@ pub(crate) struct PackedBlock {
     /// Per block-local sample (row-major over the extent), the layer key.
     pub(crate) keys: Vec<Vec<u32>>,
     /// Per level: counts, images as encoded, codestreams.
-    pub(crate) levels: Vec<(Vec<u32>, Vec<Vec<f32>>, Vec<Vec<u8>>)>,
+    pub(crate) levels: Vec<CodedLevel>,
 }
 
 /// The container and what the report and checks need to know about it.
@@ -308,15 +314,15 @@ pub(crate) fn exact_finest(pyr: &mut pis_codec::pyramid::Pyramid, samples: &[Vec
             let r = &mut finest.images[fi];
             for ((rv, &sv), &xv) in r.iter_mut().zip(&sum).zip(x) {
                 let mut c = xv - sv;
-                let mut k = 0;
+                let mut k: i32 = 0;
                 while (sv + c).to_bits() != xv.to_bits() {
                     k += 1;
                     if k > 16 {
                         return None;
                     }
-                    let step = (k + 1) / 2;
+                    let step: i32 = (k + 1) / 2;
                     let base = xv - sv;
-                    c = if k % 2 == 1 { nudge(base, step as i32) } else { nudge(base, -(step as i32)) };
+                    c = if k % 2 == 1 { nudge(base, step) } else { nudge(base, -step) };
                 }
                 *rv = c;
             }
@@ -343,7 +349,7 @@ fn nudge(v: f32, ulps: i32) -> f32 {
 
 /// Decoded linear textures (whole MIP chain, rebuilt by decimation as the player does), per
 /// object model and layer, keyed like [`super::infer_layers::InferredLayer::textures`].
-pub(crate) fn decoded_textures(models: &[ObjectModel], packed: &Packed) -> Result<Vec<Vec<std::collections::BTreeMap<Vec<u32>, Vec<f32>>>>> {
+pub(crate) fn decoded_textures(models: &[ObjectModel], packed: &Packed) -> Result<Vec<Vec<LayerTextures>>> {
     let mut out = Vec::new();
     for (mi, m) in models.iter().enumerate() {
         let mut per_layer = Vec::new();
@@ -419,7 +425,7 @@ pub(crate) fn check_lossless(path: &Path, packed: &Packed) -> Result<bool> {
 
 /// Squared display error and pixel count per object of `textures` rendered through A,
 /// against the gold-standard layers.
-pub(crate) fn display_error(set: &LoadedSet, models: &[ObjectModel], textures: &[Vec<std::collections::BTreeMap<Vec<u32>, Vec<f32>>>]) -> Vec<(f64, usize)> {
+pub(crate) fn display_error(set: &LoadedSet, models: &[ObjectModel], textures: &[Vec<LayerTextures>]) -> Vec<(f64, usize)> {
     let d = |v: f32| crate::images::srgb_encode(v.clamp(0.0, 1.0)) as f64;
     models.iter().zip(textures).map(|(m, tex)| {
         let (mut sse, mut n) = (0.0f64, 0usize);
@@ -459,7 +465,7 @@ pub(crate) struct Quality {
 /// Renders the decoded and the solved textures through the hardware model.
 pub(crate) fn predicted_psnr(set: &LoadedSet, models: &[ObjectModel], packed: &Packed) -> Result<Quality> {
     let decoded = decoded_textures(models, packed)?;
-    let solved: Vec<Vec<std::collections::BTreeMap<Vec<u32>, Vec<f32>>>> = models.iter().map(|m| m.layers.iter().map(|l| {
+    let solved: Vec<Vec<LayerTextures>> = models.iter().map(|m| m.layers.iter().map(|l| {
         l.textures.iter().map(|(k, x)| (k.clone(), mip_chain(m, finest(m, x)))).collect()
     }).collect()).collect();
     let mut max_err = 0.0f32;
