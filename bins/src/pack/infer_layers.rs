@@ -99,8 +99,15 @@ fn views_of(set: &LoadedSet, o: usize, prep: &Prepared, meshes: &[Mesh], req: &P
     Ok(out)
 }
 
-fn is_black(views: &[PointView], pick: impl Fn(&PointView) -> &[f32]) -> bool {
-    views.iter().all(|v| pick(v).iter().all(|x| x.abs() < BLACK))
+/// Half a step of an 8-bit display value: a layer whose removal moves no covered pixel by
+/// more than this changes no displayed pixel.
+pub const DISPLAY_STEP: f32 = 0.5 / 255.0;
+
+/// True when the layer `pick` is black for the display: zero (below [`BLACK`]), or so dark
+/// beside the other layer `other` that leaving it out changes no 8-bit pixel.
+fn is_black(views: &[PointView], pick: impl Fn(&PointView) -> &[f32], other: impl Fn(&PointView) -> &[f32]) -> bool {
+    let d = |v: f32| crate::images::srgb_encode(v.clamp(0.0, 1.0));
+    views.iter().all(|v| pick(v).iter().zip(other(v)).all(|(x, o)| x.abs() < BLACK || (d(x + o) - d(*o)).abs() < DISPLAY_STEP))
 }
 
 /// Infers every object that covers a pixel somewhere in the set.
@@ -124,8 +131,8 @@ pub(crate) fn infer_all(set: &LoadedSet, req: &PackRequest, stages: &mut Stages)
         }
         let area = covered as f64 / views.len() as f64;
         let mut layers = Vec::new();
-        let diffuse_black = is_black(&views, |v| &v.diffuse);
-        let specular_black = is_black(&views, |v| &v.specular);
+        let diffuse_black = is_black(&views, |v| &v.diffuse, |v| &v.specular);
+        let specular_black = is_black(&views, |v| &v.specular, |v| &v.diffuse);
         if diffuse_black && specular_black {
             eprintln!("pis-pack: object {name} is black in every layer; nothing stored");
             continue;
@@ -168,8 +175,8 @@ pub(crate) fn infer_all(set: &LoadedSet, req: &PackRequest, stages: &mut Stages)
             layers.push(InferredLayer { kind: pis_format::LayerKind::Specular, depends_on: all, textures, iterations });
         }
         let (representation, why) = match (diffuse_black, specular_black) {
-            (false, true) => ("diffuse".to_string(), "no specular radiance in the set: one view-independent diffuse texture per non-view sample".to_string()),
-            (true, false) => ("specular".to_string(), "no diffuse radiance in the set: a view-dependent texture per parameter sample".to_string()),
+            (false, true) => ("diffuse".to_string(), "the specular layer changes no displayed pixel: one view-independent diffuse texture per non-view sample".to_string()),
+            (true, false) => ("specular".to_string(), "the diffuse layer changes no displayed pixel: a view-dependent texture per parameter sample".to_string()),
             (false, false) => ("diffuse+specular".to_string(), "view-independent diffuse layer over the non-view dimensions plus a view-dependent specular layer per parameter sample".to_string()),
             (true, true) => ("black".to_string(), "both layers black: nothing stored".to_string()),
         };
