@@ -143,3 +143,25 @@ fn output_in_a_missing_folder_is_an_error() {
     assert!(String::from_utf8_lossy(&out.stderr).contains("does not exist"));
     assert!(!file.exists());
 }
+
+#[test]
+fn scene_toml_is_traced_into_a_cache_beside_it() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let scene_dir = dir.path().join("demo1");
+    std::fs::create_dir(&scene_dir).expect("mkdir");
+    let src = demo1();
+    for e in std::fs::read_dir(src.parent().expect("scene dir")).expect("demo1").filter_map(Result::ok) {
+        if e.path().is_file() {
+            std::fs::copy(e.path(), scene_dir.join(e.file_name())).expect("copy");
+        }
+    }
+    let file = dir.path().join("demo1.pis");
+    let out = Command::new(env!("CARGO_BIN_EXE_pis-pack"))
+        .arg(scene_dir.join("scene.toml")).arg("-o").arg(&file)
+        .args(["--resolution", "32x24", "--spp", "1", "--codec", "dct", "--ratio", "12", "--json"])
+        .output().expect("pis-pack runs");
+    let r = json(&out);
+    validate(&file);
+    assert!(scene_dir.join(".pis-cache/demo1-32x24-spp1/set.json").is_file());
+    assert!(r["stage_ms"]["trace"].as_f64().is_some(), "{r}");
+}
