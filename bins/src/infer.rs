@@ -125,13 +125,13 @@ pub struct InferReport {
 }
 
 /// One object's mesh, all primitives merged.
-struct Mesh {
-    positions: Vec<[f32; 3]>,
-    uvs: Vec<[f32; 2]>,
-    indices: Vec<u32>,
+pub(crate) struct Mesh {
+    pub(crate) positions: Vec<[f32; 3]>,
+    pub(crate) uvs: Vec<[f32; 2]>,
+    pub(crate) indices: Vec<u32>,
 }
 
-fn merged_mesh(scene: &Scene, o: usize) -> Mesh {
+pub(crate) fn merged_mesh(scene: &Scene, o: usize) -> Mesh {
     let mut m = Mesh { positions: vec![], uvs: vec![], indices: vec![] };
     for p in &scene.objects[o].primitives {
         let base = m.positions.len() as u32;
@@ -148,7 +148,7 @@ fn merged_mesh(scene: &Scene, o: usize) -> Mesh {
 
 /// Whether the texture wraps along u / v: the mesh has a seam, vertices at u = 0 and u = 1
 /// (v = 0 and v = 1) at the same position.
-fn seam_wraps(mesh: &Mesh) -> [bool; 2] {
+pub(crate) fn seam_wraps(mesh: &Mesh) -> [bool; 2] {
     let mut out = [false; 2];
     for (dim, flag) in out.iter_mut().enumerate() {
         let key = |p: [f32; 3]| p.map(|c| (c * 1e4).round() as i64);
@@ -249,7 +249,7 @@ pub fn psnr_display(a: &[f32], b: &[f32]) -> f64 {
 }
 
 /// Keeps the rows of A whose pixels the tracer covers; returns the reduced A and its b.
-fn restrict(a: &RenderMatrix, cov: &[f32], rgb: &[f32]) -> (RenderMatrix, Vec<f32>) {
+pub(crate) fn restrict(a: &RenderMatrix, cov: &[f32], rgb: &[f32]) -> (RenderMatrix, Vec<f32>) {
     let mut out = RenderMatrix { width: a.width, height: a.height, layout: a.layout, row_start: vec![0], ..Default::default() };
     let mut b = Vec::new();
     for r in 0..a.rows() {
@@ -268,29 +268,44 @@ fn restrict(a: &RenderMatrix, cov: &[f32], rgb: &[f32]) -> (RenderMatrix, Vec<f3
     (out, b)
 }
 
-struct Prepared {
-    mesh_uvs: Vec<[f32; 2]>,
-    transform: TextureTransform,
-    layout: TextureLayout,
-    repeat: [bool; 2],
-    texcoord_ms: f64,
+pub(crate) struct Prepared {
+    pub(crate) mesh_uvs: Vec<[f32; 2]>,
+    pub(crate) transform: TextureTransform,
+    pub(crate) layout: TextureLayout,
+    pub(crate) repeat: [bool; 2],
+    pub(crate) texcoord_ms: f64,
 }
 
 fn prepare(pt: &Point, o: usize, mesh: &Mesh, max_texture: u32, reduction: f64) -> Result<Prepared> {
+    place(&pt.scene, &[&pt.frame], pt.settings.resolution, o, mesh, max_texture, reduction)
+}
+
+/// Texture-coordinate optimization (thesis 3.2) of object `o` over the views of `frames`,
+/// with the per-object resolution reduction factor `reduction`.
+pub(crate) fn place(
+    scene: &Scene,
+    frames: &[&Frame],
+    res: (u32, u32),
+    o: usize,
+    mesh: &Mesh,
+    max_texture: u32,
+    reduction: f64,
+) -> Result<Prepared> {
     let t = Instant::now();
-    let res = pt.settings.resolution;
-    let proj = pis_trace::camera::projection_matrix(&pt.frame.camera, res);
-    let clip_from_object = proj * pt.frame.camera.world_from_camera.inverse() * pt.frame.instances[o].world_from_object;
-    let view = ViewGeometry {
-        clip: mesh.positions.iter().map(|p| clip_from_object * Vec3::from(*p).extend(1.0)).collect(),
-        width: res.0,
-        height: res.1,
-    };
+    let views: Vec<ViewGeometry> = frames.iter().map(|frame| {
+        let proj = pis_trace::camera::projection_matrix(&frame.camera, res);
+        let clip_from_object = proj * frame.camera.world_from_camera.inverse() * frame.instances[o].world_from_object;
+        ViewGeometry {
+            clip: mesh.positions.iter().map(|p| clip_from_object * Vec3::from(*p).extend(1.0)).collect(),
+            width: res.0,
+            height: res.1,
+        }
+    }).collect();
     let uvs: Vec<glam::Vec2> = mesh.uvs.iter().map(|u| glam::Vec2::from(*u)).collect();
-    let name = &pt.scene.objects[o].name;
+    let name = &scene.objects[o].name;
     let om = ObjectMesh { name, uvs: &uvs, indices: &mesh.indices, wrap: seam_wraps(mesh) };
     let settings = TexcoordSettings { max_size: max_texture, reduction, ..TexcoordSettings::default() };
-    let pl = optimize_placement(&om, &[view], &settings)?;
+    let pl = optimize_placement(&om, &views, &settings)?;
     let mesh_uvs: Vec<[f32; 2]> = mesh.uvs.iter().map(|uv| {
         let mut w = *uv;
         for (wd, cut) in w.iter_mut().zip(pl.branch_cut) {
@@ -309,7 +324,7 @@ fn prepare(pt: &Point, o: usize, mesh: &Mesh, max_texture: u32, reduction: f64) 
     })
 }
 
-fn sampler(filter: Filter, repeat: [bool; 2]) -> Sampler {
+pub(crate) fn sampler(filter: Filter, repeat: [bool; 2]) -> Sampler {
     Sampler { filter, address: repeat.map(|r| if r { Address::Repeat } else { Address::ClampToEdge }) }
 }
 

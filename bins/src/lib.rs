@@ -5,3 +5,4 @@ pub mod cli;
 pub mod images;
 pub mod infer;
 pub mod inspect;
+pub mod pack;

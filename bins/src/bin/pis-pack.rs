@@ -1,0 +1,131 @@
+//! pis-pack: a ray-traced set (or a scene.toml, traced first) to a `.pis` container.
+//!
+//! Exit codes: 0 ok, 1 bad arguments, 2 I/O, 3 invalid input, 4 runtime error.
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use clap::Parser;
+use pis::cli::{self, Exit, Failure};
+use pis::pack::{pack, print_report, PackRequest};
+use pis_codec::CodecId;
+use pis_compile::Filter;
+
+/// Infer, compress and write the parameterized textures of a ray-traced set.
+#[derive(Parser, Debug)]
+#[command(name = "pis-pack", version, about, after_help = cli::EXIT_CODES_HELP)]
+struct Cli {
+    /// A ray-traced set directory, or a scene.toml to trace first (into .pis-cache beside it).
+    input: PathBuf,
+    /// The container to write (atomically; nothing is left on error).
+    #[arg(short, long)]
+    output: PathBuf,
+    /// The set's scene.toml (default: SET_DIR/scene.toml).
+    #[arg(long)]
+    scene: Option<PathBuf>,
+    /// Target compression ratio: level-image bytes = raw image bytes / R (default 384);
+    /// geometry and tables come on top (the report gives both ratios).
+    #[arg(long, conflicts_with = "psnr")]
+    ratio: Option<f64>,
+    /// Target PSNR in dB instead of a ratio: the coding PSNR of the stored (gamma-compensated)
+    /// textures, screen-area weighted; the predicted screen PSNR is also bounded by inference.
+    #[arg(long)]
+    psnr: Option<f64>,
+    /// Level-image codec: wavelet, dct or lossless.
+    #[arg(long, default_value = "wavelet", value_parser = parse_codec)]
+    codec: CodecId,
+    /// Samples per parameter block: one size for every dimension (8) or one per dimension (8x8).
+    #[arg(long, default_value = "8", value_parser = parse_block)]
+    block: BlockSizes,
+    /// Texture filtering the player uses: trilinear or bilinear.
+    #[arg(long, default_value = "trilinear", value_parser = parse_filter)]
+    filter: Filter,
+    /// Render matrix source: `model` (the analytic hardware model; `probe` is not yet wired).
+    #[arg(long, default_value = "model")]
+    matrix: String,
+    /// Largest used texture side.
+    #[arg(long, default_value_t = 256)]
+    max_texture: u32,
+    /// Display gamma of the compensation (1: linear storage; lossless packs always use 1).
+    #[arg(long, default_value_t = 2.2)]
+    gamma: f32,
+    /// Tracing a scene.toml: image size WIDTHxHEIGHT.
+    #[arg(long, value_parser = parse_resolution)]
+    resolution: Option<(u32, u32)>,
+    /// Tracing a scene.toml: camera samples per pixel.
+    #[arg(long)]
+    spp: Option<u32>,
+    /// Print the closing report as JSON on stdout.
+    #[arg(long)]
+    json: bool,
+}
+
+fn parse_codec(s: &str) -> Result<CodecId, String> {
+    match s {
+        "wavelet" => Ok(CodecId::Wavelet),
+        "dct" => Ok(CodecId::Dct),
+        "lossless" => Ok(CodecId::Lossless),
+        _ => Err(format!("unknown codec {s:?} (wavelet, dct or lossless)")),
+    }
+}
+
+fn parse_filter(s: &str) -> Result<Filter, String> {
+    match s {
+        "trilinear" => Ok(Filter::Trilinear),
+        "bilinear" => Ok(Filter::Bilinear),
+        _ => Err(format!("unknown filter {s:?} (trilinear or bilinear)")),
+    }
+}
+
+/// `--block`: one size, or one per dimension.
+#[derive(Clone, Debug)]
+struct BlockSizes(Vec<u32>);
+
+fn parse_block(s: &str) -> Result<BlockSizes, String> {
+    sizes(s).map(BlockSizes)
+}
+
+fn sizes(s: &str) -> Result<Vec<u32>, String> {
+    s.split(['x', 'X']).map(|p| p.trim().parse::<u32>().ok().filter(|&b| b > 0).ok_or_else(|| format!("bad block size {s:?}: expected N or NxM"))).collect()
+}
+
+fn parse_resolution(s: &str) -> Result<(u32, u32), String> {
+    match sizes(s)?.as_slice() {
+        [w, h] => Ok((*w, *h)),
+        _ => Err(format!("expected WIDTHxHEIGHT, got {s:?}")),
+    }
+}
+
+fn run(cli: Cli) -> Result<Exit, Failure> {
+    if cli.matrix != "model" {
+        return Err(Failure::new(Exit::NotSupported, anyhow::anyhow!("--matrix {}: only `model` is supported by this build", cli.matrix)));
+    }
+    let req = PackRequest {
+        input: cli.input,
+        scene: cli.scene,
+        output: cli.output,
+        ratio: cli.ratio,
+        psnr: cli.psnr,
+        codec: cli.codec,
+        block: cli.block.0,
+        filter: cli.filter,
+        max_texture: cli.max_texture,
+        gamma: if cli.codec == CodecId::Lossless { 1.0 } else { cli.gamma },
+        resolution: cli.resolution,
+        spp: cli.spp,
+    };
+    let report = pack(&req)?;
+    print_report(&report, &mut std::io::stderr()).map_err(|e| Failure::new(Exit::Io, e))?;
+    if cli.json {
+        let s = serde_json::to_string_pretty(&report).map_err(|e| Failure::new(Exit::Runtime, e))?;
+        println!("{s}");
+    }
+    Ok(Exit::Ok)
+}
+
+fn main() -> ExitCode {
+    match cli::parse::<Cli>() {
+        Ok(c) => cli::finish("pis-pack", run(c)),
+        Err(code) => code,
+    }
+}

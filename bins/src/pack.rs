@@ -1,0 +1,110 @@
+//! `pis-pack`: a ray-traced set to a `.pis` container (thesis ch. 4).
+//!
+//! Per object: texture-coordinate optimization over the set's views (3.3); inference of the
+//! object's layers as parameterized surface textures (3.5) — a view-independent diffuse
+//! layer solved once over all views by stacking, depending on the non-view dimensions only,
+//! and a view-dependent specular layer solved per parameter sample with a warm start from
+//! the neighbouring sample; a layer that is black for an object is not stored. Each layer is
+//! cut into parameter-space blocks whose origins are staggered per object (4.7), each block
+//! coded as an adaptive Laplacian pyramid (4.3) of gamma-compensated textures (4.6), storage
+//! allocated by equal slopes across levels, objects and layers (4.5), and the container
+//! written atomically. MIP levels are not stored: the player decimates (3.6).
+//!
+//! The predicted PSNR renders the decoded textures through the hardware model (A, with the
+//! MIP chain rebuilt by decimation as the player does) and compares with the gold-standard
+//! layers over the pixels the tracer covers, on display values (see [`crate::infer`]).
+
+mod encode;
+mod infer_layers;
+mod input;
+mod report;
+
+use std::path::PathBuf;
+use std::time::Instant;
+
+use pis_codec::CodecId;
+use pis_compile::Filter;
+
+pub use report::{print_report, ObjectReport, PackReport};
+
+use crate::cli::{Exit, Failure};
+
+/// What to pack.
+#[derive(Clone, Debug)]
+pub struct PackRequest {
+    /// A ray-traced set directory or a scene.toml (traced first into a cache beside it).
+    pub input: PathBuf,
+    /// The set's scene.toml (default: SET_DIR/scene.toml, or the input scene.toml).
+    pub scene: Option<PathBuf>,
+    pub output: PathBuf,
+    /// Target compression ratio: bytes = raw image bytes / ratio.
+    pub ratio: Option<f64>,
+    /// Target PSNR (dB) instead of a ratio.
+    pub psnr: Option<f64>,
+    pub codec: CodecId,
+    /// Samples per block along each dimension (one value: the same for every dimension).
+    pub block: Vec<u32>,
+    pub filter: Filter,
+    /// Largest used texture side.
+    pub max_texture: u32,
+    /// Display gamma g of the compensation γ(L) = L^(1/g); lossless packs use 1.
+    pub gamma: f32,
+    /// Tracing a scene.toml: size and samples per pixel overrides.
+    pub resolution: Option<(u32, u32)>,
+    pub spp: Option<u32>,
+}
+
+/// The default compression ratio when neither `--ratio` nor `--psnr` is given.
+pub const DEFAULT_RATIO: f64 = 384.0;
+
+/// Times one stage and prints its progress line on stderr.
+pub(crate) struct Stages {
+    pub(crate) ms: Vec<(String, f64)>,
+    t: Instant,
+}
+
+impl Stages {
+    fn new() -> Self {
+        Stages { ms: Vec::new(), t: Instant::now() }
+    }
+
+    pub(crate) fn done(&mut self, name: &str, what: &str) {
+        let ms = self.t.elapsed().as_secs_f64() * 1e3;
+        eprintln!("pis-pack: {name:<9} {ms:8.0} ms  {what}");
+        self.ms.push((name.to_string(), ms));
+        self.t = Instant::now();
+    }
+}
+
+/// Runs the whole pipeline and writes the container; on error no output file is left.
+pub fn pack(req: &PackRequest) -> Result<PackReport, Failure> {
+    if req.ratio.is_some() && req.psnr.is_some() {
+        return Err(Failure::new(Exit::Usage, anyhow::anyhow!("give --ratio or --psnr, not both")));
+    }
+    if let Some(r) = req.ratio {
+        if !(r.is_finite() && r >= 1.0) {
+            return Err(Failure::new(Exit::Usage, anyhow::anyhow!("--ratio must be at least 1, got {r}")));
+        }
+    }
+    let parent = req.output.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(std::path::Path::new("."));
+    if !parent.is_dir() {
+        return Err(Failure::new(Exit::Io, anyhow::anyhow!("the output folder {} does not exist", parent.display())));
+    }
+    let mut stages = Stages::new();
+    let set = input::load(req, &mut stages)?;
+    let inferred = infer_layers::infer_all(&set, req, &mut stages).map_err(|e| Failure::new(Exit::Runtime, e))?;
+    let packed = encode::encode_all(&set, &inferred, req, &mut stages)?;
+    let bytes = pis_format::write(&req.output, &packed.container)?;
+    stages.done("write", &format!("{} ({bytes} bytes)", req.output.display()));
+    let quality = encode::predicted_psnr(&set, &inferred, &packed).map_err(|e| Failure::new(Exit::Runtime, e))?;
+    stages.done("predict", "decoded textures rendered through the hardware model");
+    // Lossless: the file's level images decode bit-exactly and the decoded textures equal
+    // the solved ones.
+    let exact = if req.codec == CodecId::Lossless {
+        let levels = encode::check_lossless(&req.output, &packed).map_err(|e| Failure::new(Exit::Runtime, e))?;
+        Some(levels && quality.max_texel_error == 0.0)
+    } else {
+        None
+    };
+    Ok(report::build(&set, &inferred, &packed, &quality, bytes, exact, req, stages))
+}

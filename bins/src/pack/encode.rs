@@ -1,0 +1,498 @@
+//! From inferred textures to the container: parameter-space blocks with staggered origins
+//! (thesis 4.7), the adaptive Laplacian pyramid of gamma-compensated textures per object,
+//! layer and block (4.3, 4.6), equal-slope storage allocation (4.5) and encoding; then the
+//! checks that read the result back.
+
+use std::path::Path;
+
+use anyhow::{anyhow, Result};
+use pis_codec::allocate::{allocate, Item, Target, DEFAULT_ALPHA};
+use pis_codec::pyramid::{adaptive, l1_cost, level_image_index, PyramidFilter};
+use pis_codec::{CodecId, Rate};
+use pis_format::blocks::BlockGrid;
+use pis_format::mip::decimate;
+use pis_format::reconstruct::{finish, prepare};
+use pis_format::*;
+
+use super::infer_layers::{key, ObjectModel};
+use super::input::LoadedSet;
+use super::{PackRequest, Stages};
+use crate::cli::{Exit, Failure};
+
+/// Linear textures of one layer, keyed like [`super::infer_layers::InferredLayer::textures`].
+pub(crate) type LayerTextures = std::collections::BTreeMap<Vec<u32>, Vec<f32>>;
+
+/// One pyramid level as coded: counts, the images as encoded, their codestreams.
+pub(crate) type CodedLevel = (Vec<u32>, Vec<Vec<f32>>, Vec<Vec<u8>>);
+
+/// One block of one layer as coded: which layer sample each block-local sample is, and the
+/// level images (gamma-compensated residuals) with their codestreams.
+pub(crate) struct PackedBlock {
+    pub(crate) extent: Vec<u32>,
+    /// Per block-local sample (row-major over the extent), the layer key.
+    pub(crate) keys: Vec<Vec<u32>>,
+    /// Per level: counts, images as encoded, codestreams.
+    pub(crate) levels: Vec<CodedLevel>,
+}
+
+/// The container and what the report and checks need to know about it.
+pub(crate) struct Packed {
+    pub(crate) container: Container,
+    /// Per object model, per layer, per block.
+    pub(crate) blocks: Vec<Vec<Vec<PackedBlock>>>,
+    /// Bytes of everything but the level images.
+    pub(crate) overhead: usize,
+    /// Per object model, per layer: codestream bytes.
+    pub(crate) layer_bytes: Vec<Vec<usize>>,
+    pub(crate) stagger: Vec<Vec<u32>>,
+}
+
+fn row3x4(m: glam::Mat4) -> [f32; 12] {
+    let mut out = [0.0; 12];
+    for r in 0..3 {
+        out[r * 4..r * 4 + 4].copy_from_slice(&m.row(r).to_array());
+    }
+    out
+}
+
+/// Samples per block along each dimension from `--block` (one value for all dimensions).
+pub fn block_sizes(block: &[u32], dims: usize) -> Result<Vec<u32>> {
+    match block.len() {
+        1 => Ok(vec![block[0].max(1); dims]),
+        n if n == dims => Ok(block.iter().map(|&b| b.max(1)).collect()),
+        n => Err(anyhow!("--block gives {n} sizes, the parameter space has {dims} dimensions")),
+    }
+}
+
+/// Block origin offsets of object `i` of `n` (thesis 4.7): `i · B / n` per dimension.
+pub fn stagger(i: usize, n: usize, sizes: &[u32]) -> Vec<u32> {
+    sizes.iter().map(|&b| (i as u64 * b as u64 / n.max(1) as u64) as u32).collect()
+}
+
+fn unflatten(mut i: usize, extent: &[u32]) -> Vec<u32> {
+    let mut out = vec![0; extent.len()];
+    for k in (0..extent.len()).rev() {
+        out[k] = (i % extent[k] as usize) as u32;
+        i /= extent[k] as usize;
+    }
+    out
+}
+
+fn surface_layer(kind: LayerKind, order: u8, depends_on: DepMask, gamma: f32) -> Layer {
+    Layer {
+        kind,
+        mapping: Mapping::Surface,
+        channels: 3,
+        mip_mode: MipMode::Decimated,
+        term: Term::Surface,
+        order,
+        combine: Combine::Add,
+        gamma,
+        depends_on,
+        blocks: vec![],
+    }
+}
+
+fn geometry(set: &LoadedSet, sizes: &[u32]) -> (ParameterSpace, CameraTable) {
+    let scene = &set.scene;
+    let space = ParameterSpace {
+        dims: scene.space.dims.iter().zip(sizes).map(|(d, &b)| Dimension {
+            name: d.name.clone(),
+            kind: d.kind,
+            periodic: d.periodic,
+            unit: d.unit.clone(),
+            block_size: b,
+            values: d.values.clone(),
+        }).collect(),
+    };
+    let view = DepMask::of(&(0..space.dims.len()).filter(|&k| space.dims[k].kind == DimensionKind::View).collect::<Vec<_>>());
+    let mut cameras = vec![None; space.table_len(view) as usize];
+    for (s, f) in set.samples.iter().zip(&set.frames) {
+        let c = f.camera;
+        cameras[space.table_index(view, s)] = Some(Camera {
+            world_from_camera: row3x4(c.world_from_camera),
+            yfov: c.yfov,
+            znear: c.znear,
+            zfar: if c.zfar.is_finite() { c.zfar } else { 1e4 },
+        });
+    }
+    let cameras = CameraTable {
+        width: set.resolution.0,
+        height: set.resolution.1,
+        depends_on: view,
+        cameras: cameras.into_iter().map(|c| c.unwrap_or(Camera { world_from_camera: IDENTITY_3X4, yfov: 0.8, znear: 0.1, zfar: 100.0 })).collect(),
+    };
+    (space, cameras)
+}
+
+fn transforms(set: &LoadedSet, space: &ParameterSpace, o: usize) -> TransformTable {
+    let first = set.frames[0].instances[o].world_from_object;
+    if set.frames.iter().all(|f| f.instances[o].world_from_object == first) {
+        return TransformTable::fixed(row3x4(first));
+    }
+    let all = DepMask::of(&(0..space.dims.len()).collect::<Vec<_>>());
+    let mut t = vec![IDENTITY_3X4; space.table_len(all) as usize];
+    for (s, f) in set.samples.iter().zip(&set.frames) {
+        t[space.table_index(all, s)] = row3x4(f.instances[o].world_from_object);
+    }
+    TransformTable { depends_on: all, transforms: t }
+}
+
+/// The finest level of a solved texture (the chain's level 0).
+pub(crate) fn finest(m: &ObjectModel, x: &[f32]) -> Vec<f32> {
+    x[..m.prep.layout.width as usize * m.prep.layout.height as usize * 3].to_vec()
+}
+
+/// Builds pyramids, allocates storage, encodes, and assembles the container.
+pub(crate) fn encode_all(set: &LoadedSet, models: &[ObjectModel], req: &PackRequest, stages: &mut Stages) -> Result<Packed, Failure> {
+    let runtime = |e: anyhow::Error| Failure::new(Exit::Runtime, e);
+    let sizes = block_sizes(&req.block, set.scene.space.dims.len()).map_err(|e| Failure::new(Exit::Usage, e))?;
+    let (space, cameras) = geometry(set, &sizes);
+    let codec = pis_codec::codec(req.codec).ok_or_else(|| runtime(anyhow!("codec {} is not in this build", req.codec)))?;
+    let mut objects = Vec::new();
+    let mut blocks_out = Vec::new();
+    let mut staggers = Vec::new();
+    // Allocation items: (object model, layer, block, level, image) and their curves.
+    let mut items = Vec::new();
+    let mut where_ = Vec::new();
+    for (mi, m) in models.iter().enumerate() {
+        let st = stagger(mi, models.len(), &sizes);
+        let mut layers = Vec::new();
+        let mut layer_blocks = Vec::new();
+        for (li, il) in m.layers.iter().enumerate() {
+            let mut layer = surface_layer(il.kind, li as u8, il.depends_on, req.gamma);
+            let grid = BlockGrid::new(&space, il.depends_on, &st);
+            let layer_samples = il.textures.len().max(1) as f64;
+            let mut pblocks = Vec::new();
+            for b in 0..grid.block_count() as usize {
+                let extent = grid.extent(b);
+                let block = Block {
+                    width: m.prep.layout.width,
+                    height: m.prep.layout.height,
+                    // Branch cuts are already applied to the mesh's texture coordinates (one
+                    // placement per object), so no block carries one.
+                    placement: Placement::Surface { affine: m.prep.transform.values, repeat: m.prep.repeat, cut: [None; 2] },
+                    levels: vec![],
+                };
+                let layout = LevelLayout::of(&layer, &block);
+                let planes = layout.planes();
+                let count: usize = extent.iter().map(|&e| e as usize).product();
+                let mut keys = vec![Vec::new(); count];
+                let mut samples = vec![Vec::new(); count];
+                for (k, x) in &il.textures {
+                    let mut point = vec![0u32; space.dims.len()];
+                    for (d, &v) in il.depends_on.dims().zip(k) {
+                        point[d] = v;
+                    }
+                    let pos = grid.locate(&point);
+                    if pos.block != b {
+                        continue;
+                    }
+                    let idx = pos.local.iter().zip(&pos.extent).fold(0usize, |a, (&l, &e)| a * e as usize + l as usize);
+                    keys[idx] = k.clone();
+                    samples[idx] = prepare(&layer, &layout, &finest(m, x));
+                }
+                if samples.iter().any(Vec::is_empty) {
+                    return Err(runtime(anyhow!("object {} layer {} block {b}: a sample has no texture", m.name, il.kind.name())));
+                }
+                let (mut pyr, _) = adaptive(&extent, &samples, PyramidFilter::Gaussian, l1_cost).map_err(|e| runtime(e.into()))?;
+                if !req.codec.is_lossy() {
+                    exact_finest(&mut pyr, &samples, &extent);
+                }
+                let mut levels = Vec::new();
+                for (lv, level) in pyr.levels.iter().enumerate() {
+                    let mut members = vec![0usize; level.images.len()];
+                    for s in 0..count {
+                        members[level_image_index(&level.counts, &unflatten(s, &extent), &extent)] += 1;
+                    }
+                    for (ii, img) in level.images.iter().enumerate() {
+                        let curve = codec.rd_curve(&planes, img).map_err(|e| runtime(e.into()))?;
+                        items.push(Item { curve, object: mi, weight: members[ii] as f64 / layer_samples });
+                        where_.push((mi, li, b, lv, ii, planes.clone()));
+                    }
+                    levels.push((level.counts.clone(), level.images.clone(), vec![Vec::new(); level.images.len()]));
+                }
+                pblocks.push(PackedBlock { extent, keys, levels });
+                layer.blocks.push(block);
+            }
+            layers.push(layer);
+            layer_blocks.push(pblocks);
+        }
+        objects.push(Object {
+            name: m.name.clone(),
+            role: ObjectRole::Diffuse,
+            shading: Shading::default(),
+            stagger: st.clone(),
+            transforms: transforms(set, &space, m.index),
+            mesh: Mesh { positions: m.mesh.positions.clone(), normals: None, texcoords: Some(m.prep.mesh_uvs.clone()), indices: m.mesh.indices.clone() },
+            layers,
+        });
+        blocks_out.push(layer_blocks);
+        staggers.push(st);
+    }
+    stages.done("pyramid", &format!("{} level images in adaptive pyramids", items.len()));
+
+    let raw = set.raw_image_bytes();
+    let settings = vec![
+        ("codec".to_string(), req.codec.name().to_string()),
+        ("block".to_string(), sizes.iter().map(u32::to_string).collect::<Vec<_>>().join("x")),
+        ("filter".to_string(), format!("{:?}", req.filter).to_lowercase()),
+        ("matrix".to_string(), "model".to_string()),
+        ("gamma".to_string(), req.gamma.to_string()),
+        ("target".to_string(), match (req.ratio, req.psnr) {
+            (_, Some(p)) => format!("psnr {p} dB"),
+            (r, None) => format!("ratio {}", r.unwrap_or(super::DEFAULT_RATIO)),
+        }),
+    ];
+    let mut container = Container {
+        space,
+        cameras,
+        objects,
+        provenance: Some(Provenance {
+            tool: format!("pis-pack {}", env!("CARGO_PKG_VERSION")),
+            source: set.dir.display().to_string(),
+            raw_image_bytes: raw,
+            settings,
+        }),
+    };
+    // Level lists with empty codestreams: the bytes everything but the images takes.
+    for (o, ob) in container.objects.iter_mut().enumerate() {
+        for (l, layer) in ob.layers.iter_mut().enumerate() {
+            for (b, block) in layer.blocks.iter_mut().enumerate() {
+                block.levels = blocks_out[o][l][b].levels.iter().map(|(c, imgs, _)| Level {
+                    counts: c.clone(),
+                    images: imgs.iter().map(|_| Codestream { codec: req.codec, bytes: vec![] }).collect(),
+                }).collect();
+            }
+        }
+    }
+    let overhead = pis_format::to_bytes_unchecked(&container).len();
+
+    let rates: Vec<Rate> = if req.codec.is_lossy() {
+        let target = match (req.ratio, req.psnr) {
+            (_, Some(db)) => Target::Psnr { db, peak: 1.0 },
+            (r, None) => {
+                // The ratio counts level images against the raw images (thesis 4.8);
+                // geometry and tables come on top and are reported apart.
+                Target::Bytes((raw as f64 / r.unwrap_or(super::DEFAULT_RATIO)) as usize)
+            }
+        };
+        let areas: Vec<f64> = models.iter().map(|m| m.area).collect();
+        let a = allocate(&items, &areas, target, Some(DEFAULT_ALPHA)).map_err(|e| runtime(e.into()))?;
+        stages.done("allocate", &format!("{} bytes over {} level images", a.total_bytes, items.len()));
+        a.bytes.into_iter().map(Rate::Bytes).collect()
+    } else {
+        vec![Rate::Default; items.len()]
+    };
+    let mut layer_bytes: Vec<Vec<usize>> = models.iter().map(|m| vec![0; m.layers.len()]).collect();
+    for ((mi, li, b, lv, ii, planes), rate) in where_.iter().zip(rates) {
+        let level = &mut blocks_out[*mi][*li][*b].levels[*lv];
+        let bytes = codec.encode(planes, &level.1[*ii], rate).map_err(|e| runtime(e.into()))?;
+        layer_bytes[*mi][*li] += bytes.len();
+        container.objects[*mi].layers[*li].blocks[*b].levels[*lv].images[*ii].bytes = bytes.clone();
+        level.2[*ii] = bytes;
+    }
+    stages.done("encode", &format!("{} level images with {}", where_.len(), req.codec));
+    Ok(Packed { container, blocks: blocks_out, overhead, layer_bytes, stagger: staggers })
+}
+
+/// Makes the finest level's residuals such that the decoder's f32 sum of the levels, top
+/// first, gives back every sample bit for bit: the residual `x − s` is nudged by a few ulps
+/// where rounding loses it; where no nudge works, the block falls back to a zero top level
+/// and the samples themselves.
+pub(crate) fn exact_finest(pyr: &mut pis_codec::pyramid::Pyramid, samples: &[Vec<f32>], extent: &[u32]) {
+    let n_levels = pyr.levels.len();
+    let ok = (|| {
+        let (coarse, finest) = pyr.levels.split_at_mut(n_levels.checked_sub(1)?);
+        let finest = finest.first_mut()?;
+        for (si, x) in samples.iter().enumerate() {
+            let local = unflatten(si, extent);
+            let mut sum = vec![0.0f32; x.len()];
+            for l in coarse.iter() {
+                let img = &l.images[level_image_index(&l.counts, &local, extent)];
+                sum.iter_mut().zip(img).for_each(|(a, v)| *a += v);
+            }
+            let fi = level_image_index(&finest.counts, &local, extent);
+            let r = &mut finest.images[fi];
+            for ((rv, &sv), &xv) in r.iter_mut().zip(&sum).zip(x) {
+                let mut c = xv - sv;
+                let mut k: i32 = 0;
+                while (sv + c).to_bits() != xv.to_bits() {
+                    k += 1;
+                    if k > 16 {
+                        return None;
+                    }
+                    let step: i32 = (k + 1) / 2;
+                    let base = xv - sv;
+                    c = if k % 2 == 1 { nudge(base, step) } else { nudge(base, -step) };
+                }
+                *rv = c;
+            }
+        }
+        Some(())
+    })();
+    if ok.is_none() && extent.iter().any(|&e| e > 1) {
+        let ones = vec![1u32; extent.len()];
+        let n = samples.first().map_or(0, Vec::len);
+        pyr.levels = vec![
+            pis_codec::pyramid::PyramidLevel { counts: ones, images: vec![vec![0.0; n]] },
+            pis_codec::pyramid::PyramidLevel { counts: extent.to_vec(), images: samples.to_vec() },
+        ];
+    }
+}
+
+fn nudge(v: f32, ulps: i32) -> f32 {
+    let mut x = v;
+    for _ in 0..ulps.unsigned_abs() {
+        x = if ulps > 0 { x.next_up() } else { x.next_down() };
+    }
+    x
+}
+
+/// Decoded linear textures (whole MIP chain, rebuilt by decimation as the player does), per
+/// object model and layer, keyed like [`super::infer_layers::InferredLayer::textures`].
+pub(crate) fn decoded_textures(models: &[ObjectModel], packed: &Packed) -> Result<Vec<Vec<LayerTextures>>> {
+    let mut out = Vec::new();
+    for (mi, m) in models.iter().enumerate() {
+        let mut per_layer = Vec::new();
+        for (li, _) in m.layers.iter().enumerate() {
+            let layer = &packed.container.objects[mi].layers[li];
+            let mut map = std::collections::BTreeMap::new();
+            for (b, pb) in packed.blocks[mi][li].iter().enumerate() {
+                let block = &layer.blocks[b];
+                let layout = LevelLayout::of(layer, block);
+                let planes = layout.planes();
+                let decoded: Vec<Vec<Vec<f32>>> = pb.levels.iter().map(|(_, _, streams)| {
+                    streams.iter().map(|s| pis_codec::decode(layer_codec(block), &planes, s)).collect::<Result<Vec<_>, _>>()
+                }).collect::<Result<_, _>>()?;
+                for (s, k) in pb.keys.iter().enumerate() {
+                    let local = unflatten(s, &pb.extent);
+                    let mut sum = vec![0.0f32; pis_codec::value_count(&planes)?];
+                    for ((counts, _, _), imgs) in pb.levels.iter().zip(&decoded) {
+                        let img = &imgs[level_image_index(counts, &local, &pb.extent)];
+                        sum.iter_mut().zip(img).for_each(|(a, v)| *a += v);
+                    }
+                    let lin = finish(layer, &layout, sum);
+                    map.insert(k.clone(), mip_chain(m, lin));
+                }
+            }
+            per_layer.push(map);
+        }
+        out.push(per_layer);
+    }
+    Ok(out)
+}
+
+fn layer_codec(block: &Block) -> CodecId {
+    block.levels.first().and_then(|l| l.images.first()).map_or(CodecId::Raw, |c| c.codec)
+}
+
+/// The MIP chain of the solver's layout from the finest level, by decimation (thesis 3.6).
+pub(crate) fn mip_chain(m: &ObjectModel, finest: Vec<f32>) -> Vec<f32> {
+    let l = m.prep.layout;
+    let mut x = finest.clone();
+    let mut cur = finest;
+    for lv in 1..l.levels {
+        let (w, h) = l.level_size(lv - 1);
+        cur = decimate(&cur, w, h, 3);
+        x.extend_from_slice(&cur);
+    }
+    x
+}
+
+/// Reads the written file back and checks that every level image decodes to exactly the
+/// values that were encoded (bit for bit), as the lossless codec promises.
+pub(crate) fn check_lossless(path: &Path, packed: &Packed) -> Result<bool> {
+    let reader = PisReader::open(path)?;
+    let c = reader.container();
+    for (mi, ob) in c.objects.iter().enumerate() {
+        for (li, layer) in ob.layers.iter().enumerate() {
+            for (b, block) in layer.blocks.iter().enumerate() {
+                let planes = LevelLayout::of(layer, block).planes();
+                for (lv, level) in block.levels.iter().enumerate() {
+                    for (ii, r) in level.images.iter().enumerate() {
+                        let bytes = reader.codestream(r)?;
+                        let got = pis_codec::decode(r.codec, &planes, &bytes)?;
+                        let want = &packed.blocks[mi][li][b].levels[lv].1[ii];
+                        if got.len() != want.len() || got.iter().zip(want).any(|(a, b)| a.to_bits() != b.to_bits()) {
+                            return Ok(false);
+                        }
+                    }
+                }
+            }
+        }
+    }
+    Ok(true)
+}
+
+/// Squared display error and pixel count per object of `textures` rendered through A,
+/// against the gold-standard layers.
+pub(crate) fn display_error(set: &LoadedSet, models: &[ObjectModel], textures: &[Vec<LayerTextures>]) -> Vec<(f64, usize)> {
+    let d = |v: f32| crate::images::srgb_encode(v.clamp(0.0, 1.0)) as f64;
+    models.iter().zip(textures).map(|(m, tex)| {
+        let (mut sse, mut n) = (0.0f64, 0usize);
+        for (p, s) in set.samples.iter().enumerate() {
+            let v = &m.views[p];
+            let mut img = vec![0.0f32; v.a.rows() * 3];
+            for (il, t) in m.layers.iter().zip(tex) {
+                if let Some(x) = t.get(&key(s, il.depends_on)) {
+                    let r = pis_compile::render(&v.a, x);
+                    img.iter_mut().zip(&r).for_each(|(a, b)| *a += b);
+                }
+            }
+            for (k, g) in img.iter().enumerate() {
+                let gold = v.diffuse[k] + v.specular[k];
+                sse += (d(*g) - d(gold)).powi(2);
+            }
+            n += img.len();
+        }
+        (sse, n)
+    }).collect()
+}
+
+/// PSNR in dB (peak 1) of a squared error sum over `n` values.
+pub(crate) fn psnr(sse: f64, n: usize) -> f64 {
+    10.0 * (1.0 / (sse / n.max(1) as f64).max(1e-20)).log10()
+}
+
+/// Predicted quality: per object (decoded, as solved) and overall, plus the largest
+/// difference between decoded and solved finest texels.
+pub(crate) struct Quality {
+    pub(crate) objects: Vec<(f64, f64)>,
+    pub(crate) overall: f64,
+    pub(crate) overall_solved: f64,
+    pub(crate) max_texel_error: f32,
+}
+
+/// Renders the decoded and the solved textures through the hardware model.
+pub(crate) fn predicted_psnr(set: &LoadedSet, models: &[ObjectModel], packed: &Packed) -> Result<Quality> {
+    let decoded = decoded_textures(models, packed)?;
+    let solved: Vec<Vec<LayerTextures>> = models.iter().map(|m| m.layers.iter().map(|l| {
+        l.textures.iter().map(|(k, x)| (k.clone(), mip_chain(m, finest(m, x)))).collect()
+    }).collect()).collect();
+    let mut max_err = 0.0f32;
+    for (m, (dl, sl)) in models.iter().zip(decoded.iter().zip(&solved)) {
+        let n = m.prep.layout.width as usize * m.prep.layout.height as usize * 3;
+        for (dm, sm) in dl.iter().zip(sl) {
+            for (k, x) in sm {
+                if let Some(y) = dm.get(k) {
+                    for (a, b) in x[..n].iter().zip(&y[..n]) {
+                        max_err = max_err.max((a - b).abs());
+                    }
+                }
+            }
+        }
+    }
+    let e_dec = display_error(set, models, &decoded);
+    let e_sol = display_error(set, models, &solved);
+    let total = |e: &[(f64, usize)]| {
+        let (s, n) = e.iter().fold((0.0, 0), |a, x| (a.0 + x.0, a.1 + x.1));
+        psnr(s, n)
+    };
+    Ok(Quality {
+        objects: e_dec.iter().zip(&e_sol).map(|(a, b)| (psnr(a.0, a.1), psnr(b.0, b.1))).collect(),
+        overall: total(&e_dec),
+        overall_solved: total(&e_sol),
+        max_texel_error: max_err,
+    })
+}
