@@ -24,6 +24,7 @@ pub mod dct;
 mod error;
 pub mod gamma;
 mod lossless;
+mod lossy_header;
 pub mod pyramid;
 mod raw;
 mod rd;

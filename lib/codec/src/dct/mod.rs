@@ -8,15 +8,11 @@ pub mod quant;
 pub mod transform;
 
 use crate::arith::{Decoder, Encoder};
-use crate::{colour, value_count, CodecError, PlaneShape, Rate, RdCurve, RdPoint};
+use crate::{colour, lossy_header, value_count, CodecError, PlaneShape, Rate, RdCurve, RdPoint};
 
-/// Codestream format version (header byte 0).
-pub const VERSION: u8 = 1;
+pub use crate::lossy_header::{HEADER_LEN, VERSION};
 /// Quality of [`Rate::Default`].
 pub const DEFAULT_QUALITY: u8 = 75;
-
-/// Header bytes of every codestream.
-pub const HEADER_LEN: usize = 8;
 
 /// Header bytes of a codestream for `planes` ([`HEADER_LEN`] whatever the planes).
 pub fn header_len(_planes: &[PlaneShape]) -> usize {
@@ -132,33 +128,13 @@ pub fn decode(planes: &[PlaneShape], bytes: &[u8]) -> Result<Vec<f32>, CodecErro
         return Ok(vec![0.0; n]);
     }
     let hl = header_len(planes);
-    if bytes.len() < hl {
-        return Err(CodecError::Corrupt(format!(
-            "{} bytes, shorter than the {hl}-byte header",
-            bytes.len()
-        )));
-    }
-    if bytes[0] != VERSION {
-        return Err(CodecError::Corrupt(format!(
-            "version {} is not 1",
-            bytes[0]
-        )));
-    }
-    let quality = bytes[1];
+    let header = lossy_header::read(bytes, "unit")?;
+    let (quality, colour, unit) = (header.param, header.colour, header.scale);
     if !(1..=100).contains(&quality) {
         return Err(CodecError::Corrupt(format!("quality {quality}")));
     }
-    let colour = match bytes[2] {
-        0 => false,
-        1 => true,
-        f => return Err(CodecError::Corrupt(format!("flags {f:#04x}"))),
-    };
-    if bytes[3] != 0 {
+    if header.param2 != 0 {
         return Err(CodecError::Corrupt("reserved byte is not 0".into()));
-    }
-    let unit = f32::from_le_bytes([bytes[4], bytes[5], bytes[6], bytes[7]]);
-    if !(unit.is_finite() && unit > 0.0) {
-        return Err(CodecError::Corrupt(format!("unit {unit}")));
     }
     let steps = quant::steps(quality, unit);
     let mut dec = Decoder::new(&bytes[hl..]);

@@ -5,11 +5,10 @@
 pub mod bitplane;
 pub mod lifting;
 
-use crate::{colour, value_count, CodecError, PlaneShape, Rate, RdCurve, RdPoint};
+use crate::{colour, lossy_header, value_count, CodecError, PlaneShape, Rate, RdCurve, RdPoint};
 use bitplane::Band;
 
-/// Codestream format version (header byte 0).
-pub const VERSION: u8 = 1;
+pub use crate::lossy_header::{HEADER_LEN, VERSION};
 /// Decomposition levels requested by the encoder (each plane uses as many as its size allows).
 pub const DEFAULT_LEVELS: u32 = 5;
 /// Largest level count a header may name.
@@ -20,9 +19,8 @@ pub const DEFAULT_BITS: u32 = 16;
 pub const CURVE_POINTS: usize = 24;
 const NO_PLANES: u8 = 255;
 
-/// Header bytes of every codestream (no channel means: the low-pass band carries them, and
-/// a pyramid of small level images cannot afford 4 bytes per channel each).
-pub const HEADER_LEN: usize = 8;
+// The header carries no channel means: the low-pass band carries them, and a pyramid of
+// small level images cannot afford 4 bytes per channel each.
 
 /// Header bytes of a codestream for `planes` ([`HEADER_LEN`] whatever the planes).
 pub fn header_len(_planes: &[PlaneShape]) -> usize {
@@ -306,36 +304,13 @@ pub fn decode(planes: &[PlaneShape], bytes: &[u8]) -> Result<Vec<f32>, CodecErro
         return Ok(vec![0.0; n]);
     }
     let hl = header_len(planes);
-    if bytes.len() < hl {
-        return Err(CodecError::Corrupt(format!(
-            "{} bytes, shorter than the {hl}-byte header",
-            bytes.len()
-        )));
-    }
-    if bytes[0] != VERSION {
-        return Err(CodecError::Corrupt(format!(
-            "version {} is not 1",
-            bytes[0]
-        )));
-    }
-    let levels = bytes[1] as u32;
+    let header = lossy_header::read(bytes, "step")?;
+    let (levels, colour, top, step) = (header.param as u32, header.colour, header.param2, header.scale);
     if levels > MAX_LEVELS {
-        return Err(CodecError::Corrupt(format!(
-            "{levels} levels (at most {MAX_LEVELS})"
-        )));
+        return Err(CodecError::Corrupt(format!("{levels} levels (at most {MAX_LEVELS})")));
     }
-    let colour = match bytes[2] {
-        0 => false,
-        1 => true,
-        f => return Err(CodecError::Corrupt(format!("flags {f:#04x}"))),
-    };
-    let top = bytes[3];
     if top > 30 && top != NO_PLANES {
         return Err(CodecError::Corrupt(format!("top bit-plane {top}")));
-    }
-    let step = f32::from_le_bytes([bytes[4], bytes[5], bytes[6], bytes[7]]);
-    if !(step.is_finite() && step > 0.0) {
-        return Err(CodecError::Corrupt(format!("step {step}")));
     }
     let (bands, scales, arrays) = layout(planes, levels);
     // Working memory peaks at about 2.5 times the decoded size: 6 bytes of coefficient
