@@ -1,80 +1,69 @@
 //! The container's data model (format-spec/SPEC.md, section "Model").
 
-/// What a parameter dimension varies (SPEC.md, `PSPC` chunk, field `kind`).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub enum DimensionKind {
-    /// The viewpoint moves.
-    View = 0,
-    /// A light moves or changes.
-    Light = 1,
-    /// An object moves rigidly.
-    ObjectMotion = 2,
-    /// Time in an animation that is none of the above.
-    Time = 3,
-    /// Anything else.
-    Other = 4,
-}
-
-impl DimensionKind {
-    pub const ALL: [DimensionKind; 5] = [
-        DimensionKind::View,
-        DimensionKind::Light,
-        DimensionKind::ObjectMotion,
-        DimensionKind::Time,
-        DimensionKind::Other,
-    ];
-
-    pub fn from_code(code: u8) -> Option<Self> {
-        Self::ALL.get(code as usize).copied()
-    }
-
-    pub fn code(self) -> u8 {
-        self as u8
-    }
-
-    pub fn name(self) -> &'static str {
-        match self {
-            DimensionKind::View => "view",
-            DimensionKind::Light => "light",
-            DimensionKind::ObjectMotion => "object_motion",
-            DimensionKind::Time => "time",
-            DimensionKind::Other => "other",
+/// A field enum of the file format: its variants, their codes in the file and their names
+/// in reports. Generates `ALL`, `from_code`, `code` and `name`.
+macro_rules! coded_enum {
+    (
+        $(#[$meta:meta])*
+        pub enum $name:ident: $repr:ty {
+            $( $(#[$vmeta:meta])* $variant:ident = $code:literal => $text:literal, )+
         }
-    }
-}
-
-/// How an object is shaded and therefore represented (SPEC.md, `OBJS` chunk, field `role`).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub enum ObjectRole {
-    /// Parameterized surface textures only.
-    Diffuse = 0,
-    /// Surface textures plus layered environment-map shells modulated by Fresnel.
-    Reflective = 1,
-    /// A refractive lens object: hybrid rendering with a two-term shading model.
-    Refractive = 2,
-}
-
-impl ObjectRole {
-    pub const ALL: [ObjectRole; 3] = [
-        ObjectRole::Diffuse,
-        ObjectRole::Reflective,
-        ObjectRole::Refractive,
-    ];
-
-    pub fn from_code(code: u8) -> Option<Self> {
-        Self::ALL.get(code as usize).copied()
-    }
-
-    pub fn code(self) -> u8 {
-        self as u8
-    }
-
-    pub fn name(self) -> &'static str {
-        match self {
-            ObjectRole::Diffuse => "diffuse",
-            ObjectRole::Reflective => "reflective",
-            ObjectRole::Refractive => "refractive",
+    ) => {
+        $(#[$meta])*
+        #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+        pub enum $name {
+            $( $(#[$vmeta])* $variant = $code, )+
         }
+
+        impl $name {
+            /// Every variant, in code order.
+            pub const ALL: [$name; <[&str]>::len(&[$(stringify!($variant)),+])] = [$($name::$variant),+];
+
+            /// The variant stored as `code`, if the format defines it.
+            pub fn from_code(code: $repr) -> Option<Self> {
+                Self::ALL.into_iter().find(|v| v.code() == code)
+            }
+
+            /// The value stored in the file.
+            pub fn code(self) -> $repr {
+                self as $repr
+            }
+
+            /// The name used in reports and JSON.
+            pub fn name(self) -> &'static str {
+                match self {
+                    $( $name::$variant => $text, )+
+                }
+            }
+        }
+    };
+}
+
+coded_enum! {
+    /// What a parameter dimension varies (SPEC.md, `PSPC` chunk, field `kind`).
+    pub enum DimensionKind: u8 {
+        /// The viewpoint moves.
+        View = 0 => "view",
+        /// A light moves or changes.
+        Light = 1 => "light",
+        /// An object moves rigidly.
+        ObjectMotion = 2 => "object_motion",
+        /// Time in an animation that is none of the above.
+        Time = 3 => "time",
+        /// Anything else.
+        Other = 4 => "other",
+    }
+}
+
+coded_enum! {
+    /// How an object is shaded and therefore represented (SPEC.md, `OBJS` chunk, field `role`).
+    pub enum ObjectRole: u8 {
+        /// Parameterized surface textures only.
+        Diffuse = 0 => "diffuse",
+        /// Surface textures plus layered environment-map shells modulated by Fresnel.
+        Reflective = 1 => "reflective",
+        /// A refractive lens object: hybrid rendering with a two-term shading model.
+        Refractive = 2 => "refractive",
     }
 }
 
@@ -278,56 +267,27 @@ pub struct Mesh {
     pub indices: Vec<u32>,
 }
 
-/// What a layer holds (SPEC.md, table "Layer kinds").
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub enum LayerKind {
-    /// View-independent radiance of the first diffuse interaction.
-    Diffuse = 0,
-    /// View-dependent radiance on the surface.
-    Specular = 1,
-    /// Reflectance texture that multiplies a lighting layer (fig. 4.8).
-    Albedo = 2,
-    /// Incident lighting that an albedo layer multiplies.
-    Lighting = 3,
-    /// Local environment-map shell (self-reflections), with alpha.
-    EnvLocal = 4,
-    /// Distant environment-map shell.
-    EnvDistant = 5,
-    /// One shell of a lens object's layered environment map.
-    EnvShell = 6,
+coded_enum! {
+    /// What a layer holds (SPEC.md, table "Layer kinds").
+    pub enum LayerKind: u8 {
+        /// View-independent radiance of the first diffuse interaction.
+        Diffuse = 0 => "diffuse",
+        /// View-dependent radiance on the surface.
+        Specular = 1 => "specular",
+        /// Reflectance texture that multiplies a lighting layer (fig. 4.8).
+        Albedo = 2 => "albedo",
+        /// Incident lighting that an albedo layer multiplies.
+        Lighting = 3 => "lighting",
+        /// Local environment-map shell (self-reflections), with alpha.
+        EnvLocal = 4 => "env_local",
+        /// Distant environment-map shell.
+        EnvDistant = 5 => "env_distant",
+        /// One shell of a lens object's layered environment map.
+        EnvShell = 6 => "env_shell",
+    }
 }
 
 impl LayerKind {
-    pub const ALL: [LayerKind; 7] = [
-        LayerKind::Diffuse,
-        LayerKind::Specular,
-        LayerKind::Albedo,
-        LayerKind::Lighting,
-        LayerKind::EnvLocal,
-        LayerKind::EnvDistant,
-        LayerKind::EnvShell,
-    ];
-
-    pub fn from_code(code: u8) -> Option<Self> {
-        Self::ALL.get(code as usize).copied()
-    }
-
-    pub fn code(self) -> u8 {
-        self as u8
-    }
-
-    pub fn name(self) -> &'static str {
-        match self {
-            LayerKind::Diffuse => "diffuse",
-            LayerKind::Specular => "specular",
-            LayerKind::Albedo => "albedo",
-            LayerKind::Lighting => "lighting",
-            LayerKind::EnvLocal => "env_local",
-            LayerKind::EnvDistant => "env_distant",
-            LayerKind::EnvShell => "env_shell",
-        }
-    }
-
     /// True for the kinds drawn through an environment-map shell.
     pub fn is_shell(self) -> bool {
         matches!(
@@ -337,104 +297,46 @@ impl LayerKind {
     }
 }
 
-/// Which term of the shading model a layer contributes to (SPEC.md, "Combining layers").
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub enum Term {
-    /// Surface textures, summed (or multiplied) in order.
-    Surface = 0,
-    /// Reflection term: shells composited "over", modulated by Fresnel.
-    Reflection = 1,
-    /// Refraction term of a lens object: shells composited "over", modulated by
-    /// transmission and absorption.
-    Refraction = 2,
-}
-
-impl Term {
-    pub fn from_code(code: u8) -> Option<Self> {
-        [Term::Surface, Term::Reflection, Term::Refraction]
-            .get(code as usize)
-            .copied()
-    }
-
-    pub fn name(self) -> &'static str {
-        match self {
-            Term::Surface => "surface",
-            Term::Reflection => "reflection",
-            Term::Refraction => "refraction",
-        }
+coded_enum! {
+    /// Which term of the shading model a layer contributes to (SPEC.md, "Combining layers").
+    pub enum Term: u8 {
+        /// Surface textures, summed (or multiplied) in order.
+        Surface = 0 => "surface",
+        /// Reflection term: shells composited "over", modulated by Fresnel.
+        Reflection = 1 => "reflection",
+        /// Refraction term of a lens object: shells composited "over", modulated by
+        /// transmission and absorption.
+        Refraction = 2 => "refraction",
     }
 }
 
-/// How a layer joins the running result of its term.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub enum Combine {
-    Add = 0,
-    Multiply = 1,
-    /// Porter–Duff "over" with straight alpha: this layer over the layers after it.
-    Over = 2,
-}
-
-impl Combine {
-    pub fn from_code(code: u8) -> Option<Self> {
-        [Combine::Add, Combine::Multiply, Combine::Over]
-            .get(code as usize)
-            .copied()
-    }
-
-    pub fn name(self) -> &'static str {
-        match self {
-            Combine::Add => "add",
-            Combine::Multiply => "multiply",
-            Combine::Over => "over",
-        }
+coded_enum! {
+    /// How a layer joins the running result of its term.
+    pub enum Combine: u8 {
+        Add = 0 => "add",
+        Multiply = 1 => "multiply",
+        /// Porter–Duff "over" with straight alpha: this layer over the layers after it.
+        Over = 2 => "over",
     }
 }
 
-/// Which MIP levels a level image holds (SPEC.md, "MIP levels").
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub enum MipMode {
-    /// The finest level only; the player rebuilds the chain by decimation (section 3.6).
-    Decimated = 0,
-    /// The whole chain; levels below the finest are stored as residuals from the decimated
-    /// finest level (section 5.8.1).
-    Stored = 1,
-}
-
-impl MipMode {
-    pub fn from_code(code: u8) -> Option<Self> {
-        [MipMode::Decimated, MipMode::Stored]
-            .get(code as usize)
-            .copied()
-    }
-
-    pub fn name(self) -> &'static str {
-        match self {
-            MipMode::Decimated => "decimated",
-            MipMode::Stored => "stored",
-        }
+coded_enum! {
+    /// Which MIP levels a level image holds (SPEC.md, "MIP levels").
+    pub enum MipMode: u8 {
+        /// The finest level only; the player rebuilds the chain by decimation (section 3.6).
+        Decimated = 0 => "decimated",
+        /// The whole chain; levels below the finest are stored as residuals from the decimated
+        /// finest level (section 5.8.1).
+        Stored = 1 => "stored",
     }
 }
 
-/// How texels reach the screen: through the mesh's texture coordinates, or through an
-/// environment-map shell.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub enum Mapping {
-    Surface = 0,
-    Shell = 1,
-}
-
-impl Mapping {
-    pub fn from_code(code: u8) -> Option<Self> {
-        [Mapping::Surface, Mapping::Shell]
-            .get(code as usize)
-            .copied()
-    }
-
-    pub fn name(self) -> &'static str {
-        match self {
-            Mapping::Surface => "surface",
-            Mapping::Shell => "shell",
-        }
+coded_enum! {
+    /// How texels reach the screen: through the mesh's texture coordinates, or through an
+    /// environment-map shell.
+    pub enum Mapping: u8 {
+        Surface = 0 => "surface",
+        Shell = 1 => "shell",
     }
 }
 
@@ -503,44 +405,23 @@ pub enum Placement {
     },
 }
 
-/// Environment-map shell geometry (SPEC.md, table "Shell shapes").
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub enum ShellShape {
-    /// params[0] = radius.
-    Sphere = 1,
-    /// params[0..3] = radii along x, y, z.
-    Ellipsoid = 2,
-    /// params[0..3] = min corner, params[3..6] = max corner (world space).
-    Box = 3,
-    /// Axis parallel to +Y through the origin: params[0] = radius, [1] = y min, [2] = y max.
-    Cylinder = 4,
-    /// A parallelogram: origin = corner, params[0..3] = edge s, params[3..6] = edge t.
-    Quad = 5,
+coded_enum! {
+    /// Environment-map shell geometry (SPEC.md, table "Shell shapes").
+    pub enum ShellShape: u32 {
+        /// params[0] = radius.
+        Sphere = 1 => "sphere",
+        /// params[0..3] = radii along x, y, z.
+        Ellipsoid = 2 => "ellipsoid",
+        /// params[0..3] = min corner, params[3..6] = max corner (world space).
+        Box = 3 => "box",
+        /// Axis parallel to +Y through the origin: params[0] = radius, [1] = y min, [2] = y max.
+        Cylinder = 4 => "cylinder",
+        /// A parallelogram: origin = corner, params[0..3] = edge s, params[3..6] = edge t.
+        Quad = 5 => "quad",
+    }
 }
 
 impl ShellShape {
-    pub const ALL: [ShellShape; 5] = [
-        ShellShape::Sphere,
-        ShellShape::Ellipsoid,
-        ShellShape::Box,
-        ShellShape::Cylinder,
-        ShellShape::Quad,
-    ];
-
-    pub fn from_code(code: u32) -> Option<Self> {
-        Self::ALL.into_iter().find(|s| *s as u32 == code)
-    }
-
-    pub fn name(self) -> &'static str {
-        match self {
-            ShellShape::Sphere => "sphere",
-            ShellShape::Ellipsoid => "ellipsoid",
-            ShellShape::Box => "box",
-            ShellShape::Cylinder => "cylinder",
-            ShellShape::Quad => "quad",
-        }
-    }
-
     /// Number of texture faces: 6 cube faces, or 1 for a quad.
     pub fn faces(self) -> u32 {
         if self == ShellShape::Quad {
