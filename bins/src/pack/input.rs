@@ -50,6 +50,42 @@ pub fn cache_dir(scene_toml: &Path, scene: &Scene) -> PathBuf {
     dir.join(".pis-cache").join(format!("{}-{}x{}-spp{}", scene.name, scene.resolution.0, scene.resolution.1, scene.spp))
 }
 
+/// True when a scene's parameter space is the one a set was traced over: the same
+/// dimensions (names, kinds) with the same sample values.
+fn same_space(scene: &Scene, set: &RaySet) -> bool {
+    scene.space.dims.len() == set.meta.space.len()
+        && scene.space.dims.iter().zip(&set.meta.space).all(|(d, m)| {
+            d.name == m.name
+                && d.kind.name() == m.kind
+                && d.values.len() == m.values.len()
+                && d.values.iter().zip(&m.values).all(|(a, b)| (a - b).abs() <= 1e-4 * a.abs().max(b.abs()).max(1.0))
+        })
+}
+
+/// Loads the scene a set was traced from at the set's resolution: scene.toml as written, or,
+/// when the set's parameter space is that of one of its `[preset.NAME]`s (a set traced with
+/// `pis-trace --preset NAME`), with that preset.
+pub(crate) fn set_scene(set: &RaySet, scene_path: &Path, res: (u32, u32)) -> Result<Scene, Failure> {
+    let load = |preset: Option<String>| {
+        let options = LoadOptions { preset, resolution: Some(res), ..LoadOptions::default() };
+        pis_scene::load_with(scene_path, &options)
+            .map_err(|e| Failure::new(Exit::Invalid, anyhow!("loading {} (the set's scene; pass --scene): {e}", scene_path.display())))
+    };
+    let scene = load(None)?;
+    if same_space(&scene, set) {
+        return Ok(scene);
+    }
+    let presets = pis_scene::manifest::Manifest::read(scene_path).map(|m| m.presets.into_keys().collect::<Vec<_>>()).unwrap_or_default();
+    for name in presets {
+        if let Ok(s) = load(Some(name)) {
+            if same_space(&s, set) {
+                return Ok(s);
+            }
+        }
+    }
+    Ok(scene)
+}
+
 /// Opens (or traces) the set, loads its scene and reads and checks every point.
 pub(crate) fn load(req: &PackRequest, stages: &mut Stages) -> Result<LoadedSet, Failure> {
     let (dir, scene_path) = if req.input.is_dir() {
@@ -70,9 +106,7 @@ pub(crate) fn load(req: &PackRequest, stages: &mut Stages) -> Result<LoadedSet, 
     let scene_path = req.scene.clone().unwrap_or(scene_path);
     let set = RaySet::open(&dir).map_err(trace_failure)?;
     let res = (set.meta.resolution[0], set.meta.resolution[1]);
-    let options = LoadOptions { resolution: Some(res), ..LoadOptions::default() };
-    let scene = pis_scene::load_with(&scene_path, &options)
-        .map_err(|e| Failure::new(Exit::Invalid, anyhow!("loading {} (the set's scene; pass --scene): {e}", scene_path.display())))?;
+    let scene = set_scene(&set, &scene_path, res)?;
     if set.meta.points.len() != scene.space.point_count() {
         return Err(invalid(format!("{}: the set has {} points, the scene's space {}", dir.display(), set.meta.points.len(), scene.space.point_count())));
     }
