@@ -331,11 +331,11 @@ pub fn run(args: &PlayArgs) -> Result<Exit, Failure> {
     match &args.compare {
         Some(set) => {
             let r = run_compare(args, set, &gpu, &mut player)?;
-            emit(args, &r, |r, w| print_compare_report(r, w))?;
+            emit(args, &r, print_compare_report)?;
         }
         None => {
             let r = run_frames(args, &gpu, &mut player)?;
-            emit(args, &r, |r, w| print_path_report(r, w))?;
+            emit(args, &r, print_path_report)?;
         }
     }
     Ok(Exit::Ok)

@@ -108,6 +108,9 @@ struct Wanted {
     repeat: [bool; 2],
 }
 
+/// An offscreen frame read back: colour and object indices.
+type Readout = (FloatImage, Vec<u32>);
+
 /// An open `.pis` ready to draw frames.
 pub struct Player {
     gpu: Arc<Gpu>,
@@ -431,7 +434,7 @@ impl Player {
         Ok(())
     }
 
-    fn frame(&mut self, req: &FrameRequest, size: (u32, u32), target: Option<(&wgpu::TextureView, wgpu::TextureFormat)>) -> Result<(Option<(FloatImage, Vec<u32>)>, FrameStats), PlayError> {
+    fn frame(&mut self, req: &FrameRequest, size: (u32, u32), target: Option<(&wgpu::TextureView, wgpu::TextureFormat)>) -> Result<(Option<Readout>, FrameStats), PlayError> {
         let t0 = Instant::now();
         let reads0 = self.reader.stats().codestreams;
         let mut stats = FrameStats::default();
