@@ -1,6 +1,7 @@
 //! `pis-bench infer`: texture inference for one object at one parameter point, compared with
 //! the gold-standard layer (thesis 3.6). Least squares with bilinear and trilinear render
-//! matrices, with pyramidal regularization, and the two baselines (forward mapping, ray
+//! matrices, with pyramidal regularization (free MIP levels, and level 0 solved through the
+//! player's decimated chain: `ls-decimated`), and the two baselines (forward mapping, ray
 //! tracing into textures), each rendered through the hardware model.
 //!
 //! The gold standard b is the object's surface radiance, diffuse + specular layer (both
@@ -19,7 +20,7 @@ use pis_compile::baseline::traced::trace_into_texture;
 use pis_compile::baseline::LayerImage;
 use pis_compile::texcoord::{branch_cut::apply_cut, charts::separate_overlapping_charts, optimize_placement, ObjectMesh, TexcoordSettings, ViewGeometry};
 use pis_compile::{
-    antialiased_render_matrix, render, render_matrix, scene_depth, DisplayFilter, solve, Address, DrawMesh, Filter, RenderMatrix, Sampler,
+    antialiased_render_matrix, render, render_matrix, scene_depth, DisplayFilter, solve, Address, DrawMesh, Filter, MipSolve, RenderMatrix, Sampler,
     SolveSettings, TextureLayout, TextureTransform, TexturedObject, Viewport,
 };
 use pis_play::{render_object, Gpu, TexturedPipeline};
@@ -456,6 +457,10 @@ pub fn infer(req: &InferRequest) -> Result<InferReport> {
     }
     let pyr = solve(&a_tri, &b, None, &pyramidal)?;
     method("ls-pyramidal", &a_tri, Filter::Trilinear, &pyr.texels, pyr.solve_ms, Some((pyr.iterations, pyr.converged)));
+    // The same in the decimated parameterization (what pis-pack solves): level 0 through the
+    // MIP chain the player decimates from it.
+    let dec = solve(&a_tri, &b, None, &SolveSettings { mip: MipSolve::Decimated, ..pyramidal })?;
+    method("ls-decimated", &a_tri, Filter::Trilinear, &dec.texels, dec.solve_ms, Some((dec.iterations, dec.converged)));
 
     // Baselines, rendered with trilinear filtering as the player would draw them.
     let t = Instant::now();
