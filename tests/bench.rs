@@ -23,7 +23,7 @@ fn infer_reports_every_method_as_json() {
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("JSON on stdout");
     assert_eq!(v["object"], "Vase");
-    for m in ["ls-bilinear", "ls-trilinear", "ls-pyramidal", "forward", "traced"] {
+    for m in ["ls-bilinear", "ls-trilinear", "ls-pyramidal", "ls-decimated", "forward", "traced"] {
         let psnr = v["methods"][m]["psnr_db"].as_f64().unwrap_or(f64::NAN);
         assert!(psnr.is_finite() && psnr > 5.0, "{m}: {psnr}");
         assert!(v["methods"][m]["psnr_db_wgpu"].is_null());

@@ -1,6 +1,7 @@
 //! `pis-bench infer`: texture inference for one object at one parameter point, compared with
 //! the gold-standard layer (thesis 3.6). Least squares with bilinear and trilinear render
-//! matrices, with pyramidal regularization, and the two baselines (forward mapping, ray
+//! matrices, with pyramidal regularization (free MIP levels, and level 0 solved through the
+//! player's decimated chain: `ls-decimated`), and the two baselines (forward mapping, ray
 //! tracing into textures), each rendered through the hardware model.
 //!
 //! The gold standard b is the object's surface radiance, diffuse + specular layer (both
@@ -17,9 +18,9 @@ use glam::Vec3;
 use pis_compile::baseline::forward::forward_map;
 use pis_compile::baseline::traced::trace_into_texture;
 use pis_compile::baseline::LayerImage;
-use pis_compile::texcoord::{branch_cut::apply_cut, optimize_placement, ObjectMesh, TexcoordSettings, ViewGeometry};
+use pis_compile::texcoord::{branch_cut::apply_cut, charts::separate_overlapping_charts, optimize_placement, ObjectMesh, TexcoordSettings, ViewGeometry};
 use pis_compile::{
-    antialiased_render_matrix, render, render_matrix, scene_depth, DisplayFilter, solve, Address, DrawMesh, Filter, RenderMatrix, Sampler,
+    antialiased_render_matrix, render, render_matrix, scene_depth, DisplayFilter, solve, Address, DrawMesh, Filter, MipSolve, RenderMatrix, Sampler,
     SolveSettings, TextureLayout, TextureTransform, TexturedObject, Viewport,
 };
 use pis_play::{render_object, Gpu, TexturedPipeline};
@@ -281,7 +282,8 @@ fn prepare(pt: &Point, o: usize, mesh: &Mesh, max_texture: u32, reduction: f64) 
 }
 
 /// Texture-coordinate optimization (thesis 3.2) of object `o` over the views of `frames`,
-/// with the per-object resolution reduction factor `reduction`.
+/// with the per-object resolution reduction factor `reduction`; visible charts that share
+/// (u, v) are laid out apart first ([`separate_overlapping_charts`]).
 pub(crate) fn place(
     scene: &Scene,
     frames: &[&Frame],
@@ -302,12 +304,18 @@ pub(crate) fn place(
         }
     }).collect();
     let uvs: Vec<glam::Vec2> = mesh.uvs.iter().map(|u| glam::Vec2::from(*u)).collect();
+    // Visible parts sharing (u, v) (a room's walls each mapped onto the whole wallpaper)
+    // are laid out side by side first: one texel per surface point.
+    let (uvs, wrap) = match separate_overlapping_charts(&uvs, &mesh.indices, &views) {
+        Some(atlas) => (atlas, [false, false]),
+        None => (uvs, seam_wraps(mesh)),
+    };
     let name = &scene.objects[o].name;
-    let om = ObjectMesh { name, uvs: &uvs, indices: &mesh.indices, wrap: seam_wraps(mesh) };
+    let om = ObjectMesh { name, uvs: &uvs, indices: &mesh.indices, wrap };
     let settings = TexcoordSettings { max_size: max_texture, reduction, ..TexcoordSettings::default() };
     let pl = optimize_placement(&om, &views, &settings)?;
-    let mesh_uvs: Vec<[f32; 2]> = mesh.uvs.iter().map(|uv| {
-        let mut w = *uv;
+    let mesh_uvs: Vec<[f32; 2]> = uvs.iter().map(|uv| uv.to_array()).map(|uv| {
+        let mut w = uv;
         for (wd, cut) in w.iter_mut().zip(pl.branch_cut) {
             if let Some(c) = cut {
                 *wd = apply_cut(*wd as f64, c) as f32;
@@ -449,6 +457,10 @@ pub fn infer(req: &InferRequest) -> Result<InferReport> {
     }
     let pyr = solve(&a_tri, &b, None, &pyramidal)?;
     method("ls-pyramidal", &a_tri, Filter::Trilinear, &pyr.texels, pyr.solve_ms, Some((pyr.iterations, pyr.converged)));
+    // The same in the decimated parameterization (what pis-pack solves): level 0 through the
+    // MIP chain the player decimates from it.
+    let dec = solve(&a_tri, &b, None, &SolveSettings { mip: MipSolve::Decimated, ..pyramidal })?;
+    method("ls-decimated", &a_tri, Filter::Trilinear, &dec.texels, dec.solve_ms, Some((dec.iterations, dec.converged)));
 
     // Baselines, rendered with trilinear filtering as the player would draw them.
     let t = Instant::now();

@@ -1,7 +1,9 @@
 //! Inference of every object's layers as parameterized surface textures (thesis 3.5, 4.8):
 //! a view-independent diffuse layer solved once over all views by stacking, and a
 //! view-dependent specular layer solved per parameter sample, each warm-started from the
-//! neighbouring sample. Layers that are black for an object are left out.
+//! neighbouring sample. Layers that are black for an object are left out. Every solve is
+//! pyramidal (ε_f = 0.1) in the decimated parameterization: the unknowns are level 0 and the
+//! coarser levels its decimations, as the player stores and rebuilds them.
 
 use std::collections::BTreeMap;
 
@@ -118,7 +120,9 @@ pub(crate) fn infer_all(set: &LoadedSet, req: &PackRequest, stages: &mut Stages)
     let view_dims: Vec<usize> = scene.space.dims.iter().enumerate().filter(|(_, d)| d.kind == DimensionKind::View).map(|(k, _)| k).collect();
     let all = DepMask::of(&(0..scene.space.dims.len()).collect::<Vec<_>>());
     let non_view = DepMask::of(&(0..scene.space.dims.len()).filter(|k| !view_dims.contains(k)).collect::<Vec<_>>());
-    let settings = SolveSettings::pyramidal();
+    // Level 0 solved through the MIP chain the player decimates from it (thesis 3.6): the
+    // solved textures are the drawn ones.
+    let settings = SolveSettings::decimated();
     let mut out = Vec::new();
     for o in 0..scene.objects.len() {
         let name = scene.objects[o].name.clone();

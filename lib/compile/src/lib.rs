@@ -16,7 +16,8 @@
 //! The solver (thesis 3.5): [`solve()`] (one view), [`solve_view_independent`] (eq. 3.7),
 //! settings in [`SolveSettings`]; [`cg`] (conjugate gradient with exact line search),
 //! [`normal_equations`] (the A and AᵀA forms), [`regularize`] (eqs. 3.8 and 3.9),
-//! [`sparse`] (deterministic parallel sparse products).
+//! [`sparse`] (deterministic parallel sparse products), [`decimation`] (the player's MIP
+//! chain as a linear map of level 0, for [`MipSolve::Decimated`]).
 //!
 //! Texture-coordinate optimization (thesis 3.2): [`texcoord`]. Render matrices for a known
 //! screen→texture map, for tests and benchmarks: [`synthetic`].
@@ -24,6 +25,7 @@
 pub mod antialias;
 pub mod baseline;
 pub mod cg;
+pub mod decimation;
 pub mod error;
 pub mod filter;
 pub mod interpolate;
@@ -49,7 +51,7 @@ pub use model::{render_matrix, scene_depth, ModelError, TexturedObject};
 pub use normal_equations::Form;
 pub use raster::DepthBuffer;
 pub use sampler::{Address, Filter, Sampler};
-pub use solve::{render, solve, solve_view_independent, FormChoice, Solution, SolveSettings, View};
+pub use solve::{render, solve, solve_view_independent, FormChoice, MipSolve, Solution, SolveSettings, View};
 pub use transform::{DrawMesh, TextureTransform, Viewport};
 
 #[cfg(test)]

@@ -6,6 +6,7 @@
 use rayon::prelude::*;
 
 use crate::cg::Quadratic;
+use crate::decimation::Decimation;
 use crate::sparse::Csr;
 
 /// Which form of the normal equations the solver iterates on.
@@ -81,11 +82,13 @@ pub struct PyramidTerm {
     pub pt: Csr,
 }
 
-/// One channel's quadratic objective `‖Ax − b‖² + λ‖Px‖²`.
+/// One channel's quadratic objective `‖Ax − b‖² + λ‖Px‖²`; with `chain`, of the level-0
+/// texels x₀ with `x = D·x₀` (the decimated parameterization: `‖ADx₀ − b‖² + λ‖PDx₀‖²`).
 pub struct ChannelProblem<'a> {
     pub op: &'a DataOperator,
     pub rhs: &'a ChannelRhs,
     pub pyramid: Option<&'a PyramidTerm>,
+    pub chain: Option<&'a Decimation>,
 }
 
 fn dot(a: &[f64], b: &[f64]) -> f64 {
@@ -94,6 +97,36 @@ fn dot(a: &[f64], b: &[f64]) -> f64 {
 
 impl Quadratic for ChannelProblem<'_> {
     fn hess_mul(&self, p: &[f64], out: &mut [f64]) {
+        match self.chain {
+            None => self.hess_mul_chain(p, out),
+            Some(d) => {
+                let n_t = d.layout.texel_count();
+                let (mut pf, mut of) = (vec![0.0; n_t], vec![0.0; n_t]);
+                d.expand(p, &mut pf);
+                self.hess_mul_chain(&pf, &mut of);
+                d.reduce(&of, out);
+            }
+        }
+    }
+
+    fn value_gradient(&self, x: &[f64], grad: &mut [f64]) -> f64 {
+        match self.chain {
+            None => self.value_gradient_chain(x, grad),
+            Some(d) => {
+                let n_t = d.layout.texel_count();
+                let (mut xf, mut gf) = (vec![0.0; n_t], vec![0.0; n_t]);
+                d.expand(x, &mut xf);
+                let f = self.value_gradient_chain(&xf, &mut gf);
+                d.reduce(&gf, grad);
+                f
+            }
+        }
+    }
+}
+
+impl ChannelProblem<'_> {
+    /// H·p over the whole chain.
+    fn hess_mul_chain(&self, p: &[f64], out: &mut [f64]) {
         match self.op {
             DataOperator::A { a, at } => {
                 let mut t = vec![0.0; a.rows];
@@ -111,7 +144,8 @@ impl Quadratic for ChannelProblem<'_> {
         }
     }
 
-    fn value_gradient(&self, x: &[f64], grad: &mut [f64]) -> f64 {
+    /// f and its gradient over the whole chain.
+    fn value_gradient_chain(&self, x: &[f64], grad: &mut [f64]) -> f64 {
         let mut f = match self.op {
             DataOperator::A { a, at } => {
                 let mut r = vec![0.0; a.rows];

@@ -9,6 +9,7 @@ use std::time::Instant;
 use rayon::prelude::*;
 
 use crate::cg::{self, CgReport, CgSettings};
+use crate::decimation::{chain_f32, Decimation};
 use crate::error::check_finite;
 use crate::normal_equations::{ChannelProblem, DataOperator, Form, PyramidTerm, DEFAULT_K};
 use crate::regularize::{barrier_d2, pyramid_operator, RangeRegularization};
@@ -28,8 +29,21 @@ pub enum FormChoice {
     Fixed(Form),
 }
 
+/// What the solver's unknowns are.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Default)]
+pub enum MipSolve {
+    /// Every texel of every MIP level (thesis 3.5: n_t counts the whole pyramid).
+    #[default]
+    Free,
+    /// Level 0 only; the coarser levels are its decimations as the player rebuilds them
+    /// (thesis 3.6), so A acts through D ([`crate::decimation`]). The solved texture is then
+    /// exactly the one drawn, and a box-bounded level 0 bounds every level.
+    Decimated,
+}
+
 /// Solver settings; [`SolveSettings::default`] is plain least squares,
-/// [`SolveSettings::pyramidal`] the thesis's regularized setting.
+/// [`SolveSettings::pyramidal`] the thesis's regularized setting,
+/// [`SolveSettings::decimated`] the same for the player's decimated MIP chain.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SolveSettings {
     /// ε_b of eq. 3.8 (0: no range term). The thesis used 1/32.
@@ -39,6 +53,7 @@ pub struct SolveSettings {
     /// The range [0, range_factor · max(b)] the range term keeps texels in.
     pub range_factor: f64,
     pub form: FormChoice,
+    pub mip: MipSolve,
     /// K of the form rule.
     pub k: f64,
     pub cg: CgSettings,
@@ -51,6 +66,7 @@ impl Default for SolveSettings {
             epsilon_f: 0.0,
             range_factor: 1.1,
             form: FormChoice::Auto,
+            mip: MipSolve::Free,
             k: DEFAULT_K,
             cg: CgSettings::default(),
         }
@@ -61,6 +77,12 @@ impl SolveSettings {
     /// Pyramidal regularization with ε_f = 0.1 (thesis 3.6): every texel defined.
     pub fn pyramidal() -> Self {
         SolveSettings { epsilon_f: 0.1, ..Default::default() }
+    }
+
+    /// Pyramidal regularization (ε_f = 0.1) in the decimated parameterization: level 0
+    /// solved through the MIP chain the player decimates from it.
+    pub fn decimated() -> Self {
+        SolveSettings { mip: MipSolve::Decimated, ..Self::pyramidal() }
     }
 
     /// Range regularization with ε_b = 1/32 (thesis 3.6).
@@ -163,6 +185,9 @@ fn solve_views(
     };
     let col_norms = a.column_norms_squared();
     let op = DataOperator::new(a, form);
+    let chain = (settings.mip == MipSolve::Decimated).then(|| Decimation::new(layout));
+    // Unknowns per channel: the whole chain, or level 0.
+    let n_x = chain.as_ref().map_or(n_t, Decimation::base_len);
     let ratio = n_s as f64 / n_t.max(1) as f64;
     let pyramid = (settings.epsilon_f > 0.0 && layout.levels > 1).then(|| {
         let p = pyramid_operator(&layout);
@@ -172,7 +197,7 @@ fn solve_views(
     let b_all: Vec<f32> = views.iter().flat_map(|v| v.b.iter().copied()).collect();
     let b_max = b_all.iter().fold(0.0f32, |m, &v| m.max(v)) as f64;
     let range = (settings.epsilon_b > 0.0).then(|| {
-        RangeRegularization::new(settings.epsilon_b, n_s, n_t,
+        RangeRegularization::new(settings.epsilon_b, n_s, n_x,
                                  (settings.range_factor * b_max).max(1e-6))
     });
 
@@ -187,10 +212,17 @@ fn solve_views(
         let c = r.scale * barrier_d2(0.5) / (r.range * r.range) * 0.5;
         diag.iter_mut().for_each(|d| *d += c);
     }
+    if let Some(d) = &chain {
+        diag = d.reduce_diagonal(&diag);
+    }
     let positive: Vec<f64> = diag.iter().copied().filter(|&d| d > 0.0).collect();
     let floor = if positive.is_empty() { 1.0 } else { positive.iter().sum::<f64>() / positive.len() as f64 };
     let inv_diag: Vec<f64> = diag.iter().map(|&d| 1.0 / if d > 0.0 { d } else { floor }).collect();
-    let undefined = if pyramid.is_some() { 0 } else { col_norms.iter().filter(|&&d| d == 0.0).count() };
+    let undefined = match (&pyramid, &chain) {
+        (Some(_), _) => 0,
+        (None, None) => col_norms.iter().filter(|&&d| d == 0.0).count(),
+        (None, Some(d)) => d.reduce_diagonal(&col_norms).iter().filter(|&&v| v == 0.0).count(),
+    };
 
     let mut texels = vec![0.0f32; n_t * CHANNELS];
     let mut channels = Vec::with_capacity(CHANNELS);
@@ -204,14 +236,19 @@ fn solve_views(
             let b: Vec<f64> = b_all.iter().skip(ch).step_by(CHANNELS).map(|&v| v as f64).collect();
             let rhs = op.rhs(b.clone());
             let mut x: Vec<f64> = match initial {
-                Some(x0) => x0.iter().skip(ch).step_by(CHANNELS).map(|&v| v as f64).collect(),
-                None => vec![0.0; n_t],
+                Some(x0) => x0.iter().skip(ch).step_by(CHANNELS).take(n_x).map(|&v| v as f64).collect(),
+                None => vec![0.0; n_x],
             };
             if let Some(r) = &range {
                 r.clamp_inside(&mut x);
             }
-            let problem = ChannelProblem { op: &op, rhs: &rhs, pyramid: pyramid.as_ref() };
+            let problem = ChannelProblem { op: &op, rhs: &rhs, pyramid: pyramid.as_ref(), chain: chain.as_ref() };
             let report = cg::minimize(&problem, range.as_ref(), &inv_diag, &mut x, &settings.cg);
+            if let Some(d) = &chain {
+                let mut full = vec![0.0; n_t];
+                d.expand(&x, &mut full);
+                x = full;
+            }
             let r2 = data_residual2(&op, &x, &b);
             (report, x, r2, rhs.bb)
         })
@@ -223,6 +260,11 @@ fn solve_views(
             texels[t * CHANNELS + ch] = v as f32;
         }
         channels.push(report);
+    }
+    if chain.is_some() {
+        // The coarser levels exactly as the player decimates the stored level 0.
+        let n0 = layout.width as usize * layout.height as usize * CHANNELS;
+        texels = chain_f32(&layout, &texels[..n0], CHANNELS as u32);
     }
     Ok(Solution {
         layout,

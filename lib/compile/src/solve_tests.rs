@@ -302,3 +302,47 @@ fn unregularized_fit_with_more_texels_than_pixels_is_an_out_of_range_overfit() {
     assert!(extent(&plain.texels) > 3.0 * b_max, "plain LS leaves the range");
     assert!(q_reg > q_plain + 3.0, "off the sample the pyramidal texture is the better one");
 }
+
+/// A receding plane: a 48×32 texture on a 40×30 screen, magnified at the bottom and
+/// minified up to about 4× (MIP levels 0–2) at the top; b is a striped image of (s, t), a
+/// traced layer rather than a rendering of some texture.
+fn receding_view() -> (RenderMatrix, Vec<f32>, TextureLayout) {
+    let layout = TextureLayout::full(48, 32);
+    let map = |x: f64, y: f64| {
+        let depth = 1.0 + 3.0 * (1.0 - y / 30.0);
+        let s = 0.5 + (x - 20.0) / (40.0 * depth) * 1.6;
+        let t = 1.0 - (1.0 - 1.0 / depth) * 1.3;
+        ((0.0..1.0).contains(&s) && (0.0..1.0).contains(&t)).then_some((s, t))
+    };
+    let a = warp_matrix(40, 30, layout, Filter::Trilinear, map);
+    let mut b = vec![0.0f32; a.rows() * 3];
+    for r in 0..a.rows() {
+        let p = a.pixels[r];
+        let (s, t) = map((p % 40) as f64 + 0.5, (p / 40) as f64 + 0.5).expect("a covered pixel");
+        let stripe = 0.5 + 0.4 * (40.0 * s).sin();
+        b[r * 3..r * 3 + 3].copy_from_slice(&[stripe as f32, (0.2 + 0.6 * t) as f32, (stripe * t) as f32]);
+    }
+    (a, b, layout)
+}
+
+#[test]
+fn the_decimated_parameterization_fits_the_chain_the_player_draws() {
+    use crate::decimation::chain_f32;
+    let (a, b, layout) = receding_view();
+    let n0 = layout.width as usize * layout.height as usize * 3;
+    // Free levels (thesis 3.5), then drawn as the player draws them: level 0 stored, the
+    // coarser levels decimated from it.
+    let free = solve(&a, &b, None, &SolveSettings::pyramidal()).unwrap();
+    let as_solved = psnr(&render(&a, &free.texels), &b);
+    let as_drawn = psnr(&render(&a, &chain_f32(&layout, &free.texels[..n0], 3)), &b);
+    // Level 0 through D: what is solved is what is drawn.
+    let dec = solve(&a, &b, None, &SolveSettings::decimated()).unwrap();
+    let redrawn = chain_f32(&layout, &dec.texels[..n0], 3);
+    assert_eq!(dec.texels, redrawn, "the solved chain is the decimated level 0");
+    let decimated = psnr(&render(&a, &dec.texels), &b);
+    assert_monotone(&dec);
+    assert!(dec.converged && dec.undefined == 0);
+    assert!(decimated >= as_drawn + 3.0,
+            "decimated solve {decimated:.2} dB vs free levels drawn decimated {as_drawn:.2} dB (as solved {as_solved:.2} dB)");
+    assert!(decimated >= 30.0, "decimated solve {decimated:.2} dB");
+}

@@ -43,6 +43,19 @@ pub fn find_cut(extents: &[(f64, f64)]) -> Option<f64> {
     best.map(|b| b.1)
 }
 
+/// Whether the cut `cut` (from [`find_cut`]) lies in the gap around the period's own seam
+/// w = 0 ≡ 1, with every extent inside [0, 1]: the visible part is then contiguous in the
+/// original coordinates and needs no cut.
+pub fn gap_holds_the_seam(extents: &[(f64, f64)], cut: f64) -> bool {
+    let eps = 1e-9;
+    if extents.is_empty() || extents.iter().any(|&(lo, hi)| lo < -eps || hi > 1.0 + eps) {
+        return false;
+    }
+    let lo = extents.iter().map(|e| e.0).fold(f64::INFINITY, f64::min);
+    let hi = extents.iter().map(|e| e.1).fold(f64::NEG_INFINITY, f64::max);
+    cut > hi || cut < lo
+}
+
 /// Applies a cut to one coordinate.
 pub fn apply_cut(w: f64, cut: f64) -> f64 {
     let d = w - cut;
@@ -63,5 +76,19 @@ mod tests {
         // everything visible: no cut
         assert_eq!(find_cut(&[(0.0, 0.5), (0.4, 1.0)]), None);
         assert_eq!(find_cut(&[(0.3, 1.4)]), None);
+    }
+
+    #[test]
+    fn a_gap_around_the_seam_needs_no_cut() {
+        // One wall of a room, its u running over [0, 1], seen from 0.13 to 0.87: the gap
+        // (0.87, 1.13) holds the seam; cutting there would move the wall's vertices at
+        // u = 1 to 0.
+        let extents = [(0.13, 0.4), (0.4, 0.87)];
+        let cut = find_cut(&extents).unwrap();
+        assert!(gap_holds_the_seam(&extents, cut));
+        assert_eq!(apply_cut(1.0, cut).round(), 0.0, "the fold the check avoids");
+        // A seam inside the visible part (a cylinder seen across its seam) still needs one.
+        let across = [(0.8, 1.0), (0.0, 0.2)];
+        assert!(!gap_holds_the_seam(&across, find_cut(&across).unwrap()));
     }
 }

@@ -18,6 +18,7 @@
 
 pub mod bounding;
 pub mod branch_cut;
+pub mod charts;
 pub mod edges;
 pub mod isometry;
 pub mod stretch;
@@ -127,6 +128,12 @@ pub fn optimize_placement(
         }).collect();
         cut[dim] = branch_cut::find_cut(&extents);
         repeat[dim] = cut[dim].is_none();
+        if cut[dim].is_some_and(|c| branch_cut::gap_holds_the_seam(&extents, c)) {
+            // The visible part already lies inside one period: the coordinates stay as
+            // they are and wrapping goes off. (A cut at the seam would send vertices at
+            // w = 1 to 0 and fold the triangles beside them across the whole texture.)
+            cut[dim] = None;
+        }
     }
     let uvs: Vec<Vec2> = mesh.uvs.iter().map(|uv| {
         let mut w = uv.as_dvec2();

@@ -128,6 +128,21 @@ fn the_seam_of_a_cylinder_seen_from_one_side_gets_a_branch_cut() {
 }
 
 #[test]
+fn a_wall_of_a_wrapping_room_seen_in_its_middle_is_not_cut_at_the_seam() {
+    // One wall whose u runs over the whole period [0, 1] (a room's walls side by side, u
+    // periodic around the room); the camera sees u ∈ about [0.16, 0.84]. The gap in the
+    // visible extents holds the seam u = 0 ≡ 1: no cut (a cut there would move the vertices
+    // at u = 1 to 0 and fold the last column of triangles over the whole texture).
+    let (p, uv, idx) = grid(3);
+    let views = [view(camera(Vec3::new(0.0, 0.0, 0.6), Vec3::ZERO), &p)];
+    let mesh = ObjectMesh { name: "wall", uvs: &uv, indices: &idx, wrap: [true, false] };
+    let pl = optimize_placement(&mesh, &views, &TexcoordSettings::default()).unwrap();
+    assert_eq!(pl.branch_cut, [None, None], "{pl:?}");
+    assert_eq!(pl.repeat, [false, false]);
+    check_visible_inside(&pl, &uv, &views, &idx);
+}
+
+#[test]
 fn a_cylinder_seen_all_around_keeps_wrapping_with_a_scale_only_map() {
     let (p, uv, idx) = cylinder(32);
     let views: Vec<_> = (0..4).map(|k| {
