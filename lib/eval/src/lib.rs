@@ -5,3 +5,5 @@
 //! linear radiance clamped to [0, 1] and sRGB-encoded, peak 1.
 
 pub mod metrics;
+pub mod diff;
+pub mod heatmap;
