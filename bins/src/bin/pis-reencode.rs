@@ -26,15 +26,15 @@ struct Cli {
     codec: CodecId,
     /// Target compression ratio: level-image bytes = raw image bytes / R. Default (lossy
     /// codecs): the input's level-image bytes.
-    #[arg(long, conflicts_with = "psnr")]
+    #[arg(long, conflicts_with = "psnr", allow_hyphen_values = true)]
     ratio: Option<f64>,
     /// Target PSNR in dB of the stored (gamma-compensated) textures, screen-area weighted,
     /// instead of a ratio.
-    #[arg(long)]
+    #[arg(long, allow_hyphen_values = true)]
     psnr: Option<f64>,
     /// Display gamma of the compensation for lossy codecs (default 2.2); lossless and raw
     /// store linear values (gamma 1).
-    #[arg(long)]
+    #[arg(long, allow_hyphen_values = true)]
     gamma: Option<f32>,
     /// Print the report as JSON on stdout.
     #[arg(long)]
