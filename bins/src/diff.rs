@@ -4,7 +4,10 @@
 //! codecs, settings and provenance (one line per difference), and bytes per chunk kind.
 //! Content: both files decoded at every parameter sample, per object, layer and parameter
 //! block: MSE, PSNR and largest error on display values ([`pis_eval::metrics`]), and the
-//! whole file's PSNR. Quality gates turn the comparison into a pass or a fail.
+//! whole file's PSNR. Quality gates turn the comparison into a pass or a fail. With a
+//! ray-traced set instead of a second file, [`gold`] measures the file against it.
+
+pub mod gold;
 
 use std::fmt::Write;
 use std::path::{Path, PathBuf};

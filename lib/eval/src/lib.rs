@@ -6,5 +6,6 @@
 
 pub mod compare;
 pub mod diff;
+pub mod flip;
 pub mod heatmap;
 pub mod metrics;
