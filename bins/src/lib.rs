@@ -7,4 +7,5 @@ pub mod images;
 pub mod infer;
 pub mod inspect;
 pub mod pack;
+pub mod play;
 pub mod reencode;
