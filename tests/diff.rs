@@ -1,6 +1,9 @@
 //! pis-diff end to end: a file and its copy are identical; a re-encoded file differs by a
 //! measured PSNR and passes or fails `--min-psnr` around it; structural differences are
 //! listed; heatmaps are written; invalid files and bad arguments give their exit codes.
+//! Against a ray-traced set, pis-diff and `pis-play --headless --compare` agree, and FLIP,
+//! FLIP maps and the PSNR gates are reported (GPU tests: lavapipe; without an adapter they
+//! skip locally and fail when `CI=true`).
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
@@ -13,8 +16,17 @@ fn repo(rel: &str) -> PathBuf {
 /// demo1 traced at 40×30, 1 spp, packed with the wavelet codec at ratio 24 and 32-texel
 /// textures, once for every test.
 fn packed() -> &'static Path {
-    static PACK: OnceLock<(tempfile::TempDir, PathBuf)> = OnceLock::new();
-    &PACK.get_or_init(|| {
+    &fixture().2
+}
+
+/// The ray-traced set the pack was made from.
+fn set() -> &'static Path {
+    &fixture().1
+}
+
+fn fixture() -> &'static (tempfile::TempDir, PathBuf, PathBuf) {
+    static PACK: OnceLock<(tempfile::TempDir, PathBuf, PathBuf)> = OnceLock::new();
+    PACK.get_or_init(|| {
         let dir = tempfile::tempdir().expect("temp dir");
         let set = dir.path().join("set");
         let out = Command::new(env!("CARGO_BIN_EXE_pis-trace"))
@@ -26,8 +38,8 @@ fn packed() -> &'static Path {
             .arg(&set).arg("--scene").arg(repo("samples/demo1/scene.toml")).arg("-o").arg(&file)
             .args(["--ratio", "24", "--max-texture", "32"]).output().expect("pis-pack runs");
         assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
-        (dir, file)
-    }).1
+        (dir, set, file)
+    })
 }
 
 fn diff(a: &Path, b: &Path, args: &[&str]) -> Output {
@@ -192,4 +204,73 @@ fn bad_arguments_and_missing_files() {
     let out = diff(&tiny, Path::new("/no/such/file.pis"), &[]);
     assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("/no/such/file.pis"));
+}
+
+/// pis-diff against the set, or `None` (printed) when there is no GPU adapter outside CI.
+fn diff_with_set_or_skip(test: &str, args: &[&str]) -> Option<Output> {
+    let out = diff(packed(), set(), args);
+    if out.status.code() == Some(5) && !std::env::var("CI").is_ok_and(|v| v == "true") {
+        eprintln!("{test}: skipped: {}", String::from_utf8_lossy(&out.stderr));
+        return None;
+    }
+    Some(out)
+}
+
+#[test]
+fn against_the_set_pis_diff_and_pis_play_agree() {
+    let Some(out) = diff_with_set_or_skip("against_the_set_pis_diff_and_pis_play_agree", &["--json"]) else { return };
+    assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
+    let d = json(&out);
+    let play = Command::new(env!("CARGO_BIN_EXE_pis-play")).arg(packed()).arg("--headless").arg("--compare").arg(set()).arg("--json").output().expect("pis-play runs");
+    assert!(play.status.success(), "{}", String::from_utf8_lossy(&play.stderr));
+    let p = json(&play);
+    let close = |a: &serde_json::Value, b: &serde_json::Value, what: &str| {
+        let (a, b) = (a.as_f64().unwrap_or_else(|| panic!("{what}: {a}")), b.as_f64().unwrap_or_else(|| panic!("{what}: {b}")));
+        assert!((a - b).abs() <= 0.1, "{what}: pis-diff {a} dB, pis-play {b} dB");
+    };
+    close(&d["psnr_db"], &p["psnr_db"], "whole image");
+    close(&d["covered_psnr_db"], &p["covered_psnr_db"], "covered pixels");
+    let objects = d["objects"].as_array().expect("objects");
+    assert!(!objects.is_empty());
+    for o in objects {
+        let q = p["objects"].as_array().expect("objects").iter().find(|q| q["name"] == o["name"]).expect("the same objects");
+        close(&o["psnr_db"], &q["psnr_db"], o["name"].as_str().unwrap_or("object"));
+        let f = o["flip_mean"].as_f64().expect("object FLIP");
+        assert!(f > 0.0 && f < 1.0, "{o}");
+        assert!(!o["blocks"].as_array().expect("blocks").is_empty());
+    }
+    let f = d["flip_mean"].as_f64().expect("FLIP");
+    assert!(f > 0.0 && f < 1.0, "mean FLIP {f}");
+    let points = d["points"].as_array().expect("points");
+    assert_eq!(points.len(), p["points"].as_array().expect("points").len());
+    for pt in points {
+        assert!(pt["psnr_db"].as_f64().is_some() && pt["flip_mean"].as_f64().is_some(), "{pt}");
+    }
+}
+
+#[test]
+fn against_the_set_gates_and_flip_maps() {
+    let Some(out) = diff_with_set_or_skip("against_the_set_gates_and_flip_maps", &["--json"]) else { return };
+    let r = json(&out);
+    let (whole, covered) = (r["psnr_db"].as_f64().expect("PSNR"), r["covered_psnr_db"].as_f64().expect("covered"));
+    assert_eq!(r["verdict"], "measured");
+    let dir = tempfile::tempdir().expect("temp dir");
+    let maps = dir.path().join("flip");
+    let pass = diff(packed(), set(), &["--json", "--min-psnr", &format!("{}", whole - 0.5), "--heatmaps", maps.to_str().expect("utf-8")]);
+    assert_eq!(pass.status.code(), Some(0), "{}", String::from_utf8_lossy(&pass.stderr));
+    let written = json(&pass)["heatmaps"].as_array().expect("heatmaps").len();
+    assert_eq!(written, r["points"].as_array().expect("points").len());
+    assert_eq!(std::fs::read_dir(&maps).expect("maps").count(), written);
+    assert_eq!(diff(packed(), set(), &["--min-psnr", &format!("{}", whole + 0.5)]).status.code(), Some(7));
+    // The drop is measured on the covered pixels against the reference.
+    let reference = format!("{}", covered + 1.0);
+    let within = diff(packed(), set(), &["--json", "--reference-psnr", &reference, "--max-psnr-drop", "1.5"]);
+    assert_eq!(within.status.code(), Some(0), "{}", String::from_utf8_lossy(&within.stderr));
+    let w = json(&within);
+    assert!((w["psnr_drop_db"].as_f64().expect("drop") - 1.0).abs() < 1e-6, "{w}");
+    assert_eq!(diff(packed(), set(), &["--reference-psnr", &reference, "--max-psnr-drop", "0.5"]).status.code(), Some(7));
+    // Without a recorded prediction the drop gate needs a reference.
+    let out = diff(packed(), set(), &["--max-psnr-drop", "1"]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("--reference-psnr"));
 }
