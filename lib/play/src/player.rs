@@ -191,7 +191,9 @@ impl Player {
         let filter = file_filter(reader.container());
         let decoder = Decoder::new(options.workers)?;
         let cache = LevelCache::new(options.cache_budget_bytes, options.lifetime_a, options.lifetime_b);
-        let pipes = FramePipelines::new(&gpu);
+        let mut pipes = FramePipelines::new(&gpu);
+        // Compiled now rather than in the first frame's time.
+        pipes.layer_pipeline(&gpu, offscreen_format(&gpu));
         let mips = MipBuilder::new(&gpu);
         Ok(Player {
             gpu,
