@@ -160,7 +160,7 @@ fn prepared(layer: &Layer<StreamRef>, layout: &LevelLayout, linear: &[f32], exac
     let mut start = 0;
     for (pi, s) in layout.planes().iter().enumerate() {
         let n = (s.width * s.height * s.channels) as usize;
-        if pi as u32 % layout.mips != 0 {
+        if !(pi as u32).is_multiple_of(layout.mips) {
             residual[start..start + n].iter_mut().for_each(|r| *r = true);
         }
         start += n;

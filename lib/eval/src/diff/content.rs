@@ -120,7 +120,7 @@ fn sample_error(layout: &LevelLayout, a: &[f32], b: &[f32], map: bool) -> Sample
         let mut start = 0usize;
         for (pi, p) in planes.iter().enumerate() {
             let n = (p.width * p.height * p.channels) as usize;
-            if pi as u32 % layout.mips == 0 {
+            if (pi as u32).is_multiple_of(layout.mips) {
                 let face = pi / layout.mips as usize;
                 for y in 0..h {
                     for x in 0..w {
