@@ -2,8 +2,10 @@
 //! each tool that are more than argument parsing.
 
 pub mod cli;
+pub mod diff;
 pub mod images;
 pub mod infer;
 pub mod inspect;
 pub mod pack;
 pub mod play;
+pub mod reencode;

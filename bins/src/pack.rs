@@ -18,6 +18,7 @@ mod encode;
 mod infer_layers;
 mod input;
 mod report;
+pub mod storage;
 
 use std::path::PathBuf;
 use std::time::Instant;

@@ -6,9 +6,9 @@
 use std::path::Path;
 
 use anyhow::{anyhow, Result};
-use pis_codec::allocate::{allocate, Item, Target, DEFAULT_ALPHA};
-use pis_codec::pyramid::{adaptive, l1_cost, level_image_index, PyramidFilter};
-use pis_codec::{CodecId, Rate};
+use pis_codec::allocate::Target;
+use pis_codec::pyramid::level_image_index;
+use pis_codec::CodecId;
 use pis_format::blocks::BlockGrid;
 use pis_format::mip::decimate;
 use pis_format::reconstruct::{finish, prepare};
@@ -16,6 +16,7 @@ use pis_format::*;
 
 use super::infer_layers::{key, ObjectModel};
 use super::input::LoadedSet;
+use super::storage::{allocate_storage, build_pyramid, encode_levels};
 use super::{PackRequest, Stages};
 use crate::cli::{Exit, Failure};
 
@@ -148,12 +149,14 @@ pub(crate) fn encode_all(set: &LoadedSet, models: &[ObjectModel], req: &PackRequ
     let runtime = |e: anyhow::Error| Failure::new(Exit::Runtime, e);
     let sizes = block_sizes(&req.block, set.scene.space.dims.len()).map_err(|e| Failure::new(Exit::Usage, e))?;
     let (space, cameras) = geometry(set, &sizes);
-    let codec = pis_codec::codec(req.codec).ok_or_else(|| runtime(anyhow!("codec {} is not in this build", req.codec)))?;
+    if pis_codec::codec(req.codec).is_none() {
+        return Err(runtime(anyhow!("codec {} is not in this build", req.codec)));
+    }
     let mut objects = Vec::new();
     let mut blocks_out = Vec::new();
     let mut staggers = Vec::new();
-    // Allocation items: (object model, layer, block, level, image) and their curves.
-    let mut items = Vec::new();
+    // Every block's pyramid, in (object model, layer, block) order, and where it goes.
+    let mut pyramids = Vec::new();
     let mut where_ = Vec::new();
     for (mi, m) in models.iter().enumerate() {
         let st = stagger(mi, models.len(), &sizes);
@@ -195,24 +198,10 @@ pub(crate) fn encode_all(set: &LoadedSet, models: &[ObjectModel], req: &PackRequ
                 if samples.iter().any(Vec::is_empty) {
                     return Err(runtime(anyhow!("object {} layer {} block {b}: a sample has no texture", m.name, il.kind.name())));
                 }
-                let (mut pyr, _) = adaptive(&extent, &samples, PyramidFilter::Gaussian, l1_cost).map_err(|e| runtime(e.into()))?;
-                if !req.codec.is_lossy() {
-                    exact_finest(&mut pyr, &samples, &extent);
-                }
-                let mut levels = Vec::new();
-                for (lv, level) in pyr.levels.iter().enumerate() {
-                    let mut members = vec![0usize; level.images.len()];
-                    for s in 0..count {
-                        members[level_image_index(&level.counts, &unflatten(s, &extent), &extent)] += 1;
-                    }
-                    for (ii, img) in level.images.iter().enumerate() {
-                        let curve = codec.rd_curve(&planes, img).map_err(|e| runtime(e.into()))?;
-                        items.push(Item { curve, object: mi, weight: members[ii] as f64 / layer_samples });
-                        where_.push((mi, li, b, lv, ii, planes.clone()));
-                    }
-                    levels.push((level.counts.clone(), level.images.clone(), vec![Vec::new(); level.images.len()]));
-                }
-                pblocks.push(PackedBlock { extent, keys, levels });
+                let pyramid = build_pyramid(mi, planes, &extent, &samples, layer_samples, !req.codec.is_lossy()).map_err(runtime)?;
+                pyramids.push(pyramid);
+                where_.push((mi, li, b));
+                pblocks.push(PackedBlock { extent, keys, levels: vec![] });
                 layer.blocks.push(block);
             }
             layers.push(layer);
@@ -230,7 +219,8 @@ pub(crate) fn encode_all(set: &LoadedSet, models: &[ObjectModel], req: &PackRequ
         blocks_out.push(layer_blocks);
         staggers.push(st);
     }
-    stages.done("pyramid", &format!("{} level images in adaptive pyramids", items.len()));
+    let level_images: usize = pyramids.iter().flat_map(|p| &p.levels).map(|l| l.1.len()).sum();
+    stages.done("pyramid", &format!("{level_images} level images in adaptive pyramids"));
 
     let raw = set.raw_image_bytes();
     let settings = vec![
@@ -256,97 +246,47 @@ pub(crate) fn encode_all(set: &LoadedSet, models: &[ObjectModel], req: &PackRequ
         }),
     };
     // Level lists with empty codestreams: the bytes everything but the images takes.
+    let mut next = 0;
     for (o, ob) in container.objects.iter_mut().enumerate() {
         for (l, layer) in ob.layers.iter_mut().enumerate() {
             for (b, block) in layer.blocks.iter_mut().enumerate() {
-                block.levels = blocks_out[o][l][b].levels.iter().map(|(c, imgs, _)| Level {
+                // Blocks come in the order their pyramids were built.
+                debug_assert_eq!(where_[next], (o, l, b));
+                block.levels = pyramids[next].levels.iter().map(|(c, imgs, _)| Level {
                     counts: c.clone(),
                     images: imgs.iter().map(|_| Codestream { codec: req.codec, bytes: vec![] }).collect(),
                 }).collect();
+                next += 1;
             }
         }
     }
     let overhead = pis_format::to_bytes_unchecked(&container).len();
 
-    let rates: Vec<Rate> = if req.codec.is_lossy() {
-        let target = match (req.ratio, req.psnr) {
-            (_, Some(db)) => Target::Psnr { db, peak: 1.0 },
-            (r, None) => {
-                // The ratio counts level images against the raw images (thesis 4.8);
-                // geometry and tables come on top and are reported apart.
-                Target::Bytes((raw as f64 / r.unwrap_or(super::DEFAULT_RATIO)) as usize)
-            }
-        };
-        let areas: Vec<f64> = models.iter().map(|m| m.area).collect();
-        let a = allocate(&items, &areas, target, Some(DEFAULT_ALPHA)).map_err(|e| runtime(e.into()))?;
-        stages.done("allocate", &format!("{} bytes over {} level images", a.total_bytes, items.len()));
-        a.bytes.into_iter().map(Rate::Bytes).collect()
-    } else {
-        vec![Rate::Default; items.len()]
+    let target = match (req.ratio, req.psnr) {
+        (_, Some(db)) => Target::Psnr { db, peak: 1.0 },
+        // The ratio counts level images against the raw images (thesis 4.8); geometry and
+        // tables come on top and are reported apart.
+        (r, None) => Target::Bytes((raw as f64 / r.unwrap_or(super::DEFAULT_RATIO)) as usize),
     };
-    let mut layer_bytes: Vec<Vec<usize>> = models.iter().map(|m| vec![0; m.layers.len()]).collect();
-    for ((mi, li, b, lv, ii, planes), rate) in where_.iter().zip(rates) {
-        let level = &mut blocks_out[*mi][*li][*b].levels[*lv];
-        let bytes = codec.encode(planes, &level.1[*ii], rate).map_err(|e| runtime(e.into()))?;
-        layer_bytes[*mi][*li] += bytes.len();
-        container.objects[*mi].layers[*li].blocks[*b].levels[*lv].images[*ii].bytes = bytes.clone();
-        level.2[*ii] = bytes;
+    let areas: Vec<f64> = models.iter().map(|m| m.area).collect();
+    let storage = allocate_storage(&pyramids, req.codec, target, &areas).map_err(runtime)?;
+    if let Some(total) = storage.allocated {
+        stages.done("allocate", &format!("{total} bytes over {} level images", storage.level_images));
     }
-    stages.done("encode", &format!("{} level images with {}", where_.len(), req.codec));
-    Ok(Packed { container, blocks: blocks_out, overhead, layer_bytes, stagger: staggers })
-}
-
-/// Makes the finest level's residuals such that the decoder's f32 sum of the levels, top
-/// first, gives back every sample bit for bit: the residual `x − s` is nudged by a few ulps
-/// where rounding loses it; where no nudge works, the block falls back to a zero top level
-/// and the samples themselves.
-pub(crate) fn exact_finest(pyr: &mut pis_codec::pyramid::Pyramid, samples: &[Vec<f32>], extent: &[u32]) {
-    let n_levels = pyr.levels.len();
-    let ok = (|| {
-        let (coarse, finest) = pyr.levels.split_at_mut(n_levels.checked_sub(1)?);
-        let finest = finest.first_mut()?;
-        for (si, x) in samples.iter().enumerate() {
-            let local = unflatten(si, extent);
-            let mut sum = vec![0.0f32; x.len()];
-            for l in coarse.iter() {
-                let img = &l.images[level_image_index(&l.counts, &local, extent)];
-                sum.iter_mut().zip(img).for_each(|(a, v)| *a += v);
-            }
-            let fi = level_image_index(&finest.counts, &local, extent);
-            let r = &mut finest.images[fi];
-            for ((rv, &sv), &xv) in r.iter_mut().zip(&sum).zip(x) {
-                let mut c = xv - sv;
-                let mut k: i32 = 0;
-                while (sv + c).to_bits() != xv.to_bits() {
-                    k += 1;
-                    if k > 16 {
-                        return None;
-                    }
-                    let step: i32 = (k + 1) / 2;
-                    let base = xv - sv;
-                    c = if k % 2 == 1 { nudge(base, step) } else { nudge(base, -step) };
-                }
-                *rv = c;
+    encode_levels(&mut pyramids, req.codec, &storage).map_err(runtime)?;
+    let mut layer_bytes: Vec<Vec<usize>> = models.iter().map(|m| vec![0; m.layers.len()]).collect();
+    for ((mi, li, b), pyramid) in where_.iter().zip(pyramids) {
+        let block = &mut container.objects[*mi].layers[*li].blocks[*b];
+        for (level, (_, _, streams)) in block.levels.iter_mut().zip(&pyramid.levels) {
+            for (image, bytes) in level.images.iter_mut().zip(streams) {
+                layer_bytes[*mi][*li] += bytes.len();
+                image.bytes = bytes.clone();
             }
         }
-        Some(())
-    })();
-    if ok.is_none() && extent.iter().any(|&e| e > 1) {
-        let ones = vec![1u32; extent.len()];
-        let n = samples.first().map_or(0, Vec::len);
-        pyr.levels = vec![
-            pis_codec::pyramid::PyramidLevel { counts: ones, images: vec![vec![0.0; n]] },
-            pis_codec::pyramid::PyramidLevel { counts: extent.to_vec(), images: samples.to_vec() },
-        ];
+        blocks_out[*mi][*li][*b].levels = pyramid.levels;
     }
-}
-
-fn nudge(v: f32, ulps: i32) -> f32 {
-    let mut x = v;
-    for _ in 0..ulps.unsigned_abs() {
-        x = if ulps > 0 { x.next_up() } else { x.next_down() };
-    }
-    x
+    stages.done("encode", &format!("{level_images} level images with {}", req.codec));
+    Ok(Packed { container, blocks: blocks_out, overhead, layer_bytes, stagger: staggers })
 }
 
 /// Decoded linear textures (whole MIP chain, rebuilt by decimation as the player does), per

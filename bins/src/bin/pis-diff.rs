@@ -1,0 +1,80 @@
+//! pis-diff: how two .pis files differ, in structure and in the textures they decode to.
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use clap::Parser;
+use pis::cli::{self, Exit, Failure};
+use pis::diff::gold::{gold, GoldRequest};
+use pis::diff::{diff, render, DiffRequest};
+
+/// Compare two .pis files: structural differences (parameter space, cameras, objects, layers,
+/// shells, blocks, pyramid levels, codecs, settings, provenance; bytes per chunk kind) and
+/// content differences (both decoded at every parameter sample: MSE, PSNR and largest error
+/// per object, layer and parameter block, and the whole file's PSNR, on display values).
+/// Says "identical" when both decode to the same textures with the same structure.
+///
+/// With a ray-traced set folder as the second argument, measures the file against the gold
+/// standard instead: every sample point drawn through the player's offscreen path and
+/// compared with the set's image (the comparison `pis-play --headless --compare` prints):
+/// PSNR per point, object and parameter block, and NVIDIA FLIP on the sRGB images (mean per
+/// image, per object and overall); --heatmaps writes FLIP error maps per point.
+#[derive(Parser, Debug)]
+#[command(name = "pis-diff", version, after_help = "Exit codes: 0 identical or within the gates, 1 bad arguments, 2 I/O error, 3 invalid file, 4 runtime error, 5 not supported, 7 the files differ (no gate given) or a gate failed")]
+struct Cli {
+    /// The first .pis file (the reference).
+    a: PathBuf,
+    /// The second .pis file, or a ray-traced set folder (gold-standard comparison).
+    b: PathBuf,
+    /// Print the report as JSON on stdout.
+    #[arg(long)]
+    json: bool,
+    /// Write one error heatmap (PNG, RMS display error per texel over all samples, faces
+    /// side by side) per object and layer into DIR.
+    #[arg(long, value_name = "DIR")]
+    heatmaps: Option<PathBuf>,
+    /// Gate: pass (exit 0) when the whole-file PSNR is at least DB, else exit 7.
+    #[arg(long, value_name = "DB", allow_hyphen_values = true)]
+    min_psnr: Option<f64>,
+    /// Gate against a gold-standard set: fail when the PSNR is more than DB below the
+    /// reference: the file's recorded prediction (provenance setting predicted_psnr_db) or
+    /// --reference-psnr. Needs a set folder as the second argument.
+    #[arg(long, value_name = "DB", allow_hyphen_values = true)]
+    max_psnr_drop: Option<f64>,
+    /// The reference PSNR of --max-psnr-drop (dB), e.g. pis-pack's predicted PSNR.
+    #[arg(long, value_name = "DB", allow_hyphen_values = true)]
+    reference_psnr: Option<f64>,
+}
+
+fn run(cli: Cli) -> Result<Exit, Failure> {
+    if cli.b.is_dir() {
+        let req = GoldRequest { file: cli.a, set: cli.b, heatmaps: cli.heatmaps, min_psnr: cli.min_psnr, max_psnr_drop: cli.max_psnr_drop, reference_psnr: cli.reference_psnr };
+        let report = gold(&req)?;
+        if cli.json {
+            let s = serde_json::to_string_pretty(&report).map_err(|e| Failure::new(Exit::Runtime, e))?;
+            println!("{s}");
+        } else {
+            print!("{}", pis::diff::gold::render(&report));
+        }
+        return Ok(report.exit());
+    }
+    if cli.max_psnr_drop.is_some() || cli.reference_psnr.is_some() {
+        return Err(Failure::new(Exit::Usage, anyhow::anyhow!("--max-psnr-drop compares with a gold-standard set: give a set folder as the second argument")));
+    }
+    let req = DiffRequest { a: cli.a, b: cli.b, heatmaps: cli.heatmaps, min_psnr: cli.min_psnr };
+    let report = diff(&req)?;
+    if cli.json {
+        let s = serde_json::to_string_pretty(&report).map_err(|e| Failure::new(Exit::Runtime, e))?;
+        println!("{s}");
+    } else {
+        print!("{}", render(&report));
+    }
+    Ok(report.exit())
+}
+
+fn main() -> ExitCode {
+    match cli::parse::<Cli>() {
+        Ok(c) => cli::finish("pis-diff", run(c)),
+        Err(code) => code,
+    }
+}

@@ -1,0 +1,170 @@
+//! Level images and the storage they get: the adaptive Laplacian pyramid of one parameter
+//! block (thesis 4.3), equal-slope storage allocation over every level image of every block,
+//! layer and object with screen-area weights (4.5), and the encoding at the allocated rates.
+//! `pis-pack` and `pis-reencode` code their textures through here.
+
+use anyhow::{anyhow, Result};
+use pis_codec::allocate::{allocate, Item, Target, DEFAULT_ALPHA};
+use pis_codec::pyramid::{adaptive, l1_cost, level_image_index, Pyramid, PyramidFilter, PyramidLevel};
+use pis_codec::{CodecId, PlaneShape, Rate};
+use rayon::prelude::*;
+
+use super::encode::CodedLevel;
+
+/// One parameter block's pyramid, ready to be allocated and encoded.
+pub struct BlockPyramid {
+    /// The object the block belongs to: an index into the allocation's screen areas.
+    pub object: usize,
+    pub planes: Vec<PlaneShape>,
+    pub extent: Vec<u32>,
+    /// Finest samples of the block's layer over all its blocks: a level image's weight in
+    /// its object's error is the share of these samples it reaches.
+    pub layer_samples: f64,
+    /// Per level, top first: counts, images as encoded, codestreams (empty until encoded).
+    pub levels: Vec<CodedLevel>,
+}
+
+/// Builds the adaptive pyramid of a block's finest samples (gamma-compensated, row-major over
+/// `extent`). With `exact` (lossless and raw codecs) the finest level is adjusted so that the
+/// decoder's sum gives every sample back bit for bit.
+pub fn build_pyramid(object: usize, planes: Vec<PlaneShape>, extent: &[u32], samples: &[Vec<f32>], layer_samples: f64, exact: bool) -> Result<BlockPyramid> {
+    let (mut pyr, _) = adaptive(extent, samples, PyramidFilter::Gaussian, l1_cost)?;
+    if exact {
+        exact_finest(&mut pyr, samples, extent);
+    }
+    let levels = pyr.levels.into_iter().map(|l| {
+        let n = l.images.len();
+        (l.counts, l.images, vec![Vec::new(); n])
+    }).collect();
+    Ok(BlockPyramid { object, planes, extent: extent.to_vec(), layer_samples, levels })
+}
+
+/// What the allocation gave: bytes per level image (in block, level, image order), or the
+/// codec's default rate for exact codecs.
+pub struct Storage {
+    pub rates: Vec<Rate>,
+    /// Bytes the allocation spends (lossy codecs).
+    pub allocated: Option<usize>,
+    pub level_images: usize,
+}
+
+fn unflatten(mut i: usize, extent: &[u32]) -> Vec<u32> {
+    let mut out = vec![0; extent.len()];
+    for k in (0..extent.len()).rev() {
+        out[k] = (i % extent[k] as usize) as u32;
+        i /= extent[k] as usize;
+    }
+    out
+}
+
+/// Equal-slope allocation (thesis 4.5) over every level image of `blocks` for a lossy
+/// `codec`: each level image's rate–distortion curve, weighted by the share of its layer's
+/// samples it reaches and by its object's screen area `areas[object]`, with the max-MSE
+/// constraint [`DEFAULT_ALPHA`]. Exact codecs need no allocation.
+pub fn allocate_storage(blocks: &[BlockPyramid], codec: CodecId, target: Target, areas: &[f64]) -> Result<Storage> {
+    let refs: Vec<(usize, usize, usize)> = blocks.iter().enumerate()
+        .flat_map(|(b, pb)| pb.levels.iter().enumerate().flat_map(move |(lv, l)| (0..l.1.len()).map(move |ii| (b, lv, ii))))
+        .collect();
+    if !codec.is_lossy() {
+        return Ok(Storage { rates: vec![Rate::Default; refs.len()], allocated: None, level_images: refs.len() });
+    }
+    let c = pis_codec::codec(codec).ok_or_else(|| anyhow!("codec {codec} is not in this build"))?;
+    // How many finest samples each level image reaches.
+    let members: Vec<Vec<Vec<usize>>> = blocks.iter().map(|pb| {
+        let count: usize = pb.extent.iter().map(|&e| e as usize).product();
+        pb.levels.iter().map(|(counts, images, _)| {
+            let mut m = vec![0usize; images.len()];
+            for s in 0..count {
+                m[level_image_index(counts, &unflatten(s, &pb.extent), &pb.extent)] += 1;
+            }
+            m
+        }).collect()
+    }).collect();
+    let items = refs.par_iter().map(|&(b, lv, ii)| {
+        let pb = &blocks[b];
+        let curve = c.rd_curve(&pb.planes, &pb.levels[lv].1[ii])?;
+        Ok(Item { curve, object: pb.object, weight: members[b][lv][ii] as f64 / pb.layer_samples })
+    }).collect::<Result<Vec<Item>, pis_codec::CodecError>>()?;
+    let a = allocate(&items, areas, target, Some(DEFAULT_ALPHA))?;
+    Ok(Storage { rates: a.bytes.into_iter().map(Rate::Bytes).collect(), allocated: Some(a.total_bytes), level_images: refs.len() })
+}
+
+/// Encodes every level image of `blocks` at its allocated rate into the blocks' codestream
+/// slots; returns the bytes written.
+pub fn encode_levels(blocks: &mut [BlockPyramid], codec: CodecId, storage: &Storage) -> Result<usize> {
+    let c = pis_codec::codec(codec).ok_or_else(|| anyhow!("codec {codec} is not in this build"))?;
+    let mut rates = storage.rates.iter();
+    let mut jobs = Vec::new();
+    for (b, pb) in blocks.iter().enumerate() {
+        for (lv, l) in pb.levels.iter().enumerate() {
+            for ii in 0..l.1.len() {
+                let rate = *rates.next().ok_or_else(|| anyhow!("fewer rates than level images"))?;
+                jobs.push((b, lv, ii, rate));
+            }
+        }
+    }
+    let streams = jobs.par_iter().map(|&(b, lv, ii, rate)| {
+        let pb = &blocks[b];
+        c.encode(&pb.planes, &pb.levels[lv].1[ii], rate)
+    }).collect::<Result<Vec<Vec<u8>>, pis_codec::CodecError>>()?;
+    let mut total = 0;
+    for ((b, lv, ii, _), bytes) in jobs.into_iter().zip(streams) {
+        total += bytes.len();
+        blocks[b].levels[lv].2[ii] = bytes;
+    }
+    Ok(total)
+}
+
+/// Makes the finest level's residuals such that the decoder's f32 sum of the levels, top
+/// first, gives back every sample bit for bit: the residual `x − s` is nudged by a few ulps
+/// where rounding loses it; where no nudge works, the block falls back to a zero top level
+/// and the samples themselves.
+pub(crate) fn exact_finest(pyr: &mut Pyramid, samples: &[Vec<f32>], extent: &[u32]) {
+    let n_levels = pyr.levels.len();
+    let ok = (|| {
+        let (coarse, finest) = pyr.levels.split_at_mut(n_levels.checked_sub(1)?);
+        let finest = finest.first_mut()?;
+        for (si, x) in samples.iter().enumerate() {
+            let local = unflatten(si, extent);
+            let mut sum = vec![0.0f32; x.len()];
+            for l in coarse.iter() {
+                let img = &l.images[level_image_index(&l.counts, &local, extent)];
+                sum.iter_mut().zip(img).for_each(|(a, v)| *a += v);
+            }
+            let fi = level_image_index(&finest.counts, &local, extent);
+            let r = &mut finest.images[fi];
+            for ((rv, &sv), &xv) in r.iter_mut().zip(&sum).zip(x) {
+                let mut c = xv - sv;
+                let mut k: i32 = 0;
+                while (sv + c).to_bits() != xv.to_bits() {
+                    k += 1;
+                    if k > 16 {
+                        return None;
+                    }
+                    let step: i32 = (k + 1) / 2;
+                    let base = xv - sv;
+                    c = if k % 2 == 1 { nudge(base, step) } else { nudge(base, -step) };
+                }
+                *rv = c;
+            }
+        }
+        Some(())
+    })();
+    if ok.is_none() && extent.iter().any(|&e| e > 1) {
+        let ones = vec![1u32; extent.len()];
+        let n = samples.first().map_or(0, Vec::len);
+        pyr.levels = vec![
+            PyramidLevel { counts: ones, images: vec![vec![0.0; n]] },
+            PyramidLevel { counts: extent.to_vec(), images: samples.to_vec() },
+        ];
+    }
+}
+
+/// `v` moved by `ulps` representable steps (up when positive).
+pub(crate) fn nudge(v: f32, ulps: i32) -> f32 {
+    let mut x = v;
+    for _ in 0..ulps.unsigned_abs() {
+        x = if ulps > 0 { x.next_up() } else { x.next_down() };
+    }
+    x
+}

@@ -1,0 +1,397 @@
+//! `pis-reencode`: a container's textures coded again, with another codec, rate or gamma.
+//!
+//! Every parameter block of every layer is decoded at all its samples; the linear textures
+//! are gamma-compensated again (thesis 4.6), built into new adaptive Laplacian pyramids
+//! (4.3), given storage by the equal-slope allocation `pis-pack` uses over all level images
+//! of all blocks, layers and objects, weighted by screen area (4.5), and encoded. Geometry,
+//! cameras, the parameter space, block origins and placements are copied. The output is
+//! written atomically, read back and compared with the input's decoded textures.
+
+mod screen_area;
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use anyhow::anyhow;
+use pis_codec::allocate::Target;
+use pis_codec::CodecId;
+use pis_eval::diff::decode::decode_block;
+use pis_format::reconstruct::{finish, prepare};
+use pis_format::*;
+use rayon::prelude::*;
+use serde::Serialize;
+
+pub use screen_area::screen_areas;
+
+use crate::cli::{Exit, Failure};
+use crate::pack::storage::{allocate_storage, build_pyramid, encode_levels, nudge, BlockPyramid};
+
+/// What to re-encode.
+#[derive(Clone, Debug)]
+pub struct ReencodeRequest {
+    pub input: PathBuf,
+    pub output: PathBuf,
+    pub codec: CodecId,
+    /// Target compression ratio: level-image bytes = raw image bytes / ratio.
+    pub ratio: Option<f64>,
+    /// Target PSNR (dB) of the stored textures instead of a ratio.
+    pub psnr: Option<f64>,
+    /// Gamma of the compensation (lossy codecs; default [`DEFAULT_GAMMA`]).
+    pub gamma: Option<f32>,
+}
+
+/// The gamma lossy re-encodings use unless told otherwise (as `pis-pack`).
+pub const DEFAULT_GAMMA: f32 = 2.2;
+
+/// One object's part of the report.
+#[derive(Clone, Debug, Serialize)]
+pub struct ObjectReport {
+    pub name: String,
+    pub bytes_before: u64,
+    pub bytes_after: u64,
+    /// PSNR of the re-encoded textures against the input's decoded textures (display
+    /// values, every parameter point); null when they are identical.
+    pub psnr_db: Option<f64>,
+    pub mse: f64,
+    pub max_error: f64,
+    pub exact: bool,
+    /// Mean covered pixels per point: the allocation's screen-area weight (lossy codecs).
+    pub area_px: Option<f64>,
+}
+
+/// The report (`--json` prints it).
+#[derive(Clone, Debug, Serialize)]
+pub struct ReencodeReport {
+    pub input: String,
+    pub output: String,
+    /// The input's codecs, by name.
+    pub codecs_before: Vec<String>,
+    pub codec: String,
+    pub gamma: f32,
+    pub target: String,
+    pub bytes_before: u64,
+    pub bytes_after: u64,
+    /// Level-image bytes.
+    pub texture_bytes_before: u64,
+    pub texture_bytes_after: u64,
+    pub raw_image_bytes: u64,
+    /// Raw image bytes over file bytes.
+    pub ratio_before: f64,
+    pub ratio_after: f64,
+    /// Raw image bytes over level-image bytes.
+    pub ratio_without_geometry_before: f64,
+    pub ratio_without_geometry_after: f64,
+    /// Whole-file texture PSNR of the output against the input's decoded textures; null when
+    /// identical.
+    pub psnr_db: Option<f64>,
+    pub mse: f64,
+    pub max_error: f64,
+    /// The output decodes to exactly the input's textures.
+    pub exact: bool,
+    pub level_images: usize,
+    pub objects: Vec<ObjectReport>,
+    pub stage_ms: BTreeMap<String, f64>,
+}
+
+/// Opens a container, naming the file in any error.
+pub fn open(path: &Path) -> Result<PisReader, Failure> {
+    PisReader::open(path).map_err(|e| in_file(path, e))
+}
+
+/// A reader error as a failure that names the file once.
+pub fn in_file(path: &Path, e: Error) -> Failure {
+    let msg = match &e {
+        Error::Io { .. } => e.to_string(),
+        _ => format!("{}: {e}", path.display()),
+    };
+    Failure::new(Failure::from(e).exit, anyhow!(msg))
+}
+
+fn usage(msg: String) -> Failure {
+    Failure::new(Exit::Usage, anyhow!(msg))
+}
+
+/// Checks the request before anything is read.
+fn check(req: &ReencodeRequest) -> Result<(), Failure> {
+    if req.ratio.is_some() && req.psnr.is_some() {
+        return Err(usage("give --ratio or --psnr, not both".into()));
+    }
+    if let Some(r) = req.ratio {
+        if !(r.is_finite() && r >= 1.0) {
+            return Err(usage(format!("--ratio must be at least 1, got {r}")));
+        }
+    }
+    if let Some(p) = req.psnr {
+        if !(p.is_finite() && p > 0.0) {
+            return Err(usage(format!("--psnr must be a positive number of dB, got {p}")));
+        }
+    }
+    if let Some(g) = req.gamma {
+        if !(g.is_finite() && g > 0.0) {
+            return Err(usage(format!("--gamma must be positive, got {g}")));
+        }
+    }
+    if !req.codec.is_lossy() {
+        if req.ratio.is_some() || req.psnr.is_some() {
+            return Err(usage(format!("--ratio and --psnr apply to the lossy codecs; {} stores textures exactly", req.codec)));
+        }
+        if req.gamma.is_some_and(|g| g != 1.0) {
+            return Err(usage(format!("{} stores linear textures exactly: --gamma must be 1", req.codec)));
+        }
+    }
+    let parent = req.output.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
+    if !parent.is_dir() {
+        return Err(Failure::new(Exit::Io, anyhow!("the output folder {} does not exist", parent.display())));
+    }
+    Ok(())
+}
+
+/// Gamma-compensated values of a linear texture for `layer`; for exact codecs (gamma 1) the
+/// stored MIP residuals are nudged so that the reader's `residual + decimate(finest)` gives
+/// every linear value back bit for bit.
+fn prepared(layer: &Layer<StreamRef>, layout: &LevelLayout, linear: &[f32], exact: bool) -> Vec<f32> {
+    let mut p = prepare(layer, layout, linear);
+    if !(exact && layer.mip_mode == MipMode::Stored && layout.mips > 1) {
+        return p;
+    }
+    // Which values are MIP residuals (planes below the finest of each face).
+    let mut residual = vec![false; p.len()];
+    let mut start = 0;
+    for (pi, s) in layout.planes().iter().enumerate() {
+        let n = (s.width * s.height * s.channels) as usize;
+        if !(pi as u32).is_multiple_of(layout.mips) {
+            residual[start..start + n].iter_mut().for_each(|r| *r = true);
+        }
+        start += n;
+    }
+    let base: Vec<f32> = p.iter().zip(&residual).map(|(&v, &r)| if r { 0.0 } else { v }).collect();
+    let decimated = finish(layer, layout, base);
+    for i in (0..p.len()).filter(|&i| residual[i]) {
+        let (d, x) = (decimated[i], linear[i]);
+        for k in 0..=32 {
+            let c = nudge(x - d, if k % 2 == 1 { (k + 1) / 2 } else { -(k / 2) });
+            if (c + d).to_bits() == x.to_bits() {
+                p[i] = c;
+                break;
+            }
+        }
+    }
+    p
+}
+
+struct Timer(Vec<(String, f64)>, Instant);
+
+impl Timer {
+    fn done(&mut self, name: &str, what: &str) {
+        let ms = self.1.elapsed().as_secs_f64() * 1e3;
+        eprintln!("pis-reencode: {name:<9} {ms:8.0} ms  {what}");
+        self.0.push((name.to_string(), ms));
+        self.1 = Instant::now();
+    }
+}
+
+fn stream_bytes<S>(o: &Object<S>, len: impl Fn(&S) -> u64) -> u64 {
+    o.layers.iter().flat_map(|l| &l.blocks).flat_map(|b| &b.levels).flat_map(|l| &l.images).map(len).sum()
+}
+
+/// Re-encodes `req.input` into `req.output`; on error no output file is left.
+pub fn reencode(req: &ReencodeRequest) -> Result<ReencodeReport, Failure> {
+    check(req)?;
+    let runtime = |e: anyhow::Error| Failure::new(Exit::Runtime, e);
+    let mut t = Timer(Vec::new(), Instant::now());
+    let input = open(&req.input)?;
+    let c = input.container();
+    let exact = !req.codec.is_lossy();
+    let gamma = if exact { 1.0 } else { req.gamma.unwrap_or(DEFAULT_GAMMA) };
+    let texture_bytes_before: u64 = c.objects.iter().map(|o| stream_bytes(o, |s| s.length as u64)).sum();
+    let raw = c.provenance.as_ref().map(|p| p.raw_image_bytes).filter(|&b| b > 0)
+        .unwrap_or(c.space.point_count() * c.cameras.width as u64 * c.cameras.height as u64 * 3);
+
+    // Decode every block, compensate gamma again, build its pyramid.
+    let mut pyramids: Vec<BlockPyramid> = Vec::new();
+    let mut layers_out = Vec::new();
+    for (oi, o) in c.objects.iter().enumerate() {
+        let mut per_layer = Vec::new();
+        for (li, l) in o.layers.iter().enumerate() {
+            let mut layer = l.clone();
+            layer.gamma = gamma;
+            let layer_samples = c.space.table_len(l.depends_on).max(1) as f64;
+            let blocks = (0..l.blocks.len()).into_par_iter().map(|bi| {
+                let block = decode_block(&input, oi, li, bi).map_err(|e| in_file(&req.input, e))?;
+                let samples: Vec<Vec<f32>> = block.textures.par_iter().map(|x| prepared(&layer, &block.layout, x, exact)).collect();
+                build_pyramid(oi, block.layout.planes(), &block.extent, &samples, layer_samples, exact).map_err(runtime)
+            }).collect::<Result<Vec<BlockPyramid>, Failure>>()?;
+            pyramids.extend(blocks);
+            per_layer.push(layer.gamma);
+        }
+        layers_out.push(per_layer);
+    }
+    let level_images: usize = pyramids.iter().flat_map(|p| &p.levels).map(|l| l.1.len()).sum();
+    t.done("pyramid", &format!("{} blocks decoded, {level_images} level images in adaptive pyramids", pyramids.len()));
+
+    let (target, target_text) = match (req.psnr, req.ratio) {
+        _ if exact => (Target::Bytes(usize::MAX), "exact".to_string()),
+        (Some(db), _) => (Target::Psnr { db, peak: 1.0 }, format!("psnr {db} dB")),
+        (None, Some(r)) => (Target::Bytes((raw as f64 / r) as usize), format!("ratio {r}")),
+        (None, None) => (Target::Bytes(texture_bytes_before as usize), format!("bytes {texture_bytes_before}")),
+    };
+    let areas = if exact { None } else {
+        let a = screen_areas(c);
+        t.done("areas", &format!("screen areas of {} objects over {} points", a.len(), c.space.point_count()));
+        Some(a)
+    };
+    let storage = allocate_storage(&pyramids, req.codec, target, areas.as_deref().unwrap_or(&[])).map_err(runtime)?;
+    if let Some(total) = storage.allocated {
+        t.done("allocate", &format!("{total} bytes over {level_images} level images"));
+    }
+    let texture_bytes_after = encode_levels(&mut pyramids, req.codec, &storage).map_err(runtime)? as u64;
+    t.done("encode", &format!("{level_images} level images with {}", req.codec));
+
+    // The container: everything copied but gamma and pyramids.
+    let mut out: Container = c.try_map(&mut |_| Ok::<_, Error>(Codestream { codec: req.codec, bytes: vec![] })).map_err(Failure::from)?;
+    let mut next = pyramids.into_iter();
+    for (o, gammas) in out.objects.iter_mut().zip(&layers_out) {
+        for (l, &g) in o.layers.iter_mut().zip(gammas) {
+            l.gamma = g;
+            for b in &mut l.blocks {
+                let p = next.next().ok_or_else(|| runtime(anyhow!("fewer pyramids than blocks")))?;
+                b.levels = p.levels.into_iter().map(|(counts, _, streams)| Level {
+                    counts,
+                    images: streams.into_iter().map(|bytes| Codestream { codec: req.codec, bytes }).collect(),
+                }).collect();
+            }
+        }
+    }
+    let before = c.provenance.clone().unwrap_or_default();
+    let mut settings: Vec<(String, String)> = before.settings.iter()
+        .filter(|(k, _)| !matches!(k.as_str(), "codec" | "gamma" | "target" | "reencoded_from" | "source_tool" | "source_codec"))
+        .cloned().collect();
+    let codecs_before: Vec<String> = {
+        let mut v: Vec<String> = c.objects.iter().flat_map(|o| &o.layers).flat_map(|l| &l.blocks).flat_map(|b| &b.levels)
+            .flat_map(|l| &l.images).map(|s| s.codec.name().to_string()).collect();
+        v.sort();
+        v.dedup();
+        v
+    };
+    settings.extend([
+        ("codec".to_string(), req.codec.name().to_string()),
+        ("gamma".to_string(), gamma.to_string()),
+        ("target".to_string(), target_text.clone()),
+        ("reencoded_from".to_string(), req.input.display().to_string()),
+        ("source_tool".to_string(), before.tool.clone()),
+        ("source_codec".to_string(), codecs_before.join("+")),
+    ]);
+    out.provenance = Some(Provenance {
+        tool: format!("pis-reencode {}", env!("CARGO_PKG_VERSION")),
+        source: if before.source.is_empty() { req.input.display().to_string() } else { before.source.clone() },
+        raw_image_bytes: raw,
+        settings,
+    });
+    let bytes_after = pis_format::write(&req.output, &out).map_err(|e| match e {
+        Error::Io { .. } => Failure::from(e),
+        e => runtime(e.into()),
+    })?;
+    t.done("write", &format!("{} ({bytes_after} bytes)", req.output.display()));
+
+    // Read back and compare with the input's decoded textures.
+    let output = open(&req.output)?;
+    let (diff, _) = pis_eval::diff::compare(&input, &output, false, &mut |_| {}).map_err(|e| runtime(e.into()))?;
+    t.done("compare", "output decoded at every sample against the input");
+    let objects = c.objects.iter().zip(&output.container().objects).zip(&diff.objects).enumerate().map(|(i, ((a, b), d))| ObjectReport {
+        name: a.name.clone(),
+        bytes_before: stream_bytes(a, |s| s.length as u64),
+        bytes_after: stream_bytes(b, |s| s.length as u64),
+        psnr_db: d.score.psnr_db,
+        mse: d.score.mse,
+        max_error: d.score.max_error,
+        exact: d.score.exact,
+        area_px: areas.as_ref().map(|a| a[i]),
+    }).collect();
+    let bytes_before = input.len();
+    Ok(ReencodeReport {
+        input: req.input.display().to_string(),
+        output: req.output.display().to_string(),
+        codecs_before,
+        codec: req.codec.name().to_string(),
+        gamma,
+        target: target_text,
+        bytes_before,
+        bytes_after,
+        texture_bytes_before,
+        texture_bytes_after,
+        raw_image_bytes: raw,
+        ratio_before: raw as f64 / bytes_before.max(1) as f64,
+        ratio_after: raw as f64 / bytes_after.max(1) as f64,
+        ratio_without_geometry_before: raw as f64 / texture_bytes_before.max(1) as f64,
+        ratio_without_geometry_after: raw as f64 / texture_bytes_after.max(1) as f64,
+        psnr_db: diff.score.psnr_db,
+        mse: diff.score.mse,
+        max_error: diff.score.max_error,
+        exact: diff.score.exact && diff.complete,
+        level_images,
+        objects,
+        stage_ms: t.0.into_iter().collect(),
+    })
+}
+
+fn db(p: Option<f64>) -> String {
+    p.map_or("identical".to_string(), |p| format!("{p:.2} dB"))
+}
+
+/// Human-readable lines of the report.
+pub fn print_report(r: &ReencodeReport, out: &mut impl std::io::Write) -> std::io::Result<()> {
+    writeln!(out, "{} → {}: {} → {} (gamma {}, target {})", r.input, r.output, r.codecs_before.join("+"), r.codec, r.gamma, r.target)?;
+    writeln!(out, "  bytes     {:>12} → {:>12}  (level images {} → {})", r.bytes_before, r.bytes_after, r.texture_bytes_before, r.texture_bytes_after)?;
+    writeln!(out, "  ratio     {:>12.1} → {:>12.1}  (without geometry {:.1} → {:.1}; raw {} bytes)", r.ratio_before, r.ratio_after,
+             r.ratio_without_geometry_before, r.ratio_without_geometry_after, r.raw_image_bytes)?;
+    writeln!(out, "  texture PSNR against the input's decoded textures: {} (max display error {:.4}){}", db(r.psnr_db), r.max_error,
+             if r.exact { ", exact" } else { "" })?;
+    for o in &r.objects {
+        writeln!(out, "  {:<12} {:>10} → {:>10} bytes  {:>10}  max error {:.4}", o.name, o.bytes_before, o.bytes_after, db(o.psnr_db), o.max_error)?;
+    }
+    let stages: Vec<String> = r.stage_ms.iter().map(|(k, v)| format!("{k} {v:.0}")).collect();
+    writeln!(out, "  stages (ms): {}", stages.join(", "))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A stored-MIP layer at gamma 1 and an 8×8 texture as a reader decodes it from stored
+    /// values: every MIP value is `residual + decimate(finest)` in f32, the residuals random.
+    fn case() -> (Layer<StreamRef>, LevelLayout, Vec<f32>) {
+        let layer = Layer {
+            kind: LayerKind::EnvDistant,
+            mapping: Mapping::Shell,
+            channels: 3,
+            mip_mode: MipMode::Stored,
+            term: Term::Reflection,
+            order: 0,
+            combine: Combine::Over,
+            gamma: 1.0,
+            depends_on: DepMask::NONE,
+            blocks: vec![],
+        };
+        let layout = LevelLayout { width: 8, height: 8, channels: 3, faces: 1, mips: 4 };
+        let n: usize = layout.planes().iter().map(|p| (p.width * p.height * p.channels) as usize).sum();
+        let mut seed = 12345u32;
+        // Finest texels small, residuals large: the sums round.
+        let linear = (0..n).map(|i| {
+            seed = seed.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
+            let u = (seed >> 8) as f32 / (1u32 << 24) as f32;
+            if i < 8 * 8 * 3 { u * 0.01 } else { u * 7.0 - 3.0 }
+        }).collect();
+        let linear = finish(&layer, &layout, linear);
+        (layer, layout, linear)
+    }
+
+    #[test]
+    fn stored_mip_values_a_reader_decoded_round_trip_exactly() {
+        let (layer, layout, linear) = case();
+        let differ = |p: Vec<f32>| finish(&layer, &layout, p).iter().zip(&linear).filter(|(a, b)| a.to_bits() != b.to_bits()).count();
+        assert_eq!(differ(prepared(&layer, &layout, &linear, true)), 0);
+        // The values are those the decoder's sum gives, whatever the residuals' scale.
+        assert!(linear.iter().skip(8 * 8 * 3).any(|v| v.abs() > 1.0) && linear.iter().take(8 * 8 * 3).all(|v| v.abs() < 0.01));
+    }
+}

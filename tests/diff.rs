@@ -1,0 +1,276 @@
+//! pis-diff end to end: a file and its copy are identical; a re-encoded file differs by a
+//! measured PSNR and passes or fails `--min-psnr` around it; structural differences are
+//! listed; heatmaps are written; invalid files and bad arguments give their exit codes.
+//! Against a ray-traced set, pis-diff and `pis-play --headless --compare` agree, and FLIP,
+//! FLIP maps and the PSNR gates are reported (GPU tests: lavapipe; without an adapter they
+//! skip locally and fail when `CI=true`).
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+use std::sync::OnceLock;
+
+fn repo(rel: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("..").join(rel)
+}
+
+/// demo1 traced at 40×30, 1 spp, packed with the wavelet codec at ratio 24 and 32-texel
+/// textures, once for every test.
+fn packed() -> &'static Path {
+    &fixture().2
+}
+
+/// The ray-traced set the pack was made from.
+fn set() -> &'static Path {
+    &fixture().1
+}
+
+fn fixture() -> &'static (tempfile::TempDir, PathBuf, PathBuf) {
+    static PACK: OnceLock<(tempfile::TempDir, PathBuf, PathBuf)> = OnceLock::new();
+    PACK.get_or_init(|| {
+        let dir = tempfile::tempdir().expect("temp dir");
+        let set = dir.path().join("set");
+        let out = Command::new(env!("CARGO_BIN_EXE_pis-trace"))
+            .arg(repo("samples/demo1/scene.toml")).arg("-o").arg(&set)
+            .args(["--resolution", "40x30", "--spp", "1"]).output().expect("pis-trace runs");
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        let file = dir.path().join("demo1.pis");
+        let out = Command::new(env!("CARGO_BIN_EXE_pis-pack"))
+            .arg(&set).arg("--scene").arg(repo("samples/demo1/scene.toml")).arg("-o").arg(&file)
+            .args(["--ratio", "24", "--max-texture", "32"]).output().expect("pis-pack runs");
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        (dir, set, file)
+    })
+}
+
+fn diff(a: &Path, b: &Path, args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_pis-diff")).arg(a).arg(b).args(args).output().expect("pis-diff runs")
+}
+
+fn json(out: &Output) -> serde_json::Value {
+    serde_json::from_slice(&out.stdout).unwrap_or_else(|e| panic!("JSON report ({e}): {}{}", String::from_utf8_lossy(&out.stdout), String::from_utf8_lossy(&out.stderr)))
+}
+
+fn reencode(input: &Path, output: &Path, args: &[&str]) {
+    let out = Command::new(env!("CARGO_BIN_EXE_pis-reencode")).arg(input).arg("-o").arg(output).args(args).output().expect("pis-reencode runs");
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+}
+
+fn copy_is_identical(file: &Path) {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let copy = dir.path().join("copy.pis");
+    std::fs::copy(file, &copy).expect("copy");
+    let out = diff(file, &copy, &["--json"]);
+    assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
+    let r = json(&out);
+    assert_eq!(r["identical"], true, "{r}");
+    assert_eq!(r["bytes_identical"], true);
+    assert_eq!(r["textures_identical"], true);
+    assert!(r["psnr_db"].is_null(), "an exact match has no finite PSNR: {r}");
+    assert_eq!(r["structure"].as_array().map(Vec::len), Some(0));
+    assert_eq!(r["verdict"], "identical");
+    let objects = r["objects"].as_array().expect("objects");
+    assert!(!objects.is_empty());
+    for o in objects {
+        assert!(o["name"].is_string());
+        for l in o["layers"].as_array().expect("layers") {
+            assert_eq!(l["compared"], true);
+            assert_eq!(l["exact"], true);
+            assert!(!l["blocks"].as_array().expect("blocks").is_empty());
+        }
+    }
+    // The readable report says so too.
+    let out = diff(file, &copy, &[]);
+    assert_eq!(out.status.code(), Some(0));
+    assert!(String::from_utf8_lossy(&out.stdout).contains("Verdict: identical (the bytes are identical)"));
+}
+
+#[test]
+fn the_sample_and_its_copy_are_identical() {
+    copy_is_identical(&repo("samples/tiny.pis"));
+}
+
+#[test]
+fn a_pack_and_its_copy_are_identical() {
+    copy_is_identical(packed());
+}
+
+#[test]
+fn a_reencoded_file_differs_by_its_psnr_and_meets_gates_around_it() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let b = dir.path().join("b.pis");
+    reencode(packed(), &b, &["--codec", "wavelet", "--ratio", "96"]);
+    let out = diff(packed(), &b, &["--json"]);
+    assert_eq!(out.status.code(), Some(7), "{}", String::from_utf8_lossy(&out.stderr));
+    let r = json(&out);
+    assert_eq!(r["identical"], false);
+    assert_eq!(r["verdict"], "different");
+    let psnr = r["psnr_db"].as_f64().expect("a finite PSNR");
+    assert!(psnr > 15.0 && psnr < 80.0, "PSNR {psnr}");
+    // Per object, layer and block figures.
+    for o in r["objects"].as_array().expect("objects") {
+        assert!(o["psnr_db"].as_f64().is_some(), "{o}");
+        for l in o["layers"].as_array().expect("layers") {
+            for b in l["blocks"].as_array().expect("blocks") {
+                assert!(b["mse"].as_f64().is_some() && b["max_error"].as_f64().is_some(), "{b}");
+            }
+        }
+    }
+    let pass = diff(packed(), &b, &["--json", "--min-psnr", &format!("{}", psnr - 0.5)]);
+    assert_eq!(pass.status.code(), Some(0), "{}", String::from_utf8_lossy(&pass.stdout));
+    assert_eq!(json(&pass)["verdict"], "within gates");
+    let fail = diff(packed(), &b, &["--json", "--min-psnr", &format!("{}", psnr + 0.5)]);
+    assert_eq!(fail.status.code(), Some(7));
+    let g = &json(&fail)["gates"][0];
+    assert_eq!(g["passed"], false, "{g}");
+}
+
+#[test]
+fn structural_differences_are_listed() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let b = dir.path().join("dct.pis");
+    reencode(packed(), &b, &["--codec", "dct"]);
+    let out = diff(packed(), &b, &["--json"]);
+    assert_eq!(out.status.code(), Some(7));
+    let r = json(&out);
+    let lines: Vec<&str> = r["structure"].as_array().expect("structure").iter().filter_map(|v| v.as_str()).collect();
+    assert!(lines.iter().any(|l| l.contains("codecs") && l.contains("wavelet") && l.contains("dct")), "{lines:?}");
+    assert!(lines.iter().any(|l| l.starts_with("setting codec: wavelet → dct")), "{lines:?}");
+    assert!(r["bytes"]["a"]["codestreams"].as_u64().is_some() && r["bytes"]["b"]["total"].as_u64().is_some());
+}
+
+#[test]
+fn heatmaps_are_written_per_object_and_layer() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let b = dir.path().join("b.pis");
+    reencode(packed(), &b, &["--codec", "dct", "--ratio", "48"]);
+    let maps = dir.path().join("maps");
+    let out = diff(packed(), &b, &["--json", "--heatmaps", maps.to_str().expect("utf-8 path")]);
+    let r = json(&out);
+    let layers: usize = r["objects"].as_array().expect("objects").iter().map(|o| o["layers"].as_array().map_or(0, Vec::len)).sum();
+    let written = r["heatmaps"].as_array().expect("heatmaps");
+    assert_eq!(written.len(), layers);
+    let inspect = Command::new(env!("CARGO_BIN_EXE_pis-inspect")).arg("--json").arg(packed()).output().expect("pis-inspect");
+    let summary: serde_json::Value = serde_json::from_slice(&inspect.stdout).expect("summary JSON");
+    for h in written {
+        let object = summary["objects"].as_array().expect("objects").iter().find(|o| o["name"] == h["object"]).expect("object");
+        let layer = &object["layers"][h["layer"].as_u64().expect("layer") as usize];
+        let img = image::open(h["file"].as_str().expect("file")).expect("a PNG").to_rgb8();
+        assert_eq!(img.dimensions(), (layer["width"].as_u64().expect("width") as u32, layer["height"].as_u64().expect("height") as u32), "{h}");
+        // The ramp's top stands for the layer's largest RMS error: zero only where it is exact.
+        let diffed = r["objects"].as_array().expect("objects").iter().find(|o| o["name"] == h["object"]).expect("object");
+        let exact = diffed["layers"][h["layer"].as_u64().expect("layer") as usize]["exact"] == true;
+        assert_eq!(h["scale"].as_f64().expect("scale") > 0.0, !exact, "{h}");
+    }
+    let leftovers = std::fs::read_dir(&maps).expect("maps").filter_map(Result::ok).filter(|e| e.file_name().to_string_lossy().ends_with(".tmp")).count();
+    assert_eq!(leftovers, 0);
+}
+
+#[test]
+fn invalid_files_exit_3_with_the_rule() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let bytes = std::fs::read(packed()).expect("read");
+    let truncated = dir.path().join("truncated.pis");
+    std::fs::write(&truncated, &bytes[..bytes.len() / 2]).expect("write");
+    let out = diff(packed(), &truncated, &[]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(3), "{err}");
+    assert!(err.contains("truncated.pis") && err.contains("error-1003"), "{err}");
+    assert!(!err.contains("panicked"));
+    // A damaged codestream is found when it is decoded.
+    let chunks = Command::new(env!("CARGO_BIN_EXE_pis-inspect")).arg("--chunks").arg("--json").arg(packed()).output().expect("pis-inspect");
+    let rows: serde_json::Value = serde_json::from_slice(&chunks.stdout).expect("chunk JSON");
+    let cstr = rows.as_array().expect("rows").iter().find(|c| c["type"] == "CSTR").expect("a CSTR chunk");
+    let at = (cstr["offset"].as_u64().expect("offset") + cstr["length"].as_u64().expect("length") / 2) as usize;
+    let mut damaged = bytes.clone();
+    damaged[at] ^= 0x5a;
+    let file = dir.path().join("damaged.pis");
+    std::fs::write(&file, &damaged).expect("write");
+    let out = diff(&file, packed(), &[]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(3), "{err}");
+    assert!(err.contains("error-8003") && err.contains("damaged.pis"), "{err}");
+    assert!(!err.contains("panicked"));
+}
+
+#[test]
+fn bad_arguments_and_missing_files() {
+    let tiny = repo("samples/tiny.pis");
+    let out = Command::new(env!("CARGO_BIN_EXE_pis-diff")).arg(&tiny).output().expect("runs");
+    assert_eq!(out.status.code(), Some(1));
+    let out = diff(&tiny, &tiny, &["--max-psnr-drop", "1"]);
+    assert_eq!(out.status.code(), Some(1), "{}", String::from_utf8_lossy(&out.stderr));
+    let out = diff(&tiny, &tiny, &["--min-psnr", "abc"]);
+    assert_eq!(out.status.code(), Some(1));
+    let out = diff(&tiny, Path::new("/no/such/file.pis"), &[]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("/no/such/file.pis"));
+}
+
+/// pis-diff against the set, or `None` (printed) when there is no GPU adapter outside CI.
+fn diff_with_set_or_skip(test: &str, args: &[&str]) -> Option<Output> {
+    let out = diff(packed(), set(), args);
+    if out.status.code() == Some(5) && !std::env::var("CI").is_ok_and(|v| v == "true") {
+        eprintln!("{test}: skipped: {}", String::from_utf8_lossy(&out.stderr));
+        return None;
+    }
+    Some(out)
+}
+
+#[test]
+fn against_the_set_pis_diff_and_pis_play_agree() {
+    let Some(out) = diff_with_set_or_skip("against_the_set_pis_diff_and_pis_play_agree", &["--json"]) else { return };
+    assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
+    let d = json(&out);
+    let play = Command::new(env!("CARGO_BIN_EXE_pis-play")).arg(packed()).arg("--headless").arg("--compare").arg(set()).arg("--json").output().expect("pis-play runs");
+    assert!(play.status.success(), "{}", String::from_utf8_lossy(&play.stderr));
+    let p = json(&play);
+    let close = |a: &serde_json::Value, b: &serde_json::Value, what: &str| {
+        let (a, b) = (a.as_f64().unwrap_or_else(|| panic!("{what}: {a}")), b.as_f64().unwrap_or_else(|| panic!("{what}: {b}")));
+        assert!((a - b).abs() <= 0.1, "{what}: pis-diff {a} dB, pis-play {b} dB");
+    };
+    close(&d["psnr_db"], &p["psnr_db"], "whole image");
+    close(&d["covered_psnr_db"], &p["covered_psnr_db"], "covered pixels");
+    let objects = d["objects"].as_array().expect("objects");
+    assert!(!objects.is_empty());
+    for o in objects {
+        let q = p["objects"].as_array().expect("objects").iter().find(|q| q["name"] == o["name"]).expect("the same objects");
+        close(&o["psnr_db"], &q["psnr_db"], o["name"].as_str().unwrap_or("object"));
+        let f = o["flip_mean"].as_f64().expect("object FLIP");
+        assert!(f > 0.0 && f < 1.0, "{o}");
+        assert!(!o["blocks"].as_array().expect("blocks").is_empty());
+    }
+    let f = d["flip_mean"].as_f64().expect("FLIP");
+    assert!(f > 0.0 && f < 1.0, "mean FLIP {f}");
+    let points = d["points"].as_array().expect("points");
+    assert_eq!(points.len(), p["points"].as_array().expect("points").len());
+    for pt in points {
+        assert!(pt["psnr_db"].as_f64().is_some() && pt["flip_mean"].as_f64().is_some(), "{pt}");
+    }
+}
+
+#[test]
+fn against_the_set_gates_and_flip_maps() {
+    let Some(out) = diff_with_set_or_skip("against_the_set_gates_and_flip_maps", &["--json"]) else { return };
+    let r = json(&out);
+    let (whole, covered) = (r["psnr_db"].as_f64().expect("PSNR"), r["covered_psnr_db"].as_f64().expect("covered"));
+    assert_eq!(r["verdict"], "measured");
+    let dir = tempfile::tempdir().expect("temp dir");
+    let maps = dir.path().join("flip");
+    let pass = diff(packed(), set(), &["--json", "--min-psnr", &format!("{}", whole - 0.5), "--heatmaps", maps.to_str().expect("utf-8")]);
+    assert_eq!(pass.status.code(), Some(0), "{}", String::from_utf8_lossy(&pass.stderr));
+    let written = json(&pass)["heatmaps"].as_array().expect("heatmaps").len();
+    assert_eq!(written, r["points"].as_array().expect("points").len());
+    assert_eq!(std::fs::read_dir(&maps).expect("maps").count(), written);
+    assert_eq!(diff(packed(), set(), &["--min-psnr", &format!("{}", whole + 0.5)]).status.code(), Some(7));
+    // The drop is measured on the covered pixels against the reference.
+    let reference = format!("{}", covered + 1.0);
+    let within = diff(packed(), set(), &["--json", "--reference-psnr", &reference, "--max-psnr-drop", "1.5"]);
+    assert_eq!(within.status.code(), Some(0), "{}", String::from_utf8_lossy(&within.stderr));
+    let w = json(&within);
+    assert!((w["psnr_drop_db"].as_f64().expect("drop") - 1.0).abs() < 1e-6, "{w}");
+    assert_eq!(diff(packed(), set(), &["--reference-psnr", &reference, "--max-psnr-drop", "0.5"]).status.code(), Some(7));
+    // Without a recorded prediction the drop gate needs a reference.
+    let out = diff(packed(), set(), &["--max-psnr-drop", "1"]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("--reference-psnr"));
+}
