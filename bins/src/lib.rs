@@ -6,3 +6,4 @@ pub mod images;
 pub mod infer;
 pub mod inspect;
 pub mod pack;
+pub mod play_window;
