@@ -5,3 +5,4 @@
 //! linear radiance clamped to [0, 1] and sRGB-encoded, peak 1.
 
 pub mod metrics;
+pub mod compare;
