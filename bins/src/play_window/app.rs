@@ -387,8 +387,10 @@ impl Running {
             wgpu::CurrentSurfaceTexture::Validation => return Err(runtime("the window surface failed validation")),
         };
         let target = frame.texture.create_view(&wgpu::TextureViewDescriptor { format: Some(self.surface.view_format), ..Default::default() });
-        for (id, delta) in &full.textures_delta.set {
-            self.renderer.update_texture(&self.gpu.device, &self.gpu.queue, *id, delta);
+        for (id, deltas) in &full.textures_delta.set {
+            for delta in deltas {
+                self.renderer.update_texture(&self.gpu.device, &self.gpu.queue, *id, delta);
+            }
         }
         let stats = self.draw(&target, size, &primitives, &screen)?;
         let last_frame = opts.frames.is_some_and(|n| self.frames + 1 >= n);
@@ -399,25 +401,26 @@ impl Running {
             write_png_rgba8(path, size.0, size.1, &pixels).map_err(|e| Failure::new(Exit::Io, e))?;
         }
         self.window.pre_present_notify();
-        frame.present();
+        self.gpu.queue.present(frame);
         self.free_textures(&full.textures_delta);
 
         let at = Instant::now();
         self.frames += 1;
-        if let Some(s) = stats {
+        let s = stats.unwrap_or_default();
+        if stats.is_some() {
             self.last_stats = s;
-            self.meter.add(FrameSample {
-                at_s: (at - self.started).as_secs_f64(),
-                frame_ms: s.frame_ms,
-                decode_ms: s.decode_ms,
-                upload_bytes: s.upload_bytes,
-                cache_bytes: s.cache_bytes,
-            });
-            if self.frames >= 2 {
-                self.sum.0 += s.frame_ms;
-                self.sum.1 += s.decode_ms;
-                self.sum.2 += s.upload_ms;
-            }
+        }
+        self.meter.add(FrameSample {
+            at_s: (at - self.started).as_secs_f64(),
+            frame_ms: s.frame_ms,
+            decode_ms: s.decode_ms,
+            upload_bytes: s.upload_bytes,
+            cache_bytes: s.cache_bytes,
+        });
+        if self.frames >= 2 {
+            self.sum.0 += s.frame_ms;
+            self.sum.1 += s.decode_ms;
+            self.sum.2 += s.upload_ms;
         }
         if self.frames == 1 {
             self.second_frame_at = Some(at);

@@ -62,7 +62,7 @@ impl Capture {
         });
         device.poll(wgpu::PollType::wait_indefinitely()).map_err(|e| format!("waiting for the screenshot copy: {e}"))?;
         rx.recv().map_err(|e| e.to_string())?.map_err(|e| format!("mapping the screenshot: {e}"))?;
-        let data = slice.get_mapped_range();
+        let data = slice.get_mapped_range().map_err(|e| format!("reading the screenshot: {e}"))?;
         let bgra = matches!(self.format, wgpu::TextureFormat::Bgra8Unorm | wgpu::TextureFormat::Bgra8UnormSrgb);
         let mut out = Vec::with_capacity((row * self.height) as usize);
         for y in 0..self.height as usize {

@@ -78,7 +78,7 @@ fn shortcuts(ui: &Ui, v: &mut ViewState, has_gold: bool, actions: &mut Actions) 
 pub fn draw(ui: &mut Ui, v: &mut ViewState, info: &PanelInfo, dt: f32) -> Actions {
     let mut actions = Actions::default();
     // The frame under the panels: drags and the wheel move the free camera.
-    let frame = ui.interact(ui.max_rect(), ui.id().with("frame"), egui::Sense::drag());
+    let frame = ui.interact(ui.max_rect(), ui.scope_id().with("frame"), egui::Sense::drag());
     if frame.dragged() {
         let d = frame.drag_delta();
         v.drag(d.x, d.y);
@@ -101,8 +101,7 @@ pub fn draw(ui: &mut Ui, v: &mut ViewState, info: &PanelInfo, dt: f32) -> Action
     }
     let ctx = ui.ctx().clone();
     egui::Window::new("Parameters").default_pos([8.0, 8.0]).resizable(false).show(&ctx, |ui| parameters(ui, v, info, &mut actions));
-    let right = ctx.content_rect().right() - 8.0;
-    egui::Window::new("Stats").default_pos([right - 190.0, 8.0]).resizable(false).default_open(true).show(&ctx, |ui| stats(ui, info));
+    egui::Window::new("Stats").default_width(180.0).max_width(220.0).anchor(egui::Align2::RIGHT_TOP, [-8.0, 8.0]).resizable(false).show(&ctx, |ui| stats(ui, info));
     actions
 }
 
@@ -121,7 +120,7 @@ fn parameters(ui: &mut Ui, v: &mut ViewState, info: &PanelInfo, actions: &mut Ac
         }
     });
     ui.horizontal(|ui| {
-        let label = if v.playback.playing { "⏸ pause" } else { "▶ play" };
+        let label = if v.playback.playing { "pause" } else { "play" };
         if ui.button(label).clicked() {
             if v.playback.playing {
                 v.playback.playing = false;
@@ -185,6 +184,7 @@ fn parameters(ui: &mut Ui, v: &mut ViewState, info: &PanelInfo, actions: &mut Ac
 }
 
 fn stats(ui: &mut Ui, info: &PanelInfo) {
+    ui.set_max_width(180.0);
     let s = info.stats;
     egui::Grid::new("stats").num_columns(2).show(ui, |ui| {
         let mut row = |k: &str, v: String| {
@@ -201,5 +201,5 @@ fn stats(ui: &mut Ui, info: &PanelInfo) {
         row("frame size", format!("{}×{}", info.frame_size.0, info.frame_size.1));
         row("traced size", format!("{}×{}", info.image_size.0, info.image_size.1));
     });
-    ui.small(info.adapter);
+    ui.add(egui::Label::new(egui::RichText::new(info.adapter).small()).wrap());
 }
