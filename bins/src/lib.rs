@@ -6,4 +6,5 @@ pub mod images;
 pub mod infer;
 pub mod inspect;
 pub mod pack;
+pub mod play;
 pub mod play_window;

@@ -407,3 +407,21 @@ pub fn colour_image(bytes: &[u8], format: wgpu::TextureFormat, size: (u32, u32))
     };
     FloatImage { width: size.0, height: size.1, rgba }
 }
+
+#[cfg(test)]
+mod tests {
+    /// The text of WGSL function `name` in `src`: from `fn name(` to the closing brace at
+    /// the start of a line.
+    fn function(src: &str, name: &str) -> String {
+        let start = src.find(&format!("fn {name}(")).unwrap_or_else(|| panic!("no fn {name}"));
+        let end = src[start..].find("\n}").expect("closing brace") + start + 2;
+        src[start..end].to_string()
+    }
+
+    #[test]
+    fn texture_math_is_the_textured_pipelines() {
+        for f in ["texcoord", "texture_lod"] {
+            assert_eq!(function(super::SHADER, f), function(crate::textured::SHADER, f), "{f} differs between frame.wgsl and textured.wgsl");
+        }
+    }
+}

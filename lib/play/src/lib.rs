@@ -10,9 +10,12 @@
 pub mod blend;
 pub mod cache;
 pub mod camera;
+pub mod decode;
 pub mod error;
+pub mod frame;
 pub mod gpu;
 pub mod image;
+pub mod mip;
 pub mod player;
 pub mod probe;
 pub mod textured;
