@@ -34,6 +34,10 @@ fn parse_size(s: &str) -> Result<(u32, u32), String> {
     }
 }
 
+/// One value per dimension. A named type: clap reads a field typed `Vec<T>` as many values
+/// of `T`, and `--at` is one value that holds the whole point.
+pub type Point = Vec<f32>;
+
 fn parse_point(s: &str) -> Result<Vec<f32>, String> {
     s.split([',', ' ']).filter(|p| !p.trim().is_empty()).map(|p| p.trim().parse::<f32>().ok().filter(|v| v.is_finite()).ok_or_else(|| format!("bad value {p:?} in {s:?}: expected numbers like 0.5,3"))).collect()
 }
@@ -56,6 +60,13 @@ fn parse_reduction(s: &str) -> Result<u32, String> {
 /// every sample point of a ray-traced set compared with its gold standard (`--compare`).
 /// Frames are written as sRGB PNGs with `--out`; timings go to stderr (and stdout with
 /// `--json`).
+///
+/// In a window (the default where a display is set and neither --headless, --out nor
+/// --compare is given): a slider per dimension, play/pause along a path (`--path diagonal`
+/// starts playing, `--path orbit` starts with the orbit camera), nearest or multilinear blend,
+/// the sample camera or a free orbit / fly camera, a stats panel, and with `--set` the
+/// ray-traced gold standard. `--frames N` exits after N frames with a frame-rate report,
+/// `--screenshot` saves the last one.
 #[derive(Parser, Debug, Clone)]
 #[command(name = "pis-play", version, about, after_help = crate::cli::EXIT_CODES_HELP)]
 pub struct PlayArgs {
@@ -67,7 +78,7 @@ pub struct PlayArgs {
     /// The parameter point: one value per dimension, in the dimension's own values
     /// (default: the middle sample of each dimension).
     #[arg(long, value_parser = parse_point, allow_hyphen_values = true)]
-    pub at: Option<Vec<f32>>,
+    pub at: Option<Point>,
     /// A path of frames: `diagonal`, `orbit` or a file of points.
     #[arg(long, value_parser = parse_path)]
     pub path: Option<PathChoice>,
@@ -101,6 +112,23 @@ pub struct PlayArgs {
     /// Print the report as JSON on stdout.
     #[arg(long)]
     pub json: bool,
+    /// Window mode: a ray-traced set of the same space; the panel (or G) shows its gold
+    /// standard at the nearest sample instead of the player's frame.
+    #[arg(long, value_name = "SET_DIR")]
+    pub set: Option<PathBuf>,
+    /// Window mode: start showing the gold standard of --set.
+    #[arg(long, requires = "set")]
+    pub show_gold: bool,
+    /// Window mode: save the window's frame number --frames (default 3) as an sRGB PNG, then
+    /// exit.
+    #[arg(long, value_name = "FILE.png")]
+    pub screenshot: Option<PathBuf>,
+    /// Window mode: start with the panels hidden (H shows them).
+    #[arg(long)]
+    pub hide_panels: bool,
+    /// Window mode: do not wait for the display refresh between frames (to measure speed).
+    #[arg(long)]
+    pub no_vsync: bool,
 }
 
 impl PlayArgs {

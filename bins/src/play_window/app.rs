@@ -26,6 +26,7 @@ use super::surface::WindowSurface;
 use super::ui::{self, PanelInfo};
 use super::view::ViewState;
 use crate::cli::{Exit, Failure};
+use crate::play::headless::play_failure;
 
 /// How the window is opened and run.
 #[derive(Clone, Debug)]
@@ -45,8 +46,14 @@ pub struct WindowOptions {
     pub at: Option<Vec<f32>>,
     /// Start with playback running along the diagonal.
     pub play: bool,
+    /// Start with the free orbit camera (at the sample camera).
+    pub orbit: bool,
+    /// Start with multilinear blending between samples (else the nearest sample).
+    pub multilinear: bool,
     /// Start with the panels hidden (H shows them).
     pub hide_ui: bool,
+    /// Start showing the gold standard (needs `set`).
+    pub show_gold: bool,
     /// Wait for the display's refresh between frames (off to measure drawing speed).
     pub vsync: bool,
     pub gpu: GpuOptions,
@@ -54,7 +61,7 @@ pub struct WindowOptions {
 }
 
 /// What a run with `frames` measured, printed at exit.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize)]
 pub struct RunReport {
     pub frames: u32,
     pub seconds: f64,
@@ -64,7 +71,7 @@ pub struct RunReport {
     pub frame_ms: f64,
     pub decode_ms: f64,
     pub upload_ms: f64,
-    pub frame_size: (u32, u32),
+    pub frame_size: [u32; 2],
 }
 
 /// Opens the window and runs it until it is closed (or `frames` frames were drawn).
@@ -130,17 +137,6 @@ fn runtime(e: impl std::fmt::Display) -> Failure {
     Failure::new(Exit::Runtime, anyhow::anyhow!("{e}"))
 }
 
-/// The exit code of a player error.
-pub fn play_failure(e: pis_play::PlayError) -> Failure {
-    use pis_play::PlayError as E;
-    match e {
-        E::File(f) => Failure::from(f),
-        E::Request(m) => Failure::new(Exit::Usage, anyhow::anyhow!(m)),
-        E::Content { .. } => Failure::new(Exit::NotSupported, e),
-        other => Failure::new(Exit::Runtime, other),
-    }
-}
-
 /// The default window size for an image of `w × h`: scaled by a whole factor to at least
 /// 640 pixels wide.
 pub fn default_window_size((w, h): (u32, u32)) -> (u32, u32) {
@@ -184,12 +180,18 @@ impl App {
         let focus = focus_distance(&player, &space, &point);
         let mut view = ViewState::new(space, point, focus);
         view.show_ui = !o.hide_ui;
+        view.multilinear = o.multilinear;
+        view.show_gold = o.show_gold && o.set.is_some();
+        if o.orbit {
+            let sample = player.sample_camera(&view.draw_point());
+            view.set_mode(super::view::CameraMode::Orbit, &sample);
+        }
         if o.play {
             view.playback = Playback::new(PathKind::Diagonal);
             view.playback.play_from(&view.space, &view.point);
         }
         let gold = match &o.set {
-            Some(dir) => Some(GoldSet::open(dir, player.dimensions()).map_err(|m| Failure::new(Exit::Invalid, anyhow::anyhow!(m)))?),
+            Some(dir) => Some(GoldSet::open(dir, player.dimensions())?),
             None => None,
         };
 
@@ -436,7 +438,7 @@ impl Running {
                 frame_ms: self.sum.0 / timed,
                 decode_ms: self.sum.1 / timed,
                 upload_ms: self.sum.2 / timed,
-                frame_size: size,
+                frame_size: [size.0, size.1],
             }));
         }
         Ok(None)

@@ -7,6 +7,8 @@ use std::path::Path;
 use pis_format::Dimension;
 use pis_trace::set::RaySet;
 
+use crate::cli::{Exit, Failure};
+
 /// A ray-traced set matched to a file's parameter space by dimension name.
 pub struct GoldSet {
     set: RaySet,
@@ -31,9 +33,14 @@ pub struct GoldImage {
 impl GoldSet {
     /// Opens the set in `dir` and matches its dimensions to `dims` by name (every dimension
     /// of the set must be one of the file's, and the reverse).
-    pub fn open(dir: &Path, dims: &[Dimension]) -> Result<GoldSet, String> {
-        let set = RaySet::open(dir).map_err(|e| e.to_string())?;
-        let file_dim = match_dimensions(&set, dims).map_err(|m| format!("{}: {m}", dir.display()))?;
+    /// Fails with exit code 2 when the set cannot be read, 3 when it is invalid or does not
+    /// match the file's space.
+    pub fn open(dir: &Path, dims: &[Dimension]) -> Result<GoldSet, Failure> {
+        let set = RaySet::open(dir).map_err(|e| {
+            let exit = if matches!(e, pis_trace::TraceError::Io { .. }) { Exit::Io } else { Exit::Invalid };
+            Failure::new(exit, anyhow::anyhow!("--set: {e}"))
+        })?;
+        let file_dim = match_dimensions(&set, dims).map_err(|m| Failure::new(Exit::Invalid, anyhow::anyhow!("--set {}: {m}", dir.display())))?;
         Ok(GoldSet { set, file_dim, last: None })
     }
 
