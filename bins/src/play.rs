@@ -19,12 +19,18 @@ pub fn run(args: &PlayArgs) -> Result<Exit, Failure> {
     let window_only = args.screenshot.is_some() || args.set.is_some();
     if !args.headless && args.out.is_none() && args.compare.is_none() {
         if has_display() {
-            return crate::play_window::run(args).map(|()| Exit::Ok);
-        }
-        if window_only {
+            match crate::play_window::try_run(args) {
+                Ok(()) => return Ok(Exit::Ok),
+                Err(crate::play_window::WindowFailure::NoDisplay(m)) if !window_only => {
+                    eprintln!("pis-play: note: {m}; drawing headless");
+                }
+                Err(e) => return Err(e.into()),
+            }
+        } else if window_only {
             return Err(Failure::new(Exit::Runtime, anyhow::anyhow!("--screenshot and --set need a window, and no display is set (DISPLAY / WAYLAND_DISPLAY): run under `xvfb-run -a`")));
+        } else {
+            eprintln!("pis-play: note: no display (DISPLAY / WAYLAND_DISPLAY unset); drawing headless");
         }
-        eprintln!("pis-play: note: no display (DISPLAY / WAYLAND_DISPLAY unset); drawing headless");
     } else if window_only {
         return Err(Failure::new(Exit::Usage, anyhow::anyhow!("--screenshot and --set are window options; they do not go with --headless, --out or --compare")));
     }

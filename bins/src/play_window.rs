@@ -13,7 +13,7 @@ pub mod surface;
 pub mod ui;
 pub mod view;
 
-pub use app::{run_window, RunReport, WindowOptions};
+pub use app::{run_window, RunReport, WindowFailure, WindowOptions};
 
 use crate::cli::{Exit, Failure};
 use crate::play::args::{PathChoice, PlayArgs};
@@ -58,6 +58,11 @@ pub fn window_options(args: &PlayArgs) -> Result<WindowOptions, Failure> {
 /// pis-play in a window: runs until the window is closed, or for `--frames` frames and then
 /// prints the frame rate (JSON on stdout with `--json`).
 pub fn run(args: &PlayArgs) -> Result<(), Failure> {
+    try_run(args).map_err(Failure::from)
+}
+
+/// [`run`], telling apart a display that cannot be connected to (nothing opened).
+pub fn try_run(args: &PlayArgs) -> Result<(), WindowFailure> {
     let report = run_window(window_options(args)?)?;
     if let Some(r) = report {
         if args.json {

@@ -74,18 +74,42 @@ pub struct RunReport {
     pub frame_size: [u32; 2],
 }
 
+/// Why a window run ended without success.
+#[derive(Debug)]
+pub enum WindowFailure {
+    /// No display could be connected to: nothing was opened (a caller may draw headless).
+    NoDisplay(String),
+    /// The window ran and failed.
+    Failed(Failure),
+}
+
+impl From<Failure> for WindowFailure {
+    fn from(f: Failure) -> Self {
+        WindowFailure::Failed(f)
+    }
+}
+
+impl From<WindowFailure> for Failure {
+    fn from(w: WindowFailure) -> Self {
+        match w {
+            WindowFailure::NoDisplay(m) => Failure::new(Exit::Runtime, anyhow::anyhow!("{m}")),
+            WindowFailure::Failed(f) => f,
+        }
+    }
+}
+
 /// Opens the window and runs it until it is closed (or `frames` frames were drawn).
-pub fn run_window(opts: WindowOptions) -> Result<Option<RunReport>, Failure> {
+pub fn run_window(opts: WindowOptions) -> Result<Option<RunReport>, WindowFailure> {
     // The instance first: it gives the process an XDG_RUNTIME_DIR where none is set, before
     // the event loop or any driver thread reads the environment.
     let instance = Gpu::instance();
     let event_loop = EventLoop::new().map_err(|e| {
-        Failure::new(Exit::Runtime, anyhow::anyhow!("cannot open a window: {e} (no display? set DISPLAY or WAYLAND_DISPLAY, or run under `xvfb-run -a`)"))
+        WindowFailure::NoDisplay(format!("cannot open a window: {e} (set DISPLAY or WAYLAND_DISPLAY to a running display, or run under `xvfb-run -a`)"))
     })?;
     let mut app = App { instance, opts, running: None, failure: None, report: None };
     event_loop.run_app(&mut app).map_err(|e| Failure::new(Exit::Runtime, anyhow::anyhow!("window event loop: {e}")))?;
     match app.failure {
-        Some(f) => Err(f),
+        Some(f) => Err(f.into()),
         None => Ok(app.report),
     }
 }
