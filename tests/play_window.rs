@@ -197,6 +197,17 @@ fn the_window_shows_the_players_frame() {
     eprintln!("window vs headless: same point {db_same:.2} dB, other point {db_other:.2} dB");
     assert!(db_same >= SAME_FRAME_DB, "window frame vs headless frame of the same request: {db_same:.2} dB");
     assert!(db_other < SAME_FRAME_DB, "the measure must tell another sample apart: {db_other:.2} dB");
+    // The free orbit camera starts on the sample camera: the same frame through the player's
+    // free-camera path (eye, target, up → view matrix) instead of the file's matrix.
+    let orbit = dir.path().join("orbit.png");
+    let out = window(&[
+        os(&f.file), os("--screenshot"), os(&orbit), os("--frames"), os("3"), os("--size"), os("160x120"),
+        os("--hide-panels"), os("--at"), os(&f.points[0]), os("--blend"), os("nearest"), os("--path"), os("orbit"),
+    ]);
+    ok(&out, "pis-play window, orbit camera");
+    let db_orbit = whole(&png(&orbit), &same);
+    eprintln!("orbit camera at its start vs headless: {db_orbit:.2} dB");
+    assert!(db_orbit >= SAME_FRAME_DB, "the orbit camera starts at the sample camera: {db_orbit:.2} dB");
 }
 
 #[test]

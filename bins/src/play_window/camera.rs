@@ -31,10 +31,11 @@ pub struct FreeCamera {
 }
 
 impl FreeCamera {
-    /// The pose of `cam` (eye, direction, up, lens) with the orbit target `focus_distance`
-    /// ahead of the eye.
+    /// The pose of `cam` (eye, direction, lens) with the orbit target `focus_distance` ahead
+    /// of the eye; yaw turns about the world axis nearest to the camera's up vector (a
+    /// camera looking down at a scene still orbits about the vertical).
     pub fn new(cam: &ViewCamera, focus_distance: f32) -> FreeCamera {
-        let up = cam.up.try_normalize().unwrap_or(Vec3::Y);
+        let up = world_up(cam.up);
         let a = up.any_orthonormal_vector();
         let b = up.cross(a);
         let dir = (cam.target - cam.eye).try_normalize().unwrap_or(-b);
@@ -99,6 +100,21 @@ impl FreeCamera {
     }
 }
 
+/// The world axis (±X, ±Y, ±Z) nearest to `up`; +Y when `up` is zero or not finite.
+pub fn world_up(up: Vec3) -> Vec3 {
+    if !up.is_finite() || up.length_squared() == 0.0 {
+        return Vec3::Y;
+    }
+    let a = up.abs();
+    if a.y >= a.x && a.y >= a.z {
+        Vec3::Y * up.y.signum()
+    } else if a.x >= a.z {
+        Vec3::X * up.x.signum()
+    } else {
+        Vec3::Z * up.z.signum()
+    }
+}
+
 /// The point nearest to every camera's line of sight in the least-squares sense: where the
 /// sampled views look (the centre of an orbit). None when the lines are (nearly) parallel, as
 /// for a single camera.
@@ -160,6 +176,21 @@ mod tests {
         let mut g = FreeCamera::new(&cam(Vec3::new(0.0, 0.0, 2.0), Vec3::ZERO), 2.0);
         g.orbit(std::f32::consts::FRAC_PI_2, 0.0);
         assert!((g.eye.x.abs() - 2.0).abs() < 1e-4 && g.eye.y.abs() < 1e-4 && g.eye.z.abs() < 1e-4, "{:?}", g.eye);
+    }
+
+    #[test]
+    fn a_tilted_camera_orbits_about_the_vertical() {
+        // Looking down at 22°, as demo1's views: the camera's up leans back, the pole is +Y.
+        let eye = Vec3::new(0.0, 0.85 + 1.7 * 0.3746, 1.7 * 0.9272);
+        let target = Vec3::new(0.0, 0.85, 0.0);
+        let dir = (target - eye).normalize();
+        let up = dir.cross(Vec3::Y).normalize().cross(dir);
+        assert!(up.y > 0.9 && up.z < -0.3, "{up:?}");
+        let mut f = FreeCamera::new(&ViewCamera { eye, target, up, yfov_rad: 0.7, near: 0.05, far: 50.0 }, 1.7);
+        f.orbit(1.0, 0.0);
+        assert!((f.eye.y - eye.y).abs() < 1e-4, "the eye stays at its height: {:?}", f.eye);
+        assert!(close(f.target(), target));
+        assert_eq!((world_up(Vec3::new(0.1, -0.9, 0.3)), world_up(Vec3::ZERO)), (-Vec3::Y, Vec3::Y));
     }
 
     #[test]
