@@ -67,12 +67,12 @@ pub struct PlayArgs {
     /// Draw offscreen, without a window.
     #[arg(long)]
     pub headless: bool,
-    /// The parameter point: one value per dimension, in the dimension's own values
-    /// (default: the middle sample of each dimension).
-    #[arg(long, value_delimiter = ',', allow_hyphen_values = true)]
+    /// The parameter point: one value per dimension, comma separated, in the dimension's own
+    /// values (default: the middle sample of each dimension).
+    #[arg(long, value_name = "V1,V2,...", value_delimiter = ',', allow_hyphen_values = true)]
     pub at: Option<Vec<f32>>,
     /// A path of frames: `diagonal`, `orbit` or a file of points.
-    #[arg(long, value_parser = parse_path)]
+    #[arg(long, value_name = "diagonal|orbit|PATHFILE", value_parser = parse_path)]
     pub path: Option<PathChoice>,
     /// Frames of the path (default: every point of the space for `diagonal`, 36 for
     /// `orbit`, every line of a path file).
@@ -99,7 +99,7 @@ pub struct PlayArgs {
     pub workers: Option<usize>,
     /// Draw every sample point of this ray-traced set and report PSNR against its gold
     /// standard, per object and for the whole image.
-    #[arg(long, conflicts_with_all = ["path", "at"])]
+    #[arg(long, value_name = "SET_DIR", conflicts_with_all = ["path", "at"])]
     pub compare: Option<PathBuf>,
     /// Print the report as JSON on stdout.
     #[arg(long)]

@@ -153,3 +153,56 @@ fn psnr(a: &[f32], b: &[f32]) -> f64 {
     let mse = a.iter().zip(b).map(|(x, y)| (*x as f64 - *y as f64).powi(2)).sum::<f64>() / a.len().max(1) as f64;
     if mse == 0.0 { f64::INFINITY } else { -10.0 * mse.log10() }
 }
+
+fn srgb(v: f32) -> f32 {
+    let l = v.clamp(0.0, 1.0);
+    if l <= 0.003_130_8 { 12.92 * l } else { 1.055 * l.powf(1.0 / 2.4) - 0.055 }
+}
+
+/// A window's surface is an sRGB texture: the frame drawn into one is the offscreen frame,
+/// sRGB-encoded by the target format.
+#[test]
+fn render_to_view_draws_the_offscreen_frame_into_an_srgb_target() {
+    let Some(gpu) = gpu_or_skip("render_to_view_draws_the_offscreen_frame_into_an_srgb_target") else { return };
+    let gpu = Arc::new(gpu);
+    let mut player = Player::open(gpu.clone(), &tiny(), PlayerOptions { workers: 1, ..Default::default() }).unwrap();
+    let size = (48, 36);
+    let req = at(&player, &[1, 1]);
+    let (img, _) = player.render_image(&req, size).unwrap();
+    let format = wgpu::TextureFormat::Rgba8UnormSrgb;
+    let target = gpu.device.create_texture(&wgpu::TextureDescriptor {
+        label: None,
+        size: wgpu::Extent3d { width: size.0, height: size.1, depth_or_array_layers: 1 },
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format,
+        usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
+        view_formats: &[],
+    });
+    let stats = player.render_to_view(&req, &target.create_view(&Default::default()), format, size).unwrap();
+    assert_eq!(stats.codestreams_read, 0, "the textures are still on the GPU");
+    let row = (size.0 * 4).div_ceil(256) * 256;
+    let buf = gpu.device.create_buffer(&wgpu::BufferDescriptor { label: None, size: (row * size.1) as u64, usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ, mapped_at_creation: false });
+    let mut enc = gpu.device.create_command_encoder(&Default::default());
+    enc.copy_texture_to_buffer(
+        wgpu::TexelCopyTextureInfo { texture: &target, mip_level: 0, origin: wgpu::Origin3d::ZERO, aspect: wgpu::TextureAspect::All },
+        wgpu::TexelCopyBufferInfo { buffer: &buf, layout: wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(row), rows_per_image: Some(size.1) } },
+        wgpu::Extent3d { width: size.0, height: size.1, depth_or_array_layers: 1 },
+    );
+    gpu.queue.submit([enc.finish()]);
+    let bytes = pis_play::frame::map_read(&gpu, &buf).unwrap();
+    let mut drawn = 0;
+    for y in 0..size.1 as usize {
+        for x in 0..size.0 as usize {
+            let p = y * size.0 as usize + x;
+            drawn += (img.rgba[p * 4 + 3] > 0.0) as usize;
+            for c in 0..3 {
+                let want = srgb(img.rgba[p * 4 + c]) * 255.0;
+                let got = bytes[y * row as usize + x * 4 + c] as f32;
+                assert!((got - want).abs() <= 1.0, "pixel ({x}, {y}) channel {c}: {got} vs {want}");
+            }
+        }
+    }
+    assert!(drawn > 20);
+}
