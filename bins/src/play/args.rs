@@ -75,7 +75,8 @@ pub struct PlayArgs {
     #[arg(long, value_name = "diagonal|orbit|PATHFILE", value_parser = parse_path)]
     pub path: Option<PathChoice>,
     /// Frames of the path (default: every point of the space for `diagonal`, 36 for
-    /// `orbit`, every line of a path file).
+    /// `orbit`, every line of a path file). In a window: exit after this many frames with a
+    /// frame-rate report.
     #[arg(long)]
     pub frames: Option<usize>,
     /// Write every frame as an 8-bit sRGB PNG into this directory.
