@@ -9,3 +9,4 @@ pub mod inspect;
 pub mod pack;
 pub mod play;
 pub mod reencode;
+pub mod play_window;

@@ -52,6 +52,13 @@ fn parse_reduction(s: &str) -> Result<u32, String> {
 /// every sample point of a ray-traced set compared with its gold standard (`--compare`).
 /// Frames are written as sRGB PNGs with `--out`; timings go to stderr (and stdout with
 /// `--json`).
+///
+/// In a window (the default where a display is set and neither --headless, --out nor
+/// --compare is given): a slider per dimension, play/pause along a path (`--path diagonal`
+/// starts playing, `--path orbit` starts with the orbit camera), nearest or multilinear blend,
+/// the sample camera or a free orbit / fly camera, a stats panel, and with `--set` the
+/// ray-traced gold standard. `--frames N` exits after N frames with a frame-rate report,
+/// `--screenshot` saves the last one.
 #[derive(Parser, Debug, Clone)]
 #[command(name = "pis-play", version, about, after_help = crate::cli::EXIT_CODES_HELP)]
 pub struct PlayArgs {
@@ -68,7 +75,8 @@ pub struct PlayArgs {
     #[arg(long, value_name = "diagonal|orbit|PATHFILE", value_parser = parse_path)]
     pub path: Option<PathChoice>,
     /// Frames of the path (default: every point of the space for `diagonal`, 36 for
-    /// `orbit`, every line of a path file).
+    /// `orbit`, every line of a path file). In a window: exit after this many frames with a
+    /// frame-rate report.
     #[arg(long)]
     pub frames: Option<usize>,
     /// Write every frame as an 8-bit sRGB PNG into this directory.
@@ -97,6 +105,23 @@ pub struct PlayArgs {
     /// Print the report as JSON on stdout.
     #[arg(long)]
     pub json: bool,
+    /// Window mode: a ray-traced set of the same space; the panel (or G) shows its gold
+    /// standard at the nearest sample instead of the player's frame.
+    #[arg(long, value_name = "SET_DIR")]
+    pub set: Option<PathBuf>,
+    /// Window mode: start showing the gold standard of --set.
+    #[arg(long, requires = "set")]
+    pub show_gold: bool,
+    /// Window mode: save the window's frame number --frames (default 3) as an sRGB PNG, then
+    /// exit.
+    #[arg(long, value_name = "FILE.png")]
+    pub screenshot: Option<PathBuf>,
+    /// Window mode: start with the panels hidden (H shows them).
+    #[arg(long)]
+    pub hide_panels: bool,
+    /// Window mode: do not wait for the display refresh between frames (to measure speed).
+    #[arg(long)]
+    pub no_vsync: bool,
 }
 
 impl PlayArgs {

@@ -87,12 +87,36 @@ impl Gpu {
 
     /// Opens the default adapter.
     pub fn with_options(options: GpuOptions) -> Result<Gpu, PlayError> {
+        let instance = Gpu::instance();
+        Gpu::open(&instance, None, options).map(|(gpu, _)| gpu)
+    }
+
+    /// The wgpu instance the player opens adapters from (backends from `WGPU_BACKEND`, else
+    /// all that are built in), after giving the process an `XDG_RUNTIME_DIR` where none is
+    /// set. A window creates its surface from this instance, then calls [`Gpu::for_surface`].
+    pub fn instance() -> wgpu::Instance {
         ensure_runtime_dir();
-        let instance = wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
+        wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env())
+    }
+
+    /// Opens an adapter of `instance` that can present to `surface` (a window's), so that the
+    /// player's frames can be drawn straight into the window's surface textures; also returns
+    /// what the surface supports on that adapter (formats, present and alpha modes).
+    pub fn for_surface(
+        instance: &wgpu::Instance,
+        surface: &wgpu::Surface<'_>,
+        options: GpuOptions,
+    ) -> Result<(Gpu, wgpu::SurfaceCapabilities), PlayError> {
+        let (gpu, adapter) = Gpu::open(instance, Some(surface), options)?;
+        let caps = surface.get_capabilities(&adapter);
+        Ok((gpu, caps))
+    }
+
+    fn open(instance: &wgpu::Instance, surface: Option<&wgpu::Surface<'_>>, options: GpuOptions) -> Result<(Gpu, wgpu::Adapter), PlayError> {
         let adapter = pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions {
             power_preference: wgpu::PowerPreference::HighPerformance,
             force_fallback_adapter: false,
-            compatible_surface: None,
+            compatible_surface: surface,
             apply_limit_buckets: false,
         }))
         .map_err(|e| PlayError::NoAdapter(e.to_string()))?;
@@ -114,7 +138,7 @@ impl Gpu {
             ..Default::default()
         }))
         .map_err(|e| PlayError::Device { adapter: info.name.clone(), message: e.to_string() })?;
-        Ok(Gpu { device, queue, info, limits, texture_format })
+        Ok((Gpu { device, queue, info, limits, texture_format }, adapter))
     }
 
     /// A one-line description of the adapter: name, backend, device type, driver.
