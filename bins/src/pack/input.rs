@@ -55,7 +55,7 @@ pub(crate) fn load(req: &PackRequest, stages: &mut Stages) -> Result<LoadedSet, 
     let (dir, scene_path) = if req.input.is_dir() {
         (req.input.clone(), req.input.join("scene.toml"))
     } else if req.input.is_file() {
-        let options = LoadOptions { preset: None, resolution: req.resolution, spp: req.spp };
+        let options = LoadOptions { preset: req.preset.clone(), resolution: req.resolution, spp: req.spp };
         let scene = pis_scene::load_with(&req.input, &options).map_err(|e| Failure::new(Exit::Invalid, e))?;
         let dir = cache_dir(&req.input, &scene);
         if !dir.join("set.json").is_file() {
@@ -70,7 +70,7 @@ pub(crate) fn load(req: &PackRequest, stages: &mut Stages) -> Result<LoadedSet, 
     let scene_path = req.scene.clone().unwrap_or(scene_path);
     let set = RaySet::open(&dir).map_err(trace_failure)?;
     let res = (set.meta.resolution[0], set.meta.resolution[1]);
-    let options = LoadOptions { resolution: Some(res), ..LoadOptions::default() };
+    let options = LoadOptions { preset: req.preset.clone(), resolution: Some(res), ..LoadOptions::default() };
     let scene = pis_scene::load_with(&scene_path, &options)
         .map_err(|e| Failure::new(Exit::Invalid, anyhow!("loading {} (the set's scene; pass --scene): {e}", scene_path.display())))?;
     if set.meta.points.len() != scene.space.point_count() {
