@@ -206,3 +206,51 @@ fn rd_argument_errors() {
     let out = bench(&["rd"]);
     assert_eq!(out.status.code(), Some(1));
 }
+
+#[test]
+fn stability_reports_every_representation_on_both_paths() {
+    let dir = tempfile::tempdir().expect("temporary directory");
+    let Some(set) = tiny_demo1_set(dir.path()) else { return };
+    let out_dir = dir.path().join("reports");
+    let out = bench(&["stability", set.to_str().unwrap(), "--ratios", "200", "--frames", "4", "--reference-spp", "1",
+                      "--out", out_dir.to_str().unwrap(), "--json"]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("JSON on stdout");
+    let csv = std::fs::read_to_string(out_dir.join("stability.csv")).expect("stability.csv");
+    let svg = std::fs::read_to_string(out_dir.join("stability.svg")).expect("stability.svg");
+    let s = v["summaries"].as_array().expect("summaries");
+    assert_eq!(s.len(), 4, "solved and 200:1, each between and away");
+    let mean = |rep: &str, path: &str| s.iter().find(|x| x["representation"] == rep && x["path"] == path).and_then(|x| x["mean_psnr_db"].as_f64()).unwrap();
+    for path in ["between", "away"] {
+        for rep in ["solved", "wavelet 200:1"] {
+            assert!(mean(rep, path) > 10.0, "{rep} {path}: {} dB", mean(rep, path));
+            assert!(svg.contains(&format!("{rep} · {path}")), "the chart names {rep} · {path}");
+            assert_eq!(csv.lines().filter(|l| l.starts_with(&format!("{rep},{path},"))).count(), 4, "{rep} {path}: 4 frames in\n{csv}");
+        }
+        // an extreme ratio costs quality off the samples too
+        assert!(mean("wavelet 200:1", path) < mean("solved", path), "{path}");
+    }
+    for x in s {
+        assert!(x["popping"].as_f64().is_some_and(|p| p.is_finite() && p > 0.0), "{x}");
+    }
+}
+
+#[test]
+fn speed_stability_and_all_argument_errors() {
+    let out = bench(&["speed", "/no/such/set"]);
+    assert_eq!(out.status.code(), Some(2));
+    let out = bench(&["stability", "/no/such/set"]);
+    assert_eq!(out.status.code(), Some(2));
+    let scene = demo1();
+    if scene.exists() {
+        let out = bench(&["speed", scene.to_str().unwrap(), "--caps", "0"]);
+        assert_eq!(out.status.code(), Some(1));
+        let out = bench(&["stability", scene.to_str().unwrap(), "--frames", "1"]);
+        assert_eq!(out.status.code(), Some(1));
+    }
+    let out = bench(&["all", "--preset", "huge"]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("ci or paper"));
+    let out = bench(&["all", "--preset", "ci", "--scene", "/no/such/scene.toml"]);
+    assert_eq!(out.status.code(), Some(2));
+}

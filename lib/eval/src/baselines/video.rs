@@ -192,7 +192,7 @@ fn encode_all(videos: &[Frames], codec: VideoCodec, crf: f64) -> Result<Vec<Vec<
 
 /// Encodes every video at one common rate factor (one quality for all: equal slopes, as
 /// an encoder's own rate control would aim for), the finest rate factor whose total bytes
-/// stay within `budget`, found by bisection (x265: to 0.05 CRF or within 2 % below the
+/// stay within `budget`, found by bisection (x265: to 0.05 CRF or within 5 % below the
 /// budget; AV1: the integer CRF).
 pub fn encode_to_budget(videos: &[Frames], codec: VideoCodec, budget: usize) -> Result<Matched> {
     let (mut lo, mut hi, integral) = codec.quality_range();
@@ -215,7 +215,7 @@ pub fn encode_to_budget(videos: &[Frames], codec: VideoCodec, budget: usize) -> 
         let bytes = total(&s);
         if bytes <= budget {
             hi = mid;
-            let close = bytes as f64 >= 0.98 * budget as f64;
+            let close = bytes as f64 >= 0.95 * budget as f64;
             best = (mid, s);
             if close {
                 break;
