@@ -202,6 +202,9 @@ fn rd_argument_errors() {
         assert!(String::from_utf8_lossy(&out.stderr).contains("at least 1"));
         let out = bench(&["rd", scene.to_str().unwrap(), "--ratios", "abc"]);
         assert_eq!(out.status.code(), Some(1));
+        let out = bench(&["rd", scene.to_str().unwrap(), "--methods", "pis-wavelet,jpeg"]);
+        assert_eq!(out.status.code(), Some(1));
+        assert!(String::from_utf8_lossy(&out.stderr).contains("unknown method \"jpeg\""));
     }
     let out = bench(&["rd"]);
     assert_eq!(out.status.code(), Some(1));

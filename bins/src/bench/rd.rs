@@ -45,6 +45,8 @@ pub struct RdRequest {
     pub preset: Option<String>,
     /// Record a row in docs/BENCHMARKS.md.
     pub record: bool,
+    /// The methods to run (empty: all of [`METHODS`]).
+    pub methods: Vec<String>,
 }
 
 /// One measured point.
@@ -123,6 +125,9 @@ pub fn check(req: &RdRequest) -> Result<(), Failure> {
     if let Some(r) = req.ratios.iter().find(|r| !(r.is_finite() && **r >= 1.0)) {
         return Err(Failure::new(Exit::Usage, anyhow!("--ratios: every ratio must be at least 1, got {r}")));
     }
+    if let Some(m) = req.methods.iter().find(|m| !METHODS.contains(&m.as_str())) {
+        return Err(Failure::new(Exit::Usage, anyhow!("--methods: unknown method {m:?} (one of {})", METHODS.join(", "))));
+    }
     if req.max_texture == 0 || req.max_texture > 16384 {
         return Err(Failure::new(Exit::Usage, anyhow!("--max-texture must be in 1..=16384")));
     }
@@ -155,7 +160,11 @@ pub fn run(req: &RdRequest) -> Result<RdReport, Failure> {
     let mut rows = Vec::new();
     let mut skipped = Vec::new();
     let budget = |r: f64| (raw as f64 / r) as usize;
+    let wanted = |m: &str| req.methods.is_empty() || req.methods.iter().any(|x| x == m);
     let pis = |name: &str, inf: &Inferred, codec: CodecId, pyramid: PyramidMode, rows: &mut Vec<RdRow>| -> Result<(), Failure> {
+        if !wanted(name) {
+            return Ok(());
+        }
         for &r in &req.ratios {
             let p = inf.pack_point(&PackRequest { ratio: Some(r), codec, pyramid, ..base.clone() })?;
             eprintln!("pis-bench: rd: {name:<28} {r:>7.1}:1 → {:>7.1}:1  {:6.2} dB", p.ratio(), p.psnr_db);
@@ -168,12 +177,13 @@ pub fn run(req: &RdRequest) -> Result<RdReport, Failure> {
     pis("pis-wavelet", &separate, CodecId::Wavelet, PyramidMode::Adaptive, &mut rows)?;
     pis("pis-dct", &separate, CodecId::Dct, PyramidMode::Adaptive, &mut rows)?;
     pis("pis-wavelet-full-pyramid", &separate, CodecId::Wavelet, PyramidMode::Full, &mut rows)?;
-    eprintln!("pis-bench: rd: inferring again with one combined lighting layer");
-    let combined = Inferred::new(&PackRequest { layers: LayerMode::Combined, ..base.clone() })?;
-    pis("pis-wavelet-combined-layers", &combined, CodecId::Wavelet, PyramidMode::Adaptive, &mut rows)?;
-    drop(combined);
+    if wanted("pis-wavelet-combined-layers") {
+        eprintln!("pis-bench: rd: inferring again with one combined lighting layer");
+        let combined = Inferred::new(&PackRequest { layers: LayerMode::Combined, ..base.clone() })?;
+        pis("pis-wavelet-combined-layers", &combined, CodecId::Wavelet, PyramidMode::Adaptive, &mut rows)?;
+    }
 
-    if video_or_skip(VideoCodec::X265, &mut skipped, "mpeg-texture-x265")? {
+    if wanted("mpeg-texture-x265") && video_or_skip(VideoCodec::X265, &mut skipped, "mpeg-texture-x265")? {
         for &r in &req.ratios {
             let t = Instant::now();
             let p = texture_point(&separate, budget(r)).map_err(runtime)?;
@@ -186,7 +196,7 @@ pub fn run(req: &RdRequest) -> Result<RdReport, Failure> {
     }
     let frames = view_frames(&separate).map_err(runtime)?;
     for (codec, name) in [(VideoCodec::X265, "view-x265"), (VideoCodec::Av1, "view-av1")] {
-        if !video_or_skip(codec, &mut skipped, name)? {
+        if !wanted(name) || !video_or_skip(codec, &mut skipped, name)? {
             continue;
         }
         for &r in &req.ratios {

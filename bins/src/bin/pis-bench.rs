@@ -120,6 +120,11 @@ enum Command {
         /// A `[preset.NAME]` of scene.toml when tracing one.
         #[arg(long)]
         preset: Option<String>,
+        /// Only these methods (comma-separated; default all): pis-wavelet, pis-dct,
+        /// pis-wavelet-full-pyramid, pis-wavelet-combined-layers, mpeg-texture-x265,
+        /// view-x265, view-av1.
+        #[arg(long, value_delimiter = ',')]
+        methods: Vec<String>,
         /// Record the run (machine, scene, command, PSNR near 384:1) in docs/BENCHMARKS.md.
         #[arg(long)]
         record: bool,
@@ -259,8 +264,8 @@ fn run(cli: Cli) -> Result<Exit, Failure> {
             }
             Ok(Exit::Ok)
         }
-        Command::Rd { input, scene, ratios, out, resolution, spp, max_texture, preset, record, json } => {
-            let req = RdRequest { input, scene, ratios, out, resolution, spp, max_texture, preset, record };
+        Command::Rd { input, scene, ratios, out, resolution, spp, max_texture, preset, methods, record, json } => {
+            let req = RdRequest { input, scene, ratios, out, resolution, spp, max_texture, preset, record, methods };
             let report = rd::run(&req)?;
             rd::print(&report, &mut std::io::stderr()).map_err(|e| Failure::new(Exit::Io, e))?;
             if json {
