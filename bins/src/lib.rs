@@ -7,3 +7,4 @@ pub mod images;
 pub mod infer;
 pub mod inspect;
 pub mod pack;
+pub mod play;

@@ -6,5 +6,6 @@
 
 pub mod baselines;
 pub mod chart;
+pub mod compare;
 pub mod metrics;
 pub mod report;

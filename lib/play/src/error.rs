@@ -25,4 +25,16 @@ pub enum PlayError {
     Readback(String),
     #[error(transparent)]
     Model(#[from] pis_compile::ModelError),
+    /// The .pis file could not be read, is invalid, or asks for something unsupported.
+    #[error(transparent)]
+    File(#[from] pis_format::Error),
+    /// The file is structurally valid but the player cannot draw it as it is.
+    #[error("{path}: {message}")]
+    Content { path: String, message: String },
+    /// A frame request that does not fit the file (wrong number of values, non-finite value).
+    #[error("{0}")]
+    Request(String),
+    /// A decoding worker failed outside the decoder (it panicked or its pool could not start).
+    #[error("decoding worker: {0}")]
+    Worker(String),
 }

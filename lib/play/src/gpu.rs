@@ -103,6 +103,9 @@ impl Gpu {
         } else {
             (wgpu::TextureFormat::Rgba16Float, wgpu::Features::empty())
         };
+        // Float32 blending lets the player add layers in an Rgba32Float frame (else it
+        // accumulates in Rgba16Float).
+        let features = features | (adapter.features() & wgpu::Features::FLOAT32_BLENDABLE);
         let limits = adapter.limits();
         let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
             label: Some("pis-play"),

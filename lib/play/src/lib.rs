@@ -1,18 +1,30 @@
-//! The PIS player over wgpu. So far: the textured-object pipeline (`textured.rs` +
-//! `textured.wgsl`), which draws an object exactly as pis-compile's hardware model says,
-//! offscreen into a float target; and probe mode (thesis 3.4.3), which measures an object's
-//! render matrix through that pipeline.
+//! The PIS player over wgpu: the textured-object pipeline (`textured.rs` + `textured.wgsl`),
+//! which draws an object exactly as pis-compile's hardware model says, offscreen into a
+//! float target; probe mode (thesis 3.4.3), which measures an object's render matrix through
+//! that pipeline; and the runtime (thesis 4.7, [`Player`]): random-access reading of a
+//! `.pis`, decoding on worker threads through a level-image cache with lifetimes, GPU MIP
+//! chains, and frames of every object with its layers.
 //!
 //! Without a GPU, wgpu runs on Mesa's lavapipe: `apt-get install -y mesa-vulkan-drivers`.
 
+pub mod blend;
+pub mod cache;
+pub mod camera;
+pub mod decode;
 pub mod error;
+pub mod frame;
 pub mod gpu;
 pub mod image;
+pub mod mip;
+pub mod player;
 pub mod probe;
 pub mod textured;
 
+pub use blend::Blend;
+pub use camera::{CameraChoice, ViewCamera};
 pub use error::{PlayError, ADAPTER_HINT};
 pub use gpu::{Gpu, GpuOptions};
 pub use image::FloatImage;
+pub use player::{FrameRequest, FrameStats, Player, PlayerOptions};
 pub use probe::probe_render_matrix;
 pub use textured::{render_object, ObjectScene, ObjectTexture, TexturedPipeline};

@@ -1,0 +1,179 @@
+//! Played frames against the ray-traced gold standard: every sample point of a set drawn
+//! through the player (offscreen), PSNR on display values per object and for the whole
+//! image.
+//!
+//! Per object, the measure is pis-pack's prediction's: the pixels the player draws the
+//! object at (its object index) that the tracer's coverage says the object covers, against
+//! the object's gold surface radiance there (diffuse + specular layers, both stored divided
+//! by coverage). The whole image is measured against the set's combined image.
+
+use std::path::Path;
+
+use anyhow::{anyhow, bail, Context, Result};
+use pis_format::blocks::BlockGrid;
+use pis_play::{CameraChoice, FloatImage, FrameRequest, Player};
+use pis_trace::layers::LayerKind;
+use pis_trace::set::RaySet;
+
+use crate::metrics::SquaredError;
+
+/// Comparison settings.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct CompareOptions {
+    /// Frame size; default the set's resolution (other sizes are compared after nothing:
+    /// the size must equal the set's for pixel-wise PSNR).
+    pub size: Option<(u32, u32)>,
+}
+
+/// One parameter block of one object.
+#[derive(Clone, Debug, PartialEq)]
+pub struct BlockScore {
+    pub block: usize,
+    pub psnr_db: f64,
+    pub error: SquaredError,
+}
+
+/// One object over all points.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ObjectScore {
+    pub name: String,
+    pub psnr_db: f64,
+    pub error: SquaredError,
+    pub blocks: Vec<BlockScore>,
+}
+
+/// One sample point.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PointComparison {
+    pub index: usize,
+    pub point: Vec<f32>,
+    /// Whole image.
+    pub psnr_db: f64,
+    pub objects: Vec<ObjectScore>,
+}
+
+/// All points.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Comparison {
+    /// Whole image, every point.
+    pub psnr_db: f64,
+    /// Every object's covered pixels pooled (each object's measure, summed over objects):
+    /// what pis-pack reports as its predicted `psnr_db`.
+    pub covered_psnr_db: f64,
+    pub objects: Vec<ObjectScore>,
+    pub points: Vec<PointComparison>,
+}
+
+/// One drawn frame with its gold image, handed to the caller as it is compared.
+pub struct FramePair<'a> {
+    pub index: usize,
+    pub point: &'a [f32],
+    pub rendered: &'a FloatImage,
+    pub gold: &'a FloatImage,
+    pub object_ids: &'a [u32],
+}
+
+/// Draws every sample point of the set at `set_dir` through `player` (offscreen, the file's
+/// camera at each point) and compares. `each` sees every frame with its gold image.
+pub fn compare_with_set(player: &mut Player, set_dir: &Path, options: &CompareOptions, each: &mut dyn FnMut(&FramePair)) -> Result<Comparison> {
+    let set = RaySet::open(set_dir).with_context(|| format!("opening the ray-traced set {}", set_dir.display()))?;
+    let res = (set.meta.resolution[0], set.meta.resolution[1]);
+    let size = options.size.unwrap_or(res);
+    if size != res {
+        bail!("frames of {}x{} cannot be compared pixel by pixel with the set's {}x{} gold images", size.0, size.1, res.0, res.1);
+    }
+    let dims = player.dimensions().len();
+    let names = player.object_names();
+    // Per object of the file: the set's channel name.
+    let channels: Vec<String> = names
+        .iter()
+        .map(|n| {
+            set.meta.objects.iter().find(|o| &o.name == n).map(|o| o.channel_name.clone()).ok_or_else(|| anyhow!("object '{n}' of the file is not in the set {}", set_dir.display()))
+        })
+        .collect::<Result<_>>()?;
+    // Per object: the grid of its layer that depends on the most dimensions (the blocks a
+    // score is reported for).
+    let grids: Vec<BlockGrid> = {
+        let c = player.reader().container();
+        c.objects
+            .iter()
+            .map(|o| {
+                let mask = o.layers.iter().map(|l| l.depends_on).max_by_key(|m| m.count()).unwrap_or(pis_format::DepMask::NONE);
+                BlockGrid::new(&c.space, mask, &o.stagger)
+            })
+            .collect()
+    };
+    let block_count = |o: usize| grids[o].block_count() as usize;
+    let mut total = SquaredError::default();
+    let mut per_object: Vec<(SquaredError, Vec<SquaredError>)> = (0..names.len()).map(|o| (SquaredError::default(), vec![SquaredError::default(); block_count(o)])).collect();
+    let mut points = Vec::with_capacity(set.meta.points.len());
+    let npx = res.0 as usize * res.1 as usize;
+    for (i, p) in set.meta.points.iter().enumerate() {
+        if p.values.len() != dims || p.samples.len() != dims {
+            bail!("point {i} of {} has {} values, the file's parameter space {dims} dimensions", set_dir.display(), p.values.len());
+        }
+        let images = set.read_point(i).with_context(|| format!("reading point {i} of {}", set_dir.display()))?;
+        if (images.width, images.height) != res {
+            bail!("point {i} of {} is {}x{}, the set declares {}x{}", set_dir.display(), images.width, images.height, res.0, res.1);
+        }
+        let req = FrameRequest { point: p.values.clone(), camera: CameraChoice::Sample };
+        let (rendered, ids, _) = player.render_ids(&req, size).with_context(|| format!("drawing point {i} {:?}", p.values))?;
+        let combined = images.layer("combined").ok_or_else(|| anyhow!("point {i} of {} has no combined image", set_dir.display()))?;
+        let mut gold = FloatImage { width: res.0, height: res.1, rgba: vec![1.0; npx * 4] };
+        for (c, name) in ["R", "G", "B"].iter().enumerate() {
+            let plane = combined.channel(name).ok_or_else(|| anyhow!("point {i}: combined image without {name}"))?;
+            for k in 0..npx {
+                gold.rgba[k * 4 + c] = plane[k];
+            }
+        }
+        let mut whole = SquaredError::default();
+        for k in 0..npx {
+            for c in 0..3 {
+                whole.add(rendered.rgba[k * 4 + c], gold.rgba[k * 4 + c]);
+            }
+        }
+        let mut objects = Vec::with_capacity(names.len());
+        for (o, ch) in channels.iter().enumerate() {
+            let layer = |kind: LayerKind| images.object_layer(ch, kind);
+            let cov = layer(LayerKind::Coverage).and_then(|l| l.channel("A"));
+            let (d, s) = (layer(LayerKind::Diffuse), layer(LayerKind::Specular));
+            let planes: Vec<[Option<&[f32]>; 2]> = ["R", "G", "B"].iter().map(|c| [d.and_then(|l| l.channel(c)), s.and_then(|l| l.channel(c))]).collect();
+            let mut e = SquaredError::default();
+            if let Some(cov) = cov {
+                for k in 0..npx {
+                    if ids[k] != o as u32 || cov[k] <= 0.0 {
+                        continue;
+                    }
+                    for (c, [dp, sp]) in planes.iter().enumerate() {
+                        let g = dp.map_or(0.0, |p| p[k]) + sp.map_or(0.0, |p| p[k]);
+                        e.add(rendered.rgba[k * 4 + c], g);
+                    }
+                }
+            }
+            let block = grids[o].locate(&p.samples).block;
+            per_object[o].0.merge(&e);
+            if let Some(b) = per_object[o].1.get_mut(block) {
+                b.merge(&e);
+            }
+            objects.push(ObjectScore { name: names[o].clone(), psnr_db: e.psnr(), error: e, blocks: vec![BlockScore { block, psnr_db: e.psnr(), error: e }] });
+        }
+        total.merge(&whole);
+        each(&FramePair { index: i, point: &p.values, rendered: &rendered, gold: &gold, object_ids: &ids });
+        points.push(PointComparison { index: i, point: p.values.clone(), psnr_db: whole.psnr(), objects });
+    }
+    let mut covered = SquaredError::default();
+    let objects = per_object
+        .into_iter()
+        .zip(&names)
+        .map(|((e, blocks), name)| {
+            covered.merge(&e);
+            ObjectScore {
+                name: name.clone(),
+                psnr_db: e.psnr(),
+                error: e,
+                blocks: blocks.into_iter().enumerate().filter(|(_, b)| b.count > 0).map(|(block, b)| BlockScore { block, psnr_db: b.psnr(), error: b }).collect(),
+            }
+        })
+        .collect();
+    Ok(Comparison { psnr_db: total.psnr(), covered_psnr_db: covered.psnr(), objects, points })
+}

@@ -1,0 +1,82 @@
+// The player's frame: every object of the file, each layer of each drawn parameter sample
+// added in linear space. Two passes share `vs_main`, so their depths are identical:
+// `fs_id` writes depth and the object index (nearest surface wins), then `fs_layer` adds
+// weight × texture wherever the pixel's nearest surface is this object.
+//
+// `texcoord` and `texture_lod` are textured.wgsl's, character for character (a test
+// compares them): the twins of pis-compile's hardware model. Change them together.
+
+struct Uniforms {
+    // projection · view · world of the object.
+    clip_from_object: mat4x4<f32>,
+    // The block's affine texture transform (SPEC.md 7.3): (a, b, c, d) and (e, f).
+    affine_abcd: vec4<f32>,
+    affine_ef: vec2<f32>,
+    // Used size of level 0 in texels (w, h).
+    size: vec2<f32>,
+    // Used size / allocated size per axis: maps (s, t) ∈ [0, 1]² onto the used region.
+    scale: vec2<f32>,
+    // Largest level of detail: levels − 1 for trilinear, 0 for nearest and bilinear.
+    max_level: f32,
+    // Multilinear weight of this parameter sample's texture.
+    weight: f32,
+    // The object's index in the file.
+    object: u32,
+    _pad0: u32,
+    _pad1: u32,
+    _pad2: u32,
+};
+
+@group(0) @binding(0) var<uniform> u: Uniforms;
+@group(0) @binding(1) var tex: texture_2d<f32>;
+@group(0) @binding(2) var samp: sampler;
+@group(1) @binding(0) var ids: texture_2d<u32>;
+
+struct VsOut {
+    @invariant @builtin(position) clip: vec4<f32>,
+    // (s, t), interpolated perspective-correct.
+    @location(0) st: vec2<f32>,
+};
+
+// s = a·u + b·v + e, t = c·u + d·v + f.
+fn texcoord(uv: vec2<f32>) -> vec2<f32> {
+    return vec2<f32>(
+        u.affine_abcd.x * uv.x + u.affine_abcd.y * uv.y + u.affine_ef.x,
+        u.affine_abcd.z * uv.x + u.affine_abcd.w * uv.y + u.affine_ef.y,
+    );
+}
+
+// The Vulkan LOD for isotropic filtering: λ = clamp(log2(max(ρx, ρy)), 0, max_level).
+fn texture_lod(ddx: vec2<f32>, ddy: vec2<f32>, size: vec2<f32>, max_level: f32) -> f32 {
+    let rho_x = sqrt((ddx.x * size.x) * (ddx.x * size.x) + (ddx.y * size.y) * (ddx.y * size.y));
+    let rho_y = sqrt((ddy.x * size.x) * (ddy.x * size.x) + (ddy.y * size.y) * (ddy.y * size.y));
+    let rho = max(max(rho_x, rho_y), 1e-30);
+    return clamp(log2(rho), 0.0, max(max_level, 0.0));
+}
+
+@vertex
+fn vs_main(@location(0) position: vec3<f32>, @location(1) uv: vec2<f32>) -> VsOut {
+    var out: VsOut;
+    out.clip = u.clip_from_object * vec4<f32>(position, 1.0);
+    out.st = texcoord(uv);
+    return out;
+}
+
+@fragment
+fn fs_id(in: VsOut) -> @location(0) u32 {
+    return u.object;
+}
+
+@fragment
+fn fs_layer(in: VsOut) -> @location(0) vec4<f32> {
+    // Fine derivatives: differences across the pixel's row and column of its 2×2 quad.
+    let ddx = dpdxFine(in.st);
+    let ddy = dpdyFine(in.st);
+    let lambda = texture_lod(ddx, ddy, u.size, u.max_level);
+    let c = textureSampleLevel(tex, samp, in.st * u.scale, lambda);
+    if (textureLoad(ids, vec2<i32>(in.clip.xy), 0).r != u.object) {
+        discard;
+    }
+    // Colour adds up over layers and samples; alpha (blended with max) marks coverage.
+    return vec4<f32>(c.rgb * u.weight, 1.0);
+}

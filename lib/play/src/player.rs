@@ -1,0 +1,513 @@
+//! The player (thesis 4.7): opens a `.pis` for random access, and per frame decodes on
+//! worker threads the level images on the pyramid paths of the parameter samples it draws
+//! (through the level-image cache), rebuilds those textures, uploads them and builds their
+//! MIP chains on the GPU, and draws every object with its block's affine texture transform,
+//! layers added in linear space, objects depth-tested against each other.
+
+use std::collections::HashMap;
+use std::path::Path;
+use std::sync::Arc;
+use std::time::Instant;
+
+use pis_compile::{Address, Filter, Sampler, TextureLayout};
+use pis_format::blocks::{level_image_index, BlockGrid};
+use pis_format::texture::LevelLayout;
+use pis_format::{Container, Placement, PisReader, StreamRef};
+
+use crate::blend::{check_point, merge_for_mask, nearest_sample, weighted_samples, Blend};
+use crate::cache::{LevelCache, LevelKey};
+use crate::camera::{mat4_from_rows, projection, CameraChoice, ViewCamera};
+use crate::decode::{AssembleJob, Decoder, LevelJob};
+use crate::error::PlayError;
+use crate::frame::{colour_image, offscreen_format, FramePipelines, LayerDraw, MeshGpu, ObjectDraw, Readback, Targets};
+use crate::gpu::Gpu;
+use crate::image::FloatImage;
+use crate::mip::MipBuilder;
+use crate::textured::{create_sampler, ObjectTexture};
+
+/// The player's settings.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PlayerOptions {
+    /// Memory for decoded level images (default 512 MiB).
+    pub cache_budget_bytes: u64,
+    /// Lifetime of a leaf level image in frames (thesis a, default 20).
+    pub lifetime_a: u32,
+    /// Lifetime growth per pyramid level up (thesis b, default 4).
+    pub lifetime_b: u32,
+    /// Decoding threads (default: cores − 1, at least 1).
+    pub workers: usize,
+    /// Texture resolution reduction: 1 draws full resolution; 2, 4, … draw MIP level
+    /// log2(r) as the finest level (textures at 1/r resolution per side).
+    pub reduction: u32,
+    pub blend: Blend,
+}
+
+impl Default for PlayerOptions {
+    fn default() -> Self {
+        let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+        PlayerOptions { cache_budget_bytes: 512 << 20, lifetime_a: 20, lifetime_b: 4, workers: cores.saturating_sub(1).max(1), reduction: 1, blend: Blend::Nearest }
+    }
+}
+
+/// One frame to draw.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FrameRequest {
+    /// Per dimension, a value in the dimension's own values and units (as stored in PSPC);
+    /// values between samples are allowed.
+    pub point: Vec<f32>,
+    pub camera: CameraChoice,
+}
+
+/// What one frame cost.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct FrameStats {
+    /// Whole frame, request to drawn (and read back, for offscreen frames).
+    pub frame_ms: f64,
+    /// Waiting for the workers: level images decoded and textures rebuilt.
+    pub decode_ms: f64,
+    /// Texture uploads and GPU MIP chains.
+    pub upload_ms: f64,
+    pub upload_bytes: u64,
+    /// Level-image cache lookups of this frame.
+    pub cache_hits: u64,
+    pub cache_misses: u64,
+    /// Bytes of decoded level images cached after the frame.
+    pub cache_bytes: u64,
+    /// Codestreams read from the file for this frame.
+    pub codestreams_read: u64,
+}
+
+/// An object's mesh on the GPU and the layers the player draws.
+struct ObjectGpu {
+    mesh: MeshGpu,
+    /// Surface layers (shell layers are not drawn by this player).
+    layers: Vec<usize>,
+}
+
+/// A rebuilt texture: object, layer, block, the image of every pyramid level it sums.
+#[derive(Clone, Debug, PartialEq, Eq, Hash)]
+struct TextureKey {
+    object: u32,
+    layer: u32,
+    block: u32,
+    images: Vec<u32>,
+}
+
+/// A texture on the GPU and the frame that last drew it.
+struct Resident {
+    texture: ObjectTexture,
+    last_frame: u64,
+}
+
+/// One texture a frame draws.
+struct Wanted {
+    draw: usize,
+    key: TextureKey,
+    weight: f32,
+    affine: [f32; 6],
+    repeat: [bool; 2],
+}
+
+/// An open `.pis` ready to draw frames.
+pub struct Player {
+    gpu: Arc<Gpu>,
+    reader: PisReader,
+    options: PlayerOptions,
+    decoder: Decoder,
+    cache: LevelCache,
+    objects: Vec<ObjectGpu>,
+    filter: Filter,
+    pipes: FramePipelines,
+    mips: MipBuilder,
+    targets: Option<Targets>,
+    readback: Option<(Readback, Readback)>,
+    resident: HashMap<TextureKey, Resident>,
+    samplers: HashMap<[bool; 2], wgpu::Sampler>,
+    frame: u64,
+}
+
+/// The texture filter the file's textures were solved for: pis-pack records it in the
+/// provenance settings (`filter`); trilinear when absent.
+fn file_filter(c: &Container<StreamRef>) -> Filter {
+    let setting = c.provenance.as_ref().and_then(|p| p.settings.iter().find(|(k, _)| k == "filter")).map(|(_, v)| v.to_ascii_lowercase());
+    match setting.as_deref() {
+        Some("nearest") => Filter::Nearest,
+        Some("bilinear") => Filter::Bilinear,
+        _ => Filter::Trilinear,
+    }
+}
+
+fn content(reader: &PisReader, message: String) -> PlayError {
+    PlayError::Content { path: reader.path().display().to_string(), message }
+}
+
+/// Checks what the player relies on beyond the reader's validation and uploads the meshes.
+fn prepare_objects(gpu: &Gpu, reader: &PisReader) -> Result<Vec<ObjectGpu>, PlayError> {
+    let c = reader.container();
+    let mut out = Vec::with_capacity(c.objects.len());
+    let mut skipped = Vec::new();
+    for (oi, o) in c.objects.iter().enumerate() {
+        let n = o.mesh.positions.len();
+        let uvs: Vec<[f32; 2]> = match &o.mesh.texcoords {
+            Some(t) if t.len() == n => t.clone(),
+            Some(t) => return Err(content(reader, format!("object {oi} '{}': {} texture coordinates for {n} positions", o.name, t.len()))),
+            None => vec![[0.0; 2]; n],
+        };
+        if let Some(bad) = o.mesh.indices.iter().find(|&&i| i as usize >= n) {
+            return Err(content(reader, format!("object {oi} '{}': index {bad} with {n} positions", o.name)));
+        }
+        let mut layers = Vec::new();
+        for (li, l) in o.layers.iter().enumerate() {
+            let surface = l.blocks.iter().all(|b| matches!(b.placement, Placement::Surface { .. }));
+            if !surface {
+                skipped.push(format!("{}/{}", o.name, l.kind.name()));
+                continue;
+            }
+            if o.mesh.texcoords.is_none() {
+                return Err(content(reader, format!("object {oi} '{}' has a surface layer but no texture coordinates", o.name)));
+            }
+            if !(1..=4).contains(&l.channels) {
+                return Err(content(reader, format!("object {oi} '{}' layer {li} has {} channels", o.name, l.channels)));
+            }
+            layers.push(li);
+        }
+        out.push(ObjectGpu { mesh: MeshGpu::new(gpu, &o.mesh.positions, &uvs, &o.mesh.indices), layers });
+    }
+    if !skipped.is_empty() {
+        eprintln!("pis-play: note: shell layers are not drawn by this player: {}", skipped.join(", "));
+    }
+    Ok(out)
+}
+
+impl Player {
+    /// Opens `path` for random access (metadata read and checked; codestreams stay on disk
+    /// until a frame needs them).
+    pub fn open(gpu: Arc<Gpu>, path: &Path, options: PlayerOptions) -> Result<Player, PlayError> {
+        if options.reduction == 0 || !options.reduction.is_power_of_two() {
+            return Err(PlayError::Request(format!("texture resolution reduction {} must be a power of two (1, 2, 4, …)", options.reduction)));
+        }
+        let reader = PisReader::open(path)?;
+        let objects = prepare_objects(&gpu, &reader)?;
+        let filter = file_filter(reader.container());
+        let decoder = Decoder::new(options.workers)?;
+        let cache = LevelCache::new(options.cache_budget_bytes, options.lifetime_a, options.lifetime_b);
+        let pipes = FramePipelines::new(&gpu);
+        let mips = MipBuilder::new(&gpu);
+        Ok(Player {
+            gpu,
+            reader,
+            options,
+            decoder,
+            cache,
+            objects,
+            filter,
+            pipes,
+            mips,
+            targets: None,
+            readback: None,
+            resident: HashMap::new(),
+            samplers: HashMap::new(),
+            frame: 0,
+        })
+    }
+
+    /// The parameter space's dimensions.
+    pub fn dimensions(&self) -> &[pis_format::Dimension] {
+        &self.reader.container().space.dims
+    }
+
+    /// The objects' names, in file order (the indices `render_ids` reports).
+    pub fn object_names(&self) -> Vec<String> {
+        self.reader.container().objects.iter().map(|o| o.name.clone()).collect()
+    }
+
+    /// The image size of the file's cameras (the ray-traced set's resolution).
+    pub fn image_size(&self) -> (u32, u32) {
+        let c = &self.reader.container().cameras;
+        (c.width, c.height)
+    }
+
+    /// The options the player was opened with.
+    pub fn options(&self) -> &PlayerOptions {
+        &self.options
+    }
+
+    /// The open file (its container and read counters).
+    pub fn reader(&self) -> &PisReader {
+        &self.reader
+    }
+
+    /// The level-image cache.
+    pub fn cache(&self) -> &LevelCache {
+        &self.cache
+    }
+
+    /// The format offscreen frames are drawn in before readback.
+    pub fn offscreen_format(&self) -> wgpu::TextureFormat {
+        offscreen_format(&self.gpu)
+    }
+
+    /// The nearest parameter sample of `point` (missing values count as the first sample,
+    /// extra values are ignored).
+    fn nearest(&self, point: &[f32]) -> Vec<u32> {
+        let dims = self.dimensions();
+        let mut full: Vec<f32> = dims.iter().map(|d| d.values.first().copied().unwrap_or(0.0)).collect();
+        for (f, &v) in full.iter_mut().zip(point) {
+            if v.is_finite() {
+                *f = v;
+            }
+        }
+        nearest_sample(dims, &full)
+    }
+
+    fn camera_record(&self, sample: &[u32]) -> pis_format::Camera {
+        let c = self.reader.container();
+        let i = c.space.table_index(c.cameras.depends_on, sample);
+        c.cameras.cameras.get(i).or(c.cameras.cameras.first()).copied().unwrap_or(pis_format::Camera {
+            world_from_camera: pis_format::IDENTITY_3X4,
+            yfov: 0.8,
+            znear: 0.1,
+            zfar: 100.0,
+        })
+    }
+
+    /// The file's camera at `point` (its nearest view sample).
+    pub fn sample_camera(&self, point: &[f32]) -> ViewCamera {
+        ViewCamera::from_file(&self.camera_record(&self.nearest(point)))
+    }
+
+    /// Draws a frame offscreen; linear RGBA read back (alpha 1 where an object is drawn).
+    pub fn render_image(&mut self, req: &FrameRequest, size: (u32, u32)) -> Result<(FloatImage, FrameStats), PlayError> {
+        let (img, _, stats) = self.render_ids(req, size)?;
+        Ok((img, stats))
+    }
+
+    /// Draws a frame offscreen; also the object index per pixel (`u32::MAX`: none).
+    pub fn render_ids(&mut self, req: &FrameRequest, size: (u32, u32)) -> Result<(FloatImage, Vec<u32>, FrameStats), PlayError> {
+        let (out, stats) = self.frame(req, size, None)?;
+        let (img, ids) = out.ok_or_else(|| PlayError::Readback("no offscreen frame".into()))?;
+        Ok((img, ids, stats))
+    }
+
+    /// Draws a frame into `view` (any colour format; linear radiance, so an `*Srgb` format
+    /// does the sRGB encoding) of `size`.
+    pub fn render_to_view(&mut self, req: &FrameRequest, view: &wgpu::TextureView, format: wgpu::TextureFormat, size: (u32, u32)) -> Result<FrameStats, PlayError> {
+        Ok(self.frame(req, size, Some((view, format)))?.1)
+    }
+
+    /// The textures a frame draws, and the frame's objects' clip transforms.
+    fn plan(&self, req: &FrameRequest, size: (u32, u32)) -> Result<(Vec<glam::Mat4>, Vec<Wanted>), PlayError> {
+        let c = self.reader.container();
+        let dims = &c.space.dims;
+        check_point(dims, &req.point).map_err(PlayError::Request)?;
+        let samples = weighted_samples(dims, &req.point, self.options.blend);
+        let nearest = nearest_sample(dims, &req.point);
+        let clip_from_world = match req.camera {
+            CameraChoice::Sample => {
+                let cam = self.camera_record(&nearest);
+                let view = mat4_from_rows(&cam.world_from_camera).inverse();
+                projection(cam.yfov, cam.znear, cam.zfar, size.0, size.1) * view
+            }
+            CameraChoice::Free(cam) => {
+                cam.check().map_err(PlayError::Request)?;
+                cam.projection(size) * cam.view_matrix()
+            }
+        };
+        let mut clips = Vec::with_capacity(c.objects.len());
+        let mut wanted = Vec::new();
+        for (oi, (o, og)) in c.objects.iter().zip(&self.objects).enumerate() {
+            let t = &o.transforms;
+            let world = t.transforms.get(c.space.table_index(t.depends_on, &nearest)).map_or(glam::Mat4::IDENTITY, mat4_from_rows);
+            clips.push(clip_from_world * world);
+            for &li in &og.layers {
+                let layer = &o.layers[li];
+                let grid = BlockGrid::new(&c.space, layer.depends_on, &o.stagger);
+                for (s, w) in merge_for_mask(&samples, layer.depends_on) {
+                    let pos = grid.locate(&s);
+                    let block = layer.blocks.get(pos.block).ok_or_else(|| content(&self.reader, format!("object {oi} layer {li}: block {} missing", pos.block)))?;
+                    let Placement::Surface { affine, repeat, .. } = block.placement else { continue };
+                    let images = block.levels.iter().map(|l| level_image_index(&l.counts, &pos.local, &pos.extent) as u32).collect();
+                    let key = TextureKey { object: oi as u32, layer: li as u32, block: pos.block as u32, images };
+                    wanted.push(Wanted { draw: oi, key, weight: w, affine, repeat });
+                }
+            }
+        }
+        Ok((clips, wanted))
+    }
+
+    /// Decodes (on the workers) and uploads every wanted texture not on the GPU.
+    fn make_resident(&mut self, wanted: &[Wanted], stats: &mut FrameStats) -> Result<(), PlayError> {
+        let frame = self.frame;
+        let mut missing: Vec<&TextureKey> = Vec::new();
+        for w in wanted {
+            match self.resident.get_mut(&w.key) {
+                Some(r) => r.last_frame = frame,
+                None if !missing.contains(&&w.key) => missing.push(&w.key),
+                None => {}
+            }
+        }
+        if missing.is_empty() {
+            return Ok(());
+        }
+        let c = self.reader.container();
+        let t = Instant::now();
+        let hits0 = self.cache.counters();
+        // Level images: cached, or decoded on the workers (each once).
+        let mut have: HashMap<LevelKey, Arc<Vec<f32>>> = HashMap::new();
+        let mut jobs: Vec<(LevelKey, u32, LevelJob)> = Vec::new();
+        for k in &missing {
+            let layer = &c.objects[k.object as usize].layers[k.layer as usize];
+            let block = &layer.blocks[k.block as usize];
+            let planes = LevelLayout::of(layer, block).planes();
+            let n = block.levels.len() as u32;
+            for (lv, (level, &img)) in block.levels.iter().zip(&k.images).enumerate() {
+                let key = LevelKey { object: k.object, layer: k.layer, block: k.block, level: lv as u32, image: img };
+                if have.contains_key(&key) || jobs.iter().any(|j| j.0 == key) {
+                    continue;
+                }
+                match self.cache.get(&key) {
+                    Some(v) => {
+                        have.insert(key, v);
+                    }
+                    None => {
+                        let stream = *level.images.get(img as usize).ok_or_else(|| content(&self.reader, format!("{key:?}: no such level image")))?;
+                        let at = (k.object as usize, k.layer as usize, k.block as usize, lv);
+                        jobs.push((key, n - 1 - lv as u32, LevelJob { stream, planes: planes.clone(), at }));
+                    }
+                }
+            }
+        }
+        let level_jobs: Vec<LevelJob> = jobs.iter().map(|j| j.2.clone()).collect();
+        let decoded = self.decoder.decode_levels(&self.reader, &level_jobs);
+        let mut first_error = None;
+        for ((key, height, _), r) in jobs.into_iter().zip(decoded) {
+            match r {
+                Ok(v) => {
+                    let v = Arc::new(v);
+                    self.cache.insert(key, height, v.clone());
+                    have.insert(key, v);
+                }
+                Err(e) => {
+                    first_error.get_or_insert(e);
+                }
+            }
+        }
+        if let Some(e) = first_error {
+            return Err(e);
+        }
+        // Textures rebuilt on the workers.
+        let drop_levels = self.options.reduction.trailing_zeros();
+        let assemble: Vec<AssembleJob> = missing
+            .iter()
+            .map(|k| {
+                let layer = &c.objects[k.object as usize].layers[k.layer as usize];
+                let block = &layer.blocks[k.block as usize];
+                let levels = k.images.iter().enumerate().map(|(lv, &img)| have[&LevelKey { object: k.object, layer: k.layer, block: k.block, level: lv as u32, image: img }].clone()).collect();
+                let full = TextureLayout::full(block.width, block.height).levels;
+                AssembleJob { layer, layout: LevelLayout::of(layer, block), levels, drop_levels: drop_levels.min(full.saturating_sub(1)) }
+            })
+            .collect();
+        let images = self.decoder.assemble(&assemble);
+        drop(assemble);
+        stats.decode_ms += t.elapsed().as_secs_f64() * 1e3;
+        let hits1 = self.cache.counters();
+        stats.cache_hits += hits1.hits - hits0.hits;
+        stats.cache_misses += hits1.misses - hits0.misses;
+        // Uploads and GPU MIP chains.
+        let t = Instant::now();
+        let mut encoder = self.gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("uploads") });
+        let mut made = Vec::with_capacity(images.len());
+        for (k, img) in missing.iter().zip(&images) {
+            let texture = self.mips.texture(&self.gpu, TextureLayout::full(img.width, img.height));
+            stats.upload_bytes += self.mips.upload(&self.gpu, &texture, img, &mut encoder)?;
+            made.push(((*k).clone(), Resident { texture, last_frame: frame }));
+        }
+        self.gpu.queue.submit([encoder.finish()]);
+        self.gpu.device.poll(wgpu::PollType::wait_indefinitely()).map_err(|e| PlayError::Readback(e.to_string()))?;
+        self.resident.extend(made);
+        stats.upload_ms += t.elapsed().as_secs_f64() * 1e3;
+        Ok(())
+    }
+
+    fn frame(&mut self, req: &FrameRequest, size: (u32, u32), target: Option<(&wgpu::TextureView, wgpu::TextureFormat)>) -> Result<(Option<(FloatImage, Vec<u32>)>, FrameStats), PlayError> {
+        let t0 = Instant::now();
+        let reads0 = self.reader.stats().codestreams;
+        let mut stats = FrameStats::default();
+        let (clips, wanted) = self.plan(req, size)?;
+        let result = self.make_resident(&wanted, &mut stats);
+        if let Err(e) = result {
+            self.end_frame();
+            return Err(e);
+        }
+        if self.targets.as_ref().is_none_or(|t| t.size != size) {
+            self.targets = Some(Targets::new(&self.gpu, &self.pipes, size)?);
+            self.readback = None;
+        }
+        let gpu = self.gpu.clone();
+        let objects: Vec<ObjectDraw> = self.objects.iter().zip(&clips).enumerate().map(|(i, (o, &clip))| ObjectDraw { object: i as u32, mesh: &o.mesh, clip_from_object: clip }).collect();
+        for w in &wanted {
+            self.samplers.entry(w.repeat).or_insert_with(|| {
+                let address = w.repeat.map(|r| if r { Address::Repeat } else { Address::ClampToEdge });
+                create_sampler(&gpu, &Sampler { filter: self.filter, address })
+            });
+        }
+        let mut layers = Vec::with_capacity(wanted.len());
+        for w in &wanted {
+            let texture = &self.resident[&w.key].texture;
+            let sampler = Sampler { filter: self.filter, address: w.repeat.map(|r| if r { Address::Repeat } else { Address::ClampToEdge }) };
+            for (axis, k, s) in [('s', 0, texture.layout.width), ('t', 1, texture.layout.height)] {
+                if w.repeat[k] && !s.is_power_of_two() {
+                    return Err(PlayError::RepeatSize { axis, size: s });
+                }
+            }
+            layers.push(LayerDraw {
+                draw: w.draw,
+                texture,
+                sampler: &self.samplers[&w.repeat],
+                affine: w.affine,
+                max_level: pis_compile::filter::max_level(&texture.layout, &sampler) as f32,
+                weight: w.weight,
+            });
+        }
+        let targets = self.targets.as_ref().expect("targets made above");
+        let mut encoder = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("frame") });
+        let offscreen_view;
+        let (view, format) = match target {
+            Some(t) => t,
+            None => {
+                offscreen_view = targets.colour.create_view(&Default::default());
+                (&offscreen_view, targets.colour.format())
+            }
+        };
+        crate::frame::encode(&gpu, &mut self.pipes, targets, view, format, &objects, &layers, &mut encoder);
+        let out = if target.is_none() {
+            let texel = if format == wgpu::TextureFormat::Rgba16Float { 8 } else { 16 };
+            let (rc, ri) = self.readback.get_or_insert_with(|| (Readback::new(&gpu, size, texel), Readback::new(&gpu, size, 4)));
+            rc.copy(&targets.colour, &mut encoder);
+            ri.copy(&targets.ids, &mut encoder);
+            gpu.queue.submit([encoder.finish()]);
+            let colour = colour_image(&rc.read(&gpu)?, format, size);
+            let ids = ri.read(&gpu)?.chunks_exact(4).map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]])).collect();
+            Some((colour, ids))
+        } else {
+            gpu.queue.submit([encoder.finish()]);
+            None
+        };
+        drop(layers);
+        drop(objects);
+        self.end_frame();
+        stats.cache_bytes = self.cache.bytes();
+        stats.codestreams_read = self.reader.stats().codestreams - reads0;
+        stats.frame_ms = t0.elapsed().as_secs_f64() * 1e3;
+        Ok((out, stats))
+    }
+
+    /// Ends the frame: level-image lifetimes and budget, and GPU textures the frame did not
+    /// draw released.
+    fn end_frame(&mut self) {
+        let frame = self.frame;
+        self.resident.retain(|_, r| r.last_frame == frame);
+        self.cache.end_frame();
+        self.frame += 1;
+    }
+}

@@ -1,0 +1,155 @@
+//! The player on samples/tiny.pis and the GPU MIP chain: a frame reads exactly the
+//! codestreams on the pyramid paths of the samples it draws (fewer when level images are
+//! cached or textures resident), multilinear blending between two light samples is the
+//! weighted sum of their frames, and the GPU's MIP decimation equals pis-format's.
+
+mod common;
+
+use std::path::PathBuf;
+use std::sync::Arc;
+
+use common::*;
+use pis_format::mip::{decimate, mip_size};
+use pis_play::decode::TextureImage;
+use pis_play::mip::{read_levels, MipBuilder};
+use pis_play::{Blend, CameraChoice, FrameRequest, Player, PlayerOptions};
+
+fn tiny() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../samples/tiny.pis")
+}
+
+/// Distinct codestreams on the pyramid paths of every surface layer at `points`.
+fn path_streams(player: &Player, points: &[Vec<u32>]) -> Vec<(u32, u64)> {
+    let r = player.reader();
+    let mut out = Vec::new();
+    for (oi, o) in r.container().objects.iter().enumerate() {
+        for (li, l) in o.layers.iter().enumerate() {
+            if l.kind.is_shell() {
+                continue;
+            }
+            for p in points {
+                for s in r.texture_path(oi, li, p).unwrap().1 {
+                    if !out.contains(&(s.chunk, s.offset)) {
+                        out.push((s.chunk, s.offset));
+                    }
+                }
+            }
+        }
+    }
+    out
+}
+
+fn at(player: &Player, samples: &[u32]) -> FrameRequest {
+    let point = player.dimensions().iter().zip(samples).map(|(d, &s)| d.values[s as usize]).collect();
+    FrameRequest { point, camera: CameraChoice::Sample }
+}
+
+#[test]
+fn a_frame_reads_only_the_codestreams_of_its_pyramid_paths() {
+    let Some(gpu) = gpu_or_skip("a_frame_reads_only_the_codestreams_of_its_pyramid_paths") else { return };
+    let mut player = Player::open(Arc::new(gpu), &tiny(), PlayerOptions { workers: 2, ..Default::default() }).unwrap();
+    let size = player.image_size();
+    // tiny.pis: dimensions (view, light); the surface layer varies with light.
+    let first = vec![0, 0];
+    let (img, ids, s) = player.render_ids(&at(&player, &first), size).unwrap();
+    let want = path_streams(&player, &[first.clone()]);
+    assert!(!want.is_empty());
+    assert_eq!(s.codestreams_read, want.len() as u64, "first frame reads its pyramid path");
+    assert_eq!(player.reader().stats().codestreams, want.len() as u64);
+    assert_eq!((s.cache_misses, s.cache_hits), (want.len() as u64, 0));
+    assert!(s.upload_bytes > 0 && s.cache_bytes > 0);
+    let covered = ids.iter().filter(|&&i| i == 0).count();
+    assert!(covered > 20, "the ball covers {covered} pixels");
+    assert!(ids.iter().all(|&i| i == 0 || i == u32::MAX));
+    for (k, &i) in ids.iter().enumerate() {
+        let a = img.rgba[k * 4 + 3];
+        assert_eq!(a, if i == 0 { 1.0 } else { 0.0 }, "alpha marks the drawn pixels");
+    }
+    // Another view, same light: the texture is the same; nothing is read.
+    let (_, s) = player.render_image(&at(&player, &[1, 0]), size).unwrap();
+    assert_eq!(s.codestreams_read, 0);
+    // Another light: only the level images not already cached.
+    let second = vec![1, 1];
+    let (_, s) = player.render_image(&at(&player, &second), size).unwrap();
+    let both = path_streams(&player, &[first, second]);
+    assert_eq!(s.codestreams_read, (both.len() - want.len()) as u64, "shared pyramid levels come from the cache");
+    assert!(s.cache_hits >= 1, "the top level is shared");
+    assert_eq!(player.reader().stats().codestreams, both.len() as u64);
+}
+
+#[test]
+fn multilinear_blend_is_the_weighted_sum_of_the_sample_frames() {
+    let Some(gpu) = gpu_or_skip("multilinear_blend_is_the_weighted_sum_of_the_sample_frames") else { return };
+    let gpu = Arc::new(gpu);
+    let mut player = Player::open(gpu, &tiny(), PlayerOptions { blend: Blend::Multilinear, workers: 1, ..Default::default() }).unwrap();
+    let size = player.image_size();
+    let light = player.dimensions()[1].values.clone();
+    let view = player.dimensions()[0].values[0];
+    let camera = CameraChoice::Free(player.sample_camera(&[view, light[0]]));
+    let frame = |p: &mut Player, l: f32| p.render_image(&FrameRequest { point: vec![view, l], camera }, size).unwrap().0;
+    let a = frame(&mut player, light[0]);
+    let b = frame(&mut player, light[1]);
+    let w = 0.3f32;
+    let mid = frame(&mut player, light[0] + w * (light[1] - light[0]));
+    let want: Vec<f32> = a.rgba.iter().zip(&b.rgba).enumerate().map(|(k, (x, y))| if k % 4 == 3 { x.max(*y) } else { (1.0 - w) * x + w * y }).collect();
+    let differ = a.rgba.iter().zip(&b.rgba).filter(|(x, y)| (*x - *y).abs() > 1e-3).count();
+    assert!(differ > 10, "the two light samples differ ({differ} values)");
+    let p = psnr(&mid.rgba, &want);
+    assert!(p >= 50.0, "blend vs weighted sum: {p:.1} dB");
+}
+
+#[test]
+fn gpu_mip_chain_equals_cpu_decimation() {
+    let Some(gpu) = gpu_or_skip("gpu_mip_chain_equals_cpu_decimation") else { return };
+    let mips = MipBuilder::new(&gpu);
+    for (w, h) in [(13u32, 7u32), (16, 16), (1, 5), (37, 20)] {
+        let values: Vec<f32> = (0..w * h * 4).map(|k| ((k as u64 * 2654435761u64 % 1000) as f32) / 997.0).collect();
+        let layout = pis_compile::TextureLayout::full(w, h);
+        let (pw, ph) = (w.next_power_of_two(), h.next_power_of_two());
+        let mut rgba = vec![0.0; (pw * ph * 4) as usize];
+        for j in 0..ph {
+            for i in 0..pw {
+                let s = ((j.min(h - 1) * w + i.min(w - 1)) * 4) as usize;
+                let d = ((j * pw + i) * 4) as usize;
+                rgba[d..d + 4].copy_from_slice(&values[s..s + 4]);
+            }
+        }
+        let image = TextureImage { width: w, height: h, padded_width: pw, padded_height: ph, rgba };
+        let texture = mips.texture(&gpu, layout);
+        let mut enc = gpu.device.create_command_encoder(&Default::default());
+        mips.upload(&gpu, &texture, &image, &mut enc).unwrap();
+        gpu.queue.submit([enc.finish()]);
+        let levels = read_levels(&gpu, &texture).unwrap();
+        assert_eq!(levels.len() as u32, layout.levels);
+        // The CPU chain, padded like the GPU levels.
+        let mut cpu = values.clone();
+        for (m, (gw, gh, img)) in levels.iter().enumerate() {
+            let m = m as u32;
+            if m > 0 {
+                let (sw, sh) = mip_size(w, h, m - 1);
+                cpu = decimate(&cpu, sw, sh, 4);
+            }
+            let (uw, uh) = mip_size(w, h, m);
+            let mut want = vec![0.0f32; img.len()];
+            for j in 0..*gh {
+                for i in 0..*gw {
+                    let s = ((j.min(uh - 1) * uw + i.min(uw - 1)) * 4) as usize;
+                    let d = ((j * gw + i) * 4) as usize;
+                    want[d..d + 4].copy_from_slice(&cpu[s..s + 4]);
+                }
+            }
+            if gpu.texture_format == wgpu::TextureFormat::Rgba32Float {
+                assert_eq!(img, &want, "{w}x{h} level {m}: GPU and CPU decimation differ");
+            } else {
+                let p = psnr(img, &want);
+                assert!(p >= 60.0, "{w}x{h} level {m}: {p:.1} dB");
+            }
+        }
+    }
+}
+
+/// PSNR of linear values, peak 1.
+fn psnr(a: &[f32], b: &[f32]) -> f64 {
+    let mse = a.iter().zip(b).map(|(x, y)| (*x as f64 - *y as f64).powi(2)).sum::<f64>() / a.len().max(1) as f64;
+    if mse == 0.0 { f64::INFINITY } else { -10.0 * mse.log10() }
+}
