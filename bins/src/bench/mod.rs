@@ -6,6 +6,7 @@ pub mod all;
 pub mod camera_path;
 pub mod mpeg_texture;
 pub mod output;
+pub mod playback;
 pub mod rd;
 pub mod speed;
 pub mod stability;

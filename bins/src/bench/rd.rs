@@ -59,9 +59,14 @@ pub struct RdRow {
     pub bytes: usize,
     pub budget: usize,
     pub psnr_db: f64,
-    /// `covered-predicted` (through the hardware model over covered pixels) or
-    /// `whole-image`.
+    /// `whole-image-played` (PIS: the file played by the player, whole frames against the
+    /// set's images), `covered-predicted` (through the hardware model over covered pixels;
+    /// PIS without a GPU adapter, and MPEG-texture) or `whole-image` (decoded video).
     pub psnr_scope: String,
+    /// PIS: the PSNR pis-pack predicts through the hardware model over covered pixels.
+    pub psnr_db_predicted: Option<f64>,
+    /// PIS played: PSNR over the pixels the objects cover.
+    pub psnr_db_covered: Option<f64>,
     /// PIS: raw / whole container bytes; null for the others.
     pub file_ratio: Option<f64>,
     /// The encoder setting that met the budget (CRF), when one was searched.
@@ -161,16 +166,37 @@ pub fn run(req: &RdRequest) -> Result<RdReport, Failure> {
     let mut skipped = Vec::new();
     let budget = |r: f64| (raw as f64 / r) as usize;
     let wanted = |m: &str| req.methods.is_empty() || req.methods.iter().any(|x| x == m);
+    let gpu = match super::playback::gpu() {
+        Ok(g) => Some(g),
+        Err(e) => {
+            let why = format!("PIS points: {e}; PSNR predicted through the hardware model over covered pixels instead of played");
+            eprintln!("pis-bench: rd: {why}");
+            skipped.push(why);
+            None
+        }
+    };
     let pis = |name: &str, inf: &Inferred, codec: CodecId, pyramid: PyramidMode, rows: &mut Vec<RdRow>| -> Result<(), Failure> {
         if !wanted(name) {
             return Ok(());
         }
         for &r in &req.ratios {
-            let p = inf.pack_point(&PackRequest { ratio: Some(r), codec, pyramid, ..base.clone() })?;
-            eprintln!("pis-bench: rd: {name:<28} {r:>7.1}:1 → {:>7.1}:1  {:6.2} dB", p.ratio(), p.psnr_db);
-            rows.push(RdRow { method: name.into(), target_ratio: r, ratio: p.ratio(), bytes: p.texture_bytes, budget: budget(r), psnr_db: p.psnr_db,
-                              psnr_scope: "covered-predicted".into(), file_ratio: Some(p.file_ratio()), crf: None,
-                              reached: p.texture_bytes <= budget(r) + budget(r) / 20, ms: p.encode_ms });
+            let preq = PackRequest { ratio: Some(r), codec, pyramid, ..base.clone() };
+            let p = inf.pack_point(&preq)?;
+            let played = match &gpu {
+                Some(g) => {
+                    let file = req.out.join(format!(".rd-{name}-{r}.pis"));
+                    inf.write(&PackRequest { output: file.clone(), ..preq.clone() })?;
+                    let c = super::playback::played_psnr(g, &file, inf.set_dir());
+                    let _ = std::fs::remove_file(&file);
+                    Some(c.map_err(runtime)?)
+                }
+                None => None,
+            };
+            let (psnr, scope) = played.map_or((p.psnr_db, "covered-predicted"), |c| (c.0, "whole-image-played"));
+            eprintln!("pis-bench: rd: {name:<28} {r:>7.1}:1 → {:>7.1}:1  {psnr:6.2} dB {scope} (predicted {:.2} dB)", p.ratio(), p.psnr_db);
+            rows.push(RdRow { method: name.into(), target_ratio: r, ratio: p.ratio(), bytes: p.texture_bytes, budget: budget(r), psnr_db: psnr,
+                              psnr_scope: scope.into(), psnr_db_predicted: Some(p.psnr_db), psnr_db_covered: played.map(|c| c.1),
+                              file_ratio: Some(p.file_ratio()), crf: None, reached: p.texture_bytes <= budget(r) + budget(r) / 20, ms: p.encode_ms });
         }
         Ok(())
     };
@@ -190,7 +216,7 @@ pub fn run(req: &RdRequest) -> Result<RdReport, Failure> {
             eprintln!("pis-bench: rd: {:<28} {r:>7.1}:1 → {:>7.1}:1  {:6.2} dB  ({} videos, CRF {:.2})", "mpeg-texture-x265",
                       raw as f64 / p.bytes as f64, p.psnr_db, p.videos, p.matched.crf);
             rows.push(RdRow { method: "mpeg-texture-x265".into(), target_ratio: r, ratio: raw as f64 / p.bytes.max(1) as f64, bytes: p.bytes,
-                              budget: budget(r), psnr_db: p.psnr_db, psnr_scope: "covered-predicted".into(), file_ratio: None,
+                              budget: budget(r), psnr_db: p.psnr_db, psnr_scope: "covered-predicted".into(), psnr_db_predicted: None, psnr_db_covered: None, file_ratio: None,
                               crf: Some(p.matched.crf), reached: p.matched.reached, ms: t.elapsed().as_secs_f64() * 1e3 });
         }
     }
@@ -204,7 +230,7 @@ pub fn run(req: &RdRequest) -> Result<RdReport, Failure> {
             let p = view_point(&frames, codec, budget(r)).map_err(runtime)?;
             eprintln!("pis-bench: rd: {name:<28} {r:>7.1}:1 → {:>7.1}:1  {:6.2} dB  (CRF {:.2})", raw as f64 / p.matched.bytes as f64, p.psnr_db, p.matched.crf);
             rows.push(RdRow { method: name.into(), target_ratio: r, ratio: raw as f64 / p.matched.bytes.max(1) as f64, bytes: p.matched.bytes,
-                              budget: budget(r), psnr_db: p.psnr_db, psnr_scope: "whole-image".into(), file_ratio: None,
+                              budget: budget(r), psnr_db: p.psnr_db, psnr_scope: "whole-image".into(), psnr_db_predicted: None, psnr_db_covered: None, file_ratio: None,
                               crf: Some(p.matched.crf), reached: p.matched.reached, ms: t.elapsed().as_secs_f64() * 1e3 });
         }
     }
@@ -212,10 +238,11 @@ pub fn run(req: &RdRequest) -> Result<RdReport, Failure> {
     let set = &separate.set;
     let scene = format!("{} ({} points, {}x{})", set.scene.name, set.samples.len(), set.resolution.0, set.resolution.1);
     let stamp = Stamp::here(&scene);
-    let mut csv = Csv::new(&["method", "target_ratio", "ratio", "bytes", "budget", "psnr_db", "psnr_scope", "file_ratio", "crf", "reached", "ms"]);
+    let mut csv = Csv::new(&["method", "target_ratio", "ratio", "bytes", "budget", "psnr_db", "psnr_scope", "psnr_db_predicted", "psnr_db_covered", "file_ratio", "crf", "reached", "ms"]);
+    let opt = |v: Option<f64>| v.map_or(String::new(), |x| format!("{x:.3}"));
     for r in &rows {
         csv.push(vec![r.method.clone(), format!("{}", r.target_ratio), format!("{:.2}", r.ratio), r.bytes.to_string(), r.budget.to_string(),
-                      format!("{:.3}", r.psnr_db), r.psnr_scope.clone(), r.file_ratio.map_or(String::new(), |f| format!("{f:.2}")),
+                      format!("{:.3}", r.psnr_db), r.psnr_scope.clone(), opt(r.psnr_db_predicted), opt(r.psnr_db_covered), r.file_ratio.map_or(String::new(), |f| format!("{f:.2}")),
                       r.crf.map_or(String::new(), |c| format!("{c:.2}")), r.reached.to_string(), format!("{:.0}", r.ms)]);
     }
     let series: Vec<Series> = METHODS.iter().filter(|m| rows.iter().any(|r| &r.method == *m)).map(|m| Series {
@@ -224,7 +251,11 @@ pub fn run(req: &RdRequest) -> Result<RdReport, Failure> {
     }).collect();
     let chart = Chart {
         title: format!("Compression ratio vs PSNR — {scene}"),
-        subtitle: "PIS and mpeg-texture: PSNR predicted through the hardware model over covered pixels; view-*: whole decoded image; display values, peak 1".into(),
+        subtitle: if gpu.is_some() {
+            "PIS: files played by the player, whole image; mpeg-texture: predicted through the hardware model over covered pixels; view-*: whole decoded image".into()
+        } else {
+            "PIS and mpeg-texture: PSNR predicted through the hardware model over covered pixels (no GPU adapter); view-*: whole decoded image".into()
+        },
         x_label: "compression ratio (raw image bytes / bytes), log".into(),
         y_label: "PSNR (dB)".into(),
         x_log: true,
@@ -235,7 +266,7 @@ pub fn run(req: &RdRequest) -> Result<RdReport, Failure> {
         "budget = raw image bytes (points × width × height × 3) / target ratio; ratio = raw / bytes spent".into(),
         "PIS bytes: level images (as pis-pack's --ratio counts them); file_ratio adds geometry, tables and headers".into(),
         "videos: 8-bit yuv420p, BT.601 limited range, elementary streams (HEVC Annex B, AV1 OBUs), one common CRF searched per point".into(),
-        "PIS and mpeg-texture PSNR: predicted through the hardware model over covered pixels (pis-pack's figure); view-based: whole image".into(),
+        "PIS PSNR: the file played by the player (pis_eval::compare), whole image (psnr_db_covered: covered pixels); without a GPU adapter pis-pack's prediction over covered pixels. mpeg-texture: predicted through the hardware model over covered pixels; view-based: whole image".into(),
     ];
     let report = RdReport {
         scene, points: set.samples.len(), resolution: [set.resolution.0, set.resolution.1], raw_image_bytes: raw, rows, skipped,

@@ -4,8 +4,10 @@
 //! then packed at one ratio; PSNR predicted through the hardware model over covered pixels,
 //! for the textures as solved and after coding.
 //!
-//! Playback frame times need the player runtime (`pis_play::Player`), which this build does
-//! not have: the report says so and charts compile time only.
+//! Playback: the set packed at that ratio with each codec, played by the player runtime
+//! along the zig-zag path at texture-resolution reduction factors 1, 2 and 4: mean and worst
+//! frame time against the played frames' PSNR (see [`super::playback`]). Without a GPU
+//! adapter the report says why and charts compile time only.
 
 use std::path::PathBuf;
 
@@ -17,6 +19,7 @@ use pis_eval::report::{Csv, Stamp};
 use serde::Serialize;
 
 use super::output::{ensure_dir, record, write_chart};
+use super::playback::{gpu, measure, PlaybackRow};
 use crate::cli::{Exit, Failure};
 use crate::pack::{Inferred, LayerMode, PackRequest, PyramidMode};
 
@@ -52,8 +55,9 @@ pub struct SpeedReport {
     pub scene: String,
     pub points: usize,
     pub compile: Vec<CompileRow>,
+    pub playback: Vec<PlaybackRow>,
     /// Why playback is not measured, when it is not.
-    pub playback: Option<String>,
+    pub playback_skipped: Option<String>,
     pub csv: String,
     pub svg: String,
     pub stamp: Stamp,
@@ -84,6 +88,7 @@ pub fn run(req: &SpeedRequest) -> Result<SpeedReport, Failure> {
     let mut rows = Vec::new();
     let mut scene = String::new();
     let mut points = 0;
+    let mut last = None;
     for &cap in &req.caps {
         let inf = Inferred::new(&PackRequest { max_iterations: Some(cap), ..base.clone() })?;
         let p = inf.pack_point(&base)?;
@@ -95,6 +100,22 @@ pub fn run(req: &SpeedRequest) -> Result<SpeedReport, Failure> {
         eprintln!("pis-bench: speed: cap {cap:>5}: {:8.1} ms per point, {} iterations, {:.2} dB solved, {:.2} dB at {:.0}:1",
                   row.ms_per_point, row.solver_iterations, row.psnr_db_solved, row.psnr_db, row.ratio);
         rows.push(row);
+        last = Some(inf);
+    }
+    let (mut playback, mut playback_skipped) = (Vec::new(), None);
+    match (gpu(), last) {
+        (Ok(g), Some(inf)) => {
+            for codec in [CodecId::Wavelet, CodecId::Dct] {
+                let file = req.out.join(format!("speed-{}.pis", codec.name()));
+                inf.write(&PackRequest { codec, output: file.clone(), ..base.clone() })?;
+                playback.extend(measure(&g, &file, inf.set_dir(), codec.name(), &[1, 2, 4]).map_err(|e| Failure::new(Exit::Runtime, e))?);
+            }
+        }
+        (Err(e), _) => {
+            eprintln!("pis-bench: speed: playback skipped: {e}");
+            playback_skipped = Some(e.to_string());
+        }
+        (_, None) => {}
     }
     let stamp = Stamp::here(&scene);
     let mut csv = Csv::new(&["measure", "max_iterations", "ms_per_point", "solver_iterations", "psnr_db_solved", "psnr_db", "ratio"]);
@@ -102,15 +123,26 @@ pub fn run(req: &SpeedRequest) -> Result<SpeedReport, Failure> {
         csv.push(vec!["compile".into(), r.max_iterations.to_string(), format!("{:.2}", r.ms_per_point), r.solver_iterations.to_string(),
                       format!("{:.3}", r.psnr_db_solved), format!("{:.3}", r.psnr_db), format!("{:.2}", r.ratio)]);
     }
-    let series = vec![
-        Series { name: "compile: textures as solved".into(), points: rows.iter().map(|r| (r.ms_per_point, r.psnr_db_solved)).collect() },
-        Series { name: format!("compile: wavelet at {}:1", req.ratio), points: rows.iter().map(|r| (r.ms_per_point, r.psnr_db)).collect() },
+    for p in &playback {
+        csv.push(vec![format!("playback {} reduction {}", p.codec, p.reduction), String::new(), format!("mean {:.2} worst {:.2}", p.frame_ms_mean, p.frame_ms_worst),
+                      p.frames.to_string(), String::new(), format!("{:.3}", p.psnr_db), format!("{}", req.ratio)]);
+    }
+    let mut series = vec![
+        Series { name: "compile: textures as solved (ms per point)".into(), points: rows.iter().map(|r| (r.ms_per_point, r.psnr_db_solved)).collect() },
+        Series { name: format!("compile: wavelet at {}:1 (ms per point)", req.ratio), points: rows.iter().map(|r| (r.ms_per_point, r.psnr_db)).collect() },
     ];
+    for codec in ["wavelet", "dct"] {
+        let mine: Vec<&PlaybackRow> = playback.iter().filter(|p| p.codec == codec).collect();
+        if !mine.is_empty() {
+            series.push(Series { name: format!("playback {codec}: mean frame ms (reduction 1, 2, 4)"), points: mine.iter().map(|p| (p.frame_ms_mean, p.psnr_db)).collect() });
+            series.push(Series { name: format!("playback {codec}: worst frame ms"), points: mine.iter().map(|p| (p.frame_ms_worst, p.psnr_db)).collect() });
+        }
+    }
     let caps: Vec<String> = req.caps.iter().map(u32::to_string).collect();
     let chart = Chart {
-        title: format!("Compile time vs PSNR — {scene}"),
-        subtitle: format!("inference wall clock per parameter point across CG iteration caps {}; PSNR predicted through the hardware model over covered pixels", caps.join(", ")),
-        x_label: "compile time per parameter point (ms)".into(),
+        title: format!("Time vs PSNR — {scene}"),
+        subtitle: format!("compile: inference per point across CG caps {}, PSNR predicted over covered pixels; playback: player frames, whole-image PSNR vs the set", caps.join(", ")),
+        x_label: "milliseconds (compile: per parameter point; playback: per frame), log".into(),
         y_label: "PSNR (dB)".into(),
         x_log: true,
         stamp: stamp.lines(),
@@ -118,10 +150,11 @@ pub fn run(req: &SpeedRequest) -> Result<SpeedReport, Failure> {
     let (c, s) = write_chart(&req.out, "speed", &csv, &chart, &series).map_err(|e| Failure::new(Exit::Io, e))?;
     let report = SpeedReport {
         scene, points, compile: rows, csv: c.display().to_string(), svg: s.display().to_string(), stamp,
-        playback: Some("playback frame times need the player runtime (pis_play::Player), not in this build".into()),
+        playback, playback_skipped,
     };
     if req.record {
-        let summary: Vec<String> = report.compile.iter().map(|r| format!("cap {}: {:.0} ms/point, {:.2} dB", r.max_iterations, r.ms_per_point, r.psnr_db)).collect();
+        let mut summary: Vec<String> = report.compile.iter().map(|r| format!("cap {}: {:.0} ms/point, {:.2} dB", r.max_iterations, r.ms_per_point, r.psnr_db)).collect();
+        summary.extend(report.playback.iter().map(|p| format!("play {} r{}: {:.1}/{:.1} ms mean/worst, {:.2} dB", p.codec, p.reduction, p.frame_ms_mean, p.frame_ms_worst, p.psnr_db)));
         record("speed", &report.stamp, &summary.join("; ")).map_err(|e| Failure::new(Exit::Io, e))?;
     }
     Ok(report)
@@ -133,8 +166,12 @@ pub fn print(r: &SpeedReport, out: &mut impl std::io::Write) -> std::io::Result<
         writeln!(out, "  cap {:>5}: {:9.1} ms/point  {:>9} iterations  solved {:6.2} dB  coded {:6.2} dB at {:.0}:1",
                  c.max_iterations, c.ms_per_point, c.solver_iterations, c.psnr_db_solved, c.psnr_db, c.ratio)?;
     }
-    if let Some(p) = &r.playback {
-        writeln!(out, "  playback: {p}")?;
+    for p in &r.playback {
+        writeln!(out, "  playback {:<8} reduction {}: {:8.2} ms mean, {:8.2} ms worst over {} frames, {:6.2} dB ({:.2} dB covered)",
+                 p.codec, p.reduction, p.frame_ms_mean, p.frame_ms_worst, p.frames, p.psnr_db, p.covered_psnr_db)?;
+    }
+    if let Some(p) = &r.playback_skipped {
+        writeln!(out, "  playback skipped: {p}")?;
     }
     writeln!(out, "  wrote {} and {}", r.csv, r.svg)
 }

@@ -110,4 +110,17 @@ impl Inferred {
         let bytes = packed.layer_bytes.iter().flatten().sum();
         Ok((decoded_textures(&self.models, &packed).map_err(|e| Failure::new(Exit::Runtime, e))?, bytes))
     }
+
+    /// Encodes with `req`'s codec, pyramid and target and writes the container to
+    /// `req.output` (atomically); returns the file's bytes.
+    pub fn write(&self, req: &PackRequest) -> Result<u64, Failure> {
+        let mut stages = Stages::quiet();
+        let packed = encode_all(&self.set, &self.models, req, &mut stages)?;
+        Ok(pis_format::write(&req.output, &packed.container)?)
+    }
+
+    /// The set's directory.
+    pub fn set_dir(&self) -> &std::path::Path {
+        &self.set.dir
+    }
 }
