@@ -34,10 +34,6 @@ fn parse_size(s: &str) -> Result<(u32, u32), String> {
     }
 }
 
-fn parse_point(s: &str) -> Result<Vec<f32>, String> {
-    s.split([',', ' ']).filter(|p| !p.trim().is_empty()).map(|p| p.trim().parse::<f32>().ok().filter(|v| v.is_finite()).ok_or_else(|| format!("bad value {p:?} in {s:?}: expected numbers like 0.5,3"))).collect()
-}
-
 fn parse_blend(s: &str) -> Result<pis_play::Blend, String> {
     match s {
         "nearest" => Ok(pis_play::Blend::Nearest),
@@ -66,7 +62,7 @@ pub struct PlayArgs {
     pub headless: bool,
     /// The parameter point: one value per dimension, in the dimension's own values
     /// (default: the middle sample of each dimension).
-    #[arg(long, value_parser = parse_point, allow_hyphen_values = true)]
+    #[arg(long, value_delimiter = ',', allow_hyphen_values = true)]
     pub at: Option<Vec<f32>>,
     /// A path of frames: `diagonal`, `orbit` or a file of points.
     #[arg(long, value_parser = parse_path)]

@@ -102,7 +102,13 @@ fn blend_name(b: pis_play::Blend) -> String {
 /// Opens the GPU and the file.
 pub fn open(args: &PlayArgs) -> Result<(Arc<Gpu>, Player), Failure> {
     let gpu = Arc::new(Gpu::new().map_err(play_failure)?);
-    let player = Player::open(gpu.clone(), &args.file, args.player_options()).map_err(play_failure)?;
+    let player = Player::open(gpu.clone(), &args.file, args.player_options()).map_err(|e| {
+        let f = play_failure(e);
+        let message = f.error.to_string();
+        let path = args.file.display().to_string();
+        // Name the file where the message does not.
+        if message.contains(&path) { f } else { Failure::new(f.exit, f.error.context(path)) }
+    })?;
     Ok((gpu, player))
 }
 
@@ -325,11 +331,11 @@ pub fn run(args: &PlayArgs) -> Result<Exit, Failure> {
     match &args.compare {
         Some(set) => {
             let r = run_compare(args, set, &gpu, &mut player)?;
-            emit(args, &r, |r, w| print_compare_report(r, w))?;
+            emit(args, &r, print_compare_report)?;
         }
         None => {
             let r = run_frames(args, &gpu, &mut player)?;
-            emit(args, &r, |r, w| print_path_report(r, w))?;
+            emit(args, &r, print_path_report)?;
         }
     }
     Ok(Exit::Ok)

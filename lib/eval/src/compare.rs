@@ -122,8 +122,8 @@ pub fn compare_with_set(player: &mut Player, set_dir: &Path, options: &CompareOp
         let mut gold = FloatImage { width: res.0, height: res.1, rgba: vec![1.0; npx * 4] };
         for (c, name) in ["R", "G", "B"].iter().enumerate() {
             let plane = combined.channel(name).ok_or_else(|| anyhow!("point {i}: combined image without {name}"))?;
-            for k in 0..npx {
-                gold.rgba[k * 4 + c] = plane[k];
+            for (px, v) in gold.rgba.chunks_exact_mut(4).zip(plane) {
+                px[c] = *v;
             }
         }
         let mut whole = SquaredError::default();

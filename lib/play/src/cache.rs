@@ -181,9 +181,9 @@ mod tests {
         assert_eq!(alive(&c), [false, true, true]);
         c.end_frame(); // frame 7: 7 > 6
         assert_eq!(alive(&c), [false, false, true]);
-        // A use resets the count.
+        // A use (in frame 8) resets the count: alive through 12 unused frames (9..=20).
         assert!(c.get(&key(2, 0)).is_some());
-        for _ in 0..12 {
+        for _ in 8..=20 {
             c.end_frame();
         }
         assert_eq!(alive(&c), [false, false, true]);

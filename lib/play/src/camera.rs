@@ -84,7 +84,9 @@ impl ViewCamera {
         if !finite || dir.length_squared() <= 0.0 || dir.cross(self.up).length_squared() <= 1e-12 * dir.length_squared() * self.up.length_squared() {
             return Err(format!("camera {self:?}: eye, target and up must be finite, eye ≠ target, up not along the view direction"));
         }
-        if !(self.yfov_rad > 0.0 && self.yfov_rad < std::f32::consts::PI) || !(self.near > 0.0) || self.far <= self.near {
+        let fov_ok = self.yfov_rad > 0.0 && self.yfov_rad < std::f32::consts::PI;
+        let near_ok = self.near > 0.0 && self.far > self.near;
+        if !(fov_ok && near_ok) {
             return Err(format!("camera {self:?}: needs 0 < yfov < π and 0 < near < far"));
         }
         Ok(())

@@ -154,7 +154,8 @@ impl FramePipelines {
         FramePipelines { module, uniform_layout, draw_layout, ids_layout, layer_layout, id_pipeline, layer_pipelines: HashMap::new() }
     }
 
-    fn layer_pipeline(&mut self, gpu: &Gpu, format: wgpu::TextureFormat) -> &wgpu::RenderPipeline {
+    /// The additive layer pipeline for a target format (compiled on first use).
+    pub fn layer_pipeline(&mut self, gpu: &Gpu, format: wgpu::TextureFormat) -> &wgpu::RenderPipeline {
         let (module, layout) = (&self.module, &self.layer_layout);
         self.layer_pipelines.entry(format).or_insert_with(|| {
             let add = wgpu::BlendComponent { src_factor: wgpu::BlendFactor::One, dst_factor: wgpu::BlendFactor::One, operation: wgpu::BlendOperation::Add };

@@ -108,6 +108,9 @@ struct Wanted {
     repeat: [bool; 2],
 }
 
+/// An offscreen frame read back: colour and object indices.
+type Readout = (FloatImage, Vec<u32>);
+
 /// An open `.pis` ready to draw frames.
 pub struct Player {
     gpu: Arc<Gpu>,
@@ -191,7 +194,9 @@ impl Player {
         let filter = file_filter(reader.container());
         let decoder = Decoder::new(options.workers)?;
         let cache = LevelCache::new(options.cache_budget_bytes, options.lifetime_a, options.lifetime_b);
-        let pipes = FramePipelines::new(&gpu);
+        let mut pipes = FramePipelines::new(&gpu);
+        // Compiled now rather than in the first frame's time.
+        pipes.layer_pipeline(&gpu, offscreen_format(&gpu));
         let mips = MipBuilder::new(&gpu);
         Ok(Player {
             gpu,
@@ -429,7 +434,7 @@ impl Player {
         Ok(())
     }
 
-    fn frame(&mut self, req: &FrameRequest, size: (u32, u32), target: Option<(&wgpu::TextureView, wgpu::TextureFormat)>) -> Result<(Option<(FloatImage, Vec<u32>)>, FrameStats), PlayError> {
+    fn frame(&mut self, req: &FrameRequest, size: (u32, u32), target: Option<(&wgpu::TextureView, wgpu::TextureFormat)>) -> Result<(Option<Readout>, FrameStats), PlayError> {
         let t0 = Instant::now();
         let reads0 = self.reader.stats().codestreams;
         let mut stats = FrameStats::default();

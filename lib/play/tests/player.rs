@@ -52,7 +52,7 @@ fn a_frame_reads_only_the_codestreams_of_its_pyramid_paths() {
     // tiny.pis: dimensions (view, light); the surface layer varies with light.
     let first = vec![0, 0];
     let (img, ids, s) = player.render_ids(&at(&player, &first), size).unwrap();
-    let want = path_streams(&player, &[first.clone()]);
+    let want = path_streams(&player, std::slice::from_ref(&first));
     assert!(!want.is_empty());
     assert_eq!(s.codestreams_read, want.len() as u64, "first frame reads its pyramid path");
     assert_eq!(player.reader().stats().codestreams, want.len() as u64);
