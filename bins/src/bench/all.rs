@@ -33,7 +33,7 @@ struct Settings {
 
 fn settings(p: Preset) -> Settings {
     match p {
-        Preset::Ci => Settings { preset: None, resolution: Some((80, 60)), spp: Some(1), rd_ratios: vec![48.0, 96.0, 192.0, 384.0],
+        Preset::Ci => Settings { preset: None, resolution: Some((80, 60)), spp: Some(1), rd_ratios: vec![24.0, 48.0, 96.0, 192.0],
                                  caps: vec![10, 50, 400], stability_ratios: vec![96.0, 384.0, 2000.0], frames: 9, reference_spp: 4 },
         Preset::Paper => Settings { preset: Some("paper"), resolution: None, spp: None, rd_ratios: vec![96.0, 192.0, 384.0, 768.0],
                                     caps: vec![25, 100, 400], stability_ratios: vec![96.0, 384.0, 2000.0], frames: 33, reference_spp: 16 },

@@ -175,13 +175,24 @@ pub fn run(req: &RdRequest) -> Result<RdReport, Failure> {
             None
         }
     };
-    let pis = |name: &str, inf: &Inferred, codec: CodecId, pyramid: PyramidMode, rows: &mut Vec<RdRow>| -> Result<(), Failure> {
+    let pis = |name: &str, inf: &Inferred, codec: CodecId, pyramid: PyramidMode, rows: &mut Vec<RdRow>, skipped: &mut Vec<String>| -> Result<(), Failure> {
         if !wanted(name) {
             return Ok(());
         }
         for &r in &req.ratios {
             let preq = PackRequest { ratio: Some(r), codec, pyramid, ..base.clone() };
-            let p = inf.pack_point(&preq)?;
+            // A budget below what the level images' headers need is a point the method
+            // cannot reach: reported, not fatal.
+            let p = match inf.pack_point(&preq) {
+                Ok(p) => p,
+                Err(f) if f.exit == Exit::Runtime => {
+                    let why = format!("{name} at {r}:1: not packed: {}", f.error);
+                    eprintln!("pis-bench: rd: {why}");
+                    skipped.push(why);
+                    continue;
+                }
+                Err(f) => return Err(f),
+            };
             let played = match &gpu {
                 Some(g) => {
                     let file = req.out.join(format!(".rd-{name}-{r}.pis"));
@@ -200,13 +211,13 @@ pub fn run(req: &RdRequest) -> Result<RdReport, Failure> {
         }
         Ok(())
     };
-    pis("pis-wavelet", &separate, CodecId::Wavelet, PyramidMode::Adaptive, &mut rows)?;
-    pis("pis-dct", &separate, CodecId::Dct, PyramidMode::Adaptive, &mut rows)?;
-    pis("pis-wavelet-full-pyramid", &separate, CodecId::Wavelet, PyramidMode::Full, &mut rows)?;
+    pis("pis-wavelet", &separate, CodecId::Wavelet, PyramidMode::Adaptive, &mut rows, &mut skipped)?;
+    pis("pis-dct", &separate, CodecId::Dct, PyramidMode::Adaptive, &mut rows, &mut skipped)?;
+    pis("pis-wavelet-full-pyramid", &separate, CodecId::Wavelet, PyramidMode::Full, &mut rows, &mut skipped)?;
     if wanted("pis-wavelet-combined-layers") {
         eprintln!("pis-bench: rd: inferring again with one combined lighting layer");
         let combined = Inferred::new(&PackRequest { layers: LayerMode::Combined, ..base.clone() })?;
-        pis("pis-wavelet-combined-layers", &combined, CodecId::Wavelet, PyramidMode::Adaptive, &mut rows)?;
+        pis("pis-wavelet-combined-layers", &combined, CodecId::Wavelet, PyramidMode::Adaptive, &mut rows, &mut skipped)?;
     }
 
     if wanted("mpeg-texture-x265") && video_or_skip(VideoCodec::X265, &mut skipped, "mpeg-texture-x265")? {
