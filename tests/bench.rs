@@ -120,3 +120,140 @@ fn infer_reports_texel_ranges_and_the_neighbouring_view() {
     let out = bench(&["infer", scene.to_str().unwrap(), "--resolution", "32x24", "--spp", "1", "--antialias", "0"]);
     assert_eq!(out.status.code(), Some(1), "--antialias 0 is a usage error");
 }
+
+/// demo1 with 2 × 2 samples at 40×30, 1 spp, traced into `dir/set` (with its scene.toml).
+fn tiny_demo1_set(dir: &std::path::Path) -> Option<PathBuf> {
+    let scene = demo1();
+    if !scene.exists() {
+        return None;
+    }
+    let text = std::fs::read_to_string(&scene).expect("demo1 scene.toml");
+    let gltf = scene.parent().unwrap().join("demo1.gltf");
+    let text = text.replace("gltf = \"demo1.gltf\"", &format!("gltf = {:?}", gltf.to_str().unwrap()))
+        .replace("resolution = [160, 120]", "resolution = [40, 30]")
+        .replace("spp = 4", "spp = 1")
+        .replace("samples = 4", "samples = 2");
+    let toml = dir.join("scene.toml");
+    std::fs::write(&toml, text).unwrap();
+    let set = dir.join("set");
+    let out = Command::new(env!("CARGO_BIN_EXE_pis-trace")).args([toml.to_str().unwrap(), "-o", set.to_str().unwrap()]).output().expect("pis-trace runs");
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    std::fs::copy(&toml, set.join("scene.toml")).unwrap();
+    Some(set)
+}
+
+fn ffmpeg_present() -> bool {
+    Command::new("ffmpeg").arg("-version").output().is_ok_and(|o| o.status.success())
+}
+
+#[test]
+fn rd_charts_every_method_at_matched_budgets() {
+    let dir = tempfile::tempdir().expect("temporary directory");
+    let Some(set) = tiny_demo1_set(dir.path()) else { return };
+    let out_dir = dir.path().join("reports");
+    let out = bench(&["rd", set.to_str().unwrap(), "--ratios", "4,12", "--out", out_dir.to_str().unwrap(), "--json"]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("JSON on stdout");
+    let csv = std::fs::read_to_string(out_dir.join("rd.csv")).expect("rd.csv");
+    let svg = std::fs::read_to_string(out_dir.join("rd.svg")).expect("rd.svg");
+    let videos = ffmpeg_present();
+    if !videos {
+        assert!(std::env::var_os("CI").is_none(), "CI needs ffmpeg (libx265, libaom-av1) for the video baselines");
+        eprintln!("ffmpeg is missing: the video baselines are skipped");
+    }
+    let methods: &[&str] = if videos {
+        &["pis-wavelet", "pis-dct", "pis-wavelet-full-pyramid", "pis-wavelet-combined-layers", "mpeg-texture-x265", "view-x265", "view-av1"]
+    } else {
+        &["pis-wavelet", "pis-dct", "pis-wavelet-full-pyramid", "pis-wavelet-combined-layers"]
+    };
+    for m in methods {
+        assert_eq!(csv.lines().filter(|l| l.starts_with(&format!("{m},"))).count(), 2, "{m} rows in\n{csv}");
+        assert!(svg.contains(m), "the chart names {m}");
+    }
+    assert!(svg.contains("command: pis-bench rd"), "the chart is stamped with the command");
+    let rows = v["rows"].as_array().expect("rows");
+    for r in rows {
+        let (m, psnr) = (r["method"].as_str().unwrap(), r["psnr_db"].as_f64().unwrap());
+        let (bytes, budget) = (r["bytes"].as_f64().unwrap(), r["budget"].as_f64().unwrap());
+        assert!(psnr.is_finite() && psnr > 12.0, "{m}: {psnr} dB");
+        // Matched budgets: videos never exceed theirs and spend at least 70 % of it when it
+        // can be reached; PIS's allocation lands within ±10 %.
+        if m.starts_with("pis-") {
+            assert!((bytes / budget - 1.0).abs() <= 0.10, "{m}: {bytes} bytes for a budget of {budget}");
+        } else if r["reached"].as_bool().unwrap() {
+            assert!(bytes <= budget && bytes >= 0.70 * budget, "{m}: {bytes} bytes for a budget of {budget}");
+        }
+    }
+    // More bytes buy quality: each method is better at 4:1 than at 12:1.
+    for m in methods {
+        let at = |t: f64| rows.iter().find(|r| r["method"] == *m && r["target_ratio"].as_f64() == Some(t)).and_then(|r| r["psnr_db"].as_f64()).unwrap();
+        assert!(at(4.0) > at(12.0), "{m}: {} dB at 4:1, {} dB at 12:1", at(4.0), at(12.0));
+    }
+}
+
+#[test]
+fn rd_argument_errors() {
+    let out = bench(&["rd", "/no/such/set"]);
+    assert_eq!(out.status.code(), Some(2), "{}", String::from_utf8_lossy(&out.stderr));
+    let scene = demo1();
+    if scene.exists() {
+        let out = bench(&["rd", scene.to_str().unwrap(), "--ratios", "0.5"]);
+        assert_eq!(out.status.code(), Some(1));
+        assert!(String::from_utf8_lossy(&out.stderr).contains("at least 1"));
+        let out = bench(&["rd", scene.to_str().unwrap(), "--ratios", "abc"]);
+        assert_eq!(out.status.code(), Some(1));
+        let out = bench(&["rd", scene.to_str().unwrap(), "--methods", "pis-wavelet,jpeg"]);
+        assert_eq!(out.status.code(), Some(1));
+        assert!(String::from_utf8_lossy(&out.stderr).contains("unknown method \"jpeg\""));
+    }
+    let out = bench(&["rd"]);
+    assert_eq!(out.status.code(), Some(1));
+}
+
+#[test]
+fn stability_reports_every_representation_on_both_paths() {
+    let dir = tempfile::tempdir().expect("temporary directory");
+    let Some(set) = tiny_demo1_set(dir.path()) else { return };
+    let out_dir = dir.path().join("reports");
+    let out = bench(&["stability", set.to_str().unwrap(), "--ratios", "200", "--frames", "4", "--reference-spp", "1",
+                      "--out", out_dir.to_str().unwrap(), "--json"]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("JSON on stdout");
+    let csv = std::fs::read_to_string(out_dir.join("stability.csv")).expect("stability.csv");
+    let svg = std::fs::read_to_string(out_dir.join("stability.svg")).expect("stability.svg");
+    let s = v["summaries"].as_array().expect("summaries");
+    assert_eq!(s.len(), 4, "solved and 200:1, each between and away");
+    let mean = |rep: &str, path: &str| s.iter().find(|x| x["representation"] == rep && x["path"] == path).and_then(|x| x["mean_psnr_db"].as_f64()).unwrap();
+    for path in ["between", "away"] {
+        for rep in ["solved", "wavelet 200:1"] {
+            assert!(mean(rep, path) > 10.0, "{rep} {path}: {} dB", mean(rep, path));
+            assert!(svg.contains(&format!("{rep} · {path}")), "the chart names {rep} · {path}");
+            assert_eq!(csv.lines().filter(|l| l.starts_with(&format!("{rep},{path},"))).count(), 4, "{rep} {path}: 4 frames in\n{csv}");
+        }
+        // an extreme ratio costs quality off the samples too
+        assert!(mean("wavelet 200:1", path) < mean("solved", path), "{path}");
+    }
+    for x in s {
+        assert!(x["popping"].as_f64().is_some_and(|p| p.is_finite() && p > 0.0), "{x}");
+    }
+}
+
+#[test]
+fn speed_stability_and_all_argument_errors() {
+    let out = bench(&["speed", "/no/such/set"]);
+    assert_eq!(out.status.code(), Some(2));
+    let out = bench(&["stability", "/no/such/set"]);
+    assert_eq!(out.status.code(), Some(2));
+    let scene = demo1();
+    if scene.exists() {
+        let out = bench(&["speed", scene.to_str().unwrap(), "--caps", "0"]);
+        assert_eq!(out.status.code(), Some(1));
+        let out = bench(&["stability", scene.to_str().unwrap(), "--frames", "1"]);
+        assert_eq!(out.status.code(), Some(1));
+    }
+    let out = bench(&["all", "--preset", "huge"]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("ci or paper"));
+    let out = bench(&["all", "--preset", "ci", "--scene", "/no/such/scene.toml"]);
+    assert_eq!(out.status.code(), Some(2));
+}

@@ -1,6 +1,7 @@
 //! What the PIS command-line tools share: exit codes, error reporting, and the pieces of
 //! each tool that are more than argument parsing.
 
+pub mod bench;
 pub mod cli;
 pub mod diff;
 pub mod images;

@@ -14,11 +14,12 @@
 //! MIP chain rebuilt by decimation as the player does) and compares with the gold-standard
 //! layers over the pixels the tracer covers, on display values (see [`crate::infer`]).
 
-mod encode;
-mod infer_layers;
-mod input;
+pub(crate) mod encode;
+pub(crate) mod infer_layers;
+pub(crate) mod input;
 mod report;
 pub mod storage;
+mod sweep;
 
 use std::path::PathBuf;
 use std::time::Instant;
@@ -27,6 +28,8 @@ use pis_codec::CodecId;
 use pis_compile::Filter;
 
 pub use report::{print_report, ObjectReport, PackReport};
+pub use input::cache_dir;
+pub use sweep::{Inferred, PackPoint};
 
 use crate::cli::{Exit, Failure};
 
@@ -53,6 +56,37 @@ pub struct PackRequest {
     /// Tracing a scene.toml: size and samples per pixel overrides.
     pub resolution: Option<(u32, u32)>,
     pub spp: Option<u32>,
+    /// Pyramid levels per block: the adaptive search (thesis 4.3) or the full dyadic sequence.
+    pub pyramid: PyramidMode,
+    /// Lighting layers: separate diffuse and specular layers, or one combined view-dependent
+    /// layer (diffuse + specular) per parameter sample.
+    pub layers: LayerMode,
+    /// Conjugate-gradient iteration cap per colour channel of every solve (None: the
+    /// solver's default).
+    pub max_iterations: Option<u32>,
+    /// Tracing a scene.toml: a `[preset.NAME]` applied before the size overrides (also
+    /// applied to the scene a set is read with).
+    pub preset: Option<String>,
+}
+
+/// How each block's pyramid levels are chosen.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum PyramidMode {
+    /// Greedy choice of each level's counts (thesis 4.3).
+    #[default]
+    Adaptive,
+    /// Every dimension halved (rounding up) per level down to one sample: no search.
+    Full,
+}
+
+/// How the lighting layers are separated.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum LayerMode {
+    /// A view-independent diffuse layer and a view-dependent specular layer (thesis 4.8).
+    #[default]
+    Separate,
+    /// One view-dependent layer of diffuse + specular radiance per parameter sample.
+    Combined,
 }
 
 /// The default compression ratio when neither `--ratio` nor `--psnr` is given.
@@ -62,16 +96,24 @@ pub const DEFAULT_RATIO: f64 = 384.0;
 pub(crate) struct Stages {
     pub(crate) ms: Vec<(String, f64)>,
     t: Instant,
+    quiet: bool,
 }
 
 impl Stages {
     fn new() -> Self {
-        Stages { ms: Vec::new(), t: Instant::now() }
+        Stages { ms: Vec::new(), t: Instant::now(), quiet: false }
+    }
+
+    /// Stages timed without progress lines.
+    fn quiet() -> Self {
+        Stages { quiet: true, ..Stages::new() }
     }
 
     pub(crate) fn done(&mut self, name: &str, what: &str) {
         let ms = self.t.elapsed().as_secs_f64() * 1e3;
-        eprintln!("pis-pack: {name:<9} {ms:8.0} ms  {what}");
+        if !self.quiet {
+            eprintln!("pis-pack: {name:<9} {ms:8.0} ms  {what}");
+        }
         self.ms.push((name.to_string(), ms));
         self.t = Instant::now();
     }

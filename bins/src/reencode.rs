@@ -220,7 +220,7 @@ pub fn reencode(req: &ReencodeRequest) -> Result<ReencodeReport, Failure> {
             let blocks = (0..l.blocks.len()).into_par_iter().map(|bi| {
                 let block = decode_block(&input, oi, li, bi).map_err(|e| in_file(&req.input, e))?;
                 let samples: Vec<Vec<f32>> = block.textures.par_iter().map(|x| prepared(&layer, &block.layout, x, exact)).collect();
-                build_pyramid(oi, block.layout.planes(), &block.extent, &samples, layer_samples, exact).map_err(runtime)
+                build_pyramid(oi, block.layout.planes(), &block.extent, &samples, layer_samples, exact, false).map_err(runtime)
             }).collect::<Result<Vec<BlockPyramid>, Failure>>()?;
             pyramids.extend(blocks);
             per_layer.push(layer.gamma);

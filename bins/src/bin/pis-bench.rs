@@ -3,12 +3,23 @@
 //! `pis-bench infer SET_DIR|scene.toml [--object NAME] [--at v1,v2] [--json]`: texture
 //! inference for one object at one parameter point, PSNR against the gold-standard layer for
 //! least squares (bilinear, trilinear, pyramidal) and the two baselines (thesis 3.6).
+//!
+//! `pis-bench rd SET_DIR|scene.toml [--ratios 96,192,384,768] [--out DIR] [--json]`:
+//! compression ratio against PSNR for PIS (wavelet, DCT, full pyramid, combined layers) and
+//! the baselines (MPEG-texture, view-based x265 and AV1), written as rd.csv and rd.svg.
+//! `pis-bench speed`: compile time per point against PSNR across solver iteration caps.
+//! `pis-bench stability`: PSNR and popping off the sampled views, against pis-trace.
+//! `pis-bench all --preset ci|paper`: every chart from scratch on demo1.
 
 use std::path::PathBuf;
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 use pis::cli::{finish, parse, Exit, Failure, EXIT_CODES_HELP};
+use pis::bench::all::{self, Preset};
+use pis::bench::rd::{self, RdRequest};
+use pis::bench::speed::{self, SpeedRequest};
+use pis::bench::stability::{self, StabilityRequest};
 use pis::infer::{infer, print_report, InferRequest};
 use pis_compile::SolveSettings;
 
@@ -83,6 +94,134 @@ enum Command {
         #[arg(long)]
         json: bool,
     },
+    /// Compression ratio against PSNR: PIS and the baselines at matched byte budgets
+    /// (writes rd.csv and rd.svg into --out).
+    Rd {
+        /// A ray-traced set directory, or a scene.toml to trace first (as pis-pack does).
+        input: PathBuf,
+        /// scene.toml of a set (default: SET_DIR/scene.toml).
+        #[arg(long)]
+        scene: Option<PathBuf>,
+        /// Target compression ratios: every method gets raw image bytes / ratio bytes.
+        #[arg(long, value_delimiter = ',', default_value = "96,192,384,768")]
+        ratios: Vec<f64>,
+        /// Output folder for rd.csv and rd.svg (created when missing).
+        #[arg(long, default_value = "reports")]
+        out: PathBuf,
+        /// Image size WIDTHxHEIGHT when tracing a scene.toml.
+        #[arg(long, value_parser = parse_resolution)]
+        resolution: Option<(u32, u32)>,
+        /// Samples per pixel when tracing a scene.toml.
+        #[arg(long)]
+        spp: Option<u32>,
+        /// Largest used texture side of the PIS inference.
+        #[arg(long, default_value_t = 256)]
+        max_texture: u32,
+        /// A `[preset.NAME]` of scene.toml when tracing one.
+        #[arg(long)]
+        preset: Option<String>,
+        /// Only these methods (comma-separated; default all): pis-wavelet, pis-dct,
+        /// pis-wavelet-full-pyramid, pis-wavelet-combined-layers, mpeg-texture-x265,
+        /// view-x265, view-av1.
+        #[arg(long, value_delimiter = ',')]
+        methods: Vec<String>,
+        /// Record the run (machine, scene, command, PSNR near 384:1) in docs/BENCHMARKS.md.
+        #[arg(long)]
+        record: bool,
+        /// Print the report as JSON on stdout.
+        #[arg(long)]
+        json: bool,
+    },
+    /// Compile (inference) time per parameter point against PSNR across solver iteration
+    /// caps (writes speed.csv and speed.svg into --out).
+    Speed {
+        /// A ray-traced set directory, or a scene.toml to trace first.
+        input: PathBuf,
+        #[arg(long)]
+        scene: Option<PathBuf>,
+        /// Conjugate-gradient iteration caps per colour channel.
+        #[arg(long, value_delimiter = ',', default_value = "10,50,400")]
+        caps: Vec<u32>,
+        /// Compression ratio of the packs whose PSNR is reported.
+        #[arg(long, default_value_t = 384.0)]
+        ratio: f64,
+        #[arg(long, default_value = "reports")]
+        out: PathBuf,
+        #[arg(long, value_parser = parse_resolution)]
+        resolution: Option<(u32, u32)>,
+        #[arg(long)]
+        spp: Option<u32>,
+        #[arg(long)]
+        preset: Option<String>,
+        #[arg(long, default_value_t = 256)]
+        max_texture: u32,
+        /// Record the run in docs/BENCHMARKS.md.
+        #[arg(long)]
+        record: bool,
+        #[arg(long)]
+        json: bool,
+    },
+    /// PSNR and popping along dense camera paths between and away from the sampled views,
+    /// against frames ray-traced at each exact camera (writes stability.csv and .svg).
+    Stability {
+        /// A ray-traced set directory, or a scene.toml to trace first.
+        input: PathBuf,
+        #[arg(long)]
+        scene: Option<PathBuf>,
+        /// Ratios of the coded representations (the textures as solved are always shown).
+        #[arg(long, value_delimiter = ',', default_value = "96,384,2000")]
+        ratios: Vec<f64>,
+        /// Frames per path.
+        #[arg(long, default_value_t = 17)]
+        frames: usize,
+        /// Samples per pixel of the ray-traced reference frames.
+        #[arg(long, default_value_t = 4)]
+        reference_spp: u32,
+        #[arg(long, default_value = "reports")]
+        out: PathBuf,
+        #[arg(long, value_parser = parse_resolution)]
+        resolution: Option<(u32, u32)>,
+        /// Samples per pixel when tracing a scene.toml.
+        #[arg(long)]
+        spp: Option<u32>,
+        #[arg(long)]
+        preset: Option<String>,
+        #[arg(long, default_value_t = 256)]
+        max_texture: u32,
+        /// Record the run in docs/BENCHMARKS.md.
+        #[arg(long)]
+        record: bool,
+        #[arg(long)]
+        json: bool,
+    },
+    /// Every chart (rd, speed, stability) from scratch on demo1: trace, pack, evaluate.
+    All {
+        /// `ci` (80×60, 1 spp: minutes on 2 cores) or `paper` (demo1's paper preset).
+        #[arg(long, value_parser = parse_preset)]
+        preset: Preset,
+        /// demo1's scene.toml (default: samples/demo1/scene.toml of the source tree).
+        #[arg(long)]
+        scene: Option<PathBuf>,
+        #[arg(long, default_value = "reports")]
+        out: PathBuf,
+        /// Record every run in docs/BENCHMARKS.md.
+        #[arg(long)]
+        record: bool,
+    },
+}
+
+fn parse_preset(s: &str) -> Result<Preset, String> {
+    match s {
+        "ci" => Ok(Preset::Ci),
+        "paper" => Ok(Preset::Paper),
+        _ => Err(format!("unknown preset {s:?} (ci or paper)")),
+    }
+}
+
+fn json_out<T: serde::Serialize>(v: &T) -> Result<(), Failure> {
+    let s = serde_json::to_string_pretty(v).map_err(|e| Failure::new(Exit::Runtime, e))?;
+    println!("{s}");
+    Ok(())
 }
 
 fn parse_resolution(s: &str) -> Result<(u32, u32), String> {
@@ -123,6 +262,37 @@ fn run(cli: Cli) -> Result<Exit, Failure> {
                 let s = serde_json::to_string_pretty(&report).map_err(|e| Failure::new(Exit::Runtime, e))?;
                 println!("{s}");
             }
+            Ok(Exit::Ok)
+        }
+        Command::Rd { input, scene, ratios, out, resolution, spp, max_texture, preset, methods, record, json } => {
+            let req = RdRequest { input, scene, ratios, out, resolution, spp, max_texture, preset, record, methods };
+            let report = rd::run(&req)?;
+            rd::print(&report, &mut std::io::stderr()).map_err(|e| Failure::new(Exit::Io, e))?;
+            if json {
+                json_out(&report)?;
+            }
+            Ok(Exit::Ok)
+        }
+        Command::Speed { input, scene, caps, ratio, out, resolution, spp, preset, max_texture, record, json } => {
+            let req = SpeedRequest { input, scene, caps, ratio, out, resolution, spp, preset, max_texture, record };
+            let report = speed::run(&req)?;
+            speed::print(&report, &mut std::io::stderr()).map_err(|e| Failure::new(Exit::Io, e))?;
+            if json {
+                json_out(&report)?;
+            }
+            Ok(Exit::Ok)
+        }
+        Command::Stability { input, scene, ratios, frames, reference_spp, out, resolution, spp, preset, max_texture, record, json } => {
+            let req = StabilityRequest { input, scene, ratios, frames, spp: reference_spp, out, resolution, trace_spp: spp, max_texture, preset, record };
+            let report = stability::run(&req)?;
+            stability::print(&report, &mut std::io::stderr()).map_err(|e| Failure::new(Exit::Io, e))?;
+            if json {
+                json_out(&report)?;
+            }
+            Ok(Exit::Ok)
+        }
+        Command::All { preset, scene, out, record } => {
+            all::run(preset, &scene.unwrap_or_else(all::demo1), &out, record)?;
             Ok(Exit::Ok)
         }
     }

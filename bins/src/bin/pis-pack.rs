@@ -7,7 +7,7 @@ use std::process::ExitCode;
 
 use clap::Parser;
 use pis::cli::{self, Exit, Failure};
-use pis::pack::{pack, print_report, PackRequest};
+use pis::pack::{pack, print_report, LayerMode, PackRequest, PyramidMode};
 use pis_codec::CodecId;
 use pis_compile::Filter;
 
@@ -55,6 +55,18 @@ struct Cli {
     /// Tracing a scene.toml: camera samples per pixel.
     #[arg(long)]
     spp: Option<u32>,
+    /// Pyramid levels per block: `adaptive` (greedy search, thesis 4.3) or `full` (every
+    /// dimension halved per level down to one sample).
+    #[arg(long, default_value = "adaptive", value_parser = parse_pyramid)]
+    pyramid: PyramidMode,
+    /// Lighting layers: `separate` (view-independent diffuse + view-dependent specular) or
+    /// `combined` (one view-dependent layer of diffuse + specular per parameter sample).
+    #[arg(long, default_value = "separate", value_parser = parse_layers)]
+    layers: LayerMode,
+    /// Conjugate-gradient iteration cap per colour channel of every texture solve
+    /// (default: the solver's own).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
+    max_iterations: Option<u32>,
     /// Print the closing report as JSON on stdout.
     #[arg(long)]
     json: bool,
@@ -66,6 +78,22 @@ fn parse_codec(s: &str) -> Result<CodecId, String> {
         "dct" => Ok(CodecId::Dct),
         "lossless" => Ok(CodecId::Lossless),
         _ => Err(format!("unknown codec {s:?} (wavelet, dct or lossless)")),
+    }
+}
+
+fn parse_pyramid(s: &str) -> Result<PyramidMode, String> {
+    match s {
+        "adaptive" => Ok(PyramidMode::Adaptive),
+        "full" => Ok(PyramidMode::Full),
+        _ => Err(format!("unknown pyramid {s:?} (adaptive or full)")),
+    }
+}
+
+fn parse_layers(s: &str) -> Result<LayerMode, String> {
+    match s {
+        "separate" => Ok(LayerMode::Separate),
+        "combined" => Ok(LayerMode::Combined),
+        _ => Err(format!("unknown layers {s:?} (separate or combined)")),
     }
 }
 
@@ -113,6 +141,10 @@ fn run(cli: Cli) -> Result<Exit, Failure> {
         gamma: if cli.codec == CodecId::Lossless { 1.0 } else { cli.gamma },
         resolution: cli.resolution,
         spp: cli.spp,
+        pyramid: cli.pyramid,
+        layers: cli.layers,
+        max_iterations: cli.max_iterations,
+        preset: None,
     };
     let report = pack(&req)?;
     print_report(&report, &mut std::io::stderr()).map_err(|e| Failure::new(Exit::Io, e))?;

@@ -144,6 +144,18 @@ pub(crate) fn finest(m: &ObjectModel, x: &[f32]) -> Vec<f32> {
     x[..m.prep.layout.width as usize * m.prep.layout.height as usize * 3].to_vec()
 }
 
+/// The full pyramid's level counts, top first: every dimension halved (rounding up) per
+/// level until one sample is left.
+pub fn full_levels(extent: &[u32]) -> Vec<Vec<u32>> {
+    let mut levels = vec![extent.to_vec()];
+    while levels.last().is_some_and(|c| c.iter().any(|&v| v > 1)) {
+        let next: Vec<u32> = levels[levels.len() - 1].iter().map(|v| v.div_ceil(2)).collect();
+        levels.push(next);
+    }
+    levels.reverse();
+    levels
+}
+
 /// Builds pyramids, allocates storage, encodes, and assembles the container.
 pub(crate) fn encode_all(set: &LoadedSet, models: &[ObjectModel], req: &PackRequest, stages: &mut Stages) -> Result<Packed, Failure> {
     let runtime = |e: anyhow::Error| Failure::new(Exit::Runtime, e);
@@ -198,7 +210,7 @@ pub(crate) fn encode_all(set: &LoadedSet, models: &[ObjectModel], req: &PackRequ
                 if samples.iter().any(Vec::is_empty) {
                     return Err(runtime(anyhow!("object {} layer {} block {b}: a sample has no texture", m.name, il.kind.name())));
                 }
-                let pyramid = build_pyramid(mi, planes, &extent, &samples, layer_samples, !req.codec.is_lossy()).map_err(runtime)?;
+                let pyramid = build_pyramid(mi, planes, &extent, &samples, layer_samples, !req.codec.is_lossy(), req.pyramid == super::PyramidMode::Full).map_err(runtime)?;
                 pyramids.push(pyramid);
                 where_.push((mi, li, b));
                 pblocks.push(PackedBlock { extent, keys, levels: vec![] });
@@ -234,6 +246,13 @@ pub(crate) fn encode_all(set: &LoadedSet, models: &[ObjectModel], req: &PackRequ
             (r, None) => format!("ratio {}", r.unwrap_or(super::DEFAULT_RATIO)),
         }),
     ];
+    let mut settings = settings;
+    if req.pyramid != super::PyramidMode::Adaptive {
+        settings.push(("pyramid".to_string(), "full".to_string()));
+    }
+    if req.layers != super::LayerMode::Separate {
+        settings.push(("layers".to_string(), "combined".to_string()));
+    }
     let mut container = Container {
         space,
         cameras,

@@ -112,6 +112,29 @@ fn is_black(views: &[PointView], pick: impl Fn(&PointView) -> &[f32], other: imp
     views.iter().all(|v| pick(v).iter().zip(other(v)).all(|(x, o)| x.abs() < BLACK || (d(x + o) - d(*o)).abs() < DISPLAY_STEP))
 }
 
+/// One view-dependent layer of diffuse + specular radiance per parameter sample (no
+/// lighting-layer separation), warm-started from the previous sample like the specular layer.
+fn combined_layer(set: &LoadedSet, views: &[PointView], prep: &Prepared, settings: &SolveSettings) -> Result<InferredLayer> {
+    let all = DepMask::of(&(0..set.scene.space.dims.len()).collect::<Vec<_>>());
+    let mut textures = BTreeMap::new();
+    let mut warm: Option<Vec<f32>> = None;
+    let mut iterations = 0u64;
+    for (p, s) in set.samples.iter().enumerate() {
+        let v = &views[p];
+        let x = if v.a.rows() == 0 {
+            warm.clone().unwrap_or_else(|| vec![0.0; prep.layout.texel_count() * 3])
+        } else {
+            let b: Vec<f32> = v.diffuse.iter().zip(&v.specular).map(|(d, s)| d + s).collect();
+            let sol = solve(&v.a, &b, warm.as_deref(), settings)?;
+            iterations += sol.iterations as u64;
+            sol.texels
+        };
+        warm = Some(x.clone());
+        textures.insert(key(s, all), x);
+    }
+    Ok(InferredLayer { kind: pis_format::LayerKind::Specular, depends_on: all, textures, iterations })
+}
+
 /// Infers every object that covers a pixel somewhere in the set.
 pub(crate) fn infer_all(set: &LoadedSet, req: &PackRequest, stages: &mut Stages) -> Result<Vec<ObjectModel>> {
     let scene = &set.scene;
@@ -122,7 +145,11 @@ pub(crate) fn infer_all(set: &LoadedSet, req: &PackRequest, stages: &mut Stages)
     let non_view = DepMask::of(&(0..scene.space.dims.len()).filter(|k| !view_dims.contains(k)).collect::<Vec<_>>());
     // Level 0 solved through the MIP chain the player decimates from it (thesis 3.6): the
     // solved textures are the drawn ones.
-    let settings = SolveSettings::decimated();
+    let mut settings = SolveSettings::decimated();
+    if let Some(n) = req.max_iterations {
+        settings.cg.max_iterations = n.max(1);
+    }
+    let combined = req.layers == super::LayerMode::Combined;
     let mut out = Vec::new();
     for o in 0..scene.objects.len() {
         let name = scene.objects[o].name.clone();
@@ -139,6 +166,13 @@ pub(crate) fn infer_all(set: &LoadedSet, req: &PackRequest, stages: &mut Stages)
         let specular_black = is_black(&views, |v| &v.specular, |v| &v.diffuse);
         if diffuse_black && specular_black {
             eprintln!("pis-pack: object {name} is black in every layer; nothing stored");
+            continue;
+        }
+        if combined {
+            let layer = combined_layer(set, &views, &prep, &settings)?;
+            let (representation, why) = ("combined".to_string(), "--layers combined: one view-dependent layer of diffuse + specular radiance per parameter sample".to_string());
+            eprintln!("pis-pack: object {name}: {}x{} texels, {representation}", prep.layout.width, prep.layout.height);
+            out.push(ObjectModel { index: o, name, mesh: merged_mesh(scene, o), prep, area, views, layers: vec![layer], representation, why });
             continue;
         }
         if !diffuse_black {

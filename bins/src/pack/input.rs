@@ -64,13 +64,16 @@ fn same_space(scene: &Scene, set: &RaySet) -> bool {
 
 /// Loads the scene a set was traced from at the set's resolution: scene.toml as written, or,
 /// when the set's parameter space is that of one of its `[preset.NAME]`s (a set traced with
-/// `pis-trace --preset NAME`), with that preset.
-pub(crate) fn set_scene(set: &RaySet, scene_path: &Path, res: (u32, u32)) -> Result<Scene, Failure> {
+/// `pis-trace --preset NAME`), with that preset. A preset named by the caller is used as is.
+pub(crate) fn set_scene(set: &RaySet, scene_path: &Path, res: (u32, u32), preset: Option<&str>) -> Result<Scene, Failure> {
     let load = |preset: Option<String>| {
         let options = LoadOptions { preset, resolution: Some(res), ..LoadOptions::default() };
         pis_scene::load_with(scene_path, &options)
             .map_err(|e| Failure::new(Exit::Invalid, anyhow!("loading {} (the set's scene; pass --scene): {e}", scene_path.display())))
     };
+    if let Some(p) = preset {
+        return load(Some(p.to_string()));
+    }
     let scene = load(None)?;
     if same_space(&scene, set) {
         return Ok(scene);
@@ -91,7 +94,7 @@ pub(crate) fn load(req: &PackRequest, stages: &mut Stages) -> Result<LoadedSet, 
     let (dir, scene_path) = if req.input.is_dir() {
         (req.input.clone(), req.input.join("scene.toml"))
     } else if req.input.is_file() {
-        let options = LoadOptions { preset: None, resolution: req.resolution, spp: req.spp };
+        let options = LoadOptions { preset: req.preset.clone(), resolution: req.resolution, spp: req.spp };
         let scene = pis_scene::load_with(&req.input, &options).map_err(|e| Failure::new(Exit::Invalid, e))?;
         let dir = cache_dir(&req.input, &scene);
         if !dir.join("set.json").is_file() {
@@ -106,7 +109,7 @@ pub(crate) fn load(req: &PackRequest, stages: &mut Stages) -> Result<LoadedSet, 
     let scene_path = req.scene.clone().unwrap_or(scene_path);
     let set = RaySet::open(&dir).map_err(trace_failure)?;
     let res = (set.meta.resolution[0], set.meta.resolution[1]);
-    let scene = set_scene(&set, &scene_path, res)?;
+    let scene = set_scene(&set, &scene_path, res, req.preset.as_deref())?;
     if set.meta.points.len() != scene.space.point_count() {
         return Err(invalid(format!("{}: the set has {} points, the scene's space {}", dir.display(), set.meta.points.len(), scene.space.point_count())));
     }

@@ -5,11 +5,11 @@
 
 use anyhow::{anyhow, Result};
 use pis_codec::allocate::{allocate, Item, Target, DEFAULT_ALPHA};
-use pis_codec::pyramid::{adaptive, l1_cost, level_image_index, Pyramid, PyramidFilter, PyramidLevel};
+use pis_codec::pyramid::{adaptive, build, l1_cost, level_image_index, Pyramid, PyramidFilter, PyramidLevel};
 use pis_codec::{CodecId, PlaneShape, Rate};
 use rayon::prelude::*;
 
-use super::encode::CodedLevel;
+use super::encode::{full_levels, CodedLevel};
 
 /// One parameter block's pyramid, ready to be allocated and encoded.
 pub struct BlockPyramid {
@@ -27,8 +27,15 @@ pub struct BlockPyramid {
 /// Builds the adaptive pyramid of a block's finest samples (gamma-compensated, row-major over
 /// `extent`). With `exact` (lossless and raw codecs) the finest level is adjusted so that the
 /// decoder's sum gives every sample back bit for bit.
-pub fn build_pyramid(object: usize, planes: Vec<PlaneShape>, extent: &[u32], samples: &[Vec<f32>], layer_samples: f64, exact: bool) -> Result<BlockPyramid> {
-    let (mut pyr, _) = adaptive(extent, samples, PyramidFilter::Gaussian, l1_cost)?;
+///
+/// `full`: every level of the pyramid over the block, without adaptive subdivision (the
+/// baseline `pis-pack --pyramid full` compares against).
+pub fn build_pyramid(object: usize, planes: Vec<PlaneShape>, extent: &[u32], samples: &[Vec<f32>], layer_samples: f64, exact: bool, full: bool) -> Result<BlockPyramid> {
+    let mut pyr = if full {
+        build(extent, samples, &full_levels(extent), PyramidFilter::Gaussian)?
+    } else {
+        adaptive(extent, samples, PyramidFilter::Gaussian, l1_cost)?.0
+    };
     if exact {
         exact_finest(&mut pyr, samples, extent);
     }
