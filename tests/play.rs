@@ -232,3 +232,45 @@ fn arguments_are_checked_and_window_mode_falls_back_to_headless() {
     assert!(out.status.success());
     assert!(String::from_utf8_lossy(&out.stderr).contains("cannot open a window"));
 }
+
+/// The one-command tour of the README: a scene.toml is traced and packed once into
+/// `.pis-cache/` beside it, then played along the diagonal; a second run reuses the pack.
+#[test]
+fn a_scene_is_traced_packed_and_played_in_one_command() {
+    if !gpu_or_skip("a_scene_is_traced_packed_and_played_in_one_command") {
+        return;
+    }
+    let dir = tempfile::tempdir().expect("temp dir");
+    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("../samples/demo1");
+    for e in std::fs::read_dir(&src).expect("demo1").filter_map(Result::ok) {
+        if e.path().is_file() {
+            std::fs::copy(e.path(), dir.path().join(e.file_name())).expect("copy");
+        }
+    }
+    let scene = dir.path().join("scene.toml");
+    let toml = std::fs::read_to_string(&scene).expect("scene.toml");
+    assert!(toml.contains("samples = 4") && toml.contains("resolution = [160, 120]"), "demo1's scene.toml changed: adapt this test");
+    // The scene's own size (pis-pack's default ratio, 384:1, needs a few hundred bytes).
+    let toml = toml.replace("samples = 4", "samples = 2").replace("spp = 4", "spp = 1");
+    std::fs::write(&scene, toml).expect("write scene.toml");
+    let first = play(&[os(&scene), os("--headless"), os("--json")]);
+    let err = String::from_utf8_lossy(&first.stderr).to_string();
+    let r = json(&first);
+    assert!(err.contains("tracing and packing"), "{err}");
+    // 2 × 2 samples: the diagonal tour visits each once.
+    assert_eq!(r["frames"], 4, "{r}");
+    let packed = dir.path().join(".pis-cache/demo1-160x120-spp1.pis");
+    assert!(packed.is_file(), "no pack at {}", packed.display());
+    assert!(dir.path().join(".pis-cache/demo1-160x120-spp1/set.json").is_file());
+    let again = play(&[os(&scene), os("--headless"), os("--at"), os(&fixture_values(&packed).join(",")), os("--json")]);
+    let err = String::from_utf8_lossy(&again.stderr).to_string();
+    let r = json(&again);
+    assert!(!err.contains("tracing and packing") && err.contains("playing"), "{err}");
+    assert_eq!(r["frames"], 1, "{r}");
+}
+
+/// The values of a container's first sample point, one per dimension.
+fn fixture_values(file: &Path) -> Vec<String> {
+    let reader = pis_format::PisReader::open(file).expect("container");
+    reader.container().space.dims.iter().map(|d| d.values[0].to_string()).collect()
+}

@@ -59,10 +59,15 @@ fn parse_reduction(s: &str) -> Result<u32, String> {
 /// the sample camera or a free orbit / fly camera, a stats panel, and with `--set` the
 /// ray-traced gold standard. `--frames N` exits after N frames with a frame-rate report,
 /// `--screenshot` saves the last one.
+///
+/// Given a scene.toml instead of a .pis file, the whole job runs first: the scene is traced
+/// (once, into `.pis-cache/` beside it) and packed with pis-pack's defaults into
+/// `.pis-cache/NAME-WxH-sppN.pis`, reused while it is newer than the scene.toml; without
+/// `--at`, `--path` or `--compare` it then plays along the diagonal (`--path diagonal`).
 #[derive(Parser, Debug, Clone)]
 #[command(name = "pis-play", version, about, after_help = crate::cli::EXIT_CODES_HELP)]
 pub struct PlayArgs {
-    /// The .pis file to play.
+    /// The .pis file to play, or a scene.toml to trace, pack and play.
     pub file: PathBuf,
     /// Draw offscreen, without a window.
     #[arg(long)]
