@@ -269,8 +269,18 @@ fn against_the_set_gates_and_flip_maps() {
     let w = json(&within);
     assert!((w["psnr_drop_db"].as_f64().expect("drop") - 1.0).abs() < 1e-6, "{w}");
     assert_eq!(diff(packed(), set(), &["--reference-psnr", &reference, "--max-psnr-drop", "0.5"]).status.code(), Some(7));
-    // Without a recorded prediction the drop gate needs a reference.
-    let out = diff(packed(), set(), &["--max-psnr-drop", "1"]);
+    // pis-pack records its prediction in the file: the drop gate measures against it, and the
+    // played covered-pixel PSNR is within 0.5 dB of it.
+    let recorded = diff(packed(), set(), &["--json", "--max-psnr-drop", "0.5"]);
+    assert_eq!(recorded.status.code(), Some(0), "{}", String::from_utf8_lossy(&recorded.stderr));
+    let g = json(&recorded);
+    assert!(g["reference_from"].as_str().is_some_and(|s| s.contains("predicted_psnr_db")), "{g}");
+    assert!(g["psnr_drop_db"].as_f64().is_some_and(|d| d.abs() <= 0.5), "{g}");
+    // A re-encoded file records no prediction: the drop gate then needs a reference.
+    let dir = tempfile::tempdir().expect("temp dir");
+    let b = dir.path().join("b.pis");
+    reencode(packed(), &b, &["--codec", "wavelet", "--ratio", "96"]);
+    let out = diff(&b, set(), &["--max-psnr-drop", "1"]);
     assert_eq!(out.status.code(), Some(1));
     assert!(String::from_utf8_lossy(&out.stderr).contains("--reference-psnr"));
 }

@@ -89,6 +89,10 @@ pub enum LayerMode {
     Combined,
 }
 
+/// The provenance setting holding the predicted PSNR (dB, display values over the pixels the
+/// objects cover) of a packed file.
+pub const PREDICTED_PSNR_SETTING: &str = "predicted_psnr_db";
+
 /// The default compression ratio when neither `--ratio` nor `--psnr` is given.
 pub const DEFAULT_RATIO: f64 = 384.0;
 
@@ -136,11 +140,16 @@ pub fn pack(req: &PackRequest) -> Result<PackReport, Failure> {
     let mut stages = Stages::new();
     let set = input::load(req, &mut stages)?;
     let inferred = infer_layers::infer_all(&set, req, &mut stages).map_err(|e| Failure::new(Exit::Runtime, e))?;
-    let packed = encode::encode_all(&set, &inferred, req, &mut stages)?;
-    let bytes = pis_format::write(&req.output, &packed.container)?;
-    stages.done("write", &format!("{} ({bytes} bytes)", req.output.display()));
+    let mut packed = encode::encode_all(&set, &inferred, req, &mut stages)?;
     let quality = encode::predicted_psnr(&set, &inferred, &packed).map_err(|e| Failure::new(Exit::Runtime, e))?;
     stages.done("predict", "decoded textures rendered through the hardware model");
+    // The prediction travels with the file: `pis-diff FILE SET --max-psnr-drop` measures
+    // the played PSNR against it.
+    if let Some(p) = packed.container.provenance.as_mut() {
+        p.settings.push((PREDICTED_PSNR_SETTING.to_string(), format!("{:.4}", quality.overall)));
+    }
+    let bytes = pis_format::write(&req.output, &packed.container)?;
+    stages.done("write", &format!("{} ({bytes} bytes)", req.output.display()));
     // Lossless: the file's level images decode bit-exactly and the decoded textures equal
     // the solved ones.
     let exact = if req.codec == CodecId::Lossless {

@@ -265,7 +265,7 @@ pub fn reencode(req: &ReencodeRequest) -> Result<ReencodeReport, Failure> {
     }
     let before = c.provenance.clone().unwrap_or_default();
     let mut settings: Vec<(String, String)> = before.settings.iter()
-        .filter(|(k, _)| !matches!(k.as_str(), "codec" | "gamma" | "target" | "reencoded_from" | "source_tool" | "source_codec"))
+        .filter(|(k, _)| !matches!(k.as_str(), "codec" | "gamma" | "target" | "reencoded_from" | "source_tool" | "source_codec" | crate::pack::PREDICTED_PSNR_SETTING))
         .cloned().collect();
     let codecs_before: Vec<String> = {
         let mut v: Vec<String> = c.objects.iter().flat_map(|o| &o.layers).flat_map(|l| &l.blocks).flat_map(|b| &b.levels)

@@ -26,7 +26,7 @@ use crate::reencode::open;
 
 /// The provenance setting that holds a writer's predicted PSNR (dB), the reference of
 /// `--max-psnr-drop` when `--reference-psnr` is not given.
-pub const PREDICTED_PSNR_SETTING: &str = "predicted_psnr_db";
+pub use crate::pack::PREDICTED_PSNR_SETTING;
 
 /// What to measure.
 #[derive(Clone, Debug, Default)]
