@@ -9,6 +9,8 @@ use std::process::{Command, Output, Stdio};
 use std::sync::OnceLock;
 use std::time::{Duration, Instant};
 
+mod common;
+
 fn tiny() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../samples/tiny.pis")
 }
@@ -76,17 +78,8 @@ fn fixture() -> &'static Fixture {
     static F: OnceLock<Fixture> = OnceLock::new();
     F.get_or_init(|| {
         let dir = tempfile::tempdir().expect("temp dir");
-        let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("../samples/demo1");
         let scene_dir = dir.path().join("demo1");
-        std::fs::create_dir(&scene_dir).expect("scene dir");
-        for e in std::fs::read_dir(&src).expect("demo1").filter_map(Result::ok) {
-            if e.path().is_file() {
-                std::fs::copy(e.path(), scene_dir.join(e.file_name())).expect("copy");
-            }
-        }
-        let toml = std::fs::read_to_string(scene_dir.join("scene.toml")).expect("scene.toml");
-        assert!(toml.contains("samples = 4"), "demo1's scene.toml changed: adapt this fixture");
-        std::fs::write(scene_dir.join("scene.toml"), toml.replace("samples = 4", "samples = 2")).expect("write scene.toml");
+        common::demo1_copy(&scene_dir, &[("samples = 4", "samples = 2")]);
         let set = dir.path().join("set");
         let out = Command::new(env!("CARGO_BIN_EXE_pis-trace"))
             .arg(scene_dir.join("scene.toml")).arg("-o").arg(&set)
@@ -241,18 +234,9 @@ fn a_scene_is_traced_packed_and_played_in_one_command() {
         return;
     }
     let dir = tempfile::tempdir().expect("temp dir");
-    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("../samples/demo1");
-    for e in std::fs::read_dir(&src).expect("demo1").filter_map(Result::ok) {
-        if e.path().is_file() {
-            std::fs::copy(e.path(), dir.path().join(e.file_name())).expect("copy");
-        }
-    }
-    let scene = dir.path().join("scene.toml");
-    let toml = std::fs::read_to_string(&scene).expect("scene.toml");
-    assert!(toml.contains("samples = 4") && toml.contains("resolution = [160, 120]"), "demo1's scene.toml changed: adapt this test");
-    // The scene's own size (pis-pack's default ratio, 384:1, needs a few hundred bytes).
-    let toml = toml.replace("samples = 4", "samples = 2").replace("spp = 4", "spp = 1");
-    std::fs::write(&scene, toml).expect("write scene.toml");
+    // The scene's own size, 160×120 (pis-pack's default ratio, 384:1, needs a few hundred
+    // bytes).
+    let scene = common::demo1_copy(dir.path(), &[("samples = 4", "samples = 2"), ("spp = 4", "spp = 1"), ("resolution = [160, 120]", "resolution = [160, 120]")]);
     let first = play(&[os(&scene), os("--headless"), os("--json")]);
     let err = String::from_utf8_lossy(&first.stderr).to_string();
     let r = json(&first);

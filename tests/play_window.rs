@@ -10,6 +10,8 @@ use std::process::{Command, Output, Stdio};
 use std::sync::OnceLock;
 use std::time::{Duration, Instant};
 
+mod common;
+
 fn in_ci() -> bool {
     std::env::var_os("CI").is_some_and(|v| !v.is_empty())
 }
@@ -95,17 +97,8 @@ fn fixture() -> &'static Fixture {
     static F: OnceLock<Fixture> = OnceLock::new();
     F.get_or_init(|| {
         let dir = tempfile::tempdir().expect("temp dir");
-        let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("../samples/demo1");
         let scene_dir = dir.path().join("demo1");
-        std::fs::create_dir(&scene_dir).expect("scene dir");
-        for e in std::fs::read_dir(&src).expect("demo1").filter_map(Result::ok) {
-            if e.path().is_file() {
-                std::fs::copy(e.path(), scene_dir.join(e.file_name())).expect("copy");
-            }
-        }
-        let toml = std::fs::read_to_string(scene_dir.join("scene.toml")).expect("scene.toml");
-        assert!(toml.contains("samples = 4"), "demo1's scene.toml changed: adapt this fixture");
-        std::fs::write(scene_dir.join("scene.toml"), toml.replace("samples = 4", "samples = 2")).expect("write scene.toml");
+        common::demo1_copy(&scene_dir, &[("samples = 4", "samples = 2")]);
         let set = dir.path().join("set");
         let out = run(
             env!("CARGO_BIN_EXE_pis-trace"),

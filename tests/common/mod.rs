@@ -1,0 +1,25 @@
+//! Helpers shared by the end-to-end tests.
+
+use std::path::{Path, PathBuf};
+
+/// Copies samples/demo1 (scene.toml, glTF, buffers, textures) into `dir` with every
+/// `(from, to)` edit applied to its scene.toml; returns the copy's scene.toml. Each `from` must
+/// occur in demo1's scene.toml, so a change there fails here rather than quietly testing
+/// another scene.
+pub fn demo1_copy(dir: &Path, edits: &[(&str, &str)]) -> PathBuf {
+    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("../samples/demo1");
+    std::fs::create_dir_all(dir).expect("scene folder");
+    for e in std::fs::read_dir(&src).expect("samples/demo1").filter_map(Result::ok) {
+        if e.path().is_file() {
+            std::fs::copy(e.path(), dir.join(e.file_name())).expect("copy demo1");
+        }
+    }
+    let toml = dir.join("scene.toml");
+    let mut text = std::fs::read_to_string(&toml).expect("scene.toml");
+    for (from, to) in edits {
+        assert!(text.contains(from), "demo1's scene.toml has no {from:?}: adapt the tests");
+        text = text.replace(from, to);
+    }
+    std::fs::write(&toml, text).expect("write scene.toml");
+    toml
+}
