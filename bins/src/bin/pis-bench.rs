@@ -23,8 +23,11 @@ use pis::bench::stability::{self, StabilityRequest};
 use pis::infer::{infer, print_report, InferRequest};
 use pis_compile::SolveSettings;
 
+/// The PIS evaluation harness: speed charted against accuracy, PIS against the codecs a user
+/// would pick instead. Each chart subcommand writes CSV and SVG into --out (default
+/// reports/); `--record` adds a stamped row to docs/BENCHMARKS.md.
 #[derive(Parser, Debug)]
-#[command(name = "pis-bench", version, about, after_help = EXIT_CODES_HELP)]
+#[command(name = "pis-bench", version, after_help = EXIT_CODES_HELP)]
 struct Cli {
     #[command(subcommand)]
     command: Command,
@@ -133,7 +136,8 @@ enum Command {
         json: bool,
     },
     /// Compile (inference) time per parameter point against PSNR across solver iteration
-    /// caps (writes speed.csv and speed.svg into --out).
+    /// caps, and playback frame times against PSNR across texture reductions and codecs
+    /// (writes speed.csv and speed.svg into --out).
     Speed {
         /// A ray-traced set directory, or a scene.toml to trace first.
         input: PathBuf,
