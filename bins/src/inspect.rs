@@ -92,22 +92,9 @@ pub struct CodecSummary {
     pub bytes: u64,
 }
 
-/// Bytes per kind of content; `total` is the file size.
-#[derive(Serialize, Default)]
-pub struct Bytes {
-    pub total: u64,
-    /// Header, chunk table and padding.
-    pub header: u64,
-    pub parameter_space: u64,
-    pub cameras: u64,
-    pub objects: u64,
-    pub geometry: u64,
-    pub layer_index: u64,
-    pub codestreams: u64,
-    pub provenance: u64,
-    /// Chunks of types this version does not define.
-    pub other: u64,
-}
+/// Bytes per kind of content; `total` is the file size, `header` the header, chunk table and
+/// padding, `other` chunks of types this version does not define.
+pub use pis_eval::diff::ChunkBytes as Bytes;
 
 #[derive(Serialize)]
 pub struct ProvenanceSummary {
@@ -126,25 +113,7 @@ fn dep_names(space: &ParameterSpace, mask: DepMask) -> Vec<String> {
 
 pub fn summarize(r: &PisReader) -> Summary {
     let c = r.container();
-    let mut bytes = Bytes {
-        total: r.len(),
-        ..Default::default()
-    };
-    for e in r.chunks() {
-        let slot = match &e.fourcc {
-            b"PSPC" => &mut bytes.parameter_space,
-            b"CAMS" => &mut bytes.cameras,
-            b"OBJS" => &mut bytes.objects,
-            b"MESH" => &mut bytes.geometry,
-            b"LAYR" => &mut bytes.layer_index,
-            b"CSTR" => &mut bytes.codestreams,
-            b"PROV" => &mut bytes.provenance,
-            _ => &mut bytes.other,
-        };
-        *slot += e.length;
-    }
-    let payloads: u64 = r.chunks().iter().map(|e| e.length).sum();
-    bytes.header = bytes.total - payloads;
+    let bytes = Bytes::of(r);
 
     let mut codecs: BTreeMap<String, CodecSummary> = BTreeMap::new();
     let objects = c
