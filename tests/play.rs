@@ -5,11 +5,11 @@
 //! a hang. Without a GPU adapter the tests skip locally and fail in CI.
 
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output, Stdio};
+use std::process::{Command, Output};
 use std::sync::OnceLock;
-use std::time::{Duration, Instant};
 
 mod common;
+use common::os;
 
 fn tiny() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../samples/tiny.pis")
@@ -25,31 +25,9 @@ fn play(args: &[&std::ffi::OsStr]) -> Output {
 }
 
 fn play_env(args: &[&std::ffi::OsStr], env: &[(&str, Option<&str>)]) -> Output {
-    let mut cmd = Command::new(env!("CARGO_BIN_EXE_pis-play"));
-    cmd.args(args).stdout(Stdio::piped()).stderr(Stdio::piped());
-    for (k, v) in env {
-        match v {
-            Some(v) => cmd.env(k, v),
-            None => cmd.env_remove(k),
-        };
-    }
-    let mut child = cmd.spawn().expect("pis-play runs");
-    let start = Instant::now();
-    loop {
-        if child.try_wait().expect("wait").is_some() {
-            return child.wait_with_output().expect("output");
-        }
-        if start.elapsed() > Duration::from_secs(120) {
-            let _ = child.kill();
-            panic!("pis-play {args:?} hung for 120 s");
-        }
-        std::thread::sleep(Duration::from_millis(20));
-    }
+    common::run(env!("CARGO_BIN_EXE_pis-play"), args, env)
 }
 
-fn os<S: AsRef<std::ffi::OsStr> + ?Sized>(s: &S) -> &std::ffi::OsStr {
-    s.as_ref()
-}
 
 /// Whether a GPU adapter exists (lavapipe counts); without one, the test is skipped
 /// locally and fails in CI.

@@ -8,41 +8,14 @@
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
 use std::sync::OnceLock;
-use std::time::{Duration, Instant};
 
 mod common;
+use common::{os, run};
 
 fn in_ci() -> bool {
     std::env::var_os("CI").is_some_and(|v| !v.is_empty())
 }
 
-/// Runs `program args`, killed after 120 s (a hang fails the test).
-fn run(program: &str, args: &[&std::ffi::OsStr], env: &[(&str, Option<&str>)]) -> Output {
-    let mut cmd = Command::new(program);
-    cmd.args(args).stdout(Stdio::piped()).stderr(Stdio::piped());
-    for (k, v) in env {
-        match v {
-            Some(v) => cmd.env(k, v),
-            None => cmd.env_remove(k),
-        };
-    }
-    let mut child = cmd.spawn().unwrap_or_else(|e| panic!("{program} runs: {e}"));
-    let start = Instant::now();
-    loop {
-        if child.try_wait().expect("wait").is_some() {
-            return child.wait_with_output().expect("output");
-        }
-        if start.elapsed() > Duration::from_secs(120) {
-            let _ = child.kill();
-            panic!("{program} {args:?} hung for 120 s");
-        }
-        std::thread::sleep(Duration::from_millis(20));
-    }
-}
-
-fn os<S: AsRef<std::ffi::OsStr> + ?Sized>(s: &S) -> &std::ffi::OsStr {
-    s.as_ref()
-}
 
 const PLAY: &str = env!("CARGO_BIN_EXE_pis-play");
 

@@ -1,6 +1,8 @@
 //! Helpers shared by the end-to-end tests.
 
 use std::path::{Path, PathBuf};
+use std::process::{Command, Output, Stdio};
+use std::time::{Duration, Instant};
 
 /// Copies samples/demo1 (scene.toml, glTF, buffers, textures) into `dir` with every
 /// `(from, to)` edit applied to its scene.toml; returns the copy's scene.toml. Each `from` must
@@ -22,4 +24,33 @@ pub fn demo1_copy(dir: &Path, edits: &[(&str, &str)]) -> PathBuf {
     }
     std::fs::write(&toml, text).expect("write scene.toml");
     toml
+}
+
+/// Runs `program args` with the environment changes `env` (a value, or `None` to remove the
+/// variable), killed after 120 s: a hang fails the test.
+pub fn run(program: &str, args: &[&std::ffi::OsStr], env: &[(&str, Option<&str>)]) -> Output {
+    let mut cmd = Command::new(program);
+    cmd.args(args).stdout(Stdio::piped()).stderr(Stdio::piped());
+    for (k, v) in env {
+        match v {
+            Some(v) => cmd.env(k, v),
+            None => cmd.env_remove(k),
+        };
+    }
+    let mut child = cmd.spawn().unwrap_or_else(|e| panic!("{program} runs: {e}"));
+    let start = Instant::now();
+    loop {
+        if child.try_wait().expect("wait").is_some() {
+            return child.wait_with_output().expect("output");
+        }
+        if start.elapsed() > Duration::from_secs(120) {
+            let _ = child.kill();
+            panic!("{program} {args:?} hung for 120 s");
+        }
+        std::thread::sleep(Duration::from_millis(20));
+    }
+}
+
+pub fn os<S: AsRef<std::ffi::OsStr> + ?Sized>(s: &S) -> &std::ffi::OsStr {
+    s.as_ref()
 }
