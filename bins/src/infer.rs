@@ -67,6 +67,8 @@ pub struct InferRequest {
     /// The per-object resolution reduction factor of texture-coordinate optimization
     /// (thesis 3.2; 1: the optimal resolution).
     pub reduction: f64,
+    /// Texel budget per covered pixel (see `pis-pack --texels-per-pixel`); None: none.
+    pub texels_per_pixel: Option<f64>,
 }
 
 /// One method's result.
@@ -275,10 +277,12 @@ pub(crate) struct Prepared {
     pub(crate) layout: TextureLayout,
     pub(crate) repeat: [bool; 2],
     pub(crate) texcoord_ms: f64,
+    /// The reduction factor applied (the requested one times the texel budget's).
+    pub(crate) reduction: f64,
 }
 
-fn prepare(pt: &Point, o: usize, mesh: &Mesh, max_texture: u32, reduction: f64) -> Result<Prepared> {
-    place(&pt.scene, &[&pt.frame], pt.settings.resolution, o, mesh, max_texture, reduction)
+fn prepare(pt: &Point, o: usize, mesh: &Mesh, req: &InferRequest, reduction: f64) -> Result<Prepared> {
+    place(&pt.scene, &[&pt.frame], pt.settings.resolution, o, mesh, req.max_texture, reduction, req.texels_per_pixel)
 }
 
 /// Texture-coordinate optimization (thesis 3.2) of object `o` over the views of `frames`,
@@ -292,6 +296,7 @@ pub(crate) fn place(
     mesh: &Mesh,
     max_texture: u32,
     reduction: f64,
+    texels_per_pixel: Option<f64>,
 ) -> Result<Prepared> {
     let t = Instant::now();
     let views: Vec<ViewGeometry> = frames.iter().map(|frame| {
@@ -312,7 +317,7 @@ pub(crate) fn place(
     };
     let name = &scene.objects[o].name;
     let om = ObjectMesh { name, uvs: &uvs, indices: &mesh.indices, wrap };
-    let settings = TexcoordSettings { max_size: max_texture, reduction, ..TexcoordSettings::default() };
+    let settings = TexcoordSettings { max_size: max_texture, reduction, texels_per_pixel, ..TexcoordSettings::default() };
     let pl = optimize_placement(&om, &views, &settings)?;
     let mesh_uvs: Vec<[f32; 2]> = uvs.iter().map(|uv| uv.to_array()).map(|uv| {
         let mut w = uv;
@@ -329,6 +334,7 @@ pub(crate) fn place(
         layout: TextureLayout::full(pl.width, pl.height),
         repeat: pl.repeat,
         texcoord_ms: t.elapsed().as_secs_f64() * 1e3,
+        reduction: pl.reduction,
     })
 }
 
@@ -390,7 +396,7 @@ pub fn infer(req: &InferRequest) -> Result<InferReport> {
             render_matrix(viewport, obj, Some(occ))?
         })
     };
-    let prep = prepare(&pt, o, &meshes[o], req.max_texture, reduction)?;
+    let prep = prepare(&pt, o, &meshes[o], req, reduction)?;
     let t = Instant::now();
     let occluders = scene_depth(viewport, &draw, Some(o))?;
     let mut mesh_o = draw[o];
@@ -503,7 +509,7 @@ pub fn infer(req: &InferRequest) -> Result<InferReport> {
         for k in 0..scene.objects.len() {
             let t0 = Instant::now();
             let Ok((cov_k, rgb_k)) = object_layer(&pt.images, &names[k]) else { continue };
-            let prep_k = prepare(&pt, k, &meshes[k], req.max_texture, reduction)?;
+            let prep_k = prepare(&pt, k, &meshes[k], req, reduction)?;
             let t1 = Instant::now();
             let occ = scene_depth(viewport, &draw, Some(k))?;
             let mut m = draw[k];

@@ -51,6 +51,9 @@ pub struct PackRequest {
     pub filter: Filter,
     /// Largest used texture side.
     pub max_texture: u32,
+    /// Texel budget: at most this many level-0 texels per pixel an object covers (its most
+    /// covered view); None: the optimal resolution of thesis 3.2, capped by `max_texture` only.
+    pub texels_per_pixel: Option<f64>,
     /// Display gamma g of the compensation γ(L) = L^(1/g); lossless packs use 1.
     pub gamma: f32,
     /// Tracing a scene.toml: size and samples per pixel overrides.
@@ -92,6 +95,9 @@ pub enum LayerMode {
 /// The provenance setting holding the predicted PSNR (dB, display values over the pixels the
 /// objects cover) of a packed file.
 pub const PREDICTED_PSNR_SETTING: &str = "predicted_psnr_db";
+
+/// The default texel budget per covered pixel (`--texels-per-pixel`).
+pub const DEFAULT_TEXELS_PER_PIXEL: Option<f64> = Some(2.0);
 
 /// The default compression ratio when neither `--ratio` nor `--psnr` is given.
 pub const DEFAULT_RATIO: f64 = 384.0;

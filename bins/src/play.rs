@@ -42,6 +42,7 @@ fn pack_scene(scene_toml: &Path) -> Result<PathBuf, Failure> {
         block: vec![8],
         filter: pis_compile::Filter::Trilinear,
         max_texture: 256,
+        texels_per_pixel: crate::pack::DEFAULT_TEXELS_PER_PIXEL,
         gamma: 2.2,
         resolution: None,
         spp: None,

@@ -106,6 +106,7 @@ fn pack_request(req: &RdRequest) -> PackRequest {
         block: vec![8],
         filter: Filter::Trilinear,
         max_texture: req.max_texture,
+        texels_per_pixel: crate::pack::DEFAULT_TEXELS_PER_PIXEL,
         gamma: 2.2,
         resolution: req.resolution,
         spp: req.spp,

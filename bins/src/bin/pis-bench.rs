@@ -90,6 +90,10 @@ enum Command {
         /// Per-object texture resolution reduction factor (thesis 3.2; 1: optimal).
         #[arg(long, default_value_t = 1.0)]
         reduction: f64,
+        /// Texel budget: at most K level-0 texels per covered pixel, as `pis-pack
+        /// --texels-per-pixel` (default: none, the optimal resolution).
+        #[arg(long)]
+        texels_per_pixel: Option<f64>,
         /// Skip the renders through wgpu (pis-play); psnr_db_wgpu is then null.
         #[arg(long)]
         no_wgpu: bool,
@@ -240,7 +244,7 @@ fn parse_resolution(s: &str) -> Result<(u32, u32), String> {
 
 fn run(cli: Cli) -> Result<Exit, Failure> {
     match cli.command {
-        Command::Infer { input, object, at, scene, resolution, spp, preset, all_objects, max_texture, epsilon_f, epsilon_b, pyramidal_epsilon_b, tolerance, max_iterations, antialias, neighbour, reduction, no_wgpu, json } => {
+        Command::Infer { input, object, at, scene, resolution, spp, preset, all_objects, max_texture, epsilon_f, epsilon_b, pyramidal_epsilon_b, tolerance, max_iterations, antialias, neighbour, reduction, texels_per_pixel, no_wgpu, json } => {
             if !input.exists() {
                 return Err(Failure::new(Exit::Io, anyhow::anyhow!("{} does not exist", input.display())));
             }
@@ -253,13 +257,16 @@ fn run(cli: Cli) -> Result<Exit, Failure> {
             if antialias == 0 || antialias > 16 || !(reduction.is_finite() && reduction > 0.0) {
                 return Err(Failure::new(Exit::Usage, anyhow::anyhow!("--antialias must be in 1..=16 and --reduction > 0")));
             }
+            if texels_per_pixel.is_some_and(|k| !(k.is_finite() && k > 0.0)) {
+                return Err(Failure::new(Exit::Usage, anyhow::anyhow!("--texels-per-pixel must be > 0")));
+            }
             if !(epsilon_b.is_finite() && epsilon_b >= 0.0 && pyramidal_epsilon_b.is_finite() && pyramidal_epsilon_b >= 0.0) {
                 return Err(Failure::new(Exit::Usage, anyhow::anyhow!("--epsilon-b and --pyramidal-epsilon-b must be ≥ 0")));
             }
             let mut solver = SolveSettings { epsilon_b, ..SolveSettings::default() };
             solver.cg.tolerance = tolerance;
             solver.cg.max_iterations = max_iterations;
-            let req = InferRequest { input, scene, object, at, resolution, spp, preset, all_objects, max_texture, solver, epsilon_f, pyramidal_epsilon_b, wgpu: !no_wgpu, antialias, neighbour, reduction };
+            let req = InferRequest { input, scene, object, at, resolution, spp, preset, all_objects, max_texture, solver, epsilon_f, pyramidal_epsilon_b, wgpu: !no_wgpu, antialias, neighbour, reduction, texels_per_pixel };
             let report = infer(&req).map_err(|e| Failure::new(Exit::Runtime, e))?;
             print_report(&report, &mut std::io::stderr()).map_err(|e| Failure::new(Exit::Io, e))?;
             if json {

@@ -46,6 +46,12 @@ struct Cli {
     /// Largest used texture side.
     #[arg(long, default_value_t = 256)]
     max_texture: u32,
+    /// Texel budget: at most K level-0 texels per pixel an object covers in its most covered
+    /// view; an object's texture over budget is reduced uniformly (thesis 3.2's per-object
+    /// reduction factor, chosen automatically). `none`: the optimal resolution, capped by
+    /// --max-texture only.
+    #[arg(long, default_value = "2", value_parser = parse_budget)]
+    texels_per_pixel: Budget,
     /// Display gamma of the compensation (1: linear storage; lossless packs always use 1).
     #[arg(long, default_value_t = 2.2)]
     gamma: f32,
@@ -105,6 +111,18 @@ fn parse_filter(s: &str) -> Result<Filter, String> {
     }
 }
 
+/// `--texels-per-pixel`: a positive number or `none`.
+#[derive(Clone, Copy, Debug)]
+struct Budget(Option<f64>);
+
+fn parse_budget(s: &str) -> Result<Budget, String> {
+    if s == "none" {
+        return Ok(Budget(None));
+    }
+    s.parse::<f64>().ok().filter(|k| k.is_finite() && *k > 0.0).map(|k| Budget(Some(k)))
+        .ok_or_else(|| format!("--texels-per-pixel {s:?}: expected a number > 0 or `none`"))
+}
+
 /// `--block`: one size, or one per dimension.
 #[derive(Clone, Debug)]
 struct BlockSizes(Vec<u32>);
@@ -138,6 +156,7 @@ fn run(cli: Cli) -> Result<Exit, Failure> {
         block: cli.block.0,
         filter: cli.filter,
         max_texture: cli.max_texture,
+        texels_per_pixel: cli.texels_per_pixel.0,
         gamma: if cli.codec == CodecId::Lossless { 1.0 } else { cli.gamma },
         resolution: cli.resolution,
         spp: cli.spp,

@@ -153,7 +153,7 @@ pub(crate) fn infer_all(set: &LoadedSet, req: &PackRequest, stages: &mut Stages)
     let mut out = Vec::new();
     for o in 0..scene.objects.len() {
         let name = scene.objects[o].name.clone();
-        let prep = place(scene, &frames, set.resolution, o, &meshes[o], req.max_texture, 1.0)?;
+        let prep = place(scene, &frames, set.resolution, o, &meshes[o], req.max_texture, 1.0, req.texels_per_pixel)?;
         let views = views_of(set, o, &prep, &meshes, req)?;
         let covered: usize = views.iter().map(|v| v.a.rows()).sum();
         if covered == 0 {

@@ -26,6 +26,10 @@ pub struct ObjectReport {
     /// The same for the textures as solved, before coding: the inference's own limit.
     pub psnr_db_solved: f64,
     pub texture: [u32; 2],
+    /// The texture's resolution reduction factor against thesis 3.2's optimal resolution
+    /// (below 1 where the texel budget, `--texels-per-pixel`, reduced it; `--max-texture`
+    /// clamps after it).
+    pub reduction: f64,
     /// Block origin offsets per dimension (thesis 4.7).
     pub stagger: Vec<u32>,
     pub blocks: usize,
@@ -87,6 +91,7 @@ pub(crate) fn build(set: &LoadedSet, models: &[ObjectModel], packed: &Packed, q:
             psnr_db: q.objects[mi].0,
             psnr_db_solved: q.objects[mi].1,
             texture: [m.prep.layout.width, m.prep.layout.height],
+            reduction: m.prep.reduction,
             stagger: packed.stagger[mi].clone(),
             blocks: ob.layers.iter().map(|l| l.blocks.len()).sum(),
             level_images: ob.layers.iter().flat_map(|l| &l.blocks).flat_map(|b| &b.levels).map(|l| l.images.len()).sum(),
@@ -131,9 +136,9 @@ pub fn print_report(r: &PackReport, out: &mut impl std::io::Write) -> std::io::R
     }
     for o in &r.objects {
         let layers: Vec<String> = o.layer_bytes.iter().map(|(k, b)| format!("{k} {b}")).collect();
-        writeln!(out, "  {:<10} {:<17} {:>8} bytes ({}), {:.2} dB (solved {:.2}), {}x{}, stagger {:?}, {} blocks, {} level images",
+        writeln!(out, "  {:<10} {:<17} {:>8} bytes ({}), {:.2} dB (solved {:.2}), {}x{} (reduction {:.2}), stagger {:?}, {} blocks, {} level images",
                  o.name, o.representation, o.bytes, layers.join(", "), o.psnr_db, o.psnr_db_solved, o.texture[0], o.texture[1],
-                 o.stagger, o.blocks, o.level_images)?;
+                 o.reduction, o.stagger, o.blocks, o.level_images)?;
         writeln!(out, "             why: {}", o.why)?;
     }
     let stages: Vec<String> = r.stage_ms.iter().map(|(k, v)| format!("{k} {v:.0}")).collect();

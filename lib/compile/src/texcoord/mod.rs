@@ -6,7 +6,8 @@
 //! 3. and 4. scaling until the largest singular value of the texture→screen Jacobian is
 //!    under a threshold at every covered pixel ([`stretch`]);
 //! 5. the minimum-area bounding rectangle over discrete directions ([`bounding`]);
-//! 6. the used resolution, times a per-object reduction factor.
+//! 6. the used resolution, times a per-object reduction factor: the user's, or the one that
+//!    keeps level 0 within a texel budget per covered pixel ([`TexcoordSettings::texels_per_pixel`]).
 //!
 //! Visibility comes from a minimal triangle-identifier z-buffer ([`visibility`]).
 //!
@@ -42,11 +43,19 @@ pub struct TexcoordSettings {
     pub reduction: f64,
     /// Largest used width or height (SPEC.md 7.3 allows 16384).
     pub max_size: u32,
+    /// Texel budget: at most this many level-0 texels per pixel the object covers in its
+    /// most covered view; a placement over budget is reduced further, uniformly. One
+    /// affine map must reach the density of the most magnified pixel over the whole
+    /// visible extent, so objects spanning large depth ranges (a floor) get many texels
+    /// that only minified pixels read, through coarser MIP levels; beyond about one
+    /// texel per pixel they add unknowns that no pixel constrains (thesis 3.2's
+    /// per-object reduction factor, chosen automatically). None: no budget.
+    pub texels_per_pixel: Option<f64>,
 }
 
 impl Default for TexcoordSettings {
     fn default() -> Self {
-        TexcoordSettings { max_stretch: 1.25, directions: 90, reduction: 1.0, max_size: 16384 }
+        TexcoordSettings { max_stretch: 1.25, directions: 90, reduction: 1.0, max_size: 16384, texels_per_pixel: None }
     }
 }
 
@@ -77,6 +86,10 @@ pub struct TexturePlacement {
     pub stretch: f64,
     /// Visible edges used over all views of the block.
     pub visible_edges: usize,
+    /// The reduction factor applied: the settings' factor, times the texel budget's.
+    pub reduction: f64,
+    /// Pixels the object covers in its most covered view of the block.
+    pub covered_pixels: usize,
 }
 
 impl TexturePlacement {
@@ -112,6 +125,9 @@ pub fn optimize_placement(
     }
     if !(settings.max_stretch > 0.0 && settings.reduction > 0.0 && settings.reduction.is_finite()) {
         return Err(CompileError::Setting("max stretch and reduction must be > 0".into()));
+    }
+    if settings.texels_per_pixel.is_some_and(|k| !(k > 0.0 && k.is_finite())) {
+        return Err(CompileError::Setting("the texel budget per pixel must be > 0".into()));
     }
 
     // Step 1: branch cuts, from the visible edges' extents in the original coordinates.
@@ -153,7 +169,7 @@ pub fn optimize_placement(
     if edges.is_empty() {
         return Ok(TexturePlacement {
             affine: [1.0, 0.0, 0.0, 1.0, 0.0, 0.0], width: 1, height: 1, repeat,
-            branch_cut: cut, stretch: 0.0, visible_edges: 0,
+            branch_cut: cut, stretch: 0.0, visible_edges: 0, reduction: settings.reduction, covered_pixels: 0,
         });
     }
 
@@ -199,9 +215,18 @@ pub fn optimize_placement(
         }
     }
 
-    // Step 6: the used resolution.
+    // Step 6: the used resolution, reduced to the texel budget.
     let ext = hi - lo;
-    let size = |e: f64| ((e * settings.reduction).ceil().max(1.0) as u64).min(settings.max_size as u64) as u32;
+    let covered_pixels = per_view.iter().map(|(_, ids)| ids.ids.iter().filter(|id| id.is_some()).count()).max().unwrap_or(0);
+    let mut reduction = settings.reduction;
+    if let Some(k) = settings.texels_per_pixel {
+        let texels = ext.x.max(1.0) * ext.y.max(1.0) * reduction * reduction;
+        let budget = k * covered_pixels.max(1) as f64;
+        if texels > budget {
+            reduction *= (budget / texels).sqrt();
+        }
+    }
+    let size = |e: f64| ((e * reduction).ceil().max(1.0) as u64).min(settings.max_size as u64) as u32;
     let (mut width, mut height) = (size(ext.x), size(ext.y));
     // A wrapped dimension keeps repeat addressing, which the player supports only on a
     // power-of-two used size (thesis 3.2: the next power of two above the optimum).
@@ -235,6 +260,8 @@ pub fn optimize_placement(
         branch_cut: cut,
         stretch,
         visible_edges: edges.len(),
+        reduction,
+        covered_pixels,
     })
 }
 

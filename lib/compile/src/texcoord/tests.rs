@@ -113,6 +113,39 @@ fn a_grazing_half_off_screen_square_uses_a_smaller_stretched_texture() {
 }
 
 #[test]
+fn the_texel_budget_reduces_a_grazing_floor_to_its_covered_pixels() {
+    // A large floor seen at a grazing angle: the nearest pixels set the density, the far
+    // end is minified, so the optimal texture holds far more texels than the pixels.
+    let (p, uv, idx) = grid(16);
+    let p: Vec<Vec3> = p.iter().map(|q| *q * 6.0).collect();
+    let views = [view(camera(Vec3::new(0.0, -3.5, 0.6), Vec3::new(0.0, 2.0, 0.0)), &p)];
+    let mesh = ObjectMesh { name: "floor", uvs: &uv, indices: &idx, wrap: [false; 2] };
+    let free = optimize_placement(&mesh, &views, &TexcoordSettings::default()).unwrap();
+    let texels = |pl: &TexturePlacement| pl.width as f64 * pl.height as f64;
+    assert!(free.covered_pixels > 0 && texels(&free) > 4.0 * free.covered_pixels as f64, "{free:?}");
+    assert_eq!(free.reduction, 1.0);
+    for k in [1.0, 2.0] {
+        let budget = TexcoordSettings { texels_per_pixel: Some(k), ..Default::default() };
+        let pl = optimize_placement(&mesh, &views, &budget).unwrap();
+        // within the budget up to the rounding of each side up to whole texels
+        let limit = k * pl.covered_pixels as f64;
+        assert!(texels(&pl) <= limit + pl.width as f64 + pl.height as f64 + 1.0, "k {k}: {pl:?}");
+        assert!(texels(&pl) >= 0.8 * limit, "k {k}: {pl:?}");
+        assert!(pl.reduction < 1.0 && pl.reduction > 0.0);
+        // the same placement, fewer texels: the affine map is unchanged
+        assert_eq!(pl.affine, free.affine);
+        check_visible_inside(&pl, &uv, &views, &idx);
+    }
+    // a budget the optimal texture already meets changes nothing
+    let loose = TexcoordSettings { texels_per_pixel: Some(texels(&free) / free.covered_pixels as f64 + 1.0), ..Default::default() };
+    let same = optimize_placement(&mesh, &views, &loose).unwrap();
+    assert_eq!((same.width, same.height, same.reduction), (free.width, free.height, 1.0));
+    // a non-positive budget is a settings error
+    let bad = TexcoordSettings { texels_per_pixel: Some(0.0), ..Default::default() };
+    assert!(optimize_placement(&mesh, &views, &bad).is_err());
+}
+
+#[test]
 fn the_seam_of_a_cylinder_seen_from_one_side_gets_a_branch_cut() {
     let (p, uv, idx) = cylinder(32);
     // the seam (u = 0) faces +x; the camera on +x sees u ∈ [−¼, ¼] across the seam
