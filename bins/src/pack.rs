@@ -64,6 +64,8 @@ pub struct PackRequest {
     /// Lighting layers: separate diffuse and specular layers, or one combined view-dependent
     /// layer (diffuse + specular) per parameter sample.
     pub layers: LayerMode,
+    /// What the storage allocation weighs: screen error (default) or texture error.
+    pub allocation: Allocation,
     /// Conjugate-gradient iteration cap per colour channel of every solve (None: the
     /// solver's default).
     pub max_iterations: Option<u32>,
@@ -80,6 +82,19 @@ pub enum PyramidMode {
     Adaptive,
     /// Every dimension halved (rounding up) per level down to one sample: no search.
     Full,
+}
+
+/// The error the storage allocation (thesis 4.5) minimizes.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Allocation {
+    /// Each level image's error weighted per texel by how much of the screen the texel
+    /// reaches through the render matrices (column sums of A, carried down the decimation),
+    /// so storage goes where errors are seen: texels no pixel reads weigh nothing, texels
+    /// that magnified pixels read weigh more.
+    #[default]
+    Screen,
+    /// Texture MSE weighted by each object's screen area (every texel of an object alike).
+    Texture,
 }
 
 /// How the lighting layers are separated.

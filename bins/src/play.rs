@@ -49,6 +49,7 @@ fn pack_scene(scene_toml: &Path) -> Result<PathBuf, Failure> {
         pyramid: crate::pack::PyramidMode::Adaptive,
         layers: crate::pack::LayerMode::Separate,
         max_iterations: None,
+        allocation: crate::pack::Allocation::Screen,
         preset: None,
     };
     let report = crate::pack::pack(&req)?;

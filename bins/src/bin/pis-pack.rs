@@ -7,7 +7,7 @@ use std::process::ExitCode;
 
 use clap::Parser;
 use pis::cli::{self, Exit, Failure};
-use pis::pack::{pack, print_report, LayerMode, PackRequest, PyramidMode};
+use pis::pack::{pack, print_report, Allocation, LayerMode, PackRequest, PyramidMode};
 use pis_codec::CodecId;
 use pis_compile::Filter;
 
@@ -73,6 +73,11 @@ struct Cli {
     /// (default: the solver's own).
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
     max_iterations: Option<u32>,
+    /// What the storage allocation minimizes: `screen` (texture error weighted per texel by
+    /// the screen pixels it reaches through the render matrices) or `texture` (texture MSE
+    /// weighted by each object's screen area).
+    #[arg(long, default_value = "screen", value_parser = parse_allocation)]
+    allocation: Allocation,
     /// Print the closing report as JSON on stdout.
     #[arg(long)]
     json: bool,
@@ -100,6 +105,14 @@ fn parse_layers(s: &str) -> Result<LayerMode, String> {
         "separate" => Ok(LayerMode::Separate),
         "combined" => Ok(LayerMode::Combined),
         _ => Err(format!("unknown layers {s:?} (separate or combined)")),
+    }
+}
+
+fn parse_allocation(s: &str) -> Result<Allocation, String> {
+    match s {
+        "screen" => Ok(Allocation::Screen),
+        "texture" => Ok(Allocation::Texture),
+        _ => Err(format!("unknown allocation {s:?} (screen or texture)")),
     }
 }
 
@@ -163,6 +176,7 @@ fn run(cli: Cli) -> Result<Exit, Failure> {
         pyramid: cli.pyramid,
         layers: cli.layers,
         max_iterations: cli.max_iterations,
+        allocation: cli.allocation,
         preset: None,
     };
     let report = pack(&req)?;

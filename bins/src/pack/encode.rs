@@ -156,6 +156,38 @@ pub fn full_levels(extent: &[u32]) -> Vec<Vec<u32>> {
     levels
 }
 
+/// The screen weight of every level-0 texel of object `m` at each point of the set: the
+/// column sums of its render matrix (how much of the covered pixels each texel of the MIP
+/// chain makes up: rows sum to 1), carried down the decimation to level 0 (Dᵀ), as the
+/// player draws coarser levels from level 0.
+fn screen_weights_per_point(m: &ObjectModel) -> Vec<Vec<f64>> {
+    let dec = pis_compile::decimation::Decimation::new(m.prep.layout);
+    m.views.iter().map(|v| {
+        let mut cols = vec![0.0f64; v.a.cols()];
+        for r in 0..v.a.rows() {
+            let (c, w) = v.a.row(r);
+            c.iter().zip(w).for_each(|(&c, &w)| cols[c as usize] += w as f64);
+        }
+        let mut out = vec![0.0f64; dec.base_len()];
+        dec.reduce(&cols, &mut out);
+        out
+    }).collect()
+}
+
+/// Texel weights of one layer sample: the sum of the per-point weights of the points that
+/// read it (all views of a view-independent sample), scaled to mean 1; all zero where no
+/// point shows the object.
+fn sample_weights(per_point: &[Vec<f64>], points: &[usize]) -> Vec<f32> {
+    let n = per_point.first().map_or(0, Vec::len);
+    let mut sum = vec![0.0f64; n];
+    for &p in points {
+        sum.iter_mut().zip(&per_point[p]).for_each(|(a, w)| *a += w);
+    }
+    let total: f64 = sum.iter().sum();
+    let scale = if total > 0.0 { n as f64 / total } else { 0.0 };
+    sum.iter().map(|w| (w * scale) as f32).collect()
+}
+
 /// Builds pyramids, allocates storage, encodes, and assembles the container.
 pub(crate) fn encode_all(set: &LoadedSet, models: &[ObjectModel], req: &PackRequest, stages: &mut Stages) -> Result<Packed, Failure> {
     let runtime = |e: anyhow::Error| Failure::new(Exit::Runtime, e);
@@ -172,6 +204,7 @@ pub(crate) fn encode_all(set: &LoadedSet, models: &[ObjectModel], req: &PackRequ
     let mut where_ = Vec::new();
     for (mi, m) in models.iter().enumerate() {
         let st = stagger(mi, models.len(), &sizes);
+        let per_point = if req.allocation == super::Allocation::Screen && req.codec.is_lossy() { screen_weights_per_point(m) } else { Vec::new() };
         let mut layers = Vec::new();
         let mut layer_blocks = Vec::new();
         for (li, il) in m.layers.iter().enumerate() {
@@ -194,6 +227,7 @@ pub(crate) fn encode_all(set: &LoadedSet, models: &[ObjectModel], req: &PackRequ
                 let count: usize = extent.iter().map(|&e| e as usize).product();
                 let mut keys = vec![Vec::new(); count];
                 let mut samples = vec![Vec::new(); count];
+                let mut weights = vec![Vec::new(); count];
                 for (k, x) in &il.textures {
                     let mut point = vec![0u32; space.dims.len()];
                     for (d, &v) in il.depends_on.dims().zip(k) {
@@ -206,11 +240,18 @@ pub(crate) fn encode_all(set: &LoadedSet, models: &[ObjectModel], req: &PackRequ
                     let idx = pos.local.iter().zip(&pos.extent).fold(0usize, |a, (&l, &e)| a * e as usize + l as usize);
                     keys[idx] = k.clone();
                     samples[idx] = prepare(&layer, &layout, &finest(m, x));
+                    if !per_point.is_empty() {
+                        let points: Vec<usize> = set.samples.iter().enumerate().filter(|(_, s)| key(s, il.depends_on) == *k).map(|(p, _)| p).collect();
+                        weights[idx] = sample_weights(&per_point, &points);
+                    }
                 }
                 if samples.iter().any(Vec::is_empty) {
                     return Err(runtime(anyhow!("object {} layer {} block {b}: a sample has no texture", m.name, il.kind.name())));
                 }
-                let pyramid = build_pyramid(mi, planes, &extent, &samples, layer_samples, !req.codec.is_lossy(), req.pyramid == super::PyramidMode::Full).map_err(runtime)?;
+                let mut pyramid = build_pyramid(mi, planes, &extent, &samples, layer_samples, !req.codec.is_lossy(), req.pyramid == super::PyramidMode::Full).map_err(runtime)?;
+                if !per_point.is_empty() {
+                    pyramid.texel_weights = Some(weights);
+                }
                 pyramids.push(pyramid);
                 where_.push((mi, li, b));
                 pblocks.push(PackedBlock { extent, keys, levels: vec![] });
@@ -252,6 +293,9 @@ pub(crate) fn encode_all(set: &LoadedSet, models: &[ObjectModel], req: &PackRequ
     }
     if req.layers != super::LayerMode::Separate {
         settings.push(("layers".to_string(), "combined".to_string()));
+    }
+    if req.allocation != super::Allocation::Screen {
+        settings.push(("allocation".to_string(), "texture".to_string()));
     }
     let mut container = Container {
         space,
@@ -454,4 +498,23 @@ pub(crate) fn predicted_psnr(set: &LoadedSet, models: &[ObjectModel], packed: &P
         overall_solved: total(&e_sol),
         max_texel_error: max_err,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::sample_weights;
+
+    #[test]
+    fn sample_weights_sum_the_points_that_read_a_sample_scaled_to_mean_one() {
+        let per_point = vec![vec![2.0, 0.0, 0.0, 2.0], vec![0.0, 0.0, 4.0, 0.0], vec![1.0, 1.0, 1.0, 1.0]];
+        // two views of a view-independent sample: texels seen by both weigh most, the
+        // texel no view reads weighs nothing
+        let w = sample_weights(&per_point, &[0, 1]);
+        assert_eq!(w, vec![1.0, 0.0, 2.0, 1.0]);
+        assert!((w.iter().sum::<f32>() / 4.0 - 1.0).abs() < 1e-6);
+        assert_eq!(sample_weights(&per_point, &[2]), vec![1.0; 4]);
+        // a sample no point shows weighs nothing anywhere
+        assert_eq!(sample_weights(&[vec![0.0; 3]], &[0]), vec![0.0; 3]);
+        assert_eq!(sample_weights(&per_point, &[]), vec![0.0; 4]);
+    }
 }

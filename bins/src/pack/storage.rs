@@ -22,6 +22,11 @@ pub struct BlockPyramid {
     pub layer_samples: f64,
     /// Per level, top first: counts, images as encoded, codestreams (empty until encoded).
     pub levels: Vec<CodedLevel>,
+    /// Screen weight of every texel of every finest sample (row-major over `extent`; one
+    /// value per texel, mean 1 where the sample shows): how much of the screen each texel's
+    /// error reaches. With them the allocation weighs texture error as screen error; None:
+    /// every texel weighs the same.
+    pub texel_weights: Option<Vec<Vec<f32>>>,
 }
 
 /// Builds the adaptive pyramid of a block's finest samples (gamma-compensated, row-major over
@@ -43,7 +48,7 @@ pub fn build_pyramid(object: usize, planes: Vec<PlaneShape>, extent: &[u32], sam
         let n = l.images.len();
         (l.counts, l.images, vec![Vec::new(); n])
     }).collect();
-    Ok(BlockPyramid { object, planes, extent: extent.to_vec(), layer_samples, levels })
+    Ok(BlockPyramid { object, planes, extent: extent.to_vec(), layer_samples, levels, texel_weights: None })
 }
 
 /// What the allocation gave: bytes per level image (in block, level, image order), or the
@@ -89,11 +94,38 @@ pub fn allocate_storage(blocks: &[BlockPyramid], codec: CodecId, target: Target,
     }).collect();
     let items = refs.par_iter().map(|&(b, lv, ii)| {
         let pb = &blocks[b];
-        let curve = c.rd_curve(&pb.planes, &pb.levels[lv].1[ii])?;
+        let values = &pb.levels[lv].1[ii];
+        let weights = level_image_weights(pb, lv, ii, values.len());
+        let curve = c.rd_curve_weighted(&pb.planes, values, weights.as_deref())?;
         Ok(Item { curve, object: pb.object, weight: members[b][lv][ii] as f64 / pb.layer_samples })
     }).collect::<Result<Vec<Item>, pis_codec::CodecError>>()?;
     let a = allocate(&items, areas, target, Some(DEFAULT_ALPHA))?;
     Ok(Storage { rates: a.bytes.into_iter().map(Rate::Bytes).collect(), allocated: Some(a.total_bytes), level_images: refs.len() })
+}
+
+/// The screen weight of every value of level image `ii` of level `lv`: the mean of the
+/// texel weights of the finest samples it reaches (its error adds to each of them), one
+/// value per channel.
+fn level_image_weights(pb: &BlockPyramid, lv: usize, ii: usize, values: usize) -> Option<Vec<f32>> {
+    let maps = pb.texel_weights.as_ref()?;
+    // one plane of interleaved channels (a surface texture's level 0)
+    let [plane] = pb.planes.as_slice() else { return None };
+    let texels = plane.width as usize * plane.height as usize;
+    let channels = plane.channels as usize;
+    if texels * channels != values || maps.iter().any(|m| m.len() != texels) {
+        return None;
+    }
+    let counts = &pb.levels[lv].0;
+    let mut sum = vec![0.0f64; texels];
+    let mut n = 0usize;
+    for (s, map) in maps.iter().enumerate() {
+        if level_image_index(counts, &unflatten(s, &pb.extent), &pb.extent) == ii {
+            sum.iter_mut().zip(map).for_each(|(a, w)| *a += *w as f64);
+            n += 1;
+        }
+    }
+    let n = n.max(1) as f64;
+    Some(sum.iter().flat_map(|w| std::iter::repeat_n((w / n) as f32, channels)).collect())
 }
 
 /// Encodes every level image of `blocks` at its allocated rate into the blocks' codestream
@@ -174,4 +206,31 @@ pub(crate) fn nudge(v: f32, ulps: i32) -> f32 {
         x = if ulps > 0 { x.next_up() } else { x.next_down() };
     }
     x
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_level_image_weighs_the_mean_of_the_samples_it_reaches_per_channel() {
+        // A 1-D block of 4 samples, 2 texels each, RGB; pyramid levels: 1 image, then 4.
+        let extent = [4u32];
+        let samples: Vec<Vec<f32>> = (0..4).map(|s| vec![s as f32; 6]).collect();
+        let mut pb = build_pyramid(0, vec![PlaneShape::new(2, 1, 3)], &extent, &samples, 4.0, false, true).unwrap();
+        let maps = vec![vec![1.0, 0.0], vec![3.0, 0.0], vec![0.0, 2.0], vec![0.0, 2.0]];
+        assert!(level_image_weights(&pb, 0, 0, 6).is_none(), "no weights: uniform");
+        pb.texel_weights = Some(maps.clone());
+        let top = 0;
+        let finest = pb.levels.len() - 1;
+        assert_eq!(pb.levels[top].1.len(), 1);
+        // the top image reaches all four samples: the mean of the maps, per channel
+        assert_eq!(level_image_weights(&pb, top, 0, 6).unwrap(), vec![1.0, 1.0, 1.0, 1.0, 1.0, 1.0]);
+        // a finest image reaches its own sample only
+        let idx = level_image_index(&pb.levels[finest].0, &[1], &extent);
+        assert_eq!(level_image_weights(&pb, finest, idx, 6).unwrap(), vec![3.0, 3.0, 3.0, 0.0, 0.0, 0.0]);
+        // maps of the wrong size are ignored rather than misread
+        pb.texel_weights = Some(vec![vec![1.0; 3]; 4]);
+        assert!(level_image_weights(&pb, top, 0, 6).is_none());
+    }
 }

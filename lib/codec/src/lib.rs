@@ -116,6 +116,19 @@ pub trait LevelCodec: Sync {
     /// point is [`wavelet::Encoded::curve`]), for `dct` at
     /// [`dct::CURVE_QUALITIES`], for exact codecs one point at zero error.
     fn rd_curve(&self, planes: &[PlaneShape], values: &[f32]) -> Result<RdCurve, CodecError> {
+        self.rd_curve_weighted(planes, values, None)
+    }
+    /// [`LevelCodec::rd_curve`] with the error of each value weighted: the curve's `mse` is
+    /// `Σ wᵢ (xᵢ − x̂ᵢ)² / n` ([`weighted_mse`]; weights of mean 1 keep the scale of the
+    /// plain MSE). A writer passes how much each value shows on screen, so that storage goes
+    /// where the error is seen (thesis 4.5). `None`: every value weighs 1.
+    fn rd_curve_weighted(
+        &self,
+        planes: &[PlaneShape],
+        values: &[f32],
+        weights: Option<&[f32]>,
+    ) -> Result<RdCurve, CodecError> {
+        check_weights(values, weights)?;
         let bytes = self.encode(planes, values, Rate::Default)?;
         Ok(RdCurve {
             points: vec![RdPoint {
@@ -124,6 +137,22 @@ pub trait LevelCodec: Sync {
             }],
         })
     }
+}
+
+/// Weights, when given, are one finite non-negative value per value.
+fn check_weights(values: &[f32], weights: Option<&[f32]>) -> Result<(), CodecError> {
+    if let Some(w) = weights {
+        if w.len() != values.len() {
+            return Err(CodecError::Length {
+                expected: values.len(),
+                found: w.len(),
+            });
+        }
+        if w.iter().any(|v| !(v.is_finite() && *v >= 0.0)) {
+            return Err(CodecError::Input("error weights must be finite and non-negative".into()));
+        }
+    }
+    Ok(())
 }
 
 struct RawCodec;
@@ -193,14 +222,20 @@ impl LevelCodec for WaveletCodec {
     fn decode(&self, planes: &[PlaneShape], bytes: &[u8]) -> Result<Vec<f32>, CodecError> {
         wavelet::decode(planes, bytes)
     }
-    fn rd_curve(&self, planes: &[PlaneShape], values: &[f32]) -> Result<RdCurve, CodecError> {
+    fn rd_curve_weighted(
+        &self,
+        planes: &[PlaneShape],
+        values: &[f32],
+        weights: Option<&[f32]>,
+    ) -> Result<RdCurve, CodecError> {
+        check_weights(values, weights)?;
         let e = wavelet::encode_full(
             planes,
             values,
             wavelet::DEFAULT_LEVELS,
             wavelet::DEFAULT_BITS,
         )?;
-        Ok(e.measured_curve(planes, values, wavelet::CURVE_POINTS)?
+        Ok(e.measured_curve_weighted(planes, values, weights, wavelet::CURVE_POINTS)?
             .monotone())
     }
 }
@@ -220,8 +255,14 @@ impl LevelCodec for DctCodec {
     fn decode(&self, planes: &[PlaneShape], bytes: &[u8]) -> Result<Vec<f32>, CodecError> {
         dct::decode(planes, bytes)
     }
-    fn rd_curve(&self, planes: &[PlaneShape], values: &[f32]) -> Result<RdCurve, CodecError> {
-        dct::rd_curve(planes, values, &dct::CURVE_QUALITIES)
+    fn rd_curve_weighted(
+        &self,
+        planes: &[PlaneShape],
+        values: &[f32],
+        weights: Option<&[f32]>,
+    ) -> Result<RdCurve, CodecError> {
+        check_weights(values, weights)?;
+        dct::rd_curve_weighted(planes, values, weights, &dct::CURVE_QUALITIES)
     }
 }
 
@@ -270,6 +311,21 @@ pub fn mse(a: &[f32], b: &[f32]) -> f64 {
         .iter()
         .zip(b)
         .map(|(x, y)| (*x as f64 - *y as f64).powi(2))
+        .sum();
+    s / a.len().max(1) as f64
+}
+
+/// `Σ wᵢ (aᵢ − bᵢ)² / n`: the mean squared error with each value's error weighted by
+/// `weights` (plain [`mse`] when `None`).
+pub fn weighted_mse(a: &[f32], b: &[f32], weights: Option<&[f32]>) -> f64 {
+    let Some(w) = weights else {
+        return mse(a, b);
+    };
+    let s: f64 = a
+        .iter()
+        .zip(b)
+        .zip(w)
+        .map(|((x, y), w)| *w as f64 * (*x as f64 - *y as f64).powi(2))
         .sum();
     s / a.len().max(1) as f64
 }

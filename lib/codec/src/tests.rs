@@ -372,3 +372,55 @@ fn constant_and_offset_images_keep_their_level() {
         }
     }
 }
+
+#[test]
+fn weighted_curves_count_only_the_error_that_is_weighted() {
+    // A textured plane whose left half weighs 2 and right half 0: the weighted curve's MSE
+    // at every truncation point equals the left half's plain error, and uniform weights of 1
+    // give the plain curve.
+    let (w, h) = (32u32, 16u32);
+    let p = [PlaneShape::new(w, h, 3)];
+    let v: Vec<f32> = (0..(w * h * 3) as usize)
+        .map(|i| {
+            let (x, y) = ((i / 3) as u32 % w, (i / 3) as u32 / w);
+            ((x * 7 + y * 3) % 11) as f32 / 11.0 + 0.2 * (i % 3) as f32
+        })
+        .collect();
+    let left: Vec<f32> = (0..v.len())
+        .map(|i| if ((i / 3) as u32 % w) < w / 2 { 2.0 } else { 0.0 })
+        .collect();
+    let ones = vec![1.0f32; v.len()];
+    for id in [CodecId::Wavelet, CodecId::Dct] {
+        let c = codec(id).unwrap();
+        let plain = c.rd_curve(&p, &v).unwrap();
+        let same = c.rd_curve_weighted(&p, &v, Some(&ones)).unwrap();
+        assert_eq!(plain.points.len(), same.points.len(), "{id}");
+        for (a, b) in plain.points.iter().zip(&same.points) {
+            assert_eq!(a.bytes, b.bytes);
+            assert!((a.mse - b.mse).abs() <= 1e-12 * a.mse.max(1.0), "{id}: {a:?} {b:?}");
+        }
+        let weighted = c.rd_curve_weighted(&p, &v, Some(&left)).unwrap();
+        let half: Vec<f32> = left.iter().map(|w| w / 2.0).collect();
+        let halved = c.rd_curve_weighted(&p, &v, Some(&half)).unwrap();
+        let zero = c.rd_curve_weighted(&p, &v, Some(&vec![0.0; v.len()])).unwrap();
+        let mut lower = 0;
+        for ((a, b), (hp, z)) in plain.points.iter().zip(&weighted.points).zip(halved.points.iter().zip(&zero.points)) {
+            // the same truncation points; the error is linear in the weights
+            assert_eq!((a.bytes, b.bytes), (hp.bytes, z.bytes), "{id}");
+            assert!((b.mse - 2.0 * hp.mse).abs() <= 1e-9 * b.mse.max(1e-9), "{id}: {} vs 2 × {}", b.mse, hp.mse);
+            assert_eq!(z.mse, 0.0, "{id}");
+            // weights 1 on the left half and 0 on the right: never above the plain error
+            assert!(hp.mse <= a.mse * (1.0 + 1e-12), "{id}");
+            if hp.mse < a.mse {
+                lower += 1;
+            }
+        }
+        assert!(lower > 0, "{id}: weighting out half the image lowers the error somewhere");
+    }
+    // weights of the wrong length or negative are an input error
+    let c = codec(CodecId::Wavelet).unwrap();
+    assert!(c.rd_curve_weighted(&p, &v, Some(&ones[1..])).is_err());
+    let mut neg = ones.clone();
+    neg[5] = -1.0;
+    assert!(c.rd_curve_weighted(&p, &v, Some(&neg)).is_err());
+}

@@ -183,8 +183,18 @@ pub fn rd_curve(
     values: &[f32],
     qualities: &[u8],
 ) -> Result<RdCurve, CodecError> {
-    let n = value_count(planes)?;
-    let zero = values.iter().map(|v| (*v as f64).powi(2)).sum::<f64>() / n.max(1) as f64;
+    rd_curve_weighted(planes, values, None, qualities)
+}
+
+/// [`rd_curve`] with per-value error weights ([`crate::weighted_mse`]).
+pub fn rd_curve_weighted(
+    planes: &[PlaneShape],
+    values: &[f32],
+    weights: Option<&[f32]>,
+    qualities: &[u8],
+) -> Result<RdCurve, CodecError> {
+    value_count(planes)?;
+    let zero = crate::weighted_mse(values, &vec![0.0; values.len()], weights);
     let mut points = vec![RdPoint {
         bytes: 0,
         mse: zero,
@@ -194,7 +204,7 @@ pub fn rd_curve(
         let back = decode(planes, &s)?;
         points.push(RdPoint {
             bytes: s.len(),
-            mse: crate::mse(values, &back),
+            mse: crate::weighted_mse(values, &back, weights),
         });
     }
     Ok(RdCurve { points }.monotone())

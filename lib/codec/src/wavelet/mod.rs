@@ -51,6 +51,17 @@ impl Encoded {
         values: &[f32],
         points: usize,
     ) -> Result<RdCurve, CodecError> {
+        self.measured_curve_weighted(planes, values, None, points)
+    }
+
+    /// [`Encoded::measured_curve`] with per-value error weights ([`crate::weighted_mse`]).
+    pub fn measured_curve_weighted(
+        &self,
+        planes: &[PlaneShape],
+        values: &[f32],
+        weights: Option<&[f32]>,
+        points: usize,
+    ) -> Result<RdCurve, CodecError> {
         let hl = header_len(planes);
         let total = self.bytes.len();
         let mut cuts = vec![0, hl.min(total)];
@@ -67,7 +78,7 @@ impl Encoded {
             let back = decode(planes, &self.bytes[..c])?;
             out.push(RdPoint {
                 bytes: c,
-                mse: crate::mse(values, &back),
+                mse: crate::weighted_mse(values, &back, weights),
             });
         }
         Ok(RdCurve { points: out })
