@@ -112,7 +112,7 @@ pub enum LayerMode {
 pub const PREDICTED_PSNR_SETTING: &str = "predicted_psnr_db";
 
 /// The default texel budget per covered pixel (`--texels-per-pixel`).
-pub const DEFAULT_TEXELS_PER_PIXEL: Option<f64> = Some(2.0);
+pub const DEFAULT_TEXELS_PER_PIXEL: Option<f64> = Some(1.0);
 
 /// The default compression ratio when neither `--ratio` nor `--psnr` is given.
 pub const DEFAULT_RATIO: f64 = 384.0;

@@ -50,7 +50,7 @@ struct Cli {
     /// view; an object's texture over budget is reduced uniformly (thesis 3.2's per-object
     /// reduction factor, chosen automatically). `none`: the optimal resolution, capped by
     /// --max-texture only.
-    #[arg(long, default_value = "2", value_parser = parse_budget)]
+    #[arg(long, default_value = "1", value_parser = parse_budget)]
     texels_per_pixel: Budget,
     /// Display gamma of the compensation (1: linear storage; lossless packs always use 1).
     #[arg(long, default_value_t = 2.2)]
