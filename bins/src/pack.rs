@@ -114,6 +114,10 @@ pub const PREDICTED_PSNR_SETTING: &str = "predicted_psnr_db";
 /// The default texel budget per covered pixel (`--texels-per-pixel`).
 pub const DEFAULT_TEXELS_PER_PIXEL: Option<f64> = Some(1.0);
 
+/// The default largest used texture side (`--max-texture`): a limit on what a GPU must
+/// hold, not the resolution control (the texel budget is).
+pub const DEFAULT_MAX_TEXTURE: u32 = 1024;
+
 /// The default compression ratio when neither `--ratio` nor `--psnr` is given.
 pub const DEFAULT_RATIO: f64 = 384.0;
 

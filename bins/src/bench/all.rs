@@ -65,16 +65,16 @@ pub fn run(preset: Preset, scene: &Path, out: &Path, record: bool) -> Result<(),
     clear_cache(scene, &s)?;
     let preset_name = s.preset.map(str::to_string);
     let rd_req = RdRequest { input: scene.to_path_buf(), scene: None, ratios: s.rd_ratios.clone(), out: out.to_path_buf(), resolution: s.resolution,
-                             spp: s.spp, max_texture: 256, preset: preset_name.clone(), record, methods: vec![] };
+                             spp: s.spp, max_texture: crate::pack::DEFAULT_MAX_TEXTURE, preset: preset_name.clone(), record, methods: vec![] };
     let r = rd::run(&rd_req)?;
     rd::print(&r, &mut std::io::stderr()).map_err(|e| Failure::new(Exit::Io, e))?;
     let speed_req = SpeedRequest { input: scene.to_path_buf(), scene: None, caps: s.caps.clone(), ratio: 384.0, out: out.to_path_buf(),
-                                   resolution: s.resolution, spp: s.spp, preset: preset_name.clone(), max_texture: 256, record };
+                                   resolution: s.resolution, spp: s.spp, preset: preset_name.clone(), max_texture: crate::pack::DEFAULT_MAX_TEXTURE, record };
     let r = speed::run(&speed_req)?;
     speed::print(&r, &mut std::io::stderr()).map_err(|e| Failure::new(Exit::Io, e))?;
     let st_req = StabilityRequest { input: scene.to_path_buf(), scene: None, ratios: s.stability_ratios.clone(), frames: s.frames,
                                     spp: s.reference_spp, out: out.to_path_buf(), resolution: s.resolution, trace_spp: s.spp,
-                                    max_texture: 256, preset: preset_name, record };
+                                    max_texture: crate::pack::DEFAULT_MAX_TEXTURE, preset: preset_name, record };
     let r = stability::run(&st_req)?;
     stability::print(&r, &mut std::io::stderr()).map_err(|e| Failure::new(Exit::Io, e))?;
     Ok(())

@@ -122,7 +122,7 @@ enum Command {
         #[arg(long)]
         spp: Option<u32>,
         /// Largest used texture side of the PIS inference.
-        #[arg(long, default_value_t = 256)]
+        #[arg(long, default_value_t = pis::pack::DEFAULT_MAX_TEXTURE)]
         max_texture: u32,
         /// A `[preset.NAME]` of scene.toml when tracing one.
         #[arg(long)]
@@ -161,7 +161,7 @@ enum Command {
         spp: Option<u32>,
         #[arg(long)]
         preset: Option<String>,
-        #[arg(long, default_value_t = 256)]
+        #[arg(long, default_value_t = pis::pack::DEFAULT_MAX_TEXTURE)]
         max_texture: u32,
         /// Record the run in docs/BENCHMARKS.md.
         #[arg(long)]
@@ -194,7 +194,7 @@ enum Command {
         spp: Option<u32>,
         #[arg(long)]
         preset: Option<String>,
-        #[arg(long, default_value_t = 256)]
+        #[arg(long, default_value_t = pis::pack::DEFAULT_MAX_TEXTURE)]
         max_texture: u32,
         /// Record the run in docs/BENCHMARKS.md.
         #[arg(long)]

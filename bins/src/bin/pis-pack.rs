@@ -44,7 +44,7 @@ struct Cli {
     #[arg(long, default_value = "model")]
     matrix: String,
     /// Largest used texture side.
-    #[arg(long, default_value_t = 256)]
+    #[arg(long, default_value_t = pis::pack::DEFAULT_MAX_TEXTURE)]
     max_texture: u32,
     /// Texel budget: at most K level-0 texels per pixel an object covers in its most covered
     /// view; an object's texture over budget is reduced uniformly (thesis 3.2's per-object
