@@ -165,3 +165,35 @@ fn scene_toml_is_traced_into_a_cache_beside_it() {
     assert!(scene_dir.join(".pis-cache/demo1-32x24-spp1/set.json").is_file());
     assert!(r["stage_ms"]["trace"].as_f64().is_some(), "{r}");
 }
+
+#[test]
+fn the_texel_budget_shrinks_textures_over_budget_and_reports_it() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let free = json(&pack(set(), &dir.path().join("free.pis"), &["--codec", "lossless", "--texels-per-pixel", "none"]));
+    let budget = json(&pack(set(), &dir.path().join("budget.pis"), &["--codec", "lossless", "--texels-per-pixel", "1"]));
+    let objects = |r: &serde_json::Value| r["objects"].as_array().expect("objects").clone();
+    let texels = |o: &serde_json::Value| o["texture"][0].as_u64().unwrap() * o["texture"][1].as_u64().unwrap();
+    let (free, budget) = (objects(&free), objects(&budget));
+    assert_eq!(free.len(), budget.len());
+    let mut reduced = 0;
+    for (f, b) in free.iter().zip(&budget) {
+        assert_eq!(f["name"], b["name"]);
+        assert_eq!(f["reduction"].as_f64(), Some(1.0), "{f}");
+        let r = b["reduction"].as_f64().expect("reduction");
+        assert!(r > 0.0 && r <= 1.0, "{b}");
+        assert!(texels(b) <= texels(f), "{} grew: {} → {}", b["name"], f["texture"], b["texture"]);
+        if r < 1.0 {
+            reduced += 1;
+            assert!(texels(b) < texels(f), "{}: reduced but not smaller", b["name"]);
+        } else {
+            assert_eq!(f["texture"], b["texture"]);
+        }
+    }
+    // demo1's floor, table top and stand hold several texels per covered pixel at the
+    // optimal resolution of thesis 3.2
+    assert!(reduced >= 3, "{reduced} objects reduced: {budget:?}");
+    // a budget of zero is refused
+    let out = pack(set(), &dir.path().join("bad.pis"), &["--codec", "lossless", "--texels-per-pixel", "0"]);
+    assert_eq!(out.status.code(), Some(1), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(!dir.path().join("bad.pis").exists());
+}
