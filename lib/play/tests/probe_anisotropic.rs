@@ -8,6 +8,8 @@
 mod common;
 
 use common::*;
+use glam::Vec3;
+use pis_compile::transform::{look_at, perspective};
 use pis_compile::{render_matrix, Address, DrawMesh, Filter, Sampler, TextureLayout, TextureTransform, TexturedObject, Viewport};
 use pis_play::{probe, render_object, TexturedPipeline};
 
@@ -15,12 +17,12 @@ use pis_play::{probe, render_object, TexturedPipeline};
 fn anisotropic_probe_predicts_the_anisotropic_draw() {
     let Some(gpu) = gpu_or_skip("anisotropic_probe_predicts_the_anisotropic_draw") else { return };
     let pipeline = TexturedPipeline::new(&gpu);
-    let vp = Viewport { width: 64, height: 48 };
+    let vp = Viewport { width: 48, height: 36 };
     // A floor (z = 0 plane, 8 × 8 units) seen from just above it: texels per pixel grow
     // along the view direction much faster than across it.
     let floor = quad(-4.0, 4.0, -4.0, 4.0, 0.0);
-    let clip = pis_compile::transform::perspective(0.8, 4.0 / 3.0, 0.1, 50.0) * pis_compile::transform::look_at(glam::Vec3::new(0.0, -4.5, 0.6), glam::Vec3::ZERO, glam::Vec3::Z);
-    let layout = TextureLayout::full(128, 128);
+    let clip = perspective(0.8, 4.0 / 3.0, 0.1, 50.0) * look_at(Vec3::new(0.0, -4.0, 1.0), Vec3::new(0.0, 0.5, 0.0), Vec3::Z);
+    let layout = TextureLayout::full(64, 64);
     let x = random_rgba(layout.texel_count(), 5);
     let object = |filter| TexturedObject {
         mesh: DrawMesh { positions: &floor.positions, uvs: &floor.uvs, indices: &floor.indices, clip_from_object: clip },
@@ -37,7 +39,7 @@ fn anisotropic_probe_predicts_the_anisotropic_draw() {
         "anisotropic 4: A·x vs draw {:.2} dB over {} pixels, {} coverage mismatches; reach {:?}, {} renderings, check error {:.1e}, nnz {}, {ms:.0} ms",
         c.psnr_db, c.both, c.coverage_mismatch, aniso.reach, aniso.renderings, aniso.check_error, aniso.matrix.cols.len()
     );
-    assert!(c.both > 500, "the floor covers too few pixels: {c:?}");
+    assert!(c.both > 300, "the floor covers too few pixels: {c:?}");
     if c.psnr_db < 50.0 || c.coverage_mismatch > 0 {
         let dir = write_failure_images("probe_anisotropic", &predict(&aniso.matrix, &x), &drawn);
         panic!("anisotropic probe A·x differs from the draw: {c:?} (images in {})", dir.display());
