@@ -111,3 +111,18 @@ fn anisotropic_pack_plays_as_predicted() {
     eprintln!("anisotropic: predicted {} dB, played {} dB (covered pixels)", r["psnr_db"], v["covered_psnr_db"]);
     assert_eq!(out.status.code(), Some(0), "played PSNR more than 0.5 dB below the prediction: {v}\n{}", String::from_utf8_lossy(&out.stderr));
 }
+
+/// Probe mode without a GPU adapter (Vulkan alone, no driver): exit 5 with the hint that
+/// installs Mesa's lavapipe, and no output file.
+#[test]
+fn probe_without_an_adapter_says_how_to_get_one() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let file = dir.path().join("p.pis");
+    let (scene, set) = set();
+    let env = [("WGPU_BACKEND", Some("vulkan")), ("VK_ICD_FILENAMES", Some("/nonexistent/icd.json")), ("VK_DRIVER_FILES", Some("/nonexistent/icd.json"))];
+    let out = run(env!("CARGO_BIN_EXE_pis-pack"), &[os(set), os("--scene"), os(scene), os("-o"), os(&file), os("--matrix"), os("probe")], &env);
+    assert_eq!(out.status.code(), Some(5), "{}", String::from_utf8_lossy(&out.stderr));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("apt-get install -y mesa-vulkan-drivers") && err.contains("--matrix probe"), "{err}");
+    assert!(!file.exists());
+}
