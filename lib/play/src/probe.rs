@@ -21,11 +21,12 @@
 //! 3·S_x·S_y renderings (108 at R = 0 with clamping; S_x·S_y for nearest and bilinear, which
 //! read level 0 only) give every column, independent of resolution.
 //!
-//! The reach of an anisotropic lookup is measured first, per axis, with two renderings of
+//! The reach of an anisotropic lookup is estimated first, per axis, with two renderings of
 //! textures holding each texel's centre (level-0 texel units), its square and its level's
-//! scale: the filtered values are the footprint's mean, second moment and level, so its
-//! spread σ per axis in texels of the level read follows; the reach is taken as 4σ + 1
-//! (twice a half-width of 2σ), the largest over the covered pixels.
+//! scale 2^m: the filtered values are the footprint's mean, second moment and mean level
+//! scale, so its spread σ per axis follows (less the ¼ texel² of one bilinear lookup); the
+//! first reach is 2σ + 1 texels of that scale, the largest over the covered pixels. It is a
+//! guess (the footprint's shape is the adapter's), which the check below corrects upward.
 //!
 //! The measured A is checked against the pipeline itself: a pseudo-random texture rendered
 //! through the pipeline must equal A times that texture at every covered pixel. A failed
@@ -229,7 +230,7 @@ fn footprint_reach(gpu: &Gpu, pipeline: &TexturedPipeline, scene: &ObjectScene, 
         if a[3] <= 0.5 || !(a[2] >= 1.0) {
             continue;
         }
-        // The finer of the two levels a lookup blends has at least half the mean scale.
+        // Texels of the mean level read (the check corrects a footprint that reads finer).
         let level_scale = a[2];
         for k in 0..2 {
             // Less the spread of one bilinear lookup (at most ¼ texel² of its level).
