@@ -18,8 +18,9 @@
 //! footprint's major axis by an amount the adapter chooses, as far as the footprint is long.
 //! The spacing along an axis is S = 6 + 2R for that axis's reach (the next power of two, at
 //! least 8, along a repeat axis, so that the groups tile the power-of-two period):
-//! 3·S_x·S_y renderings (108 at R = 0 with clamping; S_x·S_y for nearest and bilinear, which
-//! read level 0 only) give every column, independent of resolution.
+//! 3·S_x·S_y renderings at most (108 at R = 0 with clamping; S_x·S_y for nearest and
+//! bilinear, which read level 0 only; fewer where a phase's finest active level is narrower
+//! than the spacing) give every column, independent of resolution.
 //!
 //! The reach of an anisotropic lookup is estimated first, per axis, with two renderings of
 //! textures holding each texel's centre (level-0 texel units), its square and its level's
@@ -299,8 +300,11 @@ fn measure(gpu: &Gpu, pipeline: &TexturedPipeline, scene: &ObjectScene, texture:
     // Nearest and bilinear read level 0 only: one phase suffices.
     let phases = if object.sampler.filter.uses_mips() { 3.min(layout.levels) } else { 1 };
     for p in 0..phases {
-        for oy in 0..s[1] {
-            for ox in 0..s[0] {
+        // The finest active level of the phase; an offset beyond its size (spacing wider than
+        // the level) activates no texel on any level of the phase: no rendering.
+        let (w, h) = layout.level_size(p);
+        for oy in 0..s[1].min(h) {
+            for ox in 0..s[0].min(w) {
                 texture.upload(gpu, &probe_texture(&layout, address, s, reach, p, [ox, oy]))?;
                 let img = scene.render(gpu, pipeline, texture)?;
                 renderings += 1;
