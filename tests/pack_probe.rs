@@ -92,6 +92,9 @@ fn anisotropic_filter_without_probe_is_a_usage_error() {
     assert!(!file.exists());
     let out = pack(&file, &["--filter", "anisotropic", "--anisotropy", "17", "--matrix", "probe"]);
     assert_eq!(out.status.code(), Some(1), "{}", String::from_utf8_lossy(&out.stderr));
+    let out = pack(&file, &["--filter", "trilinear", "--anisotropy", "4"]);
+    assert_eq!(out.status.code(), Some(1), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("--anisotropy applies to --filter anisotropic"));
 }
 
 /// The player draws anisotropic files with the adapter's anisotropic filtering, as the pack

@@ -45,9 +45,9 @@ struct Cli {
     filter: Filter,
     /// Anisotropic filtering: the sampler's anisotropy clamp, 1 to 16 (the most lookups per
     /// pixel; an adapter may ignore it: Mesa 22.3's lavapipe filters the same for any clamp
-    /// above 1).
-    #[arg(long, default_value_t = 16, value_parser = clap::value_parser!(u8).range(1..=MAX_ANISOTROPY as i64))]
-    anisotropy: u8,
+    /// above 1). Default 16; only with `--filter anisotropic`.
+    #[arg(long, value_parser = clap::value_parser!(u8).range(1..=MAX_ANISOTROPY as i64))]
+    anisotropy: Option<u8>,
     /// Render matrix source: `model` (pis-compile's hardware model, computed in software) or
     /// `probe` (measured through the player's wgpu pipeline on this machine's GPU adapter with
     /// texel-identifier renderings, thesis 3.4.3: slower, but exact for whatever the adapter
@@ -146,9 +146,10 @@ fn parse_resolution(s: &str) -> Result<(u32, u32), String> {
 }
 
 fn run(cli: Cli) -> Result<Exit, Failure> {
-    let filter = match cli.filter {
-        Filter::Anisotropic(_) => Filter::Anisotropic(cli.anisotropy),
-        f => f,
+    let filter = match (cli.filter, cli.anisotropy) {
+        (Filter::Anisotropic(_), n) => Filter::Anisotropic(n.unwrap_or(MAX_ANISOTROPY)),
+        (f, None) => f,
+        (f, Some(_)) => return Err(Failure::new(Exit::Usage, anyhow::anyhow!("--anisotropy applies to --filter anisotropic, not {}", f.name()))),
     };
     if let Some(why) = filter_needs_probe(filter, cli.matrix) {
         return Err(Failure::new(Exit::Usage, anyhow::anyhow!(why)));
