@@ -10,13 +10,17 @@
 //! allocated by equal slopes across levels, objects and layers (4.5), and the container
 //! written atomically. MIP levels are not stored: the player decimates (3.6).
 //!
-//! The predicted PSNR renders the decoded textures through the hardware model (A, with the
-//! MIP chain rebuilt by decimation as the player does) and compares with the gold-standard
-//! layers over the pixels the tracer covers, on display values (see [`crate::infer`]).
+//! The render matrices A come from the hardware model or, with `matrix: Probe`, are measured
+//! through the player's pipeline on the GPU (probe mode, thesis 3.4.3; [`matrices`]), which
+//! anisotropic filtering needs. The predicted PSNR renders the decoded textures through the
+//! same A (with the MIP chain rebuilt by decimation as the player does) and compares with
+//! the gold-standard layers over the pixels the tracer covers, on display values (see
+//! [`crate::infer`]).
 
 pub(crate) mod encode;
 pub(crate) mod infer_layers;
 pub(crate) mod input;
+pub mod matrices;
 mod report;
 pub mod storage;
 mod sweep;
@@ -29,6 +33,7 @@ use pis_compile::Filter;
 
 pub use report::{print_report, ObjectReport, PackReport};
 pub use input::cache_dir;
+pub use matrices::{filter_needs_probe, MatrixSource};
 pub use sweep::{Inferred, PackPoint};
 
 use crate::cli::{Exit, Failure};
@@ -48,7 +53,10 @@ pub struct PackRequest {
     pub codec: CodecId,
     /// Samples per block along each dimension (one value: the same for every dimension).
     pub block: Vec<u32>,
+    /// The player's texture filter; `Anisotropic` needs `matrix: Probe`.
     pub filter: Filter,
+    /// Where the render matrices come from: the hardware model or probe mode.
+    pub matrix: MatrixSource,
     /// Largest used texture side.
     pub max_texture: u32,
     /// Texel budget: at most this many level-0 texels per pixel an object covers (its most
@@ -163,11 +171,17 @@ pub fn pack(req: &PackRequest) -> Result<PackReport, Failure> {
         return Err(Failure::new(Exit::Io, anyhow::anyhow!("the output folder {} does not exist", parent.display())));
     }
     let mut stages = Stages::new();
+    if let Some(why) = filter_needs_probe(req.filter, req.matrix) {
+        return Err(Failure::new(Exit::Usage, anyhow::anyhow!(why)));
+    }
     let set = input::load(req, &mut stages)?;
-    let inferred = infer_layers::infer_all(&set, req, &mut stages).map_err(|e| Failure::new(Exit::Runtime, e))?;
+    let mut matrices = matrices::Matrices::open(req.matrix, req.filter)?;
+    let inferred = infer_layers::infer_all(&set, req, &mut matrices, &mut stages).map_err(|e| Failure::new(Exit::Runtime, e))?;
+    let probe_renderings = matrices.renderings();
+    drop(matrices);
     let mut packed = encode::encode_all(&set, &inferred, req, &mut stages)?;
     let quality = encode::predicted_psnr(&set, &inferred, &packed).map_err(|e| Failure::new(Exit::Runtime, e))?;
-    stages.done("predict", "decoded textures rendered through the hardware model");
+    stages.done("predict", &format!("decoded textures rendered through the render matrices ({})", req.matrix.name()));
     // The prediction travels with the file: `pis-diff FILE SET --max-psnr-drop` measures
     // the played PSNR against it.
     if let Some(p) = packed.container.provenance.as_mut() {
@@ -183,5 +197,7 @@ pub fn pack(req: &PackRequest) -> Result<PackReport, Failure> {
     } else {
         None
     };
-    Ok(report::build(&set, &inferred, &packed, &quality, bytes, exact, req, stages))
+    let mut report = report::build(&set, &inferred, &packed, &quality, bytes, exact, req, stages);
+    report.probe_renderings = probe_renderings;
+    Ok(report)
 }

@@ -41,6 +41,7 @@ fn pack_scene(scene_toml: &Path) -> Result<PathBuf, Failure> {
         codec: pis_codec::CodecId::Wavelet,
         block: vec![8],
         filter: pis_compile::Filter::Trilinear,
+        matrix: crate::pack::MatrixSource::Model,
         max_texture: crate::pack::DEFAULT_MAX_TEXTURE,
         texels_per_pixel: crate::pack::DEFAULT_TEXELS_PER_PIXEL,
         gamma: 2.2,

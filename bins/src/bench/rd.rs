@@ -105,6 +105,7 @@ fn pack_request(req: &RdRequest) -> PackRequest {
         codec: CodecId::Wavelet,
         block: vec![8],
         filter: Filter::Trilinear,
+        matrix: crate::pack::MatrixSource::Model,
         max_texture: req.max_texture,
         texels_per_pixel: crate::pack::DEFAULT_TEXELS_PER_PIXEL,
         gamma: 2.2,

@@ -1,15 +1,16 @@
 //! pis-pack: a ray-traced set (or a scene.toml, traced first) to a `.pis` container.
 //!
-//! Exit codes: 0 ok, 1 bad arguments, 2 I/O, 3 invalid input, 4 runtime error.
+//! Exit codes: 0 ok, 1 bad arguments, 2 I/O, 3 invalid input, 4 runtime error, 5 unsupported
+//! (`--matrix probe` without a GPU adapter).
 
 use std::path::PathBuf;
 use std::process::ExitCode;
 
 use clap::Parser;
 use pis::cli::{self, Exit, Failure};
-use pis::pack::{pack, print_report, Allocation, LayerMode, PackRequest, PyramidMode};
+use pis::pack::{filter_needs_probe, pack, print_report, Allocation, LayerMode, MatrixSource, PackRequest, PyramidMode};
 use pis_codec::CodecId;
-use pis_compile::Filter;
+use pis_compile::{Filter, MAX_ANISOTROPY};
 
 /// Infer, compress and write the parameterized textures of a ray-traced set.
 #[derive(Parser, Debug)]
@@ -37,12 +38,22 @@ struct Cli {
     /// Samples per parameter block: one size for every dimension (8) or one per dimension (8x8).
     #[arg(long, default_value = "8", value_parser = parse_block)]
     block: BlockSizes,
-    /// Texture filtering the player uses: trilinear or bilinear.
+    /// Texture filtering the player uses: trilinear, bilinear, or anisotropic (trilinear lookups
+    /// along the footprint's major axis, as the adapter's sampler takes them; needs
+    /// `--matrix probe`, since no specification pins the footprint down).
     #[arg(long, default_value = "trilinear", value_parser = parse_filter)]
     filter: Filter,
-    /// Render matrix source: `model` (the analytic hardware model; `probe` is not yet wired).
-    #[arg(long, default_value = "model")]
-    matrix: String,
+    /// Anisotropic filtering: the sampler's anisotropy clamp, 1 to 16 (the most lookups per
+    /// pixel; an adapter may ignore it: Mesa 22.3's lavapipe filters the same for any clamp
+    /// above 1). Default 16; only with `--filter anisotropic`.
+    #[arg(long, value_parser = clap::value_parser!(u8).range(1..=MAX_ANISOTROPY as i64))]
+    anisotropy: Option<u8>,
+    /// Render matrix source: `model` (pis-compile's hardware model, computed in software) or
+    /// `probe` (measured through the player's wgpu pipeline on this machine's GPU adapter with
+    /// texel-identifier renderings, thesis 3.4.3: slower, but exact for whatever the adapter
+    /// does; needs an adapter, Mesa's lavapipe without a GPU).
+    #[arg(long, default_value = "model", value_parser = parse_matrix)]
+    matrix: MatrixSource,
     /// Largest used texture side.
     #[arg(long, default_value_t = pis::pack::DEFAULT_MAX_TEXTURE)]
     max_texture: u32,
@@ -120,7 +131,17 @@ fn parse_filter(s: &str) -> Result<Filter, String> {
     match s {
         "trilinear" => Ok(Filter::Trilinear),
         "bilinear" => Ok(Filter::Bilinear),
-        _ => Err(format!("unknown filter {s:?} (trilinear or bilinear)")),
+        // The clamp comes from --anisotropy.
+        "anisotropic" => Ok(Filter::Anisotropic(MAX_ANISOTROPY)),
+        _ => Err(format!("unknown filter {s:?} (trilinear, bilinear or anisotropic)")),
+    }
+}
+
+fn parse_matrix(s: &str) -> Result<MatrixSource, String> {
+    match s {
+        "model" => Ok(MatrixSource::Model),
+        "probe" => Ok(MatrixSource::Probe),
+        _ => Err(format!("unknown render matrix source {s:?} (model or probe)")),
     }
 }
 
@@ -156,8 +177,13 @@ fn parse_resolution(s: &str) -> Result<(u32, u32), String> {
 }
 
 fn run(cli: Cli) -> Result<Exit, Failure> {
-    if cli.matrix != "model" {
-        return Err(Failure::new(Exit::NotSupported, anyhow::anyhow!("--matrix {}: only `model` is supported by this build", cli.matrix)));
+    let filter = match (cli.filter, cli.anisotropy) {
+        (Filter::Anisotropic(_), n) => Filter::Anisotropic(n.unwrap_or(MAX_ANISOTROPY)),
+        (f, None) => f,
+        (f, Some(_)) => return Err(Failure::new(Exit::Usage, anyhow::anyhow!("--anisotropy applies to --filter anisotropic, not {}", f.name()))),
+    };
+    if let Some(why) = filter_needs_probe(filter, cli.matrix) {
+        return Err(Failure::new(Exit::Usage, anyhow::anyhow!(why)));
     }
     let req = PackRequest {
         input: cli.input,
@@ -167,7 +193,8 @@ fn run(cli: Cli) -> Result<Exit, Failure> {
         psnr: cli.psnr,
         codec: cli.codec,
         block: cli.block.0,
-        filter: cli.filter,
+        filter,
+        matrix: cli.matrix,
         max_texture: cli.max_texture,
         texels_per_pixel: cli.texels_per_pixel.0,
         gamma: if cli.codec == CodecId::Lossless { 1.0 } else { cli.gamma },

@@ -279,8 +279,7 @@ pub(crate) fn encode_all(set: &LoadedSet, models: &[ObjectModel], req: &PackRequ
     let settings = vec![
         ("codec".to_string(), req.codec.name().to_string()),
         ("block".to_string(), sizes.iter().map(u32::to_string).collect::<Vec<_>>().join("x")),
-        ("filter".to_string(), format!("{:?}", req.filter).to_lowercase()),
-        ("matrix".to_string(), "model".to_string()),
+        ("matrix".to_string(), req.matrix.name().to_string()),
         ("gamma".to_string(), req.gamma.to_string()),
         ("target".to_string(), match (req.ratio, req.psnr) {
             (_, Some(p)) => format!("psnr {p} dB"),
@@ -288,6 +287,7 @@ pub(crate) fn encode_all(set: &LoadedSet, models: &[ObjectModel], req: &PackRequ
         }),
     ];
     let mut settings = settings;
+    settings.splice(2..2, file_filter(req.filter).settings());
     if req.pyramid != super::PyramidMode::Adaptive {
         settings.push(("pyramid".to_string(), "full".to_string()));
     }
@@ -453,6 +453,16 @@ pub(crate) fn display_error(set: &LoadedSet, models: &[ObjectModel], textures: &
     }).collect()
 }
 
+/// The file's record of the player's filter (SPEC.md 6.6).
+fn file_filter(f: pis_compile::Filter) -> pis_format::FileFilter {
+    match f {
+        pis_compile::Filter::Nearest => pis_format::FileFilter::Nearest,
+        pis_compile::Filter::Bilinear => pis_format::FileFilter::Bilinear,
+        pis_compile::Filter::Trilinear => pis_format::FileFilter::Trilinear,
+        pis_compile::Filter::Anisotropic(n) => pis_format::FileFilter::Anisotropic(n),
+    }
+}
+
 /// PSNR in dB (peak 1) of a squared error sum over `n` values.
 pub(crate) fn psnr(sse: f64, n: usize) -> f64 {
     10.0 * (1.0 / (sse / n.max(1) as f64).max(1e-20)).log10()
@@ -467,7 +477,8 @@ pub(crate) struct Quality {
     pub(crate) max_texel_error: f32,
 }
 
-/// Renders the decoded and the solved textures through the hardware model.
+/// Renders the decoded and the solved textures through the render matrices (the hardware
+/// model's or probe mode's).
 pub(crate) fn predicted_psnr(set: &LoadedSet, models: &[ObjectModel], packed: &Packed) -> Result<Quality> {
     let decoded = decoded_textures(models, packed)?;
     let solved: Vec<Vec<LayerTextures>> = models.iter().map(|m| m.layers.iter().map(|l| {

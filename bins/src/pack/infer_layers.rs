@@ -8,20 +8,21 @@
 use std::collections::BTreeMap;
 
 use anyhow::{anyhow, Result};
-use pis_compile::{render_matrix, scene_depth, solve, solve_view_independent, DrawMesh, RenderMatrix, SolveSettings, TexturedObject, View, Viewport};
+use pis_compile::{solve, solve_view_independent, DrawMesh, RenderMatrix, SolveSettings, TexturedObject, View, Viewport};
 use pis_format::{DepMask, DimensionKind};
 use pis_trace::layers::LayerKind as TraceLayer;
 use pis_trace::PointImages;
 
 use super::input::LoadedSet;
+use super::matrices::Matrices;
 use super::{PackRequest, Stages};
 use crate::infer::{merged_mesh, place, restrict, sampler, Mesh, Prepared};
 
 /// Largest linear radiance below which a layer counts as black.
 pub const BLACK: f32 = 1e-4;
 
-/// One point as the hardware model sees an object: its covered rows of A and the gold
-/// standard of each layer there.
+/// One point as the render matrix sees an object (hardware model or probe mode): its covered
+/// rows of A and the gold standard of each layer there.
 pub(crate) struct PointView {
     pub(crate) a: RenderMatrix,
     pub(crate) diffuse: Vec<f32>,
@@ -74,7 +75,7 @@ fn layer_rgb(images: &PointImages, channel: &str, kind: TraceLayer) -> Vec<f32> 
     rgb
 }
 
-fn views_of(set: &LoadedSet, o: usize, prep: &Prepared, meshes: &[Mesh], req: &PackRequest) -> Result<Vec<PointView>> {
+fn views_of(set: &LoadedSet, o: usize, prep: &Prepared, meshes: &[Mesh], req: &PackRequest, matrices: &mut Matrices) -> Result<Vec<PointView>> {
     let (w, h) = set.resolution;
     let viewport = Viewport { width: w, height: h };
     let mut out = Vec::with_capacity(set.frames.len());
@@ -86,11 +87,10 @@ fn views_of(set: &LoadedSet, o: usize, prep: &Prepared, meshes: &[Mesh], req: &P
         let draw: Vec<DrawMesh> = meshes.iter().enumerate().map(|(k, m)| DrawMesh {
             positions: &m.positions, uvs: &m.uvs, indices: &m.indices, clip_from_object: clip_from(k),
         }).collect();
-        let occluders = scene_depth(viewport, &draw, Some(o))?;
         let mut mesh = draw[o];
         mesh.uvs = &prep.mesh_uvs;
         let obj = TexturedObject { mesh, transform: prep.transform, layout: prep.layout, sampler: sampler(req.filter, prep.repeat) };
-        let a_full = render_matrix(viewport, &obj, Some(&occluders))?;
+        let a_full = matrices.matrix(viewport, &draw, o, &obj)?;
         let channel = &set.channels[o];
         let cov: Vec<f32> = images.object_layer(channel, TraceLayer::Coverage).and_then(|l| l.channel("A"))
             .map(<[f32]>::to_vec).unwrap_or_else(|| vec![0.0; (w * h) as usize]);
@@ -136,7 +136,7 @@ fn combined_layer(set: &LoadedSet, views: &[PointView], prep: &Prepared, setting
 }
 
 /// Infers every object that covers a pixel somewhere in the set.
-pub(crate) fn infer_all(set: &LoadedSet, req: &PackRequest, stages: &mut Stages) -> Result<Vec<ObjectModel>> {
+pub(crate) fn infer_all(set: &LoadedSet, req: &PackRequest, matrices: &mut Matrices, stages: &mut Stages) -> Result<Vec<ObjectModel>> {
     let scene = &set.scene;
     let meshes: Vec<Mesh> = (0..scene.objects.len()).map(|o| merged_mesh(scene, o)).collect();
     let frames: Vec<&pis_scene::Frame> = set.frames.iter().collect();
@@ -150,11 +150,22 @@ pub(crate) fn infer_all(set: &LoadedSet, req: &PackRequest, stages: &mut Stages)
         settings.cg.max_iterations = n.max(1);
     }
     let combined = req.layers == super::LayerMode::Combined;
-    let mut out = Vec::new();
+    // Texture coordinates and render matrices of every object at every point first, so the
+    // matrix source's cost is a stage of its own.
+    let mut placed = Vec::with_capacity(scene.objects.len());
     for o in 0..scene.objects.len() {
-        let name = scene.objects[o].name.clone();
         let prep = place(scene, &frames, set.resolution, o, &meshes[o], req.max_texture, 1.0, req.texels_per_pixel)?;
-        let views = views_of(set, o, &prep, &meshes, req)?;
+        let before = matrices.renderings();
+        let views = views_of(set, o, &prep, &meshes, req, matrices)?;
+        if matrices.renderings() > before {
+            eprintln!("pis-pack: object {}: {} probe renderings over {} points", scene.objects[o].name, matrices.renderings() - before, views.len());
+        }
+        placed.push((prep, views));
+    }
+    stages.done("matrices", &format!("texture coordinates and render matrices of {} objects × {} points ({})", scene.objects.len(), set.frames.len(), matrices.describe()));
+    let mut out = Vec::new();
+    for (o, (prep, views)) in placed.into_iter().enumerate() {
+        let name = scene.objects[o].name.clone();
         let covered: usize = views.iter().map(|v| v.a.rows()).sum();
         if covered == 0 {
             eprintln!("pis-pack: object {name} covers no pixel of the set; left out");
@@ -224,6 +235,6 @@ pub(crate) fn infer_all(set: &LoadedSet, req: &PackRequest, stages: &mut Stages)
     if out.is_empty() {
         return Err(anyhow!("no object covers a pixel of the set"));
     }
-    stages.done("infer", &format!("{} objects (texcoords, A matrices, solves)", out.len()));
+    stages.done("infer", &format!("{} objects solved", out.len()));
     Ok(out)
 }

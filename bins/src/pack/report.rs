@@ -45,6 +45,16 @@ pub struct PackReport {
     pub output: String,
     pub source: String,
     pub codec: String,
+    /// The player's texture filter the textures were solved for (`nearest`, `bilinear`,
+    /// `trilinear`, `anisotropic`).
+    pub filter: String,
+    /// The anisotropy clamp of `anisotropic` filtering.
+    pub anisotropy: Option<u8>,
+    /// Where the render matrices came from: `model` (the hardware model) or `probe`
+    /// (measured through the GPU, thesis 3.4.3).
+    pub matrix: String,
+    /// Probe mode: test renderings made to measure every matrix (0 for the model).
+    pub probe_renderings: u64,
     pub points: usize,
     pub resolution: [u32; 2],
     /// Raw image bytes of the set (points × width × height × 3).
@@ -103,6 +113,13 @@ pub(crate) fn build(set: &LoadedSet, models: &[ObjectModel], packed: &Packed, q:
         output: req.output.display().to_string(),
         source: set.dir.display().to_string(),
         codec: req.codec.name().to_string(),
+        filter: req.filter.name().to_string(),
+        anisotropy: match req.filter {
+            pis_compile::Filter::Anisotropic(n) => Some(n),
+            _ => None,
+        },
+        matrix: req.matrix.name().to_string(),
+        probe_renderings: 0,
         points: set.samples.len(),
         resolution: [set.resolution.0, set.resolution.1],
         raw_image_bytes: raw,
@@ -119,7 +136,7 @@ pub(crate) fn build(set: &LoadedSet, models: &[ObjectModel], packed: &Packed, q:
         objects,
         stage_ms: stages.ms.into_iter().collect(),
         notes: vec![
-            "PSNR through the hardware model: decoded textures (MIP chain rebuilt by decimation) rendered with A, against the traced diffuse + specular layers over covered pixels, display values (sRGB, peak 1)".into(),
+            "PSNR through the render matrices (hardware model, or measured through the GPU in probe mode): decoded textures (MIP chain rebuilt by decimation) rendered with A, against the traced diffuse + specular layers over covered pixels, display values (sRGB, peak 1)".into(),
             format!("geometry, tables and headers: {} bytes", packed.overhead),
         ],
     }
@@ -128,6 +145,9 @@ pub(crate) fn build(set: &LoadedSet, models: &[ObjectModel], packed: &Packed, q:
 /// Human-readable lines of the report.
 pub fn print_report(r: &PackReport, out: &mut impl std::io::Write) -> std::io::Result<()> {
     writeln!(out, "{}: {} points of {}x{}, codec {}", r.output, r.points, r.resolution[0], r.resolution[1], r.codec)?;
+    let anisotropy = r.anisotropy.map(|n| format!(" {n}x")).unwrap_or_default();
+    let probe = if r.matrix == "probe" { format!(", {} probe renderings", r.probe_renderings) } else { String::new() };
+    writeln!(out, "  filter {}{anisotropy}, render matrices from the {}{probe}", r.filter, if r.matrix == "probe" { "GPU (probe mode)" } else { "hardware model" })?;
     writeln!(out, "  {} bytes (level images {}), raw {} bytes: ratio {:.1} (without geometry {:.1})",
              r.bytes, r.texture_bytes, r.raw_image_bytes, r.ratio, r.ratio_without_geometry)?;
     writeln!(out, "  predicted PSNR {:.2} dB (textures as solved {:.2} dB)", r.psnr_db, r.psnr_db_solved)?;

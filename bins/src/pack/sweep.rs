@@ -57,7 +57,8 @@ impl Inferred {
         let set = load(req, &mut stages)?;
         let load_ms = t.elapsed().as_secs_f64() * 1e3;
         let t = Instant::now();
-        let models = infer_all(&set, req, &mut stages).map_err(|e| Failure::new(Exit::Runtime, e))?;
+        let mut matrices = super::matrices::Matrices::open(req.matrix, req.filter)?;
+        let models = infer_all(&set, req, &mut matrices, &mut stages).map_err(|e| Failure::new(Exit::Runtime, e))?;
         let infer_ms = t.elapsed().as_secs_f64() * 1e3;
         Ok(Inferred { set, models, load_ms, infer_ms })
     }

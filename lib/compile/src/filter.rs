@@ -87,7 +87,9 @@ pub fn sample_taps(layout: &TextureLayout, sampler: &Sampler, st: [f64; 2], lamb
             taps.add(layout.texel(0, i, j) as u32, 1.0);
         }
         Filter::Bilinear => bilinear(layout, sampler, 0, st, 1.0, taps),
-        Filter::Trilinear => {
+        // The model's part of an anisotropic lookup is its isotropic trilinear lookup only:
+        // `render_matrix` refuses anisotropic samplers (probe mode measures them).
+        Filter::Trilinear | Filter::Anisotropic(_) => {
             let q = layout.levels.saturating_sub(1);
             let d = lambda.clamp(0.0, q as f64);
             let hi = (d.floor() as u32).min(q);
@@ -103,9 +105,10 @@ pub fn sample_taps(layout: &TextureLayout, sampler: &Sampler, st: [f64; 2], lamb
 
 /// The largest LOD the sampler may use: 0 for nearest and bilinear (level 0 only).
 pub fn max_level(layout: &TextureLayout, sampler: &Sampler) -> f64 {
-    match sampler.filter {
-        Filter::Trilinear => layout.levels.saturating_sub(1) as f64,
-        _ => 0.0,
+    if sampler.filter.uses_mips() {
+        layout.levels.saturating_sub(1) as f64
+    } else {
+        0.0
     }
 }
 

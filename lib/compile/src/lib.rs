@@ -50,7 +50,7 @@ pub use matrix::RenderMatrix;
 pub use model::{render_matrix, scene_depth, ModelError, TexturedObject};
 pub use normal_equations::Form;
 pub use raster::DepthBuffer;
-pub use sampler::{Address, Filter, Sampler};
+pub use sampler::{Address, Filter, Sampler, MAX_ANISOTROPY};
 pub use solve::{render, solve, solve_view_independent, FormChoice, MipSolve, Solution, SolveSettings, View};
 pub use transform::{DrawMesh, TextureTransform, Viewport};
 

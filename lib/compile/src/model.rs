@@ -33,6 +33,8 @@ pub enum ModelError {
     Transform([f32; 6]),
     #[error("occluder depth buffer is {got:?}, the viewport {want:?}")]
     DepthSize { got: Viewport, want: Viewport },
+    #[error("the hardware model cannot describe anisotropic filtering (the adapter chooses its taps): measure the render matrix through the GPU (probe mode)")]
+    Anisotropic,
     #[error("display filter sigma {sigma} / radius {radius} px or supersampling factor {factor} is invalid")]
     Filter { sigma: f32, radius: f32, factor: u32 },
 }
@@ -106,6 +108,9 @@ pub fn render_matrix_inputs_ok(viewport: Viewport, object: &TexturedObject) -> R
 /// [`mod@crate::antialias`]). Rows are the visible pixels in increasing order.
 pub fn render_matrix(viewport: Viewport, object: &TexturedObject, occluders: Option<&DepthBuffer>) -> Result<RenderMatrix, ModelError> {
     render_matrix_inputs_ok(viewport, object)?;
+    if matches!(object.sampler.filter, crate::Filter::Anisotropic(_)) {
+        return Err(ModelError::Anisotropic);
+    }
     if let Some(o) = occluders {
         if o.viewport != viewport {
             return Err(ModelError::DepthSize { got: o.viewport, want: viewport });
@@ -246,6 +251,13 @@ mod tests {
         let mut o = object(&half, layout, Filter::Trilinear);
         o.mesh.clip_from_object = Mat4::from_cols_array(&[f32::NAN; 16]);
         assert_eq!(render_matrix(vp, &o, None).unwrap().rows(), 0);
+    }
+
+    #[test]
+    fn anisotropic_filtering_is_not_modelled() {
+        let p = screen_quad();
+        let o = object(&p, TextureLayout::full(4, 4), Filter::Anisotropic(16));
+        assert_eq!(render_matrix(Viewport { width: 4, height: 4 }, &o, None).unwrap_err(), ModelError::Anisotropic);
     }
 
     #[test]

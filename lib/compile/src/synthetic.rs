@@ -30,7 +30,8 @@ pub fn warp_matrix(
                     entries.push((layout.texel(0, i, j) as u32, 1.0));
                 }
                 Filter::Bilinear => bilinear(&layout, 0, s, t, 1.0, &mut entries),
-                Filter::Trilinear => {
+                // Isotropic: the synthetic matrix has no anisotropic footprint.
+                Filter::Trilinear | Filter::Anisotropic(_) => {
                     let d = |dx: f64, dy: f64| {
                         let p = map(x + dx, y + dy).unwrap_or((s, t));
                         let m = map(x - dx, y - dy).unwrap_or((s, t));

@@ -51,6 +51,9 @@ pub fn check<S>(c: &Container<S>) -> Vec<Issue> {
     }
     cameras(&c.space, &c.cameras, &mut out);
     objects(c, &mut out);
+    if let Err(detail) = crate::FileFilter::of(c.provenance.as_ref()) {
+        out.push(chunk(Issue::new(9001, detail), "PROV"));
+    }
     out
 }
 

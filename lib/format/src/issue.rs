@@ -155,6 +155,7 @@ pub const RULES: &[(u16, &str)] = &[
     (8006, "decoded value is not finite"),
     (8007, "codec is reserved and not decodable by this reader"),
     (9000, "PROV payload is malformed"),
+    (9001, "filter setting is unknown, or anisotropic without an anisotropy of 1 to 16"),
 ];
 
 /// The short message of rule `id` ("unknown rule" for ids not in [`RULES`]).

@@ -14,6 +14,7 @@ pub mod blocks;
 pub mod checks;
 pub mod chunk;
 mod error;
+pub mod filter;
 pub mod hexdump;
 pub mod issue;
 pub mod mip;
@@ -30,6 +31,7 @@ mod write;
 
 pub use binary::Span;
 pub use error::Error;
+pub use filter::FileFilter;
 pub use issue::{Issue, Severity};
 pub use model::*;
 pub use pis_codec::{CodecId, PlaneShape};

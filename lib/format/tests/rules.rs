@@ -407,6 +407,14 @@ fn cases() -> Vec<(u16, Vec<u8>)> {
             .reseal(),
     ));
     v.push((9000, t().set_u32("tool length", 1 << 30).reseal()));
+    v.push((
+        9001,
+        unchecked(|c| {
+            let p = c.provenance.as_mut().unwrap();
+            p.settings.push(("filter".into(), "anisotropic".into()));
+            p.settings.push(("anisotropy".into(), "32".into()));
+        }),
+    ));
     let _ = cstr;
     v
 }

@@ -15,6 +15,8 @@ pub enum PlayError {
     Device { adapter: String, message: String },
     #[error("probe mode needs Rgba32Float textures (texel identifiers up to 2^24), but the device '{0}' uses Rgba16Float (no FLOAT32_FILTERABLE, or half textures were asked for)")]
     ProbeNeedsFloat32(String),
+    #[error("probe mode: the render matrix measured for filter {filter} at lookup reach {reach} predicts the pipeline's rendering of a check texture only to {error:.2e} (tolerance {tolerance:.0e}): the adapter's filter footprint is wider than the probe allows for")]
+    ProbeCheck { filter: String, reach: u32, error: f32, tolerance: f32 },
     #[error("repeat addressing along {axis} needs a power-of-two used texture size, got {size} (a wrapped dimension's size is chosen by texture-coordinate optimization)")]
     RepeatSize { axis: char, size: u32 },
     #[error("texture data has {got} values, the layout {width}×{height} with {levels} levels needs {want} (4 per texel)")]

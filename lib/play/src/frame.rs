@@ -33,7 +33,8 @@ struct Uniforms {
     max_level: f32,
     weight: f32,
     object: u32,
-    _pad: [u32; 3],
+    anisotropic: u32,
+    _pad: [u32; 2],
 }
 
 /// An object's mesh on the GPU.
@@ -79,6 +80,8 @@ pub struct LayerDraw<'a> {
     pub affine: [f32; 6],
     pub max_level: f32,
     pub weight: f32,
+    /// Anisotropic filtering: the lookup takes the derivatives, the sampler its clamp.
+    pub anisotropic: bool,
 }
 
 /// The frame's pipelines: object index and depth, and additive layers per target format.
@@ -238,7 +241,8 @@ fn uniforms(clip_from_object: glam::Mat4, object: u32, layer: Option<&LayerDraw>
         max_level: 0.0,
         weight: 0.0,
         object,
-        _pad: [0; 3],
+        anisotropic: 0,
+        _pad: [0; 2],
     };
     if let Some(l) = layer {
         let [a, b, c, d, e, f] = l.affine;
@@ -250,6 +254,7 @@ fn uniforms(clip_from_object: glam::Mat4, object: u32, layer: Option<&LayerDraw>
         u.scale = [layout.width as f32 / aw as f32, layout.height as f32 / ah as f32];
         u.max_level = l.max_level;
         u.weight = l.weight;
+        u.anisotropic = l.anisotropic as u32;
     }
     u
 }

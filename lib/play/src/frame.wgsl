@@ -16,13 +16,15 @@ struct Uniforms {
     size: vec2<f32>,
     // Used size / allocated size per axis: maps (s, t) ∈ [0, 1]² onto the used region.
     scale: vec2<f32>,
-    // Largest level of detail: levels − 1 for trilinear, 0 for nearest and bilinear.
+    // Largest level of detail: levels − 1 for trilinear and anisotropic, 0 for nearest and
+    // bilinear.
     max_level: f32,
     // Multilinear weight of this parameter sample's texture.
     weight: f32,
     // The object's index in the file.
     object: u32,
-    _pad0: u32,
+    // 1 for anisotropic filtering: the adapter picks footprint and LOD (no model twin).
+    anisotropic: u32,
     _pad1: u32,
     _pad2: u32,
 };
@@ -54,6 +56,15 @@ fn texture_lod(ddx: vec2<f32>, ddy: vec2<f32>, size: vec2<f32>, max_level: f32) 
     return clamp(log2(rho), 0.0, max(max_level, 0.0));
 }
 
+// textured.wgsl's lookup: at the model's LOD, or, for anisotropic filtering, from the same
+// fine derivatives so that the adapter chooses its anisotropic footprint and LOD.
+fn sample(st: vec2<f32>, ddx: vec2<f32>, ddy: vec2<f32>, lambda: f32) -> vec4<f32> {
+    if (u.anisotropic != 0u) {
+        return textureSampleGrad(tex, samp, st * u.scale, ddx * u.scale, ddy * u.scale);
+    }
+    return textureSampleLevel(tex, samp, st * u.scale, lambda);
+}
+
 @vertex
 fn vs_main(@location(0) position: vec3<f32>, @location(1) uv: vec2<f32>) -> VsOut {
     var out: VsOut;
@@ -73,7 +84,7 @@ fn fs_layer(in: VsOut) -> @location(0) vec4<f32> {
     let ddx = dpdxFine(in.st);
     let ddy = dpdyFine(in.st);
     let lambda = texture_lod(ddx, ddy, u.size, u.max_level);
-    let c = textureSampleLevel(tex, samp, in.st * u.scale, lambda);
+    let c = sample(in.st, ddx, ddy, lambda);
     if (textureLoad(ids, vec2<i32>(in.clip.xy), 0).r != u.object) {
         discard;
     }

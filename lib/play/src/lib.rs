@@ -26,5 +26,5 @@ pub use error::{PlayError, ADAPTER_HINT};
 pub use gpu::{Gpu, GpuOptions};
 pub use image::FloatImage;
 pub use player::{FrameRequest, FrameStats, Player, PlayerOptions};
-pub use probe::probe_render_matrix;
+pub use probe::{probe, probe_render_matrix, Probe};
 pub use textured::{render_object, ObjectScene, ObjectTexture, TexturedPipeline};

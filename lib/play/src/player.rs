@@ -130,13 +130,14 @@ pub struct Player {
 }
 
 /// The texture filter the file's textures were solved for: pis-pack records it in the
-/// provenance settings (`filter`); trilinear when absent.
+/// provenance settings (`filter`, `anisotropy`; SPEC.md 6.6); trilinear when absent. The
+/// reader has checked the settings (rule 9001).
 fn file_filter(c: &Container<StreamRef>) -> Filter {
-    let setting = c.provenance.as_ref().and_then(|p| p.settings.iter().find(|(k, _)| k == "filter")).map(|(_, v)| v.to_ascii_lowercase());
-    match setting.as_deref() {
-        Some("nearest") => Filter::Nearest,
-        Some("bilinear") => Filter::Bilinear,
-        _ => Filter::Trilinear,
+    match pis_format::FileFilter::of(c.provenance.as_ref()).unwrap_or_default() {
+        pis_format::FileFilter::Nearest => Filter::Nearest,
+        pis_format::FileFilter::Bilinear => Filter::Bilinear,
+        pis_format::FileFilter::Trilinear => Filter::Trilinear,
+        pis_format::FileFilter::Anisotropic(n) => Filter::Anisotropic(n),
     }
 }
 
@@ -472,6 +473,7 @@ impl Player {
                 affine: w.affine,
                 max_level: pis_compile::filter::max_level(&texture.layout, &sampler) as f32,
                 weight: w.weight,
+                anisotropic: matches!(self.filter, Filter::Anisotropic(_)),
             });
         }
         let targets = self.targets.as_ref().expect("targets made above");

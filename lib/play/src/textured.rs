@@ -47,7 +47,7 @@ struct Uniforms {
     size: [f32; 2],
     scale: [f32; 2],
     max_level: f32,
-    _pad: f32,
+    anisotropic: f32,
 }
 
 /// Size of the GPU texture allocated for a used size: the next power of two per axis.
@@ -264,14 +264,20 @@ impl TexturedPipeline {
 }
 
 /// The sampler of a model sampler state: nearest or linear texel filtering, linear MIP
-/// blending for trilinear, addressing per axis. The LOD comes from the shader.
+/// blending for trilinear and anisotropic, the anisotropy clamp of anisotropic filtering,
+/// addressing per axis. The LOD comes from the shader (the adapter's, for anisotropic).
 pub fn create_sampler(gpu: &Gpu, sampler: &pis_compile::Sampler) -> wgpu::Sampler {
     let mode = |a: Address| match a {
         Address::ClampToEdge => wgpu::AddressMode::ClampToEdge,
         Address::Repeat => wgpu::AddressMode::Repeat,
     };
     let texel = if sampler.filter == Filter::Nearest { wgpu::FilterMode::Nearest } else { wgpu::FilterMode::Linear };
-    let mip = if sampler.filter == Filter::Trilinear { wgpu::MipmapFilterMode::Linear } else { wgpu::MipmapFilterMode::Nearest };
+    let mip = if sampler.filter.uses_mips() { wgpu::MipmapFilterMode::Linear } else { wgpu::MipmapFilterMode::Nearest };
+    // Anisotropy needs linear filters everywhere (it is); WebGPU clamps to 1..=16.
+    let anisotropy_clamp = match sampler.filter {
+        Filter::Anisotropic(n) => u16::from(n.clamp(1, pis_compile::MAX_ANISOTROPY)),
+        _ => 1,
+    };
     gpu.device.create_sampler(&wgpu::SamplerDescriptor {
         label: Some("object sampler"),
         address_mode_u: mode(sampler.address[0]),
@@ -283,7 +289,7 @@ pub fn create_sampler(gpu: &Gpu, sampler: &pis_compile::Sampler) -> wgpu::Sample
         lod_min_clamp: 0.0,
         lod_max_clamp: 32.0,
         compare: None,
-        anisotropy_clamp: 1,
+        anisotropy_clamp,
         border_color: None,
     })
 }
@@ -320,7 +326,7 @@ fn uniforms_of(clip_from_object: glam::Mat4, object: Option<&TexturedObject>) ->
         size: [1.0; 2],
         scale: [1.0; 2],
         max_level: 0.0,
-        _pad: 0.0,
+        anisotropic: 0.0,
     };
     if let Some(o) = object {
         let [a, b, c, d, e, f] = o.transform.values;
@@ -330,6 +336,7 @@ fn uniforms_of(clip_from_object: glam::Mat4, object: Option<&TexturedObject>) ->
         u.size = [o.layout.width as f32, o.layout.height as f32];
         u.scale = [o.layout.width as f32 / aw as f32, o.layout.height as f32 / ah as f32];
         u.max_level = max_level(&o.layout, &o.sampler) as f32;
+        u.anisotropic = if matches!(o.sampler.filter, Filter::Anisotropic(_)) { 1.0 } else { 0.0 };
     }
     u
 }
@@ -404,6 +411,11 @@ impl ObjectScene {
             readback,
             row_bytes,
         })
+    }
+
+    /// The render target's size.
+    pub fn viewport(&self) -> Viewport {
+        self.viewport
     }
 
     /// Renders the object with `texture` over the occluders' depth; returns RGBA per pixel

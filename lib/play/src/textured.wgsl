@@ -13,9 +13,11 @@ struct Uniforms {
     size: vec2<f32>,
     // Used size / allocated size per axis: maps (s, t) ∈ [0, 1]² onto the used region.
     scale: vec2<f32>,
-    // Largest level of detail: levels − 1 for trilinear, 0 for nearest and bilinear.
+    // Largest level of detail: levels − 1 for trilinear and anisotropic, 0 for nearest and
+    // bilinear.
     max_level: f32,
-    _pad: f32,
+    // 1 for anisotropic filtering: the adapter picks footprint and LOD (no model twin).
+    anisotropic: f32,
 };
 
 @group(0) @binding(0) var<uniform> u: Uniforms;
@@ -44,6 +46,16 @@ fn texture_lod(ddx: vec2<f32>, ddy: vec2<f32>, size: vec2<f32>, max_level: f32) 
     return clamp(log2(rho), 0.0, max(max_level, 0.0));
 }
 
+// The lookup: at the model's LOD, or, for anisotropic filtering, from the same fine
+// derivatives (scaled onto the allocated texture like the coordinates) so that the adapter
+// chooses its anisotropic footprint and LOD as an implicit-derivative lookup would.
+fn sample(st: vec2<f32>, ddx: vec2<f32>, ddy: vec2<f32>, lambda: f32) -> vec4<f32> {
+    if (u.anisotropic != 0.0) {
+        return textureSampleGrad(tex, samp, st * u.scale, ddx * u.scale, ddy * u.scale);
+    }
+    return textureSampleLevel(tex, samp, st * u.scale, lambda);
+}
+
 @vertex
 fn vs_main(@location(0) position: vec3<f32>, @location(1) uv: vec2<f32>) -> VsOut {
     var out: VsOut;
@@ -64,7 +76,7 @@ fn fs_main(in: VsOut) -> @location(0) vec4<f32> {
     let ddx = dpdxFine(in.st);
     let ddy = dpdyFine(in.st);
     let lambda = texture_lod(ddx, ddy, u.size, u.max_level);
-    let c = textureSampleLevel(tex, samp, in.st * u.scale, lambda);
+    let c = sample(in.st, ddx, ddy, lambda);
     // Alpha 1 marks coverage.
     return vec4<f32>(c.rgb, 1.0);
 }

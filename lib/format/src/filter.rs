@@ -1,0 +1,102 @@
+//! The texture filter a file's textures were solved for (SPEC.md 6.6): the `filter` and
+//! `anisotropy` provenance settings, which players read to draw the textures as the writer
+//! measured them.
+
+use crate::model::Provenance;
+
+/// The setting naming the filter: `nearest`, `bilinear`, `trilinear` or `anisotropic`.
+pub const FILTER_SETTING: &str = "filter";
+/// The setting holding the anisotropy clamp of `anisotropic` (decimal 1 to 16).
+pub const ANISOTROPY_SETTING: &str = "anisotropy";
+/// The largest anisotropy clamp (WebGPU and Vulkan samplers: 16).
+pub const MAX_ANISOTROPY: u8 = 16;
+
+/// The texture filter of a file.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum FileFilter {
+    Nearest,
+    Bilinear,
+    /// Also what a file without a `filter` setting is drawn with.
+    #[default]
+    Trilinear,
+    /// Trilinear lookups along the footprint's major axis, at most this many (1..=16).
+    Anisotropic(u8),
+}
+
+impl FileFilter {
+    /// The `filter` setting's value.
+    pub fn name(self) -> &'static str {
+        match self {
+            FileFilter::Nearest => "nearest",
+            FileFilter::Bilinear => "bilinear",
+            FileFilter::Trilinear => "trilinear",
+            FileFilter::Anisotropic(_) => "anisotropic",
+        }
+    }
+
+    /// The settings recording this filter (the anisotropy only for `anisotropic`).
+    pub fn settings(self) -> Vec<(String, String)> {
+        let mut s = vec![(FILTER_SETTING.to_string(), self.name().to_string())];
+        if let FileFilter::Anisotropic(n) = self {
+            s.push((ANISOTROPY_SETTING.to_string(), n.to_string()));
+        }
+        s
+    }
+
+    /// The filter the provenance settings record (rule 9001): trilinear without a `filter`
+    /// setting; an error naming what is wrong for an unknown name, or an `anisotropic`
+    /// filter without an anisotropy of 1 to 16.
+    pub fn of(p: Option<&Provenance>) -> Result<FileFilter, String> {
+        let get = |k: &str| p.and_then(|p| p.settings.iter().find(|(key, _)| key == k)).map(|(_, v)| v.as_str());
+        match get(FILTER_SETTING) {
+            None | Some("trilinear") => Ok(FileFilter::Trilinear),
+            Some("nearest") => Ok(FileFilter::Nearest),
+            Some("bilinear") => Ok(FileFilter::Bilinear),
+            Some("anisotropic") => match get(ANISOTROPY_SETTING).map(|v| v.parse::<u8>()) {
+                Some(Ok(n)) if (1..=MAX_ANISOTROPY).contains(&n) => Ok(FileFilter::Anisotropic(n)),
+                Some(_) => Err(format!("{ANISOTROPY_SETTING} {:?} is not an integer from 1 to {MAX_ANISOTROPY}", get(ANISOTROPY_SETTING).unwrap_or(""))),
+                None => Err(format!("filter \"anisotropic\" without an {ANISOTROPY_SETTING} setting")),
+            },
+            Some(other) => Err(format!("unknown filter {other:?} (nearest, bilinear, trilinear or anisotropic)")),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn prov(settings: &[(&str, &str)]) -> Provenance {
+        Provenance {
+            tool: "t".into(),
+            source: "s".into(),
+            raw_image_bytes: 0,
+            settings: settings.iter().map(|(k, v)| (k.to_string(), v.to_string())).collect(),
+        }
+    }
+
+    #[test]
+    fn settings_round_trip() {
+        for f in [FileFilter::Nearest, FileFilter::Bilinear, FileFilter::Trilinear, FileFilter::Anisotropic(1), FileFilter::Anisotropic(16)] {
+            let s = f.settings();
+            let p = prov(&s.iter().map(|(k, v)| (k.as_str(), v.as_str())).collect::<Vec<_>>());
+            assert_eq!(FileFilter::of(Some(&p)), Ok(f));
+        }
+        assert_eq!(FileFilter::of(None), Ok(FileFilter::Trilinear));
+        assert_eq!(FileFilter::of(Some(&prov(&[("codec", "raw")]))), Ok(FileFilter::Trilinear));
+    }
+
+    #[test]
+    fn bad_settings_are_refused() {
+        for bad in [
+            vec![("filter", "cubic")],
+            vec![("filter", "Trilinear")],
+            vec![("filter", "anisotropic")],
+            vec![("filter", "anisotropic"), ("anisotropy", "0")],
+            vec![("filter", "anisotropic"), ("anisotropy", "17")],
+            vec![("filter", "anisotropic"), ("anisotropy", "4.5")],
+        ] {
+            assert!(FileFilter::of(Some(&prov(&bad))).is_err(), "{bad:?}");
+        }
+    }
+}
