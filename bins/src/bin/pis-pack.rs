@@ -7,7 +7,7 @@ use std::process::ExitCode;
 
 use clap::Parser;
 use pis::cli::{self, Exit, Failure};
-use pis::pack::{pack, print_report, LayerMode, PackRequest, PyramidMode};
+use pis::pack::{pack_with, print_report, LayerMode, PackExtras, PackRequest, PyramidMode};
 use pis_codec::CodecId;
 use pis_compile::Filter;
 
@@ -67,6 +67,12 @@ struct Cli {
     /// (default: the solver's own).
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
     max_iterations: Option<u32>,
+    /// Also store the lossless master: every solved texture, before gamma compensation and
+    /// coding, losslessly coded in MSTR chunks a player never reads. pis-reencode codes
+    /// again from it (as a direct pack at the new settings would) instead of from the decoded
+    /// textures. The ratio does not count it; the report gives its bytes.
+    #[arg(long)]
+    keep_master: bool,
     /// Print the closing report as JSON on stdout.
     #[arg(long)]
     json: bool,
@@ -146,7 +152,7 @@ fn run(cli: Cli) -> Result<Exit, Failure> {
         max_iterations: cli.max_iterations,
         preset: None,
     };
-    let report = pack(&req)?;
+    let report = pack_with(&req, PackExtras { keep_master: cli.keep_master })?;
     print_report(&report, &mut std::io::stderr()).map_err(|e| Failure::new(Exit::Io, e))?;
     if cli.json {
         let s = serde_json::to_string_pretty(&report).map_err(|e| Failure::new(Exit::Runtime, e))?;
