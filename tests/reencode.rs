@@ -201,6 +201,12 @@ fn reencoding_from_the_master_gives_a_direct_pack() {
     for (x, y) in a.container().objects.iter().zip(&b.container().objects) {
         assert_eq!((&x.name, &x.mesh, &x.stagger, &x.transforms), (&y.name, &y.mesh, &y.stagger, &y.transforms));
     }
+    // pis-diff: the same level images with and without the master, the master counted apart.
+    let d = Command::new(env!("CARGO_BIN_EXE_pis-diff")).arg(mastered()).arg(packed()).arg("--json").output().expect("pis-diff runs");
+    let v: serde_json::Value = serde_json::from_slice(&d.stdout).expect("pis-diff JSON");
+    assert_eq!(v["textures_identical"], true, "{v}");
+    assert!(v["structure"].as_array().expect("structure").iter().any(|l| l == "lossless master only in the first file"), "{v}");
+    assert_eq!((v["bytes"]["a"]["master"].as_u64(), v["bytes"]["b"]["master"].as_u64()), (Some(master), Some(0)));
     // Without a master the same request codes the decoded textures: other level images.
     let decoded = dir.path().join("from-decoded.pis");
     let r = json(&reencode(packed(), &decoded, &["--ratio", "48"]));
