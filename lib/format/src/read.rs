@@ -3,7 +3,8 @@
 //! Opening a file reads the header, the chunk table and every metadata chunk (checksums
 //! verified), checks every rule of the spec that does not need the codestreams, and keeps the
 //! codestream references. Textures are then decoded on demand, reading only the codestreams
-//! on the pyramid path of the requested parameter point (each checksum-verified).
+//! on the pyramid path of the requested parameter point (each checksum-verified). The
+//! lossless master (`MSTR`) is not read at all until [`PisReader::masters`] asks for it.
 //! Every count, offset and length is checked against the file size before anything is
 //! allocated for it.
 
