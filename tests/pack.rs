@@ -85,6 +85,32 @@ fn pack_lossless_round_trips_the_solved_textures() {
     assert!((r["psnr_db"].as_f64().unwrap_or(0.0) - r["psnr_db_solved"].as_f64().unwrap_or(1.0)).abs() < 1e-9);
 }
 
+#[test]
+fn keep_master_stores_the_solved_textures_beside_unchanged_level_images() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let (plain, kept) = (dir.path().join("plain.pis"), dir.path().join("kept.pis"));
+    let a = json(&pack(set(), &plain, &["--ratio", "24", "--max-texture", "32"]));
+    let b = json(&pack(set(), &kept, &["--ratio", "24", "--max-texture", "32", "--keep-master"]));
+    validate(&kept);
+    assert_eq!(b["master_exact"], true, "{b}");
+    assert!(a["master_exact"].is_null() && a["master_bytes"] == 0);
+    let master = b["master_bytes"].as_u64().expect("master_bytes");
+    let bytes = b["bytes"].as_u64().expect("bytes");
+    assert!(master > 0 && master < bytes);
+    // The ratio counts the bytes a player uses; the prediction and level images are the same.
+    let raw = b["raw_image_bytes"].as_f64().expect("raw");
+    assert!((b["ratio"].as_f64().expect("ratio") - raw / (bytes - master) as f64).abs() < 1e-9);
+    assert_eq!((&a["texture_bytes"], &a["psnr_db"]), (&b["texture_bytes"], &b["psnr_db"]));
+    let (x, y) = (pis_format::PisReader::open(&plain).expect("plain"), pis_format::PisReader::open(&kept).expect("kept"));
+    assert_eq!(x.load_all().expect("plain").objects, y.load_all().expect("kept").objects);
+    assert!(!x.has_master() && y.has_master() && y.master_bytes() == master);
+    // pis-inspect counts the master apart.
+    let out = Command::new(env!("CARGO_BIN_EXE_pis-inspect")).arg(&kept).arg("--json").output().expect("pis-inspect runs");
+    let i: serde_json::Value = serde_json::from_slice(&out.stdout).expect("JSON");
+    assert_eq!(i["bytes"]["master"].as_u64(), Some(master));
+    assert!((i["ratio"].as_f64().expect("ratio") - raw / (bytes - master) as f64).abs() < 1e-9);
+}
+
 /// A copy of the set that `damage` spoils, then a pack that must fail with `code` and leave
 /// no output file.
 fn fails_without_output(damage: impl Fn(&Path), code: i32, message: &str) {

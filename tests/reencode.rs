@@ -1,6 +1,8 @@
 //! pis-reencode end to end: lossless re-encoding reproduces the input's decoded textures bit
-//! for bit; a lossy re-encoding meets its ratio, validates and reports its PSNR; bad
-//! arguments and bad inputs leave no output.
+//! for bit; a lossy re-encoding meets its ratio, validates and reports its PSNR; from a
+//! lossless master it gives what a direct pack at the new settings gives, and a lossless
+//! round trip carrying the master gives the pack back; bad arguments, bad inputs and a
+//! damaged master leave no output.
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
@@ -12,24 +14,41 @@ fn repo(rel: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("..").join(rel)
 }
 
-/// demo1 traced at 40×30, 1 spp, packed with the wavelet codec at ratio 24 and 32-texel
-/// textures, once for every test.
-fn packed() -> &'static Path {
-    static PACK: OnceLock<(tempfile::TempDir, PathBuf)> = OnceLock::new();
-    &PACK.get_or_init(|| {
+/// demo1 traced at 40×30, 1 spp, once for every test.
+fn set() -> &'static Path {
+    static SET: OnceLock<(tempfile::TempDir, PathBuf)> = OnceLock::new();
+    &SET.get_or_init(|| {
         let dir = tempfile::tempdir().expect("temp dir");
         let set = dir.path().join("set");
         let out = Command::new(env!("CARGO_BIN_EXE_pis-trace"))
             .arg(repo("samples/demo1/scene.toml")).arg("-o").arg(&set)
             .args(["--resolution", "40x30", "--spp", "1"]).output().expect("pis-trace runs");
         assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
-        let file = dir.path().join("demo1.pis");
-        let out = Command::new(env!("CARGO_BIN_EXE_pis-pack"))
-            .arg(&set).arg("--scene").arg(repo("samples/demo1/scene.toml")).arg("-o").arg(&file)
-            .args(["--ratio", "24", "--max-texture", "32"]).output().expect("pis-pack runs");
-        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
-        (dir, file)
+        (dir, set)
     }).1
+}
+
+/// The set packed with the wavelet codec and 32-texel textures, with `args`.
+fn pack(name: &str, args: &[&str]) -> (tempfile::TempDir, PathBuf) {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let file = dir.path().join(name);
+    let out = Command::new(env!("CARGO_BIN_EXE_pis-pack"))
+        .arg(set()).arg("--scene").arg(repo("samples/demo1/scene.toml")).arg("-o").arg(&file)
+        .args(["--max-texture", "32"]).args(args).output().expect("pis-pack runs");
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    (dir, file)
+}
+
+/// Packed at ratio 24, once for every test.
+fn packed() -> &'static Path {
+    static PACK: OnceLock<(tempfile::TempDir, PathBuf)> = OnceLock::new();
+    &PACK.get_or_init(|| pack("demo1.pis", &["--ratio", "24"])).1
+}
+
+/// Packed at ratio 24 with the lossless master, once for every test.
+fn mastered() -> &'static Path {
+    static PACK: OnceLock<(tempfile::TempDir, PathBuf)> = OnceLock::new();
+    &PACK.get_or_init(|| pack("mastered.pis", &["--ratio", "24", "--keep-master"])).1
 }
 
 fn reencode(input: &Path, output: &Path, args: &[&str]) -> Output {
@@ -148,4 +167,122 @@ fn bad_arguments_and_inputs_leave_no_output() {
     let o = reencode(packed(), &dir.path().join("no/such/folder/out.pis"), &[]);
     assert_eq!(o.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&o.stderr).contains("does not exist"));
+}
+
+/// Level images (codecs, codestream bytes), geometry, transforms and every other part a
+/// player reads, equal in both files.
+fn same_player_content(a: &Path, b: &Path) {
+    let (x, y) = (PisReader::open(a).expect("a"), PisReader::open(b).expect("b"));
+    let (cx, cy) = (x.load_all().expect("a codestreams"), y.load_all().expect("b codestreams"));
+    assert_eq!((&cx.space, &cx.cameras), (&cy.space, &cy.cameras));
+    assert_eq!(cx.objects, cy.objects, "{} and {} differ", a.display(), b.display());
+}
+
+#[test]
+fn reencoding_from_the_master_gives_a_direct_pack() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let out = dir.path().join("from-master.pis");
+    let r = json(&reencode(mastered(), &out, &["--ratio", "48"]));
+    validate(&out);
+    assert_eq!(r["source"], "master", "{r}");
+    let master = r["master_bytes_before"].as_u64().expect("master bytes");
+    assert!(master > 0 && r["master_bytes_after"] == 0, "{r}");
+    // The ratio counts what a player uses, not the master.
+    let (raw, bytes) = (r["raw_image_bytes"].as_f64().expect("raw"), r["bytes_before"].as_f64().expect("bytes"));
+    assert!((r["ratio_before"].as_f64().expect("ratio") - raw / (bytes - master as f64)).abs() < 1e-9);
+    let before = r["psnr_master_before_db"].as_f64().expect("PSNR of the input against the master");
+    let after = r["psnr_master_after_db"].as_f64().expect("PSNR of the output against the master");
+    assert!(after < before && (r["psnr_change_db"].as_f64().expect("change") - (after - before)).abs() < 1e-9, "{r}");
+    // A direct pack at ratio 48: the same level images, byte for byte, hence the same PSNR.
+    let (_d, direct) = pack("direct.pis", &["--ratio", "48"]);
+    same_player_content(&out, &direct);
+    // Geometry and transforms are the input's.
+    let (a, b) = (PisReader::open(mastered()).expect("input"), PisReader::open(&out).expect("output"));
+    for (x, y) in a.container().objects.iter().zip(&b.container().objects) {
+        assert_eq!((&x.name, &x.mesh, &x.stagger, &x.transforms), (&y.name, &y.mesh, &y.stagger, &y.transforms));
+    }
+    // pis-diff: the same level images with and without the master, the master counted apart.
+    let d = Command::new(env!("CARGO_BIN_EXE_pis-diff")).arg(mastered()).arg(packed()).arg("--json").output().expect("pis-diff runs");
+    let v: serde_json::Value = serde_json::from_slice(&d.stdout).expect("pis-diff JSON");
+    assert_eq!(v["textures_identical"], true, "{v}");
+    assert!(v["structure"].as_array().expect("structure").iter().any(|l| l == "lossless master only in the first file"), "{v}");
+    assert_eq!((v["bytes"]["a"]["master"].as_u64(), v["bytes"]["b"]["master"].as_u64()), (Some(master), Some(0)));
+    // Without a master the same request codes the decoded textures: other level images.
+    let decoded = dir.path().join("from-decoded.pis");
+    let r = json(&reencode(packed(), &decoded, &["--ratio", "48"]));
+    assert_eq!(r["source"], "decoded textures");
+    assert!(r["psnr_master_after_db"].is_null() && r["master_bytes_before"] == 0);
+    let (x, y) = (PisReader::open(&decoded).expect("decoded").load_all().expect("load"), PisReader::open(&direct).expect("direct").load_all().expect("load"));
+    assert_ne!(x.objects, y.objects);
+}
+
+#[test]
+fn a_lossless_round_trip_carrying_the_master_gives_the_pack_back() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let lossless = dir.path().join("lossless.pis");
+    let r = json(&reencode(mastered(), &lossless, &["--codec", "lossless", "--keep-master"]));
+    validate(&lossless);
+    assert_eq!((&r["source"], &r["master_bytes_after"]), (&serde_json::json!("master"), &r["master_bytes_before"]), "{r}");
+    assert_eq!(PisReader::open(&lossless).expect("lossless").masters().expect("master"), PisReader::open(mastered()).expect("input").masters().expect("master"));
+    let back = dir.path().join("back.pis");
+    let r = json(&reencode(&lossless, &back, &["--ratio", "24", "--keep-master"]));
+    validate(&back);
+    assert_eq!(r["source"], "master");
+    same_player_content(&back, mastered());
+    // The PSNR against the master is the pack's again.
+    let first = json(&reencode(mastered(), &dir.path().join("again.pis"), &["--codec", "lossless"]));
+    let (p0, p1) = (first["psnr_master_before_db"].as_f64().expect("pack"), r["psnr_master_after_db"].as_f64().expect("round trip"));
+    assert!((p0 - p1).abs() < 0.1, "{p0} dB → {p1} dB");
+}
+
+#[test]
+fn keep_master_needs_a_master_or_an_exact_input() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let out = dir.path().join("out.pis");
+    let o = reencode(packed(), &out, &["--keep-master"]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(err.contains("carries no master") && !out.exists(), "{err}");
+    // From a lossless file: the decoded textures become the master.
+    let lossless = dir.path().join("lossless.pis");
+    json(&reencode(packed(), &lossless, &["--codec", "lossless"]));
+    let made = dir.path().join("made.pis");
+    let r = json(&reencode(&lossless, &made, &["--codec", "lossless", "--keep-master"]));
+    validate(&made);
+    assert_eq!(r["source"], "decoded textures");
+    assert!(r["master_bytes_after"].as_u64() > Some(0));
+    let m = PisReader::open(&made).expect("made");
+    let masters = m.masters().expect("master");
+    let c = m.container();
+    for o in &masters {
+        let obj = &c.objects[o.object as usize];
+        for (li, l) in obj.layers.iter().enumerate() {
+            for s in 0..c.space.table_len(l.depends_on) as usize {
+                let point = pis_format::master::sample_point(c, l, s as u64);
+                let want = m.texture(o.object as usize, li, &point).expect("texture").data;
+                let got = o.texture(c, li, s).expect("master texture");
+                assert!(got.len() == want.len() && got.iter().zip(&want).all(|(a, b)| a.to_bits() == b.to_bits()));
+            }
+        }
+    }
+}
+
+#[test]
+fn a_damaged_master_is_an_error_without_output() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let damaged = dir.path().join("damaged.pis");
+    let mut bytes = std::fs::read(mastered()).expect("read");
+    let r = PisReader::open(mastered()).expect("input");
+    let e = r.chunks().iter().find(|e| &e.fourcc == b"MSTR").expect("an MSTR chunk").clone();
+    bytes[(e.offset + e.length / 3) as usize] ^= 0x40;
+    std::fs::write(&damaged, bytes).expect("write");
+    let out = dir.path().join("out.pis");
+    let o = reencode(&damaged, &out, &["--ratio", "48"]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(3), "{err}");
+    assert!(err.contains("damaged.pis") && err.contains("error-3004") && err.contains("MSTR"), "{err}");
+    assert!(!out.exists() && !err.contains("panicked"));
+    let v = Command::new(env!("CARGO_BIN_EXE_pis-inspect")).arg("--validate").arg(&damaged).output().expect("pis-inspect runs");
+    assert_eq!(v.status.code(), Some(3));
+    assert!(String::from_utf8_lossy(&v.stdout).contains("error-3004") || String::from_utf8_lossy(&v.stderr).contains("error-3004"));
 }

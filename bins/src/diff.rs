@@ -124,7 +124,13 @@ pub fn diff(req: &DiffRequest) -> Result<DiffReport, Failure> {
     }
     let a = open(&req.a)?;
     let b = open(&req.b)?;
-    let structure = differences(a.container(), b.container());
+    let mut structure = differences(a.container(), b.container());
+    // The lossless master changes nothing a player decodes, but it is part of the file.
+    match (a.has_master(), b.has_master()) {
+        (true, false) => structure.push("lossless master only in the first file".into()),
+        (false, true) => structure.push("lossless master only in the second file".into()),
+        _ => {}
+    }
     let bytes_identical = same_bytes(&req.a, &req.b)?;
     let (content, maps) = compare(&a, &b, req.heatmaps.is_some(), &mut |line| eprintln!("pis-diff: {line}")).map_err(|e| in_file(&e.path, e.error))?;
     let mut heatmaps = Vec::new();

@@ -24,8 +24,8 @@ pub struct Summary {
     pub objects: Vec<ObjectSummary>,
     pub codecs: BTreeMap<String, CodecSummary>,
     pub bytes: Bytes,
-    /// Raw image set bytes (3 bytes per pixel per point) over the file size; null without
-    /// provenance.
+    /// Raw image set bytes (3 bytes per pixel per point) over the bytes a player uses (the
+    /// file size less the lossless master, `bytes.master`); null without provenance.
     pub ratio: Option<f64>,
     /// The same, leaving out the geometry (`MESH` chunks).
     pub ratio_without_geometry: Option<f64>,
@@ -202,9 +202,10 @@ pub fn summarize(r: &PisReader) -> Summary {
         },
         objects,
         codecs,
-        ratio: raw.map(|b| b as f64 / bytes.total as f64),
-        ratio_without_geometry: raw
-            .map(|b| b as f64 / (bytes.total - bytes.geometry).max(1) as f64),
+        ratio: raw.map(|b| b as f64 / (bytes.total - bytes.master).max(1) as f64),
+        ratio_without_geometry: raw.map(|b| {
+            b as f64 / (bytes.total - bytes.master - bytes.geometry).max(1) as f64
+        }),
         bytes,
         provenance: c.provenance.as_ref().map(|p| ProvenanceSummary {
             tool: p.tool.clone(),
@@ -324,6 +325,7 @@ pub fn render(s: &Summary) -> String {
         ("layer index", b.layer_index),
         ("codestreams", b.codestreams),
         ("provenance", b.provenance),
+        ("lossless master", b.master),
         ("other chunks", b.other),
     ] {
         if n > 0 {
@@ -339,8 +341,9 @@ pub fn render(s: &Summary) -> String {
         (Some(r), Some(g), Some(p)) => {
             let _ = writeln!(
                 o,
-                "\nCompression ratio: {r:.1}:1 ({g:.1}:1 without geometry) against a raw image set of {}",
-                human(p.raw_image_bytes)
+                "\nCompression ratio: {r:.1}:1 ({g:.1}:1 without geometry) against a raw image set of {}{}",
+                human(p.raw_image_bytes),
+                if b.master > 0 { "; the lossless master is not counted" } else { "" }
             );
         }
         _ => {

@@ -156,8 +156,22 @@ impl Stages {
     }
 }
 
+/// What `pis-pack` writes beside the level images a player uses.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct PackExtras {
+    /// Keep the lossless master (SPEC.md 6.7): every solved texture of every layer sample,
+    /// before gamma compensation and coding, and each object's allocation weight, so that
+    /// `pis-reencode` codes again from the solve rather than from the decoded textures.
+    pub keep_master: bool,
+}
+
 /// Runs the whole pipeline and writes the container; on error no output file is left.
 pub fn pack(req: &PackRequest) -> Result<PackReport, Failure> {
+    pack_with(req, PackExtras::default())
+}
+
+/// [`pack`], writing `extras` too.
+pub fn pack_with(req: &PackRequest, extras: PackExtras) -> Result<PackReport, Failure> {
     if req.ratio.is_some() && req.psnr.is_some() {
         return Err(Failure::new(Exit::Usage, anyhow::anyhow!("give --ratio or --psnr, not both")));
     }
@@ -187,8 +201,22 @@ pub fn pack(req: &PackRequest) -> Result<PackReport, Failure> {
     if let Some(p) = packed.container.provenance.as_mut() {
         p.settings.push((PREDICTED_PSNR_SETTING.to_string(), format!("{:.4}", quality.overall)));
     }
-    let bytes = pis_format::write(&req.output, &packed.container)?;
+    let masters = if extras.keep_master {
+        let m = encode::masters(&inferred, &packed).map_err(|e| Failure::new(Exit::Runtime, e))?;
+        let n: u64 = m.iter().map(pis_format::Master::payload_len).sum();
+        stages.done("master", &format!("solved textures of {} objects coded losslessly ({n} bytes)", m.len()));
+        m
+    } else {
+        Vec::new()
+    };
+    let bytes = pis_format::write_with_masters(&req.output, &packed.container, &masters)?;
     stages.done("write", &format!("{} ({bytes} bytes)", req.output.display()));
+    // The master read back from the file decodes to the solved textures bit for bit.
+    let master = if extras.keep_master {
+        Some(encode::check_master(&req.output, &inferred).map_err(|e| Failure::new(Exit::Runtime, e))?)
+    } else {
+        None
+    };
     // Lossless: the file's level images decode bit-exactly and the decoded textures equal
     // the solved ones.
     let exact = if req.codec == CodecId::Lossless {
@@ -199,5 +227,8 @@ pub fn pack(req: &PackRequest) -> Result<PackReport, Failure> {
     };
     let mut report = report::build(&set, &inferred, &packed, &quality, bytes, exact, req, stages);
     report.probe_renderings = probe_renderings;
+    if let Some((master_bytes, exact)) = master {
+        report.set_master(master_bytes, exact);
+    }
     Ok(report)
 }

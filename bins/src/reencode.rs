@@ -1,12 +1,17 @@
 //! `pis-reencode`: a container's textures coded again, with another codec, rate or gamma.
 //!
-//! Every parameter block of every layer is decoded at all its samples; the linear textures
-//! are gamma-compensated again (thesis 4.6), built into new adaptive Laplacian pyramids
-//! (4.3), given storage by the equal-slope allocation `pis-pack` uses over all level images
-//! of all blocks, layers and objects, weighted by screen area (4.5), and encoded. Geometry,
-//! cameras, the parameter space, block origins and placements are copied. The output is
-//! written atomically, read back and compared with the input's decoded textures.
+//! The source is the file's lossless master when it carries one (SPEC.md 6.7: the textures
+//! as `pis-pack` solved them, and each object's screen-area weight), else every parameter
+//! block of every layer decoded at all its samples. The linear textures are
+//! gamma-compensated again (thesis 4.6), built into new adaptive Laplacian pyramids (4.3),
+//! given storage by the equal-slope allocation `pis-pack` uses over all level images of all
+//! blocks, layers and objects, weighted by screen area (4.5), and encoded: from a master, the
+//! steps and inputs of a direct pack at the new settings. Geometry, cameras, the parameter
+//! space, block origins and placements are copied. The output is written atomically, read
+//! back and compared with the input's decoded textures (and, with a master, both files with
+//! the master).
 
+mod master;
 mod screen_area;
 
 use std::collections::BTreeMap;
@@ -16,7 +21,7 @@ use std::time::Instant;
 use anyhow::anyhow;
 use pis_codec::allocate::Target;
 use pis_codec::CodecId;
-use pis_eval::diff::decode::decode_block;
+use pis_eval::metrics::SquaredError;
 use pis_format::reconstruct::{finish, prepare};
 use pis_format::*;
 use rayon::prelude::*;
@@ -39,6 +44,9 @@ pub struct ReencodeRequest {
     pub psnr: Option<f64>,
     /// Gamma of the compensation (lossy codecs; default [`DEFAULT_GAMMA`]).
     pub gamma: Option<f32>,
+    /// Write the lossless master into the output: the input's, or one made from the decoded
+    /// textures of an input whose level images are all exact.
+    pub keep_master: bool,
 }
 
 /// The gamma lossy re-encodings use unless told otherwise (as `pis-pack`).
@@ -58,6 +66,10 @@ pub struct ObjectReport {
     pub exact: bool,
     /// Mean covered pixels per point: the allocation's screen-area weight (lossy codecs).
     pub area_px: Option<f64>,
+    /// PSNR of the input's and the output's textures against the master (null without a
+    /// master, or when identical).
+    pub psnr_master_before_db: Option<f64>,
+    pub psnr_master_after_db: Option<f64>,
 }
 
 /// The report (`--json` prints it).
@@ -70,13 +82,20 @@ pub struct ReencodeReport {
     pub codec: String,
     pub gamma: f32,
     pub target: String,
+    /// What the new level images were coded from: `master` (the input's lossless master)
+    /// or `decoded textures` (the input's level images decoded).
+    pub source: String,
+    /// Whole files, the lossless master included.
     pub bytes_before: u64,
     pub bytes_after: u64,
+    /// Bytes of the lossless master in each file (0 without); the ratios leave them out.
+    pub master_bytes_before: u64,
+    pub master_bytes_after: u64,
     /// Level-image bytes.
     pub texture_bytes_before: u64,
     pub texture_bytes_after: u64,
     pub raw_image_bytes: u64,
-    /// Raw image bytes over file bytes.
+    /// Raw image bytes over the bytes a player uses (file bytes less the master).
     pub ratio_before: f64,
     pub ratio_after: f64,
     /// Raw image bytes over level-image bytes.
@@ -89,6 +108,11 @@ pub struct ReencodeReport {
     pub max_error: f64,
     /// The output decodes to exactly the input's textures.
     pub exact: bool,
+    /// With a master: whole-file texture PSNR of the input and of the output against it, and
+    /// the change (after − before; null when either is identical to the master).
+    pub psnr_master_before_db: Option<f64>,
+    pub psnr_master_after_db: Option<f64>,
+    pub psnr_change_db: Option<f64>,
     pub level_images: usize,
     pub objects: Vec<ObjectReport>,
     pub stage_ms: BTreeMap<String, f64>,
@@ -202,33 +226,60 @@ pub fn reencode(req: &ReencodeRequest) -> Result<ReencodeReport, Failure> {
     let mut t = Timer(Vec::new(), Instant::now());
     let input = open(&req.input)?;
     let c = input.container();
+    let masters_in = if input.has_master() { input.masters().map_err(|e| in_file(&req.input, e))? } else { Vec::new() };
+    let from_master = !masters_in.is_empty();
+    let input_exact = c.objects.iter().flat_map(|o| &o.layers).flat_map(|l| &l.blocks).flat_map(|b| &b.levels)
+        .flat_map(|l| &l.images).all(|s| !s.codec.is_lossy());
+    if req.keep_master && !from_master && !input_exact {
+        return Err(usage(format!(
+            "--keep-master: {} carries no master and its level images are lossy: a master is carried over from a file that has one (pis-pack --keep-master) or made from a losslessly coded file",
+            req.input.display())));
+    }
     let exact = !req.codec.is_lossy();
     let gamma = if exact { 1.0 } else { req.gamma.unwrap_or(DEFAULT_GAMMA) };
     let texture_bytes_before: u64 = c.objects.iter().map(|o| stream_bytes(o, |s| s.length as u64)).sum();
     let raw = c.provenance.as_ref().map(|p| p.raw_image_bytes).filter(|&b| b > 0)
         .unwrap_or(c.space.point_count() * c.cameras.width as u64 * c.cameras.height as u64 * 3);
 
-    // Decode every block, compensate gamma again, build its pyramid.
+    // Every block's textures (the master's, or decoded), gamma compensated again, into its
+    // pyramid.
+    let source = if from_master { "master" } else { "decoded textures" };
     let mut pyramids: Vec<BlockPyramid> = Vec::new();
     let mut layers_out = Vec::new();
+    // A master made from an exactly coded input: per object, layer and table sample.
+    let mut made: Vec<Vec<Vec<Vec<f32>>>> = Vec::new();
     for (oi, o) in c.objects.iter().enumerate() {
         let mut per_layer = Vec::new();
+        let mut made_layers = Vec::new();
         for (li, l) in o.layers.iter().enumerate() {
             let mut layer = l.clone();
             layer.gamma = gamma;
             let layer_samples = c.space.table_len(l.depends_on).max(1) as f64;
-            let blocks = (0..l.blocks.len()).into_par_iter().map(|bi| {
-                let block = decode_block(&input, oi, li, bi).map_err(|e| in_file(&req.input, e))?;
-                let samples: Vec<Vec<f32>> = block.textures.par_iter().map(|x| prepared(&layer, &block.layout, x, exact)).collect();
-                build_pyramid(oi, block.layout.planes(), &block.extent, &samples, layer_samples, exact, false).map_err(runtime)
+            let sources = match masters_in.iter().find(|m| m.object as usize == oi) {
+                Some(m) => master::from_master(c, m, oi, li),
+                None => master::from_decoded(&input, oi, li),
+            }.map_err(|e| in_file(&req.input, e))?;
+            let blocks = sources.par_iter().map(|b| {
+                let samples: Vec<Vec<f32>> = b.textures.par_iter().map(|x| prepared(&layer, &b.layout, x, exact)).collect();
+                build_pyramid(oi, b.layout.planes(), &b.extent, &samples, layer_samples, exact, false).map_err(runtime)
             }).collect::<Result<Vec<BlockPyramid>, Failure>>()?;
+            if req.keep_master && !from_master {
+                let mut table = vec![Vec::new(); layer_samples as usize];
+                for b in sources {
+                    for (x, t) in b.textures.into_iter().zip(b.tables) {
+                        table[t] = x;
+                    }
+                }
+                made_layers.push(table);
+            }
             pyramids.extend(blocks);
             per_layer.push(layer.gamma);
         }
         layers_out.push(per_layer);
+        made.push(made_layers);
     }
     let level_images: usize = pyramids.iter().flat_map(|p| &p.levels).map(|l| l.1.len()).sum();
-    t.done("pyramid", &format!("{} blocks decoded, {level_images} level images in adaptive pyramids", pyramids.len()));
+    t.done("pyramid", &format!("{} blocks from the {source}, {level_images} level images in adaptive pyramids", pyramids.len()));
 
     let (target, target_text) = match (req.psnr, req.ratio) {
         _ if exact => (Target::Bytes(usize::MAX), "exact".to_string()),
@@ -236,12 +287,18 @@ pub fn reencode(req: &ReencodeRequest) -> Result<ReencodeReport, Failure> {
         (None, Some(r)) => (Target::Bytes((raw as f64 / r) as usize), format!("ratio {r}")),
         (None, None) => (Target::Bytes(texture_bytes_before as usize), format!("bytes {texture_bytes_before}")),
     };
-    let areas = if exact { None } else {
+    // A master carries the allocation weights its writer used; otherwise they are measured.
+    let need_areas = !exact || (req.keep_master && !from_master);
+    let areas = if from_master {
+        Some(c.objects.iter().enumerate().map(|(oi, _)| masters_in.iter().find(|m| m.object as usize == oi).map_or(1.0, |m| m.area)).collect::<Vec<f64>>())
+    } else if need_areas {
         let a = screen_areas(c);
         t.done("areas", &format!("screen areas of {} objects over {} points", a.len(), c.space.point_count()));
         Some(a)
+    } else {
+        None
     };
-    let storage = allocate_storage(&pyramids, req.codec, target, areas.as_deref().unwrap_or(&[])).map_err(runtime)?;
+    let storage = allocate_storage(&pyramids, req.codec, target, if exact { &[] } else { areas.as_deref().unwrap_or(&[]) }).map_err(runtime)?;
     if let Some(total) = storage.allocated {
         t.done("allocate", &format!("{total} bytes over {level_images} level images"));
     }
@@ -288,7 +345,18 @@ pub fn reencode(req: &ReencodeRequest) -> Result<ReencodeReport, Failure> {
         raw_image_bytes: raw,
         settings,
     });
-    let bytes_after = pis_format::write(&req.output, &out).map_err(|e| match e {
+    let masters_out = if !req.keep_master {
+        Vec::new()
+    } else if from_master {
+        masters_in.clone()
+    } else {
+        let a = areas.as_deref().unwrap_or(&[]);
+        let m = made.iter().enumerate().map(|(oi, textures)| Master::encode(&out, oi, a.get(oi).copied().unwrap_or(1.0), textures))
+            .collect::<Result<Vec<Master>, Error>>().map_err(|e| runtime(e.into()))?;
+        t.done("master", &format!("decoded textures of {} objects coded losslessly", m.len()));
+        m
+    };
+    let bytes_after = pis_format::write_with_masters(&req.output, &out, &masters_out).map_err(|e| match e {
         Error::Io { .. } => Failure::from(e),
         e => runtime(e.into()),
     })?;
@@ -298,6 +366,16 @@ pub fn reencode(req: &ReencodeRequest) -> Result<ReencodeReport, Failure> {
     let output = open(&req.output)?;
     let (diff, _) = pis_eval::diff::compare(&input, &output, false, &mut |_| {}).map_err(|e| runtime(e.into()))?;
     t.done("compare", "output decoded at every sample against the input");
+    let against = |r: &PisReader| master::error_against(r, &masters_in).map_err(|e| in_file(r.path(), e));
+    let (vs_before, vs_after) = if from_master {
+        let scores = (against(&input)?, against(&output)?);
+        t.done("master", "input and output decoded at every sample against the master");
+        (Some(scores.0), Some(scores.1))
+    } else {
+        (None, None)
+    };
+    let finite = |p: f64| p.is_finite().then_some(p);
+    let object_psnr = |s: &Option<(SquaredError, Vec<SquaredError>)>, i: usize| s.as_ref().and_then(|s| finite(s.1[i].psnr()));
     let objects = c.objects.iter().zip(&output.container().objects).zip(&diff.objects).enumerate().map(|(i, ((a, b), d))| ObjectReport {
         name: a.name.clone(),
         bytes_before: stream_bytes(a, |s| s.length as u64),
@@ -307,8 +385,13 @@ pub fn reencode(req: &ReencodeRequest) -> Result<ReencodeReport, Failure> {
         max_error: d.score.max_error,
         exact: d.score.exact,
         area_px: areas.as_ref().map(|a| a[i]),
+        psnr_master_before_db: object_psnr(&vs_before, i),
+        psnr_master_after_db: object_psnr(&vs_after, i),
     }).collect();
     let bytes_before = input.len();
+    let (master_bytes_before, master_bytes_after) = (input.master_bytes(), output.master_bytes());
+    let psnr_master_before_db = vs_before.as_ref().and_then(|s| finite(s.0.psnr()));
+    let psnr_master_after_db = vs_after.as_ref().and_then(|s| finite(s.0.psnr()));
     Ok(ReencodeReport {
         input: req.input.display().to_string(),
         output: req.output.display().to_string(),
@@ -316,19 +399,25 @@ pub fn reencode(req: &ReencodeRequest) -> Result<ReencodeReport, Failure> {
         codec: req.codec.name().to_string(),
         gamma,
         target: target_text,
+        source: source.to_string(),
         bytes_before,
         bytes_after,
+        master_bytes_before,
+        master_bytes_after,
         texture_bytes_before,
         texture_bytes_after,
         raw_image_bytes: raw,
-        ratio_before: raw as f64 / bytes_before.max(1) as f64,
-        ratio_after: raw as f64 / bytes_after.max(1) as f64,
+        ratio_before: raw as f64 / (bytes_before - master_bytes_before).max(1) as f64,
+        ratio_after: raw as f64 / (bytes_after - master_bytes_after).max(1) as f64,
         ratio_without_geometry_before: raw as f64 / texture_bytes_before.max(1) as f64,
         ratio_without_geometry_after: raw as f64 / texture_bytes_after.max(1) as f64,
         psnr_db: diff.score.psnr_db,
         mse: diff.score.mse,
         max_error: diff.score.max_error,
         exact: diff.score.exact && diff.complete,
+        psnr_master_before_db,
+        psnr_master_after_db,
+        psnr_change_db: psnr_master_before_db.zip(psnr_master_after_db).map(|(b, a)| a - b),
         level_images,
         objects,
         stage_ms: t.0.into_iter().collect(),
@@ -341,12 +430,19 @@ fn db(p: Option<f64>) -> String {
 
 /// Human-readable lines of the report.
 pub fn print_report(r: &ReencodeReport, out: &mut impl std::io::Write) -> std::io::Result<()> {
-    writeln!(out, "{} → {}: {} → {} (gamma {}, target {})", r.input, r.output, r.codecs_before.join("+"), r.codec, r.gamma, r.target)?;
+    writeln!(out, "{} → {}: {} → {} (gamma {}, target {}), from the {}", r.input, r.output, r.codecs_before.join("+"), r.codec, r.gamma, r.target, r.source)?;
     writeln!(out, "  bytes     {:>12} → {:>12}  (level images {} → {})", r.bytes_before, r.bytes_after, r.texture_bytes_before, r.texture_bytes_after)?;
     writeln!(out, "  ratio     {:>12.1} → {:>12.1}  (without geometry {:.1} → {:.1}; raw {} bytes)", r.ratio_before, r.ratio_after,
              r.ratio_without_geometry_before, r.ratio_without_geometry_after, r.raw_image_bytes)?;
+    if r.master_bytes_before > 0 || r.master_bytes_after > 0 {
+        writeln!(out, "  lossless master {:>12} → {:>12} bytes, not counted by the ratios", r.master_bytes_before, r.master_bytes_after)?;
+    }
     writeln!(out, "  texture PSNR against the input's decoded textures: {} (max display error {:.4}){}", db(r.psnr_db), r.max_error,
              if r.exact { ", exact" } else { "" })?;
+    if r.source == "master" {
+        let change = r.psnr_change_db.map_or("n/a".to_string(), |d| format!("{d:+.2} dB"));
+        writeln!(out, "  texture PSNR against the master: {} → {} (change {change})", db(r.psnr_master_before_db), db(r.psnr_master_after_db))?;
+    }
     for o in &r.objects {
         writeln!(out, "  {:<12} {:>10} → {:>10} bytes  {:>10}  max error {:.4}", o.name, o.bytes_before, o.bytes_after, db(o.psnr_db), o.max_error)?;
     }

@@ -1,5 +1,5 @@
 //! Any byte string: validation and the reader return errors, never panic; when a file opens,
-//! every texture at every point is decoded.
+//! every texture at every point is decoded, and the lossless master read and decoded.
 #![no_main]
 
 use libfuzzer_sys::fuzz_target;
@@ -14,6 +14,15 @@ fuzz_target!(|data: &[u8]| {
             for (oi, o) in c.objects.iter().enumerate() {
                 for li in 0..o.layers.len() {
                     let _ = r.texture(oi, li, &point);
+                }
+            }
+        }
+        if let Ok(masters) = r.masters() {
+            for m in &masters {
+                for (li, l) in m.layers.iter().enumerate() {
+                    for s in 0..l.samples.len().min(64) {
+                        let _ = m.texture(c, li, s);
+                    }
                 }
             }
         }

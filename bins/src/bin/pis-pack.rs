@@ -8,7 +8,7 @@ use std::process::ExitCode;
 
 use clap::Parser;
 use pis::cli::{self, Exit, Failure};
-use pis::pack::{filter_needs_probe, pack, print_report, Allocation, LayerMode, MatrixSource, PackRequest, PyramidMode};
+use pis::pack::{filter_needs_probe, pack_with, print_report, Allocation, LayerMode, MatrixSource, PackExtras, PackRequest, PyramidMode};
 use pis_codec::CodecId;
 use pis_compile::{Filter, MAX_ANISOTROPY};
 
@@ -89,6 +89,12 @@ struct Cli {
     /// weighted by each object's screen area).
     #[arg(long, default_value = "screen", value_parser = parse_allocation)]
     allocation: Allocation,
+    /// Also store the lossless master: every solved texture, before gamma compensation and
+    /// coding, losslessly coded in MSTR chunks a player never reads. pis-reencode codes
+    /// again from it (as a direct pack at the new settings would) instead of from the decoded
+    /// textures. The ratio does not count it; the report gives its bytes.
+    #[arg(long)]
+    keep_master: bool,
     /// Print the closing report as JSON on stdout.
     #[arg(long)]
     json: bool,
@@ -206,7 +212,7 @@ fn run(cli: Cli) -> Result<Exit, Failure> {
         allocation: cli.allocation,
         preset: None,
     };
-    let report = pack(&req)?;
+    let report = pack_with(&req, PackExtras { keep_master: cli.keep_master })?;
     print_report(&report, &mut std::io::stderr()).map_err(|e| Failure::new(Exit::Io, e))?;
     if cli.json {
         let s = serde_json::to_string_pretty(&report).map_err(|e| Failure::new(Exit::Runtime, e))?;

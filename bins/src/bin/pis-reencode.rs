@@ -8,11 +8,14 @@ use pis::cli::{self, Exit, Failure};
 use pis::reencode::{print_report, reencode, ReencodeRequest};
 use pis_codec::CodecId;
 
-/// Decode every texture of a .pis file (all parameter samples, all layers) and code it again:
-/// new adaptive Laplacian pyramids per parameter block, equal-slope storage allocation over
-/// all level images weighted by screen area (as pis-pack), the chosen codec. Geometry,
-/// cameras, parameter space and placements are copied; provenance records the re-encoding.
-/// The output is written atomically, read back and compared with the input.
+/// Code every texture of a .pis file (all parameter samples, all layers) again: from the
+/// file's lossless master when it carries one (pis-pack --keep-master: the textures as
+/// solved, and pis-pack's allocation weights, so the result is what a direct pack at the new
+/// settings gives), else from its decoded level images. New adaptive Laplacian pyramids per
+/// parameter block, equal-slope storage allocation over all level images weighted by screen
+/// area (as pis-pack), the chosen codec. Geometry, cameras, parameter space and placements are
+/// copied; provenance records the re-encoding. The output is written atomically, read back
+/// and compared with the input (and, with a master, both with the master).
 #[derive(Parser, Debug)]
 #[command(name = "pis-reencode", version, after_help = "Exit codes: 0 ok, 1 bad arguments, 2 I/O error, 3 invalid input file, 4 runtime error, 5 not supported")]
 struct Cli {
@@ -36,6 +39,11 @@ struct Cli {
     /// store linear values (gamma 1).
     #[arg(long, allow_hyphen_values = true)]
     gamma: Option<f32>,
+    /// Write the lossless master into the output: the input's, or one made from the decoded
+    /// textures of an input whose level images are all lossless or raw. Without it the
+    /// output carries no master.
+    #[arg(long)]
+    keep_master: bool,
     /// Print the report as JSON on stdout.
     #[arg(long)]
     json: bool,
@@ -46,7 +54,7 @@ fn parse_codec(s: &str) -> Result<CodecId, String> {
 }
 
 fn run(cli: Cli) -> Result<Exit, Failure> {
-    let req = ReencodeRequest { input: cli.input, output: cli.output, codec: cli.codec, ratio: cli.ratio, psnr: cli.psnr, gamma: cli.gamma };
+    let req = ReencodeRequest { input: cli.input, output: cli.output, codec: cli.codec, ratio: cli.ratio, psnr: cli.psnr, gamma: cli.gamma, keep_master: cli.keep_master };
     let report = reencode(&req)?;
     print_report(&report, &mut std::io::stderr()).map_err(|e| Failure::new(Exit::Io, e))?;
     if cli.json {

@@ -403,6 +403,35 @@ pub(crate) fn mip_chain(m: &ObjectModel, finest: Vec<f32>) -> Vec<f32> {
     x
 }
 
+/// The lossless master of every object (SPEC.md 6.7): each layer sample's finest solved
+/// texture, linear as solved, and the object's screen-area weight of allocation.
+pub(crate) fn masters(models: &[ObjectModel], packed: &Packed) -> Result<Vec<Master>> {
+    models.iter().enumerate().map(|(mi, m)| {
+        // Keys are sample indices over the layer's dimensions: their order is table order.
+        let textures: Vec<Vec<Vec<f32>>> = m.layers.iter().map(|l| l.textures.values().map(|x| finest(m, x)).collect()).collect();
+        Ok(Master::encode(&packed.container, mi, m.area, &textures)?)
+    }).collect()
+}
+
+/// Reads the written file's master back; returns its bytes and whether every texture decodes
+/// to the finest solved texture bit for bit.
+pub(crate) fn check_master(path: &Path, models: &[ObjectModel]) -> Result<(u64, bool)> {
+    let reader = PisReader::open(path)?;
+    let c = reader.container();
+    let masters = reader.masters()?;
+    let mut exact = masters.len() == models.len();
+    for (m, model) in masters.iter().zip(models) {
+        for (li, l) in model.layers.iter().enumerate() {
+            for (s, x) in l.textures.values().enumerate() {
+                let got = m.texture(c, li, s)?;
+                let want = finest(model, x);
+                exact &= got.len() == want.len() && got.iter().zip(&want).all(|(a, b)| a.to_bits() == b.to_bits());
+            }
+        }
+    }
+    Ok((reader.master_bytes(), exact))
+}
+
 /// Reads the written file back and checks that every level image decodes to exactly the
 /// values that were encoded (bit for bit), as the lossless codec promises.
 pub(crate) fn check_lossless(path: &Path, packed: &Packed) -> Result<bool> {

@@ -59,11 +59,17 @@ pub struct PackReport {
     pub resolution: [u32; 2],
     /// Raw image bytes of the set (points × width × height × 3).
     pub raw_image_bytes: u64,
-    /// Bytes of the whole file.
+    /// Bytes of the whole file, the lossless master included.
     pub bytes: u64,
+    /// Bytes of the lossless master (`--keep-master`; 0 without): stored for re-encoding,
+    /// never read by a player, and not counted by `ratio`.
+    pub master_bytes: u64,
+    /// `--keep-master`: the master read back from the file decodes to the solved textures
+    /// bit for bit.
+    pub master_exact: Option<bool>,
     /// Bytes of the level images alone.
     pub texture_bytes: usize,
-    /// raw / file bytes.
+    /// raw / bytes a player uses (file bytes less the master).
     pub ratio: f64,
     /// raw / level-image bytes.
     pub ratio_without_geometry: f64,
@@ -124,6 +130,8 @@ pub(crate) fn build(set: &LoadedSet, models: &[ObjectModel], packed: &Packed, q:
         resolution: [set.resolution.0, set.resolution.1],
         raw_image_bytes: raw,
         bytes,
+        master_bytes: 0,
+        master_exact: None,
         texture_bytes,
         ratio: raw as f64 / bytes.max(1) as f64,
         ratio_without_geometry: raw as f64 / texture_bytes.max(1) as f64,
@@ -142,6 +150,15 @@ pub(crate) fn build(set: &LoadedSet, models: &[ObjectModel], packed: &Packed, q:
     }
 }
 
+impl PackReport {
+    /// Records the lossless master: its bytes leave `ratio` counting what a player uses.
+    pub(crate) fn set_master(&mut self, master_bytes: u64, exact: bool) {
+        self.master_bytes = master_bytes;
+        self.master_exact = Some(exact);
+        self.ratio = self.raw_image_bytes as f64 / self.bytes.saturating_sub(master_bytes).max(1) as f64;
+    }
+}
+
 /// Human-readable lines of the report.
 pub fn print_report(r: &PackReport, out: &mut impl std::io::Write) -> std::io::Result<()> {
     writeln!(out, "{}: {} points of {}x{}, codec {}", r.output, r.points, r.resolution[0], r.resolution[1], r.codec)?;
@@ -150,6 +167,9 @@ pub fn print_report(r: &PackReport, out: &mut impl std::io::Write) -> std::io::R
     writeln!(out, "  filter {}{anisotropy}, render matrices from the {}{probe}", r.filter, if r.matrix == "probe" { "GPU (probe mode)" } else { "hardware model" })?;
     writeln!(out, "  {} bytes (level images {}), raw {} bytes: ratio {:.1} (without geometry {:.1})",
              r.bytes, r.texture_bytes, r.raw_image_bytes, r.ratio, r.ratio_without_geometry)?;
+    if let Some(e) = r.master_exact {
+        writeln!(out, "  lossless master: {} bytes, not counted by the ratio; decodes to the solved textures bit-exactly: {e}", r.master_bytes)?;
+    }
     writeln!(out, "  predicted PSNR {:.2} dB (textures as solved {:.2} dB)", r.psnr_db, r.psnr_db_solved)?;
     if let Some(e) = r.lossless_exact {
         writeln!(out, "  lossless: file decodes to the solved textures bit-exactly: {e} (max texel error {:.3e})", r.max_texel_error)?;

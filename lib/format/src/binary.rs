@@ -76,6 +76,11 @@ impl<'a> Cursor<'a> {
         Ok(u64::from_le_bytes(b.try_into().expect("8 bytes")))
     }
 
+    /// `n` raw bytes.
+    pub fn bytes(&mut self, n: usize, what: &str) -> Result<&'a [u8], Issue> {
+        self.take(n, what)
+    }
+
     pub fn f32(&mut self, what: &str) -> Result<f32, Issue> {
         Ok(f32::from_bits(self.u32(what)?))
     }

@@ -24,6 +24,7 @@ pub const MESH: FourCC = *b"MESH";
 pub const LAYR: FourCC = *b"LAYR";
 pub const CSTR: FourCC = *b"CSTR";
 pub const PROV: FourCC = *b"PROV";
+pub const MSTR: FourCC = *b"MSTR";
 
 /// What version 1 says of each chunk type it defines.
 pub struct ChunkRule {
@@ -36,7 +37,7 @@ pub struct ChunkRule {
     pub malformed: u16,
 }
 
-pub const KNOWN: [ChunkRule; 7] = [
+pub const KNOWN: [ChunkRule; 8] = [
     ChunkRule {
         fourcc: PSPC,
         required: true,
@@ -85,6 +86,13 @@ pub const KNOWN: [ChunkRule; 7] = [
         min: 0,
         max: Some(1),
         malformed: 9000,
+    },
+    ChunkRule {
+        fourcc: MSTR,
+        required: false,
+        min: 0,
+        max: None,
+        malformed: 9100,
     },
 ];
 

@@ -1,7 +1,7 @@
 //! Validation issues: every rule of format-spec/SPEC.md, section "Validation", has a stable
 //! numeric id. Ids are grouped by what they check: 1xxx I/O, 2xxx header, 3xxx chunk table,
 //! 4xxx parameter space, 5xxx cameras, objects and meshes, 6xxx layers and blocks,
-//! 7xxx pyramids, 8xxx codestreams, 9xxx provenance.
+//! 7xxx pyramids, 8xxx codestreams, 9xxx provenance (91xx the lossless master).
 
 use std::fmt;
 
@@ -156,6 +156,14 @@ pub const RULES: &[(u16, &str)] = &[
     (8007, "codec is reserved and not decodable by this reader"),
     (9000, "PROV payload is malformed"),
     (9001, "filter setting is unknown, or anisotropic without an anisotropy of 1 to 16"),
+    (9100, "MSTR payload is malformed"),
+    (9101, "master names a missing object, or a second master names the same object"),
+    (9102, "master layers or samples differ from the object's"),
+    (9103, "master codec is not raw or lossless"),
+    (9104, "master screen area is not finite and positive"),
+    (9105, "master texture does not decode to its block's planes"),
+    (9106, "decoded master value is not finite"),
+    (9107, "some objects have a master and others do not"),
 ];
 
 /// The short message of rule `id` ("unknown rule" for ids not in [`RULES`]).

@@ -17,6 +17,7 @@ mod error;
 pub mod filter;
 pub mod hexdump;
 pub mod issue;
+pub mod master;
 pub mod mip;
 pub mod model;
 mod payload_read;
@@ -33,9 +34,13 @@ pub use binary::Span;
 pub use error::Error;
 pub use filter::FileFilter;
 pub use issue::{Issue, Severity};
+pub use master::{Master, MasterLayer};
 pub use model::*;
 pub use pis_codec::{CodecId, PlaneShape};
 pub use read::{PisReader, ReadStats};
 pub use texture::{LevelLayout, Texture};
 pub use validate::{validate_bytes, validate_file, Validation};
-pub use write::{to_bytes, to_bytes_labelled, to_bytes_unchecked, write, write_atomic};
+pub use write::{
+    to_bytes, to_bytes_labelled, to_bytes_labelled_with_masters, to_bytes_unchecked, to_bytes_unchecked_with_masters, to_bytes_with_masters, write,
+    write_atomic, write_with_masters,
+};

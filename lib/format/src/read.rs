@@ -3,7 +3,8 @@
 //! Opening a file reads the header, the chunk table and every metadata chunk (checksums
 //! verified), checks every rule of the spec that does not need the codestreams, and keeps the
 //! codestream references. Textures are then decoded on demand, reading only the codestreams
-//! on the pyramid path of the requested parameter point (each checksum-verified).
+//! on the pyramid path of the requested parameter point (each checksum-verified). The
+//! lossless master (`MSTR`) is not read at all until [`PisReader::masters`] asks for it.
 //! Every count, offset and length is checked against the file size before anything is
 //! allocated for it.
 
@@ -18,6 +19,7 @@ use crate::chunk::{self, ChunkEntry, Header, ENTRY_LEN, HEADER_LEN};
 use crate::model::*;
 use crate::source::{FileSource, Source};
 use crate::texture::{LevelLayout, Texture};
+use crate::master::Master;
 use crate::{checks, payload_read as pr, reconstruct, Error, Issue, Severity};
 
 /// An open `.pis` file.
@@ -240,6 +242,29 @@ impl PisReader {
         Ok(Texture { layout, data })
     }
 
+    /// True when the file carries a lossless master (`MSTR` chunks), without reading it.
+    pub fn has_master(&self) -> bool {
+        self.chunks.iter().any(|e| e.fourcc == chunk::MSTR)
+    }
+
+    /// Bytes of the `MSTR` payloads: the part of the file a player does not use.
+    pub fn master_bytes(&self) -> u64 {
+        self.chunks.iter().filter(|e| e.fourcc == chunk::MSTR).map(|e| e.length).sum()
+    }
+
+    /// The lossless master, one per object (empty when the file has none): every `MSTR`
+    /// chunk read, checksum-verified, parsed and checked against the container (SPEC.md
+    /// 6.7). Its textures are decoded, and checked, by [`Master::texture`].
+    pub fn masters(&self) -> Result<Vec<Master>, Error> {
+        let mut issues = Vec::new();
+        let masters = crate::master::load(self.source.as_ref(), &self.chunks, &self.container, false, &mut issues);
+        match issues.into_iter().next() {
+            Some(i) if i.id == 1001 => Err(Error::Io { path: self.path.clone(), source: std::io::Error::other(i.detail) }),
+            Some(i) => Err(Error::Invalid(i)),
+            None => Ok(masters),
+        }
+    }
+
     /// Reads every codestream into memory: the whole container, ready to re-encode or write.
     pub fn load_all(&self) -> Result<Container<Codestream>, Error> {
         self.container.try_map(&mut |r| {
@@ -292,7 +317,8 @@ pub(crate) fn load(src: &dyn Source, full: bool, issues: &mut Vec<Issue>) -> Loa
     let mut ok = true;
     for (i, e) in entries.iter().enumerate() {
         let in_bounds = e.offset.checked_add(e.length).is_some_and(|end| end <= len);
-        let is_meta = chunk::rule(e.fourcc).is_some_and(|r| r.fourcc != chunk::CSTR);
+        // Codestreams and masters are read on demand: a player never reads a master.
+        let is_meta = chunk::rule(e.fourcc).is_some_and(|r| r.fourcc != chunk::CSTR && r.fourcc != chunk::MSTR);
         if !in_bounds || !(is_meta || full) {
             ok &= in_bounds;
             continue;
@@ -441,6 +467,7 @@ fn chunk_name(e: &ChunkEntry) -> &'static str {
         chunk::MESH => "MESH",
         chunk::LAYR => "LAYR",
         chunk::CSTR => "CSTR",
+        chunk::MSTR => "MSTR",
         _ => "PROV",
     })
 }

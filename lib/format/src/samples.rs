@@ -347,3 +347,18 @@ pub fn tiny() -> Result<Container, Error> {
         }),
     })
 }
+
+/// A lossless master for `c` (SPEC.md 6.7): every layer sample's texture as the container
+/// decodes it, screen area 1 for every object. With `tiny()`, the sample of a file that
+/// carries one.
+pub fn master_of(c: &Container) -> Result<Vec<crate::Master>, Error> {
+    let r = crate::PisReader::from_bytes(crate::to_bytes(c)?)?;
+    c.objects.iter().enumerate().map(|(oi, o)| {
+        let textures = o.layers.iter().enumerate().map(|(li, l)| {
+            (0..c.space.table_len(l.depends_on)).map(|s| {
+                Ok(r.texture(oi, li, &crate::master::sample_point(c, l, s))?.data)
+            }).collect::<Result<Vec<_>, Error>>()
+        }).collect::<Result<Vec<_>, Error>>()?;
+        crate::Master::encode(c, oi, 1.0, &textures)
+    }).collect()
+}

@@ -77,6 +77,9 @@ fn validate_source(src: &dyn Source) -> Validation {
             }
             k += 1;
         });
+        // The master: structure, rules and every texture decoded (a container is only
+        // parsed when every chunk's checksum held).
+        crate::master::load(src, chunks, c, true, &mut issues);
     }
     Validation {
         issues,

@@ -9,30 +9,54 @@ use crate::binary::{Sink, Span};
 use crate::chunk::{
     self, FourCC, ALIGN, ENTRY_LEN, HEADER_LEN, MAGIC, VERSION_MAJOR, VERSION_MINOR,
 };
+use crate::master::Master;
 use crate::model::{Codestream, Container, StreamRef};
 use crate::{checks, payload_write as pw, Error};
 
 /// The bytes of a `.pis` file holding `c`. Fails if `c` breaks a rule of the spec.
 pub fn to_bytes(c: &Container) -> Result<Vec<u8>, Error> {
-    Ok(serialize(c, false)?.bytes)
+    Ok(serialize(c, &[], false)?.bytes)
+}
+
+/// The bytes of a `.pis` file holding `c` and its lossless master (one [`Master`] per object,
+/// or none), the `MSTR` chunks after all others. Fails if either breaks a rule of the spec.
+pub fn to_bytes_with_masters(c: &Container, masters: &[Master]) -> Result<Vec<u8>, Error> {
+    Ok(serialize(c, masters, false)?.bytes)
 }
 
 /// Like [`to_bytes`], with a label for every field (for annotated hex dumps).
 pub fn to_bytes_labelled(c: &Container) -> Result<(Vec<u8>, Vec<Span>), Error> {
-    let s = serialize(c, true)?;
+    to_bytes_labelled_with_masters(c, &[])
+}
+
+/// Like [`to_bytes_with_masters`], with a label for every field.
+pub fn to_bytes_labelled_with_masters(c: &Container, masters: &[Master]) -> Result<(Vec<u8>, Vec<Span>), Error> {
+    let s = serialize(c, masters, true)?;
     Ok((s.bytes, s.spans.unwrap_or_default()))
 }
 
 /// Serializes without checking the model: for tests that need files breaking a rule.
 #[doc(hidden)]
 pub fn to_bytes_unchecked(c: &Container) -> Vec<u8> {
-    let s = serialize_inner(c, false);
+    let s = serialize_inner(c, &[], false);
     s.bytes
+}
+
+/// Serializes a container and masters without checking either: for tests that need files
+/// breaking a rule of the master.
+#[doc(hidden)]
+pub fn to_bytes_unchecked_with_masters(c: &Container, masters: &[Master]) -> Vec<u8> {
+    serialize_inner(c, masters, false).bytes
 }
 
 /// Writes `c` to `path` atomically; returns the file size.
 pub fn write(path: &Path, c: &Container) -> Result<u64, Error> {
-    let bytes = to_bytes(c)?;
+    write_with_masters(path, c, &[])
+}
+
+/// Writes `c` and its lossless master to `path` atomically; returns the file size.
+pub fn write_with_masters(path: &Path, c: &Container, masters: &[Master]) -> Result<u64, Error> {
+    let bytes = to_bytes_with_masters(c, masters)?;
     write_atomic(path, &bytes)?;
     Ok(bytes.len() as u64)
 }
@@ -63,9 +87,16 @@ struct Chunk {
     payload: Sink,
 }
 
-fn serialize(c: &Container, labelled: bool) -> Result<Sink, Error> {
+fn serialize(c: &Container, masters: &[Master], labelled: bool) -> Result<Sink, Error> {
     if let Some(issue) = checks::check(c).into_iter().next() {
         return Err(Error::InvalidModel(issue));
+    }
+    if let Some(issue) = crate::master::check(c, masters).into_iter().next() {
+        return Err(Error::InvalidModel(issue));
+    }
+    let too_long = masters.iter().flat_map(|m| &m.layers).flat_map(|l| &l.samples).find(|s| u32::try_from(s.len()).is_err());
+    if let Some(s) = too_long {
+        return Err(Error::Request(format!("a master codestream of {} bytes exceeds 4 GiB", s.len())));
     }
     for r in c
         .objects
@@ -82,14 +113,14 @@ fn serialize(c: &Container, labelled: bool) -> Result<Sink, Error> {
             )));
         }
     }
-    let sink = serialize_inner(c, labelled);
+    let sink = serialize_inner(c, masters, labelled);
     if let Some(issue) = checks::decoded_sizes(c, sink.len() as u64) {
         return Err(Error::InvalidModel(issue));
     }
     Ok(sink)
 }
 
-fn serialize_inner(c: &Container, labelled: bool) -> Sink {
+fn serialize_inner(c: &Container, masters: &[Master], labelled: bool) -> Sink {
     let mut chunks = Vec::new();
     let chunk = |fourcc: FourCC, fill: &mut dyn FnMut(&mut Sink)| {
         let mut payload = Sink::new(labelled);
@@ -129,6 +160,10 @@ fn serialize_inner(c: &Container, labelled: bool) -> Sink {
     });
     if let Some(p) = &c.provenance {
         chunks.push(chunk(chunk::PROV, &mut |s| pw::prov(s, p)));
+    }
+    // The master goes last: a file without one is byte for byte what it was before.
+    for m in masters {
+        chunks.push(chunk(chunk::MSTR, &mut |s| crate::master::write(s, m)));
     }
     assemble(chunks, labelled)
 }

@@ -10,7 +10,7 @@ mod common;
 use common::{reseal, u64_at};
 use pis_format::chunk::{ENTRY_LEN, HEADER_LEN};
 use pis_format::issue::RULES;
-use pis_format::samples::{minimal, tiny};
+use pis_format::samples::{master_of, minimal, tiny};
 use pis_format::*;
 
 /// A valid file with its field labels.
@@ -415,6 +415,44 @@ fn cases() -> Vec<(u16, Vec<u8>)> {
             p.settings.push(("anisotropy".into(), "32".into()));
         }),
     ));
+    // 91xx: the lossless master.
+    let c = tiny().unwrap();
+    let masters = master_of(&c).unwrap();
+    let with_master = || {
+        let (bytes, spans) = to_bytes_labelled_with_masters(&c, &masters).unwrap();
+        File { bytes, spans }
+    };
+    let edited = |edit: &dyn Fn(&mut Vec<Master>)| {
+        let mut m = masters.clone();
+        edit(&mut m);
+        to_bytes_unchecked_with_masters(&c, &m)
+    };
+    v.push((9100, with_master().set_u32("master layer 0 sample count", 1 << 30).reseal()));
+    v.push((9101, with_master().set_u32("master object index", 7).reseal()));
+    v.push((9102, edited(&|m| {
+        m[0].layers[0].samples.pop();
+    })));
+    v.push((9102, edited(&|m| {
+        m[0].layers.pop();
+    })));
+    v.push((9103, with_master().set_u8("master layer 0 codec", 2).reseal()));
+    v.push((9104, edited(&|m| m[0].area = f64::NAN)));
+    v.push((9105, edited(&|m| m[0].layers[0].samples[0].truncate(5))));
+    v.push((9106, edited(&|m| {
+        // A raw master texture holding a NaN.
+        let n = master::sample_layout(&c, &c.objects[0], 0, 0).unwrap().planes().iter().map(|p| (p.width * p.height * p.channels) as usize).sum::<usize>();
+        let mut values = vec![0.5f32; n];
+        values[3] = f32::NAN;
+        m[0].layers[0].codec = CodecId::Raw;
+        m[0].layers[0].samples[0] = values.iter().flat_map(|x| x.to_le_bytes()).collect();
+    })));
+    v.push((9107, {
+        let mut two = c.clone();
+        let mut second = two.objects[0].clone();
+        second.name = "second".into();
+        two.objects.push(second);
+        to_bytes_unchecked_with_masters(&two, &masters)
+    }));
     let _ = cstr;
     v
 }
@@ -439,7 +477,19 @@ fn every_rule_is_detected_by_its_crafted_file() {
             "rule {id}: {:?}",
             report.issues
         );
-        if is_error && ![8003, 8005, 8006].contains(&id) {
+        if is_error && (9100..9200).contains(&id) {
+            // Opening ignores the master (a player never reads it); reading it fails.
+            let r = PisReader::from_bytes(bytes).unwrap_or_else(|e| panic!("rule {id}: {e}"));
+            let failed = match r.masters() {
+                Err(e) => e.issue().is_some_and(|i| i.id == id),
+                Ok(ms) => ms.iter().any(|m| {
+                    m.layers.iter().enumerate().any(|(l, ml)| (0..ml.samples.len()).any(|s| {
+                        m.texture(r.container(), l, s).err().and_then(|e| e.issue().map(|i| i.id)) == Some(id)
+                    }))
+                }),
+            };
+            assert!(failed, "rule {id}: the master was read");
+        } else if is_error && ![8003, 8005, 8006].contains(&id) {
             // Open-time rules fail `open`; codestream rules fail when the texture is read.
             let err = PisReader::from_bytes(bytes)
                 .err()

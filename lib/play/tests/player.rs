@@ -78,6 +78,32 @@ fn a_frame_reads_only_the_codestreams_of_its_pyramid_paths() {
 }
 
 #[test]
+fn a_lossless_master_changes_no_frame_and_no_read() {
+    let Some(gpu) = gpu_or_skip("a_lossless_master_changes_no_frame_and_no_read") else { return };
+    let gpu = Arc::new(gpu);
+    // tiny.pis again, with every layer sample's texture kept as a lossless master.
+    let c = pis_format::PisReader::open(&tiny()).unwrap().load_all().unwrap();
+    let masters = pis_format::samples::master_of(&c).unwrap();
+    assert!(!masters.is_empty());
+    let dir = tempfile::tempdir().unwrap();
+    let with = dir.path().join("tiny-master.pis");
+    pis_format::write_with_masters(&with, &c, &masters).unwrap();
+    let mut plain = Player::open(gpu.clone(), &tiny(), PlayerOptions { workers: 1, ..Default::default() }).unwrap();
+    let mut mastered = Player::open(gpu, &with, PlayerOptions { workers: 1, ..Default::default() }).unwrap();
+    assert!(mastered.reader().has_master() && mastered.reader().master_bytes() > 0);
+    let size = plain.image_size();
+    for samples in [[0, 0], [1, 0], [1, 1], [0, 1], [0, 0]] {
+        let (a, sa) = plain.render_image(&at(&plain, &samples), size).unwrap();
+        let (b, sb) = mastered.render_image(&at(&mastered, &samples), size).unwrap();
+        let differ = a.rgba.iter().zip(&b.rgba).filter(|(x, y)| x.to_bits() != y.to_bits()).count();
+        assert_eq!(differ, 0, "point {samples:?}: {differ} values differ");
+        assert_eq!((sa.codestreams_read, sa.cache_hits, sa.cache_misses, sa.cache_bytes), (sb.codestreams_read, sb.cache_hits, sb.cache_misses, sb.cache_bytes), "point {samples:?}");
+    }
+    // Only level images were read: the same count and bytes as without the master.
+    assert_eq!(plain.reader().stats(), mastered.reader().stats());
+}
+
+#[test]
 fn multilinear_blend_is_the_weighted_sum_of_the_sample_frames() {
     let Some(gpu) = gpu_or_skip("multilinear_blend_is_the_weighted_sum_of_the_sample_frames") else { return };
     let gpu = Arc::new(gpu);

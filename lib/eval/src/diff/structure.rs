@@ -19,6 +19,8 @@ pub struct ChunkBytes {
     pub layer_index: u64,
     pub codestreams: u64,
     pub provenance: u64,
+    /// The lossless master (`MSTR`): stored for re-encoding, never read by a player.
+    pub master: u64,
     pub other: u64,
 }
 
@@ -34,6 +36,7 @@ impl ChunkBytes {
                 b"LAYR" => &mut b.layer_index,
                 b"CSTR" => &mut b.codestreams,
                 b"PROV" => &mut b.provenance,
+                b"MSTR" => &mut b.master,
                 _ => &mut b.other,
             };
             *slot += e.length;
@@ -43,7 +46,7 @@ impl ChunkBytes {
     }
 
     /// (kind, bytes) in report order.
-    pub fn rows(&self) -> [(&'static str, u64); 10] {
+    pub fn rows(&self) -> [(&'static str, u64); 11] {
         [
             ("header + table + padding", self.header),
             ("parameter space", self.parameter_space),
@@ -53,6 +56,7 @@ impl ChunkBytes {
             ("layer index", self.layer_index),
             ("codestreams", self.codestreams),
             ("provenance", self.provenance),
+            ("lossless master", self.master),
             ("other chunks", self.other),
             ("total", self.total),
         ]

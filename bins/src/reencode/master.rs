@@ -1,0 +1,93 @@
+//! Where `pis-reencode` takes its textures from: the file's lossless master (SPEC.md 6.7) or
+//! its decoded level images, one parameter block at a time; and how far a file's decoded
+//! textures are from the master.
+
+use pis_eval::diff::decode::decode_block;
+use pis_eval::metrics::SquaredError;
+use pis_format::blocks::BlockGrid;
+use pis_format::master::sample_point;
+use pis_format::{Container, Error, LevelLayout, Master, PisReader, StreamRef};
+use rayon::prelude::*;
+
+/// The linear textures of one parameter block.
+pub struct BlockSource {
+    pub layout: LevelLayout,
+    pub extent: Vec<u32>,
+    /// Per block-local sample (row-major over the extent): its linear values.
+    pub textures: Vec<Vec<f32>>,
+    /// Per block-local sample: its index in a table over the layer's dimensions.
+    pub tables: Vec<usize>,
+}
+
+/// The index of a layer sample (sample indices over the masked dimensions) in a table over
+/// them (SPEC.md 6.2).
+fn table_index<S>(c: &Container<S>, object: usize, layer: usize, key: &[u32]) -> usize {
+    let mask = c.objects[object].layers[layer].depends_on;
+    mask.dims().zip(key).fold(0usize, |a, (k, &s)| a * c.space.dims[k].values.len() + s as usize)
+}
+
+/// Every block of layer `layer` of object `object` from the master `m`: the textures exactly
+/// as the writer solved them.
+pub fn from_master(c: &Container<StreamRef>, m: &Master, object: usize, layer: usize) -> Result<Vec<BlockSource>, Error> {
+    let o = &c.objects[object];
+    let l = &o.layers[layer];
+    let grid = BlockGrid::new(&c.space, l.depends_on, &o.stagger);
+    let n = c.space.table_len(l.depends_on) as usize;
+    let all = (0..n).into_par_iter().map(|s| m.texture(c, layer, s)).collect::<Result<Vec<Vec<f32>>, Error>>()?;
+    let mut blocks: Vec<BlockSource> = l.blocks.iter().enumerate().map(|(bi, b)| {
+        let extent = grid.extent(bi);
+        let count = extent.iter().map(|&e| e as usize).product();
+        BlockSource { layout: LevelLayout::of(l, b), extent, textures: vec![Vec::new(); count], tables: vec![0; count] }
+    }).collect();
+    for (s, x) in all.into_iter().enumerate() {
+        let pos = grid.locate(&sample_point(c, l, s as u64));
+        let idx = pos.local.iter().zip(&pos.extent).fold(0usize, |a, (&i, &e)| a * e as usize + i as usize);
+        let b = blocks.get_mut(pos.block).ok_or_else(|| Error::Request(format!("object {object} layer {layer}: sample {s} lies in no block")))?;
+        b.textures[idx] = x;
+        b.tables[idx] = s;
+    }
+    Ok(blocks)
+}
+
+/// Every block of layer `layer` of object `object` decoded from the file's level images.
+pub fn from_decoded(r: &PisReader, object: usize, layer: usize) -> Result<Vec<BlockSource>, Error> {
+    let c = r.container();
+    (0..c.objects[object].layers[layer].blocks.len()).into_par_iter().map(|bi| {
+        let b = decode_block(r, object, layer, bi)?;
+        let tables = b.keys.iter().map(|k| table_index(c, object, layer, k)).collect();
+        Ok(BlockSource { layout: b.layout, extent: b.extent, textures: b.textures, tables })
+    }).collect()
+}
+
+/// Display error of `r`'s decoded textures against the master `masters` (one per object, of
+/// a file with the same objects and layers): per object and overall, each layer sample
+/// weighted by the parameter points that read it.
+pub fn error_against(r: &PisReader, masters: &[Master]) -> Result<(SquaredError, Vec<SquaredError>), Error> {
+    let c = r.container();
+    let points = c.space.point_count();
+    let mut total = SquaredError::default();
+    let mut objects = Vec::with_capacity(c.objects.len());
+    for (oi, o) in c.objects.iter().enumerate() {
+        let m = masters.iter().find(|m| m.object as usize == oi).ok_or_else(|| Error::Request(format!("object {oi} has no master")))?;
+        let mut obj = SquaredError::default();
+        for li in 0..o.layers.len() {
+            let multiplicity = points / c.space.table_len(o.layers[li].depends_on).max(1);
+            for b in from_decoded(r, oi, li)? {
+                let errors = b.textures.par_iter().zip(&b.tables).map(|(x, &t)| {
+                    let want = m.texture(c, li, t)?;
+                    let mut e = SquaredError::default();
+                    e.add_slices(x, &want);
+                    Ok(e)
+                }).collect::<Result<Vec<SquaredError>, Error>>()?;
+                for e in errors {
+                    obj.sum += e.sum * multiplicity as f64;
+                    obj.count += e.count * multiplicity;
+                    obj.max = obj.max.max(e.max);
+                }
+            }
+        }
+        total.merge(&obj);
+        objects.push(obj);
+    }
+    Ok((total, objects))
+}
