@@ -261,7 +261,10 @@ pub fn reencode(req: &ReencodeRequest) -> Result<ReencodeReport, Failure> {
             }.map_err(|e| in_file(&req.input, e))?;
             let blocks = sources.par_iter().map(|b| {
                 let samples: Vec<Vec<f32>> = b.textures.par_iter().map(|x| prepared(&layer, &b.layout, x, exact)).collect();
-                build_pyramid(oi, b.layout.planes(), &b.extent, &samples, layer_samples, exact, false).map_err(runtime)
+                let mut p = build_pyramid(oi, b.layout.planes(), &b.extent, &samples, layer_samples, exact, false).map_err(runtime)?;
+                // The master's screen weights: the allocation of the pack that wrote it.
+                p.texel_weights = b.weights.clone().filter(|_| !exact);
+                Ok(p)
             }).collect::<Result<Vec<BlockPyramid>, Failure>>()?;
             if req.keep_master && !from_master {
                 let mut table = vec![Vec::new(); layer_samples as usize];
@@ -351,7 +354,7 @@ pub fn reencode(req: &ReencodeRequest) -> Result<ReencodeReport, Failure> {
         masters_in.clone()
     } else {
         let a = areas.as_deref().unwrap_or(&[]);
-        let m = made.iter().enumerate().map(|(oi, textures)| Master::encode(&out, oi, a.get(oi).copied().unwrap_or(1.0), textures))
+        let m = made.iter().enumerate().map(|(oi, textures)| Master::encode(&out, oi, a.get(oi).copied().unwrap_or(1.0), textures, None))
             .collect::<Result<Vec<Master>, Error>>().map_err(|e| runtime(e.into()))?;
         t.done("master", &format!("decoded textures of {} objects coded losslessly", m.len()));
         m

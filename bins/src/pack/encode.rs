@@ -405,11 +405,20 @@ pub(crate) fn mip_chain(m: &ObjectModel, finest: Vec<f32>) -> Vec<f32> {
 
 /// The lossless master of every object (SPEC.md 6.7): each layer sample's finest solved
 /// texture, linear as solved, and the object's screen-area weight of allocation.
-pub(crate) fn masters(models: &[ObjectModel], packed: &Packed) -> Result<Vec<Master>> {
+pub(crate) fn masters(models: &[ObjectModel], packed: &Packed, samples: &[Vec<u32>], allocation: super::Allocation) -> Result<Vec<Master>> {
     models.iter().enumerate().map(|(mi, m)| {
         // Keys are sample indices over the layer's dimensions: their order is table order.
         let textures: Vec<Vec<Vec<f32>>> = m.layers.iter().map(|l| l.textures.values().map(|x| finest(m, x)).collect()).collect();
-        Ok(Master::encode(&packed.container, mi, m.area, &textures)?)
+        // The screen weights the allocation used, so that coding the master again allocates
+        // as this pack did.
+        let weights: Option<Vec<Vec<Vec<f32>>>> = (allocation == super::Allocation::Screen).then(|| {
+            let per_point = screen_weights_per_point(m);
+            m.layers.iter().map(|l| l.textures.keys().map(|k| {
+                let points: Vec<usize> = samples.iter().enumerate().filter(|(_, s)| key(s, l.depends_on) == *k).map(|(p, _)| p).collect();
+                sample_weights(&per_point, &points)
+            }).collect()).collect()
+        });
+        Ok(Master::encode(&packed.container, mi, m.area, &textures, weights.as_deref())?)
     }).collect()
 }
 

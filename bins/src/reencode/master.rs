@@ -17,6 +17,9 @@ pub struct BlockSource {
     pub textures: Vec<Vec<f32>>,
     /// Per block-local sample: its index in a table over the layer's dimensions.
     pub tables: Vec<usize>,
+    /// Per block-local sample: the master's screen weights (one per finest texel), where the
+    /// master carries them.
+    pub weights: Option<Vec<Vec<f32>>>,
 }
 
 /// The index of a layer sample (sample indices over the masked dimensions) in a table over
@@ -34,17 +37,22 @@ pub fn from_master(c: &Container<StreamRef>, m: &Master, object: usize, layer: u
     let grid = BlockGrid::new(&c.space, l.depends_on, &o.stagger);
     let n = c.space.table_len(l.depends_on) as usize;
     let all = (0..n).into_par_iter().map(|s| m.texture(c, layer, s)).collect::<Result<Vec<Vec<f32>>, Error>>()?;
+    let weights = (0..n).into_par_iter().map(|s| m.weights(c, layer, s)).collect::<Result<Vec<Option<Vec<f32>>>, Error>>()?;
+    let has_weights = weights.iter().all(Option::is_some) && n > 0;
     let mut blocks: Vec<BlockSource> = l.blocks.iter().enumerate().map(|(bi, b)| {
         let extent = grid.extent(bi);
         let count = extent.iter().map(|&e| e as usize).product();
-        BlockSource { layout: LevelLayout::of(l, b), extent, textures: vec![Vec::new(); count], tables: vec![0; count] }
+        BlockSource { layout: LevelLayout::of(l, b), extent, textures: vec![Vec::new(); count], tables: vec![0; count], weights: has_weights.then(|| vec![Vec::new(); count]) }
     }).collect();
-    for (s, x) in all.into_iter().enumerate() {
+    for (s, (x, w)) in all.into_iter().zip(weights).enumerate() {
         let pos = grid.locate(&sample_point(c, l, s as u64));
         let idx = pos.local.iter().zip(&pos.extent).fold(0usize, |a, (&i, &e)| a * e as usize + i as usize);
         let b = blocks.get_mut(pos.block).ok_or_else(|| Error::Request(format!("object {object} layer {layer}: sample {s} lies in no block")))?;
         b.textures[idx] = x;
         b.tables[idx] = s;
+        if let (Some(ws), Some(w)) = (b.weights.as_mut(), w) {
+            ws[idx] = w;
+        }
     }
     Ok(blocks)
 }
@@ -55,7 +63,7 @@ pub fn from_decoded(r: &PisReader, object: usize, layer: usize) -> Result<Vec<Bl
     (0..c.objects[object].layers[layer].blocks.len()).into_par_iter().map(|bi| {
         let b = decode_block(r, object, layer, bi)?;
         let tables = b.keys.iter().map(|k| table_index(c, object, layer, k)).collect();
-        Ok(BlockSource { layout: b.layout, extent: b.extent, textures: b.textures, tables })
+        Ok(BlockSource { layout: b.layout, extent: b.extent, textures: b.textures, tables, weights: None })
     }).collect()
 }
 

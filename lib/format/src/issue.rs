@@ -164,6 +164,7 @@ pub const RULES: &[(u16, &str)] = &[
     (9105, "master texture does not decode to its block's planes"),
     (9106, "decoded master value is not finite"),
     (9107, "some objects have a master and others do not"),
+    (9108, "master screen weights do not decode to one finite non-negative value per finest texel"),
 ];
 
 /// The short message of rule `id` ("unknown rule" for ids not in [`RULES`]).

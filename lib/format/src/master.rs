@@ -4,7 +4,7 @@
 //! leaves `MSTR` chunks alone when a file is opened and reads them on request
 //! ([`crate::PisReader::masters`]), verifying checksum, structure and the rules of 6.7.
 
-use pis_codec::{CodecError, CodecId, Rate};
+use pis_codec::{CodecError, CodecId, PlaneShape, Rate};
 
 use crate::binary::{Cursor, Sink};
 use crate::blocks::BlockGrid;
@@ -36,7 +36,15 @@ pub struct MasterLayer {
     /// (SPEC.md 6.2), each holding the linear values of every plane of the sample's block
     /// ([`LevelLayout::planes`] order, gamma 1, MIP levels as values, not residuals).
     pub samples: Vec<Vec<u8>>,
+    /// Screen weights, empty or one codestream per sample (same codec): one value per texel
+    /// of the sample's finest texture, how much of the screen the texel's error reaches (the
+    /// weights of the writer's screen-error allocation), so that a tool coding the master
+    /// again allocates as the writer did.
+    pub weights: Vec<Vec<u8>>,
 }
+
+/// Flag bit of a master layer: screen weights follow every sample's codestream.
+const HAS_WEIGHTS: u8 = 1;
 
 /// Sample indices, one per dimension of the space (0 along the dimensions the layer
 /// ignores), of entry `index` of a table over `layer`'s dependency mask.
@@ -62,7 +70,10 @@ pub fn sample_layout<S>(c: &Container<S>, o: &Object<S>, layer: usize, index: u6
 impl Master {
     /// Codes `textures[layer][sample]` (linear values of the planes of the sample's block,
     /// samples in table order) with the `lossless` codec.
-    pub fn encode<S>(c: &Container<S>, object: usize, area: f64, textures: &[Vec<Vec<f32>>]) -> Result<Master, Error> {
+    ///
+    /// `weights`, when given, are each sample's screen weights (one value per texel of its
+    /// finest texture), in the same order.
+    pub fn encode<S>(c: &Container<S>, object: usize, area: f64, textures: &[Vec<Vec<f32>>], weights: Option<&[Vec<Vec<f32>>]>) -> Result<Master, Error> {
         let o = c.objects.get(object).ok_or_else(|| Error::Request(format!("object {object} does not exist")))?;
         if textures.len() != o.layers.len() {
             return Err(Error::Request(format!("object {object} has {} layers, the master {}", o.layers.len(), textures.len())));
@@ -79,7 +90,21 @@ impl Master {
                 codec.encode(&layout.planes(), x, Rate::Default)
                     .map_err(|e| Error::Request(format!("object {object} layer {li} sample {s}: {e}")))
             }).collect::<Result<Vec<_>, Error>>()?;
-            layers.push(MasterLayer { codec: CodecId::Lossless, samples });
+            let weights = match weights.map(|w| w.get(li)) {
+                None => Vec::new(),
+                Some(None) => return Err(Error::Request(format!("object {object} layer {li}: no screen weights"))),
+                Some(Some(w)) => {
+                    if w.len() != t.len() {
+                        return Err(Error::Request(format!("object {object} layer {li}: {} screen weight maps for {} samples", w.len(), t.len())));
+                    }
+                    w.iter().enumerate().map(|(s, x)| {
+                        let layout = sample_layout(c, o, li, s as u64).ok_or_else(|| Error::Request(format!("object {object} layer {li}: no block holds sample {s}")))?;
+                        codec.encode(&[weight_plane(&layout)], x, Rate::Default)
+                            .map_err(|e| Error::Request(format!("object {object} layer {li} sample {s} screen weights: {e}")))
+                    }).collect::<Result<Vec<_>, Error>>()?
+                }
+            };
+            layers.push(MasterLayer { codec: CodecId::Lossless, samples, weights });
         }
         Ok(Master { object: object as u32, area, layers })
     }
@@ -103,10 +128,42 @@ impl Master {
         Ok(values)
     }
 
+    /// The screen weights of sample `sample` of layer `layer` (one per texel of its finest
+    /// texture), decoded and checked (rule 9108); None where the layer carries none.
+    pub fn weights<S>(&self, c: &Container<S>, layer: usize, sample: usize) -> Result<Option<Vec<f32>>, Error> {
+        let what = format!("master of object {} layer {layer} sample {sample} screen weights", self.object);
+        let (o, l) = c.objects.get(self.object as usize)
+            .and_then(|o| self.layers.get(layer).map(|l| (o, l)))
+            .ok_or_else(|| Error::Request(format!("{what} do not exist")))?;
+        if l.weights.is_empty() {
+            return Ok(None);
+        }
+        let bytes = l.weights.get(sample).ok_or_else(|| Error::Request(format!("{what} do not exist")))?;
+        let layout = sample_layout(c, o, layer, sample as u64).ok_or_else(|| Error::Request(format!("{what}: no block holds the sample")))?;
+        let values = pis_codec::decode(l.codec, &[weight_plane(&layout)], bytes).map_err(|e| match e {
+            CodecError::NotSupported(codec) => Error::NotSupported(format!("codec '{codec}' ({what})")),
+            e => Error::Invalid(Issue::new(9108, format!("{what}: {e}")).in_chunk("MSTR", usize::MAX)),
+        })?;
+        if let Some(bad) = values.iter().position(|v| !(v.is_finite() && *v >= 0.0)) {
+            return Err(Error::Invalid(Issue::new(9108, format!("{what}: value {bad} is {}", values[bad])).in_chunk("MSTR", usize::MAX)));
+        }
+        Ok(Some(values))
+    }
+
     /// Bytes of the master's payload in the file.
     pub fn payload_len(&self) -> u64 {
-        24 + self.layers.iter().map(|l| 8 + l.samples.iter().map(|s| 4 + s.len() as u64).sum::<u64>()).sum::<u64>()
+        24 + self.layers.iter().map(|l| {
+            8 + l.samples.iter().map(|s| 4 + s.len() as u64).sum::<u64>() + l.weights.iter().map(|s| 4 + s.len() as u64).sum::<u64>()
+        }).sum::<u64>()
     }
+}
+
+/// The plane of a sample's screen weights: one value per texel of its finest texture.
+fn weight_plane(layout: &LevelLayout) -> PlaneShape {
+    PlaneShape::new(layout.width, layout.height, 1)
+}
+
+impl Master {
 }
 
 /// Writes a master's payload.
@@ -118,11 +175,16 @@ pub(crate) fn write(s: &mut Sink, m: &Master) {
     s.u32(0, "master reserved");
     for (li, l) in m.layers.iter().enumerate() {
         s.u8(l.codec.code() as u8, &format!("master layer {li} codec"));
-        s.zeros(3, &format!("master layer {li} reserved"));
+        s.u8(if l.weights.is_empty() { 0 } else { HAS_WEIGHTS }, &format!("master layer {li} flags"));
+        s.zeros(2, &format!("master layer {li} reserved"));
         s.u32(l.samples.len() as u32, &format!("master layer {li} sample count"));
         for (si, b) in l.samples.iter().enumerate() {
             s.u32(b.len() as u32, &format!("master layer {li} sample {si} length"));
             s.raw(b, || format!("master layer {li} sample {si} codestream ({} bytes)", b.len()));
+            if let Some(w) = l.weights.get(si) {
+                s.u32(w.len() as u32, &format!("master layer {li} sample {si} weights length"));
+                s.raw(w, || format!("master layer {li} sample {si} screen weights ({} bytes)", w.len()));
+            }
         }
     }
 }
@@ -139,19 +201,29 @@ pub(crate) fn parse(c: &mut Cursor) -> Result<Master, Issue> {
     for li in 0..n {
         let at = c.offset();
         let code = c.u8("codec id")?;
-        c.reserved(3, "reserved")?;
+        let flags = c.u8("flags")?;
+        if flags & !HAS_WEIGHTS != 0 {
+            return Err(Issue::new(9100, format!("layer {li}: unknown flags {flags:#04x}")).in_chunk("MSTR", usize::MAX).at(at + 1));
+        }
+        c.reserved(2, "reserved")?;
         let codec = CodecId::from_code(code as u16).filter(|k| !k.is_lossy()).ok_or_else(|| {
             Issue::new(9103, format!("layer {li}: codec id {code}; a master uses raw (0) or lossless (1)")).in_chunk("MSTR", usize::MAX).at(at)
         })?;
         let count = c.u32("sample count")?;
         let count = c.expect_records(count as u64, 4, "master samples")?;
         let mut samples = Vec::with_capacity(count);
+        let mut weights = Vec::new();
         for _ in 0..count {
             let len = c.u32("sample length")?;
             let len = c.expect_records(len as u64, 1, "codestream bytes")?;
             samples.push(c.bytes(len, "codestream")?.to_vec());
+            if flags & HAS_WEIGHTS != 0 {
+                let len = c.u32("weights length")?;
+                let len = c.expect_records(len as u64, 1, "screen weight bytes")?;
+                weights.push(c.bytes(len, "screen weights")?.to_vec());
+            }
         }
-        layers.push(MasterLayer { codec, samples });
+        layers.push(MasterLayer { codec, samples, weights });
     }
     c.finish()?;
     Ok(Master { object, area, layers })
@@ -186,6 +258,9 @@ pub fn check<S>(c: &Container<S>, masters: &[Master]) -> Vec<Issue> {
             let want = c.space.table_len(l.depends_on);
             if ml.samples.len() as u64 != want {
                 out.push(e(9102, format!("object {oi} '{}' layer {li}: {} master samples, the layer has {want}", o.name, ml.samples.len())));
+            }
+            if !ml.weights.is_empty() && ml.weights.len() != ml.samples.len() {
+                out.push(e(9102, format!("object {oi} '{}' layer {li}: {} screen weight maps for {} master samples", o.name, ml.weights.len(), ml.samples.len())));
             }
         }
     }
@@ -234,6 +309,9 @@ pub(crate) fn load<S>(src: &dyn Source, entries: &[ChunkEntry], c: &Container<S>
             for (li, l) in m.layers.iter().enumerate() {
                 for s in 0..l.samples.len() {
                     if let Err(Error::Invalid(issue)) = m.texture(c, li, s) {
+                        issues.push(Issue { chunk: Some(("MSTR".into(), *i)), ..issue });
+                    }
+                    if let Err(Error::Invalid(issue)) = m.weights(c, li, s) {
                         issues.push(Issue { chunk: Some(("MSTR".into(), *i)), ..issue });
                     }
                 }

@@ -359,6 +359,6 @@ pub fn master_of(c: &Container) -> Result<Vec<crate::Master>, Error> {
                 Ok(r.texture(oi, li, &crate::master::sample_point(c, l, s))?.data)
             }).collect::<Result<Vec<_>, Error>>()
         }).collect::<Result<Vec<_>, Error>>()?;
-        crate::Master::encode(c, oi, 1.0, &textures)
+        crate::Master::encode(c, oi, 1.0, &textures, None)
     }).collect()
 }

@@ -104,3 +104,36 @@ fn damaged_masters_never_panic() {
     }
     assert!(rejected > 0);
 }
+
+#[test]
+fn screen_weights_round_trip_with_the_master() {
+    let c = tiny().unwrap();
+    let plain = master_of(&c).unwrap();
+    // Textures as the plain master holds them; weights 0, 1, 2, ... per finest texel.
+    let masters: Vec<Master> = plain.iter().map(|m| {
+        let o = &c.objects[m.object as usize];
+        let textures: Vec<Vec<Vec<f32>>> = (0..o.layers.len()).map(|l| (0..m.layers[l].samples.len()).map(|s| m.texture(&c, l, s).unwrap()).collect()).collect();
+        let weights: Vec<Vec<Vec<f32>>> = (0..o.layers.len()).map(|l| (0..m.layers[l].samples.len()).map(|s| {
+            let layout = master::sample_layout(&c, o, l, s as u64).unwrap();
+            (0..layout.width * layout.height).map(|k| (k % 7) as f32 * 0.5).collect()
+        }).collect()).collect();
+        Master::encode(&c, m.object as usize, m.area, &textures, Some(&weights)).unwrap()
+    }).collect();
+    let r = PisReader::from_bytes(to_bytes_with_masters(&c, &masters).unwrap()).unwrap();
+    let back = r.masters().unwrap();
+    assert_eq!(back, masters);
+    for m in &back {
+        let o = &c.objects[m.object as usize];
+        for l in 0..o.layers.len() {
+            for s in 0..m.layers[l].samples.len() {
+                let w = m.weights(&c, l, s).unwrap().expect("weights");
+                let layout = master::sample_layout(&c, o, l, s as u64).unwrap();
+                assert_eq!(w.len(), (layout.width * layout.height) as usize);
+                assert!(w.iter().enumerate().all(|(k, v)| *v == (k % 7) as f32 * 0.5));
+                assert_eq!(m.texture(&c, l, s).unwrap(), plain[m.object as usize].texture(&c, l, s).unwrap());
+            }
+        }
+    }
+    // the plain master carries none
+    assert!(plain[0].weights(&c, 0, 0).unwrap().is_none());
+}

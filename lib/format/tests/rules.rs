@@ -453,6 +453,29 @@ fn cases() -> Vec<(u16, Vec<u8>)> {
         two.objects.push(second);
         to_bytes_unchecked_with_masters(&two, &masters)
     }));
+    v.push((9100, with_master().set_u8("master layer 0 flags", 0x80).reseal()));
+    v.push((9108, edited(&|m| {
+        // Raw screen weights, one per finest texel, one of them negative.
+        let l = master::sample_layout(&c, &c.objects[0], 0, 0).unwrap();
+        let mut values = vec![1.0f32; (l.width * l.height) as usize];
+        values[2] = -1.0;
+        let layer = &mut m[0].layers[0];
+        layer.codec = CodecId::Raw;
+        layer.samples = layer.samples.iter().map(|_| {
+            let n = l.planes().iter().map(|p| (p.width * p.height * p.channels) as usize).sum::<usize>();
+            vec![0.5f32; n].iter().flat_map(|x| x.to_le_bytes()).collect()
+        }).collect();
+        layer.weights = layer.samples.iter().map(|_| values.iter().flat_map(|x| x.to_le_bytes()).collect()).collect();
+    })));
+    v.push((9108, edited(&|m| {
+        // Screen weights of the wrong size.
+        let layer = &mut m[0].layers[0];
+        layer.codec = CodecId::Raw;
+        let l = master::sample_layout(&c, &c.objects[0], 0, 0).unwrap();
+        let n = l.planes().iter().map(|p| (p.width * p.height * p.channels) as usize).sum::<usize>();
+        layer.samples = layer.samples.iter().map(|_| vec![0.5f32; n].iter().flat_map(|x| x.to_le_bytes()).collect()).collect();
+        layer.weights = layer.samples.iter().map(|_| vec![1.0f32; 3].iter().flat_map(|x| x.to_le_bytes()).collect()).collect();
+    })));
     let _ = cstr;
     v
 }
@@ -485,6 +508,7 @@ fn every_rule_is_detected_by_its_crafted_file() {
                 Ok(ms) => ms.iter().any(|m| {
                     m.layers.iter().enumerate().any(|(l, ml)| (0..ml.samples.len()).any(|s| {
                         m.texture(r.container(), l, s).err().and_then(|e| e.issue().map(|i| i.id)) == Some(id)
+                            || m.weights(r.container(), l, s).err().and_then(|e| e.issue().map(|i| i.id)) == Some(id)
                     }))
                 }),
             };
