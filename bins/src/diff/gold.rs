@@ -81,6 +81,8 @@ pub struct GoldReport {
     pub file: String,
     pub set: String,
     pub device: String,
+    /// Samples per pixel the player drew with (its default multisampling; 1: none).
+    pub msaa_samples: u32,
     /// Whole image, every point (display values, peak 1).
     pub psnr_db: Option<f64>,
     /// Every object's covered pixels pooled: the measure of pis-pack's predicted PSNR, which
@@ -175,6 +177,7 @@ pub fn gold(req: &GoldRequest) -> Result<GoldReport, Failure> {
     let gpu = Arc::new(Gpu::new().map_err(|e| failure(e.into()))?);
     let device = gpu.describe();
     let mut player = Player::open(gpu, &req.file, PlayerOptions::default()).map_err(|e| failure(e.into()))?;
+    let msaa_samples = player.multisample().samples;
     let names = player.object_names();
     let mut flips: Vec<(usize, FlipMean, Vec<FlipMean>)> = Vec::new();
     let mut heatmaps = Vec::new();
@@ -250,6 +253,7 @@ pub fn gold(req: &GoldRequest) -> Result<GoldReport, Failure> {
         file: req.file.display().to_string(),
         set: req.set.display().to_string(),
         device,
+        msaa_samples,
         psnr_db: psnr,
         covered_psnr_db: covered,
         flip_mean: total_flip.mean(),
@@ -276,7 +280,7 @@ fn fl(v: Option<f64>) -> String {
 pub fn render(r: &GoldReport) -> String {
     use std::fmt::Write;
     let mut s = String::new();
-    let _ = writeln!(s, "{} against the gold-standard set {} ({} points, {})", r.file, r.set, r.points.len(), r.device);
+    let _ = writeln!(s, "{} against the gold-standard set {} ({} points, {}, {})", r.file, r.set, r.points.len(), r.device, crate::play::headless::msaa_label(r.msaa_samples, pis_play::multisample::DEFAULT_SAMPLES));
     let _ = writeln!(s, "  PSNR (display values): whole image {} dB, objects' covered pixels {} dB", db(r.psnr_db), db(r.covered_psnr_db));
     let _ = writeln!(s, "  mean FLIP (sRGB images): {}", fl(r.flip_mean));
     let _ = writeln!(s, "  objects:                PSNR (dB)   mean FLIP   worst block");
