@@ -41,8 +41,9 @@ pub fn check_samples(requested: u32) -> Result<(), String> {
 }
 
 /// The samples per pixel of frames drawn into `colour` targets: `requested` where the device
-/// can multisample `colour` (and resolve it), the object-index format and the depth format
-/// that many times, else 1 with a note naming the format that cannot.
+/// can multisample `colour` (a float or normalized format, and resolve it by averaging),
+/// the object-index format and the depth format that many times, else 1 with a note naming
+/// the format that cannot.
 pub fn choose(gpu: &Gpu, requested: u32, colour: wgpu::TextureFormat) -> Multisample {
     if requested <= 1 {
         return Multisample { requested, samples: 1, note: None };
@@ -50,9 +51,11 @@ pub fn choose(gpu: &Gpu, requested: u32, colour: wgpu::TextureFormat) -> Multisa
     let mut missing = Vec::new();
     for (format, role, resolve) in [(colour, "colour", true), (ID_FORMAT, "object index", false), (DEPTH_FORMAT, "depth", false)] {
         let f = gpu.format_features(format);
+        // The resolve averages: the colour must be a float (or normalized) format.
+        let averaged = matches!(format.sample_type(None, None), Some(wgpu::TextureSampleType::Float { .. }));
         let ok = f.flags.sample_count_supported(requested)
             && f.allowed_usages.contains(wgpu::TextureUsages::RENDER_ATTACHMENT)
-            && (!resolve || f.flags.contains(wgpu::TextureFormatFeatureFlags::MULTISAMPLE_RESOLVE));
+            && (!resolve || (averaged && f.flags.contains(wgpu::TextureFormatFeatureFlags::MULTISAMPLE_RESOLVE)));
         if !ok {
             let what = if resolve { "multisampled and resolved" } else { "multisampled" };
             missing.push(format!("{role} format {format:?} cannot be {what} {requested}×"));

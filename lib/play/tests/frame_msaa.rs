@@ -99,3 +99,16 @@ fn frame_multisampling_keeps_interiors_exactly() {
     // a third change; at least a quarter must.
     assert!(mixed * 4 > silhouette, "{mixed} of {silhouette} silhouette pixels changed");
 }
+
+/// A colour format the device cannot resolve (integer formats never resolve) falls back to
+/// one sample per pixel with a note naming it; one sample asked for is one sample drawn.
+#[test]
+fn a_format_that_cannot_be_resolved_falls_back_to_one_sample() {
+    let Some(gpu) = gpu_or_skip("a_format_that_cannot_be_resolved_falls_back_to_one_sample") else { return };
+    let m = choose(&gpu, 4, wgpu::TextureFormat::Rgba32Uint);
+    assert_eq!((m.requested, m.samples), (4, 1));
+    let note = m.note.expect("a note says why");
+    assert!(note.contains("Rgba32Uint") && note.contains("1 sample per pixel"), "{note}");
+    let one = choose(&gpu, 1, offscreen_format(&gpu));
+    assert_eq!((one.requested, one.samples, one.note), (1, 1, None));
+}
