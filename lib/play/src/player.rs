@@ -331,7 +331,8 @@ impl Player {
     }
 
     /// Draws a frame into `view` (any colour format; linear radiance, so an `*Srgb` format
-    /// does the sRGB encoding) of `size`.
+    /// does the sRGB encoding) of `size`, with [`Player::multisample_for`] the format's
+    /// samples per pixel resolved into it.
     pub fn render_to_view(&mut self, req: &FrameRequest, view: &wgpu::TextureView, format: wgpu::TextureFormat, size: (u32, u32)) -> Result<FrameStats, PlayError> {
         Ok(self.frame(req, size, Target::View(view, format))?.1)
     }
