@@ -271,7 +271,7 @@ fn view_frame_is_the_offscreen_frame(gpu: &Arc<pis_play::Gpu>, msaa: u32) {
         wgpu::Extent3d { width: size.0, height: size.1, depth_or_array_layers: 1 },
     );
     gpu.queue.submit([enc.finish()]);
-    let bytes = pis_play::frame::map_read(&gpu, &buf).unwrap();
+    let bytes = pis_play::frame::map_read(gpu, &buf).unwrap();
     let mut drawn = 0;
     for y in 0..size.1 as usize {
         for x in 0..size.0 as usize {
