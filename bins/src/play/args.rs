@@ -42,7 +42,7 @@ fn parse_blend(s: &str) -> Result<pis_play::Blend, String> {
     }
 }
 
-fn parse_msaa(s: &str) -> Result<u32, String> {
+pub fn parse_msaa(s: &str) -> Result<u32, String> {
     let n = s.parse::<u32>().map_err(|_| format!("--msaa {s:?}: expected 1 or 4"))?;
     pis_play::multisample::check_samples(n).map(|()| n)
 }
