@@ -7,8 +7,10 @@
 //! pixel wholly one or the other. With n samples the depth test and the object-index test
 //! run per sample and the resolve averages the samples, so an edge pixel is the covered
 //! fraction of each surface. Shading stays once per pixel at its centre (no per-sample
-//! shading): a pixel whose samples all lie on one surface gets exactly the single-sample
-//! value, which is what pis-compile's hardware model predicts.
+//! shading): a pixel whose samples all lie on one triangle gets exactly the single-sample
+//! value, which is what pis-compile's hardware model predicts (also across a flat polygon's
+//! triangles, whose texture coordinates are one affine function; on a curved mesh's own
+//! edges each triangle shades the pixel at its centre, and the two values are mixed).
 
 use crate::frame::ID_FORMAT;
 use crate::gpu::Gpu;
