@@ -201,6 +201,9 @@ fn bad_arguments_and_missing_files() {
     assert_eq!(out.status.code(), Some(1), "{}", String::from_utf8_lossy(&out.stderr));
     let out = diff(&tiny, &tiny, &["--min-psnr", "abc"]);
     assert_eq!(out.status.code(), Some(1));
+    let out = diff(&tiny, &tiny, &["--msaa", "2"]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("expected 1 (off) or 4"), "{}", String::from_utf8_lossy(&out.stderr));
     let out = diff(&tiny, Path::new("/no/such/file.pis"), &[]);
     assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("/no/such/file.pis"));
@@ -243,6 +246,16 @@ fn against_the_set_pis_diff_and_pis_play_agree() {
     assert!(f > 0.0 && f < 1.0, "mean FLIP {f}");
     let points = d["points"].as_array().expect("points");
     assert_eq!(points.len(), p["points"].as_array().expect("points").len());
+    // The same samples per pixel, by default and at --msaa 1.
+    assert_eq!((&d["msaa_samples"], &d["msaa_requested"]), (&p["msaa_samples"], &p["msaa_requested"]));
+    let one = diff(packed(), set(), &["--json", "--msaa", "1"]);
+    assert_eq!(one.status.code(), Some(0), "{}", String::from_utf8_lossy(&one.stderr));
+    let d1 = json(&one);
+    let play1 = Command::new(env!("CARGO_BIN_EXE_pis-play")).arg(packed()).arg("--headless").arg("--compare").arg(set()).args(["--msaa", "1", "--json"]).output().expect("pis-play runs");
+    let p1 = json(&play1);
+    assert_eq!((&d1["msaa_samples"], &d1["msaa_requested"]), (&serde_json::json!(1), &serde_json::json!(1)));
+    close(&d1["psnr_db"], &p1["psnr_db"], "whole image, 1 sample");
+    close(&d1["covered_psnr_db"], &p1["covered_psnr_db"], "covered pixels, 1 sample");
     for pt in points {
         assert!(pt["psnr_db"].as_f64().is_some() && pt["flip_mean"].as_f64().is_some(), "{pt}");
     }

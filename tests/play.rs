@@ -84,7 +84,9 @@ fn compare_agrees_with_the_pack_prediction() {
         return;
     }
     let f = fixture();
-    let r = json(&play(&[os(&f.file), os("--headless"), os("--compare"), os(&f.set), os("--json")]));
+    // One sample per pixel, as pis-compile's hardware model (the prediction) draws.
+    let r = json(&play(&[os(&f.file), os("--headless"), os("--compare"), os(&f.set), os("--msaa"), os("1"), os("--json")]));
+    assert_eq!((r["msaa_samples"].as_u64(), r["msaa_requested"].as_u64()), (Some(1), Some(1)));
     let predicted = f.pack["psnr_db"].as_f64().expect("pack psnr_db");
     let covered = r["covered_psnr_db"].as_f64().expect("covered_psnr_db");
     assert!((covered - predicted).abs() <= 0.5, "played {covered:.2} dB, predicted {predicted:.2} dB");
@@ -100,6 +102,35 @@ fn compare_agrees_with_the_pack_prediction() {
         assert!((got - want).abs() <= 0.5, "{name}: played {got:.2} dB, predicted {want:.2} dB");
     }
     assert_eq!(r["points"].as_array().expect("points").len(), 4);
+}
+
+/// The gold standard's pixels are filtered (a Gaussian-weighted average of sub-pixel
+/// samples), so on silhouettes they mix an object with what lies behind it: 4 samples per
+/// pixel (the default) bring the whole image closer to it than 1.
+#[test]
+fn multisampling_brings_the_whole_image_closer_to_the_gold_standard() {
+    if !gpu_or_skip("multisampling_brings_the_whole_image_closer_to_the_gold_standard") {
+        return;
+    }
+    let f = fixture();
+    let compare = |msaa: Option<&str>| {
+        let mut args = vec![os(&f.file), os("--headless"), os("--compare"), os(&f.set), os("--json")];
+        if let Some(m) = msaa {
+            args.extend([os("--msaa"), os(m)]);
+        }
+        json(&play(&args))
+    };
+    let (one, four) = (compare(Some("1")), compare(None));
+    assert_eq!(four["msaa_requested"], 4, "4 samples by default");
+    if four["msaa_samples"] != 4 {
+        assert!(!in_ci(), "lavapipe multisamples the player's formats: {four}");
+        eprintln!("multisampling not supported by this adapter: skipped");
+        return;
+    }
+    let (a, b) = (one["psnr_db"].as_f64().expect("psnr_db"), four["psnr_db"].as_f64().expect("psnr_db"));
+    eprintln!("whole image: 1 sample {a:.2} dB, 4 samples {b:.2} dB");
+    assert!(b > a, "whole image: 1 sample {a:.2} dB, 4 samples {b:.2} dB");
+    assert_fails(&play(&[os(&tiny()), os("--headless"), os("--msaa"), os("2")]), 1, "msaa 2", "expected 1 (off) or 4");
 }
 
 #[test]

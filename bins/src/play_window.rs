@@ -69,8 +69,16 @@ pub fn try_run(args: &PlayArgs) -> Result<(), WindowFailure> {
             println!("{}", serde_json::to_string_pretty(&r).map_err(|e| Failure::new(Exit::Runtime, e))?);
         }
         eprintln!(
-            "pis-play: {} frames at {}×{} in {:.2} s: {:.1} fps (first frame left out); player {:.2} ms per frame (decode {:.2} ms, upload {:.2} ms)",
-            r.frames, r.frame_size[0], r.frame_size[1], r.seconds, r.fps, r.frame_ms, r.decode_ms, r.upload_ms
+            "pis-play: {} frames at {}×{} ({}) in {:.2} s: {:.1} fps (first frame left out); player {:.2} ms per frame (decode {:.2} ms, upload {:.2} ms)",
+            r.frames,
+            r.frame_size[0],
+            r.frame_size[1],
+            crate::play::headless::msaa_label(r.msaa_samples, r.msaa_requested),
+            r.seconds,
+            r.fps,
+            r.frame_ms,
+            r.decode_ms,
+            r.upload_ms
         );
         if let Some(p) = &args.screenshot {
             eprintln!("pis-play: frame {} saved to {}", r.frames, p.display());

@@ -44,11 +44,16 @@ struct Cli {
     /// The reference PSNR of --max-psnr-drop (dB), e.g. pis-pack's predicted PSNR.
     #[arg(long, value_name = "DB", allow_hyphen_values = true)]
     reference_psnr: Option<f64>,
+    /// Against a set: samples per pixel of the player's frames, as `pis-play --msaa` (4
+    /// antialiases silhouettes; 1 draws as pis-compile's hardware model, whose covered
+    /// pixels pis-pack's prediction measures: compare with the prediction at 1).
+    #[arg(long, default_value_t = pis_play::multisample::DEFAULT_SAMPLES, value_name = "1|4", value_parser = pis::play::args::parse_msaa)]
+    msaa: u32,
 }
 
 fn run(cli: Cli) -> Result<Exit, Failure> {
     if cli.b.is_dir() {
-        let req = GoldRequest { file: cli.a, set: cli.b, heatmaps: cli.heatmaps, min_psnr: cli.min_psnr, max_psnr_drop: cli.max_psnr_drop, reference_psnr: cli.reference_psnr };
+        let req = GoldRequest { file: cli.a, set: cli.b, heatmaps: cli.heatmaps, min_psnr: cli.min_psnr, max_psnr_drop: cli.max_psnr_drop, reference_psnr: cli.reference_psnr, msaa: cli.msaa };
         let report = gold(&req)?;
         if cli.json {
             let s = serde_json::to_string_pretty(&report).map_err(|e| Failure::new(Exit::Runtime, e))?;

@@ -38,6 +38,8 @@ pub struct GoldRequest {
     pub min_psnr: Option<f64>,
     pub max_psnr_drop: Option<f64>,
     pub reference_psnr: Option<f64>,
+    /// Samples per pixel the player draws with (1 or 4, as `pis-play --msaa`).
+    pub msaa: u32,
 }
 
 #[derive(Clone, Debug, Serialize)]
@@ -81,6 +83,10 @@ pub struct GoldReport {
     pub file: String,
     pub set: String,
     pub device: String,
+    /// Samples per pixel the player drew with (its default multisampling; 1: none).
+    pub msaa_samples: u32,
+    /// Samples per pixel asked for (`--msaa`).
+    pub msaa_requested: u32,
     /// Whole image, every point (display values, peak 1).
     pub psnr_db: Option<f64>,
     /// Every object's covered pixels pooled: the measure of pis-pack's predicted PSNR, which
@@ -174,7 +180,11 @@ pub fn gold(req: &GoldRequest) -> Result<GoldReport, Failure> {
 
     let gpu = Arc::new(Gpu::new().map_err(|e| failure(e.into()))?);
     let device = gpu.describe();
-    let mut player = Player::open(gpu, &req.file, PlayerOptions::default()).map_err(|e| failure(e.into()))?;
+    let mut player = Player::open(gpu, &req.file, PlayerOptions { msaa: req.msaa, ..PlayerOptions::default() }).map_err(|e| failure(e.into()))?;
+    let msaa_samples = player.multisample().samples;
+    if let Some(note) = &player.multisample().note {
+        eprintln!("pis-diff: note: {note}");
+    }
     let names = player.object_names();
     let mut flips: Vec<(usize, FlipMean, Vec<FlipMean>)> = Vec::new();
     let mut heatmaps = Vec::new();
@@ -250,6 +260,8 @@ pub fn gold(req: &GoldRequest) -> Result<GoldReport, Failure> {
         file: req.file.display().to_string(),
         set: req.set.display().to_string(),
         device,
+        msaa_samples,
+        msaa_requested: req.msaa,
         psnr_db: psnr,
         covered_psnr_db: covered,
         flip_mean: total_flip.mean(),
@@ -276,7 +288,7 @@ fn fl(v: Option<f64>) -> String {
 pub fn render(r: &GoldReport) -> String {
     use std::fmt::Write;
     let mut s = String::new();
-    let _ = writeln!(s, "{} against the gold-standard set {} ({} points, {})", r.file, r.set, r.points.len(), r.device);
+    let _ = writeln!(s, "{} against the gold-standard set {} ({} points, {}, {})", r.file, r.set, r.points.len(), r.device, crate::play::headless::msaa_label(r.msaa_samples, r.msaa_requested));
     let _ = writeln!(s, "  PSNR (display values): whole image {} dB, objects' covered pixels {} dB", db(r.psnr_db), db(r.covered_psnr_db));
     let _ = writeln!(s, "  mean FLIP (sRGB images): {}", fl(r.flip_mean));
     let _ = writeln!(s, "  objects:                PSNR (dB)   mean FLIP   worst block");

@@ -42,6 +42,11 @@ fn parse_blend(s: &str) -> Result<pis_play::Blend, String> {
     }
 }
 
+pub fn parse_msaa(s: &str) -> Result<u32, String> {
+    let n = s.parse::<u32>().map_err(|_| format!("--msaa {s:?}: expected 1 or 4"))?;
+    pis_play::multisample::check_samples(n).map(|()| n)
+}
+
 fn parse_reduction(s: &str) -> Result<u32, String> {
     s.parse::<u32>().ok().filter(|r| r.is_power_of_two()).ok_or_else(|| format!("--reduction {s:?}: expected a power of two (1, 2, 4, …)"))
 }
@@ -97,6 +102,12 @@ pub struct PlayArgs {
     /// Texture resolution reduction (power of two): 2 draws textures at half resolution.
     #[arg(long, default_value = "1", value_parser = parse_reduction)]
     pub reduction: u32,
+    /// Samples per pixel: 4 antialiases object silhouettes (depth and object index per
+    /// sample, shading once per pixel at its centre, samples averaged), as the ray-traced
+    /// gold standard's filtered pixels are; 1 draws each pixel wholly one surface. Where
+    /// the GPU cannot multisample the frame's formats, 1 with a note.
+    #[arg(long, default_value_t = pis_play::multisample::DEFAULT_SAMPLES, value_name = "1|4", value_parser = parse_msaa)]
+    pub msaa: u32,
     /// Memory for decoded level images, MiB.
     #[arg(long, default_value_t = 512)]
     pub cache_mb: u64,
@@ -138,6 +149,7 @@ impl PlayArgs {
             workers: self.workers.unwrap_or(d.workers).max(1),
             reduction: self.reduction,
             blend: self.blend,
+            msaa: self.msaa,
             ..d
         }
     }

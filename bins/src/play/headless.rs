@@ -31,6 +31,10 @@ pub struct PathReport {
     pub size: [u32; 2],
     pub blend: String,
     pub reduction: u32,
+    /// Samples per pixel drawn with (multisample antialiasing; 1: none).
+    pub msaa_samples: u32,
+    /// Samples per pixel asked for (`--msaa`).
+    pub msaa_requested: u32,
     pub workers: usize,
     pub frames: usize,
     pub frame_ms_mean: f64,
@@ -87,12 +91,22 @@ pub struct CompareReport {
     pub adapter: String,
     pub blend: String,
     pub reduction: u32,
+    /// Samples per pixel drawn with (multisample antialiasing; 1: none).
+    pub msaa_samples: u32,
+    /// Samples per pixel asked for (`--msaa`).
+    pub msaa_requested: u32,
     /// Whole image, every point.
     pub psnr_db: f64,
     /// Every object's covered pixels pooled (pis-pack's predicted `psnr_db` measure).
     pub covered_psnr_db: f64,
     pub objects: Vec<ObjectRow>,
     pub points: Vec<PointRow>,
+}
+
+/// "msaa 4×", "msaa off", or "msaa off (4× asked, not supported)".
+pub fn msaa_label(samples: u32, requested: u32) -> String {
+    let used = if samples > 1 { format!("msaa {samples}×") } else { "msaa off".to_string() };
+    if samples == requested { used } else { format!("{used} ({requested}× asked, not supported)") }
 }
 
 fn blend_name(b: pis_play::Blend) -> String {
@@ -109,6 +123,9 @@ pub fn open(args: &PlayArgs) -> Result<(Arc<Gpu>, Player), Failure> {
         // Name the file where the message does not.
         if message.contains(&path) { f } else { Failure::new(f.exit, f.error.context(path)) }
     })?;
+    if let Some(note) = &player.multisample().note {
+        eprintln!("pis-play: note: {note}");
+    }
     Ok((gpu, player))
 }
 
@@ -238,6 +255,8 @@ pub fn run_frames(args: &PlayArgs, gpu: &Gpu, player: &mut Player) -> Result<Pat
         size: [size.0, size.1],
         blend: blend_name(o.blend),
         reduction: o.reduction,
+        msaa_samples: player.multisample().samples,
+        msaa_requested: player.multisample().requested,
         workers: o.workers,
         frames: all.len(),
         frame_ms_mean: fm,
@@ -257,7 +276,7 @@ pub fn run_frames(args: &PlayArgs, gpu: &Gpu, player: &mut Player) -> Result<Pat
 }
 
 pub fn print_path_report(r: &PathReport, w: &mut impl std::io::Write) -> std::io::Result<()> {
-    writeln!(w, "pis-play {} ({}x{}, blend {}, reduction {}, {} decoding threads)", r.file, r.size[0], r.size[1], r.blend, r.reduction, r.workers)?;
+    writeln!(w, "pis-play {} ({}x{}, blend {}, reduction {}, {}, {} decoding threads)", r.file, r.size[0], r.size[1], r.blend, r.reduction, msaa_label(r.msaa_samples, r.msaa_requested), r.workers)?;
     writeln!(w, "  adapter: {}", r.adapter)?;
     writeln!(w, "  frames: {}", r.frames)?;
     writeln!(w, "  frame ms: mean {:.2} ({:.1} fps), worst {:.2} ({:.1} fps)", r.frame_ms_mean, r.fps_mean, r.frame_ms_worst, r.fps_worst)?;
@@ -295,6 +314,8 @@ pub fn run_compare(args: &PlayArgs, set: &Path, gpu: &Gpu, player: &mut Player) 
         adapter: gpu.describe(),
         blend: blend_name(o.blend),
         reduction: o.reduction,
+        msaa_samples: player.multisample().samples,
+        msaa_requested: player.multisample().requested,
         psnr_db: c.psnr_db,
         covered_psnr_db: c.covered_psnr_db,
         objects: c
@@ -307,7 +328,7 @@ pub fn run_compare(args: &PlayArgs, set: &Path, gpu: &Gpu, player: &mut Player) 
 }
 
 pub fn print_compare_report(r: &CompareReport, w: &mut impl std::io::Write) -> std::io::Result<()> {
-    writeln!(w, "pis-play {} against {} (blend {}, reduction {})", r.file, r.set, r.blend, r.reduction)?;
+    writeln!(w, "pis-play {} against {} (blend {}, reduction {}, {})", r.file, r.set, r.blend, r.reduction, msaa_label(r.msaa_samples, r.msaa_requested))?;
     writeln!(w, "  adapter: {}", r.adapter)?;
     writeln!(w, "  PSNR (display values): whole image {:.2} dB, objects' covered pixels {:.2} dB", r.psnr_db, r.covered_psnr_db)?;
     for o in &r.objects {

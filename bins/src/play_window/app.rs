@@ -72,6 +72,10 @@ pub struct RunReport {
     pub decode_ms: f64,
     pub upload_ms: f64,
     pub frame_size: [u32; 2],
+    /// Samples per pixel drawn with (multisample antialiasing; 1: none).
+    pub msaa_samples: u32,
+    /// Samples per pixel asked for (`--msaa`).
+    pub msaa_requested: u32,
 }
 
 /// Why a window run ended without success.
@@ -190,7 +194,10 @@ impl App {
         let (gpu, caps) = Gpu::for_surface(&self.instance, &surface, o.gpu).map_err(play_failure)?;
         let gpu = Arc::new(gpu);
         let surface = WindowSurface::new(surface, caps, &gpu.device, &window, o.vsync).map_err(runtime)?;
-        let player = Player::open(gpu.clone(), &o.file, o.player.clone()).map_err(play_failure)?;
+        let mut player = Player::open(gpu.clone(), &o.file, o.player.clone()).map_err(play_failure)?;
+        if let Some(note) = &player.multisample_for(surface.view_format).note {
+            eprintln!("pis-play: note: {note}");
+        }
 
         let space = Space::new(player.dimensions());
         let point = match &o.at {
@@ -358,6 +365,7 @@ impl Running {
             adapter: &self.adapter,
             frame_size: size,
             image_size: self.player.image_size(),
+            msaa: self.player.multisample_for(self.surface.view_format).samples,
             stats: shown,
             cache_hits: self.last_stats.cache_hits,
             cache_misses: self.last_stats.cache_misses,
@@ -463,6 +471,8 @@ impl Running {
                 decode_ms: self.sum.1 / timed,
                 upload_ms: self.sum.2 / timed,
                 frame_size: [size.0, size.1],
+                msaa_samples: self.player.multisample_for(self.surface.view_format).samples,
+                msaa_requested: self.player.options().msaa,
             }));
         }
         Ok(None)

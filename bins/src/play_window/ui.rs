@@ -13,6 +13,8 @@ pub struct PanelInfo<'a> {
     pub adapter: &'a str,
     pub frame_size: (u32, u32),
     pub image_size: (u32, u32),
+    /// Samples per pixel the frames are drawn with (multisample antialiasing; 1: none).
+    pub msaa: u32,
     pub stats: Shown,
     pub cache_hits: u64,
     pub cache_misses: u64,
@@ -200,6 +202,7 @@ fn stats(ui: &mut Ui, info: &PanelInfo) {
         row("hits / misses", format!("{} / {}", info.cache_hits, info.cache_misses));
         row("frame size", format!("{}×{}", info.frame_size.0, info.frame_size.1));
         row("traced size", format!("{}×{}", info.image_size.0, info.image_size.1));
+        row("msaa", if info.msaa > 1 { format!("{}×", info.msaa) } else { "off".into() });
     });
     ui.add(egui::Label::new(egui::RichText::new(info.adapter).small()).wrap());
 }

@@ -2,7 +2,9 @@
 //! pixel's nearest surface, then one additive draw per object, layer and parameter sample,
 //! with the block's affine texture transform in the vertex shader and the hardware model's
 //! LOD and sampler in the fragment shader. Layers add in linear space (SPEC.md "Combining
-//! layers": surface layers combine by addition).
+//! layers": surface layers combine by addition). With more than one sample per pixel
+//! (`multisample.rs`) depth and object indices are kept per sample and the colour is
+//! resolved into the target.
 
 use std::collections::HashMap;
 
@@ -84,15 +86,19 @@ pub struct LayerDraw<'a> {
     pub anisotropic: bool,
 }
 
-/// The frame's pipelines: object index and depth, and additive layers per target format.
+/// The frame's pipelines: object index and depth per sample count, and additive layers per
+/// target format and sample count.
 pub struct FramePipelines {
     module: wgpu::ShaderModule,
     uniform_layout: wgpu::BindGroupLayout,
     draw_layout: wgpu::BindGroupLayout,
     ids_layout: wgpu::BindGroupLayout,
+    ids_ms_layout: wgpu::BindGroupLayout,
+    id_layout: wgpu::PipelineLayout,
     layer_layout: wgpu::PipelineLayout,
-    id_pipeline: wgpu::RenderPipeline,
-    layer_pipelines: HashMap<wgpu::TextureFormat, wgpu::RenderPipeline>,
+    layer_ms_layout: wgpu::PipelineLayout,
+    id_pipelines: HashMap<u32, wgpu::RenderPipeline>,
+    layer_pipelines: HashMap<(wgpu::TextureFormat, u32), wgpu::RenderPipeline>,
 }
 
 const POSITION_LAYOUT: wgpu::VertexBufferLayout<'static> = wgpu::VertexBufferLayout {
@@ -112,6 +118,11 @@ fn entry(binding: u32, visibility: wgpu::ShaderStages, ty: wgpu::BindingType) ->
 
 const UNIFORM: wgpu::BindingType = wgpu::BindingType::Buffer { ty: wgpu::BufferBindingType::Uniform, has_dynamic_offset: false, min_binding_size: None };
 
+/// `count` samples per pixel, every sample written.
+fn multisample(count: u32) -> wgpu::MultisampleState {
+    wgpu::MultisampleState { count, mask: !0, alpha_to_coverage_enabled: false }
+}
+
 impl FramePipelines {
     pub fn new(gpu: &Gpu) -> FramePipelines {
         let d = &gpu.device;
@@ -126,41 +137,63 @@ impl FramePipelines {
                 entry(2, wgpu::ShaderStages::FRAGMENT, wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering)),
             ],
         });
-        let ids_layout = d.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("frame ids"),
-            entries: &[entry(0, wgpu::ShaderStages::FRAGMENT, wgpu::BindingType::Texture { sample_type: wgpu::TextureSampleType::Uint, view_dimension: wgpu::TextureViewDimension::D2, multisampled: false })],
-        });
+        let ids_entry = |binding, multisampled| entry(binding, wgpu::ShaderStages::FRAGMENT, wgpu::BindingType::Texture { sample_type: wgpu::TextureSampleType::Uint, view_dimension: wgpu::TextureViewDimension::D2, multisampled });
+        let ids_layout = d.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some("frame ids"), entries: &[ids_entry(0, false)] });
+        let ids_ms_layout = d.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some("frame ids per sample"), entries: &[ids_entry(1, true)] });
         let id_layout = d.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor { label: Some("frame ids"), bind_group_layouts: &[Some(&uniform_layout)], immediate_size: 0 });
         let layer_layout = d.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor { label: Some("frame layers"), bind_group_layouts: &[Some(&draw_layout), Some(&ids_layout)], immediate_size: 0 });
-        let id_pipeline = d.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("frame ids"),
-            layout: Some(&id_layout),
-            vertex: wgpu::VertexState { module: &module, entry_point: Some("vs_main"), compilation_options: Default::default(), buffers: &[Some(POSITION_LAYOUT), Some(UV_LAYOUT)] },
-            primitive: wgpu::PrimitiveState { topology: wgpu::PrimitiveTopology::TriangleList, cull_mode: None, ..Default::default() },
-            depth_stencil: Some(wgpu::DepthStencilState {
-                format: DEPTH_FORMAT,
-                depth_write_enabled: Some(true),
-                depth_compare: Some(wgpu::CompareFunction::Less),
-                stencil: Default::default(),
-                bias: Default::default(),
-            }),
-            multisample: Default::default(),
-            fragment: Some(wgpu::FragmentState {
-                module: &module,
-                entry_point: Some("fs_id"),
-                compilation_options: Default::default(),
-                targets: &[Some(wgpu::ColorTargetState { format: ID_FORMAT, blend: None, write_mask: wgpu::ColorWrites::ALL })],
-            }),
-            multiview_mask: None,
-            cache: None,
-        });
-        FramePipelines { module, uniform_layout, draw_layout, ids_layout, layer_layout, id_pipeline, layer_pipelines: HashMap::new() }
+        let layer_ms_layout = d.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor { label: Some("frame layers per sample"), bind_group_layouts: &[Some(&draw_layout), Some(&ids_ms_layout)], immediate_size: 0 });
+        let mut pipes = FramePipelines {
+            module,
+            uniform_layout,
+            draw_layout,
+            ids_layout,
+            ids_ms_layout,
+            id_layout,
+            layer_layout,
+            layer_ms_layout,
+            id_pipelines: HashMap::new(),
+            layer_pipelines: HashMap::new(),
+        };
+        pipes.id_pipeline(gpu, 1);
+        pipes
     }
 
-    /// The additive layer pipeline for a target format (compiled on first use).
-    pub fn layer_pipeline(&mut self, gpu: &Gpu, format: wgpu::TextureFormat) -> &wgpu::RenderPipeline {
-        let (module, layout) = (&self.module, &self.layer_layout);
-        self.layer_pipelines.entry(format).or_insert_with(|| {
+    /// The object-index and depth pipeline for `samples` per pixel (compiled on first use).
+    pub fn id_pipeline(&mut self, gpu: &Gpu, samples: u32) -> &wgpu::RenderPipeline {
+        let (module, layout) = (&self.module, &self.id_layout);
+        self.id_pipelines.entry(samples).or_insert_with(|| {
+            gpu.device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+                label: Some("frame ids"),
+                layout: Some(layout),
+                vertex: wgpu::VertexState { module, entry_point: Some("vs_main"), compilation_options: Default::default(), buffers: &[Some(POSITION_LAYOUT), Some(UV_LAYOUT)] },
+                primitive: wgpu::PrimitiveState { topology: wgpu::PrimitiveTopology::TriangleList, cull_mode: None, ..Default::default() },
+                depth_stencil: Some(wgpu::DepthStencilState {
+                    format: DEPTH_FORMAT,
+                    depth_write_enabled: Some(true),
+                    depth_compare: Some(wgpu::CompareFunction::Less),
+                    stencil: Default::default(),
+                    bias: Default::default(),
+                }),
+                multisample: multisample(samples),
+                fragment: Some(wgpu::FragmentState {
+                    module,
+                    entry_point: Some("fs_id"),
+                    compilation_options: Default::default(),
+                    targets: &[Some(wgpu::ColorTargetState { format: ID_FORMAT, blend: None, write_mask: wgpu::ColorWrites::ALL })],
+                }),
+                multiview_mask: None,
+                cache: None,
+            })
+        })
+    }
+
+    /// The additive layer pipeline for a target format and `samples` per pixel (compiled on
+    /// first use): `fs_layer`, or `fs_layer_ms` with object indices per sample.
+    pub fn layer_pipeline(&mut self, gpu: &Gpu, format: wgpu::TextureFormat, samples: u32) -> &wgpu::RenderPipeline {
+        let module = &self.module;
+        let (layout, entry_point) = if samples > 1 { (&self.layer_ms_layout, "fs_layer_ms") } else { (&self.layer_layout, "fs_layer") };
+        self.layer_pipelines.entry((format, samples)).or_insert_with(|| {
             let add = wgpu::BlendComponent { src_factor: wgpu::BlendFactor::One, dst_factor: wgpu::BlendFactor::One, operation: wgpu::BlendOperation::Add };
             let max = wgpu::BlendComponent { src_factor: wgpu::BlendFactor::One, dst_factor: wgpu::BlendFactor::One, operation: wgpu::BlendOperation::Max };
             gpu.device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
@@ -175,10 +208,10 @@ impl FramePipelines {
                     stencil: Default::default(),
                     bias: Default::default(),
                 }),
-                multisample: Default::default(),
+                multisample: multisample(samples),
                 fragment: Some(wgpu::FragmentState {
                     module,
-                    entry_point: Some("fs_layer"),
+                    entry_point: Some(entry_point),
                     compilation_options: Default::default(),
                     targets: &[Some(wgpu::ColorTargetState { format, blend: Some(wgpu::BlendState { color: add, alpha: max }), write_mask: wgpu::ColorWrites::ALL })],
                 }),
@@ -199,35 +232,65 @@ pub fn offscreen_format(gpu: &Gpu) -> wgpu::TextureFormat {
     }
 }
 
-/// The per-size targets: object indices, depth, and the offscreen colour target.
+/// The multisampled attachments of a frame drawn with more than one sample per pixel: object
+/// indices and depth per sample, and a colour attachment per target format, resolved into
+/// the frame's target.
+struct SampleTargets {
+    ids: wgpu::Texture,
+    depth: wgpu::Texture,
+    ids_bind: wgpu::BindGroup,
+    colour: HashMap<wgpu::TextureFormat, wgpu::Texture>,
+}
+
+/// The per-size targets: object indices (one per pixel, at its centre), depth, the offscreen
+/// colour target, and with `samples` > 1 the multisampled attachments.
 pub struct Targets {
     pub size: (u32, u32),
+    pub samples: u32,
     pub ids: wgpu::Texture,
     pub depth: wgpu::Texture,
     pub colour: wgpu::Texture,
     ids_bind: wgpu::BindGroup,
+    multi: Option<SampleTargets>,
+}
+
+fn target_texture(gpu: &Gpu, label: &str, size: (u32, u32), samples: u32, format: wgpu::TextureFormat, usage: wgpu::TextureUsages) -> wgpu::Texture {
+    gpu.device.create_texture(&wgpu::TextureDescriptor {
+        label: Some(label),
+        size: wgpu::Extent3d { width: size.0, height: size.1, depth_or_array_layers: 1 },
+        mip_level_count: 1,
+        sample_count: samples,
+        dimension: wgpu::TextureDimension::D2,
+        format,
+        usage,
+        view_formats: &[],
+    })
 }
 
 impl Targets {
-    pub fn new(gpu: &Gpu, pipes: &FramePipelines, size: (u32, u32)) -> Result<Targets, PlayError> {
+    /// Targets of `size` for frames of `samples` per pixel (1, or a count
+    /// [`crate::multisample::choose`] found supported).
+    pub fn new(gpu: &Gpu, pipes: &FramePipelines, size: (u32, u32), samples: u32) -> Result<Targets, PlayError> {
         let limit = gpu.limits.max_texture_dimension_2d;
         if size.0 == 0 || size.1 == 0 || size.0 > limit || size.1 > limit {
             return Err(PlayError::TargetSize { width: size.0, height: size.1, limit });
         }
-        let extent = wgpu::Extent3d { width: size.0, height: size.1, depth_or_array_layers: 1 };
-        let make = |label, format, usage| {
-            gpu.device.create_texture(&wgpu::TextureDescriptor { label: Some(label), size: extent, mip_level_count: 1, sample_count: 1, dimension: wgpu::TextureDimension::D2, format, usage, view_formats: &[] })
+        let attach = wgpu::TextureUsages::RENDER_ATTACHMENT;
+        let ids = target_texture(gpu, "object ids", size, 1, ID_FORMAT, attach | wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_SRC);
+        let depth = target_texture(gpu, "depth", size, 1, DEPTH_FORMAT, attach);
+        let colour = target_texture(gpu, "frame", size, 1, offscreen_format(gpu), attach | wgpu::TextureUsages::COPY_SRC);
+        let bind = |texture: &wgpu::Texture, layout, binding| {
+            let view = texture.create_view(&Default::default());
+            gpu.device.create_bind_group(&wgpu::BindGroupDescriptor { label: Some("object ids"), layout, entries: &[wgpu::BindGroupEntry { binding, resource: wgpu::BindingResource::TextureView(&view) }] })
         };
-        let ids = make("object ids", ID_FORMAT, wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_SRC);
-        let depth = make("depth", DEPTH_FORMAT, wgpu::TextureUsages::RENDER_ATTACHMENT);
-        let colour = make("frame", offscreen_format(gpu), wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC);
-        let ids_view = ids.create_view(&Default::default());
-        let ids_bind = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("object ids"),
-            layout: &pipes.ids_layout,
-            entries: &[wgpu::BindGroupEntry { binding: 0, resource: wgpu::BindingResource::TextureView(&ids_view) }],
+        let ids_bind = bind(&ids, &pipes.ids_layout, 0);
+        let multi = (samples > 1).then(|| {
+            let ids = target_texture(gpu, "object ids per sample", size, samples, ID_FORMAT, attach | wgpu::TextureUsages::TEXTURE_BINDING);
+            let depth = target_texture(gpu, "depth per sample", size, samples, DEPTH_FORMAT, attach);
+            let ids_bind = bind(&ids, &pipes.ids_ms_layout, 1);
+            SampleTargets { ids, depth, ids_bind, colour: HashMap::new() }
         });
-        Ok(Targets { size, ids, depth, colour, ids_bind })
+        Ok(Targets { size, samples, ids, depth, colour, ids_bind, multi })
     }
 }
 
@@ -259,20 +322,59 @@ fn uniforms(clip_from_object: glam::Mat4, object: u32, layer: Option<&LayerDraw>
     u
 }
 
+/// The object-index pass: clears `ids` and `depth`, then draws every object's index and
+/// depth, nearest surface winning.
+fn id_pass(pipeline: &wgpu::RenderPipeline, ids: &wgpu::Texture, depth: &wgpu::Texture, objects: &[ObjectDraw], binds: &[wgpu::BindGroup], encoder: &mut wgpu::CommandEncoder) {
+    let ids_view = ids.create_view(&Default::default());
+    let depth_view = depth.create_view(&Default::default());
+    let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+        label: Some("object ids"),
+        color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+            view: &ids_view,
+            depth_slice: None,
+            resolve_target: None,
+            ops: wgpu::Operations { load: wgpu::LoadOp::Clear(wgpu::Color { r: NO_OBJECT as f64, g: 0.0, b: 0.0, a: 0.0 }), store: wgpu::StoreOp::Store },
+        })],
+        depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+            view: &depth_view,
+            depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Clear(1.0), store: wgpu::StoreOp::Store }),
+            stencil_ops: None,
+        }),
+        timestamp_writes: None,
+        occlusion_query_set: None,
+        multiview_mask: None,
+    });
+    pass.set_pipeline(pipeline);
+    for (o, bg) in objects.iter().zip(binds) {
+        pass.set_bind_group(0, bg, &[]);
+        pass.set_vertex_buffer(0, o.mesh.positions.slice(..));
+        pass.set_vertex_buffer(1, o.mesh.uvs.slice(..));
+        pass.set_index_buffer(o.mesh.indices.slice(..), wgpu::IndexFormat::Uint32);
+        pass.draw_indexed(0..o.mesh.count, 0, 0..1);
+    }
+}
+
 /// Records a frame into `encoder`: clears `colour` (format `format`, size `targets.size`) to
-/// transparent black, then draws.
+/// transparent black, then draws with `targets.samples` per pixel (multisampled frames are
+/// drawn into the sample attachments and resolved into `colour`). `object_ids`: also leave
+/// every pixel's object index at its centre in `targets.ids` (single-sample frames always
+/// do; multisampled ones draw one more index pass for it).
 #[allow(clippy::too_many_arguments)]
 pub fn encode(
     gpu: &Gpu,
     pipes: &mut FramePipelines,
-    targets: &Targets,
+    targets: &mut Targets,
     colour: &wgpu::TextureView,
     format: wgpu::TextureFormat,
     objects: &[ObjectDraw],
     layers: &[LayerDraw],
+    object_ids: bool,
     encoder: &mut wgpu::CommandEncoder,
 ) {
     let d = &gpu.device;
+    let samples = targets.samples;
+    pipes.id_pipeline(gpu, samples);
+    pipes.layer_pipeline(gpu, format, samples);
     let ubuf = |u: Uniforms| d.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: Some("frame uniforms"), contents: bytemuck::bytes_of(&u), usage: wgpu::BufferUsages::UNIFORM });
     let id_binds: Vec<wgpu::BindGroup> = objects
         .iter()
@@ -297,55 +399,47 @@ pub fn encode(
             })
         })
         .collect();
-    let ids_view = targets.ids.create_view(&Default::default());
-    let depth_view = targets.depth.create_view(&Default::default());
-    {
-        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: Some("object ids"),
-            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                view: &ids_view,
-                depth_slice: None,
-                resolve_target: None,
-                ops: wgpu::Operations { load: wgpu::LoadOp::Clear(wgpu::Color { r: NO_OBJECT as f64, g: 0.0, b: 0.0, a: 0.0 }), store: wgpu::StoreOp::Store },
-            })],
-            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                view: &depth_view,
-                depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Clear(1.0), store: wgpu::StoreOp::Store }),
-                stencil_ops: None,
-            }),
-            timestamp_writes: None,
-            occlusion_query_set: None,
-            multiview_mask: None,
-        });
-        pass.set_pipeline(&pipes.id_pipeline);
-        for (o, bg) in objects.iter().zip(&id_binds) {
-            pass.set_bind_group(0, bg, &[]);
-            pass.set_vertex_buffer(0, o.mesh.positions.slice(..));
-            pass.set_vertex_buffer(1, o.mesh.uvs.slice(..));
-            pass.set_index_buffer(o.mesh.indices.slice(..), wgpu::IndexFormat::Uint32);
-            pass.draw_indexed(0..o.mesh.count, 0, 0..1);
+    let size = targets.size;
+    // The attachments the layers are drawn into: (colour, resolve target, depth, ids).
+    let (sample_colour, depth, ids_bind) = match &mut targets.multi {
+        Some(m) => {
+            let c = m.colour.entry(format).or_insert_with(|| target_texture(gpu, "frame per sample", size, samples, format, wgpu::TextureUsages::RENDER_ATTACHMENT));
+            id_pass(&pipes.id_pipelines[&samples], &m.ids, &m.depth, objects, &id_binds, encoder);
+            if object_ids {
+                id_pass(&pipes.id_pipelines[&1], &targets.ids, &targets.depth, objects, &id_binds, encoder);
+            }
+            (Some(c.create_view(&Default::default())), &m.depth, &m.ids_bind)
         }
-    }
-    let pipeline = pipes.layer_pipeline(gpu, format);
+        None => {
+            id_pass(&pipes.id_pipelines[&1], &targets.ids, &targets.depth, objects, &id_binds, encoder);
+            (None, &targets.depth, &targets.ids_bind)
+        }
+    };
+    let depth_view = depth.create_view(&Default::default());
+    // Multisampled: the samples are resolved into `colour` and then not kept.
+    let (view, resolve_target, store) = match &sample_colour {
+        Some(v) => (v, Some(colour), wgpu::StoreOp::Discard),
+        None => (colour, None, wgpu::StoreOp::Store),
+    };
     let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
         label: Some("layers"),
         color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-            view: colour,
+            view,
             depth_slice: None,
-            resolve_target: None,
-            ops: wgpu::Operations { load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT), store: wgpu::StoreOp::Store },
+            resolve_target,
+            ops: wgpu::Operations { load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT), store },
         })],
         depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
             view: &depth_view,
-            depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Load, store: wgpu::StoreOp::Store }),
+            depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Load, store }),
             stencil_ops: None,
         }),
         timestamp_writes: None,
         occlusion_query_set: None,
         multiview_mask: None,
     });
-    pass.set_pipeline(pipeline);
-    pass.set_bind_group(1, &targets.ids_bind, &[]);
+    pass.set_pipeline(&pipes.layer_pipelines[&(format, samples)]);
+    pass.set_bind_group(1, ids_bind, &[]);
     for (l, bg) in layers.iter().zip(&layer_binds) {
         let m = objects[l.draw].mesh;
         pass.set_bind_group(0, bg, &[]);

@@ -3,6 +3,10 @@
 // `fs_id` writes depth and the object index (nearest surface wins), then `fs_layer` adds
 // weight × texture wherever the pixel's nearest surface is this object.
 //
+// Multisampled frames (multisample.rs) run the same passes with depth and object indices
+// per sample: `fs_layer_ms` shades once per pixel, exactly as `fs_layer` does, and covers
+// the samples whose nearest surface is this object; the resolve averages the samples.
+//
 // `texcoord` and `texture_lod` are textured.wgsl's, character for character (a test
 // compares them): the twins of pis-compile's hardware model. Change them together.
 
@@ -33,6 +37,7 @@ struct Uniforms {
 @group(0) @binding(1) var tex: texture_2d<f32>;
 @group(0) @binding(2) var samp: sampler;
 @group(1) @binding(0) var ids: texture_2d<u32>;
+@group(1) @binding(1) var ids_ms: texture_multisampled_2d<u32>;
 
 struct VsOut {
     @invariant @builtin(position) clip: vec4<f32>,
@@ -90,4 +95,35 @@ fn fs_layer(in: VsOut) -> @location(0) vec4<f32> {
     }
     // Colour adds up over layers and samples; alpha (blended with max) marks coverage.
     return vec4<f32>(c.rgb * u.weight, 1.0);
+}
+
+struct LayerSamples {
+    @location(0) colour: vec4<f32>,
+    @builtin(sample_mask) mask: u32,
+};
+
+// `fs_layer` for multisampled targets. Reading `sample_mask` (unlike `sample_index`) does
+// not turn on per-sample shading: this runs once per pixel and fragment, at the pixel's
+// centre, with `fs_layer`'s derivatives and LOD; only the samples it writes are chosen per
+// sample, among those the triangle covers (and the depth test passes), by the object index.
+@fragment
+fn fs_layer_ms(in: VsOut, @builtin(sample_mask) covered: u32) -> LayerSamples {
+    let ddx = dpdxFine(in.st);
+    let ddy = dpdyFine(in.st);
+    let lambda = texture_lod(ddx, ddy, u.size, u.max_level);
+    let c = textureSampleLevel(tex, samp, in.st * u.scale, lambda);
+    let pixel = vec2<i32>(in.clip.xy);
+    var mask = 0u;
+    for (var i = 0u; i < textureNumSamples(ids_ms); i = i + 1u) {
+        if ((covered & (1u << i)) != 0u && textureLoad(ids_ms, pixel, i32(i)).r == u.object) {
+            mask = mask | (1u << i);
+        }
+    }
+    if (mask == 0u) {
+        discard;
+    }
+    var out: LayerSamples;
+    out.colour = vec4<f32>(c.rgb * u.weight, 1.0);
+    out.mask = mask;
+    return out;
 }

@@ -13,6 +13,8 @@ pub struct Gpu {
     /// sampler filters are exactly those the model's A multiplies; else `Rgba16Float`
     /// (always filterable; texels rounded to half floats, relative error ≤ 2^-11).
     pub texture_format: wgpu::TextureFormat,
+    /// The adapter the device was opened on (its texture format features).
+    adapter: wgpu::Adapter,
 }
 
 /// Choices when opening the GPU.
@@ -130,6 +132,9 @@ impl Gpu {
         // Float32 blending lets the player add layers in an Rgba32Float frame (else it
         // accumulates in Rgba16Float).
         let features = features | (adapter.features() & wgpu::Features::FLOAT32_BLENDABLE);
+        // The adapter's own format features (multisampled Rgba32Float and R32Uint targets,
+        // which WebGPU does not guarantee) where it reports them.
+        let features = features | (adapter.features() & wgpu::Features::TEXTURE_ADAPTER_SPECIFIC_FORMAT_FEATURES);
         let limits = adapter.limits();
         let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
             label: Some("pis-play"),
@@ -138,7 +143,17 @@ impl Gpu {
             ..Default::default()
         }))
         .map_err(|e| PlayError::Device { adapter: info.name.clone(), message: e.to_string() })?;
-        Ok((Gpu { device, queue, info, limits, texture_format }, adapter))
+        Ok((Gpu { device, queue, info, limits, texture_format, adapter: adapter.clone() }, adapter))
+    }
+
+    /// What the device can do with `format`: the adapter's features where the device was
+    /// given `TEXTURE_ADAPTER_SPECIFIC_FORMAT_FEATURES`, else those WebGPU guarantees.
+    pub fn format_features(&self, format: wgpu::TextureFormat) -> wgpu::TextureFormatFeatures {
+        if self.device.features().contains(wgpu::Features::TEXTURE_ADAPTER_SPECIFIC_FORMAT_FEATURES) {
+            self.adapter.get_texture_format_features(format)
+        } else {
+            format.guaranteed_format_features(self.device.features())
+        }
     }
 
     /// A one-line description of the adapter: name, backend, device type, driver.

@@ -3,7 +3,8 @@
 //! float target; probe mode (thesis 3.4.3), which measures an object's render matrix through
 //! that pipeline; and the runtime (thesis 4.7, [`Player`]): random-access reading of a
 //! `.pis`, decoding on worker threads through a level-image cache with lifetimes, GPU MIP
-//! chains, and frames of every object with its layers.
+//! chains, and frames of every object with its layers, multisampled on silhouettes
+//! (`multisample.rs`).
 //!
 //! Without a GPU, wgpu runs on Mesa's lavapipe: `apt-get install -y mesa-vulkan-drivers`.
 
@@ -16,6 +17,7 @@ pub mod frame;
 pub mod gpu;
 pub mod image;
 pub mod mip;
+pub mod multisample;
 pub mod player;
 pub mod probe;
 pub mod textured;
@@ -25,6 +27,7 @@ pub use camera::{CameraChoice, ViewCamera};
 pub use error::{PlayError, ADAPTER_HINT};
 pub use gpu::{Gpu, GpuOptions};
 pub use image::FloatImage;
+pub use multisample::Multisample;
 pub use player::{FrameRequest, FrameStats, Player, PlayerOptions};
 pub use probe::{probe, probe_render_matrix, Probe};
 pub use textured::{render_object, ObjectScene, ObjectTexture, TexturedPipeline};

@@ -23,6 +23,7 @@ use crate::frame::{colour_image, offscreen_format, FramePipelines, LayerDraw, Me
 use crate::gpu::Gpu;
 use crate::image::FloatImage;
 use crate::mip::MipBuilder;
+use crate::multisample::{check_samples, choose, Multisample, DEFAULT_SAMPLES};
 use crate::textured::{create_sampler, ObjectTexture};
 
 /// The player's settings.
@@ -40,12 +41,16 @@ pub struct PlayerOptions {
     /// log2(r) as the finest level (textures at 1/r resolution per side).
     pub reduction: u32,
     pub blend: Blend,
+    /// Samples per pixel (multisample antialiasing of object silhouettes): 1 or 4 (default
+    /// 4). Where the device cannot multisample a frame's formats that many times, frames
+    /// are drawn with 1 ([`Player::multisample`] says which and why).
+    pub msaa: u32,
 }
 
 impl Default for PlayerOptions {
     fn default() -> Self {
         let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
-        PlayerOptions { cache_budget_bytes: 512 << 20, lifetime_a: 20, lifetime_b: 4, workers: cores.saturating_sub(1).max(1), reduction: 1, blend: Blend::Nearest }
+        PlayerOptions { cache_budget_bytes: 512 << 20, lifetime_a: 20, lifetime_b: 4, workers: cores.saturating_sub(1).max(1), reduction: 1, blend: Blend::Nearest, msaa: DEFAULT_SAMPLES }
     }
 }
 
@@ -108,8 +113,17 @@ struct Wanted {
     repeat: [bool; 2],
 }
 
-/// An offscreen frame read back: colour and object indices.
-type Readout = (FloatImage, Vec<u32>);
+/// An offscreen frame read back: colour and, when asked for, object indices.
+type Readout = (FloatImage, Option<Vec<u32>>);
+
+/// Where a frame is drawn.
+#[derive(Clone, Copy)]
+enum Target<'a> {
+    /// The offscreen target, read back (with every pixel's object index if `ids`).
+    Offscreen { ids: bool },
+    /// A caller's view of the given format.
+    View(&'a wgpu::TextureView, wgpu::TextureFormat),
+}
 
 /// An open `.pis` ready to draw frames.
 pub struct Player {
@@ -123,6 +137,8 @@ pub struct Player {
     pipes: FramePipelines,
     mips: MipBuilder,
     targets: Option<Targets>,
+    /// The multisampling of frames per target format (offscreen first).
+    multisample: HashMap<wgpu::TextureFormat, Multisample>,
     readback: Option<(Readback, Readback)>,
     resident: HashMap<TextureKey, Resident>,
     samplers: HashMap<[bool; 2], wgpu::Sampler>,
@@ -190,14 +206,18 @@ impl Player {
         if options.reduction == 0 || !options.reduction.is_power_of_two() {
             return Err(PlayError::Request(format!("texture resolution reduction {} must be a power of two (1, 2, 4, …)", options.reduction)));
         }
+        check_samples(options.msaa).map_err(PlayError::Request)?;
         let reader = PisReader::open(path)?;
         let objects = prepare_objects(&gpu, &reader)?;
         let filter = file_filter(reader.container());
         let decoder = Decoder::new(options.workers)?;
         let cache = LevelCache::new(options.cache_budget_bytes, options.lifetime_a, options.lifetime_b);
         let mut pipes = FramePipelines::new(&gpu);
+        let offscreen = offscreen_format(&gpu);
+        let ms = choose(&gpu, options.msaa, offscreen);
         // Compiled now rather than in the first frame's time.
-        pipes.layer_pipeline(&gpu, offscreen_format(&gpu));
+        pipes.id_pipeline(&gpu, ms.samples);
+        pipes.layer_pipeline(&gpu, offscreen, ms.samples);
         let mips = MipBuilder::new(&gpu);
         Ok(Player {
             gpu,
@@ -210,6 +230,7 @@ impl Player {
             pipes,
             mips,
             targets: None,
+            multisample: HashMap::from([(offscreen, ms)]),
             readback: None,
             resident: HashMap::new(),
             samplers: HashMap::new(),
@@ -253,6 +274,17 @@ impl Player {
         offscreen_format(&self.gpu)
     }
 
+    /// The multisampling of offscreen frames: samples per pixel asked for and drawn with.
+    pub fn multisample(&self) -> &Multisample {
+        &self.multisample[&offscreen_format(&self.gpu)]
+    }
+
+    /// The multisampling of frames drawn into targets of `format` ([`Player::render_to_view`]).
+    pub fn multisample_for(&mut self, format: wgpu::TextureFormat) -> &Multisample {
+        let (gpu, msaa) = (&self.gpu, self.options.msaa);
+        self.multisample.entry(format).or_insert_with(|| choose(gpu, msaa, format))
+    }
+
     /// The nearest parameter sample of `point` (missing values count as the first sample,
     /// extra values are ignored).
     fn nearest(&self, point: &[f32]) -> Vec<u32> {
@@ -282,23 +314,28 @@ impl Player {
         ViewCamera::from_file(&self.camera_record(&self.nearest(point)))
     }
 
-    /// Draws a frame offscreen; linear RGBA read back (alpha 1 where an object is drawn).
+    /// Draws a frame offscreen; linear RGBA read back, colour premultiplied by coverage:
+    /// alpha is the fraction of the pixel's samples objects cover (1 inside objects, 0
+    /// where none is drawn, between on silhouettes of multisampled frames).
     pub fn render_image(&mut self, req: &FrameRequest, size: (u32, u32)) -> Result<(FloatImage, FrameStats), PlayError> {
-        let (img, _, stats) = self.render_ids(req, size)?;
+        let (out, stats) = self.frame(req, size, Target::Offscreen { ids: false })?;
+        let (img, _) = out.ok_or_else(|| PlayError::Readback("no offscreen frame".into()))?;
         Ok((img, stats))
     }
 
-    /// Draws a frame offscreen; also the object index per pixel (`u32::MAX`: none).
+    /// Draws a frame offscreen ([`Player::render_image`]); also the object index per pixel,
+    /// the nearest surface at the pixel's centre (`u32::MAX`: none).
     pub fn render_ids(&mut self, req: &FrameRequest, size: (u32, u32)) -> Result<(FloatImage, Vec<u32>, FrameStats), PlayError> {
-        let (out, stats) = self.frame(req, size, None)?;
+        let (out, stats) = self.frame(req, size, Target::Offscreen { ids: true })?;
         let (img, ids) = out.ok_or_else(|| PlayError::Readback("no offscreen frame".into()))?;
-        Ok((img, ids, stats))
+        Ok((img, ids.unwrap_or_default(), stats))
     }
 
     /// Draws a frame into `view` (any colour format; linear radiance, so an `*Srgb` format
-    /// does the sRGB encoding) of `size`.
+    /// does the sRGB encoding) of `size`, with [`Player::multisample_for`] the format's
+    /// samples per pixel resolved into it.
     pub fn render_to_view(&mut self, req: &FrameRequest, view: &wgpu::TextureView, format: wgpu::TextureFormat, size: (u32, u32)) -> Result<FrameStats, PlayError> {
-        Ok(self.frame(req, size, Some((view, format)))?.1)
+        Ok(self.frame(req, size, Target::View(view, format))?.1)
     }
 
     /// The textures a frame draws, and the frame's objects' clip transforms.
@@ -435,7 +472,7 @@ impl Player {
         Ok(())
     }
 
-    fn frame(&mut self, req: &FrameRequest, size: (u32, u32), target: Option<(&wgpu::TextureView, wgpu::TextureFormat)>) -> Result<(Option<Readout>, FrameStats), PlayError> {
+    fn frame(&mut self, req: &FrameRequest, size: (u32, u32), target: Target) -> Result<(Option<Readout>, FrameStats), PlayError> {
         let t0 = Instant::now();
         let reads0 = self.reader.stats().codestreams;
         let mut stats = FrameStats::default();
@@ -445,8 +482,13 @@ impl Player {
             self.end_frame();
             return Err(e);
         }
-        if self.targets.as_ref().is_none_or(|t| t.size != size) {
-            self.targets = Some(Targets::new(&self.gpu, &self.pipes, size)?);
+        let format = match target {
+            Target::Offscreen { .. } => offscreen_format(&self.gpu),
+            Target::View(_, f) => f,
+        };
+        let samples = self.multisample_for(format).samples;
+        if self.targets.as_ref().is_none_or(|t| t.size != size || t.samples != samples) {
+            self.targets = Some(Targets::new(&self.gpu, &self.pipes, size, samples)?);
             self.readback = None;
         }
         let gpu = self.gpu.clone();
@@ -476,25 +518,27 @@ impl Player {
                 anisotropic: matches!(self.filter, Filter::Anisotropic(_)),
             });
         }
-        let targets = self.targets.as_ref().expect("targets made above");
+        let targets = self.targets.as_mut().expect("targets made above");
         let mut encoder = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("frame") });
         let offscreen_view;
-        let (view, format) = match target {
-            Some(t) => t,
-            None => {
+        let (view, want_ids) = match target {
+            Target::View(v, _) => (v, false),
+            Target::Offscreen { ids } => {
                 offscreen_view = targets.colour.create_view(&Default::default());
-                (&offscreen_view, targets.colour.format())
+                (&offscreen_view, ids)
             }
         };
-        crate::frame::encode(&gpu, &mut self.pipes, targets, view, format, &objects, &layers, &mut encoder);
-        let out = if target.is_none() {
+        crate::frame::encode(&gpu, &mut self.pipes, targets, view, format, &objects, &layers, want_ids, &mut encoder);
+        let out = if let Target::Offscreen { ids } = target {
             let texel = if format == wgpu::TextureFormat::Rgba16Float { 8 } else { 16 };
             let (rc, ri) = self.readback.get_or_insert_with(|| (Readback::new(&gpu, size, texel), Readback::new(&gpu, size, 4)));
             rc.copy(&targets.colour, &mut encoder);
-            ri.copy(&targets.ids, &mut encoder);
+            if ids {
+                ri.copy(&targets.ids, &mut encoder);
+            }
             gpu.queue.submit([encoder.finish()]);
             let colour = colour_image(&rc.read(&gpu)?, format, size);
-            let ids = ri.read(&gpu)?.chunks_exact(4).map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]])).collect();
+            let ids = if ids { Some(ri.read(&gpu)?.chunks_exact(4).map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]])).collect()) } else { None };
             Some((colour, ids))
         } else {
             gpu.queue.submit([encoder.finish()]);

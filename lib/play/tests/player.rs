@@ -14,6 +14,10 @@ use pis_play::decode::TextureImage;
 use pis_play::mip::{read_levels, MipBuilder};
 use pis_play::{Blend, CameraChoice, FrameRequest, Player, PlayerOptions};
 
+fn in_ci() -> bool {
+    std::env::var("CI").is_ok_and(|v| v == "true")
+}
+
 fn tiny() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../samples/tiny.pis")
 }
@@ -47,7 +51,8 @@ fn at(player: &Player, samples: &[u32]) -> FrameRequest {
 #[test]
 fn a_frame_reads_only_the_codestreams_of_its_pyramid_paths() {
     let Some(gpu) = gpu_or_skip("a_frame_reads_only_the_codestreams_of_its_pyramid_paths") else { return };
-    let mut player = Player::open(Arc::new(gpu), &tiny(), PlayerOptions { workers: 2, ..Default::default() }).unwrap();
+    // One sample per pixel: alpha is 1 exactly where the object index is drawn.
+    let mut player = Player::open(Arc::new(gpu), &tiny(), PlayerOptions { workers: 2, msaa: 1, ..Default::default() }).unwrap();
     let size = player.image_size();
     // tiny.pis: dimensions (view, light); the surface layer varies with light.
     let first = vec![0, 0];
@@ -174,6 +179,70 @@ fn gpu_mip_chain_equals_cpu_decimation() {
     }
 }
 
+/// Multisampling on the player's path (samples/tiny.pis, a ball over nothing): object
+/// indices are those at pixel centres either way; pixels partly covered (0 < alpha < 1) lie
+/// on the silhouette only, there are about as many as the silhouette is long, and their
+/// colour is no longer the single-sample one (the ball mixed with the empty background);
+/// inside the ball, a pixel is
+/// shaded at its centre by each triangle that covers some of its samples, so it keeps the
+/// single-sample value except on the mesh's own triangle edges, where it mixes two
+/// extrapolations of the same texture: never outside the range of its 3×3 neighbourhood.
+/// (`frame_multisampling_keeps_interiors_exactly` shows exactness on flat quads.)
+#[test]
+fn multisampling_changes_silhouettes_of_played_frames() {
+    let test = "multisampling_changes_silhouettes_of_played_frames";
+    let Some(gpu) = gpu_or_skip(test) else { return };
+    let gpu = Arc::new(gpu);
+    let open = |msaa| Player::open(gpu.clone(), &tiny(), PlayerOptions { workers: 1, msaa, ..Default::default() }).unwrap();
+    let (mut one, mut four) = (open(1), open(4));
+    assert_eq!((one.multisample().requested, one.multisample().samples), (1, 1));
+    let ms = four.multisample().clone();
+    if ms.samples != 4 {
+        assert!(!in_ci(), "{test}: {ms:?}");
+        eprintln!("{test}: skipped: {}", ms.note.unwrap_or_default());
+        return;
+    }
+    // Larger than the traced size: more interior pixels and a longer silhouette.
+    let size = (96, 72);
+    let req = at(&one, &[1, 1]);
+    let (a, ids_a, _) = one.render_ids(&req, size).unwrap();
+    let (b, ids_b, _) = four.render_ids(&req, size).unwrap();
+    assert_eq!(ids_a, ids_b, "object indices are those at pixel centres either way");
+    let (w, h) = (size.0 as usize, size.1 as usize);
+    let (mut area, mut partial, mut exact, mut interior) = (0usize, 0usize, 0usize, 0usize);
+    for y in 1..h - 1 {
+        for x in 1..w - 1 {
+            let p = y * w + x;
+            let hood = || (0..9).map(|k| (y + k / 3 - 1) * w + x + k % 3 - 1);
+            let uniform = hood().all(|q| ids_a[q] == ids_a[p]);
+            let alpha = b.rgba[p * 4 + 3];
+            area += (ids_a[p] != u32::MAX) as usize;
+            if alpha > 0.0 && alpha < 1.0 {
+                partial += 1;
+                assert!(!uniform, "pixel ({x}, {y}) is partly covered ({alpha}) away from the silhouette");
+                let differ = (0..3).map(|c| (a.rgba[p * 4 + c] - b.rgba[p * 4 + c]).abs()).fold(0.0, f32::max);
+                assert!(differ > 1e-4, "partly covered pixel ({x}, {y}) keeps its single-sample colour");
+            }
+            if uniform && ids_a[p] != u32::MAX {
+                interior += 1;
+                assert_eq!(alpha, 1.0, "pixel ({x}, {y}) inside the ball is wholly covered");
+                let same = (0..3).all(|c| (a.rgba[p * 4 + c] - b.rgba[p * 4 + c]).abs() <= 1e-6 * a.rgba[p * 4 + c].abs().max(1e-3));
+                exact += same as usize;
+                for c in 0..3 {
+                    let (lo, hi) = hood().map(|q| a.rgba[q * 4 + c]).fold((f32::MAX, f32::MIN), |(l, u), v| (l.min(v), u.max(v)));
+                    let v = b.rgba[p * 4 + c];
+                    assert!(v >= lo - 1e-6 && v <= hi + 1e-6, "pixel ({x}, {y}) channel {c}: {v} outside its neighbourhood's [{lo}, {hi}]");
+                }
+            }
+        }
+    }
+    eprintln!("{test}: {area} pixels covered, {interior} inside ({exact} unchanged), {partial} partly covered");
+    assert!(interior > 200, "{interior} interior pixels");
+    // A closed silhouette around `area` pixels is at least 2·sqrt(π·area) long.
+    assert!(partial as f64 >= (area as f64).sqrt(), "{partial} partly covered pixels for {area} covered");
+    assert!(exact * 2 > interior, "{exact} of {interior} interior pixels unchanged");
+}
+
 /// PSNR of linear values, peak 1.
 fn psnr(a: &[f32], b: &[f32]) -> f64 {
     let mse = a.iter().zip(b).map(|(x, y)| (*x as f64 - *y as f64).powi(2)).sum::<f64>() / a.len().max(1) as f64;
@@ -186,12 +255,21 @@ fn srgb(v: f32) -> f32 {
 }
 
 /// A window's surface is an sRGB texture: the frame drawn into one is the offscreen frame,
-/// sRGB-encoded by the target format.
+/// sRGB-encoded by the target format, with one sample per pixel and with four (resolved
+/// into the sRGB target: where a pixel's samples differ, on silhouettes and on the mesh's
+/// triangle edges, each sample is rounded to 8 bits before the resolve averages them and
+/// the average is rounded again, one more level).
 #[test]
 fn render_to_view_draws_the_offscreen_frame_into_an_srgb_target() {
     let Some(gpu) = gpu_or_skip("render_to_view_draws_the_offscreen_frame_into_an_srgb_target") else { return };
     let gpu = Arc::new(gpu);
-    let mut player = Player::open(gpu.clone(), &tiny(), PlayerOptions { workers: 1, ..Default::default() }).unwrap();
+    for msaa in [1, 4] {
+        view_frame_is_the_offscreen_frame(&gpu, msaa);
+    }
+}
+
+fn view_frame_is_the_offscreen_frame(gpu: &Arc<pis_play::Gpu>, msaa: u32) {
+    let mut player = Player::open(gpu.clone(), &tiny(), PlayerOptions { workers: 1, msaa, ..Default::default() }).unwrap();
     let size = (48, 36);
     let req = at(&player, &[1, 1]);
     let (img, _) = player.render_image(&req, size).unwrap();
@@ -206,6 +284,8 @@ fn render_to_view_draws_the_offscreen_frame_into_an_srgb_target() {
         usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
         view_formats: &[],
     });
+    let samples = player.multisample_for(format).samples;
+    assert_eq!(samples, player.multisample().samples, "the sRGB view format is multisampled as the offscreen format is");
     let stats = player.render_to_view(&req, &target.create_view(&Default::default()), format, size).unwrap();
     assert_eq!(stats.codestreams_read, 0, "the textures are still on the GPU");
     let row = (size.0 * 4).div_ceil(256) * 256;
@@ -217,16 +297,18 @@ fn render_to_view_draws_the_offscreen_frame_into_an_srgb_target() {
         wgpu::Extent3d { width: size.0, height: size.1, depth_or_array_layers: 1 },
     );
     gpu.queue.submit([enc.finish()]);
-    let bytes = pis_play::frame::map_read(&gpu, &buf).unwrap();
+    let bytes = pis_play::frame::map_read(gpu, &buf).unwrap();
     let mut drawn = 0;
     for y in 0..size.1 as usize {
         for x in 0..size.0 as usize {
             let p = y * size.0 as usize + x;
-            drawn += (img.rgba[p * 4 + 3] > 0.0) as usize;
+            let alpha = img.rgba[p * 4 + 3];
+            drawn += (alpha > 0.0) as usize;
+            let levels = if samples > 1 { 2.0 } else { 1.0 };
             for c in 0..3 {
                 let want = srgb(img.rgba[p * 4 + c]) * 255.0;
                 let got = bytes[y * row as usize + x * 4 + c] as f32;
-                assert!((got - want).abs() <= 1.0, "pixel ({x}, {y}) channel {c}: {got} vs {want}");
+                assert!((got - want).abs() <= levels, "{samples} samples: pixel ({x}, {y}) channel {c}: {got} vs {want}");
             }
         }
     }
