@@ -10,6 +10,10 @@ use anyhow::{anyhow, Result};
 use pis_eval::baselines::path::zigzag;
 use pis_eval::compare::{compare_with_set, CompareOptions};
 use pis_play::{CameraChoice, FrameRequest, Gpu, Player, PlayerOptions};
+
+/// Samples per pixel of the harness's playback: one, as pis-pack's prediction draws (the
+/// player's window and `pis-play` default to multisampling; `pis-play --msaa 4` measures it).
+const BENCH_MSAA: u32 = 1;
 use serde::Serialize;
 
 /// One container at one reduction factor.
@@ -36,7 +40,7 @@ pub fn gpu() -> Result<Arc<Gpu>> {
 pub fn measure(gpu: &Arc<Gpu>, file: &Path, set_dir: &Path, codec: &str, reductions: &[u32]) -> Result<Vec<PlaybackRow>> {
     let mut rows = Vec::new();
     for &reduction in reductions {
-        let mut player = Player::open(gpu.clone(), file, PlayerOptions { reduction, ..Default::default() })?;
+        let mut player = Player::open(gpu.clone(), file, PlayerOptions { reduction, msaa: BENCH_MSAA, ..Default::default() })?;
         let dims: Vec<Vec<f32>> = player.dimensions().iter().map(|d| d.values.clone()).collect();
         let counts: Vec<u32> = dims.iter().map(|v| v.len() as u32).collect();
         let size = player.image_size();
@@ -58,7 +62,7 @@ pub fn measure(gpu: &Arc<Gpu>, file: &Path, set_dir: &Path, codec: &str, reducti
 
 /// PSNR of `file` played at every sample point against the set: (whole image, covered).
 pub fn played_psnr(gpu: &Arc<Gpu>, file: &Path, set_dir: &Path) -> Result<(f64, f64)> {
-    let mut player = Player::open(gpu.clone(), file, PlayerOptions::default())?;
+    let mut player = Player::open(gpu.clone(), file, PlayerOptions { msaa: BENCH_MSAA, ..Default::default() })?;
     let c = compare_with_set(&mut player, set_dir, &CompareOptions { size: None }, &mut |_| {})?;
     Ok((c.psnr_db, c.covered_psnr_db))
 }
