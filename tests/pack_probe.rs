@@ -109,7 +109,7 @@ fn anisotropic_pack_plays_as_predicted() {
     assert_eq!((r["filter"].as_str(), r["anisotropy"].as_u64(), r["matrix"].as_str()), (Some("anisotropic"), Some(8), Some("probe")));
     assert_eq!(setting(&file, "filter").as_deref(), Some("anisotropic"));
     assert_eq!(setting(&file, "anisotropy").as_deref(), Some("8"));
-    let out = run(env!("CARGO_BIN_EXE_pis-diff"), &[os(&file), os(&one.1 .1), os("--json"), os("--max-psnr-drop"), os("0.5")], &[]);
+    let out = run(env!("CARGO_BIN_EXE_pis-diff"), &[os(&file), os(&one.1 .1), os("--json"), os("--msaa"), os("1"), os("--max-psnr-drop"), os("0.5")], &[]);
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap_or_default();
     eprintln!("anisotropic: predicted {} dB, played {} dB (covered pixels)", r["psnr_db"], v["covered_psnr_db"]);
     assert_eq!(out.status.code(), Some(0), "played PSNR more than 0.5 dB below the prediction: {v}\n{}", String::from_utf8_lossy(&out.stderr));
