@@ -202,7 +202,7 @@ pub fn pack_with(req: &PackRequest, extras: PackExtras) -> Result<PackReport, Fa
         p.settings.push((PREDICTED_PSNR_SETTING.to_string(), format!("{:.4}", quality.overall)));
     }
     let masters = if extras.keep_master {
-        let m = encode::masters(&inferred, &packed, &set.samples, req.allocation).map_err(|e| Failure::new(Exit::Runtime, e))?;
+        let m = encode::masters(&inferred, &packed).map_err(|e| Failure::new(Exit::Runtime, e))?;
         let n: u64 = m.iter().map(pis_format::Master::payload_len).sum();
         stages.done("master", &format!("solved textures of {} objects coded losslessly ({n} bytes)", m.len()));
         m

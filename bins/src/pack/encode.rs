@@ -3,18 +3,19 @@
 //! layer and block (4.3, 4.6), equal-slope storage allocation (4.5) and encoding; then the
 //! checks that read the result back.
 
+use std::collections::BTreeMap;
 use std::path::Path;
 
 use anyhow::{anyhow, Result};
 use pis_codec::allocate::Target;
-use pis_codec::pyramid::level_image_index;
+use pis_codec::pyramid::{level_image_index, unflatten};
 use pis_codec::CodecId;
 use pis_format::blocks::BlockGrid;
 use pis_format::mip::decimate;
 use pis_format::reconstruct::{finish, prepare};
 use pis_format::*;
 
-use super::infer_layers::{key, ObjectModel};
+use super::infer_layers::{key, InferredLayer, ObjectModel};
 use super::input::LoadedSet;
 use super::storage::{allocate_storage, build_pyramid, encode_levels};
 use super::{PackRequest, Stages};
@@ -46,6 +47,9 @@ pub(crate) struct Packed {
     /// Per object model, per layer: codestream bytes.
     pub(crate) layer_bytes: Vec<Vec<usize>>,
     pub(crate) stagger: Vec<Vec<u32>>,
+    /// Per object model, per layer: each layer sample's screen weights, by key (empty
+    /// without screen-error allocation); the allocation and the master use them.
+    pub(crate) screen_weights: Vec<Vec<BTreeMap<Vec<u32>, Vec<f32>>>>,
 }
 
 fn row3x4(m: glam::Mat4) -> [f32; 12] {
@@ -68,15 +72,6 @@ pub fn block_sizes(block: &[u32], dims: usize) -> Result<Vec<u32>> {
 /// Block origin offsets of object `i` of `n` (thesis 4.7): `i · B / n` per dimension.
 pub fn stagger(i: usize, n: usize, sizes: &[u32]) -> Vec<u32> {
     sizes.iter().map(|&b| (i as u64 * b as u64 / n.max(1) as u64) as u32).collect()
-}
-
-fn unflatten(mut i: usize, extent: &[u32]) -> Vec<u32> {
-    let mut out = vec![0; extent.len()];
-    for k in (0..extent.len()).rev() {
-        out[k] = (i % extent[k] as usize) as u32;
-        i /= extent[k] as usize;
-    }
-    out
 }
 
 fn surface_layer(kind: LayerKind, order: u8, depends_on: DepMask, gamma: f32) -> Layer {
@@ -188,6 +183,15 @@ fn sample_weights(per_point: &[Vec<f64>], points: &[usize]) -> Vec<f32> {
     sum.iter().map(|w| (w * scale) as f32).collect()
 }
 
+/// The screen weights of every sample of layer `il` of `m`, by key: [`sample_weights`] over
+/// the points of `samples` that read it.
+fn layer_screen_weights(per_point: &[Vec<f64>], il: &InferredLayer, samples: &[Vec<u32>]) -> BTreeMap<Vec<u32>, Vec<f32>> {
+    il.textures.keys().map(|k| {
+        let points: Vec<usize> = samples.iter().enumerate().filter(|(_, s)| key(s, il.depends_on) == *k).map(|(p, _)| p).collect();
+        (k.clone(), sample_weights(per_point, &points))
+    }).collect()
+}
+
 /// Builds pyramids, allocates storage, encodes, and assembles the container.
 pub(crate) fn encode_all(set: &LoadedSet, models: &[ObjectModel], req: &PackRequest, stages: &mut Stages) -> Result<Packed, Failure> {
     let runtime = |e: anyhow::Error| Failure::new(Exit::Runtime, e);
@@ -202,12 +206,19 @@ pub(crate) fn encode_all(set: &LoadedSet, models: &[ObjectModel], req: &PackRequ
     // Every block's pyramid, in (object model, layer, block) order, and where it goes.
     let mut pyramids = Vec::new();
     let mut where_ = Vec::new();
+    let mut screen_weights = Vec::new();
     for (mi, m) in models.iter().enumerate() {
         let st = stagger(mi, models.len(), &sizes);
-        let per_point = if req.allocation == super::Allocation::Screen && req.codec.is_lossy() { screen_weights_per_point(m) } else { Vec::new() };
+        let weights_by_layer: Vec<BTreeMap<Vec<u32>, Vec<f32>>> = if req.allocation == super::Allocation::Screen {
+            let per_point = screen_weights_per_point(m);
+            m.layers.iter().map(|il| layer_screen_weights(&per_point, il, &set.samples)).collect()
+        } else {
+            m.layers.iter().map(|_| BTreeMap::new()).collect()
+        };
         let mut layers = Vec::new();
         let mut layer_blocks = Vec::new();
         for (li, il) in m.layers.iter().enumerate() {
+            let layer_weights = &weights_by_layer[li];
             let mut layer = surface_layer(il.kind, li as u8, il.depends_on, req.gamma);
             let grid = BlockGrid::new(&space, il.depends_on, &st);
             let layer_samples = il.textures.len().max(1) as f64;
@@ -240,16 +251,15 @@ pub(crate) fn encode_all(set: &LoadedSet, models: &[ObjectModel], req: &PackRequ
                     let idx = pos.local.iter().zip(&pos.extent).fold(0usize, |a, (&l, &e)| a * e as usize + l as usize);
                     keys[idx] = k.clone();
                     samples[idx] = prepare(&layer, &layout, &finest(m, x));
-                    if !per_point.is_empty() {
-                        let points: Vec<usize> = set.samples.iter().enumerate().filter(|(_, s)| key(s, il.depends_on) == *k).map(|(p, _)| p).collect();
-                        weights[idx] = sample_weights(&per_point, &points);
+                    if let Some(w) = layer_weights.get(k) {
+                        weights[idx] = w.clone();
                     }
                 }
                 if samples.iter().any(Vec::is_empty) {
                     return Err(runtime(anyhow!("object {} layer {} block {b}: a sample has no texture", m.name, il.kind.name())));
                 }
                 let mut pyramid = build_pyramid(mi, planes, &extent, &samples, layer_samples, !req.codec.is_lossy(), req.pyramid == super::PyramidMode::Full).map_err(runtime)?;
-                if !per_point.is_empty() {
+                if !layer_weights.is_empty() && req.codec.is_lossy() {
                     pyramid.texel_weights = Some(weights);
                 }
                 pyramids.push(pyramid);
@@ -270,6 +280,7 @@ pub(crate) fn encode_all(set: &LoadedSet, models: &[ObjectModel], req: &PackRequ
             layers,
         });
         blocks_out.push(layer_blocks);
+        screen_weights.push(weights_by_layer);
         staggers.push(st);
     }
     let level_images: usize = pyramids.iter().flat_map(|p| &p.levels).map(|l| l.1.len()).sum();
@@ -349,7 +360,7 @@ pub(crate) fn encode_all(set: &LoadedSet, models: &[ObjectModel], req: &PackRequ
         blocks_out[*mi][*li][*b].levels = pyramid.levels;
     }
     stages.done("encode", &format!("{level_images} level images with {}", req.codec));
-    Ok(Packed { container, blocks: blocks_out, overhead, layer_bytes, stagger: staggers })
+    Ok(Packed { container, blocks: blocks_out, overhead, layer_bytes, stagger: staggers, screen_weights })
 }
 
 /// Decoded linear textures (whole MIP chain, rebuilt by decimation as the player does), per
@@ -405,19 +416,15 @@ pub(crate) fn mip_chain(m: &ObjectModel, finest: Vec<f32>) -> Vec<f32> {
 
 /// The lossless master of every object (SPEC.md 6.7): each layer sample's finest solved
 /// texture, linear as solved, and the object's screen-area weight of allocation.
-pub(crate) fn masters(models: &[ObjectModel], packed: &Packed, samples: &[Vec<u32>], allocation: super::Allocation) -> Result<Vec<Master>> {
+pub(crate) fn masters(models: &[ObjectModel], packed: &Packed) -> Result<Vec<Master>> {
     models.iter().enumerate().map(|(mi, m)| {
         // Keys are sample indices over the layer's dimensions: their order is table order.
         let textures: Vec<Vec<Vec<f32>>> = m.layers.iter().map(|l| l.textures.values().map(|x| finest(m, x)).collect()).collect();
         // The screen weights the allocation used, so that coding the master again allocates
         // as this pack did.
-        let weights: Option<Vec<Vec<Vec<f32>>>> = (allocation == super::Allocation::Screen).then(|| {
-            let per_point = screen_weights_per_point(m);
-            m.layers.iter().map(|l| l.textures.keys().map(|k| {
-                let points: Vec<usize> = samples.iter().enumerate().filter(|(_, s)| key(s, l.depends_on) == *k).map(|(p, _)| p).collect();
-                sample_weights(&per_point, &points)
-            }).collect()).collect()
-        });
+        let by_layer = &packed.screen_weights[mi];
+        let weights: Option<Vec<Vec<Vec<f32>>>> = by_layer.iter().all(|w| !w.is_empty())
+            .then(|| by_layer.iter().map(|w| w.values().cloned().collect()).collect());
         Ok(Master::encode(&packed.container, mi, m.area, &textures, weights.as_deref())?)
     }).collect()
 }

@@ -5,7 +5,7 @@
 
 use anyhow::{anyhow, Result};
 use pis_codec::allocate::{allocate, Item, Target, DEFAULT_ALPHA};
-use pis_codec::pyramid::{adaptive, build, l1_cost, level_image_index, Pyramid, PyramidFilter, PyramidLevel};
+use pis_codec::pyramid::{adaptive, build, l1_cost, level_image_index, unflatten, Pyramid, PyramidFilter, PyramidLevel};
 use pis_codec::{CodecId, PlaneShape, Rate};
 use rayon::prelude::*;
 
@@ -58,15 +58,6 @@ pub struct Storage {
     /// Bytes the allocation spends (lossy codecs).
     pub allocated: Option<usize>,
     pub level_images: usize,
-}
-
-fn unflatten(mut i: usize, extent: &[u32]) -> Vec<u32> {
-    let mut out = vec![0; extent.len()];
-    for k in (0..extent.len()).rev() {
-        out[k] = (i % extent[k] as usize) as u32;
-        i /= extent[k] as usize;
-    }
-    out
 }
 
 /// Equal-slope allocation (thesis 4.5) over every level image of `blocks` for a lossy

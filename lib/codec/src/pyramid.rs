@@ -60,7 +60,8 @@ pub fn level_image_index(counts: &[u32], local: &[u32], extent: &[u32]) -> usize
     idx
 }
 
-fn unflatten(mut i: usize, extent: &[u32]) -> Vec<u32> {
+/// The sample indices (one per dimension) of entry `i` of a row-major table over `extent`.
+pub fn unflatten(mut i: usize, extent: &[u32]) -> Vec<u32> {
     let mut out = vec![0; extent.len()];
     for k in (0..extent.len()).rev() {
         out[k] = (i % extent[k] as usize) as u32;
