@@ -92,6 +92,11 @@ pub struct GoldReport {
     /// Every object's covered pixels pooled: the measure of pis-pack's predicted PSNR, which
     /// `--max-psnr-drop` compares with.
     pub covered_psnr_db: Option<f64>,
+    /// The whole image at the gold standard's silhouette pixels (some object partly covers
+    /// them) and elsewhere, with the silhouette pixels' share of the image.
+    pub silhouette_psnr_db: Option<f64>,
+    pub interior_psnr_db: Option<f64>,
+    pub silhouette_fraction: f64,
     /// Mean FLIP over every pixel of every point.
     pub flip_mean: Option<f64>,
     /// The reference of `--max-psnr-drop` and where it came from.
@@ -264,6 +269,9 @@ pub fn gold(req: &GoldRequest) -> Result<GoldReport, Failure> {
         msaa_requested: req.msaa,
         psnr_db: psnr,
         covered_psnr_db: covered,
+        silhouette_psnr_db: finite(comparison.silhouette.psnr()),
+        interior_psnr_db: finite(comparison.interior.psnr()),
+        silhouette_fraction: comparison.silhouette.count as f64 / (comparison.silhouette.count + comparison.interior.count).max(1) as f64,
         flip_mean: total_flip.mean(),
         reference_psnr_db: reference,
         reference_from,
@@ -290,6 +298,7 @@ pub fn render(r: &GoldReport) -> String {
     let mut s = String::new();
     let _ = writeln!(s, "{} against the gold-standard set {} ({} points, {}, {})", r.file, r.set, r.points.len(), r.device, crate::play::headless::msaa_label(r.msaa_samples, r.msaa_requested));
     let _ = writeln!(s, "  PSNR (display values): whole image {} dB, objects' covered pixels {} dB", db(r.psnr_db), db(r.covered_psnr_db));
+    let _ = writeln!(s, "  whole image at silhouettes {} dB ({:.1} % of the pixels: partly covered in the gold standard), elsewhere {} dB", db(r.silhouette_psnr_db), 100.0 * r.silhouette_fraction, db(r.interior_psnr_db));
     let _ = writeln!(s, "  mean FLIP (sRGB images): {}", fl(r.flip_mean));
     let _ = writeln!(s, "  objects:                PSNR (dB)   mean FLIP   worst block");
     for o in &r.objects {

@@ -99,6 +99,11 @@ pub struct CompareReport {
     pub psnr_db: f64,
     /// Every object's covered pixels pooled (pis-pack's predicted `psnr_db` measure).
     pub covered_psnr_db: f64,
+    /// The whole image at the gold standard's silhouette pixels (some object partly covers
+    /// them) and elsewhere, with the silhouette pixels' share of the image.
+    pub silhouette_psnr_db: f64,
+    pub interior_psnr_db: f64,
+    pub silhouette_fraction: f64,
     pub objects: Vec<ObjectRow>,
     pub points: Vec<PointRow>,
 }
@@ -318,6 +323,9 @@ pub fn run_compare(args: &PlayArgs, set: &Path, gpu: &Gpu, player: &mut Player) 
         msaa_requested: player.multisample().requested,
         psnr_db: c.psnr_db,
         covered_psnr_db: c.covered_psnr_db,
+        silhouette_psnr_db: c.silhouette.psnr(),
+        interior_psnr_db: c.interior.psnr(),
+        silhouette_fraction: c.silhouette.count as f64 / (c.silhouette.count + c.interior.count).max(1) as f64,
         objects: c
             .objects
             .iter()
@@ -331,6 +339,7 @@ pub fn print_compare_report(r: &CompareReport, w: &mut impl std::io::Write) -> s
     writeln!(w, "pis-play {} against {} (blend {}, reduction {}, {})", r.file, r.set, r.blend, r.reduction, msaa_label(r.msaa_samples, r.msaa_requested))?;
     writeln!(w, "  adapter: {}", r.adapter)?;
     writeln!(w, "  PSNR (display values): whole image {:.2} dB, objects' covered pixels {:.2} dB", r.psnr_db, r.covered_psnr_db)?;
+    writeln!(w, "  whole image at silhouettes {:.2} dB ({:.1} % of the pixels: partly covered in the gold standard), elsewhere {:.2} dB", r.silhouette_psnr_db, 100.0 * r.silhouette_fraction, r.interior_psnr_db)?;
     for o in &r.objects {
         writeln!(w, "    {:<14} {:>7.2} dB  ({} pixel samples over {} blocks)", o.name, o.psnr_db, o.pixels, o.blocks.len())?;
     }

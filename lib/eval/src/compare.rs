@@ -17,6 +17,9 @@ use pis_trace::set::RaySet;
 
 use crate::metrics::SquaredError;
 
+/// Coverage this close to 0 or 1 counts as none or full (float rounding of the filter).
+const COVERAGE_EPS: f32 = 1e-4;
+
 /// Comparison settings.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct CompareOptions {
@@ -60,6 +63,11 @@ pub struct Comparison {
     /// Every object's covered pixels pooled (each object's measure, summed over objects):
     /// what pis-pack reports as its predicted `psnr_db`.
     pub covered_psnr_db: f64,
+    /// The whole image split by the gold standard's coverage: silhouette pixels are those
+    /// some object covers partly (its filtered coverage strictly between 0 and 1: an edge
+    /// the display filter mixes with what lies behind), interior pixels all others.
+    pub interior: SquaredError,
+    pub silhouette: SquaredError,
     pub objects: Vec<ObjectScore>,
     pub points: Vec<PointComparison>,
 }
@@ -105,6 +113,8 @@ pub fn compare_with_set(player: &mut Player, set_dir: &Path, options: &CompareOp
     };
     let block_count = |o: usize| grids[o].block_count() as usize;
     let mut total = SquaredError::default();
+    let (mut interior, mut silhouette) = (SquaredError::default(), SquaredError::default());
+    let mut partial = vec![false; 0];
     let mut per_object: Vec<(SquaredError, Vec<SquaredError>)> = (0..names.len()).map(|o| (SquaredError::default(), vec![SquaredError::default(); block_count(o)])).collect();
     let mut points = Vec::with_capacity(set.meta.points.len());
     let npx = res.0 as usize * res.1 as usize;
@@ -126,11 +136,23 @@ pub fn compare_with_set(player: &mut Player, set_dir: &Path, options: &CompareOp
                 px[c] = *v;
             }
         }
+        partial.clear();
+        partial.resize(npx, false);
+        for ch in &channels {
+            if let Some(cov) = images.object_layer(ch, LayerKind::Coverage).and_then(|l| l.channel("A")) {
+                for (p, &c) in partial.iter_mut().zip(cov) {
+                    *p |= c > COVERAGE_EPS && c < 1.0 - COVERAGE_EPS;
+                }
+            }
+        }
         let mut whole = SquaredError::default();
         for k in 0..npx {
+            let mut px = SquaredError::default();
             for c in 0..3 {
-                whole.add(rendered.rgba[k * 4 + c], gold.rgba[k * 4 + c]);
+                px.add(rendered.rgba[k * 4 + c], gold.rgba[k * 4 + c]);
             }
+            whole.merge(&px);
+            if partial[k] { silhouette.merge(&px) } else { interior.merge(&px) }
         }
         let mut objects = Vec::with_capacity(names.len());
         for (o, ch) in channels.iter().enumerate() {
@@ -175,5 +197,5 @@ pub fn compare_with_set(player: &mut Player, set_dir: &Path, options: &CompareOp
             }
         })
         .collect();
-    Ok(Comparison { psnr_db: total.psnr(), covered_psnr_db: covered.psnr(), objects, points })
+    Ok(Comparison { psnr_db: total.psnr(), covered_psnr_db: covered.psnr(), interior, silhouette, objects, points })
 }
