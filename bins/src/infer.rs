@@ -1,6 +1,7 @@
 //! `pis-bench infer`: texture inference for one object at one parameter point, compared with
 //! the gold-standard layer (thesis 3.6). Least squares with bilinear and trilinear render
-//! matrices, with pyramidal regularization (free MIP levels, and level 0 solved through the
+//! matrices, under eq. 3.4's box constraint (`ls-trilinear-bounded`, `ls-pyramidal-bounded`),
+//! with pyramidal regularization (free MIP levels, and level 0 solved through the
 //! player's decimated chain: `ls-decimated`), and the two baselines (forward mapping, ray
 //! tracing into textures), each rendered through the hardware model.
 //!
@@ -460,6 +461,17 @@ pub fn infer(req: &InferRequest) -> Result<InferReport> {
         // Plain least squares without the constraint 0 ≤ x ≤ R of eq. 3.4: a diagnostic.
         let u = solve(&a_tri, &b, None, &unconstrained)?;
         method("ls-trilinear-unconstrained", &a_tri, Filter::Trilinear, &u.texels, u.solve_ms, Some((u.iterations, u.converged)));
+    }
+    if plain.epsilon_b == 0.0 {
+        // Eq. 3.4 as written: plain least squares under the box 0 ≤ x ≤ 1.1 · max(b), and
+        // the same box with the pyramidal term.
+        let bounded = SolveSettings { bounded: true, ..plain };
+        let t = solve(&a_tri, &b, None, &bounded)?;
+        method("ls-trilinear-bounded", &a_tri, Filter::Trilinear, &t.texels, t.solve_ms, Some((t.iterations, t.converged)));
+        if pyramidal.epsilon_b == 0.0 {
+            let t = solve(&a_tri, &b, None, &SolveSettings { bounded: true, ..pyramidal })?;
+            method("ls-pyramidal-bounded", &a_tri, Filter::Trilinear, &t.texels, t.solve_ms, Some((t.iterations, t.converged)));
+        }
     }
     let pyr = solve(&a_tri, &b, None, &pyramidal)?;
     method("ls-pyramidal", &a_tri, Filter::Trilinear, &pyr.texels, pyr.solve_ms, Some((pyr.iterations, pyr.converged)));

@@ -24,6 +24,7 @@
 
 pub mod antialias;
 pub mod baseline;
+pub mod bounded;
 pub mod cg;
 pub mod decimation;
 pub mod error;

@@ -8,6 +8,7 @@ use std::time::Instant;
 
 use rayon::prelude::*;
 
+use crate::bounded::minimize_bounded;
 use crate::cg::{self, CgReport, CgSettings};
 use crate::decimation::{chain_f32, Decimation};
 use crate::error::check_finite;
@@ -50,8 +51,13 @@ pub struct SolveSettings {
     pub epsilon_b: f64,
     /// ε_f of eq. 3.9 (0: no pyramidal term). The thesis used 0.1.
     pub epsilon_f: f64,
-    /// The range [0, range_factor · max(b)] the range term keeps texels in.
+    /// The range [0, range_factor · max(b)] the range term keeps texels in, and the box of
+    /// `bounded`.
     pub range_factor: f64,
+    /// Enforce eq. 3.4's constraint exactly: every unknown in [0, range_factor · max(b)]
+    /// ([`crate::bounded`]: gradient projection and CG on the free face), instead of (not
+    /// together with) the range barrier of eq. 3.8.
+    pub bounded: bool,
     pub form: FormChoice,
     pub mip: MipSolve,
     /// K of the form rule.
@@ -65,6 +71,7 @@ impl Default for SolveSettings {
             epsilon_b: 0.0,
             epsilon_f: 0.0,
             range_factor: 1.1,
+            bounded: false,
             form: FormChoice::Auto,
             mip: MipSolve::Free,
             k: DEFAULT_K,
@@ -83,6 +90,11 @@ impl SolveSettings {
     /// solved through the MIP chain the player decimates from it.
     pub fn decimated() -> Self {
         SolveSettings { mip: MipSolve::Decimated, ..Self::pyramidal() }
+    }
+
+    /// Plain least squares under eq. 3.4's box constraint 0 ≤ x ≤ 1.1 · max(b).
+    pub fn bounded() -> Self {
+        SolveSettings { bounded: true, ..Default::default() }
     }
 
     /// Range regularization with ε_b = 1/32 (thesis 3.6).
@@ -243,7 +255,12 @@ fn solve_views(
                 r.clamp_inside(&mut x);
             }
             let problem = ChannelProblem { op: &op, rhs: &rhs, pyramid: pyramid.as_ref(), chain: chain.as_ref() };
-            let report = cg::minimize(&problem, range.as_ref(), &inv_diag, &mut x, &settings.cg);
+            let report = if settings.bounded {
+                let hi = (settings.range_factor * b_max).max(1e-6);
+                minimize_bounded(&problem, 0.0, hi, &inv_diag, &mut x, &settings.cg)
+            } else {
+                cg::minimize(&problem, range.as_ref(), &inv_diag, &mut x, &settings.cg)
+            };
             if let Some(d) = &chain {
                 let mut full = vec![0.0; n_t];
                 d.expand(&x, &mut full);
@@ -303,6 +320,10 @@ fn check_settings(s: &SolveSettings) -> Result<(), CompileError> {
     if !ok(s.epsilon_b) || !ok(s.epsilon_f) {
         return Err(CompileError::Setting(format!(
             "ε_b = {} and ε_f = {} must be finite and ≥ 0", s.epsilon_b, s.epsilon_f)));
+    }
+    if s.bounded && s.epsilon_b > 0.0 {
+        return Err(CompileError::Setting(
+            "the box constraint and the range term (ε_b) are alternatives: set one".into()));
     }
     if !(s.range_factor.is_finite() && s.range_factor > 0.0 && s.k.is_finite() && s.k > 0.0) {
         return Err(CompileError::Setting("range factor and K must be finite and > 0".into()));

@@ -346,3 +346,28 @@ fn the_decimated_parameterization_fits_the_chain_the_player_draws() {
             "decimated solve {decimated:.2} dB vs free levels drawn decimated {as_drawn:.2} dB (as solved {as_solved:.2} dB)");
     assert!(decimated >= 30.0, "decimated solve {decimated:.2} dB");
 }
+
+/// Eq. 3.4 as written (the box 0 ≤ x ≤ 1.1·max b, enforced exactly): on the receding plane
+/// (a traced-like layer, not in A's range) the bounded fit stays in the box, its objective never rises, it meets the optimality
+/// conditions of the box, and a weak pyramidal term in the same box (every texel defined)
+/// costs under 0.5 dB at the sampled view against it.
+#[test]
+fn bounded_least_squares_keeps_the_box_and_weak_pyramidal_costs_little() {
+    let (a, b, _) = receding_view();
+    let b_max = b.iter().fold(0.0f32, |m, &v| m.max(v));
+    // The solver's default tolerance (1e-4), with room for the iterations.
+    let cg = crate::cg::CgSettings { max_iterations: 5000, ..Default::default() };
+    let bounded = solve(&a, &b, None, &SolveSettings { cg, ..SolveSettings::bounded() }).unwrap();
+    let hi = 1.1 * b_max;
+    assert!(bounded.texels.iter().all(|&v| (0.0..=hi * (1.0 + 1e-6)).contains(&v)), "texels leave [0, {hi}]");
+    assert_monotone(&bounded);
+    assert!(bounded.converged, "{:?}", bounded.channels.iter().map(|c| (c.iterations, c.objective.last().copied())).collect::<Vec<_>>());
+    let pyr = solve(&a, &b, None, &SolveSettings { cg, epsilon_f: 0.003, ..SolveSettings::bounded() }).unwrap();
+    assert_eq!(pyr.undefined, 0);
+    assert!(pyr.texels.iter().all(|v| v.is_finite()));
+    let (p_box, p_pyr) = (psnr(&render(&a, &bounded.texels), &b), psnr(&render(&a, &pyr.texels), &b));
+    eprintln!("bounded {p_box:.2} dB, bounded pyramidal (ε_f 0.003) {p_pyr:.2} dB");
+    assert!(p_box - p_pyr < 0.5, "bounded {p_box:.2} dB, pyramidal {p_pyr:.2} dB");
+    // The range term and the box are alternatives.
+    assert!(solve(&a, &b, None, &SolveSettings { epsilon_b: 1.0 / 32.0, ..SolveSettings::bounded() }).is_err());
+}
