@@ -286,3 +286,42 @@ fn a_damaged_master_is_an_error_without_output() {
     assert_eq!(v.status.code(), Some(3));
     assert!(String::from_utf8_lossy(&v.stdout).contains("error-3004") || String::from_utf8_lossy(&v.stderr).contains("error-3004"));
 }
+
+#[test]
+fn reblocking_from_the_master_gives_a_direct_pack_with_those_blocks() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let out = dir.path().join("reblocked.pis");
+    let r = json(&reencode(mastered(), &out, &["--ratio", "48", "--block", "2"]));
+    validate(&out);
+    assert_eq!(r["source"], "master", "{r}");
+    let (_d, direct) = pack("direct-block2.pis", &["--ratio", "48", "--block", "2"]);
+    // The same blocks, origins, pyramids and level images, byte for byte.
+    same_player_content(&out, &direct);
+    let c = PisReader::open(&out).expect("output").load_all().expect("load");
+    assert!(c.space.dims.iter().all(|d| d.block_size == 2));
+    let before = PisReader::open(mastered()).expect("input").load_all().expect("load");
+    let blocks = |c: &pis_format::Container| c.objects.iter().flat_map(|o| &o.layers).map(|l| l.blocks.len()).sum::<usize>();
+    assert!(blocks(&c) > blocks(&before), "smaller blocks, more of them");
+    for (x, y) in before.objects.iter().zip(&c.objects) {
+        assert_eq!((&x.mesh, &x.transforms), (&y.mesh, &y.transforms), "geometry and transforms are kept");
+    }
+    let prov = c.provenance.expect("provenance");
+    assert!(prov.settings.iter().any(|(k, v)| k == "block" && v == "2x2"), "{:?}", prov.settings);
+}
+
+#[test]
+fn lossless_reblocking_keeps_every_texture() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let (lossless, reblocked, back) = (dir.path().join("lossless.pis"), dir.path().join("block3.pis"), dir.path().join("back.pis"));
+    json(&reencode(packed(), &lossless, &["--codec", "lossless"]));
+    json(&reencode(&lossless, &reblocked, &["--codec", "lossless", "--block", "3x1"]));
+    validate(&reblocked);
+    same_textures(&lossless, &reblocked);
+    json(&reencode(&reblocked, &back, &["--codec", "lossless", "--block", "8"]));
+    same_textures(&lossless, &back);
+    // A bad size is a usage error, and nothing is written.
+    let bad = dir.path().join("bad.pis");
+    let out = reencode(&lossless, &bad, &["--codec", "lossless", "--block", "2x2x2"]);
+    assert_eq!(out.status.code(), Some(1), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(!bad.exists());
+}

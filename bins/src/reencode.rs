@@ -7,7 +7,9 @@
 //! given storage by the equal-slope allocation `pis-pack` uses over all level images of all
 //! blocks, layers and objects, weighted by screen area (4.5), and encoded: from a master, the
 //! steps and inputs of a direct pack at the new settings. Geometry, cameras, the parameter
-//! space, block origins and placements are copied. The output is written atomically, read
+//! space, block origins and placements are copied; with `--block` the samples are grouped
+//! into blocks of new sizes, their origins staggered per object as pis-pack staggers them
+//! (thesis 4.7), each new block keeping the layer's texture placement. The output is written atomically, read
 //! back and compared with the input's decoded textures (and, with a master, both files with
 //! the master).
 
@@ -30,6 +32,7 @@ use serde::Serialize;
 pub use screen_area::screen_areas;
 
 use crate::cli::{Exit, Failure};
+use crate::pack::encode::{block_sizes, stagger};
 use crate::pack::storage::{allocate_storage, build_pyramid, encode_levels, nudge, BlockPyramid};
 
 /// What to re-encode.
@@ -47,6 +50,9 @@ pub struct ReencodeRequest {
     /// Write the lossless master into the output: the input's, or one made from the decoded
     /// textures of an input whose level images are all exact.
     pub keep_master: bool,
+    /// New parameter-block sizes (one for every dimension, or one per dimension), the block
+    /// origins staggered again as pis-pack staggers them; None keeps the input's blocks.
+    pub block: Option<Vec<u32>>,
 }
 
 /// The gamma lossy re-encodings use unless told otherwise (as `pis-pack`).
@@ -235,6 +241,18 @@ pub fn reencode(req: &ReencodeRequest) -> Result<ReencodeReport, Failure> {
             "--keep-master: {} carries no master and its level images are lossy: a master is carried over from a file that has one (pis-pack --keep-master) or made from a losslessly coded file",
             req.input.display())));
     }
+    // The parameter blocks: the input's, or new sizes with origins staggered per object.
+    let mut space = c.space.clone();
+    let staggers: Vec<Vec<u32>> = match &req.block {
+        None => c.objects.iter().map(|o| o.stagger.clone()).collect(),
+        Some(b) => {
+            let sizes = block_sizes(b, c.space.dims.len()).map_err(|e| usage(e.to_string()))?;
+            for (d, &s) in space.dims.iter_mut().zip(&sizes) {
+                d.block_size = s;
+            }
+            (0..c.objects.len()).map(|i| stagger(i, c.objects.len(), &sizes)).collect()
+        }
+    };
     let exact = !req.codec.is_lossy();
     let gamma = if exact { 1.0 } else { req.gamma.unwrap_or(DEFAULT_GAMMA) };
     let texture_bytes_before: u64 = c.objects.iter().map(|o| stream_bytes(o, |s| s.length as u64)).sum();
@@ -259,6 +277,11 @@ pub fn reencode(req: &ReencodeRequest) -> Result<ReencodeReport, Failure> {
                 Some(m) => master::from_master(c, m, oi, li),
                 None => master::from_decoded(&input, oi, li),
             }.map_err(|e| in_file(&req.input, e))?;
+            let sources = if req.block.is_some() {
+                master::regroup(c, &space, &staggers[oi], oi, li, sources).map_err(|e| Failure::new(Exit::NotSupported, anyhow::Error::from(e)))?
+            } else {
+                sources
+            };
             let blocks = sources.par_iter().map(|b| {
                 let samples: Vec<Vec<f32>> = b.textures.par_iter().map(|x| prepared(&layer, &b.layout, x, exact)).collect();
                 let mut p = build_pyramid(oi, b.layout.planes(), &b.extent, &samples, layer_samples, exact, false).map_err(runtime)?;
@@ -310,10 +333,18 @@ pub fn reencode(req: &ReencodeRequest) -> Result<ReencodeReport, Failure> {
 
     // The container: everything copied but gamma and pyramids.
     let mut out: Container = c.try_map(&mut |_| Ok::<_, Error>(Codestream { codec: req.codec, bytes: vec![] })).map_err(Failure::from)?;
+    out.space = space.clone();
     let mut next = pyramids.into_iter();
-    for (o, gammas) in out.objects.iter_mut().zip(&layers_out) {
+    for ((o, gammas), st) in out.objects.iter_mut().zip(&layers_out).zip(&staggers) {
+        o.stagger = st.clone();
         for (l, &g) in o.layers.iter_mut().zip(gammas) {
             l.gamma = g;
+            if req.block.is_some() {
+                // Every new block keeps the layer's one placement (checked by the regrouping).
+                let template = l.blocks.first().cloned().ok_or_else(|| runtime(anyhow!("a layer without blocks")))?;
+                let count = pis_format::blocks::BlockGrid::new(&space, l.depends_on, st).block_count() as usize;
+                l.blocks = vec![Block { levels: Vec::new(), ..template }; count];
+            }
             for b in &mut l.blocks {
                 let p = next.next().ok_or_else(|| runtime(anyhow!("fewer pyramids than blocks")))?;
                 b.levels = p.levels.into_iter().map(|(counts, _, streams)| Level {
@@ -325,6 +356,7 @@ pub fn reencode(req: &ReencodeRequest) -> Result<ReencodeReport, Failure> {
     }
     let before = c.provenance.clone().unwrap_or_default();
     let mut settings: Vec<(String, String)> = before.settings.iter()
+        .filter(|(k, _)| !(req.block.is_some() && k == "block"))
         .filter(|(k, _)| !matches!(k.as_str(), "codec" | "gamma" | "target" | "reencoded_from" | "source_tool" | "source_codec" | crate::pack::PREDICTED_PSNR_SETTING))
         .cloned().collect();
     let codecs_before: Vec<String> = {
@@ -334,6 +366,9 @@ pub fn reencode(req: &ReencodeRequest) -> Result<ReencodeReport, Failure> {
         v.dedup();
         v
     };
+    if req.block.is_some() {
+        settings.push(("block".to_string(), space.dims.iter().map(|d| d.block_size.to_string()).collect::<Vec<_>>().join("x")));
+    }
     settings.extend([
         ("codec".to_string(), req.codec.name().to_string()),
         ("gamma".to_string(), gamma.to_string()),

@@ -44,6 +44,11 @@ struct Cli {
     /// output carries no master.
     #[arg(long)]
     keep_master: bool,
+    /// Parameter-block sizes of the output: N (every dimension) or NxM (one per dimension),
+    /// as pis-pack's --block; the block origins are staggered per object again as pis-pack
+    /// staggers them. Default: the input's blocks.
+    #[arg(long, value_parser = parse_block)]
+    block: Option<BlockSizes>,
     /// Print the report as JSON on stdout.
     #[arg(long)]
     json: bool,
@@ -53,8 +58,16 @@ fn parse_codec(s: &str) -> Result<CodecId, String> {
     CodecId::ALL.into_iter().find(|c| c.name() == s).ok_or_else(|| format!("unknown codec {s:?} (wavelet, dct, lossless or raw)"))
 }
 
+/// `--block`: one size, or one per dimension.
+#[derive(Clone, Debug)]
+struct BlockSizes(Vec<u32>);
+
+fn parse_block(s: &str) -> Result<BlockSizes, String> {
+    s.split(['x', 'X']).map(|p| p.trim().parse::<u32>().ok().filter(|&b| b > 0).ok_or_else(|| format!("bad block size {s:?}: expected N or NxM"))).collect::<Result<_, _>>().map(BlockSizes)
+}
+
 fn run(cli: Cli) -> Result<Exit, Failure> {
-    let req = ReencodeRequest { input: cli.input, output: cli.output, codec: cli.codec, ratio: cli.ratio, psnr: cli.psnr, gamma: cli.gamma, keep_master: cli.keep_master };
+    let req = ReencodeRequest { input: cli.input, output: cli.output, codec: cli.codec, ratio: cli.ratio, psnr: cli.psnr, gamma: cli.gamma, keep_master: cli.keep_master, block: cli.block.map(|b| b.0) };
     let report = reencode(&req)?;
     print_report(&report, &mut std::io::stderr()).map_err(|e| Failure::new(Exit::Io, e))?;
     if cli.json {

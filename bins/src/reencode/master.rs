@@ -6,7 +6,7 @@ use pis_eval::diff::decode::decode_block;
 use pis_eval::metrics::SquaredError;
 use pis_format::blocks::BlockGrid;
 use pis_format::master::sample_point;
-use pis_format::{Container, Error, LevelLayout, Master, PisReader, StreamRef};
+use pis_format::{Container, Error, LevelLayout, Master, ParameterSpace, PisReader, StreamRef};
 use rayon::prelude::*;
 
 /// The linear textures of one parameter block.
@@ -98,4 +98,49 @@ pub fn error_against(r: &PisReader, masters: &[Master]) -> Result<(SquaredError,
         objects.push(obj);
     }
     Ok((total, objects))
+}
+
+/// The same samples grouped into the blocks of another grid (`pis-reencode --block`): `space`
+/// holds the new block sizes, `stagger` the object's new block origins. Every block of the
+/// layer must share one texture placement and size (pis-pack places a texture once per
+/// object), since a new block may gather samples of several old ones.
+pub fn regroup<S>(c: &Container<S>, space: &ParameterSpace, stagger: &[u32], object: usize, layer: usize, old: Vec<BlockSource>) -> Result<Vec<BlockSource>, Error> {
+    let l = &c.objects[object].layers[layer];
+    let first = l.blocks.first().ok_or_else(|| Error::Request(format!("object {object} layer {layer} has no blocks")))?;
+    if l.blocks.iter().any(|b| b.width != first.width || b.height != first.height || b.placement != first.placement) {
+        return Err(Error::Request(format!(
+            "object '{}' layer {layer}: its blocks place the texture differently; re-blocking needs one placement per layer",
+            c.objects[object].name)));
+    }
+    let layout = old.first().map(|b| b.layout.clone()).ok_or_else(|| Error::Request(format!("object {object} layer {layer}: no block sources")))?;
+    let n = c.space.table_len(l.depends_on) as usize;
+    let mut textures: Vec<Option<Vec<f32>>> = vec![None; n];
+    let has_weights = old.iter().all(|b| b.weights.is_some());
+    let mut weights: Vec<Option<Vec<f32>>> = vec![None; n];
+    for b in old {
+        let ws = b.weights.map(|w| w.into_iter().map(Some).collect::<Vec<_>>()).unwrap_or_else(|| vec![None; b.tables.len()]);
+        for ((x, t), w) in b.textures.into_iter().zip(b.tables).zip(ws) {
+            let slot = textures.get_mut(t).ok_or_else(|| Error::Request(format!("object {object} layer {layer}: table sample {t} out of range")))?;
+            *slot = Some(x);
+            weights[t] = w;
+        }
+    }
+    let grid = BlockGrid::new(space, l.depends_on, stagger);
+    let mut blocks: Vec<BlockSource> = (0..grid.block_count() as usize).map(|bi| {
+        let extent = grid.extent(bi);
+        let count = extent.iter().map(|&e| e as usize).product();
+        BlockSource { layout: layout.clone(), extent, textures: vec![Vec::new(); count], tables: vec![0; count], weights: has_weights.then(|| vec![Vec::new(); count]) }
+    }).collect();
+    for (s, x) in textures.into_iter().enumerate() {
+        let x = x.ok_or_else(|| Error::Request(format!("object {object} layer {layer}: table sample {s} is in no block")))?;
+        let pos = grid.locate(&sample_point(c, l, s as u64));
+        let idx = pos.local.iter().zip(&pos.extent).fold(0usize, |a, (&i, &e)| a * e as usize + i as usize);
+        let b = &mut blocks[pos.block];
+        b.textures[idx] = x;
+        b.tables[idx] = s;
+        if let (Some(ws), Some(w)) = (b.weights.as_mut(), weights[s].take()) {
+            ws[idx] = w;
+        }
+    }
+    Ok(blocks)
 }
