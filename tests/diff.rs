@@ -297,3 +297,37 @@ fn against_the_set_gates_and_flip_maps() {
     assert_eq!(out.status.code(), Some(1));
     assert!(String::from_utf8_lossy(&out.stderr).contains("--reference-psnr"));
 }
+
+/// Two ray-traced sets: a set against itself is identical; against the same scene traced with
+/// more samples per pixel the noise shows as a finite PSNR that rises with the samples; sets of
+/// other sizes are refused.
+#[test]
+fn two_sets_compare_their_noise() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let trace = |name: &str, spp: &str, size: &str| {
+        let out_dir = dir.path().join(name);
+        let out = Command::new(env!("CARGO_BIN_EXE_pis-trace"))
+            .arg(repo("samples/demo1/scene.toml")).arg("-o").arg(&out_dir)
+            .args(["--resolution", size, "--spp", spp, "--points", "2"]).output().expect("pis-trace runs");
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        out_dir
+    };
+    let (s2, s8, s32, small) = (trace("s2", "2", "40x30"), trace("s8", "8", "40x30"), trace("s32", "32", "40x30"), trace("small", "2", "20x15"));
+    let same = diff(&s2, &s2, &["--json"]);
+    assert_eq!(same.status.code(), Some(0));
+    let v = json(&same);
+    assert!(v["psnr_db"].is_null(), "identical sets: {v}");
+    let score = |a: &Path| {
+        let out = diff(a, &s32, &["--json"]);
+        assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
+        let v = json(&out);
+        assert_eq!(v["points_compared"], 2, "{v}");
+        assert_eq!(v["objects"].as_array().expect("objects").len(), 6, "{v}");
+        v["psnr_db"].as_f64().expect("finite PSNR")
+    };
+    let (p2, p8) = (score(&s2), score(&s8));
+    assert!(p8 > p2 + 2.0, "8 spp {p8:.2} dB should be well above 2 spp {p2:.2} dB against 32 spp");
+    // A gate on the PSNR, and sets of other sizes.
+    assert_eq!(diff(&s2, &s32, &["--min-psnr", &format!("{}", p2 + 1.0)]).status.code(), Some(7));
+    assert_eq!(diff(&s2, &small, &[]).status.code(), Some(3));
+}

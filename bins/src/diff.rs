@@ -8,6 +8,7 @@
 //! ray-traced set instead of a second file, [`gold`] measures the file against it.
 
 pub mod gold;
+pub mod sets;
 
 use std::fmt::Write;
 use std::path::{Path, PathBuf};

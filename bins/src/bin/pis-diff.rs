@@ -19,10 +19,15 @@ use pis::diff::{diff, render, DiffRequest};
 /// compared with the set's image (the comparison `pis-play --headless --compare` prints):
 /// PSNR per point, object and parameter block, and NVIDIA FLIP on the sRGB images (mean per
 /// image, per object and overall); --heatmaps writes FLIP error maps per point.
+///
+/// With two set folders, compares the ray-traced sets themselves at the points both hold
+/// (e.g. a set against one traced with more samples per pixel: the Monte Carlo noise of the
+/// gold standard, which bounds any PSNR measured against it): PSNR of the combined images
+/// per point and overall, and per object over the pixels both cover.
 #[derive(Parser, Debug)]
 #[command(name = "pis-diff", version, after_help = "Exit codes: 0 identical or within the gates, 1 bad arguments, 2 I/O error, 3 invalid file, 4 runtime error, 5 not supported, 7 the files differ (no gate given) or a gate failed")]
 struct Cli {
-    /// The first .pis file (the reference).
+    /// The first .pis file (the reference), or a ray-traced set folder (with a second one).
     a: PathBuf,
     /// The second .pis file, or a ray-traced set folder (gold-standard comparison).
     b: PathBuf,
@@ -52,6 +57,19 @@ struct Cli {
 }
 
 fn run(cli: Cli) -> Result<Exit, Failure> {
+    if cli.a.is_dir() && cli.b.is_dir() {
+        if cli.max_psnr_drop.is_some() || cli.reference_psnr.is_some() || cli.heatmaps.is_some() {
+            return Err(Failure::new(Exit::Usage, anyhow::anyhow!("two ray-traced sets compare with --min-psnr and --json only")));
+        }
+        let report = pis::diff::sets::compare_sets(&pis::diff::sets::SetsRequest { a: cli.a, b: cli.b, min_psnr: cli.min_psnr })?;
+        if cli.json {
+            let s = serde_json::to_string_pretty(&report).map_err(|e| Failure::new(Exit::Runtime, e))?;
+            println!("{s}");
+        } else {
+            print!("{}", pis::diff::sets::render(&report));
+        }
+        return Ok(report.exit());
+    }
     if cli.b.is_dir() {
         let req = GoldRequest { file: cli.a, set: cli.b, heatmaps: cli.heatmaps, min_psnr: cli.min_psnr, max_psnr_drop: cli.max_psnr_drop, reference_psnr: cli.reference_psnr, msaa: cli.msaa };
         let report = gold(&req)?;
