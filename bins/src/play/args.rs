@@ -133,8 +133,9 @@ pub struct PlayArgs {
     /// Print the report as JSON on stdout.
     #[arg(long)]
     pub json: bool,
-    /// Window mode: a ray-traced set of the same space; the panel (or G) shows its gold
-    /// standard at the nearest sample instead of the player's frame.
+    /// A ray-traced set of the same space. Its display filter resolves multisampled frames
+    /// when the file records none (headless too). Window mode: the panel (or G) shows its
+    /// gold standard at the nearest sample instead of the player's frame.
     #[arg(long, value_name = "SET_DIR")]
     pub set: Option<PathBuf>,
     /// Window mode: start showing the gold standard of --set.

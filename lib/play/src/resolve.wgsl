@@ -50,19 +50,54 @@ fn vs_full(@builtin(vertex_index) i: u32) -> @builtin(position) vec4<f32> {
     return vec4<f32>(x * 2.0 - 1.0, 1.0 - y * 2.0, 0.0, 1.0);
 }
 
+// The filter's weight of sample `s` of the pixel at offset `o` from p.
+fn weight(o: vec2<i32>, s: i32) -> f32 {
+    let d = vec2<f32>(o) + POSITIONS[s] - vec2<f32>(0.5);
+    let r2 = dot(d, d);
+    if (r2 > kernel.radius2) {
+        return 0.0;
+    }
+    return exp(-r2 * kernel.inv_two_sigma2);
+}
+
+// The mean of p's own samples, a running mean: equal samples give exactly their value.
+fn own_average(p: vec2<i32>, n: i32) -> vec4<f32> {
+    var m = textureLoad(colour, p, 0);
+    for (var s = 1; s < n; s = s + 1) {
+        m = m + (textureLoad(colour, p, s) - m) / f32(s + 1);
+    }
+    return m;
+}
+
 @fragment
 fn fs_resolve(@builtin(position) at: vec4<f32>) -> @location(0) vec4<f32> {
     let p = vec2<i32>(at.xy);
     let size = vec2<i32>(textureDimensions(ids));
+    let n = i32(min(textureNumSamples(ids), 4u));
+    // Most pixels: every sample of the neighbourhood (that the filter reaches) on one
+    // object (or none). Its radiance at p, unfiltered.
+    let first = textureLoad(ids, p, 0).r;
+    var one_object = true;
+    for (var k = 0; k < 9 * n && one_object; k = k + 1) {
+        let o = vec2<i32>(k / n % 3 - 1, k / n / 3 - 1);
+        let q = p + o;
+        let s = k % n;
+        let inside = all(q >= vec2<i32>(0)) && all(q < size);
+        if (inside && (all(o == vec2<i32>(0)) || weight(o, s) > 0.0)) {
+            one_object = textureLoad(ids, q, s).r == first;
+        }
+    }
+    if (one_object) {
+        return own_average(p, n);
+    }
     // Per group: object index, Σ w, Σ w·colour, own samples and their running mean.
     var index: array<u32, MAX_GROUPS>;
-    var weight: array<f32, MAX_GROUPS>;
+    var mass: array<f32, MAX_GROUPS>;
     var weighted: array<vec4<f32>, MAX_GROUPS>;
     var own: array<u32, MAX_GROUPS>;
     var own_mean: array<vec4<f32>, MAX_GROUPS>;
     var groups = 0u;
     var total = 0.0;
-    let n = i32(min(textureNumSamples(ids), 4u));
     for (var dy = -1; dy <= 1; dy = dy + 1) {
         for (var dx = -1; dx <= 1; dx = dx + 1) {
             let q = p + vec2<i32>(dx, dy);
@@ -73,12 +108,7 @@ fn fs_resolve(@builtin(position) at: vec4<f32>) -> @location(0) vec4<f32> {
             }
             let is_own = dx == 0 && dy == 0;
             for (var s = 0; s < n; s = s + 1) {
-                let d = vec2<f32>(f32(dx), f32(dy)) + POSITIONS[s] - vec2<f32>(0.5);
-                let r2 = dot(d, d);
-                var w = 0.0;
-                if (r2 <= kernel.radius2) {
-                    w = exp(-r2 * kernel.inv_two_sigma2);
-                }
+                let w = weight(vec2<i32>(dx, dy), s);
                 if (w <= 0.0 && !is_own) {
                     continue;
                 }
@@ -93,13 +123,13 @@ fn fs_resolve(@builtin(position) at: vec4<f32>) -> @location(0) vec4<f32> {
                 }
                 if (g == groups) {
                     index[g] = id;
-                    weight[g] = 0.0;
+                    mass[g] = 0.0;
                     weighted[g] = vec4<f32>(0.0);
                     own[g] = 0u;
                     own_mean[g] = vec4<f32>(0.0);
                     groups = groups + 1u;
                 }
-                weight[g] = weight[g] + w;
+                mass[g] = mass[g] + w;
                 weighted[g] = weighted[g] + w * c;
                 total = total + w;
                 if (is_own) {
@@ -128,14 +158,14 @@ fn fs_resolve(@builtin(position) at: vec4<f32>) -> @location(0) vec4<f32> {
         return out;
     }
     for (var g = 0u; g < groups; g = g + 1u) {
-        if (weight[g] <= 0.0) {
+        if (mass[g] <= 0.0) {
             continue;
         }
-        var radiance = weighted[g] / weight[g];
+        var radiance = weighted[g] / mass[g];
         if (own[g] > 0u) {
             radiance = own_mean[g];
         }
-        out = out + radiance * (weight[g] / total);
+        out = out + radiance * (mass[g] / total);
     }
     return out;
 }
