@@ -50,10 +50,15 @@ fn vs_full(@builtin(vertex_index) i: u32) -> @builtin(position) vec4<f32> {
     return vec4<f32>(x * 2.0 - 1.0, 1.0 - y * 2.0, 0.0, 1.0);
 }
 
+// The squared distance from p's centre of sample `s` of the pixel at offset `o` from p.
+fn distance2(o: vec2<i32>, s: i32) -> f32 {
+    let d = vec2<f32>(o) + POSITIONS[s] - vec2<f32>(0.5);
+    return dot(d, d);
+}
+
 // The filter's weight of sample `s` of the pixel at offset `o` from p.
 fn weight(o: vec2<i32>, s: i32) -> f32 {
-    let d = vec2<f32>(o) + POSITIONS[s] - vec2<f32>(0.5);
-    let r2 = dot(d, d);
+    let r2 = distance2(o, s);
     if (r2 > kernel.radius2) {
         return 0.0;
     }
@@ -78,13 +83,19 @@ fn fs_resolve(@builtin(position) at: vec4<f32>) -> @location(0) vec4<f32> {
     // object (or none). Its radiance at p, unfiltered.
     let first = textureLoad(ids, p, 0).r;
     var one_object = true;
-    for (var k = 0; k < 9 * n && one_object; k = k + 1) {
-        let o = vec2<i32>(k / n % 3 - 1, k / n / 3 - 1);
-        let q = p + o;
-        let s = k % n;
-        let inside = all(q >= vec2<i32>(0)) && all(q < size);
-        if (inside && (all(o == vec2<i32>(0)) || weight(o, s) > 0.0)) {
-            one_object = textureLoad(ids, q, s).r == first;
+    for (var dy = -1; dy <= 1 && one_object; dy = dy + 1) {
+        for (var dx = -1; dx <= 1 && one_object; dx = dx + 1) {
+            let o = vec2<i32>(dx, dy);
+            let q = p + o;
+            if (any(q < vec2<i32>(0)) || any(q >= size)) {
+                continue;
+            }
+            for (var s = 0; s < n; s = s + 1) {
+                // Samples beyond R weigh nothing (p's own count for its radiance).
+                if ((dx == 0 && dy == 0) || distance2(o, s) <= kernel.radius2) {
+                    one_object = one_object && textureLoad(ids, q, s).r == first;
+                }
+            }
         }
     }
     if (one_object) {
