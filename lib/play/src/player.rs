@@ -337,7 +337,8 @@ impl Player {
 
     /// Draws a frame offscreen; linear RGBA read back, colour premultiplied by coverage:
     /// alpha is the fraction of the pixel's samples objects cover (1 inside objects, 0
-    /// where none is drawn, between on silhouettes of multisampled frames).
+    /// where none is drawn, between on silhouettes of multisampled frames; with a display
+    /// filter, the objects' filtered coverage of the pixel's 3×3 neighbourhood's samples).
     pub fn render_image(&mut self, req: &FrameRequest, size: (u32, u32)) -> Result<(FloatImage, FrameStats), PlayError> {
         let (out, stats) = self.frame(req, size, Target::Offscreen { ids: false })?;
         let (img, _) = out.ok_or_else(|| PlayError::Readback("no offscreen frame".into()))?;
