@@ -246,6 +246,8 @@ struct SampleTargets {
     ids_bind: wgpu::BindGroup,
     /// Keyed by format and whether the display-filter resolve reads it.
     colour: HashMap<(wgpu::TextureFormat, bool), wgpu::Texture>,
+    /// The display-filter resolve's per-pixel shared object index (made on first use).
+    shared_ids: Option<wgpu::Texture>,
 }
 
 /// The per-size targets: object indices (one per pixel, at its centre), depth, the offscreen
@@ -294,7 +296,7 @@ impl Targets {
             let ids = target_texture(gpu, "object ids per sample", size, samples, ID_FORMAT, attach | wgpu::TextureUsages::TEXTURE_BINDING);
             let depth = target_texture(gpu, "depth per sample", size, samples, DEPTH_FORMAT, attach);
             let ids_bind = bind(&ids, &pipes.ids_ms_layout, 1);
-            SampleTargets { ids, depth, ids_bind, colour: HashMap::new() }
+            SampleTargets { ids, depth, ids_bind, colour: HashMap::new(), shared_ids: None }
         });
         Ok(Targets { size, samples, ids, depth, colour, ids_bind, multi })
     }
@@ -466,8 +468,9 @@ pub fn encode(
         pass.draw_indexed(0..m.count, 0, 0..1);
     }
     drop(pass);
-    if let (Some(filter), Some(m)) = (display, &targets.multi) {
-        pipes.resolve.encode(gpu, filter, &m.colour[&(sample_format, true)], &m.ids, colour, format, encoder);
+    if let (Some(filter), Some(m)) = (display, &mut targets.multi) {
+        let shared = m.shared_ids.get_or_insert_with(|| target_texture(gpu, "shared object ids", size, 1, crate::resolve::SHARED_ID_FORMAT, wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING));
+        pipes.resolve.encode(gpu, filter, &m.colour[&(sample_format, true)], &m.ids, shared, colour, format, encoder);
     }
 }
 

@@ -37,12 +37,53 @@ impl Kernel {
     }
 }
 
-/// The resolve pipelines: one per target format.
+/// The format of the per-pixel shared object index the first pass writes.
+pub const SHARED_ID_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Uint;
+
+/// The resolve pipelines: the first pass (each pixel's shared object index) and the resolve
+/// per target format.
 pub struct ResolvePipelines {
     module: wgpu::ShaderModule,
     bind_layout: wgpu::BindGroupLayout,
+    shared_layout: wgpu::BindGroupLayout,
     layout: wgpu::PipelineLayout,
+    classify: wgpu::RenderPipeline,
     pipelines: HashMap<wgpu::TextureFormat, wgpu::RenderPipeline>,
+}
+
+fn full_screen(d: &wgpu::Device, module: &wgpu::ShaderModule, layout: &wgpu::PipelineLayout, entry_point: &str, format: wgpu::TextureFormat) -> wgpu::RenderPipeline {
+    d.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+        label: Some(entry_point),
+        layout: Some(layout),
+        vertex: wgpu::VertexState { module, entry_point: Some("vs_full"), compilation_options: Default::default(), buffers: &[] },
+        primitive: wgpu::PrimitiveState { topology: wgpu::PrimitiveTopology::TriangleList, cull_mode: None, ..Default::default() },
+        depth_stencil: None,
+        multisample: wgpu::MultisampleState::default(),
+        fragment: Some(wgpu::FragmentState {
+            module,
+            entry_point: Some(entry_point),
+            compilation_options: Default::default(),
+            targets: &[Some(wgpu::ColorTargetState { format, blend: None, write_mask: wgpu::ColorWrites::ALL })],
+        }),
+        multiview_mask: None,
+        cache: None,
+    })
+}
+
+fn full_screen_pass<'e>(encoder: &'e mut wgpu::CommandEncoder, label: &str, target: &wgpu::TextureView) -> wgpu::RenderPass<'e> {
+    encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+        label: Some(label),
+        color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+            view: target,
+            depth_slice: None,
+            resolve_target: None,
+            ops: wgpu::Operations { load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT), store: wgpu::StoreOp::Store },
+        })],
+        depth_stencil_attachment: None,
+        timestamp_writes: None,
+        occlusion_query_set: None,
+        multiview_mask: None,
+    })
 }
 
 fn entry(binding: u32, ty: wgpu::BindingType) -> wgpu::BindGroupLayoutEntry {
@@ -65,38 +106,29 @@ impl ResolvePipelines {
                 entry(2, wgpu::BindingType::Buffer { ty: wgpu::BufferBindingType::Uniform, has_dynamic_offset: false, min_binding_size: None }),
             ],
         });
-        let layout = d.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor { label: Some("resolve"), bind_group_layouts: &[Some(&bind_layout)], immediate_size: 0 });
-        ResolvePipelines { module, bind_layout, layout, pipelines: HashMap::new() }
+        let shared_layout = d.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("shared object indices"),
+            entries: &[entry(0, wgpu::BindingType::Texture { sample_type: wgpu::TextureSampleType::Uint, view_dimension: wgpu::TextureViewDimension::D2, multisampled: false })],
+        });
+        let classify_layout = d.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor { label: Some("shared object indices"), bind_group_layouts: &[Some(&bind_layout)], immediate_size: 0 });
+        let layout = d.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor { label: Some("resolve"), bind_group_layouts: &[Some(&bind_layout), Some(&shared_layout)], immediate_size: 0 });
+        let classify = full_screen(d, &module, &classify_layout, "fs_classify", SHARED_ID_FORMAT);
+        ResolvePipelines { module, bind_layout, shared_layout, layout, classify, pipelines: HashMap::new() }
     }
 
     /// The pipeline writing targets of `format` (compiled on first use).
     pub fn pipeline(&mut self, gpu: &Gpu, format: wgpu::TextureFormat) -> &wgpu::RenderPipeline {
         let (module, layout) = (&self.module, &self.layout);
-        self.pipelines.entry(format).or_insert_with(|| {
-            gpu.device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-                label: Some("display-filter resolve"),
-                layout: Some(layout),
-                vertex: wgpu::VertexState { module, entry_point: Some("vs_full"), compilation_options: Default::default(), buffers: &[] },
-                primitive: wgpu::PrimitiveState { topology: wgpu::PrimitiveTopology::TriangleList, cull_mode: None, ..Default::default() },
-                depth_stencil: None,
-                multisample: wgpu::MultisampleState::default(),
-                fragment: Some(wgpu::FragmentState {
-                    module,
-                    entry_point: Some("fs_resolve"),
-                    compilation_options: Default::default(),
-                    targets: &[Some(wgpu::ColorTargetState { format, blend: None, write_mask: wgpu::ColorWrites::ALL })],
-                }),
-                multiview_mask: None,
-                cache: None,
-            })
-        })
+        self.pipelines.entry(format).or_insert_with(|| full_screen(&gpu.device, module, layout, "fs_resolve", format))
     }
 
     /// Records the resolve of `colour` (multisampled, float) and `ids` (multisampled object
     /// indices, [`ID_FORMAT`], as many samples) into `target` (format `format`, same size):
-    /// every pixel written.
+    /// every pixel written. `shared` (single-sample, [`SHARED_ID_FORMAT`], same size,
+    /// render attachment and texture binding) holds each pixel's shared object index
+    /// between the two passes.
     #[allow(clippy::too_many_arguments)]
-    pub fn encode(&mut self, gpu: &Gpu, filter: DisplayFilter, colour: &wgpu::Texture, ids: &wgpu::Texture, target: &wgpu::TextureView, format: wgpu::TextureFormat, encoder: &mut wgpu::CommandEncoder) {
+    pub fn encode(&mut self, gpu: &Gpu, filter: DisplayFilter, colour: &wgpu::Texture, ids: &wgpu::Texture, shared: &wgpu::Texture, target: &wgpu::TextureView, format: wgpu::TextureFormat, encoder: &mut wgpu::CommandEncoder) {
         debug_assert_eq!(ids.format(), ID_FORMAT);
         self.pipeline(gpu, format);
         let d = &gpu.device;
@@ -111,21 +143,22 @@ impl ResolvePipelines {
                 wgpu::BindGroupEntry { binding: 2, resource: kernel.as_entire_binding() },
             ],
         });
-        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: Some("display-filter resolve"),
-            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                view: target,
-                depth_slice: None,
-                resolve_target: None,
-                ops: wgpu::Operations { load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT), store: wgpu::StoreOp::Store },
-            })],
-            depth_stencil_attachment: None,
-            timestamp_writes: None,
-            occlusion_query_set: None,
-            multiview_mask: None,
+        let shared_view = shared.create_view(&Default::default());
+        {
+            let mut pass = full_screen_pass(encoder, "shared object indices", &shared_view);
+            pass.set_pipeline(&self.classify);
+            pass.set_bind_group(0, &bind, &[]);
+            pass.draw(0..3, 0..1);
+        }
+        let shared_bind = d.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("shared object indices"),
+            layout: &self.shared_layout,
+            entries: &[wgpu::BindGroupEntry { binding: 0, resource: wgpu::BindingResource::TextureView(&shared_view) }],
         });
+        let mut pass = full_screen_pass(encoder, "display-filter resolve", target);
         pass.set_pipeline(&self.pipelines[&format]);
         pass.set_bind_group(0, &bind, &[]);
+        pass.set_bind_group(1, &shared_bind, &[]);
         pass.draw(0..3, 0..1);
     }
 }

@@ -31,6 +31,11 @@ struct Kernel {
 @group(0) @binding(0) var colour: texture_multisampled_2d<f32>;
 @group(0) @binding(1) var ids: texture_multisampled_2d<u32>;
 @group(0) @binding(2) var<uniform> kernel: Kernel;
+// Per pixel, the object index all its samples share, or MIXED (`fs_classify`).
+@group(1) @binding(0) var shared_ids: texture_2d<u32>;
+
+// No object index is this large (the "no object" index is 0xffffffff).
+const MIXED: u32 = 0xfffffffeu;
 
 // 3×3 pixels × 4 samples: the most distinct objects a neighbourhood can hold.
 const MAX_GROUPS: u32 = 36u;
@@ -74,29 +79,34 @@ fn own_average(p: vec2<i32>, n: i32) -> vec4<f32> {
     return m;
 }
 
+// The first pass: per pixel, the object index its samples share, or MIXED. The resolve
+// reads 9 of these instead of the neighbourhood's samples to find the pixels whose
+// neighbourhood is one object's.
+@fragment
+fn fs_classify(@builtin(position) at: vec4<f32>) -> @location(0) u32 {
+    let p = vec2<i32>(at.xy);
+    let first = textureLoad(ids, p, 0).r;
+    for (var s = 1; s < i32(textureNumSamples(ids)); s = s + 1) {
+        if (textureLoad(ids, p, s).r != first) {
+            return MIXED;
+        }
+    }
+    return first;
+}
+
 @fragment
 fn fs_resolve(@builtin(position) at: vec4<f32>) -> @location(0) vec4<f32> {
     let p = vec2<i32>(at.xy);
     let size = vec2<i32>(textureDimensions(ids));
     let n = i32(min(textureNumSamples(ids), 4u));
-    // Most pixels: every sample of the neighbourhood (that the filter reaches) on one
-    // object (or none). Its radiance at p, unfiltered.
-    let first = textureLoad(ids, p, 0).r;
-    var one_object = true;
-    for (var dy = -1; dy <= 1 && one_object; dy = dy + 1) {
-        for (var dx = -1; dx <= 1 && one_object; dx = dx + 1) {
-            let o = vec2<i32>(dx, dy);
-            let q = p + o;
-            if (any(q < vec2<i32>(0)) || any(q >= size)) {
-                continue;
-            }
-            for (var s = 0; s < n; s = s + 1) {
-                // Samples beyond R weigh nothing (p's own count for its radiance).
-                if ((dx == 0 && dy == 0) || distance2(o, s) <= kernel.radius2) {
-                    one_object = one_object && textureLoad(ids, q, s).r == first;
-                }
-            }
-        }
+    // Most pixels: every sample of the 3×3 neighbourhood on one object (or none). Its
+    // radiance at p, unfiltered. (Where only samples the filter does not reach differ, the
+    // grouping below finds one group and returns the same value.)
+    let first = textureLoad(shared_ids, p, 0).r;
+    var one_object = first != MIXED;
+    for (var k = 0; k < 9 && one_object; k = k + 1) {
+        let q = clamp(p + vec2<i32>(k % 3 - 1, k / 3 - 1), vec2<i32>(0), size - vec2<i32>(1));
+        one_object = textureLoad(shared_ids, q, 0).r == first;
     }
     if (one_object) {
         return own_average(p, n);
