@@ -5,6 +5,11 @@
 //! provenance settings, SPEC.md 6.6), each object at its radiance at the pixel. Silhouette
 //! pixels then mix the surfaces as the gold standard's filtered pixels do, up to R pixels
 //! from the edge; a pixel whose neighbourhood is one object keeps its single-sample value.
+//!
+//! Two full-screen passes: the first writes each pixel's shared object index (that of all
+//! its samples, or "mixed"), from which the second tells the pixels whose neighbourhood is
+//! one object's (9 reads) and returns their own samples' mean; only the others group and
+//! weigh the neighbourhood's 36 samples.
 
 use std::collections::HashMap;
 

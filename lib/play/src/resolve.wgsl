@@ -13,6 +13,8 @@
 //
 // which is the gold standard's composition Σ_o coverage_o · layer_o at silhouettes. A pixel
 // whose neighbourhood holds one object only returns that object's radiance unchanged.
+// `fs_classify` runs first and writes each pixel's shared object index, so that such pixels
+// are found from 9 reads.
 //
 // Sample positions: wgpu asks for 4 samples, and WebGPU (and Vulkan's
 // standardSampleLocations, which every Vulkan implementation of 4× MSAA that wgpu runs on
