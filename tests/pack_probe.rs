@@ -72,6 +72,9 @@ fn probe_pack_predicts_what_the_model_pack_predicts() {
     for (r, file, source) in [(&model, &model_file, "model"), (&probe, &probe_file, "probe")] {
         assert_eq!(setting(file, "matrix").as_deref(), Some(source));
         assert_eq!(setting(file, "filter").as_deref(), Some("trilinear"));
+        // The set's display filter (pis-trace's default), for the player's resolve.
+        assert_eq!(setting(file, "display_filter").as_deref(), Some("gaussian"));
+        assert_eq!((setting(file, "display_filter_sigma_px").as_deref(), setting(file, "display_filter_radius_px").as_deref()), (Some("0.5"), Some("1.5")));
         assert_eq!(r["lossless_exact"].as_bool(), Some(true));
     }
     // Lossless: the prediction is the inference's own, solved through each A.

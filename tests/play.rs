@@ -106,7 +106,9 @@ fn compare_agrees_with_the_pack_prediction() {
 
 /// The gold standard's pixels are filtered (a Gaussian-weighted average of sub-pixel
 /// samples), so on silhouettes they mix an object with what lies behind it: 4 samples per
-/// pixel (the default) bring the whole image closer to it than 1.
+/// pixel (the default), resolved with the display filter pis-pack records, bring the whole
+/// image closer to it than 1; a file without the filter resolves with the box, or with the
+/// filter of the set `--set` names.
 #[test]
 fn multisampling_brings_the_whole_image_closer_to_the_gold_standard() {
     if !gpu_or_skip("multisampling_brings_the_whole_image_closer_to_the_gold_standard") {
@@ -127,6 +129,22 @@ fn multisampling_brings_the_whole_image_closer_to_the_gold_standard() {
         eprintln!("multisampling not supported by this adapter: skipped");
         return;
     }
+    // pis-pack records the set's display filter; the player resolves with it.
+    assert_eq!((four["resolve"]["filter"].as_str(), four["resolve"]["from"].as_str()), (Some("gaussian"), Some("file")), "{}", four["resolve"]);
+    assert_eq!((four["resolve"]["sigma_px"].as_f64(), four["resolve"]["radius_px"].as_f64()), (Some(0.5), Some(1.5)));
+    assert_eq!(one["resolve"]["filter"], "none");
+    // A file without it: the box resolve, or the filter of the set --set names.
+    let tiny_file = tiny();
+    let tiny_at = |extra: &[&std::ffi::OsStr]| {
+        let mut args = vec![os(&tiny_file), os("--headless"), os("--json")];
+        args.extend_from_slice(extra);
+        json(&play(&args))["resolve"].clone()
+    };
+    assert_eq!(tiny_at(&[])["filter"], "box");
+    let from_set = tiny_at(&[os("--set"), os(&f.set)]);
+    assert_eq!((from_set["filter"].as_str(), from_set["from"].as_str()), (Some("gaussian"), Some("set")), "{from_set}");
+    let missing = f.set.join("missing");
+    assert_fails(&play(&[os(&tiny_file), os("--headless"), os("--set"), os(&missing)]), 2, "missing set", "missing");
     let (a, b) = (one["psnr_db"].as_f64().expect("psnr_db"), four["psnr_db"].as_f64().expect("psnr_db"));
     eprintln!("whole image: 1 sample {a:.2} dB, 4 samples {b:.2} dB");
     assert!(b > a, "whole image: 1 sample {a:.2} dB, 4 samples {b:.2} dB");

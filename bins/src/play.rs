@@ -77,7 +77,8 @@ pub fn run(args: &PlayArgs) -> Result<Exit, Failure> {
     } else {
         args
     };
-    let window_only = args.screenshot.is_some() || args.set.is_some();
+    // `--set` also names the display filter of headless runs, given with --headless.
+    let window_only = args.screenshot.is_some() || (args.set.is_some() && !args.headless);
     if !args.headless && args.out.is_none() && args.compare.is_none() {
         if has_display() {
             match crate::play_window::try_run(args) {
@@ -92,8 +93,15 @@ pub fn run(args: &PlayArgs) -> Result<Exit, Failure> {
         } else {
             eprintln!("pis-play: note: no display (DISPLAY / WAYLAND_DISPLAY unset); drawing headless");
         }
-    } else if window_only {
-        return Err(Failure::new(Exit::Usage, anyhow::anyhow!("--screenshot and --set are window options; they do not go with --headless, --out or --compare")));
+    } else if args.screenshot.is_some() || (args.set.is_some() && !args.headless) {
+        return Err(Failure::new(Exit::Usage, anyhow::anyhow!("--screenshot and --set (without --headless) are window options; they do not go with --headless, --out or --compare")));
+    }
+    if let Some(set) = &args.set {
+        // Headless, the set gives the display filter: it must be readable.
+        pis_trace::set::RaySet::open(set).map_err(|e| {
+            let exit = if matches!(e, pis_trace::TraceError::Io { .. }) { Exit::Io } else { Exit::Invalid };
+            Failure::new(exit, anyhow::anyhow!("--set {}: {e}", set.display()))
+        })?;
     }
     headless::run(args)
 }

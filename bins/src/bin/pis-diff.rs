@@ -51,7 +51,10 @@ struct Cli {
     reference_psnr: Option<f64>,
     /// Against a set: samples per pixel of the player's frames, as `pis-play --msaa` (4
     /// antialiases silhouettes; 1 draws as pis-compile's hardware model, whose covered
-    /// pixels pis-pack's prediction measures: compare with the prediction at 1).
+    /// pixels pis-pack's prediction measures: compare with the prediction at 1). With 4 the
+    /// samples are resolved with the display filter the file records, or else the set's
+    /// (`set.json` `filter`): each pixel mixes the objects of its 3×3 neighbourhood's
+    /// samples by their Gaussian coverage, as the gold standard's pixels are filtered.
     #[arg(long, default_value_t = pis_play::multisample::DEFAULT_SAMPLES, value_name = "1|4", value_parser = pis::play::args::parse_msaa)]
     msaa: u32,
 }

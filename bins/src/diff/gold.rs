@@ -87,6 +87,8 @@ pub struct GoldReport {
     pub msaa_samples: u32,
     /// Samples per pixel asked for (`--msaa`).
     pub msaa_requested: u32,
+    /// How multisampled frames are resolved (as pis-play's report).
+    pub resolve: crate::play::headless::Resolve,
     /// Whole image, every point (display values, peak 1).
     pub psnr_db: Option<f64>,
     /// Every object's covered pixels pooled: the measure of pis-pack's predicted PSNR, which
@@ -185,8 +187,9 @@ pub fn gold(req: &GoldRequest) -> Result<GoldReport, Failure> {
 
     let gpu = Arc::new(Gpu::new().map_err(|e| failure(e.into()))?);
     let device = gpu.describe();
-    let mut player = Player::open(gpu, &req.file, PlayerOptions { msaa: req.msaa, ..PlayerOptions::default() }).map_err(|e| failure(e.into()))?;
+    let mut player = Player::open(gpu, &req.file, PlayerOptions { msaa: req.msaa, display_filter: crate::play::args::set_display_filter(&req.set), ..PlayerOptions::default() }).map_err(|e| failure(e.into()))?;
     let msaa_samples = player.multisample().samples;
+    let resolve = crate::play::headless::Resolve::of(&player);
     if let Some(note) = &player.multisample().note {
         eprintln!("pis-diff: note: {note}");
     }
@@ -267,6 +270,7 @@ pub fn gold(req: &GoldRequest) -> Result<GoldReport, Failure> {
         device,
         msaa_samples,
         msaa_requested: req.msaa,
+        resolve,
         psnr_db: psnr,
         covered_psnr_db: covered,
         silhouette_psnr_db: finite(comparison.silhouette.psnr()),
@@ -296,7 +300,7 @@ fn fl(v: Option<f64>) -> String {
 pub fn render(r: &GoldReport) -> String {
     use std::fmt::Write;
     let mut s = String::new();
-    let _ = writeln!(s, "{} against the gold-standard set {} ({} points, {}, {})", r.file, r.set, r.points.len(), r.device, crate::play::headless::msaa_label(r.msaa_samples, r.msaa_requested));
+    let _ = writeln!(s, "{} against the gold-standard set {} ({} points, {}, {}{})", r.file, r.set, r.points.len(), r.device, crate::play::headless::msaa_label(r.msaa_samples, r.msaa_requested), r.resolve.label());
     let _ = writeln!(s, "  PSNR (display values): whole image {} dB, objects' covered pixels {} dB", db(r.psnr_db), db(r.covered_psnr_db));
     let _ = writeln!(s, "  whole image at silhouettes {} dB ({:.1} % of the pixels: partly covered in the gold standard), elsewhere {} dB", db(r.silhouette_psnr_db), 100.0 * r.silhouette_fraction, db(r.interior_psnr_db));
     let _ = writeln!(s, "  mean FLIP (sRGB images): {}", fl(r.flip_mean));

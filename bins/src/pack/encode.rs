@@ -308,6 +308,12 @@ pub(crate) fn encode_all(set: &LoadedSet, models: &[ObjectModel], req: &PackRequ
     if req.allocation != super::Allocation::Screen {
         settings.push(("allocation".to_string(), "texture".to_string()));
     }
+    // The set's display filter, which players resolve multisampled frames with (SPEC.md
+    // 6.6); a set recording an invalid one (rule 9002) is packed without it.
+    let f = set.display_filter;
+    if let Ok(display) = pis_format::DisplayFilter::new(f.sigma_px, f.radius_px) {
+        settings.extend(display.settings());
+    }
     let mut container = Container {
         space,
         cameras,

@@ -22,6 +22,8 @@ pub(crate) struct LoadedSet {
     pub(crate) images: Vec<PointImages>,
     /// Per object, the set's channel name (`object.<name>` prefix of its layers).
     pub(crate) channels: Vec<String>,
+    /// The set's display filter (`set.json` `filter`, RAYSET.md section 4).
+    pub(crate) display_filter: pis_trace::film::GaussianFilter,
 }
 
 impl LoadedSet {
@@ -138,5 +140,5 @@ pub(crate) fn load(req: &PackRequest, stages: &mut Stages) -> Result<LoadedSet, 
     }
     let channels = pis_trace::channel_names(&scene);
     stages.done("read", &format!("{} points of {}x{} from {}", samples.len(), res.0, res.1, dir.display()));
-    Ok(LoadedSet { dir, scene, resolution: res, samples, frames, images, channels })
+    Ok(LoadedSet { dir, scene, resolution: res, samples, frames, images, channels, display_filter: set.meta.filter })
 }

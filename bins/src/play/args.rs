@@ -47,6 +47,14 @@ pub fn parse_msaa(s: &str) -> Result<u32, String> {
     pis_play::multisample::check_samples(n).map(|()| n)
 }
 
+/// The display filter of the ray-traced set at `dir` (`set.json` `filter`, RAYSET.md section
+/// 4), which the player resolves multisampled frames with when the file records none; `None`
+/// where the set cannot be read (the comparison then says why) or records an invalid one.
+pub fn set_display_filter(dir: &std::path::Path) -> Option<pis_format::DisplayFilter> {
+    let f = pis_trace::set::RaySet::open(dir).ok()?.meta.filter;
+    pis_format::DisplayFilter::new(f.sigma_px, f.radius_px).ok()
+}
+
 fn parse_reduction(s: &str) -> Result<u32, String> {
     s.parse::<u32>().ok().filter(|r| r.is_power_of_two()).ok_or_else(|| format!("--reduction {s:?}: expected a power of two (1, 2, 4, …)"))
 }
@@ -103,9 +111,13 @@ pub struct PlayArgs {
     #[arg(long, default_value = "1", value_parser = parse_reduction)]
     pub reduction: u32,
     /// Samples per pixel: 4 antialiases object silhouettes (depth and object index per
-    /// sample, shading once per pixel at its centre, samples averaged), as the ray-traced
-    /// gold standard's filtered pixels are; 1 draws each pixel wholly one surface. Where
-    /// the GPU cannot multisample the frame's formats, 1 with a note.
+    /// sample, shading once per pixel at its centre), as the ray-traced gold standard's
+    /// filtered pixels are; 1 draws each pixel wholly one surface. The samples are resolved
+    /// with the set's display filter where the file records it (pis-pack copies it) or,
+    /// for a file that does not, where --compare or --set names a set: each pixel mixes the
+    /// objects of its 3×3 neighbourhood's samples by their Gaussian coverage. Otherwise each
+    /// pixel's own samples are averaged. Where the GPU cannot multisample the frame's
+    /// formats, 1 with a note.
     #[arg(long, default_value_t = pis_play::multisample::DEFAULT_SAMPLES, value_name = "1|4", value_parser = parse_msaa)]
     pub msaa: u32,
     /// Memory for decoded level images, MiB.
@@ -121,8 +133,9 @@ pub struct PlayArgs {
     /// Print the report as JSON on stdout.
     #[arg(long)]
     pub json: bool,
-    /// Window mode: a ray-traced set of the same space; the panel (or G) shows its gold
-    /// standard at the nearest sample instead of the player's frame.
+    /// A ray-traced set of the same space. Its display filter resolves multisampled frames
+    /// when the file records none (headless too). Window mode: the panel (or G) shows its
+    /// gold standard at the nearest sample instead of the player's frame.
     #[arg(long, value_name = "SET_DIR")]
     pub set: Option<PathBuf>,
     /// Window mode: start showing the gold standard of --set.
@@ -150,6 +163,7 @@ impl PlayArgs {
             reduction: self.reduction,
             blend: self.blend,
             msaa: self.msaa,
+            display_filter: self.compare.as_deref().or(self.set.as_deref()).and_then(set_display_filter),
             ..d
         }
     }

@@ -35,6 +35,8 @@ pub struct PathReport {
     pub msaa_samples: u32,
     /// Samples per pixel asked for (`--msaa`).
     pub msaa_requested: u32,
+    /// How multisampled frames are resolved.
+    pub resolve: Resolve,
     pub workers: usize,
     pub frames: usize,
     pub frame_ms_mean: f64,
@@ -95,6 +97,8 @@ pub struct CompareReport {
     pub msaa_samples: u32,
     /// Samples per pixel asked for (`--msaa`).
     pub msaa_requested: u32,
+    /// How multisampled frames are resolved.
+    pub resolve: Resolve,
     /// Whole image, every point.
     pub psnr_db: f64,
     /// Every object's covered pixels pooled (pis-pack's predicted `psnr_db` measure).
@@ -106,6 +110,41 @@ pub struct CompareReport {
     pub silhouette_fraction: f64,
     pub objects: Vec<ObjectRow>,
     pub points: Vec<PointRow>,
+}
+
+/// How a player resolves multisampled frames: `filter` `box` (each pixel's own samples
+/// averaged), `gaussian` (the display-filter resolve, with `sigma_px`, `radius_px` and
+/// `from`: `file`, the file's provenance settings, or `set`, the ray-traced set's filter
+/// where the file records none), or `none` (one sample per pixel).
+#[derive(Clone, Debug, Serialize)]
+pub struct Resolve {
+    pub filter: String,
+    pub sigma_px: Option<f32>,
+    pub radius_px: Option<f32>,
+    pub from: Option<String>,
+}
+
+impl Resolve {
+    pub fn of(player: &Player) -> Resolve {
+        match player.display_filter() {
+            _ if player.multisample().samples <= 1 => Resolve { filter: "none".into(), sigma_px: None, radius_px: None, from: None },
+            None => Resolve { filter: "box".into(), sigma_px: None, radius_px: None, from: None },
+            Some((f, file)) => Resolve { filter: "gaussian".into(), sigma_px: Some(f.sigma_px), radius_px: Some(f.radius_px), from: Some(if file { "file" } else { "set" }.into()) },
+        }
+    }
+
+    /// "", ", box resolve", or ", Gaussian resolve σ 0.5 px R 1.5 px (the set's: the file
+    /// records none)".
+    pub fn label(&self) -> String {
+        match (self.filter.as_str(), self.sigma_px, self.radius_px) {
+            ("gaussian", Some(s), Some(r)) => {
+                let from = if self.from.as_deref() == Some("file") { "the file's" } else { "the set's: the file records none" };
+                format!(", Gaussian resolve σ {s} px R {r} px ({from})")
+            }
+            ("box", _, _) => ", box resolve".to_string(),
+            _ => String::new(),
+        }
+    }
 }
 
 /// "msaa 4×", "msaa off", or "msaa off (4× asked, not supported)".
@@ -262,6 +301,7 @@ pub fn run_frames(args: &PlayArgs, gpu: &Gpu, player: &mut Player) -> Result<Pat
         reduction: o.reduction,
         msaa_samples: player.multisample().samples,
         msaa_requested: player.multisample().requested,
+        resolve: Resolve::of(player),
         workers: o.workers,
         frames: all.len(),
         frame_ms_mean: fm,
@@ -281,7 +321,7 @@ pub fn run_frames(args: &PlayArgs, gpu: &Gpu, player: &mut Player) -> Result<Pat
 }
 
 pub fn print_path_report(r: &PathReport, w: &mut impl std::io::Write) -> std::io::Result<()> {
-    writeln!(w, "pis-play {} ({}x{}, blend {}, reduction {}, {}, {} decoding threads)", r.file, r.size[0], r.size[1], r.blend, r.reduction, msaa_label(r.msaa_samples, r.msaa_requested), r.workers)?;
+    writeln!(w, "pis-play {} ({}x{}, blend {}, reduction {}, {}{}, {} decoding threads)", r.file, r.size[0], r.size[1], r.blend, r.reduction, msaa_label(r.msaa_samples, r.msaa_requested), r.resolve.label(), r.workers)?;
     writeln!(w, "  adapter: {}", r.adapter)?;
     writeln!(w, "  frames: {}", r.frames)?;
     writeln!(w, "  frame ms: mean {:.2} ({:.1} fps), worst {:.2} ({:.1} fps)", r.frame_ms_mean, r.fps_mean, r.frame_ms_worst, r.fps_worst)?;
@@ -321,6 +361,7 @@ pub fn run_compare(args: &PlayArgs, set: &Path, gpu: &Gpu, player: &mut Player) 
         reduction: o.reduction,
         msaa_samples: player.multisample().samples,
         msaa_requested: player.multisample().requested,
+        resolve: Resolve::of(player),
         psnr_db: c.psnr_db,
         covered_psnr_db: c.covered_psnr_db,
         silhouette_psnr_db: c.silhouette.psnr(),
@@ -336,7 +377,7 @@ pub fn run_compare(args: &PlayArgs, set: &Path, gpu: &Gpu, player: &mut Player) 
 }
 
 pub fn print_compare_report(r: &CompareReport, w: &mut impl std::io::Write) -> std::io::Result<()> {
-    writeln!(w, "pis-play {} against {} (blend {}, reduction {}, {})", r.file, r.set, r.blend, r.reduction, msaa_label(r.msaa_samples, r.msaa_requested))?;
+    writeln!(w, "pis-play {} against {} (blend {}, reduction {}, {}{})", r.file, r.set, r.blend, r.reduction, msaa_label(r.msaa_samples, r.msaa_requested), r.resolve.label())?;
     writeln!(w, "  adapter: {}", r.adapter)?;
     writeln!(w, "  PSNR (display values): whole image {:.2} dB, objects' covered pixels {:.2} dB", r.psnr_db, r.covered_psnr_db)?;
     writeln!(w, "  whole image at silhouettes {:.2} dB ({:.1} % of the pixels: partly covered in the gold standard), elsewhere {:.2} dB", r.silhouette_psnr_db, 100.0 * r.silhouette_fraction, r.interior_psnr_db)?;

@@ -54,6 +54,9 @@ pub fn check<S>(c: &Container<S>) -> Vec<Issue> {
     if let Err(detail) = crate::FileFilter::of(c.provenance.as_ref()) {
         out.push(chunk(Issue::new(9001, detail), "PROV"));
     }
+    if let Err(detail) = crate::DisplayFilter::of(c.provenance.as_ref()) {
+        out.push(chunk(Issue::new(9002, detail), "PROV"));
+    }
     out
 }
 

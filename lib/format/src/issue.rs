@@ -156,6 +156,7 @@ pub const RULES: &[(u16, &str)] = &[
     (8007, "codec is reserved and not decodable by this reader"),
     (9000, "PROV payload is malformed"),
     (9001, "filter setting is unknown, or anisotropic without an anisotropy of 1 to 16"),
+    (9002, "display filter setting is unknown, or its sigma or radius is missing or not a number of pixels in (0, 64]"),
     (9100, "MSTR payload is malformed"),
     (9101, "master names a missing object, or a second master names the same object"),
     (9102, "master layers or samples differ from the object's"),

@@ -14,6 +14,7 @@ pub mod blocks;
 pub mod checks;
 pub mod chunk;
 mod error;
+pub mod display_filter;
 pub mod filter;
 pub mod hexdump;
 pub mod issue;
@@ -32,6 +33,7 @@ mod write;
 
 pub use binary::Span;
 pub use error::Error;
+pub use display_filter::DisplayFilter;
 pub use filter::FileFilter;
 pub use issue::{Issue, Severity};
 pub use master::{Master, MasterLayer};

@@ -415,6 +415,15 @@ fn cases() -> Vec<(u16, Vec<u8>)> {
             p.settings.push(("anisotropy".into(), "32".into()));
         }),
     ));
+    v.push((
+        9002,
+        unchecked(|c| {
+            let p = c.provenance.as_mut().unwrap();
+            p.settings.push(("display_filter".into(), "gaussian".into()));
+            p.settings.push(("display_filter_sigma_px".into(), "0.5".into()));
+            p.settings.push(("display_filter_radius_px".into(), "-1.5".into()));
+        }),
+    ));
     // 91xx: the lossless master.
     let c = tiny().unwrap();
     let masters = master_of(&c).unwrap();

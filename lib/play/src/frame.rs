@@ -4,7 +4,8 @@
 //! LOD and sampler in the fragment shader. Layers add in linear space (SPEC.md "Combining
 //! layers": surface layers combine by addition). With more than one sample per pixel
 //! (`multisample.rs`) depth and object indices are kept per sample and the colour is
-//! resolved into the target.
+//! resolved into the target: by the hardware's average of each pixel's own samples, or,
+//! given the ray-traced set's display filter, by the display-filter resolve (`resolve.rs`).
 
 use std::collections::HashMap;
 
@@ -14,6 +15,7 @@ use wgpu::util::DeviceExt;
 use crate::error::PlayError;
 use crate::gpu::Gpu;
 use crate::image::FloatImage;
+use crate::resolve::ResolvePipelines;
 use crate::textured::{allocated_size, ObjectTexture, DEPTH_FORMAT};
 
 /// The WGSL source.
@@ -99,6 +101,7 @@ pub struct FramePipelines {
     layer_ms_layout: wgpu::PipelineLayout,
     id_pipelines: HashMap<u32, wgpu::RenderPipeline>,
     layer_pipelines: HashMap<(wgpu::TextureFormat, u32), wgpu::RenderPipeline>,
+    resolve: ResolvePipelines,
 }
 
 const POSITION_LAYOUT: wgpu::VertexBufferLayout<'static> = wgpu::VertexBufferLayout {
@@ -154,6 +157,7 @@ impl FramePipelines {
             layer_ms_layout,
             id_pipelines: HashMap::new(),
             layer_pipelines: HashMap::new(),
+            resolve: ResolvePipelines::new(gpu),
         };
         pipes.id_pipeline(gpu, 1);
         pipes
@@ -233,13 +237,17 @@ pub fn offscreen_format(gpu: &Gpu) -> wgpu::TextureFormat {
 }
 
 /// The multisampled attachments of a frame drawn with more than one sample per pixel: object
-/// indices and depth per sample, and a colour attachment per target format, resolved into
-/// the frame's target.
+/// indices and depth per sample, and colour attachments resolved into the frame's target:
+/// per target format for the hardware resolve, in the offscreen format (kept, for the shader
+/// to read) for the display-filter resolve.
 struct SampleTargets {
     ids: wgpu::Texture,
     depth: wgpu::Texture,
     ids_bind: wgpu::BindGroup,
-    colour: HashMap<wgpu::TextureFormat, wgpu::Texture>,
+    /// Keyed by format and whether the display-filter resolve reads it.
+    colour: HashMap<(wgpu::TextureFormat, bool), wgpu::Texture>,
+    /// The display-filter resolve's per-pixel shared object index (made on first use).
+    shared_ids: Option<wgpu::Texture>,
 }
 
 /// The per-size targets: object indices (one per pixel, at its centre), depth, the offscreen
@@ -288,7 +296,7 @@ impl Targets {
             let ids = target_texture(gpu, "object ids per sample", size, samples, ID_FORMAT, attach | wgpu::TextureUsages::TEXTURE_BINDING);
             let depth = target_texture(gpu, "depth per sample", size, samples, DEPTH_FORMAT, attach);
             let ids_bind = bind(&ids, &pipes.ids_ms_layout, 1);
-            SampleTargets { ids, depth, ids_bind, colour: HashMap::new() }
+            SampleTargets { ids, depth, ids_bind, colour: HashMap::new(), shared_ids: None }
         });
         Ok(Targets { size, samples, ids, depth, colour, ids_bind, multi })
     }
@@ -356,9 +364,12 @@ fn id_pass(pipeline: &wgpu::RenderPipeline, ids: &wgpu::Texture, depth: &wgpu::T
 
 /// Records a frame into `encoder`: clears `colour` (format `format`, size `targets.size`) to
 /// transparent black, then draws with `targets.samples` per pixel (multisampled frames are
-/// drawn into the sample attachments and resolved into `colour`). `object_ids`: also leave
-/// every pixel's object index at its centre in `targets.ids` (single-sample frames always
-/// do; multisampled ones draw one more index pass for it).
+/// drawn into the sample attachments and resolved into `colour`: with `display`, the
+/// ray-traced set's display filter, by the display-filter resolve over each pixel's 3×3
+/// neighbourhood, the samples drawn in the offscreen format; without, by the hardware's
+/// average of each pixel's own samples). `object_ids`: also leave every pixel's object index
+/// at its centre in `targets.ids` (single-sample frames always do; multisampled ones draw one
+/// more index pass for it). Single-sample frames ignore `display`.
 #[allow(clippy::too_many_arguments)]
 pub fn encode(
     gpu: &Gpu,
@@ -369,12 +380,17 @@ pub fn encode(
     objects: &[ObjectDraw],
     layers: &[LayerDraw],
     object_ids: bool,
+    display: Option<pis_format::DisplayFilter>,
     encoder: &mut wgpu::CommandEncoder,
 ) {
     let d = &gpu.device;
     let samples = targets.samples;
+    // The display filter applies to multisampled frames; their samples are then drawn in
+    // the offscreen (float) format, whatever the target's.
+    let display = display.filter(|_| samples > 1);
+    let sample_format = if display.is_some() { offscreen_format(gpu) } else { format };
     pipes.id_pipeline(gpu, samples);
-    pipes.layer_pipeline(gpu, format, samples);
+    pipes.layer_pipeline(gpu, sample_format, samples);
     let ubuf = |u: Uniforms| d.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: Some("frame uniforms"), contents: bytemuck::bytes_of(&u), usage: wgpu::BufferUsages::UNIFORM });
     let id_binds: Vec<wgpu::BindGroup> = objects
         .iter()
@@ -403,7 +419,8 @@ pub fn encode(
     // The attachments the layers are drawn into: (colour, resolve target, depth, ids).
     let (sample_colour, depth, ids_bind) = match &mut targets.multi {
         Some(m) => {
-            let c = m.colour.entry(format).or_insert_with(|| target_texture(gpu, "frame per sample", size, samples, format, wgpu::TextureUsages::RENDER_ATTACHMENT));
+            let usage = if display.is_some() { wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING } else { wgpu::TextureUsages::RENDER_ATTACHMENT };
+            let c = m.colour.entry((sample_format, display.is_some())).or_insert_with(|| target_texture(gpu, "frame per sample", size, samples, sample_format, usage));
             id_pass(&pipes.id_pipelines[&samples], &m.ids, &m.depth, objects, &id_binds, encoder);
             if object_ids {
                 id_pass(&pipes.id_pipelines[&1], &targets.ids, &targets.depth, objects, &id_binds, encoder);
@@ -416,10 +433,12 @@ pub fn encode(
         }
     };
     let depth_view = depth.create_view(&Default::default());
-    // Multisampled: the samples are resolved into `colour` and then not kept.
-    let (view, resolve_target, store) = match &sample_colour {
-        Some(v) => (v, Some(colour), wgpu::StoreOp::Discard),
-        None => (colour, None, wgpu::StoreOp::Store),
+    // Multisampled: the samples are resolved into `colour` by the hardware and then not
+    // kept, or kept for the display-filter resolve.
+    let (view, resolve_target, store) = match (&sample_colour, display) {
+        (Some(v), None) => (v, Some(colour), wgpu::StoreOp::Discard),
+        (Some(v), Some(_)) => (v, None, wgpu::StoreOp::Store),
+        (None, _) => (colour, None, wgpu::StoreOp::Store),
     };
     let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
         label: Some("layers"),
@@ -431,14 +450,14 @@ pub fn encode(
         })],
         depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
             view: &depth_view,
-            depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Load, store }),
+            depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Load, store: if sample_colour.is_some() { wgpu::StoreOp::Discard } else { wgpu::StoreOp::Store } }),
             stencil_ops: None,
         }),
         timestamp_writes: None,
         occlusion_query_set: None,
         multiview_mask: None,
     });
-    pass.set_pipeline(&pipes.layer_pipelines[&(format, samples)]);
+    pass.set_pipeline(&pipes.layer_pipelines[&(sample_format, samples)]);
     pass.set_bind_group(1, ids_bind, &[]);
     for (l, bg) in layers.iter().zip(&layer_binds) {
         let m = objects[l.draw].mesh;
@@ -447,6 +466,11 @@ pub fn encode(
         pass.set_vertex_buffer(1, m.uvs.slice(..));
         pass.set_index_buffer(m.indices.slice(..), wgpu::IndexFormat::Uint32);
         pass.draw_indexed(0..m.count, 0, 0..1);
+    }
+    drop(pass);
+    if let (Some(filter), Some(m)) = (display, &mut targets.multi) {
+        let shared = m.shared_ids.get_or_insert_with(|| target_texture(gpu, "shared object ids", size, 1, crate::resolve::SHARED_ID_FORMAT, wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING));
+        pipes.resolve.encode(gpu, filter, &m.colour[&(sample_format, true)], &m.ids, shared, colour, format, encoder);
     }
 }
 

@@ -4,7 +4,7 @@
 //! that pipeline; and the runtime (thesis 4.7, [`Player`]): random-access reading of a
 //! `.pis`, decoding on worker threads through a level-image cache with lifetimes, GPU MIP
 //! chains, and frames of every object with its layers, multisampled on silhouettes
-//! (`multisample.rs`).
+//! (`multisample.rs`) and resolved with the ray-traced set's display filter (`resolve.rs`).
 //!
 //! Without a GPU, wgpu runs on Mesa's lavapipe: `apt-get install -y mesa-vulkan-drivers`.
 
@@ -20,6 +20,7 @@ pub mod mip;
 pub mod multisample;
 pub mod player;
 pub mod probe;
+pub mod resolve;
 pub mod textured;
 
 pub use blend::Blend;

@@ -45,12 +45,16 @@ pub struct PlayerOptions {
     /// 4). Where the device cannot multisample a frame's formats that many times, frames
     /// are drawn with 1 ([`Player::multisample`] says which and why).
     pub msaa: u32,
+    /// The display filter multisampled frames are resolved with when the file records none
+    /// (SPEC.md 6.6 `display_filter`): the ray-traced set's filter (RAYSET.md section 4).
+    /// With neither, each pixel's own samples are averaged.
+    pub display_filter: Option<pis_format::DisplayFilter>,
 }
 
 impl Default for PlayerOptions {
     fn default() -> Self {
         let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
-        PlayerOptions { cache_budget_bytes: 512 << 20, lifetime_a: 20, lifetime_b: 4, workers: cores.saturating_sub(1).max(1), reduction: 1, blend: Blend::Nearest, msaa: DEFAULT_SAMPLES }
+        PlayerOptions { cache_budget_bytes: 512 << 20, lifetime_a: 20, lifetime_b: 4, workers: cores.saturating_sub(1).max(1), reduction: 1, blend: Blend::Nearest, msaa: DEFAULT_SAMPLES, display_filter: None }
     }
 }
 
@@ -140,6 +144,9 @@ pub struct Player {
     /// The multisampling of frames per target format (offscreen first).
     multisample: HashMap<wgpu::TextureFormat, Multisample>,
     readback: Option<(Readback, Readback)>,
+    /// The display filter multisampled frames are resolved with, and whether the file
+    /// records it.
+    display: Option<(pis_format::DisplayFilter, bool)>,
     resident: HashMap<TextureKey, Resident>,
     samplers: HashMap<[bool; 2], wgpu::Sampler>,
     frame: u64,
@@ -210,6 +217,9 @@ impl Player {
         let reader = PisReader::open(path)?;
         let objects = prepare_objects(&gpu, &reader)?;
         let filter = file_filter(reader.container());
+        // The reader has checked the settings (rule 9002).
+        let file_display = pis_format::DisplayFilter::of(reader.container().provenance.as_ref()).ok().flatten();
+        let display = file_display.map(|f| (f, true)).or(options.display_filter.map(|f| (f, false)));
         let decoder = Decoder::new(options.workers)?;
         let cache = LevelCache::new(options.cache_budget_bytes, options.lifetime_a, options.lifetime_b);
         let mut pipes = FramePipelines::new(&gpu);
@@ -232,6 +242,7 @@ impl Player {
             targets: None,
             multisample: HashMap::from([(offscreen, ms)]),
             readback: None,
+            display,
             resident: HashMap::new(),
             samplers: HashMap::new(),
             frame: 0,
@@ -280,9 +291,19 @@ impl Player {
     }
 
     /// The multisampling of frames drawn into targets of `format` ([`Player::render_to_view`]).
+    /// With a display filter the samples are drawn in the offscreen format whatever the
+    /// target's, and resolved by a shader: that format must multisample.
     pub fn multisample_for(&mut self, format: wgpu::TextureFormat) -> &Multisample {
         let (gpu, msaa) = (&self.gpu, self.options.msaa);
-        self.multisample.entry(format).or_insert_with(|| choose(gpu, msaa, format))
+        let drawn = if self.display.is_some() { offscreen_format(gpu) } else { format };
+        self.multisample.entry(format).or_insert_with(|| choose(gpu, msaa, drawn))
+    }
+
+    /// The display filter multisampled frames are resolved with (the ray-traced set's, RAYSET.md
+    /// section 4), and whether the file records it (else it came from
+    /// [`PlayerOptions::display_filter`]); `None`: each pixel's own samples are averaged.
+    pub fn display_filter(&self) -> Option<(pis_format::DisplayFilter, bool)> {
+        self.display
     }
 
     /// The nearest parameter sample of `point` (missing values count as the first sample,
@@ -316,7 +337,8 @@ impl Player {
 
     /// Draws a frame offscreen; linear RGBA read back, colour premultiplied by coverage:
     /// alpha is the fraction of the pixel's samples objects cover (1 inside objects, 0
-    /// where none is drawn, between on silhouettes of multisampled frames).
+    /// where none is drawn, between on silhouettes of multisampled frames; with a display
+    /// filter, the objects' filtered coverage of the pixel's 3×3 neighbourhood's samples).
     pub fn render_image(&mut self, req: &FrameRequest, size: (u32, u32)) -> Result<(FloatImage, FrameStats), PlayError> {
         let (out, stats) = self.frame(req, size, Target::Offscreen { ids: false })?;
         let (img, _) = out.ok_or_else(|| PlayError::Readback("no offscreen frame".into()))?;
@@ -528,7 +550,8 @@ impl Player {
                 (&offscreen_view, ids)
             }
         };
-        crate::frame::encode(&gpu, &mut self.pipes, targets, view, format, &objects, &layers, want_ids, &mut encoder);
+        let display = self.display.map(|(f, _)| f);
+        crate::frame::encode(&gpu, &mut self.pipes, targets, view, format, &objects, &layers, want_ids, display, &mut encoder);
         let out = if let Target::Offscreen { ids } = target {
             let texel = if format == wgpu::TextureFormat::Rgba16Float { 8 } else { 16 };
             let (rc, ri) = self.readback.get_or_insert_with(|| (Readback::new(&gpu, size, texel), Readback::new(&gpu, size, 4)));

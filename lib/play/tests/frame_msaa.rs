@@ -26,7 +26,7 @@ fn draw(gpu: &Gpu, pipes: &mut FramePipelines, samples: u32, scene: &[(MeshGpu, 
     let layers: Vec<LayerDraw> = scene.iter().enumerate().map(|(i, (_, _, texture))| LayerDraw { draw: i, texture, sampler, affine: [1.0, 0.0, 0.0, 1.0, 0.0, 0.0], max_level: 0.0, weight: 1.0, anisotropic: false }).collect();
     let mut encoder = gpu.device.create_command_encoder(&Default::default());
     let view = targets.colour.create_view(&Default::default());
-    encode(gpu, pipes, &mut targets, &view, format, &objects, &layers, true, &mut encoder);
+    encode(gpu, pipes, &mut targets, &view, format, &objects, &layers, true, None, &mut encoder);
     let texel = if format == wgpu::TextureFormat::Rgba16Float { 8 } else { 16 };
     let (rc, ri) = (Readback::new(gpu, SIZE, texel), Readback::new(gpu, SIZE, 4));
     rc.copy(&targets.colour, &mut encoder);

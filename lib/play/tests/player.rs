@@ -314,3 +314,79 @@ fn view_frame_is_the_offscreen_frame(gpu: &Arc<pis_play::Gpu>, msaa: u32) {
     }
     assert!(drawn > 20);
 }
+
+/// The display filter comes from the file: samples/tiny.pis records none and keeps the box
+/// resolve (each pixel's alpha the covered fraction of its own 4 samples, a multiple of ¼,
+/// and its frames as with `display_filter: None`, bit for bit); the same file with the
+/// provenance settings pis-pack writes resolves with the Gaussian (coverage reaching
+/// neighbouring pixels: alphas off the quarters, the silhouette band wider), keeps the box
+/// frame's values (to float rounding) where the 7×7 pixel centres around a pixel are one
+/// object, and draws
+/// single-sample frames bit for bit as without the settings. A filter given in the options
+/// applies only to a file that records none.
+#[test]
+fn the_files_display_filter_selects_the_resolve() {
+    let test = "the_files_display_filter_selects_the_resolve";
+    let Some(gpu) = gpu_or_skip(test) else { return };
+    let gpu = Arc::new(gpu);
+    let mut c = pis_format::PisReader::open(&tiny()).unwrap().load_all().unwrap();
+    let gaussian = pis_format::DisplayFilter { sigma_px: 0.5, radius_px: 1.5 };
+    c.provenance.as_mut().unwrap().settings.extend(gaussian.settings());
+    let dir = tempfile::tempdir().unwrap();
+    let with = dir.path().join("tiny-display-filter.pis");
+    pis_format::write(&with, &c).unwrap();
+    let open = |path: &PathBuf, msaa, display_filter| Player::open(gpu.clone(), path, PlayerOptions { workers: 1, msaa, display_filter, ..Default::default() }).unwrap();
+    let mut plain = open(&tiny(), 4, None);
+    if plain.multisample().samples != 4 {
+        assert!(!in_ci(), "{test}: {:?}", plain.multisample());
+        eprintln!("{test}: skipped: {}", plain.multisample().note.clone().unwrap_or_default());
+        return;
+    }
+    let mut filtered = open(&with, 4, None);
+    assert_eq!(plain.display_filter(), None);
+    assert_eq!(filtered.display_filter(), Some((gaussian, true)));
+    // An option's filter is used only where the file records none.
+    let wide = pis_format::DisplayFilter { sigma_px: 1.0, radius_px: 1.5 };
+    assert_eq!(open(&tiny(), 4, Some(wide)).display_filter(), Some((wide, false)));
+    assert_eq!(open(&with, 4, Some(wide)).display_filter(), Some((gaussian, true)));
+    let size = (96, 72);
+    let req = at(&plain, &[1, 1]);
+    let (a, ids, _) = plain.render_ids(&req, size).unwrap();
+    let (b, ids_b, _) = filtered.render_ids(&req, size).unwrap();
+    assert_eq!(ids, ids_b);
+    // The box resolve, as before the display filter existed: a fresh player, default options.
+    let (again, _) = Player::open(gpu.clone(), &tiny(), PlayerOptions { workers: 1, ..Default::default() }).unwrap().render_image(&req, size).unwrap();
+    assert!(a.rgba.iter().zip(&again.rgba).all(|(x, y)| x.to_bits() == y.to_bits()), "frames without a display filter differ");
+    let quarter = |v: f32| ((v * 4.0).round() - v * 4.0).abs() < 1e-6;
+    let (w, h) = (size.0 as usize, size.1 as usize);
+    let (mut box_partial, mut gauss_partial, mut off_quarter, mut interior) = (0usize, 0usize, 0usize, 0usize);
+    for y in 0..h {
+        for x in 0..w {
+            let p = y * w + x;
+            let (aa, ab) = (a.rgba[p * 4 + 3], b.rgba[p * 4 + 3]);
+            assert!(quarter(aa), "box resolve: pixel ({x}, {y}) alpha {aa}");
+            box_partial += (aa > 0.0 && aa < 1.0) as usize;
+            gauss_partial += (ab > 0.0 && ab < 1.0) as usize;
+            off_quarter += !quarter(ab) as usize;
+            let inside = x >= 3 && y >= 3 && x + 3 < w && y + 3 < h && (0..49).all(|k| ids[(y + k / 7 - 3) * w + x + k % 7 - 3] == ids[p]);
+            if inside && ids[p] != u32::MAX {
+                interior += 1;
+                // Where two triangles of the ball's mesh shade a pixel's samples, the box
+                // and the resolve's running mean average the same 4 values in another order.
+                for ch in 0..4 {
+                    let (va, vb) = (a.rgba[p * 4 + ch], b.rgba[p * 4 + ch]);
+                    assert!((va - vb).abs() <= 1e-6 * va.abs() + 1e-7, "pixel ({x}, {y}) inside the ball: box {va}, Gaussian {vb}");
+                }
+            }
+        }
+    }
+    eprintln!("{test}: partly covered pixels: box {box_partial}, Gaussian {gauss_partial} ({off_quarter} off the quarters); {interior} interior pixels unchanged");
+    assert!(interior > 200, "{interior} interior pixels");
+    // The Gaussian reaches 1.5 px: about three pixels across the silhouette against the box's one.
+    assert!(gauss_partial > box_partial * 2, "partly covered: box {box_partial}, Gaussian {gauss_partial}");
+    assert!(off_quarter * 2 > gauss_partial, "{off_quarter} of {gauss_partial} off the quarters");
+    // Single-sample frames ignore the display filter.
+    let (one_plain, _) = open(&tiny(), 1, None).render_image(&req, size).unwrap();
+    let (one_with, _) = open(&with, 1, None).render_image(&req, size).unwrap();
+    assert!(one_plain.rgba.iter().zip(&one_with.rgba).all(|(x, y)| x.to_bits() == y.to_bits()), "single-sample frames differ");
+}
