@@ -232,3 +232,8 @@ pub fn pack_with(req: &PackRequest, extras: PackExtras) -> Result<PackReport, Fa
     }
     Ok(report)
 }
+
+/// `N`, or `NxM…`: sizes of at least 1 separated by `x` (`--block`, `--resolution`).
+pub fn parse_sizes(s: &str) -> Result<Vec<u32>, String> {
+    s.split(['x', 'X']).map(|p| p.trim().parse::<u32>().ok().filter(|&b| b > 0).ok_or_else(|| format!("bad size {s:?}: expected N or NxM"))).collect()
+}

@@ -168,15 +168,11 @@ fn parse_budget(s: &str) -> Result<Budget, String> {
 struct BlockSizes(Vec<u32>);
 
 fn parse_block(s: &str) -> Result<BlockSizes, String> {
-    sizes(s).map(BlockSizes)
-}
-
-fn sizes(s: &str) -> Result<Vec<u32>, String> {
-    s.split(['x', 'X']).map(|p| p.trim().parse::<u32>().ok().filter(|&b| b > 0).ok_or_else(|| format!("bad block size {s:?}: expected N or NxM"))).collect()
+    pis::pack::parse_sizes(s).map(BlockSizes)
 }
 
 fn parse_resolution(s: &str) -> Result<(u32, u32), String> {
-    match sizes(s)?.as_slice() {
+    match pis::pack::parse_sizes(s)?.as_slice() {
         [w, h] => Ok((*w, *h)),
         _ => Err(format!("expected WIDTHxHEIGHT, got {s:?}")),
     }

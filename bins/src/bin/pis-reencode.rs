@@ -63,7 +63,7 @@ fn parse_codec(s: &str) -> Result<CodecId, String> {
 struct BlockSizes(Vec<u32>);
 
 fn parse_block(s: &str) -> Result<BlockSizes, String> {
-    s.split(['x', 'X']).map(|p| p.trim().parse::<u32>().ok().filter(|&b| b > 0).ok_or_else(|| format!("bad block size {s:?}: expected N or NxM"))).collect::<Result<_, _>>().map(BlockSizes)
+    pis::pack::parse_sizes(s).map(BlockSizes)
 }
 
 fn run(cli: Cli) -> Result<Exit, Failure> {
