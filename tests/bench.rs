@@ -31,6 +31,16 @@ fn infer_reports_every_method_as_json() {
     for k in ["solve_ms", "iterations", "n_s", "n_t"] {
         assert!(v[k].as_f64().is_some(), "{k}");
     }
+    // Eq. 3.4's box: the bounded solves stay in [0, 1.1·max b] (b ≤ the unconstrained fit's
+    // reach) and report their convergence.
+    for m in ["ls-trilinear-bounded", "ls-pyramidal-bounded"] {
+        let r = &v["methods"][m];
+        let psnr = r["psnr_db"].as_f64().unwrap_or(f64::NAN);
+        assert!(psnr.is_finite() && psnr > 5.0, "{m}: {psnr}");
+        let lo = r["texel_range"][0].as_f64().unwrap_or(f64::NAN);
+        assert!(lo >= 0.0, "{m}: smallest texel {lo}");
+        assert!(r["converged"].is_boolean(), "{m}");
+    }
 }
 
 #[test]
