@@ -11,31 +11,12 @@ mod common;
 
 use common::*;
 use pis_compile::{Address, Filter, Sampler, TextureLayout, Viewport};
-use pis_play::frame::{colour_image, encode, offscreen_format, FramePipelines, LayerDraw, MeshGpu, ObjectDraw, Readback, Targets, NO_OBJECT};
+use pis_play::frame::{offscreen_format, FramePipelines, MeshGpu, NO_OBJECT};
 use pis_play::multisample::choose;
 use pis_play::textured::create_sampler;
-use pis_play::{FloatImage, Gpu, ObjectTexture};
+use pis_play::ObjectTexture;
 
 const SIZE: (u32, u32) = (80, 60);
-
-/// The quads' frame with `samples` per pixel: colour and object index per pixel.
-fn draw(gpu: &Gpu, pipes: &mut FramePipelines, samples: u32, scene: &[(MeshGpu, glam::Mat4, ObjectTexture)], sampler: &wgpu::Sampler) -> (FloatImage, Vec<u32>) {
-    let format = offscreen_format(gpu);
-    let mut targets = Targets::new(gpu, pipes, SIZE, samples).unwrap();
-    let objects: Vec<ObjectDraw> = scene.iter().enumerate().map(|(i, (mesh, clip, _))| ObjectDraw { object: i as u32, mesh, clip_from_object: *clip }).collect();
-    let layers: Vec<LayerDraw> = scene.iter().enumerate().map(|(i, (_, _, texture))| LayerDraw { draw: i, texture, sampler, affine: [1.0, 0.0, 0.0, 1.0, 0.0, 0.0], max_level: 0.0, weight: 1.0, anisotropic: false }).collect();
-    let mut encoder = gpu.device.create_command_encoder(&Default::default());
-    let view = targets.colour.create_view(&Default::default());
-    encode(gpu, pipes, &mut targets, &view, format, &objects, &layers, true, None, &mut encoder);
-    let texel = if format == wgpu::TextureFormat::Rgba16Float { 8 } else { 16 };
-    let (rc, ri) = (Readback::new(gpu, SIZE, texel), Readback::new(gpu, SIZE, 4));
-    rc.copy(&targets.colour, &mut encoder);
-    ri.copy(&targets.ids, &mut encoder);
-    gpu.queue.submit([encoder.finish()]);
-    let colour = colour_image(&rc.read(gpu).unwrap(), format, SIZE);
-    let ids = ri.read(gpu).unwrap().chunks_exact(4).map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]])).collect();
-    (colour, ids)
-}
 
 #[test]
 fn frame_multisampling_keeps_interiors_exactly() {
@@ -63,8 +44,8 @@ fn frame_multisampling_keeps_interiors_exactly() {
     let mesh = |m: &Mesh| MeshGpu::new(&gpu, &m.positions, &m.uvs, &m.indices);
     let scene = [(mesh(&back), clip, texture(1)), (mesh(&front), clip * turn, texture(2))];
     let sampler = create_sampler(&gpu, &Sampler { filter: Filter::Bilinear, address: [Address::ClampToEdge; 2] });
-    let (a, ids_a) = draw(&gpu, &mut pipes, 1, &scene, &sampler);
-    let (b, ids_b) = draw(&gpu, &mut pipes, 4, &scene, &sampler);
+    let (a, ids_a) = draw_scene(&gpu, &mut pipes, SIZE, 1, None, &scene, &sampler);
+    let (b, ids_b) = draw_scene(&gpu, &mut pipes, SIZE, 4, None, &scene, &sampler);
     assert_eq!(ids_a, ids_b, "object indices at pixel centres");
     let (w, h) = (SIZE.0 as usize, SIZE.1 as usize);
     let (mut interior, mut silhouette, mut mixed) = ([0usize; 2], 0usize, 0usize);

@@ -10,7 +10,7 @@ mod common;
 use common::*;
 use pis_compile::{Address, Filter, Sampler, TextureLayout, Viewport};
 use pis_format::DisplayFilter;
-use pis_play::frame::{colour_image, encode, offscreen_format, FramePipelines, LayerDraw, MeshGpu, ObjectDraw, Readback, Targets, NO_OBJECT};
+use pis_play::frame::{offscreen_format, FramePipelines, MeshGpu, NO_OBJECT};
 use pis_play::multisample::choose;
 use pis_play::resolve::SAMPLE_POSITIONS;
 use pis_play::textured::create_sampler;
@@ -18,26 +18,6 @@ use pis_play::{FloatImage, Gpu, ObjectTexture};
 
 const SIZE: (u32, u32) = (80, 60);
 const GAUSSIAN: DisplayFilter = DisplayFilter { sigma_px: 0.5, radius_px: 1.5 };
-
-/// A frame of `scene` (mesh, clip-from-object, texture) with `samples` per pixel, resolved
-/// with `display`: colour and object index per pixel.
-fn draw(gpu: &Gpu, pipes: &mut FramePipelines, samples: u32, display: Option<DisplayFilter>, scene: &[(MeshGpu, glam::Mat4, ObjectTexture)], sampler: &wgpu::Sampler) -> (FloatImage, Vec<u32>) {
-    let format = offscreen_format(gpu);
-    let mut targets = Targets::new(gpu, pipes, SIZE, samples).unwrap();
-    let objects: Vec<ObjectDraw> = scene.iter().enumerate().map(|(i, (mesh, clip, _))| ObjectDraw { object: i as u32, mesh, clip_from_object: *clip }).collect();
-    let layers: Vec<LayerDraw> = scene.iter().enumerate().map(|(i, (_, _, texture))| LayerDraw { draw: i, texture, sampler, affine: [1.0, 0.0, 0.0, 1.0, 0.0, 0.0], max_level: 0.0, weight: 1.0, anisotropic: false }).collect();
-    let mut encoder = gpu.device.create_command_encoder(&Default::default());
-    let view = targets.colour.create_view(&Default::default());
-    encode(gpu, pipes, &mut targets, &view, format, &objects, &layers, true, display, &mut encoder);
-    let texel = if format == wgpu::TextureFormat::Rgba16Float { 8 } else { 16 };
-    let (rc, ri) = (Readback::new(gpu, SIZE, texel), Readback::new(gpu, SIZE, 4));
-    rc.copy(&targets.colour, &mut encoder);
-    ri.copy(&targets.ids, &mut encoder);
-    gpu.queue.submit([encoder.finish()]);
-    let colour = colour_image(&rc.read(gpu).unwrap(), format, SIZE);
-    let ids = ri.read(gpu).unwrap().chunks_exact(4).map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]])).collect();
-    (colour, ids)
-}
 
 /// The GPU where it multisamples the offscreen format 4×, else `None` (fails in CI).
 fn multisampling_gpu(test: &str) -> Option<Gpu> {
@@ -78,9 +58,9 @@ fn display_filter_resolve_keeps_interiors_and_spreads_silhouettes() {
     let mesh = |m: &Mesh| MeshGpu::new(&gpu, &m.positions, &m.uvs, &m.indices);
     let scene = [(mesh(&back), clip, texture(&gpu, &random_rgba(256, 1))), (mesh(&front), clip * turn, texture(&gpu, &random_rgba(256, 2)))];
     let sampler = create_sampler(&gpu, &Sampler { filter: Filter::Bilinear, address: [Address::ClampToEdge; 2] });
-    let (one, ids) = draw(&gpu, &mut pipes, 1, None, &scene, &sampler);
-    let (box_, ids_box) = draw(&gpu, &mut pipes, 4, None, &scene, &sampler);
-    let (filtered, ids_f) = draw(&gpu, &mut pipes, 4, Some(GAUSSIAN), &scene, &sampler);
+    let (one, ids) = draw_scene(&gpu, &mut pipes, SIZE, 1, None, &scene, &sampler);
+    let (box_, ids_box) = draw_scene(&gpu, &mut pipes, SIZE, 4, None, &scene, &sampler);
+    let (filtered, ids_f) = draw_scene(&gpu, &mut pipes, SIZE, 4, Some(GAUSSIAN), &scene, &sampler);
     assert_eq!(ids, ids_f, "object indices at pixel centres");
     assert_eq!(ids, ids_box, "object indices at pixel centres");
     let (w, h) = (SIZE.0 as usize, SIZE.1 as usize);
@@ -197,7 +177,7 @@ fn display_filter_resolve_matches_the_gaussian_coverage_of_an_edge() {
     let rgba: Vec<f32> = (0..256).flat_map(|_| [c[0], c[1], c[2], 1.0]).collect();
     let scene = [(MeshGpu::new(&gpu, &shape.positions, &shape.uvs, &shape.indices), glam::Mat4::IDENTITY, texture(&gpu, &rgba))];
     let sampler = create_sampler(&gpu, &Sampler { filter: Filter::Bilinear, address: [Address::ClampToEdge; 2] });
-    let (img, _) = draw(&gpu, &mut pipes, 4, Some(GAUSSIAN), &scene, &sampler);
+    let (img, _) = draw_scene(&gpu, &mut pipes, SIZE, 4, Some(GAUSSIAN), &scene, &sampler);
     let (sigma, r) = (GAUSSIAN.sigma_px as f64, GAUSSIAN.radius_px as f64);
     let weight = |dx: f64, dy: f64| if dx * dx + dy * dy <= r * r { (-(dx * dx + dy * dy) / (2.0 * sigma * sigma)).exp() } else { 0.0 };
     let norm = (1.0 + b * b).sqrt();

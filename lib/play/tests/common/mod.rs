@@ -157,3 +157,33 @@ pub fn write_failure_images(name: &str, want: &FloatImage, got: &FloatImage) -> 
     let _ = diff.save(dir.join(format!("{name}-difference.png")));
     dir
 }
+
+/// A frame of `scene` (mesh, clip-from-object, texture; each its own object, drawn with the
+/// identity affine and level 0) of `size` with `samples` per pixel, resolved with `display`
+/// (None: the box): colour and object index per pixel, read back.
+pub fn draw_scene(
+    gpu: &Gpu,
+    pipes: &mut pis_play::frame::FramePipelines,
+    size: (u32, u32),
+    samples: u32,
+    display: Option<pis_format::DisplayFilter>,
+    scene: &[(pis_play::frame::MeshGpu, Mat4, pis_play::ObjectTexture)],
+    sampler: &wgpu::Sampler,
+) -> (FloatImage, Vec<u32>) {
+    use pis_play::frame::{colour_image, encode, offscreen_format, LayerDraw, ObjectDraw, Readback, Targets};
+    let format = offscreen_format(gpu);
+    let mut targets = Targets::new(gpu, pipes, size, samples).unwrap();
+    let objects: Vec<ObjectDraw> = scene.iter().enumerate().map(|(i, (mesh, clip, _))| ObjectDraw { object: i as u32, mesh, clip_from_object: *clip }).collect();
+    let layers: Vec<LayerDraw> = scene.iter().enumerate().map(|(i, (_, _, texture))| LayerDraw { draw: i, texture, sampler, affine: [1.0, 0.0, 0.0, 1.0, 0.0, 0.0], max_level: 0.0, weight: 1.0, anisotropic: false }).collect();
+    let mut encoder = gpu.device.create_command_encoder(&Default::default());
+    let view = targets.colour.create_view(&Default::default());
+    encode(gpu, pipes, &mut targets, &view, format, &objects, &layers, true, display, &mut encoder);
+    let texel = if format == wgpu::TextureFormat::Rgba16Float { 8 } else { 16 };
+    let (rc, ri) = (Readback::new(gpu, size, texel), Readback::new(gpu, size, 4));
+    rc.copy(&targets.colour, &mut encoder);
+    ri.copy(&targets.ids, &mut encoder);
+    gpu.queue.submit([encoder.finish()]);
+    let colour = colour_image(&rc.read(gpu).unwrap(), format, size);
+    let ids = ri.read(gpu).unwrap().chunks_exact(4).map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]])).collect();
+    (colour, ids)
+}
