@@ -34,17 +34,30 @@ fn table_index<S>(c: &Container<S>, object: usize, layer: usize, key: &[u32]) ->
 pub fn from_master(c: &Container<StreamRef>, m: &Master, object: usize, layer: usize) -> Result<Vec<BlockSource>, Error> {
     let o = &c.objects[object];
     let l = &o.layers[layer];
-    let grid = BlockGrid::new(&c.space, l.depends_on, &o.stagger);
     let n = c.space.table_len(l.depends_on) as usize;
     let all = (0..n).into_par_iter().map(|s| m.texture(c, layer, s)).collect::<Result<Vec<Vec<f32>>, Error>>()?;
     let weights = (0..n).into_par_iter().map(|s| m.weights(c, layer, s)).collect::<Result<Vec<Option<Vec<f32>>>, Error>>()?;
-    let has_weights = weights.iter().all(Option::is_some) && n > 0;
-    let mut blocks: Vec<BlockSource> = l.blocks.iter().enumerate().map(|(bi, b)| {
+    let layouts: Vec<LevelLayout> = l.blocks.iter().map(|b| LevelLayout::of(l, b)).collect();
+    group(c, &c.space, &o.stagger, object, layer, &layouts, all, weights)
+}
+
+/// Table samples (`textures` and their screen `weights`, in table order) grouped into the
+/// blocks of the grid of `space` and `stagger`, block i with `layouts[i]`. Weights are kept
+/// where every sample has them.
+#[allow(clippy::too_many_arguments)]
+fn group<S>(c: &Container<S>, space: &ParameterSpace, stagger: &[u32], object: usize, layer: usize, layouts: &[LevelLayout], textures: Vec<Vec<f32>>, weights: Vec<Option<Vec<f32>>>) -> Result<Vec<BlockSource>, Error> {
+    let l = &c.objects[object].layers[layer];
+    let grid = BlockGrid::new(space, l.depends_on, stagger);
+    let has_weights = !weights.is_empty() && weights.iter().all(Option::is_some);
+    if layouts.len() != grid.block_count() as usize {
+        return Err(Error::Request(format!("object {object} layer {layer}: {} block layouts for {} blocks", layouts.len(), grid.block_count())));
+    }
+    let mut blocks: Vec<BlockSource> = layouts.iter().enumerate().map(|(bi, layout)| {
         let extent = grid.extent(bi);
         let count = extent.iter().map(|&e| e as usize).product();
-        BlockSource { layout: LevelLayout::of(l, b), extent, textures: vec![Vec::new(); count], tables: vec![0; count], weights: has_weights.then(|| vec![Vec::new(); count]) }
+        BlockSource { layout: layout.clone(), extent, textures: vec![Vec::new(); count], tables: vec![0; count], weights: has_weights.then(|| vec![Vec::new(); count]) }
     }).collect();
-    for (s, (x, w)) in all.into_iter().zip(weights).enumerate() {
+    for (s, (x, w)) in textures.into_iter().zip(weights).enumerate() {
         let pos = grid.locate(&sample_point(c, l, s as u64));
         let idx = pos.local.iter().zip(&pos.extent).fold(0usize, |a, (&i, &e)| a * e as usize + i as usize);
         let b = blocks.get_mut(pos.block).ok_or_else(|| Error::Request(format!("object {object} layer {layer}: sample {s} lies in no block")))?;
@@ -115,7 +128,6 @@ pub fn regroup<S>(c: &Container<S>, space: &ParameterSpace, stagger: &[u32], obj
     let layout = old.first().map(|b| b.layout.clone()).ok_or_else(|| Error::Request(format!("object {object} layer {layer}: no block sources")))?;
     let n = c.space.table_len(l.depends_on) as usize;
     let mut textures: Vec<Option<Vec<f32>>> = vec![None; n];
-    let has_weights = old.iter().all(|b| b.weights.is_some());
     let mut weights: Vec<Option<Vec<f32>>> = vec![None; n];
     for b in old {
         let ws = b.weights.map(|w| w.into_iter().map(Some).collect::<Vec<_>>()).unwrap_or_else(|| vec![None; b.tables.len()]);
@@ -125,22 +137,9 @@ pub fn regroup<S>(c: &Container<S>, space: &ParameterSpace, stagger: &[u32], obj
             weights[t] = w;
         }
     }
-    let grid = BlockGrid::new(space, l.depends_on, stagger);
-    let mut blocks: Vec<BlockSource> = (0..grid.block_count() as usize).map(|bi| {
-        let extent = grid.extent(bi);
-        let count = extent.iter().map(|&e| e as usize).product();
-        BlockSource { layout: layout.clone(), extent, textures: vec![Vec::new(); count], tables: vec![0; count], weights: has_weights.then(|| vec![Vec::new(); count]) }
-    }).collect();
-    for (s, x) in textures.into_iter().enumerate() {
-        let x = x.ok_or_else(|| Error::Request(format!("object {object} layer {layer}: table sample {s} is in no block")))?;
-        let pos = grid.locate(&sample_point(c, l, s as u64));
-        let idx = pos.local.iter().zip(&pos.extent).fold(0usize, |a, (&i, &e)| a * e as usize + i as usize);
-        let b = &mut blocks[pos.block];
-        b.textures[idx] = x;
-        b.tables[idx] = s;
-        if let (Some(ws), Some(w)) = (b.weights.as_mut(), weights[s].take()) {
-            ws[idx] = w;
-        }
-    }
-    Ok(blocks)
+    let textures = textures.into_iter().enumerate()
+        .map(|(s, x)| x.ok_or_else(|| Error::Request(format!("object {object} layer {layer}: table sample {s} is in no block"))))
+        .collect::<Result<Vec<_>, Error>>()?;
+    let blocks = BlockGrid::new(space, l.depends_on, stagger).block_count() as usize;
+    group(c, space, stagger, object, layer, &vec![layout; blocks], textures, weights)
 }
