@@ -69,15 +69,7 @@ impl DisplayFilter {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    fn prov(settings: &[(&str, &str)]) -> Provenance {
-        Provenance {
-            tool: "t".into(),
-            source: "s".into(),
-            raw_image_bytes: 0,
-            settings: settings.iter().map(|(k, v)| (k.to_string(), v.to_string())).collect(),
-        }
-    }
+    use crate::filter::tests::prov;
 
     #[test]
     fn settings_round_trip() {

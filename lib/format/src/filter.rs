@@ -63,10 +63,11 @@ impl FileFilter {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
 
-    fn prov(settings: &[(&str, &str)]) -> Provenance {
+    /// Provenance with just these settings (also for the display filter's tests).
+    pub(crate) fn prov(settings: &[(&str, &str)]) -> Provenance {
         Provenance {
             tool: "t".into(),
             source: "s".into(),
