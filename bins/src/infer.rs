@@ -331,7 +331,7 @@ pub(crate) fn place(
     }).collect();
     Ok(Prepared {
         mesh_uvs,
-        transform: TextureTransform { values: pl.affine },
+        transform: TextureTransform::affine(pl.affine),
         layout: TextureLayout::full(pl.width, pl.height),
         repeat: pl.repeat,
         texcoord_ms: t.elapsed().as_secs_f64() * 1e3,

@@ -13,22 +13,47 @@ pub struct Viewport {
     pub height: u32,
 }
 
-/// The affine texture-coordinate transform of a parameter block (SPEC.md 7.3):
-/// `s = a·u + b·v + e`, `t = c·u + d·v + f`; (s, t) ∈ [0, 1]² spans the used texture.
+/// The texture-coordinate transform of a parameter block (SPEC.md 7.3): branch cuts in
+/// periodic dimensions, `w' = (w − w_cut) − ⌊w − w_cut⌋` where a cut is made, then the
+/// affine map `s = a·u' + b·v' + e`, `t = c·u' + d·v' + f`; (s, t) ∈ [0, 1]² spans the used
+/// texture.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct TextureTransform {
     /// `[a, b, c, d, e, f]`, the block's placement values 0..6.
     pub values: [f32; 6],
+    /// The branch cut along u and v (placement values 6 and 7, flag bits 2 and 3), where
+    /// one was made.
+    pub cut: [Option<f32>; 2],
 }
 
 impl TextureTransform {
     /// s = u, t = v.
-    pub const IDENTITY: TextureTransform = TextureTransform { values: [1.0, 0.0, 0.0, 1.0, 0.0, 0.0] };
+    pub const IDENTITY: TextureTransform = TextureTransform { values: [1.0, 0.0, 0.0, 1.0, 0.0, 0.0], cut: [None; 2] };
+
+    /// The affine map `values` without branch cuts.
+    pub const fn affine(values: [f32; 6]) -> TextureTransform {
+        TextureTransform { values, cut: [None; 2] }
+    }
+
+    /// (u', v') of mesh texture coordinates (u, v): the branch cuts applied, in the order
+    /// of operations of the WGSL `cut_uv`: `w − c − floor(w − c)` in f32.
+    pub fn cut_uv(&self, uv: [f32; 2]) -> [f32; 2] {
+        let mut w = uv;
+        for (x, c) in w.iter_mut().zip(self.cut) {
+            if let Some(c) = c {
+                let d = *x - c;
+                *x = d - d.floor();
+            }
+        }
+        w
+    }
 
     /// (s, t) of mesh texture coordinates (u, v), in the order of operations of the WGSL
-    /// `texcoord`: `a·u + b·v + e` evaluated left to right in f32.
+    /// `texcoord`: the cuts ([`TextureTransform::cut_uv`]), then `a·u + b·v + e` evaluated
+    /// left to right in f32.
     pub fn texcoord(&self, uv: [f32; 2]) -> [f32; 2] {
         let [a, b, c, d, e, f] = self.values;
+        let uv = self.cut_uv(uv);
         [a * uv[0] + b * uv[1] + e, c * uv[0] + d * uv[1] + f]
     }
 }
@@ -156,7 +181,7 @@ mod tests {
 
     #[test]
     fn texture_transform_is_the_spec_affine() {
-        let t = TextureTransform { values: [2.0, 0.5, -1.0, 3.0, 0.25, 0.125] };
+        let t = TextureTransform::affine([2.0, 0.5, -1.0, 3.0, 0.25, 0.125]);
         assert_eq!(t.texcoord([1.0, 2.0]), [2.0 + 1.0 + 0.25, -1.0 + 6.0 + 0.125]);
     }
 }

@@ -57,9 +57,9 @@ fn run_views(gpu: &pis_play::Gpu, test: &str) {
             address: [Address::Repeat, Address::ClampToEdge],
         },
     ];
-    let skewed = TextureTransform { values: [0.93, 0.05, -0.04, 0.88, 0.03, 0.06] };
+    let skewed = TextureTransform::affine([0.93, 0.05, -0.04, 0.88, 0.03, 0.06]);
     // Along a repeat axis the transform keeps the period: s = u + e.
-    let wrapped = TextureTransform { values: [1.0, 0.0, 0.0, 0.9, 0.25, 0.05] };
+    let wrapped = TextureTransform::affine([1.0, 0.0, 0.0, 0.9, 0.25, 0.05]);
     let mut worst = f64::INFINITY;
     let mut failures = vec![];
     for view in &views {

@@ -26,7 +26,7 @@ fn anisotropic_probe_predicts_the_anisotropic_draw() {
     let x = random_rgba(layout.texel_count(), 5);
     let object = |filter| TexturedObject {
         mesh: DrawMesh { positions: &floor.positions, uvs: &floor.uvs, indices: &floor.indices, clip_from_object: clip },
-        transform: TextureTransform { values: [1.0, 0.0, 0.0, 1.0, 0.0, 0.0] },
+        transform: TextureTransform::affine([1.0, 0.0, 0.0, 1.0, 0.0, 0.0]),
         layout,
         sampler: Sampler { filter, address: [Address::ClampToEdge; 2] },
     };

@@ -41,9 +41,9 @@ fn probe_matches_model() {
         let clip = camera(vp, eye, [0.0; 3], 0.9);
         let occ = DrawMesh { positions: &occluder.positions, uvs: &occluder.uvs, indices: &occluder.indices, clip_from_object: clip };
         let transform = if address[0] == Address::Repeat {
-            TextureTransform { values: [1.0, 0.0, 0.0, 0.9, 0.0, 0.05] }
+            TextureTransform::affine([1.0, 0.0, 0.0, 0.9, 0.0, 0.05])
         } else {
-            TextureTransform { values: [0.93, 0.05, -0.04, 0.88, 0.03, 0.06] }
+            TextureTransform::affine([0.93, 0.05, -0.04, 0.88, 0.03, 0.06])
         };
         let object = TexturedObject {
             mesh: DrawMesh { positions: &sphere.positions, uvs: &sphere.uvs, indices: &sphere.indices, clip_from_object: clip },
