@@ -19,7 +19,7 @@ use glam::Vec3;
 use pis_compile::baseline::forward::forward_map;
 use pis_compile::baseline::traced::trace_into_texture;
 use pis_compile::baseline::LayerImage;
-use pis_compile::texcoord::{branch_cut::apply_cut, charts::separate_overlapping_charts, optimize_placement, ObjectMesh, TexcoordSettings, ViewGeometry};
+use pis_compile::texcoord::{charts::separate_overlapping_charts, optimize_placement, ObjectMesh, TexcoordSettings, ViewGeometry};
 use pis_compile::{
     antialiased_render_matrix, render, render_matrix, scene_depth, DisplayFilter, solve, Address, DrawMesh, Filter, MipSolve, RenderMatrix, Sampler,
     SolveSettings, TextureLayout, TextureTransform, TexturedObject, Viewport,
@@ -254,8 +254,17 @@ pub fn psnr_display(a: &[f32], b: &[f32]) -> f64 {
 
 /// Keeps the rows of A whose pixels the tracer covers; returns the reduced A and its b.
 pub(crate) fn restrict(a: &RenderMatrix, cov: &[f32], rgb: &[f32]) -> (RenderMatrix, Vec<f32>) {
+    let out = restrict_rows(a, cov);
+    let mut b = Vec::with_capacity(out.rows() * 3);
+    for &p in &out.pixels {
+        b.extend_from_slice(&rgb[p as usize * 3..p as usize * 3 + 3]);
+    }
+    (out, b)
+}
+
+/// The rows of A whose pixels the tracer covers.
+pub(crate) fn restrict_rows(a: &RenderMatrix, cov: &[f32]) -> RenderMatrix {
     let mut out = RenderMatrix { width: a.width, height: a.height, layout: a.layout, row_start: vec![0], ..Default::default() };
-    let mut b = Vec::new();
     for r in 0..a.rows() {
         let p = a.pixels[r] as usize;
         if cov.get(p).is_none_or(|&c| c <= 0.0) {
@@ -267,9 +276,8 @@ pub(crate) fn restrict(a: &RenderMatrix, cov: &[f32], rgb: &[f32]) -> (RenderMat
         out.row_start.push(out.cols.len() as u32);
         out.pixels.push(a.pixels[r]);
         out.coverage.push(a.coverage[r]);
-        b.extend_from_slice(&rgb[p * 3..p * 3 + 3]);
     }
-    (out, b)
+    out
 }
 
 pub(crate) struct Prepared {
@@ -278,8 +286,6 @@ pub(crate) struct Prepared {
     pub(crate) layout: TextureLayout,
     pub(crate) repeat: [bool; 2],
     pub(crate) texcoord_ms: f64,
-    /// The reduction factor applied (the requested one times the texel budget's).
-    pub(crate) reduction: f64,
 }
 
 fn prepare(pt: &Point, o: usize, mesh: &Mesh, req: &InferRequest, reduction: f64) -> Result<Prepared> {
@@ -287,8 +293,9 @@ fn prepare(pt: &Point, o: usize, mesh: &Mesh, req: &InferRequest, reduction: f64
 }
 
 /// Texture-coordinate optimization (thesis 3.2) of object `o` over the views of `frames`,
-/// with the per-object resolution reduction factor `reduction`; visible charts that share
-/// (u, v) are laid out apart first ([`separate_overlapping_charts`]).
+/// with the per-object resolution reduction factor `reduction`: the texture coordinates of
+/// [`atlas`] and the placement of [`place_in`] over the same views.
+#[allow(clippy::too_many_arguments)]
 pub(crate) fn place(
     scene: &Scene,
     frames: &[&Frame],
@@ -300,7 +307,27 @@ pub(crate) fn place(
     texels_per_pixel: Option<f64>,
 ) -> Result<Prepared> {
     let t = Instant::now();
-    let views: Vec<ViewGeometry> = frames.iter().map(|frame| {
+    let at = atlas(frames, res, o, mesh);
+    let pl = place_in(scene, frames, res, o, mesh, &at, max_texture, reduction, texels_per_pixel)?;
+    Ok(Prepared {
+        mesh_uvs: at.uvs,
+        transform: pl.transform,
+        layout: pl.layout,
+        repeat: pl.repeat,
+        texcoord_ms: t.elapsed().as_secs_f64() * 1e3,
+    })
+}
+
+/// An object's texture coordinates as its mesh carries them in the file, and which of them
+/// are periodic.
+pub(crate) struct Atlas {
+    pub(crate) uvs: Vec<[f32; 2]>,
+    pub(crate) wrap: [bool; 2],
+}
+
+/// The mesh of object `o` as the views of `frames` see it (clip-space vertices).
+fn view_geometry(frames: &[&Frame], res: (u32, u32), o: usize, mesh: &Mesh) -> Vec<ViewGeometry> {
+    frames.iter().map(|frame| {
         let proj = pis_trace::camera::projection_matrix(&frame.camera, res);
         let clip_from_object = proj * frame.camera.world_from_camera.inverse() * frame.instances[o].world_from_object;
         ViewGeometry {
@@ -308,33 +335,66 @@ pub(crate) fn place(
             width: res.0,
             height: res.1,
         }
-    }).collect();
+    }).collect()
+}
+
+/// The object's texture coordinates over the views of `frames`: visible parts sharing (u, v)
+/// (a room's walls each mapped onto the whole wallpaper) laid out side by side, one texel per
+/// surface point ([`separate_overlapping_charts`]); else the mesh's own, periodic where the
+/// mesh has a seam.
+pub(crate) fn atlas(frames: &[&Frame], res: (u32, u32), o: usize, mesh: &Mesh) -> Atlas {
+    let views = view_geometry(frames, res, o, mesh);
     let uvs: Vec<glam::Vec2> = mesh.uvs.iter().map(|u| glam::Vec2::from(*u)).collect();
-    // Visible parts sharing (u, v) (a room's walls each mapped onto the whole wallpaper)
-    // are laid out side by side first: one texel per surface point.
-    let (uvs, wrap) = match separate_overlapping_charts(&uvs, &mesh.indices, &views) {
-        Some(atlas) => (atlas, [false, false]),
-        None => (uvs, seam_wraps(mesh)),
-    };
+    match separate_overlapping_charts(&uvs, &mesh.indices, &views) {
+        Some(atlas) => Atlas { uvs: atlas.iter().map(|uv| uv.to_array()).collect(), wrap: [false, false] },
+        None => Atlas { uvs: mesh.uvs.clone(), wrap: seam_wraps(mesh) },
+    }
+}
+
+/// An object's texture placement for the views of one parameter block (thesis 3.2): branch
+/// cuts and affine map, used size with its MIP chain, wrapping, the reduction applied.
+#[derive(Clone, Debug)]
+pub(crate) struct Placed {
+    pub(crate) transform: TextureTransform,
+    pub(crate) layout: TextureLayout,
+    pub(crate) repeat: [bool; 2],
+    pub(crate) reduction: f64,
+}
+
+impl Placed {
+    /// Whether textures placed by `self` and `other` are drawn alike (the same texture
+    /// transform, size and wrapping).
+    pub(crate) fn same(&self, other: &Placed) -> bool {
+        self.transform == other.transform && self.layout == other.layout && self.repeat == other.repeat
+    }
+}
+
+/// Branch cuts, the most isometric map, the stretch limit, the bounding rectangle and the
+/// used resolution of object `o` with the texture coordinates of `atlas`, over the views of
+/// `frames` (one parameter block's).
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn place_in(
+    scene: &Scene,
+    frames: &[&Frame],
+    res: (u32, u32),
+    o: usize,
+    mesh: &Mesh,
+    atlas: &Atlas,
+    max_texture: u32,
+    reduction: f64,
+    texels_per_pixel: Option<f64>,
+) -> Result<Placed> {
+    let views = view_geometry(frames, res, o, mesh);
+    let uvs: Vec<glam::Vec2> = atlas.uvs.iter().map(|u| glam::Vec2::from(*u)).collect();
     let name = &scene.objects[o].name;
-    let om = ObjectMesh { name, uvs: &uvs, indices: &mesh.indices, wrap };
+    let om = ObjectMesh { name, uvs: &uvs, indices: &mesh.indices, wrap: atlas.wrap };
     let settings = TexcoordSettings { max_size: max_texture, reduction, texels_per_pixel, ..TexcoordSettings::default() };
     let pl = optimize_placement(&om, &views, &settings)?;
-    let mesh_uvs: Vec<[f32; 2]> = uvs.iter().map(|uv| uv.to_array()).map(|uv| {
-        let mut w = uv;
-        for (wd, cut) in w.iter_mut().zip(pl.branch_cut) {
-            if let Some(c) = cut {
-                *wd = apply_cut(*wd as f64, c) as f32;
-            }
-        }
-        w
-    }).collect();
-    Ok(Prepared {
-        mesh_uvs,
-        transform: TextureTransform::affine(pl.affine),
+    Ok(Placed {
+        // A cut rounded up to 1 in f32 is the cut at 0.
+        transform: TextureTransform { values: pl.affine, cut: pl.branch_cut.map(|c| c.map(|c| if (c as f32) < 1.0 { c as f32 } else { 0.0 })) },
         layout: TextureLayout::full(pl.width, pl.height),
         repeat: pl.repeat,
-        texcoord_ms: t.elapsed().as_secs_f64() * 1e3,
         reduction: pl.reduction,
     })
 }

@@ -78,6 +78,11 @@ pub struct LayerSummary {
     /// Largest used texture size over the blocks.
     pub width: u32,
     pub height: u32,
+    /// Distinct texture placements (size, branch cuts, affine map, wrapping) over the
+    /// blocks of a surface layer (thesis 3.2: per parameter block).
+    pub placements: usize,
+    /// Blocks whose placement makes a branch cut.
+    pub cut_blocks: usize,
     /// Most pyramid levels in a block.
     pub levels: usize,
     pub codestreams: usize,
@@ -148,6 +153,8 @@ pub fn summarize(r: &PisReader) -> Summary {
                         blocks: l.blocks.len(),
                         width: l.blocks.iter().map(|b| b.width).max().unwrap_or(0),
                         height: l.blocks.iter().map(|b| b.height).max().unwrap_or(0),
+                        placements: surface_placements(&l.blocks),
+                        cut_blocks: l.blocks.iter().filter(|b| matches!(b.placement, Placement::Surface { cut, .. } if cut.iter().any(Option::is_some))).count(),
                         levels: l.blocks.iter().map(|b| b.levels.len()).max().unwrap_or(0),
                         codestreams: refs.len(),
                         bytes: refs.iter().map(|s| s.length as u64).sum(),
@@ -214,6 +221,29 @@ pub fn summarize(r: &PisReader) -> Summary {
             settings: p.settings.iter().cloned().collect(),
         }),
     }
+}
+
+/// Distinct surface placements among `blocks` (0 for a shell layer).
+fn surface_placements<S>(blocks: &[pis_format::Block<S>]) -> usize {
+    let mut seen: Vec<(u32, u32, Placement)> = Vec::new();
+    for b in blocks {
+        if matches!(b.placement, Placement::Surface { .. }) && !seen.iter().any(|(w, h, p)| *w == b.width && *h == b.height && *p == b.placement) {
+            seen.push((b.width, b.height, b.placement));
+        }
+    }
+    seen.len()
+}
+
+/// ", N placements" / ", N with a branch cut" where a surface layer's blocks differ or cut.
+fn placements_text(l: &LayerSummary) -> String {
+    let mut s = String::new();
+    if l.placements > 1 {
+        s += &format!(" in {} placements", l.placements);
+    }
+    if l.cut_blocks > 0 {
+        s += &format!(", {} with a branch cut", l.cut_blocks);
+    }
+    s
 }
 
 fn human(n: u64) -> String {
@@ -290,7 +320,7 @@ pub fn render(s: &Summary) -> String {
             };
             let _ = writeln!(
                 o,
-                "    layer {i}: {:<11} {:<15} term {:<10} {}ch, gamma {}, varies with {deps}: {} block(s) of up to {}x{} texels, {} level(s), mips {}, {}",
+                "    layer {i}: {:<11} {:<15} term {:<10} {}ch, gamma {}, varies with {deps}: {} block(s) of up to {}x{} texels{}, {} level(s), mips {}, {}",
                 l.kind,
                 mapping,
                 l.term,
@@ -299,6 +329,7 @@ pub fn render(s: &Summary) -> String {
                 l.blocks,
                 l.width,
                 l.height,
+                placements_text(l),
                 l.levels,
                 l.mip_mode,
                 human(l.bytes)

@@ -74,6 +74,8 @@ pub struct PackRequest {
     pub layers: LayerMode,
     /// What the storage allocation weighs: screen error (default) or texture error.
     pub allocation: Allocation,
+    /// Texture placements per parameter block or per object.
+    pub placement: PlacementMode,
     /// Conjugate-gradient iteration cap per colour channel of every solve (None: the
     /// solver's default).
     pub max_iterations: Option<u32>,
@@ -103,6 +105,26 @@ pub enum Allocation {
     Screen,
     /// Texture MSE weighted by each object's screen area (every texel of an object alike).
     Texture,
+}
+
+/// Which views a texture placement (thesis 3.2) is optimized over.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum PlacementMode {
+    /// Per object per parameter block: the views of the block's samples (thesis 3.2).
+    #[default]
+    Block,
+    /// One placement per object over every view of the set, shared by all its blocks.
+    Object,
+}
+
+impl PlacementMode {
+    /// The name `--placement` and the provenance use.
+    pub fn name(self) -> &'static str {
+        match self {
+            PlacementMode::Block => "block",
+            PlacementMode::Object => "object",
+        }
+    }
 }
 
 /// How the lighting layers are separated.

@@ -50,7 +50,7 @@ fn pack_scene(scene_toml: &Path) -> Result<PathBuf, Failure> {
         pyramid: crate::pack::PyramidMode::Adaptive,
         layers: crate::pack::LayerMode::Separate,
         max_iterations: None,
-        allocation: crate::pack::Allocation::Screen,
+        allocation: crate::pack::Allocation::Screen, placement: crate::pack::PlacementMode::Block,
         preset: None,
     };
     let report = crate::pack::pack(&req)?;

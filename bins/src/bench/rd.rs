@@ -113,7 +113,7 @@ fn pack_request(req: &RdRequest) -> PackRequest {
         spp: req.spp,
         pyramid: PyramidMode::Adaptive,
         layers: LayerMode::Separate,
-        max_iterations: None, allocation: crate::pack::Allocation::Screen, preset: req.preset.clone(),
+        max_iterations: None, allocation: crate::pack::Allocation::Screen, placement: crate::pack::PlacementMode::Block, preset: req.preset.clone(),
     }
 }
 

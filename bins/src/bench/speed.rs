@@ -82,7 +82,7 @@ pub fn run(req: &SpeedRequest) -> Result<SpeedReport, Failure> {
     let base = PackRequest {
         input: req.input.clone(), scene: req.scene.clone(), output: req.out.join("unused.pis"), ratio: Some(req.ratio), psnr: None,
         codec: CodecId::Wavelet, block: vec![8], filter: Filter::Trilinear, matrix: crate::pack::MatrixSource::Model, max_texture: req.max_texture, texels_per_pixel: crate::pack::DEFAULT_TEXELS_PER_PIXEL, gamma: 2.2,
-        resolution: req.resolution, spp: req.spp, pyramid: PyramidMode::Adaptive, layers: LayerMode::Separate, max_iterations: None, allocation: crate::pack::Allocation::Screen,
+        resolution: req.resolution, spp: req.spp, pyramid: PyramidMode::Adaptive, layers: LayerMode::Separate, max_iterations: None, allocation: crate::pack::Allocation::Screen, placement: crate::pack::PlacementMode::Block,
         preset: req.preset.clone(),
     };
     let mut rows = Vec::new();

@@ -9,11 +9,12 @@
 //! Popping: per path, the largest frame-to-frame RMS change of the PIS frames divided by
 //! the reference's RMS change between the same two frames (1: as smooth as the reference).
 
+use std::collections::BTreeMap;
 use std::path::PathBuf;
 
 use anyhow::{anyhow, Result};
 use pis_codec::CodecId;
-use pis_compile::{render, render_matrix, scene_depth, DrawMesh, Filter, TexturedObject, Viewport};
+use pis_compile::{render, render_matrix, scene_depth, DrawMesh, Filter, RenderMatrix, TexturedObject, Viewport};
 use pis_eval::chart::{Chart, Series};
 use pis_eval::metrics::{display, SquaredError};
 use pis_eval::report::{Csv, Stamp};
@@ -91,18 +92,18 @@ struct Rendered {
     mask: Vec<bool>,
 }
 
-/// Textures of one layer at a fractional view position: the two neighbouring view samples
-/// blended linearly (the nearest alone when the layer does not depend on the view).
-fn layer_texels(t: &LayerTextures, mask: DepMask, view_dim: usize, point: &[u32], view: f32, views: u32) -> Option<Vec<f32>> {
+/// The samples of one layer at a fractional view position, with their weights: the two
+/// neighbouring view samples blended linearly (the nearest alone when the layer does not
+/// depend on the view).
+fn layer_samples(mask: DepMask, view_dim: usize, point: &[u32], view: f32, views: u32) -> Vec<(Vec<u32>, f32)> {
     let key_at = |v: u32| -> Vec<u32> { mask.dims().map(|d| if d == view_dim { v } else { point[d] }).collect() };
     if !mask.dims().any(|d| d == view_dim) {
-        return t.get(&key_at(0)).cloned();
+        return vec![(key_at(0), 1.0)];
     }
     let k0 = (view.floor() as u32).min(views - 1);
     let k1 = (k0 + 1).min(views - 1);
     let f = view - k0 as f32;
-    let (a, b) = (t.get(&key_at(k0))?, t.get(&key_at(k1))?);
-    Some(a.iter().zip(b).map(|(x, y)| x + (y - x) * f).collect())
+    vec![(key_at(k0), 1.0 - f), (key_at(k1), f)]
 }
 
 fn render_frame(inf: &Inferred, meshes: &[Mesh], tex: &[Vec<LayerTextures>], pf: &PathFrame, view_dim: usize) -> Result<Rendered> {
@@ -122,16 +123,29 @@ fn render_frame(inf: &Inferred, meshes: &[Mesh], tex: &[Vec<LayerTextures>], pf:
     for (mi, m) in inf.models.iter().enumerate() {
         let occluders = scene_depth(viewport, &draw, Some(m.index))?;
         let mut mesh = draw[m.index];
-        mesh.uvs = &m.prep.mesh_uvs;
-        let obj = TexturedObject { mesh, transform: m.prep.transform, layout: m.prep.layout, sampler: sampler(Filter::Trilinear, m.prep.repeat) };
-        let a = render_matrix(viewport, &obj, Some(&occluders))?;
-        let mut img = vec![0.0f32; a.rows() * 3];
+        mesh.uvs = &m.mesh_uvs;
+        // One render matrix per placement the frame's samples carry (the same pixels).
+        let mut matrices: BTreeMap<usize, RenderMatrix> = BTreeMap::new();
+        let mut img: Vec<f32> = Vec::new();
         for (li, l) in m.layers.iter().enumerate() {
-            let x = layer_texels(&tex[mi][li], l.depends_on, view_dim, &pf.point, pf.view, views)
-                .ok_or_else(|| anyhow!("object {}: no texture near view {}", m.name, pf.view))?;
-            let y = render(&a, &x);
-            img.iter_mut().zip(&y).for_each(|(s, v)| *s += v);
+            for (k, weight) in layer_samples(l.depends_on, view_dim, &pf.point, pf.view, views) {
+                let x = tex[mi][li].get(&k).ok_or_else(|| anyhow!("object {}: no texture near view {}", m.name, pf.view))?;
+                if weight == 0.0 {
+                    continue;
+                }
+                let pid = l.placement_of[&k];
+                if !matrices.contains_key(&pid) {
+                    let pl = &m.placements[pid];
+                    let obj = TexturedObject { mesh, transform: pl.transform, layout: pl.layout, sampler: sampler(Filter::Trilinear, pl.repeat) };
+                    matrices.insert(pid, render_matrix(viewport, &obj, Some(&occluders))?);
+                }
+                let a = &matrices[&pid];
+                img.resize(a.rows() * 3, 0.0);
+                let y = render(a, x);
+                img.iter_mut().zip(&y).for_each(|(s, v)| *s += weight * v);
+            }
         }
+        let Some(a) = matrices.values().next() else { continue };
         for r in 0..a.rows() {
             let p = a.pixels[r] as usize;
             mask[p] = true;
@@ -195,7 +209,7 @@ pub fn run(req: &StabilityRequest) -> Result<StabilityReport, Failure> {
     let base = PackRequest {
         input: req.input.clone(), scene: req.scene.clone(), output: req.out.join("unused.pis"), ratio: None, psnr: None,
         codec: CodecId::Wavelet, block: vec![8], filter: Filter::Trilinear, matrix: crate::pack::MatrixSource::Model, max_texture: req.max_texture, texels_per_pixel: crate::pack::DEFAULT_TEXELS_PER_PIXEL, gamma: 2.2,
-        resolution: req.resolution, spp: req.trace_spp, pyramid: PyramidMode::Adaptive, layers: LayerMode::Separate, max_iterations: None, allocation: crate::pack::Allocation::Screen, preset: req.preset.clone(),
+        resolution: req.resolution, spp: req.trace_spp, pyramid: PyramidMode::Adaptive, layers: LayerMode::Separate, max_iterations: None, allocation: crate::pack::Allocation::Screen, placement: crate::pack::PlacementMode::Block, preset: req.preset.clone(),
     };
     eprintln!("pis-bench: stability: loading and inferring");
     let inf = Inferred::new(&base)?;

@@ -8,7 +8,7 @@ use std::process::ExitCode;
 
 use clap::Parser;
 use pis::cli::{self, Exit, Failure};
-use pis::pack::{filter_needs_probe, pack_with, print_report, Allocation, LayerMode, MatrixSource, PackExtras, PackRequest, PyramidMode};
+use pis::pack::{filter_needs_probe, pack_with, print_report, Allocation, LayerMode, MatrixSource, PackExtras, PackRequest, PlacementMode, PyramidMode};
 use pis_codec::CodecId;
 use pis_compile::{Filter, MAX_ANISOTROPY};
 
@@ -89,6 +89,11 @@ struct Cli {
     /// weighted by each object's screen area).
     #[arg(long, default_value = "screen", value_parser = parse_allocation)]
     allocation: Allocation,
+    /// Which views each texture placement (branch cuts, affine map, used size; thesis 3.2)
+    /// is optimized over: `block` (per object per parameter block, the views of the
+    /// block's samples) or `object` (one placement per object over every view of the set).
+    #[arg(long, default_value = "block", value_parser = parse_placement)]
+    placement: PlacementMode,
     /// Also store the lossless master: every solved texture, before gamma compensation and
     /// coding, losslessly coded in MSTR chunks a player never reads. pis-reencode codes
     /// again from it (as a direct pack at the new settings would) instead of from the decoded
@@ -122,6 +127,14 @@ fn parse_layers(s: &str) -> Result<LayerMode, String> {
         "separate" => Ok(LayerMode::Separate),
         "combined" => Ok(LayerMode::Combined),
         _ => Err(format!("unknown layers {s:?} (separate or combined)")),
+    }
+}
+
+fn parse_placement(s: &str) -> Result<PlacementMode, String> {
+    match s {
+        "block" => Ok(PlacementMode::Block),
+        "object" => Ok(PlacementMode::Object),
+        _ => Err(format!("unknown placement {s:?} (block or object)")),
     }
 }
 
@@ -206,6 +219,7 @@ fn run(cli: Cli) -> Result<Exit, Failure> {
         layers: cli.layers,
         max_iterations: cli.max_iterations,
         allocation: cli.allocation,
+        placement: cli.placement,
         preset: None,
     };
     let report = pack_with(&req, PackExtras { keep_master: cli.keep_master })?;

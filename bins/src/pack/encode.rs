@@ -15,7 +15,7 @@ use pis_format::mip::decimate;
 use pis_format::reconstruct::{finish, prepare};
 use pis_format::*;
 
-use super::infer_layers::{key, InferredLayer, ObjectModel};
+use super::infer_layers::{key, ObjectModel};
 use super::input::LoadedSet;
 use super::storage::{allocate_storage, build_pyramid, encode_levels};
 use super::{PackRequest, Stages};
@@ -89,7 +89,7 @@ fn surface_layer(kind: LayerKind, order: u8, depends_on: DepMask, gamma: f32) ->
     }
 }
 
-fn geometry(set: &LoadedSet, sizes: &[u32]) -> (ParameterSpace, CameraTable) {
+pub(crate) fn geometry(set: &LoadedSet, sizes: &[u32]) -> (ParameterSpace, CameraTable) {
     let scene = &set.scene;
     let space = ParameterSpace {
         dims: scene.space.dims.iter().zip(sizes).map(|(d, &b)| Dimension {
@@ -134,9 +134,9 @@ fn transforms(set: &LoadedSet, space: &ParameterSpace, o: usize) -> TransformTab
     TransformTable { depends_on: all, transforms: t }
 }
 
-/// The finest level of a solved texture (the chain's level 0).
-pub(crate) fn finest(m: &ObjectModel, x: &[f32]) -> Vec<f32> {
-    x[..m.prep.layout.width as usize * m.prep.layout.height as usize * 3].to_vec()
+/// The finest level of a solved texture of layout `layout` (the chain's level 0).
+pub(crate) fn finest(layout: pis_compile::TextureLayout, x: &[f32]) -> Vec<f32> {
+    x[..layout.width as usize * layout.height as usize * 3].to_vec()
 }
 
 /// The full pyramid's level counts, top first: every dimension halved (rounding up) per
@@ -151,44 +151,46 @@ pub fn full_levels(extent: &[u32]) -> Vec<Vec<u32>> {
     levels
 }
 
-/// The screen weight of every level-0 texel of object `m` at each point of the set: the
-/// column sums of its render matrix (how much of the covered pixels each texel of the MIP
-/// chain makes up: rows sum to 1), carried down the decimation to level 0 (Dᵀ), as the
-/// player draws coarser levels from level 0.
-fn screen_weights_per_point(m: &ObjectModel) -> Vec<Vec<f64>> {
-    let dec = pis_compile::decimation::Decimation::new(m.prep.layout);
-    m.views.iter().map(|v| {
-        let mut cols = vec![0.0f64; v.a.cols()];
-        for r in 0..v.a.rows() {
-            let (c, w) = v.a.row(r);
-            c.iter().zip(w).for_each(|(&c, &w)| cols[c as usize] += w as f64);
-        }
-        let mut out = vec![0.0f64; dec.base_len()];
-        dec.reduce(&cols, &mut out);
-        out
-    }).collect()
+/// The screen weight of every level-0 texel of a texture placed by `placement` at one
+/// point: the column sums of its render matrix `a` (how much of the covered pixels each
+/// texel of the MIP chain makes up: rows sum to 1), carried down the decimation to level 0
+/// (Dᵀ), as the player draws coarser levels from level 0.
+fn screen_weights_at(a: &pis_compile::RenderMatrix) -> Vec<f64> {
+    let dec = pis_compile::decimation::Decimation::new(a.layout);
+    let mut cols = vec![0.0f64; a.cols()];
+    for r in 0..a.rows() {
+        let (c, w) = a.row(r);
+        c.iter().zip(w).for_each(|(&c, &w)| cols[c as usize] += w as f64);
+    }
+    let mut out = vec![0.0f64; dec.base_len()];
+    dec.reduce(&cols, &mut out);
+    out
 }
 
 /// Texel weights of one layer sample: the sum of the per-point weights of the points that
 /// read it (all views of a view-independent sample), scaled to mean 1; all zero where no
 /// point shows the object.
-fn sample_weights(per_point: &[Vec<f64>], points: &[usize]) -> Vec<f32> {
+fn sample_weights(per_point: &[Vec<f64>]) -> Vec<f32> {
     let n = per_point.first().map_or(0, Vec::len);
     let mut sum = vec![0.0f64; n];
-    for &p in points {
-        sum.iter_mut().zip(&per_point[p]).for_each(|(a, w)| *a += w);
+    for w in per_point {
+        sum.iter_mut().zip(w).for_each(|(a, w)| *a += w);
     }
     let total: f64 = sum.iter().sum();
     let scale = if total > 0.0 { n as f64 / total } else { 0.0 };
     sum.iter().map(|w| (w * scale) as f32).collect()
 }
 
-/// The screen weights of every sample of layer `il` of `m`, by key: [`sample_weights`] over
-/// the points of `samples` that read it.
-fn layer_screen_weights(per_point: &[Vec<f64>], il: &InferredLayer, samples: &[Vec<u32>]) -> BTreeMap<Vec<u32>, Vec<f32>> {
+/// The screen weights of every sample of layer `li` of `m`, by key: [`sample_weights`] over
+/// the points of `samples` that read it, through the render matrices of its placement.
+fn layer_screen_weights(m: &ObjectModel, li: usize, samples: &[Vec<u32>]) -> BTreeMap<Vec<u32>, Vec<f32>> {
+    let il = &m.layers[li];
     il.textures.keys().map(|k| {
-        let points: Vec<usize> = samples.iter().enumerate().filter(|(_, s)| key(s, il.depends_on) == *k).map(|(p, _)| p).collect();
-        (k.clone(), sample_weights(per_point, &points))
+        let pid = il.placement_of[k];
+        let per_point: Vec<Vec<f64>> = samples.iter().enumerate().filter(|(_, s)| key(s, il.depends_on) == *k)
+            .map(|(p, _)| screen_weights_at(m.views[p].a(pid))).collect();
+        let w = if per_point.is_empty() { vec![0.0; m.placements[pid].layout.width as usize * m.placements[pid].layout.height as usize] } else { sample_weights(&per_point) };
+        (k.clone(), w)
     }).collect()
 }
 
@@ -209,9 +211,14 @@ pub(crate) fn encode_all(set: &LoadedSet, models: &[ObjectModel], req: &PackRequ
     let mut screen_weights = Vec::new();
     for (mi, m) in models.iter().enumerate() {
         let st = stagger(mi, models.len(), &sizes);
+        if st != m.stagger || sizes != m.block_sizes {
+            return Err(runtime(anyhow!(
+                "object {}: its textures were placed for blocks of {:?} samples staggered by {:?}, the encoding asks for blocks of {sizes:?} staggered by {st:?}",
+                m.name, m.block_sizes, m.stagger,
+            )));
+        }
         let weights_by_layer: Vec<BTreeMap<Vec<u32>, Vec<f32>>> = if req.allocation == super::Allocation::Screen {
-            let per_point = screen_weights_per_point(m);
-            m.layers.iter().map(|il| layer_screen_weights(&per_point, il, &set.samples)).collect()
+            (0..m.layers.len()).map(|li| layer_screen_weights(m, li, &set.samples)).collect()
         } else {
             m.layers.iter().map(|_| BTreeMap::new()).collect()
         };
@@ -225,12 +232,11 @@ pub(crate) fn encode_all(set: &LoadedSet, models: &[ObjectModel], req: &PackRequ
             let mut pblocks = Vec::new();
             for b in 0..grid.block_count() as usize {
                 let extent = grid.extent(b);
+                let placed = &m.placements[il.block_placements[b]];
                 let block = Block {
-                    width: m.prep.layout.width,
-                    height: m.prep.layout.height,
-                    // Branch cuts are already applied to the mesh's texture coordinates (one
-                    // placement per object), so no block carries one.
-                    placement: Placement::Surface { affine: m.prep.transform.values, repeat: m.prep.repeat, cut: [None; 2] },
+                    width: placed.layout.width,
+                    height: placed.layout.height,
+                    placement: Placement::Surface { affine: placed.transform.values, repeat: placed.repeat, cut: placed.transform.cut },
                     levels: vec![],
                 };
                 let layout = LevelLayout::of(&layer, &block);
@@ -250,7 +256,7 @@ pub(crate) fn encode_all(set: &LoadedSet, models: &[ObjectModel], req: &PackRequ
                     }
                     let idx = pos.local.iter().zip(&pos.extent).fold(0usize, |a, (&l, &e)| a * e as usize + l as usize);
                     keys[idx] = k.clone();
-                    samples[idx] = prepare(&layer, &layout, &finest(m, x));
+                    samples[idx] = prepare(&layer, &layout, &finest(placed.layout, x));
                     if let Some(w) = layer_weights.get(k) {
                         weights[idx] = w.clone();
                     }
@@ -276,7 +282,7 @@ pub(crate) fn encode_all(set: &LoadedSet, models: &[ObjectModel], req: &PackRequ
             shading: Shading::default(),
             stagger: st.clone(),
             transforms: transforms(set, &space, m.index),
-            mesh: Mesh { positions: m.mesh.positions.clone(), normals: None, texcoords: Some(m.prep.mesh_uvs.clone()), indices: m.mesh.indices.clone() },
+            mesh: Mesh { positions: m.mesh.positions.clone(), normals: None, texcoords: Some(m.mesh_uvs.clone()), indices: m.mesh.indices.clone() },
             layers,
         });
         blocks_out.push(layer_blocks);
@@ -375,7 +381,7 @@ pub(crate) fn decoded_textures(models: &[ObjectModel], packed: &Packed) -> Resul
     let mut out = Vec::new();
     for (mi, m) in models.iter().enumerate() {
         let mut per_layer = Vec::new();
-        for (li, _) in m.layers.iter().enumerate() {
+        for li in 0..m.layers.len() {
             let layer = &packed.container.objects[mi].layers[li];
             let mut map = std::collections::BTreeMap::new();
             for (b, pb) in packed.blocks[mi][li].iter().enumerate() {
@@ -393,7 +399,7 @@ pub(crate) fn decoded_textures(models: &[ObjectModel], packed: &Packed) -> Resul
                         sum.iter_mut().zip(img).for_each(|(a, v)| *a += v);
                     }
                     let lin = finish(layer, &layout, sum);
-                    map.insert(k.clone(), mip_chain(m, lin));
+                    map.insert(k.clone(), mip_chain(m.layout(li, k), lin));
                 }
             }
             per_layer.push(map);
@@ -407,9 +413,19 @@ fn layer_codec(block: &Block) -> CodecId {
     block.levels.first().and_then(|l| l.images.first()).map_or(CodecId::Raw, |c| c.codec)
 }
 
-/// The MIP chain of the solver's layout from the finest level, by decimation (thesis 3.6).
-pub(crate) fn mip_chain(m: &ObjectModel, finest: Vec<f32>) -> Vec<f32> {
-    let l = m.prep.layout;
+/// The solved textures of `m` per layer, each as the MIP chain the player rebuilds from its
+/// finest level.
+pub(crate) fn solved_chains(m: &ObjectModel) -> Vec<LayerTextures> {
+    m.layers.iter().enumerate().map(|(li, l)| {
+        l.textures.iter().map(|(k, x)| {
+            let layout = m.layout(li, k);
+            (k.clone(), mip_chain(layout, finest(layout, x)))
+        }).collect()
+    }).collect()
+}
+
+/// The MIP chain of layout `l` from the finest level, by decimation (thesis 3.6).
+pub(crate) fn mip_chain(l: pis_compile::TextureLayout, finest: Vec<f32>) -> Vec<f32> {
     let mut x = finest.clone();
     let mut cur = finest;
     for lv in 1..l.levels {
@@ -425,7 +441,7 @@ pub(crate) fn mip_chain(m: &ObjectModel, finest: Vec<f32>) -> Vec<f32> {
 pub(crate) fn masters(models: &[ObjectModel], packed: &Packed) -> Result<Vec<Master>> {
     models.iter().enumerate().map(|(mi, m)| {
         // Keys are sample indices over the layer's dimensions: their order is table order.
-        let textures: Vec<Vec<Vec<f32>>> = m.layers.iter().map(|l| l.textures.values().map(|x| finest(m, x)).collect()).collect();
+        let textures: Vec<Vec<Vec<f32>>> = m.layers.iter().enumerate().map(|(li, l)| l.textures.iter().map(|(k, x)| finest(m.layout(li, k), x)).collect()).collect();
         // The screen weights the allocation used, so that coding the master again allocates
         // as this pack did.
         let by_layer = &packed.screen_weights[mi];
@@ -444,9 +460,9 @@ pub(crate) fn check_master(path: &Path, models: &[ObjectModel]) -> Result<(u64, 
     let mut exact = masters.len() == models.len();
     for (m, model) in masters.iter().zip(models) {
         for (li, l) in model.layers.iter().enumerate() {
-            for (s, x) in l.textures.values().enumerate() {
+            for (s, (k, x)) in l.textures.iter().enumerate() {
                 let got = m.texture(c, li, s)?;
-                let want = finest(model, x);
+                let want = finest(model.layout(li, k), x);
                 exact &= got.len() == want.len() && got.iter().zip(&want).all(|(a, b)| a.to_bits() == b.to_bits());
             }
         }
@@ -487,10 +503,11 @@ pub(crate) fn display_error(set: &LoadedSet, models: &[ObjectModel], textures: &
         let (mut sse, mut n) = (0.0f64, 0usize);
         for (p, s) in set.samples.iter().enumerate() {
             let v = &m.views[p];
-            let mut img = vec![0.0f32; v.a.rows() * 3];
+            let mut img = vec![0.0f32; v.rows() * 3];
             for (il, t) in m.layers.iter().zip(tex) {
-                if let Some(x) = t.get(&key(s, il.depends_on)) {
-                    let r = pis_compile::render(&v.a, x);
+                let k = key(s, il.depends_on);
+                if let Some(x) = t.get(&k) {
+                    let r = pis_compile::render(v.a(il.placement_of[&k]), x);
                     img.iter_mut().zip(&r).for_each(|(a, b)| *a += b);
                 }
             }
@@ -532,14 +549,13 @@ pub(crate) struct Quality {
 /// model's or probe mode's).
 pub(crate) fn predicted_psnr(set: &LoadedSet, models: &[ObjectModel], packed: &Packed) -> Result<Quality> {
     let decoded = decoded_textures(models, packed)?;
-    let solved: Vec<Vec<LayerTextures>> = models.iter().map(|m| m.layers.iter().map(|l| {
-        l.textures.iter().map(|(k, x)| (k.clone(), mip_chain(m, finest(m, x)))).collect()
-    }).collect()).collect();
+    let solved: Vec<Vec<LayerTextures>> = models.iter().map(solved_chains).collect();
     let mut max_err = 0.0f32;
     for (m, (dl, sl)) in models.iter().zip(decoded.iter().zip(&solved)) {
-        let n = m.prep.layout.width as usize * m.prep.layout.height as usize * 3;
-        for (dm, sm) in dl.iter().zip(sl) {
+        for (li, (dm, sm)) in dl.iter().zip(sl).enumerate() {
             for (k, x) in sm {
+                let l = m.layout(li, k);
+                let n = l.width as usize * l.height as usize * 3;
                 if let Some(y) = dm.get(k) {
                     for (a, b) in x[..n].iter().zip(&y[..n]) {
                         max_err = max_err.max((a - b).abs());
@@ -571,12 +587,12 @@ mod tests {
         let per_point = vec![vec![2.0, 0.0, 0.0, 2.0], vec![0.0, 0.0, 4.0, 0.0], vec![1.0, 1.0, 1.0, 1.0]];
         // two views of a view-independent sample: texels seen by both weigh most, the
         // texel no view reads weighs nothing
-        let w = sample_weights(&per_point, &[0, 1]);
+        let w = sample_weights(&per_point[..2]);
         assert_eq!(w, vec![1.0, 0.0, 2.0, 1.0]);
         assert!((w.iter().sum::<f32>() / 4.0 - 1.0).abs() < 1e-6);
-        assert_eq!(sample_weights(&per_point, &[2]), vec![1.0; 4]);
+        assert_eq!(sample_weights(&per_point[2..]), vec![1.0; 4]);
         // a sample no point shows weighs nothing anywhere
-        assert_eq!(sample_weights(&[vec![0.0; 3]], &[0]), vec![0.0; 3]);
-        assert_eq!(sample_weights(&per_point, &[]), vec![0.0; 4]);
+        assert_eq!(sample_weights(&[vec![0.0; 3]]), vec![0.0; 3]);
+        assert!(sample_weights(&[]).is_empty());
     }
 }

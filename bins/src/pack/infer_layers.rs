@@ -1,41 +1,65 @@
 //! Inference of every object's layers as parameterized surface textures (thesis 3.5, 4.8):
 //! a view-independent diffuse layer solved once over all views by stacking, and a
 //! view-dependent specular layer solved per parameter sample, each warm-started from the
-//! neighbouring sample. Layers that are black for an object are left out. Every solve is
-//! pyramidal (ε_f = 0.1) in the decimated parameterization: the unknowns are level 0 and the
-//! coarser levels its decimations, as the player stores and rebuilds them.
+//! last sample solved with the same placement. Layers that are black for an object are left
+//! out. Every solve is pyramidal (ε_f = 0.1) in the decimated parameterization: the unknowns
+//! are level 0 and the coarser levels its decimations, as the player stores and rebuilds them.
+//!
+//! Texture coordinates (thesis 3.2) are optimized per object per parameter block: each block
+//! of a layer gets the branch cuts, affine map and used size that suit the views of its
+//! samples, so every point has one render matrix per placement its layers read.
 
 use std::collections::BTreeMap;
 
 use anyhow::{anyhow, Result};
-use pis_compile::{solve, solve_view_independent, DrawMesh, RenderMatrix, SolveSettings, TexturedObject, View, Viewport};
+use pis_compile::{solve, solve_view_independent, DrawMesh, RenderMatrix, SolveSettings, TextureLayout, TexturedObject, View, Viewport};
+use pis_format::blocks::BlockGrid;
 use pis_format::{DepMask, DimensionKind};
 use pis_trace::layers::LayerKind as TraceLayer;
 use pis_trace::PointImages;
 
+use super::encode::{block_sizes, geometry, stagger};
 use super::input::LoadedSet;
 use super::matrices::Matrices;
-use super::{PackRequest, Stages};
-use crate::infer::{merged_mesh, place, restrict, sampler, Mesh, Prepared};
+use super::{PackRequest, PlacementMode, Stages};
+use crate::infer::{atlas, merged_mesh, place_in, restrict_rows, sampler, Atlas, Mesh, Placed};
 
 /// Largest linear radiance below which a layer counts as black.
 pub const BLACK: f32 = 1e-4;
 
-/// One point as the render matrix sees an object (hardware model or probe mode): its covered
-/// rows of A and the gold standard of each layer there.
+/// One point as the render matrices see an object (hardware model or probe mode): the rows
+/// of A per placement its layers read there (the rows, the covered pixels, are the same for
+/// every placement) and the gold standard of each layer at those pixels.
 pub(crate) struct PointView {
-    pub(crate) a: RenderMatrix,
+    a: Vec<(usize, RenderMatrix)>,
     pub(crate) diffuse: Vec<f32>,
     pub(crate) specular: Vec<f32>,
 }
 
-/// A solved layer: one texture (the whole MIP chain, [`Prepared::layout`]) per sample of
+impl PointView {
+    /// The render matrix of placement `placement` (of [`ObjectModel::placements`]).
+    pub(crate) fn a(&self, placement: usize) -> &RenderMatrix {
+        &self.a.iter().find(|(p, _)| *p == placement).expect("a render matrix for every placement a layer reads at the point").1
+    }
+
+    /// Covered pixels.
+    pub(crate) fn rows(&self) -> usize {
+        self.a.first().map_or(0, |(_, a)| a.rows())
+    }
+}
+
+/// A solved layer: one texture (the whole MIP chain of its placement's layout) per sample of
 /// the dimensions it depends on.
 pub(crate) struct InferredLayer {
     pub(crate) kind: pis_format::LayerKind,
     pub(crate) depends_on: DepMask,
     /// Key: sample index per masked dimension, in dimension order.
     pub(crate) textures: BTreeMap<Vec<u32>, Vec<f32>>,
+    /// Per block of the layer's grid (SPEC.md 7.2), its placement in
+    /// [`ObjectModel::placements`].
+    pub(crate) block_placements: Vec<usize>,
+    /// Per texture key, its block's placement.
+    pub(crate) placement_of: BTreeMap<Vec<u32>, usize>,
     pub(crate) iterations: u64,
 }
 
@@ -44,7 +68,13 @@ pub(crate) struct ObjectModel {
     pub(crate) index: usize,
     pub(crate) name: String,
     pub(crate) mesh: Mesh,
-    pub(crate) prep: Prepared,
+    /// The texture coordinates the file's mesh carries (before any block's branch cut).
+    pub(crate) mesh_uvs: Vec<[f32; 2]>,
+    /// The distinct placements of the object's blocks.
+    pub(crate) placements: Vec<Placed>,
+    /// Block origin offsets (thesis 4.7) and the samples per block the placements are for.
+    pub(crate) stagger: Vec<u32>,
+    pub(crate) block_sizes: Vec<u32>,
     /// Mean covered pixels per point: the screen-area weight of allocation.
     pub(crate) area: f64,
     /// Per point of the set.
@@ -53,6 +83,18 @@ pub(crate) struct ObjectModel {
     /// What was chosen and why.
     pub(crate) representation: String,
     pub(crate) why: String,
+}
+
+impl ObjectModel {
+    /// The placement of sample `key` of layer `layer`.
+    pub(crate) fn placed(&self, layer: usize, key: &[u32]) -> &Placed {
+        &self.placements[self.layers[layer].placement_of[key]]
+    }
+
+    /// The MIP layout of sample `key` of layer `layer`.
+    pub(crate) fn layout(&self, layer: usize, key: &[u32]) -> TextureLayout {
+        self.placed(layer, key).layout
+    }
 }
 
 /// The key of `samples` under `mask`.
@@ -75,30 +117,49 @@ fn layer_rgb(images: &PointImages, channel: &str, kind: TraceLayer) -> Vec<f32> 
     rgb
 }
 
-fn views_of(set: &LoadedSet, o: usize, prep: &Prepared, meshes: &[Mesh], req: &PackRequest, matrices: &mut Matrices) -> Result<Vec<PointView>> {
+fn coverage(set: &LoadedSet, p: usize, o: usize) -> Vec<f32> {
     let (w, h) = set.resolution;
-    let viewport = Viewport { width: w, height: h };
-    let mut out = Vec::with_capacity(set.frames.len());
-    for (frame, images) in set.frames.iter().zip(&set.images) {
-        let clip_from = |k: usize| {
-            pis_trace::camera::projection_matrix(&frame.camera, (w, h))
-                * frame.camera.world_from_camera.inverse() * frame.instances[k].world_from_object
+    set.images[p].object_layer(&set.channels[o], TraceLayer::Coverage).and_then(|l| l.channel("A"))
+        .map(<[f32]>::to_vec).unwrap_or_else(|| vec![0.0; (w * h) as usize])
+}
+
+/// The render matrix of object `o` at point `p` with texture coordinates `uvs` and placement
+/// `placed`, every other mesh occluding it; rows where the tracer covers no pixel removed.
+fn matrix_at(set: &LoadedSet, p: usize, o: usize, meshes: &[Mesh], uvs: &[[f32; 2]], placed: &Placed, req: &PackRequest, matrices: &mut Matrices) -> Result<RenderMatrix> {
+    let (w, h) = set.resolution;
+    let frame = &set.frames[p];
+    let clip_from = |k: usize| {
+        pis_trace::camera::projection_matrix(&frame.camera, (w, h)) * frame.camera.world_from_camera.inverse() * frame.instances[k].world_from_object
+    };
+    let draw: Vec<DrawMesh> = meshes.iter().enumerate().map(|(k, m)| DrawMesh {
+        positions: &m.positions, uvs: &m.uvs, indices: &m.indices, clip_from_object: clip_from(k),
+    }).collect();
+    let mut mesh = draw[o];
+    mesh.uvs = uvs;
+    let obj = TexturedObject { mesh, transform: placed.transform, layout: placed.layout, sampler: sampler(req.filter, placed.repeat) };
+    let a = matrices.matrix(Viewport { width: w, height: h }, &draw, o, &obj)?;
+    Ok(restrict_rows(&a, &coverage(set, p, o)))
+}
+
+/// Every point with placement 0 (over all views): the rows, the gold standard there.
+fn views_of(set: &LoadedSet, o: usize, uvs: &[[f32; 2]], placed: &Placed, meshes: &[Mesh], req: &PackRequest, matrices: &mut Matrices) -> Result<Vec<PointView>> {
+    let channel = &set.channels[o];
+    (0..set.frames.len()).map(|p| {
+        let images = &set.images[p];
+        let a = matrix_at(set, p, o, meshes, uvs, placed, req, matrices)?;
+        let cov = coverage(set, p, o);
+        let pick = |kind| {
+            let rgb = layer_rgb(images, channel, kind);
+            let mut b = Vec::with_capacity(a.rows() * 3);
+            for &px in &a.pixels {
+                debug_assert!(cov[px as usize] > 0.0);
+                b.extend_from_slice(&rgb[px as usize * 3..px as usize * 3 + 3]);
+            }
+            b
         };
-        let draw: Vec<DrawMesh> = meshes.iter().enumerate().map(|(k, m)| DrawMesh {
-            positions: &m.positions, uvs: &m.uvs, indices: &m.indices, clip_from_object: clip_from(k),
-        }).collect();
-        let mut mesh = draw[o];
-        mesh.uvs = &prep.mesh_uvs;
-        let obj = TexturedObject { mesh, transform: prep.transform, layout: prep.layout, sampler: sampler(req.filter, prep.repeat) };
-        let a_full = matrices.matrix(viewport, &draw, o, &obj)?;
-        let channel = &set.channels[o];
-        let cov: Vec<f32> = images.object_layer(channel, TraceLayer::Coverage).and_then(|l| l.channel("A"))
-            .map(<[f32]>::to_vec).unwrap_or_else(|| vec![0.0; (w * h) as usize]);
-        let (a, diffuse) = restrict(&a_full, &cov, &layer_rgb(images, channel, TraceLayer::Diffuse));
-        let (_, specular) = restrict(&a_full, &cov, &layer_rgb(images, channel, TraceLayer::Specular));
-        out.push(PointView { a, diffuse, specular });
-    }
-    Ok(out)
+        let (diffuse, specular) = (pick(TraceLayer::Diffuse), pick(TraceLayer::Specular));
+        Ok(PointView { a: vec![(0, a)], diffuse, specular })
+    }).collect()
 }
 
 /// Half a step of an 8-bit display value: a layer whose removal moves no covered pixel by
@@ -112,27 +173,101 @@ fn is_black(views: &[PointView], pick: impl Fn(&PointView) -> &[f32], other: imp
     views.iter().all(|v| pick(v).iter().zip(other(v)).all(|(x, o)| x.abs() < BLACK || (d(x + o) - d(*o)).abs() < DISPLAY_STEP))
 }
 
-/// One view-dependent layer of diffuse + specular radiance per parameter sample (no
-/// lighting-layer separation), warm-started from the previous sample like the specular layer.
-fn combined_layer(set: &LoadedSet, views: &[PointView], prep: &Prepared, settings: &SolveSettings) -> Result<InferredLayer> {
-    let all = DepMask::of(&(0..set.scene.space.dims.len()).collect::<Vec<_>>());
-    let mut textures = BTreeMap::new();
-    let mut warm: Option<Vec<f32>> = None;
-    let mut iterations = 0u64;
-    for (p, s) in set.samples.iter().enumerate() {
-        let v = &views[p];
-        let x = if v.a.rows() == 0 {
-            warm.clone().unwrap_or_else(|| vec![0.0; prep.layout.texel_count() * 3])
-        } else {
-            let b: Vec<f32> = v.diffuse.iter().zip(&v.specular).map(|(d, s)| d + s).collect();
-            let sol = solve(&v.a, &b, warm.as_deref(), settings)?;
-            iterations += sol.iterations as u64;
-            sol.texels
-        };
-        warm = Some(x.clone());
-        textures.insert(key(s, all), x);
+/// What one object's layers are before solving: mask, the block each point's sample is in,
+/// each block's placement.
+struct LayerPlan {
+    kind: pis_format::LayerKind,
+    depends_on: DepMask,
+    block_placements: Vec<usize>,
+    /// Per point of the set, its sample's placement.
+    point_placement: Vec<usize>,
+}
+
+/// Places the blocks of a layer with mask `mask` (thesis 3.2 per parameter block): each
+/// block over the views of the points whose samples it holds; placements equal to one
+/// already made are shared.
+#[allow(clippy::too_many_arguments)]
+fn plan_layer(
+    set: &LoadedSet,
+    grid: &BlockGrid,
+    kind: pis_format::LayerKind,
+    mask: DepMask,
+    o: usize,
+    mesh: &Mesh,
+    at: &Atlas,
+    placements: &mut Vec<Placed>,
+    req: &PackRequest,
+) -> Result<LayerPlan> {
+    let blocks = grid.block_count() as usize;
+    let point_block: Vec<usize> = set.samples.iter().map(|s| grid.locate(s).block).collect();
+    let mut block_placements = vec![0usize; blocks];
+    if req.placement == PlacementMode::Block {
+        for (b, slot) in block_placements.iter_mut().enumerate() {
+            let frames: Vec<&pis_scene::Frame> = point_block.iter().zip(&set.frames).filter(|(pb, _)| **pb == b).map(|(_, f)| f).collect();
+            if frames.is_empty() || frames.len() == set.frames.len() {
+                continue;
+            }
+            let pl = place_in(&set.scene, &frames, set.resolution, o, mesh, at, req.max_texture, 1.0, req.texels_per_pixel)?;
+            *slot = match placements.iter().position(|q| q.same(&pl)) {
+                Some(i) => i,
+                None => {
+                    placements.push(pl);
+                    placements.len() - 1
+                }
+            };
+        }
     }
-    Ok(InferredLayer { kind: pis_format::LayerKind::Specular, depends_on: all, textures, iterations })
+    let point_placement = point_block.iter().map(|&b| block_placements[b]).collect();
+    Ok(LayerPlan { kind, depends_on: mask, block_placements, point_placement })
+}
+
+/// One texture per key of `plan`'s mask: each key's sample solved (or, for a view-independent
+/// layer, its views stacked, eq. 3.7) with the render matrices of its block's placement,
+/// warm-started from the last sample solved with the same placement.
+fn solve_layer(set: &LoadedSet, views: &[PointView], placements: &[Placed], plan: &LayerPlan, b: impl Fn(&PointView) -> Vec<f32>, settings: &SolveSettings) -> Result<InferredLayer> {
+    let stacked = plan.kind == pis_format::LayerKind::Diffuse;
+    let mut groups: BTreeMap<Vec<u32>, Vec<usize>> = BTreeMap::new();
+    for (p, s) in set.samples.iter().enumerate() {
+        groups.entry(key(s, plan.depends_on)).or_default().push(p);
+    }
+    let mut textures = BTreeMap::new();
+    let mut placement_of = BTreeMap::new();
+    let mut warm: BTreeMap<usize, Vec<f32>> = BTreeMap::new();
+    let mut iterations = 0u64;
+    for (k, points) in groups {
+        let pid = plan.point_placement[points[0]];
+        let bs: Vec<Vec<f32>> = points.iter().map(|&p| b(&views[p])).collect();
+        let vs: Vec<View> = points.iter().zip(&bs).map(|(&p, b)| View { a: views[p].a(pid), b }).collect();
+        let start = warm.get(&pid).map(Vec::as_slice);
+        let x = if stacked {
+            // One texture for the views of the sample, stacked (eq. 3.7).
+            let s = solve_view_independent(&vs, start, settings)?;
+            iterations += s.iterations as u64;
+            s.texels
+        } else if vs[0].a.rows() == 0 {
+            // A view-dependent sample (one point per key) where the object covers no pixel.
+            start.map_or_else(|| vec![0.0; placements[pid].layout.texel_count() * 3], <[f32]>::to_vec)
+        } else {
+            let s = solve(vs[0].a, vs[0].b, start, settings)?;
+            iterations += s.iterations as u64;
+            s.texels
+        };
+        warm.insert(pid, x.clone());
+        placement_of.insert(k.clone(), pid);
+        textures.insert(k, x);
+    }
+    Ok(InferredLayer { kind: plan.kind, depends_on: plan.depends_on, textures, block_placements: plan.block_placements.clone(), placement_of, iterations })
+}
+
+/// An object that covers a pixel and is not black: its texture coordinates, placement over
+/// all views and the points as that placement sees them.
+struct Covered {
+    o: usize,
+    atlas: Atlas,
+    views: Vec<PointView>,
+    whole: Placed,
+    diffuse_black: bool,
+    specular_black: bool,
 }
 
 /// Infers every object that covers a pixel somewhere in the set.
@@ -140,9 +275,12 @@ pub(crate) fn infer_all(set: &LoadedSet, req: &PackRequest, matrices: &mut Matri
     let scene = &set.scene;
     let meshes: Vec<Mesh> = (0..scene.objects.len()).map(|o| merged_mesh(scene, o)).collect();
     let frames: Vec<&pis_scene::Frame> = set.frames.iter().collect();
+    let ndims = scene.space.dims.len();
+    let sizes = block_sizes(&req.block, ndims)?;
+    let (space, _) = geometry(set, &sizes);
     let view_dims: Vec<usize> = scene.space.dims.iter().enumerate().filter(|(_, d)| d.kind == DimensionKind::View).map(|(k, _)| k).collect();
-    let all = DepMask::of(&(0..scene.space.dims.len()).collect::<Vec<_>>());
-    let non_view = DepMask::of(&(0..scene.space.dims.len()).filter(|k| !view_dims.contains(k)).collect::<Vec<_>>());
+    let all = DepMask::of(&(0..ndims).collect::<Vec<_>>());
+    let non_view = DepMask::of(&(0..ndims).filter(|k| !view_dims.contains(k)).collect::<Vec<_>>());
     // Level 0 solved through the MIP chain the player decimates from it (thesis 3.6): the
     // solved textures are the drawn ones.
     let mut settings = SolveSettings::decimated();
@@ -150,90 +288,113 @@ pub(crate) fn infer_all(set: &LoadedSet, req: &PackRequest, matrices: &mut Matri
         settings.cg.max_iterations = n.max(1);
     }
     let combined = req.layers == super::LayerMode::Combined;
-    // Texture coordinates and render matrices of every object at every point first, so the
-    // matrix source's cost is a stage of its own.
-    let mut placed = Vec::with_capacity(scene.objects.len());
+    // Texture coordinates and render matrices over all views first: which objects cover a
+    // pixel, which layers are black, the rows and gold standard of every point.
+    let mut covered = Vec::new();
     for o in 0..scene.objects.len() {
-        let prep = place(scene, &frames, set.resolution, o, &meshes[o], req.max_texture, 1.0, req.texels_per_pixel)?;
+        let name = &scene.objects[o].name;
+        let at = atlas(&frames, set.resolution, o, &meshes[o]);
+        let whole = place_in(scene, &frames, set.resolution, o, &meshes[o], &at, req.max_texture, 1.0, req.texels_per_pixel)?;
         let before = matrices.renderings();
-        let views = views_of(set, o, &prep, &meshes, req, matrices)?;
+        let views = views_of(set, o, &at.uvs, &whole, &meshes, req, matrices)?;
         if matrices.renderings() > before {
-            eprintln!("pis-pack: object {}: {} probe renderings over {} points", scene.objects[o].name, matrices.renderings() - before, views.len());
+            eprintln!("pis-pack: object {name}: {} probe renderings over {} points", matrices.renderings() - before, views.len());
         }
-        placed.push((prep, views));
-    }
-    stages.done("matrices", &format!("texture coordinates and render matrices of {} objects × {} points ({})", scene.objects.len(), set.frames.len(), matrices.describe()));
-    let mut out = Vec::new();
-    for (o, (prep, views)) in placed.into_iter().enumerate() {
-        let name = scene.objects[o].name.clone();
-        let covered: usize = views.iter().map(|v| v.a.rows()).sum();
-        if covered == 0 {
+        if views.iter().all(|v| v.rows() == 0) {
             eprintln!("pis-pack: object {name} covers no pixel of the set; left out");
             continue;
         }
-        let area = covered as f64 / views.len() as f64;
-        let mut layers = Vec::new();
         let diffuse_black = is_black(&views, |v| &v.diffuse, |v| &v.specular);
         let specular_black = is_black(&views, |v| &v.specular, |v| &v.diffuse);
         if diffuse_black && specular_black {
             eprintln!("pis-pack: object {name} is black in every layer; nothing stored");
             continue;
         }
-        if combined {
-            let layer = combined_layer(set, &views, &prep, &settings)?;
-            let (representation, why) = ("combined".to_string(), "--layers combined: one view-dependent layer of diffuse + specular radiance per parameter sample".to_string());
-            eprintln!("pis-pack: object {name}: {}x{} texels, {representation}", prep.layout.width, prep.layout.height);
-            out.push(ObjectModel { index: o, name, mesh: merged_mesh(scene, o), prep, area, views, layers: vec![layer], representation, why });
-            continue;
-        }
-        if !diffuse_black {
-            // Stacked over the views of each non-view sample (thesis 4.8: one diffuse
-            // texture per light position).
-            let mut groups: BTreeMap<Vec<u32>, Vec<usize>> = BTreeMap::new();
-            for (p, s) in set.samples.iter().enumerate() {
-                groups.entry(key(s, non_view)).or_default().push(p);
-            }
-            let mut textures = BTreeMap::new();
-            let mut warm: Option<Vec<f32>> = None;
-            let mut iterations = 0u64;
-            for (k, points) in groups {
-                let vs: Vec<View> = points.iter().map(|&p| View { a: &views[p].a, b: &views[p].diffuse }).collect();
-                let s = solve_view_independent(&vs, warm.as_deref(), &settings)?;
-                iterations += s.iterations as u64;
-                warm = Some(s.texels.clone());
-                textures.insert(k, s.texels);
-            }
-            layers.push(InferredLayer { kind: pis_format::LayerKind::Diffuse, depends_on: non_view, textures, iterations });
-        }
-        if !specular_black {
-            let mut textures = BTreeMap::new();
-            let mut warm: Option<Vec<f32>> = None;
-            let mut iterations = 0u64;
-            for (p, s) in set.samples.iter().enumerate() {
-                let v = &views[p];
-                let x = if v.a.rows() == 0 {
-                    warm.clone().unwrap_or_else(|| vec![0.0; prep.layout.texel_count() * 3])
-                } else {
-                    let sol = solve(&v.a, &v.specular, warm.as_deref(), &settings)?;
-                    iterations += sol.iterations as u64;
-                    sol.texels
-                };
-                warm = Some(x.clone());
-                textures.insert(key(s, all), x);
-            }
-            layers.push(InferredLayer { kind: pis_format::LayerKind::Specular, depends_on: all, textures, iterations });
-        }
-        let (representation, why) = match (diffuse_black, specular_black) {
-            (false, true) => ("diffuse".to_string(), "the specular layer changes no displayed pixel: one view-independent diffuse texture per non-view sample".to_string()),
-            (true, false) => ("specular".to_string(), "the diffuse layer changes no displayed pixel: a view-dependent texture per parameter sample".to_string()),
-            (false, false) => ("diffuse+specular".to_string(), "view-independent diffuse layer over the non-view dimensions plus a view-dependent specular layer per parameter sample".to_string()),
-            (true, true) => ("black".to_string(), "both layers black: nothing stored".to_string()),
-        };
-        eprintln!("pis-pack: object {name}: {}x{} texels, {representation} ({why})", prep.layout.width, prep.layout.height);
-        out.push(ObjectModel { index: o, name, mesh: merged_mesh(scene, o), prep, area, views, layers, representation, why });
+        covered.push(Covered { o, atlas: at, views, whole, diffuse_black, specular_black });
     }
-    if out.is_empty() {
+    if covered.is_empty() {
         return Err(anyhow!("no object covers a pixel of the set"));
+    }
+    // Per object per block: the placement over the block's views, and the render matrices
+    // of the placements each point's layers read.
+    let n = covered.len();
+    let mut planned = Vec::with_capacity(n);
+    let (mut made, mut extra) = (0usize, 0usize);
+    for (mi, c) in covered.into_iter().enumerate() {
+        let st = stagger(mi, n, &sizes);
+        let mut placements = vec![c.whole.clone()];
+        let mut plans = Vec::new();
+        let mut wanted: Vec<(pis_format::LayerKind, DepMask)> = Vec::new();
+        if combined {
+            wanted.push((pis_format::LayerKind::Specular, all));
+        } else {
+            if !c.diffuse_black {
+                wanted.push((pis_format::LayerKind::Diffuse, non_view));
+            }
+            if !c.specular_black {
+                wanted.push((pis_format::LayerKind::Specular, all));
+            }
+        }
+        for (kind, mask) in wanted {
+            let grid = BlockGrid::new(&space, mask, &st);
+            plans.push(plan_layer(set, &grid, kind, mask, c.o, &meshes[c.o], &c.atlas, &mut placements, req)?);
+        }
+        made += placements.len();
+        let mut views = c.views;
+        for (p, v) in views.iter_mut().enumerate() {
+            let mut read: Vec<usize> = plans.iter().map(|pl| pl.point_placement[p]).collect();
+            read.sort_unstable();
+            read.dedup();
+            for &pid in &read {
+                if pid == 0 || v.rows() == 0 {
+                    continue;
+                }
+                let a = matrix_at(set, p, c.o, &meshes, &c.atlas.uvs, &placements[pid], req, matrices)?;
+                if a.pixels != v.a(0).pixels {
+                    return Err(anyhow!("object {}: point {p}: the render matrices of two placements cover different pixels", scene.objects[c.o].name));
+                }
+                v.a.push((pid, a));
+                extra += 1;
+            }
+            if !read.contains(&0) && v.a.len() > 1 {
+                v.a.remove(0);
+            }
+        }
+        planned.push((c.o, c.atlas, placements, st, views, plans, c.diffuse_black, c.specular_black));
+    }
+    stages.done("matrices", &format!(
+        "texture coordinates of {} objects ({made} placements, per {}) and render matrices at {} points ({}; {extra} for block placements)",
+        scene.objects.len(), req.placement.name(), set.frames.len(), matrices.describe(),
+    ));
+    let mut out = Vec::new();
+    for (o, at, placements, st, views, plans, diffuse_black, specular_black) in planned {
+        let name = scene.objects[o].name.clone();
+        let covered: usize = views.iter().map(PointView::rows).sum();
+        let area = covered as f64 / views.len() as f64;
+        let mut layers = Vec::new();
+        for plan in &plans {
+            let layer = match (combined, plan.kind) {
+                (true, _) => solve_layer(set, &views, &placements, plan, |v| v.diffuse.iter().zip(&v.specular).map(|(d, s)| d + s).collect(), &settings)?,
+                (false, pis_format::LayerKind::Diffuse) => solve_layer(set, &views, &placements, plan, |v| v.diffuse.clone(), &settings)?,
+                (false, _) => solve_layer(set, &views, &placements, plan, |v| v.specular.clone(), &settings)?,
+            };
+            layers.push(layer);
+        }
+        let (representation, why) = if combined {
+            ("combined".to_string(), "--layers combined: one view-dependent layer of diffuse + specular radiance per parameter sample".to_string())
+        } else {
+            match (diffuse_black, specular_black) {
+                (false, true) => ("diffuse".to_string(), "the specular layer changes no displayed pixel: one view-independent diffuse texture per non-view sample".to_string()),
+                (true, false) => ("specular".to_string(), "the diffuse layer changes no displayed pixel: a view-dependent texture per parameter sample".to_string()),
+                _ => ("diffuse+specular".to_string(), "view-independent diffuse layer over the non-view dimensions plus a view-dependent specular layer per parameter sample".to_string()),
+            }
+        };
+        let sizes_text: Vec<String> = placements.iter().map(|p| format!("{}x{}", p.layout.width, p.layout.height)).collect();
+        eprintln!("pis-pack: object {name}: {} texels, {representation} ({why})", sizes_text.join(", "));
+        out.push(ObjectModel {
+            index: o, name, mesh: merged_mesh(scene, o), mesh_uvs: at.uvs, placements, stagger: st, block_sizes: sizes.clone(),
+            area, views, layers, representation, why,
+        });
     }
     stages.done("infer", &format!("{} objects solved", out.len()));
     Ok(out)

@@ -25,11 +25,15 @@ pub struct ObjectReport {
     pub psnr_db: f64,
     /// The same for the textures as solved, before coding: the inference's own limit.
     pub psnr_db_solved: f64,
+    /// The largest used texture size of the object's blocks.
     pub texture: [u32; 2],
-    /// The texture's resolution reduction factor against thesis 3.2's optimal resolution
+    /// That texture's resolution reduction factor against thesis 3.2's optimal resolution
     /// (below 1 where the texel budget, `--texels-per-pixel`, reduced it; `--max-texture`
     /// clamps after it).
     pub reduction: f64,
+    /// The used sizes of the distinct placements its blocks carry (thesis 3.2, per
+    /// parameter block; one with `--placement object`).
+    pub placements: Vec<[u32; 2]>,
     /// Block origin offsets per dimension (thesis 4.7).
     pub stagger: Vec<u32>,
     pub blocks: usize,
@@ -98,6 +102,10 @@ pub(crate) fn build(set: &LoadedSet, models: &[ObjectModel], packed: &Packed, q:
     let texture_bytes: usize = packed.layer_bytes.iter().flatten().sum();
     let objects = models.iter().enumerate().map(|(mi, m)| {
         let ob = &packed.container.objects[mi];
+        let mut used: Vec<usize> = m.layers.iter().flat_map(|l| l.block_placements.iter().copied()).collect();
+        used.sort_unstable();
+        used.dedup();
+        let largest = used.iter().map(|&p| &m.placements[p]).max_by_key(|p| p.layout.width as u64 * p.layout.height as u64).unwrap_or(&m.placements[0]);
         ObjectReport {
             name: m.name.clone(),
             representation: m.representation.clone(),
@@ -106,8 +114,9 @@ pub(crate) fn build(set: &LoadedSet, models: &[ObjectModel], packed: &Packed, q:
             layer_bytes: m.layers.iter().zip(&packed.layer_bytes[mi]).map(|(l, b)| (l.kind.name().to_string(), *b)).collect(),
             psnr_db: q.objects[mi].0,
             psnr_db_solved: q.objects[mi].1,
-            texture: [m.prep.layout.width, m.prep.layout.height],
-            reduction: m.prep.reduction,
+            texture: [largest.layout.width, largest.layout.height],
+            reduction: largest.reduction,
+            placements: used.iter().map(|&p| [m.placements[p].layout.width, m.placements[p].layout.height]).collect(),
             stagger: packed.stagger[mi].clone(),
             blocks: ob.layers.iter().map(|l| l.blocks.len()).sum(),
             level_images: ob.layers.iter().flat_map(|l| &l.blocks).flat_map(|b| &b.levels).map(|l| l.images.len()).sum(),
@@ -176,7 +185,8 @@ pub fn print_report(r: &PackReport, out: &mut impl std::io::Write) -> std::io::R
     }
     for o in &r.objects {
         let layers: Vec<String> = o.layer_bytes.iter().map(|(k, b)| format!("{k} {b}")).collect();
-        writeln!(out, "  {:<10} {:<17} {:>8} bytes ({}), {:.2} dB (solved {:.2}), {}x{} (reduction {:.2}), stagger {:?}, {} blocks, {} level images",
+        let sizes = if o.placements.len() > 1 { format!(" up to, {} placements", o.placements.len()) } else { String::new() };
+        writeln!(out, "  {:<10} {:<17} {:>8} bytes ({}), {:.2} dB (solved {:.2}), {}x{}{sizes} (reduction {:.2}), stagger {:?}, {} blocks, {} level images",
                  o.name, o.representation, o.bytes, layers.join(", "), o.psnr_db, o.psnr_db_solved, o.texture[0], o.texture[1],
                  o.reduction, o.stagger, o.blocks, o.level_images)?;
         writeln!(out, "             why: {}", o.why)?;

@@ -5,7 +5,7 @@ use std::time::Instant;
 
 use serde::Serialize;
 
-use super::encode::{decoded_textures, encode_all, finest, mip_chain, predicted_psnr, LayerTextures};
+use super::encode::{decoded_textures, encode_all, predicted_psnr, solved_chains, LayerTextures};
 use super::infer_layers::{infer_all, ObjectModel};
 use super::input::{load, LoadedSet};
 use super::{PackRequest, Stages};
@@ -99,9 +99,7 @@ impl Inferred {
     /// The textures as solved (MIP chains rebuilt by decimation, as the player does), per
     /// object model and layer.
     pub(crate) fn solved(&self) -> Vec<Vec<LayerTextures>> {
-        self.models.iter().map(|m| m.layers.iter().map(|l| {
-            l.textures.iter().map(|(k, x)| (k.clone(), mip_chain(m, finest(m, x)))).collect()
-        }).collect()).collect()
+        self.models.iter().map(solved_chains).collect()
     }
 
     /// The textures after encoding with `req`'s codec, pyramid and target and decoding.
