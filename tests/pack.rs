@@ -223,3 +223,42 @@ fn the_texel_budget_shrinks_textures_over_budget_and_reports_it() {
     assert_eq!(out.status.code(), Some(1), "{}", String::from_utf8_lossy(&out.stderr));
     assert!(!dir.path().join("bad.pis").exists());
 }
+
+/// Distinct (size, placement) pairs over the blocks of each surface layer of `file`.
+fn placements_per_layer(file: &Path) -> Vec<usize> {
+    let c = pis_format::PisReader::open(file).expect("open").load_all().expect("load");
+    c.objects.iter().flat_map(|o| &o.layers).map(|l| {
+        let mut seen: Vec<(u32, u32, pis_format::Placement)> = Vec::new();
+        for b in &l.blocks {
+            if !seen.contains(&(b.width, b.height, b.placement)) {
+                seen.push((b.width, b.height, b.placement));
+            }
+        }
+        seen.len()
+    }).collect()
+}
+
+#[test]
+fn texture_coordinates_are_placed_per_parameter_block() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    // One sample per block: every view-dependent block is placed for its own view.
+    let (blocks, object) = (dir.path().join("block.pis"), dir.path().join("object.pis"));
+    let b = json(&pack(set(), &blocks, &["--codec", "lossless", "--block", "1"]));
+    let o = json(&pack(set(), &object, &["--codec", "lossless", "--block", "1", "--placement", "object"]));
+    validate(&blocks);
+    validate(&object);
+    assert_eq!(b["lossless_exact"], serde_json::Value::Bool(true), "{b}");
+    let counts = |r: &serde_json::Value| -> Vec<usize> {
+        r["objects"].as_array().expect("objects").iter().map(|o| o["placements"].as_array().expect("placements").len()).collect()
+    };
+    assert!(counts(&b).iter().any(|&n| n > 1), "some object's views differ enough for its blocks to differ: {:?}", counts(&b));
+    assert!(placements_per_layer(&blocks).iter().any(|&n| n > 1));
+    // --placement object: one placement per object, every block carries it.
+    assert!(counts(&o).iter().all(|&n| n == 1), "{:?}", counts(&o));
+    assert!(placements_per_layer(&object).iter().all(|&n| n == 1));
+    // Textures placed for each block's own views render their views as accurately as one
+    // placement for all views.
+    let (pb, po) = (b["psnr_db"].as_f64().expect("psnr"), o["psnr_db"].as_f64().expect("psnr"));
+    eprintln!("per block {pb:.2} dB, per object {po:.2} dB");
+    assert!(pb > po - 0.5, "per block {pb} dB, per object {po} dB");
+}

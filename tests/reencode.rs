@@ -51,6 +51,13 @@ fn mastered() -> &'static Path {
     &PACK.get_or_init(|| pack("mastered.pis", &["--ratio", "24", "--keep-master"])).1
 }
 
+/// Packed at ratio 24 with the lossless master and one texture placement per object (what
+/// re-blocking needs), once for every test.
+fn mastered_per_object() -> &'static Path {
+    static PACK: OnceLock<(tempfile::TempDir, PathBuf)> = OnceLock::new();
+    &PACK.get_or_init(|| pack("mastered-object.pis", &["--ratio", "24", "--keep-master", "--placement", "object"])).1
+}
+
 fn reencode(input: &Path, output: &Path, args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_pis-reencode")).arg(input).arg("-o").arg(output).args(args).arg("--json").output().expect("pis-reencode runs")
 }
@@ -291,15 +298,15 @@ fn a_damaged_master_is_an_error_without_output() {
 fn reblocking_from_the_master_gives_a_direct_pack_with_those_blocks() {
     let dir = tempfile::tempdir().expect("temp dir");
     let out = dir.path().join("reblocked.pis");
-    let r = json(&reencode(mastered(), &out, &["--ratio", "48", "--block", "2"]));
+    let r = json(&reencode(mastered_per_object(), &out, &["--ratio", "48", "--block", "2"]));
     validate(&out);
     assert_eq!(r["source"], "master", "{r}");
-    let (_d, direct) = pack("direct-block2.pis", &["--ratio", "48", "--block", "2"]);
+    let (_d, direct) = pack("direct-block2.pis", &["--ratio", "48", "--block", "2", "--placement", "object"]);
     // The same blocks, origins, pyramids and level images, byte for byte.
     same_player_content(&out, &direct);
     let c = PisReader::open(&out).expect("output").load_all().expect("load");
     assert!(c.space.dims.iter().all(|d| d.block_size == 2));
-    let before = PisReader::open(mastered()).expect("input").load_all().expect("load");
+    let before = PisReader::open(mastered_per_object()).expect("input").load_all().expect("load");
     let blocks = |c: &pis_format::Container| c.objects.iter().flat_map(|o| &o.layers).map(|l| l.blocks.len()).sum::<usize>();
     assert!(blocks(&c) > blocks(&before), "smaller blocks, more of them");
     for (x, y) in before.objects.iter().zip(&c.objects) {
@@ -310,10 +317,25 @@ fn reblocking_from_the_master_gives_a_direct_pack_with_those_blocks() {
 }
 
 #[test]
+fn reblocking_textures_placed_per_block_is_refused_without_output() {
+    // pis-pack's default places each block's texture for its own views: some layer's
+    // blocks differ, and a new block could gather samples of two placements.
+    let c = PisReader::open(mastered()).expect("input").load_all().expect("load");
+    let differs = c.objects.iter().flat_map(|o| &o.layers).any(|l| l.blocks.iter().any(|b| b.placement != l.blocks[0].placement || b.width != l.blocks[0].width));
+    assert!(differs, "the default pack places some layer's blocks differently");
+    let dir = tempfile::tempdir().expect("temp dir");
+    let out = dir.path().join("reblocked.pis");
+    let o = reencode(mastered(), &out, &["--block", "2"]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(5), "{err}");
+    assert!(err.contains("--placement object") && !out.exists(), "{err}");
+}
+
+#[test]
 fn lossless_reblocking_keeps_every_texture() {
     let dir = tempfile::tempdir().expect("temp dir");
     let (lossless, reblocked, back) = (dir.path().join("lossless.pis"), dir.path().join("block3.pis"), dir.path().join("back.pis"));
-    json(&reencode(packed(), &lossless, &["--codec", "lossless"]));
+    json(&reencode(mastered_per_object(), &lossless, &["--codec", "lossless"]));
     json(&reencode(&lossless, &reblocked, &["--codec", "lossless", "--block", "3x1"]));
     validate(&reblocked);
     same_textures(&lossless, &reblocked);

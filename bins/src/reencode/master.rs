@@ -115,14 +115,15 @@ pub fn error_against(r: &PisReader, masters: &[Master]) -> Result<(SquaredError,
 
 /// The same samples grouped into the blocks of another grid (`pis-reencode --block`): `space`
 /// holds the new block sizes, `stagger` the object's new block origins. Every block of the
-/// layer must share one texture placement and size (pis-pack places a texture once per
-/// object), since a new block may gather samples of several old ones.
+/// layer must share one texture placement and size (`pis-pack --placement object`), since a
+/// new block may gather samples of several old ones: textures placed per block (pis-pack's
+/// default) are solved again for new blocks by packing with the new `--block`.
 pub fn regroup<S>(c: &Container<S>, space: &ParameterSpace, stagger: &[u32], object: usize, layer: usize, old: Vec<BlockSource>) -> Result<Vec<BlockSource>, Error> {
     let l = &c.objects[object].layers[layer];
     let first = l.blocks.first().ok_or_else(|| Error::Request(format!("object {object} layer {layer} has no blocks")))?;
     if l.blocks.iter().any(|b| b.width != first.width || b.height != first.height || b.placement != first.placement) {
         return Err(Error::Request(format!(
-            "object '{}' layer {layer}: its blocks place the texture differently; re-blocking needs one placement per layer",
+            "object '{}' layer {layer}: its blocks place the texture differently (texture coordinates optimized per block); re-blocking needs one placement per layer: pack with --placement object, or pack again with the new --block",
             c.objects[object].name)));
     }
     let layout = old.first().map(|b| b.layout.clone()).ok_or_else(|| Error::Request(format!("object {object} layer {layer}: no block sources")))?;
