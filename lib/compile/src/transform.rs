@@ -184,4 +184,28 @@ mod tests {
         let t = TextureTransform::affine([2.0, 0.5, -1.0, 3.0, 0.25, 0.125]);
         assert_eq!(t.texcoord([1.0, 2.0]), [2.0 + 1.0 + 0.25, -1.0 + 6.0 + 0.125]);
     }
+
+    #[test]
+    fn branch_cuts_wrap_each_cut_coordinate_into_0_1() {
+        let none = TextureTransform::affine([1.0, 0.0, 0.0, 1.0, 0.0, 0.0]);
+        assert_eq!(none.cut_uv([1.25, -0.5]), [1.25, -0.5], "no cut: coordinates unchanged");
+        let u = TextureTransform { cut: [Some(0.25), None], ..none };
+        // Above the cut: shifted down; below: shifted and wrapped up; v untouched.
+        assert_eq!(u.cut_uv([0.75, 1.5]), [0.5, 1.5]);
+        assert_eq!(u.cut_uv([0.125, 1.5]), [0.875, 1.5]);
+        assert_eq!(u.cut_uv([1.5, -0.5]), [0.25, -0.5], "a wrapped range (u > 1) comes back into [0, 1)");
+        // A coordinate exactly at the cut maps to 0, and one period above it too.
+        assert_eq!(u.cut_uv([0.25, 0.0]), [0.0, 0.0]);
+        assert_eq!(u.cut_uv([1.25, 0.0]), [0.0, 0.0]);
+        let v = TextureTransform { cut: [None, Some(0.5)], ..none };
+        assert_eq!(v.cut_uv([1.5, 0.25]), [1.5, 0.75]);
+        assert_eq!(v.cut_uv([1.5, 0.5]), [1.5, 0.0]);
+        // Both cuts, then the affine map.
+        let both = TextureTransform { values: [2.0, 0.0, 0.0, 4.0, 0.5, -1.0], cut: [Some(0.25), Some(0.5)] };
+        assert_eq!(both.cut_uv([0.0, 0.0]), [0.75, 0.5]);
+        assert_eq!(both.texcoord([0.0, 0.0]), [2.0 * 0.75 + 0.5, 4.0 * 0.5 - 1.0]);
+        // Cuts that are not binary fractions: within f32 rounding of the exact wrap, in [0, 1).
+        let r = TextureTransform { cut: [Some(0.3), None], ..none }.cut_uv([0.1, 0.0])[0];
+        assert!((r - 0.8).abs() < 1e-6 && r < 1.0, "{r}");
+    }
 }

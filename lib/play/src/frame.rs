@@ -1,7 +1,7 @@
 //! Drawing a frame (`frame.wgsl`): a pass that writes depth and the object index of every
 //! pixel's nearest surface, then one additive draw per object, layer and parameter sample,
-//! with the block's affine texture transform in the vertex shader and the hardware model's
-//! LOD and sampler in the fragment shader. Layers add in linear space (SPEC.md "Combining
+//! with the block's texture transform (branch cuts, then the affine map) in the vertex
+//! shader and the hardware model's LOD and sampler in the fragment shader. Layers add in linear space (SPEC.md "Combining
 //! layers": surface layers combine by addition). With more than one sample per pixel
 //! (`multisample.rs`) depth and object indices are kept per sample and the colour is
 //! resolved into the target: by the hardware's average of each pixel's own samples, or,
@@ -16,7 +16,7 @@ use crate::error::PlayError;
 use crate::gpu::Gpu;
 use crate::image::FloatImage;
 use crate::resolve::ResolvePipelines;
-use crate::textured::{allocated_size, ObjectTexture, DEPTH_FORMAT};
+use crate::textured::{allocated_size, cut_uniform, ObjectTexture, DEPTH_FORMAT};
 
 /// The WGSL source.
 pub const SHADER: &str = include_str!("frame.wgsl");
@@ -25,7 +25,7 @@ pub const ID_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Uint;
 /// Object index of pixels no object covers.
 pub const NO_OBJECT: u32 = u32::MAX;
 
-/// `Uniforms` of `frame.wgsl` (128 bytes).
+/// `Uniforms` of `frame.wgsl` (144 bytes).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
 struct Uniforms {
@@ -39,6 +39,7 @@ struct Uniforms {
     object: u32,
     anisotropic: u32,
     _pad: [u32; 2],
+    cut: [f32; 4],
 }
 
 /// An object's mesh on the GPU.
@@ -81,7 +82,8 @@ pub struct LayerDraw<'a> {
     pub draw: usize,
     pub texture: &'a ObjectTexture,
     pub sampler: &'a wgpu::Sampler,
-    pub affine: [f32; 6],
+    /// The block's texture transform: branch cuts and affine map (SPEC.md 7.3).
+    pub transform: pis_compile::TextureTransform,
     pub max_level: f32,
     pub weight: f32,
     /// Anisotropic filtering: the lookup takes the derivatives, the sampler its clamp.
@@ -314,9 +316,10 @@ fn uniforms(clip_from_object: glam::Mat4, object: u32, layer: Option<&LayerDraw>
         object,
         anisotropic: 0,
         _pad: [0; 2],
+        cut: [0.0; 4],
     };
     if let Some(l) = layer {
-        let [a, b, c, d, e, f] = l.affine;
+        let [a, b, c, d, e, f] = l.transform.values;
         let layout = l.texture.layout;
         let (aw, ah) = allocated_size(&layout);
         u.affine_abcd = [a, b, c, d];
@@ -326,6 +329,7 @@ fn uniforms(clip_from_object: glam::Mat4, object: u32, layer: Option<&LayerDraw>
         u.max_level = l.max_level;
         u.weight = l.weight;
         u.anisotropic = l.anisotropic as u32;
+        u.cut = cut_uniform(&l.transform);
     }
     u
 }
@@ -544,7 +548,7 @@ mod tests {
 
     #[test]
     fn texture_math_is_the_textured_pipelines() {
-        for f in ["texcoord", "texture_lod"] {
+        for f in ["cut_uv", "texcoord", "texture_lod"] {
             assert_eq!(function(super::SHADER, f), function(crate::textured::SHADER, f), "{f} differs between frame.wgsl and textured.wgsl");
         }
     }

@@ -1,15 +1,16 @@
 //! The player (thesis 4.7): opens a `.pis` for random access, and per frame decodes on
 //! worker threads the level images on the pyramid paths of the parameter samples it draws
 //! (through the level-image cache), rebuilds those textures, uploads them and builds their
-//! MIP chains on the GPU, and draws every object with its block's affine texture transform,
-//! layers added in linear space, objects depth-tested against each other.
+//! MIP chains on the GPU, and draws every object with its block's texture transform (branch
+//! cuts, then the affine map), layers added in linear space, objects depth-tested against
+//! each other.
 
 use std::collections::HashMap;
 use std::path::Path;
 use std::sync::Arc;
 use std::time::Instant;
 
-use pis_compile::{Address, Filter, Sampler, TextureLayout};
+use pis_compile::{Address, Filter, Sampler, TextureLayout, TextureTransform};
 use pis_format::blocks::{level_image_index, BlockGrid};
 use pis_format::texture::LevelLayout;
 use pis_format::{Container, Placement, PisReader, StreamRef};
@@ -113,7 +114,7 @@ struct Wanted {
     draw: usize,
     key: TextureKey,
     weight: f32,
-    affine: [f32; 6],
+    transform: TextureTransform,
     repeat: [bool; 2],
 }
 
@@ -390,10 +391,10 @@ impl Player {
                 for (s, w) in merge_for_mask(&samples, layer.depends_on) {
                     let pos = grid.locate(&s);
                     let block = layer.blocks.get(pos.block).ok_or_else(|| content(&self.reader, format!("object {oi} layer {li}: block {} missing", pos.block)))?;
-                    let Placement::Surface { affine, repeat, .. } = block.placement else { continue };
+                    let Placement::Surface { affine, repeat, cut } = block.placement else { continue };
                     let images = block.levels.iter().map(|l| level_image_index(&l.counts, &pos.local, &pos.extent) as u32).collect();
                     let key = TextureKey { object: oi as u32, layer: li as u32, block: pos.block as u32, images };
-                    wanted.push(Wanted { draw: oi, key, weight: w, affine, repeat });
+                    wanted.push(Wanted { draw: oi, key, weight: w, transform: TextureTransform { values: affine, cut }, repeat });
                 }
             }
         }
@@ -534,7 +535,7 @@ impl Player {
                 draw: w.draw,
                 texture,
                 sampler: &self.samplers[&w.repeat],
-                affine: w.affine,
+                transform: w.transform,
                 max_level: pis_compile::filter::max_level(&texture.layout, &sampler) as f32,
                 weight: w.weight,
                 anisotropic: matches!(self.filter, Filter::Anisotropic(_)),

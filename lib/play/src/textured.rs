@@ -1,5 +1,5 @@
 //! The player's textured-object pipeline (`textured.wgsl`): draws a mesh with its block's
-//! affine texture transform in the vertex shader, samples a float texture with its MIP chain
+//! texture transform (branch cuts, then the affine map) in the vertex shader, samples a float texture with its MIP chain
 //! at the LOD the fragment shader computes from fine derivatives, into a float render target
 //! that is read back. Its math is pis-compile's hardware model, function for function.
 //!
@@ -22,7 +22,7 @@
 
 use bytemuck::{Pod, Zeroable};
 use pis_compile::filter::max_level;
-use pis_compile::{Address, DrawMesh, Filter, TextureLayout, TexturedObject, Viewport};
+use pis_compile::{Address, DrawMesh, Filter, TextureLayout, TextureTransform, TexturedObject, Viewport};
 use wgpu::util::DeviceExt;
 
 use crate::error::PlayError;
@@ -37,7 +37,7 @@ pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
 /// The WGSL source.
 pub const SHADER: &str = include_str!("textured.wgsl");
 
-/// `Uniforms` of `textured.wgsl` (112 bytes, std140-compatible order).
+/// `Uniforms` of `textured.wgsl` (128 bytes, std140-compatible order).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
 struct Uniforms {
@@ -48,6 +48,14 @@ struct Uniforms {
     scale: [f32; 2],
     max_level: f32,
     anisotropic: f32,
+    cut: [f32; 4],
+}
+
+/// The `cut` uniform of a transform's branch cuts: (u_cut, v_cut, 1 if cut along u, 1 if
+/// cut along v), slots without a cut 0.
+pub fn cut_uniform(transform: &TextureTransform) -> [f32; 4] {
+    let [cu, cv] = transform.cut;
+    [cu.unwrap_or(0.0), cv.unwrap_or(0.0), cu.is_some() as u8 as f32, cv.is_some() as u8 as f32]
 }
 
 /// Size of the GPU texture allocated for a used size: the next power of two per axis.
@@ -327,6 +335,7 @@ fn uniforms_of(clip_from_object: glam::Mat4, object: Option<&TexturedObject>) ->
         scale: [1.0; 2],
         max_level: 0.0,
         anisotropic: 0.0,
+        cut: [0.0; 4],
     };
     if let Some(o) = object {
         let [a, b, c, d, e, f] = o.transform.values;
@@ -337,6 +346,7 @@ fn uniforms_of(clip_from_object: glam::Mat4, object: Option<&TexturedObject>) ->
         u.scale = [o.layout.width as f32 / aw as f32, o.layout.height as f32 / ah as f32];
         u.max_level = max_level(&o.layout, &o.sampler) as f32;
         u.anisotropic = if matches!(o.sampler.filter, Filter::Anisotropic(_)) { 1.0 } else { 0.0 };
+        u.cut = cut_uniform(&o.transform);
     }
     u
 }

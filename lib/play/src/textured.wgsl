@@ -1,6 +1,6 @@
 // The player's textured-object pipeline. One function written twice: every function here has
 // a twin of the same name in pis-compile's hardware model, with the same order of operations
-// (texcoord: transform.rs; texture_lod: lod.rs; fine derivatives: interpolate.rs; the
+// (cut_uv, texcoord: transform.rs; texture_lod: lod.rs; fine derivatives: interpolate.rs; the
 // sampler: filter.rs). Change both together.
 
 struct Uniforms {
@@ -18,6 +18,9 @@ struct Uniforms {
     max_level: f32,
     // 1 for anisotropic filtering: the adapter picks footprint and LOD (no model twin).
     anisotropic: f32,
+    // The block's branch cuts (SPEC.md 7.3): (u_cut, v_cut, 1 if cut along u, 1 if cut
+    // along v).
+    cut: vec4<f32>,
 };
 
 @group(0) @binding(0) var<uniform> u: Uniforms;
@@ -30,8 +33,24 @@ struct VsOut {
     @location(0) st: vec2<f32>,
 };
 
-// s = a·u + b·v + e, t = c·u + d·v + f.
-fn texcoord(uv: vec2<f32>) -> vec2<f32> {
+// The branch cuts (SPEC.md 7.3): w' = (w − w_cut) − floor(w − w_cut) along u where cut.z
+// is 1, along v where cut.w is 1; the other coordinate as it is.
+fn cut_uv(uv: vec2<f32>) -> vec2<f32> {
+    var w = uv;
+    if (u.cut.z != 0.0) {
+        let d = w.x - u.cut.x;
+        w.x = d - floor(d);
+    }
+    if (u.cut.w != 0.0) {
+        let d = w.y - u.cut.y;
+        w.y = d - floor(d);
+    }
+    return w;
+}
+
+// The cuts, then s = a·u + b·v + e, t = c·u + d·v + f.
+fn texcoord(mesh_uv: vec2<f32>) -> vec2<f32> {
+    let uv = cut_uv(mesh_uv);
     return vec2<f32>(
         u.affine_abcd.x * uv.x + u.affine_abcd.y * uv.y + u.affine_ef.x,
         u.affine_abcd.z * uv.x + u.affine_abcd.w * uv.y + u.affine_ef.y,

@@ -98,3 +98,48 @@ fn run_views(gpu: &pis_play::Gpu, test: &str) {
     eprintln!("worst PSNR {worst:.2} dB");
     assert!(failures.is_empty(), "{failures:#?}");
 }
+
+/// Branch cuts (SPEC.md 7.3) against the model: the sphere seen across its texture seam
+/// (u = 0 and u = 1 at +x), where the visible longitudes u ∈ [0.75, 1] ∪ [0, 0.25] are one
+/// contiguous range only after a cut at 0.3; the same with u and v exchanged, cut along v.
+/// Both cases hold the thresholds above, and the images differ from those without the cut.
+#[test]
+fn model_matches_wgpu_with_branch_cuts() {
+    let Some(gpu) = gpu_or_skip("model_matches_wgpu_with_branch_cuts") else { return };
+    let pipeline = TexturedPipeline::new(&gpu);
+    let vp = Viewport { width: 160, height: 120 };
+    let sphere = uv_sphere(48, 24);
+    let swapped: Vec<[f32; 2]> = sphere.uvs.iter().map(|&[u, v]| [v, u]).collect();
+    let layout = TextureLayout::full(97, 61);
+    let clip = camera(vp, [2.3, 0.5, 0.4], [0.0, 0.0, 0.0], 0.9);
+    // After the cut the visible part is w' ∈ [0.45, 0.95]: the affine map spreads it over s.
+    let along_u = TextureTransform { values: [1.6, 0.02, 0.0, 0.9, -0.68, 0.05], cut: [Some(0.3), None] };
+    let along_v = TextureTransform { values: [0.9, 0.0, 0.02, 1.6, 0.05, -0.68], cut: [None, Some(0.3)] };
+    let x = random_rgba(layout.texel_count(), 11);
+    let mut failures = vec![];
+    for (name, uvs, transform) in [("cut-u", &sphere.uvs, along_u), ("cut-v", &swapped, along_v)] {
+        for filter in [Filter::Nearest, Filter::Bilinear, Filter::Trilinear] {
+            let object = |transform| TexturedObject {
+                mesh: DrawMesh { positions: &sphere.positions, uvs, indices: &sphere.indices, clip_from_object: clip },
+                transform,
+                layout,
+                sampler: Sampler { filter, address: CLAMP },
+            };
+            let want = predict(&render_matrix(vp, &object(transform), None).unwrap(), &x);
+            let got = render_object(&gpu, &pipeline, vp, &[], &object(transform), &x).unwrap();
+            let c = compare(&want, &got);
+            let uncut = TextureTransform::affine(transform.values);
+            let without = compare(&predict(&render_matrix(vp, &object(uncut), None).unwrap(), &x), &got);
+            eprintln!(
+                "branch cuts {name} {filter:?}: PSNR {:.2} dB over {} pixels, {} coverage mismatches; {:.2} dB against the image without the cut",
+                c.psnr_db, c.both, c.coverage_mismatch, without.psnr_db
+            );
+            let threshold = if filter == Filter::Nearest { 40.0 } else { 50.0 };
+            if c.psnr_db < threshold || c.coverage_mismatch * 1000 > c.both || without.psnr_db > 20.0 {
+                let dir = write_failure_images(&format!("branch-cuts-{name}-{filter:?}"), &want, &got);
+                failures.push(format!("{name} {filter:?}: {c:?}, without the cut {without:?} (images in {})", dir.display()));
+            }
+        }
+    }
+    assert!(failures.is_empty(), "{failures:#?}");
+}

@@ -390,3 +390,55 @@ fn the_files_display_filter_selects_the_resolve() {
     let (one_with, _) = open(&with, 1, None).render_image(&req, size).unwrap();
     assert!(one_plain.rgba.iter().zip(&one_with.rgba).all(|(x, y)| x.to_bits() == y.to_bits()), "single-sample frames differ");
 }
+
+/// tiny.pis with `texcoords` as every object's mesh texture coordinates and `cut` as every
+/// surface block's branch cuts, written into `dir` as `name`.
+fn tiny_with(dir: &std::path::Path, name: &str, uv: impl Fn([f32; 2], [f32; 6]) -> [f32; 2], cut: [Option<f32>; 2]) -> PathBuf {
+    let mut c = pis_format::PisReader::open(&tiny()).unwrap().load_all().unwrap();
+    for o in &mut c.objects {
+        let affine = o.layers.iter().flat_map(|l| &l.blocks).find_map(|b| match b.placement {
+            pis_format::Placement::Surface { affine, .. } => Some(affine),
+            _ => None,
+        });
+        let (Some(affine), Some(t)) = (affine, o.mesh.texcoords.as_mut()) else { continue };
+        t.iter_mut().for_each(|w| *w = uv(*w, affine));
+        for b in o.layers.iter_mut().flat_map(|l| &mut l.blocks) {
+            if let pis_format::Placement::Surface { cut: c, .. } = &mut b.placement {
+                *c = cut;
+            }
+        }
+    }
+    let path = dir.join(name);
+    pis_format::write(&path, &c).unwrap();
+    path
+}
+
+/// Branch cuts (SPEC.md 7.3) in played frames: a file whose mesh coordinates are tiny.pis's
+/// shifted by (0.3, 0.55) (u over [0.3, 1.3], a wrapped range) with cuts at u = 0.3 and
+/// v = 0.55 plays as the same file with the cuts applied to its coordinates beforehand and
+/// no cut (≥ 50 dB), and unlike the shifted file played without its cuts.
+#[test]
+fn branch_cuts_play_as_cut_mesh_coordinates() {
+    let test = "branch_cuts_play_as_cut_mesh_coordinates";
+    let Some(gpu) = gpu_or_skip(test) else { return };
+    let gpu = Arc::new(gpu);
+    let cut = [Some(0.3f32), Some(0.55f32)];
+    let shift = |[u, v]: [f32; 2], _| [u + 0.3, v + 0.55];
+    let dir = tempfile::tempdir().unwrap();
+    let with_cut = tiny_with(dir.path(), "cut.pis", shift, cut);
+    let pre_cut = tiny_with(dir.path(), "pre-cut.pis", |w, affine| pis_compile::TextureTransform { values: affine, cut }.cut_uv(shift(w, affine)), [None; 2]);
+    let uncut = tiny_with(dir.path(), "uncut.pis", shift, [None; 2]);
+    let open = |p: &PathBuf| Player::open(gpu.clone(), p, PlayerOptions { workers: 1, ..Default::default() }).unwrap();
+    let (mut a, mut b, mut u) = (open(&with_cut), open(&pre_cut), open(&uncut));
+    let size = a.image_size();
+    for samples in [[0, 0], [1, 1]] {
+        let req = at(&a, &samples);
+        let (x, _) = a.render_image(&req, size).unwrap();
+        let (y, _) = b.render_image(&req, size).unwrap();
+        let (z, _) = u.render_image(&req, size).unwrap();
+        let (same, differ) = (psnr(&x.rgba, &y.rgba), psnr(&z.rgba, &y.rgba));
+        eprintln!("{test} {samples:?}: {same:.2} dB against the coordinates cut beforehand, {differ:.2} dB against the file without its cuts");
+        assert!(same >= 50.0, "point {samples:?}: cut {same:.2} dB against pre-cut coordinates");
+        assert!(differ < 30.0, "point {samples:?}: the cuts change the frame ({differ:.2} dB without them)");
+    }
+}

@@ -31,20 +31,20 @@ fn probe_matches_model() {
     let vp = Viewport { width: 120, height: 90 };
     let sphere = uv_sphere(32, 16);
     let occluder = quad(-2.0, -0.2, -2.0, -0.3, 1.3);
+    let skewed = TextureTransform::affine([0.93, 0.05, -0.04, 0.88, 0.03, 0.06]);
+    let wrapped = TextureTransform::affine([1.0, 0.0, 0.0, 0.9, 0.0, 0.05]);
+    // Seen across the texture seam (u = 0 and 1 at +x): contiguous after a branch cut at 0.3.
+    let cut = TextureTransform { values: [1.6, 0.02, 0.0, 0.9, -0.68, 0.05], cut: [Some(0.3), None] };
     let cases = [
-        ("trilinear-clamp", Filter::Trilinear, [Address::ClampToEdge; 2], TextureLayout::full(151, 77), [0.3, 0.6, 2.4]),
-        ("bilinear-clamp", Filter::Bilinear, [Address::ClampToEdge; 2], TextureLayout::full(45, 29), [0.3, 0.6, 2.4]),
-        ("trilinear-repeat-s", Filter::Trilinear, [Address::Repeat, Address::ClampToEdge], TextureLayout::full(128, 37), [-1.5, 1.0, 3.5]),
+        ("trilinear-clamp", Filter::Trilinear, [Address::ClampToEdge; 2], TextureLayout::full(151, 77), [0.3, 0.6, 2.4], skewed),
+        ("bilinear-clamp", Filter::Bilinear, [Address::ClampToEdge; 2], TextureLayout::full(45, 29), [0.3, 0.6, 2.4], skewed),
+        ("trilinear-repeat-s", Filter::Trilinear, [Address::Repeat, Address::ClampToEdge], TextureLayout::full(128, 37), [-1.5, 1.0, 3.5], wrapped),
+        ("trilinear-branch-cut-u", Filter::Trilinear, [Address::ClampToEdge; 2], TextureLayout::full(97, 61), [2.3, 0.5, 0.4], cut),
     ];
     let mut failures = vec![];
-    for (name, filter, address, layout, eye) in cases {
+    for (name, filter, address, layout, eye, transform) in cases {
         let clip = camera(vp, eye, [0.0; 3], 0.9);
         let occ = DrawMesh { positions: &occluder.positions, uvs: &occluder.uvs, indices: &occluder.indices, clip_from_object: clip };
-        let transform = if address[0] == Address::Repeat {
-            TextureTransform::affine([1.0, 0.0, 0.0, 0.9, 0.0, 0.05])
-        } else {
-            TextureTransform::affine([0.93, 0.05, -0.04, 0.88, 0.03, 0.06])
-        };
         let object = TexturedObject {
             mesh: DrawMesh { positions: &sphere.positions, uvs: &sphere.uvs, indices: &sphere.indices, clip_from_object: clip },
             transform,

@@ -174,7 +174,7 @@ pub fn draw_scene(
     let format = offscreen_format(gpu);
     let mut targets = Targets::new(gpu, pipes, size, samples).unwrap();
     let objects: Vec<ObjectDraw> = scene.iter().enumerate().map(|(i, (mesh, clip, _))| ObjectDraw { object: i as u32, mesh, clip_from_object: *clip }).collect();
-    let layers: Vec<LayerDraw> = scene.iter().enumerate().map(|(i, (_, _, texture))| LayerDraw { draw: i, texture, sampler, affine: [1.0, 0.0, 0.0, 1.0, 0.0, 0.0], max_level: 0.0, weight: 1.0, anisotropic: false }).collect();
+    let layers: Vec<LayerDraw> = scene.iter().enumerate().map(|(i, (_, _, texture))| LayerDraw { draw: i, texture, sampler, transform: pis_compile::TextureTransform::IDENTITY, max_level: 0.0, weight: 1.0, anisotropic: false }).collect();
     let mut encoder = gpu.device.create_command_encoder(&Default::default());
     let view = targets.colour.create_view(&Default::default());
     encode(gpu, pipes, &mut targets, &view, format, &objects, &layers, true, display, &mut encoder);
