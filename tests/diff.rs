@@ -148,14 +148,20 @@ fn heatmaps_are_written_per_object_and_layer() {
     let r = json(&out);
     let layers: usize = r["objects"].as_array().expect("objects").iter().map(|o| o["layers"].as_array().map_or(0, Vec::len)).sum();
     let written = r["heatmaps"].as_array().expect("heatmaps");
-    assert_eq!(written.len(), layers);
-    let inspect = Command::new(env!("CARGO_BIN_EXE_pis-inspect")).arg("--json").arg(packed()).output().expect("pis-inspect");
-    let summary: serde_json::Value = serde_json::from_slice(&inspect.stdout).expect("summary JSON");
+    // A map per layer and texture placement: every block of every layer in exactly one.
+    assert!(written.len() >= layers, "{} maps for {layers} layers", written.len());
+    let c = pis_format::PisReader::open(packed()).expect("open").load_all().expect("load");
+    let blocks: usize = c.objects.iter().flat_map(|o| &o.layers).map(|l| l.blocks.len()).sum();
+    assert_eq!(written.iter().map(|h| h["blocks"].as_array().expect("blocks").len()).sum::<usize>(), blocks);
     for h in written {
-        let object = summary["objects"].as_array().expect("objects").iter().find(|o| o["name"] == h["object"]).expect("object");
-        let layer = &object["layers"][h["layer"].as_u64().expect("layer") as usize];
+        let object = c.objects.iter().find(|o| o.name == h["object"]).expect("object");
+        let layer = &object.layers[h["layer"].as_u64().expect("layer") as usize];
         let img = image::open(h["file"].as_str().expect("file")).expect("a PNG").to_rgb8();
-        assert_eq!(img.dimensions(), (layer["width"].as_u64().expect("width") as u32, layer["height"].as_u64().expect("height") as u32), "{h}");
+        let covered: Vec<&pis_format::Block> = h["blocks"].as_array().expect("blocks").iter().map(|b| &layer.blocks[b.as_u64().expect("block") as usize]).collect();
+        for b in &covered {
+            assert_eq!((b.width, b.height, b.placement), (covered[0].width, covered[0].height, covered[0].placement), "one placement per map: {h}");
+        }
+        assert_eq!(img.dimensions(), (covered[0].width, covered[0].height), "{h}");
         // The ramp's top stands for the layer's largest RMS error: zero only where it is exact.
         let diffed = r["objects"].as_array().expect("objects").iter().find(|o| o["name"] == h["object"]).expect("object");
         let exact = diffed["layers"][h["layer"].as_u64().expect("layer") as usize]["exact"] == true;

@@ -54,6 +54,8 @@ pub struct BytesPair {
 pub struct Heatmap {
     pub object: String,
     pub layer: usize,
+    /// The layer's blocks the map covers: those sharing one texture placement.
+    pub blocks: Vec<usize>,
     pub file: String,
     /// The RMS display error the ramp's top colour stands for.
     pub scale: f32,
@@ -139,9 +141,12 @@ pub fn diff(req: &DiffRequest) -> Result<DiffReport, Failure> {
         std::fs::create_dir_all(dir).map_err(|e| Failure::new(Exit::Io, anyhow!("{}: {e}", dir.display())))?;
         for m in &maps {
             let scale = m.values.iter().fold(0.0f32, |a, &v| a.max(v));
-            let file = dir.join(format!("{}-layer{}-{}.png", file_part(&m.object), m.layer, m.kind));
+            // A layer whose blocks place the texture differently gets a map per placement,
+            // named by its first block.
+            let part = if m.placements > 1 { format!("-block{}", m.blocks.first().copied().unwrap_or(0)) } else { String::new() };
+            let file = dir.join(format!("{}-layer{}-{}{part}.png", file_part(&m.object), m.layer, m.kind));
             write_heatmap(&file, m.width, m.height, &m.values, scale).map_err(|e| Failure::new(Exit::Io, e))?;
-            heatmaps.push(Heatmap { object: m.object.clone(), layer: m.layer, file: file.display().to_string(), scale });
+            heatmaps.push(Heatmap { object: m.object.clone(), layer: m.layer, blocks: m.blocks.clone(), file: file.display().to_string(), scale });
         }
     }
     let textures_identical = content.score.exact && content.complete;

@@ -91,12 +91,16 @@ pub struct ContentDiff {
 }
 
 /// Root-mean-square display error per texel of one layer's finest planes (faces side by
-/// side), over its samples and channels.
+/// side), over its samples and channels: over the blocks that share one texture placement
+/// (all of them where the writer placed the texture once per layer).
 #[derive(Clone, Debug)]
 pub struct ErrorMap {
     pub object: String,
     pub layer: usize,
     pub kind: &'static str,
+    /// The blocks the map covers; `placements` maps are made for the layer in all.
+    pub blocks: Vec<usize>,
+    pub placements: usize,
     pub width: u32,
     pub height: u32,
     pub values: Vec<f32>,
@@ -204,7 +208,8 @@ pub fn compare(a: &PisReader, b: &PisReader, maps: bool, progress: &mut dyn FnMu
             let mut layer_err = SquaredError::default();
             let mut layer_exact = true;
             let mut layout_note = None;
-            let mut map: Option<(LevelLayout, Vec<f64>, u64)> = None;
+            // One map per texture placement (size and texture transform) of the layer's blocks.
+            let mut layer_maps: Vec<(usize, LevelLayout, Vec<f64>, u64, Vec<usize>)> = Vec::new();
             let mut blocks = Vec::new();
             for bi in 0..la.blocks.len() {
                 let ta = decode_block(a, oi, li, bi).map_err(fa)?;
@@ -226,17 +231,33 @@ pub fn compare(a: &PisReader, b: &PisReader, maps: bool, progress: &mut dyn FnMu
                     layout_note = Some(format!("texture layout differs in block {bi}: {}x{} → {}x{}", ta.layout.width, ta.layout.height, tb.layout.width, tb.layout.height));
                     break;
                 }
-                let want_map = maps && map.as_ref().is_none_or(|m| m.0 == ta.layout);
-                let per: Vec<SampleError> = ta.textures.par_iter().zip(&tb.textures).map(|(x, y)| sample_error(&ta.layout, x, y, want_map)).collect();
+                let per: Vec<SampleError> = ta.textures.par_iter().zip(&tb.textures).map(|(x, y)| sample_error(&ta.layout, x, y, maps)).collect();
+                let blk = &la.blocks[bi];
+                let slot = layer_maps.iter().position(|m| {
+                    let first = &la.blocks[m.0];
+                    m.1 == ta.layout && first.placement == blk.placement && (first.width, first.height) == (blk.width, blk.height)
+                });
                 let mut block_err = SquaredError::default();
                 let mut block_exact = true;
                 for s in &per {
                     block_err.merge(&s.error);
                     block_exact &= s.exact;
                     if let Some(t) = &s.texels {
-                        let m = map.get_or_insert_with(|| (ta.layout.clone(), vec![0.0; t.len()], 0));
-                        m.1.iter_mut().zip(t).for_each(|(acc, v)| *acc += v);
-                        m.2 += ta.layout.channels as u64;
+                        let k = match slot {
+                            Some(k) => k,
+                            None => {
+                                if layer_maps.last().is_none_or(|m| m.0 != bi) {
+                                    layer_maps.push((bi, ta.layout.clone(), vec![0.0; t.len()], 0, vec![]));
+                                }
+                                layer_maps.len() - 1
+                            }
+                        };
+                        let m = &mut layer_maps[k];
+                        m.2.iter_mut().zip(t).for_each(|(acc, v)| *acc += v);
+                        m.3 += ta.layout.channels as u64;
+                        if m.4.last() != Some(&bi) {
+                            m.4.push(bi);
+                        }
                     }
                 }
                 weighted(&mut layer_err, &block_err, 1);
@@ -252,9 +273,10 @@ pub fn compare(a: &PisReader, b: &PisReader, maps: bool, progress: &mut dyn FnMu
             }
             weighted(&mut obj_err, &layer_err, multiplicity);
             obj_exact &= layer_exact;
-            if let Some((layout, sums, n)) = map {
+            let placements = layer_maps.len();
+            for (_, layout, sums, n, blocks) in layer_maps {
                 let values = sums.iter().map(|s| (s / n.max(1) as f64).sqrt() as f32).collect();
-                out_maps.push(ErrorMap { object: oa.name.clone(), layer: li, kind: la.kind.name(), width: layout.width * layout.faces, height: layout.height, values });
+                out_maps.push(ErrorMap { object: oa.name.clone(), layer: li, kind: la.kind.name(), blocks, placements, width: layout.width * layout.faces, height: layout.height, values });
             }
             layers.push(LayerDiff { layer: li, kind: la.kind.name(), compared: true, note: None, score: Score::of(&layer_err, layer_exact), blocks });
         }
