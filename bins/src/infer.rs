@@ -255,11 +255,17 @@ pub fn psnr_display(a: &[f32], b: &[f32]) -> f64 {
 /// Keeps the rows of A whose pixels the tracer covers; returns the reduced A and its b.
 pub(crate) fn restrict(a: &RenderMatrix, cov: &[f32], rgb: &[f32]) -> (RenderMatrix, Vec<f32>) {
     let out = restrict_rows(a, cov);
-    let mut b = Vec::with_capacity(out.rows() * 3);
-    for &p in &out.pixels {
+    let b = gather(&out.pixels, rgb);
+    (out, b)
+}
+
+/// The RGB values of `rgb` (3 per pixel of the image) at `pixels`: a row's b.
+pub(crate) fn gather(pixels: &[u32], rgb: &[f32]) -> Vec<f32> {
+    let mut b = Vec::with_capacity(pixels.len() * 3);
+    for &p in pixels {
         b.extend_from_slice(&rgb[p as usize * 3..p as usize * 3 + 3]);
     }
-    (out, b)
+    b
 }
 
 /// The rows of A whose pixels the tracer covers.

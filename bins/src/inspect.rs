@@ -225,10 +225,10 @@ pub fn summarize(r: &PisReader) -> Summary {
 
 /// Distinct surface placements among `blocks` (0 for a shell layer).
 fn surface_placements<S>(blocks: &[pis_format::Block<S>]) -> usize {
-    let mut seen: Vec<(u32, u32, Placement)> = Vec::new();
+    let mut seen: Vec<&pis_format::Block<S>> = Vec::new();
     for b in blocks {
-        if matches!(b.placement, Placement::Surface { .. }) && !seen.iter().any(|(w, h, p)| *w == b.width && *h == b.height && *p == b.placement) {
-            seen.push((b.width, b.height, b.placement));
+        if matches!(b.placement, Placement::Surface { .. }) && !seen.iter().any(|s| s.same_placement(b)) {
+            seen.push(b);
         }
     }
     seen.len()

@@ -9,7 +9,7 @@
 //! Popping: per path, the largest frame-to-frame RMS change of the PIS frames divided by
 //! the reference's RMS change between the same two frames (1: as smooth as the reference).
 
-use std::collections::BTreeMap;
+use std::collections::btree_map::{BTreeMap, Entry};
 use std::path::PathBuf;
 
 use anyhow::{anyhow, Result};
@@ -134,12 +134,14 @@ fn render_frame(inf: &Inferred, meshes: &[Mesh], tex: &[Vec<LayerTextures>], pf:
                     continue;
                 }
                 let pid = l.placement_of[&k];
-                if !matrices.contains_key(&pid) {
-                    let pl = &m.placements[pid];
-                    let obj = TexturedObject { mesh, transform: pl.transform, layout: pl.layout, sampler: sampler(Filter::Trilinear, pl.repeat) };
-                    matrices.insert(pid, render_matrix(viewport, &obj, Some(&occluders))?);
-                }
-                let a = &matrices[&pid];
+                let a = match matrices.entry(pid) {
+                    Entry::Occupied(e) => e.into_mut(),
+                    Entry::Vacant(e) => {
+                        let pl = &m.placements[pid];
+                        let obj = TexturedObject { mesh, transform: pl.transform, layout: pl.layout, sampler: sampler(Filter::Trilinear, pl.repeat) };
+                        e.insert(render_matrix(viewport, &obj, Some(&occluders))?)
+                    }
+                };
                 img.resize(a.rows() * 3, 0.0);
                 let y = render(a, x);
                 img.iter_mut().zip(&y).for_each(|(s, v)| *s += weight * v);

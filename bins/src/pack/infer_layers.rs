@@ -9,6 +9,7 @@
 //! of a layer gets the branch cuts, affine map and used size that suit the views of its
 //! samples, so every point has one render matrix per placement its layers read.
 
+use std::borrow::Cow;
 use std::collections::BTreeMap;
 
 use anyhow::{anyhow, Result};
@@ -22,7 +23,7 @@ use super::encode::{block_sizes, geometry, stagger};
 use super::input::LoadedSet;
 use super::matrices::Matrices;
 use super::{PackRequest, PlacementMode, Stages};
-use crate::infer::{atlas, merged_mesh, place_in, restrict_rows, sampler, Atlas, Mesh, Placed};
+use crate::infer::{atlas, gather, merged_mesh, place_in, restrict_rows, sampler, Atlas, Mesh, Placed};
 
 /// Largest linear radiance below which a layer counts as black.
 pub const BLACK: f32 = 1e-4;
@@ -91,6 +92,14 @@ impl ObjectModel {
         &self.placements[self.layers[layer].placement_of[key]]
     }
 
+    /// The placements the layers' blocks carry, in increasing order.
+    pub(crate) fn used_placements(&self) -> Vec<usize> {
+        let mut used: Vec<usize> = self.layers.iter().flat_map(|l| l.block_placements.iter().copied()).collect();
+        used.sort_unstable();
+        used.dedup();
+        used
+    }
+
     /// The MIP layout of sample `key` of layer `layer`.
     pub(crate) fn layout(&self, layer: usize, key: &[u32]) -> TextureLayout {
         self.placed(layer, key).layout
@@ -125,6 +134,7 @@ fn coverage(set: &LoadedSet, p: usize, o: usize) -> Vec<f32> {
 
 /// The render matrix of object `o` at point `p` with texture coordinates `uvs` and placement
 /// `placed`, every other mesh occluding it; rows where the tracer covers no pixel removed.
+#[allow(clippy::too_many_arguments)]
 fn matrix_at(set: &LoadedSet, p: usize, o: usize, meshes: &[Mesh], uvs: &[[f32; 2]], placed: &Placed, req: &PackRequest, matrices: &mut Matrices) -> Result<RenderMatrix> {
     let (w, h) = set.resolution;
     let frame = &set.frames[p];
@@ -145,18 +155,8 @@ fn matrix_at(set: &LoadedSet, p: usize, o: usize, meshes: &[Mesh], uvs: &[[f32; 
 fn views_of(set: &LoadedSet, o: usize, uvs: &[[f32; 2]], placed: &Placed, meshes: &[Mesh], req: &PackRequest, matrices: &mut Matrices) -> Result<Vec<PointView>> {
     let channel = &set.channels[o];
     (0..set.frames.len()).map(|p| {
-        let images = &set.images[p];
         let a = matrix_at(set, p, o, meshes, uvs, placed, req, matrices)?;
-        let cov = coverage(set, p, o);
-        let pick = |kind| {
-            let rgb = layer_rgb(images, channel, kind);
-            let mut b = Vec::with_capacity(a.rows() * 3);
-            for &px in &a.pixels {
-                debug_assert!(cov[px as usize] > 0.0);
-                b.extend_from_slice(&rgb[px as usize * 3..px as usize * 3 + 3]);
-            }
-            b
-        };
+        let pick = |kind| gather(&a.pixels, &layer_rgb(&set.images[p], channel, kind));
         let (diffuse, specular) = (pick(TraceLayer::Diffuse), pick(TraceLayer::Specular));
         Ok(PointView { a: vec![(0, a)], diffuse, specular })
     }).collect()
@@ -173,10 +173,32 @@ fn is_black(views: &[PointView], pick: impl Fn(&PointView) -> &[f32], other: imp
     views.iter().all(|v| pick(v).iter().zip(other(v)).all(|(x, o)| x.abs() < BLACK || (d(x + o) - d(*o)).abs() < DISPLAY_STEP))
 }
 
+/// The traced radiance a layer is solved for.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Radiance {
+    /// The diffuse layer: view-independent, its views stacked (eq. 3.7).
+    Diffuse,
+    Specular,
+    /// Diffuse + specular (`--layers combined`).
+    Sum,
+}
+
+impl Radiance {
+    /// b at the covered pixels of `v`.
+    fn at(self, v: &PointView) -> Cow<'_, [f32]> {
+        match self {
+            Radiance::Diffuse => Cow::Borrowed(&v.diffuse),
+            Radiance::Specular => Cow::Borrowed(&v.specular),
+            Radiance::Sum => Cow::Owned(v.diffuse.iter().zip(&v.specular).map(|(d, s)| d + s).collect()),
+        }
+    }
+}
+
 /// What one object's layers are before solving: mask, the block each point's sample is in,
 /// each block's placement.
 struct LayerPlan {
     kind: pis_format::LayerKind,
+    radiance: Radiance,
     depends_on: DepMask,
     block_placements: Vec<usize>,
     /// Per point of the set, its sample's placement.
@@ -190,8 +212,7 @@ struct LayerPlan {
 fn plan_layer(
     set: &LoadedSet,
     grid: &BlockGrid,
-    kind: pis_format::LayerKind,
-    mask: DepMask,
+    (kind, radiance, mask): (pis_format::LayerKind, Radiance, DepMask),
     o: usize,
     mesh: &Mesh,
     at: &Atlas,
@@ -218,14 +239,13 @@ fn plan_layer(
         }
     }
     let point_placement = point_block.iter().map(|&b| block_placements[b]).collect();
-    Ok(LayerPlan { kind, depends_on: mask, block_placements, point_placement })
+    Ok(LayerPlan { kind, radiance, depends_on: mask, block_placements, point_placement })
 }
 
 /// One texture per key of `plan`'s mask: each key's sample solved (or, for a view-independent
 /// layer, its views stacked, eq. 3.7) with the render matrices of its block's placement,
 /// warm-started from the last sample solved with the same placement.
-fn solve_layer(set: &LoadedSet, views: &[PointView], placements: &[Placed], plan: &LayerPlan, b: impl Fn(&PointView) -> Vec<f32>, settings: &SolveSettings) -> Result<InferredLayer> {
-    let stacked = plan.kind == pis_format::LayerKind::Diffuse;
+fn solve_layer(set: &LoadedSet, views: &[PointView], placements: &[Placed], plan: &LayerPlan, settings: &SolveSettings) -> Result<InferredLayer> {
     let mut groups: BTreeMap<Vec<u32>, Vec<usize>> = BTreeMap::new();
     for (p, s) in set.samples.iter().enumerate() {
         groups.entry(key(s, plan.depends_on)).or_default().push(p);
@@ -236,10 +256,10 @@ fn solve_layer(set: &LoadedSet, views: &[PointView], placements: &[Placed], plan
     let mut iterations = 0u64;
     for (k, points) in groups {
         let pid = plan.point_placement[points[0]];
-        let bs: Vec<Vec<f32>> = points.iter().map(|&p| b(&views[p])).collect();
+        let bs: Vec<Cow<[f32]>> = points.iter().map(|&p| plan.radiance.at(&views[p])).collect();
         let vs: Vec<View> = points.iter().zip(&bs).map(|(&p, b)| View { a: views[p].a(pid), b }).collect();
         let start = warm.get(&pid).map(Vec::as_slice);
-        let x = if stacked {
+        let x = if plan.radiance == Radiance::Diffuse {
             // One texture for the views of the sample, stacked (eq. 3.7).
             let s = solve_view_independent(&vs, start, settings)?;
             iterations += s.iterations as u64;
@@ -257,6 +277,17 @@ fn solve_layer(set: &LoadedSet, views: &[PointView], placements: &[Placed], plan
         textures.insert(k, x);
     }
     Ok(InferredLayer { kind: plan.kind, depends_on: plan.depends_on, textures, block_placements: plan.block_placements.clone(), placement_of, iterations })
+}
+
+/// An object with its blocks placed: texture coordinates, placements, block origins, the
+/// points with the render matrices its layers read, the layers to solve.
+struct Planned {
+    o: usize,
+    atlas: Atlas,
+    placements: Vec<Placed>,
+    stagger: Vec<u32>,
+    views: Vec<PointView>,
+    plans: Vec<LayerPlan>,
 }
 
 /// An object that covers a pixel and is not black: its texture coordinates, placement over
@@ -324,20 +355,16 @@ pub(crate) fn infer_all(set: &LoadedSet, req: &PackRequest, matrices: &mut Matri
         let st = stagger(mi, n, &sizes);
         let mut placements = vec![c.whole.clone()];
         let mut plans = Vec::new();
-        let mut wanted: Vec<(pis_format::LayerKind, DepMask)> = Vec::new();
-        if combined {
-            wanted.push((pis_format::LayerKind::Specular, all));
+        let wanted = if combined {
+            vec![(pis_format::LayerKind::Specular, Radiance::Sum, all)]
         } else {
-            if !c.diffuse_black {
-                wanted.push((pis_format::LayerKind::Diffuse, non_view));
-            }
-            if !c.specular_black {
-                wanted.push((pis_format::LayerKind::Specular, all));
-            }
-        }
-        for (kind, mask) in wanted {
-            let grid = BlockGrid::new(&space, mask, &st);
-            plans.push(plan_layer(set, &grid, kind, mask, c.o, &meshes[c.o], &c.atlas, &mut placements, req)?);
+            let diffuse = (!c.diffuse_black).then_some((pis_format::LayerKind::Diffuse, Radiance::Diffuse, non_view));
+            let specular = (!c.specular_black).then_some((pis_format::LayerKind::Specular, Radiance::Specular, all));
+            diffuse.into_iter().chain(specular).collect()
+        };
+        for layer in wanted {
+            let grid = BlockGrid::new(&space, layer.2, &st);
+            plans.push(plan_layer(set, &grid, layer, c.o, &meshes[c.o], &c.atlas, &mut placements, req)?);
         }
         made += placements.len();
         let mut views = c.views;
@@ -360,41 +387,33 @@ pub(crate) fn infer_all(set: &LoadedSet, req: &PackRequest, matrices: &mut Matri
                 v.a.remove(0);
             }
         }
-        planned.push((c.o, c.atlas, placements, st, views, plans, c.diffuse_black, c.specular_black));
+        planned.push(Planned { o: c.o, atlas: c.atlas, placements, stagger: st, views, plans });
     }
     stages.done("matrices", &format!(
         "texture coordinates of {} objects ({made} placements, per {}) and render matrices at {} points ({}; {extra} for block placements)",
         scene.objects.len(), req.placement.name(), set.frames.len(), matrices.describe(),
     ));
     let mut out = Vec::new();
-    for (o, at, placements, st, views, plans, diffuse_black, specular_black) in planned {
+    for Planned { o, atlas: at, placements, stagger: st, views, plans } in planned {
         let name = scene.objects[o].name.clone();
         let covered: usize = views.iter().map(PointView::rows).sum();
         let area = covered as f64 / views.len() as f64;
-        let mut layers = Vec::new();
-        for plan in &plans {
-            let layer = match (combined, plan.kind) {
-                (true, _) => solve_layer(set, &views, &placements, plan, |v| v.diffuse.iter().zip(&v.specular).map(|(d, s)| d + s).collect(), &settings)?,
-                (false, pis_format::LayerKind::Diffuse) => solve_layer(set, &views, &placements, plan, |v| v.diffuse.clone(), &settings)?,
-                (false, _) => solve_layer(set, &views, &placements, plan, |v| v.specular.clone(), &settings)?,
-            };
-            layers.push(layer);
-        }
-        let (representation, why) = if combined {
-            ("combined".to_string(), "--layers combined: one view-dependent layer of diffuse + specular radiance per parameter sample".to_string())
-        } else {
-            match (diffuse_black, specular_black) {
-                (false, true) => ("diffuse".to_string(), "the specular layer changes no displayed pixel: one view-independent diffuse texture per non-view sample".to_string()),
-                (true, false) => ("specular".to_string(), "the diffuse layer changes no displayed pixel: a view-dependent texture per parameter sample".to_string()),
-                _ => ("diffuse+specular".to_string(), "view-independent diffuse layer over the non-view dimensions plus a view-dependent specular layer per parameter sample".to_string()),
-            }
+        let layers = plans.iter().map(|plan| solve_layer(set, &views, &placements, plan, &settings)).collect::<Result<Vec<_>>>()?;
+        let radiances: Vec<Radiance> = plans.iter().map(|p| p.radiance).collect();
+        let (representation, why) = match radiances.as_slice() {
+            [Radiance::Sum] => ("combined", "--layers combined: one view-dependent layer of diffuse + specular radiance per parameter sample"),
+            [Radiance::Diffuse] => ("diffuse", "the specular layer changes no displayed pixel: one view-independent diffuse texture per non-view sample"),
+            [Radiance::Specular] => ("specular", "the diffuse layer changes no displayed pixel: a view-dependent texture per parameter sample"),
+            _ => ("diffuse+specular", "view-independent diffuse layer over the non-view dimensions plus a view-dependent specular layer per parameter sample"),
         };
-        let sizes_text: Vec<String> = placements.iter().map(|p| format!("{}x{}", p.layout.width, p.layout.height)).collect();
-        eprintln!("pis-pack: object {name}: {} texels, {representation} ({why})", sizes_text.join(", "));
-        out.push(ObjectModel {
+        let (representation, why) = (representation.to_string(), why.to_string());
+        let m = ObjectModel {
             index: o, name, mesh: merged_mesh(scene, o), mesh_uvs: at.uvs, placements, stagger: st, block_sizes: sizes.clone(),
             area, views, layers, representation, why,
-        });
+        };
+        let sizes_text: Vec<String> = m.used_placements().iter().map(|&p| format!("{}x{}", m.placements[p].layout.width, m.placements[p].layout.height)).collect();
+        eprintln!("pis-pack: object {}: {} texels, {} ({})", m.name, sizes_text.join(", "), m.representation, m.why);
+        out.push(m);
     }
     stages.done("infer", &format!("{} objects solved", out.len()));
     Ok(out)

@@ -102,9 +102,7 @@ pub(crate) fn build(set: &LoadedSet, models: &[ObjectModel], packed: &Packed, q:
     let texture_bytes: usize = packed.layer_bytes.iter().flatten().sum();
     let objects = models.iter().enumerate().map(|(mi, m)| {
         let ob = &packed.container.objects[mi];
-        let mut used: Vec<usize> = m.layers.iter().flat_map(|l| l.block_placements.iter().copied()).collect();
-        used.sort_unstable();
-        used.dedup();
+        let used = m.used_placements();
         let largest = used.iter().map(|&p| &m.placements[p]).max_by_key(|p| p.layout.width as u64 * p.layout.height as u64).unwrap_or(&m.placements[0]);
         ObjectReport {
             name: m.name.clone(),

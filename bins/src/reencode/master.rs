@@ -121,7 +121,7 @@ pub fn error_against(r: &PisReader, masters: &[Master]) -> Result<(SquaredError,
 pub fn regroup<S>(c: &Container<S>, space: &ParameterSpace, stagger: &[u32], object: usize, layer: usize, old: Vec<BlockSource>) -> Result<Vec<BlockSource>, Error> {
     let l = &c.objects[object].layers[layer];
     let first = l.blocks.first().ok_or_else(|| Error::Request(format!("object {object} layer {layer} has no blocks")))?;
-    if l.blocks.iter().any(|b| b.width != first.width || b.height != first.height || b.placement != first.placement) {
+    if l.blocks.iter().any(|b| !b.same_placement(first)) {
         return Err(Error::Request(format!(
             "object '{}' layer {layer}: its blocks place the texture differently (texture coordinates optimized per block); re-blocking needs one placement per layer: pack with --placement object, or pack again with the new --block",
             c.objects[object].name)));

@@ -383,6 +383,14 @@ pub struct Block<S = Codestream> {
     pub levels: Vec<Level<S>>,
 }
 
+impl<S> Block<S> {
+    /// Whether `other`'s texture is placed as this block's: the same used size and
+    /// placement, so a texel means the same surface point in both.
+    pub fn same_placement<T>(&self, other: &Block<T>) -> bool {
+        (self.width, self.height, self.placement) == (other.width, other.height, other.placement)
+    }
+}
+
 /// Where a block's texture sits.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Placement {

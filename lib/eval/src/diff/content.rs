@@ -106,6 +106,15 @@ pub struct ErrorMap {
     pub values: Vec<f32>,
 }
 
+/// The squared errors per texel summed over the blocks of one texture placement (an
+/// [`ErrorMap`] in the making), and how many values they sum.
+struct MapSum {
+    layout: LevelLayout,
+    sums: Vec<f64>,
+    values: u64,
+    blocks: Vec<usize>,
+}
+
 /// Per-sample result: the sample's error, exactness, and its squared error per texel.
 struct SampleError {
     error: SquaredError,
@@ -209,7 +218,7 @@ pub fn compare(a: &PisReader, b: &PisReader, maps: bool, progress: &mut dyn FnMu
             let mut layer_exact = true;
             let mut layout_note = None;
             // One map per texture placement (size and texture transform) of the layer's blocks.
-            let mut layer_maps: Vec<(usize, LevelLayout, Vec<f64>, u64, Vec<usize>)> = Vec::new();
+            let mut layer_maps: Vec<MapSum> = Vec::new();
             let mut blocks = Vec::new();
             for bi in 0..la.blocks.len() {
                 let ta = decode_block(a, oi, li, bi).map_err(fa)?;
@@ -232,33 +241,27 @@ pub fn compare(a: &PisReader, b: &PisReader, maps: bool, progress: &mut dyn FnMu
                     break;
                 }
                 let per: Vec<SampleError> = ta.textures.par_iter().zip(&tb.textures).map(|(x, y)| sample_error(&ta.layout, x, y, maps)).collect();
-                let blk = &la.blocks[bi];
-                let slot = layer_maps.iter().position(|m| {
-                    let first = &la.blocks[m.0];
-                    m.1 == ta.layout && first.placement == blk.placement && (first.width, first.height) == (blk.width, blk.height)
-                });
                 let mut block_err = SquaredError::default();
                 let mut block_exact = true;
+                let mut block_map = None;
                 for s in &per {
                     block_err.merge(&s.error);
                     block_exact &= s.exact;
                     if let Some(t) = &s.texels {
-                        let k = match slot {
-                            Some(k) => k,
-                            None => {
-                                if layer_maps.last().is_none_or(|m| m.0 != bi) {
-                                    layer_maps.push((bi, ta.layout.clone(), vec![0.0; t.len()], 0, vec![]));
-                                }
+                        let k = *block_map.get_or_insert_with(|| {
+                            let same = layer_maps.iter().position(|m| m.layout == ta.layout && la.blocks[m.blocks[0]].same_placement(&la.blocks[bi]));
+                            same.unwrap_or_else(|| {
+                                layer_maps.push(MapSum { layout: ta.layout.clone(), sums: vec![0.0; t.len()], values: 0, blocks: vec![] });
                                 layer_maps.len() - 1
-                            }
-                        };
+                            })
+                        });
                         let m = &mut layer_maps[k];
-                        m.2.iter_mut().zip(t).for_each(|(acc, v)| *acc += v);
-                        m.3 += ta.layout.channels as u64;
-                        if m.4.last() != Some(&bi) {
-                            m.4.push(bi);
-                        }
+                        m.sums.iter_mut().zip(t).for_each(|(acc, v)| *acc += v);
+                        m.values += ta.layout.channels as u64;
                     }
+                }
+                if let Some(k) = block_map {
+                    layer_maps[k].blocks.push(bi);
                 }
                 weighted(&mut layer_err, &block_err, 1);
                 layer_exact &= block_exact;
@@ -274,7 +277,7 @@ pub fn compare(a: &PisReader, b: &PisReader, maps: bool, progress: &mut dyn FnMu
             weighted(&mut obj_err, &layer_err, multiplicity);
             obj_exact &= layer_exact;
             let placements = layer_maps.len();
-            for (_, layout, sums, n, blocks) in layer_maps {
+            for MapSum { layout, sums, values: n, blocks } in layer_maps {
                 let values = sums.iter().map(|s| (s / n.max(1) as f64).sqrt() as f32).collect();
                 out_maps.push(ErrorMap { object: oa.name.clone(), layer: li, kind: la.kind.name(), blocks, placements, width: layout.width * layout.faces, height: layout.height, values });
             }
