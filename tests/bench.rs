@@ -267,3 +267,23 @@ fn speed_stability_and_all_argument_errors() {
     let out = bench(&["all", "--preset", "ci", "--scene", "/no/such/scene.toml"]);
     assert_eq!(out.status.code(), Some(2));
 }
+
+/// README's chart command (`pis-bench all --preset ci`), taken from README.md and run as
+/// written, with its charts sent to a temporary folder: it once failed with "the smallest
+/// encodings need 130 bytes, over the budget of 115".
+#[test]
+fn readme_chart_command_runs_at_its_smallest_preset() {
+    let readme = std::fs::read_to_string(PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../README.md")).expect("README.md");
+    let line = readme.lines().map(str::trim).find(|l| l.contains("--bin pis-bench -- all")).expect("README shows the chart command");
+    let args: Vec<&str> = line.split_once(" -- ").expect("cargo run … -- ARGS").1.split_whitespace().collect();
+    assert_eq!(args, ["all", "--preset", "ci"], "the chart command README shows");
+    let dir = tempfile::tempdir().expect("temporary directory");
+    let out_dir = dir.path().join("reports");
+    let mut all = args.clone();
+    all.extend(["--out", out_dir.to_str().unwrap()]);
+    let out = Command::new(env!("CARGO_BIN_EXE_pis-bench")).args(&all).current_dir(dir.path()).output().expect("pis-bench runs");
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    for chart in ["rd.svg", "speed.svg", "stability.svg"] {
+        assert!(out_dir.join(chart).is_file(), "{chart} written");
+    }
+}

@@ -262,3 +262,55 @@ fn texture_coordinates_are_placed_per_parameter_block() {
     eprintln!("per block {pb:.2} dB, per object {po:.2} dB");
     assert!(pb > po - 0.5, "per block {pb} dB, per object {po} dB");
 }
+
+/// Multi-object scenes once failed at some ratios ("the smallest encodings need N bytes,
+/// over the budget of M") and at one gave five objects no bytes: every ratio now packs,
+/// and a higher ratio never predicts a better image.
+#[test]
+fn pack_degrades_monotonically_with_the_ratio() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let mut last: Option<(f64, f64)> = None;
+    for ratio in [24.0, 48.0, 96.0, 192.0, 384.0, 768.0, 1536.0] {
+        let file = dir.path().join(format!("r{ratio}.pis"));
+        let r = json(&pack(set(), &file, &["--ratio", &ratio.to_string()]));
+        let psnr = r["psnr_db"].as_f64().expect("psnr_db");
+        if let Some((prev_ratio, prev)) = last {
+            assert!(psnr <= prev, "{ratio}:1 predicts {psnr:.3} dB, above {prev:.3} dB at {prev_ratio}:1");
+        }
+        last = Some((ratio, psnr));
+    }
+}
+
+#[test]
+fn pack_refuses_a_ratio_that_leaves_no_byte_and_names_the_highest() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let file = dir.path().join("out.pis");
+    let out = pack(set(), &file, &["--ratio", "1e9"]);
+    assert_eq!(out.status.code(), Some(1), "{}", String::from_utf8_lossy(&out.stderr));
+    let err = String::from_utf8_lossy(&out.stderr);
+    // 16 points of 64×48 pixels at 3 bytes
+    assert!(err.contains("the highest ratio is 147456:1"), "{err}");
+    assert!(!file.exists(), "no file on error");
+    let out = pack(set(), &file, &["--psnr", "400"]);
+    assert_eq!(out.status.code(), Some(1), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("out of reach: the stored textures reach at most"));
+    assert!(!file.exists(), "no file on error");
+}
+
+/// The bytes pis-pack writes for demo1 at its CI size with the defaults, recorded before
+/// the pack pipeline moved into its library: length and CRC-32 of the file.
+const DEMO1_CI_PACK: (usize, u32) = (161_285, 0x8c44_5ca9);
+
+#[test]
+fn pack_output_is_byte_identical_to_the_recorded_checksum() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let out = Command::new(env!("CARGO_BIN_EXE_pis-trace")).arg(demo1()).args(["-o", "set"]).current_dir(dir.path()).output().expect("pis-trace runs");
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    // Relative paths: the provenance records the input as given.
+    let out = Command::new(env!("CARGO_BIN_EXE_pis-pack")).args(["set", "--scene"]).arg(demo1()).args(["-o", "out.pis"])
+        .current_dir(dir.path()).output().expect("pis-pack runs");
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let bytes = std::fs::read(dir.path().join("out.pis")).expect("the packed file");
+    let got = (bytes.len(), crc32fast::hash(&bytes));
+    assert_eq!(got, DEMO1_CI_PACK, "pis-pack's output changed: {} bytes, CRC-32 {:#010x}", got.0, got.1);
+}

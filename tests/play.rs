@@ -285,3 +285,30 @@ fn fixture_values(file: &Path) -> Vec<String> {
     let reader = pis_format::PisReader::open(file).expect("container");
     reader.container().space.dims.iter().map(|d| d.values[0].to_string()).collect()
 }
+
+/// The one-command tour takes pis-pack's options (and the trace's): other options pack
+/// into a file of their own beside the default one; a .pis file refuses them.
+#[test]
+fn a_scene_is_played_with_the_pack_options_given() {
+    if !gpu_or_skip("a_scene_is_played_with_the_pack_options_given") {
+        return;
+    }
+    let dir = tempfile::tempdir().expect("temp dir");
+    let scene = common::demo1_copy(dir.path(), &[("samples = 4", "samples = 2"), ("spp = 4", "spp = 1")]);
+    let run = |ratio: &str| {
+        let out = play(&[os(&scene), os("--headless"), os("--resolution"), os("48x36"), os("--ratio"), os(ratio), os("--json")]);
+        json(&out);
+        let packs: Vec<PathBuf> = std::fs::read_dir(dir.path().join(".pis-cache")).unwrap()
+            .map(|e| e.unwrap().path()).filter(|p| p.extension().is_some_and(|e| e == "pis")).collect();
+        packs
+    };
+    let packs = run("48");
+    assert_eq!(packs.len(), 1, "{packs:?}");
+    let name = packs[0].file_name().unwrap().to_string_lossy().to_string();
+    assert!(name.starts_with("demo1-48x36-spp1-"), "--resolution traces at 48×36 and other options name the pack: {name}");
+    let reader = pis_format::PisReader::open(&packs[0]).expect("container");
+    assert_eq!(reader.container().provenance.as_ref().map(|p| p.settings.iter().any(|(k, v)| k == "target" && v == "ratio 48")), Some(true), "the pack took --ratio 48");
+    assert_eq!(run("96").len(), 2, "another ratio, another pack");
+    let out = play(&[os(&tiny()), os("--headless"), os("--ratio"), os("96")]);
+    assert_fails(&out, 1, "pack options on a .pis file", "apply to a scene.toml");
+}

@@ -8,6 +8,7 @@ pub mod images;
 pub mod infer;
 pub mod inspect;
 pub mod pack;
+pub mod pack_args;
 pub mod play;
 pub mod reencode;
 pub mod play_window;

@@ -211,6 +211,11 @@ pub fn pack_with(req: &PackRequest, extras: PackExtras) -> Result<PackReport, Fa
         return Err(Failure::new(Exit::Usage, anyhow::anyhow!(why)));
     }
     let set = input::load(req, &mut stages)?;
+    // A ratio is checked before any work: it must leave the level images a byte.
+    let raw = set.raw_image_bytes();
+    if let Some(r) = req.ratio.filter(|r| raw as f64 / r < 1.0) {
+        return Err(Failure::new(Exit::Usage, anyhow::anyhow!("--ratio {r} leaves no byte for the level images of this set (raw images {raw} bytes): the highest ratio is {raw}:1")));
+    }
     let mut matrices = matrices::Matrices::open(req.matrix, req.filter)?;
     let inferred = infer_layers::infer_all(&set, req, &mut matrices, &mut stages).map_err(|e| Failure::new(Exit::Runtime, e))?;
     let probe_renderings = matrices.renderings();

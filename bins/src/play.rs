@@ -8,19 +8,26 @@ use std::path::{Path, PathBuf};
 
 use crate::cli::{Exit, Failure};
 pub use args::PlayArgs;
+use crate::pack_args::PackOptions;
 
 /// Whether a path names a scene (scene.toml) rather than a container.
 fn is_scene(path: &Path) -> bool {
     path.extension().is_some_and(|e| e.eq_ignore_ascii_case("toml"))
 }
 
-/// Traces (when not cached) and packs a scene.toml with pis-pack's defaults; returns the
+/// Traces (when not cached) and packs a scene.toml with `options` (pis-pack's); returns the
 /// container, kept in `.pis-cache/` beside the scene and reused while it is newer than the
-/// scene.toml.
-fn pack_scene(scene_toml: &Path) -> Result<PathBuf, Failure> {
-    let scene = pis_scene::load(scene_toml, None).map_err(|e| Failure::new(Exit::Invalid, e))?;
+/// scene.toml. Options other than the defaults pack into a file of their own, named by a
+/// hash of the options.
+fn pack_scene(scene_toml: &Path, options: &PackOptions) -> Result<PathBuf, Failure> {
+    let load = pis_scene::LoadOptions { preset: options.preset.clone(), resolution: options.resolution, spp: options.spp };
+    let scene = pis_scene::load_with(scene_toml, &load).map_err(|e| Failure::new(Exit::Invalid, e))?;
     let set_dir = crate::pack::cache_dir(scene_toml, &scene);
     let mut name = set_dir.file_name().map(|n| n.to_os_string()).unwrap_or_default();
+    let fingerprint = options.fingerprint();
+    if fingerprint != PackOptions::defaults().fingerprint() {
+        name.push(format!("-{:016x}", fnv1a(fingerprint.as_bytes())));
+    }
     name.push(".pis");
     let output = set_dir.with_file_name(name);
     let modified = |p: &Path| std::fs::metadata(p).and_then(|m| m.modified()).ok();
@@ -31,31 +38,16 @@ fn pack_scene(scene_toml: &Path) -> Result<PathBuf, Failure> {
         }
     }
     std::fs::create_dir_all(set_dir.parent().unwrap_or(Path::new("."))).map_err(|e| Failure::new(Exit::Io, anyhow::anyhow!("{}: {e}", set_dir.display())))?;
-    eprintln!("pis-play: tracing and packing {} into {} (once; pis-pack's defaults)", scene_toml.display(), output.display());
-    let req = crate::pack::PackRequest {
-        input: scene_toml.to_path_buf(),
-        scene: None,
-        output: output.clone(),
-        ratio: None,
-        psnr: None,
-        codec: pis_codec::CodecId::Wavelet,
-        block: vec![8],
-        filter: pis_compile::Filter::Trilinear,
-        matrix: crate::pack::MatrixSource::Model,
-        max_texture: crate::pack::DEFAULT_MAX_TEXTURE,
-        texels_per_pixel: crate::pack::DEFAULT_TEXELS_PER_PIXEL,
-        gamma: 2.2,
-        resolution: None,
-        spp: None,
-        pyramid: crate::pack::PyramidMode::Adaptive,
-        layers: crate::pack::LayerMode::Separate,
-        max_iterations: None,
-        allocation: crate::pack::Allocation::Screen, placement: crate::pack::PlacementMode::Block,
-        preset: None,
-    };
-    let report = crate::pack::pack(&req)?;
+    eprintln!("pis-play: tracing and packing {} into {} (once)", scene_toml.display(), output.display());
+    let (req, extras) = options.request(scene_toml.to_path_buf(), None, output.clone())?;
+    let report = crate::pack::pack_with(&req, extras)?;
     crate::pack::print_report(&report, &mut std::io::stderr()).map_err(|e| Failure::new(Exit::Io, e))?;
     Ok(output)
+}
+
+/// 64-bit FNV-1a: a stable name for a set of options.
+fn fnv1a(bytes: &[u8]) -> u64 {
+    bytes.iter().fold(0xcbf2_9ce4_8422_2325u64, |h, &b| (h ^ b as u64).wrapping_mul(0x0100_0000_01b3))
 }
 
 /// Whether a display server is reachable through the environment (X11 or Wayland).
@@ -72,8 +64,10 @@ pub fn run(args: &PlayArgs) -> Result<Exit, Failure> {
         // The one-command tour: play along the diagonal unless a point or path is given.
         let tour = args.path.is_none() && args.at.is_none() && args.compare.is_none();
         let path = if tour { Some(args::PathChoice::Diagonal) } else { args.path.clone() };
-        packed = PlayArgs { file: pack_scene(&args.file)?, path, ..args.clone() };
+        packed = PlayArgs { file: pack_scene(&args.file, &args.pack)?, path, ..args.clone() };
         &packed
+    } else if args.pack.fingerprint() != PackOptions::defaults().fingerprint() {
+        return Err(Failure::new(Exit::Usage, anyhow::anyhow!("{}: pis-pack's options (--ratio, --codec, --preset, …) apply to a scene.toml; a .pis file plays as it was packed (pis-reencode codes it again)", args.file.display())));
     } else {
         args
     };

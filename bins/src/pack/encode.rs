@@ -355,7 +355,7 @@ pub(crate) fn encode_all(set: &LoadedSet, models: &[ObjectModel], req: &PackRequ
         (r, None) => Target::Bytes((raw as f64 / r.unwrap_or(super::DEFAULT_RATIO)) as usize),
     };
     let areas: Vec<f64> = models.iter().map(|m| m.area).collect();
-    let storage = allocate_storage(&pyramids, req.codec, target, &areas).map_err(runtime)?;
+    let storage = allocate_storage(&pyramids, req.codec, target, &areas).map_err(|e| target_failure(e, raw))?;
     if let Some(total) = storage.allocated {
         stages.done("allocate", &format!("{total} bytes over {} level images", storage.level_images));
     }
@@ -594,5 +594,21 @@ mod tests {
         // a sample no point shows weighs nothing anywhere
         assert_eq!(sample_weights(&[vec![0.0; 3]]), vec![0.0; 3]);
         assert!(sample_weights(&[]).is_empty());
+    }
+}
+
+/// An allocation that cannot meet its target says which target to ask for instead
+/// (exit 1: the request, not the input, is at fault); other failures are runtime errors.
+fn target_failure(e: anyhow::Error, raw: u64) -> Failure {
+    use pis_codec::allocate::AllocError;
+    match e.downcast_ref::<AllocError>() {
+        Some(AllocError::Budget { needed, budget }) => Failure::new(Exit::Usage, anyhow!(
+            "the ratio leaves {budget} bytes for the level images, but their smallest encodings need {needed}: the highest ratio this set reaches is {:.1}:1 (raw images {raw} bytes)",
+            raw as f64 / (*needed).max(1) as f64
+        )),
+        Some(AllocError::Unreachable { db, best_db }) => Failure::new(Exit::Usage, anyhow!(
+            "--psnr {db} dB is out of reach: the stored textures reach at most {best_db:.2} dB (coding PSNR at the codec's full rate); ask for at most that, or use --codec lossless"
+        )),
+        _ => Failure::new(Exit::Runtime, e),
     }
 }

@@ -74,8 +74,9 @@ fn parse_reduction(s: &str) -> Result<u32, String> {
 /// `--screenshot` saves the last one.
 ///
 /// Given a scene.toml instead of a .pis file, the whole job runs first: the scene is traced
-/// (once, into `.pis-cache/` beside it) and packed with pis-pack's defaults into
-/// `.pis-cache/NAME-WxH-sppN.pis`, reused while it is newer than the scene.toml; without
+/// (once, into `.pis-cache/` beside it) and packed with pis-pack's options (its defaults
+/// unless given) into `.pis-cache/NAME-WxH-sppN.pis` (`…-sppN-HASH.pis` for other pack
+/// options), reused while it is newer than the scene.toml; without
 /// `--at`, `--path` or `--compare` it then plays along the diagonal (`--path diagonal`).
 #[derive(Parser, Debug, Clone)]
 #[command(name = "pis-play", version, about, after_help = crate::cli::EXIT_CODES_HELP)]
@@ -151,6 +152,10 @@ pub struct PlayArgs {
     /// Window mode: do not wait for the display refresh between frames (to measure speed).
     #[arg(long)]
     pub no_vsync: bool,
+    /// Given a scene.toml: how it is traced and packed (pis-pack's options; a .pis file is
+    /// played as it is).
+    #[command(flatten, next_help_heading = "Tracing and packing a scene.toml (pis-pack's options)")]
+    pub pack: crate::pack_args::PackOptions,
 }
 
 impl PlayArgs {

@@ -68,8 +68,8 @@ pub enum AllocError {
     },
     #[error("the smallest encodings need {needed} bytes, over the budget of {budget}")]
     Budget { needed: usize, budget: usize },
-    #[error("PSNR {0} dB is out of reach of the curves")]
-    Unreachable(f64),
+    #[error("PSNR {db} dB is out of reach: every level image at its full rate gives {best_db:.2} dB")]
+    Unreachable { db: f64, best_db: f64 },
 }
 
 /// Lower convex hull of a curve: points with increasing bytes and decreasing MSE whose
@@ -101,18 +101,23 @@ struct Problem {
     gain: Vec<f64>,
 }
 
+/// Bisection steps on a slope or an error limit: far below f64 resolution where it matters.
+const BISECTIONS: usize = 100;
+
 impl Problem {
-    /// Point index per item minimising `gain · D + λ · R`.
-    fn choose(&self, lambda: f64, active: &[bool]) -> Vec<usize> {
+    /// Point index per item minimising `gain · D + λ · R`, never below `floor` (on a convex
+    /// hull the walk from the floor ends where the free walk would, or at the floor).
+    /// Items not `active` stay at their floor.
+    fn choose(&self, lambda: f64, active: &[bool], floor: &[usize]) -> Vec<usize> {
         self.hulls
             .iter()
             .zip(&self.gain)
-            .zip(active)
-            .map(|((h, &g), &on)| {
+            .zip(active.iter().zip(floor))
+            .map(|((h, &g), (&on, &f))| {
+                let mut k = f;
                 if !on {
-                    return 0;
+                    return k;
                 }
-                let mut k = 0;
                 while k + 1 < h.len() {
                     let dd = (h[k].mse - h[k + 1].mse) * g;
                     let dr = (h[k + 1].bytes - h[k].bytes) as f64;
@@ -154,13 +159,9 @@ impl Problem {
         }
     }
 
-    /// The allocation meeting `target`.
-    fn solve(
-        &self,
-        target: Target,
-        areas: &[f64],
-        items: &[Item],
-    ) -> Result<Vec<usize>, AllocError> {
+    /// The allocation meeting `target` with every item at or above its `floor`;
+    /// `Budget` when the floors alone do not fit a byte budget.
+    fn solve(&self, target: Target, areas: &[f64], items: &[Item], floor: &[usize]) -> Result<Vec<usize>, AllocError> {
         let all = vec![true; self.hulls.len()];
         let max_slope = self
             .hulls
@@ -176,38 +177,39 @@ impl Problem {
         let (mut lo, mut hi) = (0.0f64, max_slope * 2.0 + 1e-300);
         match target {
             Target::Bytes(budget) => {
-                let cheapest = self.choose(hi, &all);
-                let needed = self.bytes(&cheapest);
+                let needed = self.bytes(floor);
                 if needed > budget {
                     return Err(AllocError::Budget { needed, budget });
                 }
-                for _ in 0..200 {
+                for _ in 0..BISECTIONS {
                     let mid = 0.5 * (lo + hi);
-                    if self.bytes(&self.choose(mid, &all)) <= budget {
+                    if self.bytes(&self.choose(mid, &all, floor)) <= budget {
                         hi = mid;
                     } else {
                         lo = mid;
                     }
                 }
-                let mut pick = self.choose(hi, &all);
+                let mut pick = self.choose(hi, &all, floor);
                 self.fill(&mut pick, budget);
                 Ok(pick)
             }
             Target::Psnr { db, peak } => {
                 let goal = peak * peak / 10f64.powf(db / 10.0);
                 let screen = |pick: &[usize]| screen_mse(&self.mses(pick), items, areas).1;
-                if screen(&self.choose(0.0, &all)) > goal {
-                    return Err(AllocError::Unreachable(db));
+                let best = screen(&self.choose(0.0, &all, floor));
+                if best > goal {
+                    let best_db = 10.0 * (peak * peak / best).log10();
+                    return Err(AllocError::Unreachable { db, best_db });
                 }
-                for _ in 0..200 {
+                for _ in 0..BISECTIONS {
                     let mid = 0.5 * (lo + hi);
-                    if screen(&self.choose(mid, &all)) <= goal {
+                    if screen(&self.choose(mid, &all, floor)) <= goal {
                         lo = mid;
                     } else {
                         hi = mid;
                     }
                 }
-                Ok(self.choose(lo, &all))
+                Ok(self.choose(lo, &all, floor))
             }
         }
     }
@@ -218,6 +220,52 @@ impl Problem {
             .zip(pick)
             .map(|(h, &k)| h[k].mse)
             .collect()
+    }
+
+    /// The floors that make every object's MSE at most `limit` with the fewest bytes: per
+    /// object the cheapest equal-slope allocation of its items that meets the limit. An
+    /// object that meets it with nothing, or cannot meet it at all, gets no floor; the
+    /// second vector marks the objects that cannot.
+    fn floors(&self, items: &[Item], objects: usize, limit: f64) -> (Vec<usize>, Vec<bool>) {
+        let none = vec![0usize; items.len()];
+        let mut floor = none.clone();
+        let mut beyond = vec![false; objects];
+        for o in 0..objects {
+            let mine: Vec<bool> = items.iter().map(|it| it.object == o).collect();
+            let object_mse = |p: &[usize]| -> f64 {
+                items
+                    .iter()
+                    .enumerate()
+                    .filter(|(i, _)| mine[*i])
+                    .map(|(i, it)| it.weight * self.hulls[i][p[i]].mse)
+                    .sum()
+            };
+            let (mut lo, mut hi) = (0.0f64, 1.0f64);
+            while object_mse(&self.choose(hi, &mine, &none)) <= limit && hi < 1e300 {
+                hi *= 16.0;
+            }
+            if object_mse(&self.choose(0.0, &mine, &none)) > limit {
+                beyond[o] = true;
+                continue;
+            }
+            if object_mse(&self.choose(hi, &mine, &none)) <= limit {
+                continue;
+            }
+            for _ in 0..BISECTIONS {
+                let mid = 0.5 * (lo + hi);
+                if object_mse(&self.choose(mid, &mine, &none)) <= limit {
+                    lo = mid;
+                } else {
+                    hi = mid;
+                }
+            }
+            for (i, k) in self.choose(lo, &mine, &none).into_iter().enumerate() {
+                if mine[i] {
+                    floor[i] = k;
+                }
+            }
+        }
+        (floor, beyond)
     }
 }
 
@@ -231,8 +279,22 @@ fn screen_mse(mses: &[f64], items: &[Item], areas: &[f64]) -> (Vec<f64>, f64) {
     (obj, if area > 0.0 { s / area } else { 0.0 })
 }
 
+/// Steps of the search for the tightest consistent error limit (log-spaced bisection).
+const LIMIT_STEPS: usize = 40;
+
 /// Equal-slope allocation of `items` over objects with screen `areas`, meeting `target`,
-/// with the two-pass max-MSE constraint when `alpha` is given (thesis: 1.25).
+/// with the max-MSE constraint when `alpha` is given (thesis 4.8: 1.25).
+///
+/// The constraint (thesis 4.8): no object's MSE above a limit `L`, `alpha` times the mean
+/// object MSE `Ē` of the free allocation. The free allocation is kept when it meets it.
+/// Otherwise every object is given a floor, the cheapest allocation that holds its MSE
+/// under `L` (an object that cannot get there at any rate keeps its whole curve), and the
+/// allocation is solved again above the floors, taking storage from the objects with low
+/// MSE. When the floors do not fit the budget, or fit only by pushing other objects above
+/// `L`, the limit is raised to the smallest one (found by bisection) whose result keeps
+/// every object under it; the free allocation's largest MSE always does. So every budget
+/// the curves reach gives an allocation, and the constraint never leaves an object worse
+/// than the free allocation's worst.
 pub fn allocate(
     items: &[Item],
     areas: &[f64],
@@ -251,58 +313,18 @@ pub fn allocate(
             });
         }
     }
-    let mut problem = Problem {
+    let problem = Problem {
         hulls: items.iter().map(|it| convex_hull(&it.curve)).collect(),
         gain: items
             .iter()
             .map(|it| areas[it.object] * it.weight)
             .collect(),
     };
-    let mut pick = problem.solve(target, areas, items)?;
+    let no_floor = vec![0usize; items.len()];
+    let mut pick = problem.solve(target, areas, items, &no_floor)?;
     if let Some(alpha) = alpha {
-        let (obj, _) = screen_mse(&problem.mses(&pick), items, areas);
-        let mean = obj.iter().sum::<f64>() / obj.len().max(1) as f64;
-        let limit = alpha * mean;
-        let mut changed = false;
-        for (o, &e) in obj.iter().enumerate() {
-            if e <= limit {
-                continue;
-            }
-            // The cheapest allocation of this object's items that meets the limit.
-            let mine: Vec<bool> = items.iter().map(|it| it.object == o).collect();
-            let object_mse = |p: &[usize]| -> f64 {
-                items
-                    .iter()
-                    .enumerate()
-                    .filter(|(i, _)| mine[*i])
-                    .map(|(i, it)| it.weight * problem.hulls[i][p[i]].mse)
-                    .sum()
-            };
-            let (mut lo, mut hi) = (0.0f64, 1.0f64);
-            while object_mse(&problem.choose(hi, &mine)) <= limit && hi < 1e300 {
-                hi *= 16.0;
-            }
-            if object_mse(&problem.choose(0.0, &mine)) > limit {
-                continue; // its curves cannot reach the limit: keep them whole
-            }
-            for _ in 0..200 {
-                let mid = 0.5 * (lo + hi);
-                if object_mse(&problem.choose(mid, &mine)) <= limit {
-                    lo = mid;
-                } else {
-                    hi = mid;
-                }
-            }
-            let floor = problem.choose(lo, &mine);
-            for (i, on) in mine.iter().enumerate() {
-                if *on {
-                    problem.hulls[i].drain(..floor[i]);
-                    changed = true;
-                }
-            }
-        }
-        if changed {
-            pick = problem.solve(target, areas, items)?;
+        if let Some(balanced) = balance(&problem, items, areas, target, alpha, &pick) {
+            pick = balanced;
         }
     }
     let mse = problem.mses(&pick);
@@ -320,6 +342,60 @@ pub fn allocate(
         object_mse,
         screen_mse: screen,
     })
+}
+
+/// The objects that hold any item: objects without level images have no MSE to balance.
+fn present(items: &[Item], objects: usize) -> Vec<bool> {
+    let mut p = vec![false; objects];
+    items.iter().for_each(|it| p[it.object] = true);
+    p
+}
+
+/// Largest object MSE and `alpha` times the mean, over the objects that hold items.
+fn spread(obj: &[f64], present: &[bool], alpha: f64) -> (f64, f64) {
+    let (mut max, mut sum, mut n) = (0.0f64, 0.0f64, 0usize);
+    for (e, _) in obj.iter().zip(present).filter(|(_, p)| **p) {
+        max = max.max(*e);
+        sum += e;
+        n += 1;
+    }
+    (max, alpha * sum / n.max(1) as f64)
+}
+
+/// The max-MSE constrained allocation (see [`allocate`]), or `None` when the free one
+/// `free` already meets the constraint.
+fn balance(problem: &Problem, items: &[Item], areas: &[f64], target: Target, alpha: f64, free: &[usize]) -> Option<Vec<usize>> {
+    let present = present(items, areas.len());
+    let (max, bound) = spread(&screen_mse(&problem.mses(free), items, areas).0, &present, alpha);
+    if max <= bound * (1.0 + 1e-9) || bound <= 0.0 {
+        return None;
+    }
+    // A limit holds when its floors fit and no object that can meet it ends above it.
+    let attempt = |limit: f64| -> Option<Vec<usize>> {
+        let (floor, beyond) = problem.floors(items, areas.len(), limit);
+        let pick = problem.solve(target, areas, items, &floor).ok()?;
+        let obj = screen_mse(&problem.mses(&pick), items, areas).0;
+        let holds = obj.iter().zip(&beyond).zip(&present).all(|((&e, &out), &p)| out || !p || e <= limit * (1.0 + 1e-9));
+        holds.then_some(pick)
+    };
+    // The thesis's two passes.
+    if let Some(pick) = attempt(bound) {
+        return Some(pick);
+    }
+    // Else the smallest limit above it that holds.
+    let (mut lo, mut hi) = (bound.ln(), max.ln());
+    let mut best = attempt(max)?;
+    for _ in 0..LIMIT_STEPS {
+        let mid = 0.5 * (lo + hi);
+        match attempt(mid.exp()) {
+            Some(pick) => {
+                best = pick;
+                hi = mid;
+            }
+            None => lo = mid,
+        }
+    }
+    Some(best)
 }
 
 #[cfg(test)]
@@ -406,6 +482,70 @@ mod tests {
         assert!(a.screen_mse >= free.screen_mse);
     }
 
+    /// One object on a small screen area with a costly curve, one cheap: the free
+    /// allocation leaves the costly one far above the mean, and at small budgets the
+    /// thesis's floor for it does not fit.
+    fn lopsided() -> (Vec<Item>, Vec<f64>) {
+        let items = vec![
+            Item { curve: curve(50.0, 3000.0), object: 0, weight: 1.0 },
+            Item { curve: curve(0.5, 200.0), object: 1, weight: 1.0 },
+            Item { curve: curve(0.2, 100.0), object: 2, weight: 1.0 },
+        ];
+        (items, vec![1.0, 500.0, 400.0])
+    }
+
+    #[test]
+    fn a_budget_below_the_max_mse_floors_still_allocates() {
+        let (items, areas) = lopsided();
+        for budget in [0, 8, 40, 200, 600] {
+            let a = allocate(&items, &areas, Target::Bytes(budget), Some(DEFAULT_ALPHA))
+                .unwrap_or_else(|e| panic!("budget {budget}: {e}"));
+            assert!(a.total_bytes <= budget, "{} > {budget}", a.total_bytes);
+        }
+    }
+
+    #[test]
+    fn the_max_mse_floors_never_starve_the_other_objects() {
+        // At every budget: the constraint never leaves any object above the free
+        // allocation's worst, and the limit it settles on is met by every object.
+        let (items, areas) = lopsided();
+        for budget in (0..=3200).step_by(160) {
+            let a = allocate(&items, &areas, Target::Bytes(budget), Some(DEFAULT_ALPHA)).unwrap();
+            let free = allocate(&items, &areas, Target::Bytes(budget), None).unwrap();
+            let worst = |v: &[f64]| v.iter().cloned().fold(0.0, f64::max);
+            assert!(
+                worst(&a.object_mse) <= worst(&free.object_mse) * (1.0 + 1e-9),
+                "budget {budget}: {:?} against free {:?}",
+                a.object_mse,
+                free.object_mse
+            );
+            let mean = free.object_mse.iter().sum::<f64>() / 3.0;
+            // object 0 is the worst; where its whole curve can meet the limit, it gets it
+            let reachable = items[0].curve.points.last().unwrap().mse <= 1.25 * mean;
+            if worst(&free.object_mse) > 1.25 * mean && reachable && budget > 0 {
+                assert!(worst(&a.object_mse) < worst(&free.object_mse), "budget {budget}: the constraint did nothing");
+            }
+        }
+    }
+
+    #[test]
+    fn a_smaller_budget_never_gives_a_better_allocation() {
+        for (items, areas) in [items(), lopsided()] {
+            let mut last = 0.0f64;
+            for budget in (0..=4000).rev().step_by(37) {
+                let a = allocate(&items, &areas, Target::Bytes(budget), Some(DEFAULT_ALPHA)).unwrap();
+                let free = allocate(&items, &areas, Target::Bytes(budget), None).unwrap();
+                assert!(a.screen_mse >= free.screen_mse * (1.0 - 1e-12));
+                assert!(
+                    a.screen_mse >= last * (1.0 - 1e-9),
+                    "budget {budget}: screen MSE {} below {last} of a larger budget",
+                    a.screen_mse
+                );
+                last = a.screen_mse;
+            }
+        }
+    }
+
     #[test]
     fn psnr_target_is_met_with_fewer_bytes_for_less_quality() {
         let (items, areas) = items();
@@ -441,7 +581,7 @@ mod tests {
                 },
                 None
             ),
-            Err(AllocError::Unreachable(_))
+            Err(AllocError::Unreachable { .. })
         ));
     }
 

@@ -1,0 +1,236 @@
+//! The options of a pack, shared by `pis-pack` and by `pis-play` given a scene.toml: what
+//! to aim at (ratio or PSNR), how to code, infer and place textures, and how to trace a
+//! scene.toml first.
+
+use std::path::PathBuf;
+
+use clap::Args;
+use pis_codec::CodecId;
+use pis_compile::{Filter, MAX_ANISOTROPY};
+
+use crate::cli::{Exit, Failure};
+use crate::pack::{filter_needs_probe, Allocation, LayerMode, MatrixSource, PackExtras, PackRequest, PlacementMode, PyramidMode};
+
+/// pis-pack's settings on the command line.
+#[derive(Args, Debug, Clone)]
+pub struct PackOptions {
+    /// Target compression ratio: level-image bytes = raw image bytes / R (default 384);
+    /// geometry and tables come on top (the report gives both ratios).
+    #[arg(long, conflicts_with = "psnr")]
+    pub ratio: Option<f64>,
+    /// Target PSNR in dB instead of a ratio: the coding PSNR of the stored (gamma-compensated)
+    /// textures, screen-area weighted; the predicted screen PSNR is also bounded by inference.
+    #[arg(long)]
+    pub psnr: Option<f64>,
+    /// Level-image codec: wavelet, dct or lossless.
+    #[arg(long, default_value = "wavelet", value_parser = parse_codec)]
+    pub codec: CodecId,
+    /// Samples per parameter block: one size for every dimension (8) or one per dimension (8x8).
+    #[arg(long, default_value = "8", value_parser = parse_block)]
+    pub block: BlockSizes,
+    /// Texture filtering the player uses: trilinear, bilinear, or anisotropic (trilinear lookups
+    /// along the footprint's major axis, as the adapter's sampler takes them; needs
+    /// `--matrix probe`, since no specification pins the footprint down).
+    #[arg(long, default_value = "trilinear", value_parser = parse_filter)]
+    pub filter: Filter,
+    /// Anisotropic filtering: the sampler's anisotropy clamp, 1 to 16 (the most lookups per
+    /// pixel; an adapter may ignore it: Mesa 22.3's lavapipe filters the same for any clamp
+    /// above 1). Default 16; only with `--filter anisotropic`.
+    #[arg(long, value_parser = clap::value_parser!(u8).range(1..=MAX_ANISOTROPY as i64))]
+    pub anisotropy: Option<u8>,
+    /// Render matrix source: `model` (pis-compile's hardware model, computed in software) or
+    /// `probe` (measured through the player's wgpu pipeline on this machine's GPU adapter with
+    /// texel-identifier renderings, thesis 3.4.3: slower, but exact for whatever the adapter
+    /// does; needs an adapter, Mesa's lavapipe without a GPU).
+    #[arg(long, default_value = "model", value_parser = parse_matrix)]
+    pub matrix: MatrixSource,
+    /// Largest used texture side.
+    #[arg(long, default_value_t = crate::pack::DEFAULT_MAX_TEXTURE)]
+    pub max_texture: u32,
+    /// Texel budget: at most K level-0 texels per pixel an object covers in its most covered
+    /// view; an object's texture over budget is reduced uniformly (thesis 3.2's per-object
+    /// reduction factor, chosen automatically). `none`: the optimal resolution, capped by
+    /// --max-texture only.
+    #[arg(long, default_value = "1", value_parser = parse_budget)]
+    pub texels_per_pixel: Budget,
+    /// Display gamma of the compensation (1: linear storage; lossless packs always use 1).
+    #[arg(long, default_value_t = 2.2)]
+    pub gamma: f32,
+    /// Tracing a scene.toml: image size WIDTHxHEIGHT.
+    #[arg(long, value_parser = parse_resolution)]
+    pub resolution: Option<(u32, u32)>,
+    /// Tracing a scene.toml: camera samples per pixel.
+    #[arg(long)]
+    pub spp: Option<u32>,
+    /// Tracing a scene.toml: a `[preset.NAME]` of the scene (e.g. `paper`), applied before
+    /// --resolution and --spp; with a set, the preset its scene is read with.
+    #[arg(long, value_name = "NAME")]
+    pub preset: Option<String>,
+    /// Pyramid levels per block: `adaptive` (greedy search, thesis 4.3) or `full` (every
+    /// dimension halved per level down to one sample).
+    #[arg(long, default_value = "adaptive", value_parser = parse_pyramid)]
+    pub pyramid: PyramidMode,
+    /// Lighting layers: `separate` (view-independent diffuse + view-dependent specular) or
+    /// `combined` (one view-dependent layer of diffuse + specular per parameter sample).
+    #[arg(long, default_value = "separate", value_parser = parse_layers)]
+    pub layers: LayerMode,
+    /// Conjugate-gradient iteration cap per colour channel of every texture solve
+    /// (default: the solver's own).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
+    pub max_iterations: Option<u32>,
+    /// What the storage allocation minimizes: `screen` (texture error weighted per texel by
+    /// the screen pixels it reaches through the render matrices) or `texture` (texture MSE
+    /// weighted by each object's screen area).
+    #[arg(long, default_value = "screen", value_parser = parse_allocation)]
+    pub allocation: Allocation,
+    /// Which views each texture placement (branch cuts, affine map, used size; thesis 3.2)
+    /// is optimized over: `block` (per object per parameter block, the views of the
+    /// block's samples) or `object` (one placement per object over every view of the set).
+    #[arg(long, default_value = "block", value_parser = parse_placement)]
+    pub placement: PlacementMode,
+    /// Also store the lossless master: every solved texture, before gamma compensation and
+    /// coding, losslessly coded in MSTR chunks a player never reads. pis-reencode codes
+    /// again from it (as a direct pack at the new settings would) instead of from the decoded
+    /// textures. The ratio does not count it; the report gives its bytes.
+    #[arg(long)]
+    pub keep_master: bool,
+}
+
+impl PackOptions {
+    /// The request that packs `input` into `output` with these options.
+    pub fn request(&self, input: PathBuf, scene: Option<PathBuf>, output: PathBuf) -> Result<(PackRequest, PackExtras), Failure> {
+        let filter = match (self.filter, self.anisotropy) {
+            (Filter::Anisotropic(_), n) => Filter::Anisotropic(n.unwrap_or(MAX_ANISOTROPY)),
+            (f, None) => f,
+            (f, Some(_)) => return Err(Failure::new(Exit::Usage, anyhow::anyhow!("--anisotropy applies to --filter anisotropic, not {}", f.name()))),
+        };
+        if let Some(why) = filter_needs_probe(filter, self.matrix) {
+            return Err(Failure::new(Exit::Usage, anyhow::anyhow!(why)));
+        }
+        let req = PackRequest {
+            input,
+            scene,
+            output,
+            ratio: self.ratio,
+            psnr: self.psnr,
+            codec: self.codec,
+            block: self.block.0.clone(),
+            filter,
+            matrix: self.matrix,
+            max_texture: self.max_texture,
+            texels_per_pixel: self.texels_per_pixel.0,
+            gamma: if self.codec == CodecId::Lossless { 1.0 } else { self.gamma },
+            resolution: self.resolution,
+            spp: self.spp,
+            pyramid: self.pyramid,
+            layers: self.layers,
+            max_iterations: self.max_iterations,
+            allocation: self.allocation,
+            placement: self.placement,
+            preset: self.preset.clone(),
+        };
+        Ok((req, PackExtras { keep_master: self.keep_master }))
+    }
+
+    /// The options as written, for telling packs apart (`Debug` of every field).
+    pub fn fingerprint(&self) -> String {
+        format!("{self:?}")
+    }
+
+    /// pis-pack's defaults.
+    pub fn defaults() -> Self {
+        #[derive(clap::Parser)]
+        struct Only {
+            #[command(flatten)]
+            pack: PackOptions,
+        }
+        <Only as clap::Parser>::parse_from(["pis-pack"]).pack
+    }
+}
+
+fn parse_codec(s: &str) -> Result<CodecId, String> {
+    match s {
+        "wavelet" => Ok(CodecId::Wavelet),
+        "dct" => Ok(CodecId::Dct),
+        "lossless" => Ok(CodecId::Lossless),
+        _ => Err(format!("unknown codec {s:?} (wavelet, dct or lossless)")),
+    }
+}
+
+fn parse_pyramid(s: &str) -> Result<PyramidMode, String> {
+    match s {
+        "adaptive" => Ok(PyramidMode::Adaptive),
+        "full" => Ok(PyramidMode::Full),
+        _ => Err(format!("unknown pyramid {s:?} (adaptive or full)")),
+    }
+}
+
+fn parse_layers(s: &str) -> Result<LayerMode, String> {
+    match s {
+        "separate" => Ok(LayerMode::Separate),
+        "combined" => Ok(LayerMode::Combined),
+        _ => Err(format!("unknown layers {s:?} (separate or combined)")),
+    }
+}
+
+fn parse_placement(s: &str) -> Result<PlacementMode, String> {
+    match s {
+        "block" => Ok(PlacementMode::Block),
+        "object" => Ok(PlacementMode::Object),
+        _ => Err(format!("unknown placement {s:?} (block or object)")),
+    }
+}
+
+fn parse_allocation(s: &str) -> Result<Allocation, String> {
+    match s {
+        "screen" => Ok(Allocation::Screen),
+        "texture" => Ok(Allocation::Texture),
+        _ => Err(format!("unknown allocation {s:?} (screen or texture)")),
+    }
+}
+
+fn parse_filter(s: &str) -> Result<Filter, String> {
+    match s {
+        "trilinear" => Ok(Filter::Trilinear),
+        "bilinear" => Ok(Filter::Bilinear),
+        // The clamp comes from --anisotropy.
+        "anisotropic" => Ok(Filter::Anisotropic(MAX_ANISOTROPY)),
+        _ => Err(format!("unknown filter {s:?} (trilinear, bilinear or anisotropic)")),
+    }
+}
+
+fn parse_matrix(s: &str) -> Result<MatrixSource, String> {
+    match s {
+        "model" => Ok(MatrixSource::Model),
+        "probe" => Ok(MatrixSource::Probe),
+        _ => Err(format!("unknown render matrix source {s:?} (model or probe)")),
+    }
+}
+
+/// `--texels-per-pixel`: a positive number or `none`.
+#[derive(Clone, Copy, Debug)]
+pub struct Budget(pub Option<f64>);
+
+fn parse_budget(s: &str) -> Result<Budget, String> {
+    if s == "none" {
+        return Ok(Budget(None));
+    }
+    s.parse::<f64>().ok().filter(|k| k.is_finite() && *k > 0.0).map(|k| Budget(Some(k)))
+        .ok_or_else(|| format!("--texels-per-pixel {s:?}: expected a number > 0 or `none`"))
+}
+
+/// `--block`: one size, or one per dimension.
+#[derive(Clone, Debug)]
+pub struct BlockSizes(pub Vec<u32>);
+
+fn parse_block(s: &str) -> Result<BlockSizes, String> {
+    crate::pack::parse_sizes(s).map(BlockSizes)
+}
+
+pub fn parse_resolution(s: &str) -> Result<(u32, u32), String> {
+    match crate::pack::parse_sizes(s)?.as_slice() {
+        [w, h] => Ok((*w, *h)),
+        _ => Err(format!("expected WIDTHxHEIGHT, got {s:?}")),
+    }
+}
+
