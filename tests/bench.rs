@@ -96,9 +96,17 @@ fn infer_reads_a_ray_traced_set() {
         .output()
         .expect("pis-trace runs");
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
-    // without --scene the set directory must hold scene.toml
+    // without --scene: the scene.toml set.json records
+    let out = bench(&["infer", set.to_str().unwrap(), "--object", "Walls", "--no-wgpu"]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    // a set that records no scene, without scene.toml inside: exit 4, naming --scene
+    let json = set.join("set.json");
+    let mut meta: serde_json::Value = serde_json::from_slice(&std::fs::read(&json).unwrap()).unwrap();
+    assert!(meta.as_object_mut().unwrap().remove("scene_file").is_some(), "pis-trace records the scene");
+    std::fs::write(&json, serde_json::to_vec(&meta).unwrap()).unwrap();
     let out = bench(&["infer", set.to_str().unwrap(), "--no-wgpu"]);
     assert_eq!(out.status.code(), Some(4));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("pass --scene"));
     let out = bench(&["infer", set.to_str().unwrap(), "--scene", scene.to_str().unwrap(), "--object", "Walls",
                       "--no-wgpu", "--json"]);
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));

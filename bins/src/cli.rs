@@ -3,62 +3,10 @@
 
 use std::process::ExitCode;
 
-/// The toolchain's exit codes.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Exit {
-    /// Success.
-    Ok = 0,
-    /// Bad arguments.
-    Usage = 1,
-    /// A file could not be read or written.
-    Io = 2,
-    /// An input file is invalid.
-    Invalid = 3,
-    /// Something failed while working.
-    Runtime = 4,
-    /// The input uses something this build does not support.
-    NotSupported = 5,
-    /// Two inputs differ, or a quality gate failed (pis-diff).
-    Different = 7,
-}
-
-impl From<Exit> for ExitCode {
-    fn from(e: Exit) -> Self {
-        ExitCode::from(e as u8)
-    }
-}
+pub use pis_pack::{Exit, Failure};
 
 /// The help text's table of exit codes.
 pub const EXIT_CODES_HELP: &str = "Exit codes: 0 ok, 1 bad arguments, 2 I/O error, 3 invalid file, 4 runtime error, 5 not supported";
-
-/// An error with the exit code it maps to.
-#[derive(Debug)]
-pub struct Failure {
-    pub exit: Exit,
-    pub error: anyhow::Error,
-}
-
-impl Failure {
-    pub fn new(exit: Exit, error: impl Into<anyhow::Error>) -> Self {
-        Failure {
-            exit,
-            error: error.into(),
-        }
-    }
-}
-
-impl From<pis_format::Error> for Failure {
-    fn from(e: pis_format::Error) -> Self {
-        let exit = match &e {
-            pis_format::Error::Io { .. } => Exit::Io,
-            pis_format::Error::Invalid(_) => Exit::Invalid,
-            pis_format::Error::NotSupported(_) => Exit::NotSupported,
-            pis_format::Error::Request(_) => Exit::Usage,
-            pis_format::Error::InvalidModel(_) => Exit::Runtime,
-        };
-        Failure::new(exit, e)
-    }
-}
 
 /// Parses arguments with clap, mapping usage errors to exit code 1 (help and version to 0).
 pub fn parse<T: clap::Parser>() -> Result<T, ExitCode> {

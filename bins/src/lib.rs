@@ -1,14 +1,8 @@
-//! What the PIS command-line tools share: exit codes, error reporting, and the pieces of
-//! each tool that are more than argument parsing.
+//! What the PIS command-line tools share: exit codes and error reporting, the options
+//! several tools take, and the player's window. The work is in the library crates:
+//! pis-pack (pack), pis-eval (reencode, diff, inspect, the headless player, the benchmarks).
 
-pub mod bench;
 pub mod cli;
-pub mod diff;
-pub mod images;
-pub mod infer;
-pub mod inspect;
-pub mod pack;
 pub mod pack_args;
 pub mod play;
-pub mod reencode;
 pub mod play_window;

@@ -9,7 +9,7 @@ use pis_codec::CodecId;
 use pis_compile::{Filter, MAX_ANISOTROPY};
 
 use crate::cli::{Exit, Failure};
-use crate::pack::{filter_needs_probe, Allocation, LayerMode, MatrixSource, PackExtras, PackRequest, PlacementMode, PyramidMode};
+use pis_pack::{filter_needs_probe, Allocation, BlockSize, LayerMode, MatrixSource, PackRequest, PackSettings, PlacementMode, PyramidMode};
 
 /// pis-pack's settings on the command line.
 #[derive(Args, Debug, Clone)]
@@ -45,7 +45,7 @@ pub struct PackOptions {
     #[arg(long, default_value = "model", value_parser = parse_matrix)]
     pub matrix: MatrixSource,
     /// Largest used texture side.
-    #[arg(long, default_value_t = crate::pack::DEFAULT_MAX_TEXTURE)]
+    #[arg(long, default_value_t = pis_pack::DEFAULT_MAX_TEXTURE)]
     pub max_texture: u32,
     /// Texel budget: at most K level-0 texels per pixel an object covers in its most covered
     /// view; an object's texture over budget is reduced uniformly (thesis 3.2's per-object
@@ -98,7 +98,7 @@ pub struct PackOptions {
 
 impl PackOptions {
     /// The request that packs `input` into `output` with these options.
-    pub fn request(&self, input: PathBuf, scene: Option<PathBuf>, output: PathBuf) -> Result<(PackRequest, PackExtras), Failure> {
+    pub fn request(&self, input: PathBuf, scene: Option<PathBuf>, output: PathBuf) -> Result<PackRequest, Failure> {
         let filter = match (self.filter, self.anisotropy) {
             (Filter::Anisotropic(_), n) => Filter::Anisotropic(n.unwrap_or(MAX_ANISOTROPY)),
             (f, None) => f,
@@ -107,29 +107,27 @@ impl PackOptions {
         if let Some(why) = filter_needs_probe(filter, self.matrix) {
             return Err(Failure::new(Exit::Usage, anyhow::anyhow!(why)));
         }
-        let req = PackRequest {
-            input,
-            scene,
-            output,
+        let settings = PackSettings {
             ratio: self.ratio,
             psnr: self.psnr,
             codec: self.codec,
-            block: self.block.0.clone(),
+            block: BlockSize::from_sizes(self.block.0.clone()),
             filter,
             matrix: self.matrix,
             max_texture: self.max_texture,
             texels_per_pixel: self.texels_per_pixel.0,
             gamma: if self.codec == CodecId::Lossless { 1.0 } else { self.gamma },
-            resolution: self.resolution,
-            spp: self.spp,
             pyramid: self.pyramid,
             layers: self.layers,
-            max_iterations: self.max_iterations,
             allocation: self.allocation,
             placement: self.placement,
+            max_iterations: self.max_iterations,
+            keep_master: self.keep_master,
             preset: self.preset.clone(),
+            resolution: self.resolution,
+            spp: self.spp,
         };
-        Ok((req, PackExtras { keep_master: self.keep_master }))
+        Ok(PackRequest { input, scene, output, settings })
     }
 
     /// The options as written, for telling packs apart (`Debug` of every field).
@@ -224,11 +222,11 @@ fn parse_budget(s: &str) -> Result<Budget, String> {
 pub struct BlockSizes(pub Vec<u32>);
 
 fn parse_block(s: &str) -> Result<BlockSizes, String> {
-    crate::pack::parse_sizes(s).map(BlockSizes)
+    pis_pack::parse_sizes(s).map(BlockSizes)
 }
 
 pub fn parse_resolution(s: &str) -> Result<(u32, u32), String> {
-    match crate::pack::parse_sizes(s)?.as_slice() {
+    match pis_pack::parse_sizes(s)?.as_slice() {
         [w, h] => Ok((*w, *h)),
         _ => Err(format!("expected WIDTHxHEIGHT, got {s:?}")),
     }

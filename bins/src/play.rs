@@ -2,7 +2,6 @@
 //! arguments (`args`) are shared with a window mode.
 
 pub mod args;
-pub mod headless;
 
 use std::path::{Path, PathBuf};
 
@@ -22,7 +21,7 @@ fn is_scene(path: &Path) -> bool {
 fn pack_scene(scene_toml: &Path, options: &PackOptions) -> Result<PathBuf, Failure> {
     let load = pis_scene::LoadOptions { preset: options.preset.clone(), resolution: options.resolution, spp: options.spp };
     let scene = pis_scene::load_with(scene_toml, &load).map_err(|e| Failure::new(Exit::Invalid, e))?;
-    let set_dir = crate::pack::cache_dir(scene_toml, &scene);
+    let set_dir = pis_pack::cache_dir(scene_toml, &scene);
     let mut name = set_dir.file_name().map(|n| n.to_os_string()).unwrap_or_default();
     let fingerprint = options.fingerprint();
     if fingerprint != PackOptions::defaults().fingerprint() {
@@ -39,9 +38,9 @@ fn pack_scene(scene_toml: &Path, options: &PackOptions) -> Result<PathBuf, Failu
     }
     std::fs::create_dir_all(set_dir.parent().unwrap_or(Path::new("."))).map_err(|e| Failure::new(Exit::Io, anyhow::anyhow!("{}: {e}", set_dir.display())))?;
     eprintln!("pis-play: tracing and packing {} into {} (once)", scene_toml.display(), output.display());
-    let (req, extras) = options.request(scene_toml.to_path_buf(), None, output.clone())?;
-    let report = crate::pack::pack_with(&req, extras)?;
-    crate::pack::print_report(&report, &mut std::io::stderr()).map_err(|e| Failure::new(Exit::Io, e))?;
+    let req = options.request(scene_toml.to_path_buf(), None, output.clone())?;
+    let report = pis_pack::pack_request(&req, &pis_pack::StderrProgress)?;
+    pis_pack::print_report(&report, &mut std::io::stderr()).map_err(|e| Failure::new(Exit::Io, e))?;
     Ok(output)
 }
 
@@ -97,5 +96,33 @@ pub fn run(args: &PlayArgs) -> Result<Exit, Failure> {
             Failure::new(exit, anyhow::anyhow!("--set {}: {e}", set.display()))
         })?;
     }
-    headless::run(args)
+    headless(args)
+}
+
+/// The headless player: a frame, a path of frames, or a comparison with a set; the report
+/// on stderr (and as JSON on stdout with `--json`).
+fn headless(args: &PlayArgs) -> Result<Exit, Failure> {
+    use pis_eval::headless::{open, print_compare_report, print_path_report, run_compare, run_frames};
+    let req = args.headless();
+    let (gpu, mut player) = open(&req)?;
+    match &args.compare {
+        Some(set) => {
+            let r = run_compare(&req, set, &gpu, &mut player)?;
+            emit(args.json, &r, print_compare_report)
+        }
+        None => {
+            let r = run_frames(&req, &gpu, &mut player)?;
+            emit(args.json, &r, print_path_report)
+        }
+    }
+}
+
+/// Prints a report on stderr, and as JSON on stdout when asked.
+fn emit<T: serde::Serialize>(json: bool, report: &T, print: impl Fn(&T, &mut std::io::Stderr) -> std::io::Result<()>) -> Result<Exit, Failure> {
+    print(report, &mut std::io::stderr()).map_err(|e| Failure::new(Exit::Io, e))?;
+    if json {
+        let s = serde_json::to_string_pretty(report).map_err(|e| Failure::new(Exit::Runtime, e))?;
+        println!("{s}");
+    }
+    Ok(Exit::Ok)
 }

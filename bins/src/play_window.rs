@@ -3,15 +3,10 @@
 //! compare with the ray-traced gold standard, and watch the frame rate.
 
 pub mod app;
-pub mod camera;
 pub mod gold;
-pub mod path;
 pub mod screenshot;
-pub mod space;
-pub mod stats;
 pub mod surface;
 pub mod ui;
-pub mod view;
 
 pub use app::{run_window, RunReport, WindowFailure, WindowOptions};
 
@@ -73,7 +68,7 @@ pub fn try_run(args: &PlayArgs) -> Result<(), WindowFailure> {
             r.frames,
             r.frame_size[0],
             r.frame_size[1],
-            crate::play::headless::msaa_label(r.msaa_samples, r.msaa_requested),
+            pis_eval::headless::msaa_label(r.msaa_samples, r.msaa_requested),
             r.seconds,
             r.fps,
             r.frame_ms,

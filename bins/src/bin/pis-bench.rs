@@ -16,11 +16,11 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 use pis::cli::{finish, parse, Exit, Failure, EXIT_CODES_HELP};
-use pis::bench::all::{self, Preset};
-use pis::bench::rd::{self, RdRequest};
-use pis::bench::speed::{self, SpeedRequest};
-use pis::bench::stability::{self, StabilityRequest};
-use pis::infer::{infer, print_report, InferRequest};
+use pis_eval::bench::all::{self, Preset};
+use pis_eval::bench::rd::{self, RdRequest};
+use pis_eval::bench::speed::{self, SpeedRequest};
+use pis_eval::bench::stability::{self, StabilityRequest};
+use pis_pack::infer::{infer, print_report, InferRequest};
 use pis_compile::SolveSettings;
 
 /// The PIS evaluation harness: speed charted against accuracy, PIS against the codecs a user
@@ -45,7 +45,7 @@ enum Command {
         /// Parameter values, one per dimension (nearest sample); default: the middle sample.
         #[arg(long, value_delimiter = ',', allow_hyphen_values = true)]
         at: Option<Vec<f32>>,
-        /// scene.toml of a set (default: SET_DIR/scene.toml).
+        /// scene.toml of a set (default: the scene.toml set.json records, else SET_DIR/scene.toml).
         #[arg(long)]
         scene: Option<PathBuf>,
         /// Image size WIDTHxHEIGHT when tracing a scene.toml.
@@ -106,7 +106,7 @@ enum Command {
     Rd {
         /// A ray-traced set directory, or a scene.toml to trace first (as pis-pack does).
         input: PathBuf,
-        /// scene.toml of a set (default: SET_DIR/scene.toml).
+        /// scene.toml of a set (default: the scene.toml set.json records, else SET_DIR/scene.toml).
         #[arg(long)]
         scene: Option<PathBuf>,
         /// Target compression ratios: every method gets raw image bytes / ratio bytes.
@@ -122,7 +122,7 @@ enum Command {
         #[arg(long)]
         spp: Option<u32>,
         /// Largest used texture side of the PIS inference.
-        #[arg(long, default_value_t = pis::pack::DEFAULT_MAX_TEXTURE)]
+        #[arg(long, default_value_t = pis_pack::DEFAULT_MAX_TEXTURE)]
         max_texture: u32,
         /// A `[preset.NAME]` of scene.toml when tracing one.
         #[arg(long)]
@@ -161,7 +161,7 @@ enum Command {
         spp: Option<u32>,
         #[arg(long)]
         preset: Option<String>,
-        #[arg(long, default_value_t = pis::pack::DEFAULT_MAX_TEXTURE)]
+        #[arg(long, default_value_t = pis_pack::DEFAULT_MAX_TEXTURE)]
         max_texture: u32,
         /// Record the run in docs/BENCHMARKS.md.
         #[arg(long)]
@@ -194,7 +194,7 @@ enum Command {
         spp: Option<u32>,
         #[arg(long)]
         preset: Option<String>,
-        #[arg(long, default_value_t = pis::pack::DEFAULT_MAX_TEXTURE)]
+        #[arg(long, default_value_t = pis_pack::DEFAULT_MAX_TEXTURE)]
         max_texture: u32,
         /// Record the run in docs/BENCHMARKS.md.
         #[arg(long)]

@@ -5,8 +5,8 @@ use std::process::ExitCode;
 
 use clap::Parser;
 use pis::cli::{self, Exit, Failure};
-use pis::diff::gold::{gold, GoldRequest};
-use pis::diff::{diff, render, DiffRequest};
+use pis_eval::diff::gold::{gold, GoldRequest};
+use pis_eval::diff::files::{diff, render, DiffRequest};
 
 /// Compare two .pis files: structural differences (parameter space, cameras, objects, layers,
 /// shells, blocks, pyramid levels, codecs, settings, provenance; bytes per chunk kind) and
@@ -64,12 +64,12 @@ fn run(cli: Cli) -> Result<Exit, Failure> {
         if cli.max_psnr_drop.is_some() || cli.reference_psnr.is_some() || cli.heatmaps.is_some() {
             return Err(Failure::new(Exit::Usage, anyhow::anyhow!("two ray-traced sets compare with --min-psnr and --json only")));
         }
-        let report = pis::diff::sets::compare_sets(&pis::diff::sets::SetsRequest { a: cli.a, b: cli.b, min_psnr: cli.min_psnr })?;
+        let report = pis_eval::diff::sets::compare_sets(&pis_eval::diff::sets::SetsRequest { a: cli.a, b: cli.b, min_psnr: cli.min_psnr })?;
         if cli.json {
             let s = serde_json::to_string_pretty(&report).map_err(|e| Failure::new(Exit::Runtime, e))?;
             println!("{s}");
         } else {
-            print!("{}", pis::diff::sets::render(&report));
+            print!("{}", pis_eval::diff::sets::render(&report));
         }
         return Ok(report.exit());
     }
@@ -80,7 +80,7 @@ fn run(cli: Cli) -> Result<Exit, Failure> {
             let s = serde_json::to_string_pretty(&report).map_err(|e| Failure::new(Exit::Runtime, e))?;
             println!("{s}");
         } else {
-            print!("{}", pis::diff::gold::render(&report));
+            print!("{}", pis_eval::diff::gold::render(&report));
         }
         return Ok(report.exit());
     }

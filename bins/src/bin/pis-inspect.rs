@@ -5,7 +5,7 @@ use std::process::ExitCode;
 
 use clap::Parser;
 use pis::cli::{finish, parse, Exit, Failure, EXIT_CODES_HELP};
-use pis::inspect;
+use pis_eval::inspect;
 use pis_format::{validate_file, PisReader, Severity};
 
 /// Look inside a .pis file: its parameter space, objects, layers, shells, codecs, bytes per

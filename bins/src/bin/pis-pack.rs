@@ -8,7 +8,7 @@ use std::process::ExitCode;
 
 use clap::Parser;
 use pis::cli::{self, Exit, Failure};
-use pis::pack::{pack_with, print_report};
+use pis_pack::{pack_request, print_report, StderrProgress};
 use pis::pack_args::PackOptions;
 
 /// Infer, compress and write the parameterized textures of a ray-traced set.
@@ -20,7 +20,7 @@ struct Cli {
     /// The container to write (atomically; nothing is left on error).
     #[arg(short, long)]
     output: PathBuf,
-    /// The set's scene.toml (default: SET_DIR/scene.toml).
+    /// The set's scene.toml (default: the scene.toml set.json records, else SET_DIR/scene.toml).
     #[arg(long)]
     scene: Option<PathBuf>,
     #[command(flatten)]
@@ -31,8 +31,8 @@ struct Cli {
 }
 
 fn run(cli: Cli) -> Result<Exit, Failure> {
-    let (req, extras) = cli.pack.request(cli.input, cli.scene, cli.output)?;
-    let report = pack_with(&req, extras)?;
+    let req = cli.pack.request(cli.input, cli.scene, cli.output)?;
+    let report = pack_request(&req, &StderrProgress)?;
     print_report(&report, &mut std::io::stderr()).map_err(|e| Failure::new(Exit::Io, e))?;
     if cli.json {
         let s = serde_json::to_string_pretty(&report).map_err(|e| Failure::new(Exit::Runtime, e))?;

@@ -5,7 +5,7 @@ use std::process::ExitCode;
 
 use clap::Parser;
 use pis::cli::{self, Exit, Failure};
-use pis::reencode::{print_report, reencode, ReencodeRequest};
+use pis_eval::reencode::{print_report, reencode, ReencodeRequest};
 use pis_codec::CodecId;
 
 /// Code every texture of a .pis file (all parameter samples, all layers) again: from the
@@ -63,7 +63,7 @@ fn parse_codec(s: &str) -> Result<CodecId, String> {
 struct BlockSizes(Vec<u32>);
 
 fn parse_block(s: &str) -> Result<BlockSizes, String> {
-    pis::pack::parse_sizes(s).map(BlockSizes)
+    pis_pack::parse_sizes(s).map(BlockSizes)
 }
 
 fn run(cli: Cli) -> Result<Exit, Failure> {

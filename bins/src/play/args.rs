@@ -3,28 +3,7 @@
 use std::path::PathBuf;
 
 use clap::Parser;
-
-/// The camera and parameter path of a headless run.
-#[derive(Clone, Debug, PartialEq)]
-pub enum PathChoice {
-    /// A new parameter sample every frame along the diagonal of the space (thesis table
-    /// 4.2), wrapping onto shifted diagonals once one is done; the file's camera at each.
-    Diagonal,
-    /// A free camera circling the scene around the sample camera's target, the parameter
-    /// point fixed (`--at`).
-    Orbit,
-    /// A file with one parameter point per line (values separated by commas or spaces; `#`
-    /// starts a comment); the file's camera at each.
-    File(PathBuf),
-}
-
-fn parse_path(s: &str) -> Result<PathChoice, String> {
-    Ok(match s {
-        "diagonal" => PathChoice::Diagonal,
-        "orbit" => PathChoice::Orbit,
-        f => PathChoice::File(PathBuf::from(f)),
-    })
-}
+pub use pis_eval::headless::{parse_path, set_display_filter, PathChoice};
 
 fn parse_size(s: &str) -> Result<(u32, u32), String> {
     let v: Vec<u32> = s.split(['x', 'X']).map(|p| p.trim().parse::<u32>().ok().filter(|&n| n > 0)).collect::<Option<_>>().ok_or_else(|| format!("expected WIDTHxHEIGHT, got {s:?}"))?;
@@ -45,14 +24,6 @@ fn parse_blend(s: &str) -> Result<pis_play::Blend, String> {
 pub fn parse_msaa(s: &str) -> Result<u32, String> {
     let n = s.parse::<u32>().map_err(|_| format!("--msaa {s:?}: expected 1 or 4"))?;
     pis_play::multisample::check_samples(n).map(|()| n)
-}
-
-/// The display filter of the ray-traced set at `dir` (`set.json` `filter`, RAYSET.md section
-/// 4), which the player resolves multisampled frames with when the file records none; `None`
-/// where the set cannot be read (the comparison then says why) or records an invalid one.
-pub fn set_display_filter(dir: &std::path::Path) -> Option<pis_format::DisplayFilter> {
-    let f = pis_trace::set::RaySet::open(dir).ok()?.meta.filter;
-    pis_format::DisplayFilter::new(f.sigma_px, f.radius_px).ok()
 }
 
 fn parse_reduction(s: &str) -> Result<u32, String> {
@@ -159,6 +130,20 @@ pub struct PlayArgs {
 }
 
 impl PlayArgs {
+    /// The headless run these arguments ask for.
+    pub fn headless(&self) -> pis_eval::headless::HeadlessRequest {
+        pis_eval::headless::HeadlessRequest {
+            file: self.file.clone(),
+            at: self.at.clone(),
+            path: self.path.clone(),
+            frames: self.frames,
+            out: self.out.clone(),
+            size: self.size,
+            quiet: self.json,
+            options: self.player_options(),
+        }
+    }
+
     /// The player's options from the arguments.
     pub fn player_options(&self) -> pis_play::PlayerOptions {
         let d = pis_play::PlayerOptions::default();

@@ -16,17 +16,17 @@ use winit::event::{StartCause, WindowEvent};
 use winit::event_loop::{ActiveEventLoop, ControlFlow, EventLoop};
 use winit::window::{Window, WindowId};
 
-use super::camera::sight_convergence;
+use pis_play::window::camera::sight_convergence;
 use super::gold::GoldSet;
-use super::path::{PathKind, Playback};
+use pis_play::window::path::{PathKind, Playback};
 use super::screenshot::{write_png_rgba8, Capture};
-use super::space::Space;
-use super::stats::{FrameSample, StatsMeter};
+use pis_play::window::space::Space;
+use pis_play::window::stats::{FrameSample, StatsMeter};
 use super::surface::WindowSurface;
 use super::ui::{self, PanelInfo};
-use super::view::ViewState;
+use pis_play::window::view::ViewState;
 use crate::cli::{Exit, Failure};
-use crate::play::headless::play_failure;
+use pis_eval::headless::play_failure;
 
 /// How the window is opened and run.
 #[derive(Clone, Debug)]
@@ -215,7 +215,7 @@ impl App {
         view.show_gold = o.show_gold && o.set.is_some();
         if o.orbit {
             let sample = player.sample_camera(&view.draw_point());
-            view.set_mode(super::view::CameraMode::Orbit, &sample);
+            view.set_mode(pis_play::window::view::CameraMode::Orbit, &sample);
         }
         if o.play {
             view.playback = Playback::new(PathKind::Diagonal);

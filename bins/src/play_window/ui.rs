@@ -3,9 +3,9 @@
 
 use egui::{Key, Ui};
 
-use super::path::PathKind;
-use super::stats::Shown;
-use super::view::{CameraMode, ViewState};
+use pis_play::window::path::PathKind;
+use pis_play::window::stats::Shown;
+use pis_play::window::view::{CameraMode, ViewState};
 
 /// What the panels show besides the state they edit.
 pub struct PanelInfo<'a> {

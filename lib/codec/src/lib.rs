@@ -85,7 +85,7 @@ impl CodecId {
     }
 
     /// True for codecs whose decoded values differ from the encoded ones.
-    pub fn is_lossy(self) -> bool {
+    pub const fn is_lossy(self) -> bool {
         matches!(self, CodecId::Wavelet | CodecId::Dct)
     }
 }

@@ -4,6 +4,9 @@
 
 pub mod content;
 pub mod decode;
+pub mod files;
+pub mod gold;
+pub mod sets;
 pub mod structure;
 
 pub use content::{compare, BlockDiff, ContentDiff, ErrorMap, FileError, LayerDiff, ObjectDiff, Score};

@@ -41,7 +41,7 @@ impl Stamp {
     }
 }
 
-/// "N vCPU <model>, <memory> GiB": what the figures ran on.
+/// "N vCPU MODEL, MEMORY GiB": what the figures ran on.
 pub fn machine() -> String {
     let cpu = std::fs::read_to_string("/proc/cpuinfo").ok()
         .and_then(|s| s.lines().find(|l| l.starts_with("model name")).and_then(|l| l.split(':').nth(1)).map(|m| m.trim().to_string()))

@@ -22,6 +22,7 @@ pub mod player;
 pub mod probe;
 pub mod resolve;
 pub mod textured;
+pub mod window;
 
 pub use blend::Blend;
 pub use camera::{CameraChoice, ViewCamera};

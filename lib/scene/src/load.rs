@@ -104,6 +104,7 @@ pub fn load_with(path: &Path, options: &LoadOptions) -> Result<Scene, SceneError
         textures: g.textures,
         space,
         rig: g.rig,
+        source: Some(path.to_path_buf()),
     })
 }
 

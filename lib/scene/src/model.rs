@@ -28,6 +28,8 @@ pub struct Scene {
     pub space: ParameterSpace,
     /// Node hierarchy, camera, lights and animations: what [`Scene::frame`] poses.
     pub rig: Rig,
+    /// The scene.toml it was loaded from (`None` for a scene built in code).
+    pub source: Option<std::path::PathBuf>,
 }
 
 /// One renderable object. Its mesh is in object space; [`Frame::instances`] places it.

@@ -28,6 +28,10 @@ pub struct SetMeta {
     pub objects: Vec<ObjectMeta>,
     /// Parameter points in linear-index order (last dimension fastest).
     pub points: Vec<PointMeta>,
+    /// The scene.toml the set was traced from: relative to the set directory where both
+    /// lie under one root, else absolute (RAYSET.md section 3). Absent when unknown.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub scene_file: Option<String>,
 }
 
 /// The renderer that produced a set.

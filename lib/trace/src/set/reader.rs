@@ -18,6 +18,18 @@ pub struct RaySet {
 
 impl RaySet {
     /// Opens the set in directory `dir` and validates `set.json`.
+    /// The scene.toml set.json records (resolved against the set directory), if any.
+    pub fn scene_file(&self) -> Option<PathBuf> {
+        let f = self.meta.scene_file.as_deref()?;
+        Some(self.dir.join(f))
+    }
+
+    /// The scene this set is read with when none is named: the scene.toml set.json records
+    /// where that file exists, else `scene.toml` inside the set directory.
+    pub fn default_scene(&self) -> PathBuf {
+        self.scene_file().filter(|p| p.is_file()).unwrap_or_else(|| self.dir.join("scene.toml"))
+    }
+
     pub fn open(dir: impl AsRef<Path>) -> Result<RaySet, TraceError> {
         let dir = dir.as_ref().to_path_buf();
         let path = dir.join(SET_JSON);

@@ -107,6 +107,7 @@ impl SetWriter {
             space,
             objects,
             points: Vec::new(),
+            scene_file: scene.source.as_deref().map(|s| relative_to(s, dir)),
         };
         Ok(SetWriter { dir: dir.to_path_buf(), meta, scene_lights: 0 })
     }
@@ -204,4 +205,26 @@ impl SetWriter {
         write_atomic(&path, &json)?;
         Ok(json.len() as u64)
     }
+}
+
+/// `path` as seen from the directory `dir`: a relative path where both resolve under one
+/// root, else `path` made absolute (or as given, when it cannot be resolved).
+pub fn relative_to(path: &Path, dir: &Path) -> String {
+    let (Ok(p), Ok(d)) = (fs::canonicalize(path), fs::canonicalize(dir)) else {
+        return path.display().to_string();
+    };
+    let (pc, dc): (Vec<_>, Vec<_>) = (p.components().collect(), d.components().collect());
+    let common = pc.iter().zip(&dc).take_while(|(a, b)| a == b).count();
+    // Only the root in common: the absolute path reads better than a climb to it.
+    if common <= 1 {
+        return p.display().to_string();
+    }
+    let mut rel = std::path::PathBuf::new();
+    for _ in common..dc.len() {
+        rel.push("..");
+    }
+    for c in &pc[common..] {
+        rel.push(c);
+    }
+    rel.display().to_string()
 }

@@ -1,0 +1,303 @@
+//! `pis-bench stability`: PIS away from its samples. A dense camera path between the
+//! sampled views (fractional view values: textures blended linearly between the two
+//! neighbouring view samples) and one off the orbit (a free camera), each frame rendered
+//! through the hardware model (A built for that exact camera, occlusion by the other
+//! objects) and compared with a frame ray-traced at that exact camera by pis-trace, on
+//! display values over the pixels the objects cover. Per representation: the textures as
+//! solved and after coding at each ratio (up to extreme ratios).
+//!
+//! Popping: per path, the largest frame-to-frame RMS change of the PIS frames divided by
+//! the reference's RMS change between the same two frames (1: as smooth as the reference).
+
+use std::collections::btree_map::{BTreeMap, Entry};
+use std::path::PathBuf;
+
+use anyhow::{anyhow, Result};
+use pis_compile::{render, render_matrix, scene_depth, DrawMesh, Filter, RenderMatrix, TexturedObject, Viewport};
+use crate::chart::{Chart, Series};
+use crate::metrics::{display, SquaredError};
+use crate::report::{Csv, Stamp};
+use pis_format::DepMask;
+use pis_trace::TraceSettings;
+use rayon::prelude::*;
+use serde::Serialize;
+
+use super::camera_path::{paths, PathFrame, PathKind, AWAY_ELEVATION_DEG, AWAY_RADIUS};
+use super::output::{ensure_dir, record, write_chart};
+use pis_pack::{Exit, Failure};
+use pis_pack::infer::{merged_mesh, sampler, Mesh};
+use pis_pack::encode::LayerTextures;
+use pis_pack::{Inferred, PackRequest, PackSettings, StderrProgress};
+
+/// What to measure.
+#[derive(Clone, Debug)]
+pub struct StabilityRequest {
+    pub input: PathBuf,
+    pub scene: Option<PathBuf>,
+    /// Ratios of the coded representations (the solved textures are always included).
+    pub ratios: Vec<f64>,
+    /// Frames per path.
+    pub frames: usize,
+    /// Samples per pixel of the reference frames.
+    pub spp: u32,
+    pub out: PathBuf,
+    pub resolution: Option<(u32, u32)>,
+    pub trace_spp: Option<u32>,
+    pub max_texture: u32,
+    /// Tracing a scene.toml: a `[preset.NAME]`.
+    pub preset: Option<String>,
+    pub record: bool,
+}
+
+/// One frame's result.
+#[derive(Clone, Debug, Serialize)]
+pub struct FrameRow {
+    pub representation: String,
+    pub path: PathKind,
+    pub frame: usize,
+    pub view: f32,
+    pub psnr_db: f64,
+    /// RMS display change from the previous frame (PIS, reference); null for the first.
+    pub change: Option<[f64; 2]>,
+}
+
+/// One representation on one path.
+#[derive(Clone, Debug, Serialize)]
+pub struct PathSummary {
+    pub representation: String,
+    pub path: PathKind,
+    /// Level-image bytes (null for the textures as solved) and the ratio they give.
+    pub ratio: Option<f64>,
+    pub mean_psnr_db: f64,
+    pub min_psnr_db: f64,
+    pub popping: f64,
+}
+
+#[derive(Clone, Debug, Serialize)]
+pub struct StabilityReport {
+    pub scene: String,
+    pub frames: usize,
+    pub summaries: Vec<PathSummary>,
+    pub rows: Vec<FrameRow>,
+    pub csv: String,
+    pub svg: String,
+    pub stamp: Stamp,
+    pub notes: Vec<String>,
+}
+
+/// A frame through the hardware model: display values and a coverage mask.
+struct Rendered {
+    rgb: Vec<f32>,
+    mask: Vec<bool>,
+}
+
+/// The samples of one layer at a fractional view position, with their weights: the two
+/// neighbouring view samples blended linearly (the nearest alone when the layer does not
+/// depend on the view).
+fn layer_samples(mask: DepMask, view_dim: usize, point: &[u32], view: f32, views: u32) -> Vec<(Vec<u32>, f32)> {
+    let key_at = |v: u32| -> Vec<u32> { mask.dims().map(|d| if d == view_dim { v } else { point[d] }).collect() };
+    if !mask.dims().any(|d| d == view_dim) {
+        return vec![(key_at(0), 1.0)];
+    }
+    let k0 = (view.floor() as u32).min(views - 1);
+    let k1 = (k0 + 1).min(views - 1);
+    let f = view - k0 as f32;
+    vec![(key_at(k0), 1.0 - f), (key_at(k1), f)]
+}
+
+fn render_frame(inf: &Inferred, meshes: &[Mesh], tex: &[Vec<LayerTextures>], pf: &PathFrame, view_dim: usize) -> Result<Rendered> {
+    let set = &inf.set;
+    let (w, h) = set.resolution;
+    let viewport = Viewport { width: w, height: h };
+    let frame = &pf.frame;
+    let clip_from = |k: usize| {
+        pis_trace::camera::projection_matrix(&frame.camera, (w, h)) * frame.camera.world_from_camera.inverse() * frame.instances[k].world_from_object
+    };
+    let draw: Vec<DrawMesh> = meshes.iter().enumerate().map(|(k, m)| DrawMesh {
+        positions: &m.positions, uvs: &m.uvs, indices: &m.indices, clip_from_object: clip_from(k),
+    }).collect();
+    let views = set.scene.space.dims[view_dim].values.len() as u32;
+    let mut rgb = vec![0.0f32; w as usize * h as usize * 3];
+    let mut mask = vec![false; w as usize * h as usize];
+    for (mi, m) in inf.models.iter().enumerate() {
+        let occluders = scene_depth(viewport, &draw, Some(m.index))?;
+        let mut mesh = draw[m.index];
+        mesh.uvs = &m.mesh_uvs;
+        // One render matrix per placement the frame's samples carry (the same pixels).
+        let mut matrices: BTreeMap<usize, RenderMatrix> = BTreeMap::new();
+        let mut img: Vec<f32> = Vec::new();
+        for (li, l) in m.layers.iter().enumerate() {
+            for (k, weight) in layer_samples(l.depends_on, view_dim, &pf.point, pf.view, views) {
+                let x = tex[mi][li].get(&k).ok_or_else(|| anyhow!("object {}: no texture near view {}", m.name, pf.view))?;
+                if weight == 0.0 {
+                    continue;
+                }
+                let pid = l.placement_of[&k];
+                let a = match matrices.entry(pid) {
+                    Entry::Occupied(e) => e.into_mut(),
+                    Entry::Vacant(e) => {
+                        let pl = &m.placements[pid];
+                        let obj = TexturedObject { mesh, transform: pl.transform, layout: pl.layout, sampler: sampler(Filter::Trilinear, pl.repeat) };
+                        e.insert(render_matrix(viewport, &obj, Some(&occluders))?)
+                    }
+                };
+                img.resize(a.rows() * 3, 0.0);
+                let y = render(a, x);
+                img.iter_mut().zip(&y).for_each(|(s, v)| *s += weight * v);
+            }
+        }
+        let Some(a) = matrices.values().next() else { continue };
+        for r in 0..a.rows() {
+            let p = a.pixels[r] as usize;
+            mask[p] = true;
+            for c in 0..3 {
+                rgb[p * 3 + c] += img[r * 3 + c];
+            }
+        }
+    }
+    Ok(Rendered { rgb, mask })
+}
+
+fn reference(inf: &Inferred, pf: &PathFrame, spp: u32) -> Result<Vec<f32>> {
+    let settings = TraceSettings::new(inf.set.resolution, spp);
+    let r = pis_trace::render_point(&inf.set.scene, &pf.frame, &settings, &|| {})?;
+    let l = r.images.layer("combined").ok_or_else(|| anyhow!("the traced frame has no combined image"))?;
+    let n = l.width as usize * l.height as usize;
+    let mut rgb = vec![0.0f32; n * 3];
+    for (c, name) in ["R", "G", "B"].iter().enumerate() {
+        let p = l.channel(name).ok_or_else(|| anyhow!("the traced frame has no {name}"))?;
+        for k in 0..n {
+            rgb[k * 3 + c] = p[k];
+        }
+    }
+    Ok(rgb)
+}
+
+fn rms_change(a: &[f32], b: &[f32], mask: &[bool]) -> f64 {
+    let (mut s, mut n) = (0.0f64, 0usize);
+    for (p, &m) in mask.iter().enumerate() {
+        if m {
+            for c in 0..3 {
+                s += (display(a[p * 3 + c]) - display(b[p * 3 + c])).powi(2);
+                n += 1;
+            }
+        }
+    }
+    (s / n.max(1) as f64).sqrt()
+}
+
+fn runtime(e: anyhow::Error) -> Failure {
+    Failure::new(Exit::Runtime, e)
+}
+
+pub fn check(req: &StabilityRequest) -> Result<(), Failure> {
+    if !req.input.exists() {
+        return Err(Failure::new(Exit::Io, anyhow!("{}: no such set directory or scene file", req.input.display())));
+    }
+    if let Some(r) = req.ratios.iter().find(|r| !(r.is_finite() && **r >= 1.0)) {
+        return Err(Failure::new(Exit::Usage, anyhow!("--ratios: every ratio must be at least 1, got {r}")));
+    }
+    if req.frames < 2 || req.frames > 10_000 || req.spp == 0 {
+        return Err(Failure::new(Exit::Usage, anyhow!("--frames must be in 2..=10000 and --spp at least 1")));
+    }
+    Ok(())
+}
+
+/// Runs the paths for every representation and writes stability.csv and stability.svg.
+pub fn run(req: &StabilityRequest) -> Result<StabilityReport, Failure> {
+    check(req)?;
+    ensure_dir(&req.out).map_err(|e| Failure::new(Exit::Io, e))?;
+    let settings = PackSettings { max_texture: req.max_texture, resolution: req.resolution, spp: req.trace_spp, preset: req.preset.clone(), ..PackSettings::new() };
+    let base = PackRequest { input: req.input.clone(), scene: req.scene.clone(), output: req.out.join("unused.pis"), settings };
+    eprintln!("pis-bench: stability: loading and inferring");
+    let inf = Inferred::new(&base, &StderrProgress)?;
+    let scene = &inf.set.scene;
+    let (view_dim, frames) = paths(scene, req.frames).map_err(|e| Failure::new(Exit::NotSupported, e))?;
+    eprintln!("pis-bench: stability: tracing {} reference frames at {} spp", frames.len(), req.spp);
+    let refs: Vec<Vec<f32>> = frames.iter().map(|f| reference(&inf, f, req.spp)).collect::<Result<_>>().map_err(runtime)?;
+    let meshes: Vec<Mesh> = (0..scene.objects.len()).map(|o| merged_mesh(scene, o)).collect();
+    let raw = inf.raw_image_bytes();
+    let mut reps: Vec<(String, Option<f64>, Vec<Vec<LayerTextures>>)> = vec![("solved".into(), None, inf.solved())];
+    for &r in &req.ratios {
+        let (t, bytes) = inf.decoded(&base.with(|s| s.ratio = Some(r)))?;
+        reps.push((format!("wavelet {r}:1"), Some(raw as f64 / bytes.max(1) as f64), t));
+    }
+    let mut rows = Vec::new();
+    let mut summaries = Vec::new();
+    for (name, ratio, tex) in &reps {
+        let rendered: Vec<Rendered> = frames.par_iter().map(|f| render_frame(&inf, &meshes, tex, f, view_dim)).collect::<Result<_>>().map_err(runtime)?;
+        for kind in [PathKind::Between, PathKind::Away] {
+            let idx: Vec<usize> = (0..frames.len()).filter(|&i| frames[i].kind == kind).collect();
+            let (mut psnrs, mut popping) = (Vec::new(), 0.0f64);
+            for (j, &i) in idx.iter().enumerate() {
+                let mut e = SquaredError::default();
+                for (p, &m) in rendered[i].mask.iter().enumerate() {
+                    if m {
+                        e.add_slices(&rendered[i].rgb[p * 3..p * 3 + 3], &refs[i][p * 3..p * 3 + 3]);
+                    }
+                }
+                let change = (j > 0).then(|| {
+                    let prev = idx[j - 1];
+                    let both: Vec<bool> = rendered[i].mask.iter().zip(&rendered[prev].mask).map(|(a, b)| *a && *b).collect();
+                    [rms_change(&rendered[i].rgb, &rendered[prev].rgb, &both), rms_change(&refs[i], &refs[prev], &both)]
+                });
+                if let Some([p, r]) = change {
+                    popping = popping.max(p / r.max(0.5 / 255.0));
+                }
+                psnrs.push(e.psnr());
+                rows.push(FrameRow { representation: name.clone(), path: kind, frame: j, view: frames[i].view, psnr_db: e.psnr(), change });
+            }
+            let mean = psnrs.iter().sum::<f64>() / psnrs.len().max(1) as f64;
+            let min = psnrs.iter().copied().fold(f64::INFINITY, f64::min);
+            eprintln!("pis-bench: stability: {name:<16} {:<8} mean {mean:6.2} dB, min {min:6.2} dB, popping {popping:5.2}", kind.name());
+            summaries.push(PathSummary { representation: name.clone(), path: kind, ratio: *ratio, mean_psnr_db: mean, min_psnr_db: min, popping });
+        }
+    }
+    let set = &inf.set;
+    let scene_s = format!("{} ({} points, {}x{})", set.scene.name, set.samples.len(), set.resolution.0, set.resolution.1);
+    let stamp = Stamp::here(&scene_s);
+    let mut csv = Csv::new(&["representation", "path", "frame", "view", "psnr_db", "change_pis", "change_reference"]);
+    for r in &rows {
+        csv.push(vec![r.representation.clone(), r.path.name().into(), r.frame.to_string(), format!("{:.3}", r.view), format!("{:.3}", r.psnr_db),
+                      r.change.map_or(String::new(), |c| format!("{:.5}", c[0])), r.change.map_or(String::new(), |c| format!("{:.5}", c[1]))]);
+    }
+    for s in &summaries {
+        csv.push(vec![s.representation.clone(), format!("{}-summary", s.path.name()), String::new(), String::new(), format!("{:.3}", s.mean_psnr_db),
+                      format!("popping {:.3}", s.popping), format!("min {:.3}", s.min_psnr_db)]);
+    }
+    let series: Vec<Series> = summaries.iter().map(|s| Series {
+        name: format!("{} · {} (popping {:.2})", s.representation, s.path.name(), s.popping),
+        points: rows.iter().filter(|r| r.representation == s.representation && r.path == s.path).map(|r| (r.view as f64, r.psnr_db)).collect(),
+    }).collect();
+    let chart = Chart {
+        title: format!("Stability off the samples — {scene_s}"),
+        subtitle: format!("through the hardware model at each exact camera vs pis-trace ({} spp) over covered pixels; between: fractional view, away: radius ×{AWAY_RADIUS}, elevation +{AWAY_ELEVATION_DEG}°", req.spp),
+        x_label: "position along the view dimension (samples)".into(),
+        y_label: "PSNR (dB)".into(),
+        x_log: false,
+        stamp: stamp.lines(),
+    };
+    let (c, s) = write_chart(&req.out, "stability", &csv, &chart, &series).map_err(|e| Failure::new(Exit::Io, e))?;
+    let report = StabilityReport {
+        scene: scene_s, frames: req.frames, summaries, rows, csv: c.display().to_string(), svg: s.display().to_string(), stamp,
+        notes: vec![
+            "frames rendered through the hardware model (CPU), textures blended linearly between the two neighbouring view samples".into(),
+            "PSNR on display values over the pixels the model covers, against pis-trace's combined image at the same camera".into(),
+            "popping = max over consecutive frames of RMS change (PIS) / RMS change (reference), reference change floored at half an 8-bit step".into(),
+        ],
+    };
+    if req.record {
+        let summary: Vec<String> = report.summaries.iter().map(|s| format!("{} {} {:.2} dB (min {:.2}, popping {:.2})", s.representation, s.path.name(), s.mean_psnr_db, s.min_psnr_db, s.popping)).collect();
+        record("stability", &report.stamp, &summary.join("; ")).map_err(|e| Failure::new(Exit::Io, e))?;
+    }
+    Ok(report)
+}
+
+pub fn print(r: &StabilityReport, out: &mut impl std::io::Write) -> std::io::Result<()> {
+    writeln!(out, "stability: {} — {} frames per path", r.scene, r.frames)?;
+    for s in &r.summaries {
+        writeln!(out, "  {:<16} {:<8} {:>8} mean {:6.2} dB  min {:6.2} dB  popping {:5.2}", s.representation, s.path.name(),
+                 s.ratio.map_or("-".into(), |x| format!("{x:.0}:1")), s.mean_psnr_db, s.min_psnr_db, s.popping)?;
+    }
+    writeln!(out, "  wrote {} and {}", r.csv, r.svg)
+}

@@ -1,0 +1,441 @@
+//! pis-play without a window: frames drawn offscreen, written as sRGB PNGs, timed; or every
+//! sample point of a set compared with the gold standard.
+
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+use anyhow::{anyhow, Context};
+use crate::compare::{compare_with_set, CompareOptions, Comparison};
+use pis_play::{CameraChoice, FrameRequest, FrameStats, Gpu, PlayError, Player, ViewCamera};
+use serde::Serialize;
+
+use pis_pack::{Exit, Failure};
+
+/// The camera and parameter path of a headless run.
+#[derive(Clone, Debug, PartialEq)]
+pub enum PathChoice {
+    /// A new parameter sample every frame along the diagonal of the space (thesis table
+    /// 4.2), wrapping onto shifted diagonals once one is done; the file's camera at each.
+    Diagonal,
+    /// A free camera circling the scene around the sample camera's target, the parameter
+    /// point fixed (`--at`).
+    Orbit,
+    /// A file with one parameter point per line (values separated by commas or spaces; `#`
+    /// starts a comment); the file's camera at each.
+    File(PathBuf),
+}
+
+pub fn parse_path(s: &str) -> Result<PathChoice, String> {
+    Ok(match s {
+        "diagonal" => PathChoice::Diagonal,
+        "orbit" => PathChoice::Orbit,
+        f => PathChoice::File(PathBuf::from(f)),
+    })
+}
+
+/// What a headless run draws: one frame, a path of frames, or (with [`run_compare`]) every
+/// sample point of a set.
+#[derive(Clone, Debug)]
+pub struct HeadlessRequest {
+    /// The container to play.
+    pub file: PathBuf,
+    /// The parameter point (default: the middle sample of each dimension).
+    pub at: Option<Vec<f32>>,
+    /// A path of frames instead of one.
+    pub path: Option<PathChoice>,
+    /// Frames of the path (default: every point for `Diagonal`, 36 for `Orbit`, every line
+    /// of a path file).
+    pub frames: Option<usize>,
+    /// Write every frame as an 8-bit sRGB PNG into this folder.
+    pub out: Option<PathBuf>,
+    /// Frame size (default: the file's image size).
+    pub size: Option<(u32, u32)>,
+    /// No progress lines on stderr.
+    pub quiet: bool,
+    /// The player's settings.
+    pub options: pis_play::PlayerOptions,
+}
+
+/// The display filter of the ray-traced set at `dir` (`set.json` `filter`, RAYSET.md section
+/// 4), which the player resolves multisampled frames with when the file records none; `None`
+/// where the set cannot be read (the comparison then says why) or records an invalid one.
+pub fn set_display_filter(dir: &std::path::Path) -> Option<pis_format::DisplayFilter> {
+    let f = pis_trace::set::RaySet::open(dir).ok()?.meta.filter;
+    pis_format::DisplayFilter::new(f.sigma_px, f.radius_px).ok()
+}
+
+
+/// The exit code of a player error.
+pub fn play_failure(e: PlayError) -> Failure {
+    match e {
+        PlayError::File(f) => f.into(),
+        e @ PlayError::Request(_) => Failure::new(Exit::Usage, e),
+        e @ PlayError::Content { .. } => Failure::new(Exit::Invalid, e),
+        e @ PlayError::RepeatSize { .. } => Failure::new(Exit::Invalid, e),
+        e => Failure::new(Exit::Runtime, e),
+    }
+}
+
+/// Timings of a run of frames.
+#[derive(Clone, Debug, Serialize)]
+pub struct PathReport {
+    pub file: String,
+    pub adapter: String,
+    pub size: [u32; 2],
+    pub blend: String,
+    pub reduction: u32,
+    /// Samples per pixel drawn with (multisample antialiasing; 1: none).
+    pub msaa_samples: u32,
+    /// Samples per pixel asked for (`--msaa`).
+    pub msaa_requested: u32,
+    /// How multisampled frames are resolved.
+    pub resolve: Resolve,
+    pub workers: usize,
+    pub frames: usize,
+    pub frame_ms_mean: f64,
+    pub frame_ms_worst: f64,
+    pub fps_mean: f64,
+    pub fps_worst: f64,
+    pub decode_ms_mean: f64,
+    pub decode_ms_worst: f64,
+    pub upload_ms_mean: f64,
+    pub upload_bytes_mean: f64,
+    pub cache_hits: u64,
+    pub cache_misses: u64,
+    pub cache_bytes_max: u64,
+    pub codestreams_read: u64,
+    /// Per frame: the parameter point and its timings.
+    pub per_frame: Vec<FrameRow>,
+}
+
+#[derive(Clone, Debug, Serialize)]
+pub struct FrameRow {
+    pub point: Vec<f32>,
+    pub frame_ms: f64,
+    pub decode_ms: f64,
+    pub upload_ms: f64,
+    pub codestreams_read: u64,
+}
+
+#[derive(Clone, Debug, Serialize)]
+pub struct BlockRow {
+    pub block: usize,
+    pub psnr_db: f64,
+}
+
+#[derive(Clone, Debug, Serialize)]
+pub struct ObjectRow {
+    pub name: String,
+    pub psnr_db: f64,
+    pub pixels: u64,
+    pub blocks: Vec<BlockRow>,
+}
+
+#[derive(Clone, Debug, Serialize)]
+pub struct PointRow {
+    pub index: usize,
+    pub point: Vec<f32>,
+    pub psnr_db: f64,
+}
+
+/// PSNR against the gold standard.
+#[derive(Clone, Debug, Serialize)]
+pub struct CompareReport {
+    pub file: String,
+    pub set: String,
+    pub adapter: String,
+    pub blend: String,
+    pub reduction: u32,
+    /// Samples per pixel drawn with (multisample antialiasing; 1: none).
+    pub msaa_samples: u32,
+    /// Samples per pixel asked for (`--msaa`).
+    pub msaa_requested: u32,
+    /// How multisampled frames are resolved.
+    pub resolve: Resolve,
+    /// Whole image, every point.
+    pub psnr_db: f64,
+    /// Every object's covered pixels pooled (pis-pack's predicted `psnr_db` measure).
+    pub covered_psnr_db: f64,
+    /// The whole image at the gold standard's silhouette pixels (some object partly covers
+    /// them) and elsewhere, with the silhouette pixels' share of the image.
+    pub silhouette_psnr_db: f64,
+    pub interior_psnr_db: f64,
+    pub silhouette_fraction: f64,
+    pub objects: Vec<ObjectRow>,
+    pub points: Vec<PointRow>,
+}
+
+/// How a player resolves multisampled frames: `filter` `box` (each pixel's own samples
+/// averaged), `gaussian` (the display-filter resolve, with `sigma_px`, `radius_px` and
+/// `from`: `file`, the file's provenance settings, or `set`, the ray-traced set's filter
+/// where the file records none), or `none` (one sample per pixel).
+#[derive(Clone, Debug, Serialize)]
+pub struct Resolve {
+    pub filter: String,
+    pub sigma_px: Option<f32>,
+    pub radius_px: Option<f32>,
+    pub from: Option<String>,
+}
+
+impl Resolve {
+    pub fn of(player: &Player) -> Resolve {
+        match player.display_filter() {
+            _ if player.multisample().samples <= 1 => Resolve { filter: "none".into(), sigma_px: None, radius_px: None, from: None },
+            None => Resolve { filter: "box".into(), sigma_px: None, radius_px: None, from: None },
+            Some((f, file)) => Resolve { filter: "gaussian".into(), sigma_px: Some(f.sigma_px), radius_px: Some(f.radius_px), from: Some(if file { "file" } else { "set" }.into()) },
+        }
+    }
+
+    /// "", ", box resolve", or ", Gaussian resolve σ 0.5 px R 1.5 px (the set's: the file
+    /// records none)".
+    pub fn label(&self) -> String {
+        match (self.filter.as_str(), self.sigma_px, self.radius_px) {
+            ("gaussian", Some(s), Some(r)) => {
+                let from = if self.from.as_deref() == Some("file") { "the file's" } else { "the set's: the file records none" };
+                format!(", Gaussian resolve σ {s} px R {r} px ({from})")
+            }
+            ("box", _, _) => ", box resolve".to_string(),
+            _ => String::new(),
+        }
+    }
+}
+
+/// "msaa 4×", "msaa off", or "msaa off (4× asked, not supported)".
+pub fn msaa_label(samples: u32, requested: u32) -> String {
+    let used = if samples > 1 { format!("msaa {samples}×") } else { "msaa off".to_string() };
+    if samples == requested { used } else { format!("{used} ({requested}× asked, not supported)") }
+}
+
+fn blend_name(b: pis_play::Blend) -> String {
+    format!("{b:?}").to_lowercase()
+}
+
+/// Opens the GPU and the file.
+pub fn open(args: &HeadlessRequest) -> Result<(Arc<Gpu>, Player), Failure> {
+    let gpu = Arc::new(Gpu::new().map_err(play_failure)?);
+    let player = Player::open(gpu.clone(), &args.file, args.options.clone()).map_err(|e| {
+        let f = play_failure(e);
+        let message = f.error.to_string();
+        let path = args.file.display().to_string();
+        // Name the file where the message does not.
+        if message.contains(&path) { f } else { Failure::new(f.exit, f.error.context(path)) }
+    })?;
+    if let Some(note) = &player.multisample().note {
+        eprintln!("pis-play: note: {note}");
+    }
+    Ok((gpu, player))
+}
+
+/// The middle sample of every dimension.
+pub fn middle_point(player: &Player) -> Vec<f32> {
+    player.dimensions().iter().map(|d| d.values.get(d.values.len() / 2).copied().unwrap_or(0.0)).collect()
+}
+
+/// Frame `k` of the diagonal path: sample `k mod n₀` along the first dimension and
+/// `(k + ⌊k / n₀⌋·d) mod n_d` along dimension d, so that every frame visits a new sample
+/// until the space is covered (for equal sizes).
+pub fn diagonal_point(dims: &[pis_format::Dimension], k: usize) -> Vec<f32> {
+    let n0 = dims.first().map_or(1, |d| d.values.len().max(1));
+    dims.iter()
+        .enumerate()
+        .map(|(d, dim)| {
+            let n = dim.values.len().max(1);
+            let i = if d == 0 { k % n } else { (k + (k / n0) * d) % n };
+            dim.values.get(i).copied().unwrap_or(0.0)
+        })
+        .collect()
+}
+
+fn read_path_file(path: &Path, dims: usize) -> Result<Vec<Vec<f32>>, Failure> {
+    let text = std::fs::read_to_string(path).with_context(|| format!("reading the path file {}", path.display())).map_err(|e| Failure::new(Exit::Io, e))?;
+    let mut out = Vec::new();
+    for (n, line) in text.lines().enumerate() {
+        let line = line.split('#').next().unwrap_or("").trim();
+        if line.is_empty() {
+            continue;
+        }
+        let p: Vec<f32> = line
+            .split([',', ' ', '\t'])
+            .filter(|s| !s.is_empty())
+            .map(|s| s.parse::<f32>().ok().filter(|v| v.is_finite()))
+            .collect::<Option<_>>()
+            .ok_or_else(|| Failure::new(Exit::Invalid, anyhow!("{}:{}: expected numbers, got {line:?}", path.display(), n + 1)))?;
+        if p.len() != dims {
+            return Err(Failure::new(Exit::Invalid, anyhow!("{}:{}: {} values, the file's parameter space has {dims} dimensions", path.display(), n + 1, p.len())));
+        }
+        out.push(p);
+    }
+    if out.is_empty() {
+        return Err(Failure::new(Exit::Invalid, anyhow!("{}: no points", path.display())));
+    }
+    Ok(out)
+}
+
+/// The frames of a run: their requests.
+fn requests(args: &HeadlessRequest, player: &Player) -> Result<Vec<FrameRequest>, Failure> {
+    let dims = player.dimensions();
+    let at = match &args.at {
+        Some(p) if p.len() != dims.len() => {
+            let names: Vec<&str> = dims.iter().map(|d| d.name.as_str()).collect();
+            return Err(Failure::new(Exit::Usage, anyhow!("--at gives {} values, the parameter space has {} dimensions ({})", p.len(), dims.len(), names.join(", "))));
+        }
+        Some(p) => p.clone(),
+        None => middle_point(player),
+    };
+    let sample = |point: Vec<f32>| FrameRequest { point, camera: CameraChoice::Sample };
+    Ok(match &args.path {
+        None => vec![sample(at)],
+        Some(PathChoice::Diagonal) => {
+            let n = args.frames.unwrap_or_else(|| dims.iter().map(|d| d.values.len().max(1)).product());
+            (0..n).map(|k| sample(diagonal_point(dims, k))).collect()
+        }
+        Some(PathChoice::File(f)) => {
+            let points = read_path_file(f, dims.len())?;
+            let n = args.frames.unwrap_or(points.len());
+            (0..n).map(|k| sample(points[k % points.len()].clone())).collect()
+        }
+        Some(PathChoice::Orbit) => {
+            let n = args.frames.unwrap_or(36).max(1);
+            let c = player.sample_camera(&at);
+            let offset = c.eye - c.target;
+            (0..n)
+                .map(|k| {
+                    let angle = std::f32::consts::TAU * k as f32 / n as f32;
+                    let eye = c.target + glam::Quat::from_rotation_y(angle) * offset;
+                    FrameRequest { point: at.clone(), camera: CameraChoice::Free(ViewCamera { eye, up: glam::Vec3::Y, ..c }) }
+                })
+                .collect()
+        }
+    })
+}
+
+fn write_frame(dir: &Path, name: &str, img: &pis_play::FloatImage) -> Result<PathBuf, Failure> {
+    let path = dir.join(name);
+    pis_pack::images::write_png(&path, img.width, img.height, 4, &img.rgba).map_err(|e| Failure::new(Exit::Io, e))?;
+    Ok(path)
+}
+
+fn out_dir(args: &HeadlessRequest) -> Result<Option<&Path>, Failure> {
+    if let Some(d) = &args.out {
+        std::fs::create_dir_all(d).with_context(|| format!("creating {}", d.display())).map_err(|e| Failure::new(Exit::Io, e))?;
+    }
+    Ok(args.out.as_deref())
+}
+
+/// Draws the frames of `args` and reports their timings.
+pub fn run_frames(args: &HeadlessRequest, gpu: &Gpu, player: &mut Player) -> Result<PathReport, Failure> {
+    let size = args.size.unwrap_or_else(|| player.image_size());
+    let reqs = requests(args, player)?;
+    let out = out_dir(args)?;
+    let progress = reqs.len() > 1 && !args.quiet;
+    let mut rows = Vec::with_capacity(reqs.len());
+    let mut all = Vec::with_capacity(reqs.len());
+    for (k, req) in reqs.iter().enumerate() {
+        let (img, stats) = player.render_image(req, size).map_err(play_failure)?;
+        if let Some(dir) = out {
+            write_frame(dir, &format!("frame-{k:04}.png"), &img)?;
+        }
+        if progress && (k + 1) % 10 == 0 {
+            eprintln!("pis-play: frame {}/{}", k + 1, reqs.len());
+        }
+        rows.push(FrameRow { point: req.point.clone(), frame_ms: stats.frame_ms, decode_ms: stats.decode_ms, upload_ms: stats.upload_ms, codestreams_read: stats.codestreams_read });
+        all.push(stats);
+    }
+    let n = all.len().max(1) as f64;
+    let mean = |f: fn(&FrameStats) -> f64| all.iter().map(f).sum::<f64>() / n;
+    let worst = |f: fn(&FrameStats) -> f64| all.iter().map(f).fold(0.0, f64::max);
+    let (fm, fw) = (mean(|s| s.frame_ms), worst(|s| s.frame_ms));
+    let o = player.options();
+    Ok(PathReport {
+        file: args.file.display().to_string(),
+        adapter: gpu.describe(),
+        size: [size.0, size.1],
+        blend: blend_name(o.blend),
+        reduction: o.reduction,
+        msaa_samples: player.multisample().samples,
+        msaa_requested: player.multisample().requested,
+        resolve: Resolve::of(player),
+        workers: o.workers,
+        frames: all.len(),
+        frame_ms_mean: fm,
+        frame_ms_worst: fw,
+        fps_mean: 1e3 / fm.max(1e-9),
+        fps_worst: 1e3 / fw.max(1e-9),
+        decode_ms_mean: mean(|s| s.decode_ms),
+        decode_ms_worst: worst(|s| s.decode_ms),
+        upload_ms_mean: mean(|s| s.upload_ms),
+        upload_bytes_mean: mean(|s| s.upload_bytes as f64),
+        cache_hits: all.iter().map(|s| s.cache_hits).sum(),
+        cache_misses: all.iter().map(|s| s.cache_misses).sum(),
+        cache_bytes_max: all.iter().map(|s| s.cache_bytes).max().unwrap_or(0),
+        codestreams_read: all.iter().map(|s| s.codestreams_read).sum(),
+        per_frame: rows,
+    })
+}
+
+pub fn print_path_report(r: &PathReport, w: &mut impl std::io::Write) -> std::io::Result<()> {
+    writeln!(w, "pis-play {} ({}x{}, blend {}, reduction {}, {}{}, {} decoding threads)", r.file, r.size[0], r.size[1], r.blend, r.reduction, msaa_label(r.msaa_samples, r.msaa_requested), r.resolve.label(), r.workers)?;
+    writeln!(w, "  adapter: {}", r.adapter)?;
+    writeln!(w, "  frames: {}", r.frames)?;
+    writeln!(w, "  frame ms: mean {:.2} ({:.1} fps), worst {:.2} ({:.1} fps)", r.frame_ms_mean, r.fps_mean, r.frame_ms_worst, r.fps_worst)?;
+    writeln!(w, "  decode ms: mean {:.2}, worst {:.2}; upload ms: mean {:.2} ({:.0} KiB per frame)", r.decode_ms_mean, r.decode_ms_worst, r.upload_ms_mean, r.upload_bytes_mean / 1024.0)?;
+    writeln!(w, "  level-image cache: {} hits, {} misses, at most {:.1} MiB; codestreams read: {}", r.cache_hits, r.cache_misses, r.cache_bytes_max as f64 / (1 << 20) as f64, r.codestreams_read)
+}
+
+/// Compares every sample point of `set` with its gold standard.
+pub fn run_compare(args: &HeadlessRequest, set: &Path, gpu: &Gpu, player: &mut Player) -> Result<CompareReport, Failure> {
+    let out = out_dir(args)?;
+    let options = CompareOptions { size: args.size };
+    let mut write_error = None;
+    let quiet = args.quiet;
+    let c: Comparison = compare_with_set(player, set, &options, &mut |pair| {
+        if !quiet {
+            eprintln!("pis-play: point {} {:?}", pair.index, pair.point);
+        }
+        if let Some(dir) = out {
+            if let Err(e) = write_frame(dir, &format!("point-{:04}.png", pair.index), pair.rendered) {
+                write_error.get_or_insert(e);
+            }
+        }
+    })
+    .map_err(|e| match e.downcast::<PlayError>() {
+        Ok(p) => play_failure(p),
+        Err(e) => Failure::new(Exit::Invalid, e),
+    })?;
+    if let Some(e) = write_error {
+        return Err(e);
+    }
+    let o = player.options();
+    Ok(CompareReport {
+        file: args.file.display().to_string(),
+        set: set.display().to_string(),
+        adapter: gpu.describe(),
+        blend: blend_name(o.blend),
+        reduction: o.reduction,
+        msaa_samples: player.multisample().samples,
+        msaa_requested: player.multisample().requested,
+        resolve: Resolve::of(player),
+        psnr_db: c.psnr_db,
+        covered_psnr_db: c.covered_psnr_db,
+        silhouette_psnr_db: c.silhouette.psnr(),
+        interior_psnr_db: c.interior.psnr(),
+        silhouette_fraction: c.silhouette.count as f64 / (c.silhouette.count + c.interior.count).max(1) as f64,
+        objects: c
+            .objects
+            .iter()
+            .map(|s| ObjectRow { name: s.name.clone(), psnr_db: s.psnr_db, pixels: s.error.count / 3, blocks: s.blocks.iter().map(|b| BlockRow { block: b.block, psnr_db: b.psnr_db }).collect() })
+            .collect(),
+        points: c.points.iter().map(|p| PointRow { index: p.index, point: p.point.clone(), psnr_db: p.psnr_db }).collect(),
+    })
+}
+
+pub fn print_compare_report(r: &CompareReport, w: &mut impl std::io::Write) -> std::io::Result<()> {
+    writeln!(w, "pis-play {} against {} (blend {}, reduction {}, {}{})", r.file, r.set, r.blend, r.reduction, msaa_label(r.msaa_samples, r.msaa_requested), r.resolve.label())?;
+    writeln!(w, "  adapter: {}", r.adapter)?;
+    writeln!(w, "  PSNR (display values): whole image {:.2} dB, objects' covered pixels {:.2} dB", r.psnr_db, r.covered_psnr_db)?;
+    writeln!(w, "  whole image at silhouettes {:.2} dB ({:.1} % of the pixels: partly covered in the gold standard), elsewhere {:.2} dB", r.silhouette_psnr_db, 100.0 * r.silhouette_fraction, r.interior_psnr_db)?;
+    for o in &r.objects {
+        writeln!(w, "    {:<14} {:>7.2} dB  ({} pixel samples over {} blocks)", o.name, o.psnr_db, o.pixels, o.blocks.len())?;
+    }
+    Ok(())
+}

@@ -1,0 +1,214 @@
+//! `pis-pack`: a ray-traced set to a `.pis` container (thesis ch. 4).
+//!
+//! Per object: texture-coordinate optimization over the set's views (3.3); inference of the
+//! object's layers as parameterized surface textures (3.5) — a view-independent diffuse
+//! layer solved once over all views by stacking, depending on the non-view dimensions only,
+//! and a view-dependent specular layer solved per parameter sample with a warm start from
+//! the neighbouring sample; a layer that is black for an object is not stored. Each layer is
+//! cut into parameter-space blocks whose origins are staggered per object (4.7), each block
+//! coded as an adaptive Laplacian pyramid (4.3) of gamma-compensated textures (4.6), storage
+//! allocated by equal slopes across levels, objects and layers (4.5), and the container
+//! written atomically. MIP levels are not stored: the player decimates (3.6).
+//!
+//! The render matrices A come from the hardware model or, with `matrix: Probe`, are measured
+//! through the player's pipeline on the GPU (probe mode, thesis 3.4.3; [`matrices`]), which
+//! anisotropic filtering needs. The predicted PSNR renders the decoded textures through the
+//! same A (with the MIP chain rebuilt by decimation as the player does) and compares with
+//! the gold-standard layers over the pixels the tracer covers, on display values (see
+//! [`crate::infer`]).
+
+pub mod blocks;
+pub mod encode;
+pub mod infer_layers;
+pub mod input;
+pub mod matrices;
+pub mod report;
+pub mod settings;
+pub mod storage;
+pub mod sweep;
+
+use std::path::PathBuf;
+use std::time::Instant;
+
+use pis_codec::CodecId;
+
+pub use report::{print_report, ObjectReport, PackReport};
+pub use input::cache_dir;
+pub use matrices::{filter_needs_probe, MatrixSource};
+pub use encode::LayerTextures;
+pub use sweep::{Inferred, PackPoint};
+pub use settings::*;
+
+use crate::error::{Exit, Failure};
+
+/// What to pack: the input, the output and the settings. Derefs to its
+/// [`PackSettings`].
+#[derive(Clone, Debug)]
+pub struct PackRequest {
+    /// A ray-traced set directory or a scene.toml (traced first into a cache beside it).
+    pub input: PathBuf,
+    /// The set's scene.toml (default: the one set.json records, else SET_DIR/scene.toml, or
+    /// the input scene.toml).
+    pub scene: Option<PathBuf>,
+    /// The container to write (atomically).
+    pub output: PathBuf,
+    pub settings: PackSettings,
+}
+
+impl std::ops::Deref for PackRequest {
+    type Target = PackSettings;
+    fn deref(&self) -> &PackSettings {
+        &self.settings
+    }
+}
+
+impl PackRequest {
+    /// `input` packed into `output` with `settings`.
+    pub fn new(input: impl Into<PathBuf>, output: impl Into<PathBuf>, settings: PackSettings) -> Self {
+        PackRequest { input: input.into(), scene: None, output: output.into(), settings }
+    }
+
+    /// The same request with other settings.
+    pub fn with(&self, change: impl FnOnce(&mut PackSettings)) -> Self {
+        let mut r = self.clone();
+        change(&mut r.settings);
+        r
+    }
+}
+
+/// What a pack tells while it works: each stage as it ends, and notes on objects. Called
+/// on the calling thread.
+pub trait Progress {
+    /// A stage ended after `ms` milliseconds, having done `what`.
+    fn stage(&self, _name: &str, _ms: f64, _what: &str) {}
+    /// A note on the work (an object left out, the probe adapter, …).
+    fn note(&self, _text: &str) {}
+}
+
+/// No progress display.
+pub struct NoProgress;
+impl Progress for NoProgress {}
+
+/// Progress as `pis-pack` prints it on stderr: one line per stage with its time, one per
+/// note.
+pub struct StderrProgress;
+impl Progress for StderrProgress {
+    fn stage(&self, name: &str, ms: f64, what: &str) {
+        eprintln!("pis-pack: {name:<9} {ms:8.0} ms  {what}");
+    }
+    fn note(&self, text: &str) {
+        eprintln!("pis-pack: {text}");
+    }
+}
+
+/// Times the stages of a pack and tells its progress.
+pub struct Stages<'p> {
+    pub ms: Vec<(String, f64)>,
+    t: Instant,
+    progress: &'p dyn Progress,
+}
+
+impl<'p> Stages<'p> {
+    fn new(progress: &'p dyn Progress) -> Self {
+        Stages { ms: Vec::new(), t: Instant::now(), progress }
+    }
+
+    /// Stages timed without progress.
+    fn quiet() -> Stages<'static> {
+        Stages::new(&NoProgress)
+    }
+
+    pub fn done(&mut self, name: &str, what: &str) {
+        let ms = self.t.elapsed().as_secs_f64() * 1e3;
+        self.progress.stage(name, ms, what);
+        self.ms.push((name.to_string(), ms));
+        self.t = Instant::now();
+    }
+
+    pub fn note(&self, text: &str) {
+        self.progress.note(text);
+    }
+}
+
+/// Packs the ray-traced set (or scene.toml, traced first into `.pis-cache/` beside it) at
+/// `input` into the container `output` with `settings`, telling `progress` as it goes; on
+/// error no output file is left. The whole of `pis-pack`.
+pub fn pack(input: &std::path::Path, output: &std::path::Path, settings: &PackSettings, progress: &dyn Progress) -> Result<PackReport, Failure> {
+    pack_request(&PackRequest::new(input, output, settings.clone()), progress)
+}
+
+/// [`pack`] of a [`PackRequest`] (which may name the set's scene.toml).
+pub fn pack_request(req: &PackRequest, progress: &dyn Progress) -> Result<PackReport, Failure> {
+    if req.ratio.is_some() && req.psnr.is_some() {
+        return Err(Failure::new(Exit::Usage, anyhow::anyhow!("give --ratio or --psnr, not both")));
+    }
+    if let Some(r) = req.ratio {
+        if !(r.is_finite() && r >= 1.0) {
+            return Err(Failure::new(Exit::Usage, anyhow::anyhow!("--ratio must be at least 1, got {r}")));
+        }
+    }
+    let parent = req.output.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(std::path::Path::new("."));
+    if !parent.is_dir() {
+        return Err(Failure::new(Exit::Io, anyhow::anyhow!("the output folder {} does not exist", parent.display())));
+    }
+    let mut stages = Stages::new(progress);
+    if let Some(why) = filter_needs_probe(req.filter, req.matrix) {
+        return Err(Failure::new(Exit::Usage, anyhow::anyhow!(why)));
+    }
+    let set = input::load(req, &mut stages)?;
+    // A ratio is checked before any work: it must leave the level images a byte.
+    let raw = set.raw_image_bytes();
+    if let Some(r) = req.ratio.filter(|r| raw as f64 / r < 1.0) {
+        return Err(Failure::new(Exit::Usage, anyhow::anyhow!("--ratio {r} leaves no byte for the level images of this set (raw images {raw} bytes): the highest ratio is {raw}:1")));
+    }
+    let mut matrices = matrices::Matrices::open(req.matrix, req.filter)?;
+    if let Some(device) = matrices.device() {
+        stages.note(&format!("probe mode on {device}"));
+    }
+    let inferred = infer_layers::infer_all(&set, req, &mut matrices, &mut stages).map_err(|e| Failure::new(Exit::Runtime, e))?;
+    let probe_renderings = matrices.renderings();
+    drop(matrices);
+    let mut packed = encode::encode_all(&set, &inferred, req, &mut stages)?;
+    let quality = encode::predicted_psnr(&set, &inferred, &packed).map_err(|e| Failure::new(Exit::Runtime, e))?;
+    stages.done("predict", &format!("decoded textures rendered through the render matrices ({})", req.matrix.name()));
+    // The prediction travels with the file: `pis-diff FILE SET --max-psnr-drop` measures
+    // the played PSNR against it.
+    if let Some(p) = packed.container.provenance.as_mut() {
+        p.settings.push((PREDICTED_PSNR_SETTING.to_string(), format!("{:.4}", quality.overall)));
+    }
+    let masters = if req.keep_master {
+        let m = encode::masters(&inferred, &packed).map_err(|e| Failure::new(Exit::Runtime, e))?;
+        let n: u64 = m.iter().map(pis_format::Master::payload_len).sum();
+        stages.done("master", &format!("solved textures of {} objects coded losslessly ({n} bytes)", m.len()));
+        m
+    } else {
+        Vec::new()
+    };
+    let bytes = pis_format::write_with_masters(&req.output, &packed.container, &masters)?;
+    stages.done("write", &format!("{} ({bytes} bytes)", req.output.display()));
+    // The master read back from the file decodes to the solved textures bit for bit.
+    let master = if req.keep_master {
+        Some(encode::check_master(&req.output, &inferred).map_err(|e| Failure::new(Exit::Runtime, e))?)
+    } else {
+        None
+    };
+    // Lossless: the file's level images decode bit-exactly and the decoded textures equal
+    // the solved ones.
+    let exact = if req.codec == CodecId::Lossless {
+        let levels = encode::check_lossless(&req.output, &packed).map_err(|e| Failure::new(Exit::Runtime, e))?;
+        Some(levels && quality.max_texel_error == 0.0)
+    } else {
+        None
+    };
+    let mut report = report::build(&set, &inferred, &packed, &quality, bytes, exact, req, stages);
+    report.probe_renderings = probe_renderings;
+    if let Some((master_bytes, exact)) = master {
+        report.set_master(master_bytes, exact);
+    }
+    Ok(report)
+}
+
+/// `N`, or `NxM…`: sizes of at least 1 separated by `x` (`--block`, `--resolution`).
+pub fn parse_sizes(s: &str) -> Result<Vec<u32>, String> {
+    s.split(['x', 'X']).map(|p| p.trim().parse::<u32>().ok().filter(|&b| b > 0).ok_or_else(|| format!("bad size {s:?}: expected N or NxM"))).collect()
+}

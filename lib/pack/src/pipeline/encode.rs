@@ -1,0 +1,533 @@
+//! From inferred textures to the container: parameter-space blocks with staggered origins
+//! (thesis 4.7), the adaptive Laplacian pyramid of gamma-compensated textures per object,
+//! layer and block (4.3, 4.6), equal-slope storage allocation (4.5) and encoding; then the
+//! checks that read the result back.
+
+use std::collections::BTreeMap;
+use std::path::Path;
+
+use anyhow::{anyhow, Result};
+use pis_codec::allocate::Target;
+use pis_codec::pyramid::{level_image_index, unflatten};
+use pis_codec::CodecId;
+use pis_format::blocks::BlockGrid;
+use pis_format::mip::decimate;
+use pis_format::reconstruct::{finish, prepare};
+use pis_format::*;
+
+use super::infer_layers::{key, ObjectModel};
+use super::input::LoadedSet;
+use super::blocks::{block_sizes, geometry, stagger, transforms};
+use super::storage::{allocate_storage, build_pyramid, encode_levels, CodedLevel};
+use super::{PackRequest, Stages};
+use crate::error::{Exit, Failure};
+
+/// Linear textures of one layer, keyed like [`super::infer_layers::InferredLayer::textures`].
+pub type LayerTextures = std::collections::BTreeMap<Vec<u32>, Vec<f32>>;
+
+/// One block of one layer as coded: which layer sample each block-local sample is, and the
+/// level images (gamma-compensated residuals) with their codestreams.
+pub struct PackedBlock {
+    pub extent: Vec<u32>,
+    /// Per block-local sample (row-major over the extent), the layer key.
+    pub keys: Vec<Vec<u32>>,
+    /// Per level: counts, images as encoded, codestreams.
+    pub levels: Vec<CodedLevel>,
+}
+
+/// The container and what the report and checks need to know about it.
+pub struct Packed {
+    pub container: Container,
+    /// Per object model, per layer, per block.
+    pub blocks: Vec<Vec<Vec<PackedBlock>>>,
+    /// Bytes of everything but the level images.
+    pub overhead: usize,
+    /// Per object model, per layer: codestream bytes.
+    pub layer_bytes: Vec<Vec<usize>>,
+    pub stagger: Vec<Vec<u32>>,
+    /// Per object model, per layer: each layer sample's screen weights, by key (empty
+    /// without screen-error allocation); the allocation and the master use them.
+    pub screen_weights: Vec<Vec<BTreeMap<Vec<u32>, Vec<f32>>>>,
+}
+
+fn surface_layer(kind: LayerKind, order: u8, depends_on: DepMask, gamma: f32) -> Layer {
+    Layer {
+        kind,
+        mapping: Mapping::Surface,
+        channels: 3,
+        mip_mode: MipMode::Decimated,
+        term: Term::Surface,
+        order,
+        combine: Combine::Add,
+        gamma,
+        depends_on,
+        blocks: vec![],
+    }
+}
+
+/// The finest level of a solved texture of layout `layout` (the chain's level 0).
+pub fn finest(layout: pis_compile::TextureLayout, x: &[f32]) -> Vec<f32> {
+    x[..layout.width as usize * layout.height as usize * 3].to_vec()
+}
+
+/// The screen weight of every level-0 texel of a texture placed by `placement` at one
+/// point: the column sums of its render matrix `a` (how much of the covered pixels each
+/// texel of the MIP chain makes up: rows sum to 1), carried down the decimation to level 0
+/// (Dᵀ), as the player draws coarser levels from level 0.
+fn screen_weights_at(a: &pis_compile::RenderMatrix) -> Vec<f64> {
+    let dec = pis_compile::decimation::Decimation::new(a.layout);
+    let mut cols = vec![0.0f64; a.cols()];
+    for r in 0..a.rows() {
+        let (c, w) = a.row(r);
+        c.iter().zip(w).for_each(|(&c, &w)| cols[c as usize] += w as f64);
+    }
+    let mut out = vec![0.0f64; dec.base_len()];
+    dec.reduce(&cols, &mut out);
+    out
+}
+
+/// Texel weights of one layer sample: the sum of the per-point weights of the points that
+/// read it (all views of a view-independent sample), scaled to mean 1; all zero where no
+/// point shows the object.
+fn sample_weights(per_point: &[Vec<f64>]) -> Vec<f32> {
+    let n = per_point.first().map_or(0, Vec::len);
+    let mut sum = vec![0.0f64; n];
+    for w in per_point {
+        sum.iter_mut().zip(w).for_each(|(a, w)| *a += w);
+    }
+    let total: f64 = sum.iter().sum();
+    let scale = if total > 0.0 { n as f64 / total } else { 0.0 };
+    sum.iter().map(|w| (w * scale) as f32).collect()
+}
+
+/// The screen weights of every sample of layer `li` of `m`, by key: [`sample_weights`] over
+/// the points of `samples` that read it, through the render matrices of its placement.
+fn layer_screen_weights(m: &ObjectModel, li: usize, samples: &[Vec<u32>]) -> BTreeMap<Vec<u32>, Vec<f32>> {
+    let il = &m.layers[li];
+    il.textures.keys().map(|k| {
+        let pid = il.placement_of[k];
+        let per_point: Vec<Vec<f64>> = samples.iter().enumerate().filter(|(_, s)| key(s, il.depends_on) == *k)
+            .map(|(p, _)| screen_weights_at(m.views[p].a(pid))).collect();
+        let w = if per_point.is_empty() { vec![0.0; m.placements[pid].layout.width as usize * m.placements[pid].layout.height as usize] } else { sample_weights(&per_point) };
+        (k.clone(), w)
+    }).collect()
+}
+
+/// Builds pyramids, allocates storage, encodes, and assembles the container.
+pub fn encode_all(set: &LoadedSet, models: &[ObjectModel], req: &PackRequest, stages: &mut Stages) -> Result<Packed, Failure> {
+    let runtime = |e: anyhow::Error| Failure::new(Exit::Runtime, e);
+    let sizes = block_sizes(req.block.as_slice(), set.scene.space.dims.len()).map_err(|e| Failure::new(Exit::Usage, e))?;
+    let (space, cameras) = geometry(set, &sizes);
+    if pis_codec::codec(req.codec).is_none() {
+        return Err(runtime(anyhow!("codec {} is not in this build", req.codec)));
+    }
+    let mut objects = Vec::new();
+    let mut blocks_out = Vec::new();
+    let mut staggers = Vec::new();
+    // Every block's pyramid, in (object model, layer, block) order, and where it goes.
+    let mut pyramids = Vec::new();
+    let mut where_ = Vec::new();
+    let mut screen_weights = Vec::new();
+    for (mi, m) in models.iter().enumerate() {
+        let st = stagger(mi, models.len(), &sizes);
+        if st != m.stagger || sizes != m.block_sizes {
+            return Err(runtime(anyhow!(
+                "object {}: its textures were placed for blocks of {:?} samples staggered by {:?}, the encoding asks for blocks of {sizes:?} staggered by {st:?}",
+                m.name, m.block_sizes, m.stagger,
+            )));
+        }
+        let weights_by_layer: Vec<BTreeMap<Vec<u32>, Vec<f32>>> = if req.allocation == super::Allocation::Screen {
+            (0..m.layers.len()).map(|li| layer_screen_weights(m, li, &set.samples)).collect()
+        } else {
+            m.layers.iter().map(|_| BTreeMap::new()).collect()
+        };
+        let mut layers = Vec::new();
+        let mut layer_blocks = Vec::new();
+        for (li, il) in m.layers.iter().enumerate() {
+            let layer_weights = &weights_by_layer[li];
+            let mut layer = surface_layer(il.kind, li as u8, il.depends_on, req.gamma);
+            let grid = BlockGrid::new(&space, il.depends_on, &st);
+            let layer_samples = il.textures.len().max(1) as f64;
+            let mut pblocks = Vec::new();
+            for b in 0..grid.block_count() as usize {
+                let extent = grid.extent(b);
+                let placed = &m.placements[il.block_placements[b]];
+                let block = Block {
+                    width: placed.layout.width,
+                    height: placed.layout.height,
+                    placement: Placement::Surface { affine: placed.transform.values, repeat: placed.repeat, cut: placed.transform.cut },
+                    levels: vec![],
+                };
+                let layout = LevelLayout::of(&layer, &block);
+                let planes = layout.planes();
+                let count: usize = extent.iter().map(|&e| e as usize).product();
+                let mut keys = vec![Vec::new(); count];
+                let mut samples = vec![Vec::new(); count];
+                let mut weights = vec![Vec::new(); count];
+                for (k, x) in &il.textures {
+                    let mut point = vec![0u32; space.dims.len()];
+                    for (d, &v) in il.depends_on.dims().zip(k) {
+                        point[d] = v;
+                    }
+                    let pos = grid.locate(&point);
+                    if pos.block != b {
+                        continue;
+                    }
+                    let idx = pos.local.iter().zip(&pos.extent).fold(0usize, |a, (&l, &e)| a * e as usize + l as usize);
+                    keys[idx] = k.clone();
+                    samples[idx] = prepare(&layer, &layout, &finest(placed.layout, x));
+                    if let Some(w) = layer_weights.get(k) {
+                        weights[idx] = w.clone();
+                    }
+                }
+                if samples.iter().any(Vec::is_empty) {
+                    return Err(runtime(anyhow!("object {} layer {} block {b}: a sample has no texture", m.name, il.kind.name())));
+                }
+                let mut pyramid = build_pyramid(mi, planes, &extent, &samples, layer_samples, !req.codec.is_lossy(), req.pyramid == super::PyramidMode::Full).map_err(runtime)?;
+                if !layer_weights.is_empty() && req.codec.is_lossy() {
+                    pyramid.texel_weights = Some(weights);
+                }
+                pyramids.push(pyramid);
+                where_.push((mi, li, b));
+                pblocks.push(PackedBlock { extent, keys, levels: vec![] });
+                layer.blocks.push(block);
+            }
+            layers.push(layer);
+            layer_blocks.push(pblocks);
+        }
+        objects.push(Object {
+            name: m.name.clone(),
+            role: ObjectRole::Diffuse,
+            shading: Shading::default(),
+            stagger: st.clone(),
+            transforms: transforms(set, &space, m.index),
+            mesh: Mesh { positions: m.mesh.positions.clone(), normals: None, texcoords: Some(m.mesh_uvs.clone()), indices: m.mesh.indices.clone() },
+            layers,
+        });
+        blocks_out.push(layer_blocks);
+        screen_weights.push(weights_by_layer);
+        staggers.push(st);
+    }
+    let level_images: usize = pyramids.iter().flat_map(|p| &p.levels).map(|l| l.1.len()).sum();
+    stages.done("pyramid", &format!("{level_images} level images in adaptive pyramids"));
+
+    let raw = set.raw_image_bytes();
+    let settings = vec![
+        ("codec".to_string(), req.codec.name().to_string()),
+        ("block".to_string(), sizes.iter().map(u32::to_string).collect::<Vec<_>>().join("x")),
+        ("matrix".to_string(), req.matrix.name().to_string()),
+        ("gamma".to_string(), req.gamma.to_string()),
+        ("target".to_string(), match (req.ratio, req.psnr) {
+            (_, Some(p)) => format!("psnr {p} dB"),
+            (r, None) => format!("ratio {}", r.unwrap_or(super::DEFAULT_RATIO)),
+        }),
+    ];
+    let mut settings = settings;
+    settings.splice(2..2, file_filter(req.filter).settings());
+    if req.pyramid != super::PyramidMode::Adaptive {
+        settings.push(("pyramid".to_string(), "full".to_string()));
+    }
+    if req.layers != super::LayerMode::Separate {
+        settings.push(("layers".to_string(), "combined".to_string()));
+    }
+    if req.allocation != super::Allocation::Screen {
+        settings.push(("allocation".to_string(), "texture".to_string()));
+    }
+    // The set's display filter, which players resolve multisampled frames with (SPEC.md
+    // 6.6); a set recording an invalid one (rule 9002) is packed without it.
+    let f = set.display_filter;
+    if let Ok(display) = pis_format::DisplayFilter::new(f.sigma_px, f.radius_px) {
+        settings.extend(display.settings());
+    }
+    let mut container = Container {
+        space,
+        cameras,
+        objects,
+        provenance: Some(Provenance {
+            tool: format!("pis-pack {}", env!("CARGO_PKG_VERSION")),
+            source: set.dir.display().to_string(),
+            raw_image_bytes: raw,
+            settings,
+        }),
+    };
+    // Level lists with empty codestreams: the bytes everything but the images takes.
+    let mut next = 0;
+    for (o, ob) in container.objects.iter_mut().enumerate() {
+        for (l, layer) in ob.layers.iter_mut().enumerate() {
+            for (b, block) in layer.blocks.iter_mut().enumerate() {
+                // Blocks come in the order their pyramids were built.
+                debug_assert_eq!(where_[next], (o, l, b));
+                block.levels = pyramids[next].levels.iter().map(|(c, imgs, _)| Level {
+                    counts: c.clone(),
+                    images: imgs.iter().map(|_| Codestream { codec: req.codec, bytes: vec![] }).collect(),
+                }).collect();
+                next += 1;
+            }
+        }
+    }
+    let overhead = pis_format::to_bytes_unchecked(&container).len();
+
+    let target = match (req.ratio, req.psnr) {
+        (_, Some(db)) => Target::Psnr { db, peak: 1.0 },
+        // The ratio counts level images against the raw images (thesis 4.8); geometry and
+        // tables come on top and are reported apart.
+        (r, None) => Target::Bytes((raw as f64 / r.unwrap_or(super::DEFAULT_RATIO)) as usize),
+    };
+    let areas: Vec<f64> = models.iter().map(|m| m.area).collect();
+    let storage = allocate_storage(&pyramids, req.codec, target, &areas).map_err(|e| target_failure(e, raw))?;
+    if let Some(total) = storage.allocated {
+        stages.done("allocate", &format!("{total} bytes over {} level images", storage.level_images));
+    }
+    encode_levels(&mut pyramids, req.codec, &storage).map_err(runtime)?;
+    let mut layer_bytes: Vec<Vec<usize>> = models.iter().map(|m| vec![0; m.layers.len()]).collect();
+    for ((mi, li, b), pyramid) in where_.iter().zip(pyramids) {
+        let block = &mut container.objects[*mi].layers[*li].blocks[*b];
+        for (level, (_, _, streams)) in block.levels.iter_mut().zip(&pyramid.levels) {
+            for (image, bytes) in level.images.iter_mut().zip(streams) {
+                layer_bytes[*mi][*li] += bytes.len();
+                image.bytes = bytes.clone();
+            }
+        }
+        blocks_out[*mi][*li][*b].levels = pyramid.levels;
+    }
+    stages.done("encode", &format!("{level_images} level images with {}", req.codec));
+    Ok(Packed { container, blocks: blocks_out, overhead, layer_bytes, stagger: staggers, screen_weights })
+}
+
+/// Decoded linear textures (whole MIP chain, rebuilt by decimation as the player does), per
+/// object model and layer, keyed like [`super::infer_layers::InferredLayer::textures`].
+pub fn decoded_textures(models: &[ObjectModel], packed: &Packed) -> Result<Vec<Vec<LayerTextures>>> {
+    let mut out = Vec::new();
+    for (mi, m) in models.iter().enumerate() {
+        let mut per_layer = Vec::new();
+        for li in 0..m.layers.len() {
+            let layer = &packed.container.objects[mi].layers[li];
+            let mut map = std::collections::BTreeMap::new();
+            for (b, pb) in packed.blocks[mi][li].iter().enumerate() {
+                let block = &layer.blocks[b];
+                let layout = LevelLayout::of(layer, block);
+                let planes = layout.planes();
+                let decoded: Vec<Vec<Vec<f32>>> = pb.levels.iter().map(|(_, _, streams)| {
+                    streams.iter().map(|s| pis_codec::decode(layer_codec(block), &planes, s)).collect::<Result<Vec<_>, _>>()
+                }).collect::<Result<_, _>>()?;
+                for (s, k) in pb.keys.iter().enumerate() {
+                    let local = unflatten(s, &pb.extent);
+                    let mut sum = vec![0.0f32; pis_codec::value_count(&planes)?];
+                    for ((counts, _, _), imgs) in pb.levels.iter().zip(&decoded) {
+                        let img = &imgs[level_image_index(counts, &local, &pb.extent)];
+                        sum.iter_mut().zip(img).for_each(|(a, v)| *a += v);
+                    }
+                    let lin = finish(layer, &layout, sum);
+                    map.insert(k.clone(), mip_chain(m.layout(li, k), lin));
+                }
+            }
+            per_layer.push(map);
+        }
+        out.push(per_layer);
+    }
+    Ok(out)
+}
+
+fn layer_codec(block: &Block) -> CodecId {
+    block.levels.first().and_then(|l| l.images.first()).map_or(CodecId::Raw, |c| c.codec)
+}
+
+/// The solved textures of `m` per layer, each as the MIP chain the player rebuilds from its
+/// finest level.
+pub fn solved_chains(m: &ObjectModel) -> Vec<LayerTextures> {
+    m.layers.iter().enumerate().map(|(li, l)| {
+        l.textures.iter().map(|(k, x)| {
+            let layout = m.layout(li, k);
+            (k.clone(), mip_chain(layout, finest(layout, x)))
+        }).collect()
+    }).collect()
+}
+
+/// The MIP chain of layout `l` from the finest level, by decimation (thesis 3.6).
+pub fn mip_chain(l: pis_compile::TextureLayout, finest: Vec<f32>) -> Vec<f32> {
+    let mut x = finest.clone();
+    let mut cur = finest;
+    for lv in 1..l.levels {
+        let (w, h) = l.level_size(lv - 1);
+        cur = decimate(&cur, w, h, 3);
+        x.extend_from_slice(&cur);
+    }
+    x
+}
+
+/// The lossless master of every object (SPEC.md 6.7): each layer sample's finest solved
+/// texture, linear as solved, and the object's screen-area weight of allocation.
+pub fn masters(models: &[ObjectModel], packed: &Packed) -> Result<Vec<Master>> {
+    models.iter().enumerate().map(|(mi, m)| {
+        // Keys are sample indices over the layer's dimensions: their order is table order.
+        let textures: Vec<Vec<Vec<f32>>> = m.layers.iter().enumerate().map(|(li, l)| l.textures.iter().map(|(k, x)| finest(m.layout(li, k), x)).collect()).collect();
+        // The screen weights the allocation used, so that coding the master again allocates
+        // as this pack did.
+        let by_layer = &packed.screen_weights[mi];
+        let weights: Option<Vec<Vec<Vec<f32>>>> = by_layer.iter().all(|w| !w.is_empty())
+            .then(|| by_layer.iter().map(|w| w.values().cloned().collect()).collect());
+        Ok(Master::encode(&packed.container, mi, m.area, &textures, weights.as_deref())?)
+    }).collect()
+}
+
+/// Reads the written file's master back; returns its bytes and whether every texture decodes
+/// to the finest solved texture bit for bit.
+pub fn check_master(path: &Path, models: &[ObjectModel]) -> Result<(u64, bool)> {
+    let reader = PisReader::open(path)?;
+    let c = reader.container();
+    let masters = reader.masters()?;
+    let mut exact = masters.len() == models.len();
+    for (m, model) in masters.iter().zip(models) {
+        for (li, l) in model.layers.iter().enumerate() {
+            for (s, (k, x)) in l.textures.iter().enumerate() {
+                let got = m.texture(c, li, s)?;
+                let want = finest(model.layout(li, k), x);
+                exact &= got.len() == want.len() && got.iter().zip(&want).all(|(a, b)| a.to_bits() == b.to_bits());
+            }
+        }
+    }
+    Ok((reader.master_bytes(), exact))
+}
+
+/// Reads the written file back and checks that every level image decodes to exactly the
+/// values that were encoded (bit for bit), as the lossless codec promises.
+pub fn check_lossless(path: &Path, packed: &Packed) -> Result<bool> {
+    let reader = PisReader::open(path)?;
+    let c = reader.container();
+    for (mi, ob) in c.objects.iter().enumerate() {
+        for (li, layer) in ob.layers.iter().enumerate() {
+            for (b, block) in layer.blocks.iter().enumerate() {
+                let planes = LevelLayout::of(layer, block).planes();
+                for (lv, level) in block.levels.iter().enumerate() {
+                    for (ii, r) in level.images.iter().enumerate() {
+                        let bytes = reader.codestream(r)?;
+                        let got = pis_codec::decode(r.codec, &planes, &bytes)?;
+                        let want = &packed.blocks[mi][li][b].levels[lv].1[ii];
+                        if got.len() != want.len() || got.iter().zip(want).any(|(a, b)| a.to_bits() != b.to_bits()) {
+                            return Ok(false);
+                        }
+                    }
+                }
+            }
+        }
+    }
+    Ok(true)
+}
+
+/// Squared display error and pixel count per object of `textures` rendered through A,
+/// against the gold-standard layers.
+pub fn display_error(set: &LoadedSet, models: &[ObjectModel], textures: &[Vec<LayerTextures>]) -> Vec<(f64, usize)> {
+    let d = |v: f32| crate::images::srgb_encode(v.clamp(0.0, 1.0)) as f64;
+    models.iter().zip(textures).map(|(m, tex)| {
+        let (mut sse, mut n) = (0.0f64, 0usize);
+        for (p, s) in set.samples.iter().enumerate() {
+            let v = &m.views[p];
+            let mut img = vec![0.0f32; v.rows() * 3];
+            for (il, t) in m.layers.iter().zip(tex) {
+                let k = key(s, il.depends_on);
+                if let Some(x) = t.get(&k) {
+                    let r = pis_compile::render(v.a(il.placement_of[&k]), x);
+                    img.iter_mut().zip(&r).for_each(|(a, b)| *a += b);
+                }
+            }
+            for (k, g) in img.iter().enumerate() {
+                let gold = v.diffuse[k] + v.specular[k];
+                sse += (d(*g) - d(gold)).powi(2);
+            }
+            n += img.len();
+        }
+        (sse, n)
+    }).collect()
+}
+
+/// The file's record of the player's filter (SPEC.md 6.6).
+fn file_filter(f: pis_compile::Filter) -> pis_format::FileFilter {
+    match f {
+        pis_compile::Filter::Nearest => pis_format::FileFilter::Nearest,
+        pis_compile::Filter::Bilinear => pis_format::FileFilter::Bilinear,
+        pis_compile::Filter::Trilinear => pis_format::FileFilter::Trilinear,
+        pis_compile::Filter::Anisotropic(n) => pis_format::FileFilter::Anisotropic(n),
+    }
+}
+
+/// PSNR in dB (peak 1) of a squared error sum over `n` values.
+pub fn psnr(sse: f64, n: usize) -> f64 {
+    10.0 * (1.0 / (sse / n.max(1) as f64).max(1e-20)).log10()
+}
+
+/// Predicted quality: per object (decoded, as solved) and overall, plus the largest
+/// difference between decoded and solved finest texels.
+pub struct Quality {
+    pub objects: Vec<(f64, f64)>,
+    pub overall: f64,
+    pub overall_solved: f64,
+    pub max_texel_error: f32,
+}
+
+/// Renders the decoded and the solved textures through the render matrices (the hardware
+/// model's or probe mode's).
+pub fn predicted_psnr(set: &LoadedSet, models: &[ObjectModel], packed: &Packed) -> Result<Quality> {
+    let decoded = decoded_textures(models, packed)?;
+    let solved: Vec<Vec<LayerTextures>> = models.iter().map(solved_chains).collect();
+    let mut max_err = 0.0f32;
+    for (m, (dl, sl)) in models.iter().zip(decoded.iter().zip(&solved)) {
+        for (li, (dm, sm)) in dl.iter().zip(sl).enumerate() {
+            for (k, x) in sm {
+                let l = m.layout(li, k);
+                let n = l.width as usize * l.height as usize * 3;
+                if let Some(y) = dm.get(k) {
+                    for (a, b) in x[..n].iter().zip(&y[..n]) {
+                        max_err = max_err.max((a - b).abs());
+                    }
+                }
+            }
+        }
+    }
+    let e_dec = display_error(set, models, &decoded);
+    let e_sol = display_error(set, models, &solved);
+    let total = |e: &[(f64, usize)]| {
+        let (s, n) = e.iter().fold((0.0, 0), |a, x| (a.0 + x.0, a.1 + x.1));
+        psnr(s, n)
+    };
+    Ok(Quality {
+        objects: e_dec.iter().zip(&e_sol).map(|(a, b)| (psnr(a.0, a.1), psnr(b.0, b.1))).collect(),
+        overall: total(&e_dec),
+        overall_solved: total(&e_sol),
+        max_texel_error: max_err,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::sample_weights;
+
+    #[test]
+    fn sample_weights_sum_the_points_that_read_a_sample_scaled_to_mean_one() {
+        let per_point = vec![vec![2.0, 0.0, 0.0, 2.0], vec![0.0, 0.0, 4.0, 0.0], vec![1.0, 1.0, 1.0, 1.0]];
+        // two views of a view-independent sample: texels seen by both weigh most, the
+        // texel no view reads weighs nothing
+        let w = sample_weights(&per_point[..2]);
+        assert_eq!(w, vec![1.0, 0.0, 2.0, 1.0]);
+        assert!((w.iter().sum::<f32>() / 4.0 - 1.0).abs() < 1e-6);
+        assert_eq!(sample_weights(&per_point[2..]), vec![1.0; 4]);
+        // a sample no point shows weighs nothing anywhere
+        assert_eq!(sample_weights(&[vec![0.0; 3]]), vec![0.0; 3]);
+        assert!(sample_weights(&[]).is_empty());
+    }
+}
+
+/// An allocation that cannot meet its target says which target to ask for instead
+/// (exit 1: the request, not the input, is at fault); other failures are runtime errors.
+fn target_failure(e: anyhow::Error, raw: u64) -> Failure {
+    use pis_codec::allocate::AllocError;
+    match e.downcast_ref::<AllocError>() {
+        Some(AllocError::Budget { needed, budget }) => Failure::new(Exit::Usage, anyhow!(
+            "the ratio leaves {budget} bytes for the level images, but their smallest encodings need {needed}: the highest ratio this set reaches is {:.1}:1 (raw images {raw} bytes)",
+            raw as f64 / (*needed).max(1) as f64
+        )),
+        Some(AllocError::Unreachable { db, best_db }) => Failure::new(Exit::Usage, anyhow!(
+            "--psnr {db} dB is out of reach: the stored textures reach at most {best_db:.2} dB (coding PSNR at the codec's full rate); ask for at most that, or use --codec lossless"
+        )),
+        _ => Failure::new(Exit::Runtime, e),
+    }
+}

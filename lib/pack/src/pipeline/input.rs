@@ -1,0 +1,145 @@
+//! The pack's input: a ray-traced set (traced first when given a scene.toml), its scene,
+//! and every point's images, checked before any work is done.
+
+use std::path::{Path, PathBuf};
+
+use anyhow::anyhow;
+use pis_scene::{Frame, LoadOptions, Scene};
+use pis_trace::set::RaySet;
+use pis_trace::{PointImages, TraceError, TraceSettings};
+
+use super::{PackRequest, Stages};
+use crate::error::{Exit, Failure};
+
+/// A set in memory with the scene it was traced from.
+pub struct LoadedSet {
+    pub dir: PathBuf,
+    pub scene: Scene,
+    pub resolution: (u32, u32),
+    /// Sample indices per point, in the set's (linear-index) order.
+    pub samples: Vec<Vec<u32>>,
+    pub frames: Vec<Frame>,
+    pub images: Vec<PointImages>,
+    /// Per object, the set's channel name (`object.<name>` prefix of its layers).
+    pub channels: Vec<String>,
+    /// The set's display filter (`set.json` `filter`, RAYSET.md section 4).
+    pub display_filter: pis_trace::film::GaussianFilter,
+}
+
+impl LoadedSet {
+    /// Raw image bytes of the set at 3 bytes per pixel (thesis 4.8).
+    pub fn raw_image_bytes(&self) -> u64 {
+        self.samples.len() as u64 * self.resolution.0 as u64 * self.resolution.1 as u64 * 3
+    }
+}
+
+fn trace_failure(e: TraceError) -> Failure {
+    let exit = match &e {
+        TraceError::Io { .. } => Exit::Io,
+        TraceError::Exr { .. } | TraceError::InvalidSet { .. } => Exit::Invalid,
+        TraceError::Scene(_) | TraceError::InvalidInput(_) => Exit::Invalid,
+    };
+    Failure::new(exit, e)
+}
+
+fn invalid(msg: String) -> Failure {
+    Failure::new(Exit::Invalid, anyhow!(msg))
+}
+
+/// The cache directory a scene.toml is traced into: beside it, named by size and spp.
+pub fn cache_dir(scene_toml: &Path, scene: &Scene) -> PathBuf {
+    let dir = scene_toml.parent().unwrap_or(Path::new("."));
+    dir.join(".pis-cache").join(format!("{}-{}x{}-spp{}", scene.name, scene.resolution.0, scene.resolution.1, scene.spp))
+}
+
+/// True when a scene's parameter space is the one a set was traced over: the same
+/// dimensions (names, kinds) with the same sample values.
+fn same_space(scene: &Scene, set: &RaySet) -> bool {
+    scene.space.dims.len() == set.meta.space.len()
+        && scene.space.dims.iter().zip(&set.meta.space).all(|(d, m)| {
+            d.name == m.name
+                && d.kind.name() == m.kind
+                && d.values.len() == m.values.len()
+                && d.values.iter().zip(&m.values).all(|(a, b)| (a - b).abs() <= 1e-4 * a.abs().max(b.abs()).max(1.0))
+        })
+}
+
+/// Loads the scene a set was traced from at the set's resolution: scene.toml as written, or,
+/// when the set's parameter space is that of one of its `[preset.NAME]`s (a set traced with
+/// `pis-trace --preset NAME`), with that preset. A preset named by the caller is used as is.
+pub fn set_scene(set: &RaySet, scene_path: &Path, res: (u32, u32), preset: Option<&str>) -> Result<Scene, Failure> {
+    let load = |preset: Option<String>| {
+        let options = LoadOptions { preset, resolution: Some(res), ..LoadOptions::default() };
+        pis_scene::load_with(scene_path, &options)
+            .map_err(|e| Failure::new(Exit::Invalid, anyhow!("loading {} (the set's scene; pass --scene): {e}", scene_path.display())))
+    };
+    if let Some(p) = preset {
+        return load(Some(p.to_string()));
+    }
+    let scene = load(None)?;
+    if same_space(&scene, set) {
+        return Ok(scene);
+    }
+    let presets = pis_scene::manifest::Manifest::read(scene_path).map(|m| m.presets.into_keys().collect::<Vec<_>>()).unwrap_or_default();
+    for name in presets {
+        if let Ok(s) = load(Some(name)) {
+            if same_space(&s, set) {
+                return Ok(s);
+            }
+        }
+    }
+    Ok(scene)
+}
+
+/// Opens (or traces) the set, loads its scene and reads and checks every point.
+pub fn load(req: &PackRequest, stages: &mut Stages) -> Result<LoadedSet, Failure> {
+    let (dir, scene_path) = if req.input.is_dir() {
+        let set = RaySet::open(&req.input).map_err(trace_failure)?;
+        (req.input.clone(), set.default_scene())
+    } else if req.input.is_file() {
+        let options = LoadOptions { preset: req.preset.clone(), resolution: req.resolution, spp: req.spp };
+        let scene = pis_scene::load_with(&req.input, &options).map_err(|e| Failure::new(Exit::Invalid, e))?;
+        let dir = cache_dir(&req.input, &scene);
+        if !dir.join("set.json").is_file() {
+            let settings = TraceSettings::new(scene.resolution, scene.spp);
+            let r = pis_trace::render_set(&scene, &dir, &settings, None, &pis_trace::NoProgress).map_err(trace_failure)?;
+            stages.done("trace", &format!("{} points into {}", r.points, dir.display()));
+        }
+        (dir, req.input.clone())
+    } else {
+        return Err(Failure::new(Exit::Io, anyhow!("{}: no such set directory or scene file", req.input.display())));
+    };
+    let scene_path = req.scene.clone().unwrap_or(scene_path);
+    let set = RaySet::open(&dir).map_err(trace_failure)?;
+    let res = (set.meta.resolution[0], set.meta.resolution[1]);
+    let scene = set_scene(&set, &scene_path, res, req.preset.as_deref())?;
+    if set.meta.points.len() != scene.space.point_count() {
+        return Err(invalid(format!("{}: the set has {} points, the scene's space {}", dir.display(), set.meta.points.len(), scene.space.point_count())));
+    }
+    let mut samples = Vec::new();
+    let mut frames = Vec::new();
+    let mut images = Vec::new();
+    for (i, p) in set.meta.points.iter().enumerate() {
+        if p.samples != scene.space.point(i) {
+            return Err(invalid(format!("{}: point {i} has samples {:?}, expected {:?}", dir.display(), p.samples, scene.space.point(i))));
+        }
+        let img = set.read_point(i).map_err(trace_failure)?;
+        if (img.width, img.height) != res {
+            return Err(invalid(format!("{}: point {i} is {}x{}, the set declares {}x{}", dir.display(), img.width, img.height, res.0, res.1)));
+        }
+        for l in &img.layers {
+            if l.width != res.0 || l.height != res.1 {
+                return Err(invalid(format!("{}: point {i} layer {} is {}x{}, the set declares {}x{}", dir.display(), l.name, l.width, l.height, res.0, res.1)));
+            }
+            if let Some(c) = l.planes.iter().position(|p| p.iter().any(|v| !v.is_finite())) {
+                return Err(invalid(format!("{}: point {i} layer {} channel {} has NaN or infinite pixels", dir.display(), l.name, l.channels[c])));
+            }
+        }
+        frames.push(scene.frame(&p.samples).map_err(|e| Failure::new(Exit::Invalid, e))?);
+        samples.push(p.samples.clone());
+        images.push(img);
+    }
+    let channels = pis_trace::channel_names(&scene);
+    stages.done("read", &format!("{} points of {}x{} from {}", samples.len(), res.0, res.1, dir.display()));
+    Ok(LoadedSet { dir, scene, resolution: res, samples, frames, images, channels, display_filter: set.meta.filter })
+}

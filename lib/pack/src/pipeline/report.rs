@@ -1,0 +1,195 @@
+//! The closing report of `pis-pack` (stderr lines; `--json` on stdout).
+
+use std::collections::BTreeMap;
+
+use serde::Serialize;
+
+use super::encode::{Packed, Quality};
+use super::infer_layers::ObjectModel;
+use super::input::LoadedSet;
+use super::{PackRequest, Stages};
+
+/// One object's part of the report.
+#[derive(Clone, Debug, Serialize)]
+pub struct ObjectReport {
+    pub name: String,
+    /// The layers stored: `diffuse`, `specular` or `diffuse+specular`.
+    pub representation: String,
+    /// Why this representation was chosen.
+    pub why: String,
+    /// Codestream bytes of the object's level images.
+    pub bytes: usize,
+    /// Codestream bytes per stored layer.
+    pub layer_bytes: BTreeMap<String, usize>,
+    /// Predicted PSNR of the decoded textures through the hardware model.
+    pub psnr_db: f64,
+    /// The same for the textures as solved, before coding: the inference's own limit.
+    pub psnr_db_solved: f64,
+    /// The largest used texture size of the object's blocks.
+    pub texture: [u32; 2],
+    /// That texture's resolution reduction factor against thesis 3.2's optimal resolution
+    /// (below 1 where the texel budget, `--texels-per-pixel`, reduced it; `--max-texture`
+    /// clamps after it).
+    pub reduction: f64,
+    /// The used sizes of the distinct placements its blocks carry (thesis 3.2, per
+    /// parameter block; one with `--placement object`).
+    pub placements: Vec<[u32; 2]>,
+    /// Block origin offsets per dimension (thesis 4.7).
+    pub stagger: Vec<u32>,
+    pub blocks: usize,
+    pub level_images: usize,
+    pub solver_iterations: u64,
+    /// Mean covered pixels per point: the allocation's area weight.
+    pub area_px: f64,
+}
+
+/// The pack report (`--json` prints it).
+#[derive(Clone, Debug, Serialize)]
+pub struct PackReport {
+    pub output: String,
+    pub source: String,
+    pub codec: String,
+    /// The player's texture filter the textures were solved for (`nearest`, `bilinear`,
+    /// `trilinear`, `anisotropic`).
+    pub filter: String,
+    /// The anisotropy clamp of `anisotropic` filtering.
+    pub anisotropy: Option<u8>,
+    /// Where the render matrices came from: `model` (the hardware model) or `probe`
+    /// (measured through the GPU, thesis 3.4.3).
+    pub matrix: String,
+    /// Probe mode: test renderings made to measure every matrix (0 for the model).
+    pub probe_renderings: u64,
+    pub points: usize,
+    pub resolution: [u32; 2],
+    /// Raw image bytes of the set (points × width × height × 3).
+    pub raw_image_bytes: u64,
+    /// Bytes of the whole file, the lossless master included.
+    pub bytes: u64,
+    /// Bytes of the lossless master (`--keep-master`; 0 without): stored for re-encoding,
+    /// never read by a player, and not counted by `ratio`.
+    pub master_bytes: u64,
+    /// `--keep-master`: the master read back from the file decodes to the solved textures
+    /// bit for bit.
+    pub master_exact: Option<bool>,
+    /// Bytes of the level images alone.
+    pub texture_bytes: usize,
+    /// raw / bytes a player uses (file bytes less the master).
+    pub ratio: f64,
+    /// raw / level-image bytes.
+    pub ratio_without_geometry: f64,
+    /// The target ratio, when one was given (or the default); it applies to the level
+    /// images, `ratio_without_geometry`.
+    pub target_ratio: Option<f64>,
+    pub target_psnr_db: Option<f64>,
+    /// Predicted PSNR over every object's covered pixels, decoded textures.
+    pub psnr_db: f64,
+    /// The same with the textures as solved.
+    pub psnr_db_solved: f64,
+    /// Largest |decoded − solved| over the finest texels (linear).
+    pub max_texel_error: f32,
+    /// Lossless codec: every level image read back from the file decodes bit-exactly to
+    /// what was encoded, and the decoded finest texels equal the solved ones bit for bit.
+    pub lossless_exact: Option<bool>,
+    pub objects: Vec<ObjectReport>,
+    pub stage_ms: BTreeMap<String, f64>,
+    pub notes: Vec<String>,
+}
+
+#[allow(clippy::too_many_arguments)]
+pub fn build(set: &LoadedSet, models: &[ObjectModel], packed: &Packed, q: &Quality, bytes: u64,
+                    exact: Option<bool>, req: &PackRequest, stages: Stages) -> PackReport {
+    let raw = set.raw_image_bytes();
+    let texture_bytes: usize = packed.layer_bytes.iter().flatten().sum();
+    let objects = models.iter().enumerate().map(|(mi, m)| {
+        let ob = &packed.container.objects[mi];
+        let used = m.used_placements();
+        let largest = used.iter().map(|&p| &m.placements[p]).max_by_key(|p| p.layout.width as u64 * p.layout.height as u64).unwrap_or(&m.placements[0]);
+        ObjectReport {
+            name: m.name.clone(),
+            representation: m.representation.clone(),
+            why: m.why.clone(),
+            bytes: packed.layer_bytes[mi].iter().sum(),
+            layer_bytes: m.layers.iter().zip(&packed.layer_bytes[mi]).map(|(l, b)| (l.kind.name().to_string(), *b)).collect(),
+            psnr_db: q.objects[mi].0,
+            psnr_db_solved: q.objects[mi].1,
+            texture: [largest.layout.width, largest.layout.height],
+            reduction: largest.reduction,
+            placements: used.iter().map(|&p| [m.placements[p].layout.width, m.placements[p].layout.height]).collect(),
+            stagger: packed.stagger[mi].clone(),
+            blocks: ob.layers.iter().map(|l| l.blocks.len()).sum(),
+            level_images: ob.layers.iter().flat_map(|l| &l.blocks).flat_map(|b| &b.levels).map(|l| l.images.len()).sum(),
+            solver_iterations: m.layers.iter().map(|l| l.iterations).sum(),
+            area_px: m.area,
+        }
+    }).collect();
+    PackReport {
+        output: req.output.display().to_string(),
+        source: set.dir.display().to_string(),
+        codec: req.codec.name().to_string(),
+        filter: req.filter.name().to_string(),
+        anisotropy: match req.filter {
+            pis_compile::Filter::Anisotropic(n) => Some(n),
+            _ => None,
+        },
+        matrix: req.matrix.name().to_string(),
+        probe_renderings: 0,
+        points: set.samples.len(),
+        resolution: [set.resolution.0, set.resolution.1],
+        raw_image_bytes: raw,
+        bytes,
+        master_bytes: 0,
+        master_exact: None,
+        texture_bytes,
+        ratio: raw as f64 / bytes.max(1) as f64,
+        ratio_without_geometry: raw as f64 / texture_bytes.max(1) as f64,
+        target_ratio: if req.psnr.is_some() || !req.codec.is_lossy() { None } else { Some(req.ratio.unwrap_or(super::DEFAULT_RATIO)) },
+        target_psnr_db: req.psnr,
+        psnr_db: q.overall,
+        psnr_db_solved: q.overall_solved,
+        max_texel_error: q.max_texel_error,
+        lossless_exact: exact,
+        objects,
+        stage_ms: stages.ms.into_iter().collect(),
+        notes: vec![
+            "PSNR through the render matrices (hardware model, or measured through the GPU in probe mode): decoded textures (MIP chain rebuilt by decimation) rendered with A, against the traced diffuse + specular layers over covered pixels, display values (sRGB, peak 1)".into(),
+            format!("geometry, tables and headers: {} bytes", packed.overhead),
+        ],
+    }
+}
+
+impl PackReport {
+    /// Records the lossless master: its bytes leave `ratio` counting what a player uses.
+    pub fn set_master(&mut self, master_bytes: u64, exact: bool) {
+        self.master_bytes = master_bytes;
+        self.master_exact = Some(exact);
+        self.ratio = self.raw_image_bytes as f64 / self.bytes.saturating_sub(master_bytes).max(1) as f64;
+    }
+}
+
+/// Human-readable lines of the report.
+pub fn print_report(r: &PackReport, out: &mut impl std::io::Write) -> std::io::Result<()> {
+    writeln!(out, "{}: {} points of {}x{}, codec {}", r.output, r.points, r.resolution[0], r.resolution[1], r.codec)?;
+    let anisotropy = r.anisotropy.map(|n| format!(" {n}x")).unwrap_or_default();
+    let probe = if r.matrix == "probe" { format!(", {} probe renderings", r.probe_renderings) } else { String::new() };
+    writeln!(out, "  filter {}{anisotropy}, render matrices from the {}{probe}", r.filter, if r.matrix == "probe" { "GPU (probe mode)" } else { "hardware model" })?;
+    writeln!(out, "  {} bytes (level images {}), raw {} bytes: ratio {:.1} (without geometry {:.1})",
+             r.bytes, r.texture_bytes, r.raw_image_bytes, r.ratio, r.ratio_without_geometry)?;
+    if let Some(e) = r.master_exact {
+        writeln!(out, "  lossless master: {} bytes, not counted by the ratio; decodes to the solved textures bit-exactly: {e}", r.master_bytes)?;
+    }
+    writeln!(out, "  predicted PSNR {:.2} dB (textures as solved {:.2} dB)", r.psnr_db, r.psnr_db_solved)?;
+    if let Some(e) = r.lossless_exact {
+        writeln!(out, "  lossless: file decodes to the solved textures bit-exactly: {e} (max texel error {:.3e})", r.max_texel_error)?;
+    }
+    for o in &r.objects {
+        let layers: Vec<String> = o.layer_bytes.iter().map(|(k, b)| format!("{k} {b}")).collect();
+        let sizes = if o.placements.len() > 1 { format!(" up to, {} placements", o.placements.len()) } else { String::new() };
+        writeln!(out, "  {:<10} {:<17} {:>8} bytes ({}), {:.2} dB (solved {:.2}), {}x{}{sizes} (reduction {:.2}), stagger {:?}, {} blocks, {} level images",
+                 o.name, o.representation, o.bytes, layers.join(", "), o.psnr_db, o.psnr_db_solved, o.texture[0], o.texture[1],
+                 o.reduction, o.stagger, o.blocks, o.level_images)?;
+        writeln!(out, "             why: {}", o.why)?;
+    }
+    let stages: Vec<String> = r.stage_ms.iter().map(|(k, v)| format!("{k} {v:.0}")).collect();
+    writeln!(out, "  stages (ms): {}", stages.join(", "))?;
+    Ok(())
+}

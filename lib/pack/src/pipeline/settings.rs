@@ -1,0 +1,256 @@
+//! How to pack: [`PackSettings`], every choice of the compile pipeline with its default,
+//! and the presets (`const fn`s, in the manner of obvhs's build parameters).
+
+use pis_codec::CodecId;
+use pis_compile::Filter;
+
+use super::MatrixSource;
+
+/// Samples per parameter block along the dimensions (thesis 4.7).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum BlockSize {
+    /// The same size along every dimension.
+    Uniform(u32),
+    /// One size per dimension of the parameter space.
+    PerDimension(Vec<u32>),
+}
+
+impl BlockSize {
+    /// The sizes as `--block` writes them: one value for every dimension, or one each.
+    pub fn as_slice(&self) -> &[u32] {
+        match self {
+            BlockSize::Uniform(n) => std::slice::from_ref(n),
+            BlockSize::PerDimension(v) => v,
+        }
+    }
+
+    /// One value: the same for every dimension; several: one per dimension.
+    pub fn from_sizes(sizes: Vec<u32>) -> Self {
+        match sizes.as_slice() {
+            [n] => BlockSize::Uniform(*n),
+            _ => BlockSize::PerDimension(sizes),
+        }
+    }
+}
+
+/// Every setting of a pack. [`PackSettings::new`] gives pis-pack's defaults; the presets
+/// and the `with_*` methods change them, `const` where they can be.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PackSettings {
+    /// Target compression ratio: level-image bytes = raw image bytes / ratio (thesis 4.8;
+    /// geometry and tables come on top). `None` with no `psnr`: [`DEFAULT_RATIO`].
+    pub ratio: Option<f64>,
+    /// Target PSNR (dB) of the coded textures instead of a ratio: the fewest bytes that
+    /// reach it.
+    pub psnr: Option<f64>,
+    /// The level-image codec: wavelet (default), dct, or lossless.
+    pub codec: CodecId,
+    /// Samples per parameter block (default 8 along every dimension).
+    pub block: BlockSize,
+    /// The player's texture filter; `Anisotropic` needs `matrix: Probe`.
+    pub filter: Filter,
+    /// Where the render matrices come from: the hardware model (default) or probe mode,
+    /// measured through the player's pipeline on a GPU adapter (thesis 3.4.3).
+    pub matrix: MatrixSource,
+    /// Largest used texture side (a GPU limit, not the resolution control).
+    pub max_texture: u32,
+    /// Texel budget: at most this many level-0 texels per pixel an object covers (its most
+    /// covered view); `None`: the optimal resolution of thesis 3.2, capped by
+    /// `max_texture` only.
+    pub texels_per_pixel: Option<f64>,
+    /// Display gamma g of the compensation γ(L) = L^(1/g) (thesis 4.6); lossless packs
+    /// use 1.
+    pub gamma: f32,
+    /// Pyramid levels per block: the adaptive search (thesis 4.3) or the full dyadic
+    /// sequence.
+    pub pyramid: PyramidMode,
+    /// Lighting layers: separate diffuse and specular layers, or one combined
+    /// view-dependent layer per parameter sample.
+    pub layers: LayerMode,
+    /// What the storage allocation weighs: screen error (default) or texture error.
+    pub allocation: Allocation,
+    /// Texture placements per parameter block (default) or per object.
+    pub placement: PlacementMode,
+    /// Conjugate-gradient iteration cap per colour channel of every solve (`None`: the
+    /// solver's default).
+    pub max_iterations: Option<u32>,
+    /// Also store the lossless master (SPEC.md 6.7): every solved texture before gamma
+    /// compensation and coding, so that pis-reencode codes again from the solve.
+    pub keep_master: bool,
+    /// Tracing a scene.toml: a `[preset.NAME]` applied before the size overrides (also
+    /// the preset a set's scene is read with).
+    pub preset: Option<String>,
+    /// Tracing a scene.toml: image size override.
+    pub resolution: Option<(u32, u32)>,
+    /// Tracing a scene.toml: samples per pixel override.
+    pub spp: Option<u32>,
+}
+
+impl Default for PackSettings {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl PackSettings {
+    /// pis-pack's defaults: 384:1 with the wavelet codec, 8-sample blocks, trilinear
+    /// filtering through the hardware model, one level-0 texel per covered pixel, screen-error
+    /// allocation, texture placements per block.
+    pub const fn new() -> Self {
+        PackSettings {
+            ratio: None,
+            psnr: None,
+            codec: CodecId::Wavelet,
+            block: BlockSize::Uniform(DEFAULT_BLOCK),
+            filter: Filter::Trilinear,
+            matrix: MatrixSource::Model,
+            max_texture: DEFAULT_MAX_TEXTURE,
+            texels_per_pixel: DEFAULT_TEXELS_PER_PIXEL,
+            gamma: DEFAULT_GAMMA,
+            pyramid: PyramidMode::Adaptive,
+            layers: LayerMode::Separate,
+            allocation: Allocation::Screen,
+            placement: PlacementMode::Block,
+            max_iterations: None,
+            keep_master: false,
+            preset: None,
+            resolution: None,
+            spp: None,
+        }
+    }
+
+    /// Every solved texture stored exactly (lossless codec, linear storage): the decoded
+    /// textures are the solved ones bit for bit.
+    pub const fn lossless() -> Self {
+        Self::new().with_codec(CodecId::Lossless)
+    }
+
+    /// The thesis's own choices where they differ from the defaults: one texture placement
+    /// per object over every view, texture error weighted by screen area.
+    pub const fn thesis() -> Self {
+        let mut s = Self::new();
+        s.placement = PlacementMode::Object;
+        s.allocation = Allocation::Texture;
+        s
+    }
+
+    /// Render matrices measured on this machine's GPU adapter (probe mode, thesis 3.4.3).
+    pub const fn probe() -> Self {
+        let mut s = Self::new();
+        s.matrix = MatrixSource::Probe;
+        s
+    }
+
+    /// Aim at a compression ratio.
+    pub const fn with_ratio(mut self, ratio: f64) -> Self {
+        self.ratio = Some(ratio);
+        self.psnr = None;
+        self
+    }
+
+    /// Aim at a PSNR (dB) of the coded textures.
+    pub const fn with_psnr(mut self, db: f64) -> Self {
+        self.psnr = Some(db);
+        self.ratio = None;
+        self
+    }
+
+    /// Code with `codec` (gamma 1 for exact codecs, [`DEFAULT_GAMMA`] for lossy ones).
+    pub const fn with_codec(mut self, codec: CodecId) -> Self {
+        self.codec = codec;
+        self.gamma = if codec.is_lossy() { DEFAULT_GAMMA } else { 1.0 };
+        self
+    }
+
+    /// The same block size along every dimension.
+    pub fn with_block(mut self, samples: u32) -> Self {
+        self.block = BlockSize::Uniform(samples);
+        self
+    }
+
+    /// The texel budget (`None`: the optimal resolution).
+    pub const fn with_texels_per_pixel(mut self, k: Option<f64>) -> Self {
+        self.texels_per_pixel = k;
+        self
+    }
+
+    /// Keep the lossless master beside the level images.
+    pub const fn with_master(mut self) -> Self {
+        self.keep_master = true;
+        self
+    }
+}
+
+/// How each block's pyramid levels are chosen.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum PyramidMode {
+    /// Greedy choice of each level's counts (thesis 4.3).
+    #[default]
+    Adaptive,
+    /// Every dimension halved (rounding up) per level down to one sample: no search.
+    Full,
+}
+
+/// The error the storage allocation (thesis 4.5) minimizes.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Allocation {
+    /// Each level image's error weighted per texel by how much of the screen the texel
+    /// reaches through the render matrices (column sums of A, carried down the decimation),
+    /// so storage goes where errors are seen: texels no pixel reads weigh nothing, texels
+    /// that magnified pixels read weigh more.
+    #[default]
+    Screen,
+    /// Texture MSE weighted by each object's screen area (every texel of an object alike).
+    Texture,
+}
+
+/// Which views a texture placement (thesis 3.2) is optimized over.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum PlacementMode {
+    /// Per object per parameter block: the views of the block's samples (thesis 3.2).
+    #[default]
+    Block,
+    /// One placement per object over every view of the set, shared by all its blocks.
+    Object,
+}
+
+impl PlacementMode {
+    /// The name `--placement` and the provenance use.
+    pub fn name(self) -> &'static str {
+        match self {
+            PlacementMode::Block => "block",
+            PlacementMode::Object => "object",
+        }
+    }
+}
+
+/// How the lighting layers are separated.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum LayerMode {
+    /// A view-independent diffuse layer and a view-dependent specular layer (thesis 4.8).
+    #[default]
+    Separate,
+    /// One view-dependent layer of diffuse + specular radiance per parameter sample.
+    Combined,
+}
+
+/// The provenance setting holding the predicted PSNR (dB, display values over the pixels the
+/// objects cover) of a packed file.
+pub const PREDICTED_PSNR_SETTING: &str = "predicted_psnr_db";
+
+/// The default texel budget per covered pixel (`--texels-per-pixel`).
+pub const DEFAULT_TEXELS_PER_PIXEL: Option<f64> = Some(1.0);
+
+/// The default largest used texture side (`--max-texture`): a limit on what a GPU must
+/// hold, not the resolution control (the texel budget is).
+pub const DEFAULT_MAX_TEXTURE: u32 = 1024;
+
+/// The default samples per parameter block along each dimension (`--block`).
+pub const DEFAULT_BLOCK: u32 = 8;
+
+/// The default display gamma of the compensation of lossy codecs (`--gamma`).
+pub const DEFAULT_GAMMA: f32 = 2.2;
+
+/// The default compression ratio when neither `--ratio` nor `--psnr` is given.
+pub const DEFAULT_RATIO: f64 = 384.0;
+

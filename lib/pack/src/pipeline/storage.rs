@@ -1,0 +1,241 @@
+//! Level images and the storage they get: the adaptive Laplacian pyramid of one parameter
+//! block (thesis 4.3), equal-slope storage allocation over every level image of every block,
+//! layer and object with screen-area weights (4.5), and the encoding at the allocated rates.
+//! `pis-pack` and `pis-reencode` code their textures through here.
+
+use anyhow::{anyhow, Result};
+use pis_codec::allocate::{allocate, Item, Target, DEFAULT_ALPHA};
+use pis_codec::pyramid::{adaptive, build, l1_cost, level_image_index, unflatten, Pyramid, PyramidFilter, PyramidLevel};
+use pis_codec::{CodecId, PlaneShape, Rate};
+use rayon::prelude::*;
+
+
+/// One pyramid level as coded: counts, the images as encoded, their codestreams.
+pub type CodedLevel = (Vec<u32>, Vec<Vec<f32>>, Vec<Vec<u8>>);
+
+/// The full pyramid's level counts, top first: every dimension halved (rounding up) per
+/// level until one sample is left.
+pub fn full_levels(extent: &[u32]) -> Vec<Vec<u32>> {
+    let mut levels = vec![extent.to_vec()];
+    while levels.last().is_some_and(|c| c.iter().any(|&v| v > 1)) {
+        let next: Vec<u32> = levels[levels.len() - 1].iter().map(|v| v.div_ceil(2)).collect();
+        levels.push(next);
+    }
+    levels.reverse();
+    levels
+}
+
+/// One parameter block's pyramid, ready to be allocated and encoded.
+pub struct BlockPyramid {
+    /// The object the block belongs to: an index into the allocation's screen areas.
+    pub object: usize,
+    pub planes: Vec<PlaneShape>,
+    pub extent: Vec<u32>,
+    /// Finest samples of the block's layer over all its blocks: a level image's weight in
+    /// its object's error is the share of these samples it reaches.
+    pub layer_samples: f64,
+    /// Per level, top first: counts, images as encoded, codestreams (empty until encoded).
+    pub levels: Vec<CodedLevel>,
+    /// Screen weight of every texel of every finest sample (row-major over `extent`; one
+    /// value per texel, mean 1 where the sample shows): how much of the screen each texel's
+    /// error reaches. With them the allocation weighs texture error as screen error; None:
+    /// every texel weighs the same.
+    pub texel_weights: Option<Vec<Vec<f32>>>,
+}
+
+/// Builds the adaptive pyramid of a block's finest samples (gamma-compensated, row-major over
+/// `extent`). With `exact` (lossless and raw codecs) the finest level is adjusted so that the
+/// decoder's sum gives every sample back bit for bit.
+///
+/// `full`: every level of the pyramid over the block, without adaptive subdivision (the
+/// baseline `pis-pack --pyramid full` compares against).
+pub fn build_pyramid(object: usize, planes: Vec<PlaneShape>, extent: &[u32], samples: &[Vec<f32>], layer_samples: f64, exact: bool, full: bool) -> Result<BlockPyramid> {
+    let mut pyr = if full {
+        build(extent, samples, &full_levels(extent), PyramidFilter::Gaussian)?
+    } else {
+        adaptive(extent, samples, PyramidFilter::Gaussian, l1_cost)?.0
+    };
+    if exact {
+        exact_finest(&mut pyr, samples, extent);
+    }
+    let levels = pyr.levels.into_iter().map(|l| {
+        let n = l.images.len();
+        (l.counts, l.images, vec![Vec::new(); n])
+    }).collect();
+    Ok(BlockPyramid { object, planes, extent: extent.to_vec(), layer_samples, levels, texel_weights: None })
+}
+
+/// What the allocation gave: bytes per level image (in block, level, image order), or the
+/// codec's default rate for exact codecs.
+pub struct Storage {
+    pub rates: Vec<Rate>,
+    /// Bytes the allocation spends (lossy codecs).
+    pub allocated: Option<usize>,
+    pub level_images: usize,
+}
+
+/// Equal-slope allocation (thesis 4.5) over every level image of `blocks` for a lossy
+/// `codec`: each level image's rate–distortion curve, weighted by the share of its layer's
+/// samples it reaches and by its object's screen area `areas[object]`, with the max-MSE
+/// constraint [`DEFAULT_ALPHA`]. Exact codecs need no allocation.
+pub fn allocate_storage(blocks: &[BlockPyramid], codec: CodecId, target: Target, areas: &[f64]) -> Result<Storage> {
+    let refs: Vec<(usize, usize, usize)> = blocks.iter().enumerate()
+        .flat_map(|(b, pb)| pb.levels.iter().enumerate().flat_map(move |(lv, l)| (0..l.1.len()).map(move |ii| (b, lv, ii))))
+        .collect();
+    if !codec.is_lossy() {
+        return Ok(Storage { rates: vec![Rate::Default; refs.len()], allocated: None, level_images: refs.len() });
+    }
+    let c = pis_codec::codec(codec).ok_or_else(|| anyhow!("codec {codec} is not in this build"))?;
+    // How many finest samples each level image reaches.
+    let members: Vec<Vec<Vec<usize>>> = blocks.iter().map(|pb| {
+        let count: usize = pb.extent.iter().map(|&e| e as usize).product();
+        pb.levels.iter().map(|(counts, images, _)| {
+            let mut m = vec![0usize; images.len()];
+            for s in 0..count {
+                m[level_image_index(counts, &unflatten(s, &pb.extent), &pb.extent)] += 1;
+            }
+            m
+        }).collect()
+    }).collect();
+    let items = refs.par_iter().map(|&(b, lv, ii)| {
+        let pb = &blocks[b];
+        let values = &pb.levels[lv].1[ii];
+        let weights = level_image_weights(pb, lv, ii, values.len());
+        let curve = c.rd_curve_weighted(&pb.planes, values, weights.as_deref())?;
+        Ok(Item { curve, object: pb.object, weight: members[b][lv][ii] as f64 / pb.layer_samples })
+    }).collect::<Result<Vec<Item>, pis_codec::CodecError>>()?;
+    let a = allocate(&items, areas, target, Some(DEFAULT_ALPHA))?;
+    Ok(Storage { rates: a.bytes.into_iter().map(Rate::Bytes).collect(), allocated: Some(a.total_bytes), level_images: refs.len() })
+}
+
+/// The screen weight of every value of level image `ii` of level `lv`: the mean of the
+/// texel weights of the finest samples it reaches (its error adds to each of them), one
+/// value per channel.
+fn level_image_weights(pb: &BlockPyramid, lv: usize, ii: usize, values: usize) -> Option<Vec<f32>> {
+    let maps = pb.texel_weights.as_ref()?;
+    // one plane of interleaved channels (a surface texture's level 0)
+    let [plane] = pb.planes.as_slice() else { return None };
+    let texels = plane.width as usize * plane.height as usize;
+    let channels = plane.channels as usize;
+    if texels * channels != values || maps.iter().any(|m| m.len() != texels) {
+        return None;
+    }
+    let counts = &pb.levels[lv].0;
+    let mut sum = vec![0.0f64; texels];
+    let mut n = 0usize;
+    for (s, map) in maps.iter().enumerate() {
+        if level_image_index(counts, &unflatten(s, &pb.extent), &pb.extent) == ii {
+            sum.iter_mut().zip(map).for_each(|(a, w)| *a += *w as f64);
+            n += 1;
+        }
+    }
+    let n = n.max(1) as f64;
+    Some(sum.iter().flat_map(|w| std::iter::repeat_n((w / n) as f32, channels)).collect())
+}
+
+/// Encodes every level image of `blocks` at its allocated rate into the blocks' codestream
+/// slots; returns the bytes written.
+pub fn encode_levels(blocks: &mut [BlockPyramid], codec: CodecId, storage: &Storage) -> Result<usize> {
+    let c = pis_codec::codec(codec).ok_or_else(|| anyhow!("codec {codec} is not in this build"))?;
+    let mut rates = storage.rates.iter();
+    let mut jobs = Vec::new();
+    for (b, pb) in blocks.iter().enumerate() {
+        for (lv, l) in pb.levels.iter().enumerate() {
+            for ii in 0..l.1.len() {
+                let rate = *rates.next().ok_or_else(|| anyhow!("fewer rates than level images"))?;
+                jobs.push((b, lv, ii, rate));
+            }
+        }
+    }
+    let streams = jobs.par_iter().map(|&(b, lv, ii, rate)| {
+        let pb = &blocks[b];
+        c.encode(&pb.planes, &pb.levels[lv].1[ii], rate)
+    }).collect::<Result<Vec<Vec<u8>>, pis_codec::CodecError>>()?;
+    let mut total = 0;
+    for ((b, lv, ii, _), bytes) in jobs.into_iter().zip(streams) {
+        total += bytes.len();
+        blocks[b].levels[lv].2[ii] = bytes;
+    }
+    Ok(total)
+}
+
+/// Makes the finest level's residuals such that the decoder's f32 sum of the levels, top
+/// first, gives back every sample bit for bit: the residual `x − s` is nudged by a few ulps
+/// where rounding loses it; where no nudge works, the block falls back to a zero top level
+/// and the samples themselves.
+pub fn exact_finest(pyr: &mut Pyramid, samples: &[Vec<f32>], extent: &[u32]) {
+    let n_levels = pyr.levels.len();
+    let ok = (|| {
+        let (coarse, finest) = pyr.levels.split_at_mut(n_levels.checked_sub(1)?);
+        let finest = finest.first_mut()?;
+        for (si, x) in samples.iter().enumerate() {
+            let local = unflatten(si, extent);
+            let mut sum = vec![0.0f32; x.len()];
+            for l in coarse.iter() {
+                let img = &l.images[level_image_index(&l.counts, &local, extent)];
+                sum.iter_mut().zip(img).for_each(|(a, v)| *a += v);
+            }
+            let fi = level_image_index(&finest.counts, &local, extent);
+            let r = &mut finest.images[fi];
+            for ((rv, &sv), &xv) in r.iter_mut().zip(&sum).zip(x) {
+                let mut c = xv - sv;
+                let mut k: i32 = 0;
+                while (sv + c).to_bits() != xv.to_bits() {
+                    k += 1;
+                    if k > 16 {
+                        return None;
+                    }
+                    let step: i32 = (k + 1) / 2;
+                    let base = xv - sv;
+                    c = if k % 2 == 1 { nudge(base, step) } else { nudge(base, -step) };
+                }
+                *rv = c;
+            }
+        }
+        Some(())
+    })();
+    if ok.is_none() && extent.iter().any(|&e| e > 1) {
+        let ones = vec![1u32; extent.len()];
+        let n = samples.first().map_or(0, Vec::len);
+        pyr.levels = vec![
+            PyramidLevel { counts: ones, images: vec![vec![0.0; n]] },
+            PyramidLevel { counts: extent.to_vec(), images: samples.to_vec() },
+        ];
+    }
+}
+
+/// `v` moved by `ulps` representable steps (up when positive).
+pub fn nudge(v: f32, ulps: i32) -> f32 {
+    let mut x = v;
+    for _ in 0..ulps.unsigned_abs() {
+        x = if ulps > 0 { x.next_up() } else { x.next_down() };
+    }
+    x
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_level_image_weighs_the_mean_of_the_samples_it_reaches_per_channel() {
+        // A 1-D block of 4 samples, 2 texels each, RGB; pyramid levels: 1 image, then 4.
+        let extent = [4u32];
+        let samples: Vec<Vec<f32>> = (0..4).map(|s| vec![s as f32; 6]).collect();
+        let mut pb = build_pyramid(0, vec![PlaneShape::new(2, 1, 3)], &extent, &samples, 4.0, false, true).unwrap();
+        let maps = vec![vec![1.0, 0.0], vec![3.0, 0.0], vec![0.0, 2.0], vec![0.0, 2.0]];
+        assert!(level_image_weights(&pb, 0, 0, 6).is_none(), "no weights: uniform");
+        pb.texel_weights = Some(maps.clone());
+        let top = 0;
+        let finest = pb.levels.len() - 1;
+        assert_eq!(pb.levels[top].1.len(), 1);
+        // the top image reaches all four samples: the mean of the maps, per channel
+        assert_eq!(level_image_weights(&pb, top, 0, 6).unwrap(), vec![1.0, 1.0, 1.0, 1.0, 1.0, 1.0]);
+        // a finest image reaches its own sample only
+        let idx = level_image_index(&pb.levels[finest].0, &[1], &extent);
+        assert_eq!(level_image_weights(&pb, finest, idx, 6).unwrap(), vec![3.0, 3.0, 3.0, 0.0, 0.0, 0.0]);
+        // maps of the wrong size are ignored rather than misread
+        pb.texel_weights = Some(vec![vec![1.0; 3]; 4]);
+        assert!(level_image_weights(&pb, top, 0, 6).is_none());
+    }
+}
