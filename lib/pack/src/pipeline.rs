@@ -1,14 +1,17 @@
 //! `pis-pack`: a ray-traced set to a `.pis` container (thesis ch. 4).
 //!
-//! Per object: texture-coordinate optimization over the set's views (3.3); inference of the
-//! object's layers as parameterized surface textures (3.5) — a view-independent diffuse
-//! layer solved once over all views by stacking, depending on the non-view dimensions only,
-//! and a view-dependent specular layer solved per parameter sample with a warm start from
-//! the neighbouring sample; a layer that is black for an object is not stored. Each layer is
-//! cut into parameter-space blocks whose origins are staggered per object (4.7), each block
-//! coded as an adaptive Laplacian pyramid (4.3) of gamma-compensated textures (4.6), storage
-//! allocated by equal slopes across levels, objects and layers (4.5), and the container
-//! written atomically. MIP levels are not stored: the player decimates (3.6).
+//! The stages, one module each: [`input`] reads (or traces) the set; [`infer_layers`]
+//! chooses each object's representation and runs it ([`represent`] is the seam; today
+//! every object is stored as parameterized surface textures, [`surface`]: texture
+//! coordinates per block (3.2), a view-independent diffuse layer solved over all views by
+//! stacking and a view-dependent specular layer per parameter sample, warm-started, black
+//! layers left out (3.5)), giving an [`model::ObjectModel`] per object; [`encode`] cuts each
+//! layer into parameter-space blocks whose origins are staggered per object ([`blocks`],
+//! 4.7), builds an adaptive Laplacian pyramid (4.3) of gamma-compensated samples (4.6) per
+//! block and allocates storage by equal slopes across levels, objects and layers
+//! ([`storage`], 4.5), whatever representation made them; [`report`] says what came out.
+//! The container is written atomically. MIP levels are not stored: the player decimates
+//! (3.6).
 //!
 //! The render matrices A come from the hardware model or, with `matrix: Probe`, are measured
 //! through the player's pipeline on the GPU (probe mode, thesis 3.4.3; [`matrices`]), which
@@ -22,9 +25,12 @@ pub mod encode;
 pub mod infer_layers;
 pub mod input;
 pub mod matrices;
+pub mod model;
 pub mod report;
+pub mod represent;
 pub mod settings;
 pub mod storage;
+pub mod surface;
 pub mod sweep;
 
 use std::path::PathBuf;
@@ -127,6 +133,11 @@ impl<'p> Stages<'p> {
 
     pub fn note(&self, text: &str) {
         self.progress.note(text);
+    }
+
+    /// Where the progress goes.
+    pub fn progress(&self) -> &'p dyn Progress {
+        self.progress
     }
 }
 

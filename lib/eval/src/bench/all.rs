@@ -1,5 +1,5 @@
 //! `pis-bench all`: every chart from scratch on demo1 (trace → pack → evaluate) at a
-//! preset: `ci` (80×60, 1 spp, demo1's 16 points: minutes on 2 cores) or `paper` (demo1's
+//! preset: `ci` (80×60, 1 spp, demo1's 16 points: under a minute on 2 cores) or `paper` (demo1's
 //! paper preset: 640×480, 16 spp, 64 points).
 
 use std::path::{Path, PathBuf};

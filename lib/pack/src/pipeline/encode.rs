@@ -11,18 +11,18 @@ use pis_codec::allocate::Target;
 use pis_codec::pyramid::{level_image_index, unflatten};
 use pis_codec::CodecId;
 use pis_format::blocks::BlockGrid;
-use pis_format::mip::decimate;
 use pis_format::reconstruct::{finish, prepare};
 use pis_format::*;
 
-use super::infer_layers::{key, ObjectModel};
+use super::model::{key, ObjectModel};
 use super::input::LoadedSet;
 use super::blocks::{block_sizes, geometry, stagger, transforms};
 use super::storage::{allocate_storage, build_pyramid, encode_levels, CodedLevel};
+pub use super::surface::{finest, mip_chain};
 use super::{PackRequest, Stages};
 use crate::error::{Exit, Failure};
 
-/// Linear textures of one layer, keyed like [`super::infer_layers::InferredLayer::textures`].
+/// Linear textures of one layer, keyed like [`super::model::InferredLayer::textures`].
 pub type LayerTextures = std::collections::BTreeMap<Vec<u32>, Vec<f32>>;
 
 /// One block of one layer as coded: which layer sample each block-local sample is, and the
@@ -48,26 +48,6 @@ pub struct Packed {
     /// Per object model, per layer: each layer sample's screen weights, by key (empty
     /// without screen-error allocation); the allocation and the master use them.
     pub screen_weights: Vec<Vec<BTreeMap<Vec<u32>, Vec<f32>>>>,
-}
-
-fn surface_layer(kind: LayerKind, order: u8, depends_on: DepMask, gamma: f32) -> Layer {
-    Layer {
-        kind,
-        mapping: Mapping::Surface,
-        channels: 3,
-        mip_mode: MipMode::Decimated,
-        term: Term::Surface,
-        order,
-        combine: Combine::Add,
-        gamma,
-        depends_on,
-        blocks: vec![],
-    }
-}
-
-/// The finest level of a solved texture of layout `layout` (the chain's level 0).
-pub fn finest(layout: pis_compile::TextureLayout, x: &[f32]) -> Vec<f32> {
-    x[..layout.width as usize * layout.height as usize * 3].to_vec()
 }
 
 /// The screen weight of every level-0 texel of a texture placed by `placement` at one
@@ -108,7 +88,7 @@ fn layer_screen_weights(m: &ObjectModel, li: usize, samples: &[Vec<u32>]) -> BTr
         let pid = il.placement_of[k];
         let per_point: Vec<Vec<f64>> = samples.iter().enumerate().filter(|(_, s)| key(s, il.depends_on) == *k)
             .map(|(p, _)| screen_weights_at(m.views[p].a(pid))).collect();
-        let w = if per_point.is_empty() { vec![0.0; m.placements[pid].layout.width as usize * m.placements[pid].layout.height as usize] } else { sample_weights(&per_point) };
+        let w = if per_point.is_empty() { vec![0.0; il.form.stored_texels(k)] } else { sample_weights(&per_point) };
         (k.clone(), w)
     }).collect()
 }
@@ -145,19 +125,13 @@ pub fn encode_all(set: &LoadedSet, models: &[ObjectModel], req: &PackRequest, st
         let mut layer_blocks = Vec::new();
         for (li, il) in m.layers.iter().enumerate() {
             let layer_weights = &weights_by_layer[li];
-            let mut layer = surface_layer(il.kind, li as u8, il.depends_on, req.gamma);
+            let mut layer = il.form.layer(il.kind, li as u8, il.depends_on, req.gamma);
             let grid = BlockGrid::new(&space, il.depends_on, &st);
             let layer_samples = il.textures.len().max(1) as f64;
             let mut pblocks = Vec::new();
             for b in 0..grid.block_count() as usize {
                 let extent = grid.extent(b);
-                let placed = &m.placements[il.block_placements[b]];
-                let block = Block {
-                    width: placed.layout.width,
-                    height: placed.layout.height,
-                    placement: Placement::Surface { affine: placed.transform.values, repeat: placed.repeat, cut: placed.transform.cut },
-                    levels: vec![],
-                };
+                let block = il.form.block(b);
                 let layout = LevelLayout::of(&layer, &block);
                 let planes = layout.planes();
                 let count: usize = extent.iter().map(|&e| e as usize).product();
@@ -175,7 +149,7 @@ pub fn encode_all(set: &LoadedSet, models: &[ObjectModel], req: &PackRequest, st
                     }
                     let idx = pos.local.iter().zip(&pos.extent).fold(0usize, |a, (&l, &e)| a * e as usize + l as usize);
                     keys[idx] = k.clone();
-                    samples[idx] = prepare(&layer, &layout, &finest(placed.layout, x));
+                    samples[idx] = prepare(&layer, &layout, &il.form.stored(k, x));
                     if let Some(w) = layer_weights.get(k) {
                         weights[idx] = w.clone();
                     }
@@ -295,7 +269,7 @@ pub fn encode_all(set: &LoadedSet, models: &[ObjectModel], req: &PackRequest, st
 }
 
 /// Decoded linear textures (whole MIP chain, rebuilt by decimation as the player does), per
-/// object model and layer, keyed like [`super::infer_layers::InferredLayer::textures`].
+/// object model and layer, keyed like [`super::model::InferredLayer::textures`].
 pub fn decoded_textures(models: &[ObjectModel], packed: &Packed) -> Result<Vec<Vec<LayerTextures>>> {
     let mut out = Vec::new();
     for (mi, m) in models.iter().enumerate() {
@@ -318,7 +292,7 @@ pub fn decoded_textures(models: &[ObjectModel], packed: &Packed) -> Result<Vec<V
                         sum.iter_mut().zip(img).for_each(|(a, v)| *a += v);
                     }
                     let lin = finish(layer, &layout, sum);
-                    map.insert(k.clone(), mip_chain(m.layout(li, k), lin));
+                    map.insert(k.clone(), m.layers[li].form.drawn(k, lin));
                 }
             }
             per_layer.push(map);
@@ -335,24 +309,7 @@ fn layer_codec(block: &Block) -> CodecId {
 /// The solved textures of `m` per layer, each as the MIP chain the player rebuilds from its
 /// finest level.
 pub fn solved_chains(m: &ObjectModel) -> Vec<LayerTextures> {
-    m.layers.iter().enumerate().map(|(li, l)| {
-        l.textures.iter().map(|(k, x)| {
-            let layout = m.layout(li, k);
-            (k.clone(), mip_chain(layout, finest(layout, x)))
-        }).collect()
-    }).collect()
-}
-
-/// The MIP chain of layout `l` from the finest level, by decimation (thesis 3.6).
-pub fn mip_chain(l: pis_compile::TextureLayout, finest: Vec<f32>) -> Vec<f32> {
-    let mut x = finest.clone();
-    let mut cur = finest;
-    for lv in 1..l.levels {
-        let (w, h) = l.level_size(lv - 1);
-        cur = decimate(&cur, w, h, 3);
-        x.extend_from_slice(&cur);
-    }
-    x
+    m.layers.iter().map(|l| l.textures.iter().map(|(k, x)| (k.clone(), l.form.drawn(k, l.form.stored(k, x)))).collect()).collect()
 }
 
 /// The lossless master of every object (SPEC.md 6.7): each layer sample's finest solved
@@ -360,7 +317,7 @@ pub fn mip_chain(l: pis_compile::TextureLayout, finest: Vec<f32>) -> Vec<f32> {
 pub fn masters(models: &[ObjectModel], packed: &Packed) -> Result<Vec<Master>> {
     models.iter().enumerate().map(|(mi, m)| {
         // Keys are sample indices over the layer's dimensions: their order is table order.
-        let textures: Vec<Vec<Vec<f32>>> = m.layers.iter().enumerate().map(|(li, l)| l.textures.iter().map(|(k, x)| finest(m.layout(li, k), x)).collect()).collect();
+        let textures: Vec<Vec<Vec<f32>>> = m.layers.iter().map(|l| l.textures.iter().map(|(k, x)| l.form.stored(k, x)).collect()).collect();
         // The screen weights the allocation used, so that coding the master again allocates
         // as this pack did.
         let by_layer = &packed.screen_weights[mi];
@@ -381,7 +338,7 @@ pub fn check_master(path: &Path, models: &[ObjectModel]) -> Result<(u64, bool)> 
         for (li, l) in model.layers.iter().enumerate() {
             for (s, (k, x)) in l.textures.iter().enumerate() {
                 let got = m.texture(c, li, s)?;
-                let want = finest(model.layout(li, k), x);
+                let want = l.form.stored(k, x);
                 exact &= got.len() == want.len() && got.iter().zip(&want).all(|(a, b)| a.to_bits() == b.to_bits());
             }
         }
@@ -473,8 +430,7 @@ pub fn predicted_psnr(set: &LoadedSet, models: &[ObjectModel], packed: &Packed) 
     for (m, (dl, sl)) in models.iter().zip(decoded.iter().zip(&solved)) {
         for (li, (dm, sm)) in dl.iter().zip(sl).enumerate() {
             for (k, x) in sm {
-                let l = m.layout(li, k);
-                let n = l.width as usize * l.height as usize * 3;
+                let n = m.layers[li].form.stored_texels(k) * 3;
                 if let Some(y) = dm.get(k) {
                     for (a, b) in x[..n].iter().zip(&y[..n]) {
                         max_err = max_err.max((a - b).abs());

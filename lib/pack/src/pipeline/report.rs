@@ -5,7 +5,7 @@ use std::collections::BTreeMap;
 use serde::Serialize;
 
 use super::encode::{Packed, Quality};
-use super::infer_layers::ObjectModel;
+use super::model::ObjectModel;
 use super::input::LoadedSet;
 use super::{PackRequest, Stages};
 

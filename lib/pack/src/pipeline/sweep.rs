@@ -6,7 +6,8 @@ use std::time::Instant;
 use serde::Serialize;
 
 use super::encode::{decoded_textures, encode_all, predicted_psnr, solved_chains, LayerTextures};
-use super::infer_layers::{infer_all, ObjectModel};
+use super::infer_layers::infer_all;
+use super::model::ObjectModel;
 use super::input::{load, LoadedSet};
 use super::{PackRequest, Stages};
 use crate::error::{Exit, Failure};

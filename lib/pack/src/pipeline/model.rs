@@ -1,0 +1,118 @@
+//! A solved object, whatever represented it: its mesh and texture coordinates, the
+//! placements of its layers' blocks, the render matrices of every point (what the
+//! prediction and the screen-error allocation read), and every layer's solved samples.
+//! Encoding reads this.
+
+use std::collections::BTreeMap;
+
+use pis_compile::{RenderMatrix, TextureLayout};
+use pis_format::DepMask;
+
+use crate::infer::{Mesh, Placed};
+
+/// One point as the render matrices see an object (hardware model or probe mode): the rows
+/// of A per placement its layers read there (the rows, the covered pixels, are the same for
+/// every placement) and the gold standard of each layer at those pixels.
+pub struct PointView {
+    /// Per placement its layers read here: the render matrix.
+    pub(super) a: Vec<(usize, RenderMatrix)>,
+    pub diffuse: Vec<f32>,
+    pub specular: Vec<f32>,
+}
+
+impl PointView {
+    /// The render matrix of placement `placement` (of [`ObjectModel::placements`]).
+    pub fn a(&self, placement: usize) -> &RenderMatrix {
+        &self.a.iter().find(|(p, _)| *p == placement).expect("a render matrix for every placement a layer reads at the point").1
+    }
+
+    /// Covered pixels.
+    pub fn rows(&self) -> usize {
+        self.a.first().map_or(0, |(_, a)| a.rows())
+    }
+}
+
+/// A solved layer: one texture (the whole MIP chain of its placement's layout) per sample of
+/// the dimensions it depends on.
+pub struct InferredLayer {
+    pub kind: pis_format::LayerKind,
+    pub depends_on: DepMask,
+    /// Key: sample index per masked dimension, in dimension order.
+    pub textures: BTreeMap<Vec<u32>, Vec<f32>>,
+    /// Per block of the layer's grid (SPEC.md 7.2), its placement in
+    /// [`ObjectModel::placements`].
+    pub block_placements: Vec<usize>,
+    /// Per texture key, its block's placement.
+    pub placement_of: BTreeMap<Vec<u32>, usize>,
+    pub iterations: u64,
+    /// How the layer's samples are stored and rebuilt: its representation's part of
+    /// encoding.
+    pub form: Box<dyn LayerForm>,
+}
+
+/// How a layer's samples are stored in the container and rebuilt for drawing: what encoding
+/// asks of a representation ([`super::represent`]). The pyramids, the storage allocation
+/// and the codecs only see the values [`LayerForm::stored`] gives, in the planes of the
+/// container layer and blocks it describes.
+pub trait LayerForm: Send + Sync {
+    /// The container layer, without blocks, of a layer of `kind` drawn in `order` over the
+    /// dimensions `depends_on`, stored with gamma `gamma`.
+    fn layer(&self, kind: pis_format::LayerKind, order: u8, depends_on: DepMask, gamma: f32) -> pis_format::Layer;
+    /// Block `b` of the layer's grid as the container holds it (size, placement), without
+    /// levels.
+    fn block(&self, b: usize) -> pis_format::Block;
+    /// What the level images store of the solved sample `key` (`solved`: what the render
+    /// matrices read).
+    fn stored(&self, key: &[u32], solved: &[f32]) -> Vec<f32>;
+    /// What the render matrices read, rebuilt from stored values as the player rebuilds it.
+    fn drawn(&self, key: &[u32], stored: Vec<f32>) -> Vec<f32>;
+    /// Texels of sample `key` as stored (values per channel).
+    fn stored_texels(&self, key: &[u32]) -> usize;
+}
+
+/// An object's inferred representation.
+pub struct ObjectModel {
+    pub index: usize,
+    pub name: String,
+    pub mesh: Mesh,
+    /// The texture coordinates the file's mesh carries (before any block's branch cut).
+    pub mesh_uvs: Vec<[f32; 2]>,
+    /// The distinct placements of the object's blocks.
+    pub placements: Vec<Placed>,
+    /// Block origin offsets (thesis 4.7) and the samples per block the placements are for.
+    pub stagger: Vec<u32>,
+    pub block_sizes: Vec<u32>,
+    /// Mean covered pixels per point: the screen-area weight of allocation.
+    pub area: f64,
+    /// Per point of the set.
+    pub views: Vec<PointView>,
+    pub layers: Vec<InferredLayer>,
+    /// What was chosen and why.
+    pub representation: String,
+    pub why: String,
+}
+
+impl ObjectModel {
+    /// The placement of sample `key` of layer `layer`.
+    pub fn placed(&self, layer: usize, key: &[u32]) -> &Placed {
+        &self.placements[self.layers[layer].placement_of[key]]
+    }
+
+    /// The placements the layers' blocks carry, in increasing order.
+    pub fn used_placements(&self) -> Vec<usize> {
+        let mut used: Vec<usize> = self.layers.iter().flat_map(|l| l.block_placements.iter().copied()).collect();
+        used.sort_unstable();
+        used.dedup();
+        used
+    }
+
+    /// The MIP layout of sample `key` of layer `layer`.
+    pub fn layout(&self, layer: usize, key: &[u32]) -> TextureLayout {
+        self.placed(layer, key).layout
+    }
+}
+
+/// The key of `samples` under `mask`.
+pub fn key(samples: &[u32], mask: DepMask) -> Vec<u32> {
+    mask.dims().map(|k| samples[k]).collect()
+}

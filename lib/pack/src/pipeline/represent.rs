@@ -1,0 +1,101 @@
+//! The seam between pis-pack and the ways it can store an object. A [`Representation`] is
+//! one of them: parameterized surface textures (thesis ch. 3, [`super::surface`]); layered
+//! environment-map shells (ch. 5) and lens objects (ch. 6) are each to be one more module
+//! behind this trait. The pack chooses a representation per object, then runs its three
+//! steps over every object in turn: [`Representation::survey`] (what the object covers and
+//! needs over the set's views), [`Surveyed::plan`] (its layers' parameter blocks, with the
+//! block origins the pack staggers across objects, and the render matrices the solve reads),
+//! [`Planned::solve`] (the layers' samples). The result, an [`ObjectModel`], is coded by the
+//! same pyramids, storage allocation and codecs whatever made it.
+
+use anyhow::Result;
+use pis_compile::SolveSettings;
+use pis_format::{DepMask, DimensionKind, ParameterSpace};
+use pis_scene::ObjectRole;
+
+use super::blocks::{block_sizes, geometry};
+use super::input::LoadedSet;
+use super::matrices::Matrices;
+use super::model::ObjectModel;
+use super::surface::SurfaceTextures;
+use super::{PackRequest, Progress};
+use crate::infer::{merged_mesh, Mesh};
+
+/// A way to store an object and draw it.
+pub trait Representation: Sync {
+    /// The name the report gives.
+    fn name(&self) -> &'static str;
+    /// Whether it can store an object of `role`.
+    fn applies(&self, role: ObjectRole) -> bool;
+    /// Object `o` over the set's views: `None` when nothing of it is to be stored (a note
+    /// says why).
+    fn survey(&self, job: &mut Job<'_>, o: usize) -> Result<Option<Box<dyn Surveyed>>>;
+}
+
+/// An object surveyed by its representation.
+pub trait Surveyed {
+    /// Places the layers' parameter blocks, their origins offset by `stagger` (thesis 4.7),
+    /// and measures the render matrices the solve reads.
+    fn plan(self: Box<Self>, job: &mut Job<'_>, stagger: Vec<u32>) -> Result<Box<dyn Planned>>;
+}
+
+/// An object with its layers planned.
+pub trait Planned {
+    /// Solves every layer sample.
+    fn solve(self: Box<Self>, job: &Job<'_>) -> Result<ObjectModel>;
+}
+
+/// The representations pis-pack knows, in the order they are tried.
+pub const REPRESENTATIONS: &[&dyn Representation] = &[&SurfaceTextures];
+
+/// The representation of an object of `role`: the first that applies.
+pub fn choose(role: ObjectRole) -> Option<&'static dyn Representation> {
+    REPRESENTATIONS.iter().copied().find(|r| r.applies(role))
+}
+
+/// What every representation works with: the set and the request, the render-matrix
+/// source, every object's mesh (each occludes the others), the container's parameter space
+/// and blocks, the solver's settings; and the counts the pack reports.
+pub struct Job<'a> {
+    pub set: &'a LoadedSet,
+    pub req: &'a PackRequest,
+    pub matrices: &'a mut Matrices,
+    pub progress: &'a dyn Progress,
+    pub meshes: Vec<Mesh>,
+    /// Samples per block along each dimension.
+    pub sizes: Vec<u32>,
+    /// The container's parameter space for blocks of `sizes`.
+    pub space: ParameterSpace,
+    /// Every dimension, and the dimensions that are not a view.
+    pub all: DepMask,
+    pub non_view: DepMask,
+    pub settings: SolveSettings,
+    /// Texture placements made, and render matrices measured beyond one per object and point.
+    pub placements: usize,
+    pub extra_matrices: usize,
+}
+
+impl<'a> Job<'a> {
+    pub fn new(set: &'a LoadedSet, req: &'a PackRequest, matrices: &'a mut Matrices, progress: &'a dyn Progress) -> Result<Self> {
+        let scene = &set.scene;
+        let meshes: Vec<Mesh> = (0..scene.objects.len()).map(|o| merged_mesh(scene, o)).collect();
+        let ndims = scene.space.dims.len();
+        let sizes = block_sizes(req.block.as_slice(), ndims)?;
+        let (space, _) = geometry(set, &sizes);
+        let view_dims: Vec<usize> = scene.space.dims.iter().enumerate().filter(|(_, d)| d.kind == DimensionKind::View).map(|(k, _)| k).collect();
+        let all = DepMask::of(&(0..ndims).collect::<Vec<_>>());
+        let non_view = DepMask::of(&(0..ndims).filter(|k| !view_dims.contains(k)).collect::<Vec<_>>());
+        // Level 0 solved through the MIP chain the player decimates from it (thesis 3.6): the
+        // solved textures are the drawn ones.
+        let mut settings = SolveSettings::decimated();
+        if let Some(n) = req.max_iterations {
+            settings.cg.max_iterations = n.max(1);
+        }
+        Ok(Job { set, req, matrices, progress, meshes, sizes, space, all, non_view, settings, placements: 0, extra_matrices: 0 })
+    }
+
+    /// A note on the work.
+    pub fn note(&self, text: &str) {
+        self.progress.note(text);
+    }
+}

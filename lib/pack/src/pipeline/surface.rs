@@ -1,0 +1,454 @@
+//! Parameterized surface textures (thesis ch. 3, 4.8): the representation of every object
+//! today. A view-independent diffuse layer solved once over all views by stacking, and a
+//! view-dependent specular layer solved per parameter sample, each warm-started from the
+//! last sample solved with the same placement; layers that are black for an object are left
+//! out. Every solve is pyramidal (ε_f = 0.1) in the decimated parameterization: the unknowns
+//! are level 0 and the coarser levels its decimations, as the player stores and rebuilds them.
+//!
+//! Texture coordinates (thesis 3.2) are optimized per object per parameter block: each block
+//! of a layer gets the branch cuts, affine map and used size that suit the views of its
+//! samples, so every point has one render matrix per placement its layers read.
+
+use std::borrow::Cow;
+use std::collections::BTreeMap;
+
+use anyhow::{anyhow, Result};
+use pis_compile::{solve, solve_view_independent, DrawMesh, RenderMatrix, SolveSettings, TextureLayout, TexturedObject, View, Viewport};
+use pis_format::blocks::BlockGrid;
+use pis_format::DepMask;
+use pis_scene::ObjectRole;
+use pis_trace::layers::LayerKind as TraceLayer;
+use pis_trace::PointImages;
+
+use super::input::LoadedSet;
+use super::matrices::Matrices;
+use super::model::{key, InferredLayer, LayerForm, ObjectModel, PointView};
+use super::represent::{Job, Planned, Representation, Surveyed};
+use super::{PackRequest, PlacementMode};
+use crate::infer::{atlas, gather, merged_mesh, place_in, restrict_rows, sampler, Atlas, Mesh, Placed};
+
+/// Largest linear radiance below which a layer counts as black.
+pub const BLACK: f32 = 1e-4;
+
+fn layer_rgb(images: &PointImages, channel: &str, kind: TraceLayer) -> Vec<f32> {
+    let n = images.width as usize * images.height as usize;
+    let mut rgb = vec![0.0f32; n * 3];
+    if let Some(l) = images.object_layer(channel, kind) {
+        for (c, name) in ["R", "G", "B"].iter().enumerate() {
+            if let Some(p) = l.channel(name) {
+                for k in 0..n {
+                    rgb[k * 3 + c] = p[k];
+                }
+            }
+        }
+    }
+    rgb
+}
+
+fn coverage(set: &LoadedSet, p: usize, o: usize) -> Vec<f32> {
+    let (w, h) = set.resolution;
+    set.images[p].object_layer(&set.channels[o], TraceLayer::Coverage).and_then(|l| l.channel("A"))
+        .map(<[f32]>::to_vec).unwrap_or_else(|| vec![0.0; (w * h) as usize])
+}
+
+/// The render matrix of object `o` at point `p` with texture coordinates `uvs` and placement
+/// `placed`, every other mesh occluding it; rows where the tracer covers no pixel removed.
+#[allow(clippy::too_many_arguments)]
+fn matrix_at(set: &LoadedSet, p: usize, o: usize, meshes: &[Mesh], uvs: &[[f32; 2]], placed: &Placed, req: &PackRequest, matrices: &mut Matrices) -> Result<RenderMatrix> {
+    let (w, h) = set.resolution;
+    let frame = &set.frames[p];
+    let clip_from = |k: usize| {
+        pis_trace::camera::projection_matrix(&frame.camera, (w, h)) * frame.camera.world_from_camera.inverse() * frame.instances[k].world_from_object
+    };
+    let draw: Vec<DrawMesh> = meshes.iter().enumerate().map(|(k, m)| DrawMesh {
+        positions: &m.positions, uvs: &m.uvs, indices: &m.indices, clip_from_object: clip_from(k),
+    }).collect();
+    let mut mesh = draw[o];
+    mesh.uvs = uvs;
+    let obj = TexturedObject { mesh, transform: placed.transform, layout: placed.layout, sampler: sampler(req.filter, placed.repeat) };
+    let a = matrices.matrix(Viewport { width: w, height: h }, &draw, o, &obj)?;
+    Ok(restrict_rows(&a, &coverage(set, p, o)))
+}
+
+/// Every point with placement 0 (over all views): the rows, the gold standard there.
+fn views_of(set: &LoadedSet, o: usize, uvs: &[[f32; 2]], placed: &Placed, meshes: &[Mesh], req: &PackRequest, matrices: &mut Matrices) -> Result<Vec<PointView>> {
+    let channel = &set.channels[o];
+    (0..set.frames.len()).map(|p| {
+        let a = matrix_at(set, p, o, meshes, uvs, placed, req, matrices)?;
+        let pick = |kind| gather(&a.pixels, &layer_rgb(&set.images[p], channel, kind));
+        let (diffuse, specular) = (pick(TraceLayer::Diffuse), pick(TraceLayer::Specular));
+        Ok(PointView { a: vec![(0, a)], diffuse, specular })
+    }).collect()
+}
+
+/// Half a step of an 8-bit display value: a layer whose removal moves no covered pixel by
+/// more than this changes no displayed pixel.
+pub const DISPLAY_STEP: f32 = 0.5 / 255.0;
+
+/// True when the layer `pick` is black for the display: zero (below [`BLACK`]), or so dark
+/// beside the other layer `other` that leaving it out changes no 8-bit pixel.
+fn is_black(views: &[PointView], pick: impl Fn(&PointView) -> &[f32], other: impl Fn(&PointView) -> &[f32]) -> bool {
+    let d = |v: f32| crate::images::srgb_encode(v.clamp(0.0, 1.0));
+    views.iter().all(|v| pick(v).iter().zip(other(v)).all(|(x, o)| x.abs() < BLACK || (d(x + o) - d(*o)).abs() < DISPLAY_STEP))
+}
+
+/// The traced radiance a layer is solved for.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Radiance {
+    /// The diffuse layer: view-independent, its views stacked (eq. 3.7).
+    Diffuse,
+    Specular,
+    /// Diffuse + specular (`--layers combined`).
+    Sum,
+}
+
+impl Radiance {
+    /// b at the covered pixels of `v`.
+    fn at(self, v: &PointView) -> Cow<'_, [f32]> {
+        match self {
+            Radiance::Diffuse => Cow::Borrowed(&v.diffuse),
+            Radiance::Specular => Cow::Borrowed(&v.specular),
+            Radiance::Sum => Cow::Owned(v.diffuse.iter().zip(&v.specular).map(|(d, s)| d + s).collect()),
+        }
+    }
+}
+
+/// What one object's layers are before solving: mask, the block each point's sample is in,
+/// each block's placement.
+struct LayerPlan {
+    kind: pis_format::LayerKind,
+    radiance: Radiance,
+    depends_on: DepMask,
+    block_placements: Vec<usize>,
+    /// Per point of the set, its sample's placement.
+    point_placement: Vec<usize>,
+}
+
+/// Places the blocks of a layer with mask `mask` (thesis 3.2 per parameter block): each
+/// block over the views of the points whose samples it holds; placements equal to one
+/// already made are shared.
+#[allow(clippy::too_many_arguments)]
+fn plan_layer(
+    set: &LoadedSet,
+    grid: &BlockGrid,
+    (kind, radiance, mask): (pis_format::LayerKind, Radiance, DepMask),
+    o: usize,
+    mesh: &Mesh,
+    at: &Atlas,
+    placements: &mut Vec<Placed>,
+    req: &PackRequest,
+) -> Result<LayerPlan> {
+    let blocks = grid.block_count() as usize;
+    let point_block: Vec<usize> = set.samples.iter().map(|s| grid.locate(s).block).collect();
+    let mut block_placements = vec![0usize; blocks];
+    if req.placement == PlacementMode::Block {
+        for (b, slot) in block_placements.iter_mut().enumerate() {
+            let frames: Vec<&pis_scene::Frame> = point_block.iter().zip(&set.frames).filter(|(pb, _)| **pb == b).map(|(_, f)| f).collect();
+            if frames.is_empty() || frames.len() == set.frames.len() {
+                continue;
+            }
+            let pl = place_in(&set.scene, &frames, set.resolution, o, mesh, at, req.max_texture, 1.0, req.texels_per_pixel)?;
+            *slot = match placements.iter().position(|q| q.same(&pl)) {
+                Some(i) => i,
+                None => {
+                    placements.push(pl);
+                    placements.len() - 1
+                }
+            };
+        }
+    }
+    let point_placement = point_block.iter().map(|&b| block_placements[b]).collect();
+    Ok(LayerPlan { kind, radiance, depends_on: mask, block_placements, point_placement })
+}
+
+/// One texture per key of `plan`'s mask: each key's sample solved (or, for a view-independent
+/// layer, its views stacked, eq. 3.7) with the render matrices of its block's placement,
+/// warm-started from the last sample solved with the same placement.
+fn solve_layer(set: &LoadedSet, views: &[PointView], placements: &[Placed], plan: &LayerPlan, settings: &SolveSettings) -> Result<InferredLayer> {
+    let mut groups: BTreeMap<Vec<u32>, Vec<usize>> = BTreeMap::new();
+    for (p, s) in set.samples.iter().enumerate() {
+        groups.entry(key(s, plan.depends_on)).or_default().push(p);
+    }
+    let mut textures = BTreeMap::new();
+    let mut placement_of = BTreeMap::new();
+    let mut warm: BTreeMap<usize, Vec<f32>> = BTreeMap::new();
+    let mut iterations = 0u64;
+    for (k, points) in groups {
+        let pid = plan.point_placement[points[0]];
+        let bs: Vec<Cow<[f32]>> = points.iter().map(|&p| plan.radiance.at(&views[p])).collect();
+        let vs: Vec<View> = points.iter().zip(&bs).map(|(&p, b)| View { a: views[p].a(pid), b }).collect();
+        let start = warm.get(&pid).map(Vec::as_slice);
+        let x = if plan.radiance == Radiance::Diffuse {
+            // One texture for the views of the sample, stacked (eq. 3.7).
+            let s = solve_view_independent(&vs, start, settings)?;
+            iterations += s.iterations as u64;
+            s.texels
+        } else if vs[0].a.rows() == 0 {
+            // A view-dependent sample (one point per key) where the object covers no pixel.
+            start.map_or_else(|| vec![0.0; placements[pid].layout.texel_count() * 3], <[f32]>::to_vec)
+        } else {
+            let s = solve(vs[0].a, vs[0].b, start, settings)?;
+            iterations += s.iterations as u64;
+            s.texels
+        };
+        warm.insert(pid, x.clone());
+        placement_of.insert(k.clone(), pid);
+        textures.insert(k, x);
+    }
+    let form = Box::new(TextureForm { placements: placements.to_vec(), block_placements: plan.block_placements.clone(), placement_of: placement_of.clone() });
+    Ok(InferredLayer { kind: plan.kind, depends_on: plan.depends_on, textures, block_placements: plan.block_placements.clone(), placement_of, iterations, form })
+}
+
+/// A surface texture layer as stored: every block's texture placed as thesis 3.2 places it
+/// (branch cuts, affine map, used size); level images hold level 0 and the player rebuilds
+/// the MIP chain by decimation (3.6).
+pub struct TextureForm {
+    /// The placements of the object (the layer's blocks index into them).
+    pub placements: Vec<Placed>,
+    /// Per block of the layer's grid, its placement.
+    pub block_placements: Vec<usize>,
+    /// Per sample key, its block's placement.
+    pub placement_of: BTreeMap<Vec<u32>, usize>,
+}
+
+impl TextureForm {
+    fn layout(&self, key: &[u32]) -> TextureLayout {
+        self.placements[self.placement_of[key]].layout
+    }
+}
+
+impl LayerForm for TextureForm {
+    fn layer(&self, kind: pis_format::LayerKind, order: u8, depends_on: DepMask, gamma: f32) -> pis_format::Layer {
+        surface_layer(kind, order, depends_on, gamma)
+    }
+
+    fn block(&self, b: usize) -> pis_format::Block {
+        let placed = &self.placements[self.block_placements[b]];
+        pis_format::Block {
+            width: placed.layout.width,
+            height: placed.layout.height,
+            placement: pis_format::Placement::Surface { affine: placed.transform.values, repeat: placed.repeat, cut: placed.transform.cut },
+            levels: vec![],
+        }
+    }
+
+    fn stored(&self, key: &[u32], solved: &[f32]) -> Vec<f32> {
+        finest(self.layout(key), solved)
+    }
+
+    fn drawn(&self, key: &[u32], stored: Vec<f32>) -> Vec<f32> {
+        mip_chain(self.layout(key), stored)
+    }
+
+    fn stored_texels(&self, key: &[u32]) -> usize {
+        let l = self.layout(key);
+        l.width as usize * l.height as usize
+    }
+}
+
+fn surface_layer(kind: pis_format::LayerKind, order: u8, depends_on: DepMask, gamma: f32) -> pis_format::Layer {
+    pis_format::Layer {
+        kind,
+        mapping: pis_format::Mapping::Surface,
+        channels: 3,
+        mip_mode: pis_format::MipMode::Decimated,
+        term: pis_format::Term::Surface,
+        order,
+        combine: pis_format::Combine::Add,
+        gamma,
+        depends_on,
+        blocks: vec![],
+    }
+}
+
+/// The finest level of a solved texture of layout `layout` (the chain's level 0).
+pub fn finest(layout: pis_compile::TextureLayout, x: &[f32]) -> Vec<f32> {
+    x[..layout.width as usize * layout.height as usize * 3].to_vec()
+}
+
+/// The MIP chain of layout `l` from the finest level, by decimation (thesis 3.6).
+pub fn mip_chain(l: pis_compile::TextureLayout, finest: Vec<f32>) -> Vec<f32> {
+    let mut x = finest.clone();
+    let mut cur = finest;
+    for lv in 1..l.levels {
+        let (w, h) = l.level_size(lv - 1);
+        cur = pis_format::mip::decimate(&cur, w, h, 3);
+        x.extend_from_slice(&cur);
+    }
+    x
+}
+
+/// Parameterized surface textures: any object.
+pub struct SurfaceTextures;
+
+impl Representation for SurfaceTextures {
+    fn name(&self) -> &'static str {
+        "surface textures"
+    }
+
+    fn applies(&self, _role: ObjectRole) -> bool {
+        true
+    }
+
+    /// Texture coordinates and render matrices over all views: whether the object covers a
+    /// pixel, which layers are black, the rows and gold standard of every point.
+    fn survey(&self, job: &mut Job<'_>, o: usize) -> Result<Option<Box<dyn Surveyed>>> {
+        let (set, req) = (job.set, job.req);
+        let scene = &set.scene;
+        let frames: Vec<&pis_scene::Frame> = set.frames.iter().collect();
+        let name = &scene.objects[o].name;
+        let at = atlas(&frames, set.resolution, o, &job.meshes[o]);
+        let whole = place_in(scene, &frames, set.resolution, o, &job.meshes[o], &at, req.max_texture, 1.0, req.texels_per_pixel)?;
+        let before = job.matrices.renderings();
+        let views = views_of(set, o, &at.uvs, &whole, &job.meshes, req, job.matrices)?;
+        if job.matrices.renderings() > before {
+            job.note(&format!("object {name}: {} probe renderings over {} points", job.matrices.renderings() - before, views.len()));
+        }
+        if views.iter().all(|v| v.rows() == 0) {
+            job.note(&format!("object {name} covers no pixel of the set; left out"));
+            return Ok(None);
+        }
+        let diffuse_black = is_black(&views, |v| &v.diffuse, |v| &v.specular);
+        let specular_black = is_black(&views, |v| &v.specular, |v| &v.diffuse);
+        if diffuse_black && specular_black {
+            job.note(&format!("object {name} is black in every layer; nothing stored"));
+            return Ok(None);
+        }
+        Ok(Some(Box::new(Covered { o, atlas: at, views, whole, diffuse_black, specular_black })))
+    }
+}
+
+/// An object that covers a pixel and is not black: its texture coordinates, placement over
+/// all views and the points as that placement sees them.
+struct Covered {
+    o: usize,
+    atlas: Atlas,
+    views: Vec<PointView>,
+    whole: Placed,
+    diffuse_black: bool,
+    specular_black: bool,
+}
+
+impl Surveyed for Covered {
+    /// Per block: the placement over the block's views, and the render matrices of the
+    /// placements each point's layers read.
+    fn plan(self: Box<Self>, job: &mut Job<'_>, st: Vec<u32>) -> Result<Box<dyn Planned>> {
+        let c = *self;
+        let (set, req) = (job.set, job.req);
+        let scene = &set.scene;
+        let mut placements = vec![c.whole.clone()];
+        let mut plans = Vec::new();
+        let wanted = if req.layers == super::LayerMode::Combined {
+            vec![(pis_format::LayerKind::Specular, Radiance::Sum, job.all)]
+        } else {
+            let diffuse = (!c.diffuse_black).then_some((pis_format::LayerKind::Diffuse, Radiance::Diffuse, job.non_view));
+            let specular = (!c.specular_black).then_some((pis_format::LayerKind::Specular, Radiance::Specular, job.all));
+            diffuse.into_iter().chain(specular).collect()
+        };
+        for layer in wanted {
+            let grid = BlockGrid::new(&job.space, layer.2, &st);
+            plans.push(plan_layer(set, &grid, layer, c.o, &job.meshes[c.o], &c.atlas, &mut placements, req)?);
+        }
+        job.placements += placements.len();
+        let mut views = c.views;
+        for (p, v) in views.iter_mut().enumerate() {
+            let mut read: Vec<usize> = plans.iter().map(|pl| pl.point_placement[p]).collect();
+            read.sort_unstable();
+            read.dedup();
+            for &pid in &read {
+                if pid == 0 || v.rows() == 0 {
+                    continue;
+                }
+                let a = matrix_at(set, p, c.o, &job.meshes, &c.atlas.uvs, &placements[pid], req, job.matrices)?;
+                if a.pixels != v.a(0).pixels {
+                    return Err(anyhow!("object {}: point {p}: the render matrices of two placements cover different pixels", scene.objects[c.o].name));
+                }
+                v.a.push((pid, a));
+                job.extra_matrices += 1;
+            }
+            if !read.contains(&0) && v.a.len() > 1 {
+                v.a.remove(0);
+            }
+        }
+        Ok(Box::new(Layers { o: c.o, atlas: c.atlas, placements, stagger: st, views, plans }))
+    }
+}
+
+/// An object with its blocks placed: texture coordinates, placements, block origins, the
+/// points with the render matrices its layers read, the layers to solve.
+struct Layers {
+    o: usize,
+    atlas: Atlas,
+    placements: Vec<Placed>,
+    stagger: Vec<u32>,
+    views: Vec<PointView>,
+    plans: Vec<LayerPlan>,
+}
+
+impl Planned for Layers {
+    fn solve(self: Box<Self>, job: &Job<'_>) -> Result<ObjectModel> {
+        let Layers { o, atlas: at, placements, stagger: st, views, plans } = *self;
+        let (set, scene) = (job.set, &job.set.scene);
+        let name = scene.objects[o].name.clone();
+        let covered: usize = views.iter().map(PointView::rows).sum();
+        let area = covered as f64 / views.len() as f64;
+        let layers = plans.iter().map(|plan| solve_layer(set, &views, &placements, plan, &job.settings)).collect::<Result<Vec<_>>>()?;
+        let radiances: Vec<Radiance> = plans.iter().map(|p| p.radiance).collect();
+        let (representation, why) = match radiances.as_slice() {
+            [Radiance::Sum] => ("combined", "--layers combined: one view-dependent layer of diffuse + specular radiance per parameter sample"),
+            [Radiance::Diffuse] => ("diffuse", "the specular layer changes no displayed pixel: one view-independent diffuse texture per non-view sample"),
+            [Radiance::Specular] => ("specular", "the diffuse layer changes no displayed pixel: a view-dependent texture per parameter sample"),
+            _ => ("diffuse+specular", "view-independent diffuse layer over the non-view dimensions plus a view-dependent specular layer per parameter sample"),
+        };
+        Ok(ObjectModel {
+            index: o, name, mesh: merged_mesh(scene, o), mesh_uvs: at.uvs, placements, stagger: st, block_sizes: job.sizes.clone(),
+            area, views, layers, representation: representation.to_string(), why: why.to_string(),
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Two placements: 8×4 and 5×3 texels, each with its full MIP chain.
+    fn form() -> TextureForm {
+        let placed = |w, h| Placed { transform: pis_compile::TextureTransform::IDENTITY, layout: TextureLayout::full(w, h), repeat: [false; 2], reduction: 1.0 };
+        TextureForm {
+            placements: vec![placed(8, 4), placed(5, 3)],
+            block_placements: vec![0, 1],
+            placement_of: BTreeMap::from([(vec![0], 0), (vec![1], 1)]),
+        }
+    }
+
+    #[test]
+    fn a_texture_layer_stores_level_0_and_draws_the_decimated_chain() {
+        let f = form();
+        for (key, (w, h)) in [(vec![0u32], (8usize, 4usize)), (vec![1], (5, 3))] {
+            let layout = f.placements[f.placement_of[&key]].layout;
+            let finest: Vec<f32> = (0..w * h * 3).map(|i| (i % 7) as f32 * 0.1).collect();
+            let chain = mip_chain(layout, finest.clone());
+            assert_eq!(chain.len(), layout.texel_count() * 3, "the whole chain is drawn");
+            assert_eq!(f.stored_texels(&key), w * h);
+            assert_eq!(f.stored(&key, &chain), finest, "level images hold level 0 only");
+            assert_eq!(f.drawn(&key, f.stored(&key, &chain)), chain, "the player's decimation rebuilds the chain");
+        }
+    }
+
+    #[test]
+    fn a_texture_layer_describes_each_block_by_its_placement() {
+        let f = form();
+        let b = f.block(1);
+        assert_eq!((b.width, b.height), (5, 3));
+        assert!(matches!(b.placement, pis_format::Placement::Surface { .. }) && b.levels.is_empty());
+        let l = f.layer(pis_format::LayerKind::Diffuse, 0, DepMask::of(&[0]), 2.2);
+        assert_eq!((l.mapping, l.mip_mode, l.channels), (pis_format::Mapping::Surface, pis_format::MipMode::Decimated, 3));
+    }
+
+    #[test]
+    fn every_object_role_has_a_representation() {
+        for role in [ObjectRole::Diffuse, ObjectRole::Reflective, ObjectRole::Refractive] {
+            assert_eq!(super::super::represent::choose(role).map(|r| r.name()), Some("surface textures"), "{role:?}");
+        }
+    }
+}
