@@ -41,7 +41,7 @@ pub(crate) struct GltfCamera {
 /// Indices and accessors are checked before the gltf crate's readers see them; should the
 /// crate still panic on malformed data (its validation indexes unchecked in places), the
 /// panic becomes a [`SceneError::Gltf`].
-pub(crate) fn read_gltf(path: &Path) -> Result<GltfScene, SceneError> {
+pub(crate) fn read_gltf(path: &Path, allow_outside: bool) -> Result<GltfScene, SceneError> {
     if let Err(source) = std::fs::metadata(path) {
         return Err(SceneError::Io {
             path: path.to_owned(),
@@ -49,6 +49,7 @@ pub(crate) fn read_gltf(path: &Path) -> Result<GltfScene, SceneError> {
         });
     }
     let read = || {
+        crate::gltf_files::check_files(path, allow_outside)?;
         let (doc, buffers, images) = gltf::import(path).map_err(|e| import_error(path, e))?;
         check_animation_indices(path, &doc)?;
         convert(path, &doc, &buffers, &images)

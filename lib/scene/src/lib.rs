@@ -23,6 +23,7 @@ mod accessor_check;
 pub mod animation;
 mod error;
 mod frame;
+mod gltf_files;
 mod gltf_load;
 pub mod light_path;
 mod load;

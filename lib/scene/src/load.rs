@@ -57,7 +57,7 @@ pub fn load_with(path: &Path, options: &LoadOptions) -> Result<Scene, SceneError
 
     let dir = path.parent().unwrap_or(Path::new("."));
     let gltf_path = dir.join(&m.gltf);
-    let mut g = read_gltf(&gltf_path)?;
+    let mut g = read_gltf(&gltf_path, m.allow_outside_files)?;
 
     for (name, spec) in &m.objects {
         let Some(obj) = g.objects.iter_mut().find(|o| &o.name == name) else {

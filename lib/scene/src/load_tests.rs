@@ -645,3 +645,57 @@ fn error_normal_accessor_of_wrong_type() {
         "{err}"
     );
 }
+
+/// A glTF from elsewhere once read `../../etc/passwd`: references that leave the glTF's
+/// folder are refused, naming the field, unless scene.toml allows them.
+#[test]
+fn buffer_uri_leaving_the_scene_folder_is_refused() {
+    let with_uri = |uri: String| {
+        move |doc: &mut serde_json::Value, _: &mut Vec<u8>| {
+            doc["buffers"][0]["uri"] = json!(uri);
+        }
+    };
+    for uri in ["../../etc/passwd", "/etc/passwd", "file:///etc/passwd", "../missing.bin"] {
+        let e = load_err(&Fixture::new(TOML, with_uri(uri.to_string()))).to_string();
+        assert!(e.contains("buffers[0].uri") && e.contains("refused"), "{uri}: {e}");
+    }
+    // a path that climbs out and back in stays inside
+    let f = Fixture::new(TOML, |_, _| {});
+    let back = format!("../{}/scene.bin", f.dir.path().file_name().unwrap().to_string_lossy());
+    let gltf = f.dir.path().join("scene.gltf");
+    let mut doc: serde_json::Value = serde_json::from_slice(&std::fs::read(&gltf).unwrap()).unwrap();
+    doc["buffers"][0]["uri"] = json!(back);
+    std::fs::write(&gltf, serde_json::to_vec(&doc).unwrap()).unwrap();
+    assert!(load(&f.toml(), None).is_ok(), "{back}: inside the folder");
+    // a buffer truly outside: refused, and read when scene.toml allows it
+    let elsewhere = tempfile::tempdir().expect("temp dir");
+    let outside = elsewhere.path().join("outside.bin");
+    std::fs::copy(Fixture::new(TOML, |_, _| {}).dir.path().join("scene.bin"), &outside).unwrap();
+    let uri = outside.to_string_lossy().to_string();
+    let e = load_err(&Fixture::new(TOML, with_uri(uri.clone()))).to_string();
+    assert!(e.contains("absolute path") && e.contains("allow_outside_files"), "{e}");
+    let f = Fixture::new(&format!("allow_outside_files = true\n{TOML}"), with_uri(uri));
+    assert!(load(&f.toml(), None).is_ok(), "allow_outside_files = true reads it");
+}
+
+#[test]
+fn image_uri_leaving_the_scene_folder_is_refused() {
+    let f = Fixture::new(TOML, |doc, _| {
+        doc["images"] = json!([{"uri": "../secret.png"}]);
+    });
+    let e = load_err(&f).to_string();
+    assert!(e.contains("images[0].uri") && e.contains("leaves the glTF's folder"), "{e}");
+}
+
+/// The glTF reader pads a buffer up to 3 bytes short with zeros: refused instead.
+#[test]
+fn buffer_shorter_than_its_byte_length_is_refused() {
+    for short in 1..=3 {
+        let f = Fixture::new(TOML, |doc, bin| {
+            doc["buffers"][0]["byteLength"] = json!(bin.len());
+            bin.truncate(bin.len() - short);
+        });
+        let e = load_err(&f).to_string();
+        assert!(e.contains("buffers[0].byteLength") && e.contains("the data holds"), "{short} bytes short: {e}");
+    }
+}

@@ -33,6 +33,10 @@ pub struct Manifest {
     /// Named presets: `[preset.paper]`.
     #[serde(default, rename = "preset")]
     pub presets: BTreeMap<String, PresetSpec>,
+    /// Let the glTF read buffers and images outside its own folder (absolute paths, `file:`
+    /// URIs, relative paths that climb out with `..`); refused by default.
+    #[serde(default)]
+    pub allow_outside_files: bool,
 }
 
 /// `[camera]`: a glTF camera node, or an explicit eye and target.

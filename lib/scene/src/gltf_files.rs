@@ -1,0 +1,144 @@
+//! The files a glTF reads beside itself: its buffers and images. A reference that leaves the
+//! glTF's own folder (an absolute path, a `file:` URI, a relative path that climbs out with
+//! `..` or through a link) is refused unless scene.toml allows it (`allow_outside_files`),
+//! so that a scene from elsewhere cannot read the machine's other files; a buffer shorter
+//! than its declared `byteLength` is refused (the glTF reader pads up to 3 missing bytes
+//! with zeros).
+
+use std::path::{Component, Path, PathBuf};
+
+use crate::SceneError;
+
+/// What a URI names.
+enum Reference<'a> {
+    /// Inline base64 data (`data:…;base64,DATA`).
+    Data(&'a str),
+    /// A file: its path (percent-decoded) and whether the URI names it absolutely.
+    File(String, bool),
+    /// Another scheme (`http:` …): the glTF reader refuses it.
+    Other,
+}
+
+fn reference(uri: &str) -> Reference<'_> {
+    if let Some(rest) = uri.strip_prefix("data:") {
+        return Reference::Data(rest.split_once(',').map_or("", |(_, d)| d));
+    }
+    if let Some(rest) = uri.strip_prefix("file://").or_else(|| uri.strip_prefix("file:")) {
+        return Reference::File(percent_decode(rest), true);
+    }
+    // A scheme is letters before a colon, as in `http:`; a Windows drive is one letter.
+    if uri.split_once(':').is_some_and(|(s, _)| s.len() > 1 && s.chars().all(|c| c.is_ascii_alphabetic())) {
+        return Reference::Other;
+    }
+    let path = percent_decode(uri);
+    let absolute = Path::new(&path).is_absolute() || path.starts_with('/') || path.starts_with('\\');
+    Reference::File(path, absolute)
+}
+
+/// `%XX` escapes decoded (invalid escapes kept as written).
+fn percent_decode(s: &str) -> String {
+    let b = s.as_bytes();
+    let mut out = Vec::with_capacity(b.len());
+    let mut i = 0;
+    while i < b.len() {
+        let hex = |c: u8| (c as char).to_digit(16);
+        match (b[i], b.get(i + 1).copied().and_then(hex), b.get(i + 2).copied().and_then(hex)) {
+            (b'%', Some(h), Some(l)) => {
+                out.push((h * 16 + l) as u8);
+                i += 3;
+            }
+            (c, _, _) => {
+                out.push(c);
+                i += 1;
+            }
+        }
+    }
+    String::from_utf8_lossy(&out).into_owned()
+}
+
+/// Bytes that base64 text decodes to.
+fn base64_len(data: &str) -> usize {
+    let body = data.trim_end_matches('=');
+    body.len() * 3 / 4
+}
+
+/// The file `rel` names beside the glTF at `gltf`, refused when it leaves the glTF's folder
+/// and `allow_outside` is false.
+fn resolve(gltf: &Path, field: &str, uri: &str, rel: &str, absolute: bool, allow_outside: bool) -> Result<PathBuf, SceneError> {
+    let base = gltf.parent().unwrap_or(Path::new(""));
+    let target = base.join(rel);
+    if allow_outside {
+        return Ok(target);
+    }
+    let refuse = |why: &str| {
+        SceneError::invalid(gltf, format!("{field}.uri"), format!("{uri:?} {why}; refused (scene.toml `allow_outside_files = true` allows it)"))
+    };
+    if absolute {
+        return Err(refuse("is an absolute path, outside the glTF's folder"));
+    }
+    // Where the file exists, where it really is (`..`, links); else where its path leads.
+    let inside = match (target.canonicalize(), base.canonicalize()) {
+        (Ok(t), Ok(b)) => t.starts_with(&b),
+        _ => {
+            let mut depth = 0i32;
+            Path::new(rel).components().all(|c| {
+                depth += match c {
+                    Component::ParentDir => -1,
+                    Component::Normal(_) => 1,
+                    _ => 0,
+                };
+                depth >= 0 && !matches!(c, Component::RootDir | Component::Prefix(_))
+            })
+        }
+    };
+    if inside { Ok(target) } else { Err(refuse("leaves the glTF's folder")) }
+}
+
+/// Checks the buffer and image references of the glTF at `path`. A document the glTF reader
+/// cannot parse passes here: the reader says what is wrong with it.
+pub(crate) fn check_files(path: &Path, allow_outside: bool) -> Result<(), SceneError> {
+    let Ok(gltf) = gltf::Gltf::open(path) else { return Ok(()) };
+    for b in gltf.buffers() {
+        let field = format!("buffers[{}]", b.index());
+        let have = match b.source() {
+            gltf::buffer::Source::Bin => gltf.blob.as_ref().map(Vec::len),
+            gltf::buffer::Source::Uri(uri) => match reference(uri) {
+                Reference::Data(data) => Some(base64_len(data)),
+                Reference::File(rel, absolute) => {
+                    let file = resolve(path, &field, uri, &rel, absolute, allow_outside)?;
+                    std::fs::metadata(&file).ok().map(|m| m.len() as usize)
+                }
+                Reference::Other => None,
+            },
+        };
+        if let Some(have) = have.filter(|&n| n < b.length()) {
+            let msg = format!("declares {} bytes; the data holds {have}", b.length());
+            return Err(SceneError::invalid(path, format!("{field}.byteLength"), msg));
+        }
+    }
+    for image in gltf.images() {
+        if let gltf::image::Source::Uri { uri, .. } = image.source() {
+            if let Reference::File(rel, absolute) = reference(uri) {
+                resolve(path, &format!("images[{}]", image.index()), uri, &rel, absolute, allow_outside)?;
+            }
+        }
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn uris_name_data_files_or_other_schemes() {
+        assert!(matches!(reference("data:application/octet-stream;base64,AAAA"), Reference::Data("AAAA")));
+        assert!(matches!(reference("scene%20one.bin"), Reference::File(p, false) if p == "scene one.bin"));
+        assert!(matches!(reference("/etc/passwd"), Reference::File(_, true)));
+        assert!(matches!(reference("file:///etc/passwd"), Reference::File(_, true)));
+        assert!(matches!(reference("https://example.com/a.bin"), Reference::Other));
+        assert_eq!(base64_len("AAAA"), 3);
+        assert_eq!(base64_len("AAA="), 2);
+        assert_eq!(base64_len("AA=="), 1);
+    }
+}
