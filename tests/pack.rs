@@ -7,6 +7,8 @@ use std::sync::OnceLock;
 
 use pis_trace::set::RaySet;
 
+mod common;
+
 fn demo1() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../samples/demo1/scene.toml")
 }
@@ -313,4 +315,53 @@ fn pack_output_is_byte_identical_to_the_recorded_checksum() {
     let bytes = std::fs::read(dir.path().join("out.pis")).expect("the packed file");
     let got = (bytes.len(), crc32fast::hash(&bytes));
     assert_eq!(got, DEMO1_CI_PACK, "pis-pack's output changed: {} bytes, CRC-32 {:#010x}", got.0, got.1);
+}
+
+/// Any scaled node once made pis-pack fail after the whole solve with "error-5106:
+/// transform is not finite": the first point's scale (non-uniform, mirrored, or a glTF's
+/// unit scale of 0.01) is baked into the mesh and the file holds rigid transforms.
+#[test]
+fn scaled_and_mirrored_nodes_pack_into_a_valid_file() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let scene = common::sample_copy("glass", &dir.path().join("glass"), |doc, _| {
+        common::set_node(doc, "SilverCup", "scale", serde_json::json!([0.8, 1.3, -0.8]));
+        common::set_node(doc, "Columns", "scale", serde_json::json!([1.0, 0.5, 1.0]));
+    });
+    let file = dir.path().join("scaled.pis");
+    let out = Command::new(env!("CARGO_BIN_EXE_pis-pack")).arg(&scene).arg("-o").arg(&file)
+        .args(["--resolution", "48x36", "--spp", "1", "--ratio", "24", "--json"]).output().expect("pis-pack runs");
+    let r = json(&out);
+    validate(&file);
+    let names: Vec<&str> = r["objects"].as_array().unwrap().iter().map(|o| o["name"].as_str().unwrap()).collect();
+    assert!(names.contains(&"SilverCup") && names.contains(&"Columns"), "{names:?}");
+}
+
+/// A scale that changes over the parameter space cannot be baked into one mesh: refused
+/// before any work (the trace of a scene.toml included), naming the object, with no output.
+#[test]
+fn an_animated_scale_is_refused_before_the_solve() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let scene = common::sample_copy("demo2", &dir.path().join("demo2"), |doc, folder| {
+        // four scale keys in a buffer of their own; the spin animation scales instead
+        let keys: Vec<u8> = [1.0f32, 1.0, 1.0, 1.5, 1.5, 1.5, 2.0, 2.0, 2.0, 1.0, 1.0, 1.0].iter().flat_map(|v| v.to_le_bytes()).collect();
+        std::fs::write(folder.join("scale.bin"), &keys).unwrap();
+        let push = |doc: &mut serde_json::Value, key: &str, v: serde_json::Value| {
+            let a = doc[key].as_array_mut().unwrap();
+            a.push(v);
+            a.len() - 1
+        };
+        let buffer = push(doc, "buffers", serde_json::json!({"uri": "scale.bin", "byteLength": 48}));
+        let view = push(doc, "bufferViews", serde_json::json!({"buffer": buffer, "byteLength": 48}));
+        let accessor = push(doc, "accessors", serde_json::json!({"bufferView": view, "componentType": 5126, "count": 4, "type": "VEC3"}));
+        doc["animations"][0]["channels"][0]["target"]["path"] = serde_json::json!("scale");
+        doc["animations"][0]["samplers"][0]["output"] = serde_json::json!(accessor);
+    });
+    let file = dir.path().join("out.pis");
+    let out = Command::new(env!("CARGO_BIN_EXE_pis-pack")).arg(&scene).arg("-o").arg(&file)
+        .args(["--resolution", "32x24", "--spp", "1"]).output().expect("pis-pack runs");
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(5), "{err}");
+    assert!(err.contains("object Gewgaw: its scale or shear changes over the parameter space"), "{err}");
+    assert!(!err.contains("pis-pack: trace"), "refused before the trace: {err}");
+    assert!(!file.exists());
 }

@@ -154,7 +154,9 @@ fn finite(v: &[f32]) -> bool {
 }
 
 /// The 3×3 part of a row-major 3×4 matrix is a rotation (orthonormal, det +1) within 1e-3.
-fn rigid(m: &[f32; 12]) -> bool {
+/// Whether a row-major 3×4 transform is rigid: its 3×3 part orthonormal with determinant
+/// +1, within 10⁻³ (rule 5106).
+pub fn rigid(m: &[f32; 12]) -> bool {
     let r = |i: usize| [m[4 * i] as f64, m[4 * i + 1] as f64, m[4 * i + 2] as f64];
     let dot = |a: [f64; 3], b: [f64; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
     let (a, b, c) = (r(0), r(1), r(2));

@@ -61,17 +61,61 @@ pub fn geometry(set: &LoadedSet, sizes: &[u32]) -> (ParameterSpace, CameraTable)
     (space, cameras)
 }
 
+/// The linear part of object `o`'s transform at the set's first point when it is not a
+/// rotation (a scaled, sheared or mirrored glTF node): the container stores rigid transforms
+/// only (SPEC.md rule 5106), so pis-pack bakes it into the object's mesh and stores every
+/// transform times its inverse. `None` for a rigid object.
+pub fn baked(frames: &[pis_scene::Frame], o: usize) -> Option<glam::Mat4> {
+    let first = frames.first()?.instances[o].world_from_object;
+    if checks::rigid(&row3x4(first)) {
+        return None;
+    }
+    let mut linear = first;
+    linear.w_axis = glam::Vec4::W;
+    Some(linear)
+}
+
+/// Object `o`'s transform at frame `f` as stored: rigid once its first point's scale is in
+/// its mesh ([`baked`]).
+fn stored_transform(f: &pis_scene::Frame, o: usize, bake: Option<glam::Mat4>) -> glam::Mat4 {
+    let m = f.instances[o].world_from_object;
+    bake.map_or(m, |b| m * b.inverse())
+}
+
 /// Object `o`'s transform table over the space.
 pub fn transforms(set: &LoadedSet, space: &ParameterSpace, o: usize) -> TransformTable {
+    let bake = baked(&set.frames, o);
     let first = set.frames[0].instances[o].world_from_object;
     if set.frames.iter().all(|f| f.instances[o].world_from_object == first) {
-        return TransformTable::fixed(row3x4(first));
+        return TransformTable::fixed(row3x4(stored_transform(&set.frames[0], o, bake)));
     }
     let all = DepMask::of(&(0..space.dims.len()).collect::<Vec<_>>());
     let mut t = vec![IDENTITY_3X4; space.table_len(all) as usize];
     for (s, f) in set.samples.iter().zip(&set.frames) {
-        t[space.table_index(all, s)] = row3x4(f.instances[o].world_from_object);
+        t[space.table_index(all, s)] = row3x4(stored_transform(f, o, bake));
     }
     TransformTable { depends_on: all, transforms: t }
+}
+
+/// Every object's transforms can be stored: finite, and rigid once the first point's scale
+/// is baked into the mesh. Checked before any work: an object whose scale or shear changes
+/// over the space cannot be.
+pub fn check_transforms(scene: &pis_scene::Scene, frames: &[pis_scene::Frame]) -> Result<()> {
+    for (o, object) in scene.objects.iter().enumerate() {
+        let bake = baked(frames, o);
+        if bake.is_some_and(|b| !b.is_finite() || b.determinant().abs() < 1e-12) {
+            return Err(anyhow!("object {}: its transform at the first point is singular or not finite", object.name));
+        }
+        for (p, f) in frames.iter().enumerate() {
+            let m = row3x4(stored_transform(f, o, bake));
+            if !m.iter().all(|v| v.is_finite()) || !checks::rigid(&m) {
+                return Err(anyhow!(
+                    "object {}: its scale or shear changes over the parameter space (point {p}), and the container stores one mesh and rigid transforms per object (SPEC.md rule 5106): animate its translation and rotation only",
+                    object.name
+                ));
+            }
+        }
+    }
+    Ok(())
 }
 

@@ -16,7 +16,7 @@ use pis_format::*;
 
 use super::model::{key, ObjectModel};
 use super::input::LoadedSet;
-use super::blocks::{block_sizes, geometry, stagger, transforms};
+use super::blocks::{baked, block_sizes, geometry, stagger, transforms};
 use super::storage::{allocate_storage, build_pyramid, encode_levels, CodedLevel};
 pub use super::surface::{finest, mip_chain};
 use super::{PackRequest, Stages};
@@ -91,6 +91,15 @@ fn layer_screen_weights(m: &ObjectModel, li: usize, samples: &[Vec<u32>]) -> BTr
         let w = if per_point.is_empty() { vec![0.0; il.form.stored_texels(k)] } else { sample_weights(&per_point) };
         (k.clone(), w)
     }).collect()
+}
+
+/// The object's mesh positions as the container stores them: with the first point's scale
+/// baked in where its transform is not rigid ([`baked`]).
+fn stored_positions(set: &LoadedSet, m: &ObjectModel) -> Vec<[f32; 3]> {
+    match baked(&set.frames, m.index) {
+        Some(b) => m.mesh.positions.iter().map(|&p| b.transform_point3(glam::Vec3::from(p)).to_array()).collect(),
+        None => m.mesh.positions.clone(),
+    }
 }
 
 /// Builds pyramids, allocates storage, encodes, and assembles the container.
@@ -175,7 +184,7 @@ pub fn encode_all(set: &LoadedSet, models: &[ObjectModel], req: &PackRequest, st
             shading: Shading::default(),
             stagger: st.clone(),
             transforms: transforms(set, &space, m.index),
-            mesh: Mesh { positions: m.mesh.positions.clone(), normals: None, texcoords: Some(m.mesh_uvs.clone()), indices: m.mesh.indices.clone() },
+            mesh: Mesh { positions: stored_positions(set, m), normals: None, texcoords: Some(m.mesh_uvs.clone()), indices: m.mesh.indices.clone() },
             layers,
         });
         blocks_out.push(layer_blocks);

@@ -101,6 +101,9 @@ pub fn load(req: &PackRequest, stages: &mut Stages) -> Result<LoadedSet, Failure
         let scene = pis_scene::load_with(&req.input, &options).map_err(|e| Failure::new(Exit::Invalid, e))?;
         let dir = cache_dir(&req.input, &scene);
         if !dir.join("set.json").is_file() {
+            // What the container cannot store is refused before the trace.
+            let frames = (0..scene.space.point_count()).map(|i| scene.frame(&scene.space.point(i))).collect::<Result<Vec<_>, _>>().map_err(|e| Failure::new(Exit::Invalid, e))?;
+            super::blocks::check_transforms(&scene, &frames).map_err(|e| Failure::new(Exit::NotSupported, e))?;
             let settings = TraceSettings::new(scene.resolution, scene.spp);
             let r = pis_trace::render_set(&scene, &dir, &settings, None, &pis_trace::NoProgress).map_err(trace_failure)?;
             stages.done("trace", &format!("{} points into {}", r.points, dir.display()));
@@ -140,6 +143,8 @@ pub fn load(req: &PackRequest, stages: &mut Stages) -> Result<LoadedSet, Failure
         images.push(img);
     }
     let channels = pis_trace::channel_names(&scene);
-    stages.done("read", &format!("{} points of {}x{} from {}", samples.len(), res.0, res.1, dir.display()));
-    Ok(LoadedSet { dir, scene, resolution: res, samples, frames, images, channels, display_filter: set.meta.filter })
+    let loaded = LoadedSet { dir, scene, resolution: res, samples, frames, images, channels, display_filter: set.meta.filter };
+    super::blocks::check_transforms(&loaded.scene, &loaded.frames).map_err(|e| Failure::new(Exit::NotSupported, e))?;
+    stages.done("read", &format!("{} points of {}x{} from {}", loaded.samples.len(), res.0, res.1, loaded.dir.display()));
+    Ok(loaded)
 }
