@@ -174,6 +174,28 @@ fn extract_writes_exr_and_png_per_texture_and_face() {
     assert_eq!(out.status.code(), Some(1));
 }
 
+/// `--extract` once left the files it wrote before an error: a damaged codestream of the
+/// last layer (the shell) fails with exit 3 and leaves no file and no folder.
+#[test]
+fn extract_leaves_nothing_when_a_texture_fails() {
+    let dir = tempfile::tempdir().unwrap();
+    let bad = dir.path().join("bad.pis");
+    let mut bytes = std::fs::read(repo("samples/tiny.pis")).unwrap();
+    // the last byte of CSTR (chunk 5: offset 4160, 855 bytes): the shell's last codestream
+    bytes[4160 + 855 - 1] ^= 0xff;
+    std::fs::write(&bad, &bytes).unwrap();
+    let out_dir = dir.path().join("textures");
+    let out = Command::new(env!("CARGO_BIN_EXE_pis-inspect")).args(["--extract"]).arg(&out_dir).args(["--at", "5,0.9"]).arg(&bad).output().unwrap();
+    assert_eq!(out.status.code(), Some(3), "{}", text(&out.stderr));
+    assert!(text(&out.stderr).contains("error-8003"), "{}", text(&out.stderr));
+    assert!(!out_dir.exists(), "no folder, no partial textures");
+    // into a folder that exists: it stays, empty
+    std::fs::create_dir(&out_dir).unwrap();
+    let out = Command::new(env!("CARGO_BIN_EXE_pis-inspect")).args(["--extract"]).arg(&out_dir).args(["--at", "5,0.9"]).arg(&bad).output().unwrap();
+    assert_eq!(out.status.code(), Some(3));
+    assert_eq!(std::fs::read_dir(&out_dir).unwrap().count(), 0, "no partial textures");
+}
+
 fn image_red(path: &Path) -> f32 {
     use exr::prelude::*;
     let img = read_first_rgba_layer_from_file(

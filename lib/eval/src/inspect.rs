@@ -494,18 +494,18 @@ pub fn parse_point(space: &ParameterSpace, at: Option<&str>) -> anyhow::Result<V
 /// Cube faces in the order stored (SPEC.md, "Shell faces").
 pub const FACE_NAMES: [&str; 6] = ["px", "nx", "py", "ny", "pz", "nz"];
 
-/// Writes every layer's texture at `point` (finest MIP level) as EXR and PNG into `dir`.
-/// Returns the files written.
+/// Writes the textures (and environment-map faces) of every layer at `point` into `dir` as
+/// linear EXR and sRGB PNG; returns the file names. Every texture is decoded before a file
+/// is written, and the files written before an error are removed (the folder too, when this
+/// call made it): an error leaves nothing behind.
 pub fn extract(
     r: &PisReader,
     point: &[u32],
     dir: &Path,
 ) -> Result<Vec<String>, pis_pack::Failure> {
     use pis_pack::{Exit, Failure};
-    std::fs::create_dir_all(dir)
-        .with_context(|| format!("cannot create {}", dir.display()))
-        .map_err(|e| Failure::new(Exit::Io, e))?;
-    let mut written = Vec::new();
+    // Decode first: a damaged codestream fails before any file exists.
+    let mut images = Vec::new();
     for (oi, o) in r.container().objects.iter().enumerate() {
         for (li, l) in o.layers.iter().enumerate() {
             let t = r.texture(oi, li, point)?;
@@ -517,20 +517,30 @@ pub fn extract(
                     String::new()
                 };
                 let stem = format!("{}.{li}-{}{suffix}", sanitize(&o.name), l.kind.name());
-                let plane = t.plane(face, 0);
-                for (ext, f) in [
-                    (
-                        "exr",
-                        write_exr as fn(&Path, u32, u32, u32, &[f32]) -> anyhow::Result<()>,
-                    ),
-                    ("png", write_png),
-                ] {
-                    let name = format!("{stem}.{ext}");
-                    f(&dir.join(&name), lay.width, lay.height, lay.channels, plane)
-                        .map_err(|e| Failure::new(Exit::Io, e))?;
-                    written.push(name);
-                }
+                images.push((stem, lay.width, lay.height, lay.channels, t.plane(face, 0).to_vec()));
             }
+        }
+    }
+    let made = !dir.exists();
+    std::fs::create_dir_all(dir)
+        .with_context(|| format!("cannot create {}", dir.display()))
+        .map_err(|e| Failure::new(Exit::Io, e))?;
+    let mut written = Vec::new();
+    let writers: [(&str, fn(&Path, u32, u32, u32, &[f32]) -> anyhow::Result<()>); 2] = [("exr", write_exr), ("png", write_png)];
+    for (stem, width, height, channels, plane) in &images {
+        for (ext, f) in writers {
+            let name = format!("{stem}.{ext}");
+            if let Err(e) = f(&dir.join(&name), *width, *height, *channels, plane) {
+                for w in &written {
+                    let _ = std::fs::remove_file(dir.join(w));
+                }
+                let _ = std::fs::remove_file(dir.join(&name));
+                if made {
+                    let _ = std::fs::remove_dir(dir);
+                }
+                return Err(Failure::new(Exit::Io, e));
+            }
+            written.push(name);
         }
     }
     Ok(written)

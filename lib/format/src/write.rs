@@ -61,7 +61,10 @@ pub fn write_with_masters(path: &Path, c: &Container, masters: &[Master]) -> Res
     Ok(bytes.len() as u64)
 }
 
-/// Writes `bytes` to `path` through a temporary file and a rename.
+/// Writes `bytes` to `path` through a temporary file and a rename. The file gets the mode a
+/// new file gets (the umask's), or the mode of the file it replaces. The temporary file,
+/// `.pis-PID-N.tmp` beside the destination, is removed on error; temporary files that
+/// processes no longer running left there (killed mid-write) are removed first.
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), Error> {
     let io = |source| Error::Io {
         path: path.to_path_buf(),
@@ -71,15 +74,66 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), Error> {
         Some(d) if !d.as_os_str().is_empty() => d,
         _ => Path::new("."),
     };
-    let mut tmp = tempfile::Builder::new()
-        .prefix(".pis-")
-        .suffix(".tmp")
-        .tempfile_in(dir)
-        .map_err(io)?;
-    tmp.write_all(bytes).map_err(io)?;
-    tmp.as_file().sync_all().map_err(io)?;
-    tmp.persist(path).map_err(|e| io(e.error))?;
+    remove_stale_temporaries(dir);
+    let mut tmp = Temporary::create(dir).map_err(io)?;
+    tmp.file.write_all(bytes).map_err(io)?;
+    if let Ok(old) = std::fs::metadata(path) {
+        tmp.file.set_permissions(old.permissions()).map_err(io)?;
+    }
+    tmp.file.sync_all().map_err(io)?;
+    std::fs::rename(&tmp.path, path).map_err(io)?;
+    tmp.path.clear();
     Ok(())
+}
+
+/// A temporary file this process writes, removed when dropped unless renamed (its path
+/// cleared).
+struct Temporary {
+    path: std::path::PathBuf,
+    file: std::fs::File,
+}
+
+impl Temporary {
+    /// `.pis-PID-N.tmp` in `dir`, created new with the default mode (0666 less the umask).
+    fn create(dir: &Path) -> std::io::Result<Temporary> {
+        static NEXT: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
+        loop {
+            let n = NEXT.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+            let path = dir.join(format!(".pis-{}-{n}.tmp", std::process::id()));
+            match std::fs::OpenOptions::new().write(true).create_new(true).open(&path) {
+                Ok(file) => return Ok(Temporary { path, file }),
+                Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => continue,
+                Err(e) => return Err(e),
+            }
+        }
+    }
+}
+
+impl Drop for Temporary {
+    fn drop(&mut self) {
+        if !self.path.as_os_str().is_empty() {
+            let _ = std::fs::remove_file(&self.path);
+        }
+    }
+}
+
+/// Removes `.pis-PID-N.tmp` files in `dir` whose process PID no longer runs (where the
+/// system says which processes run: /proc).
+fn remove_stale_temporaries(dir: &Path) {
+    let proc = Path::new("/proc/self");
+    if !proc.exists() {
+        return;
+    }
+    let Ok(entries) = std::fs::read_dir(dir) else { return };
+    for e in entries.flatten() {
+        let name = e.file_name();
+        let Some(pid) = name.to_str().and_then(|n| n.strip_prefix(".pis-")?.strip_suffix(".tmp")?.split_once('-')?.0.parse::<u32>().ok()) else {
+            continue;
+        };
+        if pid != std::process::id() && !Path::new("/proc").join(pid.to_string()).exists() {
+            let _ = std::fs::remove_file(e.path());
+        }
+    }
 }
 
 struct Chunk {
@@ -236,4 +290,63 @@ fn assemble(chunks: Vec<Chunk>, labelled: bool) -> Sink {
         }
     }
     out
+}
+
+#[cfg(all(test, unix))]
+mod tests {
+    use super::*;
+    use std::os::unix::fs::PermissionsExt;
+
+    fn mode(p: &Path) -> u32 {
+        std::fs::metadata(p).unwrap().permissions().mode() & 0o777
+    }
+
+    fn temporaries(dir: &Path) -> Vec<String> {
+        std::fs::read_dir(dir).unwrap().flatten().map(|e| e.file_name().to_string_lossy().into_owned()).filter(|n| n.ends_with(".tmp")).collect()
+    }
+
+    /// Outputs were once created 0600, and rewriting a 0644 file made it 0600.
+    #[test]
+    fn a_written_file_gets_the_default_mode_or_keeps_the_old_one() {
+        let dir = tempfile::tempdir().unwrap();
+        let (a, b) = (dir.path().join("a.pis"), dir.path().join("b.pis"));
+        write_atomic(&a, b"new").unwrap();
+        std::fs::write(&b, b"plain").unwrap();
+        assert_eq!(mode(&a), mode(&b), "a new file gets the mode std gives any new file (the umask's)");
+        std::fs::set_permissions(&a, std::fs::Permissions::from_mode(0o640)).unwrap();
+        write_atomic(&a, b"again").unwrap();
+        assert_eq!(mode(&a), 0o640, "a replaced file keeps its mode");
+        assert_eq!(std::fs::read(&a).unwrap(), b"again");
+        assert!(temporaries(dir.path()).is_empty());
+    }
+
+    /// A write killed mid-way (kill -9) once left `.pis-*.tmp` files no later run removed.
+    #[test]
+    fn temporaries_of_processes_no_longer_running_are_removed() {
+        if !Path::new("/proc/self").exists() {
+            return;
+        }
+        let dir = tempfile::tempdir().unwrap();
+        // pid_max is at most 2^22: this process cannot exist
+        let stale = dir.path().join(".pis-99999999-0.tmp");
+        let mine = dir.path().join(format!(".pis-{}-999.tmp", std::process::id()));
+        let other = dir.path().join(".pis-notes.tmp");
+        for p in [&stale, &mine, &other] {
+            std::fs::write(p, b"partial").unwrap();
+        }
+        write_atomic(&dir.path().join("out.pis"), b"whole").unwrap();
+        assert!(!stale.exists(), "a dead process's temporary is removed");
+        assert!(mine.exists() && other.exists(), "a live process's temporary and other files stay");
+    }
+
+    #[test]
+    fn a_failed_write_leaves_no_temporary() {
+        let dir = tempfile::tempdir().unwrap();
+        // renaming a file over a folder fails
+        let target = dir.path().join("folder");
+        std::fs::create_dir(&target).unwrap();
+        std::fs::write(target.join("keep"), b"x").unwrap();
+        assert!(write_atomic(&target, b"bytes").is_err());
+        assert!(temporaries(dir.path()).is_empty(), "{:?}", temporaries(dir.path()));
+    }
 }
