@@ -337,3 +337,62 @@ fn two_sets_compare_their_noise() {
     assert_eq!(diff(&s2, &s32, &["--min-psnr", &format!("{}", p2 + 1.0)]).status.code(), Some(7));
     assert_eq!(diff(&s2, &small, &[]).status.code(), Some(3));
 }
+
+/// One fault, one exit code in every tool (a truncated EXR was pack 3 but diff 2, a missing
+/// set.json pack 2 but diff 3, a missing glTF trace 2 but pack 3): a damaged file is 3, a
+/// missing one 2.
+#[test]
+fn one_fault_gives_one_exit_code_in_every_tool() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let run = |bin: &str, args: &[&std::ffi::OsStr]| -> (Option<i32>, String) {
+        let out = Command::new(bin).args(args).output().expect("the tool runs");
+        (out.status.code(), String::from_utf8_lossy(&out.stderr).into_owned())
+    };
+    let (pack, diff, trace) = (env!("CARGO_BIN_EXE_pis-pack"), env!("CARGO_BIN_EXE_pis-diff"), env!("CARGO_BIN_EXE_pis-trace"));
+    let out = dir.path().join("out.pis");
+    // a truncated EXR: invalid (3) for pis-pack, pis-diff FILE SET and pis-diff SET SET
+    let damaged = dir.path().join("damaged");
+    std::fs::create_dir(&damaged).unwrap();
+    for e in std::fs::read_dir(set()).unwrap().flatten() {
+        std::fs::copy(e.path(), damaged.join(e.file_name())).unwrap();
+    }
+    let exr = damaged.join("point_00001.exr");
+    let bytes = std::fs::read(&exr).unwrap();
+    std::fs::write(&exr, &bytes[..bytes.len() / 2]).unwrap();
+    let demo1 = repo("samples/demo1/scene.toml");
+    for (bin, args) in [
+        (pack, vec![damaged.as_os_str(), "--scene".as_ref(), demo1.as_os_str(), "-o".as_ref(), out.as_os_str()]),
+        (diff, vec![packed().as_os_str(), damaged.as_os_str()]),
+        (diff, vec![set().as_os_str(), damaged.as_os_str()]),
+    ] {
+        let (code, err) = run(bin, &args);
+        assert_eq!(code, Some(3), "truncated EXR, {bin} {args:?}: {err}");
+        assert!(err.contains("point_00001.exr"), "{err}");
+    }
+    // a set folder without set.json: I/O (2)
+    let empty = dir.path().join("empty");
+    std::fs::create_dir(&empty).unwrap();
+    for (bin, args) in [
+        (pack, vec![empty.as_os_str(), "-o".as_ref(), out.as_os_str()]),
+        (diff, vec![packed().as_os_str(), empty.as_os_str()]),
+        (diff, vec![set().as_os_str(), empty.as_os_str()]),
+    ] {
+        let (code, err) = run(bin, &args);
+        assert_eq!(code, Some(2), "missing set.json, {bin} {args:?}: {err}");
+        assert!(err.contains("set.json"), "{err}");
+    }
+    // a scene.toml whose glTF is missing: I/O (2) for pis-trace and pis-pack
+    let scene = dir.path().join("scene");
+    std::fs::create_dir(&scene).unwrap();
+    std::fs::copy(&demo1, scene.join("scene.toml")).unwrap();
+    let (toml, traced) = (scene.join("scene.toml"), dir.path().join("traced"));
+    for (bin, args) in [
+        (trace, vec![toml.as_os_str(), "-o".as_ref(), traced.as_os_str()]),
+        (pack, vec![toml.as_os_str(), "-o".as_ref(), out.as_os_str()]),
+    ] {
+        let (code, err) = run(bin, &args);
+        assert_eq!(code, Some(2), "missing glTF, {bin}: {err}");
+        assert_eq!(err.matches("No such file or directory").count(), 1, "the reason once: {err}");
+    }
+    assert!(!out.exists());
+}

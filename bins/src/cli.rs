@@ -25,8 +25,24 @@ pub fn finish(tool: &str, result: Result<Exit, Failure>) -> ExitCode {
     match result {
         Ok(code) => code.into(),
         Err(f) => {
-            eprintln!("{tool}: {:#}", f.error);
+            eprintln!("{tool}: {}", message(&f.error));
             f.exit.into()
         }
     }
+}
+
+/// The error and its causes, each cause only when its text is not already in the message
+/// (a file error names its path and reason once).
+pub fn message(err: &anyhow::Error) -> String {
+    let mut out = String::new();
+    for cause in err.chain() {
+        let text = cause.to_string();
+        if !out.contains(&text) {
+            if !out.is_empty() {
+                out.push_str(": ");
+            }
+            out.push_str(&text);
+        }
+    }
+    out
 }

@@ -20,7 +20,7 @@ fn is_scene(path: &Path) -> bool {
 /// hash of the options.
 fn pack_scene(scene_toml: &Path, options: &PackOptions) -> Result<PathBuf, Failure> {
     let load = pis_scene::LoadOptions { preset: options.preset.clone(), resolution: options.resolution, spp: options.spp };
-    let scene = pis_scene::load_with(scene_toml, &load).map_err(|e| Failure::new(Exit::Invalid, e))?;
+    let scene = pis_scene::load_with(scene_toml, &load).map_err(Failure::from)?;
     let set_dir = pis_pack::cache_dir(scene_toml, &scene);
     let mut name = set_dir.file_name().map(|n| n.to_os_string()).unwrap_or_default();
     let fingerprint = options.fingerprint();

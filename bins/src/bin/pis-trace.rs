@@ -6,7 +6,7 @@
 use anyhow::Context;
 use clap::Parser;
 use indicatif::{ProgressBar, ProgressStyle};
-use pis_scene::{LoadOptions, SceneError};
+use pis_scene::LoadOptions;
 use pis_trace::{render_set, Progress, SetReport, TraceError, TraceSettings};
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -50,48 +50,9 @@ fn parse_resolution(s: &str) -> Result<(u32, u32), String> {
     Ok((w, h))
 }
 
-/// Exit code for an error, by what went wrong.
+/// Exit code for an error, by what went wrong (the toolchain's one mapping).
 fn exit_code(err: &anyhow::Error) -> u8 {
-    for cause in err.chain() {
-        if let Some(e) = cause.downcast_ref::<TraceError>() {
-            return match e {
-                TraceError::Io { .. } | TraceError::Exr { .. } => 2,
-                TraceError::InvalidSet { .. } => 3,
-                TraceError::Scene(s) => scene_code(s),
-                TraceError::InvalidInput(_) => 4,
-            };
-        }
-        if let Some(s) = cause.downcast_ref::<SceneError>() {
-            return scene_code(s);
-        }
-        if cause.downcast_ref::<std::io::Error>().is_some() {
-            return 2;
-        }
-    }
-    4
-}
-
-/// The error and its causes, each cause only when its text is not already in the message.
-fn message(err: &anyhow::Error) -> String {
-    let mut out = String::new();
-    for cause in err.chain() {
-        let text = cause.to_string();
-        if !out.contains(&text) {
-            if !out.is_empty() {
-                out.push_str(": ");
-            }
-            out.push_str(&text);
-        }
-    }
-    out
-}
-
-fn scene_code(e: &SceneError) -> u8 {
-    match e {
-        SceneError::Io { .. } => 2,
-        SceneError::PointOutOfRange { .. } => 4,
-        _ => 3,
-    }
+    pis_pack::exit_of(err, pis_pack::Exit::Runtime) as u8
 }
 
 struct Bar(ProgressBar);
@@ -171,7 +132,7 @@ fn main() -> ExitCode {
             ExitCode::SUCCESS
         }
         Err(err) => {
-            eprintln!("pis-trace: {}", message(&err));
+            eprintln!("pis-trace: {}", pis::cli::message(&err));
             ExitCode::from(exit_code(&err))
         }
     }

@@ -126,7 +126,7 @@ pub const RULES: &[(u16, &str)] = &[
     (5103, "unknown object role"),
     (5104, "shading constants out of range"),
     (5105, "staggered block origin is not less than the block size"),
-    (5106, "transform is not a finite rigid transform"),
+    (5106, "transform is not a finite rigid transform (its 3×3 part orthonormal with determinant +1, within 10⁻³)"),
     (5200, "MESH payload is malformed"),
     (5201, "mesh names a missing object, or a second mesh names the same object"),
     (5202, "object has no mesh"),

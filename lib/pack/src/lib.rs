@@ -20,5 +20,5 @@ pub mod images;
 pub mod infer;
 pub mod pipeline;
 
-pub use error::{Exit, Failure};
+pub use error::{exit_of, format_exit, scene_exit, trace_exit, Exit, Failure};
 pub use pipeline::*;

@@ -127,32 +127,17 @@ fn finite(v: f64) -> Option<f64> {
     v.is_finite().then_some(v)
 }
 
-/// The exit code a reader error stands for.
-fn reader_exit(f: &pis_format::Error) -> Exit {
-    match f {
-        pis_format::Error::Io { .. } => Exit::Io,
-        pis_format::Error::Invalid(_) => Exit::Invalid,
-        pis_format::Error::NotSupported(_) => Exit::NotSupported,
-        pis_format::Error::Request(_) => Exit::Usage,
-        pis_format::Error::InvalidModel(_) => Exit::Runtime,
-    }
-}
-
 /// The exit code of an error from the player or the comparison: no adapter is "not
 /// supported", file errors keep theirs, a set that cannot be read is an I/O error.
 fn failure(e: anyhow::Error) -> Failure {
     let exit = if let Some(p) = e.downcast_ref::<PlayError>() {
         match p {
             PlayError::NoAdapter(_) => Exit::NotSupported,
-            PlayError::File(f) => reader_exit(f),
+            PlayError::File(f) => pis_pack::format_exit(f),
             _ => Exit::Runtime,
         }
-    } else if let Some(f) = e.downcast_ref::<pis_format::Error>() {
-        reader_exit(f)
-    } else if e.downcast_ref::<std::io::Error>().is_some() {
-        Exit::Io
     } else {
-        Exit::Runtime
+        pis_pack::exit_of(&e, Exit::Runtime)
     };
     Failure::new(exit, e)
 }

@@ -8,7 +8,7 @@
 
 use std::path::{Path, PathBuf};
 
-use anyhow::{anyhow, Context};
+use anyhow::anyhow;
 use crate::metrics::SquaredError;
 use pis_trace::layers::LayerKind;
 use pis_trace::set::RaySet;
@@ -72,7 +72,7 @@ fn finite(p: f64) -> Option<f64> {
 }
 
 fn open(p: &Path) -> Result<RaySet, Failure> {
-    RaySet::open(p).with_context(|| format!("opening the ray-traced set {}", p.display())).map_err(|e| Failure::new(Exit::Invalid, e))
+    RaySet::open(p).map_err(|e| Failure::new(pis_pack::trace_exit(&e), anyhow::Error::new(e).context(format!("opening the ray-traced set {}", p.display()))))
 }
 
 /// Compares the sets of `req`.
@@ -96,7 +96,7 @@ pub fn compare_sets(req: &SetsRequest) -> Result<SetsReport, Failure> {
         if pa.values != pb.values {
             return Err(invalid(anyhow!("point {} is {:?} in {} and {:?} in {}: not the same parameter space", pa.index, pa.values, req.a.display(), pb.values, req.b.display())));
         }
-        let read = |s: &RaySet, i: usize, dir: &Path| s.read_point(i).with_context(|| format!("reading point {i} of {}", dir.display())).map_err(|e| Failure::new(Exit::Io, e));
+        let read = |s: &RaySet, i: usize, dir: &Path| s.read_point(i).map_err(|e| Failure::new(pis_pack::trace_exit(&e), anyhow::Error::new(e).context(format!("reading point {i} of {}", dir.display()))));
         let (ia, ib) = (read(&sa, pa.index, &req.a)?, read(&sb, pb.index, &req.b)?);
         let mut e = SquaredError::default();
         let (ca, cb) = match (ia.layer("combined"), ib.layer("combined")) {

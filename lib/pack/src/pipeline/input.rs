@@ -34,12 +34,7 @@ impl LoadedSet {
 }
 
 fn trace_failure(e: TraceError) -> Failure {
-    let exit = match &e {
-        TraceError::Io { .. } => Exit::Io,
-        TraceError::Exr { .. } | TraceError::InvalidSet { .. } => Exit::Invalid,
-        TraceError::Scene(_) | TraceError::InvalidInput(_) => Exit::Invalid,
-    };
-    Failure::new(exit, e)
+    Failure::from(e)
 }
 
 fn invalid(msg: String) -> Failure {
@@ -71,7 +66,7 @@ pub fn set_scene(set: &RaySet, scene_path: &Path, res: (u32, u32), preset: Optio
     let load = |preset: Option<String>| {
         let options = LoadOptions { preset, resolution: Some(res), ..LoadOptions::default() };
         pis_scene::load_with(scene_path, &options)
-            .map_err(|e| Failure::new(Exit::Invalid, anyhow!("loading {} (the set's scene; pass --scene): {e}", scene_path.display())))
+            .map_err(|e| Failure::new(crate::error::scene_exit(&e), anyhow!("loading {} (the set's scene; pass --scene): {e}", scene_path.display())))
     };
     if let Some(p) = preset {
         return load(Some(p.to_string()));
@@ -98,7 +93,7 @@ pub fn load(req: &PackRequest, stages: &mut Stages) -> Result<LoadedSet, Failure
         (req.input.clone(), set.default_scene())
     } else if req.input.is_file() {
         let options = LoadOptions { preset: req.preset.clone(), resolution: req.resolution, spp: req.spp };
-        let scene = pis_scene::load_with(&req.input, &options).map_err(|e| Failure::new(Exit::Invalid, e))?;
+        let scene = pis_scene::load_with(&req.input, &options).map_err(Failure::from)?;
         let dir = cache_dir(&req.input, &scene);
         if !dir.join("set.json").is_file() {
             // What the container cannot store is refused before the trace.
