@@ -396,3 +396,52 @@ fn one_fault_gives_one_exit_code_in_every_tool() {
     }
     assert!(!out.exists());
 }
+
+/// pis-diff on sets once accepted NaN pixels, coverage outside [0, 1] and sample indices
+/// outside the space that pis-pack refused (and pis-pack took coverage −5): one reader, one
+/// set of checks, exit 3 from both tools.
+#[test]
+fn damaged_sets_are_refused_alike_by_pis_pack_and_pis_diff() {
+    let cases: [(&str, fn(&Path)); 3] = [
+        ("is NaN", |d| edit_point(d, |img| img.layers[0].planes[1][7] = f32::NAN)),
+        ("outside [0, 1]", |d| edit_point(d, |img| {
+            let l = img.layers.iter_mut().find(|l| l.name.ends_with(".coverage")).expect("a coverage layer");
+            l.planes[0][3] = -5.0;
+        })),
+        ("samples[0] is 7", |d| {
+            let json = d.join("set.json");
+            let mut meta: serde_json::Value = serde_json::from_slice(&std::fs::read(&json).unwrap()).unwrap();
+            meta["points"][1]["samples"][0] = serde_json::json!(7);
+            std::fs::write(&json, serde_json::to_vec(&meta).unwrap()).unwrap();
+        }),
+    ];
+    for (needle, damage) in cases {
+        let dir = tempfile::tempdir().expect("temp dir");
+        let bad = dir.path().join("set");
+        std::fs::create_dir(&bad).unwrap();
+        for e in std::fs::read_dir(set()).unwrap().flatten() {
+            std::fs::copy(e.path(), bad.join(e.file_name())).unwrap();
+        }
+        damage(&bad);
+        let out_file = dir.path().join("out.pis");
+        for args in [
+            vec![env!("CARGO_BIN_EXE_pis-diff").into(), set().as_os_str().to_owned(), bad.as_os_str().to_owned()],
+            vec![env!("CARGO_BIN_EXE_pis-pack").into(), bad.as_os_str().to_owned(), "--scene".into(), repo("samples/demo1/scene.toml").into_os_string(), "-o".into(), out_file.as_os_str().to_owned()],
+        ] {
+            let out = Command::new(&args[0]).args(&args[1..]).output().expect("the tool runs");
+            let err = String::from_utf8_lossy(&out.stderr);
+            assert_eq!(out.status.code(), Some(3), "{needle}: {args:?}: {err}");
+            assert!(err.contains(needle), "{needle}: {err}");
+        }
+        assert!(!out_file.exists());
+    }
+}
+
+/// Rewrites point 1's EXR of the set at `d` after `edit`.
+fn edit_point(d: &Path, edit: impl FnOnce(&mut pis_trace::PointImages)) {
+    let set = pis_trace::set::RaySet::open(d).expect("set");
+    let mut img = set.read_point(1).expect("point");
+    edit(&mut img);
+    let path = d.join(&set.meta.points[1].image);
+    std::fs::write(&path, pis_trace::set::encode_exr(&img, &path).expect("encode")).expect("write");
+}

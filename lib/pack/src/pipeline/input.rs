@@ -129,9 +129,6 @@ pub fn load(req: &PackRequest, stages: &mut Stages) -> Result<LoadedSet, Failure
             if l.width != res.0 || l.height != res.1 {
                 return Err(invalid(format!("{}: point {i} layer {} is {}x{}, the set declares {}x{}", dir.display(), l.name, l.width, l.height, res.0, res.1)));
             }
-            if let Some(c) = l.planes.iter().position(|p| p.iter().any(|v| !v.is_finite())) {
-                return Err(invalid(format!("{}: point {i} layer {} channel {} has NaN or infinite pixels", dir.display(), l.name, l.channels[c])));
-            }
         }
         frames.push(scene.frame(&p.samples).map_err(|e| Failure::new(Exit::Invalid, e))?);
         samples.push(p.samples.clone());

@@ -9,6 +9,9 @@ use crate::records::{decode_records, RayRecord};
 use std::fs;
 use std::path::{Path, PathBuf};
 
+/// Rounding a filtered coverage may show beyond [0, 1].
+const COVERAGE_SLACK: f32 = 1e-4;
+
 /// A ray-traced set opened for reading: its metadata, points loaded on demand.
 #[derive(Clone, Debug)]
 pub struct RaySet {
@@ -61,6 +64,14 @@ impl RaySet {
             if p.image.contains(['/', '\\']) || p.rays.as_deref().is_some_and(|r| r.contains(['/', '\\'])) {
                 return Err(bad(format!("points[{i}]: file names must not contain path separators")));
             }
+            for (k, (d, (&s, &v))) in meta.space.iter().zip(p.samples.iter().zip(&p.values)).enumerate() {
+                let Some(&want) = d.values.get(s as usize) else {
+                    return Err(bad(format!("points[{i}].samples[{k}] is {s}; dimension `{}` has {} samples", d.name, d.values.len())));
+                };
+                if !v.is_finite() || (v - want).abs() > 1e-4 * want.abs().max(1.0) {
+                    return Err(bad(format!("points[{i}].values[{k}] is {v}; sample {s} of dimension `{}` is {want}", d.name)));
+                }
+            }
         }
         Ok(RaySet { dir, meta })
     }
@@ -99,6 +110,20 @@ impl RaySet {
                 match images.layer(&name) {
                     Some(img) if want.iter().all(|c| img.channel(c).is_some()) => {}
                     _ => return Err(bad(format!("layer `{name}` (channels {want:?}) is missing"))),
+                }
+            }
+        }
+        // Pixels are finite, coverage a fraction (section 4).
+        for layer in &images.layers {
+            let coverage = layer.name.ends_with(".coverage");
+            for (c, plane) in layer.channels.iter().zip(&layer.planes) {
+                if let Some(k) = plane.iter().position(|v| !v.is_finite()) {
+                    return Err(bad(format!("layer `{}` channel {c}: pixel {k} is {}", layer.name, plane[k])));
+                }
+                if coverage {
+                    if let Some(k) = plane.iter().position(|v| !(-COVERAGE_SLACK..=1.0 + COVERAGE_SLACK).contains(v)) {
+                        return Err(bad(format!("layer `{}` channel {c}: pixel {k} covers {}, outside [0, 1]", layer.name, plane[k])));
+                    }
                 }
             }
         }
