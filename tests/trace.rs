@@ -206,3 +206,21 @@ fn demo1_at_80x60_gives_identical_bytes_twice() {
     }
     assert_eq!(dir_bytes(&dirs[0]), dir_bytes(&dirs[1]));
 }
+
+/// A resolution within the file's limit but beyond this machine's memory once aborted on
+/// allocation: refused before any point, with the figures.
+#[test]
+fn a_point_larger_than_memory_is_refused_before_tracing() {
+    if pis_trace::memory::available_memory().is_none_or(|m| m > 1 << 40) {
+        return; // no figure to compare with, or a machine with a terabyte
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let scene = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../samples/demo1/scene.toml");
+    let out = Command::new(env!("CARGO_BIN_EXE_pis-trace"))
+        .arg(&scene).arg("-o").arg(dir.path().join("set")).args(["--resolution", "65536x65536"])
+        .output().unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(4), "{err}");
+    assert!(err.contains("a point of 65536x65536 pixels needs about") && err.contains("are available"), "{err}");
+    assert!(!dir.path().join("set").join("set.json").exists());
+}

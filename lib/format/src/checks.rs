@@ -5,7 +5,7 @@ use std::collections::HashSet;
 
 use crate::blocks::BlockGrid;
 use crate::model::*;
-use crate::payload_read::MAX_DIMS;
+pub use crate::payload_read::MAX_DIMS;
 use crate::Issue;
 
 /// Most parameter points a space may have.

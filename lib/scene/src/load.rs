@@ -54,6 +54,7 @@ pub fn load_with(path: &Path, options: &LoadOptions) -> Result<Scene, SceneError
     if spp == 0 {
         return Err(SceneError::invalid(path, "spp", "must be at least 1"));
     }
+    check_limits(&m, (width, height), path)?;
 
     let dir = path.parent().unwrap_or(Path::new("."));
     let gltf_path = dir.join(&m.gltf);
@@ -106,6 +107,27 @@ pub fn load_with(path: &Path, options: &LoadOptions) -> Result<Scene, SceneError
         rig: g.rig,
         source: Some(path.to_path_buf()),
     })
+}
+
+/// What a `.pis` file can hold (SPEC.md section 12), checked before the glTF is read or a
+/// sample value made: an image side, the dimension count and the parameter points.
+fn check_limits(m: &Manifest, (width, height): (u32, u32), path: &Path) -> Result<(), SceneError> {
+    use pis_format::checks::{MAX_DIMS, MAX_IMAGE_SIDE, MAX_POINTS};
+    if width > MAX_IMAGE_SIDE || height > MAX_IMAGE_SIDE {
+        let msg = format!("{width}x{height}: a .pis file holds images of at most {MAX_IMAGE_SIDE} pixels a side");
+        return Err(SceneError::invalid(path, "resolution", msg));
+    }
+    if m.dimensions.len() > MAX_DIMS as usize {
+        let msg = format!("{} dimensions: a .pis file holds at most {MAX_DIMS}", m.dimensions.len());
+        return Err(SceneError::invalid(path, "dimension", msg));
+    }
+    let points = m.dimensions.iter().try_fold(1u64, |n, d| n.checked_mul(d.samples as u64).filter(|&n| n <= MAX_POINTS));
+    if points.is_none() {
+        let counts: Vec<String> = m.dimensions.iter().map(|d| format!("{} {}", d.samples, d.name)).collect();
+        let msg = format!("{}: more than {MAX_POINTS} parameter points, the most a .pis file holds", counts.join(" × "));
+        return Err(SceneError::invalid(path, "dimension", msg));
+    }
+    Ok(())
 }
 
 /// The camera from `[camera]`, else the first glTF camera, else (with an orbit) a placeholder.

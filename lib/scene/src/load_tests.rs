@@ -699,3 +699,29 @@ fn buffer_shorter_than_its_byte_length_is_refused() {
         assert!(e.contains("buffers[0].byteLength") && e.contains("the data holds"), "{short} bytes short: {e}");
     }
 }
+
+/// A 9-dimension space once traced fully and then failed at write: refused at load.
+#[test]
+fn more_dimensions_than_a_file_holds_are_refused_at_load() {
+    let dims: String = (0..9).map(|k| format!("\n[[dimension]]\nname = \"d{k}\"\ndriver = \"animation\"\nanimation = \"spin\"\nkind = \"other\"\nsamples = 1\n")).collect();
+    let toml = format!("gltf = \"scene.gltf\"\nresolution = [32, 24]\nspp = 1\n[camera]\nnode = \"Cam\"\n{dims}");
+    let e = load_err(&Fixture::new(&toml, |_, _| {})).to_string();
+    assert!(e.contains("9 dimensions: a .pis file holds at most 8"), "{e}");
+}
+
+/// 10^9 samples once allocated 4 GB at load: refused before any sample value is made.
+#[test]
+fn more_points_than_a_file_holds_are_refused_at_load() {
+    let toml = TOML.replace("samples = 3", "samples = 1000000000");
+    let e = load_err(&Fixture::new(&toml, |_, _| {})).to_string();
+    assert!(e.contains("1000000000 spin × 4 view: more than 16777216 parameter points"), "{e}");
+}
+
+/// Huge resolutions once aborted on allocation.
+#[test]
+fn a_resolution_over_the_file_limit_is_refused_at_load() {
+    let f = Fixture::new(TOML, |_, _| {});
+    let options = LoadOptions { resolution: Some((70000, 10)), ..LoadOptions::default() };
+    let e = load_with(&f.toml(), &options).err().expect("refused").to_string();
+    assert!(e.contains("70000x10: a .pis file holds images of at most 65536 pixels a side"), "{e}");
+}

@@ -26,6 +26,7 @@ pub mod integrator;
 pub mod layers;
 pub mod lights;
 pub mod material;
+pub mod memory;
 pub mod rays;
 pub mod records;
 pub mod render;

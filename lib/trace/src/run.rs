@@ -60,6 +60,17 @@ pub fn render_set(
     limit: Option<usize>,
     progress: &dyn Progress,
 ) -> Result<SetReport, TraceError> {
+    // A point's samples, images and EXR in memory at once: refused before any work when
+    // the machine has not that much.
+    let (w, h) = settings.resolution;
+    let need = crate::memory::image_bytes(w, h, crate::memory::point_channels(scene.objects.iter().map(|o| o.role)), 3);
+    if let Some(have) = crate::memory::available_memory().filter(|&have| need > have) {
+        return Err(TraceError::InvalidInput(format!(
+            "a point of {w}x{h} pixels needs about {} of memory, {} are available: trace at a smaller resolution",
+            crate::memory::gib(need),
+            crate::memory::gib(have)
+        )));
+    }
     let start = Instant::now();
     let total_points = scene.space.point_count();
     let count = limit.map_or(total_points, |l| l.min(total_points));
