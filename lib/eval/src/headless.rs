@@ -72,6 +72,7 @@ pub fn play_failure(e: PlayError) -> Failure {
         e @ PlayError::Request(_) => Failure::new(Exit::Usage, e),
         e @ PlayError::Content { .. } => Failure::new(Exit::Invalid, e),
         e @ PlayError::RepeatSize { .. } => Failure::new(Exit::Invalid, e),
+        e @ PlayError::TextureSize { .. } => Failure::new(Exit::NotSupported, e),
         e => Failure::new(Exit::Runtime, e),
     }
 }

@@ -422,6 +422,13 @@ fn layers<S>(s: &ParameterSpace, oi: usize, o: &Object<S>, out: &mut Vec<Issue>)
             if let Some(why) = placement(&b.placement, l.mapping) {
                 out.push(e(6007, why));
             }
+            if let Placement::Surface { repeat, .. } = b.placement {
+                for (axis, wraps, side) in [("s", repeat[0], b.width), ("t", repeat[1], b.height)] {
+                    if wraps && !side.is_power_of_two() {
+                        out.push(e(6007, format!("the texture wraps along {axis} but its side {side} is not a power of two")));
+                    }
+                }
+            }
             pyramid(
                 &grid.extent(bi),
                 l.depends_on.count(),

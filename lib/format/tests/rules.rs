@@ -306,6 +306,20 @@ fn cases() -> Vec<(u16, Vec<u8>)> {
         t().set_f32("layer 1 block 0 shell parameters", -4.0)
             .reseal(),
     ));
+    // A texture that wraps along s with a side of 3 texels: the validator once passed it and
+    // the player refused it ("repeat addressing ... needs a power-of-two used texture size").
+    v.push((
+        6007,
+        unchecked(|c| {
+            let b = &mut c.objects[0].layers[0].blocks[0];
+            b.width = 3;
+            b.placement = Placement::Surface {
+                affine: [1.0, 0.0, 0.0, 1.0, 0.0, 0.0],
+                repeat: [true, false],
+                cut: [None, None],
+            };
+        }),
+    ));
     v.push((
         6008,
         unchecked(|c| {

@@ -21,6 +21,8 @@ pub enum PlayError {
     RepeatSize { axis: char, size: u32 },
     #[error("texture data has {got} values, the layout {width}×{height} with {levels} levels needs {want} (4 per texel)")]
     TextureData { got: usize, want: usize, width: u32, height: u32, levels: u32 },
+    #[error("object {object}: a {width}×{height} texture exceeds the adapter's largest texture side {limit} (textures are allocated at the next power of two)")]
+    TextureSize { object: String, width: u32, height: u32, limit: u32 },
     #[error("render target {width}×{height} is empty or exceeds the adapter's limit {limit}")]
     TargetSize { width: u32, height: u32, limit: u32 },
     #[error("reading back the frame failed: {0}")]

@@ -207,6 +207,23 @@ fn prepare_objects(gpu: &Gpu, reader: &PisReader) -> Result<Vec<ObjectGpu>, Play
     Ok(out)
 }
 
+/// Every surface texture of the file, as the player allocates it (padded to powers of
+/// two), fits the adapter's largest 2D texture: checked at open, before any frame.
+fn check_texture_sizes(gpu: &Gpu, reader: &PisReader) -> Result<(), PlayError> {
+    let limit = gpu.limits.max_texture_dimension_2d;
+    for o in &reader.container().objects {
+        for l in o.layers.iter().filter(|l| l.mapping == pis_format::Mapping::Surface) {
+            for b in &l.blocks {
+                let (w, h) = crate::textured::allocated_size(&TextureLayout::full(b.width, b.height));
+                if w > limit || h > limit {
+                    return Err(PlayError::TextureSize { object: o.name.clone(), width: b.width, height: b.height, limit });
+                }
+            }
+        }
+    }
+    Ok(())
+}
+
 impl Player {
     /// Opens `path` for random access (metadata read and checked; codestreams stay on disk
     /// until a frame needs them).
@@ -216,6 +233,7 @@ impl Player {
         }
         check_samples(options.msaa).map_err(PlayError::Request)?;
         let reader = PisReader::open(path)?;
+        check_texture_sizes(&gpu, &reader)?;
         let objects = prepare_objects(&gpu, &reader)?;
         let filter = file_filter(reader.container());
         // The reader has checked the settings (rule 9002).

@@ -132,7 +132,7 @@ fn finite(v: f64) -> Option<f64> {
 fn failure(e: anyhow::Error) -> Failure {
     let exit = if let Some(p) = e.downcast_ref::<PlayError>() {
         match p {
-            PlayError::NoAdapter(_) => Exit::NotSupported,
+            PlayError::NoAdapter(_) | PlayError::TextureSize { .. } => Exit::NotSupported,
             PlayError::File(f) => pis_pack::format_exit(f),
             _ => Exit::Runtime,
         }
