@@ -54,7 +54,7 @@ pub struct PackOptions {
     #[arg(long, default_value = "1", value_parser = parse_budget)]
     pub texels_per_pixel: Budget,
     /// Display gamma of the compensation (1: linear storage; lossless packs always use 1).
-    #[arg(long, default_value_t = 2.2)]
+    #[arg(long, default_value_t = pis_pack::DEFAULT_GAMMA)]
     pub gamma: f32,
     /// Tracing a scene.toml: image size WIDTHxHEIGHT.
     #[arg(long, value_parser = parse_resolution)]
@@ -232,3 +232,15 @@ pub fn parse_resolution(s: &str) -> Result<(u32, u32), String> {
     }
 }
 
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The command line's defaults are the library's: one truth for pis-pack's defaults.
+    #[test]
+    fn the_flags_defaults_are_pack_settings_new() {
+        let req = PackOptions::defaults().request("set".into(), None, "out.pis".into()).unwrap();
+        assert_eq!(req.settings, PackSettings::new());
+    }
+}
