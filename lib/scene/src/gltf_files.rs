@@ -94,10 +94,8 @@ fn resolve(gltf: &Path, field: &str, uri: &str, rel: &str, absolute: bool, allow
     if inside { Ok(target) } else { Err(refuse("leaves the glTF's folder")) }
 }
 
-/// Checks the buffer and image references of the glTF at `path`. A document the glTF reader
-/// cannot parse passes here: the reader says what is wrong with it.
-pub(crate) fn check_files(path: &Path, allow_outside: bool) -> Result<(), SceneError> {
-    let Ok(gltf) = gltf::Gltf::open(path) else { return Ok(()) };
+/// Checks the buffer and image references of `gltf`, read from `path`.
+pub(crate) fn check_files(path: &Path, gltf: &gltf::Gltf, allow_outside: bool) -> Result<(), SceneError> {
     for b in gltf.buffers() {
         let field = format!("buffers[{}]", b.index());
         let have = match b.source() {

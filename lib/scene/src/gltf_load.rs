@@ -49,8 +49,13 @@ pub(crate) fn read_gltf(path: &Path, allow_outside: bool) -> Result<GltfScene, S
         });
     }
     let read = || {
-        crate::gltf_files::check_files(path, allow_outside)?;
-        let (doc, buffers, images) = gltf::import(path).map_err(|e| import_error(path, e))?;
+        // Parsed once: the files it names are checked before any is read.
+        let gltf = gltf::Gltf::open(path).map_err(|e| import_error(path, e))?;
+        crate::gltf_files::check_files(path, &gltf, allow_outside)?;
+        let base = path.parent().unwrap_or(Path::new("./"));
+        let gltf::Gltf { document: doc, blob } = gltf;
+        let buffers = gltf::import_buffers(&doc, Some(base), blob).map_err(|e| import_error(path, e))?;
+        let images = gltf::import_images(&doc, Some(base), &buffers).map_err(|e| import_error(path, e))?;
         check_animation_indices(path, &doc)?;
         convert(path, &doc, &buffers, &images)
     };
