@@ -220,7 +220,7 @@ fn a_point_larger_than_memory_is_refused_before_tracing() {
         .arg(&scene).arg("-o").arg(dir.path().join("set")).args(["--resolution", "65536x65536"])
         .output().unwrap();
     let err = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(out.status.code(), Some(4), "{err}");
+    assert_eq!(out.status.code(), Some(5), "{err}");
     assert!(err.contains("a point of 65536x65536 pixels needs about") && err.contains("are available"), "{err}");
     assert!(!dir.path().join("set").join("set.json").exists());
 }

@@ -76,7 +76,8 @@ impl std::error::Error for Failure {
 
 /// The exit code of a ray-traced set's or a trace's error, the same in every tool: a file
 /// that cannot be read (a missing set.json or glTF) is an I/O error, a damaged one (a
-/// truncated EXR, a malformed set.json or scene) an invalid file.
+/// truncated EXR, a malformed set.json or scene) an invalid file, work larger than the
+/// machine's memory not supported.
 pub fn trace_exit(e: &pis_trace::TraceError) -> Exit {
     use pis_trace::TraceError;
     match e {
@@ -84,6 +85,7 @@ pub fn trace_exit(e: &pis_trace::TraceError) -> Exit {
         TraceError::Exr { .. } | TraceError::InvalidSet { .. } => Exit::Invalid,
         TraceError::Scene(s) => scene_exit(s),
         TraceError::InvalidInput(_) => Exit::Runtime,
+        TraceError::Memory(_) => Exit::NotSupported,
     }
 }
 

@@ -20,6 +20,9 @@ pub enum TraceError {
     /// The scene or the settings cannot be rendered.
     #[error("invalid render input: {0}")]
     InvalidInput(String),
+    /// The work would need more memory than the machine has available.
+    #[error("{0}")]
+    Memory(String),
 }
 
 impl TraceError {

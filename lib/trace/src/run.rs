@@ -65,7 +65,7 @@ pub fn render_set(
     let (w, h) = settings.resolution;
     let need = crate::memory::image_bytes(w, h, crate::memory::point_channels(scene.objects.iter().map(|o| o.role)), 3);
     if let Some(have) = crate::memory::available_memory().filter(|&have| need > have) {
-        return Err(TraceError::InvalidInput(format!(
+        return Err(TraceError::Memory(format!(
             "a point of {w}x{h} pixels needs about {} of memory, {} are available: trace at a smaller resolution",
             crate::memory::gib(need),
             crate::memory::gib(have)
