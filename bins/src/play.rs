@@ -92,7 +92,7 @@ pub fn run(args: &PlayArgs) -> Result<Exit, Failure> {
     if let Some(set) = &args.set {
         // Headless, the set gives the display filter: it must be readable.
         pis_trace::set::RaySet::open(set).map_err(|e| {
-            let exit = if matches!(e, pis_trace::TraceError::Io { .. }) { Exit::Io } else { Exit::Invalid };
+            let exit = pis_pack::trace_exit(&e);
             Failure::new(exit, anyhow::anyhow!("--set {}: {e}", set.display()))
         })?;
     }

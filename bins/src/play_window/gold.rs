@@ -37,7 +37,7 @@ impl GoldSet {
     /// match the file's space.
     pub fn open(dir: &Path, dims: &[Dimension]) -> Result<GoldSet, Failure> {
         let set = RaySet::open(dir).map_err(|e| {
-            let exit = if matches!(e, pis_trace::TraceError::Io { .. }) { Exit::Io } else { Exit::Invalid };
+            let exit = pis_pack::trace_exit(&e);
             Failure::new(exit, anyhow::anyhow!("--set: {e}"))
         })?;
         let file_dim = match_dimensions(&set, dims).map_err(|m| Failure::new(Exit::Invalid, anyhow::anyhow!("--set {}: {m}", dir.display())))?;

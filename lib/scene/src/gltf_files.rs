@@ -35,25 +35,9 @@ fn reference(uri: &str) -> Reference<'_> {
     Reference::File(path, absolute)
 }
 
-/// `%XX` escapes decoded (invalid escapes kept as written).
+/// `%XX` escapes decoded as the glTF reader decodes them (the path it would open).
 fn percent_decode(s: &str) -> String {
-    let b = s.as_bytes();
-    let mut out = Vec::with_capacity(b.len());
-    let mut i = 0;
-    while i < b.len() {
-        let hex = |c: u8| (c as char).to_digit(16);
-        match (b[i], b.get(i + 1).copied().and_then(hex), b.get(i + 2).copied().and_then(hex)) {
-            (b'%', Some(h), Some(l)) => {
-                out.push((h * 16 + l) as u8);
-                i += 3;
-            }
-            (c, _, _) => {
-                out.push(c);
-                i += 1;
-            }
-        }
-    }
-    String::from_utf8_lossy(&out).into_owned()
+    urlencoding::decode(s).map_or_else(|_| s.to_string(), |d| d.into_owned())
 }
 
 /// Bytes that base64 text decodes to.

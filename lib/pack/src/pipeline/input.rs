@@ -86,6 +86,21 @@ pub fn set_scene(set: &RaySet, scene_path: &Path, res: (u32, u32), preset: Optio
     Ok(scene)
 }
 
+/// Every point's images are held at once: a set of `points` images of `channels` float
+/// channels that would not fit in the machine's available memory is refused before it is
+/// traced or read.
+fn check_memory(what: &Path, points: usize, (w, h): (u32, u32), channels: u64) -> Result<(), Failure> {
+    use pis_trace::memory::{available_memory, gib, image_bytes};
+    let need = image_bytes(w, h, channels, points as u64);
+    match available_memory().filter(|&have| need > have) {
+        Some(have) => Err(Failure::new(Exit::NotSupported, anyhow!(
+            "{}: its {points} points of {w}x{h} pixels take {} in memory to pack, {} are available",
+            what.display(), gib(need), gib(have)
+        ))),
+        None => Ok(()),
+    }
+}
+
 /// Opens (or traces) the set, loads its scene and reads and checks every point.
 pub fn load(req: &PackRequest, stages: &mut Stages) -> Result<LoadedSet, Failure> {
     let (dir, scene_path) = if req.input.is_dir() {
@@ -98,14 +113,8 @@ pub fn load(req: &PackRequest, stages: &mut Stages) -> Result<LoadedSet, Failure
         if !dir.join("set.json").is_file() {
             // What the container cannot store, or this machine cannot pack, is refused before
             // the trace.
-            let (w, h) = scene.resolution;
-            let need = pis_trace::memory::image_bytes(w, h, pis_trace::memory::point_channels(scene.objects.iter().map(|o| o.role)), scene.space.point_count() as u64);
-            if let Some(have) = pis_trace::memory::available_memory().filter(|&have| need > have) {
-                return Err(Failure::new(Exit::NotSupported, anyhow!(
-                    "{}: its {} points of {w}x{h} pixels would take {} in memory to pack, {} are available",
-                    req.input.display(), scene.space.point_count(), pis_trace::memory::gib(need), pis_trace::memory::gib(have)
-                )));
-            }
+            let channels = pis_trace::memory::point_channels(scene.objects.iter().map(|o| o.role));
+            check_memory(&req.input, scene.space.point_count(), scene.resolution, channels)?;
             let frames = (0..scene.space.point_count()).map(|i| scene.frame(&scene.space.point(i))).collect::<Result<Vec<_>, _>>().map_err(|e| Failure::new(Exit::Invalid, e))?;
             super::blocks::check_transforms(&scene, &frames).map_err(|e| Failure::new(Exit::NotSupported, e))?;
             let settings = TraceSettings::new(scene.resolution, scene.spp);
@@ -119,15 +128,8 @@ pub fn load(req: &PackRequest, stages: &mut Stages) -> Result<LoadedSet, Failure
     let scene_path = req.scene.clone().unwrap_or(scene_path);
     let set = RaySet::open(&dir).map_err(trace_failure)?;
     let res = (set.meta.resolution[0], set.meta.resolution[1]);
-    // Every point's images are held at once: refused before reading when they do not fit.
     let channels: u64 = 3 + set.meta.objects.iter().flat_map(|o| &o.layers).filter_map(|l| pis_trace::LayerKind::from_name(l)).map(|k| k.channels().len() as u64).sum::<u64>();
-    let need = pis_trace::memory::image_bytes(res.0, res.1, channels, set.meta.points.len() as u64);
-    if let Some(have) = pis_trace::memory::available_memory().filter(|&have| need > have) {
-        return Err(Failure::new(Exit::NotSupported, anyhow!(
-            "{}: its {} points of {}x{} pixels take {} in memory, {} are available",
-            dir.display(), set.meta.points.len(), res.0, res.1, pis_trace::memory::gib(need), pis_trace::memory::gib(have)
-        )));
-    }
+    check_memory(&dir, set.meta.points.len(), res, channels)?;
     let scene = set_scene(&set, &scene_path, res, req.preset.as_deref())?;
     if set.meta.points.len() != scene.space.point_count() {
         return Err(invalid(format!("{}: the set has {} points, the scene's space {}", dir.display(), set.meta.points.len(), scene.space.point_count())));
