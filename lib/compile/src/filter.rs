@@ -13,12 +13,16 @@
 
 use crate::{Address, Filter, Sampler, TextureLayout};
 
-/// At most 8 (column, weight) pairs: the texels one lookup reads.
+/// The most texels one lookup reads.
+pub const MAX_TAPS: usize = 12;
+
+/// At most [`MAX_TAPS`] (column, weight) pairs: the texels one lookup reads (8 for a
+/// trilinear surface lookup; 12 for a trilinear cube-map lookup at a cube corner).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Taps {
     pub len: usize,
-    pub cols: [u32; 8],
-    pub weights: [f32; 8],
+    pub cols: [u32; MAX_TAPS],
+    pub weights: [f32; MAX_TAPS],
 }
 
 impl Taps {
@@ -30,7 +34,7 @@ impl Taps {
         }
         if let Some(k) = self.cols[..self.len].iter().position(|&c| c == col) {
             self.weights[k] += w as f32;
-        } else if self.len < 8 {
+        } else if self.len < MAX_TAPS {
             self.cols[self.len] = col;
             self.weights[self.len] = w as f32;
             self.len += 1;
@@ -39,7 +43,7 @@ impl Taps {
 
     /// The taps sorted by column.
     pub fn sorted(&self) -> impl Iterator<Item = (u32, f32)> {
-        let mut v: [(u32, f32); 8] = [(0, 0.0); 8];
+        let mut v: [(u32, f32); MAX_TAPS] = [(0, 0.0); MAX_TAPS];
         for (k, e) in v.iter_mut().enumerate().take(self.len) {
             *e = (self.cols[k], self.weights[k]);
         }

@@ -38,6 +38,7 @@ pub mod normal_equations;
 pub mod raster;
 pub mod regularize;
 pub mod sampler;
+pub mod shell;
 pub mod solve;
 pub mod sparse;
 pub mod synthetic;

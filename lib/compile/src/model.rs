@@ -269,7 +269,7 @@ mod tests {
         assert!(matches!(render_matrix(vp, &o, None), Err(ModelError::Transform(_))));
         let o = object(&p[..3], TextureLayout::full(4, 4), Filter::Bilinear);
         assert!(matches!(render_matrix(vp, &o, None), Err(ModelError::Uvs { .. })));
-        let o = object(&p, TextureLayout { width: 4, height: 4, levels: 9 }, Filter::Bilinear);
+        let o = object(&p, TextureLayout::new(4, 4, 9), Filter::Bilinear);
         assert!(matches!(render_matrix(vp, &o, None), Err(ModelError::Layout { .. })));
     }
 }

@@ -169,6 +169,9 @@ pub fn for_each_covered(tri: &ScreenTriangle, vp: Viewport, mut f: impl FnMut(i6
 pub struct Fragments {
     pub viewport: Viewport,
     pub triangles: Vec<ScreenTriangle>,
+    /// Per entry of `triangles`: the mesh triangle it was set up from (clipping may split one
+    /// mesh triangle into several).
+    pub source: Vec<u32>,
     /// Per pixel: index into `triangles`, or `u32::MAX` where the object is not visible.
     pub triangle: Vec<u32>,
 }
@@ -176,7 +179,7 @@ pub struct Fragments {
 impl Fragments {
     /// Rasterizes an object with depth test `Less` against itself and against `occluders`.
     pub fn rasterize(mesh: &DrawMesh, transform: &TextureTransform, vp: Viewport, occluders: Option<&DepthBuffer>) -> Self {
-        let triangles: Vec<ScreenTriangle> = setup_triangles(mesh, transform, vp).into_iter().map(|(_, t)| t).collect();
+        let (source, triangles): (Vec<u32>, Vec<ScreenTriangle>) = setup_triangles(mesh, transform, vp).into_iter().unzip();
         let n = vp.width as usize * vp.height as usize;
         let mut depth = match occluders {
             Some(o) if o.viewport == vp => o.depth.clone(),
@@ -194,7 +197,7 @@ impl Fragments {
                 }
             });
         }
-        Fragments { viewport: vp, triangles, triangle }
+        Fragments { viewport: vp, triangles, source, triangle }
     }
 
     /// The visible pixels `y · width + x`, in increasing order.

@@ -90,11 +90,12 @@ impl RangeRegularization {
 }
 
 /// The pyramid constraint operator P of eq. 3.9: one row per texel of levels 0..L−2, the
-/// texel minus the bilinear interpolation of the next coarser level at its centre.
+/// texel minus the bilinear interpolation of the next coarser level at its centre; each face
+/// of a cube map on its own.
 pub fn pyramid_operator(layout: &TextureLayout) -> Csr {
     let n = layout.texel_count();
     let mut p = Csr { rows: 0, cols: n, row_start: vec![0], col: vec![], val: vec![] };
-    for m in 0..layout.levels.saturating_sub(1) {
+    for (face, m) in (0..layout.faces.max(1)).flat_map(|f| (0..layout.levels.saturating_sub(1)).map(move |m| (f, m))) {
         let (w, h) = layout.level_size(m);
         let (cw, ch) = layout.level_size(m + 1);
         let taps = |i: u32, cn: u32| -> [(u32, f64); 2] {
@@ -110,12 +111,12 @@ pub fn pyramid_operator(layout: &TextureLayout) -> Csr {
             let ty = taps(j, ch);
             for i in 0..w {
                 let tx = taps(i, cw);
-                let mut entries: Vec<(u32, f64)> = vec![(layout.texel(m, i, j) as u32, 1.0)];
+                let mut entries: Vec<(u32, f64)> = vec![(layout.face_texel(face, m, i, j) as u32, 1.0)];
                 for &(y, wy) in &ty {
                     for &(x, wx) in &tx {
                         let wgt = wx * wy;
                         if wgt != 0.0 {
-                            entries.push((layout.texel(m + 1, x, y) as u32, -wgt));
+                            entries.push((layout.face_texel(face, m + 1, x, y) as u32, -wgt));
                         }
                     }
                 }

@@ -166,6 +166,9 @@ fn solve_views(
     let first = views.first().ok_or_else(|| CompileError::Setting("no views to solve".into()))?;
     let layout = first.a.layout;
     check_settings(settings)?;
+    if settings.mip == MipSolve::Decimated && layout.faces > 1 {
+        return Err(CompileError::Setting("a cube map's levels are solved together (mip solve `free`), not decimated".into()));
+    }
     let mut parts = Vec::with_capacity(views.len());
     for (k, v) in views.iter().enumerate() {
         if v.a.layout != layout {

@@ -551,5 +551,6 @@ mod tests {
         for f in ["cut_uv", "texcoord", "texture_lod"] {
             assert_eq!(function(super::SHADER, f), function(crate::textured::SHADER, f), "{f} differs between frame.wgsl and textured.wgsl");
         }
+        assert_eq!(function(crate::shell::SHELL_FUNCTIONS, "texture_lod"), function(crate::textured::SHADER, "texture_lod"), "texture_lod differs between shell.wgsl and textured.wgsl");
     }
 }

@@ -21,6 +21,7 @@ pub mod multisample;
 pub mod player;
 pub mod probe;
 pub mod resolve;
+pub mod shell;
 pub mod textured;
 pub mod window;
 
@@ -32,4 +33,5 @@ pub use image::FloatImage;
 pub use multisample::Multisample;
 pub use player::{FrameRequest, FrameStats, Player, PlayerOptions};
 pub use probe::{probe, probe_render_matrix, Probe};
+pub use shell::{render_shell, ShellPipeline, ShellTexture};
 pub use textured::{render_object, ObjectScene, ObjectTexture, TexturedPipeline};

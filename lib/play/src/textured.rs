@@ -499,24 +499,7 @@ impl ObjectScene {
             wgpu::Extent3d { width: w, height: h, depth_or_array_layers: 1 },
         );
         gpu.queue.submit([enc.finish()]);
-        let (tx, rx) = std::sync::mpsc::channel();
-        self.readback.slice(..).map_async(wgpu::MapMode::Read, move |r| {
-            let _ = tx.send(r);
-        });
-        gpu.device.poll(wgpu::PollType::wait_indefinitely()).map_err(|e| PlayError::Readback(e.to_string()))?;
-        rx.recv()
-            .map_err(|e| PlayError::Readback(e.to_string()))?
-            .map_err(|e| PlayError::Readback(e.to_string()))?;
-        let mut rgba = Vec::with_capacity(w as usize * h as usize * 4);
-        {
-            let view = self.readback.slice(..).get_mapped_range().map_err(|e| PlayError::Readback(e.to_string()))?;
-            for y in 0..h as usize {
-                let row = &view[y * self.row_bytes as usize..y * self.row_bytes as usize + w as usize * 16];
-                rgba.extend(row.chunks_exact(4).map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]])));
-            }
-        }
-        self.readback.unmap();
-        Ok(FloatImage { width: w, height: h, rgba })
+        crate::image::map_rows(gpu, &self.readback, self.row_bytes, w, h)
     }
 }
 

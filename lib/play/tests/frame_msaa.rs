@@ -35,7 +35,7 @@ fn frame_multisampling_keeps_interiors_exactly() {
     let back = quad(-1.6, 1.6, -1.2, 1.2, -0.5);
     let front = quad(-0.6, 0.6, -0.5, 0.5, 0.4);
     let turn = glam::Mat4::from_rotation_z(25f32.to_radians());
-    let layout = TextureLayout { width: 16, height: 16, levels: 1 };
+    let layout = TextureLayout::new(16, 16, 1);
     let texture = |seed| {
         let t = ObjectTexture::new(&gpu, layout);
         t.upload(&gpu, &random_rgba(16 * 16, seed)).unwrap();

@@ -32,7 +32,7 @@ fn multisampling_gpu(test: &str) -> Option<Gpu> {
 }
 
 fn texture(gpu: &Gpu, rgba: &[f32]) -> ObjectTexture {
-    let t = ObjectTexture::new(gpu, TextureLayout { width: 16, height: 16, levels: 1 });
+    let t = ObjectTexture::new(gpu, TextureLayout::new(16, 16, 1));
     t.upload(gpu, rgba).unwrap();
     t
 }

@@ -1,0 +1,236 @@
+//! The render matrix A of one environment-map shell drawn on an object at one parameter point
+//! (thesis 5.8: "the rendering matrix is created using test renderings with environment
+//! mapping instead of texture mapping"): the object is rasterized as for a surface texture
+//! (coverage, top-left rule, depth test), its world position and normal are interpolated
+//! perspective-correct, and per pixel the reflection ray off the normal meets the shell
+//! ([`super::geometry`]); the hit's cube-map lookup, its LOD from fine derivatives and its
+//! trilinear, seamless taps ([`super::cube`]) give the row.
+//!
+//! WGSL twin: `fs_shell` in `lib/play/src/shell.wgsl`.
+
+use glam::{DVec3, Mat4, Vec3, Vec4};
+use rayon::prelude::*;
+
+use super::cube::{cube_lod, cube_taps};
+use super::geometry::{lookup_direction, Shell};
+use crate::filter::Taps;
+use crate::interpolate::texcoord_at;
+use crate::model::ModelError;
+use crate::raster::{DepthBuffer, Fragments, ScreenTriangle};
+use crate::transform::{DrawMesh, TextureTransform, Viewport};
+use crate::{RenderMatrix, TextureLayout};
+
+/// One object drawn with one shell: what the model needs to build the shell's A.
+#[derive(Clone, Copy, Debug)]
+pub struct ShellObject<'a> {
+    /// Object-space positions, normals (one per position) and the triangle list.
+    pub positions: &'a [[f32; 3]],
+    pub normals: &'a [[f32; 3]],
+    pub indices: &'a [u32],
+    /// projection · view · world.
+    pub clip_from_object: Mat4,
+    /// world, a rigid transform (normals are rotated by its 3×3 part).
+    pub world_from_object: Mat4,
+    /// The camera's position in world space.
+    pub eye: Vec3,
+    pub shell: Shell,
+    /// A cube layout ([`TextureLayout::cube`]); lookups are trilinear over its levels.
+    pub layout: TextureLayout,
+    /// Per triangle, whether the shell is drawn on it (thesis 5.7: triangles on the convex
+    /// hull draw the distant shell only); `None` draws every triangle. Pixels of a triangle
+    /// that does not draw the shell have no row.
+    pub drawn: Option<&'a [bool]>,
+}
+
+/// The world position and normal of every corner, per triangle: the vertex shader's
+/// outputs.
+struct WorldCorners {
+    positions: Vec<[DVec3; 3]>,
+    normals: Vec<[DVec3; 3]>,
+}
+
+fn check(viewport: Viewport, o: &ShellObject) -> Result<(), ModelError> {
+    if viewport.width == 0 || viewport.height == 0 || viewport.width > 16384 || viewport.height > 16384 {
+        return Err(ModelError::Viewport { width: viewport.width, height: viewport.height });
+    }
+    let l = o.layout;
+    if l.faces != 6 || l.width != l.height || l.width == 0 || l.width > 16384 || l.levels == 0 || l.levels > TextureLayout::cube(l.width).levels {
+        return Err(ModelError::Layout { width: l.width, height: l.height, levels: l.levels });
+    }
+    if o.normals.len() != o.positions.len() {
+        return Err(ModelError::Uvs { positions: o.positions.len(), uvs: o.normals.len() });
+    }
+    if o.indices.len() % 3 != 0 {
+        return Err(ModelError::IndexCount(o.indices.len()));
+    }
+    if let Some((at, &index)) = o.indices.iter().enumerate().find(|(_, &i)| i as usize >= o.positions.len()) {
+        return Err(ModelError::Index { at, index, positions: o.positions.len() });
+    }
+    if let Some(k) = (0..o.positions.len()).find(|&k| !o.positions[k].iter().chain(o.normals[k].iter()).all(|v| v.is_finite())) {
+        return Err(ModelError::NotFinite(k));
+    }
+    Ok(())
+}
+
+/// The render matrix of `object`'s shell in `viewport`, its fragments tested against
+/// `occluders`; every row has coverage 1 (see [`crate::antialias`]). Rows are the pixels
+/// that draw the shell, in increasing order.
+pub fn shell_render_matrix(viewport: Viewport, object: &ShellObject, occluders: Option<&DepthBuffer>) -> Result<RenderMatrix, ModelError> {
+    check(viewport, object)?;
+    if let Some(o) = occluders {
+        if o.viewport != viewport {
+            return Err(ModelError::DepthSize { got: o.viewport, want: viewport });
+        }
+    }
+    // Each triangle's corners carry barycentric (s, t) = (λ1, λ2): interpolated
+    // perspective-correct, they weight the corners' world attributes as the GPU's
+    // interpolation of those attributes does.
+    let triangles = object.indices.len() / 3;
+    let corners: Vec<[f32; 3]> = object.indices.iter().map(|&i| object.positions[i as usize]).collect();
+    let bary: Vec<[f32; 2]> = (0..triangles).flat_map(|_| [[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]]).collect();
+    let order: Vec<u32> = (0..corners.len() as u32).collect();
+    let mesh = DrawMesh { positions: &corners, uvs: &bary, indices: &order, clip_from_object: object.clip_from_object };
+    let frags = Fragments::rasterize(&mesh, &TextureTransform::IDENTITY, viewport, occluders);
+    let world = world_corners(object);
+    let pixels: Vec<u32> = frags
+        .pixels()
+        .into_iter()
+        .filter(|&p| {
+            let src = frags.source[frags.triangle[p as usize] as usize] as usize;
+            object.drawn.is_none_or(|d| d.get(src).copied().unwrap_or(false))
+        })
+        .collect();
+    let layout = object.layout;
+    let eye = object.eye.as_dvec3();
+    let max_level = layout.levels.saturating_sub(1) as f64;
+    let rows: Vec<Taps> = pixels
+        .par_iter()
+        .map(|&p| {
+            let (x, y) = (p % viewport.width, p / viewport.width);
+            let k = frags.triangle[p as usize] as usize;
+            let (tri, src) = (&frags.triangles[k], frags.source[k] as usize);
+            let dir = |x: u32, y: u32| {
+                let (pos, n) = attributes_at(tri, &world, src, x, y);
+                lookup_direction(&object.shell, pos, n, eye)
+            };
+            let (qx, qy) = (x & !1, y & !1);
+            let d = dir(x, y);
+            let ddx = dir(qx + 1, y) - dir(qx, y);
+            let ddy = dir(x, qy + 1) - dir(x, qy);
+            let lambda = cube_lod(d, ddx, ddy, layout.width as f64, max_level);
+            let mut taps = Taps::default();
+            cube_taps(&layout, d, lambda, &mut taps);
+            taps
+        })
+        .collect();
+    let nnz: usize = rows.iter().map(|t| t.len).sum();
+    let (mut cols, mut vals) = (Vec::with_capacity(nnz), Vec::with_capacity(nnz));
+    let mut row_start = Vec::with_capacity(rows.len() + 1);
+    row_start.push(0);
+    for t in &rows {
+        for (c, v) in t.sorted() {
+            cols.push(c);
+            vals.push(v);
+        }
+        row_start.push(cols.len() as u32);
+    }
+    Ok(RenderMatrix {
+        width: viewport.width,
+        height: viewport.height,
+        layout,
+        coverage: vec![1.0; pixels.len()],
+        pixels,
+        row_start,
+        cols,
+        vals,
+    })
+}
+
+fn world_corners(o: &ShellObject) -> WorldCorners {
+    let m = o.world_from_object;
+    let (positions, normals) = o
+        .indices
+        .chunks_exact(3)
+        .map(|t| {
+            let t = [t[0], t[1], t[2]];
+            let p = t.map(|i| (m * Vec4::from((Vec3::from(o.positions[i as usize]), 1.0))).truncate().as_dvec3());
+            let n = t.map(|i| (m * Vec4::from((Vec3::from(o.normals[i as usize]), 0.0))).truncate().as_dvec3());
+            (p, n)
+        })
+        .unzip();
+    WorldCorners { positions, normals }
+}
+
+/// The interpolated world position and (unnormalized) normal at the centre of pixel (x, y)
+/// of screen triangle `tri`, set up from mesh triangle `src`.
+fn attributes_at(tri: &ScreenTriangle, world: &WorldCorners, src: usize, x: u32, y: u32) -> (DVec3, DVec3) {
+    let [b1, b2] = texcoord_at(tri, x as f64 + 0.5, y as f64 + 0.5);
+    let b0 = 1.0 - b1 - b2;
+    let (p, n) = (&world.positions[src], &world.normals[src]);
+    (p[0] * b0 + p[1] * b1 + p[2] * b2, n[0] * b0 + n[1] * b1 + n[2] * b2)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::shell::geometry::ShellShape;
+    use crate::transform::{look_at, perspective};
+
+    /// A UV sphere of radius 1 at the origin, normals outward.
+    pub(crate) fn ball(rings: u32, segments: u32) -> (Vec<[f32; 3]>, Vec<[f32; 3]>, Vec<u32>) {
+        let mut p = Vec::new();
+        for r in 0..=rings {
+            let th = std::f32::consts::PI * r as f32 / rings as f32;
+            for s in 0..=segments {
+                let ph = 2.0 * std::f32::consts::PI * s as f32 / segments as f32;
+                p.push([th.sin() * ph.cos(), th.cos(), th.sin() * ph.sin()]);
+            }
+        }
+        let mut idx = Vec::new();
+        let w = segments + 1;
+        for r in 0..rings {
+            for s in 0..segments {
+                let (a, b, c, d) = (r * w + s, r * w + s + 1, (r + 1) * w + s, (r + 1) * w + s + 1);
+                idx.extend_from_slice(&[a, c, b, b, c, d]);
+            }
+        }
+        (p.clone(), p, idx)
+    }
+
+    #[test]
+    fn a_mirror_ball_reads_every_face_with_unit_row_sums() {
+        let (p, n, idx) = ball(24, 48);
+        let vp = Viewport { width: 96, height: 72 };
+        let eye = Vec3::new(0.0, 0.5, 3.5);
+        let clip = perspective(0.7, 96.0 / 72.0, 0.1, 100.0) * look_at(eye, Vec3::ZERO, Vec3::Y);
+        let shell = Shell { origin: DVec3::ZERO, shape: ShellShape::Sphere { radius: 4.0 } };
+        let layout = TextureLayout::cube(16);
+        let o = ShellObject { positions: &p, normals: &n, indices: &idx, clip_from_object: clip, world_from_object: Mat4::IDENTITY, eye, shell, layout, drawn: None };
+        let a = shell_render_matrix(vp, &o, None).unwrap();
+        assert!(a.rows() > 1000);
+        for r in 0..a.rows() {
+            let s: f32 = a.row(r).1.iter().sum();
+            assert!((s - 1.0).abs() < 1e-4);
+        }
+        // A mirror ball reflects the whole sphere of directions: every face is read.
+        let mut faces = [false; 6];
+        for &c in &a.cols {
+            faces[c as usize / layout.face_len()] = true;
+        }
+        assert_eq!(faces, [true; 6]);
+    }
+
+    #[test]
+    fn triangles_that_do_not_draw_the_shell_have_no_rows() {
+        let (p, n, idx) = ball(8, 16);
+        let vp = Viewport { width: 48, height: 48 };
+        let eye = Vec3::new(0.0, 0.0, 3.0);
+        let clip = perspective(0.9, 1.0, 0.1, 100.0) * look_at(eye, Vec3::ZERO, Vec3::Y);
+        let shell = Shell { origin: DVec3::ZERO, shape: ShellShape::Ellipsoid { radii: DVec3::new(1.5, 1.2, 1.5) } };
+        let none = vec![false; idx.len() / 3];
+        let mut o = ShellObject { positions: &p, normals: &n, indices: &idx, clip_from_object: clip, world_from_object: Mat4::IDENTITY, eye, shell, layout: TextureLayout::cube(8), drawn: None };
+        assert!(shell_render_matrix(vp, &o, None).unwrap().rows() > 0);
+        o.drawn = Some(&none);
+        assert_eq!(shell_render_matrix(vp, &o, None).unwrap().rows(), 0);
+    }
+}

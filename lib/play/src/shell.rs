@@ -1,0 +1,282 @@
+//! Environment-map shells on the GPU (`shell.wgsl`): a cube map as a six-layer 2D array
+//! texture read with `textureLoad` and filtered in the shader exactly as pis-compile's
+//! hardware model filters it (`pis_compile::shell`), and the pipeline that draws one object
+//! with one shell — the rendering a shell's render matrix predicts.
+//!
+//! Level m of a face of size N holds `mip_size(N, m)` used texels at the top left of a GPU
+//! level of `next_pow2(N) >> m` texels, which is never smaller.
+
+use bytemuck::{Pod, Zeroable};
+use pis_compile::shell::ShellObject;
+use pis_compile::{DrawMesh, TextureLayout, Viewport};
+use wgpu::util::DeviceExt;
+
+use crate::error::PlayError;
+use crate::gpu::Gpu;
+use crate::image::FloatImage;
+use crate::textured::{DEPTH_FORMAT, TARGET_FORMAT};
+
+/// The shell functions every shell pipeline appends its entry points to.
+pub const SHELL_FUNCTIONS: &str = include_str!("shell.wgsl");
+/// The one-shell object pipeline's entry points.
+pub const SHELL_OBJECT: &str = include_str!("shell_object.wgsl");
+
+/// Texel format of cube maps: read with `textureLoad`, so no filtering support is needed.
+pub const CUBE_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
+
+/// A cube map on the GPU.
+pub struct ShellTexture {
+    pub layout: TextureLayout,
+    pub texture: wgpu::Texture,
+    pub view: wgpu::TextureView,
+}
+
+impl ShellTexture {
+    /// Allocates a cube map of `layout` (six square faces) for `object` (named in errors).
+    pub fn new(gpu: &Gpu, layout: TextureLayout, object: &str) -> Result<ShellTexture, PlayError> {
+        let side = layout.width.next_power_of_two();
+        let limit = gpu.limits.max_texture_dimension_2d;
+        if layout.faces != 6 || layout.width != layout.height || layout.width == 0 || side > limit || layout.levels == 0 || layout.levels > TextureLayout::cube(layout.width).levels {
+            return Err(PlayError::TextureSize { object: object.to_string(), width: layout.width, height: layout.height, limit });
+        }
+        let texture = gpu.device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("shell"),
+            size: wgpu::Extent3d { width: side, height: side, depth_or_array_layers: 6 },
+            mip_level_count: layout.levels,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: CUBE_FORMAT,
+            usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+            view_formats: &[],
+        });
+        let view = texture.create_view(&wgpu::TextureViewDescriptor { dimension: Some(wgpu::TextureViewDimension::D2Array), ..Default::default() });
+        Ok(ShellTexture { layout, texture, view })
+    }
+
+    /// Uploads RGBA texels in the layout's order (face after face, each level after level).
+    pub fn upload(&self, gpu: &Gpu, rgba: &[f32]) -> Result<(), PlayError> {
+        let l = self.layout;
+        let want = l.texel_count() * 4;
+        if rgba.len() != want {
+            return Err(PlayError::TextureData { got: rgba.len(), want, width: l.width, height: l.height, levels: l.levels });
+        }
+        for face in 0..6 {
+            for m in 0..l.levels {
+                let (w, h) = l.level_size(m);
+                let start = l.face_texel(face, m, 0, 0) * 4;
+                let data = &rgba[start..start + (w * h * 4) as usize];
+                gpu.queue.write_texture(
+                    wgpu::TexelCopyTextureInfo { texture: &self.texture, mip_level: m, origin: wgpu::Origin3d { x: 0, y: 0, z: face }, aspect: wgpu::TextureAspect::All },
+                    bytemuck::cast_slice(data),
+                    wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(w * 16), rows_per_image: Some(h) },
+                    wgpu::Extent3d { width: w, height: h, depth_or_array_layers: 1 },
+                );
+            }
+        }
+        Ok(())
+    }
+}
+
+/// `ShellUniforms` of `shell_object.wgsl` (208 bytes).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+struct ShellUniforms {
+    clip_from_object: [f32; 16],
+    world_from_object: [f32; 16],
+    eye: [f32; 4],
+    origin_shape: [f32; 4],
+    a: [f32; 4],
+    b: [f32; 4],
+    size: u32,
+    levels: u32,
+    _pad: [u32; 2],
+}
+
+/// A shell's geometry as the shaders' `ShellGeometry` fields: origin and shape id, `a`, `b`.
+pub fn shell_uniform(shell: &pis_compile::shell::Shell) -> ([f32; 4], [f32; 4], [f32; 4]) {
+    let (id, v) = shell.placement_values();
+    let (a, b) = match id {
+        // Box: corners; others: their parameters in `a`.
+        3 => ([v[3], v[4], v[5], 0.0], [v[6], v[7], v[8], 0.0]),
+        _ => ([v[3], v[4], v[5], 0.0], [0.0; 4]),
+    };
+    ([v[0], v[1], v[2], id as f32], a, b)
+}
+
+/// The compiled one-shell pipeline and its depth-only pass for occluders.
+pub struct ShellPipeline {
+    layout: wgpu::BindGroupLayout,
+    pipeline: wgpu::RenderPipeline,
+    depth_pipeline: wgpu::RenderPipeline,
+}
+
+const VEC3_AT: fn(u32) -> wgpu::VertexBufferLayout<'static> = |location| wgpu::VertexBufferLayout {
+    array_stride: 12,
+    step_mode: wgpu::VertexStepMode::Vertex,
+    attributes: match location {
+        0 => &[wgpu::VertexAttribute { format: wgpu::VertexFormat::Float32x3, offset: 0, shader_location: 0 }],
+        _ => &[wgpu::VertexAttribute { format: wgpu::VertexFormat::Float32x3, offset: 0, shader_location: 1 }],
+    },
+};
+
+impl ShellPipeline {
+    pub fn new(gpu: &Gpu) -> ShellPipeline {
+        let device = &gpu.device;
+        let source = format!("{SHELL_FUNCTIONS}\n{SHELL_OBJECT}");
+        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor { label: Some("shell_object.wgsl"), source: wgpu::ShaderSource::Wgsl(source.into()) });
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("shell"),
+            entries: &[
+                wgpu::BindGroupLayoutEntry {
+                    binding: 0,
+                    visibility: wgpu::ShaderStages::VERTEX_FRAGMENT,
+                    ty: wgpu::BindingType::Buffer { ty: wgpu::BufferBindingType::Uniform, has_dynamic_offset: false, min_binding_size: None },
+                    count: None,
+                },
+                wgpu::BindGroupLayoutEntry {
+                    binding: 1,
+                    visibility: wgpu::ShaderStages::FRAGMENT,
+                    ty: wgpu::BindingType::Texture {
+                        sample_type: wgpu::TextureSampleType::Float { filterable: false },
+                        view_dimension: wgpu::TextureViewDimension::D2Array,
+                        multisampled: false,
+                    },
+                    count: None,
+                },
+            ],
+        });
+        let pl = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor { label: Some("shell"), bind_group_layouts: &[Some(&layout)], immediate_size: 0 });
+        let primitive = wgpu::PrimitiveState { topology: wgpu::PrimitiveTopology::TriangleList, cull_mode: None, ..Default::default() };
+        let depth_state = wgpu::DepthStencilState {
+            format: DEPTH_FORMAT,
+            depth_write_enabled: Some(true),
+            depth_compare: Some(wgpu::CompareFunction::Less),
+            stencil: Default::default(),
+            bias: Default::default(),
+        };
+        let make = |label, vs, buffers: &[Option<wgpu::VertexBufferLayout>], fragment: Option<wgpu::FragmentState>| {
+            device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+                label: Some(label),
+                layout: Some(&pl),
+                vertex: wgpu::VertexState { module: &module, entry_point: Some(vs), compilation_options: Default::default(), buffers },
+                primitive,
+                depth_stencil: Some(depth_state.clone()),
+                multisample: Default::default(),
+                fragment,
+                multiview_mask: None,
+                cache: None,
+            })
+        };
+        let targets = [Some(wgpu::ColorTargetState { format: TARGET_FORMAT, blend: None, write_mask: wgpu::ColorWrites::ALL })];
+        let fragment = wgpu::FragmentState { module: &module, entry_point: Some("fs_shell"), compilation_options: Default::default(), targets: &targets };
+        let pipeline = make("shell", "vs_shell", &[Some(VEC3_AT(0)), Some(VEC3_AT(1))], Some(fragment));
+        let silent = [Some(wgpu::ColorTargetState { format: TARGET_FORMAT, blend: None, write_mask: wgpu::ColorWrites::empty() })];
+        let none = wgpu::FragmentState { module: &module, entry_point: Some("fs_shell_depth"), compilation_options: Default::default(), targets: &silent };
+        let depth_pipeline = make("shell depth", "vs_shell_depth", &[Some(VEC3_AT(0))], Some(none));
+        ShellPipeline { layout, pipeline, depth_pipeline }
+    }
+}
+
+/// Draws `object` with its shell's cube map `rgba` (4 values per texel of its layout) over
+/// the occluders' depth; returns RGBA per pixel (rows from the top), alpha 1 where the object
+/// draws the shell, 0 elsewhere. Triangles that do not draw the shell (`object.drawn`) are
+/// left out of the colour pass but still write depth.
+pub fn render_shell(gpu: &Gpu, pipeline: &ShellPipeline, viewport: Viewport, occluders: &[DrawMesh], object: &ShellObject, rgba: &[f32]) -> Result<FloatImage, PlayError> {
+    let limit = gpu.limits.max_texture_dimension_2d;
+    if viewport.width == 0 || viewport.height == 0 || viewport.width > limit || viewport.height > limit {
+        return Err(PlayError::TargetSize { width: viewport.width, height: viewport.height, limit });
+    }
+    let cube = ShellTexture::new(gpu, object.layout, "shell")?;
+    cube.upload(gpu, rgba)?;
+    let d = &gpu.device;
+    let init = |label: &str, contents: &[u8], usage| d.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: Some(label), contents, usage });
+    let (origin_shape, a, b) = shell_uniform(&object.shell);
+    let uniforms = |clip: glam::Mat4| ShellUniforms {
+        clip_from_object: clip.to_cols_array(),
+        world_from_object: object.world_from_object.to_cols_array(),
+        eye: [object.eye.x, object.eye.y, object.eye.z, 1.0],
+        origin_shape,
+        a,
+        b,
+        size: object.layout.width,
+        levels: object.layout.levels,
+        _pad: [0; 2],
+    };
+    let bind = |u: &wgpu::Buffer| {
+        d.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("shell"),
+            layout: &pipeline.layout,
+            entries: &[
+                wgpu::BindGroupEntry { binding: 0, resource: u.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::TextureView(&cube.view) },
+            ],
+        })
+    };
+    // Occluders, then the object's hidden triangles, write depth only.
+    let mut depth_draws = Vec::new();
+    for m in occluders {
+        pis_compile::model::check_mesh(m)?;
+        depth_draws.push((m.positions.to_vec(), m.indices.to_vec(), m.clip_from_object));
+    }
+    let (mut shown, mut hidden) = (Vec::new(), Vec::new());
+    for (t, tri) in object.indices.chunks_exact(3).enumerate() {
+        let on = object.drawn.is_none_or(|dr| dr.get(t).copied().unwrap_or(false));
+        if on { &mut shown } else { &mut hidden }.extend_from_slice(tri);
+    }
+    depth_draws.push((object.positions.to_vec(), hidden, object.clip_from_object));
+    let size = wgpu::Extent3d { width: viewport.width, height: viewport.height, depth_or_array_layers: 1 };
+    let target = |label, format, usage| {
+        d.create_texture(&wgpu::TextureDescriptor { label: Some(label), size, mip_level_count: 1, sample_count: 1, dimension: wgpu::TextureDimension::D2, format, usage, view_formats: &[] })
+    };
+    let color = target("frame", TARGET_FORMAT, wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC);
+    let depth = target("depth", DEPTH_FORMAT, wgpu::TextureUsages::RENDER_ATTACHMENT);
+    let (color_view, depth_view) = (color.create_view(&Default::default()), depth.create_view(&Default::default()));
+    let pad3 = |v: &[[f32; 3]]| if v.is_empty() { vec![[0.0f32; 3]] } else { v.to_vec() };
+    let pad1 = |v: &[u32]| if v.is_empty() { vec![0u32] } else { v.to_vec() };
+    let mut enc = d.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("shell") });
+    let depth_buffers: Vec<_> = depth_draws
+        .iter()
+        .map(|(p, i, clip)| {
+            let u = init("uniforms", bytemuck::bytes_of(&uniforms(*clip)), wgpu::BufferUsages::UNIFORM);
+            let bg = bind(&u);
+            (init("positions", bytemuck::cast_slice(&pad3(p)), wgpu::BufferUsages::VERTEX), init("indices", bytemuck::cast_slice(&pad1(i)), wgpu::BufferUsages::INDEX), i.len() as u32 / 3 * 3, bg)
+        })
+        .collect();
+    let ou = init("uniforms", bytemuck::bytes_of(&uniforms(object.clip_from_object)), wgpu::BufferUsages::UNIFORM);
+    let obg = bind(&ou);
+    let (op, on) = (init("positions", bytemuck::cast_slice(&pad3(object.positions)), wgpu::BufferUsages::VERTEX), init("normals", bytemuck::cast_slice(&pad3(object.normals)), wgpu::BufferUsages::VERTEX));
+    let oi = init("indices", bytemuck::cast_slice(&pad1(&shown)), wgpu::BufferUsages::INDEX);
+    {
+        let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("shell"),
+            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                view: &color_view,
+                depth_slice: None,
+                resolve_target: None,
+                ops: wgpu::Operations { load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT), store: wgpu::StoreOp::Store },
+            })],
+            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                view: &depth_view,
+                depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Clear(1.0), store: wgpu::StoreOp::Store }),
+                stencil_ops: None,
+            }),
+            timestamp_writes: None,
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        pass.set_pipeline(&pipeline.depth_pipeline);
+        for (p, i, n, bg) in &depth_buffers {
+            pass.set_bind_group(0, bg, &[]);
+            pass.set_vertex_buffer(0, p.slice(..));
+            pass.set_index_buffer(i.slice(..), wgpu::IndexFormat::Uint32);
+            pass.draw_indexed(0..*n, 0, 0..1);
+        }
+        pass.set_pipeline(&pipeline.pipeline);
+        pass.set_bind_group(0, &obg, &[]);
+        pass.set_vertex_buffer(0, op.slice(..));
+        pass.set_vertex_buffer(1, on.slice(..));
+        pass.set_index_buffer(oi.slice(..), wgpu::IndexFormat::Uint32);
+        pass.draw_indexed(0..shown.len() as u32 / 3 * 3, 0, 0..1);
+    }
+    crate::image::read_back(gpu, enc, &color, viewport)
+}

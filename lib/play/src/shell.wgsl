@@ -1,0 +1,252 @@
+// Environment-map shells (SPEC.md 7.3, 8.2): the lookup of one shell's cube map from a
+// surface point. One function written twice: every function here has a twin of the same
+// name in pis-compile's hardware model, with the same order of operations (reflect,
+// shell_hit, lookup_direction: shell/geometry.rs; cube_face, face_components, face_st,
+// face_vector, cube_texel, cube_texels, cube_lod, cube_bilinear, cube_sample:
+// shell/cube.rs;
+// texture_lod: lod.rs). Change both together. Pipelines append their entry points to this
+// source.
+//
+// A cube map is a 2D array texture of six layers (+X, −X, +Y, −Y, +Z, −Z) whose level m
+// holds the used mip_size(N, m) texels at its top left; texels are read with textureLoad
+// and filtered here, so the weights are the model's on every adapter.
+
+// One shell: origin; shape 1 sphere (a.x radius), 2 ellipsoid (a radii), 3 box (a min,
+// b max corner, world space), 4 cylinder (a.x radius, a.y y min, a.z y max).
+struct ShellGeometry {
+    origin: vec3<f32>,
+    shape: u32,
+    a: vec3<f32>,
+    b: vec3<f32>,
+};
+
+// The mirror reflection of v about the unit normal n: v − 2(v·n)n.
+fn reflect_about(v: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
+    return v - n * (2.0 * dot(v, n));
+}
+
+// The larger root of a·t² + 2b·t + c = 0, or −1.
+fn quadratic_far(a: f32, b: f32, c: f32) -> f32 {
+    let disc = b * b - a * c;
+    if (a <= 0.0 || disc < 0.0) {
+        return -1.0;
+    }
+    return (-b + sqrt(disc)) / a;
+}
+
+// The interval of t where q + t·r lies in [lo, hi] along one axis (empty: x > y).
+fn slab(q: f32, r: f32, lo: f32, hi: f32) -> vec2<f32> {
+    if (r == 0.0) {
+        if (q >= lo && q <= hi) {
+            return vec2<f32>(-3.0e38, 3.0e38);
+        }
+        return vec2<f32>(3.0e38, -3.0e38);
+    }
+    let t0 = (lo - q) / r;
+    let t1 = (hi - q) / r;
+    return vec2<f32>(min(t0, t1), max(t0, t1));
+}
+
+// The far intersection (largest t ≥ 0) of p + t·r with the shell, or a negative value.
+fn shell_hit(g: ShellGeometry, p: vec3<f32>, r: vec3<f32>) -> f32 {
+    let q = p - g.origin;
+    if (g.shape == 1u) {
+        return quadratic_far(dot(r, r), dot(q, r), dot(q, q) - g.a.x * g.a.x);
+    }
+    if (g.shape == 2u) {
+        let qs = q / g.a;
+        let rs = r / g.a;
+        return quadratic_far(dot(rs, rs), dot(qs, rs), dot(qs, qs) - 1.0);
+    }
+    if (g.shape == 3u) {
+        let lo = g.a - g.origin;
+        let hi = g.b - g.origin;
+        var near = -3.0e38;
+        var far = 3.0e38;
+        for (var k = 0; k < 3; k = k + 1) {
+            let s = slab(q[k], r[k], lo[k], hi[k]);
+            near = max(near, s.x);
+            far = min(far, s.y);
+        }
+        if (near <= far) {
+            return far;
+        }
+        return -1.0;
+    }
+    // Cylinder.
+    let a = r.x * r.x + r.z * r.z;
+    let b = q.x * r.x + q.z * r.z;
+    let c = q.x * q.x + q.z * q.z - g.a.x * g.a.x;
+    var near = -3.0e38;
+    var far = 3.0e38;
+    if (a > 0.0) {
+        let disc = b * b - a * c;
+        if (disc < 0.0) {
+            return -1.0;
+        }
+        let s = sqrt(disc);
+        near = (-b - s) / a;
+        far = (-b + s) / a;
+    } else if (c > 0.0) {
+        return -1.0;
+    }
+    let sy = slab(q.y, r.y, g.a.y - g.origin.y, g.a.z - g.origin.y);
+    near = max(near, sy.x);
+    far = min(far, sy.y);
+    if (near <= far) {
+        return far;
+    }
+    return -1.0;
+}
+
+// The cube-map lookup vector of surface point p with interpolated normal `normal` seen from
+// `eye`: the far hit of the reflection ray on the shell minus its origin, or the ray's
+// direction where it does not meet the shell.
+fn lookup_direction(g: ShellGeometry, p: vec3<f32>, normal: vec3<f32>, eye: vec3<f32>) -> vec3<f32> {
+    let n = normalize(normal);
+    let v = normalize(p - eye);
+    let r = reflect_about(v, n);
+    let t = shell_hit(g, p, r);
+    if (t >= 0.0) {
+        return p + r * t - g.origin;
+    }
+    return r;
+}
+
+// The face of d: the axis of largest magnitude, x before y before z on ties.
+fn cube_face(d: vec3<f32>) -> u32 {
+    let a = abs(d);
+    if (a.x >= a.y && a.x >= a.z) {
+        return select(1u, 0u, d.x >= 0.0);
+    }
+    if (a.y >= a.z) {
+        return select(3u, 2u, d.y >= 0.0);
+    }
+    return select(5u, 4u, d.z >= 0.0);
+}
+
+// (sc, tc, ma) of v on `face` (SPEC.md 8.2), ma signed: |ma| for vectors on the face.
+fn face_components(face: u32, v: vec3<f32>) -> vec3<f32> {
+    switch face {
+        case 0u: { return vec3<f32>(-v.z, -v.y, v.x); }
+        case 1u: { return vec3<f32>(v.z, -v.y, -v.x); }
+        case 2u: { return vec3<f32>(v.x, v.z, v.y); }
+        case 3u: { return vec3<f32>(v.x, -v.z, -v.y); }
+        case 4u: { return vec3<f32>(v.x, -v.y, v.z); }
+        default: { return vec3<f32>(-v.x, -v.y, -v.z); }
+    }
+}
+
+// (s, t) of d on `face`.
+fn face_st(face: u32, d: vec3<f32>) -> vec2<f32> {
+    let c = face_components(face, d);
+    return vec2<f32>((c.x / c.z + 1.0) * 0.5, (c.y / c.z + 1.0) * 0.5);
+}
+
+// The vector with |ma| = 1 and coordinates (sc, tc) on `face`.
+fn face_vector(face: u32, sc: f32, tc: f32) -> vec3<f32> {
+    switch face {
+        case 0u: { return vec3<f32>(1.0, -tc, -sc); }
+        case 1u: { return vec3<f32>(-1.0, -tc, sc); }
+        case 2u: { return vec3<f32>(sc, 1.0, tc); }
+        case 3u: { return vec3<f32>(sc, -1.0, -tc); }
+        case 4u: { return vec3<f32>(sc, -tc, 1.0); }
+        default: { return vec3<f32>(-sc, -tc, -1.0); }
+    }
+}
+
+// The texel (face, i, j) that texel (i, j) of an n × n level of `face` names: itself inside
+// the face, else the neighbouring face's texel holding the direction of its centre.
+fn cube_texel(face: u32, i: i32, j: i32, n: u32) -> vec3<i32> {
+    let ni = i32(n);
+    if (i >= 0 && i < ni && j >= 0 && j < ni) {
+        return vec3<i32>(i32(face), i, j);
+    }
+    let nf = f32(n);
+    let sc = 2.0 * (f32(i) + 0.5) / nf - 1.0;
+    let tc = 2.0 * (f32(j) + 0.5) / nf - 1.0;
+    let d = face_vector(face, sc, tc);
+    let f2 = cube_face(d);
+    let st = face_st(f2, d);
+    let k = clamp(vec2<i32>(floor(st * nf)), vec2<i32>(0), vec2<i32>(ni - 1));
+    return vec3<i32>(i32(f2), k.x, k.y);
+}
+
+// The Vulkan LOD for isotropic filtering: λ = clamp(log2(max(ρx, ρy)), 0, max_level).
+fn texture_lod(ddx: vec2<f32>, ddy: vec2<f32>, size: vec2<f32>, max_level: f32) -> f32 {
+    let rho_x = sqrt((ddx.x * size.x) * (ddx.x * size.x) + (ddx.y * size.y) * (ddx.y * size.y));
+    let rho_y = sqrt((ddy.x * size.x) * (ddy.x * size.x) + (ddy.y * size.y) * (ddy.y * size.y));
+    let rho = max(max(rho_x, rho_y), 1e-30);
+    return clamp(log2(rho), 0.0, max(max_level, 0.0));
+}
+
+// λ of a lookup with vector d and fine derivatives ddx, ddy: (s, t)'s derivatives on d's
+// face by the quotient rule, then the isotropic LOD of a `size`-texel face.
+fn cube_lod(d: vec3<f32>, ddx: vec3<f32>, ddy: vec3<f32>, size: f32, max_level: f32) -> f32 {
+    let face = cube_face(d);
+    let c = face_components(face, d);
+    let cx = face_components(face, ddx);
+    let cy = face_components(face, ddy);
+    let m2 = c.z * c.z;
+    let dx = vec2<f32>(0.5 * (cx.x * c.z - c.x * cx.z) / m2, 0.5 * (cx.y * c.z - c.y * cx.z) / m2);
+    let dy = vec2<f32>(0.5 * (cy.x * c.z - c.x * cy.z) / m2, 0.5 * (cy.y * c.z - c.y * cy.z) / m2);
+    return texture_lod(dx, dy, vec2<f32>(size, size), max_level);
+}
+
+// Texel (i, j) of an n × n level of `face` of `cube`, level m: cube_texel's texel within
+// a face or beyond one edge; beyond a corner, the mean of the three texels meeting there.
+fn cube_texels(cube: texture_2d_array<f32>, face: u32, i: i32, j: i32, n: u32, m: u32) -> vec4<f32> {
+    let ni = i32(n);
+    let in_i = i >= 0 && i < ni;
+    let in_j = j >= 0 && j < ni;
+    if (in_i || in_j) {
+        let t = cube_texel(face, i, j, n);
+        return textureLoad(cube, vec2<i32>(t.y, t.z), t.x, i32(m));
+    }
+    let ci = clamp(i, 0, ni - 1);
+    let cj = clamp(j, 0, ni - 1);
+    let third = 1.0 / 3.0;
+    let t0 = cube_texel(face, ci, cj, n);
+    let t1 = cube_texel(face, i, cj, n);
+    let t2 = cube_texel(face, ci, j, n);
+    var c = third * textureLoad(cube, vec2<i32>(t0.y, t0.z), t0.x, i32(m));
+    c = c + third * textureLoad(cube, vec2<i32>(t1.y, t1.z), t1.x, i32(m));
+    c = c + third * textureLoad(cube, vec2<i32>(t2.y, t2.z), t2.x, i32(m));
+    return c;
+}
+
+// Bilinear lookup of level m of cube map `cube` (face size `size`) with vector d.
+fn cube_bilinear(cube: texture_2d_array<f32>, size: u32, d: vec3<f32>, m: u32) -> vec4<f32> {
+    let face = cube_face(d);
+    let st = face_st(face, d);
+    let n = (size + (1u << m) - 1u) >> m;
+    let u = st.x * f32(n) - 0.5;
+    let v = st.y * f32(n) - 0.5;
+    let i0 = floor(u);
+    let j0 = floor(v);
+    let a = u - i0;
+    let b = v - j0;
+    var acc = vec4<f32>(0.0);
+    for (var dj = 0; dj < 2; dj = dj + 1) {
+        for (var di = 0; di < 2; di = di + 1) {
+            let w = select(1.0 - a, a, di == 1) * select(1.0 - b, b, dj == 1);
+            acc = acc + w * cube_texels(cube, face, i32(i0) + di, i32(j0) + dj, n, m);
+        }
+    }
+    return acc;
+}
+
+// Trilinear lookup at level of detail λ: bilinear on levels ⌊λ⌋ and ⌊λ⌋ + 1, blended by
+// frac(λ); `levels` is the cube map's MIP level count.
+fn cube_sample(cube: texture_2d_array<f32>, size: u32, levels: u32, d: vec3<f32>, lambda: f32) -> vec4<f32> {
+    let q = levels - 1u;
+    let l = clamp(lambda, 0.0, f32(q));
+    let hi = min(u32(floor(l)), q);
+    let lo = min(hi + 1u, q);
+    let delta = l - f32(hi);
+    var c = (1.0 - delta) * cube_bilinear(cube, size, d, hi);
+    if (delta > 0.0) {
+        c = c + delta * cube_bilinear(cube, size, d, lo);
+    }
+    return c;
+}
