@@ -1,7 +1,7 @@
 // Environment-map shells (SPEC.md 7.3, 8.2): the lookup of one shell's cube map from a
 // surface point. One function written twice: every function here has a twin of the same
-// name in pis-compile's hardware model, with the same order of operations (reflect,
-// shell_hit, lookup_direction: shell/geometry.rs; cube_face, face_components, face_st,
+// name in pis-compile's hardware model, with the same order of operations (reflect_about,
+// shell_hit, lookup_direction, fresnel: shell/geometry.rs; cube_face, face_components, face_st,
 // face_vector, cube_texel, cube_texels, cube_lod, cube_bilinear, cube_sample:
 // shell/cube.rs;
 // texture_lod: lod.rs). Change both together. Pipelines append their entry points to this
@@ -111,6 +111,15 @@ fn lookup_direction(g: ShellGeometry, p: vec3<f32>, normal: vec3<f32>, eye: vec3
         return p + r * t - g.origin;
     }
     return r;
+}
+
+// Schlick's Fresnel factor: F0 + (1 − F0)(1 − cos θ)⁵, cos θ = clamp(−V·N, 0, 1).
+fn fresnel(f0: vec3<f32>, p: vec3<f32>, normal: vec3<f32>, eye: vec3<f32>) -> vec3<f32> {
+    let n = normalize(normal);
+    let v = normalize(p - eye);
+    let c = clamp(-dot(v, n), 0.0, 1.0);
+    let k = pow(1.0 - c, 5.0);
+    return f0 + (vec3<f32>(1.0) - f0) * k;
 }
 
 // The face of d: the axis of largest magnitude, x before y before z on ties.

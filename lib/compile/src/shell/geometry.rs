@@ -3,8 +3,8 @@
 //! intersected with the shell, and the hit point minus the shell's origin indexes the cube
 //! map (normalization is not needed for the cube parameterization).
 //!
-//! WGSL twin: `shell_hit` and `lookup_direction` in `lib/play/src/shell.wgsl`, same names
-//! and order of operations.
+//! WGSL twin: `reflect_about`, `shell_hit`, `lookup_direction` and `fresnel` in
+//! `lib/play/src/shell.wgsl`, same names and order of operations.
 
 use glam::DVec3;
 
@@ -136,7 +136,7 @@ fn slab(q: f64, r: f64, lo: f64, hi: f64) -> (f64, f64) {
 }
 
 /// The mirror reflection of direction `v` about the unit normal `n`: v − 2(v·n)n.
-pub fn reflect(v: DVec3, n: DVec3) -> DVec3 {
+pub fn reflect_about(v: DVec3, n: DVec3) -> DVec3 {
     v - n * (2.0 * v.dot(n))
 }
 
@@ -147,9 +147,20 @@ pub fn reflect(v: DVec3, n: DVec3) -> DVec3 {
 pub fn lookup_direction(shell: &Shell, p: DVec3, normal: DVec3, eye: DVec3) -> DVec3 {
     let n = normal.normalize_or_zero();
     let v = (p - eye).normalize_or_zero();
-    let r = reflect(v, n);
+    let r = reflect_about(v, n);
     let t = shell_hit(shell, p, r);
     if t >= 0.0 { p + r * t - shell.origin } else { r }
+}
+
+/// Schlick's Fresnel factor at a surface point seen from `eye` (SPEC.md 9):
+/// F0 + (1 − F0)(1 − cos θ)⁵, cos θ = clamp(−V·N, 0, 1), V the unit view direction, N the
+/// normalized normal.
+pub fn fresnel(f0: DVec3, p: DVec3, normal: DVec3, eye: DVec3) -> DVec3 {
+    let n = normal.normalize_or_zero();
+    let v = (p - eye).normalize_or_zero();
+    let c = (-v.dot(n)).clamp(0.0, 1.0);
+    let k = (1.0 - c).powi(5);
+    f0 + (DVec3::ONE - f0) * k
 }
 
 #[cfg(test)]
@@ -213,7 +224,7 @@ mod tests {
     fn a_large_sphere_looks_up_nearly_the_reflection_direction() {
         let shell = Shell { origin: DVec3::ZERO, shape: ShellShape::Sphere { radius: 1e6 } };
         let d = lookup_direction(&shell, DVec3::new(0.1, 0.0, 0.0), DVec3::Z, DVec3::new(0.0, 0.0, 5.0));
-        let r = reflect((DVec3::new(0.1, 0.0, 0.0) - DVec3::new(0.0, 0.0, 5.0)).normalize(), DVec3::Z);
+        let r = reflect_about((DVec3::new(0.1, 0.0, 0.0) - DVec3::new(0.0, 0.0, 5.0)).normalize(), DVec3::Z);
         assert!(d.normalize().dot(r) > 1.0 - 1e-9);
     }
 

@@ -8,5 +8,5 @@ pub mod cube;
 pub mod geometry;
 pub mod model;
 
-pub use geometry::{lookup_direction, Shell, ShellShape};
+pub use geometry::{fresnel, lookup_direction, Shell, ShellShape};
 pub use model::{shell_render_matrix, ShellObject};
