@@ -28,7 +28,8 @@ fn summary_names_what_the_file_holds() {
     let s = text(&out.stdout);
     for needle in [
         "2 dimensions, 4 points",
-        "ball (reflective)",
+        "ball (reflective): 63 vertices with normals",
+        "shading: f0 (0.9, 0.85, 0.8), ior 1.5, absorption (0, 0, 0)",
         "env_distant",
         "sphere shell",
         "lossless",
@@ -52,6 +53,10 @@ fn json_has_the_documented_fields() {
     let obj = &v["objects"][0];
     assert_eq!(obj["name"], "ball");
     assert_eq!(obj["role"], "reflective");
+    assert_eq!(obj["f0"], serde_json::json!([0.9, 0.85, 0.8]));
+    assert_eq!(obj["ior"], 1.5);
+    assert_eq!(obj["absorption"], serde_json::json!([0.0, 0.0, 0.0]));
+    assert_eq!(obj["normals"], true);
     assert_eq!(obj["layers"].as_array().unwrap().len(), 2);
     assert_eq!(obj["layers"][1]["shell"], "sphere");
     let size = std::fs::metadata(repo("samples/tiny.pis")).unwrap().len();

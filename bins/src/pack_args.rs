@@ -9,7 +9,7 @@ use pis_codec::CodecId;
 use pis_compile::{Filter, MAX_ANISOTROPY};
 
 use crate::cli::{Exit, Failure};
-use pis_pack::{filter_needs_probe, Allocation, BlockSize, LayerMode, MatrixSource, PackRequest, PackSettings, PlacementMode, PyramidMode};
+use pis_pack::{filter_needs_probe, Allocation, BlockSize, LayerMode, MatrixSource, PackRequest, PackSettings, PlacementMode, PyramidMode, RepresentationMode};
 
 /// pis-pack's settings on the command line.
 #[derive(Args, Debug, Clone)]
@@ -74,6 +74,10 @@ pub struct PackOptions {
     /// `combined` (one view-dependent layer of diffuse + specular per parameter sample).
     #[arg(long, default_value = "separate", value_parser = parse_layers)]
     pub layers: LayerMode,
+    /// Reflective objects: `texture` (parameterized surface textures) or `pem` (layered
+    /// environment maps, thesis ch. 5: a local and a distant shell per parameter sample).
+    #[arg(long, default_value = "texture", value_parser = parse_representation)]
+    pub representation: RepresentationMode,
     /// Conjugate-gradient iteration cap per colour channel of every texture solve
     /// (default: the solver's own).
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
@@ -119,6 +123,7 @@ impl PackOptions {
             gamma: if self.codec == CodecId::Lossless { 1.0 } else { self.gamma },
             pyramid: self.pyramid,
             layers: self.layers,
+            representation: self.representation,
             allocation: self.allocation,
             placement: self.placement,
             max_iterations: self.max_iterations,
@@ -168,6 +173,14 @@ fn parse_layers(s: &str) -> Result<LayerMode, String> {
         "separate" => Ok(LayerMode::Separate),
         "combined" => Ok(LayerMode::Combined),
         _ => Err(format!("unknown layers {s:?} (separate or combined)")),
+    }
+}
+
+fn parse_representation(s: &str) -> Result<RepresentationMode, String> {
+    match s {
+        "texture" => Ok(RepresentationMode::Texture),
+        "pem" => Ok(RepresentationMode::Pem),
+        _ => Err(format!("unknown representation {s:?} (texture or pem)")),
     }
 }
 

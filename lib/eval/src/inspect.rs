@@ -55,7 +55,16 @@ pub struct ImageSummary {
 pub struct ObjectSummary {
     pub name: String,
     pub role: &'static str,
+    /// Shading constants (SPEC.md 6.4): reflectance at normal incidence (Schlick's F0),
+    /// linear RGB.
+    pub f0: [f32; 3],
+    /// Index of refraction.
+    pub ior: f32,
+    /// Beer–Lambert absorption coefficients per unit length, linear RGB.
+    pub absorption: [f32; 3],
     pub vertices: usize,
+    /// Whether the mesh carries vertex normals.
+    pub normals: bool,
     pub triangles: usize,
     pub stagger: Vec<u32>,
     pub transforms: usize,
@@ -168,7 +177,11 @@ pub fn summarize(r: &PisReader) -> Summary {
             ObjectSummary {
                 name: o.name.clone(),
                 role: o.role.name(),
+                f0: o.shading.f0,
+                ior: o.shading.ior,
+                absorption: o.shading.absorption,
                 vertices: o.mesh.positions.len(),
+                normals: o.mesh.normals.is_some(),
                 triangles: o.mesh.indices.len() / 3,
                 stagger: o.stagger.clone(),
                 transforms: o.transforms.transforms.len(),
@@ -246,6 +259,18 @@ fn placements_text(l: &LayerSummary) -> String {
     s
 }
 
+/// An RGB triple as `(r, g, b)`, each with at most 4 decimals.
+fn rgb(v: [f32; 3]) -> String {
+    let c: Vec<String> = v
+        .iter()
+        .map(|x| {
+            let s = format!("{x:.4}");
+            s.trim_end_matches('0').trim_end_matches('.').to_string()
+        })
+        .collect();
+    format!("({})", c.join(", "))
+}
+
 fn human(n: u64) -> String {
     match n {
         n if n >= 10 << 20 => format!("{:.1} MiB", n as f64 / (1u64 << 20) as f64),
@@ -299,14 +324,22 @@ pub fn render(s: &Summary) -> String {
     for ob in &s.objects {
         let _ = writeln!(
             o,
-            "  {} ({}): {} vertices, {} triangles, {} transform(s), block origins {:?}, {}",
+            "  {} ({}): {} vertices{}, {} triangles, {} transform(s), block origins {:?}, {}",
             ob.name,
             ob.role,
             ob.vertices,
+            if ob.normals { " with normals" } else { "" },
             ob.triangles,
             ob.transforms,
             ob.stagger,
             human(ob.bytes)
+        );
+        let _ = writeln!(
+            o,
+            "    shading: f0 {}, ior {}, absorption {}",
+            rgb(ob.f0),
+            ob.ior,
+            rgb(ob.absorption)
         );
         for (i, l) in ob.layers.iter().enumerate() {
             let mapping = match l.shell {

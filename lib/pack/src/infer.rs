@@ -128,18 +128,28 @@ pub struct InferReport {
     pub notes: Vec<String>,
 }
 
-/// One object's mesh, all primitives merged.
+/// One object's mesh, all primitives merged, in object space.
 pub struct Mesh {
     pub positions: Vec<[f32; 3]>,
+    /// Unit vertex normals, one per position.
+    pub normals: Vec<[f32; 3]>,
     pub uvs: Vec<[f32; 2]>,
     pub indices: Vec<u32>,
 }
 
+/// Object `o`'s primitives merged into one mesh, in primitive order.
 pub fn merged_mesh(scene: &Scene, o: usize) -> Mesh {
-    let mut m = Mesh { positions: vec![], uvs: vec![], indices: vec![] };
+    let mut m = Mesh { positions: vec![], normals: vec![], uvs: vec![], indices: vec![] };
     for p in &scene.objects[o].primitives {
         let base = m.positions.len() as u32;
         m.positions.extend(p.positions.iter().map(|v| v.to_array()));
+        // The scene gives one unit normal per vertex; a primitive built otherwise gets its
+        // triangles' normals.
+        if p.normals.len() == p.positions.len() {
+            m.normals.extend(p.normals.iter().map(|v| v.to_array()));
+        } else {
+            m.normals.extend(vertex_normals(&p.positions, &p.indices));
+        }
         if p.uvs.len() == p.positions.len() {
             m.uvs.extend(p.uvs.iter().map(|v| v.to_array()));
         } else {
@@ -148,6 +158,19 @@ pub fn merged_mesh(scene: &Scene, o: usize) -> Mesh {
         m.indices.extend(p.indices.iter().map(|i| i + base));
     }
     m
+}
+
+/// Area-weighted vertex normals of a triangle list (+Y where a vertex has no area).
+fn vertex_normals(positions: &[Vec3], indices: &[u32]) -> Vec<[f32; 3]> {
+    let mut n = vec![Vec3::ZERO; positions.len()];
+    for t in indices.chunks_exact(3) {
+        let [a, b, c] = [t[0], t[1], t[2]].map(|i| i as usize);
+        if let (Some(&pa), Some(&pb), Some(&pc)) = (positions.get(a), positions.get(b), positions.get(c)) {
+            let f = (pb - pa).cross(pc - pa);
+            [a, b, c].iter().for_each(|&v| n[v] += f);
+        }
+    }
+    n.iter().map(|v| v.normalize_or(Vec3::Y).to_array()).collect()
 }
 
 /// Whether the texture wraps along u / v: the mesh has a seam, vertices at u = 0 and u = 1

@@ -9,7 +9,9 @@
 //! layer into parameter-space blocks whose origins are staggered per object ([`blocks`],
 //! 4.7), builds an adaptive Laplacian pyramid (4.3) of gamma-compensated samples (4.6) per
 //! block and allocates storage by equal slopes across levels, objects and layers
-//! ([`storage`], 4.5), whatever representation made them; [`report`] says what came out.
+//! ([`storage`], 4.5), whatever representation made them, and writes each object with its
+//! scene role, its material's shading constants ([`shading`]) and its mesh ([`stored_mesh`]);
+//! [`report`] says what came out.
 //! The container is written atomically. MIP levels are not stored: the player decimates
 //! (3.6).
 //!
@@ -26,10 +28,14 @@ pub mod infer_layers;
 pub mod input;
 pub mod matrices;
 pub mod model;
+pub mod pem;
 pub mod report;
 pub mod represent;
 pub mod settings;
+pub mod shading;
+pub mod shell_fit;
 pub mod storage;
+pub mod stored_mesh;
 pub mod surface;
 pub mod sweep;
 

@@ -9,4 +9,4 @@ pub mod geometry;
 pub mod model;
 
 pub use geometry::{fresnel, lookup_direction, Shell, ShellShape};
-pub use model::{shell_render_matrix, ShellObject};
+pub use model::{shell_fresnel, shell_render_matrix, ShellObject};

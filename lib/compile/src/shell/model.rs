@@ -12,7 +12,7 @@ use glam::{DVec3, Mat4, Vec3, Vec4};
 use rayon::prelude::*;
 
 use super::cube::{cube_lod, cube_taps};
-use super::geometry::{lookup_direction, Shell};
+use super::geometry::{fresnel, lookup_direction, Shell};
 use crate::filter::Taps;
 use crate::interpolate::texcoord_at;
 use crate::model::ModelError;
@@ -82,24 +82,7 @@ pub fn shell_render_matrix(viewport: Viewport, object: &ShellObject, occluders: 
             return Err(ModelError::DepthSize { got: o.viewport, want: viewport });
         }
     }
-    // Each triangle's corners carry barycentric (s, t) = (λ1, λ2): interpolated
-    // perspective-correct, they weight the corners' world attributes as the GPU's
-    // interpolation of those attributes does.
-    let triangles = object.indices.len() / 3;
-    let corners: Vec<[f32; 3]> = object.indices.iter().map(|&i| object.positions[i as usize]).collect();
-    let bary: Vec<[f32; 2]> = (0..triangles).flat_map(|_| [[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]]).collect();
-    let order: Vec<u32> = (0..corners.len() as u32).collect();
-    let mesh = DrawMesh { positions: &corners, uvs: &bary, indices: &order, clip_from_object: object.clip_from_object };
-    let frags = Fragments::rasterize(&mesh, &TextureTransform::IDENTITY, viewport, occluders);
-    let world = world_corners(object);
-    let pixels: Vec<u32> = frags
-        .pixels()
-        .into_iter()
-        .filter(|&p| {
-            let src = frags.source[frags.triangle[p as usize] as usize] as usize;
-            object.drawn.is_none_or(|d| d.get(src).copied().unwrap_or(false))
-        })
-        .collect();
+    let (frags, world, pixels) = shell_fragments(viewport, object, occluders);
     let layout = object.layout;
     let eye = object.eye.as_dvec3();
     let max_level = layout.levels.saturating_sub(1) as f64;
@@ -144,6 +127,48 @@ pub fn shell_render_matrix(viewport: Viewport, object: &ShellObject, occluders: 
         cols,
         vals,
     })
+}
+
+/// The object rasterized as the player draws it, each triangle's world corners, and the
+/// pixels that draw the shell (in increasing order).
+fn shell_fragments(viewport: Viewport, object: &ShellObject, occluders: Option<&DepthBuffer>) -> (Fragments, WorldCorners, Vec<u32>) {
+    // Each triangle's corners carry barycentric (s, t) = (λ1, λ2): interpolated
+    // perspective-correct, they weight the corners' world attributes as the GPU's
+    // interpolation of those attributes does.
+    let triangles = object.indices.len() / 3;
+    let corners: Vec<[f32; 3]> = object.indices.iter().map(|&i| object.positions[i as usize]).collect();
+    let bary: Vec<[f32; 2]> = (0..triangles).flat_map(|_| [[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]]).collect();
+    let order: Vec<u32> = (0..corners.len() as u32).collect();
+    let mesh = DrawMesh { positions: &corners, uvs: &bary, indices: &order, clip_from_object: object.clip_from_object };
+    let frags = Fragments::rasterize(&mesh, &TextureTransform::IDENTITY, viewport, occluders);
+    let world = world_corners(object);
+    let pixels: Vec<u32> = frags
+        .pixels()
+        .into_iter()
+        .filter(|&p| {
+            let src = frags.source[frags.triangle[p as usize] as usize] as usize;
+            object.drawn.is_none_or(|d| d.get(src).copied().unwrap_or(false))
+        })
+        .collect();
+    (frags, world, pixels)
+}
+
+/// Schlick's Fresnel factor ([`super::geometry::fresnel`]) at every pixel that draws the
+/// shell, in the rows' order of [`shell_render_matrix`]: the factor the player multiplies
+/// the reflection term by. Returns the pixels and one RGB factor per pixel.
+pub fn shell_fresnel(viewport: Viewport, object: &ShellObject, occluders: Option<&DepthBuffer>, f0: [f32; 3]) -> Result<(Vec<u32>, Vec<[f32; 3]>), ModelError> {
+    check(viewport, object)?;
+    let (frags, world, pixels) = shell_fragments(viewport, object, occluders);
+    let (eye, f0) = (object.eye.as_dvec3(), Vec3::from(f0).as_dvec3());
+    let f = pixels
+        .par_iter()
+        .map(|&p| {
+            let k = frags.triangle[p as usize] as usize;
+            let (pos, n) = attributes_at(&frags.triangles[k], &world, frags.source[k] as usize, p % viewport.width, p / viewport.width);
+            fresnel(f0, pos, n, eye).as_vec3().to_array()
+        })
+        .collect();
+    Ok((pixels, f))
 }
 
 fn world_corners(o: &ShellObject) -> WorldCorners {

@@ -16,7 +16,9 @@ use pis_format::*;
 
 use super::model::{key, ObjectModel};
 use super::input::LoadedSet;
-use super::blocks::{baked, block_sizes, geometry, stagger, transforms};
+use super::blocks::{block_sizes, geometry, stagger, transforms};
+use super::shading::object_shading;
+use super::stored_mesh::stored_mesh;
 use super::storage::{allocate_storage, build_pyramid, encode_levels, CodedLevel};
 pub use super::surface::{finest, mip_chain};
 use super::{PackRequest, Stages};
@@ -56,14 +58,20 @@ pub struct Packed {
 /// (Dᵀ), as the player draws coarser levels from level 0.
 fn screen_weights_at(a: &pis_compile::RenderMatrix) -> Vec<f64> {
     let dec = pis_compile::decimation::Decimation::new(a.layout);
+    let cols = column_sums(a);
+    let mut out = vec![0.0f64; dec.base_len()];
+    dec.reduce(&cols, &mut out);
+    out
+}
+
+/// The column sums of a render matrix: how much of the covered pixels each texel makes up.
+pub fn column_sums(a: &pis_compile::RenderMatrix) -> Vec<f64> {
     let mut cols = vec![0.0f64; a.cols()];
     for r in 0..a.rows() {
         let (c, w) = a.row(r);
         c.iter().zip(w).for_each(|(&c, &w)| cols[c as usize] += w as f64);
     }
-    let mut out = vec![0.0f64; dec.base_len()];
-    dec.reduce(&cols, &mut out);
-    out
+    cols
 }
 
 /// Texel weights of one layer sample: the sum of the per-point weights of the points that
@@ -87,19 +95,14 @@ fn layer_screen_weights(m: &ObjectModel, li: usize, samples: &[Vec<u32>]) -> BTr
     il.textures.keys().map(|k| {
         let pid = il.placement_of[k];
         let per_point: Vec<Vec<f64>> = samples.iter().enumerate().filter(|(_, s)| key(s, il.depends_on) == *k)
-            .map(|(p, _)| screen_weights_at(m.views[p].a(pid))).collect();
+            .map(|(p, _)| match il.shell {
+                // Every level of a shell is stored: its texels' column sums as they are.
+                Some(_) => column_sums(m.matrix(p, li, k)),
+                None => screen_weights_at(m.views[p].a(pid)),
+            }).collect();
         let w = if per_point.is_empty() { vec![0.0; il.form.stored_texels(k)] } else { sample_weights(&per_point) };
         (k.clone(), w)
     }).collect()
-}
-
-/// The object's mesh positions as the container stores them: with the first point's scale
-/// baked in where its transform is not rigid ([`baked`]).
-fn stored_positions(set: &LoadedSet, m: &ObjectModel) -> Vec<[f32; 3]> {
-    match baked(&set.frames, m.index) {
-        Some(b) => m.mesh.positions.iter().map(|&p| b.transform_point3(glam::Vec3::from(p)).to_array()).collect(),
-        None => m.mesh.positions.clone(),
-    }
 }
 
 /// Builds pyramids, allocates storage, encodes, and assembles the container.
@@ -178,13 +181,15 @@ pub fn encode_all(set: &LoadedSet, models: &[ObjectModel], req: &PackRequest, st
             layers.push(layer);
             layer_blocks.push(pblocks);
         }
+        // The object's role and shading constants as the scene gives them (SPEC.md 6.4).
+        let role = set.scene.objects[m.index].role;
         objects.push(Object {
             name: m.name.clone(),
-            role: ObjectRole::Diffuse,
-            shading: Shading::default(),
+            role,
+            shading: object_shading(&set.scene, m.index),
             stagger: st.clone(),
             transforms: transforms(set, &space, m.index),
-            mesh: Mesh { positions: stored_positions(set, m), normals: None, texcoords: Some(m.mesh_uvs.clone()), indices: m.mesh.indices.clone() },
+            mesh: stored_mesh(set, m, role),
             layers,
         });
         blocks_out.push(layer_blocks);
@@ -330,7 +335,10 @@ pub fn masters(models: &[ObjectModel], packed: &Packed) -> Result<Vec<Master>> {
         // The screen weights the allocation used, so that coding the master again allocates
         // as this pack did.
         let by_layer = &packed.screen_weights[mi];
-        let weights: Option<Vec<Vec<Vec<f32>>>> = by_layer.iter().all(|w| !w.is_empty())
+        // SPEC.md 6.7's screen weights are one surface plane per sample: an object with
+        // shells keeps none in its master.
+        let surfaces = m.layers.iter().all(|l| l.shell.is_none());
+        let weights: Option<Vec<Vec<Vec<f32>>>> = (surfaces && by_layer.iter().all(|w| !w.is_empty()))
             .then(|| by_layer.iter().map(|w| w.values().cloned().collect()).collect());
         Ok(Master::encode(&packed.container, mi, m.area, &textures, weights.as_deref())?)
     }).collect()
@@ -388,14 +396,9 @@ pub fn display_error(set: &LoadedSet, models: &[ObjectModel], textures: &[Vec<La
         let (mut sse, mut n) = (0.0f64, 0usize);
         for (p, s) in set.samples.iter().enumerate() {
             let v = &m.views[p];
-            let mut img = vec![0.0f32; v.rows() * 3];
-            for (il, t) in m.layers.iter().zip(tex) {
-                let k = key(s, il.depends_on);
-                if let Some(x) = t.get(&k) {
-                    let r = pis_compile::render(v.a(il.placement_of[&k]), x);
-                    img.iter_mut().zip(&r).for_each(|(a, b)| *a += b);
-                }
-            }
+            let keys: Vec<Vec<u32>> = m.layers.iter().map(|il| key(s, il.depends_on)).collect();
+            let at: Vec<Option<&[f32]>> = tex.iter().zip(&keys).map(|(t, k)| t.get(k).map(Vec::as_slice)).collect();
+            let img = m.render(p, &keys, &at);
             for (k, g) in img.iter().enumerate() {
                 let gold = v.diffuse[k] + v.specular[k];
                 sse += (d(*g) - d(gold)).powi(2);
@@ -439,7 +442,7 @@ pub fn predicted_psnr(set: &LoadedSet, models: &[ObjectModel], packed: &Packed) 
     for (m, (dl, sl)) in models.iter().zip(decoded.iter().zip(&solved)) {
         for (li, (dm, sm)) in dl.iter().zip(sl).enumerate() {
             for (k, x) in sm {
-                let n = m.layers[li].form.stored_texels(k) * 3;
+                let n = m.layers[li].form.stored_texels(k) * m.layers[li].form.channels();
                 if let Some(y) = dm.get(k) {
                     for (a, b) in x[..n].iter().zip(&y[..n]) {
                         max_err = max_err.max((a - b).abs());

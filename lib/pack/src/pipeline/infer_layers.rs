@@ -20,7 +20,7 @@ pub fn infer_all(set: &LoadedSet, req: &PackRequest, matrices: &mut Matrices, st
     let mut job = Job::new(set, req, matrices, stages.progress())?;
     let mut surveyed = Vec::new();
     for (o, object) in scene.objects.iter().enumerate() {
-        let rep = choose(object.role).ok_or_else(|| anyhow!("object {}: no representation stores a {:?} object", object.name, object.role))?;
+        let rep = choose(object.role, req.representation).ok_or_else(|| anyhow!("object {}: no representation stores a {:?} object", object.name, object.role))?;
         if let Some(s) = rep.survey(&mut job, o)? {
             surveyed.push(s);
         }

@@ -8,6 +8,7 @@ use std::collections::BTreeMap;
 use pis_compile::{RenderMatrix, TextureLayout};
 use pis_format::DepMask;
 
+use super::pem::views::ShellView;
 use crate::infer::{Mesh, Placed};
 
 /// One point as the render matrices see an object (hardware model or probe mode): the rows
@@ -30,6 +31,11 @@ impl PointView {
     pub fn rows(&self) -> usize {
         self.a.first().map_or(0, |(_, a)| a.rows())
     }
+
+    /// The covered pixels, `y · width + x`, in row order.
+    pub fn pixels(&self) -> &[u32] {
+        self.a.first().map_or(&[], |(_, a)| a.pixels.as_slice())
+    }
 }
 
 /// A solved layer: one texture (the whole MIP chain of its placement's layout) per sample of
@@ -48,6 +54,9 @@ pub struct InferredLayer {
     /// How the layer's samples are stored and rebuilt: its representation's part of
     /// encoding.
     pub form: Box<dyn LayerForm>,
+    /// For a shell layer, its index among the object's shells ([`ShellView::a`]); `None`
+    /// for a surface layer.
+    pub shell: Option<usize>,
 }
 
 /// How a layer's samples are stored in the container and rebuilt for drawing: what encoding
@@ -68,6 +77,10 @@ pub trait LayerForm: Send + Sync {
     fn drawn(&self, key: &[u32], stored: Vec<f32>) -> Vec<f32>;
     /// Texels of sample `key` as stored (values per channel).
     fn stored_texels(&self, key: &[u32]) -> usize;
+    /// Values per texel of the solved and stored samples.
+    fn channels(&self) -> usize {
+        3
+    }
 }
 
 /// An object's inferred representation.
@@ -87,6 +100,8 @@ pub struct ObjectModel {
     /// Per point of the set.
     pub views: Vec<PointView>,
     pub layers: Vec<InferredLayer>,
+    /// Per point of the set, as the object's shells see it (empty without shells).
+    pub shell_views: Vec<ShellView>,
     /// What was chosen and why.
     pub representation: String,
     pub why: String,
@@ -109,6 +124,40 @@ impl ObjectModel {
     /// The MIP layout of sample `key` of layer `layer`.
     pub fn layout(&self, layer: usize, key: &[u32]) -> TextureLayout {
         self.placed(layer, key).layout
+    }
+
+    /// The object's image at point `p` over its covered pixels (rows × RGB), drawn as the
+    /// player draws it from `textures[l]`, layer l's sample at the point (the whole drawn
+    /// texture; `None` where the layer has none): the surface layers added, then the
+    /// reflection term of the shells (SPEC.md 9).
+    pub fn render(&self, p: usize, keys: &[Vec<u32>], textures: &[Option<&[f32]>]) -> Vec<f32> {
+        let v = &self.views[p];
+        let mut img = vec![0.0f32; v.rows() * 3];
+        let mut maps = Vec::new();
+        for ((il, k), x) in self.layers.iter().zip(keys).zip(textures) {
+            let Some(x) = x else { continue };
+            match il.shell {
+                None => {
+                    let r = pis_compile::render(v.a(il.placement_of[k]), x);
+                    img.iter_mut().zip(&r).for_each(|(a, b)| *a += b);
+                }
+                Some(_) => maps.push((*x, il.form.channels())),
+            }
+        }
+        if !maps.is_empty() {
+            let r = super::pem::solve::reflection(&self.shell_views[p], &maps);
+            img.iter_mut().zip(&r).for_each(|(a, b)| *a += b);
+        }
+        img
+    }
+
+    /// The render matrix through which layer `layer`'s sample `key` is drawn at point `p`.
+    pub fn matrix(&self, p: usize, layer: usize, key: &[u32]) -> &RenderMatrix {
+        let il = &self.layers[layer];
+        match il.shell {
+            Some(s) => &self.shell_views[p].a[s],
+            None => self.views[p].a(il.placement_of[key]),
+        }
     }
 }
 

@@ -17,7 +17,9 @@ use super::blocks::{block_sizes, geometry};
 use super::input::LoadedSet;
 use super::matrices::Matrices;
 use super::model::ObjectModel;
+use super::pem::LayeredPem;
 use super::surface::SurfaceTextures;
+use super::RepresentationMode;
 use super::{PackRequest, Progress};
 use crate::infer::{merged_mesh, Mesh};
 
@@ -46,11 +48,12 @@ pub trait Planned {
 }
 
 /// The representations pis-pack knows, in the order they are tried.
-pub const REPRESENTATIONS: &[&dyn Representation] = &[&SurfaceTextures];
+pub const REPRESENTATIONS: &[&dyn Representation] = &[&LayeredPem, &SurfaceTextures];
 
-/// The representation of an object of `role`: the first that applies.
-pub fn choose(role: ObjectRole) -> Option<&'static dyn Representation> {
-    REPRESENTATIONS.iter().copied().find(|r| r.applies(role))
+/// The representation of an object of `role` under `mode`: the first that applies
+/// (layered environment maps only when `mode` asks for them).
+pub fn choose(role: ObjectRole, mode: RepresentationMode) -> Option<&'static dyn Representation> {
+    REPRESENTATIONS.iter().copied().filter(|r| mode == RepresentationMode::Pem || r.name() != LayeredPem.name()).find(|r| r.applies(role))
 }
 
 /// What every representation works with: the set and the request, the render-matrix

@@ -69,6 +69,9 @@ pub struct PackSettings {
     pub layers: LayerMode,
     /// What the storage allocation weighs: screen error (default) or texture error.
     pub allocation: Allocation,
+    /// How reflective objects are stored: parameterized surface textures (default) or
+    /// layered environment maps (thesis ch. 5).
+    pub representation: RepresentationMode,
     /// Texture placements per parameter block (default) or per object.
     pub placement: PlacementMode,
     /// Conjugate-gradient iteration cap per colour channel of every solve (`None`: the
@@ -110,6 +113,7 @@ impl PackSettings {
             pyramid: PyramidMode::Adaptive,
             layers: LayerMode::Separate,
             allocation: Allocation::Screen,
+            representation: RepresentationMode::Texture,
             placement: PlacementMode::Block,
             max_iterations: None,
             keep_master: false,
@@ -159,6 +163,12 @@ impl PackSettings {
     pub const fn with_codec(mut self, codec: CodecId) -> Self {
         self.codec = codec;
         self.gamma = if codec.is_lossy() { DEFAULT_GAMMA } else { 1.0 };
+        self
+    }
+
+    /// Store reflective objects as `representation`.
+    pub const fn with_representation(mut self, representation: RepresentationMode) -> Self {
+        self.representation = representation;
         self
     }
 
@@ -220,6 +230,27 @@ impl PlacementMode {
         match self {
             PlacementMode::Block => "block",
             PlacementMode::Object => "object",
+        }
+    }
+}
+
+/// How reflective objects are stored.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum RepresentationMode {
+    /// Parameterized surface textures, as every other object (thesis ch. 3–4).
+    #[default]
+    Texture,
+    /// Layered, parameterized environment maps: a local and a distant shell per parameter
+    /// sample, plus a diffuse surface layer when the object has one (thesis ch. 5).
+    Pem,
+}
+
+impl RepresentationMode {
+    /// The name `--representation` takes.
+    pub fn name(self) -> &'static str {
+        match self {
+            RepresentationMode::Texture => "texture",
+            RepresentationMode::Pem => "pem",
         }
     }
 }

@@ -110,13 +110,16 @@ pub fn allocate_storage(blocks: &[BlockPyramid], codec: CodecId, target: Target,
 
 /// The screen weight of every value of level image `ii` of level `lv`: the mean of the
 /// texel weights of the finest samples it reaches (its error adds to each of them), one
-/// value per channel.
+/// value per channel; `None` (texture error) when the weights do not cover its planes.
 fn level_image_weights(pb: &BlockPyramid, lv: usize, ii: usize, values: usize) -> Option<Vec<f32>> {
     let maps = pb.texel_weights.as_ref()?;
-    // one plane of interleaved channels (a surface texture's level 0)
-    let [plane] = pb.planes.as_slice() else { return None };
-    let texels = plane.width as usize * plane.height as usize;
-    let channels = plane.channels as usize;
+    // Planes of interleaved channels (a surface texture's level 0, or a shell's faces and
+    // MIP levels): one weight per texel of all planes.
+    let channels = pb.planes.first()?.channels as usize;
+    if pb.planes.iter().any(|p| p.channels as usize != channels) {
+        return None;
+    }
+    let texels: usize = pb.planes.iter().map(|p| p.width as usize * p.height as usize).sum();
     if texels * channels != values || maps.iter().any(|m| m.len() != texels) {
         return None;
     }

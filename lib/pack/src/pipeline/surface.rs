@@ -196,7 +196,7 @@ fn solve_layer(set: &LoadedSet, views: &[PointView], placements: &[Placed], plan
         textures.insert(k, x);
     }
     let form = Box::new(TextureForm { placements: placements.to_vec(), block_placements: plan.block_placements.clone(), placement_of: placement_of.clone() });
-    Ok(InferredLayer { kind: plan.kind, depends_on: plan.depends_on, textures, block_placements: plan.block_placements.clone(), placement_of, iterations, form })
+    Ok(InferredLayer { kind: plan.kind, depends_on: plan.depends_on, textures, block_placements: plan.block_placements.clone(), placement_of, iterations, form, shell: None })
 }
 
 /// A surface texture layer as stored: every block's texture placed as thesis 3.2 places it
@@ -293,6 +293,15 @@ impl Representation for SurfaceTextures {
     /// Texture coordinates and render matrices over all views: whether the object covers a
     /// pixel, which layers are black, the rows and gold standard of every point.
     fn survey(&self, job: &mut Job<'_>, o: usize) -> Result<Option<Box<dyn Surveyed>>> {
+        survey_surface(job, o, true)
+    }
+}
+
+/// [`SurfaceTextures`]' survey of object `o`; without `with_specular`, the object's surface
+/// part is its diffuse layer alone (another representation stores the rest) and the object
+/// is surveyed even when that layer is black, for its views' rows and gold standard.
+pub fn survey_surface(job: &mut Job<'_>, o: usize, with_specular: bool) -> Result<Option<Box<dyn Surveyed>>> {
+    {
         let (set, req) = (job.set, job.req);
         let scene = &set.scene;
         let frames: Vec<&pis_scene::Frame> = set.frames.iter().collect();
@@ -309,12 +318,12 @@ impl Representation for SurfaceTextures {
             return Ok(None);
         }
         let diffuse_black = is_black(&views, |v| &v.diffuse, |v| &v.specular);
-        let specular_black = is_black(&views, |v| &v.specular, |v| &v.diffuse);
-        if diffuse_black && specular_black {
+        let specular_black = !with_specular || is_black(&views, |v| &v.specular, |v| &v.diffuse);
+        if diffuse_black && specular_black && with_specular {
             job.note(&format!("object {name} is black in every layer; nothing stored"));
             return Ok(None);
         }
-        Ok(Some(Box::new(Covered { o, atlas: at, views, whole, diffuse_black, specular_black })))
+        Ok(Some(Box::new(Covered { o, atlas: at, views, whole, diffuse_black, specular_black, diffuse_only: !with_specular })))
     }
 }
 
@@ -327,6 +336,8 @@ struct Covered {
     whole: Placed,
     diffuse_black: bool,
     specular_black: bool,
+    /// The diffuse layer is the object's only surface layer (whatever `--layers` says).
+    diffuse_only: bool,
 }
 
 impl Surveyed for Covered {
@@ -338,7 +349,7 @@ impl Surveyed for Covered {
         let scene = &set.scene;
         let mut placements = vec![c.whole.clone()];
         let mut plans = Vec::new();
-        let wanted = if req.layers == super::LayerMode::Combined {
+        let wanted = if req.layers == super::LayerMode::Combined && !c.diffuse_only {
             vec![(pis_format::LayerKind::Specular, Radiance::Sum, job.all)]
         } else {
             let diffuse = (!c.diffuse_black).then_some((pis_format::LayerKind::Diffuse, Radiance::Diffuse, job.non_view));
@@ -402,7 +413,7 @@ impl Planned for Layers {
         };
         Ok(ObjectModel {
             index: o, name, mesh: merged_mesh(scene, o), mesh_uvs: at.uvs, placements, stagger: st, block_sizes: job.sizes.clone(),
-            area, views, layers, representation: representation.to_string(), why: why.to_string(),
+            area, views, layers, shell_views: vec![], representation: representation.to_string(), why: why.to_string(),
         })
     }
 }
@@ -448,7 +459,9 @@ mod tests {
     #[test]
     fn every_object_role_has_a_representation() {
         for role in [ObjectRole::Diffuse, ObjectRole::Reflective, ObjectRole::Refractive] {
-            assert_eq!(super::super::represent::choose(role).map(|r| r.name()), Some("surface textures"), "{role:?}");
+            assert_eq!(super::super::represent::choose(role, super::super::RepresentationMode::Texture).map(|r| r.name()), Some("surface textures"), "{role:?}");
+            let pem = if role == ObjectRole::Reflective { "layered environment maps" } else { "surface textures" };
+            assert_eq!(super::super::represent::choose(role, super::super::RepresentationMode::Pem).map(|r| r.name()), Some(pem), "{role:?}");
         }
     }
 }

@@ -1,0 +1,164 @@
+//! Layered, parameterized environment maps (thesis ch. 5): a reflective object's incident
+//! specular light as two environment-map shells per parameter sample — a local shell, the
+//! least-volume ellipsoid bounding the object, with alpha for the object's reflections of
+//! itself, over a distant shell, a box on the supporting surface or a sphere, whichever
+//! reproduces the traced distant layer better ([`fit`]) — modulated by the Fresnel factor
+//! the player evaluates from the object's F0; plus a diffuse surface texture when the object
+//! has one ([`super::surface`]). Each shell's render matrix comes from the hardware model's
+//! environment-map lookup ([`views`]); the cube maps are solved, every MIP level together,
+//! against the tracer's local and distant layers ([`solve`]) and stored whole ([`form`]).
+
+pub mod fit;
+pub mod form;
+pub mod solve;
+pub mod views;
+
+use anyhow::Result;
+use pis_compile::shell::Shell;
+use pis_compile::{SolveSettings, TextureLayout};
+use pis_scene::ObjectRole;
+use pis_trace::layers::LayerKind as TraceLayer;
+
+use super::model::{key, InferredLayer, ObjectModel};
+use super::represent::{Job, Planned, Representation, Surveyed};
+use super::surface::survey_surface;
+use fit::{fit_shells, FittedShells};
+use form::ShellForm;
+use solve::{reflection, solve_shell, SolvedShell, Target};
+use views::{face_resolution, shell_views, ShellView};
+
+/// The largest cube face tried when choosing a shell's resolution (thesis 5.8.2).
+pub const LARGEST_FACE: u32 = 256;
+
+/// Layered environment maps: reflective objects whose set has the tracer's local and
+/// distant layers.
+pub struct LayeredPem;
+
+impl Representation for LayeredPem {
+    fn name(&self) -> &'static str {
+        "layered environment maps"
+    }
+
+    fn applies(&self, role: ObjectRole) -> bool {
+        role == ObjectRole::Reflective
+    }
+
+    /// The object's surface part (its diffuse layer, if any, and every point's rows and gold
+    /// standard) and its fitted shells; an object whose set lacks the local and distant
+    /// layers is stored as surface textures.
+    fn survey(&self, job: &mut Job<'_>, o: usize) -> Result<Option<Box<dyn Surveyed>>> {
+        let set = job.set;
+        let name = &set.scene.objects[o].name;
+        let layered = set.images.first().is_some_and(|i| {
+            i.object_layer(&set.channels[o], TraceLayer::Local).is_some() && i.object_layer(&set.channels[o], TraceLayer::Distant).is_some()
+        });
+        if !layered {
+            job.note(&format!("object {name}: the set has no local and distant layers for it; stored as surface textures"));
+            return survey_surface(job, o, true);
+        }
+        let Some(surface) = survey_surface(job, o, false)? else { return Ok(None) };
+        let fitted = fit_shells(set, o, &job.meshes[o])?;
+        Ok(Some(Box::new(PemSurveyed { o, surface, fitted })))
+    }
+}
+
+struct PemSurveyed {
+    o: usize,
+    surface: Box<dyn Surveyed>,
+    fitted: FittedShells,
+}
+
+impl Surveyed for PemSurveyed {
+    fn plan(self: Box<Self>, job: &mut Job<'_>, stagger: Vec<u32>) -> Result<Box<dyn Planned>> {
+        let PemSurveyed { o, surface, fitted } = *self;
+        let surface = surface.plan(job, stagger)?;
+        Ok(Box::new(PemPlanned { o, surface, fitted }))
+    }
+}
+
+struct PemPlanned {
+    o: usize,
+    surface: Box<dyn Planned>,
+    fitted: FittedShells,
+}
+
+/// The shells chosen for an object, their layouts and solutions.
+struct Chosen {
+    shells: Vec<(Shell, TextureLayout, Target)>,
+    views: Vec<ShellView>,
+    solved: Vec<SolvedShell>,
+    why: String,
+}
+
+impl Planned for PemPlanned {
+    fn solve(self: Box<Self>, job: &Job<'_>) -> Result<ObjectModel> {
+        let PemPlanned { o, surface, fitted } = *self;
+        let mut model = surface.solve(job)?;
+        let set = job.set;
+        let f0 = super::shading::object_shading(&set.scene, o).f0;
+        let pixels: Vec<Vec<u32>> = model.views.iter().map(|v| v.pixels().to_vec()).collect();
+        let keys: Vec<Vec<u32>> = set.samples.iter().map(|s| key(s, job.all)).collect();
+        let mut settings = SolveSettings::pyramidal();
+        settings.cg = job.settings.cg;
+        let largest = LARGEST_FACE.min(job.req.max_texture.next_power_of_two() / 2).max(8);
+        let local_n = face_resolution(set, o, &job.meshes, fitted.local, largest)?;
+        let local_layout = TextureLayout::cube(local_n);
+        let has_local = model.views.iter().enumerate().any(|(p, v)| local_alpha(set, p, o, v.pixels()) > 1e-3);
+        // The distant shell: a box and a sphere, each solved; the one nearer the traced
+        // distant layer is kept.
+        let mut best: Option<Chosen> = None;
+        for (label, shell) in [("box", fitted.distant_box), ("sphere", fitted.distant_sphere)] {
+            let n = face_resolution(set, o, &job.meshes, shell, largest)?;
+            let layout = TextureLayout::cube(n);
+            let mut shells = Vec::new();
+            if has_local {
+                shells.push((fitted.local, local_layout, Target::Local));
+            }
+            shells.push((shell, layout, Target::Distant));
+            let geometry: Vec<(Shell, TextureLayout)> = shells.iter().map(|s| (s.0, s.1)).collect();
+            let views = shell_views(set, o, &job.meshes, &geometry, f0, &pixels)?;
+            let mut solved = Vec::new();
+            for (s, &(_, layout, target)) in shells.iter().enumerate() {
+                solved.push(solve_shell(&views, s, layout, target, &keys, &settings)?);
+            }
+            let residual = solved.last().map_or(f64::INFINITY, |s| s.residual_rms);
+            let why = format!("distant {label} {n}² (traced distant layer residual {residual:.4}){}", if has_local { format!(", local ellipsoid {local_n}²") } else { String::new() });
+            if best.as_ref().is_none_or(|b| residual < b.solved.last().map_or(f64::INFINITY, |s| s.residual_rms)) {
+                best = Some(Chosen { shells, views, solved, why });
+            }
+        }
+        let chosen = best.expect("two candidates were solved");
+        for (s, ((shell, layout, target), solved)) in chosen.shells.iter().zip(chosen.solved).enumerate() {
+            let kind = if *target == Target::Local { pis_format::LayerKind::EnvLocal } else { pis_format::LayerKind::EnvDistant };
+            let form = Box::new(ShellForm { shell: *shell, layout: *layout, channels: target.channels() as u8, order: s as u8 });
+            let grid_blocks = pis_format::blocks::BlockGrid::new(&job.space, job.all, &model.stagger).block_count() as usize;
+            model.layers.push(InferredLayer {
+                kind,
+                depends_on: job.all,
+                placement_of: solved.textures.keys().map(|k| (k.clone(), 0)).collect(),
+                textures: solved.textures,
+                block_placements: vec![0; grid_blocks],
+                iterations: solved.iterations,
+                form,
+                shell: Some(s),
+            });
+        }
+        model.shell_views = chosen.views;
+        model.representation = "layered environment maps".to_string();
+        model.why = format!("reflective: {}, Fresnel from F0 {:?}", chosen.why, f0);
+        Ok(model)
+    }
+}
+
+/// The largest traced local alpha of object `o` over `pixels` at point `p`.
+fn local_alpha(set: &super::input::LoadedSet, p: usize, o: usize, pixels: &[u32]) -> f32 {
+    set.images[p]
+        .object_layer(&set.channels[o], TraceLayer::Local)
+        .and_then(|l| l.channel("A"))
+        .map_or(0.0, |a| pixels.iter().map(|&px| a[px as usize]).fold(0.0, f32::max))
+}
+
+/// The reflection term of a point from the shells' samples at it (see [`solve::reflection`]).
+pub fn reflection_at(v: &ShellView, maps: &[(&[f32], usize)]) -> Vec<f32> {
+    reflection(v, maps)
+}

@@ -1,0 +1,121 @@
+//! Inferring a layered environment map (thesis 5.8): per parameter sample, each shell's cube
+//! map — every MIP level at once (5.8.1) — by chapter 3's regularized least squares
+//! against the tracer's incident specular layer, through the shell's render matrix. The
+//! local shell's premultiplied colour and its alpha are solved apart (the same A), the
+//! distant shell's colour alone; each sample starts from the last sample's solution.
+
+use std::collections::BTreeMap;
+
+use anyhow::Result;
+use pis_compile::{solve, SolveSettings, TextureLayout};
+
+use super::views::ShellView;
+
+/// Which traced layer a shell is solved for.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Target {
+    /// The local layer: premultiplied RGB and alpha (4 channels).
+    Local,
+    /// The distant layer (3 channels).
+    Distant,
+}
+
+impl Target {
+    pub fn channels(self) -> usize {
+        match self {
+            Target::Local => 4,
+            Target::Distant => 3,
+        }
+    }
+}
+
+/// One shell's samples: per key, the cube map (texels × channels, the layout's order).
+pub struct SolvedShell {
+    pub textures: BTreeMap<Vec<u32>, Vec<f32>>,
+    pub iterations: u64,
+    pub residual_rms: f64,
+}
+
+/// Solves shell `s` (of the views' shells) for `target` at every point, keyed by `keys`
+/// (one key per point: shells are view-dependent).
+pub fn solve_shell(views: &[ShellView], s: usize, layout: TextureLayout, target: Target, keys: &[Vec<u32>], settings: &SolveSettings) -> Result<SolvedShell> {
+    let n = layout.texel_count();
+    let c = target.channels();
+    let mut textures = BTreeMap::new();
+    let (mut iterations, mut sq, mut count) = (0u64, 0.0f64, 0usize);
+    let mut warm_rgb: Option<Vec<f32>> = None;
+    let mut warm_alpha: Option<Vec<f32>> = None;
+    for (v, k) in views.iter().zip(keys) {
+        let a = &v.a[s];
+        let mut texels = vec![0.0f32; n * c];
+        if a.rows() > 0 {
+            let (rgb, alpha) = split(v, target);
+            let x = solve(a, &rgb, warm_rgb.as_deref(), settings)?;
+            iterations += x.iterations as u64;
+            sq += x.residual_rms * x.residual_rms * a.rows() as f64;
+            count += a.rows();
+            for t in 0..n {
+                texels[t * c..t * c + 3].copy_from_slice(&x.texels[t * 3..t * 3 + 3]);
+            }
+            warm_rgb = Some(x.texels);
+            if let Some(alpha) = alpha {
+                let y = solve(a, &alpha, warm_alpha.as_deref(), settings)?;
+                iterations += y.iterations as u64;
+                for t in 0..n {
+                    texels[t * c + 3] = y.texels[t * 3];
+                }
+                warm_alpha = Some(y.texels);
+            }
+        } else if let Some(w) = &warm_rgb {
+            // A sample where the object covers no pixel keeps its neighbour's map.
+            for t in 0..n {
+                texels[t * c..t * c + 3].copy_from_slice(&w[t * 3..t * 3 + 3]);
+                if c == 4 {
+                    texels[t * c + 3] = warm_alpha.as_ref().map_or(0.0, |a| a[t * 3]);
+                }
+            }
+        }
+        textures.insert(k.clone(), texels);
+    }
+    Ok(SolvedShell { textures, iterations, residual_rms: (sq / count.max(1) as f64).sqrt() })
+}
+
+/// The right-hand sides of a point: RGB per row, and for the local layer its alpha in the
+/// first channel (the other two zero, so their solves stop at once).
+fn split(v: &ShellView, target: Target) -> (Vec<f32>, Option<Vec<f32>>) {
+    match target {
+        Target::Distant => (v.distant.clone(), None),
+        Target::Local => {
+            let rgb = v.local.chunks_exact(4).flat_map(|p| [p[0], p[1], p[2]]).collect();
+            let alpha = v.local.chunks_exact(4).flat_map(|p| [p[3], 0.0, 0.0]).collect();
+            (rgb, Some(alpha))
+        }
+    }
+}
+
+/// The reflection term of a point per row, from its shells' cube maps (local first when
+/// there is one): F ⊙ (L + (1 − α_L)·D), premultiplied "over" (SPEC.md 9).
+pub fn reflection(v: &ShellView, maps: &[(&[f32], usize)]) -> Vec<f32> {
+    let rows = v.fresnel.len() / 3;
+    let mut acc = vec![0.0f32; rows * 3];
+    let mut through = vec![1.0f32; rows];
+    for (s, &(x, c)) in maps.iter().enumerate() {
+        let a = &v.a[s];
+        for r in 0..rows {
+            let (cols, vals) = a.row(r);
+            let mut px = [0.0f32; 4];
+            for (&col, &w) in cols.iter().zip(vals) {
+                for ch in 0..c {
+                    px[ch] += w * x[col as usize * c + ch];
+                }
+            }
+            let alpha = if c == 4 { px[3] } else { 1.0 };
+            for ch in 0..3 {
+                acc[r * 3 + ch] += through[r] * px[ch];
+            }
+            through[r] *= 1.0 - alpha;
+        }
+    }
+    acc.iter_mut().zip(&v.fresnel).for_each(|(a, f)| *a *= f);
+    acc
+}

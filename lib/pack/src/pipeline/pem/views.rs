@@ -1,0 +1,176 @@
+//! Every point as an object's shells see it: per shell, the render matrix A of the hardware
+//! model's environment-map lookup (thesis 5.8: "test renderings with environment mapping
+//! instead of texture mapping"), restricted to the pixels the tracer covers; the Fresnel
+//! factor the player multiplies the reflection term by; and the tracer's local (RGBA,
+//! premultiplied) and distant (RGB) incident specular layers there (5.7), which the shells
+//! are solved for.
+
+use anyhow::{anyhow, Result};
+use glam::Vec3;
+use pis_compile::shell::{shell_fresnel, shell_render_matrix, Shell, ShellObject};
+use pis_compile::{scene_depth, DrawMesh, RenderMatrix, TextureLayout, Viewport};
+use pis_trace::layers::LayerKind as TraceLayer;
+use rayon::prelude::*;
+
+use super::super::input::LoadedSet;
+use crate::infer::{restrict_rows, Mesh};
+
+/// One point as the shells see it: the rows are the covered pixels, in the order of the
+/// object's surface render matrices at the point.
+pub struct ShellView {
+    /// Per shell of the object, in the object's shell order: its render matrix.
+    pub a: Vec<RenderMatrix>,
+    /// F per row, RGB.
+    pub fresnel: Vec<f32>,
+    /// The tracer's local layer per row: premultiplied RGB and alpha (4 values).
+    pub local: Vec<f32>,
+    /// The tracer's distant layer per row (RGB).
+    pub distant: Vec<f32>,
+}
+
+/// The tracer's layer `kind` of object channel `channel` at point `p`, `channels` values per
+/// pixel (missing channels 0).
+fn layer_values(set: &LoadedSet, p: usize, channel: &str, kind: TraceLayer, names: &[&str]) -> Vec<f32> {
+    let (w, h) = set.resolution;
+    let n = (w * h) as usize;
+    let mut out = vec![0.0f32; n * names.len()];
+    if let Some(l) = set.images[p].object_layer(channel, kind) {
+        for (c, name) in names.iter().enumerate() {
+            if let Some(plane) = l.channel(name) {
+                for k in 0..n {
+                    out[k * names.len() + c] = plane[k];
+                }
+            }
+        }
+    }
+    out
+}
+
+fn gather_n(pixels: &[u32], values: &[f32], n: usize) -> Vec<f32> {
+    pixels.iter().flat_map(|&p| values[p as usize * n..p as usize * n + n].iter().copied()).collect()
+}
+
+/// The shell object of `o` at point `p` for `shell` with `layout`, its eye and its
+/// clip-from-object, as the player draws it.
+fn shell_object<'m>(set: &LoadedSet, p: usize, o: usize, mesh: &'m Mesh, shell: Shell, layout: TextureLayout) -> ShellObject<'m> {
+    let (w, h) = set.resolution;
+    let frame = &set.frames[p];
+    let world = frame.instances[o].world_from_object;
+    let clip = pis_trace::camera::projection_matrix(&frame.camera, (w, h)) * frame.camera.world_from_camera.inverse() * world;
+    ShellObject {
+        positions: &mesh.positions,
+        normals: &mesh.normals,
+        indices: &mesh.indices,
+        clip_from_object: clip,
+        world_from_object: world,
+        eye: frame.camera.world_from_camera.w_axis.truncate(),
+        shell,
+        layout,
+        drawn: None,
+    }
+}
+
+/// The scene's depth at point `p` without object `o`: its occluders.
+fn occluders(set: &LoadedSet, p: usize, o: usize, meshes: &[Mesh]) -> Result<pis_compile::DepthBuffer> {
+    let (w, h) = set.resolution;
+    let frame = &set.frames[p];
+    let view_proj = pis_trace::camera::projection_matrix(&frame.camera, (w, h)) * frame.camera.world_from_camera.inverse();
+    let draw: Vec<DrawMesh> = meshes
+        .iter()
+        .enumerate()
+        .map(|(k, m)| DrawMesh { positions: &m.positions, uvs: &m.uvs, indices: &m.indices, clip_from_object: view_proj * frame.instances[k].world_from_object })
+        .collect();
+    Ok(scene_depth(Viewport { width: w, height: h }, &draw, Some(o))?)
+}
+
+/// Coverage of object channel `channel` at point `p`.
+fn coverage(set: &LoadedSet, p: usize, channel: &str) -> Vec<f32> {
+    let (w, h) = set.resolution;
+    set.images[p].object_layer(channel, TraceLayer::Coverage).and_then(|l| l.channel("A")).map(<[f32]>::to_vec).unwrap_or_else(|| vec![0.0; (w * h) as usize])
+}
+
+/// Every point of the set as object `o`'s `shells` (each with its cube layout) see it.
+/// `pixels[p]` are the rows of the object's surface render matrices at point p, which the
+/// shells' rows must equal.
+pub fn shell_views(set: &LoadedSet, o: usize, meshes: &[Mesh], shells: &[(Shell, TextureLayout)], f0: [f32; 3], pixels: &[Vec<u32>]) -> Result<Vec<ShellView>> {
+    let (w, h) = set.resolution;
+    let vp = Viewport { width: w, height: h };
+    let channel = &set.channels[o];
+    let name = &set.scene.objects[o].name;
+    (0..set.frames.len())
+        .into_par_iter()
+        .map(|p| {
+            let depth = occluders(set, p, o, meshes)?;
+            let cov = coverage(set, p, channel);
+            let mut a = Vec::with_capacity(shells.len());
+            for &(shell, layout) in shells {
+                let m = shell_render_matrix(vp, &shell_object(set, p, o, &meshes[o], shell, layout), Some(&depth))?;
+                let m = restrict_rows(&m, &cov);
+                if m.pixels != pixels[p] {
+                    return Err(anyhow!("object {name}: point {p}: the shell and surface render matrices cover different pixels"));
+                }
+                a.push(m);
+            }
+            let (fp, f) = shell_fresnel(vp, &shell_object(set, p, o, &meshes[o], shells[0].0, shells[0].1), Some(&depth), f0)?;
+            let mut fresnel = Vec::with_capacity(pixels[p].len() * 3);
+            let mut k = 0;
+            for &px in &pixels[p] {
+                while fp[k] != px {
+                    k += 1;
+                }
+                fresnel.extend_from_slice(&f[k]);
+            }
+            let local = gather_n(&pixels[p], &layer_values(set, p, channel, TraceLayer::Local, &["R", "G", "B", "A"]), 4);
+            let distant = gather_n(&pixels[p], &layer_values(set, p, channel, TraceLayer::Distant, &["R", "G", "B"]), 3);
+            Ok(ShellView { a, fresnel, local, distant })
+        })
+        .collect()
+}
+
+/// The cube-face resolution of a shell (thesis 5.8.2: "test renderings to determine the most
+/// detailed EM MIPMAP level actually accessed"): `shell` drawn with a `largest`-texel cube
+/// map at every `step`-th point; the finest level that at least [`ACCESS_SHARE`] of the rows
+/// read is the level whose size is chosen (at least [`MIN_FACE`]).
+pub fn face_resolution(set: &LoadedSet, o: usize, meshes: &[Mesh], shell: Shell, largest: u32) -> Result<u32> {
+    let (w, h) = set.resolution;
+    let vp = Viewport { width: w, height: h };
+    let layout = TextureLayout::cube(largest);
+    let step = set.frames.len().div_ceil(8).max(1);
+    let mut finest = vec![0usize; layout.levels as usize];
+    for p in (0..set.frames.len()).step_by(step) {
+        let depth = occluders(set, p, o, meshes)?;
+        let a = restrict_rows(&shell_render_matrix(vp, &shell_object(set, p, o, &meshes[o], shell, layout), Some(&depth))?, &coverage(set, p, &set.channels[o]));
+        for r in 0..a.rows() {
+            let (cols, vals) = a.row(r);
+            let level = cols.iter().zip(vals).filter(|(_, &v)| v > 0.0).map(|(&c, _)| level_of(&layout, c as usize)).min();
+            if let Some(l) = level {
+                finest[l] += 1;
+            }
+        }
+    }
+    let total: usize = finest.iter().sum();
+    let mut seen = 0;
+    for (l, &n) in finest.iter().enumerate() {
+        seen += n;
+        if seen as f64 >= ACCESS_SHARE * total as f64 && total > 0 {
+            return Ok((largest >> l).max(MIN_FACE));
+        }
+    }
+    Ok(MIN_FACE)
+}
+
+/// The share of rows whose finest level read decides the face resolution.
+pub const ACCESS_SHARE: f64 = 0.02;
+/// The smallest cube face chosen.
+pub const MIN_FACE: u32 = 8;
+
+/// The MIP level of column `c` of a cube layout.
+fn level_of(layout: &TextureLayout, c: usize) -> usize {
+    let within = c % layout.face_len();
+    (0..layout.levels).rev().find(|&m| layout.level_offset(m) <= within).unwrap_or(0) as usize
+}
+
+/// The camera position at point `p`.
+pub fn eye(set: &LoadedSet, p: usize) -> Vec3 {
+    set.frames[p].camera.world_from_camera.w_axis.truncate()
+}
