@@ -101,6 +101,11 @@ pub struct PathReport {
     pub decode_ms_worst: f64,
     pub upload_ms_mean: f64,
     pub upload_bytes_mean: f64,
+    /// Draws per frame of surface layers (object × layer × parameter sample).
+    pub surface_draws_mean: f64,
+    /// Draws per frame of reflection terms (object × parameter sample, each looking up the
+    /// term's environment-map shells).
+    pub shell_draws_mean: f64,
     pub cache_hits: u64,
     pub cache_misses: u64,
     pub cache_bytes_max: u64,
@@ -116,6 +121,8 @@ pub struct FrameRow {
     pub decode_ms: f64,
     pub upload_ms: f64,
     pub codestreams_read: u64,
+    pub surface_draws: u64,
+    pub shell_draws: u64,
 }
 
 #[derive(Clone, Debug, Serialize)]
@@ -339,7 +346,15 @@ pub fn run_frames(args: &HeadlessRequest, gpu: &Gpu, player: &mut Player) -> Res
         if progress && (k + 1) % 10 == 0 {
             eprintln!("pis-play: frame {}/{}", k + 1, reqs.len());
         }
-        rows.push(FrameRow { point: req.point.clone(), frame_ms: stats.frame_ms, decode_ms: stats.decode_ms, upload_ms: stats.upload_ms, codestreams_read: stats.codestreams_read });
+        rows.push(FrameRow {
+            point: req.point.clone(),
+            frame_ms: stats.frame_ms,
+            decode_ms: stats.decode_ms,
+            upload_ms: stats.upload_ms,
+            codestreams_read: stats.codestreams_read,
+            surface_draws: stats.surface_draws,
+            shell_draws: stats.shell_draws,
+        });
         all.push(stats);
     }
     let n = all.len().max(1) as f64;
@@ -366,6 +381,8 @@ pub fn run_frames(args: &HeadlessRequest, gpu: &Gpu, player: &mut Player) -> Res
         decode_ms_worst: worst(|s| s.decode_ms),
         upload_ms_mean: mean(|s| s.upload_ms),
         upload_bytes_mean: mean(|s| s.upload_bytes as f64),
+        surface_draws_mean: mean(|s| s.surface_draws as f64),
+        shell_draws_mean: mean(|s| s.shell_draws as f64),
         cache_hits: all.iter().map(|s| s.cache_hits).sum(),
         cache_misses: all.iter().map(|s| s.cache_misses).sum(),
         cache_bytes_max: all.iter().map(|s| s.cache_bytes).max().unwrap_or(0),
@@ -380,6 +397,7 @@ pub fn print_path_report(r: &PathReport, w: &mut impl std::io::Write) -> std::io
     writeln!(w, "  frames: {}", r.frames)?;
     writeln!(w, "  frame ms: mean {:.2} ({:.1} fps), worst {:.2} ({:.1} fps)", r.frame_ms_mean, r.fps_mean, r.frame_ms_worst, r.fps_worst)?;
     writeln!(w, "  decode ms: mean {:.2}, worst {:.2}; upload ms: mean {:.2} ({:.0} KiB per frame)", r.decode_ms_mean, r.decode_ms_worst, r.upload_ms_mean, r.upload_bytes_mean / 1024.0)?;
+    writeln!(w, "  draws per frame: {:.1} surface layers, {:.1} reflection terms (environment-map shells)", r.surface_draws_mean, r.shell_draws_mean)?;
     writeln!(w, "  level-image cache: {} hits, {} misses, at most {:.1} MiB; codestreams read: {}", r.cache_hits, r.cache_misses, r.cache_bytes_max as f64 / (1 << 20) as f64, r.codestreams_read)
 }
 

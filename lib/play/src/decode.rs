@@ -1,11 +1,13 @@
 //! The decoder's work, done on worker threads (never on the render thread): decoding level
 //! images from their codestreams, and rebuilding a parameter sample's texture from the level
-//! images on its pyramid path (sum, inverse gamma, SPEC.md "Reconstructing a texture"), at
-//! full or reduced resolution, as the finest GPU level padded for upload.
+//! images on its pyramid path (sum, inverse gamma, stored MIP residuals: SPEC.md 8.4), at
+//! full or reduced resolution: a surface texture as the finest GPU level padded for upload,
+//! a shell's cube map as every face and MIP level in the cube layout's order.
 
 use std::sync::Arc;
 
 use pis_codec::{CodecError, PlaneShape};
+use pis_compile::TextureLayout;
 use pis_format::mip::{decimate, mip_size};
 use pis_format::texture::LevelLayout;
 use pis_format::{Error, Issue, Layer, PisReader, StreamRef};
@@ -43,6 +45,15 @@ pub struct TextureImage {
     pub rgba: Vec<f32>,
 }
 
+/// A rebuilt cube map ready to upload: its layout (six square faces and their MIP chains,
+/// from the finest drawn level down) and its texels as RGBA f32 in that layout's order, face
+/// after face, each face's levels in order (SPEC.md 8.1).
+#[derive(Clone, Debug, PartialEq)]
+pub struct CubeImage {
+    pub layout: TextureLayout,
+    pub rgba: Vec<f32>,
+}
+
 /// The pool of decoding threads.
 pub struct Decoder {
     pool: rayon::ThreadPool,
@@ -66,15 +77,33 @@ pub fn decode_level(reader: &PisReader, job: &LevelJob) -> Result<Vec<f32>, Play
     Ok(values)
 }
 
-/// Rebuilds a texture: the level images summed (top first, as the encoder's prediction),
-/// inverse gamma, the finest level decimated `drop_levels` times, padded to powers of two.
-pub fn assemble(job: &AssembleJob) -> TextureImage {
+/// The linear texture of a job (SPEC.md 8.4 steps 2–4): the level images summed (top first,
+/// as the encoder's prediction), inverse gamma, stored MIP residuals added to the decimated
+/// finest level; every plane of the level layout, in its order.
+fn reconstruct(job: &AssembleJob) -> Vec<f32> {
     let n: usize = job.layout.planes().iter().map(|p| (p.width * p.height * p.channels) as usize).sum();
     let mut sum = vec![0.0f32; n];
     for img in &job.levels {
         sum.iter_mut().zip(img.iter()).for_each(|(a, v)| *a += v);
     }
-    let linear = pis_format::reconstruct::finish(job.layer, &job.layout, sum);
+    pis_format::reconstruct::finish(job.layer, &job.layout, sum)
+}
+
+/// One texel of `c` channels as RGBA: grey for 1 channel, grey and alpha for 2, opaque RGB
+/// for 3.
+fn rgba_texel(px: &[f32]) -> [f32; 4] {
+    match px.len() {
+        1 => [px[0], px[0], px[0], 1.0],
+        2 => [px[0], px[0], px[0], px[1]],
+        3 => [px[0], px[1], px[2], 1.0],
+        _ => [px[0], px[1], px[2], px[3]],
+    }
+}
+
+/// Rebuilds a texture: [`reconstruct`], the finest level decimated `drop_levels` times,
+/// padded to powers of two.
+pub fn assemble(job: &AssembleJob) -> TextureImage {
+    let linear = reconstruct(job);
     let (w0, h0, c) = (job.layout.width, job.layout.height, job.layout.channels);
     let mut finest = linear[..(w0 * h0 * c) as usize].to_vec();
     let (mut w, mut h) = (w0, h0);
@@ -89,16 +118,57 @@ pub fn assemble(job: &AssembleJob) -> TextureImage {
         for i in 0..pw {
             let src = (j.min(h - 1) * w + i.min(w - 1)) as usize * c;
             let dst = (j * pw + i) as usize * 4;
-            let px = &finest[src..src + c];
-            rgba[dst..dst + 4].copy_from_slice(&match c {
-                1 => [px[0], px[0], px[0], 1.0],
-                2 => [px[0], px[0], px[0], px[1]],
-                3 => [px[0], px[1], px[2], 1.0],
-                _ => [px[0], px[1], px[2], px[3]],
-            });
+            rgba[dst..dst + 4].copy_from_slice(&rgba_texel(&finest[src..src + c]));
         }
     }
     TextureImage { width: w, height: h, padded_width: pw, padded_height: ph, rgba }
+}
+
+/// Every face's MIP chain of a reconstructed shell texture: its stored levels (mip mode
+/// `stored`), or level 0 decimated down to 1×1 (mip mode `decimated`, SPEC.md 8.3); face
+/// after face, each face's levels in order.
+fn face_chains(layout: &LevelLayout, linear: &[f32]) -> Vec<Vec<Vec<f32>>> {
+    let (n, c) = (layout.width, layout.channels);
+    let levels = pis_format::mip::mip_count(n, n);
+    let mut faces = Vec::with_capacity(layout.faces as usize);
+    let mut at = 0;
+    for _ in 0..layout.faces {
+        let mut chain: Vec<Vec<f32>> = Vec::with_capacity(levels as usize);
+        for m in 0..levels {
+            let (w, h) = mip_size(n, n, m);
+            let len = (w * h * c) as usize;
+            if m < layout.mips {
+                chain.push(linear[at..at + len].to_vec());
+                at += len;
+            } else {
+                let (pw, ph) = mip_size(n, n, m - 1);
+                let coarser = decimate(&chain[m as usize - 1], pw, ph, c);
+                chain.push(coarser);
+            }
+        }
+        faces.push(chain);
+    }
+    faces
+}
+
+/// Rebuilds a shell's cube map: [`reconstruct`], each face's MIP chain from its finest drawn
+/// level (level `drop_levels` of the stored chain, for a resolution reduction) down to 1×1,
+/// as RGBA (a 3-channel shell opaque: alpha 1).
+pub fn assemble_cube(job: &AssembleJob) -> CubeImage {
+    let linear = reconstruct(job);
+    let faces = face_chains(&job.layout, &linear);
+    let full = TextureLayout::cube(job.layout.width);
+    let drop = job.drop_levels.min(full.levels - 1);
+    let (size, _) = full.level_size(drop);
+    let layout = TextureLayout { width: size, height: size, levels: full.levels - drop, faces: 6 };
+    let c = job.layout.channels as usize;
+    let mut rgba = Vec::with_capacity(layout.texel_count() * 4);
+    for chain in &faces {
+        for level in &chain[drop as usize..] {
+            level.chunks_exact(c).for_each(|px| rgba.extend_from_slice(&rgba_texel(px)));
+        }
+    }
+    CubeImage { layout, rgba }
 }
 
 impl Decoder {
@@ -119,5 +189,95 @@ impl Decoder {
     /// Rebuilds textures on the workers; the caller waits.
     pub fn assemble(&self, jobs: &[AssembleJob]) -> Vec<TextureImage> {
         self.pool.install(|| jobs.par_iter().map(assemble).collect())
+    }
+
+    /// Rebuilds cube maps on the workers; the caller waits.
+    pub fn assemble_cubes(&self, jobs: &[AssembleJob]) -> Vec<CubeImage> {
+        self.pool.install(|| jobs.par_iter().map(assemble_cube).collect())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use pis_format::mip::mip_count;
+    use pis_format::reconstruct::prepare;
+    use pis_format::{Combine, DepMask, LayerKind, Mapping, MipMode, Term};
+
+    fn shell_layer(channels: u8, mip_mode: MipMode) -> Layer<StreamRef> {
+        Layer { kind: LayerKind::EnvLocal, mapping: Mapping::Shell, channels, mip_mode, term: Term::Reflection, order: 0, combine: Combine::Over, gamma: 2.2, depends_on: DepMask::NONE, blocks: vec![] }
+    }
+
+    /// The level images a writer stores for `linear` (gamma, MIP residuals), split into two
+    /// pyramid levels that sum to them.
+    fn job<'a>(layer: &'a Layer<StreamRef>, layout: &LevelLayout, linear: &[f32], drop_levels: u32) -> AssembleJob<'a> {
+        let stored = prepare(layer, layout, linear);
+        let top: Vec<f32> = stored.iter().map(|v| v * 0.25).collect();
+        let rest: Vec<f32> = stored.iter().zip(&top).map(|(v, t)| v - t).collect();
+        AssembleJob { layer, layout: layout.clone(), levels: vec![Arc::new(top), Arc::new(rest)], drop_levels }
+    }
+
+    fn values(n: usize) -> Vec<f32> {
+        (0..n).map(|k| ((k as u64 * 2654435761 % 1000) as f32) / 1000.0).collect()
+    }
+
+    #[test]
+    fn a_stored_cube_map_is_rebuilt_face_after_face_level_after_level() {
+        let layer = shell_layer(4, MipMode::Stored);
+        let layout = LevelLayout { width: 5, height: 5, channels: 4, faces: 6, mips: mip_count(5, 5) };
+        let n: usize = layout.planes().iter().map(|p| (p.width * p.height * p.channels) as usize).sum();
+        let linear = values(n);
+        let cube = assemble_cube(&job(&layer, &layout, &linear, 0));
+        assert_eq!(cube.layout, TextureLayout::cube(5));
+        assert_eq!(cube.rgba.len(), cube.layout.texel_count() * 4);
+        let worst = cube.rgba.iter().zip(&linear).map(|(a, b)| (a - b).abs()).fold(0.0, f32::max);
+        assert!(worst < 1e-5, "{worst}");
+    }
+
+    #[test]
+    fn a_reduced_rgb_cube_map_starts_at_a_coarser_level_and_is_opaque() {
+        let layer = shell_layer(3, MipMode::Stored);
+        let layout = LevelLayout { width: 6, height: 6, channels: 3, faces: 6, mips: mip_count(6, 6) };
+        let planes = layout.planes();
+        let n: usize = planes.iter().map(|p| (p.width * p.height * 3) as usize).sum();
+        let linear = values(n);
+        let cube = assemble_cube(&job(&layer, &layout, &linear, 1));
+        assert_eq!(cube.layout, TextureLayout::cube(3));
+        // Per face, the stored levels 1.. as RGBA with alpha 1.
+        let mut want = Vec::new();
+        let mut at = 0;
+        for (k, p) in planes.iter().enumerate() {
+            let len = (p.width * p.height * 3) as usize;
+            if !(k as u32).is_multiple_of(layout.mips) {
+                linear[at..at + len].chunks_exact(3).for_each(|t| want.extend([t[0], t[1], t[2], 1.0]));
+            }
+            at += len;
+        }
+        assert_eq!(cube.rgba.len(), want.len());
+        let worst = cube.rgba.iter().zip(&want).map(|(a, b)| (a - b).abs()).fold(0.0, f32::max);
+        assert!(worst < 1e-5, "{worst}");
+    }
+
+    #[test]
+    fn a_decimated_cube_map_gets_its_chain_by_decimation() {
+        let layer = shell_layer(4, MipMode::Decimated);
+        let layout = LevelLayout { width: 3, height: 3, channels: 4, faces: 6, mips: 1 };
+        let linear = values(6 * 9 * 4);
+        let cube = assemble_cube(&job(&layer, &layout, &linear, 0));
+        assert_eq!(cube.layout, TextureLayout::cube(3));
+        for face in 0..6u32 {
+            let finest = &linear[face as usize * 36..face as usize * 36 + 36];
+            let mut level = finest.to_vec();
+            for m in 0..cube.layout.levels {
+                if m > 0 {
+                    let (w, h) = mip_size(3, 3, m - 1);
+                    level = decimate(&level, w, h, 4);
+                }
+                let start = cube.layout.face_texel(face, m, 0, 0) * 4;
+                let got = &cube.rgba[start..start + level.len()];
+                let worst = got.iter().zip(&level).map(|(a, b)| (a - b).abs()).fold(0.0, f32::max);
+                assert!(worst < 1e-5, "face {face} level {m}: {worst}");
+            }
+        }
     }
 }

@@ -1,11 +1,15 @@
 //! Drawing a frame (`frame.wgsl`): a pass that writes depth and the object index of every
 //! pixel's nearest surface, then one additive draw per object, layer and parameter sample,
 //! with the block's texture transform (branch cuts, then the affine map) in the vertex
-//! shader and the hardware model's LOD and sampler in the fragment shader. Layers add in linear space (SPEC.md "Combining
-//! layers": surface layers combine by addition). With more than one sample per pixel
-//! (`multisample.rs`) depth and object indices are kept per sample and the colour is
-//! resolved into the target: by the hardware's average of each pixel's own samples, or,
-//! given the ray-traced set's display filter, by the display-filter resolve (`resolve.rs`).
+//! shader and the hardware model's LOD and sampler in the fragment shader, and one additive
+//! draw of the reflection term per reflective object and parameter sample
+//! (`frame_reflection.wgsl`: the environment-map shells looked up as the hardware model
+//! does, composited "over", times Fresnel). Layers and terms add in linear space (SPEC.md 9:
+//! surface layers combine by addition, radiance = surface + F · reflection). With more than
+//! one sample per pixel (`multisample.rs`) depth and object indices are kept per sample and
+//! the colour is resolved into the target: by the hardware's average of each pixel's own
+//! samples, or, given the ray-traced set's display filter, by the display-filter resolve
+//! (`resolve.rs`).
 
 use std::collections::HashMap;
 
@@ -16,10 +20,15 @@ use crate::error::PlayError;
 use crate::gpu::Gpu;
 use crate::image::FloatImage;
 use crate::resolve::ResolvePipelines;
+use crate::shell::{shell_uniform, ShellTexture, SHELL_FUNCTIONS};
 use crate::textured::{allocated_size, cut_uniform, ObjectTexture, DEPTH_FORMAT};
 
 /// The WGSL source.
 pub const SHADER: &str = include_str!("frame.wgsl");
+/// The reflection term's entry points, appended to [`SHELL_FUNCTIONS`].
+pub const REFLECTION: &str = include_str!("frame_reflection.wgsl");
+/// The most shells a reflection term draws in one pass (orders 0 and 1).
+pub const MAX_TERM_SHELLS: usize = 2;
 /// The object-index target's format.
 pub const ID_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Uint;
 /// Object index of pixels no object covers.
@@ -42,9 +51,35 @@ struct Uniforms {
     cut: [f32; 4],
 }
 
+/// `ShellSlot` of `frame_reflection.wgsl` (64 bytes).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+struct ShellSlot {
+    origin_shape: [f32; 4],
+    a: [f32; 4],
+    b: [f32; 4],
+    size_levels: [u32; 4],
+}
+
+/// `ReflectionUniforms` of `frame_reflection.wgsl` (304 bytes).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+struct ReflectionUniforms {
+    clip_from_object: [f32; 16],
+    world_from_object: [f32; 16],
+    eye: [f32; 4],
+    f0_weight: [f32; 4],
+    shells: [ShellSlot; MAX_TERM_SHELLS],
+    object: u32,
+    count: u32,
+    _pad: [u32; 2],
+}
+
 /// An object's mesh on the GPU.
 pub struct MeshGpu {
     pub positions: wgpu::Buffer,
+    /// Object-space vertex normals (zeros for a mesh without normals).
+    pub normals: wgpu::Buffer,
     pub uvs: wgpu::Buffer,
     pub indices: wgpu::Buffer,
     pub count: u32,
@@ -52,16 +87,20 @@ pub struct MeshGpu {
 
 impl MeshGpu {
     /// Uploads a mesh; the caller has checked every index against the positions, and that
-    /// there is one texture coordinate per position.
-    pub fn new(gpu: &Gpu, positions: &[[f32; 3]], uvs: &[[f32; 2]], indices: &[u32]) -> MeshGpu {
+    /// there is one texture coordinate and, if given, one normal per position. Without
+    /// normals the normal buffer holds zeros.
+    pub fn new(gpu: &Gpu, positions: &[[f32; 3]], normals: Option<&[[f32; 3]]>, uvs: &[[f32; 2]], indices: &[u32]) -> MeshGpu {
         let d = &gpu.device;
         let init = |label: &str, contents: &[u8], usage| d.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: Some(label), contents, usage });
         // A zero-length buffer cannot be bound: pad empty inputs.
         let p: &[[f32; 3]] = if positions.is_empty() { &[[0.0; 3]] } else { positions };
+        let zeros = vec![[0.0f32; 3]; p.len()];
+        let n: &[[f32; 3]] = normals.filter(|n| !n.is_empty()).unwrap_or(&zeros);
         let t: &[[f32; 2]] = if uvs.is_empty() { &[[0.0; 2]] } else { uvs };
         let i: &[u32] = if indices.is_empty() { &[0] } else { indices };
         MeshGpu {
             positions: init("positions", bytemuck::cast_slice(p), wgpu::BufferUsages::VERTEX),
+            normals: init("normals", bytemuck::cast_slice(n), wgpu::BufferUsages::VERTEX),
             uvs: init("uvs", bytemuck::cast_slice(t), wgpu::BufferUsages::VERTEX),
             indices: init("indices", bytemuck::cast_slice(i), wgpu::BufferUsages::INDEX),
             count: indices.len() as u32 / 3 * 3,
@@ -90,19 +129,42 @@ pub struct LayerDraw<'a> {
     pub anisotropic: bool,
 }
 
-/// The frame's pipelines: object index and depth per sample count, and additive layers per
-/// target format and sample count.
+/// One reflection term drawn on an object (SPEC.md 9, thesis ch. 5): its environment-map
+/// shells at one parameter sample, with the sample's weight.
+pub struct ReflectionDraw<'a> {
+    /// Index into the frame's objects.
+    pub draw: usize,
+    /// The object's world transform (rigid): world positions and normals.
+    pub world_from_object: glam::Mat4,
+    /// The frame's camera position (world space).
+    pub eye: glam::Vec3,
+    /// The object's reflectance at normal incidence (Schlick's F0, linear RGB).
+    pub f0: [f32; 3],
+    /// Multilinear weight of this parameter sample.
+    pub weight: f32,
+    /// The term's shells in increasing order (order 0 nearest), each with its cube map:
+    /// 1 to [`MAX_TERM_SHELLS`] (the player checks the count when it opens a file).
+    pub shells: Vec<(pis_compile::shell::Shell, &'a ShellTexture)>,
+}
+
+/// The frame's pipelines: object index and depth per sample count, and additive layers and
+/// reflection terms per target format and sample count.
 pub struct FramePipelines {
     module: wgpu::ShaderModule,
+    reflection_module: wgpu::ShaderModule,
     uniform_layout: wgpu::BindGroupLayout,
     draw_layout: wgpu::BindGroupLayout,
+    reflection_draw_layout: wgpu::BindGroupLayout,
     ids_layout: wgpu::BindGroupLayout,
     ids_ms_layout: wgpu::BindGroupLayout,
     id_layout: wgpu::PipelineLayout,
     layer_layout: wgpu::PipelineLayout,
     layer_ms_layout: wgpu::PipelineLayout,
+    reflection_layout: wgpu::PipelineLayout,
+    reflection_ms_layout: wgpu::PipelineLayout,
     id_pipelines: HashMap<u32, wgpu::RenderPipeline>,
     layer_pipelines: HashMap<(wgpu::TextureFormat, u32), wgpu::RenderPipeline>,
+    reflection_pipelines: HashMap<(wgpu::TextureFormat, u32), wgpu::RenderPipeline>,
     resolve: ResolvePipelines,
 }
 
@@ -116,6 +178,13 @@ const UV_LAYOUT: wgpu::VertexBufferLayout<'static> = wgpu::VertexBufferLayout {
     step_mode: wgpu::VertexStepMode::Vertex,
     attributes: &[wgpu::VertexAttribute { format: wgpu::VertexFormat::Float32x2, offset: 0, shader_location: 1 }],
 };
+const NORMAL_LAYOUT: wgpu::VertexBufferLayout<'static> = wgpu::VertexBufferLayout {
+    array_stride: 12,
+    step_mode: wgpu::VertexStepMode::Vertex,
+    attributes: &[wgpu::VertexAttribute { format: wgpu::VertexFormat::Float32x3, offset: 0, shader_location: 2 }],
+};
+/// A cube map as `frame_reflection.wgsl` reads it: a 2D array read with `textureLoad`.
+const CUBE: wgpu::BindingType = wgpu::BindingType::Texture { sample_type: wgpu::TextureSampleType::Float { filterable: false }, view_dimension: wgpu::TextureViewDimension::D2Array, multisampled: false };
 
 fn entry(binding: u32, visibility: wgpu::ShaderStages, ty: wgpu::BindingType) -> wgpu::BindGroupLayoutEntry {
     wgpu::BindGroupLayoutEntry { binding, visibility, ty, count: None }
@@ -128,10 +197,31 @@ fn multisample(count: u32) -> wgpu::MultisampleState {
     wgpu::MultisampleState { count, mask: !0, alpha_to_coverage_enabled: false }
 }
 
+/// The additive pass's colour target: colour adds, alpha (coverage) takes the maximum.
+fn additive_target(format: wgpu::TextureFormat) -> wgpu::ColorTargetState {
+    let add = wgpu::BlendComponent { src_factor: wgpu::BlendFactor::One, dst_factor: wgpu::BlendFactor::One, operation: wgpu::BlendOperation::Add };
+    let max = wgpu::BlendComponent { src_factor: wgpu::BlendFactor::One, dst_factor: wgpu::BlendFactor::One, operation: wgpu::BlendOperation::Max };
+    wgpu::ColorTargetState { format, blend: Some(wgpu::BlendState { color: add, alpha: max }), write_mask: wgpu::ColorWrites::ALL }
+}
+
+/// The additive pass's depth state: tested against the id pass's depth (equal passes), not
+/// written.
+fn additive_depth() -> wgpu::DepthStencilState {
+    wgpu::DepthStencilState {
+        format: DEPTH_FORMAT,
+        depth_write_enabled: Some(false),
+        depth_compare: Some(wgpu::CompareFunction::LessEqual),
+        stencil: Default::default(),
+        bias: Default::default(),
+    }
+}
+
 impl FramePipelines {
     pub fn new(gpu: &Gpu) -> FramePipelines {
         let d = &gpu.device;
         let module = d.create_shader_module(wgpu::ShaderModuleDescriptor { label: Some("frame.wgsl"), source: wgpu::ShaderSource::Wgsl(SHADER.into()) });
+        let reflection_source = format!("{SHELL_FUNCTIONS}\n{REFLECTION}");
+        let reflection_module = d.create_shader_module(wgpu::ShaderModuleDescriptor { label: Some("frame_reflection.wgsl"), source: wgpu::ShaderSource::Wgsl(reflection_source.into()) });
         let vf = wgpu::ShaderStages::VERTEX_FRAGMENT;
         let uniform_layout = d.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some("frame uniforms"), entries: &[entry(0, vf, UNIFORM)] });
         let draw_layout = d.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
@@ -142,23 +232,32 @@ impl FramePipelines {
                 entry(2, wgpu::ShaderStages::FRAGMENT, wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering)),
             ],
         });
+        let fragment = wgpu::ShaderStages::FRAGMENT;
+        let reflection_draw_layout = d.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some("frame reflection"), entries: &[entry(0, vf, UNIFORM), entry(1, fragment, CUBE), entry(2, fragment, CUBE)] });
         let ids_entry = |binding, multisampled| entry(binding, wgpu::ShaderStages::FRAGMENT, wgpu::BindingType::Texture { sample_type: wgpu::TextureSampleType::Uint, view_dimension: wgpu::TextureViewDimension::D2, multisampled });
         let ids_layout = d.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some("frame ids"), entries: &[ids_entry(0, false)] });
         let ids_ms_layout = d.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some("frame ids per sample"), entries: &[ids_entry(1, true)] });
         let id_layout = d.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor { label: Some("frame ids"), bind_group_layouts: &[Some(&uniform_layout)], immediate_size: 0 });
         let layer_layout = d.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor { label: Some("frame layers"), bind_group_layouts: &[Some(&draw_layout), Some(&ids_layout)], immediate_size: 0 });
         let layer_ms_layout = d.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor { label: Some("frame layers per sample"), bind_group_layouts: &[Some(&draw_layout), Some(&ids_ms_layout)], immediate_size: 0 });
+        let reflection_layout = d.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor { label: Some("frame reflections"), bind_group_layouts: &[Some(&reflection_draw_layout), Some(&ids_layout)], immediate_size: 0 });
+        let reflection_ms_layout = d.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor { label: Some("frame reflections per sample"), bind_group_layouts: &[Some(&reflection_draw_layout), Some(&ids_ms_layout)], immediate_size: 0 });
         let mut pipes = FramePipelines {
             module,
+            reflection_module,
             uniform_layout,
             draw_layout,
+            reflection_draw_layout,
             ids_layout,
             ids_ms_layout,
             id_layout,
             layer_layout,
             layer_ms_layout,
+            reflection_layout,
+            reflection_ms_layout,
             id_pipelines: HashMap::new(),
             layer_pipelines: HashMap::new(),
+            reflection_pipelines: HashMap::new(),
             resolve: ResolvePipelines::new(gpu),
         };
         pipes.id_pipeline(gpu, 1);
@@ -200,27 +299,35 @@ impl FramePipelines {
         let module = &self.module;
         let (layout, entry_point) = if samples > 1 { (&self.layer_ms_layout, "fs_layer_ms") } else { (&self.layer_layout, "fs_layer") };
         self.layer_pipelines.entry((format, samples)).or_insert_with(|| {
-            let add = wgpu::BlendComponent { src_factor: wgpu::BlendFactor::One, dst_factor: wgpu::BlendFactor::One, operation: wgpu::BlendOperation::Add };
-            let max = wgpu::BlendComponent { src_factor: wgpu::BlendFactor::One, dst_factor: wgpu::BlendFactor::One, operation: wgpu::BlendOperation::Max };
             gpu.device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
                 label: Some("frame layers"),
                 layout: Some(layout),
                 vertex: wgpu::VertexState { module, entry_point: Some("vs_main"), compilation_options: Default::default(), buffers: &[Some(POSITION_LAYOUT), Some(UV_LAYOUT)] },
                 primitive: wgpu::PrimitiveState { topology: wgpu::PrimitiveTopology::TriangleList, cull_mode: None, ..Default::default() },
-                depth_stencil: Some(wgpu::DepthStencilState {
-                    format: DEPTH_FORMAT,
-                    depth_write_enabled: Some(false),
-                    depth_compare: Some(wgpu::CompareFunction::LessEqual),
-                    stencil: Default::default(),
-                    bias: Default::default(),
-                }),
+                depth_stencil: Some(additive_depth()),
                 multisample: multisample(samples),
-                fragment: Some(wgpu::FragmentState {
-                    module,
-                    entry_point: Some(entry_point),
-                    compilation_options: Default::default(),
-                    targets: &[Some(wgpu::ColorTargetState { format, blend: Some(wgpu::BlendState { color: add, alpha: max }), write_mask: wgpu::ColorWrites::ALL })],
-                }),
+                fragment: Some(wgpu::FragmentState { module, entry_point: Some(entry_point), compilation_options: Default::default(), targets: &[Some(additive_target(format))] }),
+                multiview_mask: None,
+                cache: None,
+            })
+        })
+    }
+
+    /// The additive reflection-term pipeline for a target format and `samples` per pixel
+    /// (compiled on first use): `fs_reflection`, or `fs_reflection_ms` with object indices
+    /// per sample; positions and normals as vertex buffers 0 and 1.
+    pub fn reflection_pipeline(&mut self, gpu: &Gpu, format: wgpu::TextureFormat, samples: u32) -> &wgpu::RenderPipeline {
+        let module = &self.reflection_module;
+        let (layout, entry_point) = if samples > 1 { (&self.reflection_ms_layout, "fs_reflection_ms") } else { (&self.reflection_layout, "fs_reflection") };
+        self.reflection_pipelines.entry((format, samples)).or_insert_with(|| {
+            gpu.device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+                label: Some("frame reflections"),
+                layout: Some(layout),
+                vertex: wgpu::VertexState { module, entry_point: Some("vs_reflection"), compilation_options: Default::default(), buffers: &[Some(POSITION_LAYOUT), Some(NORMAL_LAYOUT)] },
+                primitive: wgpu::PrimitiveState { topology: wgpu::PrimitiveTopology::TriangleList, cull_mode: None, ..Default::default() },
+                depth_stencil: Some(additive_depth()),
+                multisample: multisample(samples),
+                fragment: Some(wgpu::FragmentState { module, entry_point: Some(entry_point), compilation_options: Default::default(), targets: &[Some(additive_target(format))] }),
                 multiview_mask: None,
                 cache: None,
             })
@@ -334,6 +441,38 @@ fn uniforms(clip_from_object: glam::Mat4, object: u32, layer: Option<&LayerDraw>
     u
 }
 
+/// The uniforms of a reflection term drawn on `object`.
+fn reflection_uniforms(object: &ObjectDraw, r: &ReflectionDraw) -> ReflectionUniforms {
+    let mut shells = [ShellSlot::zeroed(); MAX_TERM_SHELLS];
+    for (slot, (shell, cube)) in shells.iter_mut().zip(&r.shells) {
+        let (origin_shape, a, b) = shell_uniform(shell);
+        *slot = ShellSlot { origin_shape, a, b, size_levels: [cube.layout.width, cube.layout.levels, 0, 0] };
+    }
+    ReflectionUniforms {
+        clip_from_object: object.clip_from_object.to_cols_array(),
+        world_from_object: r.world_from_object.to_cols_array(),
+        eye: [r.eye.x, r.eye.y, r.eye.z, 1.0],
+        f0_weight: [r.f0[0], r.f0[1], r.f0[2], r.weight],
+        shells,
+        object: object.object,
+        count: r.shells.len().min(MAX_TERM_SHELLS) as u32,
+        _pad: [0; 2],
+    }
+}
+
+/// The bind group of a reflection term drawn on `object`: its uniforms and the cube maps of
+/// its shells 0 and 1 (shell 0's twice for a one-shell term).
+fn reflection_bind(gpu: &Gpu, layout: &wgpu::BindGroupLayout, object: &ObjectDraw, r: &ReflectionDraw) -> wgpu::BindGroup {
+    let d = &gpu.device;
+    let u = d.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: Some("reflection uniforms"), contents: bytemuck::bytes_of(&reflection_uniforms(object, r)), usage: wgpu::BufferUsages::UNIFORM });
+    let cube = |k: usize| wgpu::BindingResource::TextureView(&r.shells[k.min(r.shells.len() - 1)].1.view);
+    d.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some("reflection"),
+        layout,
+        entries: &[wgpu::BindGroupEntry { binding: 0, resource: u.as_entire_binding() }, wgpu::BindGroupEntry { binding: 1, resource: cube(0) }, wgpu::BindGroupEntry { binding: 2, resource: cube(1) }],
+    })
+}
+
 /// The object-index pass: clears `ids` and `depth`, then draws every object's index and
 /// depth, nearest surface winning.
 fn id_pass(pipeline: &wgpu::RenderPipeline, ids: &wgpu::Texture, depth: &wgpu::Texture, objects: &[ObjectDraw], binds: &[wgpu::BindGroup], encoder: &mut wgpu::CommandEncoder) {
@@ -373,7 +512,8 @@ fn id_pass(pipeline: &wgpu::RenderPipeline, ids: &wgpu::Texture, depth: &wgpu::T
 /// neighbourhood, the samples drawn in the offscreen format; without, by the hardware's
 /// average of each pixel's own samples). `object_ids`: also leave every pixel's object index
 /// at its centre in `targets.ids` (single-sample frames always do; multisampled ones draw one
-/// more index pass for it). Single-sample frames ignore `display`.
+/// more index pass for it). Single-sample frames ignore `display`. The additive pass draws
+/// `layers`, then `reflections` (a draw without shells draws nothing).
 #[allow(clippy::too_many_arguments)]
 pub fn encode(
     gpu: &Gpu,
@@ -383,6 +523,7 @@ pub fn encode(
     format: wgpu::TextureFormat,
     objects: &[ObjectDraw],
     layers: &[LayerDraw],
+    reflections: &[ReflectionDraw],
     object_ids: bool,
     display: Option<pis_format::DisplayFilter>,
     encoder: &mut wgpu::CommandEncoder,
@@ -395,6 +536,10 @@ pub fn encode(
     let sample_format = if display.is_some() { offscreen_format(gpu) } else { format };
     pipes.id_pipeline(gpu, samples);
     pipes.layer_pipeline(gpu, sample_format, samples);
+    let reflections: Vec<&ReflectionDraw> = reflections.iter().filter(|r| !r.shells.is_empty()).collect();
+    if !reflections.is_empty() {
+        pipes.reflection_pipeline(gpu, sample_format, samples);
+    }
     let ubuf = |u: Uniforms| d.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: Some("frame uniforms"), contents: bytemuck::bytes_of(&u), usage: wgpu::BufferUsages::UNIFORM });
     let id_binds: Vec<wgpu::BindGroup> = objects
         .iter()
@@ -419,6 +564,7 @@ pub fn encode(
             })
         })
         .collect();
+    let reflection_binds: Vec<wgpu::BindGroup> = reflections.iter().map(|r| reflection_bind(gpu, &pipes.reflection_draw_layout, &objects[r.draw], r)).collect();
     let size = targets.size;
     // The attachments the layers are drawn into: (colour, resolve target, depth, ids).
     let (sample_colour, depth, ids_bind) = match &mut targets.multi {
@@ -470,6 +616,18 @@ pub fn encode(
         pass.set_vertex_buffer(1, m.uvs.slice(..));
         pass.set_index_buffer(m.indices.slice(..), wgpu::IndexFormat::Uint32);
         pass.draw_indexed(0..m.count, 0, 0..1);
+    }
+    if !reflections.is_empty() {
+        pass.set_pipeline(&pipes.reflection_pipelines[&(sample_format, samples)]);
+        pass.set_bind_group(1, ids_bind, &[]);
+        for (r, bg) in reflections.iter().zip(&reflection_binds) {
+            let m = objects[r.draw].mesh;
+            pass.set_bind_group(0, bg, &[]);
+            pass.set_vertex_buffer(0, m.positions.slice(..));
+            pass.set_vertex_buffer(1, m.normals.slice(..));
+            pass.set_index_buffer(m.indices.slice(..), wgpu::IndexFormat::Uint32);
+            pass.draw_indexed(0..m.count, 0, 0..1);
+        }
     }
     drop(pass);
     if let (Some(filter), Some(m)) = (display, &mut targets.multi) {
@@ -544,6 +702,13 @@ mod tests {
         let start = src.find(&format!("fn {name}(")).unwrap_or_else(|| panic!("no fn {name}"));
         let end = src[start..].find("\n}").expect("closing brace") + start + 2;
         src[start..end].to_string()
+    }
+
+    #[test]
+    fn reflection_uniforms_have_the_wgsl_layout() {
+        // ShellSlot: 4 vec4s; ReflectionUniforms: 2 mat4x4, 2 vec4, 2 slots, 4 u32.
+        assert_eq!(std::mem::size_of::<super::ShellSlot>(), 64);
+        assert_eq!(std::mem::size_of::<super::ReflectionUniforms>(), 2 * 64 + 2 * 16 + 2 * 64 + 16);
     }
 
     #[test]

@@ -7,6 +7,9 @@
 // per sample: `fs_layer_ms` shades once per pixel, exactly as `fs_layer` does, and covers
 // the samples whose nearest surface is this object; the resolve averages the samples.
 //
+// The reflection term of reflective objects is drawn in the same additive pass by
+// frame_reflection.wgsl, whose vertex shader computes the clip position as `vs_main` does.
+//
 // `cut_uv`, `texcoord` and `texture_lod` are textured.wgsl's, character for character (a test
 // compares them): the twins of pis-compile's hardware model. Change them together.
 

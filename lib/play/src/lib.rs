@@ -3,8 +3,10 @@
 //! float target; probe mode (thesis 3.4.3), which measures an object's render matrix through
 //! that pipeline; and the runtime (thesis 4.7, [`Player`]): random-access reading of a
 //! `.pis`, decoding on worker threads through a level-image cache with lifetimes, GPU MIP
-//! chains, and frames of every object with its layers, multisampled on silhouettes
-//! (`multisample.rs`) and resolved with the ray-traced set's display filter (`resolve.rs`).
+//! chains, and frames of every object with its surface layers and, for reflective objects,
+//! its reflection term (environment-map shells, `shell.rs`, looked up as the hardware model
+//! does, composited "over", times Fresnel), multisampled on silhouettes (`multisample.rs`)
+//! and resolved with the ray-traced set's display filter (`resolve.rs`).
 //!
 //! Without a GPU, wgpu runs on Mesa's lavapipe: `apt-get install -y mesa-vulkan-drivers`.
 

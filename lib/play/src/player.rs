@@ -1,30 +1,35 @@
 //! The player (thesis 4.7): opens a `.pis` for random access, and per frame decodes on
 //! worker threads the level images on the pyramid paths of the parameter samples it draws
 //! (through the level-image cache), rebuilds those textures, uploads them and builds their
-//! MIP chains on the GPU, and draws every object with its block's texture transform (branch
-//! cuts, then the affine map), layers added in linear space, objects depth-tested against
-//! each other.
+//! MIP chains on the GPU (a shell's cube map with every face and stored MIP level), and
+//! draws every object with its block's texture transform (branch cuts, then the affine map),
+//! layers added in linear space, objects depth-tested against each other; an object with
+//! environment-map shells in its reflection term also gets that term (the shells composited
+//! "over", times Fresnel from its f0, SPEC.md 9) per parameter sample, with the sample's
+//! weight. Refraction-term shells are not drawn.
 
 use std::collections::HashMap;
 use std::path::Path;
 use std::sync::Arc;
 use std::time::Instant;
 
+use pis_compile::shell::Shell;
 use pis_compile::{Address, Filter, Sampler, TextureLayout, TextureTransform};
 use pis_format::blocks::{level_image_index, BlockGrid};
 use pis_format::texture::LevelLayout;
-use pis_format::{Container, Placement, PisReader, StreamRef};
+use pis_format::{Container, DepMask, Mapping, Placement, PisReader, StreamRef, Term};
 
 use crate::blend::{check_point, merge_for_mask, nearest_sample, weighted_samples, Blend};
 use crate::cache::{LevelCache, LevelKey};
 use crate::camera::{mat4_from_rows, projection, CameraChoice, ViewCamera};
 use crate::decode::{AssembleJob, Decoder, LevelJob};
 use crate::error::PlayError;
-use crate::frame::{colour_image, offscreen_format, FramePipelines, LayerDraw, MeshGpu, ObjectDraw, Readback, Targets};
+use crate::frame::{colour_image, offscreen_format, FramePipelines, LayerDraw, MeshGpu, ObjectDraw, Readback, ReflectionDraw, Targets, MAX_TERM_SHELLS};
 use crate::gpu::Gpu;
 use crate::image::FloatImage;
 use crate::mip::MipBuilder;
 use crate::multisample::{check_samples, choose, Multisample, DEFAULT_SAMPLES};
+use crate::shell::ShellTexture;
 use crate::textured::{create_sampler, ObjectTexture};
 
 /// The player's settings.
@@ -85,13 +90,21 @@ pub struct FrameStats {
     pub cache_bytes: u64,
     /// Codestreams read from the file for this frame.
     pub codestreams_read: u64,
+    /// Draws of surface layers (one per object, layer and parameter sample).
+    pub surface_draws: u64,
+    /// Draws of reflection terms (one per reflective object and parameter sample, each
+    /// looking up all the term's shells).
+    pub shell_draws: u64,
 }
 
 /// An object's mesh on the GPU and the layers the player draws.
 struct ObjectGpu {
     mesh: MeshGpu,
-    /// Surface layers (shell layers are not drawn by this player).
+    /// Surface layers.
     layers: Vec<usize>,
+    /// The reflection term's shell layers in increasing order (at most
+    /// [`MAX_TERM_SHELLS`]); empty for an object without them or without normals.
+    reflection: Vec<usize>,
 }
 
 /// A rebuilt texture: object, layer, block, the image of every pyramid level it sums.
@@ -103,9 +116,15 @@ struct TextureKey {
     images: Vec<u32>,
 }
 
+/// A texture on the GPU: a surface texture with its MIP chain, or a shell's cube map.
+enum GpuTexture {
+    Surface(ObjectTexture),
+    Shell(ShellTexture),
+}
+
 /// A texture on the GPU and the frame that last drew it.
 struct Resident {
-    texture: ObjectTexture,
+    texture: GpuTexture,
     last_frame: u64,
 }
 
@@ -116,6 +135,32 @@ struct Wanted {
     weight: f32,
     transform: TextureTransform,
     repeat: [bool; 2],
+}
+
+/// One reflection term a frame draws: an object's shells at one parameter sample.
+struct WantedReflection {
+    draw: usize,
+    weight: f32,
+    /// Per shell of the term, in order: its texture and its geometry.
+    shells: Vec<(TextureKey, Shell)>,
+}
+
+/// What a frame draws: per object its clip and world transforms, the frame's camera
+/// position, and the textures and reflection terms of the parameter samples.
+struct Plan {
+    clips: Vec<glam::Mat4>,
+    worlds: Vec<glam::Mat4>,
+    eye: glam::Vec3,
+    surfaces: Vec<Wanted>,
+    reflections: Vec<WantedReflection>,
+}
+
+impl Plan {
+    /// Every texture the frame draws (a texture drawn twice is listed twice).
+    fn keys(&self) -> Vec<&TextureKey> {
+        let shells = self.reflections.iter().flat_map(|r| r.shells.iter().map(|(k, _)| k));
+        self.surfaces.iter().map(|w| &w.key).chain(shells).collect()
+    }
 }
 
 /// An offscreen frame read back: colour and, when asked for, object indices.
@@ -184,22 +229,24 @@ fn prepare_objects(gpu: &Gpu, reader: &PisReader) -> Result<Vec<ObjectGpu>, Play
         if let Some(bad) = o.mesh.indices.iter().find(|&&i| i as usize >= n) {
             return Err(content(reader, format!("object {oi} '{}': index {bad} with {n} positions", o.name)));
         }
+        if let Some(normals) = o.mesh.normals.as_ref().filter(|v| v.len() != n) {
+            return Err(content(reader, format!("object {oi} '{}': {} normals for {n} positions", o.name, normals.len())));
+        }
         let mut layers = Vec::new();
         for (li, l) in o.layers.iter().enumerate() {
-            let surface = l.blocks.iter().all(|b| matches!(b.placement, Placement::Surface { .. }));
-            if !surface {
-                skipped.push(format!("{}/{}", o.name, l.kind.name()));
+            if !(1..=4).contains(&l.channels) {
+                return Err(content(reader, format!("object {oi} '{}' layer {li} has {} channels", o.name, l.channels)));
+            }
+            if l.mapping == Mapping::Shell {
                 continue;
             }
             if o.mesh.texcoords.is_none() {
                 return Err(content(reader, format!("object {oi} '{}' has a surface layer but no texture coordinates", o.name)));
             }
-            if !(1..=4).contains(&l.channels) {
-                return Err(content(reader, format!("object {oi} '{}' layer {li} has {} channels", o.name, l.channels)));
-            }
             layers.push(li);
         }
-        out.push(ObjectGpu { mesh: MeshGpu::new(gpu, &o.mesh.positions, &uvs, &o.mesh.indices), layers });
+        let reflection = reflection_shells(reader, oi, &mut skipped)?;
+        out.push(ObjectGpu { mesh: MeshGpu::new(gpu, &o.mesh.positions, o.mesh.normals.as_deref(), &uvs, &o.mesh.indices), layers, reflection });
     }
     if !skipped.is_empty() {
         eprintln!("pis-play: note: shell layers are not drawn by this player: {}", skipped.join(", "));
@@ -207,14 +254,74 @@ fn prepare_objects(gpu: &Gpu, reader: &PisReader) -> Result<Vec<ObjectGpu>, Play
     Ok(out)
 }
 
-/// Every surface texture of the file, as the player allocates it (padded to powers of
-/// two), fits the adapter's largest 2D texture: checked at open, before any frame.
+/// The shell layers of object `oi`'s reflection term in increasing order, the player draws
+/// them all in one pass: at most [`MAX_TERM_SHELLS`] (more is not supported), each block a
+/// closed shell (sphere, ellipsoid, box or cylinder; a quad is not supported). Shell layers
+/// the player does not draw — the refraction term's, and every shell of an object without
+/// normals — are listed in `skipped` (`object/kind (why)`).
+fn reflection_shells(reader: &PisReader, oi: usize, skipped: &mut Vec<String>) -> Result<Vec<usize>, PlayError> {
+    let o = &reader.container().objects[oi];
+    let shells = |term| o.layers.iter().enumerate().filter(move |(_, l)| l.mapping == Mapping::Shell && l.term == term);
+    let mut note = |li: usize, why: &str| skipped.push(format!("{}/{} ({why})", o.name, o.layers[li].kind.name()));
+    shells(Term::Refraction).for_each(|(li, _)| note(li, "refraction term"));
+    let mut term: Vec<usize> = shells(Term::Reflection).map(|(li, _)| li).collect();
+    if o.mesh.normals.is_none() {
+        term.iter().for_each(|&li| note(li, "the mesh has no normals"));
+        return Ok(Vec::new());
+    }
+    term.sort_by_key(|&li| o.layers[li].order);
+    let not_supported = |message: String| PlayError::File(pis_format::Error::NotSupported(format!("{}: object {oi} '{}': {message}", reader.path().display(), o.name)));
+    if term.len() > MAX_TERM_SHELLS {
+        return Err(not_supported(format!("{} shells in the reflection term; this player draws at most {MAX_TERM_SHELLS}", term.len())));
+    }
+    for &li in &term {
+        let closed = o.layers[li].blocks.iter().all(|b| matches!(b.placement, Placement::Shell { shape, .. } if shape.faces() == 6));
+        if !closed {
+            return Err(not_supported(format!("layer {li} ({}) is not a closed shell (sphere, ellipsoid, box or cylinder): quad shells are not drawn", o.layers[li].kind.name())));
+        }
+    }
+    Ok(term)
+}
+
+/// The cube-map geometry of a shell block's placement (SPEC.md 7.3); `None` for a quad or a
+/// surface placement.
+fn shell_of(placement: &Placement) -> Option<Shell> {
+    let Placement::Shell { shape, origin, params } = placement else { return None };
+    let mut values = [0.0f32; 12];
+    values[..3].copy_from_slice(origin);
+    values[3..9].copy_from_slice(params);
+    Shell::from_placement(shape.code() as u16, &values)
+}
+
+/// The reflection terms of a plan, with their cube maps on the GPU (`resident`).
+fn reflection_draws<'a>(reader: &PisReader, resident: &'a HashMap<TextureKey, Resident>, plan: &Plan) -> Result<Vec<ReflectionDraw<'a>>, PlayError> {
+    let c = reader.container();
+    let mut out = Vec::with_capacity(plan.reflections.len());
+    for r in &plan.reflections {
+        let mut shells = Vec::with_capacity(r.shells.len());
+        for (key, shell) in &r.shells {
+            let GpuTexture::Shell(cube) = &resident[key].texture else {
+                return Err(content(reader, format!("{key:?}: a surface texture drawn as a shell")));
+            };
+            shells.push((*shell, cube));
+        }
+        out.push(ReflectionDraw { draw: r.draw, world_from_object: plan.worlds[r.draw], eye: plan.eye, f0: c.objects[r.draw].shading.f0, weight: r.weight, shells });
+    }
+    Ok(out)
+}
+
+/// Every surface texture and cube-map face of the file, as the player allocates it (padded
+/// to powers of two), fits the adapter's largest 2D texture: checked at open, before any
+/// frame.
 fn check_texture_sizes(gpu: &Gpu, reader: &PisReader) -> Result<(), PlayError> {
     let limit = gpu.limits.max_texture_dimension_2d;
     for o in &reader.container().objects {
-        for l in o.layers.iter().filter(|l| l.mapping == pis_format::Mapping::Surface) {
+        for l in &o.layers {
             for b in &l.blocks {
-                let (w, h) = crate::textured::allocated_size(&TextureLayout::full(b.width, b.height));
+                let (w, h) = match l.mapping {
+                    Mapping::Surface => crate::textured::allocated_size(&TextureLayout::full(b.width, b.height)),
+                    Mapping::Shell => (b.width.next_power_of_two(), b.height.next_power_of_two()),
+                };
                 if w > limit || h > limit {
                     return Err(PlayError::TextureSize { object: o.name.clone(), width: b.width, height: b.height, limit });
                 }
@@ -247,6 +354,9 @@ impl Player {
         // Compiled now rather than in the first frame's time.
         pipes.id_pipeline(&gpu, ms.samples);
         pipes.layer_pipeline(&gpu, offscreen, ms.samples);
+        if objects.iter().any(|o| !o.reflection.is_empty()) {
+            pipes.reflection_pipeline(&gpu, offscreen, ms.samples);
+        }
         let mips = MipBuilder::new(&gpu);
         Ok(Player {
             gpu,
@@ -379,54 +489,85 @@ impl Player {
         Ok(self.frame(req, size, Target::View(view, format))?.1)
     }
 
-    /// The textures a frame draws, and the frame's objects' clip transforms.
-    fn plan(&self, req: &FrameRequest, size: (u32, u32)) -> Result<(Vec<glam::Mat4>, Vec<Wanted>), PlayError> {
+    /// What a frame draws: the objects' transforms, the camera position, and per object the
+    /// textures of its surface layers and its reflection terms at the parameter samples.
+    fn plan(&self, req: &FrameRequest, size: (u32, u32)) -> Result<Plan, PlayError> {
         let c = self.reader.container();
         let dims = &c.space.dims;
         check_point(dims, &req.point).map_err(PlayError::Request)?;
         let samples = weighted_samples(dims, &req.point, self.options.blend);
         let nearest = nearest_sample(dims, &req.point);
-        let clip_from_world = match req.camera {
+        let (clip_from_world, eye) = match req.camera {
             CameraChoice::Sample => {
                 let cam = self.camera_record(&nearest);
-                let view = mat4_from_rows(&cam.world_from_camera).inverse();
-                projection(cam.yfov, cam.znear, cam.zfar, size.0, size.1) * view
+                let world_from_camera = mat4_from_rows(&cam.world_from_camera);
+                (projection(cam.yfov, cam.znear, cam.zfar, size.0, size.1) * world_from_camera.inverse(), world_from_camera.w_axis.truncate())
             }
             CameraChoice::Free(cam) => {
                 cam.check().map_err(PlayError::Request)?;
-                cam.projection(size) * cam.view_matrix()
+                (cam.projection(size) * cam.view_matrix(), cam.eye)
             }
         };
-        let mut clips = Vec::with_capacity(c.objects.len());
-        let mut wanted = Vec::new();
+        let mut plan = Plan { clips: Vec::with_capacity(c.objects.len()), worlds: Vec::with_capacity(c.objects.len()), eye, surfaces: Vec::new(), reflections: Vec::new() };
         for (oi, (o, og)) in c.objects.iter().zip(&self.objects).enumerate() {
             let t = &o.transforms;
             let world = t.transforms.get(c.space.table_index(t.depends_on, &nearest)).map_or(glam::Mat4::IDENTITY, mat4_from_rows);
-            clips.push(clip_from_world * world);
+            plan.clips.push(clip_from_world * world);
+            plan.worlds.push(world);
             for &li in &og.layers {
-                let layer = &o.layers[li];
-                let grid = BlockGrid::new(&c.space, layer.depends_on, &o.stagger);
-                for (s, w) in merge_for_mask(&samples, layer.depends_on) {
-                    let pos = grid.locate(&s);
-                    let block = layer.blocks.get(pos.block).ok_or_else(|| content(&self.reader, format!("object {oi} layer {li}: block {} missing", pos.block)))?;
+                for (s, w) in merge_for_mask(&samples, o.layers[li].depends_on) {
+                    let (key, block) = self.texture_key(oi, li, &s)?;
                     let Placement::Surface { affine, repeat, cut } = block.placement else { continue };
-                    let images = block.levels.iter().map(|l| level_image_index(&l.counts, &pos.local, &pos.extent) as u32).collect();
-                    let key = TextureKey { object: oi as u32, layer: li as u32, block: pos.block as u32, images };
-                    wanted.push(Wanted { draw: oi, key, weight: w, transform: TextureTransform { values: affine, cut }, repeat });
+                    plan.surfaces.push(Wanted { draw: oi, key, weight: w, transform: TextureTransform { values: affine, cut }, repeat });
                 }
             }
+            plan.reflections.extend(self.reflection_terms(oi, &samples)?);
         }
-        Ok((clips, wanted))
+        Ok(plan)
+    }
+
+    /// The texture of object `oi`'s layer `li` at parameter sample `sample`: its key and its
+    /// block.
+    fn texture_key(&self, oi: usize, li: usize, sample: &[u32]) -> Result<(TextureKey, &pis_format::Block<StreamRef>), PlayError> {
+        let c = self.reader.container();
+        let (o, layer) = (&c.objects[oi], &c.objects[oi].layers[li]);
+        let pos = BlockGrid::new(&c.space, layer.depends_on, &o.stagger).locate(sample);
+        let block = layer.blocks.get(pos.block).ok_or_else(|| content(&self.reader, format!("object {oi} layer {li}: block {} missing", pos.block)))?;
+        let images = block.levels.iter().map(|l| level_image_index(&l.counts, &pos.local, &pos.extent) as u32).collect();
+        Ok((TextureKey { object: oi as u32, layer: li as u32, block: pos.block as u32, images }, block))
+    }
+
+    /// Object `oi`'s reflection terms at the weighted parameter samples: one per class of
+    /// samples the term's shells cannot tell apart (equal on the union of their dependency
+    /// masks), with the class's summed weight, as the surface layers are blended.
+    fn reflection_terms(&self, oi: usize, samples: &[(Vec<u32>, f32)]) -> Result<Vec<WantedReflection>, PlayError> {
+        let o = &self.reader.container().objects[oi];
+        let term = &self.objects[oi].reflection;
+        if term.is_empty() {
+            return Ok(Vec::new());
+        }
+        let mask = DepMask(term.iter().fold(0, |m, &li| m | o.layers[li].depends_on.0));
+        let mut out = Vec::new();
+        for (s, weight) in merge_for_mask(samples, mask) {
+            let mut shells = Vec::with_capacity(term.len());
+            for &li in term {
+                let (key, block) = self.texture_key(oi, li, &s)?;
+                let shell = shell_of(&block.placement).ok_or_else(|| content(&self.reader, format!("object {oi} layer {li} block {}: not a closed shell", key.block)))?;
+                shells.push((key, shell));
+            }
+            out.push(WantedReflection { draw: oi, weight, shells });
+        }
+        Ok(out)
     }
 
     /// Decodes (on the workers) and uploads every wanted texture not on the GPU.
-    fn make_resident(&mut self, wanted: &[Wanted], stats: &mut FrameStats) -> Result<(), PlayError> {
+    fn make_resident(&mut self, wanted: &[&TextureKey], stats: &mut FrameStats) -> Result<(), PlayError> {
         let frame = self.frame;
         let mut missing: Vec<&TextureKey> = Vec::new();
-        for w in wanted {
-            match self.resident.get_mut(&w.key) {
+        for &key in wanted {
+            match self.resident.get_mut(key) {
                 Some(r) => r.last_frame = frame,
-                None if !missing.contains(&&w.key) => missing.push(&w.key),
+                None if !missing.contains(&key) => missing.push(key),
                 None => {}
             }
         }
@@ -479,32 +620,37 @@ impl Player {
         if let Some(e) = first_error {
             return Err(e);
         }
-        // Textures rebuilt on the workers.
+        // Textures rebuilt on the workers: surface textures' finest levels, shells' cube maps.
         let drop_levels = self.options.reduction.trailing_zeros();
-        let assemble: Vec<AssembleJob> = missing
-            .iter()
-            .map(|k| {
-                let layer = &c.objects[k.object as usize].layers[k.layer as usize];
-                let block = &layer.blocks[k.block as usize];
-                let levels = k.images.iter().enumerate().map(|(lv, &img)| have[&LevelKey { object: k.object, layer: k.layer, block: k.block, level: lv as u32, image: img }].clone()).collect();
-                let full = TextureLayout::full(block.width, block.height).levels;
-                AssembleJob { layer, layout: LevelLayout::of(layer, block), levels, drop_levels: drop_levels.min(full.saturating_sub(1)) }
-            })
-            .collect();
-        let images = self.decoder.assemble(&assemble);
-        drop(assemble);
+        let is_shell = |k: &TextureKey| c.objects[k.object as usize].layers[k.layer as usize].mapping == Mapping::Shell;
+        let (shells, surfaces): (Vec<&TextureKey>, Vec<&TextureKey>) = missing.iter().partition(|k| is_shell(k));
+        let job = |k: &&TextureKey| {
+            let layer = &c.objects[k.object as usize].layers[k.layer as usize];
+            let block = &layer.blocks[k.block as usize];
+            let levels = k.images.iter().enumerate().map(|(lv, &img)| have[&LevelKey { object: k.object, layer: k.layer, block: k.block, level: lv as u32, image: img }].clone()).collect();
+            let full = TextureLayout::full(block.width, block.height).levels;
+            AssembleJob { layer, layout: LevelLayout::of(layer, block), levels, drop_levels: drop_levels.min(full.saturating_sub(1)) }
+        };
+        let images = self.decoder.assemble(&surfaces.iter().map(job).collect::<Vec<_>>());
+        let cubes = self.decoder.assemble_cubes(&shells.iter().map(job).collect::<Vec<_>>());
         stats.decode_ms += t.elapsed().as_secs_f64() * 1e3;
         let hits1 = self.cache.counters();
         stats.cache_hits += hits1.hits - hits0.hits;
         stats.cache_misses += hits1.misses - hits0.misses;
-        // Uploads and GPU MIP chains.
+        // Uploads, GPU MIP chains of surface textures, cube maps with their stored levels.
         let t = Instant::now();
         let mut encoder = self.gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("uploads") });
-        let mut made = Vec::with_capacity(images.len());
-        for (k, img) in missing.iter().zip(&images) {
+        let mut made = Vec::with_capacity(missing.len());
+        for (k, img) in surfaces.iter().zip(&images) {
             let texture = self.mips.texture(&self.gpu, TextureLayout::full(img.width, img.height));
             stats.upload_bytes += self.mips.upload(&self.gpu, &texture, img, &mut encoder)?;
-            made.push(((*k).clone(), Resident { texture, last_frame: frame }));
+            made.push(((*k).clone(), Resident { texture: GpuTexture::Surface(texture), last_frame: frame }));
+        }
+        for (k, cube) in shells.iter().zip(&cubes) {
+            let texture = ShellTexture::new(&self.gpu, cube.layout, &c.objects[k.object as usize].name)?;
+            texture.upload(&self.gpu, &cube.rgba)?;
+            stats.upload_bytes += (cube.rgba.len() * 4) as u64;
+            made.push(((*k).clone(), Resident { texture: GpuTexture::Shell(texture), last_frame: frame }));
         }
         self.gpu.queue.submit([encoder.finish()]);
         self.gpu.device.poll(wgpu::PollType::wait_indefinitely()).map_err(|e| PlayError::Readback(e.to_string()))?;
@@ -517,8 +663,8 @@ impl Player {
         let t0 = Instant::now();
         let reads0 = self.reader.stats().codestreams;
         let mut stats = FrameStats::default();
-        let (clips, wanted) = self.plan(req, size)?;
-        let result = self.make_resident(&wanted, &mut stats);
+        let plan = self.plan(req, size)?;
+        let result = self.make_resident(&plan.keys(), &mut stats);
         if let Err(e) = result {
             self.end_frame();
             return Err(e);
@@ -533,16 +679,18 @@ impl Player {
             self.readback = None;
         }
         let gpu = self.gpu.clone();
-        let objects: Vec<ObjectDraw> = self.objects.iter().zip(&clips).enumerate().map(|(i, (o, &clip))| ObjectDraw { object: i as u32, mesh: &o.mesh, clip_from_object: clip }).collect();
-        for w in &wanted {
+        let objects: Vec<ObjectDraw> = self.objects.iter().zip(&plan.clips).enumerate().map(|(i, (o, &clip))| ObjectDraw { object: i as u32, mesh: &o.mesh, clip_from_object: clip }).collect();
+        for w in &plan.surfaces {
             self.samplers.entry(w.repeat).or_insert_with(|| {
                 let address = w.repeat.map(|r| if r { Address::Repeat } else { Address::ClampToEdge });
                 create_sampler(&gpu, &Sampler { filter: self.filter, address })
             });
         }
-        let mut layers = Vec::with_capacity(wanted.len());
-        for w in &wanted {
-            let texture = &self.resident[&w.key].texture;
+        let mut layers = Vec::with_capacity(plan.surfaces.len());
+        for w in &plan.surfaces {
+            let GpuTexture::Surface(texture) = &self.resident[&w.key].texture else {
+                return Err(content(&self.reader, format!("{:?}: a shell's texture drawn as a surface layer", w.key)));
+            };
             let sampler = Sampler { filter: self.filter, address: w.repeat.map(|r| if r { Address::Repeat } else { Address::ClampToEdge }) };
             for (axis, k, s) in [('s', 0, texture.layout.width), ('t', 1, texture.layout.height)] {
                 if w.repeat[k] && !s.is_power_of_two() {
@@ -559,6 +707,9 @@ impl Player {
                 anisotropic: matches!(self.filter, Filter::Anisotropic(_)),
             });
         }
+        let reflections = reflection_draws(&self.reader, &self.resident, &plan)?;
+        stats.surface_draws = layers.len() as u64;
+        stats.shell_draws = reflections.len() as u64;
         let targets = self.targets.as_mut().expect("targets made above");
         let mut encoder = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("frame") });
         let offscreen_view;
@@ -570,7 +721,7 @@ impl Player {
             }
         };
         let display = self.display.map(|(f, _)| f);
-        crate::frame::encode(&gpu, &mut self.pipes, targets, view, format, &objects, &layers, want_ids, display, &mut encoder);
+        crate::frame::encode(&gpu, &mut self.pipes, targets, view, format, &objects, &layers, &reflections, want_ids, display, &mut encoder);
         let out = if let Target::Offscreen { ids } = target {
             let texel = if format == wgpu::TextureFormat::Rgba16Float { 8 } else { 16 };
             let (rc, ri) = self.readback.get_or_insert_with(|| (Readback::new(&gpu, size, texel), Readback::new(&gpu, size, 4)));
@@ -586,6 +737,7 @@ impl Player {
             gpu.queue.submit([encoder.finish()]);
             None
         };
+        drop(reflections);
         drop(layers);
         drop(objects);
         self.end_frame();

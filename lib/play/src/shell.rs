@@ -1,7 +1,9 @@
 //! Environment-map shells on the GPU (`shell.wgsl`): a cube map as a six-layer 2D array
 //! texture read with `textureLoad` and filtered in the shader exactly as pis-compile's
 //! hardware model filters it (`pis_compile::shell`), and the pipeline that draws one object
-//! with one shell — the rendering a shell's render matrix predicts.
+//! with one shell — the rendering a shell's render matrix predicts. The player's frames
+//! draw a reflective object's shells with the same functions (`frame_reflection.wgsl`,
+//! `frame.rs`).
 //!
 //! Level m of a face of size N holds `mip_size(N, m)` used texels at the top left of a GPU
 //! level of `next_pow2(N) >> m` texels, which is never smaller.

@@ -41,7 +41,7 @@ fn frame_multisampling_keeps_interiors_exactly() {
         t.upload(&gpu, &random_rgba(16 * 16, seed)).unwrap();
         t
     };
-    let mesh = |m: &Mesh| MeshGpu::new(&gpu, &m.positions, &m.uvs, &m.indices);
+    let mesh = |m: &Mesh| MeshGpu::new(&gpu, &m.positions, None, &m.uvs, &m.indices);
     let scene = [(mesh(&back), clip, texture(1)), (mesh(&front), clip * turn, texture(2))];
     let sampler = create_sampler(&gpu, &Sampler { filter: Filter::Bilinear, address: [Address::ClampToEdge; 2] });
     let (a, ids_a) = draw_scene(&gpu, &mut pipes, SIZE, 1, None, &scene, &sampler);

@@ -55,7 +55,7 @@ fn display_filter_resolve_keeps_interiors_and_spreads_silhouettes() {
     let back = quad(-1.6, 1.6, -1.2, 1.2, -0.5);
     let front = quad(-0.6, 0.6, -0.5, 0.5, 0.4);
     let turn = glam::Mat4::from_rotation_z(25f32.to_radians());
-    let mesh = |m: &Mesh| MeshGpu::new(&gpu, &m.positions, &m.uvs, &m.indices);
+    let mesh = |m: &Mesh| MeshGpu::new(&gpu, &m.positions, None, &m.uvs, &m.indices);
     let scene = [(mesh(&back), clip, texture(&gpu, &random_rgba(256, 1))), (mesh(&front), clip * turn, texture(&gpu, &random_rgba(256, 2)))];
     let sampler = create_sampler(&gpu, &Sampler { filter: Filter::Bilinear, address: [Address::ClampToEdge; 2] });
     let (one, ids) = draw_scene(&gpu, &mut pipes, SIZE, 1, None, &scene, &sampler);
@@ -175,7 +175,7 @@ fn display_filter_resolve_matches_the_gaussian_coverage_of_an_edge() {
     };
     let c = [0.8f32, 0.5, 0.25];
     let rgba: Vec<f32> = (0..256).flat_map(|_| [c[0], c[1], c[2], 1.0]).collect();
-    let scene = [(MeshGpu::new(&gpu, &shape.positions, &shape.uvs, &shape.indices), glam::Mat4::IDENTITY, texture(&gpu, &rgba))];
+    let scene = [(MeshGpu::new(&gpu, &shape.positions, None, &shape.uvs, &shape.indices), glam::Mat4::IDENTITY, texture(&gpu, &rgba))];
     let sampler = create_sampler(&gpu, &Sampler { filter: Filter::Bilinear, address: [Address::ClampToEdge; 2] });
     let (img, _) = draw_scene(&gpu, &mut pipes, SIZE, 4, Some(GAUSSIAN), &scene, &sampler);
     let (sigma, r) = (GAUSSIAN.sigma_px as f64, GAUSSIAN.radius_px as f64);

@@ -1,7 +1,9 @@
-//! The player on samples/tiny.pis and the GPU MIP chain: a frame reads exactly the
-//! codestreams on the pyramid paths of the samples it draws (fewer when level images are
-//! cached or textures resident), multilinear blending between two light samples is the
-//! weighted sum of their frames, and the GPU's MIP decimation equals pis-format's.
+//! The player on samples/tiny.pis (a reflective ball: a diffuse texture over the light and a
+//! distant shell over the view) and the GPU MIP chain: a frame reads exactly the codestreams
+//! on the pyramid paths of the samples it draws, surface layers' and shells' (fewer when
+//! level images are cached or textures resident), multilinear blending between two light
+//! samples is the weighted sum of their frames, and the GPU's MIP decimation equals
+//! pis-format's.
 
 mod common;
 
@@ -22,15 +24,12 @@ fn tiny() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../samples/tiny.pis")
 }
 
-/// Distinct codestreams on the pyramid paths of every surface layer at `points`.
+/// Distinct codestreams on the pyramid paths of every layer at `points`.
 fn path_streams(player: &Player, points: &[Vec<u32>]) -> Vec<(u32, u64)> {
     let r = player.reader();
     let mut out = Vec::new();
     for (oi, o) in r.container().objects.iter().enumerate() {
-        for (li, l) in o.layers.iter().enumerate() {
-            if l.kind.is_shell() {
-                continue;
-            }
+        for li in 0..o.layers.len() {
             for p in points {
                 for s in r.texture_path(oi, li, p).unwrap().1 {
                     if !out.contains(&(s.chunk, s.offset)) {
@@ -54,11 +53,13 @@ fn a_frame_reads_only_the_codestreams_of_its_pyramid_paths() {
     // One sample per pixel: alpha is 1 exactly where the object index is drawn.
     let mut player = Player::open(Arc::new(gpu), &tiny(), PlayerOptions { workers: 2, msaa: 1, ..Default::default() }).unwrap();
     let size = player.image_size();
-    // tiny.pis: dimensions (view, light); the surface layer varies with light.
+    // tiny.pis: dimensions (view, light); the surface layer varies with light, the shell
+    // with the view.
     let first = vec![0, 0];
     let (img, ids, s) = player.render_ids(&at(&player, &first), size).unwrap();
     let want = path_streams(&player, std::slice::from_ref(&first));
     assert!(!want.is_empty());
+    assert_eq!((s.surface_draws, s.shell_draws), (1, 1));
     assert_eq!(s.codestreams_read, want.len() as u64, "first frame reads its pyramid path");
     assert_eq!(player.reader().stats().codestreams, want.len() as u64);
     assert_eq!((s.cache_misses, s.cache_hits), (want.len() as u64, 0));
@@ -70,16 +71,20 @@ fn a_frame_reads_only_the_codestreams_of_its_pyramid_paths() {
         let a = img.rgba[k * 4 + 3];
         assert_eq!(a, if i == 0 { 1.0 } else { 0.0 }, "alpha marks the drawn pixels");
     }
-    // Another view, same light: the texture is the same; nothing is read.
-    let (_, s) = player.render_image(&at(&player, &[1, 0]), size).unwrap();
-    assert_eq!(s.codestreams_read, 0);
+    // Another view, same light: the diffuse texture is the same; only the shell of the new
+    // view (another block) is read.
+    let view = vec![1, 0];
+    let (_, s) = player.render_image(&at(&player, &view), size).unwrap();
+    let seen = path_streams(&player, &[first.clone(), view.clone()]);
+    assert!(seen.len() > want.len());
+    assert_eq!(s.codestreams_read, (seen.len() - want.len()) as u64, "only the new view's shell");
     // Another light: only the level images not already cached.
     let second = vec![1, 1];
     let (_, s) = player.render_image(&at(&player, &second), size).unwrap();
-    let both = path_streams(&player, &[first, second]);
-    assert_eq!(s.codestreams_read, (both.len() - want.len()) as u64, "shared pyramid levels come from the cache");
+    let all = path_streams(&player, &[first, view, second]);
+    assert_eq!(s.codestreams_read, (all.len() - seen.len()) as u64, "shared pyramid levels come from the cache");
     assert!(s.cache_hits >= 1, "the top level is shared");
-    assert_eq!(player.reader().stats().codestreams, both.len() as u64);
+    assert_eq!(player.reader().stats().codestreams, all.len() as u64);
 }
 
 #[test]
@@ -186,7 +191,9 @@ fn gpu_mip_chain_equals_cpu_decimation() {
 /// inside the ball, a pixel is
 /// shaded at its centre by each triangle that covers some of its samples, so it keeps the
 /// single-sample value except on the mesh's own triangle edges, where it mixes two
-/// extrapolations of the same texture: never outside the range of its 3×3 neighbourhood.
+/// extrapolations of the same texture and reflection: outside the range of its 3×3
+/// neighbourhood by less than 10⁻³ (the reflection looked up at an extrapolated position
+/// and normal can leave it by a little).
 /// (`frame_multisampling_keeps_interiors_exactly` shows exactness on flat quads.)
 #[test]
 fn multisampling_changes_silhouettes_of_played_frames() {
@@ -231,7 +238,7 @@ fn multisampling_changes_silhouettes_of_played_frames() {
                 for c in 0..3 {
                     let (lo, hi) = hood().map(|q| a.rgba[q * 4 + c]).fold((f32::MAX, f32::MIN), |(l, u), v| (l.min(v), u.max(v)));
                     let v = b.rgba[p * 4 + c];
-                    assert!(v >= lo - 1e-6 && v <= hi + 1e-6, "pixel ({x}, {y}) channel {c}: {v} outside its neighbourhood's [{lo}, {hi}]");
+                    assert!(v >= lo - 1e-3 && v <= hi + 1e-3, "pixel ({x}, {y}) channel {c}: {v} outside its neighbourhood's [{lo}, {hi}]");
                 }
             }
         }
@@ -258,18 +265,30 @@ fn srgb(v: f32) -> f32 {
 /// sRGB-encoded by the target format, with one sample per pixel and with four (resolved
 /// into the sRGB target: where a pixel's samples differ, on silhouettes and on the mesh's
 /// triangle edges, each sample is rounded to 8 bits before the resolve averages them and
-/// the average is rounded again, one more level).
+/// the average is rounded again, one more level). Each sample is clamped to 1 first: the
+/// ball without its shell stays below 1 and is drawn so everywhere; with its reflection
+/// (radiance above 1 in places) a multisampled pixel near such radiance can only be darker
+/// than the offscreen frame's.
 #[test]
 fn render_to_view_draws_the_offscreen_frame_into_an_srgb_target() {
     let Some(gpu) = gpu_or_skip("render_to_view_draws_the_offscreen_frame_into_an_srgb_target") else { return };
     let gpu = Arc::new(gpu);
+    let mut c = pis_format::PisReader::open(&tiny()).unwrap().load_all().unwrap();
+    c.objects.iter_mut().for_each(|o| o.layers.retain(|l| !l.kind.is_shell()));
+    let dir = tempfile::tempdir().unwrap();
+    let diffuse = dir.path().join("tiny-without-shell.pis");
+    pis_format::write(&diffuse, &c).unwrap();
     for msaa in [1, 4] {
-        view_frame_is_the_offscreen_frame(&gpu, msaa);
+        let clamped = view_frame_is_the_offscreen_frame(&gpu, &diffuse, msaa);
+        assert_eq!(clamped, 0, "{msaa} samples: the ball without its shell is below 1");
+        view_frame_is_the_offscreen_frame(&gpu, &tiny(), msaa);
     }
 }
 
-fn view_frame_is_the_offscreen_frame(gpu: &Arc<pis_play::Gpu>, msaa: u32) {
-    let mut player = Player::open(gpu.clone(), &tiny(), PlayerOptions { workers: 1, msaa, ..Default::default() }).unwrap();
+/// Checks the frame of `file` drawn into an sRGB view against its offscreen frame; returns
+/// how many pixel channels lie near radiance above 1 (checked one-sided).
+fn view_frame_is_the_offscreen_frame(gpu: &Arc<pis_play::Gpu>, file: &std::path::Path, msaa: u32) -> usize {
+    let mut player = Player::open(gpu.clone(), file, PlayerOptions { workers: 1, msaa, ..Default::default() }).unwrap();
     let size = (48, 36);
     let req = at(&player, &[1, 1]);
     let (img, _) = player.render_image(&req, size).unwrap();
@@ -298,21 +317,33 @@ fn view_frame_is_the_offscreen_frame(gpu: &Arc<pis_play::Gpu>, msaa: u32) {
     );
     gpu.queue.submit([enc.finish()]);
     let bytes = pis_play::frame::map_read(gpu, &buf).unwrap();
-    let mut drawn = 0;
-    for y in 0..size.1 as usize {
-        for x in 0..size.0 as usize {
-            let p = y * size.0 as usize + x;
+    let (w, h) = (size.0 as usize, size.1 as usize);
+    // Whether the ball's radiance in channel c exceeds 1 around (x, y): some pixel of the
+    // 3×3 neighbourhood whose colour over its coverage does (a covered sample's radiance,
+    // where they agree).
+    let radiance = |q: usize, c: usize| if img.rgba[q * 4 + 3] > 0.0 { img.rgba[q * 4 + c] / img.rgba[q * 4 + 3] } else { 0.0 };
+    let bright = |x: usize, y: usize, c: usize| (y.saturating_sub(1)..(y + 2).min(h)).any(|j| (x.saturating_sub(1)..(x + 2).min(w)).any(|i| radiance(j * w + i, c) > 1.0));
+    let (mut drawn, mut exact, mut clamped) = (0, 0, 0);
+    for y in 0..h {
+        for x in 0..w {
+            let p = y * w + x;
             let alpha = img.rgba[p * 4 + 3];
             drawn += (alpha > 0.0) as usize;
             let levels = if samples > 1 { 2.0 } else { 1.0 };
             for c in 0..3 {
                 let want = srgb(img.rgba[p * 4 + c]) * 255.0;
                 let got = bytes[y * row as usize + x * 4 + c] as f32;
-                assert!((got - want).abs() <= levels, "{samples} samples: pixel ({x}, {y}) channel {c}: {got} vs {want}");
+                let clamps = samples > 1 && bright(x, y, c);
+                clamped += clamps as usize;
+                exact += (!clamps && alpha > 0.0) as usize;
+                let fits = if clamps { got <= want + levels } else { (got - want).abs() <= levels };
+                assert!(fits, "{samples} samples: pixel ({x}, {y}) channel {c}: {got} vs {want}");
             }
         }
     }
-    assert!(drawn > 20);
+    eprintln!("{}, {samples} samples: {drawn} pixels drawn; channels: {exact} drawn as the offscreen frame, {clamped} near radiance above 1", file.display());
+    assert!(drawn > 20 && exact > 100, "{drawn} pixels drawn, {exact} channels as the offscreen frame");
+    clamped
 }
 
 /// The display filter comes from the file: samples/tiny.pis records none and keeps the box
