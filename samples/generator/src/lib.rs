@@ -1,7 +1,7 @@
 //! The PIS sample scenes, generated procedurally: glTF (JSON + binary buffer + PNG
-//! textures) plus scene.toml for `demo1`, `demo2`, `teapot-pem` and `glass` (seed thesis,
-//! sections 4.8.1, 4.8.2, 5.10 and 6.5). `cargo run -p pis-samples --release -- samples/`
-//! regenerates them byte for byte.
+//! textures) plus scene.toml for `demo1`, `demo2`, `teapot-pem`, `teapot-glossy` and `glass`
+//! (seed thesis, sections 4.8.1, 4.8.2, 5.10, 5.10 with figures 5.11–5.12, and 6.5).
+//! `cargo run -p pis-samples --release -- samples/` regenerates them byte for byte.
 
 use std::io;
 use std::path::Path;
@@ -14,13 +14,14 @@ pub mod teapot_data;
 pub mod textures;
 
 /// The sample scene directory names, in generation order.
-pub const SAMPLES: [&str; 4] = ["demo1", "demo2", "teapot-pem", "glass"];
+pub const SAMPLES: [&str; 5] = ["demo1", "demo2", "teapot-pem", "teapot-glossy", "glass"];
 
 /// Writes every sample scene into `root/<name>/`.
 pub fn generate_all(root: &Path) -> io::Result<()> {
     scenes::demo1::write(&root.join("demo1"))?;
     scenes::demo2::write(&root.join("demo2"))?;
     scenes::teapot_pem::write(&root.join("teapot-pem"))?;
+    scenes::teapot_glossy::write(&root.join("teapot-glossy"))?;
     scenes::glass::write(&root.join("glass"))?;
     Ok(())
 }

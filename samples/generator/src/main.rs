@@ -9,7 +9,7 @@ fn main() -> ExitCode {
         [dir] if !dir.starts_with('-') => PathBuf::from(dir),
         _ => {
             eprintln!(
-                "usage: pis-samples DIR   (writes DIR/demo1, DIR/demo2, DIR/teapot-pem, DIR/glass)"
+                "usage: pis-samples DIR   (writes DIR/demo1, DIR/demo2, DIR/teapot-pem, DIR/teapot-glossy, DIR/glass)"
             );
             return ExitCode::from(1);
         }

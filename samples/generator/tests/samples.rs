@@ -4,7 +4,8 @@
 use std::path::{Path, PathBuf};
 
 use glam::Vec3;
-use pis_scene::{load, DimensionKind, Driver, Scene};
+use pis_scene::material::{material_role, MIRROR_ROUGHNESS};
+use pis_scene::{load, DimensionKind, Driver, ObjectRole, Scene};
 
 fn samples_dir() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
@@ -102,6 +103,7 @@ fn demo_spaces_have_the_seed_kinds() {
         [DimensionKind::View, DimensionKind::ObjectMotion]
     );
     assert_eq!(kinds("teapot-pem"), [DimensionKind::View]);
+    assert_eq!(kinds("teapot-glossy"), [DimensionKind::View]);
     assert_eq!(kinds("glass"), [DimensionKind::View]);
 }
 
@@ -128,6 +130,51 @@ fn demo1_light_swings_and_demo2_gewgaw_turns() {
     let (_, rb, _) = b.to_scale_rotation_translation();
     let turned = (ra.inverse() * rb).to_axis_angle().1.to_degrees();
     assert!((turned - 7.5).abs() < 1e-2, "{turned}");
+}
+
+#[test]
+fn teapot_glossy_is_teapot_pem_with_a_glossy_reflective_teapot() {
+    for preset in [None, Some("paper")] {
+        let pem = load(&samples_dir().join("teapot-pem/scene.toml"), preset).unwrap();
+        let glossy = load(&samples_dir().join("teapot-glossy/scene.toml"), preset).unwrap();
+        assert_eq!(glossy.resolution, pem.resolution);
+        assert_eq!(glossy.spp, pem.spp);
+        assert_eq!(glossy.space.point_count(), pem.space.point_count());
+        let names = |s: &Scene| s.objects.iter().map(|o| o.name.clone()).collect::<Vec<_>>();
+        assert_eq!(names(&glossy), names(&pem));
+        for (g, p) in glossy.objects.iter().zip(&pem.objects) {
+            assert_eq!(g.role, p.role, "{}", g.name);
+            assert_eq!(g.primitives.len(), p.primitives.len());
+            for (gp, pp) in g.primitives.iter().zip(&p.primitives) {
+                assert_eq!(gp.positions, pp.positions, "{}", g.name);
+                assert_eq!(gp.indices, pp.indices, "{}", g.name);
+                let (gm, pm) = (&glossy.materials[gp.material], &pem.materials[pp.material]);
+                if g.name.starts_with("Teapot") {
+                    assert_eq!(g.role, ObjectRole::Reflective);
+                    assert_eq!(gm.base_color, pm.base_color);
+                    assert_eq!(gm.metallic, 1.0);
+                    assert!(
+                        pm.roughness < MIRROR_ROUGHNESS,
+                        "teapot-pem's teapot is a mirror"
+                    );
+                    // Glossy, not a mirror, yet still inferred reflective.
+                    assert!(gm.roughness > MIRROR_ROUGHNESS, "{}", gm.roughness);
+                    assert_eq!(material_role(gm), ObjectRole::Reflective);
+                } else {
+                    assert_eq!(gm.name, pm.name);
+                    assert_eq!(gm.roughness, pm.roughness);
+                }
+            }
+        }
+        for index in 0..pem.space.point_count() {
+            let (g, p) = (
+                glossy.frame_at(index).unwrap(),
+                pem.frame_at(index).unwrap(),
+            );
+            assert_eq!(g.camera.world_from_camera, p.camera.world_from_camera);
+            assert_eq!(g.lights.len(), p.lights.len());
+        }
+    }
 }
 
 /// Numbers equal up to float rounding (sin/cos come from the platform's libm, so another
