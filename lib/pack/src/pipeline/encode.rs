@@ -93,16 +93,41 @@ fn sample_weights(per_point: &[Vec<f64>]) -> Vec<f32> {
 fn layer_screen_weights(m: &ObjectModel, li: usize, samples: &[Vec<u32>]) -> BTreeMap<Vec<u32>, Vec<f32>> {
     let il = &m.layers[li];
     il.textures.keys().map(|k| {
-        let pid = il.placement_of[k];
-        let per_point: Vec<Vec<f64>> = samples.iter().enumerate().filter(|(_, s)| key(s, il.depends_on) == *k)
-            .map(|(p, _)| match il.shell {
-                // Every level of a shell is stored: its texels' column sums as they are.
-                Some(_) => column_sums(m.matrix(p, li, k)),
-                None => screen_weights_at(m.views[p].a(pid)),
-            }).collect();
-        let w = if per_point.is_empty() { vec![0.0; il.form.stored_texels(k)] } else { sample_weights(&per_point) };
+        let points: Vec<usize> = samples.iter().enumerate().filter(|(_, s)| key(s, il.depends_on) == *k).map(|(p, _)| p).collect();
+        let w = if points.is_empty() {
+            vec![0.0; il.form.stored_texels(k)]
+        } else if let Some(s) = il.shell {
+            shell_weights(m, s, li, k, &points)
+        } else {
+            let pid = il.placement_of[k];
+            sample_weights(&points.iter().map(|&p| screen_weights_at(m.views[p].a(pid))).collect::<Vec<_>>())
+        };
         (k.clone(), w)
     }).collect()
+}
+
+/// The screen weights of a shell sample: every level is stored, so each texel's column sums
+/// as they are, each row weighed by its squared Fresnel factor (the reflection term's error
+/// reaches the screen multiplied by F); scaled as [`sample_weights`] scales the unweighed
+/// sums, so that a shell's error counts F² times a surface texture's.
+fn shell_weights(m: &ObjectModel, s: usize, li: usize, k: &[u32], points: &[usize]) -> Vec<f32> {
+    let n = m.layers[li].form.stored_texels(k);
+    let (mut weighed, mut plain) = (vec![0.0f64; n], 0.0f64);
+    for &p in points {
+        let v = &m.shell_views[p];
+        let a = &v.a[s];
+        for r in 0..a.rows() {
+            let f = &v.fresnel[r * 3..r * 3 + 3];
+            let f2 = ((f[0] + f[1] + f[2]) as f64 / 3.0).powi(2);
+            let (cols, vals) = a.row(r);
+            for (&c, &w) in cols.iter().zip(vals) {
+                weighed[c as usize] += w as f64 * f2;
+                plain += w as f64;
+            }
+        }
+    }
+    let scale = if plain > 0.0 { n as f64 / plain } else { 0.0 };
+    weighed.iter().map(|w| (w * scale) as f32).collect()
 }
 
 /// Builds pyramids, allocates storage, encodes, and assembles the container.

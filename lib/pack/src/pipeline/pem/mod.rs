@@ -104,30 +104,36 @@ impl Planned for PemPlanned {
         let local_n = face_resolution(set, o, &job.meshes, fitted.local, largest)?;
         let local_layout = TextureLayout::cube(local_n);
         let has_local = model.views.iter().enumerate().any(|(p, v)| local_alpha(set, p, o, v.pixels()) > 1e-3);
-        // The distant shell: a box and a sphere, each solved; the one nearer the traced
-        // distant layer is kept.
-        let mut best: Option<Chosen> = None;
+        // The distant shell: a box and a sphere, each solved at a few points spread over the
+        // set; the one nearer the traced distant layer there is kept and solved everywhere.
+        let probe: Vec<usize> = probe_points(set.frames.len());
+        let probe_pixels: Vec<Vec<u32>> = probe.iter().map(|&p| pixels[p].clone()).collect();
+        let probe_keys: Vec<Vec<u32>> = probe.iter().map(|&p| keys[p].clone()).collect();
+        let mut trial: Vec<(f64, &str, Shell, u32)> = Vec::new();
         for (label, shell) in [("box", fitted.distant_box), ("sphere", fitted.distant_sphere)] {
             let n = face_resolution(set, o, &job.meshes, shell, largest)?;
-            let layout = TextureLayout::cube(n);
-            let mut shells = Vec::new();
-            if has_local {
-                shells.push((fitted.local, local_layout, Target::Local));
-            }
-            shells.push((shell, layout, Target::Distant));
-            let geometry: Vec<(Shell, TextureLayout)> = shells.iter().map(|s| (s.0, s.1)).collect();
-            let views = shell_views(set, o, &job.meshes, &geometry, f0, &pixels)?;
-            let mut solved = Vec::new();
-            for (s, &(_, layout, target)) in shells.iter().enumerate() {
-                solved.push(solve_shell(&views, s, layout, target, &keys, &settings)?);
-            }
-            let residual = solved.last().map_or(f64::INFINITY, |s| s.residual_rms);
-            let why = format!("distant {label} {n}² (traced distant layer residual {residual:.4}){}", if has_local { format!(", local ellipsoid {local_n}²") } else { String::new() });
-            if best.as_ref().is_none_or(|b| residual < b.solved.last().map_or(f64::INFINITY, |s| s.residual_rms)) {
-                best = Some(Chosen { shells, views, solved, why });
-            }
+            let views = shell_views(set, o, &job.meshes, &[(shell, TextureLayout::cube(n))], f0, &probe_pixels, &probe)?;
+            let solved = solve_shell(&views, 0, TextureLayout::cube(n), Target::Distant, &probe_keys, &settings)?;
+            trial.push((solved.residual_rms, label, shell, n));
         }
-        let chosen = best.expect("two candidates were solved");
+        trial.sort_by(|a, b| a.0.total_cmp(&b.0));
+        let (residual, label, shell, n) = trial[0];
+        let other = trial[1];
+        let mut shells = Vec::new();
+        if has_local {
+            shells.push((fitted.local, local_layout, Target::Local));
+        }
+        shells.push((shell, TextureLayout::cube(n), Target::Distant));
+        let geometry: Vec<(Shell, TextureLayout)> = shells.iter().map(|s| (s.0, s.1)).collect();
+        let all: Vec<usize> = (0..set.frames.len()).collect();
+        let views = shell_views(set, o, &job.meshes, &geometry, f0, &pixels, &all)?;
+        let mut solved = Vec::new();
+        for (s, &(_, layout, target)) in shells.iter().enumerate() {
+            solved.push(solve_shell(&views, s, layout, target, &keys, &settings)?);
+        }
+        let local_text = if has_local { format!(", local ellipsoid {local_n}²") } else { String::new() };
+        let why = format!("distant {label} {n}² (traced distant layer residual {residual:.4}, {} {:.4}){local_text}", other.1, other.0);
+        let chosen = Chosen { shells, views, solved, why };
         for (s, ((shell, layout, target), solved)) in chosen.shells.iter().zip(chosen.solved).enumerate() {
             let kind = if *target == Target::Local { pis_format::LayerKind::EnvLocal } else { pis_format::LayerKind::EnvDistant };
             let form = Box::new(ShellForm { shell: *shell, layout: *layout, channels: target.channels() as u8, order: s as u8 });
@@ -148,6 +154,13 @@ impl Planned for PemPlanned {
         model.why = format!("reflective: {}, Fresnel from F0 {:?}", chosen.why, f0);
         Ok(model)
     }
+}
+
+/// At most three points spread over `n`: first, middle, last.
+fn probe_points(n: usize) -> Vec<usize> {
+    let mut p = vec![0, n / 2, n.saturating_sub(1)];
+    p.dedup();
+    p
 }
 
 /// The largest traced local alpha of object `o` over `pixels` at point `p`.

@@ -81,12 +81,17 @@ pub fn solve_shell(views: &[ShellView], s: usize, layout: TextureLayout, target:
 }
 
 /// The right-hand sides of a point: RGB per row, and for the local layer its alpha in the
-/// first channel (the other two zero, so their solves stop at once).
+/// first channel (the other two zero, so their solves stop at once). Incident radiance is
+/// clipped at 1/F per channel (thesis 5.9 clips samples too bright): beyond it the
+/// reflection term alone is white on a display, so the clip changes no displayed pixel,
+/// while a light's reflection, orders of magnitude brighter than the rest, would otherwise
+/// dominate the least-squares fit of its neighbourhood.
 fn split(v: &ShellView, target: Target) -> (Vec<f32>, Option<Vec<f32>>) {
+    let clip = |x: f32, f: f32| if f > 0.0 { x.min(1.0 / f) } else { x };
     match target {
-        Target::Distant => (v.distant.clone(), None),
+        Target::Distant => (v.distant.iter().zip(&v.fresnel).map(|(&x, &f)| clip(x, f)).collect(), None),
         Target::Local => {
-            let rgb = v.local.chunks_exact(4).flat_map(|p| [p[0], p[1], p[2]]).collect();
+            let rgb = v.local.chunks_exact(4).zip(v.fresnel.chunks_exact(3)).flat_map(|(p, f)| [clip(p[0], f[0]), clip(p[1], f[1]), clip(p[2], f[2])]).collect();
             let alpha = v.local.chunks_exact(4).flat_map(|p| [p[3], 0.0, 0.0]).collect();
             (rgb, Some(alpha))
         }

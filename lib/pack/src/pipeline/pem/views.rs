@@ -6,7 +6,6 @@
 //! are solved for.
 
 use anyhow::{anyhow, Result};
-use glam::Vec3;
 use pis_compile::shell::{shell_fresnel, shell_render_matrix, Shell, ShellObject};
 use pis_compile::{scene_depth, DrawMesh, RenderMatrix, TextureLayout, Viewport};
 use pis_trace::layers::LayerKind as TraceLayer;
@@ -89,39 +88,40 @@ fn coverage(set: &LoadedSet, p: usize, channel: &str) -> Vec<f32> {
     set.images[p].object_layer(channel, TraceLayer::Coverage).and_then(|l| l.channel("A")).map(<[f32]>::to_vec).unwrap_or_else(|| vec![0.0; (w * h) as usize])
 }
 
-/// Every point of the set as object `o`'s `shells` (each with its cube layout) see it.
-/// `pixels[p]` are the rows of the object's surface render matrices at point p, which the
-/// shells' rows must equal.
-pub fn shell_views(set: &LoadedSet, o: usize, meshes: &[Mesh], shells: &[(Shell, TextureLayout)], f0: [f32; 3], pixels: &[Vec<u32>]) -> Result<Vec<ShellView>> {
+/// The set's points `points` as object `o`'s `shells` (each with its cube layout) see them.
+/// `pixels[k]` are the rows of the object's surface render matrices at point `points[k]`,
+/// which the shells' rows must equal.
+pub fn shell_views(set: &LoadedSet, o: usize, meshes: &[Mesh], shells: &[(Shell, TextureLayout)], f0: [f32; 3], pixels: &[Vec<u32>], points: &[usize]) -> Result<Vec<ShellView>> {
     let (w, h) = set.resolution;
     let vp = Viewport { width: w, height: h };
     let channel = &set.channels[o];
     let name = &set.scene.objects[o].name;
-    (0..set.frames.len())
-        .into_par_iter()
-        .map(|p| {
+    points
+        .par_iter()
+        .zip(pixels)
+        .map(|(&p, pixels)| {
             let depth = occluders(set, p, o, meshes)?;
             let cov = coverage(set, p, channel);
             let mut a = Vec::with_capacity(shells.len());
             for &(shell, layout) in shells {
                 let m = shell_render_matrix(vp, &shell_object(set, p, o, &meshes[o], shell, layout), Some(&depth))?;
                 let m = restrict_rows(&m, &cov);
-                if m.pixels != pixels[p] {
+                if m.pixels != *pixels {
                     return Err(anyhow!("object {name}: point {p}: the shell and surface render matrices cover different pixels"));
                 }
                 a.push(m);
             }
             let (fp, f) = shell_fresnel(vp, &shell_object(set, p, o, &meshes[o], shells[0].0, shells[0].1), Some(&depth), f0)?;
-            let mut fresnel = Vec::with_capacity(pixels[p].len() * 3);
+            let mut fresnel = Vec::with_capacity(pixels.len() * 3);
             let mut k = 0;
-            for &px in &pixels[p] {
+            for &px in pixels {
                 while fp[k] != px {
                     k += 1;
                 }
                 fresnel.extend_from_slice(&f[k]);
             }
-            let local = gather_n(&pixels[p], &layer_values(set, p, channel, TraceLayer::Local, &["R", "G", "B", "A"]), 4);
-            let distant = gather_n(&pixels[p], &layer_values(set, p, channel, TraceLayer::Distant, &["R", "G", "B"]), 3);
+            let local = gather_n(pixels, &layer_values(set, p, channel, TraceLayer::Local, &["R", "G", "B", "A"]), 4);
+            let distant = gather_n(pixels, &layer_values(set, p, channel, TraceLayer::Distant, &["R", "G", "B"]), 3);
             Ok(ShellView { a, fresnel, local, distant })
         })
         .collect()
@@ -168,9 +168,4 @@ pub const MIN_FACE: u32 = 8;
 fn level_of(layout: &TextureLayout, c: usize) -> usize {
     let within = c % layout.face_len();
     (0..layout.levels).rev().find(|&m| layout.level_offset(m) <= within).unwrap_or(0) as usize
-}
-
-/// The camera position at point `p`.
-pub fn eye(set: &LoadedSet, p: usize) -> Vec3 {
-    set.frames[p].camera.world_from_camera.w_axis.truncate()
 }
