@@ -9,6 +9,8 @@
 //! the baselines (MPEG-texture, view-based x265 and AV1), written as rd.csv and rd.svg.
 //! `pis-bench speed`: compile time per point against PSNR across solver iteration caps.
 //! `pis-bench stability`: PSNR and popping off the sampled views, against pis-trace.
+//! `pis-bench reflective`: packed files played on and off the sampled views, over the
+//! reflective objects' pixels, against pis-trace.
 //! `pis-bench all --preset ci|paper`: every chart from scratch on demo1.
 
 use std::path::PathBuf;
@@ -19,6 +21,7 @@ use pis::cli::{finish, parse, Exit, Failure, EXIT_CODES_HELP};
 use pis_eval::bench::all::{self, Preset};
 use pis_eval::bench::rd::{self, RdRequest};
 use pis_eval::bench::speed::{self, SpeedRequest};
+use pis_eval::bench::reflective::{self, ReflectiveRequest};
 use pis_eval::bench::stability::{self, StabilityRequest};
 use pis_pack::infer::{infer, print_report, InferRequest};
 use pis_compile::SolveSettings;
@@ -202,6 +205,30 @@ enum Command {
         #[arg(long)]
         json: bool,
     },
+    /// Reflective objects as the player draws them: each packed file played along dense
+    /// camera paths between and away from the sampled views, against frames ray-traced at each
+    /// exact camera, over the reflective objects' pixels (writes reflective.csv).
+    Reflective {
+        /// The scene.toml the files were packed from.
+        scene: PathBuf,
+        /// The packed files to compare (e.g. packed with --representation texture and pem).
+        #[arg(required = true)]
+        files: Vec<PathBuf>,
+        /// Frames per path.
+        #[arg(long, default_value_t = 9)]
+        frames: usize,
+        /// Samples per pixel of the ray-traced reference frames.
+        #[arg(long, default_value_t = 16)]
+        reference_spp: u32,
+        #[arg(long, default_value = "reports")]
+        out: PathBuf,
+        #[arg(long, value_parser = parse_resolution)]
+        resolution: Option<(u32, u32)>,
+        #[arg(long)]
+        preset: Option<String>,
+        #[arg(long)]
+        json: bool,
+    },
     /// Every chart (rd, speed, stability) from scratch on demo1: trace, pack, evaluate.
     All {
         /// `ci` (80×60, 1 spp: minutes on 2 cores) or `paper` (demo1's paper preset).
@@ -297,6 +324,15 @@ fn run(cli: Cli) -> Result<Exit, Failure> {
             let req = StabilityRequest { input, scene, ratios, frames, spp: reference_spp, out, resolution, trace_spp: spp, max_texture, preset, record };
             let report = stability::run(&req)?;
             stability::print(&report, &mut std::io::stderr()).map_err(|e| Failure::new(Exit::Io, e))?;
+            if json {
+                json_out(&report)?;
+            }
+            Ok(Exit::Ok)
+        }
+        Command::Reflective { scene, files, frames, reference_spp, out, resolution, preset, json } => {
+            let req = ReflectiveRequest { scene, preset, resolution, files, frames, spp: reference_spp, out };
+            let report = reflective::run(&req)?;
+            reflective::print(&report, &mut std::io::stderr()).map_err(|e| Failure::new(Exit::Io, e))?;
             if json {
                 json_out(&report)?;
             }

@@ -8,6 +8,7 @@ pub mod mpeg_texture;
 pub mod output;
 pub mod playback;
 pub mod rd;
+pub mod reflective;
 pub mod speed;
 pub mod stability;
 pub mod view_video;

@@ -7,7 +7,11 @@
 use std::collections::BTreeMap;
 
 use anyhow::Result;
-use pis_compile::{solve, SolveSettings, TextureLayout};
+use pis_compile::{solve, solve_view_independent, RenderMatrix, SolveSettings, TextureLayout, View};
+
+/// The amplitude weight of a neighbouring sample's rows in a sample's solve (its squared
+/// error counts this squared: 1/16).
+pub const NEIGHBOUR_SCALE: f32 = 0.25;
 
 use super::views::ShellView;
 
@@ -37,7 +41,8 @@ pub struct SolvedShell {
 }
 
 /// Solves shell `s` (of the views' shells) for `target` at every point, keyed by `keys`
-/// (one key per point: shells are view-dependent).
+/// (one key per point: shells are view-dependent), each point's rows stacked with its
+/// neighbours' (the points before and after it) weighed by [`NEIGHBOUR_SCALE`].
 pub fn solve_shell(views: &[ShellView], s: usize, layout: TextureLayout, target: Target, keys: &[Vec<u32>], settings: &SolveSettings) -> Result<SolvedShell> {
     let n = layout.texel_count();
     let c = target.channels();
@@ -45,12 +50,24 @@ pub fn solve_shell(views: &[ShellView], s: usize, layout: TextureLayout, target:
     let (mut iterations, mut sq, mut count) = (0u64, 0.0f64, 0usize);
     let mut warm_rgb: Option<Vec<f32>> = None;
     let mut warm_alpha: Option<Vec<f32>> = None;
-    for (v, k) in views.iter().zip(keys) {
+    // Each neighbour's rows, weighed down: the parts of the environment a sample's view does
+    // not see are inferred from its neighbours' views (thesis 6.3: matching over several
+    // nearby viewpoints keeps the maps complete for cameras off the samples).
+    let scaled: Vec<(RenderMatrix, Vec<f32>, Option<Vec<f32>>)> = views.iter().map(|v| {
+        let mut a = v.a[s].clone();
+        a.vals.iter_mut().for_each(|x| *x *= NEIGHBOUR_SCALE);
+        let (rgb, alpha) = split(v, target);
+        let scale = |b: Vec<f32>| b.into_iter().map(|x| x * NEIGHBOUR_SCALE).collect::<Vec<f32>>();
+        (a, scale(rgb), alpha.map(scale))
+    }).collect();
+    for (i, (v, k)) in views.iter().zip(keys).enumerate() {
         let a = &v.a[s];
         let mut texels = vec![0.0f32; n * c];
+        let neighbours: Vec<usize> = [i.wrapping_sub(1), i + 1].into_iter().filter(|&j| j < views.len() && scaled[j].0.rows() > 0).collect();
         if a.rows() > 0 {
             let (rgb, alpha) = split(v, target);
-            let x = solve(a, &rgb, warm_rgb.as_deref(), settings)?;
+            let rgb_n: Vec<(&RenderMatrix, &[f32])> = neighbours.iter().map(|&j| (&scaled[j].0, scaled[j].1.as_slice())).collect();
+            let x = solve_stacked(a, &rgb, &rgb_n, warm_rgb.as_deref(), settings)?;
             iterations += x.iterations as u64;
             sq += x.residual_rms * x.residual_rms * a.rows() as f64;
             count += a.rows();
@@ -59,7 +76,8 @@ pub fn solve_shell(views: &[ShellView], s: usize, layout: TextureLayout, target:
             }
             warm_rgb = Some(x.texels);
             if let Some(alpha) = alpha {
-                let y = solve(a, &alpha, warm_alpha.as_deref(), settings)?;
+                let alpha_n: Vec<(&RenderMatrix, &[f32])> = neighbours.iter().filter_map(|&j| scaled[j].2.as_deref().map(|b| (&scaled[j].0, b))).collect();
+                let y = solve_stacked(a, &alpha, &alpha_n, warm_alpha.as_deref(), settings)?;
                 iterations += y.iterations as u64;
                 for t in 0..n {
                     texels[t * c + 3] = y.texels[t * 3];
@@ -78,6 +96,16 @@ pub fn solve_shell(views: &[ShellView], s: usize, layout: TextureLayout, target:
         textures.insert(k.clone(), texels);
     }
     Ok(SolvedShell { textures, iterations, residual_rms: (sq / count.max(1) as f64).sqrt() })
+}
+
+/// One sample's solve: its own rows, stacked with its weighed-down neighbours' when it has
+/// any (eq. 3.7's stacking, in the AᵀA form).
+fn solve_stacked(a: &RenderMatrix, b: &[f32], neighbours: &[(&RenderMatrix, &[f32])], warm: Option<&[f32]>, settings: &SolveSettings) -> Result<pis_compile::Solution> {
+    if neighbours.is_empty() {
+        return Ok(solve(a, b, warm, settings)?);
+    }
+    let views: Vec<View> = std::iter::once(View { a, b }).chain(neighbours.iter().map(|&(a, b)| View { a, b })).collect();
+    Ok(solve_view_independent(&views, warm, settings)?)
 }
 
 /// The right-hand sides of a point: RGB per row, and for the local layer its alpha in the

@@ -1,0 +1,204 @@
+//! `pis-bench reflective`: reflective objects on and off the sampled views, as the player
+//! draws them (thesis 5.10, figs 5.9–5.10). Given packed files of one scene — e.g. its
+//! reflective objects as parameterized textures and as layered environment maps — every
+//! file is played at each camera of two dense paths (between the sampled views on their
+//! orbit, and away from it: a larger radius, higher elevation) and compared with a frame
+//! ray-traced at that exact camera, on display values over the pixels the scene's
+//! reflective objects cover in the traced frame. Popping: per path, the largest
+//! frame-to-frame RMS change of the played frames over the reference's change between the
+//! same frames.
+
+use std::path::PathBuf;
+use std::sync::Arc;
+
+use anyhow::{anyhow, Result};
+use glam::Vec3;
+use pis_play::{CameraChoice, FrameRequest, Gpu, Player, PlayerOptions, ViewCamera};
+use pis_scene::{LoadOptions, ObjectRole, Scene};
+use pis_trace::layers::LayerKind;
+use pis_trace::TraceSettings;
+use serde::Serialize;
+
+use super::camera_path::{paths, PathFrame, PathKind};
+use crate::metrics::{display, SquaredError};
+use crate::report::{Csv, Stamp};
+use pis_pack::{Exit, Failure};
+
+/// What to measure.
+#[derive(Clone, Debug)]
+pub struct ReflectiveRequest {
+    /// The scene.toml the files were packed from.
+    pub scene: PathBuf,
+    pub preset: Option<String>,
+    pub resolution: Option<(u32, u32)>,
+    /// The packed files, each a representation.
+    pub files: Vec<PathBuf>,
+    /// Frames per path.
+    pub frames: usize,
+    /// Samples per pixel of the reference frames.
+    pub spp: u32,
+    /// Where reflective.csv goes.
+    pub out: PathBuf,
+}
+
+/// One file on one path.
+#[derive(Clone, Debug, Serialize)]
+pub struct ReflectiveSummary {
+    pub file: String,
+    pub path: PathKind,
+    pub mean_psnr_db: f64,
+    pub min_psnr_db: f64,
+    pub popping: f64,
+}
+
+#[derive(Clone, Debug, Serialize)]
+pub struct ReflectiveReport {
+    pub scene: String,
+    /// The objects measured (the scene's reflective objects).
+    pub objects: Vec<String>,
+    pub frames: usize,
+    pub reference_spp: u32,
+    pub summaries: Vec<ReflectiveSummary>,
+    pub csv: String,
+    pub stamp: Stamp,
+}
+
+/// A traced reference frame: linear RGB and the mask of the reflective objects' pixels.
+struct Reference {
+    rgb: Vec<f32>,
+    mask: Vec<bool>,
+}
+
+fn reference(scene: &Scene, pf: &PathFrame, spp: u32, objects: &[usize]) -> Result<Reference> {
+    let settings = TraceSettings::new(scene.resolution, spp);
+    let r = pis_trace::render_point(scene, &pf.frame, &settings, &|| {})?;
+    let l = r.images.layer("combined").ok_or_else(|| anyhow!("the traced frame has no combined image"))?;
+    let n = l.width as usize * l.height as usize;
+    let mut rgb = vec![0.0f32; n * 3];
+    for (c, name) in ["R", "G", "B"].iter().enumerate() {
+        let p = l.channel(name).ok_or_else(|| anyhow!("the traced frame has no {name}"))?;
+        (0..n).for_each(|k| rgb[k * 3 + c] = p[k]);
+    }
+    let channels = pis_trace::channel_names(scene);
+    let mut mask = vec![false; n];
+    for &o in objects {
+        if let Some(a) = r.images.object_layer(&channels[o], LayerKind::Coverage).and_then(|l| l.channel("A")) {
+            mask.iter_mut().zip(a).for_each(|(m, &c)| *m |= c > 0.5);
+        }
+    }
+    Ok(Reference { rgb, mask })
+}
+
+/// The player's camera for a path frame.
+fn camera(scene: &Scene, pf: &PathFrame) -> ViewCamera {
+    let c = &pf.frame.camera;
+    let m = c.world_from_camera;
+    let eye = m.w_axis.truncate();
+    ViewCamera { eye, target: eye - m.z_axis.truncate(), up: m.y_axis.truncate().normalize_or(Vec3::Y), yfov_rad: c.yfov, near: c.znear, far: if c.zfar.is_finite() { c.zfar } else { 1.0e4_f32.max(scene.resolution.0 as f32) } }
+}
+
+/// The path frame's point in the dimensions' units: the view value between its samples,
+/// the other dimensions at the frame's samples.
+fn point(scene: &Scene, pf: &PathFrame, view_dim: usize) -> Vec<f32> {
+    scene.space.dims.iter().enumerate().map(|(d, dim)| {
+        if d == view_dim {
+            let (k0, f) = (pf.view.floor() as usize, pf.view.fract());
+            let k1 = (k0 + 1).min(dim.values.len() - 1);
+            dim.values[k0] + (dim.values[k1] - dim.values[k0]) * f
+        } else {
+            dim.values[pf.point[d] as usize]
+        }
+    }).collect()
+}
+
+fn rms_change(a: &[f32], b: &[f32], mask: &[bool]) -> f64 {
+    let (mut s, mut n) = (0.0f64, 0usize);
+    for (p, _) in mask.iter().enumerate().filter(|(_, m)| **m) {
+        for c in 0..3 {
+            s += (display(a[p * 3 + c]) - display(b[p * 3 + c])).powi(2);
+            n += 1;
+        }
+    }
+    (s / n.max(1) as f64).sqrt()
+}
+
+fn runtime(e: impl Into<anyhow::Error>) -> Failure {
+    Failure::new(Exit::Runtime, e.into())
+}
+
+/// Plays every file along both paths and measures it against the traced references.
+pub fn run(req: &ReflectiveRequest) -> Result<ReflectiveReport, Failure> {
+    if req.files.is_empty() || req.frames < 2 || req.spp == 0 {
+        return Err(Failure::new(Exit::Usage, anyhow!("give at least one file, --frames ≥ 2 and --spp ≥ 1")));
+    }
+    let options = LoadOptions { preset: req.preset.clone(), resolution: req.resolution, spp: None };
+    let scene = pis_scene::load_with(&req.scene, &options).map_err(|e| Failure::new(pis_pack::scene_exit(&e), anyhow!("{}: {e}", req.scene.display())))?;
+    let objects: Vec<usize> = scene.objects.iter().enumerate().filter(|(_, o)| o.role == ObjectRole::Reflective).map(|(i, _)| i).collect();
+    if objects.is_empty() {
+        return Err(Failure::new(Exit::Usage, anyhow!("scene {} has no reflective object", scene.name)));
+    }
+    let (view_dim, frames) = paths(&scene, req.frames).map_err(|e| Failure::new(Exit::NotSupported, e))?;
+    eprintln!("pis-bench: reflective: tracing {} reference frames at {} spp", frames.len(), req.spp);
+    let refs: Vec<Reference> = frames.iter().map(|f| reference(&scene, f, req.spp, &objects)).collect::<Result<_>>().map_err(runtime)?;
+    let gpu = Arc::new(Gpu::new().map_err(|e| Failure::new(Exit::NotSupported, anyhow!("{e}")))?);
+    let size = scene.resolution;
+    let mut csv = Csv::new(&["file", "path", "frame", "view", "psnr_db", "change_played", "change_reference"]);
+    let mut summaries = Vec::new();
+    for file in &req.files {
+        let mut player = Player::open(gpu.clone(), file, PlayerOptions::default()).map_err(|e| Failure::new(Exit::Invalid, anyhow!("{}: {e}", file.display())))?;
+        if player.image_size() != size {
+            return Err(Failure::new(Exit::Usage, anyhow!("{}: {}x{} frames, the scene's are {}x{} (pass the same --preset or --resolution)", file.display(), player.image_size().0, player.image_size().1, size.0, size.1)));
+        }
+        let played: Vec<Vec<f32>> = frames.iter().map(|pf| {
+            let req = FrameRequest { point: point(&scene, pf, view_dim), camera: CameraChoice::Free(camera(&scene, pf)) };
+            let (img, _) = player.render_image(&req, size)?;
+            Ok(img.rgba.chunks_exact(4).flat_map(|p| [p[0], p[1], p[2]]).collect())
+        }).collect::<Result<_, pis_play::PlayError>>().map_err(runtime)?;
+        let name = file.file_name().map_or_else(|| file.display().to_string(), |n| n.to_string_lossy().into_owned());
+        for kind in [PathKind::Between, PathKind::Away] {
+            let idx: Vec<usize> = (0..frames.len()).filter(|&i| frames[i].kind == kind).collect();
+            let (mut psnrs, mut popping) = (Vec::new(), 0.0f64);
+            for (j, &i) in idx.iter().enumerate() {
+                let mut e = SquaredError::default();
+                for (p, _) in refs[i].mask.iter().enumerate().filter(|(_, m)| **m) {
+                    e.add_slices(&played[i][p * 3..p * 3 + 3], &refs[i].rgb[p * 3..p * 3 + 3]);
+                }
+                let change = (j > 0).then(|| {
+                    let prev = idx[j - 1];
+                    let both: Vec<bool> = refs[i].mask.iter().zip(&refs[prev].mask).map(|(a, b)| *a && *b).collect();
+                    [rms_change(&played[i], &played[prev], &both), rms_change(&refs[i].rgb, &refs[prev].rgb, &both)]
+                });
+                if let Some([p, r]) = change {
+                    popping = popping.max(p / r.max(0.5 / 255.0));
+                }
+                psnrs.push(e.psnr());
+                csv.push(vec![name.clone(), kind.name().into(), j.to_string(), format!("{:.3}", frames[i].view), format!("{:.3}", e.psnr()),
+                              change.map_or(String::new(), |c| format!("{:.5}", c[0])), change.map_or(String::new(), |c| format!("{:.5}", c[1]))]);
+            }
+            let mean = psnrs.iter().sum::<f64>() / psnrs.len().max(1) as f64;
+            let min = psnrs.iter().copied().fold(f64::INFINITY, f64::min);
+            summaries.push(ReflectiveSummary { file: name.clone(), path: kind, mean_psnr_db: mean, min_psnr_db: min, popping });
+        }
+    }
+    std::fs::create_dir_all(&req.out).map_err(|e| Failure::new(Exit::Io, anyhow!("{}: {e}", req.out.display())))?;
+    let csv_path = req.out.join("reflective.csv");
+    crate::report::write_atomic(&csv_path, csv.text().as_bytes()).map_err(|e| Failure::new(Exit::Io, e))?;
+    let scene_s = format!("{} ({}x{}, {} views)", scene.name, size.0, size.1, scene.space.dims[view_dim].values.len());
+    Ok(ReflectiveReport {
+        stamp: Stamp::here(&scene_s),
+        scene: scene_s,
+        objects: objects.iter().map(|&o| scene.objects[o].name.clone()).collect(),
+        frames: req.frames,
+        reference_spp: req.spp,
+        summaries,
+        csv: csv_path.display().to_string(),
+    })
+}
+
+pub fn print(r: &ReflectiveReport, out: &mut impl std::io::Write) -> std::io::Result<()> {
+    writeln!(out, "reflective: {} — {} over the pixels of {}, {} frames per path, references at {} spp", r.scene, "played frames vs pis-trace", r.objects.join(", "), r.frames, r.reference_spp)?;
+    for s in &r.summaries {
+        writeln!(out, "  {:<28} {:<8} mean {:6.2} dB  min {:6.2} dB  popping {:5.2}", s.file, s.path.name(), s.mean_psnr_db, s.min_psnr_db, s.popping)?;
+    }
+    writeln!(out, "  wrote {}", r.csv)
+}
