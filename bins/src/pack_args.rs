@@ -74,8 +74,9 @@ pub struct PackOptions {
     /// `combined` (one view-dependent layer of diffuse + specular per parameter sample).
     #[arg(long, default_value = "separate", value_parser = parse_layers)]
     pub layers: LayerMode,
-    /// Reflective objects: `texture` (parameterized surface textures) or `pem` (layered
-    /// environment maps, thesis ch. 5: a local and a distant shell per parameter sample).
+    /// Reflective objects: `texture` (parameterized surface textures), `pem` (layered
+    /// environment maps, thesis ch. 5: a local and a distant shell per parameter sample) or
+    /// `pem-infinity` (one environment map at infinity per sample: the single-shell baseline).
     #[arg(long, default_value = "texture", value_parser = parse_representation)]
     pub representation: RepresentationMode,
     /// Conjugate-gradient iteration cap per colour channel of every texture solve
@@ -180,7 +181,8 @@ fn parse_representation(s: &str) -> Result<RepresentationMode, String> {
     match s {
         "texture" => Ok(RepresentationMode::Texture),
         "pem" => Ok(RepresentationMode::Pem),
-        _ => Err(format!("unknown representation {s:?} (texture or pem)")),
+        "pem-infinity" => Ok(RepresentationMode::PemInfinity),
+        _ => Err(format!("unknown representation {s:?} (texture, pem or pem-infinity)")),
     }
 }
 

@@ -226,6 +226,9 @@ enum Command {
         resolution: Option<(u32, u32)>,
         #[arg(long)]
         preset: Option<String>,
+        /// Also write every played frame beside its traced reference (PNG) into --out.
+        #[arg(long)]
+        images: bool,
         #[arg(long)]
         json: bool,
     },
@@ -329,8 +332,8 @@ fn run(cli: Cli) -> Result<Exit, Failure> {
             }
             Ok(Exit::Ok)
         }
-        Command::Reflective { scene, files, frames, reference_spp, out, resolution, preset, json } => {
-            let req = ReflectiveRequest { scene, preset, resolution, files, frames, spp: reference_spp, out };
+        Command::Reflective { scene, files, frames, reference_spp, out, resolution, preset, images, json } => {
+            let req = ReflectiveRequest { scene, preset, resolution, files, frames, spp: reference_spp, out, images };
             let report = reflective::run(&req)?;
             reflective::print(&report, &mut std::io::stderr()).map_err(|e| Failure::new(Exit::Io, e))?;
             if json {

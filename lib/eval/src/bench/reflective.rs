@@ -39,6 +39,8 @@ pub struct ReflectiveRequest {
     pub spp: u32,
     /// Where reflective.csv goes.
     pub out: PathBuf,
+    /// Also write every played frame beside its traced reference as an sRGB PNG.
+    pub images: bool,
 }
 
 /// One file on one path.
@@ -111,6 +113,16 @@ fn point(scene: &Scene, pf: &PathFrame, view_dim: usize) -> Vec<f32> {
     }).collect()
 }
 
+/// A played frame (left) beside its traced reference (right), sRGB.
+fn side_by_side(played: &[f32], traced: &[f32], (w, h): (u32, u32)) -> image::RgbImage {
+    let to8 = |v: f32| (display(v) * 255.0 + 0.5) as u8;
+    image::RgbImage::from_fn(w * 2, h, |x, y| {
+        let (src, x) = if x < w { (played, x) } else { (traced, x - w) };
+        let p = (y * w + x) as usize * 3;
+        image::Rgb([to8(src[p]), to8(src[p + 1]), to8(src[p + 2])])
+    })
+}
+
 fn rms_change(a: &[f32], b: &[f32], mask: &[bool]) -> f64 {
     let (mut s, mut n) = (0.0f64, 0usize);
     for (p, _) in mask.iter().enumerate().filter(|(_, m)| **m) {
@@ -155,6 +167,14 @@ pub fn run(req: &ReflectiveRequest) -> Result<ReflectiveReport, Failure> {
             Ok(img.rgba.chunks_exact(4).flat_map(|p| [p[0], p[1], p[2]]).collect())
         }).collect::<Result<_, pis_play::PlayError>>().map_err(runtime)?;
         let name = file.file_name().map_or_else(|| file.display().to_string(), |n| n.to_string_lossy().into_owned());
+        if req.images {
+            std::fs::create_dir_all(&req.out).map_err(|e| Failure::new(Exit::Io, anyhow!("{}: {e}", req.out.display())))?;
+            for (i, (pf, pl)) in frames.iter().zip(&played).enumerate() {
+                let j = frames[..i].iter().filter(|f| f.kind == pf.kind).count();
+                let path = req.out.join(format!("{name}-{}-{j}.png", pf.kind.name()));
+                side_by_side(pl, &refs[i].rgb, size).save(&path).map_err(|e| Failure::new(Exit::Io, anyhow!("{}: {e}", path.display())))?;
+            }
+        }
         for kind in [PathKind::Between, PathKind::Away] {
             let idx: Vec<usize> = (0..frames.len()).filter(|&i| frames[i].kind == kind).collect();
             let (mut psnrs, mut popping) = (Vec::new(), 0.0f64);

@@ -51,9 +51,10 @@ pub trait Planned {
 pub const REPRESENTATIONS: &[&dyn Representation] = &[&LayeredPem, &SurfaceTextures];
 
 /// The representation of an object of `role` under `mode`: the first that applies
-/// (layered environment maps only when `mode` asks for them).
+/// (environment maps only when `mode` asks for them; the layered representation then makes
+/// one or two shells as `mode` says).
 pub fn choose(role: ObjectRole, mode: RepresentationMode) -> Option<&'static dyn Representation> {
-    REPRESENTATIONS.iter().copied().filter(|r| mode == RepresentationMode::Pem || r.name() != LayeredPem.name()).find(|r| r.applies(role))
+    REPRESENTATIONS.iter().copied().filter(|r| mode != RepresentationMode::Texture || r.name() != LayeredPem.name()).find(|r| r.applies(role))
 }
 
 /// What every representation works with: the set and the request, the render-matrix

@@ -243,6 +243,10 @@ pub enum RepresentationMode {
     /// Layered, parameterized environment maps: a local and a distant shell per parameter
     /// sample, plus a diffuse surface layer when the object has one (thesis ch. 5).
     Pem,
+    /// One environment map per parameter sample on a sphere at infinity (looked up by the
+    /// reflection direction alone), inferred against the traced incident light: the
+    /// single-shell baseline of thesis 5.10.
+    PemInfinity,
 }
 
 impl RepresentationMode {
@@ -251,6 +255,7 @@ impl RepresentationMode {
         match self {
             RepresentationMode::Texture => "texture",
             RepresentationMode::Pem => "pem",
+            RepresentationMode::PemInfinity => "pem-infinity",
         }
     }
 }

@@ -101,6 +101,9 @@ impl Planned for PemPlanned {
         let mut settings = SolveSettings::pyramidal();
         settings.cg = job.settings.cg;
         let largest = LARGEST_FACE.min(job.req.max_texture.next_power_of_two() / 2).max(8);
+        if job.req.representation == super::RepresentationMode::PemInfinity {
+            return single_shell(model, job, o, f0, &pixels, &keys, &settings, largest, fitted.local.origin);
+        }
         let local_n = face_resolution(set, o, &job.meshes, fitted.local, largest)?;
         let local_layout = TextureLayout::cube(local_n);
         let has_local = model.views.iter().enumerate().any(|(p, v)| local_alpha(set, p, o, v.pixels()) > 1e-3);
@@ -154,6 +157,34 @@ impl Planned for PemPlanned {
         model.why = format!("reflective: {}, Fresnel from F0 {:?}", chosen.why, f0);
         Ok(model)
     }
+}
+
+/// The single-shell baseline (thesis 5.10): one sphere-at-infinity map per sample against
+/// all the traced incident light.
+#[allow(clippy::too_many_arguments)]
+fn single_shell(mut model: ObjectModel, job: &Job<'_>, o: usize, f0: [f32; 3], pixels: &[Vec<u32>], keys: &[Vec<u32>], settings: &SolveSettings, largest: u32, origin: glam::DVec3) -> Result<ObjectModel> {
+    let set = job.set;
+    let shell = fit::sphere_at_infinity(origin);
+    let n = face_resolution(set, o, &job.meshes, shell, largest)?;
+    let layout = TextureLayout::cube(n);
+    let all: Vec<usize> = (0..set.frames.len()).collect();
+    let views = shell_views(set, o, &job.meshes, &[(shell, layout)], f0, pixels, &all)?;
+    let solved = solve_shell(&views, 0, layout, Target::Incident, keys, settings)?;
+    let grid_blocks = pis_format::blocks::BlockGrid::new(&job.space, job.all, &model.stagger).block_count() as usize;
+    model.layers.push(InferredLayer {
+        kind: pis_format::LayerKind::EnvDistant,
+        depends_on: job.all,
+        placement_of: solved.textures.keys().map(|k| (k.clone(), 0)).collect(),
+        textures: solved.textures,
+        block_placements: vec![0; grid_blocks],
+        iterations: solved.iterations,
+        form: Box::new(ShellForm { shell, layout, channels: 3, order: 0 }),
+        shell: Some(0),
+    });
+    model.shell_views = views;
+    model.representation = "environment map at infinity".to_string();
+    model.why = format!("--representation pem-infinity: one sphere-at-infinity map {n}² per sample (traced incident light residual {:.4}), Fresnel from F0 {f0:?}", solved.residual_rms);
+    Ok(model)
 }
 
 /// At most three points spread over `n`: first, middle, last.

@@ -22,13 +22,16 @@ pub enum Target {
     Local,
     /// The distant layer (3 channels).
     Distant,
+    /// All incident light: the local layer over the distant (3 channels), for a single
+    /// shell.
+    Incident,
 }
 
 impl Target {
     pub fn channels(self) -> usize {
         match self {
             Target::Local => 4,
-            Target::Distant => 3,
+            Target::Distant | Target::Incident => 3,
         }
     }
 }
@@ -118,6 +121,12 @@ fn split(v: &ShellView, target: Target) -> (Vec<f32>, Option<Vec<f32>>) {
     let clip = |x: f32, f: f32| if f > 0.0 { x.min(1.0 / f) } else { x };
     match target {
         Target::Distant => (v.distant.iter().zip(&v.fresnel).map(|(&x, &f)| clip(x, f)).collect(), None),
+        Target::Incident => {
+            let rgb = v.local.chunks_exact(4).zip(v.distant.chunks_exact(3)).zip(v.fresnel.chunks_exact(3))
+                .flat_map(|((l, d), f)| [0, 1, 2].map(|c| clip(l[c] + (1.0 - l[3]) * d[c], f[c])))
+                .collect();
+            (rgb, None)
+        }
         Target::Local => {
             let rgb = v.local.chunks_exact(4).zip(v.fresnel.chunks_exact(3)).flat_map(|(p, f)| [clip(p[0], f[0]), clip(p[1], f[1]), clip(p[2], f[2])]).collect();
             let alpha = v.local.chunks_exact(4).flat_map(|p| [p[3], 0.0, 0.0]).collect();
