@@ -24,6 +24,23 @@ pub struct RenderMatrix {
 }
 
 impl RenderMatrix {
+    /// The matrix of one lookup's `taps` per pixel of `pixels` (increasing), each row with
+    /// coverage 1, its entries sorted by column.
+    pub fn from_taps(viewport: crate::Viewport, layout: TextureLayout, pixels: Vec<u32>, rows: &[crate::filter::Taps]) -> RenderMatrix {
+        let nnz: usize = rows.iter().map(|t| t.len).sum();
+        let (mut cols, mut vals) = (Vec::with_capacity(nnz), Vec::with_capacity(nnz));
+        let mut row_start = Vec::with_capacity(rows.len() + 1);
+        row_start.push(0);
+        for t in rows {
+            for (c, v) in t.sorted() {
+                cols.push(c);
+                vals.push(v);
+            }
+            row_start.push(cols.len() as u32);
+        }
+        RenderMatrix { width: viewport.width, height: viewport.height, layout, coverage: vec![1.0; pixels.len()], pixels, row_start, cols, vals }
+    }
+
     /// n_s.
     pub fn rows(&self) -> usize {
         self.pixels.len()

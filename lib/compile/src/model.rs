@@ -133,27 +133,7 @@ pub fn render_matrix(viewport: Viewport, object: &TexturedObject, occluders: Opt
             taps
         })
         .collect();
-    let mut row_start = Vec::with_capacity(rows.len() + 1);
-    let nnz: usize = rows.iter().map(|t| t.len).sum();
-    let (mut cols, mut vals) = (Vec::with_capacity(nnz), Vec::with_capacity(nnz));
-    row_start.push(0);
-    for t in &rows {
-        for (c, v) in t.sorted() {
-            cols.push(c);
-            vals.push(v);
-        }
-        row_start.push(cols.len() as u32);
-    }
-    Ok(RenderMatrix {
-        width: viewport.width,
-        height: viewport.height,
-        layout,
-        coverage: vec![1.0; pixels.len()],
-        pixels,
-        row_start,
-        cols,
-        vals,
-    })
+    Ok(RenderMatrix::from_taps(viewport, layout, pixels, &rows))
 }
 
 #[cfg(test)]

@@ -106,27 +106,7 @@ pub fn shell_render_matrix(viewport: Viewport, object: &ShellObject, occluders: 
             taps
         })
         .collect();
-    let nnz: usize = rows.iter().map(|t| t.len).sum();
-    let (mut cols, mut vals) = (Vec::with_capacity(nnz), Vec::with_capacity(nnz));
-    let mut row_start = Vec::with_capacity(rows.len() + 1);
-    row_start.push(0);
-    for t in &rows {
-        for (c, v) in t.sorted() {
-            cols.push(c);
-            vals.push(v);
-        }
-        row_start.push(cols.len() as u32);
-    }
-    Ok(RenderMatrix {
-        width: viewport.width,
-        height: viewport.height,
-        layout,
-        coverage: vec![1.0; pixels.len()],
-        pixels,
-        row_start,
-        cols,
-        vals,
-    })
+    Ok(RenderMatrix::from_taps(viewport, layout, pixels, &rows))
 }
 
 /// The object rasterized as the player draws it, each triangle's world corners, and the
