@@ -369,6 +369,7 @@ impl Running {
             stats: shown,
             cache_hits: self.last_stats.cache_hits,
             cache_misses: self.last_stats.cache_misses,
+            draws: (self.last_stats.surface_draws, self.last_stats.shell_draws),
             gold: gold_label.as_deref(),
             has_gold: self.gold.is_some(),
             message: self.message.as_deref(),

@@ -18,6 +18,8 @@ pub struct PanelInfo<'a> {
     pub stats: Shown,
     pub cache_hits: u64,
     pub cache_misses: u64,
+    /// Draws of the last frame: surface layers, and reflection terms (environment-map shells).
+    pub draws: (u64, u64),
     /// Sample indices of the gold-standard image shown, when one is.
     pub gold: Option<&'a str>,
     /// A gold-standard set was given.
@@ -200,6 +202,7 @@ fn stats(ui: &mut Ui, info: &PanelInfo) {
         row("cache", format!("{:.1} MB", s.cache_mb));
         row("upload", format!("{:.1} MB/s", s.upload_mb_s));
         row("hits / misses", format!("{} / {}", info.cache_hits, info.cache_misses));
+        row("draws", format!("{} surface, {} shell", info.draws.0, info.draws.1));
         row("frame size", format!("{}×{}", info.frame_size.0, info.frame_size.1));
         row("traced size", format!("{}×{}", info.image_size.0, info.image_size.1));
         row("msaa", if info.msaa > 1 { format!("{}×", info.msaa) } else { "off".into() });
