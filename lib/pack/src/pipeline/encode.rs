@@ -65,7 +65,7 @@ fn screen_weights_at(a: &pis_compile::RenderMatrix) -> Vec<f64> {
 }
 
 /// The column sums of a render matrix: how much of the covered pixels each texel makes up.
-pub fn column_sums(a: &pis_compile::RenderMatrix) -> Vec<f64> {
+fn column_sums(a: &pis_compile::RenderMatrix) -> Vec<f64> {
     let mut cols = vec![0.0f64; a.cols()];
     for r in 0..a.rows() {
         let (c, w) = a.row(r);

@@ -150,15 +150,6 @@ impl ObjectModel {
         }
         img
     }
-
-    /// The render matrix through which layer `layer`'s sample `key` is drawn at point `p`.
-    pub fn matrix(&self, p: usize, layer: usize, key: &[u32]) -> &RenderMatrix {
-        let il = &self.layers[layer];
-        match il.shell {
-            Some(s) => &self.shell_views[p].a[s],
-            None => self.views[p].a(il.placement_of[key]),
-        }
-    }
 }
 
 /// The key of `samples` under `mask`.

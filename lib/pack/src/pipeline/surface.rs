@@ -45,7 +45,8 @@ fn layer_rgb(images: &PointImages, channel: &str, kind: TraceLayer) -> Vec<f32> 
     rgb
 }
 
-fn coverage(set: &LoadedSet, p: usize, o: usize) -> Vec<f32> {
+/// Object `o`'s coverage at point `p`, per pixel.
+pub(super) fn coverage(set: &LoadedSet, p: usize, o: usize) -> Vec<f32> {
     let (w, h) = set.resolution;
     set.images[p].object_layer(&set.channels[o], TraceLayer::Coverage).and_then(|l| l.channel("A"))
         .map(<[f32]>::to_vec).unwrap_or_else(|| vec![0.0; (w * h) as usize])

@@ -30,7 +30,7 @@ pub struct FittedShells {
 }
 
 /// The world-space vertices of object `o` at point `p`.
-pub fn world_positions(set: &LoadedSet, p: usize, o: usize, mesh: &Mesh) -> Vec<Vec3> {
+fn world_positions(set: &LoadedSet, p: usize, o: usize, mesh: &Mesh) -> Vec<Vec3> {
     let m = set.frames[p].instances[o].world_from_object;
     mesh.positions.iter().map(|&q| m.transform_point3(Vec3::from(q))).collect()
 }

@@ -24,7 +24,7 @@ use super::represent::{Job, Planned, Representation, Surveyed};
 use super::surface::survey_surface;
 use fit::{fit_shells, FittedShells};
 use form::ShellForm;
-use solve::{reflection, solve_shell, SolvedShell, Target};
+use solve::{solve_shell, SolvedShell, Target};
 use views::{face_resolution, shell_views, ShellView};
 
 /// The largest cube face tried when choosing a shell's resolution (thesis 5.8.2).
@@ -200,9 +200,4 @@ fn local_alpha(set: &super::input::LoadedSet, p: usize, o: usize, pixels: &[u32]
         .object_layer(&set.channels[o], TraceLayer::Local)
         .and_then(|l| l.channel("A"))
         .map_or(0.0, |a| pixels.iter().map(|&px| a[px as usize]).fold(0.0, f32::max))
-}
-
-/// The reflection term of a point from the shells' samples at it (see [`solve::reflection`]).
-pub fn reflection_at(v: &ShellView, maps: &[(&[f32], usize)]) -> Vec<f32> {
-    reflection(v, maps)
 }

@@ -12,6 +12,7 @@ use pis_trace::layers::LayerKind as TraceLayer;
 use rayon::prelude::*;
 
 use super::super::input::LoadedSet;
+use super::super::surface::coverage;
 use crate::infer::{restrict_rows, Mesh};
 
 /// One point as the shells see it: the rows are the covered pixels, in the order of the
@@ -82,12 +83,6 @@ fn occluders(set: &LoadedSet, p: usize, o: usize, meshes: &[Mesh]) -> Result<pis
     Ok(scene_depth(Viewport { width: w, height: h }, &draw, Some(o))?)
 }
 
-/// Coverage of object channel `channel` at point `p`.
-fn coverage(set: &LoadedSet, p: usize, channel: &str) -> Vec<f32> {
-    let (w, h) = set.resolution;
-    set.images[p].object_layer(channel, TraceLayer::Coverage).and_then(|l| l.channel("A")).map(<[f32]>::to_vec).unwrap_or_else(|| vec![0.0; (w * h) as usize])
-}
-
 /// The set's points `points` as object `o`'s `shells` (each with its cube layout) see them.
 /// `pixels[k]` are the rows of the object's surface render matrices at point `points[k]`,
 /// which the shells' rows must equal.
@@ -101,7 +96,7 @@ pub fn shell_views(set: &LoadedSet, o: usize, meshes: &[Mesh], shells: &[(Shell,
         .zip(pixels)
         .map(|(&p, pixels)| {
             let depth = occluders(set, p, o, meshes)?;
-            let cov = coverage(set, p, channel);
+            let cov = coverage(set, p, o);
             let mut a = Vec::with_capacity(shells.len());
             for &(shell, layout) in shells {
                 let m = shell_render_matrix(vp, &shell_object(set, p, o, &meshes[o], shell, layout), Some(&depth))?;
@@ -139,7 +134,7 @@ pub fn face_resolution(set: &LoadedSet, o: usize, meshes: &[Mesh], shell: Shell,
     let mut finest = vec![0usize; layout.levels as usize];
     for p in (0..set.frames.len()).step_by(step) {
         let depth = occluders(set, p, o, meshes)?;
-        let a = restrict_rows(&shell_render_matrix(vp, &shell_object(set, p, o, &meshes[o], shell, layout), Some(&depth))?, &coverage(set, p, &set.channels[o]));
+        let a = restrict_rows(&shell_render_matrix(vp, &shell_object(set, p, o, &meshes[o], shell, layout), Some(&depth))?, &coverage(set, p, o));
         for r in 0..a.rows() {
             let (cols, vals) = a.row(r);
             let level = cols.iter().zip(vals).filter(|(_, &v)| v > 0.0).map(|(&c, _)| level_of(&layout, c as usize)).min();
