@@ -232,6 +232,7 @@ fn convert(
         objects.push(SceneObject {
             name,
             role: infer_role(&mats),
+            reflector: None,
             primitives,
         });
         rig.object_nodes.push(r);

@@ -78,6 +78,12 @@ pub fn load_with(path: &Path, options: &LoadOptions) -> Result<Scene, SceneError
                 RoleSpec::Refractive => ObjectRole::Refractive,
             };
         }
+        if let Some(reflector) = &spec.reflector {
+            if reflector.trim().is_empty() {
+                return Err(SceneError::invalid(path, format!("object.{name}.reflector"), "a reflector name must not be empty"));
+            }
+            obj.reflector = Some(reflector.clone());
+        }
     }
 
     let space = build_space(&m.dimensions, &g, path)?;

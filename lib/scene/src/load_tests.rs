@@ -341,6 +341,27 @@ fn role_override() {
 }
 
 #[test]
+fn reflector_names_the_object_a_part_of() {
+    let toml = format!("{TOML}\n[object.Tri]\nreflector = \"Teapot\"\n");
+    let f = Fixture::new(&toml, |_, _| {});
+    let s = load(&f.toml(), None).unwrap();
+    assert_eq!(s.objects[0].reflector.as_deref(), Some("Teapot"));
+    let f = Fixture::new(&format!("{TOML}\n[object.Tri]\nreflector = \" \"\n"), |_, _| {});
+    let err = load_err(&f);
+    assert!(err.to_string().contains("object.Tri.reflector"), "{err}");
+}
+
+#[test]
+fn parts_naming_one_reflector_share_its_first_part() {
+    let mut s = crate::Scene::default();
+    for (name, reflector) in [("Body", None), ("Box", None), ("Lid", Some("Body")), ("Knob", Some("Pot")), ("Spout", Some("Pot"))] {
+        s.objects.push(crate::SceneObject { name: name.into(), role: ObjectRole::Reflective, reflector: reflector.map(String::from), primitives: vec![] });
+    }
+    let of: Vec<u32> = (0..5).map(|o| s.reflector_of(o)).collect();
+    assert_eq!(of, [0, 1, 0, 3, 3]);
+}
+
+#[test]
 fn error_missing_scene_toml() {
     let err = load(Path::new("/nonexistent/scene.toml"), None).unwrap_err();
     assert!(matches!(err, SceneError::Io { .. }));
@@ -538,6 +559,7 @@ fn hand_built_scene_has_identity_instances() {
     s.objects.push(crate::SceneObject {
         name: "o".into(),
         role: ObjectRole::Diffuse,
+        reflector: None,
         primitives: vec![],
     });
     let frame = s.frame(&[]).unwrap();

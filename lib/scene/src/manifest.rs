@@ -63,6 +63,9 @@ pub struct CameraSpec {
 pub struct ObjectSpec {
     /// Overrides the role inferred from the material.
     pub role: Option<RoleSpec>,
+    /// Joins the object to the reflector of that name: its parts reflect each other in
+    /// their local layers.
+    pub reflector: Option<String>,
 }
 
 /// An object role as written in scene.toml.

@@ -32,6 +32,23 @@ pub struct Scene {
     pub source: Option<std::path::PathBuf>,
 }
 
+impl Scene {
+    /// The reflector object `o` is a part of, as the index of its first part. An object is
+    /// a reflector of its own, named after itself, unless it names another (`reflector`);
+    /// objects of the same reflector name share the index of the first of them.
+    pub fn reflector_of(&self, o: usize) -> u32 {
+        let Some(name) = self.objects.get(o).map(SceneObject::reflector_name) else { return o as u32 };
+        self.objects.iter().position(|x| x.reflector_name() == name).unwrap_or(o) as u32
+    }
+}
+
+impl SceneObject {
+    /// The name of the reflector the object is a part of: `reflector`, else its own name.
+    pub fn reflector_name(&self) -> &str {
+        self.reflector.as_deref().unwrap_or(&self.name)
+    }
+}
+
 /// One renderable object. Its mesh is in object space; [`Frame::instances`] places it.
 #[derive(Clone, Debug)]
 pub struct SceneObject {
@@ -39,6 +56,11 @@ pub struct SceneObject {
     /// Inferred from the material (transmission → refractive, metallic or low roughness →
     /// reflective, else diffuse) unless scene.toml overrides it.
     pub role: ObjectRole,
+    /// The reflector this object is a part of (scene.toml `reflector`; `None`: a reflector
+    /// of its own, named after the object). A reflective part's local layer records its reflected rays that hit any part
+    /// of its reflector, and its distant layer sees through all of them (thesis 5.10: the
+    /// teapot's lid and body, one local shell each, reflecting each other locally).
+    pub reflector: Option<String>,
     pub primitives: Vec<Primitive>,
 }
 

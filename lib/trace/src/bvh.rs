@@ -13,6 +13,8 @@ use std::time::Duration;
 #[derive(Clone, Copy, Debug)]
 struct TriangleSource {
     object: u32,
+    /// [`Scene::reflector_of`] the object.
+    reflector: u32,
     primitive: u32,
     /// Index of the triangle's first index in the primitive's index list.
     first_index: u32,
@@ -96,6 +98,7 @@ impl<'s> SceneGeometry<'s> {
                     triangles.push(Triangle { v0: a.into(), v1: b.into(), v2: c.into() });
                     sources.push(TriangleSource {
                         object: o as u32,
+                        reflector: scene.reflector_of(o),
                         primitive: p as u32,
                         first_index: (k * 3) as u32,
                     });
@@ -117,15 +120,15 @@ impl<'s> SceneGeometry<'s> {
         self.triangles.len()
     }
 
-    /// The closest hit along `origin + t·dir`, t in (0, `tmax`), ignoring triangles of
-    /// object `skip` when given.
+    /// The closest hit along `origin + t·dir`, t in (0, `tmax`), ignoring the triangles of
+    /// every part of reflector `skip` ([`Scene::reflector_of`]) when given.
     pub fn closest(&self, origin: Vec3, dir: Vec3, tmax: f32, skip: Option<u32>) -> Option<Hit> {
         let bvh = self.bvh.as_ref()?;
         let ray = Ray::new(Vec3A::from(origin), Vec3A::from(dir), 0.0, tmax);
         let mut hit = RayHit::none();
         let found = bvh.ray_traverse(ray, &mut hit, |r, id| {
             let tri = bvh.primitive_indices[id] as usize;
-            if skip.is_some_and(|s| self.sources[tri].object == s) {
+            if skip.is_some_and(|s| self.sources[tri].reflector == s) {
                 return f32::INFINITY;
             }
             self.triangles[tri].intersect(r)

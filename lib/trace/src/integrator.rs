@@ -73,11 +73,12 @@ pub struct TermSample {
 pub struct ReflectiveSample {
     /// Fresnel modulation F(n·v) of the specular lobe.
     pub fresnel: Vec3,
-    /// Incident specular radiance when the reflected ray hits the object again (else 0).
+    /// Incident specular radiance when the reflected ray hits the reflector again: the object
+    /// or another part of it (else 0).
     pub local: Vec3,
-    /// 1 when the reflected ray hits the object again, else 0.
+    /// 1 when the reflected ray hits the reflector again, else 0.
     pub local_alpha: f32,
-    /// Incident specular radiance with the object made transparent for the reflected ray.
+    /// Incident specular radiance with the reflector made transparent for the reflected ray.
     pub distant: Vec3,
 }
 
@@ -105,6 +106,8 @@ pub struct Integrator<'s> {
     pub settings: TraceSettings,
     /// Coherent-sampling cell size actually used (0 = per pixel sample).
     pub cell: f32,
+    /// [`Scene::reflector_of`] each object.
+    reflectors: Vec<u32>,
 }
 
 impl<'s> Integrator<'s> {
@@ -118,7 +121,8 @@ impl<'s> Integrator<'s> {
                 if diag > 0.0 { diag / 4096.0 } else { 0.0 }
             }
         };
-        Integrator { scene, frame, geometry, settings: settings.clone(), cell }
+        let reflectors = (0..scene.objects.len()).map(|o| scene.reflector_of(o)).collect();
+        Integrator { scene, frame, geometry, settings: settings.clone(), cell, reflectors }
     }
 
     fn rng_at(&self, sp: &SurfacePoint, depth: u32, ctx: &PathContext) -> Rng {
@@ -528,10 +532,11 @@ impl<'s> Integrator<'s> {
         let hit = self.trace(o, d, None, ctx);
         let light_first = hit_light_sphere(&self.frame.lights, o, d, hit.map_or(f32::INFINITY, |h| h.t)).is_some();
         let incident = self.radiance_from(hit, o, d, 1, diffuse_left, true, ctx) * g;
-        if !light_first && hit.is_some_and(|h| h.object == object) {
+        let reflector = self.reflectors[object as usize];
+        if !light_first && hit.is_some_and(|h| self.reflectors[h.object as usize] == reflector) {
             s.local = incident;
             s.local_alpha = 1.0;
-            s.distant = self.radiance(o, d, 1, diffuse_left, true, Some(object), ctx) * g;
+            s.distant = self.radiance(o, d, 1, diffuse_left, true, Some(reflector), ctx) * g;
         } else {
             s.distant = incident;
         }

@@ -19,8 +19,8 @@ pub enum LayerKind {
     Specular,
     /// Reflective: Fresnel modulation F(n·v) of the specular lobe (RGB).
     Fresnel,
-    /// Reflective: incident specular radiance from rays that hit the object again, alpha
-    /// premultiplied (RGBA).
+    /// Reflective: incident specular radiance from rays that hit the reflector again (the
+    /// object or another part of it), alpha premultiplied (RGBA).
     Local,
     /// Reflective: incident specular radiance with the object transparent after the first
     /// bounce (RGB), defined wherever the object is covered.

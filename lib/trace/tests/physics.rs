@@ -249,6 +249,56 @@ fn distant_layer_has_no_holes() {
     assert!(max_alpha > 0.9, "no self-reflection seen (max local alpha {max_alpha})");
 }
 
+/// A corner reflector made of two objects: alone, each panel's reflections of the other are
+/// distant light (no local alpha, the distant layer shows the other panel); as parts of one
+/// reflector, they are local and the distant layer sees through both panels to the sky.
+#[test]
+fn parts_of_one_reflector_reflect_each_other_locally() {
+    let le = 0.8;
+    for joined in [false, true] {
+        let panel = |name: &str, c: Vec3, v: Vec3| {
+            let mut o = object(name, ObjectRole::Reflective, vec![quad(c, Vec3::Y * 1.0, v, 0)]);
+            o.reflector = joined.then(|| "corner".to_string());
+            o
+        };
+        let s = scene(
+            vec![
+                panel("left", Vec3::new(-0.5, 0.0, 0.0), Vec3::new(0.5, 0.0, -0.5)),
+                panel("right", Vec3::new(0.5, 0.0, 0.0), Vec3::new(0.5, 0.0, 0.5)),
+                object("sky", ObjectRole::Diffuse, vec![sphere(Vec3::ZERO, 8.0, 12, 24, 1, true)]),
+            ],
+            vec![metal([0.5; 3], 0.0), emitter([le; 3])],
+            (20, 16),
+            4,
+        );
+        assert_eq!(s.reflector_of(1), if joined { 0 } else { 1 });
+        let f = frame(&s, camera(Vec3::new(0.0, 0.3, 3.0), Vec3::ZERO, 40.0), vec![]);
+        let r = render(&s, &f, &TraceSettings::new(s.resolution, s.spp));
+        let (mut max_alpha, mut darkest) = (0.0f32, f32::INFINITY);
+        for o in ["left", "right"] {
+            let cov = r.images.object_layer(o, LayerKind::Coverage).unwrap();
+            let local = r.images.object_layer(o, LayerKind::Local).unwrap();
+            let distant = r.images.object_layer(o, LayerKind::Distant).unwrap();
+            for y in 0..16 {
+                for x in 0..20 {
+                    if cov.value("A", x, y) > 0.0 {
+                        max_alpha = max_alpha.max(local.value("A", x, y));
+                        darkest = darkest.min(distant.rgb(x, y).min_element());
+                    }
+                }
+            }
+        }
+        if joined {
+            assert!(max_alpha > 0.9, "joined: no reflection of the other part seen locally (max local alpha {max_alpha})");
+            assert!((darkest - le).abs() < 1e-4, "joined: the distant layer shows a part ({darkest})");
+        } else {
+            assert_eq!(max_alpha, 0.0, "apart: a panel reflects the other locally");
+            // The other panel reflects the sky at about F0 = 0.5.
+            assert!(darkest < le - 0.2, "apart: the distant layer sees through the other panel ({darkest})");
+        }
+    }
+}
+
 /// Two renders of the same input are bit-identical, on one thread and on two.
 #[test]
 fn renders_are_deterministic_across_thread_counts() {

@@ -107,7 +107,7 @@ mod tests {
     fn scene(materials: Vec<Material>, primitives: Vec<Primitive>) -> Scene {
         Scene {
             materials,
-            objects: vec![SceneObject { name: "o".into(), role: ObjectRole::Reflective, primitives }],
+            objects: vec![SceneObject { name: "o".into(), role: ObjectRole::Reflective, reflector: None, primitives }],
             ..Scene::default()
         }
     }

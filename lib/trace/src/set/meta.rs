@@ -74,6 +74,10 @@ pub struct ObjectMeta {
     pub layers: Vec<String>,
     /// True when the points' ray-record side files hold records of this object.
     pub records: bool,
+    /// The reflector the object is a part of, when it is not a reflector of its own
+    /// (scene.toml `reflector`): its `local` layer counts hits on every part of it.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub reflector: Option<String>,
 }
 
 /// One parameter point.

@@ -72,6 +72,7 @@ impl SetWriter {
                 role: role_name(o.role).into(),
                 layers: LayerKind::for_role(o.role).iter().map(|l| l.name().to_string()).collect(),
                 records: o.role == ObjectRole::Refractive,
+                reflector: o.reflector.clone(),
             })
             .collect();
         let space = scene

@@ -103,7 +103,7 @@ pub fn glass(ior: f32, attenuation: [f32; 3], distance: f32) -> Material {
 }
 
 pub fn object(name: &str, role: ObjectRole, primitives: Vec<Primitive>) -> SceneObject {
-    SceneObject { name: name.into(), role, primitives }
+    SceneObject { name: name.into(), role, reflector: None, primitives }
 }
 
 /// A scene without parameter space (one point) at `res` and `spp`.
