@@ -205,16 +205,17 @@ enum Command {
         #[arg(long)]
         json: bool,
     },
-    /// Reflective objects as the player draws them: each packed file played along dense
-    /// camera paths between and away from the sampled views, against frames ray-traced at each
-    /// exact camera, over the reflective objects' pixels (writes reflective.csv).
+    /// Reflective objects as the player draws them: each packed file played at the sampled
+    /// views and along dense camera paths between and away from them, against frames
+    /// ray-traced at each exact camera, over the reflective objects' pixels (writes
+    /// reflective.csv).
     Reflective {
         /// The scene.toml the files were packed from.
         scene: PathBuf,
         /// The packed files to compare (e.g. packed with --representation texture and pem).
         #[arg(required = true)]
         files: Vec<PathBuf>,
-        /// Frames per path.
+        /// Frames on the between and away paths (the samples path has one per sampled view).
         #[arg(long, default_value_t = 9)]
         frames: usize,
         /// Samples per pixel of the ray-traced reference frames.

@@ -1,10 +1,11 @@
 //! `pis-bench reflective`: reflective objects on and off the sampled views, as the player
 //! draws them (thesis 5.10, figs 5.9–5.10). Given packed files of one scene — e.g. its
 //! reflective objects as parameterized textures and as layered environment maps — every
-//! file is played at each camera of two dense paths (between the sampled views on their
-//! orbit, and away from it: a larger radius, higher elevation) and compared with a frame
-//! ray-traced at that exact camera, on display values over the pixels the scene's
-//! reflective objects cover in the traced frame. Popping: per path, the largest
+//! file is played at each sampled view and at each camera of two dense paths (between the
+//! sampled views on their orbit, and away from it: a larger radius, higher elevation) and
+//! compared with a frame ray-traced at that exact camera (the gold standard, at its own
+//! samples per pixel), on display values over the pixels the scene's reflective objects
+//! cover in the traced frame. Popping: per path, the largest
 //! frame-to-frame RMS change of the played frames over the reference's change between the
 //! same frames.
 
@@ -24,6 +25,9 @@ use crate::metrics::{display, SquaredError};
 use crate::report::{Csv, Stamp};
 use pis_pack::{Exit, Failure};
 
+/// The paths measured, in report order.
+const PATHS: [PathKind; 3] = [PathKind::Samples, PathKind::Between, PathKind::Away];
+
 /// What to measure.
 #[derive(Clone, Debug)]
 pub struct ReflectiveRequest {
@@ -33,7 +37,7 @@ pub struct ReflectiveRequest {
     pub resolution: Option<(u32, u32)>,
     /// The packed files, each a representation.
     pub files: Vec<PathBuf>,
-    /// Frames per path.
+    /// Frames on the between and away paths.
     pub frames: usize,
     /// Samples per pixel of the reference frames.
     pub spp: u32,
@@ -149,7 +153,7 @@ pub fn run(req: &ReflectiveRequest) -> Result<ReflectiveReport, Failure> {
     if objects.is_empty() {
         return Err(Failure::new(Exit::Usage, anyhow!("scene {} has no reflective object", scene.name)));
     }
-    let (view_dim, frames) = paths(&scene, req.frames).map_err(|e| Failure::new(Exit::NotSupported, e))?;
+    let (view_dim, frames) = paths(&scene, req.frames, &PATHS).map_err(|e| Failure::new(Exit::NotSupported, e))?;
     eprintln!("pis-bench: reflective: tracing {} reference frames at {} spp", frames.len(), req.spp);
     let refs: Vec<Reference> = frames.iter().map(|f| reference(&scene, f, req.spp, &objects)).collect::<Result<_>>().map_err(runtime)?;
     let gpu = Arc::new(Gpu::new().map_err(|e| Failure::new(Exit::NotSupported, anyhow!("{e}")))?);
@@ -175,7 +179,7 @@ pub fn run(req: &ReflectiveRequest) -> Result<ReflectiveReport, Failure> {
                 side_by_side(pl, &refs[i].rgb, size).save(&path).map_err(|e| Failure::new(Exit::Io, anyhow!("{}: {e}", path.display())))?;
             }
         }
-        for kind in [PathKind::Between, PathKind::Away] {
+        for kind in PATHS {
             let idx: Vec<usize> = (0..frames.len()).filter(|&i| frames[i].kind == kind).collect();
             let (mut psnrs, mut popping) = (Vec::new(), 0.0f64);
             for (j, &i) in idx.iter().enumerate() {
@@ -216,7 +220,7 @@ pub fn run(req: &ReflectiveRequest) -> Result<ReflectiveReport, Failure> {
 }
 
 pub fn print(r: &ReflectiveReport, out: &mut impl std::io::Write) -> std::io::Result<()> {
-    writeln!(out, "reflective: {} — {} over the pixels of {}, {} frames per path, references at {} spp", r.scene, "played frames vs pis-trace", r.objects.join(", "), r.frames, r.reference_spp)?;
+    writeln!(out, "reflective: {} — {} over the pixels of {}, {} frames between and away, references at {} spp", r.scene, "played frames vs pis-trace", r.objects.join(", "), r.frames, r.reference_spp)?;
     for s in &r.summaries {
         writeln!(out, "  {:<28} {:<8} mean {:6.2} dB  min {:6.2} dB  popping {:5.2}", s.file, s.path.name(), s.mean_psnr_db, s.min_psnr_db, s.popping)?;
     }

@@ -212,7 +212,7 @@ pub fn run(req: &StabilityRequest) -> Result<StabilityReport, Failure> {
     eprintln!("pis-bench: stability: loading and inferring");
     let inf = Inferred::new(&base, &StderrProgress)?;
     let scene = &inf.set.scene;
-    let (view_dim, frames) = paths(scene, req.frames).map_err(|e| Failure::new(Exit::NotSupported, e))?;
+    let (view_dim, frames) = paths(scene, req.frames, &[PathKind::Between, PathKind::Away]).map_err(|e| Failure::new(Exit::NotSupported, e))?;
     eprintln!("pis-bench: stability: tracing {} reference frames at {} spp", frames.len(), req.spp);
     let refs: Vec<Vec<f32>> = frames.iter().map(|f| reference(&inf, f, req.spp)).collect::<Result<_>>().map_err(runtime)?;
     let meshes: Vec<Mesh> = (0..scene.objects.len()).map(|o| merged_mesh(scene, o)).collect();
