@@ -66,6 +66,8 @@ pub struct ObjectSummary {
     /// Whether the mesh carries vertex normals.
     pub normals: bool,
     pub triangles: usize,
+    /// Leading triangles on the convex hull (drawn with the most distant shell only).
+    pub hull_triangles: u32,
     pub stagger: Vec<u32>,
     pub transforms: usize,
     pub layers: Vec<LayerSummary>,
@@ -183,6 +185,7 @@ pub fn summarize(r: &PisReader) -> Summary {
                 vertices: o.mesh.positions.len(),
                 normals: o.mesh.normals.is_some(),
                 triangles: o.mesh.indices.len() / 3,
+                hull_triangles: o.mesh.hull_triangles,
                 stagger: o.stagger.clone(),
                 transforms: o.transforms.transforms.len(),
                 bytes: layers.iter().map(|l| l.bytes).sum(),
@@ -324,12 +327,13 @@ pub fn render(s: &Summary) -> String {
     for ob in &s.objects {
         let _ = writeln!(
             o,
-            "  {} ({}): {} vertices{}, {} triangles, {} transform(s), block origins {:?}, {}",
+            "  {} ({}): {} vertices{}, {} triangles{}, {} transform(s), block origins {:?}, {}",
             ob.name,
             ob.role,
             ob.vertices,
             if ob.normals { " with normals" } else { "" },
             ob.triangles,
+            if ob.hull_triangles > 0 { format!(" ({} on the convex hull)", ob.hull_triangles) } else { String::new() },
             ob.transforms,
             ob.stagger,
             human(ob.bytes)

@@ -320,6 +320,16 @@ fn mesh<S>(oi: usize, o: &Object<S>, out: &mut Vec<Issue>) {
             "non-finite values, or attribute arrays of unequal length".into(),
         ));
     }
+    if m.hull_triangles as usize > m.indices.len() / 3 {
+        out.push(e(
+            5206,
+            format!(
+                "{} hull triangles, the mesh has {}",
+                m.hull_triangles,
+                m.indices.len() / 3
+            ),
+        ));
+    }
 }
 
 fn layers<S>(s: &ParameterSpace, oi: usize, o: &Object<S>, out: &mut Vec<Issue>) {

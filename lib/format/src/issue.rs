@@ -133,6 +133,7 @@ pub const RULES: &[(u16, &str)] = &[
     (5203, "index count is zero or not a multiple of 3"),
     (5204, "vertex index out of range"),
     (5205, "vertex data is not finite"),
+    (5206, "more hull triangles than triangles"),
     (6000, "LAYR payload is malformed"),
     (6001, "layer names an object that does not exist"),
     (6002, "unknown layer kind, mapping, mip mode, term or combine mode"),

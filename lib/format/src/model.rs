@@ -265,6 +265,9 @@ pub struct Mesh {
     pub texcoords: Option<Vec<[f32; 2]>>,
     /// Triangle list.
     pub indices: Vec<u32>,
+    /// The first `hull_triangles` triangles lie on the object's convex hull: the
+    /// reflection term draws them with its most distant shell only (thesis 5.7).
+    pub hull_triangles: u32,
 }
 
 coded_enum! {

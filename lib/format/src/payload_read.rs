@@ -6,7 +6,7 @@ use pis_codec::CodecId;
 
 use crate::binary::Cursor;
 use crate::model::*;
-use crate::payload_write::{MESH_NORMALS, MESH_TEXCOORDS};
+use crate::payload_write::{MESH_HULL, MESH_NORMALS, MESH_TEXCOORDS};
 use crate::Issue;
 
 /// Most dimensions a space may have (so masks fit and tables stay small).
@@ -149,7 +149,7 @@ pub fn mesh(c: &mut Cursor) -> Result<(u32, Mesh), Issue> {
     let vc = c.u32("vertex count")?;
     let ic = c.u32("index count")?;
     let attrs = c.u32("attributes")?;
-    if attrs & !(MESH_NORMALS | MESH_TEXCOORDS) != 0 {
+    if attrs & !(MESH_NORMALS | MESH_TEXCOORDS | MESH_HULL) != 0 {
         return Err(c.issue(3006, format!("attributes {attrs:#x} set undefined bits")));
     }
     let per_vertex = 12
@@ -178,6 +178,15 @@ pub fn mesh(c: &mut Cursor) -> Result<(u32, Mesh), Issue> {
     let indices = (0..ic)
         .map(|_| c.u32("index"))
         .collect::<Result<Vec<_>, _>>()?;
+    let hull_triangles = if attrs & MESH_HULL != 0 {
+        let h = c.u32("hull triangles")?;
+        if h == 0 {
+            return Err(c.issue(5200, "attribute bit 2 (hull) set with a hull triangle count of 0".to_string()));
+        }
+        h
+    } else {
+        0
+    };
     c.finish()?;
     Ok((
         object,
@@ -186,6 +195,7 @@ pub fn mesh(c: &mut Cursor) -> Result<(u32, Mesh), Issue> {
             normals,
             texcoords,
             indices,
+            hull_triangles,
         },
     ))
 }

@@ -68,14 +68,16 @@ pub fn objs<S>(s: &mut Sink, objects: &[Object<S>]) {
 /// Attribute bits of a `MESH` chunk.
 pub const MESH_NORMALS: u32 = 1;
 pub const MESH_TEXCOORDS: u32 = 2;
+pub const MESH_HULL: u32 = 4;
 
 pub fn mesh(s: &mut Sink, object: u32, m: &Mesh) {
     let attrs = m.normals.as_ref().map_or(0, |_| MESH_NORMALS)
-        | m.texcoords.as_ref().map_or(0, |_| MESH_TEXCOORDS);
+        | m.texcoords.as_ref().map_or(0, |_| MESH_TEXCOORDS)
+        | if m.hull_triangles > 0 { MESH_HULL } else { 0 };
     s.u32(object, "object index");
     s.u32(m.positions.len() as u32, "vertex count");
     s.u32(m.indices.len() as u32, "index count");
-    s.u32(attrs, "attributes (1 normals, 2 texcoords)");
+    s.u32(attrs, "attributes (1 normals, 2 texcoords, 4 hull)");
     let flat3 = |v: &[[f32; 3]]| v.iter().flatten().copied().collect::<Vec<f32>>();
     s.f32s(&flat3(&m.positions), "positions");
     if let Some(n) = &m.normals {
@@ -87,6 +89,9 @@ pub fn mesh(s: &mut Sink, object: u32, m: &Mesh) {
     }
     let idx: Vec<u8> = m.indices.iter().flat_map(|i| i.to_le_bytes()).collect();
     s.raw(&idx, || format!("indices = {:?}", m.indices));
+    if m.hull_triangles > 0 {
+        s.u32(m.hull_triangles, "hull triangles");
+    }
 }
 
 pub fn layr<S>(s: &mut Sink, objects: &[Object<S>], mut stream_ref: impl FnMut(&S) -> StreamRef) {

@@ -125,6 +125,7 @@ pub fn minimal() -> Result<Container, Error> {
         normals: None,
         texcoords: Some(vec![[0.0, 1.0], [1.0, 1.0], [1.0, 0.0], [0.0, 0.0]]),
         indices: vec![0, 1, 2, 0, 2, 3],
+        hull_triangles: 0,
     };
     let layer = surface_layer(LayerKind::Diffuse, 0, DepMask::NONE, 1.0);
     let block = Block {

@@ -117,3 +117,17 @@ fn branch_cuts_and_repeat_flags_round_trip() {
     let r = PisReader::from_bytes(to_bytes(&c).unwrap()).unwrap();
     assert_eq!(r.load_all().unwrap(), c);
 }
+
+#[test]
+fn hull_triangles_round_trip_and_too_many_are_refused() {
+    let mut c = tiny().unwrap();
+    let triangles = c.objects[0].mesh.indices.len() / 3;
+    c.objects[0].mesh.hull_triangles = triangles as u32;
+    let r = PisReader::from_bytes(to_bytes(&c).unwrap()).unwrap();
+    assert_eq!(r.load_all().unwrap().objects[0].mesh.hull_triangles, triangles as u32);
+    c.objects[0].mesh.hull_triangles = triangles as u32 + 1;
+    match to_bytes(&c) {
+        Err(Error::InvalidModel(issue)) => assert_eq!(issue.id, 5206, "{issue:?}"),
+        other => panic!("a mesh with more hull triangles than triangles was written: {:?}", other.map(|b| b.len())),
+    }
+}

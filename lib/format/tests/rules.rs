@@ -288,6 +288,12 @@ fn cases() -> Vec<(u16, Vec<u8>)> {
     ));
     v.push((5204, t().set_u32("indices", 9999).reseal()));
     v.push((5205, t().set_f32("positions", f32::NAN).reseal()));
+    v.push((
+        5206,
+        unchecked(|c| {
+            c.objects[0].mesh.hull_triangles = c.objects[0].mesh.indices.len() as u32;
+        }),
+    ));
     // 6xxx
     v.push((6000, t().set_u32("layer count", 3).reseal()));
     v.push((6001, t().set_u32("layer 0 object index", 3).reseal()));

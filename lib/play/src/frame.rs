@@ -57,6 +57,9 @@ pub struct MeshGpu {
     pub uvs: wgpu::Buffer,
     pub indices: wgpu::Buffer,
     pub count: u32,
+    /// Indices of the leading triangles on the object's convex hull (SPEC.md 6.5): the
+    /// reflection term draws them with its most distant shell only.
+    pub hull: u32,
 }
 
 impl MeshGpu {
@@ -78,7 +81,15 @@ impl MeshGpu {
             uvs: init("uvs", bytemuck::cast_slice(t), wgpu::BufferUsages::VERTEX),
             indices: init("indices", bytemuck::cast_slice(i), wgpu::BufferUsages::INDEX),
             count: indices.len() as u32 / 3 * 3,
+            hull: 0,
         }
+    }
+
+    /// The same mesh with its first `triangles` triangles on the convex hull (clamped to
+    /// the mesh).
+    pub fn with_hull(self, triangles: u32) -> MeshGpu {
+        let hull = triangles.saturating_mul(3).min(self.count);
+        MeshGpu { hull, ..self }
     }
 }
 
@@ -488,7 +499,17 @@ pub fn encode(
             })
         })
         .collect();
-    let reflection_binds: Vec<wgpu::BindGroup> = reflections.iter().map(|r| reflection_bind(gpu, &pipes.reflection_draw_layout, &objects[r.draw], r)).collect();
+    // Per reflection term: the bind group of its whole shell stack and, where the mesh has
+    // hull triangles and the term more than one shell, the bind group of its most distant
+    // shell alone (thesis 5.7: hull polygons never see the object itself).
+    let reflection_binds: Vec<(wgpu::BindGroup, Option<wgpu::BindGroup>)> = reflections
+        .iter()
+        .map(|r| {
+            let o = &objects[r.draw];
+            let hull = (o.mesh.hull > 0 && r.shells.len() > 1).then(|| reflection_bind(gpu, &pipes.reflection_draw_layout, o, r, &r.shells[r.shells.len() - 1..]));
+            (reflection_bind(gpu, &pipes.reflection_draw_layout, o, r, &r.shells), hull)
+        })
+        .collect();
     let size = targets.size;
     // The attachments the layers are drawn into: (colour, resolve target, depth, ids).
     let (sample_colour, depth, ids_bind) = match &mut targets.multi {
@@ -544,13 +565,21 @@ pub fn encode(
     if !reflections.is_empty() {
         pass.set_pipeline(&pipes.reflection_pipelines[&(sample_format, samples)]);
         pass.set_bind_group(1, ids_bind, &[]);
-        for (r, bg) in reflections.iter().zip(&reflection_binds) {
+        for (r, (all, hull)) in reflections.iter().zip(&reflection_binds) {
             let m = objects[r.draw].mesh;
-            pass.set_bind_group(0, bg, &[]);
             pass.set_vertex_buffer(0, m.positions.slice(..));
             pass.set_vertex_buffer(1, m.normals.slice(..));
             pass.set_index_buffer(m.indices.slice(..), wgpu::IndexFormat::Uint32);
-            pass.draw_indexed(0..m.count, 0, 0..1);
+            let rest = match hull {
+                Some(bg) => {
+                    pass.set_bind_group(0, bg, &[]);
+                    pass.draw_indexed(0..m.hull, 0, 0..1);
+                    m.hull
+                }
+                None => 0,
+            };
+            pass.set_bind_group(0, all, &[]);
+            pass.draw_indexed(rest..m.count, 0, 0..1);
         }
     }
     drop(pass);

@@ -57,10 +57,11 @@ pub struct ReflectionDraw<'a> {
     pub shells: Vec<(pis_compile::shell::Shell, &'a ShellTexture)>,
 }
 
-/// The uniforms of a reflection term drawn on `object`.
-fn reflection_uniforms(object: &ObjectDraw, r: &ReflectionDraw) -> ReflectionUniforms {
+/// The uniforms of a reflection term drawn on `object` with `shells` (the term's, or the
+/// most distant alone on hull triangles).
+fn reflection_uniforms(object: &ObjectDraw, r: &ReflectionDraw, shells_drawn: &[(pis_compile::shell::Shell, &ShellTexture)]) -> ReflectionUniforms {
     let mut shells = [ShellSlot::zeroed(); MAX_TERM_SHELLS];
-    for (slot, (shell, cube)) in shells.iter_mut().zip(&r.shells) {
+    for (slot, (shell, cube)) in shells.iter_mut().zip(shells_drawn) {
         let (origin_shape, a, b) = shell_uniform(shell);
         *slot = ShellSlot { origin_shape, a, b, size_levels: [cube.layout.width, cube.layout.levels, 0, 0] };
     }
@@ -71,17 +72,18 @@ fn reflection_uniforms(object: &ObjectDraw, r: &ReflectionDraw) -> ReflectionUni
         f0_weight: [r.f0[0], r.f0[1], r.f0[2], r.weight],
         shells,
         object: object.object,
-        count: r.shells.len().min(MAX_TERM_SHELLS) as u32,
+        count: shells_drawn.len().min(MAX_TERM_SHELLS) as u32,
         _pad: [0; 2],
     }
 }
 
-/// The bind group of a reflection term drawn on `object`: its uniforms and the cube maps of
-/// its shells 0 and 1 (shell 0's twice for a one-shell term).
-pub fn reflection_bind(gpu: &Gpu, layout: &wgpu::BindGroupLayout, object: &ObjectDraw, r: &ReflectionDraw) -> wgpu::BindGroup {
+/// The bind group of a reflection term drawn on `object` with `shells` (one or two of the
+/// term's, in order): its uniforms and the cube maps of shells 0 and 1 (shell 0's twice for
+/// one shell).
+pub fn reflection_bind(gpu: &Gpu, layout: &wgpu::BindGroupLayout, object: &ObjectDraw, r: &ReflectionDraw, shells: &[(pis_compile::shell::Shell, &ShellTexture)]) -> wgpu::BindGroup {
     let d = &gpu.device;
-    let u = d.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: Some("reflection uniforms"), contents: bytemuck::bytes_of(&reflection_uniforms(object, r)), usage: wgpu::BufferUsages::UNIFORM });
-    let cube = |k: usize| wgpu::BindingResource::TextureView(&r.shells[k.min(r.shells.len() - 1)].1.view);
+    let u = d.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: Some("reflection uniforms"), contents: bytemuck::bytes_of(&reflection_uniforms(object, r, shells)), usage: wgpu::BufferUsages::UNIFORM });
+    let cube = |k: usize| wgpu::BindingResource::TextureView(&shells[k.min(shells.len() - 1)].1.view);
     d.create_bind_group(&wgpu::BindGroupDescriptor {
         label: Some("reflection"),
         layout,

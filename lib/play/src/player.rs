@@ -246,7 +246,8 @@ fn prepare_objects(gpu: &Gpu, reader: &PisReader) -> Result<Vec<ObjectGpu>, Play
             layers.push(li);
         }
         let reflection = reflection_shells(reader, oi, &mut skipped)?;
-        out.push(ObjectGpu { mesh: MeshGpu::new(gpu, &o.mesh.positions, o.mesh.normals.as_deref(), &uvs, &o.mesh.indices), layers, reflection });
+        let mesh = MeshGpu::new(gpu, &o.mesh.positions, o.mesh.normals.as_deref(), &uvs, &o.mesh.indices).with_hull(o.mesh.hull_triangles);
+        out.push(ObjectGpu { mesh, layers, reflection });
     }
     if !skipped.is_empty() {
         eprintln!("pis-play: note: shell layers are not drawn by this player: {}", skipped.join(", "));

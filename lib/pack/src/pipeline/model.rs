@@ -102,6 +102,9 @@ pub struct ObjectModel {
     pub layers: Vec<InferredLayer>,
     /// Per point of the set, as the object's shells see it (empty without shells).
     pub shell_views: Vec<ShellView>,
+    /// The first `hull_triangles` triangles of `mesh` lie on its convex hull and draw the
+    /// most distant shell only (thesis 5.7; SPEC.md 6.5).
+    pub hull_triangles: u32,
     /// What was chosen and why.
     pub representation: String,
     pub why: String,

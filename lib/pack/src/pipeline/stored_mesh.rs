@@ -20,6 +20,7 @@ pub fn stored_mesh(set: &LoadedSet, m: &ObjectModel, role: ObjectRole) -> Mesh {
         normals: (role != ObjectRole::Diffuse).then(|| stored_normals(bake, &m.mesh.normals)),
         texcoords: Some(m.mesh_uvs.clone()),
         indices: m.mesh.indices.clone(),
+        hull_triangles: m.hull_triangles,
     }
 }
 

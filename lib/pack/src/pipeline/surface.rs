@@ -414,7 +414,7 @@ impl Planned for Layers {
         };
         Ok(ObjectModel {
             index: o, name, mesh: merged_mesh(scene, o), mesh_uvs: at.uvs, placements, stagger: st, block_sizes: job.sizes.clone(),
-            area, views, layers, shell_views: vec![], representation: representation.to_string(), why: why.to_string(),
+            area, views, layers, shell_views: vec![], hull_triangles: 0, representation: representation.to_string(), why: why.to_string(),
         })
     }
 }

@@ -115,7 +115,7 @@ impl Planned for PemPlanned {
         let mut trial: Vec<(f64, &str, Shell, u32)> = Vec::new();
         for (label, shell) in [("box", fitted.distant_box), ("sphere", fitted.distant_sphere)] {
             let n = face_resolution(set, o, &job.meshes, shell, largest)?;
-            let views = shell_views(set, o, &job.meshes, &[(shell, TextureLayout::cube(n))], f0, &probe_pixels, &probe)?;
+            let views = shell_views(set, o, &job.meshes, &[(shell, TextureLayout::cube(n), None)], f0, &probe_pixels, &probe)?;
             let solved = solve_shell(&views, 0, TextureLayout::cube(n), Target::Distant, &probe_keys, &settings)?;
             trial.push((solved.residual_rms, label, shell, n));
         }
@@ -127,14 +127,26 @@ impl Planned for PemPlanned {
             shells.push((fitted.local, local_layout, Target::Local));
         }
         shells.push((shell, TextureLayout::cube(n), Target::Distant));
-        let geometry: Vec<(Shell, TextureLayout)> = shells.iter().map(|s| (s.0, s.1)).collect();
+        // The convex-hull split (thesis 5.7): triangles on the hull never see the object, so
+        // they draw the distant shell alone; the file stores them first.
+        let hull = if has_local { hull_split(job, o)? } else { None };
+        let local_drawn: Option<Vec<bool>> = hull.as_ref().map(|h| h.iter().map(|&on| !on).collect());
+        let geometry: Vec<(Shell, TextureLayout, Option<&[bool]>)> = shells.iter().map(|s| (s.0, s.1, if s.2 == Target::Local { local_drawn.as_deref() } else { None })).collect();
         let all: Vec<usize> = (0..set.frames.len()).collect();
         let views = shell_views(set, o, &job.meshes, &geometry, f0, &pixels, &all)?;
         let mut solved = Vec::new();
         for (s, &(_, layout, target)) in shells.iter().enumerate() {
             solved.push(solve_shell(&views, s, layout, target, &keys, &settings)?);
         }
-        let local_text = if has_local { format!(", local ellipsoid {local_n}²") } else { String::new() };
+        let hull_text = match &hull {
+            Some(h) => {
+                model.hull_triangles = hull_first(&mut model.mesh.indices, h);
+                format!(", {} of {} triangles on the convex hull draw the distant shell only", model.hull_triangles, h.len())
+            }
+            None if has_local => ", no convex-hull split (a part of a reflector of several objects)".to_string(),
+            None => String::new(),
+        };
+        let local_text = if has_local { format!(", local ellipsoid {local_n}²{hull_text}") } else { String::new() };
         let why = format!("distant {label} {n}² (traced distant layer residual {residual:.4}, {} {:.4}){local_text}", other.1, other.0);
         let chosen = Chosen { shells, views, solved, why };
         for (s, ((shell, layout, target), solved)) in chosen.shells.iter().zip(chosen.solved).enumerate() {
@@ -168,7 +180,7 @@ fn single_shell(mut model: ObjectModel, job: &Job<'_>, o: usize, f0: [f32; 3], p
     let n = face_resolution(set, o, &job.meshes, shell, largest)?;
     let layout = TextureLayout::cube(n);
     let all: Vec<usize> = (0..set.frames.len()).collect();
-    let views = shell_views(set, o, &job.meshes, &[(shell, layout)], f0, pixels, &all)?;
+    let views = shell_views(set, o, &job.meshes, &[(shell, layout, None)], f0, pixels, &all)?;
     let solved = solve_shell(&views, 0, layout, Target::Incident, keys, settings)?;
     let grid_blocks = pis_format::blocks::BlockGrid::new(&job.space, job.all, &model.stagger).block_count() as usize;
     model.layers.push(InferredLayer {
@@ -187,6 +199,29 @@ fn single_shell(mut model: ObjectModel, job: &Job<'_>, o: usize, f0: [f32; 3], p
     Ok(model)
 }
 
+/// Per triangle of object `o`'s mesh, whether it lies on the mesh's convex hull; `None` when
+/// the object is a part of a reflector of several objects, whose other parts a hull
+/// triangle may see.
+fn hull_split(job: &Job<'_>, o: usize) -> Result<Option<Vec<bool>>> {
+    let scene = &job.set.scene;
+    let reflector = scene.reflector_of(o);
+    if (0..scene.objects.len()).any(|k| k != o && scene.reflector_of(k) == reflector) {
+        return Ok(None);
+    }
+    let mesh = &job.meshes[o];
+    let positions: Vec<glam::Vec3> = mesh.positions.iter().map(|&p| glam::Vec3::from(p)).collect();
+    Ok(Some(crate::pipeline::shell_fit::convex_hull_triangles(&positions, &mesh.indices)?))
+}
+
+/// Reorders the triangles of `indices` so those with `hull` set come first, each group in
+/// its order; returns how many are on the hull.
+fn hull_first(indices: &mut Vec<u32>, hull: &[bool]) -> u32 {
+    let tris: Vec<[u32; 3]> = indices.chunks_exact(3).map(|t| [t[0], t[1], t[2]]).collect();
+    let (on, off): (Vec<_>, Vec<_>) = tris.iter().zip(hull).partition(|(_, &h)| h);
+    *indices = on.iter().chain(&off).flat_map(|(t, _)| t.iter().copied()).collect();
+    on.len() as u32
+}
+
 /// At most three points spread over `n`: first, middle, last.
 fn probe_points(n: usize) -> Vec<usize> {
     let mut p = vec![0, n / 2, n.saturating_sub(1)];
@@ -200,4 +235,17 @@ fn local_alpha(set: &super::input::LoadedSet, p: usize, o: usize, pixels: &[u32]
         .object_layer(&set.channels[o], TraceLayer::Local)
         .and_then(|l| l.channel("A"))
         .map_or(0.0, |a| pixels.iter().map(|&px| a[px as usize]).fold(0.0, f32::max))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::hull_first;
+
+    #[test]
+    fn hull_triangles_move_first_in_their_order() {
+        let mut indices = vec![0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11];
+        let hull = [false, true, false, true];
+        assert_eq!(hull_first(&mut indices, &hull), 2);
+        assert_eq!(indices, [3, 4, 5, 9, 10, 11, 0, 1, 2, 6, 7, 8]);
+    }
 }

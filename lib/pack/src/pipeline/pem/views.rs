@@ -52,7 +52,7 @@ fn gather_n(pixels: &[u32], values: &[f32], n: usize) -> Vec<f32> {
 
 /// The shell object of `o` at point `p` for `shell` with `layout`, its eye and its
 /// clip-from-object, as the player draws it.
-fn shell_object<'m>(set: &LoadedSet, p: usize, o: usize, mesh: &'m Mesh, shell: Shell, layout: TextureLayout) -> ShellObject<'m> {
+fn shell_object<'m>(set: &LoadedSet, p: usize, o: usize, mesh: &'m Mesh, shell: Shell, layout: TextureLayout, drawn: Option<&'m [bool]>) -> ShellObject<'m> {
     let (w, h) = set.resolution;
     let frame = &set.frames[p];
     let world = frame.instances[o].world_from_object;
@@ -66,7 +66,7 @@ fn shell_object<'m>(set: &LoadedSet, p: usize, o: usize, mesh: &'m Mesh, shell: 
         eye: frame.camera.world_from_camera.w_axis.truncate(),
         shell,
         layout,
-        drawn: None,
+        drawn,
     }
 }
 
@@ -83,10 +83,34 @@ fn occluders(set: &LoadedSet, p: usize, o: usize, meshes: &[Mesh]) -> Result<pis
     Ok(scene_depth(Viewport { width: w, height: h }, &draw, Some(o))?)
 }
 
-/// The set's points `points` as object `o`'s `shells` (each with its cube layout) see them.
-/// `pixels[k]` are the rows of the object's surface render matrices at point `points[k]`,
-/// which the shells' rows must equal.
-pub fn shell_views(set: &LoadedSet, o: usize, meshes: &[Mesh], shells: &[(Shell, TextureLayout)], f0: [f32; 3], pixels: &[Vec<u32>], points: &[usize]) -> Result<Vec<ShellView>> {
+/// `a` with a row at every pixel of `pixels` (ascending, a superset of `a`'s): its own row
+/// where it has one, else an empty row (the shell is not drawn there).
+fn with_rows_at(a: &RenderMatrix, pixels: &[u32]) -> RenderMatrix {
+    let mut out = RenderMatrix { width: a.width, height: a.height, layout: a.layout, row_start: vec![0], ..Default::default() };
+    let mut r = 0;
+    for &p in pixels {
+        while r < a.rows() && a.pixels[r] < p {
+            r += 1;
+        }
+        if r < a.rows() && a.pixels[r] == p {
+            let (c, v) = a.row(r);
+            out.cols.extend_from_slice(c);
+            out.vals.extend_from_slice(v);
+            out.coverage.push(a.coverage[r]);
+        } else {
+            out.coverage.push(0.0);
+        }
+        out.row_start.push(out.cols.len() as u32);
+        out.pixels.push(p);
+    }
+    out
+}
+
+/// The set's points `points` as object `o`'s `shells` (each with its cube layout, and the
+/// triangles it is drawn on: `None` all of them) see them. `pixels[k]` are the rows of the
+/// object's surface render matrices at point `points[k]`, which the shells' rows must equal;
+/// a pixel whose triangle does not draw a shell has an empty row in its matrix.
+pub fn shell_views(set: &LoadedSet, o: usize, meshes: &[Mesh], shells: &[(Shell, TextureLayout, Option<&[bool]>)], f0: [f32; 3], pixels: &[Vec<u32>], points: &[usize]) -> Result<Vec<ShellView>> {
     let (w, h) = set.resolution;
     let vp = Viewport { width: w, height: h };
     let channel = &set.channels[o];
@@ -98,15 +122,18 @@ pub fn shell_views(set: &LoadedSet, o: usize, meshes: &[Mesh], shells: &[(Shell,
             let depth = occluders(set, p, o, meshes)?;
             let cov = coverage(set, p, o);
             let mut a = Vec::with_capacity(shells.len());
-            for &(shell, layout) in shells {
-                let m = shell_render_matrix(vp, &shell_object(set, p, o, &meshes[o], shell, layout), Some(&depth))?;
-                let m = restrict_rows(&m, &cov);
+            for &(shell, layout, drawn) in shells {
+                let m = shell_render_matrix(vp, &shell_object(set, p, o, &meshes[o], shell, layout, drawn), Some(&depth))?;
+                let mut m = restrict_rows(&m, &cov);
+                if drawn.is_some() {
+                    m = with_rows_at(&m, pixels);
+                }
                 if m.pixels != *pixels {
                     return Err(anyhow!("object {name}: point {p}: the shell and surface render matrices cover different pixels"));
                 }
                 a.push(m);
             }
-            let (fp, f) = shell_fresnel(vp, &shell_object(set, p, o, &meshes[o], shells[0].0, shells[0].1), Some(&depth), f0)?;
+            let (fp, f) = shell_fresnel(vp, &shell_object(set, p, o, &meshes[o], shells[0].0, shells[0].1, None), Some(&depth), f0)?;
             let mut fresnel = Vec::with_capacity(pixels.len() * 3);
             let mut k = 0;
             for &px in pixels {
@@ -134,7 +161,7 @@ pub fn face_resolution(set: &LoadedSet, o: usize, meshes: &[Mesh], shell: Shell,
     let mut finest = vec![0usize; layout.levels as usize];
     for p in (0..set.frames.len()).step_by(step) {
         let depth = occluders(set, p, o, meshes)?;
-        let a = restrict_rows(&shell_render_matrix(vp, &shell_object(set, p, o, &meshes[o], shell, layout), Some(&depth))?, &coverage(set, p, o));
+        let a = restrict_rows(&shell_render_matrix(vp, &shell_object(set, p, o, &meshes[o], shell, layout, None), Some(&depth))?, &coverage(set, p, o));
         for r in 0..a.rows() {
             let (cols, vals) = a.row(r);
             let level = cols.iter().zip(vals).filter(|(_, &v)| v > 0.0).map(|(&c, _)| level_of(&layout, c as usize)).min();
@@ -163,4 +190,21 @@ pub const MIN_FACE: u32 = 8;
 fn level_of(layout: &TextureLayout, c: usize) -> usize {
     let within = c % layout.face_len();
     (0..layout.levels).rev().find(|&m| layout.level_offset(m) <= within).unwrap_or(0) as usize
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn rows_are_placed_at_their_pixels_and_the_others_left_empty() {
+        let a = RenderMatrix { width: 4, height: 1, layout: TextureLayout::cube(1), row_start: vec![0, 2, 3], cols: vec![0, 1, 5], vals: vec![0.25, 0.75, 1.0], pixels: vec![1, 3], coverage: vec![1.0, 0.5] };
+        let b = with_rows_at(&a, &[0, 1, 2, 3]);
+        assert_eq!(b.pixels, [0, 1, 2, 3]);
+        assert_eq!(b.coverage, [0.0, 1.0, 0.0, 0.5]);
+        assert_eq!(b.row(0).0.len(), 0);
+        assert_eq!(b.row(1), (&[0u32, 1][..], &[0.25f32, 0.75][..]));
+        assert_eq!(b.row(2).0.len(), 0);
+        assert_eq!(b.row(3), (&[5u32][..], &[1.0f32][..]));
+    }
 }
