@@ -75,8 +75,10 @@ pub struct PackOptions {
     #[arg(long, default_value = "separate", value_parser = parse_layers)]
     pub layers: LayerMode,
     /// Reflective objects: `texture` (parameterized surface textures), `pem` (layered
-    /// environment maps, thesis ch. 5: a local and a distant shell per parameter sample) or
-    /// `pem-infinity` (one environment map at infinity per sample: the single-shell baseline).
+    /// environment maps, thesis ch. 5: a local and a distant shell per parameter sample),
+    /// `pem-infinity` (one environment map at infinity per sample, inferred: the single-shell
+    /// baseline) or `static-env` (one environment map at infinity per sample, ray-traced from
+    /// the object's centre without the object: the static environment map of thesis 5.1).
     #[arg(long, default_value = "texture", value_parser = parse_representation)]
     pub representation: RepresentationMode,
     /// Conjugate-gradient iteration cap per colour channel of every texture solve
@@ -182,7 +184,8 @@ fn parse_representation(s: &str) -> Result<RepresentationMode, String> {
         "texture" => Ok(RepresentationMode::Texture),
         "pem" => Ok(RepresentationMode::Pem),
         "pem-infinity" => Ok(RepresentationMode::PemInfinity),
-        _ => Err(format!("unknown representation {s:?} (texture, pem or pem-infinity)")),
+        "static-env" => Ok(RepresentationMode::StaticEnv),
+        _ => Err(format!("unknown representation {s:?} (texture, pem, pem-infinity or static-env)")),
     }
 }
 
@@ -257,5 +260,14 @@ mod tests {
     fn the_flags_defaults_are_pack_settings_new() {
         let req = PackOptions::defaults().request("set".into(), None, "out.pis".into()).unwrap();
         assert_eq!(req.settings, PackSettings::new());
+    }
+
+    /// `--representation` takes every mode by the name the library gives it.
+    #[test]
+    fn every_representation_parses_by_its_name() {
+        for mode in [RepresentationMode::Texture, RepresentationMode::Pem, RepresentationMode::PemInfinity, RepresentationMode::StaticEnv] {
+            assert_eq!(parse_representation(mode.name()), Ok(mode));
+        }
+        assert!(parse_representation("static").unwrap_err().contains("static-env"));
     }
 }

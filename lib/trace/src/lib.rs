@@ -11,6 +11,8 @@
 //! - [`render_set`]: every point of a loaded scene (`pis_scene::load_with`) into a set
 //!   directory, one EXR (and ray-record file) per point as it finishes, then `set.json`.
 //! - [`render_point`]: one [`pis_scene::Frame`] into [`PointImages`] and ray records.
+//! - [`probe::incident_radiance`]: radiance arriving at a point from given directions, one
+//!   object left out (a traditional environment map, thesis 5.1).
 //! - [`set::RaySet::open`], [`set::RaySet::read_point`], [`set::RaySet::read_records`]: read
 //!   a set back (what `pis-pack` consumes).
 //!
@@ -27,6 +29,7 @@ pub mod layers;
 pub mod lights;
 pub mod material;
 pub mod memory;
+pub mod probe;
 pub mod rays;
 pub mod records;
 pub mod render;

@@ -24,6 +24,10 @@ pub struct LoadedSet {
     pub channels: Vec<String>,
     /// The set's display filter (`set.json` `filter`, RAYSET.md section 4).
     pub display_filter: pis_trace::film::GaussianFilter,
+    /// The tracer's settings the set was rendered with (`set.json` `renderer.settings`;
+    /// else the defaults at its resolution and samples per pixel): what anything traced
+    /// for the set afterwards, such as a static environment map, is traced with.
+    pub trace: TraceSettings,
 }
 
 impl LoadedSet {
@@ -155,7 +159,8 @@ pub fn load(req: &PackRequest, stages: &mut Stages) -> Result<LoadedSet, Failure
         images.push(img);
     }
     let channels = pis_trace::channel_names(&scene);
-    let loaded = LoadedSet { dir, scene, resolution: res, samples, frames, images, channels, display_filter: set.meta.filter };
+    let trace = set.meta.renderer.as_ref().and_then(|r| r.settings.clone()).unwrap_or_else(|| TraceSettings::new(res, set.meta.spp.max(1)));
+    let loaded = LoadedSet { dir, scene, resolution: res, samples, frames, images, channels, display_filter: set.meta.filter, trace };
     super::blocks::check_transforms(&loaded.scene, &loaded.frames).map_err(|e| Failure::new(Exit::NotSupported, e))?;
     stages.done("read", &format!("{} points of {}x{} from {}", loaded.samples.len(), res.0, res.1, loaded.dir.display()));
     Ok(loaded)

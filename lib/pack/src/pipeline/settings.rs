@@ -247,6 +247,10 @@ pub enum RepresentationMode {
     /// reflection direction alone), inferred against the traced incident light: the
     /// single-shell baseline of thesis 5.10.
     PemInfinity,
+    /// The static environment map of thesis 5.1 (fig. 5.1): per parameter sample one cube
+    /// map on a sphere at infinity, ray-traced from the object's centre with the object left
+    /// out (its reflections of itself are lost), not inferred from the images.
+    StaticEnv,
 }
 
 impl RepresentationMode {
@@ -256,6 +260,7 @@ impl RepresentationMode {
             RepresentationMode::Texture => "texture",
             RepresentationMode::Pem => "pem",
             RepresentationMode::PemInfinity => "pem-infinity",
+            RepresentationMode::StaticEnv => "static-env",
         }
     }
 }

@@ -7,10 +7,13 @@
 //! has one ([`super::surface`]). Each shell's render matrix comes from the hardware model's
 //! environment-map lookup ([`views`]); the cube maps are solved, every MIP level together,
 //! against the tracer's local and distant layers ([`solve`]) and stored whole ([`form`]).
+//! The baselines of thesis 5.10 and 5.1 are made here too: one map at infinity per sample,
+//! inferred (`single_shell`) or ray-traced from the object's centre ([`traced`]).
 
 pub mod fit;
 pub mod form;
 pub mod solve;
+pub mod traced;
 pub mod views;
 
 use anyhow::Result;
@@ -101,8 +104,10 @@ impl Planned for PemPlanned {
         let mut settings = SolveSettings::pyramidal();
         settings.cg = job.settings.cg;
         let largest = LARGEST_FACE.min(job.req.max_texture.next_power_of_two() / 2).max(8);
-        if job.req.representation == super::RepresentationMode::PemInfinity {
-            return single_shell(model, job, o, f0, &pixels, &keys, &settings, largest, fitted.local.origin);
+        match job.req.representation {
+            super::RepresentationMode::PemInfinity => return single_shell(model, job, o, f0, &pixels, &keys, &settings, largest, fitted.local.origin),
+            super::RepresentationMode::StaticEnv => return traced::static_env(model, job, o, f0, &pixels, &keys, largest, fitted.local.origin),
+            _ => {}
         }
         let local_n = face_resolution(set, o, &job.meshes, fitted.local, largest)?;
         let local_layout = TextureLayout::cube(local_n);
