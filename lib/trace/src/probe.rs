@@ -37,8 +37,8 @@ impl Footprint {
 }
 
 /// Radiance arriving at `origin` from each of `footprints`, for `scene` at `frame` with
-/// object `omit`, if any, taken out of it with the other parts of its reflector: per footprint the mean of `settings.spp` rays
-/// from `origin` into the patch, spread over it by the R2 sequence with a per-footprint
+/// object `omit`, if any, taken out of it with the other parts of its reflector: per
+/// footprint the mean of `settings.spp` rays from `origin` into the patch, spread over it by the R2 sequence with a per-footprint
 /// shift (as a pixel's camera samples are). The rays are traced as a reflective object's
 /// reflected rays are (one scattering event deep, seeing light spheres), so the result is
 /// comparable with the set's distant layer. Footprints are traced in parallel; every random
