@@ -74,7 +74,9 @@ pub struct PackOptions {
     /// `combined` (one view-dependent layer of diffuse + specular per parameter sample).
     #[arg(long, default_value = "separate", value_parser = parse_layers)]
     pub layers: LayerMode,
-    /// Reflective objects: `texture` (parameterized surface textures), `pem` (layered
+    /// Reflective objects: `auto` (per object, textures or layered environment maps,
+    /// whichever meets the target with fewer bytes: both are solved and the file encoded
+    /// with each), `texture` (parameterized surface textures), `pem` (layered
     /// environment maps, thesis ch. 5: a local and a distant shell per parameter sample),
     /// `pem-infinity` (one environment map at infinity per sample, inferred: the single-shell
     /// baseline) or `static-env` (one environment map at infinity per sample, ray-traced from
@@ -185,7 +187,8 @@ fn parse_representation(s: &str) -> Result<RepresentationMode, String> {
         "pem" => Ok(RepresentationMode::Pem),
         "pem-infinity" => Ok(RepresentationMode::PemInfinity),
         "static-env" => Ok(RepresentationMode::StaticEnv),
-        _ => Err(format!("unknown representation {s:?} (texture, pem, pem-infinity or static-env)")),
+        "auto" => Ok(RepresentationMode::Auto),
+        _ => Err(format!("unknown representation {s:?} (auto, texture, pem, pem-infinity or static-env)")),
     }
 }
 
@@ -265,7 +268,7 @@ mod tests {
     /// `--representation` takes every mode by the name the library gives it.
     #[test]
     fn every_representation_parses_by_its_name() {
-        for mode in [RepresentationMode::Texture, RepresentationMode::Pem, RepresentationMode::PemInfinity, RepresentationMode::StaticEnv] {
+        for mode in [RepresentationMode::Texture, RepresentationMode::Pem, RepresentationMode::PemInfinity, RepresentationMode::StaticEnv, RepresentationMode::Auto] {
             assert_eq!(parse_representation(mode.name()), Ok(mode));
         }
         assert!(parse_representation("static").unwrap_err().contains("static-env"));

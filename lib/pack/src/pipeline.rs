@@ -23,6 +23,7 @@
 //! [`crate::infer`]).
 
 pub mod blocks;
+pub mod choice;
 pub mod encode;
 pub mod infer_layers;
 pub mod input;
@@ -185,9 +186,16 @@ pub fn pack_request(req: &PackRequest, progress: &dyn Progress) -> Result<PackRe
     let inferred = infer_layers::infer_all(&set, req, &mut matrices, &mut stages).map_err(|e| Failure::new(Exit::Runtime, e))?;
     let probe_renderings = matrices.renderings();
     drop(matrices);
-    let mut packed = encode::encode_all(&set, &inferred, req, &mut stages)?;
-    let quality = encode::predicted_psnr(&set, &inferred, &packed).map_err(|e| Failure::new(Exit::Runtime, e))?;
-    stages.done("predict", &format!("decoded textures rendered through the render matrices ({})", req.matrix.name()));
+    let (inferred, chosen) = choice::choose(&set, inferred, req, &mut stages)?;
+    let (mut packed, quality) = match chosen {
+        Some(done) => done,
+        None => {
+            let packed = encode::encode_all(&set, &inferred, req, &mut stages)?;
+            let quality = encode::predicted_psnr(&set, &inferred, &packed).map_err(|e| Failure::new(Exit::Runtime, e))?;
+            stages.done("predict", &format!("decoded textures rendered through the render matrices ({})", req.matrix.name()));
+            (packed, quality)
+        }
+    };
     // The prediction travels with the file: `pis-diff FILE SET --max-psnr-drop` measures
     // the played PSNR against it.
     if let Some(p) = packed.container.provenance.as_mut() {

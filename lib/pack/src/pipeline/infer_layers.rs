@@ -8,21 +8,34 @@ use super::blocks::stagger;
 use super::input::LoadedSet;
 use super::matrices::Matrices;
 use super::model::ObjectModel;
-use super::represent::{choose, Job};
+use super::represent::{alternative, choose, Job};
 use super::{PackRequest, Stages};
 
 pub use super::model::{key, InferredLayer, PointView};
 pub use super::surface::{BLACK, DISPLAY_STEP};
 
-/// Infers every object that covers a pixel somewhere in the set.
-pub fn infer_all(set: &LoadedSet, req: &PackRequest, matrices: &mut Matrices, stages: &mut Stages) -> Result<Vec<ObjectModel>> {
+/// Every object that covers a pixel somewhere in the set, inferred; and, for the objects
+/// that have an alternative representation to choose from (`--representation auto`), that
+/// alternative, by index into the models.
+pub struct Inferred {
+    pub models: Vec<ObjectModel>,
+    pub alternatives: Vec<(usize, ObjectModel)>,
+}
+
+/// Infers every object that covers a pixel somewhere in the set, in its representation and
+/// in its alternative, if any.
+pub fn infer_all(set: &LoadedSet, req: &PackRequest, matrices: &mut Matrices, stages: &mut Stages) -> Result<Inferred> {
     let scene = &set.scene;
     let mut job = Job::new(set, req, matrices, stages.progress())?;
     let mut surveyed = Vec::new();
     for (o, object) in scene.objects.iter().enumerate() {
         let rep = choose(object.role, req.representation).ok_or_else(|| anyhow!("object {}: no representation stores a {:?} object", object.name, object.role))?;
         if let Some(s) = rep.survey(&mut job, o)? {
-            surveyed.push(s);
+            let other = match alternative(object.role, req.representation).filter(|_| super::pem::layered(set, o)) {
+                Some(alt) => alt.survey(&mut job, o)?,
+                None => None,
+            };
+            surveyed.push((s, other));
         }
     }
     if surveyed.is_empty() {
@@ -30,9 +43,13 @@ pub fn infer_all(set: &LoadedSet, req: &PackRequest, matrices: &mut Matrices, st
     }
     let n = surveyed.len();
     let mut planned = Vec::with_capacity(n);
-    for (mi, s) in surveyed.into_iter().enumerate() {
+    for (mi, (s, other)) in surveyed.into_iter().enumerate() {
         let st = stagger(mi, n, &job.sizes);
-        planned.push(s.plan(&mut job, st)?);
+        let other = match other {
+            Some(a) => Some(a.plan(&mut job, st.clone())?),
+            None => None,
+        };
+        planned.push((s.plan(&mut job, st)?, other));
     }
     let (made, extra) = (job.placements, job.extra_matrices);
     let matrices_text = format!(
@@ -41,13 +58,23 @@ pub fn infer_all(set: &LoadedSet, req: &PackRequest, matrices: &mut Matrices, st
     );
     let progress = job.progress;
     stages.done("matrices", &matrices_text);
-    let mut out = Vec::with_capacity(n);
-    for p in planned {
-        let m = p.solve(&job)?;
+    let mut models = Vec::with_capacity(n);
+    let mut alternatives = Vec::new();
+    let note = |m: &ObjectModel| {
         let sizes_text: Vec<String> = m.used_placements().iter().map(|&p| format!("{}x{}", m.placements[p].layout.width, m.placements[p].layout.height)).collect();
         progress.note(&format!("object {}: {} texels, {} ({})", m.name, sizes_text.join(", "), m.representation, m.why));
-        out.push(m);
+    };
+    for (mi, (p, other)) in planned.into_iter().enumerate() {
+        let m = p.solve(&job)?;
+        note(&m);
+        models.push(m);
+        if let Some(a) = other {
+            let m = a.solve(&job)?;
+            note(&m);
+            alternatives.push((mi, m));
+        }
     }
-    stages.done("infer", &format!("{} objects solved", out.len()));
-    Ok(out)
+    let also = if alternatives.is_empty() { String::new() } else { format!(", {} of them also as the alternative", alternatives.len()) };
+    stages.done("infer", &format!("{} objects solved{also}", models.len()));
+    Ok(Inferred { models, alternatives })
 }

@@ -54,7 +54,14 @@ pub const REPRESENTATIONS: &[&dyn Representation] = &[&LayeredPem, &SurfaceTextu
 /// (environment maps only when `mode` asks for them; the layered representation then makes
 /// one or two shells as `mode` says).
 pub fn choose(role: ObjectRole, mode: RepresentationMode) -> Option<&'static dyn Representation> {
-    REPRESENTATIONS.iter().copied().filter(|r| mode != RepresentationMode::Texture || r.name() != LayeredPem.name()).find(|r| r.applies(role))
+    let textures_only = matches!(mode, RepresentationMode::Texture | RepresentationMode::Auto);
+    REPRESENTATIONS.iter().copied().filter(|r| !textures_only || r.name() != LayeredPem.name()).find(|r| r.applies(role))
+}
+
+/// The representation also solved for an object of `role` under `mode`, to be chosen
+/// between by [`super::choice`]: layered environment maps for a reflective object in `auto`.
+pub fn alternative(role: ObjectRole, mode: RepresentationMode) -> Option<&'static dyn Representation> {
+    (mode == RepresentationMode::Auto && LayeredPem.applies(role)).then_some(&LayeredPem as &dyn Representation)
 }
 
 /// What every representation works with: the set and the request, the render-matrix

@@ -251,6 +251,10 @@ pub enum RepresentationMode {
     /// map on a sphere at infinity, ray-traced from the object's centre with the object left
     /// out (its reflections of itself are lost), not inferred from the images.
     StaticEnv,
+    /// Per reflective object, surface textures or layered environment maps, whichever meets
+    /// the target with fewer bytes: both are solved and the whole file encoded with each
+    /// ([`super::choice`]).
+    Auto,
 }
 
 impl RepresentationMode {
@@ -261,6 +265,7 @@ impl RepresentationMode {
             RepresentationMode::Pem => "pem",
             RepresentationMode::PemInfinity => "pem-infinity",
             RepresentationMode::StaticEnv => "static-env",
+            RepresentationMode::Auto => "auto",
         }
     }
 }

@@ -63,7 +63,9 @@ impl Inferred {
         if let Some(device) = matrices.device() {
             stages.note(&format!("probe mode on {device}"));
         }
-        let models = infer_all(&set, req, &mut matrices, &mut stages).map_err(|e| Failure::new(Exit::Runtime, e))?;
+        let inferred = infer_all(&set, req, &mut matrices, &mut stages).map_err(|e| Failure::new(Exit::Runtime, e))?;
+        // `auto` chooses once, for the request's own target.
+        let (models, _) = super::choice::choose(&set, inferred, req, &mut stages)?;
         let infer_ms = t.elapsed().as_secs_f64() * 1e3;
         Ok(Inferred { set, models, load_ms, infer_ms })
     }

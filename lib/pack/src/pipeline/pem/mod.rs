@@ -52,10 +52,7 @@ impl Representation for LayeredPem {
     fn survey(&self, job: &mut Job<'_>, o: usize) -> Result<Option<Box<dyn Surveyed>>> {
         let set = job.set;
         let name = &set.scene.objects[o].name;
-        let layered = set.images.first().is_some_and(|i| {
-            i.object_layer(&set.channels[o], TraceLayer::Local).is_some() && i.object_layer(&set.channels[o], TraceLayer::Distant).is_some()
-        });
-        if !layered {
+        if !layered(set, o) {
             job.note(&format!("object {name}: the set has no local and distant layers for it; stored as surface textures"));
             return survey_surface(job, o, true);
         }
@@ -225,6 +222,12 @@ fn hull_first(indices: &mut Vec<u32>, hull: &[bool]) -> u32 {
     let (on, off): (Vec<_>, Vec<_>) = tris.iter().zip(hull).partition(|(_, &h)| h);
     *indices = on.iter().chain(&off).flat_map(|(t, _)| t.iter().copied()).collect();
     on.len() as u32
+}
+
+/// Whether the set has the tracer's local and distant layers of object `o`, which layered
+/// environment maps are solved against.
+pub fn layered(set: &super::input::LoadedSet, o: usize) -> bool {
+    set.images.first().is_some_and(|i| i.object_layer(&set.channels[o], TraceLayer::Local).is_some() && i.object_layer(&set.channels[o], TraceLayer::Distant).is_some())
 }
 
 /// At most three points spread over `n`: first, middle, last.
