@@ -281,16 +281,22 @@ fn random_premultiplied(texels: usize, seed: u64) -> Vec<f32> {
     (0..texels).flat_map(|t| [r[4 * t] * r[4 * t + 3], r[4 * t + 1] * r[4 * t + 3], r[4 * t + 2] * r[4 * t + 3], r[4 * t + 3]]).collect()
 }
 
+/// Random local (premultiplied, from `seed`) and distant (from `seed + 1`) cube maps, and
+/// the sphere's placement: turned 30° about y and moved, as rows and as a matrix.
+fn random_shells_on_a_turned_sphere(seed: u64) -> (Vec<f32>, Vec<f32>, [f32; 12], Mat4) {
+    let local = random_premultiplied(LOCAL.layout().texel_count(), seed);
+    let distant = random(DISTANT.layout().texel_count() * 3, seed + 1);
+    let world_rows = pis_format::samples::rotate_y_translate(30.0, [0.1, -0.05, 0.0]);
+    (local, distant, world_rows, mat4_from_rows(&world_rows))
+}
+
 #[test]
 fn random_shells_match_the_hardware_model() {
     let test = "random_shells_match_the_hardware_model";
     let Some(gpu) = gpu_or_skip(test) else { return };
     let gpu = Arc::new(gpu);
     let dir = tempfile::tempdir().unwrap();
-    let local = random_premultiplied(LOCAL.layout().texel_count(), 11);
-    let distant = random(DISTANT.layout().texel_count() * 3, 12);
-    let world_rows = pis_format::samples::rotate_y_translate(30.0, [0.1, -0.05, 0.0]);
-    let world = mat4_from_rows(&world_rows);
+    let (local, distant, world_rows, world) = random_shells_on_a_turned_sphere(11);
     let mesh = uv_sphere(1.0, 48, 24);
     let normals = mesh.normals.clone().unwrap();
     let free = ViewCamera { eye: Vec3::new(-1.3, 0.9, 2.6), target: Vec3::new(0.1, 0.0, 0.0), up: Vec3::Y, yfov_rad: 0.9, near: 0.1, far: 50.0 };
@@ -339,10 +345,7 @@ fn hull_triangles_draw_the_distant_shell_only() {
     let Some(gpu) = gpu_or_skip(test) else { return };
     let gpu = Arc::new(gpu);
     let dir = tempfile::tempdir().unwrap();
-    let local = random_premultiplied(LOCAL.layout().texel_count(), 21);
-    let distant = random(DISTANT.layout().texel_count() * 3, 22);
-    let world_rows = pis_format::samples::rotate_y_translate(30.0, [0.1, -0.05, 0.0]);
-    let world = mat4_from_rows(&world_rows);
+    let (local, distant, world_rows, world) = random_shells_on_a_turned_sphere(21);
     let mut mesh = uv_sphere(1.0, 48, 24);
     let triangles = mesh.indices.len() / 3;
     mesh.hull_triangles = (triangles / 2) as u32;
