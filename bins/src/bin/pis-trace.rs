@@ -64,6 +64,9 @@ impl Progress for Bar {
     fn row(&self) {
         self.0.inc(1);
     }
+    fn note(&self, text: &str) {
+        self.0.suspend(|| eprintln!("pis-trace: warning: {text}"));
+    }
 }
 
 fn run(cli: &Cli) -> anyhow::Result<SetReport> {

@@ -36,6 +36,7 @@ pub mod orbit;
 pub mod rig;
 mod space;
 pub mod texture;
+pub mod toml_lights;
 
 pub use error::SceneError;
 pub use load::{load, load_with, LoadOptions};

@@ -86,6 +86,7 @@ pub fn load_with(path: &Path, options: &LoadOptions) -> Result<Scene, SceneError
         }
     }
 
+    crate::toml_lights::add_lights(&mut g.rig, &m.lights, path)?;
     let space = build_space(&m.dimensions, &g, path)?;
     g.rig.camera = resolve_camera(
         &m,

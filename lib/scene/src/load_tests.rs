@@ -302,6 +302,54 @@ fn loads_binary_gltf() {
 }
 
 #[test]
+fn scene_toml_lights_join_the_gltfs() {
+    let lights = r#"
+[[light]]
+name = "Key"
+kind = "sphere"
+position = [1, 2, 3]
+radius = 0.5
+intensity = 4
+color = [1, 0.5, 0.25]
+
+[[light]]
+name = "Sun"
+kind = "directional"
+direction = [0, -2, 0]
+
+[[light]]
+name = "Spot"
+kind = "spot"
+position = [0, 3, 0]
+direction = [1, 0, 0]
+outer_cone_deg = 30
+"#;
+    let f = Fixture::new(&format!("{TOML}{lights}"), |_, _| {});
+    let s = load(&f.toml(), None).unwrap();
+    assert!(s.emits());
+    let frame = s.frame(&[0, 0]).unwrap();
+    let names: Vec<&str> = frame.lights.iter().map(|l| l.name.as_str()).collect();
+    assert_eq!(names, ["Lamp", "Key", "Sun", "Spot"]);
+    let (key, sun, spot) = (&frame.lights[1], &frame.lights[2], &frame.lights[3]);
+    assert_eq!((key.kind, key.position, key.radius, key.radiance), (crate::LightKind::Point, Vec3::new(1.0, 2.0, 3.0), 0.5, [4.0, 2.0, 1.0]));
+    assert_eq!(sun.kind, crate::LightKind::Directional);
+    assert!(sun.direction.abs_diff_eq(Vec3::NEG_Y, 1e-6), "{}", sun.direction);
+    assert!(spot.direction.abs_diff_eq(Vec3::X, 1e-6) && spot.position.abs_diff_eq(Vec3::new(0.0, 3.0, 0.0), 1e-6), "{spot:?}");
+    assert!(matches!(spot.kind, crate::LightKind::Spot { outer_cone, .. } if (outer_cone - 30f32.to_radians()).abs() < 1e-6));
+    for (bad, field) in [
+        ("[[light]]\nname = \"A\"\nkind = \"sphere\"\nposition = [0, 1, 0]\n", "light[1].radius"),
+        ("[[light]]\nname = \"A\"\nkind = \"spot\"\nposition = [0, 1, 0]\n", "light[1].direction"),
+        ("[[light]]\nname = \"A\"\nkind = \"directional\"\ndirection = [0, 0, 0]\n", "light[1].direction"),
+        ("[[light]]\nname = \"Lamp\"\nkind = \"point\"\nposition = [0, 1, 0]\n", "light[1].name"),
+        ("[[light]]\nname = \"A\"\nkind = \"point\"\nposition = [0, 1, 0]\nintensity = -1\n", "light[1].intensity"),
+    ] {
+        let f = Fixture::new(&format!("{TOML}\n{bad}"), |_, _| {});
+        let err = load_err(&f).to_string();
+        assert!(err.contains(field), "{bad}: {err}");
+    }
+}
+
+#[test]
 fn light_path_moves_the_light() {
     let toml = r#"
 gltf = "scene.gltf"

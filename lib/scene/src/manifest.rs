@@ -30,6 +30,9 @@ pub struct Manifest {
     /// The parameter space, one `[[dimension]]` table per dimension, slowest first.
     #[serde(default, rename = "dimension")]
     pub dimensions: Vec<DimensionSpec>,
+    /// Lights of the scene.toml's own, beside the glTF's: `[[light]]`.
+    #[serde(default, rename = "light")]
+    pub lights: Vec<crate::toml_lights::LightSpec>,
     /// Named presets: `[preset.paper]`.
     #[serde(default, rename = "preset")]
     pub presets: BTreeMap<String, PresetSpec>,

@@ -33,6 +33,12 @@ pub struct Scene {
 }
 
 impl Scene {
+    /// Whether anything in the scene emits light: a light (the glTF's or scene.toml's) or a
+    /// material with emission. Without, every traced image is black.
+    pub fn emits(&self) -> bool {
+        !self.rig.lights.is_empty() || self.materials.iter().any(|m| m.emissive.iter().any(|&e| e > 0.0))
+    }
+
     /// The reflector object `o` is a part of, as the index of its first part. An object is
     /// a reflector of its own, named after itself, unless it names another (`reflector`);
     /// objects of the same reflector name share the index of the first of them.

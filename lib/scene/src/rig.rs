@@ -25,7 +25,8 @@ pub struct Rig {
 #[derive(Clone, Debug, PartialEq)]
 pub struct Node {
     pub name: String,
-    /// Index of the node in the glTF `nodes` array.
+    /// Index of the node in the glTF `nodes` array (`usize::MAX` for the node of a light
+    /// written in scene.toml).
     pub gltf_index: usize,
     /// Index into [`Rig::nodes`]; always smaller than this node's own index.
     pub parent: Option<usize>,

@@ -36,6 +36,9 @@ pub struct SetReport {
     pub seconds: f64,
     /// Bytes written (EXRs, ray records, set.json).
     pub output_bytes: u64,
+    /// What the trace found wrong with the scene without failing (also told to
+    /// [`Progress::note`] as found).
+    pub warnings: Vec<String>,
 }
 
 /// Progress notifications from [`render_set`], called from worker threads.
@@ -44,6 +47,16 @@ pub trait Progress: Sync {
     fn point(&self, _index: usize, _count: usize) {}
     /// One image row of the current point is done.
     fn row(&self) {}
+    /// A warning on the scene, before the work (e.g. nothing emits light).
+    fn note(&self, _text: &str) {}
+}
+
+/// The warning when nothing in `scene` emits light.
+pub fn darkness_warning(scene: &Scene) -> Option<String> {
+    (!scene.emits()).then(|| format!(
+        "nothing in scene {} emits light (no light in the glTF or in scene.toml, no emissive material): every image will be black; add a [[light]] to scene.toml (docs/SCENE.md)",
+        scene.name
+    ))
 }
 
 /// No progress display.
@@ -84,6 +97,10 @@ pub fn render_set(
         threads: rayon::current_num_threads(),
         ..Default::default()
     };
+    if let Some(w) = darkness_warning(scene) {
+        progress.note(&w);
+        report.warnings.push(w);
+    }
     let mut trace_seconds = 0.0;
     for index in 0..count {
         progress.point(index, count);
@@ -107,4 +124,23 @@ pub fn render_set(
         report.trace_ms_per_point = trace_seconds * 1000.0 / count as f64;
     }
     Ok(report)
+}
+
+#[cfg(test)]
+mod darkness_tests {
+    use super::darkness_warning;
+    use pis_scene::rig::LightRig;
+    use pis_scene::{LightKind, Material, Scene};
+
+    #[test]
+    fn a_scene_that_nothing_lights_is_warned_of() {
+        let mut s = Scene { name: "dark".into(), materials: vec![Material::default()], ..Default::default() };
+        let w = darkness_warning(&s).expect("a warning");
+        assert!(w.contains("dark") && w.contains("[[light]]"), "{w}");
+        s.materials[0].emissive = [0.0, 0.2, 0.0];
+        assert_eq!(darkness_warning(&s), None, "an emissive material lights it");
+        s.materials[0].emissive = [0.0; 3];
+        s.rig.lights.push(LightRig { name: "Key".into(), node: 0, kind: LightKind::Point, radiance: [1.0; 3], radius: 0.0 });
+        assert_eq!(darkness_warning(&s), None, "a light lights it");
+    }
 }

@@ -123,6 +123,9 @@ pub fn load(req: &PackRequest, stages: &mut Stages) -> Result<LoadedSet, Failure
             super::blocks::check_transforms(&scene, &frames).map_err(|e| Failure::new(Exit::NotSupported, e))?;
             let settings = TraceSettings::new(scene.resolution, scene.spp);
             let r = pis_trace::render_set(&scene, &dir, &settings, None, &pis_trace::NoProgress).map_err(trace_failure)?;
+            for w in &r.warnings {
+                stages.note(&format!("warning: {w}"));
+            }
             stages.done("trace", &format!("{} points into {}", r.points, dir.display()));
         }
         (dir, req.input.clone())
