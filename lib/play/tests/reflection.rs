@@ -290,6 +290,17 @@ fn random_shells_on_a_turned_sphere(seed: u64) -> (Vec<f32>, Vec<f32>, [f32; 12]
     (local, distant, world_rows, mat4_from_rows(&world_rows))
 }
 
+/// The layers of one sample: the local shell `local` (order 0) over the distant `distant`.
+fn local_over_distant(local: &[f32], distant: &[f32]) -> Vec<Layer<Codestream>> {
+    vec![shell_layer(&LOCAL, 0, &[local.to_vec()]), shell_layer(&DISTANT, 1, &[distant.to_vec()])]
+}
+
+/// The file camera's clip-from-world matrix at [`SIZE`].
+fn file_clip_from_world() -> Mat4 {
+    let cam = file_camera(CAMERA_EYE);
+    projection(cam.yfov, cam.znear, cam.zfar, SIZE.0, SIZE.1) * mat4_from_rows(&cam.world_from_camera).inverse()
+}
+
 #[test]
 fn random_shells_match_the_hardware_model() {
     let test = "random_shells_match_the_hardware_model";
@@ -300,15 +311,13 @@ fn random_shells_match_the_hardware_model() {
     let mesh = uv_sphere(1.0, 48, 24);
     let normals = mesh.normals.clone().unwrap();
     let free = ViewCamera { eye: Vec3::new(-1.3, 0.9, 2.6), target: Vec3::new(0.1, 0.0, 0.0), up: Vec3::Y, yfov_rad: 0.9, near: 0.1, far: 50.0 };
-    let file_cam = file_camera(CAMERA_EYE);
     let views = [
-        ("file camera", CameraChoice::Sample, projection(file_cam.yfov, file_cam.znear, file_cam.zfar, SIZE.0, SIZE.1) * mat4_from_rows(&file_cam.world_from_camera).inverse(), Vec3::from(CAMERA_EYE)),
+        ("file camera", CameraChoice::Sample, file_clip_from_world(), Vec3::from(CAMERA_EYE)),
         ("free camera", CameraChoice::Free(free), free.projection(SIZE) * free.view_matrix(), free.eye),
     ];
     let mut failures = Vec::new();
     for f0 in [[1.0f32; 3], [0.2, 0.5, 0.9]] {
-        let layers = vec![shell_layer(&LOCAL, 0, std::slice::from_ref(&local)), shell_layer(&DISTANT, 1, std::slice::from_ref(&distant))];
-        let path = write_file(dir.path(), "random.pis", f0, world_rows, 1, layers);
+        let path = write_file(dir.path(), "random.pis", f0, world_rows, 1, local_over_distant(&local, &distant));
         let mut player = open(&gpu, &path, Blend::Nearest, 1);
         for (vname, camera, clip_from_world, eye) in views {
             let object = ShellObject {
@@ -352,16 +361,13 @@ fn hull_triangles_draw_the_distant_shell_only() {
     let drawn: Vec<bool> = (0..triangles).map(|t| t >= triangles / 2).collect();
     let normals = mesh.normals.clone().unwrap();
     let f0 = [0.2f32, 0.5, 0.9];
-    let layers = vec![shell_layer(&LOCAL, 0, std::slice::from_ref(&local)), shell_layer(&DISTANT, 1, std::slice::from_ref(&distant))];
-    let path = write_mesh_file(dir.path(), "hull.pis", f0, world_rows, 1, layers, mesh.clone());
+    let path = write_mesh_file(dir.path(), "hull.pis", f0, world_rows, 1, local_over_distant(&local, &distant), mesh.clone());
     let mut player = open(&gpu, &path, Blend::Nearest, 1);
-    let cam = file_camera(CAMERA_EYE);
-    let clip_from_world = projection(cam.yfov, cam.znear, cam.zfar, SIZE.0, SIZE.1) * mat4_from_rows(&cam.world_from_camera).inverse();
     let object = ShellObject {
         positions: &mesh.positions,
         normals: &normals,
         indices: &mesh.indices,
-        clip_from_object: clip_from_world * world,
+        clip_from_object: file_clip_from_world() * world,
         world_from_object: world,
         eye: Vec3::from(CAMERA_EYE),
         shell: LOCAL.model(),

@@ -406,6 +406,7 @@ fn parts_naming_one_reflector_share_its_first_part() {
         s.objects.push(crate::SceneObject { name: name.into(), role: ObjectRole::Reflective, reflector: reflector.map(String::from), primitives: vec![] });
     }
     let of: Vec<u32> = (0..5).map(|o| s.reflector_of(o)).collect();
+    assert_eq!(s.reflectors(), of);
     assert_eq!(of, [0, 1, 0, 3, 3]);
 }
 

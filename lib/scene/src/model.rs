@@ -46,6 +46,12 @@ impl Scene {
         let Some(name) = self.objects.get(o).map(SceneObject::reflector_name) else { return o as u32 };
         self.objects.iter().position(|x| x.reflector_name() == name).unwrap_or(o) as u32
     }
+
+    /// [`Scene::reflector_of`] every object, in one pass.
+    pub fn reflectors(&self) -> Vec<u32> {
+        let mut first = std::collections::HashMap::new();
+        self.objects.iter().enumerate().map(|(o, x)| *first.entry(x.reflector_name()).or_insert(o as u32)).collect()
+    }
 }
 
 impl SceneObject {

@@ -44,6 +44,8 @@ pub struct SceneGeometry<'s> {
     triangles: Vec<Triangle>,
     sources: Vec<TriangleSource>,
     placements: Vec<Placement>,
+    /// [`Scene::reflector_of`] every object.
+    pub reflectors: Vec<u32>,
     bvh: Option<CwBvh>,
     /// Axis-aligned bounds of all triangles (min, max); zero when empty.
     pub bounds: (Vec3, Vec3),
@@ -73,6 +75,7 @@ impl<'s> SceneGeometry<'s> {
         let mut triangles = Vec::new();
         let mut sources = Vec::new();
         let mut placements = Vec::with_capacity(scene.objects.len());
+        let reflectors = scene.reflectors();
         let mut lo = Vec3::splat(f32::INFINITY);
         let mut hi = Vec3::splat(f32::NEG_INFINITY);
         for (o, object) in scene.objects.iter().enumerate() {
@@ -98,7 +101,7 @@ impl<'s> SceneGeometry<'s> {
                     triangles.push(Triangle { v0: a.into(), v1: b.into(), v2: c.into() });
                     sources.push(TriangleSource {
                         object: o as u32,
-                        reflector: scene.reflector_of(o),
+                        reflector: reflectors[o],
                         primitive: p as u32,
                         first_index: (k * 3) as u32,
                     });
@@ -112,7 +115,7 @@ impl<'s> SceneGeometry<'s> {
         } else {
             Some(build_cwbvh_from_tris(&triangles, BvhBuildParams::medium_build(), &mut Duration::default()))
         };
-        SceneGeometry { scene, triangles, sources, placements, bvh, bounds: (lo, hi) }
+        SceneGeometry { scene, triangles, sources, placements, reflectors, bvh, bounds: (lo, hi) }
     }
 
     /// Number of world triangles.

@@ -106,8 +106,6 @@ pub struct Integrator<'s> {
     pub settings: TraceSettings,
     /// Coherent-sampling cell size actually used (0 = per pixel sample).
     pub cell: f32,
-    /// [`Scene::reflector_of`] each object.
-    reflectors: Vec<u32>,
 }
 
 impl<'s> Integrator<'s> {
@@ -121,8 +119,7 @@ impl<'s> Integrator<'s> {
                 if diag > 0.0 { diag / 4096.0 } else { 0.0 }
             }
         };
-        let reflectors = (0..scene.objects.len()).map(|o| scene.reflector_of(o)).collect();
-        Integrator { scene, frame, geometry, settings: settings.clone(), cell, reflectors }
+        Integrator { scene, frame, geometry, settings: settings.clone(), cell }
     }
 
     fn rng_at(&self, sp: &SurfacePoint, depth: u32, ctx: &PathContext) -> Rng {
@@ -532,8 +529,9 @@ impl<'s> Integrator<'s> {
         let hit = self.trace(o, d, None, ctx);
         let light_first = hit_light_sphere(&self.frame.lights, o, d, hit.map_or(f32::INFINITY, |h| h.t)).is_some();
         let incident = self.radiance_from(hit, o, d, 1, diffuse_left, true, ctx) * g;
-        let reflector = self.reflectors[object as usize];
-        if !light_first && hit.is_some_and(|h| self.reflectors[h.object as usize] == reflector) {
+        let reflectors = &self.geometry.reflectors;
+        let reflector = reflectors[object as usize];
+        if !light_first && hit.is_some_and(|h| reflectors[h.object as usize] == reflector) {
             s.local = incident;
             s.local_alpha = 1.0;
             s.distant = self.radiance(o, d, 1, diffuse_left, true, Some(reflector), ctx) * g;

@@ -55,10 +55,10 @@ pub fn incident_radiance(scene: &Scene, frame: &Frame, settings: &TraceSettings,
     // indices) and lose their triangles.
     let scene = match omit {
         Some(o) if (o as usize) < scene.objects.len() => {
-            let reflector = scene.reflector_of(o as usize);
+            let reflectors = scene.reflectors();
             let mut without = scene.clone();
-            for (k, object) in without.objects.iter_mut().enumerate() {
-                if scene.reflector_of(k) == reflector {
+            for (object, &r) in without.objects.iter_mut().zip(&reflectors) {
+                if r == reflectors[o as usize] {
                     object.primitives.clear();
                 }
             }

@@ -102,10 +102,19 @@ pub fn static_env(mut model: ObjectModel, job: &Job<'_>, o: usize, f0: [f32; 3],
     let all: Vec<usize> = (0..set.frames.len()).collect();
     let views = shell_views(set, o, &job.meshes, &[(shell, layout, None)], f0, pixels, &all)?;
     let first = set.frames[0].instances[o].world_from_object.inverse();
-    let mut textures = BTreeMap::new();
-    for (frame, k) in set.frames.iter().zip(keys) {
-        let centre = (frame.instances[o].world_from_object * first).transform_point3(origin.as_vec3());
-        textures.insert(k.clone(), traced_cube(&set.scene, frame, &set.trace, centre, layout, Some(o as u32), radiance_clip(f0))?);
+    // The map does not depend on the camera: points whose objects and lights stand alike
+    // (every point of a view-only space) share one trace.
+    let mut textures: BTreeMap<Vec<u32>, Vec<f32>> = BTreeMap::new();
+    for (p, (frame, k)) in set.frames.iter().zip(keys).enumerate() {
+        let same = (0..p).find(|&q| set.frames[q].instances == frame.instances && set.frames[q].lights == frame.lights);
+        let cube = match same {
+            Some(q) => textures[&keys[q]].clone(),
+            None => {
+                let centre = (frame.instances[o].world_from_object * first).transform_point3(origin.as_vec3());
+                traced_cube(&set.scene, frame, &set.trace, centre, layout, Some(o as u32), radiance_clip(f0))?
+            }
+        };
+        textures.insert(k.clone(), cube);
     }
     let grid_blocks = pis_format::blocks::BlockGrid::new(&job.space, job.all, &model.stagger).block_count() as usize;
     model.layers.push(InferredLayer {
