@@ -17,23 +17,75 @@ pub const MAX_TEXTURE_SIDE: u32 = 16384;
 /// Largest number of pyramid levels.
 pub const MAX_LEVELS: usize = 32;
 
-/// A level image may decode to at most this many times the file's length (rule 6009), so
-/// that no small file can make a reader allocate without bound.
-pub const MAX_EXPANSION: u64 = 1024;
+/// A level image may decode to at most this many times the bytes of the file's codestreams
+/// (rule 6009), so that no small file can make a reader allocate without bound.
+pub const MAX_EXPANSION: u64 = 1 << 13;
 
-/// Rule 6009 for a file of `file_len` bytes: every level image's decoded size (4 bytes per
-/// value) is at most [`MAX_EXPANSION`] × `file_len`.
-pub fn decoded_sizes<S>(c: &Container<S>, file_len: u64) -> Option<Issue> {
-    let limit = MAX_EXPANSION.saturating_mul(file_len);
+/// All level images of a file together may decode to at most this many times the bytes of
+/// its codestreams (rule 6010), so that decoding every one (validation, re-encoding) takes
+/// time proportional to the codestreams.
+pub const MAX_TOTAL_EXPANSION: u64 = 1 << 17;
+
+/// Bytes one level image of `layer`'s block `block` decodes to (4 bytes per value, all
+/// planes); `u64::MAX` when its planes are malformed.
+pub fn level_image_bytes<S>(layer: &Layer<S>, block: &Block<S>) -> u64 {
+    let planes = crate::texture::LevelLayout::of(layer, block).planes();
+    pis_codec::value_count(&planes).map_or(u64::MAX, |n| (n as u64).saturating_mul(4))
+}
+
+/// Bytes of codestream the level images of a file read: the union of the byte ranges its
+/// references cover (a codestream shared by several references counts once), the quantity
+/// rules 6009 and 6010 measure decoded sizes against.
+pub fn referenced_bytes(c: &Container<StreamRef>) -> u64 {
+    let mut ranges: Vec<(u32, u64, u64)> = Vec::new();
+    for o in &c.objects {
+        for l in &o.layers {
+            for b in &l.blocks {
+                for r in b.levels.iter().flat_map(|level| &level.images) {
+                    ranges.push((r.chunk, r.offset, r.offset.saturating_add(r.length as u64)));
+                }
+            }
+        }
+    }
+    ranges.sort_unstable();
+    let (mut total, mut open): (u64, Option<(u32, u64, u64)>) = (0, None);
+    for (chunk, start, end) in ranges {
+        open = match open {
+            Some((c, s, e)) if c == chunk && start <= e => Some((c, s, e.max(end))),
+            Some((_, s, e)) => {
+                total = total.saturating_add(e - s);
+                Some((chunk, start, end))
+            }
+            None => Some((chunk, start, end)),
+        };
+    }
+    total.saturating_add(open.map_or(0, |(_, s, e)| e - s))
+}
+
+/// Rules 6009 and 6010 for a file whose level images read `codestream_bytes` bytes of
+/// codestream ([`referenced_bytes`]): every level image decodes to at most
+/// [`MAX_EXPANSION`] × `codestream_bytes`, all of them together to at most
+/// [`MAX_TOTAL_EXPANSION`] × `codestream_bytes`. Checked before anything is decoded, so
+/// every allocation and all the decoding a file can ask for are bounded by its codestreams,
+/// not by bytes a writer could pad the file with.
+pub fn decoded_sizes<S>(c: &Container<S>, codestream_bytes: u64) -> Option<Issue> {
+    let limit = MAX_EXPANSION.saturating_mul(codestream_bytes);
+    let total_limit = MAX_TOTAL_EXPANSION.saturating_mul(codestream_bytes);
+    let mut total = 0u64;
     for (oi, o) in c.objects.iter().enumerate() {
         for (li, l) in o.layers.iter().enumerate() {
             for (bi, b) in l.blocks.iter().enumerate() {
-                let planes = crate::texture::LevelLayout::of(l, b).planes();
-                let bytes = pis_codec::value_count(&planes).map_or(u64::MAX, |n| n as u64 * 4);
+                let bytes = level_image_bytes(l, b);
+                let what = || format!("object {oi} '{}' layer {li} block {bi}", o.name);
                 if bytes > limit {
-                    let what = format!("object {oi} '{}' layer {li} block {bi}", o.name);
-                    let detail = format!("{what}: {bytes} bytes per level image; a {file_len}-byte file allows {limit}");
+                    let detail = format!("{}: {bytes} bytes per level image; {codestream_bytes} bytes of codestream allow {limit}", what());
                     return Some(chunk(Issue::new(6009, detail), "LAYR"));
+                }
+                let images = b.levels.iter().map(|level| level.images.len() as u64).sum::<u64>();
+                total = total.saturating_add(bytes.saturating_mul(images));
+                if total > total_limit {
+                    let detail = format!("{}: the level images up to this block decode to {total} bytes; {codestream_bytes} bytes of codestream allow {total_limit}", what());
+                    return Some(chunk(Issue::new(6010, detail), "LAYR"));
                 }
             }
         }

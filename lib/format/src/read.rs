@@ -353,14 +353,13 @@ pub(crate) fn load(src: &dyn Source, full: bool, issues: &mut Vec<Issue>) -> Loa
     if !ok || issues.iter().any(|i| i.severity == Severity::Error) {
         return out;
     }
-    out.container = parse(&out.chunks, &payloads, len, issues);
+    out.container = parse(&out.chunks, &payloads, issues);
     out
 }
 
 fn parse(
     entries: &[ChunkEntry],
     payloads: &[Option<Vec<u8>>],
-    file_len: u64,
     issues: &mut Vec<Issue>,
 ) -> Option<Container<StreamRef>> {
     let find = |f: chunk::FourCC| entries.iter().position(|e| e.fourcc == f);
@@ -452,7 +451,7 @@ fn parse(
     }
     stream_ranges(entries, &container, issues);
     if issues.len() == before {
-        if let Some(issue) = checks::decoded_sizes(&container, file_len) {
+        if let Some(issue) = checks::decoded_sizes(&container, checks::referenced_bytes(&container)) {
             issues.push(issue);
         }
     }

@@ -167,10 +167,12 @@ fn serialize(c: &Container, masters: &[Master], labelled: bool) -> Result<Sink, 
             )));
         }
     }
-    let sink = serialize_inner(c, masters, labelled);
-    if let Some(issue) = checks::decoded_sizes(c, sink.len() as u64) {
+    // The writer stores every codestream once, in one CSTR chunk (see `serialize_inner`).
+    let codestream_bytes = c.objects.iter().flat_map(|o| &o.layers).flat_map(|l| &l.blocks).flat_map(|b| &b.levels).flat_map(|l| &l.images).map(|r| r.bytes.len() as u64).sum();
+    if let Some(issue) = checks::decoded_sizes(c, codestream_bytes) {
         return Err(Error::InvalidModel(issue));
     }
+    let sink = serialize_inner(c, masters, labelled);
     Ok(sink)
 }
 

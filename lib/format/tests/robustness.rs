@@ -176,13 +176,35 @@ fn damaged_files_give_errors_never_panics() {
             "only {deep} mutations reached the payload parsers"
         );
         let largest = LARGEST.load(Ordering::Relaxed);
-        // A level image decodes to at most 1024× the file (rule 6009); decoders may need a
-        // few times that as working memory. Anything beyond would be an allocation sized by an
-        // unchecked field.
+        // A level image decodes to at most MAX_EXPANSION × the file's codestream bytes, fewer
+        // than its length (rule 6009); decoders may need a few times that as working memory.
+        // Anything beyond would be an allocation sized by an unchecked field.
         assert!(
-            largest <= 4 * 1024 * good.len(),
+            largest as u64 <= 4 * pis_format::checks::MAX_EXPANSION * good.len() as u64,
             "largest allocation {largest} bytes for a {}-byte file",
             good.len()
         );
     }
+}
+
+/// A valid file padded with an unknown optional chunk of 1 MiB once raised the decoded-size
+/// bound (then 1024 × the file's length) to 1 GiB per level image, so that a few hundred
+/// bytes of codestream could declare textures a player allocated gigabytes for. The bound
+/// is now measured on the codestream bytes the level images read: padding changes nothing.
+#[test]
+fn padding_a_file_does_not_raise_its_decoded_size_bound() {
+    let mut c = tiny().unwrap();
+    let b = &mut c.objects[0].layers[0].blocks[0];
+    (b.width, b.height) = (1024, 1024);
+    let declared = to_bytes_unchecked(&c);
+    let padded = common::append_chunk(&declared, *b"ZZZZ", 0, &vec![0; 1 << 20]);
+    assert_eq!(PisReader::from_bytes(declared).err().and_then(|e| e.issue().map(|i| i.id)), Some(6009));
+    let report = validate_bytes(padded.clone());
+    assert!(report.issues.iter().any(|i| i.id == 6009), "{:?}", report.issues);
+    assert!(!report.issues.iter().any(|i| (1000..4000).contains(&i.id)), "the padded file's structure is valid: {:?}", report.issues);
+    assert_eq!(PisReader::from_bytes(padded).err().and_then(|e| e.issue().map(|i| i.id)), Some(6009));
+    // The same padding on the valid file is skipped, as an unknown optional chunk must be.
+    let good = common::append_chunk(&to_bytes(&tiny().unwrap()).unwrap(), *b"ZZZZ", 0, &vec![0; 1 << 20]);
+    assert!(validate_bytes(good.clone()).is_valid());
+    assert!(read_everything(&good));
 }
