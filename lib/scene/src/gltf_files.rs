@@ -60,8 +60,14 @@ fn resolve(gltf: &Path, field: &str, uri: &str, rel: &str, absolute: bool, allow
     if absolute {
         return Err(refuse("is an absolute path, outside the glTF's folder"));
     }
-    // Where the file exists, where it really is (`..`, links); else where its path leads.
-    let inside = match (target.canonicalize(), base.canonicalize()) {
+    if stays_inside(base, &target, rel) { Ok(target) } else { Err(refuse("leaves the glTF's folder")) }
+}
+
+/// Whether `target`, the relative path `rel` joined to the folder `base`, lies inside
+/// `base`: where the file exists, where it really is (`..`, links); else where its path
+/// leads (never above `base`, no root or drive).
+pub(crate) fn stays_inside(base: &Path, target: &Path, rel: &str) -> bool {
+    match (target.canonicalize(), base.canonicalize()) {
         (Ok(t), Ok(b)) => t.starts_with(&b),
         _ => {
             let mut depth = 0i32;
@@ -74,8 +80,7 @@ fn resolve(gltf: &Path, field: &str, uri: &str, rel: &str, absolute: bool, allow
                 depth >= 0 && !matches!(c, Component::RootDir | Component::Prefix(_))
             })
         }
-    };
-    if inside { Ok(target) } else { Err(refuse("leaves the glTF's folder")) }
+    }
 }
 
 /// Checks the buffer and image references of `gltf`, read from `path`.

@@ -21,12 +21,17 @@
 
 mod accessor_check;
 pub mod animation;
+pub mod distribution;
+mod env_image;
+pub mod environment;
 mod error;
 mod frame;
 mod gltf_files;
 mod gltf_load;
 pub mod light_path;
 mod load;
+#[cfg(test)]
+mod environment_tests;
 #[cfg(test)]
 mod load_tests;
 pub mod manifest;
@@ -38,6 +43,8 @@ mod space;
 pub mod texture;
 pub mod toml_lights;
 
+pub use env_image::{MAX_SIDE as MAX_ENVIRONMENT_SIDE, MAX_TEXELS as MAX_ENVIRONMENT_TEXELS};
+pub use environment::{Environment, EnvironmentRadiance, LatLongImage};
 pub use error::SceneError;
 pub use load::{load, load_with, LoadOptions};
 pub use model::*;

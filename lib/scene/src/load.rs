@@ -87,6 +87,7 @@ pub fn load_with(path: &Path, options: &LoadOptions) -> Result<Scene, SceneError
     }
 
     crate::toml_lights::add_lights(&mut g.rig, &m.lights, path)?;
+    let environment = m.environment.as_ref().map(|e| crate::environment::load(e, path, m.allow_outside_files)).transpose()?;
     let space = build_space(&m.dimensions, &g, path)?;
     g.rig.camera = resolve_camera(
         &m,
@@ -112,6 +113,7 @@ pub fn load_with(path: &Path, options: &LoadOptions) -> Result<Scene, SceneError
         textures: g.textures,
         space,
         rig: g.rig,
+        environment,
         source: Some(path.to_path_buf()),
     })
 }

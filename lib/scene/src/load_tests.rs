@@ -9,11 +9,11 @@ use serde_json::json;
 
 use crate::{load, load_with, LoadOptions, ObjectRole, SceneError};
 
-struct Fixture {
-    dir: tempfile::TempDir,
+pub(crate) struct Fixture {
+    pub(crate) dir: tempfile::TempDir,
 }
 
-const TOML: &str = r#"
+pub(crate) const TOML: &str = r#"
 gltf = "scene.gltf"
 resolution = [32, 24]
 spp = 2
@@ -48,7 +48,7 @@ fn f32s(v: &[f32]) -> Vec<u8> {
 
 impl Fixture {
     /// Writes the fixture; `edit` may change the glTF JSON and the buffer before writing.
-    fn new(toml: &str, edit: impl FnOnce(&mut serde_json::Value, &mut Vec<u8>)) -> Fixture {
+    pub(crate) fn new(toml: &str, edit: impl FnOnce(&mut serde_json::Value, &mut Vec<u8>)) -> Fixture {
         let positions = [0.0f32, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0];
         let times = [0.0f32, 1.0, 2.0];
         let half = std::f32::consts::FRAC_PI_4; // rotations 0°, 90°, 180° about +Y
@@ -122,12 +122,12 @@ impl Fixture {
         Fixture { dir }
     }
 
-    fn toml(&self) -> PathBuf {
+    pub(crate) fn toml(&self) -> PathBuf {
         self.dir.path().join("scene.toml")
     }
 }
 
-fn load_err(f: &Fixture) -> SceneError {
+pub(crate) fn load_err(f: &Fixture) -> SceneError {
     match load(&f.toml(), None) {
         Ok(_) => panic!("expected an error"),
         Err(e) => e,

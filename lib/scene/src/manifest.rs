@@ -33,11 +33,14 @@ pub struct Manifest {
     /// Lights of the scene.toml's own, beside the glTF's: `[[light]]`.
     #[serde(default, rename = "light")]
     pub lights: Vec<crate::toml_lights::LightSpec>,
+    /// The environment light: `[environment]`.
+    pub environment: Option<crate::environment::EnvironmentSpec>,
     /// Named presets: `[preset.paper]`.
     #[serde(default, rename = "preset")]
     pub presets: BTreeMap<String, PresetSpec>,
-    /// Let the glTF read buffers and images outside its own folder (absolute paths, `file:`
-    /// URIs, relative paths that climb out with `..`); refused by default.
+    /// Let the glTF read buffers and images, and `[environment]` its image, outside their
+    /// own folder (absolute paths, `file:` URIs, relative paths that climb out with `..`);
+    /// refused by default.
     #[serde(default)]
     pub allow_outside_files: bool,
 }

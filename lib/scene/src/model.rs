@@ -28,15 +28,21 @@ pub struct Scene {
     pub space: ParameterSpace,
     /// Node hierarchy, camera, lights and animations: what [`Scene::frame`] poses.
     pub rig: Rig,
+    /// Light from infinitely far away (scene.toml `[environment]`), the same at every
+    /// parameter point.
+    pub environment: Option<crate::environment::Environment>,
     /// The scene.toml it was loaded from (`None` for a scene built in code).
     pub source: Option<std::path::PathBuf>,
 }
 
 impl Scene {
-    /// Whether anything in the scene emits light: a light (the glTF's or scene.toml's) or a
-    /// material with emission. Without, every traced image is black.
+    /// Whether anything in the scene emits light: a light (the glTF's or scene.toml's), an
+    /// environment that is not black, or a material with emission. Without, every traced
+    /// image is black.
     pub fn emits(&self) -> bool {
-        !self.rig.lights.is_empty() || self.materials.iter().any(|m| m.emissive.iter().any(|&e| e > 0.0))
+        !self.rig.lights.is_empty()
+            || self.environment.as_ref().is_some_and(|e| e.emits())
+            || self.materials.iter().any(|m| m.emissive.iter().any(|&e| e > 0.0))
     }
 
     /// The reflector object `o` is a part of, as the index of its first part. An object is

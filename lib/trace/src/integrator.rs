@@ -1,7 +1,16 @@
 //! The distribution ray tracer: radiance along rays, and the segmented first hit that
 //! produces the per-object layers (thesis 3.1, 5.7, 6.2).
+//!
+//! Emitters are reached in two ways. Light spheres and the environment are seen by camera
+//! rays (the environment only as a `background`) and by rays of mirror, glossy and
+//! dielectric lobes until the path's first diffuse bounce; after it, and from diffuse and
+//! rough specular lobes, lights are reached by next-event estimation only (no caustics
+//! through diffuse paths: no fireflies). The environment is also sampled by next-event
+//! estimation at diffuse and rough specular lobes, and there weighed against the lobe's own
+//! sampled ray (which may leave the scene and see it) by multiple importance sampling.
 
 use crate::bvh::{offset_origin, Hit, SceneGeometry, SurfacePoint};
+use crate::environment::{balance, EnvironmentLight};
 use crate::lights::{hit_light_sphere, sample_light};
 use crate::material::{fresnel_dielectric, reflect, refract, ShadingMaterial};
 use crate::sampling::{cosine_hemisphere, ggx_g1, ggx_half_vector, luminance, Rng};
@@ -106,6 +115,8 @@ pub struct Integrator<'s> {
     pub settings: TraceSettings,
     /// Coherent-sampling cell size actually used (0 = per pixel sample).
     pub cell: f32,
+    /// The scene's environment light, if it emits.
+    pub environment: Option<EnvironmentLight<'s>>,
 }
 
 impl<'s> Integrator<'s> {
@@ -119,7 +130,39 @@ impl<'s> Integrator<'s> {
                 if diag > 0.0 { diag / 4096.0 } else { 0.0 }
             }
         };
-        Integrator { scene, frame, geometry, settings: settings.clone(), cell }
+        let environment = scene.environment.as_ref().and_then(EnvironmentLight::new);
+        Integrator { scene, frame, geometry, settings: settings.clone(), cell, environment }
+    }
+
+    /// Whether a ray sees light spheres and the environment: `sees_lights` and no diffuse
+    /// bounce on its path yet.
+    fn sees_emitters(&self, sees_lights: bool, diffuse_left: u32) -> bool {
+        sees_lights && diffuse_left >= self.settings.diffuse_bounces.max(1)
+    }
+
+    /// Radiance of the environment along a ray that leaves the scene, where the ray sees it.
+    fn escaped(&self, dir: Vec3, sees_lights: bool, diffuse_left: u32) -> Vec3 {
+        match &self.environment {
+            Some(env) if self.sees_emitters(sees_lights, diffuse_left) => env.radiance(dir),
+            _ => Vec3::ZERO,
+        }
+    }
+
+    /// Radiance along a ray sampled by a lobe whose directions the environment is also drawn
+    /// for by next-event estimation: where the ray leaves the scene, the environment weighed
+    /// by the balance heuristic (`lobe_pdf` the lobe's density of `dir`, `n` the shading
+    /// normal the environment was drawn for); where it hits, as [`Self::radiance`] with light
+    /// spheres unseen.
+    #[allow(clippy::too_many_arguments)]
+    fn radiance_mis(&self, origin: Vec3, dir: Vec3, depth: u32, diffuse_left: u32, lobe_pdf: f32, n: Vec3, ctx: &mut PathContext) -> Vec3 {
+        if depth > self.settings.max_depth {
+            return Vec3::ZERO;
+        }
+        let hit = self.trace(origin, dir, None, ctx);
+        match (&self.environment, hit) {
+            (Some(env), None) => env.radiance(dir) * balance(lobe_pdf, env.pdf(dir, n)),
+            _ => self.radiance_from(hit, origin, dir, depth, diffuse_left, false, ctx),
+        }
     }
 
     fn rng_at(&self, sp: &SurfacePoint, depth: u32, ctx: &PathContext) -> Rng {
@@ -178,15 +221,16 @@ impl<'s> Integrator<'s> {
         sees_lights: bool,
         ctx: &mut PathContext,
     ) -> Vec3 {
-        // After a diffuse bounce light spheres are reached by next-event estimation only,
-        // also along later specular segments (no caustics through diffuse paths: no fireflies).
-        if sees_lights && diffuse_left >= self.settings.diffuse_bounces.max(1) {
+        // After a diffuse bounce light spheres and the environment are reached by next-event
+        // estimation only, also along later specular segments (no caustics through diffuse
+        // paths: no fireflies).
+        if self.sees_emitters(sees_lights, diffuse_left) {
             let tmax = hit.map_or(f32::INFINITY, |h| h.t);
             if let Some((_, l)) = hit_light_sphere(&self.frame.lights, origin, dir, tmax) {
                 return l;
             }
         }
-        let Some(hit) = hit else { return Vec3::ZERO };
+        let Some(hit) = hit else { return self.escaped(dir, sees_lights, diffuse_left) };
         let sp = self.geometry.surface(&hit, origin, dir);
         let m = self.material(&sp);
         let absorb = self.absorption(&sp, &m, hit.t);
@@ -279,7 +323,11 @@ impl<'s> Integrator<'s> {
                 return direct * (1.0 - m.transmission) * (total / p_s);
             };
             let o = offset_origin(sp.position, sp.geometric_normal, d);
-            let l = self.radiance(o, d, depth + 1, diffuse_left, !rough, None, ctx);
+            let l = if rough && self.environment.is_some() {
+                self.radiance_mis(o, d, depth + 1, diffuse_left, ggx_reflection_pdf(sp.normal, -dir, d, m.alpha), sp.normal, ctx)
+            } else {
+                self.radiance(o, d, depth + 1, diffuse_left, !rough, None, ctx)
+            };
             (direct + l * f * g) * (1.0 - m.transmission) * (total / p_s)
         } else {
             self.dielectric(sp, m, dir, depth, diffuse_left, rng, ctx) * m.transmission * (total / p_t)
@@ -300,8 +348,9 @@ impl<'s> Integrator<'s> {
     }
 
     /// Incident irradiance / π at `sp` (so that albedo × it is the diffuse radiance):
-    /// next-event estimation towards every light plus `diffuse_left > 0` an indirect bounce,
-    /// averaged over `samples` estimates.
+    /// next-event estimation towards every light and the environment, plus with
+    /// `diffuse_left > 0` an indirect bounce (the environment weighed against it by multiple
+    /// importance sampling), averaged over `samples` estimates.
     fn irradiance(
         &self,
         sp: &SurfacePoint,
@@ -312,6 +361,7 @@ impl<'s> Integrator<'s> {
         ctx: &mut PathContext,
     ) -> Vec3 {
         let n = sp.normal;
+        let bounce = diffuse_left > 0 && depth < self.settings.max_depth;
         let mut direct = Vec3::ZERO;
         let mut indirect = Vec3::ZERO;
         for _ in 0..samples.max(1) {
@@ -328,7 +378,8 @@ impl<'s> Integrator<'s> {
                     direct += ls.weight * cos;
                 }
             }
-            if diffuse_left > 0 && depth < self.settings.max_depth {
+            indirect += self.environment_direct(sp, bounce, rng, ctx);
+            if bounce {
                 let mut d = cosine_hemisphere(rng.next_2d(), n);
                 // A direction below the geometric surface (shading normals differ from the
                 // facets) is mirrored back above it, keeping the lobe's energy.
@@ -337,10 +388,33 @@ impl<'s> Integrator<'s> {
                     d = (d - sp.geometric_normal * (2.0 * below)).normalize();
                 }
                 let o = offset_origin(sp.position, sp.geometric_normal, d);
-                indirect += self.radiance(o, d, depth + 1, diffuse_left - 1, false, None, ctx);
+                indirect += if self.environment.is_some() {
+                    self.radiance_mis(o, d, depth + 1, diffuse_left - 1, diffuse_pdf(n, sp.geometric_normal, d), n, ctx)
+                } else {
+                    self.radiance(o, d, depth + 1, diffuse_left - 1, false, None, ctx)
+                };
             }
         }
         (direct / PI + indirect) / samples.max(1) as f32
+    }
+
+    /// Next-event estimation of the environment's irradiance / π at `sp`, weighed against
+    /// the diffuse lobe's sampled ray when `bounce` (that ray is traced). Both estimate
+    /// ∫ L p_d with p_d the diffuse lobe's density ([`diffuse_pdf`]): each contributes
+    /// L · p_d / (p_env + p_d) with the balance heuristic.
+    fn environment_direct(&self, sp: &SurfacePoint, bounce: bool, rng: &mut Rng, ctx: &mut PathContext) -> Vec3 {
+        let Some(env) = &self.environment else { return Vec3::ZERO };
+        let Some(s) = env.sample(sp.normal, rng.next_2d()) else { return Vec3::ZERO };
+        let p_d = diffuse_pdf(sp.normal, sp.geometric_normal, s.direction);
+        if p_d <= 0.0 {
+            return Vec3::ZERO;
+        }
+        let o = offset_origin(sp.position, sp.geometric_normal, s.direction);
+        ctx.rays += 1;
+        if self.geometry.occluded(o, s.direction, f32::INFINITY) {
+            return Vec3::ZERO;
+        }
+        s.radiance * if bounce { p_d / (s.pdf + p_d) } else { p_d / s.pdf }
     }
 
     /// Irradiance / π at a camera ray's first hit. With coherent sampling it is a function of
@@ -392,6 +466,25 @@ impl<'s> Integrator<'s> {
             let tmax = if ls.distance.is_finite() { ls.distance * (1.0 - 1e-4) } else { f32::INFINITY };
             if !self.geometry.occluded(o, l, tmax) {
                 sum += f * ls.weight * (d * g / (4.0 * cos_o));
+            }
+        }
+        // The environment, weighed against the lobe's sampled ray (always traced after this).
+        if let Some(s) = self.environment.as_ref().and_then(|env| env.sample(n, rng.next_2d())) {
+            let l = s.direction;
+            let cos_l = n.dot(l);
+            if cos_l > 0.0 && sp.geometric_normal.dot(l) > 0.0 {
+                let h = (wo + l).normalize();
+                let nh = n.dot(h).max(0.0);
+                let dd = nh * nh * (a2 - 1.0) + 1.0;
+                let d = a2 / (PI * dd * dd);
+                let g = ggx_g1(cos_o, m.alpha) * ggx_g1(cos_l, m.alpha);
+                let f = m.fresnel(wo.dot(h));
+                let o = offset_origin(sp.position, sp.geometric_normal, l);
+                ctx.rays += 1;
+                if !self.geometry.occluded(o, l, f32::INFINITY) {
+                    let w = balance(s.pdf, ggx_reflection_pdf(n, wo, l, m.alpha));
+                    sum += f * s.radiance * (d * g / (4.0 * cos_o) / s.pdf * w);
+                }
             }
         }
         sum
@@ -470,7 +563,15 @@ impl<'s> Integrator<'s> {
         if let Some((_, l)) = hit_light_sphere(&self.frame.lights, origin, dir, tmax) {
             return CameraSample { combined: l, ..Default::default() };
         }
-        let Some(hit) = hit else { return CameraSample::default() };
+        let Some(hit) = hit else {
+            // The environment is drawn behind the objects only when asked for (`background`):
+            // the player draws none, and no object's layer holds it.
+            let combined = match &self.environment {
+                Some(env) if env.environment.background => env.radiance(dir),
+                _ => Vec3::ZERO,
+            };
+            return CameraSample { combined, ..Default::default() };
+        };
         let sp = self.geometry.surface(&hit, origin, dir);
         let m = self.material(&sp);
         let diffuse_left = self.settings.diffuse_bounces.max(1);
@@ -628,4 +729,31 @@ impl<'s> Integrator<'s> {
         }
         hits
     }
+}
+
+/// The density of the diffuse lobe's sampled direction `d` ([`Integrator`]'s indirect
+/// bounce): cosine-weighted about the shading normal `n`, a direction below the geometric
+/// surface (normal `ng`) mirrored back above it, so that both the direction and its mirror
+/// image lead to `d`.
+pub fn diffuse_pdf(n: Vec3, ng: Vec3, d: Vec3) -> f32 {
+    let c = ng.dot(d);
+    if c <= 0.0 {
+        return 0.0;
+    }
+    let mirrored = d - ng * (2.0 * c);
+    (n.dot(d).max(0.0) + n.dot(mirrored).max(0.0)) / PI
+}
+
+/// The density of the GGX lobe's reflected direction `l` for the view direction `wo` (both
+/// unit, away from the surface) about the shading normal `n`: D(h) (n·h) / (4 (wo·h)), the
+/// half vector h drawn proportionally to D(h) (n·h).
+pub fn ggx_reflection_pdf(n: Vec3, wo: Vec3, l: Vec3, alpha: f32) -> f32 {
+    let h = (wo + l).normalize_or_zero();
+    let (nh, vh) = (n.dot(h), wo.dot(h));
+    if nh <= 0.0 || vh <= 0.0 {
+        return 0.0;
+    }
+    let a2 = alpha * alpha;
+    let dd = nh * nh * (a2 - 1.0) + 1.0;
+    a2 / (PI * dd * dd) * nh / (4.0 * vh)
 }

@@ -22,6 +22,7 @@
 
 pub mod bvh;
 pub mod camera;
+pub mod environment;
 pub mod error;
 pub mod film;
 pub mod integrator;

@@ -40,8 +40,8 @@ impl Footprint {
 /// object `omit`, if any, taken out of it with the other parts of its reflector: per
 /// footprint the mean of `settings.spp` rays from `origin` into the patch, spread over it by the R2 sequence with a per-footprint
 /// shift (as a pixel's camera samples are). The rays are traced as a reflective object's
-/// reflected rays are (one scattering event deep, seeing light spheres), so the result is
-/// comparable with the set's distant layer. Footprints are traced in parallel; every random
+/// reflected rays are (one scattering event deep, seeing light spheres and, where they leave
+/// the scene, the environment), so the result is comparable with the set's distant layer. Footprints are traced in parallel; every random
 /// number comes from the footprint's index and the surface points the paths meet, so the
 /// result does not depend on the thread count.
 pub fn incident_radiance(scene: &Scene, frame: &Frame, settings: &TraceSettings, origin: Vec3, footprints: &[Footprint], omit: Option<u32>) -> Result<Vec<Vec3>, TraceError> {

@@ -54,7 +54,7 @@ pub trait Progress: Sync {
 /// The warning when nothing in `scene` emits light.
 pub fn darkness_warning(scene: &Scene) -> Option<String> {
     (!scene.emits()).then(|| format!(
-        "nothing in scene {} emits light (no light in the glTF or in scene.toml, no emissive material): every image will be black; add a [[light]] to scene.toml (docs/SCENE.md)",
+        "nothing in scene {} emits light (no light in the glTF or in scene.toml, no [environment], no emissive material): every image will be black; add a [[light]] or an [environment] to scene.toml (docs/SCENE.md)",
         scene.name
     ))
 }
@@ -130,7 +130,7 @@ pub fn render_set(
 mod darkness_tests {
     use super::darkness_warning;
     use pis_scene::rig::LightRig;
-    use pis_scene::{LightKind, Material, Scene};
+    use pis_scene::{Environment, EnvironmentRadiance, LightKind, Material, Scene};
 
     #[test]
     fn a_scene_that_nothing_lights_is_warned_of() {
@@ -142,5 +142,14 @@ mod darkness_tests {
         s.materials[0].emissive = [0.0; 3];
         s.rig.lights.push(LightRig { name: "Key".into(), node: 0, kind: LightKind::Point, radiance: [1.0; 3], radius: 0.0 });
         assert_eq!(darkness_warning(&s), None, "a light lights it");
+    }
+
+    #[test]
+    fn an_environment_alone_lights_a_scene_unless_it_is_black() {
+        let sky = |c: [f32; 3]| Some(Environment { radiance: EnvironmentRadiance::Uniform(c), rotation: 0.0, background: false });
+        let mut s = Scene { name: "sky".into(), materials: vec![Material::default()], environment: sky([0.0; 3]), ..Default::default() };
+        assert!(darkness_warning(&s).is_some_and(|w| w.contains("[environment]")), "a black environment lights nothing");
+        s.environment = sky([0.2, 0.3, 0.4]);
+        assert_eq!(darkness_warning(&s), None);
     }
 }
