@@ -9,7 +9,8 @@ use gltf::mesh::Mode;
 
 use crate::accessor_check::check_accessor;
 use crate::animation::{Animation, Channel, Interpolation, Sampler, TargetPath, Trs};
-use crate::material::{convert_material, infer_role};
+use crate::material::{convert_material, infer_role, mean_material};
+use crate::material_textures::TextureSet;
 use crate::model::{LightKind, Material, Primitive, SceneObject, TextureImage};
 use crate::rig::{LightRig, Node, Rig};
 use crate::SceneError;
@@ -25,6 +26,8 @@ pub(crate) struct GltfScene {
     pub cameras: Vec<GltfCamera>,
     /// Animations that cannot be sampled, with the field and reason (used only if referenced).
     pub unsupported_animations: BTreeMap<String, (String, String)>,
+    /// What the glTF uses that PIS ignores or reads otherwise, one line each.
+    pub warnings: Vec<String>,
 }
 
 /// A perspective glTF camera on a node.
@@ -50,7 +53,7 @@ pub(crate) fn read_gltf(path: &Path, allow_outside: bool) -> Result<GltfScene, S
     }
     let read = || {
         // Parsed once: the files it names are checked before any is read.
-        let gltf = gltf::Gltf::open(path).map_err(|e| import_error(path, e))?;
+        let gltf = open_gltf(path)?;
         crate::gltf_files::check_files(path, &gltf, allow_outside)?;
         let base = path.parent().unwrap_or(Path::new("./"));
         let gltf::Gltf { document: doc, blob } = gltf;
@@ -70,6 +73,20 @@ pub(crate) fn read_gltf(path: &Path, allow_outside: bool) -> Result<GltfScene, S
             message: format!("malformed data made the glTF reader fail: {what}"),
         })
     })
+}
+
+/// Parses the glTF, refuses an extension it requires that PIS can neither implement nor
+/// ignore (naming it), then validates the rest (the glTF reader's own list of extensions it
+/// accepts as required is narrower than what PIS reads).
+fn open_gltf(path: &Path) -> Result<gltf::Gltf, SceneError> {
+    let file = std::fs::File::open(path).map_err(|source| SceneError::Io { path: path.to_owned(), source })?;
+    let parsed = gltf::Gltf::from_reader_without_validation(std::io::BufReader::new(file));
+    let gltf::Gltf { document, blob } = parsed.map_err(|e| import_error(path, e))?;
+    let mut root = document.into_json();
+    crate::extensions::check_required(path, &root.extensions_required)?;
+    root.extensions_required.clear();
+    let document = gltf::Document::from_json(root).map_err(|e| import_error(path, e))?;
+    Ok(gltf::Gltf { document, blob })
 }
 
 /// Animation channel targets and samplers are not validated by the gltf crate, whose
@@ -156,36 +173,21 @@ fn convert(
     }
 
     // Materials in glTF order; a default material is appended if a primitive has none.
-    let mut textures = Vec::new();
-    let mut texture_of_image: BTreeMap<usize, usize> = BTreeMap::new();
+    let mut texture_set = TextureSet::new(path, images);
     let mut materials = Vec::new();
     for m in doc.materials() {
         let mut mat = convert_material(&m);
-        if let Some(info) = m.pbr_metallic_roughness().base_color_texture() {
-            let field = format!(
-                "materials[{}].pbrMetallicRoughness.baseColorTexture",
-                m.index().unwrap_or(0)
-            );
-            if info.tex_coord() != 0 {
-                return Err(SceneError::unsupported(
-                    path,
-                    format!("{field}.texCoord"),
-                    "texture coordinate sets other than TEXCOORD_0",
-                ));
-            }
-            let image = info.texture().source().index();
-            let data = images
-                .get(image)
-                .ok_or_else(|| SceneError::invalid(path, &field, "image index out of range"))?;
-            let next = textures.len();
-            let t = *texture_of_image.entry(image).or_insert(next);
-            if t == next {
-                textures.push(crate::texture::decode(data, true));
-            }
-            mat.base_color_texture = Some(t);
-        }
+        texture_set.read_material(&m, &mut mat)?;
         materials.push(mat);
     }
+    let TextureSet { textures, warnings: texture_warnings, .. } = texture_set;
+    let mut warnings = crate::extensions::unimplemented_warnings(
+        doc.extensions_used().chain(
+            (doc.as_json().materials.iter())
+                .flat_map(|m| m.extensions.iter().flat_map(|e| e.others.keys().map(String::as_str))),
+        ),
+    );
+    warnings.extend(texture_warnings);
     let mut default_material = None;
 
     // Objects: one per node with a mesh, in glTF node order.
@@ -212,12 +214,22 @@ fn convert(
                 }),
             };
             let field = format!("meshes[{}].primitives[{}]", mesh.index(), p.index());
-            primitives.push(ctx.read_primitive(&p, material, &field)?);
+            let prim = ctx.read_primitive(&p, material, &field)?;
+            if prim.uvs1.is_empty() && materials.get(material).is_some_and(|m| m.textures().any(|t| t.tex_coord == 1)) {
+                let w = format!("{field} has no TEXCOORD_1, which the textures of materials[{material}] read: TEXCOORD_0 is read instead");
+                if !warnings.contains(&w) {
+                    warnings.push(w);
+                }
+            }
+            primitives.push(prim);
         }
-        let mats: Vec<&Material> = primitives
+        // Roles are judged on the materials with their textures' means.
+        let flat: Vec<Material> = primitives
             .iter()
             .filter_map(|p: &Primitive| materials.get(p.material))
+            .map(|m| mean_material(m, &textures))
             .collect();
+        let mats: Vec<&Material> = flat.iter().collect();
         let mut name = rig.nodes[r].name.clone();
         if node.name().is_none() {
             if let Some(mesh_name) = mesh.name() {
@@ -282,6 +294,7 @@ fn convert(
         rig,
         cameras,
         unsupported_animations,
+        warnings,
     })
 }
 
@@ -368,6 +381,13 @@ impl Ctx<'_> {
                 D::Vec2,
                 &[T::F32, T::U8, T::U16][..],
             ),
+            (
+                Semantic::TexCoords(1),
+                "TEXCOORD_1",
+                D::Vec2,
+                &[T::F32, T::U8, T::U16][..],
+            ),
+            (Semantic::Tangents, "TANGENT", D::Vec4, &[T::F32][..]),
         ] {
             if let Some(a) = p.get(&semantic) {
                 let f = format!("{field}.attributes.{name}");
@@ -410,12 +430,25 @@ impl Ctx<'_> {
             }
         }
         let uvs: Option<Vec<[f32; 2]>> = reader.read_tex_coords(0).map(|r| r.into_f32().collect());
-        if let Some(us) = &uvs {
-            self.check_finite(us, || format!("{field}.attributes.TEXCOORD_0"))?;
+        let uvs1: Option<Vec<[f32; 2]>> = reader.read_tex_coords(1).map(|r| r.into_f32().collect());
+        for (set, values) in [(0, &uvs), (1, &uvs1)] {
+            let Some(us) = values else { continue };
+            self.check_finite(us, || format!("{field}.attributes.TEXCOORD_{set}"))?;
             if us.len() != n {
                 return Err(SceneError::invalid(
                     &self.path,
-                    format!("{field}.attributes.TEXCOORD_0"),
+                    format!("{field}.attributes.TEXCOORD_{set}"),
+                    "count differs from POSITION",
+                ));
+            }
+        }
+        let tangents: Option<Vec<[f32; 4]>> = reader.read_tangents().map(|r| r.collect());
+        if let Some(ts) = &tangents {
+            self.check_finite(ts, || format!("{field}.attributes.TANGENT"))?;
+            if ts.len() != n {
+                return Err(SceneError::invalid(
+                    &self.path,
+                    format!("{field}.attributes.TANGENT"),
                     "count differs from POSITION",
                 ));
             }
@@ -447,6 +480,7 @@ impl Ctx<'_> {
             Some(u) => u.into_iter().map(Vec2::from).collect(),
             None => vec![Vec2::ZERO; n],
         };
+        let uvs1: Vec<Vec2> = uvs1.map_or_else(Vec::new, |u| u.into_iter().map(Vec2::from).collect());
         match normals {
             Some(ns) => {
                 let smooth = smooth_normals(&positions, &indices);
@@ -459,11 +493,14 @@ impl Ctx<'_> {
                     positions,
                     normals,
                     uvs,
+                    uvs1,
+                    // The glTF rule: tangents are read only beside normals.
+                    tangents: tangents.map_or_else(Vec::new, |t| t.into_iter().map(Vec4::from).collect()),
                     indices,
                     material,
                 })
             }
-            None => Ok(flat_shaded(&positions, &uvs, &indices, material)),
+            None => Ok(flat_shaded(&positions, &uvs, &uvs1, &indices, material)),
         }
     }
 
@@ -700,15 +737,10 @@ fn smooth_normals(positions: &[Vec3], indices: &[u32]) -> Vec<Vec3> {
     acc.into_iter().map(|n| n.normalize_or(Vec3::Y)).collect()
 }
 
-/// Unshares vertices so each triangle gets its face normal (the glTF rule for missing normals).
-fn flat_shaded(positions: &[Vec3], uvs: &[Vec2], indices: &[u32], material: usize) -> Primitive {
-    let mut out = Primitive {
-        positions: vec![],
-        normals: vec![],
-        uvs: vec![],
-        indices: vec![],
-        material,
-    };
+/// Unshares vertices so each triangle gets its face normal (the glTF rule for missing
+/// normals, which also has tangents ignored).
+fn flat_shaded(positions: &[Vec3], uvs: &[Vec2], uvs1: &[Vec2], indices: &[u32], material: usize) -> Primitive {
+    let mut out = Primitive { material, ..Primitive::default() };
     for t in indices.chunks_exact(3) {
         let [a, b, c] = [t[0] as usize, t[1] as usize, t[2] as usize];
         let n = (positions[b] - positions[a])
@@ -719,6 +751,9 @@ fn flat_shaded(positions: &[Vec3], uvs: &[Vec2], indices: &[u32], material: usiz
             out.positions.push(positions[v]);
             out.normals.push(n);
             out.uvs.push(uvs[v]);
+            if let Some(&u) = uvs1.get(v) {
+                out.uvs1.push(u);
+            }
         }
     }
     out
@@ -744,7 +779,7 @@ mod tests {
     #[test]
     fn flat_shading_unshares_vertices() {
         let p = [Vec3::ZERO, Vec3::X, Vec3::Y, Vec3::Z];
-        let prim = flat_shaded(&p, &[Vec2::ZERO; 4], &[0, 1, 2, 0, 3, 1], 0);
+        let prim = flat_shaded(&p, &[Vec2::ZERO; 4], &[], &[0, 1, 2, 0, 3, 1], 0);
         assert_eq!(prim.positions.len(), 6);
         assert_eq!(prim.normals[0], Vec3::Z);
         assert_eq!(prim.normals[3], Vec3::Y);

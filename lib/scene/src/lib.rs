@@ -25,6 +25,7 @@ pub mod distribution;
 mod env_image;
 pub mod environment;
 mod error;
+pub mod extensions;
 mod frame;
 mod gltf_files;
 mod gltf_load;
@@ -36,11 +37,15 @@ mod environment_tests;
 mod load_tests;
 pub mod manifest;
 pub mod material;
+mod material_textures;
+#[cfg(test)]
+mod material_load_tests;
 pub mod model;
 pub mod orbit;
 pub mod rig;
 mod space;
 pub mod texture;
+mod texture_ref;
 pub mod toml_lights;
 
 pub use env_image::{MAX_SIDE as MAX_ENVIRONMENT_SIDE, MAX_TEXELS as MAX_ENVIRONMENT_TEXELS};

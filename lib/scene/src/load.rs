@@ -115,6 +115,7 @@ pub fn load_with(path: &Path, options: &LoadOptions) -> Result<Scene, SceneError
         rig: g.rig,
         environment,
         source: Some(path.to_path_buf()),
+        warnings: g.warnings,
     })
 }
 

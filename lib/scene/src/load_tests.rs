@@ -42,7 +42,7 @@ resolution = [64, 48]
 samples = { view = 8 }
 "#;
 
-fn f32s(v: &[f32]) -> Vec<u8> {
+pub(crate) fn f32s(v: &[f32]) -> Vec<u8> {
     v.iter().flat_map(|x| x.to_le_bytes()).collect()
 }
 

@@ -1,10 +1,11 @@
 //! Materials: glTF PBR metallic-roughness with the transmission, IOR, volume, specular and
 //! emissive-strength extensions, and the object role they imply.
 
-use crate::model::Material;
+use crate::model::{AlphaMode, Material, TextureImage};
 use crate::ObjectRole;
 
-/// Converts a glTF material (textures other than base colour are not read).
+/// Converts a glTF material's factors and alpha mode (its textures are read by
+/// [`crate::material_textures`]).
 pub fn convert_material(m: &gltf::Material) -> Material {
     let pbr = m.pbr_metallic_roughness();
     let strength = m.emissive_strength().unwrap_or(1.0);
@@ -26,6 +27,13 @@ pub fn convert_material(m: &gltf::Material) -> Material {
         ior: m.ior().unwrap_or(1.5),
         ..Material::default()
     };
+    mat.alpha_mode = match m.alpha_mode() {
+        gltf::material::AlphaMode::Opaque => AlphaMode::Opaque,
+        gltf::material::AlphaMode::Mask => AlphaMode::Mask {
+            cutoff: m.alpha_cutoff().filter(|c| c.is_finite()).unwrap_or(0.5),
+        },
+        gltf::material::AlphaMode::Blend => AlphaMode::Blend,
+    };
     if let Some(v) = m.volume() {
         mat.attenuation_distance = v.attenuation_distance();
         mat.attenuation_color = v.attenuation_color();
@@ -37,11 +45,36 @@ pub fn convert_material(m: &gltf::Material) -> Material {
     mat
 }
 
+/// `m` with its textures replaced by their means over all texels: base colour × the mean
+/// base-colour texel, roughness × the mean G and metallic × the mean B of the
+/// metallic-roughness texture, emission × the mean emissive texel; the normal map dropped.
+/// What a per-object description (the role, the packed shading constants) reads.
+pub fn mean_material(m: &Material, textures: &[TextureImage]) -> Material {
+    let mean = |t: &Option<crate::TextureRef>| t.and_then(|t| textures.get(t.texture)).map(TextureImage::mean);
+    let mut flat = m.clone();
+    if let Some(c) = mean(&m.base_color_texture) {
+        flat.base_color.iter_mut().zip(c).for_each(|(f, c)| *f *= c);
+    }
+    if let Some(c) = mean(&m.metallic_roughness_texture) {
+        flat.roughness *= c[1];
+        flat.metallic *= c[2];
+    }
+    if let Some(c) = mean(&m.emissive_texture) {
+        flat.emissive.iter_mut().zip(c).for_each(|(f, c)| *f *= c);
+    }
+    flat.base_color_texture = None;
+    flat.metallic_roughness_texture = None;
+    flat.emissive_texture = None;
+    flat.normal_texture = None;
+    flat
+}
+
 /// Roughness below which any material is treated as a mirror-like reflector.
 pub const MIRROR_ROUGHNESS: f32 = 0.1;
 
 /// The role a material implies: transmission > 0 → refractive; metallic ≥ 0.5 with
-/// roughness ≤ 0.3, or roughness < [`MIRROR_ROUGHNESS`] → reflective; else diffuse.
+/// roughness ≤ 0.3, or roughness < [`MIRROR_ROUGHNESS`] → reflective; else diffuse. A
+/// textured material is judged by its [`mean_material`].
 pub fn material_role(m: &Material) -> ObjectRole {
     if m.transmission > 0.0 {
         ObjectRole::Refractive
@@ -90,5 +123,18 @@ mod tests {
         let (a, b) = (mat(0.0, 0.8, 0.0), mat(0.0, 0.0, 1.0));
         assert_eq!(infer_role(&[&a, &b]), ObjectRole::Refractive);
         assert_eq!(infer_role(&[]), ObjectRole::Diffuse);
+    }
+
+    #[test]
+    fn a_textured_metal_is_judged_by_its_mean_texel() {
+        // Factors 1 (as exporters write them) with a map of rough dielectric texels: the
+        // object is not a mirror-like metal.
+        let rough = TextureImage { width: 1, height: 1, texels: vec![[0.0, 0.9, 0.1, 1.0]] };
+        let m = Material { metallic: 1.0, roughness: 1.0, metallic_roughness_texture: Some(crate::TextureRef::new(0)), ..Material::default() };
+        let flat = mean_material(&m, &[rough]);
+        assert!((flat.roughness - 0.9).abs() < 1e-6 && (flat.metallic - 0.1).abs() < 1e-6);
+        assert_eq!(material_role(&flat), ObjectRole::Diffuse);
+        let polished = TextureImage { width: 1, height: 1, texels: vec![[0.0, 0.2, 1.0, 1.0]] };
+        assert_eq!(material_role(&mean_material(&m, &[polished])), ObjectRole::Reflective);
     }
 }

@@ -3,10 +3,11 @@
 //! Conventions: right-handed world, +Y up, metres; cameras look down their local -Z with +Y up
 //! (glTF). Colours are linear RGB. Matrices are column-major `glam::Mat4`.
 
-use glam::{Mat4, Vec2, Vec3};
+use glam::{Mat4, Vec2, Vec3, Vec4};
 use pis_format::{DimensionKind, ObjectRole};
 
 use crate::rig::Rig;
+pub use crate::texture_ref::{TextureRef, UvTransform};
 
 /// A loaded scene: static content plus the parameter space that animates it.
 ///
@@ -33,6 +34,9 @@ pub struct Scene {
     pub environment: Option<crate::environment::Environment>,
     /// The scene.toml it was loaded from (`None` for a scene built in code).
     pub source: Option<std::path::PathBuf>,
+    /// What loading found and rendering will ignore or approximate (glTF extensions PIS does
+    /// not implement, texture coordinate sets a mesh lacks), one line each, each said once.
+    pub warnings: Vec<String>,
 }
 
 impl Scene {
@@ -83,13 +87,19 @@ pub struct SceneObject {
 }
 
 /// A triangle list with one material.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, Default)]
 pub struct Primitive {
     pub positions: Vec<Vec3>,
     /// Unit normals, one per vertex (generated flat if the glTF has none).
     pub normals: Vec<Vec3>,
     /// Texture coordinates (TEXCOORD_0), one per vertex; zeros if the glTF has none.
     pub uvs: Vec<Vec2>,
+    /// Second texture coordinates (TEXCOORD_1), one per vertex; empty if the glTF has none
+    /// (textures reading set 1 then read TEXCOORD_0).
+    pub uvs1: Vec<Vec2>,
+    /// glTF TANGENT: unit tangent (xyz) and bitangent sign (w), one per vertex; empty if the
+    /// glTF has none (normal maps then use a tangent frame made per triangle from the UVs).
+    pub tangents: Vec<Vec4>,
     /// Triangle list, three indices per triangle.
     pub indices: Vec<u32>,
     /// Index into [`Scene::materials`].
@@ -97,18 +107,29 @@ pub struct Primitive {
 }
 
 /// glTF PBR metallic-roughness with KHR_materials_transmission, _ior, _volume, _specular,
-/// and emission (KHR_materials_emissive_strength folded into `emissive`).
+/// and emission (KHR_materials_emissive_strength folded into `emissive`). Each texture is
+/// multiplied by its factor where it is sampled (docs/SCENE.md).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Material {
     pub name: String,
     /// Linear RGBA base colour factor.
     pub base_color: [f32; 4],
-    /// Index into [`Scene::textures`], sampled with TEXCOORD_0 and multiplied by `base_color`.
-    pub base_color_texture: Option<usize>,
+    /// Base colour (sRGB, decoded to linear) and alpha, multiplied by `base_color`.
+    pub base_color_texture: Option<TextureRef>,
     pub metallic: f32,
     pub roughness: f32,
+    /// Roughness in G and metallic in B (linear), multiplying `roughness` and `metallic`.
+    pub metallic_roughness_texture: Option<TextureRef>,
     /// Emitted radiance (linear RGB, strength applied).
     pub emissive: [f32; 3],
+    /// Emission colour (sRGB, decoded to linear), multiplying `emissive`.
+    pub emissive_texture: Option<TextureRef>,
+    /// Tangent-space normal map (linear; X right, Y up, Z out of the surface).
+    pub normal_texture: Option<TextureRef>,
+    /// The normal map's `scale`, applied to its X and Y (default 1).
+    pub normal_scale: f32,
+    /// How base-colour alpha covers the surface.
+    pub alpha_mode: AlphaMode,
     /// KHR_materials_transmission factor (0 opaque .. 1 fully transmissive).
     pub transmission: f32,
     /// KHR_materials_ior (default 1.5).
@@ -129,7 +150,12 @@ impl Default for Material {
             base_color_texture: None,
             metallic: 1.0,
             roughness: 1.0,
+            metallic_roughness_texture: None,
             emissive: [0.0; 3],
+            emissive_texture: None,
+            normal_texture: None,
+            normal_scale: 1.0,
+            alpha_mode: AlphaMode::Opaque,
             transmission: 0.0,
             ior: 1.5,
             attenuation_distance: f32::INFINITY,
@@ -138,6 +164,27 @@ impl Default for Material {
             specular_color: [1.0; 3],
         }
     }
+}
+
+impl Material {
+    /// Every texture the material reads.
+    pub fn textures(&self) -> impl Iterator<Item = &TextureRef> {
+        [&self.base_color_texture, &self.metallic_roughness_texture, &self.emissive_texture, &self.normal_texture]
+            .into_iter()
+            .flatten()
+    }
+}
+
+/// glTF `alphaMode`: how the base colour's alpha (factor × texture) covers the surface.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum AlphaMode {
+    /// Alpha is ignored: the surface is solid.
+    Opaque,
+    /// Texels of alpha below the cutoff are holes every ray passes through (glTF
+    /// `alphaCutoff`, default 0.5); the rest is solid.
+    Mask { cutoff: f32 },
+    /// Stochastic transparency: a ray passes with probability 1 − alpha.
+    Blend,
 }
 
 /// A decoded texture in linear RGBA f32, rows top to bottom (glTF UV (0,0) is the top-left).

@@ -169,11 +169,18 @@ impl<'s> Integrator<'s> {
         Rng::at_surface(sp.object_position, self.cell, sp.object, depth, ctx.fallback_seed)
     }
 
-    fn material(&self, sp: &SurfacePoint) -> ShadingMaterial {
-        match self.scene.materials.get(sp.material) {
-            Some(m) => ShadingMaterial::at(self.scene, m, sp.uv),
-            None => ShadingMaterial::at(self.scene, &pis_scene::Material::default(), sp.uv),
-        }
+    /// The material at `sp`, whose shading normal it bends by its normal map.
+    fn material(&self, sp: &mut SurfacePoint) -> ShadingMaterial {
+        let default;
+        let m = match self.scene.materials.get(sp.material) {
+            Some(m) => m,
+            None => {
+                default = pis_scene::Material::default();
+                &default
+            }
+        };
+        sp.apply_normal_map(self.scene, m);
+        ShadingMaterial::at_uvs(self.scene, m, [sp.uv, sp.uv1])
     }
 
     /// Role of object `o`.
@@ -231,8 +238,8 @@ impl<'s> Integrator<'s> {
             }
         }
         let Some(hit) = hit else { return self.escaped(dir, sees_lights, diffuse_left) };
-        let sp = self.geometry.surface(&hit, origin, dir);
-        let m = self.material(&sp);
+        let mut sp = self.geometry.surface(&hit, origin, dir);
+        let m = self.material(&mut sp);
         let absorb = self.absorption(&sp, &m, hit.t);
         let mut rng = self.rng_at(&sp, depth, ctx);
         absorb * (m.emission + self.scatter(&sp, &m, dir, depth, diffuse_left, &mut rng, ctx))
@@ -572,8 +579,8 @@ impl<'s> Integrator<'s> {
             };
             return CameraSample { combined, ..Default::default() };
         };
-        let sp = self.geometry.surface(&hit, origin, dir);
-        let m = self.material(&sp);
+        let mut sp = self.geometry.surface(&hit, origin, dir);
+        let m = self.material(&mut sp);
         let diffuse_left = self.settings.diffuse_bounces.max(1);
         let diffuse = if luminance(m.diffuse) > 0.0 {
             m.diffuse * self.first_irradiance(&sp, diffuse_left, ctx)
@@ -673,8 +680,8 @@ impl<'s> Integrator<'s> {
             let light_first = hit_light_sphere(&self.frame.lights, o, d, hit.map_or(f32::INFINITY, |h| h.t)).is_some();
             match hit {
                 Some(h) if h.object == object && !light_first => {
-                    let s2 = self.geometry.surface(&h, o, d);
-                    let m2 = self.material(&s2);
+                    let mut s2 = self.geometry.surface(&h, o, d);
+                    let m2 = self.material(&mut s2);
                     modulation *= self.absorption(&s2, &m2, h.t);
                     let eta2 = if s2.front_face { 1.0 / m2.ior } else { m2.ior };
                     let f2 = fresnel_dielectric(-d.dot(s2.normal), eta2);
@@ -718,11 +725,11 @@ impl<'s> Integrator<'s> {
             if h.object == object {
                 continue;
             }
-            let sp = self.geometry.surface(&h, o, d);
+            let mut sp = self.geometry.surface(&h, o, d);
             if !sp.front_face {
                 continue;
             }
-            let m = self.material(&sp);
+            let m = self.material(&mut sp);
             let mut rng = self.rng_at(&sp, 1, ctx);
             let colour = m.emission + self.scatter(&sp, &m, d, 1, diffuse_left, &mut rng, ctx);
             hits.push(ContinuedHit { t: h.t, position: sp.position, object: h.object, colour });

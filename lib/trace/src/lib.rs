@@ -38,6 +38,8 @@ pub mod run;
 pub mod sampling;
 pub mod set;
 pub mod settings;
+pub mod tangent;
+pub mod textures;
 
 pub use error::TraceError;
 pub use film::GaussianFilter;

@@ -108,7 +108,7 @@ mod tests {
         let positions: Vec<Vec3> = (0..8).map(corner).collect();
         let indices = quads.iter().flat_map(|q| [q[0], q[1], q[2], q[0], q[2], q[3]]).map(|i| i as u32).collect();
         let normals = positions.iter().map(|p| (*p - (lo + hi) * 0.5).normalize()).collect();
-        Primitive { positions, normals, uvs: vec![Vec2::ZERO; 8], indices, material }
+        Primitive { positions, normals, uvs: vec![Vec2::ZERO; 8], indices, material, ..Primitive::default() }
     }
 
     /// A pure emitter: black, no specular lobe, so what a ray meets is its emission exactly.

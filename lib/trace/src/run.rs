@@ -47,7 +47,8 @@ pub trait Progress: Sync {
     fn point(&self, _index: usize, _count: usize) {}
     /// One image row of the current point is done.
     fn row(&self) {}
-    /// A warning on the scene, before the work (e.g. nothing emits light).
+    /// A warning on the scene, before the work (e.g. nothing emits light, a glTF extension
+    /// PIS does not implement).
     fn note(&self, _text: &str) {}
 }
 
@@ -97,7 +98,7 @@ pub fn render_set(
         threads: rayon::current_num_threads(),
         ..Default::default()
     };
-    if let Some(w) = darkness_warning(scene) {
+    for w in scene.warnings.iter().cloned().chain(darkness_warning(scene)) {
         progress.note(&w);
         report.warnings.push(w);
     }

@@ -56,7 +56,8 @@ fn trace(
     let uv = t.uv[0] * w + t.uv[1] * u + t.uv[2] * v;
     let m = &scene.materials[t.material];
     let mut albedo = Vec3::new(m.base_color[0], m.base_color[1], m.base_color[2]);
-    if let Some(tex) = m.base_color_texture.and_then(|i| scene.textures.get(i)) {
+    if let Some((r, tex)) = m.base_color_texture.and_then(|r| scene.textures.get(r.texture).map(|t| (r, t))) {
+        let uv = r.transform.apply(uv);
         let x = ((uv.x.rem_euclid(1.0)) * tex.width as f32) as usize % tex.width as usize;
         let y = ((uv.y.rem_euclid(1.0)) * tex.height as f32) as usize % tex.height as usize;
         let c = tex.texels[y * tex.width as usize + x];

@@ -2,12 +2,15 @@
 //! the formulas the tracer shades with ([`pis_trace::material::ShadingMaterial`]).
 //!
 //! An object with several materials is described by the one covering the largest surface
-//! area of its mesh (object space; the first of equal ones). A base-colour texture counts as
-//! the mean of its texels: the constants are per object, not per surface point.
+//! area of its mesh (object space; the first of equal ones). A texture counts as the mean of
+//! its texels ([`pis_scene::material::mean_material`]: base colour × its texture's mean,
+//! metallic × the metallic-roughness texture's mean B): the constants are per object, not
+//! per surface point.
 
 use glam::Vec3;
 use pis_format::Shading;
-use pis_scene::{Material, Scene, TextureImage};
+use pis_scene::material::mean_material;
+use pis_scene::{Material, Scene};
 use pis_trace::material::ShadingMaterial;
 
 /// The shading constants of object `o` of `scene`: those of its largest material
@@ -22,8 +25,8 @@ pub fn object_shading(scene: &Scene, o: usize) -> Shading {
 /// The shading constants of `material`:
 ///
 /// - f0 = f0_dielectric · (1 − metallic) · specular + base · metallic, linear RGB clamped to
-///   [0, 1], with the tracer's f0_dielectric (((ior − 1)/(ior + 1))² × specular colour) and
-///   base (base colour factor × the mean of its base-colour texture). The tracer's opaque
+///   [0, 1], with the tracer's f0_dielectric (((ior − 1)/(ior + 1))² × specular colour), and
+///   base and metallic of the material with its textures' means. The tracer's opaque
 ///   Fresnel is specular · (1 − metallic) · Schlick(f0_dielectric) + metallic · Schlick(base);
 ///   Schlick's approximation is affine in F0, so Schlick(f0) reproduces it exactly when the
 ///   specular factor is 1 (as it is without KHR_materials_specular), and otherwise differs
@@ -32,14 +35,7 @@ pub fn object_shading(scene: &Scene, o: usize) -> Shading {
 /// - absorption: KHR_materials_volume's Beer–Lambert coefficients, −ln(attenuation colour) /
 ///   attenuation distance; 0 without a finite attenuation distance.
 pub fn material_shading(scene: &Scene, material: &Material) -> Shading {
-    let mut flat = material.clone();
-    if let Some(tex) = material.base_color_texture.and_then(|t| scene.textures.get(t)) {
-        let mean = texture_mean(tex);
-        for (c, m) in flat.base_color.iter_mut().zip(mean.to_array()) {
-            *c *= m;
-        }
-    }
-    flat.base_color_texture = None;
+    let flat = mean_material(material, &scene.textures);
     let s = ShadingMaterial::at(scene, &flat, glam::Vec2::ZERO);
     let f0 = s.f0_dielectric * ((1.0 - s.metallic) * s.specular) + s.base * s.metallic;
     Shading {
@@ -69,25 +65,11 @@ pub fn dominant_material(scene: &Scene, o: usize) -> Option<usize> {
     }).map(|(m, _)| m)
 }
 
-/// The mean RGB of a texture's texels (white for an empty texture, which the tracer reads as
-/// white).
-fn texture_mean(tex: &TextureImage) -> Vec3 {
-    let n = (tex.width as usize * tex.height as usize).min(tex.texels.len());
-    if n == 0 || tex.texels.len() < tex.width as usize * tex.height as usize {
-        return Vec3::ONE;
-    }
-    let sum = tex.texels[..n].iter().fold([0.0f64; 3], |mut s, t| {
-        s.iter_mut().zip(t).for_each(|(s, v)| *s += *v as f64);
-        s
-    });
-    Vec3::from(sum.map(|s| (s / n as f64) as f32))
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
     use glam::Vec2;
-    use pis_scene::{ObjectRole, Primitive, SceneObject};
+    use pis_scene::{ObjectRole, Primitive, SceneObject, TextureImage, TextureRef};
 
     fn close(a: [f32; 3], b: [f32; 3]) -> bool {
         a.iter().zip(&b).all(|(a, b)| (a - b).abs() < 1e-6)
@@ -101,6 +83,7 @@ mod tests {
             uvs: vec![Vec2::ZERO; 3],
             indices: vec![0, 1, 2],
             material,
+            ..Primitive::default()
         }
     }
 
@@ -153,9 +136,19 @@ mod tests {
     fn a_base_colour_texture_counts_as_its_mean() {
         let mut sc = Scene::default();
         sc.textures.push(TextureImage { width: 2, height: 1, texels: vec![[1.0, 0.0, 0.5, 1.0], [0.0, 0.0, 0.5, 1.0]] });
-        let m = Material { base_color: [0.8, 1.0, 1.0, 1.0], base_color_texture: Some(0), metallic: 1.0, ..Material::default() };
+        let m = Material { base_color: [0.8, 1.0, 1.0, 1.0], base_color_texture: Some(TextureRef::new(0)), metallic: 1.0, ..Material::default() };
         let s = material_shading(&sc, &m);
         assert!(close(s.f0, [0.4, 0.0, 0.5]), "{:?}", s.f0);
+    }
+
+    #[test]
+    fn a_metallic_roughness_texture_counts_as_its_mean_metallic() {
+        // metallicFactor 1 with a map half dielectric, half metal: metallic ½, not 1.
+        let mut sc = Scene::default();
+        sc.textures.push(TextureImage { width: 2, height: 1, texels: vec![[0.0, 1.0, 0.0, 1.0], [0.0, 1.0, 1.0, 1.0]] });
+        let m = Material { base_color: [0.8, 0.8, 0.8, 1.0], metallic: 1.0, metallic_roughness_texture: Some(TextureRef::new(0)), ..Material::default() };
+        let s = material_shading(&sc, &m);
+        assert!(close(s.f0, [0.04 * 0.5 + 0.8 * 0.5; 3]), "{:?}", s.f0);
     }
 
     #[test]

@@ -14,6 +14,7 @@ pub fn quad(c: Vec3, u: Vec3, v: Vec3, material: usize) -> Primitive {
         uvs: vec![Vec2::new(0.0, 1.0), Vec2::new(1.0, 1.0), Vec2::new(1.0, 0.0), Vec2::ZERO],
         indices: vec![0, 1, 2, 0, 2, 3],
         material,
+        ..Primitive::default()
     }
 }
 
@@ -43,7 +44,7 @@ pub fn cuboid(lo: Vec3, hi: Vec3, material: usize, inward: bool) -> Vec<Primitiv
 
 /// A UV sphere with smooth normals (pointing outwards, or inwards with `inward`).
 pub fn sphere(c: Vec3, r: f32, rings: u32, segments: u32, material: usize, inward: bool) -> Primitive {
-    let mut p = Primitive { positions: vec![], normals: vec![], uvs: vec![], indices: vec![], material };
+    let mut p = Primitive { material, ..Primitive::default() };
     for i in 0..=rings {
         let th = PI * i as f32 / rings as f32;
         for j in 0..=segments {

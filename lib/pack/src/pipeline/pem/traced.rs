@@ -175,7 +175,7 @@ mod tests {
 
     /// A quad emitting `l` with corners `c ± u ± v`.
     fn quad(c: Vec3, u: Vec3, v: Vec3, material: usize) -> Primitive {
-        Primitive { positions: vec![c - u - v, c + u - v, c + u + v, c - u + v], normals: vec![u.cross(v).normalize(); 4], uvs: vec![Vec2::ZERO; 4], indices: vec![0, 1, 2, 0, 2, 3], material }
+        Primitive { positions: vec![c - u - v, c + u - v, c + u + v, c - u + v], normals: vec![u.cross(v).normalize(); 4], uvs: vec![Vec2::ZERO; 4], indices: vec![0, 1, 2, 0, 2, 3], material, ..Primitive::default() }
     }
 
     fn emitter(l: Vec3) -> Material {
