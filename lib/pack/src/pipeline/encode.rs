@@ -107,24 +107,18 @@ fn layer_screen_weights(m: &ObjectModel, li: usize, samples: &[Vec<u32>]) -> BTr
 }
 
 /// The screen weights of a shell sample: every level is stored, so each texel's column sums
-/// as they are, each row weighed by how much of the shell's error reaches the pixel: its
-/// squared Fresnel factor (the reflection term is multiplied by F), and for a distant shell
-/// drawn under a local one, the squared share the local layer leaves it, (1 − α_L)² with
-/// the traced local alpha (F ⊙ (L + (1 − α_L) D): where the object reflects itself, the
-/// distant shell is hidden). Scaled as [`sample_weights`] scales the unweighed sums, so
-/// that a shell's error counts as much as a surface texture's where it shows fully.
+/// as they are, each row weighed by its squared Fresnel factor (the reflection term's error
+/// reaches the screen multiplied by F); scaled as [`sample_weights`] scales the unweighed
+/// sums, so that a shell's error counts F² times a surface texture's.
 fn shell_weights(m: &ObjectModel, s: usize, li: usize, k: &[u32], points: &[usize]) -> Vec<f32> {
     let n = m.layers[li].form.stored_texels(k);
-    let under_local = m.layers[li].kind == pis_format::LayerKind::EnvDistant
-        && m.layers.iter().any(|l| l.kind == pis_format::LayerKind::EnvLocal);
     let (mut weighed, mut plain) = (vec![0.0f64; n], 0.0f64);
     for &p in points {
         let v = &m.shell_views[p];
         let a = &v.a[s];
         for r in 0..a.rows() {
             let f = &v.fresnel[r * 3..r * 3 + 3];
-            let shown = if under_local { 1.0 - v.local[r * 4 + 3].clamp(0.0, 1.0) as f64 } else { 1.0 };
-            let f2 = ((f[0] + f[1] + f[2]) as f64 / 3.0 * shown).powi(2);
+            let f2 = ((f[0] + f[1] + f[2]) as f64 / 3.0).powi(2);
             let (cols, vals) = a.row(r);
             for (&c, &w) in cols.iter().zip(vals) {
                 weighed[c as usize] += w as f64 * f2;
