@@ -19,4 +19,7 @@ pub enum CodecError {
     Input(String),
     #[error("codestream is corrupt: {0}")]
     Corrupt(String),
+    /// The codestream's data ends before its last byte (SPEC.md 11, rule 8008).
+    #[error("codestream has {extra} bytes after the end of its data ({length} bytes in all)")]
+    TrailingBytes { extra: usize, length: usize },
 }

@@ -5,7 +5,8 @@
 //!    the first value of a plane uses 0.
 //! 2. Byte planes: the residuals' most significant bytes, then the next bytes, down to the
 //!    least significant bytes (4 runs of n bytes).
-//! 3. Raw DEFLATE (RFC 1951) of those 4n bytes.
+//! 3. Raw DEFLATE (RFC 1951) of those 4n bytes. The DEFLATE stream is the whole codestream:
+//!    bytes after its final block make the codestream invalid (SPEC.md 11.1, rule 8008).
 
 use std::io::{Read, Write};
 
@@ -63,13 +64,23 @@ pub fn decode(planes: &[PlaneShape], n: usize, bytes: &[u8]) -> Result<Vec<f32>,
     let expected = 4 * n;
     // Grow with the data actually inflated: a forged shape cannot force a large allocation.
     let mut shuffled = Vec::new();
-    let mut dec = DeflateDecoder::new(bytes).take(expected as u64 + 1);
-    dec.read_to_end(&mut shuffled)
+    let mut dec = DeflateDecoder::new(bytes);
+    (&mut dec)
+        .take(expected as u64 + 1)
+        .read_to_end(&mut shuffled)
         .map_err(|e| CodecError::Corrupt(e.to_string()))?;
     if shuffled.len() != expected {
         return Err(CodecError::DecodedLength {
             expected,
             found: shuffled.len(),
+        });
+    }
+    // The DEFLATE stream is the whole codestream: its final block ends in the last byte.
+    let used = dec.total_in() as usize;
+    if used < bytes.len() {
+        return Err(CodecError::TrailingBytes {
+            extra: bytes.len() - used,
+            length: bytes.len(),
         });
     }
     let mut bits = vec![0u32; n];

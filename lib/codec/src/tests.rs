@@ -424,3 +424,44 @@ fn weighted_curves_count_only_the_error_that_is_weighted() {
     neg[5] = -1.0;
     assert!(c.rd_curve_weighted(&p, &v, Some(&neg)).is_err());
 }
+
+#[test]
+fn bytes_after_a_codestreams_data_are_rejected() {
+    let p = [PlaneShape::new(19, 13, 3), PlaneShape::new(10, 7, 3)];
+    let v: Vec<f32> = texture(19, 13, 3, 0.2).into_iter().chain(texture(10, 7, 3, -0.1)).collect();
+    for codec in [CodecId::Lossless, CodecId::Wavelet, CodecId::Dct] {
+        let s = encode(codec, &p, &v).unwrap();
+        assert!(decode(codec, &p, &s).is_ok(), "{codec}");
+        for extra in [&[0u8][..], &[0x5a, 0, 0, 0, 0, 0, 0, 0]] {
+            let mut longer = s.clone();
+            longer.extend_from_slice(extra);
+            assert_eq!(
+                decode(codec, &p, &longer),
+                Err(CodecError::TrailingBytes { extra: extra.len(), length: longer.len() }),
+                "{codec} with {} bytes after its data",
+                extra.len()
+            );
+        }
+    }
+    // Raw: the length is exactly 4 bytes per value.
+    let s = encode(CodecId::Raw, &p, &v).unwrap();
+    assert!(decode(CodecId::Raw, &p, &[s.as_slice(), &[0]].concat()).is_err());
+    // Wavelet with top bit-plane 255 (every coefficient 0) has no body.
+    let zero_header = [wavelet::VERSION, 5, 1, 255, 0, 0, 128, 63];
+    assert_eq!(decode(CodecId::Wavelet, &p, &zero_header), Ok(vec![0.0; v.len()]));
+    assert!(matches!(
+        decode(CodecId::Wavelet, &p, &[&zero_header[..], &[7]].concat()),
+        Err(CodecError::TrailingBytes { extra: 1, .. })
+    ));
+}
+
+#[test]
+fn every_prefix_of_a_wavelet_stream_is_read_to_its_end() {
+    // A truncated embedded stream has no trailing bytes: the decoder reads all it holds.
+    let p = [PlaneShape::new(13, 9, 4)];
+    let v = texture(13, 9, 4, 0.3);
+    let s = encode(CodecId::Wavelet, &p, &v).unwrap();
+    for cut in wavelet::HEADER_LEN..=s.len() {
+        assert!(decode(CodecId::Wavelet, &p, &s[..cut]).is_ok(), "cut {cut}");
+    }
+}

@@ -13,6 +13,9 @@ pub struct Cursor<'a> {
     /// Rule id for "payload is malformed" of this chunk type.
     malformed: u16,
     chunk: (&'a str, usize),
+    /// Broken rules that leave the payload readable, when the cursor collects them
+    /// ([`Cursor::collecting`]); `None`: the first one stops the parse.
+    flagged: Option<Vec<Issue>>,
 }
 
 impl<'a> Cursor<'a> {
@@ -23,7 +26,33 @@ impl<'a> Cursor<'a> {
             base,
             malformed,
             chunk,
+            flagged: None,
         }
+    }
+
+    /// Keeps parsing past broken rules that leave the payload's structure readable (a
+    /// reserved field that is not 0, an undefined flag bit): they are collected, for
+    /// [`Cursor::take_flagged`], so that a validator reports every one.
+    pub fn collecting(mut self) -> Self {
+        self.flagged = Some(Vec::new());
+        self
+    }
+
+    /// Reports a broken rule after which the payload can still be parsed: collected when the
+    /// cursor collects, else returned as the parse's error.
+    pub fn flag(&mut self, issue: Issue) -> Result<(), Issue> {
+        match &mut self.flagged {
+            Some(v) => {
+                v.push(issue);
+                Ok(())
+            }
+            None => Err(issue),
+        }
+    }
+
+    /// The collected broken rules, in payload order.
+    pub fn take_flagged(&mut self) -> Vec<Issue> {
+        self.flagged.take().unwrap_or_default()
     }
 
     /// Absolute file offset of the next byte.
@@ -93,16 +122,15 @@ impl<'a> Cursor<'a> {
         Ok(out)
     }
 
-    /// A reserved field: must be zero (rule 3006).
+    /// A reserved field: must be zero (rule 3006, see [`Cursor::flag`]).
     pub fn reserved(&mut self, bytes: usize, what: &str) -> Result<(), Issue> {
         let at = self.offset();
         let b = self.take(bytes, what)?;
         if b.iter().any(|&x| x != 0) {
-            return Err(
-                Issue::new(3006, format!("{what} must be 0, found {b:02x?}"))
-                    .in_chunk(self.chunk.0, self.chunk.1)
-                    .at(at),
-            );
+            let issue = Issue::new(3006, format!("{what} must be 0, found {b:02x?}"))
+                .in_chunk(self.chunk.0, self.chunk.1)
+                .at(at);
+            return self.flag(issue);
         }
         Ok(())
     }

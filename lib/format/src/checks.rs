@@ -93,23 +93,75 @@ pub fn decoded_sizes<S>(c: &Container<S>, codestream_bytes: u64) -> Option<Issue
     None
 }
 
-/// Every rule broken by `c`, in chunk order. Later sections are checked only when the ones
-/// they build on hold (a layer's block grid needs a valid space).
+/// Every rule broken by `c`, in chunk order.
 pub fn check<S>(c: &Container<S>) -> Vec<Issue> {
+    let meshes = vec![true; c.objects.len()];
+    check_parsed(&Parsed {
+        space: Some(&c.space),
+        cameras: Some(&c.cameras),
+        objects: Some(&c.objects),
+        meshes: &meshes,
+        layers: true,
+        provenance: Some(c.provenance.as_ref()),
+    })
+}
+
+/// The parts of a file that parsed: [`check_parsed`] checks them, and skips the rules whose
+/// inputs did not parse.
+pub(crate) struct Parsed<'a, S> {
+    pub space: Option<&'a ParameterSpace>,
+    pub cameras: Option<&'a CameraTable>,
+    pub objects: Option<&'a [Object<S>]>,
+    /// Per object: its mesh parsed.
+    pub meshes: &'a [bool],
+    /// The objects' layers parsed.
+    pub layers: bool,
+    /// `Some(p)` when the provenance parsed (`Some(None)`: the file has none).
+    pub provenance: Option<Option<&'a Provenance>>,
+}
+
+/// Every rule broken by what parsed, in chunk order. Independent rules are all checked;
+/// a rule that builds on another is checked only when that one holds: tables, block origins
+/// and block grids are measured on the parameter space, so they wait for a valid space; a
+/// layer's blocks wait for its mask and its object's block origins, and the texture
+/// coordinates of its surface layers for its object's mesh.
+pub(crate) fn check_parsed<S>(p: &Parsed<S>) -> Vec<Issue> {
     let mut out = Vec::new();
-    space(&c.space, &mut out);
-    if !out.is_empty() {
-        return out;
+    let space = p.space.filter(|s| {
+        let before = out.len();
+        space(s, &mut out);
+        out.len() == before
+    });
+    if let Some(t) = p.cameras {
+        cameras(space, t, &mut out);
     }
-    cameras(&c.space, &c.cameras, &mut out);
-    objects(c, &mut out);
-    if let Err(detail) = crate::FileFilter::of(c.provenance.as_ref()) {
-        out.push(chunk(Issue::new(9001, detail), "PROV"));
+    if let Some(objects) = p.objects {
+        self::objects(space, objects, p.meshes, p.layers, &mut out);
     }
-    if let Err(detail) = crate::DisplayFilter::of(c.provenance.as_ref()) {
-        out.push(chunk(Issue::new(9002, detail), "PROV"));
+    if let Some(prov) = p.provenance {
+        provenance(prov, &mut out);
     }
     out
+}
+
+/// Rules 9001–9003 on the provenance settings.
+fn provenance(p: Option<&Provenance>, out: &mut Vec<Issue>) {
+    if let Some(p) = p {
+        let mut seen = HashSet::new();
+        let mut repeated = HashSet::new();
+        for (k, _) in &p.settings {
+            if !seen.insert(k.as_str()) && repeated.insert(k.as_str()) {
+                let n = p.settings.iter().filter(|(key, _)| key == k).count();
+                out.push(chunk(Issue::new(9003, format!("key {k:?} appears {n} times")), "PROV"));
+            }
+        }
+    }
+    if let Err(detail) = crate::FileFilter::of(p) {
+        out.push(chunk(Issue::new(9001, detail), "PROV"));
+    }
+    if let Err(detail) = crate::DisplayFilter::of(p) {
+        out.push(chunk(Issue::new(9002, detail), "PROV"));
+    }
 }
 
 fn chunk(i: Issue, fourcc: &str) -> Issue {
@@ -205,9 +257,9 @@ fn finite(v: &[f32]) -> bool {
     v.iter().all(|x| x.is_finite())
 }
 
-/// The 3×3 part of a row-major 3×4 matrix is a rotation (orthonormal, det +1) within 1e-3.
-/// Whether a row-major 3×4 transform is rigid: its 3×3 part orthonormal with determinant
-/// +1, within 10⁻³ (rule 5106).
+/// Whether a row-major 3×4 transform is rigid (rules 5003 and 5106, SPEC.md 6.4): with the
+/// rows r0, r1, r2 of its 3×3 part widened to f64, every rᵢ·rⱼ differs from δᵢⱼ, and the
+/// determinant (cofactor expansion along r0) from 1, by less than 10⁻³.
 pub fn rigid(m: &[f32; 12]) -> bool {
     let r = |i: usize| [m[4 * i] as f64, m[4 * i + 1] as f64, m[4 * i + 2] as f64];
     let dot = |a: [f64; 3], b: [f64; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
@@ -224,7 +276,7 @@ pub fn rigid(m: &[f32; 12]) -> bool {
         && ok(det, 1.0)
 }
 
-fn cameras(s: &ParameterSpace, t: &CameraTable, out: &mut Vec<Issue>) {
+fn cameras(s: Option<&ParameterSpace>, t: &CameraTable, out: &mut Vec<Issue>) {
     let e = |id, d: String| chunk(Issue::new(id, d), "CAMS");
     if t.width == 0 || t.height == 0 || t.width > MAX_IMAGE_SIDE || t.height > MAX_IMAGE_SIDE {
         out.push(e(
@@ -235,14 +287,9 @@ fn cameras(s: &ParameterSpace, t: &CameraTable, out: &mut Vec<Issue>) {
             ),
         ));
     }
-    table(
-        s,
-        t.depends_on,
-        t.cameras.len(),
-        "camera table",
-        "CAMS",
-        out,
-    );
+    if let Some(s) = s {
+        table(s, t.depends_on, t.cameras.len(), "camera table", "CAMS", out);
+    }
     for (i, c) in t.cameras.iter().enumerate() {
         let ok = finite(&c.world_from_camera)
             && rigid(&c.world_from_camera)
@@ -259,9 +306,14 @@ fn cameras(s: &ParameterSpace, t: &CameraTable, out: &mut Vec<Issue>) {
     }
 }
 
-fn objects<S>(c: &Container<S>, out: &mut Vec<Issue>) {
-    let s = &c.space;
-    let n = c.objects.len();
+fn objects<S>(
+    s: Option<&ParameterSpace>,
+    objects: &[Object<S>],
+    meshes: &[bool],
+    layers_parsed: bool,
+    out: &mut Vec<Issue>,
+) {
+    let n = objects.len();
     if n == 0 || n > 65535 {
         out.push(chunk(
             Issue::new(5101, format!("{n} objects, expected 1 to 65535")),
@@ -269,7 +321,7 @@ fn objects<S>(c: &Container<S>, out: &mut Vec<Issue>) {
         ));
     }
     let mut names = HashSet::new();
-    for (oi, o) in c.objects.iter().enumerate() {
+    for (oi, o) in objects.iter().enumerate() {
         let e = |id, d: String| {
             chunk(
                 Issue::new(id, format!("object {oi} '{}': {d}", o.name)),
@@ -286,8 +338,8 @@ fn objects<S>(c: &Container<S>, out: &mut Vec<Issue>) {
         if !(sh.f0.iter().all(unit) && ior_ok && absorption_ok) {
             out.push(e(5104, format!("{sh:?}")));
         }
-        let mut stagger_ok = o.stagger.len() == s.dims.len();
-        for (k, (&off, d)) in o.stagger.iter().zip(&s.dims).enumerate() {
+        let mut stagger_ok = s.is_some_and(|s| o.stagger.len() == s.dims.len());
+        for (k, (&off, d)) in o.stagger.iter().zip(s.map_or(&[][..], |s| &s.dims)).enumerate() {
             if off >= d.block_size {
                 out.push(e(
                     5105,
@@ -299,14 +351,8 @@ fn objects<S>(c: &Container<S>, out: &mut Vec<Issue>) {
                 stagger_ok = false;
             }
         }
-        if table(
-            s,
-            o.transforms.depends_on,
-            o.transforms.transforms.len(),
-            &format!("object {oi} transforms"),
-            "OBJS",
-            out,
-        ) {
+        let what = format!("object {oi} transforms");
+        if s.is_none_or(|s| table(s, o.transforms.depends_on, o.transforms.transforms.len(), &what, "OBJS", out)) {
             for (t, m) in o.transforms.transforms.iter().enumerate() {
                 if !finite(m) || !rigid(m) {
                     out.push(e(
@@ -316,9 +362,12 @@ fn objects<S>(c: &Container<S>, out: &mut Vec<Issue>) {
                 }
             }
         }
-        mesh(oi, o, out);
-        if stagger_ok {
-            layers(s, oi, o, out);
+        let has_mesh = meshes.get(oi).copied().unwrap_or(false);
+        if has_mesh {
+            mesh(oi, o, out);
+        }
+        if layers_parsed {
+            layers(s.filter(|_| stagger_ok), oi, o, has_mesh, out);
         }
     }
 }
@@ -332,7 +381,7 @@ fn mesh<S>(oi: usize, o: &Object<S>, out: &mut Vec<Issue>) {
     };
     let m = &o.mesh;
     if m.positions.is_empty() {
-        out.push(e(5202, "no vertices".into()));
+        out.push(e(5207, "vertex count 0".into()));
         return;
     }
     if m.indices.is_empty() || m.indices.len() % 3 != 0 {
@@ -384,7 +433,10 @@ fn mesh<S>(oi: usize, o: &Object<S>, out: &mut Vec<Issue>) {
     }
 }
 
-fn layers<S>(s: &ParameterSpace, oi: usize, o: &Object<S>, out: &mut Vec<Issue>) {
+/// The rules of `o`'s layers. `has_mesh`: the object's mesh parsed (the texture coordinates
+/// a surface layer needs, rule 6003); `grid`: the space, when it and the object's block
+/// origins hold (the block grids, rules 6005–6007 and 7xxx).
+fn layers<S>(grid: Option<&ParameterSpace>, oi: usize, o: &Object<S>, has_mesh: bool, out: &mut Vec<Issue>) {
     let mut slots = HashSet::new();
     for (li, l) in o.layers.iter().enumerate() {
         let e = |id, d: String| {
@@ -406,7 +458,7 @@ fn layers<S>(s: &ParameterSpace, oi: usize, o: &Object<S>, out: &mut Vec<Issue>)
                 && l.term == Term::Surface
                 && matches!(l.combine, Combine::Add | Combine::Multiply)
                 && l.channels == 3
-                && o.mesh.texcoords.is_some()
+                && (o.mesh.texcoords.is_some() || !has_mesh)
         } else {
             l.kind.is_shell()
                 && l.combine == Combine::Over
@@ -444,6 +496,9 @@ fn layers<S>(s: &ParameterSpace, oi: usize, o: &Object<S>, out: &mut Vec<Issue>)
         if !(l.gamma.is_finite() && l.gamma > 0.0) {
             out.push(e(6004, format!("gamma {}", l.gamma)));
         }
+        let Some(s) = grid else {
+            continue;
+        };
         if !mask_ok(s, l.depends_on) {
             out.push(e(
                 5002,
@@ -568,6 +623,9 @@ fn pyramid<S>(extent: &[u32], dims: usize, levels: &[Level<S>], push: &mut dyn F
             format!("{} levels, expected 1 to {MAX_LEVELS}", levels.len()),
         );
         return;
+    }
+    if dims == 0 && levels.len() > 1 {
+        push(7005, format!("{} levels; a layer with dependency mask 0 has exactly 1", levels.len()));
     }
     for (lv, level) in levels.iter().enumerate() {
         let images: u64 = level.counts.iter().map(|&c| c as u64).product();

@@ -203,7 +203,7 @@ pub(crate) fn parse(c: &mut Cursor) -> Result<Master, Issue> {
         let code = c.u8("codec id")?;
         let flags = c.u8("flags")?;
         if flags & !HAS_WEIGHTS != 0 {
-            return Err(Issue::new(9100, format!("layer {li}: unknown flags {flags:#04x}")).in_chunk("MSTR", usize::MAX).at(at + 1));
+            c.flag(Issue::new(9100, format!("layer {li}: unknown flags {flags:#04x}")).in_chunk("MSTR", usize::MAX).at(at + 1))?;
         }
         c.reserved(2, "reserved")?;
         let codec = CodecId::from_code(code as u16).filter(|k| !k.is_lossy()).ok_or_else(|| {
@@ -277,7 +277,10 @@ pub fn check<S>(c: &Container<S>, masters: &[Master]) -> Vec<Issue> {
 pub(crate) fn load<S>(src: &dyn Source, entries: &[ChunkEntry], c: &Container<S>, decode: bool, issues: &mut Vec<Issue>) -> Vec<Master> {
     let mut masters = Vec::new();
     for (i, e) in entries.iter().enumerate().filter(|(_, e)| e.fourcc == chunk::MSTR) {
-        // The table checks put every chunk inside the file before a container is parsed.
+        // A chunk past the end of the file is reported by the table (rule 3002).
+        if e.offset.checked_add(e.length).is_none_or(|end| end > src.len()) {
+            continue;
+        }
         let mut bytes = vec![0; e.length as usize];
         if let Err(err) = src.read_at(e.offset, &mut bytes) {
             issues.push(Issue::new(1001, err.to_string()).in_chunk("MSTR", i).at(e.offset));
@@ -288,7 +291,10 @@ pub(crate) fn load<S>(src: &dyn Source, entries: &[ChunkEntry], c: &Container<S>
             issues.push(Issue::new(3004, format!("stored {:#010x}, computed {crc:#010x}", e.crc)).in_chunk("MSTR", i).at(e.offset));
             continue;
         }
-        match parse(&mut Cursor::new(&bytes, e.offset, 9100, ("MSTR", i))) {
+        let mut cursor = Cursor::new(&bytes, e.offset, 9100, ("MSTR", i)).collecting();
+        let parsed = parse(&mut cursor);
+        issues.extend(cursor.take_flagged());
+        match parsed {
             Ok(m) => masters.push((i, m)),
             Err(issue) => issues.push(issue),
         }

@@ -1,6 +1,8 @@
 //! Chunk payload decoders: the inverse of `payload_write.rs`. They check structure (lengths,
 //! counts against the bytes left, enum codes, UTF-8); range and consistency rules are
-//! checked on the model by `checks.rs`.
+//! checked on the model by `checks.rs`. A broken rule that leaves the payload readable
+//! (reserved fields, undefined flag bits) goes through [`Cursor::flag`], so that a
+//! validator's cursor reports it and parses on.
 
 use pis_codec::CodecId;
 
@@ -33,10 +35,8 @@ pub fn pspc(c: &mut Cursor) -> Result<ParameterSpace, Issue> {
         })?;
         let flags = c.u8("flags")?;
         if flags & !1 != 0 {
-            return Err(c.issue(
-                3006,
-                format!("dimension {k} flags {flags:#x} set undefined bits"),
-            ));
+            let issue = c.issue(3006, format!("dimension {k} flags {flags:#x} set undefined bits"));
+            c.flag(issue)?;
         }
         c.reserved(2, "reserved")?;
         let block_size = c.u32("block size")?;
@@ -150,7 +150,8 @@ pub fn mesh(c: &mut Cursor) -> Result<(u32, Mesh), Issue> {
     let ic = c.u32("index count")?;
     let attrs = c.u32("attributes")?;
     if attrs & !(MESH_NORMALS | MESH_TEXCOORDS | MESH_HULL) != 0 {
-        return Err(c.issue(3006, format!("attributes {attrs:#x} set undefined bits")));
+        let issue = c.issue(3006, format!("attributes {attrs:#x} set undefined bits"));
+        c.flag(issue)?;
     }
     let per_vertex = 12
         + if attrs & MESH_NORMALS != 0 { 12 } else { 0 }
@@ -181,7 +182,8 @@ pub fn mesh(c: &mut Cursor) -> Result<(u32, Mesh), Issue> {
     let hull_triangles = if attrs & MESH_HULL != 0 {
         let h = c.u32("hull triangles")?;
         if h == 0 {
-            return Err(c.issue(5200, "attribute bit 2 (hull) set with a hull triangle count of 0".to_string()));
+            let issue = c.issue(5200, "attribute bit 2 (hull) set with a hull triangle count of 0".to_string());
+            c.flag(issue)?;
         }
         h
     } else {
@@ -246,12 +248,10 @@ pub fn layr(c: &mut Cursor, objects: &mut [Object<StreamRef>]) -> Result<(), Iss
             let shape = c.u16("shell shape")? as u32;
             let flags = c.u16("placement flags")?;
             if flags & !15 != 0 || (shape != 0 && flags != 0) {
-                return Err(c
-                    .issue(
-                        3006,
-                        format!("layer {li} block {bi} placement flags {flags:#x}"),
-                    )
-                    .at(shape_at + 2));
+                let issue = c
+                    .issue(3006, format!("layer {li} block {bi} placement flags {flags:#x}"))
+                    .at(shape_at + 2);
+                c.flag(issue)?;
             }
             let values = c.f32s::<12>("placement values")?;
             let placement = if shape == 0 {
@@ -291,12 +291,10 @@ pub fn layr(c: &mut Cursor, objects: &mut [Object<StreamRef>]) -> Result<(), Iss
                 values[9..].to_vec()
             };
             if unused.iter().any(|v| v.to_bits() != 0) {
-                return Err(c
-                    .issue(
-                        3006,
-                        format!("layer {li} block {bi} unused placement values are not 0"),
-                    )
-                    .at(shape_at + 4));
+                let issue = c
+                    .issue(3006, format!("layer {li} block {bi} unused placement values are not +0.0"))
+                    .at(shape_at + 4);
+                c.flag(issue)?;
             }
             let lc = c.u32("level count")?;
             if lc == 0 || lc > 32 {

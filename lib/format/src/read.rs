@@ -40,10 +40,13 @@ pub struct ReadStats {
     pub bytes: u64,
 }
 
-/// What a structural pass over a file found.
+/// What a structural pass over a file found (its issues go to the caller's list).
 pub(crate) struct Loaded {
     pub header: Option<Header>,
     pub chunks: Vec<ChunkEntry>,
+    /// The container, when its space and layers parsed and its codestreams can be decoded
+    /// within section 12's limits. With `full`, other rules may be broken and the parts that
+    /// did not parse (cameras, meshes, provenance) left empty.
     pub container: Option<Container<StreamRef>>,
 }
 
@@ -219,6 +222,13 @@ impl PisReader {
                 CodecError::NotSupported(c) => {
                     Error::NotSupported(format!("codec '{c}' (object {object}, layer {layer})"))
                 }
+                e @ CodecError::TrailingBytes { .. } => Error::Invalid(
+                    Issue::new(
+                        8008,
+                        format!("object {object} layer {layer} block {bi} level {lv}: {e}"),
+                    )
+                    .in_chunk("CSTR", r.chunk as usize),
+                ),
                 e => Error::Invalid(
                     Issue::new(
                         8005,
@@ -277,8 +287,15 @@ impl PisReader {
 }
 
 /// The structural pass shared by [`PisReader::open`] and `validate`: header, table, metadata
-/// chunks, model rules and codestream ranges. With `full`, also every checksum of chunks the
-/// reader otherwise reads lazily (`CSTR`, unknown chunks).
+/// chunks, model rules and codestream ranges. With `full` (validation), also every checksum
+/// of chunks the reader otherwise reads lazily (`CSTR`, unknown chunks), and every rule that
+/// can be checked: a reader stops at the first broken rule, a validator reports every rule
+/// whose inputs are readable (a chunk whose checksum fails is not parsed, and the rules that
+/// build on its content are not checked).
+///
+/// The container is returned when its space and layers parsed and the rules that bound
+/// decoding hold (the space, block grids, pyramids, codestream ranges and section 12's
+/// limits), so that its codestreams can be decoded; other rules may be broken.
 pub(crate) fn load(src: &dyn Source, full: bool, issues: &mut Vec<Issue>) -> Loaded {
     let mut out = Loaded {
         header: None,
@@ -312,7 +329,7 @@ pub(crate) fn load(src: &dyn Source, full: bool, issues: &mut Vec<Issue>) -> Loa
     chunk::check_padding(&entries, &mut read, issues);
     out.header = Some(header);
 
-    // Read and verify the chunks; parse the metadata ones.
+    // Read and verify the chunks; keep the metadata payloads whose checksums hold.
     let mut payloads: Vec<Option<Vec<u8>>> = vec![None; entries.len()];
     let mut ok = true;
     for (i, e) in entries.iter().enumerate() {
@@ -350,11 +367,44 @@ pub(crate) fn load(src: &dyn Source, full: bool, issues: &mut Vec<Issue>) -> Loa
         }
     }
     out.chunks = entries;
-    if !ok || issues.iter().any(|i| i.severity == Severity::Error) {
+    // A reader refuses the file at its first broken rule; a validator goes on.
+    if !full && (!ok || issues.iter().any(|i| i.severity == Severity::Error)) {
         return out;
     }
     out.container = parse(&out.chunks, &payloads, issues);
     out
+}
+
+/// Parses the metadata chunk `i` with `f`, when its payload was read and its checksum held
+/// (else its issue is already reported). Broken rules that leave the payload readable are
+/// reported and parsing goes on.
+fn parse_chunk<T>(
+    entries: &[ChunkEntry],
+    payloads: &[Option<Vec<u8>>],
+    i: usize,
+    issues: &mut Vec<Issue>,
+    f: impl FnOnce(&mut Cursor) -> Result<T, Issue>,
+) -> Option<T> {
+    let data = payloads[i].as_deref()?;
+    let e = &entries[i];
+    let malformed = chunk::rule(e.fourcc).map_or(3004, |r| r.malformed);
+    let mut c = Cursor::new(data, e.offset, malformed, (chunk_name(e), i)).collecting();
+    let parsed = f(&mut c);
+    issues.extend(c.take_flagged());
+    parsed.map_err(|issue| issues.push(issue)).ok()
+}
+
+/// Whether a broken rule leaves the file's codestreams undecodable or their decoded size
+/// unbounded: the space, block origins, layer masks, block grids, texture sizes, pyramids
+/// and codestream ranges.
+fn guards_decoding(i: &Issue) -> bool {
+    let layr = i.chunk.as_ref().is_some_and(|(t, _)| t == "LAYR");
+    (4000..5000).contains(&i.id)
+        || i.id == 5105
+        || (i.id == 5002 && layr)
+        || (6000..8000).contains(&i.id)
+        || i.id == 8001
+        || i.id == 8002
 }
 
 fn parse(
@@ -363,36 +413,32 @@ fn parse(
     issues: &mut Vec<Issue>,
 ) -> Option<Container<StreamRef>> {
     let find = |f: chunk::FourCC| entries.iter().position(|e| e.fourcc == f);
-    let cursor = |i: usize| {
-        let e = &entries[i];
-        let malformed = chunk::rule(e.fourcc).map_or(3004, |r| r.malformed);
-        Cursor::new(
-            payloads[i].as_deref().unwrap_or(&[]),
-            e.offset,
-            malformed,
-            (chunk_name(e), i),
-        )
+    let before = issues.len();
+    let space = find(chunk::PSPC).and_then(|i| parse_chunk(entries, payloads, i, issues, pr::pspc));
+    let cameras = find(chunk::CAMS).and_then(|i| parse_chunk(entries, payloads, i, issues, pr::cams));
+    // OBJS needs the dimension count.
+    let mut objects = match (&space, find(chunk::OBJS)) {
+        (Some(s), Some(i)) => {
+            let d = s.dims.len();
+            parse_chunk(entries, payloads, i, issues, |c| pr::objs(c, d))
+        }
+        _ => None,
     };
-    fn attempt<T>(r: Result<T, Issue>, issues: &mut Vec<Issue>) -> Option<T> {
-        r.map_err(|i| issues.push(i)).ok()
-    }
-
-    let (pspc, cams, objs, layr) = (
-        find(chunk::PSPC)?,
-        find(chunk::CAMS)?,
-        find(chunk::OBJS)?,
-        find(chunk::LAYR)?,
-    );
-    let space = attempt(pr::pspc(&mut cursor(pspc)), issues)?;
-    let cameras = attempt(pr::cams(&mut cursor(cams)), issues)?;
-    let mut objects = attempt(pr::objs(&mut cursor(objs), space.dims.len()), issues)?;
-    let mut has_mesh = vec![false; objects.len()];
+    // Each MESH parses alone; it is given to its object when OBJS parsed.
+    let mut has_mesh = vec![false; objects.as_ref().map_or(0, Vec::len)];
+    let mut every_mesh_parsed = true;
     for (i, e) in entries
         .iter()
         .enumerate()
         .filter(|(_, e)| e.fourcc == chunk::MESH)
     {
-        let (oi, mesh) = attempt(pr::mesh(&mut cursor(i)), issues)?;
+        let Some((oi, mesh)) = parse_chunk(entries, payloads, i, issues, pr::mesh) else {
+            every_mesh_parsed = false;
+            continue;
+        };
+        let Some(objects) = objects.as_mut() else {
+            continue;
+        };
         match has_mesh.get_mut(oi as usize) {
             Some(seen @ false) => {
                 *seen = true;
@@ -410,31 +456,38 @@ fn parse(
                     .in_chunk("MESH", i)
                     .at(e.offset),
                 );
-                return None;
             }
         }
     }
-    if let Some(oi) = has_mesh.iter().position(|&m| !m) {
-        issues.push(Issue::new(
-            5202,
-            format!("object {oi} '{}' has no MESH chunk", objects[oi].name),
-        ));
-        return None;
+    if let Some(objects) = &objects {
+        // A MESH that did not parse may be the missing one.
+        if every_mesh_parsed {
+            for (oi, _) in has_mesh.iter().enumerate().filter(|(_, &m)| !m) {
+                issues.push(Issue::new(
+                    5202,
+                    format!("object {oi} '{}' has no MESH chunk", objects[oi].name),
+                ));
+            }
+        }
     }
-    attempt(pr::layr(&mut cursor(layr), &mut objects), issues)?;
-    let provenance = match find(chunk::PROV) {
-        Some(i) => Some(attempt(pr::prov(&mut cursor(i)), issues)?),
-        None => None,
+    let layers = match (objects.as_mut(), find(chunk::LAYR)) {
+        (Some(objects), Some(i)) => parse_chunk(entries, payloads, i, issues, |c| pr::layr(c, objects)).is_some(),
+        _ => false,
     };
-    let container = Container {
-        space,
-        cameras,
-        objects,
-        provenance,
+    let provenance = match find(chunk::PROV) {
+        Some(i) => parse_chunk(entries, payloads, i, issues, pr::prov).map(Some),
+        None => Some(None),
     };
 
-    let before = issues.len();
-    for mut issue in checks::check(&container) {
+    let parsed = checks::Parsed {
+        space: space.as_ref(),
+        cameras: cameras.as_ref(),
+        objects: objects.as_deref(),
+        meshes: &has_mesh,
+        layers,
+        provenance: provenance.as_ref().map(Option::as_ref),
+    };
+    for mut issue in checks::check_parsed(&parsed) {
         // Name the chunk's index where its type occurs once.
         if let Some((t, idx)) = &mut issue.chunk {
             let matches: Vec<usize> = entries
@@ -449,13 +502,31 @@ fn parse(
         }
         issues.push(issue);
     }
+    // The codestreams need the space and the layers; what else did not parse is left empty
+    // (its issues are reported, so a reader never uses such a container).
+    let (Some(space), Some(objects), true) = (space, objects, layers) else {
+        return None;
+    };
+    let container = Container {
+        space,
+        cameras: cameras.unwrap_or(CameraTable {
+            width: 0,
+            height: 0,
+            depends_on: DepMask::NONE,
+            cameras: Vec::new(),
+        }),
+        objects,
+        provenance: provenance.flatten(),
+    };
     stream_ranges(entries, &container, issues);
-    if issues.len() == before {
-        if let Some(issue) = checks::decoded_sizes(&container, checks::referenced_bytes(&container)) {
-            issues.push(issue);
-        }
+    if issues[before..].iter().any(guards_decoding) {
+        return None;
     }
-    (issues.len() == before).then_some(container)
+    if let Some(issue) = checks::decoded_sizes(&container, checks::referenced_bytes(&container)) {
+        issues.push(issue);
+        return None;
+    }
+    Some(container)
 }
 
 fn chunk_name(e: &ChunkEntry) -> &'static str {

@@ -166,6 +166,12 @@ pub fn decode(planes: &[PlaneShape], bytes: &[u8]) -> Result<Vec<f32>, CodecErro
         }
         chans.push(a);
     }
+    // The body is exactly the coded blocks: a decoder that did not run out of bytes has read
+    // every one.
+    let body = bytes.len() - hl;
+    if !dec.exhausted() && dec.position() < body {
+        return Err(CodecError::TrailingBytes { extra: body - dec.position(), length: bytes.len() });
+    }
     let mut out = Vec::with_capacity(n);
     colour::merge(planes, &chans, colour, &mut out);
     if out.iter().any(|v| !v.is_finite()) {

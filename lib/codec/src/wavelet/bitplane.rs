@@ -201,6 +201,9 @@ pub fn encode(bands: &[Band], a: &[f64], neg: &[bool], top: u32) -> (Vec<u8>, Ve
 pub struct Decoded {
     pub mag: Vec<u32>,
     pub low: Vec<u8>,
+    /// Body bytes the range decoder read: the whole body when it ended (a truncated stream)
+    /// or when the stream is exact; fewer when bytes follow the coded data.
+    pub used: usize,
 }
 
 impl Decoded {
@@ -226,6 +229,7 @@ pub fn decode(bands: &[Band], n: usize, top: u32, body: &[u8]) -> Decoded {
     let mut out = Decoded {
         mag: vec![0u32; n],
         low: vec![255u8; n],
+        used: 0,
     };
     let bases = tile_bases(bands);
     let mut tsig = vec![
@@ -302,5 +306,6 @@ pub fn decode(bands: &[Band], n: usize, top: u32, body: &[u8]) -> Decoded {
             }
         }
     }
+    out.used = dec.position();
     out
 }

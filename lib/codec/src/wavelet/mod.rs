@@ -326,7 +326,14 @@ pub fn decode(planes: &[PlaneShape], bytes: &[u8]) -> Result<Vec<f32>, CodecErro
     let (bands, scales, arrays) = layout(planes, levels);
     // Working memory peaks at about 2.5 times the decoded size: 6 bytes of coefficient
     // state per value while decoding bit-planes, then 9 while filling the arrays.
-    let dec = (top != NO_PLANES).then(|| bitplane::decode(&bands, n, top as u32, &bytes[hl..]));
+    let body = &bytes[hl..];
+    let dec = (top != NO_PLANES).then(|| bitplane::decode(&bands, n, top as u32, body));
+    // The body is exactly the coded data: nothing after a top bit-plane of 255, and no byte
+    // the decoder did not read after the last bit-plane (a truncated body is read to its end).
+    let used = dec.as_ref().map_or(0, |d| d.used);
+    if used < body.len() {
+        return Err(CodecError::TrailingBytes { extra: body.len() - used, length: bytes.len() });
+    }
     let mut chans: Vec<Vec<f32>> = arrays
         .iter()
         .map(|&(w, h, _)| vec![0.0f32; w * h])
