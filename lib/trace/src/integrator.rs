@@ -453,44 +453,27 @@ impl<'s> Integrator<'s> {
         if cos_o <= 0.0 {
             return Vec3::ZERO;
         }
-        let a2 = m.alpha * m.alpha;
         let mut sum = Vec3::ZERO;
         for light in &self.frame.lights {
             let Some(ls) = sample_light(light, sp.position, rng) else { continue };
             let l = ls.direction;
-            let cos_l = n.dot(l);
-            if cos_l <= 0.0 || sp.geometric_normal.dot(l) <= 0.0 {
-                continue;
-            }
-            let h = (wo + l).normalize();
-            let nh = n.dot(h).max(0.0);
-            let dd = nh * nh * (a2 - 1.0) + 1.0;
-            let d = a2 / (PI * dd * dd);
-            let g = ggx_g1(cos_o, m.alpha) * ggx_g1(cos_l, m.alpha);
-            let f = m.fresnel(wo.dot(h));
+            let Some((f, lobe)) = ggx_reflection(sp, m, wo, l, cos_o) else { continue };
             let o = offset_origin(sp.position, sp.geometric_normal, l);
             ctx.rays += 1;
             let tmax = if ls.distance.is_finite() { ls.distance * (1.0 - 1e-4) } else { f32::INFINITY };
             if !self.geometry.occluded(o, l, tmax) {
-                sum += f * ls.weight * (d * g / (4.0 * cos_o));
+                sum += f * ls.weight * lobe;
             }
         }
         // The environment, weighed against the lobe's sampled ray (always traced after this).
         if let Some(s) = self.environment.as_ref().and_then(|env| env.sample(n, rng.next_2d())) {
             let l = s.direction;
-            let cos_l = n.dot(l);
-            if cos_l > 0.0 && sp.geometric_normal.dot(l) > 0.0 {
-                let h = (wo + l).normalize();
-                let nh = n.dot(h).max(0.0);
-                let dd = nh * nh * (a2 - 1.0) + 1.0;
-                let d = a2 / (PI * dd * dd);
-                let g = ggx_g1(cos_o, m.alpha) * ggx_g1(cos_l, m.alpha);
-                let f = m.fresnel(wo.dot(h));
+            if let Some((f, lobe)) = ggx_reflection(sp, m, wo, l, cos_o) {
                 let o = offset_origin(sp.position, sp.geometric_normal, l);
                 ctx.rays += 1;
                 if !self.geometry.occluded(o, l, f32::INFINITY) {
                     let w = balance(s.pdf, ggx_reflection_pdf(n, wo, l, m.alpha));
-                    sum += f * s.radiance * (d * g / (4.0 * cos_o) / s.pdf * w);
+                    sum += f * s.radiance * (lobe / s.pdf * w);
                 }
             }
         }
@@ -749,6 +732,25 @@ pub fn diffuse_pdf(n: Vec3, ng: Vec3, d: Vec3) -> f32 {
     }
     let mirrored = d - ng * (2.0 * c);
     (n.dot(d).max(0.0) + n.dot(mirrored).max(0.0)) / PI
+}
+
+/// The opaque GGX lobe towards the unit direction `l` seen from `wo` at `sp` (`cos_o` =
+/// n·wo > 0): its Fresnel factor and D G / (4 cos_o), so that the reflected radiance of light
+/// L arriving along `l` is F · L · that; `None` where `l` is below the shading or the
+/// geometric surface.
+fn ggx_reflection(sp: &SurfacePoint, m: &ShadingMaterial, wo: Vec3, l: Vec3, cos_o: f32) -> Option<(Vec3, f32)> {
+    let n = sp.normal;
+    let cos_l = n.dot(l);
+    if cos_l <= 0.0 || sp.geometric_normal.dot(l) <= 0.0 {
+        return None;
+    }
+    let a2 = m.alpha * m.alpha;
+    let h = (wo + l).normalize();
+    let nh = n.dot(h).max(0.0);
+    let dd = nh * nh * (a2 - 1.0) + 1.0;
+    let d = a2 / (PI * dd * dd);
+    let g = ggx_g1(cos_o, m.alpha) * ggx_g1(cos_l, m.alpha);
+    Some((m.fresnel(wo.dot(h)), d * g / (4.0 * cos_o)))
 }
 
 /// The density of the GGX lobe's reflected direction `l` for the view direction `wo` (both
