@@ -364,6 +364,15 @@ impl Ctx<'_> {
         }
     }
 
+    /// A vertex attribute beside POSITION's `n` values: finite, and one per vertex.
+    fn check_vertex_attribute<const N: usize>(&self, values: &[[f32; N]], n: usize, field: impl Fn() -> String) -> Result<(), SceneError> {
+        self.check_finite(values, &field)?;
+        if values.len() != n {
+            return Err(SceneError::invalid(&self.path, field(), "count differs from POSITION"));
+        }
+        Ok(())
+    }
+
     fn read_primitive(
         &self,
         p: &gltf::Primitive,
@@ -420,38 +429,17 @@ impl Ctx<'_> {
         let n = positions.len();
         let normals: Option<Vec<[f32; 3]>> = reader.read_normals().map(|r| r.collect());
         if let Some(ns) = &normals {
-            self.check_finite(ns, || format!("{field}.attributes.NORMAL"))?;
-            if ns.len() != n {
-                return Err(SceneError::invalid(
-                    &self.path,
-                    format!("{field}.attributes.NORMAL"),
-                    "count differs from POSITION",
-                ));
-            }
+            self.check_vertex_attribute(ns, n, || format!("{field}.attributes.NORMAL"))?;
         }
         let uvs: Option<Vec<[f32; 2]>> = reader.read_tex_coords(0).map(|r| r.into_f32().collect());
         let uvs1: Option<Vec<[f32; 2]>> = reader.read_tex_coords(1).map(|r| r.into_f32().collect());
         for (set, values) in [(0, &uvs), (1, &uvs1)] {
             let Some(us) = values else { continue };
-            self.check_finite(us, || format!("{field}.attributes.TEXCOORD_{set}"))?;
-            if us.len() != n {
-                return Err(SceneError::invalid(
-                    &self.path,
-                    format!("{field}.attributes.TEXCOORD_{set}"),
-                    "count differs from POSITION",
-                ));
-            }
+            self.check_vertex_attribute(us, n, || format!("{field}.attributes.TEXCOORD_{set}"))?;
         }
         let tangents: Option<Vec<[f32; 4]>> = reader.read_tangents().map(|r| r.collect());
         if let Some(ts) = &tangents {
-            self.check_finite(ts, || format!("{field}.attributes.TANGENT"))?;
-            if ts.len() != n {
-                return Err(SceneError::invalid(
-                    &self.path,
-                    format!("{field}.attributes.TANGENT"),
-                    "count differs from POSITION",
-                ));
-            }
+            self.check_vertex_attribute(ts, n, || format!("{field}.attributes.TANGENT"))?;
         }
         let raw: Vec<u32> = match reader.read_indices() {
             Some(r) => r.into_u32().collect(),
