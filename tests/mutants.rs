@@ -132,6 +132,7 @@ fn exercise(file: &Path, original: &Path, scratch: &Path, gpu: &Arc<Gpu>) {
         gamma: None,
         keep_master: false,
         block: None,
+        max_mse: None,
     });
     let _ = std::fs::remove_file(&out);
     // pis-diff against the file it came from.
@@ -158,7 +159,7 @@ fn seeds(dir: &Path) -> Vec<PathBuf> {
     let mut out = vec![tiny.clone(), repo("format-spec/examples/minimal.pis")];
     for (name, codec, keep_master) in [("wavelet", CodecId::Wavelet, false), ("dct", CodecId::Dct, false), ("master", CodecId::Lossless, true)] {
         let path = dir.join(format!("seed-{name}.pis"));
-        pis_eval::reencode::reencode(&ReencodeRequest { input: tiny.clone(), output: path.clone(), codec, ratio: (codec != CodecId::Lossless).then_some(6.0), psnr: None, gamma: None, keep_master, block: None })
+        pis_eval::reencode::reencode(&ReencodeRequest { input: tiny.clone(), output: path.clone(), codec, ratio: (codec != CodecId::Lossless).then_some(6.0), psnr: None, gamma: None, keep_master, block: None, max_mse: None })
             .unwrap_or_else(|e| panic!("seed {name}: {}", e.error));
         out.push(path);
     }

@@ -303,8 +303,10 @@ fn pack_refuses_a_ratio_that_leaves_no_byte_and_names_the_highest() {
 /// of the file. Recorded again when objects came to be written with their scene roles, their
 /// materials' shading constants and, for the reflective vase and table top and the
 /// refractive glass cup, vertex normals (35 232 bytes of them, less 8 of chunk padding); the
-/// level images did not change.
-const DEMO1_CI_PACK: (usize, u32) = (196_509, 0x2e6e_f8cd);
+/// level images did not change. Recorded again when `--max-mse-ratio auto` became the
+/// default: demo1 keeps the free allocation at 384:1 (26.33 dB predicted against 25.55 with
+/// the constraint), and the provenance records `max_mse_ratio = off`.
+const DEMO1_CI_PACK: (usize, u32) = (196_533, 0xf7c2_23fc);
 
 #[test]
 fn pack_output_is_byte_identical_to_the_recorded_checksum() {

@@ -9,7 +9,7 @@ use pis_codec::CodecId;
 use pis_compile::{Filter, MAX_ANISOTROPY};
 
 use crate::cli::{Exit, Failure};
-use pis_pack::{filter_needs_probe, Allocation, BlockSize, LayerMode, MatrixSource, PackRequest, PackSettings, PlacementMode, PyramidMode, RepresentationMode};
+use pis_pack::{filter_needs_probe, Allocation, BlockSize, LayerMode, MatrixSource, MaxMse, PackRequest, PackSettings, PlacementMode, PyramidMode, RepresentationMode};
 
 /// pis-pack's settings on the command line.
 #[derive(Args, Debug, Clone)]
@@ -92,6 +92,13 @@ pub struct PackOptions {
     /// weighted by each object's screen area).
     #[arg(long, default_value = "screen", value_parser = parse_allocation)]
     pub allocation: Allocation,
+    /// The allocation's max-MSE constraint (thesis 4.8): no object's coding MSE above ALPHA
+    /// times the mean object MSE, storage taken from the objects with low MSE. `auto`: the
+    /// constraint at the thesis's 1.25 and the free allocation are both encoded, and the one
+    /// whose decoded textures predict the higher PSNR is kept (the report says which);
+    /// `off`: the free equal-slope allocation; a number above 1: the constraint at that α.
+    #[arg(long, value_name = "auto|off|ALPHA", default_value = "auto", value_parser = parse_max_mse_ratio)]
+    pub max_mse_ratio: MaxMse,
     /// Which views each texture placement (branch cuts, affine map, used size; thesis 3.2)
     /// is optimized over: `block` (per object per parameter block, the views of the
     /// block's samples) or `object` (one placement per object over every view of the set).
@@ -130,6 +137,7 @@ impl PackOptions {
             layers: self.layers,
             representation: self.representation,
             allocation: self.allocation,
+            max_mse: self.max_mse_ratio,
             placement: self.placement,
             max_iterations: self.max_iterations,
             keep_master: self.keep_master,
@@ -197,6 +205,18 @@ fn parse_placement(s: &str) -> Result<PlacementMode, String> {
         "block" => Ok(PlacementMode::Block),
         "object" => Ok(PlacementMode::Object),
         _ => Err(format!("unknown placement {s:?} (block or object)")),
+    }
+}
+
+/// `--max-mse-ratio`: `auto`, `off`, or α above 1.
+pub fn parse_max_mse_ratio(s: &str) -> Result<MaxMse, String> {
+    match s {
+        "auto" => Ok(MaxMse::Best(pis_codec::allocate::DEFAULT_ALPHA)),
+        "off" => Ok(MaxMse::Off),
+        _ => match s.parse::<f64>() {
+            Ok(a) if a.is_finite() && a > 1.0 => Ok(MaxMse::On(a)),
+            _ => Err(format!("{s:?} is not `auto`, `off` or a ratio above 1 (the thesis uses 1.25)")),
+        },
     }
 }
 

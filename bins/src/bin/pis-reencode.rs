@@ -49,6 +49,11 @@ struct Cli {
     /// staggers them. Default: the input's blocks.
     #[arg(long, value_parser = parse_block)]
     block: Option<BlockSizes>,
+    /// The allocation's max-MSE constraint (thesis 4.8), as pis-pack's --max-mse-ratio: `off`
+    /// or α above 1 (`auto` needs the traced set and means 1.25 here). Default: what the
+    /// input's provenance records its writer applied (1.25 where it records nothing).
+    #[arg(long, value_name = "off|ALPHA", value_parser = pis::pack_args::parse_max_mse_ratio)]
+    max_mse_ratio: Option<pis_pack::MaxMse>,
     /// Print the report as JSON on stdout.
     #[arg(long)]
     json: bool,
@@ -67,7 +72,7 @@ fn parse_block(s: &str) -> Result<BlockSizes, String> {
 }
 
 fn run(cli: Cli) -> Result<Exit, Failure> {
-    let req = ReencodeRequest { input: cli.input, output: cli.output, codec: cli.codec, ratio: cli.ratio, psnr: cli.psnr, gamma: cli.gamma, keep_master: cli.keep_master, block: cli.block.map(|b| b.0) };
+    let req = ReencodeRequest { input: cli.input, output: cli.output, codec: cli.codec, ratio: cli.ratio, psnr: cli.psnr, gamma: cli.gamma, keep_master: cli.keep_master, block: cli.block.map(|b| b.0), max_mse: cli.max_mse_ratio };
     let report = reencode(&req)?;
     print_report(&report, &mut std::io::stderr()).map_err(|e| Failure::new(Exit::Io, e))?;
     if cli.json {

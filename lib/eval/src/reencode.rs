@@ -31,7 +31,7 @@ use serde::Serialize;
 
 pub use screen_area::screen_areas;
 
-use pis_pack::{Exit, Failure};
+use pis_pack::{Exit, Failure, MaxMse};
 use pis_pack::blocks::{block_sizes, stagger};
 use pis_pack::storage::{allocate_storage, build_pyramid, encode_levels, nudge, BlockPyramid};
 
@@ -53,6 +53,21 @@ pub struct ReencodeRequest {
     /// New parameter-block sizes (one for every dimension, or one per dimension), the block
     /// origins staggered again as pis-pack staggers them; None keeps the input's blocks.
     pub block: Option<Vec<u32>>,
+    /// The allocation's max-MSE constraint (thesis 4.8): `Off` or `On(α)`. None: what the
+    /// input's provenance records its writer applied (`max_mse_ratio`), α = 1.25 where it
+    /// records nothing.
+    pub max_mse: Option<MaxMse>,
+}
+
+/// The max-MSE constraint the input's writer applied, from its provenance setting
+/// `max_mse_ratio` (`off` or α); α = 1.25 where none is recorded.
+fn writer_max_mse<S>(c: &pis_format::Container<S>) -> MaxMse {
+    let recorded = c.provenance.as_ref().and_then(|p| p.settings.iter().rev().find(|(k, _)| k == "max_mse_ratio")).map(|(_, v)| v.as_str());
+    match recorded {
+        Some("off") => MaxMse::Off,
+        Some(v) => v.parse::<f64>().ok().filter(|a| a.is_finite() && *a > 1.0).map_or(MaxMse::On(pis_codec::allocate::DEFAULT_ALPHA), MaxMse::On),
+        None => MaxMse::On(pis_codec::allocate::DEFAULT_ALPHA),
+    }
 }
 
 /// The gamma lossy re-encodings use unless told otherwise (as `pis-pack`).
@@ -324,11 +339,18 @@ pub fn reencode(req: &ReencodeRequest) -> Result<ReencodeReport, Failure> {
     } else {
         None
     };
-    let storage = allocate_storage(&pyramids, req.codec, target, if exact { &[] } else { areas.as_deref().unwrap_or(&[]) }).map_err(runtime)?;
+    // The constraint as asked, else as the writer applied it (a best-of choice needs the
+    // traced set, which a re-encoding does not have).
+    let max_mse = match req.max_mse {
+        Some(MaxMse::Best(a)) => MaxMse::On(a),
+        Some(m) => m,
+        None => writer_max_mse(c),
+    };
+    let storage = allocate_storage(&pyramids, req.codec, target, if exact { &[] } else { areas.as_deref().unwrap_or(&[]) }, max_mse).map_err(runtime)?;
     if let Some(total) = storage.allocated {
         t.done("allocate", &format!("{total} bytes over {level_images} level images"));
     }
-    let texture_bytes_after = encode_levels(&mut pyramids, req.codec, &storage).map_err(runtime)? as u64;
+    let texture_bytes_after = encode_levels(&mut pyramids, req.codec, &storage.rates).map_err(runtime)? as u64;
     t.done("encode", &format!("{level_images} level images with {}", req.codec));
 
     // The container: everything copied but gamma and pyramids.
@@ -358,6 +380,8 @@ pub fn reencode(req: &ReencodeRequest) -> Result<ReencodeReport, Failure> {
     let mut settings: Vec<(String, String)> = before.settings.iter()
         .filter(|(k, _)| !(req.block.is_some() && k == "block"))
         .filter(|(k, _)| !matches!(k.as_str(), "codec" | "gamma" | "target" | "reencoded_from" | "source_tool" | "source_codec" | pis_pack::PREDICTED_PSNR_SETTING))
+        // An exact output carries the writer's constraint on, for the next lossy coding.
+        .filter(|(k, _)| exact || k != "max_mse_ratio")
         .cloned().collect();
     let codecs_before: Vec<String> = {
         let mut v: Vec<String> = c.objects.iter().flat_map(|o| &o.layers).flat_map(|l| &l.blocks).flat_map(|b| &b.levels)
@@ -377,6 +401,9 @@ pub fn reencode(req: &ReencodeRequest) -> Result<ReencodeReport, Failure> {
         ("source_tool".to_string(), before.tool.clone()),
         ("source_codec".to_string(), codecs_before.join("+")),
     ]);
+    if !exact {
+        settings.push(("max_mse_ratio".to_string(), max_mse.alpha().map_or_else(|| "off".to_string(), |a| a.to_string())));
+    }
     out.provenance = Some(Provenance {
         tool: format!("pis-reencode {}", env!("CARGO_PKG_VERSION")),
         source: if before.source.is_empty() { req.input.display().to_string() } else { before.source.clone() },

@@ -19,7 +19,7 @@ use super::input::LoadedSet;
 use super::blocks::{block_sizes, geometry, stagger, transforms};
 use super::shading::object_shading;
 use super::stored_mesh::stored_mesh;
-use super::storage::{allocate_storage, build_pyramid, encode_levels, CodedLevel};
+use super::storage::{allocate_storage, build_pyramid, encode_levels, BlockPyramid, CodedLevel};
 pub use super::surface::{finest, mip_chain};
 use super::{PackRequest, Stages};
 use crate::error::{Exit, Failure};
@@ -29,6 +29,7 @@ pub type LayerTextures = std::collections::BTreeMap<Vec<u32>, Vec<f32>>;
 
 /// One block of one layer as coded: which layer sample each block-local sample is, and the
 /// level images (gamma-compensated residuals) with their codestreams.
+#[derive(Clone)]
 pub struct PackedBlock {
     pub extent: Vec<u32>,
     /// Per block-local sample (row-major over the extent), the layer key.
@@ -38,6 +39,7 @@ pub struct PackedBlock {
 }
 
 /// The container and what the report and checks need to know about it.
+#[derive(Clone)]
 pub struct Packed {
     pub container: Container,
     /// Per object model, per layer, per block.
@@ -50,6 +52,23 @@ pub struct Packed {
     /// Per object model, per layer: each layer sample's screen weights, by key (empty
     /// without screen-error allocation); the allocation and the master use them.
     pub screen_weights: Vec<Vec<BTreeMap<Vec<u32>, Vec<f32>>>>,
+    /// Per object model: the solved textures' squared display error against the traced
+    /// images and the number of values it sums ([`display_error`]).
+    pub solved_error: Vec<(f64, usize)>,
+    /// With [`super::MaxMse::Best`], where the constraint changed the allocation: which
+    /// allocation was kept and why.
+    pub max_mse: Option<MaxMseChoice>,
+}
+
+/// The choice between the max-MSE constrained and the free allocation.
+#[derive(Clone, Debug, PartialEq)]
+pub struct MaxMseChoice {
+    pub alpha: f64,
+    /// The constrained allocation was kept.
+    pub constrained: bool,
+    /// Predicted PSNR (dB) of each.
+    pub psnr_db_constrained: f64,
+    pub psnr_db_free: f64,
 }
 
 /// The screen weight of every level-0 texel of a texture placed by `placement` at one
@@ -287,24 +306,62 @@ pub fn encode_all(set: &LoadedSet, models: &[ObjectModel], req: &PackRequest, st
         (r, None) => Target::Bytes((raw as f64 / r.unwrap_or(super::DEFAULT_RATIO)) as usize),
     };
     let areas: Vec<f64> = models.iter().map(|m| m.area).collect();
-    let storage = allocate_storage(&pyramids, req.codec, target, &areas).map_err(|e| target_failure(e, raw))?;
+    let storage = allocate_storage(&pyramids, req.codec, target, &areas, req.max_mse).map_err(|e| target_failure(e, raw))?;
     if let Some(total) = storage.allocated {
         stages.done("allocate", &format!("{total} bytes over {} level images", storage.level_images));
     }
-    encode_levels(&mut pyramids, req.codec, &storage).map_err(runtime)?;
+    let solved: Vec<Vec<LayerTextures>> = models.iter().map(solved_chains).collect();
+    let solved_error = display_error(set, models, &solved);
+    let packed = Packed { container, blocks: blocks_out, overhead, layer_bytes: Vec::new(), stagger: staggers, screen_weights, solved_error, max_mse: None };
+    let Some((free_rates, free_bytes)) = &storage.free else {
+        let mut packed = emit(packed, pyramids, &where_, models, req.codec, &storage.rates)?;
+        if req.codec.is_lossy() {
+            record_max_mse(&mut packed, req.max_mse.alpha());
+        }
+        stages.done("encode", &format!("{level_images} level images with {}", req.codec));
+        return Ok(packed);
+    };
+    // Both allocations encoded; the decoded textures of each rendered through the render
+    // matrices against the traced images: the higher predicted PSNR is kept.
+    let alpha = req.max_mse.alpha().unwrap_or(pis_codec::allocate::DEFAULT_ALPHA);
+    let with = emit(packed.clone(), pyramids.clone(), &where_, models, req.codec, &storage.rates)?;
+    let without = emit(packed, pyramids, &where_, models, req.codec, free_rates)?;
+    let db = |p: &Packed| -> Result<f64, Failure> { Ok(predicted_psnr(set, models, p).map_err(runtime)?.overall) };
+    let (db_with, db_without) = (db(&with)?, db(&without)?);
+    let keep = db_with >= db_without;
+    let mut packed = if keep { with } else { without };
+    packed.max_mse = Some(MaxMseChoice { alpha, constrained: keep, psnr_db_constrained: db_with, psnr_db_free: db_without });
+    record_max_mse(&mut packed, keep.then_some(alpha));
+    stages.done("encode", &format!(
+        "{level_images} level images with {}, twice: the max-MSE constraint (alpha {alpha}) predicts {db_with:.2} dB, the free allocation ({free_bytes} bytes) {db_without:.2} dB: {} kept",
+        req.codec, if keep { "the constraint" } else { "the free allocation" },
+    ));
+    Ok(packed)
+}
+
+/// Provenance: the max-MSE constraint the allocation applied (`off`, or its α).
+fn record_max_mse(packed: &mut Packed, alpha: Option<f64>) {
+    if let Some(p) = packed.container.provenance.as_mut() {
+        p.settings.push(("max_mse_ratio".to_string(), alpha.map_or_else(|| "off".to_string(), |a| a.to_string())));
+    }
+}
+
+/// The codestreams of `pyramids` at `rates`, moved into `packed`'s container and blocks.
+fn emit(mut packed: Packed, mut pyramids: Vec<BlockPyramid>, where_: &[(usize, usize, usize)], models: &[ObjectModel], codec: CodecId, rates: &[pis_codec::Rate]) -> Result<Packed, Failure> {
+    encode_levels(&mut pyramids, codec, rates).map_err(|e| Failure::new(Exit::Runtime, e))?;
     let mut layer_bytes: Vec<Vec<usize>> = models.iter().map(|m| vec![0; m.layers.len()]).collect();
     for ((mi, li, b), pyramid) in where_.iter().zip(pyramids) {
-        let block = &mut container.objects[*mi].layers[*li].blocks[*b];
+        let block = &mut packed.container.objects[*mi].layers[*li].blocks[*b];
         for (level, (_, _, streams)) in block.levels.iter_mut().zip(&pyramid.levels) {
             for (image, bytes) in level.images.iter_mut().zip(streams) {
                 layer_bytes[*mi][*li] += bytes.len();
                 image.bytes = bytes.clone();
             }
         }
-        blocks_out[*mi][*li][*b].levels = pyramid.levels;
+        packed.blocks[*mi][*li][*b].levels = pyramid.levels;
     }
-    stages.done("encode", &format!("{level_images} level images with {}", req.codec));
-    Ok(Packed { container, blocks: blocks_out, overhead, layer_bytes, stagger: staggers, screen_weights })
+    packed.layer_bytes = layer_bytes;
+    Ok(packed)
 }
 
 /// Decoded linear textures (whole MIP chain, rebuilt by decimation as the player does), per
@@ -477,15 +534,15 @@ pub fn predicted_psnr(set: &LoadedSet, models: &[ObjectModel], packed: &Packed) 
         }
     }
     let e_dec = display_error(set, models, &decoded);
-    let e_sol = display_error(set, models, &solved);
+    let e_sol = &packed.solved_error;
     let total = |e: &[(f64, usize)]| {
         let (s, n) = e.iter().fold((0.0, 0), |a, x| (a.0 + x.0, a.1 + x.1));
         psnr(s, n)
     };
     Ok(Quality {
-        objects: e_dec.iter().zip(&e_sol).map(|(a, b)| (psnr(a.0, a.1), psnr(b.0, b.1))).collect(),
+        objects: e_dec.iter().zip(e_sol).map(|(a, b)| (psnr(a.0, a.1), psnr(b.0, b.1))).collect(),
         overall: total(&e_dec),
-        overall_solved: total(&e_sol),
+        overall_solved: total(e_sol),
         max_texel_error: max_err,
     })
 }

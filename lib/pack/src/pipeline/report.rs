@@ -90,9 +90,21 @@ pub struct PackReport {
     /// Lossless codec: every level image read back from the file decodes bit-exactly to
     /// what was encoded, and the decoded finest texels equal the solved ones bit for bit.
     pub lossless_exact: Option<bool>,
+    /// The allocation's max-MSE constraint (thesis 4.8) as applied: `off`, or its α.
+    pub max_mse_ratio: Option<String>,
+    /// `--max-mse-ratio auto` where the constraint changed the allocation: the predicted
+    /// PSNR (dB) with it and with the free allocation; the higher was kept.
+    pub max_mse_psnr_db: Option<MaxMsePsnr>,
     pub objects: Vec<ObjectReport>,
     pub stage_ms: BTreeMap<String, f64>,
     pub notes: Vec<String>,
+}
+
+/// Both allocations' predicted PSNR, when `auto` encoded both.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct MaxMsePsnr {
+    pub constrained: f64,
+    pub free: f64,
 }
 
 #[allow(clippy::too_many_arguments)]
@@ -148,6 +160,8 @@ pub fn build(set: &LoadedSet, models: &[ObjectModel], packed: &Packed, q: &Quali
         psnr_db_solved: q.overall_solved,
         max_texel_error: q.max_texel_error,
         lossless_exact: exact,
+        max_mse_ratio: packed.container.provenance.as_ref().and_then(|p| p.settings.iter().find(|(k, _)| k == "max_mse_ratio")).map(|(_, v)| v.clone()),
+        max_mse_psnr_db: packed.max_mse.as_ref().map(|c| MaxMsePsnr { constrained: c.psnr_db_constrained, free: c.psnr_db_free }),
         objects,
         stage_ms: stages.ms.into_iter().collect(),
         notes: vec![
@@ -178,6 +192,12 @@ pub fn print_report(r: &PackReport, out: &mut impl std::io::Write) -> std::io::R
         writeln!(out, "  lossless master: {} bytes, not counted by the ratio; decodes to the solved textures bit-exactly: {e}", r.master_bytes)?;
     }
     writeln!(out, "  predicted PSNR {:.2} dB (textures as solved {:.2} dB)", r.psnr_db, r.psnr_db_solved)?;
+    match (&r.max_mse_ratio, &r.max_mse_psnr_db) {
+        (Some(a), Some(p)) => writeln!(out, "  allocation: max-MSE constraint {} (predicted {:.2} dB with the constraint, {:.2} dB free: the higher kept)", if a == "off" { "dropped" } else { "kept" }, p.constrained, p.free)?,
+        (Some(a), None) if a == "off" => writeln!(out, "  allocation: free (no max-MSE constraint)")?,
+        (Some(a), None) => writeln!(out, "  allocation: max-MSE constraint at alpha {a}")?,
+        _ => {}
+    }
     if let Some(e) = r.lossless_exact {
         writeln!(out, "  lossless: file decodes to the solved textures bit-exactly: {e} (max texel error {:.3e})", r.max_texel_error)?;
     }

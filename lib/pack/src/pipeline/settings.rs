@@ -69,6 +69,8 @@ pub struct PackSettings {
     pub layers: LayerMode,
     /// What the storage allocation weighs: screen error (default) or texture error.
     pub allocation: Allocation,
+    /// The allocation's max-MSE constraint (thesis 4.8).
+    pub max_mse: MaxMse,
     /// How reflective objects are stored: parameterized surface textures (default) or
     /// layered environment maps (thesis ch. 5).
     pub representation: RepresentationMode,
@@ -113,6 +115,7 @@ impl PackSettings {
             pyramid: PyramidMode::Adaptive,
             layers: LayerMode::Separate,
             allocation: Allocation::Screen,
+            max_mse: MaxMse::Best(pis_codec::allocate::DEFAULT_ALPHA),
             representation: RepresentationMode::Texture,
             placement: PlacementMode::Block,
             max_iterations: None,
@@ -199,6 +202,44 @@ pub enum PyramidMode {
     Adaptive,
     /// Every dimension halved (rounding up) per level down to one sample: no search.
     Full,
+}
+
+/// The storage allocation's max-MSE constraint (thesis 4.8): no object's coding MSE above
+/// α times the mean object MSE, storage taken from the objects with low MSE.
+///
+/// The thesis measures objects by texture-space coding error. Where a texture holds values
+/// the display clips (a glass object's refracted highlights) that measure ranks objects
+/// wrongly and the constraint starves objects the screen shows; where the free allocation
+/// leaves a small object no bytes at all, the constraint is what keeps it from decoding to
+/// black. Neither wins everywhere (docs/BENCHMARKS.md), so pis-pack's default tries both.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum MaxMse {
+    /// The free equal-slope allocation: the least texture error for the bytes.
+    Off,
+    /// The constraint at this α (the thesis: 1.25).
+    On(f64),
+    /// The constraint at this α and the free allocation, both encoded: the one whose decoded
+    /// textures, rendered through the render matrices, predict the higher PSNR.
+    Best(f64),
+}
+
+impl MaxMse {
+    /// The α the allocation applies, if any.
+    pub fn alpha(self) -> Option<f64> {
+        match self {
+            MaxMse::Off => None,
+            MaxMse::On(a) | MaxMse::Best(a) => Some(a),
+        }
+    }
+
+    /// Its name in provenance and reports: `off`, `1.25`, `best of 1.25 and off`.
+    pub fn name(self) -> String {
+        match self {
+            MaxMse::Off => "off".to_string(),
+            MaxMse::On(a) => a.to_string(),
+            MaxMse::Best(a) => format!("best of {a} and off"),
+        }
+    }
 }
 
 /// The error the storage allocation (thesis 4.5) minimizes.

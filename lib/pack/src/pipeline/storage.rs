@@ -4,10 +4,12 @@
 //! `pis-pack` and `pis-reencode` code their textures through here.
 
 use anyhow::{anyhow, Result};
-use pis_codec::allocate::{allocate, Item, Target, DEFAULT_ALPHA};
+use pis_codec::allocate::{allocate, Item, Target};
 use pis_codec::pyramid::{adaptive, build, l1_cost, level_image_index, unflatten, Pyramid, PyramidFilter, PyramidLevel};
 use pis_codec::{CodecId, PlaneShape, Rate};
 use rayon::prelude::*;
+
+use super::settings::MaxMse;
 
 
 /// One pyramid level as coded: counts, the images as encoded, their codestreams.
@@ -26,6 +28,7 @@ pub fn full_levels(extent: &[u32]) -> Vec<Vec<u32>> {
 }
 
 /// One parameter block's pyramid, ready to be allocated and encoded.
+#[derive(Clone)]
 pub struct BlockPyramid {
     /// The object the block belongs to: an index into the allocation's screen areas.
     pub object: usize,
@@ -72,18 +75,21 @@ pub struct Storage {
     /// Bytes the allocation spends (lossy codecs).
     pub allocated: Option<usize>,
     pub level_images: usize,
+    /// With [`MaxMse::Best`], the free allocation (rates and bytes) where the constraint
+    /// changed it: the alternative to encode and compare.
+    pub free: Option<(Vec<Rate>, usize)>,
 }
 
 /// Equal-slope allocation (thesis 4.5) over every level image of `blocks` for a lossy
 /// `codec`: each level image's rate–distortion curve, weighted by the share of its layer's
 /// samples it reaches and by its object's screen area `areas[object]`, with the max-MSE
-/// constraint [`DEFAULT_ALPHA`]. Exact codecs need no allocation.
-pub fn allocate_storage(blocks: &[BlockPyramid], codec: CodecId, target: Target, areas: &[f64]) -> Result<Storage> {
+/// constraint as `max_mse` asks (thesis 4.8). Exact codecs need no allocation.
+pub fn allocate_storage(blocks: &[BlockPyramid], codec: CodecId, target: Target, areas: &[f64], max_mse: MaxMse) -> Result<Storage> {
     let refs: Vec<(usize, usize, usize)> = blocks.iter().enumerate()
         .flat_map(|(b, pb)| pb.levels.iter().enumerate().flat_map(move |(lv, l)| (0..l.1.len()).map(move |ii| (b, lv, ii))))
         .collect();
     if !codec.is_lossy() {
-        return Ok(Storage { rates: vec![Rate::Default; refs.len()], allocated: None, level_images: refs.len() });
+        return Ok(Storage { rates: vec![Rate::Default; refs.len()], allocated: None, level_images: refs.len(), free: None });
     }
     let c = pis_codec::codec(codec).ok_or_else(|| anyhow!("codec {codec} is not in this build"))?;
     // How many finest samples each level image reaches.
@@ -104,8 +110,12 @@ pub fn allocate_storage(blocks: &[BlockPyramid], codec: CodecId, target: Target,
         let curve = c.rd_curve_weighted(&pb.planes, values, weights.as_deref())?;
         Ok(Item { curve, object: pb.object, weight: members[b][lv][ii] as f64 / pb.layer_samples })
     }).collect::<Result<Vec<Item>, pis_codec::CodecError>>()?;
-    let a = allocate(&items, areas, target, Some(DEFAULT_ALPHA))?;
-    Ok(Storage { rates: a.bytes.into_iter().map(Rate::Bytes).collect(), allocated: Some(a.total_bytes), level_images: refs.len() })
+    let a = allocate(&items, areas, target, max_mse.alpha())?;
+    let free = match max_mse {
+        MaxMse::Best(_) => Some(allocate(&items, areas, target, None)?).filter(|f| f.bytes != a.bytes).map(|f| (f.bytes.into_iter().map(Rate::Bytes).collect(), f.total_bytes)),
+        _ => None,
+    };
+    Ok(Storage { rates: a.bytes.into_iter().map(Rate::Bytes).collect(), allocated: Some(a.total_bytes), level_images: refs.len(), free })
 }
 
 /// The screen weight of every value of level image `ii` of level `lv`: the mean of the
@@ -138,9 +148,9 @@ fn level_image_weights(pb: &BlockPyramid, lv: usize, ii: usize, values: usize) -
 
 /// Encodes every level image of `blocks` at its allocated rate into the blocks' codestream
 /// slots; returns the bytes written.
-pub fn encode_levels(blocks: &mut [BlockPyramid], codec: CodecId, storage: &Storage) -> Result<usize> {
+pub fn encode_levels(blocks: &mut [BlockPyramid], codec: CodecId, rates: &[Rate]) -> Result<usize> {
     let c = pis_codec::codec(codec).ok_or_else(|| anyhow!("codec {codec} is not in this build"))?;
-    let mut rates = storage.rates.iter();
+    let mut rates = rates.iter();
     let mut jobs = Vec::new();
     for (b, pb) in blocks.iter().enumerate() {
         for (lv, l) in pb.levels.iter().enumerate() {
