@@ -31,6 +31,12 @@ pub struct MaterialDesc {
     pub specular: Option<f32>,
     /// Emissive colour and KHR_materials_emissive_strength.
     pub emissive: Option<([f32; 3], f32)>,
+    /// `metallicRoughnessTexture` (roughness in G, metallic in B).
+    pub metallic_roughness_texture: Option<usize>,
+    /// `normalTexture` and its `scale`.
+    pub normal_texture: Option<(usize, f32)>,
+    /// `emissiveTexture` (times the emissive colour; needs `emissive`).
+    pub emissive_texture: Option<usize>,
 }
 
 impl MaterialDesc {
@@ -47,6 +53,9 @@ impl MaterialDesc {
             volume: None,
             specular: None,
             emissive: None,
+            metallic_roughness_texture: None,
+            normal_texture: None,
+            emissive_texture: None,
         }
     }
 
@@ -199,7 +208,16 @@ impl GltfWriter {
         if let Some(t) = m.base_color_texture {
             pbr["baseColorTexture"] = json!({"index": t});
         }
+        if let Some(t) = m.metallic_roughness_texture {
+            pbr["metallicRoughnessTexture"] = json!({"index": t});
+        }
         let mut v = json!({"name": m.name, "pbrMetallicRoughness": pbr});
+        if let Some((t, scale)) = m.normal_texture {
+            v["normalTexture"] = json!({"index": t, "scale": scale});
+        }
+        if let Some(t) = m.emissive_texture {
+            v["emissiveTexture"] = json!({"index": t});
+        }
         let mut ext: Vec<(&'static str, Value)> = Vec::new();
         if let Some(t) = m.transmission {
             ext.push((
@@ -284,6 +302,11 @@ impl GltfWriter {
         self.textures
             .push(json!({"source": self.images.len() - 1, "sampler": 0}));
         self.textures.len() - 1
+    }
+
+    /// Lists `name` in `extensionsUsed` (as exporters do for extensions they write).
+    pub fn use_extension(&mut self, name: &'static str) {
+        self.extensions_used.insert(name);
     }
 
     /// Adds a node; `root` puts it in the scene's root list. Returns its index.

@@ -16,12 +16,18 @@ pub mod textures;
 /// The sample scene directory names, in generation order.
 pub const SAMPLES: [&str; 5] = ["demo1", "demo2", "teapot-pem", "teapot-glossy", "glass"];
 
-/// Writes every sample scene into `root/<name>/`.
+/// The scenes from the wild, under `wild/`: glTF as exporters write it (see
+/// [`scenes::wild`]).
+pub const WILD: [&str; 4] = scenes::wild::WILD;
+
+/// Writes every sample scene into `root/<name>/`, and the scenes from the wild into
+/// `root/wild/<name>/`.
 pub fn generate_all(root: &Path) -> io::Result<()> {
     scenes::demo1::write(&root.join("demo1"))?;
     scenes::demo2::write(&root.join("demo2"))?;
     scenes::teapot_pem::write(&root.join("teapot-pem"))?;
     scenes::teapot_glossy::write(&root.join("teapot-glossy"))?;
     scenes::glass::write(&root.join("glass"))?;
+    scenes::wild::write_all(&root.join("wild"))?;
     Ok(())
 }

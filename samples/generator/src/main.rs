@@ -9,7 +9,7 @@ fn main() -> ExitCode {
         [dir] if !dir.starts_with('-') => PathBuf::from(dir),
         _ => {
             eprintln!(
-                "usage: pis-samples DIR   (writes DIR/demo1, DIR/demo2, DIR/teapot-pem, DIR/teapot-glossy, DIR/glass)"
+                "usage: pis-samples DIR   (writes DIR/demo1, DIR/demo2, DIR/teapot-pem, DIR/teapot-glossy, DIR/glass, DIR/wild/*)"
             );
             return ExitCode::from(1);
         }
@@ -18,6 +18,9 @@ fn main() -> ExitCode {
         Ok(()) => {
             for name in pis_samples::SAMPLES {
                 println!("wrote {}", root.join(name).display());
+            }
+            for name in pis_samples::WILD {
+                println!("wrote {}", root.join("wild").join(name).display());
             }
             ExitCode::SUCCESS
         }

@@ -41,3 +41,9 @@ pub fn wallpaper(path: &Path, size: u32, stripes: u32, a: [u8; 3], b: [u8; 3]) -
     });
     save(&img, path)
 }
+
+/// An image of `size × size` texels from `texel(x, y)` (bytes as stored: sRGB for colour
+/// maps, linear for metallic-roughness and normal maps).
+pub fn from_fn(path: &Path, size: u32, texel: impl Fn(u32, u32) -> [u8; 3]) -> io::Result<()> {
+    save(&RgbImage::from_fn(size, size, |x, y| Rgb(texel(x, y))), path)
+}

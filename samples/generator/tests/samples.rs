@@ -216,7 +216,9 @@ fn same_bin(a: &[u8], b: &[u8]) -> bool {
 fn generator_reproduces_the_checked_in_files() {
     let dir = tempfile::tempdir().unwrap();
     pis_samples::generate_all(dir.path()).unwrap();
-    for name in pis_samples::SAMPLES {
+    let wild = pis_samples::WILD.iter().map(|n| format!("wild/{n}"));
+    for name in pis_samples::SAMPLES.iter().map(|n| n.to_string()).chain(wild) {
+        let name = name.as_str();
         let mut files: Vec<_> = std::fs::read_dir(dir.path().join(name))
             .unwrap()
             .map(|e| e.unwrap().file_name())

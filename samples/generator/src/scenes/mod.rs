@@ -6,3 +6,4 @@ pub mod demo2;
 pub mod glass;
 pub mod teapot_glossy;
 pub mod teapot_pem;
+pub mod wild;

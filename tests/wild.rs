@@ -1,0 +1,89 @@
+//! Scenes from the wild (samples/wild: glTF as exporters write it: centimetre root scales, a
+//! mirrored instance, PBR texture maps, transmission glass, lights from scene.toml only),
+//! each traced at its scene.toml (CI) size, packed at the default ratio and played: the
+//! player's frames are measured against a 64-spp gold standard with `pis-diff FILE GOLD`:
+//! the whole image at 25 dB or more. Each object's figure is printed beside it: at CI size
+//! the default ratio leaves about 1.2 KB for every level image of a scene, and a small
+//! object's share of it is tens of bytes.
+//!
+//! `cargo test --release --test wild -- --nocapture` prints the figures.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+use std::time::Instant;
+
+/// The floor every figure must reach (dB).
+const FLOOR_DB: f64 = 25.0;
+
+fn scene(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../samples/wild").join(name).join("scene.toml")
+}
+
+fn run(program: &str, args: &[&std::ffi::OsStr]) -> Output {
+    let out = Command::new(program).args(args).output().unwrap_or_else(|e| panic!("{program} runs: {e}"));
+    assert!(
+        out.status.success(),
+        "{program} {args:?} failed ({}): {}",
+        out.status,
+        String::from_utf8_lossy(&out.stderr)
+    );
+    out
+}
+
+fn os<S: AsRef<std::ffi::OsStr> + ?Sized>(s: &S) -> &std::ffi::OsStr {
+    s.as_ref()
+}
+
+/// Traces `name` (the set at its own spp, the gold standard at 64), packs the set at the
+/// default ratio, measures the file against the gold standard and checks every figure.
+fn check(name: &str) {
+    let start = Instant::now();
+    let dir = tempfile::tempdir().expect("temp dir");
+    let toml = scene(name);
+    let (set, gold, file) = (dir.path().join("set"), dir.path().join("gold"), dir.path().join(format!("{name}.pis")));
+    let trace = run(env!("CARGO_BIN_EXE_pis-trace"), &[os(&toml), os("-o"), os(&set), os("--json")]);
+    let report: serde_json::Value = serde_json::from_slice(&trace.stdout).expect("pis-trace JSON");
+    run(env!("CARGO_BIN_EXE_pis-trace"), &[os(&toml), os("--spp"), os("64"), os("-o"), os(&gold)]);
+    let pack = run(env!("CARGO_BIN_EXE_pis-pack"), &[os(&set), os("--scene"), os(&toml), os("-o"), os(&file), os("--json")]);
+    let pack: serde_json::Value = serde_json::from_slice(&pack.stdout).expect("pis-pack JSON");
+    let ratio = pack["ratio_without_geometry"].as_f64().expect("ratio_without_geometry");
+    assert!((ratio / 384.0 - 1.0).abs() < 0.05, "{name}: ratio {ratio:.1}, default 384");
+    let diff = run(env!("CARGO_BIN_EXE_pis-diff"), &[os(&file), os(&gold), os("--json")]);
+    let diff: serde_json::Value = serde_json::from_slice(&diff.stdout).expect("pis-diff JSON");
+
+    let whole = diff["psnr_db"].as_f64().expect("psnr_db");
+    let mut figures = vec![("whole image".to_string(), whole)];
+    for o in diff["objects"].as_array().expect("objects") {
+        figures.push((o["name"].as_str().expect("name").to_string(), o["psnr_db"].as_f64().expect("object psnr_db")));
+    }
+    println!(
+        "{name}: {} points, ratio {ratio:.0}:1, predicted {:.2} dB, {:.0} s; against the 64-spp gold standard:",
+        report["points"].as_u64().map_or_else(|| "?".into(), |p| p.to_string()),
+        pack["psnr_db"].as_f64().unwrap_or(f64::NAN),
+        start.elapsed().as_secs_f64()
+    );
+    for (what, db) in &figures {
+        println!("  {what:<12} {db:6.2} dB");
+    }
+    assert!(whole >= FLOOR_DB, "{name}: the whole image {whole:.2} dB against the gold standard, below {FLOOR_DB} dB");
+}
+
+#[test]
+fn cm_export_plays_at_25_db() {
+    check("cm-export");
+}
+
+#[test]
+fn pbr_props_plays_at_25_db() {
+    check("pbr-props");
+}
+
+#[test]
+fn glass_shelf_plays_at_25_db() {
+    check("glass-shelf");
+}
+
+#[test]
+fn still_life_plays_at_25_db() {
+    check("still-life");
+}
