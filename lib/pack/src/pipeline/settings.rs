@@ -219,7 +219,8 @@ pub enum MaxMse {
     /// The constraint at this α (the thesis: 1.25).
     On(f64),
     /// The constraint at this α and the free allocation, both encoded: the one whose decoded
-    /// textures, rendered through the render matrices, predict the higher PSNR.
+    /// textures, rendered through the render matrices, predict the higher PSNR (a byte
+    /// budget; a PSNR target applies the constraint).
     Best(f64),
 }
 

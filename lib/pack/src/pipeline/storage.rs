@@ -111,8 +111,10 @@ pub fn allocate_storage(blocks: &[BlockPyramid], codec: CodecId, target: Target,
         Ok(Item { curve, object: pb.object, weight: members[b][lv][ii] as f64 / pb.layer_samples })
     }).collect::<Result<Vec<Item>, pis_codec::CodecError>>()?;
     let a = allocate(&items, areas, target, max_mse.alpha())?;
+    // Two allocations of one byte budget compare by their predictions; a PSNR target asks
+    // for the fewest bytes instead, and keeps the constraint.
     let free = match max_mse {
-        MaxMse::Best(_) => Some(allocate(&items, areas, target, None)?).filter(|f| f.bytes != a.bytes).map(|f| (f.bytes.into_iter().map(Rate::Bytes).collect(), f.total_bytes)),
+        MaxMse::Best(_) if matches!(target, Target::Bytes(_)) => Some(allocate(&items, areas, target, None)?).filter(|f| f.bytes != a.bytes).map(|f| (f.bytes.into_iter().map(Rate::Bytes).collect(), f.total_bytes)),
         _ => None,
     };
     Ok(Storage { rates: a.bytes.into_iter().map(Rate::Bytes).collect(), allocated: Some(a.total_bytes), level_images: refs.len(), free })
