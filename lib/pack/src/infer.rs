@@ -19,7 +19,7 @@ use glam::Vec3;
 use pis_compile::baseline::forward::forward_map;
 use pis_compile::baseline::traced::trace_into_texture;
 use pis_compile::baseline::LayerImage;
-use pis_compile::texcoord::{charts::separate_overlapping_charts, optimize_placement, ObjectMesh, TexcoordSettings, ViewGeometry};
+use pis_compile::texcoord::{charts::{separate_overlapping_charts, unfold_charts}, optimize_placement, ObjectMesh, TexcoordSettings, ViewGeometry};
 use pis_compile::{
     antialiased_render_matrix, render, render_matrix, scene_depth, DisplayFilter, solve, Address, DrawMesh, Filter, MipSolve, RenderMatrix, Sampler,
     SolveSettings, TextureLayout, TextureTransform, TexturedObject, Viewport,
@@ -137,7 +137,8 @@ pub struct Mesh {
     pub indices: Vec<u32>,
 }
 
-/// Object `o`'s primitives merged into one mesh, in primitive order.
+/// Object `o`'s primitives merged into one mesh, in primitive order, its folded charts cut
+/// apart ([`unfold_charts`]: vertices copied, triangles kept in order).
 pub fn merged_mesh(scene: &Scene, o: usize) -> Mesh {
     let mut m = Mesh { positions: vec![], normals: vec![], uvs: vec![], indices: vec![] };
     for p in &scene.objects[o].primitives {
@@ -156,6 +157,18 @@ pub fn merged_mesh(scene: &Scene, o: usize) -> Mesh {
             m.uvs.extend(std::iter::repeat_n([0.0, 0.0], p.positions.len()));
         }
         m.indices.extend(p.indices.iter().map(|i| i + base));
+    }
+    // A chart folded onto itself (mirrored coordinates) is cut where it turns over, so that
+    // its halves can get texels of their own.
+    let uvs: Vec<glam::Vec2> = m.uvs.iter().map(|u| glam::Vec2::from(*u)).collect();
+    if let Some(u) = unfold_charts(&uvs, &m.indices) {
+        for &v in &u.copies {
+            let v = v as usize;
+            m.positions.push(m.positions[v]);
+            m.normals.push(m.normals[v]);
+            m.uvs.push(m.uvs[v]);
+        }
+        m.indices = u.indices;
     }
     m
 }

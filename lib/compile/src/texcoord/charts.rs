@@ -15,6 +15,12 @@ use super::visibility::{rasterize_ids, screen_triangle, uv_jacobian, ViewGeometr
 /// scaled to): keeps bilinear taps of the finest levels inside their chart.
 pub const GUTTER: f64 = 4.0;
 
+/// Largest ratio between the texel densities the seen charts of one texture need before
+/// they are laid out again, each at its own: above it, a texture sized for the most
+/// magnified chart wastes most of its texels on the others, and the texel budget's
+/// reduction blurs the magnified one.
+pub const NONUNIFORM: f64 = 8.0;
+
 /// Cells per side of the grid the overlap test rasterizes (u, v) triangles into.
 const OVERLAP_GRID: usize = 128;
 
@@ -49,6 +55,61 @@ pub fn charts(indices: &[u32], vertices: usize) -> (Vec<u32>, usize) {
         id[r]
     }).collect();
     (tri_chart, count as usize)
+}
+
+/// A mesh with its folded charts cut apart: the new index list (same triangles, same order)
+/// and, for every vertex added after the original ones, the vertex it copies.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Unfolded {
+    pub indices: Vec<u32>,
+    pub copies: Vec<u32>,
+}
+
+/// Charts folded onto themselves in (u, v), cut where they turn over.
+///
+/// An artist's mirrored model gives its two halves one half's coordinates: the halves meet
+/// at the mirror line through shared vertices, so they form one chart whose (u, v) map
+/// overlaps itself, and one texture cannot hold both. With a consistent winding, a chart's
+/// triangles all turn the same way in (u, v) unless it folds: two triangles that share an
+/// edge and turn opposite ways lie on the same side of it and overlap. So the vertices used
+/// by triangles of both turnings are duplicated, the triangles that turn clockwise taking
+/// the copies: every chart then turns one way, and the halves become charts of their own
+/// that [`separate_overlapping_charts`] lays apart where both are seen. Triangles of zero
+/// (u, v) area (a mesh without coordinates) count as counter-clockwise. `None` when no chart
+/// folds.
+pub fn unfold_charts(uvs: &[Vec2], indices: &[u32]) -> Option<Unfolded> {
+    let turn = |t: &[u32]| -> usize {
+        let [a, b, c] = [t[0], t[1], t[2]].map(|v| uvs.get(v as usize).copied().unwrap_or(Vec2::ZERO).as_dvec2());
+        usize::from(super::visibility::edge(a, b, c) < 0.0)
+    };
+    // Which turnings use each vertex.
+    let mut used = vec![[false; 2]; uvs.len()];
+    for t in indices.chunks_exact(3) {
+        let s = turn(t);
+        for &v in t {
+            if let Some(u) = used.get_mut(v as usize) {
+                u[s] = true;
+            }
+        }
+    }
+    if !used.iter().any(|u| u[0] && u[1]) {
+        return None;
+    }
+    // The clockwise users of a vertex both turnings use get one copy of it.
+    let mut copy = vec![u32::MAX; uvs.len()];
+    let mut copies = Vec::new();
+    for (v, u) in used.iter().enumerate() {
+        if u[0] && u[1] {
+            copy[v] = (uvs.len() + copies.len()) as u32;
+            copies.push(v as u32);
+        }
+    }
+    let mut out = Vec::with_capacity(indices.len());
+    for t in indices.chunks_exact(3) {
+        let s = turn(t);
+        out.extend(t.iter().map(|&v| if s == 1 && copy.get(v as usize).is_some_and(|&c| c != u32::MAX) { copy[v as usize] } else { v }));
+    }
+    Some(Unfolded { indices: out, copies })
 }
 
 /// Largest stretch of J⁻¹ (pixels per unit of (u, v) in the worst direction): 1/σ_min(J).
@@ -108,8 +169,11 @@ fn overlapping(uvs: &[Vec2], indices: &[u32], tri_chart: &[u32], take: &[bool]) 
 }
 
 /// New texture coordinates that lay the visible charts out side by side when two of them
-/// overlap in (u, v); `None` when the mesh's coordinates already give every visible
-/// surface point its own texel. Charts no view sees collapse to the atlas origin.
+/// overlap in (u, v), or when the texel densities they need differ by more than
+/// [`NONUNIFORM`] (an artist's atlas with one part at a fraction of the others' scale);
+/// `None` when the mesh's coordinates already give every visible surface point its own
+/// texel at a density close to the others'. Charts no view sees collapse to the atlas
+/// origin.
 pub fn separate_overlapping_charts(uvs: &[Vec2], indices: &[u32], views: &[ViewGeometry]) -> Option<Vec<Vec2>> {
     let (tri_chart, n) = charts(indices, uvs.len());
     if n < 2 {
@@ -133,7 +197,12 @@ pub fn separate_overlapping_charts(uvs: &[Vec2], indices: &[u32], views: &[ViewG
             }
         }
     }
-    if seen.iter().filter(|&&s| s).count() < 2 || !overlapping(uvs, indices, &tri_chart, &seen) {
+    if seen.iter().filter(|&&s| s).count() < 2 {
+        return None;
+    }
+    let dense = |f: fn(f64, f64) -> f64, init: f64| need.iter().zip(&seen).filter(|(d, s)| **s && **d > 0.0).map(|(d, _)| *d).fold(init, f);
+    let uneven = dense(f64::max, 0.0) > NONUNIFORM * dense(f64::min, f64::INFINITY);
+    if !uneven && !overlapping(uvs, indices, &tri_chart, &seen) {
         return None;
     }
     // Chart bounds in (u, v), then scaled to texel units.
@@ -233,6 +302,68 @@ mod tests {
         // Each chart keeps its shape (a square stays a square, same size: same density).
         assert!(((a1 - a0).x - (a1 - a0).y).abs() < 1e-4 && ((a1 - a0) - (b1 - b0)).length() < 1e-3);
         assert!(new.iter().all(|v| v.is_finite() && v.x >= 0.0 && v.y >= 0.0 && v.x <= 1.0 && v.y <= 1.0));
+    }
+
+    /// The two quads of [`two_quads`] sharing their middle edge, the right one mirroring the
+    /// left one's coordinates (u = 1 − |x|): one chart folded onto itself.
+    fn mirrored_quads() -> (Vec<Vec2>, Vec<u32>, ViewGeometry) {
+        let (_, _, view) = two_quads(true);
+        // Vertices: the left quad's four, then the right quad's two outer ones; the middle
+        // edge's two vertices are shared.
+        let pos_uv = [(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)];
+        let mut uvs: Vec<Vec2> = pos_uv.iter().map(|&(u, v)| Vec2::new(u, v)).collect();
+        uvs.extend([Vec2::new(0.0, 0.0), Vec2::new(0.0, 1.0)]);
+        let idx = vec![0, 1, 2, 0, 2, 3, 1, 4, 5, 1, 5, 2];
+        // Clip positions: left quad x ∈ [−1, 0], right quad's outer edge at x = 1.
+        let clip = vec![view.clip[0], view.clip[1], view.clip[2], view.clip[3], view.clip[5], view.clip[6]];
+        (uvs, idx, ViewGeometry { clip, ..view })
+    }
+
+    #[test]
+    fn a_mirrored_chart_is_cut_at_the_mirror_line_and_laid_apart() {
+        let (uvs, idx, view) = mirrored_quads();
+        // One chart, so the overlap between charts alone finds nothing.
+        assert_eq!(charts(&idx, uvs.len()).1, 1);
+        assert_eq!(separate_overlapping_charts(&uvs, &idx, &[view.clone()]), None);
+        let u = unfold_charts(&uvs, &idx).expect("the chart folds at the shared edge");
+        // The shared edge's two vertices are copied for the mirrored quad, nothing else.
+        assert_eq!(u.copies, vec![1, 2]);
+        assert_eq!(u.indices, vec![0, 1, 2, 0, 2, 3, 6, 4, 5, 6, 5, 7]);
+        let uvs2: Vec<Vec2> = uvs.iter().copied().chain(u.copies.iter().map(|&v| uvs[v as usize])).collect();
+        let mut clip = view.clip.clone();
+        clip.extend(u.copies.iter().map(|&v| view.clip[v as usize]));
+        assert_eq!(charts(&u.indices, uvs2.len()).1, 2);
+        let new = separate_overlapping_charts(&uvs2, &u.indices, &[ViewGeometry { clip, ..view }]).expect("the halves overlap");
+        let bounds = |vs: &[u32]| {
+            let p: Vec<Vec2> = vs.iter().map(|&v| new[v as usize]).collect();
+            (p.iter().fold(Vec2::splat(f32::INFINITY), |a, v| a.min(*v)), p.iter().fold(Vec2::splat(f32::NEG_INFINITY), |a, v| a.max(*v)))
+        };
+        let ((a0, a1), (b0, b1)) = (bounds(&[0, 1, 2, 3]), bounds(&[6, 4, 5, 7]));
+        assert!(a1.x <= b0.x || b1.x <= a0.x || a1.y <= b0.y || b1.y <= a0.y, "{a0} {a1} / {b0} {b1}");
+    }
+
+    #[test]
+    fn a_chart_that_turns_one_way_is_not_cut() {
+        let (uvs, idx, _) = two_quads(false);
+        assert_eq!(unfold_charts(&uvs, &idx), None);
+        // No coordinates at all: every triangle has zero area, nothing folds.
+        assert_eq!(unfold_charts(&vec![Vec2::ZERO; uvs.len()], &idx), None);
+    }
+
+    #[test]
+    fn charts_of_very_different_texel_density_are_laid_out_at_one() {
+        // The right quad's coordinates a sixteenth of the left one's: it needs 16 times the
+        // texels per unit of (u, v).
+        let (mut uvs, idx, view) = two_quads(true);
+        uvs[4..].iter_mut().for_each(|v| *v = Vec2::new(2.0, 0.0) + *v / 16.0);
+        let new = separate_overlapping_charts(&uvs, &idx, &[view.clone()]).expect("the densities differ 16 times");
+        let side = |q: usize| new[q * 4 + 1].x - new[q * 4].x;
+        // Same screen size, so the same size in the atlas.
+        assert!((side(0) / side(1) - 1.0).abs() < 1e-3, "{} {}", side(0), side(1));
+        // Four times as dense only: left alone.
+        let (mut uvs, idx, view) = two_quads(true);
+        uvs[4..].iter_mut().for_each(|v| *v = Vec2::new(2.0, 0.0) + *v / 4.0);
+        assert_eq!(separate_overlapping_charts(&uvs, &idx, &[view]), None);
     }
 
     #[test]
