@@ -59,6 +59,14 @@ impl MaterialDesc {
         }
     }
 
+    /// A plain dielectric whose base colour is the image `texture` (white factor).
+    pub fn textured(name: &'static str, texture: usize, roughness: f32) -> MaterialDesc {
+        MaterialDesc {
+            base_color_texture: Some(texture),
+            ..MaterialDesc::plain(name, [1.0; 3], roughness)
+        }
+    }
+
     /// A metal (metallic 1) of the given colour and roughness.
     pub fn metal(name: &'static str, rgb: [f32; 3], roughness: f32) -> MaterialDesc {
         MaterialDesc {

@@ -106,14 +106,8 @@ pub fn room_materials(w: &mut GltfWriter, dir: &Path) -> io::Result<(usize, usiz
     )?;
     let floor_tex = w.add_png_texture("floor.png");
     let wall_tex = w.add_png_texture("wallpaper.png");
-    let floor = w.add_material(&MaterialDesc {
-        base_color_texture: Some(floor_tex),
-        ..MaterialDesc::plain("Floor", [1.0; 3], 0.8)
-    });
-    let walls = w.add_material(&MaterialDesc {
-        base_color_texture: Some(wall_tex),
-        ..MaterialDesc::plain("Wallpaper", [1.0; 3], 0.9)
-    });
+    let floor = w.add_material(&MaterialDesc::textured("Floor", floor_tex, 0.8));
+    let walls = w.add_material(&MaterialDesc::textured("Wallpaper", wall_tex, 0.9));
     Ok((floor, walls))
 }
 

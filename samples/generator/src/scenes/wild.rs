@@ -129,18 +129,9 @@ fn cm_export(dir: &Path) -> io::Result<()> {
     let floor_tex = w.add_png_texture("floor_basecolor.png");
     let wood_tex = w.add_png_texture("wood_basecolor.png");
     let spines_tex = w.add_png_texture("spines_basecolor.png");
-    let floor_mat = w.add_material(&MaterialDesc {
-        base_color_texture: Some(floor_tex),
-        ..MaterialDesc::plain("M_Floor", [1.0; 3], 0.8)
-    });
-    let wood_mat = w.add_material(&MaterialDesc {
-        base_color_texture: Some(wood_tex),
-        ..MaterialDesc::plain("M_Wood", [1.0; 3], 0.6)
-    });
-    let book_mat = w.add_material(&MaterialDesc {
-        base_color_texture: Some(spines_tex),
-        ..MaterialDesc::plain("M_Books", [1.0; 3], 0.7)
-    });
+    let floor_mat = w.add_material(&MaterialDesc::textured("M_Floor", floor_tex, 0.8));
+    let wood_mat = w.add_material(&MaterialDesc::textured("M_Wood", wood_tex, 0.6));
+    let book_mat = w.add_material(&MaterialDesc::textured("M_Books", spines_tex, 0.7));
     let globe_mat = w.add_material(&MaterialDesc::plain("M_Globe", [0.2, 0.45, 0.7], 0.45));
 
     // Everything below is in centimetres.
@@ -359,10 +350,7 @@ fn glass_shelf(dir: &Path) -> io::Result<()> {
         base_color: [0.7, 0.9, 0.75, 1.0],
         ..glass("Glass_Green")
     });
-    let back_mat = w.add_material(&MaterialDesc {
-        base_color_texture: Some(back_tex),
-        ..MaterialDesc::plain("Backdrop", [1.0; 3], 0.9)
-    });
+    let back_mat = w.add_material(&MaterialDesc::textured("Backdrop", back_tex, 0.9));
     let shelf_mat = w.add_material(&MaterialDesc::plain("ShelfOak", [0.55, 0.38, 0.22], 0.7));
     let cube_mat = w.add_material(&MaterialDesc::plain("RedPaint", [0.75, 0.1, 0.08], 0.5));
 
@@ -439,14 +427,8 @@ fn still_life(dir: &Path) -> io::Result<()> {
     })?;
     let glaze_tex = w.add_png_texture("glaze_basecolor.png");
     let cloth_tex = w.add_png_texture("cloth_basecolor.png");
-    let glaze = w.add_material(&MaterialDesc {
-        base_color_texture: Some(glaze_tex),
-        ..MaterialDesc::plain("Glaze", [1.0; 3], 0.35)
-    });
-    let cloth = w.add_material(&MaterialDesc {
-        base_color_texture: Some(cloth_tex),
-        ..MaterialDesc::plain("Tablecloth", [1.0; 3], 0.95)
-    });
+    let glaze = w.add_material(&MaterialDesc::textured("Glaze", glaze_tex, 0.35));
+    let cloth = w.add_material(&MaterialDesc::textured("Tablecloth", cloth_tex, 0.95));
     let fruit = w.add_material(&MaterialDesc::plain("Fruit", [0.7, 0.25, 0.08], 0.5));
     let brass = w.add_material(&MaterialDesc::metal("Brass", [0.8, 0.6, 0.3], 0.45));
     let clay = w.add_material(&MaterialDesc::plain("Clay", [0.6, 0.4, 0.3], 0.8));
