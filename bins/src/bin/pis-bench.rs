@@ -135,6 +135,11 @@ enum Command {
         /// view-x265, view-av1.
         #[arg(long, value_delimiter = ',')]
         methods: Vec<String>,
+        /// The PIS packs' max-MSE constraint, as pis-pack's --max-mse-ratio: `auto` (the
+        /// better prediction of the constraint at 1.25 and the free allocation), `off`, or
+        /// the constraint at ALPHA.
+        #[arg(long, value_name = "auto|off|ALPHA", default_value = "auto", value_parser = pis::pack_args::parse_max_mse_ratio)]
+        max_mse_ratio: pis_pack::MaxMse,
         /// Record the run (machine, scene, command, PSNR near 384:1) in docs/BENCHMARKS.md.
         #[arg(long)]
         record: bool,
@@ -306,8 +311,8 @@ fn run(cli: Cli) -> Result<Exit, Failure> {
             }
             Ok(Exit::Ok)
         }
-        Command::Rd { input, scene, ratios, out, resolution, spp, max_texture, preset, methods, record, json } => {
-            let req = RdRequest { input, scene, ratios, out, resolution, spp, max_texture, preset, record, methods };
+        Command::Rd { input, scene, ratios, out, resolution, spp, max_texture, preset, methods, max_mse_ratio, record, json } => {
+            let req = RdRequest { input, scene, ratios, out, resolution, spp, max_texture, preset, record, methods, max_mse: max_mse_ratio };
             let report = rd::run(&req)?;
             rd::print(&report, &mut std::io::stderr()).map_err(|e| Failure::new(Exit::Io, e))?;
             if json {

@@ -46,6 +46,8 @@ pub struct RdRequest {
     pub record: bool,
     /// The methods to run (empty: all of [`METHODS`]).
     pub methods: Vec<String>,
+    /// The PIS packs' max-MSE constraint (thesis 4.8), as `pis-pack --max-mse-ratio`.
+    pub max_mse: pis_pack::MaxMse,
 }
 
 /// One measured point.
@@ -95,7 +97,7 @@ pub struct RdReport {
 pub const METHODS: [&str; 7] = ["pis-wavelet", "pis-dct", "pis-wavelet-full-pyramid", "pis-wavelet-combined-layers", "mpeg-texture-x265", "view-x265", "view-av1"];
 
 fn pack_request(req: &RdRequest) -> PackRequest {
-    let settings = PackSettings { max_texture: req.max_texture, resolution: req.resolution, spp: req.spp, preset: req.preset.clone(), ..PackSettings::new() };
+    let settings = PackSettings { max_texture: req.max_texture, resolution: req.resolution, spp: req.spp, preset: req.preset.clone(), max_mse: req.max_mse, ..PackSettings::new() };
     PackRequest { input: req.input.clone(), scene: req.scene.clone(), output: req.out.join("unused.pis"), settings }
 }
 
