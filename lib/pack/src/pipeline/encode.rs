@@ -58,6 +58,9 @@ pub struct Packed {
     /// With [`super::MaxMse::Best`], where the constraint changed the allocation: which
     /// allocation was kept and why.
     pub max_mse: Option<MaxMseChoice>,
+    /// The prediction made while choosing the allocation, which [`predicted_psnr`] returns
+    /// instead of rendering the same textures again.
+    pub quality: Option<Quality>,
 }
 
 /// The choice between the max-MSE constrained and the free allocation.
@@ -312,7 +315,7 @@ pub fn encode_all(set: &LoadedSet, models: &[ObjectModel], req: &PackRequest, st
     }
     let solved: Vec<Vec<LayerTextures>> = models.iter().map(solved_chains).collect();
     let solved_error = display_error(set, models, &solved);
-    let packed = Packed { container, blocks: blocks_out, overhead, layer_bytes: Vec::new(), stagger: staggers, screen_weights, solved_error, max_mse: None };
+    let packed = Packed { container, blocks: blocks_out, overhead, layer_bytes: Vec::new(), stagger: staggers, screen_weights, solved_error, max_mse: None, quality: None };
     let Some((free_rates, free_bytes)) = &storage.free else {
         let mut packed = emit(packed, pyramids, &where_, models, req.codec, &storage.rates)?;
         if req.codec.is_lossy() {
@@ -326,10 +329,11 @@ pub fn encode_all(set: &LoadedSet, models: &[ObjectModel], req: &PackRequest, st
     let alpha = req.max_mse.alpha().unwrap_or(pis_codec::allocate::DEFAULT_ALPHA);
     let with = emit(packed.clone(), pyramids.clone(), &where_, models, req.codec, &storage.rates)?;
     let without = emit(packed, pyramids, &where_, models, req.codec, free_rates)?;
-    let db = |p: &Packed| -> Result<f64, Failure> { Ok(predicted_psnr(set, models, p).map_err(runtime)?.overall) };
-    let (db_with, db_without) = (db(&with)?, db(&without)?);
+    let (q_with, q_without) = (predicted_psnr(set, models, &with).map_err(runtime)?, predicted_psnr(set, models, &without).map_err(runtime)?);
+    let (db_with, db_without) = (q_with.overall, q_without.overall);
     let keep = db_with >= db_without;
-    let mut packed = if keep { with } else { without };
+    let (mut packed, quality) = if keep { (with, q_with) } else { (without, q_without) };
+    packed.quality = Some(quality);
     packed.max_mse = Some(MaxMseChoice { alpha, constrained: keep, psnr_db_constrained: db_with, psnr_db_free: db_without });
     record_max_mse(&mut packed, keep.then_some(alpha));
     stages.done("encode", &format!(
@@ -508,6 +512,7 @@ pub fn psnr(sse: f64, n: usize) -> f64 {
 
 /// Predicted quality: per object (decoded, as solved) and overall, plus the largest
 /// difference between decoded and solved finest texels.
+#[derive(Clone)]
 pub struct Quality {
     pub objects: Vec<(f64, f64)>,
     pub overall: f64,
@@ -518,6 +523,9 @@ pub struct Quality {
 /// Renders the decoded and the solved textures through the render matrices (the hardware
 /// model's or probe mode's).
 pub fn predicted_psnr(set: &LoadedSet, models: &[ObjectModel], packed: &Packed) -> Result<Quality> {
+    if let Some(q) = &packed.quality {
+        return Ok(q.clone());
+    }
     let decoded = decoded_textures(models, packed)?;
     let solved: Vec<Vec<LayerTextures>> = models.iter().map(solved_chains).collect();
     let mut max_err = 0.0f32;
