@@ -165,6 +165,9 @@ fn paths_write_frames_and_report_timings() {
         assert!(r[k].as_f64().is_some_and(|v| v >= 0.0), "{k}: {}", r[k]);
     }
     assert!(r["frame_ms_worst"].as_f64() >= r["frame_ms_mean"].as_f64());
+    // Written frames are read back; the frame's draw is timed apart from it.
+    assert!(r["draw_ms_mean"].as_f64().is_some_and(|v| v > 0.0), "draw_ms_mean: {}", r["draw_ms_mean"]);
+    assert!(r["readback_ms_mean"].as_f64().is_some_and(|v| v > 0.0), "readback_ms_mean: {}", r["readback_ms_mean"]);
     // 2 × 2 samples: the diagonal visits 4 different samples, then the first again (its
     // level images still cached: nothing to read).
     let rows = r["per_frame"].as_array().expect("per_frame");
@@ -182,6 +185,9 @@ fn paths_write_frames_and_report_timings() {
     let r = json(&play(&[os(&f.file), os("--headless"), os("--path"), os("orbit"), os("--frames"), os("3"), os("--at"), os(&values.join(",")), os("--size"), os("64x48"), os("--blend"), os("multilinear"), os("--reduction"), os("2"), os("--json")]));
     assert_eq!(r["frames"], 3);
     assert_eq!(r["size"], serde_json::json!([64, 48]));
+    // Frames not written are drawn and waited for, never copied back.
+    assert_eq!(r["readback_ms_mean"].as_f64(), Some(0.0));
+    assert!(r["draw_ms_mean"].as_f64().is_some_and(|v| v > 0.0), "draw_ms_mean: {}", r["draw_ms_mean"]);
     // A path file.
     let path = dir.path().join("path.txt");
     std::fs::write(&path, format!("# two points\n{}\n{}\n", values.join(","), values.join(" "))).expect("path file");

@@ -101,6 +101,11 @@ pub struct PathReport {
     pub decode_ms_worst: f64,
     pub upload_ms_mean: f64,
     pub upload_bytes_mean: f64,
+    /// Recording the draws and waiting for the GPU to finish them.
+    pub draw_ms_mean: f64,
+    pub draw_ms_worst: f64,
+    /// Copying each frame to memory: 0 unless the frames are written (`--out`).
+    pub readback_ms_mean: f64,
     /// Draws per frame of surface layers (object × layer × parameter sample).
     pub surface_draws_mean: f64,
     /// Draws per frame of reflection terms (object × parameter sample, each looking up the
@@ -120,6 +125,8 @@ pub struct FrameRow {
     pub frame_ms: f64,
     pub decode_ms: f64,
     pub upload_ms: f64,
+    pub draw_ms: f64,
+    pub readback_ms: f64,
     pub codestreams_read: u64,
     pub surface_draws: u64,
     pub shell_draws: u64,
@@ -339,10 +346,16 @@ pub fn run_frames(args: &HeadlessRequest, gpu: &Gpu, player: &mut Player) -> Res
     let mut rows = Vec::with_capacity(reqs.len());
     let mut all = Vec::with_capacity(reqs.len());
     for (k, req) in reqs.iter().enumerate() {
-        let (img, stats) = player.render_image(req, size).map_err(play_failure)?;
-        if let Some(dir) = out {
-            write_frame(dir, &format!("frame-{k:04}.png"), &img)?;
-        }
+        // Frames that are not written are not read back: their time is the frame's cost
+        // where it is shown.
+        let stats = match out {
+            Some(dir) => {
+                let (img, stats) = player.render_image(req, size).map_err(play_failure)?;
+                write_frame(dir, &format!("frame-{k:04}.png"), &img)?;
+                stats
+            }
+            None => player.render_timed(req, size).map_err(play_failure)?,
+        };
         if progress && (k + 1) % 10 == 0 {
             eprintln!("pis-play: frame {}/{}", k + 1, reqs.len());
         }
@@ -351,6 +364,8 @@ pub fn run_frames(args: &HeadlessRequest, gpu: &Gpu, player: &mut Player) -> Res
             frame_ms: stats.frame_ms,
             decode_ms: stats.decode_ms,
             upload_ms: stats.upload_ms,
+            draw_ms: stats.draw_ms,
+            readback_ms: stats.readback_ms,
             codestreams_read: stats.codestreams_read,
             surface_draws: stats.surface_draws,
             shell_draws: stats.shell_draws,
@@ -381,6 +396,9 @@ pub fn run_frames(args: &HeadlessRequest, gpu: &Gpu, player: &mut Player) -> Res
         decode_ms_worst: worst(|s| s.decode_ms),
         upload_ms_mean: mean(|s| s.upload_ms),
         upload_bytes_mean: mean(|s| s.upload_bytes as f64),
+        draw_ms_mean: mean(|s| s.draw_ms),
+        draw_ms_worst: worst(|s| s.draw_ms),
+        readback_ms_mean: mean(|s| s.readback_ms),
         surface_draws_mean: mean(|s| s.surface_draws as f64),
         shell_draws_mean: mean(|s| s.shell_draws as f64),
         cache_hits: all.iter().map(|s| s.cache_hits).sum(),
@@ -397,6 +415,11 @@ pub fn print_path_report(r: &PathReport, w: &mut impl std::io::Write) -> std::io
     writeln!(w, "  frames: {}", r.frames)?;
     writeln!(w, "  frame ms: mean {:.2} ({:.1} fps), worst {:.2} ({:.1} fps)", r.frame_ms_mean, r.fps_mean, r.frame_ms_worst, r.fps_worst)?;
     writeln!(w, "  decode ms: mean {:.2}, worst {:.2}; upload ms: mean {:.2} ({:.0} KiB per frame)", r.decode_ms_mean, r.decode_ms_worst, r.upload_ms_mean, r.upload_bytes_mean / 1024.0)?;
+    write!(w, "  draw ms (recorded, submitted, finished on the GPU): mean {:.2}, worst {:.2}", r.draw_ms_mean, r.draw_ms_worst)?;
+    if r.readback_ms_mean > 0.0 {
+        write!(w, "; readback ms (frames written): mean {:.2}", r.readback_ms_mean)?;
+    }
+    writeln!(w)?;
     writeln!(w, "  draws per frame: {:.1} surface layers, {:.1} reflection terms (environment-map shells)", r.surface_draws_mean, r.shell_draws_mean)?;
     writeln!(w, "  level-image cache: {} hits, {} misses, at most {:.1} MiB; codestreams read: {}", r.cache_hits, r.cache_misses, r.cache_bytes_max as f64 / (1 << 20) as f64, r.codestreams_read)
 }

@@ -9,7 +9,9 @@ use std::sync::Arc;
 use pis_codec::{CodecError, PlaneShape};
 use pis_compile::TextureLayout;
 use pis_format::mip::{decimate, mip_size};
+use pis_format::reconstruct::{add_stored_mips, face_len};
 use pis_format::texture::LevelLayout;
+use pis_format::MipMode;
 use pis_format::{Error, Issue, Layer, PisReader, StreamRef};
 use rayon::prelude::*;
 
@@ -83,11 +85,22 @@ pub fn decode_level(reader: &PisReader, job: &LevelJob) -> Result<Vec<f32>, Play
 fn reconstruct(job: &AssembleJob) -> Vec<f32> {
     let n: usize = job.layout.planes().iter().map(|p| (p.width * p.height * p.channels) as usize).sum();
     let mut sum = vec![0.0f32; n];
-    for img in &job.levels {
-        sum.iter_mut().zip(img.iter()).for_each(|(a, v)| *a += v);
+    // Element by element, so chunks on the workers give the values `finish` gives.
+    sum.par_chunks_mut(CHUNK).enumerate().for_each(|(k, out)| {
+        let (at, len) = (k * CHUNK, out.len());
+        for img in &job.levels {
+            out.iter_mut().zip(&img[at..at + len]).for_each(|(a, v)| *a += v);
+        }
+        pis_codec::gamma::uncompensate(out, job.layer.gamma);
+    });
+    if job.layer.mip_mode == MipMode::Stored && job.layout.mips > 1 {
+        sum.par_chunks_exact_mut(face_len(&job.layout)).for_each(|face| add_stored_mips(&job.layout, face));
     }
-    pis_format::reconstruct::finish(job.layer, &job.layout, sum)
+    sum
 }
+
+/// Values per parallel piece of a texture's sum and inverse gamma.
+const CHUNK: usize = 1 << 14;
 
 /// One texel of `c` channels as RGBA: grey for 1 channel, grey and alpha for 2, opaque RGB
 /// for 3.
@@ -124,51 +137,50 @@ pub fn assemble(job: &AssembleJob) -> TextureImage {
     TextureImage { width: w, height: h, padded_width: pw, padded_height: ph, rgba }
 }
 
-/// Every face's MIP chain of a reconstructed shell texture: its stored levels (mip mode
-/// `stored`), or level 0 decimated down to 1×1 (mip mode `decimated`, SPEC.md 8.3); face
-/// after face, each face's levels in order.
-fn face_chains(layout: &LevelLayout, linear: &[f32]) -> Vec<Vec<Vec<f32>>> {
+/// One face's MIP chain of a reconstructed shell texture (`face`: its stored planes): its
+/// stored levels (mip mode `stored`), or level 0 decimated down to 1×1 (mip mode
+/// `decimated`, SPEC.md 8.3); from level `drop` down, as RGBA texels appended to `rgba`.
+fn face_chain(layout: &LevelLayout, face: &[f32], drop: u32, rgba: &mut Vec<f32>) {
     let (n, c) = (layout.width, layout.channels);
     let levels = pis_format::mip::mip_count(n, n);
-    let mut faces = Vec::with_capacity(layout.faces as usize);
     let mut at = 0;
-    for _ in 0..layout.faces {
-        let mut chain: Vec<Vec<f32>> = Vec::with_capacity(levels as usize);
-        for m in 0..levels {
-            let (w, h) = mip_size(n, n, m);
-            let len = (w * h * c) as usize;
-            if m < layout.mips {
-                chain.push(linear[at..at + len].to_vec());
-                at += len;
-            } else {
-                let (pw, ph) = mip_size(n, n, m - 1);
-                let coarser = decimate(&chain[m as usize - 1], pw, ph, c);
-                chain.push(coarser);
-            }
+    let mut coarser: Vec<f32> = Vec::new();
+    for m in 0..levels {
+        let (w, h) = mip_size(n, n, m);
+        let len = (w * h * c) as usize;
+        let level: &[f32] = if m < layout.mips {
+            at += len;
+            &face[at - len..at]
+        } else {
+            let (pw, ph) = mip_size(n, n, m - 1);
+            coarser = if m == layout.mips { decimate(&face[at - (pw * ph * c) as usize..at], pw, ph, c) } else { decimate(&coarser, pw, ph, c) };
+            &coarser
+        };
+        if m >= drop {
+            level.chunks_exact(c as usize).for_each(|px| rgba.extend_from_slice(&rgba_texel(px)));
         }
-        faces.push(chain);
     }
-    faces
 }
 
 /// Rebuilds a shell's cube map: [`reconstruct`], each face's MIP chain from its finest drawn
 /// level (level `drop_levels` of the stored chain, for a resolution reduction) down to 1×1,
-/// as RGBA (a 3-channel shell opaque: alpha 1).
+/// as RGBA (a 3-channel shell opaque: alpha 1); the faces on the workers.
 pub fn assemble_cube(job: &AssembleJob) -> CubeImage {
     let linear = reconstruct(job);
-    let faces = face_chains(&job.layout, &linear);
     let full = TextureLayout::cube(job.layout.width);
     let drop = job.drop_levels.min(full.levels - 1);
     let (size, _) = full.level_size(drop);
     let layout = TextureLayout { width: size, height: size, levels: full.levels - drop, faces: 6 };
-    let c = job.layout.channels as usize;
-    let mut rgba = Vec::with_capacity(layout.texel_count() * 4);
-    for chain in &faces {
-        for level in &chain[drop as usize..] {
-            level.chunks_exact(c).for_each(|px| rgba.extend_from_slice(&rgba_texel(px)));
-        }
-    }
-    CubeImage { layout, rgba }
+    let per_face = layout.texel_count() / 6 * 4;
+    let faces: Vec<Vec<f32>> = linear
+        .par_chunks_exact(face_len(&job.layout))
+        .map(|face| {
+            let mut rgba = Vec::with_capacity(per_face);
+            face_chain(&job.layout, face, drop, &mut rgba);
+            rgba
+        })
+        .collect();
+    CubeImage { layout, rgba: faces.concat() }
 }
 
 impl Decoder {

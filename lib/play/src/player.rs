@@ -78,6 +78,11 @@ pub struct FrameRequest {
 pub struct FrameStats {
     /// Whole frame, request to drawn (and read back, for offscreen frames).
     pub frame_ms: f64,
+    /// Recording and submitting the frame's draws and waiting for the GPU to finish them
+    /// (offscreen frames; a window's frame is not waited for, and this stays 0).
+    pub draw_ms: f64,
+    /// Copying an offscreen frame to memory and converting it to linear RGBA.
+    pub readback_ms: f64,
     /// Waiting for the workers: level images decoded and textures rebuilt.
     pub decode_ms: f64,
     /// Texture uploads and GPU MIP chains.
@@ -171,6 +176,9 @@ type Readout = (FloatImage, Option<Vec<u32>>);
 enum Target<'a> {
     /// The offscreen target, read back (with every pixel's object index if `ids`).
     Offscreen { ids: bool },
+    /// The offscreen target, drawn and waited for but not read back: a frame's cost as
+    /// playback pays it, where the frame is shown rather than copied to memory.
+    Timed,
     /// A caller's view of the given format.
     View(&'a wgpu::TextureView, wgpu::TextureFormat),
 }
@@ -483,6 +491,12 @@ impl Player {
         Ok((img, ids.unwrap_or_default(), stats))
     }
 
+    /// Draws a frame offscreen and waits for the GPU to finish it, without reading it back:
+    /// what the frame costs where it is shown rather than copied to memory (timings).
+    pub fn render_timed(&mut self, req: &FrameRequest, size: (u32, u32)) -> Result<FrameStats, PlayError> {
+        Ok(self.frame(req, size, Target::Timed)?.1)
+    }
+
     /// Draws a frame into `view` (any colour format; linear radiance, so an `*Srgb` format
     /// does the sRGB encoding) of `size`, with [`Player::multisample_for`] the format's
     /// samples per pixel resolved into it.
@@ -671,7 +685,7 @@ impl Player {
             return Err(e);
         }
         let format = match target {
-            Target::Offscreen { .. } => offscreen_format(&self.gpu),
+            Target::Offscreen { .. } | Target::Timed => offscreen_format(&self.gpu),
             Target::View(_, f) => f,
         };
         let samples = self.multisample_for(format).samples;
@@ -712,6 +726,7 @@ impl Player {
         stats.surface_draws = layers.len() as u64;
         stats.shell_draws = reflections.len() as u64;
         let targets = self.targets.as_mut().expect("targets made above");
+        let t_draw = Instant::now();
         let mut encoder = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("frame") });
         let offscreen_view;
         let (view, want_ids) = match target {
@@ -720,23 +735,42 @@ impl Player {
                 offscreen_view = targets.colour.create_view(&Default::default());
                 (&offscreen_view, ids)
             }
+            Target::Timed => {
+                offscreen_view = targets.colour.create_view(&Default::default());
+                (&offscreen_view, false)
+            }
         };
         let display = self.display.map(|(f, _)| f);
         crate::frame::encode(&gpu, &mut self.pipes, targets, view, format, &objects, &layers, &reflections, want_ids, display, &mut encoder);
-        let out = if let Target::Offscreen { ids } = target {
-            let texel = if format == wgpu::TextureFormat::Rgba16Float { 8 } else { 16 };
-            let (rc, ri) = self.readback.get_or_insert_with(|| (Readback::new(&gpu, size, texel), Readback::new(&gpu, size, 4)));
-            rc.copy(&targets.colour, &mut encoder);
-            if ids {
-                ri.copy(&targets.ids, &mut encoder);
+        let out = match target {
+            Target::Offscreen { ids } => {
+                gpu.queue.submit([encoder.finish()]);
+                wait_for_gpu(&gpu)?;
+                stats.draw_ms = t_draw.elapsed().as_secs_f64() * 1e3;
+                let t_read = Instant::now();
+                let texel = if format == wgpu::TextureFormat::Rgba16Float { 8 } else { 16 };
+                let (rc, ri) = self.readback.get_or_insert_with(|| (Readback::new(&gpu, size, texel), Readback::new(&gpu, size, 4)));
+                let mut copy = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("readback") });
+                rc.copy(&targets.colour, &mut copy);
+                if ids {
+                    ri.copy(&targets.ids, &mut copy);
+                }
+                gpu.queue.submit([copy.finish()]);
+                let colour = colour_image(&rc.read(&gpu)?, format, size);
+                let ids = if ids { Some(ri.read(&gpu)?.chunks_exact(4).map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]])).collect()) } else { None };
+                stats.readback_ms = t_read.elapsed().as_secs_f64() * 1e3;
+                Some((colour, ids))
             }
-            gpu.queue.submit([encoder.finish()]);
-            let colour = colour_image(&rc.read(&gpu)?, format, size);
-            let ids = if ids { Some(ri.read(&gpu)?.chunks_exact(4).map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]])).collect()) } else { None };
-            Some((colour, ids))
-        } else {
-            gpu.queue.submit([encoder.finish()]);
-            None
+            Target::Timed => {
+                gpu.queue.submit([encoder.finish()]);
+                wait_for_gpu(&gpu)?;
+                stats.draw_ms = t_draw.elapsed().as_secs_f64() * 1e3;
+                None
+            }
+            Target::View(..) => {
+                gpu.queue.submit([encoder.finish()]);
+                None
+            }
         };
         drop(reflections);
         drop(layers);
@@ -756,4 +790,9 @@ impl Player {
         self.cache.end_frame();
         self.frame += 1;
     }
+}
+
+/// Blocks until the GPU has finished everything submitted.
+fn wait_for_gpu(gpu: &Gpu) -> Result<(), PlayError> {
+    gpu.device.poll(wgpu::PollType::wait_indefinitely()).map(|_| ()).map_err(|e| PlayError::Readback(e.to_string()))
 }

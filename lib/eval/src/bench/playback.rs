@@ -47,7 +47,7 @@ pub fn measure(gpu: &Arc<Gpu>, file: &Path, set_dir: &Path, codec: &str, reducti
         let mut times = Vec::new();
         for p in zigzag(&counts) {
             let point: Vec<f32> = p.iter().zip(&dims).map(|(&i, v)| v[i as usize]).collect();
-            let (_, stats) = player.render_image(&FrameRequest { point, camera: CameraChoice::Sample }, size)?;
+            let stats = player.render_timed(&FrameRequest { point, camera: CameraChoice::Sample }, size)?;
             times.push(stats.frame_ms);
         }
         let c = compare_with_set(&mut player, set_dir, &CompareOptions { size: None }, &mut |_| {})?;
