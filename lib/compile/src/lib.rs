@@ -29,6 +29,7 @@ pub mod cg;
 pub mod decimation;
 pub mod error;
 pub mod filter;
+pub mod hybrid;
 pub mod interpolate;
 pub mod layout;
 pub mod lod;

@@ -1,0 +1,14 @@
+//! Hybrid rendering of lens objects (thesis ch. 6), the part the player computes per frame
+//! on the CPU: the greedy two-path model traced through the lens object alone at the
+//! vertices of an adaptively refined tessellation ([`tessellate()`]), giving per vertex the
+//! outgoing rays that index the layered environment-map shells and the F·G modulation of
+//! each term. One function, used by the player each frame and by pis-pack's render
+//! matrices.
+
+pub mod lens;
+pub mod path;
+pub mod tessellate;
+
+pub use lens::{LensMaterial, LensObject};
+pub use path::{greedy_path, LensPath, Term, Topology, TERMS};
+pub use tessellate::{tessellate, HybridVertex, HybridView, Tessellation, TessellationSettings, TessellationStats};
