@@ -1,0 +1,128 @@
+//! Hybrid rendering's per-frame tracer (pis-compile `hybrid`) against pis-trace: the greedy
+//! two-path model is one model, so the runtime's paths through the lens object alone must
+//! leave it where the tracer's outgoing-ray records say, for the same camera rays.
+
+use std::path::Path;
+
+use glam::{Mat3, Vec3};
+use pis_compile::hybrid::{greedy_path, tessellate, HybridView, LensMaterial, LensObject, Term, TessellationSettings};
+use pis_scene::{ObjectRole, Scene};
+use pis_trace::camera::PerspectiveCamera;
+use pis_trace::TraceSettings;
+
+fn glass_scene() -> Scene {
+    let toml = Path::new(env!("CARGO_MANIFEST_DIR")).join("../samples/glass/scene.toml");
+    pis_scene::load(&toml, None).expect("glass sample loads")
+}
+
+/// The lens object `o` of `scene` at `frame` as pis-trace places it, and its material as
+/// pis-trace shades it (constant base colour: the sample's glass has no textures).
+fn lens_object(scene: &Scene, frame: &pis_scene::Frame, o: usize) -> LensObject {
+    let m = frame.instances[o].world_from_object;
+    let normal_matrix = Mat3::from_mat4(m).inverse().transpose();
+    let (mut positions, mut normals, mut indices) = (Vec::new(), Vec::new(), Vec::new());
+    let mut material = None;
+    for prim in &scene.objects[o].primitives {
+        let base = positions.len() as u32;
+        positions.extend(prim.positions.iter().map(|&p| m.transform_point3(p)));
+        normals.extend(prim.normals.iter().map(|&n| normal_matrix * n));
+        indices.extend(prim.indices.iter().map(|&i| base + i));
+        let mat = &scene.materials[prim.material];
+        assert!(mat.base_color_texture.is_none(), "a textured lens material");
+        let ior = if mat.ior.is_finite() && mat.ior >= 1.0 { mat.ior } else { 1.5 };
+        let sigma_a = if mat.attenuation_distance.is_finite() && mat.attenuation_distance > 0.0 {
+            Vec3::from(mat.attenuation_color).max(Vec3::splat(1e-6)).min(Vec3::ONE).map(|c| -c.ln()) / mat.attenuation_distance
+        } else {
+            Vec3::ZERO
+        };
+        let base = Vec3::new(mat.base_color[0], mat.base_color[1], mat.base_color[2]);
+        material.get_or_insert(LensMaterial { ior, base, sigma_a });
+    }
+    LensObject::new(material.expect("a primitive"), positions, normals, &indices)
+}
+
+#[test]
+fn runtime_paths_leave_the_lens_where_the_tracer_records_say() {
+    let scene = glass_scene();
+    let frame = scene.frame(&[1]).expect("view 1");
+    let o = scene.objects.iter().position(|x| x.role == ObjectRole::Refractive).expect("a lens object");
+    let mut settings = TraceSettings::new((80, 60), 2);
+    settings.records_per_pixel = 2;
+    let render = pis_trace::render_point(&scene, &frame, &settings, &|| {}).expect("traces");
+    let lens = lens_object(&scene, &frame, o);
+    let camera = PerspectiveCamera::new(&frame.camera, settings.resolution);
+    let (mut agree, mut total, mut worst_deg) = (0, 0, 0f32);
+    let mut terms = [0; 2];
+    for r in render.records.iter().filter(|r| r.object == o as u32) {
+        total += 1;
+        let dir = camera.direction(glam::Vec2::from(r.pixel));
+        let Some(hit) = lens.closest(camera.origin, dir, f32::INFINITY) else { continue };
+        let first = lens.surface(&hit, camera.origin, dir);
+        let term = if r.term == 0 { Term::ReflectionFirst } else { Term::RefractionFirst };
+        let Some(p) = greedy_path(&lens, &first, dir, term, settings.max_depth) else { continue };
+        // The angle between the directions, from their chord (acos near 1 is too coarse).
+        let angle = (2.0 * (0.5 * (p.exit_direction - Vec3::from(r.exit_direction)).length()).asin()).to_degrees();
+        let origin = (p.exit_origin - Vec3::from(r.exit_origin)).length();
+        let modulation = (p.modulation - Vec3::from(r.modulation)).abs().max_element() / Vec3::from(r.modulation).max_element().max(1e-6);
+        if angle < 1e-3 && origin < 1e-4 && modulation < 1e-4 {
+            agree += 1;
+            terms[r.term as usize] += 1;
+        } else {
+            worst_deg = worst_deg.max(angle);
+        }
+    }
+    eprintln!("{agree} of {total} records agree (reflection-first {}, refraction-first {}); worst other: {worst_deg:.3}°", terms[0], terms[1]);
+    assert!(total > 500, "only {total} records of the lens object");
+    assert!(terms[0] > 0 && terms[1] > 0);
+    assert!(agree as f64 >= 0.99 * total as f64, "{agree} of {total} records agree");
+}
+
+#[test]
+fn tessellation_is_deterministic_watertight_and_finer_for_smaller_tau() {
+    let scene = glass_scene();
+    let frame = scene.frame(&[0]).expect("view 0");
+    let o = scene.objects.iter().position(|x| x.role == ObjectRole::Refractive).expect("a lens object");
+    let lens = lens_object(&scene, &frame, o);
+    let size = (320, 240);
+    let camera = PerspectiveCamera::new(&frame.camera, size);
+    let clip_from_world = pis_trace::camera::projection_matrix(&frame.camera, size) * frame.camera.world_from_camera.inverse();
+    let view = HybridView { eye: camera.origin, clip_from_world, size };
+    let mut vertices = Vec::new();
+    for tau in [10.0, 5.0, 3.0] {
+        let settings = TessellationSettings { tau_px: tau, ..Default::default() };
+        let a = tessellate(&lens, &view, &settings);
+        let b = tessellate(&lens, &view, &settings);
+        assert_eq!(a, b, "τ = {tau}: two runs differ");
+        eprintln!("τ = {tau}: {:?}", a.stats);
+        assert!(a.stats.splits > 0 && a.stats.triangles > a.stats.front_triangles);
+        // Watertight: an edge drawn by two triangles has no T-junction; one drawn once lies on
+        // the front-facing region's border or has a T-junction: no vertex may lie inside it.
+        let mut count = std::collections::HashMap::new();
+        for t in &a.triangles {
+            for e in 0..3 {
+                let (u, v) = (t[e], t[(e + 1) % 3]);
+                *count.entry((u.min(v), u.max(v))).or_insert(0) += 1;
+            }
+        }
+        assert!(count.values().all(|&c| c <= 2), "τ = {tau}: an edge drawn by more than two triangles");
+        let used: std::collections::BTreeSet<u32> = a.triangles.iter().flatten().copied().collect();
+        let once: Vec<(u32, u32)> = count.iter().filter(|(_, &c)| c == 1).map(|(&e, _)| e).collect();
+        for &(u, w) in &once {
+            let (p, q) = (a.vertices[u as usize].position, a.vertices[w as usize].position);
+            let len2 = (q - p).length_squared();
+            for &v in &used {
+                if v == u || v == w {
+                    continue;
+                }
+                let x = a.vertices[v as usize].position;
+                let s = (x - p).dot(q - p) / len2;
+                if s > 1e-4 && s < 1.0 - 1e-4 && (p + (q - p) * s - x).length_squared() < 1e-10 * len2 {
+                    panic!("τ = {tau}: vertex {v} lies inside edge {u}–{w}, drawn by one triangle");
+                }
+            }
+        }
+        eprintln!("τ = {tau}: {} edges, {} drawn once", count.len(), once.len());
+        vertices.push(a.stats.traced_vertices);
+    }
+    assert!(vertices[0] < vertices[1] && vertices[1] < vertices[2], "traced vertices by τ 10, 5, 3: {vertices:?}");
+}
