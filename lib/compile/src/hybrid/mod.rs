@@ -6,9 +6,11 @@
 //! matrices.
 
 pub mod lens;
+pub mod model;
 pub mod path;
 pub mod tessellate;
 
 pub use lens::{LensMaterial, LensObject};
+pub use model::{hybrid_pixels, hybrid_render_matrix, shell_vector, vertex_vectors, HybridPixels};
 pub use path::{greedy_path, LensPath, Term, Topology, TERMS};
-pub use tessellate::{tessellate, HybridVertex, HybridView, Tessellation, TessellationSettings, TessellationStats};
+pub use tessellate::{tessellate, tessellate_timed, HybridVertex, HybridView, Tessellation, TessellationSettings, TessellationStats, TessellationTimes};

@@ -1,0 +1,104 @@
+//! The render matrix A of one shell of a lens object's term at one view (thesis 6.3.3: "the
+//! two rendering matrices A_R and A_T, corresponding to hybrid rendering with an initial
+//! reflection or refraction"): the frame's tessellation ([`super::tessellate()`]) is
+//! rasterized as the player draws it; per vertex the term's outgoing ray meets the shell and
+//! the hit point minus the shell's origin is the vertex's cube-map vector ([`shell_vector`],
+//! thesis 6.4.2); per pixel the vectors are interpolated perspective-correct, and the cube
+//! lookup (face, LOD from fine derivatives, trilinear seamless taps over every stored level:
+//! [`crate::shell::cube`]) gives the row. A triangle draws the term only where all three
+//! vertices have its path; the F·G modulation is the player's to multiply, per vertex
+//! interpolated, and is not in A (the shells hold the radiance along the outgoing rays).
+
+use glam::{DVec3, Mat4};
+use rayon::prelude::*;
+
+use super::path::{LensPath, Term};
+use super::tessellate::Tessellation;
+use crate::filter::Taps;
+use crate::interpolate::texcoord_at;
+use crate::raster::{DepthBuffer, Fragments};
+use crate::shell::cube::{cube_lod, cube_taps};
+use crate::shell::geometry::{shell_hit, Shell};
+use crate::transform::{DrawMesh, TextureTransform, Viewport};
+use crate::{RenderMatrix, TextureLayout};
+
+/// The cube-map vector of `shell` for an outgoing ray: where the ray meets the shell minus
+/// the shell's origin, rounded to `f32` as the player's vertex buffer holds it; `None` where
+/// the ray does not meet the shell.
+pub fn shell_vector(shell: &Shell, path: &LensPath) -> Option<[f32; 3]> {
+    let (o, d) = (path.exit_origin.as_dvec3(), path.exit_direction.as_dvec3());
+    let t = shell_hit(shell, o, d);
+    (t >= 0.0).then(|| (o + d * t - shell.origin).as_vec3().to_array())
+}
+
+/// Per vertex of `tess`, the cube-map vector of `shell` for `term`, `None` where the vertex
+/// has no such path or its ray misses the shell.
+pub fn vertex_vectors(tess: &Tessellation, term: Term, shell: &Shell) -> Vec<Option<[f32; 3]>> {
+    tess.vertices.par_iter().map(|v| v.paths[term as usize].as_ref().and_then(|p| shell_vector(shell, p))).collect()
+}
+
+/// The pixels that draw the term (increasing order) and, per pixel, its interpolated cube
+/// vector and those of its right and lower neighbours in the 2×2 quad (fine derivatives).
+pub struct HybridPixels {
+    pub pixels: Vec<u32>,
+    pub vectors: Vec<[DVec3; 3]>,
+}
+
+/// The pixels of `tess` (world positions, drawn with `clip_from_world`) that draw a term
+/// with per-vertex vectors `vectors`, depth-tested against the tessellation itself and
+/// `occluders`.
+pub fn hybrid_pixels(viewport: Viewport, tess: &Tessellation, clip_from_world: Mat4, vectors: &[Option<[f32; 3]>], occluders: Option<&DepthBuffer>) -> HybridPixels {
+    // Each triangle's corners carry barycentric (s, t) = (λ1, λ2), interpolated
+    // perspective-correct like the player's vertex attributes.
+    let corners: Vec<[f32; 3]> = tess.triangles.iter().flat_map(|t| t.map(|i| tess.vertices[i as usize].position.to_array())).collect();
+    let bary: Vec<[f32; 2]> = tess.triangles.iter().flat_map(|_| [[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]]).collect();
+    let order: Vec<u32> = (0..corners.len() as u32).collect();
+    let mesh = DrawMesh { positions: &corners, uvs: &bary, indices: &order, clip_from_object: clip_from_world };
+    let frags = Fragments::rasterize(&mesh, &TextureTransform::IDENTITY, viewport, occluders);
+    let corner_vectors: Vec<Option<[DVec3; 3]>> = tess
+        .triangles
+        .iter()
+        .map(|t| {
+            let v = t.map(|i| vectors[i as usize]);
+            match v {
+                [Some(a), Some(b), Some(c)] => Some([a, b, c].map(|x| DVec3::from(x.map(f64::from)))),
+                _ => None,
+            }
+        })
+        .collect();
+    let pixels: Vec<u32> = frags.pixels().into_iter().filter(|&p| corner_vectors[frags.source[frags.triangle[p as usize] as usize] as usize].is_some()).collect();
+    let vectors = pixels
+        .par_iter()
+        .map(|&p| {
+            let (x, y) = (p % viewport.width, p / viewport.width);
+            let k = frags.triangle[p as usize] as usize;
+            let (tri, src) = (&frags.triangles[k], frags.source[k] as usize);
+            let v = corner_vectors[src].expect("pixels of drawn triangles");
+            let at = |x: u32, y: u32| {
+                let [b1, b2] = texcoord_at(tri, x as f64 + 0.5, y as f64 + 0.5);
+                v[0] * (1.0 - b1 - b2) + v[1] * b1 + v[2] * b2
+            };
+            let (qx, qy) = (x & !1, y & !1);
+            [at(x, y), at(qx + 1, y) - at(qx, y), at(x, qy + 1) - at(x, qy)]
+        })
+        .collect();
+    HybridPixels { pixels, vectors }
+}
+
+/// The render matrix of one shell (per-vertex vectors `vectors`, cube layout `layout`) for
+/// one term of the tessellated lens object; rows are [`hybrid_pixels`]'s pixels.
+pub fn hybrid_render_matrix(viewport: Viewport, tess: &Tessellation, clip_from_world: Mat4, vectors: &[Option<[f32; 3]>], layout: TextureLayout, occluders: Option<&DepthBuffer>) -> RenderMatrix {
+    let px = hybrid_pixels(viewport, tess, clip_from_world, vectors, occluders);
+    let max_level = layout.levels.saturating_sub(1) as f64;
+    let rows: Vec<Taps> = px
+        .vectors
+        .par_iter()
+        .map(|&[d, ddx, ddy]| {
+            let lambda = cube_lod(d, ddx, ddy, layout.width as f64, max_level);
+            let mut taps = Taps::default();
+            cube_taps(&layout, d, lambda, &mut taps);
+            taps
+        })
+        .collect();
+    RenderMatrix::from_taps(viewport, layout, px.pixels, &rows)
+}
