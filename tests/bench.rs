@@ -295,3 +295,32 @@ fn readme_chart_command_runs_at_its_smallest_preset() {
         assert!(out_dir.join(chart).is_file(), "{chart} written");
     }
 }
+
+#[test]
+fn hybrid_reports_the_vertex_rays_and_their_accuracy_per_tau() {
+    let glass = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../samples/glass/scene.toml");
+    let out = bench(&["hybrid", glass.to_str().unwrap(), "--tau", "2,8", "--frames", "2", "--json"]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("JSON on stdout");
+    assert_eq!(v["frames"], 2);
+    assert_eq!(v["per_pixel"][0]["object"], "GlassTeapot");
+    let rows = v["rows"].as_array().expect("rows");
+    assert_eq!(rows.len(), 2);
+    let f = |r: &serde_json::Value, k: &str| r[k].as_f64().unwrap_or(f64::NAN);
+    // A larger τ stops splitting sooner: fewer rays, and the interpolated vectors further
+    // from the traced ones.
+    assert!(f(&rows[0], "vertex_rays") > f(&rows[1], "vertex_rays"), "{rows:?}");
+    assert!(f(&rows[0], "triangles") > f(&rows[1], "triangles"));
+    for t in 0..2 {
+        let (a, b) = (rows[0]["p90_angle_deg"][t].as_f64().unwrap(), rows[1]["p90_angle_deg"][t].as_f64().unwrap());
+        assert!(a.is_finite() && a < b, "term {t}: τ 2 {a}°, τ 8 {b}°");
+    }
+    assert!(f(&v["per_pixel"][0], "pixels") > 1000.0);
+    // A scene without a lens object, and a τ that is not positive, are refused.
+    let teapot = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../samples/teapot-pem/scene.toml");
+    let out = bench(&["hybrid", teapot.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(1), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("no refractive"));
+    let out = bench(&["hybrid", glass.to_str().unwrap(), "--tau", "0"]);
+    assert_eq!(out.status.code(), Some(1), "{}", String::from_utf8_lossy(&out.stderr));
+}

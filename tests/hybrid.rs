@@ -4,8 +4,8 @@
 
 use std::path::Path;
 
-use glam::{Mat3, Vec3};
-use pis_compile::hybrid::{greedy_path, tessellate, HybridView, LensMaterial, LensObject, Term, TessellationSettings};
+use glam::Vec3;
+use pis_compile::hybrid::{greedy_path, tessellate, HybridView, LensObject, Term, TessellationSettings};
 use pis_scene::{ObjectRole, Scene};
 use pis_trace::camera::PerspectiveCamera;
 use pis_trace::TraceSettings;
@@ -15,30 +15,8 @@ fn glass_scene() -> Scene {
     pis_scene::load(&toml, None).expect("glass sample loads")
 }
 
-/// The lens object `o` of `scene` at `frame` as pis-trace places it, and its material as
-/// pis-trace shades it (constant base colour: the sample's glass has no textures).
 fn lens_object(scene: &Scene, frame: &pis_scene::Frame, o: usize) -> LensObject {
-    let m = frame.instances[o].world_from_object;
-    let normal_matrix = Mat3::from_mat4(m).inverse().transpose();
-    let (mut positions, mut normals, mut indices) = (Vec::new(), Vec::new(), Vec::new());
-    let mut material = None;
-    for prim in &scene.objects[o].primitives {
-        let base = positions.len() as u32;
-        positions.extend(prim.positions.iter().map(|&p| m.transform_point3(p)));
-        normals.extend(prim.normals.iter().map(|&n| normal_matrix * n));
-        indices.extend(prim.indices.iter().map(|&i| base + i));
-        let mat = &scene.materials[prim.material];
-        assert!(mat.base_color_texture.is_none(), "a textured lens material");
-        let ior = if mat.ior.is_finite() && mat.ior >= 1.0 { mat.ior } else { 1.5 };
-        let sigma_a = if mat.attenuation_distance.is_finite() && mat.attenuation_distance > 0.0 {
-            Vec3::from(mat.attenuation_color).max(Vec3::splat(1e-6)).min(Vec3::ONE).map(|c| -c.ln()) / mat.attenuation_distance
-        } else {
-            Vec3::ZERO
-        };
-        let base = Vec3::new(mat.base_color[0], mat.base_color[1], mat.base_color[2]);
-        material.get_or_insert(LensMaterial { ior, base, sigma_a });
-    }
-    LensObject::new(material.expect("a primitive"), positions, normals, &indices)
+    pis_pack::lens::lens_object(scene, frame, o)
 }
 
 #[test]

@@ -21,6 +21,7 @@ use pis::cli::{finish, parse, Exit, Failure, EXIT_CODES_HELP};
 use pis_eval::bench::all::{self, Preset};
 use pis_eval::bench::rd::{self, RdRequest};
 use pis_eval::bench::speed::{self, SpeedRequest};
+use pis_eval::bench::hybrid::{self, HybridRequest};
 use pis_eval::bench::reflective::{self, ReflectiveRequest};
 use pis_eval::bench::stability::{self, StabilityRequest};
 use pis_pack::infer::{infer, print_report, InferRequest};
@@ -238,6 +239,26 @@ enum Command {
         #[arg(long)]
         json: bool,
     },
+    /// Hybrid rendering's per-frame CPU work on a scene's lens objects (thesis 6.4, table
+    /// 6.1): per τ, the vertex rays of the greedy two-path model, the adaptive tessellation,
+    /// the milliseconds for tracing, tessellating and cube-vector generation, against the
+    /// same model traced at every pixel, along the camera path between the sampled views.
+    Hybrid {
+        /// The scene.toml (its refractive objects are measured).
+        scene: PathBuf,
+        /// τ values: the screen edge length in pixels below which triangles are not split.
+        #[arg(long, value_delimiter = ',', default_value = "1,3,5,10")]
+        tau: Vec<f32>,
+        /// Frames on the path between the sampled views.
+        #[arg(long, default_value_t = 9)]
+        frames: usize,
+        #[arg(long, value_parser = parse_resolution)]
+        resolution: Option<(u32, u32)>,
+        #[arg(long)]
+        preset: Option<String>,
+        #[arg(long)]
+        json: bool,
+    },
     /// Every chart (rd, speed, stability) from scratch on demo1: trace, pack, evaluate.
     All {
         /// `ci` (80×60, 1 spp: minutes on 2 cores) or `paper` (demo1's paper preset).
@@ -342,6 +363,14 @@ fn run(cli: Cli) -> Result<Exit, Failure> {
             let req = ReflectiveRequest { scene, preset, resolution, files, frames, spp: reference_spp, out, images };
             let report = reflective::run(&req)?;
             reflective::print(&report, &mut std::io::stderr()).map_err(|e| Failure::new(Exit::Io, e))?;
+            if json {
+                json_out(&report)?;
+            }
+            Ok(Exit::Ok)
+        }
+        Command::Hybrid { scene, tau, frames, resolution, preset, json } => {
+            let report = hybrid::run(&HybridRequest { scene, preset, resolution, taus: tau, frames })?;
+            hybrid::print(&report, &mut std::io::stderr()).map_err(|e| Failure::new(Exit::Io, e))?;
             if json {
                 json_out(&report)?;
             }

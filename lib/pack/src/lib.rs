@@ -18,6 +18,7 @@
 mod error;
 pub mod images;
 pub mod infer;
+pub mod lens;
 pub mod pipeline;
 
 pub use error::{exit_of, format_exit, scene_exit, trace_exit, Exit, Failure};

@@ -4,6 +4,7 @@
 
 pub mod all;
 pub mod camera_path;
+pub mod hybrid;
 pub mod mpeg_texture;
 pub mod output;
 pub mod playback;
