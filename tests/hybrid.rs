@@ -168,3 +168,50 @@ fn interpolated_shell_vectors_follow_the_paths_traced_at_each_pixel() {
     assert!(p90[2] < p90[0] && p90[3] < p90[1] && p90[4] < p90[2] && p90[5] < p90[3], "90th percentiles (τ 10, 3, 1; reflection, refraction): {p90:?}");
     assert!(p90[4] < 3.0 && p90[5] < 3.0, "90th percentiles at τ = 1: {p90:?}");
 }
+
+#[test]
+fn the_glass_teapots_environment_clusters_into_layers_of_whole_objects() {
+    use pis_compile::hybrid::{choose_layers, fit_shell, layer_hits, OutgoingRay};
+    use pis_compile::shell::geometry::ShellShape;
+    let scene = glass_scene();
+    let o = scene.objects.iter().position(|x| x.role == ObjectRole::Refractive).expect("a lens object");
+    let mut settings = TraceSettings::new((80, 60), 1);
+    settings.records_per_pixel = 1;
+    // Every view at once, so that the layers are the same for all of them (thesis 6.3.2).
+    let mut rays = Vec::new();
+    let (mut origin, mut scale) = (glam::DVec3::ZERO, 0.0);
+    for v in 0..scene.space.dims[0].samples() {
+        let frame = scene.frame(&[v]).expect("view");
+        let lens = lens_object(&scene, &frame, o);
+        origin = lens.centroid().as_dvec3();
+        scale = lens.positions.iter().map(|p| (p.as_dvec3() - origin).length()).fold(0.0, f64::max);
+        let render = pis_trace::render_point(&scene, &frame, &settings, &|| {}).expect("traces");
+        rays.extend(render.records.iter().filter(|r| r.object == o as u32).map(|r| OutgoingRay {
+            origin: Vec3::from(r.exit_origin).as_dvec3(),
+            direction: Vec3::from(r.exit_direction).as_dvec3(),
+            hits: r.hits.iter().map(|h| (h.t as f64, h.object)).collect(),
+        }));
+    }
+    let (layers, shells) = choose_layers(&rays, origin, 4, scale);
+    let names: Vec<Vec<&str>> = (0..layers.distances.len()).map(|l| layers.layer_of.iter().filter(|(_, &k)| k == l).map(|(&ob, _)| scene.objects[ob as usize].name.as_str()).collect()).collect();
+    eprintln!("{} outgoing rays, layers at {:?}: {names:?}; shells' error {:.1} over {} hits", rays.len(), layers.distances, pis_compile::hybrid::shells_error(&rays, &layers, &shells, origin, scale), layers.counted);
+    assert_eq!(shells.len(), layers.distances.len());
+    for (l, fit) in shells.iter().enumerate() {
+        eprintln!("layer {l}: {:?}, relative rms {:.3}", fit.shell.shape, fit.mse.sqrt());
+        assert!(matches!(fit.shell.shape, ShellShape::Sphere { .. } | ShellShape::Cylinder { .. } | ShellShape::Box { .. }));
+    }
+    assert!(layers.distances.len() >= 2, "{layers:?}");
+    assert!(layers.distances.windows(2).all(|w| w[0] < w[1]));
+    // The cup beside the teapot is nearer than the room's walls.
+    let layer = |name: &str| scene.objects.iter().position(|x| x.name == name).and_then(|k| layers.layer_of.get(&(k as u32)).copied());
+    assert!(layer("SilverCup") < layer("Columns") && layer("Columns") < layer("Walls"), "cup {:?}, columns {:?}, walls {:?}", layer("SilverCup"), layer("Columns"), layer("Walls"));
+    // The shells put the environment within 10 % (rms) of its distance; the objects moved to
+    // the shells that fit them beat the clustering by distance alone 10 times over.
+    let error = pis_compile::hybrid::shells_error(&rays, &layers, &shells, origin, scale);
+    assert!(error < 0.01 * layers.counted as f64, "shells' error {error} over {} hits", layers.counted);
+    let by_distance = pis_compile::hybrid::cluster(&rays, origin, layers.distances.len());
+    let fitted: Vec<_> = (0..by_distance.distances.len()).filter_map(|l| fit_shell(&rays, &layer_hits(&rays, &by_distance, l), origin, scale)).collect();
+    let plain = pis_compile::hybrid::shells_error(&rays, &by_distance, &fitted, origin, scale);
+    eprintln!("clustered by distance alone: shells' error {plain:.1}");
+    assert!(plain > 10.0 * error, "by distance {plain}, refined {error}");
+}

@@ -109,6 +109,19 @@ impl LensObject {
         LensSurface { position: p, normal, geometric_normal, front_face }
     }
 
+    /// The area-weighted centroid of the surface: the layered environment map's origin
+    /// (thesis 5.7, 6.3.2).
+    pub fn centroid(&self) -> Vec3 {
+        let (mut sum, mut area) = (glam::DVec3::ZERO, 0.0f64);
+        for t in &self.triangles {
+            let [a, b, c] = t.map(|i| self.positions[i as usize].as_dvec3());
+            let w = 0.5 * (b - a).cross(c - a).length();
+            sum += (a + b + c) * (w / 3.0);
+            area += w;
+        }
+        if area > 0.0 { (sum / area).as_vec3() } else { Vec3::ZERO }
+    }
+
     /// The winding normal of triangle `t` (unit).
     pub fn face_normal(&self, t: usize) -> Vec3 {
         let [a, b, c] = self.triangles[t].map(|i| self.positions[i as usize]);

@@ -5,11 +5,13 @@
 //! each term. One function, used by the player each frame and by pis-pack's render
 //! matrices.
 
+pub mod layers;
 pub mod lens;
 pub mod model;
 pub mod path;
 pub mod tessellate;
 
+pub use layers::{choose_layers, cluster, fit_shell, layer_hits, relative_error, shells_error, FittedShell, Layers, OutgoingRay};
 pub use lens::{LensMaterial, LensObject};
 pub use model::{hybrid_pixels, hybrid_render_matrix, shell_vector, vertex_vectors, HybridPixels};
 pub use path::{greedy_path, LensPath, Term, Topology, TERMS};
