@@ -19,6 +19,7 @@ mod error;
 pub mod images;
 pub mod infer;
 pub mod lens;
+pub mod lens_infer;
 pub mod pipeline;
 
 pub use error::{exit_of, format_exit, scene_exit, trace_exit, Exit, Failure};

@@ -5,8 +5,8 @@
 //! the hit point minus the shell's origin is the vertex's cube-map vector ([`shell_vector`],
 //! thesis 6.4.2); per pixel the vectors are interpolated perspective-correct, and the cube
 //! lookup (face, LOD from fine derivatives, trilinear seamless taps over every stored level:
-//! [`crate::shell::cube`]) gives the row. A triangle draws the term only where all three
-//! vertices have its path; the F·G modulation is the player's to multiply, per vertex
+//! [`crate::shell::cube`]) gives the row. A triangle draws the term where a vertex has its
+//! path ([`Missing`]: the others have F·G 0); the F·G modulation is the player's to multiply, per vertex
 //! interpolated, and is not in A (the shells hold the radiance along the outgoing rays).
 
 use glam::{DVec3, Mat4};
@@ -37,6 +37,17 @@ pub fn vertex_vectors(tess: &Tessellation, term: Term, shell: &Shell) -> Vec<Opt
     tess.vertices.par_iter().map(|v| v.paths[term as usize].as_ref().and_then(|p| shell_vector(shell, p))).collect()
 }
 
+/// What a triangle's corner without a value takes, where its other corners have one: the
+/// term's path ends inside the lens object there (cut after the last interface), so its
+/// F·G is 0 ([`Missing::Zero`]), and its cube vector, which F·G = 0 makes irrelevant, is
+/// the mean of the others' ([`Missing::Mean`]), so that the lookup stays where the valid
+/// corners look.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Missing {
+    Zero,
+    Mean,
+}
+
 /// The pixels that draw the term (increasing order) and, per pixel, its interpolated cube
 /// vector and those of its right and lower neighbours in the 2×2 quad (fine derivatives).
 pub struct HybridPixels {
@@ -45,9 +56,10 @@ pub struct HybridPixels {
 }
 
 /// The pixels of `tess` (world positions, drawn with `clip_from_world`) that draw a term
-/// with per-vertex vectors `vectors`, depth-tested against the tessellation itself and
+/// with per-vertex values `vectors` (a triangle draws where at least one corner has a
+/// value; the others take `missing`), depth-tested against the tessellation itself and
 /// `occluders`.
-pub fn hybrid_pixels(viewport: Viewport, tess: &Tessellation, clip_from_world: Mat4, vectors: &[Option<[f32; 3]>], occluders: Option<&DepthBuffer>) -> HybridPixels {
+pub fn hybrid_pixels(viewport: Viewport, tess: &Tessellation, clip_from_world: Mat4, vectors: &[Option<[f32; 3]>], missing: Missing, occluders: Option<&DepthBuffer>) -> HybridPixels {
     // Each triangle's corners carry barycentric (s, t) = (λ1, λ2), interpolated
     // perspective-correct like the player's vertex attributes.
     let corners: Vec<[f32; 3]> = tess.triangles.iter().flat_map(|t| t.map(|i| tess.vertices[i as usize].position.to_array())).collect();
@@ -59,11 +71,16 @@ pub fn hybrid_pixels(viewport: Viewport, tess: &Tessellation, clip_from_world: M
         .triangles
         .iter()
         .map(|t| {
-            let v = t.map(|i| vectors[i as usize]);
-            match v {
-                [Some(a), Some(b), Some(c)] => Some([a, b, c].map(|x| DVec3::from(x.map(f64::from)))),
-                _ => None,
+            let v = t.map(|i| vectors[i as usize].map(|x| DVec3::from(x.map(f64::from))));
+            let valid: Vec<DVec3> = v.iter().flatten().copied().collect();
+            if valid.is_empty() {
+                return None;
             }
+            let fill = match missing {
+                Missing::Zero => DVec3::ZERO,
+                Missing::Mean => valid.iter().sum::<DVec3>() / valid.len() as f64,
+            };
+            Some(v.map(|x| x.unwrap_or(fill)))
         })
         .collect();
     let pixels: Vec<u32> = frags.pixels().into_iter().filter(|&p| corner_vectors[frags.source[frags.triangle[p as usize] as usize] as usize].is_some()).collect();
@@ -88,7 +105,7 @@ pub fn hybrid_pixels(viewport: Viewport, tess: &Tessellation, clip_from_world: M
 /// The render matrix of one shell (per-vertex vectors `vectors`, cube layout `layout`) for
 /// one term of the tessellated lens object; rows are [`hybrid_pixels`]'s pixels.
 pub fn hybrid_render_matrix(viewport: Viewport, tess: &Tessellation, clip_from_world: Mat4, vectors: &[Option<[f32; 3]>], layout: TextureLayout, occluders: Option<&DepthBuffer>) -> RenderMatrix {
-    let px = hybrid_pixels(viewport, tess, clip_from_world, vectors, occluders);
+    let px = hybrid_pixels(viewport, tess, clip_from_world, vectors, Missing::Mean, occluders);
     let max_level = layout.levels.saturating_sub(1) as f64;
     let rows: Vec<Taps> = px
         .vectors

@@ -125,11 +125,14 @@ pub fn refract(d: Vec3, n: Vec3, eta: f32) -> Option<Vec3> {
 }
 
 /// Whether two paths of one term differ (thesis 6.4.1): one exists and the other not,
-/// different topologies, or exit directions more than `max_angle` (radians) apart.
-pub fn paths_differ(a: Option<&LensPath>, b: Option<&LensPath>, cos_max_angle: f32) -> bool {
+/// different topologies, exit directions more than `max_angle` (as its cosine) apart, or
+/// F·G differing by more than `max_modulation` in a channel (F·G is interpolated linearly
+/// across a triangle, and Fresnel's factors change fast towards grazing angles, faster
+/// than the directions do).
+pub fn paths_differ(a: Option<&LensPath>, b: Option<&LensPath>, cos_max_angle: f32, max_modulation: f32) -> bool {
     match (a, b) {
         (None, None) => false,
-        (Some(a), Some(b)) => a.topology != b.topology || a.exit_direction.dot(b.exit_direction) < cos_max_angle,
+        (Some(a), Some(b)) => a.topology != b.topology || a.exit_direction.dot(b.exit_direction) < cos_max_angle || (a.modulation - b.modulation).abs().max_element() > max_modulation,
         _ => true,
     }
 }
@@ -205,10 +208,13 @@ mod tests {
     }
 
     #[test]
-    fn paths_differ_by_topology_existence_and_angle() {
+    fn paths_differ_by_topology_existence_angle_and_modulation() {
         let a = LensPath { exit_origin: Vec3::ZERO, exit_direction: Vec3::Z, modulation: Vec3::ONE, topology: Topology { interfaces: 2, reflected: 0 } };
         let mut b = a;
         let cos3 = 3f32.to_radians().cos();
+        fn paths_differ(a: Option<&LensPath>, b: Option<&LensPath>, c: f32) -> bool {
+            super::paths_differ(a, b, c, 0.05)
+        }
         assert!(!paths_differ(Some(&a), Some(&b), cos3));
         b.exit_direction = Vec3::new(0.0, 4f32.to_radians().sin(), 4f32.to_radians().cos());
         assert!(paths_differ(Some(&a), Some(&b), cos3));
@@ -218,5 +224,10 @@ mod tests {
         assert!(paths_differ(Some(&a), Some(&b), cos3));
         assert!(paths_differ(Some(&a), None, cos3));
         assert!(!paths_differ(None, None, cos3));
+        b.topology = a.topology;
+        b.modulation = Vec3::splat(0.94);
+        assert!(paths_differ(Some(&a), Some(&b), cos3));
+        b.modulation = Vec3::splat(0.96);
+        assert!(!paths_differ(Some(&a), Some(&b), cos3));
     }
 }

@@ -1,7 +1,8 @@
 //! Adaptive tessellation of a lens object for one frame (thesis 6.4.1): the greedy paths
 //! traced at the front-facing vertices, triangles split at their edges' midpoints (1-to-4,
 //! 1-to-3 or 1-to-2) where their vertices' paths differ in topology or in exit direction by
-//! more than 3°, down to a screen edge length τ; the T-junctions left between triangles split
+//! more than 3° (or, beyond the thesis, in F·G by more than 0.05), down to a screen edge
+//! length τ; the T-junctions left between triangles split
 //! to different depths removed afterwards through the same edge table, which also keeps each
 //! vertex's rays from being traced twice.
 //!
@@ -36,6 +37,8 @@ pub struct TessellationSettings {
     pub tau_px: f32,
     /// Paths whose exit directions differ more than this (degrees) are different.
     pub max_angle_deg: f32,
+    /// Paths whose F·G differ more than this in a channel are different.
+    pub max_modulation: f32,
     /// Interfaces a path may meet after the first (pis-trace's `max_depth`).
     pub max_depth: u32,
     /// Splits of an original triangle at most.
@@ -44,7 +47,7 @@ pub struct TessellationSettings {
 
 impl Default for TessellationSettings {
     fn default() -> Self {
-        TessellationSettings { tau_px: 1.0, max_angle_deg: 3.0, max_depth: 8, max_levels: 12 }
+        TessellationSettings { tau_px: 1.0, max_angle_deg: 3.0, max_modulation: 0.05, max_depth: 8, max_levels: 12 }
     }
 }
 
@@ -268,7 +271,7 @@ impl Mesh<'_> {
         }
         let differ = (0..3).any(|e| {
             let (p, q) = (v[e], v[(e + 1) % 3]);
-            (0..2).any(|t| paths_differ(p.paths[t].as_ref(), q.paths[t].as_ref(), cos_max))
+            (0..2).any(|t| paths_differ(p.paths[t].as_ref(), q.paths[t].as_ref(), cos_max, self.settings.max_modulation))
         });
         if !differ {
             return None;

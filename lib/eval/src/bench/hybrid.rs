@@ -12,7 +12,7 @@ use std::time::Instant;
 
 use anyhow::{anyhow, Result};
 use glam::{DVec3, Vec2, Vec3};
-use pis_compile::hybrid::{greedy_path, hybrid_pixels, shell_vector, tessellate_timed, vertex_vectors, HybridView, LensObject, TessellationSettings, TERMS};
+use pis_compile::hybrid::{greedy_path, hybrid_pixels, Missing, shell_vector, tessellate_timed, vertex_vectors, HybridView, LensObject, TessellationSettings, TERMS};
 use pis_compile::shell::geometry::{Shell, ShellShape};
 use pis_compile::Viewport;
 use pis_scene::{LoadOptions, ObjectRole};
@@ -157,7 +157,7 @@ pub fn run(req: &HybridRequest) -> Result<HybridReport, Failure> {
                 r.tessellate_ms += times.tessellate.as_secs_f64() * 1e3;
                 r.texgen_ms += texgen;
                 for (term, v) in vectors.iter().enumerate() {
-                    let px = hybrid_pixels(viewport, &tess, clip_from_world, v, None);
+                    let px = hybrid_pixels(viewport, &tess, clip_from_world, v, Missing::Mean, None);
                     for (&p, d) in px.pixels.iter().zip(&px.vectors) {
                         let Some(Some(path)) = traced[p as usize].map(|t| t[term]) else { continue };
                         let Some(w) = shell_vector(&shell, &path) else { continue };

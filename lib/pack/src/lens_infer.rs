@@ -1,0 +1,263 @@
+//! A lens object's layered environment maps inferred at its view samples (thesis 6.3.3):
+//! the layers and shells built from the outgoing rays of every view
+//! ([`pis_compile::hybrid::choose_layers`]); per view, the frame's tessellation and, per
+//! term and shell, the render matrix of hybrid rendering ([`hybrid_render_matrix`]); per
+//! shell one RGBA cube map solved by least squares against both terms at once (eq. 6.1: the
+//! two matrices stacked), its premultiplied colour and its alpha apart, the targets being the
+//! tracer's outgoing-ray records of each pixel recombined per layer (alpha: the fraction of
+//! the pixel's rays that meet the layer, colour: what they meet there, premultiplied); the
+//! prediction composites each term's shells "over", nearest first, multiplies by the F·G the
+//! player interpolates per vertex, and is compared with the traced `reflection` and
+//! `refraction` layers over the lens object's pixels.
+//!
+//! Not yet: simultaneous inference over nearby viewpoints or direct images (6.3.3.1), the
+//! confidence weights, the cube-face size from the finest level the frames read (5.8.2).
+
+use anyhow::{anyhow, Result};
+use glam::{DVec3, Vec3};
+use pis_compile::hybrid::{choose_layers, hybrid_pixels, Missing, hybrid_render_matrix, tessellate, vertex_vectors, FittedShell, HybridView, Layers, OutgoingRay, Term, TessellationSettings, TERMS};
+use pis_compile::solve::{solve_view_independent, View};
+use pis_compile::{RenderMatrix, SolveSettings, TextureLayout, Viewport};
+use pis_scene::{Frame, Scene};
+use pis_trace::camera::{projection_matrix, PerspectiveCamera};
+use pis_trace::layers::LayerKind;
+use pis_trace::PointRender;
+
+use crate::infer::psnr_display;
+use crate::lens::lens_object;
+
+/// What the inference is given and how it runs.
+#[derive(Clone, Debug)]
+pub struct LensInferSettings {
+    /// Cube-face size of every shell.
+    pub face: u32,
+    pub tessellation: TessellationSettings,
+    pub max_layers: usize,
+    pub solve: SolveSettings,
+}
+
+impl Default for LensInferSettings {
+    fn default() -> Self {
+        LensInferSettings { face: 32, tessellation: TessellationSettings::default(), max_layers: 4, solve: SolveSettings::pyramidal() }
+    }
+}
+
+/// One term's prediction at one view, over the lens object's pixels.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TermFit {
+    pub psnr_db: f64,
+    pub pixels: usize,
+}
+
+/// The inference's result at one view.
+#[derive(Clone, Debug)]
+pub struct LensView {
+    pub reflection: TermFit,
+    pub refraction: TermFit,
+    /// The two terms summed, against the traced terms summed.
+    pub both: TermFit,
+    /// Per shell, its RGBA cube map (texels × 4, premultiplied colour then alpha).
+    pub cubes: Vec<Vec<f32>>,
+}
+
+#[derive(Clone, Debug)]
+pub struct LensInference {
+    pub layers: Layers,
+    pub shells: Vec<FittedShell>,
+    pub views: Vec<LensView>,
+}
+
+/// Object `o`'s outgoing rays in `render`'s records.
+fn outgoing_rays(render: &PointRender, o: usize) -> Vec<OutgoingRay> {
+    render
+        .records
+        .iter()
+        .filter(|r| r.object == o as u32)
+        .map(|r| OutgoingRay { origin: Vec3::from(r.exit_origin).as_dvec3(), direction: Vec3::from(r.exit_direction).as_dvec3(), hits: r.hits.iter().map(|h| (h.t as f64, h.object)).collect() })
+        .collect()
+}
+
+/// Per pixel, for `term`'s records splatted with the display filter (a Gaussian of σ 0.5
+/// pixel, radius 1.5, as the tracer's film): their weight, and per layer the weight of
+/// those meeting it and of the colour they meet there (each record's frontmost hit in the
+/// layer). A record's first hit takes the radiance the traced term holds along the pixel's
+/// outgoing rays (the term over its F·G, the tracer's many-sample estimate) where that is
+/// defined; hidden hits keep the record's own one-sample colour.
+fn layer_targets(render: &PointRender, o: usize, term: Term, layers: &Layers, size: (u32, u32), radiance: &[Option<Vec3>]) -> (Vec<f32>, Vec<Vec<(f32, Vec3)>>) {
+    const SIGMA: f32 = 0.5;
+    const RADIUS: f32 = 1.5;
+    let n = (size.0 * size.1) as usize;
+    let mut weight = vec![0.0f32; n];
+    let mut per = vec![vec![(0.0f32, Vec3::ZERO); n]; layers.distances.len()];
+    for r in render.records.iter().filter(|r| r.object == o as u32 && r.term == term as u8) {
+        let (x, y) = (r.pixel[0], r.pixel[1]);
+        let own = (x.floor().clamp(0.0, size.0 as f32 - 1.0) as usize, y.floor().clamp(0.0, size.1 as f32 - 1.0) as usize);
+        let first = radiance[own.1 * size.0 as usize + own.0];
+        let mut colours: Vec<Option<Vec3>> = vec![None; layers.distances.len()];
+        for (k, h) in r.hits.iter().enumerate() {
+            if let Some(&l) = layers.layer_of.get(&h.object) {
+                if colours[l].is_none() {
+                    colours[l] = Some(if k == 0 { first.unwrap_or(Vec3::from(h.colour)) } else { Vec3::from(h.colour) });
+                }
+            }
+        }
+        let (x0, x1) = ((x - RADIUS - 0.5).ceil().max(0.0) as i64, ((x + RADIUS - 0.5).floor() as i64).min(size.0 as i64 - 1));
+        let (y0, y1) = ((y - RADIUS - 0.5).ceil().max(0.0) as i64, ((y + RADIUS - 0.5).floor() as i64).min(size.1 as i64 - 1));
+        for py in y0..=y1 {
+            for px in x0..=x1 {
+                let (dx, dy) = (px as f32 + 0.5 - x, py as f32 + 0.5 - y);
+                let d2 = dx * dx + dy * dy;
+                if d2 > RADIUS * RADIUS {
+                    continue;
+                }
+                let w = (-d2 / (2.0 * SIGMA * SIGMA)).exp();
+                let p = py as usize * size.0 as usize + px as usize;
+                weight[p] += w;
+                for (l, c) in colours.iter().enumerate() {
+                    if let Some(c) = c {
+                        per[l][p].0 += w;
+                        per[l][p].1 += *c * w;
+                    }
+                }
+            }
+        }
+    }
+    (weight, per)
+}
+
+/// The rows of `a` whose pixel `keep` marks.
+fn select_rows(a: &RenderMatrix, keep: impl Fn(u32) -> bool) -> RenderMatrix {
+    let mut out = RenderMatrix { width: a.width, height: a.height, layout: a.layout, row_start: vec![0], ..Default::default() };
+    for r in 0..a.rows() {
+        if !keep(a.pixels[r]) {
+            continue;
+        }
+        let (c, v) = a.row(r);
+        out.cols.extend_from_slice(c);
+        out.vals.extend_from_slice(v);
+        out.row_start.push(out.cols.len() as u32);
+        out.pixels.push(a.pixels[r]);
+        out.coverage.push(a.coverage[r]);
+    }
+    out
+}
+
+/// A traced image's RGB at every pixel (zeros where the layer is missing).
+fn traced_rgb(scene: &Scene, render: &PointRender, o: usize, kind: LayerKind, n: usize) -> Vec<f32> {
+    let mut out = vec![0.0f32; n * 3];
+    if let Some(l) = render.images.object_layer(&scene.objects[o].name, kind) {
+        for (c, name) in ["R", "G", "B"].iter().enumerate() {
+            if let Some(p) = l.channel(name) {
+                (0..n).for_each(|k| out[k * 3 + c] = p[k]);
+            }
+        }
+    }
+    out
+}
+
+/// Infers lens object `o`'s shells at every view of `views` (each its frame and the render
+/// traced there, with records).
+pub fn infer_lens(scene: &Scene, o: usize, views: &[(Frame, PointRender)], settings: &LensInferSettings) -> Result<LensInference> {
+    let (w, h) = views.first().map(|(_, r)| (r.images.width, r.images.height)).ok_or_else(|| anyhow!("no views"))?;
+    let lens0 = lens_object(scene, &views[0].0, o);
+    let origin = lens0.centroid().as_dvec3();
+    let scale = lens0.positions.iter().map(|p| (p.as_dvec3() - origin).length()).fold(0.0, f64::max);
+    let rays: Vec<OutgoingRay> = views.iter().flat_map(|(_, r)| outgoing_rays(r, o)).collect();
+    if rays.is_empty() {
+        return Err(anyhow!("{}: the traced views hold no outgoing-ray records of the lens object", scene.objects[o].name));
+    }
+    let (layers, shells) = choose_layers(&rays, origin, settings.max_layers, scale);
+    let layout = TextureLayout::cube(settings.face);
+    let viewport = Viewport { width: w, height: h };
+    let n = (w * h) as usize;
+    let mut out = Vec::with_capacity(views.len());
+    for (frame, render) in views {
+        let lens = lens_object(scene, frame, o);
+        let camera = PerspectiveCamera::new(&frame.camera, (w, h));
+        let clip = projection_matrix(&frame.camera, (w, h)) * frame.camera.world_from_camera.inverse();
+        let tess = tessellate(&lens, &HybridView { eye: camera.origin, clip_from_world: clip, size: (w, h) }, &settings.tessellation);
+        // Per term and shell: the full render matrix; per term the records' targets.
+        let mut a = Vec::new();
+        let mut targets = Vec::new();
+        for term in TERMS {
+            a.push(shells.iter().map(|s| hybrid_render_matrix(viewport, &tess, clip, &vertex_vectors(&tess, term, &s.shell), layout, None)).collect::<Vec<_>>());
+            let (kind, modulation) = if term == Term::ReflectionFirst { (LayerKind::Reflection, LayerKind::ReflectionModulation) } else { (LayerKind::Refraction, LayerKind::RefractionModulation) };
+            let (value, fg) = (traced_rgb(scene, render, o, kind, n), traced_rgb(scene, render, o, modulation, n));
+            let radiance: Vec<Option<Vec3>> = (0..n).map(|p| {
+                let f = Vec3::from_slice(&fg[p * 3..p * 3 + 3]);
+                (f.min_element() > 1e-3).then(|| Vec3::from_slice(&value[p * 3..p * 3 + 3]) / f)
+            }).collect();
+            targets.push(layer_targets(render, o, term, &layers, (w, h), &radiance));
+        }
+        // Per shell: colour and alpha solved over both terms' rows that have records.
+        let mut cubes = Vec::with_capacity(shells.len());
+        for l in 0..shells.len() {
+            let mut sub = Vec::new();
+            for t in 0..2 {
+                let (weight, per) = &targets[t];
+                let m = select_rows(&a[t][l], |p| weight[p as usize] > 0.0);
+                let rgb: Vec<f32> = m.pixels.iter().flat_map(|&p| (per[l][p as usize].1 / weight[p as usize]).to_array()).collect();
+                let alpha: Vec<f32> = m.pixels.iter().flat_map(|&p| [per[l][p as usize].0 / weight[p as usize], 0.0, 0.0]).collect();
+                sub.push((m, rgb, alpha));
+            }
+            let colour = solve_view_independent(&sub.iter().map(|(m, rgb, _)| View { a: m, b: rgb }).collect::<Vec<_>>(), None, &settings.solve)?;
+            let alpha = solve_view_independent(&sub.iter().map(|(m, _, al)| View { a: m, b: al }).collect::<Vec<_>>(), None, &settings.solve)?;
+            let texels = layout.texel_count();
+            let mut cube = vec![0.0f32; texels * 4];
+            for k in 0..texels {
+                cube[k * 4..k * 4 + 3].copy_from_slice(&colour.texels[k * 3..k * 3 + 3]);
+                cube[k * 4 + 3] = alpha.texels[k * 3].clamp(0.0, 1.0);
+            }
+            cubes.push(cube);
+        }
+        // Prediction: shells composited over, times the interpolated F·G, per term.
+        let cover = render.images.object_layer(&scene.objects[o].name, LayerKind::Coverage).and_then(|l| l.channel("A")).map(|c| c.to_vec()).unwrap_or_else(|| vec![0.0; n]);
+        let mut predicted = [vec![0.0f32; n * 3], vec![0.0f32; n * 3]];
+        for (t, term) in TERMS.into_iter().enumerate() {
+            let modulation: Vec<Option<[f32; 3]>> = tess.vertices.iter().map(|v| v.paths[term as usize].map(|p| p.modulation.to_array())).collect();
+            let fg = hybrid_pixels(viewport, &tess, clip, &modulation, Missing::Zero, None);
+            let mut through = vec![1.0f32; n];
+            for (l, cube) in cubes.iter().enumerate() {
+                let m = &a[t][l];
+                let mut y = vec![0.0f32; m.rows() * 4];
+                for r in 0..m.rows() {
+                    let (c, v) = m.row(r);
+                    for (&col, &wgt) in c.iter().zip(v) {
+                        for ch in 0..4 {
+                            y[r * 4 + ch] += wgt * cube[col as usize * 4 + ch];
+                        }
+                    }
+                }
+                for r in 0..m.rows() {
+                    let p = m.pixels[r] as usize;
+                    for ch in 0..3 {
+                        predicted[t][p * 3 + ch] += through[p] * y[r * 4 + ch];
+                    }
+                    through[p] *= 1.0 - y[r * 4 + 3].clamp(0.0, 1.0);
+                }
+            }
+            let mut modulated = vec![0.0f32; n * 3];
+            for (&p, v) in fg.pixels.iter().zip(&fg.vectors) {
+                let f: DVec3 = v[0];
+                for ch in 0..3 {
+                    modulated[p as usize * 3 + ch] = predicted[t][p as usize * 3 + ch] * f[ch] as f32;
+                }
+            }
+            predicted[t] = modulated;
+        }
+        let traced = [traced_rgb(scene, render, o, LayerKind::Reflection, n), traced_rgb(scene, render, o, LayerKind::Refraction, n)];
+        let fit = |pred: &[f32], truth: &[f32]| {
+            let pixels: Vec<usize> = (0..n).filter(|&p| cover[p] > 0.5).collect();
+            let gather = |v: &[f32]| pixels.iter().flat_map(|&p| [v[p * 3], v[p * 3 + 1], v[p * 3 + 2]]).collect::<Vec<f32>>();
+            TermFit { psnr_db: psnr_display(&gather(pred), &gather(truth)), pixels: pixels.len() }
+        };
+        let sum = |a: &[f32], b: &[f32]| a.iter().zip(b).map(|(x, y)| x + y).collect::<Vec<f32>>();
+        out.push(LensView {
+            reflection: fit(&predicted[0], &traced[0]),
+            refraction: fit(&predicted[1], &traced[1]),
+            both: fit(&sum(&predicted[0], &predicted[1]), &sum(&traced[0], &traced[1])),
+            cubes,
+        });
+    }
+    Ok(LensInference { layers, shells, views: out })
+}
