@@ -48,6 +48,31 @@ pub enum Missing {
     Mean,
 }
 
+/// Per triangle of `tess`, its corners' values for one term (`None`: no corner has one,
+/// the triangle does not draw the term); corners without a value take `missing`, the mean
+/// computed in `f32`. What the player's vertex buffer holds, corner by corner.
+pub fn corner_values(tess: &Tessellation, values: &[Option<[f32; 3]>], missing: Missing) -> Vec<Option<[[f32; 3]; 3]>> {
+    tess.triangles
+        .iter()
+        .map(|t| {
+            let v = t.map(|i| values[i as usize]);
+            let valid: Vec<[f32; 3]> = v.iter().flatten().copied().collect();
+            if valid.is_empty() {
+                return None;
+            }
+            let fill = match missing {
+                Missing::Zero => [0.0; 3],
+                Missing::Mean => {
+                    let n = valid.len() as f32;
+                    let s = valid.iter().fold([0.0f32; 3], |a, x| [a[0] + x[0], a[1] + x[1], a[2] + x[2]]);
+                    [s[0] / n, s[1] / n, s[2] / n]
+                }
+            };
+            Some(v.map(|x| x.unwrap_or(fill)))
+        })
+        .collect()
+}
+
 /// The pixels that draw the term (increasing order) and, per pixel, its interpolated cube
 /// vector and those of its right and lower neighbours in the 2×2 quad (fine derivatives).
 pub struct HybridPixels {
@@ -67,22 +92,7 @@ pub fn hybrid_pixels(viewport: Viewport, tess: &Tessellation, clip_from_world: M
     let order: Vec<u32> = (0..corners.len() as u32).collect();
     let mesh = DrawMesh { positions: &corners, uvs: &bary, indices: &order, clip_from_object: clip_from_world };
     let frags = Fragments::rasterize(&mesh, &TextureTransform::IDENTITY, viewport, occluders);
-    let corner_vectors: Vec<Option<[DVec3; 3]>> = tess
-        .triangles
-        .iter()
-        .map(|t| {
-            let v = t.map(|i| vectors[i as usize].map(|x| DVec3::from(x.map(f64::from))));
-            let valid: Vec<DVec3> = v.iter().flatten().copied().collect();
-            if valid.is_empty() {
-                return None;
-            }
-            let fill = match missing {
-                Missing::Zero => DVec3::ZERO,
-                Missing::Mean => valid.iter().sum::<DVec3>() / valid.len() as f64,
-            };
-            Some(v.map(|x| x.unwrap_or(fill)))
-        })
-        .collect();
+    let corner_vectors: Vec<Option<[DVec3; 3]>> = corner_values(tess, vectors, missing).into_iter().map(|c| c.map(|c| c.map(|x| DVec3::from(x.map(f64::from))))).collect();
     let pixels: Vec<u32> = frags.pixels().into_iter().filter(|&p| corner_vectors[frags.source[frags.triangle[p as usize] as usize] as usize].is_some()).collect();
     let vectors = pixels
         .par_iter()

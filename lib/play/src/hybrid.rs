@@ -1,0 +1,167 @@
+//! A lens object drawn by hybrid rendering on the GPU (`hybrid_object.wgsl`, thesis 6.4.2):
+//! the frame's tessellation with one shell's cube vectors per corner, looked up with the
+//! shell functions of `shell.wgsl` — the rendering that pis-compile's
+//! `hybrid_render_matrix` predicts. Corners are not shared: each triangle's corners carry
+//! the values [`pis_compile::hybrid::corner_values`] gives it.
+
+use bytemuck::{Pod, Zeroable};
+use glam::Mat4;
+use pis_compile::hybrid::{corner_values, Missing, Tessellation};
+use pis_compile::{TextureLayout, Viewport};
+use wgpu::util::DeviceExt;
+
+use crate::error::PlayError;
+use crate::gpu::Gpu;
+use crate::image::FloatImage;
+use crate::shell::{ShellTexture, SHELL_FUNCTIONS};
+use crate::textured::{DEPTH_FORMAT, TARGET_FORMAT};
+
+/// The hybrid pipeline's entry points.
+pub const HYBRID_OBJECT: &str = include_str!("hybrid_object.wgsl");
+
+/// `HybridUniforms` of `hybrid_object.wgsl` (80 bytes).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+struct HybridUniforms {
+    clip_from_world: [f32; 16],
+    size: u32,
+    levels: u32,
+    _pad: [u32; 2],
+}
+
+/// The compiled hybrid pipeline and its depth-only pass.
+pub struct HybridPipeline {
+    layout: wgpu::BindGroupLayout,
+    pipeline: wgpu::RenderPipeline,
+    depth_pipeline: wgpu::RenderPipeline,
+}
+
+fn vec3_at(location: u32) -> wgpu::VertexBufferLayout<'static> {
+    wgpu::VertexBufferLayout {
+        array_stride: 12,
+        step_mode: wgpu::VertexStepMode::Vertex,
+        attributes: if location == 0 {
+            &[wgpu::VertexAttribute { format: wgpu::VertexFormat::Float32x3, offset: 0, shader_location: 0 }]
+        } else {
+            &[wgpu::VertexAttribute { format: wgpu::VertexFormat::Float32x3, offset: 0, shader_location: 1 }]
+        },
+    }
+}
+
+impl HybridPipeline {
+    pub fn new(gpu: &Gpu) -> HybridPipeline {
+        let device = &gpu.device;
+        let source = format!("{SHELL_FUNCTIONS}\n{HYBRID_OBJECT}");
+        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor { label: Some("hybrid_object.wgsl"), source: wgpu::ShaderSource::Wgsl(source.into()) });
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("hybrid"),
+            entries: &[
+                wgpu::BindGroupLayoutEntry {
+                    binding: 0,
+                    visibility: wgpu::ShaderStages::VERTEX_FRAGMENT,
+                    ty: wgpu::BindingType::Buffer { ty: wgpu::BufferBindingType::Uniform, has_dynamic_offset: false, min_binding_size: None },
+                    count: None,
+                },
+                wgpu::BindGroupLayoutEntry {
+                    binding: 1,
+                    visibility: wgpu::ShaderStages::FRAGMENT,
+                    ty: wgpu::BindingType::Texture { sample_type: wgpu::TextureSampleType::Float { filterable: false }, view_dimension: wgpu::TextureViewDimension::D2Array, multisampled: false },
+                    count: None,
+                },
+            ],
+        });
+        let pl = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor { label: Some("hybrid"), bind_group_layouts: &[Some(&layout)], immediate_size: 0 });
+        let primitive = wgpu::PrimitiveState { topology: wgpu::PrimitiveTopology::TriangleList, cull_mode: None, ..Default::default() };
+        let depth_state = wgpu::DepthStencilState {
+            format: DEPTH_FORMAT,
+            depth_write_enabled: Some(true),
+            depth_compare: Some(wgpu::CompareFunction::Less),
+            stencil: Default::default(),
+            bias: Default::default(),
+        };
+        let make = |label, vs, buffers: &[Option<wgpu::VertexBufferLayout>], fragment: Option<wgpu::FragmentState>| {
+            device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+                label: Some(label),
+                layout: Some(&pl),
+                vertex: wgpu::VertexState { module: &module, entry_point: Some(vs), compilation_options: Default::default(), buffers },
+                primitive,
+                depth_stencil: Some(depth_state.clone()),
+                multisample: Default::default(),
+                fragment,
+                multiview_mask: None,
+                cache: None,
+            })
+        };
+        let targets = [Some(wgpu::ColorTargetState { format: TARGET_FORMAT, blend: None, write_mask: wgpu::ColorWrites::ALL })];
+        let fragment = wgpu::FragmentState { module: &module, entry_point: Some("fs_hybrid"), compilation_options: Default::default(), targets: &targets };
+        let pipeline = make("hybrid", "vs_hybrid", &[Some(vec3_at(0)), Some(vec3_at(1))], Some(fragment));
+        let silent = [Some(wgpu::ColorTargetState { format: TARGET_FORMAT, blend: None, write_mask: wgpu::ColorWrites::empty() })];
+        let none = wgpu::FragmentState { module: &module, entry_point: Some("fs_hybrid_depth"), compilation_options: Default::default(), targets: &silent };
+        let depth_pipeline = make("hybrid depth", "vs_hybrid_depth", &[Some(vec3_at(0))], Some(none));
+        HybridPipeline { layout, pipeline, depth_pipeline }
+    }
+}
+
+/// Draws the tessellation `tess` (world positions, `clip_from_world`) with one shell's cube
+/// map `rgba` (4 values per texel of `layout`) looked up along the per-vertex cube vectors
+/// `vectors` of one term; returns RGBA per pixel (rows from the top), alpha 1 where the
+/// term is drawn. Triangles without the term write depth only.
+pub fn render_hybrid(gpu: &Gpu, pipeline: &HybridPipeline, viewport: Viewport, tess: &Tessellation, clip_from_world: Mat4, vectors: &[Option<[f32; 3]>], layout: TextureLayout, rgba: &[f32]) -> Result<FloatImage, PlayError> {
+    let limit = gpu.limits.max_texture_dimension_2d;
+    if viewport.width == 0 || viewport.height == 0 || viewport.width > limit || viewport.height > limit {
+        return Err(PlayError::TargetSize { width: viewport.width, height: viewport.height, limit });
+    }
+    if vectors.len() != tess.vertices.len() {
+        return Err(PlayError::Request(format!("{} cube vectors for {} vertices", vectors.len(), tess.vertices.len())));
+    }
+    let cube = ShellTexture::new(gpu, layout, "lens object")?;
+    cube.upload(gpu, rgba)?;
+    let corners = corner_values(tess, vectors, Missing::Mean);
+    let (mut drawn_p, mut drawn_v, mut hidden_p) = (Vec::new(), Vec::new(), Vec::new());
+    for (t, c) in tess.triangles.iter().zip(&corners) {
+        let p = t.map(|i| tess.vertices[i as usize].position.to_array());
+        match c {
+            Some(v) => {
+                drawn_p.extend(p);
+                drawn_v.extend(*v);
+            }
+            None => hidden_p.extend(p),
+        }
+    }
+    let d = &gpu.device;
+    let init = |label: &str, contents: &[u8], usage| d.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: Some(label), contents, usage });
+    let u = HybridUniforms { clip_from_world: clip_from_world.to_cols_array(), size: layout.width, levels: layout.levels, _pad: [0; 2] };
+    let ub = init("uniforms", bytemuck::bytes_of(&u), wgpu::BufferUsages::UNIFORM);
+    let bind = d.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some("hybrid"),
+        layout: &pipeline.layout,
+        entries: &[wgpu::BindGroupEntry { binding: 0, resource: ub.as_entire_binding() }, wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::TextureView(&cube.view) }],
+    });
+    let pad = |v: &[[f32; 3]]| if v.is_empty() { vec![[0.0f32; 3]] } else { v.to_vec() };
+    let (dp, dv, hp) = (init("positions", bytemuck::cast_slice(&pad(&drawn_p)), wgpu::BufferUsages::VERTEX), init("vectors", bytemuck::cast_slice(&pad(&drawn_v)), wgpu::BufferUsages::VERTEX), init("hidden", bytemuck::cast_slice(&pad(&hidden_p)), wgpu::BufferUsages::VERTEX));
+    let size = wgpu::Extent3d { width: viewport.width, height: viewport.height, depth_or_array_layers: 1 };
+    let target = |label, format, usage| d.create_texture(&wgpu::TextureDescriptor { label: Some(label), size, mip_level_count: 1, sample_count: 1, dimension: wgpu::TextureDimension::D2, format, usage, view_formats: &[] });
+    let color = target("frame", TARGET_FORMAT, wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC);
+    let depth = target("depth", DEPTH_FORMAT, wgpu::TextureUsages::RENDER_ATTACHMENT);
+    let (color_view, depth_view) = (color.create_view(&Default::default()), depth.create_view(&Default::default()));
+    let mut enc = d.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("hybrid") });
+    {
+        let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("hybrid"),
+            color_attachments: &[Some(wgpu::RenderPassColorAttachment { view: &color_view, depth_slice: None, resolve_target: None, ops: wgpu::Operations { load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT), store: wgpu::StoreOp::Store } })],
+            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment { view: &depth_view, depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Clear(1.0), store: wgpu::StoreOp::Store }), stencil_ops: None }),
+            timestamp_writes: None,
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        pass.set_bind_group(0, &bind, &[]);
+        pass.set_pipeline(&pipeline.depth_pipeline);
+        pass.set_vertex_buffer(0, hp.slice(..));
+        pass.draw(0..hidden_p.len() as u32, 0..1);
+        pass.set_pipeline(&pipeline.pipeline);
+        pass.set_vertex_buffer(0, dp.slice(..));
+        pass.set_vertex_buffer(1, dv.slice(..));
+        pass.draw(0..drawn_p.len() as u32, 0..1);
+    }
+    crate::image::read_back(gpu, enc, &color, viewport)
+}

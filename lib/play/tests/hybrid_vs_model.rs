@@ -1,0 +1,62 @@
+//! The player's hybrid-rendering pipeline against the hardware model (thesis 6.4.2): a lens
+//! object's tessellation, traced for one view, drawn through wgpu with a random cube map
+//! looked up along each term's per-vertex cube vectors matches A_model·x (PSNR ≥ 60 dB over
+//! the pixels both cover) for every shell shape and both terms, close up (the cube map
+//! magnified) and far away (minified across many MIP levels). Runs on Mesa's lavapipe in CI.
+
+mod common;
+
+use common::*;
+use glam::{DVec3, Vec3};
+use pis_compile::hybrid::{hybrid_render_matrix, tessellate, vertex_vectors, HybridView, LensMaterial, LensObject, TessellationSettings, TERMS};
+use pis_compile::shell::{Shell, ShellShape};
+use pis_compile::{TextureLayout, Viewport};
+use pis_play::{render_hybrid, HybridPipeline};
+
+fn shells() -> Vec<(&'static str, Shell)> {
+    let o = DVec3::new(0.05, -0.1, 0.02);
+    vec![
+        ("sphere", Shell { origin: o, shape: ShellShape::Sphere { radius: 3.0 } }),
+        ("ellipsoid", Shell { origin: o, shape: ShellShape::Ellipsoid { radii: DVec3::new(1.6, 1.3, 1.5) } }),
+        ("box", Shell { origin: o, shape: ShellShape::Box { min: DVec3::new(-3.0, -1.3, -4.0), max: DVec3::new(4.0, 3.0, 3.5) } }),
+        ("cylinder", Shell { origin: o, shape: ShellShape::Cylinder { radius: 2.5, y_min: -1.3, y_max: 2.0 } }),
+    ]
+}
+
+#[test]
+fn hybrid_frames_match_the_model() {
+    let Some(gpu) = gpu_or_skip("hybrid_frames_match_the_model") else { return };
+    let pipeline = HybridPipeline::new(&gpu);
+    let vp = Viewport { width: 160, height: 120 };
+    // A glass ball: refraction bends every path, total internal reflection inside cuts some.
+    let ball = uv_sphere(40, 20);
+    let positions: Vec<Vec3> = ball.positions.iter().map(|&p| Vec3::from(p)).collect();
+    let lens = LensObject::new(LensMaterial { ior: 1.5, base: Vec3::ONE, sigma_a: Vec3::splat(0.3) }, positions.clone(), positions, &ball.indices);
+    let views: [(&str, [f32; 3], f32, u32); 2] = [("close", [0.4, 0.6, 2.6], 1.0, 24), ("far", [-2.5, 1.8, 8.0], 0.4, 64)];
+    let mut worst = f64::INFINITY;
+    let mut failures = vec![];
+    for (vname, eye, fovy, size) in views {
+        let clip = camera(vp, eye, [0.0, 0.0, 0.0], fovy);
+        let tess = tessellate(&lens, &HybridView { eye: Vec3::from(eye), clip_from_world: clip, size: (vp.width, vp.height) }, &TessellationSettings { tau_px: 2.0, ..Default::default() });
+        let layout = TextureLayout::cube(size);
+        let x = random_rgba(layout.texel_count(), 7 + size as u64);
+        for (sname, shell) in shells() {
+            for term in TERMS {
+                let vectors = vertex_vectors(&tess, term, &shell);
+                let a = hybrid_render_matrix(vp, &tess, clip, &vectors, layout, None);
+                let want = predict(&a, &x);
+                let got = render_hybrid(&gpu, &pipeline, vp, &tess, clip, &vectors, layout, &x).unwrap();
+                let c = compare(&want, &got);
+                let name = format!("hybrid-{vname}-{sname}-{term:?}");
+                eprintln!("{name}: PSNR {:.2} dB over {} pixels, {} coverage mismatches, {:.2} taps/row", c.psnr_db, c.both, c.coverage_mismatch, a.cols.len() as f64 / a.rows().max(1) as f64);
+                worst = worst.min(c.psnr_db);
+                if c.psnr_db < 60.0 || c.coverage_mismatch * 1000 > c.both || c.both < 500 {
+                    let dir = write_failure_images(&name, &want, &got);
+                    failures.push(format!("{name}: {c:?} (images in {})", dir.display()));
+                }
+            }
+        }
+    }
+    eprintln!("worst PSNR {worst:.2} dB");
+    assert!(failures.is_empty(), "{failures:#?}");
+}
