@@ -46,6 +46,11 @@ fn hybrid_frames_match_the_model() {
                 let a = hybrid_render_matrix(vp, &tess, clip, &vectors, layout, None);
                 let want = predict(&a, &x);
                 let got = render_hybrid(&gpu, &pipeline, vp, &tess, clip, &vectors, layout, &x).unwrap();
+                // The same frame twice: the same tessellation (pis-compile's tests) and pixels.
+                if sname == "sphere" {
+                    let again = render_hybrid(&gpu, &pipeline, vp, &tess, clip, &vectors, layout, &x).unwrap();
+                    assert!(again.rgba.iter().zip(&got.rgba).all(|(a, b)| a.to_bits() == b.to_bits()), "{vname} {term:?}: two draws differ");
+                }
                 let c = compare(&want, &got);
                 let name = format!("hybrid-{vname}-{sname}-{term:?}");
                 eprintln!("{name}: PSNR {:.2} dB over {} pixels, {} coverage mismatches, {:.2} taps/row", c.psnr_db, c.both, c.coverage_mismatch, a.cols.len() as f64 / a.rows().max(1) as f64);
