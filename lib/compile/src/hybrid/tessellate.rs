@@ -142,8 +142,8 @@ pub fn tessellate_timed(lens: &LensObject, view: &HybridView, settings: &Tessell
     let normal_of = |i: usize| lens.normals.get(i).copied().unwrap_or(Vec3::ZERO);
     let originals: Vec<(Vec3, Vec3)> = (0..lens.positions.len()).map(|i| (lens.positions[i], normal_of(i))).collect();
     mesh.vertices = originals.iter().map(|&(p, n)| HybridVertex { position: p, normal: n, visible: false, paths: [None, None] }).collect();
-    let todo: Vec<u32> = (0..lens.positions.len() as u32).filter(|&i| used[i as usize]).collect();
-    mesh.trace(&todo);
+    let front_vertices: Vec<u32> = (0..lens.positions.len() as u32).filter(|&i| used[i as usize]).collect();
+    mesh.trace(&front_vertices);
     // Split level by level.
     let mut current = front;
     let mut leaves = Vec::new();
