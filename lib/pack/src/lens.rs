@@ -20,13 +20,14 @@ pub fn lens_material(m: &Material) -> LensMaterial {
 
 /// Object `o` of `scene` at `frame` as a lens object: every primitive's triangles in world
 /// space, normals by the normal matrix (not renormalized, as pis-trace blends them), the
-/// material of its first primitive.
+/// material of its first primitive; an index past the scene's objects gives an empty lens
+/// object.
 pub fn lens_object(scene: &Scene, frame: &Frame, o: usize) -> LensObject {
     let m = frame.instances.get(o).map(|i| i.world_from_object).unwrap_or(glam::Mat4::IDENTITY);
     let normal_matrix = Mat3::from_mat4(m).inverse().transpose();
     let (mut positions, mut normals, mut indices) = (Vec::new(), Vec::new(), Vec::new());
     let mut material = None;
-    for prim in &scene.objects[o].primitives {
+    for prim in scene.objects.get(o).map_or(&[][..], |x| &x.primitives[..]) {
         let base = positions.len() as u32;
         positions.extend(prim.positions.iter().map(|&p| m.transform_point3(p)));
         normals.extend((0..prim.positions.len()).map(|k| prim.normals.get(k).map_or(Vec3::ZERO, |&n| normal_matrix * n)));

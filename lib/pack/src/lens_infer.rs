@@ -158,6 +158,9 @@ fn traced_rgb(scene: &Scene, render: &PointRender, o: usize, kind: LayerKind, n:
 /// Infers lens object `o`'s shells at every view of `views` (each its frame and the render
 /// traced there, with records).
 pub fn infer_lens(scene: &Scene, o: usize, views: &[(Frame, PointRender)], settings: &LensInferSettings) -> Result<LensInference> {
+    if o >= scene.objects.len() {
+        return Err(anyhow!("object {o}: the scene has {} objects", scene.objects.len()));
+    }
     let (w, h) = views.first().map(|(_, r)| (r.images.width, r.images.height)).ok_or_else(|| anyhow!("no views"))?;
     let lens0 = lens_object(scene, &views[0].0, o);
     let origin = lens0.centroid().as_dvec3();
