@@ -244,3 +244,49 @@ fn shells_inferred_at_the_sampled_views_reproduce_the_traced_terms() {
     }
     assert_eq!(result.shells.len(), 3);
 }
+
+/// Between the sampled views and 8° above them (pis-bench's camera paths), the lens
+/// object's terms drawn by the model from the two nearest samples' shells, blended, against
+/// frames traced at each camera: three layers against one.
+#[test]
+fn layered_shells_off_the_sampled_views() {
+    use pis_eval::bench::camera_path::{paths, PathKind};
+    use pis_pack::lens_infer::{infer_lens, predict_view, LensInferSettings};
+    let scene = glass_scene();
+    let o = scene.objects.iter().position(|x| x.role == ObjectRole::Refractive).expect("a lens object");
+    let mut settings = TraceSettings::new((160, 120), 4);
+    settings.records_per_pixel = 4;
+    let views: Vec<_> = (0..scene.space.dims[0].samples())
+        .map(|v| {
+            let frame = scene.frame(&[v]).expect("view");
+            let render = pis_trace::render_point(&scene, &frame, &settings, &|| {}).expect("traces");
+            (frame, render)
+        })
+        .collect();
+    let layered = infer_lens(&scene, o, &views, &LensInferSettings::default()).expect("infers");
+    let one = infer_lens(&scene, o, &views, &LensInferSettings { max_layers: 1, ..Default::default() }).expect("infers one layer");
+    let (_, frames) = paths(&scene, 7, &[PathKind::Between, PathKind::Away]).expect("paths");
+    let reference = TraceSettings::new((160, 120), 8);
+    let last = views.len() - 1;
+    let mut sums = std::collections::BTreeMap::new();
+    for pf in &frames {
+        let render = pis_trace::render_point(&scene, &pf.frame, &reference, &|| {}).expect("traces the reference");
+        // The two nearest view samples, blended by distance (thesis 6.4.2).
+        let k0 = (pf.view.floor() as usize).min(last);
+        let k1 = (k0 + 1).min(last);
+        let f = (pf.view - k0 as f32).clamp(0.0, 1.0);
+        let (_, _, a) = predict_view(&scene, o, &pf.frame, &render, &layered.shells, &[(&layered.views[k0].cubes, 1.0 - f), (&layered.views[k1].cubes, f)], &LensInferSettings::default());
+        let (_, _, b) = predict_view(&scene, o, &pf.frame, &render, &one.shells, &[(&one.views[k0].cubes, 1.0 - f), (&one.views[k1].cubes, f)], &LensInferSettings { max_layers: 1, ..Default::default() });
+        eprintln!("{:?} view {:.2}: layered {:.2} dB, one shell {:.2} dB over {} pixels", pf.kind, pf.view, a.psnr_db, b.psnr_db, a.pixels);
+        let e = sums.entry(format!("{:?}", pf.kind)).or_insert((0.0, 0.0, 0));
+        e.0 += a.psnr_db;
+        e.1 += b.psnr_db;
+        e.2 += 1;
+    }
+    for (kind, (a, b, n)) in &sums {
+        eprintln!("{kind}: layered {:.2} dB, one shell {:.2} dB (means of {n})", a / *n as f64, b / *n as f64);
+        // The layers' parallax: off the samples, the layered shells beat one shell.
+        assert!(a > b, "{kind}: layered {a}, one shell {b} (sums)");
+    }
+    assert_eq!(sums.len(), 2);
+}

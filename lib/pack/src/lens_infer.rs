@@ -213,54 +213,75 @@ pub fn infer_lens(scene: &Scene, o: usize, views: &[(Frame, PointRender)], setti
             }
             cubes.push(cube);
         }
-        // Prediction: shells composited over, times the interpolated F·G, per term.
-        let cover = render.images.object_layer(&scene.objects[o].name, LayerKind::Coverage).and_then(|l| l.channel("A")).map(|c| c.to_vec()).unwrap_or_else(|| vec![0.0; n]);
-        let mut predicted = [vec![0.0f32; n * 3], vec![0.0f32; n * 3]];
-        for (t, term) in TERMS.into_iter().enumerate() {
-            let modulation: Vec<Option<[f32; 3]>> = tess.vertices.iter().map(|v| v.paths[term as usize].map(|p| p.modulation.to_array())).collect();
-            let fg = hybrid_pixels(viewport, &tess, clip, &modulation, Missing::Zero, None);
-            let mut through = vec![1.0f32; n];
-            for (l, cube) in cubes.iter().enumerate() {
-                let m = &a[t][l];
-                let mut y = vec![0.0f32; m.rows() * 4];
-                for r in 0..m.rows() {
-                    let (c, v) = m.row(r);
-                    for (&col, &wgt) in c.iter().zip(v) {
-                        for ch in 0..4 {
-                            y[r * 4 + ch] += wgt * cube[col as usize * 4 + ch];
-                        }
-                    }
-                }
-                for r in 0..m.rows() {
-                    let p = m.pixels[r] as usize;
-                    for ch in 0..3 {
-                        predicted[t][p * 3 + ch] += through[p] * y[r * 4 + ch];
-                    }
-                    through[p] *= 1.0 - y[r * 4 + 3].clamp(0.0, 1.0);
-                }
-            }
-            let mut modulated = vec![0.0f32; n * 3];
-            for (&p, v) in fg.pixels.iter().zip(&fg.vectors) {
-                let f: DVec3 = v[0];
-                for ch in 0..3 {
-                    modulated[p as usize * 3 + ch] = predicted[t][p as usize * 3 + ch] * f[ch] as f32;
-                }
-            }
-            predicted[t] = modulated;
-        }
-        let traced = [traced_rgb(scene, render, o, LayerKind::Reflection, n), traced_rgb(scene, render, o, LayerKind::Refraction, n)];
-        let fit = |pred: &[f32], truth: &[f32]| {
-            let pixels: Vec<usize> = (0..n).filter(|&p| cover[p] > 0.5).collect();
-            let gather = |v: &[f32]| pixels.iter().flat_map(|&p| [v[p * 3], v[p * 3 + 1], v[p * 3 + 2]]).collect::<Vec<f32>>();
-            TermFit { psnr_db: psnr_display(&gather(pred), &gather(truth)), pixels: pixels.len() }
-        };
-        let sum = |a: &[f32], b: &[f32]| a.iter().zip(b).map(|(x, y)| x + y).collect::<Vec<f32>>();
-        out.push(LensView {
-            reflection: fit(&predicted[0], &traced[0]),
-            refraction: fit(&predicted[1], &traced[1]),
-            both: fit(&sum(&predicted[0], &predicted[1]), &sum(&traced[0], &traced[1])),
-            cubes,
-        });
+        let (reflection, refraction, both) = predict_view(scene, o, frame, render, &shells, &[(&cubes, 1.0)], settings);
+        out.push(LensView { reflection, refraction, both, cubes });
     }
     Ok(LensInference { layers, shells, views: out })
+}
+
+/// The lens object's two terms drawn at `frame` by hybrid rendering (the frame's own
+/// tessellation and vertex rays) from view samples' cube maps `samples` (each shell's cube
+/// per sample, with the sample's blending weight), against `render` traced at that frame:
+/// per term and for both, over the pixels the traced object covers.
+pub fn predict_view(scene: &Scene, o: usize, frame: &Frame, render: &PointRender, shells: &[FittedShell], samples: &[(&Vec<Vec<f32>>, f32)], settings: &LensInferSettings) -> (TermFit, TermFit, TermFit) {
+    let (w, h) = (render.images.width, render.images.height);
+    let (viewport, n) = (Viewport { width: w, height: h }, (w * h) as usize);
+    let layout = TextureLayout::cube(settings.face);
+    let lens = lens_object(scene, frame, o);
+    let camera = PerspectiveCamera::new(&frame.camera, (w, h));
+    let clip = projection_matrix(&frame.camera, (w, h)) * frame.camera.world_from_camera.inverse();
+    let tess = tessellate(&lens, &HybridView { eye: camera.origin, clip_from_world: clip, size: (w, h) }, &settings.tessellation);
+    let a: Vec<Vec<RenderMatrix>> = TERMS.iter().map(|&term| shells.iter().map(|s| hybrid_render_matrix(viewport, &tess, clip, &vertex_vectors(&tess, term, &s.shell), layout, None)).collect()).collect();
+    let cubes: Vec<Vec<f32>> = (0..shells.len())
+        .map(|l| {
+            let mut c = vec![0.0f32; layout.texel_count() * 4];
+            for (s, weight) in samples {
+                c.iter_mut().zip(&s[l]).for_each(|(x, v)| *x += weight * v);
+            }
+            c
+        })
+        .collect();
+    // Prediction: shells composited over, times the interpolated F·G, per term.
+    let cover = render.images.object_layer(&scene.objects[o].name, LayerKind::Coverage).and_then(|l| l.channel("A")).map(|c| c.to_vec()).unwrap_or_else(|| vec![0.0; n]);
+    let mut predicted = [vec![0.0f32; n * 3], vec![0.0f32; n * 3]];
+    for (t, term) in TERMS.into_iter().enumerate() {
+        let modulation: Vec<Option<[f32; 3]>> = tess.vertices.iter().map(|v| v.paths[term as usize].map(|p| p.modulation.to_array())).collect();
+        let fg = hybrid_pixels(viewport, &tess, clip, &modulation, Missing::Zero, None);
+        let mut through = vec![1.0f32; n];
+        for (l, cube) in cubes.iter().enumerate() {
+            let m = &a[t][l];
+            let mut y = vec![0.0f32; m.rows() * 4];
+            for r in 0..m.rows() {
+                let (c, v) = m.row(r);
+                for (&col, &wgt) in c.iter().zip(v) {
+                    for ch in 0..4 {
+                        y[r * 4 + ch] += wgt * cube[col as usize * 4 + ch];
+                    }
+                }
+            }
+            for r in 0..m.rows() {
+                let p = m.pixels[r] as usize;
+                for ch in 0..3 {
+                    predicted[t][p * 3 + ch] += through[p] * y[r * 4 + ch];
+                }
+                through[p] *= 1.0 - y[r * 4 + 3].clamp(0.0, 1.0);
+            }
+        }
+        let mut modulated = vec![0.0f32; n * 3];
+        for (&p, v) in fg.pixels.iter().zip(&fg.vectors) {
+            let f: DVec3 = v[0];
+            for ch in 0..3 {
+                modulated[p as usize * 3 + ch] = predicted[t][p as usize * 3 + ch] * f[ch] as f32;
+            }
+        }
+        predicted[t] = modulated;
+    }
+    let traced = [traced_rgb(scene, render, o, LayerKind::Reflection, n), traced_rgb(scene, render, o, LayerKind::Refraction, n)];
+    let fit = |pred: &[f32], truth: &[f32]| {
+        let pixels: Vec<usize> = (0..n).filter(|&p| cover[p] > 0.5).collect();
+        let gather = |v: &[f32]| pixels.iter().flat_map(|&p| [v[p * 3], v[p * 3 + 1], v[p * 3 + 2]]).collect::<Vec<f32>>();
+        TermFit { psnr_db: psnr_display(&gather(pred), &gather(truth)), pixels: pixels.len() }
+    };
+    let sum = |a: &[f32], b: &[f32]| a.iter().zip(b).map(|(x, y)| x + y).collect::<Vec<f32>>();
+    (fit(&predicted[0], &traced[0]), fit(&predicted[1], &traced[1]), fit(&sum(&predicted[0], &predicted[1]), &sum(&traced[0], &traced[1])))
 }
