@@ -158,51 +158,45 @@ fn traced_rgb(scene: &Scene, render: &PointRender, o: usize, kind: LayerKind, n:
 /// Infers lens object `o`'s shells at every view of `views` (each its frame and the render
 /// traced there, with records).
 pub fn infer_lens(scene: &Scene, o: usize, views: &[(Frame, PointRender)], settings: &LensInferSettings) -> Result<LensInference> {
+    let samples: Vec<Vec<&(Frame, PointRender)>> = views.iter().map(|v| vec![v]).collect();
+    infer_lens_nearby(scene, o, &samples, settings)
+}
+
+/// [`infer_lens`] with each view sample's shells solved simultaneously over several views
+/// near it (thesis 6.3.3.1: "a single EM layer inferred as a least-squares simultaneous match
+/// at all viewpoints"), so that parts of the environment the sample's own view does not see
+/// are filled from the others; the first view of each sample is the sample's, where the
+/// prediction is made. The layers are built from the outgoing rays of every view.
+pub fn infer_lens_nearby(scene: &Scene, o: usize, samples: &[Vec<&(Frame, PointRender)>], settings: &LensInferSettings) -> Result<LensInference> {
     if o >= scene.objects.len() {
         return Err(anyhow!("object {o}: the scene has {} objects", scene.objects.len()));
     }
-    let (w, h) = views.first().map(|(_, r)| (r.images.width, r.images.height)).ok_or_else(|| anyhow!("no views"))?;
-    let lens0 = lens_object(scene, &views[0].0, o);
+    let first = samples.first().and_then(|s| s.first()).ok_or_else(|| anyhow!("no views"))?;
+    let (w, h) = (first.1.images.width, first.1.images.height);
+    if samples.iter().flatten().any(|(_, r)| (r.images.width, r.images.height) != (w, h)) {
+        return Err(anyhow!("the views are traced at different sizes"));
+    }
+    let lens0 = lens_object(scene, &first.0, o);
     let origin = lens0.centroid().as_dvec3();
     let scale = lens0.positions.iter().map(|p| (p.as_dvec3() - origin).length()).fold(0.0, f64::max);
-    let rays: Vec<OutgoingRay> = views.iter().flat_map(|(_, r)| outgoing_rays(r, o)).collect();
+    let rays: Vec<OutgoingRay> = samples.iter().flatten().flat_map(|(_, r)| outgoing_rays(r, o)).collect();
     if rays.is_empty() {
         return Err(anyhow!("{}: the traced views hold no outgoing-ray records of the lens object", scene.objects[o].name));
     }
     let (layers, shells) = choose_layers(&rays, origin, settings.max_layers, scale);
     let layout = TextureLayout::cube(settings.face);
-    let viewport = Viewport { width: w, height: h };
-    let n = (w * h) as usize;
-    let mut out = Vec::with_capacity(views.len());
-    for (frame, render) in views {
-        let lens = lens_object(scene, frame, o);
-        let camera = PerspectiveCamera::new(&frame.camera, (w, h));
-        let clip = projection_matrix(&frame.camera, (w, h)) * frame.camera.world_from_camera.inverse();
-        let tess = tessellate(&lens, &HybridView { eye: camera.origin, clip_from_world: clip, size: (w, h) }, &settings.tessellation);
-        // Per term and shell: the full render matrix; per term the records' targets.
-        let mut a = Vec::new();
-        let mut targets = Vec::new();
-        for term in TERMS {
-            a.push(shells.iter().map(|s| hybrid_render_matrix(viewport, &tess, clip, &vertex_vectors(&tess, term, &s.shell), layout, None)).collect::<Vec<_>>());
-            let (kind, modulation) = if term == Term::ReflectionFirst { (LayerKind::Reflection, LayerKind::ReflectionModulation) } else { (LayerKind::Refraction, LayerKind::RefractionModulation) };
-            let (value, fg) = (traced_rgb(scene, render, o, kind, n), traced_rgb(scene, render, o, modulation, n));
-            let radiance: Vec<Option<Vec3>> = (0..n).map(|p| {
-                let f = Vec3::from_slice(&fg[p * 3..p * 3 + 3]);
-                (f.min_element() > 1e-3).then(|| Vec3::from_slice(&value[p * 3..p * 3 + 3]) / f)
-            }).collect();
-            targets.push(layer_targets(render, o, term, &layers, (w, h), &radiance));
-        }
-        // Per shell: colour and alpha solved over both terms' rows that have records.
-        let mut cubes = Vec::with_capacity(shells.len());
-        for l in 0..shells.len() {
-            let mut sub = Vec::new();
-            for t in 0..2 {
-                let (weight, per) = &targets[t];
-                let m = select_rows(&a[t][l], |p| weight[p as usize] > 0.0);
-                let rgb: Vec<f32> = m.pixels.iter().flat_map(|&p| (per[l][p as usize].1 / weight[p as usize]).to_array()).collect();
-                let alpha: Vec<f32> = m.pixels.iter().flat_map(|&p| [per[l][p as usize].0 / weight[p as usize], 0.0, 0.0]).collect();
-                sub.push((m, rgb, alpha));
+    let mut out = Vec::with_capacity(samples.len());
+    for sample in samples {
+        let (frame, render) = sample[0];
+        let mut sub_all: Vec<Vec<(RenderMatrix, Vec<f32>, Vec<f32>)>> = vec![Vec::new(); shells.len()];
+        for &(frame, render) in sample {
+            for (l, sub) in view_rows(scene, o, frame, render, &layers, &shells, settings).into_iter().enumerate() {
+                sub_all[l].extend(sub);
             }
+        }
+        // Per shell: colour and alpha solved over both terms' rows of every view.
+        let mut cubes = Vec::with_capacity(shells.len());
+        for sub in &sub_all {
             let colour = solve_view_independent(&sub.iter().map(|(m, rgb, _)| View { a: m, b: rgb }).collect::<Vec<_>>(), None, &settings.solve)?;
             let alpha = solve_view_independent(&sub.iter().map(|(m, _, al)| View { a: m, b: al }).collect::<Vec<_>>(), None, &settings.solve)?;
             let texels = layout.texel_count();
@@ -217,6 +211,44 @@ pub fn infer_lens(scene: &Scene, o: usize, views: &[(Frame, PointRender)], setti
         out.push(LensView { reflection, refraction, both, cubes });
     }
     Ok(LensInference { layers, shells, views: out })
+}
+
+/// One view's rows for each shell: per term, the render matrix's rows of the pixels the
+/// records reach, with their colour and alpha targets.
+fn view_rows(scene: &Scene, o: usize, frame: &Frame, render: &PointRender, layers: &Layers, shells: &[FittedShell], settings: &LensInferSettings) -> Vec<Vec<(RenderMatrix, Vec<f32>, Vec<f32>)>> {
+    let (w, h) = (render.images.width, render.images.height);
+    let (viewport, n) = (Viewport { width: w, height: h }, (w * h) as usize);
+    let layout = TextureLayout::cube(settings.face);
+    let lens = lens_object(scene, frame, o);
+    let camera = PerspectiveCamera::new(&frame.camera, (w, h));
+    let clip = projection_matrix(&frame.camera, (w, h)) * frame.camera.world_from_camera.inverse();
+    let tess = tessellate(&lens, &HybridView { eye: camera.origin, clip_from_world: clip, size: (w, h) }, &settings.tessellation);
+    // Per term and shell: the full render matrix; per term the records' targets.
+    let mut a = Vec::new();
+    let mut targets = Vec::new();
+    for term in TERMS {
+        a.push(shells.iter().map(|s| hybrid_render_matrix(viewport, &tess, clip, &vertex_vectors(&tess, term, &s.shell), layout, None)).collect::<Vec<_>>());
+        let (kind, modulation) = if term == Term::ReflectionFirst { (LayerKind::Reflection, LayerKind::ReflectionModulation) } else { (LayerKind::Refraction, LayerKind::RefractionModulation) };
+        let (value, fg) = (traced_rgb(scene, render, o, kind, n), traced_rgb(scene, render, o, modulation, n));
+        let radiance: Vec<Option<Vec3>> = (0..n).map(|p| {
+            let f = Vec3::from_slice(&fg[p * 3..p * 3 + 3]);
+            (f.min_element() > 1e-3).then(|| Vec3::from_slice(&value[p * 3..p * 3 + 3]) / f)
+        }).collect();
+        targets.push(layer_targets(render, o, term, layers, (w, h), &radiance));
+    }
+    (0..shells.len())
+        .map(|l| {
+            (0..2)
+                .map(|t| {
+                    let (weight, per) = &targets[t];
+                    let m = select_rows(&a[t][l], |p| weight[p as usize] > 0.0);
+                    let rgb: Vec<f32> = m.pixels.iter().flat_map(|&p| (per[l][p as usize].1 / weight[p as usize]).to_array()).collect();
+                    let alpha: Vec<f32> = m.pixels.iter().flat_map(|&p| [per[l][p as usize].0 / weight[p as usize], 0.0, 0.0]).collect();
+                    (m, rgb, alpha)
+                })
+                .collect()
+        })
+        .collect()
 }
 
 /// The lens object's two terms drawn at `frame` by hybrid rendering (the frame's own
