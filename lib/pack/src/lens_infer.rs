@@ -34,11 +34,14 @@ pub struct LensInferSettings {
     pub tessellation: TessellationSettings,
     pub max_layers: usize,
     pub solve: SolveSettings,
+    /// Weigh each pixel's rows by the traced confidence of its exit directions (thesis 6.3.3;
+    /// off by default: measured worse on the glass sample, docs/BENCHMARKS.md).
+    pub confidence: bool,
 }
 
 impl Default for LensInferSettings {
     fn default() -> Self {
-        LensInferSettings { face: 32, tessellation: TessellationSettings::default(), max_layers: 4, solve: SolveSettings::pyramidal() }
+        LensInferSettings { face: 32, tessellation: TessellationSettings::default(), max_layers: 4, solve: SolveSettings::pyramidal(), confidence: false }
     }
 }
 
@@ -236,14 +239,29 @@ fn view_rows(scene: &Scene, o: usize, frame: &Frame, render: &PointRender, layer
         }).collect();
         targets.push(layer_targets(render, o, term, layers, (w, h), &radiance));
     }
+    // Confidence (thesis 6.3.3): 1 − min(θm², θc²)/θc² from the spread of each pixel's exit
+    // directions, multiplied into both sides of each row.
+    let confidence: Vec<Vec<f32>> = [LayerKind::ReflectionConfidence, LayerKind::RefractionConfidence]
+        .iter()
+        .map(|&k| {
+            let plane = render.images.object_layer(&scene.objects[o].name, k).and_then(|l| l.channel("Y")).map(|c| c.to_vec());
+            plane.filter(|_| settings.confidence).unwrap_or_else(|| vec![1.0; n])
+        })
+        .collect();
     (0..shells.len())
         .map(|l| {
             (0..2)
                 .map(|t| {
                     let (weight, per) = &targets[t];
-                    let m = select_rows(&a[t][l], |p| weight[p as usize] > 0.0);
-                    let rgb: Vec<f32> = m.pixels.iter().flat_map(|&p| (per[l][p as usize].1 / weight[p as usize]).to_array()).collect();
-                    let alpha: Vec<f32> = m.pixels.iter().flat_map(|&p| [per[l][p as usize].0 / weight[p as usize], 0.0, 0.0]).collect();
+                    let c = &confidence[t];
+                    let mut m = select_rows(&a[t][l], |p| weight[p as usize] > 0.0 && c[p as usize] > 0.0);
+                    for r in 0..m.rows() {
+                        let k = c[m.pixels[r] as usize];
+                        let (lo, hi) = (m.row_start[r] as usize, m.row_start[r + 1] as usize);
+                        m.vals[lo..hi].iter_mut().for_each(|v| *v *= k);
+                    }
+                    let rgb: Vec<f32> = m.pixels.iter().flat_map(|&p| (per[l][p as usize].1 / weight[p as usize] * c[p as usize]).to_array()).collect();
+                    let alpha: Vec<f32> = m.pixels.iter().flat_map(|&p| [per[l][p as usize].0 / weight[p as usize] * c[p as usize], 0.0, 0.0]).collect();
                     (m, rgb, alpha)
                 })
                 .collect()
