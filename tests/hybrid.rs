@@ -299,9 +299,10 @@ fn layered_shells_off_the_sampled_views() {
         let k0 = (pf.view.floor() as usize).min(last);
         let k1 = (k0 + 1).min(last);
         let f = (pf.view - k0 as f32).clamp(0.0, 1.0);
-        let (_, _, a) = predict_view(&scene, o, &pf.frame, &render, &layered.shells, &[(&layered.views[k0].cubes, 1.0 - f), (&layered.views[k1].cubes, f)], &LensInferSettings::default());
-        let (_, _, b) = predict_view(&scene, o, &pf.frame, &render, &one.shells, &[(&one.views[k0].cubes, 1.0 - f), (&one.views[k1].cubes, f)], &LensInferSettings { max_layers: 1, ..Default::default() });
-        let (_, _, c) = predict_view(&scene, o, &pf.frame, &render, &simultaneous.shells, &[(&simultaneous.views[k0].cubes, 1.0 - f), (&simultaneous.views[k1].cubes, f)], &LensInferSettings::default());
+        let blend = [(k0, 1.0 - f), (k1, f)];
+        let (_, _, a) = predict_view(&scene, o, &pf.frame, &render, &layered, &blend, &LensInferSettings::default());
+        let (_, _, b) = predict_view(&scene, o, &pf.frame, &render, &one, &blend, &LensInferSettings { max_layers: 1, ..Default::default() });
+        let (_, _, c) = predict_view(&scene, o, &pf.frame, &render, &simultaneous, &blend, &LensInferSettings::default());
         eprintln!("{:?} view {:.2}: layered {:.2} dB, one shell {:.2} dB, layered over 5 views {:.2} dB over {} pixels", pf.kind, pf.view, a.psnr_db, b.psnr_db, c.psnr_db, a.pixels);
         let e = sums.entry(format!("{:?}", pf.kind)).or_insert((0.0, 0.0, 0, 0.0));
         e.0 += a.psnr_db;

@@ -29,8 +29,9 @@ use crate::lens::lens_object;
 /// What the inference is given and how it runs.
 #[derive(Clone, Debug)]
 pub struct LensInferSettings {
-    /// Cube-face size of every shell.
-    pub face: u32,
+    /// Cube-face size of every shell; `None`: the size at which the sample views' lookups
+    /// read the finest level about one texel per pixel ([`face_size`], thesis 5.8.2).
+    pub face: Option<u32>,
     pub tessellation: TessellationSettings,
     pub max_layers: usize,
     pub solve: SolveSettings,
@@ -41,7 +42,7 @@ pub struct LensInferSettings {
 
 impl Default for LensInferSettings {
     fn default() -> Self {
-        LensInferSettings { face: 32, tessellation: TessellationSettings::default(), max_layers: 4, solve: SolveSettings::pyramidal(), confidence: false }
+        LensInferSettings { face: None, tessellation: TessellationSettings::default(), max_layers: 4, solve: SolveSettings::pyramidal(), confidence: false }
     }
 }
 
@@ -65,6 +66,8 @@ pub struct LensView {
 
 #[derive(Clone, Debug)]
 pub struct LensInference {
+    /// The shells' cube-face size.
+    pub face: u32,
     pub layers: Layers,
     pub shells: Vec<FittedShell>,
     pub views: Vec<LensView>,
@@ -187,7 +190,12 @@ pub fn infer_lens_nearby(scene: &Scene, o: usize, samples: &[Vec<&(Frame, PointR
         return Err(anyhow!("{}: the traced views hold no outgoing-ray records of the lens object", scene.objects[o].name));
     }
     let (layers, shells) = choose_layers(&rays, origin, settings.max_layers, scale);
-    let layout = TextureLayout::cube(settings.face);
+    let face = match settings.face {
+        Some(f) => f,
+        None => face_size(scene, o, &samples.iter().map(|s| s[0]).collect::<Vec<_>>(), &shells, settings),
+    };
+    let settings = &LensInferSettings { face: Some(face), ..settings.clone() };
+    let layout = TextureLayout::cube(face);
     let mut out = Vec::with_capacity(samples.len());
     for sample in samples {
         let (frame, render) = sample[0];
@@ -210,10 +218,10 @@ pub fn infer_lens_nearby(scene: &Scene, o: usize, samples: &[Vec<&(Frame, PointR
             }
             cubes.push(cube);
         }
-        let (reflection, refraction, both) = predict_view(scene, o, frame, render, &shells, &[(&cubes, 1.0)], settings);
+        let (reflection, refraction, both) = predict_with(scene, o, frame, render, &shells, face, &[(&cubes, 1.0)], settings);
         out.push(LensView { reflection, refraction, both, cubes });
     }
-    Ok(LensInference { layers, shells, views: out })
+    Ok(LensInference { face, layers, shells, views: out })
 }
 
 /// One view's rows for each shell: per term, the render matrix's rows of the pixels the
@@ -221,7 +229,7 @@ pub fn infer_lens_nearby(scene: &Scene, o: usize, samples: &[Vec<&(Frame, PointR
 fn view_rows(scene: &Scene, o: usize, frame: &Frame, render: &PointRender, layers: &Layers, shells: &[FittedShell], settings: &LensInferSettings) -> Vec<Vec<(RenderMatrix, Vec<f32>, Vec<f32>)>> {
     let (w, h) = (render.images.width, render.images.height);
     let (viewport, n) = (Viewport { width: w, height: h }, (w * h) as usize);
-    let layout = TextureLayout::cube(settings.face);
+    let layout = TextureLayout::cube(settings.face.unwrap_or(32));
     let lens = lens_object(scene, frame, o);
     let camera = PerspectiveCamera::new(&frame.camera, (w, h));
     let clip = projection_matrix(&frame.camera, (w, h)) * frame.camera.world_from_camera.inverse();
@@ -269,14 +277,48 @@ fn view_rows(scene: &Scene, o: usize, frame: &Frame, render: &PointRender, layer
         .collect()
 }
 
+/// The cube-face size (a power of two, 8 to 256) at which the views' lookups of every shell
+/// and term read level 0 at about one texel per pixel: 2^(−λ₁), λ₁ the 10th percentile of
+/// the lookups' LOD on a one-texel face (thesis 5.8.2: "the most detailed MIPMAP level
+/// actually accessed").
+pub fn face_size(scene: &Scene, o: usize, views: &[&(Frame, PointRender)], shells: &[FittedShell], settings: &LensInferSettings) -> u32 {
+    const BIG: f64 = 1048576.0;
+    let mut lods = Vec::new();
+    for (frame, render) in views {
+        let (w, h) = (render.images.width, render.images.height);
+        let lens = lens_object(scene, frame, o);
+        let camera = PerspectiveCamera::new(&frame.camera, (w, h));
+        let clip = projection_matrix(&frame.camera, (w, h)) * frame.camera.world_from_camera.inverse();
+        let tess = tessellate(&lens, &HybridView { eye: camera.origin, clip_from_world: clip, size: (w, h) }, &settings.tessellation);
+        for term in TERMS {
+            for s in shells {
+                let px = hybrid_pixels(Viewport { width: w, height: h }, &tess, clip, &vertex_vectors(&tess, term, &s.shell), Missing::Mean, None);
+                lods.extend(px.vectors.iter().map(|&[d, dx, dy]| pis_compile::shell::cube::cube_lod(d, dx, dy, BIG, 64.0) - BIG.log2()));
+            }
+        }
+    }
+    if lods.is_empty() {
+        return 32;
+    }
+    lods.sort_by(f64::total_cmp);
+    let p10 = lods[lods.len() / 10];
+    2f64.powf((-p10).round().clamp(3.0, 8.0)) as u32
+}
+
 /// The lens object's two terms drawn at `frame` by hybrid rendering (the frame's own
-/// tessellation and vertex rays) from view samples' cube maps `samples` (each shell's cube
-/// per sample, with the sample's blending weight), against `render` traced at that frame:
-/// per term and for both, over the pixels the traced object covers.
-pub fn predict_view(scene: &Scene, o: usize, frame: &Frame, render: &PointRender, shells: &[FittedShell], samples: &[(&Vec<Vec<f32>>, f32)], settings: &LensInferSettings) -> (TermFit, TermFit, TermFit) {
+/// tessellation and vertex rays) from `inference`'s cube maps at view samples `samples`
+/// (sample index and blending weight), against `render` traced at that frame: per term and
+/// for both, over the pixels the traced object covers.
+pub fn predict_view(scene: &Scene, o: usize, frame: &Frame, render: &PointRender, inference: &LensInference, samples: &[(usize, f32)], settings: &LensInferSettings) -> (TermFit, TermFit, TermFit) {
+    let cubes: Vec<(&Vec<Vec<f32>>, f32)> = samples.iter().filter_map(|&(k, w)| inference.views.get(k).map(|v| (&v.cubes, w))).collect();
+    predict_with(scene, o, frame, render, &inference.shells, inference.face, &cubes, settings)
+}
+
+#[allow(clippy::too_many_arguments)]
+fn predict_with(scene: &Scene, o: usize, frame: &Frame, render: &PointRender, shells: &[FittedShell], face: u32, samples: &[(&Vec<Vec<f32>>, f32)], settings: &LensInferSettings) -> (TermFit, TermFit, TermFit) {
     let (w, h) = (render.images.width, render.images.height);
     let (viewport, n) = (Viewport { width: w, height: h }, (w * h) as usize);
-    let layout = TextureLayout::cube(settings.face);
+    let layout = TextureLayout::cube(face);
     let lens = lens_object(scene, frame, o);
     let camera = PerspectiveCamera::new(&frame.camera, (w, h));
     let clip = projection_matrix(&frame.camera, (w, h)) * frame.camera.world_from_camera.inverse();
