@@ -306,10 +306,14 @@ pub fn gather(pixels: &[u32], rgb: &[f32]) -> Vec<f32> {
 
 /// The rows of A whose pixels the tracer covers.
 pub fn restrict_rows(a: &RenderMatrix, cov: &[f32]) -> RenderMatrix {
+    select_rows(a, |p| !cov.get(p as usize).is_none_or(|&c| c <= 0.0))
+}
+
+/// The rows of `a` whose pixel `keep` marks, in their order.
+pub fn select_rows(a: &RenderMatrix, keep: impl Fn(u32) -> bool) -> RenderMatrix {
     let mut out = RenderMatrix { width: a.width, height: a.height, layout: a.layout, row_start: vec![0], ..Default::default() };
     for r in 0..a.rows() {
-        let p = a.pixels[r] as usize;
-        if cov.get(p).is_none_or(|&c| c <= 0.0) {
+        if !keep(a.pixels[r]) {
             continue;
         }
         let (c, v) = a.row(r);

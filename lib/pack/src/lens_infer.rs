@@ -23,7 +23,7 @@ use pis_trace::camera::{projection_matrix, PerspectiveCamera};
 use pis_trace::layers::LayerKind;
 use pis_trace::PointRender;
 
-use crate::infer::psnr_display;
+use crate::infer::{psnr_display, select_rows};
 use crate::lens::lens_object;
 
 /// What the inference is given and how it runs.
@@ -129,23 +129,6 @@ fn layer_targets(render: &PointRender, o: usize, term: Term, layers: &Layers, si
         }
     }
     (weight, per)
-}
-
-/// The rows of `a` whose pixel `keep` marks.
-fn select_rows(a: &RenderMatrix, keep: impl Fn(u32) -> bool) -> RenderMatrix {
-    let mut out = RenderMatrix { width: a.width, height: a.height, layout: a.layout, row_start: vec![0], ..Default::default() };
-    for r in 0..a.rows() {
-        if !keep(a.pixels[r]) {
-            continue;
-        }
-        let (c, v) = a.row(r);
-        out.cols.extend_from_slice(c);
-        out.vals.extend_from_slice(v);
-        out.row_start.push(out.cols.len() as u32);
-        out.pixels.push(a.pixels[r]);
-        out.coverage.push(a.coverage[r]);
-    }
-    out
 }
 
 /// A traced image's RGB at every pixel (zeros where the layer is missing).

@@ -13,7 +13,7 @@ use wgpu::util::DeviceExt;
 use crate::error::PlayError;
 use crate::gpu::Gpu;
 use crate::image::FloatImage;
-use crate::shell::{ShellTexture, SHELL_FUNCTIONS};
+use crate::shell::{object_pipelines, ShellTexture};
 use crate::textured::{DEPTH_FORMAT, TARGET_FORMAT};
 
 /// The hybrid pipeline's entry points.
@@ -36,68 +36,9 @@ pub struct HybridPipeline {
     depth_pipeline: wgpu::RenderPipeline,
 }
 
-fn vec3_at(location: u32) -> wgpu::VertexBufferLayout<'static> {
-    wgpu::VertexBufferLayout {
-        array_stride: 12,
-        step_mode: wgpu::VertexStepMode::Vertex,
-        attributes: if location == 0 {
-            &[wgpu::VertexAttribute { format: wgpu::VertexFormat::Float32x3, offset: 0, shader_location: 0 }]
-        } else {
-            &[wgpu::VertexAttribute { format: wgpu::VertexFormat::Float32x3, offset: 0, shader_location: 1 }]
-        },
-    }
-}
-
 impl HybridPipeline {
     pub fn new(gpu: &Gpu) -> HybridPipeline {
-        let device = &gpu.device;
-        let source = format!("{SHELL_FUNCTIONS}\n{HYBRID_OBJECT}");
-        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor { label: Some("hybrid_object.wgsl"), source: wgpu::ShaderSource::Wgsl(source.into()) });
-        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("hybrid"),
-            entries: &[
-                wgpu::BindGroupLayoutEntry {
-                    binding: 0,
-                    visibility: wgpu::ShaderStages::VERTEX_FRAGMENT,
-                    ty: wgpu::BindingType::Buffer { ty: wgpu::BufferBindingType::Uniform, has_dynamic_offset: false, min_binding_size: None },
-                    count: None,
-                },
-                wgpu::BindGroupLayoutEntry {
-                    binding: 1,
-                    visibility: wgpu::ShaderStages::FRAGMENT,
-                    ty: wgpu::BindingType::Texture { sample_type: wgpu::TextureSampleType::Float { filterable: false }, view_dimension: wgpu::TextureViewDimension::D2Array, multisampled: false },
-                    count: None,
-                },
-            ],
-        });
-        let pl = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor { label: Some("hybrid"), bind_group_layouts: &[Some(&layout)], immediate_size: 0 });
-        let primitive = wgpu::PrimitiveState { topology: wgpu::PrimitiveTopology::TriangleList, cull_mode: None, ..Default::default() };
-        let depth_state = wgpu::DepthStencilState {
-            format: DEPTH_FORMAT,
-            depth_write_enabled: Some(true),
-            depth_compare: Some(wgpu::CompareFunction::Less),
-            stencil: Default::default(),
-            bias: Default::default(),
-        };
-        let make = |label, vs, buffers: &[Option<wgpu::VertexBufferLayout>], fragment: Option<wgpu::FragmentState>| {
-            device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-                label: Some(label),
-                layout: Some(&pl),
-                vertex: wgpu::VertexState { module: &module, entry_point: Some(vs), compilation_options: Default::default(), buffers },
-                primitive,
-                depth_stencil: Some(depth_state.clone()),
-                multisample: Default::default(),
-                fragment,
-                multiview_mask: None,
-                cache: None,
-            })
-        };
-        let targets = [Some(wgpu::ColorTargetState { format: TARGET_FORMAT, blend: None, write_mask: wgpu::ColorWrites::ALL })];
-        let fragment = wgpu::FragmentState { module: &module, entry_point: Some("fs_hybrid"), compilation_options: Default::default(), targets: &targets };
-        let pipeline = make("hybrid", "vs_hybrid", &[Some(vec3_at(0)), Some(vec3_at(1))], Some(fragment));
-        let silent = [Some(wgpu::ColorTargetState { format: TARGET_FORMAT, blend: None, write_mask: wgpu::ColorWrites::empty() })];
-        let none = wgpu::FragmentState { module: &module, entry_point: Some("fs_hybrid_depth"), compilation_options: Default::default(), targets: &silent };
-        let depth_pipeline = make("hybrid depth", "vs_hybrid_depth", &[Some(vec3_at(0))], Some(none));
+        let (layout, pipeline, depth_pipeline) = object_pipelines(gpu, "hybrid_object.wgsl", HYBRID_OBJECT, ("vs_hybrid", "fs_hybrid"), ("vs_hybrid_depth", "fs_hybrid_depth"));
         HybridPipeline { layout, pipeline, depth_pipeline }
     }
 }

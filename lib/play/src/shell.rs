@@ -112,7 +112,8 @@ pub struct ShellPipeline {
     depth_pipeline: wgpu::RenderPipeline,
 }
 
-const VEC3_AT: fn(u32) -> wgpu::VertexBufferLayout<'static> = |location| wgpu::VertexBufferLayout {
+/// A vertex buffer of `Float32x3` at shader location `location` (0 or 1).
+pub(crate) const VEC3_AT: fn(u32) -> wgpu::VertexBufferLayout<'static> = |location| wgpu::VertexBufferLayout {
     array_stride: 12,
     step_mode: wgpu::VertexStepMode::Vertex,
     attributes: match location {
@@ -121,60 +122,70 @@ const VEC3_AT: fn(u32) -> wgpu::VertexBufferLayout<'static> = |location| wgpu::V
     },
 };
 
+/// The pipelines of one object drawn with one cube map over `shell.wgsl` and `entries`
+/// (WGSL appended to it): the bind group layout (binding 0 the uniforms, 1 the cube map), the
+/// colour pipeline (vertex entry `vs` with two `Float32x3` buffers, fragment `fs`) and the
+/// depth-only one (`vs_depth` over positions, `fs_depth`, no colour written); depth test
+/// `Less`, no culling.
+pub(crate) fn object_pipelines(gpu: &Gpu, label: &str, entries: &str, (vs, fs): (&str, &str), (vs_depth, fs_depth): (&str, &str)) -> (wgpu::BindGroupLayout, wgpu::RenderPipeline, wgpu::RenderPipeline) {
+    let device = &gpu.device;
+    let source = format!("{SHELL_FUNCTIONS}\n{entries}");
+    let module = device.create_shader_module(wgpu::ShaderModuleDescriptor { label: Some(label), source: wgpu::ShaderSource::Wgsl(source.into()) });
+    let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some(label),
+        entries: &[
+            wgpu::BindGroupLayoutEntry {
+                binding: 0,
+                visibility: wgpu::ShaderStages::VERTEX_FRAGMENT,
+                ty: wgpu::BindingType::Buffer { ty: wgpu::BufferBindingType::Uniform, has_dynamic_offset: false, min_binding_size: None },
+                count: None,
+            },
+            wgpu::BindGroupLayoutEntry {
+                binding: 1,
+                visibility: wgpu::ShaderStages::FRAGMENT,
+                ty: wgpu::BindingType::Texture {
+                    sample_type: wgpu::TextureSampleType::Float { filterable: false },
+                    view_dimension: wgpu::TextureViewDimension::D2Array,
+                    multisampled: false,
+                },
+                count: None,
+            },
+        ],
+    });
+    let pl = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor { label: Some(label), bind_group_layouts: &[Some(&layout)], immediate_size: 0 });
+    let primitive = wgpu::PrimitiveState { topology: wgpu::PrimitiveTopology::TriangleList, cull_mode: None, ..Default::default() };
+    let depth_state = wgpu::DepthStencilState {
+        format: DEPTH_FORMAT,
+        depth_write_enabled: Some(true),
+        depth_compare: Some(wgpu::CompareFunction::Less),
+        stencil: Default::default(),
+        bias: Default::default(),
+    };
+    let make = |vs, buffers: &[Option<wgpu::VertexBufferLayout>], fragment: Option<wgpu::FragmentState>| {
+        device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some(label),
+            layout: Some(&pl),
+            vertex: wgpu::VertexState { module: &module, entry_point: Some(vs), compilation_options: Default::default(), buffers },
+            primitive,
+            depth_stencil: Some(depth_state.clone()),
+            multisample: Default::default(),
+            fragment,
+            multiview_mask: None,
+            cache: None,
+        })
+    };
+    let targets = [Some(wgpu::ColorTargetState { format: TARGET_FORMAT, blend: None, write_mask: wgpu::ColorWrites::ALL })];
+    let fragment = wgpu::FragmentState { module: &module, entry_point: Some(fs), compilation_options: Default::default(), targets: &targets };
+    let pipeline = make(vs, &[Some(VEC3_AT(0)), Some(VEC3_AT(1))], Some(fragment));
+    let silent = [Some(wgpu::ColorTargetState { format: TARGET_FORMAT, blend: None, write_mask: wgpu::ColorWrites::empty() })];
+    let none = wgpu::FragmentState { module: &module, entry_point: Some(fs_depth), compilation_options: Default::default(), targets: &silent };
+    let depth_pipeline = make(vs_depth, &[Some(VEC3_AT(0))], Some(none));
+    (layout, pipeline, depth_pipeline)
+}
+
 impl ShellPipeline {
     pub fn new(gpu: &Gpu) -> ShellPipeline {
-        let device = &gpu.device;
-        let source = format!("{SHELL_FUNCTIONS}\n{SHELL_OBJECT}");
-        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor { label: Some("shell_object.wgsl"), source: wgpu::ShaderSource::Wgsl(source.into()) });
-        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("shell"),
-            entries: &[
-                wgpu::BindGroupLayoutEntry {
-                    binding: 0,
-                    visibility: wgpu::ShaderStages::VERTEX_FRAGMENT,
-                    ty: wgpu::BindingType::Buffer { ty: wgpu::BufferBindingType::Uniform, has_dynamic_offset: false, min_binding_size: None },
-                    count: None,
-                },
-                wgpu::BindGroupLayoutEntry {
-                    binding: 1,
-                    visibility: wgpu::ShaderStages::FRAGMENT,
-                    ty: wgpu::BindingType::Texture {
-                        sample_type: wgpu::TextureSampleType::Float { filterable: false },
-                        view_dimension: wgpu::TextureViewDimension::D2Array,
-                        multisampled: false,
-                    },
-                    count: None,
-                },
-            ],
-        });
-        let pl = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor { label: Some("shell"), bind_group_layouts: &[Some(&layout)], immediate_size: 0 });
-        let primitive = wgpu::PrimitiveState { topology: wgpu::PrimitiveTopology::TriangleList, cull_mode: None, ..Default::default() };
-        let depth_state = wgpu::DepthStencilState {
-            format: DEPTH_FORMAT,
-            depth_write_enabled: Some(true),
-            depth_compare: Some(wgpu::CompareFunction::Less),
-            stencil: Default::default(),
-            bias: Default::default(),
-        };
-        let make = |label, vs, buffers: &[Option<wgpu::VertexBufferLayout>], fragment: Option<wgpu::FragmentState>| {
-            device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-                label: Some(label),
-                layout: Some(&pl),
-                vertex: wgpu::VertexState { module: &module, entry_point: Some(vs), compilation_options: Default::default(), buffers },
-                primitive,
-                depth_stencil: Some(depth_state.clone()),
-                multisample: Default::default(),
-                fragment,
-                multiview_mask: None,
-                cache: None,
-            })
-        };
-        let targets = [Some(wgpu::ColorTargetState { format: TARGET_FORMAT, blend: None, write_mask: wgpu::ColorWrites::ALL })];
-        let fragment = wgpu::FragmentState { module: &module, entry_point: Some("fs_shell"), compilation_options: Default::default(), targets: &targets };
-        let pipeline = make("shell", "vs_shell", &[Some(VEC3_AT(0)), Some(VEC3_AT(1))], Some(fragment));
-        let silent = [Some(wgpu::ColorTargetState { format: TARGET_FORMAT, blend: None, write_mask: wgpu::ColorWrites::empty() })];
-        let none = wgpu::FragmentState { module: &module, entry_point: Some("fs_shell_depth"), compilation_options: Default::default(), targets: &silent };
-        let depth_pipeline = make("shell depth", "vs_shell_depth", &[Some(VEC3_AT(0))], Some(none));
+        let (layout, pipeline, depth_pipeline) = object_pipelines(gpu, "shell_object.wgsl", SHELL_OBJECT, ("vs_shell", "fs_shell"), ("vs_shell_depth", "fs_shell_depth"));
         ShellPipeline { layout, pipeline, depth_pipeline }
     }
 }

@@ -7,21 +7,10 @@
 mod common;
 
 use common::*;
-use glam::{DVec3, Vec3};
+use glam::Vec3;
 use pis_compile::hybrid::{hybrid_render_matrix, tessellate, vertex_vectors, HybridView, LensMaterial, LensObject, TessellationSettings, TERMS};
-use pis_compile::shell::{Shell, ShellShape};
 use pis_compile::{TextureLayout, Viewport};
 use pis_play::{render_hybrid, HybridPipeline};
-
-fn shells() -> Vec<(&'static str, Shell)> {
-    let o = DVec3::new(0.05, -0.1, 0.02);
-    vec![
-        ("sphere", Shell { origin: o, shape: ShellShape::Sphere { radius: 3.0 } }),
-        ("ellipsoid", Shell { origin: o, shape: ShellShape::Ellipsoid { radii: DVec3::new(1.6, 1.3, 1.5) } }),
-        ("box", Shell { origin: o, shape: ShellShape::Box { min: DVec3::new(-3.0, -1.3, -4.0), max: DVec3::new(4.0, 3.0, 3.5) } }),
-        ("cylinder", Shell { origin: o, shape: ShellShape::Cylinder { radius: 2.5, y_min: -1.3, y_max: 2.0 } }),
-    ]
-}
 
 #[test]
 fn hybrid_frames_match_the_model() {

@@ -8,8 +8,8 @@
 mod common;
 
 use common::*;
-use glam::{DVec3, Mat4, Vec3};
-use pis_compile::shell::{shell_render_matrix, Shell, ShellObject, ShellShape};
+use glam::{Mat4, Vec3};
+use pis_compile::shell::{shell_render_matrix, ShellObject};
 use pis_compile::{scene_depth, DrawMesh, TextureLayout, Viewport};
 use pis_play::{render_shell, ShellPipeline};
 
@@ -47,16 +47,6 @@ fn bumpy() -> (Vec<[f32; 3]>, Vec<[f32; 3]>, Vec<u32>) {
     }
     let normals = merged.iter().map(|n| n.normalize_or_zero().to_array()).collect();
     (positions, normals, m.indices)
-}
-
-fn shells() -> Vec<(&'static str, Shell)> {
-    let o = DVec3::new(0.05, -0.1, 0.02);
-    vec![
-        ("sphere", Shell { origin: o, shape: ShellShape::Sphere { radius: 3.0 } }),
-        ("ellipsoid", Shell { origin: o, shape: ShellShape::Ellipsoid { radii: DVec3::new(1.6, 1.3, 1.5) } }),
-        ("box", Shell { origin: o, shape: ShellShape::Box { min: DVec3::new(-3.0, -1.3, -4.0), max: DVec3::new(4.0, 3.0, 3.5) } }),
-        ("cylinder", Shell { origin: o, shape: ShellShape::Cylinder { radius: 2.5, y_min: -1.3, y_max: 2.0 } }),
-    ]
 }
 
 #[test]

@@ -6,7 +6,8 @@
 use std::f32::consts::PI;
 use std::path::PathBuf;
 
-use glam::{Mat4, Vec3};
+use glam::{DVec3, Mat4, Vec3};
+use pis_compile::shell::{Shell, ShellShape};
 use pis_compile::transform::{look_at, perspective};
 use pis_compile::{RenderMatrix, Viewport};
 use pis_play::{FloatImage, Gpu};
@@ -186,4 +187,16 @@ pub fn draw_scene(
     let colour = colour_image(&rc.read(gpu).unwrap(), format, size);
     let ids = ri.read(gpu).unwrap().chunks_exact(4).map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]])).collect();
     (colour, ids)
+}
+
+/// One shell of each shape (SPEC.md 7.3) about a point near the origin, sized for the unit
+/// test objects.
+pub fn shells() -> Vec<(&'static str, Shell)> {
+    let o = DVec3::new(0.05, -0.1, 0.02);
+    vec![
+        ("sphere", Shell { origin: o, shape: ShellShape::Sphere { radius: 3.0 } }),
+        ("ellipsoid", Shell { origin: o, shape: ShellShape::Ellipsoid { radii: DVec3::new(1.6, 1.3, 1.5) } }),
+        ("box", Shell { origin: o, shape: ShellShape::Box { min: DVec3::new(-3.0, -1.3, -4.0), max: DVec3::new(4.0, 3.0, 3.5) } }),
+        ("cylinder", Shell { origin: o, shape: ShellShape::Cylinder { radius: 2.5, y_min: -1.3, y_max: 2.0 } }),
+    ]
 }
