@@ -19,11 +19,27 @@ fn lens_object(scene: &Scene, frame: &pis_scene::Frame, o: usize) -> LensObject 
     pis_pack::lens::lens_object(scene, frame, o)
 }
 
+/// The scene's (first) refractive object.
+fn lens_index(scene: &Scene) -> usize {
+    scene.objects.iter().position(|x| x.role == ObjectRole::Refractive).expect("a lens object")
+}
+
+/// Every view sample traced with `settings`: its frame and render.
+fn traced_views(scene: &Scene, settings: &TraceSettings) -> Vec<(pis_scene::Frame, pis_trace::PointRender)> {
+    (0..scene.space.dims[0].samples())
+        .map(|v| {
+            let frame = scene.frame(&[v]).expect("view");
+            let render = pis_trace::render_point(scene, &frame, settings, &|| {}).expect("traces");
+            (frame, render)
+        })
+        .collect()
+}
+
 #[test]
 fn runtime_paths_leave_the_lens_where_the_tracer_records_say() {
     let scene = glass_scene();
     let frame = scene.frame(&[1]).expect("view 1");
-    let o = scene.objects.iter().position(|x| x.role == ObjectRole::Refractive).expect("a lens object");
+    let o = lens_index(&scene);
     let mut settings = TraceSettings::new((80, 60), 2);
     settings.records_per_pixel = 2;
     let render = pis_trace::render_point(&scene, &frame, &settings, &|| {}).expect("traces");
@@ -59,7 +75,7 @@ fn runtime_paths_leave_the_lens_where_the_tracer_records_say() {
 fn tessellation_is_deterministic_watertight_and_finer_for_smaller_tau() {
     let scene = glass_scene();
     let frame = scene.frame(&[0]).expect("view 0");
-    let o = scene.objects.iter().position(|x| x.role == ObjectRole::Refractive).expect("a lens object");
+    let o = lens_index(&scene);
     let lens = lens_object(&scene, &frame, o);
     let size = (320, 240);
     let camera = PerspectiveCamera::new(&frame.camera, size);
@@ -117,7 +133,7 @@ fn interpolated_shell_vectors_follow_the_paths_traced_at_each_pixel() {
     use pis_compile::{TextureLayout, Viewport};
     let scene = glass_scene();
     let frame = scene.frame(&[0]).expect("view 0");
-    let o = scene.objects.iter().position(|x| x.role == ObjectRole::Refractive).expect("a lens object");
+    let o = lens_index(&scene);
     let lens = lens_object(&scene, &frame, o);
     let size = (320, 240);
     let camera = PerspectiveCamera::new(&frame.camera, size);
@@ -174,7 +190,7 @@ fn the_glass_teapots_environment_clusters_into_layers_of_whole_objects() {
     use pis_compile::hybrid::{choose_layers, fit_shell, layer_hits, OutgoingRay};
     use pis_compile::shell::geometry::ShellShape;
     let scene = glass_scene();
-    let o = scene.objects.iter().position(|x| x.role == ObjectRole::Refractive).expect("a lens object");
+    let o = lens_index(&scene);
     let mut settings = TraceSettings::new((80, 60), 1);
     settings.records_per_pixel = 1;
     // Every view at once, so that the layers are the same for all of them (thesis 6.3.2).
@@ -220,16 +236,10 @@ fn the_glass_teapots_environment_clusters_into_layers_of_whole_objects() {
 fn shells_inferred_at_the_sampled_views_reproduce_the_traced_terms() {
     use pis_pack::lens_infer::{infer_lens, LensInferSettings};
     let scene = glass_scene();
-    let o = scene.objects.iter().position(|x| x.role == ObjectRole::Refractive).expect("a lens object");
+    let o = lens_index(&scene);
     let mut settings = TraceSettings::new((160, 120), 4);
     settings.records_per_pixel = 4;
-    let views: Vec<_> = (0..scene.space.dims[0].samples())
-        .map(|v| {
-            let frame = scene.frame(&[v]).expect("view");
-            let render = pis_trace::render_point(&scene, &frame, &settings, &|| {}).expect("traces");
-            (frame, render)
-        })
-        .collect();
+    let views = traced_views(&scene, &settings);
     let t = std::time::Instant::now();
     let result = infer_lens(&scene, o, &views, &LensInferSettings::default()).expect("infers");
     eprintln!("{} layers at {:?} ({:.1} s)", result.shells.len(), result.layers.distances, t.elapsed().as_secs_f64());
@@ -255,16 +265,10 @@ fn layered_shells_off_the_sampled_views() {
     use pis_eval::bench::camera_path::{paths, PathKind};
     use pis_pack::lens_infer::{infer_lens, predict_view, LensInferSettings};
     let scene = glass_scene();
-    let o = scene.objects.iter().position(|x| x.role == ObjectRole::Refractive).expect("a lens object");
+    let o = lens_index(&scene);
     let mut settings = TraceSettings::new((160, 120), 4);
     settings.records_per_pixel = 4;
-    let views: Vec<_> = (0..scene.space.dims[0].samples())
-        .map(|v| {
-            let frame = scene.frame(&[v]).expect("view");
-            let render = pis_trace::render_point(&scene, &frame, &settings, &|| {}).expect("traces");
-            (frame, render)
-        })
-        .collect();
+    let views = traced_views(&scene, &settings);
     let layered = infer_lens(&scene, o, &views, &LensInferSettings::default()).expect("infers");
     let one = infer_lens(&scene, o, &views, &LensInferSettings { max_layers: 1, ..Default::default() }).expect("infers one layer");
     // Thesis 6.3.3.1: each sample's shells solved over 5 views, its own and 3.5° and 7°
@@ -316,4 +320,29 @@ fn layered_shells_off_the_sampled_views() {
         assert!(a > b, "{kind}: layered {a}, one shell {b} (sums)");
     }
     assert_eq!(sums.len(), 2);
+}
+
+/// The runtime's copies of pis-trace's interface functions (pis-compile does not depend on
+/// the tracer) are the same functions: bit for bit over a grid of inputs.
+#[test]
+fn the_runtimes_interface_functions_are_the_tracers() {
+    use pis_compile::hybrid::lens::offset_origin;
+    use pis_compile::hybrid::path::{fresnel_dielectric, reflect, refract};
+    use pis_trace::material as m;
+    let mut compared = 0;
+    for i in 0..=40 {
+        let cos_i = -0.1 + i as f32 * 0.0275;
+        for eta in [1.0 / 1.5, 1.0 / 1.33, 1.0, 1.33, 1.5, 2.4] {
+            assert_eq!(fresnel_dielectric(cos_i, eta).to_bits(), m::fresnel_dielectric(cos_i, eta).to_bits(), "cos {cos_i}, eta {eta}");
+            let sin = (1.0 - cos_i * cos_i).max(0.0).sqrt();
+            let d = Vec3::new(sin, -cos_i, 0.3 * sin).normalize();
+            let n = Vec3::Y;
+            assert_eq!(reflect(d, n), m::reflect(d, n));
+            assert_eq!(refract(d, n, eta), m::refract(d, n, eta));
+            let p = d * (7.0 * cos_i) + Vec3::splat(eta);
+            assert_eq!(offset_origin(p, n, d), pis_trace::bvh::offset_origin(p, n, d));
+            compared += 1;
+        }
+    }
+    assert_eq!(compared, 41 * 6);
 }

@@ -15,7 +15,7 @@
 
 use anyhow::{anyhow, Result};
 use glam::{DVec3, Vec3};
-use pis_compile::hybrid::{choose_layers, hybrid_pixels, Missing, hybrid_render_matrix, tessellate, vertex_vectors, FittedShell, HybridView, Layers, OutgoingRay, Term, TessellationSettings, TERMS};
+use pis_compile::hybrid::{choose_layers, hybrid_pixels, Missing, Tessellation, hybrid_render_matrix, tessellate, vertex_vectors, FittedShell, HybridView, Layers, OutgoingRay, Term, TessellationSettings, TERMS};
 use pis_compile::solve::{solve_view_independent, View};
 use pis_compile::{RenderMatrix, SolveSettings, TextureLayout, Viewport};
 use pis_scene::{Frame, Scene};
@@ -30,7 +30,7 @@ use crate::lens::lens_object;
 #[derive(Clone, Debug)]
 pub struct LensInferSettings {
     /// Cube-face size of every shell; `None`: the size at which the sample views' lookups
-    /// read the finest level about one texel per pixel ([`face_size`], thesis 5.8.2).
+    /// read the finest level about one texel per pixel (thesis 5.8.2).
     pub face: Option<u32>,
     pub tessellation: TessellationSettings,
     pub max_layers: usize,
@@ -144,6 +144,34 @@ fn traced_rgb(scene: &Scene, render: &PointRender, o: usize, kind: LayerKind, n:
     out
 }
 
+/// A view as the model draws it: the frame's tessellation of the lens object (its vertex
+/// rays) and, once the face size is known, per term and shell the render matrix.
+struct ViewModel {
+    viewport: Viewport,
+    clip: glam::Mat4,
+    tess: Tessellation,
+    /// Per term, per shell.
+    a: Vec<Vec<RenderMatrix>>,
+}
+
+impl ViewModel {
+    /// The tessellation of `frame` at `size`, no matrices yet.
+    fn new(scene: &Scene, o: usize, frame: &Frame, size: (u32, u32), settings: &LensInferSettings) -> ViewModel {
+        let lens = lens_object(scene, frame, o);
+        let camera = PerspectiveCamera::new(&frame.camera, size);
+        let clip = projection_matrix(&frame.camera, size) * frame.camera.world_from_camera.inverse();
+        let tess = tessellate(&lens, &HybridView { eye: camera.origin, clip_from_world: clip, size }, &settings.tessellation);
+        ViewModel { viewport: Viewport { width: size.0, height: size.1 }, clip, tess, a: Vec::new() }
+    }
+
+    /// Per term and shell, the render matrix of cube faces of `face` texels.
+    fn with_matrices(mut self, shells: &[FittedShell], face: u32) -> ViewModel {
+        let layout = TextureLayout::cube(face);
+        self.a = TERMS.iter().map(|&term| shells.iter().map(|s| hybrid_render_matrix(self.viewport, &self.tess, self.clip, &vertex_vectors(&self.tess, term, &s.shell), layout, None)).collect()).collect();
+        self
+    }
+}
+
 /// Infers lens object `o`'s shells at every view of `views` (each its frame and the render
 /// traced there, with records).
 pub fn infer_lens(scene: &Scene, o: usize, views: &[(Frame, PointRender)], settings: &LensInferSettings) -> Result<LensInference> {
@@ -173,18 +201,20 @@ pub fn infer_lens_nearby(scene: &Scene, o: usize, samples: &[Vec<&(Frame, PointR
         return Err(anyhow!("{}: the traced views hold no outgoing-ray records of the lens object", scene.objects[o].name));
     }
     let (layers, shells) = choose_layers(&rays, origin, settings.max_layers, scale);
+    // Every view's tessellation, once: it serves the face size, the rows and the prediction.
+    let mut models: Vec<Vec<ViewModel>> = samples.iter().map(|s| s.iter().map(|(frame, _)| ViewModel::new(scene, o, frame, (w, h), settings)).collect()).collect();
     let face = match settings.face {
         Some(f) => f,
-        None => face_size(scene, o, &samples.iter().map(|s| s[0]).collect::<Vec<_>>(), &shells, settings),
+        None => face_size(&models.iter().map(|m| &m[0]).collect::<Vec<_>>(), &shells),
     };
-    let settings = &LensInferSettings { face: Some(face), ..settings.clone() };
+    models = models.into_iter().map(|m| m.into_iter().map(|v| v.with_matrices(&shells, face)).collect()).collect();
     let layout = TextureLayout::cube(face);
     let mut out = Vec::with_capacity(samples.len());
-    for sample in samples {
-        let (frame, render) = sample[0];
+    for (sample, models) in samples.iter().zip(&models) {
+        let (_, render) = sample[0];
         let mut sub_all: Vec<Vec<(RenderMatrix, Vec<f32>, Vec<f32>)>> = vec![Vec::new(); shells.len()];
-        for &(frame, render) in sample {
-            for (l, sub) in view_rows(scene, o, frame, render, &layers, &shells, settings).into_iter().enumerate() {
+        for (&(_, render), model) in sample.iter().zip(models) {
+            for (l, sub) in view_rows(scene, o, model, render, &layers, settings).into_iter().enumerate() {
                 sub_all[l].extend(sub);
             }
         }
@@ -201,7 +231,7 @@ pub fn infer_lens_nearby(scene: &Scene, o: usize, samples: &[Vec<&(Frame, PointR
             }
             cubes.push(cube);
         }
-        let (reflection, refraction, both) = predict_with(scene, o, frame, render, &shells, face, &[(&cubes, 1.0)], settings);
+        let (reflection, refraction, both) = predict_with(scene, o, &models[0], render, face, &[(&cubes, 1.0)]);
         out.push(LensView { reflection, refraction, both, cubes });
     }
     Ok(LensInference { face, layers, shells, views: out })
@@ -209,19 +239,12 @@ pub fn infer_lens_nearby(scene: &Scene, o: usize, samples: &[Vec<&(Frame, PointR
 
 /// One view's rows for each shell: per term, the render matrix's rows of the pixels the
 /// records reach, with their colour and alpha targets.
-fn view_rows(scene: &Scene, o: usize, frame: &Frame, render: &PointRender, layers: &Layers, shells: &[FittedShell], settings: &LensInferSettings) -> Vec<Vec<(RenderMatrix, Vec<f32>, Vec<f32>)>> {
+fn view_rows(scene: &Scene, o: usize, model: &ViewModel, render: &PointRender, layers: &Layers, settings: &LensInferSettings) -> Vec<Vec<(RenderMatrix, Vec<f32>, Vec<f32>)>> {
     let (w, h) = (render.images.width, render.images.height);
-    let (viewport, n) = (Viewport { width: w, height: h }, (w * h) as usize);
-    let layout = TextureLayout::cube(settings.face.unwrap_or(32));
-    let lens = lens_object(scene, frame, o);
-    let camera = PerspectiveCamera::new(&frame.camera, (w, h));
-    let clip = projection_matrix(&frame.camera, (w, h)) * frame.camera.world_from_camera.inverse();
-    let tess = tessellate(&lens, &HybridView { eye: camera.origin, clip_from_world: clip, size: (w, h) }, &settings.tessellation);
-    // Per term and shell: the full render matrix; per term the records' targets.
-    let mut a = Vec::new();
+    let n = (w * h) as usize;
+    // Per term, the records' targets.
     let mut targets = Vec::new();
     for term in TERMS {
-        a.push(shells.iter().map(|s| hybrid_render_matrix(viewport, &tess, clip, &vertex_vectors(&tess, term, &s.shell), layout, None)).collect::<Vec<_>>());
         let (kind, modulation) = if term == Term::ReflectionFirst { (LayerKind::Reflection, LayerKind::ReflectionModulation) } else { (LayerKind::Refraction, LayerKind::RefractionModulation) };
         let (value, fg) = (traced_rgb(scene, render, o, kind, n), traced_rgb(scene, render, o, modulation, n));
         let radiance: Vec<Option<Vec3>> = (0..n).map(|p| {
@@ -239,13 +262,13 @@ fn view_rows(scene: &Scene, o: usize, frame: &Frame, render: &PointRender, layer
             plane.filter(|_| settings.confidence).unwrap_or_else(|| vec![1.0; n])
         })
         .collect();
-    (0..shells.len())
+    (0..layers.distances.len())
         .map(|l| {
             (0..2)
                 .map(|t| {
                     let (weight, per) = &targets[t];
                     let c = &confidence[t];
-                    let mut m = select_rows(&a[t][l], |p| weight[p as usize] > 0.0 && c[p as usize] > 0.0);
+                    let mut m = select_rows(&model.a[t][l], |p| weight[p as usize] > 0.0 && c[p as usize] > 0.0);
                     for r in 0..m.rows() {
                         let k = c[m.pixels[r] as usize];
                         let (lo, hi) = (m.row_start[r] as usize, m.row_start[r + 1] as usize);
@@ -264,18 +287,13 @@ fn view_rows(scene: &Scene, o: usize, frame: &Frame, render: &PointRender, layer
 /// and term read level 0 at about one texel per pixel: 2^(−λ₁), λ₁ the 10th percentile of
 /// the lookups' LOD on a one-texel face (thesis 5.8.2: "the most detailed MIPMAP level
 /// actually accessed").
-pub fn face_size(scene: &Scene, o: usize, views: &[&(Frame, PointRender)], shells: &[FittedShell], settings: &LensInferSettings) -> u32 {
+fn face_size(views: &[&ViewModel], shells: &[FittedShell]) -> u32 {
     const BIG: f64 = 1048576.0;
     let mut lods = Vec::new();
-    for (frame, render) in views {
-        let (w, h) = (render.images.width, render.images.height);
-        let lens = lens_object(scene, frame, o);
-        let camera = PerspectiveCamera::new(&frame.camera, (w, h));
-        let clip = projection_matrix(&frame.camera, (w, h)) * frame.camera.world_from_camera.inverse();
-        let tess = tessellate(&lens, &HybridView { eye: camera.origin, clip_from_world: clip, size: (w, h) }, &settings.tessellation);
+    for v in views {
         for term in TERMS {
             for s in shells {
-                let px = hybrid_pixels(Viewport { width: w, height: h }, &tess, clip, &vertex_vectors(&tess, term, &s.shell), Missing::Mean, None);
+                let px = hybrid_pixels(v.viewport, &v.tess, v.clip, &vertex_vectors(&v.tess, term, &s.shell), Missing::Mean, None);
                 lods.extend(px.vectors.iter().map(|&[d, dx, dy]| pis_compile::shell::cube::cube_lod(d, dx, dy, BIG, 64.0) - BIG.log2()));
             }
         }
@@ -294,20 +312,17 @@ pub fn face_size(scene: &Scene, o: usize, views: &[&(Frame, PointRender)], shell
 /// for both, over the pixels the traced object covers.
 pub fn predict_view(scene: &Scene, o: usize, frame: &Frame, render: &PointRender, inference: &LensInference, samples: &[(usize, f32)], settings: &LensInferSettings) -> (TermFit, TermFit, TermFit) {
     let cubes: Vec<(&Vec<Vec<f32>>, f32)> = samples.iter().filter_map(|&(k, w)| inference.views.get(k).map(|v| (&v.cubes, w))).collect();
-    predict_with(scene, o, frame, render, &inference.shells, inference.face, &cubes, settings)
+    let model = ViewModel::new(scene, o, frame, (render.images.width, render.images.height), settings).with_matrices(&inference.shells, inference.face);
+    predict_with(scene, o, &model, render, inference.face, &cubes)
 }
 
-#[allow(clippy::too_many_arguments)]
-fn predict_with(scene: &Scene, o: usize, frame: &Frame, render: &PointRender, shells: &[FittedShell], face: u32, samples: &[(&Vec<Vec<f32>>, f32)], settings: &LensInferSettings) -> (TermFit, TermFit, TermFit) {
+/// [`predict_view`] with the view's model made.
+fn predict_with(scene: &Scene, o: usize, model: &ViewModel, render: &PointRender, face: u32, samples: &[(&Vec<Vec<f32>>, f32)]) -> (TermFit, TermFit, TermFit) {
     let (w, h) = (render.images.width, render.images.height);
-    let (viewport, n) = (Viewport { width: w, height: h }, (w * h) as usize);
+    let n = (w * h) as usize;
     let layout = TextureLayout::cube(face);
-    let lens = lens_object(scene, frame, o);
-    let camera = PerspectiveCamera::new(&frame.camera, (w, h));
-    let clip = projection_matrix(&frame.camera, (w, h)) * frame.camera.world_from_camera.inverse();
-    let tess = tessellate(&lens, &HybridView { eye: camera.origin, clip_from_world: clip, size: (w, h) }, &settings.tessellation);
-    let a: Vec<Vec<RenderMatrix>> = TERMS.iter().map(|&term| shells.iter().map(|s| hybrid_render_matrix(viewport, &tess, clip, &vertex_vectors(&tess, term, &s.shell), layout, None)).collect()).collect();
-    let cubes: Vec<Vec<f32>> = (0..shells.len())
+    let (viewport, clip, tess, a) = (model.viewport, model.clip, &model.tess, &model.a);
+    let cubes: Vec<Vec<f32>> = (0..a.first().map_or(0, Vec::len))
         .map(|l| {
             let mut c = vec![0.0f32; layout.texel_count() * 4];
             for (s, weight) in samples {
@@ -321,7 +336,7 @@ fn predict_with(scene: &Scene, o: usize, frame: &Frame, render: &PointRender, sh
     let mut predicted = [vec![0.0f32; n * 3], vec![0.0f32; n * 3]];
     for (t, term) in TERMS.into_iter().enumerate() {
         let modulation: Vec<Option<[f32; 3]>> = tess.vertices.iter().map(|v| v.paths[term as usize].map(|p| p.modulation.to_array())).collect();
-        let fg = hybrid_pixels(viewport, &tess, clip, &modulation, Missing::Zero, None);
+        let fg = hybrid_pixels(viewport, tess, clip, &modulation, Missing::Zero, None);
         let mut through = vec![1.0f32; n];
         for (l, cube) in cubes.iter().enumerate() {
             let m = &a[t][l];

@@ -39,13 +39,11 @@ pub struct Layers {
     pub distances: Vec<f64>,
     /// Each environment object's layer.
     pub layer_of: BTreeMap<u32, usize>,
-    /// Σ ((distance − its object's layer distance) / distance)² over every hit, and their
-    /// number.
-    pub error: f64,
+    /// The hits clustered (every hit of every ray, hidden ones too).
     pub counted: usize,
 }
 
-/// Where hit `k` of `ray` lies, and its distance from `origin`.
+/// The distance from `origin` of the point at `t` along `ray`.
 fn hit_distance(ray: &OutgoingRay, t: f64, origin: DVec3) -> f64 {
     (ray.origin + ray.direction * t - origin).length()
 }
@@ -56,7 +54,7 @@ fn hit_distance(ray: &OutgoingRay, t: f64, origin: DVec3) -> f64 {
 pub fn cluster(rays: &[OutgoingRay], origin: DVec3, n: usize) -> Layers {
     let mut all: Vec<(f64, u32)> = rays.iter().flat_map(|r| r.hits.iter().map(move |&(t, o)| (hit_distance(r, t, origin), o))).collect();
     if all.is_empty() || n == 0 {
-        return Layers { distances: Vec::new(), layer_of: BTreeMap::new(), error: 0.0, counted: 0 };
+        return Layers { distances: Vec::new(), layer_of: BTreeMap::new(), counted: 0 };
     }
     all.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
     let n = n.min(all.len());
@@ -108,18 +106,8 @@ fn finish_layers(rays: &[OutgoingRay], mut layer_of: BTreeMap<u32, usize>, origi
     let renumber: BTreeMap<usize, usize> = kept.iter().enumerate().map(|(new, &(_, old))| (old, new)).collect();
     layer_of.values_mut().for_each(|l| *l = renumber[l]);
     let distances: Vec<f64> = kept.iter().map(|k| k.0).collect();
-    // The error counts every hit, hidden ones too (the layers must hold what the views
-    // between the samples uncover), relative to the hit's distance.
-    let mut error = 0.0;
-    let mut count = 0;
-    for r in rays {
-        for &(t, o) in &r.hits {
-            let d = hit_distance(r, t, origin);
-            error += ((d - distances[layer_of[&o]]) / d.max(1e-9)).powi(2);
-            count += 1;
-        }
-    }
-    Layers { distances, layer_of, error, counted: count }
+    let counted = rays.iter().map(|r| r.hits.len()).sum();
+    Layers { distances, layer_of, counted }
 }
 
 /// The number of layers (1..=`max`) after which one more no longer halves the error of the
@@ -166,7 +154,8 @@ fn refine(rays: &[OutgoingRay], mut layers: Layers, origin: DVec3, scale: f64) -
         if moved == layers.layer_of {
             break;
         }
-        let next = relayer(rays, moved, origin);
+        let n = moved.values().max().map_or(0, |m| m + 1);
+        let next = finish_layers(rays, moved, origin, n);
         let next_shells = fitted(&next);
         if next_shells.len() != next.distances.len() {
             break;
@@ -174,13 +163,6 @@ fn refine(rays: &[OutgoingRay], mut layers: Layers, origin: DVec3, scale: f64) -
         (layers, shells) = (next, next_shells);
     }
     (layers, shells)
-}
-
-/// Layers from an assignment of objects to layers: empty layers dropped, the rest ordered by
-/// their mean distance (frontmost hit of each ray in each), the error recomputed.
-fn relayer(rays: &[OutgoingRay], layer_of: BTreeMap<u32, usize>, origin: DVec3) -> Layers {
-    let n = layer_of.values().max().map_or(0, |m| m + 1);
-    finish_layers(rays, layer_of, origin, n)
 }
 
 /// How far the shells put the environment from where it is: over every hit of every ray

@@ -139,9 +139,9 @@ pub fn tessellate_timed(lens: &LensObject, view: &HybridView, settings: &Tessell
     let mut used = vec![false; lens.positions.len()];
     front.iter().flatten().for_each(|&v| used[v as usize] = true);
     let mut mesh = Mesh { lens, view, settings, vertices: Vec::new(), midpoints: HashMap::new(), stats, trace_time: Duration::ZERO };
-    let normal_of = |i: usize| lens.normals.get(i).copied().unwrap_or(Vec3::ZERO);
-    let originals: Vec<(Vec3, Vec3)> = (0..lens.positions.len()).map(|i| (lens.positions[i], normal_of(i))).collect();
-    mesh.vertices = originals.iter().map(|&(p, n)| HybridVertex { position: p, normal: n, visible: false, paths: [None, None] }).collect();
+    mesh.vertices = (0..lens.positions.len())
+        .map(|i| HybridVertex { position: lens.positions[i], normal: lens.normals.get(i).copied().unwrap_or(Vec3::ZERO), visible: false, paths: [None, None] })
+        .collect();
     let front_vertices: Vec<u32> = (0..lens.positions.len() as u32).filter(|&i| used[i as usize]).collect();
     mesh.trace(&front_vertices);
     // Split level by level.
