@@ -74,13 +74,17 @@ pub struct PackOptions {
     /// `combined` (one view-dependent layer of diffuse + specular per parameter sample).
     #[arg(long, default_value = "separate", value_parser = parse_layers)]
     pub layers: LayerMode,
-    /// Reflective objects: `auto` (per object, textures or layered environment maps,
-    /// whichever meets the target with fewer bytes: both are solved and the file encoded
-    /// with each), `texture` (parameterized surface textures), `pem` (layered
-    /// environment maps, thesis ch. 5: a local and a distant shell per parameter sample),
-    /// `pem-infinity` (one environment map at infinity per sample, inferred: the single-shell
-    /// baseline) or `static-env` (one environment map at infinity per sample, ray-traced from
-    /// the object's centre without the object: the static environment map of thesis 5.1).
+    /// Reflective and refractive objects: `auto` (per object, textures or environment-map
+    /// shells, whichever meets the target with fewer bytes: both are solved and the file
+    /// encoded with each), `texture` (parameterized surface textures), `pem` (reflective
+    /// objects as layered environment maps, thesis ch. 5: a local and a distant shell per
+    /// parameter sample; refractive objects by hybrid rendering, thesis ch. 6: shells from
+    /// the set's ray records, looked up through the lens object's vertex rays traced each
+    /// frame), `pem-infinity` (reflective objects as one environment map at infinity per
+    /// sample, inferred: the single-shell baseline) or `static-env` (reflective objects as one
+    /// environment map at infinity per sample, ray-traced from the object's centre without
+    /// the object: the static environment map of thesis 5.1); the last two store refractive
+    /// objects as `pem` does.
     #[arg(long, default_value = "texture", value_parser = parse_representation)]
     pub representation: RepresentationMode,
     /// Conjugate-gradient iteration cap per colour channel of every texture solve

@@ -14,14 +14,14 @@
 //! confidence weights, the cube-face size from the finest level the frames read (5.8.2).
 
 use anyhow::{anyhow, Result};
-use glam::{DVec3, Vec3};
-use pis_compile::hybrid::{choose_layers, hybrid_pixels, Missing, Tessellation, hybrid_render_matrix, tessellate, vertex_vectors, FittedShell, HybridView, Layers, OutgoingRay, Term, TessellationSettings, TERMS};
+use glam::Vec3;
+use pis_compile::hybrid::{choose_layers, hybrid_pixels, hybrid_render_matrix, tessellate, term_radiance, vertex_modulation, vertex_vectors, FittedShell, HybridPixels, HybridView, Layers, Missing, OutgoingRay, Tessellation, Term, TessellationSettings, TERMS};
 use pis_compile::solve::{solve_view_independent, View};
 use pis_compile::{RenderMatrix, SolveSettings, TextureLayout, Viewport};
 use pis_scene::{Frame, Scene};
 use pis_trace::camera::{projection_matrix, PerspectiveCamera};
 use pis_trace::layers::LayerKind;
-use pis_trace::PointRender;
+use pis_trace::{PointImages, PointRender, RayRecord};
 
 use crate::infer::{psnr_display, select_rows};
 use crate::lens::lens_object;
@@ -71,10 +71,27 @@ pub struct LensInference {
     pub layers: Layers,
     pub shells: Vec<FittedShell>,
     pub views: Vec<LensView>,
+    /// Per view sample, its own view as the model draws it.
+    pub models: Vec<LensViewModel>,
+}
+
+/// One traced view of a lens object: its frame, the traced images and the outgoing-ray
+/// records.
+#[derive(Clone, Copy)]
+pub struct TracedView<'a> {
+    pub frame: &'a Frame,
+    pub images: &'a PointImages,
+    pub records: &'a [RayRecord],
+}
+
+impl<'a> From<&'a (Frame, PointRender)> for TracedView<'a> {
+    fn from(v: &'a (Frame, PointRender)) -> Self {
+        TracedView { frame: &v.0, images: &v.1.images, records: &v.1.records }
+    }
 }
 
 /// Object `o`'s outgoing rays in `render`'s records.
-fn outgoing_rays(render: &PointRender, o: usize) -> Vec<OutgoingRay> {
+fn outgoing_rays(render: &TracedView, o: usize) -> Vec<OutgoingRay> {
     render
         .records
         .iter()
@@ -89,7 +106,7 @@ fn outgoing_rays(render: &PointRender, o: usize) -> Vec<OutgoingRay> {
 /// layer). A record's first hit takes the radiance the traced term holds along the pixel's
 /// outgoing rays (the term over its F·G, the tracer's many-sample estimate) where that is
 /// defined; hidden hits keep the record's own one-sample colour.
-fn layer_targets(render: &PointRender, o: usize, term: Term, layers: &Layers, size: (u32, u32), radiance: &[Option<Vec3>]) -> (Vec<f32>, Vec<Vec<(f32, Vec3)>>) {
+fn layer_targets(render: &TracedView, o: usize, term: Term, layers: &Layers, size: (u32, u32), radiance: &[Option<Vec3>]) -> (Vec<f32>, Vec<Vec<(f32, Vec3)>>) {
     const SIGMA: f32 = 0.5;
     const RADIUS: f32 = 1.5;
     let n = (size.0 * size.1) as usize;
@@ -132,9 +149,9 @@ fn layer_targets(render: &PointRender, o: usize, term: Term, layers: &Layers, si
 }
 
 /// A traced image's RGB at every pixel (zeros where the layer is missing).
-fn traced_rgb(scene: &Scene, render: &PointRender, o: usize, kind: LayerKind, n: usize) -> Vec<f32> {
+fn traced_rgb(scene: &Scene, images: &PointImages, o: usize, kind: LayerKind, n: usize) -> Vec<f32> {
     let mut out = vec![0.0f32; n * 3];
-    if let Some(l) = render.images.object_layer(&scene.objects[o].name, kind) {
+    if let Some(l) = images.object_layer(&scene.objects[o].name, kind) {
         for (c, name) in ["R", "G", "B"].iter().enumerate() {
             if let Some(p) = l.channel(name) {
                 (0..n).for_each(|k| out[k * 3 + c] = p[k]);
@@ -146,15 +163,18 @@ fn traced_rgb(scene: &Scene, render: &PointRender, o: usize, kind: LayerKind, n:
 
 /// A view as the model draws it: the frame's tessellation of the lens object (its vertex
 /// rays) and, once the face size is known, per term and shell the render matrix.
-struct ViewModel {
-    viewport: Viewport,
-    clip: glam::Mat4,
-    tess: Tessellation,
+#[derive(Clone, Debug)]
+pub struct LensViewModel {
+    pub viewport: Viewport,
+    pub clip: glam::Mat4,
+    pub tess: Tessellation,
     /// Per term, per shell.
-    a: Vec<Vec<RenderMatrix>>,
+    pub a: Vec<Vec<RenderMatrix>>,
 }
 
-impl ViewModel {
+type ViewModel = LensViewModel;
+
+impl LensViewModel {
     /// The tessellation of `frame` at `size`, no matrices yet.
     fn new(scene: &Scene, o: usize, frame: &Frame, size: (u32, u32), settings: &LensInferSettings) -> ViewModel {
         let lens = lens_object(scene, frame, o);
@@ -175,8 +195,8 @@ impl ViewModel {
 /// Infers lens object `o`'s shells at every view of `views` (each its frame and the render
 /// traced there, with records).
 pub fn infer_lens(scene: &Scene, o: usize, views: &[(Frame, PointRender)], settings: &LensInferSettings) -> Result<LensInference> {
-    let samples: Vec<Vec<&(Frame, PointRender)>> = views.iter().map(|v| vec![v]).collect();
-    infer_lens_nearby(scene, o, &samples, settings)
+    let samples: Vec<Vec<TracedView>> = views.iter().map(|v| vec![TracedView::from(v)]).collect();
+    infer_lens_views(scene, o, &samples, settings)
 }
 
 /// [`infer_lens`] with each view sample's shells solved simultaneously over several views
@@ -185,24 +205,30 @@ pub fn infer_lens(scene: &Scene, o: usize, views: &[(Frame, PointRender)], setti
 /// are filled from the others; the first view of each sample is the sample's, where the
 /// prediction is made. The layers are built from the outgoing rays of every view.
 pub fn infer_lens_nearby(scene: &Scene, o: usize, samples: &[Vec<&(Frame, PointRender)>], settings: &LensInferSettings) -> Result<LensInference> {
+    let samples: Vec<Vec<TracedView>> = samples.iter().map(|s| s.iter().map(|&v| TracedView::from(v)).collect()).collect();
+    infer_lens_views(scene, o, &samples, settings)
+}
+
+/// [`infer_lens_nearby`] over traced views held anywhere (a set's images and records).
+pub fn infer_lens_views(scene: &Scene, o: usize, samples: &[Vec<TracedView>], settings: &LensInferSettings) -> Result<LensInference> {
     if o >= scene.objects.len() {
         return Err(anyhow!("object {o}: the scene has {} objects", scene.objects.len()));
     }
     let first = samples.first().and_then(|s| s.first()).ok_or_else(|| anyhow!("no views"))?;
-    let (w, h) = (first.1.images.width, first.1.images.height);
-    if samples.iter().flatten().any(|(_, r)| (r.images.width, r.images.height) != (w, h)) {
+    let (w, h) = (first.images.width, first.images.height);
+    if samples.iter().flatten().any(|r| (r.images.width, r.images.height) != (w, h)) {
         return Err(anyhow!("the views are traced at different sizes"));
     }
-    let lens0 = lens_object(scene, &first.0, o);
+    let lens0 = lens_object(scene, first.frame, o);
     let origin = lens0.centroid().as_dvec3();
     let scale = lens0.positions.iter().map(|p| (p.as_dvec3() - origin).length()).fold(0.0, f64::max);
-    let rays: Vec<OutgoingRay> = samples.iter().flatten().flat_map(|(_, r)| outgoing_rays(r, o)).collect();
+    let rays: Vec<OutgoingRay> = samples.iter().flatten().flat_map(|r| outgoing_rays(r, o)).collect();
     if rays.is_empty() {
         return Err(anyhow!("{}: the traced views hold no outgoing-ray records of the lens object", scene.objects[o].name));
     }
     let (layers, shells) = choose_layers(&rays, origin, settings.max_layers, scale);
     // Every view's tessellation, once: it serves the face size, the rows and the prediction.
-    let mut models: Vec<Vec<ViewModel>> = samples.iter().map(|s| s.iter().map(|(frame, _)| ViewModel::new(scene, o, frame, (w, h), settings)).collect()).collect();
+    let mut models: Vec<Vec<ViewModel>> = samples.iter().map(|s| s.iter().map(|v| ViewModel::new(scene, o, v.frame, (w, h), settings)).collect()).collect();
     let face = match settings.face {
         Some(f) => f,
         None => face_size(&models.iter().map(|m| &m[0]).collect::<Vec<_>>(), &shells),
@@ -211,9 +237,9 @@ pub fn infer_lens_nearby(scene: &Scene, o: usize, samples: &[Vec<&(Frame, PointR
     let layout = TextureLayout::cube(face);
     let mut out = Vec::with_capacity(samples.len());
     for (sample, models) in samples.iter().zip(&models) {
-        let (_, render) = sample[0];
+        let render = &sample[0];
         let mut sub_all: Vec<Vec<(RenderMatrix, Vec<f32>, Vec<f32>)>> = vec![Vec::new(); shells.len()];
-        for (&(_, render), model) in sample.iter().zip(models) {
+        for (render, model) in sample.iter().zip(models) {
             for (l, sub) in view_rows(scene, o, model, render, &layers, settings).into_iter().enumerate() {
                 sub_all[l].extend(sub);
             }
@@ -231,22 +257,23 @@ pub fn infer_lens_nearby(scene: &Scene, o: usize, samples: &[Vec<&(Frame, PointR
             }
             cubes.push(cube);
         }
-        let (reflection, refraction, both) = predict_with(scene, o, &models[0], render, face, &[(&cubes, 1.0)]);
+        let (reflection, refraction, both) = predict_with(scene, o, &models[0], render.images, face, &[(&cubes, 1.0)]);
         out.push(LensView { reflection, refraction, both, cubes });
     }
-    Ok(LensInference { face, layers, shells, views: out })
+    let models = models.into_iter().map(|m| m.into_iter().next().expect("a sample's own view")).collect();
+    Ok(LensInference { face, layers, shells, views: out, models })
 }
 
 /// One view's rows for each shell: per term, the render matrix's rows of the pixels the
 /// records reach, with their colour and alpha targets.
-fn view_rows(scene: &Scene, o: usize, model: &ViewModel, render: &PointRender, layers: &Layers, settings: &LensInferSettings) -> Vec<Vec<(RenderMatrix, Vec<f32>, Vec<f32>)>> {
+fn view_rows(scene: &Scene, o: usize, model: &ViewModel, render: &TracedView, layers: &Layers, settings: &LensInferSettings) -> Vec<Vec<(RenderMatrix, Vec<f32>, Vec<f32>)>> {
     let (w, h) = (render.images.width, render.images.height);
     let n = (w * h) as usize;
     // Per term, the records' targets.
     let mut targets = Vec::new();
     for term in TERMS {
         let (kind, modulation) = if term == Term::ReflectionFirst { (LayerKind::Reflection, LayerKind::ReflectionModulation) } else { (LayerKind::Refraction, LayerKind::RefractionModulation) };
-        let (value, fg) = (traced_rgb(scene, render, o, kind, n), traced_rgb(scene, render, o, modulation, n));
+        let (value, fg) = (traced_rgb(scene, render.images, o, kind, n), traced_rgb(scene, render.images, o, modulation, n));
         let radiance: Vec<Option<Vec3>> = (0..n).map(|p| {
             let f = Vec3::from_slice(&fg[p * 3..p * 3 + 3]);
             (f.min_element() > 1e-3).then(|| Vec3::from_slice(&value[p * 3..p * 3 + 3]) / f)
@@ -313,16 +340,38 @@ fn face_size(views: &[&ViewModel], shells: &[FittedShell]) -> u32 {
 pub fn predict_view(scene: &Scene, o: usize, frame: &Frame, render: &PointRender, inference: &LensInference, samples: &[(usize, f32)], settings: &LensInferSettings) -> (TermFit, TermFit, TermFit) {
     let cubes: Vec<(&Vec<Vec<f32>>, f32)> = samples.iter().filter_map(|&(k, w)| inference.views.get(k).map(|v| (&v.cubes, w))).collect();
     let model = ViewModel::new(scene, o, frame, (render.images.width, render.images.height), settings).with_matrices(&inference.shells, inference.face);
-    predict_with(scene, o, &model, render, inference.face, &cubes)
+    predict_with(scene, o, &model, &render.images, inference.face, &cubes)
+}
+
+/// The lens object's two terms as the player draws them at a view of `model` from the
+/// per-shell RGBA cube maps `cubes` (each shell's cube already blended over the view
+/// samples): per term, [`term_radiance`] at the pixels that draw it. Returns per term the
+/// RGB image (`width · height · 3`, zero where the term is not drawn).
+pub fn lens_image(model: &LensViewModel, cubes: &[&[f32]]) -> [Vec<f32>; 2] {
+    let fg = TERMS.map(|term| hybrid_pixels(model.viewport, &model.tess, model.clip, &vertex_modulation(&model.tess, term), Missing::Zero, None));
+    lens_terms(model, &fg, cubes)
+}
+
+/// [`lens_image`] with each term's pixels and F·G (`fg`, [`hybrid_pixels`] of the
+/// modulation with [`Missing::Zero`]) made.
+pub fn lens_terms(model: &LensViewModel, fg: &[HybridPixels; 2], cubes: &[&[f32]]) -> [Vec<f32>; 2] {
+    let n = (model.viewport.width * model.viewport.height) as usize;
+    let mut out = [vec![0.0f32; n * 3], vec![0.0f32; n * 3]];
+    for (t, fg) in fg.iter().enumerate() {
+        let a: Vec<&RenderMatrix> = model.a[t].iter().collect();
+        for (&p, c) in fg.pixels.iter().zip(term_radiance(fg, &a, cubes)) {
+            out[t][p as usize * 3..p as usize * 3 + 3].copy_from_slice(&c);
+        }
+    }
+    out
 }
 
 /// [`predict_view`] with the view's model made.
-fn predict_with(scene: &Scene, o: usize, model: &ViewModel, render: &PointRender, face: u32, samples: &[(&Vec<Vec<f32>>, f32)]) -> (TermFit, TermFit, TermFit) {
-    let (w, h) = (render.images.width, render.images.height);
+fn predict_with(scene: &Scene, o: usize, model: &ViewModel, images: &PointImages, face: u32, samples: &[(&Vec<Vec<f32>>, f32)]) -> (TermFit, TermFit, TermFit) {
+    let (w, h) = (images.width, images.height);
     let n = (w * h) as usize;
     let layout = TextureLayout::cube(face);
-    let (viewport, clip, tess, a) = (model.viewport, model.clip, &model.tess, &model.a);
-    let cubes: Vec<Vec<f32>> = (0..a.first().map_or(0, Vec::len))
+    let cubes: Vec<Vec<f32>> = (0..model.a.first().map_or(0, Vec::len))
         .map(|l| {
             let mut c = vec![0.0f32; layout.texel_count() * 4];
             for (s, weight) in samples {
@@ -331,42 +380,9 @@ fn predict_with(scene: &Scene, o: usize, model: &ViewModel, render: &PointRender
             c
         })
         .collect();
-    // Prediction: shells composited over, times the interpolated F·G, per term.
-    let cover = render.images.object_layer(&scene.objects[o].name, LayerKind::Coverage).and_then(|l| l.channel("A")).map(|c| c.to_vec()).unwrap_or_else(|| vec![0.0; n]);
-    let mut predicted = [vec![0.0f32; n * 3], vec![0.0f32; n * 3]];
-    for (t, term) in TERMS.into_iter().enumerate() {
-        let modulation: Vec<Option<[f32; 3]>> = tess.vertices.iter().map(|v| v.paths[term as usize].map(|p| p.modulation.to_array())).collect();
-        let fg = hybrid_pixels(viewport, tess, clip, &modulation, Missing::Zero, None);
-        let mut through = vec![1.0f32; n];
-        for (l, cube) in cubes.iter().enumerate() {
-            let m = &a[t][l];
-            let mut y = vec![0.0f32; m.rows() * 4];
-            for r in 0..m.rows() {
-                let (c, v) = m.row(r);
-                for (&col, &wgt) in c.iter().zip(v) {
-                    for ch in 0..4 {
-                        y[r * 4 + ch] += wgt * cube[col as usize * 4 + ch];
-                    }
-                }
-            }
-            for r in 0..m.rows() {
-                let p = m.pixels[r] as usize;
-                for ch in 0..3 {
-                    predicted[t][p * 3 + ch] += through[p] * y[r * 4 + ch];
-                }
-                through[p] *= 1.0 - y[r * 4 + 3].clamp(0.0, 1.0);
-            }
-        }
-        let mut modulated = vec![0.0f32; n * 3];
-        for (&p, v) in fg.pixels.iter().zip(&fg.vectors) {
-            let f: DVec3 = v[0];
-            for ch in 0..3 {
-                modulated[p as usize * 3 + ch] = predicted[t][p as usize * 3 + ch] * f[ch] as f32;
-            }
-        }
-        predicted[t] = modulated;
-    }
-    let traced = [traced_rgb(scene, render, o, LayerKind::Reflection, n), traced_rgb(scene, render, o, LayerKind::Refraction, n)];
+    let cover = images.object_layer(&scene.objects[o].name, LayerKind::Coverage).and_then(|l| l.channel("A")).map(|c| c.to_vec()).unwrap_or_else(|| vec![0.0; n]);
+    let predicted = lens_image(model, &cubes.iter().map(Vec::as_slice).collect::<Vec<_>>());
+    let traced = [traced_rgb(scene, images, o, LayerKind::Reflection, n), traced_rgb(scene, images, o, LayerKind::Refraction, n)];
     let fit = |pred: &[f32], truth: &[f32]| {
         let pixels: Vec<usize> = (0..n).filter(|&p| cover[p] > 0.5).collect();
         let gather = |v: &[f32]| pixels.iter().flat_map(|&p| [v[p * 3], v[p * 3 + 1], v[p * 3 + 2]]).collect::<Vec<f32>>();

@@ -25,6 +25,7 @@
 pub mod blocks;
 pub mod choice;
 pub mod encode;
+pub mod hybrid;
 pub mod infer_layers;
 pub mod input;
 pub mod matrices;

@@ -129,3 +129,47 @@ pub fn hybrid_render_matrix(viewport: Viewport, tess: &Tessellation, clip_from_w
         .collect();
     RenderMatrix::from_taps(viewport, layout, px.pixels, &rows)
 }
+
+/// One term of a lens object as the player draws it (SPEC.md 9; `frame_hybrid.wgsl`'s
+/// `hybrid_term` is its twin): at every pixel of `fg` (the pixels that draw the term, each
+/// with its interpolated F·G in `vectors[k][0]`), the term's shells looked up through their
+/// render matrices `a` (one per shell, in order, order 0 nearest; rows a subset of `fg`'s
+/// pixels) in their RGBA cube maps `cubes` (premultiplied colour, then alpha), composited
+/// "over" in increasing order — `rgb += through · c.rgb`, `through ·= 1 − clamp(c.a, 0, 1)`
+/// — and multiplied by F·G. Returns RGB per pixel of `fg`, in its order.
+pub fn term_radiance(fg: &HybridPixels, a: &[&RenderMatrix], cubes: &[&[f32]]) -> Vec<[f32; 3]> {
+    let n = fg.pixels.len();
+    let mut acc = vec![[0.0f32; 3]; n];
+    let mut through = vec![1.0f32; n];
+    for (m, cube) in a.iter().zip(cubes) {
+        let mut k = 0;
+        for r in 0..m.rows() {
+            let p = m.pixels[r];
+            while k < n && fg.pixels[k] < p {
+                k += 1;
+            }
+            if k == n || fg.pixels[k] != p {
+                continue;
+            }
+            let (cols, vals) = m.row(r);
+            let mut c = [0.0f32; 4];
+            for (&col, &w) in cols.iter().zip(vals) {
+                let t = &cube[col as usize * 4..col as usize * 4 + 4];
+                for ch in 0..4 {
+                    c[ch] += w * t[ch];
+                }
+            }
+            for ch in 0..3 {
+                acc[k][ch] += through[k] * c[ch];
+            }
+            through[k] *= 1.0 - c[3].clamp(0.0, 1.0);
+        }
+    }
+    acc.iter().zip(&fg.vectors).map(|(c, v)| [c[0] * v[0].x as f32, c[1] * v[0].y as f32, c[2] * v[0].z as f32]).collect()
+}
+
+/// Per vertex of `tess`, the F·G modulation of `term` (`None` where the vertex has no such
+/// path): what [`hybrid_pixels`] interpolates, with [`Missing::Zero`], for [`term_radiance`].
+pub fn vertex_modulation(tess: &Tessellation, term: Term) -> Vec<Option<[f32; 3]>> {
+    tess.vertices.iter().map(|v| v.paths[term as usize].map(|p| p.modulation.to_array())).collect()
+}

@@ -21,6 +21,18 @@ pub enum ShellShape {
     Cylinder { radius: f64, y_min: f64, y_max: f64 },
 }
 
+impl ShellShape {
+    /// The shape's name (SPEC.md 7.3).
+    pub fn name(&self) -> &'static str {
+        match self {
+            ShellShape::Sphere { .. } => "sphere",
+            ShellShape::Ellipsoid { .. } => "ellipsoid",
+            ShellShape::Box { .. } => "box",
+            ShellShape::Cylinder { .. } => "cylinder",
+        }
+    }
+}
+
 /// A closed shell: its shape and the origin lookup vectors start from.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Shell {

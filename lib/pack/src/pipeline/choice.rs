@@ -52,7 +52,7 @@ pub fn better(b: Outcome, a: Outcome, target_db: Option<f64>) -> bool {
 
 /// How the report names a model's representation.
 fn label(m: &ObjectModel) -> String {
-    if m.shell_views.is_empty() {
+    if m.shell_views.is_empty() && m.lens.is_empty() {
         format!("surface textures ({})", m.representation)
     } else {
         m.representation.clone()

@@ -118,6 +118,8 @@ fn layer_screen_weights(m: &ObjectModel, li: usize, samples: &[Vec<u32>]) -> BTr
         let points: Vec<usize> = samples.iter().enumerate().filter(|(_, s)| key(s, il.depends_on) == *k).map(|(p, _)| p).collect();
         let w = if points.is_empty() {
             vec![0.0; il.form.stored_texels(k)]
+        } else if let (Some(s), false) = (il.shell, m.lens.is_empty()) {
+            super::hybrid::shell_weights(m, s, il.form.stored_texels(k), &points)
         } else if let Some(s) = il.shell {
             shell_weights(m, s, li, k, &points)
         } else {

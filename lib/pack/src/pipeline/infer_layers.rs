@@ -31,7 +31,7 @@ pub fn infer_all(set: &LoadedSet, req: &PackRequest, matrices: &mut Matrices, st
     for (o, object) in scene.objects.iter().enumerate() {
         let rep = choose(object.role, req.representation).ok_or_else(|| anyhow!("object {}: no representation stores a {:?} object", object.name, object.role))?;
         if let Some(s) = rep.survey(&mut job, o)? {
-            let other = match alternative(object.role, req.representation).filter(|_| super::pem::layered(set, o)) {
+            let other = match alternative(object.role, req.representation).filter(|_| super::pem::layered(set, o) || object.role == pis_scene::ObjectRole::Refractive) {
                 Some(alt) => alt.survey(&mut job, o)?,
                 None => None,
             };

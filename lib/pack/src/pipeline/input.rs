@@ -28,6 +28,9 @@ pub struct LoadedSet {
     /// else the defaults at its resolution and samples per pixel): what anything traced
     /// for the set afterwards, such as a static environment map, is traced with.
     pub trace: TraceSettings,
+    /// Per point, the outgoing-ray records of the lens objects (RAYSET.md 6; empty where the
+    /// set has none).
+    pub records: Vec<Vec<pis_trace::RayRecord>>,
 }
 
 impl LoadedSet {
@@ -144,6 +147,8 @@ pub fn load(req: &PackRequest, stages: &mut Stages) -> Result<LoadedSet, Failure
     let mut samples = Vec::new();
     let mut frames = Vec::new();
     let mut images = Vec::new();
+    let mut records = Vec::new();
+    let with_records = set.meta.objects.iter().any(|o| o.records);
     for (i, p) in set.meta.points.iter().enumerate() {
         if p.samples != scene.space.point(i) {
             return Err(invalid(format!("{}: point {i} has samples {:?}, expected {:?}", dir.display(), p.samples, scene.space.point(i))));
@@ -160,10 +165,11 @@ pub fn load(req: &PackRequest, stages: &mut Stages) -> Result<LoadedSet, Failure
         frames.push(scene.frame(&p.samples).map_err(|e| Failure::new(Exit::Invalid, e))?);
         samples.push(p.samples.clone());
         images.push(img);
+        records.push(if with_records { set.read_records(i).map_err(trace_failure)? } else { Vec::new() });
     }
     let channels = pis_trace::channel_names(&scene);
     let trace = set.meta.renderer.as_ref().and_then(|r| r.settings.clone()).unwrap_or_else(|| TraceSettings::new(res, set.meta.spp.max(1)));
-    let loaded = LoadedSet { dir, scene, resolution: res, samples, frames, images, channels, display_filter: set.meta.filter, trace };
+    let loaded = LoadedSet { dir, scene, resolution: res, samples, frames, images, channels, display_filter: set.meta.filter, trace, records };
     super::blocks::check_transforms(&loaded.scene, &loaded.frames).map_err(|e| Failure::new(Exit::NotSupported, e))?;
     stages.done("read", &format!("{} points of {}x{} from {}", loaded.samples.len(), res.0, res.1, loaded.dir.display()));
     Ok(loaded)

@@ -102,6 +102,9 @@ pub struct ObjectModel {
     pub layers: Vec<InferredLayer>,
     /// Per point of the set, as the object's shells see it (empty without shells).
     pub shell_views: Vec<ShellView>,
+    /// Per point of the set, a lens object as hybrid rendering draws it (empty for other
+    /// objects; [`super::hybrid`]).
+    pub lens: Vec<super::hybrid::LensPoint>,
     /// The first `hull_triangles` triangles of `mesh` lie on its convex hull and draw the
     /// most distant shell only (thesis 5.7; SPEC.md 6.5).
     pub hull_triangles: u32,
@@ -132,7 +135,7 @@ impl ObjectModel {
     /// The object's image at point `p` over its covered pixels (rows × RGB), drawn as the
     /// player draws it from `textures[l]`, layer l's sample at the point (the whole drawn
     /// texture; `None` where the layer has none): the surface layers added, then the
-    /// reflection term of the shells (SPEC.md 9).
+    /// reflection term of the shells, or a lens object's two terms (SPEC.md 9).
     pub fn render(&self, p: usize, keys: &[Vec<u32>], textures: &[Option<&[f32]>]) -> Vec<f32> {
         let v = &self.views[p];
         let mut img = vec![0.0f32; v.rows() * 3];
@@ -147,7 +150,10 @@ impl ObjectModel {
                 Some(_) => maps.push((*x, il.form.channels())),
             }
         }
-        if !maps.is_empty() {
+        if !maps.is_empty() && !self.lens.is_empty() {
+            let r = self.lens[p].render(v.pixels(), &maps);
+            img.iter_mut().zip(&r).for_each(|(a, b)| *a += b);
+        } else if !maps.is_empty() {
             let r = super::pem::solve::reflection(&self.shell_views[p], &maps);
             img.iter_mut().zip(&r).for_each(|(a, b)| *a += b);
         }

@@ -17,6 +17,7 @@ use super::blocks::{block_sizes, geometry};
 use super::input::LoadedSet;
 use super::matrices::Matrices;
 use super::model::ObjectModel;
+use super::hybrid::HybridRendering;
 use super::pem::LayeredPem;
 use super::surface::SurfaceTextures;
 use super::RepresentationMode;
@@ -48,20 +49,28 @@ pub trait Planned {
 }
 
 /// The representations pis-pack knows, in the order they are tried.
-pub const REPRESENTATIONS: &[&dyn Representation] = &[&LayeredPem, &SurfaceTextures];
+pub const REPRESENTATIONS: &[&dyn Representation] = &[&HybridRendering, &LayeredPem, &SurfaceTextures];
+
+/// The representations that store an object as environment-map shells.
+const SHELLS: &[&dyn Representation] = &[&HybridRendering, &LayeredPem];
 
 /// The representation of an object of `role` under `mode`: the first that applies
-/// (environment maps only when `mode` asks for them; the layered representation then makes
-/// one or two shells as `mode` says).
+/// (environment maps, for reflective and refractive objects, only when `mode` asks for
+/// them; the layered representation of reflective objects then makes one or two shells as
+/// `mode` says).
 pub fn choose(role: ObjectRole, mode: RepresentationMode) -> Option<&'static dyn Representation> {
     let textures_only = matches!(mode, RepresentationMode::Texture | RepresentationMode::Auto);
-    REPRESENTATIONS.iter().copied().filter(|r| !textures_only || r.name() != LayeredPem.name()).find(|r| r.applies(role))
+    REPRESENTATIONS.iter().copied().filter(|r| !textures_only || !SHELLS.iter().any(|s| s.name() == r.name())).find(|r| r.applies(role))
 }
 
 /// The representation also solved for an object of `role` under `mode`, to be chosen
-/// between by [`super::choice`]: layered environment maps for a reflective object in `auto`.
+/// between by [`super::choice`]: in `auto`, layered environment maps for a reflective object
+/// and hybrid rendering for a refractive one.
 pub fn alternative(role: ObjectRole, mode: RepresentationMode) -> Option<&'static dyn Representation> {
-    (mode == RepresentationMode::Auto && LayeredPem.applies(role)).then_some(&LayeredPem as &dyn Representation)
+    if mode != RepresentationMode::Auto {
+        return None;
+    }
+    SHELLS.iter().copied().find(|r| r.applies(role))
 }
 
 /// What every representation works with: the set and the request, the render-matrix

@@ -276,7 +276,8 @@ impl PlacementMode {
     }
 }
 
-/// How reflective objects are stored.
+/// How reflective objects are stored; refractive objects are stored by hybrid rendering
+/// (thesis ch. 6) in every mode but `Texture`, and chosen against textures in `Auto`.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum RepresentationMode {
     /// Parameterized surface textures, as every other object (thesis ch. 3–4).

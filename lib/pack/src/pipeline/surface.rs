@@ -414,7 +414,7 @@ impl Planned for Layers {
         };
         Ok(ObjectModel {
             index: o, name, mesh: merged_mesh(scene, o), mesh_uvs: at.uvs, placements, stagger: st, block_sizes: job.sizes.clone(),
-            area, views, layers, shell_views: vec![], hull_triangles: 0, representation: representation.to_string(), why: why.to_string(),
+            area, views, layers, shell_views: vec![], lens: vec![], hull_triangles: 0, representation: representation.to_string(), why: why.to_string(),
         })
     }
 }
@@ -461,7 +461,11 @@ mod tests {
     fn every_object_role_has_a_representation() {
         for role in [ObjectRole::Diffuse, ObjectRole::Reflective, ObjectRole::Refractive] {
             assert_eq!(super::super::represent::choose(role, super::super::RepresentationMode::Texture).map(|r| r.name()), Some("surface textures"), "{role:?}");
-            let pem = if role == ObjectRole::Reflective { "layered environment maps" } else { "surface textures" };
+            let pem = match role {
+                ObjectRole::Reflective => "layered environment maps",
+                ObjectRole::Refractive => "hybrid rendering",
+                ObjectRole::Diffuse => "surface textures",
+            };
             assert_eq!(super::super::represent::choose(role, super::super::RepresentationMode::Pem).map(|r| r.name()), Some(pem), "{role:?}");
         }
     }

@@ -1,7 +1,7 @@
 //! A shell layer as stored (SPEC.md 7.1, 7.3, 8.3): a cube map per sample, every MIP level
 //! inferred and stored (mip mode `stored`: level images hold the finest level and each
 //! coarser level's residual from the decimated finest, thesis 5.8.1), on the shell its
-//! blocks name; composited "over" in the reflection term in its order (0 nearest).
+//! blocks name; composited "over" in its term in its order (0 nearest).
 
 use pis_compile::shell::Shell;
 use pis_compile::TextureLayout;
@@ -15,8 +15,11 @@ pub struct ShellForm {
     pub layout: TextureLayout,
     /// 4 (premultiplied RGBA: a local shell) or 3 (opaque RGB).
     pub channels: u8,
-    /// Order within the reflection term (0 is nearest).
+    /// Order within its term (0 is nearest).
     pub order: u8,
+    /// The term the shell is looked up in: the reflection term of a reflective object, the
+    /// refraction term of a lens object (whose reflection term reads the same shells, SPEC.md 9).
+    pub term: pis_format::Term,
 }
 
 impl LayerForm for ShellForm {
@@ -26,7 +29,7 @@ impl LayerForm for ShellForm {
             mapping: pis_format::Mapping::Shell,
             channels: self.channels,
             mip_mode: pis_format::MipMode::Stored,
-            term: pis_format::Term::Reflection,
+            term: self.term,
             order: self.order,
             combine: pis_format::Combine::Over,
             gamma,
@@ -80,7 +83,7 @@ mod tests {
     #[test]
     fn a_shell_layer_is_stored_whole_on_its_shell() {
         let shell = Shell { origin: DVec3::new(0.5, 1.0, -2.0), shape: ShellShape::Ellipsoid { radii: DVec3::new(1.0, 2.0, 3.0) } };
-        let f = ShellForm { shell, layout: TextureLayout::cube(8), channels: 4, order: 0 };
+        let f = ShellForm { shell, layout: TextureLayout::cube(8), channels: 4, order: 0, term: pis_format::Term::Reflection };
         let l = f.layer(pis_format::LayerKind::EnvLocal, 3, DepMask::of(&[0]), 1.0);
         assert_eq!((l.mapping, l.mip_mode, l.term, l.combine, l.channels, l.order), (pis_format::Mapping::Shell, pis_format::MipMode::Stored, pis_format::Term::Reflection, pis_format::Combine::Over, 4, 0));
         let b = f.block(0);

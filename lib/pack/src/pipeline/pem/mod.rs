@@ -153,7 +153,7 @@ impl Planned for PemPlanned {
         let chosen = Chosen { shells, views, solved, why };
         for (s, ((shell, layout, target), solved)) in chosen.shells.iter().zip(chosen.solved).enumerate() {
             let kind = if *target == Target::Local { pis_format::LayerKind::EnvLocal } else { pis_format::LayerKind::EnvDistant };
-            let form = Box::new(ShellForm { shell: *shell, layout: *layout, channels: target.channels() as u8, order: s as u8 });
+            let form = Box::new(ShellForm { shell: *shell, layout: *layout, channels: target.channels() as u8, order: s as u8, term: pis_format::Term::Reflection });
             let grid_blocks = pis_format::blocks::BlockGrid::new(&job.space, job.all, &model.stagger).block_count() as usize;
             model.layers.push(InferredLayer {
                 kind,
@@ -192,7 +192,7 @@ fn single_shell(mut model: ObjectModel, job: &Job<'_>, o: usize, f0: [f32; 3], p
         textures: solved.textures,
         block_placements: vec![0; grid_blocks],
         iterations: solved.iterations,
-        form: Box::new(ShellForm { shell, layout, channels: 3, order: 0 }),
+        form: Box::new(ShellForm { shell, layout, channels: 3, order: 0, term: pis_format::Term::Reflection }),
         shell: Some(0),
     });
     model.shell_views = views;

@@ -124,7 +124,7 @@ pub fn static_env(mut model: ObjectModel, job: &Job<'_>, o: usize, f0: [f32; 3],
         textures,
         block_placements: vec![0; grid_blocks],
         iterations: 0,
-        form: Box::new(ShellForm { shell, layout, channels: 3, order: 0 }),
+        form: Box::new(ShellForm { shell, layout, channels: 3, order: 0, term: pis_format::Term::Reflection }),
         shell: Some(0),
     });
     model.shell_views = views;

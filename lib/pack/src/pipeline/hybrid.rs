@@ -1,0 +1,164 @@
+//! Hybrid rendering of lens objects (thesis ch. 6) as a representation: a refractive
+//! object's layered environment map, inferred from the set's outgoing-ray records at every
+//! parameter sample ([`crate::lens_infer`]: the layers clustered from the records' hit
+//! distances, one shell fitted per layer, each shell's RGBA cube map solved against both
+//! greedy terms at once, eq. 6.1). The file stores each shell as an `env_shell` layer of the
+//! refraction term, every MIP level inferred and stored (SPEC.md 7.1, 8.3); the player
+//! traces the object's vertex rays each frame and looks up the same shells in both terms
+//! (SPEC.md 9). A diffuse surface layer is added when the object has one
+//! ([`super::surface`]). The prediction and the storage allocation draw the object as the
+//! player does, through the per-point render matrices of hybrid rendering ([`LensPoint`]).
+
+use anyhow::Result;
+use pis_compile::hybrid::{hybrid_pixels, vertex_modulation, HybridPixels, Missing, TERMS};
+use pis_compile::TextureLayout;
+use pis_scene::ObjectRole;
+
+use super::model::{key, InferredLayer, ObjectModel};
+use super::pem::form::ShellForm;
+use super::represent::{Job, Planned, Representation, Surveyed};
+use super::surface::survey_surface;
+use crate::lens_infer::{infer_lens_views, lens_terms, LensInferSettings, LensViewModel, TracedView};
+
+/// Hybrid rendering: refractive objects whose set has outgoing-ray records of them.
+pub struct HybridRendering;
+
+impl Representation for HybridRendering {
+    fn name(&self) -> &'static str {
+        "hybrid rendering"
+    }
+
+    fn applies(&self, role: ObjectRole) -> bool {
+        role == ObjectRole::Refractive
+    }
+
+    /// The object's surface part (its diffuse layer, if any, and every point's rows and gold
+    /// standard); an object whose set has no ray records of it is stored as surface textures.
+    fn survey(&self, job: &mut Job<'_>, o: usize) -> Result<Option<Box<dyn Surveyed>>> {
+        let set = job.set;
+        if !set.records.iter().any(|r| r.iter().any(|r| r.object == o as u32)) {
+            job.note(&format!("object {}: the set has no outgoing-ray records of it (RAYSET.md 6); stored as surface textures", set.scene.objects[o].name));
+            return survey_surface(job, o, true);
+        }
+        let Some(surface) = survey_surface(job, o, false)? else { return Ok(None) };
+        Ok(Some(Box::new(HybridSurveyed { o, surface })))
+    }
+}
+
+struct HybridSurveyed {
+    o: usize,
+    surface: Box<dyn Surveyed>,
+}
+
+impl Surveyed for HybridSurveyed {
+    fn plan(self: Box<Self>, job: &mut Job<'_>, stagger: Vec<u32>) -> Result<Box<dyn Planned>> {
+        let HybridSurveyed { o, surface } = *self;
+        Ok(Box::new(HybridPlanned { o, surface: surface.plan(job, stagger)? }))
+    }
+}
+
+struct HybridPlanned {
+    o: usize,
+    surface: Box<dyn Planned>,
+}
+
+impl Planned for HybridPlanned {
+    fn solve(self: Box<Self>, job: &Job<'_>) -> Result<ObjectModel> {
+        let HybridPlanned { o, surface } = *self;
+        let mut model = surface.solve(job)?;
+        let set = job.set;
+        let scene = &set.scene;
+        let views: Vec<Vec<TracedView>> = (0..set.frames.len()).map(|p| vec![TracedView { frame: &set.frames[p], images: &set.images[p], records: &set.records[p] }]).collect();
+        let mut settings = LensInferSettings::default();
+        settings.solve.cg = job.settings.cg;
+        let inference = infer_lens_views(scene, o, &views, &settings)?;
+        let layout = TextureLayout::cube(inference.face);
+        let grid_blocks = pis_format::blocks::BlockGrid::new(&job.space, job.all, &model.stagger).block_count() as usize;
+        for (l, fitted) in inference.shells.iter().enumerate() {
+            let textures: std::collections::BTreeMap<Vec<u32>, Vec<f32>> = set.samples.iter().zip(&inference.views).map(|(s, v)| (key(s, job.all), v.cubes[l].clone())).collect();
+            model.layers.push(InferredLayer {
+                kind: pis_format::LayerKind::EnvShell,
+                depends_on: job.all,
+                placement_of: textures.keys().map(|k| (k.clone(), 0)).collect(),
+                textures,
+                block_placements: vec![0; grid_blocks],
+                iterations: 0,
+                form: Box::new(ShellForm { shell: fitted.shell, layout, channels: 4, order: l as u8, term: pis_format::Term::Refraction }),
+                shell: Some(l),
+            });
+        }
+        let layers: Vec<String> = (0..inference.shells.len())
+            .map(|l| {
+                let names: Vec<&str> = inference.layers.layer_of.iter().filter(|(_, &k)| k == l).filter_map(|(&obj, _)| scene.objects.get(obj as usize).map(|x| x.name.as_str())).collect();
+                format!("{} {{{}}}", inference.shells[l].shell.shape.name(), names.join(", "))
+            })
+            .collect();
+        let both: Vec<f64> = inference.views.iter().map(|v| v.both.psnr_db).collect();
+        let (lo, hi) = both.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |a, &x| (a.0.min(x), a.1.max(x)));
+        model.lens = inference.models.into_iter().map(LensPoint::new).collect();
+        model.representation = "hybrid rendering".to_string();
+        model.why = format!(
+            "refractive: {} shell(s) from the ray records' hit distances ({}), cube faces {}², both terms {lo:.1}–{hi:.1} dB at the samples as solved; vertex rays traced per frame (τ {} px)",
+            layers.len(),
+            layers.join(", "),
+            inference.face,
+            settings.tessellation.tau_px
+        );
+        Ok(model)
+    }
+}
+
+/// A lens object at one point of the set as hybrid rendering draws it: the point's
+/// tessellation and render matrices, and per term the pixels that draw it with their F·G.
+pub struct LensPoint {
+    pub model: LensViewModel,
+    pub fg: [HybridPixels; 2],
+}
+
+impl LensPoint {
+    pub fn new(model: LensViewModel) -> LensPoint {
+        let fg = TERMS.map(|term| hybrid_pixels(model.viewport, &model.tess, model.clip, &vertex_modulation(&model.tess, term), Missing::Zero, None));
+        LensPoint { model, fg }
+    }
+
+    /// The two terms summed at `rows` (pixels, increasing), RGB per row, drawn from the
+    /// shells' RGBA cube maps `maps` (each with its channel count, 4).
+    pub fn render(&self, rows: &[u32], maps: &[(&[f32], usize)]) -> Vec<f32> {
+        let cubes: Vec<&[f32]> = maps.iter().map(|(m, _)| *m).collect();
+        let [r, t] = lens_terms(&self.model, &self.fg, &cubes);
+        rows.iter().flat_map(|&p| {
+            let k = p as usize * 3;
+            [r[k] + t[k], r[k + 1] + t[k + 1], r[k + 2] + t[k + 2]]
+        }).collect()
+    }
+}
+
+/// The screen weights of shell `s`'s sample at `points` (`texels` texels, every level
+/// stored): each texel's column sums over both terms' rows, each row weighed by its squared
+/// F·G (the term reaches the screen multiplied by it); scaled as the reflection shells'
+/// weights are.
+pub fn shell_weights(m: &ObjectModel, s: usize, texels: usize, points: &[usize]) -> Vec<f32> {
+    let (mut weighed, mut plain) = (vec![0.0f64; texels], 0.0f64);
+    for &p in points {
+        let lp = &m.lens[p];
+        for (t, fg) in lp.fg.iter().enumerate() {
+            let a = &lp.model.a[t][s];
+            let mut k = 0;
+            for r in 0..a.rows() {
+                while k < fg.pixels.len() && fg.pixels[k] < a.pixels[r] {
+                    k += 1;
+                }
+                let f2 = fg.vectors.get(k).filter(|_| fg.pixels.get(k) == Some(&a.pixels[r])).map_or(0.0, |v| ((v[0].x + v[0].y + v[0].z) / 3.0).powi(2));
+                let (cols, vals) = a.row(r);
+                for (&c, &w) in cols.iter().zip(vals) {
+                    if let Some(x) = weighed.get_mut(c as usize) {
+                        *x += w as f64 * f2;
+                    }
+                    plain += w as f64;
+                }
+            }
+        }
+    }
+    let scale = if plain > 0.0 { texels as f64 / plain } else { 0.0 };
+    weighed.iter().map(|w| (w * scale) as f32).collect()
+}
