@@ -21,6 +21,13 @@ fn parse_blend(s: &str) -> Result<pis_play::Blend, String> {
     }
 }
 
+pub fn parse_tau(s: &str) -> Result<f32, String> {
+    match s.parse::<f32>() {
+        Ok(t) if t.is_finite() && t >= 0.25 => Ok(t),
+        _ => Err(format!("--tau {s:?}: expected a number of pixels, at least 0.25")),
+    }
+}
+
 pub fn parse_msaa(s: &str) -> Result<u32, String> {
     let n = s.parse::<u32>().map_err(|_| format!("--msaa {s:?}: expected 1 or 4"))?;
     pis_play::multisample::check_samples(n).map(|()| n)
@@ -92,6 +99,10 @@ pub struct PlayArgs {
     /// formats, 1 with a note.
     #[arg(long, default_value_t = pis_play::multisample::DEFAULT_SAMPLES, value_name = "1|4", value_parser = parse_msaa)]
     pub msaa: u32,
+    /// Lens objects (hybrid rendering): the screen edge length in pixels down to which
+    /// their tessellation is refined where the vertex rays' paths differ (thesis 6.4.1's τ).
+    #[arg(long, default_value_t = 1.0, value_name = "PIXELS", value_parser = parse_tau)]
+    pub tau: f32,
     /// Memory for decoded level images, MiB.
     #[arg(long, default_value_t = 512)]
     pub cache_mb: u64,
@@ -153,6 +164,7 @@ impl PlayArgs {
             reduction: self.reduction,
             blend: self.blend,
             msaa: self.msaa,
+            tau_px: self.tau,
             display_filter: self.compare.as_deref().or(self.set.as_deref()).and_then(set_display_filter),
             ..d
         }

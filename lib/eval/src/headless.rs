@@ -111,6 +111,14 @@ pub struct PathReport {
     /// Draws per frame of reflection terms (object × parameter sample, each looking up the
     /// term's environment-map shells).
     pub shell_draws_mean: f64,
+    /// Lens objects (hybrid rendering): ms per frame tracing their vertex rays, refining the
+    /// tessellation and building the terms' vertex buffers; rays, triangles and draws of
+    /// lens terms per frame.
+    pub lens_ms_mean: f64,
+    pub lens_ms_worst: f64,
+    pub lens_rays_mean: f64,
+    pub lens_triangles_mean: f64,
+    pub lens_draws_mean: f64,
     pub cache_hits: u64,
     pub cache_misses: u64,
     pub cache_bytes_max: u64,
@@ -130,6 +138,8 @@ pub struct FrameRow {
     pub codestreams_read: u64,
     pub surface_draws: u64,
     pub shell_draws: u64,
+    pub lens_ms: f64,
+    pub lens_rays: u64,
 }
 
 #[derive(Clone, Debug, Serialize)]
@@ -369,6 +379,8 @@ pub fn run_frames(args: &HeadlessRequest, gpu: &Gpu, player: &mut Player) -> Res
             codestreams_read: stats.codestreams_read,
             surface_draws: stats.surface_draws,
             shell_draws: stats.shell_draws,
+            lens_ms: stats.lens_ms,
+            lens_rays: stats.lens_rays,
         });
         all.push(stats);
     }
@@ -401,6 +413,11 @@ pub fn run_frames(args: &HeadlessRequest, gpu: &Gpu, player: &mut Player) -> Res
         readback_ms_mean: mean(|s| s.readback_ms),
         surface_draws_mean: mean(|s| s.surface_draws as f64),
         shell_draws_mean: mean(|s| s.shell_draws as f64),
+        lens_ms_mean: mean(|s| s.lens_ms),
+        lens_ms_worst: worst(|s| s.lens_ms),
+        lens_rays_mean: mean(|s| s.lens_rays as f64),
+        lens_triangles_mean: mean(|s| s.lens_triangles as f64),
+        lens_draws_mean: mean(|s| s.lens_draws as f64),
         cache_hits: all.iter().map(|s| s.cache_hits).sum(),
         cache_misses: all.iter().map(|s| s.cache_misses).sum(),
         cache_bytes_max: all.iter().map(|s| s.cache_bytes).max().unwrap_or(0),
@@ -420,7 +437,10 @@ pub fn print_path_report(r: &PathReport, w: &mut impl std::io::Write) -> std::io
         write!(w, "; readback ms (frames written): mean {:.2}", r.readback_ms_mean)?;
     }
     writeln!(w)?;
-    writeln!(w, "  draws per frame: {:.1} surface layers, {:.1} reflection terms (environment-map shells)", r.surface_draws_mean, r.shell_draws_mean)?;
+    writeln!(w, "  draws per frame: {:.1} surface layers, {:.1} reflection terms (environment-map shells), {:.1} lens terms", r.surface_draws_mean, r.shell_draws_mean, r.lens_draws_mean)?;
+    if r.lens_draws_mean > 0.0 {
+        writeln!(w, "  lens objects (vertex rays, tessellation, vertex buffers): mean {:.2} ms, worst {:.2}; {:.0} rays, {:.0} triangles per frame", r.lens_ms_mean, r.lens_ms_worst, r.lens_rays_mean, r.lens_triangles_mean)?;
+    }
     writeln!(w, "  level-image cache: {} hits, {} misses, at most {:.1} MiB; codestreams read: {}", r.cache_hits, r.cache_misses, r.cache_bytes_max as f64 / (1 << 20) as f64, r.codestreams_read)
 }
 

@@ -20,6 +20,7 @@ use crate::error::PlayError;
 use crate::gpu::Gpu;
 use crate::image::FloatImage;
 use crate::resolve::ResolvePipelines;
+use crate::frame_hybrid::{lens_bind, LensDraw, HYBRID_FRAME, LENS_CORNER_LAYOUT, MAX_LENS_SHELLS};
 use crate::frame_reflection::{reflection_bind, REFLECTION};
 pub use crate::frame_reflection::{ReflectionDraw, MAX_TERM_SHELLS};
 use crate::shell::SHELL_FUNCTIONS;
@@ -119,9 +120,11 @@ pub struct LayerDraw<'a> {
 pub struct FramePipelines {
     module: wgpu::ShaderModule,
     reflection_module: wgpu::ShaderModule,
+    hybrid_module: wgpu::ShaderModule,
     uniform_layout: wgpu::BindGroupLayout,
     draw_layout: wgpu::BindGroupLayout,
     reflection_draw_layout: wgpu::BindGroupLayout,
+    hybrid_draw_layout: wgpu::BindGroupLayout,
     ids_layout: wgpu::BindGroupLayout,
     ids_ms_layout: wgpu::BindGroupLayout,
     id_layout: wgpu::PipelineLayout,
@@ -129,9 +132,12 @@ pub struct FramePipelines {
     layer_ms_layout: wgpu::PipelineLayout,
     reflection_layout: wgpu::PipelineLayout,
     reflection_ms_layout: wgpu::PipelineLayout,
+    hybrid_layout: wgpu::PipelineLayout,
+    hybrid_ms_layout: wgpu::PipelineLayout,
     id_pipelines: HashMap<u32, wgpu::RenderPipeline>,
     layer_pipelines: HashMap<(wgpu::TextureFormat, u32), wgpu::RenderPipeline>,
     reflection_pipelines: HashMap<(wgpu::TextureFormat, u32), wgpu::RenderPipeline>,
+    hybrid_pipelines: HashMap<(wgpu::TextureFormat, u32), wgpu::RenderPipeline>,
     resolve: ResolvePipelines,
 }
 
@@ -189,6 +195,8 @@ impl FramePipelines {
         let module = d.create_shader_module(wgpu::ShaderModuleDescriptor { label: Some("frame.wgsl"), source: wgpu::ShaderSource::Wgsl(SHADER.into()) });
         let reflection_source = format!("{SHELL_FUNCTIONS}\n{REFLECTION}");
         let reflection_module = d.create_shader_module(wgpu::ShaderModuleDescriptor { label: Some("frame_reflection.wgsl"), source: wgpu::ShaderSource::Wgsl(reflection_source.into()) });
+        let hybrid_source = format!("{SHELL_FUNCTIONS}\n{HYBRID_FRAME}");
+        let hybrid_module = d.create_shader_module(wgpu::ShaderModuleDescriptor { label: Some("frame_hybrid.wgsl"), source: wgpu::ShaderSource::Wgsl(hybrid_source.into()) });
         let vf = wgpu::ShaderStages::VERTEX_FRAGMENT;
         let uniform_layout = d.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some("frame uniforms"), entries: &[entry(0, vf, UNIFORM)] });
         let draw_layout = d.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
@@ -201,6 +209,8 @@ impl FramePipelines {
         });
         let fragment = wgpu::ShaderStages::FRAGMENT;
         let reflection_draw_layout = d.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some("frame reflection"), entries: &[entry(0, vf, UNIFORM), entry(1, fragment, CUBE), entry(2, fragment, CUBE)] });
+        let hybrid_entries: Vec<wgpu::BindGroupLayoutEntry> = std::iter::once(entry(0, vf, UNIFORM)).chain((0..MAX_LENS_SHELLS).map(|k| entry(k as u32 + 1, fragment, CUBE))).collect();
+        let hybrid_draw_layout = d.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some("frame lens term"), entries: &hybrid_entries });
         let ids_entry = |binding, multisampled| entry(binding, wgpu::ShaderStages::FRAGMENT, wgpu::BindingType::Texture { sample_type: wgpu::TextureSampleType::Uint, view_dimension: wgpu::TextureViewDimension::D2, multisampled });
         let ids_layout = d.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some("frame ids"), entries: &[ids_entry(0, false)] });
         let ids_ms_layout = d.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some("frame ids per sample"), entries: &[ids_entry(1, true)] });
@@ -209,12 +219,16 @@ impl FramePipelines {
         let layer_ms_layout = d.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor { label: Some("frame layers per sample"), bind_group_layouts: &[Some(&draw_layout), Some(&ids_ms_layout)], immediate_size: 0 });
         let reflection_layout = d.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor { label: Some("frame reflections"), bind_group_layouts: &[Some(&reflection_draw_layout), Some(&ids_layout)], immediate_size: 0 });
         let reflection_ms_layout = d.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor { label: Some("frame reflections per sample"), bind_group_layouts: &[Some(&reflection_draw_layout), Some(&ids_ms_layout)], immediate_size: 0 });
+        let hybrid_layout = d.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor { label: Some("frame lens terms"), bind_group_layouts: &[Some(&hybrid_draw_layout), Some(&ids_layout)], immediate_size: 0 });
+        let hybrid_ms_layout = d.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor { label: Some("frame lens terms per sample"), bind_group_layouts: &[Some(&hybrid_draw_layout), Some(&ids_ms_layout)], immediate_size: 0 });
         let mut pipes = FramePipelines {
             module,
             reflection_module,
+            hybrid_module,
             uniform_layout,
             draw_layout,
             reflection_draw_layout,
+            hybrid_draw_layout,
             ids_layout,
             ids_ms_layout,
             id_layout,
@@ -222,9 +236,12 @@ impl FramePipelines {
             layer_ms_layout,
             reflection_layout,
             reflection_ms_layout,
+            hybrid_layout,
+            hybrid_ms_layout,
             id_pipelines: HashMap::new(),
             layer_pipelines: HashMap::new(),
             reflection_pipelines: HashMap::new(),
+            hybrid_pipelines: HashMap::new(),
             resolve: ResolvePipelines::new(gpu),
         };
         pipes.id_pipeline(gpu, 1);
@@ -291,6 +308,29 @@ impl FramePipelines {
                 label: Some("frame reflections"),
                 layout: Some(layout),
                 vertex: wgpu::VertexState { module, entry_point: Some("vs_reflection"), compilation_options: Default::default(), buffers: &[Some(POSITION_LAYOUT), Some(NORMAL_LAYOUT)] },
+                primitive: wgpu::PrimitiveState { topology: wgpu::PrimitiveTopology::TriangleList, cull_mode: None, ..Default::default() },
+                depth_stencil: Some(additive_depth()),
+                multisample: multisample(samples),
+                fragment: Some(wgpu::FragmentState { module, entry_point: Some(entry_point), compilation_options: Default::default(), targets: &[Some(additive_target(format))] }),
+                multiview_mask: None,
+                cache: None,
+            })
+        })
+    }
+}
+
+impl FramePipelines {
+    /// The additive lens-term pipeline for a target format and `samples` per pixel
+    /// (compiled on first use): `fs_hybrid_frame`, or `fs_hybrid_frame_ms` with object
+    /// indices per sample; the corners ([`LENS_CORNER_LAYOUT`]) as vertex buffer 0.
+    pub fn hybrid_pipeline(&mut self, gpu: &Gpu, format: wgpu::TextureFormat, samples: u32) -> &wgpu::RenderPipeline {
+        let module = &self.hybrid_module;
+        let (layout, entry_point) = if samples > 1 { (&self.hybrid_ms_layout, "fs_hybrid_frame_ms") } else { (&self.hybrid_layout, "fs_hybrid_frame") };
+        self.hybrid_pipelines.entry((format, samples)).or_insert_with(|| {
+            gpu.device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+                label: Some("frame lens terms"),
+                layout: Some(layout),
+                vertex: wgpu::VertexState { module, entry_point: Some("vs_hybrid_frame"), compilation_options: Default::default(), buffers: &[Some(LENS_CORNER_LAYOUT)] },
                 primitive: wgpu::PrimitiveState { topology: wgpu::PrimitiveTopology::TriangleList, cull_mode: None, ..Default::default() },
                 depth_stencil: Some(additive_depth()),
                 multisample: multisample(samples),
@@ -459,6 +499,7 @@ pub fn encode(
     objects: &[ObjectDraw],
     layers: &[LayerDraw],
     reflections: &[ReflectionDraw],
+    lenses: &[LensDraw],
     object_ids: bool,
     display: Option<pis_format::DisplayFilter>,
     encoder: &mut wgpu::CommandEncoder,
@@ -475,6 +516,11 @@ pub fn encode(
     if !reflections.is_empty() {
         pipes.reflection_pipeline(gpu, sample_format, samples);
     }
+    let lenses: Vec<&LensDraw> = lenses.iter().filter(|l| !l.shells.is_empty() && l.count > 0).collect();
+    if !lenses.is_empty() {
+        pipes.hybrid_pipeline(gpu, sample_format, samples);
+    }
+    let lens_binds: Vec<wgpu::BindGroup> = lenses.iter().map(|l| lens_bind(gpu, &pipes.hybrid_draw_layout, l)).collect();
     let ubuf = |u: Uniforms| d.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: Some("frame uniforms"), contents: bytemuck::bytes_of(&u), usage: wgpu::BufferUsages::UNIFORM });
     let id_binds: Vec<wgpu::BindGroup> = objects
         .iter()
@@ -580,6 +626,15 @@ pub fn encode(
             };
             pass.set_bind_group(0, all, &[]);
             pass.draw_indexed(rest..m.count, 0, 0..1);
+        }
+    }
+    if !lenses.is_empty() {
+        pass.set_pipeline(&pipes.hybrid_pipelines[&(sample_format, samples)]);
+        pass.set_bind_group(1, ids_bind, &[]);
+        for (l, bg) in lenses.iter().zip(&lens_binds) {
+            pass.set_bind_group(0, bg, &[]);
+            pass.set_vertex_buffer(0, l.corners.slice(..));
+            pass.draw(0..l.count, 0..1);
         }
     }
     drop(pass);

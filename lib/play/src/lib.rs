@@ -16,6 +16,7 @@ pub mod camera;
 pub mod decode;
 pub mod error;
 pub mod frame;
+pub mod frame_hybrid;
 pub mod frame_reflection;
 pub mod gpu;
 pub mod hybrid;

@@ -6,13 +6,17 @@
 //! layers added in linear space, objects depth-tested against each other; an object with
 //! environment-map shells in its reflection term also gets that term (the shells composited
 //! "over", times Fresnel from its f0, SPEC.md 9) per parameter sample, with the sample's
-//! weight. Refraction-term shells are not drawn.
+//! weight. A lens object (role `refractive`, its shells in the refraction term) is drawn by
+//! hybrid rendering (thesis 6.4): per frame its vertex rays are traced through it on the
+//! workers, its tessellation refined where they diverge, and both terms drawn from its
+//! shells per parameter sample ([`crate::frame_hybrid`]).
 
 use std::collections::HashMap;
 use std::path::Path;
 use std::sync::Arc;
 use std::time::Instant;
 
+use pis_compile::hybrid::{tessellate, HybridView, LensMaterial, LensObject, TessellationSettings, TERMS};
 use pis_compile::shell::Shell;
 use pis_compile::{Address, Filter, Sampler, TextureLayout, TextureTransform};
 use pis_format::blocks::{level_image_index, BlockGrid};
@@ -24,6 +28,7 @@ use crate::cache::{LevelCache, LevelKey};
 use crate::camera::{mat4_from_rows, projection, CameraChoice, ViewCamera};
 use crate::decode::{AssembleJob, Decoder, LevelJob};
 use crate::error::PlayError;
+use crate::frame_hybrid::{corner_buffer, term_corners, LensDraw, MAX_LENS_SHELLS};
 use crate::frame::{colour_image, offscreen_format, FramePipelines, LayerDraw, MeshGpu, ObjectDraw, Readback, ReflectionDraw, Targets, MAX_TERM_SHELLS};
 use crate::gpu::Gpu;
 use crate::image::FloatImage;
@@ -55,12 +60,15 @@ pub struct PlayerOptions {
     /// (SPEC.md 6.6 `display_filter`): the ray-traced set's filter (RAYSET.md section 4).
     /// With neither, each pixel's own samples are averaged.
     pub display_filter: Option<pis_format::DisplayFilter>,
+    /// Lens objects: the screen edge length in pixels down to which the tessellation is
+    /// refined where vertex rays diverge (thesis 6.4.1's τ; default 1).
+    pub tau_px: f32,
 }
 
 impl Default for PlayerOptions {
     fn default() -> Self {
         let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
-        PlayerOptions { cache_budget_bytes: 512 << 20, lifetime_a: 20, lifetime_b: 4, workers: cores.saturating_sub(1).max(1), reduction: 1, blend: Blend::Nearest, msaa: DEFAULT_SAMPLES, display_filter: None }
+        PlayerOptions { cache_budget_bytes: 512 << 20, lifetime_a: 20, lifetime_b: 4, workers: cores.saturating_sub(1).max(1), reduction: 1, blend: Blend::Nearest, msaa: DEFAULT_SAMPLES, display_filter: None, tau_px: TessellationSettings::default().tau_px }
     }
 }
 
@@ -100,6 +108,14 @@ pub struct FrameStats {
     /// Draws of reflection terms (one per reflective object and parameter sample, each
     /// looking up all the term's shells).
     pub shell_draws: u64,
+    /// Lens objects: tracing their vertex rays, refining the tessellation and building the
+    /// terms' vertex buffers (texture-coordinate generation), on the workers.
+    pub lens_ms: f64,
+    /// Lens objects: rays traced for the frame's vertices, and the triangles drawn.
+    pub lens_rays: u64,
+    pub lens_triangles: u64,
+    /// Draws of lens terms (two per lens object and parameter sample).
+    pub lens_draws: u64,
 }
 
 /// An object's mesh on the GPU and the layers the player draws.
@@ -110,6 +126,32 @@ struct ObjectGpu {
     /// The reflection term's shell layers in increasing order (at most
     /// [`MAX_TERM_SHELLS`]); empty for an object without them or without normals.
     reflection: Vec<usize>,
+    /// A lens object drawn by hybrid rendering.
+    lens: Option<LensState>,
+}
+
+/// A lens object: its shell layers (the refraction term's, in increasing order, at most
+/// [`MAX_LENS_SHELLS`]; both terms look them up), its triangles in object space, its
+/// material, and the object placed in world space at the last transform drawn.
+struct LensState {
+    layers: Vec<usize>,
+    positions: Vec<glam::Vec3>,
+    normals: Vec<glam::Vec3>,
+    indices: Vec<u32>,
+    material: LensMaterial,
+    placed: Option<(glam::Mat4, LensObject)>,
+}
+
+impl LensState {
+    /// The lens object at `world` (rigid), built once per transform.
+    fn at(&mut self, world: glam::Mat4) -> &LensObject {
+        if self.placed.as_ref().is_none_or(|(m, _)| *m != world) {
+            let positions = self.positions.iter().map(|&p| world.transform_point3(p)).collect();
+            let normals = self.normals.iter().map(|&n| world.transform_vector3(n)).collect();
+            self.placed = Some((world, LensObject::new(self.material, positions, normals, &self.indices)));
+        }
+        &self.placed.as_ref().expect("placed above").1
+    }
 }
 
 /// A rebuilt texture: object, layer, block, the image of every pyramid level it sums.
@@ -158,12 +200,15 @@ struct Plan {
     eye: glam::Vec3,
     surfaces: Vec<Wanted>,
     reflections: Vec<WantedReflection>,
+    /// Lens objects' shells per parameter sample (both terms look them up).
+    lenses: Vec<WantedReflection>,
+    clip_from_world: glam::Mat4,
 }
 
 impl Plan {
     /// Every texture the frame draws (a texture drawn twice is listed twice).
     fn keys(&self) -> Vec<&TextureKey> {
-        let shells = self.reflections.iter().flat_map(|r| r.shells.iter().map(|(k, _)| k));
+        let shells = self.reflections.iter().chain(&self.lenses).flat_map(|r| r.shells.iter().map(|(k, _)| k));
         self.surfaces.iter().map(|w| &w.key).chain(shells).collect()
     }
 }
@@ -253,9 +298,10 @@ fn prepare_objects(gpu: &Gpu, reader: &PisReader) -> Result<Vec<ObjectGpu>, Play
             }
             layers.push(li);
         }
-        let reflection = reflection_shells(reader, oi, &mut skipped)?;
+        let lens = lens_state(reader, oi, &mut skipped)?;
+        let reflection = if lens.is_some() { Vec::new() } else { reflection_shells(reader, oi, &mut skipped)? };
         let mesh = MeshGpu::new(gpu, &o.mesh.positions, o.mesh.normals.as_deref(), &uvs, &o.mesh.indices).with_hull(o.mesh.hull_triangles);
-        out.push(ObjectGpu { mesh, layers, reflection });
+        out.push(ObjectGpu { mesh, layers, reflection, lens });
     }
     if !skipped.is_empty() {
         eprintln!("pis-play: note: shell layers are not drawn by this player: {}", skipped.join(", "));
@@ -290,6 +336,42 @@ fn reflection_shells(reader: &PisReader, oi: usize, skipped: &mut Vec<String>) -
         }
     }
     Ok(term)
+}
+
+/// Object `oi` as a lens object, when it is one: role `refractive`, shell layers in the
+/// refraction term (at most [`MAX_LENS_SHELLS`], closed shells), normals. Its reflection
+/// term's own shells, if any, are not drawn (listed in `skipped`), nor are the shells of a
+/// refractive object without normals.
+fn lens_state(reader: &PisReader, oi: usize, skipped: &mut Vec<String>) -> Result<Option<LensState>, PlayError> {
+    let o = &reader.container().objects[oi];
+    if o.role != pis_format::ObjectRole::Refractive {
+        return Ok(None);
+    }
+    let shells = |term| o.layers.iter().enumerate().filter(move |(_, l)| l.mapping == Mapping::Shell && l.term == term).map(|(li, _)| li);
+    let mut layers: Vec<usize> = shells(Term::Refraction).collect();
+    if layers.is_empty() {
+        return Ok(None);
+    }
+    let Some(normals) = &o.mesh.normals else {
+        layers.iter().for_each(|&li| skipped.push(format!("{}/{} (the mesh has no normals)", o.name, o.layers[li].kind.name())));
+        return Ok(None);
+    };
+    shells(Term::Reflection).for_each(|li| skipped.push(format!("{}/{} (a lens object's reflection term reads its refraction term's shells)", o.name, o.layers[li].kind.name())));
+    layers.sort_by_key(|&li| o.layers[li].order);
+    let not_supported = |message: String| PlayError::File(pis_format::Error::NotSupported(format!("{}: object {oi} '{}': {message}", reader.path().display(), o.name)));
+    if layers.len() > MAX_LENS_SHELLS {
+        return Err(not_supported(format!("{} shells in the refraction term; this player draws at most {MAX_LENS_SHELLS}", layers.len())));
+    }
+    for &li in &layers {
+        if !o.layers[li].blocks.iter().all(|b| matches!(b.placement, Placement::Shell { shape, .. } if shape.faces() == 6)) {
+            return Err(not_supported(format!("layer {li} ({}) is not a closed shell (sphere, ellipsoid, box or cylinder): quad shells are not drawn", o.layers[li].kind.name())));
+        }
+    }
+    let v3 = |v: &[f32; 3]| glam::Vec3::from_array(*v);
+    // The runtime's paths take the file's constants: IOR and absorption (SPEC.md 6.4, 9);
+    // the transmission has no colour of its own.
+    let material = LensMaterial { ior: o.shading.ior, base: glam::Vec3::ONE, sigma_a: v3(&o.shading.absorption) };
+    Ok(Some(LensState { layers, positions: o.mesh.positions.iter().map(v3).collect(), normals: normals.iter().map(v3).collect(), indices: o.mesh.indices.clone(), material, placed: None }))
 }
 
 /// The cube-map geometry of a shell block's placement (SPEC.md 7.3); `None` for a quad or a
@@ -365,6 +447,9 @@ impl Player {
         pipes.layer_pipeline(&gpu, offscreen, ms.samples);
         if objects.iter().any(|o| !o.reflection.is_empty()) {
             pipes.reflection_pipeline(&gpu, offscreen, ms.samples);
+        }
+        if objects.iter().any(|o| o.lens.is_some()) {
+            pipes.hybrid_pipeline(&gpu, offscreen, ms.samples);
         }
         let mips = MipBuilder::new(&gpu);
         Ok(Player {
@@ -523,7 +608,7 @@ impl Player {
                 (cam.projection(size) * cam.view_matrix(), cam.eye)
             }
         };
-        let mut plan = Plan { clips: Vec::with_capacity(c.objects.len()), worlds: Vec::with_capacity(c.objects.len()), eye, surfaces: Vec::new(), reflections: Vec::new() };
+        let mut plan = Plan { clips: Vec::with_capacity(c.objects.len()), worlds: Vec::with_capacity(c.objects.len()), eye, surfaces: Vec::new(), reflections: Vec::new(), lenses: Vec::new(), clip_from_world };
         for (oi, (o, og)) in c.objects.iter().zip(&self.objects).enumerate() {
             let t = &o.transforms;
             let world = t.transforms.get(c.space.table_index(t.depends_on, &nearest)).map_or(glam::Mat4::IDENTITY, mat4_from_rows);
@@ -536,7 +621,10 @@ impl Player {
                     plan.surfaces.push(Wanted { draw: oi, key, weight: w, transform: TextureTransform { values: affine, cut }, repeat });
                 }
             }
-            plan.reflections.extend(self.reflection_terms(oi, &samples)?);
+            plan.reflections.extend(self.shell_terms(oi, &og.reflection, &samples)?);
+            if let Some(lens) = &og.lens {
+                plan.lenses.extend(self.shell_terms(oi, &lens.layers, &samples)?);
+            }
         }
         Ok(plan)
     }
@@ -552,12 +640,12 @@ impl Player {
         Ok((TextureKey { object: oi as u32, layer: li as u32, block: pos.block as u32, images }, block))
     }
 
-    /// Object `oi`'s reflection terms at the weighted parameter samples: one per class of
-    /// samples the term's shells cannot tell apart (equal on the union of their dependency
-    /// masks), with the class's summed weight, as the surface layers are blended.
-    fn reflection_terms(&self, oi: usize, samples: &[(Vec<u32>, f32)]) -> Result<Vec<WantedReflection>, PlayError> {
+    /// Object `oi`'s terms of shell layers `term` (in order) at the weighted parameter
+    /// samples: one per class of samples the term's shells cannot tell apart (equal on the
+    /// union of their dependency masks), with the class's summed weight, as the surface
+    /// layers are blended.
+    fn shell_terms(&self, oi: usize, term: &[usize], samples: &[(Vec<u32>, f32)]) -> Result<Vec<WantedReflection>, PlayError> {
         let o = &self.reader.container().objects[oi];
-        let term = &self.objects[oi].reflection;
         if term.is_empty() {
             return Ok(Vec::new());
         }
@@ -684,6 +772,28 @@ impl Player {
             self.end_frame();
             return Err(e);
         }
+        // Lens objects: vertex rays, tessellation and the terms' corners (on the workers),
+        // once per object and shell geometry; one draw per term and parameter sample.
+        let t_lens = Instant::now();
+        let settings = TessellationSettings { tau_px: self.options.tau_px, ..TessellationSettings::default() };
+        let mut corner_sets: Vec<(usize, Vec<Shell>, [(wgpu::Buffer, u32); 2])> = Vec::new();
+        for r in &plan.lenses {
+            let shells: Vec<Shell> = r.shells.iter().map(|(_, s)| *s).collect();
+            if corner_sets.iter().any(|(d, s, _)| *d == r.draw && *s == shells) {
+                continue;
+            }
+            let Some(state) = self.objects[r.draw].lens.as_mut() else { continue };
+            let lens = state.at(plan.worlds[r.draw]);
+            let tess = tessellate(lens, &HybridView { eye: plan.eye, clip_from_world: plan.clip_from_world, size }, &settings);
+            stats.lens_rays += tess.stats.rays;
+            let buffers = TERMS.map(|term| {
+                let corners = term_corners(&tess, term, &shells);
+                (corner_buffer(&self.gpu, &corners), corners.len() as u32)
+            });
+            stats.lens_triangles += buffers.iter().map(|b| b.1 as u64 / 3).max().unwrap_or(0);
+            corner_sets.push((r.draw, shells, buffers));
+        }
+        stats.lens_ms = t_lens.elapsed().as_secs_f64() * 1e3;
         let format = match target {
             Target::Offscreen { .. } | Target::Timed => offscreen_format(&self.gpu),
             Target::View(_, f) => f,
@@ -723,6 +833,22 @@ impl Player {
             });
         }
         let reflections = reflection_draws(&self.reader, &self.resident, &plan)?;
+        let mut lenses = Vec::new();
+        for r in &plan.lenses {
+            let shells: Vec<Shell> = r.shells.iter().map(|(_, s)| *s).collect();
+            let Some((_, _, buffers)) = corner_sets.iter().find(|(d, s, _)| *d == r.draw && *s == shells) else { continue };
+            let mut cubes = Vec::with_capacity(r.shells.len());
+            for (key, _) in &r.shells {
+                let GpuTexture::Shell(cube) = &self.resident[key].texture else {
+                    return Err(content(&self.reader, format!("{key:?}: a surface texture drawn as a shell")));
+                };
+                cubes.push(cube);
+            }
+            for (corners, count) in buffers {
+                lenses.push(LensDraw { object: r.draw as u32, clip_from_world: plan.clip_from_world, weight: r.weight, corners, count: *count, shells: cubes.clone() });
+            }
+        }
+        stats.lens_draws = lenses.len() as u64;
         stats.surface_draws = layers.len() as u64;
         stats.shell_draws = reflections.len() as u64;
         let targets = self.targets.as_mut().expect("targets made above");
@@ -741,7 +867,7 @@ impl Player {
             }
         };
         let display = self.display.map(|(f, _)| f);
-        crate::frame::encode(&gpu, &mut self.pipes, targets, view, format, &objects, &layers, &reflections, want_ids, display, &mut encoder);
+        crate::frame::encode(&gpu, &mut self.pipes, targets, view, format, &objects, &layers, &reflections, &lenses, want_ids, display, &mut encoder);
         let out = match target {
             Target::Offscreen { ids } => {
                 gpu.queue.submit([encoder.finish()]);
@@ -772,6 +898,7 @@ impl Player {
                 None
             }
         };
+        drop(lenses);
         drop(reflections);
         drop(layers);
         drop(objects);

@@ -2,13 +2,16 @@
 //! object's tessellation, traced for one view, drawn through wgpu with a random cube map
 //! looked up along each term's per-vertex cube vectors matches A_model·x (PSNR ≥ 60 dB over
 //! the pixels both cover) for every shell shape and both terms, close up (the cube map
-//! magnified) and far away (minified across many MIP levels). Runs on Mesa's lavapipe in CI.
+//! magnified) and far away (minified across many MIP levels). A whole lens term in the
+//! player's frame — every shell of the term composited "over" with alpha, times the
+//! interpolated F·G — matches pis-compile's `term_radiance` the same way. Runs on Mesa's
+//! lavapipe in CI.
 
 mod common;
 
 use common::*;
 use glam::Vec3;
-use pis_compile::hybrid::{hybrid_render_matrix, tessellate, vertex_vectors, HybridView, LensMaterial, LensObject, TessellationSettings, TERMS};
+use pis_compile::hybrid::{hybrid_pixels, hybrid_render_matrix, term_radiance, tessellate, vertex_modulation, vertex_vectors, HybridView, LensMaterial, LensObject, Missing, TessellationSettings, TERMS};
 use pis_compile::{TextureLayout, Viewport};
 use pis_play::{render_hybrid, HybridPipeline};
 
@@ -53,4 +56,59 @@ fn hybrid_frames_match_the_model() {
     }
     eprintln!("worst PSNR {worst:.2} dB");
     assert!(failures.is_empty(), "{failures:#?}");
+}
+
+/// A term of a glass ball in the player's frame, four shells of every shape (nearest first)
+/// with random premultiplied colours and alphas, against the model's composite.
+#[test]
+fn lens_terms_in_the_frame_match_the_model() {
+    let Some(gpu) = gpu_or_skip("lens_terms_in_the_frame_match_the_model") else { return };
+    let vp = Viewport { width: 160, height: 120 };
+    let ball = uv_sphere(40, 20);
+    let positions: Vec<Vec3> = ball.positions.iter().map(|&p| Vec3::from(p)).collect();
+    let lens = LensObject::new(LensMaterial { ior: 1.5, base: Vec3::ONE, sigma_a: Vec3::splat(0.3) }, positions.clone(), positions, &ball.indices);
+    let eye = [0.4f32, 0.6, 2.6];
+    let clip = camera(vp, eye, [0.0, 0.0, 0.0], 1.0);
+    let tess = tessellate(&lens, &HybridView { eye: Vec3::from(eye), clip_from_world: clip, size: (vp.width, vp.height) }, &TessellationSettings { tau_px: 2.0, ..Default::default() });
+    // Shells nearest first: ellipsoid, cylinder, box, sphere; each cube with alpha in [0, 1]
+    // and its colour premultiplied.
+    let all = shells();
+    let order = ["ellipsoid", "cylinder", "box", "sphere"];
+    let layouts = [TextureLayout::cube(16), TextureLayout::cube(32), TextureLayout::cube(8), TextureLayout::cube(24)];
+    let cubes: Vec<Vec<f32>> = layouts
+        .iter()
+        .enumerate()
+        .map(|(k, l)| {
+            let c = random_rgba(l.texel_count(), 31 + k as u64);
+            let a = random_rgba(l.texel_count(), 97 + k as u64);
+            (0..l.texel_count()).flat_map(|t| [c[4 * t] * a[4 * t], c[4 * t + 1] * a[4 * t], c[4 * t + 2] * a[4 * t], a[4 * t]]).collect()
+        })
+        .collect();
+    let geometry: Vec<_> = order.iter().map(|n| all.iter().find(|(s, _)| s == n).expect("shell").1).collect();
+    let mut worst = f64::INFINITY;
+    for count in [1usize, 4] {
+        for term in TERMS {
+            let fg = hybrid_pixels(vp, &tess, clip, &vertex_modulation(&tess, term), Missing::Zero, None);
+            let a: Vec<_> = geometry[..count].iter().zip(&layouts).map(|(s, l)| hybrid_render_matrix(vp, &tess, clip, &vertex_vectors(&tess, term, s), *l, None)).collect();
+            let refs: Vec<&_> = a.iter().collect();
+            let cube_refs: Vec<&[f32]> = cubes[..count].iter().map(Vec::as_slice).collect();
+            let mut want = pis_play::FloatImage { width: vp.width, height: vp.height, rgba: vec![0.0; (vp.width * vp.height * 4) as usize] };
+            for (&p, c) in fg.pixels.iter().zip(term_radiance(&fg, &refs, &cube_refs)) {
+                want.rgba[4 * p as usize..4 * p as usize + 4].copy_from_slice(&[c[0], c[1], c[2], 1.0]);
+            }
+            let shells: Vec<_> = geometry[..count].iter().zip(&layouts).zip(&cubes).map(|((s, l), c)| (*s, *l, c.as_slice())).collect();
+            let got = pis_play::frame_hybrid::render_lens_term(&gpu, vp, &tess, clip, term, &shells).unwrap();
+            let again = pis_play::frame_hybrid::render_lens_term(&gpu, vp, &tess, clip, term, &shells).unwrap();
+            assert!(again.rgba.iter().zip(&got.rgba).all(|(a, b)| a.to_bits() == b.to_bits()), "{count} shells {term:?}: two frames differ");
+            let c = compare(&want, &got);
+            let name = format!("lens-term-{count}-{term:?}");
+            eprintln!("{name}: PSNR {:.2} dB over {} pixels, {} coverage mismatches", c.psnr_db, c.both, c.coverage_mismatch);
+            worst = worst.min(c.psnr_db);
+            if c.psnr_db < 60.0 || c.coverage_mismatch * 1000 > c.both || c.both < 500 {
+                let dir = write_failure_images(&name, &want, &got);
+                panic!("{name}: {c:?} (images in {})", dir.display());
+            }
+        }
+    }
+    eprintln!("worst PSNR {worst:.2} dB");
 }

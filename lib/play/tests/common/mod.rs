@@ -178,7 +178,7 @@ pub fn draw_scene(
     let layers: Vec<LayerDraw> = scene.iter().enumerate().map(|(i, (_, _, texture))| LayerDraw { draw: i, texture, sampler, transform: pis_compile::TextureTransform::IDENTITY, max_level: 0.0, weight: 1.0, anisotropic: false }).collect();
     let mut encoder = gpu.device.create_command_encoder(&Default::default());
     let view = targets.colour.create_view(&Default::default());
-    encode(gpu, pipes, &mut targets, &view, format, &objects, &layers, &[], true, display, &mut encoder);
+    encode(gpu, pipes, &mut targets, &view, format, &objects, &layers, &[], &[], true, display, &mut encoder);
     let texel = if format == wgpu::TextureFormat::Rgba16Float { 8 } else { 16 };
     let (rc, ri) = (Readback::new(gpu, size, texel), Readback::new(gpu, size, 4));
     rc.copy(&targets.colour, &mut encoder);

@@ -1,0 +1,174 @@
+//! A lens object in the player's frame (SPEC.md 9, thesis 6.4): the frame's tessellation of
+//! the object, traced on the workers ([`pis_compile::hybrid::tessellate`]), turned into one
+//! vertex buffer per term — per corner its triangle's F·G and, per shell, the cube-map
+//! vector of the outgoing ray — and drawn additively by `frame_hybrid.wgsl` (appended to
+//! `shell.wgsl`) once per term and parameter sample, the term's shells composited "over".
+//! Both terms look up the same shells (a lens object's shells are stored in its refraction
+//! term; SPEC.md 9). [`crate::frame`] encodes the draws.
+
+use bytemuck::{Pod, Zeroable};
+use pis_compile::hybrid::{corner_values, vertex_modulation, vertex_vectors, Missing, Term, Tessellation};
+use pis_compile::shell::Shell;
+use rayon::prelude::*;
+use wgpu::util::DeviceExt;
+
+use crate::gpu::Gpu;
+use crate::shell::ShellTexture;
+
+/// The lens-term entry points, appended to [`crate::shell::SHELL_FUNCTIONS`].
+pub const HYBRID_FRAME: &str = include_str!("frame_hybrid.wgsl");
+/// The most shells a lens object's term draws in one pass.
+pub const MAX_LENS_SHELLS: usize = 4;
+
+/// `HybridFrameUniforms` of `frame_hybrid.wgsl` (160 bytes).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+struct HybridFrameUniforms {
+    clip_from_world: [f32; 16],
+    shells: [[u32; 4]; MAX_LENS_SHELLS],
+    weight: [f32; 4],
+    object: u32,
+    count: u32,
+    _pad: [u32; 2],
+}
+
+/// One corner of a drawn triangle as the vertex buffer holds it (88 bytes): world position,
+/// F·G, and per shell slot the cube-map vector with w = 1 where the triangle draws the shell.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct LensCorner {
+    pub position: [f32; 3],
+    pub fg: [f32; 3],
+    pub vectors: [[f32; 4]; MAX_LENS_SHELLS],
+}
+
+/// The vertex buffer layout of [`LensCorner`].
+pub const LENS_CORNER_LAYOUT: wgpu::VertexBufferLayout<'static> = wgpu::VertexBufferLayout {
+    array_stride: std::mem::size_of::<LensCorner>() as u64,
+    step_mode: wgpu::VertexStepMode::Vertex,
+    attributes: &[
+        wgpu::VertexAttribute { format: wgpu::VertexFormat::Float32x3, offset: 0, shader_location: 0 },
+        wgpu::VertexAttribute { format: wgpu::VertexFormat::Float32x3, offset: 12, shader_location: 1 },
+        wgpu::VertexAttribute { format: wgpu::VertexFormat::Float32x4, offset: 24, shader_location: 2 },
+        wgpu::VertexAttribute { format: wgpu::VertexFormat::Float32x4, offset: 40, shader_location: 3 },
+        wgpu::VertexAttribute { format: wgpu::VertexFormat::Float32x4, offset: 56, shader_location: 4 },
+        wgpu::VertexAttribute { format: wgpu::VertexFormat::Float32x4, offset: 72, shader_location: 5 },
+    ],
+};
+
+/// The corners of the triangles of `tess` that draw `term`, with the cube vectors of
+/// `shells` (at most [`MAX_LENS_SHELLS`]): a triangle draws the term where a corner has the
+/// term's path (the others take F·G 0), and a shell where a corner's outgoing ray meets it
+/// (the others take the mean vector), as pis-compile's `hybrid_pixels` and
+/// `hybrid_render_matrix` draw it.
+pub fn term_corners(tess: &Tessellation, term: Term, shells: &[Shell]) -> Vec<LensCorner> {
+    let fg = corner_values(tess, &vertex_modulation(tess, term), Missing::Zero);
+    let vectors: Vec<Vec<Option<[[f32; 3]; 3]>>> = shells.par_iter().take(MAX_LENS_SHELLS).map(|s| corner_values(tess, &vertex_vectors(tess, term, s), Missing::Mean)).collect();
+    let mut out = Vec::new();
+    for (t, tri) in tess.triangles.iter().enumerate() {
+        let Some(f) = fg[t] else { continue };
+        for c in 0..3 {
+            let mut v = [[0.0f32; 4]; MAX_LENS_SHELLS];
+            for (k, vs) in vectors.iter().enumerate() {
+                if let Some(x) = vs[t] {
+                    v[k] = [x[c][0], x[c][1], x[c][2], 1.0];
+                }
+            }
+            out.push(LensCorner { position: tess.vertices[tri[c] as usize].position.to_array(), fg: f[c], vectors: v });
+        }
+    }
+    out
+}
+
+/// One term of a lens object drawn at one parameter sample.
+pub struct LensDraw<'a> {
+    /// The object's index in the file (the id pass's).
+    pub object: u32,
+    pub clip_from_world: glam::Mat4,
+    pub weight: f32,
+    /// The term's corners ([`term_corners`]) on the GPU, and how many.
+    pub corners: &'a wgpu::Buffer,
+    pub count: u32,
+    /// The term's shells in order, each its cube map (1 to [`MAX_LENS_SHELLS`]).
+    pub shells: Vec<&'a ShellTexture>,
+}
+
+/// The corners on the GPU (at least one corner's worth of bytes).
+pub fn corner_buffer(gpu: &Gpu, corners: &[LensCorner]) -> wgpu::Buffer {
+    let empty = [LensCorner::zeroed()];
+    let bytes: &[u8] = bytemuck::cast_slice(if corners.is_empty() { &empty } else { corners });
+    gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: Some("lens corners"), contents: bytes, usage: wgpu::BufferUsages::VERTEX })
+}
+
+/// The bind group of one lens draw: its uniforms and its shells' cube maps (the last
+/// repeated in the unused slots).
+pub fn lens_bind(gpu: &Gpu, layout: &wgpu::BindGroupLayout, draw: &LensDraw) -> wgpu::BindGroup {
+    let d = &gpu.device;
+    let mut shells = [[0u32; 4]; MAX_LENS_SHELLS];
+    for (slot, cube) in shells.iter_mut().zip(&draw.shells) {
+        *slot = [cube.layout.width, cube.layout.levels, 0, 0];
+    }
+    let u = HybridFrameUniforms {
+        clip_from_world: draw.clip_from_world.to_cols_array(),
+        shells,
+        weight: [draw.weight, 0.0, 0.0, 0.0],
+        object: draw.object,
+        count: draw.shells.len().min(MAX_LENS_SHELLS) as u32,
+        _pad: [0; 2],
+    };
+    let ub = d.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: Some("lens uniforms"), contents: bytemuck::bytes_of(&u), usage: wgpu::BufferUsages::UNIFORM });
+    let cube = |k: usize| wgpu::BindingResource::TextureView(&draw.shells[k.min(draw.shells.len() - 1)].view);
+    let mut entries = vec![wgpu::BindGroupEntry { binding: 0, resource: ub.as_entire_binding() }];
+    entries.extend((0..MAX_LENS_SHELLS).map(|k| wgpu::BindGroupEntry { binding: k as u32 + 1, resource: cube(k) }));
+    d.create_bind_group(&wgpu::BindGroupDescriptor { label: Some("lens term"), layout, entries: &entries })
+}
+
+/// One term of the tessellated lens object `tess` drawn through the frame's own path
+/// ([`crate::frame::encode`], one sample per pixel): the id pass of the tessellation, then
+/// the term with `shells` (each its geometry, cube layout and RGBA texels: premultiplied
+/// colour, then alpha) at weight 1. Returns RGBA per pixel (rows from the top; alpha 1 where
+/// the term is drawn). pis-compile's [`pis_compile::hybrid::term_radiance`] is its twin.
+pub fn render_lens_term(gpu: &Gpu, viewport: pis_compile::Viewport, tess: &Tessellation, clip_from_world: glam::Mat4, term: Term, shells: &[(Shell, pis_compile::TextureLayout, &[f32])]) -> Result<crate::FloatImage, crate::PlayError> {
+    use crate::frame::{colour_image, encode, offscreen_format, FramePipelines, MeshGpu, ObjectDraw, Readback, Targets};
+    if shells.is_empty() || shells.len() > MAX_LENS_SHELLS {
+        return Err(crate::PlayError::Request(format!("{} shells: a lens term draws 1 to {MAX_LENS_SHELLS}", shells.len())));
+    }
+    let size = (viewport.width, viewport.height);
+    let mut pipes = FramePipelines::new(gpu);
+    let mut targets = Targets::new(gpu, &pipes, size, 1)?;
+    let mut cubes = Vec::with_capacity(shells.len());
+    for (_, layout, rgba) in shells {
+        let cube = ShellTexture::new(gpu, *layout, "lens object")?;
+        cube.upload(gpu, rgba)?;
+        cubes.push(cube);
+    }
+    let geometry: Vec<Shell> = shells.iter().map(|s| s.0).collect();
+    let corners = term_corners(tess, term, &geometry);
+    let buffer = corner_buffer(gpu, &corners);
+    let positions: Vec<[f32; 3]> = tess.vertices.iter().map(|v| v.position.to_array()).collect();
+    let indices: Vec<u32> = tess.triangles.iter().flatten().copied().collect();
+    let mesh = MeshGpu::new(gpu, &positions, None, &vec![[0.0; 2]; positions.len()], &indices);
+    let objects = [ObjectDraw { object: 0, mesh: &mesh, clip_from_object: clip_from_world }];
+    let lenses = [LensDraw { object: 0, clip_from_world, weight: 1.0, corners: &buffer, count: corners.len() as u32, shells: cubes.iter().collect() }];
+    let format = offscreen_format(gpu);
+    let view = targets.colour.create_view(&Default::default());
+    let mut encoder = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("lens term") });
+    encode(gpu, &mut pipes, &mut targets, &view, format, &objects, &[], &[], &lenses, false, None, &mut encoder);
+    let texel = if format == wgpu::TextureFormat::Rgba16Float { 8 } else { 16 };
+    let readback = Readback::new(gpu, size, texel);
+    readback.copy(&targets.colour, &mut encoder);
+    gpu.queue.submit([encoder.finish()]);
+    Ok(colour_image(&readback.read(gpu)?, format, size))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn lens_structs_have_the_wgsl_layout() {
+        assert_eq!(std::mem::size_of::<HybridFrameUniforms>(), 64 + 64 + 16 + 16);
+        assert_eq!(std::mem::size_of::<LensCorner>(), 88);
+        assert_eq!(LENS_CORNER_LAYOUT.attributes.last().map(|a| a.offset + 16), Some(88));
+    }
+}
