@@ -83,8 +83,9 @@ pub struct PackOptions {
     /// frame), `pem-infinity` (reflective objects as one environment map at infinity per
     /// sample, inferred: the single-shell baseline) or `static-env` (reflective objects as one
     /// environment map at infinity per sample, ray-traced from the object's centre without
-    /// the object: the static environment map of thesis 5.1); the last two store refractive
-    /// objects as `pem` does.
+    /// the object: the static environment map of thesis 5.1); `pem-infinity` stores
+    /// refractive objects by hybrid rendering with a single shell (the single-shell
+    /// baseline of thesis 6.5), `static-env` as `pem` does.
     #[arg(long, default_value = "texture", value_parser = parse_representation)]
     pub representation: RepresentationMode,
     /// Conjugate-gradient iteration cap per colour channel of every texture solve

@@ -213,8 +213,8 @@ enum Command {
     },
     /// Reflective objects as the player draws them: each packed file played at the sampled
     /// views and along dense camera paths between and away from them, against frames
-    /// ray-traced at each exact camera, over the reflective objects' pixels (writes
-    /// reflective.csv).
+    /// ray-traced at each exact camera, over the reflective objects' pixels (with --role
+    /// refractive, the lens objects'; writes reflective.csv).
     Reflective {
         /// The scene.toml the files were packed from.
         scene: PathBuf,
@@ -236,6 +236,13 @@ enum Command {
         /// Also write every played frame beside its traced reference (PNG) into --out.
         #[arg(long)]
         images: bool,
+        /// The objects measured: `reflective` or `refractive` (the lens objects, drawn by
+        /// hybrid rendering).
+        #[arg(long, default_value = "reflective", value_parser = parse_role)]
+        role: pis_scene::ObjectRole,
+        /// The player's τ for lens objects (pis-play --tau), pixels.
+        #[arg(long, default_value_t = 1.0)]
+        tau: f32,
         #[arg(long)]
         json: bool,
     },
@@ -359,8 +366,8 @@ fn run(cli: Cli) -> Result<Exit, Failure> {
             }
             Ok(Exit::Ok)
         }
-        Command::Reflective { scene, files, frames, reference_spp, out, resolution, preset, images, json } => {
-            let req = ReflectiveRequest { scene, preset, resolution, files, frames, spp: reference_spp, out, images };
+        Command::Reflective { scene, files, frames, reference_spp, out, resolution, preset, images, role, tau, json } => {
+            let req = ReflectiveRequest { scene, preset, resolution, files, frames, spp: reference_spp, out, images, role, tau_px: tau };
             let report = reflective::run(&req)?;
             reflective::print(&report, &mut std::io::stderr()).map_err(|e| Failure::new(Exit::Io, e))?;
             if json {
@@ -389,4 +396,12 @@ fn main() -> ExitCode {
         Err(code) => return code,
     };
     finish("pis-bench", run(cli))
+}
+
+fn parse_role(s: &str) -> Result<pis_scene::ObjectRole, String> {
+    match s {
+        "reflective" => Ok(pis_scene::ObjectRole::Reflective),
+        "refractive" => Ok(pis_scene::ObjectRole::Refractive),
+        _ => Err(format!("unknown role {s:?} (reflective or refractive)")),
+    }
 }

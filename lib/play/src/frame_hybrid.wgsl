@@ -59,45 +59,59 @@ fn vs_hybrid_frame(@location(0) position: vec3<f32>, @location(1) fg: vec3<f32>,
 }
 
 // Shell k's premultiplied RGBA along the interpolated vector v (xyz) with derivatives
-// ddx, ddy.
-fn lens_shell(k: u32, v: vec3<f32>, ddx: vec3<f32>, ddy: vec3<f32>) -> vec4<f32> {
+// ddx, ddy, looked up in `cube`.
+fn lens_shell(k: u32, cube: texture_2d_array<f32>, v: vec3<f32>, ddx: vec3<f32>, ddy: vec3<f32>) -> vec4<f32> {
     let size = hf.shells[k].x;
     let levels = hf.shells[k].y;
     let lambda = cube_lod(v, ddx, ddy, f32(size), f32(levels - 1u));
-    switch k {
-        case 0u: { return cube_sample(lens_cube0, size, levels, v, lambda); }
-        case 1u: { return cube_sample(lens_cube1, size, levels, v, lambda); }
-        case 2u: { return cube_sample(lens_cube2, size, levels, v, lambda); }
-        default: { return cube_sample(lens_cube3, size, levels, v, lambda); }
-    }
+    return cube_sample(cube, size, levels, v, lambda);
+}
+
+// One step of "over": the running colour and transmittance after shell colour c.
+fn lens_over(acc: vec4<f32>, c: vec4<f32>) -> vec4<f32> {
+    return vec4<f32>(acc.rgb + acc.a * c.rgb, acc.a * (1.0 - clamp(c.a, 0.0, 1.0)));
+}
+
+// The derivatives of the four shell vectors (fine: across the pixel's 2×2 quad), taken in
+// uniform control flow before any fragment is discarded.
+struct LensDerivatives {
+    dx: array<vec3<f32>, 4>,
+    dy: array<vec3<f32>, 4>,
+};
+
+fn lens_derivatives(in: HybridFrameVsOut) -> LensDerivatives {
+    return LensDerivatives(
+        array<vec3<f32>, 4>(dpdxFine(in.v0.xyz), dpdxFine(in.v1.xyz), dpdxFine(in.v2.xyz), dpdxFine(in.v3.xyz)),
+        array<vec3<f32>, 4>(dpdyFine(in.v0.xyz), dpdyFine(in.v1.xyz), dpdyFine(in.v2.xyz), dpdyFine(in.v3.xyz)),
+    );
 }
 
 // The term (SPEC.md 9): shells "over" in increasing order, rgb += through · c.rgb,
 // through ·= 1 − clamp(c.a, 0, 1), shells the triangle does not draw skipped; times F·G.
-fn hybrid_term(in: HybridFrameVsOut) -> vec3<f32> {
-    // Derivatives first, in uniform control flow.
-    var v = array<vec4<f32>, 4>(in.v0, in.v1, in.v2, in.v3);
-    var dx = array<vec3<f32>, 4>(dpdxFine(in.v0.xyz), dpdxFine(in.v1.xyz), dpdxFine(in.v2.xyz), dpdxFine(in.v3.xyz));
-    var dy = array<vec3<f32>, 4>(dpdyFine(in.v0.xyz), dpdyFine(in.v1.xyz), dpdyFine(in.v2.xyz), dpdyFine(in.v3.xyz));
-    var acc = vec3<f32>(0.0);
-    var through = 1.0;
-    for (var k = 0u; k < hf.count; k = k + 1u) {
-        if (v[k].w > 0.5) {
-            let c = lens_shell(k, v[k].xyz, dx[k], dy[k]);
-            acc = acc + through * c.rgb;
-            through = through * (1.0 - clamp(c.a, 0.0, 1.0));
-        }
+fn hybrid_term(in: HybridFrameVsOut, d: LensDerivatives) -> vec3<f32> {
+    var acc = vec4<f32>(0.0, 0.0, 0.0, 1.0);
+    if (hf.count > 0u && in.v0.w > 0.5) {
+        acc = lens_over(acc, lens_shell(0u, lens_cube0, in.v0.xyz, d.dx[0], d.dy[0]));
     }
-    return acc * in.fg;
+    if (hf.count > 1u && in.v1.w > 0.5) {
+        acc = lens_over(acc, lens_shell(1u, lens_cube1, in.v1.xyz, d.dx[1], d.dy[1]));
+    }
+    if (hf.count > 2u && in.v2.w > 0.5) {
+        acc = lens_over(acc, lens_shell(2u, lens_cube2, in.v2.xyz, d.dx[2], d.dy[2]));
+    }
+    if (hf.count > 3u && in.v3.w > 0.5) {
+        acc = lens_over(acc, lens_shell(3u, lens_cube3, in.v3.xyz, d.dx[3], d.dy[3]));
+    }
+    return acc.rgb * in.fg;
 }
 
 @fragment
 fn fs_hybrid_frame(in: HybridFrameVsOut) -> @location(0) vec4<f32> {
-    let c = hybrid_term(in) * hf.weight.x;
+    let d = lens_derivatives(in);
     if (textureLoad(ids, vec2<i32>(in.clip.xy), 0).r != hf.object) {
         discard;
     }
-    return vec4<f32>(c, 1.0);
+    return vec4<f32>(hybrid_term(in, d) * hf.weight.x, 1.0);
 }
 
 struct HybridFrameSamples {
@@ -108,7 +122,7 @@ struct HybridFrameSamples {
 // `fs_hybrid_frame` for multisampled targets, as frame.wgsl's `fs_layer_ms`.
 @fragment
 fn fs_hybrid_frame_ms(in: HybridFrameVsOut, @builtin(sample_mask) covered: u32) -> HybridFrameSamples {
-    let c = hybrid_term(in) * hf.weight.x;
+    let d = lens_derivatives(in);
     let pixel = vec2<i32>(in.clip.xy);
     var mask = 0u;
     for (var i = 0u; i < textureNumSamples(ids_ms); i = i + 1u) {
@@ -120,7 +134,7 @@ fn fs_hybrid_frame_ms(in: HybridFrameVsOut, @builtin(sample_mask) covered: u32) 
         discard;
     }
     var out: HybridFrameSamples;
-    out.colour = vec4<f32>(c, 1.0);
+    out.colour = vec4<f32>(hybrid_term(in, d) * hf.weight.x, 1.0);
     out.mask = mask;
     return out;
 }

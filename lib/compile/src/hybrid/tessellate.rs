@@ -1,5 +1,6 @@
 //! Adaptive tessellation of a lens object for one frame (thesis 6.4.1): the greedy paths
-//! traced at the front-facing vertices, triangles split at their edges' midpoints (1-to-4,
+//! traced at the vertices of the front-facing triangles — and of the back-facing ones the
+//! eye sees through an open mesh's holes, entered from inside as pis-trace enters them — triangles split at their edges' midpoints (1-to-4,
 //! 1-to-3 or 1-to-2) where their vertices' paths differ in topology or in exit direction by
 //! more than 3° (or, beyond the thesis, in F·G by more than 0.05), down to a screen edge
 //! length τ; the T-junctions left between triangles split
@@ -59,6 +60,9 @@ pub struct HybridVertex {
     pub normal: Vec3,
     /// Seen from the eye past the lens object's other triangles.
     pub visible: bool,
+    /// Traced as the outside of the surface (the eye on the side its normal faces); else
+    /// as its inside, seen through a hole of an open mesh.
+    pub front_face: bool,
     /// The reflection-first and refraction-first paths.
     pub paths: [Option<LensPath>; 2],
 }
@@ -72,6 +76,9 @@ pub struct TessellationStats {
     pub rays: u64,
     /// Front-facing triangles of the mesh, and triangles drawn.
     pub front_triangles: u64,
+    /// Back-facing triangles traced: those with a vertex the eye sees (an open mesh's
+    /// inside through its holes).
+    pub back_triangles: u64,
     pub triangles: u64,
     /// Triangles split, and triangles fanned to remove T-junctions.
     pub splits: u64,
@@ -87,8 +94,9 @@ pub struct Tessellation {
     pub stats: TessellationStats,
 }
 
-/// Traces the paths of a surface point seen from `eye` (thesis 6.4.1: the vertex ray).
-pub fn trace_vertex(lens: &LensObject, eye: Vec3, position: Vec3, normal: Vec3, max_depth: u32) -> (HybridVertex, u64) {
+/// Traces the paths of a surface point seen from `eye` (thesis 6.4.1: the vertex ray), on
+/// the outside of the surface (`front_face`, the side `normal` faces) or on its inside.
+pub fn trace_vertex(lens: &LensObject, eye: Vec3, position: Vec3, normal: Vec3, front_face: bool, max_depth: u32) -> (HybridVertex, u64) {
     let to = position - eye;
     let distance = to.length();
     let dir = to / distance;
@@ -98,14 +106,23 @@ pub fn trace_vertex(lens: &LensObject, eye: Vec3, position: Vec3, normal: Vec3, 
     // vertex has no single face).
     let n = normal.normalize_or_zero();
     let n = if n == Vec3::ZERO { -dir } else { n };
-    let first = LensSurface { position, normal: n, geometric_normal: n, front_face: true };
+    let facing = if front_face { n } else { -n };
+    let first = LensSurface { position, normal: facing, geometric_normal: facing, front_face };
     let mut rays = 1;
     let paths = TERMS.map(|t| {
         let p = greedy_path(lens, &first, dir, t, max_depth);
         rays += p.map_or(0, |p| p.topology.interfaces as u64);
         p
     });
-    (HybridVertex { position, normal: n, visible, paths }, rays)
+    (HybridVertex { position, normal: n, visible, front_face, paths }, rays)
+}
+
+/// Whether the eye sees `position` past the lens object's triangles.
+fn sees(lens: &LensObject, eye: Vec3, position: Vec3) -> bool {
+    let to = position - eye;
+    let distance = to.length();
+    let eps = 1e-4 * (1.0 + position.abs().max_element());
+    distance > 0.0 && lens.closest(eye, to / distance, distance - eps).is_none()
 }
 
 /// Where a tessellation's time went (wall clock, not part of its result).
@@ -138,14 +155,33 @@ pub fn tessellate_timed(lens: &LensObject, view: &HybridView, settings: &Tessell
     stats.front_triangles = front.len() as u64;
     let mut used = vec![false; lens.positions.len()];
     front.iter().flatten().for_each(|&v| used[v as usize] = true);
+    // Back-facing triangles with a vertex no part of the object hides: an open mesh's
+    // inside seen through its holes (a closed mesh's are hidden, but at its silhouette).
+    let back_candidates: Vec<[u32; 3]> = (0..lens.triangles.len())
+        .filter(|&t| {
+            let a = lens.positions[lens.triangles[t][0] as usize];
+            lens.face_normal(t).dot(view.eye - a) <= 0.0
+        })
+        .map(|t| lens.triangles[t])
+        .collect();
+    let mut back_vertex: Vec<u32> = back_candidates.iter().flatten().copied().filter(|&v| !used[v as usize]).collect();
+    back_vertex.sort_unstable();
+    back_vertex.dedup();
+    let seen: Vec<bool> = back_vertex.par_iter().map(|&v| sees(lens, view.eye, lens.positions[v as usize])).collect();
+    let mut visible_back = vec![false; lens.positions.len()];
+    back_vertex.iter().zip(&seen).for_each(|(&v, &s)| visible_back[v as usize] = s);
+    let back: Vec<[u32; 3]> = back_candidates.into_iter().filter(|t| t.iter().any(|&v| visible_back[v as usize])).collect();
+    stats.back_triangles = back.len() as u64;
     let mut mesh = Mesh { lens, view, settings, vertices: Vec::new(), midpoints: HashMap::new(), stats, trace_time: Duration::ZERO };
     mesh.vertices = (0..lens.positions.len())
-        .map(|i| HybridVertex { position: lens.positions[i], normal: lens.normals.get(i).copied().unwrap_or(Vec3::ZERO), visible: false, paths: [None, None] })
+        .map(|i| HybridVertex { position: lens.positions[i], normal: lens.normals.get(i).copied().unwrap_or(Vec3::ZERO), visible: false, front_face: used[i], paths: [None, None] })
         .collect();
-    let front_vertices: Vec<u32> = (0..lens.positions.len() as u32).filter(|&i| used[i as usize]).collect();
-    mesh.trace(&front_vertices);
+    back.iter().flatten().for_each(|&v| used[v as usize] = true);
+    let first_vertices: Vec<u32> = (0..lens.positions.len() as u32).filter(|&i| used[i as usize]).collect();
+    mesh.trace(&first_vertices);
     // Split level by level.
     let mut current = front;
+    current.extend(back);
     let mut leaves = Vec::new();
     for _ in 0..settings.max_levels {
         if current.is_empty() {
@@ -190,7 +226,7 @@ pub fn tessellate_timed(lens: &LensObject, view: &HybridView, settings: &Tessell
                 // A centre vertex, fanned to every boundary segment.
                 let c = mesh.vertices.len() as u32 + centres.len() as u32;
                 let [a, b, d] = tri.map(|v| mesh.vertices[v as usize]);
-                centres.push(((a.position + b.position + d.position) / 3.0, (a.normal + b.normal + d.normal).normalize_or_zero()));
+                centres.push(((a.position + b.position + d.position) / 3.0, (a.normal + b.normal + d.normal).normalize_or_zero(), a.front_face || b.front_face || d.front_face));
                 let mut ring = Vec::new();
                 for e in 0..3 {
                     ring.push(tri[e]);
@@ -203,7 +239,7 @@ pub fn tessellate_timed(lens: &LensObject, view: &HybridView, settings: &Tessell
     }
     if !centres.is_empty() {
         let first = mesh.vertices.len() as u32;
-        mesh.vertices.extend(centres.iter().map(|&(p, n)| HybridVertex { position: p, normal: n, visible: false, paths: [None, None] }));
+        mesh.vertices.extend(centres.iter().map(|&(p, n, front_face)| HybridVertex { position: p, normal: n, visible: false, front_face, paths: [None, None] }));
         let ids: Vec<u32> = (first..mesh.vertices.len() as u32).collect();
         mesh.trace(&ids);
     }
@@ -251,7 +287,7 @@ impl Mesh<'_> {
             .par_iter()
             .map(|&i| {
                 let v = self.vertices[i as usize];
-                trace_vertex(lens, eye, v.position, v.normal, depth)
+                trace_vertex(lens, eye, v.position, v.normal, v.front_face, depth)
             })
             .collect();
         for (&i, (v, rays)) in ids.iter().zip(traced) {
@@ -301,7 +337,7 @@ impl Mesh<'_> {
         }
         let (p, q) = (self.vertices[key.0 as usize], self.vertices[key.1 as usize]);
         let m = self.vertices.len() as u32;
-        self.vertices.push(HybridVertex { position: (p.position + q.position) * 0.5, normal: (p.normal + q.normal).normalize_or_zero(), visible: false, paths: [None, None] });
+        self.vertices.push(HybridVertex { position: (p.position + q.position) * 0.5, normal: (p.normal + q.normal).normalize_or_zero(), visible: false, front_face: p.front_face || q.front_face, paths: [None, None] });
         self.midpoints.insert(key, m);
         made.push(m);
         m

@@ -1,5 +1,6 @@
 //! `pis-bench reflective`: reflective objects on and off the sampled views, as the player
-//! draws them (thesis 5.10, figs 5.9–5.10). Given packed files of one scene — e.g. its
+//! draws them (thesis 5.10, figs 5.9–5.10); with `role` refractive, the lens objects
+//! (thesis 6.5). Given packed files of one scene — e.g. its
 //! reflective objects as parameterized textures and as layered environment maps — every
 //! file is played at each sampled view and at each camera of two dense paths (between the
 //! sampled views on their orbit, and away from it: a larger radius, higher elevation) and
@@ -45,6 +46,11 @@ pub struct ReflectiveRequest {
     pub out: PathBuf,
     /// Also write every played frame beside its traced reference as an sRGB PNG.
     pub images: bool,
+    /// The objects measured: the scene's reflective objects, or its refractive (lens)
+    /// objects.
+    pub role: ObjectRole,
+    /// The player's τ for lens objects (pixels).
+    pub tau_px: f32,
 }
 
 /// One file on one path.
@@ -138,6 +144,15 @@ fn rms_change(a: &[f32], b: &[f32], mask: &[bool]) -> f64 {
     (s / n.max(1) as f64).sqrt()
 }
 
+/// The name `--role` takes.
+pub fn role_name(role: ObjectRole) -> &'static str {
+    match role {
+        ObjectRole::Diffuse => "diffuse",
+        ObjectRole::Reflective => "reflective",
+        ObjectRole::Refractive => "refractive",
+    }
+}
+
 fn runtime(e: impl Into<anyhow::Error>) -> Failure {
     Failure::new(Exit::Runtime, e.into())
 }
@@ -149,9 +164,9 @@ pub fn run(req: &ReflectiveRequest) -> Result<ReflectiveReport, Failure> {
     }
     let options = LoadOptions { preset: req.preset.clone(), resolution: req.resolution, spp: None };
     let scene = pis_scene::load_with(&req.scene, &options).map_err(|e| Failure::new(pis_pack::scene_exit(&e), anyhow!("{}: {e}", req.scene.display())))?;
-    let objects: Vec<usize> = scene.objects.iter().enumerate().filter(|(_, o)| o.role == ObjectRole::Reflective).map(|(i, _)| i).collect();
+    let objects: Vec<usize> = scene.objects.iter().enumerate().filter(|(_, o)| o.role == req.role).map(|(i, _)| i).collect();
     if objects.is_empty() {
-        return Err(Failure::new(Exit::Usage, anyhow!("scene {} has no reflective object", scene.name)));
+        return Err(Failure::new(Exit::Usage, anyhow!("scene {} has no {} object", scene.name, role_name(req.role))));
     }
     let (view_dim, frames) = paths(&scene, req.frames, &PATHS).map_err(|e| Failure::new(Exit::NotSupported, e))?;
     eprintln!("pis-bench: reflective: tracing {} reference frames at {} spp", frames.len(), req.spp);
@@ -161,7 +176,7 @@ pub fn run(req: &ReflectiveRequest) -> Result<ReflectiveReport, Failure> {
     let mut csv = Csv::new(&["file", "path", "frame", "view", "psnr_db", "change_played", "change_reference"]);
     let mut summaries = Vec::new();
     for file in &req.files {
-        let mut player = Player::open(gpu.clone(), file, PlayerOptions::default()).map_err(|e| Failure::new(Exit::Invalid, anyhow!("{}: {e}", file.display())))?;
+        let mut player = Player::open(gpu.clone(), file, PlayerOptions { tau_px: req.tau_px, ..PlayerOptions::default() }).map_err(|e| Failure::new(Exit::Invalid, anyhow!("{}: {e}", file.display())))?;
         if player.image_size() != size {
             return Err(Failure::new(Exit::Usage, anyhow!("{}: {}x{} frames, the scene's are {}x{} (pass the same --preset or --resolution)", file.display(), player.image_size().0, player.image_size().1, size.0, size.1)));
         }

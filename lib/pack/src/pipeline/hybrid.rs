@@ -71,6 +71,11 @@ impl Planned for HybridPlanned {
         let views: Vec<Vec<TracedView>> = (0..set.frames.len()).map(|p| vec![TracedView { frame: &set.frames[p], images: &set.images[p], records: &set.records[p] }]).collect();
         let mut settings = LensInferSettings::default();
         settings.solve.cg = job.settings.cg;
+        // The single-shell baseline (thesis 6.5's comparison): one layer, one shell.
+        let one = job.req.representation == super::RepresentationMode::PemInfinity;
+        if one {
+            settings.max_layers = 1;
+        }
         let inference = infer_lens_views(scene, o, &views, &settings)?;
         let layout = TextureLayout::cube(inference.face);
         let grid_blocks = pis_format::blocks::BlockGrid::new(&job.space, job.all, &model.stagger).block_count() as usize;
@@ -96,7 +101,7 @@ impl Planned for HybridPlanned {
         let both: Vec<f64> = inference.views.iter().map(|v| v.both.psnr_db).collect();
         let (lo, hi) = both.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |a, &x| (a.0.min(x), a.1.max(x)));
         model.lens = inference.models.into_iter().map(LensPoint::new).collect();
-        model.representation = "hybrid rendering".to_string();
+        model.representation = if one { "hybrid rendering, one shell" } else { "hybrid rendering" }.to_string();
         model.why = format!(
             "refractive: {} shell(s) from the ray records' hit distances ({}), cube faces {}², both terms {lo:.1}–{hi:.1} dB at the samples as solved; vertex rays traced per frame (τ {} px)",
             layers.len(),

@@ -277,7 +277,8 @@ impl PlacementMode {
 }
 
 /// How reflective objects are stored; refractive objects are stored by hybrid rendering
-/// (thesis ch. 6) in every mode but `Texture`, and chosen against textures in `Auto`.
+/// (thesis ch. 6) in every mode but `Texture` (with one shell in `PemInfinity`), and chosen
+/// against textures in `Auto`.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum RepresentationMode {
     /// Parameterized surface textures, as every other object (thesis ch. 3–4).
