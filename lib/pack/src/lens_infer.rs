@@ -10,8 +10,10 @@
 //! player interpolates per vertex, and is compared with the traced `reflection` and
 //! `refraction` layers over the lens object's pixels.
 //!
-//! Not yet: simultaneous inference over nearby viewpoints or direct images (6.3.3.1), the
-//! confidence weights, the cube-face size from the finest level the frames read (5.8.2).
+//! The cube-face size is chosen from the finest level the sample views read (5.8.2).
+//! Simultaneous inference over nearby viewpoints ([`infer_lens_nearby`], 6.3.3.1) and the
+//! confidence weights are options, off by default (measured worse on the glass sample); the
+//! direct images of the environment of 6.3.3.1 are not used.
 
 use anyhow::{anyhow, Result};
 use glam::Vec3;

@@ -1,8 +1,9 @@
 //! `pis-pack`: a ray-traced set to a `.pis` container (thesis ch. 4).
 //!
 //! The stages, one module each: [`input`] reads (or traces) the set; [`infer_layers`]
-//! chooses each object's representation and runs it ([`represent`] is the seam; today
-//! every object is stored as parameterized surface textures, [`surface`]: texture
+//! chooses each object's representation and runs it ([`represent`] is the seam: layered
+//! environment maps for reflective objects, [`pem`], and hybrid rendering for refractive
+//! ones, [`hybrid`], where asked; otherwise parameterized surface textures, [`surface`]: texture
 //! coordinates per block (3.2), a view-independent diffuse layer solved over all views by
 //! stacking and a view-dependent specular layer per parameter sample, warm-started, black
 //! layers left out (3.5)), giving an [`model::ObjectModel`] per object; [`encode`] cuts each

@@ -5,7 +5,9 @@
 //! `.pis`, decoding on worker threads through a level-image cache with lifetimes, GPU MIP
 //! chains, and frames of every object with its surface layers and, for reflective objects,
 //! its reflection term (environment-map shells, `shell.rs`, looked up as the hardware model
-//! does, composited "over", times Fresnel), multisampled on silhouettes (`multisample.rs`)
+//! does, composited "over", times Fresnel), for lens objects both terms of hybrid rendering
+//! (`frame_hybrid.rs`: vertex rays traced through the object each frame), multisampled on
+//! silhouettes (`multisample.rs`)
 //! and resolved with the ray-traced set's display filter (`resolve.rs`).
 //!
 //! Without a GPU, wgpu runs on Mesa's lavapipe: `apt-get install -y mesa-vulkan-drivers`.
