@@ -402,6 +402,13 @@ fn a_glass_teapot_packed_and_played_by_hybrid_rendering() {
     let set = std::fs::read_dir(dir.path().join(".pis-cache")).expect("cache").next().expect("a traced set").expect("entry").path();
     let d = std::process::Command::new(env!("CARGO_BIN_EXE_pis-diff")).arg(&pem).arg(&set).args(["--msaa", "1", "--max-psnr-drop", "0.3"]).output().expect("pis-diff runs");
     assert!(d.status.success(), "{}{}", String::from_utf8_lossy(&d.stdout), String::from_utf8_lossy(&d.stderr));
+    // Table 6.1's whole frame: the file played at two τ on the bench's cameras.
+    let h = run_json(env!("CARGO_BIN_EXE_pis-bench"), &["hybrid".as_ref(), scene.as_os_str(), "--tau".as_ref(), "2,8".as_ref(), "--frames".as_ref(), "2".as_ref(), "--file".as_ref(), pem.as_os_str(), "--msaa".as_ref(), "1".as_ref(), "--json".as_ref()]);
+    let played = h["played"].as_array().expect("played rows");
+    assert_eq!(played.len(), 2, "{h}");
+    let g = |r: &serde_json::Value, k: &str| r[k].as_f64().unwrap_or(f64::NAN);
+    assert!(g(&played[0], "lens_rays") > g(&played[1], "lens_rays"), "{played:?}");
+    assert!(played.iter().all(|r| g(r, "draw_ms") > 0.0 && g(r, "frame_ms") >= g(r, "lens_ms")), "{played:?}");
     // On and off the sampled views, against frames traced at each camera.
     let b = run_json(env!("CARGO_BIN_EXE_pis-bench"), &["reflective".as_ref(), scene.as_os_str(), tex.as_os_str(), pem.as_os_str(), one.as_os_str(), "--role".as_ref(), "refractive".as_ref(), "--frames".as_ref(), "5".as_ref(), "--reference-spp".as_ref(), "4".as_ref(), "--json".as_ref(), "--out".as_ref(), dir.path().join("reports").as_os_str()]);
     let summary = |file: &str, path: &str, key: &str| b["summaries"].as_array().expect("summaries").iter()

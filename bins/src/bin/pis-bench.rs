@@ -263,6 +263,14 @@ enum Command {
         resolution: Option<(u32, u32)>,
         #[arg(long)]
         preset: Option<String>,
+        /// A file packed from the scene (its lens objects by hybrid rendering: pis-pack
+        /// --representation pem): also played at each τ on the same cameras, for the
+        /// player's whole frame (lens objects' CPU work, draw, frame).
+        #[arg(long, value_name = "FILE.pis")]
+        file: Option<PathBuf>,
+        /// Samples per pixel of the played frames (--file), as pis-play --msaa.
+        #[arg(long, default_value_t = pis_play::multisample::DEFAULT_SAMPLES, value_name = "1|4")]
+        msaa: u32,
         #[arg(long)]
         json: bool,
     },
@@ -375,8 +383,8 @@ fn run(cli: Cli) -> Result<Exit, Failure> {
             }
             Ok(Exit::Ok)
         }
-        Command::Hybrid { scene, tau, frames, resolution, preset, json } => {
-            let report = hybrid::run(&HybridRequest { scene, preset, resolution, taus: tau, frames })?;
+        Command::Hybrid { scene, tau, frames, resolution, preset, file, msaa, json } => {
+            let report = hybrid::run(&HybridRequest { scene, preset, resolution, taus: tau, frames, file, msaa })?;
             hybrid::print(&report, &mut std::io::stderr()).map_err(|e| Failure::new(Exit::Io, e))?;
             if json {
                 json_out(&report)?;

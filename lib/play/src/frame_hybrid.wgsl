@@ -88,18 +88,20 @@ fn lens_derivatives(in: HybridFrameVsOut) -> LensDerivatives {
 
 // The term (SPEC.md 9): shells "over" in increasing order, rgb += through · c.rgb,
 // through ·= 1 − clamp(c.a, 0, 1), shells the triangle does not draw skipped; times F·G.
+// Behind an opaque shell (through exactly 0) the farther shells add exactly nothing and are
+// not looked up.
 fn hybrid_term(in: HybridFrameVsOut, d: LensDerivatives) -> vec3<f32> {
     var acc = vec4<f32>(0.0, 0.0, 0.0, 1.0);
     if (hf.count > 0u && in.v0.w > 0.5) {
         acc = lens_over(acc, lens_shell(0u, lens_cube0, in.v0.xyz, d.dx[0], d.dy[0]));
     }
-    if (hf.count > 1u && in.v1.w > 0.5) {
+    if (hf.count > 1u && in.v1.w > 0.5 && acc.a > 0.0) {
         acc = lens_over(acc, lens_shell(1u, lens_cube1, in.v1.xyz, d.dx[1], d.dy[1]));
     }
-    if (hf.count > 2u && in.v2.w > 0.5) {
+    if (hf.count > 2u && in.v2.w > 0.5 && acc.a > 0.0) {
         acc = lens_over(acc, lens_shell(2u, lens_cube2, in.v2.xyz, d.dx[2], d.dy[2]));
     }
-    if (hf.count > 3u && in.v3.w > 0.5) {
+    if (hf.count > 3u && in.v3.w > 0.5 && acc.a > 0.0) {
         acc = lens_over(acc, lens_shell(3u, lens_cube3, in.v3.xyz, d.dx[3], d.dy[3]));
     }
     return acc.rgb * in.fg;

@@ -5,7 +5,10 @@
 //! tessellating and generating one shell's cube vectors per term; against the same model
 //! traced at every pixel centre the lens object covers (the same code, one path pair per
 //! pixel), in rays and milliseconds; and how far the interpolated vectors of a far sphere
-//! shell are from those traced at each pixel (the 90th percentile of the angle).
+//! shell are from those traced at each pixel (the 90th percentile of the angle). Given a
+//! file packed from the scene, also the whole frame as the player draws it at each τ on the
+//! same cameras: its lens objects' CPU work, the draw (recorded, submitted and finished on
+//! the GPU) and the frame.
 
 use std::path::PathBuf;
 use std::time::Instant;
@@ -34,6 +37,24 @@ pub struct HybridRequest {
     pub taus: Vec<f32>,
     /// Frames on the path between the sampled views.
     pub frames: usize,
+    /// A file packed from the scene (its lens objects by hybrid rendering), played at each τ.
+    pub file: Option<PathBuf>,
+    /// The player's samples per pixel for `file`.
+    pub msaa: u32,
+}
+
+/// The player's frame at one τ, means over the frames.
+#[derive(Clone, Debug, Serialize)]
+pub struct PlayedRow {
+    pub tau_px: f32,
+    /// Lens objects' vertex rays, tessellation and vertex buffers.
+    pub lens_ms: f64,
+    pub lens_rays: f64,
+    pub decode_ms: f64,
+    pub draw_ms: f64,
+    pub frame_ms: f64,
+    /// The per-pixel tracing of the lens objects (summed) over the whole frame.
+    pub frame_reduction: f64,
 }
 
 /// One lens object at one τ, means over the frames.
@@ -77,6 +98,10 @@ pub struct HybridReport {
     pub threads: usize,
     pub per_pixel: Vec<PixelTracing>,
     pub rows: Vec<HybridRow>,
+    /// With a file: the played frame per τ, its adapter and samples per pixel.
+    pub played: Vec<PlayedRow>,
+    pub adapter: Option<String>,
+    pub msaa: u32,
     pub stamp: Stamp,
 }
 
@@ -180,7 +205,52 @@ pub fn run(req: &HybridRequest) -> Result<HybridReport, Failure> {
             rows.push(r);
         }
     }
-    Ok(HybridReport { scene: scene.name.clone(), size: [size.0, size.1], frames: frames.len(), threads: rayon::current_num_threads(), per_pixel, rows, stamp: Stamp::here(&scene.name) })
+    let (played, adapter, msaa) = match &req.file {
+        Some(file) => {
+            let base_ms: f64 = per_pixel.iter().map(|p| p.ms).sum();
+            let (rows, adapter, msaa) = play(&scene, file, &frames, &req.taus, req.msaa, base_ms)?;
+            (rows, Some(adapter), msaa)
+        }
+        None => (Vec::new(), None, 0),
+    };
+    Ok(HybridReport { scene: scene.name.clone(), size: [size.0, size.1], frames: frames.len(), threads: rayon::current_num_threads(), per_pixel, rows, played, adapter, msaa, stamp: Stamp::here(&scene.name) })
+}
+
+/// `file` played at every frame's camera with each τ; the first frame of each τ, which
+/// decodes and uploads the file's textures, is drawn twice and counted once.
+fn play(scene: &pis_scene::Scene, file: &std::path::Path, frames: &[super::camera_path::PathFrame], taus: &[f32], msaa: u32, base_ms: f64) -> Result<(Vec<PlayedRow>, String, u32), Failure> {
+    use pis_play::{CameraChoice, FrameRequest, Gpu, Player, PlayerOptions};
+    let gpu = std::sync::Arc::new(Gpu::new().map_err(|e| Failure::new(Exit::NotSupported, anyhow!("{e}")))?);
+    let view_dim = scene.space.dims.iter().position(|d| d.kind == pis_format::DimensionKind::View).unwrap_or(0);
+    let mut rows = Vec::new();
+    let mut samples = msaa;
+    for &tau in taus {
+        let mut player = Player::open(gpu.clone(), file, PlayerOptions { tau_px: tau, msaa, ..PlayerOptions::default() }).map_err(|e| Failure::new(Exit::Invalid, anyhow!("{}: {e}", file.display())))?;
+        if player.image_size() != scene.resolution {
+            return Err(Failure::new(Exit::Usage, anyhow!("{}: {}x{} frames, the scene's are {}x{} (pass the same --preset or --resolution)", file.display(), player.image_size().0, player.image_size().1, scene.resolution.0, scene.resolution.1)));
+        }
+        samples = player.multisample().samples;
+        let mut row = PlayedRow { tau_px: tau, lens_ms: 0.0, lens_rays: 0.0, decode_ms: 0.0, draw_ms: 0.0, frame_ms: 0.0, frame_reduction: 0.0 };
+        for (i, pf) in frames.iter().enumerate() {
+            let req = FrameRequest { point: super::reflective::point(scene, pf, view_dim), camera: CameraChoice::Free(super::reflective::camera(scene, pf)) };
+            if i == 0 {
+                player.render_timed(&req, scene.resolution).map_err(|e| Failure::new(Exit::Runtime, anyhow!("{e}")))?;
+            }
+            let s = player.render_timed(&req, scene.resolution).map_err(|e| Failure::new(Exit::Runtime, anyhow!("{e}")))?;
+            row.lens_ms += s.lens_ms;
+            row.lens_rays += s.lens_rays as f64;
+            row.decode_ms += s.decode_ms;
+            row.draw_ms += s.draw_ms;
+            row.frame_ms += s.frame_ms;
+        }
+        let n = frames.len().max(1) as f64;
+        for v in [&mut row.lens_ms, &mut row.lens_rays, &mut row.decode_ms, &mut row.draw_ms, &mut row.frame_ms] {
+            *v /= n;
+        }
+        row.frame_reduction = base_ms / row.frame_ms.max(1e-9);
+        rows.push(row);
+    }
+    Ok((rows, gpu.describe(), samples))
 }
 
 pub fn print(r: &HybridReport, w: &mut impl std::io::Write) -> std::io::Result<()> {
@@ -190,6 +260,13 @@ pub fn print(r: &HybridReport, w: &mut impl std::io::Write) -> std::io::Result<(
         writeln!(w, "    {:>6} {:>10} {:>9} {:>9} {:>9} {:>11} {:>9} {:>9} {:>8} {:>8} {:>15}", "τ px", "rays", "vertices", "triangles", "trace ms", "tessel. ms", "texgen ms", "total ms", "rays ÷", "time ÷", "90 % angle R/T")?;
         for x in r.rows.iter().filter(|x| x.object == p.object) {
             writeln!(w, "    {:>6} {:>10.0} {:>9.0} {:>9.0} {:>9.2} {:>11.2} {:>9.2} {:>9.2} {:>8.1} {:>8.1} {:>7.2}°/{:.2}°", x.tau_px, x.vertex_rays, x.traced_vertices, x.triangles, x.trace_ms, x.tessellate_ms, x.texgen_ms, x.cpu_ms, x.ray_reduction, x.time_reduction, x.p90_angle_deg[0], x.p90_angle_deg[1])?;
+        }
+    }
+    if let Some(a) = &r.adapter {
+        writeln!(w, "  played ({a}, {} sample(s) per pixel), means per frame:", r.msaa)?;
+        writeln!(w, "    {:>6} {:>10} {:>8} {:>9} {:>8} {:>9} {:>13}", "τ px", "lens rays", "lens ms", "decode ms", "draw ms", "frame ms", "per-pixel ÷")?;
+        for p in &r.played {
+            writeln!(w, "    {:>6} {:>10.0} {:>8.2} {:>9.2} {:>8.2} {:>9.2} {:>13.2}", p.tau_px, p.lens_rays, p.lens_ms, p.decode_ms, p.draw_ms, p.frame_ms, p.frame_reduction)?;
         }
     }
     Ok(())

@@ -102,7 +102,7 @@ fn reference(scene: &Scene, pf: &PathFrame, spp: u32, objects: &[usize]) -> Resu
 }
 
 /// The player's camera for a path frame.
-fn camera(scene: &Scene, pf: &PathFrame) -> ViewCamera {
+pub(crate) fn camera(scene: &Scene, pf: &PathFrame) -> ViewCamera {
     let c = &pf.frame.camera;
     let m = c.world_from_camera;
     let eye = m.w_axis.truncate();
@@ -111,7 +111,7 @@ fn camera(scene: &Scene, pf: &PathFrame) -> ViewCamera {
 
 /// The path frame's point in the dimensions' units: the view value between its samples,
 /// the other dimensions at the frame's samples.
-fn point(scene: &Scene, pf: &PathFrame, view_dim: usize) -> Vec<f32> {
+pub(crate) fn point(scene: &Scene, pf: &PathFrame, view_dim: usize) -> Vec<f32> {
     scene.space.dims.iter().enumerate().map(|(d, dim)| {
         if d == view_dim {
             let (k0, f) = (pf.view.floor() as usize, pf.view.fract());
