@@ -109,7 +109,8 @@ pub struct FrameStats {
     /// looking up all the term's shells).
     pub shell_draws: u64,
     /// Lens objects: tracing their vertex rays, refining the tessellation and building the
-    /// terms' vertex buffers (texture-coordinate generation), on the workers.
+    /// terms' vertex buffers (texture-coordinate generation), on a thread of its own (the
+    /// tracing on the workers) while the frame's textures are decoded.
     pub lens_ms: f64,
     /// Lens objects: rays traced for the frame's vertices, and the triangles drawn.
     pub lens_rays: u64,
@@ -767,33 +768,42 @@ impl Player {
         let reads0 = self.reader.stats().codestreams;
         let mut stats = FrameStats::default();
         let plan = self.plan(req, size)?;
-        let result = self.make_resident(&plan.keys(), &mut stats);
+        // Lens objects' vertex rays, tessellation and vertex buffers on their own thread (its
+        // tracing on the workers) while the textures are decoded: their states are taken out
+        // of the objects for the frame.
+        let mut lens_states: Vec<(usize, LensState)> = Vec::new();
+        for r in &plan.lenses {
+            if !lens_states.iter().any(|(d, _)| *d == r.draw) {
+                if let Some(state) = self.objects[r.draw].lens.take() {
+                    lens_states.push((r.draw, state));
+                }
+            }
+        }
+        let tau_px = self.options.tau_px;
+        let gpu_for_lenses = self.gpu.clone();
+        let (result, lens_work) = std::thread::scope(|scope| {
+            let lens_thread = scope.spawn(|| lens_corners(&gpu_for_lenses, &mut lens_states, &plan, size, tau_px));
+            let result = self.make_resident(&plan.keys(), &mut stats);
+            (result, lens_thread.join())
+        });
+        for (draw, state) in lens_states {
+            self.objects[draw].lens = Some(state);
+        }
+        let lens_work = match lens_work {
+            Ok(w) => w,
+            Err(_) => {
+                self.end_frame();
+                return Err(PlayError::Request("the lens objects' tessellation failed".into()));
+            }
+        };
         if let Err(e) = result {
             self.end_frame();
             return Err(e);
         }
-        // Lens objects: vertex rays, tessellation and the terms' corners (on the workers),
-        // once per object and shell geometry; one draw per term and parameter sample.
-        let t_lens = Instant::now();
-        let settings = TessellationSettings { tau_px: self.options.tau_px, ..TessellationSettings::default() };
-        let mut corner_sets: Vec<(usize, Vec<Shell>, [(wgpu::Buffer, u32); 2])> = Vec::new();
-        for r in &plan.lenses {
-            let shells: Vec<Shell> = r.shells.iter().map(|(_, s)| *s).collect();
-            if corner_sets.iter().any(|(d, s, _)| *d == r.draw && *s == shells) {
-                continue;
-            }
-            let Some(state) = self.objects[r.draw].lens.as_mut() else { continue };
-            let lens = state.at(plan.worlds[r.draw]);
-            let tess = tessellate(lens, &HybridView { eye: plan.eye, clip_from_world: plan.clip_from_world, size }, &settings);
-            stats.lens_rays += tess.stats.rays;
-            let buffers = TERMS.map(|term| {
-                let corners = term_corners(&tess, term, &shells);
-                (corner_buffer(&self.gpu, &corners), corners.len() as u32)
-            });
-            stats.lens_triangles += buffers.iter().map(|b| b.1 as u64 / 3).max().unwrap_or(0);
-            corner_sets.push((r.draw, shells, buffers));
-        }
-        stats.lens_ms = t_lens.elapsed().as_secs_f64() * 1e3;
+        let corner_sets = lens_work.sets;
+        stats.lens_ms = lens_work.ms;
+        stats.lens_rays = lens_work.rays;
+        stats.lens_triangles = lens_work.triangles;
         let format = match target {
             Target::Offscreen { .. } | Target::Timed => offscreen_format(&self.gpu),
             Target::View(_, f) => f,
@@ -917,6 +927,42 @@ impl Player {
         self.cache.end_frame();
         self.frame += 1;
     }
+}
+
+/// A frame's lens work: per lens object and shell geometry, both terms' corner buffers
+/// (and their corner counts); the time it took, its rays and triangles.
+struct LensWork {
+    sets: Vec<(usize, Vec<Shell>, [(wgpu::Buffer, u32); 2])>,
+    ms: f64,
+    rays: u64,
+    triangles: u64,
+}
+
+/// Traces the vertex rays of every lens object `plan` draws through the object placed at
+/// the frame's transform, refines its tessellation down to `tau_px`, and builds both
+/// terms' corners once per object and shell geometry (`states`: the objects' lens states).
+fn lens_corners(gpu: &Gpu, states: &mut [(usize, LensState)], plan: &Plan, size: (u32, u32), tau_px: f32) -> LensWork {
+    let t = Instant::now();
+    let settings = TessellationSettings { tau_px, ..TessellationSettings::default() };
+    let mut work = LensWork { sets: Vec::new(), ms: 0.0, rays: 0, triangles: 0 };
+    for r in &plan.lenses {
+        let shells: Vec<Shell> = r.shells.iter().map(|(_, s)| *s).collect();
+        if work.sets.iter().any(|(d, s, _)| *d == r.draw && *s == shells) {
+            continue;
+        }
+        let Some((_, state)) = states.iter_mut().find(|(d, _)| *d == r.draw) else { continue };
+        let lens = state.at(plan.worlds[r.draw]);
+        let tess = tessellate(lens, &HybridView { eye: plan.eye, clip_from_world: plan.clip_from_world, size }, &settings);
+        work.rays += tess.stats.rays;
+        let buffers = TERMS.map(|term| {
+            let corners = term_corners(&tess, term, &shells);
+            (corner_buffer(gpu, &corners), corners.len() as u32)
+        });
+        work.triangles += buffers.iter().map(|b| b.1 as u64 / 3).max().unwrap_or(0);
+        work.sets.push((r.draw, shells, buffers));
+    }
+    work.ms = t.elapsed().as_secs_f64() * 1e3;
+    work
 }
 
 /// Blocks until the GPU has finished everything submitted.
