@@ -31,13 +31,17 @@ struct HybridFrameUniforms {
 @group(1) @binding(0) var ids: texture_2d<u32>;
 @group(1) @binding(1) var ids_ms: texture_multisampled_2d<u32>;
 
+// Interpolated per sample: in a multisampled frame the lens terms are shaded at every
+// sample (the thesis's supersampled hybrid frames, 6.4), the refracted image's fast changes
+// averaged by the resolve as the tracer's samples average them; single-sampled, at the
+// pixel centre, as the model.
 struct HybridFrameVsOut {
     @builtin(position) clip: vec4<f32>,
-    @location(0) fg: vec3<f32>,
-    @location(1) v0: vec4<f32>,
-    @location(2) v1: vec4<f32>,
-    @location(3) v2: vec4<f32>,
-    @location(4) v3: vec4<f32>,
+    @location(0) @interpolate(perspective, sample) fg: vec3<f32>,
+    @location(1) @interpolate(perspective, sample) v0: vec4<f32>,
+    @location(2) @interpolate(perspective, sample) v1: vec4<f32>,
+    @location(3) @interpolate(perspective, sample) v2: vec4<f32>,
+    @location(4) @interpolate(perspective, sample) v3: vec4<f32>,
 };
 
 // The tessellation lies on the mesh's triangles: its depth is pulled toward the camera by
@@ -121,7 +125,9 @@ struct HybridFrameSamples {
     @builtin(sample_mask) mask: u32,
 };
 
-// `fs_hybrid_frame` for multisampled targets, as frame.wgsl's `fs_layer_ms`.
+// `fs_hybrid_frame` for multisampled targets, run once per sample (the inputs are
+// interpolated per sample): the sample is written where the pixel's object index at it is
+// this object.
 @fragment
 fn fs_hybrid_frame_ms(in: HybridFrameVsOut, @builtin(sample_mask) covered: u32) -> HybridFrameSamples {
     let d = lens_derivatives(in);
