@@ -63,21 +63,24 @@ pub const LENS_CORNER_LAYOUT: wgpu::VertexBufferLayout<'static> = wgpu::VertexBu
 /// `hybrid_render_matrix` draw it.
 pub fn term_corners(tess: &Tessellation, term: Term, shells: &[Shell]) -> Vec<LensCorner> {
     let fg = corner_values(tess, &vertex_modulation(tess, term), Missing::Zero);
-    let vectors: Vec<Vec<Option<[[f32; 3]; 3]>>> = shells.par_iter().take(MAX_LENS_SHELLS).map(|s| corner_values(tess, &vertex_vectors(tess, term, s), Missing::Mean)).collect();
-    let mut out = Vec::new();
-    for (t, tri) in tess.triangles.iter().enumerate() {
-        let Some(f) = fg[t] else { continue };
-        for c in 0..3 {
-            let mut v = [[0.0f32; 4]; MAX_LENS_SHELLS];
-            for (k, vs) in vectors.iter().enumerate() {
-                if let Some(x) = vs[t] {
-                    v[k] = [x[c][0], x[c][1], x[c][2], 1.0];
+    let vectors: Vec<Vec<Option<[[f32; 3]; 3]>>> = shells.iter().take(MAX_LENS_SHELLS).map(|s| corner_values(tess, &vertex_vectors(tess, term, s), Missing::Mean)).collect();
+    tess.triangles
+        .par_iter()
+        .enumerate()
+        .filter_map(|(t, tri)| fg[t].map(|f| (t, tri, f)))
+        .flat_map_iter(|(t, tri, f)| {
+            let vectors = &vectors;
+            (0..3).map(move |c| {
+                let mut v = [[0.0f32; 4]; MAX_LENS_SHELLS];
+                for (k, vs) in vectors.iter().enumerate() {
+                    if let Some(x) = vs[t] {
+                        v[k] = [x[c][0], x[c][1], x[c][2], 1.0];
+                    }
                 }
-            }
-            out.push(LensCorner { position: tess.vertices[tri[c] as usize].position.to_array(), fg: f[c], vectors: v });
-        }
-    }
-    out
+                LensCorner { position: tess.vertices[tri[c] as usize].position.to_array(), fg: f[c], vectors: v }
+            })
+        })
+        .collect()
 }
 
 /// One term of a lens object drawn at one parameter sample.

@@ -954,10 +954,8 @@ fn lens_corners(gpu: &Gpu, states: &mut [(usize, LensState)], plan: &Plan, size:
         let lens = state.at(plan.worlds[r.draw]);
         let tess = tessellate(lens, &HybridView { eye: plan.eye, clip_from_world: plan.clip_from_world, size }, &settings);
         work.rays += tess.stats.rays;
-        let buffers = TERMS.map(|term| {
-            let corners = term_corners(&tess, term, &shells);
-            (corner_buffer(gpu, &corners), corners.len() as u32)
-        });
+        let (reflection, refraction) = rayon::join(|| term_corners(&tess, TERMS[0], &shells), || term_corners(&tess, TERMS[1], &shells));
+        let buffers = [reflection, refraction].map(|corners| (corner_buffer(gpu, &corners), corners.len() as u32));
         work.triangles += buffers.iter().map(|b| b.1 as u64 / 3).max().unwrap_or(0);
         work.sets.push((r.draw, shells, buffers));
     }

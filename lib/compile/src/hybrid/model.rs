@@ -53,18 +53,19 @@ pub enum Missing {
 /// computed in `f32`. What the player's vertex buffer holds, corner by corner.
 pub fn corner_values(tess: &Tessellation, values: &[Option<[f32; 3]>], missing: Missing) -> Vec<Option<[[f32; 3]; 3]>> {
     tess.triangles
-        .iter()
+        .par_iter()
         .map(|t| {
             let v = t.map(|i| values[i as usize]);
-            let valid: Vec<[f32; 3]> = v.iter().flatten().copied().collect();
-            if valid.is_empty() {
+            let n = v.iter().flatten().count();
+            if n == 0 {
                 return None;
             }
             let fill = match missing {
                 Missing::Zero => [0.0; 3],
                 Missing::Mean => {
-                    let n = valid.len() as f32;
-                    let s = valid.iter().fold([0.0f32; 3], |a, x| [a[0] + x[0], a[1] + x[1], a[2] + x[2]]);
+                    // The valid corners summed in corner order, then divided.
+                    let s = v.iter().flatten().fold([0.0f32; 3], |a, x| [a[0] + x[0], a[1] + x[1], a[2] + x[2]]);
+                    let n = n as f32;
                     [s[0] / n, s[1] / n, s[2] / n]
                 }
             };
