@@ -41,6 +41,14 @@ impl Representation for HybridRendering {
             return survey_surface(job, o, true);
         }
         let Some(surface) = survey_surface(job, o, false)? else { return Ok(None) };
+        let base = set.frames.first().map(|f| crate::lens::lens_object(&set.scene, f, o).material.base);
+        if let Some(b) = base.filter(|b| (*b - glam::Vec3::ONE).abs().max_element() > 1e-3) {
+            job.note(&format!(
+                "object {}: its base colour {:?} tints the light it transmits, which the file does not carry (SPEC.md 6.4): the player's paths leave the tint out and its frames differ from the prediction there",
+                set.scene.objects[o].name,
+                b.to_array()
+            ));
+        }
         Ok(Some(Box::new(HybridSurveyed { o, surface })))
     }
 }
