@@ -140,11 +140,17 @@ pub(crate) fn check_parsed<S>(p: &Parsed<S>) -> Vec<Issue> {
     }
     if let Some(prov) = p.provenance {
         provenance(prov, &mut out);
+        if let Some(objects) = p.objects {
+            let named: Vec<(&str, crate::ObjectRole)> = objects.iter().map(|o| (o.name.as_str(), o.role)).collect();
+            if let Err(detail) = crate::tint::tints(prov, &named) {
+                out.push(chunk(Issue::new(9004, detail), "PROV"));
+            }
+        }
     }
     out
 }
 
-/// Rules 9001–9003 on the provenance settings.
+/// Rules 9001–9003 on the provenance settings (9004, which needs the objects, above).
 fn provenance(p: Option<&Provenance>, out: &mut Vec<Issue>) {
     if let Some(p) = p {
         let mut seen = HashSet::new();

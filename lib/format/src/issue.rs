@@ -163,6 +163,7 @@ pub const RULES: &[(u16, &str)] = &[
     (9001, "filter setting is unknown, or anisotropic without an anisotropy of 1 to 16"),
     (9002, "display filter setting is unknown, or its sigma or radius is missing or not a number of pixels in (0, 64]"),
     (9003, "setting key appears more than once"),
+    (9004, "transmission tint setting names no refractive object, or is not three numbers in [0, 1]"),
     (9100, "MSTR payload is malformed"),
     (9101, "master names a missing object, or a second master names the same object"),
     (9102, "master layers or samples differ from the object's"),

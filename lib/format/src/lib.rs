@@ -28,6 +28,7 @@ pub mod reconstruct;
 pub mod samples;
 mod source;
 pub mod texture;
+pub mod tint;
 mod validate;
 mod write;
 

@@ -495,6 +495,13 @@ fn cases() -> Vec<(u16, Vec<u8>)> {
             p.settings.push(("codec".into(), "raw".into()));
         }),
     ));
+    v.push((
+        9004,
+        unchecked(|c| {
+            let p = c.provenance.as_mut().unwrap();
+            p.settings.push(("transmission_tint.nobody".into(), "1,1,1".into()));
+        }),
+    ));
     // 91xx: the lossless master.
     let c = tiny().unwrap();
     let masters = master_of(&c).unwrap();

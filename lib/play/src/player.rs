@@ -273,6 +273,9 @@ fn prepare_objects(gpu: &Gpu, reader: &PisReader) -> Result<Vec<ObjectGpu>, Play
     let c = reader.container();
     let mut out = Vec::with_capacity(c.objects.len());
     let mut skipped = Vec::new();
+    // The reader has checked the tints (rule 9004).
+    let named: Vec<(&str, pis_format::ObjectRole)> = c.objects.iter().map(|o| (o.name.as_str(), o.role)).collect();
+    let tints = pis_format::tint::tints(c.provenance.as_ref(), &named).unwrap_or_else(|_| vec![[1.0; 3]; c.objects.len()]);
     for (oi, o) in c.objects.iter().enumerate() {
         let n = o.mesh.positions.len();
         let uvs: Vec<[f32; 2]> = match &o.mesh.texcoords {
@@ -299,7 +302,7 @@ fn prepare_objects(gpu: &Gpu, reader: &PisReader) -> Result<Vec<ObjectGpu>, Play
             }
             layers.push(li);
         }
-        let lens = lens_state(reader, oi, &mut skipped)?;
+        let lens = lens_state(reader, oi, tints[oi], &mut skipped)?;
         let reflection = if lens.is_some() { Vec::new() } else { reflection_shells(reader, oi, &mut skipped)? };
         let mesh = MeshGpu::new(gpu, &o.mesh.positions, o.mesh.normals.as_deref(), &uvs, &o.mesh.indices).with_hull(o.mesh.hull_triangles);
         out.push(ObjectGpu { mesh, layers, reflection, lens });
@@ -340,10 +343,11 @@ fn reflection_shells(reader: &PisReader, oi: usize, skipped: &mut Vec<String>) -
 }
 
 /// Object `oi` as a lens object, when it is one: role `refractive`, shell layers in the
-/// refraction term (at most [`MAX_LENS_SHELLS`], closed shells), normals. Its reflection
+/// refraction term (at most [`MAX_LENS_SHELLS`], closed shells), normals; its transmission
+/// tint `tint`. Its reflection
 /// term's own shells, if any, are not drawn (listed in `skipped`), nor are the shells of a
 /// refractive object without normals.
-fn lens_state(reader: &PisReader, oi: usize, skipped: &mut Vec<String>) -> Result<Option<LensState>, PlayError> {
+fn lens_state(reader: &PisReader, oi: usize, tint: [f32; 3], skipped: &mut Vec<String>) -> Result<Option<LensState>, PlayError> {
     let o = &reader.container().objects[oi];
     if o.role != pis_format::ObjectRole::Refractive {
         return Ok(None);
@@ -369,9 +373,9 @@ fn lens_state(reader: &PisReader, oi: usize, skipped: &mut Vec<String>) -> Resul
         }
     }
     let v3 = |v: &[f32; 3]| glam::Vec3::from_array(*v);
-    // The runtime's paths take the file's constants: IOR and absorption (SPEC.md 6.4, 9);
-    // the transmission has no colour of its own.
-    let material = LensMaterial { ior: o.shading.ior, base: glam::Vec3::ONE, sigma_a: v3(&o.shading.absorption) };
+    // The runtime's paths take the file's constants: IOR, absorption and the transmission
+    // tint (SPEC.md 6.4, 6.6, 9).
+    let material = LensMaterial { ior: o.shading.ior, base: glam::Vec3::from_array(tint), sigma_a: v3(&o.shading.absorption) };
     Ok(Some(LensState { layers, positions: o.mesh.positions.iter().map(v3).collect(), normals: normals.iter().map(v3).collect(), indices: o.mesh.indices.clone(), material, placed: None }))
 }
 

@@ -276,6 +276,13 @@ pub fn encode_all(set: &LoadedSet, models: &[ObjectModel], req: &PackRequest, st
     if let Ok(display) = pis_format::DisplayFilter::new(f.sigma_px, f.radius_px) {
         settings.extend(display.settings());
     }
+    // The tint lens objects give the light they transmit (SPEC.md 6.6), where not white.
+    for m in models.iter().filter(|m| !m.lens.is_empty()) {
+        let tint = super::hybrid::transmission_tint(set, m.index);
+        if tint != [1.0; 3] {
+            settings.push(pis_format::tint::tint_setting(&m.name, tint));
+        }
+    }
     let mut container = Container {
         space,
         cameras,

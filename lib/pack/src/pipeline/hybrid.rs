@@ -17,6 +17,7 @@ use pis_scene::ObjectRole;
 use super::model::{key, InferredLayer, ObjectModel};
 use super::pem::form::ShellForm;
 use super::represent::{Job, Planned, Representation, Surveyed};
+use super::input::LoadedSet;
 use super::surface::survey_surface;
 use crate::lens_infer::{infer_lens_views, lens_terms, LensInferSettings, LensViewModel, TracedView};
 
@@ -41,14 +42,6 @@ impl Representation for HybridRendering {
             return survey_surface(job, o, true);
         }
         let Some(surface) = survey_surface(job, o, false)? else { return Ok(None) };
-        let base = set.frames.first().map(|f| crate::lens::lens_object(&set.scene, f, o).material.base);
-        if let Some(b) = base.filter(|b| (*b - glam::Vec3::ONE).abs().max_element() > 1e-3) {
-            job.note(&format!(
-                "object {}: its base colour {:?} tints the light it transmits, which the file does not carry (SPEC.md 6.4): the player's paths leave the tint out and its frames differ from the prediction there",
-                set.scene.objects[o].name,
-                b.to_array()
-            ));
-        }
         Ok(Some(Box::new(HybridSurveyed { o, surface })))
     }
 }
@@ -119,6 +112,14 @@ impl Planned for HybridPlanned {
         );
         Ok(model)
     }
+}
+
+/// The colour lens object `o` gives the light it transmits: its material's base colour,
+/// clamped to [0, 1], which the file records (SPEC.md 6.6 `transmission_tint`) and the
+/// player's paths multiply in as the tracer's do.
+pub fn transmission_tint(set: &LoadedSet, o: usize) -> [f32; 3] {
+    let base = set.frames.first().map_or(glam::Vec3::ONE, |f| crate::lens::lens_object(&set.scene, f, o).material.base);
+    base.clamp(glam::Vec3::ZERO, glam::Vec3::ONE).to_array()
 }
 
 /// A lens object at one point of the set as hybrid rendering draws it: the point's
