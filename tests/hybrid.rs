@@ -397,6 +397,15 @@ fn a_glass_teapot_packed_and_played_by_hybrid_rendering() {
     let play = run_json(env!("CARGO_BIN_EXE_pis-play"), &[pem.as_os_str(), "--headless".as_ref(), "--path".as_ref(), "diagonal".as_ref(), "--json".as_ref()]);
     assert_eq!(play["lens_draws_mean"].as_f64(), Some(2.0), "{play}");
     assert!(play["lens_rays_mean"].as_f64().is_some_and(|r| r > 10_000.0), "{play}");
+    // The same frame twice: the second draws the first's tessellation again (no ray traced)
+    // and the same pixels.
+    let gpu = std::sync::Arc::new(pis_play::Gpu::new().expect("a Vulkan adapter (lavapipe: apt-get install -y mesa-vulkan-drivers)"));
+    let mut player = pis_play::Player::open(gpu, &pem, pis_play::PlayerOptions { msaa: 1, ..Default::default() }).expect("opens");
+    let req = pis_play::FrameRequest { point: vec![8.0], camera: pis_play::CameraChoice::Sample };
+    let (a, first) = player.render_image(&req, (160, 120)).expect("draws");
+    let (b, second) = player.render_image(&req, (160, 120)).expect("draws again");
+    assert!(first.lens_rays > 10_000 && second.lens_rays == 0, "{} then {} rays", first.lens_rays, second.lens_rays);
+    assert!(a.rgba.iter().zip(&b.rgba).all(|(x, y)| x.to_bits() == y.to_bits()), "the same frame drawn twice differs");
     // The player against the traced set, single-sample as the prediction is: what pis-pack
     // predicted, within 0.3 dB.
     let set = std::fs::read_dir(dir.path().join(".pis-cache")).expect("cache").next().expect("a traced set").expect("entry").path();

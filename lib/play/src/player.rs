@@ -112,7 +112,9 @@ pub struct FrameStats {
     /// terms' vertex buffers (texture-coordinate generation), on a thread of its own (the
     /// tracing on the workers) while the frame's textures are decoded.
     pub lens_ms: f64,
-    /// Lens objects: rays traced for the frame's vertices, and the triangles drawn.
+    /// Lens objects: rays traced for the frame's vertices (none where the frame draws the
+    /// previous frame's tessellation again: same camera, transform, size and τ), and the
+    /// triangles drawn.
     pub lens_rays: u64,
     pub lens_triangles: u64,
     /// Draws of lens terms (two per lens object and parameter sample).
@@ -141,7 +143,13 @@ struct LensState {
     indices: Vec<u32>,
     material: LensMaterial,
     placed: Option<(glam::Mat4, LensObject)>,
+    /// The last frame's tessellation and what it was made for (transform, eye, view and
+    /// projection, frame size, τ): a frame that changes none of them draws it again.
+    tessellated: Option<(TessellationKey, std::sync::Arc<pis_compile::hybrid::Tessellation>)>,
 }
+
+/// What a lens object's tessellation depends on.
+type TessellationKey = (glam::Mat4, glam::Vec3, glam::Mat4, (u32, u32), f32);
 
 impl LensState {
     /// The lens object at `world` (rigid), built once per transform.
@@ -376,7 +384,7 @@ fn lens_state(reader: &PisReader, oi: usize, tint: [f32; 3], skipped: &mut Vec<S
     // The runtime's paths take the file's constants: IOR, absorption and the transmission
     // tint (SPEC.md 6.4, 6.6, 9).
     let material = LensMaterial { ior: o.shading.ior, base: glam::Vec3::from_array(tint), sigma_a: v3(&o.shading.absorption) };
-    Ok(Some(LensState { layers, positions: o.mesh.positions.iter().map(v3).collect(), normals: normals.iter().map(v3).collect(), indices: o.mesh.indices.clone(), material, placed: None }))
+    Ok(Some(LensState { layers, positions: o.mesh.positions.iter().map(v3).collect(), normals: normals.iter().map(v3).collect(), indices: o.mesh.indices.clone(), material, placed: None, tessellated: None }))
 }
 
 /// The cube-map geometry of a shell block's placement (SPEC.md 7.3); `None` for a quad or a
@@ -955,9 +963,17 @@ fn lens_corners(gpu: &Gpu, states: &mut [(usize, LensState)], plan: &Plan, size:
             continue;
         }
         let Some((_, state)) = states.iter_mut().find(|(d, _)| *d == r.draw) else { continue };
-        let lens = state.at(plan.worlds[r.draw]);
-        let tess = tessellate(lens, &HybridView { eye: plan.eye, clip_from_world: plan.clip_from_world, size }, &settings);
-        work.rays += tess.stats.rays;
+        let key: TessellationKey = (plan.worlds[r.draw], plan.eye, plan.clip_from_world, size, tau_px);
+        let tess = match &state.tessellated {
+            Some((k, t)) if *k == key => t.clone(),
+            _ => {
+                let lens = state.at(plan.worlds[r.draw]);
+                let t = std::sync::Arc::new(tessellate(lens, &HybridView { eye: plan.eye, clip_from_world: plan.clip_from_world, size }, &settings));
+                state.tessellated = Some((key, t.clone()));
+                work.rays += t.stats.rays;
+                t
+            }
+        };
         let (reflection, refraction) = rayon::join(|| term_corners(&tess, TERMS[0], &shells), || term_corners(&tess, TERMS[1], &shells));
         let buffers = [reflection, refraction].map(|corners| (corner_buffer(gpu, &corners), corners.len() as u32));
         work.triangles += buffers.iter().map(|b| b.1 as u64 / 3).max().unwrap_or(0);

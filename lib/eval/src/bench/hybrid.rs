@@ -216,8 +216,10 @@ pub fn run(req: &HybridRequest) -> Result<HybridReport, Failure> {
     Ok(HybridReport { scene: scene.name.clone(), size: [size.0, size.1], frames: frames.len(), threads: rayon::current_num_threads(), per_pixel, rows, played, adapter, msaa, stamp: Stamp::here(&scene.name) })
 }
 
-/// `file` played at every frame's camera with each τ; the first frame of each τ, which
-/// decodes and uploads the file's textures, is drawn twice and counted once.
+/// `file` played at every frame's camera with each τ; before them the last frame is drawn
+/// once, not counted, so that the file is opened, its first textures decoded and uploaded
+/// and its pipelines compiled (and the first counted frame, at another camera, traces its
+/// own vertex rays).
 fn play(scene: &pis_scene::Scene, file: &std::path::Path, frames: &[super::camera_path::PathFrame], taus: &[f32], msaa: u32, base_ms: f64) -> Result<(Vec<PlayedRow>, String, u32), Failure> {
     use pis_play::{CameraChoice, FrameRequest, Gpu, Player, PlayerOptions};
     let gpu = std::sync::Arc::new(Gpu::new().map_err(|e| Failure::new(Exit::NotSupported, anyhow!("{e}")))?);
@@ -231,12 +233,12 @@ fn play(scene: &pis_scene::Scene, file: &std::path::Path, frames: &[super::camer
         }
         samples = player.multisample().samples;
         let mut row = PlayedRow { tau_px: tau, lens_ms: 0.0, lens_rays: 0.0, decode_ms: 0.0, draw_ms: 0.0, frame_ms: 0.0, frame_reduction: 0.0 };
-        for (i, pf) in frames.iter().enumerate() {
-            let req = FrameRequest { point: super::reflective::point(scene, pf, view_dim), camera: CameraChoice::Free(super::reflective::camera(scene, pf)) };
-            if i == 0 {
-                player.render_timed(&req, scene.resolution).map_err(|e| Failure::new(Exit::Runtime, anyhow!("{e}")))?;
-            }
-            let s = player.render_timed(&req, scene.resolution).map_err(|e| Failure::new(Exit::Runtime, anyhow!("{e}")))?;
+        let request = |pf: &super::camera_path::PathFrame| FrameRequest { point: super::reflective::point(scene, pf, view_dim), camera: CameraChoice::Free(super::reflective::camera(scene, pf)) };
+        if let Some(last) = frames.last() {
+            player.render_timed(&request(last), scene.resolution).map_err(|e| Failure::new(Exit::Runtime, anyhow!("{e}")))?;
+        }
+        for pf in frames {
+            let s = player.render_timed(&request(pf), scene.resolution).map_err(|e| Failure::new(Exit::Runtime, anyhow!("{e}")))?;
             row.lens_ms += s.lens_ms;
             row.lens_rays += s.lens_rays as f64;
             row.decode_ms += s.decode_ms;
