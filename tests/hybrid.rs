@@ -347,9 +347,10 @@ fn the_runtimes_interface_functions_are_the_tracers() {
     assert_eq!(compared, 41 * 6);
 }
 
-/// Copies the glass sample's files (not its cache) into `dir`; returns the scene.toml.
-fn copy_glass(dir: &Path) -> std::path::PathBuf {
-    let sample = Path::new(env!("CARGO_MANIFEST_DIR")).join("../samples/glass");
+/// Copies the files (not the cache) of the sample at `rel` under samples/ into `dir`;
+/// returns the scene.toml.
+fn copy_sample(rel: &str, dir: &Path) -> std::path::PathBuf {
+    let sample = Path::new(env!("CARGO_MANIFEST_DIR")).join("../samples").join(rel);
     for e in std::fs::read_dir(&sample).expect("sample folder") {
         let p = e.expect("entry").path();
         if p.is_file() {
@@ -374,7 +375,7 @@ fn run_json(tool: &str, args: &[&std::ffi::OsStr]) -> serde_json::Value {
 #[test]
 fn a_glass_teapot_packed_and_played_by_hybrid_rendering() {
     let dir = tempfile::tempdir().expect("temp dir");
-    let scene = copy_glass(dir.path());
+    let scene = copy_sample("glass", dir.path());
     let pack = |name: &str, rep: &str| {
         let out = dir.path().join(name);
         let r = run_json(env!("CARGO_BIN_EXE_pis-pack"), &[scene.as_os_str(), "-o".as_ref(), out.as_os_str(), "--representation".as_ref(), rep.as_ref(), "--codec".as_ref(), "lossless".as_ref(), "--json".as_ref()]);
@@ -440,14 +441,7 @@ fn a_glass_teapot_packed_and_played_by_hybrid_rendering() {
 #[test]
 fn a_tinted_glass_from_the_wild_plays_as_predicted() {
     let dir = tempfile::tempdir().expect("temp dir");
-    let sample = Path::new(env!("CARGO_MANIFEST_DIR")).join("../samples/wild/glass-shelf");
-    for e in std::fs::read_dir(&sample).expect("sample folder") {
-        let p = e.expect("entry").path();
-        if p.is_file() {
-            std::fs::copy(&p, dir.path().join(p.file_name().expect("name"))).expect("copy");
-        }
-    }
-    let scene = dir.path().join("scene.toml");
+    let scene = copy_sample("wild/glass-shelf", dir.path());
     let file = dir.path().join("pem.pis");
     let pack = run_json(env!("CARGO_BIN_EXE_pis-pack"), &[scene.as_os_str(), "-o".as_ref(), file.as_os_str(), "--representation".as_ref(), "pem".as_ref(), "--codec".as_ref(), "lossless".as_ref(), "--json".as_ref()]);
     let inspect = String::from_utf8_lossy(&std::process::Command::new(env!("CARGO_BIN_EXE_pis-inspect")).arg(&file).output().expect("pis-inspect runs").stdout).into_owned();

@@ -331,37 +331,44 @@ fn reflection_shells(reader: &PisReader, oi: usize, skipped: &mut Vec<String>) -
     let shells = |term| o.layers.iter().enumerate().filter(move |(_, l)| l.mapping == Mapping::Shell && l.term == term);
     let mut note = |li: usize, why: &str| skipped.push(format!("{}/{} ({why})", o.name, o.layers[li].kind.name()));
     shells(Term::Refraction).for_each(|(li, _)| note(li, "refraction term"));
-    let mut term: Vec<usize> = shells(Term::Reflection).map(|(li, _)| li).collect();
+    let term: Vec<usize> = shells(Term::Reflection).map(|(li, _)| li).collect();
     if o.mesh.normals.is_none() {
         term.iter().for_each(|&li| note(li, "the mesh has no normals"));
         return Ok(Vec::new());
     }
-    term.sort_by_key(|&li| o.layers[li].order);
+    ordered_closed_shells(reader, oi, term, "reflection", MAX_TERM_SHELLS)
+}
+
+/// Shell layers `layers` of object `oi`'s `term` in increasing order, checked drawable: at
+/// most `max` of them, each block a closed shell (sphere, ellipsoid, box or cylinder; a quad
+/// is not supported).
+fn ordered_closed_shells(reader: &PisReader, oi: usize, mut layers: Vec<usize>, term: &str, max: usize) -> Result<Vec<usize>, PlayError> {
+    let o = &reader.container().objects[oi];
+    layers.sort_by_key(|&li| o.layers[li].order);
     let not_supported = |message: String| PlayError::File(pis_format::Error::NotSupported(format!("{}: object {oi} '{}': {message}", reader.path().display(), o.name)));
-    if term.len() > MAX_TERM_SHELLS {
-        return Err(not_supported(format!("{} shells in the reflection term; this player draws at most {MAX_TERM_SHELLS}", term.len())));
+    if layers.len() > max {
+        return Err(not_supported(format!("{} shells in the {term} term; this player draws at most {max}", layers.len())));
     }
-    for &li in &term {
+    for &li in &layers {
         let closed = o.layers[li].blocks.iter().all(|b| matches!(b.placement, Placement::Shell { shape, .. } if shape.faces() == 6));
         if !closed {
             return Err(not_supported(format!("layer {li} ({}) is not a closed shell (sphere, ellipsoid, box or cylinder): quad shells are not drawn", o.layers[li].kind.name())));
         }
     }
-    Ok(term)
+    Ok(layers)
 }
 
 /// Object `oi` as a lens object, when it is one: role `refractive`, shell layers in the
 /// refraction term (at most [`MAX_LENS_SHELLS`], closed shells), normals; its transmission
-/// tint `tint`. Its reflection
-/// term's own shells, if any, are not drawn (listed in `skipped`), nor are the shells of a
-/// refractive object without normals.
+/// tint `tint`. Its reflection term's own shells, if any, are not drawn (listed in
+/// `skipped`), nor are the shells of a refractive object without normals.
 fn lens_state(reader: &PisReader, oi: usize, tint: [f32; 3], skipped: &mut Vec<String>) -> Result<Option<LensState>, PlayError> {
     let o = &reader.container().objects[oi];
     if o.role != pis_format::ObjectRole::Refractive {
         return Ok(None);
     }
     let shells = |term| o.layers.iter().enumerate().filter(move |(_, l)| l.mapping == Mapping::Shell && l.term == term).map(|(li, _)| li);
-    let mut layers: Vec<usize> = shells(Term::Refraction).collect();
+    let layers: Vec<usize> = shells(Term::Refraction).collect();
     if layers.is_empty() {
         return Ok(None);
     }
@@ -370,16 +377,7 @@ fn lens_state(reader: &PisReader, oi: usize, tint: [f32; 3], skipped: &mut Vec<S
         return Ok(None);
     };
     shells(Term::Reflection).for_each(|li| skipped.push(format!("{}/{} (a lens object's reflection term reads its refraction term's shells)", o.name, o.layers[li].kind.name())));
-    layers.sort_by_key(|&li| o.layers[li].order);
-    let not_supported = |message: String| PlayError::File(pis_format::Error::NotSupported(format!("{}: object {oi} '{}': {message}", reader.path().display(), o.name)));
-    if layers.len() > MAX_LENS_SHELLS {
-        return Err(not_supported(format!("{} shells in the refraction term; this player draws at most {MAX_LENS_SHELLS}", layers.len())));
-    }
-    for &li in &layers {
-        if !o.layers[li].blocks.iter().all(|b| matches!(b.placement, Placement::Shell { shape, .. } if shape.faces() == 6)) {
-            return Err(not_supported(format!("layer {li} ({}) is not a closed shell (sphere, ellipsoid, box or cylinder): quad shells are not drawn", o.layers[li].kind.name())));
-        }
-    }
+    let layers = ordered_closed_shells(reader, oi, layers, "refraction", MAX_LENS_SHELLS)?;
     let v3 = |v: &[f32; 3]| glam::Vec3::from_array(*v);
     // The runtime's paths take the file's constants: IOR, absorption and the transmission
     // tint (SPEC.md 6.4, 6.6, 9).
