@@ -350,12 +350,16 @@ pub fn predict_view(scene: &Scene, o: usize, frame: &Frame, render: &PointRender
 /// samples): per term, [`term_radiance`] at the pixels that draw it. Returns per term the
 /// RGB image (`width · height · 3`, zero where the term is not drawn).
 pub fn lens_image(model: &LensViewModel, cubes: &[&[f32]]) -> [Vec<f32>; 2] {
-    let fg = TERMS.map(|term| hybrid_pixels(model.viewport, &model.tess, model.clip, &vertex_modulation(&model.tess, term), Missing::Zero, None));
-    lens_terms(model, &fg, cubes)
+    lens_terms(model, &term_pixels(model), cubes)
 }
 
-/// [`lens_image`] with each term's pixels and F·G (`fg`, [`hybrid_pixels`] of the
-/// modulation with [`Missing::Zero`]) made.
+/// Per term, the pixels of `model` that draw it with their interpolated F·G
+/// ([`hybrid_pixels`] of the modulation, [`Missing::Zero`]).
+pub fn term_pixels(model: &LensViewModel) -> [HybridPixels; 2] {
+    TERMS.map(|term| hybrid_pixels(model.viewport, &model.tess, model.clip, &vertex_modulation(&model.tess, term), Missing::Zero, None))
+}
+
+/// [`lens_image`] with each term's pixels and F·G ([`term_pixels`]) made.
 pub fn lens_terms(model: &LensViewModel, fg: &[HybridPixels; 2], cubes: &[&[f32]]) -> [Vec<f32>; 2] {
     let n = (model.viewport.width * model.viewport.height) as usize;
     let mut out = [vec![0.0f32; n * 3], vec![0.0f32; n * 3]];

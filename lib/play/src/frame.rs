@@ -177,6 +177,24 @@ fn additive_target(format: wgpu::TextureFormat) -> wgpu::ColorTargetState {
     wgpu::ColorTargetState { format, blend: Some(wgpu::BlendState { color: add, alpha: max }), write_mask: wgpu::ColorWrites::ALL }
 }
 
+/// An additive pipeline of the frame's layer pass: `module`'s vertex entry point with its
+/// vertex buffers, fragment entry point `fragment`, triangles unculled, tested against the id
+/// pass's depth without writing it, colour added ([`additive_target`]).
+#[allow(clippy::too_many_arguments)]
+fn additive_pipeline(gpu: &Gpu, label: &str, layout: &wgpu::PipelineLayout, module: &wgpu::ShaderModule, vertex: (&str, &[Option<wgpu::VertexBufferLayout>]), fragment: &str, format: wgpu::TextureFormat, samples: u32) -> wgpu::RenderPipeline {
+    gpu.device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+        label: Some(label),
+        layout: Some(layout),
+        vertex: wgpu::VertexState { module, entry_point: Some(vertex.0), compilation_options: Default::default(), buffers: vertex.1 },
+        primitive: wgpu::PrimitiveState { topology: wgpu::PrimitiveTopology::TriangleList, cull_mode: None, ..Default::default() },
+        depth_stencil: Some(additive_depth()),
+        multisample: multisample(samples),
+        fragment: Some(wgpu::FragmentState { module, entry_point: Some(fragment), compilation_options: Default::default(), targets: &[Some(additive_target(format))] }),
+        multiview_mask: None,
+        cache: None,
+    })
+}
+
 /// The additive pass's depth state: tested against the id pass's depth (equal passes), not
 /// written.
 fn additive_depth() -> wgpu::DepthStencilState {
@@ -282,19 +300,7 @@ impl FramePipelines {
     pub fn layer_pipeline(&mut self, gpu: &Gpu, format: wgpu::TextureFormat, samples: u32) -> &wgpu::RenderPipeline {
         let module = &self.module;
         let (layout, entry_point) = if samples > 1 { (&self.layer_ms_layout, "fs_layer_ms") } else { (&self.layer_layout, "fs_layer") };
-        self.layer_pipelines.entry((format, samples)).or_insert_with(|| {
-            gpu.device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-                label: Some("frame layers"),
-                layout: Some(layout),
-                vertex: wgpu::VertexState { module, entry_point: Some("vs_main"), compilation_options: Default::default(), buffers: &[Some(POSITION_LAYOUT), Some(UV_LAYOUT)] },
-                primitive: wgpu::PrimitiveState { topology: wgpu::PrimitiveTopology::TriangleList, cull_mode: None, ..Default::default() },
-                depth_stencil: Some(additive_depth()),
-                multisample: multisample(samples),
-                fragment: Some(wgpu::FragmentState { module, entry_point: Some(entry_point), compilation_options: Default::default(), targets: &[Some(additive_target(format))] }),
-                multiview_mask: None,
-                cache: None,
-            })
-        })
+        self.layer_pipelines.entry((format, samples)).or_insert_with(|| additive_pipeline(gpu, "frame layers", layout, module, ("vs_main", &[Some(POSITION_LAYOUT), Some(UV_LAYOUT)]), entry_point, format, samples))
     }
 
     /// The additive reflection-term pipeline for a target format and `samples` per pixel
@@ -303,42 +309,16 @@ impl FramePipelines {
     pub fn reflection_pipeline(&mut self, gpu: &Gpu, format: wgpu::TextureFormat, samples: u32) -> &wgpu::RenderPipeline {
         let module = &self.reflection_module;
         let (layout, entry_point) = if samples > 1 { (&self.reflection_ms_layout, "fs_reflection_ms") } else { (&self.reflection_layout, "fs_reflection") };
-        self.reflection_pipelines.entry((format, samples)).or_insert_with(|| {
-            gpu.device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-                label: Some("frame reflections"),
-                layout: Some(layout),
-                vertex: wgpu::VertexState { module, entry_point: Some("vs_reflection"), compilation_options: Default::default(), buffers: &[Some(POSITION_LAYOUT), Some(NORMAL_LAYOUT)] },
-                primitive: wgpu::PrimitiveState { topology: wgpu::PrimitiveTopology::TriangleList, cull_mode: None, ..Default::default() },
-                depth_stencil: Some(additive_depth()),
-                multisample: multisample(samples),
-                fragment: Some(wgpu::FragmentState { module, entry_point: Some(entry_point), compilation_options: Default::default(), targets: &[Some(additive_target(format))] }),
-                multiview_mask: None,
-                cache: None,
-            })
-        })
+        self.reflection_pipelines.entry((format, samples)).or_insert_with(|| additive_pipeline(gpu, "frame reflections", layout, module, ("vs_reflection", &[Some(POSITION_LAYOUT), Some(NORMAL_LAYOUT)]), entry_point, format, samples))
     }
-}
 
-impl FramePipelines {
     /// The additive lens-term pipeline for a target format and `samples` per pixel
     /// (compiled on first use): `fs_hybrid_frame`, or `fs_hybrid_frame_ms` with object
     /// indices per sample; the corners ([`LENS_CORNER_LAYOUT`]) as vertex buffer 0.
     pub fn hybrid_pipeline(&mut self, gpu: &Gpu, format: wgpu::TextureFormat, samples: u32) -> &wgpu::RenderPipeline {
         let module = &self.hybrid_module;
         let (layout, entry_point) = if samples > 1 { (&self.hybrid_ms_layout, "fs_hybrid_frame_ms") } else { (&self.hybrid_layout, "fs_hybrid_frame") };
-        self.hybrid_pipelines.entry((format, samples)).or_insert_with(|| {
-            gpu.device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-                label: Some("frame lens terms"),
-                layout: Some(layout),
-                vertex: wgpu::VertexState { module, entry_point: Some("vs_hybrid_frame"), compilation_options: Default::default(), buffers: &[Some(LENS_CORNER_LAYOUT)] },
-                primitive: wgpu::PrimitiveState { topology: wgpu::PrimitiveTopology::TriangleList, cull_mode: None, ..Default::default() },
-                depth_stencil: Some(additive_depth()),
-                multisample: multisample(samples),
-                fragment: Some(wgpu::FragmentState { module, entry_point: Some(entry_point), compilation_options: Default::default(), targets: &[Some(additive_target(format))] }),
-                multiview_mask: None,
-                cache: None,
-            })
-        })
+        self.hybrid_pipelines.entry((format, samples)).or_insert_with(|| additive_pipeline(gpu, "frame lens terms", layout, module, ("vs_hybrid_frame", &[Some(LENS_CORNER_LAYOUT)]), entry_point, format, samples))
     }
 }
 

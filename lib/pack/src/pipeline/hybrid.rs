@@ -10,7 +10,7 @@
 //! player does, through the per-point render matrices of hybrid rendering ([`LensPoint`]).
 
 use anyhow::Result;
-use pis_compile::hybrid::{hybrid_pixels, vertex_modulation, HybridPixels, Missing, TERMS};
+use pis_compile::hybrid::HybridPixels;
 use pis_compile::TextureLayout;
 use pis_scene::ObjectRole;
 
@@ -19,7 +19,7 @@ use super::pem::form::ShellForm;
 use super::represent::{Job, Planned, Representation, Surveyed};
 use super::input::LoadedSet;
 use super::surface::survey_surface;
-use crate::lens_infer::{infer_lens_views, lens_terms, LensInferSettings, LensViewModel, TracedView};
+use crate::lens_infer::{infer_lens_views, lens_terms, term_pixels, LensInferSettings, LensViewModel, TracedView};
 
 /// Hybrid rendering: refractive objects whose set has outgoing-ray records of them.
 pub struct HybridRendering;
@@ -79,19 +79,10 @@ impl Planned for HybridPlanned {
         }
         let inference = infer_lens_views(scene, o, &views, &settings)?;
         let layout = TextureLayout::cube(inference.face);
-        let grid_blocks = pis_format::blocks::BlockGrid::new(&job.space, job.all, &model.stagger).block_count() as usize;
         for (l, fitted) in inference.shells.iter().enumerate() {
             let textures: std::collections::BTreeMap<Vec<u32>, Vec<f32>> = set.samples.iter().zip(&inference.views).map(|(s, v)| (key(s, job.all), v.cubes[l].clone())).collect();
-            model.layers.push(InferredLayer {
-                kind: pis_format::LayerKind::EnvShell,
-                depends_on: job.all,
-                placement_of: textures.keys().map(|k| (k.clone(), 0)).collect(),
-                textures,
-                block_placements: vec![0; grid_blocks],
-                iterations: 0,
-                form: Box::new(ShellForm { shell: fitted.shell, layout, channels: 4, order: l as u8, term: pis_format::Term::Refraction }),
-                shell: Some(l),
-            });
+            let form = Box::new(ShellForm { shell: fitted.shell, layout, channels: 4, order: l as u8, term: pis_format::Term::Refraction });
+            model.layers.push(InferredLayer::shell(pis_format::LayerKind::EnvShell, job, &model.stagger, textures, 0, form, l));
         }
         let layers: Vec<String> = (0..inference.shells.len())
             .map(|l| {
@@ -131,8 +122,7 @@ pub struct LensPoint {
 
 impl LensPoint {
     pub fn new(model: LensViewModel) -> LensPoint {
-        let fg = TERMS.map(|term| hybrid_pixels(model.viewport, &model.tess, model.clip, &vertex_modulation(&model.tess, term), Missing::Zero, None));
-        LensPoint { model, fg }
+        LensPoint { fg: term_pixels(&model), model }
     }
 
     /// The two terms summed at `rows` (pixels, increasing), RGB per row, drawn from the

@@ -59,6 +59,25 @@ pub struct InferredLayer {
     pub shell: Option<usize>,
 }
 
+impl InferredLayer {
+    /// Shell `shell` of an object as a layer over every dimension of `job`'s space: one
+    /// texture per parameter sample (`textures`, keyed by sample), every block of its grid
+    /// (origins `stagger`) on the one shell and cube layout that `form` describes.
+    pub fn shell(kind: pis_format::LayerKind, job: &super::represent::Job<'_>, stagger: &[u32], textures: BTreeMap<Vec<u32>, Vec<f32>>, iterations: u64, form: Box<dyn LayerForm>, shell: usize) -> InferredLayer {
+        let grid_blocks = pis_format::blocks::BlockGrid::new(&job.space, job.all, stagger).block_count() as usize;
+        InferredLayer {
+            kind,
+            depends_on: job.all,
+            placement_of: textures.keys().map(|k| (k.clone(), 0)).collect(),
+            textures,
+            block_placements: vec![0; grid_blocks],
+            iterations,
+            form,
+            shell: Some(shell),
+        }
+    }
+}
+
 /// How a layer's samples are stored in the container and rebuilt for drawing: what encoding
 /// asks of a representation ([`super::represent`]). The pyramids, the storage allocation
 /// and the codecs only see the values [`LayerForm::stored`] gives, in the planes of the

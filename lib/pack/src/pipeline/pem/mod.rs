@@ -154,17 +154,7 @@ impl Planned for PemPlanned {
         for (s, ((shell, layout, target), solved)) in chosen.shells.iter().zip(chosen.solved).enumerate() {
             let kind = if *target == Target::Local { pis_format::LayerKind::EnvLocal } else { pis_format::LayerKind::EnvDistant };
             let form = Box::new(ShellForm { shell: *shell, layout: *layout, channels: target.channels() as u8, order: s as u8, term: pis_format::Term::Reflection });
-            let grid_blocks = pis_format::blocks::BlockGrid::new(&job.space, job.all, &model.stagger).block_count() as usize;
-            model.layers.push(InferredLayer {
-                kind,
-                depends_on: job.all,
-                placement_of: solved.textures.keys().map(|k| (k.clone(), 0)).collect(),
-                textures: solved.textures,
-                block_placements: vec![0; grid_blocks],
-                iterations: solved.iterations,
-                form,
-                shell: Some(s),
-            });
+            model.layers.push(InferredLayer::shell(kind, job, &model.stagger, solved.textures, solved.iterations, form, s));
         }
         model.shell_views = chosen.views;
         model.representation = "layered environment maps".to_string();
@@ -184,17 +174,8 @@ fn single_shell(mut model: ObjectModel, job: &Job<'_>, o: usize, f0: [f32; 3], p
     let all: Vec<usize> = (0..set.frames.len()).collect();
     let views = shell_views(set, o, &job.meshes, &[(shell, layout, None)], f0, pixels, &all)?;
     let solved = solve_shell(&views, 0, layout, Target::Incident, keys, settings)?;
-    let grid_blocks = pis_format::blocks::BlockGrid::new(&job.space, job.all, &model.stagger).block_count() as usize;
-    model.layers.push(InferredLayer {
-        kind: pis_format::LayerKind::EnvDistant,
-        depends_on: job.all,
-        placement_of: solved.textures.keys().map(|k| (k.clone(), 0)).collect(),
-        textures: solved.textures,
-        block_placements: vec![0; grid_blocks],
-        iterations: solved.iterations,
-        form: Box::new(ShellForm { shell, layout, channels: 3, order: 0, term: pis_format::Term::Reflection }),
-        shell: Some(0),
-    });
+    let form = Box::new(ShellForm { shell, layout, channels: 3, order: 0, term: pis_format::Term::Reflection });
+    model.layers.push(InferredLayer::shell(pis_format::LayerKind::EnvDistant, job, &model.stagger, solved.textures, solved.iterations, form, 0));
     model.shell_views = views;
     model.representation = "environment map at infinity".to_string();
     model.why = format!("--representation pem-infinity: one sphere-at-infinity map {n}² per sample (traced incident light residual {:.4}), Fresnel from F0 {f0:?}", solved.residual_rms);

@@ -116,17 +116,8 @@ pub fn static_env(mut model: ObjectModel, job: &Job<'_>, o: usize, f0: [f32; 3],
         };
         textures.insert(k.clone(), cube);
     }
-    let grid_blocks = pis_format::blocks::BlockGrid::new(&job.space, job.all, &model.stagger).block_count() as usize;
-    model.layers.push(InferredLayer {
-        kind: pis_format::LayerKind::EnvDistant,
-        depends_on: job.all,
-        placement_of: textures.keys().map(|k| (k.clone(), 0)).collect(),
-        textures,
-        block_placements: vec![0; grid_blocks],
-        iterations: 0,
-        form: Box::new(ShellForm { shell, layout, channels: 3, order: 0, term: pis_format::Term::Reflection }),
-        shell: Some(0),
-    });
+    let form = Box::new(ShellForm { shell, layout, channels: 3, order: 0, term: pis_format::Term::Reflection });
+    model.layers.push(InferredLayer::shell(pis_format::LayerKind::EnvDistant, job, &model.stagger, textures, 0, form, 0));
     model.shell_views = views;
     model.representation = "static environment map".to_string();
     model.why = format!(
