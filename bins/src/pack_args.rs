@@ -150,7 +150,9 @@ impl PackOptions {
             resolution: self.resolution,
             spp: self.spp,
         };
-        Ok(PackRequest { input, scene, output, settings })
+        let mut req = PackRequest::new(input, output, settings);
+        req.scene = scene;
+        Ok(req)
     }
 
     /// The options as written, for telling packs apart (`Debug` of every field).

@@ -7,19 +7,36 @@ use anyhow::Context;
 use clap::Parser;
 use indicatif::{ProgressBar, ProgressStyle};
 use pis_scene::LoadOptions;
-use pis_trace::{render_set, Progress, SetReport, TraceError, TraceSettings};
-use std::path::PathBuf;
+use pis_trace::set::{merge_set, MergeReport, Shard};
+use pis_trace::{render_shard, Progress, SetReport, TraceError, TraceRun, TraceSettings};
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 /// Ray-trace SCENE.toml at every point of its parameter space into the set directory OUT.
+///
+/// A trace can be split over processes or machines that share OUT: each runs with
+/// `--shard I/N` (points whose index modulo N is I), and the one that finds every point
+/// traced writes set.json; `pis-trace merge OUT` does the same on demand. `--resume`
+/// continues an interrupted trace from the points it recorded.
 #[derive(Parser, Debug)]
-#[command(name = "pis-trace", version, about)]
+#[command(name = "pis-trace", version, about, args_conflicts_with_subcommands = true, subcommand_negates_reqs = true)]
 struct Cli {
+    #[command(subcommand)]
+    command: Option<Command>,
     /// The scene manifest (scene.toml naming a glTF file).
-    scene: PathBuf,
+    #[arg(required = true)]
+    scene: Option<PathBuf>,
     /// Output directory of the ray-traced set (created if missing).
-    #[arg(short, long)]
-    output: PathBuf,
+    #[arg(short, long, required = true)]
+    output: Option<PathBuf>,
+    /// Render only shard I of N (counted from 0): the points whose linear index modulo N is
+    /// I. Shards of one trace share OUT; the last to finish writes set.json.
+    #[arg(long, value_name = "I/N")]
+    shard: Option<Shard>,
+    /// Skip the points an earlier run of the same trace (same scene, settings and points)
+    /// recorded in OUT/shards/; a complete set of the same trace is left as it is.
+    #[arg(long)]
+    resume: bool,
     /// Image size WIDTHxHEIGHT, overriding scene.toml and the preset.
     #[arg(long, value_parser = parse_resolution)]
     resolution: Option<(u32, u32)>,
@@ -40,6 +57,20 @@ struct Cli {
     json: bool,
 }
 
+#[derive(clap::Subcommand, Debug)]
+enum Command {
+    /// Write SET/set.json from the points the shards of a trace recorded (SET/shards/), and
+    /// remove the records; an error names the points not traced yet. A complete set is
+    /// left as it is.
+    Merge {
+        /// The set directory the shards wrote.
+        set: PathBuf,
+        /// Print the report as JSON on stdout.
+        #[arg(long)]
+        json: bool,
+    },
+}
+
 fn parse_resolution(s: &str) -> Result<(u32, u32), String> {
     let (w, h) = s.split_once(['x', 'X']).ok_or_else(|| format!("expected WIDTHxHEIGHT, got {s:?}"))?;
     let w: u32 = w.trim().parse().map_err(|_| format!("bad width in {s:?}"))?;
@@ -58,6 +89,9 @@ fn exit_code(err: &anyhow::Error) -> u8 {
 struct Bar(ProgressBar);
 
 impl Progress for Bar {
+    fn start(&self, points: usize, rows: u32) {
+        self.0.set_length(points as u64 * rows as u64);
+    }
     fn point(&self, index: usize, count: usize) {
         self.0.set_message(format!("point {}/{count}", index + 1));
     }
@@ -69,12 +103,11 @@ impl Progress for Bar {
     }
 }
 
-fn run(cli: &Cli) -> anyhow::Result<SetReport> {
+fn run(cli: &Cli, scene: &Path, output: &Path) -> anyhow::Result<SetReport> {
     let options = LoadOptions { preset: cli.preset.clone(), resolution: cli.resolution, spp: cli.spp };
-    let scene = pis_scene::load_with(&cli.scene, &options).map_err(TraceError::from)?;
+    let scene = pis_scene::load_with(scene, &options).map_err(TraceError::from)?;
     let settings = TraceSettings::new(scene.resolution, scene.spp);
-    let points = cli.points.map_or(scene.space.point_count(), |n| n.min(scene.space.point_count()));
-    let bar = ProgressBar::new(points as u64 * scene.resolution.1 as u64);
+    let bar = ProgressBar::new(0);
     bar.set_style(
         ProgressStyle::with_template("{spinner} {msg} [{bar:40}] {percent}% {elapsed_precise} (eta {eta})")
             .unwrap_or_else(|_| ProgressStyle::default_bar())
@@ -86,7 +119,8 @@ fn run(cli: &Cli) -> anyhow::Result<SetReport> {
     }
     let pool = pool.build().context("starting worker threads")?;
     let progress = Bar(bar);
-    let report = pool.install(|| render_set(&scene, &cli.output, &settings, cli.points, &progress))?;
+    let run = TraceRun { limit: cli.points, shard: cli.shard.unwrap_or(Shard::WHOLE), resume: cli.resume };
+    let report = pool.install(|| render_shard(&scene, output, &settings, &run, &progress))?;
     progress.0.finish_and_clear();
     Ok(report)
 }
@@ -108,6 +142,50 @@ fn print_report(r: &SetReport) {
         "  time: {:.1} ms per point ({:.1} ms tracing), {:.2} s in all; output {:.2} MiB",
         r.ms_per_point, r.trace_ms_per_point, r.seconds, mib
     );
+    if let Some(shard) = &r.shard {
+        eprintln!("  shard {shard}: {} points traced, {} recorded before (--resume)", r.points, r.resumed);
+    } else if r.resumed > 0 {
+        eprintln!("  {} points recorded before (--resume)", r.resumed);
+    }
+    eprintln!(
+        "  set: {}",
+        if r.complete { format!("complete, {} points (set.json written)", r.set_points) } else { "not complete yet: other shards are to trace the rest (pis-trace merge assembles it)".to_string() }
+    );
+}
+
+fn print_json<T: serde::Serialize>(value: &T) -> ExitCode {
+    match serde_json::to_string_pretty(value) {
+        Ok(s) => {
+            println!("{s}");
+            ExitCode::SUCCESS
+        }
+        Err(e) => {
+            eprintln!("pis-trace: encoding the report: {e}");
+            ExitCode::from(4)
+        }
+    }
+}
+
+fn merge(set: &Path, json: bool) -> ExitCode {
+    match merge_set(set) {
+        Ok(r) => {
+            let MergeReport { points, already_complete, bytes } = &r;
+            if *already_complete {
+                eprintln!("pis-trace: {}: complete already, {points} points", set.display());
+            } else {
+                eprintln!("pis-trace: {}: {points} points merged (set.json, {bytes} bytes)", set.display());
+            }
+            if json {
+                return print_json(&r);
+            }
+            ExitCode::SUCCESS
+        }
+        Err(e) => {
+            let err = anyhow::Error::from(e);
+            eprintln!("pis-trace: {}", pis::cli::message(&err));
+            ExitCode::from(exit_code(&err))
+        }
+    }
 }
 
 fn main() -> ExitCode {
@@ -119,19 +197,20 @@ fn main() -> ExitCode {
             return ExitCode::from(code);
         }
     };
-    match run(&cli) {
+    let (scene, output) = match (&cli.command, &cli.scene, &cli.output) {
+        (Some(Command::Merge { set, json }), _, _) => return merge(set, *json),
+        (None, Some(scene), Some(output)) => (scene.clone(), output.clone()),
+        _ => {
+            eprintln!("pis-trace: give SCENE.toml and -o OUT, or `merge SET`");
+            return ExitCode::from(1);
+        }
+    };
+    match run(&cli, &scene, &output) {
         Ok(report) => {
             if cli.json {
-                match serde_json::to_string_pretty(&report) {
-                    Ok(s) => println!("{s}"),
-                    Err(e) => {
-                        eprintln!("pis-trace: encoding the report: {e}");
-                        return ExitCode::from(4);
-                    }
-                }
-            } else {
-                print_report(&report);
+                return print_json(&report);
             }
+            print_report(&report);
             ExitCode::SUCCESS
         }
         Err(err) => {

@@ -18,7 +18,9 @@
 use anyhow::{anyhow, Result};
 use glam::Vec3;
 use pis_compile::hybrid::{choose_layers, hybrid_pixels, hybrid_render_matrix, tessellate, term_radiance, vertex_modulation, vertex_vectors, FittedShell, HybridPixels, HybridView, Layers, Missing, OutgoingRay, Tessellation, Term, TessellationSettings, TERMS};
-use pis_compile::solve::{solve_view_independent, View};
+use pis_compile::solve::View;
+
+use crate::solutions::Solver;
 use pis_compile::{RenderMatrix, SolveSettings, TextureLayout, Viewport};
 use pis_scene::{Frame, Scene};
 use pis_trace::camera::{projection_matrix, PerspectiveCamera};
@@ -40,11 +42,13 @@ pub struct LensInferSettings {
     /// Weigh each pixel's rows by the traced confidence of its exit directions (thesis 6.3.3;
     /// off by default: measured worse on the glass sample, docs/BENCHMARKS.md).
     pub confidence: bool,
+    /// Where the cube maps' solves go (a sharded pack's store of solutions, [`Solver`]).
+    pub solver: Solver,
 }
 
 impl Default for LensInferSettings {
     fn default() -> Self {
-        LensInferSettings { face: None, tessellation: TessellationSettings::default(), max_layers: 4, solve: SolveSettings::pyramidal(), confidence: false }
+        LensInferSettings { face: None, tessellation: TessellationSettings::default(), max_layers: 4, solve: SolveSettings::pyramidal(), confidence: false, solver: Solver::default() }
     }
 }
 
@@ -249,8 +253,8 @@ pub fn infer_lens_views(scene: &Scene, o: usize, samples: &[Vec<TracedView>], se
         // Per shell: colour and alpha solved over both terms' rows of every view.
         let mut cubes = Vec::with_capacity(shells.len());
         for sub in &sub_all {
-            let colour = solve_view_independent(&sub.iter().map(|(m, rgb, _)| View { a: m, b: rgb }).collect::<Vec<_>>(), None, &settings.solve)?;
-            let alpha = solve_view_independent(&sub.iter().map(|(m, _, al)| View { a: m, b: al }).collect::<Vec<_>>(), None, &settings.solve)?;
+            let colour = settings.solver.solve_view_independent(&sub.iter().map(|(m, rgb, _)| View { a: m, b: rgb }).collect::<Vec<_>>(), None, &settings.solve)?;
+            let alpha = settings.solver.solve_view_independent(&sub.iter().map(|(m, _, al)| View { a: m, b: al }).collect::<Vec<_>>(), None, &settings.solve)?;
             let texels = layout.texel_count();
             let mut cube = vec![0.0f32; texels * 4];
             for k in 0..texels {

@@ -21,6 +21,7 @@ pub mod infer;
 pub mod lens;
 pub mod lens_infer;
 pub mod pipeline;
+pub mod solutions;
 
 pub use error::{exit_of, format_exit, scene_exit, trace_exit, Exit, Failure};
 pub use pipeline::*;

@@ -42,12 +42,15 @@ pub mod stored_mesh;
 pub mod surface;
 pub mod sweep;
 
+use std::collections::BTreeMap;
 use std::path::PathBuf;
 use std::time::Instant;
 
+pub use pis_trace::set::Shard;
+
 use pis_codec::CodecId;
 
-pub use report::{print_report, ObjectReport, PackReport};
+pub use report::{print_report, FragmentsReport, ObjectReport, PackReport};
 pub use input::cache_dir;
 pub use matrices::{filter_needs_probe, MatrixSource};
 pub use encode::LayerTextures;
@@ -68,6 +71,11 @@ pub struct PackRequest {
     /// The container to write (atomically).
     pub output: PathBuf,
     pub settings: PackSettings,
+    /// Where the solves go: the solver, or a store of solutions (a pack split over
+    /// processes, [`solve_shard`] and [`merge_fragments`]).
+    pub solver: crate::solutions::Solver,
+    /// Solve only the objects of this shard ([`solve_shard`]).
+    pub shard: Option<Shard>,
 }
 
 impl std::ops::Deref for PackRequest {
@@ -80,7 +88,7 @@ impl std::ops::Deref for PackRequest {
 impl PackRequest {
     /// `input` packed into `output` with `settings`.
     pub fn new(input: impl Into<PathBuf>, output: impl Into<PathBuf>, settings: PackSettings) -> Self {
-        PackRequest { input: input.into(), scene: None, output: output.into(), settings }
+        PackRequest { input: input.into(), scene: None, output: output.into(), settings, solver: Default::default(), shard: None }
     }
 
     /// The same request with other settings.
@@ -157,8 +165,8 @@ pub fn pack(input: &std::path::Path, output: &std::path::Path, settings: &PackSe
     pack_request(&PackRequest::new(input, output, settings.clone()), progress)
 }
 
-/// [`pack`] of a [`PackRequest`] (which may name the set's scene.toml).
-pub fn pack_request(req: &PackRequest, progress: &dyn Progress) -> Result<PackReport, Failure> {
+/// The checks before any work, the set read (or traced) and the render-matrix source opened.
+fn begin(req: &PackRequest, stages: &mut Stages) -> Result<(input::LoadedSet, matrices::Matrices), Failure> {
     if req.ratio.is_some() && req.psnr.is_some() {
         return Err(Failure::new(Exit::Usage, anyhow::anyhow!("give --ratio or --psnr, not both")));
     }
@@ -167,24 +175,30 @@ pub fn pack_request(req: &PackRequest, progress: &dyn Progress) -> Result<PackRe
             return Err(Failure::new(Exit::Usage, anyhow::anyhow!("--ratio must be at least 1, got {r}")));
         }
     }
-    let parent = req.output.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(std::path::Path::new("."));
-    if !parent.is_dir() {
-        return Err(Failure::new(Exit::Io, anyhow::anyhow!("the output folder {} does not exist", parent.display())));
-    }
-    let mut stages = Stages::new(progress);
     if let Some(why) = filter_needs_probe(req.filter, req.matrix) {
         return Err(Failure::new(Exit::Usage, anyhow::anyhow!(why)));
     }
-    let set = input::load(req, &mut stages)?;
+    let set = input::load(req, stages)?;
     // A ratio is checked before any work: it must leave the level images a byte.
     let raw = set.raw_image_bytes();
     if let Some(r) = req.ratio.filter(|r| raw as f64 / r < 1.0) {
         return Err(Failure::new(Exit::Usage, anyhow::anyhow!("--ratio {r} leaves no byte for the level images of this set (raw images {raw} bytes): the highest ratio is {raw}:1")));
     }
-    let mut matrices = matrices::Matrices::open(req.matrix, req.filter)?;
+    let matrices = matrices::Matrices::open(req.matrix, req.filter)?;
     if let Some(device) = matrices.device() {
         stages.note(&format!("probe mode on {device}"));
     }
+    Ok((set, matrices))
+}
+
+/// [`pack`] of a [`PackRequest`] (which may name the set's scene.toml).
+pub fn pack_request(req: &PackRequest, progress: &dyn Progress) -> Result<PackReport, Failure> {
+    let parent = req.output.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(std::path::Path::new("."));
+    if !parent.is_dir() {
+        return Err(Failure::new(Exit::Io, anyhow::anyhow!("the output folder {} does not exist", parent.display())));
+    }
+    let mut stages = Stages::new(progress);
+    let (set, mut matrices) = begin(req, &mut stages)?;
     let inferred = infer_layers::infer_all(&set, req, &mut matrices, &mut stages).map_err(|e| Failure::new(Exit::Runtime, e))?;
     let probe_renderings = matrices.renderings();
     drop(matrices);
@@ -238,4 +252,98 @@ pub fn pack_request(req: &PackRequest, progress: &dyn Progress) -> Result<PackRe
 /// `N`, or `NxM…`: sizes of at least 1 separated by `x` (`--block`, `--resolution`).
 pub fn parse_sizes(s: &str) -> Result<Vec<u32>, String> {
     s.split(['x', 'X']).map(|p| p.trim().parse::<u32>().ok().filter(|&b| b > 0).ok_or_else(|| format!("bad size {s:?}: expected N or NxM"))).collect()
+}
+
+/// What a solve shard did ([`solve_shard`]).
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct SolveReport {
+    /// `I/N`.
+    pub shard: String,
+    /// The fragment file.
+    pub fragment: String,
+    /// The objects this shard solved (for `--representation auto`, both ways).
+    pub objects: Vec<String>,
+    /// Solutions in the fragment.
+    pub solutions: usize,
+    pub bytes: u64,
+    /// The fragment was there already (`resume`): nothing was done.
+    pub resumed: bool,
+    pub seconds: f64,
+    /// Milliseconds per stage.
+    pub stage_ms: BTreeMap<String, f64>,
+}
+
+/// The fragment file of shard `shard` in the folder `fragments`.
+pub fn fragment_path(fragments: &std::path::Path, shard: Shard) -> PathBuf {
+    fragments.join(format!("solve-{:04}-of-{:04}.{}", shard.index, shard.count, crate::solutions::FRAGMENT_EXTENSION))
+}
+
+/// The solve of a pack split over processes: runs `req`'s inference for the objects of
+/// `shard` (the objects that cover a pixel, in scene order, every N-th from the I-th) and
+/// writes the solutions to a fragment file in the folder `fragments` (atomically); with
+/// `resume`, a fragment that is there already is kept and nothing is done.
+/// [`merge_fragments`] then writes the file.
+pub fn solve_shard(req: &PackRequest, shard: Shard, fragments: &std::path::Path, resume: bool, progress: &dyn Progress) -> Result<SolveReport, Failure> {
+    let start = Instant::now();
+    std::fs::create_dir_all(fragments).map_err(|e| Failure::new(Exit::Io, anyhow::anyhow!("{}: {e}", fragments.display())))?;
+    let path = fragment_path(fragments, shard);
+    let mut report = SolveReport { shard: shard.to_string(), fragment: path.display().to_string(), objects: Vec::new(), solutions: 0, bytes: 0, resumed: false, seconds: 0.0, stage_ms: BTreeMap::new() };
+    if resume && path.is_file() {
+        report.resumed = true;
+        report.bytes = std::fs::metadata(&path).map(|m| m.len()).unwrap_or(0);
+        return Ok(report);
+    }
+    let store = std::sync::Arc::new(crate::solutions::Solutions::recording());
+    let mut req = req.clone();
+    req.solver = crate::solutions::Solver::with(store.clone());
+    req.shard = Some(shard);
+    let mut stages = Stages::new(progress);
+    let (set, mut matrices) = begin(&req, &mut stages)?;
+    let inferred = infer_layers::infer_all(&set, &req, &mut matrices, &mut stages).map_err(|e| Failure::new(Exit::Runtime, e))?;
+    report.objects = inferred.models.iter().map(|m| m.name.clone()).collect();
+    report.solutions = store.len();
+    report.bytes = store.write_fragment(&path).map_err(|e| Failure::new(Exit::Io, e))?;
+    stages.done("fragment", &format!("{} solutions of {} objects ({} bytes) to {}", report.solutions, report.objects.len(), report.bytes, path.display()));
+    report.stage_ms = stages.ms.into_iter().collect();
+    report.seconds = start.elapsed().as_secs_f64();
+    Ok(report)
+}
+
+/// The fragment files in the folder `fragments`, in name order.
+pub fn fragment_files(fragments: &std::path::Path) -> Result<Vec<PathBuf>, Failure> {
+    let read = std::fs::read_dir(fragments).map_err(|e| Failure::new(Exit::Io, anyhow::anyhow!("{}: {e}", fragments.display())))?;
+    let mut files: Vec<PathBuf> = read
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.extension().is_some_and(|x| x == crate::solutions::FRAGMENT_EXTENSION) && p.is_file())
+        .collect();
+    files.sort();
+    Ok(files)
+}
+
+/// The merge of a pack split over processes: packs `req` as [`pack_request`] does, every
+/// solve the fragments in the folder `fragments` hold read from them instead of solved
+/// (a solve none holds is solved here). The file is the one a single process writes.
+pub fn merge_fragments(req: &PackRequest, fragments: &std::path::Path, progress: &dyn Progress) -> Result<PackReport, Failure> {
+    let t = Instant::now();
+    let files = fragment_files(fragments)?;
+    if files.is_empty() {
+        return Err(Failure::new(Exit::Invalid, anyhow::anyhow!("no solve fragments (*.{}) in {}: run `pis-pack solve --shard I/N --fragments {}` first", crate::solutions::FRAGMENT_EXTENSION, fragments.display(), fragments.display())));
+    }
+    let store = std::sync::Arc::new(crate::solutions::Solutions::default());
+    let mut held = 0;
+    for f in &files {
+        held += store.read_fragment(f).map_err(|e| Failure::new(Exit::Invalid, e))?;
+    }
+    let read_ms = t.elapsed().as_secs_f64() * 1e3;
+    progress.stage("fragments", read_ms, &format!("{held} solutions from {} fragment files in {}", files.len(), fragments.display()));
+    let mut req = req.clone();
+    req.solver = crate::solutions::Solver::with(store.clone());
+    let mut report = pack_request(&req, progress)?;
+    let (read, solved) = store.counts();
+    if solved > 0 {
+        progress.note(&format!("{solved} of {} solves were in no fragment and were solved here: the shards ran with other settings, on another set, or some shard is missing", read + solved));
+    }
+    report.stage_ms.insert("fragments".to_string(), read_ms);
+    report.fragments = Some(FragmentsReport { files: files.len(), solutions: held, read, solved });
+    Ok(report)
 }

@@ -46,5 +46,5 @@ pub use film::GaussianFilter;
 pub use layers::{LayerImage, LayerKind, PointImages};
 pub use records::{RayRecord, RecordHit};
 pub use render::{channel_names, render_point, PointRender, RenderStats};
-pub use run::{render_set, NoProgress, Progress, SetReport};
+pub use run::{render_set, render_shard, NoProgress, Progress, SetReport, TraceRun};
 pub use settings::TraceSettings;

@@ -2,7 +2,7 @@
 
 use crate::error::TraceError;
 use crate::render::render_point;
-use crate::set::SetWriter;
+use crate::set::{Begin, SetWriter, Shard};
 use crate::settings::TraceSettings;
 use pis_scene::Scene;
 use serde::Serialize;
@@ -36,6 +36,16 @@ pub struct SetReport {
     pub seconds: f64,
     /// Bytes written (EXRs, ray records, set.json).
     pub output_bytes: u64,
+    /// The shard this process rendered (`I/N`), when the trace is split over processes.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub shard: Option<String>,
+    /// Points of the set (the whole space, or the first `--points`).
+    pub set_points: usize,
+    /// Points of this process skipped because an earlier run of the same trace recorded
+    /// them (`resume`).
+    pub resumed: usize,
+    /// Whether the set is complete (set.json written, by this process or before it).
+    pub complete: bool,
     /// What the trace found wrong with the scene without failing (also told to
     /// [`Progress::note`] as found).
     pub warnings: Vec<String>,
@@ -43,6 +53,8 @@ pub struct SetReport {
 
 /// Progress notifications from [`render_set`], called from worker threads.
 pub trait Progress: Sync {
+    /// The work is known: `points` points to render (of `rows` rows each).
+    fn start(&self, _points: usize, _rows: u32) {}
     /// A point starts (`index` in rendering order, of `count`).
     fn point(&self, _index: usize, _count: usize) {}
     /// One image row of the current point is done.
@@ -74,6 +86,38 @@ pub fn render_set(
     limit: Option<usize>,
     progress: &dyn Progress,
 ) -> Result<SetReport, TraceError> {
+    render_shard(scene, out, settings, &TraceRun { limit, ..TraceRun::default() }, progress)
+}
+
+/// Which points of a set a process renders (RAYSET.md 7).
+#[derive(Clone, Copy, Debug)]
+pub struct TraceRun {
+    /// The set is the first `limit` points of the space (all when `None`).
+    pub limit: Option<usize>,
+    /// The points this process renders: [`Shard::WHOLE`], or one shard of a trace split
+    /// over processes sharing the set directory.
+    pub shard: Shard,
+    /// Skip the points an earlier run of the same trace recorded.
+    pub resume: bool,
+}
+
+impl Default for TraceRun {
+    fn default() -> Self {
+        TraceRun { limit: None, shard: Shard::WHOLE, resume: false }
+    }
+}
+
+/// Renders `run`'s points of `scene` into the set directory `out`, one EXR (and
+/// ray-record file) per point as each finishes, each recorded once written; the process
+/// that finds every point of the set recorded writes set.json. Runs on the current rayon
+/// pool.
+pub fn render_shard(
+    scene: &Scene,
+    out: &Path,
+    settings: &TraceSettings,
+    run: &TraceRun,
+    progress: &dyn Progress,
+) -> Result<SetReport, TraceError> {
     // A point's samples, images and EXR in memory at once: refused before any work when
     // the machine has not that much.
     let (w, h) = settings.resolution;
@@ -87,12 +131,14 @@ pub fn render_set(
     }
     let start = Instant::now();
     let total_points = scene.space.point_count();
-    let count = limit.map_or(total_points, |l| l.min(total_points));
-    let mut writer = SetWriter::create(out, scene, settings)?;
+    let count = run.limit.map_or(total_points, |l| l.min(total_points));
+    let mine: Vec<usize> = run.shard.points(count).collect();
     let mut report = SetReport {
         scene: scene.name.clone(),
-        points: count,
+        points: 0,
         points_in_space: total_points,
+        shard: (run.shard != Shard::WHOLE).then(|| run.shard.to_string()),
+        set_points: count,
         resolution: [settings.resolution.0, settings.resolution.1],
         spp: settings.spp,
         threads: rayon::current_num_threads(),
@@ -102,9 +148,22 @@ pub fn render_set(
         progress.note(&w);
         report.warnings.push(w);
     }
+    // A resumed trace of a set that is complete already has nothing to do.
+    if run.resume && crate::set::is_complete(out, &SetWriter::meta(out, scene, settings), count) {
+        report.resumed = mine.len();
+        report.complete = true;
+        report.seconds = start.elapsed().as_secs_f64();
+        return Ok(report);
+    }
+    let joins = run.resume || run.shard != Shard::WHOLE;
+    let mut writer = SetWriter::begin(out, scene, settings, count, if joins { Begin::Join } else { Begin::Fresh })?;
+    let todo: Vec<usize> = mine.iter().copied().filter(|&i| !(run.resume && writer.done(i).is_some())).collect();
+    report.resumed = mine.len() - todo.len();
+    report.points = todo.len();
+    progress.start(todo.len(), settings.resolution.1);
     let mut trace_seconds = 0.0;
-    for index in 0..count {
-        progress.point(index, count);
+    for (k, &index) in todo.iter().enumerate() {
+        progress.point(k, todo.len());
         let point = scene.space.point(index);
         let frame = scene.frame(&point)?;
         let render = render_point(scene, &frame, settings, &|| progress.row())?;
@@ -114,15 +173,18 @@ pub fn render_set(
         report.triangles = report.triangles.max(render.stats.triangles);
         trace_seconds += render.stats.trace_seconds;
     }
-    report.output_bytes += writer.finish()?;
+    if let Some(bytes) = writer.finish_if_complete()? {
+        report.output_bytes += bytes;
+        report.complete = true;
+    }
     report.seconds = start.elapsed().as_secs_f64();
     if trace_seconds > 0.0 {
         report.rays_per_second = report.total_rays as f64 / trace_seconds;
         report.camera_rays_per_second = report.camera_rays as f64 / trace_seconds;
     }
-    if count > 0 {
-        report.ms_per_point = report.seconds * 1000.0 / count as f64;
-        report.trace_ms_per_point = trace_seconds * 1000.0 / count as f64;
+    if !todo.is_empty() {
+        report.ms_per_point = report.seconds * 1000.0 / todo.len() as f64;
+        report.trace_ms_per_point = trace_seconds * 1000.0 / todo.len() as f64;
     }
     Ok(report)
 }

@@ -98,7 +98,7 @@ pub const METHODS: [&str; 7] = ["pis-wavelet", "pis-dct", "pis-wavelet-full-pyra
 
 fn pack_request(req: &RdRequest) -> PackRequest {
     let settings = PackSettings { max_texture: req.max_texture, resolution: req.resolution, spp: req.spp, preset: req.preset.clone(), max_mse: req.max_mse, ..PackSettings::new() };
-    PackRequest { input: req.input.clone(), scene: req.scene.clone(), output: req.out.join("unused.pis"), settings }
+    PackRequest { scene: req.scene.clone(), ..PackRequest::new(req.input.clone(), req.out.join("unused.pis"), settings) }
 }
 
 fn runtime(e: anyhow::Error) -> Failure {

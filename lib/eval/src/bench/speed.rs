@@ -79,7 +79,7 @@ pub fn run(req: &SpeedRequest) -> Result<SpeedReport, Failure> {
     check(req)?;
     ensure_dir(&req.out).map_err(|e| Failure::new(Exit::Io, e))?;
     let settings = PackSettings { max_texture: req.max_texture, resolution: req.resolution, spp: req.spp, preset: req.preset.clone(), ..PackSettings::new().with_ratio(req.ratio) };
-    let base = PackRequest { input: req.input.clone(), scene: req.scene.clone(), output: req.out.join("unused.pis"), settings };
+    let base = PackRequest { scene: req.scene.clone(), ..PackRequest::new(req.input.clone(), req.out.join("unused.pis"), settings) };
     let mut rows = Vec::new();
     let mut scene = String::new();
     let mut points = 0;

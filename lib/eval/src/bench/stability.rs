@@ -208,7 +208,7 @@ pub fn run(req: &StabilityRequest) -> Result<StabilityReport, Failure> {
     check(req)?;
     ensure_dir(&req.out).map_err(|e| Failure::new(Exit::Io, e))?;
     let settings = PackSettings { max_texture: req.max_texture, resolution: req.resolution, spp: req.trace_spp, preset: req.preset.clone(), ..PackSettings::new() };
-    let base = PackRequest { input: req.input.clone(), scene: req.scene.clone(), output: req.out.join("unused.pis"), settings };
+    let base = PackRequest { scene: req.scene.clone(), ..PackRequest::new(req.input.clone(), req.out.join("unused.pis"), settings) };
     eprintln!("pis-bench: stability: loading and inferring");
     let inf = Inferred::new(&base, &StderrProgress)?;
     let scene = &inf.set.scene;

@@ -72,6 +72,7 @@ impl Planned for HybridPlanned {
         let views: Vec<Vec<TracedView>> = (0..set.frames.len()).map(|p| vec![TracedView { frame: &set.frames[p], images: &set.images[p], records: &set.records[p] }]).collect();
         let mut settings = LensInferSettings::default();
         settings.solve.cg = job.settings.cg;
+        settings.solver = job.solver.clone();
         // The single-shell baseline (thesis 6.5's comparison): one layer, one shell.
         let one = job.req.representation == super::RepresentationMode::PemInfinity;
         if one {

@@ -65,6 +65,10 @@ pub fn infer_all(set: &LoadedSet, req: &PackRequest, matrices: &mut Matrices, st
         progress.note(&format!("object {}: {} texels, {} ({})", m.name, sizes_text.join(", "), m.representation, m.why));
     };
     for (mi, (p, other)) in planned.into_iter().enumerate() {
+        // A solve shard solves its objects only (pis-pack solve --shard).
+        if req.shard.is_some_and(|s| !s.has(mi)) {
+            continue;
+        }
         let m = p.solve(&job)?;
         note(&m);
         models.push(m);

@@ -43,6 +43,19 @@ pub struct ObjectReport {
     pub area_px: f64,
 }
 
+/// What the merge of a pack split over processes read ([`super::merge_fragments`]).
+#[derive(Clone, Debug, Serialize)]
+pub struct FragmentsReport {
+    /// Fragment files read.
+    pub files: usize,
+    /// Solutions they hold.
+    pub solutions: usize,
+    /// Solves read from them.
+    pub read: usize,
+    /// Solves no fragment held, solved by the merge.
+    pub solved: usize,
+}
+
 /// The pack report (`--json` prints it).
 #[derive(Clone, Debug, Serialize)]
 pub struct PackReport {
@@ -90,6 +103,9 @@ pub struct PackReport {
     /// Lossless codec: every level image read back from the file decodes bit-exactly to
     /// what was encoded, and the decoded finest texels equal the solved ones bit for bit.
     pub lossless_exact: Option<bool>,
+    /// The merge of a pack split over processes: what its fragments gave.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub fragments: Option<FragmentsReport>,
     /// The allocation's max-MSE constraint (thesis 4.8) as applied: `off`, or its α.
     pub max_mse_ratio: Option<String>,
     /// `--max-mse-ratio auto` where the constraint changed the allocation: the predicted
@@ -160,6 +176,7 @@ pub fn build(set: &LoadedSet, models: &[ObjectModel], packed: &Packed, q: &Quali
         psnr_db_solved: q.overall_solved,
         max_texel_error: q.max_texel_error,
         lossless_exact: exact,
+        fragments: None,
         max_mse_ratio: packed.container.provenance.as_ref().and_then(|p| p.settings.iter().find(|(k, _)| k == "max_mse_ratio")).map(|(_, v)| v.clone()),
         max_mse_psnr_db: packed.max_mse.as_ref().map(|c| MaxMsePsnr { constrained: c.psnr_db_constrained, free: c.psnr_db_free }),
         objects,
@@ -200,6 +217,9 @@ pub fn print_report(r: &PackReport, out: &mut impl std::io::Write) -> std::io::R
     }
     if let Some(e) = r.lossless_exact {
         writeln!(out, "  lossless: file decodes to the solved textures bit-exactly: {e} (max texel error {:.3e})", r.max_texel_error)?;
+    }
+    if let Some(f) = &r.fragments {
+        writeln!(out, "  fragments: {} files, {} solutions; {} solves read from them, {} solved here", f.files, f.solutions, f.read, f.solved)?;
     }
     for o in &r.objects {
         let layers: Vec<String> = o.layer_bytes.iter().map(|(k, b)| format!("{k} {b}")).collect();

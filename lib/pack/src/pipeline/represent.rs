@@ -90,6 +90,8 @@ pub struct Job<'a> {
     pub all: DepMask,
     pub non_view: DepMask,
     pub settings: SolveSettings,
+    /// Where the solves go: the solver, or a sharded pack's store of solutions.
+    pub solver: crate::solutions::Solver,
     /// Texture placements made, and render matrices measured beyond one per object and point.
     pub placements: usize,
     pub extra_matrices: usize,
@@ -111,7 +113,7 @@ impl<'a> Job<'a> {
         if let Some(n) = req.max_iterations {
             settings.cg.max_iterations = n.max(1);
         }
-        Ok(Job { set, req, matrices, progress, meshes, sizes, space, all, non_view, settings, placements: 0, extra_matrices: 0 })
+        Ok(Job { set, req, matrices, progress, meshes, sizes, space, all, non_view, settings, solver: req.solver.clone(), placements: 0, extra_matrices: 0 })
     }
 
     /// A note on the work.

@@ -13,7 +13,7 @@ use std::borrow::Cow;
 use std::collections::BTreeMap;
 
 use anyhow::{anyhow, Result};
-use pis_compile::{solve, solve_view_independent, DrawMesh, RenderMatrix, SolveSettings, TextureLayout, TexturedObject, View, Viewport};
+use pis_compile::{DrawMesh, RenderMatrix, SolveSettings, TextureLayout, TexturedObject, View, Viewport};
 use pis_format::blocks::BlockGrid;
 use pis_format::DepMask;
 use pis_scene::ObjectRole;
@@ -25,6 +25,7 @@ use super::matrices::Matrices;
 use super::model::{key, InferredLayer, LayerForm, ObjectModel, PointView};
 use super::represent::{Job, Planned, Representation, Surveyed};
 use super::{PackRequest, PlacementMode};
+use crate::solutions::Solver;
 use crate::infer::{atlas, gather, merged_mesh, place_in, restrict_rows, sampler, Atlas, Mesh, Placed};
 
 /// Largest linear radiance below which a layer counts as black.
@@ -165,7 +166,7 @@ fn plan_layer(
 /// One texture per key of `plan`'s mask: each key's sample solved (or, for a view-independent
 /// layer, its views stacked, eq. 3.7) with the render matrices of its block's placement,
 /// warm-started from the last sample solved with the same placement.
-fn solve_layer(set: &LoadedSet, views: &[PointView], placements: &[Placed], plan: &LayerPlan, settings: &SolveSettings) -> Result<InferredLayer> {
+fn solve_layer(set: &LoadedSet, views: &[PointView], placements: &[Placed], plan: &LayerPlan, settings: &SolveSettings, solver: &Solver) -> Result<InferredLayer> {
     let mut groups: BTreeMap<Vec<u32>, Vec<usize>> = BTreeMap::new();
     for (p, s) in set.samples.iter().enumerate() {
         groups.entry(key(s, plan.depends_on)).or_default().push(p);
@@ -181,14 +182,14 @@ fn solve_layer(set: &LoadedSet, views: &[PointView], placements: &[Placed], plan
         let start = warm.get(&pid).map(Vec::as_slice);
         let x = if plan.radiance == Radiance::Diffuse {
             // One texture for the views of the sample, stacked (eq. 3.7).
-            let s = solve_view_independent(&vs, start, settings)?;
+            let s = solver.solve_view_independent(&vs, start, settings)?;
             iterations += s.iterations as u64;
             s.texels
         } else if vs[0].a.rows() == 0 {
             // A view-dependent sample (one point per key) where the object covers no pixel.
             start.map_or_else(|| vec![0.0; placements[pid].layout.texel_count() * 3], <[f32]>::to_vec)
         } else {
-            let s = solve(vs[0].a, vs[0].b, start, settings)?;
+            let s = solver.solve(vs[0].a, vs[0].b, start, settings)?;
             iterations += s.iterations as u64;
             s.texels
         };
@@ -404,7 +405,7 @@ impl Planned for Layers {
         let name = scene.objects[o].name.clone();
         let covered: usize = views.iter().map(PointView::rows).sum();
         let area = covered as f64 / views.len() as f64;
-        let layers = plans.iter().map(|plan| solve_layer(set, &views, &placements, plan, &job.settings)).collect::<Result<Vec<_>>>()?;
+        let layers = plans.iter().map(|plan| solve_layer(set, &views, &placements, plan, &job.settings, &job.solver)).collect::<Result<Vec<_>>>()?;
         let radiances: Vec<Radiance> = plans.iter().map(|p| p.radiance).collect();
         let (representation, why) = match radiances.as_slice() {
             [Radiance::Sum] => ("combined", "--layers combined: one view-dependent layer of diffuse + specular radiance per parameter sample"),

@@ -3,7 +3,8 @@
 
 use super::exr_io::encode_exr;
 use super::meta::*;
-use super::{SET_FORMAT, SET_JSON, SET_VERSION};
+use super::shards::{all_recorded, merge_set, Begin, Records};
+use super::{SET_FORMAT, SET_VERSION};
 use crate::camera::projection_matrix;
 use crate::error::TraceError;
 use crate::layers::LayerKind;
@@ -50,17 +51,23 @@ fn kind_name(kind: DimensionKind) -> &'static str {
     }
 }
 
-/// Writes a ray-traced set point by point, then `set.json`.
+/// Writes a ray-traced set point by point, each point recorded once its files are written
+/// ([`Records`]), then `set.json` from the records.
 pub struct SetWriter {
     dir: PathBuf,
     meta: SetMeta,
-    scene_lights: usize,
+    records: Records,
 }
 
 impl SetWriter {
-    /// Creates the directory `dir` (if needed) for a set of `scene` rendered with `settings`.
+    /// Creates the directory `dir` (if needed) for a set of every point of `scene` rendered
+    /// with `settings`, by this process alone.
     pub fn create(dir: &Path, scene: &Scene, settings: &TraceSettings) -> Result<SetWriter, TraceError> {
-        fs::create_dir_all(dir).map_err(|e| TraceError::io(dir, e))?;
+        SetWriter::begin(dir, scene, settings, scene.space.point_count(), Begin::Fresh)
+    }
+
+    /// The set meta (without points) of `scene` rendered with `settings` into `dir`.
+    pub fn meta(dir: &Path, scene: &Scene, settings: &TraceSettings) -> SetMeta {
         let names = channel_names(scene);
         let objects = scene
             .objects
@@ -93,7 +100,7 @@ impl SetWriter {
                 values: d.values.clone(),
             })
             .collect();
-        let meta = SetMeta {
+        SetMeta {
             format: SET_FORMAT.into(),
             version: SET_VERSION,
             scene: scene.name.clone(),
@@ -109,8 +116,22 @@ impl SetWriter {
             objects,
             points: Vec::new(),
             scene_file: scene.source.as_deref().map(|s| relative_to(s, dir)),
-        };
-        Ok(SetWriter { dir: dir.to_path_buf(), meta, scene_lights: 0 })
+        }
+    }
+
+    /// Creates the directory `dir` (if needed) for a set of the first `points` points of
+    /// `scene` rendered with `settings`, taking up the records there as `begin` says
+    /// (several processes may write one set, each its own points).
+    pub fn begin(dir: &Path, scene: &Scene, settings: &TraceSettings, points: usize, begin: Begin) -> Result<SetWriter, TraceError> {
+        fs::create_dir_all(dir).map_err(|e| TraceError::io(dir, e))?;
+        let meta = SetWriter::meta(dir, scene, settings);
+        let records = Records::begin(dir, &meta, points, begin)?;
+        Ok(SetWriter { dir: dir.to_path_buf(), meta, records })
+    }
+
+    /// The record of point `index` when an earlier run of the same trace wrote it.
+    pub fn done(&self, index: usize) -> Option<PointMeta> {
+        self.records.done(index)
     }
 
     /// The set directory.
@@ -191,20 +212,23 @@ impl SetWriter {
                 })
                 .collect(),
         };
-        self.scene_lights = self.scene_lights.max(frame.lights.len());
-        self.meta.points.retain(|p| p.index != index);
-        self.meta.points.push(point);
+        self.records.record(&point)?;
         Ok(bytes)
     }
 
-    /// Writes `set.json` (points sorted by index) and returns its size in bytes.
-    pub fn finish(mut self) -> Result<u64, TraceError> {
-        self.meta.points.sort_by_key(|p| p.index);
-        let path = self.dir.join(SET_JSON);
-        let json = serde_json::to_vec_pretty(&self.meta)
-            .map_err(|e| TraceError::InvalidInput(format!("cannot encode {}: {e}", path.display())))?;
-        write_atomic(&path, &json)?;
-        Ok(json.len() as u64)
+    /// Writes `set.json` from the records (points sorted by index) and returns its size in
+    /// bytes; an error when some point has no record yet.
+    pub fn finish(self) -> Result<u64, TraceError> {
+        Ok(merge_set(&self.dir)?.bytes)
+    }
+
+    /// Writes `set.json` when every point has a record (another process may still be
+    /// writing its points): returns its size in bytes, `None` while points are missing.
+    pub fn finish_if_complete(self) -> Result<Option<u64>, TraceError> {
+        if !all_recorded(&self.dir)? {
+            return Ok(None);
+        }
+        Ok(Some(merge_set(&self.dir)?.bytes))
     }
 }
 

@@ -118,7 +118,7 @@ impl Planned for PemPlanned {
         for (label, shell) in [("box", fitted.distant_box), ("sphere", fitted.distant_sphere)] {
             let n = face_resolution(set, o, &job.meshes, shell, largest)?;
             let views = shell_views(set, o, &job.meshes, &[(shell, TextureLayout::cube(n), None)], f0, &probe_pixels, &probe)?;
-            let solved = solve_shell(&views, 0, TextureLayout::cube(n), Target::Distant, &probe_keys, &settings)?;
+            let solved = solve_shell(&views, 0, TextureLayout::cube(n), Target::Distant, &probe_keys, &settings, &job.solver)?;
             trial.push((solved.residual_rms, label, shell, n));
         }
         trial.sort_by(|a, b| a.0.total_cmp(&b.0));
@@ -138,7 +138,7 @@ impl Planned for PemPlanned {
         let views = shell_views(set, o, &job.meshes, &geometry, f0, &pixels, &all)?;
         let mut solved = Vec::new();
         for (s, &(_, layout, target)) in shells.iter().enumerate() {
-            solved.push(solve_shell(&views, s, layout, target, &keys, &settings)?);
+            solved.push(solve_shell(&views, s, layout, target, &keys, &settings, &job.solver)?);
         }
         let hull_text = match &hull {
             Some(h) => {
@@ -173,7 +173,7 @@ fn single_shell(mut model: ObjectModel, job: &Job<'_>, o: usize, f0: [f32; 3], p
     let layout = TextureLayout::cube(n);
     let all: Vec<usize> = (0..set.frames.len()).collect();
     let views = shell_views(set, o, &job.meshes, &[(shell, layout, None)], f0, pixels, &all)?;
-    let solved = solve_shell(&views, 0, layout, Target::Incident, keys, settings)?;
+    let solved = solve_shell(&views, 0, layout, Target::Incident, keys, settings, &job.solver)?;
     let form = Box::new(ShellForm { shell, layout, channels: 3, order: 0, term: pis_format::Term::Reflection });
     model.layers.push(InferredLayer::shell(pis_format::LayerKind::EnvDistant, job, &model.stagger, solved.textures, solved.iterations, form, 0));
     model.shell_views = views;

@@ -7,7 +7,9 @@
 use std::collections::BTreeMap;
 
 use anyhow::Result;
-use pis_compile::{solve, solve_view_independent, RenderMatrix, SolveSettings, TextureLayout, View};
+use pis_compile::{RenderMatrix, SolveSettings, TextureLayout, View};
+
+use crate::solutions::Solver;
 
 /// The amplitude weight of a neighbouring sample's rows in a sample's solve (its squared
 /// error counts this squared: 1/16).
@@ -46,7 +48,7 @@ pub struct SolvedShell {
 /// Solves shell `s` (of the views' shells) for `target` at every point, keyed by `keys`
 /// (one key per point: shells are view-dependent), each point's rows stacked with its
 /// neighbours' (the points before and after it) weighed by [`NEIGHBOUR_SCALE`].
-pub fn solve_shell(views: &[ShellView], s: usize, layout: TextureLayout, target: Target, keys: &[Vec<u32>], settings: &SolveSettings) -> Result<SolvedShell> {
+pub fn solve_shell(views: &[ShellView], s: usize, layout: TextureLayout, target: Target, keys: &[Vec<u32>], settings: &SolveSettings, solver: &Solver) -> Result<SolvedShell> {
     let n = layout.texel_count();
     let c = target.channels();
     let mut textures = BTreeMap::new();
@@ -70,7 +72,7 @@ pub fn solve_shell(views: &[ShellView], s: usize, layout: TextureLayout, target:
         if a.rows() > 0 {
             let (rgb, alpha) = split(v, target);
             let rgb_n: Vec<(&RenderMatrix, &[f32])> = neighbours.iter().map(|&j| (&scaled[j].0, scaled[j].1.as_slice())).collect();
-            let x = solve_stacked(a, &rgb, &rgb_n, warm_rgb.as_deref(), settings)?;
+            let x = solve_stacked(a, &rgb, &rgb_n, warm_rgb.as_deref(), settings, solver)?;
             iterations += x.iterations as u64;
             sq += x.residual_rms * x.residual_rms * a.rows() as f64;
             count += a.rows();
@@ -80,7 +82,7 @@ pub fn solve_shell(views: &[ShellView], s: usize, layout: TextureLayout, target:
             warm_rgb = Some(x.texels);
             if let Some(alpha) = alpha {
                 let alpha_n: Vec<(&RenderMatrix, &[f32])> = neighbours.iter().filter_map(|&j| scaled[j].2.as_deref().map(|b| (&scaled[j].0, b))).collect();
-                let y = solve_stacked(a, &alpha, &alpha_n, warm_alpha.as_deref(), settings)?;
+                let y = solve_stacked(a, &alpha, &alpha_n, warm_alpha.as_deref(), settings, solver)?;
                 iterations += y.iterations as u64;
                 for t in 0..n {
                     texels[t * c + 3] = y.texels[t * 3];
@@ -103,12 +105,12 @@ pub fn solve_shell(views: &[ShellView], s: usize, layout: TextureLayout, target:
 
 /// One sample's solve: its own rows, stacked with its weighed-down neighbours' when it has
 /// any (eq. 3.7's stacking, in the AᵀA form).
-fn solve_stacked(a: &RenderMatrix, b: &[f32], neighbours: &[(&RenderMatrix, &[f32])], warm: Option<&[f32]>, settings: &SolveSettings) -> Result<pis_compile::Solution> {
+fn solve_stacked(a: &RenderMatrix, b: &[f32], neighbours: &[(&RenderMatrix, &[f32])], warm: Option<&[f32]>, settings: &SolveSettings, solver: &Solver) -> Result<pis_compile::Solution> {
     if neighbours.is_empty() {
-        return Ok(solve(a, b, warm, settings)?);
+        return Ok(solver.solve(a, b, warm, settings)?);
     }
     let views: Vec<View> = std::iter::once(View { a, b }).chain(neighbours.iter().map(|&(a, b)| View { a, b })).collect();
-    Ok(solve_view_independent(&views, warm, settings)?)
+    Ok(solver.solve_view_independent(&views, warm, settings)?)
 }
 
 /// The right-hand sides of a point: RGB per row, and for the local layer its alpha in the
