@@ -4,8 +4,8 @@
 //! every `cargo run` command it shows runs as written. docs/TOOLS.md documents every flag each
 //! tool's `--help` prints, and no flag a tool no longer has.
 //!
-//! The flags convention of docs/TOOLS.md: each tool's `## pis-X` section (for pis-bench, each
-//! subcommand's `### pis-bench SUB` subsection) holds tables whose header's first cell is
+//! The flags convention of docs/TOOLS.md: each tool's `## pis-X` section (for a tool with
+//! subcommands, each subcommand's `### pis-X SUB` subsection) holds tables whose header's first cell is
 //! `flag`; the first cell of every row names the flag (`--ratio`, or `-o`, `--output`). Those
 //! cells are what is checked against `--help`, both ways.
 
@@ -117,19 +117,17 @@ fn help(tool: &str, sub: Option<&str>) -> String {
     String::from_utf8(out.stdout).expect("--help is UTF-8")
 }
 
-/// pis-bench's subcommands, from the `Commands:` list of its --help (`help` left out).
-fn bench_subcommands() -> Vec<String> {
-    let text = help("pis-bench", None);
-    let list = text.split_once("Commands:\n").expect("pis-bench --help lists its commands").1;
-    let subs: Vec<String> = list
-        .lines()
+/// A tool's subcommands, from the `Commands:` list of its --help (`help` left out); none
+/// when it lists no commands.
+fn subcommands(tool: &str) -> Vec<String> {
+    let text = help(tool, None);
+    let Some((_, list)) = text.split_once("Commands:\n") else { return Vec::new() };
+    list.lines()
         .take_while(|l| !l.trim().is_empty())
         .filter_map(|l| l.split_whitespace().next())
         .filter(|s| *s != "help")
         .map(String::from)
-        .collect();
-    assert!(!subs.is_empty(), "pis-bench --help lists subcommands");
-    subs
+        .collect()
 }
 
 /// The text of the section headed exactly `{level}{name}` (`## pis-pack`), up to the next
@@ -187,20 +185,19 @@ fn scopes(tools_md: &str) -> Vec<(String, &str, BTreeSet<String>)> {
     for tool in TOOLS {
         let text = section(tools_md, "## ", tool).unwrap_or_else(|| panic!("docs/TOOLS.md has no `## {tool}` section"));
         positions.push((tools_md.find(&format!("\n## {tool}\n")).unwrap_or(0), tool));
-        if tool == "pis-bench" {
-            let mut all = help_flags(tool, None);
-            for sub in bench_subcommands() {
-                let name = format!("pis-bench {sub}");
-                let text = section(text, "### ", &name).unwrap_or_else(|| panic!("docs/TOOLS.md has no `### {name}` subsection under `## pis-bench`"));
-                let flags = help_flags(tool, Some(&sub));
-                all.extend(flags.iter().cloned());
-                scopes.push((name, text, flags));
-            }
-            // The section as a whole documents only flags some subcommand has.
-            scopes.push((tool.to_string(), text, all));
-        } else {
-            scopes.push((tool.to_string(), text, help_flags(tool, None)));
+        // A tool with subcommands documents each in a `### TOOL SUB` subsection.
+        let subs = subcommands(tool);
+        assert!(tool != "pis-bench" || !subs.is_empty(), "pis-bench --help lists subcommands");
+        let mut all = help_flags(tool, None);
+        for sub in subs {
+            let name = format!("{tool} {sub}");
+            let text = section(text, "### ", &name).unwrap_or_else(|| panic!("docs/TOOLS.md has no `### {name}` subsection under `## {tool}`"));
+            let flags = help_flags(tool, Some(&sub));
+            all.extend(flags.iter().cloned());
+            scopes.push((name, text, flags));
         }
+        // The section as a whole documents only flags the tool or some subcommand has.
+        scopes.push((tool.to_string(), text, all));
     }
     positions.sort();
     let order: Vec<&str> = positions.iter().map(|p| p.1).collect();

@@ -89,7 +89,7 @@ pub fn render_set(
     render_shard(scene, out, settings, &TraceRun { limit, ..TraceRun::default() }, progress)
 }
 
-/// Which points of a set a process renders (RAYSET.md 7).
+/// Which points of a set a process renders (RAYSET.md 9).
 #[derive(Clone, Copy, Debug)]
 pub struct TraceRun {
     /// The set is the first `limit` points of the space (all when `None`).

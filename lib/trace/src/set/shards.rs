@@ -1,4 +1,4 @@
-//! A set traced point by point, by one process or by several (RAYSET.md 7): each point's
+//! A set traced point by point, by one process or by several (RAYSET.md 9): each point's
 //! entry of `set.json` is recorded in `shards/` once its files are written, and `set.json`
 //! is assembled from the records when every point has one. The records are what an
 //! interrupted trace resumes from and what shards of one trace, run as separate processes
