@@ -127,13 +127,16 @@ impl Progress for StderrProgress {
 /// Times the stages of a pack and tells its progress.
 pub struct Stages<'p> {
     pub ms: Vec<(String, f64)>,
+    /// Per stage in order, the process's peak resident memory in MiB when it ended (where
+    /// the system tells it).
+    pub peak_mib: Vec<(String, f64)>,
     t: Instant,
     progress: &'p dyn Progress,
 }
 
 impl<'p> Stages<'p> {
     fn new(progress: &'p dyn Progress) -> Self {
-        Stages { ms: Vec::new(), t: Instant::now(), progress }
+        Stages { ms: Vec::new(), peak_mib: Vec::new(), t: Instant::now(), progress }
     }
 
     /// Stages timed without progress.
@@ -145,6 +148,9 @@ impl<'p> Stages<'p> {
         let ms = self.t.elapsed().as_secs_f64() * 1e3;
         self.progress.stage(name, ms, what);
         self.ms.push((name.to_string(), ms));
+        if let Some(b) = pis_trace::memory::peak_resident() {
+            self.peak_mib.push((name.to_string(), b as f64 / (1 << 20) as f64));
+        }
         self.t = Instant::now();
     }
 

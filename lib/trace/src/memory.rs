@@ -15,6 +15,15 @@ pub fn available_memory() -> Option<u64> {
     Some(kib.saturating_mul(1024))
 }
 
+/// Bytes of the largest resident memory this process has had so far (Linux: `VmHWM` of
+/// /proc/self/status); `None` where it cannot tell.
+pub fn peak_resident() -> Option<u64> {
+    let text = std::fs::read_to_string("/proc/self/status").ok()?;
+    let line = text.lines().find(|l| l.starts_with("VmHWM:"))?;
+    let kib: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kib.saturating_mul(1024))
+}
+
 /// Float channels of one point's images: `combined` and every object's layers for its role.
 pub fn point_channels(roles: impl IntoIterator<Item = ObjectRole>) -> u64 {
     3 + roles.into_iter().map(|r| LayerKind::for_role(r).iter().map(|l| l.channels().len() as u64).sum::<u64>()).sum::<u64>()

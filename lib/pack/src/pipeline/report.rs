@@ -113,6 +113,9 @@ pub struct PackReport {
     pub max_mse_psnr_db: Option<MaxMsePsnr>,
     pub objects: Vec<ObjectReport>,
     pub stage_ms: BTreeMap<String, f64>,
+    /// Per stage in order, `[name, MiB]`: the process's peak resident memory when the stage
+    /// ended (empty where the system does not tell it).
+    pub stage_peak_mib: Vec<(String, f64)>,
     pub notes: Vec<String>,
 }
 
@@ -181,6 +184,7 @@ pub fn build(set: &LoadedSet, models: &[ObjectModel], packed: &Packed, q: &Quali
         max_mse_psnr_db: packed.max_mse.as_ref().map(|c| MaxMsePsnr { constrained: c.psnr_db_constrained, free: c.psnr_db_free }),
         objects,
         stage_ms: stages.ms.into_iter().collect(),
+        stage_peak_mib: stages.peak_mib,
         notes: vec![
             "PSNR through the render matrices (hardware model, or measured through the GPU in probe mode): decoded textures (MIP chain rebuilt by decimation) rendered with A, against the traced diffuse + specular layers over covered pixels, display values (sRGB, peak 1)".into(),
             format!("geometry, tables and headers: {} bytes", packed.overhead),
@@ -231,5 +235,9 @@ pub fn print_report(r: &PackReport, out: &mut impl std::io::Write) -> std::io::R
     }
     let stages: Vec<String> = r.stage_ms.iter().map(|(k, v)| format!("{k} {v:.0}")).collect();
     writeln!(out, "  stages (ms): {}", stages.join(", "))?;
+    if !r.stage_peak_mib.is_empty() {
+        let peaks: Vec<String> = r.stage_peak_mib.iter().map(|(k, v)| format!("{k} {v:.0}")).collect();
+        writeln!(out, "  peak memory after each stage (MiB): {}", peaks.join(", "))?;
+    }
     Ok(())
 }
