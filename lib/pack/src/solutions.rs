@@ -14,7 +14,6 @@
 //! converged (u8), the number of values (u64) and the values (f32).
 
 use std::collections::HashMap;
-use std::io::Write;
 use std::path::Path;
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::{Arc, Mutex};
@@ -213,25 +212,9 @@ impl Solutions {
                 out.extend_from_slice(&v.to_le_bytes());
             }
         }
-        write_atomic(path, &out)?;
+        pis_trace::set::write_atomic(path, &out)?;
         Ok(out.len() as u64)
     }
-}
-
-fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
-    let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
-    let tmp = path.with_file_name(format!(".{name}.tmp{}", std::process::id()));
-    let result = (|| -> std::io::Result<()> {
-        let mut f = std::fs::File::create(&tmp)?;
-        f.write_all(bytes)?;
-        f.sync_all()?;
-        std::fs::rename(&tmp, path)
-    })();
-    if let Err(e) = result {
-        let _ = std::fs::remove_file(&tmp);
-        return Err(anyhow!("{}: {e}", path.display()));
-    }
-    Ok(())
 }
 
 /// A cursor over a fragment's bytes that fails, instead of reading past the end.

@@ -163,8 +163,21 @@ pub struct MergeReport {
 /// Assembles `set.json` in the set directory `set_dir` from the records of its trace and
 /// removes them: the set is complete. An error names the points not traced yet. A set
 /// that is complete already (set.json and no records) is left as it is; several processes
-/// may merge at once (each writes the same bytes).
+/// may merge at once (each writes the same bytes, and one that finds the records removed
+/// under it by another's merge finds the set complete).
 pub fn merge_set(set_dir: &Path) -> Result<MergeReport, TraceError> {
+    merge_records(set_dir).or_else(|e| {
+        // A merge writes set.json, then removes the records, and a trace removes set.json
+        // before it records a point: a set.json there now, after records went missing under
+        // this merge, is another process's merge of the same records.
+        match read_json::<SetMeta>(&set_dir.join(SET_JSON)) {
+            Ok(meta) => Ok(MergeReport { points: meta.points.len(), already_complete: true, bytes: 0 }),
+            Err(_) => Err(e),
+        }
+    })
+}
+
+fn merge_records(set_dir: &Path) -> Result<MergeReport, TraceError> {
     let dir = set_dir.join(SHARDS_DIR);
     let meta_path = dir.join(SHARD_META);
     let set_json = set_dir.join(SET_JSON);
@@ -231,7 +244,69 @@ pub fn all_recorded(set_dir: &Path) -> Result<bool, TraceError> {
 
 #[cfg(test)]
 mod tests {
-    use super::Shard;
+    use super::*;
+
+    /// A set's metadata of `points` points, as set.json holds it.
+    fn meta(points: usize) -> SetMeta {
+        let m = vec![0.0f32; 16];
+        let point = |i: usize| serde_json::json!({
+            "index": i, "samples": [i], "values": [i as f32], "image": format!("point_{i:05}.exr"), "rays": null,
+            "camera": {"world_from_camera": m, "camera_from_world": m, "projection": m, "yfov": 0.7, "znear": 0.1, "zfar": null},
+            "lights": [], "objects": []
+        });
+        serde_json::from_value(serde_json::json!({
+            "format": "pis-rayset", "version": 1, "scene": "s", "resolution": [4, 3], "spp": 1,
+            "filter": {"sigma_px": 0.5, "radius_px": 1.5},
+            "space": [{"name": "view", "kind": "view", "driver": "orbit", "periodic": false, "unit": "deg", "values": (0..points).map(|i| i as f32).collect::<Vec<_>>()}],
+            "objects": [], "points": (0..points).map(point).collect::<Vec<_>>()
+        }))
+        .expect("a set.json")
+    }
+
+    #[test]
+    fn processes_merging_at_once_all_find_the_set_complete() {
+        for round in 0..8 {
+            let dir = tempfile::tempdir().unwrap();
+            let full = meta(6);
+            let records = Records::begin(dir.path(), &full, 6, Begin::Join).unwrap();
+            for p in &full.points {
+                std::fs::write(dir.path().join(&p.image), b"exr").unwrap();
+                records.record(p).unwrap();
+            }
+            let merges: Vec<_> = (0..4).map(|_| {
+                let d = dir.path().to_path_buf();
+                std::thread::spawn(move || merge_set(&d))
+            }).collect();
+            for m in merges {
+                let r = m.join().unwrap().unwrap_or_else(|e| panic!("round {round}: {e}"));
+                assert_eq!(r.points, 6);
+            }
+            let written: SetMeta = read_json(&dir.path().join(SET_JSON)).unwrap();
+            assert_eq!(written, full, "set.json holds the records in index order");
+            assert!(!dir.path().join(SHARDS_DIR).exists());
+        }
+    }
+
+    #[test]
+    fn a_merge_names_the_points_not_traced_and_a_join_refuses_another_trace() {
+        let dir = tempfile::tempdir().unwrap();
+        let full = meta(5);
+        let records = Records::begin(dir.path(), &full, 5, Begin::Join).unwrap();
+        for p in full.points.iter().filter(|p| p.index != 1 && p.index != 4) {
+            std::fs::write(dir.path().join(&p.image), b"exr").unwrap();
+            records.record(p).unwrap();
+        }
+        // A record whose image is gone is not done.
+        std::fs::remove_file(dir.path().join(&full.points[2].image)).unwrap();
+        let e = merge_set(dir.path()).unwrap_err().to_string();
+        assert!(e.contains("3 of 5 points are not traced yet (points 1, 2, 4;"), "{e}");
+        let other = SetMeta { spp: 2, ..full.clone() };
+        let e = Records::begin(dir.path(), &other, 5, Begin::Join).err().expect("another trace is refused").to_string();
+        assert!(e.contains("another trace"), "{e}");
+        assert!(Records::begin(dir.path(), &full, 6, Begin::Join).is_err(), "another point count is another trace");
+        assert!(Records::begin(dir.path(), &other, 5, Begin::Fresh).is_ok(), "a fresh trace starts over");
+        assert!(merge_set(dir.path()).is_err(), "the fresh trace has recorded nothing");
+    }
 
     #[test]
     fn a_shard_parses_from_i_of_n_and_takes_every_nth_point() {

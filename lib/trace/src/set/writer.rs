@@ -17,9 +17,13 @@ use std::io::Write;
 use std::path::{Path, PathBuf};
 
 /// Writes `bytes` to `path` atomically (temporary file in the same directory, then rename).
+/// The temporary name is the process's and the call's own, so that writers of one file in
+/// several processes or threads never share one.
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), TraceError> {
+    static CALLS: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
+    let call = CALLS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
     let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
-    let tmp = path.with_file_name(format!(".{name}.tmp{}", std::process::id()));
+    let tmp = path.with_file_name(format!(".{name}.tmp{}.{call}", std::process::id()));
     let result = (|| {
         let mut f = fs::File::create(&tmp)?;
         f.write_all(bytes)?;
@@ -225,10 +229,12 @@ impl SetWriter {
     /// Writes `set.json` when every point has a record (another process may still be
     /// writing its points): returns its size in bytes, `None` while points are missing.
     pub fn finish_if_complete(self) -> Result<Option<u64>, TraceError> {
-        if !all_recorded(&self.dir)? {
-            return Ok(None);
+        match all_recorded(&self.dir) {
+            Ok(false) => Ok(None),
+            // Every point recorded, or the records gone: another process merged them; the
+            // merge says which (and any error).
+            _ => Ok(Some(merge_set(&self.dir)?.bytes)),
         }
-        Ok(Some(merge_set(&self.dir)?.bytes))
     }
 }
 
