@@ -93,6 +93,23 @@ pub fn set_scene(set: &RaySet, scene_path: &Path, res: (u32, u32), preset: Optio
     Ok(scene)
 }
 
+/// Whether the pack reads layer `kind` of an object under `mode`: surface textures read an
+/// object's coverage, diffuse and specular layers; environment maps and hybrid rendering
+/// also its Fresnel, local/distant and lens-object layers (and the ray records).
+pub fn reads_layer(mode: super::RepresentationMode, kind: pis_trace::LayerKind) -> bool {
+    use pis_trace::LayerKind::*;
+    mode != super::RepresentationMode::Texture || matches!(kind, Coverage | Diffuse | Specular)
+}
+
+/// Whether the pack reads the layer named `name` (`combined`, `object.<object>.<layer>`;
+/// layers of unknown kind are kept).
+fn reads_layer_named(mode: super::RepresentationMode, name: &str) -> bool {
+    match name.strip_prefix("object.").and_then(|n| n.rsplit_once('.')).and_then(|(_, l)| pis_trace::LayerKind::from_name(l)) {
+        Some(kind) => reads_layer(mode, kind),
+        None => true,
+    }
+}
+
 /// Every point's images are held at once: a set of `points` images of `channels` float
 /// channels that would not fit in the machine's available memory is refused before it is
 /// traced or read.
@@ -120,7 +137,7 @@ pub fn load(req: &PackRequest, stages: &mut Stages) -> Result<LoadedSet, Failure
         if !dir.join("set.json").is_file() {
             // What the container cannot store, or this machine cannot pack, is refused before
             // the trace.
-            let channels = pis_trace::memory::point_channels(scene.objects.iter().map(|o| o.role));
+            let channels = 3 + scene.objects.iter().flat_map(|o| pis_trace::LayerKind::for_role(o.role)).filter(|&&k| reads_layer(req.representation, k)).map(|k| k.channels().len() as u64).sum::<u64>();
             check_memory(&req.input, scene.space.point_count(), scene.resolution, channels)?;
             let frames = (0..scene.space.point_count()).map(|i| scene.frame(&scene.space.point(i))).collect::<Result<Vec<_>, _>>().map_err(|e| Failure::new(Exit::Invalid, e))?;
             super::blocks::check_transforms(&scene, &frames).map_err(|e| Failure::new(Exit::NotSupported, e))?;
@@ -138,7 +155,7 @@ pub fn load(req: &PackRequest, stages: &mut Stages) -> Result<LoadedSet, Failure
     let scene_path = req.scene.clone().unwrap_or(scene_path);
     let set = RaySet::open(&dir).map_err(trace_failure)?;
     let res = (set.meta.resolution[0], set.meta.resolution[1]);
-    let channels: u64 = 3 + set.meta.objects.iter().flat_map(|o| &o.layers).filter_map(|l| pis_trace::LayerKind::from_name(l)).map(|k| k.channels().len() as u64).sum::<u64>();
+    let channels: u64 = 3 + set.meta.objects.iter().flat_map(|o| &o.layers).filter_map(|l| pis_trace::LayerKind::from_name(l)).filter(|&k| reads_layer(req.representation, k)).map(|k| k.channels().len() as u64).sum::<u64>();
     check_memory(&dir, set.meta.points.len(), res, channels)?;
     let scene = set_scene(&set, &scene_path, res, req.preset.as_deref())?;
     if set.meta.points.len() != scene.space.point_count() {
@@ -148,12 +165,14 @@ pub fn load(req: &PackRequest, stages: &mut Stages) -> Result<LoadedSet, Failure
     let mut frames = Vec::new();
     let mut images = Vec::new();
     let mut records = Vec::new();
-    let with_records = set.meta.objects.iter().any(|o| o.records);
+    // Only the layers (and ray records) the pack reads are kept, as each point is read.
+    let with_records = set.meta.objects.iter().any(|o| o.records) && req.representation != super::RepresentationMode::Texture;
     for (i, p) in set.meta.points.iter().enumerate() {
         if p.samples != scene.space.point(i) {
             return Err(invalid(format!("{}: point {i} has samples {:?}, expected {:?}", dir.display(), p.samples, scene.space.point(i))));
         }
-        let img = set.read_point(i).map_err(trace_failure)?;
+        let mut img = set.read_point(i).map_err(trace_failure)?;
+        img.layers.retain(|l| reads_layer_named(req.representation, &l.name));
         if (img.width, img.height) != res {
             return Err(invalid(format!("{}: point {i} is {}x{}, the set declares {}x{}", dir.display(), img.width, img.height, res.0, res.1)));
         }
@@ -173,4 +192,24 @@ pub fn load(req: &PackRequest, stages: &mut Stages) -> Result<LoadedSet, Failure
     super::blocks::check_transforms(&loaded.scene, &loaded.frames).map_err(|e| Failure::new(Exit::NotSupported, e))?;
     stages.done("read", &format!("{} points of {}x{} from {}", loaded.samples.len(), res.0, res.1, loaded.dir.display()));
     Ok(loaded)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::pipeline::RepresentationMode;
+
+    #[test]
+    fn surface_textures_keep_the_surface_layers_and_the_combined_image() {
+        let t = RepresentationMode::Texture;
+        for name in ["combined", "object.vase.coverage", "object.vase.diffuse", "object.glass_cup.specular", "object.a.b.diffuse", "object.vase.unknown"] {
+            assert!(reads_layer_named(t, name), "{name}");
+        }
+        for name in ["object.vase.local", "object.vase.distant", "object.vase.fresnel", "object.cup.refraction", "object.cup.reflection_confidence"] {
+            assert!(!reads_layer_named(t, name), "{name}");
+        }
+        for mode in [RepresentationMode::Pem, RepresentationMode::Auto, RepresentationMode::PemInfinity, RepresentationMode::StaticEnv] {
+            assert!(reads_layer_named(mode, "object.vase.local") && reads_layer_named(mode, "object.cup.refraction_modulation"), "{mode:?}");
+        }
+    }
 }
