@@ -128,8 +128,8 @@ fn run(cli: &Cli, scene: &Path, output: &Path) -> anyhow::Result<SetReport> {
 fn print_report(r: &SetReport) {
     let mib = r.output_bytes as f64 / (1024.0 * 1024.0);
     eprintln!(
-        "pis-trace: {} — {} of {} points, {}x{}, {} spp, {} threads, {} triangles",
-        r.scene, r.points, r.points_in_space, r.resolution[0], r.resolution[1], r.spp, r.threads, r.triangles
+        "pis-trace: {} — {} points traced of the set's {} (the space has {}), {}x{}, {} spp, {} threads, {} triangles",
+        r.scene, r.points, r.set_points, r.points_in_space, r.resolution[0], r.resolution[1], r.spp, r.threads, r.triangles
     );
     eprintln!(
         "  rays: {:.2} M camera rays/s, {:.2} M rays/s total ({} camera, {} total)",

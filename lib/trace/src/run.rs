@@ -13,7 +13,7 @@ use std::time::Instant;
 #[derive(Clone, Debug, Default, PartialEq, Serialize)]
 pub struct SetReport {
     pub scene: String,
-    /// Parameter points rendered.
+    /// Parameter points this process rendered (its shard's, less those resumed).
     pub points: usize,
     /// Parameter points the scene's space has.
     pub points_in_space: usize,
