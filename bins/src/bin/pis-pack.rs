@@ -43,8 +43,8 @@ enum Command {
     /// pixel, in scene order, from the I-th) into a fragment file in the folder --fragments.
     /// Give the same pack options as the merge.
     Solve {
-        /// The ray-traced set directory (or scene.toml).
-        input: PathBuf,
+        #[command(flatten)]
+        set: SetArgs,
         /// This process's shard: I/N, I counted from 0.
         #[arg(long, value_name = "I/N")]
         shard: Shard,
@@ -56,36 +56,36 @@ enum Command {
         /// interruption does only what is missing).
         #[arg(long)]
         resume: bool,
-        /// The set's scene.toml (default: the scene.toml set.json records).
-        #[arg(long)]
-        scene: Option<PathBuf>,
-        #[command(flatten)]
-        pack: PackOptions,
-        /// Print the report as JSON on stdout.
-        #[arg(long)]
-        json: bool,
     },
     /// Pack the set with the solves read from the fragment files in --fragments (a solve no
     /// fragment holds is solved here) and write the container: the same bytes as one
     /// `pis-pack` run with the same options.
     Merge {
-        /// The ray-traced set directory (or scene.toml).
-        input: PathBuf,
+        #[command(flatten)]
+        set: SetArgs,
         /// The folder of the solve shards' fragment files.
         #[arg(long, value_name = "DIR")]
         fragments: PathBuf,
         /// The container to write (atomically; nothing is left on error).
         #[arg(short, long)]
         output: PathBuf,
-        /// The set's scene.toml (default: the scene.toml set.json records).
-        #[arg(long)]
-        scene: Option<PathBuf>,
-        #[command(flatten)]
-        pack: PackOptions,
-        /// Print the closing report as JSON on stdout.
-        #[arg(long)]
-        json: bool,
     },
+}
+
+/// What `solve` and `merge` read and how: the set, its scene, the pack's options, the
+/// report's form.
+#[derive(clap::Args, Debug)]
+struct SetArgs {
+    /// The ray-traced set directory (or scene.toml).
+    input: PathBuf,
+    /// The set's scene.toml (default: the scene.toml set.json records).
+    #[arg(long)]
+    scene: Option<PathBuf>,
+    #[command(flatten)]
+    pack: PackOptions,
+    /// Print the report as JSON on stdout.
+    #[arg(long)]
+    json: bool,
 }
 
 fn json_out<T: serde::Serialize>(value: &T) -> Result<(), Failure> {
@@ -104,7 +104,7 @@ fn finish_pack(report: &PackReport, json: bool) -> Result<Exit, Failure> {
 
 fn run(cli: Cli) -> Result<Exit, Failure> {
     match cli.command {
-        Some(Command::Solve { input, shard, fragments, resume, scene, pack, json }) => {
+        Some(Command::Solve { set: SetArgs { input, scene, pack, json }, shard, fragments, resume }) => {
             let req = pack.request(input, scene, PathBuf::new())?;
             let r = solve_shard(&req, shard, &fragments, resume, &StderrProgress)?;
             if r.resumed {
@@ -117,7 +117,7 @@ fn run(cli: Cli) -> Result<Exit, Failure> {
             }
             Ok(Exit::Ok)
         }
-        Some(Command::Merge { input, fragments, output, scene, pack, json }) => {
+        Some(Command::Merge { set: SetArgs { input, scene, pack, json }, fragments, output }) => {
             let req = pack.request(input, scene, output)?;
             finish_pack(&merge_fragments(&req, &fragments, &StderrProgress)?, json)
         }
