@@ -115,6 +115,12 @@ pub struct PackOptions {
     /// textures. The ratio does not count it; the report gives its bytes.
     #[arg(long)]
     pub keep_master: bool,
+    /// Memory budget in GB (default: the memory available). A set whose pack would take
+    /// more (about three times its float images) is streamed: its images, render matrices
+    /// and gold standard go to a scratch file beside the output, read back an object and
+    /// point at a time, and removed at the end. The file written is the same byte for byte.
+    #[arg(long, value_name = "GB", value_parser = parse_memory)]
+    pub memory: Option<f64>,
 }
 
 impl PackOptions {
@@ -149,6 +155,7 @@ impl PackOptions {
             preset: self.preset.clone(),
             resolution: self.resolution,
             spp: self.spp,
+            memory: self.memory,
         };
         let mut req = PackRequest::new(input, output, settings);
         req.scene = scene;
@@ -169,6 +176,10 @@ impl PackOptions {
         }
         <Only as clap::Parser>::parse_from(["pis-pack"]).pack
     }
+}
+
+fn parse_memory(s: &str) -> Result<f64, String> {
+    s.parse::<f64>().ok().filter(|v| v.is_finite() && *v > 0.0).ok_or_else(|| format!("bad memory budget {s:?}: expected a number of GB above 0"))
 }
 
 fn parse_codec(s: &str) -> Result<CodecId, String> {

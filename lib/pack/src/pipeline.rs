@@ -30,10 +30,13 @@ pub mod hybrid;
 pub mod infer_layers;
 pub mod input;
 pub mod matrices;
+pub mod memory;
 pub mod model;
 pub mod pem;
 pub mod report;
 pub mod represent;
+pub mod scratch;
+pub mod set_images;
 pub mod settings;
 pub mod shading;
 pub mod sharded;
@@ -50,7 +53,7 @@ pub use pis_trace::set::Shard;
 
 use pis_codec::CodecId;
 
-pub use report::{print_report, FragmentsReport, ObjectReport, PackReport};
+pub use report::{print_report, FragmentsReport, MemoryReport, ObjectReport, PackReport};
 pub use input::cache_dir;
 pub use matrices::{filter_needs_probe, MatrixSource};
 pub use encode::LayerTextures;

@@ -80,7 +80,7 @@ pub fn texture_point(inf: &Inferred, budget: usize) -> Result<TexturePoint> {
             textures[v.model][v.layer].insert(k.clone(), mip_chain(m.layout(v.layer, k), lin));
         }
     }
-    let e = display_error(&inf.set, &inf.models, &textures);
+    let e = display_error(&inf.set, &inf.models, &textures)?;
     let (s, n) = e.iter().fold((0.0, 0), |a, x| (a.0 + x.0, a.1 + x.1));
     Ok(TexturePoint { bytes: matched.bytes + side, matched, psnr_db: psnr(s, n), videos: vids.len() })
 }

@@ -33,7 +33,7 @@ pub fn view_frames(set: &Inferred) -> Result<ViewFrames> {
     let mut gold = Vec::new();
     for p in zigzag(&counts) {
         let i = linear_index(&p, &counts);
-        let img = set.images.get(i).ok_or_else(|| anyhow!("point {p:?} is not in the set"))?;
+        let img = set.images.shared(i).map_err(|e| anyhow!("point {p:?}: {e}"))?;
         let l = img.layer("combined").ok_or_else(|| anyhow!("point {p:?} has no combined image"))?;
         let mut lin = vec![0.0f32; n * 3];
         for (c, name) in ["R", "G", "B"].iter().enumerate() {

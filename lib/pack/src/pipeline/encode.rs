@@ -112,7 +112,7 @@ fn sample_weights(per_point: &[Vec<f64>]) -> Vec<f32> {
 
 /// The screen weights of every sample of layer `li` of `m`, by key: [`sample_weights`] over
 /// the points of `samples` that read it, through the render matrices of its placement.
-fn layer_screen_weights(m: &ObjectModel, li: usize, samples: &[Vec<u32>]) -> BTreeMap<Vec<u32>, Vec<f32>> {
+fn layer_screen_weights(m: &ObjectModel, li: usize, samples: &[Vec<u32>]) -> Result<BTreeMap<Vec<u32>, Vec<f32>>> {
     let il = &m.layers[li];
     il.textures.keys().map(|k| {
         let points: Vec<usize> = samples.iter().enumerate().filter(|(_, s)| key(s, il.depends_on) == *k).map(|(p, _)| p).collect();
@@ -124,9 +124,9 @@ fn layer_screen_weights(m: &ObjectModel, li: usize, samples: &[Vec<u32>]) -> BTr
             shell_weights(m, s, li, k, &points)
         } else {
             let pid = il.placement_of[k];
-            sample_weights(&points.iter().map(|&p| screen_weights_at(m.views[p].a(pid))).collect::<Vec<_>>())
+            sample_weights(&points.iter().map(|&p| Ok(screen_weights_at(m.views.get(p)?.a(pid)))).collect::<Result<Vec<_>>>()?)
         };
-        (k.clone(), w)
+        Ok((k.clone(), w))
     }).collect()
 }
 
@@ -178,7 +178,7 @@ pub fn encode_all(set: &LoadedSet, models: &[ObjectModel], req: &PackRequest, st
             )));
         }
         let weights_by_layer: Vec<BTreeMap<Vec<u32>, Vec<f32>>> = if req.allocation == super::Allocation::Screen {
-            (0..m.layers.len()).map(|li| layer_screen_weights(m, li, &set.samples)).collect()
+            (0..m.layers.len()).map(|li| layer_screen_weights(m, li, &set.samples)).collect::<Result<_>>().map_err(runtime)?
         } else {
             m.layers.iter().map(|_| BTreeMap::new()).collect()
         };
@@ -323,7 +323,7 @@ pub fn encode_all(set: &LoadedSet, models: &[ObjectModel], req: &PackRequest, st
         stages.done("allocate", &format!("{total} bytes over {} level images", storage.level_images));
     }
     let solved: Vec<Vec<LayerTextures>> = models.iter().map(solved_chains).collect();
-    let solved_error = display_error(set, models, &solved);
+    let solved_error = display_error(set, models, &solved).map_err(runtime)?;
     let packed = Packed { container, blocks: blocks_out, overhead, layer_bytes: Vec::new(), stagger: staggers, screen_weights, solved_error, max_mse: None, quality: None };
     let Some((free_rates, free_bytes)) = &storage.free else {
         let mut packed = emit(packed, pyramids, &where_, models, req.codec, &storage.rates)?;
@@ -485,22 +485,22 @@ pub fn check_lossless(path: &Path, packed: &Packed) -> Result<bool> {
 
 /// Squared display error and pixel count per object of `textures` rendered through A,
 /// against the gold-standard layers.
-pub fn display_error(set: &LoadedSet, models: &[ObjectModel], textures: &[Vec<LayerTextures>]) -> Vec<(f64, usize)> {
+pub fn display_error(set: &LoadedSet, models: &[ObjectModel], textures: &[Vec<LayerTextures>]) -> Result<Vec<(f64, usize)>> {
     let d = |v: f32| crate::images::srgb_encode(v.clamp(0.0, 1.0)) as f64;
     models.iter().zip(textures).map(|(m, tex)| {
         let (mut sse, mut n) = (0.0f64, 0usize);
         for (p, s) in set.samples.iter().enumerate() {
-            let v = &m.views[p];
+            let v = m.views.get(p)?;
             let keys: Vec<Vec<u32>> = m.layers.iter().map(|il| key(s, il.depends_on)).collect();
             let at: Vec<Option<&[f32]>> = tex.iter().zip(&keys).map(|(t, k)| t.get(k).map(Vec::as_slice)).collect();
-            let img = m.render(p, &keys, &at);
+            let img = m.render_view(&v, p, &keys, &at);
             for (k, g) in img.iter().enumerate() {
                 let gold = v.diffuse[k] + v.specular[k];
                 sse += (d(*g) - d(gold)).powi(2);
             }
             n += img.len();
         }
-        (sse, n)
+        Ok((sse, n))
     }).collect()
 }
 
@@ -550,7 +550,7 @@ pub fn predicted_psnr(set: &LoadedSet, models: &[ObjectModel], packed: &Packed) 
             }
         }
     }
-    let e_dec = display_error(set, models, &decoded);
+    let e_dec = display_error(set, models, &decoded)?;
     let e_sol = &packed.solved_error;
     let total = |e: &[(f64, usize)]| {
         let (s, n) = e.iter().fold((0.0, 0), |a, x| (a.0 + x.0, a.1 + x.1));

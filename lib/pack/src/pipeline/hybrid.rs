@@ -69,7 +69,10 @@ impl Planned for HybridPlanned {
         let mut model = surface.solve(job)?;
         let set = job.set;
         let scene = &set.scene;
-        let views: Vec<Vec<TracedView>> = (0..set.frames.len()).map(|p| vec![TracedView { frame: &set.frames[p], images: &set.images[p], records: &set.records[p] }]).collect();
+        // A lens object's views read every point's images at once (held in memory, also for a
+        // pack that streams).
+        let images = (0..set.frames.len()).map(|p| set.images.object(p, o)).collect::<Result<Vec<_>>>()?;
+        let views: Vec<Vec<TracedView>> = (0..set.frames.len()).map(|p| vec![TracedView { frame: &set.frames[p], images: &images[p], records: &set.records[p] }]).collect();
         let mut settings = LensInferSettings::default();
         settings.solve.cg = job.settings.cg;
         settings.solver = job.solver.clone();

@@ -2,12 +2,16 @@
 //! and every point's images, checked before any work is done.
 
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 
 use anyhow::anyhow;
 use pis_scene::{Frame, LoadOptions, Scene};
 use pis_trace::set::RaySet;
-use pis_trace::{PointImages, TraceError, TraceSettings};
+use pis_trace::{TraceError, TraceSettings};
 
+use super::memory::MemoryPlan;
+use super::scratch::Scratch;
+use super::set_images::{spill_point, SetImages};
 use super::{PackRequest, Stages};
 use crate::error::{Exit, Failure};
 
@@ -19,7 +23,12 @@ pub struct LoadedSet {
     /// Sample indices per point, in the set's (linear-index) order.
     pub samples: Vec<Vec<u32>>,
     pub frames: Vec<Frame>,
-    pub images: Vec<PointImages>,
+    /// Every point's images, held or spilled to the scratch file ([`super::memory`]).
+    pub images: SetImages,
+    /// The scratch file of a pack that streams.
+    pub scratch: Option<Arc<Scratch>>,
+    /// How the pack holds the set, and why.
+    pub memory: MemoryPlan,
     /// Per object, the set's channel name (`object.<name>` prefix of its layers).
     pub channels: Vec<String>,
     /// The set's display filter (`set.json` `filter`, RAYSET.md section 4).
@@ -110,21 +119,6 @@ fn reads_layer_named(mode: super::RepresentationMode, name: &str) -> bool {
     }
 }
 
-/// Every point's images are held at once: a set of `points` images of `channels` float
-/// channels that would not fit in the machine's available memory is refused before it is
-/// traced or read.
-fn check_memory(what: &Path, points: usize, (w, h): (u32, u32), channels: u64) -> Result<(), Failure> {
-    use pis_trace::memory::{available_memory, gib, image_bytes};
-    let need = image_bytes(w, h, channels, points as u64);
-    match available_memory().filter(|&have| need > have) {
-        Some(have) => Err(Failure::new(Exit::NotSupported, anyhow!(
-            "{}: its {points} points of {w}x{h} pixels take {} in memory to pack, {} are available",
-            what.display(), gib(need), gib(have)
-        ))),
-        None => Ok(()),
-    }
-}
-
 /// Opens (or traces) the set, loads its scene and reads and checks every point.
 pub fn load(req: &PackRequest, stages: &mut Stages) -> Result<LoadedSet, Failure> {
     let (dir, scene_path) = if req.input.is_dir() {
@@ -135,10 +129,7 @@ pub fn load(req: &PackRequest, stages: &mut Stages) -> Result<LoadedSet, Failure
         let scene = pis_scene::load_with(&req.input, &options).map_err(Failure::from)?;
         let dir = cache_dir(&req.input, &scene);
         if !dir.join("set.json").is_file() {
-            // What the container cannot store, or this machine cannot pack, is refused before
-            // the trace.
-            let channels = 3 + scene.objects.iter().flat_map(|o| pis_trace::LayerKind::for_role(o.role)).filter(|&&k| reads_layer(req.representation, k)).map(|k| k.channels().len() as u64).sum::<u64>();
-            check_memory(&req.input, scene.space.point_count(), scene.resolution, channels)?;
+            // What the container cannot store is refused before the trace.
             let frames = (0..scene.space.point_count()).map(|i| scene.frame(&scene.space.point(i))).collect::<Result<Vec<_>, _>>().map_err(|e| Failure::new(Exit::Invalid, e))?;
             super::blocks::check_transforms(&scene, &frames).map_err(|e| Failure::new(Exit::NotSupported, e))?;
             let settings = TraceSettings::new(scene.resolution, scene.spp);
@@ -156,7 +147,11 @@ pub fn load(req: &PackRequest, stages: &mut Stages) -> Result<LoadedSet, Failure
     let set = RaySet::open(&dir).map_err(trace_failure)?;
     let res = (set.meta.resolution[0], set.meta.resolution[1]);
     let channels: u64 = 3 + set.meta.objects.iter().flat_map(|o| &o.layers).filter_map(|l| pis_trace::LayerKind::from_name(l)).filter(|&k| reads_layer(req.representation, k)).map(|k| k.channels().len() as u64).sum::<u64>();
-    check_memory(&dir, set.meta.points.len(), res, channels)?;
+    let memory = MemoryPlan::new(pis_trace::memory::image_bytes(res.0, res.1, channels, set.meta.points.len() as u64), req.memory, pis_trace::memory::available_memory());
+    if memory.stream {
+        stages.note(&format!("the set is {}", memory.describe()));
+    }
+    let scratch = if memory.stream { Some(Arc::new(Scratch::beside(&req.output).map_err(|e| Failure::new(Exit::Io, e))?)) } else { None };
     let scene = set_scene(&set, &scene_path, res, req.preset.as_deref())?;
     if set.meta.points.len() != scene.space.point_count() {
         return Err(invalid(format!("{}: the set has {} points, the scene's space {}", dir.display(), set.meta.points.len(), scene.space.point_count())));
@@ -164,6 +159,8 @@ pub fn load(req: &PackRequest, stages: &mut Stages) -> Result<LoadedSet, Failure
     let mut samples = Vec::new();
     let mut frames = Vec::new();
     let mut images = Vec::new();
+    let mut spans = Vec::new();
+    let channel_names = pis_trace::channel_names(&scene);
     let mut records = Vec::new();
     // Only the layers (and ray records) the pack reads are kept, as each point is read.
     let with_records = set.meta.objects.iter().any(|o| o.records) && req.representation != super::RepresentationMode::Texture;
@@ -183,12 +180,18 @@ pub fn load(req: &PackRequest, stages: &mut Stages) -> Result<LoadedSet, Failure
         }
         frames.push(scene.frame(&p.samples).map_err(|e| Failure::new(Exit::Invalid, e))?);
         samples.push(p.samples.clone());
-        images.push(img);
+        match &scratch {
+            Some(sc) => spans.push(spill_point(sc, &img, &channel_names).map_err(|e| Failure::new(Exit::Io, e))?),
+            None => images.push(img),
+        }
         records.push(if with_records { set.read_records(i).map_err(trace_failure)? } else { Vec::new() });
     }
-    let channels = pis_trace::channel_names(&scene);
     let trace = set.meta.renderer.as_ref().and_then(|r| r.settings.clone()).unwrap_or_else(|| TraceSettings::new(res, set.meta.spp.max(1)));
-    let loaded = LoadedSet { dir, scene, resolution: res, samples, frames, images, channels, display_filter: set.meta.filter, trace, records };
+    let images = match &scratch {
+        Some(sc) => SetImages::Spilled { scratch: sc.clone(), width: res.0, height: res.1, spans },
+        None => SetImages::Held(images),
+    };
+    let loaded = LoadedSet { dir, scene, resolution: res, samples, frames, images, scratch, memory, channels: channel_names, display_filter: set.meta.filter, trace, records };
     super::blocks::check_transforms(&loaded.scene, &loaded.frames).map_err(|e| Failure::new(Exit::NotSupported, e))?;
     stages.done("read", &format!("{} points of {}x{} from {}", loaded.samples.len(), res.0, res.1, loaded.dir.display()));
     Ok(loaded)

@@ -3,17 +3,23 @@
 //! prediction and the screen-error allocation read), and every layer's solved samples.
 //! Encoding reads this.
 
+use std::borrow::Cow;
 use std::collections::BTreeMap;
+use std::sync::Arc;
+
+use anyhow::{anyhow, Result};
 
 use pis_compile::{RenderMatrix, TextureLayout};
 use pis_format::DepMask;
 
 use super::pem::views::ShellView;
+use super::scratch::{Reader, Scratch, Span, Writer};
 use crate::infer::{Mesh, Placed};
 
 /// One point as the render matrices see an object (hardware model or probe mode): the rows
 /// of A per placement its layers read there (the rows, the covered pixels, are the same for
 /// every placement) and the gold standard of each layer at those pixels.
+#[derive(Clone)]
 pub struct PointView {
     /// Per placement its layers read here: the render matrix.
     pub(super) a: Vec<(usize, RenderMatrix)>,
@@ -35,6 +41,125 @@ impl PointView {
     /// The covered pixels, `y · width + x`, in row order.
     pub fn pixels(&self) -> &[u32] {
         self.a.first().map_or(&[], |(_, a)| a.pixels.as_slice())
+    }
+}
+
+impl PointView {
+    fn record(&self) -> Vec<u8> {
+        let mut w = Writer::default();
+        w.u64(self.a.len() as u64);
+        for (p, a) in &self.a {
+            w.u64(*p as u64);
+            w.matrix(a);
+        }
+        w.f32s(&self.diffuse);
+        w.f32s(&self.specular);
+        w.0
+    }
+
+    fn read(bytes: &[u8]) -> Result<PointView> {
+        let mut r = Reader::new(bytes);
+        let n = r.u64()?;
+        let mut a = Vec::new();
+        for _ in 0..n.min(bytes.len() as u64) {
+            let p = r.u64()? as usize;
+            a.push((p, r.matrix()?));
+        }
+        let (diffuse, specular) = (r.f32s()?, r.f32s()?);
+        r.done()?;
+        Ok(PointView { a, diffuse, specular })
+    }
+}
+
+/// Every point's [`PointView`] of an object: held in memory, or, for a pack that streams
+/// ([`super::memory`]), in the scratch file, read back one point at a time (the covered
+/// pixels of each point stay in memory).
+pub struct Views {
+    store: ViewStore,
+}
+
+enum ViewStore {
+    Held(Vec<PointView>),
+    Spilled { scratch: Arc<Scratch>, spans: Vec<Span>, pixels: Vec<Vec<u32>> },
+}
+
+impl Views {
+    /// No points yet; points pushed go to `scratch` where given.
+    pub fn new(scratch: Option<Arc<Scratch>>) -> Views {
+        Views {
+            store: match scratch {
+                Some(scratch) => ViewStore::Spilled { scratch, spans: Vec::new(), pixels: Vec::new() },
+                None => ViewStore::Held(Vec::new()),
+            },
+        }
+    }
+
+    /// Views held in memory.
+    pub fn held(views: Vec<PointView>) -> Views {
+        Views { store: ViewStore::Held(views) }
+    }
+
+    /// Adds the next point.
+    pub fn push(&mut self, v: PointView) -> Result<()> {
+        match &mut self.store {
+            ViewStore::Held(h) => h.push(v),
+            ViewStore::Spilled { scratch, spans, pixels } => {
+                spans.push(scratch.put(&v.record())?);
+                pixels.push(v.pixels().to_vec());
+            }
+        }
+        Ok(())
+    }
+
+    /// Changes point `p` by `change`.
+    pub fn update(&mut self, p: usize, change: impl FnOnce(&mut PointView) -> Result<()>) -> Result<()> {
+        match &mut self.store {
+            ViewStore::Held(h) => change(h.get_mut(p).ok_or_else(|| anyhow!("no view of point {p}"))?),
+            ViewStore::Spilled { scratch, spans, pixels } => {
+                let span = *spans.get(p).ok_or_else(|| anyhow!("no view of point {p}"))?;
+                let mut v = PointView::read(&scratch.get(span)?)?;
+                change(&mut v)?;
+                spans[p] = scratch.put(&v.record())?;
+                pixels[p] = v.pixels().to_vec();
+                Ok(())
+            }
+        }
+    }
+
+    /// The number of points.
+    pub fn len(&self) -> usize {
+        match &self.store {
+            ViewStore::Held(h) => h.len(),
+            ViewStore::Spilled { spans, .. } => spans.len(),
+        }
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// Point `p`'s view (read back from the scratch file where spilled).
+    pub fn get(&self, p: usize) -> Result<Cow<'_, PointView>> {
+        match &self.store {
+            ViewStore::Held(h) => h.get(p).map(Cow::Borrowed).ok_or_else(|| anyhow!("no view of point {p}")),
+            ViewStore::Spilled { scratch, spans, .. } => {
+                let span = *spans.get(p).ok_or_else(|| anyhow!("no view of point {p}"))?;
+                Ok(Cow::Owned(PointView::read(&scratch.get(span)?)?))
+            }
+        }
+    }
+
+    /// The covered pixels of point `p`, `y · width + x`, in row order.
+    pub fn pixels(&self, p: usize) -> &[u32] {
+        match &self.store {
+            ViewStore::Held(h) => h.get(p).map_or(&[], PointView::pixels),
+            ViewStore::Spilled { pixels, .. } => pixels.get(p).map_or(&[], Vec::as_slice),
+        }
+    }
+
+    /// The covered pixels of point `p`.
+    pub fn rows(&self, p: usize) -> usize {
+        self.pixels(p).len()
     }
 }
 
@@ -117,7 +242,7 @@ pub struct ObjectModel {
     /// Mean covered pixels per point: the screen-area weight of allocation.
     pub area: f64,
     /// Per point of the set.
-    pub views: Vec<PointView>,
+    pub views: Views,
     pub layers: Vec<InferredLayer>,
     /// Per point of the set, as the object's shells see it (empty without shells).
     pub shell_views: Vec<ShellView>,
@@ -155,8 +280,13 @@ impl ObjectModel {
     /// player draws it from `textures[l]`, layer l's sample at the point (the whole drawn
     /// texture; `None` where the layer has none): the surface layers added, then the
     /// reflection term of the shells, or a lens object's two terms (SPEC.md 9).
-    pub fn render(&self, p: usize, keys: &[Vec<u32>], textures: &[Option<&[f32]>]) -> Vec<f32> {
-        let v = &self.views[p];
+    pub fn render(&self, p: usize, keys: &[Vec<u32>], textures: &[Option<&[f32]>]) -> Result<Vec<f32>> {
+        let v = self.views.get(p)?;
+        Ok(self.render_view(&v, p, keys, textures))
+    }
+
+    /// [`ObjectModel::render`] with point `p`'s view `v` read already.
+    pub fn render_view(&self, v: &PointView, p: usize, keys: &[Vec<u32>], textures: &[Option<&[f32]>]) -> Vec<f32> {
         let mut img = vec![0.0f32; v.rows() * 3];
         let mut maps = Vec::new();
         for ((il, k), x) in self.layers.iter().zip(keys).zip(textures) {

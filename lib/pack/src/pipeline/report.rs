@@ -116,7 +116,26 @@ pub struct PackReport {
     /// Per stage in order, `[name, MiB]`: the process's peak resident memory when the stage
     /// ended (empty where the system does not tell it).
     pub stage_peak_mib: Vec<(String, f64)>,
+    /// How the pack held the set: in memory or streamed, and why.
+    pub memory: MemoryReport,
     pub notes: Vec<String>,
+}
+
+/// How a pack held its set ([`super::memory`]).
+#[derive(Clone, Debug, Serialize)]
+pub struct MemoryReport {
+    /// The budget in bytes (`--memory`, else the memory available; `None`: unknown).
+    pub budget_bytes: Option<u64>,
+    /// Whether the budget was asked for (`--memory`).
+    pub budget_asked: bool,
+    /// The bytes the pack was expected to take in memory.
+    pub held_estimate_bytes: u64,
+    /// Whether it streamed through a scratch file.
+    pub streamed: bool,
+    /// Bytes written to the scratch file.
+    pub scratch_bytes: u64,
+    /// In words.
+    pub why: String,
 }
 
 /// Both allocations' predicted PSNR, when `auto` encoded both.
@@ -185,6 +204,14 @@ pub fn build(set: &LoadedSet, models: &[ObjectModel], packed: &Packed, q: &Quali
         objects,
         stage_ms: stages.ms.into_iter().collect(),
         stage_peak_mib: stages.peak_mib,
+        memory: MemoryReport {
+            budget_bytes: set.memory.budget,
+            budget_asked: set.memory.asked,
+            held_estimate_bytes: set.memory.held,
+            streamed: set.memory.stream,
+            scratch_bytes: set.scratch.as_ref().map_or(0, |s| s.len()),
+            why: set.memory.describe(),
+        },
         notes: vec![
             "PSNR through the render matrices (hardware model, or measured through the GPU in probe mode): decoded textures (MIP chain rebuilt by decimation) rendered with A, against the traced diffuse + specular layers over covered pixels, display values (sRGB, peak 1)".into(),
             format!("geometry, tables and headers: {} bytes", packed.overhead),
@@ -235,6 +262,9 @@ pub fn print_report(r: &PackReport, out: &mut impl std::io::Write) -> std::io::R
     }
     let stages: Vec<String> = r.stage_ms.iter().map(|(k, v)| format!("{k} {v:.0}")).collect();
     writeln!(out, "  stages (ms): {}", stages.join(", "))?;
+    if r.memory.streamed {
+        writeln!(out, "  memory: {}; scratch file {:.0} MiB", r.memory.why, r.memory.scratch_bytes as f64 / (1 << 20) as f64)?;
+    }
     if !r.stage_peak_mib.is_empty() {
         let peaks: Vec<String> = r.stage_peak_mib.iter().map(|(k, v)| format!("{k} {v:.0}")).collect();
         writeln!(out, "  peak memory after each stage (MiB): {}", peaks.join(", "))?;

@@ -89,6 +89,9 @@ pub struct PackSettings {
     pub resolution: Option<(u32, u32)>,
     /// Tracing a scene.toml: samples per pixel override.
     pub spp: Option<u32>,
+    /// The memory budget in GB (`None`: the memory available): a set whose pack would not
+    /// fit is streamed through a scratch file ([`super::memory`]), with the same output.
+    pub memory: Option<f64>,
 }
 
 impl Default for PackSettings {
@@ -123,6 +126,7 @@ impl PackSettings {
             preset: None,
             resolution: None,
             spp: None,
+            memory: None,
         }
     }
 

@@ -22,7 +22,7 @@ use pis_trace::PointImages;
 
 use super::input::LoadedSet;
 use super::matrices::Matrices;
-use super::model::{key, InferredLayer, LayerForm, ObjectModel, PointView};
+use super::model::{key, InferredLayer, LayerForm, ObjectModel, PointView, Views};
 use super::represent::{Job, Planned, Representation, Surveyed};
 use super::{PackRequest, PlacementMode};
 use crate::solutions::Solver;
@@ -47,16 +47,23 @@ fn layer_rgb(images: &PointImages, channel: &str, kind: TraceLayer) -> Vec<f32> 
 }
 
 /// Object `o`'s coverage at point `p`, per pixel.
-pub(super) fn coverage(set: &LoadedSet, p: usize, o: usize) -> Vec<f32> {
+pub(super) fn coverage(set: &LoadedSet, p: usize, o: usize) -> Result<Vec<f32>> {
+    let images = set.images.object(p, o)?;
+    Ok(coverage_in(set, &images, o))
+}
+
+/// Object `o`'s coverage per pixel in `images` (a point of `set`).
+fn coverage_in(set: &LoadedSet, images: &PointImages, o: usize) -> Vec<f32> {
     let (w, h) = set.resolution;
-    set.images[p].object_layer(&set.channels[o], TraceLayer::Coverage).and_then(|l| l.channel("A"))
+    images.object_layer(&set.channels[o], TraceLayer::Coverage).and_then(|l| l.channel("A"))
         .map(<[f32]>::to_vec).unwrap_or_else(|| vec![0.0; (w * h) as usize])
 }
 
 /// The render matrix of object `o` at point `p` with texture coordinates `uvs` and placement
-/// `placed`, every other mesh occluding it; rows where the tracer covers no pixel removed.
+/// `placed`, every other mesh occluding it; rows where the tracer covers no pixel (of
+/// `coverage`, the object's there) removed.
 #[allow(clippy::too_many_arguments)]
-fn matrix_at(set: &LoadedSet, p: usize, o: usize, meshes: &[Mesh], uvs: &[[f32; 2]], placed: &Placed, req: &PackRequest, matrices: &mut Matrices) -> Result<RenderMatrix> {
+fn matrix_at(set: &LoadedSet, p: usize, o: usize, meshes: &[Mesh], uvs: &[[f32; 2]], placed: &Placed, req: &PackRequest, matrices: &mut Matrices, coverage: &[f32]) -> Result<RenderMatrix> {
     let (w, h) = set.resolution;
     let frame = &set.frames[p];
     let clip_from = |k: usize| {
@@ -69,18 +76,21 @@ fn matrix_at(set: &LoadedSet, p: usize, o: usize, meshes: &[Mesh], uvs: &[[f32; 
     mesh.uvs = uvs;
     let obj = TexturedObject { mesh, transform: placed.transform, layout: placed.layout, sampler: sampler(req.filter, placed.repeat) };
     let a = matrices.matrix(Viewport { width: w, height: h }, &draw, o, &obj)?;
-    Ok(restrict_rows(&a, &coverage(set, p, o)))
+    Ok(restrict_rows(&a, coverage))
 }
 
 /// Every point with placement 0 (over all views): the rows, the gold standard there.
-fn views_of(set: &LoadedSet, o: usize, uvs: &[[f32; 2]], placed: &Placed, meshes: &[Mesh], req: &PackRequest, matrices: &mut Matrices) -> Result<Vec<PointView>> {
+fn views_of(set: &LoadedSet, o: usize, uvs: &[[f32; 2]], placed: &Placed, meshes: &[Mesh], req: &PackRequest, matrices: &mut Matrices) -> Result<Views> {
     let channel = &set.channels[o];
-    (0..set.frames.len()).map(|p| {
-        let a = matrix_at(set, p, o, meshes, uvs, placed, req, matrices)?;
-        let pick = |kind| gather(&a.pixels, &layer_rgb(&set.images[p], channel, kind));
+    let mut views = Views::new(set.scratch.clone());
+    for p in 0..set.frames.len() {
+        let images = set.images.object(p, o)?;
+        let a = matrix_at(set, p, o, meshes, uvs, placed, req, matrices, &coverage_in(set, &images, o))?;
+        let pick = |kind| gather(&a.pixels, &layer_rgb(&images, channel, kind));
         let (diffuse, specular) = (pick(TraceLayer::Diffuse), pick(TraceLayer::Specular));
-        Ok(PointView { a: vec![(0, a)], diffuse, specular })
-    }).collect()
+        views.push(PointView { a: vec![(0, a)], diffuse, specular })?;
+    }
+    Ok(views)
 }
 
 /// Half a step of an 8-bit display value: a layer whose removal moves no covered pixel by
@@ -89,9 +99,15 @@ pub const DISPLAY_STEP: f32 = 0.5 / 255.0;
 
 /// True when the layer `pick` is black for the display: zero (below [`BLACK`]), or so dark
 /// beside the other layer `other` that leaving it out changes no 8-bit pixel.
-fn is_black(views: &[PointView], pick: impl Fn(&PointView) -> &[f32], other: impl Fn(&PointView) -> &[f32]) -> bool {
+fn is_black(views: &Views, pick: impl Fn(&PointView) -> &[f32], other: impl Fn(&PointView) -> &[f32]) -> Result<bool> {
     let d = |v: f32| crate::images::srgb_encode(v.clamp(0.0, 1.0));
-    views.iter().all(|v| pick(v).iter().zip(other(v)).all(|(x, o)| x.abs() < BLACK || (d(x + o) - d(*o)).abs() < DISPLAY_STEP))
+    for p in 0..views.len() {
+        let v = views.get(p)?;
+        if !pick(&v).iter().zip(other(&v)).all(|(x, o)| x.abs() < BLACK || (d(x + o) - d(*o)).abs() < DISPLAY_STEP) {
+            return Ok(false);
+        }
+    }
+    Ok(true)
 }
 
 /// The traced radiance a layer is solved for.
@@ -166,7 +182,7 @@ fn plan_layer(
 /// One texture per key of `plan`'s mask: each key's sample solved (or, for a view-independent
 /// layer, its views stacked, eq. 3.7) with the render matrices of its block's placement,
 /// warm-started from the last sample solved with the same placement.
-fn solve_layer(set: &LoadedSet, views: &[PointView], placements: &[Placed], plan: &LayerPlan, settings: &SolveSettings, solver: &Solver) -> Result<InferredLayer> {
+fn solve_layer(set: &LoadedSet, views: &Views, placements: &[Placed], plan: &LayerPlan, settings: &SolveSettings, solver: &Solver) -> Result<InferredLayer> {
     let mut groups: BTreeMap<Vec<u32>, Vec<usize>> = BTreeMap::new();
     for (p, s) in set.samples.iter().enumerate() {
         groups.entry(key(s, plan.depends_on)).or_default().push(p);
@@ -177,8 +193,9 @@ fn solve_layer(set: &LoadedSet, views: &[PointView], placements: &[Placed], plan
     let mut iterations = 0u64;
     for (k, points) in groups {
         let pid = plan.point_placement[points[0]];
-        let bs: Vec<Cow<[f32]>> = points.iter().map(|&p| plan.radiance.at(&views[p])).collect();
-        let vs: Vec<View> = points.iter().zip(&bs).map(|(&p, b)| View { a: views[p].a(pid), b }).collect();
+        let read = points.iter().map(|&p| views.get(p)).collect::<Result<Vec<_>>>()?;
+        let bs: Vec<Cow<[f32]>> = read.iter().map(|v| plan.radiance.at(v)).collect();
+        let vs: Vec<View> = read.iter().zip(&bs).map(|(v, b)| View { a: v.a(pid), b }).collect();
         let start = warm.get(&pid).map(Vec::as_slice);
         let x = if plan.radiance == Radiance::Diffuse {
             // One texture for the views of the sample, stacked (eq. 3.7).
@@ -315,12 +332,12 @@ pub fn survey_surface(job: &mut Job<'_>, o: usize, with_specular: bool) -> Resul
         if job.matrices.renderings() > before {
             job.note(&format!("object {name}: {} probe renderings over {} points", job.matrices.renderings() - before, views.len()));
         }
-        if views.iter().all(|v| v.rows() == 0) {
+        if (0..views.len()).all(|p| views.rows(p) == 0) {
             job.note(&format!("object {name} covers no pixel of the set; left out"));
             return Ok(None);
         }
-        let diffuse_black = is_black(&views, |v| &v.diffuse, |v| &v.specular);
-        let specular_black = !with_specular || is_black(&views, |v| &v.specular, |v| &v.diffuse);
+        let diffuse_black = is_black(&views, |v| &v.diffuse, |v| &v.specular)?;
+        let specular_black = !with_specular || is_black(&views, |v| &v.specular, |v| &v.diffuse)?;
         if diffuse_black && specular_black && with_specular {
             job.note(&format!("object {name} is black in every layer; nothing stored"));
             return Ok(None);
@@ -334,7 +351,7 @@ pub fn survey_surface(job: &mut Job<'_>, o: usize, with_specular: bool) -> Resul
 struct Covered {
     o: usize,
     atlas: Atlas,
-    views: Vec<PointView>,
+    views: Views,
     whole: Placed,
     diffuse_black: bool,
     specular_black: bool,
@@ -364,24 +381,33 @@ impl Surveyed for Covered {
         }
         job.placements += placements.len();
         let mut views = c.views;
-        for (p, v) in views.iter_mut().enumerate() {
+        for p in 0..views.len() {
             let mut read: Vec<usize> = plans.iter().map(|pl| pl.point_placement[p]).collect();
             read.sort_unstable();
             read.dedup();
-            for &pid in &read {
-                if pid == 0 || v.rows() == 0 {
-                    continue;
-                }
-                let a = matrix_at(set, p, c.o, &job.meshes, &c.atlas.uvs, &placements[pid], req, job.matrices)?;
-                if a.pixels != v.a(0).pixels {
-                    return Err(anyhow!("object {}: point {p}: the render matrices of two placements cover different pixels", scene.objects[c.o].name));
-                }
-                v.a.push((pid, a));
+            let extra: Vec<usize> = read.iter().copied().filter(|&pid| pid != 0 && views.rows(p) > 0).collect();
+            if extra.is_empty() && read.contains(&0) {
+                continue;
+            }
+            let cov = if extra.is_empty() { Vec::new() } else { coverage(set, p, c.o)? };
+            let mut made = Vec::new();
+            for &pid in &extra {
+                made.push((pid, matrix_at(set, p, c.o, &job.meshes, &c.atlas.uvs, &placements[pid], req, job.matrices, &cov)?));
                 job.extra_matrices += 1;
             }
-            if !read.contains(&0) && v.a.len() > 1 {
-                v.a.remove(0);
-            }
+            let name = &scene.objects[c.o].name;
+            views.update(p, |v| {
+                for (pid, a) in made {
+                    if a.pixels != v.a(0).pixels {
+                        return Err(anyhow!("object {name}: point {p}: the render matrices of two placements cover different pixels"));
+                    }
+                    v.a.push((pid, a));
+                }
+                if !read.contains(&0) && v.a.len() > 1 {
+                    v.a.remove(0);
+                }
+                Ok(())
+            })?;
         }
         Ok(Box::new(Layers { o: c.o, atlas: c.atlas, placements, stagger: st, views, plans }))
     }
@@ -394,7 +420,7 @@ struct Layers {
     atlas: Atlas,
     placements: Vec<Placed>,
     stagger: Vec<u32>,
-    views: Vec<PointView>,
+    views: Views,
     plans: Vec<LayerPlan>,
 }
 
@@ -403,7 +429,7 @@ impl Planned for Layers {
         let Layers { o, atlas: at, placements, stagger: st, views, plans } = *self;
         let (set, scene) = (job.set, &job.set.scene);
         let name = scene.objects[o].name.clone();
-        let covered: usize = views.iter().map(PointView::rows).sum();
+        let covered: usize = (0..views.len()).map(|p| views.rows(p)).sum();
         let area = covered as f64 / views.len() as f64;
         let layers = plans.iter().map(|plan| solve_layer(set, &views, &placements, plan, &job.settings, &job.solver)).collect::<Result<Vec<_>>>()?;
         let radiances: Vec<Radiance> = plans.iter().map(|p| p.radiance).collect();

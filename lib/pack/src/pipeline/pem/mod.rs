@@ -96,7 +96,7 @@ impl Planned for PemPlanned {
         let mut model = surface.solve(job)?;
         let set = job.set;
         let f0 = super::shading::object_shading(&set.scene, o).f0;
-        let pixels: Vec<Vec<u32>> = model.views.iter().map(|v| v.pixels().to_vec()).collect();
+        let pixels: Vec<Vec<u32>> = (0..model.views.len()).map(|p| model.views.pixels(p).to_vec()).collect();
         let keys: Vec<Vec<u32>> = set.samples.iter().map(|s| key(s, job.all)).collect();
         let mut settings = SolveSettings::pyramidal();
         settings.cg = job.settings.cg;
@@ -108,7 +108,7 @@ impl Planned for PemPlanned {
         }
         let local_n = face_resolution(set, o, &job.meshes, fitted.local, largest)?;
         let local_layout = TextureLayout::cube(local_n);
-        let has_local = model.views.iter().enumerate().any(|(p, v)| local_alpha(set, p, o, v.pixels()) > 1e-3);
+        let has_local = (0..model.views.len()).map(|p| local_alpha(set, p, o, model.views.pixels(p))).collect::<Result<Vec<f32>>>()?.iter().any(|&a| a > 1e-3);
         // The distant shell: a box and a sphere, each solved at a few points spread over the
         // set; the one nearer the traced distant layer there is kept and solved everywhere.
         let probe: Vec<usize> = probe_points(set.frames.len());
@@ -208,7 +208,7 @@ fn hull_first(indices: &mut Vec<u32>, hull: &[bool]) -> u32 {
 /// Whether the set has the tracer's local and distant layers of object `o`, which layered
 /// environment maps are solved against.
 pub fn layered(set: &super::input::LoadedSet, o: usize) -> bool {
-    set.images.first().is_some_and(|i| i.object_layer(&set.channels[o], TraceLayer::Local).is_some() && i.object_layer(&set.channels[o], TraceLayer::Distant).is_some())
+    set.images.object(0, o).is_ok_and(|i| i.object_layer(&set.channels[o], TraceLayer::Local).is_some() && i.object_layer(&set.channels[o], TraceLayer::Distant).is_some())
 }
 
 /// At most three points spread over `n`: first, middle, last.
@@ -219,11 +219,11 @@ fn probe_points(n: usize) -> Vec<usize> {
 }
 
 /// The largest traced local alpha of object `o` over `pixels` at point `p`.
-fn local_alpha(set: &super::input::LoadedSet, p: usize, o: usize, pixels: &[u32]) -> f32 {
-    set.images[p]
+fn local_alpha(set: &super::input::LoadedSet, p: usize, o: usize, pixels: &[u32]) -> Result<f32> {
+    Ok(set.images.object(p, o)?
         .object_layer(&set.channels[o], TraceLayer::Local)
         .and_then(|l| l.channel("A"))
-        .map_or(0.0, |a| pixels.iter().map(|&px| a[px as usize]).fold(0.0, f32::max))
+        .map_or(0.0, |a| pixels.iter().map(|&px| a[px as usize]).fold(0.0, f32::max)))
 }
 
 #[cfg(test)]

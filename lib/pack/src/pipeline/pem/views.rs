@@ -30,11 +30,11 @@ pub struct ShellView {
 
 /// The tracer's layer `kind` of object channel `channel` at point `p`, `channels` values per
 /// pixel (missing channels 0).
-fn layer_values(set: &LoadedSet, p: usize, channel: &str, kind: TraceLayer, names: &[&str]) -> Vec<f32> {
+fn layer_values(set: &LoadedSet, p: usize, o: usize, kind: TraceLayer, names: &[&str]) -> Result<Vec<f32>> {
     let (w, h) = set.resolution;
     let n = (w * h) as usize;
     let mut out = vec![0.0f32; n * names.len()];
-    if let Some(l) = set.images[p].object_layer(channel, kind) {
+    if let Some(l) = set.images.object(p, o)?.object_layer(&set.channels[o], kind) {
         for (c, name) in names.iter().enumerate() {
             if let Some(plane) = l.channel(name) {
                 for k in 0..n {
@@ -43,7 +43,7 @@ fn layer_values(set: &LoadedSet, p: usize, channel: &str, kind: TraceLayer, name
             }
         }
     }
-    out
+    Ok(out)
 }
 
 fn gather_n(pixels: &[u32], values: &[f32], n: usize) -> Vec<f32> {
@@ -113,14 +113,13 @@ fn with_rows_at(a: &RenderMatrix, pixels: &[u32]) -> RenderMatrix {
 pub fn shell_views(set: &LoadedSet, o: usize, meshes: &[Mesh], shells: &[(Shell, TextureLayout, Option<&[bool]>)], f0: [f32; 3], pixels: &[Vec<u32>], points: &[usize]) -> Result<Vec<ShellView>> {
     let (w, h) = set.resolution;
     let vp = Viewport { width: w, height: h };
-    let channel = &set.channels[o];
     let name = &set.scene.objects[o].name;
     points
         .par_iter()
         .zip(pixels)
         .map(|(&p, pixels)| {
             let depth = occluders(set, p, o, meshes)?;
-            let cov = coverage(set, p, o);
+            let cov = coverage(set, p, o)?;
             let mut a = Vec::with_capacity(shells.len());
             for &(shell, layout, drawn) in shells {
                 let m = shell_render_matrix(vp, &shell_object(set, p, o, &meshes[o], shell, layout, drawn), Some(&depth))?;
@@ -142,8 +141,8 @@ pub fn shell_views(set: &LoadedSet, o: usize, meshes: &[Mesh], shells: &[(Shell,
                 }
                 fresnel.extend_from_slice(&f[k]);
             }
-            let local = gather_n(pixels, &layer_values(set, p, channel, TraceLayer::Local, &["R", "G", "B", "A"]), 4);
-            let distant = gather_n(pixels, &layer_values(set, p, channel, TraceLayer::Distant, &["R", "G", "B"]), 3);
+            let local = gather_n(pixels, &layer_values(set, p, o, TraceLayer::Local, &["R", "G", "B", "A"])?, 4);
+            let distant = gather_n(pixels, &layer_values(set, p, o, TraceLayer::Distant, &["R", "G", "B"])?, 3);
             Ok(ShellView { a, fresnel, local, distant })
         })
         .collect()
@@ -161,7 +160,7 @@ pub fn face_resolution(set: &LoadedSet, o: usize, meshes: &[Mesh], shell: Shell,
     let mut finest = vec![0usize; layout.levels as usize];
     for p in (0..set.frames.len()).step_by(step) {
         let depth = occluders(set, p, o, meshes)?;
-        let a = restrict_rows(&shell_render_matrix(vp, &shell_object(set, p, o, &meshes[o], shell, layout, None), Some(&depth))?, &coverage(set, p, o));
+        let a = restrict_rows(&shell_render_matrix(vp, &shell_object(set, p, o, &meshes[o], shell, layout, None), Some(&depth))?, &coverage(set, p, o)?);
         for r in 0..a.rows() {
             let (cols, vals) = a.row(r);
             let level = cols.iter().zip(vals).filter(|(_, &v)| v > 0.0).map(|(&c, _)| level_of(&layout, c as usize)).min();
