@@ -19,7 +19,7 @@ use super::input::LoadedSet;
 use super::blocks::{block_sizes, geometry, stagger, transforms};
 use super::shading::object_shading;
 use super::stored_mesh::stored_mesh;
-use super::storage::{allocate_storage, build_pyramid, encode_levels, BlockPyramid, CodedLevel};
+use super::storage::{allocate_storage, build_pyramid, level_streams, BlockPyramid, CodedLevel};
 pub use super::surface::{finest, mip_chain};
 use super::{PackRequest, Stages};
 use crate::error::{Exit, Failure};
@@ -49,8 +49,9 @@ pub struct Packed {
     /// Per object model, per layer: codestream bytes.
     pub layer_bytes: Vec<Vec<usize>>,
     pub stagger: Vec<Vec<u32>>,
-    /// Per object model, per layer: each layer sample's screen weights, by key (empty
-    /// without screen-error allocation); the allocation and the master use them.
+    /// Per object model, per layer: each layer sample's screen weights, by key, kept for
+    /// the master (empty without screen-error allocation or `--keep-master`; the
+    /// allocation reads them from the pyramids).
     pub screen_weights: Vec<Vec<BTreeMap<Vec<u32>, Vec<f32>>>>,
     /// Per object model: the solved textures' squared display error against the traced
     /// images and the number of values it sums ([`display_error`]).
@@ -177,7 +178,7 @@ pub fn encode_all(set: &LoadedSet, models: &[ObjectModel], req: &PackRequest, st
                 m.name, m.block_sizes, m.stagger,
             )));
         }
-        let weights_by_layer: Vec<BTreeMap<Vec<u32>, Vec<f32>>> = if req.allocation == super::Allocation::Screen {
+        let mut weights_by_layer: Vec<BTreeMap<Vec<u32>, Vec<f32>>> = if req.allocation == super::Allocation::Screen {
             (0..m.layers.len()).map(|li| layer_screen_weights(m, li, &set.samples)).collect::<Result<_>>().map_err(runtime)?
         } else {
             m.layers.iter().map(|_| BTreeMap::new()).collect()
@@ -185,7 +186,9 @@ pub fn encode_all(set: &LoadedSet, models: &[ObjectModel], req: &PackRequest, st
         let mut layers = Vec::new();
         let mut layer_blocks = Vec::new();
         for (li, il) in m.layers.iter().enumerate() {
-            let layer_weights = &weights_by_layer[li];
+            // The weights go to the pyramids; the master (`--keep-master`) keeps a copy.
+            let layer_weights = &mut weights_by_layer[li];
+            let weighed = !layer_weights.is_empty() && req.codec.is_lossy();
             let mut layer = il.form.layer(il.kind, li as u8, il.depends_on, req.gamma);
             let grid = BlockGrid::new(&space, il.depends_on, &st);
             let layer_samples = il.textures.len().max(1) as f64;
@@ -211,15 +214,15 @@ pub fn encode_all(set: &LoadedSet, models: &[ObjectModel], req: &PackRequest, st
                     let idx = pos.local.iter().zip(&pos.extent).fold(0usize, |a, (&l, &e)| a * e as usize + l as usize);
                     keys[idx] = k.clone();
                     samples[idx] = prepare(&layer, &layout, &il.form.stored(k, x));
-                    if let Some(w) = layer_weights.get(k) {
-                        weights[idx] = w.clone();
+                    if let Some(w) = if req.keep_master { layer_weights.get(k).cloned() } else { layer_weights.remove(k) } {
+                        weights[idx] = w;
                     }
                 }
                 if samples.iter().any(Vec::is_empty) {
                     return Err(runtime(anyhow!("object {} layer {} block {b}: a sample has no texture", m.name, il.kind.name())));
                 }
                 let mut pyramid = build_pyramid(mi, planes, &extent, &samples, layer_samples, !req.codec.is_lossy(), req.pyramid == super::PyramidMode::Full).map_err(runtime)?;
-                if !layer_weights.is_empty() && req.codec.is_lossy() {
+                if weighed {
                     pyramid.texel_weights = Some(weights);
                 }
                 pyramids.push(pyramid);
@@ -322,11 +325,12 @@ pub fn encode_all(set: &LoadedSet, models: &[ObjectModel], req: &PackRequest, st
     if let Some(total) = storage.allocated {
         stages.done("allocate", &format!("{total} bytes over {} level images", storage.level_images));
     }
-    let solved: Vec<Vec<LayerTextures>> = models.iter().map(solved_chains).collect();
-    let solved_error = display_error(set, models, &solved).map_err(runtime)?;
+    // Per object, its solved textures drawn and measured, then dropped.
+    let solved_error = models.iter().map(|m| Ok(display_error(set, std::slice::from_ref(m), &[solved_chains(m)])?[0])).collect::<Result<Vec<_>>>().map_err(runtime)?;
     let packed = Packed { container, blocks: blocks_out, overhead, layer_bytes: Vec::new(), stagger: staggers, screen_weights, solved_error, max_mse: None, quality: None };
     let Some((free_rates, free_bytes)) = &storage.free else {
-        let mut packed = emit(packed, pyramids, &where_, models, req.codec, &storage.rates)?;
+        let mut packed = emit(packed, &pyramids, &where_, models, req.codec, &storage.rates)?;
+        drop(pyramids);
         if req.codec.is_lossy() {
             record_max_mse(&mut packed, req.max_mse.alpha());
         }
@@ -336,8 +340,9 @@ pub fn encode_all(set: &LoadedSet, models: &[ObjectModel], req: &PackRequest, st
     // Both allocations encoded; the decoded textures of each rendered through the render
     // matrices against the traced images: the higher predicted PSNR is kept.
     let alpha = req.max_mse.alpha().unwrap_or(pis_codec::allocate::DEFAULT_ALPHA);
-    let with = emit(packed.clone(), pyramids.clone(), &where_, models, req.codec, &storage.rates)?;
-    let without = emit(packed, pyramids, &where_, models, req.codec, free_rates)?;
+    let with = emit(packed.clone(), &pyramids, &where_, models, req.codec, &storage.rates)?;
+    let without = emit(packed, &pyramids, &where_, models, req.codec, free_rates)?;
+    drop(pyramids);
     let (q_with, q_without) = (predicted_psnr(set, models, &with).map_err(runtime)?, predicted_psnr(set, models, &without).map_err(runtime)?);
     let (db_with, db_without) = (q_with.overall, q_without.overall);
     let keep = db_with >= db_without;
@@ -359,19 +364,22 @@ fn record_max_mse(packed: &mut Packed, alpha: Option<f64>) {
     }
 }
 
-/// The codestreams of `pyramids` at `rates`, moved into `packed`'s container and blocks.
-fn emit(mut packed: Packed, mut pyramids: Vec<BlockPyramid>, where_: &[(usize, usize, usize)], models: &[ObjectModel], codec: CodecId, rates: &[pis_codec::Rate]) -> Result<Packed, Failure> {
-    encode_levels(&mut pyramids, codec, rates).map_err(|e| Failure::new(Exit::Runtime, e))?;
+/// The codestreams of `pyramids` at `rates`, put into `packed`'s container and blocks (with
+/// the level images as encoded where the codec is exact, which [`check_lossless`] reads).
+fn emit(mut packed: Packed, pyramids: &[BlockPyramid], where_: &[(usize, usize, usize)], models: &[ObjectModel], codec: CodecId, rates: &[pis_codec::Rate]) -> Result<Packed, Failure> {
+    let streams = level_streams(pyramids, codec, rates).map_err(|e| Failure::new(Exit::Runtime, e))?;
     let mut layer_bytes: Vec<Vec<usize>> = models.iter().map(|m| vec![0; m.layers.len()]).collect();
-    for ((mi, li, b), pyramid) in where_.iter().zip(pyramids) {
+    for ((mi, li, b), (pyramid, streams)) in where_.iter().zip(pyramids.iter().zip(streams)) {
         let block = &mut packed.container.objects[*mi].layers[*li].blocks[*b];
-        for (level, (_, _, streams)) in block.levels.iter_mut().zip(&pyramid.levels) {
+        for (level, streams) in block.levels.iter_mut().zip(&streams) {
             for (image, bytes) in level.images.iter_mut().zip(streams) {
                 layer_bytes[*mi][*li] += bytes.len();
                 image.bytes = bytes.clone();
             }
         }
-        packed.blocks[*mi][*li][*b].levels = pyramid.levels;
+        packed.blocks[*mi][*li][*b].levels = pyramid.levels.iter().zip(streams).map(|((counts, images, _), streams)| {
+            (counts.clone(), if codec.is_lossy() { Vec::new() } else { images.clone() }, streams)
+        }).collect();
     }
     packed.layer_bytes = layer_bytes;
     Ok(packed)
@@ -380,35 +388,36 @@ fn emit(mut packed: Packed, mut pyramids: Vec<BlockPyramid>, where_: &[(usize, u
 /// Decoded linear textures (whole MIP chain, rebuilt by decimation as the player does), per
 /// object model and layer, keyed like [`super::model::InferredLayer::textures`].
 pub fn decoded_textures(models: &[ObjectModel], packed: &Packed) -> Result<Vec<Vec<LayerTextures>>> {
-    let mut out = Vec::new();
-    for (mi, m) in models.iter().enumerate() {
-        let mut per_layer = Vec::new();
-        for li in 0..m.layers.len() {
-            let layer = &packed.container.objects[mi].layers[li];
-            let mut map = std::collections::BTreeMap::new();
-            for (b, pb) in packed.blocks[mi][li].iter().enumerate() {
-                let block = &layer.blocks[b];
-                let layout = LevelLayout::of(layer, block);
-                let planes = layout.planes();
-                let decoded: Vec<Vec<Vec<f32>>> = pb.levels.iter().map(|(_, _, streams)| {
-                    streams.iter().map(|s| pis_codec::decode(layer_codec(block), &planes, s)).collect::<Result<Vec<_>, _>>()
-                }).collect::<Result<_, _>>()?;
-                for (s, k) in pb.keys.iter().enumerate() {
-                    let local = unflatten(s, &pb.extent);
-                    let mut sum = vec![0.0f32; pis_codec::value_count(&planes)?];
-                    for ((counts, _, _), imgs) in pb.levels.iter().zip(&decoded) {
-                        let img = &imgs[level_image_index(counts, &local, &pb.extent)];
-                        sum.iter_mut().zip(img).for_each(|(a, v)| *a += v);
-                    }
-                    let lin = finish(layer, &layout, sum);
-                    map.insert(k.clone(), m.layers[li].form.drawn(k, lin));
+    models.iter().enumerate().map(|(mi, m)| decoded_model_textures(mi, m, packed)).collect()
+}
+
+/// [`decoded_textures`] of object model `mi`, `m`.
+pub fn decoded_model_textures(mi: usize, m: &ObjectModel, packed: &Packed) -> Result<Vec<LayerTextures>> {
+    let mut per_layer = Vec::new();
+    for li in 0..m.layers.len() {
+        let layer = &packed.container.objects[mi].layers[li];
+        let mut map = std::collections::BTreeMap::new();
+        for (b, pb) in packed.blocks[mi][li].iter().enumerate() {
+            let block = &layer.blocks[b];
+            let layout = LevelLayout::of(layer, block);
+            let planes = layout.planes();
+            let decoded: Vec<Vec<Vec<f32>>> = pb.levels.iter().map(|(_, _, streams)| {
+                streams.iter().map(|s| pis_codec::decode(layer_codec(block), &planes, s)).collect::<Result<Vec<_>, _>>()
+            }).collect::<Result<_, _>>()?;
+            for (s, k) in pb.keys.iter().enumerate() {
+                let local = unflatten(s, &pb.extent);
+                let mut sum = vec![0.0f32; pis_codec::value_count(&planes)?];
+                for ((counts, _, _), imgs) in pb.levels.iter().zip(&decoded) {
+                    let img = &imgs[level_image_index(counts, &local, &pb.extent)];
+                    sum.iter_mut().zip(img).for_each(|(a, v)| *a += v);
                 }
+                let lin = finish(layer, &layout, sum);
+                map.insert(k.clone(), m.layers[li].form.drawn(k, lin));
             }
-            per_layer.push(map);
         }
-        out.push(per_layer);
+        per_layer.push(map);
     }
-    Ok(out)
+    Ok(per_layer)
 }
 
 fn layer_codec(block: &Block) -> CodecId {
@@ -535,11 +544,13 @@ pub fn predicted_psnr(set: &LoadedSet, models: &[ObjectModel], packed: &Packed) 
     if let Some(q) = &packed.quality {
         return Ok(q.clone());
     }
-    let decoded = decoded_textures(models, packed)?;
-    let solved: Vec<Vec<LayerTextures>> = models.iter().map(solved_chains).collect();
+    // Per object, its decoded and solved textures, then dropped.
     let mut max_err = 0.0f32;
-    for (m, (dl, sl)) in models.iter().zip(decoded.iter().zip(&solved)) {
-        for (li, (dm, sm)) in dl.iter().zip(sl).enumerate() {
+    let mut e_dec = Vec::with_capacity(models.len());
+    for (mi, m) in models.iter().enumerate() {
+        let dl = decoded_model_textures(mi, m, packed)?;
+        let sl = solved_chains(m);
+        for (li, (dm, sm)) in dl.iter().zip(&sl).enumerate() {
             for (k, x) in sm {
                 let n = m.layers[li].form.stored_texels(k) * m.layers[li].form.channels();
                 if let Some(y) = dm.get(k) {
@@ -549,8 +560,9 @@ pub fn predicted_psnr(set: &LoadedSet, models: &[ObjectModel], packed: &Packed) 
                 }
             }
         }
+        drop(sl);
+        e_dec.push(display_error(set, std::slice::from_ref(m), &[dl])?[0]);
     }
-    let e_dec = display_error(set, models, &decoded)?;
     let e_sol = &packed.solved_error;
     let total = |e: &[(f64, usize)]| {
         let (s, n) = e.iter().fold((0.0, 0), |a, x| (a.0 + x.0, a.1 + x.1));

@@ -32,7 +32,7 @@ impl MemoryPlan {
     /// The plan for a set whose images read `image_bytes` bytes as floats, under `memory`
     /// GB (`--memory`), else `available` bytes.
     pub fn new(image_bytes: u64, memory: Option<f64>, available: Option<u64>) -> MemoryPlan {
-        let budget = memory.map(|gb| (gb * 1e9) as u64).or(available);
+        let budget = memory.map(|gib| (gib * (1u64 << 30) as f64) as u64).or(available);
         let held = image_bytes.saturating_mul(HELD_PER_IMAGE_BYTE);
         MemoryPlan { budget, asked: memory.is_some(), held, stream: budget.is_some_and(|b| held > b) }
     }
@@ -59,7 +59,7 @@ mod tests {
 
     #[test]
     fn a_pack_streams_when_its_estimate_exceeds_the_budget() {
-        let gb = 1_000_000_000u64;
+        let gb = 1u64 << 30;
         assert!(!MemoryPlan::new(gb, Some(4.0), None).stream, "3 GB held fits 4 GB");
         assert!(MemoryPlan::new(gb, Some(2.0), None).stream);
         assert!(MemoryPlan::new(gb, None, Some(2 * gb)).stream, "without --memory, the available memory is the budget");

@@ -151,6 +151,20 @@ fn level_image_weights(pb: &BlockPyramid, lv: usize, ii: usize, values: usize) -
 /// Encodes every level image of `blocks` at its allocated rate into the blocks' codestream
 /// slots; returns the bytes written.
 pub fn encode_levels(blocks: &mut [BlockPyramid], codec: CodecId, rates: &[Rate]) -> Result<usize> {
+    let streams = level_streams(blocks, codec, rates)?;
+    let mut total = 0;
+    for (pb, block) in blocks.iter_mut().zip(streams) {
+        for (l, level) in pb.levels.iter_mut().zip(block) {
+            total += level.iter().map(Vec::len).sum::<usize>();
+            l.2 = level;
+        }
+    }
+    Ok(total)
+}
+
+/// The codestreams of every level image of `blocks` at `rates` (in block, level, image
+/// order), per block, level and image; the pyramids are left as they are.
+pub fn level_streams(blocks: &[BlockPyramid], codec: CodecId, rates: &[Rate]) -> Result<Vec<Vec<Vec<Vec<u8>>>>> {
     let c = pis_codec::codec(codec).ok_or_else(|| anyhow!("codec {codec} is not in this build"))?;
     let mut rates = rates.iter();
     let mut jobs = Vec::new();
@@ -166,12 +180,11 @@ pub fn encode_levels(blocks: &mut [BlockPyramid], codec: CodecId, rates: &[Rate]
         let pb = &blocks[b];
         c.encode(&pb.planes, &pb.levels[lv].1[ii], rate)
     }).collect::<Result<Vec<Vec<u8>>, pis_codec::CodecError>>()?;
-    let mut total = 0;
+    let mut out: Vec<Vec<Vec<Vec<u8>>>> = blocks.iter().map(|pb| pb.levels.iter().map(|l| vec![Vec::new(); l.1.len()]).collect()).collect();
     for ((b, lv, ii, _), bytes) in jobs.into_iter().zip(streams) {
-        total += bytes.len();
-        blocks[b].levels[lv].2[ii] = bytes;
+        out[b][lv][ii] = bytes;
     }
-    Ok(total)
+    Ok(out)
 }
 
 /// Makes the finest level's residuals such that the decoder's f32 sum of the levels, top

@@ -1,0 +1,61 @@
+#!/usr/bin/env bash
+# Peak memory of pis-pack in memory and streamed under a budget (--memory), at demo1's paper
+# preset and at a 16 × 16-point space at 640×480 (docs/BENCHMARKS.md, "Bounded memory").
+#
+# Usage: docs/cluster/memory.sh WORK_DIR [paper|grid|all]
+#   WORK_DIR  scratch folder (sets of several GB)
+#   paper     demo1 --preset paper (64 points at 640×480), packed in memory and with
+#             --memory 2; the two files must be the same bytes
+#   grid      demo1 at 16 × 16 points at 640×480, packed with --memory 8
+#
+# Runs from the repository root with the release binaries built (cargo build --release);
+# PIS_BIN names another folder of them. Sets are traced at 1 sample per pixel: memory does
+# not depend on the samples per pixel. Every pack is timed by /usr/bin/time (wall seconds,
+# peak resident memory).
+set -euo pipefail
+
+work=${1:?usage: docs/cluster/memory.sh WORK_DIR [paper|grid|all]}
+what=${2:-all}
+bin=${PIS_BIN:-target/release}
+src=samples/demo1
+[ -f "$src/scene.toml" ] || { echo "memory.sh: run from the repository root" >&2; exit 1; }
+[ -x "$bin/pis-trace" ] && [ -x "$bin/pis-pack" ] || { echo "memory.sh: no pis-trace and pis-pack in $bin (cargo build --release)" >&2; exit 1; }
+mkdir -p "$work"
+
+# Runs "$@" under /usr/bin/time; prints "SECONDS PEAK_MIB".
+timed() {
+    local t
+    t=$(mktemp)
+    /usr/bin/time -f "%e %M" -o "$t" "$@" > /dev/null 2>> "$work/log.txt" || { echo "memory.sh: failed: $* (see $work/log.txt)" >&2; exit 1; }
+    awk '{ printf "%s %.0f\n", $1, $2 / 1024 }' "$t"
+    rm -f "$t"
+}
+
+row() { # space run budget seconds mib
+    printf '| %s | %s | %s | %s | %s |\n' "$1" "$2" "$3" "$4" "$5"
+}
+
+echo "| space | pack | budget | wall s | peak MiB |"
+echo "|---|---|---|---|---|"
+
+if [ "$what" = paper ] || [ "$what" = all ]; then
+    set="$work/paper-set"
+    [ -f "$set/set.json" ] || "$bin/pis-trace" "$src/scene.toml" -o "$set" --preset paper --spp 1 > /dev/null 2>> "$work/log.txt"
+    read -r s m < <(timed "$bin/pis-pack" "$set" -o "$work/paper-held.pis")
+    row "paper preset, 64 points at 640×480" "in memory" "-" "$s" "$m"
+    read -r s m < <(timed "$bin/pis-pack" "$set" -o "$work/paper-streamed.pis" --memory 2)
+    row "paper preset, 64 points at 640×480" "streamed" "2 GiB" "$s" "$m"
+    cmp "$work/paper-held.pis" "$work/paper-streamed.pis" || { echo "memory.sh: the streamed pack differs from the pack in memory" >&2; exit 1; }
+fi
+
+if [ "$what" = grid ] || [ "$what" = all ]; then
+    dir="$work/demo1-16"
+    mkdir -p "$dir"
+    cp "$src"/demo1.gltf "$src"/demo1.bin "$src"/*.png "$dir"/
+    sed "s/^samples = 4$/samples = 16/" "$src/scene.toml" > "$dir/scene.toml"
+    [ "$(grep -c "^samples = 16$" "$dir/scene.toml")" = 2 ] || { echo "memory.sh: demo1's scene.toml no longer has two 'samples = 4' lines" >&2; exit 1; }
+    set="$work/grid-set"
+    [ -f "$set/set.json" ] || "$bin/pis-trace" "$dir/scene.toml" -o "$set" --resolution 640x480 --spp 1 > /dev/null 2>> "$work/log.txt"
+    read -r s m < <(timed "$bin/pis-pack" "$set" -o "$work/grid-streamed.pis" --memory 8)
+    row "16 × 16 points at 640×480" "streamed" "8 GiB" "$s" "$m"
+fi
