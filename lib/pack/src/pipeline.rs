@@ -45,6 +45,7 @@ pub mod storage;
 pub mod stored_mesh;
 pub mod surface;
 pub mod sweep;
+pub mod textures;
 
 use std::path::PathBuf;
 use std::time::Instant;

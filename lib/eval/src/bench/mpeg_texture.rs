@@ -29,7 +29,7 @@ struct LayerVideo {
     frames: Frames,
 }
 
-fn videos(inf: &Inferred) -> Vec<LayerVideo> {
+fn videos(inf: &Inferred) -> Result<Vec<LayerVideo>> {
     let dims = &inf.set.scene.space.dims;
     let mut out = Vec::new();
     for (mi, m) in inf.models.iter().enumerate() {
@@ -42,17 +42,18 @@ fn videos(inf: &Inferred) -> Vec<LayerVideo> {
             for pid in placements {
                 let layout = m.placements[pid].layout;
                 let keys: Vec<Vec<u32>> = path.iter().filter(|k| l.placement_of[*k] == pid).cloned().collect();
-                let scale = keys.iter().flat_map(|k| finest(layout, &l.textures[k])).fold(0.0f32, f32::max).max(1e-6);
+                let textures = keys.iter().map(|k| l.textures.get(k)).collect::<Result<Vec<_>>>()?;
+                let scale = textures.iter().flat_map(|x| finest(layout, x)).fold(0.0f32, f32::max).max(1e-6);
                 let mut rgb = Vec::new();
-                for k in &keys {
-                    rgb.extend(finest(layout, &l.textures[k]).iter().map(|&v| ((v.max(0.0) / scale).powf(1.0 / GAMMA) * 255.0).round().clamp(0.0, 255.0) as u8));
+                for x in &textures {
+                    rgb.extend(finest(layout, x).iter().map(|&v| ((v.max(0.0) / scale).powf(1.0 / GAMMA) * 255.0).round().clamp(0.0, 255.0) as u8));
                 }
                 let frames = Frames { width: layout.width, height: layout.height, count: keys.len(), rgb };
                 out.push(LayerVideo { model: mi, layer: li, frames, keys, scale });
             }
         }
     }
-    out
+    Ok(out)
 }
 
 /// One encoded point.
@@ -66,7 +67,7 @@ pub struct TexturePoint {
 
 /// Encodes every layer video at `budget` bytes in all, decodes, renders through A.
 pub fn texture_point(inf: &Inferred, budget: usize) -> Result<TexturePoint> {
-    let vids = videos(inf);
+    let vids = videos(inf)?;
     let side = 4 * vids.len();
     let frames: Vec<Frames> = vids.iter().map(|v| v.frames.clone()).collect();
     let matched = encode_to_budget(&frames, VideoCodec::X265, budget.saturating_sub(side).max(1))?;

@@ -217,7 +217,7 @@ pub fn run(req: &StabilityRequest) -> Result<StabilityReport, Failure> {
     let refs: Vec<Vec<f32>> = frames.iter().map(|f| reference(&inf, f, req.spp)).collect::<Result<_>>().map_err(runtime)?;
     let meshes: Vec<Mesh> = (0..scene.objects.len()).map(|o| merged_mesh(scene, o)).collect();
     let raw = inf.raw_image_bytes();
-    let mut reps: Vec<(String, Option<f64>, Vec<Vec<LayerTextures>>)> = vec![("solved".into(), None, inf.solved())];
+    let mut reps: Vec<(String, Option<f64>, Vec<Vec<LayerTextures>>)> = vec![("solved".into(), None, inf.solved().map_err(runtime)?)];
     for &r in &req.ratios {
         let (t, bytes) = inf.decoded(&base.with(|s| s.ratio = Some(r)))?;
         reps.push((format!("wavelet {r}:1"), Some(raw as f64 / bytes.max(1) as f64), t));

@@ -202,7 +202,7 @@ pub fn encode_all(set: &LoadedSet, models: &[ObjectModel], req: &PackRequest, st
                 let mut keys = vec![Vec::new(); count];
                 let mut samples = vec![Vec::new(); count];
                 let mut weights = vec![Vec::new(); count];
-                for (k, x) in &il.textures {
+                for k in il.textures.keys() {
                     let mut point = vec![0u32; space.dims.len()];
                     for (d, &v) in il.depends_on.dims().zip(k) {
                         point[d] = v;
@@ -211,9 +211,10 @@ pub fn encode_all(set: &LoadedSet, models: &[ObjectModel], req: &PackRequest, st
                     if pos.block != b {
                         continue;
                     }
+                    let x = il.textures.get(k).map_err(runtime)?;
                     let idx = pos.local.iter().zip(&pos.extent).fold(0usize, |a, (&l, &e)| a * e as usize + l as usize);
                     keys[idx] = k.clone();
-                    samples[idx] = prepare(&layer, &layout, &il.form.stored(k, x));
+                    samples[idx] = prepare(&layer, &layout, &il.form.stored(k, &x));
                     if let Some(w) = if req.keep_master { layer_weights.get(k).cloned() } else { layer_weights.remove(k) } {
                         weights[idx] = w;
                     }
@@ -224,6 +225,11 @@ pub fn encode_all(set: &LoadedSet, models: &[ObjectModel], req: &PackRequest, st
                 let mut pyramid = build_pyramid(mi, planes, &extent, &samples, layer_samples, !req.codec.is_lossy(), req.pyramid == super::PyramidMode::Full).map_err(runtime)?;
                 if weighed {
                     pyramid.texel_weights = Some(weights);
+                }
+                // A pack that streams keeps the level images in its scratch file, their
+                // rate–distortion curves measured.
+                if let Some(scratch) = &set.scratch {
+                    pyramid.spill(scratch, req.codec).map_err(runtime)?;
                 }
                 pyramids.push(pyramid);
                 where_.push((mi, li, b));
@@ -326,7 +332,7 @@ pub fn encode_all(set: &LoadedSet, models: &[ObjectModel], req: &PackRequest, st
         stages.done("allocate", &format!("{total} bytes over {} level images", storage.level_images));
     }
     // Per object, its solved textures drawn and measured, then dropped.
-    let solved_error = models.iter().map(|m| Ok(display_error(set, std::slice::from_ref(m), &[solved_chains(m)])?[0])).collect::<Result<Vec<_>>>().map_err(runtime)?;
+    let solved_error = models.iter().map(|m| Ok(display_error(set, std::slice::from_ref(m), &[solved_chains(m)?])?[0])).collect::<Result<Vec<_>>>().map_err(runtime)?;
     let packed = Packed { container, blocks: blocks_out, overhead, layer_bytes: Vec::new(), stagger: staggers, screen_weights, solved_error, max_mse: None, quality: None };
     let Some((free_rates, free_bytes)) = &storage.free else {
         let mut packed = emit(packed, &pyramids, &where_, models, req.codec, &storage.rates)?;
@@ -377,8 +383,9 @@ fn emit(mut packed: Packed, pyramids: &[BlockPyramid], where_: &[(usize, usize, 
                 image.bytes = bytes.clone();
             }
         }
-        packed.blocks[*mi][*li][*b].levels = pyramid.levels.iter().zip(streams).map(|((counts, images, _), streams)| {
-            (counts.clone(), if codec.is_lossy() { Vec::new() } else { images.clone() }, streams)
+        let images = if codec.is_lossy() { None } else { Some(pyramid.level_images().map_err(|e| Failure::new(Exit::Runtime, e))?) };
+        packed.blocks[*mi][*li][*b].levels = pyramid.levels.iter().zip(streams).enumerate().map(|(lv, ((counts, _, _), streams))| {
+            (counts.clone(), images.as_ref().map_or_else(Vec::new, |i| i[lv].to_vec()), streams)
         }).collect();
     }
     packed.layer_bytes = layer_bytes;
@@ -426,8 +433,8 @@ fn layer_codec(block: &Block) -> CodecId {
 
 /// The solved textures of `m` per layer, each as the MIP chain the player rebuilds from its
 /// finest level.
-pub fn solved_chains(m: &ObjectModel) -> Vec<LayerTextures> {
-    m.layers.iter().map(|l| l.textures.iter().map(|(k, x)| (k.clone(), l.form.drawn(k, l.form.stored(k, x)))).collect()).collect()
+pub fn solved_chains(m: &ObjectModel) -> Result<Vec<LayerTextures>> {
+    m.layers.iter().map(|l| l.textures.iter().map(|r| r.map(|(k, x)| (k.clone(), l.form.drawn(k, l.form.stored(k, &x))))).collect()).collect()
 }
 
 /// The lossless master of every object (SPEC.md 6.7): each layer sample's finest solved
@@ -435,7 +442,7 @@ pub fn solved_chains(m: &ObjectModel) -> Vec<LayerTextures> {
 pub fn masters(models: &[ObjectModel], packed: &Packed) -> Result<Vec<Master>> {
     models.iter().enumerate().map(|(mi, m)| {
         // Keys are sample indices over the layer's dimensions: their order is table order.
-        let textures: Vec<Vec<Vec<f32>>> = m.layers.iter().map(|l| l.textures.iter().map(|(k, x)| l.form.stored(k, x)).collect()).collect();
+        let textures: Vec<Vec<Vec<f32>>> = m.layers.iter().map(|l| l.textures.iter().map(|r| r.map(|(k, x)| l.form.stored(k, &x))).collect()).collect::<Result<_>>()?;
         // The screen weights the allocation used, so that coding the master again allocates
         // as this pack did.
         let by_layer = &packed.screen_weights[mi];
@@ -457,9 +464,10 @@ pub fn check_master(path: &Path, models: &[ObjectModel]) -> Result<(u64, bool)> 
     let mut exact = masters.len() == models.len();
     for (m, model) in masters.iter().zip(models) {
         for (li, l) in model.layers.iter().enumerate() {
-            for (s, (k, x)) in l.textures.iter().enumerate() {
+            for (s, r) in l.textures.iter().enumerate() {
+                let (k, x) = r?;
                 let got = m.texture(c, li, s)?;
-                let want = l.form.stored(k, x);
+                let want = l.form.stored(k, &x);
                 exact &= got.len() == want.len() && got.iter().zip(&want).all(|(a, b)| a.to_bits() == b.to_bits());
             }
         }
@@ -549,7 +557,7 @@ pub fn predicted_psnr(set: &LoadedSet, models: &[ObjectModel], packed: &Packed) 
     let mut e_dec = Vec::with_capacity(models.len());
     for (mi, m) in models.iter().enumerate() {
         let dl = decoded_model_textures(mi, m, packed)?;
-        let sl = solved_chains(m);
+        let sl = solved_chains(m)?;
         for (li, (dm, sm)) in dl.iter().zip(&sl).enumerate() {
             for (k, x) in sm {
                 let n = m.layers[li].form.stored_texels(k) * m.layers[li].form.channels();

@@ -69,11 +69,18 @@ pub fn infer_all(set: &LoadedSet, req: &PackRequest, matrices: &mut Matrices, st
         if req.shard.is_some_and(|s| !s.has(mi)) {
             continue;
         }
-        let m = p.solve(&job)?;
+        // A pack that streams keeps the solved textures in its scratch file.
+        let spill = |mut m: ObjectModel| -> Result<ObjectModel> {
+            if let Some(scratch) = &set.scratch {
+                m.spill_textures(scratch)?;
+            }
+            Ok(m)
+        };
+        let m = spill(p.solve(&job)?)?;
         note(&m);
         models.push(m);
         if let Some(a) = other {
-            let m = a.solve(&job)?;
+            let m = spill(a.solve(&job)?)?;
             note(&m);
             alternatives.push((mi, m));
         }

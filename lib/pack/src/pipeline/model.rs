@@ -14,6 +14,7 @@ use pis_format::DepMask;
 
 use super::pem::views::ShellView;
 use super::scratch::{Reader, Scratch, Span, Writer};
+use super::textures::Textures;
 use crate::infer::{Mesh, Placed};
 
 /// One point as the render matrices see an object (hardware model or probe mode): the rows
@@ -72,15 +73,15 @@ impl PointView {
 }
 
 /// Every point's [`PointView`] of an object: held in memory, or, for a pack that streams
-/// ([`super::memory`]), in the scratch file, read back one point at a time (the covered
-/// pixels of each point stay in memory).
+/// ([`super::memory`]), in the scratch file, read back one point at a time (the number of
+/// covered pixels of each point stays in memory).
 pub struct Views {
     store: ViewStore,
 }
 
 enum ViewStore {
     Held(Vec<PointView>),
-    Spilled { scratch: Arc<Scratch>, spans: Vec<Span>, pixels: Vec<Vec<u32>> },
+    Spilled { scratch: Arc<Scratch>, spans: Vec<Span>, rows: Vec<usize> },
 }
 
 impl Views {
@@ -88,7 +89,7 @@ impl Views {
     pub fn new(scratch: Option<Arc<Scratch>>) -> Views {
         Views {
             store: match scratch {
-                Some(scratch) => ViewStore::Spilled { scratch, spans: Vec::new(), pixels: Vec::new() },
+                Some(scratch) => ViewStore::Spilled { scratch, spans: Vec::new(), rows: Vec::new() },
                 None => ViewStore::Held(Vec::new()),
             },
         }
@@ -103,9 +104,9 @@ impl Views {
     pub fn push(&mut self, v: PointView) -> Result<()> {
         match &mut self.store {
             ViewStore::Held(h) => h.push(v),
-            ViewStore::Spilled { scratch, spans, pixels } => {
+            ViewStore::Spilled { scratch, spans, rows } => {
                 spans.push(scratch.put(&v.record())?);
-                pixels.push(v.pixels().to_vec());
+                rows.push(v.rows());
             }
         }
         Ok(())
@@ -115,12 +116,12 @@ impl Views {
     pub fn update(&mut self, p: usize, change: impl FnOnce(&mut PointView) -> Result<()>) -> Result<()> {
         match &mut self.store {
             ViewStore::Held(h) => change(h.get_mut(p).ok_or_else(|| anyhow!("no view of point {p}"))?),
-            ViewStore::Spilled { scratch, spans, pixels } => {
+            ViewStore::Spilled { scratch, spans, rows } => {
                 let span = *spans.get(p).ok_or_else(|| anyhow!("no view of point {p}"))?;
                 let mut v = PointView::read(&scratch.get(span)?)?;
                 change(&mut v)?;
                 spans[p] = scratch.put(&v.record())?;
-                pixels[p] = v.pixels().to_vec();
+                rows[p] = v.rows();
                 Ok(())
             }
         }
@@ -150,16 +151,19 @@ impl Views {
     }
 
     /// The covered pixels of point `p`, `y · width + x`, in row order.
-    pub fn pixels(&self, p: usize) -> &[u32] {
-        match &self.store {
-            ViewStore::Held(h) => h.get(p).map_or(&[], PointView::pixels),
-            ViewStore::Spilled { pixels, .. } => pixels.get(p).map_or(&[], Vec::as_slice),
-        }
+    pub fn pixels(&self, p: usize) -> Result<Cow<'_, [u32]>> {
+        Ok(match self.get(p)? {
+            Cow::Borrowed(v) => Cow::Borrowed(v.pixels()),
+            Cow::Owned(v) => Cow::Owned(v.pixels().to_vec()),
+        })
     }
 
-    /// The covered pixels of point `p`.
+    /// The number of covered pixels of point `p`.
     pub fn rows(&self, p: usize) -> usize {
-        self.pixels(p).len()
+        match &self.store {
+            ViewStore::Held(h) => h.get(p).map_or(0, PointView::rows),
+            ViewStore::Spilled { rows, .. } => rows.get(p).copied().unwrap_or(0),
+        }
     }
 }
 
@@ -169,7 +173,7 @@ pub struct InferredLayer {
     pub kind: pis_format::LayerKind,
     pub depends_on: DepMask,
     /// Key: sample index per masked dimension, in dimension order.
-    pub textures: BTreeMap<Vec<u32>, Vec<f32>>,
+    pub textures: Textures,
     /// Per block of the layer's grid (SPEC.md 7.2), its placement in
     /// [`ObjectModel::placements`].
     pub block_placements: Vec<usize>,
@@ -194,7 +198,7 @@ impl InferredLayer {
             kind,
             depends_on: job.all,
             placement_of: textures.keys().map(|k| (k.clone(), 0)).collect(),
-            textures,
+            textures: textures.into(),
             block_placements: vec![0; grid_blocks],
             iterations,
             form,
@@ -258,6 +262,11 @@ pub struct ObjectModel {
 }
 
 impl ObjectModel {
+    /// Moves every layer's textures to `scratch` (a pack that streams).
+    pub fn spill_textures(&mut self, scratch: &Arc<Scratch>) -> Result<()> {
+        self.layers.iter_mut().try_for_each(|l| l.textures.spill(scratch))
+    }
+
     /// The placement of sample `key` of layer `layer`.
     pub fn placed(&self, layer: usize, key: &[u32]) -> &Placed {
         &self.placements[self.layers[layer].placement_of[key]]

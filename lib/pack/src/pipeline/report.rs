@@ -134,8 +134,19 @@ pub struct MemoryReport {
     pub streamed: bool,
     /// Bytes written to the scratch file.
     pub scratch_bytes: u64,
+    /// The process's peak resident memory when the report was made (where the system tells
+    /// it).
+    pub peak_bytes: Option<u64>,
     /// In words.
     pub why: String,
+}
+
+impl MemoryReport {
+    /// Whether the pack's peak went above the budget asked for: what is held whatever the
+    /// budget (the solved textures, the pyramids and the level images) did not fit it.
+    pub fn over_budget(&self) -> bool {
+        self.budget_asked && matches!((self.peak_bytes, self.budget_bytes), (Some(p), Some(b)) if p > b)
+    }
 }
 
 /// Both allocations' predicted PSNR, when `auto` encoded both.
@@ -210,6 +221,7 @@ pub fn build(set: &LoadedSet, models: &[ObjectModel], packed: &Packed, q: &Quali
             held_estimate_bytes: set.memory.held,
             streamed: set.memory.stream,
             scratch_bytes: set.scratch.as_ref().map_or(0, |s| s.len()),
+            peak_bytes: pis_trace::memory::peak_resident(),
             why: set.memory.describe(),
         },
         notes: vec![
@@ -264,6 +276,10 @@ pub fn print_report(r: &PackReport, out: &mut impl std::io::Write) -> std::io::R
     writeln!(out, "  stages (ms): {}", stages.join(", "))?;
     if r.memory.streamed {
         writeln!(out, "  memory: {}; scratch file {:.0} MiB", r.memory.why, r.memory.scratch_bytes as f64 / (1 << 20) as f64)?;
+    }
+    if r.memory.over_budget() {
+        let gib = |b: Option<u64>| b.unwrap_or(0) as f64 / (1u64 << 30) as f64;
+        writeln!(out, "  memory: the peak of {:.2} GiB is above --memory {:.2} GiB: the solved textures, pyramids and level images are held in memory whatever the budget", gib(r.memory.peak_bytes), gib(r.memory.budget_bytes))?;
     }
     if !r.stage_peak_mib.is_empty() {
         let peaks: Vec<String> = r.stage_peak_mib.iter().map(|(k, v)| format!("{k} {v:.0}")).collect();

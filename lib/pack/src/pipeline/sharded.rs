@@ -54,6 +54,8 @@ pub fn solve_shard(req: &PackRequest, shard: Shard, fragments: &std::path::Path,
     let mut req = req.clone();
     req.solver = crate::solutions::Solver::with(store.clone());
     req.shard = Some(shard);
+    // A streamed solve keeps its scratch file beside its fragment.
+    req.output = path.clone();
     let mut stages = Stages::new(progress);
     let (set, mut matrices) = begin(&req, &mut stages)?;
     let inferred = infer_layers::infer_all(&set, &req, &mut matrices, &mut stages).map_err(|e| Failure::new(Exit::Runtime, e))?;

@@ -3,12 +3,16 @@
 //! layer and object with screen-area weights (4.5), and the encoding at the allocated rates.
 //! `pis-pack` and `pis-reencode` code their textures through here.
 
-use anyhow::{anyhow, Result};
+use std::borrow::Cow;
+use std::sync::Arc;
+
+use anyhow::{anyhow, bail, Result};
 use pis_codec::allocate::{allocate, Item, Target};
 use pis_codec::pyramid::{adaptive, build, l1_cost, level_image_index, unflatten, Pyramid, PyramidFilter, PyramidLevel};
-use pis_codec::{CodecId, PlaneShape, Rate};
+use pis_codec::{CodecId, LevelCodec, PlaneShape, Rate};
 use rayon::prelude::*;
 
+use super::scratch::{Reader, Scratch, Span, Writer};
 use super::settings::MaxMse;
 
 
@@ -44,6 +48,70 @@ pub struct BlockPyramid {
     /// error reaches. With them the allocation weighs texture error as screen error; None:
     /// every texel weighs the same.
     pub texel_weights: Option<Vec<Vec<f32>>>,
+    /// Where a pack that streams keeps the level images ([`BlockPyramid::spill`]): each is
+    /// then an empty vector in `levels` (the counts stay), and `rd` holds their
+    /// rate–distortion items, measured before.
+    pub spilled: Option<(Arc<Scratch>, Span)>,
+    pub rd: Option<Vec<Item>>,
+}
+
+impl BlockPyramid {
+    /// The level images per level (read back from the scratch file where spilled).
+    pub fn level_images(&self) -> Result<Vec<Cow<'_, [Vec<f32>]>>> {
+        let Some((scratch, span)) = &self.spilled else {
+            return Ok(self.levels.iter().map(|l| Cow::Borrowed(l.1.as_slice())).collect());
+        };
+        let bytes = scratch.get(*span)?;
+        let mut r = Reader::new(&bytes);
+        let levels = self.levels.iter().map(|l| (0..l.1.len()).map(|_| r.f32s()).collect::<Result<Vec<_>>>().map(Cow::Owned)).collect::<Result<Vec<_>>>()?;
+        r.done()?;
+        Ok(levels)
+    }
+
+    /// The allocation's item of every level image, in level and image order (with `c`, a
+    /// lossy codec): its rate–distortion curve, weighed by the screen weights where the
+    /// block has them, and the share of its layer's samples it reaches.
+    fn items(&self, c: &dyn LevelCodec) -> Result<Vec<Item>> {
+        if let Some(rd) = &self.rd {
+            return Ok(rd.clone());
+        }
+        let count: usize = self.extent.iter().map(|&e| e as usize).product();
+        let members: Vec<Vec<usize>> = self.levels.iter().map(|(counts, images, _)| {
+            let mut m = vec![0usize; images.len()];
+            for s in 0..count {
+                m[level_image_index(counts, &unflatten(s, &self.extent), &self.extent)] += 1;
+            }
+            m
+        }).collect();
+        let refs: Vec<(usize, usize)> = self.levels.iter().enumerate().flat_map(|(lv, l)| (0..l.1.len()).map(move |ii| (lv, ii))).collect();
+        Ok(refs.par_iter().map(|&(lv, ii)| {
+            let values = &self.levels[lv].1[ii];
+            let weights = level_image_weights(self, lv, ii, values.len());
+            let curve = c.rd_curve_weighted(&self.planes, values, weights.as_deref())?;
+            Ok(Item { curve, object: self.object, weight: members[lv][ii] as f64 / self.layer_samples })
+        }).collect::<Result<Vec<Item>, pis_codec::CodecError>>()?)
+    }
+
+    /// Moves the level images to `scratch`, having measured their rate–distortion items
+    /// for `codec` where it is lossy (a pack that streams).
+    pub fn spill(&mut self, scratch: &Arc<Scratch>, codec: CodecId) -> Result<()> {
+        if self.spilled.is_some() {
+            return Ok(());
+        }
+        if codec.is_lossy() {
+            let c = pis_codec::codec(codec).ok_or_else(|| anyhow!("codec {codec} is not in this build"))?;
+            self.rd = Some(self.items(c)?);
+        }
+        let mut w = Writer::default();
+        for l in &mut self.levels {
+            for img in &mut l.1 {
+                w.f32s(img);
+                *img = Vec::new();
+            }
+        }
+        self.spilled = Some((scratch.clone(), scratch.put(&w.0)?));
+        Ok(())
+    }
 }
 
 /// Builds the adaptive pyramid of a block's finest samples (gamma-compensated, row-major over
@@ -65,7 +133,7 @@ pub fn build_pyramid(object: usize, planes: Vec<PlaneShape>, extent: &[u32], sam
         let n = l.images.len();
         (l.counts, l.images, vec![Vec::new(); n])
     }).collect();
-    Ok(BlockPyramid { object, planes, extent: extent.to_vec(), layer_samples, levels, texel_weights: None })
+    Ok(BlockPyramid { object, planes, extent: extent.to_vec(), layer_samples, levels, texel_weights: None, spilled: None, rd: None })
 }
 
 /// What the allocation gave: bytes per level image (in block, level, image order), or the
@@ -92,24 +160,9 @@ pub fn allocate_storage(blocks: &[BlockPyramid], codec: CodecId, target: Target,
         return Ok(Storage { rates: vec![Rate::Default; refs.len()], allocated: None, level_images: refs.len(), free: None });
     }
     let c = pis_codec::codec(codec).ok_or_else(|| anyhow!("codec {codec} is not in this build"))?;
-    // How many finest samples each level image reaches.
-    let members: Vec<Vec<Vec<usize>>> = blocks.iter().map(|pb| {
-        let count: usize = pb.extent.iter().map(|&e| e as usize).product();
-        pb.levels.iter().map(|(counts, images, _)| {
-            let mut m = vec![0usize; images.len()];
-            for s in 0..count {
-                m[level_image_index(counts, &unflatten(s, &pb.extent), &pb.extent)] += 1;
-            }
-            m
-        }).collect()
-    }).collect();
-    let items = refs.par_iter().map(|&(b, lv, ii)| {
-        let pb = &blocks[b];
-        let values = &pb.levels[lv].1[ii];
-        let weights = level_image_weights(pb, lv, ii, values.len());
-        let curve = c.rd_curve_weighted(&pb.planes, values, weights.as_deref())?;
-        Ok(Item { curve, object: pb.object, weight: members[b][lv][ii] as f64 / pb.layer_samples })
-    }).collect::<Result<Vec<Item>, pis_codec::CodecError>>()?;
+    // Blocks in parallel where their items are to be measured, their level images in
+    // parallel within each.
+    let items: Vec<Item> = blocks.par_iter().map(|pb| pb.items(c)).collect::<Result<Vec<_>>>()?.into_iter().flatten().collect();
     let a = allocate(&items, areas, target, max_mse.alpha())?;
     // Two allocations of one byte budget compare by their predictions; a PSNR target asks
     // for the fewest bytes instead, and keeps the constraint.
@@ -166,25 +219,26 @@ pub fn encode_levels(blocks: &mut [BlockPyramid], codec: CodecId, rates: &[Rate]
 /// order), per block, level and image; the pyramids are left as they are.
 pub fn level_streams(blocks: &[BlockPyramid], codec: CodecId, rates: &[Rate]) -> Result<Vec<Vec<Vec<Vec<u8>>>>> {
     let c = pis_codec::codec(codec).ok_or_else(|| anyhow!("codec {codec} is not in this build"))?;
-    let mut rates = rates.iter();
-    let mut jobs = Vec::new();
-    for (b, pb) in blocks.iter().enumerate() {
-        for (lv, l) in pb.levels.iter().enumerate() {
-            for ii in 0..l.1.len() {
-                let rate = *rates.next().ok_or_else(|| anyhow!("fewer rates than level images"))?;
-                jobs.push((b, lv, ii, rate));
-            }
+    // Each block's first rate.
+    let mut first = Vec::with_capacity(blocks.len());
+    let mut n = 0usize;
+    for pb in blocks {
+        first.push(n);
+        n += pb.levels.iter().map(|l| l.1.len()).sum::<usize>();
+    }
+    if rates.len() < n {
+        bail!("fewer rates ({}) than level images ({n})", rates.len());
+    }
+    blocks.par_iter().zip(first).map(|(pb, first)| {
+        let images = pb.level_images()?;
+        let jobs: Vec<(usize, usize, Rate)> = images.iter().enumerate().flat_map(|(lv, l)| (0..l.len()).map(move |ii| (lv, ii))).enumerate().map(|(k, (lv, ii))| (lv, ii, rates[first + k])).collect();
+        let streams = jobs.par_iter().map(|&(lv, ii, rate)| c.encode(&pb.planes, &images[lv][ii], rate)).collect::<Result<Vec<Vec<u8>>, pis_codec::CodecError>>()?;
+        let mut out: Vec<Vec<Vec<u8>>> = images.iter().map(|l| vec![Vec::new(); l.len()]).collect();
+        for ((lv, ii, _), bytes) in jobs.into_iter().zip(streams) {
+            out[lv][ii] = bytes;
         }
-    }
-    let streams = jobs.par_iter().map(|&(b, lv, ii, rate)| {
-        let pb = &blocks[b];
-        c.encode(&pb.planes, &pb.levels[lv].1[ii], rate)
-    }).collect::<Result<Vec<Vec<u8>>, pis_codec::CodecError>>()?;
-    let mut out: Vec<Vec<Vec<Vec<u8>>>> = blocks.iter().map(|pb| pb.levels.iter().map(|l| vec![Vec::new(); l.1.len()]).collect()).collect();
-    for ((b, lv, ii, _), bytes) in jobs.into_iter().zip(streams) {
-        out[b][lv][ii] = bytes;
-    }
-    Ok(out)
+        Ok(out)
+    }).collect()
 }
 
 /// Makes the finest level's residuals such that the decoder's f32 sum of the levels, top

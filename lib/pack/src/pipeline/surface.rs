@@ -215,7 +215,7 @@ fn solve_layer(set: &LoadedSet, views: &Views, placements: &[Placed], plan: &Lay
         textures.insert(k, x);
     }
     let form = Box::new(TextureForm { placements: placements.to_vec(), block_placements: plan.block_placements.clone(), placement_of: placement_of.clone() });
-    Ok(InferredLayer { kind: plan.kind, depends_on: plan.depends_on, textures, block_placements: plan.block_placements.clone(), placement_of, iterations, form, shell: None })
+    Ok(InferredLayer { kind: plan.kind, depends_on: plan.depends_on, textures: textures.into(), block_placements: plan.block_placements.clone(), placement_of, iterations, form, shell: None })
 }
 
 /// A surface texture layer as stored: every block's texture placed as thesis 3.2 places it

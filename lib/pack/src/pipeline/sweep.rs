@@ -105,7 +105,7 @@ impl Inferred {
 
     /// The textures as solved (MIP chains rebuilt by decimation, as the player does), per
     /// object model and layer.
-    pub fn solved(&self) -> Vec<Vec<LayerTextures>> {
+    pub fn solved(&self) -> anyhow::Result<Vec<Vec<LayerTextures>>> {
         self.models.iter().map(solved_chains).collect()
     }
 

@@ -96,7 +96,7 @@ impl Planned for PemPlanned {
         let mut model = surface.solve(job)?;
         let set = job.set;
         let f0 = super::shading::object_shading(&set.scene, o).f0;
-        let pixels: Vec<Vec<u32>> = (0..model.views.len()).map(|p| model.views.pixels(p).to_vec()).collect();
+        let pixels: Vec<Vec<u32>> = (0..model.views.len()).map(|p| model.views.pixels(p).map(|x| x.into_owned())).collect::<Result<_>>()?;
         let keys: Vec<Vec<u32>> = set.samples.iter().map(|s| key(s, job.all)).collect();
         let mut settings = SolveSettings::pyramidal();
         settings.cg = job.settings.cg;
@@ -108,7 +108,7 @@ impl Planned for PemPlanned {
         }
         let local_n = face_resolution(set, o, &job.meshes, fitted.local, largest)?;
         let local_layout = TextureLayout::cube(local_n);
-        let has_local = (0..model.views.len()).map(|p| local_alpha(set, p, o, model.views.pixels(p))).collect::<Result<Vec<f32>>>()?.iter().any(|&a| a > 1e-3);
+        let has_local = pixels.iter().enumerate().map(|(p, px)| local_alpha(set, p, o, px)).collect::<Result<Vec<f32>>>()?.iter().any(|&a| a > 1e-3);
         // The distant shell: a box and a sphere, each solved at a few points spread over the
         // set; the one nearer the traced distant layer there is kept and solved everywhere.
         let probe: Vec<usize> = probe_points(set.frames.len());
