@@ -162,9 +162,12 @@ impl PackOptions {
         Ok(req)
     }
 
-    /// The options as written, for telling packs apart (`Debug` of every field).
+    /// The options as written, for telling packs apart (`Debug` of every field but the
+    /// memory budget, which changes how the pack runs, not the file).
     pub fn fingerprint(&self) -> String {
-        format!("{self:?}")
+        let mut o = self.clone();
+        o.memory = None;
+        format!("{o:?}")
     }
 
     /// pis-pack's defaults.

@@ -6,7 +6,8 @@
 #   WORK_DIR  scratch folder (sets of several GB)
 #   paper     demo1 --preset paper (64 points at 640×480), packed in memory and with
 #             --memory 2; the two files must be the same bytes
-#   grid      demo1 at 16 × 16 points at 640×480, packed with --memory 8
+#   grid      demo1 at 4 × 4 and 16 × 16 points at 640×480, packed with --memory 2 (and
+#             the 4 × 4 also in memory, the same bytes)
 #
 # Runs from the repository root with the release binaries built (cargo build --release);
 # PIS_BIN names another folder of them. Sets are traced at 1 sample per pixel: memory does
@@ -48,14 +49,24 @@ if [ "$what" = paper ] || [ "$what" = all ]; then
     cmp "$work/paper-held.pis" "$work/paper-streamed.pis" || { echo "memory.sh: the streamed pack differs from the pack in memory" >&2; exit 1; }
 fi
 
-if [ "$what" = grid ] || [ "$what" = all ]; then
-    dir="$work/demo1-16"
+# demo1 with N samples along each of its two dimensions, traced at 640×480 into $work/grid-N.
+grid_set() {
+    local n=$1 dir="$work/demo1-$1"
     mkdir -p "$dir"
     cp "$src"/demo1.gltf "$src"/demo1.bin "$src"/*.png "$dir"/
-    sed "s/^samples = 4$/samples = 16/" "$src/scene.toml" > "$dir/scene.toml"
-    [ "$(grep -c "^samples = 16$" "$dir/scene.toml")" = 2 ] || { echo "memory.sh: demo1's scene.toml no longer has two 'samples = 4' lines" >&2; exit 1; }
-    set="$work/grid-set"
-    [ -f "$set/set.json" ] || "$bin/pis-trace" "$dir/scene.toml" -o "$set" --resolution 640x480 --spp 1 > /dev/null 2>> "$work/log.txt"
-    read -r s m < <(timed "$bin/pis-pack" "$set" -o "$work/grid-streamed.pis" --memory 8)
-    row "16 × 16 points at 640×480" "streamed" "8 GiB" "$s" "$m"
+    sed "s/^samples = 4$/samples = $n/" "$src/scene.toml" > "$dir/scene.toml"
+    [ "$(grep -c "^samples = $n$" "$dir/scene.toml")" = 2 ] || { echo "memory.sh: demo1's scene.toml no longer has two 'samples = 4' lines" >&2; exit 1; }
+    [ -f "$work/grid-$n/set.json" ] || "$bin/pis-trace" "$dir/scene.toml" -o "$work/grid-$n" --resolution 640x480 --spp 1 > /dev/null 2>> "$work/log.txt"
+}
+
+if [ "$what" = grid ] || [ "$what" = all ]; then
+    grid_set 4
+    read -r s m < <(timed "$bin/pis-pack" "$work/grid-4" -o "$work/grid-4-held.pis")
+    row "4 × 4 points at 640×480" "in memory" "-" "$s" "$m"
+    read -r s m < <(timed "$bin/pis-pack" "$work/grid-4" -o "$work/grid-4-streamed.pis" --memory 2)
+    row "4 × 4 points at 640×480" "streamed" "2 GiB" "$s" "$m"
+    cmp "$work/grid-4-held.pis" "$work/grid-4-streamed.pis" || { echo "memory.sh: the streamed pack differs from the pack in memory" >&2; exit 1; }
+    grid_set 16
+    read -r s m < <(timed "$bin/pis-pack" "$work/grid-16" -o "$work/grid-16-streamed.pis" --memory 2)
+    row "16 × 16 points at 640×480" "streamed" "2 GiB" "$s" "$m"
 fi

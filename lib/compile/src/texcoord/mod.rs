@@ -130,8 +130,17 @@ pub fn optimize_placement(
         return Err(CompileError::Setting("the texel budget per pixel must be > 0".into()));
     }
 
-    // Step 1: branch cuts, from the visible edges' extents in the original coordinates.
-    let first: Vec<_> = views.iter().map(|v| visible_edges(v, mesh.uvs, mesh.indices)).collect();
+    // Step 1: branch cuts, from the visible edges' extents in the original coordinates. Each
+    // view's edges are kept, and the pixels it covers counted; its triangle-id buffer (one
+    // entry per pixel) is not: steps 3–4 rasterize each view again, one at a time, so that
+    // memory does not grow with the number of views.
+    let edges_of = |uvs: &[Vec2]| -> Vec<(Vec<edges::VisibleEdge>, usize)> {
+        views.iter().map(|v| {
+            let (e, ids) = visible_edges(v, uvs, mesh.indices);
+            (e, ids.ids.iter().filter(|id| id.is_some()).count())
+        }).collect()
+    };
+    let first = edges_of(mesh.uvs);
     let mut cut = [None, None];
     let mut repeat = [false, false];
     for dim in 0..2 {
@@ -160,11 +169,7 @@ pub fn optimize_placement(
         }
         w.as_vec2()
     }).collect();
-    let per_view: Vec<_> = if cut.iter().any(Option::is_some) {
-        views.iter().map(|v| visible_edges(v, &uvs, mesh.indices)).collect()
-    } else {
-        first
-    };
+    let per_view = if cut.iter().any(Option::is_some) { edges_of(&uvs) } else { first };
     let edges: Vec<_> = per_view.iter().flat_map(|(e, _)| e.iter().copied()).collect();
     if edges.is_empty() {
         return Ok(TexturePlacement {
@@ -183,7 +188,8 @@ pub fn optimize_placement(
 
     // Steps 3–4: scale until the stretch is under the threshold at every covered pixel.
     let mut jacobians = Vec::new();
-    for (view, (_, ids)) in views.iter().zip(&per_view) {
+    for view in views {
+        let ids = visibility::rasterize_ids(view, mesh.indices);
         for (k, id) in ids.ids.iter().enumerate() {
             let Some(t) = id else { continue };
             let tri = &mesh.indices[3 * *t as usize..3 * *t as usize + 3];
@@ -217,7 +223,7 @@ pub fn optimize_placement(
 
     // Step 6: the used resolution, reduced to the texel budget.
     let ext = hi - lo;
-    let covered_pixels = per_view.iter().map(|(_, ids)| ids.ids.iter().filter(|id| id.is_some()).count()).max().unwrap_or(0);
+    let covered_pixels = per_view.iter().map(|&(_, covered)| covered).max().unwrap_or(0);
     let mut reduction = settings.reduction;
     if let Some(k) = settings.texels_per_pixel {
         let texels = ext.x.max(1.0) * ext.y.max(1.0) * reduction * reduction;

@@ -1,8 +1,10 @@
 //! The pack's memory budget (`pis-pack --memory GB`, else the memory this machine has
-//! available): a set whose pack would not fit in memory is streamed. Its images are read
-//! point by point and each object's layers written to the scratch file ([`super::scratch`],
-//! [`super::set_images`]); each object's render matrices and gold standard are written
-//! there as they are made and read back a point at a time ([`super::model::Views`]). The
+//! available): a set whose pack would not fit in memory is streamed through the scratch file
+//! ([`super::scratch`]). Its images are read point by point and each object's layers written
+//! there ([`super::set_images`]); each object's render matrices and gold standard are
+//! written as they are made and read back a point at a time ([`super::model::Views`]); each
+//! layer sample's texture once solved ([`super::textures`]); each block's level images once
+//! their rate–distortion curves are measured ([`super::storage::BlockPyramid::spill`]). The
 //! file is the same, byte for byte: the pack reads the same values, in the same order.
 //!
 //! Whether to stream is decided before the set is read, from the bytes of its images: a pack
@@ -45,7 +47,7 @@ impl MemoryPlan {
             (None, _) => "an unknown budget".to_string(),
         };
         let how = if self.stream {
-            "streamed: images, render matrices and gold standard in the scratch file, read back an object and point at a time"
+            "streamed: images, render matrices, gold standard, solved textures and level images in the scratch file, read back an object, point or block at a time"
         } else {
             "in memory"
         };

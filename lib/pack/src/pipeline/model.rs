@@ -43,9 +43,8 @@ impl PointView {
     pub fn pixels(&self) -> &[u32] {
         self.a.first().map_or(&[], |(_, a)| a.pixels.as_slice())
     }
-}
 
-impl PointView {
+    /// The view as a scratch record.
     fn record(&self) -> Vec<u8> {
         let mut w = Writer::default();
         w.u64(self.a.len() as u64);
@@ -58,6 +57,7 @@ impl PointView {
         w.0
     }
 
+    /// A view from its scratch record.
     fn read(bytes: &[u8]) -> Result<PointView> {
         let mut r = Reader::new(bytes);
         let n = r.u64()?;
@@ -322,4 +322,57 @@ impl ObjectModel {
 /// The key of `samples` under `mask`.
 pub fn key(samples: &[u32], mask: DepMask) -> Vec<u32> {
     mask.dims().map(|k| samples[k]).collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use pis_compile::{RenderMatrix, TextureLayout};
+
+    fn view(p: u32) -> PointView {
+        let a = RenderMatrix {
+            width: 8, height: 8, layout: TextureLayout::full(2, 2),
+            pixels: vec![p, p + 3], coverage: vec![1.0, 0.5], row_start: vec![0, 1, 3], cols: vec![0, 1, 4], vals: vec![1.0, 0.25, 0.75],
+        };
+        PointView { a: vec![(0, a)], diffuse: vec![0.1 * p as f32; 6], specular: vec![-0.0; 6] }
+    }
+
+    fn same(a: &PointView, b: &PointView) -> bool {
+        let bits = |v: &[f32]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+        a.a.len() == b.a.len()
+            && a.a.iter().zip(&b.a).all(|((pa, ma), (pb, mb))| pa == pb && ma == mb)
+            && bits(&a.diffuse) == bits(&b.diffuse)
+            && bits(&a.specular) == bits(&b.specular)
+    }
+
+    #[test]
+    fn spilled_views_read_and_change_as_held_ones() {
+        let dir = tempfile::tempdir().unwrap();
+        let scratch = Arc::new(Scratch::create(&dir.path().join("s")).unwrap());
+        let mut held = Views::new(None);
+        let mut spilled = Views::new(Some(scratch.clone()));
+        for p in 0..3 {
+            held.push(view(p)).unwrap();
+            spilled.push(view(p)).unwrap();
+        }
+        assert!(scratch.len() > 0, "the views went to the scratch file");
+        // A second placement's matrix added at point 1, the first one dropped.
+        let change = |v: &mut PointView| {
+            let mut b = v.a[0].1.clone();
+            b.vals.iter_mut().for_each(|x| *x *= 0.5);
+            v.a.push((2, b));
+            v.a.remove(0);
+            Ok(())
+        };
+        held.update(1, change).unwrap();
+        spilled.update(1, change).unwrap();
+        assert_eq!((held.len(), spilled.len()), (3, 3));
+        for p in 0..3 {
+            assert!(same(&held.get(p).unwrap(), &spilled.get(p).unwrap()), "point {p}");
+            assert_eq!(held.pixels(p).unwrap(), spilled.pixels(p).unwrap());
+            assert_eq!((held.rows(p), spilled.rows(p)), (2, 2));
+        }
+        assert_eq!(spilled.get(1).unwrap().a[0].0, 2);
+        assert!(held.get(3).is_err() && spilled.get(3).is_err() && spilled.update(5, |_| Ok(())).is_err());
+    }
 }

@@ -142,8 +142,8 @@ pub struct MemoryReport {
 }
 
 impl MemoryReport {
-    /// Whether the pack's peak went above the budget asked for: what is held whatever the
-    /// budget (the solved textures, the pyramids and the level images) did not fit it.
+    /// Whether the pack's peak went above the budget asked for: what a streamed pack still
+    /// holds did not fit it.
     pub fn over_budget(&self) -> bool {
         self.budget_asked && matches!((self.peak_bytes, self.budget_bytes), (Some(p), Some(b)) if p > b)
     }
@@ -279,7 +279,7 @@ pub fn print_report(r: &PackReport, out: &mut impl std::io::Write) -> std::io::R
     }
     if r.memory.over_budget() {
         let gib = |b: Option<u64>| b.unwrap_or(0) as f64 / (1u64 << 30) as f64;
-        writeln!(out, "  memory: the peak of {:.2} GiB is above --memory {:.2} GiB: the solved textures, pyramids and level images are held in memory whatever the budget", gib(r.memory.peak_bytes), gib(r.memory.budget_bytes))?;
+        writeln!(out, "  memory: the peak of {:.2} GiB is above --memory {:.2} GiB: what a streamed pack still holds (meshes, placements, the codestreams, shell render matrices, a lens object's layers) did not fit", gib(r.memory.peak_bytes), gib(r.memory.budget_bytes))?;
     }
     if !r.stage_peak_mib.is_empty() {
         let peaks: Vec<String> = r.stage_peak_mib.iter().map(|(k, v)| format!("{k} {v:.0}")).collect();

@@ -28,10 +28,13 @@ pub struct Scratch {
 }
 
 impl Scratch {
-    /// A new scratch file for the pack writing `output`, in the output's folder.
+    /// A new scratch file for the pack writing `output`, in the output's folder. The
+    /// scratch files of earlier packs of `output` whose processes are gone (killed before
+    /// they could remove their own) are removed first.
     pub fn beside(output: &Path) -> Result<Scratch> {
         let dir = output.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
         let name = output.file_name().map_or_else(|| "pack".into(), |n| n.to_string_lossy().into_owned());
+        remove_stale(dir, &name);
         Scratch::create(&dir.join(format!(".{name}.scratch{}", std::process::id())))
     }
 
@@ -77,6 +80,28 @@ impl Scratch {
     pub fn path(&self) -> &Path {
         &self.path
     }
+}
+
+/// Removes the scratch files `.NAME.scratch<pid>` in `dir` of processes that are not
+/// running (where the system tells: Linux's /proc); returns how many were removed.
+fn remove_stale(dir: &Path, name: &str) -> usize {
+    let prefix = format!(".{name}.scratch");
+    let Ok(entries) = std::fs::read_dir(dir) else { return 0 };
+    let mut removed = 0;
+    for e in entries.filter_map(Result::ok) {
+        let file = e.file_name().to_string_lossy().into_owned();
+        let Some(pid) = file.strip_prefix(&prefix).and_then(|p| p.parse::<u32>().ok()) else { continue };
+        if pid != std::process::id() && !running(pid) && std::fs::remove_file(e.path()).is_ok() {
+            removed += 1;
+        }
+    }
+    removed
+}
+
+/// Whether process `pid` is running; true where the system cannot tell.
+fn running(pid: u32) -> bool {
+    let proc = Path::new("/proc");
+    !proc.join("self").exists() || proc.join(pid.to_string()).exists()
 }
 
 impl Drop for Scratch {
@@ -235,5 +260,26 @@ mod tests {
         assert!(short.f32s().is_err(), "a record cut short is an error");
         drop(s);
         assert!(!path.exists(), "the scratch file is removed with the scratch");
+    }
+
+    #[test]
+    fn the_scratch_files_of_packs_that_are_gone_are_removed() {
+        let dir = tempfile::tempdir().unwrap();
+        // pid_max is at most 2^22 on Linux: this process cannot be running.
+        let gone = dir.path().join(".out.pis.scratch4294967");
+        let other = dir.path().join(".other.pis.scratch4294967");
+        let kept = dir.path().join(".out.pis.scratch-notes");
+        for p in [&gone, &other, &kept] {
+            std::fs::write(p, b"x").unwrap();
+        }
+        let s = Scratch::beside(&dir.path().join("out.pis")).unwrap();
+        if Path::new("/proc/self").exists() {
+            assert!(!gone.exists(), "a dead pack's scratch file is removed");
+        }
+        assert!(other.exists() && kept.exists(), "other outputs' files and other names are left alone");
+        assert!(s.path().exists(), "this pack's own file is there");
+        // A pack that is running keeps its file: this process's is not removed by another.
+        assert_eq!(remove_stale(dir.path(), "out.pis"), 0);
+        assert!(s.path().exists());
     }
 }
