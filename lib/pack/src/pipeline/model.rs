@@ -95,11 +95,6 @@ impl Views {
         }
     }
 
-    /// Views held in memory.
-    pub fn held(views: Vec<PointView>) -> Views {
-        Views { store: ViewStore::Held(views) }
-    }
-
     /// Adds the next point.
     pub fn push(&mut self, v: PointView) -> Result<()> {
         match &mut self.store {
