@@ -23,18 +23,8 @@ src=samples/demo1
 [ -x "$bin/pis-trace" ] && [ -x "$bin/pis-pack" ] || { echo "memory.sh: no pis-trace and pis-pack in $bin (cargo build --release)" >&2; exit 1; }
 mkdir -p "$work"
 
-# Runs "$@" under /usr/bin/time; prints "SECONDS PEAK_MIB".
-timed() {
-    local t
-    t=$(mktemp)
-    /usr/bin/time -f "%e %M" -o "$t" "$@" > /dev/null 2>> "$work/log.txt" || { echo "memory.sh: failed: $* (see $work/log.txt)" >&2; exit 1; }
-    awk '{ printf "%s %.0f\n", $1, $2 / 1024 }' "$t"
-    rm -f "$t"
-}
-
-row() { # space run budget seconds mib
-    printf '| %s | %s | %s | %s | %s |\n' "$1" "$2" "$3" "$4" "$5"
-}
+# shellcheck source=docs/cluster/measure.sh
+. "$(dirname "$0")/measure.sh"
 
 echo "| space | pack | budget | wall s | peak MiB |"
 echo "|---|---|---|---|---|"
@@ -51,12 +41,9 @@ fi
 
 # demo1 with N samples along each of its two dimensions, traced at 640×480 into $work/grid-N.
 grid_set() {
-    local n=$1 dir="$work/demo1-$1"
-    mkdir -p "$dir"
-    cp "$src"/demo1.gltf "$src"/demo1.bin "$src"/*.png "$dir"/
-    sed "s/^samples = 4$/samples = $n/" "$src/scene.toml" > "$dir/scene.toml"
-    [ "$(grep -c "^samples = $n$" "$dir/scene.toml")" = 2 ] || { echo "memory.sh: demo1's scene.toml no longer has two 'samples = 4' lines" >&2; exit 1; }
-    [ -f "$work/grid-$n/set.json" ] || "$bin/pis-trace" "$dir/scene.toml" -o "$work/grid-$n" --resolution 640x480 --spp 1 > /dev/null 2>> "$work/log.txt"
+    local n=$1 scene
+    scene=$(scene_copy "$n")
+    [ -f "$work/grid-$n/set.json" ] || "$bin/pis-trace" "$scene" -o "$work/grid-$n" --resolution 640x480 --spp 1 > /dev/null 2>> "$work/log.txt"
 }
 
 if [ "$what" = grid ] || [ "$what" = all ]; then

@@ -21,28 +21,8 @@ src=samples/demo1
 [ -x "$bin/pis-trace" ] && [ -x "$bin/pis-pack" ] || { echo "scaling.sh: no pis-trace and pis-pack in $bin (cargo build --release)" >&2; exit 1; }
 mkdir -p "$work"
 
-# demo1 with N samples along each of its two dimensions.
-scene_copy() {
-    local n=$1 dir="$work/demo1-$1"
-    mkdir -p "$dir"
-    cp "$src"/demo1.gltf "$src"/demo1.bin "$src"/*.png "$dir"/
-    sed "s/^samples = 4$/samples = $n/" "$src/scene.toml" > "$dir/scene.toml"
-    [ "$(grep -c "^samples = $n$" "$dir/scene.toml")" = 2 ] || { echo "scaling.sh: demo1's scene.toml no longer has two 'samples = 4' lines" >&2; exit 1; }
-    echo "$dir/scene.toml"
-}
-
-# Runs "$@" under /usr/bin/time; prints "SECONDS PEAK_MIB".
-timed() {
-    local t
-    t=$(mktemp)
-    /usr/bin/time -f "%e %M" -o "$t" "$@" > /dev/null 2>> "$work/log.txt" || { echo "scaling.sh: failed: $* (see $work/log.txt)" >&2; exit 1; }
-    awk '{ printf "%s %.0f\n", $1, $2 / 1024 }' "$t"
-    rm -f "$t"
-}
-
-row() { # what points resolution seconds mib
-    printf '| %s | %s | %s | %s | %s |\n' "$1" "$2" "$3" "$4" "$5"
-}
+# shellcheck source=docs/cluster/measure.sh
+. "$(dirname "$0")/measure.sh"
 
 echo "| run | points | resolution | wall s | peak MiB |"
 echo "|---|---|---|---|---|"
