@@ -33,6 +33,7 @@ pub mod matrices;
 pub mod memory;
 pub mod model;
 pub mod pem;
+pub mod predict;
 pub mod report;
 pub mod represent;
 pub mod scratch;
@@ -218,7 +219,7 @@ pub fn pack_request(req: &PackRequest, progress: &dyn Progress) -> Result<PackRe
         Some(done) => done,
         None => {
             let packed = encode::encode_all(&set, &inferred, req, &mut stages)?;
-            let quality = encode::predicted_psnr(&set, &inferred, &packed).map_err(|e| Failure::new(Exit::Runtime, e))?;
+            let quality = predict::predicted_psnr(&set, &inferred, &packed).map_err(|e| Failure::new(Exit::Runtime, e))?;
             stages.done("predict", &format!("decoded textures rendered through the render matrices ({})", req.matrix.name()));
             (packed, quality)
         }

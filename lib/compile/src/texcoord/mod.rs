@@ -186,9 +186,12 @@ pub fn optimize_placement(
     let r = isometry::most_isometric(&terms, scale_only);
     let r = DMat2::from_cols(DVec2::new(r[0], r[2]), DVec2::new(r[1], r[3]));
 
-    // Steps 3–4: scale until the stretch is under the threshold at every covered pixel.
+    // Steps 3–4: scale until the stretch is under the threshold at every covered pixel, of
+    // which each view keeps those that can be the most stretched.
     let mut jacobians = Vec::new();
+    let mut in_view = Vec::new();
     for view in views {
+        in_view.clear();
         let ids = visibility::rasterize_ids(view, mesh.indices);
         for (k, id) in ids.ids.iter().enumerate() {
             let Some(t) = id else { continue };
@@ -197,9 +200,10 @@ pub fn optimize_placement(
             let p = DVec2::new((k % view.width as usize) as f64 + 0.5, (k / view.width as usize) as f64 + 0.5);
             let tuv = [uvs[tri[0] as usize], uvs[tri[1] as usize], uvs[tri[2] as usize]];
             if let Some(j) = visibility::uv_jacobian(&sv, tuv, p) {
-                jacobians.push(j);
+                in_view.push(j);
             }
         }
+        jacobians.extend(stretch::envelope(&in_view));
     }
     let (r, stretch) = stretch::limit_stretch(r, &jacobians, settings.max_stretch, scale_only);
 

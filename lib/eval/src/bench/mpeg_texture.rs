@@ -16,7 +16,8 @@ use anyhow::Result;
 use crate::baselines::path::zigzag;
 use crate::baselines::video::{decode, encode_to_budget, Frames, Matched, VideoCodec};
 
-use pis_pack::encode::{display_error, finest, mip_chain, psnr, LayerTextures};
+use pis_pack::encode::{finest, mip_chain, LayerTextures};
+use pis_pack::predict::{display_error, psnr};
 use pis_pack::Inferred;
 
 const GAMMA: f32 = 2.2;
@@ -81,7 +82,7 @@ pub fn texture_point(inf: &Inferred, budget: usize) -> Result<TexturePoint> {
             textures[v.model][v.layer].insert(k.clone(), mip_chain(m.layout(v.layer, k), lin));
         }
     }
-    let e = display_error(&inf.set, &inf.models, &textures)?;
+    let e = inf.models.iter().zip(&textures).map(|(m, t)| display_error(&inf.set, m, t.as_slice())).collect::<anyhow::Result<Vec<_>>>()?;
     let (s, n) = e.iter().fold((0.0, 0), |a, x| (a.0 + x.0, a.1 + x.1));
     Ok(TexturePoint { bytes: matched.bytes + side, matched, psnr_db: psnr(s, n), videos: vids.len() })
 }

@@ -14,7 +14,8 @@
 
 use anyhow::anyhow;
 
-use super::encode::{encode_all, predicted_psnr, Packed, Quality};
+use super::encode::{encode_all, Packed};
+use super::predict::{predicted_psnr, Quality};
 use super::infer_layers::Inferred;
 use super::input::LoadedSet;
 use super::model::ObjectModel;

@@ -8,10 +8,9 @@ use std::path::Path;
 
 use anyhow::{anyhow, Result};
 use pis_codec::allocate::Target;
-use pis_codec::pyramid::{level_image_index, unflatten};
 use pis_codec::CodecId;
 use pis_format::blocks::BlockGrid;
-use pis_format::reconstruct::{finish, prepare};
+use pis_format::reconstruct::prepare;
 use pis_format::*;
 
 use super::model::{key, ObjectModel};
@@ -21,6 +20,7 @@ use super::shading::object_shading;
 use super::stored_mesh::stored_mesh;
 use super::storage::{allocate_storage, build_pyramid, level_streams, BlockPyramid, CodedLevel};
 pub use super::surface::{finest, mip_chain};
+use super::predict::{predicted_psnr, solved_error, Quality};
 use super::{PackRequest, Stages};
 use crate::error::{Exit, Failure};
 
@@ -54,7 +54,7 @@ pub struct Packed {
     /// allocation reads them from the pyramids).
     pub screen_weights: Vec<Vec<BTreeMap<Vec<u32>, Vec<f32>>>>,
     /// Per object model: the solved textures' squared display error against the traced
-    /// images and the number of values it sums ([`display_error`]).
+    /// images and the number of values it sums ([`super::predict::display_error`]).
     pub solved_error: Vec<(f64, usize)>,
     /// With [`super::MaxMse::Best`], where the constraint changed the allocation: which
     /// allocation was kept and why.
@@ -332,7 +332,7 @@ pub fn encode_all(set: &LoadedSet, models: &[ObjectModel], req: &PackRequest, st
         stages.done("allocate", &format!("{total} bytes over {} level images", storage.level_images));
     }
     // Per object, its solved textures drawn and measured, then dropped.
-    let solved_error = models.iter().map(|m| Ok(display_error(set, std::slice::from_ref(m), &[solved_chains(m)?])?[0])).collect::<Result<Vec<_>>>().map_err(runtime)?;
+    let solved_error = models.iter().map(|m| solved_error(set, m)).collect::<Result<Vec<_>>>().map_err(runtime)?;
     let packed = Packed { container, blocks: blocks_out, overhead, layer_bytes: Vec::new(), stagger: staggers, screen_weights, solved_error, max_mse: None, quality: None };
     let Some((free_rates, free_bytes)) = &storage.free else {
         let mut packed = emit(packed, &pyramids, &where_, models, req.codec, &storage.rates)?;
@@ -390,51 +390,6 @@ fn emit(mut packed: Packed, pyramids: &[BlockPyramid], where_: &[(usize, usize, 
     }
     packed.layer_bytes = layer_bytes;
     Ok(packed)
-}
-
-/// Decoded linear textures (whole MIP chain, rebuilt by decimation as the player does), per
-/// object model and layer, keyed like [`super::model::InferredLayer::textures`].
-pub fn decoded_textures(models: &[ObjectModel], packed: &Packed) -> Result<Vec<Vec<LayerTextures>>> {
-    models.iter().enumerate().map(|(mi, m)| decoded_model_textures(mi, m, packed)).collect()
-}
-
-/// [`decoded_textures`] of object model `mi`, `m`.
-pub fn decoded_model_textures(mi: usize, m: &ObjectModel, packed: &Packed) -> Result<Vec<LayerTextures>> {
-    let mut per_layer = Vec::new();
-    for li in 0..m.layers.len() {
-        let layer = &packed.container.objects[mi].layers[li];
-        let mut map = std::collections::BTreeMap::new();
-        for (b, pb) in packed.blocks[mi][li].iter().enumerate() {
-            let block = &layer.blocks[b];
-            let layout = LevelLayout::of(layer, block);
-            let planes = layout.planes();
-            let decoded: Vec<Vec<Vec<f32>>> = pb.levels.iter().map(|(_, _, streams)| {
-                streams.iter().map(|s| pis_codec::decode(layer_codec(block), &planes, s)).collect::<Result<Vec<_>, _>>()
-            }).collect::<Result<_, _>>()?;
-            for (s, k) in pb.keys.iter().enumerate() {
-                let local = unflatten(s, &pb.extent);
-                let mut sum = vec![0.0f32; pis_codec::value_count(&planes)?];
-                for ((counts, _, _), imgs) in pb.levels.iter().zip(&decoded) {
-                    let img = &imgs[level_image_index(counts, &local, &pb.extent)];
-                    sum.iter_mut().zip(img).for_each(|(a, v)| *a += v);
-                }
-                let lin = finish(layer, &layout, sum);
-                map.insert(k.clone(), m.layers[li].form.drawn(k, lin));
-            }
-        }
-        per_layer.push(map);
-    }
-    Ok(per_layer)
-}
-
-fn layer_codec(block: &Block) -> CodecId {
-    block.levels.first().and_then(|l| l.images.first()).map_or(CodecId::Raw, |c| c.codec)
-}
-
-/// The solved textures of `m` per layer, each as the MIP chain the player rebuilds from its
-/// finest level.
-pub fn solved_chains(m: &ObjectModel) -> Result<Vec<LayerTextures>> {
-    m.layers.iter().map(|l| l.textures.iter().map(|r| r.map(|(k, x)| (k.clone(), l.form.drawn(k, l.form.stored(k, &x))))).collect()).collect()
 }
 
 /// The lossless master of every object (SPEC.md 6.7): each layer sample's finest solved
@@ -500,27 +455,6 @@ pub fn check_lossless(path: &Path, packed: &Packed) -> Result<bool> {
     Ok(true)
 }
 
-/// Squared display error and pixel count per object of `textures` rendered through A,
-/// against the gold-standard layers.
-pub fn display_error(set: &LoadedSet, models: &[ObjectModel], textures: &[Vec<LayerTextures>]) -> Result<Vec<(f64, usize)>> {
-    let d = |v: f32| crate::images::srgb_encode(v.clamp(0.0, 1.0)) as f64;
-    models.iter().zip(textures).map(|(m, tex)| {
-        let (mut sse, mut n) = (0.0f64, 0usize);
-        for (p, s) in set.samples.iter().enumerate() {
-            let v = m.views.get(p)?;
-            let keys: Vec<Vec<u32>> = m.layers.iter().map(|il| key(s, il.depends_on)).collect();
-            let at: Vec<Option<&[f32]>> = tex.iter().zip(&keys).map(|(t, k)| t.get(k).map(Vec::as_slice)).collect();
-            let img = m.render_view(&v, p, &keys, &at);
-            for (k, g) in img.iter().enumerate() {
-                let gold = v.diffuse[k] + v.specular[k];
-                sse += (d(*g) - d(gold)).powi(2);
-            }
-            n += img.len();
-        }
-        Ok((sse, n))
-    }).collect()
-}
-
 /// The file's record of the player's filter (SPEC.md 6.6).
 fn file_filter(f: pis_compile::Filter) -> pis_format::FileFilter {
     match f {
@@ -529,59 +463,6 @@ fn file_filter(f: pis_compile::Filter) -> pis_format::FileFilter {
         pis_compile::Filter::Trilinear => pis_format::FileFilter::Trilinear,
         pis_compile::Filter::Anisotropic(n) => pis_format::FileFilter::Anisotropic(n),
     }
-}
-
-/// PSNR in dB (peak 1) of a squared error sum over `n` values.
-pub fn psnr(sse: f64, n: usize) -> f64 {
-    10.0 * (1.0 / (sse / n.max(1) as f64).max(1e-20)).log10()
-}
-
-/// Predicted quality: per object (decoded, as solved) and overall, plus the largest
-/// difference between decoded and solved finest texels.
-#[derive(Clone)]
-pub struct Quality {
-    pub objects: Vec<(f64, f64)>,
-    pub overall: f64,
-    pub overall_solved: f64,
-    pub max_texel_error: f32,
-}
-
-/// Renders the decoded and the solved textures through the render matrices (the hardware
-/// model's or probe mode's).
-pub fn predicted_psnr(set: &LoadedSet, models: &[ObjectModel], packed: &Packed) -> Result<Quality> {
-    if let Some(q) = &packed.quality {
-        return Ok(q.clone());
-    }
-    // Per object, its decoded and solved textures, then dropped.
-    let mut max_err = 0.0f32;
-    let mut e_dec = Vec::with_capacity(models.len());
-    for (mi, m) in models.iter().enumerate() {
-        let dl = decoded_model_textures(mi, m, packed)?;
-        let sl = solved_chains(m)?;
-        for (li, (dm, sm)) in dl.iter().zip(&sl).enumerate() {
-            for (k, x) in sm {
-                let n = m.layers[li].form.stored_texels(k) * m.layers[li].form.channels();
-                if let Some(y) = dm.get(k) {
-                    for (a, b) in x[..n].iter().zip(&y[..n]) {
-                        max_err = max_err.max((a - b).abs());
-                    }
-                }
-            }
-        }
-        drop(sl);
-        e_dec.push(display_error(set, std::slice::from_ref(m), &[dl])?[0]);
-    }
-    let e_sol = &packed.solved_error;
-    let total = |e: &[(f64, usize)]| {
-        let (s, n) = e.iter().fold((0.0, 0), |a, x| (a.0 + x.0, a.1 + x.1));
-        psnr(s, n)
-    };
-    Ok(Quality {
-        objects: e_dec.iter().zip(e_sol).map(|(a, b)| (psnr(a.0, a.1), psnr(b.0, b.1))).collect(),
-        overall: total(&e_dec),
-        overall_solved: total(e_sol),
-        max_texel_error: max_err,
-    })
 }
 
 #[cfg(test)]

@@ -4,7 +4,8 @@ use std::collections::BTreeMap;
 
 use serde::Serialize;
 
-use super::encode::{Packed, Quality};
+use super::encode::Packed;
+use super::predict::Quality;
 use super::model::ObjectModel;
 use super::input::LoadedSet;
 use super::{PackRequest, Stages};

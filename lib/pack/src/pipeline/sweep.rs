@@ -5,7 +5,8 @@ use std::time::Instant;
 
 use serde::Serialize;
 
-use super::encode::{decoded_textures, encode_all, predicted_psnr, solved_chains, LayerTextures};
+use super::encode::{encode_all, LayerTextures};
+use super::predict::{decoded_textures, predicted_psnr, solved_chains};
 use super::infer_layers::infer_all;
 use super::model::ObjectModel;
 use super::input::{load, LoadedSet};

@@ -27,6 +27,30 @@ impl From<BTreeMap<Vec<u32>, Vec<f32>>> for Textures {
 }
 
 impl Textures {
+    /// No textures yet: held, or spilled to `scratch` as they are inserted.
+    pub fn new(scratch: Option<&Arc<Scratch>>) -> Self {
+        let store = match scratch {
+            None => Store::Held(BTreeMap::new()),
+            Some(s) => Store::Spilled { scratch: s.clone(), spans: BTreeMap::new() },
+        };
+        Textures { store }
+    }
+
+    /// Adds (or replaces) the texture of sample `key`.
+    pub fn insert(&mut self, key: Vec<u32>, x: Vec<f32>) -> Result<()> {
+        match &mut self.store {
+            Store::Held(t) => {
+                t.insert(key, x);
+            }
+            Store::Spilled { scratch, spans } => {
+                let mut w = Writer::default();
+                w.f32s(&x);
+                spans.insert(key, scratch.put(&w.0)?);
+            }
+        }
+        Ok(())
+    }
+
     /// The number of samples.
     pub fn len(&self) -> usize {
         match &self.store {
@@ -77,13 +101,11 @@ impl Textures {
     /// Moves the textures to `scratch`.
     pub fn spill(&mut self, scratch: &Arc<Scratch>) -> Result<()> {
         if let Store::Held(t) = &mut self.store {
-            let mut spans = BTreeMap::new();
-            for (k, x) in std::mem::take(t) {
-                let mut w = Writer::default();
-                w.f32s(&x);
-                spans.insert(k, scratch.put(&w.0)?);
+            let held = std::mem::take(t);
+            *self = Textures::new(Some(scratch));
+            for (k, x) in held {
+                self.insert(k, x)?;
             }
-            self.store = Store::Spilled { scratch: scratch.clone(), spans };
         }
         Ok(())
     }
@@ -109,5 +131,8 @@ mod tests {
             assert!(a.iter().zip(b).all(|(x, y)| x.to_bits() == y.to_bits()));
         }
         assert!(t.get(&[9]).is_err());
+        let mut inserted = Textures::new(Some(&scratch));
+        inserted.insert(vec![3], vec![2.0, 0.25]).unwrap();
+        assert_eq!(inserted.get(&[3]).unwrap().as_ref(), &[2.0, 0.25]);
     }
 }

@@ -1,0 +1,192 @@
+//! The pack's predicted quality: textures, as solved or as decoded, rebuilt into the MIP
+//! chains the player draws, drawn through each point's render matrices and compared with the
+//! traced images (the display error of thesis 4.8).
+//!
+//! A pack in memory holds one object's chains at a time. One that streams
+//! ([`super::memory`]) builds a solved chain when a point reads it and spills the decoded
+//! ones to its scratch file block by block, so that neither the prediction nor the solved
+//! error holds more than one block's level images and one chain per layer.
+
+use std::borrow::Cow;
+use std::collections::BTreeMap;
+
+use anyhow::Result;
+use pis_codec::pyramid::{level_image_index, unflatten};
+use pis_codec::CodecId;
+use pis_format::reconstruct::finish;
+use pis_format::{Block, LevelLayout};
+
+use super::encode::{LayerTextures, Packed};
+use super::input::LoadedSet;
+use super::model::{key, ObjectModel};
+use super::textures::Textures;
+
+/// Where [`display_error`] reads an object's texture chains, one sample at a time.
+pub trait Chains {
+    /// The MIP chain of layer `li`'s sample `k`; `None` where the layer has no such sample.
+    fn chain(&self, li: usize, k: &[u32]) -> Result<Option<Cow<'_, [f32]>>>;
+}
+
+impl Chains for [LayerTextures] {
+    fn chain(&self, li: usize, k: &[u32]) -> Result<Option<Cow<'_, [f32]>>> {
+        Ok(self[li].get(k).map(|x| Cow::Borrowed(x.as_slice())))
+    }
+}
+
+impl Chains for [Textures] {
+    fn chain(&self, li: usize, k: &[u32]) -> Result<Option<Cow<'_, [f32]>>> {
+        let t = &self[li];
+        if t.contains_key(k) { t.get(k).map(Some) } else { Ok(None) }
+    }
+}
+
+/// An object's solved textures, each chain rebuilt from its finest level when read.
+pub struct SolvedChains<'a>(pub &'a ObjectModel);
+
+impl Chains for SolvedChains<'_> {
+    fn chain(&self, li: usize, k: &[u32]) -> Result<Option<Cow<'_, [f32]>>> {
+        let l = &self.0.layers[li];
+        if !l.textures.contains_key(k) {
+            return Ok(None);
+        }
+        let x = l.textures.get(k)?;
+        Ok(Some(Cow::Owned(l.form.drawn(k, l.form.stored(k, &x)))))
+    }
+}
+
+/// The solved textures of `m` per layer, each as the MIP chain the player rebuilds from its
+/// finest level.
+pub fn solved_chains(m: &ObjectModel) -> Result<Vec<LayerTextures>> {
+    m.layers.iter().map(|l| l.textures.iter().map(|r| r.map(|(k, x)| (k.clone(), l.form.drawn(k, l.form.stored(k, &x))))).collect()).collect()
+}
+
+/// The squared display error of object `m` drawn with `chains` through A at every point,
+/// against the gold-standard layers, and the number of values it sums.
+pub fn display_error(set: &LoadedSet, m: &ObjectModel, chains: &(impl Chains + ?Sized)) -> Result<(f64, usize)> {
+    let d = |v: f32| crate::images::srgb_encode(v.clamp(0.0, 1.0)) as f64;
+    let (mut sse, mut n) = (0.0f64, 0usize);
+    // The chain each layer read last: consecutive points share the samples of a layer that
+    // does not depend on the fastest dimension.
+    let mut last: Vec<Option<(Vec<u32>, Option<Cow<'_, [f32]>>)>> = m.layers.iter().map(|_| None).collect();
+    for (p, s) in set.samples.iter().enumerate() {
+        let v = m.views.get(p)?;
+        let keys: Vec<Vec<u32>> = m.layers.iter().map(|il| key(s, il.depends_on)).collect();
+        for (li, k) in keys.iter().enumerate() {
+            if last[li].as_ref().is_none_or(|(held, _)| held != k) {
+                last[li] = Some((k.clone(), chains.chain(li, k)?));
+            }
+        }
+        let at: Vec<Option<&[f32]>> = last.iter().map(|l| l.as_ref().and_then(|(_, c)| c.as_deref())).collect();
+        let img = m.render_view(&v, p, &keys, &at);
+        for (k, g) in img.iter().enumerate() {
+            let gold = v.diffuse[k] + v.specular[k];
+            sse += (d(*g) - d(gold)).powi(2);
+        }
+        n += img.len();
+    }
+    Ok((sse, n))
+}
+
+/// The solved error of `m` ([`Packed::solved_error`]): from chains held for the object, or,
+/// for a pack that streams, built as the points read them.
+pub fn solved_error(set: &LoadedSet, m: &ObjectModel) -> Result<(f64, usize)> {
+    match set.scratch {
+        Some(_) => display_error(set, m, &SolvedChains(m)),
+        None => display_error(set, m, solved_chains(m)?.as_slice()),
+    }
+}
+
+/// Decoded linear textures (whole MIP chain, rebuilt by decimation as the player does), per
+/// object model and layer, keyed like [`super::model::InferredLayer::textures`].
+pub fn decoded_textures(models: &[ObjectModel], packed: &Packed) -> Result<Vec<Vec<LayerTextures>>> {
+    models.iter().enumerate().map(|(mi, m)| {
+        let mut per_layer = vec![BTreeMap::new(); m.layers.len()];
+        for_each_decoded(mi, m, packed, |li, k, x| {
+            per_layer[li].insert(k, x);
+            Ok(())
+        })?;
+        Ok(per_layer)
+    }).collect()
+}
+
+/// Calls `f(layer, key, chain)` with every decoded chain of object model `mi`, `m`, one
+/// block's level images decoded at a time.
+fn for_each_decoded(mi: usize, m: &ObjectModel, packed: &Packed, mut f: impl FnMut(usize, Vec<u32>, Vec<f32>) -> Result<()>) -> Result<()> {
+    for li in 0..m.layers.len() {
+        let layer = &packed.container.objects[mi].layers[li];
+        for (b, pb) in packed.blocks[mi][li].iter().enumerate() {
+            let block = &layer.blocks[b];
+            let layout = LevelLayout::of(layer, block);
+            let planes = layout.planes();
+            let decoded: Vec<Vec<Vec<f32>>> = pb.levels.iter().map(|(_, _, streams)| {
+                streams.iter().map(|s| pis_codec::decode(layer_codec(block), &planes, s)).collect::<Result<Vec<_>, _>>()
+            }).collect::<Result<_, _>>()?;
+            for (s, k) in pb.keys.iter().enumerate() {
+                let local = unflatten(s, &pb.extent);
+                let mut sum = vec![0.0f32; pis_codec::value_count(&planes)?];
+                for ((counts, _, _), imgs) in pb.levels.iter().zip(&decoded) {
+                    let img = &imgs[level_image_index(counts, &local, &pb.extent)];
+                    sum.iter_mut().zip(img).for_each(|(a, v)| *a += v);
+                }
+                let lin = finish(layer, &layout, sum);
+                f(li, k.clone(), m.layers[li].form.drawn(k, lin))?;
+            }
+        }
+    }
+    Ok(())
+}
+
+fn layer_codec(block: &Block) -> CodecId {
+    block.levels.first().and_then(|l| l.images.first()).map_or(CodecId::Raw, |c| c.codec)
+}
+
+/// PSNR in dB (peak 1) of a squared error sum over `n` values.
+pub fn psnr(sse: f64, n: usize) -> f64 {
+    10.0 * (1.0 / (sse / n.max(1) as f64).max(1e-20)).log10()
+}
+
+/// Predicted quality: per object (decoded, as solved) and overall, plus the largest
+/// difference between decoded and solved finest texels.
+#[derive(Clone)]
+pub struct Quality {
+    pub objects: Vec<(f64, f64)>,
+    pub overall: f64,
+    pub overall_solved: f64,
+    pub max_texel_error: f32,
+}
+
+/// Renders the decoded and the solved textures through the render matrices (the hardware
+/// model's or probe mode's). Object by object, each decoded chain is compared with the
+/// solved one, kept (held, or spilled when the pack streams), and drawn at every point.
+pub fn predicted_psnr(set: &LoadedSet, models: &[ObjectModel], packed: &Packed) -> Result<Quality> {
+    if let Some(q) = &packed.quality {
+        return Ok(q.clone());
+    }
+    let mut max_err = 0.0f32;
+    let mut e_dec = Vec::with_capacity(models.len());
+    for (mi, m) in models.iter().enumerate() {
+        let solved = SolvedChains(m);
+        let mut decoded: Vec<Textures> = m.layers.iter().map(|_| Textures::new(set.scratch.as_ref())).collect();
+        for_each_decoded(mi, m, packed, |li, k, y| {
+            if let Some(x) = solved.chain(li, &k)? {
+                let n = m.layers[li].form.stored_texels(&k) * m.layers[li].form.channels();
+                for (a, b) in x[..n].iter().zip(&y[..n]) {
+                    max_err = max_err.max((a - b).abs());
+                }
+            }
+            decoded[li].insert(k, y)
+        })?;
+        e_dec.push(display_error(set, m, decoded.as_slice())?);
+    }
+    let e_sol = &packed.solved_error;
+    let total = |e: &[(f64, usize)]| {
+        let (s, n) = e.iter().fold((0.0, 0), |a, x| (a.0 + x.0, a.1 + x.1));
+        psnr(s, n)
+    };
+    Ok(Quality {
+        objects: e_dec.iter().zip(e_sol).map(|(a, b)| (psnr(a.0, a.1), psnr(b.0, b.1))).collect(),
+        overall: total(&e_dec),
+        overall_solved: total(e_sol),
+        max_texel_error: max_err,
+    })
+}
