@@ -73,26 +73,50 @@ pub fn limit_stretch(mut r: DMat2, jacobians: &[DMat2], threshold: f64, axis_ali
 /// end: an exact test on sinusoids, so nothing that reaches the envelope is lost. Singular
 /// Jacobians, which no R makes stretched ([`max_stretch`] is `None`), are left out.
 pub fn envelope(jacobians: &[DMat2]) -> Vec<DMat2> {
+    const N: usize = ENVELOPE_ANGLES;
     let curves: Vec<Option<[f64; 3]>> = jacobians.iter().map(|&j| curve(j)).collect();
-    let angles: Vec<f64> = (0..=ENVELOPE_ANGLES).map(|k| std::f64::consts::TAU * k as f64 / ENVELOPE_ANGLES as f64).collect();
+    let angles: Vec<f64> = (0..=N).map(|k| std::f64::consts::TAU * k as f64 / N as f64).collect();
     let trig: Vec<(f64, f64)> = angles.iter().map(|t| (t.cos(), t.sin())).collect();
+    let values = |c: &[f64; 3]| -> [f64; N + 1] {
+        let mut v = [0.0; N + 1];
+        v.iter_mut().zip(&trig).for_each(|(v, (cos, sin))| *v = c[0] + c[1] * cos + c[2] * sin);
+        v
+    };
+    let amplitude = |c: &[f64; 3]| c[1].hypot(c[2]);
     // The maximizer at each sampled angle (the first, on a tie).
-    let mut best: Vec<Option<(f64, usize)>> = vec![None; ENVELOPE_ANGLES];
+    let mut best: Vec<Option<(f64, usize)>> = vec![None; N];
     for (i, c) in curves.iter().enumerate() {
         let Some(c) = c else { continue };
-        for (b, (cos, sin)) in best.iter_mut().zip(&trig) {
-            let v = c[0] + c[1] * cos + c[2] * sin;
+        for (b, v) in best.iter_mut().zip(values(c)) {
             if b.is_none_or(|(w, _)| v > w) {
                 *b = Some((v, i));
             }
         }
     }
+    let Some(best) = best.into_iter().collect::<Option<Vec<(f64, usize)>>>() else { return Vec::new() };
+    let of = |k: usize| curves[best[k % N].1].expect("a maximizer has a curve");
+    let at_best: Vec<[f64; N + 1]> = (0..N).map(|k| values(&of(k))).collect();
+    // Between two samples Δ apart a sinusoid of amplitude A rises at most A(1 − cos Δ/2) above
+    // its higher end, and falls at most AΔ below either end (it is A-Lipschitz), so the
+    // envelope is nowhere under `floor`.
+    let delta = angles[1];
+    let rise = 1.0 - (0.5 * delta).cos();
+    let floor = (0..N).map(|k| best[k].0 - amplitude(&of(k)) * delta).fold(f64::INFINITY, f64::min);
     let keep = |i: usize, c: &[f64; 3]| {
-        (0..ENVELOPE_ANGLES).any(|k| {
-            let ends = [best[k], best[(k + 1) % ENVELOPE_ANGLES]].map(|b| b.expect("a curve sets every maximizer").1);
-            ends.contains(&i) || ends.iter().all(|&e| {
-                let d = curves[e].expect("a maximizer has a curve");
-                !nowhere_above([c[0] - d[0], c[1] - d[1], c[2] - d[2]], angles[k], angles[k + 1])
+        if c[0] + amplitude(c) <= floor {
+            return false;
+        }
+        let fc = values(c);
+        (0..N).any(|k| {
+            let ends = [k, (k + 1) % N];
+            ends.iter().any(|&e| best[e].1 == i) || ends.iter().all(|&e| {
+                let (d, v) = (of(e), &at_best[e]);
+                let (g0, g1) = (fc[k] - v[k], fc[k + 1] - v[k + 1]);
+                // Under this end's maximizer on the interval: at once when even the largest
+                // rise keeps the difference under zero, else by the exact test.
+                let under = g0.max(g1) + rise * (amplitude(c) + amplitude(&d)) <= 0.0
+                    || nowhere_above([c[0] - d[0], c[1] - d[1], c[2] - d[2]], angles[k], angles[k + 1]);
+                !under
             })
         })
     };
@@ -100,7 +124,7 @@ pub fn envelope(jacobians: &[DMat2]) -> Vec<DMat2> {
 }
 
 /// The number of angles 2φ ∈ [0, 2π) at which [`envelope`] samples the upper envelope.
-pub const ENVELOPE_ANGLES: usize = 64;
+pub const ENVELOPE_ANGLES: usize = 16;
 
 /// (m, p, q) of f_Q(2φ) = m + p·cos 2φ + q·sin 2φ for Q = (J Jᵀ)⁻¹; `None` for a singular J.
 fn curve(j: DMat2) -> Option<[f64; 3]> {

@@ -24,6 +24,7 @@ use super::input::LoadedSet;
 use super::matrices::Matrices;
 use super::model::{key, InferredLayer, LayerForm, ObjectModel, PointView, Views};
 use super::represent::{Job, Planned, Representation, Surveyed};
+use super::textures::Textures;
 use super::{PackRequest, PlacementMode};
 use crate::solutions::Solver;
 use crate::infer::{atlas, gather, merged_mesh, place_in, restrict_rows, sampler, Atlas, Mesh, Placed};
@@ -187,7 +188,8 @@ fn solve_layer(set: &LoadedSet, views: &Views, placements: &[Placed], plan: &Lay
     for (p, s) in set.samples.iter().enumerate() {
         groups.entry(key(s, plan.depends_on)).or_default().push(p);
     }
-    let mut textures = BTreeMap::new();
+    // Spilled as solved when the pack streams: a layer's samples grow with the points.
+    let mut textures = Textures::new(set.scratch.as_ref());
     let mut placement_of = BTreeMap::new();
     let mut warm: BTreeMap<usize, Vec<f32>> = BTreeMap::new();
     let mut iterations = 0u64;
@@ -212,10 +214,10 @@ fn solve_layer(set: &LoadedSet, views: &Views, placements: &[Placed], plan: &Lay
         };
         warm.insert(pid, x.clone());
         placement_of.insert(k.clone(), pid);
-        textures.insert(k, x);
+        textures.insert(k, x)?;
     }
     let form = Box::new(TextureForm { placements: placements.to_vec(), block_placements: plan.block_placements.clone(), placement_of: placement_of.clone() });
-    Ok(InferredLayer { kind: plan.kind, depends_on: plan.depends_on, textures: textures.into(), block_placements: plan.block_placements.clone(), placement_of, iterations, form, shell: None })
+    Ok(InferredLayer { kind: plan.kind, depends_on: plan.depends_on, textures, block_placements: plan.block_placements.clone(), placement_of, iterations, form, shell: None })
 }
 
 /// A surface texture layer as stored: every block's texture placed as thesis 3.2 places it
