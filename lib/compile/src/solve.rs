@@ -191,7 +191,9 @@ fn solve_views(
         }
         check_finite("initial guess", x0)?;
     }
-    let a = if parts.len() == 1 { parts.pop().expect("one part") } else { Csr::stack(&parts)? };
+    // The views' parts are dropped once stacked: a view-independent solve stacks every view
+    // of its sample, and holds them once.
+    let a = if parts.len() == 1 { parts.pop().expect("one part") } else { Csr::stack(&std::mem::take(&mut parts))? };
     let n_s = a.rows;
     let form = match settings.form {
         FormChoice::Fixed(f) => f,

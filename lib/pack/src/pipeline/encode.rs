@@ -111,24 +111,22 @@ fn sample_weights(per_point: &[Vec<f64>]) -> Vec<f32> {
     sum.iter().map(|w| (w * scale) as f32).collect()
 }
 
-/// The screen weights of every sample of layer `li` of `m`, by key: [`sample_weights`] over
-/// the points of `samples` that read it, through the render matrices of its placement.
-fn layer_screen_weights(m: &ObjectModel, li: usize, samples: &[Vec<u32>]) -> Result<BTreeMap<Vec<u32>, Vec<f32>>> {
+/// The screen weights of sample `k` of layer `li` of `m`: [`sample_weights`] over the points
+/// of `samples` that read it, through the render matrices of its placement. Made as each
+/// block's pyramid is built, so that a pack holds the weights of one block at a time.
+fn sample_screen_weights(m: &ObjectModel, li: usize, k: &[u32], samples: &[Vec<u32>]) -> Result<Vec<f32>> {
     let il = &m.layers[li];
-    il.textures.keys().map(|k| {
-        let points: Vec<usize> = samples.iter().enumerate().filter(|(_, s)| key(s, il.depends_on) == *k).map(|(p, _)| p).collect();
-        let w = if points.is_empty() {
-            vec![0.0; il.form.stored_texels(k)]
-        } else if let (Some(s), false) = (il.shell, m.lens.is_empty()) {
-            super::hybrid::shell_weights(m, s, il.form.stored_texels(k), &points)
-        } else if let Some(s) = il.shell {
-            shell_weights(m, s, li, k, &points)
-        } else {
-            let pid = il.placement_of[k];
-            sample_weights(&points.iter().map(|&p| Ok(screen_weights_at(m.views.get(p)?.a(pid)))).collect::<Result<Vec<_>>>()?)
-        };
-        Ok((k.clone(), w))
-    }).collect()
+    let points: Vec<usize> = samples.iter().enumerate().filter(|(_, s)| key(s, il.depends_on) == k).map(|(p, _)| p).collect();
+    Ok(if points.is_empty() {
+        vec![0.0; il.form.stored_texels(k)]
+    } else if let (Some(s), false) = (il.shell, m.lens.is_empty()) {
+        super::hybrid::shell_weights(m, s, il.form.stored_texels(k), &points)
+    } else if let Some(s) = il.shell {
+        shell_weights(m, s, li, k, &points)
+    } else {
+        let pid = il.placement_of[k];
+        sample_weights(&points.iter().map(|&p| Ok(screen_weights_at(m.views.get(p)?.a(pid)))).collect::<Result<Vec<_>>>()?)
+    })
 }
 
 /// The screen weights of a shell sample: every level is stored, so each texel's column sums
@@ -178,17 +176,14 @@ pub fn encode_all(set: &LoadedSet, models: &[ObjectModel], req: &PackRequest, st
                 m.name, m.block_sizes, m.stagger,
             )));
         }
-        let mut weights_by_layer: Vec<BTreeMap<Vec<u32>, Vec<f32>>> = if req.allocation == super::Allocation::Screen {
-            (0..m.layers.len()).map(|li| layer_screen_weights(m, li, &set.samples)).collect::<Result<_>>().map_err(runtime)?
-        } else {
-            m.layers.iter().map(|_| BTreeMap::new()).collect()
-        };
+        // The weights go to the pyramids; the master (`--keep-master`) keeps a copy.
+        let screen = req.allocation == super::Allocation::Screen;
+        let mut weights_by_layer: Vec<BTreeMap<Vec<u32>, Vec<f32>>> = m.layers.iter().map(|_| BTreeMap::new()).collect();
         let mut layers = Vec::new();
         let mut layer_blocks = Vec::new();
         for (li, il) in m.layers.iter().enumerate() {
-            // The weights go to the pyramids; the master (`--keep-master`) keeps a copy.
-            let layer_weights = &mut weights_by_layer[li];
-            let weighed = !layer_weights.is_empty() && req.codec.is_lossy();
+            let master_weights = &mut weights_by_layer[li];
+            let weighed = screen && !il.textures.is_empty() && req.codec.is_lossy();
             let mut layer = il.form.layer(il.kind, li as u8, il.depends_on, req.gamma);
             let grid = BlockGrid::new(&space, il.depends_on, &st);
             let layer_samples = il.textures.len().max(1) as f64;
@@ -215,7 +210,11 @@ pub fn encode_all(set: &LoadedSet, models: &[ObjectModel], req: &PackRequest, st
                     let idx = pos.local.iter().zip(&pos.extent).fold(0usize, |a, (&l, &e)| a * e as usize + l as usize);
                     keys[idx] = k.clone();
                     samples[idx] = prepare(&layer, &layout, &il.form.stored(k, &x));
-                    if let Some(w) = if req.keep_master { layer_weights.get(k).cloned() } else { layer_weights.remove(k) } {
+                    if screen {
+                        let w = sample_screen_weights(m, li, k, &set.samples).map_err(runtime)?;
+                        if req.keep_master {
+                            master_weights.insert(k.clone(), w.clone());
+                        }
                         weights[idx] = w;
                     }
                 }

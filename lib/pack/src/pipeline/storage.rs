@@ -46,7 +46,8 @@ pub struct BlockPyramid {
     /// Screen weight of every texel of every finest sample (row-major over `extent`; one
     /// value per texel, mean 1 where the sample shows): how much of the screen each texel's
     /// error reaches. With them the allocation weighs texture error as screen error; None:
-    /// every texel weighs the same.
+    /// every texel weighs the same. A block that is spilled drops them once its curves are
+    /// measured.
     pub texel_weights: Option<Vec<Vec<f32>>>,
     /// Where a pack that streams keeps the level images ([`BlockPyramid::spill`]): each is
     /// then an empty vector in `levels` (the counts stay), and `rd` holds their
@@ -102,6 +103,8 @@ impl BlockPyramid {
             let c = pis_codec::codec(codec).ok_or_else(|| anyhow!("codec {codec} is not in this build"))?;
             self.rd = Some(self.items(c)?);
         }
+        // The screen weights served the curves only.
+        self.texel_weights = None;
         let mut w = Writer::default();
         for l in &mut self.levels {
             for img in &mut l.1 {
