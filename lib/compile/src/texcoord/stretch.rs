@@ -69,8 +69,9 @@ pub fn limit_stretch(mut r: DMat2, jacobians: &[DMat2], threshold: f64, axis_ali
 /// one that maximizes f_Q(φ) for some φ: the upper envelope of the curves
 /// f_Q = m + p·cos 2φ + q·sin 2φ (m = (Q₁₁ + Q₂₂)/2, p = (Q₁₁ − Q₂₂)/2, q = Q₁₂), the same for
 /// every R. The envelope is sampled at [`ENVELOPE_ANGLES`] angles; a Jacobian is left out
-/// only when, on each interval between two of them, it is nowhere above the maximizer at one
-/// end: an exact test on sinusoids, so nothing that reaches the envelope is lost. Singular
+/// only when its curve's maximum is under the envelope's lowest possible value, or when, on
+/// each interval between two angles, it is nowhere above the maximizer at one end: exact
+/// bounds on sinusoids, so nothing that reaches the envelope is lost. Singular
 /// Jacobians, which no R makes stretched ([`max_stretch`] is `None`), are left out.
 pub fn envelope(jacobians: &[DMat2]) -> Vec<DMat2> {
     const N: usize = ENVELOPE_ANGLES;
