@@ -111,18 +111,17 @@ fn sample_weights(per_point: &[Vec<f64>]) -> Vec<f32> {
     sum.iter().map(|w| (w * scale) as f32).collect()
 }
 
-/// The screen weights of sample `k` of layer `li` of `m`: [`sample_weights`] over the points
-/// of `samples` that read it, through the render matrices of its placement. Made as each
+/// The screen weights of sample `k` of layer `li` of `m`: [`sample_weights`] over `points`,
+/// the points that read it, through the render matrices of its placement. Made as each
 /// block's pyramid is built, so that a pack holds the weights of one block at a time.
-fn sample_screen_weights(m: &ObjectModel, li: usize, k: &[u32], samples: &[Vec<u32>]) -> Result<Vec<f32>> {
+fn sample_screen_weights(m: &ObjectModel, li: usize, k: &[u32], points: &[usize]) -> Result<Vec<f32>> {
     let il = &m.layers[li];
-    let points: Vec<usize> = samples.iter().enumerate().filter(|(_, s)| key(s, il.depends_on) == k).map(|(p, _)| p).collect();
     Ok(if points.is_empty() {
         vec![0.0; il.form.stored_texels(k)]
     } else if let (Some(s), false) = (il.shell, m.lens.is_empty()) {
-        super::hybrid::shell_weights(m, s, il.form.stored_texels(k), &points)
+        super::hybrid::shell_weights(m, s, il.form.stored_texels(k), points)
     } else if let Some(s) = il.shell {
-        shell_weights(m, s, li, k, &points)
+        shell_weights(m, s, li, k, points)
     } else {
         let pid = il.placement_of[k];
         sample_weights(&points.iter().map(|&p| Ok(screen_weights_at(m.views.get(p)?.a(pid)))).collect::<Result<Vec<_>>>()?)
@@ -178,12 +177,19 @@ pub fn encode_all(set: &LoadedSet, models: &[ObjectModel], req: &PackRequest, st
         }
         // The weights go to the pyramids; the master (`--keep-master`) keeps a copy.
         let screen = req.allocation == super::Allocation::Screen;
-        let mut weights_by_layer: Vec<BTreeMap<Vec<u32>, Vec<f32>>> = m.layers.iter().map(|_| BTreeMap::new()).collect();
+        let mut master_by_layer: Vec<BTreeMap<Vec<u32>, Vec<f32>>> = m.layers.iter().map(|_| BTreeMap::new()).collect();
         let mut layers = Vec::new();
         let mut layer_blocks = Vec::new();
         for (li, il) in m.layers.iter().enumerate() {
-            let master_weights = &mut weights_by_layer[li];
+            let master_weights = &mut master_by_layer[li];
             let weighed = screen && !il.textures.is_empty() && req.codec.is_lossy();
+            // The points that read each sample of the layer.
+            let mut points_of: BTreeMap<Vec<u32>, Vec<usize>> = BTreeMap::new();
+            if screen {
+                for (p, s) in set.samples.iter().enumerate() {
+                    points_of.entry(key(s, il.depends_on)).or_default().push(p);
+                }
+            }
             let mut layer = il.form.layer(il.kind, li as u8, il.depends_on, req.gamma);
             let grid = BlockGrid::new(&space, il.depends_on, &st);
             let layer_samples = il.textures.len().max(1) as f64;
@@ -211,7 +217,8 @@ pub fn encode_all(set: &LoadedSet, models: &[ObjectModel], req: &PackRequest, st
                     keys[idx] = k.clone();
                     samples[idx] = prepare(&layer, &layout, &il.form.stored(k, &x));
                     if screen {
-                        let w = sample_screen_weights(m, li, k, &set.samples).map_err(runtime)?;
+                        let points = points_of.get(k).map_or(&[][..], Vec::as_slice);
+                        let w = sample_screen_weights(m, li, k, points).map_err(runtime)?;
                         if req.keep_master {
                             master_weights.insert(k.clone(), w.clone());
                         }
@@ -250,7 +257,7 @@ pub fn encode_all(set: &LoadedSet, models: &[ObjectModel], req: &PackRequest, st
             layers,
         });
         blocks_out.push(layer_blocks);
-        screen_weights.push(weights_by_layer);
+        screen_weights.push(master_by_layer);
         staggers.push(st);
     }
     let level_images: usize = pyramids.iter().flat_map(|p| &p.levels).map(|l| l.1.len()).sum();

@@ -18,7 +18,7 @@ use pis_format::{Block, LevelLayout};
 
 use super::encode::{LayerTextures, Packed};
 use super::input::LoadedSet;
-use super::model::{key, ObjectModel};
+use super::model::{key, InferredLayer, ObjectModel};
 use super::textures::Textures;
 
 /// Where [`display_error`] reads an object's texture chains, one sample at a time.
@@ -49,15 +49,20 @@ impl Chains for SolvedChains<'_> {
         if !l.textures.contains_key(k) {
             return Ok(None);
         }
-        let x = l.textures.get(k)?;
-        Ok(Some(Cow::Owned(l.form.drawn(k, l.form.stored(k, &x)))))
+        Ok(Some(Cow::Owned(solved_chain(l, k, &l.textures.get(k)?))))
     }
+}
+
+/// The MIP chain the player rebuilds from the finest level of `l`'s solved texture `x` of
+/// sample `k`.
+fn solved_chain(l: &InferredLayer, k: &[u32], x: &[f32]) -> Vec<f32> {
+    l.form.drawn(k, l.form.stored(k, x))
 }
 
 /// The solved textures of `m` per layer, each as the MIP chain the player rebuilds from its
 /// finest level.
 pub fn solved_chains(m: &ObjectModel) -> Result<Vec<LayerTextures>> {
-    m.layers.iter().map(|l| l.textures.iter().map(|r| r.map(|(k, x)| (k.clone(), l.form.drawn(k, l.form.stored(k, &x))))).collect()).collect()
+    m.layers.iter().map(|l| l.textures.iter().map(|r| r.map(|(k, x)| (k.clone(), solved_chain(l, k, &x)))).collect()).collect()
 }
 
 /// The squared display error of object `m` drawn with `chains` through A at every point,
