@@ -22,6 +22,9 @@ pub enum CompileError {
     /// A setting is out of range.
     #[error("invalid setting: {0}")]
     Setting(String),
+    /// A view could not be read from where a [`crate::ViewSource`] keeps it.
+    #[error("reading a view: {0}")]
+    Source(String),
     /// Geometry that texture-coordinate optimization cannot work with.
     #[error("object {object}: {message}")]
     Geometry { object: String, message: String },

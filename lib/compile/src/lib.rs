@@ -13,7 +13,8 @@
 //! (s, t) and fine derivatives), [`lod`] (the Vulkan LOD), [`filter`] (sampler weights),
 //! [`model`] (the render matrix), [`mod@antialias`] (thesis 3.4.4).
 //!
-//! The solver (thesis 3.5): [`solve()`] (one view), [`solve_view_independent`] (eq. 3.7),
+//! The solver (thesis 3.5): [`solve()`] (one view), [`solve_view_independent`] (eq. 3.7;
+//! [`solve_view_source`] with the views read one at a time, [`stacked`]),
 //! settings in [`SolveSettings`]; [`cg`] (conjugate gradient with exact line search),
 //! [`normal_equations`] (the A and AᵀA forms), [`regularize`] (eqs. 3.8 and 3.9),
 //! [`sparse`] (deterministic parallel sparse products), [`decimation`] (the player's MIP
@@ -42,6 +43,7 @@ pub mod sampler;
 pub mod shell;
 pub mod solve;
 pub mod sparse;
+pub mod stacked;
 pub mod synthetic;
 pub mod texcoord;
 pub mod transform;
@@ -54,7 +56,8 @@ pub use model::{render_matrix, scene_depth, ModelError, TexturedObject};
 pub use normal_equations::Form;
 pub use raster::DepthBuffer;
 pub use sampler::{Address, Filter, Sampler, MAX_ANISOTROPY};
-pub use solve::{render, solve, solve_view_independent, FormChoice, MipSolve, Solution, SolveSettings, View};
+pub use solve::{render, solve, solve_view_independent, solve_view_source, FormChoice, MipSolve, Solution, SolveSettings, View};
+pub use stacked::ViewSource;
 pub use transform::{DrawMesh, TextureTransform, Viewport};
 
 #[cfg(test)]

@@ -32,6 +32,9 @@ impl Form {
 pub enum DataOperator {
     A { a: Csr, at: Csr },
     Normal { h: Csr, at: Csr },
+    /// AᵀA alone, assembled view by view with its right-hand sides
+    /// ([`crate::stacked`]): A itself is never held.
+    Gram { h: Csr },
 }
 
 impl DataOperator {
@@ -57,6 +60,7 @@ impl DataOperator {
                 at.mul(&b, &mut atb);
                 ChannelRhs { b: vec![], atb, bb }
             }
+            DataOperator::Gram { .. } => unreachable!("a Gram operator's right-hand sides are assembled with it"),
         }
     }
 
@@ -64,6 +68,7 @@ impl DataOperator {
     pub fn cols(&self) -> usize {
         match self {
             DataOperator::A { at, .. } | DataOperator::Normal { at, .. } => at.rows,
+            DataOperator::Gram { h } => h.rows,
         }
     }
 }
@@ -133,7 +138,7 @@ impl ChannelProblem<'_> {
                 a.mul(p, &mut t);
                 at.mul(&t, out);
             }
-            DataOperator::Normal { h, .. } => h.mul(p, out),
+            DataOperator::Normal { h, .. } | DataOperator::Gram { h } => h.mul(p, out),
         }
         if let Some(pt) = self.pyramid {
             let mut t = vec![0.0; pt.p.rows];
@@ -155,7 +160,7 @@ impl ChannelProblem<'_> {
                 grad.iter_mut().for_each(|g| *g *= 2.0);
                 dot(&r, &r)
             }
-            DataOperator::Normal { h, .. } => {
+            DataOperator::Normal { h, .. } | DataOperator::Gram { h } => {
                 h.mul(x, grad);
                 let f = dot(x, grad) - 2.0 * dot(x, &self.rhs.atb) + self.rhs.bb;
                 grad.iter_mut().zip(&self.rhs.atb).for_each(|(g, c)| *g = 2.0 * (*g - c));

@@ -12,9 +12,10 @@ use crate::bounded::minimize_bounded;
 use crate::cg::{self, CgReport, CgSettings};
 use crate::decimation::{chain_f32, Decimation};
 use crate::error::check_finite;
-use crate::normal_equations::{ChannelProblem, DataOperator, Form, PyramidTerm, DEFAULT_K};
+use crate::normal_equations::{ChannelProblem, ChannelRhs, DataOperator, Form, PyramidTerm, DEFAULT_K};
 use crate::regularize::{barrier_d2, pyramid_operator, RangeRegularization};
 use crate::sparse::Csr;
+use crate::stacked::{assemble, residual2 as residual2_of, ViewSource};
 use crate::{CompileError, RenderMatrix, TextureLayout};
 
 /// Colour channels per texel and per pixel (RGB, interleaved).
@@ -153,10 +154,77 @@ pub fn solve_view_independent(
     initial: Option<&[f32]>,
     settings: &SolveSettings,
 ) -> Result<Solution, CompileError> {
-    solve_views(views, initial, settings, true)
+    solve_view_source(views, initial, settings)
 }
 
-fn solve_views(
+/// [`solve_view_independent`] with the views served one at a time by `source`: in the AᵀA
+/// form (the rule's choice for stacked views) the data term is assembled view by view and
+/// the solve holds one view's render matrix at a time, with the same result bit for bit
+/// ([`crate::stacked`]). The A form multiplies by the stacked A, so it holds every view.
+pub fn solve_view_source<S: ViewSource + ?Sized>(
+    source: &S,
+    initial: Option<&[f32]>,
+    settings: &SolveSettings,
+) -> Result<Solution, CompileError> {
+    let start = Instant::now();
+    check_settings(settings)?;
+    if settings.form == FormChoice::Fixed(Form::A) {
+        let mut held = Vec::with_capacity(source.count());
+        for k in 0..source.count() {
+            source.visit(k, &mut |v| {
+                held.push((v.a.clone(), v.b.to_vec()));
+                Ok(())
+            })?;
+        }
+        let views: Vec<View> = held.iter().map(|(a, b)| View { a, b }).collect();
+        return solve_views(&views, initial, settings, true);
+    }
+    let (layout, t) = assemble(source)?;
+    check_layout(layout, settings, initial)?;
+    let data = DataTerm {
+        layout,
+        op: DataOperator::Gram { h: t.h },
+        form: Form::Normal,
+        col_norms: t.col_norms,
+        n_s: t.n_s,
+        b_max: t.b_max as f64,
+        rhs: t.atb.into_iter().zip(t.bb).map(|(atb, bb)| ChannelRhs { b: vec![], atb, bb }).collect(),
+        b: None,
+    };
+    finish(data, initial, settings, start, Some(&|xs: &[Vec<f64>]| residual2_of(source, layout, xs)))
+}
+
+/// A solve's data term: the operator, its right-hand side per channel, and what the
+/// preconditioner and the regularization read of it.
+struct DataTerm {
+    layout: TextureLayout,
+    op: DataOperator,
+    form: Form,
+    col_norms: Vec<f64>,
+    n_s: usize,
+    b_max: f64,
+    rhs: Vec<ChannelRhs>,
+    /// Per channel, the pixels, for the residual; `None`: the residual reads the views again.
+    b: Option<Vec<Vec<f64>>>,
+}
+
+/// The settings the layout allows, and the warm start's size and values.
+fn check_layout(layout: TextureLayout, settings: &SolveSettings, initial: Option<&[f32]>) -> Result<(), CompileError> {
+    if settings.mip == MipSolve::Decimated && layout.faces > 1 {
+        return Err(CompileError::Setting("a cube map's levels are solved together (mip solve `free`), not decimated".into()));
+    }
+    if let Some(x0) = initial {
+        let n_t = layout.texel_count();
+        if x0.len() != n_t * CHANNELS {
+            return Err(CompileError::Size {
+                what: "initial guess (texels × 3)".into(), expected: n_t * CHANNELS, found: x0.len() });
+        }
+        check_finite("initial guess", x0)?;
+    }
+    Ok(())
+}
+
+pub(crate) fn solve_views(
     views: &[View<'_>],
     initial: Option<&[f32]>,
     settings: &SolveSettings,
@@ -166,9 +234,7 @@ fn solve_views(
     let first = views.first().ok_or_else(|| CompileError::Setting("no views to solve".into()))?;
     let layout = first.a.layout;
     check_settings(settings)?;
-    if settings.mip == MipSolve::Decimated && layout.faces > 1 {
-        return Err(CompileError::Setting("a cube map's levels are solved together (mip solve `free`), not decimated".into()));
-    }
+    check_layout(layout, settings, initial)?;
     let mut parts = Vec::with_capacity(views.len());
     for (k, v) in views.iter().enumerate() {
         if v.a.layout != layout {
@@ -184,15 +250,7 @@ fn solve_views(
         parts.push(Csr::from_render_matrix(v.a)?);
     }
     let n_t = layout.texel_count();
-    if let Some(x0) = initial {
-        if x0.len() != n_t * CHANNELS {
-            return Err(CompileError::Size {
-                what: "initial guess (texels × 3)".into(), expected: n_t * CHANNELS, found: x0.len() });
-        }
-        check_finite("initial guess", x0)?;
-    }
-    // The views' parts are dropped once stacked: a view-independent solve stacks every view
-    // of its sample, and holds them once.
+    // The views' parts are dropped once stacked.
     let a = if parts.len() == 1 { parts.pop().expect("one part") } else { Csr::stack(&std::mem::take(&mut parts))? };
     let n_s = a.rows;
     let form = match settings.form {
@@ -202,6 +260,26 @@ fn solve_views(
     };
     let col_norms = a.column_norms_squared();
     let op = DataOperator::new(a, form);
+    let b_max = views.iter().flat_map(|v| v.b.iter()).fold(0.0f32, |m, &v| m.max(v)) as f64;
+    let b: Vec<Vec<f64>> = (0..CHANNELS)
+        .map(|ch| views.iter().flat_map(|v| v.b.iter().skip(ch).step_by(CHANNELS)).map(|&v| v as f64).collect())
+        .collect();
+    let rhs = b.iter().map(|b| op.rhs(b.clone())).collect();
+    let data = DataTerm { layout, op, form, col_norms, n_s, b_max, rhs, b: Some(b) };
+    finish(data, initial, settings, start, None)
+}
+
+/// Solves the three channels of `data`; the residual from the held pixels, or by
+/// `residual` (per channel, from the channels' texels) where the pixels are not held.
+fn finish(
+    data: DataTerm,
+    initial: Option<&[f32]>,
+    settings: &SolveSettings,
+    start: Instant,
+    residual: Option<&dyn Fn(&[Vec<f64>]) -> Result<Vec<f64>, CompileError>>,
+) -> Result<Solution, CompileError> {
+    let DataTerm { layout, op, form, col_norms, n_s, b_max, rhs, b } = data;
+    let n_t = layout.texel_count();
     let chain = (settings.mip == MipSolve::Decimated).then(|| Decimation::new(layout));
     // Unknowns per channel: the whole chain, or level 0.
     let n_x = chain.as_ref().map_or(n_t, Decimation::base_len);
@@ -211,8 +289,6 @@ fn solve_views(
         let pt = p.transpose();
         PyramidTerm { lambda: settings.epsilon_f * ratio, p, pt }
     });
-    let b_all: Vec<f32> = views.iter().flat_map(|v| v.b.iter().copied()).collect();
-    let b_max = b_all.iter().fold(0.0f32, |m, &v| m.max(v)) as f64;
     let range = (settings.epsilon_b > 0.0).then(|| {
         RangeRegularization::new(settings.epsilon_b, n_s, n_x,
                                  (settings.range_factor * b_max).max(1e-6))
@@ -247,11 +323,10 @@ fn solve_views(
     let mut bb_total = 0.0;
     // The channels are independent problems sharing A: solved concurrently (each result
     // depends only on its own inputs, so the outcome does not depend on scheduling).
-    let results: Vec<(CgReport, Vec<f64>, f64, f64)> = (0..CHANNELS)
+    let results: Vec<(CgReport, Vec<f64>, Option<f64>, f64)> = (0..CHANNELS)
         .into_par_iter()
         .map(|ch| {
-            let b: Vec<f64> = b_all.iter().skip(ch).step_by(CHANNELS).map(|&v| v as f64).collect();
-            let rhs = op.rhs(b.clone());
+            let rhs = &rhs[ch];
             let mut x: Vec<f64> = match initial {
                 Some(x0) => x0.iter().skip(ch).step_by(CHANNELS).take(n_x).map(|&v| v as f64).collect(),
                 None => vec![0.0; n_x],
@@ -259,7 +334,7 @@ fn solve_views(
             if let Some(r) = &range {
                 r.clamp_inside(&mut x);
             }
-            let problem = ChannelProblem { op: &op, rhs: &rhs, pyramid: pyramid.as_ref(), chain: chain.as_ref() };
+            let problem = ChannelProblem { op: &op, rhs, pyramid: pyramid.as_ref(), chain: chain.as_ref() };
             let report = if settings.bounded {
                 let hi = (settings.range_factor * b_max).max(1e-6);
                 minimize_bounded(&problem, 0.0, hi, &inv_diag, &mut x, &settings.cg)
@@ -271,11 +346,19 @@ fn solve_views(
                 d.expand(&x, &mut full);
                 x = full;
             }
-            let r2 = data_residual2(&op, &x, &b);
+            let r2 = b.as_ref().map(|b| data_residual2(&op, &x, &b[ch]));
             (report, x, r2, rhs.bb)
         })
         .collect();
-    for (ch, (report, x, r2, bb)) in results.into_iter().enumerate() {
+    drop(op);
+    let r2: Vec<f64> = match residual {
+        Some(f) if b.is_none() => {
+            let xs: Vec<Vec<f64>> = results.iter().map(|r| r.1.clone()).collect();
+            f(&xs)?
+        }
+        _ => results.iter().map(|r| r.2.unwrap_or(0.0)).collect(),
+    };
+    for (ch, ((report, x, _, bb), r2)) in results.into_iter().zip(r2).enumerate() {
         residual2 += r2;
         bb_total += bb;
         for (t, &v) in x.iter().enumerate() {
@@ -308,6 +391,7 @@ fn solve_views(
 fn data_residual2(op: &DataOperator, x: &[f64], b: &[f64]) -> f64 {
     let at = match op {
         DataOperator::A { at, .. } | DataOperator::Normal { at, .. } => at,
+        DataOperator::Gram { .. } => unreachable!("a Gram operator's residual reads the views again"),
     };
     // Ax through the transpose's columns: (Ax)_r = Σ_c A_rc x_c, gathered row by row.
     let mut ax = vec![0.0; b.len()];

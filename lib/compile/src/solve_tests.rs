@@ -195,6 +195,53 @@ fn a_view_independent_texture_is_solved_over_stacked_views() {
     assert!(psnr(&sol.texels[..n0], &x[..n0]) > 50.0);
 }
 
+/// Serves views one at a time, as a scratch file would, counting what it serves.
+struct OneAtATime<'a> {
+    views: &'a [View<'a>],
+    served: std::cell::Cell<usize>,
+}
+
+impl crate::ViewSource for OneAtATime<'_> {
+    fn count(&self) -> usize {
+        self.views.len()
+    }
+
+    fn visit(&self, k: usize, f: &mut dyn FnMut(View<'_>) -> Result<(), CompileError>) -> Result<(), CompileError> {
+        self.served.set(self.served.get() + 1);
+        // A copy that lives only for the call.
+        let (a, b) = (self.views[k].a.clone(), self.views[k].b.to_vec());
+        f(View { a: &a, b: &b })
+    }
+}
+
+#[test]
+fn views_served_one_at_a_time_give_the_stacked_solve_bit_for_bit() {
+    let layout = TextureLayout::full(16, 16);
+    let x = texture(&layout);
+    let mats: Vec<RenderMatrix> = (0..4)
+        .map(|k| {
+            let (u0, v0) = (0.1 * k as f64, 0.05 * k as f64);
+            warp_matrix(28 + 3 * k, 30, layout, Filter::Trilinear, move |x, y| Some((u0 + x / 70.0, v0 + (y / 40.0).powf(1.1))))
+        })
+        .collect();
+    let bs: Vec<Vec<f32>> = mats.iter().enumerate().map(|(k, a)| render(a, &x).iter().map(|v| v * (1.0 + 0.01 * k as f32)).collect()).collect();
+    let views: Vec<View> = mats.iter().zip(&bs).map(|(a, b)| View { a, b }).collect();
+    for settings in [SolveSettings::pyramidal(), SolveSettings::range(), SolveSettings::decimated()] {
+        // The stacked matrix held, in the AᵀA form.
+        let held = crate::solve::solve_views(&views, Some(&x), &settings, true).unwrap();
+        let source = OneAtATime { views: &views, served: std::cell::Cell::new(0) };
+        let streamed = crate::solve_view_source(&source, Some(&x), &settings).unwrap();
+        assert_eq!(streamed.form, Form::Normal);
+        assert_eq!(streamed.texels, held.texels);
+        assert_eq!(streamed.iterations, held.iterations);
+        assert_eq!((streamed.n_s, streamed.undefined), (held.n_s, held.undefined));
+        assert_eq!(streamed.residual_rms.to_bits(), held.residual_rms.to_bits());
+        assert_eq!(streamed.residual_relative.to_bits(), held.residual_relative.to_bits());
+        // The data term, then the residual.
+        assert_eq!(source.served.get(), 2 * views.len());
+    }
+}
+
 #[test]
 fn solving_twice_gives_identical_bytes() {
     let (a, b) = view(Filter::Trilinear, 0.3);

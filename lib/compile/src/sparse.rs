@@ -111,16 +111,36 @@ impl Csr {
     /// MᵀM, assembled sparse (thesis eq. 3.5). `mt` must be `self.transpose()`. Row i is
     /// accumulated by one thread, visiting M's rows in order, so the sums are deterministic.
     pub fn gram(&self, mt: &Csr) -> Csr {
-        let n = self.cols;
+        Csr::zeros(self.cols).add_gram(self, mt)
+    }
+
+    /// The `n × n` matrix with no entries.
+    pub fn zeros(n: usize) -> Csr {
+        Csr { rows: n, cols: n, row_start: vec![0; n + 1], col: vec![], val: vec![] }
+    }
+
+    /// `self + MᵀM` (`self` square, as many columns as M; `mt` must be `M.transpose()`).
+    /// Each entry continues its running sum over M's rows in order: the Gram matrices of
+    /// matrices added one after the other are the Gram matrix of the matrices stacked, bit
+    /// for bit (thesis eq. 3.7 assembled view by view).
+    pub fn add_gram(&self, m: &Csr, mt: &Csr) -> Csr {
+        let n = self.rows;
+        debug_assert!(self.cols == n && m.cols == n && mt.rows == n);
         let rows: Vec<(Vec<u32>, Vec<f64>)> = (0..n)
             .into_par_iter()
             .with_min_len(64)
             .map_init(
                 || (vec![0.0f64; n], vec![false; n], Vec::<u32>::new()),
                 |(acc, seen, touched), i| {
+                    let (cs, vs) = self.row(i);
+                    for (&j, &v) in cs.iter().zip(vs) {
+                        seen[j as usize] = true;
+                        touched.push(j);
+                        acc[j as usize] = v;
+                    }
                     let (rs, ws) = mt.row(i);
                     for (&r, &wi) in rs.iter().zip(ws) {
-                        let (cs, vs) = self.row(r as usize);
+                        let (cs, vs) = m.row(r as usize);
                         for (&j, &wj) in cs.iter().zip(vs) {
                             let j = j as usize;
                             if !seen[j] {
@@ -142,7 +162,8 @@ impl Csr {
                 },
             )
             .collect();
-        let mut out = Csr { rows: n, cols: n, row_start: vec![0], col: vec![], val: vec![] };
+        let mut out = Csr { rows: n, cols: n, row_start: Vec::with_capacity(n + 1), col: vec![], val: vec![] };
+        out.row_start.push(0);
         for (c, v) in rows {
             out.col.extend(c);
             out.val.extend(v);
@@ -189,5 +210,38 @@ mod tests {
         }
         assert_eq!(dense, [[1.0, 2.0, 0.0], [2.0, 13.0, 12.0], [0.0, 12.0, 16.0]]);
         assert_eq!(m.column_norms_squared(), vec![1.0, 13.0, 16.0]);
+    }
+
+    /// A pseudo-random sparse matrix (about a third of the entries set).
+    fn random(rows: usize, cols: usize, seed: u64) -> Csr {
+        let mut s = seed;
+        let mut next = || {
+            s = s.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            (s >> 33) as f64 / (1u64 << 31) as f64
+        };
+        let mut m = Csr { rows, cols, row_start: vec![0], col: vec![], val: vec![] };
+        for _ in 0..rows {
+            for c in 0..cols {
+                if next() < 0.35 {
+                    m.col.push(c as u32);
+                    m.val.push(next() * 2.0 - 0.7);
+                }
+            }
+            m.row_start.push(m.col.len());
+        }
+        m
+    }
+
+    #[test]
+    fn gram_matrices_added_view_by_view_are_the_stacked_gram_bit_for_bit() {
+        let parts: Vec<Csr> = (0..5).map(|k| random(40 + 7 * k, 30, k as u64 + 1)).collect();
+        let stacked = Csr::stack(&parts).unwrap();
+        let whole = stacked.gram(&stacked.transpose());
+        let mut sum = Csr::zeros(30);
+        for p in &parts {
+            sum = sum.add_gram(p, &p.transpose());
+        }
+        assert!(whole.nnz() > 0);
+        assert_eq!(sum, whole);
     }
 }

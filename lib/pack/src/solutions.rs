@@ -19,8 +19,8 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::{Arc, Mutex};
 
 use anyhow::{anyhow, bail, Context, Result};
-use pis_compile::solve::{solve, solve_view_independent, Solution, SolveSettings, View};
-use pis_compile::{CompileError, Form, RenderMatrix, TextureLayout};
+use pis_compile::solve::{solve, solve_view_source, Solution, SolveSettings, View};
+use pis_compile::{CompileError, Form, RenderMatrix, TextureLayout, ViewSource};
 
 const MAGIC: &[u8; 8] = b"PISSOLVD";
 const VERSION: u32 = 1;
@@ -98,13 +98,16 @@ fn matrix_words(h: &mut Hasher, a: &RenderMatrix) {
 
 /// The digest of a solve: `stacked` (view-independent) or one view, its views, start and
 /// settings.
-fn digest(stacked: bool, views: &[View<'_>], initial: Option<&[f32]>, settings: &SolveSettings) -> Digest {
+fn digest<S: ViewSource + ?Sized>(stacked: bool, views: &S, initial: Option<&[f32]>, settings: &SolveSettings) -> Result<Digest, CompileError> {
     let mut h = Hasher::new();
     h.word(stacked as u64);
-    h.word(views.len() as u64);
-    for v in views {
-        matrix_words(&mut h, v.a);
-        h.f32s(v.b);
+    h.word(views.count() as u64);
+    for k in 0..views.count() {
+        views.visit(k, &mut |v| {
+            matrix_words(&mut h, v.a);
+            h.f32s(v.b);
+            Ok(())
+        })?;
     }
     match initial {
         Some(x) => {
@@ -115,7 +118,7 @@ fn digest(stacked: bool, views: &[View<'_>], initial: Option<&[f32]>, settings: 
     }
     // Every setting, by its exact printed form (floats print so as to read back exactly).
     h.bytes(format!("{settings:?}").as_bytes());
-    h.finish()
+    Ok(h.finish())
 }
 
 /// A store of solutions, by digest, and what it was asked.
@@ -148,8 +151,8 @@ impl Solutions {
         self.len() == 0
     }
 
-    fn through(&self, stacked: bool, views: &[View<'_>], initial: Option<&[f32]>, settings: &SolveSettings) -> Result<Solution, CompileError> {
-        let d = digest(stacked, views, initial, settings);
+    fn through<S: ViewSource + ?Sized>(&self, stacked: bool, views: &S, initial: Option<&[f32]>, settings: &SolveSettings) -> Result<Solution, CompileError> {
+        let d = digest(stacked, views, initial, settings)?;
         // A solution read is taken out: each is read once, and the store does not double
         // the textures the pack holds.
         let found = {
@@ -160,7 +163,16 @@ impl Solutions {
             self.read.fetch_add(1, Ordering::Relaxed);
             return Ok(s);
         }
-        let s = if stacked { solve_view_independent(views, initial, settings)? } else { solve(views[0].a, views[0].b, initial, settings)? };
+        let s = if stacked {
+            solve_view_source(views, initial, settings)?
+        } else {
+            let mut one = None;
+            views.visit(0, &mut |v| {
+                one = Some(solve(v.a, v.b, initial, settings));
+                Ok(())
+            })?;
+            one.ok_or_else(|| CompileError::Source("view 0 was not served".into()))??
+        };
         self.solved.fetch_add(1, Ordering::Relaxed);
         if self.record {
             // What a reader gets back: the solution without its per-channel history and timing.
@@ -313,14 +325,20 @@ impl Solver {
     pub fn solve(&self, a: &RenderMatrix, b: &[f32], initial: Option<&[f32]>, settings: &SolveSettings) -> Result<Solution, CompileError> {
         match &self.0 {
             None => solve(a, b, initial, settings),
-            Some(s) => s.through(false, &[View { a, b }], initial, settings),
+            Some(s) => s.through(false, &[View { a, b }][..], initial, settings),
         }
     }
 
     /// [`pis_compile::solve_view_independent`], through the store when there is one.
     pub fn solve_view_independent(&self, views: &[View<'_>], initial: Option<&[f32]>, settings: &SolveSettings) -> Result<Solution, CompileError> {
+        self.solve_view_source(views, initial, settings)
+    }
+
+    /// [`pis_compile::solve_view_source`] (the views read one at a time), through the store
+    /// when there is one.
+    pub fn solve_view_source<S: ViewSource + ?Sized>(&self, views: &S, initial: Option<&[f32]>, settings: &SolveSettings) -> Result<Solution, CompileError> {
         match &self.0 {
-            None => solve_view_independent(views, initial, settings),
+            None => solve_view_source(views, initial, settings),
             Some(s) => s.through(true, views, initial, settings),
         }
     }

@@ -13,7 +13,7 @@ use std::borrow::Cow;
 use std::collections::BTreeMap;
 
 use anyhow::{anyhow, Result};
-use pis_compile::{DrawMesh, RenderMatrix, SolveSettings, TextureLayout, TexturedObject, View, Viewport};
+use pis_compile::{CompileError, DrawMesh, RenderMatrix, SolveSettings, TextureLayout, TexturedObject, View, ViewSource, Viewport};
 use pis_format::blocks::BlockGrid;
 use pis_format::DepMask;
 use pis_scene::ObjectRole;
@@ -195,22 +195,26 @@ fn solve_layer(set: &LoadedSet, views: &Views, placements: &[Placed], plan: &Lay
     let mut iterations = 0u64;
     for (k, points) in groups {
         let pid = plan.point_placement[points[0]];
-        let read = points.iter().map(|&p| views.get(p)).collect::<Result<Vec<_>>>()?;
-        let bs: Vec<Cow<[f32]>> = read.iter().map(|v| plan.radiance.at(v)).collect();
-        let vs: Vec<View> = read.iter().zip(&bs).map(|(v, b)| View { a: v.a(pid), b }).collect();
         let start = warm.get(&pid).map(Vec::as_slice);
         let x = if plan.radiance == Radiance::Diffuse {
-            // One texture for the views of the sample, stacked (eq. 3.7).
-            let s = solver.solve_view_independent(&vs, start, settings)?;
+            // One texture for the views of the sample, stacked (eq. 3.7), read one at a time.
+            let source = SampleViews { views, points: &points, placement: pid, radiance: plan.radiance };
+            let s = solver.solve_view_source(&source, start, settings)?;
             iterations += s.iterations as u64;
             s.texels
-        } else if vs[0].a.rows() == 0 {
-            // A view-dependent sample (one point per key) where the object covers no pixel.
-            start.map_or_else(|| vec![0.0; placements[pid].layout.texel_count() * 3], <[f32]>::to_vec)
         } else {
-            let s = solver.solve(vs[0].a, vs[0].b, start, settings)?;
-            iterations += s.iterations as u64;
-            s.texels
+            // A view-dependent sample: one point per key.
+            let v = views.get(points[0])?;
+            let b = plan.radiance.at(&v);
+            let a = v.a(pid);
+            if a.rows() == 0 {
+                // The object covers no pixel.
+                start.map_or_else(|| vec![0.0; placements[pid].layout.texel_count() * 3], <[f32]>::to_vec)
+            } else {
+                let s = solver.solve(a, &b, start, settings)?;
+                iterations += s.iterations as u64;
+                s.texels
+            }
         };
         warm.insert(pid, x.clone());
         placement_of.insert(k.clone(), pid);
@@ -218,6 +222,28 @@ fn solve_layer(set: &LoadedSet, views: &Views, placements: &[Placed], plan: &Lay
     }
     let form = Box::new(TextureForm { placements: placements.to_vec(), block_placements: plan.block_placements.clone(), placement_of: placement_of.clone() });
     Ok(InferredLayer { kind: plan.kind, depends_on: plan.depends_on, textures, block_placements: plan.block_placements.clone(), placement_of, iterations, form, shell: None })
+}
+
+/// The views of a view-independent sample: its points' render matrices for one placement
+/// and their radiance, each read (from the scratch file when the pack streams) as the solve
+/// asks for it.
+struct SampleViews<'a> {
+    views: &'a Views,
+    points: &'a [usize],
+    placement: usize,
+    radiance: Radiance,
+}
+
+impl ViewSource for SampleViews<'_> {
+    fn count(&self) -> usize {
+        self.points.len()
+    }
+
+    fn visit(&self, k: usize, f: &mut dyn FnMut(View<'_>) -> Result<(), CompileError>) -> Result<(), CompileError> {
+        let v = self.views.get(self.points[k]).map_err(|e| CompileError::Source(format!("{e:#}")))?;
+        let b = self.radiance.at(&v);
+        f(View { a: v.a(self.placement), b: &b })
+    }
 }
 
 /// A surface texture layer as stored: every block's texture placed as thesis 3.2 places it
