@@ -322,6 +322,7 @@ pub fn adaptive(
     let ones = vec![1u32; extent.len()];
     // Chosen levels, finest first.
     let mut chosen = vec![extent.to_vec()];
+    // A candidate's pyramid is scored and dropped: the search holds one pyramid at a time.
     let mut score = |levels: &[Vec<u32>], cache: &mut HashMap<Vec<u32>, Vec<Vec<f32>>>| {
         let p = build_cached(extent, samples, levels, filter, cache)?;
         let total: f64 = p
@@ -330,7 +331,7 @@ pub fn adaptive(
             .flat_map(|l| &l.images)
             .map(|i| cost(i))
             .sum();
-        Ok::<_, CodecError>((p, total))
+        Ok::<_, CodecError>(total)
     };
     let sequence = |chosen: &[Vec<u32>], next: &[u32]| {
         let mut seq = vec![ones.clone()];
@@ -342,24 +343,30 @@ pub fn adaptive(
         seq
     };
     if chosen[0] == ones {
-        return score(std::slice::from_ref(&ones), &mut cache);
+        let total = score(std::slice::from_ref(&ones), &mut cache)?;
+        return Ok((build_cached(extent, samples, std::slice::from_ref(&ones), filter, &mut cache)?, total));
     }
     loop {
         let current = chosen.last().cloned().unwrap_or_default();
-        let mut best: Option<(Vec<u32>, Pyramid, f64)> = None;
+        let mut best: Option<(Vec<u32>, f64)> = None;
         for cand in coarser_candidates(&current) {
-            let (p, total) = score(&sequence(&chosen, &cand), &mut cache)?;
-            if best.as_ref().is_none_or(|b| total < b.2) {
-                best = Some((cand, p, total));
+            let total = score(&sequence(&chosen, &cand), &mut cache)?;
+            if best.as_ref().is_none_or(|b| total < b.1) {
+                best = Some((cand, total));
             }
         }
-        let Some((cand, p, total)) = best else {
+        let Some((cand, total)) = best else {
             return Err(CodecError::Input("no coarser level".into()));
         };
         if cand == ones {
+            let p = build_cached(extent, samples, &sequence(&chosen, &cand), filter, &mut cache)?;
             return Ok((p, total));
         }
         chosen.push(cand);
+        // Later sequences hold the chosen levels and candidates coarser than the last: the
+        // targets of no other counts are asked for again.
+        let last = &chosen[chosen.len() - 1];
+        cache.retain(|c, _| chosen.contains(c) || c.iter().zip(last).all(|(a, b)| a <= b));
     }
 }
 

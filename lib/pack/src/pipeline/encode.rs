@@ -229,6 +229,8 @@ pub fn encode_all(set: &LoadedSet, models: &[ObjectModel], req: &PackRequest, st
                     return Err(runtime(anyhow!("object {} layer {} block {b}: a sample has no texture", m.name, il.kind.name())));
                 }
                 let mut pyramid = build_pyramid(mi, planes, &extent, &samples, layer_samples, !req.codec.is_lossy(), req.pyramid == super::PyramidMode::Full).map_err(runtime)?;
+                // The level images hold the samples from here on.
+                drop(samples);
                 if weighed {
                     pyramid.texel_weights = Some(weights);
                 }

@@ -49,24 +49,29 @@ pub struct BlockPyramid {
     /// every texel weighs the same. A block that is spilled drops them once its curves are
     /// measured.
     pub texel_weights: Option<Vec<Vec<f32>>>,
-    /// Where a pack that streams keeps the level images ([`BlockPyramid::spill`]): each is
-    /// then an empty vector in `levels` (the counts stay), and `rd` holds their
-    /// rate–distortion items, measured before.
-    pub spilled: Option<(Arc<Scratch>, Span)>,
+    /// Where a pack that streams keeps the level images ([`BlockPyramid::spill`]), one span
+    /// per image in level and image order: each is then an empty vector in `levels` (the
+    /// counts stay), and `rd` holds their rate–distortion items, measured before.
+    pub spilled: Option<(Arc<Scratch>, Vec<Span>)>,
     pub rd: Option<Vec<Item>>,
 }
 
 impl BlockPyramid {
     /// The level images per level (read back from the scratch file where spilled).
     pub fn level_images(&self) -> Result<Vec<Cow<'_, [Vec<f32>]>>> {
-        let Some((scratch, span)) = &self.spilled else {
+        let Some((scratch, spans)) = &self.spilled else {
             return Ok(self.levels.iter().map(|l| Cow::Borrowed(l.1.as_slice())).collect());
         };
-        let bytes = scratch.get(*span)?;
-        let mut r = Reader::new(&bytes);
-        let levels = self.levels.iter().map(|l| (0..l.1.len()).map(|_| r.f32s()).collect::<Result<Vec<_>>>().map(Cow::Owned)).collect::<Result<Vec<_>>>()?;
-        r.done()?;
-        Ok(levels)
+        let mut spans = spans.iter();
+        let mut read = || -> Result<Vec<f32>> {
+            let span = spans.next().ok_or_else(|| anyhow!("a spilled block has fewer level images than its levels count"))?;
+            let bytes = scratch.get(*span)?;
+            let mut r = Reader::new(&bytes);
+            let img = r.f32s()?;
+            r.done()?;
+            Ok(img)
+        };
+        self.levels.iter().map(|l| (0..l.1.len()).map(|_| read()).collect::<Result<Vec<_>>>().map(Cow::Owned)).collect()
     }
 
     /// The allocation's item of every level image, in level and image order (with `c`, a
@@ -105,14 +110,17 @@ impl BlockPyramid {
         }
         // The screen weights served the curves only.
         self.texel_weights = None;
-        let mut w = Writer::default();
+        // One image at a time: the block's images are never held twice.
+        let mut spans = Vec::new();
         for l in &mut self.levels {
             for img in &mut l.1 {
+                let mut w = Writer::default();
                 w.f32s(img);
                 *img = Vec::new();
+                spans.push(scratch.put(&w.0)?);
             }
         }
-        self.spilled = Some((scratch.clone(), scratch.put(&w.0)?));
+        self.spilled = Some((scratch.clone(), spans));
         Ok(())
     }
 }
