@@ -15,11 +15,12 @@ scene_copy() {
     echo "$dir/scene.toml"
 }
 
-# Runs "$@" under /usr/bin/time; prints "SECONDS PEAK_MIB".
+# Runs "$@" under /usr/bin/time; prints "SECONDS PEAK_MIB". The command's report goes to
+# the file $REPORT where set (pis-pack's lists each stage's time and peak memory).
 timed() {
     local t
     t=$(mktemp)
-    /usr/bin/time -f "%e %M" -o "$t" "$@" > /dev/null 2>> "$work/log.txt" || { echo "$me: failed: $* (see $work/log.txt)" >&2; exit 1; }
+    /usr/bin/time -f "%e %M" -o "$t" "$@" > "${REPORT:-/dev/null}" 2>> "$work/log.txt" || { echo "$me: failed: $* (see $work/log.txt)" >&2; exit 1; }
     awk '{ printf "%s %.0f\n", $1, $2 / 1024 }' "$t"
     rm -f "$t"
 }
