@@ -224,6 +224,7 @@ fn check_layout(layout: TextureLayout, settings: &SolveSettings, initial: Option
     Ok(())
 }
 
+/// The views held: one, or several stacked (eq. 3.7), in the form the settings choose.
 pub(crate) fn solve_views(
     views: &[View<'_>],
     initial: Option<&[f32]>,
