@@ -322,17 +322,7 @@ pub fn adaptive(
     let ones = vec![1u32; extent.len()];
     // Chosen levels, finest first.
     let mut chosen = vec![extent.to_vec()];
-    // A candidate's pyramid is scored and dropped: the search holds one pyramid at a time.
-    let mut score = |levels: &[Vec<u32>], cache: &mut HashMap<Vec<u32>, Vec<Vec<f32>>>| {
-        let p = build_cached(extent, samples, levels, filter, cache)?;
-        let total: f64 = p
-            .levels
-            .iter()
-            .flat_map(|l| &l.images)
-            .map(|i| cost(i))
-            .sum();
-        Ok::<_, CodecError>(total)
-    };
+    let mut total_of = |p: &Pyramid| -> f64 { p.levels.iter().flat_map(|l| &l.images).map(|i| cost(i)).sum() };
     let sequence = |chosen: &[Vec<u32>], next: &[u32]| {
         let mut seq = vec![ones.clone()];
         if next != ones.as_slice() {
@@ -343,14 +333,17 @@ pub fn adaptive(
         seq
     };
     if chosen[0] == ones {
-        let total = score(std::slice::from_ref(&ones), &mut cache)?;
-        return Ok((build_cached(extent, samples, std::slice::from_ref(&ones), filter, &mut cache)?, total));
+        let p = build_cached(extent, samples, std::slice::from_ref(&ones), filter, &mut cache)?;
+        let total = total_of(&p);
+        return Ok((p, total));
     }
     loop {
         let current = chosen.last().cloned().unwrap_or_default();
+        // A candidate's pyramid is scored and dropped: the search holds one at a time, and
+        // builds the one chosen again at the end.
         let mut best: Option<(Vec<u32>, f64)> = None;
         for cand in coarser_candidates(&current) {
-            let total = score(&sequence(&chosen, &cand), &mut cache)?;
+            let total = total_of(&build_cached(extent, samples, &sequence(&chosen, &cand), filter, &mut cache)?);
             if best.as_ref().is_none_or(|b| total < b.1) {
                 best = Some((cand, total));
             }

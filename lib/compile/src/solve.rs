@@ -15,7 +15,7 @@ use crate::error::check_finite;
 use crate::normal_equations::{ChannelProblem, ChannelRhs, DataOperator, Form, PyramidTerm, DEFAULT_K};
 use crate::regularize::{barrier_d2, pyramid_operator, RangeRegularization};
 use crate::sparse::Csr;
-use crate::stacked::{assemble, residual2 as residual2_of, ViewSource};
+use crate::stacked::{assemble, residual2 as residual2_of, view_matrix, ViewSource};
 use crate::{CompileError, RenderMatrix, TextureLayout};
 
 /// Colour channels per texel and per pixel (RGB, interleaved).
@@ -189,14 +189,22 @@ pub fn solve_view_source<S: ViewSource + ?Sized>(
         n_s: t.n_s,
         b_max: t.b_max as f64,
         rhs: t.atb.into_iter().zip(t.bb).map(|(atb, bb)| ChannelRhs { b: vec![], atb, bb }).collect(),
-        b: None,
+        pixels: Pixels::Read(&|xs: &[&[f64]]| residual2_of(source, layout, xs)),
     };
-    finish(data, initial, settings, start, Some(&|xs: &[Vec<f64>]| residual2_of(source, layout, xs)))
+    finish(data, initial, settings, start)
+}
+
+/// Where the residual ‖Ax − b‖² finds the pixels b.
+enum Pixels<'a> {
+    /// Per channel, held with the operator.
+    Held(Vec<Vec<f64>>),
+    /// Read again from the views: per channel, the residual of the channels' texels.
+    Read(&'a dyn Fn(&[&[f64]]) -> Result<Vec<f64>, CompileError>),
 }
 
 /// A solve's data term: the operator, its right-hand side per channel, and what the
 /// preconditioner and the regularization read of it.
-struct DataTerm {
+struct DataTerm<'a> {
     layout: TextureLayout,
     op: DataOperator,
     form: Form,
@@ -204,8 +212,7 @@ struct DataTerm {
     n_s: usize,
     b_max: f64,
     rhs: Vec<ChannelRhs>,
-    /// Per channel, the pixels, for the residual; `None`: the residual reads the views again.
-    b: Option<Vec<Vec<f64>>>,
+    pixels: Pixels<'a>,
 }
 
 /// The settings the layout allows, and the warm start's size and values.
@@ -236,20 +243,7 @@ pub(crate) fn solve_views(
     let layout = first.a.layout;
     check_settings(settings)?;
     check_layout(layout, settings, initial)?;
-    let mut parts = Vec::with_capacity(views.len());
-    for (k, v) in views.iter().enumerate() {
-        if v.a.layout != layout {
-            return Err(CompileError::Setting(format!(
-                "view {k}'s texture layout differs from view 0's")));
-        }
-        if v.b.len() != v.a.rows() * CHANNELS {
-            return Err(CompileError::Size {
-                what: format!("b of view {k} (covered pixels × 3)"),
-                expected: v.a.rows() * CHANNELS, found: v.b.len() });
-        }
-        check_finite("b", v.b)?;
-        parts.push(Csr::from_render_matrix(v.a)?);
-    }
+    let mut parts = views.iter().enumerate().map(|(k, v)| view_matrix(k, v, layout)).collect::<Result<Vec<_>, _>>()?;
     let n_t = layout.texel_count();
     // The views' parts are dropped once stacked.
     let a = if parts.len() == 1 { parts.pop().expect("one part") } else { Csr::stack(&std::mem::take(&mut parts))? };
@@ -266,20 +260,18 @@ pub(crate) fn solve_views(
         .map(|ch| views.iter().flat_map(|v| v.b.iter().skip(ch).step_by(CHANNELS)).map(|&v| v as f64).collect())
         .collect();
     let rhs = b.iter().map(|b| op.rhs(b.clone())).collect();
-    let data = DataTerm { layout, op, form, col_norms, n_s, b_max, rhs, b: Some(b) };
-    finish(data, initial, settings, start, None)
+    let data = DataTerm { layout, op, form, col_norms, n_s, b_max, rhs, pixels: Pixels::Held(b) };
+    finish(data, initial, settings, start)
 }
 
-/// Solves the three channels of `data`; the residual from the held pixels, or by
-/// `residual` (per channel, from the channels' texels) where the pixels are not held.
+/// Solves the three channels of `data`, and measures the residual where its pixels are.
 fn finish(
-    data: DataTerm,
+    data: DataTerm<'_>,
     initial: Option<&[f32]>,
     settings: &SolveSettings,
     start: Instant,
-    residual: Option<&dyn Fn(&[Vec<f64>]) -> Result<Vec<f64>, CompileError>>,
 ) -> Result<Solution, CompileError> {
-    let DataTerm { layout, op, form, col_norms, n_s, b_max, rhs, b } = data;
+    let DataTerm { layout, op, form, col_norms, n_s, b_max, rhs, pixels } = data;
     let n_t = layout.texel_count();
     let chain = (settings.mip == MipSolve::Decimated).then(|| Decimation::new(layout));
     // Unknowns per channel: the whole chain, or level 0.
@@ -324,7 +316,7 @@ fn finish(
     let mut bb_total = 0.0;
     // The channels are independent problems sharing A: solved concurrently (each result
     // depends only on its own inputs, so the outcome does not depend on scheduling).
-    let results: Vec<(CgReport, Vec<f64>, Option<f64>, f64)> = (0..CHANNELS)
+    let results: Vec<(CgReport, Vec<f64>, f64)> = (0..CHANNELS)
         .into_par_iter()
         .map(|ch| {
             let rhs = &rhs[ch];
@@ -347,19 +339,16 @@ fn finish(
                 d.expand(&x, &mut full);
                 x = full;
             }
-            let r2 = b.as_ref().map(|b| data_residual2(&op, &x, &b[ch]));
-            (report, x, r2, rhs.bb)
+            (report, x, rhs.bb)
         })
         .collect();
-    drop(op);
-    let r2: Vec<f64> = match residual {
-        Some(f) if b.is_none() => {
-            let xs: Vec<Vec<f64>> = results.iter().map(|r| r.1.clone()).collect();
-            f(&xs)?
-        }
-        _ => results.iter().map(|r| r.2.unwrap_or(0.0)).collect(),
+    let xs: Vec<&[f64]> = results.iter().map(|r| r.1.as_slice()).collect();
+    let r2: Vec<f64> = match &pixels {
+        Pixels::Held(b) => xs.par_iter().zip(b).map(|(x, b)| data_residual2(&op, x, b)).collect(),
+        Pixels::Read(read) => read(&xs)?,
     };
-    for (ch, ((report, x, _, bb), r2)) in results.into_iter().zip(r2).enumerate() {
+    drop(op);
+    for (ch, ((report, x, bb), r2)) in results.into_iter().zip(r2).enumerate() {
         residual2 += r2;
         bb_total += bb;
         for (t, &v) in x.iter().enumerate() {

@@ -49,7 +49,7 @@ pub(crate) struct Assembled {
 }
 
 /// Checks view `k` against `layout` and converts its matrix.
-fn view_matrix(k: usize, v: &View<'_>, layout: TextureLayout) -> Result<Csr, CompileError> {
+pub(crate) fn view_matrix(k: usize, v: &View<'_>, layout: TextureLayout) -> Result<Csr, CompileError> {
     if v.a.layout != layout {
         return Err(CompileError::Setting(format!("view {k}'s texture layout differs from view 0's")));
     }
@@ -103,7 +103,7 @@ pub(crate) fn assemble<S: ViewSource + ?Sized>(source: &S) -> Result<(TextureLay
 }
 
 /// Per channel, ‖Ax − b‖² over the views of `source`, `x[ch]` the channel's texels.
-pub(crate) fn residual2<S: ViewSource + ?Sized>(source: &S, layout: TextureLayout, x: &[Vec<f64>]) -> Result<Vec<f64>, CompileError> {
+pub(crate) fn residual2<S: ViewSource + ?Sized>(source: &S, layout: TextureLayout, x: &[&[f64]]) -> Result<Vec<f64>, CompileError> {
     let mut r2 = vec![-0.0; CHANNELS];
     for k in 0..source.count() {
         source.visit(k, &mut |v| {

@@ -151,7 +151,8 @@ impl Solutions {
         self.len() == 0
     }
 
-    fn through<S: ViewSource + ?Sized>(&self, stacked: bool, views: &S, initial: Option<&[f32]>, settings: &SolveSettings) -> Result<Solution, CompileError> {
+    /// The solution of `views` from the store, or `solve`d.
+    fn through<S: ViewSource + ?Sized>(&self, stacked: bool, views: &S, initial: Option<&[f32]>, settings: &SolveSettings, solve: impl FnOnce() -> Result<Solution, CompileError>) -> Result<Solution, CompileError> {
         let d = digest(stacked, views, initial, settings)?;
         // A solution read is taken out: each is read once, and the store does not double
         // the textures the pack holds.
@@ -163,16 +164,7 @@ impl Solutions {
             self.read.fetch_add(1, Ordering::Relaxed);
             return Ok(s);
         }
-        let s = if stacked {
-            solve_view_source(views, initial, settings)?
-        } else {
-            let mut one = None;
-            views.visit(0, &mut |v| {
-                one = Some(solve(v.a, v.b, initial, settings));
-                Ok(())
-            })?;
-            one.ok_or_else(|| CompileError::Source("view 0 was not served".into()))??
-        };
+        let s = solve()?;
         self.solved.fetch_add(1, Ordering::Relaxed);
         if self.record {
             // What a reader gets back: the solution without its per-channel history and timing.
@@ -325,7 +317,7 @@ impl Solver {
     pub fn solve(&self, a: &RenderMatrix, b: &[f32], initial: Option<&[f32]>, settings: &SolveSettings) -> Result<Solution, CompileError> {
         match &self.0 {
             None => solve(a, b, initial, settings),
-            Some(s) => s.through(false, &[View { a, b }][..], initial, settings),
+            Some(s) => s.through(false, &[View { a, b }][..], initial, settings, || solve(a, b, initial, settings)),
         }
     }
 
@@ -339,7 +331,7 @@ impl Solver {
     pub fn solve_view_source<S: ViewSource + ?Sized>(&self, views: &S, initial: Option<&[f32]>, settings: &SolveSettings) -> Result<Solution, CompileError> {
         match &self.0 {
             None => solve_view_source(views, initial, settings),
-            Some(s) => s.through(true, views, initial, settings),
+            Some(s) => s.through(true, views, initial, settings, || solve_view_source(views, initial, settings)),
         }
     }
 }
