@@ -162,6 +162,30 @@ fn traces_a_scene_into_a_set_deterministically() {
     assert_eq!(dir_bytes(&a), dir_bytes(&b), "a second run gives other bytes");
 }
 
+/// `--shading-seed sample` (a gold standard) is recorded in set.json and the report, and
+/// gives other pixels than the default seeding per surface cell.
+#[test]
+fn shading_seeded_per_sample_is_recorded() {
+    let tmp = tempfile::tempdir().unwrap();
+    let scene = tiny_scene(tmp.path());
+    let (cell, sample) = (tmp.path().join("cell"), tmp.path().join("sample"));
+    let out = trace(&[scene.to_str().unwrap(), "-o", cell.to_str().unwrap(), "--points", "1", "--json"]);
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+    let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(report["shading_seed"], "cell");
+    let out = trace(&[scene.to_str().unwrap(), "-o", sample.to_str().unwrap(), "--points", "1", "--shading-seed", "sample", "--json"]);
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+    let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(report["shading_seed"], "sample");
+    let settings = |dir: &Path| RaySet::open(dir).unwrap().meta.renderer.and_then(|r| r.settings).unwrap();
+    assert_eq!(settings(&sample).coherence_cell, Some(0.0));
+    assert_eq!(settings(&cell).coherence_cell, None);
+    let combined = |dir: &Path| RaySet::open(dir).unwrap().read_point(0).unwrap().layer("combined").unwrap().planes[0].clone();
+    assert_ne!(combined(&cell), combined(&sample));
+    let out = trace(&[scene.to_str().unwrap(), "-o", tmp.path().join("x").to_str().unwrap(), "--shading-seed", "pixel"]);
+    assert_eq!(out.status.code(), Some(1), "{}", text(&out.stderr));
+}
+
 #[test]
 fn errors_have_documented_exit_codes() {
     let tmp = tempfile::tempdir().unwrap();

@@ -46,3 +46,21 @@ pub fn message(err: &anyhow::Error) -> String {
     }
     out
 }
+
+/// `--shading-seed` and `--reference-seed`: what seeds the tracer's shading.
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ShadingSeedArg {
+    /// The quantized surface point: the same noise on a surface in every image.
+    Cell,
+    /// Each camera sample: the noise falls as 1/spp.
+    Sample,
+}
+
+impl From<ShadingSeedArg> for pis_trace::ShadingSeed {
+    fn from(a: ShadingSeedArg) -> pis_trace::ShadingSeed {
+        match a {
+            ShadingSeedArg::Cell => pis_trace::ShadingSeed::Cell,
+            ShadingSeedArg::Sample => pis_trace::ShadingSeed::Sample,
+        }
+    }
+}

@@ -17,7 +17,7 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
-use pis::cli::{finish, parse, Exit, Failure, EXIT_CODES_HELP};
+use pis::cli::{finish, parse, Exit, Failure, ShadingSeedArg, EXIT_CODES_HELP};
 use pis_eval::bench::all::{self, Preset};
 use pis_eval::bench::rd::{self, RdRequest};
 use pis_eval::bench::speed::{self, SpeedRequest};
@@ -194,6 +194,11 @@ enum Command {
         /// Samples per pixel of the ray-traced reference frames.
         #[arg(long, default_value_t = 4)]
         reference_spp: u32,
+        /// What seeds the reference frames' shading: `cell`, as in a packed set (its noise
+        /// stays on the surfaces however many samples), or `sample` (the noise falls as
+        /// 1/spp: a gold standard).
+        #[arg(long, value_enum, default_value_t = ShadingSeedArg::Cell)]
+        reference_seed: ShadingSeedArg,
         #[arg(long, default_value = "reports")]
         out: PathBuf,
         #[arg(long, value_parser = parse_resolution)]
@@ -227,6 +232,11 @@ enum Command {
         /// Samples per pixel of the ray-traced reference frames.
         #[arg(long, default_value_t = 16)]
         reference_spp: u32,
+        /// What seeds the reference frames' shading: `cell`, as in a packed set (its noise
+        /// stays on the surfaces however many samples), or `sample` (the noise falls as
+        /// 1/spp: a gold standard).
+        #[arg(long, value_enum, default_value_t = ShadingSeedArg::Cell)]
+        reference_seed: ShadingSeedArg,
         #[arg(long, default_value = "reports")]
         out: PathBuf,
         #[arg(long, value_parser = parse_resolution)]
@@ -365,8 +375,8 @@ fn run(cli: Cli) -> Result<Exit, Failure> {
             }
             Ok(Exit::Ok)
         }
-        Command::Stability { input, scene, ratios, frames, reference_spp, out, resolution, spp, preset, max_texture, record, json } => {
-            let req = StabilityRequest { input, scene, ratios, frames, spp: reference_spp, out, resolution, trace_spp: spp, max_texture, preset, record };
+        Command::Stability { input, scene, ratios, frames, reference_spp, reference_seed, out, resolution, spp, preset, max_texture, record, json } => {
+            let req = StabilityRequest { input, scene, ratios, frames, spp: reference_spp, reference_seed: reference_seed.into(), out, resolution, trace_spp: spp, max_texture, preset, record };
             let report = stability::run(&req)?;
             stability::print(&report, &mut std::io::stderr()).map_err(|e| Failure::new(Exit::Io, e))?;
             if json {
@@ -374,8 +384,8 @@ fn run(cli: Cli) -> Result<Exit, Failure> {
             }
             Ok(Exit::Ok)
         }
-        Command::Reflective { scene, files, frames, reference_spp, out, resolution, preset, images, role, tau, json } => {
-            let req = ReflectiveRequest { scene, preset, resolution, files, frames, spp: reference_spp, out, images, role, tau_px: tau };
+        Command::Reflective { scene, files, frames, reference_spp, reference_seed, out, resolution, preset, images, role, tau, json } => {
+            let req = ReflectiveRequest { scene, preset, resolution, files, frames, spp: reference_spp, reference_seed: reference_seed.into(), out, images, role, tau_px: tau };
             let report = reflective::run(&req)?;
             reflective::print(&report, &mut std::io::stderr()).map_err(|e| Failure::new(Exit::Io, e))?;
             if json {

@@ -7,6 +7,7 @@ use anyhow::Context;
 use clap::Parser;
 use indicatif::{ProgressBar, ProgressStyle};
 use pis_scene::LoadOptions;
+use pis::cli::ShadingSeedArg;
 use pis_trace::set::{merge_set, MergeReport, Shard};
 use pis_trace::{render_shard, Progress, SetReport, TraceError, TraceRun, TraceSettings};
 use std::path::{Path, PathBuf};
@@ -52,6 +53,13 @@ struct Cli {
     /// Render only the first N parameter points (in linear order, last dimension fastest).
     #[arg(long, value_name = "N")]
     points: Option<usize>,
+    /// What seeds the shading's random numbers. `cell` (default): the quantized surface
+    /// point, so a surface's noise is the same in every image of the space and the solved
+    /// textures agree across it; more samples average more cells, but a cell's own estimate
+    /// never improves. `sample`: each camera sample, so the noise falls as 1/spp: for a gold
+    /// standard to measure files against, not for a set to pack.
+    #[arg(long, value_enum, default_value_t = ShadingSeedArg::Cell)]
+    shading_seed: ShadingSeedArg,
     /// Print the closing report as JSON on stdout.
     #[arg(long)]
     json: bool,
@@ -106,7 +114,7 @@ impl Progress for Bar {
 fn run(cli: &Cli, scene: &Path, output: &Path) -> anyhow::Result<SetReport> {
     let options = LoadOptions { preset: cli.preset.clone(), resolution: cli.resolution, spp: cli.spp };
     let scene = pis_scene::load_with(scene, &options).map_err(TraceError::from)?;
-    let settings = TraceSettings::new(scene.resolution, scene.spp);
+    let settings = TraceSettings::new(scene.resolution, scene.spp).with_shading_seed(cli.shading_seed.into());
     let bar = ProgressBar::new(0);
     bar.set_style(
         ProgressStyle::with_template("{spinner} {msg} [{bar:40}] {percent}% {elapsed_precise} (eta {eta})")
@@ -128,8 +136,8 @@ fn run(cli: &Cli, scene: &Path, output: &Path) -> anyhow::Result<SetReport> {
 fn print_report(r: &SetReport) {
     let mib = r.output_bytes as f64 / (1024.0 * 1024.0);
     eprintln!(
-        "pis-trace: {} — {} points traced of the set's {} (the space has {}), {}x{}, {} spp, {} threads, {} triangles",
-        r.scene, r.points, r.set_points, r.points_in_space, r.resolution[0], r.resolution[1], r.spp, r.threads, r.triangles
+        "pis-trace: {} — {} points traced of the set's {} (the space has {}), {}x{}, {} spp (shading seeded per {}), {} threads, {} triangles",
+        r.scene, r.points, r.set_points, r.points_in_space, r.resolution[0], r.resolution[1], r.spp, r.shading_seed, r.threads, r.triangles
     );
     eprintln!(
         "  rays: {:.2} M camera rays/s, {:.2} M rays/s total ({} camera, {} total)",

@@ -19,6 +19,9 @@ pub struct SetReport {
     pub points_in_space: usize,
     pub resolution: [u32; 2],
     pub spp: u32,
+    /// What seeded the shading: `cell` (the surface point) or `sample` (each camera
+    /// sample).
+    pub shading_seed: String,
     /// Worker threads.
     pub threads: usize,
     /// Largest number of world triangles of any point.
@@ -141,6 +144,7 @@ pub fn render_shard(
         set_points: count,
         resolution: [settings.resolution.0, settings.resolution.1],
         spp: settings.spp,
+        shading_seed: if settings.coherence_cell == Some(0.0) { "sample" } else { "cell" }.into(),
         threads: rayon::current_num_threads(),
         ..Default::default()
     };

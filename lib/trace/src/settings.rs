@@ -30,7 +30,28 @@ pub struct TraceSettings {
     pub max_record_hits: u32,
 }
 
+/// What seeds the shading's random numbers ([`TraceSettings::coherence_cell`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ShadingSeed {
+    /// The quantized surface point: a surface's noise is the same in every image of the
+    /// space, so textures solved from the images agree across it; more camera samples
+    /// average more cells, but each cell's estimate stays what it is.
+    Cell,
+    /// Each camera sample: the noise falls as 1/spp (a gold standard).
+    Sample,
+}
+
 impl TraceSettings {
+    /// The same settings with shading seeded by `seed` (`Cell`: the default cell size).
+    pub fn with_shading_seed(mut self, seed: ShadingSeed) -> TraceSettings {
+        self.coherence_cell = match seed {
+            ShadingSeed::Cell => None,
+            ShadingSeed::Sample => Some(0.0),
+        };
+        self
+    }
+
+
     /// Defaults for a render at `resolution` with `spp` samples per pixel.
     pub fn new(resolution: (u32, u32), spp: u32) -> TraceSettings {
         TraceSettings {

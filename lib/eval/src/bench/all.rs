@@ -72,7 +72,7 @@ pub fn run(preset: Preset, scene: &Path, out: &Path, record: bool) -> Result<(),
                                    resolution: s.resolution, spp: s.spp, preset: preset_name.clone(), max_texture: pis_pack::DEFAULT_MAX_TEXTURE, record };
     let r = speed::run(&speed_req)?;
     speed::print(&r, &mut std::io::stderr()).map_err(|e| Failure::new(Exit::Io, e))?;
-    let st_req = StabilityRequest { input: scene.to_path_buf(), scene: None, ratios: s.stability_ratios.clone(), frames: s.frames,
+    let st_req = StabilityRequest { input: scene.to_path_buf(), scene: None, ratios: s.stability_ratios.clone(), frames: s.frames, reference_seed: pis_trace::ShadingSeed::Cell,
                                     spp: s.reference_spp, out: out.to_path_buf(), resolution: s.resolution, trace_spp: s.spp,
                                     max_texture: pis_pack::DEFAULT_MAX_TEXTURE, preset: preset_name, record };
     let r = stability::run(&st_req)?;

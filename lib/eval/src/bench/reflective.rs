@@ -18,7 +18,7 @@ use glam::Vec3;
 use pis_play::{CameraChoice, FrameRequest, Gpu, Player, PlayerOptions, ViewCamera};
 use pis_scene::{LoadOptions, ObjectRole, Scene};
 use pis_trace::layers::LayerKind;
-use pis_trace::TraceSettings;
+use pis_trace::{ShadingSeed, TraceSettings};
 use serde::Serialize;
 
 use super::camera_path::{paths, PathFrame, PathKind};
@@ -42,6 +42,9 @@ pub struct ReflectiveRequest {
     pub frames: usize,
     /// Samples per pixel of the reference frames.
     pub spp: u32,
+    /// What seeds the reference frames' shading (`Sample` for a gold standard whose noise
+    /// falls as 1/spp).
+    pub reference_seed: ShadingSeed,
     /// Where reflective.csv goes.
     pub out: PathBuf,
     /// Also write every played frame beside its traced reference as an sRGB PNG.
@@ -70,6 +73,8 @@ pub struct ReflectiveReport {
     pub objects: Vec<String>,
     pub frames: usize,
     pub reference_spp: u32,
+    /// `cell` or `sample`: what seeded the reference frames' shading.
+    pub reference_seed: String,
     pub summaries: Vec<ReflectiveSummary>,
     pub csv: String,
     pub stamp: Stamp,
@@ -81,8 +86,8 @@ struct Reference {
     mask: Vec<bool>,
 }
 
-fn reference(scene: &Scene, pf: &PathFrame, spp: u32, objects: &[usize]) -> Result<Reference> {
-    let settings = TraceSettings::new(scene.resolution, spp);
+fn reference(scene: &Scene, pf: &PathFrame, spp: u32, seed: ShadingSeed, objects: &[usize]) -> Result<Reference> {
+    let settings = TraceSettings::new(scene.resolution, spp).with_shading_seed(seed);
     let r = pis_trace::render_point(scene, &pf.frame, &settings, &|| {})?;
     let l = r.images.layer("combined").ok_or_else(|| anyhow!("the traced frame has no combined image"))?;
     let n = l.width as usize * l.height as usize;
@@ -170,7 +175,7 @@ pub fn run(req: &ReflectiveRequest) -> Result<ReflectiveReport, Failure> {
     }
     let (view_dim, frames) = paths(&scene, req.frames, &PATHS).map_err(|e| Failure::new(Exit::NotSupported, e))?;
     eprintln!("pis-bench: reflective: tracing {} reference frames at {} spp", frames.len(), req.spp);
-    let refs: Vec<Reference> = frames.iter().map(|f| reference(&scene, f, req.spp, &objects)).collect::<Result<_>>().map_err(runtime)?;
+    let refs: Vec<Reference> = frames.iter().map(|f| reference(&scene, f, req.spp, req.reference_seed, &objects)).collect::<Result<_>>().map_err(runtime)?;
     let gpu = Arc::new(Gpu::new().map_err(|e| Failure::new(Exit::NotSupported, anyhow!("{e}")))?);
     let size = scene.resolution;
     let mut csv = Csv::new(&["file", "path", "frame", "view", "psnr_db", "change_played", "change_reference"]);
@@ -229,15 +234,24 @@ pub fn run(req: &ReflectiveRequest) -> Result<ReflectiveReport, Failure> {
         objects: objects.iter().map(|&o| scene.objects[o].name.clone()).collect(),
         frames: req.frames,
         reference_spp: req.spp,
+        reference_seed: seed_name(req.reference_seed).into(),
         summaries,
         csv: csv_path.display().to_string(),
     })
 }
 
 pub fn print(r: &ReflectiveReport, out: &mut impl std::io::Write) -> std::io::Result<()> {
-    writeln!(out, "reflective: {} — {} over the pixels of {}, {} frames between and away, references at {} spp", r.scene, "played frames vs pis-trace", r.objects.join(", "), r.frames, r.reference_spp)?;
+    writeln!(out, "reflective: {} — {} over the pixels of {}, {} frames between and away, references at {} spp (shading seeded per {})", r.scene, "played frames vs pis-trace", r.objects.join(", "), r.frames, r.reference_spp, r.reference_seed)?;
     for s in &r.summaries {
         writeln!(out, "  {:<28} {:<8} mean {:6.2} dB  min {:6.2} dB  popping {:5.2}", s.file, s.path.name(), s.mean_psnr_db, s.min_psnr_db, s.popping)?;
     }
     writeln!(out, "  wrote {}", r.csv)
+}
+
+/// `cell` or `sample`, as the tools' options spell it.
+pub(crate) fn seed_name(seed: ShadingSeed) -> &'static str {
+    match seed {
+        ShadingSeed::Cell => "cell",
+        ShadingSeed::Sample => "sample",
+    }
 }

@@ -18,7 +18,7 @@ use crate::chart::{Chart, Series};
 use crate::metrics::{display, SquaredError};
 use crate::report::{Csv, Stamp};
 use pis_format::DepMask;
-use pis_trace::TraceSettings;
+use pis_trace::{ShadingSeed, TraceSettings};
 use rayon::prelude::*;
 use serde::Serialize;
 
@@ -40,6 +40,8 @@ pub struct StabilityRequest {
     pub frames: usize,
     /// Samples per pixel of the reference frames.
     pub spp: u32,
+    /// What seeds the reference frames' shading.
+    pub reference_seed: ShadingSeed,
     pub out: PathBuf,
     pub resolution: Option<(u32, u32)>,
     pub trace_spp: Option<u32>,
@@ -158,8 +160,8 @@ fn render_frame(inf: &Inferred, meshes: &[Mesh], tex: &[Vec<LayerTextures>], pf:
     Ok(Rendered { rgb, mask })
 }
 
-fn reference(inf: &Inferred, pf: &PathFrame, spp: u32) -> Result<Vec<f32>> {
-    let settings = TraceSettings::new(inf.set.resolution, spp);
+fn reference(inf: &Inferred, pf: &PathFrame, spp: u32, seed: ShadingSeed) -> Result<Vec<f32>> {
+    let settings = TraceSettings::new(inf.set.resolution, spp).with_shading_seed(seed);
     let r = pis_trace::render_point(&inf.set.scene, &pf.frame, &settings, &|| {})?;
     let l = r.images.layer("combined").ok_or_else(|| anyhow!("the traced frame has no combined image"))?;
     let n = l.width as usize * l.height as usize;
@@ -213,8 +215,8 @@ pub fn run(req: &StabilityRequest) -> Result<StabilityReport, Failure> {
     let inf = Inferred::new(&base, &StderrProgress)?;
     let scene = &inf.set.scene;
     let (view_dim, frames) = paths(scene, req.frames, &[PathKind::Between, PathKind::Away]).map_err(|e| Failure::new(Exit::NotSupported, e))?;
-    eprintln!("pis-bench: stability: tracing {} reference frames at {} spp", frames.len(), req.spp);
-    let refs: Vec<Vec<f32>> = frames.iter().map(|f| reference(&inf, f, req.spp)).collect::<Result<_>>().map_err(runtime)?;
+    eprintln!("pis-bench: stability: tracing {} reference frames at {} spp (shading seeded per {})", frames.len(), req.spp, crate::bench::reflective::seed_name(req.reference_seed));
+    let refs: Vec<Vec<f32>> = frames.iter().map(|f| reference(&inf, f, req.spp, req.reference_seed)).collect::<Result<_>>().map_err(runtime)?;
     let meshes: Vec<Mesh> = (0..scene.objects.len()).map(|o| merged_mesh(scene, o)).collect();
     let raw = inf.raw_image_bytes();
     let mut reps: Vec<(String, Option<f64>, Vec<Vec<LayerTextures>>)> = vec![("solved".into(), None, inf.solved().map_err(runtime)?)];
@@ -271,7 +273,7 @@ pub fn run(req: &StabilityRequest) -> Result<StabilityReport, Failure> {
     }).collect();
     let chart = Chart {
         title: format!("Stability off the samples — {scene_s}"),
-        subtitle: format!("through the hardware model at each exact camera vs pis-trace ({} spp) over covered pixels; between: fractional view, away: radius ×{AWAY_RADIUS}, elevation +{AWAY_ELEVATION_DEG}°", req.spp),
+        subtitle: format!("through the hardware model at each exact camera vs pis-trace ({} spp, shading seeded per {}) over covered pixels; between: fractional view, away: radius ×{AWAY_RADIUS}, elevation +{AWAY_ELEVATION_DEG}°", req.spp, crate::bench::reflective::seed_name(req.reference_seed)),
         x_label: "position along the view dimension (samples)".into(),
         y_label: "PSNR (dB)".into(),
         x_log: false,
