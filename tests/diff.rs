@@ -5,6 +5,8 @@
 //! FLIP maps and the PSNR gates are reported (GPU tests: lavapipe; without an adapter they
 //! skip locally and fail when `CI=true`).
 
+mod common;
+
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 use std::sync::OnceLock;
@@ -27,7 +29,7 @@ fn set() -> &'static Path {
 fn fixture() -> &'static (tempfile::TempDir, PathBuf, PathBuf) {
     static PACK: OnceLock<(tempfile::TempDir, PathBuf, PathBuf)> = OnceLock::new();
     PACK.get_or_init(|| {
-        let dir = tempfile::tempdir().expect("temp dir");
+        let dir = common::fixture_tempdir();
         let set = dir.path().join("set");
         let out = Command::new(env!("CARGO_BIN_EXE_pis-trace"))
             .arg(repo("samples/demo1/scene.toml")).arg("-o").arg(&set)

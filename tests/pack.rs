@@ -17,7 +17,7 @@ fn demo1() -> PathBuf {
 fn set() -> &'static Path {
     static SET: OnceLock<(tempfile::TempDir, PathBuf)> = OnceLock::new();
     &SET.get_or_init(|| {
-        let dir = tempfile::tempdir().expect("temp dir");
+        let dir = common::fixture_tempdir();
         let out = Command::new(env!("CARGO_BIN_EXE_pis-trace"))
             .arg(demo1()).arg("-o").arg(dir.path().join("set"))
             .args(["--resolution", "64x48", "--spp", "2"]).output().expect("pis-trace runs");

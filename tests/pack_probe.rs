@@ -15,7 +15,7 @@ use common::{demo1_copy, os, run};
 
 /// demo1 with `n × n` points, traced at the size `resolution`, 2 spp: its scene.toml and set.
 fn traced(n: u32, resolution: &str) -> (tempfile::TempDir, (PathBuf, PathBuf)) {
-    let dir = tempfile::tempdir().expect("temp dir");
+    let dir = common::fixture_tempdir();
     let samples = format!("samples = {n}\n");
     let scene = demo1_copy(&dir.path().join("scene"), &[("samples = 4\ntime", &format!("{samples}time")), ("samples = 4\ntarget", &format!("{samples}target"))]);
     let out = Command::new(env!("CARGO_BIN_EXE_pis-trace"))

@@ -4,6 +4,8 @@
 //! round trip carrying the master gives the pack back; bad arguments, bad inputs and a
 //! damaged master leave no output.
 
+mod common;
+
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 use std::sync::OnceLock;
@@ -18,7 +20,7 @@ fn repo(rel: &str) -> PathBuf {
 fn set() -> &'static Path {
     static SET: OnceLock<(tempfile::TempDir, PathBuf)> = OnceLock::new();
     &SET.get_or_init(|| {
-        let dir = tempfile::tempdir().expect("temp dir");
+        let dir = common::fixture_tempdir();
         let set = dir.path().join("set");
         let out = Command::new(env!("CARGO_BIN_EXE_pis-trace"))
             .arg(repo("samples/demo1/scene.toml")).arg("-o").arg(&set)
@@ -30,7 +32,7 @@ fn set() -> &'static Path {
 
 /// The set packed with the wavelet codec and 32-texel textures, with `args`.
 fn pack(name: &str, args: &[&str]) -> (tempfile::TempDir, PathBuf) {
-    let dir = tempfile::tempdir().expect("temp dir");
+    let dir = common::fixture_tempdir();
     let file = dir.path().join(name);
     let out = Command::new(env!("CARGO_BIN_EXE_pis-pack"))
         .arg(set()).arg("--scene").arg(repo("samples/demo1/scene.toml")).arg("-o").arg(&file)

@@ -81,3 +81,17 @@ pub fn set_node(doc: &mut serde_json::Value, node: &str, key: &str, value: serde
     let n = doc["nodes"].as_array_mut().expect("nodes").iter_mut().find(|n| n["name"] == node).unwrap_or_else(|| panic!("no node {node}"));
     n[key] = value;
 }
+
+/// A temporary folder for a fixture that every test of a binary shares. Such a fixture lives
+/// in a `static`, which is never dropped, so its folder is never removed: it goes under the
+/// target folder's tmp/ rather than the system's temporary folder, in a folder per test
+/// binary that the binary's first fixture empties, so runs do not pile up.
+pub fn fixture_tempdir() -> tempfile::TempDir {
+    static CLEARED: std::sync::Once = std::sync::Once::new();
+    let root = Path::new(env!("CARGO_TARGET_TMPDIR")).join(env!("CARGO_CRATE_NAME"));
+    CLEARED.call_once(|| {
+        let _ = std::fs::remove_dir_all(&root);
+    });
+    std::fs::create_dir_all(&root).expect("fixture folder");
+    tempfile::tempdir_in(&root).expect("temp dir")
+}
