@@ -445,3 +445,21 @@ fn mirrored_texture_coordinates_give_each_half_its_own_texels() {
     // 3.5 dB of the unmirrored floor, where the folded chart was 10 dB below it.
     assert!(mirrored >= plain - 3.5, "mirrored floor {mirrored:.2} dB, unmirrored {plain:.2} dB");
 }
+
+/// A set traced with shading seeded per camera sample (a gold standard) packs, with a
+/// warning that its noise differs between images; the default seeding packs without it.
+#[test]
+fn a_set_seeded_per_sample_packs_with_a_warning() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let seeded = dir.path().join("set");
+    let out = Command::new(env!("CARGO_BIN_EXE_pis-trace"))
+        .arg(demo1()).arg("-o").arg(&seeded)
+        .args(["--resolution", "40x30", "--spp", "1", "--shading-seed", "sample"]).output().expect("pis-trace runs");
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let out = pack(&seeded, &dir.path().join("a.pis"), &["--ratio", "24", "--max-texture", "32"]);
+    json(&out);
+    assert!(String::from_utf8_lossy(&out.stderr).contains("seeded per camera sample"), "{}", String::from_utf8_lossy(&out.stderr));
+    let out = pack(set(), &dir.path().join("b.pis"), &["--ratio", "24", "--max-texture", "32"]);
+    json(&out);
+    assert!(!String::from_utf8_lossy(&out.stderr).contains("seeded per camera sample"));
+}
