@@ -119,6 +119,13 @@ pub struct Integrator<'s> {
     pub environment: Option<EnvironmentLight<'s>>,
 }
 
+/// Whether a uniform `u` drawn in [0, `first` + `second`) picks the first of two lobes of
+/// those weights. `u` may round up to the sum (and past `first` when a preceding weight was
+/// taken off it): a lobe of weight 0 is never picked, since its estimate divides by it.
+fn picks_first(u: f32, first: f32, second: f32) -> bool {
+    second <= 0.0 || (first > 0.0 && u < first)
+}
+
 impl<'s> Integrator<'s> {
     /// Builds the geometry of `scene` at `frame`.
     pub fn new(scene: &'s Scene, frame: &'s Frame, settings: &TraceSettings) -> Integrator<'s> {
@@ -273,7 +280,7 @@ impl<'s> Integrator<'s> {
             return Vec3::ZERO;
         }
         let u = rng.next_f32() * total;
-        if u < p_d {
+        if picks_first(u, p_d, rest.0 + rest.1) {
             self.diffuse(sp, m, depth, diffuse_left, rng, ctx) * (total / p_d)
         } else {
             self.scatter_nondiffuse(sp, m, dir, depth, diffuse_left, rng, ctx, Some((u - p_d, rest))) * (total / (rest.0 + rest.1))
@@ -321,7 +328,7 @@ impl<'s> Integrator<'s> {
             return Vec3::ZERO;
         }
         let total = total / survival;
-        if u < p_s {
+        if picks_first(u, p_s, p_t) {
             // Rough lobes reach the lights by next-event estimation, their sampled rays do
             // not see light spheres; glossy and mirror lobes see them along sampled rays.
             let rough = m.alpha >= NEE_ALPHA;
@@ -765,4 +772,29 @@ pub fn ggx_reflection_pdf(n: Vec3, wo: Vec3, l: Vec3, alpha: f32) -> f32 {
     let a2 = alpha * alpha;
     let dd = nh * nh * (a2 - 1.0) + 1.0;
     a2 / (PI * dd * dd) * nh / (4.0 * vh)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::picks_first;
+
+    /// A sample of the floor of teapot-pem (a rough dielectric: diffuse weight 0.0481,
+    /// specular 0.1302, transmission 0) drew u = 0.1782612, which rounds to the sum of the
+    /// weights: with the diffuse weight taken off it is not below the specular weight, and
+    /// picking the transmission lobe of weight 0 gave 0 × ∞ = NaN in the traced image.
+    #[test]
+    fn a_lobe_of_weight_zero_is_never_picked() {
+        let (p_d, p_s, p_t) = (0.048_096_44f32, 0.130_164_77f32, 0.0f32);
+        let total = p_d + p_s + p_t;
+        let u = 0.999_999_94f32 * total;
+        assert!(!picks_first(u, p_d, p_s + p_t));
+        assert!(picks_first(u - p_d, p_s, p_t), "u − p_d = {} against p_s = {p_s}", u - p_d);
+        assert!(picks_first(total, p_s, 0.0) && !picks_first(0.0, 0.0, 0.5) && picks_first(1.0, 1.0, 0.0));
+        assert!(picks_first(0.2, 0.5, 0.5) && !picks_first(0.7, 0.5, 0.5));
+        for k in 0..1000 {
+            let u = k as f32 / 1000.0 * total;
+            let specular = picks_first(u - p_d, p_s, p_t);
+            assert!(picks_first(u, p_d, p_s + p_t) || specular, "u = {u}");
+        }
+    }
 }
