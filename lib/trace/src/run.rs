@@ -144,7 +144,7 @@ pub fn render_shard(
         set_points: count,
         resolution: [settings.resolution.0, settings.resolution.1],
         spp: settings.spp,
-        shading_seed: if settings.coherence_cell == Some(0.0) { "sample" } else { "cell" }.into(),
+        shading_seed: settings.shading_seed().name().into(),
         threads: rayon::current_num_threads(),
         ..Default::default()
     };

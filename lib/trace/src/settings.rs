@@ -41,7 +41,22 @@ pub enum ShadingSeed {
     Sample,
 }
 
+impl ShadingSeed {
+    /// `cell` or `sample`, as the tools spell it.
+    pub fn name(self) -> &'static str {
+        match self {
+            ShadingSeed::Cell => "cell",
+            ShadingSeed::Sample => "sample",
+        }
+    }
+}
+
 impl TraceSettings {
+    /// What seeds the shading: a cell size of 0 seeds per camera sample.
+    pub fn shading_seed(&self) -> ShadingSeed {
+        if self.coherence_cell == Some(0.0) { ShadingSeed::Sample } else { ShadingSeed::Cell }
+    }
+
     /// The same settings with shading seeded by `seed` (`Cell`: the default cell size).
     pub fn with_shading_seed(mut self, seed: ShadingSeed) -> TraceSettings {
         self.coherence_cell = match seed {

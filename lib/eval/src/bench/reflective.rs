@@ -234,24 +234,16 @@ pub fn run(req: &ReflectiveRequest) -> Result<ReflectiveReport, Failure> {
         objects: objects.iter().map(|&o| scene.objects[o].name.clone()).collect(),
         frames: req.frames,
         reference_spp: req.spp,
-        reference_seed: seed_name(req.reference_seed).into(),
+        reference_seed: req.reference_seed.name().into(),
         summaries,
         csv: csv_path.display().to_string(),
     })
 }
 
 pub fn print(r: &ReflectiveReport, out: &mut impl std::io::Write) -> std::io::Result<()> {
-    writeln!(out, "reflective: {} — {} over the pixels of {}, {} frames between and away, references at {} spp (shading seeded per {})", r.scene, "played frames vs pis-trace", r.objects.join(", "), r.frames, r.reference_spp, r.reference_seed)?;
+    writeln!(out, "reflective: {} — played frames vs pis-trace over the pixels of {}, {} frames between and away, references at {} spp (shading seeded per {})", r.scene, r.objects.join(", "), r.frames, r.reference_spp, r.reference_seed)?;
     for s in &r.summaries {
         writeln!(out, "  {:<28} {:<8} mean {:6.2} dB  min {:6.2} dB  popping {:5.2}", s.file, s.path.name(), s.mean_psnr_db, s.min_psnr_db, s.popping)?;
     }
     writeln!(out, "  wrote {}", r.csv)
-}
-
-/// `cell` or `sample`, as the tools' options spell it.
-pub(crate) fn seed_name(seed: ShadingSeed) -> &'static str {
-    match seed {
-        ShadingSeed::Cell => "cell",
-        ShadingSeed::Sample => "sample",
-    }
 }

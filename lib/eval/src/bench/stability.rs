@@ -215,7 +215,7 @@ pub fn run(req: &StabilityRequest) -> Result<StabilityReport, Failure> {
     let inf = Inferred::new(&base, &StderrProgress)?;
     let scene = &inf.set.scene;
     let (view_dim, frames) = paths(scene, req.frames, &[PathKind::Between, PathKind::Away]).map_err(|e| Failure::new(Exit::NotSupported, e))?;
-    eprintln!("pis-bench: stability: tracing {} reference frames at {} spp (shading seeded per {})", frames.len(), req.spp, crate::bench::reflective::seed_name(req.reference_seed));
+    eprintln!("pis-bench: stability: tracing {} reference frames at {} spp (shading seeded per {})", frames.len(), req.spp, req.reference_seed.name());
     let refs: Vec<Vec<f32>> = frames.iter().map(|f| reference(&inf, f, req.spp, req.reference_seed)).collect::<Result<_>>().map_err(runtime)?;
     let meshes: Vec<Mesh> = (0..scene.objects.len()).map(|o| merged_mesh(scene, o)).collect();
     let raw = inf.raw_image_bytes();
@@ -273,7 +273,7 @@ pub fn run(req: &StabilityRequest) -> Result<StabilityReport, Failure> {
     }).collect();
     let chart = Chart {
         title: format!("Stability off the samples — {scene_s}"),
-        subtitle: format!("through the hardware model at each exact camera vs pis-trace ({} spp, shading seeded per {}) over covered pixels; between: fractional view, away: radius ×{AWAY_RADIUS}, elevation +{AWAY_ELEVATION_DEG}°", req.spp, crate::bench::reflective::seed_name(req.reference_seed)),
+        subtitle: format!("through the hardware model at each exact camera vs pis-trace ({} spp, shading seeded per {}) over covered pixels; between: fractional view, away: radius ×{AWAY_RADIUS}, elevation +{AWAY_ELEVATION_DEG}°", req.spp, req.reference_seed.name()),
         x_label: "position along the view dimension (samples)".into(),
         y_label: "PSNR (dB)".into(),
         x_log: false,

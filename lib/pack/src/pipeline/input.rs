@@ -187,7 +187,7 @@ pub fn load(req: &PackRequest, stages: &mut Stages) -> Result<LoadedSet, Failure
         records.push(if with_records { set.read_records(i).map_err(trace_failure)? } else { Vec::new() });
     }
     let trace = set.meta.renderer.as_ref().and_then(|r| r.settings.clone()).unwrap_or_else(|| TraceSettings::new(res, set.meta.spp.max(1)));
-    if trace.coherence_cell == Some(0.0) {
+    if trace.shading_seed() == pis_trace::ShadingSeed::Sample {
         stages.note(&format!(
             "warning: {} was traced with shading seeded per camera sample (pis-trace --shading-seed sample): a surface's noise differs between its images, so the solved textures average it rather than match it; a set to pack is traced with the default seeding",
             dir.display()
