@@ -48,19 +48,6 @@ pub fn message(err: &anyhow::Error) -> String {
 }
 
 /// `--shading-seed` and `--reference-seed`: what seeds the tracer's shading.
-#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
-pub enum ShadingSeedArg {
-    /// The quantized surface point: the same noise on a surface in every image.
-    Cell,
-    /// Each camera sample: the noise falls as 1/spp.
-    Sample,
-}
-
-impl From<ShadingSeedArg> for pis_trace::ShadingSeed {
-    fn from(a: ShadingSeedArg) -> pis_trace::ShadingSeed {
-        match a {
-            ShadingSeedArg::Cell => pis_trace::ShadingSeed::Cell,
-            ShadingSeedArg::Sample => pis_trace::ShadingSeed::Sample,
-        }
-    }
+pub fn parse_shading_seed(s: &str) -> Result<pis_trace::ShadingSeed, String> {
+    pis_trace::ShadingSeed::from_name(s).ok_or_else(|| format!("unknown shading seed {s:?} (cell or sample)"))
 }

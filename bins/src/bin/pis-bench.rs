@@ -17,7 +17,7 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
-use pis::cli::{finish, parse, Exit, Failure, ShadingSeedArg, EXIT_CODES_HELP};
+use pis::cli::{finish, parse, Exit, Failure, parse_shading_seed, EXIT_CODES_HELP};
 use pis_eval::bench::all::{self, Preset};
 use pis_eval::bench::rd::{self, RdRequest};
 use pis_eval::bench::speed::{self, SpeedRequest};
@@ -197,8 +197,8 @@ enum Command {
         /// What seeds the reference frames' shading: `cell`, as in a packed set (its noise
         /// stays on the surfaces however many samples), or `sample` (the noise falls as
         /// 1/spp: a gold standard).
-        #[arg(long, value_enum, default_value_t = ShadingSeedArg::Cell)]
-        reference_seed: ShadingSeedArg,
+        #[arg(long, value_name = "cell|sample", default_value = "cell", value_parser = parse_shading_seed)]
+        reference_seed: pis_trace::ShadingSeed,
         #[arg(long, default_value = "reports")]
         out: PathBuf,
         #[arg(long, value_parser = parse_resolution)]
@@ -235,8 +235,8 @@ enum Command {
         /// What seeds the reference frames' shading: `cell`, as in a packed set (its noise
         /// stays on the surfaces however many samples), or `sample` (the noise falls as
         /// 1/spp: a gold standard).
-        #[arg(long, value_enum, default_value_t = ShadingSeedArg::Cell)]
-        reference_seed: ShadingSeedArg,
+        #[arg(long, value_name = "cell|sample", default_value = "cell", value_parser = parse_shading_seed)]
+        reference_seed: pis_trace::ShadingSeed,
         #[arg(long, default_value = "reports")]
         out: PathBuf,
         #[arg(long, value_parser = parse_resolution)]
@@ -376,7 +376,7 @@ fn run(cli: Cli) -> Result<Exit, Failure> {
             Ok(Exit::Ok)
         }
         Command::Stability { input, scene, ratios, frames, reference_spp, reference_seed, out, resolution, spp, preset, max_texture, record, json } => {
-            let req = StabilityRequest { input, scene, ratios, frames, spp: reference_spp, reference_seed: reference_seed.into(), out, resolution, trace_spp: spp, max_texture, preset, record };
+            let req = StabilityRequest { input, scene, ratios, frames, spp: reference_spp, reference_seed, out, resolution, trace_spp: spp, max_texture, preset, record };
             let report = stability::run(&req)?;
             stability::print(&report, &mut std::io::stderr()).map_err(|e| Failure::new(Exit::Io, e))?;
             if json {
@@ -385,7 +385,7 @@ fn run(cli: Cli) -> Result<Exit, Failure> {
             Ok(Exit::Ok)
         }
         Command::Reflective { scene, files, frames, reference_spp, reference_seed, out, resolution, preset, images, role, tau, json } => {
-            let req = ReflectiveRequest { scene, preset, resolution, files, frames, spp: reference_spp, reference_seed: reference_seed.into(), out, images, role, tau_px: tau };
+            let req = ReflectiveRequest { scene, preset, resolution, files, frames, spp: reference_spp, reference_seed, out, images, role, tau_px: tau };
             let report = reflective::run(&req)?;
             reflective::print(&report, &mut std::io::stderr()).map_err(|e| Failure::new(Exit::Io, e))?;
             if json {

@@ -7,7 +7,7 @@ use anyhow::Context;
 use clap::Parser;
 use indicatif::{ProgressBar, ProgressStyle};
 use pis_scene::LoadOptions;
-use pis::cli::ShadingSeedArg;
+use pis::cli::parse_shading_seed;
 use pis_trace::set::{merge_set, MergeReport, Shard};
 use pis_trace::{render_shard, Progress, SetReport, TraceError, TraceRun, TraceSettings};
 use std::path::{Path, PathBuf};
@@ -58,8 +58,8 @@ struct Cli {
     /// textures agree across it; more samples average more cells, but a cell's own estimate
     /// never improves. `sample`: each camera sample, so the noise falls as 1/spp: for a gold
     /// standard to measure files against, not for a set to pack.
-    #[arg(long, value_enum, default_value_t = ShadingSeedArg::Cell)]
-    shading_seed: ShadingSeedArg,
+    #[arg(long, value_name = "cell|sample", default_value = "cell", value_parser = parse_shading_seed)]
+    shading_seed: pis_trace::ShadingSeed,
     /// Print the closing report as JSON on stdout.
     #[arg(long)]
     json: bool,
@@ -114,7 +114,7 @@ impl Progress for Bar {
 fn run(cli: &Cli, scene: &Path, output: &Path) -> anyhow::Result<SetReport> {
     let options = LoadOptions { preset: cli.preset.clone(), resolution: cli.resolution, spp: cli.spp };
     let scene = pis_scene::load_with(scene, &options).map_err(TraceError::from)?;
-    let settings = TraceSettings::new(scene.resolution, scene.spp).with_shading_seed(cli.shading_seed.into());
+    let settings = TraceSettings::new(scene.resolution, scene.spp).with_shading_seed(cli.shading_seed);
     let bar = ProgressBar::new(0);
     bar.set_style(
         ProgressStyle::with_template("{spinner} {msg} [{bar:40}] {percent}% {elapsed_precise} (eta {eta})")

@@ -42,6 +42,14 @@ pub enum ShadingSeed {
 }
 
 impl ShadingSeed {
+    /// Every seeding, in the order the tools list them.
+    pub const ALL: [ShadingSeed; 2] = [ShadingSeed::Cell, ShadingSeed::Sample];
+
+    /// The seeding the tools spell `name` ([`ShadingSeed::name`]).
+    pub fn from_name(name: &str) -> Option<ShadingSeed> {
+        ShadingSeed::ALL.into_iter().find(|s| s.name() == name)
+    }
+
     /// `cell` or `sample`, as the tools spell it.
     pub fn name(self) -> &'static str {
         match self {
@@ -65,7 +73,6 @@ impl TraceSettings {
         };
         self
     }
-
 
     /// Defaults for a render at `resolution` with `spp` samples per pixel.
     pub fn new(resolution: (u32, u32), spp: u32) -> TraceSettings {

@@ -335,11 +335,8 @@ fn renders_are_deterministic_across_thread_counts() {
     assert_eq!(a.stats.total_rays, b.stats.total_rays);
 }
 
-/// Shading is seeded from the surface point: the diffuse radiance of a point is the same
-/// whichever view sees it (and differs between views when seeded per pixel sample).
-#[test]
-fn diffuse_noise_is_fixed_to_the_surface() {
-    use pis_trace::integrator::{Integrator, PathContext};
+/// A diffuse block on a diffuse floor lit by a sphere light, seen from above at 8×8, 1 spp.
+fn lit_block_on_a_floor() -> (pis_scene::Scene, pis_scene::Frame) {
     let s = scene(
         vec![
             object("floor", ObjectRole::Diffuse, vec![quad(Vec3::ZERO, Vec3::Z * 3.0, Vec3::X * 3.0, 0)]),
@@ -354,6 +351,15 @@ fn diffuse_noise_is_fixed_to_the_surface() {
         camera(Vec3::new(0.0, 2.0, 3.0), Vec3::ZERO, 40.0),
         vec![sphere_light("key", Vec3::new(0.5, 3.0, 1.0), [10.0; 3], 0.6)],
     );
+    (s, f)
+}
+
+/// Shading is seeded from the surface point: the diffuse radiance of a point is the same
+/// whichever view sees it (and differs between views when seeded per pixel sample).
+#[test]
+fn diffuse_noise_is_fixed_to_the_surface() {
+    use pis_trace::integrator::{Integrator, PathContext};
+    let (s, f) = lit_block_on_a_floor();
     let target = Vec3::new(0.834, 0.0, 0.617);
     let eyes = [Vec3::new(0.0, 2.0, 3.0), Vec3::new(2.5, 1.0, 1.5)];
     let diffuse_seen = |settings: &TraceSettings, seed_base: u64| -> Vec<Vec3> {
@@ -386,20 +392,7 @@ fn diffuse_noise_is_fixed_to_the_surface() {
 #[test]
 fn shading_seeded_per_sample_converges_as_one_over_spp() {
     use pis_trace::ShadingSeed;
-    let s = scene(
-        vec![
-            object("floor", ObjectRole::Diffuse, vec![quad(Vec3::ZERO, Vec3::Z * 3.0, Vec3::X * 3.0, 0)]),
-            object("block", ObjectRole::Diffuse, cuboid(Vec3::new(-0.5, 0.0, -0.5), Vec3::new(0.5, 1.0, 0.5), 1, false)),
-        ],
-        vec![matte([0.7; 3]), matte([0.2, 0.6, 0.3])],
-        (8, 8),
-        1,
-    );
-    let f = frame(
-        &s,
-        camera(Vec3::new(0.0, 2.0, 3.0), Vec3::ZERO, 40.0),
-        vec![sphere_light("key", Vec3::new(0.5, 3.0, 1.0), [10.0; 3], 0.6)],
-    );
+    let (s, f) = lit_block_on_a_floor();
     assert_eq!(TraceSettings::new(s.resolution, 1).with_shading_seed(ShadingSeed::Cell), TraceSettings::new(s.resolution, 1));
     let image = |spp: u32| -> Vec<f32> {
         let settings = TraceSettings::new(s.resolution, spp).with_shading_seed(ShadingSeed::Sample);
