@@ -187,6 +187,34 @@ fn shading_seeded_per_sample_is_recorded() {
 }
 
 #[test]
+fn a_sample_stream_is_recorded_and_changes_the_noise() {
+    let tmp = tempfile::tempdir().unwrap();
+    let scene = tiny_scene(tmp.path());
+    let s = scene.to_str().unwrap();
+    let dir = |n: &str| tmp.path().join(n);
+    for (name, extra) in [("default", &[][..]), ("zero", &["--seed", "0"][..]), ("one", &["--seed", "1"][..])] {
+        let o = dir(name);
+        let mut args = vec![s, "-o", o.to_str().unwrap(), "--points", "1", "--shading-seed", "sample", "--json"];
+        args.extend_from_slice(extra);
+        let out = trace(&args);
+        assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+        let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        assert_eq!(report["seed"], if name == "one" { 1 } else { 0 });
+    }
+    let combined = |n: &str| RaySet::open(&dir(n)).unwrap().read_point(0).unwrap().layer("combined").unwrap().planes[0].clone();
+    assert_eq!(combined("default"), combined("zero"));
+    assert_ne!(combined("default"), combined("one"));
+    let settings = |n: &str| RaySet::open(&dir(n)).unwrap().meta.renderer.and_then(|r| r.settings).unwrap();
+    assert_eq!(settings("one").seed, 1);
+    assert_eq!(settings("zero").seed, 0);
+    // The default stream leaves set.json as it was before streams were recorded.
+    let json = std::fs::read_to_string(dir("zero").join("set.json")).unwrap();
+    assert!(!json.contains("\"seed\""), "{json}");
+    let out = trace(&[s, "-o", dir("bad").to_str().unwrap(), "--seed", "-1"]);
+    assert_eq!(out.status.code(), Some(1), "{}", text(&out.stderr));
+}
+
+#[test]
 fn errors_have_documented_exit_codes() {
     let tmp = tempfile::tempdir().unwrap();
     let scene = tiny_scene(tmp.path());

@@ -237,6 +237,12 @@ enum Command {
         /// 1/spp: a gold standard).
         #[arg(long, value_name = "cell|sample", default_value = "cell", value_parser = parse_shading_seed)]
         reference_seed: pis_trace::ShadingSeed,
+        /// Trace every reference twice from independent sample streams (needs
+        /// --reference-seed sample): the gold standard is their mean, their difference
+        /// measures its own noise, and the report adds each figure with that noise taken out
+        /// (an estimate of the PSNR against the converged image).
+        #[arg(long)]
+        reference_pair: bool,
         #[arg(long, default_value = "reports")]
         out: PathBuf,
         #[arg(long, value_parser = parse_resolution)]
@@ -384,8 +390,8 @@ fn run(cli: Cli) -> Result<Exit, Failure> {
             }
             Ok(Exit::Ok)
         }
-        Command::Reflective { scene, files, frames, reference_spp, reference_seed, out, resolution, preset, images, role, tau, json } => {
-            let req = ReflectiveRequest { scene, preset, resolution, files, frames, spp: reference_spp, reference_seed, out, images, role, tau_px: tau };
+        Command::Reflective { scene, files, frames, reference_spp, reference_seed, reference_pair, out, resolution, preset, images, role, tau, json } => {
+            let req = ReflectiveRequest { scene, preset, resolution, files, frames, spp: reference_spp, reference_seed, reference_pair, out, images, role, tau_px: tau };
             let report = reflective::run(&req)?;
             reflective::print(&report, &mut std::io::stderr()).map_err(|e| Failure::new(Exit::Io, e))?;
             if json {

@@ -139,7 +139,10 @@ fn render_row(
     let mut pixels = Vec::with_capacity(w as usize);
     let mut records = Vec::new();
     for x in 0..w {
-        let pixel_seed = hash_keys(&[x as u64, y as u64]);
+        let pixel_seed = match settings.seed {
+            0 => hash_keys(&[x as u64, y as u64]),
+            seed => hash_keys(&[x as u64, y as u64, seed]),
+        };
         let shift = Rng::new(pixel_seed).next_2d();
         let mut acc = PixelAccum::default();
         for s in 0..settings.spp {

@@ -22,6 +22,8 @@ pub struct SetReport {
     /// What seeded the shading: `cell` (the surface point) or `sample` (each camera
     /// sample).
     pub shading_seed: String,
+    /// The camera samples' stream (`pis-trace --seed`; 0 the default).
+    pub seed: u64,
     /// Worker threads.
     pub threads: usize,
     /// Largest number of world triangles of any point.
@@ -145,6 +147,7 @@ pub fn render_shard(
         resolution: [settings.resolution.0, settings.resolution.1],
         spp: settings.spp,
         shading_seed: settings.shading_seed().name().into(),
+        seed: settings.seed,
         threads: rayon::current_num_threads(),
         ..Default::default()
     };

@@ -28,6 +28,16 @@ pub struct TraceSettings {
     pub records_per_pixel: u32,
     /// Most front-facing hits recorded along one continued outgoing ray.
     pub max_record_hits: u32,
+    /// Stream of the camera samples' random numbers (their positions in the pixel and, with
+    /// shading seeded per sample, their shading): renders that differ only in `seed` have
+    /// independent noise, so two of them measure a render's own noise ([`ShadingSeed`]:
+    /// seeded per cell, the surfaces' noise stays the same). 0 is the default stream.
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub seed: u64,
+}
+
+fn is_zero(v: &u64) -> bool {
+    *v == 0
 }
 
 /// What seeds the shading's random numbers ([`TraceSettings::coherence_cell`]).
@@ -74,6 +84,12 @@ impl TraceSettings {
         self
     }
 
+    /// The same settings drawing their camera samples from stream `seed`.
+    pub fn with_seed(mut self, seed: u64) -> TraceSettings {
+        self.seed = seed;
+        self
+    }
+
     /// Defaults for a render at `resolution` with `spp` samples per pixel.
     pub fn new(resolution: (u32, u32), spp: u32) -> TraceSettings {
         TraceSettings {
@@ -86,6 +102,7 @@ impl TraceSettings {
             coherence_cell: None,
             records_per_pixel: 2,
             max_record_hits: 4,
+            seed: 0,
         }
     }
 }

@@ -406,3 +406,28 @@ fn shading_seeded_per_sample_converges_as_one_over_spp() {
     let (e4, e64) = (mse(&image(4)), mse(&image(64)));
     assert!(e64 > 0.0 && e4 > 8.0 * e64, "squared error {e4} at 4 spp, {e64} at 64 spp");
 }
+
+/// Two renders seeded per sample from different streams (`TraceSettings::seed`) have
+/// independent noise: their squared difference is the sum of their squared errors against
+/// a converged render (within the estimates' spread; 0 for the same stream), which is what
+/// lets a pair of references measure its own noise. Stream 0 is the default.
+#[test]
+fn renders_from_two_streams_have_independent_noise() {
+    use pis_trace::ShadingSeed;
+    let (s, f) = lit_block_on_a_floor();
+    assert_eq!(TraceSettings::new(s.resolution, 1).with_seed(0), TraceSettings::new(s.resolution, 1));
+    let image = |spp: u32, stream: u64| -> Vec<f32> {
+        let settings = TraceSettings::new(s.resolution, spp).with_shading_seed(ShadingSeed::Sample).with_seed(stream);
+        let r = render(&s, &f, &settings);
+        let c = r.images.layer("combined").unwrap();
+        (0..8).flat_map(|y| (0..8).map(move |x| (x, y))).map(|(x, y)| c.rgb(x, y).element_sum()).collect()
+    };
+    let mse = |a: &[f32], b: &[f32]| a.iter().zip(b).map(|(a, b)| ((a - b) as f64).powi(2)).sum::<f64>() / a.len() as f64;
+    let truth = image(2048, 7);
+    let (a, b) = (image(16, 0), image(16, 1));
+    assert_eq!(a, image(16, 0));
+    let (ea, eb, ab) = (mse(&a, &truth), mse(&b, &truth), mse(&a, &b));
+    let ratio = ab / (ea + eb);
+    eprintln!("difference {ab:.5}, errors {ea:.5} and {eb:.5}: ratio {ratio:.3}");
+    assert!((0.6..1.6).contains(&ratio), "difference {ab}, errors {ea} and {eb}: ratio {ratio}");
+}

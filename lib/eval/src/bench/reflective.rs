@@ -6,7 +6,10 @@
 //! sampled views on their orbit, and away from it: a larger radius, higher elevation) and
 //! compared with a frame ray-traced at that exact camera (the gold standard, at its own
 //! samples per pixel), on display values over the pixels the scene's reflective objects
-//! cover in the traced frame. Popping: per path, the largest
+//! cover in the traced frame. With a reference pair, each frame is traced twice from
+//! independent sample streams (`pis-trace --seed`): the gold standard is their mean, and
+//! their difference measures its own noise, which is then taken out of each file's error
+//! ([`PairedError`]). Popping: per path, the largest
 //! frame-to-frame RMS change of the played frames over the reference's change between the
 //! same frames.
 
@@ -22,7 +25,7 @@ use pis_trace::{ShadingSeed, TraceSettings};
 use serde::Serialize;
 
 use super::camera_path::{paths, PathFrame, PathKind};
-use crate::metrics::{display, SquaredError};
+use crate::metrics::{display, PairedError, SquaredError};
 use crate::report::{Csv, Stamp};
 use pis_pack::{Exit, Failure};
 
@@ -45,6 +48,9 @@ pub struct ReflectiveRequest {
     /// What seeds the reference frames' shading (`Sample` for a gold standard whose noise
     /// falls as 1/spp).
     pub reference_seed: ShadingSeed,
+    /// Trace every reference twice, from independent sample streams, to measure and take out
+    /// its noise (needs `reference_seed` `Sample`).
+    pub reference_pair: bool,
     /// Where reflective.csv goes.
     pub out: PathBuf,
     /// Also write every played frame beside its traced reference as an sRGB PNG.
@@ -64,6 +70,14 @@ pub struct ReflectiveSummary {
     pub mean_psnr_db: f64,
     pub min_psnr_db: f64,
     pub popping: f64,
+    /// With a reference pair: over the path's frames pooled, the PSNR against the
+    /// references' mean; the same with the references' own noise taken out (an estimate of
+    /// the PSNR against the converged image; infinite, `null` in JSON, when the error is
+    /// within that noise); and the references' mean's own noise as a PSNR (its variance;
+    /// see [`PairedError`] for the bias of clamped display values, which stays in).
+    pub pooled_psnr_db: Option<f64>,
+    pub noise_removed_psnr_db: Option<f64>,
+    pub reference_psnr_db: Option<f64>,
 }
 
 #[derive(Clone, Debug, Serialize)]
@@ -75,19 +89,37 @@ pub struct ReflectiveReport {
     pub reference_spp: u32,
     /// `cell` or `sample`: what seeded the reference frames' shading.
     pub reference_seed: String,
+    /// Whether each reference was traced twice from independent streams (its noise taken
+    /// out of the figures: [`ReflectiveSummary::noise_removed_psnr_db`]).
+    pub reference_pair: bool,
     pub summaries: Vec<ReflectiveSummary>,
     pub csv: String,
     pub stamp: Stamp,
 }
 
-/// A traced reference frame: linear RGB and the mask of the reflective objects' pixels.
+/// A traced reference frame: linear RGB (with a pair, the mean of the two), the mask of
+/// the measured objects' pixels, and with a pair the two renders.
 struct Reference {
     rgb: Vec<f32>,
     mask: Vec<bool>,
+    pair: Option<[Vec<f32>; 2]>,
 }
 
-fn reference(scene: &Scene, pf: &PathFrame, spp: u32, seed: ShadingSeed, objects: &[usize]) -> Result<Reference> {
-    let settings = TraceSettings::new(scene.resolution, spp).with_shading_seed(seed);
+/// The stream of the second render of a reference pair (the first is the default, 0).
+const SECOND_STREAM: u64 = 1;
+
+fn reference(scene: &Scene, pf: &PathFrame, spp: u32, seed: ShadingSeed, pair: bool, objects: &[usize]) -> Result<Reference> {
+    let first = render_reference(scene, pf, spp, seed, 0, objects)?;
+    if !pair {
+        return Ok(first);
+    }
+    let second = render_reference(scene, pf, spp, seed, SECOND_STREAM, objects)?;
+    let rgb = first.rgb.iter().zip(&second.rgb).map(|(a, b)| 0.5 * (a + b)).collect();
+    Ok(Reference { rgb, mask: first.mask, pair: Some([first.rgb, second.rgb]) })
+}
+
+fn render_reference(scene: &Scene, pf: &PathFrame, spp: u32, seed: ShadingSeed, stream: u64, objects: &[usize]) -> Result<Reference> {
+    let settings = TraceSettings::new(scene.resolution, spp).with_shading_seed(seed).with_seed(stream);
     let r = pis_trace::render_point(scene, &pf.frame, &settings, &|| {})?;
     let l = r.images.layer("combined").ok_or_else(|| anyhow!("the traced frame has no combined image"))?;
     let n = l.width as usize * l.height as usize;
@@ -103,7 +135,7 @@ fn reference(scene: &Scene, pf: &PathFrame, spp: u32, seed: ShadingSeed, objects
             mask.iter_mut().zip(a).for_each(|(m, &c)| *m |= c > 0.5);
         }
     }
-    Ok(Reference { rgb, mask })
+    Ok(Reference { rgb, mask, pair: None })
 }
 
 /// The player's camera for a path frame.
@@ -167,6 +199,9 @@ pub fn run(req: &ReflectiveRequest) -> Result<ReflectiveReport, Failure> {
     if req.files.is_empty() || req.frames < 2 || req.spp == 0 {
         return Err(Failure::new(Exit::Usage, anyhow!("give at least one file, --frames ≥ 2 and --spp ≥ 1")));
     }
+    if req.reference_pair && req.reference_seed != ShadingSeed::Sample {
+        return Err(Failure::new(Exit::Usage, anyhow!("--reference-pair needs --reference-seed sample: seeded per cell, both renders carry the same surface noise, so their difference cannot measure it")));
+    }
     let options = LoadOptions { preset: req.preset.clone(), resolution: req.resolution, spp: None };
     let scene = pis_scene::load_with(&req.scene, &options).map_err(|e| Failure::new(pis_pack::scene_exit(&e), anyhow!("{}: {e}", req.scene.display())))?;
     let objects: Vec<usize> = scene.objects.iter().enumerate().filter(|(_, o)| o.role == req.role).map(|(i, _)| i).collect();
@@ -174,11 +209,12 @@ pub fn run(req: &ReflectiveRequest) -> Result<ReflectiveReport, Failure> {
         return Err(Failure::new(Exit::Usage, anyhow!("scene {} has no {} object", scene.name, role_name(req.role))));
     }
     let (view_dim, frames) = paths(&scene, req.frames, &PATHS).map_err(|e| Failure::new(Exit::NotSupported, e))?;
-    eprintln!("pis-bench: reflective: tracing {} reference frames at {} spp", frames.len(), req.spp);
-    let refs: Vec<Reference> = frames.iter().map(|f| reference(&scene, f, req.spp, req.reference_seed, &objects)).collect::<Result<_>>().map_err(runtime)?;
+    let twice = if req.reference_pair { ", each twice from independent streams" } else { "" };
+    eprintln!("pis-bench: reflective: tracing {} reference frames at {} spp{twice}", frames.len(), req.spp);
+    let refs: Vec<Reference> = frames.iter().map(|f| reference(&scene, f, req.spp, req.reference_seed, req.reference_pair, &objects)).collect::<Result<_>>().map_err(runtime)?;
     let gpu = Arc::new(Gpu::new().map_err(|e| Failure::new(Exit::NotSupported, anyhow!("{e}")))?);
     let size = scene.resolution;
-    let mut csv = Csv::new(&["file", "path", "frame", "view", "psnr_db", "change_played", "change_reference"]);
+    let mut csv = Csv::new(&["file", "path", "frame", "view", "psnr_db", "change_played", "change_reference", "psnr_noise_removed_db", "reference_psnr_db"]);
     let mut summaries = Vec::new();
     for file in &req.files {
         let mut player = Player::open(gpu.clone(), file, PlayerOptions { tau_px: req.tau_px, ..PlayerOptions::default() }).map_err(|e| Failure::new(Exit::Invalid, anyhow!("{}: {e}", file.display())))?;
@@ -201,12 +237,22 @@ pub fn run(req: &ReflectiveRequest) -> Result<ReflectiveReport, Failure> {
         }
         for kind in PATHS {
             let idx: Vec<usize> = (0..frames.len()).filter(|&i| frames[i].kind == kind).collect();
-            let (mut psnrs, mut popping) = (Vec::new(), 0.0f64);
+            let (mut psnrs, mut popping, mut pooled) = (Vec::new(), 0.0f64, PairedError::default());
             for (j, &i) in idx.iter().enumerate() {
                 let mut e = SquaredError::default();
+                let mut paired = PairedError::default();
                 for (p, _) in refs[i].mask.iter().enumerate().filter(|(_, m)| **m) {
-                    e.add_slices(&played[i][p * 3..p * 3 + 3], &refs[i].rgb[p * 3..p * 3 + 3]);
+                    let k = p * 3..p * 3 + 3;
+                    e.add_slices(&played[i][k.clone()], &refs[i].rgb[k.clone()]);
+                    if let Some([a, b]) = &refs[i].pair {
+                        paired.add_slices(&played[i][k.clone()], &a[k.clone()], &b[k]);
+                    }
                 }
+                pooled.merge(&paired);
+                let paired_cells = match refs[i].pair {
+                    Some(_) => [format!("{:.3}", paired.psnr_noise_removed()), format!("{:.3}", paired.reference_psnr())],
+                    None => [String::new(), String::new()],
+                };
                 let change = (j > 0).then(|| {
                     let prev = idx[j - 1];
                     let both: Vec<bool> = refs[i].mask.iter().zip(&refs[prev].mask).map(|(a, b)| *a && *b).collect();
@@ -217,11 +263,22 @@ pub fn run(req: &ReflectiveRequest) -> Result<ReflectiveReport, Failure> {
                 }
                 psnrs.push(e.psnr());
                 csv.push(vec![name.clone(), kind.name().into(), j.to_string(), format!("{:.3}", frames[i].view), format!("{:.3}", e.psnr()),
-                              change.map_or(String::new(), |c| format!("{:.5}", c[0])), change.map_or(String::new(), |c| format!("{:.5}", c[1]))]);
+                              change.map_or(String::new(), |c| format!("{:.5}", c[0])), change.map_or(String::new(), |c| format!("{:.5}", c[1])),
+                              paired_cells[0].clone(), paired_cells[1].clone()]);
             }
             let mean = psnrs.iter().sum::<f64>() / psnrs.len().max(1) as f64;
             let min = psnrs.iter().copied().fold(f64::INFINITY, f64::min);
-            summaries.push(ReflectiveSummary { file: name.clone(), path: kind, mean_psnr_db: mean, min_psnr_db: min, popping });
+            let pair = |v: f64| req.reference_pair.then_some(v);
+            summaries.push(ReflectiveSummary {
+                file: name.clone(),
+                path: kind,
+                mean_psnr_db: mean,
+                min_psnr_db: min,
+                popping,
+                pooled_psnr_db: pair(pooled.against_mean.psnr()),
+                noise_removed_psnr_db: pair(pooled.psnr_noise_removed()),
+                reference_psnr_db: pair(pooled.reference_psnr()),
+            });
         }
     }
     std::fs::create_dir_all(&req.out).map_err(|e| Failure::new(Exit::Io, anyhow!("{}: {e}", req.out.display())))?;
@@ -235,15 +292,22 @@ pub fn run(req: &ReflectiveRequest) -> Result<ReflectiveReport, Failure> {
         frames: req.frames,
         reference_spp: req.spp,
         reference_seed: req.reference_seed.name().into(),
+        reference_pair: req.reference_pair,
         summaries,
         csv: csv_path.display().to_string(),
     })
 }
 
 pub fn print(r: &ReflectiveReport, out: &mut impl std::io::Write) -> std::io::Result<()> {
-    writeln!(out, "reflective: {} — played frames vs pis-trace over the pixels of {}, {} frames between and away, references at {} spp (shading seeded per {})", r.scene, r.objects.join(", "), r.frames, r.reference_spp, r.reference_seed)?;
+    let pair = if r.reference_pair { ", each traced twice: the gold standard is their mean, its noise measured from their difference" } else { "" };
+    writeln!(out, "reflective: {} — played frames vs pis-trace over the pixels of {}, {} frames between and away, references at {} spp (shading seeded per {}{pair})", r.scene, r.objects.join(", "), r.frames, r.reference_spp, r.reference_seed)?;
     for s in &r.summaries {
-        writeln!(out, "  {:<28} {:<8} mean {:6.2} dB  min {:6.2} dB  popping {:5.2}", s.file, s.path.name(), s.mean_psnr_db, s.min_psnr_db, s.popping)?;
+        write!(out, "  {:<28} {:<8} mean {:6.2} dB  min {:6.2} dB  popping {:5.2}", s.file, s.path.name(), s.mean_psnr_db, s.min_psnr_db, s.popping)?;
+        if let (Some(pooled), Some(removed), Some(reference)) = (s.pooled_psnr_db, s.noise_removed_psnr_db, s.reference_psnr_db) {
+            let removed = if removed.is_finite() { format!("{removed:6.2} dB") } else { "within the references' noise".to_string() };
+            write!(out, "  pooled {pooled:6.2} dB  noise removed {removed}  (gold standard's noise {reference:.2} dB)")?;
+        }
+        writeln!(out)?;
     }
     writeln!(out, "  wrote {}", r.csv)
 }
