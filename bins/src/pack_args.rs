@@ -9,7 +9,7 @@ use pis_codec::CodecId;
 use pis_compile::{Filter, MAX_ANISOTROPY};
 
 use crate::cli::{Exit, Failure};
-use pis_pack::{filter_needs_probe, Allocation, BlockSize, LayerMode, MatrixSource, MaxMse, PackRequest, PackSettings, PlacementMode, PyramidMode, RepresentationMode};
+use pis_pack::{filter_needs_probe, Allocation, BlockSize, LayerMode, MatrixSource, MaxMse, PackRequest, PackSettings, PlacementMode, PyramidMode, RepresentationMode, Stagger};
 
 /// pis-pack's settings on the command line.
 #[derive(Args, Debug, Clone)]
@@ -109,6 +109,12 @@ pub struct PackOptions {
     /// block's samples) or `object` (one placement per object over every view of the set).
     #[arg(long, default_value = "block", value_parser = parse_placement)]
     pub placement: PlacementMode,
+    /// Which dimensions the objects' block origins are staggered along (thesis 4.7), so that
+    /// crossing a block boundary decodes one object's block at a time: `auto`, those with
+    /// more samples than a block (one that fits in a block has no boundary, and an offset
+    /// would only split each object's samples in two); `always`, every dimension.
+    #[arg(long, value_name = "auto|always", default_value = "auto", value_parser = parse_stagger)]
+    pub stagger: Stagger,
     /// Also store the lossless master: every solved texture, before gamma compensation and
     /// coding, losslessly coded in MSTR chunks a player never reads. pis-reencode codes
     /// again from it (as a direct pack at the new settings would) instead of from the decoded
@@ -150,6 +156,7 @@ impl PackOptions {
             allocation: self.allocation,
             max_mse: self.max_mse_ratio,
             placement: self.placement,
+            stagger: self.stagger,
             max_iterations: self.max_iterations,
             keep_master: self.keep_master,
             preset: self.preset.clone(),
@@ -219,6 +226,10 @@ fn parse_representation(s: &str) -> Result<RepresentationMode, String> {
         "auto" => Ok(RepresentationMode::Auto),
         _ => Err(format!("unknown representation {s:?} (auto, texture, pem, pem-infinity or static-env)")),
     }
+}
+
+fn parse_stagger(s: &str) -> Result<Stagger, String> {
+    Stagger::from_name(s).ok_or_else(|| format!("unknown stagger {s:?} (auto or always)"))
 }
 
 fn parse_placement(s: &str) -> Result<PlacementMode, String> {

@@ -265,7 +265,8 @@ pub fn reencode(req: &ReencodeRequest) -> Result<ReencodeReport, Failure> {
             for (d, &s) in space.dims.iter_mut().zip(&sizes) {
                 d.block_size = s;
             }
-            (0..c.objects.len()).map(|i| stagger(i, c.objects.len(), &sizes)).collect()
+            let samples: Vec<usize> = c.space.dims.iter().map(|d| d.values.len()).collect();
+            (0..c.objects.len()).map(|i| stagger(i, c.objects.len(), &sizes, &samples, pis_pack::Stagger::Auto)).collect()
         }
     };
     let exact = !req.codec.is_lossy();

@@ -5,6 +5,7 @@ use anyhow::{anyhow, Result};
 use pis_format::*;
 
 use super::input::LoadedSet;
+use super::Stagger;
 
 fn row3x4(m: glam::Mat4) -> [f32; 12] {
     let mut out = [0.0; 12];
@@ -23,9 +24,17 @@ pub fn block_sizes(block: &[u32], dims: usize) -> Result<Vec<u32>> {
     }
 }
 
-/// Block origin offsets of object `i` of `n` (thesis 4.7): `i · B / n` per dimension.
-pub fn stagger(i: usize, n: usize, sizes: &[u32]) -> Vec<u32> {
-    sizes.iter().map(|&b| (i as u64 * b as u64 / n.max(1) as u64) as u32).collect()
+/// Block origin offsets of object `i` of `n` (thesis 4.7): `i · B / n` per dimension of
+/// `samples` values, so that the objects' blocks end at different points of the space and
+/// a player crossing a block boundary decodes one object's block, not every object's. With
+/// [`Stagger::Auto`], a dimension whose samples fit in one block (`samples` ≤ B) has no
+/// boundary to cross and is not staggered: there an offset would only cut the object's
+/// samples into two blocks, each coding its own top level, and add a decode on the way
+/// across.
+pub fn stagger(i: usize, n: usize, sizes: &[u32], samples: &[usize], mode: Stagger) -> Vec<u32> {
+    sizes.iter().zip(samples).map(|(&b, &k)| {
+        if mode == Stagger::Auto && k <= b as usize { 0 } else { (i as u64 * b as u64 / n.max(1) as u64) as u32 }
+    }).collect()
 }
 
 /// The parameter space and camera table of the container for blocks of `sizes`.
@@ -119,3 +128,19 @@ pub fn check_transforms(scene: &pis_scene::Scene, frames: &[pis_scene::Frame]) -
     Ok(())
 }
 
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn only_dimensions_longer_than_a_block_are_staggered() {
+        // Two dimensions of 8 and 20 samples, blocks of 8, object 3 of 6.
+        assert_eq!(stagger(3, 6, &[8, 8], &[8, 20], Stagger::Auto), vec![0, 4]);
+        assert_eq!(stagger(3, 6, &[8, 8], &[8, 20], Stagger::Always), vec![4, 4]);
+        // Blocks of 4 over the 8 samples: two blocks to cross, so staggered.
+        assert_eq!(stagger(3, 6, &[4, 8], &[8, 20], Stagger::Auto), vec![2, 4]);
+        // The first object is never offset.
+        assert_eq!(stagger(0, 6, &[8, 8], &[9, 20], Stagger::Always), vec![0, 0]);
+    }
+}

@@ -156,6 +156,7 @@ fn shell_weights(m: &ObjectModel, s: usize, li: usize, k: &[u32], points: &[usiz
 pub fn encode_all(set: &LoadedSet, models: &[ObjectModel], req: &PackRequest, stages: &mut Stages) -> Result<Packed, Failure> {
     let runtime = |e: anyhow::Error| Failure::new(Exit::Runtime, e);
     let sizes = block_sizes(req.block.as_slice(), set.scene.space.dims.len()).map_err(|e| Failure::new(Exit::Usage, e))?;
+    let samples: Vec<usize> = set.scene.space.dims.iter().map(|d| d.values.len()).collect();
     let (space, cameras) = geometry(set, &sizes);
     if pis_codec::codec(req.codec).is_none() {
         return Err(runtime(anyhow!("codec {} is not in this build", req.codec)));
@@ -168,7 +169,7 @@ pub fn encode_all(set: &LoadedSet, models: &[ObjectModel], req: &PackRequest, st
     let mut where_ = Vec::new();
     let mut screen_weights = Vec::new();
     for (mi, m) in models.iter().enumerate() {
-        let st = stagger(mi, models.len(), &sizes);
+        let st = stagger(mi, models.len(), &sizes, &samples, req.stagger);
         if st != m.stagger || sizes != m.block_sizes {
             return Err(runtime(anyhow!(
                 "object {}: its textures were placed for blocks of {:?} samples staggered by {:?}, the encoding asks for blocks of {sizes:?} staggered by {st:?}",
@@ -286,6 +287,9 @@ pub fn encode_all(set: &LoadedSet, models: &[ObjectModel], req: &PackRequest, st
     }
     if req.allocation != super::Allocation::Screen {
         settings.push(("allocation".to_string(), "texture".to_string()));
+    }
+    if req.stagger != super::Stagger::Auto {
+        settings.push(("stagger".to_string(), req.stagger.name().to_string()));
     }
     // The set's display filter, which players resolve multisampled frames with (SPEC.md
     // 6.6); a set recording an invalid one (rule 9002) is packed without it.

@@ -76,6 +76,8 @@ pub struct PackSettings {
     pub representation: RepresentationMode,
     /// Texture placements per parameter block (default) or per object.
     pub placement: PlacementMode,
+    /// Which dimensions the objects' block origins are staggered along (thesis 4.7).
+    pub stagger: Stagger,
     /// Conjugate-gradient iteration cap per colour channel of every solve (`None`: the
     /// solver's default).
     pub max_iterations: Option<u32>,
@@ -121,6 +123,7 @@ impl PackSettings {
             max_mse: MaxMse::Best(pis_codec::allocate::DEFAULT_ALPHA),
             representation: RepresentationMode::Texture,
             placement: PlacementMode::Block,
+            stagger: Stagger::Auto,
             max_iterations: None,
             keep_master: false,
             preset: None,
@@ -277,6 +280,37 @@ impl PlacementMode {
             PlacementMode::Block => "block",
             PlacementMode::Object => "object",
         }
+    }
+}
+
+/// Which dimensions the objects' parameter-block origins are staggered along (thesis 4.7).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Stagger {
+    /// The dimensions with more samples than a block: there the objects' blocks end at
+    /// different points, so a player crossing a boundary decodes one object's block at a
+    /// time. A dimension that fits in one block has no boundary, and an offset would only
+    /// cut each object's samples in two.
+    #[default]
+    Auto,
+    /// Every dimension, whatever its samples (object i of n offset by i·B/n).
+    Always,
+}
+
+impl Stagger {
+    /// The name `--stagger` and the provenance use.
+    pub fn name(self) -> &'static str {
+        match self {
+            Stagger::Auto => "auto",
+            Stagger::Always => "always",
+        }
+    }
+
+    /// Every mode, in the order the tools list them.
+    pub const ALL: [Stagger; 2] = [Stagger::Auto, Stagger::Always];
+
+    /// The mode the tools spell `name`.
+    pub fn from_name(name: &str) -> Option<Stagger> {
+        Stagger::ALL.into_iter().find(|m| m.name() == name)
     }
 }
 
