@@ -228,7 +228,7 @@ fn parse_representation(s: &str) -> Result<RepresentationMode, String> {
     }
 }
 
-fn parse_stagger(s: &str) -> Result<Stagger, String> {
+pub fn parse_stagger(s: &str) -> Result<Stagger, String> {
     Stagger::from_name(s).ok_or_else(|| format!("unknown stagger {s:?} (auto or always)"))
 }
 

@@ -141,6 +141,10 @@ enum Command {
         /// the constraint at ALPHA.
         #[arg(long, value_name = "auto|off|ALPHA", default_value = "auto", value_parser = pis::pack_args::parse_max_mse_ratio)]
         max_mse_ratio: pis_pack::MaxMse,
+        /// The PIS packs' block staggering, as pis-pack's --stagger: `auto` (the dimensions
+        /// with more samples than a block) or `always` (every dimension).
+        #[arg(long, value_name = "auto|always", default_value = "auto", value_parser = pis::pack_args::parse_stagger)]
+        stagger: pis_pack::Stagger,
         /// Record the run (machine, scene, command, PSNR near 384:1) in docs/BENCHMARKS.md.
         #[arg(long)]
         record: bool,
@@ -363,8 +367,8 @@ fn run(cli: Cli) -> Result<Exit, Failure> {
             }
             Ok(Exit::Ok)
         }
-        Command::Rd { input, scene, ratios, out, resolution, spp, max_texture, preset, methods, max_mse_ratio, record, json } => {
-            let req = RdRequest { input, scene, ratios, out, resolution, spp, max_texture, preset, record, methods, max_mse: max_mse_ratio };
+        Command::Rd { input, scene, ratios, out, resolution, spp, max_texture, preset, methods, max_mse_ratio, stagger, record, json } => {
+            let req = RdRequest { input, scene, ratios, out, resolution, spp, max_texture, preset, record, methods, max_mse: max_mse_ratio, stagger };
             let report = rd::run(&req)?;
             rd::print(&report, &mut std::io::stderr()).map_err(|e| Failure::new(Exit::Io, e))?;
             if json {

@@ -65,7 +65,7 @@ pub fn run(preset: Preset, scene: &Path, out: &Path, record: bool) -> Result<(),
     clear_cache(scene, &s)?;
     let preset_name = s.preset.map(str::to_string);
     let rd_req = RdRequest { input: scene.to_path_buf(), scene: None, ratios: s.rd_ratios.clone(), out: out.to_path_buf(), resolution: s.resolution,
-                             spp: s.spp, max_texture: pis_pack::DEFAULT_MAX_TEXTURE, preset: preset_name.clone(), record, methods: vec![], max_mse: pis_pack::PackSettings::new().max_mse };
+                             spp: s.spp, max_texture: pis_pack::DEFAULT_MAX_TEXTURE, preset: preset_name.clone(), record, methods: vec![], max_mse: pis_pack::PackSettings::new().max_mse, stagger: pis_pack::Stagger::Auto };
     let r = rd::run(&rd_req)?;
     rd::print(&r, &mut std::io::stderr()).map_err(|e| Failure::new(Exit::Io, e))?;
     let speed_req = SpeedRequest { input: scene.to_path_buf(), scene: None, caps: s.caps.clone(), ratio: 384.0, out: out.to_path_buf(),

@@ -48,6 +48,8 @@ pub struct RdRequest {
     pub methods: Vec<String>,
     /// The PIS packs' max-MSE constraint (thesis 4.8), as `pis-pack --max-mse-ratio`.
     pub max_mse: pis_pack::MaxMse,
+    /// The PIS packs' block staggering, as `pis-pack --stagger`.
+    pub stagger: pis_pack::Stagger,
 }
 
 /// One measured point.
@@ -97,7 +99,7 @@ pub struct RdReport {
 pub const METHODS: [&str; 7] = ["pis-wavelet", "pis-dct", "pis-wavelet-full-pyramid", "pis-wavelet-combined-layers", "mpeg-texture-x265", "view-x265", "view-av1"];
 
 fn pack_request(req: &RdRequest) -> PackRequest {
-    let settings = PackSettings { max_texture: req.max_texture, resolution: req.resolution, spp: req.spp, preset: req.preset.clone(), max_mse: req.max_mse, ..PackSettings::new() };
+    let settings = PackSettings { max_texture: req.max_texture, resolution: req.resolution, spp: req.spp, preset: req.preset.clone(), max_mse: req.max_mse, stagger: req.stagger, ..PackSettings::new() };
     PackRequest { scene: req.scene.clone(), ..PackRequest::new(req.input.clone(), req.out.join("unused.pis"), settings) }
 }
 
