@@ -60,6 +60,14 @@ fn mastered_per_object() -> &'static Path {
     &PACK.get_or_init(|| pack("mastered-object.pis", &["--ratio", "24", "--keep-master", "--placement", "object"])).1
 }
 
+/// The max-MSE constraint a file's writer applied, as its provenance records it (what
+/// pis-reencode applies again): a direct pack compared with a re-encoding is given the same,
+/// since `auto` may choose otherwise at the new ratio.
+fn recorded_max_mse(file: &Path) -> String {
+    let c = PisReader::open(file).expect("file").load_all().expect("load");
+    c.provenance.expect("provenance").settings.iter().find(|(k, _)| k == "max_mse_ratio").map(|(_, v)| v.clone()).expect("max_mse_ratio recorded")
+}
+
 fn reencode(input: &Path, output: &Path, args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_pis-reencode")).arg(input).arg("-o").arg(output).args(args).arg("--json").output().expect("pis-reencode runs")
 }
@@ -203,7 +211,7 @@ fn reencoding_from_the_master_gives_a_direct_pack() {
     let after = r["psnr_master_after_db"].as_f64().expect("PSNR of the output against the master");
     assert!(after < before && (r["psnr_change_db"].as_f64().expect("change") - (after - before)).abs() < 1e-9, "{r}");
     // A direct pack at ratio 48: the same level images, byte for byte, hence the same PSNR.
-    let (_d, direct) = pack("direct.pis", &["--ratio", "48"]);
+    let (_d, direct) = pack("direct.pis", &["--ratio", "48", "--max-mse-ratio", &recorded_max_mse(mastered())]);
     same_player_content(&out, &direct);
     // Geometry and transforms are the input's.
     let (a, b) = (PisReader::open(mastered()).expect("input"), PisReader::open(&out).expect("output"));
@@ -303,7 +311,7 @@ fn reblocking_from_the_master_gives_a_direct_pack_with_those_blocks() {
     let r = json(&reencode(mastered_per_object(), &out, &["--ratio", "48", "--block", "2"]));
     validate(&out);
     assert_eq!(r["source"], "master", "{r}");
-    let (_d, direct) = pack("direct-block2.pis", &["--ratio", "48", "--block", "2", "--placement", "object"]);
+    let (_d, direct) = pack("direct-block2.pis", &["--ratio", "48", "--block", "2", "--placement", "object", "--max-mse-ratio", &recorded_max_mse(mastered_per_object())]);
     // The same blocks, origins, pyramids and level images, byte for byte.
     same_player_content(&out, &direct);
     let c = PisReader::open(&out).expect("output").load_all().expect("load");
@@ -320,14 +328,17 @@ fn reblocking_from_the_master_gives_a_direct_pack_with_those_blocks() {
 
 #[test]
 fn reblocking_textures_placed_per_block_is_refused_without_output() {
-    // pis-pack's default places each block's texture for its own views: some layer's
-    // blocks differ, and a new block could gather samples of two placements.
-    let c = PisReader::open(mastered()).expect("input").load_all().expect("load");
+    // pis-pack's default places each block's texture for its own views. With blocks of 2
+    // over the 4 × 4 points (demo1's 4 samples fit in the default block of 8: one block per
+    // object, which re-blocks), some layer's blocks differ, and a new block could gather
+    // samples of two placements.
+    let (_d, small) = pack("mastered-block2.pis", &["--ratio", "24", "--keep-master", "--block", "2"]);
+    let c = PisReader::open(&small).expect("input").load_all().expect("load");
     let differs = c.objects.iter().flat_map(|o| &o.layers).any(|l| l.blocks.iter().any(|b| b.placement != l.blocks[0].placement || b.width != l.blocks[0].width));
-    assert!(differs, "the default pack places some layer's blocks differently");
+    assert!(differs, "a pack in blocks of 2 places some layer's blocks differently");
     let dir = tempfile::tempdir().expect("temp dir");
     let out = dir.path().join("reblocked.pis");
-    let o = reencode(mastered(), &out, &["--block", "2"]);
+    let o = reencode(&small, &out, &["--block", "4"]);
     let err = String::from_utf8_lossy(&o.stderr);
     assert_eq!(o.status.code(), Some(5), "{err}");
     assert!(err.contains("--placement object") && !out.exists(), "{err}");
