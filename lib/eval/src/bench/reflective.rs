@@ -239,15 +239,17 @@ pub fn run(req: &ReflectiveRequest) -> Result<ReflectiveReport, Failure> {
             let idx: Vec<usize> = (0..frames.len()).filter(|&i| frames[i].kind == kind).collect();
             let (mut psnrs, mut popping, mut pooled) = (Vec::new(), 0.0f64, PairedError::default());
             for (j, &i) in idx.iter().enumerate() {
-                let mut e = SquaredError::default();
-                let mut paired = PairedError::default();
+                // Against the gold standard (with a pair, the pair's mean), and between the
+                // pair's renders: together the pair's error (`PairedError`).
+                let (mut e, mut between) = (SquaredError::default(), SquaredError::default());
                 for (p, _) in refs[i].mask.iter().enumerate().filter(|(_, m)| **m) {
                     let k = p * 3..p * 3 + 3;
                     e.add_slices(&played[i][k.clone()], &refs[i].rgb[k.clone()]);
                     if let Some([a, b]) = &refs[i].pair {
-                        paired.add_slices(&played[i][k.clone()], &a[k.clone()], &b[k]);
+                        between.add_slices(&a[k.clone()], &b[k]);
                     }
                 }
+                let paired = PairedError { against_mean: e, between };
                 pooled.merge(&paired);
                 let paired_cells = match refs[i].pair {
                     Some(_) => [format!("{:.3}", paired.psnr_noise_removed()), format!("{:.3}", paired.reference_psnr())],

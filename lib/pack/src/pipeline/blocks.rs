@@ -37,6 +37,11 @@ pub fn stagger(i: usize, n: usize, sizes: &[u32], samples: &[usize], mode: Stagg
     }).collect()
 }
 
+/// The samples along each dimension of the set's parameter space ([`stagger`]'s `samples`).
+pub fn samples_per_dimension(set: &LoadedSet) -> Vec<usize> {
+    set.scene.space.dims.iter().map(|d| d.values.len()).collect()
+}
+
 /// The parameter space and camera table of the container for blocks of `sizes`.
 pub fn geometry(set: &LoadedSet, sizes: &[u32]) -> (ParameterSpace, CameraTable) {
     let scene = &set.scene;

@@ -156,7 +156,7 @@ fn shell_weights(m: &ObjectModel, s: usize, li: usize, k: &[u32], points: &[usiz
 pub fn encode_all(set: &LoadedSet, models: &[ObjectModel], req: &PackRequest, stages: &mut Stages) -> Result<Packed, Failure> {
     let runtime = |e: anyhow::Error| Failure::new(Exit::Runtime, e);
     let sizes = block_sizes(req.block.as_slice(), set.scene.space.dims.len()).map_err(|e| Failure::new(Exit::Usage, e))?;
-    let samples: Vec<usize> = set.scene.space.dims.iter().map(|d| d.values.len()).collect();
+    let samples = super::blocks::samples_per_dimension(set);
     let (space, cameras) = geometry(set, &sizes);
     if pis_codec::codec(req.codec).is_none() {
         return Err(runtime(anyhow!("codec {} is not in this build", req.codec)));

@@ -42,7 +42,7 @@ pub fn infer_all(set: &LoadedSet, req: &PackRequest, matrices: &mut Matrices, st
         return Err(anyhow!("no object covers a pixel of the set"));
     }
     let n = surveyed.len();
-    let samples: Vec<usize> = set.scene.space.dims.iter().map(|d| d.values.len()).collect();
+    let samples = super::blocks::samples_per_dimension(set);
     let mut planned = Vec::with_capacity(n);
     for (mi, (s, other)) in surveyed.into_iter().enumerate() {
         let st = stagger(mi, n, &job.sizes, &samples, req.stagger);
