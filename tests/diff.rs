@@ -325,6 +325,24 @@ fn two_sets_compare_their_noise() {
     assert_eq!(same.status.code(), Some(0));
     let v = json(&same);
     assert!(v["psnr_db"].is_null(), "identical sets: {v}");
+    // Reflective and refractive objects get their layers composed as the player's model;
+    // diffuse objects have none. Against itself the surface is identical and the model's
+    // own error shows.
+    for o in v["objects"].as_array().expect("objects") {
+        let model = o["model"].as_str();
+        match o["name"].as_str().expect("name") {
+            "Vase" | "TableTop" => assert_eq!(model, Some("diffuse + fresnel * (local + (1 - alpha) * distant)"), "{o}"),
+            "GlassCup" => assert_eq!(model, Some("diffuse + reflection + refraction"), "{o}"),
+            _ => assert!(model.is_none() && o.get("model_psnr_db").is_none(), "{o}"),
+        }
+        if model.is_some() {
+            assert!(o["psnr_db"].is_null(), "{o}");
+            let m = o["model_psnr_db"].as_f64().expect("the model differs from the traced surface");
+            assert!(m > 10.0, "{o}");
+        }
+    }
+    let text = String::from_utf8_lossy(&diff(&s2, &s2, &[]).stdout).to_string();
+    assert!(text.contains("composed as the player's model, diffuse + reflection + refraction"), "{text}");
     let score = |a: &Path| {
         let out = diff(a, &s32, &["--json"]);
         assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));

@@ -23,7 +23,12 @@ use pis_eval::diff::files::{diff, render, DiffRequest};
 /// With two set folders, compares the ray-traced sets themselves at the points both hold
 /// (e.g. a set against one traced with more samples per pixel: the Monte Carlo noise of the
 /// gold standard, which bounds any PSNR measured against it): PSNR of the combined images
-/// per point and overall, and per object over the pixels both cover.
+/// per point and overall, and per object over the pixels both cover. For reflective and
+/// refractive objects it adds the second set's layers composed as the player's model
+/// composes them (diffuse + fresnel · (local + (1 − α) · distant); diffuse + reflection +
+/// refraction, the greedy two-path model) against the first set's surface radiance: the
+/// ceiling of any file that stores the object in that model. A set against itself gives the
+/// model's own error.
 #[derive(Parser, Debug)]
 #[command(name = "pis-diff", version, after_help = "Exit codes: 0 identical or within the gates, 1 bad arguments, 2 I/O error, 3 invalid file, 4 runtime error, 5 not supported, 7 the files differ (no gate given) or a gate failed")]
 struct Cli {

@@ -5,12 +5,19 @@
 //! The points both sets hold (same index and parameter values) are compared: the combined
 //! image per point, and per object its surface radiance (diffuse + specular layers, stored
 //! divided by coverage) over the pixels both sets cover; display values (sRGB, peak 1).
+//!
+//! For reflective and refractive objects the second set's layers are also composed as the
+//! player's model composes them — diffuse + fresnel · (local + (1 − α_L) · distant) (thesis
+//! 5.7, RAYSET.md 5.3) and diffuse + reflection + refraction (the greedy two-path model,
+//! thesis 6.2) — and compared with the first set's surface radiance: the ceiling of any file
+//! that stores the object in that model, whatever its representation and coding. With a set
+//! against itself this is the model's own error at that set's samples.
 
 use std::path::{Path, PathBuf};
 
 use anyhow::anyhow;
 use crate::metrics::SquaredError;
-use pis_trace::layers::LayerKind;
+use pis_trace::layers::{LayerKind, PointImages};
 use pis_trace::set::RaySet;
 use serde::Serialize;
 
@@ -40,6 +47,61 @@ pub struct ObjectRow {
     pub psnr_db: Option<f64>,
     /// Pixels both sets cover, summed over points.
     pub pixels: u64,
+    /// Reflective and refractive objects: the layered model the player draws, composed from
+    /// the second set's layers ([`LayeredModel::formula`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub model: Option<&'static str>,
+    /// That composition against the first set's surface radiance, over the same pixels.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub model_psnr_db: Option<f64>,
+}
+
+/// The layered model of an object's role, as the player composes its layers.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum LayeredModel {
+    /// Reflective: diffuse + fresnel · (local + (1 − α_L) · distant).
+    Environment,
+    /// Refractive: diffuse + reflection + refraction.
+    TwoPath,
+}
+
+impl LayeredModel {
+    /// The model an object's layers carry, if any.
+    pub fn of(layers: &[String]) -> Option<LayeredModel> {
+        let has = |k: LayerKind| layers.iter().any(|l| l == k.name());
+        if has(LayerKind::Fresnel) && has(LayerKind::Local) && has(LayerKind::Distant) {
+            Some(LayeredModel::Environment)
+        } else if has(LayerKind::Reflection) && has(LayerKind::Refraction) {
+            Some(LayeredModel::TwoPath)
+        } else {
+            None
+        }
+    }
+
+    pub fn formula(self) -> &'static str {
+        match self {
+            LayeredModel::Environment => "diffuse + fresnel * (local + (1 - alpha) * distant)",
+            LayeredModel::TwoPath => "diffuse + reflection + refraction",
+        }
+    }
+
+    /// Channel `c` of the composition at every pixel (None when a layer is missing).
+    pub fn compose(self, im: &PointImages, object: &str, c: &str) -> Option<Vec<f32>> {
+        let get = |k: LayerKind, c: &str| im.object_layer(object, k).and_then(|l| l.channel(c));
+        let d = get(LayerKind::Diffuse, c)?;
+        match self {
+            LayeredModel::Environment => {
+                let (f, l, a, t) = (get(LayerKind::Fresnel, c)?, get(LayerKind::Local, c)?, get(LayerKind::Local, "A")?, get(LayerKind::Distant, c)?);
+                let n = d.len().min(f.len()).min(l.len()).min(a.len()).min(t.len());
+                Some((0..n).map(|k| d[k] + f[k] * (l[k] + (1.0 - a[k]) * t[k])).collect())
+            }
+            LayeredModel::TwoPath => {
+                let (r, t) = (get(LayerKind::Reflection, c)?, get(LayerKind::Refraction, c)?);
+                let n = d.len().min(r.len()).min(t.len());
+                Some((0..n).map(|k| d[k] + r[k] + t[k]).collect())
+            }
+        }
+    }
 }
 
 /// The report.
@@ -85,11 +147,12 @@ pub fn compare_sets(req: &SetsRequest) -> Result<SetsReport, Failure> {
     }
     let npx = sa.meta.resolution[0] as usize * sa.meta.resolution[1] as usize;
     // Objects of A that B also has, with both channel names.
-    let objects: Vec<(String, String, String)> = sa.meta.objects.iter()
-        .filter_map(|o| sb.meta.objects.iter().find(|p| p.name == o.name).map(|p| (o.name.clone(), o.channel_name.clone(), p.channel_name.clone())))
+    let objects: Vec<(String, String, String, Option<LayeredModel>)> = sa.meta.objects.iter()
+        .filter_map(|o| sb.meta.objects.iter().find(|p| p.name == o.name).map(|p| (o.name.clone(), o.channel_name.clone(), p.channel_name.clone(), LayeredModel::of(&p.layers))))
         .collect();
     let mut total = SquaredError::default();
     let mut per_object = vec![SquaredError::default(); objects.len()];
+    let mut per_model = vec![SquaredError::default(); objects.len()];
     let mut per_point = Vec::new();
     for pa in &sa.meta.points {
         let Some(pb) = sb.meta.points.iter().find(|p| p.index == pa.index) else { continue };
@@ -109,19 +172,23 @@ pub fn compare_sets(req: &SetsRequest) -> Result<SetsReport, Failure> {
                 _ => return Err(invalid(anyhow!("point {}: combined image without a full {c} channel", pa.index))),
             }
         }
-        for ((_, cha, chb), acc) in objects.iter().zip(per_object.iter_mut()) {
-            let cov = |im: &pis_trace::layers::PointImages, ch: &str| im.object_layer(ch, LayerKind::Coverage).and_then(|l| l.channel("A")).map(<[f32]>::to_vec);
+        for (((_, cha, chb, model), acc), macc) in objects.iter().zip(per_object.iter_mut()).zip(per_model.iter_mut()) {
+            let cov = |im: &PointImages, ch: &str| im.object_layer(ch, LayerKind::Coverage).and_then(|l| l.channel("A")).map(<[f32]>::to_vec);
             let (Some(cova), Some(covb)) = (cov(&ia, cha), cov(&ib, chb)) else { continue };
-            let surface = |im: &pis_trace::layers::PointImages, ch: &str, c: &str| -> Vec<f32> {
+            let surface = |im: &PointImages, ch: &str, c: &str| -> Vec<f32> {
                 let get = |k| im.object_layer(ch, k).and_then(|l| l.channel(c));
                 let (d, s) = (get(LayerKind::Diffuse), get(LayerKind::Specular));
                 (0..npx).map(|k| d.and_then(|p| p.get(k)).copied().unwrap_or(0.0) + s.and_then(|p| p.get(k)).copied().unwrap_or(0.0)).collect()
             };
             for c in ["R", "G", "B"] {
                 let (x, y) = (surface(&ia, cha, c), surface(&ib, chb, c));
+                let composed = model.and_then(|m| m.compose(&ib, chb, c));
                 for k in 0..npx.min(cova.len()).min(covb.len()) {
                     if cova[k] > 0.0 && covb[k] > 0.0 {
                         acc.add(y[k], x[k]);
+                        if let Some(m) = composed.as_ref().and_then(|m| m.get(k)) {
+                            macc.add(*m, x[k]);
+                        }
                     }
                 }
             }
@@ -143,7 +210,12 @@ pub fn compare_sets(req: &SetsRequest) -> Result<SetsReport, Failure> {
         points: [sa.meta.points.len(), sb.meta.points.len()],
         psnr_db: psnr,
         max_error: total.max,
-        objects: objects.iter().zip(&per_object).map(|((n, _, _), e)| ObjectRow { name: n.clone(), psnr_db: finite(e.psnr()), pixels: e.count / 3 }).collect(),
+        objects: objects.iter().zip(per_object.iter().zip(&per_model))
+            .map(|((n, _, _, model), (e, m))| {
+                let model = model.filter(|_| m.count > 0);
+                ObjectRow { name: n.clone(), psnr_db: finite(e.psnr()), pixels: e.count / 3, model: model.map(LayeredModel::formula), model_psnr_db: model.and_then(|_| finite(m.psnr())) }
+            })
+            .collect(),
         per_point,
         min_psnr_db: req.min_psnr,
         passed,
@@ -160,9 +232,59 @@ pub fn render(r: &SetsReport) -> String {
     let _ = writeln!(s, "  combined images: {} (largest display error {:.4})", db(r.psnr_db), r.max_error);
     for o in &r.objects {
         let _ = writeln!(s, "    {:<14} {}  ({} pixels both cover)", o.name, db(o.psnr_db), o.pixels);
+        if let Some(m) = o.model {
+            let _ = writeln!(s, "    {:<14} {}  the second set's layers composed as the player's model, {m}", "", db(o.model_psnr_db));
+        }
     }
     if let Some(m) = r.min_psnr_db {
         let _ = writeln!(s, "  gate --min-psnr {m}: {}", if r.passed { "passed" } else { "failed" });
     }
     s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use pis_scene::ObjectRole;
+    use pis_trace::layers::LayerImage;
+
+    fn layer(object: &str, kind: LayerKind, channels: &[&str], values: &[f32]) -> LayerImage {
+        let mut l = LayerImage::new(format!("object.{object}.{}", kind.name()), channels, 2, 1);
+        for p in &mut l.planes {
+            p.copy_from_slice(values);
+        }
+        l
+    }
+
+    #[test]
+    fn the_model_of_an_object_is_read_from_its_layers() {
+        let names = |ks: &[LayerKind]| ks.iter().map(|k| k.name().to_string()).collect::<Vec<_>>();
+        assert_eq!(LayeredModel::of(&names(&LayerKind::for_role(ObjectRole::Reflective))), Some(LayeredModel::Environment));
+        assert_eq!(LayeredModel::of(&names(&LayerKind::for_role(ObjectRole::Refractive))), Some(LayeredModel::TwoPath));
+        assert_eq!(LayeredModel::of(&names(&LayerKind::for_role(ObjectRole::Diffuse))), None);
+    }
+
+    #[test]
+    fn layers_compose_as_the_player_composes_them() {
+        let rgb = ["R", "G", "B"];
+        let im = PointImages {
+            width: 2,
+            height: 1,
+            layers: vec![
+                layer("m", LayerKind::Diffuse, &rgb, &[0.1, 0.0]),
+                layer("m", LayerKind::Fresnel, &rgb, &[0.5, 1.0]),
+                // Premultiplied local layer: α 0.25 at the first pixel, 1 at the second.
+                layer("m", LayerKind::Local, &["R", "G", "B", "A"], &[0.25, 1.0]),
+                layer("m", LayerKind::Distant, &rgb, &[0.4, 7.0]),
+                layer("g", LayerKind::Diffuse, &rgb, &[0.1, 0.2]),
+                layer("g", LayerKind::Reflection, &rgb, &[0.3, 0.0]),
+                layer("g", LayerKind::Refraction, &rgb, &[0.5, 0.25]),
+            ],
+        };
+        // 0.1 + 0.5 · (0.25 + 0.75 · 0.4); the fully covering local layer hides the distant one.
+        let m = LayeredModel::Environment.compose(&im, "m", "G").expect("all layers");
+        assert!((m[0] - 0.375).abs() < 1e-6 && (m[1] - 1.0).abs() < 1e-6, "{m:?}");
+        assert_eq!(LayeredModel::TwoPath.compose(&im, "g", "B").expect("all layers"), vec![0.9, 0.45]);
+        assert!(LayeredModel::TwoPath.compose(&im, "m", "R").is_none(), "no reflection layer");
+    }
 }
