@@ -128,6 +128,37 @@ fn auto_keeps_the_representation_that_does_better_for_the_whole_file() {
     assert!(pa >= pp - 2.0 * 0.05, "auto {pa:.2} dB, all layered PEM {pp:.2} dB");
 }
 
+/// `--shell-lookups 2` (SPEC.md 8.2): each pixel averages 2 × 2 lookups of every shell, as
+/// a traced pixel averages its samples where the reflected direction turns fast across it;
+/// the shells solved through those lookups reproduce the traced views better than one
+/// lookup per pixel, every shell block records the count, pis-inspect shows it, and the
+/// player draws what pis-pack predicted.
+#[test]
+fn sub_pixel_lookups_follow_the_traced_footprint() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let scene = copy_sample(dir.path());
+    let (one, four) = (dir.path().join("one.pis"), dir.path().join("four.pis"));
+    let a = pack(&scene, &one, &["--representation", "pem"]);
+    let b = pack(&scene, &four, &["--representation", "pem", "--shell-lookups", "2"]);
+    for name in ["TeapotBody", "TeapotLid"] {
+        let (x, y) = (object(&a, name), object(&b, name));
+        let (pa, pb) = (x["psnr_db"].as_f64().expect("psnr"), y["psnr_db"].as_f64().expect("psnr"));
+        eprintln!("{name}: one lookup per pixel {pa:.2} dB, 2×2 {pb:.2} dB ({})", y["why"]);
+        assert!(y["why"].as_str().is_some_and(|w| w.contains("2×2 lookups per pixel")), "{}", y["why"]);
+        assert!(!x["why"].as_str().is_some_and(|w| w.contains("lookups per pixel")), "{}", x["why"]);
+        assert!(pb >= pa + 0.5, "{name}: 2×2 lookups {pb:.2} dB, one lookup {pa:.2} dB");
+    }
+    let v = Command::new(env!("CARGO_BIN_EXE_pis-inspect")).arg("--validate").arg(&four).output().expect("pis-inspect runs");
+    assert_eq!(v.status.code(), Some(0), "{}", String::from_utf8_lossy(&v.stdout));
+    let i = Command::new(env!("CARGO_BIN_EXE_pis-inspect")).arg(&four).arg("--json").output().expect("pis-inspect runs");
+    let j: serde_json::Value = serde_json::from_slice(&i.stdout).expect("JSON");
+    let shells: Vec<&serde_json::Value> = j["objects"].as_array().expect("objects").iter().flat_map(|o| o["layers"].as_array().expect("layers")).filter(|l| l["shell"].is_string()).collect();
+    assert!(shells.len() >= 4 && shells.iter().all(|l| l["lookups"] == 2), "{shells:?}");
+    let set = std::fs::read_dir(dir.path().join(".pis-cache")).expect("cache").next().expect("a traced set").expect("entry").path();
+    let d = Command::new(env!("CARGO_BIN_EXE_pis-diff")).arg(&four).arg(&set).args(["--msaa", "1", "--max-psnr-drop", "0.3"]).output().expect("pis-diff runs");
+    assert!(d.status.success(), "{}{}", String::from_utf8_lossy(&d.stdout), String::from_utf8_lossy(&d.stderr));
+}
+
 /// `pis-bench reflective --reference-pair`: every reference traced twice from independent
 /// sample streams, the pair's difference measures its noise, which the report takes out of
 /// each figure. Taken out of a noisy pair's figure, it brings the figure nearer what a pair

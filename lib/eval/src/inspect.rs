@@ -100,6 +100,9 @@ pub struct LayerSummary {
     pub bytes: u64,
     /// Shell shape of the first block, for shell layers.
     pub shell: Option<&'static str>,
+    /// Lookups per pixel side of the first block, for shell layers (SPEC.md 8.2).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub lookups: Option<u32>,
 }
 
 #[derive(Serialize, Default)]
@@ -171,6 +174,10 @@ pub fn summarize(r: &PisReader) -> Summary {
                         bytes: refs.iter().map(|s| s.length as u64).sum(),
                         shell: l.blocks.first().and_then(|b| match b.placement {
                             Placement::Shell { shape, .. } => Some(shape.name()),
+                            Placement::Surface { .. } => None,
+                        }),
+                        lookups: l.blocks.first().and_then(|b| match b.placement {
+                            Placement::Shell { lookups, .. } => Some(lookups),
                             Placement::Surface { .. } => None,
                         }),
                     }
@@ -347,7 +354,10 @@ pub fn render(s: &Summary) -> String {
         );
         for (i, l) in ob.layers.iter().enumerate() {
             let mapping = match l.shell {
-                Some(shape) => format!("{} shell", shape),
+                Some(shape) => match l.lookups {
+                    Some(k) if k > 1 => format!("{shape} shell, {k}×{k} lookups"),
+                    _ => format!("{shape} shell"),
+                },
                 None => "surface".to_string(),
             };
             let deps = if l.depends_on.is_empty() {

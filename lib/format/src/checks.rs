@@ -579,6 +579,7 @@ fn placement(p: &Placement, mapping: Mapping) -> Option<String> {
                 shape,
                 origin,
                 params,
+                ..
             },
             Mapping::Shell,
         ) => {

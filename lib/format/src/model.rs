@@ -408,13 +408,19 @@ pub enum Placement {
         repeat: [bool; 2],
         cut: [Option<f32>; 2],
     },
-    /// Environment-map shell geometry with its cube-map origin.
+    /// Environment-map shell geometry with its cube-map origin, and the lookups per pixel:
+    /// `lookups` × `lookups` sub-pixel lookups averaged (1 to [`MAX_SHELL_LOOKUPS`]; SPEC.md
+    /// 8.2), stored in the block's flags as `lookups − 1`.
     Shell {
         shape: ShellShape,
         origin: [f32; 3],
         params: [f32; 6],
+        lookups: u32,
     },
 }
+
+/// The most lookups per pixel side of a shell block (SPEC.md 7.3 flags, 8.2).
+pub const MAX_SHELL_LOOKUPS: u32 = 3;
 
 coded_enum! {
     /// Environment-map shell geometry (SPEC.md, table "Shell shapes").

@@ -247,7 +247,8 @@ pub fn layr(c: &mut Cursor, objects: &mut [Object<StreamRef>]) -> Result<(), Iss
             let shape_at = c.offset();
             let shape = c.u16("shell shape")? as u32;
             let flags = c.u16("placement flags")?;
-            if flags & !15 != 0 || (shape != 0 && flags != 0) {
+            // Shells: the lookups per pixel side less one (0 to MAX_SHELL_LOOKUPS − 1).
+            if flags & !15 != 0 || (shape != 0 && flags as u32 >= crate::model::MAX_SHELL_LOOKUPS) {
                 let issue = c
                     .issue(3006, format!("layer {li} block {bi} placement flags {flags:#x}"))
                     .at(shape_at + 2);
@@ -275,6 +276,7 @@ pub fn layr(c: &mut Cursor, objects: &mut [Object<StreamRef>]) -> Result<(), Iss
                     shape,
                     origin: values[0..3].try_into().expect("3 values"),
                     params: values[3..9].try_into().expect("6 values"),
+                    lookups: (flags as u32).min(crate::model::MAX_SHELL_LOOKUPS - 1) + 1,
                 }
             };
             let unused = if shape == 0 {

@@ -152,9 +152,10 @@ pub fn layr<S>(s: &mut Sink, objects: &[Object<S>], mut stream_ref: impl FnMut(&
                         shape,
                         origin,
                         params,
+                        lookups,
                     } => {
                         s.u16(shape as u16, &format!("{p} shell shape ({})", shape.name()));
-                        s.u16(0, &format!("{p} flags (none for shells)"));
+                        s.u16(lookups.saturating_sub(1) as u16, &format!("{p} flags (lookups per pixel side − 1)"));
                         s.f32s(&origin, &format!("{p} shell origin"));
                         s.f32s(&params, &format!("{p} shell parameters"));
                         s.zeros(12, &format!("{p} unused placement values"));

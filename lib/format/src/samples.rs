@@ -295,6 +295,7 @@ pub fn tiny() -> Result<Container, Error> {
                 shape: ShellShape::Sphere,
                 origin: [0.0; 3],
                 params: [4.0, 0.0, 0.0, 0.0, 0.0, 0.0],
+                lookups: 1,
             },
             levels: vec![],
         };

@@ -377,6 +377,13 @@ fn cases() -> Vec<(u16, Vec<u8>)> {
         t().set_f32("layer 0 block 0 branch cuts u, v", 0.5)
             .reseal(),
     ));
+    // A shell block's flags hold the lookups per pixel side less one: 0 to 2.
+    v.push((3006, {
+        let mut f = t();
+        let at = f.spans.iter().find(|s| s.label.contains("flags (lookups per pixel side")).expect("a shell block").start;
+        f.bytes[at..at + 2].copy_from_slice(&3u16.to_le_bytes());
+        f.reseal()
+    }));
     v.push((
         6009,
         t().set_u32("layer 0 block 0 width", 16384)
@@ -744,4 +751,33 @@ fn a_rule_that_builds_on_a_broken_structure_is_skipped() {
     // A parameter space that breaks a rule: the tables measured on it are not checked.
     let ids = reported(File::tiny().set_u32("dimension 0 block size", 0).reseal());
     assert!(ids.contains(&4005) && !ids.contains(&5105), "{ids:?}");
+}
+
+/// A shell block's lookups per pixel side (SPEC.md 7.3 flags, 8.2) survive writing and
+/// reading, and a file written with 1 has the flags of a file from before the field.
+#[test]
+fn shell_lookups_round_trip() {
+    let mut c = tiny().unwrap();
+    let plain = to_bytes(&c).unwrap();
+    let mut shells = 0;
+    for (k, b) in c.objects.iter_mut().flat_map(|o| o.layers.iter_mut()).flat_map(|l| l.blocks.iter_mut()).enumerate() {
+        if let Placement::Shell { lookups, .. } = &mut b.placement {
+            assert_eq!(*lookups, 1);
+            *lookups = 1 + (k as u32 % 3);
+            shells += 1;
+        }
+    }
+    assert!(shells > 0, "the sample has shell blocks");
+    let read = PisReader::from_bytes(to_bytes(&c).unwrap()).unwrap();
+    let got: Vec<u32> = read.container().objects.iter().flat_map(|o| &o.layers).flat_map(|l| &l.blocks).filter_map(|b| match b.placement {
+        Placement::Shell { lookups, .. } => Some(lookups),
+        Placement::Surface { .. } => None,
+    }).collect();
+    let want: Vec<u32> = c.objects.iter().flat_map(|o| &o.layers).flat_map(|l| &l.blocks).filter_map(|b| match b.placement {
+        Placement::Shell { lookups, .. } => Some(lookups),
+        Placement::Surface { .. } => None,
+    }).collect();
+    assert_eq!(got, want);
+    assert!(want.iter().any(|&k| k > 1));
+    assert_ne!(plain, to_bytes(&c).unwrap());
 }

@@ -55,15 +55,20 @@ pub struct ReflectionDraw<'a> {
     /// The term's shells in increasing order (order 0 nearest), each with its cube map:
     /// 1 to [`MAX_TERM_SHELLS`] (the player checks the count when it opens a file).
     pub shells: Vec<(pis_compile::shell::Shell, &'a ShellTexture)>,
+    /// Per shell: lookups per pixel side (SPEC.md 8.2; 1 when empty).
+    pub lookups: Vec<u32>,
 }
 
 /// The uniforms of a reflection term drawn on `object` with `shells` (the term's, or the
 /// most distant alone on hull triangles).
 fn reflection_uniforms(object: &ObjectDraw, r: &ReflectionDraw, shells_drawn: &[(pis_compile::shell::Shell, &ShellTexture)]) -> ReflectionUniforms {
     let mut shells = [ShellSlot::zeroed(); MAX_TERM_SHELLS];
-    for (slot, (shell, cube)) in shells.iter_mut().zip(shells_drawn) {
+    // The drawn shells are the term's last ones (all, or the most distant on hull triangles).
+    let first = r.shells.len().saturating_sub(shells_drawn.len());
+    for (k, (slot, (shell, cube))) in shells.iter_mut().zip(shells_drawn).enumerate() {
         let (origin_shape, a, b) = shell_uniform(shell);
-        *slot = ShellSlot { origin_shape, a, b, size_levels: [cube.layout.width, cube.layout.levels, 0, 0] };
+        let lookups = r.lookups.get(first + k).copied().unwrap_or(1).max(1);
+        *slot = ShellSlot { origin_shape, a, b, size_levels: [cube.layout.width, cube.layout.levels, lookups, 0] };
     }
     ReflectionUniforms {
         clip_from_object: object.clip_from_object.to_cols_array(),

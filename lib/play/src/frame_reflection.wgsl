@@ -10,7 +10,7 @@
 // wherever the pixel's nearest surface is this object (frame.wgsl's `fs_layer` masking).
 
 // One shell of the term: origin and shape id, `a`, `b` (shell.rs `shell_uniform`) and the
-// cube map's face size N and MIP level count.
+// cube map's face size N, MIP level count and lookups per pixel side.
 struct ShellSlot {
     origin_shape: vec4<f32>,
     a: vec4<f32>,
@@ -57,15 +57,19 @@ fn shell_geometry_of(k: u32) -> ShellGeometry {
 
 // Shell k's premultiplied RGBA at world position p with normal n: the lookup vector D, its
 // LOD from D's fine derivatives (differences across the pixel's 2×2 quad), the trilinear,
-// seamless lookup of `cube`.
+// seamless lookup of `cube`, once or k × k times over the pixel (size_levels.z;
+// `cube_sample_pixel`).
 fn shell_colour(k: u32, cube: texture_2d_array<f32>, p: vec3<f32>, n: vec3<f32>) -> vec4<f32> {
-    let d = lookup_direction(shell_geometry_of(k), p, n, ru.eye.xyz);
+    let g = shell_geometry_of(k);
+    let d = lookup_direction(g, p, n, ru.eye.xyz);
     let ddx = dpdxFine(d);
     let ddy = dpdyFine(d);
-    let size = ru.shells[k].size_levels.x;
-    let levels = ru.shells[k].size_levels.y;
-    let lambda = cube_lod(d, ddx, ddy, f32(size), f32(levels - 1u));
-    return cube_sample(cube, size, levels, d, lambda);
+    let dpx = dpdxFine(p);
+    let dpy = dpdyFine(p);
+    let dnx = dpdxFine(n);
+    let dny = dpdyFine(n);
+    let sl = ru.shells[k].size_levels;
+    return cube_sample_pixel(g, cube, sl.x, sl.y, sl.z, ru.eye.xyz, p, n, dpx, dpy, dnx, dny, ddx, ddy);
 }
 
 // The reflection term (SPEC.md 9): the shells composited "over" in increasing order,

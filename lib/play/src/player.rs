@@ -199,6 +199,8 @@ struct WantedReflection {
     weight: f32,
     /// Per shell of the term, in order: its texture and its geometry.
     shells: Vec<(TextureKey, Shell)>,
+    /// Per shell: lookups per pixel side (SPEC.md 8.2).
+    lookups: Vec<u32>,
 }
 
 /// What a frame draws: per object its clip and world transforms, the frame's camera
@@ -388,7 +390,7 @@ fn lens_state(reader: &PisReader, oi: usize, tint: [f32; 3], skipped: &mut Vec<S
 /// The cube-map geometry of a shell block's placement (SPEC.md 7.3); `None` for a quad or a
 /// surface placement.
 fn shell_of(placement: &Placement) -> Option<Shell> {
-    let Placement::Shell { shape, origin, params } = placement else { return None };
+    let Placement::Shell { shape, origin, params, .. } = placement else { return None };
     let mut values = [0.0f32; 12];
     values[..3].copy_from_slice(origin);
     values[3..9].copy_from_slice(params);
@@ -407,7 +409,7 @@ fn reflection_draws<'a>(reader: &PisReader, resident: &'a HashMap<TextureKey, Re
             };
             shells.push((*shell, cube));
         }
-        out.push(ReflectionDraw { draw: r.draw, world_from_object: plan.worlds[r.draw], eye: plan.eye, f0: c.objects[r.draw].shading.f0, weight: r.weight, shells });
+        out.push(ReflectionDraw { draw: r.draw, world_from_object: plan.worlds[r.draw], eye: plan.eye, f0: c.objects[r.draw].shading.f0, weight: r.weight, shells, lookups: r.lookups.clone() });
     }
     Ok(out)
 }
@@ -664,12 +666,17 @@ impl Player {
         let mut out = Vec::new();
         for (s, weight) in merge_for_mask(samples, mask) {
             let mut shells = Vec::with_capacity(term.len());
+            let mut lookups = Vec::with_capacity(term.len());
             for &li in term {
                 let (key, block) = self.texture_key(oi, li, &s)?;
                 let shell = shell_of(&block.placement).ok_or_else(|| content(&self.reader, format!("object {oi} layer {li} block {}: not a closed shell", key.block)))?;
+                lookups.push(match block.placement {
+                    Placement::Shell { lookups, .. } => lookups,
+                    Placement::Surface { .. } => 1,
+                });
                 shells.push((key, shell));
             }
-            out.push(WantedReflection { draw: oi, weight, shells });
+            out.push(WantedReflection { draw: oi, weight, shells, lookups });
         }
         Ok(out)
     }

@@ -91,7 +91,8 @@ struct ShellUniforms {
     b: [f32; 4],
     size: u32,
     levels: u32,
-    _pad: [u32; 2],
+    lookups: u32,
+    _pad: u32,
 }
 
 /// A shell's geometry as the shaders' `ShellGeometry` fields: origin and shape id, `a`, `b`.
@@ -213,7 +214,8 @@ pub fn render_shell(gpu: &Gpu, pipeline: &ShellPipeline, viewport: Viewport, occ
         b,
         size: object.layout.width,
         levels: object.layout.levels,
-        _pad: [0; 2],
+        lookups: object.lookups.max(1),
+        _pad: 0,
     };
     let bind = |u: &wgpu::Buffer| {
         d.create_bind_group(&wgpu::BindGroupDescriptor {

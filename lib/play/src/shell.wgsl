@@ -259,3 +259,30 @@ fn cube_sample(cube: texture_2d_array<f32>, size: u32, levels: u32, d: vec3<f32>
     }
     return c;
 }
+
+// A shell's colour at a pixel (SPEC.md 8.2), the twin of pis-compile's
+// `shell_render_matrix`: with k = 1 one trilinear lookup of D at λ from D's fine derivatives
+// (ddx, ddy); with k > 1 the mean of k × k lookups at the sub-pixel offsets
+// o = ((i + ½)/k − ½, (j + ½)/k − ½), each from the position p and normal n moved by o times
+// their fine derivatives, at λ from D's derivatives divided by k.
+fn cube_sample_pixel(g: ShellGeometry, cube: texture_2d_array<f32>, size: u32, levels: u32, k: u32, eye: vec3<f32>, p: vec3<f32>, n: vec3<f32>, dpx: vec3<f32>, dpy: vec3<f32>, dnx: vec3<f32>, dny: vec3<f32>, ddx: vec3<f32>, ddy: vec3<f32>) -> vec4<f32> {
+    let max_level = f32(levels - 1u);
+    if (k <= 1u) {
+        let d = lookup_direction(g, p, n, eye);
+        return cube_sample(cube, size, levels, d, cube_lod(d, ddx, ddy, f32(size), max_level));
+    }
+    let kf = f32(k);
+    let sx = ddx / kf;
+    let sy = ddy / kf;
+    let w = 1.0 / (kf * kf);
+    var acc = vec4<f32>(0.0);
+    for (var j = 0u; j < k; j = j + 1u) {
+        let oy = (f32(j) + 0.5) / kf - 0.5;
+        for (var i = 0u; i < k; i = i + 1u) {
+            let ox = (f32(i) + 0.5) / kf - 0.5;
+            let ds = lookup_direction(g, p + ox * dpx + oy * dpy, n + ox * dnx + oy * dny, eye);
+            acc = acc + w * cube_sample(cube, size, levels, ds, cube_lod(ds, sx, sy, f32(size), max_level));
+        }
+    }
+    return acc;
+}

@@ -14,10 +14,11 @@ struct ShellUniforms {
     origin_shape: vec4<f32>,
     a: vec4<f32>,
     b: vec4<f32>,
-    // Face size N, MIP level count.
+    // Face size N, MIP level count, lookups per pixel side.
     size: u32,
     levels: u32,
-    _pad: vec2<u32>,
+    lookups: u32,
+    _pad: u32,
 };
 
 @group(0) @binding(0) var<uniform> su: ShellUniforms;
@@ -51,12 +52,16 @@ fn vs_shell_depth(@location(0) position: vec3<f32>) -> @builtin(position) vec4<f
 
 @fragment
 fn fs_shell(in: ShellVsOut) -> @location(0) vec4<f32> {
-    let d = lookup_direction(shell_geometry(), in.world, in.normal, su.eye.xyz);
+    let g = shell_geometry();
+    let d = lookup_direction(g, in.world, in.normal, su.eye.xyz);
     // Fine derivatives: differences across the pixel's row and column of its 2×2 quad.
     let ddx = dpdxFine(d);
     let ddy = dpdyFine(d);
-    let lambda = cube_lod(d, ddx, ddy, f32(su.size), f32(su.levels - 1u));
-    let c = cube_sample(cube, su.size, su.levels, d, lambda);
+    let dpx = dpdxFine(in.world);
+    let dpy = dpdyFine(in.world);
+    let dnx = dpdxFine(in.normal);
+    let dny = dpdyFine(in.normal);
+    let c = cube_sample_pixel(g, cube, su.size, su.levels, su.lookups, su.eye.xyz, in.world, in.normal, dpx, dpy, dnx, dny, ddx, ddy);
     // Alpha 1 marks coverage.
     return vec4<f32>(c.rgb, 1.0);
 }

@@ -41,12 +41,14 @@ struct ShellSpec {
     origin: [f32; 3],
     params: [f32; 6],
     size: u32,
+    /// Lookups per pixel side (SPEC.md 8.2).
+    lookups: u32,
 }
 
 /// The local shell: an ellipsoid around the sphere.
-const LOCAL: ShellSpec = ShellSpec { kind: LayerKind::EnvLocal, channels: 4, shape: ShellShape::Ellipsoid, origin: [0.05, -0.1, 0.02], params: [1.6, 1.3, 1.5, 0.0, 0.0, 0.0], size: 12 };
+const LOCAL: ShellSpec = ShellSpec { kind: LayerKind::EnvLocal, channels: 4, shape: ShellShape::Ellipsoid, origin: [0.05, -0.1, 0.02], params: [1.6, 1.3, 1.5, 0.0, 0.0, 0.0], size: 12, lookups: 1 };
 /// The distant shell: a box.
-const DISTANT: ShellSpec = ShellSpec { kind: LayerKind::EnvDistant, channels: 3, shape: ShellShape::Box, origin: [0.0, 0.2, 0.0], params: [-3.0, -1.5, -4.0, 4.0, 3.0, 3.5], size: 20 };
+const DISTANT: ShellSpec = ShellSpec { kind: LayerKind::EnvDistant, channels: 3, shape: ShellShape::Box, origin: [0.0, 0.2, 0.0], params: [-3.0, -1.5, -4.0, 4.0, 3.0, 3.5], size: 20, lookups: 1 };
 
 impl ShellSpec {
     fn layout(&self) -> TextureLayout {
@@ -89,7 +91,7 @@ fn shell_layer(spec: &ShellSpec, order: u8, textures: &[Vec<f32>]) -> Layer<Code
         depends_on: if varies { DepMask::of(&[0]) } else { DepMask::NONE },
         blocks: vec![],
     };
-    let block = Block { width: spec.size, height: spec.size, placement: Placement::Shell { shape: spec.shape, origin: spec.origin, params: spec.params }, levels: vec![] };
+    let block = Block { width: spec.size, height: spec.size, placement: Placement::Shell { shape: spec.shape, origin: spec.origin, params: spec.params, lookups: spec.lookups }, levels: vec![] };
     let (extent, counts): (Vec<u32>, Vec<Vec<u32>>) = if varies { (vec![textures.len() as u32], vec![vec![1], vec![textures.len() as u32]]) } else { (vec![], vec![vec![]]) };
     let block = encode_block(&layer, block, &extent, &counts, textures, CodecId::Lossless).expect("encodes");
     Layer { blocks: vec![block], ..layer }
@@ -291,8 +293,8 @@ fn random_shells_on_a_turned_sphere(seed: u64) -> (Vec<f32>, Vec<f32>, [f32; 12]
 }
 
 /// The layers of one sample: the local shell `local` (order 0) over the distant `distant`.
-fn local_over_distant(local: &[f32], distant: &[f32]) -> Vec<Layer<Codestream>> {
-    vec![shell_layer(&LOCAL, 0, &[local.to_vec()]), shell_layer(&DISTANT, 1, &[distant.to_vec()])]
+fn local_over_distant(local: &[f32], distant: &[f32], lookups: u32) -> Vec<Layer<Codestream>> {
+    vec![shell_layer(&ShellSpec { lookups, ..LOCAL }, 0, &[local.to_vec()]), shell_layer(&ShellSpec { lookups, ..DISTANT }, 1, &[distant.to_vec()])]
 }
 
 /// The file camera's clip-from-world matrix at [`SIZE`].
@@ -316,8 +318,9 @@ fn random_shells_match_the_hardware_model() {
         ("free camera", CameraChoice::Free(free), free.projection(SIZE) * free.view_matrix(), free.eye),
     ];
     let mut failures = Vec::new();
-    for f0 in [[1.0f32; 3], [0.2, 0.5, 0.9]] {
-        let path = write_file(dir.path(), "random.pis", f0, world_rows, 1, local_over_distant(&local, &distant));
+    // One lookup per pixel, then 2 × 2 and 3 × 3 (SPEC.md 8.2).
+    for (f0, lookups) in [([1.0f32; 3], 1), ([0.2, 0.5, 0.9], 1), ([1.0; 3], 2), ([0.2, 0.5, 0.9], 3)] {
+        let path = write_file(dir.path(), &format!("random-{lookups}.pis"), f0, world_rows, 1, local_over_distant(&local, &distant, lookups));
         let mut player = open(&gpu, &path, Blend::Nearest, 1);
         for (vname, camera, clip_from_world, eye) in views {
             let object = ShellObject {
@@ -330,12 +333,13 @@ fn random_shells_match_the_hardware_model() {
                 shell: LOCAL.model(),
                 layout: LOCAL.layout(),
                 drawn: None,
+                lookups,
             };
             let want = model_frame(&object, f0, &local, &distant);
             let (got, stats) = player.render_image(&at(0.0, camera), SIZE).unwrap();
             let c = compare(&want, &got);
-            let name = format!("reflection-f0-{}-{}", f0[0], vname.replace(' ', "-"));
-            eprintln!("{test}: f0 {f0:?}, {vname}: PSNR {:.2} dB over {} pixels, {} coverage mismatches; {} shell draw(s)", c.psnr_db, c.both, c.coverage_mismatch, stats.shell_draws);
+            let name = format!("reflection-f0-{}-{}-lookups-{lookups}", f0[0], vname.replace(' ', "-"));
+            eprintln!("{test}: f0 {f0:?}, {lookups}×{lookups} lookups, {vname}: PSNR {:.2} dB over {} pixels, {} coverage mismatches; {} shell draw(s)", c.psnr_db, c.both, c.coverage_mismatch, stats.shell_draws);
             if c.psnr_db < 50.0 || c.coverage_mismatch * 200 > c.both || c.both < 1000 || stats.shell_draws != 1 {
                 let dir = write_failure_images(&name, &want, &got);
                 failures.push(format!("{name}: {c:?} (images in {})", dir.display()));
@@ -361,7 +365,7 @@ fn hull_triangles_draw_the_distant_shell_only() {
     let drawn: Vec<bool> = (0..triangles).map(|t| t >= triangles / 2).collect();
     let normals = mesh.normals.clone().unwrap();
     let f0 = [0.2f32, 0.5, 0.9];
-    let path = write_mesh_file(dir.path(), "hull.pis", f0, world_rows, 1, local_over_distant(&local, &distant), mesh.clone());
+    let path = write_mesh_file(dir.path(), "hull.pis", f0, world_rows, 1, local_over_distant(&local, &distant, 2), mesh.clone());
     let mut player = open(&gpu, &path, Blend::Nearest, 1);
     let object = ShellObject {
         positions: &mesh.positions,
@@ -373,6 +377,7 @@ fn hull_triangles_draw_the_distant_shell_only() {
         shell: LOCAL.model(),
         layout: LOCAL.layout(),
         drawn: Some(&drawn),
+        lookups: 2,
     };
     let want = model_frame(&object, f0, &local, &distant);
     let unsplit = model_frame(&ShellObject { drawn: None, ..object }, f0, &local, &distant);

@@ -40,6 +40,11 @@ pub struct ShellObject<'a> {
     /// hull draw the distant shell only); `None` draws every triangle. Pixels of a triangle
     /// that does not draw the shell have no row.
     pub drawn: Option<&'a [bool]>,
+    /// Lookups per pixel side (SPEC.md 8.2): 1 looks the shell up once at the pixel's
+    /// centre; k averages k × k lookups at the sub-pixel offsets ((i + ½)/k − ½, (j + ½)/k −
+    /// ½), each from the position and normal moved by the offsets times their fine screen
+    /// derivatives, at the level of detail of D's derivatives divided by k.
+    pub lookups: u32,
 }
 
 /// The world position and normal of every corner, per triangle: the vertex shader's
@@ -86,27 +91,68 @@ pub fn shell_render_matrix(viewport: Viewport, object: &ShellObject, occluders: 
     let layout = object.layout;
     let eye = object.eye.as_dvec3();
     let max_level = layout.levels.saturating_sub(1) as f64;
-    let rows: Vec<Taps> = pixels
+    let k = object.lookups.max(1);
+    let rows: Vec<Vec<(u32, f32)>> = pixels
         .par_iter()
         .map(|&p| {
             let (x, y) = (p % viewport.width, p / viewport.width);
-            let k = frags.triangle[p as usize] as usize;
-            let (tri, src) = (&frags.triangles[k], frags.source[k] as usize);
+            let t = frags.triangle[p as usize] as usize;
+            let (tri, src) = (&frags.triangles[t], frags.source[t] as usize);
+            let at = |x: u32, y: u32| attributes_at(tri, &world, src, x, y);
             let dir = |x: u32, y: u32| {
-                let (pos, n) = attributes_at(tri, &world, src, x, y);
+                let (pos, n) = at(x, y);
                 lookup_direction(&object.shell, pos, n, eye)
             };
             let (qx, qy) = (x & !1, y & !1);
             let d = dir(x, y);
             let ddx = dir(qx + 1, y) - dir(qx, y);
             let ddy = dir(x, qy + 1) - dir(x, qy);
-            let lambda = cube_lod(d, ddx, ddy, layout.width as f64, max_level);
             let mut taps = Taps::default();
-            cube_taps(&layout, d, lambda, &mut taps);
-            taps
+            if k == 1 {
+                let lambda = cube_lod(d, ddx, ddy, layout.width as f64, max_level);
+                cube_taps(&layout, d, lambda, &mut taps);
+                return taps.sorted().collect();
+            }
+            // The fine derivatives of the interpolated position and normal, as the
+            // fragment shader's dpdxFine / dpdyFine give them.
+            let (pos, n) = at(x, y);
+            let ((px0, nx0), (px1, nx1)) = (at(qx, y), at(qx + 1, y));
+            let ((py0, ny0), (py1, ny1)) = (at(x, qy), at(x, qy + 1));
+            let (dpx, dnx, dpy, dny) = (px1 - px0, nx1 - nx0, py1 - py0, ny1 - ny0);
+            let kf = k as f64;
+            let (sx, sy) = (ddx / kf, ddy / kf);
+            let w = 1.0 / (kf * kf);
+            let mut row: Vec<(u32, f32)> = Vec::with_capacity(k as usize * k as usize * 8);
+            for j in 0..k {
+                let oy = (j as f64 + 0.5) / kf - 0.5;
+                for i in 0..k {
+                    let ox = (i as f64 + 0.5) / kf - 0.5;
+                    let ds = lookup_direction(&object.shell, pos + ox * dpx + oy * dpy, n + ox * dnx + oy * dny, eye);
+                    let lambda = cube_lod(ds, sx, sy, layout.width as f64, max_level);
+                    cube_taps(&layout, ds, lambda, &mut taps);
+                    for (c, v) in taps.sorted() {
+                        match row.iter_mut().find(|e| e.0 == c) {
+                            Some(e) => e.1 += v * w as f32,
+                            None => row.push((c, v * w as f32)),
+                        }
+                    }
+                }
+            }
+            row.sort_unstable_by_key(|e| e.0);
+            row
         })
         .collect();
-    Ok(RenderMatrix::from_taps(viewport, layout, pixels, &rows))
+    let mut row_start = Vec::with_capacity(rows.len() + 1);
+    row_start.push(0u32);
+    let (mut cols, mut vals) = (Vec::new(), Vec::new());
+    for r in &rows {
+        for &(c, v) in r {
+            cols.push(c);
+            vals.push(v);
+        }
+        row_start.push(cols.len() as u32);
+    }
+    Ok(RenderMatrix { width: viewport.width, height: viewport.height, layout, coverage: vec![1.0; pixels.len()], pixels, row_start, cols, vals })
 }
 
 /// The object rasterized as the player draws it, each triangle's world corners, and the
@@ -210,7 +256,7 @@ mod tests {
         let clip = perspective(0.7, 96.0 / 72.0, 0.1, 100.0) * look_at(eye, Vec3::ZERO, Vec3::Y);
         let shell = Shell { origin: DVec3::ZERO, shape: ShellShape::Sphere { radius: 4.0 } };
         let layout = TextureLayout::cube(16);
-        let o = ShellObject { positions: &p, normals: &n, indices: &idx, clip_from_object: clip, world_from_object: Mat4::IDENTITY, eye, shell, layout, drawn: None };
+        let o = ShellObject { positions: &p, normals: &n, indices: &idx, clip_from_object: clip, world_from_object: Mat4::IDENTITY, eye, shell, layout, drawn: None, lookups: 1 };
         let a = shell_render_matrix(vp, &o, None).unwrap();
         assert!(a.rows() > 1000);
         for r in 0..a.rows() {
@@ -233,7 +279,7 @@ mod tests {
         let clip = perspective(0.9, 1.0, 0.1, 100.0) * look_at(eye, Vec3::ZERO, Vec3::Y);
         let shell = Shell { origin: DVec3::ZERO, shape: ShellShape::Ellipsoid { radii: DVec3::new(1.5, 1.2, 1.5) } };
         let none = vec![false; idx.len() / 3];
-        let mut o = ShellObject { positions: &p, normals: &n, indices: &idx, clip_from_object: clip, world_from_object: Mat4::IDENTITY, eye, shell, layout: TextureLayout::cube(8), drawn: None };
+        let mut o = ShellObject { positions: &p, normals: &n, indices: &idx, clip_from_object: clip, world_from_object: Mat4::IDENTITY, eye, shell, layout: TextureLayout::cube(8), drawn: None, lookups: 1 };
         assert!(shell_render_matrix(vp, &o, None).unwrap().rows() > 0);
         o.drawn = Some(&none);
         assert_eq!(shell_render_matrix(vp, &o, None).unwrap().rows(), 0);

@@ -85,7 +85,7 @@ impl Planned for HybridPlanned {
         let layout = TextureLayout::cube(inference.face);
         for (l, fitted) in inference.shells.iter().enumerate() {
             let textures: std::collections::BTreeMap<Vec<u32>, Vec<f32>> = set.samples.iter().zip(&inference.views).map(|(s, v)| (key(s, job.all), v.cubes[l].clone())).collect();
-            let form = Box::new(ShellForm { shell: fitted.shell, layout, channels: 4, order: l as u8, term: pis_format::Term::Refraction });
+            let form = Box::new(ShellForm { shell: fitted.shell, layout, lookups: 1, channels: 4, order: l as u8, term: pis_format::Term::Refraction });
             model.layers.push(InferredLayer::shell(pis_format::LayerKind::EnvShell, job, &model.stagger, textures, 0, form, l));
         }
         let layers: Vec<String> = (0..inference.shells.len())

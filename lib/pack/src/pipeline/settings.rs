@@ -78,6 +78,10 @@ pub struct PackSettings {
     pub placement: PlacementMode,
     /// Which dimensions the objects' block origins are staggered along (thesis 4.7).
     pub stagger: Stagger,
+    /// Inferred environment-map shells: lookups per pixel side (1 to
+    /// [`pis_format::MAX_SHELL_LOOKUPS`]; SPEC.md 8.2): k × k sub-pixel lookups averaged,
+    /// recorded in each shell block for the player.
+    pub shell_lookups: u32,
     /// Conjugate-gradient iteration cap per colour channel of every solve (`None`: the
     /// solver's default).
     pub max_iterations: Option<u32>,
@@ -124,6 +128,7 @@ impl PackSettings {
             representation: RepresentationMode::Texture,
             placement: PlacementMode::Block,
             stagger: Stagger::Auto,
+            shell_lookups: 1,
             max_iterations: None,
             keep_master: false,
             preset: None,

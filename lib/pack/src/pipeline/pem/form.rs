@@ -13,6 +13,8 @@ use super::super::model::LayerForm;
 pub struct ShellForm {
     pub shell: Shell,
     pub layout: TextureLayout,
+    /// Lookups per pixel side the shell was solved through (SPEC.md 8.2).
+    pub lookups: u32,
     /// 4 (premultiplied RGBA: a local shell) or 3 (opaque RGB).
     pub channels: u8,
     /// Order within its term (0 is nearest).
@@ -51,7 +53,7 @@ impl LayerForm for ShellForm {
         pis_format::Block {
             width: self.layout.width,
             height: self.layout.height,
-            placement: pis_format::Placement::Shell { shape, origin: [v[0], v[1], v[2]], params },
+            placement: pis_format::Placement::Shell { shape, origin: [v[0], v[1], v[2]], params, lookups: self.lookups },
             levels: vec![],
         }
     }
@@ -83,13 +85,14 @@ mod tests {
     #[test]
     fn a_shell_layer_is_stored_whole_on_its_shell() {
         let shell = Shell { origin: DVec3::new(0.5, 1.0, -2.0), shape: ShellShape::Ellipsoid { radii: DVec3::new(1.0, 2.0, 3.0) } };
-        let f = ShellForm { shell, layout: TextureLayout::cube(8), channels: 4, order: 0, term: pis_format::Term::Reflection };
+        let f = ShellForm { shell, layout: TextureLayout::cube(8), lookups: 2, channels: 4, order: 0, term: pis_format::Term::Reflection };
         let l = f.layer(pis_format::LayerKind::EnvLocal, 3, DepMask::of(&[0]), 1.0);
         assert_eq!((l.mapping, l.mip_mode, l.term, l.combine, l.channels, l.order), (pis_format::Mapping::Shell, pis_format::MipMode::Stored, pis_format::Term::Reflection, pis_format::Combine::Over, 4, 0));
         let b = f.block(0);
         assert_eq!((b.width, b.height), (8, 8));
         match b.placement {
-            pis_format::Placement::Shell { shape, origin, params } => {
+            pis_format::Placement::Shell { shape, origin, params, lookups } => {
+                assert_eq!(lookups, 2);
                 assert_eq!(shape, pis_format::ShellShape::Ellipsoid);
                 assert_eq!(origin, [0.5, 1.0, -2.0]);
                 assert_eq!(params, [1.0, 2.0, 3.0, 0.0, 0.0, 0.0]);

@@ -30,6 +30,11 @@ use form::ShellForm;
 use solve::{solve_shell, SolvedShell, Target};
 use views::{face_resolution, shell_views, ShellView};
 
+/// The report's words for `--shell-lookups` above 1.
+fn lookups_text(lookups: u32) -> String {
+    if lookups > 1 { format!(", {lookups}×{lookups} lookups per pixel") } else { String::new() }
+}
+
 /// The largest cube face tried when choosing a shell's resolution (thesis 5.8.2).
 pub const LARGEST_FACE: u32 = 256;
 
@@ -101,6 +106,7 @@ impl Planned for PemPlanned {
         let mut settings = SolveSettings::pyramidal();
         settings.cg = job.settings.cg;
         let largest = LARGEST_FACE.min(job.req.max_texture.next_power_of_two() / 2).max(8);
+        let lookups = job.req.shell_lookups.clamp(1, pis_format::MAX_SHELL_LOOKUPS);
         match job.req.representation {
             super::RepresentationMode::PemInfinity => return single_shell(model, job, o, f0, &pixels, &keys, &settings, largest, fitted.local.origin),
             super::RepresentationMode::StaticEnv => return traced::static_env(model, job, o, f0, &pixels, &keys, largest, fitted.local.origin),
@@ -117,7 +123,7 @@ impl Planned for PemPlanned {
         let mut trial: Vec<(f64, &str, Shell, u32)> = Vec::new();
         for (label, shell) in [("box", fitted.distant_box), ("sphere", fitted.distant_sphere)] {
             let n = face_resolution(set, o, &job.meshes, shell, largest)?;
-            let views = shell_views(set, o, &job.meshes, &[(shell, TextureLayout::cube(n), None)], f0, &probe_pixels, &probe)?;
+            let views = shell_views(set, o, &job.meshes, &[(shell, TextureLayout::cube(n), None)], lookups, f0, &probe_pixels, &probe)?;
             let solved = solve_shell(&views, 0, TextureLayout::cube(n), Target::Distant, &probe_keys, &settings, &job.solver)?;
             trial.push((solved.residual_rms, label, shell, n));
         }
@@ -135,7 +141,7 @@ impl Planned for PemPlanned {
         let local_drawn: Option<Vec<bool>> = hull.as_ref().map(|h| h.iter().map(|&on| !on).collect());
         let geometry: Vec<(Shell, TextureLayout, Option<&[bool]>)> = shells.iter().map(|s| (s.0, s.1, if s.2 == Target::Local { local_drawn.as_deref() } else { None })).collect();
         let all: Vec<usize> = (0..set.frames.len()).collect();
-        let views = shell_views(set, o, &job.meshes, &geometry, f0, &pixels, &all)?;
+        let views = shell_views(set, o, &job.meshes, &geometry, lookups, f0, &pixels, &all)?;
         let mut solved = Vec::new();
         for (s, &(_, layout, target)) in shells.iter().enumerate() {
             solved.push(solve_shell(&views, s, layout, target, &keys, &settings, &job.solver)?);
@@ -149,11 +155,11 @@ impl Planned for PemPlanned {
             None => String::new(),
         };
         let local_text = if has_local { format!(", local ellipsoid {local_n}²{hull_text}") } else { String::new() };
-        let why = format!("distant {label} {n}² (traced distant layer residual {residual:.4}, {} {:.4}){local_text}", other.1, other.0);
+        let why = format!("distant {label} {n}² (traced distant layer residual {residual:.4}, {} {:.4}){local_text}{}", other.1, other.0, lookups_text(lookups));
         let chosen = Chosen { shells, views, solved, why };
         for (s, ((shell, layout, target), solved)) in chosen.shells.iter().zip(chosen.solved).enumerate() {
             let kind = if *target == Target::Local { pis_format::LayerKind::EnvLocal } else { pis_format::LayerKind::EnvDistant };
-            let form = Box::new(ShellForm { shell: *shell, layout: *layout, channels: target.channels() as u8, order: s as u8, term: pis_format::Term::Reflection });
+            let form = Box::new(ShellForm { shell: *shell, layout: *layout, lookups, channels: target.channels() as u8, order: s as u8, term: pis_format::Term::Reflection });
             model.layers.push(InferredLayer::shell(kind, job, &model.stagger, solved.textures, solved.iterations, form, s));
         }
         model.shell_views = chosen.views;
@@ -169,16 +175,17 @@ impl Planned for PemPlanned {
 fn single_shell(mut model: ObjectModel, job: &Job<'_>, o: usize, f0: [f32; 3], pixels: &[Vec<u32>], keys: &[Vec<u32>], settings: &SolveSettings, largest: u32, origin: glam::DVec3) -> Result<ObjectModel> {
     let set = job.set;
     let shell = fit::sphere_at_infinity(origin);
+    let lookups = job.req.shell_lookups.clamp(1, pis_format::MAX_SHELL_LOOKUPS);
     let n = face_resolution(set, o, &job.meshes, shell, largest)?;
     let layout = TextureLayout::cube(n);
     let all: Vec<usize> = (0..set.frames.len()).collect();
-    let views = shell_views(set, o, &job.meshes, &[(shell, layout, None)], f0, pixels, &all)?;
+    let views = shell_views(set, o, &job.meshes, &[(shell, layout, None)], lookups, f0, pixels, &all)?;
     let solved = solve_shell(&views, 0, layout, Target::Incident, keys, settings, &job.solver)?;
-    let form = Box::new(ShellForm { shell, layout, channels: 3, order: 0, term: pis_format::Term::Reflection });
+    let form = Box::new(ShellForm { shell, layout, lookups, channels: 3, order: 0, term: pis_format::Term::Reflection });
     model.layers.push(InferredLayer::shell(pis_format::LayerKind::EnvDistant, job, &model.stagger, solved.textures, solved.iterations, form, 0));
     model.shell_views = views;
     model.representation = "environment map at infinity".to_string();
-    model.why = format!("--representation pem-infinity: one sphere-at-infinity map {n}² per sample (traced incident light residual {:.4}), Fresnel from F0 {f0:?}", solved.residual_rms);
+    model.why = format!("--representation pem-infinity: one sphere-at-infinity map {n}² per sample (traced incident light residual {:.4}){}, Fresnel from F0 {f0:?}", solved.residual_rms, lookups_text(lookups));
     Ok(model)
 }
 

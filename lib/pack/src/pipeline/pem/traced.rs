@@ -100,7 +100,7 @@ pub fn static_env(mut model: ObjectModel, job: &Job<'_>, o: usize, f0: [f32; 3],
     let n = face_resolution(set, o, &job.meshes, shell, largest)?;
     let layout = TextureLayout::cube(n);
     let all: Vec<usize> = (0..set.frames.len()).collect();
-    let views = shell_views(set, o, &job.meshes, &[(shell, layout, None)], f0, pixels, &all)?;
+    let views = shell_views(set, o, &job.meshes, &[(shell, layout, None)], 1, f0, pixels, &all)?;
     let first = set.frames[0].instances[o].world_from_object.inverse();
     // The map does not depend on the camera: points whose objects and lights stand alike
     // (every point of a view-only space) share one trace.
@@ -116,7 +116,7 @@ pub fn static_env(mut model: ObjectModel, job: &Job<'_>, o: usize, f0: [f32; 3],
         };
         textures.insert(k.clone(), cube);
     }
-    let form = Box::new(ShellForm { shell, layout, channels: 3, order: 0, term: pis_format::Term::Reflection });
+    let form = Box::new(ShellForm { shell, layout, lookups: 1, channels: 3, order: 0, term: pis_format::Term::Reflection });
     model.layers.push(InferredLayer::shell(pis_format::LayerKind::EnvDistant, job, &model.stagger, textures, 0, form, 0));
     model.shell_views = views;
     model.representation = "static environment map".to_string();

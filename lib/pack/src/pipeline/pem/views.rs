@@ -52,7 +52,7 @@ fn gather_n(pixels: &[u32], values: &[f32], n: usize) -> Vec<f32> {
 
 /// The shell object of `o` at point `p` for `shell` with `layout`, its eye and its
 /// clip-from-object, as the player draws it.
-fn shell_object<'m>(set: &LoadedSet, p: usize, o: usize, mesh: &'m Mesh, shell: Shell, layout: TextureLayout, drawn: Option<&'m [bool]>) -> ShellObject<'m> {
+fn shell_object<'m>(set: &LoadedSet, p: usize, o: usize, mesh: &'m Mesh, shell: Shell, layout: TextureLayout, drawn: Option<&'m [bool]>, lookups: u32) -> ShellObject<'m> {
     let (w, h) = set.resolution;
     let frame = &set.frames[p];
     let world = frame.instances[o].world_from_object;
@@ -67,6 +67,7 @@ fn shell_object<'m>(set: &LoadedSet, p: usize, o: usize, mesh: &'m Mesh, shell: 
         shell,
         layout,
         drawn,
+        lookups,
     }
 }
 
@@ -110,7 +111,8 @@ fn with_rows_at(a: &RenderMatrix, pixels: &[u32]) -> RenderMatrix {
 /// triangles it is drawn on: `None` all of them) see them. `pixels[k]` are the rows of the
 /// object's surface render matrices at point `points[k]`, which the shells' rows must equal;
 /// a pixel whose triangle does not draw a shell has an empty row in its matrix.
-pub fn shell_views(set: &LoadedSet, o: usize, meshes: &[Mesh], shells: &[(Shell, TextureLayout, Option<&[bool]>)], f0: [f32; 3], pixels: &[Vec<u32>], points: &[usize]) -> Result<Vec<ShellView>> {
+/// Each pixel looks every shell up `lookups` × `lookups` times (SPEC.md 8.2).
+pub fn shell_views(set: &LoadedSet, o: usize, meshes: &[Mesh], shells: &[(Shell, TextureLayout, Option<&[bool]>)], lookups: u32, f0: [f32; 3], pixels: &[Vec<u32>], points: &[usize]) -> Result<Vec<ShellView>> {
     let (w, h) = set.resolution;
     let vp = Viewport { width: w, height: h };
     let name = &set.scene.objects[o].name;
@@ -122,7 +124,7 @@ pub fn shell_views(set: &LoadedSet, o: usize, meshes: &[Mesh], shells: &[(Shell,
             let cov = coverage(set, p, o)?;
             let mut a = Vec::with_capacity(shells.len());
             for &(shell, layout, drawn) in shells {
-                let m = shell_render_matrix(vp, &shell_object(set, p, o, &meshes[o], shell, layout, drawn), Some(&depth))?;
+                let m = shell_render_matrix(vp, &shell_object(set, p, o, &meshes[o], shell, layout, drawn, lookups), Some(&depth))?;
                 let mut m = restrict_rows(&m, &cov);
                 if drawn.is_some() {
                     m = with_rows_at(&m, pixels);
@@ -132,7 +134,7 @@ pub fn shell_views(set: &LoadedSet, o: usize, meshes: &[Mesh], shells: &[(Shell,
                 }
                 a.push(m);
             }
-            let (fp, f) = shell_fresnel(vp, &shell_object(set, p, o, &meshes[o], shells[0].0, shells[0].1, None), Some(&depth), f0)?;
+            let (fp, f) = shell_fresnel(vp, &shell_object(set, p, o, &meshes[o], shells[0].0, shells[0].1, None, 1), Some(&depth), f0)?;
             let mut fresnel = Vec::with_capacity(pixels.len() * 3);
             let mut k = 0;
             for &px in pixels {
@@ -151,7 +153,11 @@ pub fn shell_views(set: &LoadedSet, o: usize, meshes: &[Mesh], shells: &[(Shell,
 /// The cube-face resolution of a shell (thesis 5.8.2: "test renderings to determine the most
 /// detailed EM MIPMAP level actually accessed"): `shell` drawn with a `largest`-texel cube
 /// map at every `step`-th point; the finest level that at least [`ACCESS_SHARE`] of the rows
-/// read is the level whose size is chosen (at least [`MIN_FACE`]).
+/// read is the level whose size is chosen (at least [`MIN_FACE`]). The renderings look the
+/// shell up once per pixel whatever `--shell-lookups` is: sub-pixel lookups shape a pixel's
+/// footprint, they do not make the pixel see finer detail (measured at the teapot-pem paper
+/// preset at 384:1: sized from 2 × 2 lookups, the faces doubled and the lid's local shell
+/// was left no bytes).
 pub fn face_resolution(set: &LoadedSet, o: usize, meshes: &[Mesh], shell: Shell, largest: u32) -> Result<u32> {
     let (w, h) = set.resolution;
     let vp = Viewport { width: w, height: h };
@@ -160,7 +166,7 @@ pub fn face_resolution(set: &LoadedSet, o: usize, meshes: &[Mesh], shell: Shell,
     let mut finest = vec![0usize; layout.levels as usize];
     for p in (0..set.frames.len()).step_by(step) {
         let depth = occluders(set, p, o, meshes)?;
-        let a = restrict_rows(&shell_render_matrix(vp, &shell_object(set, p, o, &meshes[o], shell, layout, None), Some(&depth))?, &coverage(set, p, o)?);
+        let a = restrict_rows(&shell_render_matrix(vp, &shell_object(set, p, o, &meshes[o], shell, layout, None, 1), Some(&depth))?, &coverage(set, p, o)?);
         for r in 0..a.rows() {
             let (cols, vals) = a.row(r);
             let level = cols.iter().zip(vals).filter(|(_, &v)| v > 0.0).map(|(&c, _)| level_of(&layout, c as usize)).min();
