@@ -91,69 +91,100 @@ pub fn shell_render_matrix(viewport: Viewport, object: &ShellObject, occluders: 
     let layout = object.layout;
     let eye = object.eye.as_dvec3();
     let max_level = layout.levels.saturating_sub(1) as f64;
+    // Pixel p's triangle, interpolated attributes and lookup vector (the fragment shader's
+    // inputs), at any pixel of the triangle's plane: fine derivatives are differences
+    // across p's 2×2 quad.
+    let world = &world;
+    let frags = &frags;
+    let fragment = |p: u32| {
+        let (x, y) = (p % viewport.width, p / viewport.width);
+        let t = frags.triangle[p as usize] as usize;
+        let (tri, src) = (&frags.triangles[t], frags.source[t] as usize);
+        let at = move |x: u32, y: u32| attributes_at(tri, world, src, x, y);
+        (x, y, at)
+    };
+    let dir = |pos: DVec3, n: DVec3| lookup_direction(&object.shell, pos, n, eye);
     let k = object.lookups.max(1);
-    let rows: Vec<Vec<(u32, f32)>> = pixels
-        .par_iter()
-        .map(|&p| {
-            let (x, y) = (p % viewport.width, p / viewport.width);
-            let t = frags.triangle[p as usize] as usize;
-            let (tri, src) = (&frags.triangles[t], frags.source[t] as usize);
-            let at = |x: u32, y: u32| attributes_at(tri, &world, src, x, y);
-            let dir = |x: u32, y: u32| {
-                let (pos, n) = at(x, y);
-                lookup_direction(&object.shell, pos, n, eye)
-            };
-            let (qx, qy) = (x & !1, y & !1);
-            let d = dir(x, y);
-            let ddx = dir(qx + 1, y) - dir(qx, y);
-            let ddy = dir(x, qy + 1) - dir(x, qy);
-            let mut taps = Taps::default();
-            if k == 1 {
+    if k == 1 {
+        let rows: Vec<Taps> = pixels
+            .par_iter()
+            .map(|&p| {
+                let (x, y, at) = fragment(p);
+                let d_at = |x: u32, y: u32| {
+                    let (pos, n) = at(x, y);
+                    dir(pos, n)
+                };
+                let (qx, qy) = (x & !1, y & !1);
+                let d = d_at(x, y);
+                let ddx = d_at(qx + 1, y) - d_at(qx, y);
+                let ddy = d_at(x, qy + 1) - d_at(x, qy);
                 let lambda = cube_lod(d, ddx, ddy, layout.width as f64, max_level);
+                let mut taps = Taps::default();
                 cube_taps(&layout, d, lambda, &mut taps);
-                return taps.sorted().collect();
-            }
-            // The fine derivatives of the interpolated position and normal, as the
-            // fragment shader's dpdxFine / dpdyFine give them.
-            let (pos, n) = at(x, y);
-            let ((px0, nx0), (px1, nx1)) = (at(qx, y), at(qx + 1, y));
-            let ((py0, ny0), (py1, ny1)) = (at(x, qy), at(x, qy + 1));
-            let (dpx, dnx, dpy, dny) = (px1 - px0, nx1 - nx0, py1 - py0, ny1 - ny0);
-            let kf = k as f64;
-            let (sx, sy) = (ddx / kf, ddy / kf);
-            let w = 1.0 / (kf * kf);
-            let mut row: Vec<(u32, f32)> = Vec::with_capacity(k as usize * k as usize * 8);
-            for j in 0..k {
-                let oy = (j as f64 + 0.5) / kf - 0.5;
-                for i in 0..k {
-                    let ox = (i as f64 + 0.5) / kf - 0.5;
-                    let ds = lookup_direction(&object.shell, pos + ox * dpx + oy * dpy, n + ox * dnx + oy * dny, eye);
-                    let lambda = cube_lod(ds, sx, sy, layout.width as f64, max_level);
-                    cube_taps(&layout, ds, lambda, &mut taps);
-                    for (c, v) in taps.sorted() {
-                        match row.iter_mut().find(|e| e.0 == c) {
-                            Some(e) => e.1 += v * w as f32,
-                            None => row.push((c, v * w as f32)),
+                taps
+            })
+            .collect();
+        return Ok(RenderMatrix::from_taps(viewport, layout, pixels, &rows));
+    }
+    // k × k lookups per pixel (SPEC.md 8.2): each chunk of pixels fills its own entries,
+    // one row buffer reused from pixel to pixel.
+    let kf = k as f64;
+    let w = (1.0 / (kf * kf)) as f32;
+    let chunks: Vec<(Vec<u32>, Vec<f32>, Vec<u32>)> = pixels
+        .par_chunks(ROWS_PER_CHUNK)
+        .map(|chunk| {
+            let (mut cols, mut vals, mut lens) = (Vec::new(), Vec::new(), Vec::with_capacity(chunk.len()));
+            let mut row: Vec<(u32, f32)> = Vec::with_capacity(k as usize * k as usize * crate::filter::MAX_TAPS);
+            let mut taps = Taps::default();
+            for &p in chunk {
+                let (x, y, at) = fragment(p);
+                let (qx, qy) = (x & !1, y & !1);
+                let (pos, n) = at(x, y);
+                let ((px0, nx0), (px1, nx1)) = (at(qx, y), at(qx + 1, y));
+                let ((py0, ny0), (py1, ny1)) = (at(x, qy), at(x, qy + 1));
+                let (dpx, dnx, dpy, dny) = (px1 - px0, nx1 - nx0, py1 - py0, ny1 - ny0);
+                let ddx = dir(px1, nx1) - dir(px0, nx0);
+                let ddy = dir(py1, ny1) - dir(py0, ny0);
+                let (sx, sy) = (ddx / kf, ddy / kf);
+                row.clear();
+                for j in 0..k {
+                    let oy = (j as f64 + 0.5) / kf - 0.5;
+                    for i in 0..k {
+                        let ox = (i as f64 + 0.5) / kf - 0.5;
+                        let ds = dir(pos + ox * dpx + oy * dpy, n + ox * dnx + oy * dny);
+                        cube_taps(&layout, ds, cube_lod(ds, sx, sy, layout.width as f64, max_level), &mut taps);
+                        for (c, v) in taps.sorted() {
+                            match row.iter_mut().find(|e| e.0 == c) {
+                                Some(e) => e.1 += v * w,
+                                None => row.push((c, v * w)),
+                            }
                         }
                     }
                 }
+                row.sort_unstable_by_key(|e| e.0);
+                cols.extend(row.iter().map(|e| e.0));
+                vals.extend(row.iter().map(|e| e.1));
+                lens.push(row.len() as u32);
             }
-            row.sort_unstable_by_key(|e| e.0);
-            row
+            (cols, vals, lens)
         })
         .collect();
-    let mut row_start = Vec::with_capacity(rows.len() + 1);
+    let mut row_start = Vec::with_capacity(pixels.len() + 1);
     row_start.push(0u32);
-    let (mut cols, mut vals) = (Vec::new(), Vec::new());
-    for r in &rows {
-        for &(c, v) in r {
-            cols.push(c);
-            vals.push(v);
+    let nnz = chunks.iter().map(|c| c.0.len()).sum();
+    let (mut cols, mut vals) = (Vec::with_capacity(nnz), Vec::with_capacity(nnz));
+    for (c, v, lens) in chunks {
+        for len in lens {
+            row_start.push(row_start[row_start.len() - 1] + len);
         }
-        row_start.push(cols.len() as u32);
+        cols.extend(c);
+        vals.extend(v);
     }
     Ok(RenderMatrix { width: viewport.width, height: viewport.height, layout, coverage: vec![1.0; pixels.len()], pixels, row_start, cols, vals })
 }
+
+/// Pixels per parallel chunk of a render matrix with several lookups per pixel.
+const ROWS_PER_CHUNK: usize = 256;
 
 /// The object rasterized as the player draws it, each triangle's world corners, and the
 /// pixels that draw the shell (in increasing order).
