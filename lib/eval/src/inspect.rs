@@ -154,6 +154,10 @@ pub fn summarize(r: &PisReader) -> Summary {
                         e.codestreams += 1;
                         e.bytes += s.length as u64;
                     }
+                    let first_shell = l.blocks.first().and_then(|b| match b.placement {
+                        Placement::Shell { shape, lookups, .. } => Some((shape, lookups)),
+                        Placement::Surface { .. } => None,
+                    });
                     LayerSummary {
                         kind: l.kind.name(),
                         mapping: l.mapping.name(),
@@ -172,14 +176,8 @@ pub fn summarize(r: &PisReader) -> Summary {
                         levels: l.blocks.iter().map(|b| b.levels.len()).max().unwrap_or(0),
                         codestreams: refs.len(),
                         bytes: refs.iter().map(|s| s.length as u64).sum(),
-                        shell: l.blocks.first().and_then(|b| match b.placement {
-                            Placement::Shell { shape, .. } => Some(shape.name()),
-                            Placement::Surface { .. } => None,
-                        }),
-                        lookups: l.blocks.first().and_then(|b| match b.placement {
-                            Placement::Shell { lookups, .. } => Some(lookups),
-                            Placement::Surface { .. } => None,
-                        }),
+                        shell: first_shell.map(|(shape, _)| shape.name()),
+                        lookups: first_shell.map(|(_, k)| k),
                     }
                 })
                 .collect();

@@ -190,6 +190,9 @@ fn begin(req: &PackRequest, stages: &mut Stages) -> Result<(input::LoadedSet, ma
     if let Some(why) = filter_needs_probe(req.filter, req.matrix) {
         return Err(Failure::new(Exit::Usage, anyhow::anyhow!(why)));
     }
+    if !(1..=pis_format::MAX_SHELL_LOOKUPS).contains(&req.shell_lookups) {
+        return Err(Failure::new(Exit::Usage, anyhow::anyhow!("--shell-lookups must be 1 to {}, got {}", pis_format::MAX_SHELL_LOOKUPS, req.shell_lookups)));
+    }
     let set = input::load(req, stages)?;
     // A ratio is checked before any work: it must leave the level images a byte.
     let raw = set.raw_image_bytes();

@@ -22,7 +22,7 @@ use crate::image::FloatImage;
 use crate::resolve::ResolvePipelines;
 use crate::frame_hybrid::{lens_bind, LensDraw, HYBRID_FRAME, LENS_CORNER_LAYOUT, MAX_LENS_SHELLS};
 use crate::frame_reflection::{reflection_bind, REFLECTION};
-pub use crate::frame_reflection::{ReflectionDraw, MAX_TERM_SHELLS};
+pub use crate::frame_reflection::{ReflectionDraw, TermShell, MAX_TERM_SHELLS};
 use crate::shell::SHELL_FUNCTIONS;
 use crate::textured::{allocated_size, cut_uniform, ObjectTexture, DEPTH_FORMAT};
 

@@ -54,21 +54,25 @@ pub struct ReflectionDraw<'a> {
     pub weight: f32,
     /// The term's shells in increasing order (order 0 nearest), each with its cube map:
     /// 1 to [`MAX_TERM_SHELLS`] (the player checks the count when it opens a file).
-    pub shells: Vec<(pis_compile::shell::Shell, &'a ShellTexture)>,
-    /// Per shell: lookups per pixel side (SPEC.md 8.2; 1 when empty).
-    pub lookups: Vec<u32>,
+    pub shells: Vec<TermShell<'a>>,
+}
+
+/// One shell of a reflection term: its geometry, its lookups per pixel side (SPEC.md 8.2)
+/// and its cube map.
+#[derive(Clone, Copy)]
+pub struct TermShell<'a> {
+    pub shell: pis_compile::shell::Shell,
+    pub lookups: u32,
+    pub cube: &'a ShellTexture,
 }
 
 /// The uniforms of a reflection term drawn on `object` with `shells` (the term's, or the
 /// most distant alone on hull triangles).
-fn reflection_uniforms(object: &ObjectDraw, r: &ReflectionDraw, shells_drawn: &[(pis_compile::shell::Shell, &ShellTexture)]) -> ReflectionUniforms {
+fn reflection_uniforms(object: &ObjectDraw, r: &ReflectionDraw, shells_drawn: &[TermShell]) -> ReflectionUniforms {
     let mut shells = [ShellSlot::zeroed(); MAX_TERM_SHELLS];
-    // The drawn shells are the term's last ones (all, or the most distant on hull triangles).
-    let first = r.shells.len().saturating_sub(shells_drawn.len());
-    for (k, (slot, (shell, cube))) in shells.iter_mut().zip(shells_drawn).enumerate() {
-        let (origin_shape, a, b) = shell_uniform(shell);
-        let lookups = r.lookups.get(first + k).copied().unwrap_or(1).max(1);
-        *slot = ShellSlot { origin_shape, a, b, size_levels: [cube.layout.width, cube.layout.levels, lookups, 0] };
+    for (slot, s) in shells.iter_mut().zip(shells_drawn) {
+        let (origin_shape, a, b) = shell_uniform(&s.shell);
+        *slot = ShellSlot { origin_shape, a, b, size_levels: [s.cube.layout.width, s.cube.layout.levels, s.lookups.max(1), 0] };
     }
     ReflectionUniforms {
         clip_from_object: object.clip_from_object.to_cols_array(),
@@ -85,10 +89,10 @@ fn reflection_uniforms(object: &ObjectDraw, r: &ReflectionDraw, shells_drawn: &[
 /// The bind group of a reflection term drawn on `object` with `shells` (one or two of the
 /// term's, in order): its uniforms and the cube maps of shells 0 and 1 (shell 0's twice for
 /// one shell).
-pub fn reflection_bind(gpu: &Gpu, layout: &wgpu::BindGroupLayout, object: &ObjectDraw, r: &ReflectionDraw, shells: &[(pis_compile::shell::Shell, &ShellTexture)]) -> wgpu::BindGroup {
+pub fn reflection_bind(gpu: &Gpu, layout: &wgpu::BindGroupLayout, object: &ObjectDraw, r: &ReflectionDraw, shells: &[TermShell]) -> wgpu::BindGroup {
     let d = &gpu.device;
     let u = d.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: Some("reflection uniforms"), contents: bytemuck::bytes_of(&reflection_uniforms(object, r, shells)), usage: wgpu::BufferUsages::UNIFORM });
-    let cube = |k: usize| wgpu::BindingResource::TextureView(&shells[k.min(shells.len() - 1)].1.view);
+    let cube = |k: usize| wgpu::BindingResource::TextureView(&shells[k.min(shells.len() - 1)].cube.view);
     d.create_bind_group(&wgpu::BindGroupDescriptor {
         label: Some("reflection"),
         layout,

@@ -55,21 +55,11 @@ fn shell_geometry_of(k: u32) -> ShellGeometry {
     return ShellGeometry(s.origin_shape.xyz, u32(s.origin_shape.w), s.a.xyz, s.b.xyz);
 }
 
-// Shell k's premultiplied RGBA at world position p with normal n: the lookup vector D, its
-// LOD from D's fine derivatives (differences across the pixel's 2×2 quad), the trilinear,
-// seamless lookup of `cube`, once or k × k times over the pixel (size_levels.z;
-// `cube_sample_pixel`).
+// Shell k's premultiplied RGBA at world position p with normal n: the trilinear, seamless
+// lookup of `cube`, once or k × k times over the pixel (size_levels.z; `cube_sample_pixel`).
 fn shell_colour(k: u32, cube: texture_2d_array<f32>, p: vec3<f32>, n: vec3<f32>) -> vec4<f32> {
-    let g = shell_geometry_of(k);
-    let d = lookup_direction(g, p, n, ru.eye.xyz);
-    let ddx = dpdxFine(d);
-    let ddy = dpdyFine(d);
-    let dpx = dpdxFine(p);
-    let dpy = dpdyFine(p);
-    let dnx = dpdxFine(n);
-    let dny = dpdyFine(n);
     let sl = ru.shells[k].size_levels;
-    return cube_sample_pixel(g, cube, sl.x, sl.y, sl.z, ru.eye.xyz, p, n, dpx, dpy, dnx, dny, ddx, ddy);
+    return cube_sample_pixel(shell_geometry_of(k), cube, sl.x, sl.y, sl.z, ru.eye.xyz, p, n);
 }
 
 // The reflection term (SPEC.md 9): the shells composited "over" in increasing order,

@@ -29,7 +29,7 @@ use crate::camera::{mat4_from_rows, projection, CameraChoice, ViewCamera};
 use crate::decode::{AssembleJob, Decoder, LevelJob};
 use crate::error::PlayError;
 use crate::frame_hybrid::{corner_buffer, term_corners, LensDraw, MAX_LENS_SHELLS};
-use crate::frame::{colour_image, offscreen_format, FramePipelines, LayerDraw, MeshGpu, ObjectDraw, Readback, ReflectionDraw, Targets, MAX_TERM_SHELLS};
+use crate::frame::{colour_image, offscreen_format, FramePipelines, LayerDraw, MeshGpu, ObjectDraw, Readback, ReflectionDraw, Targets, TermShell, MAX_TERM_SHELLS};
 use crate::gpu::Gpu;
 use crate::image::FloatImage;
 use crate::mip::MipBuilder;
@@ -197,10 +197,9 @@ struct Wanted {
 struct WantedReflection {
     draw: usize,
     weight: f32,
-    /// Per shell of the term, in order: its texture and its geometry.
-    shells: Vec<(TextureKey, Shell)>,
-    /// Per shell: lookups per pixel side (SPEC.md 8.2).
-    lookups: Vec<u32>,
+    /// Per shell of the term, in order: its texture, its geometry and its lookups per pixel
+    /// side (SPEC.md 8.2).
+    shells: Vec<(TextureKey, Shell, u32)>,
 }
 
 /// What a frame draws: per object its clip and world transforms, the frame's camera
@@ -219,7 +218,7 @@ struct Plan {
 impl Plan {
     /// Every texture the frame draws (a texture drawn twice is listed twice).
     fn keys(&self) -> Vec<&TextureKey> {
-        let shells = self.reflections.iter().chain(&self.lenses).flat_map(|r| r.shells.iter().map(|(k, _)| k));
+        let shells = self.reflections.iter().chain(&self.lenses).flat_map(|r| r.shells.iter().map(|(k, _, _)| k));
         self.surfaces.iter().map(|w| &w.key).chain(shells).collect()
     }
 }
@@ -387,14 +386,14 @@ fn lens_state(reader: &PisReader, oi: usize, tint: [f32; 3], skipped: &mut Vec<S
     Ok(Some(LensState { layers, positions: o.mesh.positions.iter().map(v3).collect(), normals: normals.iter().map(v3).collect(), indices: o.mesh.indices.clone(), material, placed: None, tessellated: None }))
 }
 
-/// The cube-map geometry of a shell block's placement (SPEC.md 7.3); `None` for a quad or a
-/// surface placement.
-fn shell_of(placement: &Placement) -> Option<Shell> {
-    let Placement::Shell { shape, origin, params, .. } = placement else { return None };
+/// The cube-map geometry of a shell block's placement (SPEC.md 7.3) and its lookups per
+/// pixel side (8.2); `None` for a quad or a surface placement.
+fn shell_of(placement: &Placement) -> Option<(Shell, u32)> {
+    let Placement::Shell { shape, origin, params, lookups } = placement else { return None };
     let mut values = [0.0f32; 12];
     values[..3].copy_from_slice(origin);
     values[3..9].copy_from_slice(params);
-    Shell::from_placement(shape.code() as u16, &values)
+    Shell::from_placement(shape.code() as u16, &values).map(|s| (s, *lookups))
 }
 
 /// The reflection terms of a plan, with their cube maps on the GPU (`resident`).
@@ -403,13 +402,13 @@ fn reflection_draws<'a>(reader: &PisReader, resident: &'a HashMap<TextureKey, Re
     let mut out = Vec::with_capacity(plan.reflections.len());
     for r in &plan.reflections {
         let mut shells = Vec::with_capacity(r.shells.len());
-        for (key, shell) in &r.shells {
+        for (key, shell, lookups) in &r.shells {
             let GpuTexture::Shell(cube) = &resident[key].texture else {
                 return Err(content(reader, format!("{key:?}: a surface texture drawn as a shell")));
             };
-            shells.push((*shell, cube));
+            shells.push(TermShell { shell: *shell, lookups: *lookups, cube });
         }
-        out.push(ReflectionDraw { draw: r.draw, world_from_object: plan.worlds[r.draw], eye: plan.eye, f0: c.objects[r.draw].shading.f0, weight: r.weight, shells, lookups: r.lookups.clone() });
+        out.push(ReflectionDraw { draw: r.draw, world_from_object: plan.worlds[r.draw], eye: plan.eye, f0: c.objects[r.draw].shading.f0, weight: r.weight, shells });
     }
     Ok(out)
 }
@@ -666,17 +665,12 @@ impl Player {
         let mut out = Vec::new();
         for (s, weight) in merge_for_mask(samples, mask) {
             let mut shells = Vec::with_capacity(term.len());
-            let mut lookups = Vec::with_capacity(term.len());
             for &li in term {
                 let (key, block) = self.texture_key(oi, li, &s)?;
-                let shell = shell_of(&block.placement).ok_or_else(|| content(&self.reader, format!("object {oi} layer {li} block {}: not a closed shell", key.block)))?;
-                lookups.push(match block.placement {
-                    Placement::Shell { lookups, .. } => lookups,
-                    Placement::Surface { .. } => 1,
-                });
-                shells.push((key, shell));
+                let (shell, lookups) = shell_of(&block.placement).ok_or_else(|| content(&self.reader, format!("object {oi} layer {li} block {}: not a closed shell", key.block)))?;
+                shells.push((key, shell, lookups));
             }
-            out.push(WantedReflection { draw: oi, weight, shells, lookups });
+            out.push(WantedReflection { draw: oi, weight, shells });
         }
         Ok(out)
     }
@@ -862,10 +856,10 @@ impl Player {
         let reflections = reflection_draws(&self.reader, &self.resident, &plan)?;
         let mut lenses = Vec::new();
         for r in &plan.lenses {
-            let shells: Vec<Shell> = r.shells.iter().map(|(_, s)| *s).collect();
+            let shells: Vec<Shell> = r.shells.iter().map(|(_, s, _)| *s).collect();
             let Some((_, _, buffers)) = corner_sets.iter().find(|(d, s, _)| *d == r.draw && *s == shells) else { continue };
             let mut cubes = Vec::with_capacity(r.shells.len());
-            for (key, _) in &r.shells {
+            for (key, _, _) in &r.shells {
                 let GpuTexture::Shell(cube) = &self.resident[key].texture else {
                     return Err(content(&self.reader, format!("{key:?}: a surface texture drawn as a shell")));
                 };
@@ -963,7 +957,7 @@ fn lens_corners(gpu: &Gpu, states: &mut [(usize, LensState)], plan: &Plan, size:
     let settings = TessellationSettings { tau_px, ..TessellationSettings::default() };
     let mut work = LensWork { sets: Vec::new(), ms: 0.0, rays: 0, triangles: 0 };
     for r in &plan.lenses {
-        let shells: Vec<Shell> = r.shells.iter().map(|(_, s)| *s).collect();
+        let shells: Vec<Shell> = r.shells.iter().map(|(_, s, _)| *s).collect();
         if work.sets.iter().any(|(d, s, _)| *d == r.draw && *s == shells) {
             continue;
         }

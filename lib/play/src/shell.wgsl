@@ -261,16 +261,24 @@ fn cube_sample(cube: texture_2d_array<f32>, size: u32, levels: u32, d: vec3<f32>
 }
 
 // A shell's colour at a pixel (SPEC.md 8.2), the twin of pis-compile's
-// `shell_render_matrix`: with k = 1 one trilinear lookup of D at λ from D's fine derivatives
-// (ddx, ddy); with k > 1 the mean of k × k lookups at the sub-pixel offsets
-// o = ((i + ½)/k − ½, (j + ½)/k − ½), each from the position p and normal n moved by o times
-// their fine derivatives, at λ from D's derivatives divided by k.
-fn cube_sample_pixel(g: ShellGeometry, cube: texture_2d_array<f32>, size: u32, levels: u32, k: u32, eye: vec3<f32>, p: vec3<f32>, n: vec3<f32>, dpx: vec3<f32>, dpy: vec3<f32>, dnx: vec3<f32>, dny: vec3<f32>, ddx: vec3<f32>, ddy: vec3<f32>) -> vec4<f32> {
+// `shell_render_matrix`, at world position p with normal n (interpolated): with k = 1 one
+// trilinear lookup of D at λ from D's fine derivatives (differences across the pixel's 2×2
+// quad); with k > 1 the mean of k × k lookups at the sub-pixel offsets
+// o = ((i + ½)/k − ½, (j + ½)/k − ½), each from p and n moved by o times their fine
+// derivatives, at λ from D's derivatives divided by k. Call it in uniform control flow with
+// a uniform k (it takes derivatives).
+fn cube_sample_pixel(g: ShellGeometry, cube: texture_2d_array<f32>, size: u32, levels: u32, k: u32, eye: vec3<f32>, p: vec3<f32>, n: vec3<f32>) -> vec4<f32> {
+    let d = lookup_direction(g, p, n, eye);
+    let ddx = dpdxFine(d);
+    let ddy = dpdyFine(d);
     let max_level = f32(levels - 1u);
     if (k <= 1u) {
-        let d = lookup_direction(g, p, n, eye);
         return cube_sample(cube, size, levels, d, cube_lod(d, ddx, ddy, f32(size), max_level));
     }
+    let dpx = dpdxFine(p);
+    let dpy = dpdyFine(p);
+    let dnx = dpdxFine(n);
+    let dny = dpdyFine(n);
     let kf = f32(k);
     let sx = ddx / kf;
     let sy = ddy / kf;

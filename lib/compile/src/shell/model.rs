@@ -91,9 +91,10 @@ pub fn shell_render_matrix(viewport: Viewport, object: &ShellObject, occluders: 
     let layout = object.layout;
     let eye = object.eye.as_dvec3();
     let max_level = layout.levels.saturating_sub(1) as f64;
-    // Pixel p's triangle, interpolated attributes and lookup vector (the fragment shader's
-    // inputs), at any pixel of the triangle's plane: fine derivatives are differences
-    // across p's 2×2 quad.
+    // Pixel p's coordinates and its triangle's interpolated world position and normal at
+    // any pixel of the triangle's plane (the fragment shader's inputs): fine derivatives are
+    // differences across p's 2×2 quad. As `cube_sample_pixel` in shell.wgsl, one lookup
+    // takes D's derivatives alone, k × k lookups the attributes' too.
     let world = &world;
     let frags = &frags;
     let fragment = |p: u32| {

@@ -106,7 +106,7 @@ impl Planned for PemPlanned {
         let mut settings = SolveSettings::pyramidal();
         settings.cg = job.settings.cg;
         let largest = LARGEST_FACE.min(job.req.max_texture.next_power_of_two() / 2).max(8);
-        let lookups = job.req.shell_lookups.clamp(1, pis_format::MAX_SHELL_LOOKUPS);
+        let lookups = job.req.shell_lookups;
         match job.req.representation {
             super::RepresentationMode::PemInfinity => return single_shell(model, job, o, f0, &pixels, &keys, &settings, largest, fitted.local.origin),
             super::RepresentationMode::StaticEnv => return traced::static_env(model, job, o, f0, &pixels, &keys, largest, fitted.local.origin),
@@ -175,7 +175,7 @@ impl Planned for PemPlanned {
 fn single_shell(mut model: ObjectModel, job: &Job<'_>, o: usize, f0: [f32; 3], pixels: &[Vec<u32>], keys: &[Vec<u32>], settings: &SolveSettings, largest: u32, origin: glam::DVec3) -> Result<ObjectModel> {
     let set = job.set;
     let shell = fit::sphere_at_infinity(origin);
-    let lookups = job.req.shell_lookups.clamp(1, pis_format::MAX_SHELL_LOOKUPS);
+    let lookups = job.req.shell_lookups;
     let n = face_resolution(set, o, &job.meshes, shell, largest)?;
     let layout = TextureLayout::cube(n);
     let all: Vec<usize> = (0..set.frames.len()).collect();
