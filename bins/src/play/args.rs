@@ -106,7 +106,7 @@ pub struct PlayArgs {
     /// Memory for decoded level images, MiB.
     #[arg(long, default_value_t = 512)]
     pub cache_mb: u64,
-    /// Decoding threads (default: cores − 1, at least 1).
+    /// Decoding threads (default: one per core; the frame waits for its textures).
     #[arg(long)]
     pub workers: Option<usize>,
     /// Draw every sample point of this ray-traced set and report PSNR against its gold

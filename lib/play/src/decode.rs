@@ -84,11 +84,15 @@ pub fn decode_level(reader: &PisReader, job: &LevelJob) -> Result<Vec<f32>, Play
 /// finest level; every plane of the level layout, in its order.
 fn reconstruct(job: &AssembleJob) -> Vec<f32> {
     let n: usize = job.layout.planes().iter().map(|p| (p.width * p.height * p.channels) as usize).sum();
-    let mut sum = vec![0.0f32; n];
-    // Element by element, so chunks on the workers give the values `finish` gives.
+    // Element by element, so chunks on the workers give the values `finish` gives: the sum
+    // starts as the top level's copy (0 + v is v).
+    let mut sum = match job.levels.first() {
+        Some(top) => top[..n].to_vec(),
+        None => vec![0.0f32; n],
+    };
     sum.par_chunks_mut(CHUNK).enumerate().for_each(|(k, out)| {
         let (at, len) = (k * CHUNK, out.len());
-        for img in &job.levels {
+        for img in job.levels.iter().skip(1) {
             out.iter_mut().zip(&img[at..at + len]).for_each(|(a, v)| *a += v);
         }
         pis_codec::gamma::uncompensate(out, job.layer.gamma);
@@ -113,12 +117,28 @@ fn rgba_texel(px: &[f32]) -> [f32; 4] {
     }
 }
 
+/// A level of `C`-channel texels written as RGBA texels into `out` ([`rgba_texel`]).
+fn put_rgba<const C: usize>(level: &[f32], out: &mut [f32]) {
+    level.chunks_exact(C).zip(out.chunks_exact_mut(4)).for_each(|(px, o)| o.copy_from_slice(&rgba_texel(px)));
+}
+
+/// [`put_rgba`] for a level of `c` channels.
+fn level_rgba(level: &[f32], c: u32, out: &mut [f32]) {
+    match c {
+        1 => put_rgba::<1>(level, out),
+        2 => put_rgba::<2>(level, out),
+        3 => put_rgba::<3>(level, out),
+        _ => put_rgba::<4>(level, out),
+    }
+}
+
 /// Rebuilds a texture: [`reconstruct`], the finest level decimated `drop_levels` times,
 /// padded to powers of two.
 pub fn assemble(job: &AssembleJob) -> TextureImage {
-    let linear = reconstruct(job);
+    let mut linear = reconstruct(job);
     let (w0, h0, c) = (job.layout.width, job.layout.height, job.layout.channels);
-    let mut finest = linear[..(w0 * h0 * c) as usize].to_vec();
+    linear.truncate((w0 * h0 * c) as usize);
+    let mut finest = linear;
     let (mut w, mut h) = (w0, h0);
     for m in 0..job.drop_levels {
         finest = decimate(&finest, w, h, c);
@@ -126,24 +146,26 @@ pub fn assemble(job: &AssembleJob) -> TextureImage {
     }
     let (pw, ph) = (w.next_power_of_two(), h.next_power_of_two());
     let mut rgba = vec![0.0f32; pw as usize * ph as usize * 4];
-    let c = c as usize;
-    for j in 0..ph {
-        for i in 0..pw {
-            let src = (j.min(h - 1) * w + i.min(w - 1)) as usize * c;
-            let dst = (j * pw + i) as usize * 4;
-            rgba[dst..dst + 4].copy_from_slice(&rgba_texel(&finest[src..src + c]));
-        }
+    let (row_in, row_out) = ((w * c) as usize, pw as usize * 4);
+    for (j, out) in rgba.chunks_exact_mut(row_out).enumerate() {
+        let src = (j as u32).min(h - 1) as usize * row_in;
+        let (used, pad) = out.split_at_mut(w as usize * 4);
+        level_rgba(&finest[src..src + row_in], c, used);
+        let last = [used[used.len() - 4], used[used.len() - 3], used[used.len() - 2], used[used.len() - 1]];
+        pad.chunks_exact_mut(4).for_each(|t| t.copy_from_slice(&last));
     }
     TextureImage { width: w, height: h, padded_width: pw, padded_height: ph, rgba }
 }
 
 /// One face's MIP chain of a reconstructed shell texture (`face`: its stored planes): its
 /// stored levels (mip mode `stored`), or level 0 decimated down to 1×1 (mip mode
-/// `decimated`, SPEC.md 8.3); from level `drop` down, as RGBA texels appended to `rgba`.
-fn face_chain(layout: &LevelLayout, face: &[f32], drop: u32, rgba: &mut Vec<f32>) {
+/// `decimated`, SPEC.md 8.3); from level `drop` down, as RGBA texels written to `rgba`
+/// (exactly their length).
+fn face_chain(layout: &LevelLayout, face: &[f32], drop: u32, rgba: &mut [f32]) {
     let (n, c) = (layout.width, layout.channels);
     let levels = pis_format::mip::mip_count(n, n);
     let mut at = 0;
+    let mut put = 0;
     let mut coarser: Vec<f32> = Vec::new();
     for m in 0..levels {
         let (w, h) = mip_size(n, n, m);
@@ -157,9 +179,12 @@ fn face_chain(layout: &LevelLayout, face: &[f32], drop: u32, rgba: &mut Vec<f32>
             &coarser
         };
         if m >= drop {
-            level.chunks_exact(c as usize).for_each(|px| rgba.extend_from_slice(&rgba_texel(px)));
+            let texels = (w * h) as usize * 4;
+            level_rgba(level, c, &mut rgba[put..put + texels]);
+            put += texels;
         }
     }
+    debug_assert_eq!(put, rgba.len());
 }
 
 /// Rebuilds a shell's cube map: [`reconstruct`], each face's MIP chain from its finest drawn
@@ -172,15 +197,11 @@ pub fn assemble_cube(job: &AssembleJob) -> CubeImage {
     let (size, _) = full.level_size(drop);
     let layout = TextureLayout { width: size, height: size, levels: full.levels - drop, faces: 6 };
     let per_face = layout.texel_count() / 6 * 4;
-    let faces: Vec<Vec<f32>> = linear
-        .par_chunks_exact(face_len(&job.layout))
-        .map(|face| {
-            let mut rgba = Vec::with_capacity(per_face);
-            face_chain(&job.layout, face, drop, &mut rgba);
-            rgba
-        })
-        .collect();
-    CubeImage { layout, rgba: faces.concat() }
+    let mut rgba = vec![0.0f32; per_face * 6];
+    rgba.par_chunks_exact_mut(per_face)
+        .zip(linear.par_chunks_exact(face_len(&job.layout)))
+        .for_each(|(out, face)| face_chain(&job.layout, face, drop, out));
+    CubeImage { layout, rgba }
 }
 
 impl Decoder {

@@ -46,7 +46,8 @@ pub struct PlayerOptions {
     pub lifetime_a: u32,
     /// Lifetime growth per pyramid level up (thesis b, default 4).
     pub lifetime_b: u32,
-    /// Decoding threads (default: cores − 1, at least 1).
+    /// Decoding threads (default: one per core; a frame waits for its textures, so the
+    /// render thread is idle while they decode).
     pub workers: usize,
     /// Texture resolution reduction: 1 draws full resolution; 2, 4, … draw MIP level
     /// log2(r) as the finest level (textures at 1/r resolution per side).
@@ -68,7 +69,7 @@ pub struct PlayerOptions {
 impl Default for PlayerOptions {
     fn default() -> Self {
         let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
-        PlayerOptions { cache_budget_bytes: 512 << 20, lifetime_a: 20, lifetime_b: 4, workers: cores.saturating_sub(1).max(1), reduction: 1, blend: Blend::Nearest, msaa: DEFAULT_SAMPLES, display_filter: None, tau_px: TessellationSettings::default().tau_px }
+        PlayerOptions { cache_budget_bytes: 512 << 20, lifetime_a: 20, lifetime_b: 4, workers: cores.max(1), reduction: 1, blend: Blend::Nearest, msaa: DEFAULT_SAMPLES, display_filter: None, tau_px: TessellationSettings::default().tau_px }
     }
 }
 

@@ -2,7 +2,7 @@
 // surface point. One function written twice: every function here has a twin of the same
 // name in pis-compile's hardware model, with the same order of operations (reflect_about,
 // shell_hit, lookup_direction, fresnel: shell/geometry.rs; cube_face, face_components, face_st,
-// face_vector, cube_texel, cube_texels, cube_lod, cube_bilinear, cube_sample:
+// face_vector, cube_texel, beyond, bilinear_corner, cube_lod, cube_bilinear, cube_sample:
 // shell/cube.rs;
 // texture_lod: lod.rs). Change both together. Pipelines append their entry points to this
 // source.
@@ -202,47 +202,55 @@ fn cube_lod(d: vec3<f32>, ddx: vec3<f32>, ddy: vec3<f32>, size: f32, max_level: 
     return texture_lod(dx, dy, vec2<f32>(size, size), max_level);
 }
 
-// Texel (i, j) of an n × n level of `face` of `cube`, level m: cube_texel's texel within
-// a face or beyond one edge; beyond a corner, the mean of the three texels meeting there.
-fn cube_texels(cube: texture_2d_array<f32>, face: u32, i: i32, j: i32, n: u32, m: u32) -> vec4<f32> {
-    let ni = i32(n);
-    let in_i = i >= 0 && i < ni;
-    let in_j = j >= 0 && j < ni;
-    if (in_i || in_j) {
-        let t = cube_texel(face, i, j, n);
-        return textureLoad(cube, vec2<i32>(t.y, t.z), t.x, i32(m));
-    }
-    let ci = clamp(i, 0, ni - 1);
-    let cj = clamp(j, 0, ni - 1);
-    let third = 1.0 / 3.0;
-    let t0 = cube_texel(face, ci, cj, n);
-    let t1 = cube_texel(face, i, cj, n);
-    let t2 = cube_texel(face, ci, j, n);
-    var c = third * textureLoad(cube, vec2<i32>(t0.y, t0.z), t0.x, i32(m));
-    c = c + third * textureLoad(cube, vec2<i32>(t1.y, t1.z), t1.x, i32(m));
-    c = c + third * textureLoad(cube, vec2<i32>(t2.y, t2.z), t2.x, i32(m));
-    return c;
-}
-
-// Bilinear lookup of level m of cube map `cube` (face size `size`) with vector d.
+// Bilinear lookup of level m of cube map `cube` (face size `size`) with vector d: the four
+// texels around (u, v), each cube_texel's texel within the face or beyond one edge. Beyond
+// a corner, where three faces meet and no fourth texel exists, a texel is the mean of the
+// three meeting there, which are the footprint's other three: at most one of the four is
+// beyond a corner, and its weight goes to the other three in thirds (bilinear_corner), so
+// every lookup loads four texels.
 fn cube_bilinear(cube: texture_2d_array<f32>, size: u32, d: vec3<f32>, m: u32) -> vec4<f32> {
     let face = cube_face(d);
     let st = face_st(face, d);
     let n = (size + (1u << m) - 1u) >> m;
+    let ni = i32(n);
     let u = st.x * f32(n) - 0.5;
     let v = st.y * f32(n) - 0.5;
     let i0 = floor(u);
     let j0 = floor(v);
     let a = u - i0;
     let b = v - j0;
+    let third = bilinear_corner(i32(i0), i32(j0), ni, a, b) / 3.0;
     var acc = vec4<f32>(0.0);
     for (var dj = 0; dj < 2; dj = dj + 1) {
         for (var di = 0; di < 2; di = di + 1) {
-            let w = select(1.0 - a, a, di == 1) * select(1.0 - b, b, dj == 1);
-            acc = acc + w * cube_texels(cube, face, i32(i0) + di, i32(j0) + dj, n, m);
+            let i = i32(i0) + di;
+            let j = i32(j0) + dj;
+            let corner = beyond(i, ni) && beyond(j, ni);
+            let w = select(select(1.0 - a, a, di == 1) * select(1.0 - b, b, dj == 1) + third, 0.0, corner);
+            let t = cube_texel(face, select(i, clamp(i, 0, ni - 1), corner), select(j, clamp(j, 0, ni - 1), corner), n);
+            acc = acc + w * textureLoad(cube, vec2<i32>(t.y, t.z), t.x, i32(m));
         }
     }
     return acc;
+}
+
+// Whether texel coordinate x lies beyond an n-texel face.
+fn beyond(x: i32, n: i32) -> bool {
+    return x < 0 || x >= n;
+}
+
+// The bilinear weight of the footprint's texel beyond a corner (both coordinates beyond
+// the face) at (i0, j0), or 0 when none is.
+fn bilinear_corner(i0: i32, j0: i32, n: i32, a: f32, b: f32) -> f32 {
+    var w = 0.0;
+    for (var dj = 0; dj < 2; dj = dj + 1) {
+        for (var di = 0; di < 2; di = di + 1) {
+            if (beyond(i0 + di, n) && beyond(j0 + dj, n)) {
+                w = select(1.0 - a, a, di == 1) * select(1.0 - b, b, dj == 1);
+            }
+        }
+    }
+    return w;
 }
 
 // Trilinear lookup at level of detail λ: bilinear on levels ⌊λ⌋ and ⌊λ⌋ + 1, blended by

@@ -5,8 +5,8 @@
 //!
 //! The player reads a cube map's texels itself (`textureLoad`), so every weight here is what
 //! the GPU computes, on any adapter. WGSL twins in `lib/play/src/shell.wgsl`: `cube_face`,
-//! `face_st`, `face_vector`, `cube_texel`, `cube_texels`, `cube_lod`, `cube_bilinear`, and the
-//! lookup `cube_sample`.
+//! `face_st`, `face_vector`, `cube_texel`, `beyond`, `bilinear_corner`, `cube_lod`,
+//! `cube_bilinear`, and the lookup `cube_sample`.
 
 use glam::DVec3;
 
@@ -62,28 +62,23 @@ pub fn face_vector(face: u32, sc: f64, tc: f64) -> DVec3 {
     }
 }
 
-/// The texels, with their weights, that texel (i, j) of an `n × n` level of face `face`
-/// stands for: itself inside the face; beyond one edge, the texel of the neighbouring face
-/// that holds the direction of its centre ([`cube_texel`]); beyond a corner, where three
-/// faces meet and no fourth texel exists, the mean of the three corner texels (as Vulkan's
-/// seamless cube filtering does), which keeps lookups continuous across corners.
-pub fn cube_texels(face: u32, i: i64, j: i64, n: u32, out: &mut [(u32, u32, u32, f64); 3]) -> usize {
-    let n64 = n as i64;
-    let (in_i, in_j) = ((0..n64).contains(&i), (0..n64).contains(&j));
-    if in_i || in_j {
-        out[0] = with_weight(cube_texel(face, i, j, n), 1.0);
-        return 1;
-    }
-    let (ci, cj) = (i.clamp(0, n64 - 1), j.clamp(0, n64 - 1));
-    let third = 1.0 / 3.0;
-    out[0] = with_weight(cube_texel(face, ci, cj, n), third);
-    out[1] = with_weight(cube_texel(face, i, cj, n), third);
-    out[2] = with_weight(cube_texel(face, ci, j, n), third);
-    3
+/// Whether texel coordinate `x` lies beyond an `n`-texel face.
+pub fn beyond(x: i64, n: u32) -> bool {
+    !(0..n as i64).contains(&x)
 }
 
-fn with_weight(t: (u32, u32, u32), w: f64) -> (u32, u32, u32, f64) {
-    (t.0, t.1, t.2, w)
+/// The bilinear weight (`wi[di] · wj[dj]`) of the footprint's texel beyond a corner (both
+/// coordinates beyond the face) at (i0, j0), or 0 when none is.
+pub fn bilinear_corner(i0: i64, j0: i64, n: u32, wi: [f64; 2], wj: [f64; 2]) -> f64 {
+    let mut w = 0.0;
+    for dj in 0..2 {
+        for di in 0..2 {
+            if beyond(i0 + di as i64, n) && beyond(j0 + dj as i64, n) {
+                w = wi[di] * wj[dj];
+            }
+        }
+    }
+    w
 }
 
 /// The texel that texel (i, j) of an `n × n` level of face `face` names, (i, j) beyond at
@@ -118,7 +113,12 @@ pub fn cube_lod(d: DVec3, ddx: DVec3, ddy: DVec3, size: f64, max_level: f64) -> 
     texture_lod(deriv(ddx), deriv(ddy), [size, size], max_level)
 }
 
-/// Adds the bilinear taps of level `m` of lookup vector `d`, scaled by `scale`.
+/// Adds the bilinear taps of level `m` of lookup vector `d`, scaled by `scale`: the four
+/// texels around (u, v), each [`cube_texel`]'s texel within the face or beyond one edge.
+/// Beyond a corner, where three faces meet and no fourth texel exists, a texel is the mean
+/// of the three meeting there (as Vulkan's seamless cube filtering does, which keeps lookups
+/// continuous across corners); those are the footprint's other three, so the corner's
+/// weight goes to them in thirds ([`bilinear_corner`]; at most one texel is beyond a corner).
 pub fn cube_bilinear(layout: &TextureLayout, d: DVec3, m: u32, scale: f64, taps: &mut Taps) {
     let face = cube_face(d);
     let [s, t] = face_st(face, d);
@@ -130,13 +130,15 @@ pub fn cube_bilinear(layout: &TextureLayout, d: DVec3, m: u32, scale: f64, taps:
     let (i0, j0) = (i0 as i64, j0 as i64);
     let wi = [1.0 - a, a];
     let wj = [1.0 - b, b];
-    let mut texels = [(0, 0, 0, 0.0); 3];
+    let third = bilinear_corner(i0, j0, n, wi, wj) / 3.0;
     for dj in 0..2 {
         for di in 0..2 {
-            let k = cube_texels(face, i0 + di as i64, j0 + dj as i64, n, &mut texels);
-            for &(f, i, j, w) in &texels[..k] {
-                taps.add(layout.face_texel(f, m, i, j) as u32, scale * wi[di] * wj[dj] * w);
+            let (i, j) = (i0 + di as i64, j0 + dj as i64);
+            if beyond(i, n) && beyond(j, n) {
+                continue;
             }
+            let (f, ti, tj) = cube_texel(face, i, j, n);
+            taps.add(layout.face_texel(f, m, ti, tj) as u32, scale * (wi[di] * wj[dj] + third));
         }
     }
 }
@@ -240,6 +242,58 @@ mod tests {
             ] {
                 assert_ne!(cube_face(a), cube_face(b));
                 assert!((value(a, lambda) - value(b, lambda)).abs() < 1e-6, "{a} {b} λ {lambda}");
+            }
+        }
+    }
+
+    /// Beyond a corner the footprint's fourth texel is the mean of the three meeting there
+    /// (clamped, and beyond either edge): spreading its weight over the footprint's other
+    /// three in thirds gives the same taps, at every corner of every face and level.
+    #[test]
+    fn a_corner_texel_is_the_mean_of_the_three_meeting_there() {
+        let layout = TextureLayout::cube(5);
+        for face in 0..6 {
+            for m in 0..layout.levels {
+                let (n, _) = layout.level_size(m);
+                let nf = n as f64;
+                // Directions at the four corners of the face, a quarter texel inside.
+                for (sc, tc) in [(-1.0, -1.0), (1.0, -1.0), (-1.0, 1.0), (1.0, 1.0)] {
+                    let q = 1.0 - 0.5 / nf;
+                    let d = face_vector(face, sc * q, tc * q);
+                    let mut taps = Taps::default();
+                    cube_bilinear(&layout, d, m, 1.0, &mut taps);
+                    // The same footprint with the corner texel as three thirds.
+                    let [s, t] = face_st(cube_face(d), d);
+                    let (u, v) = (s * nf - 0.5, t * nf - 0.5);
+                    let (i0, j0) = (u.floor() as i64, v.floor() as i64);
+                    let (a, b) = (u - u.floor(), v - v.floor());
+                    let mut want = Taps::default();
+                    let mut corners = 0;
+                    for dj in 0..2 {
+                        for di in 0..2 {
+                            let (i, j) = (i0 + di, j0 + dj);
+                            let w = [1.0 - a, a][di as usize] * [1.0 - b, b][dj as usize];
+                            let texels = if beyond(i, n) && beyond(j, n) {
+                                corners += 1;
+                                let (ci, cj) = (i.clamp(0, n as i64 - 1), j.clamp(0, n as i64 - 1));
+                                vec![(cube_texel(cube_face(d), ci, cj, n), w / 3.0), (cube_texel(cube_face(d), i, cj, n), w / 3.0), (cube_texel(cube_face(d), ci, j, n), w / 3.0)]
+                            } else {
+                                vec![(cube_texel(cube_face(d), i, j, n), w)]
+                            };
+                            for ((f, ti, tj), w) in texels {
+                                want.add(layout.face_texel(f, m, ti, tj) as u32, w);
+                            }
+                        }
+                    }
+                    assert_eq!(corners, 1, "face {face} level {m} corner ({sc}, {tc})");
+                    let got: Vec<(u32, f32)> = taps.sorted().collect();
+                    let exp: Vec<(u32, f32)> = want.sorted().collect();
+                    assert_eq!(got.len(), 3);
+                    assert_eq!(got.iter().map(|t| t.0).collect::<Vec<_>>(), exp.iter().map(|t| t.0).collect::<Vec<_>>());
+                    for (g, e) in got.iter().zip(&exp) {
+                        assert!((g.1 - e.1).abs() < 1e-6, "face {face} level {m}: {got:?} against {exp:?}");
+                    }
+                }
             }
         }
     }
