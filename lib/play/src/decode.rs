@@ -255,6 +255,25 @@ mod tests {
     }
 
     #[test]
+    fn a_surface_texture_is_padded_with_its_last_column_and_row() {
+        let layer = Layer { mapping: Mapping::Surface, mip_mode: MipMode::Decimated, ..shell_layer(3, MipMode::Decimated) };
+        let layout = LevelLayout { width: 3, height: 3, channels: 3, faces: 1, mips: 1 };
+        let linear = values(27);
+        let img = assemble(&job(&layer, &layout, &linear, 0));
+        assert_eq!((img.width, img.height, img.padded_width, img.padded_height), (3, 3, 4, 4));
+        for j in 0..4usize {
+            for i in 0..4usize {
+                let src = (j.min(2) * 3 + i.min(2)) * 3;
+                let want = [linear[src], linear[src + 1], linear[src + 2], 1.0];
+                let got = &img.rgba[(j * 4 + i) * 4..(j * 4 + i) * 4 + 4];
+                for (g, w) in got.iter().zip(want) {
+                    assert!((g - w).abs() < 1e-5, "texel ({i}, {j}): {got:?} against {want:?}");
+                }
+            }
+        }
+    }
+
+    #[test]
     fn a_stored_cube_map_is_rebuilt_face_after_face_level_after_level() {
         let layer = shell_layer(4, MipMode::Stored);
         let layout = LevelLayout { width: 5, height: 5, channels: 4, faces: 6, mips: mip_count(5, 5) };
