@@ -25,10 +25,30 @@ fn copy_sample(dir: &Path) -> PathBuf {
     dir.join("scene.toml")
 }
 
-fn pack(scene: &Path, out: &Path, args: &[&str]) -> serde_json::Value {
-    let o = Command::new(env!("CARGO_BIN_EXE_pis-pack")).arg(scene).arg("-o").arg(out).args(args).args(["--codec", "lossless", "--json"]).output().expect("pis-pack runs");
+/// Packs `scene` losslessly into the file `name` beside it: the file and pis-pack's report.
+fn pack(scene: &Path, name: &str, args: &[&str]) -> (PathBuf, serde_json::Value) {
+    let out = scene.with_file_name(name);
+    let o = Command::new(env!("CARGO_BIN_EXE_pis-pack")).arg(scene).arg("-o").arg(&out).args(args).args(["--codec", "lossless", "--json"]).output().expect("pis-pack runs");
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    serde_json::from_slice(&o.stdout).expect("JSON report")
+    (out, serde_json::from_slice(&o.stdout).expect("JSON report"))
+}
+
+/// The set the scene's first pack traced into `.pis-cache/` beside it.
+fn traced_set(dir: &Path) -> PathBuf {
+    std::fs::read_dir(dir.join(".pis-cache")).expect("cache").next().expect("a traced set").expect("entry").path()
+}
+
+/// `pis-inspect --validate` passes `file`.
+fn assert_valid(file: &Path) {
+    let v = Command::new(env!("CARGO_BIN_EXE_pis-inspect")).arg("--validate").arg(file).output().expect("pis-inspect runs");
+    assert_eq!(v.status.code(), Some(0), "{}", String::from_utf8_lossy(&v.stdout));
+}
+
+/// The player draws `file` at the set's sample points, single-sample as the prediction is,
+/// within 0.3 dB of what pis-pack predicted (`pis-diff --max-psnr-drop`).
+fn assert_plays_as_predicted(file: &Path, set: &Path) {
+    let d = Command::new(env!("CARGO_BIN_EXE_pis-diff")).arg(file).arg(set).args(["--msaa", "1", "--max-psnr-drop", "0.3"]).output().expect("pis-diff runs");
+    assert!(d.status.success(), "{}{}", String::from_utf8_lossy(&d.stdout), String::from_utf8_lossy(&d.stderr));
 }
 
 fn object<'a>(r: &'a serde_json::Value, name: &str) -> &'a serde_json::Value {
@@ -39,11 +59,10 @@ fn object<'a>(r: &'a serde_json::Value, name: &str) -> &'a serde_json::Value {
 fn a_mirror_teapot_as_layered_environment_maps() {
     let dir = tempfile::tempdir().expect("temp dir");
     let scene = copy_sample(dir.path());
-    let (tex, pem, inf, stat) = (dir.path().join("tex.pis"), dir.path().join("pem.pis"), dir.path().join("inf.pis"), dir.path().join("stat.pis"));
-    let t = pack(&scene, &tex, &[]);
-    let p = pack(&scene, &pem, &["--representation", "pem"]);
-    let i = pack(&scene, &inf, &["--representation", "pem-infinity"]);
-    let s = pack(&scene, &stat, &["--representation", "static-env"]);
+    let (tex, t) = pack(&scene, "tex.pis", &[]);
+    let (pem, p) = pack(&scene, "pem.pis", &["--representation", "pem"]);
+    let (inf, i) = pack(&scene, "inf.pis", &["--representation", "pem-infinity"]);
+    let (stat, s) = pack(&scene, "stat.pis", &["--representation", "static-env"]);
     assert_eq!(object(&i, "TeapotBody")["representation"], "environment map at infinity");
     for name in ["TeapotBody", "TeapotLid"] {
         let (a, b) = (object(&t, name), object(&p, name));
@@ -62,17 +81,12 @@ fn a_mirror_teapot_as_layered_environment_maps() {
         eprintln!("{name}: static environment map {sa:.2} dB ({})", c["why"]);
         assert!(pa >= sa + 3.0, "{name}: layered PEM {pa:.2} dB, static environment map {sa:.2} dB");
     }
-    let v = Command::new(env!("CARGO_BIN_EXE_pis-inspect")).arg("--validate").arg(&stat).output().expect("pis-inspect runs");
-    assert_eq!(v.status.code(), Some(0), "{}", String::from_utf8_lossy(&v.stdout));
-    let v = Command::new(env!("CARGO_BIN_EXE_pis-inspect")).arg("--validate").arg(&pem).output().expect("pis-inspect runs");
-    assert_eq!(v.status.code(), Some(0), "{}", String::from_utf8_lossy(&v.stdout));
+    assert_valid(&stat);
+    assert_valid(&pem);
     let i = Command::new(env!("CARGO_BIN_EXE_pis-inspect")).arg(&pem).output().expect("pis-inspect runs");
     let text = String::from_utf8_lossy(&i.stdout);
     assert!(text.contains("env_local") && text.contains("env_distant") && text.contains("ellipsoid shell"), "{text}");
-    // The player against the traced set, single-sample as the prediction is.
-    let set = std::fs::read_dir(dir.path().join(".pis-cache")).expect("cache").next().expect("a traced set").expect("entry").path();
-    let d = Command::new(env!("CARGO_BIN_EXE_pis-diff")).arg(&pem).arg(&set).args(["--msaa", "1", "--max-psnr-drop", "0.3"]).output().expect("pis-diff runs");
-    assert!(d.status.success(), "{}{}", String::from_utf8_lossy(&d.stdout), String::from_utf8_lossy(&d.stderr));
+    assert_plays_as_predicted(&pem, &traced_set(dir.path()));
     // Off the samples (thesis 5.10, figs 5.9–5.10): played between the sampled views against
     // frames traced at those cameras, the layered PEM's worst frame stays well above the
     // textures' (pasted on, they are worst half-way between two samples); away from the
@@ -116,9 +130,8 @@ fn a_mirror_teapot_as_layered_environment_maps() {
 fn auto_keeps_the_representation_that_does_better_for_the_whole_file() {
     let dir = tempfile::tempdir().expect("temp dir");
     let scene = copy_sample(dir.path());
-    let (auto, pem) = (dir.path().join("auto.pis"), dir.path().join("pem.pis"));
-    let a = pack(&scene, &auto, &["--representation", "auto"]);
-    let p = pack(&scene, &pem, &["--representation", "pem"]);
+    let (_, a) = pack(&scene, "auto.pis", &["--representation", "auto"]);
+    let (_, p) = pack(&scene, "pem.pis", &["--representation", "pem"]);
     let why = |name: &str| object(&a, name)["why"].as_str().expect("why").to_string();
     eprintln!("TeapotBody: {}\nTeapotLid: {}", why("TeapotBody"), why("TeapotLid"));
     assert_eq!(object(&a, "TeapotBody")["representation"], "layered environment maps", "{}", why("TeapotBody"));
@@ -137,9 +150,8 @@ fn auto_keeps_the_representation_that_does_better_for_the_whole_file() {
 fn sub_pixel_lookups_follow_the_traced_footprint() {
     let dir = tempfile::tempdir().expect("temp dir");
     let scene = copy_sample(dir.path());
-    let (one, four) = (dir.path().join("one.pis"), dir.path().join("four.pis"));
-    let a = pack(&scene, &one, &["--representation", "pem"]);
-    let b = pack(&scene, &four, &["--representation", "pem", "--shell-lookups", "2"]);
+    let (_, a) = pack(&scene, "one.pis", &["--representation", "pem"]);
+    let (four, b) = pack(&scene, "four.pis", &["--representation", "pem", "--shell-lookups", "2"]);
     for name in ["TeapotBody", "TeapotLid"] {
         let (x, y) = (object(&a, name), object(&b, name));
         let (pa, pb) = (x["psnr_db"].as_f64().expect("psnr"), y["psnr_db"].as_f64().expect("psnr"));
@@ -148,15 +160,12 @@ fn sub_pixel_lookups_follow_the_traced_footprint() {
         assert!(!x["why"].as_str().is_some_and(|w| w.contains("lookups per pixel")), "{}", x["why"]);
         assert!(pb >= pa + 0.5, "{name}: 2×2 lookups {pb:.2} dB, one lookup {pa:.2} dB");
     }
-    let v = Command::new(env!("CARGO_BIN_EXE_pis-inspect")).arg("--validate").arg(&four).output().expect("pis-inspect runs");
-    assert_eq!(v.status.code(), Some(0), "{}", String::from_utf8_lossy(&v.stdout));
+    assert_valid(&four);
     let i = Command::new(env!("CARGO_BIN_EXE_pis-inspect")).arg(&four).arg("--json").output().expect("pis-inspect runs");
     let j: serde_json::Value = serde_json::from_slice(&i.stdout).expect("JSON");
     let shells: Vec<&serde_json::Value> = j["objects"].as_array().expect("objects").iter().flat_map(|o| o["layers"].as_array().expect("layers")).filter(|l| l["shell"].is_string()).collect();
     assert!(shells.len() >= 4 && shells.iter().all(|l| l["lookups"] == 2), "{shells:?}");
-    let set = std::fs::read_dir(dir.path().join(".pis-cache")).expect("cache").next().expect("a traced set").expect("entry").path();
-    let d = Command::new(env!("CARGO_BIN_EXE_pis-diff")).arg(&four).arg(&set).args(["--msaa", "1", "--max-psnr-drop", "0.3"]).output().expect("pis-diff runs");
-    assert!(d.status.success(), "{}{}", String::from_utf8_lossy(&d.stdout), String::from_utf8_lossy(&d.stderr));
+    assert_plays_as_predicted(&four, &traced_set(dir.path()));
 }
 
 /// `pis-bench reflective --reference-pair`: every reference traced twice from independent
@@ -170,8 +179,7 @@ fn sub_pixel_lookups_follow_the_traced_footprint() {
 fn a_reference_pair_takes_its_own_noise_out() {
     let dir = tempfile::tempdir().expect("temp dir");
     let scene = copy_sample(dir.path());
-    let tex = dir.path().join("tex.pis");
-    pack(&scene, &tex, &[]);
+    let (tex, _) = pack(&scene, "tex.pis", &[]);
     let bench = |spp: &str, extra: &[&str]| Command::new(env!("CARGO_BIN_EXE_pis-bench"))
         .arg("reflective").arg(&scene).arg(&tex)
         .args(["--frames", "2", "--reference-spp", spp, "--reference-pair", "--json", "--out"]).arg(dir.path().join("reports")).args(extra)

@@ -7,6 +7,10 @@
 //! finish}` call these functions, so the container and the codecs share one definition.
 //! Values are floats throughout: bright specular layers above 1 are not clipped.
 
+/// The display gamma writers compensate for unless told otherwise (pis-pack's and
+/// pis-reencode's `--gamma`); [`uncompensate`] has a fast path for it.
+pub const DEFAULT_GAMMA: f32 = 2.2;
+
 /// `sign(v) · |v|^(1/g)` in place: the values a pyramid encodes for linear values `v`.
 pub fn compensate(values: &mut [f32], g: f32) {
     if g != 1.0 {
@@ -18,10 +22,10 @@ pub fn compensate(values: &mut [f32], g: f32) {
 }
 
 /// `sign(v) · |v|^g` in place: linear values from decoded, summed pyramid values. The
-/// writers' gamma, 2.2, takes [`pow_11_5`], four times faster than `powf` and closer to
-/// |v|^2.2; other exponents take `powf`.
+/// writers' gamma, [`DEFAULT_GAMMA`] = 2.2, takes [`pow_11_5`], four times faster than
+/// `powf` and closer to |v|^2.2; other exponents take `powf`.
 pub fn uncompensate(values: &mut [f32], g: f32) {
-    if g == 2.2 {
+    if g == DEFAULT_GAMMA {
         values.iter_mut().for_each(|v| *v = pow_11_5(*v));
     } else if g != 1.0 {
         values

@@ -41,6 +41,24 @@ impl RenderMatrix {
         RenderMatrix { width: viewport.width, height: viewport.height, layout, coverage: vec![1.0; pixels.len()], pixels, row_start, cols, vals }
     }
 
+    /// The matrix of rows built in chunks of consecutive pixels of `pixels` (increasing):
+    /// each chunk's columns and values, row after row, and its rows' entry counts; every
+    /// row with coverage 1.
+    pub fn from_row_chunks(viewport: crate::Viewport, layout: TextureLayout, pixels: Vec<u32>, chunks: Vec<(Vec<u32>, Vec<f32>, Vec<u32>)>) -> RenderMatrix {
+        let nnz = chunks.iter().map(|c| c.0.len()).sum();
+        let (mut cols, mut vals) = (Vec::with_capacity(nnz), Vec::with_capacity(nnz));
+        let mut row_start = Vec::with_capacity(pixels.len() + 1);
+        row_start.push(0u32);
+        for (c, v, lens) in chunks {
+            for len in lens {
+                row_start.push(row_start[row_start.len() - 1] + len);
+            }
+            cols.extend(c);
+            vals.extend(v);
+        }
+        RenderMatrix { width: viewport.width, height: viewport.height, layout, coverage: vec![1.0; pixels.len()], pixels, row_start, cols, vals }
+    }
+
     /// n_s.
     pub fn rows(&self) -> usize {
         self.pixels.len()

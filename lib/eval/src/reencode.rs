@@ -71,7 +71,7 @@ fn writer_max_mse<S>(c: &pis_format::Container<S>) -> MaxMse {
 }
 
 /// The gamma lossy re-encodings use unless told otherwise (as `pis-pack`).
-pub const DEFAULT_GAMMA: f32 = 2.2;
+pub const DEFAULT_GAMMA: f32 = pis_codec::gamma::DEFAULT_GAMMA;
 
 /// One object's part of the report.
 #[derive(Clone, Debug, Serialize)]

@@ -135,10 +135,9 @@ fn level_rgba(level: &[f32], c: u32, out: &mut [f32]) {
 /// Rebuilds a texture: [`reconstruct`], the finest level decimated `drop_levels` times,
 /// padded to powers of two.
 pub fn assemble(job: &AssembleJob) -> TextureImage {
-    let mut linear = reconstruct(job);
     let (w0, h0, c) = (job.layout.width, job.layout.height, job.layout.channels);
-    linear.truncate((w0 * h0 * c) as usize);
-    let mut finest = linear;
+    let mut finest = reconstruct(job);
+    finest.truncate((w0 * h0 * c) as usize);
     let (mut w, mut h) = (w0, h0);
     for m in 0..job.drop_levels {
         finest = decimate(&finest, w, h, c);
@@ -151,8 +150,8 @@ pub fn assemble(job: &AssembleJob) -> TextureImage {
         let src = (j as u32).min(h - 1) as usize * row_in;
         let (used, pad) = out.split_at_mut(w as usize * 4);
         level_rgba(&finest[src..src + row_in], c, used);
-        let last = [used[used.len() - 4], used[used.len() - 3], used[used.len() - 2], used[used.len() - 1]];
-        pad.chunks_exact_mut(4).for_each(|t| t.copy_from_slice(&last));
+        let last = &used[used.len() - 4..];
+        pad.chunks_exact_mut(4).for_each(|t| t.copy_from_slice(last));
     }
     TextureImage { width: w, height: h, padded_width: pw, padded_height: ph, rgba }
 }

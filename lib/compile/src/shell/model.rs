@@ -170,18 +170,7 @@ pub fn shell_render_matrix(viewport: Viewport, object: &ShellObject, occluders: 
             (cols, vals, lens)
         })
         .collect();
-    let mut row_start = Vec::with_capacity(pixels.len() + 1);
-    row_start.push(0u32);
-    let nnz = chunks.iter().map(|c| c.0.len()).sum();
-    let (mut cols, mut vals) = (Vec::with_capacity(nnz), Vec::with_capacity(nnz));
-    for (c, v, lens) in chunks {
-        for len in lens {
-            row_start.push(row_start[row_start.len() - 1] + len);
-        }
-        cols.extend(c);
-        vals.extend(v);
-    }
-    Ok(RenderMatrix { width: viewport.width, height: viewport.height, layout, coverage: vec![1.0; pixels.len()], pixels, row_start, cols, vals })
+    Ok(RenderMatrix::from_row_chunks(viewport, layout, pixels, chunks))
 }
 
 /// Pixels per parallel chunk of a render matrix with several lookups per pixel.

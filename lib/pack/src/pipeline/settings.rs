@@ -382,7 +382,7 @@ pub const DEFAULT_MAX_TEXTURE: u32 = 1024;
 pub const DEFAULT_BLOCK: u32 = 8;
 
 /// The default display gamma of the compensation of lossy codecs (`--gamma`).
-pub const DEFAULT_GAMMA: f32 = 2.2;
+pub const DEFAULT_GAMMA: f32 = pis_codec::gamma::DEFAULT_GAMMA;
 
 /// The default compression ratio when neither `--ratio` nor `--psnr` is given.
 pub const DEFAULT_RATIO: f64 = 384.0;
