@@ -141,6 +141,33 @@ fn auto_keeps_the_representation_that_does_better_for_the_whole_file() {
     assert!(pa >= pp - 2.0 * 0.05, "auto {pa:.2} dB, all layered PEM {pp:.2} dB");
 }
 
+/// A reader refuses a level image that decodes to more than 8192 times the file's codestream
+/// bytes (SPEC.md section 12, rule 6009). At the default ratio a single 160 × 120 view
+/// leaves 150 bytes, too few for the lid's 128² distant sphere with its MIP levels (1.57 MB
+/// decoded), so pis-pack caps the shells' faces before solving, says so, and writes a file
+/// every reader opens, instead of refusing its own file after the work.
+#[test]
+fn a_small_budget_caps_the_shells_faces() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let scene = copy_sample(dir.path());
+    let text = std::fs::read_to_string(&scene).expect("scene.toml");
+    assert!(text.contains("samples = 4\n"), "teapot-pem's view has 4 samples: adapt the test");
+    std::fs::write(&scene, text.replacen("samples = 4\n", "samples = 1\n", 1)).expect("write scene.toml");
+    let out = dir.path().join("pem.pis");
+    let o = Command::new(env!("CARGO_BIN_EXE_pis-pack")).arg(&scene).arg("-o").arg(&out).args(["--representation", "pem", "--json"]).output().expect("pis-pack runs");
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let r: serde_json::Value = serde_json::from_slice(&o.stdout).expect("JSON report");
+    // The lid's distant sphere would be 128² (the set's 4 views, or 1 view under a lossless
+    // codec); at 150 bytes it is 64², and the report says why.
+    let why = object(&r, "TeapotLid")["why"].as_str().expect("why");
+    assert!(why.contains("distant sphere 64²") && why.contains("cube faces at most 64² (the ratio leaves 150 bytes"), "{why}");
+    for name in ["TeapotBody", "TeapotLid"] {
+        let why = object(&r, name)["why"].as_str().expect("why");
+        assert!(!why.contains("128²") && !why.contains("256²"), "{name}: {why}");
+    }
+    assert_valid(&out);
+}
+
 /// `--shell-lookups 2` (SPEC.md 8.2): each pixel averages 2 × 2 lookups of every shell, as
 /// a traced pixel averages its samples where the reflected direction turns fast across it;
 /// the shells solved through those lookups reproduce the traced views better than one

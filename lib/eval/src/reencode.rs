@@ -498,7 +498,7 @@ fn db(p: Option<f64>) -> String {
 pub fn print_report(r: &ReencodeReport, out: &mut impl std::io::Write) -> std::io::Result<()> {
     writeln!(out, "{} → {}: {} → {} (gamma {}, target {}), from the {}", r.input, r.output, r.codecs_before.join("+"), r.codec, r.gamma, r.target, r.source)?;
     writeln!(out, "  bytes     {:>12} → {:>12}  (level images {} → {})", r.bytes_before, r.bytes_after, r.texture_bytes_before, r.texture_bytes_after)?;
-    writeln!(out, "  ratio     {:>12.1} → {:>12.1}  (without geometry {:.1} → {:.1}; raw {} bytes)", r.ratio_before, r.ratio_after,
+    writeln!(out, "  ratio     {:>12.1} → {:>12.1}  (level images alone {:.1} → {:.1}; raw {} bytes)", r.ratio_before, r.ratio_after,
              r.ratio_without_geometry_before, r.ratio_without_geometry_after, r.raw_image_bytes)?;
     if r.master_bytes_before > 0 || r.master_bytes_after > 0 {
         writeln!(out, "  lossless master {:>12} → {:>12} bytes, not counted by the ratios", r.master_bytes_before, r.master_bytes_after)?;

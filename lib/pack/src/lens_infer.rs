@@ -36,6 +36,8 @@ pub struct LensInferSettings {
     /// Cube-face size of every shell; `None`: the size at which the sample views' lookups
     /// read the finest level about one texel per pixel (thesis 5.8.2).
     pub face: Option<u32>,
+    /// The largest face the chosen size may be (a byte budget's cap).
+    pub max_face: u32,
     pub tessellation: TessellationSettings,
     pub max_layers: usize,
     pub solve: SolveSettings,
@@ -48,7 +50,7 @@ pub struct LensInferSettings {
 
 impl Default for LensInferSettings {
     fn default() -> Self {
-        LensInferSettings { face: None, tessellation: TessellationSettings::default(), max_layers: 4, solve: SolveSettings::pyramidal(), confidence: false, solver: Solver::default() }
+        LensInferSettings { face: None, max_face: 256, tessellation: TessellationSettings::default(), max_layers: 4, solve: SolveSettings::pyramidal(), confidence: false, solver: Solver::default() }
     }
 }
 
@@ -237,7 +239,7 @@ pub fn infer_lens_views(scene: &Scene, o: usize, samples: &[Vec<TracedView>], se
     let mut models: Vec<Vec<ViewModel>> = samples.iter().map(|s| s.iter().map(|v| ViewModel::new(scene, o, v.frame, (w, h), settings)).collect()).collect();
     let face = match settings.face {
         Some(f) => f,
-        None => face_size(&models.iter().map(|m| &m[0]).collect::<Vec<_>>(), &shells),
+        None => face_size(&models.iter().map(|m| &m[0]).collect::<Vec<_>>(), &shells).min(settings.max_face.max(8)),
     };
     models = models.into_iter().map(|m| m.into_iter().map(|v| v.with_matrices(&shells, face)).collect()).collect();
     let layout = TextureLayout::cube(face);

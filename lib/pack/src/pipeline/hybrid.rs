@@ -76,6 +76,10 @@ impl Planned for HybridPlanned {
         let mut settings = LensInferSettings::default();
         settings.solve.cg = job.settings.cg;
         settings.solver = job.solver.clone();
+        let cap = super::pem::budget::face_cap(set, job.req);
+        if let Some(c) = cap {
+            settings.max_face = c.face.min(settings.max_face);
+        }
         // The single-shell baseline (thesis 6.5's comparison): one layer, one shell.
         let one = job.req.representation == super::RepresentationMode::PemInfinity;
         if one {
@@ -105,6 +109,11 @@ impl Planned for HybridPlanned {
             inference.face,
             settings.tessellation.tau_px
         );
+        if inference.face == settings.max_face {
+            if let Some(note) = cap.and_then(|c| c.note(LensInferSettings::default().max_face)) {
+                model.why.push_str(&note);
+            }
+        }
         Ok(model)
     }
 }

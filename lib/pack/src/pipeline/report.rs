@@ -247,7 +247,7 @@ pub fn print_report(r: &PackReport, out: &mut impl std::io::Write) -> std::io::R
     let anisotropy = r.anisotropy.map(|n| format!(" {n}x")).unwrap_or_default();
     let probe = if r.matrix == "probe" { format!(", {} probe renderings", r.probe_renderings) } else { String::new() };
     writeln!(out, "  filter {}{anisotropy}, render matrices from the {}{probe}", r.filter, if r.matrix == "probe" { "GPU (probe mode)" } else { "hardware model" })?;
-    writeln!(out, "  {} bytes (level images {}), raw {} bytes: ratio {:.1} (without geometry {:.1})",
+    writeln!(out, "  {} bytes (level images {}), raw {} bytes: ratio {:.1} (level images alone {:.1}, the ratio --ratio aims at)",
              r.bytes, r.texture_bytes, r.raw_image_bytes, r.ratio, r.ratio_without_geometry)?;
     if let Some(e) = r.master_exact {
         writeln!(out, "  lossless master: {} bytes, not counted by the ratio; decodes to the solved textures bit-exactly: {e}", r.master_bytes)?;

@@ -10,6 +10,7 @@
 //! The baselines of thesis 5.10 and 5.1 are made here too: one map at infinity per sample,
 //! inferred (`single_shell`) or ray-traced from the object's centre ([`traced`]).
 
+pub mod budget;
 pub mod fit;
 pub mod form;
 pub mod solve;
@@ -105,11 +106,22 @@ impl Planned for PemPlanned {
         let keys: Vec<Vec<u32>> = set.samples.iter().map(|s| key(s, job.all)).collect();
         let mut settings = SolveSettings::pyramidal();
         settings.cg = job.settings.cg;
-        let largest = LARGEST_FACE.min(job.req.max_texture.next_power_of_two() / 2).max(8);
+        let unbudgeted = LARGEST_FACE.min(job.req.max_texture.next_power_of_two() / 2).max(8);
+        let cap = budget::face_cap(set, job.req);
+        let largest = cap.map_or(unbudgeted, |c| c.face.min(unbudgeted));
+        let cap_note = cap.and_then(|c| c.note(unbudgeted)).unwrap_or_default();
+        // The report says so where a shell's face is at the cap the budget set.
+        let at_cap = TextureLayout::cube(largest).texel_count();
+        let with_note = |mut m: ObjectModel| {
+            if m.layers.iter().any(|l| l.shell.is_some() && l.form.stored_texels(&[]) == at_cap) {
+                m.why.push_str(&cap_note);
+            }
+            m
+        };
         let lookups = job.req.shell_lookups;
         match job.req.representation {
-            super::RepresentationMode::PemInfinity => return single_shell(model, job, o, f0, &pixels, &keys, &settings, largest, fitted.local.origin),
-            super::RepresentationMode::StaticEnv => return traced::static_env(model, job, o, f0, &pixels, &keys, largest, fitted.local.origin),
+            super::RepresentationMode::PemInfinity => return single_shell(model, job, o, f0, &pixels, &keys, &settings, largest, fitted.local.origin).map(with_note),
+            super::RepresentationMode::StaticEnv => return traced::static_env(model, job, o, f0, &pixels, &keys, largest, fitted.local.origin).map(with_note),
             _ => {}
         }
         let local_n = face_resolution(set, o, &job.meshes, fitted.local, largest)?;
@@ -165,7 +177,7 @@ impl Planned for PemPlanned {
         model.shell_views = chosen.views;
         model.representation = "layered environment maps".to_string();
         model.why = format!("reflective: {}, Fresnel from F0 {:?}", chosen.why, f0);
-        Ok(model)
+        Ok(with_note(model))
     }
 }
 
