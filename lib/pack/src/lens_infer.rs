@@ -30,13 +30,16 @@ use pis_trace::{PointImages, PointRender, RayRecord};
 use crate::infer::{psnr_display, select_rows};
 use crate::lens::lens_object;
 
+/// The largest cube face the views' lookups choose (thesis 5.8.2).
+pub const MAX_FACE: u32 = 256;
+
 /// What the inference is given and how it runs.
 #[derive(Clone, Debug)]
 pub struct LensInferSettings {
     /// Cube-face size of every shell; `None`: the size at which the sample views' lookups
     /// read the finest level about one texel per pixel (thesis 5.8.2).
     pub face: Option<u32>,
-    /// The largest face the chosen size may be (a byte budget's cap).
+    /// The largest face the chosen size may be: [`MAX_FACE`], or a byte budget's cap.
     pub max_face: u32,
     pub tessellation: TessellationSettings,
     pub max_layers: usize,
@@ -50,7 +53,7 @@ pub struct LensInferSettings {
 
 impl Default for LensInferSettings {
     fn default() -> Self {
-        LensInferSettings { face: None, max_face: 256, tessellation: TessellationSettings::default(), max_layers: 4, solve: SolveSettings::pyramidal(), confidence: false, solver: Solver::default() }
+        LensInferSettings { face: None, max_face: MAX_FACE, tessellation: TessellationSettings::default(), max_layers: 4, solve: SolveSettings::pyramidal(), confidence: false, solver: Solver::default() }
     }
 }
 
@@ -318,7 +321,7 @@ fn view_rows(scene: &Scene, o: usize, model: &ViewModel, render: &TracedView, la
         .collect()
 }
 
-/// The cube-face size (a power of two, 8 to 256) at which the views' lookups of every shell
+/// The cube-face size (a power of two, 8 to [`MAX_FACE`]) at which the views' lookups of every shell
 /// and term read level 0 at about one texel per pixel: 2^(−λ₁), λ₁ the 10th percentile of
 /// the lookups' LOD on a one-texel face (thesis 5.8.2: "the most detailed MIPMAP level
 /// actually accessed").

@@ -110,7 +110,7 @@ impl Planned for HybridPlanned {
             settings.tessellation.tau_px
         );
         if inference.face == settings.max_face {
-            if let Some(note) = cap.and_then(|c| c.note(LensInferSettings::default().max_face)) {
+            if let Some(note) = cap.and_then(|c| c.note(crate::lens_infer::MAX_FACE)) {
                 model.why.push_str(&note);
             }
         }
