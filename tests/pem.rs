@@ -27,8 +27,14 @@ fn copy_sample(dir: &Path) -> PathBuf {
 
 /// Packs `scene` losslessly into the file `name` beside it: the file and pis-pack's report.
 fn pack(scene: &Path, name: &str, args: &[&str]) -> (PathBuf, serde_json::Value) {
+    pack_coded(scene, name, &[args, &["--codec", "lossless"]].concat())
+}
+
+/// Packs `scene` with `args` alone (pis-pack's codec and ratio unless they say otherwise)
+/// into the file `name` beside it: the file and pis-pack's report.
+fn pack_coded(scene: &Path, name: &str, args: &[&str]) -> (PathBuf, serde_json::Value) {
     let out = scene.with_file_name(name);
-    let o = Command::new(env!("CARGO_BIN_EXE_pis-pack")).arg(scene).arg("-o").arg(&out).args(args).args(["--codec", "lossless", "--json"]).output().expect("pis-pack runs");
+    let o = Command::new(env!("CARGO_BIN_EXE_pis-pack")).arg(scene).arg("-o").arg(&out).args(args).arg("--json").output().expect("pis-pack runs");
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     (out, serde_json::from_slice(&o.stdout).expect("JSON report"))
 }
@@ -153,10 +159,7 @@ fn a_small_budget_caps_the_shells_faces() {
     let text = std::fs::read_to_string(&scene).expect("scene.toml");
     assert!(text.contains("samples = 4\n"), "teapot-pem's view has 4 samples: adapt the test");
     std::fs::write(&scene, text.replacen("samples = 4\n", "samples = 1\n", 1)).expect("write scene.toml");
-    let out = dir.path().join("pem.pis");
-    let o = Command::new(env!("CARGO_BIN_EXE_pis-pack")).arg(&scene).arg("-o").arg(&out).args(["--representation", "pem", "--json"]).output().expect("pis-pack runs");
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let r: serde_json::Value = serde_json::from_slice(&o.stdout).expect("JSON report");
+    let (out, r) = pack_coded(&scene, "pem.pis", &["--representation", "pem"]);
     // The lid's distant sphere would be 128² (the set's 4 views, or 1 view under a lossless
     // codec); at 150 bytes it is 64², and the report says why.
     let why = object(&r, "TeapotLid")["why"].as_str().expect("why");

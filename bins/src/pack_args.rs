@@ -78,8 +78,8 @@ pub struct PackOptions {
     /// shells, whichever does better for the whole file: both are solved and the file
     /// encoded with each; under `--psnr` the one that meets it with fewer bytes, under a
     /// ratio the one whose file predicts a PSNR at least 0.05 dB higher), `texture`
-    /// (parameterized surface textures), `pem` (reflective objects as layered environment maps, thesis ch. 5: a local and a distant shell per
-    /// parameter sample; refractive objects by hybrid rendering, thesis ch. 6: shells from
+    /// (parameterized surface textures), `pem` (reflective objects as layered environment
+    /// maps, thesis ch. 5: a local and a distant shell per parameter sample; refractive objects by hybrid rendering, thesis ch. 6: shells from
     /// the set's ray records, looked up through the lens object's vertex rays traced each
     /// frame), `pem-infinity` (reflective objects as one environment map at infinity per
     /// sample, inferred: the single-shell baseline) or `static-env` (reflective objects as one

@@ -341,7 +341,7 @@ fn face_size(views: &[&ViewModel], shells: &[FittedShell]) -> u32 {
     }
     lods.sort_by(f64::total_cmp);
     let p10 = lods[lods.len() / 10];
-    2f64.powf((-p10).round().clamp(3.0, 8.0)) as u32
+    2f64.powf((-p10).round().clamp(3.0, MAX_FACE.ilog2() as f64)) as u32
 }
 
 /// The lens object's two terms drawn at `frame` by hybrid rendering (the frame's own
