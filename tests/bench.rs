@@ -18,8 +18,20 @@ fn infer_reports_every_method_as_json() {
     if !scene.exists() {
         return;
     }
-    let out = bench(&["infer", scene.to_str().unwrap(), "--resolution", "64x48", "--spp", "1",
-                      "--object", "Vase", "--at", "0,0", "--no-wgpu", "--json"]);
+    let out = bench(&[
+        "infer",
+        scene.to_str().unwrap(),
+        "--resolution",
+        "64x48",
+        "--spp",
+        "1",
+        "--object",
+        "Vase",
+        "--at",
+        "0,0",
+        "--no-wgpu",
+        "--json",
+    ]);
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("JSON on stdout");
     assert_eq!(v["object"], "Vase");
@@ -49,17 +61,32 @@ fn infer_renders_through_wgpu_where_an_adapter_exists() {
     if !scene.exists() {
         return;
     }
-    let out = bench(&["infer", scene.to_str().unwrap(), "--resolution", "64x48", "--spp", "1",
-                      "--object", "Vase", "--json"]);
+    let out = bench(&[
+        "infer",
+        scene.to_str().unwrap(),
+        "--resolution",
+        "64x48",
+        "--spp",
+        "1",
+        "--object",
+        "Vase",
+        "--json",
+    ]);
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("JSON on stdout");
     let notes = v["notes"].to_string();
     for m in ["ls-bilinear", "ls-trilinear", "ls-pyramidal", "forward", "traced"] {
         let w = &v["methods"][m]["psnr_db_wgpu"];
         if notes.contains("rendered by pis-play") {
-            let (w, model) = (w.as_f64().unwrap_or(f64::NAN), v["methods"][m]["psnr_db"].as_f64().unwrap_or(f64::NAN));
+            let (w, model) = (
+                w.as_f64().unwrap_or(f64::NAN),
+                v["methods"][m]["psnr_db"].as_f64().unwrap_or(f64::NAN),
+            );
             // the player draws what the model predicts (one truth for the rendering math)
-            assert!(w > 5.0 && (w >= 35.0 || (w - model).abs() < 6.0), "{m}: wgpu {w} dB, model {model} dB");
+            assert!(
+                w > 5.0 && (w >= 35.0 || (w - model).abs() < 6.0),
+                "{m}: wgpu {w} dB, model {model} dB"
+            );
         } else {
             assert!(w.is_null(), "{m}");
         }
@@ -73,7 +100,16 @@ fn infer_exit_codes() {
     assert!(String::from_utf8_lossy(&out.stderr).starts_with("pis-bench: "));
     let scene = demo1();
     if scene.exists() {
-        let out = bench(&["infer", scene.to_str().unwrap(), "--resolution", "32x24", "--spp", "1", "--object", "Nope"]);
+        let out = bench(&[
+            "infer",
+            scene.to_str().unwrap(),
+            "--resolution",
+            "32x24",
+            "--spp",
+            "1",
+            "--object",
+            "Nope",
+        ]);
         assert_eq!(out.status.code(), Some(4));
         assert!(String::from_utf8_lossy(&out.stderr).contains("no object \"Nope\""));
         let out = bench(&["infer", scene.to_str().unwrap(), "--at", "1"]);
@@ -92,7 +128,15 @@ fn infer_reads_a_ray_traced_set() {
     let dir = tempfile::tempdir().expect("temporary directory");
     let set = dir.path().join("set");
     let out = Command::new(env!("CARGO_BIN_EXE_pis-trace"))
-        .args([scene.to_str().unwrap(), "-o", set.to_str().unwrap(), "--resolution", "48x36", "--spp", "1"])
+        .args([
+            scene.to_str().unwrap(),
+            "-o",
+            set.to_str().unwrap(),
+            "--resolution",
+            "48x36",
+            "--spp",
+            "1",
+        ])
         .output()
         .expect("pis-trace runs");
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
@@ -101,14 +145,26 @@ fn infer_reads_a_ray_traced_set() {
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     // a set that records no scene, without scene.toml inside: exit 4, naming --scene
     let json = set.join("set.json");
-    let mut meta: serde_json::Value = serde_json::from_slice(&std::fs::read(&json).unwrap()).unwrap();
-    assert!(meta.as_object_mut().unwrap().remove("scene_file").is_some(), "pis-trace records the scene");
+    let mut meta: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(&json).unwrap()).unwrap();
+    assert!(
+        meta.as_object_mut().unwrap().remove("scene_file").is_some(),
+        "pis-trace records the scene"
+    );
     std::fs::write(&json, serde_json::to_vec(&meta).unwrap()).unwrap();
     let out = bench(&["infer", set.to_str().unwrap(), "--no-wgpu"]);
     assert_eq!(out.status.code(), Some(4));
     assert!(String::from_utf8_lossy(&out.stderr).contains("pass --scene"));
-    let out = bench(&["infer", set.to_str().unwrap(), "--scene", scene.to_str().unwrap(), "--object", "Walls",
-                      "--no-wgpu", "--json"]);
+    let out = bench(&[
+        "infer",
+        set.to_str().unwrap(),
+        "--scene",
+        scene.to_str().unwrap(),
+        "--object",
+        "Walls",
+        "--no-wgpu",
+        "--json",
+    ]);
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("JSON on stdout");
     assert_eq!(v["object"], "Walls");
@@ -122,20 +178,55 @@ fn infer_reports_texel_ranges_and_the_neighbouring_view() {
     if !scene.exists() {
         return;
     }
-    let out = bench(&["infer", scene.to_str().unwrap(), "--resolution", "64x48", "--spp", "1",
-                      "--object", "Vase", "--at", "0,0", "--no-wgpu", "--json", "--neighbour",
-                      "--antialias", "2", "--epsilon-b", "0.03125"]);
+    let out = bench(&[
+        "infer",
+        scene.to_str().unwrap(),
+        "--resolution",
+        "64x48",
+        "--spp",
+        "1",
+        "--object",
+        "Vase",
+        "--at",
+        "0,0",
+        "--no-wgpu",
+        "--json",
+        "--neighbour",
+        "--antialias",
+        "2",
+        "--epsilon-b",
+        "0.03125",
+    ]);
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("JSON on stdout");
     assert!(v["neighbour_point"].is_array());
-    for m in ["ls-bilinear", "ls-trilinear", "ls-trilinear-unconstrained", "ls-pyramidal", "forward", "traced"] {
+    for m in [
+        "ls-bilinear",
+        "ls-trilinear",
+        "ls-trilinear-unconstrained",
+        "ls-pyramidal",
+        "forward",
+        "traced",
+    ] {
         let r = &v["methods"][m];
         let n = r["psnr_db_neighbour"].as_f64().unwrap_or(f64::NAN);
         assert!(n.is_finite(), "{m}: neighbour {n}");
-        let (lo, hi) = (r["texel_range"][0].as_f64().unwrap_or(f64::NAN), r["texel_range"][1].as_f64().unwrap_or(f64::NAN));
+        let (lo, hi) = (
+            r["texel_range"][0].as_f64().unwrap_or(f64::NAN),
+            r["texel_range"][1].as_f64().unwrap_or(f64::NAN),
+        );
         assert!(lo <= hi, "{m}: texel range [{lo}, {hi}]");
     }
-    let out = bench(&["infer", scene.to_str().unwrap(), "--resolution", "32x24", "--spp", "1", "--antialias", "0"]);
+    let out = bench(&[
+        "infer",
+        scene.to_str().unwrap(),
+        "--resolution",
+        "32x24",
+        "--spp",
+        "1",
+        "--antialias",
+        "0",
+    ]);
     assert_eq!(out.status.code(), Some(1), "--antialias 0 is a usage error");
 }
 
@@ -147,14 +238,18 @@ fn tiny_demo1_set(dir: &std::path::Path) -> Option<PathBuf> {
     }
     let text = std::fs::read_to_string(&scene).expect("demo1 scene.toml");
     let gltf = scene.parent().unwrap().join("demo1.gltf");
-    let text = text.replace("gltf = \"demo1.gltf\"", &format!("gltf = {:?}", gltf.to_str().unwrap()))
+    let text = text
+        .replace("gltf = \"demo1.gltf\"", &format!("gltf = {:?}", gltf.to_str().unwrap()))
         .replace("resolution = [160, 120]", "resolution = [40, 30]")
         .replace("spp = 4", "spp = 1")
         .replace("samples = 4", "samples = 2");
     let toml = dir.join("scene.toml");
     std::fs::write(&toml, text).unwrap();
     let set = dir.join("set");
-    let out = Command::new(env!("CARGO_BIN_EXE_pis-trace")).args([toml.to_str().unwrap(), "-o", set.to_str().unwrap()]).output().expect("pis-trace runs");
+    let out = Command::new(env!("CARGO_BIN_EXE_pis-trace"))
+        .args([toml.to_str().unwrap(), "-o", set.to_str().unwrap()])
+        .output()
+        .expect("pis-trace runs");
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     std::fs::copy(&toml, set.join("scene.toml")).unwrap();
     Some(set)
@@ -169,23 +264,46 @@ fn rd_charts_every_method_at_matched_budgets() {
     let dir = tempfile::tempdir().expect("temporary directory");
     let Some(set) = tiny_demo1_set(dir.path()) else { return };
     let out_dir = dir.path().join("reports");
-    let out = bench(&["rd", set.to_str().unwrap(), "--ratios", "4,12", "--out", out_dir.to_str().unwrap(), "--json"]);
+    let out = bench(&[
+        "rd",
+        set.to_str().unwrap(),
+        "--ratios",
+        "4,12",
+        "--out",
+        out_dir.to_str().unwrap(),
+        "--json",
+    ]);
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("JSON on stdout");
     let csv = std::fs::read_to_string(out_dir.join("rd.csv")).expect("rd.csv");
     let svg = std::fs::read_to_string(out_dir.join("rd.svg")).expect("rd.svg");
     let videos = ffmpeg_present();
     if !videos {
-        assert!(std::env::var_os("CI").is_none(), "CI needs ffmpeg (libx265, libaom-av1) for the video baselines");
+        assert!(
+            std::env::var_os("CI").is_none(),
+            "CI needs ffmpeg (libx265, libaom-av1) for the video baselines"
+        );
         eprintln!("ffmpeg is missing: the video baselines are skipped");
     }
     let methods: &[&str] = if videos {
-        &["pis-wavelet", "pis-dct", "pis-wavelet-full-pyramid", "pis-wavelet-combined-layers", "mpeg-texture-x265", "view-x265", "view-av1"]
+        &[
+            "pis-wavelet",
+            "pis-dct",
+            "pis-wavelet-full-pyramid",
+            "pis-wavelet-combined-layers",
+            "mpeg-texture-x265",
+            "view-x265",
+            "view-av1",
+        ]
     } else {
         &["pis-wavelet", "pis-dct", "pis-wavelet-full-pyramid", "pis-wavelet-combined-layers"]
     };
     for m in methods {
-        assert_eq!(csv.lines().filter(|l| l.starts_with(&format!("{m},"))).count(), 2, "{m} rows in\n{csv}");
+        assert_eq!(
+            csv.lines().filter(|l| l.starts_with(&format!("{m},"))).count(),
+            2,
+            "{m} rows in\n{csv}"
+        );
         assert!(svg.contains(m), "the chart names {m}");
     }
     assert!(svg.contains("command: pis-bench rd"), "the chart is stamped with the command");
@@ -197,14 +315,25 @@ fn rd_charts_every_method_at_matched_budgets() {
         // Matched budgets: videos never exceed theirs and spend at least 70 % of it when it
         // can be reached; PIS's allocation lands within ±10 %.
         if m.starts_with("pis-") {
-            assert!((bytes / budget - 1.0).abs() <= 0.10, "{m}: {bytes} bytes for a budget of {budget}");
+            assert!(
+                (bytes / budget - 1.0).abs() <= 0.10,
+                "{m}: {bytes} bytes for a budget of {budget}"
+            );
         } else if r["reached"].as_bool().unwrap() {
-            assert!(bytes <= budget && bytes >= 0.70 * budget, "{m}: {bytes} bytes for a budget of {budget}");
+            assert!(
+                bytes <= budget && bytes >= 0.70 * budget,
+                "{m}: {bytes} bytes for a budget of {budget}"
+            );
         }
     }
     // More bytes buy quality: each method is better at 4:1 than at 12:1.
     for m in methods {
-        let at = |t: f64| rows.iter().find(|r| r["method"] == *m && r["target_ratio"].as_f64() == Some(t)).and_then(|r| r["psnr_db"].as_f64()).unwrap();
+        let at = |t: f64| {
+            rows.iter()
+                .find(|r| r["method"] == *m && r["target_ratio"].as_f64() == Some(t))
+                .and_then(|r| r["psnr_db"].as_f64())
+                .unwrap()
+        };
         assert!(at(4.0) > at(12.0), "{m}: {} dB at 4:1, {} dB at 12:1", at(4.0), at(12.0));
     }
 }
@@ -233,20 +362,40 @@ fn stability_reports_every_representation_on_both_paths() {
     let dir = tempfile::tempdir().expect("temporary directory");
     let Some(set) = tiny_demo1_set(dir.path()) else { return };
     let out_dir = dir.path().join("reports");
-    let out = bench(&["stability", set.to_str().unwrap(), "--ratios", "200", "--frames", "4", "--reference-spp", "1",
-                      "--out", out_dir.to_str().unwrap(), "--json"]);
+    let out = bench(&[
+        "stability",
+        set.to_str().unwrap(),
+        "--ratios",
+        "200",
+        "--frames",
+        "4",
+        "--reference-spp",
+        "1",
+        "--out",
+        out_dir.to_str().unwrap(),
+        "--json",
+    ]);
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("JSON on stdout");
     let csv = std::fs::read_to_string(out_dir.join("stability.csv")).expect("stability.csv");
     let svg = std::fs::read_to_string(out_dir.join("stability.svg")).expect("stability.svg");
     let s = v["summaries"].as_array().expect("summaries");
     assert_eq!(s.len(), 4, "solved and 200:1, each between and away");
-    let mean = |rep: &str, path: &str| s.iter().find(|x| x["representation"] == rep && x["path"] == path).and_then(|x| x["mean_psnr_db"].as_f64()).unwrap();
+    let mean = |rep: &str, path: &str| {
+        s.iter()
+            .find(|x| x["representation"] == rep && x["path"] == path)
+            .and_then(|x| x["mean_psnr_db"].as_f64())
+            .unwrap()
+    };
     for path in ["between", "away"] {
         for rep in ["solved", "wavelet 200:1"] {
             assert!(mean(rep, path) > 10.0, "{rep} {path}: {} dB", mean(rep, path));
             assert!(svg.contains(&format!("{rep} · {path}")), "the chart names {rep} · {path}");
-            assert_eq!(csv.lines().filter(|l| l.starts_with(&format!("{rep},{path},"))).count(), 4, "{rep} {path}: 4 frames in\n{csv}");
+            assert_eq!(
+                csv.lines().filter(|l| l.starts_with(&format!("{rep},{path},"))).count(),
+                4,
+                "{rep} {path}: 4 frames in\n{csv}"
+            );
         }
         // an extreme ratio costs quality off the samples too
         assert!(mean("wavelet 200:1", path) < mean("solved", path), "{path}");
@@ -281,15 +430,26 @@ fn speed_stability_and_all_argument_errors() {
 /// encodings need 130 bytes, over the budget of 115".
 #[test]
 fn readme_chart_command_runs_at_its_smallest_preset() {
-    let readme = std::fs::read_to_string(PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../README.md")).expect("README.md");
-    let line = readme.lines().map(str::trim).find(|l| l.contains("--bin pis-bench -- all")).expect("README shows the chart command");
-    let args: Vec<&str> = line.split_once(" -- ").expect("cargo run … -- ARGS").1.split_whitespace().collect();
+    let readme =
+        std::fs::read_to_string(PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../README.md"))
+            .expect("README.md");
+    let line = readme
+        .lines()
+        .map(str::trim)
+        .find(|l| l.contains("--bin pis-bench -- all"))
+        .expect("README shows the chart command");
+    let args: Vec<&str> =
+        line.split_once(" -- ").expect("cargo run … -- ARGS").1.split_whitespace().collect();
     assert_eq!(args, ["all", "--preset", "ci"], "the chart command README shows");
     let dir = tempfile::tempdir().expect("temporary directory");
     let out_dir = dir.path().join("reports");
     let mut all = args.clone();
     all.extend(["--out", out_dir.to_str().unwrap()]);
-    let out = Command::new(env!("CARGO_BIN_EXE_pis-bench")).args(&all).current_dir(dir.path()).output().expect("pis-bench runs");
+    let out = Command::new(env!("CARGO_BIN_EXE_pis-bench"))
+        .args(&all)
+        .current_dir(dir.path())
+        .output()
+        .expect("pis-bench runs");
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     for chart in ["rd.svg", "speed.svg", "stability.svg"] {
         assert!(out_dir.join(chart).is_file(), "{chart} written");
@@ -299,7 +459,8 @@ fn readme_chart_command_runs_at_its_smallest_preset() {
 #[test]
 fn hybrid_reports_the_vertex_rays_and_their_accuracy_per_tau() {
     let glass = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../samples/glass/scene.toml");
-    let out = bench(&["hybrid", glass.to_str().unwrap(), "--tau", "2,8", "--frames", "2", "--json"]);
+    let out =
+        bench(&["hybrid", glass.to_str().unwrap(), "--tau", "2,8", "--frames", "2", "--json"]);
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("JSON on stdout");
     assert_eq!(v["frames"], 2);
@@ -312,7 +473,10 @@ fn hybrid_reports_the_vertex_rays_and_their_accuracy_per_tau() {
     assert!(f(&rows[0], "vertex_rays") > f(&rows[1], "vertex_rays"), "{rows:?}");
     assert!(f(&rows[0], "triangles") > f(&rows[1], "triangles"));
     for t in 0..2 {
-        let (a, b) = (rows[0]["p90_angle_deg"][t].as_f64().unwrap(), rows[1]["p90_angle_deg"][t].as_f64().unwrap());
+        let (a, b) = (
+            rows[0]["p90_angle_deg"][t].as_f64().unwrap(),
+            rows[1]["p90_angle_deg"][t].as_f64().unwrap(),
+        );
         assert!(a.is_finite() && a < b, "term {t}: τ 2 {a}°, τ 8 {b}°");
     }
     assert!(f(&v["per_pixel"][0], "pixels") > 1000.0);

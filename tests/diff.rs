@@ -32,28 +32,55 @@ fn fixture() -> &'static (tempfile::TempDir, PathBuf, PathBuf) {
         let dir = common::fixture_tempdir();
         let set = dir.path().join("set");
         let out = Command::new(env!("CARGO_BIN_EXE_pis-trace"))
-            .arg(repo("samples/demo1/scene.toml")).arg("-o").arg(&set)
-            .args(["--resolution", "40x30", "--spp", "1"]).output().expect("pis-trace runs");
+            .arg(repo("samples/demo1/scene.toml"))
+            .arg("-o")
+            .arg(&set)
+            .args(["--resolution", "40x30", "--spp", "1"])
+            .output()
+            .expect("pis-trace runs");
         assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
         let file = dir.path().join("demo1.pis");
         let out = Command::new(env!("CARGO_BIN_EXE_pis-pack"))
-            .arg(&set).arg("--scene").arg(repo("samples/demo1/scene.toml")).arg("-o").arg(&file)
-            .args(["--ratio", "24", "--max-texture", "32"]).output().expect("pis-pack runs");
+            .arg(&set)
+            .arg("--scene")
+            .arg(repo("samples/demo1/scene.toml"))
+            .arg("-o")
+            .arg(&file)
+            .args(["--ratio", "24", "--max-texture", "32"])
+            .output()
+            .expect("pis-pack runs");
         assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
         (dir, set, file)
     })
 }
 
 fn diff(a: &Path, b: &Path, args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_pis-diff")).arg(a).arg(b).args(args).output().expect("pis-diff runs")
+    Command::new(env!("CARGO_BIN_EXE_pis-diff"))
+        .arg(a)
+        .arg(b)
+        .args(args)
+        .output()
+        .expect("pis-diff runs")
 }
 
 fn json(out: &Output) -> serde_json::Value {
-    serde_json::from_slice(&out.stdout).unwrap_or_else(|e| panic!("JSON report ({e}): {}{}", String::from_utf8_lossy(&out.stdout), String::from_utf8_lossy(&out.stderr)))
+    serde_json::from_slice(&out.stdout).unwrap_or_else(|e| {
+        panic!(
+            "JSON report ({e}): {}{}",
+            String::from_utf8_lossy(&out.stdout),
+            String::from_utf8_lossy(&out.stderr)
+        )
+    })
 }
 
 fn reencode(input: &Path, output: &Path, args: &[&str]) {
-    let out = Command::new(env!("CARGO_BIN_EXE_pis-reencode")).arg(input).arg("-o").arg(output).args(args).output().expect("pis-reencode runs");
+    let out = Command::new(env!("CARGO_BIN_EXE_pis-reencode"))
+        .arg(input)
+        .arg("-o")
+        .arg(output)
+        .args(args)
+        .output()
+        .expect("pis-reencode runs");
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
 }
 
@@ -83,7 +110,8 @@ fn copy_is_identical(file: &Path) {
     // The readable report says so too.
     let out = diff(file, &copy, &[]);
     assert_eq!(out.status.code(), Some(0));
-    assert!(String::from_utf8_lossy(&out.stdout).contains("Verdict: identical (the bytes are identical)"));
+    assert!(String::from_utf8_lossy(&out.stdout)
+        .contains("Verdict: identical (the bytes are identical)"));
 }
 
 #[test]
@@ -134,10 +162,17 @@ fn structural_differences_are_listed() {
     let out = diff(packed(), &b, &["--json"]);
     assert_eq!(out.status.code(), Some(7));
     let r = json(&out);
-    let lines: Vec<&str> = r["structure"].as_array().expect("structure").iter().filter_map(|v| v.as_str()).collect();
-    assert!(lines.iter().any(|l| l.contains("codecs") && l.contains("wavelet") && l.contains("dct")), "{lines:?}");
+    let lines: Vec<&str> =
+        r["structure"].as_array().expect("structure").iter().filter_map(|v| v.as_str()).collect();
+    assert!(
+        lines.iter().any(|l| l.contains("codecs") && l.contains("wavelet") && l.contains("dct")),
+        "{lines:?}"
+    );
     assert!(lines.iter().any(|l| l.starts_with("setting codec: wavelet → dct")), "{lines:?}");
-    assert!(r["bytes"]["a"]["codestreams"].as_u64().is_some() && r["bytes"]["b"]["total"].as_u64().is_some());
+    assert!(
+        r["bytes"]["a"]["codestreams"].as_u64().is_some()
+            && r["bytes"]["b"]["total"].as_u64().is_some()
+    );
 }
 
 #[test]
@@ -148,28 +183,54 @@ fn heatmaps_are_written_per_object_and_layer() {
     let maps = dir.path().join("maps");
     let out = diff(packed(), &b, &["--json", "--heatmaps", maps.to_str().expect("utf-8 path")]);
     let r = json(&out);
-    let layers: usize = r["objects"].as_array().expect("objects").iter().map(|o| o["layers"].as_array().map_or(0, Vec::len)).sum();
+    let layers: usize = r["objects"]
+        .as_array()
+        .expect("objects")
+        .iter()
+        .map(|o| o["layers"].as_array().map_or(0, Vec::len))
+        .sum();
     let written = r["heatmaps"].as_array().expect("heatmaps");
     // A map per layer and texture placement: every block of every layer in exactly one.
     assert!(written.len() >= layers, "{} maps for {layers} layers", written.len());
     let c = pis_format::PisReader::open(packed()).expect("open").load_all().expect("load");
     let blocks: usize = c.objects.iter().flat_map(|o| &o.layers).map(|l| l.blocks.len()).sum();
-    assert_eq!(written.iter().map(|h| h["blocks"].as_array().expect("blocks").len()).sum::<usize>(), blocks);
+    assert_eq!(
+        written.iter().map(|h| h["blocks"].as_array().expect("blocks").len()).sum::<usize>(),
+        blocks
+    );
     for h in written {
         let object = c.objects.iter().find(|o| o.name == h["object"]).expect("object");
         let layer = &object.layers[h["layer"].as_u64().expect("layer") as usize];
         let img = image::open(h["file"].as_str().expect("file")).expect("a PNG").to_rgb8();
-        let covered: Vec<&pis_format::Block> = h["blocks"].as_array().expect("blocks").iter().map(|b| &layer.blocks[b.as_u64().expect("block") as usize]).collect();
+        let covered: Vec<&pis_format::Block> = h["blocks"]
+            .as_array()
+            .expect("blocks")
+            .iter()
+            .map(|b| &layer.blocks[b.as_u64().expect("block") as usize])
+            .collect();
         for b in &covered {
-            assert_eq!((b.width, b.height, b.placement), (covered[0].width, covered[0].height, covered[0].placement), "one placement per map: {h}");
+            assert_eq!(
+                (b.width, b.height, b.placement),
+                (covered[0].width, covered[0].height, covered[0].placement),
+                "one placement per map: {h}"
+            );
         }
         assert_eq!(img.dimensions(), (covered[0].width, covered[0].height), "{h}");
         // The ramp's top stands for the layer's largest RMS error: zero only where it is exact.
-        let diffed = r["objects"].as_array().expect("objects").iter().find(|o| o["name"] == h["object"]).expect("object");
+        let diffed = r["objects"]
+            .as_array()
+            .expect("objects")
+            .iter()
+            .find(|o| o["name"] == h["object"])
+            .expect("object");
         let exact = diffed["layers"][h["layer"].as_u64().expect("layer") as usize]["exact"] == true;
         assert_eq!(h["scale"].as_f64().expect("scale") > 0.0, !exact, "{h}");
     }
-    let leftovers = std::fs::read_dir(&maps).expect("maps").filter_map(Result::ok).filter(|e| e.file_name().to_string_lossy().ends_with(".tmp")).count();
+    let leftovers = std::fs::read_dir(&maps)
+        .expect("maps")
+        .filter_map(Result::ok)
+        .filter(|e| e.file_name().to_string_lossy().ends_with(".tmp"))
+        .count();
     assert_eq!(leftovers, 0);
 }
 
@@ -185,10 +246,17 @@ fn invalid_files_exit_3_with_the_rule() {
     assert!(err.contains("truncated.pis") && err.contains("error-1003"), "{err}");
     assert!(!err.contains("panicked"));
     // A damaged codestream is found when it is decoded.
-    let chunks = Command::new(env!("CARGO_BIN_EXE_pis-inspect")).arg("--chunks").arg("--json").arg(packed()).output().expect("pis-inspect");
+    let chunks = Command::new(env!("CARGO_BIN_EXE_pis-inspect"))
+        .arg("--chunks")
+        .arg("--json")
+        .arg(packed())
+        .output()
+        .expect("pis-inspect");
     let rows: serde_json::Value = serde_json::from_slice(&chunks.stdout).expect("chunk JSON");
-    let cstr = rows.as_array().expect("rows").iter().find(|c| c["type"] == "CSTR").expect("a CSTR chunk");
-    let at = (cstr["offset"].as_u64().expect("offset") + cstr["length"].as_u64().expect("length") / 2) as usize;
+    let cstr =
+        rows.as_array().expect("rows").iter().find(|c| c["type"] == "CSTR").expect("a CSTR chunk");
+    let at = (cstr["offset"].as_u64().expect("offset")
+        + cstr["length"].as_u64().expect("length") / 2) as usize;
     let mut damaged = bytes.clone();
     damaged[at] ^= 0x5a;
     let file = dir.path().join("damaged.pis");
@@ -211,7 +279,11 @@ fn bad_arguments_and_missing_files() {
     assert_eq!(out.status.code(), Some(1));
     let out = diff(&tiny, &tiny, &["--msaa", "2"]);
     assert_eq!(out.status.code(), Some(1));
-    assert!(String::from_utf8_lossy(&out.stderr).contains("expected 1 (off) or 4"), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        String::from_utf8_lossy(&out.stderr).contains("expected 1 (off) or 4"),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let out = diff(&tiny, Path::new("/no/such/file.pis"), &[]);
     assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("/no/such/file.pis"));
@@ -229,14 +301,28 @@ fn diff_with_set_or_skip(test: &str, args: &[&str]) -> Option<Output> {
 
 #[test]
 fn against_the_set_pis_diff_and_pis_play_agree() {
-    let Some(out) = diff_with_set_or_skip("against_the_set_pis_diff_and_pis_play_agree", &["--json"]) else { return };
+    let Some(out) =
+        diff_with_set_or_skip("against_the_set_pis_diff_and_pis_play_agree", &["--json"])
+    else {
+        return;
+    };
     assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
     let d = json(&out);
-    let play = Command::new(env!("CARGO_BIN_EXE_pis-play")).arg(packed()).arg("--headless").arg("--compare").arg(set()).arg("--json").output().expect("pis-play runs");
+    let play = Command::new(env!("CARGO_BIN_EXE_pis-play"))
+        .arg(packed())
+        .arg("--headless")
+        .arg("--compare")
+        .arg(set())
+        .arg("--json")
+        .output()
+        .expect("pis-play runs");
     assert!(play.status.success(), "{}", String::from_utf8_lossy(&play.stderr));
     let p = json(&play);
     let close = |a: &serde_json::Value, b: &serde_json::Value, what: &str| {
-        let (a, b) = (a.as_f64().unwrap_or_else(|| panic!("{what}: {a}")), b.as_f64().unwrap_or_else(|| panic!("{what}: {b}")));
+        let (a, b) = (
+            a.as_f64().unwrap_or_else(|| panic!("{what}: {a}")),
+            b.as_f64().unwrap_or_else(|| panic!("{what}: {b}")),
+        );
         assert!((a - b).abs() <= 0.1, "{what}: pis-diff {a} dB, pis-play {b} dB");
     };
     close(&d["psnr_db"], &p["psnr_db"], "whole image");
@@ -244,7 +330,12 @@ fn against_the_set_pis_diff_and_pis_play_agree() {
     let objects = d["objects"].as_array().expect("objects");
     assert!(!objects.is_empty());
     for o in objects {
-        let q = p["objects"].as_array().expect("objects").iter().find(|q| q["name"] == o["name"]).expect("the same objects");
+        let q = p["objects"]
+            .as_array()
+            .expect("objects")
+            .iter()
+            .find(|q| q["name"] == o["name"])
+            .expect("the same objects");
         close(&o["psnr_db"], &q["psnr_db"], o["name"].as_str().unwrap_or("object"));
         let f = o["flip_mean"].as_f64().expect("object FLIP");
         assert!(f > 0.0 && f < 1.0, "{o}");
@@ -255,13 +346,26 @@ fn against_the_set_pis_diff_and_pis_play_agree() {
     let points = d["points"].as_array().expect("points");
     assert_eq!(points.len(), p["points"].as_array().expect("points").len());
     // The same samples per pixel, by default and at --msaa 1.
-    assert_eq!((&d["msaa_samples"], &d["msaa_requested"]), (&p["msaa_samples"], &p["msaa_requested"]));
+    assert_eq!(
+        (&d["msaa_samples"], &d["msaa_requested"]),
+        (&p["msaa_samples"], &p["msaa_requested"])
+    );
     let one = diff(packed(), set(), &["--json", "--msaa", "1"]);
     assert_eq!(one.status.code(), Some(0), "{}", String::from_utf8_lossy(&one.stderr));
     let d1 = json(&one);
-    let play1 = Command::new(env!("CARGO_BIN_EXE_pis-play")).arg(packed()).arg("--headless").arg("--compare").arg(set()).args(["--msaa", "1", "--json"]).output().expect("pis-play runs");
+    let play1 = Command::new(env!("CARGO_BIN_EXE_pis-play"))
+        .arg(packed())
+        .arg("--headless")
+        .arg("--compare")
+        .arg(set())
+        .args(["--msaa", "1", "--json"])
+        .output()
+        .expect("pis-play runs");
     let p1 = json(&play1);
-    assert_eq!((&d1["msaa_samples"], &d1["msaa_requested"]), (&serde_json::json!(1), &serde_json::json!(1)));
+    assert_eq!(
+        (&d1["msaa_samples"], &d1["msaa_requested"]),
+        (&serde_json::json!(1), &serde_json::json!(1))
+    );
     close(&d1["psnr_db"], &p1["psnr_db"], "whole image, 1 sample");
     close(&d1["covered_psnr_db"], &p1["covered_psnr_db"], "covered pixels, 1 sample");
     for pt in points {
@@ -271,25 +375,51 @@ fn against_the_set_pis_diff_and_pis_play_agree() {
 
 #[test]
 fn against_the_set_gates_and_flip_maps() {
-    let Some(out) = diff_with_set_or_skip("against_the_set_gates_and_flip_maps", &["--json"]) else { return };
+    let Some(out) = diff_with_set_or_skip("against_the_set_gates_and_flip_maps", &["--json"])
+    else {
+        return;
+    };
     let r = json(&out);
-    let (whole, covered) = (r["psnr_db"].as_f64().expect("PSNR"), r["covered_psnr_db"].as_f64().expect("covered"));
+    let (whole, covered) =
+        (r["psnr_db"].as_f64().expect("PSNR"), r["covered_psnr_db"].as_f64().expect("covered"));
     assert_eq!(r["verdict"], "measured");
     let dir = tempfile::tempdir().expect("temp dir");
     let maps = dir.path().join("flip");
-    let pass = diff(packed(), set(), &["--json", "--min-psnr", &format!("{}", whole - 0.5), "--heatmaps", maps.to_str().expect("utf-8")]);
+    let pass = diff(
+        packed(),
+        set(),
+        &[
+            "--json",
+            "--min-psnr",
+            &format!("{}", whole - 0.5),
+            "--heatmaps",
+            maps.to_str().expect("utf-8"),
+        ],
+    );
     assert_eq!(pass.status.code(), Some(0), "{}", String::from_utf8_lossy(&pass.stderr));
     let written = json(&pass)["heatmaps"].as_array().expect("heatmaps").len();
     assert_eq!(written, r["points"].as_array().expect("points").len());
     assert_eq!(std::fs::read_dir(&maps).expect("maps").count(), written);
-    assert_eq!(diff(packed(), set(), &["--min-psnr", &format!("{}", whole + 0.5)]).status.code(), Some(7));
+    assert_eq!(
+        diff(packed(), set(), &["--min-psnr", &format!("{}", whole + 0.5)]).status.code(),
+        Some(7)
+    );
     // The drop is measured on the covered pixels against the reference.
     let reference = format!("{}", covered + 1.0);
-    let within = diff(packed(), set(), &["--json", "--reference-psnr", &reference, "--max-psnr-drop", "1.5"]);
+    let within = diff(
+        packed(),
+        set(),
+        &["--json", "--reference-psnr", &reference, "--max-psnr-drop", "1.5"],
+    );
     assert_eq!(within.status.code(), Some(0), "{}", String::from_utf8_lossy(&within.stderr));
     let w = json(&within);
     assert!((w["psnr_drop_db"].as_f64().expect("drop") - 1.0).abs() < 1e-6, "{w}");
-    assert_eq!(diff(packed(), set(), &["--reference-psnr", &reference, "--max-psnr-drop", "0.5"]).status.code(), Some(7));
+    assert_eq!(
+        diff(packed(), set(), &["--reference-psnr", &reference, "--max-psnr-drop", "0.5"])
+            .status
+            .code(),
+        Some(7)
+    );
     // pis-pack records its prediction in the file: the drop gate measures against it, and the
     // played covered-pixel PSNR is within 0.5 dB of it.
     let recorded = diff(packed(), set(), &["--json", "--max-psnr-drop", "0.5"]);
@@ -315,12 +445,21 @@ fn two_sets_compare_their_noise() {
     let trace = |name: &str, spp: &str, size: &str| {
         let out_dir = dir.path().join(name);
         let out = Command::new(env!("CARGO_BIN_EXE_pis-trace"))
-            .arg(repo("samples/demo1/scene.toml")).arg("-o").arg(&out_dir)
-            .args(["--resolution", size, "--spp", spp, "--points", "2"]).output().expect("pis-trace runs");
+            .arg(repo("samples/demo1/scene.toml"))
+            .arg("-o")
+            .arg(&out_dir)
+            .args(["--resolution", size, "--spp", spp, "--points", "2"])
+            .output()
+            .expect("pis-trace runs");
         assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
         out_dir
     };
-    let (s2, s8, s32, small) = (trace("s2", "2", "40x30"), trace("s8", "8", "40x30"), trace("s32", "32", "40x30"), trace("small", "2", "20x15"));
+    let (s2, s8, s32, small) = (
+        trace("s2", "2", "40x30"),
+        trace("s8", "8", "40x30"),
+        trace("s32", "32", "40x30"),
+        trace("small", "2", "20x15"),
+    );
     let same = diff(&s2, &s2, &["--json"]);
     assert_eq!(same.status.code(), Some(0));
     let v = json(&same);
@@ -331,7 +470,11 @@ fn two_sets_compare_their_noise() {
     for o in v["objects"].as_array().expect("objects") {
         let model = o["model"].as_str();
         match o["name"].as_str().expect("name") {
-            "Vase" | "TableTop" => assert_eq!(model, Some("diffuse + fresnel * (local + (1 - alpha) * distant)"), "{o}"),
+            "Vase" | "TableTop" => assert_eq!(
+                model,
+                Some("diffuse + fresnel * (local + (1 - alpha) * distant)"),
+                "{o}"
+            ),
             "GlassCup" => assert_eq!(model, Some("diffuse + reflection + refraction"), "{o}"),
             _ => assert!(model.is_none() && o.get("model_psnr_db").is_none(), "{o}"),
         }
@@ -342,7 +485,10 @@ fn two_sets_compare_their_noise() {
         }
     }
     let text = String::from_utf8_lossy(&diff(&s2, &s2, &[]).stdout).to_string();
-    assert!(text.contains("composed as the player's model, diffuse + reflection + refraction"), "{text}");
+    assert!(
+        text.contains("composed as the player's model, diffuse + reflection + refraction"),
+        "{text}"
+    );
     let score = |a: &Path| {
         let out = diff(a, &s32, &["--json"]);
         assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
@@ -368,7 +514,11 @@ fn one_fault_gives_one_exit_code_in_every_tool() {
         let out = Command::new(bin).args(args).output().expect("the tool runs");
         (out.status.code(), String::from_utf8_lossy(&out.stderr).into_owned())
     };
-    let (pack, diff, trace) = (env!("CARGO_BIN_EXE_pis-pack"), env!("CARGO_BIN_EXE_pis-diff"), env!("CARGO_BIN_EXE_pis-trace"));
+    let (pack, diff, trace) = (
+        env!("CARGO_BIN_EXE_pis-pack"),
+        env!("CARGO_BIN_EXE_pis-diff"),
+        env!("CARGO_BIN_EXE_pis-trace"),
+    );
     let out = dir.path().join("out.pis");
     // a truncated EXR: invalid (3) for pis-pack, pis-diff FILE SET and pis-diff SET SET
     let damaged = dir.path().join("damaged");
@@ -381,7 +531,16 @@ fn one_fault_gives_one_exit_code_in_every_tool() {
     std::fs::write(&exr, &bytes[..bytes.len() / 2]).unwrap();
     let demo1 = repo("samples/demo1/scene.toml");
     for (bin, args) in [
-        (pack, vec![damaged.as_os_str(), "--scene".as_ref(), demo1.as_os_str(), "-o".as_ref(), out.as_os_str()]),
+        (
+            pack,
+            vec![
+                damaged.as_os_str(),
+                "--scene".as_ref(),
+                demo1.as_os_str(),
+                "-o".as_ref(),
+                out.as_os_str(),
+            ],
+        ),
         (diff, vec![packed().as_os_str(), damaged.as_os_str()]),
         (diff, vec![set().as_os_str(), damaged.as_os_str()]),
     ] {
@@ -424,13 +583,20 @@ fn one_fault_gives_one_exit_code_in_every_tool() {
 fn damaged_sets_are_refused_alike_by_pis_pack_and_pis_diff() {
     let cases: [(&str, fn(&Path)); 3] = [
         ("is NaN", |d| edit_point(d, |img| img.layers[0].planes[1][7] = f32::NAN)),
-        ("outside [0, 1]", |d| edit_point(d, |img| {
-            let l = img.layers.iter_mut().find(|l| l.name.ends_with(".coverage")).expect("a coverage layer");
-            l.planes[0][3] = -5.0;
-        })),
+        ("outside [0, 1]", |d| {
+            edit_point(d, |img| {
+                let l = img
+                    .layers
+                    .iter_mut()
+                    .find(|l| l.name.ends_with(".coverage"))
+                    .expect("a coverage layer");
+                l.planes[0][3] = -5.0;
+            })
+        }),
         ("samples[0] is 7", |d| {
             let json = d.join("set.json");
-            let mut meta: serde_json::Value = serde_json::from_slice(&std::fs::read(&json).unwrap()).unwrap();
+            let mut meta: serde_json::Value =
+                serde_json::from_slice(&std::fs::read(&json).unwrap()).unwrap();
             meta["points"][1]["samples"][0] = serde_json::json!(7);
             std::fs::write(&json, serde_json::to_vec(&meta).unwrap()).unwrap();
         }),
@@ -445,8 +611,19 @@ fn damaged_sets_are_refused_alike_by_pis_pack_and_pis_diff() {
         damage(&bad);
         let out_file = dir.path().join("out.pis");
         for args in [
-            vec![env!("CARGO_BIN_EXE_pis-diff").into(), set().as_os_str().to_owned(), bad.as_os_str().to_owned()],
-            vec![env!("CARGO_BIN_EXE_pis-pack").into(), bad.as_os_str().to_owned(), "--scene".into(), repo("samples/demo1/scene.toml").into_os_string(), "-o".into(), out_file.as_os_str().to_owned()],
+            vec![
+                env!("CARGO_BIN_EXE_pis-diff").into(),
+                set().as_os_str().to_owned(),
+                bad.as_os_str().to_owned(),
+            ],
+            vec![
+                env!("CARGO_BIN_EXE_pis-pack").into(),
+                bad.as_os_str().to_owned(),
+                "--scene".into(),
+                repo("samples/demo1/scene.toml").into_os_string(),
+                "-o".into(),
+                out_file.as_os_str().to_owned(),
+            ],
         ] {
             let out = Command::new(&args[0]).args(&args[1..]).output().expect("the tool runs");
             let err = String::from_utf8_lossy(&out.stderr);

@@ -16,7 +16,8 @@ use std::process::{Command, Output, Stdio};
 use std::time::{Duration, Instant};
 
 /// The tools, in the order of docs/TOOLS.md.
-const TOOLS: [&str; 7] = ["pis-trace", "pis-pack", "pis-play", "pis-inspect", "pis-diff", "pis-reencode", "pis-bench"];
+const TOOLS: [&str; 7] =
+    ["pis-trace", "pis-pack", "pis-play", "pis-inspect", "pis-diff", "pis-reencode", "pis-bench"];
 
 /// README's one-command tour and its test command (the one .ci/run runs).
 const MAIN_JOB: &str = "cargo run --release --bin pis-play -- samples/demo1/scene.toml";
@@ -65,7 +66,10 @@ fn readme_is_under_8_kb_with_both_commands_in_its_first_screen() {
         );
     }
     // .ci/run takes the first `^    cargo test` line of README.md and requires exactly this.
-    let ci = readme.lines().find(|l| l.starts_with("    cargo test")).expect("README.md shows a test command");
+    let ci = readme
+        .lines()
+        .find(|l| l.starts_with("    cargo test"))
+        .expect("README.md shows a test command");
     assert_eq!(ci.trim(), TEST_COMMAND, "the test command .ci/run reads from README.md");
 }
 
@@ -75,12 +79,22 @@ fn readme_shows_the_pipeline_picture_and_links_every_tool_to_its_section() {
     assert!(readme.contains("](docs/pipeline.png)"), "README.md shows docs/pipeline.png");
     let png = std::fs::read(repo().join("docs/pipeline.png")).expect("docs/pipeline.png");
     assert!(png.starts_with(b"\x89PNG\r\n\x1a\n"), "docs/pipeline.png is a PNG");
-    assert!(png.len() < 100 * 1024, "docs/pipeline.png is {} bytes: keep it under 100 KB", png.len());
+    assert!(
+        png.len() < 100 * 1024,
+        "docs/pipeline.png is {} bytes: keep it under 100 KB",
+        png.len()
+    );
     let tools_md = read("docs/TOOLS.md");
     for tool in TOOLS {
         let link = format!("](docs/TOOLS.md#{tool})");
-        assert!(readme.contains(&link), "README.md's tool table links {tool} to its section ({link})");
-        assert!(section(&tools_md, "## ", tool).is_some(), "docs/TOOLS.md has a `## {tool}` section for README's link");
+        assert!(
+            readme.contains(&link),
+            "README.md's tool table links {tool} to its section ({link})"
+        );
+        assert!(
+            section(&tools_md, "## ", tool).is_some(),
+            "docs/TOOLS.md has a `## {tool}` section for README's link"
+        );
     }
 }
 
@@ -98,7 +112,8 @@ fn help_flags(tool: &str, sub: Option<&str>) -> BTreeSet<String> {
         if line.len() - trimmed.len() > 6 || !trimmed.starts_with('-') {
             continue;
         }
-        let long = trimmed.split(|c: char| c.is_whitespace() || c == ',').find(|t| t.starts_with("--"));
+        let long =
+            trimmed.split(|c: char| c.is_whitespace() || c == ',').find(|t| t.starts_with("--"));
         if let Some(long) = long {
             let name = long.split(['<', '=', '[']).next().unwrap();
             if name != "--help" && name != "--version" {
@@ -113,7 +128,12 @@ fn help(tool: &str, sub: Option<&str>) -> String {
     let mut cmd = Command::new(bin(tool));
     cmd.args(sub).arg("--help");
     let out = cmd.output().unwrap_or_else(|e| panic!("{tool} --help runs: {e}"));
-    assert!(out.status.success(), "{tool} {} --help: {}", sub.unwrap_or(""), String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{tool} {} --help: {}",
+        sub.unwrap_or(""),
+        String::from_utf8_lossy(&out.stderr)
+    );
     String::from_utf8(out.stdout).expect("--help is UTF-8")
 }
 
@@ -170,8 +190,14 @@ fn table_flags(text: &str, what: &str) -> BTreeSet<String> {
         if first.chars().all(|c| c == '-' || c == ':') {
             continue; // the header's separator row
         }
-        let names: Vec<&str> = first.split(|c: char| c.is_whitespace() || c == ',' || c == '`').filter(|t| t.starts_with("--")).collect();
-        assert!(!names.is_empty(), "{what}: the flags table row {line:?} names no --flag in its first cell");
+        let names: Vec<&str> = first
+            .split(|c: char| c.is_whitespace() || c == ',' || c == '`')
+            .filter(|t| t.starts_with("--"))
+            .collect();
+        assert!(
+            !names.is_empty(),
+            "{what}: the flags table row {line:?} names no --flag in its first cell"
+        );
         flags.extend(names.into_iter().map(String::from));
     }
     flags
@@ -183,7 +209,8 @@ fn scopes(tools_md: &str) -> Vec<(String, &str, BTreeSet<String>)> {
     let mut positions = Vec::new();
     let mut scopes = Vec::new();
     for tool in TOOLS {
-        let text = section(tools_md, "## ", tool).unwrap_or_else(|| panic!("docs/TOOLS.md has no `## {tool}` section"));
+        let text = section(tools_md, "## ", tool)
+            .unwrap_or_else(|| panic!("docs/TOOLS.md has no `## {tool}` section"));
         positions.push((tools_md.find(&format!("\n## {tool}\n")).unwrap_or(0), tool));
         // A tool with subcommands documents each in a `### TOOL SUB` subsection.
         let subs = subcommands(tool);
@@ -191,7 +218,9 @@ fn scopes(tools_md: &str) -> Vec<(String, &str, BTreeSet<String>)> {
         let mut all = help_flags(tool, None);
         for sub in subs {
             let name = format!("{tool} {sub}");
-            let text = section(text, "### ", &name).unwrap_or_else(|| panic!("docs/TOOLS.md has no `### {name}` subsection under `## {tool}`"));
+            let text = section(text, "### ", &name).unwrap_or_else(|| {
+                panic!("docs/TOOLS.md has no `### {name}` subsection under `## {tool}`")
+            });
             let flags = help_flags(tool, Some(&sub));
             all.extend(flags.iter().cloned());
             scopes.push((name, text, flags));
@@ -213,7 +242,9 @@ fn every_flag_of_every_tool_is_documented_in_tools_md() {
         assert!(!flags.is_empty(), "{what} --help: no flags parsed; has its format changed?");
         let documented = table_flags(text, &what);
         for flag in flags.difference(&documented) {
-            missing.push(format!("{what}: {flag} (printed by --help) has no row in the flags table of its section"));
+            missing.push(format!(
+                "{what}: {flag} (printed by --help) has no row in the flags table of its section"
+            ));
         }
     }
     assert!(missing.is_empty(), "docs/TOOLS.md misses flags:\n  {}", missing.join("\n  "));
@@ -228,7 +259,11 @@ fn tools_md_documents_only_flags_the_tools_have() {
             gone.push(format!("{what}: {flag} is in the flags table but not in --help"));
         }
     }
-    assert!(gone.is_empty(), "docs/TOOLS.md documents flags the tools do not have:\n  {}", gone.join("\n  "));
+    assert!(
+        gone.is_empty(),
+        "docs/TOOLS.md documents flags the tools do not have:\n  {}",
+        gone.join("\n  ")
+    );
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -238,7 +273,10 @@ fn tools_md_documents_only_flags_the_tools_have() {
 /// out, so the commands start from what a fresh checkout holds.
 fn copy_tree(from: &Path, to: &Path) {
     std::fs::create_dir_all(to).unwrap_or_else(|e| panic!("{}: {e}", to.display()));
-    for e in std::fs::read_dir(from).unwrap_or_else(|e| panic!("{}: {e}", from.display())).map(Result::unwrap) {
+    for e in std::fs::read_dir(from)
+        .unwrap_or_else(|e| panic!("{}: {e}", from.display()))
+        .map(Result::unwrap)
+    {
         let (src, dst) = (e.path(), to.join(e.file_name()));
         let kind = e.file_type().expect("file type");
         if kind.is_dir() {
@@ -305,13 +343,18 @@ fn readme_commands_run_as_written() {
             (tool.trim(), args.split_whitespace().collect())
         })
         .collect();
-    assert!(commands.iter().any(|(tool, _)| *tool == "pis-play"), "README.md shows pis-play commands");
+    assert!(
+        commands.iter().any(|(tool, _)| *tool == "pis-play"),
+        "README.md shows pis-play commands"
+    );
     let dir = tempfile::tempdir().expect("temporary directory");
     copy_tree(&repo().join("samples"), &dir.path().join("samples"));
     for (tool, args) in &commands {
         let shown = format!("cargo run --release --bin {tool} -- {}", args.join(" "));
         if *tool == "pis-bench" && args.first() == Some(&"all") {
-            eprintln!("`{shown}`: run by tests/bench.rs readme_chart_command_runs_at_its_smallest_preset");
+            eprintln!(
+                "`{shown}`: run by tests/bench.rs readme_chart_command_runs_at_its_smallest_preset"
+            );
             continue;
         }
         eprintln!("README's `{shown}`");
@@ -324,5 +367,8 @@ fn readme_commands_run_as_written() {
         }
         assert!(out.status.success(), "README's `{shown}` exits {:?}:\n{err}", out.status.code());
     }
-    assert!(dir.path().join("demo1.pis").is_file(), "README's step-by-step commands write demo1.pis");
+    assert!(
+        dir.path().join("demo1.pis").is_file(),
+        "README's step-by-step commands write demo1.pis"
+    );
 }

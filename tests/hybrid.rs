@@ -5,7 +5,9 @@
 use std::path::Path;
 
 use glam::Vec3;
-use pis_compile::hybrid::{greedy_path, tessellate, HybridView, LensObject, Term, TessellationSettings};
+use pis_compile::hybrid::{
+    greedy_path, tessellate, HybridView, LensObject, Term, TessellationSettings,
+};
 use pis_scene::{ObjectRole, Scene};
 use pis_trace::camera::PerspectiveCamera;
 use pis_trace::TraceSettings;
@@ -25,7 +27,10 @@ fn lens_index(scene: &Scene) -> usize {
 }
 
 /// Every view sample traced with `settings`: its frame and render.
-fn traced_views(scene: &Scene, settings: &TraceSettings) -> Vec<(pis_scene::Frame, pis_trace::PointRender)> {
+fn traced_views(
+    scene: &Scene,
+    settings: &TraceSettings,
+) -> Vec<(pis_scene::Frame, pis_trace::PointRender)> {
     (0..scene.space.dims[0].samples())
         .map(|v| {
             let frame = scene.frame(&[v]).expect("view");
@@ -55,9 +60,12 @@ fn runtime_paths_leave_the_lens_where_the_tracer_records_say() {
         let term = if r.term == 0 { Term::ReflectionFirst } else { Term::RefractionFirst };
         let Some(p) = greedy_path(&lens, &first, dir, term, settings.max_depth) else { continue };
         // The angle between the directions, from their chord (acos near 1 is too coarse).
-        let angle = (2.0 * (0.5 * (p.exit_direction - Vec3::from(r.exit_direction)).length()).asin()).to_degrees();
+        let angle = (2.0
+            * (0.5 * (p.exit_direction - Vec3::from(r.exit_direction)).length()).asin())
+        .to_degrees();
         let origin = (p.exit_origin - Vec3::from(r.exit_origin)).length();
-        let modulation = (p.modulation - Vec3::from(r.modulation)).abs().max_element() / Vec3::from(r.modulation).max_element().max(1e-6);
+        let modulation = (p.modulation - Vec3::from(r.modulation)).abs().max_element()
+            / Vec3::from(r.modulation).max_element().max(1e-6);
         if angle < 1e-3 && origin < 1e-4 && modulation < 1e-4 {
             agree += 1;
             terms[r.term as usize] += 1;
@@ -79,7 +87,8 @@ fn tessellation_is_deterministic_watertight_and_finer_for_smaller_tau() {
     let lens = lens_object(&scene, &frame, o);
     let size = (320, 240);
     let camera = PerspectiveCamera::new(&frame.camera, size);
-    let clip_from_world = pis_trace::camera::projection_matrix(&frame.camera, size) * frame.camera.world_from_camera.inverse();
+    let clip_from_world = pis_trace::camera::projection_matrix(&frame.camera, size)
+        * frame.camera.world_from_camera.inverse();
     let view = HybridView { eye: camera.origin, clip_from_world, size };
     let mut vertices = Vec::new();
     for tau in [10.0, 5.0, 3.0] {
@@ -98,9 +107,13 @@ fn tessellation_is_deterministic_watertight_and_finer_for_smaller_tau() {
                 *count.entry((u.min(v), u.max(v))).or_insert(0) += 1;
             }
         }
-        assert!(count.values().all(|&c| c <= 2), "τ = {tau}: an edge drawn by more than two triangles");
+        assert!(
+            count.values().all(|&c| c <= 2),
+            "τ = {tau}: an edge drawn by more than two triangles"
+        );
         let used: std::collections::BTreeSet<u32> = a.triangles.iter().flatten().copied().collect();
-        let once: Vec<(u32, u32)> = count.iter().filter(|(_, &c)| c == 1).map(|(&e, _)| e).collect();
+        let once: Vec<(u32, u32)> =
+            count.iter().filter(|(_, &c)| c == 1).map(|(&e, _)| e).collect();
         for &(u, w) in &once {
             let (p, q) = (a.vertices[u as usize].position, a.vertices[w as usize].position);
             let len2 = (q - p).length_squared();
@@ -110,7 +123,10 @@ fn tessellation_is_deterministic_watertight_and_finer_for_smaller_tau() {
                 }
                 let x = a.vertices[v as usize].position;
                 let s = (x - p).dot(q - p) / len2;
-                if s > 1e-4 && s < 1.0 - 1e-4 && (p + (q - p) * s - x).length_squared() < 1e-10 * len2 {
+                if s > 1e-4
+                    && s < 1.0 - 1e-4
+                    && (p + (q - p) * s - x).length_squared() < 1e-10 * len2
+                {
                     panic!("τ = {tau}: vertex {v} lies inside edge {u}–{w}, drawn by one triangle");
                 }
             }
@@ -118,7 +134,10 @@ fn tessellation_is_deterministic_watertight_and_finer_for_smaller_tau() {
         eprintln!("τ = {tau}: {} edges, {} drawn once", count.len(), once.len());
         vertices.push(a.stats.traced_vertices);
     }
-    assert!(vertices[0] < vertices[1] && vertices[1] < vertices[2], "traced vertices by τ 10, 5, 3: {vertices:?}");
+    assert!(
+        vertices[0] < vertices[1] && vertices[1] < vertices[2],
+        "traced vertices by τ 10, 5, 3: {vertices:?}"
+    );
 }
 
 /// The angle in degrees between two vectors, from their unit chord.
@@ -128,7 +147,9 @@ fn angle_deg(a: glam::DVec3, b: glam::DVec3) -> f64 {
 
 #[test]
 fn interpolated_shell_vectors_follow_the_paths_traced_at_each_pixel() {
-    use pis_compile::hybrid::{hybrid_pixels, hybrid_render_matrix, shell_vector, vertex_vectors, Missing};
+    use pis_compile::hybrid::{
+        hybrid_pixels, hybrid_render_matrix, shell_vector, vertex_vectors, Missing,
+    };
     use pis_compile::shell::geometry::{Shell, ShellShape};
     use pis_compile::{TextureLayout, Viewport};
     let scene = glass_scene();
@@ -137,14 +158,17 @@ fn interpolated_shell_vectors_follow_the_paths_traced_at_each_pixel() {
     let lens = lens_object(&scene, &frame, o);
     let size = (320, 240);
     let camera = PerspectiveCamera::new(&frame.camera, size);
-    let clip_from_world = pis_trace::camera::projection_matrix(&frame.camera, size) * frame.camera.world_from_camera.inverse();
+    let clip_from_world = pis_trace::camera::projection_matrix(&frame.camera, size)
+        * frame.camera.world_from_camera.inverse();
     let view = HybridView { eye: camera.origin, clip_from_world, size };
-    let centre = lens.positions.iter().fold(Vec3::ZERO, |a, &p| a + p) / lens.positions.len() as f32;
+    let centre =
+        lens.positions.iter().fold(Vec3::ZERO, |a, &p| a + p) / lens.positions.len() as f32;
     let shell = Shell { origin: centre.as_dvec3(), shape: ShellShape::Sphere { radius: 2.0 } };
     let viewport = Viewport { width: size.0, height: size.1 };
     let mut p90 = Vec::new();
     for tau in [10.0, 3.0, 1.0] {
-        let tess = tessellate(&lens, &view, &TessellationSettings { tau_px: tau, ..Default::default() });
+        let tess =
+            tessellate(&lens, &view, &TessellationSettings { tau_px: tau, ..Default::default() });
         for term in [Term::ReflectionFirst, Term::RefractionFirst] {
             let vectors = vertex_vectors(&tess, term, &shell);
             let px = hybrid_pixels(viewport, &tess, clip_from_world, &vectors, Missing::Mean, None);
@@ -154,7 +178,8 @@ fn interpolated_shell_vectors_follow_the_paths_traced_at_each_pixel() {
                 .iter()
                 .zip(&px.vectors)
                 .filter_map(|(&p, v)| {
-                    let centre = glam::Vec2::new((p % size.0) as f32 + 0.5, (p / size.0) as f32 + 0.5);
+                    let centre =
+                        glam::Vec2::new((p % size.0) as f32 + 0.5, (p / size.0) as f32 + 0.5);
                     let dir = camera.direction(centre);
                     let hit = lens.closest(camera.origin, dir, f32::INFINITY)?;
                     let first = lens.surface(&hit, camera.origin, dir);
@@ -169,7 +194,14 @@ fn interpolated_shell_vectors_follow_the_paths_traced_at_each_pixel() {
             assert!(errors.len() > 5000, "{} pixels compared", errors.len());
             p90.push(q(0.9));
             // Every row is a full cube lookup.
-            let a = hybrid_render_matrix(viewport, &tess, clip_from_world, &vectors, TextureLayout::cube(32), None);
+            let a = hybrid_render_matrix(
+                viewport,
+                &tess,
+                clip_from_world,
+                &vectors,
+                TextureLayout::cube(32),
+                None,
+            );
             assert_eq!(a.rows(), px.pixels.len());
             for r in 0..a.rows() {
                 let s: f32 = a.row(r).1.iter().sum();
@@ -181,7 +213,10 @@ fn interpolated_shell_vectors_follow_the_paths_traced_at_each_pixel() {
     // τ = 3 on its 3 × 3 supersampled frames) nine pixels in ten are within the 3° the
     // tessellation refines to. (The tail is where a pixel straddles a change of path
     // topology: a handful of pixels on internal silhouettes.)
-    assert!(p90[2] < p90[0] && p90[3] < p90[1] && p90[4] < p90[2] && p90[5] < p90[3], "90th percentiles (τ 10, 3, 1; reflection, refraction): {p90:?}");
+    assert!(
+        p90[2] < p90[0] && p90[3] < p90[1] && p90[4] < p90[2] && p90[5] < p90[3],
+        "90th percentiles (τ 10, 3, 1; reflection, refraction): {p90:?}"
+    );
     assert!(p90[4] < 3.0 && p90[5] < 3.0, "90th percentiles at τ = 1: {p90:?}");
 }
 
@@ -209,24 +244,60 @@ fn the_glass_teapots_environment_clusters_into_layers_of_whole_objects() {
         }));
     }
     let (layers, shells) = choose_layers(&rays, origin, 4, scale);
-    let names: Vec<Vec<&str>> = (0..layers.distances.len()).map(|l| layers.layer_of.iter().filter(|(_, &k)| k == l).map(|(&ob, _)| scene.objects[ob as usize].name.as_str()).collect()).collect();
-    eprintln!("{} outgoing rays, layers at {:?}: {names:?}; shells' error {:.1} over {} hits", rays.len(), layers.distances, pis_compile::hybrid::shells_error(&rays, &layers, &shells, origin, scale), layers.counted);
+    let names: Vec<Vec<&str>> = (0..layers.distances.len())
+        .map(|l| {
+            layers
+                .layer_of
+                .iter()
+                .filter(|(_, &k)| k == l)
+                .map(|(&ob, _)| scene.objects[ob as usize].name.as_str())
+                .collect()
+        })
+        .collect();
+    eprintln!(
+        "{} outgoing rays, layers at {:?}: {names:?}; shells' error {:.1} over {} hits",
+        rays.len(),
+        layers.distances,
+        pis_compile::hybrid::shells_error(&rays, &layers, &shells, origin, scale),
+        layers.counted
+    );
     assert_eq!(shells.len(), layers.distances.len());
     for (l, fit) in shells.iter().enumerate() {
         eprintln!("layer {l}: {:?}, relative rms {:.3}", fit.shell.shape, fit.mse.sqrt());
-        assert!(matches!(fit.shell.shape, ShellShape::Sphere { .. } | ShellShape::Cylinder { .. } | ShellShape::Box { .. }));
+        assert!(matches!(
+            fit.shell.shape,
+            ShellShape::Sphere { .. } | ShellShape::Cylinder { .. } | ShellShape::Box { .. }
+        ));
     }
     assert!(layers.distances.len() >= 2, "{layers:?}");
     assert!(layers.distances.windows(2).all(|w| w[0] < w[1]));
     // The cup beside the teapot is nearer than the room's walls.
-    let layer = |name: &str| scene.objects.iter().position(|x| x.name == name).and_then(|k| layers.layer_of.get(&(k as u32)).copied());
-    assert!(layer("SilverCup") < layer("Columns") && layer("Columns") < layer("Walls"), "cup {:?}, columns {:?}, walls {:?}", layer("SilverCup"), layer("Columns"), layer("Walls"));
+    let layer = |name: &str| {
+        scene
+            .objects
+            .iter()
+            .position(|x| x.name == name)
+            .and_then(|k| layers.layer_of.get(&(k as u32)).copied())
+    };
+    assert!(
+        layer("SilverCup") < layer("Columns") && layer("Columns") < layer("Walls"),
+        "cup {:?}, columns {:?}, walls {:?}",
+        layer("SilverCup"),
+        layer("Columns"),
+        layer("Walls")
+    );
     // The shells put the environment within 10 % (rms) of its distance; the objects moved to
     // the shells that fit them beat the clustering by distance alone 10 times over.
     let error = pis_compile::hybrid::shells_error(&rays, &layers, &shells, origin, scale);
-    assert!(error < 0.01 * layers.counted as f64, "shells' error {error} over {} hits", layers.counted);
+    assert!(
+        error < 0.01 * layers.counted as f64,
+        "shells' error {error} over {} hits",
+        layers.counted
+    );
     let by_distance = pis_compile::hybrid::cluster(&rays, origin, layers.distances.len());
-    let fitted: Vec<_> = (0..by_distance.distances.len()).filter_map(|l| fit_shell(&rays, &layer_hits(&rays, &by_distance, l), origin, scale)).collect();
+    let fitted: Vec<_> = (0..by_distance.distances.len())
+        .filter_map(|l| fit_shell(&rays, &layer_hits(&rays, &by_distance, l), origin, scale))
+        .collect();
     let plain = pis_compile::hybrid::shells_error(&rays, &by_distance, &fitted, origin, scale);
     eprintln!("clustered by distance alone: shells' error {plain:.1}");
     assert!(plain > 10.0 * error, "by distance {plain}, refined {error}");
@@ -242,16 +313,37 @@ fn shells_inferred_at_the_sampled_views_reproduce_the_traced_terms() {
     let views = traced_views(&scene, &settings);
     let t = std::time::Instant::now();
     let result = infer_lens(&scene, o, &views, &LensInferSettings::default()).expect("infers");
-    eprintln!("{} layers at {:?} ({:.1} s)", result.shells.len(), result.layers.distances, t.elapsed().as_secs_f64());
-    let one = infer_lens(&scene, o, &views, &LensInferSettings { max_layers: 1, ..Default::default() }).expect("infers one layer");
-    let weighted = infer_lens(&scene, o, &views, &LensInferSettings { confidence: true, ..Default::default() }).expect("infers with confidence");
-    eprintln!("with the confidence weights, both terms: {:?}", weighted.views.iter().map(|v| format!("{:.2}", v.both.psnr_db)).collect::<Vec<_>>());
+    eprintln!(
+        "{} layers at {:?} ({:.1} s)",
+        result.shells.len(),
+        result.layers.distances,
+        t.elapsed().as_secs_f64()
+    );
+    let one =
+        infer_lens(&scene, o, &views, &LensInferSettings { max_layers: 1, ..Default::default() })
+            .expect("infers one layer");
+    let weighted = infer_lens(
+        &scene,
+        o,
+        &views,
+        &LensInferSettings { confidence: true, ..Default::default() },
+    )
+    .expect("infers with confidence");
+    eprintln!(
+        "with the confidence weights, both terms: {:?}",
+        weighted.views.iter().map(|v| format!("{:.2}", v.both.psnr_db)).collect::<Vec<_>>()
+    );
     for (v, (r, s)) in result.views.iter().zip(&one.views).enumerate() {
         eprintln!("view {v}: reflection {:.2} dB, refraction {:.2} dB, both {:.2} dB over {} pixels; one shell: {:.2}, {:.2}, {:.2} dB", r.reflection.psnr_db, r.refraction.psnr_db, r.both.psnr_db, r.both.pixels, s.reflection.psnr_db, s.refraction.psnr_db, s.both.psnr_db);
         // Regression guards below the measured figures (docs/BENCHMARKS.md: 18.2–19.4 dB for
         // both terms, 22.3–26.6 dB for the reflection-first term at CI size).
         assert!(r.both.pixels > 1500);
-        assert!(r.both.psnr_db > 17.0 && r.reflection.psnr_db > 21.0, "view {v}: {:?}, {:?}", r.both, r.reflection);
+        assert!(
+            r.both.psnr_db > 17.0 && r.reflection.psnr_db > 21.0,
+            "view {v}: {:?}, {:?}",
+            r.both,
+            r.reflection
+        );
         assert_eq!(r.cubes.len(), result.shells.len());
     }
     assert_eq!(result.shells.len(), 3);
@@ -270,43 +362,92 @@ fn layered_shells_off_the_sampled_views() {
     settings.records_per_pixel = 4;
     let views = traced_views(&scene, &settings);
     let layered = infer_lens(&scene, o, &views, &LensInferSettings::default()).expect("infers");
-    let one = infer_lens(&scene, o, &views, &LensInferSettings { max_layers: 1, ..Default::default() }).expect("infers one layer");
+    let one =
+        infer_lens(&scene, o, &views, &LensInferSettings { max_layers: 1, ..Default::default() })
+            .expect("infers one layer");
     // Thesis 6.3.3.1: each sample's shells solved over 5 views, its own and 3.5° and 7°
     // above and below it.
-    let pis_scene::Driver::Orbit { target, radius, elevation_deg } = scene.space.dims[0].driver.clone() else { panic!("an orbit") };
+    let pis_scene::Driver::Orbit { target, radius, elevation_deg } =
+        scene.space.dims[0].driver.clone()
+    else {
+        panic!("an orbit")
+    };
     let nearby: Vec<Vec<(pis_scene::Frame, pis_trace::PointRender)>> = (0..views.len())
         .map(|v| {
             [-7.0f32, -3.5, 3.5, 7.0]
                 .iter()
                 .map(|de| {
                     let mut frame = scene.frame(&[v as u32]).expect("view");
-                    frame.camera.world_from_camera = pis_scene::orbit::orbit_camera(target, radius, elevation_deg + de, scene.space.dims[0].values[v]);
-                    let render = pis_trace::render_point(&scene, &frame, &settings, &|| {}).expect("traces");
+                    frame.camera.world_from_camera = pis_scene::orbit::orbit_camera(
+                        target,
+                        radius,
+                        elevation_deg + de,
+                        scene.space.dims[0].values[v],
+                    );
+                    let render =
+                        pis_trace::render_point(&scene, &frame, &settings, &|| {}).expect("traces");
                     (frame, render)
                 })
                 .collect()
         })
         .collect();
-    let samples: Vec<Vec<&(pis_scene::Frame, pis_trace::PointRender)>> = views.iter().zip(&nearby).map(|(v, near)| std::iter::once(v).chain(near.iter()).collect()).collect();
-    let simultaneous = pis_pack::lens_infer::infer_lens_nearby(&scene, o, &samples, &LensInferSettings::default()).expect("infers over nearby views");
+    let samples: Vec<Vec<&(pis_scene::Frame, pis_trace::PointRender)>> = views
+        .iter()
+        .zip(&nearby)
+        .map(|(v, near)| std::iter::once(v).chain(near.iter()).collect())
+        .collect();
+    let simultaneous =
+        pis_pack::lens_infer::infer_lens_nearby(&scene, o, &samples, &LensInferSettings::default())
+            .expect("infers over nearby views");
     for (k, (a, c)) in layered.views.iter().zip(&simultaneous.views).enumerate() {
-        eprintln!("sample {k}: both terms {:.2} dB, over 5 views {:.2} dB", a.both.psnr_db, c.both.psnr_db);
+        eprintln!(
+            "sample {k}: both terms {:.2} dB, over 5 views {:.2} dB",
+            a.both.psnr_db, c.both.psnr_db
+        );
     }
-    eprintln!("layers {:?}, over 5 views {:?}", layered.layers.distances, simultaneous.layers.distances);
+    eprintln!(
+        "layers {:?}, over 5 views {:?}",
+        layered.layers.distances, simultaneous.layers.distances
+    );
     let (_, frames) = paths(&scene, 7, &[PathKind::Between, PathKind::Away]).expect("paths");
     let reference = TraceSettings::new((160, 120), 8);
     let last = views.len() - 1;
     let mut sums = std::collections::BTreeMap::new();
     for pf in &frames {
-        let render = pis_trace::render_point(&scene, &pf.frame, &reference, &|| {}).expect("traces the reference");
+        let render = pis_trace::render_point(&scene, &pf.frame, &reference, &|| {})
+            .expect("traces the reference");
         // The two nearest view samples, blended by distance (thesis 6.4.2).
         let k0 = (pf.view.floor() as usize).min(last);
         let k1 = (k0 + 1).min(last);
         let f = (pf.view - k0 as f32).clamp(0.0, 1.0);
         let blend = [(k0, 1.0 - f), (k1, f)];
-        let (_, _, a) = predict_view(&scene, o, &pf.frame, &render, &layered, &blend, &LensInferSettings::default());
-        let (_, _, b) = predict_view(&scene, o, &pf.frame, &render, &one, &blend, &LensInferSettings { max_layers: 1, ..Default::default() });
-        let (_, _, c) = predict_view(&scene, o, &pf.frame, &render, &simultaneous, &blend, &LensInferSettings::default());
+        let (_, _, a) = predict_view(
+            &scene,
+            o,
+            &pf.frame,
+            &render,
+            &layered,
+            &blend,
+            &LensInferSettings::default(),
+        );
+        let (_, _, b) = predict_view(
+            &scene,
+            o,
+            &pf.frame,
+            &render,
+            &one,
+            &blend,
+            &LensInferSettings { max_layers: 1, ..Default::default() },
+        );
+        let (_, _, c) = predict_view(
+            &scene,
+            o,
+            &pf.frame,
+            &render,
+            &simultaneous,
+            &blend,
+            &LensInferSettings::default(),
+        );
         eprintln!("{:?} view {:.2}: layered {:.2} dB, one shell {:.2} dB, layered over 5 views {:.2} dB over {} pixels", pf.kind, pf.view, a.psnr_db, b.psnr_db, c.psnr_db, a.pixels);
         let e = sums.entry(format!("{:?}", pf.kind)).or_insert((0.0, 0.0, 0, 0.0));
         e.0 += a.psnr_db;
@@ -333,7 +474,11 @@ fn the_runtimes_interface_functions_are_the_tracers() {
     for i in 0..=40 {
         let cos_i = -0.1 + i as f32 * 0.0275;
         for eta in [1.0 / 1.5, 1.0 / 1.33, 1.0, 1.33, 1.5, 2.4] {
-            assert_eq!(fresnel_dielectric(cos_i, eta).to_bits(), m::fresnel_dielectric(cos_i, eta).to_bits(), "cos {cos_i}, eta {eta}");
+            assert_eq!(
+                fresnel_dielectric(cos_i, eta).to_bits(),
+                m::fresnel_dielectric(cos_i, eta).to_bits(),
+                "cos {cos_i}, eta {eta}"
+            );
             let sin = (1.0 - cos_i * cos_i).max(0.0).sqrt();
             let d = Vec3::new(sin, -cos_i, 0.3 * sin).normalize();
             let n = Vec3::Y;
@@ -378,8 +523,26 @@ fn a_glass_teapot_packed_and_played_by_hybrid_rendering() {
     let scene = copy_sample("glass", dir.path());
     let pack = |name: &str, rep: &str| {
         let out = dir.path().join(name);
-        let r = run_json(env!("CARGO_BIN_EXE_pis-pack"), &[scene.as_os_str(), "-o".as_ref(), out.as_os_str(), "--representation".as_ref(), rep.as_ref(), "--codec".as_ref(), "lossless".as_ref(), "--json".as_ref()]);
-        let o = r["objects"].as_array().expect("objects").iter().find(|o| o["name"] == "GlassTeapot").expect("the glass teapot").clone();
+        let r = run_json(
+            env!("CARGO_BIN_EXE_pis-pack"),
+            &[
+                scene.as_os_str(),
+                "-o".as_ref(),
+                out.as_os_str(),
+                "--representation".as_ref(),
+                rep.as_ref(),
+                "--codec".as_ref(),
+                "lossless".as_ref(),
+                "--json".as_ref(),
+            ],
+        );
+        let o = r["objects"]
+            .as_array()
+            .expect("objects")
+            .iter()
+            .find(|o| o["name"] == "GlassTeapot")
+            .expect("the glass teapot")
+            .clone();
         (out, o)
     };
     let (tex, t) = pack("texture.pis", "texture");
@@ -388,44 +551,160 @@ fn a_glass_teapot_packed_and_played_by_hybrid_rendering() {
     assert_eq!(p["representation"], "hybrid rendering", "{}", p["why"]);
     assert_eq!(i["representation"], "hybrid rendering, one shell", "{}", i["why"]);
     let why = p["why"].as_str().expect("why");
-    assert!(why.contains("3 shell(s)") && why.contains("{SilverCup, Platform}") && why.contains("{Walls, Floor}"), "{why}");
-    eprintln!("as solved at the samples: textures {}, hybrid {}, one shell {} dB", t["psnr_db"], p["psnr_db"], i["psnr_db"]);
-    let v = std::process::Command::new(env!("CARGO_BIN_EXE_pis-inspect")).arg("--validate").arg(&pem).output().expect("pis-inspect runs");
+    assert!(
+        why.contains("3 shell(s)")
+            && why.contains("{SilverCup, Platform}")
+            && why.contains("{Walls, Floor}"),
+        "{why}"
+    );
+    eprintln!(
+        "as solved at the samples: textures {}, hybrid {}, one shell {} dB",
+        t["psnr_db"], p["psnr_db"], i["psnr_db"]
+    );
+    let v = std::process::Command::new(env!("CARGO_BIN_EXE_pis-inspect"))
+        .arg("--validate")
+        .arg(&pem)
+        .output()
+        .expect("pis-inspect runs");
     assert_eq!(v.status.code(), Some(0), "{}", String::from_utf8_lossy(&v.stdout));
-    let text = String::from_utf8_lossy(&std::process::Command::new(env!("CARGO_BIN_EXE_pis-inspect")).arg(&pem).output().expect("pis-inspect runs").stdout).into_owned();
-    assert!(text.contains("GlassTeapot (refractive)") && text.contains("env_shell") && text.contains("term refraction"), "{text}");
+    let text = String::from_utf8_lossy(
+        &std::process::Command::new(env!("CARGO_BIN_EXE_pis-inspect"))
+            .arg(&pem)
+            .output()
+            .expect("pis-inspect runs")
+            .stdout,
+    )
+    .into_owned();
+    assert!(
+        text.contains("GlassTeapot (refractive)")
+            && text.contains("env_shell")
+            && text.contains("term refraction"),
+        "{text}"
+    );
     // Both terms drawn per frame, from vertex rays traced per frame.
-    let play = run_json(env!("CARGO_BIN_EXE_pis-play"), &[pem.as_os_str(), "--headless".as_ref(), "--path".as_ref(), "diagonal".as_ref(), "--json".as_ref()]);
+    let play = run_json(
+        env!("CARGO_BIN_EXE_pis-play"),
+        &[
+            pem.as_os_str(),
+            "--headless".as_ref(),
+            "--path".as_ref(),
+            "diagonal".as_ref(),
+            "--json".as_ref(),
+        ],
+    );
     assert_eq!(play["lens_draws_mean"].as_f64(), Some(2.0), "{play}");
     assert!(play["lens_rays_mean"].as_f64().is_some_and(|r| r > 10_000.0), "{play}");
     // The same frame twice: the second draws the first's tessellation again (no ray traced)
     // and the same pixels.
-    let gpu = std::sync::Arc::new(pis_play::Gpu::new().expect("a Vulkan adapter (lavapipe: apt-get install -y mesa-vulkan-drivers)"));
-    let mut player = pis_play::Player::open(gpu, &pem, pis_play::PlayerOptions { msaa: 1, ..Default::default() }).expect("opens");
+    let gpu = std::sync::Arc::new(
+        pis_play::Gpu::new()
+            .expect("a Vulkan adapter (lavapipe: apt-get install -y mesa-vulkan-drivers)"),
+    );
+    let mut player = pis_play::Player::open(
+        gpu,
+        &pem,
+        pis_play::PlayerOptions { msaa: 1, ..Default::default() },
+    )
+    .expect("opens");
     let req = pis_play::FrameRequest { point: vec![8.0], camera: pis_play::CameraChoice::Sample };
     let (a, first) = player.render_image(&req, (160, 120)).expect("draws");
     let (b, second) = player.render_image(&req, (160, 120)).expect("draws again");
-    assert!(first.lens_rays > 10_000 && second.lens_rays == 0, "{} then {} rays", first.lens_rays, second.lens_rays);
-    assert!(a.rgba.iter().zip(&b.rgba).all(|(x, y)| x.to_bits() == y.to_bits()), "the same frame drawn twice differs");
+    assert!(
+        first.lens_rays > 10_000 && second.lens_rays == 0,
+        "{} then {} rays",
+        first.lens_rays,
+        second.lens_rays
+    );
+    assert!(
+        a.rgba.iter().zip(&b.rgba).all(|(x, y)| x.to_bits() == y.to_bits()),
+        "the same frame drawn twice differs"
+    );
     // The player against the traced set, single-sample as the prediction is: what pis-pack
     // predicted, within 0.3 dB.
-    let set = std::fs::read_dir(dir.path().join(".pis-cache")).expect("cache").next().expect("a traced set").expect("entry").path();
-    let d = std::process::Command::new(env!("CARGO_BIN_EXE_pis-diff")).arg(&pem).arg(&set).args(["--msaa", "1", "--max-psnr-drop", "0.3"]).output().expect("pis-diff runs");
-    assert!(d.status.success(), "{}{}", String::from_utf8_lossy(&d.stdout), String::from_utf8_lossy(&d.stderr));
+    let set = std::fs::read_dir(dir.path().join(".pis-cache"))
+        .expect("cache")
+        .next()
+        .expect("a traced set")
+        .expect("entry")
+        .path();
+    let d = std::process::Command::new(env!("CARGO_BIN_EXE_pis-diff"))
+        .arg(&pem)
+        .arg(&set)
+        .args(["--msaa", "1", "--max-psnr-drop", "0.3"])
+        .output()
+        .expect("pis-diff runs");
+    assert!(
+        d.status.success(),
+        "{}{}",
+        String::from_utf8_lossy(&d.stdout),
+        String::from_utf8_lossy(&d.stderr)
+    );
     // Table 6.1's whole frame: the file played at two τ on the bench's cameras.
-    let h = run_json(env!("CARGO_BIN_EXE_pis-bench"), &["hybrid".as_ref(), scene.as_os_str(), "--tau".as_ref(), "2,8".as_ref(), "--frames".as_ref(), "2".as_ref(), "--file".as_ref(), pem.as_os_str(), "--msaa".as_ref(), "1".as_ref(), "--json".as_ref()]);
+    let h = run_json(
+        env!("CARGO_BIN_EXE_pis-bench"),
+        &[
+            "hybrid".as_ref(),
+            scene.as_os_str(),
+            "--tau".as_ref(),
+            "2,8".as_ref(),
+            "--frames".as_ref(),
+            "2".as_ref(),
+            "--file".as_ref(),
+            pem.as_os_str(),
+            "--msaa".as_ref(),
+            "1".as_ref(),
+            "--json".as_ref(),
+        ],
+    );
     let played = h["played"].as_array().expect("played rows");
     assert_eq!(played.len(), 2, "{h}");
     let g = |r: &serde_json::Value, k: &str| r[k].as_f64().unwrap_or(f64::NAN);
     assert!(g(&played[0], "lens_rays") > g(&played[1], "lens_rays"), "{played:?}");
-    assert!(played.iter().all(|r| g(r, "draw_ms") > 0.0 && g(r, "frame_ms") >= g(r, "lens_ms")), "{played:?}");
+    assert!(
+        played.iter().all(|r| g(r, "draw_ms") > 0.0 && g(r, "frame_ms") >= g(r, "lens_ms")),
+        "{played:?}"
+    );
     // On and off the sampled views, against frames traced at each camera.
-    let b = run_json(env!("CARGO_BIN_EXE_pis-bench"), &["reflective".as_ref(), scene.as_os_str(), tex.as_os_str(), pem.as_os_str(), one.as_os_str(), "--role".as_ref(), "refractive".as_ref(), "--frames".as_ref(), "5".as_ref(), "--reference-spp".as_ref(), "4".as_ref(), "--json".as_ref(), "--out".as_ref(), dir.path().join("reports").as_os_str()]);
-    let summary = |file: &str, path: &str, key: &str| b["summaries"].as_array().expect("summaries").iter()
-        .find(|s| s["file"] == file && s["path"] == path).unwrap_or_else(|| panic!("{file} {path}"))[key].as_f64().expect("a figure");
+    let b = run_json(
+        env!("CARGO_BIN_EXE_pis-bench"),
+        &[
+            "reflective".as_ref(),
+            scene.as_os_str(),
+            tex.as_os_str(),
+            pem.as_os_str(),
+            one.as_os_str(),
+            "--role".as_ref(),
+            "refractive".as_ref(),
+            "--frames".as_ref(),
+            "5".as_ref(),
+            "--reference-spp".as_ref(),
+            "4".as_ref(),
+            "--json".as_ref(),
+            "--out".as_ref(),
+            dir.path().join("reports").as_os_str(),
+        ],
+    );
+    let summary = |file: &str, path: &str, key: &str| {
+        b["summaries"]
+            .as_array()
+            .expect("summaries")
+            .iter()
+            .find(|s| s["file"] == file && s["path"] == path)
+            .unwrap_or_else(|| panic!("{file} {path}"))[key]
+            .as_f64()
+            .expect("a figure")
+    };
     for path in ["samples", "between", "away"] {
-        let (t, h, o) = (summary("texture.pis", path, "min_psnr_db"), summary("pem.pis", path, "min_psnr_db"), summary("one.pis", path, "min_psnr_db"));
-        let (tm, hm, om) = (summary("texture.pis", path, "mean_psnr_db"), summary("pem.pis", path, "mean_psnr_db"), summary("one.pis", path, "mean_psnr_db"));
+        let (t, h, o) = (
+            summary("texture.pis", path, "min_psnr_db"),
+            summary("pem.pis", path, "min_psnr_db"),
+            summary("one.pis", path, "min_psnr_db"),
+        );
+        let (tm, hm, om) = (
+            summary("texture.pis", path, "mean_psnr_db"),
+            summary("pem.pis", path, "mean_psnr_db"),
+            summary("one.pis", path, "mean_psnr_db"),
+        );
         eprintln!("{path}: worst frame textures {t:.2}, hybrid {h:.2}, one shell {o:.2} dB; means {tm:.2}, {hm:.2}, {om:.2} dB");
         if path != "away" {
             assert!(h >= t + 3.0, "{path}: hybrid's worst frame {h:.2} dB, textures' {t:.2} dB");
@@ -443,16 +722,56 @@ fn a_tinted_glass_from_the_wild_plays_as_predicted() {
     let dir = tempfile::tempdir().expect("temp dir");
     let scene = copy_sample("wild/glass-shelf", dir.path());
     let file = dir.path().join("pem.pis");
-    let pack = run_json(env!("CARGO_BIN_EXE_pis-pack"), &[scene.as_os_str(), "-o".as_ref(), file.as_os_str(), "--representation".as_ref(), "pem".as_ref(), "--codec".as_ref(), "lossless".as_ref(), "--json".as_ref()]);
-    let inspect = String::from_utf8_lossy(&std::process::Command::new(env!("CARGO_BIN_EXE_pis-inspect")).arg(&file).output().expect("pis-inspect runs").stdout).into_owned();
+    let pack = run_json(
+        env!("CARGO_BIN_EXE_pis-pack"),
+        &[
+            scene.as_os_str(),
+            "-o".as_ref(),
+            file.as_os_str(),
+            "--representation".as_ref(),
+            "pem".as_ref(),
+            "--codec".as_ref(),
+            "lossless".as_ref(),
+            "--json".as_ref(),
+        ],
+    );
+    let inspect = String::from_utf8_lossy(
+        &std::process::Command::new(env!("CARGO_BIN_EXE_pis-inspect"))
+            .arg(&file)
+            .output()
+            .expect("pis-inspect runs")
+            .stdout,
+    )
+    .into_owned();
     assert!(inspect.contains("transmission_tint.Tumbler=0.7,0.9,0.75"), "{inspect}");
-    let set = std::fs::read_dir(dir.path().join(".pis-cache")).expect("cache").next().expect("a traced set").expect("entry").path();
-    let diff = run_json(env!("CARGO_BIN_EXE_pis-diff"), &[file.as_os_str(), set.as_os_str(), "--msaa".as_ref(), "1".as_ref(), "--json".as_ref()]);
+    let set = std::fs::read_dir(dir.path().join(".pis-cache"))
+        .expect("cache")
+        .next()
+        .expect("a traced set")
+        .expect("entry")
+        .path();
+    let diff = run_json(
+        env!("CARGO_BIN_EXE_pis-diff"),
+        &[file.as_os_str(), set.as_os_str(), "--msaa".as_ref(), "1".as_ref(), "--json".as_ref()],
+    );
     for name in ["GlassBall", "Tumbler"] {
-        let packed = pack["objects"].as_array().expect("objects").iter().find(|o| o["name"] == name).expect("packed object");
+        let packed = pack["objects"]
+            .as_array()
+            .expect("objects")
+            .iter()
+            .find(|o| o["name"] == name)
+            .expect("packed object");
         assert_eq!(packed["representation"], "hybrid rendering", "{name}: {}", packed["why"]);
-        let played = diff["objects"].as_array().expect("objects").iter().find(|o| o["name"] == name).expect("played object");
-        let (p, q) = (packed["psnr_db"].as_f64().expect("predicted"), played["psnr_db"].as_f64().expect("played"));
+        let played = diff["objects"]
+            .as_array()
+            .expect("objects")
+            .iter()
+            .find(|o| o["name"] == name)
+            .expect("played object");
+        let (p, q) = (
+            packed["psnr_db"].as_f64().expect("predicted"),
+            played["psnr_db"].as_f64().expect("played"),
+        );
         eprintln!("{name}: predicted {p:.2} dB, played {q:.2} dB");
         assert!((p - q).abs() < 0.1, "{name}: predicted {p:.2} dB, played {q:.2} dB");
     }

@@ -4,9 +4,7 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
 fn repo(rel: &str) -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("..")
-        .join(rel)
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("..").join(rel)
 }
 
 fn inspect(args: &[&str], file: &Path) -> Output {
@@ -84,13 +82,7 @@ fn json_has_the_documented_fields() {
 #[test]
 fn validate_accepts_the_sample() {
     let out = inspect(&["--validate"], &repo("samples/tiny.pis"));
-    assert_eq!(
-        out.status.code(),
-        Some(0),
-        "{}{}",
-        text(&out.stdout),
-        text(&out.stderr)
-    );
+    assert_eq!(out.status.code(), Some(0), "{}{}", text(&out.stdout), text(&out.stderr));
     let out = inspect(&["--validate", "--json"], &repo("samples/tiny.pis"));
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     assert_eq!(v["valid"], true);
@@ -107,11 +99,7 @@ fn validate_reports_numbered_errors_and_exits_3() {
     std::fs::write(&path, &bad).unwrap();
     let out = inspect(&["--validate"], &path);
     assert_eq!(out.status.code(), Some(3));
-    assert!(
-        text(&out.stdout).contains("error-3004"),
-        "{}",
-        text(&out.stdout)
-    );
+    assert!(text(&out.stdout).contains("error-3004"), "{}", text(&out.stdout));
     // Truncated: a clear message, exit 3, for the summary too.
     let path = dir.path().join("truncated.pis");
     std::fs::write(&path, &good[..good.len() / 2]).unwrap();
@@ -127,21 +115,10 @@ fn chunks_lists_offsets_and_checksums() {
     let out = inspect(&["--chunks", "--json"], &repo("samples/tiny.pis"));
     assert_eq!(out.status.code(), Some(0));
     let rows: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
-    let types: Vec<&str> = rows
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|r| r["type"].as_str().unwrap())
-        .collect();
-    assert_eq!(
-        types,
-        ["PSPC", "CAMS", "OBJS", "MESH", "LAYR", "CSTR", "PROV"]
-    );
-    assert!(rows
-        .as_array()
-        .unwrap()
-        .iter()
-        .all(|r| r["checksum"] == "ok"));
+    let types: Vec<&str> =
+        rows.as_array().unwrap().iter().map(|r| r["type"].as_str().unwrap()).collect();
+    assert_eq!(types, ["PSPC", "CAMS", "OBJS", "MESH", "LAYR", "CSTR", "PROV"]);
+    assert!(rows.as_array().unwrap().iter().all(|r| r["checksum"] == "ok"));
 }
 
 #[test]
@@ -190,13 +167,25 @@ fn extract_leaves_nothing_when_a_texture_fails() {
     bytes[4160 + 855 - 1] ^= 0xff;
     std::fs::write(&bad, &bytes).unwrap();
     let out_dir = dir.path().join("textures");
-    let out = Command::new(env!("CARGO_BIN_EXE_pis-inspect")).args(["--extract"]).arg(&out_dir).args(["--at", "5,0.9"]).arg(&bad).output().unwrap();
+    let out = Command::new(env!("CARGO_BIN_EXE_pis-inspect"))
+        .args(["--extract"])
+        .arg(&out_dir)
+        .args(["--at", "5,0.9"])
+        .arg(&bad)
+        .output()
+        .unwrap();
     assert_eq!(out.status.code(), Some(3), "{}", text(&out.stderr));
     assert!(text(&out.stderr).contains("error-8003"), "{}", text(&out.stderr));
     assert!(!out_dir.exists(), "no folder, no partial textures");
     // into a folder that exists: it stays, empty
     std::fs::create_dir(&out_dir).unwrap();
-    let out = Command::new(env!("CARGO_BIN_EXE_pis-inspect")).args(["--extract"]).arg(&out_dir).args(["--at", "5,0.9"]).arg(&bad).output().unwrap();
+    let out = Command::new(env!("CARGO_BIN_EXE_pis-inspect"))
+        .args(["--extract"])
+        .arg(&out_dir)
+        .args(["--at", "5,0.9"])
+        .arg(&bad)
+        .output()
+        .unwrap();
     assert_eq!(out.status.code(), Some(3));
     assert_eq!(std::fs::read_dir(&out_dir).unwrap().count(), 0, "no partial textures");
 }
@@ -217,9 +206,6 @@ fn missing_file_is_an_io_error() {
     let out = inspect(&[], Path::new("/no/such.pis"));
     assert_eq!(out.status.code(), Some(2));
     assert!(text(&out.stderr).contains("/no/such.pis"));
-    let out = Command::new(env!("CARGO_BIN_EXE_pis-inspect"))
-        .arg("--bogus")
-        .output()
-        .unwrap();
+    let out = Command::new(env!("CARGO_BIN_EXE_pis-inspect")).arg("--bogus").output().unwrap();
     assert_eq!(out.status.code(), Some(1));
 }

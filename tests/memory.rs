@@ -22,12 +22,18 @@ fn ok(program: &str, args: &[&str]) -> Output {
 }
 
 fn report(out: &Output) -> Value {
-    serde_json::from_slice(&out.stdout).unwrap_or_else(|e| panic!("JSON report: {e}: {}", String::from_utf8_lossy(&out.stdout)))
+    serde_json::from_slice(&out.stdout)
+        .unwrap_or_else(|e| panic!("JSON report: {e}: {}", String::from_utf8_lossy(&out.stdout)))
 }
 
 /// Files in `dir` whose names say they are scratch files.
 fn scratch_files(dir: &Path) -> Vec<String> {
-    std::fs::read_dir(dir).unwrap().filter_map(Result::ok).map(|e| e.file_name().to_string_lossy().into_owned()).filter(|n| n.contains(".scratch")).collect()
+    std::fs::read_dir(dir)
+        .unwrap()
+        .filter_map(Result::ok)
+        .map(|e| e.file_name().to_string_lossy().into_owned())
+        .filter(|n| n.contains(".scratch"))
+        .collect()
 }
 
 /// Packs `set` into `dir/NAME-held.pis` and, streamed under a budget far below what it
@@ -44,10 +50,18 @@ fn held_and_streamed(dir: &Path, set: &str, name: &str, flags: &[&str]) {
     let s = report(&ok(PACK, &args));
     assert_eq!(s["memory"]["streamed"], true, "{name}: {}", s["memory"]);
     assert_eq!(s["memory"]["budget_asked"], true);
-    assert!(s["memory"]["scratch_bytes"].as_u64().unwrap() > 0, "{name}: the images went to the scratch file");
+    assert!(
+        s["memory"]["scratch_bytes"].as_u64().unwrap() > 0,
+        "{name}: the images went to the scratch file"
+    );
     assert!(s["memory"]["why"].as_str().unwrap().starts_with("streamed"));
     let (a, b) = (std::fs::read(&held).unwrap(), std::fs::read(&streamed).unwrap());
-    assert!(a == b, "{name} {flags:?}: the streamed pack wrote other bytes ({} against {})", b.len(), a.len());
+    assert!(
+        a == b,
+        "{name} {flags:?}: the streamed pack wrote other bytes ({} against {})",
+        b.len(),
+        a.len()
+    );
     assert_eq!(r["psnr_db"], s["psnr_db"]);
     assert_eq!(scratch_files(dir), Vec::<String>::new(), "{name}: the scratch file is removed");
 }
@@ -57,26 +71,46 @@ fn a_streamed_pack_writes_the_bytes_of_a_pack_in_memory() {
     let dir = tempfile::tempdir().unwrap();
     // demo1 at 64×48 over 4 × 4 points, blocks of 2 samples: several texture placements
     // per object, each with its own render matrices.
-    let scene = demo1_copy(&dir.path().join("demo1"), &[("resolution = [160, 120]", "resolution = [64, 48]"), ("spp = 4", "spp = 1")]);
+    let scene = demo1_copy(
+        &dir.path().join("demo1"),
+        &[("resolution = [160, 120]", "resolution = [64, 48]"), ("spp = 4", "spp = 1")],
+    );
     let set = dir.path().join("demo1-set");
     ok(TRACE, &[scene.to_str().unwrap(), "-o", set.to_str().unwrap()]);
     let set = set.to_str().unwrap();
     held_and_streamed(dir.path(), set, "demo1", &["--block", "2"]);
-    held_and_streamed(dir.path(), set, "demo1-lossless", &["--block", "2", "--codec", "lossless", "--keep-master"]);
+    held_and_streamed(
+        dir.path(),
+        set,
+        "demo1-lossless",
+        &["--block", "2", "--codec", "lossless", "--keep-master"],
+    );
     // Environment-map shells and hybrid rendering under `auto` (demo1's vase and glass
     // cup), each against its surface textures.
-    held_and_streamed(dir.path(), set, "demo1-auto", &["--representation", "auto", "--ratio", "100"]);
+    held_and_streamed(
+        dir.path(),
+        set,
+        "demo1-auto",
+        &["--representation", "auto", "--ratio", "100"],
+    );
 }
 
 #[test]
 fn a_streamed_pack_that_fails_leaves_no_file() {
     let dir = tempfile::tempdir().unwrap();
-    let scene = demo1_copy(&dir.path().join("demo1"), &[("resolution = [160, 120]", "resolution = [32, 24]"), ("spp = 4", "spp = 1")]);
+    let scene = demo1_copy(
+        &dir.path().join("demo1"),
+        &[("resolution = [160, 120]", "resolution = [32, 24]"), ("spp = 4", "spp = 1")],
+    );
     let set = dir.path().join("set");
     ok(TRACE, &[scene.to_str().unwrap(), "-o", set.to_str().unwrap()]);
     let out = dir.path().join("out.pis");
     // A PSNR no coding reaches fails at the allocation, after the set was streamed.
-    let args: Vec<&std::ffi::OsStr> = [set.to_str().unwrap(), "-o", out.to_str().unwrap(), "--psnr", "200", "--memory", "0.0001"].into_iter().map(os).collect();
+    let args: Vec<&std::ffi::OsStr> =
+        [set.to_str().unwrap(), "-o", out.to_str().unwrap(), "--psnr", "200", "--memory", "0.0001"]
+            .into_iter()
+            .map(os)
+            .collect();
     let failed = run(PACK, &args, &[]);
     assert!(!failed.status.success());
     let err = String::from_utf8_lossy(&failed.stderr);
@@ -84,8 +118,17 @@ fn a_streamed_pack_that_fails_leaves_no_file() {
     assert!(!out.exists(), "no output on failure");
     assert_eq!(scratch_files(dir.path()), Vec::<String>::new(), "no scratch file on failure");
     // A budget that is not a size is refused before any work.
-    let bad: Vec<&std::ffi::OsStr> = [set.to_str().unwrap(), "-o", out.to_str().unwrap(), "--memory", "0"].into_iter().map(os).collect();
+    let bad: Vec<&std::ffi::OsStr> =
+        [set.to_str().unwrap(), "-o", out.to_str().unwrap(), "--memory", "0"]
+            .into_iter()
+            .map(os)
+            .collect();
     let refused = run(PACK, &bad, &[]);
-    assert_eq!(refused.status.code(), Some(1), "a usage error: {}", String::from_utf8_lossy(&refused.stderr));
+    assert_eq!(
+        refused.status.code(),
+        Some(1),
+        "a usage error: {}",
+        String::from_utf8_lossy(&refused.stderr)
+    );
     assert!(String::from_utf8_lossy(&refused.stderr).contains("memory budget"));
 }

@@ -48,7 +48,8 @@ impl Rng {
 }
 
 /// Values that make fields interesting: zero, one, signs, powers of two, the extremes.
-const EXTREMES: [u64; 10] = [0, 1, 2, 0x7f, 0xff, 0xffff, 0x7fff_ffff, 0x8000_0000, 0xffff_ffff, u64::MAX];
+const EXTREMES: [u64; 10] =
+    [0, 1, 2, 0x7f, 0xff, 0xffff, 0x7fff_ffff, 0x8000_0000, 0xffff_ffff, u64::MAX];
 
 /// One mutant of `good`.
 fn mutate(rng: &mut Rng, good: &[u8]) -> Vec<u8> {
@@ -67,8 +68,10 @@ fn mutate(rng: &mut Rng, good: &[u8]) -> Vec<u8> {
         // A 4- or 8-byte field set to an extreme value.
         1 | 2 => {
             let width = if rng.below(2) == 0 { 4 } else { 8 };
-            let at = payload_start + rng.below((b.len() - payload_start).saturating_sub(width)) / 4 * 4;
-            let v = EXTREMES[rng.below(EXTREMES.len())] ^ if rng.below(4) == 0 { rng.next() & 0xff } else { 0 };
+            let at =
+                payload_start + rng.below((b.len() - payload_start).saturating_sub(width)) / 4 * 4;
+            let v = EXTREMES[rng.below(EXTREMES.len())]
+                ^ if rng.below(4) == 0 { rng.next() & 0xff } else { 0 };
             if at + width <= b.len() {
                 b[at..at + width].copy_from_slice(&v.to_le_bytes()[..width]);
             }
@@ -97,7 +100,8 @@ fn mutate(rng: &mut Rng, good: &[u8]) -> Vec<u8> {
         // A chunk-table entry's offset or length moved by a little or a lot.
         _ => {
             let count = u32::from_le_bytes(b[24..28].try_into().unwrap()) as usize;
-            let e = (HEADER_LEN + rng.below(count) as u64 * ENTRY_LEN) as usize + if rng.below(2) == 0 { 8 } else { 16 };
+            let e = (HEADER_LEN + rng.below(count) as u64 * ENTRY_LEN) as usize
+                + if rng.below(2) == 0 { 8 } else { 16 };
             let v = u64::from_le_bytes(b[e..e + 8].try_into().unwrap());
             let d = [1u64, 7, 8, 4096, 1 << 40][rng.below(5)];
             let v = if rng.below(2) == 0 { v.wrapping_add(d) } else { v.wrapping_sub(d) };
@@ -136,11 +140,25 @@ fn exercise(file: &Path, original: &Path, scratch: &Path, gpu: &Arc<Gpu>) {
     });
     let _ = std::fs::remove_file(&out);
     // pis-diff against the file it came from.
-    let _ = pis_eval::diff::files::diff(&DiffRequest { a: original.to_path_buf(), b: file.to_path_buf(), heatmaps: None, min_psnr: None });
+    let _ = pis_eval::diff::files::diff(&DiffRequest {
+        a: original.to_path_buf(),
+        b: file.to_path_buf(),
+        heatmaps: None,
+        min_psnr: None,
+    });
     // pis-play: two frames along the diagonal.
     let options = PlayerOptions { workers: 1, ..PlayerOptions::default() };
     if let Ok(mut player) = Player::open(gpu.clone(), file, options.clone()) {
-        let req = HeadlessRequest { file: file.to_path_buf(), at: None, path: Some(PathChoice::Diagonal), frames: Some(2), out: None, size: None, quiet: true, options };
+        let req = HeadlessRequest {
+            file: file.to_path_buf(),
+            at: None,
+            path: Some(PathChoice::Diagonal),
+            frames: Some(2),
+            out: None,
+            size: None,
+            quiet: true,
+            options,
+        };
         let _ = run_frames(&req, gpu, &mut player);
     }
 }
@@ -148,7 +166,11 @@ fn exercise(file: &Path, original: &Path, scratch: &Path, gpu: &Arc<Gpu>) {
 /// Peak resident memory of this process (VmHWM), in bytes.
 fn peak_rss() -> u64 {
     let status = std::fs::read_to_string("/proc/self/status").unwrap_or_default();
-    status.lines().find_map(|l| l.strip_prefix("VmHWM:")).and_then(|v| v.trim().trim_end_matches("kB").trim().parse::<u64>().ok()).map_or(0, |kb| kb * 1024)
+    status
+        .lines()
+        .find_map(|l| l.strip_prefix("VmHWM:"))
+        .and_then(|v| v.trim().trim_end_matches("kB").trim().parse::<u64>().ok())
+        .map_or(0, |kb| kb * 1024)
 }
 
 /// The valid files the mutants start from: the bundled sample (surface layers and a shell),
@@ -157,10 +179,24 @@ fn peak_rss() -> u64 {
 fn seeds(dir: &Path) -> Vec<PathBuf> {
     let tiny = repo("samples/tiny.pis");
     let mut out = vec![tiny.clone(), repo("format-spec/examples/minimal.pis")];
-    for (name, codec, keep_master) in [("wavelet", CodecId::Wavelet, false), ("dct", CodecId::Dct, false), ("master", CodecId::Lossless, true)] {
+    for (name, codec, keep_master) in [
+        ("wavelet", CodecId::Wavelet, false),
+        ("dct", CodecId::Dct, false),
+        ("master", CodecId::Lossless, true),
+    ] {
         let path = dir.join(format!("seed-{name}.pis"));
-        pis_eval::reencode::reencode(&ReencodeRequest { input: tiny.clone(), output: path.clone(), codec, ratio: (codec != CodecId::Lossless).then_some(6.0), psnr: None, gamma: None, keep_master, block: None, max_mse: None })
-            .unwrap_or_else(|e| panic!("seed {name}: {}", e.error));
+        pis_eval::reencode::reencode(&ReencodeRequest {
+            input: tiny.clone(),
+            output: path.clone(),
+            codec,
+            ratio: (codec != CodecId::Lossless).then_some(6.0),
+            psnr: None,
+            gamma: None,
+            keep_master,
+            block: None,
+            max_mse: None,
+        })
+        .unwrap_or_else(|e| panic!("seed {name}: {}", e.error));
         out.push(path);
     }
     out

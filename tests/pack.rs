@@ -19,18 +19,30 @@ fn set() -> &'static Path {
     &SET.get_or_init(|| {
         let dir = common::fixture_tempdir();
         let out = Command::new(env!("CARGO_BIN_EXE_pis-trace"))
-            .arg(demo1()).arg("-o").arg(dir.path().join("set"))
-            .args(["--resolution", "64x48", "--spp", "2"]).output().expect("pis-trace runs");
+            .arg(demo1())
+            .arg("-o")
+            .arg(dir.path().join("set"))
+            .args(["--resolution", "64x48", "--spp", "2"])
+            .output()
+            .expect("pis-trace runs");
         assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
         let path = dir.path().join("set");
         (dir, path)
-    }).1
+    })
+    .1
 }
 
 fn pack(set: &Path, out: &Path, args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_pis-pack"))
-        .arg(set).arg("--scene").arg(demo1()).arg("-o").arg(out).args(args).arg("--json")
-        .output().expect("pis-pack runs")
+        .arg(set)
+        .arg("--scene")
+        .arg(demo1())
+        .arg("-o")
+        .arg(out)
+        .args(args)
+        .arg("--json")
+        .output()
+        .expect("pis-pack runs")
 }
 
 fn json(out: &Output) -> serde_json::Value {
@@ -39,8 +51,18 @@ fn json(out: &Output) -> serde_json::Value {
 }
 
 fn validate(file: &Path) {
-    let out = Command::new(env!("CARGO_BIN_EXE_pis-inspect")).arg("--validate").arg(file).output().expect("pis-inspect runs");
-    assert_eq!(out.status.code(), Some(0), "{}{}", String::from_utf8_lossy(&out.stdout), String::from_utf8_lossy(&out.stderr));
+    let out = Command::new(env!("CARGO_BIN_EXE_pis-inspect"))
+        .arg("--validate")
+        .arg(file)
+        .output()
+        .expect("pis-inspect runs");
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}{}",
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr)
+    );
 }
 
 /// Measured at 64×48, 2 spp, --ratio 24: wavelet 24.25 dB, dct 23.92 dB (solved 25.63 dB).
@@ -84,7 +106,10 @@ fn pack_lossless_round_trips_the_solved_textures() {
     validate(&file);
     assert_eq!(r["lossless_exact"], serde_json::Value::Bool(true), "{r}");
     assert_eq!(r["max_texel_error"].as_f64(), Some(0.0));
-    assert!((r["psnr_db"].as_f64().unwrap_or(0.0) - r["psnr_db_solved"].as_f64().unwrap_or(1.0)).abs() < 1e-9);
+    assert!(
+        (r["psnr_db"].as_f64().unwrap_or(0.0) - r["psnr_db_solved"].as_f64().unwrap_or(1.0)).abs()
+            < 1e-9
+    );
 }
 
 #[test]
@@ -103,11 +128,18 @@ fn keep_master_stores_the_solved_textures_beside_unchanged_level_images() {
     let raw = b["raw_image_bytes"].as_f64().expect("raw");
     assert!((b["ratio"].as_f64().expect("ratio") - raw / (bytes - master) as f64).abs() < 1e-9);
     assert_eq!((&a["texture_bytes"], &a["psnr_db"]), (&b["texture_bytes"], &b["psnr_db"]));
-    let (x, y) = (pis_format::PisReader::open(&plain).expect("plain"), pis_format::PisReader::open(&kept).expect("kept"));
+    let (x, y) = (
+        pis_format::PisReader::open(&plain).expect("plain"),
+        pis_format::PisReader::open(&kept).expect("kept"),
+    );
     assert_eq!(x.load_all().expect("plain").objects, y.load_all().expect("kept").objects);
     assert!(!x.has_master() && y.has_master() && y.master_bytes() == master);
     // pis-inspect counts the master apart.
-    let out = Command::new(env!("CARGO_BIN_EXE_pis-inspect")).arg(&kept).arg("--json").output().expect("pis-inspect runs");
+    let out = Command::new(env!("CARGO_BIN_EXE_pis-inspect"))
+        .arg(&kept)
+        .arg("--json")
+        .output()
+        .expect("pis-inspect runs");
     let i: serde_json::Value = serde_json::from_slice(&out.stdout).expect("JSON");
     assert_eq!(i["bytes"]["master"].as_u64(), Some(master));
     assert!((i["ratio"].as_f64().expect("ratio") - raw / (bytes - master) as f64).abs() < 1e-9);
@@ -130,36 +162,53 @@ fn fails_without_output(damage: impl Fn(&Path), code: i32, message: &str) {
     assert_eq!(out.status.code(), Some(code), "{err}");
     assert!(err.contains(message), "{err}");
     assert!(!file.exists(), "partial output left behind");
-    let leftovers: Vec<_> = std::fs::read_dir(dir.path()).expect("dir").filter_map(Result::ok)
-        .filter(|e| e.file_name() != "set").collect();
+    let leftovers: Vec<_> = std::fs::read_dir(dir.path())
+        .expect("dir")
+        .filter_map(Result::ok)
+        .filter(|e| e.file_name() != "set")
+        .collect();
     assert!(leftovers.is_empty(), "files left: {leftovers:?}");
 }
 
 #[test]
 fn missing_exr_is_an_error_without_output() {
-    fails_without_output(|d| std::fs::remove_file(d.join("point_00003.exr")).expect("rm"), 2, "point_00003.exr");
+    fails_without_output(
+        |d| std::fs::remove_file(d.join("point_00003.exr")).expect("rm"),
+        2,
+        "point_00003.exr",
+    );
 }
 
 #[test]
 fn mismatched_resolution_is_an_error_without_output() {
-    fails_without_output(|d| {
-        let p = d.join("set.json");
-        let mut v: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&p).expect("set.json")).expect("JSON");
-        v["resolution"][0] = 65.into();
-        std::fs::write(&p, v.to_string()).expect("write");
-    }, 3, "65x48");
+    fails_without_output(
+        |d| {
+            let p = d.join("set.json");
+            let mut v: serde_json::Value =
+                serde_json::from_str(&std::fs::read_to_string(&p).expect("set.json"))
+                    .expect("JSON");
+            v["resolution"][0] = 65.into();
+            std::fs::write(&p, v.to_string()).expect("write");
+        },
+        3,
+        "65x48",
+    );
 }
 
 #[test]
 fn nan_pixels_are_an_error_without_output() {
-    fails_without_output(|d| {
-        let set = RaySet::open(d).expect("set");
-        let mut img = set.read_point(5).expect("point");
-        img.layers[0].planes[0][10] = f32::NAN;
-        let path = d.join("point_00005.exr");
-        let bytes = pis_trace::set::encode_exr(&img, &path).expect("encode");
-        std::fs::write(&path, bytes).expect("write");
-    }, 3, "NaN");
+    fails_without_output(
+        |d| {
+            let set = RaySet::open(d).expect("set");
+            let mut img = set.read_point(5).expect("point");
+            img.layers[0].planes[0][10] = f32::NAN;
+            let path = d.join("point_00005.exr");
+            let bytes = pis_trace::set::encode_exr(&img, &path).expect("encode");
+            std::fs::write(&path, bytes).expect("write");
+        },
+        3,
+        "NaN",
+    );
 }
 
 #[test]
@@ -178,16 +227,21 @@ fn scene_toml_is_traced_into_a_cache_beside_it() {
     let scene_dir = dir.path().join("demo1");
     std::fs::create_dir(&scene_dir).expect("mkdir");
     let src = demo1();
-    for e in std::fs::read_dir(src.parent().expect("scene dir")).expect("demo1").filter_map(Result::ok) {
+    for e in
+        std::fs::read_dir(src.parent().expect("scene dir")).expect("demo1").filter_map(Result::ok)
+    {
         if e.path().is_file() {
             std::fs::copy(e.path(), scene_dir.join(e.file_name())).expect("copy");
         }
     }
     let file = dir.path().join("demo1.pis");
     let out = Command::new(env!("CARGO_BIN_EXE_pis-pack"))
-        .arg(scene_dir.join("scene.toml")).arg("-o").arg(&file)
+        .arg(scene_dir.join("scene.toml"))
+        .arg("-o")
+        .arg(&file)
         .args(["--resolution", "32x24", "--spp", "1", "--codec", "dct", "--ratio", "12", "--json"])
-        .output().expect("pis-pack runs");
+        .output()
+        .expect("pis-pack runs");
     let r = json(&out);
     validate(&file);
     assert!(scene_dir.join(".pis-cache/demo1-32x24-spp1/set.json").is_file());
@@ -197,10 +251,20 @@ fn scene_toml_is_traced_into_a_cache_beside_it() {
 #[test]
 fn the_texel_budget_shrinks_textures_over_budget_and_reports_it() {
     let dir = tempfile::tempdir().expect("temp dir");
-    let free = json(&pack(set(), &dir.path().join("free.pis"), &["--codec", "lossless", "--texels-per-pixel", "none"]));
-    let budget = json(&pack(set(), &dir.path().join("budget.pis"), &["--codec", "lossless", "--texels-per-pixel", "1"]));
+    let free = json(&pack(
+        set(),
+        &dir.path().join("free.pis"),
+        &["--codec", "lossless", "--texels-per-pixel", "none"],
+    ));
+    let budget = json(&pack(
+        set(),
+        &dir.path().join("budget.pis"),
+        &["--codec", "lossless", "--texels-per-pixel", "1"],
+    ));
     let objects = |r: &serde_json::Value| r["objects"].as_array().expect("objects").clone();
-    let texels = |o: &serde_json::Value| o["texture"][0].as_u64().unwrap() * o["texture"][1].as_u64().unwrap();
+    let texels = |o: &serde_json::Value| {
+        o["texture"][0].as_u64().unwrap() * o["texture"][1].as_u64().unwrap()
+    };
     let (free, budget) = (objects(&free), objects(&budget));
     assert_eq!(free.len(), budget.len());
     let mut reduced = 0;
@@ -221,7 +285,11 @@ fn the_texel_budget_shrinks_textures_over_budget_and_reports_it() {
     // optimal resolution of thesis 3.2
     assert!(reduced >= 3, "{reduced} objects reduced: {budget:?}");
     // a budget of zero is refused
-    let out = pack(set(), &dir.path().join("bad.pis"), &["--codec", "lossless", "--texels-per-pixel", "0"]);
+    let out = pack(
+        set(),
+        &dir.path().join("bad.pis"),
+        &["--codec", "lossless", "--texels-per-pixel", "0"],
+    );
     assert_eq!(out.status.code(), Some(1), "{}", String::from_utf8_lossy(&out.stderr));
     assert!(!dir.path().join("bad.pis").exists());
 }
@@ -229,15 +297,19 @@ fn the_texel_budget_shrinks_textures_over_budget_and_reports_it() {
 /// Distinct (size, placement) pairs over the blocks of each surface layer of `file`.
 fn placements_per_layer(file: &Path) -> Vec<usize> {
     let c = pis_format::PisReader::open(file).expect("open").load_all().expect("load");
-    c.objects.iter().flat_map(|o| &o.layers).map(|l| {
-        let mut seen: Vec<(u32, u32, pis_format::Placement)> = Vec::new();
-        for b in &l.blocks {
-            if !seen.contains(&(b.width, b.height, b.placement)) {
-                seen.push((b.width, b.height, b.placement));
+    c.objects
+        .iter()
+        .flat_map(|o| &o.layers)
+        .map(|l| {
+            let mut seen: Vec<(u32, u32, pis_format::Placement)> = Vec::new();
+            for b in &l.blocks {
+                if !seen.contains(&(b.width, b.height, b.placement)) {
+                    seen.push((b.width, b.height, b.placement));
+                }
             }
-        }
-        seen.len()
-    }).collect()
+            seen.len()
+        })
+        .collect()
 }
 
 #[test]
@@ -246,14 +318,27 @@ fn texture_coordinates_are_placed_per_parameter_block() {
     // One sample per block: every view-dependent block is placed for its own view.
     let (blocks, object) = (dir.path().join("block.pis"), dir.path().join("object.pis"));
     let b = json(&pack(set(), &blocks, &["--codec", "lossless", "--block", "1"]));
-    let o = json(&pack(set(), &object, &["--codec", "lossless", "--block", "1", "--placement", "object"]));
+    let o = json(&pack(
+        set(),
+        &object,
+        &["--codec", "lossless", "--block", "1", "--placement", "object"],
+    ));
     validate(&blocks);
     validate(&object);
     assert_eq!(b["lossless_exact"], serde_json::Value::Bool(true), "{b}");
     let counts = |r: &serde_json::Value| -> Vec<usize> {
-        r["objects"].as_array().expect("objects").iter().map(|o| o["placements"].as_array().expect("placements").len()).collect()
+        r["objects"]
+            .as_array()
+            .expect("objects")
+            .iter()
+            .map(|o| o["placements"].as_array().expect("placements").len())
+            .collect()
     };
-    assert!(counts(&b).iter().any(|&n| n > 1), "some object's views differ enough for its blocks to differ: {:?}", counts(&b));
+    assert!(
+        counts(&b).iter().any(|&n| n > 1),
+        "some object's views differ enough for its blocks to differ: {:?}",
+        counts(&b)
+    );
     assert!(placements_per_layer(&blocks).iter().any(|&n| n > 1));
     // --placement object: one placement per object, every block carries it.
     assert!(counts(&o).iter().all(|&n| n == 1), "{:?}", counts(&o));
@@ -277,7 +362,10 @@ fn pack_degrades_monotonically_with_the_ratio() {
         let r = json(&pack(set(), &file, &["--ratio", &ratio.to_string()]));
         let psnr = r["psnr_db"].as_f64().expect("psnr_db");
         if let Some((prev_ratio, prev)) = last {
-            assert!(psnr <= prev, "{ratio}:1 predicts {psnr:.3} dB, above {prev:.3} dB at {prev_ratio}:1");
+            assert!(
+                psnr <= prev,
+                "{ratio}:1 predicts {psnr:.3} dB, above {prev:.3} dB at {prev_ratio}:1"
+            );
         }
         last = Some((ratio, psnr));
     }
@@ -295,7 +383,8 @@ fn pack_refuses_a_ratio_that_leaves_no_byte_and_names_the_highest() {
     assert!(!file.exists(), "no file on error");
     let out = pack(set(), &file, &["--psnr", "400"]);
     assert_eq!(out.status.code(), Some(1), "{}", String::from_utf8_lossy(&out.stderr));
-    assert!(String::from_utf8_lossy(&out.stderr).contains("out of reach: the stored textures reach at most"));
+    assert!(String::from_utf8_lossy(&out.stderr)
+        .contains("out of reach: the stored textures reach at most"));
     assert!(!file.exists(), "no file on error");
 }
 
@@ -310,24 +399,41 @@ fn auto_max_mse_keeps_the_better_of_the_constraint_and_the_free_allocation() {
     for ratio in ["96", "384", "1536"] {
         let mut db = Vec::new();
         for mode in ["off", "1.25", "auto"] {
-            let r = json(&pack(set(), &dir.path().join(format!("{ratio}-{mode}.pis")), &["--ratio", ratio, "--max-mse-ratio", mode]));
+            let r = json(&pack(
+                set(),
+                &dir.path().join(format!("{ratio}-{mode}.pis")),
+                &["--ratio", ratio, "--max-mse-ratio", mode],
+            ));
             db.push(r["psnr_db"].as_f64().expect("psnr_db"));
             let applied = r["max_mse_ratio"].as_str().expect("max_mse_ratio").to_string();
             match mode {
                 "auto" => {
                     kept.push(applied.clone());
                     if let Some(both) = r["max_mse_psnr_db"].as_object() {
-                        let (c, f) = (both["constrained"].as_f64().expect("constrained"), both["free"].as_f64().expect("free"));
+                        let (c, f) = (
+                            both["constrained"].as_f64().expect("constrained"),
+                            both["free"].as_f64().expect("free"),
+                        );
                         assert_eq!((c, f), (db[1], db[0]), "{ratio}:1 {r}");
                         assert_eq!(applied, if c >= f { "1.25" } else { "off" }, "{ratio}:1 {r}");
                     } else {
-                        assert_eq!(db[0], db[1], "{ratio}:1: the constraint changed nothing, so both agree");
+                        assert_eq!(
+                            db[0], db[1],
+                            "{ratio}:1: the constraint changed nothing, so both agree"
+                        );
                     }
                 }
                 _ => assert_eq!(applied, mode),
             }
         }
-        assert_eq!(db[2], db[0].max(db[1]), "{ratio}:1: auto {:.3} dB, off {:.3}, 1.25 {:.3}", db[2], db[0], db[1]);
+        assert_eq!(
+            db[2],
+            db[0].max(db[1]),
+            "{ratio}:1: auto {:.3} dB, off {:.3}, 1.25 {:.3}",
+            db[2],
+            db[0],
+            db[1]
+        );
     }
     println!("auto kept {kept:?}");
 }
@@ -347,15 +453,29 @@ const DEMO1_CI_PACK: (usize, u32) = (195_789, 0x3041_3b31);
 #[test]
 fn pack_output_is_byte_identical_to_the_recorded_checksum() {
     let dir = tempfile::tempdir().expect("temp dir");
-    let out = Command::new(env!("CARGO_BIN_EXE_pis-trace")).arg(demo1()).args(["-o", "set"]).current_dir(dir.path()).output().expect("pis-trace runs");
+    let out = Command::new(env!("CARGO_BIN_EXE_pis-trace"))
+        .arg(demo1())
+        .args(["-o", "set"])
+        .current_dir(dir.path())
+        .output()
+        .expect("pis-trace runs");
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     // Relative paths: the provenance records the input as given.
-    let out = Command::new(env!("CARGO_BIN_EXE_pis-pack")).args(["set", "--scene"]).arg(demo1()).args(["-o", "out.pis"])
-        .current_dir(dir.path()).output().expect("pis-pack runs");
+    let out = Command::new(env!("CARGO_BIN_EXE_pis-pack"))
+        .args(["set", "--scene"])
+        .arg(demo1())
+        .args(["-o", "out.pis"])
+        .current_dir(dir.path())
+        .output()
+        .expect("pis-pack runs");
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     let bytes = std::fs::read(dir.path().join("out.pis")).expect("the packed file");
     let got = (bytes.len(), crc32fast::hash(&bytes));
-    assert_eq!(got, DEMO1_CI_PACK, "pis-pack's output changed: {} bytes, CRC-32 {:#010x}", got.0, got.1);
+    assert_eq!(
+        got, DEMO1_CI_PACK,
+        "pis-pack's output changed: {} bytes, CRC-32 {:#010x}",
+        got.0, got.1
+    );
 }
 
 /// Any scaled node once made pis-pack fail after the whole solve with "error-5106:
@@ -369,11 +489,17 @@ fn scaled_and_mirrored_nodes_pack_into_a_valid_file() {
         common::set_node(doc, "Columns", "scale", serde_json::json!([1.0, 0.5, 1.0]));
     });
     let file = dir.path().join("scaled.pis");
-    let out = Command::new(env!("CARGO_BIN_EXE_pis-pack")).arg(&scene).arg("-o").arg(&file)
-        .args(["--resolution", "48x36", "--spp", "1", "--ratio", "24", "--json"]).output().expect("pis-pack runs");
+    let out = Command::new(env!("CARGO_BIN_EXE_pis-pack"))
+        .arg(&scene)
+        .arg("-o")
+        .arg(&file)
+        .args(["--resolution", "48x36", "--spp", "1", "--ratio", "24", "--json"])
+        .output()
+        .expect("pis-pack runs");
     let r = json(&out);
     validate(&file);
-    let names: Vec<&str> = r["objects"].as_array().unwrap().iter().map(|o| o["name"].as_str().unwrap()).collect();
+    let names: Vec<&str> =
+        r["objects"].as_array().unwrap().iter().map(|o| o["name"].as_str().unwrap()).collect();
     assert!(names.contains(&"SilverCup") && names.contains(&"Columns"), "{names:?}");
 }
 
@@ -384,25 +510,42 @@ fn an_animated_scale_is_refused_before_the_solve() {
     let dir = tempfile::tempdir().expect("temp dir");
     let scene = common::sample_copy("demo2", &dir.path().join("demo2"), |doc, folder| {
         // four scale keys in a buffer of their own; the spin animation scales instead
-        let keys: Vec<u8> = [1.0f32, 1.0, 1.0, 1.5, 1.5, 1.5, 2.0, 2.0, 2.0, 1.0, 1.0, 1.0].iter().flat_map(|v| v.to_le_bytes()).collect();
+        let keys: Vec<u8> = [1.0f32, 1.0, 1.0, 1.5, 1.5, 1.5, 2.0, 2.0, 2.0, 1.0, 1.0, 1.0]
+            .iter()
+            .flat_map(|v| v.to_le_bytes())
+            .collect();
         std::fs::write(folder.join("scale.bin"), &keys).unwrap();
         let push = |doc: &mut serde_json::Value, key: &str, v: serde_json::Value| {
             let a = doc[key].as_array_mut().unwrap();
             a.push(v);
             a.len() - 1
         };
-        let buffer = push(doc, "buffers", serde_json::json!({"uri": "scale.bin", "byteLength": 48}));
-        let view = push(doc, "bufferViews", serde_json::json!({"buffer": buffer, "byteLength": 48}));
-        let accessor = push(doc, "accessors", serde_json::json!({"bufferView": view, "componentType": 5126, "count": 4, "type": "VEC3"}));
+        let buffer =
+            push(doc, "buffers", serde_json::json!({"uri": "scale.bin", "byteLength": 48}));
+        let view =
+            push(doc, "bufferViews", serde_json::json!({"buffer": buffer, "byteLength": 48}));
+        let accessor = push(
+            doc,
+            "accessors",
+            serde_json::json!({"bufferView": view, "componentType": 5126, "count": 4, "type": "VEC3"}),
+        );
         doc["animations"][0]["channels"][0]["target"]["path"] = serde_json::json!("scale");
         doc["animations"][0]["samplers"][0]["output"] = serde_json::json!(accessor);
     });
     let file = dir.path().join("out.pis");
-    let out = Command::new(env!("CARGO_BIN_EXE_pis-pack")).arg(&scene).arg("-o").arg(&file)
-        .args(["--resolution", "32x24", "--spp", "1"]).output().expect("pis-pack runs");
+    let out = Command::new(env!("CARGO_BIN_EXE_pis-pack"))
+        .arg(&scene)
+        .arg("-o")
+        .arg(&file)
+        .args(["--resolution", "32x24", "--spp", "1"])
+        .output()
+        .expect("pis-pack runs");
     let err = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(5), "{err}");
-    assert!(err.contains("object Gewgaw: its scale or shear changes over the parameter space"), "{err}");
+    assert!(
+        err.contains("object Gewgaw: its scale or shear changes over the parameter space"),
+        "{err}"
+    );
     assert!(!err.contains("pis-pack: trace"), "refused before the trace: {err}");
     assert!(!file.exists());
 }
@@ -411,13 +554,24 @@ fn an_animated_scale_is_refused_before_the_solve() {
 /// (u' = 1 − |2u − 1|): the mirrored coordinates an artist gives a symmetric model, its two
 /// halves sharing the vertices of the mirror line.
 fn mirror_texcoords(doc: &serde_json::Value, dir: &Path, mesh: &str) {
-    let m = doc["meshes"].as_array().expect("meshes").iter().find(|m| m["name"] == mesh).unwrap_or_else(|| panic!("no mesh {mesh}"));
-    let acc = &doc["accessors"][m["primitives"][0]["attributes"]["TEXCOORD_0"].as_u64().expect("TEXCOORD_0") as usize];
+    let m = doc["meshes"]
+        .as_array()
+        .expect("meshes")
+        .iter()
+        .find(|m| m["name"] == mesh)
+        .unwrap_or_else(|| panic!("no mesh {mesh}"));
+    let acc = &doc["accessors"]
+        [m["primitives"][0]["attributes"]["TEXCOORD_0"].as_u64().expect("TEXCOORD_0") as usize];
     let view = &doc["bufferViews"][acc["bufferView"].as_u64().expect("bufferView") as usize];
-    assert_eq!((acc["componentType"].as_u64(), view.get("byteStride")), (Some(5126), None), "float, tightly packed");
+    assert_eq!(
+        (acc["componentType"].as_u64(), view.get("byteStride")),
+        (Some(5126), None),
+        "float, tightly packed"
+    );
     let bin = dir.join(doc["buffers"][0]["uri"].as_str().expect("buffer uri"));
     let mut bytes = std::fs::read(&bin).expect("the buffer");
-    let start = (view["byteOffset"].as_u64().unwrap_or(0) + acc["byteOffset"].as_u64().unwrap_or(0)) as usize;
+    let start = (view["byteOffset"].as_u64().unwrap_or(0) + acc["byteOffset"].as_u64().unwrap_or(0))
+        as usize;
     for i in 0..acc["count"].as_u64().expect("count") as usize {
         let at = start + 8 * i;
         let u = f32::from_le_bytes(bytes[at..at + 4].try_into().expect("4 bytes"));
@@ -434,15 +588,40 @@ fn mirrored_texture_coordinates_give_each_half_its_own_texels() {
     let dir = tempfile::tempdir().expect("temp dir");
     let floor_db = |toml: &Path, name: &str| -> f64 {
         let set = dir.path().join(format!("{name}-set"));
-        let out = Command::new(env!("CARGO_BIN_EXE_pis-trace")).arg(toml).arg("-o").arg(&set).output().expect("pis-trace runs");
+        let out = Command::new(env!("CARGO_BIN_EXE_pis-trace"))
+            .arg(toml)
+            .arg("-o")
+            .arg(&set)
+            .output()
+            .expect("pis-trace runs");
         assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
-        let out = Command::new(env!("CARGO_BIN_EXE_pis-pack")).arg(&set).arg("--scene").arg(toml).arg("-o").arg(dir.path().join(format!("{name}.pis")))
-            .args(["--codec", "lossless", "--json"]).output().expect("pis-pack runs");
+        let out = Command::new(env!("CARGO_BIN_EXE_pis-pack"))
+            .arg(&set)
+            .arg("--scene")
+            .arg(toml)
+            .arg("-o")
+            .arg(dir.path().join(format!("{name}.pis")))
+            .args(["--codec", "lossless", "--json"])
+            .output()
+            .expect("pis-pack runs");
         let r = json(&out);
-        r["objects"].as_array().expect("objects").iter().find(|o| o["name"] == "Floor").expect("Floor")["psnr_db"].as_f64().expect("psnr_db")
+        r["objects"]
+            .as_array()
+            .expect("objects")
+            .iter()
+            .find(|o| o["name"] == "Floor")
+            .expect("Floor")["psnr_db"]
+            .as_f64()
+            .expect("psnr_db")
     };
-    let plain = floor_db(&common::sample_copy("demo1", &dir.path().join("plain"), |_, _| {}), "plain");
-    let mirrored = floor_db(&common::sample_copy("demo1", &dir.path().join("mirrored"), |doc, d| mirror_texcoords(doc, d, "Floor")), "mirrored");
+    let plain =
+        floor_db(&common::sample_copy("demo1", &dir.path().join("plain"), |_, _| {}), "plain");
+    let mirrored = floor_db(
+        &common::sample_copy("demo1", &dir.path().join("mirrored"), |doc, d| {
+            mirror_texcoords(doc, d, "Floor")
+        }),
+        "mirrored",
+    );
     println!("Floor, lossless: {plain:.2} dB with its own coordinates, {mirrored:.2} dB mirrored");
     // The halves meet at a cut now (a chart border in the middle of the view): within
     // 3.5 dB of the unmirrored floor, where the folded chart was 10 dB below it.
@@ -456,12 +635,20 @@ fn a_set_seeded_per_sample_packs_with_a_warning() {
     let dir = tempfile::tempdir().expect("temp dir");
     let seeded = dir.path().join("set");
     let out = Command::new(env!("CARGO_BIN_EXE_pis-trace"))
-        .arg(demo1()).arg("-o").arg(&seeded)
-        .args(["--resolution", "40x30", "--spp", "1", "--shading-seed", "sample"]).output().expect("pis-trace runs");
+        .arg(demo1())
+        .arg("-o")
+        .arg(&seeded)
+        .args(["--resolution", "40x30", "--spp", "1", "--shading-seed", "sample"])
+        .output()
+        .expect("pis-trace runs");
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     let out = pack(&seeded, &dir.path().join("a.pis"), &["--ratio", "24", "--max-texture", "32"]);
     json(&out);
-    assert!(String::from_utf8_lossy(&out.stderr).contains("seeded per camera sample"), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        String::from_utf8_lossy(&out.stderr).contains("seeded per camera sample"),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let out = pack(set(), &dir.path().join("b.pis"), &["--ratio", "24", "--max-texture", "32"]);
     json(&out);
     assert!(!String::from_utf8_lossy(&out.stderr).contains("seeded per camera sample"));

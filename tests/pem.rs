@@ -34,31 +34,62 @@ fn pack(scene: &Path, name: &str, args: &[&str]) -> (PathBuf, serde_json::Value)
 /// into the file `name` beside it: the file and pis-pack's report.
 fn pack_coded(scene: &Path, name: &str, args: &[&str]) -> (PathBuf, serde_json::Value) {
     let out = scene.with_file_name(name);
-    let o = Command::new(env!("CARGO_BIN_EXE_pis-pack")).arg(scene).arg("-o").arg(&out).args(args).arg("--json").output().expect("pis-pack runs");
+    let o = Command::new(env!("CARGO_BIN_EXE_pis-pack"))
+        .arg(scene)
+        .arg("-o")
+        .arg(&out)
+        .args(args)
+        .arg("--json")
+        .output()
+        .expect("pis-pack runs");
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     (out, serde_json::from_slice(&o.stdout).expect("JSON report"))
 }
 
 /// The set the scene's first pack traced into `.pis-cache/` beside it.
 fn traced_set(dir: &Path) -> PathBuf {
-    std::fs::read_dir(dir.join(".pis-cache")).expect("cache").next().expect("a traced set").expect("entry").path()
+    std::fs::read_dir(dir.join(".pis-cache"))
+        .expect("cache")
+        .next()
+        .expect("a traced set")
+        .expect("entry")
+        .path()
 }
 
 /// `pis-inspect --validate` passes `file`.
 fn assert_valid(file: &Path) {
-    let v = Command::new(env!("CARGO_BIN_EXE_pis-inspect")).arg("--validate").arg(file).output().expect("pis-inspect runs");
+    let v = Command::new(env!("CARGO_BIN_EXE_pis-inspect"))
+        .arg("--validate")
+        .arg(file)
+        .output()
+        .expect("pis-inspect runs");
     assert_eq!(v.status.code(), Some(0), "{}", String::from_utf8_lossy(&v.stdout));
 }
 
 /// The player draws `file` at the set's sample points, single-sample as the prediction is,
 /// within 0.3 dB of what pis-pack predicted (`pis-diff --max-psnr-drop`).
 fn assert_plays_as_predicted(file: &Path, set: &Path) {
-    let d = Command::new(env!("CARGO_BIN_EXE_pis-diff")).arg(file).arg(set).args(["--msaa", "1", "--max-psnr-drop", "0.3"]).output().expect("pis-diff runs");
-    assert!(d.status.success(), "{}{}", String::from_utf8_lossy(&d.stdout), String::from_utf8_lossy(&d.stderr));
+    let d = Command::new(env!("CARGO_BIN_EXE_pis-diff"))
+        .arg(file)
+        .arg(set)
+        .args(["--msaa", "1", "--max-psnr-drop", "0.3"])
+        .output()
+        .expect("pis-diff runs");
+    assert!(
+        d.status.success(),
+        "{}{}",
+        String::from_utf8_lossy(&d.stdout),
+        String::from_utf8_lossy(&d.stderr)
+    );
 }
 
 fn object<'a>(r: &'a serde_json::Value, name: &str) -> &'a serde_json::Value {
-    r["objects"].as_array().expect("objects").iter().find(|o| o["name"] == name).unwrap_or_else(|| panic!("object {name}"))
+    r["objects"]
+        .as_array()
+        .expect("objects")
+        .iter()
+        .find(|o| o["name"] == name)
+        .unwrap_or_else(|| panic!("object {name}"))
 }
 
 #[test]
@@ -82,47 +113,94 @@ fn a_mirror_teapot_as_layered_environment_maps() {
         // TeapotLid 17.83 against 26.08 (8.2 dB below).
         let c = object(&s, name);
         assert_eq!(c["representation"], "static environment map", "{name}: {}", c["why"]);
-        assert!(c["why"].as_str().is_some_and(|w| w.contains("traced from the object's centre") && w.contains("object omitted")), "{}", c["why"]);
+        assert!(
+            c["why"]
+                .as_str()
+                .is_some_and(|w| w.contains("traced from the object's centre")
+                    && w.contains("object omitted")),
+            "{}",
+            c["why"]
+        );
         let sa = c["psnr_db"].as_f64().expect("psnr");
         eprintln!("{name}: static environment map {sa:.2} dB ({})", c["why"]);
-        assert!(pa >= sa + 3.0, "{name}: layered PEM {pa:.2} dB, static environment map {sa:.2} dB");
+        assert!(
+            pa >= sa + 3.0,
+            "{name}: layered PEM {pa:.2} dB, static environment map {sa:.2} dB"
+        );
     }
     assert_valid(&stat);
     assert_valid(&pem);
-    let i = Command::new(env!("CARGO_BIN_EXE_pis-inspect")).arg(&pem).output().expect("pis-inspect runs");
+    let i = Command::new(env!("CARGO_BIN_EXE_pis-inspect"))
+        .arg(&pem)
+        .output()
+        .expect("pis-inspect runs");
     let text = String::from_utf8_lossy(&i.stdout);
-    assert!(text.contains("env_local") && text.contains("env_distant") && text.contains("ellipsoid shell"), "{text}");
+    assert!(
+        text.contains("env_local")
+            && text.contains("env_distant")
+            && text.contains("ellipsoid shell"),
+        "{text}"
+    );
     assert_plays_as_predicted(&pem, &traced_set(dir.path()));
     // Off the samples (thesis 5.10, figs 5.9–5.10): played between the sampled views against
     // frames traced at those cameras, the layered PEM's worst frame stays well above the
     // textures' (pasted on, they are worst half-way between two samples); away from the
     // orbit, its shells place reflections better than one map at infinity.
     let b = Command::new(env!("CARGO_BIN_EXE_pis-bench"))
-        .arg("reflective").arg(&scene).arg(&tex).arg(&pem).arg(&inf).arg(&stat)
-        .args(["--frames", "3", "--reference-spp", "4", "--json", "--out"]).arg(dir.path().join("reports"))
-        .output().expect("pis-bench runs");
+        .arg("reflective")
+        .arg(&scene)
+        .arg(&tex)
+        .arg(&pem)
+        .arg(&inf)
+        .arg(&stat)
+        .args(["--frames", "3", "--reference-spp", "4", "--json", "--out"])
+        .arg(dir.path().join("reports"))
+        .output()
+        .expect("pis-bench runs");
     assert!(b.status.success(), "{}", String::from_utf8_lossy(&b.stderr));
     let r: serde_json::Value = serde_json::from_slice(&b.stdout).expect("JSON report");
-    let summary = |file: &str, path: &str, key: &str| r["summaries"].as_array().expect("summaries").iter()
-        .find(|s| s["file"] == file && s["path"] == path).unwrap_or_else(|| panic!("{file} {path}"))[key].as_f64().expect("a figure");
+    let summary = |file: &str, path: &str, key: &str| {
+        r["summaries"]
+            .as_array()
+            .expect("summaries")
+            .iter()
+            .find(|s| s["file"] == file && s["path"] == path)
+            .unwrap_or_else(|| panic!("{file} {path}"))[key]
+            .as_f64()
+            .expect("a figure")
+    };
     // At the sampled views themselves, against the traced gold standard: the textures'
     // worst view is where the reflections they bake in are most wrong.
-    let (t, p) = (summary("tex.pis", "samples", "min_psnr_db"), summary("pem.pis", "samples", "min_psnr_db"));
+    let (t, p) = (
+        summary("tex.pis", "samples", "min_psnr_db"),
+        summary("pem.pis", "samples", "min_psnr_db"),
+    );
     eprintln!("at the sampled views, worst view: textures {t:.2} dB, layered PEM {p:.2} dB");
-    assert!(p >= t + 3.0, "layered PEM {p:.2} dB, textures {t:.2} dB (16.31 and 20.92 when written)");
-    let (t, p) = (summary("tex.pis", "between", "min_psnr_db"), summary("pem.pis", "between", "min_psnr_db"));
+    assert!(
+        p >= t + 3.0,
+        "layered PEM {p:.2} dB, textures {t:.2} dB (16.31 and 20.92 when written)"
+    );
+    let (t, p) = (
+        summary("tex.pis", "between", "min_psnr_db"),
+        summary("pem.pis", "between", "min_psnr_db"),
+    );
     eprintln!("between the samples, worst frame: textures {t:.2} dB, layered PEM {p:.2} dB");
     assert!(p >= t + 1.5, "layered PEM {p:.2} dB, textures {t:.2} dB");
-    let (p, s) = (summary("pem.pis", "away", "mean_psnr_db"), summary("inf.pis", "away", "mean_psnr_db"));
+    let (p, s) =
+        (summary("pem.pis", "away", "mean_psnr_db"), summary("inf.pis", "away", "mean_psnr_db"));
     eprintln!("away from the orbit, mean: layered PEM {p:.2} dB, one map at infinity {s:.2} dB");
     assert!(p >= s + 0.8, "layered PEM {p:.2} dB, one map at infinity {s:.2} dB");
     // Between the samples the static environment map stays as far below (measured: layered
     // PEM 20.79 dB, static map 16.53 dB; away 17.40 and 16.40 dB).
     for path in ["between", "away"] {
-        let (p, s) = (summary("pem.pis", path, "mean_psnr_db"), summary("stat.pis", path, "mean_psnr_db"));
+        let (p, s) =
+            (summary("pem.pis", path, "mean_psnr_db"), summary("stat.pis", path, "mean_psnr_db"));
         eprintln!("{path}, mean: layered PEM {p:.2} dB, static environment map {s:.2} dB");
         if path == "between" {
-            assert!(p >= s + 2.0, "between the samples: layered PEM {p:.2} dB, static environment map {s:.2} dB");
+            assert!(
+                p >= s + 2.0,
+                "between the samples: layered PEM {p:.2} dB, static environment map {s:.2} dB"
+            );
         }
     }
 }
@@ -140,8 +218,18 @@ fn auto_keeps_the_representation_that_does_better_for_the_whole_file() {
     let (_, p) = pack(&scene, "pem.pis", &["--representation", "pem"]);
     let why = |name: &str| object(&a, name)["why"].as_str().expect("why").to_string();
     eprintln!("TeapotBody: {}\nTeapotLid: {}", why("TeapotBody"), why("TeapotLid"));
-    assert_eq!(object(&a, "TeapotBody")["representation"], "layered environment maps", "{}", why("TeapotBody"));
-    assert!(why("TeapotBody").contains("auto: layered environment maps, the file") && why("TeapotBody").contains("lossless against"), "{}", why("TeapotBody"));
+    assert_eq!(
+        object(&a, "TeapotBody")["representation"],
+        "layered environment maps",
+        "{}",
+        why("TeapotBody")
+    );
+    assert!(
+        why("TeapotBody").contains("auto: layered environment maps, the file")
+            && why("TeapotBody").contains("lossless against"),
+        "{}",
+        why("TeapotBody")
+    );
     assert!(why("TeapotLid").contains("auto: surface textures"), "{}", why("TeapotLid"));
     let (pa, pp) = (a["psnr_db"].as_f64().expect("psnr"), p["psnr_db"].as_f64().expect("psnr"));
     assert!(pa >= pp - 2.0 * 0.05, "auto {pa:.2} dB, all layered PEM {pp:.2} dB");
@@ -158,12 +246,17 @@ fn a_small_budget_caps_the_shells_faces() {
     let scene = copy_sample(dir.path());
     let text = std::fs::read_to_string(&scene).expect("scene.toml");
     assert!(text.contains("samples = 4\n"), "teapot-pem's view has 4 samples: adapt the test");
-    std::fs::write(&scene, text.replacen("samples = 4\n", "samples = 1\n", 1)).expect("write scene.toml");
+    std::fs::write(&scene, text.replacen("samples = 4\n", "samples = 1\n", 1))
+        .expect("write scene.toml");
     let (out, r) = pack_coded(&scene, "pem.pis", &["--representation", "pem"]);
     // The lid's distant sphere would be 128² (the set's 4 views, or 1 view under a lossless
     // codec); at 150 bytes it is 64², and the report says why.
     let why = object(&r, "TeapotLid")["why"].as_str().expect("why");
-    assert!(why.contains("distant sphere 64²") && why.contains("cube faces at most 64² (the ratio leaves 150 bytes"), "{why}");
+    assert!(
+        why.contains("distant sphere 64²")
+            && why.contains("cube faces at most 64² (the ratio leaves 150 bytes"),
+        "{why}"
+    );
     for name in ["TeapotBody", "TeapotLid"] {
         let why = object(&r, name)["why"].as_str().expect("why");
         assert!(!why.contains("128²") && !why.contains("256²"), "{name}: {why}");
@@ -186,14 +279,32 @@ fn sub_pixel_lookups_follow_the_traced_footprint() {
         let (x, y) = (object(&a, name), object(&b, name));
         let (pa, pb) = (x["psnr_db"].as_f64().expect("psnr"), y["psnr_db"].as_f64().expect("psnr"));
         eprintln!("{name}: one lookup per pixel {pa:.2} dB, 2×2 {pb:.2} dB ({})", y["why"]);
-        assert!(y["why"].as_str().is_some_and(|w| w.contains("2×2 lookups per pixel")), "{}", y["why"]);
-        assert!(!x["why"].as_str().is_some_and(|w| w.contains("lookups per pixel")), "{}", x["why"]);
+        assert!(
+            y["why"].as_str().is_some_and(|w| w.contains("2×2 lookups per pixel")),
+            "{}",
+            y["why"]
+        );
+        assert!(
+            !x["why"].as_str().is_some_and(|w| w.contains("lookups per pixel")),
+            "{}",
+            x["why"]
+        );
         assert!(pb >= pa + 0.5, "{name}: 2×2 lookups {pb:.2} dB, one lookup {pa:.2} dB");
     }
     assert_valid(&four);
-    let i = Command::new(env!("CARGO_BIN_EXE_pis-inspect")).arg(&four).arg("--json").output().expect("pis-inspect runs");
+    let i = Command::new(env!("CARGO_BIN_EXE_pis-inspect"))
+        .arg(&four)
+        .arg("--json")
+        .output()
+        .expect("pis-inspect runs");
     let j: serde_json::Value = serde_json::from_slice(&i.stdout).expect("JSON");
-    let shells: Vec<&serde_json::Value> = j["objects"].as_array().expect("objects").iter().flat_map(|o| o["layers"].as_array().expect("layers")).filter(|l| l["shell"].is_string()).collect();
+    let shells: Vec<&serde_json::Value> = j["objects"]
+        .as_array()
+        .expect("objects")
+        .iter()
+        .flat_map(|o| o["layers"].as_array().expect("layers"))
+        .filter(|l| l["shell"].is_string())
+        .collect();
     assert!(shells.len() >= 4 && shells.iter().all(|l| l["lookups"] == 2), "{shells:?}");
     assert_plays_as_predicted(&four, &traced_set(dir.path()));
 }
@@ -210,19 +321,35 @@ fn a_reference_pair_takes_its_own_noise_out() {
     let dir = tempfile::tempdir().expect("temp dir");
     let scene = copy_sample(dir.path());
     let (tex, _) = pack(&scene, "tex.pis", &[]);
-    let bench = |spp: &str, extra: &[&str]| Command::new(env!("CARGO_BIN_EXE_pis-bench"))
-        .arg("reflective").arg(&scene).arg(&tex)
-        .args(["--frames", "2", "--reference-spp", spp, "--reference-pair", "--json", "--out"]).arg(dir.path().join("reports")).args(extra)
-        .output().expect("pis-bench runs");
+    let bench = |spp: &str, extra: &[&str]| {
+        Command::new(env!("CARGO_BIN_EXE_pis-bench"))
+            .arg("reflective")
+            .arg(&scene)
+            .arg(&tex)
+            .args(["--frames", "2", "--reference-spp", spp, "--reference-pair", "--json", "--out"])
+            .arg(dir.path().join("reports"))
+            .args(extra)
+            .output()
+            .expect("pis-bench runs")
+    };
     let refused = bench("4", &[]);
     assert_eq!(refused.status.code(), Some(1), "{}", String::from_utf8_lossy(&refused.stderr));
-    assert!(String::from_utf8_lossy(&refused.stderr).contains("--reference-seed sample"), "{}", String::from_utf8_lossy(&refused.stderr));
+    assert!(
+        String::from_utf8_lossy(&refused.stderr).contains("--reference-seed sample"),
+        "{}",
+        String::from_utf8_lossy(&refused.stderr)
+    );
     let figures = |spp: &str| -> (f64, f64, f64) {
         let b = bench(spp, &["--reference-seed", "sample"]);
         assert!(b.status.success(), "{}", String::from_utf8_lossy(&b.stderr));
         let r: serde_json::Value = serde_json::from_slice(&b.stdout).expect("JSON report");
         assert_eq!(r["reference_pair"], true);
-        let s = r["summaries"].as_array().expect("summaries").iter().find(|s| s["path"] == "samples").expect("the samples path");
+        let s = r["summaries"]
+            .as_array()
+            .expect("summaries")
+            .iter()
+            .find(|s| s["path"] == "samples")
+            .expect("the samples path");
         let f = |k: &str| s[k].as_f64().unwrap_or_else(|| panic!("{k}: {s}"));
         (f("pooled_psnr_db"), f("noise_removed_psnr_db"), f("reference_psnr_db"))
     };
@@ -230,6 +357,15 @@ fn a_reference_pair_takes_its_own_noise_out() {
     eprintln!("at the sampled views, against pairs at 2 and 32 spp: pooled {:.2} and {:.2} dB, noise removed {:.2} and {:.2} dB; the pairs' means' own noise {:.2} and {:.2} dB",
               noisy.0, clean.0, noisy.1, clean.1, noisy.2, clean.2);
     assert!(clean.2 > noisy.2 + 6.0, "16 times the samples: {:.2} and {:.2} dB", noisy.2, clean.2);
-    assert!(noisy.1 > noisy.0 && clean.1 > clean.0, "taking noise out raises a figure: {noisy:?} {clean:?}");
-    assert!((noisy.1 - clean.1).abs() < 0.7 * (noisy.0 - clean.1).abs(), "noise removed at 2 spp {:.2} dB, raw {:.2}: the pair at 32 spp measures {:.2}", noisy.1, noisy.0, clean.1);
+    assert!(
+        noisy.1 > noisy.0 && clean.1 > clean.0,
+        "taking noise out raises a figure: {noisy:?} {clean:?}"
+    );
+    assert!(
+        (noisy.1 - clean.1).abs() < 0.7 * (noisy.0 - clean.1).abs(),
+        "noise removed at 2 spp {:.2} dB, raw {:.2}: the pair at 32 spp measures {:.2}",
+        noisy.1,
+        noisy.0,
+        clean.1
+    );
 }

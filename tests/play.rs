@@ -28,7 +28,6 @@ fn play_env(args: &[&std::ffi::OsStr], env: &[(&str, Option<&str>)]) -> Output {
     common::run(env!("CARGO_BIN_EXE_pis-play"), args, env)
 }
 
-
 /// Whether a GPU adapter exists (lavapipe counts); without one, the test is skipped
 /// locally and fails in CI.
 fn gpu_or_skip(test: &str) -> bool {
@@ -60,13 +59,23 @@ fn fixture() -> &'static Fixture {
         common::demo1_copy(&scene_dir, &[("samples = 4", "samples = 2")]);
         let set = dir.path().join("set");
         let out = Command::new(env!("CARGO_BIN_EXE_pis-trace"))
-            .arg(scene_dir.join("scene.toml")).arg("-o").arg(&set)
-            .args(["--resolution", "40x30", "--spp", "2"]).output().expect("pis-trace runs");
+            .arg(scene_dir.join("scene.toml"))
+            .arg("-o")
+            .arg(&set)
+            .args(["--resolution", "40x30", "--spp", "2"])
+            .output()
+            .expect("pis-trace runs");
         assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
         let file = dir.path().join("demo1.pis");
         let out = Command::new(env!("CARGO_BIN_EXE_pis-pack"))
-            .arg(&set).arg("--scene").arg(scene_dir.join("scene.toml")).arg("-o").arg(&file)
-            .args(["--ratio", "24", "--json"]).output().expect("pis-pack runs");
+            .arg(&set)
+            .arg("--scene")
+            .arg(scene_dir.join("scene.toml"))
+            .arg("-o")
+            .arg(&file)
+            .args(["--ratio", "24", "--json"])
+            .output()
+            .expect("pis-pack runs");
         assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
         let pack = serde_json::from_slice(&out.stdout).expect("pis-pack JSON");
         Fixture { _dir: dir, set, file, pack }
@@ -85,11 +94,22 @@ fn compare_agrees_with_the_pack_prediction() {
     }
     let f = fixture();
     // One sample per pixel, as pis-compile's hardware model (the prediction) draws.
-    let r = json(&play(&[os(&f.file), os("--headless"), os("--compare"), os(&f.set), os("--msaa"), os("1"), os("--json")]));
+    let r = json(&play(&[
+        os(&f.file),
+        os("--headless"),
+        os("--compare"),
+        os(&f.set),
+        os("--msaa"),
+        os("1"),
+        os("--json"),
+    ]));
     assert_eq!((r["msaa_samples"].as_u64(), r["msaa_requested"].as_u64()), (Some(1), Some(1)));
     let predicted = f.pack["psnr_db"].as_f64().expect("pack psnr_db");
     let covered = r["covered_psnr_db"].as_f64().expect("covered_psnr_db");
-    assert!((covered - predicted).abs() <= 0.5, "played {covered:.2} dB, predicted {predicted:.2} dB");
+    assert!(
+        (covered - predicted).abs() <= 0.5,
+        "played {covered:.2} dB, predicted {predicted:.2} dB"
+    );
     let whole = r["psnr_db"].as_f64().expect("psnr_db");
     assert!(whole.is_finite() && whole > 10.0, "whole image {whole} dB");
     let objects = r["objects"].as_array().expect("objects");
@@ -97,8 +117,12 @@ fn compare_agrees_with_the_pack_prediction() {
     assert_eq!(objects.len(), packed.len());
     for p in packed {
         let name = p["name"].as_str().expect("name");
-        let o = objects.iter().find(|o| o["name"] == name).unwrap_or_else(|| panic!("object {name} missing"));
-        let (got, want) = (o["psnr_db"].as_f64().expect("psnr_db"), p["psnr_db"].as_f64().expect("psnr_db"));
+        let o = objects
+            .iter()
+            .find(|o| o["name"] == name)
+            .unwrap_or_else(|| panic!("object {name} missing"));
+        let (got, want) =
+            (o["psnr_db"].as_f64().expect("psnr_db"), p["psnr_db"].as_f64().expect("psnr_db"));
         assert!((got - want).abs() <= 0.5, "{name}: played {got:.2} dB, predicted {want:.2} dB");
     }
     assert_eq!(r["points"].as_array().expect("points").len(), 4);
@@ -116,7 +140,8 @@ fn multisampling_brings_the_whole_image_closer_to_the_gold_standard() {
     }
     let f = fixture();
     let compare = |msaa: Option<&str>| {
-        let mut args = vec![os(&f.file), os("--headless"), os("--compare"), os(&f.set), os("--json")];
+        let mut args =
+            vec![os(&f.file), os("--headless"), os("--compare"), os(&f.set), os("--json")];
         if let Some(m) = msaa {
             args.extend([os("--msaa"), os(m)]);
         }
@@ -130,8 +155,16 @@ fn multisampling_brings_the_whole_image_closer_to_the_gold_standard() {
         return;
     }
     // pis-pack records the set's display filter; the player resolves with it.
-    assert_eq!((four["resolve"]["filter"].as_str(), four["resolve"]["from"].as_str()), (Some("gaussian"), Some("file")), "{}", four["resolve"]);
-    assert_eq!((four["resolve"]["sigma_px"].as_f64(), four["resolve"]["radius_px"].as_f64()), (Some(0.5), Some(1.5)));
+    assert_eq!(
+        (four["resolve"]["filter"].as_str(), four["resolve"]["from"].as_str()),
+        (Some("gaussian"), Some("file")),
+        "{}",
+        four["resolve"]
+    );
+    assert_eq!(
+        (four["resolve"]["sigma_px"].as_f64(), four["resolve"]["radius_px"].as_f64()),
+        (Some(0.5), Some(1.5))
+    );
     assert_eq!(one["resolve"]["filter"], "none");
     // A file without it: the box resolve, or the filter of the set --set names.
     let tiny_file = tiny();
@@ -142,13 +175,28 @@ fn multisampling_brings_the_whole_image_closer_to_the_gold_standard() {
     };
     assert_eq!(tiny_at(&[])["filter"], "box");
     let from_set = tiny_at(&[os("--set"), os(&f.set)]);
-    assert_eq!((from_set["filter"].as_str(), from_set["from"].as_str()), (Some("gaussian"), Some("set")), "{from_set}");
+    assert_eq!(
+        (from_set["filter"].as_str(), from_set["from"].as_str()),
+        (Some("gaussian"), Some("set")),
+        "{from_set}"
+    );
     let missing = f.set.join("missing");
-    assert_fails(&play(&[os(&tiny_file), os("--headless"), os("--set"), os(&missing)]), 2, "missing set", "missing");
-    let (a, b) = (one["psnr_db"].as_f64().expect("psnr_db"), four["psnr_db"].as_f64().expect("psnr_db"));
+    assert_fails(
+        &play(&[os(&tiny_file), os("--headless"), os("--set"), os(&missing)]),
+        2,
+        "missing set",
+        "missing",
+    );
+    let (a, b) =
+        (one["psnr_db"].as_f64().expect("psnr_db"), four["psnr_db"].as_f64().expect("psnr_db"));
     eprintln!("whole image: 1 sample {a:.2} dB, 4 samples {b:.2} dB");
     assert!(b > a, "whole image: 1 sample {a:.2} dB, 4 samples {b:.2} dB");
-    assert_fails(&play(&[os(&tiny()), os("--headless"), os("--msaa"), os("2")]), 1, "msaa 2", "expected 1 (off) or 4");
+    assert_fails(
+        &play(&[os(&tiny()), os("--headless"), os("--msaa"), os("2")]),
+        1,
+        "msaa 2",
+        "expected 1 (off) or 4",
+    );
 }
 
 #[test]
@@ -159,15 +207,33 @@ fn paths_write_frames_and_report_timings() {
     let f = fixture();
     let dir = tempfile::tempdir().expect("temp dir");
     let out = dir.path().join("frames");
-    let r = json(&play(&[os(&f.file), os("--headless"), os("--path"), os("diagonal"), os("--frames"), os("5"), os("--out"), os(&out), os("--json")]));
+    let r = json(&play(&[
+        os(&f.file),
+        os("--headless"),
+        os("--path"),
+        os("diagonal"),
+        os("--frames"),
+        os("5"),
+        os("--out"),
+        os(&out),
+        os("--json"),
+    ]));
     assert_eq!(r["frames"], 5);
     for k in ["frame_ms_mean", "frame_ms_worst", "decode_ms_mean", "upload_ms_mean"] {
         assert!(r[k].as_f64().is_some_and(|v| v >= 0.0), "{k}: {}", r[k]);
     }
     assert!(r["frame_ms_worst"].as_f64() >= r["frame_ms_mean"].as_f64());
     // Written frames are read back; the frame's draw is timed apart from it.
-    assert!(r["draw_ms_mean"].as_f64().is_some_and(|v| v > 0.0), "draw_ms_mean: {}", r["draw_ms_mean"]);
-    assert!(r["readback_ms_mean"].as_f64().is_some_and(|v| v > 0.0), "readback_ms_mean: {}", r["readback_ms_mean"]);
+    assert!(
+        r["draw_ms_mean"].as_f64().is_some_and(|v| v > 0.0),
+        "draw_ms_mean: {}",
+        r["draw_ms_mean"]
+    );
+    assert!(
+        r["readback_ms_mean"].as_f64().is_some_and(|v| v > 0.0),
+        "readback_ms_mean: {}",
+        r["readback_ms_mean"]
+    );
     // 2 × 2 samples: the diagonal visits 4 different samples, then the first again (its
     // level images still cached: nothing to read).
     let rows = r["per_frame"].as_array().expect("per_frame");
@@ -182,15 +248,36 @@ fn paths_write_frames_and_report_timings() {
     // An orbit of a free camera at a given point, another size, multilinear blending, half
     // texture resolution.
     let values: Vec<String> = fixture_point(f);
-    let r = json(&play(&[os(&f.file), os("--headless"), os("--path"), os("orbit"), os("--frames"), os("3"), os("--at"), os(&values.join(",")), os("--size"), os("64x48"), os("--blend"), os("multilinear"), os("--reduction"), os("2"), os("--json")]));
+    let r = json(&play(&[
+        os(&f.file),
+        os("--headless"),
+        os("--path"),
+        os("orbit"),
+        os("--frames"),
+        os("3"),
+        os("--at"),
+        os(&values.join(",")),
+        os("--size"),
+        os("64x48"),
+        os("--blend"),
+        os("multilinear"),
+        os("--reduction"),
+        os("2"),
+        os("--json"),
+    ]));
     assert_eq!(r["frames"], 3);
     assert_eq!(r["size"], serde_json::json!([64, 48]));
     // Frames not written are drawn and waited for, never copied back.
     assert_eq!(r["readback_ms_mean"].as_f64(), Some(0.0));
-    assert!(r["draw_ms_mean"].as_f64().is_some_and(|v| v > 0.0), "draw_ms_mean: {}", r["draw_ms_mean"]);
+    assert!(
+        r["draw_ms_mean"].as_f64().is_some_and(|v| v > 0.0),
+        "draw_ms_mean: {}",
+        r["draw_ms_mean"]
+    );
     // A path file.
     let path = dir.path().join("path.txt");
-    std::fs::write(&path, format!("# two points\n{}\n{}\n", values.join(","), values.join(" "))).expect("path file");
+    std::fs::write(&path, format!("# two points\n{}\n{}\n", values.join(","), values.join(" ")))
+        .expect("path file");
     let r = json(&play(&[os(&f.file), os("--headless"), os("--path"), os(&path), os("--json")]));
     assert_eq!(r["frames"], 2);
 }
@@ -224,7 +311,12 @@ fn damaged_files_fail_with_a_clear_error() {
     let junk = dir.path().join("junk.pis");
     std::fs::write(&junk, b"hello").expect("write");
     assert_fails(&play(&[os(&junk), os("--headless")]), 3, "junk", "");
-    assert_fails(&play(&[os(&dir.path().join("none.pis")), os("--headless")]), 2, "missing", "none.pis");
+    assert_fails(
+        &play(&[os(&dir.path().join("none.pis")), os("--headless")]),
+        2,
+        "missing",
+        "none.pis",
+    );
     // A flipped byte in a codestream the frame reads: found when the frame reads it.
     let reader = pis_format::PisReader::open(&tiny()).expect("tiny.pis opens");
     let stream = reader.container().objects[0].layers[0].blocks[0].levels[0].images[0];
@@ -249,8 +341,18 @@ fn arguments_are_checked_and_window_mode_falls_back_to_headless() {
         return;
     }
     let t = tiny();
-    assert_fails(&play(&[os(&t), os("--headless"), os("--at"), os("1,2,3")]), 1, "wrong point", "2 dimensions");
-    assert_fails(&play(&[os(&t), os("--headless"), os("--reduction"), os("3")]), 1, "reduction", "power of two");
+    assert_fails(
+        &play(&[os(&t), os("--headless"), os("--at"), os("1,2,3")]),
+        1,
+        "wrong point",
+        "2 dimensions",
+    );
+    assert_fails(
+        &play(&[os(&t), os("--headless"), os("--reduction"), os("3")]),
+        1,
+        "reduction",
+        "power of two",
+    );
     let out = play_env(&[os(&t)], &[("DISPLAY", None), ("WAYLAND_DISPLAY", None)]);
     assert!(out.status.success());
     assert!(String::from_utf8_lossy(&out.stderr).contains("no display"));
@@ -269,7 +371,14 @@ fn a_scene_is_traced_packed_and_played_in_one_command() {
     let dir = tempfile::tempdir().expect("temp dir");
     // The scene's own size, 160×120 (pis-pack's default ratio, 384:1, needs a few hundred
     // bytes).
-    let scene = common::demo1_copy(dir.path(), &[("samples = 4", "samples = 2"), ("spp = 4", "spp = 1"), ("resolution = [160, 120]", "resolution = [160, 120]")]);
+    let scene = common::demo1_copy(
+        dir.path(),
+        &[
+            ("samples = 4", "samples = 2"),
+            ("spp = 4", "spp = 1"),
+            ("resolution = [160, 120]", "resolution = [160, 120]"),
+        ],
+    );
     let first = play(&[os(&scene), os("--headless"), os("--json")]);
     let err = String::from_utf8_lossy(&first.stderr).to_string();
     let r = json(&first);
@@ -279,7 +388,13 @@ fn a_scene_is_traced_packed_and_played_in_one_command() {
     let packed = dir.path().join(".pis-cache/demo1-160x120-spp1.pis");
     assert!(packed.is_file(), "no pack at {}", packed.display());
     assert!(dir.path().join(".pis-cache/demo1-160x120-spp1/set.json").is_file());
-    let again = play(&[os(&scene), os("--headless"), os("--at"), os(&fixture_values(&packed).join(",")), os("--json")]);
+    let again = play(&[
+        os(&scene),
+        os("--headless"),
+        os("--at"),
+        os(&fixture_values(&packed).join(",")),
+        os("--json"),
+    ]);
     let err = String::from_utf8_lossy(&again.stderr).to_string();
     let r = json(&again);
     assert!(!err.contains("tracing and packing") && err.contains("playing"), "{err}");
@@ -300,20 +415,43 @@ fn a_scene_is_played_with_the_pack_options_given() {
         return;
     }
     let dir = tempfile::tempdir().expect("temp dir");
-    let scene = common::demo1_copy(dir.path(), &[("samples = 4", "samples = 2"), ("spp = 4", "spp = 1")]);
+    let scene =
+        common::demo1_copy(dir.path(), &[("samples = 4", "samples = 2"), ("spp = 4", "spp = 1")]);
     let run = |ratio: &str| {
-        let out = play(&[os(&scene), os("--headless"), os("--resolution"), os("48x36"), os("--ratio"), os(ratio), os("--json")]);
+        let out = play(&[
+            os(&scene),
+            os("--headless"),
+            os("--resolution"),
+            os("48x36"),
+            os("--ratio"),
+            os(ratio),
+            os("--json"),
+        ]);
         json(&out);
-        let packs: Vec<PathBuf> = std::fs::read_dir(dir.path().join(".pis-cache")).unwrap()
-            .map(|e| e.unwrap().path()).filter(|p| p.extension().is_some_and(|e| e == "pis")).collect();
+        let packs: Vec<PathBuf> = std::fs::read_dir(dir.path().join(".pis-cache"))
+            .unwrap()
+            .map(|e| e.unwrap().path())
+            .filter(|p| p.extension().is_some_and(|e| e == "pis"))
+            .collect();
         packs
     };
     let packs = run("48");
     assert_eq!(packs.len(), 1, "{packs:?}");
     let name = packs[0].file_name().unwrap().to_string_lossy().to_string();
-    assert!(name.starts_with("demo1-48x36-spp1-"), "--resolution traces at 48×36 and other options name the pack: {name}");
+    assert!(
+        name.starts_with("demo1-48x36-spp1-"),
+        "--resolution traces at 48×36 and other options name the pack: {name}"
+    );
     let reader = pis_format::PisReader::open(&packs[0]).expect("container");
-    assert_eq!(reader.container().provenance.as_ref().map(|p| p.settings.iter().any(|(k, v)| k == "target" && v == "ratio 48")), Some(true), "the pack took --ratio 48");
+    assert_eq!(
+        reader
+            .container()
+            .provenance
+            .as_ref()
+            .map(|p| p.settings.iter().any(|(k, v)| k == "target" && v == "ratio 48")),
+        Some(true),
+        "the pack took --ratio 48"
+    );
     assert_eq!(run("96").len(), 2, "another ratio, another pack");
     let out = play(&[os(&tiny()), os("--headless"), os("--ratio"), os("96")]);
     assert_fails(&out, 1, "pack options on a .pis file", "apply to a scene.toml");
@@ -331,16 +469,48 @@ fn scaled_and_mirrored_nodes_play_as_predicted() {
         common::set_node(doc, "SilverCup", "scale", serde_json::json!([0.8, 1.3, -0.8]));
     });
     let set = dir.path().join("set");
-    let out = Command::new(env!("CARGO_BIN_EXE_pis-trace")).arg(&scene).arg("-o").arg(&set)
-        .args(["--resolution", "48x36", "--spp", "1"]).output().expect("pis-trace runs");
+    let out = Command::new(env!("CARGO_BIN_EXE_pis-trace"))
+        .arg(&scene)
+        .arg("-o")
+        .arg(&set)
+        .args(["--resolution", "48x36", "--spp", "1"])
+        .output()
+        .expect("pis-trace runs");
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     let file = dir.path().join("scaled.pis");
-    let out = Command::new(env!("CARGO_BIN_EXE_pis-pack")).arg(&set).arg("-o").arg(&file).args(["--ratio", "24", "--json"]).output().expect("pis-pack runs");
+    let out = Command::new(env!("CARGO_BIN_EXE_pis-pack"))
+        .arg(&set)
+        .arg("-o")
+        .arg(&file)
+        .args(["--ratio", "24", "--json"])
+        .output()
+        .expect("pis-pack runs");
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     let pack: serde_json::Value = serde_json::from_slice(&out.stdout).expect("pis-pack JSON");
-    let played = json(&play(&[os(&file), os("--headless"), os("--compare"), os(&set), os("--msaa"), os("1"), os("--json")]));
-    let cup = |v: &serde_json::Value| v["objects"].as_array().unwrap().iter().find(|o| o["name"] == "SilverCup").and_then(|o| o["psnr_db"].as_f64()).expect("SilverCup");
-    assert!((cup(&played) - cup(&pack)).abs() < 0.05, "SilverCup played {} dB, predicted {} dB", cup(&played), cup(&pack));
+    let played = json(&play(&[
+        os(&file),
+        os("--headless"),
+        os("--compare"),
+        os(&set),
+        os("--msaa"),
+        os("1"),
+        os("--json"),
+    ]));
+    let cup = |v: &serde_json::Value| {
+        v["objects"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|o| o["name"] == "SilverCup")
+            .and_then(|o| o["psnr_db"].as_f64())
+            .expect("SilverCup")
+    };
+    assert!(
+        (cup(&played) - cup(&pack)).abs() < 0.05,
+        "SilverCup played {} dB, predicted {} dB",
+        cup(&played),
+        cup(&pack)
+    );
     let (p, q) = (played["covered_psnr_db"].as_f64().unwrap(), pack["psnr_db"].as_f64().unwrap());
     assert!((p - q).abs() < 0.05, "covered pixels played {p} dB, predicted {q} dB");
 }

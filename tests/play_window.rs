@@ -16,7 +16,6 @@ fn in_ci() -> bool {
     std::env::var_os("CI").is_some_and(|v| !v.is_empty())
 }
 
-
 const PLAY: &str = env!("CARGO_BIN_EXE_pis-play");
 
 /// pis-play in a window on a fresh Xvfb display.
@@ -33,13 +32,23 @@ fn headless(args: &[&std::ffi::OsStr]) -> Output {
 }
 
 fn ok(out: &Output, what: &str) {
-    assert!(out.status.success(), "{what} failed ({:?}): {}", out.status.code(), String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{what} failed ({:?}): {}",
+        out.status.code(),
+        String::from_utf8_lossy(&out.stderr)
+    );
 }
 
 /// Whether xvfb-run and a GPU adapter exist; without them the test is skipped locally and
 /// fails in CI.
 fn window_or_skip(test: &str) -> bool {
-    let found = Command::new("xvfb-run").arg("--help").stdout(Stdio::null()).stderr(Stdio::null()).status().is_ok();
+    let found = Command::new("xvfb-run")
+        .arg("--help")
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .status()
+        .is_ok();
     if !found {
         let why = "xvfb-run is missing (apt-get install -y xvfb xauth)";
         assert!(!in_ci(), "{test}: {why}");
@@ -75,19 +84,39 @@ fn fixture() -> &'static Fixture {
         let set = dir.path().join("set");
         let out = run(
             env!("CARGO_BIN_EXE_pis-trace"),
-            &[os(&scene_dir.join("scene.toml")), os("-o"), os(&set), os("--resolution"), os("40x30"), os("--spp"), os("2")],
+            &[
+                os(&scene_dir.join("scene.toml")),
+                os("-o"),
+                os(&set),
+                os("--resolution"),
+                os("40x30"),
+                os("--spp"),
+                os("2"),
+            ],
             &[],
         );
         ok(&out, "pis-trace");
         let file = dir.path().join("demo1.pis");
         let out = run(
             env!("CARGO_BIN_EXE_pis-pack"),
-            &[os(&set), os("--scene"), os(&scene_dir.join("scene.toml")), os("-o"), os(&file), os("--ratio"), os("24")],
+            &[
+                os(&set),
+                os("--scene"),
+                os(&scene_dir.join("scene.toml")),
+                os("-o"),
+                os(&file),
+                os("--ratio"),
+                os("24"),
+            ],
             &[],
         );
         ok(&out, "pis-pack");
         let meta = pis_trace::set::RaySet::open(&set).expect("set").meta;
-        let points = meta.points.iter().map(|p| p.values.iter().map(|v| v.to_string()).collect::<Vec<_>>().join(",")).collect();
+        let points = meta
+            .points
+            .iter()
+            .map(|p| p.values.iter().map(|v| v.to_string()).collect::<Vec<_>>().join(","))
+            .collect();
         Fixture { _dir: dir, set, file, points }
     })
 }
@@ -119,7 +148,11 @@ fn psnr(a: &Rgb, b: &Rgb, rows: std::ops::Range<u32>, cols: std::ops::Range<u32>
         }
     }
     let mse = sum / n.max(1) as f64;
-    if mse == 0.0 { f64::INFINITY } else { -10.0 * mse.log10() }
+    if mse == 0.0 {
+        f64::INFINITY
+    } else {
+        -10.0 * mse.log10()
+    }
 }
 
 fn whole(a: &Rgb, b: &Rgb) -> f64 {
@@ -136,7 +169,20 @@ const SAME_FRAME_DB: f64 = 40.0;
 /// Headless frame of `at` at `size` as PNG.
 fn headless_frame(f: &Fixture, dir: &Path, name: &str, at: &str, size: &str) -> Rgb {
     let out_dir = dir.join(name);
-    ok(&headless(&[os(&f.file), os("--at"), os(at), os("--size"), os(size), os("--blend"), os("nearest"), os("--out"), os(&out_dir)]), "headless pis-play");
+    ok(
+        &headless(&[
+            os(&f.file),
+            os("--at"),
+            os(at),
+            os("--size"),
+            os(size),
+            os("--blend"),
+            os("nearest"),
+            os("--out"),
+            os(&out_dir),
+        ]),
+        "headless pis-play",
+    );
     png(&out_dir.join("frame-0000.png"))
 }
 
@@ -149,8 +195,18 @@ fn the_window_shows_the_players_frame() {
     let dir = tempfile::tempdir().expect("temp dir");
     let shot = dir.path().join("window.png");
     let out = window(&[
-        os(&f.file), os("--screenshot"), os(&shot), os("--frames"), os("3"), os("--size"), os("160x120"),
-        os("--hide-panels"), os("--at"), os(&f.points[0]), os("--blend"), os("nearest"),
+        os(&f.file),
+        os("--screenshot"),
+        os(&shot),
+        os("--frames"),
+        os("3"),
+        os("--size"),
+        os("160x120"),
+        os("--hide-panels"),
+        os("--at"),
+        os(&f.points[0]),
+        os("--blend"),
+        os("nearest"),
     ]);
     ok(&out, "pis-play window");
     let err = String::from_utf8_lossy(&out.stderr);
@@ -161,19 +217,40 @@ fn the_window_shows_the_players_frame() {
     let other = headless_frame(f, dir.path(), "other", &f.points[3], "160x120");
     let (db_same, db_other) = (whole(&w, &same), whole(&w, &other));
     eprintln!("window vs headless: same point {db_same:.2} dB, other point {db_other:.2} dB");
-    assert!(db_same >= SAME_FRAME_DB, "window frame vs headless frame of the same request: {db_same:.2} dB");
-    assert!(db_other < SAME_FRAME_DB, "the measure must tell another sample apart: {db_other:.2} dB");
+    assert!(
+        db_same >= SAME_FRAME_DB,
+        "window frame vs headless frame of the same request: {db_same:.2} dB"
+    );
+    assert!(
+        db_other < SAME_FRAME_DB,
+        "the measure must tell another sample apart: {db_other:.2} dB"
+    );
     // The free orbit camera starts on the sample camera: the same frame through the player's
     // free-camera path (eye, target, up → view matrix) instead of the file's matrix.
     let orbit = dir.path().join("orbit.png");
     let out = window(&[
-        os(&f.file), os("--screenshot"), os(&orbit), os("--frames"), os("3"), os("--size"), os("160x120"),
-        os("--hide-panels"), os("--at"), os(&f.points[0]), os("--blend"), os("nearest"), os("--path"), os("orbit"),
+        os(&f.file),
+        os("--screenshot"),
+        os(&orbit),
+        os("--frames"),
+        os("3"),
+        os("--size"),
+        os("160x120"),
+        os("--hide-panels"),
+        os("--at"),
+        os(&f.points[0]),
+        os("--blend"),
+        os("nearest"),
+        os("--path"),
+        os("orbit"),
     ]);
     ok(&out, "pis-play window, orbit camera");
     let db_orbit = whole(&png(&orbit), &same);
     eprintln!("orbit camera at its start vs headless: {db_orbit:.2} dB");
-    assert!(db_orbit >= SAME_FRAME_DB, "the orbit camera starts at the sample camera: {db_orbit:.2} dB");
+    assert!(
+        db_orbit >= SAME_FRAME_DB,
+        "the orbit camera starts at the sample camera: {db_orbit:.2} dB"
+    );
 }
 
 #[test]
@@ -185,8 +262,17 @@ fn the_panels_are_drawn_over_the_frame() {
     let dir = tempfile::tempdir().expect("temp dir");
     let shot = dir.path().join("panels.png");
     let out = window(&[
-        os(&f.file), os("--screenshot"), os(&shot), os("--frames"), os("3"), os("--size"), os("640x480"),
-        os("--at"), os(&f.points[0]), os("--blend"), os("nearest"),
+        os(&f.file),
+        os("--screenshot"),
+        os(&shot),
+        os("--frames"),
+        os("3"),
+        os("--size"),
+        os("640x480"),
+        os("--at"),
+        os(&f.points[0]),
+        os("--blend"),
+        os("nearest"),
     ]);
     ok(&out, "pis-play window with panels");
     let w = png(&shot);
@@ -212,8 +298,19 @@ fn the_gold_standard_of_the_nearest_sample_is_shown() {
     let at: Vec<String> = a.iter().zip(b).map(|(x, y)| (0.2 * x + 0.8 * y).to_string()).collect();
     let shot = dir.path().join("gold.png");
     let out = window(&[
-        os(&f.file), os("--screenshot"), os(&shot), os("--frames"), os("3"), os("--size"), os("40x30"),
-        os("--hide-panels"), os("--at"), os(&at.join(",")), os("--set"), os(&f.set), os("--show-gold"),
+        os(&f.file),
+        os("--screenshot"),
+        os(&shot),
+        os("--frames"),
+        os("3"),
+        os("--size"),
+        os("40x30"),
+        os("--hide-panels"),
+        os("--at"),
+        os(&at.join(",")),
+        os("--set"),
+        os(&f.set),
+        os("--show-gold"),
     ]);
     ok(&out, "pis-play window with the gold standard");
     let w = png(&shot);
@@ -252,22 +349,50 @@ fn window_options_fail_clearly() {
         assert!(!err.contains("panicked"), "{what}: {err}");
     };
     // No display at all.
-    let out = run(PLAY, &[os(&f.file), os("--screenshot"), os(&shot)], &[("DISPLAY", None), ("WAYLAND_DISPLAY", None)]);
+    let out = run(
+        PLAY,
+        &[os(&f.file), os("--screenshot"), os(&shot)],
+        &[("DISPLAY", None), ("WAYLAND_DISPLAY", None)],
+    );
     check(out, 4, "xvfb-run", "no display");
     // A window option with a headless run.
-    check(headless(&[os(&f.file), os("--screenshot"), os(&shot)]), 1, "window options", "--headless --screenshot");
+    check(
+        headless(&[os(&f.file), os("--screenshot"), os(&shot)]),
+        1,
+        "window options",
+        "--headless --screenshot",
+    );
     // A set that is not there, and one of another space.
     let missing = dir.path().join("no-set");
-    check(window(&[os(&f.file), os("--set"), os(&missing), os("--frames"), os("1")]), 2, "no-set", "missing set");
+    check(
+        window(&[os(&f.file), os("--set"), os(&missing), os("--frames"), os("1")]),
+        2,
+        "no-set",
+        "missing set",
+    );
     let other = dir.path().join("other-set");
     std::fs::create_dir(&other).expect("mkdir");
     let json = std::fs::read_to_string(f.set.join("set.json")).expect("set.json");
     assert!(json.contains("\"name\": \"view\""), "set.json layout changed: adapt this test");
-    std::fs::write(other.join("set.json"), json.replace("\"name\": \"view\"", "\"name\": \"azimuth\"")).expect("write");
-    check(window(&[os(&f.file), os("--set"), os(&other), os("--frames"), os("1")]), 3, "'azimuth' is not one of the file's", "set of another space");
+    std::fs::write(
+        other.join("set.json"),
+        json.replace("\"name\": \"view\"", "\"name\": \"azimuth\""),
+    )
+    .expect("write");
+    check(
+        window(&[os(&f.file), os("--set"), os(&other), os("--frames"), os("1")]),
+        3,
+        "'azimuth' is not one of the file's",
+        "set of another space",
+    );
     // A path file is played headless only.
     let path = dir.path().join("path.txt");
     std::fs::write(&path, format!("{}\n", f.points[0])).expect("path file");
-    check(window(&[os(&f.file), os("--path"), os(&path), os("--frames"), os("1")]), 1, "headless", "path file");
+    check(
+        window(&[os(&f.file), os("--path"), os(&path), os("--frames"), os("1")]),
+        1,
+        "headless",
+        "path file",
+    );
     assert!(!shot.exists(), "no screenshot from failed runs");
 }

@@ -23,11 +23,16 @@ fn set() -> &'static Path {
         let dir = common::fixture_tempdir();
         let set = dir.path().join("set");
         let out = Command::new(env!("CARGO_BIN_EXE_pis-trace"))
-            .arg(repo("samples/demo1/scene.toml")).arg("-o").arg(&set)
-            .args(["--resolution", "40x30", "--spp", "1"]).output().expect("pis-trace runs");
+            .arg(repo("samples/demo1/scene.toml"))
+            .arg("-o")
+            .arg(&set)
+            .args(["--resolution", "40x30", "--spp", "1"])
+            .output()
+            .expect("pis-trace runs");
         assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
         (dir, set)
-    }).1
+    })
+    .1
 }
 
 /// The set packed with the wavelet codec and 32-texel textures, with `args`.
@@ -35,8 +40,15 @@ fn pack(name: &str, args: &[&str]) -> (tempfile::TempDir, PathBuf) {
     let dir = common::fixture_tempdir();
     let file = dir.path().join(name);
     let out = Command::new(env!("CARGO_BIN_EXE_pis-pack"))
-        .arg(set()).arg("--scene").arg(repo("samples/demo1/scene.toml")).arg("-o").arg(&file)
-        .args(["--max-texture", "32"]).args(args).output().expect("pis-pack runs");
+        .arg(set())
+        .arg("--scene")
+        .arg(repo("samples/demo1/scene.toml"))
+        .arg("-o")
+        .arg(&file)
+        .args(["--max-texture", "32"])
+        .args(args)
+        .output()
+        .expect("pis-pack runs");
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     (dir, file)
 }
@@ -57,7 +69,14 @@ fn mastered() -> &'static Path {
 /// re-blocking needs), once for every test.
 fn mastered_per_object() -> &'static Path {
     static PACK: OnceLock<(tempfile::TempDir, PathBuf)> = OnceLock::new();
-    &PACK.get_or_init(|| pack("mastered-object.pis", &["--ratio", "24", "--keep-master", "--placement", "object"])).1
+    &PACK
+        .get_or_init(|| {
+            pack(
+                "mastered-object.pis",
+                &["--ratio", "24", "--keep-master", "--placement", "object"],
+            )
+        })
+        .1
 }
 
 /// The max-MSE constraint a file's writer applied, as its provenance records it (what
@@ -65,11 +84,24 @@ fn mastered_per_object() -> &'static Path {
 /// since `auto` may choose otherwise at the new ratio.
 fn recorded_max_mse(file: &Path) -> String {
     let c = PisReader::open(file).expect("file").load_all().expect("load");
-    c.provenance.expect("provenance").settings.iter().find(|(k, _)| k == "max_mse_ratio").map(|(_, v)| v.clone()).expect("max_mse_ratio recorded")
+    c.provenance
+        .expect("provenance")
+        .settings
+        .iter()
+        .find(|(k, _)| k == "max_mse_ratio")
+        .map(|(_, v)| v.clone())
+        .expect("max_mse_ratio recorded")
 }
 
 fn reencode(input: &Path, output: &Path, args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_pis-reencode")).arg(input).arg("-o").arg(output).args(args).arg("--json").output().expect("pis-reencode runs")
+    Command::new(env!("CARGO_BIN_EXE_pis-reencode"))
+        .arg(input)
+        .arg("-o")
+        .arg(output)
+        .args(args)
+        .arg("--json")
+        .output()
+        .expect("pis-reencode runs")
 }
 
 fn json(out: &Output) -> serde_json::Value {
@@ -85,18 +117,36 @@ fn same_textures(a: &Path, b: &Path) {
         for li in 0..o.layers.len() {
             for p in 0..space.point_count() {
                 let point = space.point(p);
-                let (x, y) = (ra.texture(oi, li, &point).expect("decode a"), rb.texture(oi, li, &point).expect("decode b"));
+                let (x, y) = (
+                    ra.texture(oi, li, &point).expect("decode a"),
+                    rb.texture(oi, li, &point).expect("decode b"),
+                );
                 assert_eq!(x.layout, y.layout);
-                let differ = x.data.iter().zip(&y.data).filter(|(u, v)| u.to_bits() != v.to_bits()).count();
-                assert_eq!(differ, 0, "object {} layer {li} point {point:?}: {differ} values differ", o.name);
+                let differ =
+                    x.data.iter().zip(&y.data).filter(|(u, v)| u.to_bits() != v.to_bits()).count();
+                assert_eq!(
+                    differ, 0,
+                    "object {} layer {li} point {point:?}: {differ} values differ",
+                    o.name
+                );
             }
         }
     }
 }
 
 fn validate(file: &Path) {
-    let out = Command::new(env!("CARGO_BIN_EXE_pis-inspect")).arg("--validate").arg(file).output().expect("pis-inspect runs");
-    assert_eq!(out.status.code(), Some(0), "{}{}", String::from_utf8_lossy(&out.stdout), String::from_utf8_lossy(&out.stderr));
+    let out = Command::new(env!("CARGO_BIN_EXE_pis-inspect"))
+        .arg("--validate")
+        .arg(file)
+        .output()
+        .expect("pis-inspect runs");
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}{}",
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr)
+    );
 }
 
 #[test]
@@ -133,13 +183,19 @@ fn dct_reencoding_meets_its_ratio_and_records_provenance() {
     validate(&out);
     let ratio = r["ratio_without_geometry_after"].as_f64().expect("ratio");
     assert!((ratio / 48.0 - 1.0).abs() < 0.1, "ratio {ratio}, target 48");
-    assert!(r["ratio_before"].as_f64().expect("before") > 0.0 && r["bytes_after"].as_u64().expect("bytes") > 0);
+    assert!(
+        r["ratio_before"].as_f64().expect("before") > 0.0
+            && r["bytes_after"].as_u64().expect("bytes") > 0
+    );
     let psnr = r["psnr_db"].as_f64().expect("PSNR");
     // Against the input's own decoded textures: the second coding's error only.
     assert!(psnr > 25.0, "PSNR {psnr}");
     assert_eq!(r["exact"], false);
     for o in r["objects"].as_array().expect("objects") {
-        assert!(o["psnr_db"].as_f64().is_some() && o["area_px"].as_f64().expect("area") >= 1.0, "{o}");
+        assert!(
+            o["psnr_db"].as_f64().is_some() && o["area_px"].as_f64().expect("area") >= 1.0,
+            "{o}"
+        );
     }
     let c = PisReader::open(&out).expect("output");
     let p = c.container().provenance.clone().expect("provenance");
@@ -153,7 +209,10 @@ fn dct_reencoding_meets_its_ratio_and_records_provenance() {
     assert_eq!(a.container().space, c.container().space);
     assert_eq!(a.container().cameras, c.container().cameras);
     for (x, y) in a.container().objects.iter().zip(&c.container().objects) {
-        assert_eq!((&x.name, &x.mesh, &x.stagger, &x.transforms), (&y.name, &y.mesh, &y.stagger, &y.transforms));
+        assert_eq!(
+            (&x.name, &x.mesh, &x.stagger, &x.transforms),
+            (&y.name, &y.mesh, &y.stagger, &y.transforms)
+        );
     }
 }
 
@@ -178,7 +237,12 @@ fn bad_arguments_and_inputs_leave_no_output() {
         assert_eq!(o.status.code(), Some(code), "{args:?}: {err}");
         assert!(err.contains(message), "{args:?}: {err}");
         assert!(!err.contains("panicked"));
-        let left: Vec<_> = std::fs::read_dir(dir.path()).expect("dir").filter_map(Result::ok).map(|e| e.file_name()).filter(|n| n != "bad.pis").collect();
+        let left: Vec<_> = std::fs::read_dir(dir.path())
+            .expect("dir")
+            .filter_map(Result::ok)
+            .map(|e| e.file_name())
+            .filter(|n| n != "bad.pis")
+            .collect();
         assert!(left.is_empty(), "{args:?} left {left:?}");
     }
     let o = reencode(packed(), &dir.path().join("no/such/folder/out.pis"), &[]);
@@ -205,31 +269,61 @@ fn reencoding_from_the_master_gives_a_direct_pack() {
     let master = r["master_bytes_before"].as_u64().expect("master bytes");
     assert!(master > 0 && r["master_bytes_after"] == 0, "{r}");
     // The ratio counts what a player uses, not the master.
-    let (raw, bytes) = (r["raw_image_bytes"].as_f64().expect("raw"), r["bytes_before"].as_f64().expect("bytes"));
-    assert!((r["ratio_before"].as_f64().expect("ratio") - raw / (bytes - master as f64)).abs() < 1e-9);
+    let (raw, bytes) =
+        (r["raw_image_bytes"].as_f64().expect("raw"), r["bytes_before"].as_f64().expect("bytes"));
+    assert!(
+        (r["ratio_before"].as_f64().expect("ratio") - raw / (bytes - master as f64)).abs() < 1e-9
+    );
     let before = r["psnr_master_before_db"].as_f64().expect("PSNR of the input against the master");
     let after = r["psnr_master_after_db"].as_f64().expect("PSNR of the output against the master");
-    assert!(after < before && (r["psnr_change_db"].as_f64().expect("change") - (after - before)).abs() < 1e-9, "{r}");
+    assert!(
+        after < before
+            && (r["psnr_change_db"].as_f64().expect("change") - (after - before)).abs() < 1e-9,
+        "{r}"
+    );
     // A direct pack at ratio 48: the same level images, byte for byte, hence the same PSNR.
-    let (_d, direct) = pack("direct.pis", &["--ratio", "48", "--max-mse-ratio", &recorded_max_mse(mastered())]);
+    let (_d, direct) =
+        pack("direct.pis", &["--ratio", "48", "--max-mse-ratio", &recorded_max_mse(mastered())]);
     same_player_content(&out, &direct);
     // Geometry and transforms are the input's.
-    let (a, b) = (PisReader::open(mastered()).expect("input"), PisReader::open(&out).expect("output"));
+    let (a, b) =
+        (PisReader::open(mastered()).expect("input"), PisReader::open(&out).expect("output"));
     for (x, y) in a.container().objects.iter().zip(&b.container().objects) {
-        assert_eq!((&x.name, &x.mesh, &x.stagger, &x.transforms), (&y.name, &y.mesh, &y.stagger, &y.transforms));
+        assert_eq!(
+            (&x.name, &x.mesh, &x.stagger, &x.transforms),
+            (&y.name, &y.mesh, &y.stagger, &y.transforms)
+        );
     }
     // pis-diff: the same level images with and without the master, the master counted apart.
-    let d = Command::new(env!("CARGO_BIN_EXE_pis-diff")).arg(mastered()).arg(packed()).arg("--json").output().expect("pis-diff runs");
+    let d = Command::new(env!("CARGO_BIN_EXE_pis-diff"))
+        .arg(mastered())
+        .arg(packed())
+        .arg("--json")
+        .output()
+        .expect("pis-diff runs");
     let v: serde_json::Value = serde_json::from_slice(&d.stdout).expect("pis-diff JSON");
     assert_eq!(v["textures_identical"], true, "{v}");
-    assert!(v["structure"].as_array().expect("structure").iter().any(|l| l == "lossless master only in the first file"), "{v}");
-    assert_eq!((v["bytes"]["a"]["master"].as_u64(), v["bytes"]["b"]["master"].as_u64()), (Some(master), Some(0)));
+    assert!(
+        v["structure"]
+            .as_array()
+            .expect("structure")
+            .iter()
+            .any(|l| l == "lossless master only in the first file"),
+        "{v}"
+    );
+    assert_eq!(
+        (v["bytes"]["a"]["master"].as_u64(), v["bytes"]["b"]["master"].as_u64()),
+        (Some(master), Some(0))
+    );
     // Without a master the same request codes the decoded textures: other level images.
     let decoded = dir.path().join("from-decoded.pis");
     let r = json(&reencode(packed(), &decoded, &["--ratio", "48"]));
     assert_eq!(r["source"], "decoded textures");
     assert!(r["psnr_master_after_db"].is_null() && r["master_bytes_before"] == 0);
-    let (x, y) = (PisReader::open(&decoded).expect("decoded").load_all().expect("load"), PisReader::open(&direct).expect("direct").load_all().expect("load"));
+    let (x, y) = (
+        PisReader::open(&decoded).expect("decoded").load_all().expect("load"),
+        PisReader::open(&direct).expect("direct").load_all().expect("load"),
+    );
     assert_ne!(x.objects, y.objects);
 }
 
@@ -239,16 +333,27 @@ fn a_lossless_round_trip_carrying_the_master_gives_the_pack_back() {
     let lossless = dir.path().join("lossless.pis");
     let r = json(&reencode(mastered(), &lossless, &["--codec", "lossless", "--keep-master"]));
     validate(&lossless);
-    assert_eq!((&r["source"], &r["master_bytes_after"]), (&serde_json::json!("master"), &r["master_bytes_before"]), "{r}");
-    assert_eq!(PisReader::open(&lossless).expect("lossless").masters().expect("master"), PisReader::open(mastered()).expect("input").masters().expect("master"));
+    assert_eq!(
+        (&r["source"], &r["master_bytes_after"]),
+        (&serde_json::json!("master"), &r["master_bytes_before"]),
+        "{r}"
+    );
+    assert_eq!(
+        PisReader::open(&lossless).expect("lossless").masters().expect("master"),
+        PisReader::open(mastered()).expect("input").masters().expect("master")
+    );
     let back = dir.path().join("back.pis");
     let r = json(&reencode(&lossless, &back, &["--ratio", "24", "--keep-master"]));
     validate(&back);
     assert_eq!(r["source"], "master");
     same_player_content(&back, mastered());
     // The PSNR against the master is the pack's again.
-    let first = json(&reencode(mastered(), &dir.path().join("again.pis"), &["--codec", "lossless"]));
-    let (p0, p1) = (first["psnr_master_before_db"].as_f64().expect("pack"), r["psnr_master_after_db"].as_f64().expect("round trip"));
+    let first =
+        json(&reencode(mastered(), &dir.path().join("again.pis"), &["--codec", "lossless"]));
+    let (p0, p1) = (
+        first["psnr_master_before_db"].as_f64().expect("pack"),
+        r["psnr_master_after_db"].as_f64().expect("round trip"),
+    );
     assert!((p0 - p1).abs() < 0.1, "{p0} dB → {p1} dB");
 }
 
@@ -278,7 +383,10 @@ fn keep_master_needs_a_master_or_an_exact_input() {
                 let point = pis_format::master::sample_point(c, l, s as u64);
                 let want = m.texture(o.object as usize, li, &point).expect("texture").data;
                 let got = o.texture(c, li, s).expect("master texture");
-                assert!(got.len() == want.len() && got.iter().zip(&want).all(|(a, b)| a.to_bits() == b.to_bits()));
+                assert!(
+                    got.len() == want.len()
+                        && got.iter().zip(&want).all(|(a, b)| a.to_bits() == b.to_bits())
+                );
             }
         }
     }
@@ -297,11 +405,21 @@ fn a_damaged_master_is_an_error_without_output() {
     let o = reencode(&damaged, &out, &["--ratio", "48"]);
     let err = String::from_utf8_lossy(&o.stderr);
     assert_eq!(o.status.code(), Some(3), "{err}");
-    assert!(err.contains("damaged.pis") && err.contains("error-3004") && err.contains("MSTR"), "{err}");
+    assert!(
+        err.contains("damaged.pis") && err.contains("error-3004") && err.contains("MSTR"),
+        "{err}"
+    );
     assert!(!out.exists() && !err.contains("panicked"));
-    let v = Command::new(env!("CARGO_BIN_EXE_pis-inspect")).arg("--validate").arg(&damaged).output().expect("pis-inspect runs");
+    let v = Command::new(env!("CARGO_BIN_EXE_pis-inspect"))
+        .arg("--validate")
+        .arg(&damaged)
+        .output()
+        .expect("pis-inspect runs");
     assert_eq!(v.status.code(), Some(3));
-    assert!(String::from_utf8_lossy(&v.stdout).contains("error-3004") || String::from_utf8_lossy(&v.stderr).contains("error-3004"));
+    assert!(
+        String::from_utf8_lossy(&v.stdout).contains("error-3004")
+            || String::from_utf8_lossy(&v.stderr).contains("error-3004")
+    );
 }
 
 #[test]
@@ -311,16 +429,34 @@ fn reblocking_from_the_master_gives_a_direct_pack_with_those_blocks() {
     let r = json(&reencode(mastered_per_object(), &out, &["--ratio", "48", "--block", "2"]));
     validate(&out);
     assert_eq!(r["source"], "master", "{r}");
-    let (_d, direct) = pack("direct-block2.pis", &["--ratio", "48", "--block", "2", "--placement", "object", "--max-mse-ratio", &recorded_max_mse(mastered_per_object())]);
+    let (_d, direct) = pack(
+        "direct-block2.pis",
+        &[
+            "--ratio",
+            "48",
+            "--block",
+            "2",
+            "--placement",
+            "object",
+            "--max-mse-ratio",
+            &recorded_max_mse(mastered_per_object()),
+        ],
+    );
     // The same blocks, origins, pyramids and level images, byte for byte.
     same_player_content(&out, &direct);
     let c = PisReader::open(&out).expect("output").load_all().expect("load");
     assert!(c.space.dims.iter().all(|d| d.block_size == 2));
     let before = PisReader::open(mastered_per_object()).expect("input").load_all().expect("load");
-    let blocks = |c: &pis_format::Container| c.objects.iter().flat_map(|o| &o.layers).map(|l| l.blocks.len()).sum::<usize>();
+    let blocks = |c: &pis_format::Container| {
+        c.objects.iter().flat_map(|o| &o.layers).map(|l| l.blocks.len()).sum::<usize>()
+    };
     assert!(blocks(&c) > blocks(&before), "smaller blocks, more of them");
     for (x, y) in before.objects.iter().zip(&c.objects) {
-        assert_eq!((&x.mesh, &x.transforms), (&y.mesh, &y.transforms), "geometry and transforms are kept");
+        assert_eq!(
+            (&x.mesh, &x.transforms),
+            (&y.mesh, &y.transforms),
+            "geometry and transforms are kept"
+        );
     }
     let prov = c.provenance.expect("provenance");
     assert!(prov.settings.iter().any(|(k, v)| k == "block" && v == "2x2"), "{:?}", prov.settings);
@@ -332,9 +468,14 @@ fn reblocking_textures_placed_per_block_is_refused_without_output() {
     // over the 4 × 4 points (demo1's 4 samples fit in the default block of 8: one block per
     // object, which re-blocks), some layer's blocks differ, and a new block could gather
     // samples of two placements.
-    let (_d, small) = pack("mastered-block2.pis", &["--ratio", "24", "--keep-master", "--block", "2"]);
+    let (_d, small) =
+        pack("mastered-block2.pis", &["--ratio", "24", "--keep-master", "--block", "2"]);
     let c = PisReader::open(&small).expect("input").load_all().expect("load");
-    let differs = c.objects.iter().flat_map(|o| &o.layers).any(|l| l.blocks.iter().any(|b| b.placement != l.blocks[0].placement || b.width != l.blocks[0].width));
+    let differs = c.objects.iter().flat_map(|o| &o.layers).any(|l| {
+        l.blocks
+            .iter()
+            .any(|b| b.placement != l.blocks[0].placement || b.width != l.blocks[0].width)
+    });
     assert!(differs, "a pack in blocks of 2 places some layer's blocks differently");
     let dir = tempfile::tempdir().expect("temp dir");
     let out = dir.path().join("reblocked.pis");
@@ -347,7 +488,11 @@ fn reblocking_textures_placed_per_block_is_refused_without_output() {
 #[test]
 fn lossless_reblocking_keeps_every_texture() {
     let dir = tempfile::tempdir().expect("temp dir");
-    let (lossless, reblocked, back) = (dir.path().join("lossless.pis"), dir.path().join("block3.pis"), dir.path().join("back.pis"));
+    let (lossless, reblocked, back) = (
+        dir.path().join("lossless.pis"),
+        dir.path().join("block3.pis"),
+        dir.path().join("back.pis"),
+    );
     json(&reencode(mastered_per_object(), &lossless, &["--codec", "lossless"]));
     json(&reencode(&lossless, &reblocked, &["--codec", "lossless", "--block", "3x1"]));
     validate(&reblocked);

@@ -29,9 +29,19 @@ fn pack_default(name: &str) -> serde_json::Value {
     let dir = tempfile::tempdir().expect("temp dir");
     let scene = copy_sample(name, dir.path());
     let file = dir.path().join(format!("{name}.pis"));
-    let out = Command::new(env!("CARGO_BIN_EXE_pis-pack")).arg(&scene).arg("-o").arg(&file).arg("--json").output().expect("pis-pack runs");
+    let out = Command::new(env!("CARGO_BIN_EXE_pis-pack"))
+        .arg(&scene)
+        .arg("-o")
+        .arg(&file)
+        .arg("--json")
+        .output()
+        .expect("pis-pack runs");
     assert!(out.status.success(), "{name}: {}", String::from_utf8_lossy(&out.stderr));
-    let v = Command::new(env!("CARGO_BIN_EXE_pis-inspect")).arg("--validate").arg(&file).output().expect("pis-inspect runs");
+    let v = Command::new(env!("CARGO_BIN_EXE_pis-inspect"))
+        .arg("--validate")
+        .arg(&file)
+        .output()
+        .expect("pis-inspect runs");
     assert_eq!(v.status.code(), Some(0), "{name}: {}", String::from_utf8_lossy(&v.stdout));
     serde_json::from_slice(&out.stdout).expect("JSON report")
 }
@@ -45,7 +55,11 @@ fn check(name: &str, floor_db: f64) {
     let psnr = r["psnr_db"].as_f64().expect("psnr_db");
     assert!(psnr >= floor_db, "{name}: predicted {psnr:.2} dB, below {floor_db} dB");
     for o in r["objects"].as_array().expect("objects") {
-        assert!(o["bytes"].as_u64().expect("bytes") > 0, "{name}: object {} got no storage at the default ratio", o["name"]);
+        assert!(
+            o["bytes"].as_u64().expect("bytes") > 0,
+            "{name}: object {} got no storage at the default ratio",
+            o["name"]
+        );
     }
 }
 

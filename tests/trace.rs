@@ -16,7 +16,9 @@ fn base64(bytes: &[u8]) -> String {
     const T: &[u8; 64] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
     let mut s = String::new();
     for c in bytes.chunks(3) {
-        let n = (c[0] as u32) << 16 | (*c.get(1).unwrap_or(&0) as u32) << 8 | *c.get(2).unwrap_or(&0) as u32;
+        let n = (c[0] as u32) << 16
+            | (*c.get(1).unwrap_or(&0) as u32) << 8
+            | *c.get(2).unwrap_or(&0) as u32;
         for k in 0..4 {
             if k <= c.len() {
                 s.push(T[(n >> (18 - 6 * k) & 63) as usize] as char);
@@ -69,7 +71,10 @@ fn tiny_scene(dir: &Path) -> PathBuf {
             buf.extend_from_slice(&i.to_le_bytes());
         }
         views.push(format!(r#"{{"buffer":0,"byteOffset":{off},"byteLength":12}}"#));
-        accessors.push(format!(r#"{{"bufferView":{},"componentType":5123,"count":6,"type":"SCALAR"}}"#, views.len() - 1));
+        accessors.push(format!(
+            r#"{{"bufferView":{},"componentType":5123,"count":6,"type":"SCALAR"}}"#,
+            views.len() - 1
+        ));
     }
     let gltf = format!(
         r#"{{
@@ -142,7 +147,8 @@ fn traces_a_scene_into_a_set_deterministically() {
     let (a, b) = (tmp.path().join("a"), tmp.path().join("b"));
     let out = trace(&[scene.to_str().unwrap(), "-o", a.to_str().unwrap(), "--json"]);
     assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
-    let report: serde_json::Value = serde_json::from_slice(&out.stdout).expect("--json prints JSON");
+    let report: serde_json::Value =
+        serde_json::from_slice(&out.stdout).expect("--json prints JSON");
     assert_eq!(report["points"], 2);
     assert!(report["rays_per_second"].as_f64().unwrap() > 0.0);
     assert!(report["ms_per_point"].as_f64().unwrap() > 0.0);
@@ -153,7 +159,10 @@ fn traces_a_scene_into_a_set_deterministically() {
     let roles: Vec<&str> = set.meta.objects.iter().map(|o| o.role.as_str()).collect();
     assert_eq!(roles, ["diffuse", "reflective", "refractive"]);
     let img = set.read_point(1).unwrap();
-    assert!(img.layer("object.Mirror.distant").is_some() && img.layer("object.Glass.refraction_confidence").is_some());
+    assert!(
+        img.layer("object.Mirror.distant").is_some()
+            && img.layer("object.Glass.refraction_confidence").is_some()
+    );
     assert!(img.layer("combined").unwrap().planes[0].iter().any(|&v| v > 0.0));
 
     let out = trace(&[scene.to_str().unwrap(), "-o", b.to_str().unwrap(), "--threads", "1"]);
@@ -169,20 +178,40 @@ fn shading_seeded_per_sample_is_recorded() {
     let tmp = tempfile::tempdir().unwrap();
     let scene = tiny_scene(tmp.path());
     let (cell, sample) = (tmp.path().join("cell"), tmp.path().join("sample"));
-    let out = trace(&[scene.to_str().unwrap(), "-o", cell.to_str().unwrap(), "--points", "1", "--json"]);
+    let out =
+        trace(&[scene.to_str().unwrap(), "-o", cell.to_str().unwrap(), "--points", "1", "--json"]);
     assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
     let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     assert_eq!(report["shading_seed"], "cell");
-    let out = trace(&[scene.to_str().unwrap(), "-o", sample.to_str().unwrap(), "--points", "1", "--shading-seed", "sample", "--json"]);
+    let out = trace(&[
+        scene.to_str().unwrap(),
+        "-o",
+        sample.to_str().unwrap(),
+        "--points",
+        "1",
+        "--shading-seed",
+        "sample",
+        "--json",
+    ]);
     assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
     let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     assert_eq!(report["shading_seed"], "sample");
-    let settings = |dir: &Path| RaySet::open(dir).unwrap().meta.renderer.and_then(|r| r.settings).unwrap();
+    let settings =
+        |dir: &Path| RaySet::open(dir).unwrap().meta.renderer.and_then(|r| r.settings).unwrap();
     assert_eq!(settings(&sample).coherence_cell, Some(0.0));
     assert_eq!(settings(&cell).coherence_cell, None);
-    let combined = |dir: &Path| RaySet::open(dir).unwrap().read_point(0).unwrap().layer("combined").unwrap().planes[0].clone();
+    let combined = |dir: &Path| {
+        RaySet::open(dir).unwrap().read_point(0).unwrap().layer("combined").unwrap().planes[0]
+            .clone()
+    };
     assert_ne!(combined(&cell), combined(&sample));
-    let out = trace(&[scene.to_str().unwrap(), "-o", tmp.path().join("x").to_str().unwrap(), "--shading-seed", "pixel"]);
+    let out = trace(&[
+        scene.to_str().unwrap(),
+        "-o",
+        tmp.path().join("x").to_str().unwrap(),
+        "--shading-seed",
+        "pixel",
+    ]);
     assert_eq!(out.status.code(), Some(1), "{}", text(&out.stderr));
 }
 
@@ -192,19 +221,34 @@ fn a_sample_stream_is_recorded_and_changes_the_noise() {
     let scene = tiny_scene(tmp.path());
     let s = scene.to_str().unwrap();
     let dir = |n: &str| tmp.path().join(n);
-    for (name, extra) in [("default", &[][..]), ("zero", &["--seed", "0"][..]), ("one", &["--seed", "1"][..])] {
+    for (name, extra) in
+        [("default", &[][..]), ("zero", &["--seed", "0"][..]), ("one", &["--seed", "1"][..])]
+    {
         let o = dir(name);
-        let mut args = vec![s, "-o", o.to_str().unwrap(), "--points", "1", "--shading-seed", "sample", "--json"];
+        let mut args = vec![
+            s,
+            "-o",
+            o.to_str().unwrap(),
+            "--points",
+            "1",
+            "--shading-seed",
+            "sample",
+            "--json",
+        ];
         args.extend_from_slice(extra);
         let out = trace(&args);
         assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
         let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
         assert_eq!(report["seed"], if name == "one" { 1 } else { 0 });
     }
-    let combined = |n: &str| RaySet::open(&dir(n)).unwrap().read_point(0).unwrap().layer("combined").unwrap().planes[0].clone();
+    let combined = |n: &str| {
+        RaySet::open(&dir(n)).unwrap().read_point(0).unwrap().layer("combined").unwrap().planes[0]
+            .clone()
+    };
     assert_eq!(combined("default"), combined("zero"));
     assert_ne!(combined("default"), combined("one"));
-    let settings = |n: &str| RaySet::open(&dir(n)).unwrap().meta.renderer.and_then(|r| r.settings).unwrap();
+    let settings =
+        |n: &str| RaySet::open(&dir(n)).unwrap().meta.renderer.and_then(|r| r.settings).unwrap();
     assert_eq!(settings("one").seed, 1);
     assert_eq!(settings("zero").seed, 0);
     // The default stream leaves set.json as it was before streams were recorded.
@@ -248,7 +292,15 @@ fn demo1_at_80x60_gives_identical_bytes_twice() {
     let mut dirs = Vec::new();
     for run in ["a", "b"] {
         let d = tmp.path().join(run);
-        let out = trace(&[scene.to_str().unwrap(), "-o", d.to_str().unwrap(), "--resolution", "80x60", "--spp", "4"]);
+        let out = trace(&[
+            scene.to_str().unwrap(),
+            "-o",
+            d.to_str().unwrap(),
+            "--resolution",
+            "80x60",
+            "--spp",
+            "4",
+        ]);
         assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
         dirs.push(d);
     }
@@ -269,10 +321,17 @@ fn a_point_larger_than_memory_is_refused_before_tracing() {
     let dir = tempfile::tempdir().unwrap();
     let scene = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../samples/demo1/scene.toml");
     let out = Command::new(env!("CARGO_BIN_EXE_pis-trace"))
-        .arg(&scene).arg("-o").arg(dir.path().join("set")).args(["--resolution", "65536x65536"])
-        .output().unwrap();
+        .arg(&scene)
+        .arg("-o")
+        .arg(dir.path().join("set"))
+        .args(["--resolution", "65536x65536"])
+        .output()
+        .unwrap();
     let err = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(5), "{err}");
-    assert!(err.contains("a point of 65536x65536 pixels needs about") && err.contains("are available"), "{err}");
+    assert!(
+        err.contains("a point of 65536x65536 pixels needs about") && err.contains("are available"),
+        "{err}"
+    );
     assert!(!dir.path().join("set").join("set.json").exists());
 }

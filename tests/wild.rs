@@ -20,7 +20,8 @@ fn scene(name: &str) -> PathBuf {
 }
 
 fn run(program: &str, args: &[&std::ffi::OsStr]) -> Output {
-    let out = Command::new(program).args(args).output().unwrap_or_else(|e| panic!("{program} runs: {e}"));
+    let out =
+        Command::new(program).args(args).output().unwrap_or_else(|e| panic!("{program} runs: {e}"));
     assert!(
         out.status.success(),
         "{program} {args:?} failed ({}): {}",
@@ -40,11 +41,16 @@ fn check(name: &str) {
     let start = Instant::now();
     let dir = tempfile::tempdir().expect("temp dir");
     let toml = scene(name);
-    let (set, gold, file) = (dir.path().join("set"), dir.path().join("gold"), dir.path().join(format!("{name}.pis")));
-    let trace = run(env!("CARGO_BIN_EXE_pis-trace"), &[os(&toml), os("-o"), os(&set), os("--json")]);
+    let (set, gold, file) =
+        (dir.path().join("set"), dir.path().join("gold"), dir.path().join(format!("{name}.pis")));
+    let trace =
+        run(env!("CARGO_BIN_EXE_pis-trace"), &[os(&toml), os("-o"), os(&set), os("--json")]);
     let report: serde_json::Value = serde_json::from_slice(&trace.stdout).expect("pis-trace JSON");
     run(env!("CARGO_BIN_EXE_pis-trace"), &[os(&toml), os("--spp"), os("64"), os("-o"), os(&gold)]);
-    let pack = run(env!("CARGO_BIN_EXE_pis-pack"), &[os(&set), os("--scene"), os(&toml), os("-o"), os(&file), os("--json")]);
+    let pack = run(
+        env!("CARGO_BIN_EXE_pis-pack"),
+        &[os(&set), os("--scene"), os(&toml), os("-o"), os(&file), os("--json")],
+    );
     let pack: serde_json::Value = serde_json::from_slice(&pack.stdout).expect("pis-pack JSON");
     let ratio = pack["ratio_without_geometry"].as_f64().expect("ratio_without_geometry");
     assert!((ratio / 384.0 - 1.0).abs() < 0.05, "{name}: ratio {ratio:.1}, default 384");
@@ -54,7 +60,10 @@ fn check(name: &str) {
     let whole = diff["psnr_db"].as_f64().expect("psnr_db");
     let mut figures = vec![("whole image".to_string(), whole)];
     for o in diff["objects"].as_array().expect("objects") {
-        figures.push((o["name"].as_str().expect("name").to_string(), o["psnr_db"].as_f64().expect("object psnr_db")));
+        figures.push((
+            o["name"].as_str().expect("name").to_string(),
+            o["psnr_db"].as_f64().expect("object psnr_db"),
+        ));
     }
     println!(
         "{name}: {} points, ratio {ratio:.0}:1, predicted {:.2} dB, {:.0} s; against the 64-spp gold standard:",
@@ -65,7 +74,10 @@ fn check(name: &str) {
     for (what, db) in &figures {
         println!("  {what:<12} {db:6.2} dB");
     }
-    assert!(whole >= FLOOR_DB, "{name}: the whole image {whole:.2} dB against the gold standard, below {FLOOR_DB} dB");
+    assert!(
+        whole >= FLOOR_DB,
+        "{name}: the whole image {whole:.2} dB against the gold standard, below {FLOOR_DB} dB"
+    );
 }
 
 #[test]

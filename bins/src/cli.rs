@@ -49,5 +49,6 @@ pub fn message(err: &anyhow::Error) -> String {
 
 /// `--shading-seed` and `--reference-seed`: what seeds the tracer's shading.
 pub fn parse_shading_seed(s: &str) -> Result<pis_trace::ShadingSeed, String> {
-    pis_trace::ShadingSeed::from_name(s).ok_or_else(|| format!("unknown shading seed {s:?} (cell or sample)"))
+    pis_trace::ShadingSeed::from_name(s)
+        .ok_or_else(|| format!("unknown shading seed {s:?} (cell or sample)"))
 }

@@ -9,7 +9,10 @@ use pis_codec::CodecId;
 use pis_compile::{Filter, MAX_ANISOTROPY};
 
 use crate::cli::{Exit, Failure};
-use pis_pack::{filter_needs_probe, Allocation, BlockSize, LayerMode, MatrixSource, MaxMse, PackRequest, PackSettings, PlacementMode, PyramidMode, RepresentationMode, Stagger};
+use pis_pack::{
+    filter_needs_probe, Allocation, BlockSize, LayerMode, MatrixSource, MaxMse, PackRequest,
+    PackSettings, PlacementMode, PyramidMode, RepresentationMode, Stagger,
+};
 
 /// pis-pack's settings on the command line.
 #[derive(Args, Debug, Clone)]
@@ -138,11 +141,24 @@ pub struct PackOptions {
 
 impl PackOptions {
     /// The request that packs `input` into `output` with these options.
-    pub fn request(&self, input: PathBuf, scene: Option<PathBuf>, output: PathBuf) -> Result<PackRequest, Failure> {
+    pub fn request(
+        &self,
+        input: PathBuf,
+        scene: Option<PathBuf>,
+        output: PathBuf,
+    ) -> Result<PackRequest, Failure> {
         let filter = match (self.filter, self.anisotropy) {
             (Filter::Anisotropic(_), n) => Filter::Anisotropic(n.unwrap_or(MAX_ANISOTROPY)),
             (f, None) => f,
-            (f, Some(_)) => return Err(Failure::new(Exit::Usage, anyhow::anyhow!("--anisotropy applies to --filter anisotropic, not {}", f.name()))),
+            (f, Some(_)) => {
+                return Err(Failure::new(
+                    Exit::Usage,
+                    anyhow::anyhow!(
+                        "--anisotropy applies to --filter anisotropic, not {}",
+                        f.name()
+                    ),
+                ))
+            }
         };
         if let Some(why) = filter_needs_probe(filter, self.matrix) {
             return Err(Failure::new(Exit::Usage, anyhow::anyhow!(why)));
@@ -197,7 +213,10 @@ impl PackOptions {
 }
 
 fn parse_memory(s: &str) -> Result<f64, String> {
-    s.parse::<f64>().ok().filter(|v| v.is_finite() && *v > 0.0).ok_or_else(|| format!("bad memory budget {s:?}: expected a number of GB above 0"))
+    s.parse::<f64>()
+        .ok()
+        .filter(|v| v.is_finite() && *v > 0.0)
+        .ok_or_else(|| format!("bad memory budget {s:?}: expected a number of GB above 0"))
 }
 
 fn parse_codec(s: &str) -> Result<CodecId, String> {
@@ -232,7 +251,9 @@ fn parse_representation(s: &str) -> Result<RepresentationMode, String> {
         "pem-infinity" => Ok(RepresentationMode::PemInfinity),
         "static-env" => Ok(RepresentationMode::StaticEnv),
         "auto" => Ok(RepresentationMode::Auto),
-        _ => Err(format!("unknown representation {s:?} (auto, texture, pem, pem-infinity or static-env)")),
+        _ => Err(format!(
+            "unknown representation {s:?} (auto, texture, pem, pem-infinity or static-env)"
+        )),
     }
 }
 
@@ -255,7 +276,9 @@ pub fn parse_max_mse_ratio(s: &str) -> Result<MaxMse, String> {
         "off" => Ok(MaxMse::Off),
         _ => match s.parse::<f64>() {
             Ok(a) if a.is_finite() && a > 1.0 => Ok(MaxMse::On(a)),
-            _ => Err(format!("{s:?} is not `auto`, `off` or a ratio above 1 (the thesis uses 1.25)")),
+            _ => {
+                Err(format!("{s:?} is not `auto`, `off` or a ratio above 1 (the thesis uses 1.25)"))
+            }
         },
     }
 }
@@ -294,7 +317,10 @@ fn parse_budget(s: &str) -> Result<Budget, String> {
     if s == "none" {
         return Ok(Budget(None));
     }
-    s.parse::<f64>().ok().filter(|k| k.is_finite() && *k > 0.0).map(|k| Budget(Some(k)))
+    s.parse::<f64>()
+        .ok()
+        .filter(|k| k.is_finite() && *k > 0.0)
+        .map(|k| Budget(Some(k)))
         .ok_or_else(|| format!("--texels-per-pixel {s:?}: expected a number > 0 or `none`"))
 }
 
@@ -313,7 +339,6 @@ pub fn parse_resolution(s: &str) -> Result<(u32, u32), String> {
     }
 }
 
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -328,7 +353,13 @@ mod tests {
     /// `--representation` takes every mode by the name the library gives it.
     #[test]
     fn every_representation_parses_by_its_name() {
-        for mode in [RepresentationMode::Texture, RepresentationMode::Pem, RepresentationMode::PemInfinity, RepresentationMode::StaticEnv, RepresentationMode::Auto] {
+        for mode in [
+            RepresentationMode::Texture,
+            RepresentationMode::Pem,
+            RepresentationMode::PemInfinity,
+            RepresentationMode::StaticEnv,
+            RepresentationMode::Auto,
+        ] {
             assert_eq!(parse_representation(mode.name()), Ok(mode));
         }
         assert!(parse_representation("static").unwrap_err().contains("static-env"));

@@ -6,8 +6,8 @@ pub mod args;
 use std::path::{Path, PathBuf};
 
 use crate::cli::{Exit, Failure};
-pub use args::PlayArgs;
 use crate::pack_args::PackOptions;
+pub use args::PlayArgs;
 
 /// Whether a path names a scene (scene.toml) rather than a container.
 fn is_scene(path: &Path) -> bool {
@@ -19,7 +19,11 @@ fn is_scene(path: &Path) -> bool {
 /// scene.toml. Options other than the defaults pack into a file of their own, named by a
 /// hash of the options.
 fn pack_scene(scene_toml: &Path, options: &PackOptions) -> Result<PathBuf, Failure> {
-    let load = pis_scene::LoadOptions { preset: options.preset.clone(), resolution: options.resolution, spp: options.spp };
+    let load = pis_scene::LoadOptions {
+        preset: options.preset.clone(),
+        resolution: options.resolution,
+        spp: options.spp,
+    };
     let scene = pis_scene::load_with(scene_toml, &load).map_err(Failure::from)?;
     let set_dir = pis_pack::cache_dir(scene_toml, &scene);
     let mut name = set_dir.file_name().map(|n| n.to_os_string()).unwrap_or_default();
@@ -32,26 +36,40 @@ fn pack_scene(scene_toml: &Path, options: &PackOptions) -> Result<PathBuf, Failu
     let modified = |p: &Path| std::fs::metadata(p).and_then(|m| m.modified()).ok();
     if let (Some(pis), Some(toml)) = (modified(&output), modified(scene_toml)) {
         if pis >= toml {
-            eprintln!("pis-play: playing {} (packed from {})", output.display(), scene_toml.display());
+            eprintln!(
+                "pis-play: playing {} (packed from {})",
+                output.display(),
+                scene_toml.display()
+            );
             return Ok(output);
         }
     }
-    std::fs::create_dir_all(set_dir.parent().unwrap_or(Path::new("."))).map_err(|e| Failure::new(Exit::Io, anyhow::anyhow!("{}: {e}", set_dir.display())))?;
-    eprintln!("pis-play: tracing and packing {} into {} (once)", scene_toml.display(), output.display());
+    std::fs::create_dir_all(set_dir.parent().unwrap_or(Path::new(".")))
+        .map_err(|e| Failure::new(Exit::Io, anyhow::anyhow!("{}: {e}", set_dir.display())))?;
+    eprintln!(
+        "pis-play: tracing and packing {} into {} (once)",
+        scene_toml.display(),
+        output.display()
+    );
     let req = options.request(scene_toml.to_path_buf(), None, output.clone())?;
     let report = pis_pack::pack_request(&req, &pis_pack::StderrProgress)?;
-    pis_pack::print_report(&report, &mut std::io::stderr()).map_err(|e| Failure::new(Exit::Io, e))?;
+    pis_pack::print_report(&report, &mut std::io::stderr())
+        .map_err(|e| Failure::new(Exit::Io, e))?;
     Ok(output)
 }
 
 /// 64-bit FNV-1a: a stable name for a set of options.
 fn fnv1a(bytes: &[u8]) -> u64 {
-    bytes.iter().fold(0xcbf2_9ce4_8422_2325u64, |h, &b| (h ^ b as u64).wrapping_mul(0x0100_0000_01b3))
+    bytes
+        .iter()
+        .fold(0xcbf2_9ce4_8422_2325u64, |h, &b| (h ^ b as u64).wrapping_mul(0x0100_0000_01b3))
 }
 
 /// Whether a display server is reachable through the environment (X11 or Wayland).
 pub fn has_display() -> bool {
-    ["DISPLAY", "WAYLAND_DISPLAY"].iter().any(|v| std::env::var_os(v).is_some_and(|s| !s.is_empty()))
+    ["DISPLAY", "WAYLAND_DISPLAY"]
+        .iter()
+        .any(|v| std::env::var_os(v).is_some_and(|s| !s.is_empty()))
 }
 
 /// Runs pis-play: in a window where a display is set and no headless output (--out,
@@ -84,7 +102,9 @@ pub fn run(args: &PlayArgs) -> Result<Exit, Failure> {
         } else if window_only {
             return Err(Failure::new(Exit::Runtime, anyhow::anyhow!("--screenshot and --set need a window, and no display is set (DISPLAY / WAYLAND_DISPLAY): run under `xvfb-run -a`")));
         } else {
-            eprintln!("pis-play: note: no display (DISPLAY / WAYLAND_DISPLAY unset); drawing headless");
+            eprintln!(
+                "pis-play: note: no display (DISPLAY / WAYLAND_DISPLAY unset); drawing headless"
+            );
         }
     } else if args.screenshot.is_some() || (args.set.is_some() && !args.headless) {
         return Err(Failure::new(Exit::Usage, anyhow::anyhow!("--screenshot and --set (without --headless) are window options; they do not go with --headless, --out or --compare")));
@@ -102,7 +122,9 @@ pub fn run(args: &PlayArgs) -> Result<Exit, Failure> {
 /// The headless player: a frame, a path of frames, or a comparison with a set; the report
 /// on stderr (and as JSON on stdout with `--json`).
 fn headless(args: &PlayArgs) -> Result<Exit, Failure> {
-    use pis_eval::headless::{open, print_compare_report, print_path_report, run_compare, run_frames};
+    use pis_eval::headless::{
+        open, print_compare_report, print_path_report, run_compare, run_frames,
+    };
     let req = args.headless();
     let (gpu, mut player) = open(&req)?;
     match &args.compare {
@@ -118,7 +140,11 @@ fn headless(args: &PlayArgs) -> Result<Exit, Failure> {
 }
 
 /// Prints a report on stderr, and as JSON on stdout when asked.
-fn emit<T: serde::Serialize>(json: bool, report: &T, print: impl Fn(&T, &mut std::io::Stderr) -> std::io::Result<()>) -> Result<Exit, Failure> {
+fn emit<T: serde::Serialize>(
+    json: bool,
+    report: &T,
+    print: impl Fn(&T, &mut std::io::Stderr) -> std::io::Result<()>,
+) -> Result<Exit, Failure> {
     print(report, &mut std::io::stderr()).map_err(|e| Failure::new(Exit::Io, e))?;
     if json {
         let s = serde_json::to_string_pretty(report).map_err(|e| Failure::new(Exit::Runtime, e))?;

@@ -24,11 +24,19 @@ pub fn window_options(args: &PlayArgs) -> Result<WindowOptions, Failure> {
         Some(PathChoice::Diagonal) => (true, false),
         Some(PathChoice::Orbit) => (false, true),
         Some(PathChoice::File(f)) => {
-            return Err(Failure::new(Exit::Usage, anyhow::anyhow!("--path {}: a path file is played headless (--headless)", f.display())))
+            return Err(Failure::new(
+                Exit::Usage,
+                anyhow::anyhow!(
+                    "--path {}: a path file is played headless (--headless)",
+                    f.display()
+                ),
+            ))
         }
     };
     let frames = match (args.frames, &args.screenshot) {
-        (Some(n), _) => Some(u32::try_from(n).ok().filter(|&n| n > 0).ok_or_else(|| Failure::new(Exit::Usage, anyhow::anyhow!("--frames {n}: expected 1 to {}", u32::MAX)))?),
+        (Some(n), _) => Some(u32::try_from(n).ok().filter(|&n| n > 0).ok_or_else(|| {
+            Failure::new(Exit::Usage, anyhow::anyhow!("--frames {n}: expected 1 to {}", u32::MAX))
+        })?),
         (None, Some(_)) => Some(SCREENSHOT_FRAME),
         (None, None) => None,
     };
@@ -61,7 +69,10 @@ pub fn try_run(args: &PlayArgs) -> Result<(), WindowFailure> {
     let report = run_window(window_options(args)?)?;
     if let Some(r) = report {
         if args.json {
-            println!("{}", serde_json::to_string_pretty(&r).map_err(|e| Failure::new(Exit::Runtime, e))?);
+            println!(
+                "{}",
+                serde_json::to_string_pretty(&r).map_err(|e| Failure::new(Exit::Runtime, e))?
+            );
         }
         eprintln!(
             "pis-play: {} frames at {}×{} ({}) in {:.2} s: {:.1} fps (first frame left out); player {:.2} ms per frame (decode {:.2} ms, upload {:.2} ms)",

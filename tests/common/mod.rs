@@ -60,7 +60,11 @@ pub fn os<S: AsRef<std::ffi::OsStr> + ?Sized>(s: &S) -> &std::ffi::OsStr {
 /// Copies samples/NAME (without its cache) into `dir` with `edit` applied to its glTF JSON
 /// (`NAME.gltf`); returns the copy's scene.toml.
 #[allow(dead_code)]
-pub fn sample_copy(name: &str, dir: &Path, edit: impl FnOnce(&mut serde_json::Value, &Path)) -> PathBuf {
+pub fn sample_copy(
+    name: &str,
+    dir: &Path,
+    edit: impl FnOnce(&mut serde_json::Value, &Path),
+) -> PathBuf {
     let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("../samples").join(name);
     std::fs::create_dir_all(dir).expect("scene folder");
     for e in std::fs::read_dir(&src).expect("the sample").filter_map(Result::ok) {
@@ -69,7 +73,8 @@ pub fn sample_copy(name: &str, dir: &Path, edit: impl FnOnce(&mut serde_json::Va
         }
     }
     let gltf = dir.join(format!("{name}.gltf"));
-    let mut doc: serde_json::Value = serde_json::from_slice(&std::fs::read(&gltf).expect("the glTF")).expect("glTF JSON");
+    let mut doc: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(&gltf).expect("the glTF")).expect("glTF JSON");
     edit(&mut doc, dir);
     std::fs::write(&gltf, serde_json::to_vec(&doc).expect("JSON")).expect("write the glTF");
     dir.join("scene.toml")
@@ -78,7 +83,12 @@ pub fn sample_copy(name: &str, dir: &Path, edit: impl FnOnce(&mut serde_json::Va
 /// Sets `key` of the glTF node named `node` (e.g. its `scale`).
 #[allow(dead_code)]
 pub fn set_node(doc: &mut serde_json::Value, node: &str, key: &str, value: serde_json::Value) {
-    let n = doc["nodes"].as_array_mut().expect("nodes").iter_mut().find(|n| n["name"] == node).unwrap_or_else(|| panic!("no node {node}"));
+    let n = doc["nodes"]
+        .as_array_mut()
+        .expect("nodes")
+        .iter_mut()
+        .find(|n| n["name"] == node)
+        .unwrap_or_else(|| panic!("no node {node}"));
     n[key] = value;
 }
 

@@ -17,15 +17,15 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
-use pis::cli::{finish, parse, Exit, Failure, parse_shading_seed, EXIT_CODES_HELP};
+use pis::cli::{finish, parse, parse_shading_seed, Exit, Failure, EXIT_CODES_HELP};
+use pis_compile::SolveSettings;
 use pis_eval::bench::all::{self, Preset};
-use pis_eval::bench::rd::{self, RdRequest};
-use pis_eval::bench::speed::{self, SpeedRequest};
 use pis_eval::bench::hybrid::{self, HybridRequest};
+use pis_eval::bench::rd::{self, RdRequest};
 use pis_eval::bench::reflective::{self, ReflectiveRequest};
+use pis_eval::bench::speed::{self, SpeedRequest};
 use pis_eval::bench::stability::{self, StabilityRequest};
 use pis_pack::infer::{infer, print_report, InferRequest};
-use pis_compile::SolveSettings;
 
 /// The PIS evaluation harness: speed charted against accuracy, PIS against the codecs a user
 /// would pick instead. Each chart subcommand writes CSV and SVG into --out (default
@@ -325,7 +325,8 @@ fn json_out<T: serde::Serialize>(v: &T) -> Result<(), Failure> {
 }
 
 fn parse_resolution(s: &str) -> Result<(u32, u32), String> {
-    let (w, h) = s.split_once(['x', 'X']).ok_or_else(|| format!("expected WIDTHxHEIGHT, got {s:?}"))?;
+    let (w, h) =
+        s.split_once(['x', 'X']).ok_or_else(|| format!("expected WIDTHxHEIGHT, got {s:?}"))?;
     let w: u32 = w.trim().parse().map_err(|_| format!("bad width in {s:?}"))?;
     let h: u32 = h.trim().parse().map_err(|_| format!("bad height in {s:?}"))?;
     if w == 0 || h == 0 {
@@ -336,39 +337,132 @@ fn parse_resolution(s: &str) -> Result<(u32, u32), String> {
 
 fn run(cli: Cli) -> Result<Exit, Failure> {
     match cli.command {
-        Command::Infer { input, object, at, scene, resolution, spp, preset, all_objects, max_texture, epsilon_f, epsilon_b, pyramidal_epsilon_b, tolerance, max_iterations, antialias, neighbour, reduction, texels_per_pixel, no_wgpu, json } => {
+        Command::Infer {
+            input,
+            object,
+            at,
+            scene,
+            resolution,
+            spp,
+            preset,
+            all_objects,
+            max_texture,
+            epsilon_f,
+            epsilon_b,
+            pyramidal_epsilon_b,
+            tolerance,
+            max_iterations,
+            antialias,
+            neighbour,
+            reduction,
+            texels_per_pixel,
+            no_wgpu,
+            json,
+        } => {
             if !input.exists() {
-                return Err(Failure::new(Exit::Io, anyhow::anyhow!("{} does not exist", input.display())));
+                return Err(Failure::new(
+                    Exit::Io,
+                    anyhow::anyhow!("{} does not exist", input.display()),
+                ));
             }
             if max_texture == 0 || max_texture > 16384 {
-                return Err(Failure::new(Exit::Usage, anyhow::anyhow!("--max-texture must be in 1..=16384")));
+                return Err(Failure::new(
+                    Exit::Usage,
+                    anyhow::anyhow!("--max-texture must be in 1..=16384"),
+                ));
             }
-            if !(epsilon_f.is_finite() && epsilon_f >= 0.0 && tolerance.is_finite() && tolerance > 0.0) {
-                return Err(Failure::new(Exit::Usage, anyhow::anyhow!("--epsilon-f must be ≥ 0 and --tolerance > 0")));
+            if !(epsilon_f.is_finite()
+                && epsilon_f >= 0.0
+                && tolerance.is_finite()
+                && tolerance > 0.0)
+            {
+                return Err(Failure::new(
+                    Exit::Usage,
+                    anyhow::anyhow!("--epsilon-f must be ≥ 0 and --tolerance > 0"),
+                ));
             }
             if antialias == 0 || antialias > 16 || !(reduction.is_finite() && reduction > 0.0) {
-                return Err(Failure::new(Exit::Usage, anyhow::anyhow!("--antialias must be in 1..=16 and --reduction > 0")));
+                return Err(Failure::new(
+                    Exit::Usage,
+                    anyhow::anyhow!("--antialias must be in 1..=16 and --reduction > 0"),
+                ));
             }
             if texels_per_pixel.is_some_and(|k| !(k.is_finite() && k > 0.0)) {
-                return Err(Failure::new(Exit::Usage, anyhow::anyhow!("--texels-per-pixel must be > 0")));
+                return Err(Failure::new(
+                    Exit::Usage,
+                    anyhow::anyhow!("--texels-per-pixel must be > 0"),
+                ));
             }
-            if !(epsilon_b.is_finite() && epsilon_b >= 0.0 && pyramidal_epsilon_b.is_finite() && pyramidal_epsilon_b >= 0.0) {
-                return Err(Failure::new(Exit::Usage, anyhow::anyhow!("--epsilon-b and --pyramidal-epsilon-b must be ≥ 0")));
+            if !(epsilon_b.is_finite()
+                && epsilon_b >= 0.0
+                && pyramidal_epsilon_b.is_finite()
+                && pyramidal_epsilon_b >= 0.0)
+            {
+                return Err(Failure::new(
+                    Exit::Usage,
+                    anyhow::anyhow!("--epsilon-b and --pyramidal-epsilon-b must be ≥ 0"),
+                ));
             }
             let mut solver = SolveSettings { epsilon_b, ..SolveSettings::default() };
             solver.cg.tolerance = tolerance;
             solver.cg.max_iterations = max_iterations;
-            let req = InferRequest { input, scene, object, at, resolution, spp, preset, all_objects, max_texture, solver, epsilon_f, pyramidal_epsilon_b, wgpu: !no_wgpu, antialias, neighbour, reduction, texels_per_pixel };
+            let req = InferRequest {
+                input,
+                scene,
+                object,
+                at,
+                resolution,
+                spp,
+                preset,
+                all_objects,
+                max_texture,
+                solver,
+                epsilon_f,
+                pyramidal_epsilon_b,
+                wgpu: !no_wgpu,
+                antialias,
+                neighbour,
+                reduction,
+                texels_per_pixel,
+            };
             let report = infer(&req).map_err(|e| Failure::new(Exit::Runtime, e))?;
             print_report(&report, &mut std::io::stderr()).map_err(|e| Failure::new(Exit::Io, e))?;
             if json {
-                let s = serde_json::to_string_pretty(&report).map_err(|e| Failure::new(Exit::Runtime, e))?;
+                let s = serde_json::to_string_pretty(&report)
+                    .map_err(|e| Failure::new(Exit::Runtime, e))?;
                 println!("{s}");
             }
             Ok(Exit::Ok)
         }
-        Command::Rd { input, scene, ratios, out, resolution, spp, max_texture, preset, methods, max_mse_ratio, stagger, record, json } => {
-            let req = RdRequest { input, scene, ratios, out, resolution, spp, max_texture, preset, record, methods, max_mse: max_mse_ratio, stagger };
+        Command::Rd {
+            input,
+            scene,
+            ratios,
+            out,
+            resolution,
+            spp,
+            max_texture,
+            preset,
+            methods,
+            max_mse_ratio,
+            stagger,
+            record,
+            json,
+        } => {
+            let req = RdRequest {
+                input,
+                scene,
+                ratios,
+                out,
+                resolution,
+                spp,
+                max_texture,
+                preset,
+                record,
+                methods,
+                max_mse: max_mse_ratio,
+                stagger,
+            };
             let report = rd::run(&req)?;
             rd::print(&report, &mut std::io::stderr()).map_err(|e| Failure::new(Exit::Io, e))?;
             if json {
@@ -376,8 +470,31 @@ fn run(cli: Cli) -> Result<Exit, Failure> {
             }
             Ok(Exit::Ok)
         }
-        Command::Speed { input, scene, caps, ratio, out, resolution, spp, preset, max_texture, record, json } => {
-            let req = SpeedRequest { input, scene, caps, ratio, out, resolution, spp, preset, max_texture, record };
+        Command::Speed {
+            input,
+            scene,
+            caps,
+            ratio,
+            out,
+            resolution,
+            spp,
+            preset,
+            max_texture,
+            record,
+            json,
+        } => {
+            let req = SpeedRequest {
+                input,
+                scene,
+                caps,
+                ratio,
+                out,
+                resolution,
+                spp,
+                preset,
+                max_texture,
+                record,
+            };
             let report = speed::run(&req)?;
             speed::print(&report, &mut std::io::stderr()).map_err(|e| Failure::new(Exit::Io, e))?;
             if json {
@@ -385,27 +502,92 @@ fn run(cli: Cli) -> Result<Exit, Failure> {
             }
             Ok(Exit::Ok)
         }
-        Command::Stability { input, scene, ratios, frames, reference_spp, reference_seed, out, resolution, spp, preset, max_texture, record, json } => {
-            let req = StabilityRequest { input, scene, ratios, frames, spp: reference_spp, reference_seed, out, resolution, trace_spp: spp, max_texture, preset, record };
+        Command::Stability {
+            input,
+            scene,
+            ratios,
+            frames,
+            reference_spp,
+            reference_seed,
+            out,
+            resolution,
+            spp,
+            preset,
+            max_texture,
+            record,
+            json,
+        } => {
+            let req = StabilityRequest {
+                input,
+                scene,
+                ratios,
+                frames,
+                spp: reference_spp,
+                reference_seed,
+                out,
+                resolution,
+                trace_spp: spp,
+                max_texture,
+                preset,
+                record,
+            };
             let report = stability::run(&req)?;
-            stability::print(&report, &mut std::io::stderr()).map_err(|e| Failure::new(Exit::Io, e))?;
+            stability::print(&report, &mut std::io::stderr())
+                .map_err(|e| Failure::new(Exit::Io, e))?;
             if json {
                 json_out(&report)?;
             }
             Ok(Exit::Ok)
         }
-        Command::Reflective { scene, files, frames, reference_spp, reference_seed, reference_pair, out, resolution, preset, images, role, tau, json } => {
-            let req = ReflectiveRequest { scene, preset, resolution, files, frames, spp: reference_spp, reference_seed, reference_pair, out, images, role, tau_px: tau };
+        Command::Reflective {
+            scene,
+            files,
+            frames,
+            reference_spp,
+            reference_seed,
+            reference_pair,
+            out,
+            resolution,
+            preset,
+            images,
+            role,
+            tau,
+            json,
+        } => {
+            let req = ReflectiveRequest {
+                scene,
+                preset,
+                resolution,
+                files,
+                frames,
+                spp: reference_spp,
+                reference_seed,
+                reference_pair,
+                out,
+                images,
+                role,
+                tau_px: tau,
+            };
             let report = reflective::run(&req)?;
-            reflective::print(&report, &mut std::io::stderr()).map_err(|e| Failure::new(Exit::Io, e))?;
+            reflective::print(&report, &mut std::io::stderr())
+                .map_err(|e| Failure::new(Exit::Io, e))?;
             if json {
                 json_out(&report)?;
             }
             Ok(Exit::Ok)
         }
         Command::Hybrid { scene, tau, frames, resolution, preset, file, msaa, json } => {
-            let report = hybrid::run(&HybridRequest { scene, preset, resolution, taus: tau, frames, file, msaa })?;
-            hybrid::print(&report, &mut std::io::stderr()).map_err(|e| Failure::new(Exit::Io, e))?;
+            let report = hybrid::run(&HybridRequest {
+                scene,
+                preset,
+                resolution,
+                taus: tau,
+                frames,
+                file,
+                msaa,
+            })?;
+            hybrid::print(&report, &mut std::io::stderr())
+                .map_err(|e| Failure::new(Exit::Io, e))?;
             if json {
                 json_out(&report)?;
             }

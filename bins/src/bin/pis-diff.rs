@@ -5,8 +5,8 @@ use std::process::ExitCode;
 
 use clap::Parser;
 use pis::cli::{self, Exit, Failure};
-use pis_eval::diff::gold::{gold, GoldRequest};
 use pis_eval::diff::files::{diff, render, DiffRequest};
+use pis_eval::diff::gold::{gold, GoldRequest};
 
 /// Compare two .pis files: structural differences (parameter space, cameras, objects, layers,
 /// shells, blocks, pyramid levels, codecs, settings, provenance; bytes per chunk kind) and
@@ -30,7 +30,11 @@ use pis_eval::diff::files::{diff, render, DiffRequest};
 /// ceiling of any file that stores the object in that model. A set against itself gives the
 /// model's own error.
 #[derive(Parser, Debug)]
-#[command(name = "pis-diff", version, after_help = "Exit codes: 0 identical or within the gates, 1 bad arguments, 2 I/O error, 3 invalid file, 4 runtime error, 5 not supported, 7 the files differ (no gate given) or a gate failed")]
+#[command(
+    name = "pis-diff",
+    version,
+    after_help = "Exit codes: 0 identical or within the gates, 1 bad arguments, 2 I/O error, 3 invalid file, 4 runtime error, 5 not supported, 7 the files differ (no gate given) or a gate failed"
+)]
 struct Cli {
     /// The first .pis file (the reference), or a ray-traced set folder (with a second one).
     a: PathBuf,
@@ -67,11 +71,19 @@ struct Cli {
 fn run(cli: Cli) -> Result<Exit, Failure> {
     if cli.a.is_dir() && cli.b.is_dir() {
         if cli.max_psnr_drop.is_some() || cli.reference_psnr.is_some() || cli.heatmaps.is_some() {
-            return Err(Failure::new(Exit::Usage, anyhow::anyhow!("two ray-traced sets compare with --min-psnr and --json only")));
+            return Err(Failure::new(
+                Exit::Usage,
+                anyhow::anyhow!("two ray-traced sets compare with --min-psnr and --json only"),
+            ));
         }
-        let report = pis_eval::diff::sets::compare_sets(&pis_eval::diff::sets::SetsRequest { a: cli.a, b: cli.b, min_psnr: cli.min_psnr })?;
+        let report = pis_eval::diff::sets::compare_sets(&pis_eval::diff::sets::SetsRequest {
+            a: cli.a,
+            b: cli.b,
+            min_psnr: cli.min_psnr,
+        })?;
         if cli.json {
-            let s = serde_json::to_string_pretty(&report).map_err(|e| Failure::new(Exit::Runtime, e))?;
+            let s = serde_json::to_string_pretty(&report)
+                .map_err(|e| Failure::new(Exit::Runtime, e))?;
             println!("{s}");
         } else {
             print!("{}", pis_eval::diff::sets::render(&report));
@@ -79,10 +91,19 @@ fn run(cli: Cli) -> Result<Exit, Failure> {
         return Ok(report.exit());
     }
     if cli.b.is_dir() {
-        let req = GoldRequest { file: cli.a, set: cli.b, heatmaps: cli.heatmaps, min_psnr: cli.min_psnr, max_psnr_drop: cli.max_psnr_drop, reference_psnr: cli.reference_psnr, msaa: cli.msaa };
+        let req = GoldRequest {
+            file: cli.a,
+            set: cli.b,
+            heatmaps: cli.heatmaps,
+            min_psnr: cli.min_psnr,
+            max_psnr_drop: cli.max_psnr_drop,
+            reference_psnr: cli.reference_psnr,
+            msaa: cli.msaa,
+        };
         let report = gold(&req)?;
         if cli.json {
-            let s = serde_json::to_string_pretty(&report).map_err(|e| Failure::new(Exit::Runtime, e))?;
+            let s = serde_json::to_string_pretty(&report)
+                .map_err(|e| Failure::new(Exit::Runtime, e))?;
             println!("{s}");
         } else {
             print!("{}", pis_eval::diff::gold::render(&report));
@@ -95,7 +116,8 @@ fn run(cli: Cli) -> Result<Exit, Failure> {
     let req = DiffRequest { a: cli.a, b: cli.b, heatmaps: cli.heatmaps, min_psnr: cli.min_psnr };
     let report = diff(&req)?;
     if cli.json {
-        let s = serde_json::to_string_pretty(&report).map_err(|e| Failure::new(Exit::Runtime, e))?;
+        let s =
+            serde_json::to_string_pretty(&report).map_err(|e| Failure::new(Exit::Runtime, e))?;
         println!("{s}");
     } else {
         print!("{}", render(&report));

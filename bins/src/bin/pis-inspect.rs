@@ -86,11 +86,7 @@ fn run(args: &Args) -> Result<Exit, Failure> {
                 for i in &v.issues {
                     println!("{i}");
                 }
-                let errors = v
-                    .issues
-                    .iter()
-                    .filter(|i| i.severity == Severity::Error)
-                    .count();
+                let errors = v.issues.iter().filter(|i| i.severity == Severity::Error).count();
                 let warnings = v.issues.len() - errors;
                 if v.is_valid() {
                     eprintln!("{}: valid ({warnings} warning(s))", args.file.display());
@@ -101,11 +97,7 @@ fn run(args: &Args) -> Result<Exit, Failure> {
                     );
                 }
             }
-            return Ok(if v.is_valid() {
-                Exit::Ok
-            } else {
-                Exit::Invalid
-            });
+            return Ok(if v.is_valid() { Exit::Ok } else { Exit::Invalid });
         }
         if args.extract.is_none() {
             return Ok(Exit::Ok);

@@ -9,7 +9,9 @@ use std::process::ExitCode;
 use clap::Parser;
 use pis::cli::{self, Exit, Failure};
 use pis::pack_args::PackOptions;
-use pis_pack::{merge_fragments, pack_request, print_report, solve_shard, PackReport, Shard, StderrProgress};
+use pis_pack::{
+    merge_fragments, pack_request, print_report, solve_shard, PackReport, Shard, StderrProgress,
+};
 
 /// Infer, compress and write the parameterized textures of a ray-traced set.
 ///
@@ -104,11 +106,19 @@ fn finish_pack(report: &PackReport, json: bool) -> Result<Exit, Failure> {
 
 fn run(cli: Cli) -> Result<Exit, Failure> {
     match cli.command {
-        Some(Command::Solve { set: SetArgs { input, scene, pack, json }, shard, fragments, resume }) => {
+        Some(Command::Solve {
+            set: SetArgs { input, scene, pack, json },
+            shard,
+            fragments,
+            resume,
+        }) => {
             let req = pack.request(input, scene, PathBuf::new())?;
             let r = solve_shard(&req, shard, &fragments, resume, &StderrProgress)?;
             if r.resumed {
-                eprintln!("pis-pack: shard {}: {} is there already (--resume): nothing to do", r.shard, r.fragment);
+                eprintln!(
+                    "pis-pack: shard {}: {} is there already (--resume): nothing to do",
+                    r.shard, r.fragment
+                );
             } else {
                 eprintln!("pis-pack: shard {}: {} objects solved ({}), {} solutions, {} bytes to {}, {:.1} s", r.shard, r.objects.len(), r.objects.join(", "), r.solutions, r.bytes, r.fragment, r.seconds);
             }
@@ -123,7 +133,10 @@ fn run(cli: Cli) -> Result<Exit, Failure> {
         }
         None => {
             let (Some(input), Some(output)) = (cli.input, cli.output) else {
-                return Err(Failure::new(Exit::Usage, anyhow::anyhow!("give INPUT and -o OUTPUT, or a subcommand (solve, merge)")));
+                return Err(Failure::new(
+                    Exit::Usage,
+                    anyhow::anyhow!("give INPUT and -o OUTPUT, or a subcommand (solve, merge)"),
+                ));
             };
             let req = cli.pack.request(input, cli.scene, output)?;
             finish_pack(&pack_request(&req, &StderrProgress)?, cli.json)

@@ -5,8 +5,8 @@ use std::process::ExitCode;
 
 use clap::Parser;
 use pis::cli::{self, Exit, Failure};
-use pis_eval::reencode::{print_report, reencode, ReencodeRequest};
 use pis_codec::CodecId;
+use pis_eval::reencode::{print_report, reencode, ReencodeRequest};
 
 /// Code every texture of a .pis file (all parameter samples, all layers) again: from the
 /// file's lossless master when it carries one (pis-pack --keep-master: the textures as
@@ -17,7 +17,11 @@ use pis_codec::CodecId;
 /// copied; provenance records the re-encoding. The output is written atomically, read back
 /// and compared with the input (and, with a master, both with the master).
 #[derive(Parser, Debug)]
-#[command(name = "pis-reencode", version, after_help = "Exit codes: 0 ok, 1 bad arguments, 2 I/O error, 3 invalid input file, 4 runtime error, 5 not supported")]
+#[command(
+    name = "pis-reencode",
+    version,
+    after_help = "Exit codes: 0 ok, 1 bad arguments, 2 I/O error, 3 invalid input file, 4 runtime error, 5 not supported"
+)]
 struct Cli {
     /// The .pis file to re-encode.
     input: PathBuf,
@@ -60,7 +64,10 @@ struct Cli {
 }
 
 fn parse_codec(s: &str) -> Result<CodecId, String> {
-    CodecId::ALL.into_iter().find(|c| c.name() == s).ok_or_else(|| format!("unknown codec {s:?} (wavelet, dct, lossless or raw)"))
+    CodecId::ALL
+        .into_iter()
+        .find(|c| c.name() == s)
+        .ok_or_else(|| format!("unknown codec {s:?} (wavelet, dct, lossless or raw)"))
 }
 
 /// `--block`: one size, or one per dimension.
@@ -72,11 +79,22 @@ fn parse_block(s: &str) -> Result<BlockSizes, String> {
 }
 
 fn run(cli: Cli) -> Result<Exit, Failure> {
-    let req = ReencodeRequest { input: cli.input, output: cli.output, codec: cli.codec, ratio: cli.ratio, psnr: cli.psnr, gamma: cli.gamma, keep_master: cli.keep_master, block: cli.block.map(|b| b.0), max_mse: cli.max_mse_ratio };
+    let req = ReencodeRequest {
+        input: cli.input,
+        output: cli.output,
+        codec: cli.codec,
+        ratio: cli.ratio,
+        psnr: cli.psnr,
+        gamma: cli.gamma,
+        keep_master: cli.keep_master,
+        block: cli.block.map(|b| b.0),
+        max_mse: cli.max_mse_ratio,
+    };
     let report = reencode(&req)?;
     print_report(&report, &mut std::io::stderr()).map_err(|e| Failure::new(Exit::Io, e))?;
     if cli.json {
-        let s = serde_json::to_string_pretty(&report).map_err(|e| Failure::new(Exit::Runtime, e))?;
+        let s =
+            serde_json::to_string_pretty(&report).map_err(|e| Failure::new(Exit::Runtime, e))?;
         println!("{s}");
     }
     Ok(Exit::Ok)

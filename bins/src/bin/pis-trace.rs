@@ -6,8 +6,8 @@
 use anyhow::Context;
 use clap::Parser;
 use indicatif::{ProgressBar, ProgressStyle};
-use pis_scene::LoadOptions;
 use pis::cli::parse_shading_seed;
+use pis_scene::LoadOptions;
 use pis_trace::set::{merge_set, MergeReport, Shard};
 use pis_trace::{render_shard, Progress, SetReport, TraceError, TraceRun, TraceSettings};
 use std::path::{Path, PathBuf};
@@ -20,7 +20,13 @@ use std::process::ExitCode;
 /// traced writes set.json; `pis-trace merge OUT` does the same on demand. `--resume`
 /// continues an interrupted trace from the points it recorded.
 #[derive(Parser, Debug)]
-#[command(name = "pis-trace", version, about, args_conflicts_with_subcommands = true, subcommand_negates_reqs = true)]
+#[command(
+    name = "pis-trace",
+    version,
+    about,
+    args_conflicts_with_subcommands = true,
+    subcommand_negates_reqs = true
+)]
 struct Cli {
     #[command(subcommand)]
     command: Option<Command>,
@@ -85,7 +91,8 @@ enum Command {
 }
 
 fn parse_resolution(s: &str) -> Result<(u32, u32), String> {
-    let (w, h) = s.split_once(['x', 'X']).ok_or_else(|| format!("expected WIDTHxHEIGHT, got {s:?}"))?;
+    let (w, h) =
+        s.split_once(['x', 'X']).ok_or_else(|| format!("expected WIDTHxHEIGHT, got {s:?}"))?;
     let w: u32 = w.trim().parse().map_err(|_| format!("bad width in {s:?}"))?;
     let h: u32 = h.trim().parse().map_err(|_| format!("bad height in {s:?}"))?;
     if w == 0 || h == 0 {
@@ -117,14 +124,19 @@ impl Progress for Bar {
 }
 
 fn run(cli: &Cli, scene: &Path, output: &Path) -> anyhow::Result<SetReport> {
-    let options = LoadOptions { preset: cli.preset.clone(), resolution: cli.resolution, spp: cli.spp };
+    let options =
+        LoadOptions { preset: cli.preset.clone(), resolution: cli.resolution, spp: cli.spp };
     let scene = pis_scene::load_with(scene, &options).map_err(TraceError::from)?;
-    let settings = TraceSettings::new(scene.resolution, scene.spp).with_shading_seed(cli.shading_seed).with_seed(cli.seed);
+    let settings = TraceSettings::new(scene.resolution, scene.spp)
+        .with_shading_seed(cli.shading_seed)
+        .with_seed(cli.seed);
     let bar = ProgressBar::new(0);
     bar.set_style(
-        ProgressStyle::with_template("{spinner} {msg} [{bar:40}] {percent}% {elapsed_precise} (eta {eta})")
-            .unwrap_or_else(|_| ProgressStyle::default_bar())
-            .progress_chars("=> "),
+        ProgressStyle::with_template(
+            "{spinner} {msg} [{bar:40}] {percent}% {elapsed_precise} (eta {eta})",
+        )
+        .unwrap_or_else(|_| ProgressStyle::default_bar())
+        .progress_chars("=> "),
     );
     let mut pool = rayon::ThreadPoolBuilder::new();
     if let Some(t) = cli.threads {
@@ -132,7 +144,11 @@ fn run(cli: &Cli, scene: &Path, output: &Path) -> anyhow::Result<SetReport> {
     }
     let pool = pool.build().context("starting worker threads")?;
     let progress = Bar(bar);
-    let run = TraceRun { limit: cli.points, shard: cli.shard.unwrap_or(Shard::WHOLE), resume: cli.resume };
+    let run = TraceRun {
+        limit: cli.points,
+        shard: cli.shard.unwrap_or(Shard::WHOLE),
+        resume: cli.resume,
+    };
     let report = pool.install(|| render_shard(&scene, output, &settings, &run, &progress))?;
     progress.0.finish_and_clear();
     Ok(report)
@@ -157,13 +173,21 @@ fn print_report(r: &SetReport) {
         r.ms_per_point, r.trace_ms_per_point, r.seconds, mib
     );
     if let Some(shard) = &r.shard {
-        eprintln!("  shard {shard}: {} points traced, {} recorded before (--resume)", r.points, r.resumed);
+        eprintln!(
+            "  shard {shard}: {} points traced, {} recorded before (--resume)",
+            r.points, r.resumed
+        );
     } else if r.resumed > 0 {
         eprintln!("  {} points recorded before (--resume)", r.resumed);
     }
     eprintln!(
         "  set: {}",
-        if r.complete { format!("complete, {} points (set.json written)", r.set_points) } else { "not complete yet: other shards are to trace the rest (pis-trace merge assembles it)".to_string() }
+        if r.complete {
+            format!("complete, {} points (set.json written)", r.set_points)
+        } else {
+            "not complete yet: other shards are to trace the rest (pis-trace merge assembles it)"
+                .to_string()
+        }
     );
 }
 
@@ -187,7 +211,10 @@ fn merge(set: &Path, json: bool) -> ExitCode {
             if *already_complete {
                 eprintln!("pis-trace: {}: complete already, {points} points", set.display());
             } else {
-                eprintln!("pis-trace: {}: {points} points merged (set.json, {bytes} bytes)", set.display());
+                eprintln!(
+                    "pis-trace: {}: {points} points merged (set.json, {bytes} bytes)",
+                    set.display()
+                );
             }
             if json {
                 return print_json(&r);

@@ -6,7 +6,11 @@ use clap::Parser;
 pub use pis_eval::headless::{parse_path, set_display_filter, PathChoice};
 
 fn parse_size(s: &str) -> Result<(u32, u32), String> {
-    let v: Vec<u32> = s.split(['x', 'X']).map(|p| p.trim().parse::<u32>().ok().filter(|&n| n > 0)).collect::<Option<_>>().ok_or_else(|| format!("expected WIDTHxHEIGHT, got {s:?}"))?;
+    let v: Vec<u32> = s
+        .split(['x', 'X'])
+        .map(|p| p.trim().parse::<u32>().ok().filter(|&n| n > 0))
+        .collect::<Option<_>>()
+        .ok_or_else(|| format!("expected WIDTHxHEIGHT, got {s:?}"))?;
     match v.as_slice() {
         [w, h] => Ok((*w, *h)),
         _ => Err(format!("expected WIDTHxHEIGHT, got {s:?}")),
@@ -34,7 +38,10 @@ pub fn parse_msaa(s: &str) -> Result<u32, String> {
 }
 
 fn parse_reduction(s: &str) -> Result<u32, String> {
-    s.parse::<u32>().ok().filter(|r| r.is_power_of_two()).ok_or_else(|| format!("--reduction {s:?}: expected a power of two (1, 2, 4, …)"))
+    s.parse::<u32>()
+        .ok()
+        .filter(|r| r.is_power_of_two())
+        .ok_or_else(|| format!("--reduction {s:?}: expected a power of two (1, 2, 4, …)"))
 }
 
 /// Play a `.pis` file: draw frames of its parameterized textures on the GPU (thesis 4.7).
@@ -136,7 +143,10 @@ pub struct PlayArgs {
     pub no_vsync: bool,
     /// Given a scene.toml: how it is traced and packed (pis-pack's options; a .pis file is
     /// played as it is).
-    #[command(flatten, next_help_heading = "Tracing and packing a scene.toml (pis-pack's options)")]
+    #[command(
+        flatten,
+        next_help_heading = "Tracing and packing a scene.toml (pis-pack's options)"
+    )]
     pub pack: crate::pack_args::PackOptions,
 }
 
@@ -165,7 +175,11 @@ impl PlayArgs {
             blend: self.blend,
             msaa: self.msaa,
             tau_px: self.tau,
-            display_filter: self.compare.as_deref().or(self.set.as_deref()).and_then(set_display_filter),
+            display_filter: self
+                .compare
+                .as_deref()
+                .or(self.set.as_deref())
+                .and_then(set_display_filter),
             ..d
         }
     }

@@ -16,17 +16,17 @@ use winit::event::{StartCause, WindowEvent};
 use winit::event_loop::{ActiveEventLoop, ControlFlow, EventLoop};
 use winit::window::{Window, WindowId};
 
-use pis_play::window::camera::sight_convergence;
 use super::gold::GoldSet;
-use pis_play::window::path::{PathKind, Playback};
 use super::screenshot::{write_png_rgba8, Capture};
-use pis_play::window::space::Space;
-use pis_play::window::stats::{FrameSample, StatsMeter};
 use super::surface::WindowSurface;
 use super::ui::{self, PanelInfo};
-use pis_play::window::view::ViewState;
 use crate::cli::{Exit, Failure};
 use pis_eval::headless::play_failure;
+use pis_play::window::camera::sight_convergence;
+use pis_play::window::path::{PathKind, Playback};
+use pis_play::window::space::Space;
+use pis_play::window::stats::{FrameSample, StatsMeter};
+use pis_play::window::view::ViewState;
 
 /// How the window is opened and run.
 #[derive(Clone, Debug)]
@@ -111,7 +111,9 @@ pub fn run_window(opts: WindowOptions) -> Result<Option<RunReport>, WindowFailur
         WindowFailure::NoDisplay(format!("cannot open a window: {e} (set DISPLAY or WAYLAND_DISPLAY to a running display, or run under `xvfb-run -a`)"))
     })?;
     let mut app = App { instance, opts, running: None, failure: None, report: None };
-    event_loop.run_app(&mut app).map_err(|e| Failure::new(Exit::Runtime, anyhow::anyhow!("window event loop: {e}")))?;
+    event_loop
+        .run_app(&mut app)
+        .map_err(|e| Failure::new(Exit::Runtime, anyhow::anyhow!("window event loop: {e}")))?;
     match app.failure {
         Some(f) => Err(f.into()),
         None => Ok(app.report),
@@ -185,16 +187,29 @@ impl App {
                 default_window_size((c.width, c.height))
             }
         };
-        let name = o.file.file_name().map_or_else(|| o.file.display().to_string(), |n| n.to_string_lossy().into_owned());
+        let name = o
+            .file
+            .file_name()
+            .map_or_else(|| o.file.display().to_string(), |n| n.to_string_lossy().into_owned());
         let attrs = Window::default_attributes()
             .with_title(format!("pis-play — {name}"))
             .with_inner_size(winit::dpi::PhysicalSize::new(probe_size.0, probe_size.1));
-        let window = Arc::new(event_loop.create_window(attrs).map_err(|e| runtime(format!("cannot open a window: {e}")))?);
-        let surface = self.instance.create_surface(window.clone()).map_err(|e| runtime(format!("cannot make a wgpu surface for the window: {e}")))?;
-        let (gpu, caps) = Gpu::for_surface(&self.instance, &surface, o.gpu).map_err(play_failure)?;
+        let window = Arc::new(
+            event_loop
+                .create_window(attrs)
+                .map_err(|e| runtime(format!("cannot open a window: {e}")))?,
+        );
+        let surface = self
+            .instance
+            .create_surface(window.clone())
+            .map_err(|e| runtime(format!("cannot make a wgpu surface for the window: {e}")))?;
+        let (gpu, caps) =
+            Gpu::for_surface(&self.instance, &surface, o.gpu).map_err(play_failure)?;
         let gpu = Arc::new(gpu);
-        let surface = WindowSurface::new(surface, caps, &gpu.device, &window, o.vsync).map_err(runtime)?;
-        let mut player = Player::open(gpu.clone(), &o.file, o.player.clone()).map_err(play_failure)?;
+        let surface =
+            WindowSurface::new(surface, caps, &gpu.device, &window, o.vsync).map_err(runtime)?;
+        let mut player =
+            Player::open(gpu.clone(), &o.file, o.player.clone()).map_err(play_failure)?;
         if let Some(note) = &player.multisample_for(surface.view_format).note {
             eprintln!("pis-play: note: {note}");
         }
@@ -204,7 +219,15 @@ impl App {
             Some(at) if at.len() == space.axes.len() => at.clone(),
             Some(at) => {
                 let names: Vec<&str> = space.axes.iter().map(|a| a.name.as_str()).collect();
-                return Err(Failure::new(Exit::Usage, anyhow::anyhow!("--at has {} values, the file's space has {} dimensions ({})", at.len(), names.len(), names.join(", "))));
+                return Err(Failure::new(
+                    Exit::Usage,
+                    anyhow::anyhow!(
+                        "--at has {} values, the file's space has {} dimensions ({})",
+                        at.len(),
+                        names.len(),
+                        names.join(", ")
+                    ),
+                ));
             }
             None => space.start_point(),
         };
@@ -228,7 +251,14 @@ impl App {
 
         let egui_ctx = egui::Context::default();
         let max_side = gpu.limits.max_texture_dimension_2d as usize;
-        let egui_state = egui_winit::State::new(egui_ctx.clone(), egui::ViewportId::ROOT, &window, Some(window.scale_factor() as f32), window.theme(), Some(max_side));
+        let egui_state = egui_winit::State::new(
+            egui_ctx.clone(),
+            egui::ViewportId::ROOT,
+            &window,
+            Some(window.scale_factor() as f32),
+            window.theme(),
+            Some(max_side),
+        );
         let renderer = egui_wgpu::Renderer::new(
             &gpu.device,
             surface.view_format,
@@ -279,7 +309,8 @@ fn focus_distance(player: &Player, space: &Space, point: &[f32]) -> f32 {
             cams.push(player.sample_camera(&p));
         }
     }
-    let ahead = sight_convergence(&cams).map(|c| (c - here.eye).dot((here.target - here.eye).normalize_or_zero()));
+    let ahead = sight_convergence(&cams)
+        .map(|c| (c - here.eye).dot((here.target - here.eye).normalize_or_zero()));
     match ahead {
         Some(d) if d.is_finite() && d > 2.0 * here.near => d,
         _ if here.far.is_finite() => (here.near * here.far).sqrt(),
@@ -359,7 +390,8 @@ impl Running {
 
         let size = self.surface.size();
         let shown = self.meter.shown();
-        let gold_label = self.gold_texture.as_ref().filter(|_| self.view.show_gold).map(|g| g.label.clone());
+        let gold_label =
+            self.gold_texture.as_ref().filter(|_| self.view.show_gold).map(|g| g.label.clone());
         let info = PanelInfo {
             file: &self.file_label,
             adapter: &self.adapter,
@@ -378,7 +410,8 @@ impl Running {
         let mut actions = ui::Actions::default();
         let mut active = false;
         let view = &mut self.view;
-        let gold = self.gold_texture.as_ref().filter(|_| view.show_gold).map(|g| (g.texture.id(), g.size));
+        let gold =
+            self.gold_texture.as_ref().filter(|_| view.show_gold).map(|g| (g.texture.id(), g.size));
         let full = self.egui_ctx.run_ui(input, |ui| {
             if let Some((id, (w, h))) = gold {
                 paint_gold(ui, id, w, h);
@@ -397,10 +430,17 @@ impl Running {
         if actions.play {
             self.view.playback.play_from(&self.view.space, &self.view.point);
         }
-        self.repaint_after = full.viewport_output.get(&egui::ViewportId::ROOT).map(|v| v.repaint_delay).filter(|d| *d < Duration::from_secs(3600));
+        self.repaint_after = full
+            .viewport_output
+            .get(&egui::ViewportId::ROOT)
+            .map(|v| v.repaint_delay)
+            .filter(|d| *d < Duration::from_secs(3600));
         self.egui_state.handle_platform_output(&self.window, full.platform_output);
         let primitives = self.egui_ctx.tessellate(full.shapes, full.pixels_per_point);
-        let screen = egui_wgpu::ScreenDescriptor { size_in_pixels: [size.0, size.1], pixels_per_point: full.pixels_per_point };
+        let screen = egui_wgpu::ScreenDescriptor {
+            size_in_pixels: [size.0, size.1],
+            pixels_per_point: full.pixels_per_point,
+        };
 
         let frame = match self.surface.surface.get_current_texture() {
             wgpu::CurrentSurfaceTexture::Success(t) => t,
@@ -419,9 +459,14 @@ impl Running {
                 self.window.request_redraw();
                 return Ok(None);
             }
-            wgpu::CurrentSurfaceTexture::Validation => return Err(runtime("the window surface failed validation")),
+            wgpu::CurrentSurfaceTexture::Validation => {
+                return Err(runtime("the window surface failed validation"))
+            }
         };
-        let target = frame.texture.create_view(&wgpu::TextureViewDescriptor { format: Some(self.surface.view_format), ..Default::default() });
+        let target = frame.texture.create_view(&wgpu::TextureViewDescriptor {
+            format: Some(self.surface.view_format),
+            ..Default::default()
+        });
         for (id, deltas) in &full.textures_delta.set {
             for delta in deltas {
                 self.renderer.update_texture(&self.gpu.device, &self.gpu.queue, *id, delta);
@@ -430,10 +475,12 @@ impl Running {
         let stats = self.draw(&target, size, &primitives, &screen)?;
         let last_frame = opts.frames.is_some_and(|n| self.frames + 1 >= n);
         if let (true, Some(path)) = (last_frame, &opts.screenshot) {
-            let capture = Capture::new(&self.gpu.device, self.surface.view_format, size.0, size.1).map_err(|m| Failure::new(Exit::NotSupported, anyhow::anyhow!(m)))?;
+            let capture = Capture::new(&self.gpu.device, self.surface.view_format, size.0, size.1)
+                .map_err(|m| Failure::new(Exit::NotSupported, anyhow::anyhow!(m)))?;
             self.draw(&capture.view, size, &primitives, &screen)?;
             let pixels = capture.read(&self.gpu.device, &self.gpu.queue).map_err(runtime)?;
-            write_png_rgba8(path, size.0, size.1, &pixels).map_err(|e| Failure::new(Exit::Io, e))?;
+            write_png_rgba8(path, size.0, size.1, &pixels)
+                .map_err(|e| Failure::new(Exit::Io, e))?;
         }
         self.window.pre_present_notify();
         self.gpu.queue.present(frame);
@@ -491,7 +538,12 @@ impl Running {
         let gold = self.view.show_gold && self.gold_texture.is_some();
         let mut stats = None;
         if !gold {
-            match self.player.render_to_view(&self.view.request(), target, self.surface.view_format, size) {
+            match self.player.render_to_view(
+                &self.view.request(),
+                target,
+                self.surface.view_format,
+                size,
+            ) {
                 Ok(s) => {
                     stats = Some(s);
                     self.message = None;
@@ -503,10 +555,17 @@ impl Running {
             }
         }
         let device = &self.gpu.device;
-        let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("pis-play panels") });
-        let user = self.renderer.update_buffers(device, &self.gpu.queue, &mut encoder, primitives, screen);
+        let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
+            label: Some("pis-play panels"),
+        });
+        let user =
+            self.renderer.update_buffers(device, &self.gpu.queue, &mut encoder, primitives, screen);
         {
-            let load = if gold || stats.is_none() { wgpu::LoadOp::Clear(wgpu::Color::BLACK) } else { wgpu::LoadOp::Load };
+            let load = if gold || stats.is_none() {
+                wgpu::LoadOp::Clear(wgpu::Color::BLACK)
+            } else {
+                wgpu::LoadOp::Load
+            };
             let pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
                 label: Some("pis-play panels"),
                 color_attachments: &[Some(wgpu::RenderPassColorAttachment {
@@ -541,10 +600,26 @@ impl Running {
         match set.image_near(&self.view.point) {
             Ok(img) => {
                 if self.gold_texture.as_ref().is_none_or(|t| t.index != img.index) {
-                    let color = egui::ColorImage::from_rgba_unmultiplied([img.width as usize, img.height as usize], &img.srgba);
-                    let texture = self.egui_ctx.load_texture("gold standard", color, egui::TextureOptions::LINEAR);
-                    let label = format!("{} (point {})", img.samples.iter().map(|s| s.to_string()).collect::<Vec<_>>().join(", "), img.index);
-                    self.gold_texture = Some(GoldTexture { index: img.index, texture, size: (img.width, img.height), label });
+                    let color = egui::ColorImage::from_rgba_unmultiplied(
+                        [img.width as usize, img.height as usize],
+                        &img.srgba,
+                    );
+                    let texture = self.egui_ctx.load_texture(
+                        "gold standard",
+                        color,
+                        egui::TextureOptions::LINEAR,
+                    );
+                    let label = format!(
+                        "{} (point {})",
+                        img.samples.iter().map(|s| s.to_string()).collect::<Vec<_>>().join(", "),
+                        img.index
+                    );
+                    self.gold_texture = Some(GoldTexture {
+                        index: img.index,
+                        texture,
+                        size: (img.width, img.height),
+                        label,
+                    });
                 }
             }
             Err(m) => {
@@ -560,7 +635,8 @@ impl Running {
 fn paint_gold(ui: &egui::Ui, id: egui::TextureId, w: u32, h: u32) {
     let rect = ui.max_rect();
     let scale = rect.height() / h.max(1) as f32;
-    let fitted = egui::Rect::from_center_size(rect.center(), egui::vec2(w as f32 * scale, rect.height()));
+    let fitted =
+        egui::Rect::from_center_size(rect.center(), egui::vec2(w as f32 * scale, rect.height()));
     let uv = egui::Rect::from_min_max(egui::pos2(0.0, 0.0), egui::pos2(1.0, 1.0));
     ui.painter().image(id, fitted, uv, egui::Color32::WHITE);
 }

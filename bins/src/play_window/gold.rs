@@ -40,7 +40,9 @@ impl GoldSet {
             let exit = pis_pack::trace_exit(&e);
             Failure::new(exit, anyhow::anyhow!("--set: {e}"))
         })?;
-        let file_dim = match_dimensions(&set, dims).map_err(|m| Failure::new(Exit::Invalid, anyhow::anyhow!("--set {}: {m}", dir.display())))?;
+        let file_dim = match_dimensions(&set, dims).map_err(|m| {
+            Failure::new(Exit::Invalid, anyhow::anyhow!("--set {}: {m}", dir.display()))
+        })?;
         Ok(GoldSet { set, file_dim, last: None })
     }
 
@@ -69,10 +71,14 @@ impl GoldSet {
 
     /// The gold-standard image nearest to `point`, read from disk unless it is the last one.
     pub fn image_near(&mut self, point: &[f32]) -> Result<&GoldImage, String> {
-        let index = self.nearest(point).ok_or_else(|| format!("{}: no point at the samples nearest to {point:?}", self.set.dir.display()))?;
+        let index = self.nearest(point).ok_or_else(|| {
+            format!("{}: no point at the samples nearest to {point:?}", self.set.dir.display())
+        })?;
         if self.last.as_ref().is_none_or(|g| g.index != index) {
             let images = self.set.read_point(index).map_err(|e| e.to_string())?;
-            let combined = images.layer("combined").ok_or_else(|| format!("point {index}: no `combined` layer"))?;
+            let combined = images
+                .layer("combined")
+                .ok_or_else(|| format!("point {index}: no `combined` layer"))?;
             let n = combined.width as usize * combined.height as usize;
             let mut srgba = vec![255u8; 4 * n];
             for (c, name) in ["R", "G", "B"].iter().enumerate() {
@@ -83,7 +89,13 @@ impl GoldSet {
                 }
             }
             let samples = self.set.meta.points[index].samples.clone();
-            self.last = Some(GoldImage { index, samples, width: combined.width, height: combined.height, srgba });
+            self.last = Some(GoldImage {
+                index,
+                samples,
+                width: combined.width,
+                height: combined.height,
+                srgba,
+            });
         }
         self.last.as_ref().ok_or_else(|| "no image".to_string())
     }
@@ -104,15 +116,21 @@ fn match_dimensions(set: &RaySet, dims: &[Dimension]) -> Result<Vec<usize>, Stri
     let set_names: Vec<&str> = set.meta.space.iter().map(|d| d.name.as_str()).collect();
     let file_names: Vec<&str> = dims.iter().map(|d| d.name.as_str()).collect();
     if set_names.len() != file_names.len() {
-        return Err(format!("the set's dimensions ({}) are not the file's ({})", names(set_names), names(file_names)));
+        return Err(format!(
+            "the set's dimensions ({}) are not the file's ({})",
+            names(set_names),
+            names(file_names)
+        ));
     }
     set_names
         .iter()
         .map(|n| {
-            file_names
-                .iter()
-                .position(|f| f == n)
-                .ok_or_else(|| format!("the set's dimension '{n}' is not one of the file's ({})", names(file_names.clone())))
+            file_names.iter().position(|f| f == n).ok_or_else(|| {
+                format!(
+                    "the set's dimension '{n}' is not one of the file's ({})",
+                    names(file_names.clone())
+                )
+            })
         })
         .collect()
 }

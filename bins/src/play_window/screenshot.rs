@@ -16,9 +16,16 @@ pub struct Capture {
 
 impl Capture {
     /// A `width × height` target of `format` (an 8-bit RGBA or BGRA format, sRGB or not).
-    pub fn new(device: &wgpu::Device, format: wgpu::TextureFormat, width: u32, height: u32) -> Result<Capture, String> {
+    pub fn new(
+        device: &wgpu::Device,
+        format: wgpu::TextureFormat,
+        width: u32,
+        height: u32,
+    ) -> Result<Capture, String> {
         if format.block_copy_size(None) != Some(4) || format.components() != 4 {
-            return Err(format!("cannot save frames of format {format:?} (8-bit RGBA or BGRA needed)"));
+            return Err(format!(
+                "cannot save frames of format {format:?} (8-bit RGBA or BGRA needed)"
+            ));
         }
         let texture = device.create_texture(&wgpu::TextureDescriptor {
             label: Some("pis-play screenshot"),
@@ -38,19 +45,26 @@ impl Capture {
     /// an sRGB format).
     pub fn read(&self, device: &wgpu::Device, queue: &wgpu::Queue) -> Result<Vec<u8>, String> {
         let row = 4 * self.width;
-        let padded = row.div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
+        let padded =
+            row.div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
         let buffer = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("pis-play screenshot readback"),
             size: padded as u64 * self.height as u64,
             usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
             mapped_at_creation: false,
         });
-        let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("screenshot copy") });
+        let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
+            label: Some("screenshot copy"),
+        });
         encoder.copy_texture_to_buffer(
             self.texture.as_image_copy(),
             wgpu::TexelCopyBufferInfo {
                 buffer: &buffer,
-                layout: wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(padded), rows_per_image: Some(self.height) },
+                layout: wgpu::TexelCopyBufferLayout {
+                    offset: 0,
+                    bytes_per_row: Some(padded),
+                    rows_per_image: Some(self.height),
+                },
             },
             wgpu::Extent3d { width: self.width, height: self.height, depth_or_array_layers: 1 },
         );
@@ -60,10 +74,17 @@ impl Capture {
         slice.map_async(wgpu::MapMode::Read, move |r| {
             let _ = tx.send(r);
         });
-        device.poll(wgpu::PollType::wait_indefinitely()).map_err(|e| format!("waiting for the screenshot copy: {e}"))?;
-        rx.recv().map_err(|e| e.to_string())?.map_err(|e| format!("mapping the screenshot: {e}"))?;
+        device
+            .poll(wgpu::PollType::wait_indefinitely())
+            .map_err(|e| format!("waiting for the screenshot copy: {e}"))?;
+        rx.recv()
+            .map_err(|e| e.to_string())?
+            .map_err(|e| format!("mapping the screenshot: {e}"))?;
         let data = slice.get_mapped_range().map_err(|e| format!("reading the screenshot: {e}"))?;
-        let bgra = matches!(self.format, wgpu::TextureFormat::Bgra8Unorm | wgpu::TextureFormat::Bgra8UnormSrgb);
+        let bgra = matches!(
+            self.format,
+            wgpu::TextureFormat::Bgra8Unorm | wgpu::TextureFormat::Bgra8UnormSrgb
+        );
         let mut out = Vec::with_capacity((row * self.height) as usize);
         for y in 0..self.height as usize {
             let line = &data[y * padded as usize..y * padded as usize + row as usize];
@@ -87,10 +108,18 @@ impl Capture {
 pub fn write_png_rgba8(path: &Path, width: u32, height: u32, rgba: &[u8]) -> anyhow::Result<()> {
     let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
     let tmp = path.with_file_name(format!(".{name}.tmp"));
-    let written = image::save_buffer_with_format(&tmp, rgba, width, height, image::ExtendedColorType::Rgba8, image::ImageFormat::Png);
+    let written = image::save_buffer_with_format(
+        &tmp,
+        rgba,
+        width,
+        height,
+        image::ExtendedColorType::Rgba8,
+        image::ImageFormat::Png,
+    );
     if let Err(e) = written {
         let _ = std::fs::remove_file(&tmp);
         return Err(e).with_context(|| format!("cannot write {}", path.display()));
     }
-    std::fs::rename(&tmp, path).with_context(|| format!("cannot move {} to {}", tmp.display(), path.display()))
+    std::fs::rename(&tmp, path)
+        .with_context(|| format!("cannot move {} to {}", tmp.display(), path.display()))
 }

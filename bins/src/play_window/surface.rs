@@ -16,7 +16,9 @@ pub struct WindowSurface {
 
 /// Picks the surface format and the view format: an sRGB surface format if the surface has
 /// one, else its first format viewed through the sRGB twin.
-pub fn choose_formats(formats: &[wgpu::TextureFormat]) -> Option<(wgpu::TextureFormat, wgpu::TextureFormat)> {
+pub fn choose_formats(
+    formats: &[wgpu::TextureFormat],
+) -> Option<(wgpu::TextureFormat, wgpu::TextureFormat)> {
     if let Some(&f) = formats.iter().find(|f| f.is_srgb()) {
         return Some((f, f));
     }
@@ -34,7 +36,8 @@ impl WindowSurface {
         window: &Arc<Window>,
         vsync: bool,
     ) -> Result<WindowSurface, String> {
-        let (format, view_format) = choose_formats(&adapter_caps.formats).ok_or("the window surface offers no texture format")?;
+        let (format, view_format) = choose_formats(&adapter_caps.formats)
+            .ok_or("the window surface offers no texture format")?;
         let size = window.inner_size();
         let config = wgpu::SurfaceConfiguration {
             usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
@@ -42,9 +45,17 @@ impl WindowSurface {
             color_space: wgpu::SurfaceColorSpace::Auto,
             width: size.width.max(1),
             height: size.height.max(1),
-            present_mode: if vsync { wgpu::PresentMode::AutoVsync } else { wgpu::PresentMode::AutoNoVsync },
+            present_mode: if vsync {
+                wgpu::PresentMode::AutoVsync
+            } else {
+                wgpu::PresentMode::AutoNoVsync
+            },
             desired_maximum_frame_latency: 2,
-            alpha_mode: adapter_caps.alpha_modes.first().copied().unwrap_or(wgpu::CompositeAlphaMode::Auto),
+            alpha_mode: adapter_caps
+                .alpha_modes
+                .first()
+                .copied()
+                .unwrap_or(wgpu::CompositeAlphaMode::Auto),
             view_formats: if view_format != format { vec![view_format] } else { Vec::new() },
         };
         surface.configure(device, &config);
@@ -77,7 +88,10 @@ mod tests {
 
     #[test]
     fn an_srgb_format_is_preferred_and_a_linear_one_viewed_as_srgb() {
-        assert_eq!(choose_formats(&[F::Bgra8Unorm, F::Bgra8UnormSrgb]), Some((F::Bgra8UnormSrgb, F::Bgra8UnormSrgb)));
+        assert_eq!(
+            choose_formats(&[F::Bgra8Unorm, F::Bgra8UnormSrgb]),
+            Some((F::Bgra8UnormSrgb, F::Bgra8UnormSrgb))
+        );
         assert_eq!(choose_formats(&[F::Rgba8Unorm]), Some((F::Rgba8Unorm, F::Rgba8UnormSrgb)));
         assert_eq!(choose_formats(&[]), None);
     }

@@ -41,7 +41,9 @@ pub struct Actions {
 /// Movement keys held, as −1..1 per axis, and Shift.
 pub fn fly_keys(ui: &Ui) -> (f32, f32, f32, bool) {
     ui.input(|i| {
-        let axis = |plus: Key, minus: Key| i.key_down(plus) as i32 as f32 - i.key_down(minus) as i32 as f32;
+        let axis = |plus: Key, minus: Key| {
+            i.key_down(plus) as i32 as f32 - i.key_down(minus) as i32 as f32
+        };
         (axis(Key::W, Key::S), axis(Key::D, Key::A), axis(Key::E, Key::Q), i.modifiers.shift)
     })
 }
@@ -104,8 +106,16 @@ pub fn draw(ui: &mut Ui, v: &mut ViewState, info: &PanelInfo, dt: f32) -> Action
         return actions;
     }
     let ctx = ui.ctx().clone();
-    egui::Window::new("Parameters").default_pos([8.0, 8.0]).resizable(false).show(&ctx, |ui| parameters(ui, v, info, &mut actions));
-    egui::Window::new("Stats").default_width(180.0).max_width(220.0).anchor(egui::Align2::RIGHT_TOP, [-8.0, 8.0]).resizable(false).show(&ctx, |ui| stats(ui, info));
+    egui::Window::new("Parameters")
+        .default_pos([8.0, 8.0])
+        .resizable(false)
+        .show(&ctx, |ui| parameters(ui, v, info, &mut actions));
+    egui::Window::new("Stats")
+        .default_width(180.0)
+        .max_width(220.0)
+        .anchor(egui::Align2::RIGHT_TOP, [-8.0, 8.0])
+        .resizable(false)
+        .show(&ctx, |ui| stats(ui, info));
     actions
 }
 
@@ -113,13 +123,24 @@ fn parameters(ui: &mut Ui, v: &mut ViewState, info: &PanelInfo, actions: &mut Ac
     ui.label(info.file);
     egui::Grid::new("dims").num_columns(2).show(ui, |ui| {
         for (k, axis) in v.space.axes.clone().iter().enumerate() {
-            let label = if axis.unit.is_empty() { axis.name.clone() } else { format!("{} ({})", axis.name, axis.unit) };
+            let label = if axis.unit.is_empty() {
+                axis.name.clone()
+            } else {
+                format!("{} ({})", axis.name, axis.unit)
+            };
             ui.label(label);
-            let s = ui.add_enabled(axis.span() > 0.0, egui::Slider::new(&mut v.point[k], axis.min..=axis.max));
+            let s = ui.add_enabled(
+                axis.span() > 0.0,
+                egui::Slider::new(&mut v.point[k], axis.min..=axis.max),
+            );
             if s.changed() {
                 v.playback.playing = false;
             }
-            ui.label(format!("sample {}/{}", axis.nearest_sample(v.point[k]) + 1, axis.samples.len()));
+            ui.label(format!(
+                "sample {}/{}",
+                axis.nearest_sample(v.point[k]) + 1,
+                axis.samples.len()
+            ));
             ui.end_row();
         }
     });
@@ -134,7 +155,9 @@ fn parameters(ui: &mut Ui, v: &mut ViewState, info: &PanelInfo, actions: &mut Ac
         }
         let name = |k: PathKind| match k {
             PathKind::Diagonal => "diagonal".to_string(),
-            PathKind::Along(d) => format!("along {}", v.space.axes.get(d).map_or("?", |a| a.name.as_str())),
+            PathKind::Along(d) => {
+                format!("along {}", v.space.axes.get(d).map_or("?", |a| a.name.as_str()))
+            }
         };
         let mut kind = v.playback.kind;
         egui::ComboBox::from_id_salt("path").selected_text(name(kind)).show_ui(ui, |ui| {
@@ -150,7 +173,11 @@ fn parameters(ui: &mut Ui, v: &mut ViewState, info: &PanelInfo, actions: &mut Ac
             }
         }
     });
-    ui.add(egui::Slider::new(&mut v.playback.seconds_per_traverse, 1.0..=60.0).logarithmic(true).text("s per traverse"));
+    ui.add(
+        egui::Slider::new(&mut v.playback.seconds_per_traverse, 1.0..=60.0)
+            .logarithmic(true)
+            .text("s per traverse"),
+    );
     ui.horizontal(|ui| {
         ui.label("blend");
         ui.radio_value(&mut v.multilinear, false, "nearest sample");
@@ -159,7 +186,9 @@ fn parameters(ui: &mut Ui, v: &mut ViewState, info: &PanelInfo, actions: &mut Ac
     ui.separator();
     ui.horizontal(|ui| {
         ui.label("camera");
-        for (m, name) in [(CameraMode::Sample, "sample"), (CameraMode::Orbit, "orbit"), (CameraMode::Fly, "fly")] {
+        for (m, name) in
+            [(CameraMode::Sample, "sample"), (CameraMode::Orbit, "orbit"), (CameraMode::Fly, "fly")]
+        {
             if ui.radio(v.mode == m, name).clicked() {
                 actions.mode = Some(m);
             }

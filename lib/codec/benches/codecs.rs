@@ -33,11 +33,7 @@ fn edges(w: u32, h: u32) -> Vec<f32> {
     let mut v = Vec::with_capacity((w * h * 3) as usize);
     for y in 0..h {
         for x in 0..w {
-            let check = if ((x + 5) / 13 + (y + 3) / 13) % 2 == 0 {
-                0.2
-            } else {
-                0.7
-            };
+            let check = if ((x + 5) / 13 + (y + 3) / 13) % 2 == 0 { 0.2 } else { 0.7 };
             let (dx, dy) = (x as f32 / w as f32 - 0.4, y as f32 / h as f32 - 0.6);
             let glow = 0.5 * (-(dx * dx + dy * dy) * 20.0).exp();
             for c in 0..3 {
@@ -81,13 +77,9 @@ fn main() {
         println!();
         println!("rate-distortion on '{name}' (decode MB/s of decoded f32 at that rate; PSNR for peak 1.0)");
         println!("target ratio   wavelet bytes  PSNR dB  dec MB/s    dct bytes  PSNR dB  dec MB/s");
-        let full = wavelet::encode_full(
-            &planes,
-            &values,
-            wavelet::DEFAULT_LEVELS,
-            wavelet::DEFAULT_BITS,
-        )
-        .expect("encode");
+        let full =
+            wavelet::encode_full(&planes, &values, wavelet::DEFAULT_LEVELS, wavelet::DEFAULT_BITS)
+                .expect("encode");
         for ratio in [16usize, 48, 96, 192, 384, 768] {
             let budget = values.len() * 4 / ratio;
             let w = full.truncated(budget, &planes);

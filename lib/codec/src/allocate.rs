@@ -61,14 +61,12 @@ pub enum AllocError {
     #[error("item {0} has an empty rate-distortion curve")]
     EmptyCurve(usize),
     #[error("item {item} names object {object}, but there are {objects} areas")]
-    Object {
-        item: usize,
-        object: usize,
-        objects: usize,
-    },
+    Object { item: usize, object: usize, objects: usize },
     #[error("the smallest encodings need {needed} bytes, over the budget of {budget}")]
     Budget { needed: usize, budget: usize },
-    #[error("PSNR {db} dB is out of reach: every level image at its full rate gives {best_db:.2} dB")]
+    #[error(
+        "PSNR {db} dB is out of reach: every level image at its full rate gives {best_db:.2} dB"
+    )]
     Unreachable { db: f64, best_db: f64 },
 }
 
@@ -161,7 +159,13 @@ impl Problem {
 
     /// The allocation meeting `target` with every item at or above its `floor`;
     /// `Budget` when the floors alone do not fit a byte budget.
-    fn solve(&self, target: Target, areas: &[f64], items: &[Item], floor: &[usize]) -> Result<Vec<usize>, AllocError> {
+    fn solve(
+        &self,
+        target: Target,
+        areas: &[f64],
+        items: &[Item],
+        floor: &[usize],
+    ) -> Result<Vec<usize>, AllocError> {
         let all = vec![true; self.hulls.len()];
         let max_slope = self
             .hulls
@@ -215,11 +219,7 @@ impl Problem {
     }
 
     fn mses(&self, pick: &[usize]) -> Vec<f64> {
-        self.hulls
-            .iter()
-            .zip(pick)
-            .map(|(h, &k)| h[k].mse)
-            .collect()
+        self.hulls.iter().zip(pick).map(|(h, &k)| h[k].mse).collect()
     }
 
     /// The floors that make every object's MSE at most `limit` with the fewest bytes: per
@@ -306,19 +306,12 @@ pub fn allocate(
             return Err(AllocError::EmptyCurve(i));
         }
         if it.object >= areas.len() {
-            return Err(AllocError::Object {
-                item: i,
-                object: it.object,
-                objects: areas.len(),
-            });
+            return Err(AllocError::Object { item: i, object: it.object, objects: areas.len() });
         }
     }
     let problem = Problem {
         hulls: items.iter().map(|it| convex_hull(&it.curve)).collect(),
-        gain: items
-            .iter()
-            .map(|it| areas[it.object] * it.weight)
-            .collect(),
+        gain: items.iter().map(|it| areas[it.object] * it.weight).collect(),
     };
     let no_floor = vec![0usize; items.len()];
     let mut pick = problem.solve(target, areas, items, &no_floor)?;
@@ -328,20 +321,9 @@ pub fn allocate(
         }
     }
     let mse = problem.mses(&pick);
-    let bytes: Vec<usize> = problem
-        .hulls
-        .iter()
-        .zip(&pick)
-        .map(|(h, &k)| h[k].bytes)
-        .collect();
+    let bytes: Vec<usize> = problem.hulls.iter().zip(&pick).map(|(h, &k)| h[k].bytes).collect();
     let (object_mse, screen) = screen_mse(&mse, items, areas);
-    Ok(Allocation {
-        total_bytes: bytes.iter().sum(),
-        bytes,
-        mse,
-        object_mse,
-        screen_mse: screen,
-    })
+    Ok(Allocation { total_bytes: bytes.iter().sum(), bytes, mse, object_mse, screen_mse: screen })
 }
 
 /// The objects that hold any item: objects without level images have no MSE to balance.
@@ -364,7 +346,14 @@ fn spread(obj: &[f64], present: &[bool], alpha: f64) -> (f64, f64) {
 
 /// The max-MSE constrained allocation (see [`allocate`]), or `None` when the free one
 /// `free` already meets the constraint.
-fn balance(problem: &Problem, items: &[Item], areas: &[f64], target: Target, alpha: f64, free: &[usize]) -> Option<Vec<usize>> {
+fn balance(
+    problem: &Problem,
+    items: &[Item],
+    areas: &[f64],
+    target: Target,
+    alpha: f64,
+    free: &[usize],
+) -> Option<Vec<usize>> {
     let present = present(items, areas.len());
     let (max, bound) = spread(&screen_mse(&problem.mses(free), items, areas).0, &present, alpha);
     if max <= bound * (1.0 + 1e-9) || bound <= 0.0 {
@@ -375,7 +364,11 @@ fn balance(problem: &Problem, items: &[Item], areas: &[f64], target: Target, alp
         let (floor, beyond) = problem.floors(items, areas.len(), limit);
         let pick = problem.solve(target, areas, items, &floor).ok()?;
         let obj = screen_mse(&problem.mses(&pick), items, areas).0;
-        let holds = obj.iter().zip(&beyond).zip(&present).all(|((&e, &out), &p)| out || !p || e <= limit * (1.0 + 1e-9));
+        let holds = obj
+            .iter()
+            .zip(&beyond)
+            .zip(&present)
+            .all(|((&e, &out), &p)| out || !p || e <= limit * (1.0 + 1e-9));
         holds.then_some(pick)
     };
     // The thesis's two passes.
@@ -408,10 +401,7 @@ mod tests {
             points: (0..=400)
                 .map(|k| {
                     let r = k * 8;
-                    RdPoint {
-                        bytes: r,
-                        mse: var * 2f64.powf(-2.0 * r as f64 / n),
-                    }
+                    RdPoint { bytes: r, mse: var * 2f64.powf(-2.0 * r as f64 / n) }
                 })
                 .collect(),
         }
@@ -419,31 +409,11 @@ mod tests {
 
     fn items() -> (Vec<Item>, Vec<f64>) {
         let items = vec![
-            Item {
-                curve: curve(1.0, 400.0),
-                object: 0,
-                weight: 1.0,
-            },
-            Item {
-                curve: curve(0.1, 300.0),
-                object: 0,
-                weight: 0.5,
-            },
-            Item {
-                curve: curve(4.0, 800.0),
-                object: 1,
-                weight: 1.0,
-            },
-            Item {
-                curve: curve(0.01, 200.0),
-                object: 2,
-                weight: 1.0,
-            },
-            Item {
-                curve: curve(2.0, 600.0),
-                object: 2,
-                weight: 0.25,
-            },
+            Item { curve: curve(1.0, 400.0), object: 0, weight: 1.0 },
+            Item { curve: curve(0.1, 300.0), object: 0, weight: 0.5 },
+            Item { curve: curve(4.0, 800.0), object: 1, weight: 1.0 },
+            Item { curve: curve(0.01, 200.0), object: 2, weight: 1.0 },
+            Item { curve: curve(2.0, 600.0), object: 2, weight: 0.25 },
         ];
         (items, vec![1000.0, 50.0, 300.0])
     }
@@ -457,11 +427,7 @@ mod tests {
         let per = budget / items.len();
         let uniform: Vec<f64> = items.iter().map(|it| it.curve.mse_at(per)).collect();
         let (_, uniform_screen) = screen_mse(&uniform, &items, &areas);
-        assert!(
-            a.screen_mse < uniform_screen,
-            "{} vs {uniform_screen}",
-            a.screen_mse
-        );
+        assert!(a.screen_mse < uniform_screen, "{} vs {uniform_screen}", a.screen_mse);
     }
 
     #[test]
@@ -469,11 +435,7 @@ mod tests {
         let (items, areas) = items();
         let free = allocate(&items, &areas, Target::Bytes(1500), None).unwrap();
         let mean = free.object_mse.iter().sum::<f64>() / 3.0;
-        assert!(
-            free.object_mse.iter().any(|&e| e > 1.25 * mean),
-            "{:?}",
-            free.object_mse
-        );
+        assert!(free.object_mse.iter().any(|&e| e > 1.25 * mean), "{:?}", free.object_mse);
         let a = allocate(&items, &areas, Target::Bytes(1500), Some(DEFAULT_ALPHA)).unwrap();
         assert!(a.total_bytes <= 1500);
         for &e in &a.object_mse {
@@ -523,7 +485,10 @@ mod tests {
             // object 0 is the worst; where its whole curve can meet the limit, it gets it
             let reachable = items[0].curve.points.last().unwrap().mse <= 1.25 * mean;
             if worst(&free.object_mse) > 1.25 * mean && reachable && budget > 0 {
-                assert!(worst(&a.object_mse) < worst(&free.object_mse), "budget {budget}: the constraint did nothing");
+                assert!(
+                    worst(&a.object_mse) < worst(&free.object_mse),
+                    "budget {budget}: the constraint did nothing"
+                );
             }
         }
     }
@@ -533,7 +498,8 @@ mod tests {
         for (items, areas) in [items(), lopsided()] {
             let mut last = 0.0f64;
             for budget in (0..=4000).rev().step_by(37) {
-                let a = allocate(&items, &areas, Target::Bytes(budget), Some(DEFAULT_ALPHA)).unwrap();
+                let a =
+                    allocate(&items, &areas, Target::Bytes(budget), Some(DEFAULT_ALPHA)).unwrap();
                 let free = allocate(&items, &areas, Target::Bytes(budget), None).unwrap();
                 assert!(a.screen_mse >= free.screen_mse * (1.0 - 1e-12));
                 assert!(
@@ -549,38 +515,12 @@ mod tests {
     #[test]
     fn psnr_target_is_met_with_fewer_bytes_for_less_quality() {
         let (items, areas) = items();
-        let hi = allocate(
-            &items,
-            &areas,
-            Target::Psnr {
-                db: 30.0,
-                peak: 1.0,
-            },
-            None,
-        )
-        .unwrap();
-        let lo = allocate(
-            &items,
-            &areas,
-            Target::Psnr {
-                db: 20.0,
-                peak: 1.0,
-            },
-            None,
-        )
-        .unwrap();
+        let hi = allocate(&items, &areas, Target::Psnr { db: 30.0, peak: 1.0 }, None).unwrap();
+        let lo = allocate(&items, &areas, Target::Psnr { db: 20.0, peak: 1.0 }, None).unwrap();
         assert!(hi.screen_mse <= 1e-3 && lo.screen_mse <= 1e-2);
         assert!(lo.total_bytes < hi.total_bytes);
         assert!(matches!(
-            allocate(
-                &items,
-                &areas,
-                Target::Psnr {
-                    db: 400.0,
-                    peak: 1.0
-                },
-                None
-            ),
+            allocate(&items, &areas, Target::Psnr { db: 400.0, peak: 1.0 }, None),
             Err(AllocError::Unreachable { .. })
         ));
     }
@@ -589,28 +529,13 @@ mod tests {
     fn hull_drops_points_above_it() {
         let c = RdCurve {
             points: vec![
-                RdPoint {
-                    bytes: 0,
-                    mse: 10.0,
-                },
-                RdPoint {
-                    bytes: 10,
-                    mse: 9.5,
-                },
-                RdPoint {
-                    bytes: 20,
-                    mse: 2.0,
-                },
-                RdPoint {
-                    bytes: 30,
-                    mse: 1.0,
-                },
+                RdPoint { bytes: 0, mse: 10.0 },
+                RdPoint { bytes: 10, mse: 9.5 },
+                RdPoint { bytes: 20, mse: 2.0 },
+                RdPoint { bytes: 30, mse: 1.0 },
             ],
         };
         let h = convex_hull(&c);
-        assert_eq!(
-            h.iter().map(|p| p.bytes).collect::<Vec<_>>(),
-            vec![0, 20, 30]
-        );
+        assert_eq!(h.iter().map(|p| p.bytes).collect::<Vec<_>>(), vec![0, 20, 30]);
     }
 }

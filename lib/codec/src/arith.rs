@@ -54,14 +54,7 @@ impl Default for Encoder {
 
 impl Encoder {
     pub fn new() -> Self {
-        Encoder {
-            low: 0,
-            range: u32::MAX,
-            cache: 0,
-            cache_size: 1,
-            out: Vec::new(),
-            norms: 0,
-        }
+        Encoder { low: 0, range: u32::MAX, cache: 0, cache_size: 1, out: Vec::new(), norms: 0 }
     }
 
     /// Bytes a decoder needs to decide the *next* bit: 4 + the normalisations so far.
@@ -141,18 +134,9 @@ pub struct Decoder<'a> {
 impl<'a> Decoder<'a> {
     pub fn new(bytes: &'a [u8]) -> Self {
         let dead = bytes.len() < 4;
-        let code = if dead {
-            0
-        } else {
-            u32::from_be_bytes([bytes[0], bytes[1], bytes[2], bytes[3]])
-        };
-        Decoder {
-            bytes,
-            pos: 4,
-            code,
-            range: u32::MAX,
-            dead,
-        }
+        let code =
+            if dead { 0 } else { u32::from_be_bytes([bytes[0], bytes[1], bytes[2], bytes[3]]) };
+        Decoder { bytes, pos: 4, code, range: u32::MAX, dead }
     }
 
     /// True once the decoder has run out of bytes.
@@ -248,11 +232,7 @@ mod tests {
             let mut dec = Decoder::new(&stream[..cut]);
             let mut ctx = [Context::default(); 3];
             for (i, &b) in bits.iter().enumerate() {
-                let got = if i % 5 == 4 {
-                    dec.direct()
-                } else {
-                    dec.bit(&mut ctx[i % 3])
-                };
+                let got = if i % 5 == 4 { dec.direct() } else { dec.bit(&mut ctx[i % 3]) };
                 if needed[i] <= cut as u64 {
                     assert_eq!(got, Some(b), "bit {i} cut {cut}");
                 } else {

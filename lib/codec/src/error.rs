@@ -6,11 +6,7 @@ pub enum CodecError {
     #[error("codec '{0}' is reserved but not implemented in this build")]
     NotSupported(CodecId),
     #[error("plane shape {width}×{height}×{channels} is empty or too large")]
-    Shape {
-        width: u32,
-        height: u32,
-        channels: u32,
-    },
+    Shape { width: u32, height: u32, channels: u32 },
     #[error("expected {expected} values, found {found}")]
     Length { expected: usize, found: usize },
     #[error("codestream decodes to {found} bytes, expected {expected}")]

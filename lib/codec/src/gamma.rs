@@ -15,9 +15,7 @@ pub const DEFAULT_GAMMA: f32 = 2.2;
 pub fn compensate(values: &mut [f32], g: f32) {
     if g != 1.0 {
         let inv = 1.0 / g;
-        values
-            .iter_mut()
-            .for_each(|v| *v = v.signum() * v.abs().powf(inv));
+        values.iter_mut().for_each(|v| *v = v.signum() * v.abs().powf(inv));
     }
 }
 
@@ -28,9 +26,7 @@ pub fn uncompensate(values: &mut [f32], g: f32) {
     if g == DEFAULT_GAMMA {
         values.iter_mut().for_each(|v| *v = pow_11_5(*v));
     } else if g != 1.0 {
-        values
-            .iter_mut()
-            .for_each(|v| *v = v.signum() * v.abs().powf(g));
+        values.iter_mut().for_each(|v| *v = v.signum() * v.abs().powf(g));
     }
 }
 

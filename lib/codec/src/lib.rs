@@ -49,12 +49,7 @@ pub enum CodecId {
 }
 
 impl CodecId {
-    pub const ALL: [CodecId; 4] = [
-        CodecId::Raw,
-        CodecId::Lossless,
-        CodecId::Wavelet,
-        CodecId::Dct,
-    ];
+    pub const ALL: [CodecId; 4] = [CodecId::Raw, CodecId::Lossless, CodecId::Wavelet, CodecId::Dct];
 
     /// The id stored in the file.
     pub fn code(self) -> u16 {
@@ -130,12 +125,7 @@ pub trait LevelCodec: Sync {
     ) -> Result<RdCurve, CodecError> {
         check_weights(values, weights)?;
         let bytes = self.encode(planes, values, Rate::Default)?;
-        Ok(RdCurve {
-            points: vec![RdPoint {
-                bytes: bytes.len(),
-                mse: 0.0,
-            }],
-        })
+        Ok(RdCurve { points: vec![RdPoint { bytes: bytes.len(), mse: 0.0 }] })
     }
 }
 
@@ -143,10 +133,7 @@ pub trait LevelCodec: Sync {
 fn check_weights(values: &[f32], weights: Option<&[f32]>) -> Result<(), CodecError> {
     if let Some(w) = weights {
         if w.len() != values.len() {
-            return Err(CodecError::Length {
-                expected: values.len(),
-                found: w.len(),
-            });
+            return Err(CodecError::Length { expected: values.len(), found: w.len() });
         }
         if w.iter().any(|v| !(v.is_finite() && *v >= 0.0)) {
             return Err(CodecError::Input("error weights must be finite and non-negative".into()));
@@ -163,10 +150,7 @@ struct DctCodec;
 fn check_len(planes: &[PlaneShape], values: &[f32]) -> Result<usize, CodecError> {
     let n = value_count(planes)?;
     if values.len() != n {
-        return Err(CodecError::Length {
-            expected: n,
-            found: values.len(),
-        });
+        return Err(CodecError::Length { expected: n, found: values.len() });
     }
     Ok(n)
 }
@@ -229,14 +213,9 @@ impl LevelCodec for WaveletCodec {
         weights: Option<&[f32]>,
     ) -> Result<RdCurve, CodecError> {
         check_weights(values, weights)?;
-        let e = wavelet::encode_full(
-            planes,
-            values,
-            wavelet::DEFAULT_LEVELS,
-            wavelet::DEFAULT_BITS,
-        )?;
-        Ok(e.measured_curve_weighted(planes, values, weights, wavelet::CURVE_POINTS)?
-            .monotone())
+        let e =
+            wavelet::encode_full(planes, values, wavelet::DEFAULT_LEVELS, wavelet::DEFAULT_BITS)?;
+        Ok(e.measured_curve_weighted(planes, values, weights, wavelet::CURVE_POINTS)?.monotone())
     }
 }
 
@@ -307,11 +286,7 @@ pub fn decode(codec: CodecId, planes: &[PlaneShape], bytes: &[u8]) -> Result<Vec
 
 /// Mean squared error per value between two equally long slices.
 pub fn mse(a: &[f32], b: &[f32]) -> f64 {
-    let s: f64 = a
-        .iter()
-        .zip(b)
-        .map(|(x, y)| (*x as f64 - *y as f64).powi(2))
-        .sum();
+    let s: f64 = a.iter().zip(b).map(|(x, y)| (*x as f64 - *y as f64).powi(2)).sum();
     s / a.len().max(1) as f64
 }
 
@@ -321,12 +296,8 @@ pub fn weighted_mse(a: &[f32], b: &[f32], weights: Option<&[f32]>) -> f64 {
     let Some(w) = weights else {
         return mse(a, b);
     };
-    let s: f64 = a
-        .iter()
-        .zip(b)
-        .zip(w)
-        .map(|((x, y), w)| *w as f64 * (*x as f64 - *y as f64).powi(2))
-        .sum();
+    let s: f64 =
+        a.iter().zip(b).zip(w).map(|((x, y), w)| *w as f64 * (*x as f64 - *y as f64).powi(2)).sum();
     s / a.len().max(1) as f64
 }
 

@@ -20,11 +20,7 @@ pub fn encode(planes: &[PlaneShape], values: &[f32]) -> Vec<u8> {
     let mut start = 0;
     for p in planes {
         let len = (p.width * p.height * p.channels) as usize;
-        predict(
-            p,
-            &values[start..start + len],
-            &mut residual[start..start + len],
-        );
+        predict(p, &values[start..start + len], &mut residual[start..start + len]);
         start += len;
     }
     let mut shuffled = vec![0u8; 4 * n];
@@ -70,18 +66,12 @@ pub fn decode(planes: &[PlaneShape], n: usize, bytes: &[u8]) -> Result<Vec<f32>,
         .read_to_end(&mut shuffled)
         .map_err(|e| CodecError::Corrupt(e.to_string()))?;
     if shuffled.len() != expected {
-        return Err(CodecError::DecodedLength {
-            expected,
-            found: shuffled.len(),
-        });
+        return Err(CodecError::DecodedLength { expected, found: shuffled.len() });
     }
     // The DEFLATE stream is the whole codestream: its final block ends in the last byte.
     let used = dec.total_in() as usize;
     if used < bytes.len() {
-        return Err(CodecError::TrailingBytes {
-            extra: bytes.len() - used,
-            length: bytes.len(),
-        });
+        return Err(CodecError::TrailingBytes { extra: bytes.len() - used, length: bytes.len() });
     }
     let mut bits = vec![0u32; n];
     for (i, b) in bits.iter_mut().enumerate() {

@@ -24,7 +24,10 @@ pub(crate) struct LossyHeader {
 /// Parses the header of a non-empty codestream; `scale_name` names bytes 4..8 in errors.
 pub(crate) fn read(bytes: &[u8], scale_name: &str) -> Result<LossyHeader, CodecError> {
     if bytes.len() < HEADER_LEN {
-        return Err(CodecError::Corrupt(format!("{} bytes, shorter than the {HEADER_LEN}-byte header", bytes.len())));
+        return Err(CodecError::Corrupt(format!(
+            "{} bytes, shorter than the {HEADER_LEN}-byte header",
+            bytes.len()
+        )));
     }
     if bytes[0] != VERSION {
         return Err(CodecError::Corrupt(format!("version {} is not 1", bytes[0])));

@@ -72,9 +72,7 @@ pub fn unflatten(mut i: usize, extent: &[u32]) -> Vec<u32> {
 
 fn check(extent: &[u32], samples: &[Vec<f32>]) -> Result<usize, CodecError> {
     if extent.contains(&0) {
-        return Err(CodecError::Input(format!(
-            "extent {extent:?} has an empty dimension"
-        )));
+        return Err(CodecError::Input(format!("extent {extent:?} has an empty dimension")));
     }
     let count: usize = extent.iter().map(|&e| e as usize).product();
     if samples.len() != count {
@@ -126,10 +124,8 @@ fn targets(
 ) -> Vec<Vec<f32>> {
     let n = samples[0].len();
     let mut shape: Vec<usize> = extent.iter().map(|&e| e as usize).collect();
-    let mut data: Vec<Vec<f64>> = samples
-        .iter()
-        .map(|s| s.iter().map(|&v| v as f64).collect())
-        .collect();
+    let mut data: Vec<Vec<f64>> =
+        samples.iter().map(|s| s.iter().map(|&v| v as f64).collect()).collect();
     for k in 0..extent.len() {
         if counts[k] == extent[k] {
             continue;
@@ -144,18 +140,14 @@ fn targets(
             let base = (o / (stride * c)) * (stride * e) + o % stride;
             for (s, &wt) in w[j].iter().enumerate() {
                 if wt != 0.0 {
-                    img.iter_mut()
-                        .zip(&data[base + s * stride])
-                        .for_each(|(a, v)| *a += wt * v);
+                    img.iter_mut().zip(&data[base + s * stride]).for_each(|(a, v)| *a += wt * v);
                 }
             }
         }
         data = out;
         shape[k] = c;
     }
-    data.into_iter()
-        .map(|d| d.into_iter().map(|v| v as f32).collect())
-        .collect()
+    data.into_iter().map(|d| d.into_iter().map(|v| v as f32).collect()).collect()
 }
 
 /// Builds the pyramid with the given level counts (top first; the first must be all ones,
@@ -182,12 +174,8 @@ fn build_cached(
         && level_counts[0].iter().all(|&c| c == 1)
         && level_counts.last().map(Vec::as_slice) == Some(extent)
         && level_counts.iter().all(|c| c.len() == extent.len())
-        && level_counts
-            .windows(2)
-            .all(|w| w[0].iter().zip(&w[1]).all(|(a, b)| a <= b))
-        && level_counts
-            .iter()
-            .all(|c| c.iter().zip(extent).all(|(c, e)| *c >= 1 && c <= e));
+        && level_counts.windows(2).all(|w| w[0].iter().zip(&w[1]).all(|(a, b)| a <= b))
+        && level_counts.iter().all(|c| c.iter().zip(extent).all(|(c, e)| *c >= 1 && c <= e));
     if !valid {
         return Err(CodecError::Input(format!(
             "level counts {level_counts:?} for extent {extent:?}"
@@ -220,15 +208,10 @@ fn build_cached(
                 .map(|(t, m)| {
                     let mut mean = vec![0.0f64; n];
                     for &s in m {
-                        mean.iter_mut()
-                            .zip(&above[s])
-                            .for_each(|(a, v)| *a += *v as f64);
+                        mean.iter_mut().zip(&above[s]).for_each(|(a, v)| *a += *v as f64);
                     }
                     let k = m.len().max(1) as f64;
-                    t.iter()
-                        .zip(&mean)
-                        .map(|(t, a)| t - (a / k) as f32)
-                        .collect()
+                    t.iter().zip(&mean).map(|(t, a)| t - (a / k) as f32).collect()
                 })
                 .collect()
         };
@@ -239,15 +222,9 @@ fn build_cached(
                 }
             }
         }
-        levels.push(PyramidLevel {
-            counts: counts.clone(),
-            images,
-        });
+        levels.push(PyramidLevel { counts: counts.clone(), images });
     }
-    Ok(Pyramid {
-        extent: extent.to_vec(),
-        levels,
-    })
+    Ok(Pyramid { extent: extent.to_vec(), levels })
 }
 
 impl Pyramid {
@@ -322,7 +299,8 @@ pub fn adaptive(
     let ones = vec![1u32; extent.len()];
     // Chosen levels, finest first.
     let mut chosen = vec![extent.to_vec()];
-    let mut total_of = |p: &Pyramid| -> f64 { p.levels.iter().flat_map(|l| &l.images).map(|i| cost(i)).sum() };
+    let mut total_of =
+        |p: &Pyramid| -> f64 { p.levels.iter().flat_map(|l| &l.images).map(|i| cost(i)).sum() };
     let sequence = |chosen: &[Vec<u32>], next: &[u32]| {
         let mut seq = vec![ones.clone()];
         if next != ones.as_slice() {
@@ -343,7 +321,13 @@ pub fn adaptive(
         // builds the one chosen again at the end.
         let mut best: Option<(Vec<u32>, f64)> = None;
         for cand in coarser_candidates(&current) {
-            let total = total_of(&build_cached(extent, samples, &sequence(&chosen, &cand), filter, &mut cache)?);
+            let total = total_of(&build_cached(
+                extent,
+                samples,
+                &sequence(&chosen, &cand),
+                filter,
+                &mut cache,
+            )?);
             if best.as_ref().is_none_or(|b| total < b.1) {
                 best = Some((cand, total));
             }
@@ -398,16 +382,10 @@ mod tests {
     #[test]
     fn exact_reconstruction_for_fixed_sequences() {
         for (extent, seq) in [
-            (
-                vec![8, 8],
-                vec![vec![1, 1], vec![2, 2], vec![4, 4], vec![8, 8]],
-            ),
+            (vec![8, 8], vec![vec![1, 1], vec![2, 2], vec![4, 4], vec![8, 8]]),
             (vec![8, 8], vec![vec![1, 1], vec![8, 1], vec![8, 8]]),
             (vec![5, 3], vec![vec![1, 1], vec![3, 2], vec![5, 3]]),
-            (
-                vec![5, 3],
-                vec![vec![1, 1], vec![2, 1], vec![3, 3], vec![5, 3]],
-            ),
+            (vec![5, 3], vec![vec![1, 1], vec![2, 1], vec![3, 3], vec![5, 3]]),
             (vec![7], vec![vec![1], vec![2], vec![4], vec![7]]),
             (vec![1], vec![vec![1]]),
         ] {
@@ -433,12 +411,7 @@ mod tests {
         let s = block(&[8, 8], 11);
         let (p, _) = adaptive(&[8, 8], &s, PyramidFilter::Box, l1_cost).unwrap();
         let below = &p.levels[p.levels.len() - 2].counts;
-        assert_eq!(
-            below[1],
-            8,
-            "{:?}",
-            p.levels.iter().map(|l| &l.counts).collect::<Vec<_>>()
-        );
+        assert_eq!(below[1], 8, "{:?}", p.levels.iter().map(|l| &l.counts).collect::<Vec<_>>());
     }
 
     #[test]
@@ -455,9 +428,7 @@ mod tests {
     #[test]
     fn index_rule_matches_the_spec_example() {
         // 5 samples, 2 level samples: floor(s·2/5) = 0,0,0,1,1.
-        let idx: Vec<usize> = (0..5)
-            .map(|s| level_image_index(&[2], &[s], &[5]))
-            .collect();
+        let idx: Vec<usize> = (0..5).map(|s| level_image_index(&[2], &[s], &[5])).collect();
         assert_eq!(idx, vec![0, 0, 0, 1, 1]);
     }
 

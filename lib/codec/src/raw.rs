@@ -8,13 +8,7 @@ pub fn encode(values: &[f32]) -> Vec<u8> {
 
 pub fn decode(n: usize, bytes: &[u8]) -> Result<Vec<f32>, CodecError> {
     if bytes.len() != n * 4 {
-        return Err(CodecError::DecodedLength {
-            expected: n * 4,
-            found: bytes.len(),
-        });
+        return Err(CodecError::DecodedLength { expected: n * 4, found: bytes.len() });
     }
-    Ok(bytes
-        .chunks_exact(4)
-        .map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]]))
-        .collect())
+    Ok(bytes.chunks_exact(4).map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]])).collect())
 }

@@ -11,11 +11,7 @@ pub struct PlaneShape {
 
 impl PlaneShape {
     pub fn new(width: u32, height: u32, channels: u32) -> Self {
-        PlaneShape {
-            width,
-            height,
-            channels,
-        }
+        PlaneShape { width, height, channels }
     }
 }
 
@@ -24,11 +20,7 @@ impl PlaneShape {
 pub fn value_count(planes: &[PlaneShape]) -> Result<usize, CodecError> {
     let mut total: usize = 0;
     for p in planes {
-        let bad = || CodecError::Shape {
-            width: p.width,
-            height: p.height,
-            channels: p.channels,
-        };
+        let bad = || CodecError::Shape { width: p.width, height: p.height, channels: p.channels };
         if p.width == 0 || p.height == 0 || !(1..=4).contains(&p.channels) {
             return Err(bad());
         }
@@ -40,10 +32,7 @@ pub fn value_count(planes: &[PlaneShape]) -> Result<usize, CodecError> {
     }
     // Keep byte counts representable (4 bytes per value).
     if total > usize::MAX / 4 {
-        return Err(CodecError::Length {
-            expected: usize::MAX / 4,
-            found: total,
-        });
+        return Err(CodecError::Length { expected: usize::MAX / 4, found: total });
     }
     Ok(total)
 }

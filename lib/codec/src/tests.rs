@@ -1,18 +1,12 @@
 use super::*;
 
 fn planes() -> Vec<PlaneShape> {
-    vec![
-        PlaneShape::new(5, 3, 3),
-        PlaneShape::new(3, 2, 4),
-        PlaneShape::new(1, 1, 1),
-    ]
+    vec![PlaneShape::new(5, 3, 3), PlaneShape::new(3, 2, 4), PlaneShape::new(1, 1, 1)]
 }
 
 fn values(n: usize) -> Vec<f32> {
     // Smooth data with a few special bit patterns that a lossy path would not keep.
-    let mut v: Vec<f32> = (0..n)
-        .map(|i| (i as f32 * 0.37).sin() * 3.0 + 0.25)
-        .collect();
+    let mut v: Vec<f32> = (0..n).map(|i| (i as f32 * 0.37).sin() * 3.0 + 0.25).collect();
     v[1] = -0.0;
     v[4] = f32::MIN_POSITIVE / 8.0; // subnormal
     v[7] = 1.0e30;
@@ -33,16 +27,9 @@ fn lossless_round_trips_every_bit() {
 #[test]
 fn lossless_compresses_smooth_data() {
     let p = [PlaneShape::new(64, 64, 3)];
-    let v: Vec<f32> = (0..64 * 64 * 3)
-        .map(|i| ((i / 3) % 64) as f32 / 64.0)
-        .collect();
+    let v: Vec<f32> = (0..64 * 64 * 3).map(|i| ((i / 3) % 64) as f32 / 64.0).collect();
     let bytes = encode(CodecId::Lossless, &p, &v).unwrap();
-    assert!(
-        bytes.len() * 4 < v.len() * 4,
-        "{} bytes for {} values",
-        bytes.len(),
-        v.len()
-    );
+    assert!(bytes.len() * 4 < v.len() * 4, "{} bytes for {} values", bytes.len(), v.len());
 }
 
 #[test]
@@ -52,10 +39,7 @@ fn raw_round_trips_and_checks_length() {
     let bytes = encode(CodecId::Raw, &p, &v).unwrap();
     assert_eq!(bytes.len(), v.len() * 4);
     assert_eq!(decode(CodecId::Raw, &p, &bytes).unwrap(), v);
-    assert!(matches!(
-        decode(CodecId::Raw, &p, &bytes[1..]),
-        Err(CodecError::DecodedLength { .. })
-    ));
+    assert!(matches!(decode(CodecId::Raw, &p, &bytes[1..]), Err(CodecError::DecodedLength { .. })));
 }
 
 #[test]
@@ -64,10 +48,7 @@ fn lossless_rejects_damaged_streams() {
     let v = values(value_count(&p).unwrap());
     let bytes = encode(CodecId::Lossless, &p, &v).unwrap();
     for cut in 0..bytes.len() {
-        assert!(
-            decode(CodecId::Lossless, &p, &bytes[..cut]).is_err(),
-            "truncated at {cut}"
-        );
+        assert!(decode(CodecId::Lossless, &p, &bytes[..cut]).is_err(), "truncated at {cut}");
     }
     // A stream for other shapes decodes to the wrong length.
     let small = [PlaneShape::new(2, 2, 1)];
@@ -94,10 +75,7 @@ fn shapes_are_checked() {
     assert!(value_count(&[PlaneShape::new(u32::MAX, u32::MAX, 4); 8]).is_err());
     assert_eq!(
         encode(CodecId::Raw, &[PlaneShape::new(2, 1, 1)], &[1.0]),
-        Err(CodecError::Length {
-            expected: 2,
-            found: 1
-        })
+        Err(CodecError::Length { expected: 2, found: 1 })
     );
 }
 
@@ -133,13 +111,9 @@ fn texture(w: u32, h: u32, c: u32, offset: f32) -> Vec<f32> {
 
 #[test]
 fn lossy_codecs_round_trip_closely() {
-    for (w, h, c, offset) in [
-        (64, 48, 3, 0.5),
-        (37, 21, 4, 0.0),
-        (5, 3, 1, -2.0),
-        (1, 1, 3, 1.0),
-        (9, 1, 3, 0.0),
-    ] {
+    for (w, h, c, offset) in
+        [(64, 48, 3, 0.5), (37, 21, 4, 0.0), (5, 3, 1, -2.0), (1, 1, 3, 1.0), (9, 1, 3, 0.0)]
+    {
         let p = [PlaneShape::new(w, h, c)];
         let v = texture(w, h, c, offset);
         for id in [CodecId::Wavelet, CodecId::Dct] {
@@ -169,10 +143,7 @@ fn lossy_codecs_handle_several_planes() {
 fn lossy_codecs_refuse_non_finite_input() {
     let p = [PlaneShape::new(2, 1, 1)];
     for id in [CodecId::Wavelet, CodecId::Dct] {
-        assert!(matches!(
-            encode(id, &p, &[1.0, f32::NAN]),
-            Err(CodecError::Input(_))
-        ));
+        assert!(matches!(encode(id, &p, &[1.0, f32::NAN]), Err(CodecError::Input(_))));
     }
 }
 
@@ -219,10 +190,7 @@ fn wavelet_curve_decreases_and_matches_the_codec() {
     let v = texture(64, 64, 3, 0.5);
     let curve = codec(CodecId::Wavelet).unwrap().rd_curve(&p, &v).unwrap();
     assert!(curve.points.len() > 10);
-    assert!(curve
-        .points
-        .windows(2)
-        .all(|w| w[0].bytes < w[1].bytes && w[0].mse > w[1].mse));
+    assert!(curve.points.windows(2).all(|w| w[0].bytes < w[1].bytes && w[0].mse > w[1].mse));
     let full = encode(CodecId::Wavelet, &p, &v).unwrap();
     for pt in &curve.points {
         let back = decode(CodecId::Wavelet, &p, &full[..pt.bytes]).unwrap();
@@ -238,18 +206,12 @@ fn dct_budget_and_quality_order() {
     for q in [10, 50, 90] {
         let s = encode_with(CodecId::Dct, &p, &v, Rate::Quality(q)).unwrap();
         let m = mse(&v, &decode(CodecId::Dct, &p, &s).unwrap());
-        assert!(
-            s.len() > prev.0 && m < prev.1,
-            "q {q}: {} bytes, mse {m}",
-            s.len()
-        );
+        assert!(s.len() > prev.0 && m < prev.1, "q {q}: {} bytes, mse {m}", s.len());
         prev = (s.len(), m);
     }
     let s = encode_with(CodecId::Dct, &p, &v, Rate::Bytes(300)).unwrap();
     assert!(s.len() <= 300 && !s.is_empty());
-    assert!(encode_with(CodecId::Dct, &p, &v, Rate::Bytes(5))
-        .unwrap()
-        .is_empty());
+    assert!(encode_with(CodecId::Dct, &p, &v, Rate::Bytes(5)).unwrap().is_empty());
     let curve = codec(CodecId::Dct).unwrap().rd_curve(&p, &v).unwrap();
     assert!(curve.points.len() > 5);
 }
@@ -267,10 +229,7 @@ fn dct_rejects_truncation() {
 #[test]
 fn lossy_decoders_survive_random_corruption() {
     let p = [PlaneShape::new(19, 13, 3), PlaneShape::new(10, 7, 3)];
-    let v = texture(19, 13, 3, 0.2)
-        .into_iter()
-        .chain(texture(10, 7, 3, 0.0))
-        .collect::<Vec<_>>();
+    let v = texture(19, 13, 3, 0.2).into_iter().chain(texture(10, 7, 3, 0.0)).collect::<Vec<_>>();
     let mut seed = 12345u32;
     let mut rnd = move || {
         seed ^= seed << 13;
@@ -317,10 +276,8 @@ fn lossy_decoders_with_forged_huge_shape_fail_or_stay_bounded() {
 fn wavelet_truncations_of_mixed_planes_decode() {
     // Planes of 3, 4 and 1 channels (colour transform on some).
     let p = planes();
-    let v: Vec<f32> = values(value_count(&p).unwrap())
-        .into_iter()
-        .map(|x| x.clamp(-4.0, 4.0))
-        .collect();
+    let v: Vec<f32> =
+        values(value_count(&p).unwrap()).into_iter().map(|x| x.clamp(-4.0, 4.0)).collect();
     let e = wavelet::encode_full(&p, &v, 5, 14).unwrap();
     let hl = wavelet::header_len(&p);
     assert_eq!(hl, 8);
@@ -352,9 +309,7 @@ fn constant_and_offset_images_keep_their_level() {
     let constant = vec![0.5f32; n];
     let offset: Vec<f32> = (0..n).map(|i| 1000.0 + (i % 7) as f32 * 1e-3).collect();
     // Large DC jumps between blocks: the top rows at +3·10⁴, the rest at −3·10⁴.
-    let mixed: Vec<f32> = (0..n)
-        .map(|i| if i < n / 3 { 3.0e4 } else { -3.0e4 })
-        .collect();
+    let mixed: Vec<f32> = (0..n).map(|i| if i < n / 3 { 3.0e4 } else { -3.0e4 }).collect();
     for (k, v) in [constant, offset, mixed].into_iter().enumerate() {
         for id in [CodecId::Wavelet, CodecId::Dct] {
             let s = encode_with(id, &p, &v, Rate::Quality(100)).unwrap();
@@ -365,10 +320,7 @@ fn constant_and_offset_images_keep_their_level() {
             // At the default rate the level (the mean) survives.
             let back = decode(id, &p, &encode(id, &p, &v).unwrap()).unwrap();
             let mean = |x: &[f32]| x.iter().map(|v| *v as f64).sum::<f64>() / x.len() as f64;
-            assert!(
-                (mean(&v) - mean(&back)).abs() < 1e-2 * peak,
-                "{id} case {k}"
-            );
+            assert!((mean(&v) - mean(&back)).abs() < 1e-2 * peak, "{id} case {k}");
         }
     }
 }
@@ -386,9 +338,8 @@ fn weighted_curves_count_only_the_error_that_is_weighted() {
             ((x * 7 + y * 3) % 11) as f32 / 11.0 + 0.2 * (i % 3) as f32
         })
         .collect();
-    let left: Vec<f32> = (0..v.len())
-        .map(|i| if ((i / 3) as u32 % w) < w / 2 { 2.0 } else { 0.0 })
-        .collect();
+    let left: Vec<f32> =
+        (0..v.len()).map(|i| if ((i / 3) as u32 % w) < w / 2 { 2.0 } else { 0.0 }).collect();
     let ones = vec![1.0f32; v.len()];
     for id in [CodecId::Wavelet, CodecId::Dct] {
         let c = codec(id).unwrap();
@@ -404,10 +355,17 @@ fn weighted_curves_count_only_the_error_that_is_weighted() {
         let halved = c.rd_curve_weighted(&p, &v, Some(&half)).unwrap();
         let zero = c.rd_curve_weighted(&p, &v, Some(&vec![0.0; v.len()])).unwrap();
         let mut lower = 0;
-        for ((a, b), (hp, z)) in plain.points.iter().zip(&weighted.points).zip(halved.points.iter().zip(&zero.points)) {
+        for ((a, b), (hp, z)) in
+            plain.points.iter().zip(&weighted.points).zip(halved.points.iter().zip(&zero.points))
+        {
             // the same truncation points; the error is linear in the weights
             assert_eq!((a.bytes, b.bytes), (hp.bytes, z.bytes), "{id}");
-            assert!((b.mse - 2.0 * hp.mse).abs() <= 1e-9 * b.mse.max(1e-9), "{id}: {} vs 2 × {}", b.mse, hp.mse);
+            assert!(
+                (b.mse - 2.0 * hp.mse).abs() <= 1e-9 * b.mse.max(1e-9),
+                "{id}: {} vs 2 × {}",
+                b.mse,
+                hp.mse
+            );
             assert_eq!(z.mse, 0.0, "{id}");
             // weights 1 on the left half and 0 on the right: never above the plain error
             assert!(hp.mse <= a.mse * (1.0 + 1e-12), "{id}");

@@ -30,10 +30,7 @@ fn sample(a: u32, b: u32) -> Vec<f32> {
 }
 
 fn unflatten(i: usize, extent: &[u32]) -> Vec<u32> {
-    vec![
-        (i / extent[1] as usize) as u32,
-        (i % extent[1] as usize) as u32,
-    ]
+    vec![(i / extent[1] as usize) as u32, (i % extent[1] as usize) as u32]
 }
 
 /// Packs the block at `ratio`:1 with `codec` and returns (measured PSNR, predicted PSNR,
@@ -63,16 +60,9 @@ fn pack(codec: CodecId, ratio: usize) -> (f64, f64, usize, usize, Pyramid) {
                 c
             } else {
                 encoded.push(None);
-                pis_codec::codec(codec)
-                    .unwrap()
-                    .rd_curve(&planes, img)
-                    .unwrap()
+                pis_codec::codec(codec).unwrap().rd_curve(&planes, img).unwrap()
             };
-            items.push(Item {
-                curve,
-                object: 0,
-                weight: covered as f64 / 64.0,
-            });
+            items.push(Item { curve, object: 0, weight: covered as f64 / 64.0 });
         }
     }
     let raw: usize = samples.iter().map(|s| s.len() * 4).sum();
@@ -101,13 +91,7 @@ fn pack(codec: CodecId, ratio: usize) -> (f64, f64, usize, usize, Pyramid) {
         err += mse(s, &decoded.sample(&unflatten(i, &extent)));
     }
     err /= 64.0;
-    (
-        psnr(err, 1.0),
-        psnr(alloc.screen_mse, 1.0),
-        spent,
-        budget,
-        pyramid,
-    )
+    (psnr(err, 1.0), psnr(alloc.screen_mse, 1.0), spent, budget, pyramid)
 }
 
 #[test]
@@ -136,9 +120,6 @@ fn check_levels(p: &Pyramid) {
     for level in &p.levels {
         let n: u32 = level.counts.iter().product();
         assert_eq!(level.images.len(), n as usize);
-        assert_eq!(
-            level_image_index(&level.counts, &[7, 7], &p.extent),
-            n as usize - 1
-        );
+        assert_eq!(level_image_index(&level.counts, &[7, 7], &p.extent), n as usize - 1);
     }
 }

@@ -9,8 +9,8 @@ use common::demo1;
 use std::time::Instant;
 
 use pis_compile::{
-    antialias, render_matrix, scene_depth, Address, DisplayFilter, DrawMesh, Filter, Sampler, TextureLayout, TextureTransform,
-    TexturedObject, Viewport,
+    antialias, render_matrix, scene_depth, Address, DisplayFilter, DrawMesh, Filter, Sampler,
+    TextureLayout, TextureTransform, TexturedObject, Viewport,
 };
 
 fn main() {
@@ -20,7 +20,12 @@ fn main() {
         let (meshes, clip_from_world) = demo1((w, h));
         let draws: Vec<DrawMesh> = meshes
             .iter()
-            .map(|m| DrawMesh { positions: &m.positions, uvs: &m.uvs, indices: &m.indices, clip_from_object: clip_from_world * m.world_from_object })
+            .map(|m| DrawMesh {
+                positions: &m.positions,
+                uvs: &m.uvs,
+                indices: &m.indices,
+                clip_from_object: clip_from_world * m.world_from_object,
+            })
             .collect();
         for factor in [1u32, 2] {
             let vp = Viewport { width: w * factor, height: h * factor };
@@ -30,10 +35,16 @@ fn main() {
             for (k, m) in meshes.iter().enumerate() {
                 let t = Instant::now();
                 let depth = scene_depth(vp, &draws, Some(k)).expect("depth");
-                let object = TexturedObject { mesh: draws[k], transform: TextureTransform::IDENTITY, layout, sampler };
+                let object = TexturedObject {
+                    mesh: draws[k],
+                    transform: TextureTransform::IDENTITY,
+                    layout,
+                    sampler,
+                };
                 let mut a = render_matrix(vp, &object, Some(&depth)).expect("A");
                 if factor > 1 {
-                    a = antialias(&a, factor, DisplayFilter { sigma_px: 0.5, radius_px: 1.5 }).expect("antialias");
+                    a = antialias(&a, factor, DisplayFilter { sigma_px: 0.5, radius_px: 1.5 })
+                        .expect("antialias");
                 }
                 let ms = t.elapsed().as_secs_f64() * 1e3;
                 rows += a.rows();

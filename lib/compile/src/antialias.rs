@@ -25,10 +25,21 @@ pub struct DisplayFilter {
 /// to display pixels: row p = Σ_k w_k · row_k / c_p over the covered sub-pixels k within the
 /// filter radius, with c_p = Σ_k w_k over those covered sub-pixels (weights normalised over
 /// all sub-pixels in the radius), the pixel's coverage. Pixels with c_p = 0 have no row.
-pub fn antialias(supersampled: &RenderMatrix, factor: u32, filter: DisplayFilter) -> Result<RenderMatrix, ModelError> {
-    let bad = !(filter.sigma_px > 0.0 && filter.sigma_px.is_finite() && filter.radius_px > 0.0 && filter.radius_px.is_finite());
+pub fn antialias(
+    supersampled: &RenderMatrix,
+    factor: u32,
+    filter: DisplayFilter,
+) -> Result<RenderMatrix, ModelError> {
+    let bad = !(filter.sigma_px > 0.0
+        && filter.sigma_px.is_finite()
+        && filter.radius_px > 0.0
+        && filter.radius_px.is_finite());
     if bad || factor == 0 || supersampled.width % factor != 0 || supersampled.height % factor != 0 {
-        return Err(ModelError::Filter { sigma: filter.sigma_px, radius: filter.radius_px, factor });
+        return Err(ModelError::Filter {
+            sigma: filter.sigma_px,
+            radius: filter.radius_px,
+            factor,
+        });
     }
     let (sw, sh) = (supersampled.width as i64, supersampled.height as i64);
     let (w, h) = (supersampled.width / factor, supersampled.height / factor);
@@ -57,8 +68,10 @@ pub fn antialias(supersampled: &RenderMatrix, factor: u32, filter: DisplayFilter
         .map_init(Vec::new, |acc: &mut Vec<(u32, f64)>, &p| {
             acc.clear();
             let (cx, cy) = ((p % w) as f64 + 0.5, (p / w) as f64 + 0.5);
-            let (x0, x1) = (((cx - radius) * f - 0.5).ceil() as i64, ((cx + radius) * f - 0.5).floor() as i64);
-            let (y0, y1) = (((cy - radius) * f - 0.5).ceil() as i64, ((cy + radius) * f - 0.5).floor() as i64);
+            let (x0, x1) =
+                (((cx - radius) * f - 0.5).ceil() as i64, ((cx + radius) * f - 0.5).floor() as i64);
+            let (y0, y1) =
+                (((cy - radius) * f - 0.5).ceil() as i64, ((cy + radius) * f - 0.5).floor() as i64);
             let (mut total, mut covered) = (0.0f64, 0.0f64);
             for sy in y0..=y1 {
                 for sx in x0..=x1 {
@@ -101,7 +114,8 @@ pub fn antialias(supersampled: &RenderMatrix, factor: u32, filter: DisplayFilter
         })
         .flatten()
         .collect();
-    let mut out = RenderMatrix { width: w, height: h, layout: supersampled.layout, ..Default::default() };
+    let mut out =
+        RenderMatrix { width: w, height: h, layout: supersampled.layout, ..Default::default() };
     out.row_start.push(0);
     for (p, c, entries) in rows {
         out.pixels.push(p);
@@ -126,9 +140,16 @@ pub fn antialiased_render_matrix(
     occluders: &[DrawMesh],
 ) -> Result<RenderMatrix, ModelError> {
     if factor == 0 || factor > 16 {
-        return Err(ModelError::Filter { sigma: filter.sigma_px, radius: filter.radius_px, factor });
+        return Err(ModelError::Filter {
+            sigma: filter.sigma_px,
+            radius: filter.radius_px,
+            factor,
+        });
     }
-    let ss = Viewport { width: viewport.width.saturating_mul(factor), height: viewport.height.saturating_mul(factor) };
+    let ss = Viewport {
+        width: viewport.width.saturating_mul(factor),
+        height: viewport.height.saturating_mul(factor),
+    };
     let depth = scene_depth(ss, occluders, None)?;
     antialias(&render_matrix(ss, object, Some(&depth))?, factor, filter)
 }
@@ -174,17 +195,30 @@ mod tests {
         let positions = [[-1.0, 1.0, 0.5], [-0.2, 1.0, 0.5], [-0.2, -1.0, 0.5], [-1.0, -1.0, 0.5]];
         let uvs = [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]];
         let object = TexturedObject {
-            mesh: DrawMesh { positions: &positions, uvs: &uvs, indices: &[0, 1, 2, 0, 2, 3], clip_from_object: glam::Mat4::IDENTITY },
+            mesh: DrawMesh {
+                positions: &positions,
+                uvs: &uvs,
+                indices: &[0, 1, 2, 0, 2, 3],
+                clip_from_object: glam::Mat4::IDENTITY,
+            },
             transform: TextureTransform::IDENTITY,
             layout: TextureLayout::full(8, 8),
             sampler: Sampler { filter: Filter::Trilinear, address: [Address::ClampToEdge; 2] },
         };
         let f = DisplayFilter { sigma_px: 0.5, radius_px: 1.5 };
-        let a = antialiased_render_matrix(Viewport { width: 10, height: 4 }, 4, f, &object, &[]).unwrap();
-        let cov = |x: u32, y: u32| a.pixels.iter().position(|&p| p == y * 10 + x).map(|r| a.coverage[r]).unwrap_or(0.0);
+        let a = antialiased_render_matrix(Viewport { width: 10, height: 4 }, 4, f, &object, &[])
+            .unwrap();
+        let cov = |x: u32, y: u32| {
+            a.pixels.iter().position(|&p| p == y * 10 + x).map(|r| a.coverage[r]).unwrap_or(0.0)
+        };
         assert!(cov(1, 1) > 0.99, "{}", cov(1, 1));
         // The edge x = 4 px runs between pixels 3 and 4: about half each side of the edge.
-        assert!(cov(3, 1) > 0.6 && cov(3, 1) < 1.0 && cov(4, 1) > 0.0 && cov(4, 1) < 0.4, "{} {}", cov(3, 1), cov(4, 1));
+        assert!(
+            cov(3, 1) > 0.6 && cov(3, 1) < 1.0 && cov(4, 1) > 0.0 && cov(4, 1) < 0.4,
+            "{} {}",
+            cov(3, 1),
+            cov(4, 1)
+        );
         assert!((cov(3, 1) + cov(4, 1) - 1.0).abs() < 0.05);
         assert_eq!(cov(7, 1), 0.0);
         for r in 0..a.rows() {

@@ -40,12 +40,24 @@ fn held(x: f64, g: f64, lo: f64, hi: f64) -> bool {
 
 /// Σ M⁻¹·pg² of the projected gradient.
 fn projected_measure(x: &[f64], g: &[f64], inv_diag: &[f64], lo: f64, hi: f64) -> f64 {
-    x.iter().zip(g).zip(inv_diag).filter(|((&x, &g), _)| !held(x, g, lo, hi)).map(|((_, &g), &m)| g * g * m).sum()
+    x.iter()
+        .zip(g)
+        .zip(inv_diag)
+        .filter(|((&x, &g), _)| !held(x, g, lo, hi))
+        .map(|((_, &g), &m)| g * g * m)
+        .sum()
 }
 
 /// Minimizes the quadratic `q` over the box `[lo, hi]ⁿ` from `x` (projected into the box
 /// first), in place. `inv_diag` is the Jacobi preconditioner M⁻¹ (positive).
-pub fn minimize_bounded(q: &dyn Quadratic, lo: f64, hi: f64, inv_diag: &[f64], x: &mut [f64], settings: &CgSettings) -> CgReport {
+pub fn minimize_bounded(
+    q: &dyn Quadratic,
+    lo: f64,
+    hi: f64,
+    inv_diag: &[f64],
+    x: &mut [f64],
+    settings: &CgSettings,
+) -> CgReport {
     let n = x.len();
     x.iter_mut().for_each(|v| *v = v.clamp(lo, hi));
     let mut g = vec![0.0; n];
@@ -56,7 +68,11 @@ pub fn minimize_bounded(q: &dyn Quadratic, lo: f64, hi: f64, inv_diag: &[f64], x
         let mut g0 = vec![0.0; n];
         q.value_gradient(&vec![0.0; n], &mut g0);
         let cold: f64 = g0.iter().zip(inv_diag).map(|(g, m)| g * g * m).sum();
-        if cold > 0.0 { cold } else { projected_measure(x, &g, inv_diag, lo, hi) }
+        if cold > 0.0 {
+            cold
+        } else {
+            projected_measure(x, &g, inv_diag, lo, hi)
+        }
     };
     let goal = settings.tolerance * settings.tolerance * gz0;
     let (mut trial, mut g_trial) = (vec![0.0; n], vec![0.0; n]);
@@ -86,7 +102,8 @@ pub fn minimize_bounded(q: &dyn Quadratic, lo: f64, hi: f64, inv_diag: &[f64], x
                     trial[i] = (x[i] + t * d[i]).clamp(lo, hi);
                 }
                 let ft = q.value_gradient(&trial, &mut g_trial);
-                let moved: f64 = g.iter().zip(&trial).zip(x.iter()).map(|((g, t), x)| g * (t - x)).sum();
+                let moved: f64 =
+                    g.iter().zip(&trial).zip(x.iter()).map(|((g, t), x)| g * (t - x)).sum();
                 if ft.is_finite() && ft <= f + ARMIJO * moved && ft < f {
                     accepted = Some(ft);
                     break;
@@ -94,7 +111,8 @@ pub fn minimize_bounded(q: &dyn Quadratic, lo: f64, hi: f64, inv_diag: &[f64], x
                 t *= 0.5;
             }
             let Some(ft) = accepted else { break };
-            let face_changed = (0..n).any(|i| (x[i] > lo && x[i] < hi) != (trial[i] > lo && trial[i] < hi));
+            let face_changed =
+                (0..n).any(|i| (x[i] > lo && x[i] < hi) != (trial[i] > lo && trial[i] < hi));
             let decrease = f - ft;
             x.copy_from_slice(&trial);
             std::mem::swap(&mut g, &mut g_trial);
@@ -111,7 +129,8 @@ pub fn minimize_bounded(q: &dyn Quadratic, lo: f64, hi: f64, inv_diag: &[f64], x
         }
         // 2. CG on the face: the coordinates strictly inside the box.
         let free: Vec<bool> = x.iter().map(|&v| v > lo && v < hi).collect();
-        let mut r: Vec<f64> = g.iter().zip(&free).map(|(&g, &f)| if f { -g } else { 0.0 }).collect();
+        let mut r: Vec<f64> =
+            g.iter().zip(&free).map(|(&g, &f)| if f { -g } else { 0.0 }).collect();
         let mut z: Vec<f64> = r.iter().zip(inv_diag).map(|(r, m)| r * m).collect();
         let mut rz = dot(&r, &z);
         if !(rz > 0.0) {
@@ -237,17 +256,28 @@ mod tests {
     fn kkt_violation(q: &Dense, x: &[f64], lo: f64, hi: f64) -> f64 {
         let mut g = vec![0.0; x.len()];
         q.value_gradient(x, &mut g);
-        x.iter().zip(&g).map(|(&x, &g)| if held(x, g, lo, hi) { 0.0 } else { g.abs() }).fold(0.0, f64::max)
+        x.iter()
+            .zip(&g)
+            .map(|(&x, &g)| if held(x, g, lo, hi) { 0.0 } else { g.abs() })
+            .fold(0.0, f64::max)
     }
 
     #[test]
     fn identity_problem_is_the_clipped_target() {
         let n = 6;
-        let a: Vec<Vec<f64>> = (0..n).map(|i| (0..n).map(|j| if i == j { 1.0 } else { 0.0 }).collect()).collect();
+        let a: Vec<Vec<f64>> =
+            (0..n).map(|i| (0..n).map(|j| if i == j { 1.0 } else { 0.0 }).collect()).collect();
         let b = vec![-2.0, 0.3, 1.7, 0.9, 5.0, 0.0];
         let q = Dense { a, b: b.clone() };
         let mut x = vec![0.5; n];
-        let r = minimize_bounded(&q, 0.0, 1.0, &vec![1.0; n], &mut x, &CgSettings { max_iterations: 100, tolerance: 1e-10, refresh_every: 0 });
+        let r = minimize_bounded(
+            &q,
+            0.0,
+            1.0,
+            &vec![1.0; n],
+            &mut x,
+            &CgSettings { max_iterations: 100, tolerance: 1e-10, refresh_every: 0 },
+        );
         assert!(r.converged);
         for (x, b) in x.iter().zip(&b) {
             assert!((x - b.clamp(0.0, 1.0)).abs() < 1e-9, "{x} vs {b}");
@@ -260,14 +290,22 @@ mod tests {
         // minimizer is far outside, the bounded one must stop at the box's optimum.
         let mut seed = 7;
         let (rows, cols) = (12, 30);
-        let a: Vec<Vec<f64>> = (0..rows).map(|_| (0..cols).map(|_| if lcg(&mut seed) < 0.3 { lcg(&mut seed) } else { 0.0 }).collect()).collect();
+        let a: Vec<Vec<f64>> = (0..rows)
+            .map(|_| {
+                (0..cols).map(|_| if lcg(&mut seed) < 0.3 { lcg(&mut seed) } else { 0.0 }).collect()
+            })
+            .collect();
         let b: Vec<f64> = (0..rows).map(|_| 3.0 * lcg(&mut seed) - 1.0).collect();
         let q = Dense { a, b };
         let mut x = vec![0.0; cols];
         let s = CgSettings { max_iterations: 5000, tolerance: 1e-9, refresh_every: 0 };
         let r = minimize_bounded(&q, 0.0, 1.0, &vec![1.0; cols], &mut x, &s);
         assert!(x.iter().all(|&v| (0.0..=1.0).contains(&v)));
-        assert!(r.objective.windows(2).all(|w| w[1] <= w[0] + 1e-12 * w[0].abs()), "objective rose: {:?}", r.objective);
+        assert!(
+            r.objective.windows(2).all(|w| w[1] <= w[0] + 1e-12 * w[0].abs()),
+            "objective rose: {:?}",
+            r.objective
+        );
         let v = kkt_violation(&q, &x, 0.0, 1.0);
         assert!(r.converged && v < 1e-5, "converged {}, KKT violation {v}", r.converged);
     }
@@ -276,12 +314,20 @@ mod tests {
     fn unconstrained_optimum_inside_the_box_is_found() {
         let mut seed = 3;
         let n = 10;
-        let a: Vec<Vec<f64>> = (0..2 * n).map(|_| (0..n).map(|_| lcg(&mut seed) - 0.5).collect()).collect();
+        let a: Vec<Vec<f64>> =
+            (0..2 * n).map(|_| (0..n).map(|_| lcg(&mut seed) - 0.5).collect()).collect();
         let x_true: Vec<f64> = (0..n).map(|_| 0.2 + 0.6 * lcg(&mut seed)).collect();
         let b: Vec<f64> = a.iter().map(|row| dot(row, &x_true)).collect();
         let q = Dense { a, b };
         let mut x = vec![0.0; n];
-        let r = minimize_bounded(&q, 0.0, 1.0, &vec![1.0; n], &mut x, &CgSettings { max_iterations: 1000, tolerance: 1e-10, refresh_every: 0 });
+        let r = minimize_bounded(
+            &q,
+            0.0,
+            1.0,
+            &vec![1.0; n],
+            &mut x,
+            &CgSettings { max_iterations: 1000, tolerance: 1e-10, refresh_every: 0 },
+        );
         assert!(r.converged);
         for (x, t) in x.iter().zip(&x_true) {
             assert!((x - t).abs() < 1e-6, "{x} vs {t}");

@@ -86,7 +86,11 @@ pub fn minimize(
         let mut g0 = vec![0.0; n];
         q.value_gradient(&vec![0.0; n], &mut g0);
         let cold = dot(&g0, &g0.iter().zip(inv_diag).map(|(g, m)| g * m).collect::<Vec<_>>());
-        if cold > 0.0 { cold } else { gz }
+        if cold > 0.0 {
+            cold
+        } else {
+            gz
+        }
     };
     if !(gz > 0.0) || !gz.is_finite() {
         report.converged = gz == 0.0;
@@ -174,7 +178,8 @@ fn line_minimum(
         return None;
     }
     let limit = r.step_limit(x, d);
-    let (mut lo, mut hi) = (0.0, if limit.is_finite() { limit * (1.0 - 1e-9) } else { f64::INFINITY });
+    let (mut lo, mut hi) =
+        (0.0, if limit.is_finite() { limit * (1.0 - 1e-9) } else { f64::INFINITY });
     // Start from the quadratic part's minimum, kept inside the bracket.
     let mut a = if curv > 0.0 { (-slope_q / (2.0 * curv)).max(0.0) } else { 1.0 };
     if !hi.is_finite() {
@@ -189,7 +194,11 @@ fn line_minimum(
         if d1.abs() <= 1e-12 * s0.abs() {
             break;
         }
-        if d1 < 0.0 { lo = a } else { hi = a }
+        if d1 < 0.0 {
+            lo = a
+        } else {
+            hi = a
+        }
         let newton = a - d1 / d2;
         a = if d2 > 0.0 && newton > lo && newton < hi { newton } else { 0.5 * (lo + hi) };
         if hi - lo <= 1e-15 * hi {

@@ -24,7 +24,13 @@ pub struct Decimation {
 fn step(w: u32, h: u32) -> Csr {
     let (w, h) = (w as usize, h as usize);
     let (ow, oh) = (w.div_ceil(2), h.div_ceil(2));
-    let mut m = Csr { rows: ow * oh, cols: w * h, row_start: Vec::with_capacity(ow * oh + 1), col: vec![], val: vec![] };
+    let mut m = Csr {
+        rows: ow * oh,
+        cols: w * h,
+        row_start: Vec::with_capacity(ow * oh + 1),
+        col: vec![],
+        val: vec![],
+    };
     m.row_start.push(0);
     for j in 0..oh {
         let (y0, y1) = (2 * j, (2 * j + 1).min(h - 1));
@@ -52,12 +58,14 @@ fn step(w: u32, h: u32) -> Csr {
 
 impl Decimation {
     pub fn new(layout: TextureLayout) -> Self {
-        let steps = (0..layout.levels.saturating_sub(1)).map(|m| {
-            let (w, h) = layout.level_size(m);
-            let s = step(w, h);
-            let t = s.transpose();
-            (s, t)
-        }).collect();
+        let steps = (0..layout.levels.saturating_sub(1))
+            .map(|m| {
+                let (w, h) = layout.level_size(m);
+                let s = step(w, h);
+                let t = s.transpose();
+                (s, t)
+            })
+            .collect();
         Decimation { layout, steps }
     }
 
@@ -107,7 +115,8 @@ impl Decimation {
             let mut lower = vec![0.0; t.rows];
             for (r, l) in lower.iter_mut().enumerate() {
                 let (c, v) = t.row(r);
-                *l = d[off + r] + c.iter().zip(v).map(|(&c, &v)| v * v * acc[c as usize]).sum::<f64>();
+                *l = d[off + r]
+                    + c.iter().zip(v).map(|(&c, &v)| v * v * acc[c as usize]).sum::<f64>();
             }
             acc = lower;
         }

@@ -34,6 +34,8 @@ pub enum CompileError {
 pub fn check_finite(what: &str, v: &[f32]) -> Result<(), CompileError> {
     match v.iter().position(|x| !x.is_finite()) {
         None => Ok(()),
-        Some(index) => Err(CompileError::NonFinite { what: what.to_string(), index, value: v[index] }),
+        Some(index) => {
+            Err(CompileError::NonFinite { what: what.to_string(), index, value: v[index] })
+        }
     }
 }

@@ -61,7 +61,14 @@ pub fn address(i: i64, size: u32, mode: Address) -> u32 {
 }
 
 /// Adds the bilinear taps of level `m` at (s, t), scaled by `scale`.
-pub fn bilinear(layout: &TextureLayout, sampler: &Sampler, m: u32, st: [f64; 2], scale: f64, taps: &mut Taps) {
+pub fn bilinear(
+    layout: &TextureLayout,
+    sampler: &Sampler,
+    m: u32,
+    st: [f64; 2],
+    scale: f64,
+    taps: &mut Taps,
+) {
     let (w, h) = layout.level_size(m);
     let k = (0.5f64).powi(m as i32);
     let u = st[0] * layout.width as f64 * k - 0.5;
@@ -81,7 +88,13 @@ pub fn bilinear(layout: &TextureLayout, sampler: &Sampler, m: u32, st: [f64; 2],
 }
 
 /// The taps of one lookup at (s, t) with level of detail λ (already clamped by `texture_lod`).
-pub fn sample_taps(layout: &TextureLayout, sampler: &Sampler, st: [f64; 2], lambda: f64, taps: &mut Taps) {
+pub fn sample_taps(
+    layout: &TextureLayout,
+    sampler: &Sampler,
+    st: [f64; 2],
+    lambda: f64,
+    taps: &mut Taps,
+) {
     *taps = Taps::default();
     match sampler.filter {
         Filter::Nearest => {
@@ -154,7 +167,8 @@ mod tests {
         let s = Sampler { filter: Filter::Trilinear, address: [Address::ClampToEdge; 2] };
         // s = 0.7 → u1 = 1.75 → bilinear between 1 and 2 with α = 0.25; t = 0.5 → v1 = 0.75 → rows 0, 1.
         let t = taps(l, s, [0.7, 0.5], 1.0);
-        let want = [(1, 0, 0.75 * 0.75), (2, 0, 0.25 * 0.75), (1, 1, 0.75 * 0.25), (2, 1, 0.25 * 0.25)];
+        let want =
+            [(1, 0, 0.75 * 0.75), (2, 0, 0.25 * 0.75), (1, 1, 0.75 * 0.25), (2, 1, 0.25 * 0.25)];
         for (i, j, w) in want {
             let c = l.texel(1, i, j) as u32;
             let got = t.iter().find(|p| p.0 == c).map(|p| p.1).unwrap_or(0.0);
@@ -170,7 +184,8 @@ mod tests {
         let s = Sampler { filter: Filter::Trilinear, address: [Address::ClampToEdge; 2] };
         let t = taps(l, s, [0.3, 0.6], 1.25);
         assert_eq!(t.len(), 8);
-        let level1: f32 = t.iter().filter(|p| (p.0 as usize) < l.level_offset(2)).map(|p| p.1).sum();
+        let level1: f32 =
+            t.iter().filter(|p| (p.0 as usize) < l.level_offset(2)).map(|p| p.1).sum();
         assert!((level1 - 0.75).abs() < 1e-6);
     }
 }

@@ -54,7 +54,12 @@ mod tests {
         let vp = Viewport { width: 8, height: 8 };
         let positions = [[-1.0, 1.0, 0.5], [1.0, 1.0, 0.5], [-1.0, -1.0, 0.5]];
         let uvs = [[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]];
-        let mesh = DrawMesh { positions: &positions, uvs: &uvs, indices: &[0, 1, 2], clip_from_object: Mat4::IDENTITY };
+        let mesh = DrawMesh {
+            positions: &positions,
+            uvs: &uvs,
+            indices: &[0, 1, 2],
+            clip_from_object: Mat4::IDENTITY,
+        };
         let tris = setup_triangles(&mesh, &TextureTransform::IDENTITY, vp);
         let i = interpolate(&tris[0].1, 1, 2);
         assert!((i.st[0] - 1.5 / 8.0).abs() < 1e-9 && (i.st[1] - 2.5 / 8.0).abs() < 1e-9);

@@ -47,7 +47,12 @@ impl TextureLayout {
 
     /// Index in x of the first texel of level `m` (of face 0; add [`Self::face_offset`]).
     pub fn level_offset(&self, m: u32) -> usize {
-        (0..m).map(|l| { let (w, h) = self.level_size(l); w as usize * h as usize }).sum()
+        (0..m)
+            .map(|l| {
+                let (w, h) = self.level_size(l);
+                w as usize * h as usize
+            })
+            .sum()
     }
 
     /// Index in x of texel (i, j) of level `m` (of face 0).

@@ -56,7 +56,10 @@ pub use model::{render_matrix, scene_depth, ModelError, TexturedObject};
 pub use normal_equations::Form;
 pub use raster::DepthBuffer;
 pub use sampler::{Address, Filter, Sampler, MAX_ANISOTROPY};
-pub use solve::{render, solve, solve_view_independent, solve_view_source, FormChoice, MipSolve, Solution, SolveSettings, View};
+pub use solve::{
+    render, solve, solve_view_independent, solve_view_source, FormChoice, MipSolve, Solution,
+    SolveSettings, View,
+};
 pub use stacked::ViewSource;
 pub use transform::{DrawMesh, TextureTransform, Viewport};
 

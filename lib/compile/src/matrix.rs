@@ -26,7 +26,12 @@ pub struct RenderMatrix {
 impl RenderMatrix {
     /// The matrix of one lookup's `taps` per pixel of `pixels` (increasing), each row with
     /// coverage 1, its entries sorted by column.
-    pub fn from_taps(viewport: crate::Viewport, layout: TextureLayout, pixels: Vec<u32>, rows: &[crate::filter::Taps]) -> RenderMatrix {
+    pub fn from_taps(
+        viewport: crate::Viewport,
+        layout: TextureLayout,
+        pixels: Vec<u32>,
+        rows: &[crate::filter::Taps],
+    ) -> RenderMatrix {
         let nnz: usize = rows.iter().map(|t| t.len).sum();
         let (mut cols, mut vals) = (Vec::with_capacity(nnz), Vec::with_capacity(nnz));
         let mut row_start = Vec::with_capacity(rows.len() + 1);
@@ -38,13 +43,27 @@ impl RenderMatrix {
             }
             row_start.push(cols.len() as u32);
         }
-        RenderMatrix { width: viewport.width, height: viewport.height, layout, coverage: vec![1.0; pixels.len()], pixels, row_start, cols, vals }
+        RenderMatrix {
+            width: viewport.width,
+            height: viewport.height,
+            layout,
+            coverage: vec![1.0; pixels.len()],
+            pixels,
+            row_start,
+            cols,
+            vals,
+        }
     }
 
     /// The matrix of rows built in chunks of consecutive pixels of `pixels` (increasing):
     /// each chunk's columns and values, row after row, and its rows' entry counts; every
     /// row with coverage 1.
-    pub fn from_row_chunks(viewport: crate::Viewport, layout: TextureLayout, pixels: Vec<u32>, chunks: Vec<(Vec<u32>, Vec<f32>, Vec<u32>)>) -> RenderMatrix {
+    pub fn from_row_chunks(
+        viewport: crate::Viewport,
+        layout: TextureLayout,
+        pixels: Vec<u32>,
+        chunks: Vec<(Vec<u32>, Vec<f32>, Vec<u32>)>,
+    ) -> RenderMatrix {
         let nnz = chunks.iter().map(|c| c.0.len()).sum();
         let (mut cols, mut vals) = (Vec::with_capacity(nnz), Vec::with_capacity(nnz));
         let mut row_start = Vec::with_capacity(pixels.len() + 1);
@@ -56,7 +75,16 @@ impl RenderMatrix {
             cols.extend(c);
             vals.extend(v);
         }
-        RenderMatrix { width: viewport.width, height: viewport.height, layout, coverage: vec![1.0; pixels.len()], pixels, row_start, cols, vals }
+        RenderMatrix {
+            width: viewport.width,
+            height: viewport.height,
+            layout,
+            coverage: vec![1.0; pixels.len()],
+            pixels,
+            row_start,
+            cols,
+            vals,
+        }
     }
 
     /// n_s.

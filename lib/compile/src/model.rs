@@ -47,7 +47,9 @@ pub fn check_mesh(mesh: &DrawMesh) -> Result<(), ModelError> {
     if mesh.indices.len() % 3 != 0 {
         return Err(ModelError::IndexCount(mesh.indices.len()));
     }
-    if let Some((at, &index)) = mesh.indices.iter().enumerate().find(|(_, &i)| i as usize >= mesh.positions.len()) {
+    if let Some((at, &index)) =
+        mesh.indices.iter().enumerate().find(|(_, &i)| i as usize >= mesh.positions.len())
+    {
         return Err(ModelError::Index { at, index, positions: mesh.positions.len() });
     }
     if let Some(k) = (0..mesh.positions.len())
@@ -58,14 +60,22 @@ pub fn check_mesh(mesh: &DrawMesh) -> Result<(), ModelError> {
     Ok(())
 }
 
-pub(crate) fn check_inputs(vp: Viewport, layout: &TextureLayout, transform: &TextureTransform) -> Result<(), ModelError> {
+pub(crate) fn check_inputs(
+    vp: Viewport,
+    layout: &TextureLayout,
+    transform: &TextureTransform,
+) -> Result<(), ModelError> {
     if vp.width == 0 || vp.height == 0 || vp.width > 16384 || vp.height > 16384 {
         return Err(ModelError::Viewport { width: vp.width, height: vp.height });
     }
     let full = TextureLayout::full(layout.width.max(1), layout.height.max(1)).levels;
     let bad = |v: u32| v == 0 || v > 16384;
     if bad(layout.width) || bad(layout.height) || layout.levels == 0 || layout.levels > full {
-        return Err(ModelError::Layout { width: layout.width, height: layout.height, levels: layout.levels });
+        return Err(ModelError::Layout {
+            width: layout.width,
+            height: layout.height,
+            levels: layout.levels,
+        });
     }
     let [a, b, c, d, ..] = transform.values;
     let det = a * d - b * c;
@@ -86,7 +96,11 @@ pub struct TexturedObject<'a> {
 
 /// The depth of every object of the scene except `skip` (the object being modelled): the
 /// occluders against which its fragments are tested. Meshes are drawn in order.
-pub fn scene_depth(viewport: Viewport, meshes: &[DrawMesh], skip: Option<usize>) -> Result<DepthBuffer, ModelError> {
+pub fn scene_depth(
+    viewport: Viewport,
+    meshes: &[DrawMesh],
+    skip: Option<usize>,
+) -> Result<DepthBuffer, ModelError> {
     let mut depth = DepthBuffer::new(viewport);
     for (k, m) in meshes.iter().enumerate() {
         if Some(k) != skip {
@@ -98,7 +112,10 @@ pub fn scene_depth(viewport: Viewport, meshes: &[DrawMesh], skip: Option<usize>)
 }
 
 /// Checks what [`render_matrix`] checks before drawing (probe mode checks the same).
-pub fn render_matrix_inputs_ok(viewport: Viewport, object: &TexturedObject) -> Result<(), ModelError> {
+pub fn render_matrix_inputs_ok(
+    viewport: Viewport,
+    object: &TexturedObject,
+) -> Result<(), ModelError> {
     check_mesh(&object.mesh)?;
     check_inputs(viewport, &object.layout, &object.transform)
 }
@@ -106,7 +123,11 @@ pub fn render_matrix_inputs_ok(viewport: Viewport, object: &TexturedObject) -> R
 /// The render matrix A of `object` in `viewport`, its fragments tested against `occluders`
 /// (see [`scene_depth`]); every row has coverage 1 (no antialiasing: see
 /// [`mod@crate::antialias`]). Rows are the visible pixels in increasing order.
-pub fn render_matrix(viewport: Viewport, object: &TexturedObject, occluders: Option<&DepthBuffer>) -> Result<RenderMatrix, ModelError> {
+pub fn render_matrix(
+    viewport: Viewport,
+    object: &TexturedObject,
+    occluders: Option<&DepthBuffer>,
+) -> Result<RenderMatrix, ModelError> {
     render_matrix_inputs_ok(viewport, object)?;
     if matches!(object.sampler.filter, crate::Filter::Anisotropic(_)) {
         return Err(ModelError::Anisotropic);
@@ -150,9 +171,18 @@ mod tests {
         [[-1.0, 1.0, 0.5], [1.0, 1.0, 0.5], [1.0, -1.0, 0.5], [-1.0, -1.0, 0.5]]
     }
 
-    fn object<'a>(positions: &'a [[f32; 3]], layout: TextureLayout, filter: Filter) -> TexturedObject<'a> {
+    fn object<'a>(
+        positions: &'a [[f32; 3]],
+        layout: TextureLayout,
+        filter: Filter,
+    ) -> TexturedObject<'a> {
         TexturedObject {
-            mesh: DrawMesh { positions, uvs: &QUAD_UV, indices: &QUAD_IDX, clip_from_object: Mat4::IDENTITY },
+            mesh: DrawMesh {
+                positions,
+                uvs: &QUAD_UV,
+                indices: &QUAD_IDX,
+                clip_from_object: Mat4::IDENTITY,
+            },
             transform: TextureTransform::IDENTITY,
             layout,
             sampler: Sampler { filter, address: [Address::ClampToEdge; 2] },
@@ -164,7 +194,9 @@ mod tests {
         let p = screen_quad();
         for filter in [Filter::Nearest, Filter::Bilinear, Filter::Trilinear] {
             let layout = TextureLayout::full(12, 7);
-            let a = render_matrix(Viewport { width: 12, height: 7 }, &object(&p, layout, filter), None).unwrap();
+            let a =
+                render_matrix(Viewport { width: 12, height: 7 }, &object(&p, layout, filter), None)
+                    .unwrap();
             assert_eq!(a.rows(), 84, "{filter:?}");
             for r in 0..a.rows() {
                 // Weight 1 on the pixel's own texel, up to rounding of (s, t).
@@ -179,7 +211,12 @@ mod tests {
     fn two_to_one_minified_quad_reads_level_one() {
         let p = screen_quad();
         let layout = TextureLayout::full(32, 32);
-        let a = render_matrix(Viewport { width: 16, height: 16 }, &object(&p, layout, Filter::Trilinear), None).unwrap();
+        let a = render_matrix(
+            Viewport { width: 16, height: 16 },
+            &object(&p, layout, Filter::Trilinear),
+            None,
+        )
+        .unwrap();
         let level1 = layout.level_offset(1) as u32..layout.level_offset(2) as u32;
         for r in 0..a.rows() {
             let (c, v) = a.row(r);
@@ -195,7 +232,11 @@ mod tests {
     fn rows_sum_to_one_on_a_perspective_quad() {
         let p = [[-1.0, 0.0, -2.0], [1.0, 0.0, -2.0], [1.0, 0.0, -12.0], [-1.0, 0.0, -12.0]];
         let proj = crate::transform::perspective(1.0, 4.0 / 3.0, 0.1, 100.0);
-        let view = crate::transform::look_at(glam::Vec3::new(0.0, 1.0, 0.0), glam::Vec3::new(0.0, 0.0, -6.0), glam::Vec3::Y);
+        let view = crate::transform::look_at(
+            glam::Vec3::new(0.0, 1.0, 0.0),
+            glam::Vec3::new(0.0, 0.0, -6.0),
+            glam::Vec3::Y,
+        );
         let mut o = object(&p, TextureLayout::full(37, 100), Filter::Trilinear);
         o.mesh.clip_from_object = proj * view;
         let a = render_matrix(Viewport { width: 64, height: 48 }, &o, None).unwrap();
@@ -237,7 +278,10 @@ mod tests {
     fn anisotropic_filtering_is_not_modelled() {
         let p = screen_quad();
         let o = object(&p, TextureLayout::full(4, 4), Filter::Anisotropic(16));
-        assert_eq!(render_matrix(Viewport { width: 4, height: 4 }, &o, None).unwrap_err(), ModelError::Anisotropic);
+        assert_eq!(
+            render_matrix(Viewport { width: 4, height: 4 }, &o, None).unwrap_err(),
+            ModelError::Anisotropic
+        );
     }
 
     #[test]

@@ -24,17 +24,29 @@ pub const DEFAULT_K: f64 = 4.0;
 impl Form {
     /// The rule of thesis 3.5: the AᵀA form when `2·n_s ≥ K·n_t`.
     pub fn choose(n_s: usize, n_t: usize, k: f64) -> Form {
-        if 2.0 * n_s as f64 >= k * n_t as f64 { Form::Normal } else { Form::A }
+        if 2.0 * n_s as f64 >= k * n_t as f64 {
+            Form::Normal
+        } else {
+            Form::A
+        }
     }
 }
 
 /// The data operator shared by the three colour channels.
 pub enum DataOperator {
-    A { a: Csr, at: Csr },
-    Normal { h: Csr, at: Csr },
+    A {
+        a: Csr,
+        at: Csr,
+    },
+    Normal {
+        h: Csr,
+        at: Csr,
+    },
     /// AᵀA alone, assembled view by view with its right-hand sides
     /// ([`crate::stacked`]): A itself is never held.
-    Gram { h: Csr },
+    Gram {
+        h: Csr,
+    },
 }
 
 impl DataOperator {
@@ -60,7 +72,9 @@ impl DataOperator {
                 at.mul(&b, &mut atb);
                 ChannelRhs { b: vec![], atb, bb }
             }
-            DataOperator::Gram { .. } => unreachable!("a Gram operator's right-hand sides are assembled with it"),
+            DataOperator::Gram { .. } => {
+                unreachable!("a Gram operator's right-hand sides are assembled with it")
+            }
         }
     }
 

@@ -82,7 +82,11 @@ fn snap(v: f32) -> i64 {
 /// Runs the vertex stage and clipping over a mesh: the screen triangles in draw order, with
 /// the index of the source triangle. Triangles of zero snapped area are dropped (as the
 /// rasterizer drops them).
-pub fn setup_triangles(mesh: &DrawMesh, transform: &TextureTransform, vp: Viewport) -> Vec<(u32, ScreenTriangle)> {
+pub fn setup_triangles(
+    mesh: &DrawMesh,
+    transform: &TextureTransform,
+    vp: Viewport,
+) -> Vec<(u32, ScreenTriangle)> {
     let mut out = Vec::with_capacity(mesh.indices.len() / 3);
     for (t, idx) in mesh.indices.chunks_exact(3).enumerate() {
         let v = |i: u32| {
@@ -91,7 +95,11 @@ pub fn setup_triangles(mesh: &DrawMesh, transform: &TextureTransform, vp: Viewpo
             vertex(&mesh.clip_from_object, mesh.positions[i], uv, transform)
         };
         let tri = [v(idx[0]), v(idx[1]), v(idx[2])];
-        let poly = if tri.iter().all(|v| v.clip.z >= 0.0 && v.clip.z <= v.clip.w) { tri.to_vec() } else { clip_depth(tri) };
+        let poly = if tri.iter().all(|v| v.clip.z >= 0.0 && v.clip.z <= v.clip.w) {
+            tri.to_vec()
+        } else {
+            clip_depth(tri)
+        };
         for k in 1..poly.len().saturating_sub(1) {
             let corners = [poly[0], poly[k], poly[k + 1]];
             if corners.iter().any(|c| c.clip.w <= 0.0 || !c.clip.is_finite()) {
@@ -132,7 +140,10 @@ pub struct DepthBuffer {
 
 impl DepthBuffer {
     pub fn new(viewport: Viewport) -> Self {
-        DepthBuffer { viewport, depth: vec![1.0; viewport.width as usize * viewport.height as usize] }
+        DepthBuffer {
+            viewport,
+            depth: vec![1.0; viewport.width as usize * viewport.height as usize],
+        }
     }
 
     /// Draws a mesh's depth (test `Less`, write on).
@@ -178,8 +189,14 @@ pub struct Fragments {
 
 impl Fragments {
     /// Rasterizes an object with depth test `Less` against itself and against `occluders`.
-    pub fn rasterize(mesh: &DrawMesh, transform: &TextureTransform, vp: Viewport, occluders: Option<&DepthBuffer>) -> Self {
-        let (source, triangles): (Vec<u32>, Vec<ScreenTriangle>) = setup_triangles(mesh, transform, vp).into_iter().unzip();
+    pub fn rasterize(
+        mesh: &DrawMesh,
+        transform: &TextureTransform,
+        vp: Viewport,
+        occluders: Option<&DepthBuffer>,
+    ) -> Self {
+        let (source, triangles): (Vec<u32>, Vec<ScreenTriangle>) =
+            setup_triangles(mesh, transform, vp).into_iter().unzip();
         let n = vp.width as usize * vp.height as usize;
         let mut depth = match occluders {
             Some(o) if o.viewport == vp => o.depth.clone(),
@@ -220,7 +237,12 @@ mod tests {
         let positions = [c(2.5, 2.5), c(12.5, 2.5), c(12.5, 12.5), c(2.5, 12.5), c(7.5, 0.5)];
         let uvs = [[0.0; 2]; 5];
         let indices = [0, 1, 2, 0, 2, 3, 0, 4, 1];
-        let mesh = DrawMesh { positions: &positions, uvs: &uvs, indices: &indices, clip_from_object: Mat4::IDENTITY };
+        let mesh = DrawMesh {
+            positions: &positions,
+            uvs: &uvs,
+            indices: &indices,
+            clip_from_object: Mat4::IDENTITY,
+        };
         let tris = setup_triangles(&mesh, &TextureTransform::IDENTITY, vp);
         let mut count = vec![0u32; 256];
         for (_, t) in &tris {
@@ -246,7 +268,12 @@ mod tests {
         let (far, near) = (quad(0.6), quad(0.3));
         let uvs = [[0.0; 2]; 4];
         let idx = [0, 1, 2, 0, 2, 3];
-        let m = |p: &'static [[f32; 3]]| DrawMesh { positions: p, uvs: &uvs, indices: &idx, clip_from_object: Mat4::IDENTITY };
+        let m = |p: &'static [[f32; 3]]| DrawMesh {
+            positions: p,
+            uvs: &uvs,
+            indices: &idx,
+            clip_from_object: Mat4::IDENTITY,
+        };
         let far: &'static [[f32; 3]] = Box::leak(Box::new(far));
         let near: &'static [[f32; 3]] = Box::leak(Box::new(near));
         let mut occ = DepthBuffer::new(vp);

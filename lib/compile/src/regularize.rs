@@ -30,7 +30,11 @@ pub struct RangeRegularization {
 /// g(y) of eq. 3.8 (+∞ outside (−δ, 1 + δ)).
 pub fn barrier(y: f64) -> f64 {
     let (p, q) = (y + RANGE_DELTA, 1.0 + RANGE_DELTA - y);
-    if p <= 0.0 || q <= 0.0 { f64::INFINITY } else { 1.0 / (p * q) }
+    if p <= 0.0 || q <= 0.0 {
+        f64::INFINITY
+    } else {
+        1.0 / (p * q)
+    }
 }
 
 /// g'(y).
@@ -95,7 +99,9 @@ impl RangeRegularization {
 pub fn pyramid_operator(layout: &TextureLayout) -> Csr {
     let n = layout.texel_count();
     let mut p = Csr { rows: 0, cols: n, row_start: vec![0], col: vec![], val: vec![] };
-    for (face, m) in (0..layout.faces.max(1)).flat_map(|f| (0..layout.levels.saturating_sub(1)).map(move |m| (f, m))) {
+    for (face, m) in (0..layout.faces.max(1))
+        .flat_map(|f| (0..layout.levels.saturating_sub(1)).map(move |m| (f, m)))
+    {
         let (w, h) = layout.level_size(m);
         let (cw, ch) = layout.level_size(m + 1);
         let taps = |i: u32, cn: u32| -> [(u32, f64); 2] {
@@ -111,7 +117,8 @@ pub fn pyramid_operator(layout: &TextureLayout) -> Csr {
             let ty = taps(j, ch);
             for i in 0..w {
                 let tx = taps(i, cw);
-                let mut entries: Vec<(u32, f64)> = vec![(layout.face_texel(face, m, i, j) as u32, 1.0)];
+                let mut entries: Vec<(u32, f64)> =
+                    vec![(layout.face_texel(face, m, i, j) as u32, 1.0)];
                 for &(y, wy) in &ty {
                     for &(x, wx) in &tx {
                         let wgt = wx * wy;
@@ -147,8 +154,16 @@ mod tests {
             let h = 1e-6;
             let d1 = (barrier(y + h) - barrier(y - h)) / (2.0 * h);
             let d2 = (barrier_d1(y + h) - barrier_d1(y - h)) / (2.0 * h);
-            assert!((d1 - barrier_d1(y)).abs() <= 1e-5 * d1.abs().max(1.0), "{y}: {d1} vs {}", barrier_d1(y));
-            assert!((d2 - barrier_d2(y)).abs() <= 1e-4 * d2.abs().max(1.0), "{y}: {d2} vs {}", barrier_d2(y));
+            assert!(
+                (d1 - barrier_d1(y)).abs() <= 1e-5 * d1.abs().max(1.0),
+                "{y}: {d1} vs {}",
+                barrier_d1(y)
+            );
+            assert!(
+                (d2 - barrier_d2(y)).abs() <= 1e-4 * d2.abs().max(1.0),
+                "{y}: {d2} vs {}",
+                barrier_d2(y)
+            );
         }
         assert!(barrier(-1.0).is_infinite() && barrier(2.0).is_infinite());
     }

@@ -12,7 +12,9 @@ use crate::bounded::minimize_bounded;
 use crate::cg::{self, CgReport, CgSettings};
 use crate::decimation::{chain_f32, Decimation};
 use crate::error::check_finite;
-use crate::normal_equations::{ChannelProblem, ChannelRhs, DataOperator, Form, PyramidTerm, DEFAULT_K};
+use crate::normal_equations::{
+    ChannelProblem, ChannelRhs, DataOperator, Form, PyramidTerm, DEFAULT_K,
+};
 use crate::regularize::{barrier_d2, pyramid_operator, RangeRegularization};
 use crate::sparse::Csr;
 use crate::stacked::{assemble, residual2 as residual2_of, view_matrix, ViewSource};
@@ -188,7 +190,12 @@ pub fn solve_view_source<S: ViewSource + ?Sized>(
         col_norms: t.col_norms,
         n_s: t.n_s,
         b_max: t.b_max as f64,
-        rhs: t.atb.into_iter().zip(t.bb).map(|(atb, bb)| ChannelRhs { b: vec![], atb, bb }).collect(),
+        rhs: t
+            .atb
+            .into_iter()
+            .zip(t.bb)
+            .map(|(atb, bb)| ChannelRhs { b: vec![], atb, bb })
+            .collect(),
         pixels: Pixels::Read(&|xs: &[&[f64]]| residual2_of(source, layout, xs)),
     };
     finish(data, initial, settings, start)
@@ -216,15 +223,24 @@ struct DataTerm<'a> {
 }
 
 /// The settings the layout allows, and the warm start's size and values.
-fn check_layout(layout: TextureLayout, settings: &SolveSettings, initial: Option<&[f32]>) -> Result<(), CompileError> {
+fn check_layout(
+    layout: TextureLayout,
+    settings: &SolveSettings,
+    initial: Option<&[f32]>,
+) -> Result<(), CompileError> {
     if settings.mip == MipSolve::Decimated && layout.faces > 1 {
-        return Err(CompileError::Setting("a cube map's levels are solved together (mip solve `free`), not decimated".into()));
+        return Err(CompileError::Setting(
+            "a cube map's levels are solved together (mip solve `free`), not decimated".into(),
+        ));
     }
     if let Some(x0) = initial {
         let n_t = layout.texel_count();
         if x0.len() != n_t * CHANNELS {
             return Err(CompileError::Size {
-                what: "initial guess (texels × 3)".into(), expected: n_t * CHANNELS, found: x0.len() });
+                what: "initial guess (texels × 3)".into(),
+                expected: n_t * CHANNELS,
+                found: x0.len(),
+            });
         }
         check_finite("initial guess", x0)?;
     }
@@ -243,10 +259,18 @@ pub(crate) fn solve_views(
     let layout = first.a.layout;
     check_settings(settings)?;
     check_layout(layout, settings, initial)?;
-    let mut parts = views.iter().enumerate().map(|(k, v)| view_matrix(k, v, layout)).collect::<Result<Vec<_>, _>>()?;
+    let mut parts = views
+        .iter()
+        .enumerate()
+        .map(|(k, v)| view_matrix(k, v, layout))
+        .collect::<Result<Vec<_>, _>>()?;
     let n_t = layout.texel_count();
     // The views' parts are dropped once stacked.
-    let a = if parts.len() == 1 { parts.pop().expect("one part") } else { Csr::stack(&std::mem::take(&mut parts))? };
+    let a = if parts.len() == 1 {
+        parts.pop().expect("one part")
+    } else {
+        Csr::stack(&std::mem::take(&mut parts))?
+    };
     let n_s = a.rows;
     let form = match settings.form {
         FormChoice::Fixed(f) => f,
@@ -257,7 +281,13 @@ pub(crate) fn solve_views(
     let op = DataOperator::new(a, form);
     let b_max = views.iter().flat_map(|v| v.b.iter()).fold(0.0f32, |m, &v| m.max(v)) as f64;
     let b: Vec<Vec<f64>> = (0..CHANNELS)
-        .map(|ch| views.iter().flat_map(|v| v.b.iter().skip(ch).step_by(CHANNELS)).map(|&v| v as f64).collect())
+        .map(|ch| {
+            views
+                .iter()
+                .flat_map(|v| v.b.iter().skip(ch).step_by(CHANNELS))
+                .map(|&v| v as f64)
+                .collect()
+        })
         .collect();
     let rhs = b.iter().map(|b| op.rhs(b.clone())).collect();
     let data = DataTerm { layout, op, form, col_norms, n_s, b_max, rhs, pixels: Pixels::Held(b) };
@@ -283,8 +313,12 @@ fn finish(
         PyramidTerm { lambda: settings.epsilon_f * ratio, p, pt }
     });
     let range = (settings.epsilon_b > 0.0).then(|| {
-        RangeRegularization::new(settings.epsilon_b, n_s, n_x,
-                                 (settings.range_factor * b_max).max(1e-6))
+        RangeRegularization::new(
+            settings.epsilon_b,
+            n_s,
+            n_x,
+            (settings.range_factor * b_max).max(1e-6),
+        )
     });
 
     // Jacobi preconditioner: the diagonal of AᵀA + λPᵀP + the barrier's curvature at ½.
@@ -302,7 +336,11 @@ fn finish(
         diag = d.reduce_diagonal(&diag);
     }
     let positive: Vec<f64> = diag.iter().copied().filter(|&d| d > 0.0).collect();
-    let floor = if positive.is_empty() { 1.0 } else { positive.iter().sum::<f64>() / positive.len() as f64 };
+    let floor = if positive.is_empty() {
+        1.0
+    } else {
+        positive.iter().sum::<f64>() / positive.len() as f64
+    };
     let inv_diag: Vec<f64> = diag.iter().map(|&d| 1.0 / if d > 0.0 { d } else { floor }).collect();
     let undefined = match (&pyramid, &chain) {
         (Some(_), _) => 0,
@@ -321,13 +359,16 @@ fn finish(
         .map(|ch| {
             let rhs = &rhs[ch];
             let mut x: Vec<f64> = match initial {
-                Some(x0) => x0.iter().skip(ch).step_by(CHANNELS).take(n_x).map(|&v| v as f64).collect(),
+                Some(x0) => {
+                    x0.iter().skip(ch).step_by(CHANNELS).take(n_x).map(|&v| v as f64).collect()
+                }
                 None => vec![0.0; n_x],
             };
             if let Some(r) = &range {
                 r.clamp_inside(&mut x);
             }
-            let problem = ChannelProblem { op: &op, rhs, pyramid: pyramid.as_ref(), chain: chain.as_ref() };
+            let problem =
+                ChannelProblem { op: &op, rhs, pyramid: pyramid.as_ref(), chain: chain.as_ref() };
             let report = if settings.bounded {
                 let hi = (settings.range_factor * b_max).max(1e-6);
                 minimize_bounded(&problem, 0.0, hi, &inv_diag, &mut x, &settings.cg)
@@ -371,7 +412,11 @@ fn finish(
         converged: channels.iter().all(|c| c.converged),
         channels,
         residual_rms: (residual2 / (n_s.max(1) * CHANNELS) as f64).sqrt(),
-        residual_relative: if bb_total > 0.0 { (residual2 / bb_total).sqrt() } else { residual2.sqrt() },
+        residual_relative: if bb_total > 0.0 {
+            (residual2 / bb_total).sqrt()
+        } else {
+            residual2.sqrt()
+        },
         undefined,
         solve_ms: start.elapsed().as_secs_f64() * 1e3,
     })
@@ -381,7 +426,9 @@ fn finish(
 fn data_residual2(op: &DataOperator, x: &[f64], b: &[f64]) -> f64 {
     let at = match op {
         DataOperator::A { at, .. } | DataOperator::Normal { at, .. } => at,
-        DataOperator::Gram { .. } => unreachable!("a Gram operator's residual reads the views again"),
+        DataOperator::Gram { .. } => {
+            unreachable!("a Gram operator's residual reads the views again")
+        }
     };
     // Ax through the transpose's columns: (Ax)_r = Σ_c A_rc x_c, gathered row by row.
     let mut ax = vec![0.0; b.len()];
@@ -398,11 +445,14 @@ fn check_settings(s: &SolveSettings) -> Result<(), CompileError> {
     let ok = |v: f64| v.is_finite() && v >= 0.0;
     if !ok(s.epsilon_b) || !ok(s.epsilon_f) {
         return Err(CompileError::Setting(format!(
-            "ε_b = {} and ε_f = {} must be finite and ≥ 0", s.epsilon_b, s.epsilon_f)));
+            "ε_b = {} and ε_f = {} must be finite and ≥ 0",
+            s.epsilon_b, s.epsilon_f
+        )));
     }
     if s.bounded && s.epsilon_b > 0.0 {
         return Err(CompileError::Setting(
-            "the box constraint and the range term (ε_b) are alternatives: set one".into()));
+            "the box constraint and the range term (ε_b) are alternatives: set one".into(),
+        ));
     }
     if !(s.range_factor.is_finite() && s.range_factor > 0.0 && s.k.is_finite() && s.k > 0.0) {
         return Err(CompileError::Setting("range factor and K must be finite and > 0".into()));

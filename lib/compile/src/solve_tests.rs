@@ -118,22 +118,32 @@ fn unobserved_texels_grazing_views_tiny_coverage_and_half_off_screen_stay_finite
     let x = texture(&layout);
     let cases: Vec<(&str, RenderMatrix)> = vec![
         // grazing: t spans the texture over 2 rows of pixels
-        ("grazing", warp_matrix(40, 30, layout, Filter::Trilinear, |x, y| {
-            let (s, t) = (x / 40.0, (y - 14.0) / 2.0);
-            (0.0..1.0).contains(&t).then_some((s, t))
-        })),
-        ("tiny", warp_matrix(40, 30, layout, Filter::Trilinear, |x, y| {
-            (x < 2.0 && y < 2.0).then_some((0.3 + x * 0.01, 0.6 + y * 0.01))
-        })),
+        (
+            "grazing",
+            warp_matrix(40, 30, layout, Filter::Trilinear, |x, y| {
+                let (s, t) = (x / 40.0, (y - 14.0) / 2.0);
+                (0.0..1.0).contains(&t).then_some((s, t))
+            }),
+        ),
+        (
+            "tiny",
+            warp_matrix(40, 30, layout, Filter::Trilinear, |x, y| {
+                (x < 2.0 && y < 2.0).then_some((0.3 + x * 0.01, 0.6 + y * 0.01))
+            }),
+        ),
         // the object's left half is off screen: only s ≥ ½ is seen
-        ("half-off-screen", warp_matrix(40, 30, layout, Filter::Trilinear, |x, y| {
-            Some((0.5 + x / 80.0, y / 30.0))
-        })),
+        (
+            "half-off-screen",
+            warp_matrix(40, 30, layout, Filter::Trilinear, |x, y| Some((0.5 + x / 80.0, y / 30.0))),
+        ),
     ];
     for (name, a) in cases {
         let b = render(&a, &x);
-        for settings in [SolveSettings::default(), SolveSettings::pyramidal(),
-                         SolveSettings { epsilon_b: 1.0 / 32.0, ..SolveSettings::pyramidal() }] {
+        for settings in [
+            SolveSettings::default(),
+            SolveSettings::pyramidal(),
+            SolveSettings { epsilon_b: 1.0 / 32.0, ..SolveSettings::pyramidal() },
+        ] {
             let sol = solve(&a, &b, None, &settings).unwrap();
             assert!(sol.texels.iter().all(|v| v.is_finite()), "{name}");
             assert!(sol.residual_rms.is_finite(), "{name}");
@@ -156,13 +166,16 @@ fn non_finite_inputs_are_rejected() {
     assert!(matches!(e, CompileError::NonFinite { index: 3, .. }), "{e}");
     a.vals[3] = 0.5;
     let x0 = vec![f32::NEG_INFINITY; a.cols() * 3];
-    assert!(matches!(solve(&a, &b, Some(&x0), &SolveSettings::default()),
-                     Err(CompileError::NonFinite { .. })));
-    assert!(matches!(solve(&a, &b[1..], None, &SolveSettings::default()),
-                     Err(CompileError::Size { .. })));
+    assert!(matches!(
+        solve(&a, &b, Some(&x0), &SolveSettings::default()),
+        Err(CompileError::NonFinite { .. })
+    ));
+    assert!(matches!(
+        solve(&a, &b[1..], None, &SolveSettings::default()),
+        Err(CompileError::Size { .. })
+    ));
     a.cols[0] = a.cols() as u32;
-    assert!(matches!(solve(&a, &b, None, &SolveSettings::default()),
-                     Err(CompileError::Matrix(_))));
+    assert!(matches!(solve(&a, &b, None, &SolveSettings::default()), Err(CompileError::Matrix(_))));
 }
 
 #[test]
@@ -182,7 +195,8 @@ fn a_view_independent_texture_is_solved_over_stacked_views() {
     let x = texture(&layout);
     // each view sees one half of the texture
     let left = warp_matrix(32, 32, layout, Filter::Bilinear, |x, y| Some((x / 64.0, y / 32.0)));
-    let right = warp_matrix(32, 32, layout, Filter::Bilinear, |x, y| Some((0.5 + x / 64.0, y / 32.0)));
+    let right =
+        warp_matrix(32, 32, layout, Filter::Bilinear, |x, y| Some((0.5 + x / 64.0, y / 32.0)));
     let (bl, br) = (render(&left, &x), render(&right, &x));
     let views = [View { a: &left, b: &bl }, View { a: &right, b: &br }];
     let sol = solve_view_independent(&views, None, &SolveSettings::default()).unwrap();
@@ -206,7 +220,11 @@ impl crate::ViewSource for OneAtATime<'_> {
         self.views.len()
     }
 
-    fn visit(&self, k: usize, f: &mut dyn FnMut(View<'_>) -> Result<(), CompileError>) -> Result<(), CompileError> {
+    fn visit(
+        &self,
+        k: usize,
+        f: &mut dyn FnMut(View<'_>) -> Result<(), CompileError>,
+    ) -> Result<(), CompileError> {
         self.served.set(self.served.get() + 1);
         // A copy that lives only for the call.
         let (a, b) = (self.views[k].a.clone(), self.views[k].b.to_vec());
@@ -221,12 +239,19 @@ fn views_served_one_at_a_time_give_the_stacked_solve_bit_for_bit() {
     let mats: Vec<RenderMatrix> = (0..4)
         .map(|k| {
             let (u0, v0) = (0.1 * k as f64, 0.05 * k as f64);
-            warp_matrix(28 + 3 * k, 30, layout, Filter::Trilinear, move |x, y| Some((u0 + x / 70.0, v0 + (y / 40.0).powf(1.1))))
+            warp_matrix(28 + 3 * k, 30, layout, Filter::Trilinear, move |x, y| {
+                Some((u0 + x / 70.0, v0 + (y / 40.0).powf(1.1)))
+            })
         })
         .collect();
-    let bs: Vec<Vec<f32>> = mats.iter().enumerate().map(|(k, a)| render(a, &x).iter().map(|v| v * (1.0 + 0.01 * k as f32)).collect()).collect();
+    let bs: Vec<Vec<f32>> = mats
+        .iter()
+        .enumerate()
+        .map(|(k, a)| render(a, &x).iter().map(|v| v * (1.0 + 0.01 * k as f32)).collect())
+        .collect();
     let views: Vec<View> = mats.iter().zip(&bs).map(|(a, b)| View { a, b }).collect();
-    for settings in [SolveSettings::pyramidal(), SolveSettings::range(), SolveSettings::decimated()] {
+    for settings in [SolveSettings::pyramidal(), SolveSettings::range(), SolveSettings::decimated()]
+    {
         // The stacked matrix held, in the AᵀA form.
         let held = crate::solve::solve_views(&views, Some(&x), &settings, true).unwrap();
         let source = OneAtATime { views: &views, served: std::cell::Cell::new(0) };
@@ -254,11 +279,15 @@ fn solving_twice_gives_identical_bytes() {
     }
 }
 
-
-
 /// A quad from the hardware model: positions in object space, uv = corners.
-fn model_matrix(positions: [[f32; 3]; 4], clip_from_object: glam::Mat4, layout: TextureLayout) -> RenderMatrix {
-    use crate::{render_matrix, Address, DrawMesh, Sampler, TextureTransform, TexturedObject, Viewport};
+fn model_matrix(
+    positions: [[f32; 3]; 4],
+    clip_from_object: glam::Mat4,
+    layout: TextureLayout,
+) -> RenderMatrix {
+    use crate::{
+        render_matrix, Address, DrawMesh, Sampler, TextureTransform, TexturedObject, Viewport,
+    };
     const UV: [[f32; 2]; 4] = [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]];
     const IDX: [u32; 6] = [0, 1, 2, 0, 2, 3];
     let object = TexturedObject {
@@ -285,18 +314,28 @@ fn hardware_model_views_where_most_texels_are_unobserved_converge() {
         // far away: a few pixels
         ("tiny", floor, proj * look_at(Vec3::new(0.0, 12.0, 16.0), Vec3::ZERO, Vec3::Y)),
         // the camera looks past the quad's edge: its left half is off screen
-        ("half-off-screen", floor, proj * look_at(Vec3::new(-1.0, 2.0, 0.5), Vec3::new(-1.0, 0.0, 0.0), Vec3::Y)),
+        (
+            "half-off-screen",
+            floor,
+            proj * look_at(Vec3::new(-1.0, 2.0, 0.5), Vec3::new(-1.0, 0.0, 0.0), Vec3::Y),
+        ),
     ];
     for (name, p, m) in cases {
         let a = model_matrix(p, m, layout);
         assert!(a.rows() > 0, "{name}: the quad is visible");
         let b = render(&a, &x);
-        for settings in [SolveSettings::default(), SolveSettings::pyramidal(),
-                         SolveSettings { epsilon_b: 1.0 / 32.0, ..SolveSettings::pyramidal() }] {
+        for settings in [
+            SolveSettings::default(),
+            SolveSettings::pyramidal(),
+            SolveSettings { epsilon_b: 1.0 / 32.0, ..SolveSettings::pyramidal() },
+        ] {
             let sol = solve(&a, &b, None, &settings).unwrap();
             assert!(sol.texels.iter().all(|v| v.is_finite()), "{name}");
-            assert!(sol.residual_rms.is_finite() && sol.residual_relative < 0.05,
-                    "{name}: residual {}", sol.residual_relative);
+            assert!(
+                sol.residual_rms.is_finite() && sol.residual_relative < 0.05,
+                "{name}: residual {}",
+                sol.residual_relative
+            );
             assert_monotone(&sol);
             if settings.epsilon_f > 0.0 {
                 assert_eq!(sol.undefined, 0);
@@ -331,17 +370,27 @@ fn unregularized_fit_with_more_texels_than_pixels_is_an_out_of_range_overfit() {
     for (k, v) in b.iter_mut().enumerate() {
         *v += 0.02 * (((k * 2654435761) % 1000) as f32 / 1000.0 - 0.5);
     }
-    assert!(a.layout.texel_count() > 4 * a.rows(), "n_t {} vs n_s {}", a.layout.texel_count(), a.rows());
-    let settings = |s: SolveSettings| SolveSettings { cg: crate::cg::CgSettings { tolerance: 1e-8, max_iterations: 5000, ..s.cg }, ..s };
+    assert!(
+        a.layout.texel_count() > 4 * a.rows(),
+        "n_t {} vs n_s {}",
+        a.layout.texel_count(),
+        a.rows()
+    );
+    let settings = |s: SolveSettings| SolveSettings {
+        cg: crate::cg::CgSettings { tolerance: 1e-8, max_iterations: 5000, ..s.cg },
+        ..s
+    };
     let plain = solve(&a, &b, None, &settings(SolveSettings::default())).unwrap();
     let reg = solve(&a, &b, None, &settings(SolveSettings::pyramidal())).unwrap();
     assert_monotone(&reg);
     let b_max = b.iter().fold(0.0f32, |m, &v| m.max(v.abs()));
     let extent = |x: &[f32]| x.iter().fold(0.0f32, |m, &v| m.max(v.abs()));
-    let (p_plain, p_reg) = (psnr(&render(&a, &plain.texels), &b), psnr(&render(&a, &reg.texels), &b));
+    let (p_plain, p_reg) =
+        (psnr(&render(&a, &plain.texels), &b), psnr(&render(&a, &reg.texels), &b));
     // a neighbouring view, against the noise-free truth there
     let (a2, truth2) = minified_view(0.7);
-    let (q_plain, q_reg) = (psnr(&render(&a2, &plain.texels), &truth2), psnr(&render(&a2, &reg.texels), &truth2));
+    let (q_plain, q_reg) =
+        (psnr(&render(&a2, &plain.texels), &truth2), psnr(&render(&a2, &reg.texels), &truth2));
     eprintln!("plain {p_plain:.1} dB (|x| ≤ {}), pyramidal {p_reg:.1} dB (|x| ≤ {}), b ≤ {b_max}; neighbour: plain {q_plain:.1}, pyramidal {q_reg:.1}",
               extent(&plain.texels), extent(&reg.texels));
     assert!(p_plain > p_reg, "plain LS fits the sample (noise included) closer");
@@ -367,7 +416,11 @@ fn receding_view() -> (RenderMatrix, Vec<f32>, TextureLayout) {
         let p = a.pixels[r];
         let (s, t) = map((p % 40) as f64 + 0.5, (p / 40) as f64 + 0.5).expect("a covered pixel");
         let stripe = 0.5 + 0.4 * (40.0 * s).sin();
-        b[r * 3..r * 3 + 3].copy_from_slice(&[stripe as f32, (0.2 + 0.6 * t) as f32, (stripe * t) as f32]);
+        b[r * 3..r * 3 + 3].copy_from_slice(&[
+            stripe as f32,
+            (0.2 + 0.6 * t) as f32,
+            (stripe * t) as f32,
+        ]);
     }
     (a, b, layout)
 }
@@ -406,15 +459,35 @@ fn bounded_least_squares_keeps_the_box_and_weak_pyramidal_costs_little() {
     let cg = crate::cg::CgSettings { max_iterations: 5000, ..Default::default() };
     let bounded = solve(&a, &b, None, &SolveSettings { cg, ..SolveSettings::bounded() }).unwrap();
     let hi = 1.1 * b_max;
-    assert!(bounded.texels.iter().all(|&v| (0.0..=hi * (1.0 + 1e-6)).contains(&v)), "texels leave [0, {hi}]");
+    assert!(
+        bounded.texels.iter().all(|&v| (0.0..=hi * (1.0 + 1e-6)).contains(&v)),
+        "texels leave [0, {hi}]"
+    );
     assert_monotone(&bounded);
-    assert!(bounded.converged, "{:?}", bounded.channels.iter().map(|c| (c.iterations, c.objective.last().copied())).collect::<Vec<_>>());
-    let pyr = solve(&a, &b, None, &SolveSettings { cg, epsilon_f: 0.003, ..SolveSettings::bounded() }).unwrap();
+    assert!(
+        bounded.converged,
+        "{:?}",
+        bounded
+            .channels
+            .iter()
+            .map(|c| (c.iterations, c.objective.last().copied()))
+            .collect::<Vec<_>>()
+    );
+    let pyr =
+        solve(&a, &b, None, &SolveSettings { cg, epsilon_f: 0.003, ..SolveSettings::bounded() })
+            .unwrap();
     assert_eq!(pyr.undefined, 0);
     assert!(pyr.texels.iter().all(|v| v.is_finite()));
-    let (p_box, p_pyr) = (psnr(&render(&a, &bounded.texels), &b), psnr(&render(&a, &pyr.texels), &b));
+    let (p_box, p_pyr) =
+        (psnr(&render(&a, &bounded.texels), &b), psnr(&render(&a, &pyr.texels), &b));
     eprintln!("bounded {p_box:.2} dB, bounded pyramidal (ε_f 0.003) {p_pyr:.2} dB");
     assert!(p_box - p_pyr < 0.5, "bounded {p_box:.2} dB, pyramidal {p_pyr:.2} dB");
     // The range term and the box are alternatives.
-    assert!(solve(&a, &b, None, &SolveSettings { epsilon_b: 1.0 / 32.0, ..SolveSettings::bounded() }).is_err());
+    assert!(solve(
+        &a,
+        &b,
+        None,
+        &SolveSettings { epsilon_b: 1.0 / 32.0, ..SolveSettings::bounded() }
+    )
+    .is_err());
 }

@@ -33,9 +33,12 @@ impl Csr {
         let (rows, cols) = (a.rows(), a.cols());
         if a.row_start.len() != rows + 1 {
             return Err(CompileError::Matrix(format!(
-                "{} row pointers for {rows} rows", a.row_start.len())));
+                "{} row pointers for {rows} rows",
+                a.row_start.len()
+            )));
         }
-        if a.cols.len() != a.vals.len() || a.row_start[rows] as usize != a.vals.len()
+        if a.cols.len() != a.vals.len()
+            || a.row_start[rows] as usize != a.vals.len()
             || a.row_start[0] != 0
         {
             return Err(CompileError::Matrix("row pointers disagree with the entry count".into()));
@@ -45,7 +48,9 @@ impl Csr {
         }
         if let Some(i) = a.cols.iter().position(|&c| c as usize >= cols) {
             return Err(CompileError::Matrix(format!(
-                "entry {i} names column {} of {cols}", a.cols[i])));
+                "entry {i} names column {} of {cols}",
+                a.cols[i]
+            )));
         }
         crate::error::check_finite("A", &a.vals)?;
         Ok(Csr {
@@ -97,7 +102,10 @@ impl Csr {
         for p in parts {
             if p.cols != cols {
                 return Err(CompileError::Size {
-                    what: "stacked matrices' column count".into(), expected: cols, found: p.cols });
+                    what: "stacked matrices' column count".into(),
+                    expected: cols,
+                    found: p.cols,
+                });
             }
             let base = out.nnz();
             out.row_start.extend(p.row_start[1..].iter().map(|s| s + base));
@@ -162,7 +170,13 @@ impl Csr {
                 },
             )
             .collect();
-        let mut out = Csr { rows: n, cols: n, row_start: Vec::with_capacity(n + 1), col: vec![], val: vec![] };
+        let mut out = Csr {
+            rows: n,
+            cols: n,
+            row_start: Vec::with_capacity(n + 1),
+            col: vec![],
+            val: vec![],
+        };
         out.row_start.push(0);
         for (c, v) in rows {
             out.col.extend(c);
@@ -188,8 +202,13 @@ mod tests {
 
     fn small() -> Csr {
         // [[1 2 0], [0 3 4]]
-        Csr { rows: 2, cols: 3, row_start: vec![0, 2, 4], col: vec![0, 1, 1, 2],
-              val: vec![1.0, 2.0, 3.0, 4.0] }
+        Csr {
+            rows: 2,
+            cols: 3,
+            row_start: vec![0, 2, 4],
+            col: vec![0, 1, 1, 2],
+            val: vec![1.0, 2.0, 3.0, 4.0],
+        }
     }
 
     #[test]

@@ -19,7 +19,11 @@ pub trait ViewSource {
     /// How many views.
     fn count(&self) -> usize;
     /// Calls `f` with view `k` (`k < count()`).
-    fn visit(&self, k: usize, f: &mut dyn FnMut(View<'_>) -> Result<(), CompileError>) -> Result<(), CompileError>;
+    fn visit(
+        &self,
+        k: usize,
+        f: &mut dyn FnMut(View<'_>) -> Result<(), CompileError>,
+    ) -> Result<(), CompileError>;
 }
 
 impl ViewSource for [View<'_>] {
@@ -27,7 +31,11 @@ impl ViewSource for [View<'_>] {
         self.len()
     }
 
-    fn visit(&self, k: usize, f: &mut dyn FnMut(View<'_>) -> Result<(), CompileError>) -> Result<(), CompileError> {
+    fn visit(
+        &self,
+        k: usize,
+        f: &mut dyn FnMut(View<'_>) -> Result<(), CompileError>,
+    ) -> Result<(), CompileError> {
         f(self[k])
     }
 }
@@ -49,30 +57,56 @@ pub(crate) struct Assembled {
 }
 
 /// Checks view `k` against `layout` and converts its matrix.
-pub(crate) fn view_matrix(k: usize, v: &View<'_>, layout: TextureLayout) -> Result<Csr, CompileError> {
+pub(crate) fn view_matrix(
+    k: usize,
+    v: &View<'_>,
+    layout: TextureLayout,
+) -> Result<Csr, CompileError> {
     if v.a.layout != layout {
-        return Err(CompileError::Setting(format!("view {k}'s texture layout differs from view 0's")));
+        return Err(CompileError::Setting(format!(
+            "view {k}'s texture layout differs from view 0's"
+        )));
     }
     if v.b.len() != v.a.rows() * CHANNELS {
-        return Err(CompileError::Size { what: format!("b of view {k} (covered pixels × 3)"), expected: v.a.rows() * CHANNELS, found: v.b.len() });
+        return Err(CompileError::Size {
+            what: format!("b of view {k} (covered pixels × 3)"),
+            expected: v.a.rows() * CHANNELS,
+            found: v.b.len(),
+        });
     }
     check_finite("b", v.b)?;
     Csr::from_render_matrix(v.a)
 }
 
 /// Adds the views of `source` one at a time; the layout is view 0's.
-pub(crate) fn assemble<S: ViewSource + ?Sized>(source: &S) -> Result<(TextureLayout, Assembled), CompileError> {
+pub(crate) fn assemble<S: ViewSource + ?Sized>(
+    source: &S,
+) -> Result<(TextureLayout, Assembled), CompileError> {
     if source.count() == 0 {
         return Err(CompileError::Setting("no views to solve".into()));
     }
     let mut layout = None;
-    let mut t = Assembled { h: Csr::zeros(0), atb: vec![], bb: vec![], col_norms: vec![], n_s: 0, b_max: 0.0 };
+    let mut t = Assembled {
+        h: Csr::zeros(0),
+        atb: vec![],
+        bb: vec![],
+        col_norms: vec![],
+        n_s: 0,
+        b_max: 0.0,
+    };
     for k in 0..source.count() {
         source.visit(k, &mut |v| {
             let layout = *layout.get_or_insert_with(|| {
                 let n_t = v.a.layout.texel_count();
                 // Sums start where the iterator sums of the stacked products start (-0.0).
-                t = Assembled { h: Csr::zeros(n_t), atb: vec![vec![-0.0; n_t]; CHANNELS], bb: vec![-0.0; CHANNELS], col_norms: vec![0.0; n_t], n_s: 0, b_max: 0.0 };
+                t = Assembled {
+                    h: Csr::zeros(n_t),
+                    atb: vec![vec![-0.0; n_t]; CHANNELS],
+                    bb: vec![-0.0; CHANNELS],
+                    col_norms: vec![0.0; n_t],
+                    n_s: 0,
+                    b_max: 0.0,
+                };
                 v.a.layout
             });
             let a = view_matrix(k, &v, layout)?;
@@ -103,7 +137,11 @@ pub(crate) fn assemble<S: ViewSource + ?Sized>(source: &S) -> Result<(TextureLay
 }
 
 /// Per channel, ‖Ax − b‖² over the views of `source`, `x[ch]` the channel's texels.
-pub(crate) fn residual2<S: ViewSource + ?Sized>(source: &S, layout: TextureLayout, x: &[&[f64]]) -> Result<Vec<f64>, CompileError> {
+pub(crate) fn residual2<S: ViewSource + ?Sized>(
+    source: &S,
+    layout: TextureLayout,
+    x: &[&[f64]],
+) -> Result<Vec<f64>, CompileError> {
     let mut r2 = vec![-0.0; CHANNELS];
     for k in 0..source.count() {
         source.visit(k, &mut |v| {

@@ -64,7 +64,14 @@ pub fn warp_matrix(
 }
 
 /// Bilinear taps of level m at (s, t), clamp-to-edge, scaled by `weight`.
-fn bilinear(layout: &TextureLayout, m: u32, s: f64, t: f64, weight: f64, out: &mut Vec<(u32, f64)>) {
+fn bilinear(
+    layout: &TextureLayout,
+    m: u32,
+    s: f64,
+    t: f64,
+    weight: f64,
+    out: &mut Vec<(u32, f64)>,
+) {
     let (w, h) = layout.level_size(m);
     // Texel coordinates of level m: u = s·w₀/2^m (crate::filter; on odd sizes the level's
     // last texel, the replicated boundary, is only partly inside the used area).
@@ -109,7 +116,10 @@ mod tests {
                 assert_eq!(ours.len(), model.len(), "level {m} at {st:?}: {ours:?} vs {model:?}");
                 for ((c0, w0), (c1, w1)) in ours.iter().zip(&model) {
                     assert_eq!(c0, c1);
-                    assert!((w0 - *w1 as f64).abs() < 1e-5, "level {m} at {st:?}: {ours:?} vs {model:?}");
+                    assert!(
+                        (w0 - *w1 as f64).abs() < 1e-5,
+                        "level {m} at {st:?}: {ours:?} vs {model:?}"
+                    );
                 }
             }
         }

@@ -28,7 +28,8 @@ pub struct TextureTransform {
 
 impl TextureTransform {
     /// s = u, t = v.
-    pub const IDENTITY: TextureTransform = TextureTransform { values: [1.0, 0.0, 0.0, 1.0, 0.0, 0.0], cut: [None; 2] };
+    pub const IDENTITY: TextureTransform =
+        TextureTransform { values: [1.0, 0.0, 0.0, 1.0, 0.0, 0.0], cut: [None; 2] };
 
     /// The affine map `values` without branch cuts.
     pub const fn affine(values: [f32; 6]) -> TextureTransform {
@@ -102,7 +103,12 @@ pub struct ClipVertex {
 }
 
 /// The vertex shader: clip = clip_from_object · (p, 1), (s, t) = transform(u, v).
-pub fn vertex(clip_from_object: &Mat4, position: [f32; 3], uv: [f32; 2], transform: &TextureTransform) -> ClipVertex {
+pub fn vertex(
+    clip_from_object: &Mat4,
+    position: [f32; 3],
+    uv: [f32; 2],
+    transform: &TextureTransform,
+) -> ClipVertex {
     let clip = *clip_from_object * Vec4::new(position[0], position[1], position[2], 1.0);
     ClipVertex { clip, st: transform.texcoord(uv) }
 }
@@ -176,7 +182,9 @@ mod tests {
         let f = p * Vec4::new(0.0, 0.0, -10.0, 1.0);
         assert!((n.z / n.w).abs() < 1e-6 && (f.z / f.w - 1.0).abs() < 1e-6);
         let v = look_at(Vec3::new(0.0, 0.0, 5.0), Vec3::ZERO, Vec3::Y);
-        assert!((v * Vec4::new(0.0, 0.0, 0.0, 1.0) - Vec4::new(0.0, 0.0, -5.0, 1.0)).length() < 1e-6);
+        assert!(
+            (v * Vec4::new(0.0, 0.0, 0.0, 1.0) - Vec4::new(0.0, 0.0, -5.0, 1.0)).length() < 1e-6
+        );
     }
 
     #[test]
@@ -193,7 +201,11 @@ mod tests {
         // Above the cut: shifted down; below: shifted and wrapped up; v untouched.
         assert_eq!(u.cut_uv([0.75, 1.5]), [0.5, 1.5]);
         assert_eq!(u.cut_uv([0.125, 1.5]), [0.875, 1.5]);
-        assert_eq!(u.cut_uv([1.5, -0.5]), [0.25, -0.5], "a wrapped range (u > 1) comes back into [0, 1)");
+        assert_eq!(
+            u.cut_uv([1.5, -0.5]),
+            [0.25, -0.5],
+            "a wrapped range (u > 1) comes back into [0, 1)"
+        );
         // A coordinate exactly at the cut maps to 0, and one period above it too.
         assert_eq!(u.cut_uv([0.25, 0.0]), [0.0, 0.0]);
         assert_eq!(u.cut_uv([1.25, 0.0]), [0.0, 0.0]);
@@ -201,7 +213,10 @@ mod tests {
         assert_eq!(v.cut_uv([1.5, 0.25]), [1.5, 0.75]);
         assert_eq!(v.cut_uv([1.5, 0.5]), [1.5, 0.0]);
         // Both cuts, then the affine map.
-        let both = TextureTransform { values: [2.0, 0.0, 0.0, 4.0, 0.5, -1.0], cut: [Some(0.25), Some(0.5)] };
+        let both = TextureTransform {
+            values: [2.0, 0.0, 0.0, 4.0, 0.5, -1.0],
+            cut: [Some(0.25), Some(0.5)],
+        };
         assert_eq!(both.cut_uv([0.0, 0.0]), [0.75, 0.5]);
         assert_eq!(both.texcoord([0.0, 0.0]), [2.0 * 0.75 + 0.5, 4.0 * 0.5 - 1.0]);
         // Cuts that are not binary fractions: within f32 rounding of the exact wrap, in [0, 1).

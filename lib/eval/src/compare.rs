@@ -83,12 +83,24 @@ pub struct FramePair<'a> {
 
 /// Draws every sample point of the set at `set_dir` through `player` (offscreen, the file's
 /// camera at each point) and compares. `each` sees every frame with its gold image.
-pub fn compare_with_set(player: &mut Player, set_dir: &Path, options: &CompareOptions, each: &mut dyn FnMut(&FramePair)) -> Result<Comparison> {
-    let set = RaySet::open(set_dir).with_context(|| format!("opening the ray-traced set {}", set_dir.display()))?;
+pub fn compare_with_set(
+    player: &mut Player,
+    set_dir: &Path,
+    options: &CompareOptions,
+    each: &mut dyn FnMut(&FramePair),
+) -> Result<Comparison> {
+    let set = RaySet::open(set_dir)
+        .with_context(|| format!("opening the ray-traced set {}", set_dir.display()))?;
     let res = (set.meta.resolution[0], set.meta.resolution[1]);
     let size = options.size.unwrap_or(res);
     if size != res {
-        bail!("frames of {}x{} cannot be compared pixel by pixel with the set's {}x{} gold images", size.0, size.1, res.0, res.1);
+        bail!(
+            "frames of {}x{} cannot be compared pixel by pixel with the set's {}x{} gold images",
+            size.0,
+            size.1,
+            res.0,
+            res.1
+        );
     }
     let dims = player.dimensions().len();
     let names = player.object_names();
@@ -96,7 +108,14 @@ pub fn compare_with_set(player: &mut Player, set_dir: &Path, options: &CompareOp
     let channels: Vec<String> = names
         .iter()
         .map(|n| {
-            set.meta.objects.iter().find(|o| &o.name == n).map(|o| o.channel_name.clone()).ok_or_else(|| anyhow!("object '{n}' of the file is not in the set {}", set_dir.display()))
+            set.meta
+                .objects
+                .iter()
+                .find(|o| &o.name == n)
+                .map(|o| o.channel_name.clone())
+                .ok_or_else(|| {
+                    anyhow!("object '{n}' of the file is not in the set {}", set_dir.display())
+                })
         })
         .collect::<Result<_>>()?;
     // Per object: the grid of its layer that depends on the most dimensions (the blocks a
@@ -106,7 +125,12 @@ pub fn compare_with_set(player: &mut Player, set_dir: &Path, options: &CompareOp
         c.objects
             .iter()
             .map(|o| {
-                let mask = o.layers.iter().map(|l| l.depends_on).max_by_key(|m| m.count()).unwrap_or(pis_format::DepMask::NONE);
+                let mask = o
+                    .layers
+                    .iter()
+                    .map(|l| l.depends_on)
+                    .max_by_key(|m| m.count())
+                    .unwrap_or(pis_format::DepMask::NONE);
                 BlockGrid::new(&c.space, mask, &o.stagger)
             })
             .collect()
@@ -115,23 +139,44 @@ pub fn compare_with_set(player: &mut Player, set_dir: &Path, options: &CompareOp
     let mut total = SquaredError::default();
     let (mut interior, mut silhouette) = (SquaredError::default(), SquaredError::default());
     let mut partial = vec![false; 0];
-    let mut per_object: Vec<(SquaredError, Vec<SquaredError>)> = (0..names.len()).map(|o| (SquaredError::default(), vec![SquaredError::default(); block_count(o)])).collect();
+    let mut per_object: Vec<(SquaredError, Vec<SquaredError>)> = (0..names.len())
+        .map(|o| (SquaredError::default(), vec![SquaredError::default(); block_count(o)]))
+        .collect();
     let mut points = Vec::with_capacity(set.meta.points.len());
     let npx = res.0 as usize * res.1 as usize;
     for (i, p) in set.meta.points.iter().enumerate() {
         if p.values.len() != dims || p.samples.len() != dims {
-            bail!("point {i} of {} has {} values, the file's parameter space {dims} dimensions", set_dir.display(), p.values.len());
+            bail!(
+                "point {i} of {} has {} values, the file's parameter space {dims} dimensions",
+                set_dir.display(),
+                p.values.len()
+            );
         }
-        let images = set.read_point(i).with_context(|| format!("reading point {i} of {}", set_dir.display()))?;
+        let images = set
+            .read_point(i)
+            .with_context(|| format!("reading point {i} of {}", set_dir.display()))?;
         if (images.width, images.height) != res {
-            bail!("point {i} of {} is {}x{}, the set declares {}x{}", set_dir.display(), images.width, images.height, res.0, res.1);
+            bail!(
+                "point {i} of {} is {}x{}, the set declares {}x{}",
+                set_dir.display(),
+                images.width,
+                images.height,
+                res.0,
+                res.1
+            );
         }
         let req = FrameRequest { point: p.values.clone(), camera: CameraChoice::Sample };
-        let (rendered, ids, _) = player.render_ids(&req, size).with_context(|| format!("drawing point {i} {:?}", p.values))?;
-        let combined = images.layer("combined").ok_or_else(|| anyhow!("point {i} of {} has no combined image", set_dir.display()))?;
+        let (rendered, ids, _) = player
+            .render_ids(&req, size)
+            .with_context(|| format!("drawing point {i} {:?}", p.values))?;
+        let combined = images
+            .layer("combined")
+            .ok_or_else(|| anyhow!("point {i} of {} has no combined image", set_dir.display()))?;
         let mut gold = FloatImage { width: res.0, height: res.1, rgba: vec![1.0; npx * 4] };
         for (c, name) in ["R", "G", "B"].iter().enumerate() {
-            let plane = combined.channel(name).ok_or_else(|| anyhow!("point {i}: combined image without {name}"))?;
+            let plane = combined
+                .channel(name)
+                .ok_or_else(|| anyhow!("point {i}: combined image without {name}"))?;
             for (px, v) in gold.rgba.chunks_exact_mut(4).zip(plane) {
                 px[c] = *v;
             }
@@ -139,7 +184,9 @@ pub fn compare_with_set(player: &mut Player, set_dir: &Path, options: &CompareOp
         partial.clear();
         partial.resize(npx, false);
         for ch in &channels {
-            if let Some(cov) = images.object_layer(ch, LayerKind::Coverage).and_then(|l| l.channel("A")) {
+            if let Some(cov) =
+                images.object_layer(ch, LayerKind::Coverage).and_then(|l| l.channel("A"))
+            {
                 for (p, &c) in partial.iter_mut().zip(cov) {
                     *p |= c > COVERAGE_EPS && c < 1.0 - COVERAGE_EPS;
                 }
@@ -152,14 +199,21 @@ pub fn compare_with_set(player: &mut Player, set_dir: &Path, options: &CompareOp
                 px.add(rendered.rgba[k * 4 + c], gold.rgba[k * 4 + c]);
             }
             whole.merge(&px);
-            if partial[k] { silhouette.merge(&px) } else { interior.merge(&px) }
+            if partial[k] {
+                silhouette.merge(&px)
+            } else {
+                interior.merge(&px)
+            }
         }
         let mut objects = Vec::with_capacity(names.len());
         for (o, ch) in channels.iter().enumerate() {
             let layer = |kind: LayerKind| images.object_layer(ch, kind);
             let cov = layer(LayerKind::Coverage).and_then(|l| l.channel("A"));
             let (d, s) = (layer(LayerKind::Diffuse), layer(LayerKind::Specular));
-            let planes: Vec<[Option<&[f32]>; 2]> = ["R", "G", "B"].iter().map(|c| [d.and_then(|l| l.channel(c)), s.and_then(|l| l.channel(c))]).collect();
+            let planes: Vec<[Option<&[f32]>; 2]> = ["R", "G", "B"]
+                .iter()
+                .map(|c| [d.and_then(|l| l.channel(c)), s.and_then(|l| l.channel(c))])
+                .collect();
             let mut e = SquaredError::default();
             if let Some(cov) = cov {
                 for k in 0..npx {
@@ -177,11 +231,27 @@ pub fn compare_with_set(player: &mut Player, set_dir: &Path, options: &CompareOp
             if let Some(b) = per_object[o].1.get_mut(block) {
                 b.merge(&e);
             }
-            objects.push(ObjectScore { name: names[o].clone(), psnr_db: e.psnr(), error: e, blocks: vec![BlockScore { block, psnr_db: e.psnr(), error: e }] });
+            objects.push(ObjectScore {
+                name: names[o].clone(),
+                psnr_db: e.psnr(),
+                error: e,
+                blocks: vec![BlockScore { block, psnr_db: e.psnr(), error: e }],
+            });
         }
         total.merge(&whole);
-        each(&FramePair { index: i, point: &p.values, rendered: &rendered, gold: &gold, object_ids: &ids });
-        points.push(PointComparison { index: i, point: p.values.clone(), psnr_db: whole.psnr(), objects });
+        each(&FramePair {
+            index: i,
+            point: &p.values,
+            rendered: &rendered,
+            gold: &gold,
+            object_ids: &ids,
+        });
+        points.push(PointComparison {
+            index: i,
+            point: p.values.clone(),
+            psnr_db: whole.psnr(),
+            objects,
+        });
     }
     let mut covered = SquaredError::default();
     let objects = per_object
@@ -193,9 +263,21 @@ pub fn compare_with_set(player: &mut Player, set_dir: &Path, options: &CompareOp
                 name: name.clone(),
                 psnr_db: e.psnr(),
                 error: e,
-                blocks: blocks.into_iter().enumerate().filter(|(_, b)| b.count > 0).map(|(block, b)| BlockScore { block, psnr_db: b.psnr(), error: b }).collect(),
+                blocks: blocks
+                    .into_iter()
+                    .enumerate()
+                    .filter(|(_, b)| b.count > 0)
+                    .map(|(block, b)| BlockScore { block, psnr_db: b.psnr(), error: b })
+                    .collect(),
             }
         })
         .collect();
-    Ok(Comparison { psnr_db: total.psnr(), covered_psnr_db: covered.psnr(), interior, silhouette, objects, points })
+    Ok(Comparison {
+        psnr_db: total.psnr(),
+        covered_psnr_db: covered.psnr(),
+        interior,
+        silhouette,
+        objects,
+        points,
+    })
 }

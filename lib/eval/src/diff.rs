@@ -9,5 +9,7 @@ pub mod gold;
 pub mod sets;
 pub mod structure;
 
-pub use content::{compare, BlockDiff, ContentDiff, ErrorMap, FileError, LayerDiff, ObjectDiff, Score};
+pub use content::{
+    compare, BlockDiff, ContentDiff, ErrorMap, FileError, LayerDiff, ObjectDiff, Score,
+};
 pub use structure::{differences, ChunkBytes};

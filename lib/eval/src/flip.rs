@@ -13,20 +13,30 @@ pub const PIXELS_PER_DEGREE: f32 = nv_flip::DEFAULT_PIXELS_PER_DEGREE;
 
 /// The 8-bit sRGB display image of linear RGBA values (alpha dropped).
 pub fn display_rgb8(img: &FloatImage) -> Vec<u8> {
-    img.rgba.chunks_exact(4).flat_map(|p| [p[0], p[1], p[2]]).map(|v| (srgb_encode(v) * 255.0).round() as u8).collect()
+    img.rgba
+        .chunks_exact(4)
+        .flat_map(|p| [p[0], p[1], p[2]])
+        .map(|v| (srgb_encode(v) * 255.0).round() as u8)
+        .collect()
 }
 
 /// The FLIP error map of `test` against `reference` (row-major, one value per pixel).
 pub fn flip_map(reference: &FloatImage, test: &FloatImage) -> anyhow::Result<Vec<f32>> {
     anyhow::ensure!(
-        (reference.width, reference.height) == (test.width, test.height) && reference.width > 0 && reference.height > 0,
+        (reference.width, reference.height) == (test.width, test.height)
+            && reference.width > 0
+            && reference.height > 0,
         "FLIP needs two images of one non-empty size, got {}x{} and {}x{}",
         reference.width,
         reference.height,
         test.width,
         test.height
     );
-    let r = nv_flip::FlipImageRgb8::with_data(reference.width, reference.height, &display_rgb8(reference));
+    let r = nv_flip::FlipImageRgb8::with_data(
+        reference.width,
+        reference.height,
+        &display_rgb8(reference),
+    );
     let t = nv_flip::FlipImageRgb8::with_data(test.width, test.height, &display_rgb8(test));
     Ok(nv_flip::flip(r, t, PIXELS_PER_DEGREE).to_vec())
 }
@@ -92,7 +102,8 @@ mod tests {
         assert!(same.iter().all(|&v| v == 0.0));
         let slightly = image(48, 32, |x, y| [x as f32 / 48.0 * 0.97, y as f32 / 32.0, 0.3]);
         let very = image(48, 32, |x, y| [1.0 - x as f32 / 48.0, 0.0, 1.0 - y as f32 / 32.0]);
-        let m = |t: &FloatImage| means(&flip_map(&a, t).expect("flip"), &[], 0).0.mean().expect("mean");
+        let m =
+            |t: &FloatImage| means(&flip_map(&a, t).expect("flip"), &[], 0).0.mean().expect("mean");
         let (s, v) = (m(&slightly), m(&very));
         assert!(s > 0.0 && s < v && v <= 1.0, "slight {s}, very {v}");
         assert!(flip_map(&a, &image(4, 4, |_, _| [0.0; 3])).is_err());

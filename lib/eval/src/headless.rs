@@ -4,8 +4,8 @@
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
-use anyhow::{anyhow, Context};
 use crate::compare::{compare_with_set, CompareOptions, Comparison};
+use anyhow::{anyhow, Context};
 use pis_play::{CameraChoice, FrameRequest, FrameStats, Gpu, PlayError, Player, ViewCamera};
 use serde::Serialize;
 
@@ -63,7 +63,6 @@ pub fn set_display_filter(dir: &std::path::Path) -> Option<pis_format::DisplayFi
     let f = pis_trace::set::RaySet::open(dir).ok()?.meta.filter;
     pis_format::DisplayFilter::new(f.sigma_px, f.radius_px).ok()
 }
-
 
 /// The exit code of a player error.
 pub fn play_failure(e: PlayError) -> Failure {
@@ -205,9 +204,16 @@ pub struct Resolve {
 impl Resolve {
     pub fn of(player: &Player) -> Resolve {
         match player.display_filter() {
-            _ if player.multisample().samples <= 1 => Resolve { filter: "none".into(), sigma_px: None, radius_px: None, from: None },
+            _ if player.multisample().samples <= 1 => {
+                Resolve { filter: "none".into(), sigma_px: None, radius_px: None, from: None }
+            }
             None => Resolve { filter: "box".into(), sigma_px: None, radius_px: None, from: None },
-            Some((f, file)) => Resolve { filter: "gaussian".into(), sigma_px: Some(f.sigma_px), radius_px: Some(f.radius_px), from: Some(if file { "file" } else { "set" }.into()) },
+            Some((f, file)) => Resolve {
+                filter: "gaussian".into(),
+                sigma_px: Some(f.sigma_px),
+                radius_px: Some(f.radius_px),
+                from: Some(if file { "file" } else { "set" }.into()),
+            },
         }
     }
 
@@ -216,7 +222,11 @@ impl Resolve {
     pub fn label(&self) -> String {
         match (self.filter.as_str(), self.sigma_px, self.radius_px) {
             ("gaussian", Some(s), Some(r)) => {
-                let from = if self.from.as_deref() == Some("file") { "the file's" } else { "the set's: the file records none" };
+                let from = if self.from.as_deref() == Some("file") {
+                    "the file's"
+                } else {
+                    "the set's: the file records none"
+                };
                 format!(", Gaussian resolve σ {s} px R {r} px ({from})")
             }
             ("box", _, _) => ", box resolve".to_string(),
@@ -228,7 +238,11 @@ impl Resolve {
 /// "msaa 4×", "msaa off", or "msaa off (4× asked, not supported)".
 pub fn msaa_label(samples: u32, requested: u32) -> String {
     let used = if samples > 1 { format!("msaa {samples}×") } else { "msaa off".to_string() };
-    if samples == requested { used } else { format!("{used} ({requested}× asked, not supported)") }
+    if samples == requested {
+        used
+    } else {
+        format!("{used} ({requested}× asked, not supported)")
+    }
 }
 
 fn blend_name(b: pis_play::Blend) -> String {
@@ -243,7 +257,11 @@ pub fn open(args: &HeadlessRequest) -> Result<(Arc<Gpu>, Player), Failure> {
         let message = f.error.to_string();
         let path = args.file.display().to_string();
         // Name the file where the message does not.
-        if message.contains(&path) { f } else { Failure::new(f.exit, f.error.context(path)) }
+        if message.contains(&path) {
+            f
+        } else {
+            Failure::new(f.exit, f.error.context(path))
+        }
     })?;
     if let Some(note) = &player.multisample().note {
         eprintln!("pis-play: note: {note}");
@@ -253,7 +271,11 @@ pub fn open(args: &HeadlessRequest) -> Result<(Arc<Gpu>, Player), Failure> {
 
 /// The middle sample of every dimension.
 pub fn middle_point(player: &Player) -> Vec<f32> {
-    player.dimensions().iter().map(|d| d.values.get(d.values.len() / 2).copied().unwrap_or(0.0)).collect()
+    player
+        .dimensions()
+        .iter()
+        .map(|d| d.values.get(d.values.len() / 2).copied().unwrap_or(0.0))
+        .collect()
 }
 
 /// Frame `k` of the diagonal path: sample `k mod n₀` along the first dimension and
@@ -272,7 +294,9 @@ pub fn diagonal_point(dims: &[pis_format::Dimension], k: usize) -> Vec<f32> {
 }
 
 fn read_path_file(path: &Path, dims: usize) -> Result<Vec<Vec<f32>>, Failure> {
-    let text = std::fs::read_to_string(path).with_context(|| format!("reading the path file {}", path.display())).map_err(|e| Failure::new(Exit::Io, e))?;
+    let text = std::fs::read_to_string(path)
+        .with_context(|| format!("reading the path file {}", path.display()))
+        .map_err(|e| Failure::new(Exit::Io, e))?;
     let mut out = Vec::new();
     for (n, line) in text.lines().enumerate() {
         let line = line.split('#').next().unwrap_or("").trim();
@@ -284,9 +308,22 @@ fn read_path_file(path: &Path, dims: usize) -> Result<Vec<Vec<f32>>, Failure> {
             .filter(|s| !s.is_empty())
             .map(|s| s.parse::<f32>().ok().filter(|v| v.is_finite()))
             .collect::<Option<_>>()
-            .ok_or_else(|| Failure::new(Exit::Invalid, anyhow!("{}:{}: expected numbers, got {line:?}", path.display(), n + 1)))?;
+            .ok_or_else(|| {
+                Failure::new(
+                    Exit::Invalid,
+                    anyhow!("{}:{}: expected numbers, got {line:?}", path.display(), n + 1),
+                )
+            })?;
         if p.len() != dims {
-            return Err(Failure::new(Exit::Invalid, anyhow!("{}:{}: {} values, the file's parameter space has {dims} dimensions", path.display(), n + 1, p.len())));
+            return Err(Failure::new(
+                Exit::Invalid,
+                anyhow!(
+                    "{}:{}: {} values, the file's parameter space has {dims} dimensions",
+                    path.display(),
+                    n + 1,
+                    p.len()
+                ),
+            ));
         }
         out.push(p);
     }
@@ -302,7 +339,15 @@ fn requests(args: &HeadlessRequest, player: &Player) -> Result<Vec<FrameRequest>
     let at = match &args.at {
         Some(p) if p.len() != dims.len() => {
             let names: Vec<&str> = dims.iter().map(|d| d.name.as_str()).collect();
-            return Err(Failure::new(Exit::Usage, anyhow!("--at gives {} values, the parameter space has {} dimensions ({})", p.len(), dims.len(), names.join(", "))));
+            return Err(Failure::new(
+                Exit::Usage,
+                anyhow!(
+                    "--at gives {} values, the parameter space has {} dimensions ({})",
+                    p.len(),
+                    dims.len(),
+                    names.join(", ")
+                ),
+            ));
         }
         Some(p) => p.clone(),
         None => middle_point(player),
@@ -311,7 +356,8 @@ fn requests(args: &HeadlessRequest, player: &Player) -> Result<Vec<FrameRequest>
     Ok(match &args.path {
         None => vec![sample(at)],
         Some(PathChoice::Diagonal) => {
-            let n = args.frames.unwrap_or_else(|| dims.iter().map(|d| d.values.len().max(1)).product());
+            let n =
+                args.frames.unwrap_or_else(|| dims.iter().map(|d| d.values.len().max(1)).product());
             (0..n).map(|k| sample(diagonal_point(dims, k))).collect()
         }
         Some(PathChoice::File(f)) => {
@@ -327,7 +373,10 @@ fn requests(args: &HeadlessRequest, player: &Player) -> Result<Vec<FrameRequest>
                 .map(|k| {
                     let angle = std::f32::consts::TAU * k as f32 / n as f32;
                     let eye = c.target + glam::Quat::from_rotation_y(angle) * offset;
-                    FrameRequest { point: at.clone(), camera: CameraChoice::Free(ViewCamera { eye, up: glam::Vec3::Y, ..c }) }
+                    FrameRequest {
+                        point: at.clone(),
+                        camera: CameraChoice::Free(ViewCamera { eye, up: glam::Vec3::Y, ..c }),
+                    }
                 })
                 .collect()
         }
@@ -336,19 +385,26 @@ fn requests(args: &HeadlessRequest, player: &Player) -> Result<Vec<FrameRequest>
 
 fn write_frame(dir: &Path, name: &str, img: &pis_play::FloatImage) -> Result<PathBuf, Failure> {
     let path = dir.join(name);
-    pis_pack::images::write_png(&path, img.width, img.height, 4, &img.rgba).map_err(|e| Failure::new(Exit::Io, e))?;
+    pis_pack::images::write_png(&path, img.width, img.height, 4, &img.rgba)
+        .map_err(|e| Failure::new(Exit::Io, e))?;
     Ok(path)
 }
 
 fn out_dir(args: &HeadlessRequest) -> Result<Option<&Path>, Failure> {
     if let Some(d) = &args.out {
-        std::fs::create_dir_all(d).with_context(|| format!("creating {}", d.display())).map_err(|e| Failure::new(Exit::Io, e))?;
+        std::fs::create_dir_all(d)
+            .with_context(|| format!("creating {}", d.display()))
+            .map_err(|e| Failure::new(Exit::Io, e))?;
     }
     Ok(args.out.as_deref())
 }
 
 /// Draws the frames of `args` and reports their timings.
-pub fn run_frames(args: &HeadlessRequest, gpu: &Gpu, player: &mut Player) -> Result<PathReport, Failure> {
+pub fn run_frames(
+    args: &HeadlessRequest,
+    gpu: &Gpu,
+    player: &mut Player,
+) -> Result<PathReport, Failure> {
     let size = args.size.unwrap_or_else(|| player.image_size());
     let reqs = requests(args, player)?;
     let out = out_dir(args)?;
@@ -427,12 +483,38 @@ pub fn run_frames(args: &HeadlessRequest, gpu: &Gpu, player: &mut Player) -> Res
 }
 
 pub fn print_path_report(r: &PathReport, w: &mut impl std::io::Write) -> std::io::Result<()> {
-    writeln!(w, "pis-play {} ({}x{}, blend {}, reduction {}, {}{}, {} decoding threads)", r.file, r.size[0], r.size[1], r.blend, r.reduction, msaa_label(r.msaa_samples, r.msaa_requested), r.resolve.label(), r.workers)?;
+    writeln!(
+        w,
+        "pis-play {} ({}x{}, blend {}, reduction {}, {}{}, {} decoding threads)",
+        r.file,
+        r.size[0],
+        r.size[1],
+        r.blend,
+        r.reduction,
+        msaa_label(r.msaa_samples, r.msaa_requested),
+        r.resolve.label(),
+        r.workers
+    )?;
     writeln!(w, "  adapter: {}", r.adapter)?;
     writeln!(w, "  frames: {}", r.frames)?;
-    writeln!(w, "  frame ms: mean {:.2} ({:.1} fps), worst {:.2} ({:.1} fps)", r.frame_ms_mean, r.fps_mean, r.frame_ms_worst, r.fps_worst)?;
-    writeln!(w, "  decode ms: mean {:.2}, worst {:.2}; upload ms: mean {:.2} ({:.0} KiB per frame)", r.decode_ms_mean, r.decode_ms_worst, r.upload_ms_mean, r.upload_bytes_mean / 1024.0)?;
-    write!(w, "  draw ms (recorded, submitted, finished on the GPU): mean {:.2}, worst {:.2}", r.draw_ms_mean, r.draw_ms_worst)?;
+    writeln!(
+        w,
+        "  frame ms: mean {:.2} ({:.1} fps), worst {:.2} ({:.1} fps)",
+        r.frame_ms_mean, r.fps_mean, r.frame_ms_worst, r.fps_worst
+    )?;
+    writeln!(
+        w,
+        "  decode ms: mean {:.2}, worst {:.2}; upload ms: mean {:.2} ({:.0} KiB per frame)",
+        r.decode_ms_mean,
+        r.decode_ms_worst,
+        r.upload_ms_mean,
+        r.upload_bytes_mean / 1024.0
+    )?;
+    write!(
+        w,
+        "  draw ms (recorded, submitted, finished on the GPU): mean {:.2}, worst {:.2}",
+        r.draw_ms_mean, r.draw_ms_worst
+    )?;
     if r.readback_ms_mean > 0.0 {
         write!(w, "; readback ms (frames written): mean {:.2}", r.readback_ms_mean)?;
     }
@@ -441,11 +523,23 @@ pub fn print_path_report(r: &PathReport, w: &mut impl std::io::Write) -> std::io
     if r.lens_draws_mean > 0.0 {
         writeln!(w, "  lens objects (vertex rays, tessellation, vertex buffers): mean {:.2} ms, worst {:.2}; {:.0} rays, {:.0} triangles per frame", r.lens_ms_mean, r.lens_ms_worst, r.lens_rays_mean, r.lens_triangles_mean)?;
     }
-    writeln!(w, "  level-image cache: {} hits, {} misses, at most {:.1} MiB; codestreams read: {}", r.cache_hits, r.cache_misses, r.cache_bytes_max as f64 / (1 << 20) as f64, r.codestreams_read)
+    writeln!(
+        w,
+        "  level-image cache: {} hits, {} misses, at most {:.1} MiB; codestreams read: {}",
+        r.cache_hits,
+        r.cache_misses,
+        r.cache_bytes_max as f64 / (1 << 20) as f64,
+        r.codestreams_read
+    )
 }
 
 /// Compares every sample point of `set` with its gold standard.
-pub fn run_compare(args: &HeadlessRequest, set: &Path, gpu: &Gpu, player: &mut Player) -> Result<CompareReport, Failure> {
+pub fn run_compare(
+    args: &HeadlessRequest,
+    set: &Path,
+    gpu: &Gpu,
+    player: &mut Player,
+) -> Result<CompareReport, Failure> {
     let out = out_dir(args)?;
     let options = CompareOptions { size: args.size };
     let mut write_error = None;
@@ -455,7 +549,8 @@ pub fn run_compare(args: &HeadlessRequest, set: &Path, gpu: &Gpu, player: &mut P
             eprintln!("pis-play: point {} {:?}", pair.index, pair.point);
         }
         if let Some(dir) = out {
-            if let Err(e) = write_frame(dir, &format!("point-{:04}.png", pair.index), pair.rendered) {
+            if let Err(e) = write_frame(dir, &format!("point-{:04}.png", pair.index), pair.rendered)
+            {
                 write_error.get_or_insert(e);
             }
         }
@@ -481,23 +576,57 @@ pub fn run_compare(args: &HeadlessRequest, set: &Path, gpu: &Gpu, player: &mut P
         covered_psnr_db: c.covered_psnr_db,
         silhouette_psnr_db: c.silhouette.psnr(),
         interior_psnr_db: c.interior.psnr(),
-        silhouette_fraction: c.silhouette.count as f64 / (c.silhouette.count + c.interior.count).max(1) as f64,
+        silhouette_fraction: c.silhouette.count as f64
+            / (c.silhouette.count + c.interior.count).max(1) as f64,
         objects: c
             .objects
             .iter()
-            .map(|s| ObjectRow { name: s.name.clone(), psnr_db: s.psnr_db, pixels: s.error.count / 3, blocks: s.blocks.iter().map(|b| BlockRow { block: b.block, psnr_db: b.psnr_db }).collect() })
+            .map(|s| ObjectRow {
+                name: s.name.clone(),
+                psnr_db: s.psnr_db,
+                pixels: s.error.count / 3,
+                blocks: s
+                    .blocks
+                    .iter()
+                    .map(|b| BlockRow { block: b.block, psnr_db: b.psnr_db })
+                    .collect(),
+            })
             .collect(),
-        points: c.points.iter().map(|p| PointRow { index: p.index, point: p.point.clone(), psnr_db: p.psnr_db }).collect(),
+        points: c
+            .points
+            .iter()
+            .map(|p| PointRow { index: p.index, point: p.point.clone(), psnr_db: p.psnr_db })
+            .collect(),
     })
 }
 
 pub fn print_compare_report(r: &CompareReport, w: &mut impl std::io::Write) -> std::io::Result<()> {
-    writeln!(w, "pis-play {} against {} (blend {}, reduction {}, {}{})", r.file, r.set, r.blend, r.reduction, msaa_label(r.msaa_samples, r.msaa_requested), r.resolve.label())?;
+    writeln!(
+        w,
+        "pis-play {} against {} (blend {}, reduction {}, {}{})",
+        r.file,
+        r.set,
+        r.blend,
+        r.reduction,
+        msaa_label(r.msaa_samples, r.msaa_requested),
+        r.resolve.label()
+    )?;
     writeln!(w, "  adapter: {}", r.adapter)?;
-    writeln!(w, "  PSNR (display values): whole image {:.2} dB, objects' covered pixels {:.2} dB", r.psnr_db, r.covered_psnr_db)?;
+    writeln!(
+        w,
+        "  PSNR (display values): whole image {:.2} dB, objects' covered pixels {:.2} dB",
+        r.psnr_db, r.covered_psnr_db
+    )?;
     writeln!(w, "  whole image at silhouettes {:.2} dB ({:.1} % of the pixels: partly covered in the gold standard), elsewhere {:.2} dB", r.silhouette_psnr_db, 100.0 * r.silhouette_fraction, r.interior_psnr_db)?;
     for o in &r.objects {
-        writeln!(w, "    {:<14} {:>7.2} dB  ({} pixel samples over {} blocks)", o.name, o.psnr_db, o.pixels, o.blocks.len())?;
+        writeln!(
+            w,
+            "    {:<14} {:>7.2} dB  ({} pixel samples over {} blocks)",
+            o.name,
+            o.psnr_db,
+            o.pixels,
+            o.blocks.len()
+        )?;
     }
     Ok(())
 }

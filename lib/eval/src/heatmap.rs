@@ -38,8 +38,18 @@ pub fn colourize(values: &[f32], scale: f32) -> Vec<u8> {
 }
 
 /// Writes `values` as a heatmap PNG at `path` (temporary file, then rename).
-pub fn write_heatmap(path: &Path, width: u32, height: u32, values: &[f32], scale: f32) -> anyhow::Result<()> {
-    anyhow::ensure!(values.len() == width as usize * height as usize, "heatmap of {width}x{height} has {} values", values.len());
+pub fn write_heatmap(
+    path: &Path,
+    width: u32,
+    height: u32,
+    values: &[f32],
+    scale: f32,
+) -> anyhow::Result<()> {
+    anyhow::ensure!(
+        values.len() == width as usize * height as usize,
+        "heatmap of {width}x{height} has {} values",
+        values.len()
+    );
     let rgb = colourize(values, scale);
     let mut png = Vec::new();
     image::codecs::png::PngEncoder::new(&mut png)

@@ -124,10 +124,7 @@ pub struct ProvenanceSummary {
 }
 
 fn dep_names(space: &ParameterSpace, mask: DepMask) -> Vec<String> {
-    mask.dims()
-        .filter_map(|k| space.dims.get(k))
-        .map(|d| d.name.clone())
-        .collect()
+    mask.dims().filter_map(|k| space.dims.get(k)).map(|d| d.name.clone()).collect()
 }
 
 pub fn summarize(r: &PisReader) -> Summary {
@@ -198,11 +195,7 @@ pub fn summarize(r: &PisReader) -> Summary {
             }
         })
         .collect();
-    let raw = c
-        .provenance
-        .as_ref()
-        .map(|p| p.raw_image_bytes)
-        .filter(|&b| b > 0);
+    let raw = c.provenance.as_ref().map(|p| p.raw_image_bytes).filter(|&b| b > 0);
     Summary {
         file: r.path().display().to_string(),
         version: format!("{}.{}", r.header().major, r.header().minor),
@@ -231,9 +224,8 @@ pub fn summarize(r: &PisReader) -> Summary {
         objects,
         codecs,
         ratio: raw.map(|b| b as f64 / (bytes.total - bytes.master).max(1) as f64),
-        ratio_without_geometry: raw.map(|b| {
-            b as f64 / (bytes.total - bytes.master - bytes.geometry).max(1) as f64
-        }),
+        ratio_without_geometry: raw
+            .map(|b| b as f64 / (bytes.total - bytes.master - bytes.geometry).max(1) as f64),
         bytes,
         provenance: c.provenance.as_ref().map(|p| ProvenanceSummary {
             tool: p.tool.clone(),
@@ -248,7 +240,9 @@ pub fn summarize(r: &PisReader) -> Summary {
 fn surface_placements<S>(blocks: &[pis_format::Block<S>]) -> usize {
     let mut seen: Vec<&pis_format::Block<S>> = Vec::new();
     for b in blocks {
-        if matches!(b.placement, Placement::Surface { .. }) && !seen.iter().any(|s| s.same_placement(b)) {
+        if matches!(b.placement, Placement::Surface { .. })
+            && !seen.iter().any(|s| s.same_placement(b))
+        {
             seen.push(b);
         }
     }
@@ -298,12 +292,8 @@ pub fn render(s: &Summary) -> String {
         human(s.file_size),
         s.file_size
     );
-    let _ = writeln!(
-        o,
-        "\nParameter space: {} dimensions, {} points",
-        s.dimensions.len(),
-        s.points
-    );
+    let _ =
+        writeln!(o, "\nParameter space: {} dimensions, {} points", s.dimensions.len(), s.points);
     for d in &s.dimensions {
         let range = match (d.values.first(), d.values.last()) {
             (Some(a), Some(b)) => format!("{a} .. {b} {}", d.unit),
@@ -338,7 +328,11 @@ pub fn render(s: &Summary) -> String {
             ob.vertices,
             if ob.normals { " with normals" } else { "" },
             ob.triangles,
-            if ob.hull_triangles > 0 { format!(" ({} on the convex hull)", ob.hull_triangles) } else { String::new() },
+            if ob.hull_triangles > 0 {
+                format!(" ({} on the convex hull)", ob.hull_triangles)
+            } else {
+                String::new()
+            },
             ob.transforms,
             ob.stagger,
             human(ob.bytes)
@@ -383,12 +377,7 @@ pub fn render(s: &Summary) -> String {
     }
     let _ = writeln!(o, "\nCodecs:");
     for (name, c) in &s.codecs {
-        let _ = writeln!(
-            o,
-            "  {name:<10} {} codestreams, {}",
-            c.codestreams,
-            human(c.bytes)
-        );
+        let _ = writeln!(o, "  {name:<10} {} codestreams, {}", c.codestreams, human(c.bytes));
     }
     let b = &s.bytes;
     let _ = writeln!(o, "\nBytes:");
@@ -423,25 +412,15 @@ pub fn render(s: &Summary) -> String {
             );
         }
         _ => {
-            let _ = writeln!(
-                o,
-                "\nCompression ratio: unknown (the file records no raw image size)"
-            );
+            let _ =
+                writeln!(o, "\nCompression ratio: unknown (the file records no raw image size)");
         }
     }
     if let Some(p) = &s.provenance {
         let settings: Vec<String> = p.settings.iter().map(|(k, v)| format!("{k}={v}")).collect();
-        let source = if p.source.is_empty() {
-            String::new()
-        } else {
-            format!(" from {}", p.source)
-        };
-        let _ = writeln!(
-            o,
-            "Written by {}{source}; settings: {}",
-            p.tool,
-            settings.join(", ")
-        );
+        let source =
+            if p.source.is_empty() { String::new() } else { format!(" from {}", p.source) };
+        let _ = writeln!(o, "Written by {}{source}; settings: {}", p.tool, settings.join(", "));
     }
     o
 }
@@ -490,12 +469,7 @@ pub fn render_chunks(rows: &[ChunkRow]) -> String {
         "#", "type", "offset", "length", "crc32", "checksum"
     );
     let _ = writeln!(o, "  -  header {:>10} {:>10}", 0, HEADER_LEN);
-    let _ = writeln!(
-        o,
-        "  -  table  {:>10} {:>10}",
-        HEADER_LEN,
-        rows.len() as u64 * ENTRY_LEN
-    );
+    let _ = writeln!(o, "  -  table  {:>10} {:>10}", HEADER_LEN, rows.len() as u64 * ENTRY_LEN);
     for r in rows {
         let flags = match (r.required, r.known) {
             (true, true) => "required",
@@ -519,19 +493,11 @@ pub fn parse_point(space: &ParameterSpace, at: Option<&str>) -> anyhow::Result<V
     };
     let values: Vec<f32> = at
         .split(',')
-        .map(|v| {
-            v.trim()
-                .parse::<f32>()
-                .with_context(|| format!("--at: '{v}' is not a number"))
-        })
+        .map(|v| v.trim().parse::<f32>().with_context(|| format!("--at: '{v}' is not a number")))
         .collect::<anyhow::Result<_>>()?;
     if values.len() != space.dims.len() || values.iter().any(|v| !v.is_finite()) {
         let names: Vec<&str> = space.dims.iter().map(|d| d.name.as_str()).collect();
-        anyhow::bail!(
-            "--at needs {} finite values ({}), got '{at}'",
-            names.len(),
-            names.join(",")
-        );
+        anyhow::bail!("--at needs {} finite values ({}), got '{at}'", names.len(), names.join(","));
     }
     Ok(space.nearest(&values))
 }
@@ -543,11 +509,7 @@ pub const FACE_NAMES: [&str; 6] = ["px", "nx", "py", "ny", "pz", "nz"];
 /// linear EXR and sRGB PNG; returns the file names. Every texture is decoded before a file
 /// is written, and the files written before an error are removed (the folder too, when this
 /// call made it): an error leaves nothing behind.
-pub fn extract(
-    r: &PisReader,
-    point: &[u32],
-    dir: &Path,
-) -> Result<Vec<String>, pis_pack::Failure> {
+pub fn extract(r: &PisReader, point: &[u32], dir: &Path) -> Result<Vec<String>, pis_pack::Failure> {
     use pis_pack::{Exit, Failure};
     // Decode first: a damaged codestream fails before any file exists.
     let mut images = Vec::new();
@@ -571,7 +533,8 @@ pub fn extract(
         .with_context(|| format!("cannot create {}", dir.display()))
         .map_err(|e| Failure::new(Exit::Io, e))?;
     let mut written = Vec::new();
-    let writers: [(&str, fn(&Path, u32, u32, u32, &[f32]) -> anyhow::Result<()>); 2] = [("exr", write_exr), ("png", write_png)];
+    let writers: [(&str, fn(&Path, u32, u32, u32, &[f32]) -> anyhow::Result<()>); 2] =
+        [("exr", write_exr), ("png", write_png)];
     for (stem, width, height, channels, plane) in &images {
         for (ext, f) in writers {
             let name = format!("{stem}.{ext}");
@@ -594,12 +557,6 @@ pub fn extract(
 /// A file-name-safe version of an object name.
 fn sanitize(name: &str) -> String {
     name.chars()
-        .map(|c| {
-            if c.is_ascii_alphanumeric() || c == '-' || c == '_' {
-                c
-            } else {
-                '_'
-            }
-        })
+        .map(|c| if c.is_ascii_alphanumeric() || c == '-' || c == '_' { c } else { '_' })
         .collect()
 }

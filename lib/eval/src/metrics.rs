@@ -120,7 +120,11 @@ impl PairedError {
 
 /// PSNR in dB (peak 1) of a mean squared error; 0 or less reports `f64::INFINITY`.
 fn psnr_of(mse: f64) -> f64 {
-    if mse <= 0.0 { f64::INFINITY } else { 10.0 * (1.0 / mse).log10() }
+    if mse <= 0.0 {
+        f64::INFINITY
+    } else {
+        10.0 * (1.0 / mse).log10()
+    }
 }
 
 /// PSNR in dB (peak 1) of two equally long slices of linear values, on display values.
@@ -164,18 +168,32 @@ mod tests {
         let n = 400_000;
         let t: Vec<f32> = (0..n).map(|_| 0.3 + 0.3 * u()).collect();
         let v: Vec<f32> = t.iter().map(|&x| x + 0.1 * (u() - 0.5)).collect();
-        let noisy = |u: &mut dyn FnMut() -> f32| -> Vec<f32> { t.iter().map(|&x| x + 0.2 * (u() - 0.5)).collect() };
+        let noisy = |u: &mut dyn FnMut() -> f32| -> Vec<f32> {
+            t.iter().map(|&x| x + 0.2 * (u() - 0.5)).collect()
+        };
         let (r1, r2) = (noisy(&mut u), noisy(&mut u));
         let truth = psnr_display(&v, &t);
         let mut e = PairedError::default();
         e.add_slices(&v, &r1, &r2);
         let raw = e.against_mean.psnr();
         eprintln!("truth {truth:.2} dB, against the references' mean {raw:.2}, noise removed {:.2}, references {:.2}", e.psnr_noise_removed(), e.reference_psnr());
-        assert!(truth - raw > 4.0, "the references' noise should dominate the raw figure: {raw} against {truth}");
-        assert!((e.psnr_noise_removed() - truth).abs() < 0.25, "noise removed {} against the truth {truth}", e.psnr_noise_removed());
+        assert!(
+            truth - raw > 4.0,
+            "the references' noise should dominate the raw figure: {raw} against {truth}"
+        );
+        assert!(
+            (e.psnr_noise_removed() - truth).abs() < 0.25,
+            "noise removed {} against the truth {truth}",
+            e.psnr_noise_removed()
+        );
         // The references' own noise: the mean's error about t, measured without t.
         let mean: Vec<f32> = r1.iter().zip(&r2).map(|(a, b)| 0.5 * (a + b)).collect();
-        assert!((e.reference_psnr() - psnr_display(&mean, &t)).abs() < 0.1, "{} against {}", e.reference_psnr(), psnr_display(&mean, &t));
+        assert!(
+            (e.reference_psnr() - psnr_display(&mean, &t)).abs() < 0.1,
+            "{} against {}",
+            e.reference_psnr(),
+            psnr_display(&mean, &t)
+        );
         // Values exactly at the converged image score above any finite figure, as they should.
         let mut exact = PairedError::default();
         exact.add_slices(&t, &r1, &r2);

@@ -20,10 +20,10 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
+use crate::metrics::SquaredError;
 use anyhow::anyhow;
 use pis_codec::allocate::Target;
 use pis_codec::CodecId;
-use crate::metrics::SquaredError;
 use pis_format::reconstruct::{finish, prepare};
 use pis_format::*;
 use rayon::prelude::*;
@@ -31,9 +31,9 @@ use serde::Serialize;
 
 pub use screen_area::screen_areas;
 
-use pis_pack::{Exit, Failure, MaxMse};
 use pis_pack::blocks::{block_sizes, stagger};
 use pis_pack::storage::{allocate_storage, build_pyramid, encode_levels, nudge, BlockPyramid};
+use pis_pack::{Exit, Failure, MaxMse};
 
 /// What to re-encode.
 #[derive(Clone, Debug)]
@@ -62,10 +62,18 @@ pub struct ReencodeRequest {
 /// The max-MSE constraint the input's writer applied, from its provenance setting
 /// `max_mse_ratio` (`off` or α); α = 1.25 where none is recorded.
 fn writer_max_mse<S>(c: &pis_format::Container<S>) -> MaxMse {
-    let recorded = c.provenance.as_ref().and_then(|p| p.settings.iter().rev().find(|(k, _)| k == "max_mse_ratio")).map(|(_, v)| v.as_str());
+    let recorded = c
+        .provenance
+        .as_ref()
+        .and_then(|p| p.settings.iter().rev().find(|(k, _)| k == "max_mse_ratio"))
+        .map(|(_, v)| v.as_str());
     match recorded {
         Some("off") => MaxMse::Off,
-        Some(v) => v.parse::<f64>().ok().filter(|a| a.is_finite() && *a > 1.0).map_or(MaxMse::On(pis_codec::allocate::DEFAULT_ALPHA), MaxMse::On),
+        Some(v) => v
+            .parse::<f64>()
+            .ok()
+            .filter(|a| a.is_finite() && *a > 1.0)
+            .map_or(MaxMse::On(pis_codec::allocate::DEFAULT_ALPHA), MaxMse::On),
         None => MaxMse::On(pis_codec::allocate::DEFAULT_ALPHA),
     }
 }
@@ -179,15 +187,25 @@ fn check(req: &ReencodeRequest) -> Result<(), Failure> {
     }
     if !req.codec.is_lossy() {
         if req.ratio.is_some() || req.psnr.is_some() {
-            return Err(usage(format!("--ratio and --psnr apply to the lossy codecs; {} stores textures exactly", req.codec)));
+            return Err(usage(format!(
+                "--ratio and --psnr apply to the lossy codecs; {} stores textures exactly",
+                req.codec
+            )));
         }
         if req.gamma.is_some_and(|g| g != 1.0) {
-            return Err(usage(format!("{} stores linear textures exactly: --gamma must be 1", req.codec)));
+            return Err(usage(format!(
+                "{} stores linear textures exactly: --gamma must be 1",
+                req.codec
+            )));
         }
     }
-    let parent = req.output.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
+    let parent =
+        req.output.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
     if !parent.is_dir() {
-        return Err(Failure::new(Exit::Io, anyhow!("the output folder {} does not exist", parent.display())));
+        return Err(Failure::new(
+            Exit::Io,
+            anyhow!("the output folder {} does not exist", parent.display()),
+        ));
     }
     Ok(())
 }
@@ -195,7 +213,12 @@ fn check(req: &ReencodeRequest) -> Result<(), Failure> {
 /// Gamma-compensated values of a linear texture for `layer`; for exact codecs (gamma 1) the
 /// stored MIP residuals are nudged so that the reader's `residual + decimate(finest)` gives
 /// every linear value back bit for bit.
-fn prepared(layer: &Layer<StreamRef>, layout: &LevelLayout, linear: &[f32], exact: bool) -> Vec<f32> {
+fn prepared(
+    layer: &Layer<StreamRef>,
+    layout: &LevelLayout,
+    linear: &[f32],
+    exact: bool,
+) -> Vec<f32> {
     let mut p = prepare(layer, layout, linear);
     if !(exact && layer.mip_mode == MipMode::Stored && layout.mips > 1) {
         return p;
@@ -237,7 +260,13 @@ impl Timer {
 }
 
 fn stream_bytes<S>(o: &Object<S>, len: impl Fn(&S) -> u64) -> u64 {
-    o.layers.iter().flat_map(|l| &l.blocks).flat_map(|b| &b.levels).flat_map(|l| &l.images).map(len).sum()
+    o.layers
+        .iter()
+        .flat_map(|l| &l.blocks)
+        .flat_map(|b| &b.levels)
+        .flat_map(|l| &l.images)
+        .map(len)
+        .sum()
 }
 
 /// Re-encodes `req.input` into `req.output`; on error no output file is left.
@@ -247,10 +276,20 @@ pub fn reencode(req: &ReencodeRequest) -> Result<ReencodeReport, Failure> {
     let mut t = Timer(Vec::new(), Instant::now());
     let input = open(&req.input)?;
     let c = input.container();
-    let masters_in = if input.has_master() { input.masters().map_err(|e| in_file(&req.input, e))? } else { Vec::new() };
+    let masters_in = if input.has_master() {
+        input.masters().map_err(|e| in_file(&req.input, e))?
+    } else {
+        Vec::new()
+    };
     let from_master = !masters_in.is_empty();
-    let input_exact = c.objects.iter().flat_map(|o| &o.layers).flat_map(|l| &l.blocks).flat_map(|b| &b.levels)
-        .flat_map(|l| &l.images).all(|s| !s.codec.is_lossy());
+    let input_exact = c
+        .objects
+        .iter()
+        .flat_map(|o| &o.layers)
+        .flat_map(|l| &l.blocks)
+        .flat_map(|b| &b.levels)
+        .flat_map(|l| &l.images)
+        .all(|s| !s.codec.is_lossy());
     if req.keep_master && !from_master && !input_exact {
         return Err(usage(format!(
             "--keep-master: {} carries no master and its level images are lossy: a master is carried over from a file that has one (pis-pack --keep-master) or made from a losslessly coded file",
@@ -266,14 +305,19 @@ pub fn reencode(req: &ReencodeRequest) -> Result<ReencodeReport, Failure> {
                 d.block_size = s;
             }
             let samples: Vec<usize> = c.space.dims.iter().map(|d| d.values.len()).collect();
-            (0..c.objects.len()).map(|i| stagger(i, c.objects.len(), &sizes, &samples, pis_pack::Stagger::Auto)).collect()
+            (0..c.objects.len())
+                .map(|i| stagger(i, c.objects.len(), &sizes, &samples, pis_pack::Stagger::Auto))
+                .collect()
         }
     };
     let exact = !req.codec.is_lossy();
     let gamma = if exact { 1.0 } else { req.gamma.unwrap_or(DEFAULT_GAMMA) };
-    let texture_bytes_before: u64 = c.objects.iter().map(|o| stream_bytes(o, |s| s.length as u64)).sum();
-    let raw = c.provenance.as_ref().map(|p| p.raw_image_bytes).filter(|&b| b > 0)
-        .unwrap_or(c.space.point_count() * c.cameras.width as u64 * c.cameras.height as u64 * 3);
+    let texture_bytes_before: u64 =
+        c.objects.iter().map(|o| stream_bytes(o, |s| s.length as u64)).sum();
+    let raw =
+        c.provenance.as_ref().map(|p| p.raw_image_bytes).filter(|&b| b > 0).unwrap_or(
+            c.space.point_count() * c.cameras.width as u64 * c.cameras.height as u64 * 3,
+        );
 
     // Every block's textures (the master's, or decoded), gamma compensated again, into its
     // pyramid.
@@ -292,19 +336,37 @@ pub fn reencode(req: &ReencodeRequest) -> Result<ReencodeReport, Failure> {
             let sources = match masters_in.iter().find(|m| m.object as usize == oi) {
                 Some(m) => master::from_master(c, m, oi, li),
                 None => master::from_decoded(&input, oi, li),
-            }.map_err(|e| in_file(&req.input, e))?;
+            }
+            .map_err(|e| in_file(&req.input, e))?;
             let sources = if req.block.is_some() {
-                master::regroup(c, &space, &staggers[oi], oi, li, sources).map_err(|e| Failure::new(Exit::NotSupported, anyhow::Error::from(e)))?
+                master::regroup(c, &space, &staggers[oi], oi, li, sources)
+                    .map_err(|e| Failure::new(Exit::NotSupported, anyhow::Error::from(e)))?
             } else {
                 sources
             };
-            let blocks = sources.par_iter().map(|b| {
-                let samples: Vec<Vec<f32>> = b.textures.par_iter().map(|x| prepared(&layer, &b.layout, x, exact)).collect();
-                let mut p = build_pyramid(oi, b.layout.planes(), &b.extent, &samples, layer_samples, exact, false).map_err(runtime)?;
-                // The master's screen weights: the allocation of the pack that wrote it.
-                p.texel_weights = b.weights.clone().filter(|_| !exact);
-                Ok(p)
-            }).collect::<Result<Vec<BlockPyramid>, Failure>>()?;
+            let blocks = sources
+                .par_iter()
+                .map(|b| {
+                    let samples: Vec<Vec<f32>> = b
+                        .textures
+                        .par_iter()
+                        .map(|x| prepared(&layer, &b.layout, x, exact))
+                        .collect();
+                    let mut p = build_pyramid(
+                        oi,
+                        b.layout.planes(),
+                        &b.extent,
+                        &samples,
+                        layer_samples,
+                        exact,
+                        false,
+                    )
+                    .map_err(runtime)?;
+                    // The master's screen weights: the allocation of the pack that wrote it.
+                    p.texel_weights = b.weights.clone().filter(|_| !exact);
+                    Ok(p)
+                })
+                .collect::<Result<Vec<BlockPyramid>, Failure>>()?;
             if req.keep_master && !from_master {
                 let mut table = vec![Vec::new(); layer_samples as usize];
                 for b in sources {
@@ -321,21 +383,40 @@ pub fn reencode(req: &ReencodeRequest) -> Result<ReencodeReport, Failure> {
         made.push(made_layers);
     }
     let level_images: usize = pyramids.iter().flat_map(|p| &p.levels).map(|l| l.1.len()).sum();
-    t.done("pyramid", &format!("{} blocks from the {source}, {level_images} level images in adaptive pyramids", pyramids.len()));
+    t.done(
+        "pyramid",
+        &format!(
+            "{} blocks from the {source}, {level_images} level images in adaptive pyramids",
+            pyramids.len()
+        ),
+    );
 
     let (target, target_text) = match (req.psnr, req.ratio) {
         _ if exact => (Target::Bytes(usize::MAX), "exact".to_string()),
         (Some(db), _) => (Target::Psnr { db, peak: 1.0 }, format!("psnr {db} dB")),
         (None, Some(r)) => (Target::Bytes((raw as f64 / r) as usize), format!("ratio {r}")),
-        (None, None) => (Target::Bytes(texture_bytes_before as usize), format!("bytes {texture_bytes_before}")),
+        (None, None) => {
+            (Target::Bytes(texture_bytes_before as usize), format!("bytes {texture_bytes_before}"))
+        }
     };
     // A master carries the allocation weights its writer used; otherwise they are measured.
     let need_areas = !exact || (req.keep_master && !from_master);
     let areas = if from_master {
-        Some(c.objects.iter().enumerate().map(|(oi, _)| masters_in.iter().find(|m| m.object as usize == oi).map_or(1.0, |m| m.area)).collect::<Vec<f64>>())
+        Some(
+            c.objects
+                .iter()
+                .enumerate()
+                .map(|(oi, _)| {
+                    masters_in.iter().find(|m| m.object as usize == oi).map_or(1.0, |m| m.area)
+                })
+                .collect::<Vec<f64>>(),
+        )
     } else if need_areas {
         let a = screen_areas(c);
-        t.done("areas", &format!("screen areas of {} objects over {} points", a.len(), c.space.point_count()));
+        t.done(
+            "areas",
+            &format!("screen areas of {} objects over {} points", a.len(), c.space.point_count()),
+        );
         Some(a)
     } else {
         None
@@ -347,15 +428,25 @@ pub fn reencode(req: &ReencodeRequest) -> Result<ReencodeReport, Failure> {
         Some(m) => m,
         None => writer_max_mse(c),
     };
-    let storage = allocate_storage(&pyramids, req.codec, target, if exact { &[] } else { areas.as_deref().unwrap_or(&[]) }, max_mse).map_err(runtime)?;
+    let storage = allocate_storage(
+        &pyramids,
+        req.codec,
+        target,
+        if exact { &[] } else { areas.as_deref().unwrap_or(&[]) },
+        max_mse,
+    )
+    .map_err(runtime)?;
     if let Some(total) = storage.allocated {
         t.done("allocate", &format!("{total} bytes over {level_images} level images"));
     }
-    let texture_bytes_after = encode_levels(&mut pyramids, req.codec, &storage.rates).map_err(runtime)? as u64;
+    let texture_bytes_after =
+        encode_levels(&mut pyramids, req.codec, &storage.rates).map_err(runtime)? as u64;
     t.done("encode", &format!("{level_images} level images with {}", req.codec));
 
     // The container: everything copied but gamma and pyramids.
-    let mut out: Container = c.try_map(&mut |_| Ok::<_, Error>(Codestream { codec: req.codec, bytes: vec![] })).map_err(Failure::from)?;
+    let mut out: Container = c
+        .try_map(&mut |_| Ok::<_, Error>(Codestream { codec: req.codec, bytes: vec![] }))
+        .map_err(Failure::from)?;
     out.space = space.clone();
     let mut next = pyramids.into_iter();
     for ((o, gammas), st) in out.objects.iter_mut().zip(&layers_out).zip(&staggers) {
@@ -364,35 +455,72 @@ pub fn reencode(req: &ReencodeRequest) -> Result<ReencodeReport, Failure> {
             l.gamma = g;
             if req.block.is_some() {
                 // Every new block keeps the layer's one placement (checked by the regrouping).
-                let template = l.blocks.first().cloned().ok_or_else(|| runtime(anyhow!("a layer without blocks")))?;
-                let count = pis_format::blocks::BlockGrid::new(&space, l.depends_on, st).block_count() as usize;
+                let template = l
+                    .blocks
+                    .first()
+                    .cloned()
+                    .ok_or_else(|| runtime(anyhow!("a layer without blocks")))?;
+                let count = pis_format::blocks::BlockGrid::new(&space, l.depends_on, st)
+                    .block_count() as usize;
                 l.blocks = vec![Block { levels: Vec::new(), ..template }; count];
             }
             for b in &mut l.blocks {
-                let p = next.next().ok_or_else(|| runtime(anyhow!("fewer pyramids than blocks")))?;
-                b.levels = p.levels.into_iter().map(|(counts, _, streams)| Level {
-                    counts,
-                    images: streams.into_iter().map(|bytes| Codestream { codec: req.codec, bytes }).collect(),
-                }).collect();
+                let p =
+                    next.next().ok_or_else(|| runtime(anyhow!("fewer pyramids than blocks")))?;
+                b.levels = p
+                    .levels
+                    .into_iter()
+                    .map(|(counts, _, streams)| Level {
+                        counts,
+                        images: streams
+                            .into_iter()
+                            .map(|bytes| Codestream { codec: req.codec, bytes })
+                            .collect(),
+                    })
+                    .collect();
             }
         }
     }
     let before = c.provenance.clone().unwrap_or_default();
-    let mut settings: Vec<(String, String)> = before.settings.iter()
+    let mut settings: Vec<(String, String)> = before
+        .settings
+        .iter()
         .filter(|(k, _)| !(req.block.is_some() && k == "block"))
-        .filter(|(k, _)| !matches!(k.as_str(), "codec" | "gamma" | "target" | "reencoded_from" | "source_tool" | "source_codec" | pis_pack::PREDICTED_PSNR_SETTING))
+        .filter(|(k, _)| {
+            !matches!(
+                k.as_str(),
+                "codec"
+                    | "gamma"
+                    | "target"
+                    | "reencoded_from"
+                    | "source_tool"
+                    | "source_codec"
+                    | pis_pack::PREDICTED_PSNR_SETTING
+            )
+        })
         // An exact output carries the writer's constraint on, for the next lossy coding.
         .filter(|(k, _)| exact || k != "max_mse_ratio")
-        .cloned().collect();
+        .cloned()
+        .collect();
     let codecs_before: Vec<String> = {
-        let mut v: Vec<String> = c.objects.iter().flat_map(|o| &o.layers).flat_map(|l| &l.blocks).flat_map(|b| &b.levels)
-            .flat_map(|l| &l.images).map(|s| s.codec.name().to_string()).collect();
+        let mut v: Vec<String> = c
+            .objects
+            .iter()
+            .flat_map(|o| &o.layers)
+            .flat_map(|l| &l.blocks)
+            .flat_map(|b| &b.levels)
+            .flat_map(|l| &l.images)
+            .map(|s| s.codec.name().to_string())
+            .collect();
         v.sort();
         v.dedup();
         v
     };
     if req.block.is_some() {
-        settings.push(("block".to_string(), space.dims.iter().map(|d| d.block_size.to_string()).collect::<Vec<_>>().join("x")));
+        settings.push((
+            "block".to_string(),
+            space.dims.iter().map(|d| d.block_size.to_string()).collect::<Vec<_>>().join("x"),
+        ));
     }
     settings.extend([
         ("codec".to_string(), req.codec.name().to_string()),
@@ -403,11 +531,18 @@ pub fn reencode(req: &ReencodeRequest) -> Result<ReencodeReport, Failure> {
         ("source_codec".to_string(), codecs_before.join("+")),
     ]);
     if !exact {
-        settings.push(("max_mse_ratio".to_string(), max_mse.alpha().map_or_else(|| "off".to_string(), |a| a.to_string())));
+        settings.push((
+            "max_mse_ratio".to_string(),
+            max_mse.alpha().map_or_else(|| "off".to_string(), |a| a.to_string()),
+        ));
     }
     out.provenance = Some(Provenance {
         tool: format!("pis-reencode {}", env!("CARGO_PKG_VERSION")),
-        source: if before.source.is_empty() { req.input.display().to_string() } else { before.source.clone() },
+        source: if before.source.is_empty() {
+            req.input.display().to_string()
+        } else {
+            before.source.clone()
+        },
         raw_image_bytes: raw,
         settings,
     });
@@ -417,22 +552,31 @@ pub fn reencode(req: &ReencodeRequest) -> Result<ReencodeReport, Failure> {
         masters_in.clone()
     } else {
         let a = areas.as_deref().unwrap_or(&[]);
-        let m = made.iter().enumerate().map(|(oi, textures)| Master::encode(&out, oi, a.get(oi).copied().unwrap_or(1.0), textures, None))
-            .collect::<Result<Vec<Master>, Error>>().map_err(|e| runtime(e.into()))?;
+        let m = made
+            .iter()
+            .enumerate()
+            .map(|(oi, textures)| {
+                Master::encode(&out, oi, a.get(oi).copied().unwrap_or(1.0), textures, None)
+            })
+            .collect::<Result<Vec<Master>, Error>>()
+            .map_err(|e| runtime(e.into()))?;
         t.done("master", &format!("decoded textures of {} objects coded losslessly", m.len()));
         m
     };
-    let bytes_after = pis_format::write_with_masters(&req.output, &out, &masters_out).map_err(|e| match e {
-        Error::Io { .. } => Failure::from(e),
-        e => runtime(e.into()),
-    })?;
+    let bytes_after =
+        pis_format::write_with_masters(&req.output, &out, &masters_out).map_err(|e| match e {
+            Error::Io { .. } => Failure::from(e),
+            e => runtime(e.into()),
+        })?;
     t.done("write", &format!("{} ({bytes_after} bytes)", req.output.display()));
 
     // Read back and compare with the input's decoded textures.
     let output = open(&req.output)?;
-    let (diff, _) = crate::diff::compare(&input, &output, false, &mut |_| {}).map_err(|e| runtime(e.into()))?;
+    let (diff, _) =
+        crate::diff::compare(&input, &output, false, &mut |_| {}).map_err(|e| runtime(e.into()))?;
     t.done("compare", "output decoded at every sample against the input");
-    let against = |r: &PisReader| master::error_against(r, &masters_in).map_err(|e| in_file(r.path(), e));
+    let against =
+        |r: &PisReader| master::error_against(r, &masters_in).map_err(|e| in_file(r.path(), e));
     let (vs_before, vs_after) = if from_master {
         let scores = (against(&input)?, against(&output)?);
         t.done("master", "input and output decoded at every sample against the master");
@@ -441,19 +585,28 @@ pub fn reencode(req: &ReencodeRequest) -> Result<ReencodeReport, Failure> {
         (None, None)
     };
     let finite = |p: f64| p.is_finite().then_some(p);
-    let object_psnr = |s: &Option<(SquaredError, Vec<SquaredError>)>, i: usize| s.as_ref().and_then(|s| finite(s.1[i].psnr()));
-    let objects = c.objects.iter().zip(&output.container().objects).zip(&diff.objects).enumerate().map(|(i, ((a, b), d))| ObjectReport {
-        name: a.name.clone(),
-        bytes_before: stream_bytes(a, |s| s.length as u64),
-        bytes_after: stream_bytes(b, |s| s.length as u64),
-        psnr_db: d.score.psnr_db,
-        mse: d.score.mse,
-        max_error: d.score.max_error,
-        exact: d.score.exact,
-        area_px: areas.as_ref().map(|a| a[i]),
-        psnr_master_before_db: object_psnr(&vs_before, i),
-        psnr_master_after_db: object_psnr(&vs_after, i),
-    }).collect();
+    let object_psnr = |s: &Option<(SquaredError, Vec<SquaredError>)>, i: usize| {
+        s.as_ref().and_then(|s| finite(s.1[i].psnr()))
+    };
+    let objects = c
+        .objects
+        .iter()
+        .zip(&output.container().objects)
+        .zip(&diff.objects)
+        .enumerate()
+        .map(|(i, ((a, b), d))| ObjectReport {
+            name: a.name.clone(),
+            bytes_before: stream_bytes(a, |s| s.length as u64),
+            bytes_after: stream_bytes(b, |s| s.length as u64),
+            psnr_db: d.score.psnr_db,
+            mse: d.score.mse,
+            max_error: d.score.max_error,
+            exact: d.score.exact,
+            area_px: areas.as_ref().map(|a| a[i]),
+            psnr_master_before_db: object_psnr(&vs_before, i),
+            psnr_master_after_db: object_psnr(&vs_after, i),
+        })
+        .collect();
     let bytes_before = input.len();
     let (master_bytes_before, master_bytes_after) = (input.master_bytes(), output.master_bytes());
     let psnr_master_before_db = vs_before.as_ref().and_then(|s| finite(s.0.psnr()));
@@ -496,21 +649,64 @@ fn db(p: Option<f64>) -> String {
 
 /// Human-readable lines of the report.
 pub fn print_report(r: &ReencodeReport, out: &mut impl std::io::Write) -> std::io::Result<()> {
-    writeln!(out, "{} → {}: {} → {} (gamma {}, target {}), from the {}", r.input, r.output, r.codecs_before.join("+"), r.codec, r.gamma, r.target, r.source)?;
-    writeln!(out, "  bytes     {:>12} → {:>12}  (level images {} → {})", r.bytes_before, r.bytes_after, r.texture_bytes_before, r.texture_bytes_after)?;
-    writeln!(out, "  ratio     {:>12.1} → {:>12.1}  (level images alone {:.1} → {:.1}; raw {} bytes)", r.ratio_before, r.ratio_after,
-             r.ratio_without_geometry_before, r.ratio_without_geometry_after, r.raw_image_bytes)?;
+    writeln!(
+        out,
+        "{} → {}: {} → {} (gamma {}, target {}), from the {}",
+        r.input,
+        r.output,
+        r.codecs_before.join("+"),
+        r.codec,
+        r.gamma,
+        r.target,
+        r.source
+    )?;
+    writeln!(
+        out,
+        "  bytes     {:>12} → {:>12}  (level images {} → {})",
+        r.bytes_before, r.bytes_after, r.texture_bytes_before, r.texture_bytes_after
+    )?;
+    writeln!(
+        out,
+        "  ratio     {:>12.1} → {:>12.1}  (level images alone {:.1} → {:.1}; raw {} bytes)",
+        r.ratio_before,
+        r.ratio_after,
+        r.ratio_without_geometry_before,
+        r.ratio_without_geometry_after,
+        r.raw_image_bytes
+    )?;
     if r.master_bytes_before > 0 || r.master_bytes_after > 0 {
-        writeln!(out, "  lossless master {:>12} → {:>12} bytes, not counted by the ratios", r.master_bytes_before, r.master_bytes_after)?;
+        writeln!(
+            out,
+            "  lossless master {:>12} → {:>12} bytes, not counted by the ratios",
+            r.master_bytes_before, r.master_bytes_after
+        )?;
     }
-    writeln!(out, "  texture PSNR against the input's decoded textures: {} (max display error {:.4}){}", db(r.psnr_db), r.max_error,
-             if r.exact { ", exact" } else { "" })?;
+    writeln!(
+        out,
+        "  texture PSNR against the input's decoded textures: {} (max display error {:.4}){}",
+        db(r.psnr_db),
+        r.max_error,
+        if r.exact { ", exact" } else { "" }
+    )?;
     if r.source == "master" {
         let change = r.psnr_change_db.map_or("n/a".to_string(), |d| format!("{d:+.2} dB"));
-        writeln!(out, "  texture PSNR against the master: {} → {} (change {change})", db(r.psnr_master_before_db), db(r.psnr_master_after_db))?;
+        writeln!(
+            out,
+            "  texture PSNR against the master: {} → {} (change {change})",
+            db(r.psnr_master_before_db),
+            db(r.psnr_master_after_db)
+        )?;
     }
     for o in &r.objects {
-        writeln!(out, "  {:<12} {:>10} → {:>10} bytes  {:>10}  max error {:.4}", o.name, o.bytes_before, o.bytes_after, db(o.psnr_db), o.max_error)?;
+        writeln!(
+            out,
+            "  {:<12} {:>10} → {:>10} bytes  {:>10}  max error {:.4}",
+            o.name,
+            o.bytes_before,
+            o.bytes_after,
+            db(o.psnr_db),
+            o.max_error
+        )?;
     }
     let stages: Vec<String> = r.stage_ms.iter().map(|(k, v)| format!("{k} {v:.0}")).collect();
     writeln!(out, "  stages (ms): {}", stages.join(", "))
@@ -536,14 +732,21 @@ mod tests {
             blocks: vec![],
         };
         let layout = LevelLayout { width: 8, height: 8, channels: 3, faces: 1, mips: 4 };
-        let n: usize = layout.planes().iter().map(|p| (p.width * p.height * p.channels) as usize).sum();
+        let n: usize =
+            layout.planes().iter().map(|p| (p.width * p.height * p.channels) as usize).sum();
         let mut seed = 12345u32;
         // Finest texels small, residuals large: the sums round.
-        let linear = (0..n).map(|i| {
-            seed = seed.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
-            let u = (seed >> 8) as f32 / (1u32 << 24) as f32;
-            if i < 8 * 8 * 3 { u * 0.01 } else { u * 7.0 - 3.0 }
-        }).collect();
+        let linear = (0..n)
+            .map(|i| {
+                seed = seed.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
+                let u = (seed >> 8) as f32 / (1u32 << 24) as f32;
+                if i < 8 * 8 * 3 {
+                    u * 0.01
+                } else {
+                    u * 7.0 - 3.0
+                }
+            })
+            .collect();
         let linear = finish(&layer, &layout, linear);
         (layer, layout, linear)
     }
@@ -551,9 +754,18 @@ mod tests {
     #[test]
     fn stored_mip_values_a_reader_decoded_round_trip_exactly() {
         let (layer, layout, linear) = case();
-        let differ = |p: Vec<f32>| finish(&layer, &layout, p).iter().zip(&linear).filter(|(a, b)| a.to_bits() != b.to_bits()).count();
+        let differ = |p: Vec<f32>| {
+            finish(&layer, &layout, p)
+                .iter()
+                .zip(&linear)
+                .filter(|(a, b)| a.to_bits() != b.to_bits())
+                .count()
+        };
         assert_eq!(differ(prepared(&layer, &layout, &linear, true)), 0);
         // The values are those the decoder's sum gives, whatever the residuals' scale.
-        assert!(linear.iter().skip(8 * 8 * 3).any(|v| v.abs() > 1.0) && linear.iter().take(8 * 8 * 3).all(|v| v.abs() < 0.01));
+        assert!(
+            linear.iter().skip(8 * 8 * 3).any(|v| v.abs() > 1.0)
+                && linear.iter().take(8 * 8 * 3).all(|v| v.abs() < 0.01)
+        );
     }
 }

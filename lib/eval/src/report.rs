@@ -30,26 +30,56 @@ impl Stamp {
     /// line as given.
     pub fn here(scene: &str) -> Stamp {
         let args: Vec<String> = std::env::args().collect();
-        let prog = args.first().map(|a| Path::new(a).file_name().map_or(a.clone(), |f| f.to_string_lossy().into_owned())).unwrap_or_default();
-        let rest: Vec<String> = args.iter().skip(1).map(|a| if a.contains(' ') { format!("'{a}'") } else { a.clone() }).collect();
-        Stamp { machine: machine(), scene: scene.to_string(), command: format!("{prog} {}", rest.join(" ")).trim().to_string() }
+        let prog = args
+            .first()
+            .map(|a| {
+                Path::new(a).file_name().map_or(a.clone(), |f| f.to_string_lossy().into_owned())
+            })
+            .unwrap_or_default();
+        let rest: Vec<String> = args
+            .iter()
+            .skip(1)
+            .map(|a| if a.contains(' ') { format!("'{a}'") } else { a.clone() })
+            .collect();
+        Stamp {
+            machine: machine(),
+            scene: scene.to_string(),
+            command: format!("{prog} {}", rest.join(" ")).trim().to_string(),
+        }
     }
 
     /// The stamp as chart footer lines.
     pub fn lines(&self) -> Vec<String> {
-        vec![format!("machine: {}", self.machine), format!("scene: {}", self.scene), format!("command: {}", self.command)]
+        vec![
+            format!("machine: {}", self.machine),
+            format!("scene: {}", self.scene),
+            format!("command: {}", self.command),
+        ]
     }
 }
 
 /// "N vCPU MODEL, MEMORY GiB": what the figures ran on.
 pub fn machine() -> String {
-    let cpu = std::fs::read_to_string("/proc/cpuinfo").ok()
-        .and_then(|s| s.lines().find(|l| l.starts_with("model name")).and_then(|l| l.split(':').nth(1)).map(|m| m.trim().to_string()))
+    let cpu = std::fs::read_to_string("/proc/cpuinfo")
+        .ok()
+        .and_then(|s| {
+            s.lines()
+                .find(|l| l.starts_with("model name"))
+                .and_then(|l| l.split(':').nth(1))
+                .map(|m| m.trim().to_string())
+        })
         .unwrap_or_else(|| std::env::consts::ARCH.to_string());
     let n = std::thread::available_parallelism().map_or(1, |n| n.get());
-    let mem = std::fs::read_to_string("/proc/meminfo").ok()
-        .and_then(|s| s.lines().next().and_then(|l| l.split_whitespace().nth(1)).and_then(|k| k.parse::<f64>().ok()))
-        .map(|kb| format!(", {:.0} GiB", kb / 1048576.0)).unwrap_or_default();
+    let mem = std::fs::read_to_string("/proc/meminfo")
+        .ok()
+        .and_then(|s| {
+            s.lines()
+                .next()
+                .and_then(|l| l.split_whitespace().nth(1))
+                .and_then(|k| k.parse::<f64>().ok())
+        })
+        .map(|kb| format!(", {:.0} GiB", kb / 1048576.0))
+        .unwrap_or_default();
     format!("{n} vCPU {cpu}{mem}")
 }
 
@@ -61,7 +91,11 @@ pub struct Csv {
 }
 
 fn field(s: &str) -> String {
-    if s.contains([',', '"', '\n']) { format!("\"{}\"", s.replace('"', "\"\"")) } else { s.to_string() }
+    if s.contains([',', '"', '\n']) {
+        format!("\"{}\"", s.replace('"', "\"\""))
+    } else {
+        s.to_string()
+    }
 }
 
 impl Csv {
@@ -86,8 +120,15 @@ impl Csv {
 /// Puts `row` (a Markdown table row starting `| key |`) under `## heading` of the Markdown
 /// file `path`: replaces the row with the same key, or appends it after the section's last
 /// table row; creates the section (with `table_head`) at the end of the file when missing.
-pub fn record_row(path: &Path, heading: &str, table_head: &str, key: &str, row: &str) -> Result<()> {
-    let text = std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
+pub fn record_row(
+    path: &Path,
+    heading: &str,
+    table_head: &str,
+    key: &str,
+    row: &str,
+) -> Result<()> {
+    let text =
+        std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
     let mut lines: Vec<String> = text.lines().map(str::to_string).collect();
     let title = format!("## {heading}");
     let start = match lines.iter().position(|l| l.trim_end() == title) {
@@ -102,7 +143,12 @@ pub fn record_row(path: &Path, heading: &str, table_head: &str, key: &str, row: 
             lines.len() - table_head.lines().count() - 2
         }
     };
-    let end = lines.iter().enumerate().skip(start + 1).find(|(_, l)| l.starts_with("## ")).map_or(lines.len(), |(i, _)| i);
+    let end = lines
+        .iter()
+        .enumerate()
+        .skip(start + 1)
+        .find(|(_, l)| l.starts_with("## "))
+        .map_or(lines.len(), |(i, _)| i);
     let prefix = format!("| {key} |");
     if let Some(i) = (start..end).find(|&i| lines[i].starts_with(&prefix)) {
         lines[i] = row.to_string();
@@ -139,7 +185,10 @@ mod tests {
         record_row(&md, "bench", head, "rd demo1", "| rd demo1 | 3 |").unwrap();
         let t = std::fs::read_to_string(&md).unwrap();
         assert!(t.contains("## other\n\ntext\n"), "{t}");
-        assert!(t.contains("| run | value |\n|---|---|\n| rd demo1 | 3 |\n| rd demo2 | 2 |\n"), "{t}");
+        assert!(
+            t.contains("| run | value |\n|---|---|\n| rd demo1 | 3 |\n| rd demo2 | 2 |\n"),
+            "{t}"
+        );
         assert!(!t.contains("| rd demo1 | 1 |"));
         std::fs::remove_dir_all(&dir).unwrap();
     }

@@ -19,10 +19,7 @@ fn container() -> Container {
         values: (0..8).map(|i| i as f32).collect(),
     };
     let space = ParameterSpace {
-        dims: vec![
-            dim("light", DimensionKind::Light),
-            dim("view", DimensionKind::View),
-        ],
+        dims: vec![dim("light", DimensionKind::Light), dim("view", DimensionKind::View)],
     };
     let cameras = CameraTable {
         width: 640,
@@ -85,15 +82,9 @@ fn container() -> Container {
             stagger: vec![0, 0],
             transforms: TransformTable::fixed(IDENTITY_3X4),
             mesh: uv_sphere(1.0, 32, 16),
-            layers: vec![Layer {
-                blocks: vec![block],
-                ..layer
-            }],
+            layers: vec![Layer { blocks: vec![block], ..layer }],
         }],
-        provenance: Some(Provenance {
-            raw_image_bytes: 64 * 640 * 480 * 3,
-            ..Default::default()
-        }),
+        provenance: Some(Provenance { raw_image_bytes: 64 * 640 * 480 * 3, ..Default::default() }),
     }
 }
 

@@ -20,14 +20,7 @@ pub struct Cursor<'a> {
 
 impl<'a> Cursor<'a> {
     pub fn new(data: &'a [u8], base: u64, malformed: u16, chunk: (&'a str, usize)) -> Self {
-        Cursor {
-            data,
-            pos: 0,
-            base,
-            malformed,
-            chunk,
-            flagged: None,
-        }
+        Cursor { data, pos: 0, base, malformed, chunk, flagged: None }
     }
 
     /// Keeps parsing past broken rules that leave the payload's structure readable (a
@@ -66,9 +59,7 @@ impl<'a> Cursor<'a> {
 
     /// An issue located at the cursor.
     pub fn issue(&self, id: u16, detail: impl Into<String>) -> Issue {
-        Issue::new(id, detail)
-            .in_chunk(self.chunk.0, self.chunk.1)
-            .at(self.offset())
+        Issue::new(id, detail).in_chunk(self.chunk.0, self.chunk.1).at(self.offset())
     }
 
     fn take(&mut self, n: usize, what: &str) -> Result<&'a [u8], Issue> {
@@ -191,10 +182,7 @@ pub struct Sink {
 
 impl Sink {
     pub fn new(labelled: bool) -> Self {
-        Sink {
-            bytes: Vec::new(),
-            spans: labelled.then(Vec::new),
-        }
+        Sink { bytes: Vec::new(), spans: labelled.then(Vec::new) }
     }
 
     pub fn len(&self) -> usize {
@@ -204,11 +192,7 @@ impl Sink {
     pub fn raw(&mut self, b: &[u8], label: impl FnOnce() -> String) {
         if let Some(spans) = &mut self.spans {
             if !b.is_empty() {
-                spans.push(Span {
-                    start: self.bytes.len(),
-                    len: b.len(),
-                    label: label(),
-                });
+                spans.push(Span { start: self.bytes.len(), len: b.len(), label: label() });
             }
         }
         self.bytes.extend_from_slice(b);
@@ -264,10 +248,7 @@ impl Sink {
     pub fn append(&mut self, other: Sink) {
         let base = self.bytes.len();
         if let (Some(mine), Some(theirs)) = (&mut self.spans, other.spans) {
-            mine.extend(theirs.into_iter().map(|s| Span {
-                start: s.start + base,
-                ..s
-            }));
+            mine.extend(theirs.into_iter().map(|s| Span { start: s.start + base, ..s }));
         }
         self.bytes.extend_from_slice(&other.bytes);
     }

@@ -52,12 +52,7 @@ impl BlockGrid {
             .dims()
             .map(|k| {
                 let d = &space.dims[k];
-                Axis {
-                    dim: k,
-                    n: d.values.len() as u32,
-                    size: d.block_size,
-                    offset: stagger[k],
-                }
+                Axis { dim: k, n: d.values.len() as u32, size: d.block_size, offset: stagger[k] }
             })
             .collect();
         BlockGrid { axes }
@@ -109,11 +104,7 @@ impl BlockGrid {
             local.push(s - lo);
             extent.push(hi - lo);
         }
-        BlockPosition {
-            block,
-            local,
-            extent,
-        }
+        BlockPosition { block, local, extent }
     }
 }
 
@@ -173,30 +164,9 @@ mod tests {
         // Offset 3: blocks [0,5) [5,13) [13,19).
         let g = BlockGrid::new(&s, DepMask::of(&[0]), &[3]);
         assert_eq!(g.block_count(), 3);
-        assert_eq!(
-            g.locate(&[4]),
-            BlockPosition {
-                block: 0,
-                local: vec![4],
-                extent: vec![5]
-            }
-        );
-        assert_eq!(
-            g.locate(&[5]),
-            BlockPosition {
-                block: 1,
-                local: vec![0],
-                extent: vec![8]
-            }
-        );
-        assert_eq!(
-            g.locate(&[18]),
-            BlockPosition {
-                block: 2,
-                local: vec![5],
-                extent: vec![6]
-            }
-        );
+        assert_eq!(g.locate(&[4]), BlockPosition { block: 0, local: vec![4], extent: vec![5] });
+        assert_eq!(g.locate(&[5]), BlockPosition { block: 1, local: vec![0], extent: vec![8] });
+        assert_eq!(g.locate(&[18]), BlockPosition { block: 2, local: vec![5], extent: vec![6] });
     }
 
     #[test]

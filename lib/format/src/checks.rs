@@ -141,7 +141,8 @@ pub(crate) fn check_parsed<S>(p: &Parsed<S>) -> Vec<Issue> {
     if let Some(prov) = p.provenance {
         provenance(prov, &mut out);
         if let Some(objects) = p.objects {
-            let named: Vec<(&str, crate::ObjectRole)> = objects.iter().map(|o| (o.name.as_str(), o.role)).collect();
+            let named: Vec<(&str, crate::ObjectRole)> =
+                objects.iter().map(|o| (o.name.as_str(), o.role)).collect();
             if let Err(detail) = crate::tint::tints(prov, &named) {
                 out.push(chunk(Issue::new(9004, detail), "PROV"));
             }
@@ -172,10 +173,7 @@ fn provenance(p: Option<&Provenance>, out: &mut Vec<Issue>) {
 
 fn chunk(i: Issue, fourcc: &str) -> Issue {
     // Chunk indices follow the writer's order; the reader re-tags with the real index.
-    Issue {
-        chunk: Some((fourcc.to_string(), usize::MAX)),
-        ..i
-    }
+    Issue { chunk: Some((fourcc.to_string(), usize::MAX)), ..i }
 }
 
 fn space(s: &ParameterSpace, out: &mut Vec<Issue>) {
@@ -188,34 +186,19 @@ fn space(s: &ParameterSpace, out: &mut Vec<Issue>) {
     let mut names = HashSet::new();
     for (k, d) in s.dims.iter().enumerate() {
         if d.name.is_empty() || !names.insert(d.name.as_str()) {
-            out.push(e(
-                4002,
-                format!("dimension {k} name {:?} is empty or repeated", d.name),
-            ));
+            out.push(e(4002, format!("dimension {k} name {:?} is empty or repeated", d.name)));
         }
         if d.values.is_empty() {
-            out.push(e(
-                4004,
-                format!("dimension {k} '{}' has no samples", d.name),
-            ));
+            out.push(e(4004, format!("dimension {k} '{}' has no samples", d.name)));
         }
         if d.block_size == 0 {
-            out.push(e(
-                4005,
-                format!("dimension {k} '{}' has block size 0", d.name),
-            ));
+            out.push(e(4005, format!("dimension {k} '{}' has block size 0", d.name)));
         }
         if d.values.iter().any(|v| !v.is_finite()) || d.values.windows(2).any(|w| w[1] <= w[0]) {
-            out.push(e(
-                4006,
-                format!("dimension {k} '{}' values {:?}", d.name, d.values),
-            ));
+            out.push(e(4006, format!("dimension {k} '{}' values {:?}", d.name, d.values)));
         }
     }
-    let points = s
-        .dims
-        .iter()
-        .try_fold(1u64, |p, d| p.checked_mul(d.values.len() as u64));
+    let points = s.dims.iter().try_fold(1u64, |p, d| p.checked_mul(d.values.len() as u64));
     if points.is_none_or(|p| p > MAX_POINTS) {
         out.push(e(4007, format!("more than {MAX_POINTS} points")));
     }
@@ -238,11 +221,7 @@ fn table(
         out.push(chunk(
             Issue::new(
                 5002,
-                format!(
-                    "{what} mask {:#x}, the space has {} dimensions",
-                    mask.0,
-                    s.dims.len()
-                ),
+                format!("{what} mask {:#x}, the space has {} dimensions", mask.0, s.dims.len()),
             ),
             fourcc,
         ));
@@ -287,10 +266,7 @@ fn cameras(s: Option<&ParameterSpace>, t: &CameraTable, out: &mut Vec<Issue>) {
     if t.width == 0 || t.height == 0 || t.width > MAX_IMAGE_SIDE || t.height > MAX_IMAGE_SIDE {
         out.push(e(
             5004,
-            format!(
-                "{}×{} pixels, each side must be 1 to {MAX_IMAGE_SIDE}",
-                t.width, t.height
-            ),
+            format!("{}×{} pixels, each side must be 1 to {MAX_IMAGE_SIDE}", t.width, t.height),
         ));
     }
     if let Some(s) = s {
@@ -321,19 +297,12 @@ fn objects<S>(
 ) {
     let n = objects.len();
     if n == 0 || n > 65535 {
-        out.push(chunk(
-            Issue::new(5101, format!("{n} objects, expected 1 to 65535")),
-            "OBJS",
-        ));
+        out.push(chunk(Issue::new(5101, format!("{n} objects, expected 1 to 65535")), "OBJS"));
     }
     let mut names = HashSet::new();
     for (oi, o) in objects.iter().enumerate() {
-        let e = |id, d: String| {
-            chunk(
-                Issue::new(id, format!("object {oi} '{}': {d}", o.name)),
-                "OBJS",
-            )
-        };
+        let e =
+            |id, d: String| chunk(Issue::new(id, format!("object {oi} '{}': {d}", o.name)), "OBJS");
         if o.name.is_empty() || !names.insert(o.name.as_str()) {
             out.push(e(5102, "name is empty or repeated".into()));
         }
@@ -349,16 +318,15 @@ fn objects<S>(
             if off >= d.block_size {
                 out.push(e(
                     5105,
-                    format!(
-                        "offset {off} along dimension {k} with block size {}",
-                        d.block_size
-                    ),
+                    format!("offset {off} along dimension {k} with block size {}", d.block_size),
                 ));
                 stagger_ok = false;
             }
         }
         let what = format!("object {oi} transforms");
-        if s.is_none_or(|s| table(s, o.transforms.depends_on, o.transforms.transforms.len(), &what, "OBJS", out)) {
+        if s.is_none_or(|s| {
+            table(s, o.transforms.depends_on, o.transforms.transforms.len(), &what, "OBJS", out)
+        }) {
             for (t, m) in o.transforms.transforms.iter().enumerate() {
                 if !finite(m) || !rigid(m) {
                     out.push(e(
@@ -380,10 +348,7 @@ fn objects<S>(
 
 fn mesh<S>(oi: usize, o: &Object<S>, out: &mut Vec<Issue>) {
     let e = |id, d: String| {
-        chunk(
-            Issue::new(id, format!("mesh of object {oi} '{}': {d}", o.name)),
-            "MESH",
-        )
+        chunk(Issue::new(id, format!("mesh of object {oi} '{}': {d}", o.name)), "MESH")
     };
     let m = &o.mesh;
     if m.positions.is_empty() {
@@ -393,48 +358,24 @@ fn mesh<S>(oi: usize, o: &Object<S>, out: &mut Vec<Issue>) {
     if m.indices.is_empty() || m.indices.len() % 3 != 0 {
         out.push(e(5203, format!("{} indices", m.indices.len())));
     }
-    if let Some(i) = m
-        .indices
-        .iter()
-        .position(|&i| i as usize >= m.positions.len())
-    {
+    if let Some(i) = m.indices.iter().position(|&i| i as usize >= m.positions.len()) {
         out.push(e(
             5204,
-            format!(
-                "index {i} is {}, there are {} vertices",
-                m.indices[i],
-                m.positions.len()
-            ),
+            format!("index {i} is {}, there are {} vertices", m.indices[i], m.positions.len()),
         ));
     }
     let all_finite = m.positions.iter().all(|p| finite(p))
-        && m.normals
-            .as_ref()
-            .is_none_or(|n| n.iter().all(|p| finite(p)))
-        && m.texcoords
-            .as_ref()
-            .is_none_or(|t| t.iter().all(|p| finite(p)));
-    let lengths = m
-        .normals
-        .as_ref()
-        .is_none_or(|n| n.len() == m.positions.len())
-        && m.texcoords
-            .as_ref()
-            .is_none_or(|t| t.len() == m.positions.len());
+        && m.normals.as_ref().is_none_or(|n| n.iter().all(|p| finite(p)))
+        && m.texcoords.as_ref().is_none_or(|t| t.iter().all(|p| finite(p)));
+    let lengths = m.normals.as_ref().is_none_or(|n| n.len() == m.positions.len())
+        && m.texcoords.as_ref().is_none_or(|t| t.len() == m.positions.len());
     if !all_finite || !lengths {
-        out.push(e(
-            5205,
-            "non-finite values, or attribute arrays of unequal length".into(),
-        ));
+        out.push(e(5205, "non-finite values, or attribute arrays of unequal length".into()));
     }
     if m.hull_triangles as usize > m.indices.len() / 3 {
         out.push(e(
             5206,
-            format!(
-                "{} hull triangles, the mesh has {}",
-                m.hull_triangles,
-                m.indices.len() / 3
-            ),
+            format!("{} hull triangles, the mesh has {}", m.hull_triangles, m.indices.len() / 3),
         ));
     }
 }
@@ -442,18 +383,20 @@ fn mesh<S>(oi: usize, o: &Object<S>, out: &mut Vec<Issue>) {
 /// The rules of `o`'s layers. `has_mesh`: the object's mesh parsed (the texture coordinates
 /// a surface layer needs, rule 6003); `grid`: the space, when it and the object's block
 /// origins hold (the block grids, rules 6005–6007 and 7xxx).
-fn layers<S>(grid: Option<&ParameterSpace>, oi: usize, o: &Object<S>, has_mesh: bool, out: &mut Vec<Issue>) {
+fn layers<S>(
+    grid: Option<&ParameterSpace>,
+    oi: usize,
+    o: &Object<S>,
+    has_mesh: bool,
+    out: &mut Vec<Issue>,
+) {
     let mut slots = HashSet::new();
     for (li, l) in o.layers.iter().enumerate() {
         let e = |id, d: String| {
             chunk(
                 Issue::new(
                     id,
-                    format!(
-                        "object {oi} '{}' layer {li} ({}): {d}",
-                        o.name,
-                        l.kind.name()
-                    ),
+                    format!("object {oi} '{}' layer {li} ({}): {d}", o.name, l.kind.name()),
                 ),
                 "LAYR",
             )
@@ -494,10 +437,7 @@ fn layers<S>(grid: Option<&ParameterSpace>, oi: usize, o: &Object<S>, has_mesh: 
             ));
         }
         if !slots.insert((l.term as u8, l.order)) {
-            out.push(e(
-                6008,
-                format!("term {} order {} is already used", l.term.name(), l.order),
-            ));
+            out.push(e(6008, format!("term {} order {} is already used", l.term.name(), l.order)));
         }
         if !(l.gamma.is_finite() && l.gamma > 0.0) {
             out.push(e(6004, format!("gamma {}", l.gamma)));
@@ -508,11 +448,7 @@ fn layers<S>(grid: Option<&ParameterSpace>, oi: usize, o: &Object<S>, has_mesh: 
         if !mask_ok(s, l.depends_on) {
             out.push(e(
                 5002,
-                format!(
-                    "mask {:#x}, the space has {} dimensions",
-                    l.depends_on.0,
-                    s.dims.len()
-                ),
+                format!("mask {:#x}, the space has {} dimensions", l.depends_on.0, s.dims.len()),
             ));
             continue;
         }
@@ -520,11 +456,7 @@ fn layers<S>(grid: Option<&ParameterSpace>, oi: usize, o: &Object<S>, has_mesh: 
         if l.blocks.len() as u64 != grid.block_count() {
             out.push(e(
                 6005,
-                format!(
-                    "{} blocks, the grid has {}",
-                    l.blocks.len(),
-                    grid.block_count()
-                ),
+                format!("{} blocks, the grid has {}", l.blocks.len(), grid.block_count()),
             ));
             continue;
         }
@@ -552,12 +484,9 @@ fn layers<S>(grid: Option<&ParameterSpace>, oi: usize, o: &Object<S>, has_mesh: 
                     }
                 }
             }
-            pyramid(
-                &grid.extent(bi),
-                l.depends_on.count(),
-                &b.levels,
-                &mut |id, d| out.push(e(id, d)),
-            );
+            pyramid(&grid.extent(bi), l.depends_on.count(), &b.levels, &mut |id, d| {
+                out.push(e(id, d))
+            });
         }
     }
 }
@@ -574,15 +503,7 @@ fn placement(p: &Placement, mapping: Mapping) -> Option<String> {
             (!finite(affine) || det == 0.0 || !det.is_finite())
                 .then(|| format!("affine {affine:?} is not invertible"))
         }
-        (
-            Placement::Shell {
-                shape,
-                origin,
-                params,
-                ..
-            },
-            Mapping::Shell,
-        ) => {
+        (Placement::Shell { shape, origin, params, .. }, Mapping::Shell) => {
             if !finite(origin) || !finite(params) {
                 return Some(format!("{} with non-finite values", shape.name()));
             }
@@ -606,12 +527,7 @@ fn placement(p: &Placement, mapping: Mapping) -> Option<String> {
                     c.iter().any(|&x| x != 0.0)
                 }
             };
-            (!ok).then(|| {
-                format!(
-                    "{} parameters {params:?} with origin {origin:?}",
-                    shape.name()
-                )
-            })
+            (!ok).then(|| format!("{} parameters {params:?} with origin {origin:?}", shape.name()))
         }
         (Placement::Surface { .. }, Mapping::Shell) => {
             Some("a shell layer's block has no shell shape".into())
@@ -625,14 +541,14 @@ fn placement(p: &Placement, mapping: Mapping) -> Option<String> {
 /// Rules 7001–7004 for one block's levels.
 fn pyramid<S>(extent: &[u32], dims: usize, levels: &[Level<S>], push: &mut dyn FnMut(u16, String)) {
     if levels.is_empty() || levels.len() > MAX_LEVELS {
-        push(
-            7001,
-            format!("{} levels, expected 1 to {MAX_LEVELS}", levels.len()),
-        );
+        push(7001, format!("{} levels, expected 1 to {MAX_LEVELS}", levels.len()));
         return;
     }
     if dims == 0 && levels.len() > 1 {
-        push(7005, format!("{} levels; a layer with dependency mask 0 has exactly 1", levels.len()));
+        push(
+            7005,
+            format!("{} levels; a layer with dependency mask 0 has exactly 1", levels.len()),
+        );
     }
     for (lv, level) in levels.iter().enumerate() {
         let images: u64 = level.counts.iter().map(|&c| c as u64).product();
@@ -656,36 +572,17 @@ fn pyramid<S>(extent: &[u32], dims: usize, levels: &[Level<S>], push: &mut dyn F
         if bad {
             push(
                 7003,
-                format!(
-                    "level {} counts {:?} after {:?}",
-                    lv + 1,
-                    w[1].counts,
-                    w[0].counts
-                ),
+                format!("level {} counts {:?} after {:?}", lv + 1, w[1].counts, w[0].counts),
             );
         }
     }
     for (lv, level) in levels.iter().enumerate() {
-        if level
-            .counts
-            .iter()
-            .zip(extent)
-            .any(|(&c, &e)| c == 0 || c > e)
-        {
-            push(
-                7003,
-                format!(
-                    "level {lv} counts {:?} for block extent {extent:?}",
-                    level.counts
-                ),
-            );
+        if level.counts.iter().zip(extent).any(|(&c, &e)| c == 0 || c > e) {
+            push(7003, format!("level {lv} counts {:?} for block extent {extent:?}", level.counts));
         }
     }
     let last = &levels[levels.len() - 1].counts;
     if last.as_slice() != extent {
-        push(
-            7004,
-            format!("finest level counts {last:?}, block extent {extent:?}"),
-        );
+        push(7004, format!("finest level counts {last:?}, block extent {extent:?}"));
     }
 }

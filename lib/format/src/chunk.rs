@@ -38,62 +38,14 @@ pub struct ChunkRule {
 }
 
 pub const KNOWN: [ChunkRule; 8] = [
-    ChunkRule {
-        fourcc: PSPC,
-        required: true,
-        min: 1,
-        max: Some(1),
-        malformed: 4000,
-    },
-    ChunkRule {
-        fourcc: CAMS,
-        required: true,
-        min: 1,
-        max: Some(1),
-        malformed: 5000,
-    },
-    ChunkRule {
-        fourcc: OBJS,
-        required: true,
-        min: 1,
-        max: Some(1),
-        malformed: 5100,
-    },
-    ChunkRule {
-        fourcc: MESH,
-        required: true,
-        min: 1,
-        max: None,
-        malformed: 5200,
-    },
-    ChunkRule {
-        fourcc: LAYR,
-        required: true,
-        min: 1,
-        max: Some(1),
-        malformed: 6000,
-    },
-    ChunkRule {
-        fourcc: CSTR,
-        required: true,
-        min: 0,
-        max: None,
-        malformed: 8002,
-    },
-    ChunkRule {
-        fourcc: PROV,
-        required: false,
-        min: 0,
-        max: Some(1),
-        malformed: 9000,
-    },
-    ChunkRule {
-        fourcc: MSTR,
-        required: false,
-        min: 0,
-        max: None,
-        malformed: 9100,
-    },
+    ChunkRule { fourcc: PSPC, required: true, min: 1, max: Some(1), malformed: 4000 },
+    ChunkRule { fourcc: CAMS, required: true, min: 1, max: Some(1), malformed: 5000 },
+    ChunkRule { fourcc: OBJS, required: true, min: 1, max: Some(1), malformed: 5100 },
+    ChunkRule { fourcc: MESH, required: true, min: 1, max: None, malformed: 5200 },
+    ChunkRule { fourcc: LAYR, required: true, min: 1, max: Some(1), malformed: 6000 },
+    ChunkRule { fourcc: CSTR, required: true, min: 0, max: None, malformed: 8002 },
+    ChunkRule { fourcc: PROV, required: false, min: 0, max: Some(1), malformed: 9000 },
+    ChunkRule { fourcc: MSTR, required: false, min: 0, max: None, malformed: 9100 },
 ];
 
 pub fn rule(fourcc: FourCC) -> Option<&'static ChunkRule> {
@@ -103,13 +55,15 @@ pub fn rule(fourcc: FourCC) -> Option<&'static ChunkRule> {
 /// The chunk type as text (non-printable bytes escaped).
 pub fn fourcc_str(f: FourCC) -> String {
     f.iter()
-        .map(|&b| {
-            if b.is_ascii_graphic() {
-                (b as char).to_string()
-            } else {
-                format!("\\x{b:02x}")
-            }
-        })
+        .map(
+            |&b| {
+                if b.is_ascii_graphic() {
+                    (b as char).to_string()
+                } else {
+                    format!("\\x{b:02x}")
+                }
+            },
+        )
         .collect()
 }
 
@@ -177,10 +131,7 @@ pub fn parse_header(b: &[u8], actual_len: u64) -> Result<Header, Issue> {
     if h.major != VERSION_MAJOR {
         return Err(Issue::new(
             2002,
-            format!(
-                "major version {}, this reader reads {VERSION_MAJOR}",
-                h.major
-            ),
+            format!("major version {}, this reader reads {VERSION_MAJOR}", h.major),
         )
         .at(8));
     }
@@ -194,17 +145,13 @@ pub fn parse_header(b: &[u8], actual_len: u64) -> Result<Header, Issue> {
         )
         .at(16));
     }
-    let table_end = (h.chunk_count as u64)
-        .checked_mul(ENTRY_LEN)
-        .and_then(|t| t.checked_add(HEADER_LEN));
+    let table_end =
+        (h.chunk_count as u64).checked_mul(ENTRY_LEN).and_then(|t| t.checked_add(HEADER_LEN));
     match table_end {
         Some(end) if end <= actual_len => Ok(h),
         _ => Err(Issue::new(
             2005,
-            format!(
-                "{} chunk entries do not fit in {actual_len} bytes",
-                h.chunk_count
-            ),
+            format!("{} chunk entries do not fit in {actual_len} bytes", h.chunk_count),
         )
         .at(24)),
     }
@@ -228,22 +175,13 @@ pub fn parse_table(
 ) -> Vec<ChunkEntry> {
     if h.flags != 0 {
         issues.push(
-            Issue::new(
-                2003,
-                format!("flags are {:#x}, version 1 defines none", h.flags),
-            )
-            .at(12),
+            Issue::new(2003, format!("flags are {:#x}, version 1 defines none", h.flags)).at(12),
         );
     }
     let crc = header_crc(header_bytes, table);
     if crc != h.crc {
-        issues.push(
-            Issue::new(
-                2004,
-                format!("stored {:#010x}, computed {crc:#010x}", h.crc),
-            )
-            .at(28),
-        );
+        issues
+            .push(Issue::new(2004, format!("stored {:#010x}, computed {crc:#010x}", h.crc)).at(28));
     }
     let mut entries = Vec::with_capacity(h.chunk_count as usize);
     let table_end = HEADER_LEN + h.chunk_count as u64 * ENTRY_LEN;
@@ -278,29 +216,17 @@ pub fn parse_table(
                 )
                 .at(at + 4),
             ),
-            None if entry.required() => issues.push(
-                tag(
-                    3007,
-                    format!("chunk type '{name}' is not defined by version 1"),
-                )
-                .at(at),
-            ),
+            None if entry.required() => issues
+                .push(tag(3007, format!("chunk type '{name}' is not defined by version 1")).at(at)),
             _ => {}
         }
         if entry.offset % ALIGN != 0 {
             issues.push(
-                tag(
-                    3001,
-                    format!("offset {} is not a multiple of {ALIGN}", entry.offset),
-                )
-                .at(at + 8),
+                tag(3001, format!("offset {} is not a multiple of {ALIGN}", entry.offset))
+                    .at(at + 8),
             );
         }
-        if entry
-            .offset
-            .checked_add(entry.length)
-            .is_none_or(|end| end > h.file_length)
-        {
+        if entry.offset.checked_add(entry.length).is_none_or(|end| end > h.file_length) {
             issues.push(
                 tag(
                     3002,
@@ -333,10 +259,7 @@ pub fn parse_table(
         issues.push(
             Issue::new(
                 3011,
-                format!(
-                    "last chunk ends at {prev_end}, the file at {}",
-                    h.file_length
-                ),
+                format!("last chunk ends at {prev_end}, the file at {}", h.file_length),
             )
             .at(prev_end),
         );
@@ -351,10 +274,7 @@ pub fn parse_table(
         if r.max.is_some_and(|m| n > m) {
             issues.push(Issue::new(
                 3009,
-                format!(
-                    "{n} '{name}' chunks, at most {} allowed",
-                    r.max.unwrap_or(0)
-                ),
+                format!("{n} '{name}' chunks, at most {} allowed", r.max.unwrap_or(0)),
             ));
         }
     }

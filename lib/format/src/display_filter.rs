@@ -50,17 +50,28 @@ impl DisplayFilter {
     /// `display_filter` setting; an error naming what is wrong for an unknown filter, a
     /// missing or malformed σ or R, or σ or R without `display_filter`.
     pub fn of(p: Option<&Provenance>) -> Result<Option<DisplayFilter>, String> {
-        let get = |k: &str| p.and_then(|p| p.settings.iter().find(|(key, _)| key == k)).map(|(_, v)| v.as_str());
+        let get = |k: &str| {
+            p.and_then(|p| p.settings.iter().find(|(key, _)| key == k)).map(|(_, v)| v.as_str())
+        };
         let number = |k: &str| -> Result<f32, String> {
-            let v = get(k).ok_or_else(|| format!("{DISPLAY_FILTER_SETTING} \"gaussian\" without a {k} setting"))?;
+            let v = get(k).ok_or_else(|| {
+                format!("{DISPLAY_FILTER_SETTING} \"gaussian\" without a {k} setting")
+            })?;
             v.trim().parse::<f32>().map_err(|_| format!("{k} {v:?} is not a decimal number"))
         };
         match get(DISPLAY_FILTER_SETTING) {
-            None => match [DISPLAY_FILTER_SIGMA_SETTING, DISPLAY_FILTER_RADIUS_SETTING].into_iter().find(|k| get(k).is_some()) {
+            None => match [DISPLAY_FILTER_SIGMA_SETTING, DISPLAY_FILTER_RADIUS_SETTING]
+                .into_iter()
+                .find(|k| get(k).is_some())
+            {
                 Some(k) => Err(format!("{k} without a {DISPLAY_FILTER_SETTING} setting")),
                 None => Ok(None),
             },
-            Some("gaussian") => DisplayFilter::new(number(DISPLAY_FILTER_SIGMA_SETTING)?, number(DISPLAY_FILTER_RADIUS_SETTING)?).map(Some),
+            Some("gaussian") => DisplayFilter::new(
+                number(DISPLAY_FILTER_SIGMA_SETTING)?,
+                number(DISPLAY_FILTER_RADIUS_SETTING)?,
+            )
+            .map(Some),
             Some(other) => Err(format!("unknown {DISPLAY_FILTER_SETTING} {other:?} (gaussian)")),
         }
     }
@@ -73,7 +84,10 @@ mod tests {
 
     #[test]
     fn settings_round_trip() {
-        for f in [DisplayFilter { sigma_px: 0.5, radius_px: 1.5 }, DisplayFilter { sigma_px: 0.3333, radius_px: 2.0 }] {
+        for f in [
+            DisplayFilter { sigma_px: 0.5, radius_px: 1.5 },
+            DisplayFilter { sigma_px: 0.3333, radius_px: 2.0 },
+        ] {
             let s = f.settings();
             let p = prov(&s.iter().map(|(k, v)| (k.as_str(), v.as_str())).collect::<Vec<_>>());
             assert_eq!(DisplayFilter::of(Some(&p)), Ok(Some(f)));
@@ -87,7 +101,11 @@ mod tests {
         let g = ("display_filter", "gaussian");
         for bad in [
             vec![("display_filter", "box")],
-            vec![("display_filter", "Gaussian"), ("display_filter_sigma_px", "0.5"), ("display_filter_radius_px", "1.5")],
+            vec![
+                ("display_filter", "Gaussian"),
+                ("display_filter_sigma_px", "0.5"),
+                ("display_filter_radius_px", "1.5"),
+            ],
             vec![g],
             vec![g, ("display_filter_sigma_px", "0.5")],
             vec![g, ("display_filter_radius_px", "1.5")],

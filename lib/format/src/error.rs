@@ -7,10 +7,7 @@ use crate::Issue;
 pub enum Error {
     /// The file system failed.
     #[error("{path}: {source}")]
-    Io {
-        path: PathBuf,
-        source: std::io::Error,
-    },
+    Io { path: PathBuf, source: std::io::Error },
     /// The file breaks a rule of the spec.
     #[error("{0}")]
     Invalid(Issue),

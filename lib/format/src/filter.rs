@@ -47,17 +47,26 @@ impl FileFilter {
     /// setting; an error naming what is wrong for an unknown name, or an `anisotropic`
     /// filter without an anisotropy of 1 to 16.
     pub fn of(p: Option<&Provenance>) -> Result<FileFilter, String> {
-        let get = |k: &str| p.and_then(|p| p.settings.iter().find(|(key, _)| key == k)).map(|(_, v)| v.as_str());
+        let get = |k: &str| {
+            p.and_then(|p| p.settings.iter().find(|(key, _)| key == k)).map(|(_, v)| v.as_str())
+        };
         match get(FILTER_SETTING) {
             None | Some("trilinear") => Ok(FileFilter::Trilinear),
             Some("nearest") => Ok(FileFilter::Nearest),
             Some("bilinear") => Ok(FileFilter::Bilinear),
             Some("anisotropic") => match get(ANISOTROPY_SETTING).map(|v| v.parse::<u8>()) {
                 Some(Ok(n)) if (1..=MAX_ANISOTROPY).contains(&n) => Ok(FileFilter::Anisotropic(n)),
-                Some(_) => Err(format!("{ANISOTROPY_SETTING} {:?} is not an integer from 1 to {MAX_ANISOTROPY}", get(ANISOTROPY_SETTING).unwrap_or(""))),
-                None => Err(format!("filter \"anisotropic\" without an {ANISOTROPY_SETTING} setting")),
+                Some(_) => Err(format!(
+                    "{ANISOTROPY_SETTING} {:?} is not an integer from 1 to {MAX_ANISOTROPY}",
+                    get(ANISOTROPY_SETTING).unwrap_or("")
+                )),
+                None => {
+                    Err(format!("filter \"anisotropic\" without an {ANISOTROPY_SETTING} setting"))
+                }
             },
-            Some(other) => Err(format!("unknown filter {other:?} (nearest, bilinear, trilinear or anisotropic)")),
+            Some(other) => Err(format!(
+                "unknown filter {other:?} (nearest, bilinear, trilinear or anisotropic)"
+            )),
         }
     }
 }
@@ -78,7 +87,13 @@ pub(crate) mod tests {
 
     #[test]
     fn settings_round_trip() {
-        for f in [FileFilter::Nearest, FileFilter::Bilinear, FileFilter::Trilinear, FileFilter::Anisotropic(1), FileFilter::Anisotropic(16)] {
+        for f in [
+            FileFilter::Nearest,
+            FileFilter::Bilinear,
+            FileFilter::Trilinear,
+            FileFilter::Anisotropic(1),
+            FileFilter::Anisotropic(16),
+        ] {
             let s = f.settings();
             let p = prov(&s.iter().map(|(k, v)| (k.as_str(), v.as_str())).collect::<Vec<_>>());
             assert_eq!(FileFilter::of(Some(&p)), Ok(f));

@@ -17,13 +17,7 @@ pub fn annotate(bytes: &[u8], spans: &[Span]) -> String {
                 label.truncate(87);
                 label.push_str("...");
             }
-            let _ = writeln!(
-                out,
-                "{:08x}  {:<47}  {}",
-                s.start + 16 * i,
-                hex.join(" "),
-                label
-            );
+            let _ = writeln!(out, "{:08x}  {:<47}  {}", s.start + 16 * i, hex.join(" "), label);
         }
     }
     out
@@ -36,16 +30,10 @@ pub fn parse(dump: &str) -> Vec<u8> {
         let Some(rest) = line.get(10..57) else {
             continue;
         };
-        if !line
-            .get(..8)
-            .is_some_and(|o| o.chars().all(|c| c.is_ascii_hexdigit()))
-        {
+        if !line.get(..8).is_some_and(|o| o.chars().all(|c| c.is_ascii_hexdigit())) {
             continue;
         }
-        out.extend(
-            rest.split_whitespace()
-                .filter_map(|h| u8::from_str_radix(h, 16).ok()),
-        );
+        out.extend(rest.split_whitespace().filter_map(|h| u8::from_str_radix(h, 16).ok()));
     }
     out
 }

@@ -28,20 +28,11 @@ pub struct Issue {
 
 impl Issue {
     pub fn new(id: u16, detail: impl Into<String>) -> Self {
-        Issue {
-            id,
-            severity: Severity::Error,
-            chunk: None,
-            offset: None,
-            detail: detail.into(),
-        }
+        Issue { id, severity: Severity::Error, chunk: None, offset: None, detail: detail.into() }
     }
 
     pub fn warning(id: u16, detail: impl Into<String>) -> Self {
-        Issue {
-            severity: Severity::Warning,
-            ..Issue::new(id, detail)
-        }
+        Issue { severity: Severity::Warning, ..Issue::new(id, detail) }
     }
 
     pub fn at(mut self, offset: u64) -> Self {
@@ -177,9 +168,5 @@ pub const RULES: &[(u16, &str)] = &[
 
 /// The short message of rule `id` ("unknown rule" for ids not in [`RULES`]).
 pub fn summary(id: u16) -> &'static str {
-    RULES
-        .iter()
-        .find(|(i, _)| *i == id)
-        .map(|(_, m)| *m)
-        .unwrap_or("unknown rule")
+    RULES.iter().find(|(i, _)| *i == id).map(|(_, m)| *m).unwrap_or("unknown rule")
 }

@@ -13,8 +13,8 @@ mod binary;
 pub mod blocks;
 pub mod checks;
 pub mod chunk;
-mod error;
 pub mod display_filter;
+mod error;
 pub mod filter;
 pub mod hexdump;
 pub mod issue;
@@ -33,8 +33,8 @@ mod validate;
 mod write;
 
 pub use binary::Span;
-pub use error::Error;
 pub use display_filter::DisplayFilter;
+pub use error::Error;
 pub use filter::FileFilter;
 pub use issue::{Issue, Severity};
 pub use master::{Master, MasterLayer};
@@ -44,6 +44,7 @@ pub use read::{PisReader, ReadStats};
 pub use texture::{LevelLayout, Texture};
 pub use validate::{validate_bytes, validate_file, Validation};
 pub use write::{
-    to_bytes, to_bytes_labelled, to_bytes_labelled_with_masters, to_bytes_unchecked, to_bytes_unchecked_with_masters, to_bytes_with_masters, write,
-    write_atomic, write_with_masters,
+    to_bytes, to_bytes_labelled, to_bytes_labelled_with_masters, to_bytes_unchecked,
+    to_bytes_unchecked_with_masters, to_bytes_with_masters, write, write_atomic,
+    write_with_masters,
 };

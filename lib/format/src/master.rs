@@ -60,7 +60,12 @@ pub fn sample_point<S>(c: &Container<S>, layer: &Layer<S>, mut index: u64) -> Ve
 }
 
 /// The planes of sample `index` of layer `layer` of `o`: those of the block holding it.
-pub fn sample_layout<S>(c: &Container<S>, o: &Object<S>, layer: usize, index: u64) -> Option<LevelLayout> {
+pub fn sample_layout<S>(
+    c: &Container<S>,
+    o: &Object<S>,
+    layer: usize,
+    index: u64,
+) -> Option<LevelLayout> {
     let l = o.layers.get(layer)?;
     let point = sample_point(c, l, index);
     let block = BlockGrid::new(&c.space, l.depends_on, &o.stagger).locate(&point).block;
@@ -73,35 +78,79 @@ impl Master {
     ///
     /// `weights`, when given, are each sample's screen weights (one value per texel of its
     /// finest texture), in the same order.
-    pub fn encode<S>(c: &Container<S>, object: usize, area: f64, textures: &[Vec<Vec<f32>>], weights: Option<&[Vec<Vec<f32>>]>) -> Result<Master, Error> {
-        let o = c.objects.get(object).ok_or_else(|| Error::Request(format!("object {object} does not exist")))?;
+    pub fn encode<S>(
+        c: &Container<S>,
+        object: usize,
+        area: f64,
+        textures: &[Vec<Vec<f32>>],
+        weights: Option<&[Vec<Vec<f32>>]>,
+    ) -> Result<Master, Error> {
+        let o = c
+            .objects
+            .get(object)
+            .ok_or_else(|| Error::Request(format!("object {object} does not exist")))?;
         if textures.len() != o.layers.len() {
-            return Err(Error::Request(format!("object {object} has {} layers, the master {}", o.layers.len(), textures.len())));
+            return Err(Error::Request(format!(
+                "object {object} has {} layers, the master {}",
+                o.layers.len(),
+                textures.len()
+            )));
         }
-        let codec = pis_codec::codec(CodecId::Lossless).ok_or_else(|| Error::NotSupported("codec 'lossless'".into()))?;
+        let codec = pis_codec::codec(CodecId::Lossless)
+            .ok_or_else(|| Error::NotSupported("codec 'lossless'".into()))?;
         let mut layers = Vec::with_capacity(textures.len());
         for (li, (l, t)) in o.layers.iter().zip(textures).enumerate() {
             let want = c.space.table_len(l.depends_on);
             if t.len() as u64 != want {
-                return Err(Error::Request(format!("object {object} layer {li}: {} master textures, the layer has {want} samples", t.len())));
+                return Err(Error::Request(format!(
+                    "object {object} layer {li}: {} master textures, the layer has {want} samples",
+                    t.len()
+                )));
             }
-            let samples = t.iter().enumerate().map(|(s, x)| {
-                let layout = sample_layout(c, o, li, s as u64).ok_or_else(|| Error::Request(format!("object {object} layer {li}: no block holds sample {s}")))?;
-                codec.encode(&layout.planes(), x, Rate::Default)
-                    .map_err(|e| Error::Request(format!("object {object} layer {li} sample {s}: {e}")))
-            }).collect::<Result<Vec<_>, Error>>()?;
+            let samples = t
+                .iter()
+                .enumerate()
+                .map(|(s, x)| {
+                    let layout = sample_layout(c, o, li, s as u64).ok_or_else(|| {
+                        Error::Request(format!(
+                            "object {object} layer {li}: no block holds sample {s}"
+                        ))
+                    })?;
+                    codec.encode(&layout.planes(), x, Rate::Default).map_err(|e| {
+                        Error::Request(format!("object {object} layer {li} sample {s}: {e}"))
+                    })
+                })
+                .collect::<Result<Vec<_>, Error>>()?;
             let weights = match weights.map(|w| w.get(li)) {
                 None => Vec::new(),
-                Some(None) => return Err(Error::Request(format!("object {object} layer {li}: no screen weights"))),
+                Some(None) => {
+                    return Err(Error::Request(format!(
+                        "object {object} layer {li}: no screen weights"
+                    )))
+                }
                 Some(Some(w)) => {
                     if w.len() != t.len() {
-                        return Err(Error::Request(format!("object {object} layer {li}: {} screen weight maps for {} samples", w.len(), t.len())));
+                        return Err(Error::Request(format!(
+                            "object {object} layer {li}: {} screen weight maps for {} samples",
+                            w.len(),
+                            t.len()
+                        )));
                     }
-                    w.iter().enumerate().map(|(s, x)| {
-                        let layout = sample_layout(c, o, li, s as u64).ok_or_else(|| Error::Request(format!("object {object} layer {li}: no block holds sample {s}")))?;
-                        codec.encode(&[weight_plane(&layout)], x, Rate::Default)
-                            .map_err(|e| Error::Request(format!("object {object} layer {li} sample {s} screen weights: {e}")))
-                    }).collect::<Result<Vec<_>, Error>>()?
+                    w.iter()
+                        .enumerate()
+                        .map(|(s, x)| {
+                            let layout = sample_layout(c, o, li, s as u64).ok_or_else(|| {
+                                Error::Request(format!(
+                                    "object {object} layer {li}: no block holds sample {s}"
+                                ))
+                            })?;
+                            codec.encode(&[weight_plane(&layout)], x, Rate::Default).map_err(|e| {
+                                Error::Request(format!(
+                                    "object {object} layer {li} sample {s} screen weights: {e}"
+                                ))
+                            })
+                        })
+                        .collect::<Result<Vec<_>, Error>>()?
                 }
             };
             layers.push(MasterLayer { codec: CodecId::Lossless, samples, weights });
@@ -111,50 +160,93 @@ impl Master {
 
     /// The linear values of sample `sample` of layer `layer`, decoded and checked (rules
     /// 9105 and 9106). `c` is the container the master belongs to.
-    pub fn texture<S>(&self, c: &Container<S>, layer: usize, sample: usize) -> Result<Vec<f32>, Error> {
+    pub fn texture<S>(
+        &self,
+        c: &Container<S>,
+        layer: usize,
+        sample: usize,
+    ) -> Result<Vec<f32>, Error> {
         let what = format!("master of object {} layer {layer} sample {sample}", self.object);
-        let (o, l) = c.objects.get(self.object as usize)
+        let (o, l) = c
+            .objects
+            .get(self.object as usize)
             .and_then(|o| self.layers.get(layer).map(|l| (o, l)))
             .ok_or_else(|| Error::Request(format!("{what} does not exist")))?;
-        let bytes = l.samples.get(sample).ok_or_else(|| Error::Request(format!("{what} does not exist")))?;
-        let layout = sample_layout(c, o, layer, sample as u64).ok_or_else(|| Error::Request(format!("{what}: no block holds it")))?;
+        let bytes = l
+            .samples
+            .get(sample)
+            .ok_or_else(|| Error::Request(format!("{what} does not exist")))?;
+        let layout = sample_layout(c, o, layer, sample as u64)
+            .ok_or_else(|| Error::Request(format!("{what}: no block holds it")))?;
         let values = pis_codec::decode(l.codec, &layout.planes(), bytes).map_err(|e| match e {
-            CodecError::NotSupported(codec) => Error::NotSupported(format!("codec '{codec}' ({what})")),
-            e => Error::Invalid(Issue::new(9105, format!("{what}: {e}")).in_chunk("MSTR", usize::MAX)),
+            CodecError::NotSupported(codec) => {
+                Error::NotSupported(format!("codec '{codec}' ({what})"))
+            }
+            e => Error::Invalid(
+                Issue::new(9105, format!("{what}: {e}")).in_chunk("MSTR", usize::MAX),
+            ),
         })?;
         if let Some(bad) = values.iter().position(|v| !v.is_finite()) {
-            return Err(Error::Invalid(Issue::new(9106, format!("{what}: value {bad} is {}", values[bad])).in_chunk("MSTR", usize::MAX)));
+            return Err(Error::Invalid(
+                Issue::new(9106, format!("{what}: value {bad} is {}", values[bad]))
+                    .in_chunk("MSTR", usize::MAX),
+            ));
         }
         Ok(values)
     }
 
     /// The screen weights of sample `sample` of layer `layer` (one per texel of its finest
     /// texture), decoded and checked (rule 9108); None where the layer carries none.
-    pub fn weights<S>(&self, c: &Container<S>, layer: usize, sample: usize) -> Result<Option<Vec<f32>>, Error> {
-        let what = format!("master of object {} layer {layer} sample {sample} screen weights", self.object);
-        let (o, l) = c.objects.get(self.object as usize)
+    pub fn weights<S>(
+        &self,
+        c: &Container<S>,
+        layer: usize,
+        sample: usize,
+    ) -> Result<Option<Vec<f32>>, Error> {
+        let what = format!(
+            "master of object {} layer {layer} sample {sample} screen weights",
+            self.object
+        );
+        let (o, l) = c
+            .objects
+            .get(self.object as usize)
             .and_then(|o| self.layers.get(layer).map(|l| (o, l)))
             .ok_or_else(|| Error::Request(format!("{what} do not exist")))?;
         if l.weights.is_empty() {
             return Ok(None);
         }
-        let bytes = l.weights.get(sample).ok_or_else(|| Error::Request(format!("{what} do not exist")))?;
-        let layout = sample_layout(c, o, layer, sample as u64).ok_or_else(|| Error::Request(format!("{what}: no block holds the sample")))?;
-        let values = pis_codec::decode(l.codec, &[weight_plane(&layout)], bytes).map_err(|e| match e {
-            CodecError::NotSupported(codec) => Error::NotSupported(format!("codec '{codec}' ({what})")),
-            e => Error::Invalid(Issue::new(9108, format!("{what}: {e}")).in_chunk("MSTR", usize::MAX)),
-        })?;
+        let bytes =
+            l.weights.get(sample).ok_or_else(|| Error::Request(format!("{what} do not exist")))?;
+        let layout = sample_layout(c, o, layer, sample as u64)
+            .ok_or_else(|| Error::Request(format!("{what}: no block holds the sample")))?;
+        let values =
+            pis_codec::decode(l.codec, &[weight_plane(&layout)], bytes).map_err(|e| match e {
+                CodecError::NotSupported(codec) => {
+                    Error::NotSupported(format!("codec '{codec}' ({what})"))
+                }
+                e => Error::Invalid(
+                    Issue::new(9108, format!("{what}: {e}")).in_chunk("MSTR", usize::MAX),
+                ),
+            })?;
         if let Some(bad) = values.iter().position(|v| !(v.is_finite() && *v >= 0.0)) {
-            return Err(Error::Invalid(Issue::new(9108, format!("{what}: value {bad} is {}", values[bad])).in_chunk("MSTR", usize::MAX)));
+            return Err(Error::Invalid(
+                Issue::new(9108, format!("{what}: value {bad} is {}", values[bad]))
+                    .in_chunk("MSTR", usize::MAX),
+            ));
         }
         Ok(Some(values))
     }
 
     /// Bytes of the master's payload in the file.
     pub fn payload_len(&self) -> u64 {
-        24 + self.layers.iter().map(|l| {
-            8 + l.samples.iter().map(|s| 4 + s.len() as u64).sum::<u64>() + l.weights.iter().map(|s| 4 + s.len() as u64).sum::<u64>()
-        }).sum::<u64>()
+        24 + self
+            .layers
+            .iter()
+            .map(|l| {
+                8 + l.samples.iter().map(|s| 4 + s.len() as u64).sum::<u64>()
+                    + l.weights.iter().map(|s| 4 + s.len() as u64).sum::<u64>()
+            })
+            .sum::<u64>()
     }
 }
 
@@ -163,8 +255,7 @@ fn weight_plane(layout: &LevelLayout) -> PlaneShape {
     PlaneShape::new(layout.width, layout.height, 1)
 }
 
-impl Master {
-}
+impl Master {}
 
 /// Writes a master's payload.
 pub(crate) fn write(s: &mut Sink, m: &Master) {
@@ -175,7 +266,10 @@ pub(crate) fn write(s: &mut Sink, m: &Master) {
     s.u32(0, "master reserved");
     for (li, l) in m.layers.iter().enumerate() {
         s.u8(l.codec.code() as u8, &format!("master layer {li} codec"));
-        s.u8(if l.weights.is_empty() { 0 } else { HAS_WEIGHTS }, &format!("master layer {li} flags"));
+        s.u8(
+            if l.weights.is_empty() { 0 } else { HAS_WEIGHTS },
+            &format!("master layer {li} flags"),
+        );
         s.zeros(2, &format!("master layer {li} reserved"));
         s.u32(l.samples.len() as u32, &format!("master layer {li} sample count"));
         for (si, b) in l.samples.iter().enumerate() {
@@ -183,7 +277,9 @@ pub(crate) fn write(s: &mut Sink, m: &Master) {
             s.raw(b, || format!("master layer {li} sample {si} codestream ({} bytes)", b.len()));
             if let Some(w) = l.weights.get(si) {
                 s.u32(w.len() as u32, &format!("master layer {li} sample {si} weights length"));
-                s.raw(w, || format!("master layer {li} sample {si} screen weights ({} bytes)", w.len()));
+                s.raw(w, || {
+                    format!("master layer {li} sample {si} screen weights ({} bytes)", w.len())
+                });
             }
         }
     }
@@ -203,11 +299,20 @@ pub(crate) fn parse(c: &mut Cursor) -> Result<Master, Issue> {
         let code = c.u8("codec id")?;
         let flags = c.u8("flags")?;
         if flags & !HAS_WEIGHTS != 0 {
-            c.flag(Issue::new(9100, format!("layer {li}: unknown flags {flags:#04x}")).in_chunk("MSTR", usize::MAX).at(at + 1))?;
+            c.flag(
+                Issue::new(9100, format!("layer {li}: unknown flags {flags:#04x}"))
+                    .in_chunk("MSTR", usize::MAX)
+                    .at(at + 1),
+            )?;
         }
         c.reserved(2, "reserved")?;
         let codec = CodecId::from_code(code as u16).filter(|k| !k.is_lossy()).ok_or_else(|| {
-            Issue::new(9103, format!("layer {li}: codec id {code}; a master uses raw (0) or lossless (1)")).in_chunk("MSTR", usize::MAX).at(at)
+            Issue::new(
+                9103,
+                format!("layer {li}: codec id {code}; a master uses raw (0) or lossless (1)"),
+            )
+            .in_chunk("MSTR", usize::MAX)
+            .at(at)
         })?;
         let count = c.u32("sample count")?;
         let count = c.expect_records(count as u64, 4, "master samples")?;
@@ -239,7 +344,13 @@ pub fn check<S>(c: &Container<S>, masters: &[Master]) -> Vec<Issue> {
         match seen.get_mut(oi) {
             Some(s @ false) => *s = true,
             _ => {
-                out.push(e(9101, format!("names object {oi}; {} objects, this one missing or already given a master", c.objects.len())));
+                out.push(e(
+                    9101,
+                    format!(
+                        "names object {oi}; {} objects, this one missing or already given a master",
+                        c.objects.len()
+                    ),
+                ));
                 continue;
             }
         }
@@ -248,7 +359,15 @@ pub fn check<S>(c: &Container<S>, masters: &[Master]) -> Vec<Issue> {
             out.push(e(9104, format!("object {oi} '{}': screen area {}", o.name, m.area)));
         }
         if m.layers.len() != o.layers.len() {
-            out.push(e(9102, format!("object {oi} '{}': {} master layers, the object has {}", o.name, m.layers.len(), o.layers.len())));
+            out.push(e(
+                9102,
+                format!(
+                    "object {oi} '{}': {} master layers, the object has {}",
+                    o.name,
+                    m.layers.len(),
+                    o.layers.len()
+                ),
+            ));
             continue;
         }
         for (li, (ml, l)) in m.layers.iter().zip(&o.layers).enumerate() {
@@ -257,16 +376,34 @@ pub fn check<S>(c: &Container<S>, masters: &[Master]) -> Vec<Issue> {
             }
             let want = c.space.table_len(l.depends_on);
             if ml.samples.len() as u64 != want {
-                out.push(e(9102, format!("object {oi} '{}' layer {li}: {} master samples, the layer has {want}", o.name, ml.samples.len())));
+                out.push(e(
+                    9102,
+                    format!(
+                        "object {oi} '{}' layer {li}: {} master samples, the layer has {want}",
+                        o.name,
+                        ml.samples.len()
+                    ),
+                ));
             }
             if !ml.weights.is_empty() && ml.weights.len() != ml.samples.len() {
-                out.push(e(9102, format!("object {oi} '{}' layer {li}: {} screen weight maps for {} master samples", o.name, ml.weights.len(), ml.samples.len())));
+                out.push(e(
+                    9102,
+                    format!(
+                        "object {oi} '{}' layer {li}: {} screen weight maps for {} master samples",
+                        o.name,
+                        ml.weights.len(),
+                        ml.samples.len()
+                    ),
+                ));
             }
         }
     }
     if !masters.is_empty() {
         if let Some(oi) = seen.iter().position(|&s| !s) {
-            out.push(e(9107, format!("object {oi} '{}' has no master while others have one", c.objects[oi].name)));
+            out.push(e(
+                9107,
+                format!("object {oi} '{}' has no master while others have one", c.objects[oi].name),
+            ));
         }
     }
     out
@@ -274,7 +411,13 @@ pub fn check<S>(c: &Container<S>, masters: &[Master]) -> Vec<Issue> {
 
 /// Reads, checksums, parses and checks every `MSTR` chunk of a file whose container parsed.
 /// With `decode`, also decodes every master texture (rules 9105, 9106).
-pub(crate) fn load<S>(src: &dyn Source, entries: &[ChunkEntry], c: &Container<S>, decode: bool, issues: &mut Vec<Issue>) -> Vec<Master> {
+pub(crate) fn load<S>(
+    src: &dyn Source,
+    entries: &[ChunkEntry],
+    c: &Container<S>,
+    decode: bool,
+    issues: &mut Vec<Issue>,
+) -> Vec<Master> {
     let mut masters = Vec::new();
     for (i, e) in entries.iter().enumerate().filter(|(_, e)| e.fourcc == chunk::MSTR) {
         // A chunk past the end of the file is reported by the table (rule 3002).
@@ -288,7 +431,11 @@ pub(crate) fn load<S>(src: &dyn Source, entries: &[ChunkEntry], c: &Container<S>
         }
         let crc = crc32fast::hash(&bytes);
         if crc != e.crc {
-            issues.push(Issue::new(3004, format!("stored {:#010x}, computed {crc:#010x}", e.crc)).in_chunk("MSTR", i).at(e.offset));
+            issues.push(
+                Issue::new(3004, format!("stored {:#010x}, computed {crc:#010x}", e.crc))
+                    .in_chunk("MSTR", i)
+                    .at(e.offset),
+            );
             continue;
         }
         let mut cursor = Cursor::new(&bytes, e.offset, 9100, ("MSTR", i)).collecting();

@@ -92,10 +92,7 @@ impl ParameterSpace {
 
     /// Number of entries of a table that depends on the dimensions in `mask`.
     pub fn table_len(&self, mask: DepMask) -> u64 {
-        mask.dims()
-            .filter_map(|k| self.dims.get(k))
-            .map(|d| d.values.len() as u64)
-            .product()
+        mask.dims().filter_map(|k| self.dims.get(k)).map(|d| d.values.len() as u64).product()
     }
 
     /// Index into a table that depends on `mask`, for the point with sample indices `point`
@@ -231,11 +228,7 @@ pub struct Shading {
 
 impl Default for Shading {
     fn default() -> Self {
-        Shading {
-            f0: [0.04; 3],
-            ior: 1.5,
-            absorption: [0.0; 3],
-        }
+        Shading { f0: [0.04; 3], ior: 1.5, absorption: [0.0; 3] }
     }
 }
 
@@ -250,10 +243,7 @@ pub struct TransformTable {
 impl TransformTable {
     /// A static object.
     pub fn fixed(t: [f32; 12]) -> Self {
-        TransformTable {
-            depends_on: DepMask::NONE,
-            transforms: vec![t],
-        }
+        TransformTable { depends_on: DepMask::NONE, transforms: vec![t] }
     }
 }
 
@@ -293,10 +283,7 @@ coded_enum! {
 impl LayerKind {
     /// True for the kinds drawn through an environment-map shell.
     pub fn is_shell(self) -> bool {
-        matches!(
-            self,
-            LayerKind::EnvLocal | LayerKind::EnvDistant | LayerKind::EnvShell
-        )
+        matches!(self, LayerKind::EnvLocal | LayerKind::EnvDistant | LayerKind::EnvShell)
     }
 }
 
@@ -367,11 +354,7 @@ pub struct Layer<S = Codestream> {
 impl Placement {
     /// A surface placement with the given transform, clamped in both directions.
     pub fn surface(affine: [f32; 6]) -> Self {
-        Placement::Surface {
-            affine,
-            repeat: [false; 2],
-            cut: [None; 2],
-        }
+        Placement::Surface { affine, repeat: [false; 2], cut: [None; 2] }
     }
 }
 
@@ -403,20 +386,11 @@ pub enum Placement {
     /// (no branch cut was made there); otherwise it is clamped to its edge.
     /// `cut[0]` / `cut[1]`: a branch cut along u / v (thesis 3.2): before the affine
     /// transform, each vertex's coordinate w becomes `(w − cut) − floor(w − cut)`.
-    Surface {
-        affine: [f32; 6],
-        repeat: [bool; 2],
-        cut: [Option<f32>; 2],
-    },
+    Surface { affine: [f32; 6], repeat: [bool; 2], cut: [Option<f32>; 2] },
     /// Environment-map shell geometry with its cube-map origin, and the lookups per pixel:
     /// `lookups` × `lookups` sub-pixel lookups averaged (1 to [`MAX_SHELL_LOOKUPS`]; SPEC.md
     /// 8.2), stored in the block's flags as `lookups − 1`.
-    Shell {
-        shape: ShellShape,
-        origin: [f32; 3],
-        params: [f32; 6],
-        lookups: u32,
-    },
+    Shell { shape: ShellShape, origin: [f32; 3], params: [f32; 6], lookups: u32 },
 }
 
 /// The most lookups per pixel side of a shell block (SPEC.md 7.3 flags, 8.2).
@@ -502,15 +476,9 @@ impl<S> Container<S> {
                 for b in &l.blocks {
                     let mut levels = Vec::with_capacity(b.levels.len());
                     for level in &b.levels {
-                        let images = level
-                            .images
-                            .iter()
-                            .map(&mut *f)
-                            .collect::<Result<Vec<_>, E>>()?;
-                        levels.push(Level {
-                            counts: level.counts.clone(),
-                            images,
-                        });
+                        let images =
+                            level.images.iter().map(&mut *f).collect::<Result<Vec<_>, E>>()?;
+                        levels.push(Level { counts: level.counts.clone(), images });
                     }
                     blocks.push(Block {
                         width: b.width,

@@ -27,11 +27,7 @@ pub fn pspc(c: &mut Cursor) -> Result<ParameterSpace, Issue> {
         let at = c.offset();
         let kind_code = c.u8("kind")?;
         let kind = DimensionKind::from_code(kind_code).ok_or_else(|| {
-            c.issue(
-                4003,
-                format!("dimension {k} kind {kind_code}; 0 to 4 are defined"),
-            )
-            .at(at)
+            c.issue(4003, format!("dimension {k} kind {kind_code}; 0 to 4 are defined")).at(at)
         })?;
         let flags = c.u8("flags")?;
         if flags & !1 != 0 {
@@ -46,14 +42,7 @@ pub fn pspc(c: &mut Cursor) -> Result<ParameterSpace, Issue> {
         for _ in 0..count {
             values.push(c.f32("sample value")?);
         }
-        dims.push(Dimension {
-            name,
-            kind,
-            periodic: flags & 1 != 0,
-            unit,
-            block_size,
-            values,
-        });
+        dims.push(Dimension { name, kind, periodic: flags & 1 != 0, unit, block_size, values });
     }
     c.finish()?;
     Ok(ParameterSpace { dims })
@@ -70,20 +59,10 @@ pub fn cams(c: &mut Cursor) -> Result<CameraTable, Issue> {
         let world_from_camera = c.f32s::<12>("world_from_camera")?;
         let [yfov, znear, zfar] = c.f32s::<3>("yfov, znear, zfar")?;
         c.reserved(4, "camera reserved")?;
-        cameras.push(Camera {
-            world_from_camera,
-            yfov,
-            znear,
-            zfar,
-        });
+        cameras.push(Camera { world_from_camera, yfov, znear, zfar });
     }
     c.finish()?;
-    Ok(CameraTable {
-        width,
-        height,
-        depends_on,
-        cameras,
-    })
+    Ok(CameraTable { width, height, depends_on, cameras })
 }
 
 /// Parses `OBJS`; meshes and layers are filled in from their own chunks.
@@ -101,11 +80,7 @@ pub fn objs(c: &mut Cursor, dim_count: usize) -> Result<Vec<Object<StreamRef>>, 
         let at = c.offset();
         let role_code = c.u8("role")?;
         let role = ObjectRole::from_code(role_code).ok_or_else(|| {
-            c.issue(
-                5103,
-                format!("object {i} role {role_code}; 0 to 2 are defined"),
-            )
-            .at(at)
+            c.issue(5103, format!("object {i} role {role_code}; 0 to 2 are defined")).at(at)
         })?;
         c.reserved(3, "object reserved")?;
         let f0 = c.f32s::<3>("f0")?;
@@ -125,16 +100,9 @@ pub fn objs(c: &mut Cursor, dim_count: usize) -> Result<Vec<Object<StreamRef>>, 
         objects.push(Object {
             name,
             role,
-            shading: Shading {
-                f0,
-                ior,
-                absorption,
-            },
+            shading: Shading { f0, ior, absorption },
             stagger,
-            transforms: TransformTable {
-                depends_on,
-                transforms,
-            },
+            transforms: TransformTable { depends_on, transforms },
             mesh: Mesh::default(),
             layers: Vec::new(),
         });
@@ -161,28 +129,21 @@ pub fn mesh(c: &mut Cursor) -> Result<(u32, Mesh), Issue> {
         (0..vc).map(|_| c.f32s::<3>(what)).collect()
     };
     let positions = read3(c, "position")?;
-    let normals = if attrs & MESH_NORMALS != 0 {
-        Some(read3(c, "normal")?)
-    } else {
-        None
-    };
+    let normals = if attrs & MESH_NORMALS != 0 { Some(read3(c, "normal")?) } else { None };
     let texcoords = if attrs & MESH_TEXCOORDS != 0 {
-        Some(
-            (0..vc)
-                .map(|_| c.f32s::<2>("texcoord"))
-                .collect::<Result<Vec<_>, _>>()?,
-        )
+        Some((0..vc).map(|_| c.f32s::<2>("texcoord")).collect::<Result<Vec<_>, _>>()?)
     } else {
         None
     };
     let ic = c.expect_records(ic as u64, 4, "indices")?;
-    let indices = (0..ic)
-        .map(|_| c.u32("index"))
-        .collect::<Result<Vec<_>, _>>()?;
+    let indices = (0..ic).map(|_| c.u32("index")).collect::<Result<Vec<_>, _>>()?;
     let hull_triangles = if attrs & MESH_HULL != 0 {
         let h = c.u32("hull triangles")?;
         if h == 0 {
-            let issue = c.issue(5200, "attribute bit 2 (hull) set with a hull triangle count of 0".to_string());
+            let issue = c.issue(
+                5200,
+                "attribute bit 2 (hull) set with a hull triangle count of 0".to_string(),
+            );
             c.flag(issue)?;
         }
         h
@@ -190,16 +151,7 @@ pub fn mesh(c: &mut Cursor) -> Result<(u32, Mesh), Issue> {
         0
     };
     c.finish()?;
-    Ok((
-        object,
-        Mesh {
-            positions,
-            normals,
-            texcoords,
-            indices,
-            hull_triangles,
-        },
-    ))
+    Ok((object, Mesh { positions, normals, texcoords, indices, hull_triangles }))
 }
 
 /// Parses `LAYR` into the objects' layer lists.
@@ -211,10 +163,7 @@ pub fn layr(c: &mut Cursor, objects: &mut [Object<StreamRef>]) -> Result<(), Iss
         let oi = c.u32("object index")? as usize;
         if oi >= objects.len() {
             return Err(c
-                .issue(
-                    6001,
-                    format!("layer {li} names object {oi}; there are {}", objects.len()),
-                )
+                .issue(6001, format!("layer {li} names object {oi}; there are {}", objects.len()))
                 .at(at));
         }
         let codes_at = c.offset();
@@ -227,8 +176,7 @@ pub fn layr(c: &mut Cursor, objects: &mut [Object<StreamRef>]) -> Result<(), Iss
         let combine = c.u8("combine")?;
         c.reserved(1, "layer reserved")?;
         let bad = |what: &str, v: u8| {
-            c.issue(6002, format!("layer {li} {what} {v} is not defined"))
-                .at(codes_at)
+            c.issue(6002, format!("layer {li} {what} {v} is not defined")).at(codes_at)
         };
         let kind = LayerKind::from_code(kind).ok_or_else(|| bad("kind", kind))?;
         let mapping = Mapping::from_code(mapping).ok_or_else(|| bad("mapping", mapping))?;
@@ -281,20 +229,18 @@ pub fn layr(c: &mut Cursor, objects: &mut [Object<StreamRef>]) -> Result<(), Iss
             };
             let unused = if shape == 0 {
                 // A branch-cut slot without its flag is unused too.
-                let cuts = [
-                    (flags & 4 == 0).then_some(values[6]),
-                    (flags & 8 == 0).then_some(values[7]),
-                ];
-                cuts.into_iter()
-                    .flatten()
-                    .chain(values[8..].iter().copied())
-                    .collect::<Vec<f32>>()
+                let cuts =
+                    [(flags & 4 == 0).then_some(values[6]), (flags & 8 == 0).then_some(values[7])];
+                cuts.into_iter().flatten().chain(values[8..].iter().copied()).collect::<Vec<f32>>()
             } else {
                 values[9..].to_vec()
             };
             if unused.iter().any(|v| v.to_bits() != 0) {
                 let issue = c
-                    .issue(3006, format!("layer {li} block {bi} unused placement values are not +0.0"))
+                    .issue(
+                        3006,
+                        format!("layer {li} block {bi} unused placement values are not +0.0"),
+                    )
                     .at(shape_at + 4);
                 c.flag(issue)?;
             }
@@ -320,33 +266,18 @@ pub fn layr(c: &mut Cursor, objects: &mut [Object<StreamRef>]) -> Result<(), Iss
                     let at = c.offset();
                     let code = c.u16("codec")?;
                     let codec = CodecId::from_code(code).ok_or_else(|| {
-                        c.issue(8004, format!("codec id {code}; 0 to 3 are defined"))
-                            .at(at)
+                        c.issue(8004, format!("codec id {code}; 0 to 3 are defined")).at(at)
                     })?;
                     c.reserved(2, "reference reserved")?;
                     let chunk = c.u32("chunk index")?;
                     let offset = c.u64("offset")?;
                     let length = c.u32("length")?;
                     let crc = c.u32("crc32")?;
-                    refs.push(StreamRef {
-                        codec,
-                        chunk,
-                        offset,
-                        length,
-                        crc,
-                    });
+                    refs.push(StreamRef { codec, chunk, offset, length, crc });
                 }
-                levels.push(Level {
-                    counts,
-                    images: refs,
-                });
+                levels.push(Level { counts, images: refs });
             }
-            blocks.push(Block {
-                width,
-                height,
-                placement,
-                levels,
-            });
+            blocks.push(Block { width, height, placement, levels });
         }
         objects[oi].layers.push(Layer {
             kind,
@@ -377,10 +308,5 @@ pub fn prov(c: &mut Cursor) -> Result<Provenance, Issue> {
         settings.push((k, v));
     }
     c.finish()?;
-    Ok(Provenance {
-        tool,
-        source,
-        raw_image_bytes,
-        settings,
-    })
+    Ok(Provenance { tool, source, raw_image_bytes, settings })
 }

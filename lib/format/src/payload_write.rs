@@ -26,14 +26,8 @@ pub fn cams(s: &mut Sink, t: &CameraTable) {
     s.u32(t.depends_on.0, "dependency mask");
     s.u32(t.cameras.len() as u32, "camera count");
     for (i, c) in t.cameras.iter().enumerate() {
-        s.f32s(
-            &c.world_from_camera,
-            &format!("camera {i} world_from_camera"),
-        );
-        s.f32s(
-            &[c.yfov, c.znear, c.zfar],
-            &format!("camera {i} yfov, znear, zfar"),
-        );
+        s.f32s(&c.world_from_camera, &format!("camera {i} world_from_camera"));
+        s.f32s(&[c.yfov, c.znear, c.zfar], &format!("camera {i} yfov, znear, zfar"));
         s.zeros(4, &format!("camera {i} reserved"));
     }
 }
@@ -51,14 +45,8 @@ pub fn objs<S>(s: &mut Sink, objects: &[Object<S>]) {
         for (k, off) in o.stagger.iter().enumerate() {
             s.u32(*off, &format!("{p} block origin offset, dimension {k}"));
         }
-        s.u32(
-            o.transforms.depends_on.0,
-            &format!("{p} transform dependency mask"),
-        );
-        s.u32(
-            o.transforms.transforms.len() as u32,
-            &format!("{p} transform count"),
-        );
+        s.u32(o.transforms.depends_on.0, &format!("{p} transform dependency mask"));
+        s.u32(o.transforms.transforms.len() as u32, &format!("{p} transform count"));
         for (t, m) in o.transforms.transforms.iter().enumerate() {
             s.f32s(m, &format!("{p} world_from_object {t}"));
         }
@@ -103,21 +91,12 @@ pub fn layr<S>(s: &mut Sink, objects: &[Object<S>], mut stream_ref: impl FnMut(&
             let p = format!("layer {li}");
             s.u32(oi as u32, &format!("{p} object index"));
             s.u8(l.kind.code(), &format!("{p} kind ({})", l.kind.name()));
-            s.u8(
-                l.mapping as u8,
-                &format!("{p} mapping ({})", l.mapping.name()),
-            );
+            s.u8(l.mapping as u8, &format!("{p} mapping ({})", l.mapping.name()));
             s.u8(l.channels, &format!("{p} channels"));
-            s.u8(
-                l.mip_mode as u8,
-                &format!("{p} mip mode ({})", l.mip_mode.name()),
-            );
+            s.u8(l.mip_mode as u8, &format!("{p} mip mode ({})", l.mip_mode.name()));
             s.u8(l.term as u8, &format!("{p} term ({})", l.term.name()));
             s.u8(l.order, &format!("{p} order"));
-            s.u8(
-                l.combine as u8,
-                &format!("{p} combine ({})", l.combine.name()),
-            );
+            s.u8(l.combine as u8, &format!("{p} combine ({})", l.combine.name()));
             s.zeros(1, &format!("{p} reserved"));
             s.f32s(&[l.gamma], &format!("{p} gamma"));
             s.u32(l.depends_on.0, &format!("{p} dependency mask"));
@@ -127,11 +106,7 @@ pub fn layr<S>(s: &mut Sink, objects: &[Object<S>], mut stream_ref: impl FnMut(&
                 s.u32(b.width, &format!("{p} width"));
                 s.u32(b.height, &format!("{p} height"));
                 match b.placement {
-                    Placement::Surface {
-                        affine,
-                        repeat,
-                        cut,
-                    } => {
+                    Placement::Surface { affine, repeat, cut } => {
                         s.u16(0, &format!("{p} shell shape (none)"));
                         let bits = repeat[0] as u16
                             | (repeat[1] as u16) << 1
@@ -148,14 +123,12 @@ pub fn layr<S>(s: &mut Sink, objects: &[Object<S>], mut stream_ref: impl FnMut(&
                         );
                         s.zeros(16, &format!("{p} unused placement values"));
                     }
-                    Placement::Shell {
-                        shape,
-                        origin,
-                        params,
-                        lookups,
-                    } => {
+                    Placement::Shell { shape, origin, params, lookups } => {
                         s.u16(shape as u16, &format!("{p} shell shape ({})", shape.name()));
-                        s.u16(lookups.saturating_sub(1) as u16, &format!("{p} flags (lookups per pixel side − 1)"));
+                        s.u16(
+                            lookups.saturating_sub(1) as u16,
+                            &format!("{p} flags (lookups per pixel side − 1)"),
+                        );
                         s.f32s(&origin, &format!("{p} shell origin"));
                         s.f32s(&params, &format!("{p} shell parameters"));
                         s.zeros(12, &format!("{p} unused placement values"));

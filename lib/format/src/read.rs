@@ -16,10 +16,10 @@ use pis_codec::CodecError;
 use crate::binary::Cursor;
 use crate::blocks::{level_image_index, BlockGrid};
 use crate::chunk::{self, ChunkEntry, Header, ENTRY_LEN, HEADER_LEN};
+use crate::master::Master;
 use crate::model::*;
 use crate::source::{FileSource, Source};
 use crate::texture::{LevelLayout, Texture};
-use crate::master::Master;
 use crate::{checks, payload_read as pr, reconstruct, Error, Issue, Severity};
 
 /// An open `.pis` file.
@@ -53,10 +53,7 @@ pub(crate) struct Loaded {
 impl PisReader {
     /// Opens and checks `path`.
     pub fn open(path: &Path) -> Result<Self, Error> {
-        let io = |source| Error::Io {
-            path: path.to_path_buf(),
-            source,
-        };
+        let io = |source| Error::Io { path: path.to_path_buf(), source };
         let file = std::fs::File::open(path).map_err(io)?;
         let source = FileSource::new(file).map_err(io)?;
         Self::from_source(Box::new(source), path.to_path_buf())
@@ -72,10 +69,7 @@ impl PisReader {
         let loaded = load(source.as_ref(), false, &mut issues);
         if let Some(first) = issues.into_iter().find(|i| i.severity == Severity::Error) {
             return Err(match first.id {
-                1001 => Error::Io {
-                    path,
-                    source: std::io::Error::other(first.detail),
-                },
+                1001 => Error::Io { path, source: std::io::Error::other(first.detail) },
                 _ => Error::Invalid(first),
             });
         }
@@ -131,22 +125,15 @@ impl PisReader {
         let mut buf = vec![0; r.length as usize];
         self.source
             .read_at(entry.offset + r.offset, &mut buf)
-            .map_err(|source| Error::Io {
-                path: self.path.clone(),
-                source,
-            })?;
+            .map_err(|source| Error::Io { path: self.path.clone(), source })?;
         self.reads.fetch_add(1, Ordering::Relaxed);
-        self.read_bytes
-            .fetch_add(r.length as u64, Ordering::Relaxed);
+        self.read_bytes.fetch_add(r.length as u64, Ordering::Relaxed);
         let crc = crc32fast::hash(&buf);
         if crc != r.crc {
             return Err(Error::Invalid(
-                Issue::new(
-                    8003,
-                    format!("stored {:#010x}, computed {crc:#010x}", r.crc),
-                )
-                .in_chunk("CSTR", r.chunk as usize)
-                .at(entry.offset + r.offset),
+                Issue::new(8003, format!("stored {:#010x}, computed {crc:#010x}", r.crc))
+                    .in_chunk("CSTR", r.chunk as usize)
+                    .at(entry.offset + r.offset),
             ));
         }
         Ok(buf)
@@ -267,9 +254,17 @@ impl PisReader {
     /// 6.7). Its textures are decoded, and checked, by [`Master::texture`].
     pub fn masters(&self) -> Result<Vec<Master>, Error> {
         let mut issues = Vec::new();
-        let masters = crate::master::load(self.source.as_ref(), &self.chunks, &self.container, false, &mut issues);
+        let masters = crate::master::load(
+            self.source.as_ref(),
+            &self.chunks,
+            &self.container,
+            false,
+            &mut issues,
+        );
         match issues.into_iter().next() {
-            Some(i) if i.id == 1001 => Err(Error::Io { path: self.path.clone(), source: std::io::Error::other(i.detail) }),
+            Some(i) if i.id == 1001 => {
+                Err(Error::Io { path: self.path.clone(), source: std::io::Error::other(i.detail) })
+            }
             Some(i) => Err(Error::Invalid(i)),
             None => Ok(masters),
         }
@@ -277,12 +272,8 @@ impl PisReader {
 
     /// Reads every codestream into memory: the whole container, ready to re-encode or write.
     pub fn load_all(&self) -> Result<Container<Codestream>, Error> {
-        self.container.try_map(&mut |r| {
-            Ok(Codestream {
-                codec: r.codec,
-                bytes: self.codestream(r)?,
-            })
-        })
+        self.container
+            .try_map(&mut |r| Ok(Codestream { codec: r.codec, bytes: self.codestream(r)? }))
     }
 }
 
@@ -297,11 +288,7 @@ impl PisReader {
 /// decoding hold (the space, block grids, pyramids, codestream ranges and section 12's
 /// limits), so that its codestreams can be decoded; other rules may be broken.
 pub(crate) fn load(src: &dyn Source, full: bool, issues: &mut Vec<Issue>) -> Loaded {
-    let mut out = Loaded {
-        header: None,
-        chunks: Vec::new(),
-        container: None,
-    };
+    let mut out = Loaded { header: None, chunks: Vec::new(), container: None };
     let len = src.len();
     let mut head = vec![0u8; len.min(HEADER_LEN) as usize];
     if let Err(e) = src.read_at(0, &mut head) {
@@ -335,29 +322,23 @@ pub(crate) fn load(src: &dyn Source, full: bool, issues: &mut Vec<Issue>) -> Loa
     for (i, e) in entries.iter().enumerate() {
         let in_bounds = e.offset.checked_add(e.length).is_some_and(|end| end <= len);
         // Codestreams and masters are read on demand: a player never reads a master.
-        let is_meta = chunk::rule(e.fourcc).is_some_and(|r| r.fourcc != chunk::CSTR && r.fourcc != chunk::MSTR);
+        let is_meta = chunk::rule(e.fourcc)
+            .is_some_and(|r| r.fourcc != chunk::CSTR && r.fourcc != chunk::MSTR);
         if !in_bounds || !(is_meta || full) {
             ok &= in_bounds;
             continue;
         }
         let Some(bytes) = read(e.offset, e.length as usize) else {
-            issues.push(
-                Issue::new(1001, "read failed")
-                    .in_chunk(&e.name(), i)
-                    .at(e.offset),
-            );
+            issues.push(Issue::new(1001, "read failed").in_chunk(&e.name(), i).at(e.offset));
             ok = false;
             continue;
         };
         let crc = crc32fast::hash(&bytes);
         if crc != e.crc {
             issues.push(
-                Issue::new(
-                    3004,
-                    format!("stored {:#010x}, computed {crc:#010x}", e.crc),
-                )
-                .in_chunk(&e.name(), i)
-                .at(e.offset),
+                Issue::new(3004, format!("stored {:#010x}, computed {crc:#010x}", e.crc))
+                    .in_chunk(&e.name(), i)
+                    .at(e.offset),
             );
             ok = false;
             continue;
@@ -415,7 +396,8 @@ fn parse(
     let find = |f: chunk::FourCC| entries.iter().position(|e| e.fourcc == f);
     let before = issues.len();
     let space = find(chunk::PSPC).and_then(|i| parse_chunk(entries, payloads, i, issues, pr::pspc));
-    let cameras = find(chunk::CAMS).and_then(|i| parse_chunk(entries, payloads, i, issues, pr::cams));
+    let cameras =
+        find(chunk::CAMS).and_then(|i| parse_chunk(entries, payloads, i, issues, pr::cams));
     // OBJS needs the dimension count.
     let mut objects = match (&space, find(chunk::OBJS)) {
         (Some(s), Some(i)) => {
@@ -427,11 +409,7 @@ fn parse(
     // Each MESH parses alone; it is given to its object when OBJS parsed.
     let mut has_mesh = vec![false; objects.as_ref().map_or(0, Vec::len)];
     let mut every_mesh_parsed = true;
-    for (i, e) in entries
-        .iter()
-        .enumerate()
-        .filter(|(_, e)| e.fourcc == chunk::MESH)
-    {
+    for (i, e) in entries.iter().enumerate().filter(|(_, e)| e.fourcc == chunk::MESH) {
         let Some((oi, mesh)) = parse_chunk(entries, payloads, i, issues, pr::mesh) else {
             every_mesh_parsed = false;
             continue;
@@ -471,7 +449,9 @@ fn parse(
         }
     }
     let layers = match (objects.as_mut(), find(chunk::LAYR)) {
-        (Some(objects), Some(i)) => parse_chunk(entries, payloads, i, issues, |c| pr::layr(c, objects)).is_some(),
+        (Some(objects), Some(i)) => {
+            parse_chunk(entries, payloads, i, issues, |c| pr::layr(c, objects)).is_some()
+        }
         _ => false,
     };
     let provenance = match find(chunk::PROV) {
@@ -546,10 +526,7 @@ fn chunk_name(e: &ChunkEntry) -> &'static str {
 fn stream_ranges(entries: &[ChunkEntry], c: &Container<StreamRef>, issues: &mut Vec<Issue>) {
     for_each_ref(c, |what, r| match entries.get(r.chunk as usize) {
         Some(e) if e.fourcc == chunk::CSTR => {
-            if r.offset
-                .checked_add(r.length as u64)
-                .is_none_or(|end| end > e.length)
-            {
+            if r.offset.checked_add(r.length as u64).is_none_or(|end| end > e.length) {
                 issues.push(
                     Issue::new(
                         8002,
@@ -575,10 +552,7 @@ pub(crate) fn for_each_ref(c: &Container<StreamRef>, mut f: impl FnMut(String, &
             for (bi, b) in l.blocks.iter().enumerate() {
                 for (lv, level) in b.levels.iter().enumerate() {
                     for (ii, r) in level.images.iter().enumerate() {
-                        f(
-                            format!("object {oi} layer {li} block {bi} level {lv} image {ii}"),
-                            r,
-                        );
+                        f(format!("object {oi} layer {li} block {bi} level {lv} image {ii}"), r);
                     }
                 }
             }

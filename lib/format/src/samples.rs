@@ -36,30 +36,18 @@ pub fn encode_block(
         for (s, local) in locals.iter().enumerate() {
             let m = level_image_index(counts, local, extent);
             members[m].push(s);
-            means[m]
-                .iter_mut()
-                .zip(&prepared[s])
-                .for_each(|(a, v)| *a += *v as f64);
+            means[m].iter_mut().zip(&prepared[s]).for_each(|(a, v)| *a += *v as f64);
         }
-        let mut level = Level {
-            counts: counts.clone(),
-            images: Vec::with_capacity(images),
-        };
+        let mut level = Level { counts: counts.clone(), images: Vec::with_capacity(images) };
         for (m, sum) in means.iter().enumerate() {
             let first = *members[m].first().ok_or_else(|| {
                 Error::Request(format!("level {counts:?} image {m} covers no sample"))
             })?;
             let k = members[m].len() as f64;
-            let residual: Vec<f32> = sum
-                .iter()
-                .zip(&above[first])
-                .map(|(s, a)| (s / k) as f32 - a)
-                .collect();
+            let residual: Vec<f32> =
+                sum.iter().zip(&above[first]).map(|(s, a)| (s / k) as f32 - a).collect();
             for &s in &members[m] {
-                above[s]
-                    .iter_mut()
-                    .zip(&residual)
-                    .for_each(|(a, r)| *a += r);
+                above[s].iter_mut().zip(&residual).for_each(|(a, r)| *a += r);
             }
             let bytes = pis_codec::encode(codec, &planes, &residual)
                 .map_err(|e| Error::Request(e.to_string()))?;
@@ -116,12 +104,7 @@ pub fn minimal() -> Result<Container, Error> {
         cameras: vec![orbit_camera(0.0, 2.0), orbit_camera(10.0, 2.0)],
     };
     let mesh = Mesh {
-        positions: vec![
-            [-0.5, -0.5, 0.0],
-            [0.5, -0.5, 0.0],
-            [0.5, 0.5, 0.0],
-            [-0.5, 0.5, 0.0],
-        ],
+        positions: vec![[-0.5, -0.5, 0.0], [0.5, -0.5, 0.0], [0.5, 0.5, 0.0], [-0.5, 0.5, 0.0]],
         normals: None,
         texcoords: Some(vec![[0.0, 1.0], [1.0, 1.0], [1.0, 0.0], [0.0, 0.0]]),
         indices: vec![0, 1, 2, 0, 2, 3],
@@ -143,10 +126,7 @@ pub fn minimal() -> Result<Container, Error> {
         stagger: vec![0],
         transforms: TransformTable::fixed(IDENTITY_3X4),
         mesh,
-        layers: vec![Layer {
-            blocks: vec![block],
-            ..layer
-        }],
+        layers: vec![Layer { blocks: vec![block], ..layer }],
     };
     Ok(Container {
         space,
@@ -178,22 +158,14 @@ fn surface_layer(kind: LayerKind, order: u8, depends_on: DepMask, gamma: f32) ->
 
 /// A UV sphere of radius `r` (longitude × latitude segments) with normals and texcoords.
 pub fn uv_sphere(r: f32, lon: u32, lat: u32) -> Mesh {
-    let mut m = Mesh {
-        normals: Some(vec![]),
-        texcoords: Some(vec![]),
-        ..Default::default()
-    };
+    let mut m = Mesh { normals: Some(vec![]), texcoords: Some(vec![]), ..Default::default() };
     for j in 0..=lat {
         let v = j as f32 / lat as f32;
         let theta = v * std::f32::consts::PI;
         for i in 0..=lon {
             let u = i as f32 / lon as f32;
             let phi = u * std::f32::consts::TAU;
-            let n = [
-                theta.sin() * phi.cos(),
-                theta.cos(),
-                theta.sin() * phi.sin(),
-            ];
+            let n = [theta.sin() * phi.cos(), theta.cos(), theta.sin() * phi.sin()];
             m.positions.push([n[0] * r, n[1] * r, n[2] * r]);
             m.normals.as_mut().expect("set above").push(n);
             m.texcoords.as_mut().expect("set above").push([u, v]);
@@ -257,18 +229,9 @@ pub fn tiny() -> Result<Container, Error> {
         placement: Placement::surface([1.0, 0.0, 0.0, 1.0, 0.0, 0.0]),
         levels: vec![],
     };
-    let block = encode_block(
-        &diffuse,
-        block,
-        &[2],
-        &[vec![1], vec![2]],
-        &[texture(0), texture(1)],
-        codec,
-    )?;
-    let diffuse = Layer {
-        blocks: vec![block],
-        ..diffuse
-    };
+    let block =
+        encode_block(&diffuse, block, &[2], &[vec![1], vec![2]], &[texture(0), texture(1)], codec)?;
+    let diffuse = Layer { blocks: vec![block], ..diffuse };
 
     // Distant shell: a sphere of radius 4, 4×4 faces with their MIP chain, over `view`,
     // whose block origin is staggered by 1: two blocks of one sample each.
@@ -310,25 +273,14 @@ pub fn tiny() -> Result<Container, Error> {
                 }
             }
         }
-        blocks.push(encode_block(
-            &shell,
-            block,
-            &grid.extent(b),
-            &[vec![1]],
-            &[values],
-            codec,
-        )?);
+        blocks.push(encode_block(&shell, block, &grid.extent(b), &[vec![1]], &[values], codec)?);
     }
     let shell = Layer { blocks, ..shell };
 
     let object = Object {
         name: "ball".into(),
         role: ObjectRole::Reflective,
-        shading: Shading {
-            f0: [0.9, 0.85, 0.8],
-            ior: 1.5,
-            absorption: [0.0; 3],
-        },
+        shading: Shading { f0: [0.9, 0.85, 0.8], ior: 1.5, absorption: [0.0; 3] },
         stagger,
         transforms: TransformTable::fixed(IDENTITY_3X4),
         mesh: uv_sphere(1.0, 8, 6),
@@ -342,10 +294,7 @@ pub fn tiny() -> Result<Container, Error> {
             tool: format!("pis-format {}", env!("CARGO_PKG_VERSION")),
             source: "generated by pis_format::samples::tiny".into(),
             raw_image_bytes: 4 * 32 * 24 * 3,
-            settings: vec![
-                ("codec".into(), "lossless".into()),
-                ("block".into(), "2x2".into()),
-            ],
+            settings: vec![("codec".into(), "lossless".into()), ("block".into(), "2x2".into())],
         }),
     })
 }
@@ -355,12 +304,21 @@ pub fn tiny() -> Result<Container, Error> {
 /// carries one.
 pub fn master_of(c: &Container) -> Result<Vec<crate::Master>, Error> {
     let r = crate::PisReader::from_bytes(crate::to_bytes(c)?)?;
-    c.objects.iter().enumerate().map(|(oi, o)| {
-        let textures = o.layers.iter().enumerate().map(|(li, l)| {
-            (0..c.space.table_len(l.depends_on)).map(|s| {
-                Ok(r.texture(oi, li, &crate::master::sample_point(c, l, s))?.data)
-            }).collect::<Result<Vec<_>, Error>>()
-        }).collect::<Result<Vec<_>, Error>>()?;
-        crate::Master::encode(c, oi, 1.0, &textures, None)
-    }).collect()
+    c.objects
+        .iter()
+        .enumerate()
+        .map(|(oi, o)| {
+            let textures = o
+                .layers
+                .iter()
+                .enumerate()
+                .map(|(li, l)| {
+                    (0..c.space.table_len(l.depends_on))
+                        .map(|s| Ok(r.texture(oi, li, &crate::master::sample_point(c, l, s))?.data))
+                        .collect::<Result<Vec<_>, Error>>()
+                })
+                .collect::<Result<Vec<_>, Error>>()?;
+            crate::Master::encode(c, oi, 1.0, &textures, None)
+        })
+        .collect()
 }

@@ -19,10 +19,7 @@ pub struct FileSource {
 impl FileSource {
     pub fn new(file: File) -> io::Result<Self> {
         let len = file.metadata()?.len();
-        Ok(FileSource {
-            file: Mutex::new(file),
-            len,
-        })
+        Ok(FileSource { file: Mutex::new(file), len })
     }
 }
 
@@ -32,10 +29,7 @@ impl Source for FileSource {
     }
 
     fn read_at(&self, offset: u64, buf: &mut [u8]) -> io::Result<()> {
-        let mut f = self
-            .file
-            .lock()
-            .map_err(|_| io::Error::other("file lock poisoned"))?;
+        let mut f = self.file.lock().map_err(|_| io::Error::other("file lock poisoned"))?;
         f.seek(SeekFrom::Start(offset))?;
         f.read_exact(buf)
     }

@@ -61,10 +61,8 @@ impl Texture {
     pub fn plane(&self, face: u32, mip: u32) -> &[f32] {
         let planes = self.layout.planes();
         let idx = (face * self.layout.mips + mip) as usize;
-        let start: usize = planes[..idx]
-            .iter()
-            .map(|p| (p.width * p.height * p.channels) as usize)
-            .sum();
+        let start: usize =
+            planes[..idx].iter().map(|p| (p.width * p.height * p.channels) as usize).sum();
         let p = planes[idx];
         &self.data[start..start + (p.width * p.height * p.channels) as usize]
     }

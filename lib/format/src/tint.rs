@@ -17,19 +17,31 @@ pub fn tint_setting(object: &str, rgb: [f32; 3]) -> (String, String) {
 /// records (white without one) — rule 9004: an error naming what is wrong for a setting that
 /// names no refractive object, or whose value is not three comma-separated decimal numbers
 /// in [0, 1].
-pub fn tints(p: Option<&Provenance>, objects: &[(&str, ObjectRole)]) -> Result<Vec<[f32; 3]>, String> {
+pub fn tints(
+    p: Option<&Provenance>,
+    objects: &[(&str, ObjectRole)],
+) -> Result<Vec<[f32; 3]>, String> {
     let mut out = vec![[1.0f32; 3]; objects.len()];
     let Some(p) = p else { return Ok(out) };
     for (k, v) in &p.settings {
         let Some(name) = k.strip_prefix(TINT_PREFIX) else { continue };
-        let o = objects.iter().position(|o| o.0 == name).ok_or_else(|| format!("{k}: no object is named {name:?}"))?;
+        let o = objects
+            .iter()
+            .position(|o| o.0 == name)
+            .ok_or_else(|| format!("{k}: no object is named {name:?}"))?;
         if objects[o].1 != ObjectRole::Refractive {
             return Err(format!("{k}: object {name:?} is not refractive"));
         }
         let parts: Vec<&str> = v.split(',').collect();
-        let rgb: Vec<f32> = parts.iter().filter_map(|s| s.trim().parse::<f32>().ok()).filter(|x| x.is_finite() && (0.0..=1.0).contains(x)).collect();
+        let rgb: Vec<f32> = parts
+            .iter()
+            .filter_map(|s| s.trim().parse::<f32>().ok())
+            .filter(|x| x.is_finite() && (0.0..=1.0).contains(x))
+            .collect();
         if parts.len() != 3 || rgb.len() != 3 {
-            return Err(format!("{k} {v:?} is not three decimal numbers in [0, 1] separated by commas"));
+            return Err(format!(
+                "{k} {v:?} is not three decimal numbers in [0, 1] separated by commas"
+            ));
         }
         out[o] = [rgb[0], rgb[1], rgb[2]];
     }
@@ -45,7 +57,10 @@ mod tests {
     fn tints_round_trip_and_bad_ones_are_named() {
         let objects = [("Cup", ObjectRole::Refractive), ("Table", ObjectRole::Diffuse)];
         let (k, v) = tint_setting("Cup", [0.7, 0.9, 0.75]);
-        assert_eq!(tints(Some(&prov(&[(k.as_str(), v.as_str())])), &objects), Ok(vec![[0.7, 0.9, 0.75], [1.0; 3]]));
+        assert_eq!(
+            tints(Some(&prov(&[(k.as_str(), v.as_str())])), &objects),
+            Ok(vec![[0.7, 0.9, 0.75], [1.0; 3]])
+        );
         assert_eq!(tints(None, &objects), Ok(vec![[1.0; 3]; 2]));
         for (key, value, why) in [
             ("transmission_tint.Table", "1,1,1", "not refractive"),

@@ -74,7 +74,10 @@ fn validate_source(src: &dyn Source) -> Validation {
         let mut k = 0;
         for_each_ref(c, |what, r| {
             // A chunk past the end of the file is reported by the table (rule 3002).
-            let in_file = chunks[r.chunk as usize].offset.checked_add(chunks[r.chunk as usize].length).is_some_and(|end| end <= src.len());
+            let in_file = chunks[r.chunk as usize]
+                .offset
+                .checked_add(chunks[r.chunk as usize].length)
+                .is_some_and(|end| end <= src.len());
             if in_file {
                 if let Some(issue) = check_stream(src, chunks, r, &layouts[k], &what) {
                     issues.push(issue);
@@ -87,11 +90,7 @@ fn validate_source(src: &dyn Source) -> Validation {
         // master's textures too).
         crate::master::load(src, chunks, c, true, &mut issues);
     }
-    Validation {
-        issues,
-        chunks: loaded.chunks,
-        chunk_crc_ok,
-    }
+    Validation { issues, chunks: loaded.chunks, chunk_crc_ok }
 }
 
 fn check_stream(
@@ -118,12 +117,11 @@ fn check_stream(
     match pis_codec::decode(r.codec, &layout.planes(), &bytes) {
         Ok(values) => {
             let bad = values.iter().position(|v| !v.is_finite())?;
-            Some(tag(Issue::new(
-                8006,
-                format!("{what}: value {bad} is {}", values[bad]),
-            )))
+            Some(tag(Issue::new(8006, format!("{what}: value {bad} is {}", values[bad]))))
         }
-        Err(err @ CodecError::TrailingBytes { .. }) => Some(tag(Issue::new(8008, format!("{what}: {err}")))),
+        Err(err @ CodecError::TrailingBytes { .. }) => {
+            Some(tag(Issue::new(8008, format!("{what}: {err}"))))
+        }
         Err(CodecError::NotSupported(c)) => Some(tag(Issue::warning(
             8007,
             format!("{what}: codec '{c}' cannot be checked by this build"),

@@ -30,7 +30,10 @@ pub fn to_bytes_labelled(c: &Container) -> Result<(Vec<u8>, Vec<Span>), Error> {
 }
 
 /// Like [`to_bytes_with_masters`], with a label for every field.
-pub fn to_bytes_labelled_with_masters(c: &Container, masters: &[Master]) -> Result<(Vec<u8>, Vec<Span>), Error> {
+pub fn to_bytes_labelled_with_masters(
+    c: &Container,
+    masters: &[Master],
+) -> Result<(Vec<u8>, Vec<Span>), Error> {
     let s = serialize(c, masters, true)?;
     Ok((s.bytes, s.spans.unwrap_or_default()))
 }
@@ -66,10 +69,7 @@ pub fn write_with_masters(path: &Path, c: &Container, masters: &[Master]) -> Res
 /// `.pis-PID-N.tmp` beside the destination, is removed on error; temporary files that
 /// processes no longer running left there (killed mid-write) are removed first.
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), Error> {
-    let io = |source| Error::Io {
-        path: path.to_path_buf(),
-        source,
-    };
+    let io = |source| Error::Io { path: path.to_path_buf(), source };
     let dir = match path.parent() {
         Some(d) if !d.as_os_str().is_empty() => d,
         _ => Path::new("."),
@@ -127,7 +127,9 @@ fn remove_stale_temporaries(dir: &Path) {
     let Ok(entries) = std::fs::read_dir(dir) else { return };
     for e in entries.flatten() {
         let name = e.file_name();
-        let Some(pid) = name.to_str().and_then(|n| n.strip_prefix(".pis-")?.strip_suffix(".tmp")?.split_once('-')?.0.parse::<u32>().ok()) else {
+        let Some(pid) = name.to_str().and_then(|n| {
+            n.strip_prefix(".pis-")?.strip_suffix(".tmp")?.split_once('-')?.0.parse::<u32>().ok()
+        }) else {
             continue;
         };
         if pid != std::process::id() && !Path::new("/proc").join(pid.to_string()).exists() {
@@ -148,9 +150,16 @@ fn serialize(c: &Container, masters: &[Master], labelled: bool) -> Result<Sink, 
     if let Some(issue) = crate::master::check(c, masters).into_iter().next() {
         return Err(Error::InvalidModel(issue));
     }
-    let too_long = masters.iter().flat_map(|m| &m.layers).flat_map(|l| &l.samples).find(|s| u32::try_from(s.len()).is_err());
+    let too_long = masters
+        .iter()
+        .flat_map(|m| &m.layers)
+        .flat_map(|l| &l.samples)
+        .find(|s| u32::try_from(s.len()).is_err());
     if let Some(s) = too_long {
-        return Err(Error::Request(format!("a master codestream of {} bytes exceeds 4 GiB", s.len())));
+        return Err(Error::Request(format!(
+            "a master codestream of {} bytes exceeds 4 GiB",
+            s.len()
+        )));
     }
     for r in c
         .objects
@@ -168,7 +177,15 @@ fn serialize(c: &Container, masters: &[Master], labelled: bool) -> Result<Sink, 
         }
     }
     // The writer stores every codestream once, in one CSTR chunk (see `serialize_inner`).
-    let codestream_bytes = c.objects.iter().flat_map(|o| &o.layers).flat_map(|l| &l.blocks).flat_map(|b| &b.levels).flat_map(|l| &l.images).map(|r| r.bytes.len() as u64).sum();
+    let codestream_bytes = c
+        .objects
+        .iter()
+        .flat_map(|o| &o.layers)
+        .flat_map(|l| &l.blocks)
+        .flat_map(|b| &b.levels)
+        .flat_map(|l| &l.images)
+        .map(|r| r.bytes.len() as u64)
+        .sum();
     if let Some(issue) = checks::decoded_sizes(c, codestream_bytes) {
         return Err(Error::InvalidModel(issue));
     }
@@ -206,14 +223,9 @@ fn serialize_inner(c: &Container, masters: &[Master], labelled: bool) -> Sink {
     }
     let mut next = refs.into_iter();
     chunks.push(chunk(chunk::LAYR, &mut |s| {
-        pw::layr(s, &c.objects, |_| {
-            next.next().expect("one reference per image")
-        })
+        pw::layr(s, &c.objects, |_| next.next().expect("one reference per image"))
     }));
-    chunks.push(Chunk {
-        fourcc: chunk::CSTR,
-        payload: cstr,
-    });
+    chunks.push(Chunk { fourcc: chunk::CSTR, payload: cstr });
     if let Some(p) = &c.provenance {
         chunks.push(chunk(chunk::PROV, &mut |s| pw::prov(s, p)));
     }
@@ -234,11 +246,7 @@ fn place(cstr: &mut Sink, chunk: u32, img: &Codestream) -> StreamRef {
         crc: crc32fast::hash(&img.bytes),
     };
     cstr.raw(&img.bytes, || {
-        format!(
-            "codestream ({}, {} bytes)",
-            img.codec.name(),
-            img.bytes.len()
-        )
+        format!("codestream ({}, {} bytes)", img.codec.name(), img.bytes.len())
     });
     r
 }
@@ -304,7 +312,12 @@ mod tests {
     }
 
     fn temporaries(dir: &Path) -> Vec<String> {
-        std::fs::read_dir(dir).unwrap().flatten().map(|e| e.file_name().to_string_lossy().into_owned()).filter(|n| n.ends_with(".tmp")).collect()
+        std::fs::read_dir(dir)
+            .unwrap()
+            .flatten()
+            .map(|e| e.file_name().to_string_lossy().into_owned())
+            .filter(|n| n.ends_with(".tmp"))
+            .collect()
     }
 
     /// Outputs were once created 0600, and rewriting a 0644 file made it 0600.
@@ -314,7 +327,11 @@ mod tests {
         let (a, b) = (dir.path().join("a.pis"), dir.path().join("b.pis"));
         write_atomic(&a, b"new").unwrap();
         std::fs::write(&b, b"plain").unwrap();
-        assert_eq!(mode(&a), mode(&b), "a new file gets the mode std gives any new file (the umask's)");
+        assert_eq!(
+            mode(&a),
+            mode(&b),
+            "a new file gets the mode std gives any new file (the umask's)"
+        );
         std::fs::set_permissions(&a, std::fs::Permissions::from_mode(0o640)).unwrap();
         write_atomic(&a, b"again").unwrap();
         assert_eq!(mode(&a), 0o640, "a replaced file keeps its mode");

@@ -34,7 +34,8 @@ fn all_textures(r: &PisReader) -> (Vec<Vec<f32>>, ReadStats) {
 fn a_master_round_trips_and_changes_nothing_a_player_reads() {
     let (c, masters, plain, with) = files();
     assert_eq!(to_bytes_with_masters(&c, &[]).unwrap(), plain, "no master: the file as before");
-    let (a, b) = (PisReader::from_bytes(plain).unwrap(), PisReader::from_bytes(with.clone()).unwrap());
+    let (a, b) =
+        (PisReader::from_bytes(plain).unwrap(), PisReader::from_bytes(with.clone()).unwrap());
     assert!(!a.has_master() && a.masters().unwrap().is_empty() && a.master_bytes() == 0);
     assert!(b.has_master());
     assert_eq!(a.container().objects, b.container().objects);
@@ -50,7 +51,10 @@ fn a_master_round_trips_and_changes_nothing_a_player_reads() {
                 let point = master::sample_point(&c, l, s);
                 let want = b.texture(m.object as usize, li, &point).unwrap().data;
                 let got = m.texture(b.container(), li, s as usize).unwrap();
-                assert!(got.iter().zip(&want).all(|(x, y)| x.to_bits() == y.to_bits()) && got.len() == want.len());
+                assert!(
+                    got.iter().zip(&want).all(|(x, y)| x.to_bits() == y.to_bits())
+                        && got.len() == want.len()
+                );
             }
         }
     }
@@ -62,17 +66,31 @@ fn a_master_round_trips_and_changes_nothing_a_player_reads() {
 fn a_corrupted_master_is_reported_and_textures_still_decode() {
     let (_, _, plain, mut with) = files();
     let r = PisReader::from_bytes(with.clone()).unwrap();
-    let (i, e) = r.chunks().iter().enumerate().find(|(_, e)| &e.fourcc == b"MSTR").map(|(i, e)| (i, e.clone())).unwrap();
+    let (i, e) = r
+        .chunks()
+        .iter()
+        .enumerate()
+        .find(|(_, e)| &e.fourcc == b"MSTR")
+        .map(|(i, e)| (i, e.clone()))
+        .unwrap();
     with[(e.offset + e.length / 2) as usize] ^= 0x5a;
     // Opened and played as before.
-    let damaged = PisReader::from_bytes(with.clone()).expect("a damaged master does not stop a player");
+    let damaged =
+        PisReader::from_bytes(with.clone()).expect("a damaged master does not stop a player");
     assert_eq!(all_textures(&damaged).0, all_textures(&PisReader::from_bytes(plain).unwrap()).0);
     let err = damaged.masters().unwrap_err();
     let issue = err.issue().expect("an invalid-file error");
     assert_eq!((issue.id, issue.chunk.clone()), (3004, Some(("MSTR".to_string(), i))));
-    assert!(err.to_string().contains("chunk checksum mismatch") && err.to_string().contains("'MSTR'"), "{err}");
+    assert!(
+        err.to_string().contains("chunk checksum mismatch") && err.to_string().contains("'MSTR'"),
+        "{err}"
+    );
     let v = validate_bytes(with);
-    assert!(v.issues.iter().any(|x| x.id == 3004 && x.chunk == Some(("MSTR".to_string(), i))), "{:?}", v.issues);
+    assert!(
+        v.issues.iter().any(|x| x.id == 3004 && x.chunk == Some(("MSTR".to_string(), i))),
+        "{:?}",
+        v.issues
+    );
 }
 
 #[test]
@@ -110,15 +128,30 @@ fn screen_weights_round_trip_with_the_master() {
     let c = tiny().unwrap();
     let plain = master_of(&c).unwrap();
     // Textures as the plain master holds them; weights 0, 1, 2, ... per finest texel.
-    let masters: Vec<Master> = plain.iter().map(|m| {
-        let o = &c.objects[m.object as usize];
-        let textures: Vec<Vec<Vec<f32>>> = (0..o.layers.len()).map(|l| (0..m.layers[l].samples.len()).map(|s| m.texture(&c, l, s).unwrap()).collect()).collect();
-        let weights: Vec<Vec<Vec<f32>>> = (0..o.layers.len()).map(|l| (0..m.layers[l].samples.len()).map(|s| {
-            let layout = master::sample_layout(&c, o, l, s as u64).unwrap();
-            (0..layout.width * layout.height).map(|k| (k % 7) as f32 * 0.5).collect()
-        }).collect()).collect();
-        Master::encode(&c, m.object as usize, m.area, &textures, Some(&weights)).unwrap()
-    }).collect();
+    let masters: Vec<Master> = plain
+        .iter()
+        .map(|m| {
+            let o = &c.objects[m.object as usize];
+            let textures: Vec<Vec<Vec<f32>>> = (0..o.layers.len())
+                .map(|l| {
+                    (0..m.layers[l].samples.len()).map(|s| m.texture(&c, l, s).unwrap()).collect()
+                })
+                .collect();
+            let weights: Vec<Vec<Vec<f32>>> = (0..o.layers.len())
+                .map(|l| {
+                    (0..m.layers[l].samples.len())
+                        .map(|s| {
+                            let layout = master::sample_layout(&c, o, l, s as u64).unwrap();
+                            (0..layout.width * layout.height)
+                                .map(|k| (k % 7) as f32 * 0.5)
+                                .collect()
+                        })
+                        .collect()
+                })
+                .collect();
+            Master::encode(&c, m.object as usize, m.area, &textures, Some(&weights)).unwrap()
+        })
+        .collect();
     let r = PisReader::from_bytes(to_bytes_with_masters(&c, &masters).unwrap()).unwrap();
     let back = r.masters().unwrap();
     assert_eq!(back, masters);
@@ -130,7 +163,10 @@ fn screen_weights_round_trip_with_the_master() {
                 let layout = master::sample_layout(&c, o, l, s as u64).unwrap();
                 assert_eq!(w.len(), (layout.width * layout.height) as usize);
                 assert!(w.iter().enumerate().all(|(k, v)| *v == (k % 7) as f32 * 0.5));
-                assert_eq!(m.texture(&c, l, s).unwrap(), plain[m.object as usize].texture(&c, l, s).unwrap());
+                assert_eq!(
+                    m.texture(&c, l, s).unwrap(),
+                    plain[m.object as usize].texture(&c, l, s).unwrap()
+                );
             }
         }
     }

@@ -127,10 +127,7 @@ fn mutate(rng: &mut Rng, good: &[u8]) -> Vec<u8> {
 
 #[test]
 fn damaged_files_give_errors_never_panics() {
-    for good in [
-        to_bytes(&tiny().unwrap()).unwrap(),
-        to_bytes(&minimal().unwrap()).unwrap(),
-    ] {
+    for good in [to_bytes(&tiny().unwrap()).unwrap(), to_bytes(&minimal().unwrap()).unwrap()] {
         assert!(read_everything(&good));
 
         // Every single flipped byte is caught by validation, and by the reader at the latest
@@ -138,10 +135,7 @@ fn damaged_files_give_errors_never_panics() {
         for at in 0..good.len() {
             let mut b = good.clone();
             b[at] ^= 0x5a;
-            assert!(
-                !validate_bytes(b.clone()).is_valid(),
-                "flip at {at} not detected"
-            );
+            assert!(!validate_bytes(b.clone()).is_valid(), "flip at {at} not detected");
             assert!(!read_everything(&b), "flip at {at} read back without error");
         }
 
@@ -149,9 +143,8 @@ fn damaged_files_give_errors_never_panics() {
         for len in 0..good.len() {
             let report = validate_bytes(good[..len].to_vec());
             assert!(!report.is_valid(), "truncation to {len} not detected");
-            let err = PisReader::from_bytes(good[..len].to_vec())
-                .err()
-                .expect("truncated file opened");
+            let err =
+                PisReader::from_bytes(good[..len].to_vec()).err().expect("truncated file opened");
             assert!(
                 matches!(err.issue().map(|i| i.id), Some(1002 | 1003)),
                 "truncation to {len}: {err}"
@@ -171,10 +164,7 @@ fn damaged_files_give_errors_never_panics() {
         }
         TRACK.store(false, Ordering::Relaxed);
         // Resealed mutations must get past the checksums into the payload rules.
-        assert!(
-            deep > 300,
-            "only {deep} mutations reached the payload parsers"
-        );
+        assert!(deep > 300, "only {deep} mutations reached the payload parsers");
         let largest = LARGEST.load(Ordering::Relaxed);
         // A level image decodes to at most MAX_EXPANSION × the file's codestream bytes, fewer
         // than its length (rule 6009); decoders may need a few times that as working memory.
@@ -198,13 +188,24 @@ fn padding_a_file_does_not_raise_its_decoded_size_bound() {
     (b.width, b.height) = (1024, 1024);
     let declared = to_bytes_unchecked(&c);
     let padded = common::append_chunk(&declared, *b"ZZZZ", 0, &vec![0; 1 << 20]);
-    assert_eq!(PisReader::from_bytes(declared).err().and_then(|e| e.issue().map(|i| i.id)), Some(6009));
+    assert_eq!(
+        PisReader::from_bytes(declared).err().and_then(|e| e.issue().map(|i| i.id)),
+        Some(6009)
+    );
     let report = validate_bytes(padded.clone());
     assert!(report.issues.iter().any(|i| i.id == 6009), "{:?}", report.issues);
-    assert!(!report.issues.iter().any(|i| (1000..4000).contains(&i.id)), "the padded file's structure is valid: {:?}", report.issues);
-    assert_eq!(PisReader::from_bytes(padded).err().and_then(|e| e.issue().map(|i| i.id)), Some(6009));
+    assert!(
+        !report.issues.iter().any(|i| (1000..4000).contains(&i.id)),
+        "the padded file's structure is valid: {:?}",
+        report.issues
+    );
+    assert_eq!(
+        PisReader::from_bytes(padded).err().and_then(|e| e.issue().map(|i| i.id)),
+        Some(6009)
+    );
     // The same padding on the valid file is skipped, as an unknown optional chunk must be.
-    let good = common::append_chunk(&to_bytes(&tiny().unwrap()).unwrap(), *b"ZZZZ", 0, &vec![0; 1 << 20]);
+    let good =
+        common::append_chunk(&to_bytes(&tiny().unwrap()).unwrap(), *b"ZZZZ", 0, &vec![0; 1 << 20]);
     assert!(validate_bytes(good.clone()).is_valid());
     assert!(read_everything(&good));
 }

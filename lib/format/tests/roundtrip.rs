@@ -16,10 +16,7 @@ fn tiny_round_trips_through_bytes() {
 
 #[test]
 fn serialization_is_deterministic() {
-    assert_eq!(
-        to_bytes(&tiny().unwrap()).unwrap(),
-        to_bytes(&tiny().unwrap()).unwrap()
-    );
+    assert_eq!(to_bytes(&tiny().unwrap()).unwrap(), to_bytes(&tiny().unwrap()).unwrap());
 }
 
 #[test]
@@ -28,11 +25,7 @@ fn tiny_textures_decode_to_what_was_encoded() {
     // Diffuse (layer 0) varies with the light only: a brighter light gives brighter texels.
     let dark = r.texture(0, 0, &[0, 0]).unwrap();
     let bright = r.texture(0, 0, &[1, 1]).unwrap();
-    assert_eq!(
-        dark,
-        r.texture(0, 0, &[1, 0]).unwrap(),
-        "diffuse must not depend on the view"
-    );
+    assert_eq!(dark, r.texture(0, 0, &[1, 0]).unwrap(), "diffuse must not depend on the view");
     assert_eq!(dark.layout.width, 8);
     // Texel (0,0) is a light checker square: 0.8 × (0.5 + 0.5·light) in red.
     assert!((dark.data[0] - 0.4).abs() < 1e-5, "{}", dark.data[0]);
@@ -41,11 +34,7 @@ fn tiny_textures_decode_to_what_was_encoded() {
     let shell = r.texture(0, 1, &[1, 0]).unwrap();
     assert_eq!((shell.layout.faces, shell.layout.mips), (6, 3));
     assert!((shell.plane(2, 0)[1] - 0.4).abs() < 1e-6);
-    assert!(
-        (shell.plane(5, 2)[0] - 0.5).abs() < 1e-6,
-        "{}",
-        shell.plane(5, 2)[0]
-    );
+    assert!((shell.plane(5, 2)[0] - 0.5).abs() < 1e-6, "{}", shell.plane(5, 2)[0]);
     assert!((r.texture(0, 1, &[0, 1]).unwrap().plane(0, 0)[1] - 0.3).abs() < 1e-6);
 }
 
@@ -72,10 +61,7 @@ fn minimal_example_round_trips() {
     let c = minimal().unwrap();
     let r = PisReader::from_bytes(to_bytes(&c).unwrap()).unwrap();
     let t = r.texture(0, 0, &[1]).unwrap();
-    assert_eq!(
-        t.data,
-        vec![1.0, 0.5, 0.25, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.5, 0.5, 0.5]
-    );
+    assert_eq!(t.data, vec![1.0, 0.5, 0.25, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.5, 0.5, 0.5]);
 }
 
 #[test]
@@ -91,19 +77,10 @@ fn atomic_write_leaves_no_partial_file() {
     assert_eq!(std::fs::metadata(&path).unwrap().len(), n);
     // A missing folder is an I/O error, and nothing is created.
     let missing = dir.path().join("no/such/dir/out.pis");
-    assert!(matches!(
-        write(&missing, &tiny().unwrap()),
-        Err(Error::Io { .. })
-    ));
-    let names: Vec<_> = std::fs::read_dir(dir.path())
-        .unwrap()
-        .map(|e| e.unwrap().file_name())
-        .collect();
-    assert_eq!(
-        names,
-        vec![std::ffi::OsString::from("out.pis")],
-        "no temporary file left behind"
-    );
+    assert!(matches!(write(&missing, &tiny().unwrap()), Err(Error::Io { .. })));
+    let names: Vec<_> =
+        std::fs::read_dir(dir.path()).unwrap().map(|e| e.unwrap().file_name()).collect();
+    assert_eq!(names, vec![std::ffi::OsString::from("out.pis")], "no temporary file left behind");
 }
 
 #[test]
@@ -128,6 +105,9 @@ fn hull_triangles_round_trip_and_too_many_are_refused() {
     c.objects[0].mesh.hull_triangles = triangles as u32 + 1;
     match to_bytes(&c) {
         Err(Error::InvalidModel(issue)) => assert_eq!(issue.id, 5206, "{issue:?}"),
-        other => panic!("a mesh with more hull triangles than triangles was written: {:?}", other.map(|b| b.len())),
+        other => panic!(
+            "a mesh with more hull triangles than triangles was written: {:?}",
+            other.map(|b| b.len())
+        ),
     }
 }

@@ -102,8 +102,17 @@ fn many_large_level_images() -> Vec<u8> {
     let block = Block { levels: vec![], ..layer.blocks[0].clone() };
     let (w, h) = (block.width, block.height);
     let counts: Vec<Vec<u32>> = (0..6).map(|k| vec![1 << k]).collect();
-    let textures: Vec<Vec<f32>> = (0..32).map(|i| vec![0.1 + 0.02 * i as f32; (w * h * 3) as usize]).collect();
-    let block = pis_format::samples::encode_block(&layer, block, &[32], &counts, &textures, CodecId::Lossless).unwrap();
+    let textures: Vec<Vec<f32>> =
+        (0..32).map(|i| vec![0.1 + 0.02 * i as f32; (w * h * 3) as usize]).collect();
+    let block = pis_format::samples::encode_block(
+        &layer,
+        block,
+        &[32],
+        &counts,
+        &textures,
+        CodecId::Lossless,
+    )
+    .unwrap();
     c.objects[0].layers[0].blocks = vec![block];
     let mut f = File::of(&c);
     f.set_u32("layer 0 block 0 width", 1024).set_u32("layer 0 block 0 height", 1024).reseal()
@@ -114,10 +123,7 @@ fn cases() -> Vec<(u16, Vec<u8>)> {
     let mut v: Vec<(u16, Vec<u8>)> = Vec::new();
     let t = || File::tiny();
     let good = t().bytes;
-    let chunks = PisReader::from_bytes(good.clone())
-        .unwrap()
-        .chunks()
-        .to_vec();
+    let chunks = PisReader::from_bytes(good.clone()).unwrap().chunks().to_vec();
     let idx = |f: &[u8; 4]| chunks.iter().position(|e| &e.fourcc == f).unwrap();
     let (prov, cstr) = (idx(b"PROV"), idx(b"CSTR"));
 
@@ -238,10 +244,7 @@ fn cases() -> Vec<(u16, Vec<u8>)> {
     v.push((4003, t().set_u8("dimension 0 kind", 9).reseal()));
     v.push((4004, unchecked(|c| c.space.dims[1].values.clear())));
     v.push((4005, t().set_u32("dimension 0 block size", 0).reseal()));
-    v.push((
-        4006,
-        t().set_f32("dimension 0 sample values", f32::NAN).reseal(),
-    ));
+    v.push((4006, t().set_f32("dimension 0 sample values", f32::NAN).reseal()));
     v.push((
         4007,
         unchecked(|c| {
@@ -270,16 +273,8 @@ fn cases() -> Vec<(u16, Vec<u8>)> {
         f.bytes[at..at + 4].copy_from_slice(&0.5f32.to_le_bytes());
         f.reseal()
     }));
-    v.push((
-        5105,
-        t().set_u32("object 0 block origin offset, dimension 0", 2)
-            .reseal(),
-    ));
-    v.push((
-        5106,
-        t().set_f32("object 0 world_from_object 0", f32::INFINITY)
-            .reseal(),
-    ));
+    v.push((5105, t().set_u32("object 0 block origin offset, dimension 0", 2).reseal()));
+    v.push((5106, t().set_f32("object 0 world_from_object 0", f32::INFINITY).reseal()));
     v.push((5200, t().set_u32("vertex count", 1000).reseal()));
     v.push((5201, t().set_u32("object index", 4).reseal()));
     v.push((5202, {
@@ -290,11 +285,7 @@ fn cases() -> Vec<(u16, Vec<u8>)> {
         let mut b = to_bytes(&c).unwrap();
         // The second MESH chunk becomes an unknown optional chunk: object 1 has no mesh.
         let r = PisReader::from_bytes(b.clone()).unwrap();
-        let i = r
-            .chunks()
-            .iter()
-            .rposition(|e| &e.fourcc == b"MESH")
-            .unwrap();
+        let i = r.chunks().iter().rposition(|e| &e.fourcc == b"MESH").unwrap();
         b[entry(i)..entry(i) + 4].copy_from_slice(b"XMSH");
         b[entry(i) + 4] = 0;
         reseal(&mut b);
@@ -336,11 +327,7 @@ fn cases() -> Vec<(u16, Vec<u8>)> {
         }),
     ));
     v.push((6006, t().set_u32("layer 1 block 0 width", 5).reseal()));
-    v.push((
-        6007,
-        t().set_f32("layer 1 block 0 shell parameters", -4.0)
-            .reseal(),
-    ));
+    v.push((6007, t().set_f32("layer 1 block 0 shell parameters", -4.0).reseal()));
     // A texture that wraps along s with a side of 3 texels: the validator once passed it and
     // the player refused it ("repeat addressing ... needs a power-of-two used texture size").
     v.push((
@@ -372,15 +359,16 @@ fn cases() -> Vec<(u16, Vec<u8>)> {
             };
         }),
     ));
-    v.push((
-        3006,
-        t().set_f32("layer 0 block 0 branch cuts u, v", 0.5)
-            .reseal(),
-    ));
+    v.push((3006, t().set_f32("layer 0 block 0 branch cuts u, v", 0.5).reseal()));
     // A shell block's flags hold the lookups per pixel side less one: 0 to 2.
     v.push((3006, {
         let mut f = t();
-        let at = f.spans.iter().find(|s| s.label.contains("flags (lookups per pixel side")).expect("a shell block").start;
+        let at = f
+            .spans
+            .iter()
+            .find(|s| s.label.contains("flags (lookups per pixel side"))
+            .expect("a shell block")
+            .start;
         f.bytes[at..at + 2].copy_from_slice(&3u16.to_le_bytes());
         f.reseal()
     }));
@@ -422,43 +410,22 @@ fn cases() -> Vec<(u16, Vec<u8>)> {
         to_bytes_unchecked(&c)
     }));
     // 8xxx
-    v.push((
-        8001,
-        t().set_u32("layer 0 block 0 level 0 image 0 chunk index", 0)
-            .reseal(),
-    ));
-    v.push((
-        8002,
-        t().set_u32("layer 0 block 0 level 0 image 0 offset", 1 << 20)
-            .reseal(),
-    ));
+    v.push((8001, t().set_u32("layer 0 block 0 level 0 image 0 chunk index", 0).reseal()));
+    v.push((8002, t().set_u32("layer 0 block 0 level 0 image 0 offset", 1 << 20).reseal()));
     v.push((8003, {
         let mut f = t();
         let at = f.at("codestream");
         f.bytes[at + 3] ^= 0x10;
         f.reseal()
     }));
-    v.push((
-        8004,
-        t().set_u16("layer 0 block 0 level 0 image 0 codec", 77)
-            .reseal(),
-    ));
-    v.push((
-        8005,
-        t().set_u16("layer 0 block 0 level 0 image 0 codec", 0)
-            .reseal(),
-    ));
+    v.push((8004, t().set_u16("layer 0 block 0 level 0 image 0 codec", 77).reseal()));
+    v.push((8005, t().set_u16("layer 0 block 0 level 0 image 0 codec", 0).reseal()));
     v.push((8006, {
         // A raw texel becomes NaN, with the codestream's own checksum updated.
         let mut f = File::of(&minimal().unwrap());
         let at = f.at("codestream");
         f.bytes[at..at + 4].copy_from_slice(&f32::NAN.to_le_bytes());
-        let span = f
-            .spans
-            .iter()
-            .find(|s| s.label.starts_with("codestream"))
-            .unwrap()
-            .clone();
+        let span = f.spans.iter().find(|s| s.label.starts_with("codestream")).unwrap().clone();
         let crc = crc32fast::hash(&f.bytes[span.start..span.start + span.len]);
         f.set_u32("layer 0 block 0 level 0 image 0 crc32", crc);
         f.reseal()
@@ -472,11 +439,7 @@ fn cases() -> Vec<(u16, Vec<u8>)> {
     ));
     // 8007 (reserved codec) has no case: every codec id of version 1 is decodable by this
     // build. A raw codestream relabelled as `wavelet` is now checked, and is corrupt.
-    v.push((
-        8005,
-        t().set_u16("layer 0 block 0 level 0 image 0 codec", 2)
-            .reseal(),
-    ));
+    v.push((8005, t().set_u16("layer 0 block 0 level 0 image 0 codec", 2).reseal()));
     v.push((9000, t().set_u32("tool length", 1 << 30).reseal()));
     v.push((
         9001,
@@ -523,23 +486,37 @@ fn cases() -> Vec<(u16, Vec<u8>)> {
     };
     v.push((9100, with_master().set_u32("master layer 0 sample count", 1 << 30).reseal()));
     v.push((9101, with_master().set_u32("master object index", 7).reseal()));
-    v.push((9102, edited(&|m| {
-        m[0].layers[0].samples.pop();
-    })));
-    v.push((9102, edited(&|m| {
-        m[0].layers.pop();
-    })));
+    v.push((
+        9102,
+        edited(&|m| {
+            m[0].layers[0].samples.pop();
+        }),
+    ));
+    v.push((
+        9102,
+        edited(&|m| {
+            m[0].layers.pop();
+        }),
+    ));
     v.push((9103, with_master().set_u8("master layer 0 codec", 2).reseal()));
     v.push((9104, edited(&|m| m[0].area = f64::NAN)));
     v.push((9105, edited(&|m| m[0].layers[0].samples[0].truncate(5))));
-    v.push((9106, edited(&|m| {
-        // A raw master texture holding a NaN.
-        let n = master::sample_layout(&c, &c.objects[0], 0, 0).unwrap().planes().iter().map(|p| (p.width * p.height * p.channels) as usize).sum::<usize>();
-        let mut values = vec![0.5f32; n];
-        values[3] = f32::NAN;
-        m[0].layers[0].codec = CodecId::Raw;
-        m[0].layers[0].samples[0] = values.iter().flat_map(|x| x.to_le_bytes()).collect();
-    })));
+    v.push((
+        9106,
+        edited(&|m| {
+            // A raw master texture holding a NaN.
+            let n = master::sample_layout(&c, &c.objects[0], 0, 0)
+                .unwrap()
+                .planes()
+                .iter()
+                .map(|p| (p.width * p.height * p.channels) as usize)
+                .sum::<usize>();
+            let mut values = vec![0.5f32; n];
+            values[3] = f32::NAN;
+            m[0].layers[0].codec = CodecId::Raw;
+            m[0].layers[0].samples[0] = values.iter().flat_map(|x| x.to_le_bytes()).collect();
+        }),
+    ));
     v.push((9107, {
         let mut two = c.clone();
         let mut second = two.objects[0].clone();
@@ -548,28 +525,58 @@ fn cases() -> Vec<(u16, Vec<u8>)> {
         to_bytes_unchecked_with_masters(&two, &masters)
     }));
     v.push((9100, with_master().set_u8("master layer 0 flags", 0x80).reseal()));
-    v.push((9108, edited(&|m| {
-        // Raw screen weights, one per finest texel, one of them negative.
-        let l = master::sample_layout(&c, &c.objects[0], 0, 0).unwrap();
-        let mut values = vec![1.0f32; (l.width * l.height) as usize];
-        values[2] = -1.0;
-        let layer = &mut m[0].layers[0];
-        layer.codec = CodecId::Raw;
-        layer.samples = layer.samples.iter().map(|_| {
-            let n = l.planes().iter().map(|p| (p.width * p.height * p.channels) as usize).sum::<usize>();
-            vec![0.5f32; n].iter().flat_map(|x| x.to_le_bytes()).collect()
-        }).collect();
-        layer.weights = layer.samples.iter().map(|_| values.iter().flat_map(|x| x.to_le_bytes()).collect()).collect();
-    })));
-    v.push((9108, edited(&|m| {
-        // Screen weights of the wrong size.
-        let layer = &mut m[0].layers[0];
-        layer.codec = CodecId::Raw;
-        let l = master::sample_layout(&c, &c.objects[0], 0, 0).unwrap();
-        let n = l.planes().iter().map(|p| (p.width * p.height * p.channels) as usize).sum::<usize>();
-        layer.samples = layer.samples.iter().map(|_| vec![0.5f32; n].iter().flat_map(|x| x.to_le_bytes()).collect()).collect();
-        layer.weights = layer.samples.iter().map(|_| vec![1.0f32; 3].iter().flat_map(|x| x.to_le_bytes()).collect()).collect();
-    })));
+    v.push((
+        9108,
+        edited(&|m| {
+            // Raw screen weights, one per finest texel, one of them negative.
+            let l = master::sample_layout(&c, &c.objects[0], 0, 0).unwrap();
+            let mut values = vec![1.0f32; (l.width * l.height) as usize];
+            values[2] = -1.0;
+            let layer = &mut m[0].layers[0];
+            layer.codec = CodecId::Raw;
+            layer.samples = layer
+                .samples
+                .iter()
+                .map(|_| {
+                    let n = l
+                        .planes()
+                        .iter()
+                        .map(|p| (p.width * p.height * p.channels) as usize)
+                        .sum::<usize>();
+                    vec![0.5f32; n].iter().flat_map(|x| x.to_le_bytes()).collect()
+                })
+                .collect();
+            layer.weights = layer
+                .samples
+                .iter()
+                .map(|_| values.iter().flat_map(|x| x.to_le_bytes()).collect())
+                .collect();
+        }),
+    ));
+    v.push((
+        9108,
+        edited(&|m| {
+            // Screen weights of the wrong size.
+            let layer = &mut m[0].layers[0];
+            layer.codec = CodecId::Raw;
+            let l = master::sample_layout(&c, &c.objects[0], 0, 0).unwrap();
+            let n = l
+                .planes()
+                .iter()
+                .map(|p| (p.width * p.height * p.channels) as usize)
+                .sum::<usize>();
+            layer.samples = layer
+                .samples
+                .iter()
+                .map(|_| vec![0.5f32; n].iter().flat_map(|x| x.to_le_bytes()).collect())
+                .collect();
+            layer.weights = layer
+                .samples
+                .iter()
+                .map(|_| vec![1.0f32; 3].iter().flat_map(|x| x.to_le_bytes()).collect())
+                .collect();
+        }),
+    ));
     let _ = cstr;
     v
 }
@@ -579,31 +586,27 @@ fn every_rule_is_detected_by_its_crafted_file() {
     for (id, bytes) in cases() {
         let report = validate_bytes(bytes.clone());
         let ids: Vec<u16> = report.issues.iter().map(|i| i.id).collect();
-        assert!(
-            ids.contains(&id),
-            "rule {id}: expected it among {:?}",
-            report.issues
-        );
-        let is_error = report
-            .issues
-            .iter()
-            .any(|i| i.id == id && i.severity == Severity::Error);
-        assert_eq!(
-            report.is_valid(),
-            !is_error,
-            "rule {id}: {:?}",
-            report.issues
-        );
+        assert!(ids.contains(&id), "rule {id}: expected it among {:?}", report.issues);
+        let is_error = report.issues.iter().any(|i| i.id == id && i.severity == Severity::Error);
+        assert_eq!(report.is_valid(), !is_error, "rule {id}: {:?}", report.issues);
         if is_error && (9100..9200).contains(&id) {
             // Opening ignores the master (a player never reads it); reading it fails.
             let r = PisReader::from_bytes(bytes).unwrap_or_else(|e| panic!("rule {id}: {e}"));
             let failed = match r.masters() {
                 Err(e) => e.issue().is_some_and(|i| i.id == id),
                 Ok(ms) => ms.iter().any(|m| {
-                    m.layers.iter().enumerate().any(|(l, ml)| (0..ml.samples.len()).any(|s| {
-                        m.texture(r.container(), l, s).err().and_then(|e| e.issue().map(|i| i.id)) == Some(id)
-                            || m.weights(r.container(), l, s).err().and_then(|e| e.issue().map(|i| i.id)) == Some(id)
-                    }))
+                    m.layers.iter().enumerate().any(|(l, ml)| {
+                        (0..ml.samples.len()).any(|s| {
+                            m.texture(r.container(), l, s)
+                                .err()
+                                .and_then(|e| e.issue().map(|i| i.id))
+                                == Some(id)
+                                || m.weights(r.container(), l, s)
+                                    .err()
+                                    .and_then(|e| e.issue().map(|i| i.id))
+                                    == Some(id)
+                        })
+                    })
                 }),
             };
             assert!(failed, "rule {id}: the master was read");
@@ -613,8 +616,7 @@ fn every_rule_is_detected_by_its_crafted_file() {
                 .err()
                 .unwrap_or_else(|| panic!("rule {id}: reader accepted the file"));
             assert!(
-                err.to_string()
-                    .contains(&format!("error-{}", err.issue().map_or(0, |i| i.id))),
+                err.to_string().contains(&format!("error-{}", err.issue().map_or(0, |i| i.id))),
                 "{err}"
             );
         } else if is_error {
@@ -633,11 +635,8 @@ fn every_rule_has_a_case() {
     let covered: BTreeSet<u16> = cases().iter().map(|(id, _)| *id).collect();
     // 1001 (unreadable file) is covered by `missing_file_is_an_io_issue`; 8007 (a codec
     // this reader cannot decode) applies to no codec id in this build.
-    let all: BTreeSet<u16> = RULES
-        .iter()
-        .map(|(id, _)| *id)
-        .filter(|&id| id != 1001 && id != 8007)
-        .collect();
+    let all: BTreeSet<u16> =
+        RULES.iter().map(|(id, _)| *id).filter(|&id| id != 1001 && id != 8007).collect();
     assert_eq!(covered, all);
 }
 
@@ -645,10 +644,7 @@ fn every_rule_has_a_case() {
 fn missing_file_is_an_io_issue() {
     let report = validate_file("/no/such/file.pis".as_ref());
     assert_eq!(report.issues[0].id, 1001);
-    assert!(matches!(
-        PisReader::open("/no/such/file.pis".as_ref()),
-        Err(Error::Io { .. })
-    ));
+    assert!(matches!(PisReader::open("/no/such/file.pis".as_ref()), Err(Error::Io { .. })));
 }
 
 #[test]
@@ -692,10 +688,7 @@ fn validation_reports_every_independent_broken_rule() {
     assert_reports(f.bytes.clone(), &[3004, 5104]);
     // Two broken rules in one payload that stays readable: a reserved field and a sample value.
     assert_reports(
-        File::tiny()
-            .set_u32("reserved", 5)
-            .set_f32("dimension 0 sample values", f32::NAN)
-            .reseal(),
+        File::tiny().set_u32("reserved", 5).set_f32("dimension 0 sample values", f32::NAN).reseal(),
         &[3006, 4006],
     );
     // A broken header rule does not hide the chunks' rules.
@@ -746,7 +739,9 @@ fn validation_reports_every_independent_broken_rule() {
 fn a_rule_that_builds_on_a_broken_structure_is_skipped() {
     // OBJS does not parse: the layers, which name objects, are not checked, and no
     // codestream is decoded; the camera rules still are.
-    let ids = reported(File::tiny().set_u8("object 0 role", 7).set_u32("layer 0 object index", 3).reseal());
+    let ids = reported(
+        File::tiny().set_u8("object 0 role", 7).set_u32("layer 0 object index", 3).reseal(),
+    );
     assert!(ids.contains(&5103) && !ids.contains(&6001), "{ids:?}");
     // A parameter space that breaks a rule: the tables measured on it are not checked.
     let ids = reported(File::tiny().set_u32("dimension 0 block size", 0).reseal());
@@ -758,15 +753,29 @@ fn a_rule_that_builds_on_a_broken_structure_is_skipped() {
 #[test]
 fn shell_lookups_round_trip() {
     fn lookups<S>(c: &Container<S>) -> Vec<u32> {
-        c.objects.iter().flat_map(|o| &o.layers).flat_map(|l| &l.blocks).filter_map(|b| match b.placement {
-            Placement::Shell { lookups, .. } => Some(lookups),
-            Placement::Surface { .. } => None,
-        }).collect()
+        c.objects
+            .iter()
+            .flat_map(|o| &o.layers)
+            .flat_map(|l| &l.blocks)
+            .filter_map(|b| match b.placement {
+                Placement::Shell { lookups, .. } => Some(lookups),
+                Placement::Surface { .. } => None,
+            })
+            .collect()
     }
     let mut c = tiny().unwrap();
     let plain = to_bytes(&c).unwrap();
-    assert!(!lookups(&c).is_empty() && lookups(&c).iter().all(|&k| k == 1), "the sample has shell blocks, each looked up once");
-    for (k, b) in c.objects.iter_mut().flat_map(|o| o.layers.iter_mut()).flat_map(|l| l.blocks.iter_mut()).enumerate() {
+    assert!(
+        !lookups(&c).is_empty() && lookups(&c).iter().all(|&k| k == 1),
+        "the sample has shell blocks, each looked up once"
+    );
+    for (k, b) in c
+        .objects
+        .iter_mut()
+        .flat_map(|o| o.layers.iter_mut())
+        .flat_map(|l| l.blocks.iter_mut())
+        .enumerate()
+    {
         if let Placement::Shell { lookups, .. } = &mut b.placement {
             *lookups = 1 + (k as u32 % 3);
         }

@@ -8,9 +8,7 @@ use pis_format::samples::{minimal, tiny};
 use pis_format::{hexdump, to_bytes, to_bytes_labelled};
 
 fn repo(rel: &str) -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("../..")
-        .join(rel)
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../..").join(rel)
 }
 
 fn updating() -> bool {
@@ -37,11 +35,7 @@ fn spec_example_matches_the_writer() {
     check_file("format-spec/examples/minimal.pis", &bytes);
     let dump = hexdump::annotate(&bytes, &spans);
     check_file("format-spec/examples/minimal.hex", dump.as_bytes());
-    assert_eq!(
-        hexdump::parse(&dump),
-        bytes,
-        "the dump's hex columns are the file"
-    );
+    assert_eq!(hexdump::parse(&dump), bytes, "the dump's hex columns are the file");
     // Every byte is labelled exactly once, in order.
     let mut at = 0;
     for s in &spans {
@@ -56,10 +50,7 @@ fn spec_lists_every_validation_rule() {
     let spec = std::fs::read_to_string(repo("format-spec/SPEC.md")).unwrap();
     for (id, message) in pis_format::issue::RULES {
         let row = format!("| {id} | {message} |");
-        assert!(
-            spec.lines().any(|l| l == row),
-            "SPEC.md lacks the row {row:?}"
-        );
+        assert!(spec.lines().any(|l| l == row), "SPEC.md lacks the row {row:?}");
     }
     let rows = spec
         .lines()
@@ -81,20 +72,12 @@ fn spec_lists_every_validation_rule() {
 fn spec_excerpt_is_from_the_example_dump() {
     let spec = std::fs::read_to_string(repo("format-spec/SPEC.md")).unwrap();
     let dump = std::fs::read_to_string(repo("format-spec/examples/minimal.hex")).unwrap();
-    let section = spec
-        .split("## 14. Worked example")
-        .nth(1)
-        .expect("section 14");
+    let section = spec.split("## 14. Worked example").nth(1).expect("section 14");
     let excerpt = section.split("```").nth(1).expect("an excerpt");
-    let lines: Vec<&str> = excerpt
-        .lines()
-        .filter(|l| !l.trim().is_empty() && l.trim() != "...")
-        .collect();
+    let lines: Vec<&str> =
+        excerpt.lines().filter(|l| !l.trim().is_empty() && l.trim() != "...").collect();
     assert!(lines.len() > 10);
     for l in lines {
-        assert!(
-            dump.lines().any(|d| d == l),
-            "excerpt line not in minimal.hex: {l:?}"
-        );
+        assert!(dump.lines().any(|d| d == l), "excerpt line not in minimal.hex: {l:?}");
     }
 }

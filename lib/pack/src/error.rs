@@ -38,10 +38,7 @@ pub struct Failure {
 
 impl Failure {
     pub fn new(exit: Exit, error: impl Into<anyhow::Error>) -> Self {
-        Failure {
-            exit,
-            error: error.into(),
-        }
+        Failure { exit, error: error.into() }
     }
 }
 

@@ -7,11 +7,7 @@ use anyhow::Context;
 
 /// Linear → sRGB transfer function (IEC 61966-2-1), clamped to [0, 1].
 pub fn srgb_encode(linear: f32) -> f32 {
-    let l = if linear.is_finite() {
-        linear.clamp(0.0, 1.0)
-    } else {
-        0.0
-    };
+    let l = if linear.is_finite() { linear.clamp(0.0, 1.0) } else { 0.0 };
     if l <= 0.003_130_8 {
         12.92 * l
     } else {
@@ -20,10 +16,7 @@ pub fn srgb_encode(linear: f32) -> f32 {
 }
 
 fn temp_beside(path: &Path) -> PathBuf {
-    let name = path
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_default();
+    let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
     path.with_file_name(format!(".{name}.tmp"))
 }
 
@@ -45,9 +38,7 @@ pub fn write_exr(
     let (w, h, c) = (width as usize, height as usize, channels as usize);
     let at = |x: usize, y: usize, k: usize| data[(y * w + x) * c + k];
     let result = if c == 4 {
-        write_rgba_file(&tmp, w, h, |x, y| {
-            (at(x, y, 0), at(x, y, 1), at(x, y, 2), at(x, y, 3))
-        })
+        write_rgba_file(&tmp, w, h, |x, y| (at(x, y, 0), at(x, y, 1), at(x, y, 2), at(x, y, 3)))
     } else {
         write_rgb_file(&tmp, w, h, |x, y| (at(x, y, 0), at(x, y, 1), at(x, y, 2)))
     };
@@ -71,21 +62,14 @@ pub fn write_png(
         .chunks_exact(c)
         .flat_map(|px| {
             (0..c).map(move |k| {
-                let v = if k == 3 {
-                    px[k].clamp(0.0, 1.0)
-                } else {
-                    srgb_encode(px[k])
-                };
+                let v = if k == 3 { px[k].clamp(0.0, 1.0) } else { srgb_encode(px[k]) };
                 (v * 255.0 + 0.5) as u8
             })
         })
         .collect();
     let tmp = temp_beside(path);
-    let color = if c == 4 {
-        image::ExtendedColorType::Rgba8
-    } else {
-        image::ExtendedColorType::Rgb8
-    };
+    let color =
+        if c == 4 { image::ExtendedColorType::Rgba8 } else { image::ExtendedColorType::Rgb8 };
     if let Err(e) =
         image::save_buffer_with_format(&tmp, &bytes, width, height, color, image::ImageFormat::Png)
     {

@@ -19,10 +19,14 @@ use glam::Vec3;
 use pis_compile::baseline::forward::forward_map;
 use pis_compile::baseline::traced::trace_into_texture;
 use pis_compile::baseline::LayerImage;
-use pis_compile::texcoord::{charts::{separate_overlapping_charts, unfold_charts}, optimize_placement, ObjectMesh, TexcoordSettings, ViewGeometry};
+use pis_compile::texcoord::{
+    charts::{separate_overlapping_charts, unfold_charts},
+    optimize_placement, ObjectMesh, TexcoordSettings, ViewGeometry,
+};
 use pis_compile::{
-    antialiased_render_matrix, render, render_matrix, scene_depth, DisplayFilter, solve, Address, DrawMesh, Filter, MipSolve, RenderMatrix, Sampler,
-    SolveSettings, TextureLayout, TextureTransform, TexturedObject, Viewport,
+    antialiased_render_matrix, render, render_matrix, scene_depth, solve, Address, DisplayFilter,
+    DrawMesh, Filter, MipSolve, RenderMatrix, Sampler, SolveSettings, TextureLayout,
+    TextureTransform, TexturedObject, Viewport,
 };
 use pis_play::{render_object, Gpu, TexturedPipeline};
 use pis_scene::{Frame, LoadOptions, Scene};
@@ -178,7 +182,9 @@ fn vertex_normals(positions: &[Vec3], indices: &[u32]) -> Vec<[f32; 3]> {
     let mut n = vec![Vec3::ZERO; positions.len()];
     for t in indices.chunks_exact(3) {
         let [a, b, c] = [t[0], t[1], t[2]].map(|i| i as usize);
-        if let (Some(&pa), Some(&pb), Some(&pc)) = (positions.get(a), positions.get(b), positions.get(c)) {
+        if let (Some(&pa), Some(&pb), Some(&pc)) =
+            (positions.get(a), positions.get(b), positions.get(c))
+        {
             let f = (pb - pa).cross(pc - pa);
             [a, b, c].iter().for_each(|&v| n[v] += f);
         }
@@ -192,10 +198,19 @@ pub fn seam_wraps(mesh: &Mesh) -> [bool; 2] {
     let mut out = [false; 2];
     for (dim, flag) in out.iter_mut().enumerate() {
         let key = |p: [f32; 3]| p.map(|c| (c * 1e4).round() as i64);
-        let lo: std::collections::BTreeSet<_> = mesh.positions.iter().zip(&mesh.uvs)
-            .filter(|(_, uv)| uv[dim].abs() < 1e-4).map(|(p, _)| key(*p)).collect();
-        let matches = mesh.positions.iter().zip(&mesh.uvs)
-            .filter(|(p, uv)| (uv[dim] - 1.0).abs() < 1e-4 && lo.contains(&key(**p))).count();
+        let lo: std::collections::BTreeSet<_> = mesh
+            .positions
+            .iter()
+            .zip(&mesh.uvs)
+            .filter(|(_, uv)| uv[dim].abs() < 1e-4)
+            .map(|(p, _)| key(*p))
+            .collect();
+        let matches = mesh
+            .positions
+            .iter()
+            .zip(&mesh.uvs)
+            .filter(|(p, uv)| (uv[dim] - 1.0).abs() < 1e-4 && lo.contains(&key(**p)))
+            .count();
         *flag = matches >= 2;
     }
     out
@@ -217,14 +232,24 @@ fn nearest_samples(scene: &Scene, at: Option<&[f32]>) -> Result<Vec<u32>> {
         None => Ok(dims.iter().map(|d| d.samples() / 2).collect()),
         Some(v) => {
             if v.len() != dims.len() {
-                bail!("--at gives {} values, the parameter space has {} dimensions ({})", v.len(), dims.len(),
-                      dims.iter().map(|d| d.name.as_str()).collect::<Vec<_>>().join(", "));
+                bail!(
+                    "--at gives {} values, the parameter space has {} dimensions ({})",
+                    v.len(),
+                    dims.len(),
+                    dims.iter().map(|d| d.name.as_str()).collect::<Vec<_>>().join(", ")
+                );
             }
-            Ok(dims.iter().zip(v).map(|(d, &x)| {
-                d.values.iter().enumerate()
-                    .min_by(|a, b| (a.1 - x).abs().total_cmp(&(b.1 - x).abs()))
-                    .map_or(0, |(i, _)| i as u32)
-            }).collect())
+            Ok(dims
+                .iter()
+                .zip(v)
+                .map(|(d, &x)| {
+                    d.values
+                        .iter()
+                        .enumerate()
+                        .min_by(|a, b| (a.1 - x).abs().total_cmp(&(b.1 - x).abs()))
+                        .map_or(0, |(i, _)| i as u32)
+                })
+                .collect())
         }
     }
 }
@@ -236,10 +261,15 @@ fn load_point(req: &InferRequest) -> Result<Point> {
         let scene_path = req.scene.clone().unwrap_or_else(|| set.default_scene());
         let res = (set.meta.resolution[0], set.meta.resolution[1]);
         let options = LoadOptions { resolution: Some(res), ..LoadOptions::default() };
-        let scene = pis_scene::load_with(&scene_path, &options)
-            .with_context(|| format!("loading {} (the set's scene; pass --scene)", scene_path.display()))?;
+        let scene = pis_scene::load_with(&scene_path, &options).with_context(|| {
+            format!("loading {} (the set's scene; pass --scene)", scene_path.display())
+        })?;
         let samples = nearest_samples(&scene, req.at.as_deref())?;
-        let index = set.meta.points.iter().position(|p| p.samples == samples)
+        let index = set
+            .meta
+            .points
+            .iter()
+            .position(|p| p.samples == samples)
             .ok_or_else(|| anyhow!("the set has no point at samples {samples:?}"))?;
         let images = set.read_point(index)?;
         let frame = scene.frame(&samples)?;
@@ -248,11 +278,13 @@ fn load_point(req: &InferRequest) -> Result<Point> {
         settings.filter = set.meta.filter;
         Ok(Point { scene, frame, images, samples, values, settings, trace_ms: 0.0 })
     } else {
-        let options = LoadOptions { preset: req.preset.clone(), resolution: req.resolution, spp: req.spp };
+        let options =
+            LoadOptions { preset: req.preset.clone(), resolution: req.resolution, spp: req.spp };
         let scene = pis_scene::load_with(&req.input, &options)?;
         let samples = nearest_samples(&scene, req.at.as_deref())?;
         let frame = scene.frame(&samples)?;
-        let values = scene.space.dims.iter().zip(&samples).map(|(d, &s)| d.values[s as usize]).collect();
+        let values =
+            scene.space.dims.iter().zip(&samples).map(|(d, &s)| d.values[s as usize]).collect();
         let settings = TraceSettings::new(scene.resolution, scene.spp);
         let t = Instant::now();
         let render = pis_trace::render_point(&scene, &frame, &settings, &|| {})?;
@@ -263,9 +295,15 @@ fn load_point(req: &InferRequest) -> Result<Point> {
 
 /// Per pixel: coverage and the object's surface radiance (diffuse + specular).
 fn object_layer(images: &PointImages, channel: &str) -> Result<(Vec<f32>, Vec<f32>)> {
-    let get = |k: LayerKind| images.object_layer(channel, k)
-        .ok_or_else(|| anyhow!("the point has no {} layer for object {channel}", k.name()));
-    let cov = get(LayerKind::Coverage)?.channel("A").ok_or_else(|| anyhow!("coverage without A"))?.to_vec();
+    let get = |k: LayerKind| {
+        images
+            .object_layer(channel, k)
+            .ok_or_else(|| anyhow!("the point has no {} layer for object {channel}", k.name()))
+    };
+    let cov = get(LayerKind::Coverage)?
+        .channel("A")
+        .ok_or_else(|| anyhow!("coverage without A"))?
+        .to_vec();
     let (d, s) = (get(LayerKind::Diffuse)?, get(LayerKind::Specular)?);
     let n = cov.len();
     let mut rgb = vec![0.0f32; n * 3];
@@ -284,7 +322,8 @@ fn display(v: f32) -> f64 {
 
 /// PSNR of display values, peak 1.
 pub fn psnr_display(a: &[f32], b: &[f32]) -> f64 {
-    let mse = a.iter().zip(b).map(|(x, y)| (display(*x) - display(*y)).powi(2)).sum::<f64>() / a.len().max(1) as f64;
+    let mse = a.iter().zip(b).map(|(x, y)| (display(*x) - display(*y)).powi(2)).sum::<f64>()
+        / a.len().max(1) as f64;
     10.0 * (1.0 / mse.max(1e-20)).log10()
 }
 
@@ -311,7 +350,13 @@ pub fn restrict_rows(a: &RenderMatrix, cov: &[f32]) -> RenderMatrix {
 
 /// The rows of `a` whose pixel `keep` marks, in their order.
 pub fn select_rows(a: &RenderMatrix, keep: impl Fn(u32) -> bool) -> RenderMatrix {
-    let mut out = RenderMatrix { width: a.width, height: a.height, layout: a.layout, row_start: vec![0], ..Default::default() };
+    let mut out = RenderMatrix {
+        width: a.width,
+        height: a.height,
+        layout: a.layout,
+        row_start: vec![0],
+        ..Default::default()
+    };
     for r in 0..a.rows() {
         if !keep(a.pixels[r]) {
             continue;
@@ -334,8 +379,23 @@ pub struct Prepared {
     pub texcoord_ms: f64,
 }
 
-fn prepare(pt: &Point, o: usize, mesh: &Mesh, req: &InferRequest, reduction: f64) -> Result<Prepared> {
-    place(&pt.scene, &[&pt.frame], pt.settings.resolution, o, mesh, req.max_texture, reduction, req.texels_per_pixel)
+fn prepare(
+    pt: &Point,
+    o: usize,
+    mesh: &Mesh,
+    req: &InferRequest,
+    reduction: f64,
+) -> Result<Prepared> {
+    place(
+        &pt.scene,
+        &[&pt.frame],
+        pt.settings.resolution,
+        o,
+        mesh,
+        req.max_texture,
+        reduction,
+        req.texels_per_pixel,
+    )
 }
 
 /// Texture-coordinate optimization (thesis 3.2) of object `o` over the views of `frames`,
@@ -373,15 +433,24 @@ pub struct Atlas {
 
 /// The mesh of object `o` as the views of `frames` see it (clip-space vertices).
 fn view_geometry(frames: &[&Frame], res: (u32, u32), o: usize, mesh: &Mesh) -> Vec<ViewGeometry> {
-    frames.iter().map(|frame| {
-        let proj = pis_trace::camera::projection_matrix(&frame.camera, res);
-        let clip_from_object = proj * frame.camera.world_from_camera.inverse() * frame.instances[o].world_from_object;
-        ViewGeometry {
-            clip: mesh.positions.iter().map(|p| clip_from_object * Vec3::from(*p).extend(1.0)).collect(),
-            width: res.0,
-            height: res.1,
-        }
-    }).collect()
+    frames
+        .iter()
+        .map(|frame| {
+            let proj = pis_trace::camera::projection_matrix(&frame.camera, res);
+            let clip_from_object = proj
+                * frame.camera.world_from_camera.inverse()
+                * frame.instances[o].world_from_object;
+            ViewGeometry {
+                clip: mesh
+                    .positions
+                    .iter()
+                    .map(|p| clip_from_object * Vec3::from(*p).extend(1.0))
+                    .collect(),
+                width: res.0,
+                height: res.1,
+            }
+        })
+        .collect()
 }
 
 /// The object's texture coordinates over the views of `frames`: visible parts sharing (u, v)
@@ -392,7 +461,9 @@ pub fn atlas(frames: &[&Frame], res: (u32, u32), o: usize, mesh: &Mesh) -> Atlas
     let views = view_geometry(frames, res, o, mesh);
     let uvs: Vec<glam::Vec2> = mesh.uvs.iter().map(|u| glam::Vec2::from(*u)).collect();
     match separate_overlapping_charts(&uvs, &mesh.indices, &views) {
-        Some(atlas) => Atlas { uvs: atlas.iter().map(|uv| uv.to_array()).collect(), wrap: [false, false] },
+        Some(atlas) => {
+            Atlas { uvs: atlas.iter().map(|uv| uv.to_array()).collect(), wrap: [false, false] }
+        }
         None => Atlas { uvs: mesh.uvs.clone(), wrap: seam_wraps(mesh) },
     }
 }
@@ -411,7 +482,9 @@ impl Placed {
     /// Whether textures placed by `self` and `other` are drawn alike (the same texture
     /// transform, size and wrapping).
     pub fn same(&self, other: &Placed) -> bool {
-        self.transform == other.transform && self.layout == other.layout && self.repeat == other.repeat
+        self.transform == other.transform
+            && self.layout == other.layout
+            && self.repeat == other.repeat
     }
 }
 
@@ -434,11 +507,19 @@ pub fn place_in(
     let uvs: Vec<glam::Vec2> = atlas.uvs.iter().map(|u| glam::Vec2::from(*u)).collect();
     let name = &scene.objects[o].name;
     let om = ObjectMesh { name, uvs: &uvs, indices: &mesh.indices, wrap: atlas.wrap };
-    let settings = TexcoordSettings { max_size: max_texture, reduction, texels_per_pixel, ..TexcoordSettings::default() };
+    let settings = TexcoordSettings {
+        max_size: max_texture,
+        reduction,
+        texels_per_pixel,
+        ..TexcoordSettings::default()
+    };
     let pl = optimize_placement(&om, &views, &settings)?;
     Ok(Placed {
         // A cut rounded up to 1 in f32 is the cut at 0.
-        transform: TextureTransform { values: pl.affine, cut: pl.branch_cut.map(|c| c.map(|c| if (c as f32) < 1.0 { c as f32 } else { 0.0 })) },
+        transform: TextureTransform {
+            values: pl.affine,
+            cut: pl.branch_cut.map(|c| c.map(|c| if (c as f32) < 1.0 { c as f32 } else { 0.0 })),
+        },
         layout: TextureLayout::full(pl.width, pl.height),
         repeat: pl.repeat,
         reduction: pl.reduction,
@@ -446,7 +527,10 @@ pub fn place_in(
 }
 
 pub fn sampler(filter: Filter, repeat: [bool; 2]) -> Sampler {
-    Sampler { filter, address: repeat.map(|r| if r { Address::Repeat } else { Address::ClampToEdge }) }
+    Sampler {
+        filter,
+        address: repeat.map(|r| if r { Address::Repeat } else { Address::ClampToEdge }),
+    }
 }
 
 /// Runs the comparison.
@@ -459,15 +543,27 @@ pub fn infer(req: &InferRequest) -> Result<InferReport> {
     let meshes: Vec<Mesh> = (0..scene.objects.len()).map(|o| merged_mesh(scene, o)).collect();
     let clip_from = |o: usize| {
         pis_trace::camera::projection_matrix(&pt.frame.camera, (w, h))
-            * pt.frame.camera.world_from_camera.inverse() * pt.frame.instances[o].world_from_object
+            * pt.frame.camera.world_from_camera.inverse()
+            * pt.frame.instances[o].world_from_object
     };
-    let draw: Vec<DrawMesh> = meshes.iter().enumerate().map(|(o, m)| DrawMesh {
-        positions: &m.positions, uvs: &m.uvs, indices: &m.indices, clip_from_object: clip_from(o),
-    }).collect();
+    let draw: Vec<DrawMesh> = meshes
+        .iter()
+        .enumerate()
+        .map(|(o, m)| DrawMesh {
+            positions: &m.positions,
+            uvs: &m.uvs,
+            indices: &m.indices,
+            clip_from_object: clip_from(o),
+        })
+        .collect();
 
     // The object: named, or the most specular (largest specular share of its radiance).
     let o = match &req.object {
-        Some(n) => scene.objects.iter().position(|x| &x.name == n).or_else(|| names.iter().position(|x| x == n))
+        Some(n) => scene
+            .objects
+            .iter()
+            .position(|x| &x.name == n)
+            .or_else(|| names.iter().position(|x| x == n))
             .ok_or_else(|| anyhow!("no object {n:?}; the scene has {}", names.join(", ")))?,
         None => {
             let mut best = (f64::NEG_INFINITY, 0);
@@ -476,7 +572,9 @@ pub fn infer(req: &InferRequest) -> Result<InferReport> {
                     pt.images.object_layer(n, LayerKind::Coverage).and_then(|l| l.channel("A")),
                     pt.images.object_layer(n, LayerKind::Diffuse),
                     pt.images.object_layer(n, LayerKind::Specular),
-                ) else { continue };
+                ) else {
+                    continue;
+                };
                 let (mut sd, mut ss) = (0.0f64, 0.0f64);
                 for (i, &cv) in c.iter().enumerate() {
                     let (x, y) = (i as u32 % w, i as u32 / w);
@@ -493,10 +591,18 @@ pub fn infer(req: &InferRequest) -> Result<InferReport> {
     };
     let (cov, rgb) = object_layer(&pt.images, &names[o])?;
     let reduction = if req.reduction > 0.0 { req.reduction } else { 1.0 };
-    let display_filter = DisplayFilter { sigma_px: pt.settings.filter.sigma_px, radius_px: pt.settings.filter.radius_px };
-    let all_but = |k: usize| -> Vec<DrawMesh> { draw.iter().enumerate().filter(|(j, _)| *j != k).map(|(_, m)| *m).collect() };
+    let display_filter = DisplayFilter {
+        sigma_px: pt.settings.filter.sigma_px,
+        radius_px: pt.settings.filter.radius_px,
+    };
+    let all_but = |k: usize| -> Vec<DrawMesh> {
+        draw.iter().enumerate().filter(|(j, _)| *j != k).map(|(_, m)| *m).collect()
+    };
     // A for one object: antialiased (thesis 3.4.4) or at pixel centres.
-    let build = |obj: &TexturedObject, k: usize, occ: &pis_compile::DepthBuffer| -> Result<RenderMatrix> {
+    let build = |obj: &TexturedObject,
+                 k: usize,
+                 occ: &pis_compile::DepthBuffer|
+     -> Result<RenderMatrix> {
         Ok(if req.antialias > 1 {
             antialiased_render_matrix(viewport, req.antialias, display_filter, obj, &all_but(k))?
         } else {
@@ -509,7 +615,12 @@ pub fn infer(req: &InferRequest) -> Result<InferReport> {
     let mut mesh_o = draw[o];
     mesh_o.uvs = &prep.mesh_uvs;
     let matrix = |filter| -> Result<RenderMatrix> {
-        let obj = TexturedObject { mesh: mesh_o, transform: prep.transform, layout: prep.layout, sampler: sampler(filter, prep.repeat) };
+        let obj = TexturedObject {
+            mesh: mesh_o,
+            transform: prep.transform,
+            layout: prep.layout,
+            sampler: sampler(filter, prep.repeat),
+        };
         build(&obj, o, &occluders)
     };
     let (a_bil, b) = restrict(&matrix(Filter::Bilinear)?, &cov, &rgb);
@@ -522,7 +633,12 @@ pub fn infer(req: &InferRequest) -> Result<InferReport> {
     // a GPU).
     let mut notes = Vec::new();
     let gpu_state: Result<(Gpu, TexturedPipeline), String> = if req.wgpu {
-        Gpu::new().map(|g| { let p = TexturedPipeline::new(&g); (g, p) }).map_err(|e| e.to_string())
+        Gpu::new()
+            .map(|g| {
+                let p = TexturedPipeline::new(&g);
+                (g, p)
+            })
+            .map_err(|e| e.to_string())
     } else {
         Err("not asked for (--no-wgpu)".into())
     };
@@ -530,82 +646,183 @@ pub fn infer(req: &InferRequest) -> Result<InferReport> {
         Ok((g, _)) => notes.push(format!("psnr_db_wgpu: rendered by pis-play on {}", g.describe())),
         Err(e) => notes.push(format!("psnr_db_wgpu is null: no wgpu rendering ({e})")),
     }
-    let occluder_meshes: Vec<DrawMesh> = draw.iter().enumerate().filter(|(k, _)| *k != o).map(|(_, m)| *m).collect();
+    let occluder_meshes: Vec<DrawMesh> =
+        draw.iter().enumerate().filter(|(k, _)| *k != o).map(|(_, m)| *m).collect();
     let wgpu_psnr = |a: &RenderMatrix, filter: Filter, x: &[f32]| -> Result<Option<f64>, String> {
         let Ok((gpu, pipeline)) = gpu_state.as_ref() else { return Ok(None) };
-        let obj = TexturedObject { mesh: mesh_o, transform: prep.transform, layout: prep.layout, sampler: sampler(filter, prep.repeat) };
+        let obj = TexturedObject {
+            mesh: mesh_o,
+            transform: prep.transform,
+            layout: prep.layout,
+            sampler: sampler(filter, prep.repeat),
+        };
         let rgba: Vec<f32> = x.chunks_exact(3).flat_map(|c| [c[0], c[1], c[2], 1.0]).collect();
-        let img = render_object(gpu, pipeline, viewport, &occluder_meshes, &obj, &rgba).map_err(|e| e.to_string())?;
-        let got: Vec<f32> = a.pixels.iter().flat_map(|&p| { let v = img.pixel(p as usize); [v[0], v[1], v[2]] }).collect();
+        let img = render_object(gpu, pipeline, viewport, &occluder_meshes, &obj, &rgba)
+            .map_err(|e| e.to_string())?;
+        let got: Vec<f32> = a
+            .pixels
+            .iter()
+            .flat_map(|&p| {
+                let v = img.pixel(p as usize);
+                [v[0], v[1], v[2]]
+            })
+            .collect();
         Ok(Some(psnr_display(&got, &b)))
     };
     let mut methods = BTreeMap::new();
     let mut kept: Vec<Kept> = Vec::new();
-    let mut method = |name: &str, a: &RenderMatrix, filter: Filter, x: &[f32], ms: f64, it: Option<(u32, bool)>| {
+    let mut method = |name: &str,
+                      a: &RenderMatrix,
+                      filter: Filter,
+                      x: &[f32],
+                      ms: f64,
+                      it: Option<(u32, bool)>| {
         let (it, converged) = (it.map(|i| i.0), it.map(|i| i.1));
         let p = psnr_display(&render(a, x), &b);
         let w = wgpu_psnr(a, filter, x).unwrap_or_else(|e| {
             notes.push(format!("{name}: wgpu rendering failed: {e}"));
             None
         });
-        methods.insert(name.to_string(), MethodReport {
-            psnr_db: p, psnr_db_wgpu: w, ms, iterations: it,
-            texel_range: x.iter().fold([f32::INFINITY, f32::NEG_INFINITY], |r, &v| [r[0].min(v), r[1].max(v)]),
-            psnr_db_neighbour: None,
-            converged,
-        });
+        methods.insert(
+            name.to_string(),
+            MethodReport {
+                psnr_db: p,
+                psnr_db_wgpu: w,
+                ms,
+                iterations: it,
+                texel_range: x
+                    .iter()
+                    .fold([f32::INFINITY, f32::NEG_INFINITY], |r, &v| [r[0].min(v), r[1].max(v)]),
+                psnr_db_neighbour: None,
+                converged,
+            },
+        );
         kept.push((name.to_string(), filter, x.to_vec()));
     };
     let plain = req.solver;
-    let pyramidal = SolveSettings { epsilon_f: req.epsilon_f, epsilon_b: req.pyramidal_epsilon_b, ..req.solver };
+    let pyramidal = SolveSettings {
+        epsilon_f: req.epsilon_f,
+        epsilon_b: req.pyramidal_epsilon_b,
+        ..req.solver
+    };
     let unconstrained = SolveSettings { epsilon_b: 0.0, epsilon_f: 0.0, ..req.solver };
     let bil = solve(&a_bil, &b, None, &plain)?;
-    method("ls-bilinear", &a_bil, Filter::Bilinear, &bil.texels, bil.solve_ms, Some((bil.iterations, bil.converged)));
+    method(
+        "ls-bilinear",
+        &a_bil,
+        Filter::Bilinear,
+        &bil.texels,
+        bil.solve_ms,
+        Some((bil.iterations, bil.converged)),
+    );
     let tri = solve(&a_tri, &b, None, &plain)?;
-    method("ls-trilinear", &a_tri, Filter::Trilinear, &tri.texels, tri.solve_ms, Some((tri.iterations, tri.converged)));
+    method(
+        "ls-trilinear",
+        &a_tri,
+        Filter::Trilinear,
+        &tri.texels,
+        tri.solve_ms,
+        Some((tri.iterations, tri.converged)),
+    );
     if plain.epsilon_b > 0.0 {
         // Plain least squares without the constraint 0 ≤ x ≤ R of eq. 3.4: a diagnostic.
         let u = solve(&a_tri, &b, None, &unconstrained)?;
-        method("ls-trilinear-unconstrained", &a_tri, Filter::Trilinear, &u.texels, u.solve_ms, Some((u.iterations, u.converged)));
+        method(
+            "ls-trilinear-unconstrained",
+            &a_tri,
+            Filter::Trilinear,
+            &u.texels,
+            u.solve_ms,
+            Some((u.iterations, u.converged)),
+        );
     }
     if plain.epsilon_b == 0.0 {
         // Eq. 3.4 as written: plain least squares under the box 0 ≤ x ≤ 1.1 · max(b), and
         // the same box with the pyramidal term.
         let bounded = SolveSettings { bounded: true, ..plain };
         let t = solve(&a_tri, &b, None, &bounded)?;
-        method("ls-trilinear-bounded", &a_tri, Filter::Trilinear, &t.texels, t.solve_ms, Some((t.iterations, t.converged)));
+        method(
+            "ls-trilinear-bounded",
+            &a_tri,
+            Filter::Trilinear,
+            &t.texels,
+            t.solve_ms,
+            Some((t.iterations, t.converged)),
+        );
         if pyramidal.epsilon_b == 0.0 {
             let t = solve(&a_tri, &b, None, &SolveSettings { bounded: true, ..pyramidal })?;
-            method("ls-pyramidal-bounded", &a_tri, Filter::Trilinear, &t.texels, t.solve_ms, Some((t.iterations, t.converged)));
+            method(
+                "ls-pyramidal-bounded",
+                &a_tri,
+                Filter::Trilinear,
+                &t.texels,
+                t.solve_ms,
+                Some((t.iterations, t.converged)),
+            );
         }
     }
     let pyr = solve(&a_tri, &b, None, &pyramidal)?;
-    method("ls-pyramidal", &a_tri, Filter::Trilinear, &pyr.texels, pyr.solve_ms, Some((pyr.iterations, pyr.converged)));
+    method(
+        "ls-pyramidal",
+        &a_tri,
+        Filter::Trilinear,
+        &pyr.texels,
+        pyr.solve_ms,
+        Some((pyr.iterations, pyr.converged)),
+    );
     // The same in the decimated parameterization (what pis-pack solves): level 0 through the
     // MIP chain the player decimates from it.
     let dec = solve(&a_tri, &b, None, &SolveSettings { mip: MipSolve::Decimated, ..pyramidal })?;
-    method("ls-decimated", &a_tri, Filter::Trilinear, &dec.texels, dec.solve_ms, Some((dec.iterations, dec.converged)));
+    method(
+        "ls-decimated",
+        &a_tri,
+        Filter::Trilinear,
+        &dec.texels,
+        dec.solve_ms,
+        Some((dec.iterations, dec.converged)),
+    );
 
     // Baselines, rendered with trilinear filtering as the player would draw them.
     let t = Instant::now();
-    let layer = LayerImage { width: w, height: h, rgb: rgb.clone(), covered: cov.iter().map(|&c| c > 0.0).collect() };
+    let layer = LayerImage {
+        width: w,
+        height: h,
+        rgb: rgb.clone(),
+        covered: cov.iter().map(|&c| c > 0.0).collect(),
+    };
     let fwd = forward_map(&mesh_o, &prep.transform, &layer, &prep.layout)?;
     method("forward", &a_tri, Filter::Trilinear, &fwd, t.elapsed().as_secs_f64() * 1e3, None);
     let t = Instant::now();
     let eye = pt.frame.camera.world_from_camera.w_axis.truncate();
     let mut trace_err = None;
-    let traced = trace_into_texture(&mesh_o, &prep.transform, pt.frame.instances[o].world_from_object, eye, &prep.layout, |rays| {
-        // Start just before the object point, so the object's own surface is what is seen
-        // (thesis 3.6: front- or back-facing, occluded or not).
-        let r: Vec<(Vec3, Vec3)> = rays.iter().map(|r| (r.origin + r.direction * (r.distance * 0.999), r.direction)).collect();
-        match pis_trace::rays::trace_rays(scene, &pt.frame, &pt.settings, &r, pt.settings.spp.max(1)) {
-            Ok(v) => v.iter().map(|x| (x.diffuse + x.specular).to_array()).collect(),
-            Err(e) => {
-                trace_err = Some(e);
-                vec![[0.0; 3]; rays.len()]
+    let traced = trace_into_texture(
+        &mesh_o,
+        &prep.transform,
+        pt.frame.instances[o].world_from_object,
+        eye,
+        &prep.layout,
+        |rays| {
+            // Start just before the object point, so the object's own surface is what is seen
+            // (thesis 3.6: front- or back-facing, occluded or not).
+            let r: Vec<(Vec3, Vec3)> = rays
+                .iter()
+                .map(|r| (r.origin + r.direction * (r.distance * 0.999), r.direction))
+                .collect();
+            match pis_trace::rays::trace_rays(
+                scene,
+                &pt.frame,
+                &pt.settings,
+                &r,
+                pt.settings.spp.max(1),
+            ) {
+                Ok(v) => v.iter().map(|x| (x.diffuse + x.specular).to_array()).collect(),
+                Err(e) => {
+                    trace_err = Some(e);
+                    vec![[0.0; 3]; rays.len()]
+                }
             }
-        }
-    })?;
+        },
+    )?;
     if let Some(e) = trace_err {
         return Err(e.into());
     }
@@ -632,7 +849,12 @@ pub fn infer(req: &InferRequest) -> Result<InferReport> {
             let occ = scene_depth(viewport, &draw, Some(k))?;
             let mut m = draw[k];
             m.uvs = &prep_k.mesh_uvs;
-            let obj = TexturedObject { mesh: m, transform: prep_k.transform, layout: prep_k.layout, sampler: sampler(Filter::Trilinear, prep_k.repeat) };
+            let obj = TexturedObject {
+                mesh: m,
+                transform: prep_k.transform,
+                layout: prep_k.layout,
+                sampler: sampler(Filter::Trilinear, prep_k.repeat),
+            };
             let (a, bk) = restrict(&build(&obj, k, &occ)?, &cov_k, &rgb_k);
             let matrix_ms = t1.elapsed().as_secs_f64() * 1e3;
             if a.rows() == 0 {
@@ -640,9 +862,14 @@ pub fn infer(req: &InferRequest) -> Result<InferReport> {
             }
             let s = solve(&a, &bk, None, &pyramidal)?;
             objects.push(ObjectTiming {
-                object: scene.objects[k].name.clone(), n_s: s.n_s, n_t: s.n_t,
-                texture: [prep_k.layout.width, prep_k.layout.height], texcoord_ms: prep_k.texcoord_ms,
-                matrix_ms, solve_ms: s.solve_ms, iterations: s.iterations,
+                object: scene.objects[k].name.clone(),
+                n_s: s.n_s,
+                n_t: s.n_t,
+                texture: [prep_k.layout.width, prep_k.layout.height],
+                texcoord_ms: prep_k.texcoord_ms,
+                matrix_ms,
+                solve_ms: s.solve_ms,
+                iterations: s.iterations,
                 total_ms: t0.elapsed().as_secs_f64() * 1e3,
             });
         }
@@ -689,7 +916,8 @@ fn neighbour_psnr(
 ) -> Result<NeighbourPsnr> {
     let dims = &pt.scene.space.dims;
     let mut samples = pt.samples.clone();
-    let last = dims.len().checked_sub(1).ok_or_else(|| anyhow!("the parameter space has no dimension"))?;
+    let last =
+        dims.len().checked_sub(1).ok_or_else(|| anyhow!("the parameter space has no dimension"))?;
     let n = dims[last].samples();
     if n < 2 {
         bail!("the last parameter dimension has one sample: no neighbouring view");
@@ -703,16 +931,27 @@ fn neighbour_psnr(
     let meshes: Vec<Mesh> = (0..q.scene.objects.len()).map(|k| merged_mesh(&q.scene, k)).collect();
     let proj = pis_trace::camera::projection_matrix(&q.frame.camera, (w, h));
     let view_from_world = q.frame.camera.world_from_camera.inverse();
-    let mut draw: Vec<DrawMesh> = meshes.iter().enumerate().map(|(k, m)| DrawMesh {
-        positions: &m.positions, uvs: &m.uvs, indices: &m.indices,
-        clip_from_object: proj * view_from_world * q.frame.instances[k].world_from_object,
-    }).collect();
+    let mut draw: Vec<DrawMesh> = meshes
+        .iter()
+        .enumerate()
+        .map(|(k, m)| DrawMesh {
+            positions: &m.positions,
+            uvs: &m.uvs,
+            indices: &m.indices,
+            clip_from_object: proj * view_from_world * q.frame.instances[k].world_from_object,
+        })
+        .collect();
     draw[o].uvs = &prep.mesh_uvs;
     let (cov, rgb) = object_layer(&q.images, &names[o])?;
     let occ = scene_depth(viewport, &draw, Some(o))?;
     let mut out = Vec::new();
     for (name, filter, x) in textures {
-        let obj = TexturedObject { mesh: draw[o], transform: prep.transform, layout: prep.layout, sampler: sampler(*filter, prep.repeat) };
+        let obj = TexturedObject {
+            mesh: draw[o],
+            transform: prep.transform,
+            layout: prep.layout,
+            sampler: sampler(*filter, prep.repeat),
+        };
         let (a, b) = restrict(&render_matrix(viewport, &obj, Some(&occ))?, &cov, &rgb);
         if a.rows() == 0 {
             bail!("object {} covers no pixel at the neighbouring point {samples:?}", names[o]);
@@ -724,11 +963,23 @@ fn neighbour_psnr(
 
 /// Human-readable lines of the report (stderr).
 pub fn print_report(r: &InferReport, out: &mut impl std::io::Write) -> std::io::Result<()> {
-    writeln!(out, "object {} at point {:?} (values {:?}), {}x{}", r.object, r.point, r.values, r.resolution[0], r.resolution[1])?;
-    writeln!(out, "  texture {}x{} (repeat {:?}), n_s {}, n_t {}", r.texture[0], r.texture[1], r.repeat, r.n_s, r.n_t)?;
+    writeln!(
+        out,
+        "object {} at point {:?} (values {:?}), {}x{}",
+        r.object, r.point, r.values, r.resolution[0], r.resolution[1]
+    )?;
+    writeln!(
+        out,
+        "  texture {}x{} (repeat {:?}), n_s {}, n_t {}",
+        r.texture[0], r.texture[1], r.repeat, r.n_s, r.n_t
+    )?;
     for (name, m) in &r.methods {
-        let it = m.iterations.map_or(String::new(), |i| format!(", {i} iterations{}",
-            if m.converged == Some(false) { ", not converged" } else { "" }));
+        let it = m.iterations.map_or(String::new(), |i| {
+            format!(
+                ", {i} iterations{}",
+                if m.converged == Some(false) { ", not converged" } else { "" }
+            )
+        });
         let w = m.psnr_db_wgpu.map_or("     -".to_string(), |p| format!("{p:6.2}"));
         let nb = m.psnr_db_neighbour.map_or(String::new(), |p| format!(", neighbour {p:6.2} dB"));
         writeln!(out, "  {name:<13} model {:6.2} dB, wgpu {w} dB{nb}   ({:.0} ms{it}; texels in [{:.3}, {:.3}])",
@@ -738,7 +989,10 @@ pub fn print_report(r: &InferReport, out: &mut impl std::io::Write) -> std::io::
         writeln!(out, "  note: {n}")?;
     }
     if let Some(p) = &r.neighbour_point {
-        writeln!(out, "  neighbour: the textures drawn at point {p:?} (placement of this point), model")?;
+        writeln!(
+            out,
+            "  neighbour: the textures drawn at point {p:?} (placement of this point), model"
+        )?;
     }
     writeln!(out, "  trace {:.0} ms, texcoord {:.0} ms, matrices {:.0} ms, LS-trilinear solve {:.0} ms ({} iterations)",
              r.trace_ms, r.texcoord_ms, r.matrix_ms, r.solve_ms, r.iterations)?;

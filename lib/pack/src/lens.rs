@@ -11,11 +11,16 @@ use pis_scene::{Frame, Material, Scene};
 pub fn lens_material(m: &Material) -> LensMaterial {
     let ior = if m.ior.is_finite() && m.ior >= 1.0 { m.ior } else { 1.5 };
     let sigma_a = if m.attenuation_distance.is_finite() && m.attenuation_distance > 0.0 {
-        Vec3::from(m.attenuation_color).max(Vec3::splat(1e-6)).min(Vec3::ONE).map(|c| -c.ln()) / m.attenuation_distance
+        Vec3::from(m.attenuation_color).max(Vec3::splat(1e-6)).min(Vec3::ONE).map(|c| -c.ln())
+            / m.attenuation_distance
     } else {
         Vec3::ZERO
     };
-    LensMaterial { ior, base: Vec3::new(m.base_color[0], m.base_color[1], m.base_color[2]), sigma_a }
+    LensMaterial {
+        ior,
+        base: Vec3::new(m.base_color[0], m.base_color[1], m.base_color[2]),
+        sigma_a,
+    }
 }
 
 /// Object `o` of `scene` at `frame` as a lens object: every primitive's triangles in world
@@ -30,12 +35,16 @@ pub fn lens_object(scene: &Scene, frame: &Frame, o: usize) -> LensObject {
     for prim in scene.objects.get(o).map_or(&[][..], |x| &x.primitives[..]) {
         let base = positions.len() as u32;
         positions.extend(prim.positions.iter().map(|&p| m.transform_point3(p)));
-        normals.extend((0..prim.positions.len()).map(|k| prim.normals.get(k).map_or(Vec3::ZERO, |&n| normal_matrix * n)));
+        normals.extend(
+            (0..prim.positions.len())
+                .map(|k| prim.normals.get(k).map_or(Vec3::ZERO, |&n| normal_matrix * n)),
+        );
         indices.extend(prim.indices.iter().map(|&i| base + i));
         if material.is_none() {
             material = scene.materials.get(prim.material).map(lens_material);
         }
     }
-    let material = material.unwrap_or(LensMaterial { ior: 1.5, base: Vec3::ONE, sigma_a: Vec3::ZERO });
+    let material =
+        material.unwrap_or(LensMaterial { ior: 1.5, base: Vec3::ONE, sigma_a: Vec3::ZERO });
     LensObject::new(material, positions, normals, &indices)
 }

@@ -17,7 +17,11 @@
 
 use anyhow::{anyhow, Result};
 use glam::Vec3;
-use pis_compile::hybrid::{choose_layers, hybrid_pixels, hybrid_render_matrix, tessellate, term_radiance, vertex_modulation, vertex_vectors, FittedShell, HybridPixels, HybridView, Layers, Missing, OutgoingRay, Tessellation, Term, TessellationSettings, TERMS};
+use pis_compile::hybrid::{
+    choose_layers, hybrid_pixels, hybrid_render_matrix, term_radiance, tessellate,
+    vertex_modulation, vertex_vectors, FittedShell, HybridPixels, HybridView, Layers, Missing,
+    OutgoingRay, Term, Tessellation, TessellationSettings, TERMS,
+};
 use pis_compile::solve::View;
 
 use crate::solutions::Solver;
@@ -53,7 +57,15 @@ pub struct LensInferSettings {
 
 impl Default for LensInferSettings {
     fn default() -> Self {
-        LensInferSettings { face: None, max_face: MAX_FACE, tessellation: TessellationSettings::default(), max_layers: 4, solve: SolveSettings::pyramidal(), confidence: false, solver: Solver::default() }
+        LensInferSettings {
+            face: None,
+            max_face: MAX_FACE,
+            tessellation: TessellationSettings::default(),
+            max_layers: 4,
+            solve: SolveSettings::pyramidal(),
+            confidence: false,
+            solver: Solver::default(),
+        }
     }
 }
 
@@ -107,7 +119,11 @@ fn outgoing_rays(render: &TracedView, o: usize) -> Vec<OutgoingRay> {
         .records
         .iter()
         .filter(|r| r.object == o as u32)
-        .map(|r| OutgoingRay { origin: Vec3::from(r.exit_origin).as_dvec3(), direction: Vec3::from(r.exit_direction).as_dvec3(), hits: r.hits.iter().map(|h| (h.t as f64, h.object)).collect() })
+        .map(|r| OutgoingRay {
+            origin: Vec3::from(r.exit_origin).as_dvec3(),
+            direction: Vec3::from(r.exit_direction).as_dvec3(),
+            hits: r.hits.iter().map(|h| (h.t as f64, h.object)).collect(),
+        })
         .collect()
 }
 
@@ -117,7 +133,14 @@ fn outgoing_rays(render: &TracedView, o: usize) -> Vec<OutgoingRay> {
 /// layer). A record's first hit takes the radiance the traced term holds along the pixel's
 /// outgoing rays (the term over its F·G, the tracer's many-sample estimate) where that is
 /// defined; hidden hits keep the record's own one-sample colour.
-fn layer_targets(render: &TracedView, o: usize, term: Term, layers: &Layers, size: (u32, u32), radiance: &[Option<Vec3>]) -> (Vec<f32>, Vec<Vec<(f32, Vec3)>>) {
+fn layer_targets(
+    render: &TracedView,
+    o: usize,
+    term: Term,
+    layers: &Layers,
+    size: (u32, u32),
+    radiance: &[Option<Vec3>],
+) -> (Vec<f32>, Vec<Vec<(f32, Vec3)>>) {
     const SIGMA: f32 = 0.5;
     const RADIUS: f32 = 1.5;
     let n = (size.0 * size.1) as usize;
@@ -125,18 +148,31 @@ fn layer_targets(render: &TracedView, o: usize, term: Term, layers: &Layers, siz
     let mut per = vec![vec![(0.0f32, Vec3::ZERO); n]; layers.distances.len()];
     for r in render.records.iter().filter(|r| r.object == o as u32 && r.term == term as u8) {
         let (x, y) = (r.pixel[0], r.pixel[1]);
-        let own = (x.floor().clamp(0.0, size.0 as f32 - 1.0) as usize, y.floor().clamp(0.0, size.1 as f32 - 1.0) as usize);
+        let own = (
+            x.floor().clamp(0.0, size.0 as f32 - 1.0) as usize,
+            y.floor().clamp(0.0, size.1 as f32 - 1.0) as usize,
+        );
         let first = radiance[own.1 * size.0 as usize + own.0];
         let mut colours: Vec<Option<Vec3>> = vec![None; layers.distances.len()];
         for (k, h) in r.hits.iter().enumerate() {
             if let Some(&l) = layers.layer_of.get(&h.object) {
                 if colours[l].is_none() {
-                    colours[l] = Some(if k == 0 { first.unwrap_or(Vec3::from(h.colour)) } else { Vec3::from(h.colour) });
+                    colours[l] = Some(if k == 0 {
+                        first.unwrap_or(Vec3::from(h.colour))
+                    } else {
+                        Vec3::from(h.colour)
+                    });
                 }
             }
         }
-        let (x0, x1) = ((x - RADIUS - 0.5).ceil().max(0.0) as i64, ((x + RADIUS - 0.5).floor() as i64).min(size.0 as i64 - 1));
-        let (y0, y1) = ((y - RADIUS - 0.5).ceil().max(0.0) as i64, ((y + RADIUS - 0.5).floor() as i64).min(size.1 as i64 - 1));
+        let (x0, x1) = (
+            (x - RADIUS - 0.5).ceil().max(0.0) as i64,
+            ((x + RADIUS - 0.5).floor() as i64).min(size.0 as i64 - 1),
+        );
+        let (y0, y1) = (
+            (y - RADIUS - 0.5).ceil().max(0.0) as i64,
+            ((y + RADIUS - 0.5).floor() as i64).min(size.1 as i64 - 1),
+        );
         for py in y0..=y1 {
             for px in x0..=x1 {
                 let (dx, dy) = (px as f32 + 0.5 - x, py as f32 + 0.5 - y);
@@ -160,7 +196,13 @@ fn layer_targets(render: &TracedView, o: usize, term: Term, layers: &Layers, siz
 }
 
 /// A traced image's RGB at every pixel (zeros where the layer is missing).
-fn traced_rgb(scene: &Scene, images: &PointImages, o: usize, kind: LayerKind, n: usize) -> Vec<f32> {
+fn traced_rgb(
+    scene: &Scene,
+    images: &PointImages,
+    o: usize,
+    kind: LayerKind,
+    n: usize,
+) -> Vec<f32> {
     let mut out = vec![0.0f32; n * 3];
     if let Some(l) = images.object_layer(&scene.objects[o].name, kind) {
         for (c, name) in ["R", "G", "B"].iter().enumerate() {
@@ -187,25 +229,63 @@ type ViewModel = LensViewModel;
 
 impl LensViewModel {
     /// The tessellation of `frame` at `size`, no matrices yet.
-    fn new(scene: &Scene, o: usize, frame: &Frame, size: (u32, u32), settings: &LensInferSettings) -> ViewModel {
+    fn new(
+        scene: &Scene,
+        o: usize,
+        frame: &Frame,
+        size: (u32, u32),
+        settings: &LensInferSettings,
+    ) -> ViewModel {
         let lens = lens_object(scene, frame, o);
         let camera = PerspectiveCamera::new(&frame.camera, size);
-        let clip = projection_matrix(&frame.camera, size) * frame.camera.world_from_camera.inverse();
-        let tess = tessellate(&lens, &HybridView { eye: camera.origin, clip_from_world: clip, size }, &settings.tessellation);
-        ViewModel { viewport: Viewport { width: size.0, height: size.1 }, clip, tess, a: Vec::new() }
+        let clip =
+            projection_matrix(&frame.camera, size) * frame.camera.world_from_camera.inverse();
+        let tess = tessellate(
+            &lens,
+            &HybridView { eye: camera.origin, clip_from_world: clip, size },
+            &settings.tessellation,
+        );
+        ViewModel {
+            viewport: Viewport { width: size.0, height: size.1 },
+            clip,
+            tess,
+            a: Vec::new(),
+        }
     }
 
     /// Per term and shell, the render matrix of cube faces of `face` texels.
     fn with_matrices(mut self, shells: &[FittedShell], face: u32) -> ViewModel {
         let layout = TextureLayout::cube(face);
-        self.a = TERMS.iter().map(|&term| shells.iter().map(|s| hybrid_render_matrix(self.viewport, &self.tess, self.clip, &vertex_vectors(&self.tess, term, &s.shell), layout, None)).collect()).collect();
+        self.a = TERMS
+            .iter()
+            .map(|&term| {
+                shells
+                    .iter()
+                    .map(|s| {
+                        hybrid_render_matrix(
+                            self.viewport,
+                            &self.tess,
+                            self.clip,
+                            &vertex_vectors(&self.tess, term, &s.shell),
+                            layout,
+                            None,
+                        )
+                    })
+                    .collect()
+            })
+            .collect();
         self
     }
 }
 
 /// Infers lens object `o`'s shells at every view of `views` (each its frame and the render
 /// traced there, with records).
-pub fn infer_lens(scene: &Scene, o: usize, views: &[(Frame, PointRender)], settings: &LensInferSettings) -> Result<LensInference> {
+pub fn infer_lens(
+    scene: &Scene,
+    o: usize,
+    views: &[(Frame, PointRender)],
+    settings: &LensInferSettings,
+) -> Result<LensInference> {
     let samples: Vec<Vec<TracedView>> = views.iter().map(|v| vec![TracedView::from(v)]).collect();
     infer_lens_views(scene, o, &samples, settings)
 }
@@ -215,13 +295,24 @@ pub fn infer_lens(scene: &Scene, o: usize, views: &[(Frame, PointRender)], setti
 /// at all viewpoints"), so that parts of the environment the sample's own view does not see
 /// are filled from the others; the first view of each sample is the sample's, where the
 /// prediction is made. The layers are built from the outgoing rays of every view.
-pub fn infer_lens_nearby(scene: &Scene, o: usize, samples: &[Vec<&(Frame, PointRender)>], settings: &LensInferSettings) -> Result<LensInference> {
-    let samples: Vec<Vec<TracedView>> = samples.iter().map(|s| s.iter().map(|&v| TracedView::from(v)).collect()).collect();
+pub fn infer_lens_nearby(
+    scene: &Scene,
+    o: usize,
+    samples: &[Vec<&(Frame, PointRender)>],
+    settings: &LensInferSettings,
+) -> Result<LensInference> {
+    let samples: Vec<Vec<TracedView>> =
+        samples.iter().map(|s| s.iter().map(|&v| TracedView::from(v)).collect()).collect();
     infer_lens_views(scene, o, &samples, settings)
 }
 
 /// [`infer_lens_nearby`] over traced views held anywhere (a set's images and records).
-pub fn infer_lens_views(scene: &Scene, o: usize, samples: &[Vec<TracedView>], settings: &LensInferSettings) -> Result<LensInference> {
+pub fn infer_lens_views(
+    scene: &Scene,
+    o: usize,
+    samples: &[Vec<TracedView>],
+    settings: &LensInferSettings,
+) -> Result<LensInference> {
     if o >= scene.objects.len() {
         return Err(anyhow!("object {o}: the scene has {} objects", scene.objects.len()));
     }
@@ -232,34 +323,57 @@ pub fn infer_lens_views(scene: &Scene, o: usize, samples: &[Vec<TracedView>], se
     }
     let lens0 = lens_object(scene, first.frame, o);
     let origin = lens0.centroid().as_dvec3();
-    let scale = lens0.positions.iter().map(|p| (p.as_dvec3() - origin).length()).fold(0.0, f64::max);
-    let rays: Vec<OutgoingRay> = samples.iter().flatten().flat_map(|r| outgoing_rays(r, o)).collect();
+    let scale =
+        lens0.positions.iter().map(|p| (p.as_dvec3() - origin).length()).fold(0.0, f64::max);
+    let rays: Vec<OutgoingRay> =
+        samples.iter().flatten().flat_map(|r| outgoing_rays(r, o)).collect();
     if rays.is_empty() {
-        return Err(anyhow!("{}: the traced views hold no outgoing-ray records of the lens object", scene.objects[o].name));
+        return Err(anyhow!(
+            "{}: the traced views hold no outgoing-ray records of the lens object",
+            scene.objects[o].name
+        ));
     }
     let (layers, shells) = choose_layers(&rays, origin, settings.max_layers, scale);
     // Every view's tessellation, once: it serves the face size, the rows and the prediction.
-    let mut models: Vec<Vec<ViewModel>> = samples.iter().map(|s| s.iter().map(|v| ViewModel::new(scene, o, v.frame, (w, h), settings)).collect()).collect();
+    let mut models: Vec<Vec<ViewModel>> = samples
+        .iter()
+        .map(|s| s.iter().map(|v| ViewModel::new(scene, o, v.frame, (w, h), settings)).collect())
+        .collect();
     let face = match settings.face {
         Some(f) => f,
-        None => face_size(&models.iter().map(|m| &m[0]).collect::<Vec<_>>(), &shells).min(settings.max_face.max(8)),
+        None => face_size(&models.iter().map(|m| &m[0]).collect::<Vec<_>>(), &shells)
+            .min(settings.max_face.max(8)),
     };
-    models = models.into_iter().map(|m| m.into_iter().map(|v| v.with_matrices(&shells, face)).collect()).collect();
+    models = models
+        .into_iter()
+        .map(|m| m.into_iter().map(|v| v.with_matrices(&shells, face)).collect())
+        .collect();
     let layout = TextureLayout::cube(face);
     let mut out = Vec::with_capacity(samples.len());
     for (sample, models) in samples.iter().zip(&models) {
         let render = &sample[0];
-        let mut sub_all: Vec<Vec<(RenderMatrix, Vec<f32>, Vec<f32>)>> = vec![Vec::new(); shells.len()];
+        let mut sub_all: Vec<Vec<(RenderMatrix, Vec<f32>, Vec<f32>)>> =
+            vec![Vec::new(); shells.len()];
         for (render, model) in sample.iter().zip(models) {
-            for (l, sub) in view_rows(scene, o, model, render, &layers, settings).into_iter().enumerate() {
+            for (l, sub) in
+                view_rows(scene, o, model, render, &layers, settings).into_iter().enumerate()
+            {
                 sub_all[l].extend(sub);
             }
         }
         // Per shell: colour and alpha solved over both terms' rows of every view.
         let mut cubes = Vec::with_capacity(shells.len());
         for sub in &sub_all {
-            let colour = settings.solver.solve_view_independent(&sub.iter().map(|(m, rgb, _)| View { a: m, b: rgb }).collect::<Vec<_>>(), None, &settings.solve)?;
-            let alpha = settings.solver.solve_view_independent(&sub.iter().map(|(m, _, al)| View { a: m, b: al }).collect::<Vec<_>>(), None, &settings.solve)?;
+            let colour = settings.solver.solve_view_independent(
+                &sub.iter().map(|(m, rgb, _)| View { a: m, b: rgb }).collect::<Vec<_>>(),
+                None,
+                &settings.solve,
+            )?;
+            let alpha = settings.solver.solve_view_independent(
+                &sub.iter().map(|(m, _, al)| View { a: m, b: al }).collect::<Vec<_>>(),
+                None,
+                &settings.solve,
+            )?;
             let texels = layout.texel_count();
             let mut cube = vec![0.0f32; texels * 4];
             for k in 0..texels {
@@ -268,52 +382,89 @@ pub fn infer_lens_views(scene: &Scene, o: usize, samples: &[Vec<TracedView>], se
             }
             cubes.push(cube);
         }
-        let (reflection, refraction, both) = predict_with(scene, o, &models[0], render.images, face, &[(&cubes, 1.0)]);
+        let (reflection, refraction, both) =
+            predict_with(scene, o, &models[0], render.images, face, &[(&cubes, 1.0)]);
         out.push(LensView { reflection, refraction, both, cubes });
     }
-    let models = models.into_iter().map(|m| m.into_iter().next().expect("a sample's own view")).collect();
+    let models =
+        models.into_iter().map(|m| m.into_iter().next().expect("a sample's own view")).collect();
     Ok(LensInference { face, layers, shells, views: out, models })
 }
 
 /// One view's rows for each shell: per term, the render matrix's rows of the pixels the
 /// records reach, with their colour and alpha targets.
-fn view_rows(scene: &Scene, o: usize, model: &ViewModel, render: &TracedView, layers: &Layers, settings: &LensInferSettings) -> Vec<Vec<(RenderMatrix, Vec<f32>, Vec<f32>)>> {
+fn view_rows(
+    scene: &Scene,
+    o: usize,
+    model: &ViewModel,
+    render: &TracedView,
+    layers: &Layers,
+    settings: &LensInferSettings,
+) -> Vec<Vec<(RenderMatrix, Vec<f32>, Vec<f32>)>> {
     let (w, h) = (render.images.width, render.images.height);
     let n = (w * h) as usize;
     // Per term, the records' targets.
     let mut targets = Vec::new();
     for term in TERMS {
-        let (kind, modulation) = if term == Term::ReflectionFirst { (LayerKind::Reflection, LayerKind::ReflectionModulation) } else { (LayerKind::Refraction, LayerKind::RefractionModulation) };
-        let (value, fg) = (traced_rgb(scene, render.images, o, kind, n), traced_rgb(scene, render.images, o, modulation, n));
-        let radiance: Vec<Option<Vec3>> = (0..n).map(|p| {
-            let f = Vec3::from_slice(&fg[p * 3..p * 3 + 3]);
-            (f.min_element() > 1e-3).then(|| Vec3::from_slice(&value[p * 3..p * 3 + 3]) / f)
-        }).collect();
+        let (kind, modulation) = if term == Term::ReflectionFirst {
+            (LayerKind::Reflection, LayerKind::ReflectionModulation)
+        } else {
+            (LayerKind::Refraction, LayerKind::RefractionModulation)
+        };
+        let (value, fg) = (
+            traced_rgb(scene, render.images, o, kind, n),
+            traced_rgb(scene, render.images, o, modulation, n),
+        );
+        let radiance: Vec<Option<Vec3>> = (0..n)
+            .map(|p| {
+                let f = Vec3::from_slice(&fg[p * 3..p * 3 + 3]);
+                (f.min_element() > 1e-3).then(|| Vec3::from_slice(&value[p * 3..p * 3 + 3]) / f)
+            })
+            .collect();
         targets.push(layer_targets(render, o, term, layers, (w, h), &radiance));
     }
     // Confidence (thesis 6.3.3): 1 − min(θm², θc²)/θc² from the spread of each pixel's exit
     // directions, multiplied into both sides of each row.
-    let confidence: Vec<Vec<f32>> = [LayerKind::ReflectionConfidence, LayerKind::RefractionConfidence]
-        .iter()
-        .map(|&k| {
-            let plane = render.images.object_layer(&scene.objects[o].name, k).and_then(|l| l.channel("Y")).map(|c| c.to_vec());
-            plane.filter(|_| settings.confidence).unwrap_or_else(|| vec![1.0; n])
-        })
-        .collect();
+    let confidence: Vec<Vec<f32>> =
+        [LayerKind::ReflectionConfidence, LayerKind::RefractionConfidence]
+            .iter()
+            .map(|&k| {
+                let plane = render
+                    .images
+                    .object_layer(&scene.objects[o].name, k)
+                    .and_then(|l| l.channel("Y"))
+                    .map(|c| c.to_vec());
+                plane.filter(|_| settings.confidence).unwrap_or_else(|| vec![1.0; n])
+            })
+            .collect();
     (0..layers.distances.len())
         .map(|l| {
             (0..2)
                 .map(|t| {
                     let (weight, per) = &targets[t];
                     let c = &confidence[t];
-                    let mut m = select_rows(&model.a[t][l], |p| weight[p as usize] > 0.0 && c[p as usize] > 0.0);
+                    let mut m = select_rows(&model.a[t][l], |p| {
+                        weight[p as usize] > 0.0 && c[p as usize] > 0.0
+                    });
                     for r in 0..m.rows() {
                         let k = c[m.pixels[r] as usize];
                         let (lo, hi) = (m.row_start[r] as usize, m.row_start[r + 1] as usize);
                         m.vals[lo..hi].iter_mut().for_each(|v| *v *= k);
                     }
-                    let rgb: Vec<f32> = m.pixels.iter().flat_map(|&p| (per[l][p as usize].1 / weight[p as usize] * c[p as usize]).to_array()).collect();
-                    let alpha: Vec<f32> = m.pixels.iter().flat_map(|&p| [per[l][p as usize].0 / weight[p as usize] * c[p as usize], 0.0, 0.0]).collect();
+                    let rgb: Vec<f32> = m
+                        .pixels
+                        .iter()
+                        .flat_map(|&p| {
+                            (per[l][p as usize].1 / weight[p as usize] * c[p as usize]).to_array()
+                        })
+                        .collect();
+                    let alpha: Vec<f32> = m
+                        .pixels
+                        .iter()
+                        .flat_map(|&p| {
+                            [per[l][p as usize].0 / weight[p as usize] * c[p as usize], 0.0, 0.0]
+                        })
+                        .collect();
                     (m, rgb, alpha)
                 })
                 .collect()
@@ -331,8 +482,17 @@ fn face_size(views: &[&ViewModel], shells: &[FittedShell]) -> u32 {
     for v in views {
         for term in TERMS {
             for s in shells {
-                let px = hybrid_pixels(v.viewport, &v.tess, v.clip, &vertex_vectors(&v.tess, term, &s.shell), Missing::Mean, None);
-                lods.extend(px.vectors.iter().map(|&[d, dx, dy]| pis_compile::shell::cube::cube_lod(d, dx, dy, BIG, 64.0) - BIG.log2()));
+                let px = hybrid_pixels(
+                    v.viewport,
+                    &v.tess,
+                    v.clip,
+                    &vertex_vectors(&v.tess, term, &s.shell),
+                    Missing::Mean,
+                    None,
+                );
+                lods.extend(px.vectors.iter().map(|&[d, dx, dy]| {
+                    pis_compile::shell::cube::cube_lod(d, dx, dy, BIG, 64.0) - BIG.log2()
+                }));
             }
         }
     }
@@ -348,9 +508,22 @@ fn face_size(views: &[&ViewModel], shells: &[FittedShell]) -> u32 {
 /// tessellation and vertex rays) from `inference`'s cube maps at view samples `samples`
 /// (sample index and blending weight), against `render` traced at that frame: per term and
 /// for both, over the pixels the traced object covers.
-pub fn predict_view(scene: &Scene, o: usize, frame: &Frame, render: &PointRender, inference: &LensInference, samples: &[(usize, f32)], settings: &LensInferSettings) -> (TermFit, TermFit, TermFit) {
-    let cubes: Vec<(&Vec<Vec<f32>>, f32)> = samples.iter().filter_map(|&(k, w)| inference.views.get(k).map(|v| (&v.cubes, w))).collect();
-    let model = ViewModel::new(scene, o, frame, (render.images.width, render.images.height), settings).with_matrices(&inference.shells, inference.face);
+pub fn predict_view(
+    scene: &Scene,
+    o: usize,
+    frame: &Frame,
+    render: &PointRender,
+    inference: &LensInference,
+    samples: &[(usize, f32)],
+    settings: &LensInferSettings,
+) -> (TermFit, TermFit, TermFit) {
+    let cubes: Vec<(&Vec<Vec<f32>>, f32)> = samples
+        .iter()
+        .filter_map(|&(k, w)| inference.views.get(k).map(|v| (&v.cubes, w)))
+        .collect();
+    let model =
+        ViewModel::new(scene, o, frame, (render.images.width, render.images.height), settings)
+            .with_matrices(&inference.shells, inference.face);
     predict_with(scene, o, &model, &render.images, inference.face, &cubes)
 }
 
@@ -365,11 +538,24 @@ pub fn lens_image(model: &LensViewModel, cubes: &[&[f32]]) -> [Vec<f32>; 2] {
 /// Per term, the pixels of `model` that draw it with their interpolated F·G
 /// ([`hybrid_pixels`] of the modulation, [`Missing::Zero`]).
 pub fn term_pixels(model: &LensViewModel) -> [HybridPixels; 2] {
-    TERMS.map(|term| hybrid_pixels(model.viewport, &model.tess, model.clip, &vertex_modulation(&model.tess, term), Missing::Zero, None))
+    TERMS.map(|term| {
+        hybrid_pixels(
+            model.viewport,
+            &model.tess,
+            model.clip,
+            &vertex_modulation(&model.tess, term),
+            Missing::Zero,
+            None,
+        )
+    })
 }
 
 /// [`lens_image`] with each term's pixels and F·G ([`term_pixels`]) made.
-pub fn lens_terms(model: &LensViewModel, fg: &[HybridPixels; 2], cubes: &[&[f32]]) -> [Vec<f32>; 2] {
+pub fn lens_terms(
+    model: &LensViewModel,
+    fg: &[HybridPixels; 2],
+    cubes: &[&[f32]],
+) -> [Vec<f32>; 2] {
     let n = (model.viewport.width * model.viewport.height) as usize;
     let mut out = [vec![0.0f32; n * 3], vec![0.0f32; n * 3]];
     for (t, fg) in fg.iter().enumerate() {
@@ -382,7 +568,14 @@ pub fn lens_terms(model: &LensViewModel, fg: &[HybridPixels; 2], cubes: &[&[f32]
 }
 
 /// [`predict_view`] with the view's model made.
-fn predict_with(scene: &Scene, o: usize, model: &ViewModel, images: &PointImages, face: u32, samples: &[(&Vec<Vec<f32>>, f32)]) -> (TermFit, TermFit, TermFit) {
+fn predict_with(
+    scene: &Scene,
+    o: usize,
+    model: &ViewModel,
+    images: &PointImages,
+    face: u32,
+    samples: &[(&Vec<Vec<f32>>, f32)],
+) -> (TermFit, TermFit, TermFit) {
     let (w, h) = (images.width, images.height);
     let n = (w * h) as usize;
     let layout = TextureLayout::cube(face);
@@ -395,14 +588,30 @@ fn predict_with(scene: &Scene, o: usize, model: &ViewModel, images: &PointImages
             c
         })
         .collect();
-    let cover = images.object_layer(&scene.objects[o].name, LayerKind::Coverage).and_then(|l| l.channel("A")).map(|c| c.to_vec()).unwrap_or_else(|| vec![0.0; n]);
+    let cover = images
+        .object_layer(&scene.objects[o].name, LayerKind::Coverage)
+        .and_then(|l| l.channel("A"))
+        .map(|c| c.to_vec())
+        .unwrap_or_else(|| vec![0.0; n]);
     let predicted = lens_image(model, &cubes.iter().map(Vec::as_slice).collect::<Vec<_>>());
-    let traced = [traced_rgb(scene, images, o, LayerKind::Reflection, n), traced_rgb(scene, images, o, LayerKind::Refraction, n)];
+    let traced = [
+        traced_rgb(scene, images, o, LayerKind::Reflection, n),
+        traced_rgb(scene, images, o, LayerKind::Refraction, n),
+    ];
     let fit = |pred: &[f32], truth: &[f32]| {
         let pixels: Vec<usize> = (0..n).filter(|&p| cover[p] > 0.5).collect();
-        let gather = |v: &[f32]| pixels.iter().flat_map(|&p| [v[p * 3], v[p * 3 + 1], v[p * 3 + 2]]).collect::<Vec<f32>>();
+        let gather = |v: &[f32]| {
+            pixels
+                .iter()
+                .flat_map(|&p| [v[p * 3], v[p * 3 + 1], v[p * 3 + 2]])
+                .collect::<Vec<f32>>()
+        };
         TermFit { psnr_db: psnr_display(&gather(pred), &gather(truth)), pixels: pixels.len() }
     };
     let sum = |a: &[f32], b: &[f32]| a.iter().zip(b).map(|(x, y)| x + y).collect::<Vec<f32>>();
-    (fit(&predicted[0], &traced[0]), fit(&predicted[1], &traced[1]), fit(&sum(&predicted[0], &predicted[1]), &sum(&traced[0], &traced[1])))
+    (
+        fit(&predicted[0], &traced[0]),
+        fit(&predicted[1], &traced[1]),
+        fit(&sum(&predicted[0], &predicted[1]), &sum(&traced[0], &traced[1])),
+    )
 }

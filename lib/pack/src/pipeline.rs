@@ -55,13 +55,13 @@ pub use pis_trace::set::Shard;
 
 use pis_codec::CodecId;
 
-pub use report::{print_report, FragmentsReport, MemoryReport, ObjectReport, PackReport};
+pub use encode::LayerTextures;
 pub use input::cache_dir;
 pub use matrices::{filter_needs_probe, MatrixSource};
-pub use encode::LayerTextures;
-pub use sweep::{Inferred, PackPoint};
+pub use report::{print_report, FragmentsReport, MemoryReport, ObjectReport, PackReport};
 pub use settings::*;
 pub use sharded::{fragment_files, fragment_path, merge_fragments, solve_shard, SolveReport};
+pub use sweep::{Inferred, PackPoint};
 
 use crate::error::{Exit, Failure};
 
@@ -93,8 +93,19 @@ impl std::ops::Deref for PackRequest {
 
 impl PackRequest {
     /// `input` packed into `output` with `settings`.
-    pub fn new(input: impl Into<PathBuf>, output: impl Into<PathBuf>, settings: PackSettings) -> Self {
-        PackRequest { input: input.into(), scene: None, output: output.into(), settings, solver: Default::default(), shard: None }
+    pub fn new(
+        input: impl Into<PathBuf>,
+        output: impl Into<PathBuf>,
+        settings: PackSettings,
+    ) -> Self {
+        PackRequest {
+            input: input.into(),
+            scene: None,
+            output: output.into(),
+            settings,
+            solver: Default::default(),
+            shard: None,
+        }
     }
 
     /// The same request with other settings.
@@ -173,25 +184,43 @@ impl<'p> Stages<'p> {
 /// Packs the ray-traced set (or scene.toml, traced first into `.pis-cache/` beside it) at
 /// `input` into the container `output` with `settings`, telling `progress` as it goes; on
 /// error no output file is left. The whole of `pis-pack`.
-pub fn pack(input: &std::path::Path, output: &std::path::Path, settings: &PackSettings, progress: &dyn Progress) -> Result<PackReport, Failure> {
+pub fn pack(
+    input: &std::path::Path,
+    output: &std::path::Path,
+    settings: &PackSettings,
+    progress: &dyn Progress,
+) -> Result<PackReport, Failure> {
     pack_request(&PackRequest::new(input, output, settings.clone()), progress)
 }
 
 /// The checks before any work, the set read (or traced) and the render-matrix source opened.
-fn begin(req: &PackRequest, stages: &mut Stages) -> Result<(input::LoadedSet, matrices::Matrices), Failure> {
+fn begin(
+    req: &PackRequest,
+    stages: &mut Stages,
+) -> Result<(input::LoadedSet, matrices::Matrices), Failure> {
     if req.ratio.is_some() && req.psnr.is_some() {
         return Err(Failure::new(Exit::Usage, anyhow::anyhow!("give --ratio or --psnr, not both")));
     }
     if let Some(r) = req.ratio {
         if !(r.is_finite() && r >= 1.0) {
-            return Err(Failure::new(Exit::Usage, anyhow::anyhow!("--ratio must be at least 1, got {r}")));
+            return Err(Failure::new(
+                Exit::Usage,
+                anyhow::anyhow!("--ratio must be at least 1, got {r}"),
+            ));
         }
     }
     if let Some(why) = filter_needs_probe(req.filter, req.matrix) {
         return Err(Failure::new(Exit::Usage, anyhow::anyhow!(why)));
     }
     if !(1..=pis_format::MAX_SHELL_LOOKUPS).contains(&req.shell_lookups) {
-        return Err(Failure::new(Exit::Usage, anyhow::anyhow!("--shell-lookups must be 1 to {}, got {}", pis_format::MAX_SHELL_LOOKUPS, req.shell_lookups)));
+        return Err(Failure::new(
+            Exit::Usage,
+            anyhow::anyhow!(
+                "--shell-lookups must be 1 to {}, got {}",
+                pis_format::MAX_SHELL_LOOKUPS,
+                req.shell_lookups
+            ),
+        ));
     }
     let set = input::load(req, stages)?;
     // A ratio is checked before any work: it must leave the level images a byte.
@@ -208,13 +237,21 @@ fn begin(req: &PackRequest, stages: &mut Stages) -> Result<(input::LoadedSet, ma
 
 /// [`pack`] of a [`PackRequest`] (which may name the set's scene.toml).
 pub fn pack_request(req: &PackRequest, progress: &dyn Progress) -> Result<PackReport, Failure> {
-    let parent = req.output.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(std::path::Path::new("."));
+    let parent = req
+        .output
+        .parent()
+        .filter(|p| !p.as_os_str().is_empty())
+        .unwrap_or(std::path::Path::new("."));
     if !parent.is_dir() {
-        return Err(Failure::new(Exit::Io, anyhow::anyhow!("the output folder {} does not exist", parent.display())));
+        return Err(Failure::new(
+            Exit::Io,
+            anyhow::anyhow!("the output folder {} does not exist", parent.display()),
+        ));
     }
     let mut stages = Stages::new(progress);
     let (set, mut matrices) = begin(req, &mut stages)?;
-    let inferred = infer_layers::infer_all(&set, req, &mut matrices, &mut stages).map_err(|e| Failure::new(Exit::Runtime, e))?;
+    let inferred = infer_layers::infer_all(&set, req, &mut matrices, &mut stages)
+        .map_err(|e| Failure::new(Exit::Runtime, e))?;
     let probe_renderings = matrices.renderings();
     drop(matrices);
     let (inferred, chosen) = choice::choose(&set, inferred, req, &mut stages)?;
@@ -222,8 +259,15 @@ pub fn pack_request(req: &PackRequest, progress: &dyn Progress) -> Result<PackRe
         Some(done) => done,
         None => {
             let packed = encode::encode_all(&set, &inferred, req, &mut stages)?;
-            let quality = predict::predicted_psnr(&set, &inferred, &packed).map_err(|e| Failure::new(Exit::Runtime, e))?;
-            stages.done("predict", &format!("decoded textures rendered through the render matrices ({})", req.matrix.name()));
+            let quality = predict::predicted_psnr(&set, &inferred, &packed)
+                .map_err(|e| Failure::new(Exit::Runtime, e))?;
+            stages.done(
+                "predict",
+                &format!(
+                    "decoded textures rendered through the render matrices ({})",
+                    req.matrix.name()
+                ),
+            );
             (packed, quality)
         }
     };
@@ -235,7 +279,10 @@ pub fn pack_request(req: &PackRequest, progress: &dyn Progress) -> Result<PackRe
     let masters = if req.keep_master {
         let m = encode::masters(&inferred, &packed).map_err(|e| Failure::new(Exit::Runtime, e))?;
         let n: u64 = m.iter().map(pis_format::Master::payload_len).sum();
-        stages.done("master", &format!("solved textures of {} objects coded losslessly ({n} bytes)", m.len()));
+        stages.done(
+            "master",
+            &format!("solved textures of {} objects coded losslessly ({n} bytes)", m.len()),
+        );
         m
     } else {
         Vec::new()
@@ -244,14 +291,18 @@ pub fn pack_request(req: &PackRequest, progress: &dyn Progress) -> Result<PackRe
     stages.done("write", &format!("{} ({bytes} bytes)", req.output.display()));
     // The master read back from the file decodes to the solved textures bit for bit.
     let master = if req.keep_master {
-        Some(encode::check_master(&req.output, &inferred).map_err(|e| Failure::new(Exit::Runtime, e))?)
+        Some(
+            encode::check_master(&req.output, &inferred)
+                .map_err(|e| Failure::new(Exit::Runtime, e))?,
+        )
     } else {
         None
     };
     // Lossless: the file's level images decode bit-exactly and the decoded textures equal
     // the solved ones.
     let exact = if req.codec == CodecId::Lossless {
-        let levels = encode::check_lossless(&req.output, &packed).map_err(|e| Failure::new(Exit::Runtime, e))?;
+        let levels = encode::check_lossless(&req.output, &packed)
+            .map_err(|e| Failure::new(Exit::Runtime, e))?;
         Some(levels && quality.max_texel_error == 0.0)
     } else {
         None
@@ -266,6 +317,13 @@ pub fn pack_request(req: &PackRequest, progress: &dyn Progress) -> Result<PackRe
 
 /// `N`, or `NxM…`: sizes of at least 1 separated by `x` (`--block`, `--resolution`).
 pub fn parse_sizes(s: &str) -> Result<Vec<u32>, String> {
-    s.split(['x', 'X']).map(|p| p.trim().parse::<u32>().ok().filter(|&b| b > 0).ok_or_else(|| format!("bad size {s:?}: expected N or NxM"))).collect()
+    s.split(['x', 'X'])
+        .map(|p| {
+            p.trim()
+                .parse::<u32>()
+                .ok()
+                .filter(|&b| b > 0)
+                .ok_or_else(|| format!("bad size {s:?}: expected N or NxM"))
+        })
+        .collect()
 }
-

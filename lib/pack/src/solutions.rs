@@ -44,7 +44,8 @@ impl Hasher {
 
     fn word(&mut self, w: u64) {
         self.lanes[0] = (self.lanes[0] ^ w).wrapping_mul(0x9E37_79B9_7F4A_7C15).rotate_left(31);
-        self.lanes[1] = (self.lanes[1] ^ w.rotate_left(23)).wrapping_mul(0xC2B2_AE3D_27D4_EB4F).rotate_left(29);
+        self.lanes[1] =
+            (self.lanes[1] ^ w.rotate_left(23)).wrapping_mul(0xC2B2_AE3D_27D4_EB4F).rotate_left(29);
         self.words += 1;
     }
 
@@ -78,7 +79,10 @@ impl Hasher {
         };
         let n = self.words;
         self.word(n);
-        let (a, b) = (mix(self.lanes[0] ^ self.lanes[1].rotate_left(17)), mix(self.lanes[1] ^ self.lanes[0].rotate_left(41)));
+        let (a, b) = (
+            mix(self.lanes[0] ^ self.lanes[1].rotate_left(17)),
+            mix(self.lanes[1] ^ self.lanes[0].rotate_left(41)),
+        );
         let mut d = [0u8; 16];
         d[..8].copy_from_slice(&a.to_le_bytes());
         d[8..].copy_from_slice(&b.to_le_bytes());
@@ -98,7 +102,12 @@ fn matrix_words(h: &mut Hasher, a: &RenderMatrix) {
 
 /// The digest of a solve: `stacked` (view-independent) or one view, its views, start and
 /// settings.
-fn digest<S: ViewSource + ?Sized>(stacked: bool, views: &S, initial: Option<&[f32]>, settings: &SolveSettings) -> Result<Digest, CompileError> {
+fn digest<S: ViewSource + ?Sized>(
+    stacked: bool,
+    views: &S,
+    initial: Option<&[f32]>,
+    settings: &SolveSettings,
+) -> Result<Digest, CompileError> {
     let mut h = Hasher::new();
     h.word(stacked as u64);
     h.word(views.count() as u64);
@@ -152,13 +161,24 @@ impl Solutions {
     }
 
     /// The solution of `views` from the store, or `solve`d.
-    fn through<S: ViewSource + ?Sized>(&self, stacked: bool, views: &S, initial: Option<&[f32]>, settings: &SolveSettings, solve: impl FnOnce() -> Result<Solution, CompileError>) -> Result<Solution, CompileError> {
+    fn through<S: ViewSource + ?Sized>(
+        &self,
+        stacked: bool,
+        views: &S,
+        initial: Option<&[f32]>,
+        settings: &SolveSettings,
+        solve: impl FnOnce() -> Result<Solution, CompileError>,
+    ) -> Result<Solution, CompileError> {
         let d = digest(stacked, views, initial, settings)?;
         // A solution read is taken out: each is read once, and the store does not double
         // the textures the pack holds.
         let found = {
             let mut map = self.map.lock().expect("the solutions lock");
-            if self.record { map.get(&d).cloned() } else { map.remove(&d) }
+            if self.record {
+                map.get(&d).cloned()
+            } else {
+                map.remove(&d)
+            }
         };
         if let Some(s) = found {
             self.read.fetch_add(1, Ordering::Relaxed);
@@ -176,8 +196,11 @@ impl Solutions {
 
     /// Reads the fragment file `path` into the store; returns the solutions read.
     pub fn read_fragment(&self, path: &Path) -> Result<usize> {
-        let bytes = std::fs::read(path).with_context(|| format!("{}: cannot read the fragment", path.display()))?;
-        let entries = decode(&bytes).with_context(|| format!("{}: not a solve fragment of this pis-pack", path.display()))?;
+        let bytes = std::fs::read(path)
+            .with_context(|| format!("{}: cannot read the fragment", path.display()))?;
+        let entries = decode(&bytes).with_context(|| {
+            format!("{}: not a solve fragment of this pis-pack", path.display())
+        })?;
         let n = entries.len();
         self.map.lock().expect("the solutions lock").extend(entries);
         Ok(n)
@@ -193,7 +216,11 @@ impl Solutions {
         let mut out = Vec::new();
         out.extend_from_slice(MAGIC);
         out.extend_from_slice(&VERSION.to_le_bytes());
-        out.extend_from_slice(&u32::try_from(entries.len()).map_err(|_| anyhow!("too many solutions for one fragment"))?.to_le_bytes());
+        out.extend_from_slice(
+            &u32::try_from(entries.len())
+                .map_err(|_| anyhow!("too many solutions for one fragment"))?
+                .to_le_bytes(),
+        );
         for (d, s) in entries {
             out.extend_from_slice(d);
             let l = s.layout;
@@ -268,7 +295,8 @@ fn decode(bytes: &[u8]) -> Result<Vec<(Digest, Solution)>> {
     let mut out = Vec::with_capacity(count);
     for k in 0..count {
         let d: Digest = c.take(16)?.try_into().expect("16 bytes");
-        let layout = TextureLayout { width: c.u32()?, height: c.u32()?, levels: c.u32()?, faces: c.u32()? };
+        let layout =
+            TextureLayout { width: c.u32()?, height: c.u32()?, levels: c.u32()?, faces: c.u32()? };
         let form = match c.u8()? {
             0 => Form::A,
             1 => Form::Normal,
@@ -283,8 +311,25 @@ fn decode(bytes: &[u8]) -> Result<Vec<(Digest, Solution)>> {
         if n > (c.bytes.len() / 4) as u64 {
             bail!("solution {k}: {n} values announced, {} bytes left", c.bytes.len());
         }
-        let texels: Vec<f32> = c.take(n as usize * 4)?.chunks_exact(4).map(|b| f32::from_le_bytes(b.try_into().expect("4 bytes"))).collect();
-        let solution = Solution { layout, texels, form, n_s, n_t, iterations, channels: Vec::new(), residual_rms, residual_relative, undefined, converged, solve_ms: 0.0 };
+        let texels: Vec<f32> = c
+            .take(n as usize * 4)?
+            .chunks_exact(4)
+            .map(|b| f32::from_le_bytes(b.try_into().expect("4 bytes")))
+            .collect();
+        let solution = Solution {
+            layout,
+            texels,
+            form,
+            n_s,
+            n_t,
+            iterations,
+            channels: Vec::new(),
+            residual_rms,
+            residual_relative,
+            undefined,
+            converged,
+            solve_ms: 0.0,
+        };
         out.push((d, solution));
     }
     if !c.bytes.is_empty() {
@@ -314,24 +359,44 @@ impl Solver {
     }
 
     /// [`pis_compile::solve()`], through the store when there is one.
-    pub fn solve(&self, a: &RenderMatrix, b: &[f32], initial: Option<&[f32]>, settings: &SolveSettings) -> Result<Solution, CompileError> {
+    pub fn solve(
+        &self,
+        a: &RenderMatrix,
+        b: &[f32],
+        initial: Option<&[f32]>,
+        settings: &SolveSettings,
+    ) -> Result<Solution, CompileError> {
         match &self.0 {
             None => solve(a, b, initial, settings),
-            Some(s) => s.through(false, &[View { a, b }][..], initial, settings, || solve(a, b, initial, settings)),
+            Some(s) => s.through(false, &[View { a, b }][..], initial, settings, || {
+                solve(a, b, initial, settings)
+            }),
         }
     }
 
     /// [`pis_compile::solve_view_independent`], through the store when there is one.
-    pub fn solve_view_independent(&self, views: &[View<'_>], initial: Option<&[f32]>, settings: &SolveSettings) -> Result<Solution, CompileError> {
+    pub fn solve_view_independent(
+        &self,
+        views: &[View<'_>],
+        initial: Option<&[f32]>,
+        settings: &SolveSettings,
+    ) -> Result<Solution, CompileError> {
         self.solve_view_source(views, initial, settings)
     }
 
     /// [`pis_compile::solve_view_source`] (the views read one at a time), through the store
     /// when there is one.
-    pub fn solve_view_source<S: ViewSource + ?Sized>(&self, views: &S, initial: Option<&[f32]>, settings: &SolveSettings) -> Result<Solution, CompileError> {
+    pub fn solve_view_source<S: ViewSource + ?Sized>(
+        &self,
+        views: &S,
+        initial: Option<&[f32]>,
+        settings: &SolveSettings,
+    ) -> Result<Solution, CompileError> {
         match &self.0 {
             None => solve_view_source(views, initial, settings),
-            Some(s) => s.through(true, views, initial, settings, || solve_view_source(views, initial, settings)),
+            Some(s) => s.through(true, views, initial, settings, || {
+                solve_view_source(views, initial, settings)
+            }),
         }
     }
 }
@@ -343,7 +408,9 @@ mod tests {
 
     fn problem() -> (RenderMatrix, Vec<f32>) {
         let layout = TextureLayout::full(8, 8);
-        let a = synthetic::warp_matrix(40, 30, layout, pis_compile::Filter::Trilinear, |x, y| (x > 4.0).then_some((x / 40.0, (y / 30.0).powf(1.3))));
+        let a = synthetic::warp_matrix(40, 30, layout, pis_compile::Filter::Trilinear, |x, y| {
+            (x > 4.0).then_some((x / 40.0, (y / 30.0).powf(1.3)))
+        });
         let b: Vec<f32> = (0..a.rows() * 3).map(|i| ((i * 37 % 101) as f32) / 101.0).collect();
         (a, b)
     }
@@ -361,8 +428,14 @@ mod tests {
         assert_eq!(merge.read_fragment(&path).unwrap(), 1);
         let read = Solver::with(merge.clone()).solve(&a, &b, None, &settings).unwrap();
         assert_eq!(merge.counts(), (1, 0), "read, not solved");
-        assert!(read.texels.iter().zip(&solved.texels).all(|(x, y)| x.to_bits() == y.to_bits()) && read.texels.len() == solved.texels.len());
-        assert_eq!((read.iterations, read.layout, read.form, read.residual_rms.to_bits()), (solved.iterations, solved.layout, solved.form, solved.residual_rms.to_bits()));
+        assert!(
+            read.texels.iter().zip(&solved.texels).all(|(x, y)| x.to_bits() == y.to_bits())
+                && read.texels.len() == solved.texels.len()
+        );
+        assert_eq!(
+            (read.iterations, read.layout, read.form, read.residual_rms.to_bits()),
+            (solved.iterations, solved.layout, solved.form, solved.residual_rms.to_bits())
+        );
         // Another start, other pixels or other settings are other solves.
         let mut b2 = b.clone();
         b2[5] += 1e-3;

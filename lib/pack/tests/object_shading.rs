@@ -22,13 +22,24 @@ fn demo1_with_a_metallic_vase(dir: &Path) -> PathBuf {
     }
     let toml = dir.join("scene.toml");
     let text = std::fs::read_to_string(&toml).expect("scene.toml");
-    assert_eq!(text.matches("samples = 4\n").count(), 2, "demo1 samples both dimensions 4 times: adapt the test");
-    std::fs::write(&toml, text.replace("samples = 4\n", "samples = 2\n")).expect("write scene.toml");
+    assert_eq!(
+        text.matches("samples = 4\n").count(),
+        2,
+        "demo1 samples both dimensions 4 times: adapt the test"
+    );
+    std::fs::write(&toml, text.replace("samples = 4\n", "samples = 2\n"))
+        .expect("write scene.toml");
     let gltf = dir.join("demo1.gltf");
-    let mut doc: serde_json::Value = serde_json::from_slice(&std::fs::read(&gltf).expect("the glTF")).expect("glTF JSON");
-    let glaze = doc["materials"].as_array_mut().expect("materials").iter_mut()
-        .find(|m| m["name"] == "GlazedCeramic").expect("demo1's vase material");
-    glaze["pbrMetallicRoughness"]["baseColorFactor"] = serde_json::json!([VASE_BASE[0], VASE_BASE[1], VASE_BASE[2], 1.0]);
+    let mut doc: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(&gltf).expect("the glTF")).expect("glTF JSON");
+    let glaze = doc["materials"]
+        .as_array_mut()
+        .expect("materials")
+        .iter_mut()
+        .find(|m| m["name"] == "GlazedCeramic")
+        .expect("demo1's vase material");
+    glaze["pbrMetallicRoughness"]["baseColorFactor"] =
+        serde_json::json!([VASE_BASE[0], VASE_BASE[1], VASE_BASE[2], 1.0]);
     glaze["pbrMetallicRoughness"]["metallicFactor"] = serde_json::json!(VASE_METALLIC);
     glaze["extensions"] = serde_json::json!({ "KHR_materials_ior": { "ior": VASE_IOR } });
     std::fs::write(&gltf, serde_json::to_vec(&doc).expect("JSON")).expect("write the glTF");
@@ -50,7 +61,9 @@ fn objects_carry_their_role_shading_and_normals_into_the_file() {
     pis_pack::pack(&scene, &file, &settings, &NoProgress).expect("demo1 packs");
     let reader = PisReader::open(&file).expect("the file reads back");
     let objects = &reader.container().objects;
-    let object = |name: &str| objects.iter().find(|o| o.name == name).unwrap_or_else(|| panic!("no object {name}"));
+    let object = |name: &str| {
+        objects.iter().find(|o| o.name == name).unwrap_or_else(|| panic!("no object {name}"))
+    };
 
     // The vase: reflective (scene.toml), f0 = F0(ior) · (1 − metallic) + base · metallic.
     let vase = object("Vase");
@@ -66,7 +79,11 @@ fn objects_carry_their_role_shading_and_normals_into_the_file() {
     assert_eq!(cup.role, ObjectRole::Refractive);
     assert_eq!(cup.shading.ior, 1.5);
     let absorption = [0.85f32, 0.95, 0.9].map(|c| -c.ln() / 0.5);
-    assert!(close(cup.shading.absorption, absorption), "cup absorption {:?}, want {absorption:?}", cup.shading.absorption);
+    assert!(
+        close(cup.shading.absorption, absorption),
+        "cup absorption {:?}, want {absorption:?}",
+        cup.shading.absorption
+    );
 
     for o in [vase, cup] {
         let normals = o.mesh.normals.as_ref().unwrap_or_else(|| panic!("{}: no normals", o.name));

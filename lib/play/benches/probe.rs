@@ -9,7 +9,10 @@ mod common;
 use common::demo1;
 use std::time::Instant;
 
-use pis_compile::{render_matrix, scene_depth, Address, DrawMesh, Filter, RenderMatrix, Sampler, TextureLayout, TextureTransform, TexturedObject, Viewport};
+use pis_compile::{
+    render_matrix, scene_depth, Address, DrawMesh, Filter, RenderMatrix, Sampler, TextureLayout,
+    TextureTransform, TexturedObject, Viewport,
+};
 use pis_play::{probe_render_matrix, Gpu, TexturedPipeline};
 
 fn product(a: &RenderMatrix, x: &[f32]) -> Vec<(u32, f32)> {
@@ -36,7 +39,12 @@ fn main() {
     let (meshes, clip_from_world) = demo1(size);
     let draws: Vec<DrawMesh> = meshes
         .iter()
-        .map(|m| DrawMesh { positions: &m.positions, uvs: &m.uvs, indices: &m.indices, clip_from_object: clip_from_world * m.world_from_object })
+        .map(|m| DrawMesh {
+            positions: &m.positions,
+            uvs: &m.uvs,
+            indices: &m.indices,
+            clip_from_object: clip_from_world * m.world_from_object,
+        })
         .collect();
     let layout = TextureLayout::full(512, 512);
     let sampler = Sampler { filter: Filter::Trilinear, address: [Address::ClampToEdge; 2] };
@@ -51,8 +59,14 @@ fn main() {
         .collect();
     let t_all = Instant::now();
     for (k, m) in meshes.iter().enumerate() {
-        let occluders: Vec<DrawMesh> = draws.iter().enumerate().filter(|(j, _)| *j != k).map(|(_, d)| *d).collect();
-        let object = TexturedObject { mesh: draws[k], transform: TextureTransform::IDENTITY, layout, sampler };
+        let occluders: Vec<DrawMesh> =
+            draws.iter().enumerate().filter(|(j, _)| *j != k).map(|(_, d)| *d).collect();
+        let object = TexturedObject {
+            mesh: draws[k],
+            transform: TextureTransform::IDENTITY,
+            layout,
+            sampler,
+        };
         let t = Instant::now();
         let probe = probe_render_matrix(&gpu, &pipeline, vp, &occluders, &object).expect("probe");
         let ms = t.elapsed().as_secs_f64() * 1e3;

@@ -37,14 +37,23 @@ fn bracket(values: &[f32], x: f32) -> (u32, u32, f32) {
 /// The nearest sample along one dimension (ties to the lower one).
 fn nearest(values: &[f32], x: f32) -> u32 {
     let (lo, hi, w) = bracket(values, x);
-    if w > 0.5 { hi } else { lo }
+    if w > 0.5 {
+        hi
+    } else {
+        lo
+    }
 }
 
 /// Checks a point against the space: one finite value per dimension.
 pub fn check_point(dims: &[Dimension], point: &[f32]) -> Result<(), String> {
     if point.len() != dims.len() {
         let names: Vec<&str> = dims.iter().map(|d| d.name.as_str()).collect();
-        return Err(format!("a parameter point needs {} values ({}), got {}", dims.len(), names.join(", "), point.len()));
+        return Err(format!(
+            "a parameter point needs {} values ({}), got {}",
+            dims.len(),
+            names.join(", "),
+            point.len()
+        ));
     }
     if let Some(k) = point.iter().position(|v| !v.is_finite()) {
         return Err(format!("value {} of dimension '{}' is not finite", point[k], dims[k].name));
@@ -105,7 +114,14 @@ mod tests {
     use pis_format::DimensionKind;
 
     fn dim(values: &[f32]) -> Dimension {
-        Dimension { name: "d".into(), kind: DimensionKind::Other, periodic: false, unit: String::new(), block_size: 8, values: values.to_vec() }
+        Dimension {
+            name: "d".into(),
+            kind: DimensionKind::Other,
+            periodic: false,
+            unit: String::new(),
+            block_size: 8,
+            values: values.to_vec(),
+        }
     }
 
     #[test]
@@ -118,8 +134,14 @@ mod tests {
         assert!((w([2, 1]) - 0.25 * 0.25).abs() < 1e-6);
         assert!((s.iter().map(|x| x.1).sum::<f32>() - 1.0).abs() < 1e-6);
         // On a sample: that sample alone; outside the range: clamped.
-        assert_eq!(weighted_samples(&dims, &[2.0, 10.0], Blend::Multilinear), vec![(vec![2, 0], 1.0)]);
-        assert_eq!(weighted_samples(&dims, &[-5.0, 99.0], Blend::Multilinear), vec![(vec![0, 1], 1.0)]);
+        assert_eq!(
+            weighted_samples(&dims, &[2.0, 10.0], Blend::Multilinear),
+            vec![(vec![2, 0], 1.0)]
+        );
+        assert_eq!(
+            weighted_samples(&dims, &[-5.0, 99.0], Blend::Multilinear),
+            vec![(vec![0, 1], 1.0)]
+        );
         assert_eq!(weighted_samples(&dims, &[1.6, 14.0], Blend::Nearest), vec![(vec![2, 0], 1.0)]);
         let merged = merge_for_mask(&s, DepMask::of(&[0]));
         assert_eq!(merged.len(), 2);

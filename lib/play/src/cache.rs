@@ -50,7 +50,15 @@ pub struct LevelCache {
 
 impl LevelCache {
     pub fn new(budget_bytes: u64, a: u32, b: u32) -> LevelCache {
-        LevelCache { entries: HashMap::new(), bytes: 0, budget: budget_bytes, a: a as u64, b: b as u64, frame: 0, counters: CacheCounters::default() }
+        LevelCache {
+            entries: HashMap::new(),
+            bytes: 0,
+            budget: budget_bytes,
+            a: a as u64,
+            b: b as u64,
+            frame: 0,
+            counters: CacheCounters::default(),
+        }
     }
 
     /// Lifetime in frames of an entry at pyramid level `height` (leaves 0): a·b^height,
@@ -88,7 +96,8 @@ impl LevelCache {
     /// from the leaves.
     pub fn insert(&mut self, key: LevelKey, height: u32, values: Arc<Vec<f32>>) {
         let size = (values.len() * 4) as u64;
-        if let Some(old) = self.entries.insert(key, Entry { values, height, last_used: self.frame }) {
+        if let Some(old) = self.entries.insert(key, Entry { values, height, last_used: self.frame })
+        {
             self.bytes -= (old.values.len() * 4) as u64;
         }
         self.bytes += size;
@@ -112,7 +121,8 @@ impl LevelCache {
         self.bytes -= freed;
         self.counters.expired += (before - self.entries.len()) as u64;
         if self.bytes > self.budget {
-            let mut order: Vec<(u64, u32, LevelKey)> = self.entries.iter().map(|(k, e)| (e.last_used, e.height, *k)).collect();
+            let mut order: Vec<(u64, u32, LevelKey)> =
+                self.entries.iter().map(|(k, e)| (e.last_used, e.height, *k)).collect();
             // Oldest first; among equally old, leaves (shortest lifetimes) first.
             order.sort();
             for (_, _, k) in order {

@@ -40,7 +40,11 @@ pub fn mat4_from_rows(m: &[f32; 12]) -> Mat4 {
 pub fn projection(yfov: f32, near: f32, far: f32, width: u32, height: u32) -> Mat4 {
     let aspect = width.max(1) as f32 / height.max(1) as f32;
     let f = 1.0 / (yfov * 0.5).tan();
-    let (c2z, c3z) = if far.is_finite() && far > near { (far / (near - far), near * far / (near - far)) } else { (-1.0, -near) };
+    let (c2z, c3z) = if far.is_finite() && far > near {
+        (far / (near - far), near * far / (near - far))
+    } else {
+        (-1.0, -near)
+    };
     Mat4::from_cols(
         Vec4::new(f / aspect, 0.0, 0.0, 0.0),
         Vec4::new(0.0, f, 0.0, 0.0),
@@ -55,7 +59,14 @@ impl ViewCamera {
         let m = mat4_from_rows(&c.world_from_camera);
         let eye = m.w_axis.truncate();
         let forward = -m.z_axis.truncate();
-        ViewCamera { eye, target: eye + forward, up: m.y_axis.truncate(), yfov_rad: c.yfov, near: c.znear, far: c.zfar }
+        ViewCamera {
+            eye,
+            target: eye + forward,
+            up: m.y_axis.truncate(),
+            yfov_rad: c.yfov,
+            near: c.znear,
+            far: c.zfar,
+        }
     }
 
     /// World to camera.
@@ -79,9 +90,15 @@ impl ViewCamera {
     /// Whether the camera can be drawn from: finite values, eye ≠ target, up not along the
     /// view direction, 0 < yfov < π, 0 < near < far.
     pub fn check(&self) -> Result<(), String> {
-        let finite = [self.eye, self.target, self.up].iter().all(|v| v.is_finite()) && self.yfov_rad.is_finite() && self.near.is_finite();
+        let finite = [self.eye, self.target, self.up].iter().all(|v| v.is_finite())
+            && self.yfov_rad.is_finite()
+            && self.near.is_finite();
         let dir = self.target - self.eye;
-        if !finite || dir.length_squared() <= 0.0 || dir.cross(self.up).length_squared() <= 1e-12 * dir.length_squared() * self.up.length_squared() {
+        if !finite
+            || dir.length_squared() <= 0.0
+            || dir.cross(self.up).length_squared()
+                <= 1e-12 * dir.length_squared() * self.up.length_squared()
+        {
             return Err(format!("camera {self:?}: eye, target and up must be finite, eye ≠ target, up not along the view direction"));
         }
         let fov_ok = self.yfov_rad > 0.0 && self.yfov_rad < std::f32::consts::PI;
@@ -99,12 +116,19 @@ mod tests {
 
     #[test]
     fn file_camera_round_trips_through_look_at() {
-        let world_from_camera = Mat4::from_translation(Vec3::new(1.0, 2.0, 3.0)) * Mat4::from_rotation_y(0.7) * Mat4::from_rotation_x(-0.2);
+        let world_from_camera = Mat4::from_translation(Vec3::new(1.0, 2.0, 3.0))
+            * Mat4::from_rotation_y(0.7)
+            * Mat4::from_rotation_x(-0.2);
         let mut rows = [0.0; 12];
         for r in 0..3 {
             rows[r * 4..r * 4 + 4].copy_from_slice(&world_from_camera.row(r).to_array());
         }
-        let cam = ViewCamera::from_file(&pis_format::Camera { world_from_camera: rows, yfov: 0.8, znear: 0.1, zfar: 100.0 });
+        let cam = ViewCamera::from_file(&pis_format::Camera {
+            world_from_camera: rows,
+            yfov: 0.8,
+            znear: 0.1,
+            zfar: 100.0,
+        });
         let view = cam.view_matrix();
         let want = world_from_camera.inverse();
         for (a, b) in view.to_cols_array().iter().zip(want.to_cols_array()) {

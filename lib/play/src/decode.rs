@@ -66,15 +66,25 @@ pub fn decode_level(reader: &PisReader, job: &LevelJob) -> Result<Vec<f32>, Play
     let (o, l, b, lv) = job.at;
     let bytes = reader.codestream(&job.stream)?;
     let values = pis_codec::decode(job.stream.codec, &job.planes, &bytes).map_err(|e| match e {
-        CodecError::NotSupported(c) => Error::NotSupported(format!("codec '{c}' (object {o}, layer {l})")),
-        e => Error::Invalid(Issue::new(8005, format!("object {o} layer {l} block {b} level {lv}: {e}")).in_chunk("CSTR", job.stream.chunk as usize)),
+        CodecError::NotSupported(c) => {
+            Error::NotSupported(format!("codec '{c}' (object {o}, layer {l})"))
+        }
+        e => Error::Invalid(
+            Issue::new(8005, format!("object {o} layer {l} block {b} level {lv}: {e}"))
+                .in_chunk("CSTR", job.stream.chunk as usize),
+        ),
     })?;
-    let want = pis_codec::value_count(&job.planes).map_err(|e| PlayError::Request(e.to_string()))?;
+    let want =
+        pis_codec::value_count(&job.planes).map_err(|e| PlayError::Request(e.to_string()))?;
     if values.len() != want {
         return Err(Error::Invalid(Issue::new(8005, format!("object {o} layer {l} block {b} level {lv}: {} values decoded, the planes hold {want}", values.len()))).into());
     }
     if let Some(bad) = values.iter().position(|v| !v.is_finite()) {
-        return Err(Error::Invalid(Issue::new(8006, format!("object {o} layer {l} block {b} level {lv}: value {bad} is {}", values[bad]))).into());
+        return Err(Error::Invalid(Issue::new(
+            8006,
+            format!("object {o} layer {l} block {b} level {lv}: value {bad} is {}", values[bad]),
+        ))
+        .into());
     }
     Ok(values)
 }
@@ -83,7 +93,8 @@ pub fn decode_level(reader: &PisReader, job: &LevelJob) -> Result<Vec<f32>, Play
 /// as the encoder's prediction), inverse gamma, stored MIP residuals added to the decimated
 /// finest level; every plane of the level layout, in its order.
 fn reconstruct(job: &AssembleJob) -> Vec<f32> {
-    let n: usize = job.layout.planes().iter().map(|p| (p.width * p.height * p.channels) as usize).sum();
+    let n: usize =
+        job.layout.planes().iter().map(|p| (p.width * p.height * p.channels) as usize).sum();
     // Element by element, so chunks on the workers give the values `finish` gives: the sum
     // starts as the top level's copy (0 + v is v).
     let mut sum = match job.levels.first() {
@@ -98,7 +109,8 @@ fn reconstruct(job: &AssembleJob) -> Vec<f32> {
         pis_codec::gamma::uncompensate(out, job.layer.gamma);
     });
     if job.layer.mip_mode == MipMode::Stored && job.layout.mips > 1 {
-        sum.par_chunks_exact_mut(face_len(&job.layout)).for_each(|face| add_stored_mips(&job.layout, face));
+        sum.par_chunks_exact_mut(face_len(&job.layout))
+            .for_each(|face| add_stored_mips(&job.layout, face));
     }
     sum
 }
@@ -119,7 +131,10 @@ fn rgba_texel(px: &[f32]) -> [f32; 4] {
 
 /// A level of `C`-channel texels written as RGBA texels into `out` ([`rgba_texel`]).
 fn put_rgba<const C: usize>(level: &[f32], out: &mut [f32]) {
-    level.chunks_exact(C).zip(out.chunks_exact_mut(4)).for_each(|(px, o)| o.copy_from_slice(&rgba_texel(px)));
+    level
+        .chunks_exact(C)
+        .zip(out.chunks_exact_mut(4))
+        .for_each(|(px, o)| o.copy_from_slice(&rgba_texel(px)));
 }
 
 /// [`put_rgba`] for a level of `c` channels.
@@ -174,7 +189,11 @@ fn face_chain(layout: &LevelLayout, face: &[f32], drop: u32, rgba: &mut [f32]) {
             &face[at - len..at]
         } else {
             let (pw, ph) = mip_size(n, n, m - 1);
-            coarser = if m == layout.mips { decimate(&face[at - (pw * ph * c) as usize..at], pw, ph, c) } else { decimate(&coarser, pw, ph, c) };
+            coarser = if m == layout.mips {
+                decimate(&face[at - (pw * ph * c) as usize..at], pw, ph, c)
+            } else {
+                decimate(&coarser, pw, ph, c)
+            };
             &coarser
         };
         if m >= drop {
@@ -214,7 +233,11 @@ impl Decoder {
     }
 
     /// Decodes `jobs` on the workers; the caller waits.
-    pub fn decode_levels(&self, reader: &PisReader, jobs: &[LevelJob]) -> Vec<Result<Vec<f32>, PlayError>> {
+    pub fn decode_levels(
+        &self,
+        reader: &PisReader,
+        jobs: &[LevelJob],
+    ) -> Vec<Result<Vec<f32>, PlayError>> {
         self.pool.install(|| jobs.par_iter().map(|j| decode_level(reader, j)).collect())
     }
 
@@ -237,16 +260,37 @@ mod tests {
     use pis_format::{Combine, DepMask, LayerKind, Mapping, MipMode, Term};
 
     fn shell_layer(channels: u8, mip_mode: MipMode) -> Layer<StreamRef> {
-        Layer { kind: LayerKind::EnvLocal, mapping: Mapping::Shell, channels, mip_mode, term: Term::Reflection, order: 0, combine: Combine::Over, gamma: 2.2, depends_on: DepMask::NONE, blocks: vec![] }
+        Layer {
+            kind: LayerKind::EnvLocal,
+            mapping: Mapping::Shell,
+            channels,
+            mip_mode,
+            term: Term::Reflection,
+            order: 0,
+            combine: Combine::Over,
+            gamma: 2.2,
+            depends_on: DepMask::NONE,
+            blocks: vec![],
+        }
     }
 
     /// The level images a writer stores for `linear` (gamma, MIP residuals), split into two
     /// pyramid levels that sum to them.
-    fn job<'a>(layer: &'a Layer<StreamRef>, layout: &LevelLayout, linear: &[f32], drop_levels: u32) -> AssembleJob<'a> {
+    fn job<'a>(
+        layer: &'a Layer<StreamRef>,
+        layout: &LevelLayout,
+        linear: &[f32],
+        drop_levels: u32,
+    ) -> AssembleJob<'a> {
         let stored = prepare(layer, layout, linear);
         let top: Vec<f32> = stored.iter().map(|v| v * 0.25).collect();
         let rest: Vec<f32> = stored.iter().zip(&top).map(|(v, t)| v - t).collect();
-        AssembleJob { layer, layout: layout.clone(), levels: vec![Arc::new(top), Arc::new(rest)], drop_levels }
+        AssembleJob {
+            layer,
+            layout: layout.clone(),
+            levels: vec![Arc::new(top), Arc::new(rest)],
+            drop_levels,
+        }
     }
 
     fn values(n: usize) -> Vec<f32> {
@@ -255,7 +299,11 @@ mod tests {
 
     #[test]
     fn a_surface_texture_is_padded_with_its_last_column_and_row() {
-        let layer = Layer { mapping: Mapping::Surface, mip_mode: MipMode::Decimated, ..shell_layer(3, MipMode::Decimated) };
+        let layer = Layer {
+            mapping: Mapping::Surface,
+            mip_mode: MipMode::Decimated,
+            ..shell_layer(3, MipMode::Decimated)
+        };
         let layout = LevelLayout { width: 3, height: 3, channels: 3, faces: 1, mips: 1 };
         let linear = values(27);
         let img = assemble(&job(&layer, &layout, &linear, 0));
@@ -275,8 +323,10 @@ mod tests {
     #[test]
     fn a_stored_cube_map_is_rebuilt_face_after_face_level_after_level() {
         let layer = shell_layer(4, MipMode::Stored);
-        let layout = LevelLayout { width: 5, height: 5, channels: 4, faces: 6, mips: mip_count(5, 5) };
-        let n: usize = layout.planes().iter().map(|p| (p.width * p.height * p.channels) as usize).sum();
+        let layout =
+            LevelLayout { width: 5, height: 5, channels: 4, faces: 6, mips: mip_count(5, 5) };
+        let n: usize =
+            layout.planes().iter().map(|p| (p.width * p.height * p.channels) as usize).sum();
         let linear = values(n);
         let cube = assemble_cube(&job(&layer, &layout, &linear, 0));
         assert_eq!(cube.layout, TextureLayout::cube(5));
@@ -288,7 +338,8 @@ mod tests {
     #[test]
     fn a_reduced_rgb_cube_map_starts_at_a_coarser_level_and_is_opaque() {
         let layer = shell_layer(3, MipMode::Stored);
-        let layout = LevelLayout { width: 6, height: 6, channels: 3, faces: 6, mips: mip_count(6, 6) };
+        let layout =
+            LevelLayout { width: 6, height: 6, channels: 3, faces: 6, mips: mip_count(6, 6) };
         let planes = layout.planes();
         let n: usize = planes.iter().map(|p| (p.width * p.height * 3) as usize).sum();
         let linear = values(n);
@@ -300,7 +351,9 @@ mod tests {
         for (k, p) in planes.iter().enumerate() {
             let len = (p.width * p.height * 3) as usize;
             if !(k as u32).is_multiple_of(layout.mips) {
-                linear[at..at + len].chunks_exact(3).for_each(|t| want.extend([t[0], t[1], t[2], 1.0]));
+                linear[at..at + len]
+                    .chunks_exact(3)
+                    .for_each(|t| want.extend([t[0], t[1], t[2], 1.0]));
             }
             at += len;
         }

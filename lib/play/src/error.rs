@@ -3,7 +3,8 @@
 use thiserror::Error;
 
 /// How to get a GPU adapter on a machine without one.
-pub const ADAPTER_HINT: &str = "no GPU adapter found; on a machine without a GPU install Mesa's software \
+pub const ADAPTER_HINT: &str =
+    "no GPU adapter found; on a machine without a GPU install Mesa's software \
 Vulkan driver (lavapipe): `apt-get install -y mesa-vulkan-drivers`";
 
 /// Why the player cannot draw.

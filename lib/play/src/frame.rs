@@ -17,12 +17,12 @@ use bytemuck::{Pod, Zeroable};
 use wgpu::util::DeviceExt;
 
 use crate::error::PlayError;
-use crate::gpu::Gpu;
-use crate::image::FloatImage;
-use crate::resolve::ResolvePipelines;
 use crate::frame_hybrid::{lens_bind, LensDraw, HYBRID_FRAME, LENS_CORNER_LAYOUT, MAX_LENS_SHELLS};
 use crate::frame_reflection::{reflection_bind, REFLECTION};
 pub use crate::frame_reflection::{ReflectionDraw, TermShell, MAX_TERM_SHELLS};
+use crate::gpu::Gpu;
+use crate::image::FloatImage;
+use crate::resolve::ResolvePipelines;
 use crate::shell::SHELL_FUNCTIONS;
 use crate::textured::{allocated_size, cut_uniform, ObjectTexture, DEPTH_FORMAT};
 
@@ -67,9 +67,21 @@ impl MeshGpu {
     /// Uploads a mesh; the caller has checked every index against the positions, and that
     /// there is one texture coordinate and, if given, one normal per position. Without
     /// normals the normal buffer holds zeros.
-    pub fn new(gpu: &Gpu, positions: &[[f32; 3]], normals: Option<&[[f32; 3]]>, uvs: &[[f32; 2]], indices: &[u32]) -> MeshGpu {
+    pub fn new(
+        gpu: &Gpu,
+        positions: &[[f32; 3]],
+        normals: Option<&[[f32; 3]]>,
+        uvs: &[[f32; 2]],
+        indices: &[u32],
+    ) -> MeshGpu {
         let d = &gpu.device;
-        let init = |label: &str, contents: &[u8], usage| d.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: Some(label), contents, usage });
+        let init = |label: &str, contents: &[u8], usage| {
+            d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some(label),
+                contents,
+                usage,
+            })
+        };
         // A zero-length buffer cannot be bound: pad empty inputs.
         let p: &[[f32; 3]] = if positions.is_empty() { &[[0.0; 3]] } else { positions };
         let zeros = vec![[0.0f32; 3]; p.len()];
@@ -144,26 +156,50 @@ pub struct FramePipelines {
 const POSITION_LAYOUT: wgpu::VertexBufferLayout<'static> = wgpu::VertexBufferLayout {
     array_stride: 12,
     step_mode: wgpu::VertexStepMode::Vertex,
-    attributes: &[wgpu::VertexAttribute { format: wgpu::VertexFormat::Float32x3, offset: 0, shader_location: 0 }],
+    attributes: &[wgpu::VertexAttribute {
+        format: wgpu::VertexFormat::Float32x3,
+        offset: 0,
+        shader_location: 0,
+    }],
 };
 const UV_LAYOUT: wgpu::VertexBufferLayout<'static> = wgpu::VertexBufferLayout {
     array_stride: 8,
     step_mode: wgpu::VertexStepMode::Vertex,
-    attributes: &[wgpu::VertexAttribute { format: wgpu::VertexFormat::Float32x2, offset: 0, shader_location: 1 }],
+    attributes: &[wgpu::VertexAttribute {
+        format: wgpu::VertexFormat::Float32x2,
+        offset: 0,
+        shader_location: 1,
+    }],
 };
 const NORMAL_LAYOUT: wgpu::VertexBufferLayout<'static> = wgpu::VertexBufferLayout {
     array_stride: 12,
     step_mode: wgpu::VertexStepMode::Vertex,
-    attributes: &[wgpu::VertexAttribute { format: wgpu::VertexFormat::Float32x3, offset: 0, shader_location: 2 }],
+    attributes: &[wgpu::VertexAttribute {
+        format: wgpu::VertexFormat::Float32x3,
+        offset: 0,
+        shader_location: 2,
+    }],
 };
 /// A cube map as `frame_reflection.wgsl` reads it: a 2D array read with `textureLoad`.
-const CUBE: wgpu::BindingType = wgpu::BindingType::Texture { sample_type: wgpu::TextureSampleType::Float { filterable: false }, view_dimension: wgpu::TextureViewDimension::D2Array, multisampled: false };
+const CUBE: wgpu::BindingType = wgpu::BindingType::Texture {
+    sample_type: wgpu::TextureSampleType::Float { filterable: false },
+    view_dimension: wgpu::TextureViewDimension::D2Array,
+    multisampled: false,
+};
 
-fn entry(binding: u32, visibility: wgpu::ShaderStages, ty: wgpu::BindingType) -> wgpu::BindGroupLayoutEntry {
+fn entry(
+    binding: u32,
+    visibility: wgpu::ShaderStages,
+    ty: wgpu::BindingType,
+) -> wgpu::BindGroupLayoutEntry {
     wgpu::BindGroupLayoutEntry { binding, visibility, ty, count: None }
 }
 
-const UNIFORM: wgpu::BindingType = wgpu::BindingType::Buffer { ty: wgpu::BufferBindingType::Uniform, has_dynamic_offset: false, min_binding_size: None };
+const UNIFORM: wgpu::BindingType = wgpu::BindingType::Buffer {
+    ty: wgpu::BufferBindingType::Uniform,
+    has_dynamic_offset: false,
+    min_binding_size: None,
+};
 
 /// `count` samples per pixel, every sample written.
 fn multisample(count: u32) -> wgpu::MultisampleState {
@@ -172,24 +208,59 @@ fn multisample(count: u32) -> wgpu::MultisampleState {
 
 /// The additive pass's colour target: colour adds, alpha (coverage) takes the maximum.
 fn additive_target(format: wgpu::TextureFormat) -> wgpu::ColorTargetState {
-    let add = wgpu::BlendComponent { src_factor: wgpu::BlendFactor::One, dst_factor: wgpu::BlendFactor::One, operation: wgpu::BlendOperation::Add };
-    let max = wgpu::BlendComponent { src_factor: wgpu::BlendFactor::One, dst_factor: wgpu::BlendFactor::One, operation: wgpu::BlendOperation::Max };
-    wgpu::ColorTargetState { format, blend: Some(wgpu::BlendState { color: add, alpha: max }), write_mask: wgpu::ColorWrites::ALL }
+    let add = wgpu::BlendComponent {
+        src_factor: wgpu::BlendFactor::One,
+        dst_factor: wgpu::BlendFactor::One,
+        operation: wgpu::BlendOperation::Add,
+    };
+    let max = wgpu::BlendComponent {
+        src_factor: wgpu::BlendFactor::One,
+        dst_factor: wgpu::BlendFactor::One,
+        operation: wgpu::BlendOperation::Max,
+    };
+    wgpu::ColorTargetState {
+        format,
+        blend: Some(wgpu::BlendState { color: add, alpha: max }),
+        write_mask: wgpu::ColorWrites::ALL,
+    }
 }
 
 /// An additive pipeline of the frame's layer pass: `module`'s vertex entry point with its
 /// vertex buffers, fragment entry point `fragment`, triangles unculled, tested against the id
 /// pass's depth without writing it, colour added ([`additive_target`]).
 #[allow(clippy::too_many_arguments)]
-fn additive_pipeline(gpu: &Gpu, label: &str, layout: &wgpu::PipelineLayout, module: &wgpu::ShaderModule, vertex: (&str, &[Option<wgpu::VertexBufferLayout>]), fragment: &str, format: wgpu::TextureFormat, samples: u32) -> wgpu::RenderPipeline {
+fn additive_pipeline(
+    gpu: &Gpu,
+    label: &str,
+    layout: &wgpu::PipelineLayout,
+    module: &wgpu::ShaderModule,
+    vertex: (&str, &[Option<wgpu::VertexBufferLayout>]),
+    fragment: &str,
+    format: wgpu::TextureFormat,
+    samples: u32,
+) -> wgpu::RenderPipeline {
     gpu.device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
         label: Some(label),
         layout: Some(layout),
-        vertex: wgpu::VertexState { module, entry_point: Some(vertex.0), compilation_options: Default::default(), buffers: vertex.1 },
-        primitive: wgpu::PrimitiveState { topology: wgpu::PrimitiveTopology::TriangleList, cull_mode: None, ..Default::default() },
+        vertex: wgpu::VertexState {
+            module,
+            entry_point: Some(vertex.0),
+            compilation_options: Default::default(),
+            buffers: vertex.1,
+        },
+        primitive: wgpu::PrimitiveState {
+            topology: wgpu::PrimitiveTopology::TriangleList,
+            cull_mode: None,
+            ..Default::default()
+        },
         depth_stencil: Some(additive_depth()),
         multisample: multisample(samples),
-        fragment: Some(wgpu::FragmentState { module, entry_point: Some(fragment), compilation_options: Default::default(), targets: &[Some(additive_target(format))] }),
+        fragment: Some(wgpu::FragmentState {
+            module,
+            entry_point: Some(fragment),
+            compilation_options: Default::default(),
+            targets: &[Some(additive_target(format))],
+        }),
         multiview_mask: None,
         cache: None,
     })
@@ -210,35 +281,112 @@ fn additive_depth() -> wgpu::DepthStencilState {
 impl FramePipelines {
     pub fn new(gpu: &Gpu) -> FramePipelines {
         let d = &gpu.device;
-        let module = d.create_shader_module(wgpu::ShaderModuleDescriptor { label: Some("frame.wgsl"), source: wgpu::ShaderSource::Wgsl(SHADER.into()) });
+        let module = d.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some("frame.wgsl"),
+            source: wgpu::ShaderSource::Wgsl(SHADER.into()),
+        });
         let reflection_source = format!("{SHELL_FUNCTIONS}\n{REFLECTION}");
-        let reflection_module = d.create_shader_module(wgpu::ShaderModuleDescriptor { label: Some("frame_reflection.wgsl"), source: wgpu::ShaderSource::Wgsl(reflection_source.into()) });
+        let reflection_module = d.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some("frame_reflection.wgsl"),
+            source: wgpu::ShaderSource::Wgsl(reflection_source.into()),
+        });
         let hybrid_source = format!("{SHELL_FUNCTIONS}\n{HYBRID_FRAME}");
-        let hybrid_module = d.create_shader_module(wgpu::ShaderModuleDescriptor { label: Some("frame_hybrid.wgsl"), source: wgpu::ShaderSource::Wgsl(hybrid_source.into()) });
+        let hybrid_module = d.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some("frame_hybrid.wgsl"),
+            source: wgpu::ShaderSource::Wgsl(hybrid_source.into()),
+        });
         let vf = wgpu::ShaderStages::VERTEX_FRAGMENT;
-        let uniform_layout = d.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some("frame uniforms"), entries: &[entry(0, vf, UNIFORM)] });
+        let uniform_layout = d.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("frame uniforms"),
+            entries: &[entry(0, vf, UNIFORM)],
+        });
         let draw_layout = d.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("frame layer"),
             entries: &[
                 entry(0, vf, UNIFORM),
-                entry(1, wgpu::ShaderStages::FRAGMENT, wgpu::BindingType::Texture { sample_type: wgpu::TextureSampleType::Float { filterable: true }, view_dimension: wgpu::TextureViewDimension::D2, multisampled: false }),
-                entry(2, wgpu::ShaderStages::FRAGMENT, wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering)),
+                entry(
+                    1,
+                    wgpu::ShaderStages::FRAGMENT,
+                    wgpu::BindingType::Texture {
+                        sample_type: wgpu::TextureSampleType::Float { filterable: true },
+                        view_dimension: wgpu::TextureViewDimension::D2,
+                        multisampled: false,
+                    },
+                ),
+                entry(
+                    2,
+                    wgpu::ShaderStages::FRAGMENT,
+                    wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
+                ),
             ],
         });
         let fragment = wgpu::ShaderStages::FRAGMENT;
-        let reflection_draw_layout = d.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some("frame reflection"), entries: &[entry(0, vf, UNIFORM), entry(1, fragment, CUBE), entry(2, fragment, CUBE)] });
-        let hybrid_entries: Vec<wgpu::BindGroupLayoutEntry> = std::iter::once(entry(0, vf, UNIFORM)).chain((0..MAX_LENS_SHELLS).map(|k| entry(k as u32 + 1, fragment, CUBE))).collect();
-        let hybrid_draw_layout = d.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some("frame lens term"), entries: &hybrid_entries });
-        let ids_entry = |binding, multisampled| entry(binding, wgpu::ShaderStages::FRAGMENT, wgpu::BindingType::Texture { sample_type: wgpu::TextureSampleType::Uint, view_dimension: wgpu::TextureViewDimension::D2, multisampled });
-        let ids_layout = d.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some("frame ids"), entries: &[ids_entry(0, false)] });
-        let ids_ms_layout = d.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some("frame ids per sample"), entries: &[ids_entry(1, true)] });
-        let id_layout = d.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor { label: Some("frame ids"), bind_group_layouts: &[Some(&uniform_layout)], immediate_size: 0 });
-        let layer_layout = d.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor { label: Some("frame layers"), bind_group_layouts: &[Some(&draw_layout), Some(&ids_layout)], immediate_size: 0 });
-        let layer_ms_layout = d.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor { label: Some("frame layers per sample"), bind_group_layouts: &[Some(&draw_layout), Some(&ids_ms_layout)], immediate_size: 0 });
-        let reflection_layout = d.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor { label: Some("frame reflections"), bind_group_layouts: &[Some(&reflection_draw_layout), Some(&ids_layout)], immediate_size: 0 });
-        let reflection_ms_layout = d.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor { label: Some("frame reflections per sample"), bind_group_layouts: &[Some(&reflection_draw_layout), Some(&ids_ms_layout)], immediate_size: 0 });
-        let hybrid_layout = d.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor { label: Some("frame lens terms"), bind_group_layouts: &[Some(&hybrid_draw_layout), Some(&ids_layout)], immediate_size: 0 });
-        let hybrid_ms_layout = d.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor { label: Some("frame lens terms per sample"), bind_group_layouts: &[Some(&hybrid_draw_layout), Some(&ids_ms_layout)], immediate_size: 0 });
+        let reflection_draw_layout = d.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("frame reflection"),
+            entries: &[entry(0, vf, UNIFORM), entry(1, fragment, CUBE), entry(2, fragment, CUBE)],
+        });
+        let hybrid_entries: Vec<wgpu::BindGroupLayoutEntry> =
+            std::iter::once(entry(0, vf, UNIFORM))
+                .chain((0..MAX_LENS_SHELLS).map(|k| entry(k as u32 + 1, fragment, CUBE)))
+                .collect();
+        let hybrid_draw_layout = d.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("frame lens term"),
+            entries: &hybrid_entries,
+        });
+        let ids_entry = |binding, multisampled| {
+            entry(
+                binding,
+                wgpu::ShaderStages::FRAGMENT,
+                wgpu::BindingType::Texture {
+                    sample_type: wgpu::TextureSampleType::Uint,
+                    view_dimension: wgpu::TextureViewDimension::D2,
+                    multisampled,
+                },
+            )
+        };
+        let ids_layout = d.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("frame ids"),
+            entries: &[ids_entry(0, false)],
+        });
+        let ids_ms_layout = d.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("frame ids per sample"),
+            entries: &[ids_entry(1, true)],
+        });
+        let id_layout = d.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("frame ids"),
+            bind_group_layouts: &[Some(&uniform_layout)],
+            immediate_size: 0,
+        });
+        let layer_layout = d.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("frame layers"),
+            bind_group_layouts: &[Some(&draw_layout), Some(&ids_layout)],
+            immediate_size: 0,
+        });
+        let layer_ms_layout = d.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("frame layers per sample"),
+            bind_group_layouts: &[Some(&draw_layout), Some(&ids_ms_layout)],
+            immediate_size: 0,
+        });
+        let reflection_layout = d.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("frame reflections"),
+            bind_group_layouts: &[Some(&reflection_draw_layout), Some(&ids_layout)],
+            immediate_size: 0,
+        });
+        let reflection_ms_layout = d.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("frame reflections per sample"),
+            bind_group_layouts: &[Some(&reflection_draw_layout), Some(&ids_ms_layout)],
+            immediate_size: 0,
+        });
+        let hybrid_layout = d.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("frame lens terms"),
+            bind_group_layouts: &[Some(&hybrid_draw_layout), Some(&ids_layout)],
+            immediate_size: 0,
+        });
+        let hybrid_ms_layout = d.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("frame lens terms per sample"),
+            bind_group_layouts: &[Some(&hybrid_draw_layout), Some(&ids_ms_layout)],
+            immediate_size: 0,
+        });
         let mut pipes = FramePipelines {
             module,
             reflection_module,
@@ -273,8 +421,17 @@ impl FramePipelines {
             gpu.device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
                 label: Some("frame ids"),
                 layout: Some(layout),
-                vertex: wgpu::VertexState { module, entry_point: Some("vs_main"), compilation_options: Default::default(), buffers: &[Some(POSITION_LAYOUT), Some(UV_LAYOUT)] },
-                primitive: wgpu::PrimitiveState { topology: wgpu::PrimitiveTopology::TriangleList, cull_mode: None, ..Default::default() },
+                vertex: wgpu::VertexState {
+                    module,
+                    entry_point: Some("vs_main"),
+                    compilation_options: Default::default(),
+                    buffers: &[Some(POSITION_LAYOUT), Some(UV_LAYOUT)],
+                },
+                primitive: wgpu::PrimitiveState {
+                    topology: wgpu::PrimitiveTopology::TriangleList,
+                    cull_mode: None,
+                    ..Default::default()
+                },
                 depth_stencil: Some(wgpu::DepthStencilState {
                     format: DEPTH_FORMAT,
                     depth_write_enabled: Some(true),
@@ -287,7 +444,11 @@ impl FramePipelines {
                     module,
                     entry_point: Some("fs_id"),
                     compilation_options: Default::default(),
-                    targets: &[Some(wgpu::ColorTargetState { format: ID_FORMAT, blend: None, write_mask: wgpu::ColorWrites::ALL })],
+                    targets: &[Some(wgpu::ColorTargetState {
+                        format: ID_FORMAT,
+                        blend: None,
+                        write_mask: wgpu::ColorWrites::ALL,
+                    })],
                 }),
                 multiview_mask: None,
                 cache: None,
@@ -297,28 +458,88 @@ impl FramePipelines {
 
     /// The additive layer pipeline for a target format and `samples` per pixel (compiled on
     /// first use): `fs_layer`, or `fs_layer_ms` with object indices per sample.
-    pub fn layer_pipeline(&mut self, gpu: &Gpu, format: wgpu::TextureFormat, samples: u32) -> &wgpu::RenderPipeline {
+    pub fn layer_pipeline(
+        &mut self,
+        gpu: &Gpu,
+        format: wgpu::TextureFormat,
+        samples: u32,
+    ) -> &wgpu::RenderPipeline {
         let module = &self.module;
-        let (layout, entry_point) = if samples > 1 { (&self.layer_ms_layout, "fs_layer_ms") } else { (&self.layer_layout, "fs_layer") };
-        self.layer_pipelines.entry((format, samples)).or_insert_with(|| additive_pipeline(gpu, "frame layers", layout, module, ("vs_main", &[Some(POSITION_LAYOUT), Some(UV_LAYOUT)]), entry_point, format, samples))
+        let (layout, entry_point) = if samples > 1 {
+            (&self.layer_ms_layout, "fs_layer_ms")
+        } else {
+            (&self.layer_layout, "fs_layer")
+        };
+        self.layer_pipelines.entry((format, samples)).or_insert_with(|| {
+            additive_pipeline(
+                gpu,
+                "frame layers",
+                layout,
+                module,
+                ("vs_main", &[Some(POSITION_LAYOUT), Some(UV_LAYOUT)]),
+                entry_point,
+                format,
+                samples,
+            )
+        })
     }
 
     /// The additive reflection-term pipeline for a target format and `samples` per pixel
     /// (compiled on first use): `fs_reflection`, or `fs_reflection_ms` with object indices
     /// per sample; positions and normals as vertex buffers 0 and 1.
-    pub fn reflection_pipeline(&mut self, gpu: &Gpu, format: wgpu::TextureFormat, samples: u32) -> &wgpu::RenderPipeline {
+    pub fn reflection_pipeline(
+        &mut self,
+        gpu: &Gpu,
+        format: wgpu::TextureFormat,
+        samples: u32,
+    ) -> &wgpu::RenderPipeline {
         let module = &self.reflection_module;
-        let (layout, entry_point) = if samples > 1 { (&self.reflection_ms_layout, "fs_reflection_ms") } else { (&self.reflection_layout, "fs_reflection") };
-        self.reflection_pipelines.entry((format, samples)).or_insert_with(|| additive_pipeline(gpu, "frame reflections", layout, module, ("vs_reflection", &[Some(POSITION_LAYOUT), Some(NORMAL_LAYOUT)]), entry_point, format, samples))
+        let (layout, entry_point) = if samples > 1 {
+            (&self.reflection_ms_layout, "fs_reflection_ms")
+        } else {
+            (&self.reflection_layout, "fs_reflection")
+        };
+        self.reflection_pipelines.entry((format, samples)).or_insert_with(|| {
+            additive_pipeline(
+                gpu,
+                "frame reflections",
+                layout,
+                module,
+                ("vs_reflection", &[Some(POSITION_LAYOUT), Some(NORMAL_LAYOUT)]),
+                entry_point,
+                format,
+                samples,
+            )
+        })
     }
 
     /// The additive lens-term pipeline for a target format and `samples` per pixel
     /// (compiled on first use): `fs_hybrid_frame`, or `fs_hybrid_frame_ms` with object
     /// indices per sample; the corners ([`LENS_CORNER_LAYOUT`]) as vertex buffer 0.
-    pub fn hybrid_pipeline(&mut self, gpu: &Gpu, format: wgpu::TextureFormat, samples: u32) -> &wgpu::RenderPipeline {
+    pub fn hybrid_pipeline(
+        &mut self,
+        gpu: &Gpu,
+        format: wgpu::TextureFormat,
+        samples: u32,
+    ) -> &wgpu::RenderPipeline {
         let module = &self.hybrid_module;
-        let (layout, entry_point) = if samples > 1 { (&self.hybrid_ms_layout, "fs_hybrid_frame_ms") } else { (&self.hybrid_layout, "fs_hybrid_frame") };
-        self.hybrid_pipelines.entry((format, samples)).or_insert_with(|| additive_pipeline(gpu, "frame lens terms", layout, module, ("vs_hybrid_frame", &[Some(LENS_CORNER_LAYOUT)]), entry_point, format, samples))
+        let (layout, entry_point) = if samples > 1 {
+            (&self.hybrid_ms_layout, "fs_hybrid_frame_ms")
+        } else {
+            (&self.hybrid_layout, "fs_hybrid_frame")
+        };
+        self.hybrid_pipelines.entry((format, samples)).or_insert_with(|| {
+            additive_pipeline(
+                gpu,
+                "frame lens terms",
+                layout,
+                module,
+                ("vs_hybrid_frame", &[Some(LENS_CORNER_LAYOUT)]),
+                entry_point,
+                format,
+                samples,
+            )
+        })
     }
 }
 
@@ -358,7 +579,14 @@ pub struct Targets {
     multi: Option<SampleTargets>,
 }
 
-fn target_texture(gpu: &Gpu, label: &str, size: (u32, u32), samples: u32, format: wgpu::TextureFormat, usage: wgpu::TextureUsages) -> wgpu::Texture {
+fn target_texture(
+    gpu: &Gpu,
+    label: &str,
+    size: (u32, u32),
+    samples: u32,
+    format: wgpu::TextureFormat,
+    usage: wgpu::TextureUsages,
+) -> wgpu::Texture {
     gpu.device.create_texture(&wgpu::TextureDescriptor {
         label: Some(label),
         size: wgpu::Extent3d { width: size.0, height: size.1, depth_or_array_layers: 1 },
@@ -374,23 +602,57 @@ fn target_texture(gpu: &Gpu, label: &str, size: (u32, u32), samples: u32, format
 impl Targets {
     /// Targets of `size` for frames of `samples` per pixel (1, or a count
     /// [`crate::multisample::choose`] found supported).
-    pub fn new(gpu: &Gpu, pipes: &FramePipelines, size: (u32, u32), samples: u32) -> Result<Targets, PlayError> {
+    pub fn new(
+        gpu: &Gpu,
+        pipes: &FramePipelines,
+        size: (u32, u32),
+        samples: u32,
+    ) -> Result<Targets, PlayError> {
         let limit = gpu.limits.max_texture_dimension_2d;
         if size.0 == 0 || size.1 == 0 || size.0 > limit || size.1 > limit {
             return Err(PlayError::TargetSize { width: size.0, height: size.1, limit });
         }
         let attach = wgpu::TextureUsages::RENDER_ATTACHMENT;
-        let ids = target_texture(gpu, "object ids", size, 1, ID_FORMAT, attach | wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_SRC);
+        let ids = target_texture(
+            gpu,
+            "object ids",
+            size,
+            1,
+            ID_FORMAT,
+            attach | wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_SRC,
+        );
         let depth = target_texture(gpu, "depth", size, 1, DEPTH_FORMAT, attach);
-        let colour = target_texture(gpu, "frame", size, 1, offscreen_format(gpu), attach | wgpu::TextureUsages::COPY_SRC);
+        let colour = target_texture(
+            gpu,
+            "frame",
+            size,
+            1,
+            offscreen_format(gpu),
+            attach | wgpu::TextureUsages::COPY_SRC,
+        );
         let bind = |texture: &wgpu::Texture, layout, binding| {
             let view = texture.create_view(&Default::default());
-            gpu.device.create_bind_group(&wgpu::BindGroupDescriptor { label: Some("object ids"), layout, entries: &[wgpu::BindGroupEntry { binding, resource: wgpu::BindingResource::TextureView(&view) }] })
+            gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("object ids"),
+                layout,
+                entries: &[wgpu::BindGroupEntry {
+                    binding,
+                    resource: wgpu::BindingResource::TextureView(&view),
+                }],
+            })
         };
         let ids_bind = bind(&ids, &pipes.ids_layout, 0);
         let multi = (samples > 1).then(|| {
-            let ids = target_texture(gpu, "object ids per sample", size, samples, ID_FORMAT, attach | wgpu::TextureUsages::TEXTURE_BINDING);
-            let depth = target_texture(gpu, "depth per sample", size, samples, DEPTH_FORMAT, attach);
+            let ids = target_texture(
+                gpu,
+                "object ids per sample",
+                size,
+                samples,
+                ID_FORMAT,
+                attach | wgpu::TextureUsages::TEXTURE_BINDING,
+            );
+            let depth =
+                target_texture(gpu, "depth per sample", size, samples, DEPTH_FORMAT, attach);
             let ids_bind = bind(&ids, &pipes.ids_ms_layout, 1);
             SampleTargets { ids, depth, ids_bind, colour: HashMap::new(), shared_ids: None }
         });
@@ -430,7 +692,14 @@ fn uniforms(clip_from_object: glam::Mat4, object: u32, layer: Option<&LayerDraw>
 
 /// The object-index pass: clears `ids` and `depth`, then draws every object's index and
 /// depth, nearest surface winning.
-fn id_pass(pipeline: &wgpu::RenderPipeline, ids: &wgpu::Texture, depth: &wgpu::Texture, objects: &[ObjectDraw], binds: &[wgpu::BindGroup], encoder: &mut wgpu::CommandEncoder) {
+fn id_pass(
+    pipeline: &wgpu::RenderPipeline,
+    ids: &wgpu::Texture,
+    depth: &wgpu::Texture,
+    objects: &[ObjectDraw],
+    binds: &[wgpu::BindGroup],
+    encoder: &mut wgpu::CommandEncoder,
+) {
     let ids_view = ids.create_view(&Default::default());
     let depth_view = depth.create_view(&Default::default());
     let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
@@ -439,11 +708,22 @@ fn id_pass(pipeline: &wgpu::RenderPipeline, ids: &wgpu::Texture, depth: &wgpu::T
             view: &ids_view,
             depth_slice: None,
             resolve_target: None,
-            ops: wgpu::Operations { load: wgpu::LoadOp::Clear(wgpu::Color { r: NO_OBJECT as f64, g: 0.0, b: 0.0, a: 0.0 }), store: wgpu::StoreOp::Store },
+            ops: wgpu::Operations {
+                load: wgpu::LoadOp::Clear(wgpu::Color {
+                    r: NO_OBJECT as f64,
+                    g: 0.0,
+                    b: 0.0,
+                    a: 0.0,
+                }),
+                store: wgpu::StoreOp::Store,
+            },
         })],
         depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
             view: &depth_view,
-            depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Clear(1.0), store: wgpu::StoreOp::Store }),
+            depth_ops: Some(wgpu::Operations {
+                load: wgpu::LoadOp::Clear(1.0),
+                store: wgpu::StoreOp::Store,
+            }),
             stencil_ops: None,
         }),
         timestamp_writes: None,
@@ -492,21 +772,34 @@ pub fn encode(
     let sample_format = if display.is_some() { offscreen_format(gpu) } else { format };
     pipes.id_pipeline(gpu, samples);
     pipes.layer_pipeline(gpu, sample_format, samples);
-    let reflections: Vec<&ReflectionDraw> = reflections.iter().filter(|r| !r.shells.is_empty()).collect();
+    let reflections: Vec<&ReflectionDraw> =
+        reflections.iter().filter(|r| !r.shells.is_empty()).collect();
     if !reflections.is_empty() {
         pipes.reflection_pipeline(gpu, sample_format, samples);
     }
-    let lenses: Vec<&LensDraw> = lenses.iter().filter(|l| !l.shells.is_empty() && l.count > 0).collect();
+    let lenses: Vec<&LensDraw> =
+        lenses.iter().filter(|l| !l.shells.is_empty() && l.count > 0).collect();
     if !lenses.is_empty() {
         pipes.hybrid_pipeline(gpu, sample_format, samples);
     }
-    let lens_binds: Vec<wgpu::BindGroup> = lenses.iter().map(|l| lens_bind(gpu, &pipes.hybrid_draw_layout, l)).collect();
-    let ubuf = |u: Uniforms| d.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: Some("frame uniforms"), contents: bytemuck::bytes_of(&u), usage: wgpu::BufferUsages::UNIFORM });
+    let lens_binds: Vec<wgpu::BindGroup> =
+        lenses.iter().map(|l| lens_bind(gpu, &pipes.hybrid_draw_layout, l)).collect();
+    let ubuf = |u: Uniforms| {
+        d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("frame uniforms"),
+            contents: bytemuck::bytes_of(&u),
+            usage: wgpu::BufferUsages::UNIFORM,
+        })
+    };
     let id_binds: Vec<wgpu::BindGroup> = objects
         .iter()
         .map(|o| {
             let b = ubuf(uniforms(o.clip_from_object, o.object, None));
-            d.create_bind_group(&wgpu::BindGroupDescriptor { label: Some("object id"), layout: &pipes.uniform_layout, entries: &[wgpu::BindGroupEntry { binding: 0, resource: b.as_entire_binding() }] })
+            d.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("object id"),
+                layout: &pipes.uniform_layout,
+                entries: &[wgpu::BindGroupEntry { binding: 0, resource: b.as_entire_binding() }],
+            })
         })
         .collect();
     let layer_binds: Vec<wgpu::BindGroup> = layers
@@ -519,8 +812,14 @@ pub fn encode(
                 layout: &pipes.draw_layout,
                 entries: &[
                     wgpu::BindGroupEntry { binding: 0, resource: b.as_entire_binding() },
-                    wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::TextureView(&l.texture.view) },
-                    wgpu::BindGroupEntry { binding: 2, resource: wgpu::BindingResource::Sampler(l.sampler) },
+                    wgpu::BindGroupEntry {
+                        binding: 1,
+                        resource: wgpu::BindingResource::TextureView(&l.texture.view),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 2,
+                        resource: wgpu::BindingResource::Sampler(l.sampler),
+                    },
                 ],
             })
         })
@@ -532,7 +831,15 @@ pub fn encode(
         .iter()
         .map(|r| {
             let o = &objects[r.draw];
-            let hull = (o.mesh.hull > 0 && r.shells.len() > 1).then(|| reflection_bind(gpu, &pipes.reflection_draw_layout, o, r, &r.shells[r.shells.len() - 1..]));
+            let hull = (o.mesh.hull > 0 && r.shells.len() > 1).then(|| {
+                reflection_bind(
+                    gpu,
+                    &pipes.reflection_draw_layout,
+                    o,
+                    r,
+                    &r.shells[r.shells.len() - 1..],
+                )
+            });
             (reflection_bind(gpu, &pipes.reflection_draw_layout, o, r, &r.shells), hull)
         })
         .collect();
@@ -540,16 +847,36 @@ pub fn encode(
     // The attachments the layers are drawn into: (colour, resolve target, depth, ids).
     let (sample_colour, depth, ids_bind) = match &mut targets.multi {
         Some(m) => {
-            let usage = if display.is_some() { wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING } else { wgpu::TextureUsages::RENDER_ATTACHMENT };
-            let c = m.colour.entry((sample_format, display.is_some())).or_insert_with(|| target_texture(gpu, "frame per sample", size, samples, sample_format, usage));
+            let usage = if display.is_some() {
+                wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING
+            } else {
+                wgpu::TextureUsages::RENDER_ATTACHMENT
+            };
+            let c = m.colour.entry((sample_format, display.is_some())).or_insert_with(|| {
+                target_texture(gpu, "frame per sample", size, samples, sample_format, usage)
+            });
             id_pass(&pipes.id_pipelines[&samples], &m.ids, &m.depth, objects, &id_binds, encoder);
             if object_ids {
-                id_pass(&pipes.id_pipelines[&1], &targets.ids, &targets.depth, objects, &id_binds, encoder);
+                id_pass(
+                    &pipes.id_pipelines[&1],
+                    &targets.ids,
+                    &targets.depth,
+                    objects,
+                    &id_binds,
+                    encoder,
+                );
             }
             (Some(c.create_view(&Default::default())), &m.depth, &m.ids_bind)
         }
         None => {
-            id_pass(&pipes.id_pipelines[&1], &targets.ids, &targets.depth, objects, &id_binds, encoder);
+            id_pass(
+                &pipes.id_pipelines[&1],
+                &targets.ids,
+                &targets.depth,
+                objects,
+                &id_binds,
+                encoder,
+            );
             (None, &targets.depth, &targets.ids_bind)
         }
     };
@@ -571,7 +898,14 @@ pub fn encode(
         })],
         depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
             view: &depth_view,
-            depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Load, store: if sample_colour.is_some() { wgpu::StoreOp::Discard } else { wgpu::StoreOp::Store } }),
+            depth_ops: Some(wgpu::Operations {
+                load: wgpu::LoadOp::Load,
+                store: if sample_colour.is_some() {
+                    wgpu::StoreOp::Discard
+                } else {
+                    wgpu::StoreOp::Store
+                },
+            }),
             stencil_ops: None,
         }),
         timestamp_writes: None,
@@ -619,8 +953,26 @@ pub fn encode(
     }
     drop(pass);
     if let (Some(filter), Some(m)) = (display, &mut targets.multi) {
-        let shared = m.shared_ids.get_or_insert_with(|| target_texture(gpu, "shared object ids", size, 1, crate::resolve::SHARED_ID_FORMAT, wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING));
-        pipes.resolve.encode(gpu, filter, &m.colour[&(sample_format, true)], &m.ids, shared, colour, format, encoder);
+        let shared = m.shared_ids.get_or_insert_with(|| {
+            target_texture(
+                gpu,
+                "shared object ids",
+                size,
+                1,
+                crate::resolve::SHARED_ID_FORMAT,
+                wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
+            )
+        });
+        pipes.resolve.encode(
+            gpu,
+            filter,
+            &m.colour[&(sample_format, true)],
+            &m.ids,
+            shared,
+            colour,
+            format,
+            encoder,
+        );
     }
 }
 
@@ -630,9 +982,17 @@ pub fn map_read(gpu: &Gpu, buffer: &wgpu::Buffer) -> Result<Vec<u8>, PlayError> 
     buffer.slice(..).map_async(wgpu::MapMode::Read, move |r| {
         let _ = tx.send(r);
     });
-    gpu.device.poll(wgpu::PollType::wait_indefinitely()).map_err(|e| PlayError::Readback(e.to_string()))?;
-    rx.recv().map_err(|e| PlayError::Readback(e.to_string()))?.map_err(|e| PlayError::Readback(e.to_string()))?;
-    let bytes = buffer.slice(..).get_mapped_range().map_err(|e| PlayError::Readback(e.to_string()))?.to_vec();
+    gpu.device
+        .poll(wgpu::PollType::wait_indefinitely())
+        .map_err(|e| PlayError::Readback(e.to_string()))?;
+    rx.recv()
+        .map_err(|e| PlayError::Readback(e.to_string()))?
+        .map_err(|e| PlayError::Readback(e.to_string()))?;
+    let bytes = buffer
+        .slice(..)
+        .get_mapped_range()
+        .map_err(|e| PlayError::Readback(e.to_string()))?
+        .to_vec();
     buffer.unmap();
     Ok(bytes)
 }
@@ -648,14 +1008,31 @@ pub struct Readback {
 impl Readback {
     pub fn new(gpu: &Gpu, size: (u32, u32), texel_bytes: u32) -> Readback {
         let row = (size.0 * texel_bytes).div_ceil(256) * 256;
-        let buffer = gpu.device.create_buffer(&wgpu::BufferDescriptor { label: Some("readback"), size: row as u64 * size.1 as u64, usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ, mapped_at_creation: false });
+        let buffer = gpu.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("readback"),
+            size: row as u64 * size.1 as u64,
+            usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+            mapped_at_creation: false,
+        });
         Readback { buffer, row, texel_bytes, size }
     }
 
     pub fn copy(&self, texture: &wgpu::Texture, encoder: &mut wgpu::CommandEncoder) {
         encoder.copy_texture_to_buffer(
-            wgpu::TexelCopyTextureInfo { texture, mip_level: 0, origin: wgpu::Origin3d::ZERO, aspect: wgpu::TextureAspect::All },
-            wgpu::TexelCopyBufferInfo { buffer: &self.buffer, layout: wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(self.row), rows_per_image: Some(self.size.1) } },
+            wgpu::TexelCopyTextureInfo {
+                texture,
+                mip_level: 0,
+                origin: wgpu::Origin3d::ZERO,
+                aspect: wgpu::TextureAspect::All,
+            },
+            wgpu::TexelCopyBufferInfo {
+                buffer: &self.buffer,
+                layout: wgpu::TexelCopyBufferLayout {
+                    offset: 0,
+                    bytes_per_row: Some(self.row),
+                    rows_per_image: Some(self.size.1),
+                },
+            },
             wgpu::Extent3d { width: self.size.0, height: self.size.1, depth_or_array_layers: 1 },
         );
     }
@@ -675,7 +1052,10 @@ impl Readback {
 /// Decodes colour readback bytes (`Rgba32Float` or `Rgba16Float`) into an image.
 pub fn colour_image(bytes: &[u8], format: wgpu::TextureFormat, size: (u32, u32)) -> FloatImage {
     let rgba = if format == wgpu::TextureFormat::Rgba16Float {
-        bytes.chunks_exact(2).map(|b| half::f16::from_bits(u16::from_le_bytes([b[0], b[1]])).to_f32()).collect()
+        bytes
+            .chunks_exact(2)
+            .map(|b| half::f16::from_bits(u16::from_le_bytes([b[0], b[1]])).to_f32())
+            .collect()
     } else {
         bytes.chunks_exact(4).map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]])).collect()
     };
@@ -695,8 +1075,16 @@ mod tests {
     #[test]
     fn texture_math_is_the_textured_pipelines() {
         for f in ["cut_uv", "texcoord", "texture_lod"] {
-            assert_eq!(function(super::SHADER, f), function(crate::textured::SHADER, f), "{f} differs between frame.wgsl and textured.wgsl");
+            assert_eq!(
+                function(super::SHADER, f),
+                function(crate::textured::SHADER, f),
+                "{f} differs between frame.wgsl and textured.wgsl"
+            );
         }
-        assert_eq!(function(crate::shell::SHELL_FUNCTIONS, "texture_lod"), function(crate::textured::SHADER, "texture_lod"), "texture_lod differs between shell.wgsl and textured.wgsl");
+        assert_eq!(
+            function(crate::shell::SHELL_FUNCTIONS, "texture_lod"),
+            function(crate::textured::SHADER, "texture_lod"),
+            "texture_lod differs between shell.wgsl and textured.wgsl"
+        );
     }
 }

@@ -7,7 +7,9 @@
 //! term; SPEC.md 9). [`crate::frame`] encodes the draws.
 
 use bytemuck::{Pod, Zeroable};
-use pis_compile::hybrid::{corner_values, vertex_modulation, vertex_vectors, Missing, Term, Tessellation};
+use pis_compile::hybrid::{
+    corner_values, vertex_modulation, vertex_vectors, Missing, Term, Tessellation,
+};
 use pis_compile::shell::Shell;
 use rayon::prelude::*;
 use wgpu::util::DeviceExt;
@@ -47,12 +49,36 @@ pub const LENS_CORNER_LAYOUT: wgpu::VertexBufferLayout<'static> = wgpu::VertexBu
     array_stride: std::mem::size_of::<LensCorner>() as u64,
     step_mode: wgpu::VertexStepMode::Vertex,
     attributes: &[
-        wgpu::VertexAttribute { format: wgpu::VertexFormat::Float32x3, offset: 0, shader_location: 0 },
-        wgpu::VertexAttribute { format: wgpu::VertexFormat::Float32x3, offset: 12, shader_location: 1 },
-        wgpu::VertexAttribute { format: wgpu::VertexFormat::Float32x4, offset: 24, shader_location: 2 },
-        wgpu::VertexAttribute { format: wgpu::VertexFormat::Float32x4, offset: 40, shader_location: 3 },
-        wgpu::VertexAttribute { format: wgpu::VertexFormat::Float32x4, offset: 56, shader_location: 4 },
-        wgpu::VertexAttribute { format: wgpu::VertexFormat::Float32x4, offset: 72, shader_location: 5 },
+        wgpu::VertexAttribute {
+            format: wgpu::VertexFormat::Float32x3,
+            offset: 0,
+            shader_location: 0,
+        },
+        wgpu::VertexAttribute {
+            format: wgpu::VertexFormat::Float32x3,
+            offset: 12,
+            shader_location: 1,
+        },
+        wgpu::VertexAttribute {
+            format: wgpu::VertexFormat::Float32x4,
+            offset: 24,
+            shader_location: 2,
+        },
+        wgpu::VertexAttribute {
+            format: wgpu::VertexFormat::Float32x4,
+            offset: 40,
+            shader_location: 3,
+        },
+        wgpu::VertexAttribute {
+            format: wgpu::VertexFormat::Float32x4,
+            offset: 56,
+            shader_location: 4,
+        },
+        wgpu::VertexAttribute {
+            format: wgpu::VertexFormat::Float32x4,
+            offset: 72,
+            shader_location: 5,
+        },
     ],
 };
 
@@ -63,7 +89,11 @@ pub const LENS_CORNER_LAYOUT: wgpu::VertexBufferLayout<'static> = wgpu::VertexBu
 /// `hybrid_render_matrix` draw it.
 pub fn term_corners(tess: &Tessellation, term: Term, shells: &[Shell]) -> Vec<LensCorner> {
     let fg = corner_values(tess, &vertex_modulation(tess, term), Missing::Zero);
-    let vectors: Vec<Vec<Option<[[f32; 3]; 3]>>> = shells.iter().take(MAX_LENS_SHELLS).map(|s| corner_values(tess, &vertex_vectors(tess, term, s), Missing::Mean)).collect();
+    let vectors: Vec<Vec<Option<[[f32; 3]; 3]>>> = shells
+        .iter()
+        .take(MAX_LENS_SHELLS)
+        .map(|s| corner_values(tess, &vertex_vectors(tess, term, s), Missing::Mean))
+        .collect();
     tess.triangles
         .par_iter()
         .enumerate()
@@ -77,7 +107,11 @@ pub fn term_corners(tess: &Tessellation, term: Term, shells: &[Shell]) -> Vec<Le
                         v[k] = [x[c][0], x[c][1], x[c][2], 1.0];
                     }
                 }
-                LensCorner { position: tess.vertices[tri[c] as usize].position.to_array(), fg: f[c], vectors: v }
+                LensCorner {
+                    position: tess.vertices[tri[c] as usize].position.to_array(),
+                    fg: f[c],
+                    vectors: v,
+                }
             })
         })
         .collect()
@@ -100,7 +134,11 @@ pub struct LensDraw<'a> {
 pub fn corner_buffer(gpu: &Gpu, corners: &[LensCorner]) -> wgpu::Buffer {
     let empty = [LensCorner::zeroed()];
     let bytes: &[u8] = bytemuck::cast_slice(if corners.is_empty() { &empty } else { corners });
-    gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: Some("lens corners"), contents: bytes, usage: wgpu::BufferUsages::VERTEX })
+    gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: Some("lens corners"),
+        contents: bytes,
+        usage: wgpu::BufferUsages::VERTEX,
+    })
 }
 
 /// The bind group of one lens draw: its uniforms and its shells' cube maps (the last
@@ -119,11 +157,24 @@ pub fn lens_bind(gpu: &Gpu, layout: &wgpu::BindGroupLayout, draw: &LensDraw) -> 
         count: draw.shells.len().min(MAX_LENS_SHELLS) as u32,
         _pad: [0; 2],
     };
-    let ub = d.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: Some("lens uniforms"), contents: bytemuck::bytes_of(&u), usage: wgpu::BufferUsages::UNIFORM });
-    let cube = |k: usize| wgpu::BindingResource::TextureView(&draw.shells[k.min(draw.shells.len() - 1)].view);
+    let ub = d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: Some("lens uniforms"),
+        contents: bytemuck::bytes_of(&u),
+        usage: wgpu::BufferUsages::UNIFORM,
+    });
+    let cube = |k: usize| {
+        wgpu::BindingResource::TextureView(&draw.shells[k.min(draw.shells.len() - 1)].view)
+    };
     let mut entries = vec![wgpu::BindGroupEntry { binding: 0, resource: ub.as_entire_binding() }];
-    entries.extend((0..MAX_LENS_SHELLS).map(|k| wgpu::BindGroupEntry { binding: k as u32 + 1, resource: cube(k) }));
-    d.create_bind_group(&wgpu::BindGroupDescriptor { label: Some("lens term"), layout, entries: &entries })
+    entries.extend(
+        (0..MAX_LENS_SHELLS)
+            .map(|k| wgpu::BindGroupEntry { binding: k as u32 + 1, resource: cube(k) }),
+    );
+    d.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some("lens term"),
+        layout,
+        entries: &entries,
+    })
 }
 
 /// One term of the tessellated lens object `tess` drawn through the frame's own path
@@ -131,10 +182,23 @@ pub fn lens_bind(gpu: &Gpu, layout: &wgpu::BindGroupLayout, draw: &LensDraw) -> 
 /// the term with `shells` (each its geometry, cube layout and RGBA texels: premultiplied
 /// colour, then alpha) at weight 1. Returns RGBA per pixel (rows from the top; alpha 1 where
 /// the term is drawn). pis-compile's [`pis_compile::hybrid::term_radiance`] is its twin.
-pub fn render_lens_term(gpu: &Gpu, viewport: pis_compile::Viewport, tess: &Tessellation, clip_from_world: glam::Mat4, term: Term, shells: &[(Shell, pis_compile::TextureLayout, &[f32])]) -> Result<crate::FloatImage, crate::PlayError> {
-    use crate::frame::{colour_image, encode, offscreen_format, FramePipelines, MeshGpu, ObjectDraw, Readback, Targets};
+pub fn render_lens_term(
+    gpu: &Gpu,
+    viewport: pis_compile::Viewport,
+    tess: &Tessellation,
+    clip_from_world: glam::Mat4,
+    term: Term,
+    shells: &[(Shell, pis_compile::TextureLayout, &[f32])],
+) -> Result<crate::FloatImage, crate::PlayError> {
+    use crate::frame::{
+        colour_image, encode, offscreen_format, FramePipelines, MeshGpu, ObjectDraw, Readback,
+        Targets,
+    };
     if shells.is_empty() || shells.len() > MAX_LENS_SHELLS {
-        return Err(crate::PlayError::Request(format!("{} shells: a lens term draws 1 to {MAX_LENS_SHELLS}", shells.len())));
+        return Err(crate::PlayError::Request(format!(
+            "{} shells: a lens term draws 1 to {MAX_LENS_SHELLS}",
+            shells.len()
+        )));
     }
     let size = (viewport.width, viewport.height);
     let mut pipes = FramePipelines::new(gpu);
@@ -152,11 +216,33 @@ pub fn render_lens_term(gpu: &Gpu, viewport: pis_compile::Viewport, tess: &Tesse
     let indices: Vec<u32> = tess.triangles.iter().flatten().copied().collect();
     let mesh = MeshGpu::new(gpu, &positions, None, &vec![[0.0; 2]; positions.len()], &indices);
     let objects = [ObjectDraw { object: 0, mesh: &mesh, clip_from_object: clip_from_world }];
-    let lenses = [LensDraw { object: 0, clip_from_world, weight: 1.0, corners: &buffer, count: corners.len() as u32, shells: cubes.iter().collect() }];
+    let lenses = [LensDraw {
+        object: 0,
+        clip_from_world,
+        weight: 1.0,
+        corners: &buffer,
+        count: corners.len() as u32,
+        shells: cubes.iter().collect(),
+    }];
     let format = offscreen_format(gpu);
     let view = targets.colour.create_view(&Default::default());
-    let mut encoder = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("lens term") });
-    encode(gpu, &mut pipes, &mut targets, &view, format, &objects, &[], &[], &lenses, false, None, &mut encoder);
+    let mut encoder = gpu
+        .device
+        .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("lens term") });
+    encode(
+        gpu,
+        &mut pipes,
+        &mut targets,
+        &view,
+        format,
+        &objects,
+        &[],
+        &[],
+        &lenses,
+        false,
+        None,
+        &mut encoder,
+    );
     let texel = if format == wgpu::TextureFormat::Rgba16Float { 8 } else { 16 };
     let readback = Readback::new(gpu, size, texel);
     readback.copy(&targets.colour, &mut encoder);

@@ -68,11 +68,20 @@ pub struct TermShell<'a> {
 
 /// The uniforms of a reflection term drawn on `object` with `shells` (the term's, or the
 /// most distant alone on hull triangles).
-fn reflection_uniforms(object: &ObjectDraw, r: &ReflectionDraw, shells_drawn: &[TermShell]) -> ReflectionUniforms {
+fn reflection_uniforms(
+    object: &ObjectDraw,
+    r: &ReflectionDraw,
+    shells_drawn: &[TermShell],
+) -> ReflectionUniforms {
     let mut shells = [ShellSlot::zeroed(); MAX_TERM_SHELLS];
     for (slot, s) in shells.iter_mut().zip(shells_drawn) {
         let (origin_shape, a, b) = shell_uniform(&s.shell);
-        *slot = ShellSlot { origin_shape, a, b, size_levels: [s.cube.layout.width, s.cube.layout.levels, s.lookups.max(1), 0] };
+        *slot = ShellSlot {
+            origin_shape,
+            a,
+            b,
+            size_levels: [s.cube.layout.width, s.cube.layout.levels, s.lookups.max(1), 0],
+        };
     }
     ReflectionUniforms {
         clip_from_object: object.clip_from_object.to_cols_array(),
@@ -89,14 +98,29 @@ fn reflection_uniforms(object: &ObjectDraw, r: &ReflectionDraw, shells_drawn: &[
 /// The bind group of a reflection term drawn on `object` with `shells` (one or two of the
 /// term's, in order): its uniforms and the cube maps of shells 0 and 1 (shell 0's twice for
 /// one shell).
-pub fn reflection_bind(gpu: &Gpu, layout: &wgpu::BindGroupLayout, object: &ObjectDraw, r: &ReflectionDraw, shells: &[TermShell]) -> wgpu::BindGroup {
+pub fn reflection_bind(
+    gpu: &Gpu,
+    layout: &wgpu::BindGroupLayout,
+    object: &ObjectDraw,
+    r: &ReflectionDraw,
+    shells: &[TermShell],
+) -> wgpu::BindGroup {
     let d = &gpu.device;
-    let u = d.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: Some("reflection uniforms"), contents: bytemuck::bytes_of(&reflection_uniforms(object, r, shells)), usage: wgpu::BufferUsages::UNIFORM });
-    let cube = |k: usize| wgpu::BindingResource::TextureView(&shells[k.min(shells.len() - 1)].cube.view);
+    let u = d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: Some("reflection uniforms"),
+        contents: bytemuck::bytes_of(&reflection_uniforms(object, r, shells)),
+        usage: wgpu::BufferUsages::UNIFORM,
+    });
+    let cube =
+        |k: usize| wgpu::BindingResource::TextureView(&shells[k.min(shells.len() - 1)].cube.view);
     d.create_bind_group(&wgpu::BindGroupDescriptor {
         label: Some("reflection"),
         layout,
-        entries: &[wgpu::BindGroupEntry { binding: 0, resource: u.as_entire_binding() }, wgpu::BindGroupEntry { binding: 1, resource: cube(0) }, wgpu::BindGroupEntry { binding: 2, resource: cube(1) }],
+        entries: &[
+            wgpu::BindGroupEntry { binding: 0, resource: u.as_entire_binding() },
+            wgpu::BindGroupEntry { binding: 1, resource: cube(0) },
+            wgpu::BindGroupEntry { binding: 2, resource: cube(1) },
+        ],
     })
 }
 

@@ -58,7 +58,9 @@ fn private_runtime_dir() -> Option<std::path::PathBuf> {
     let base = std::env::temp_dir();
     let private = |p: &std::path::Path| {
         std::fs::symlink_metadata(p).is_ok_and(|m| {
-            m.is_dir() && Some(m.uid()) == uid.or(Some(m.uid())) && m.permissions().mode() & 0o077 == 0
+            m.is_dir()
+                && Some(m.uid()) == uid.or(Some(m.uid()))
+                && m.permissions().mode() & 0o077 == 0
         })
     };
     let mut candidates = Vec::new();
@@ -114,7 +116,11 @@ impl Gpu {
         Ok((gpu, caps))
     }
 
-    fn open(instance: &wgpu::Instance, surface: Option<&wgpu::Surface<'_>>, options: GpuOptions) -> Result<(Gpu, wgpu::Adapter), PlayError> {
+    fn open(
+        instance: &wgpu::Instance,
+        surface: Option<&wgpu::Surface<'_>>,
+        options: GpuOptions,
+    ) -> Result<(Gpu, wgpu::Adapter), PlayError> {
         let adapter = pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions {
             power_preference: wgpu::PowerPreference::HighPerformance,
             force_fallback_adapter: false,
@@ -123,7 +129,8 @@ impl Gpu {
         }))
         .map_err(|e| PlayError::NoAdapter(e.to_string()))?;
         let info = adapter.get_info();
-        let full = adapter.features().contains(wgpu::Features::FLOAT32_FILTERABLE) && !options.half_textures;
+        let full = adapter.features().contains(wgpu::Features::FLOAT32_FILTERABLE)
+            && !options.half_textures;
         let (texture_format, features) = if full {
             (wgpu::TextureFormat::Rgba32Float, wgpu::Features::FLOAT32_FILTERABLE)
         } else {
@@ -134,7 +141,8 @@ impl Gpu {
         let features = features | (adapter.features() & wgpu::Features::FLOAT32_BLENDABLE);
         // The adapter's own format features (multisampled Rgba32Float and R32Uint targets,
         // which WebGPU does not guarantee) where it reports them.
-        let features = features | (adapter.features() & wgpu::Features::TEXTURE_ADAPTER_SPECIFIC_FORMAT_FEATURES);
+        let features = features
+            | (adapter.features() & wgpu::Features::TEXTURE_ADAPTER_SPECIFIC_FORMAT_FEATURES);
         let limits = adapter.limits();
         let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
             label: Some("pis-play"),
@@ -149,7 +157,8 @@ impl Gpu {
     /// What the device can do with `format`: the adapter's features where the device was
     /// given `TEXTURE_ADAPTER_SPECIFIC_FORMAT_FEATURES`, else those WebGPU guarantees.
     pub fn format_features(&self, format: wgpu::TextureFormat) -> wgpu::TextureFormatFeatures {
-        if self.device.features().contains(wgpu::Features::TEXTURE_ADAPTER_SPECIFIC_FORMAT_FEATURES) {
+        if self.device.features().contains(wgpu::Features::TEXTURE_ADAPTER_SPECIFIC_FORMAT_FEATURES)
+        {
             self.adapter.get_texture_format_features(format)
         } else {
             format.guaranteed_format_features(self.device.features())
@@ -160,7 +169,12 @@ impl Gpu {
     pub fn describe(&self) -> String {
         format!(
             "{} ({:?}, {:?}, {} {}; textures {:?})",
-            self.info.name, self.info.backend, self.info.device_type, self.info.driver, self.info.driver_info, self.texture_format
+            self.info.name,
+            self.info.backend,
+            self.info.device_type,
+            self.info.driver,
+            self.info.driver_info,
+            self.texture_format
         )
     }
 }

@@ -38,7 +38,13 @@ pub struct HybridPipeline {
 
 impl HybridPipeline {
     pub fn new(gpu: &Gpu) -> HybridPipeline {
-        let (layout, pipeline, depth_pipeline) = object_pipelines(gpu, "hybrid_object.wgsl", HYBRID_OBJECT, ("vs_hybrid", "fs_hybrid"), ("vs_hybrid_depth", "fs_hybrid_depth"));
+        let (layout, pipeline, depth_pipeline) = object_pipelines(
+            gpu,
+            "hybrid_object.wgsl",
+            HYBRID_OBJECT,
+            ("vs_hybrid", "fs_hybrid"),
+            ("vs_hybrid_depth", "fs_hybrid_depth"),
+        );
         HybridPipeline { layout, pipeline, depth_pipeline }
     }
 }
@@ -47,13 +53,34 @@ impl HybridPipeline {
 /// map `rgba` (4 values per texel of `layout`) looked up along the per-vertex cube vectors
 /// `vectors` of one term; returns RGBA per pixel (rows from the top), alpha 1 where the
 /// term is drawn. Triangles without the term write depth only.
-pub fn render_hybrid(gpu: &Gpu, pipeline: &HybridPipeline, viewport: Viewport, tess: &Tessellation, clip_from_world: Mat4, vectors: &[Option<[f32; 3]>], layout: TextureLayout, rgba: &[f32]) -> Result<FloatImage, PlayError> {
+pub fn render_hybrid(
+    gpu: &Gpu,
+    pipeline: &HybridPipeline,
+    viewport: Viewport,
+    tess: &Tessellation,
+    clip_from_world: Mat4,
+    vectors: &[Option<[f32; 3]>],
+    layout: TextureLayout,
+    rgba: &[f32],
+) -> Result<FloatImage, PlayError> {
     let limit = gpu.limits.max_texture_dimension_2d;
-    if viewport.width == 0 || viewport.height == 0 || viewport.width > limit || viewport.height > limit {
-        return Err(PlayError::TargetSize { width: viewport.width, height: viewport.height, limit });
+    if viewport.width == 0
+        || viewport.height == 0
+        || viewport.width > limit
+        || viewport.height > limit
+    {
+        return Err(PlayError::TargetSize {
+            width: viewport.width,
+            height: viewport.height,
+            limit,
+        });
     }
     if vectors.len() != tess.vertices.len() {
-        return Err(PlayError::Request(format!("{} cube vectors for {} vertices", vectors.len(), tess.vertices.len())));
+        return Err(PlayError::Request(format!(
+            "{} cube vectors for {} vertices",
+            vectors.len(),
+            tess.vertices.len()
+        )));
     }
     let cube = ShellTexture::new(gpu, layout, "lens object")?;
     cube.upload(gpu, rgba)?;
@@ -70,27 +97,81 @@ pub fn render_hybrid(gpu: &Gpu, pipeline: &HybridPipeline, viewport: Viewport, t
         }
     }
     let d = &gpu.device;
-    let init = |label: &str, contents: &[u8], usage| d.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: Some(label), contents, usage });
-    let u = HybridUniforms { clip_from_world: clip_from_world.to_cols_array(), size: layout.width, levels: layout.levels, _pad: [0; 2] };
+    let init = |label: &str, contents: &[u8], usage| {
+        d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some(label),
+            contents,
+            usage,
+        })
+    };
+    let u = HybridUniforms {
+        clip_from_world: clip_from_world.to_cols_array(),
+        size: layout.width,
+        levels: layout.levels,
+        _pad: [0; 2],
+    };
     let ub = init("uniforms", bytemuck::bytes_of(&u), wgpu::BufferUsages::UNIFORM);
     let bind = d.create_bind_group(&wgpu::BindGroupDescriptor {
         label: Some("hybrid"),
         layout: &pipeline.layout,
-        entries: &[wgpu::BindGroupEntry { binding: 0, resource: ub.as_entire_binding() }, wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::TextureView(&cube.view) }],
+        entries: &[
+            wgpu::BindGroupEntry { binding: 0, resource: ub.as_entire_binding() },
+            wgpu::BindGroupEntry {
+                binding: 1,
+                resource: wgpu::BindingResource::TextureView(&cube.view),
+            },
+        ],
     });
     let pad = |v: &[[f32; 3]]| if v.is_empty() { vec![[0.0f32; 3]] } else { v.to_vec() };
-    let (dp, dv, hp) = (init("positions", bytemuck::cast_slice(&pad(&drawn_p)), wgpu::BufferUsages::VERTEX), init("vectors", bytemuck::cast_slice(&pad(&drawn_v)), wgpu::BufferUsages::VERTEX), init("hidden", bytemuck::cast_slice(&pad(&hidden_p)), wgpu::BufferUsages::VERTEX));
-    let size = wgpu::Extent3d { width: viewport.width, height: viewport.height, depth_or_array_layers: 1 };
-    let target = |label, format, usage| d.create_texture(&wgpu::TextureDescriptor { label: Some(label), size, mip_level_count: 1, sample_count: 1, dimension: wgpu::TextureDimension::D2, format, usage, view_formats: &[] });
-    let color = target("frame", TARGET_FORMAT, wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC);
+    let (dp, dv, hp) = (
+        init("positions", bytemuck::cast_slice(&pad(&drawn_p)), wgpu::BufferUsages::VERTEX),
+        init("vectors", bytemuck::cast_slice(&pad(&drawn_v)), wgpu::BufferUsages::VERTEX),
+        init("hidden", bytemuck::cast_slice(&pad(&hidden_p)), wgpu::BufferUsages::VERTEX),
+    );
+    let size =
+        wgpu::Extent3d { width: viewport.width, height: viewport.height, depth_or_array_layers: 1 };
+    let target = |label, format, usage| {
+        d.create_texture(&wgpu::TextureDescriptor {
+            label: Some(label),
+            size,
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format,
+            usage,
+            view_formats: &[],
+        })
+    };
+    let color = target(
+        "frame",
+        TARGET_FORMAT,
+        wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
+    );
     let depth = target("depth", DEPTH_FORMAT, wgpu::TextureUsages::RENDER_ATTACHMENT);
-    let (color_view, depth_view) = (color.create_view(&Default::default()), depth.create_view(&Default::default()));
-    let mut enc = d.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("hybrid") });
+    let (color_view, depth_view) =
+        (color.create_view(&Default::default()), depth.create_view(&Default::default()));
+    let mut enc =
+        d.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("hybrid") });
     {
         let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("hybrid"),
-            color_attachments: &[Some(wgpu::RenderPassColorAttachment { view: &color_view, depth_slice: None, resolve_target: None, ops: wgpu::Operations { load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT), store: wgpu::StoreOp::Store } })],
-            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment { view: &depth_view, depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Clear(1.0), store: wgpu::StoreOp::Store }), stencil_ops: None }),
+            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                view: &color_view,
+                depth_slice: None,
+                resolve_target: None,
+                ops: wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
+                    store: wgpu::StoreOp::Store,
+                },
+            })],
+            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                view: &depth_view,
+                depth_ops: Some(wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(1.0),
+                    store: wgpu::StoreOp::Store,
+                }),
+                stencil_ops: None,
+            }),
             timestamp_writes: None,
             occlusion_query_set: None,
             multiview_mask: None,

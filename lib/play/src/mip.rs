@@ -40,31 +40,50 @@ impl MipBuilder {
     pub fn new(gpu: &Gpu) -> MipBuilder {
         let d = &gpu.device;
         let source = SHADER.replace("FORMAT", storage_name(gpu.texture_format));
-        let module = d.create_shader_module(wgpu::ShaderModuleDescriptor { label: Some("mip.wgsl"), source: wgpu::ShaderSource::Wgsl(source.into()) });
+        let module = d.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some("mip.wgsl"),
+            source: wgpu::ShaderSource::Wgsl(source.into()),
+        });
         let layout = d.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("mip"),
             entries: &[
                 wgpu::BindGroupLayoutEntry {
                     binding: 0,
                     visibility: wgpu::ShaderStages::COMPUTE,
-                    ty: wgpu::BindingType::Buffer { ty: wgpu::BufferBindingType::Uniform, has_dynamic_offset: false, min_binding_size: None },
+                    ty: wgpu::BindingType::Buffer {
+                        ty: wgpu::BufferBindingType::Uniform,
+                        has_dynamic_offset: false,
+                        min_binding_size: None,
+                    },
                     count: None,
                 },
                 wgpu::BindGroupLayoutEntry {
                     binding: 1,
                     visibility: wgpu::ShaderStages::COMPUTE,
-                    ty: wgpu::BindingType::Texture { sample_type: wgpu::TextureSampleType::Float { filterable: false }, view_dimension: wgpu::TextureViewDimension::D2, multisampled: false },
+                    ty: wgpu::BindingType::Texture {
+                        sample_type: wgpu::TextureSampleType::Float { filterable: false },
+                        view_dimension: wgpu::TextureViewDimension::D2,
+                        multisampled: false,
+                    },
                     count: None,
                 },
                 wgpu::BindGroupLayoutEntry {
                     binding: 2,
                     visibility: wgpu::ShaderStages::COMPUTE,
-                    ty: wgpu::BindingType::StorageTexture { access: wgpu::StorageTextureAccess::WriteOnly, format: gpu.texture_format, view_dimension: wgpu::TextureViewDimension::D2 },
+                    ty: wgpu::BindingType::StorageTexture {
+                        access: wgpu::StorageTextureAccess::WriteOnly,
+                        format: gpu.texture_format,
+                        view_dimension: wgpu::TextureViewDimension::D2,
+                    },
                     count: None,
                 },
             ],
         });
-        let pl = d.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor { label: Some("mip"), bind_group_layouts: &[Some(&layout)], immediate_size: 0 });
+        let pl = d.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("mip"),
+            bind_group_layouts: &[Some(&layout)],
+            immediate_size: 0,
+        });
         let pipeline = d.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
             label: Some("mip"),
             layout: Some(&pl),
@@ -87,7 +106,10 @@ impl MipBuilder {
             sample_count: 1,
             dimension: wgpu::TextureDimension::D2,
             format: gpu.texture_format,
-            usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST | wgpu::TextureUsages::COPY_SRC | wgpu::TextureUsages::STORAGE_BINDING,
+            usage: wgpu::TextureUsages::TEXTURE_BINDING
+                | wgpu::TextureUsages::COPY_DST
+                | wgpu::TextureUsages::COPY_SRC
+                | wgpu::TextureUsages::STORAGE_BINDING,
             view_formats: &[],
         });
         let view = texture.create_view(&wgpu::TextureViewDescriptor::default());
@@ -96,11 +118,26 @@ impl MipBuilder {
 
     /// Uploads the finest level of `image` into `texture` and records the decimation of every
     /// coarser level into `encoder`. Returns the bytes uploaded.
-    pub fn upload(&self, gpu: &Gpu, texture: &ObjectTexture, image: &TextureImage, encoder: &mut wgpu::CommandEncoder) -> Result<u64, PlayError> {
+    pub fn upload(
+        &self,
+        gpu: &Gpu,
+        texture: &ObjectTexture,
+        image: &TextureImage,
+        encoder: &mut wgpu::CommandEncoder,
+    ) -> Result<u64, PlayError> {
         let layout = texture.layout;
         let (aw, ah) = crate::textured::allocated_size(&layout);
-        if (layout.width, layout.height, aw, ah) != (image.width, image.height, image.padded_width, image.padded_height) || image.rgba.len() != (aw * ah * 4) as usize {
-            return Err(PlayError::TextureData { got: image.rgba.len(), want: (aw * ah * 4) as usize, width: layout.width, height: layout.height, levels: layout.levels });
+        if (layout.width, layout.height, aw, ah)
+            != (image.width, image.height, image.padded_width, image.padded_height)
+            || image.rgba.len() != (aw * ah * 4) as usize
+        {
+            return Err(PlayError::TextureData {
+                got: image.rgba.len(),
+                want: (aw * ah * 4) as usize,
+                width: layout.width,
+                height: layout.height,
+                levels: layout.levels,
+            });
         }
         let half = texture.texture.format() == wgpu::TextureFormat::Rgba16Float;
         let halves: Vec<u16>;
@@ -112,31 +149,57 @@ impl MipBuilder {
         };
         let texel_bytes = if half { 8 } else { 16 };
         gpu.queue.write_texture(
-            wgpu::TexelCopyTextureInfo { texture: &texture.texture, mip_level: 0, origin: wgpu::Origin3d::ZERO, aspect: wgpu::TextureAspect::All },
+            wgpu::TexelCopyTextureInfo {
+                texture: &texture.texture,
+                mip_level: 0,
+                origin: wgpu::Origin3d::ZERO,
+                aspect: wgpu::TextureAspect::All,
+            },
             bytes,
-            wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(aw * texel_bytes), rows_per_image: Some(ah) },
+            wgpu::TexelCopyBufferLayout {
+                offset: 0,
+                bytes_per_row: Some(aw * texel_bytes),
+                rows_per_image: Some(ah),
+            },
             wgpu::Extent3d { width: aw, height: ah, depth_or_array_layers: 1 },
         );
         for m in 1..layout.levels {
             let view = |level: u32| {
-                texture.texture.create_view(&wgpu::TextureViewDescriptor { base_mip_level: level, mip_level_count: Some(1), ..Default::default() })
+                texture.texture.create_view(&wgpu::TextureViewDescriptor {
+                    base_mip_level: level,
+                    mip_level_count: Some(1),
+                    ..Default::default()
+                })
             };
             let (src, dst) = (view(m - 1), view(m));
             let (sw, sh) = layout.level_size(m - 1);
             let (dw, dh) = layout.level_size(m);
             let (gw, gh) = ((aw >> m).max(1), (ah >> m).max(1));
             let sizes = Sizes { src: [sw, sh], dst: [dw, dh], alloc: [gw, gh], _pad: [0; 2] };
-            let ubuf = gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: Some("mip sizes"), contents: bytemuck::bytes_of(&sizes), usage: wgpu::BufferUsages::UNIFORM });
+            let ubuf = gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("mip sizes"),
+                contents: bytemuck::bytes_of(&sizes),
+                usage: wgpu::BufferUsages::UNIFORM,
+            });
             let bg = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
                 label: Some("mip"),
                 layout: &self.layout,
                 entries: &[
                     wgpu::BindGroupEntry { binding: 0, resource: ubuf.as_entire_binding() },
-                    wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::TextureView(&src) },
-                    wgpu::BindGroupEntry { binding: 2, resource: wgpu::BindingResource::TextureView(&dst) },
+                    wgpu::BindGroupEntry {
+                        binding: 1,
+                        resource: wgpu::BindingResource::TextureView(&src),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 2,
+                        resource: wgpu::BindingResource::TextureView(&dst),
+                    },
                 ],
             });
-            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("mip"), timestamp_writes: None });
+            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("mip"),
+                timestamp_writes: None,
+            });
             pass.set_pipeline(&self.pipeline);
             pass.set_bind_group(0, &bg, &[]);
             pass.dispatch_workgroups(gw.div_ceil(8), gh.div_ceil(8), 1);
@@ -147,7 +210,10 @@ impl MipBuilder {
 
 /// Reads every level of a texture back (test and diagnostics): per level, the allocated
 /// `max(1, W/2^m) × max(1, H/2^m)` image, RGBA f32.
-pub fn read_levels(gpu: &Gpu, texture: &ObjectTexture) -> Result<Vec<(u32, u32, Vec<f32>)>, PlayError> {
+pub fn read_levels(
+    gpu: &Gpu,
+    texture: &ObjectTexture,
+) -> Result<Vec<(u32, u32, Vec<f32>)>, PlayError> {
     let (aw, ah) = crate::textured::allocated_size(&texture.layout);
     let half = texture.texture.format() == wgpu::TextureFormat::Rgba16Float;
     let texel = if half { 8 } else { 16 };
@@ -155,11 +221,28 @@ pub fn read_levels(gpu: &Gpu, texture: &ObjectTexture) -> Result<Vec<(u32, u32, 
     for m in 0..texture.layout.levels {
         let (w, h) = ((aw >> m).max(1), (ah >> m).max(1));
         let row = (w * texel).div_ceil(256) * 256;
-        let buf = gpu.device.create_buffer(&wgpu::BufferDescriptor { label: Some("level readback"), size: row as u64 * h as u64, usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ, mapped_at_creation: false });
+        let buf = gpu.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("level readback"),
+            size: row as u64 * h as u64,
+            usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+            mapped_at_creation: false,
+        });
         let mut enc = gpu.device.create_command_encoder(&Default::default());
         enc.copy_texture_to_buffer(
-            wgpu::TexelCopyTextureInfo { texture: &texture.texture, mip_level: m, origin: wgpu::Origin3d::ZERO, aspect: wgpu::TextureAspect::All },
-            wgpu::TexelCopyBufferInfo { buffer: &buf, layout: wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(row), rows_per_image: Some(h) } },
+            wgpu::TexelCopyTextureInfo {
+                texture: &texture.texture,
+                mip_level: m,
+                origin: wgpu::Origin3d::ZERO,
+                aspect: wgpu::TextureAspect::All,
+            },
+            wgpu::TexelCopyBufferInfo {
+                buffer: &buf,
+                layout: wgpu::TexelCopyBufferLayout {
+                    offset: 0,
+                    bytes_per_row: Some(row),
+                    rows_per_image: Some(h),
+                },
+            },
             wgpu::Extent3d { width: w, height: h, depth_or_array_layers: 1 },
         );
         gpu.queue.submit([enc.finish()]);
@@ -168,7 +251,10 @@ pub fn read_levels(gpu: &Gpu, texture: &ObjectTexture) -> Result<Vec<(u32, u32, 
         for y in 0..h as usize {
             let r = &bytes[y * row as usize..y * row as usize + (w * texel) as usize];
             if half {
-                img.extend(r.chunks_exact(2).map(|b| half::f16::from_bits(u16::from_le_bytes([b[0], b[1]])).to_f32()));
+                img.extend(
+                    r.chunks_exact(2)
+                        .map(|b| half::f16::from_bits(u16::from_le_bytes([b[0], b[1]])).to_f32()),
+                );
             } else {
                 img.extend(r.chunks_exact(4).map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]])));
             }

@@ -51,13 +51,20 @@ pub fn choose(gpu: &Gpu, requested: u32, colour: wgpu::TextureFormat) -> Multisa
         return Multisample { requested, samples: 1, note: None };
     }
     let mut missing = Vec::new();
-    for (format, role, resolve) in [(colour, "colour", true), (ID_FORMAT, "object index", false), (DEPTH_FORMAT, "depth", false)] {
+    for (format, role, resolve) in [
+        (colour, "colour", true),
+        (ID_FORMAT, "object index", false),
+        (DEPTH_FORMAT, "depth", false),
+    ] {
         let f = gpu.format_features(format);
         // The resolve averages: the colour must be a float (or normalized) format.
-        let averaged = matches!(format.sample_type(None, None), Some(wgpu::TextureSampleType::Float { .. }));
+        let averaged =
+            matches!(format.sample_type(None, None), Some(wgpu::TextureSampleType::Float { .. }));
         let ok = f.flags.sample_count_supported(requested)
             && f.allowed_usages.contains(wgpu::TextureUsages::RENDER_ATTACHMENT)
-            && (!resolve || (averaged && f.flags.contains(wgpu::TextureFormatFeatureFlags::MULTISAMPLE_RESOLVE)));
+            && (!resolve
+                || (averaged
+                    && f.flags.contains(wgpu::TextureFormatFeatureFlags::MULTISAMPLE_RESOLVE)));
         if !ok {
             let what = if resolve { "multisampled and resolved" } else { "multisampled" };
             missing.push(format!("{role} format {format:?} cannot be {what} {requested}×"));
@@ -66,7 +73,11 @@ pub fn choose(gpu: &Gpu, requested: u32, colour: wgpu::TextureFormat) -> Multisa
     if missing.is_empty() {
         Multisample { requested, samples: requested, note: None }
     } else {
-        let note = format!("{} on {}; drawing 1 sample per pixel (no antialiasing)", missing.join(", "), gpu.info.name);
+        let note = format!(
+            "{} on {}; drawing 1 sample per pixel (no antialiasing)",
+            missing.join(", "),
+            gpu.info.name
+        );
         Multisample { requested, samples: 1, note: Some(note) }
     }
 }

@@ -16,20 +16,25 @@ use std::path::Path;
 use std::sync::Arc;
 use std::time::Instant;
 
-use pis_compile::hybrid::{tessellate, HybridView, LensMaterial, LensObject, TessellationSettings, TERMS};
+use pis_compile::hybrid::{
+    tessellate, HybridView, LensMaterial, LensObject, TessellationSettings, TERMS,
+};
 use pis_compile::shell::Shell;
 use pis_compile::{Address, Filter, Sampler, TextureLayout, TextureTransform};
 use pis_format::blocks::{level_image_index, BlockGrid};
 use pis_format::texture::LevelLayout;
-use pis_format::{Container, DepMask, Mapping, Placement, PisReader, StreamRef, Term};
+use pis_format::{Container, DepMask, Mapping, PisReader, Placement, StreamRef, Term};
 
 use crate::blend::{check_point, merge_for_mask, nearest_sample, weighted_samples, Blend};
 use crate::cache::{LevelCache, LevelKey};
 use crate::camera::{mat4_from_rows, projection, CameraChoice, ViewCamera};
 use crate::decode::{AssembleJob, Decoder, LevelJob};
 use crate::error::PlayError;
+use crate::frame::{
+    colour_image, offscreen_format, FramePipelines, LayerDraw, MeshGpu, ObjectDraw, Readback,
+    ReflectionDraw, Targets, TermShell, MAX_TERM_SHELLS,
+};
 use crate::frame_hybrid::{corner_buffer, term_corners, LensDraw, MAX_LENS_SHELLS};
-use crate::frame::{colour_image, offscreen_format, FramePipelines, LayerDraw, MeshGpu, ObjectDraw, Readback, ReflectionDraw, Targets, TermShell, MAX_TERM_SHELLS};
 use crate::gpu::Gpu;
 use crate::image::FloatImage;
 use crate::mip::MipBuilder;
@@ -69,7 +74,17 @@ pub struct PlayerOptions {
 impl Default for PlayerOptions {
     fn default() -> Self {
         let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
-        PlayerOptions { cache_budget_bytes: 512 << 20, lifetime_a: 20, lifetime_b: 4, workers: cores.max(1), reduction: 1, blend: Blend::Nearest, msaa: DEFAULT_SAMPLES, display_filter: None, tau_px: TessellationSettings::default().tau_px }
+        PlayerOptions {
+            cache_budget_bytes: 512 << 20,
+            lifetime_a: 20,
+            lifetime_b: 4,
+            workers: cores.max(1),
+            reduction: 1,
+            blend: Blend::Nearest,
+            msaa: DEFAULT_SAMPLES,
+            display_filter: None,
+            tau_px: TessellationSettings::default().tau_px,
+        }
     }
 }
 
@@ -158,7 +173,8 @@ impl LensState {
         if self.placed.as_ref().is_none_or(|(m, _)| *m != world) {
             let positions = self.positions.iter().map(|&p| world.transform_point3(p)).collect();
             let normals = self.normals.iter().map(|&n| world.transform_vector3(n)).collect();
-            self.placed = Some((world, LensObject::new(self.material, positions, normals, &self.indices)));
+            self.placed =
+                Some((world, LensObject::new(self.material, positions, normals, &self.indices)));
         }
         &self.placed.as_ref().expect("placed above").1
     }
@@ -219,7 +235,11 @@ struct Plan {
 impl Plan {
     /// Every texture the frame draws (a texture drawn twice is listed twice).
     fn keys(&self) -> Vec<&TextureKey> {
-        let shells = self.reflections.iter().chain(&self.lenses).flat_map(|r| r.shells.iter().map(|(k, _, _)| k));
+        let shells = self
+            .reflections
+            .iter()
+            .chain(&self.lenses)
+            .flat_map(|r| r.shells.iter().map(|(k, _, _)| k));
         self.surfaces.iter().map(|w| &w.key).chain(shells).collect()
     }
 }
@@ -284,41 +304,73 @@ fn prepare_objects(gpu: &Gpu, reader: &PisReader) -> Result<Vec<ObjectGpu>, Play
     let mut out = Vec::with_capacity(c.objects.len());
     let mut skipped = Vec::new();
     // The reader has checked the tints (rule 9004).
-    let named: Vec<(&str, pis_format::ObjectRole)> = c.objects.iter().map(|o| (o.name.as_str(), o.role)).collect();
-    let tints = pis_format::tint::tints(c.provenance.as_ref(), &named).unwrap_or_else(|_| vec![[1.0; 3]; c.objects.len()]);
+    let named: Vec<(&str, pis_format::ObjectRole)> =
+        c.objects.iter().map(|o| (o.name.as_str(), o.role)).collect();
+    let tints = pis_format::tint::tints(c.provenance.as_ref(), &named)
+        .unwrap_or_else(|_| vec![[1.0; 3]; c.objects.len()]);
     for (oi, o) in c.objects.iter().enumerate() {
         let n = o.mesh.positions.len();
         let uvs: Vec<[f32; 2]> = match &o.mesh.texcoords {
             Some(t) if t.len() == n => t.clone(),
-            Some(t) => return Err(content(reader, format!("object {oi} '{}': {} texture coordinates for {n} positions", o.name, t.len()))),
+            Some(t) => {
+                return Err(content(
+                    reader,
+                    format!(
+                        "object {oi} '{}': {} texture coordinates for {n} positions",
+                        o.name,
+                        t.len()
+                    ),
+                ))
+            }
             None => vec![[0.0; 2]; n],
         };
         if let Some(bad) = o.mesh.indices.iter().find(|&&i| i as usize >= n) {
-            return Err(content(reader, format!("object {oi} '{}': index {bad} with {n} positions", o.name)));
+            return Err(content(
+                reader,
+                format!("object {oi} '{}': index {bad} with {n} positions", o.name),
+            ));
         }
         if let Some(normals) = o.mesh.normals.as_ref().filter(|v| v.len() != n) {
-            return Err(content(reader, format!("object {oi} '{}': {} normals for {n} positions", o.name, normals.len())));
+            return Err(content(
+                reader,
+                format!("object {oi} '{}': {} normals for {n} positions", o.name, normals.len()),
+            ));
         }
         let mut layers = Vec::new();
         for (li, l) in o.layers.iter().enumerate() {
             if !(1..=4).contains(&l.channels) {
-                return Err(content(reader, format!("object {oi} '{}' layer {li} has {} channels", o.name, l.channels)));
+                return Err(content(
+                    reader,
+                    format!("object {oi} '{}' layer {li} has {} channels", o.name, l.channels),
+                ));
             }
             if l.mapping == Mapping::Shell {
                 continue;
             }
             if o.mesh.texcoords.is_none() {
-                return Err(content(reader, format!("object {oi} '{}' has a surface layer but no texture coordinates", o.name)));
+                return Err(content(
+                    reader,
+                    format!(
+                        "object {oi} '{}' has a surface layer but no texture coordinates",
+                        o.name
+                    ),
+                ));
             }
             layers.push(li);
         }
         let lens = lens_state(reader, oi, tints[oi], &mut skipped)?;
-        let reflection = if lens.is_some() { Vec::new() } else { reflection_shells(reader, oi, &mut skipped)? };
-        let mesh = MeshGpu::new(gpu, &o.mesh.positions, o.mesh.normals.as_deref(), &uvs, &o.mesh.indices).with_hull(o.mesh.hull_triangles);
+        let reflection =
+            if lens.is_some() { Vec::new() } else { reflection_shells(reader, oi, &mut skipped)? };
+        let mesh =
+            MeshGpu::new(gpu, &o.mesh.positions, o.mesh.normals.as_deref(), &uvs, &o.mesh.indices)
+                .with_hull(o.mesh.hull_triangles);
         out.push(ObjectGpu { mesh, layers, reflection, lens });
     }
     if !skipped.is_empty() {
-        eprintln!("pis-play: note: shell layers are not drawn by this player: {}", skipped.join(", "));
+        eprintln!(
+            "pis-play: note: shell layers are not drawn by this player: {}",
+            skipped.join(", ")
+        );
     }
     Ok(out)
 }
@@ -328,10 +380,21 @@ fn prepare_objects(gpu: &Gpu, reader: &PisReader) -> Result<Vec<ObjectGpu>, Play
 /// closed shell (sphere, ellipsoid, box or cylinder; a quad is not supported). Shell layers
 /// the player does not draw — the refraction term's, and every shell of an object without
 /// normals — are listed in `skipped` (`object/kind (why)`).
-fn reflection_shells(reader: &PisReader, oi: usize, skipped: &mut Vec<String>) -> Result<Vec<usize>, PlayError> {
+fn reflection_shells(
+    reader: &PisReader,
+    oi: usize,
+    skipped: &mut Vec<String>,
+) -> Result<Vec<usize>, PlayError> {
     let o = &reader.container().objects[oi];
-    let shells = |term| o.layers.iter().enumerate().filter(move |(_, l)| l.mapping == Mapping::Shell && l.term == term);
-    let mut note = |li: usize, why: &str| skipped.push(format!("{}/{} ({why})", o.name, o.layers[li].kind.name()));
+    let shells = |term| {
+        o.layers
+            .iter()
+            .enumerate()
+            .filter(move |(_, l)| l.mapping == Mapping::Shell && l.term == term)
+    };
+    let mut note = |li: usize, why: &str| {
+        skipped.push(format!("{}/{} ({why})", o.name, o.layers[li].kind.name()))
+    };
     shells(Term::Refraction).for_each(|(li, _)| note(li, "refraction term"));
     let term: Vec<usize> = shells(Term::Reflection).map(|(li, _)| li).collect();
     if o.mesh.normals.is_none() {
@@ -344,15 +407,33 @@ fn reflection_shells(reader: &PisReader, oi: usize, skipped: &mut Vec<String>) -
 /// Shell layers `layers` of object `oi`'s `term` in increasing order, checked drawable: at
 /// most `max` of them, each block a closed shell (sphere, ellipsoid, box or cylinder; a quad
 /// is not supported).
-fn ordered_closed_shells(reader: &PisReader, oi: usize, mut layers: Vec<usize>, term: &str, max: usize) -> Result<Vec<usize>, PlayError> {
+fn ordered_closed_shells(
+    reader: &PisReader,
+    oi: usize,
+    mut layers: Vec<usize>,
+    term: &str,
+    max: usize,
+) -> Result<Vec<usize>, PlayError> {
     let o = &reader.container().objects[oi];
     layers.sort_by_key(|&li| o.layers[li].order);
-    let not_supported = |message: String| PlayError::File(pis_format::Error::NotSupported(format!("{}: object {oi} '{}': {message}", reader.path().display(), o.name)));
+    let not_supported = |message: String| {
+        PlayError::File(pis_format::Error::NotSupported(format!(
+            "{}: object {oi} '{}': {message}",
+            reader.path().display(),
+            o.name
+        )))
+    };
     if layers.len() > max {
-        return Err(not_supported(format!("{} shells in the {term} term; this player draws at most {max}", layers.len())));
+        return Err(not_supported(format!(
+            "{} shells in the {term} term; this player draws at most {max}",
+            layers.len()
+        )));
     }
     for &li in &layers {
-        let closed = o.layers[li].blocks.iter().all(|b| matches!(b.placement, Placement::Shell { shape, .. } if shape.faces() == 6));
+        let closed = o.layers[li]
+            .blocks
+            .iter()
+            .all(|b| matches!(b.placement, Placement::Shell { shape, .. } if shape.faces() == 6));
         if !closed {
             return Err(not_supported(format!("layer {li} ({}) is not a closed shell (sphere, ellipsoid, box or cylinder): quad shells are not drawn", o.layers[li].kind.name())));
         }
@@ -364,27 +445,62 @@ fn ordered_closed_shells(reader: &PisReader, oi: usize, mut layers: Vec<usize>, 
 /// refraction term (at most [`MAX_LENS_SHELLS`], closed shells), normals; its transmission
 /// tint `tint`. Its reflection term's own shells, if any, are not drawn (listed in
 /// `skipped`), nor are the shells of a refractive object without normals.
-fn lens_state(reader: &PisReader, oi: usize, tint: [f32; 3], skipped: &mut Vec<String>) -> Result<Option<LensState>, PlayError> {
+fn lens_state(
+    reader: &PisReader,
+    oi: usize,
+    tint: [f32; 3],
+    skipped: &mut Vec<String>,
+) -> Result<Option<LensState>, PlayError> {
     let o = &reader.container().objects[oi];
     if o.role != pis_format::ObjectRole::Refractive {
         return Ok(None);
     }
-    let shells = |term| o.layers.iter().enumerate().filter(move |(_, l)| l.mapping == Mapping::Shell && l.term == term).map(|(li, _)| li);
+    let shells = |term| {
+        o.layers
+            .iter()
+            .enumerate()
+            .filter(move |(_, l)| l.mapping == Mapping::Shell && l.term == term)
+            .map(|(li, _)| li)
+    };
     let layers: Vec<usize> = shells(Term::Refraction).collect();
     if layers.is_empty() {
         return Ok(None);
     }
     let Some(normals) = &o.mesh.normals else {
-        layers.iter().for_each(|&li| skipped.push(format!("{}/{} (the mesh has no normals)", o.name, o.layers[li].kind.name())));
+        layers.iter().for_each(|&li| {
+            skipped.push(format!(
+                "{}/{} (the mesh has no normals)",
+                o.name,
+                o.layers[li].kind.name()
+            ))
+        });
         return Ok(None);
     };
-    shells(Term::Reflection).for_each(|li| skipped.push(format!("{}/{} (a lens object's reflection term reads its refraction term's shells)", o.name, o.layers[li].kind.name())));
+    shells(Term::Reflection).for_each(|li| {
+        skipped.push(format!(
+            "{}/{} (a lens object's reflection term reads its refraction term's shells)",
+            o.name,
+            o.layers[li].kind.name()
+        ))
+    });
     let layers = ordered_closed_shells(reader, oi, layers, "refraction", MAX_LENS_SHELLS)?;
     let v3 = |v: &[f32; 3]| glam::Vec3::from_array(*v);
     // The runtime's paths take the file's constants: IOR, absorption and the transmission
     // tint (SPEC.md 6.4, 6.6, 9).
-    let material = LensMaterial { ior: o.shading.ior, base: glam::Vec3::from_array(tint), sigma_a: v3(&o.shading.absorption) };
-    Ok(Some(LensState { layers, positions: o.mesh.positions.iter().map(v3).collect(), normals: normals.iter().map(v3).collect(), indices: o.mesh.indices.clone(), material, placed: None, tessellated: None }))
+    let material = LensMaterial {
+        ior: o.shading.ior,
+        base: glam::Vec3::from_array(tint),
+        sigma_a: v3(&o.shading.absorption),
+    };
+    Ok(Some(LensState {
+        layers,
+        positions: o.mesh.positions.iter().map(v3).collect(),
+        normals: normals.iter().map(v3).collect(),
+        indices: o.mesh.indices.clone(),
+        material,
+        placed: None,
+        tessellated: None,
+    }))
 }
 
 /// The cube-map geometry of a shell block's placement (SPEC.md 7.3) and its lookups per
@@ -398,18 +514,32 @@ fn shell_of(placement: &Placement) -> Option<(Shell, u32)> {
 }
 
 /// The reflection terms of a plan, with their cube maps on the GPU (`resident`).
-fn reflection_draws<'a>(reader: &PisReader, resident: &'a HashMap<TextureKey, Resident>, plan: &Plan) -> Result<Vec<ReflectionDraw<'a>>, PlayError> {
+fn reflection_draws<'a>(
+    reader: &PisReader,
+    resident: &'a HashMap<TextureKey, Resident>,
+    plan: &Plan,
+) -> Result<Vec<ReflectionDraw<'a>>, PlayError> {
     let c = reader.container();
     let mut out = Vec::with_capacity(plan.reflections.len());
     for r in &plan.reflections {
         let mut shells = Vec::with_capacity(r.shells.len());
         for (key, shell, lookups) in &r.shells {
             let GpuTexture::Shell(cube) = &resident[key].texture else {
-                return Err(content(reader, format!("{key:?}: a surface texture drawn as a shell")));
+                return Err(content(
+                    reader,
+                    format!("{key:?}: a surface texture drawn as a shell"),
+                ));
             };
             shells.push(TermShell { shell: *shell, lookups: *lookups, cube });
         }
-        out.push(ReflectionDraw { draw: r.draw, world_from_object: plan.worlds[r.draw], eye: plan.eye, f0: c.objects[r.draw].shading.f0, weight: r.weight, shells });
+        out.push(ReflectionDraw {
+            draw: r.draw,
+            world_from_object: plan.worlds[r.draw],
+            eye: plan.eye,
+            f0: c.objects[r.draw].shading.f0,
+            weight: r.weight,
+            shells,
+        });
     }
     Ok(out)
 }
@@ -423,11 +553,18 @@ fn check_texture_sizes(gpu: &Gpu, reader: &PisReader) -> Result<(), PlayError> {
         for l in &o.layers {
             for b in &l.blocks {
                 let (w, h) = match l.mapping {
-                    Mapping::Surface => crate::textured::allocated_size(&TextureLayout::full(b.width, b.height)),
+                    Mapping::Surface => {
+                        crate::textured::allocated_size(&TextureLayout::full(b.width, b.height))
+                    }
                     Mapping::Shell => (b.width.next_power_of_two(), b.height.next_power_of_two()),
                 };
                 if w > limit || h > limit {
-                    return Err(PlayError::TextureSize { object: o.name.clone(), width: b.width, height: b.height, limit });
+                    return Err(PlayError::TextureSize {
+                        object: o.name.clone(),
+                        width: b.width,
+                        height: b.height,
+                        limit,
+                    });
                 }
             }
         }
@@ -440,7 +577,10 @@ impl Player {
     /// until a frame needs them).
     pub fn open(gpu: Arc<Gpu>, path: &Path, options: PlayerOptions) -> Result<Player, PlayError> {
         if options.reduction == 0 || !options.reduction.is_power_of_two() {
-            return Err(PlayError::Request(format!("texture resolution reduction {} must be a power of two (1, 2, 4, …)", options.reduction)));
+            return Err(PlayError::Request(format!(
+                "texture resolution reduction {} must be a power of two (1, 2, 4, …)",
+                options.reduction
+            )));
         }
         check_samples(options.msaa).map_err(PlayError::Request)?;
         let reader = PisReader::open(path)?;
@@ -448,10 +588,13 @@ impl Player {
         let objects = prepare_objects(&gpu, &reader)?;
         let filter = file_filter(reader.container());
         // The reader has checked the settings (rule 9002).
-        let file_display = pis_format::DisplayFilter::of(reader.container().provenance.as_ref()).ok().flatten();
-        let display = file_display.map(|f| (f, true)).or(options.display_filter.map(|f| (f, false)));
+        let file_display =
+            pis_format::DisplayFilter::of(reader.container().provenance.as_ref()).ok().flatten();
+        let display =
+            file_display.map(|f| (f, true)).or(options.display_filter.map(|f| (f, false)));
         let decoder = Decoder::new(options.workers)?;
-        let cache = LevelCache::new(options.cache_budget_bytes, options.lifetime_a, options.lifetime_b);
+        let cache =
+            LevelCache::new(options.cache_budget_bytes, options.lifetime_a, options.lifetime_b);
         let mut pipes = FramePipelines::new(&gpu);
         let offscreen = offscreen_format(&gpu);
         let ms = choose(&gpu, options.msaa, offscreen);
@@ -546,7 +689,8 @@ impl Player {
     /// extra values are ignored).
     fn nearest(&self, point: &[f32]) -> Vec<u32> {
         let dims = self.dimensions();
-        let mut full: Vec<f32> = dims.iter().map(|d| d.values.first().copied().unwrap_or(0.0)).collect();
+        let mut full: Vec<f32> =
+            dims.iter().map(|d| d.values.first().copied().unwrap_or(0.0)).collect();
         for (f, &v) in full.iter_mut().zip(point) {
             if v.is_finite() {
                 *f = v;
@@ -558,12 +702,14 @@ impl Player {
     fn camera_record(&self, sample: &[u32]) -> pis_format::Camera {
         let c = self.reader.container();
         let i = c.space.table_index(c.cameras.depends_on, sample);
-        c.cameras.cameras.get(i).or(c.cameras.cameras.first()).copied().unwrap_or(pis_format::Camera {
-            world_from_camera: pis_format::IDENTITY_3X4,
-            yfov: 0.8,
-            znear: 0.1,
-            zfar: 100.0,
-        })
+        c.cameras.cameras.get(i).or(c.cameras.cameras.first()).copied().unwrap_or(
+            pis_format::Camera {
+                world_from_camera: pis_format::IDENTITY_3X4,
+                yfov: 0.8,
+                znear: 0.1,
+                zfar: 100.0,
+            },
+        )
     }
 
     /// The file's camera at `point` (its nearest view sample).
@@ -575,7 +721,11 @@ impl Player {
     /// alpha is the fraction of the pixel's samples objects cover (1 inside objects, 0
     /// where none is drawn, between on silhouettes of multisampled frames; with a display
     /// filter, the objects' filtered coverage of the pixel's 3×3 neighbourhood's samples).
-    pub fn render_image(&mut self, req: &FrameRequest, size: (u32, u32)) -> Result<(FloatImage, FrameStats), PlayError> {
+    pub fn render_image(
+        &mut self,
+        req: &FrameRequest,
+        size: (u32, u32),
+    ) -> Result<(FloatImage, FrameStats), PlayError> {
         let (out, stats) = self.frame(req, size, Target::Offscreen { ids: false })?;
         let (img, _) = out.ok_or_else(|| PlayError::Readback("no offscreen frame".into()))?;
         Ok((img, stats))
@@ -583,7 +733,11 @@ impl Player {
 
     /// Draws a frame offscreen ([`Player::render_image`]); also the object index per pixel,
     /// the nearest surface at the pixel's centre (`u32::MAX`: none).
-    pub fn render_ids(&mut self, req: &FrameRequest, size: (u32, u32)) -> Result<(FloatImage, Vec<u32>, FrameStats), PlayError> {
+    pub fn render_ids(
+        &mut self,
+        req: &FrameRequest,
+        size: (u32, u32),
+    ) -> Result<(FloatImage, Vec<u32>, FrameStats), PlayError> {
         let (out, stats) = self.frame(req, size, Target::Offscreen { ids: true })?;
         let (img, ids) = out.ok_or_else(|| PlayError::Readback("no offscreen frame".into()))?;
         Ok((img, ids.unwrap_or_default(), stats))
@@ -591,14 +745,24 @@ impl Player {
 
     /// Draws a frame offscreen and waits for the GPU to finish it, without reading it back:
     /// what the frame costs where it is shown rather than copied to memory (timings).
-    pub fn render_timed(&mut self, req: &FrameRequest, size: (u32, u32)) -> Result<FrameStats, PlayError> {
+    pub fn render_timed(
+        &mut self,
+        req: &FrameRequest,
+        size: (u32, u32),
+    ) -> Result<FrameStats, PlayError> {
         Ok(self.frame(req, size, Target::Timed)?.1)
     }
 
     /// Draws a frame into `view` (any colour format; linear radiance, so an `*Srgb` format
     /// does the sRGB encoding) of `size`, with [`Player::multisample_for`] the format's
     /// samples per pixel resolved into it.
-    pub fn render_to_view(&mut self, req: &FrameRequest, view: &wgpu::TextureView, format: wgpu::TextureFormat, size: (u32, u32)) -> Result<FrameStats, PlayError> {
+    pub fn render_to_view(
+        &mut self,
+        req: &FrameRequest,
+        view: &wgpu::TextureView,
+        format: wgpu::TextureFormat,
+        size: (u32, u32),
+    ) -> Result<FrameStats, PlayError> {
         Ok(self.frame(req, size, Target::View(view, format))?.1)
     }
 
@@ -614,24 +778,47 @@ impl Player {
             CameraChoice::Sample => {
                 let cam = self.camera_record(&nearest);
                 let world_from_camera = mat4_from_rows(&cam.world_from_camera);
-                (projection(cam.yfov, cam.znear, cam.zfar, size.0, size.1) * world_from_camera.inverse(), world_from_camera.w_axis.truncate())
+                (
+                    projection(cam.yfov, cam.znear, cam.zfar, size.0, size.1)
+                        * world_from_camera.inverse(),
+                    world_from_camera.w_axis.truncate(),
+                )
             }
             CameraChoice::Free(cam) => {
                 cam.check().map_err(PlayError::Request)?;
                 (cam.projection(size) * cam.view_matrix(), cam.eye)
             }
         };
-        let mut plan = Plan { clips: Vec::with_capacity(c.objects.len()), worlds: Vec::with_capacity(c.objects.len()), eye, surfaces: Vec::new(), reflections: Vec::new(), lenses: Vec::new(), clip_from_world };
+        let mut plan = Plan {
+            clips: Vec::with_capacity(c.objects.len()),
+            worlds: Vec::with_capacity(c.objects.len()),
+            eye,
+            surfaces: Vec::new(),
+            reflections: Vec::new(),
+            lenses: Vec::new(),
+            clip_from_world,
+        };
         for (oi, (o, og)) in c.objects.iter().zip(&self.objects).enumerate() {
             let t = &o.transforms;
-            let world = t.transforms.get(c.space.table_index(t.depends_on, &nearest)).map_or(glam::Mat4::IDENTITY, mat4_from_rows);
+            let world = t
+                .transforms
+                .get(c.space.table_index(t.depends_on, &nearest))
+                .map_or(glam::Mat4::IDENTITY, mat4_from_rows);
             plan.clips.push(clip_from_world * world);
             plan.worlds.push(world);
             for &li in &og.layers {
                 for (s, w) in merge_for_mask(&samples, o.layers[li].depends_on) {
                     let (key, block) = self.texture_key(oi, li, &s)?;
-                    let Placement::Surface { affine, repeat, cut } = block.placement else { continue };
-                    plan.surfaces.push(Wanted { draw: oi, key, weight: w, transform: TextureTransform { values: affine, cut }, repeat });
+                    let Placement::Surface { affine, repeat, cut } = block.placement else {
+                        continue;
+                    };
+                    plan.surfaces.push(Wanted {
+                        draw: oi,
+                        key,
+                        weight: w,
+                        transform: TextureTransform { values: affine, cut },
+                        repeat,
+                    });
                 }
             }
             plan.reflections.extend(self.shell_terms(oi, &og.reflection, &samples)?);
@@ -644,20 +831,39 @@ impl Player {
 
     /// The texture of object `oi`'s layer `li` at parameter sample `sample`: its key and its
     /// block.
-    fn texture_key(&self, oi: usize, li: usize, sample: &[u32]) -> Result<(TextureKey, &pis_format::Block<StreamRef>), PlayError> {
+    fn texture_key(
+        &self,
+        oi: usize,
+        li: usize,
+        sample: &[u32],
+    ) -> Result<(TextureKey, &pis_format::Block<StreamRef>), PlayError> {
         let c = self.reader.container();
         let (o, layer) = (&c.objects[oi], &c.objects[oi].layers[li]);
         let pos = BlockGrid::new(&c.space, layer.depends_on, &o.stagger).locate(sample);
-        let block = layer.blocks.get(pos.block).ok_or_else(|| content(&self.reader, format!("object {oi} layer {li}: block {} missing", pos.block)))?;
-        let images = block.levels.iter().map(|l| level_image_index(&l.counts, &pos.local, &pos.extent) as u32).collect();
-        Ok((TextureKey { object: oi as u32, layer: li as u32, block: pos.block as u32, images }, block))
+        let block = layer.blocks.get(pos.block).ok_or_else(|| {
+            content(&self.reader, format!("object {oi} layer {li}: block {} missing", pos.block))
+        })?;
+        let images = block
+            .levels
+            .iter()
+            .map(|l| level_image_index(&l.counts, &pos.local, &pos.extent) as u32)
+            .collect();
+        Ok((
+            TextureKey { object: oi as u32, layer: li as u32, block: pos.block as u32, images },
+            block,
+        ))
     }
 
     /// Object `oi`'s terms of shell layers `term` (in order) at the weighted parameter
     /// samples: one per class of samples the term's shells cannot tell apart (equal on the
     /// union of their dependency masks), with the class's summed weight, as the surface
     /// layers are blended.
-    fn shell_terms(&self, oi: usize, term: &[usize], samples: &[(Vec<u32>, f32)]) -> Result<Vec<WantedReflection>, PlayError> {
+    fn shell_terms(
+        &self,
+        oi: usize,
+        term: &[usize],
+        samples: &[(Vec<u32>, f32)],
+    ) -> Result<Vec<WantedReflection>, PlayError> {
         let o = &self.reader.container().objects[oi];
         if term.is_empty() {
             return Ok(Vec::new());
@@ -668,7 +874,12 @@ impl Player {
             let mut shells = Vec::with_capacity(term.len());
             for &li in term {
                 let (key, block) = self.texture_key(oi, li, &s)?;
-                let (shell, lookups) = shell_of(&block.placement).ok_or_else(|| content(&self.reader, format!("object {oi} layer {li} block {}: not a closed shell", key.block)))?;
+                let (shell, lookups) = shell_of(&block.placement).ok_or_else(|| {
+                    content(
+                        &self.reader,
+                        format!("object {oi} layer {li} block {}: not a closed shell", key.block),
+                    )
+                })?;
                 shells.push((key, shell, lookups));
             }
             out.push(WantedReflection { draw: oi, weight, shells });
@@ -677,7 +888,11 @@ impl Player {
     }
 
     /// Decodes (on the workers) and uploads every wanted texture not on the GPU.
-    fn make_resident(&mut self, wanted: &[&TextureKey], stats: &mut FrameStats) -> Result<(), PlayError> {
+    fn make_resident(
+        &mut self,
+        wanted: &[&TextureKey],
+        stats: &mut FrameStats,
+    ) -> Result<(), PlayError> {
         let frame = self.frame;
         let mut missing: Vec<&TextureKey> = Vec::new();
         for &key in wanted {
@@ -702,7 +917,13 @@ impl Player {
             let planes = LevelLayout::of(layer, block).planes();
             let n = block.levels.len() as u32;
             for (lv, (level, &img)) in block.levels.iter().zip(&k.images).enumerate() {
-                let key = LevelKey { object: k.object, layer: k.layer, block: k.block, level: lv as u32, image: img };
+                let key = LevelKey {
+                    object: k.object,
+                    layer: k.layer,
+                    block: k.block,
+                    level: lv as u32,
+                    image: img,
+                };
                 if have.contains_key(&key) || jobs.iter().any(|j| j.0 == key) {
                     continue;
                 }
@@ -711,9 +932,15 @@ impl Player {
                         have.insert(key, v);
                     }
                     None => {
-                        let stream = *level.images.get(img as usize).ok_or_else(|| content(&self.reader, format!("{key:?}: no such level image")))?;
+                        let stream = *level.images.get(img as usize).ok_or_else(|| {
+                            content(&self.reader, format!("{key:?}: no such level image"))
+                        })?;
                         let at = (k.object as usize, k.layer as usize, k.block as usize, lv);
-                        jobs.push((key, n - 1 - lv as u32, LevelJob { stream, planes: planes.clone(), at }));
+                        jobs.push((
+                            key,
+                            n - 1 - lv as u32,
+                            LevelJob { stream, planes: planes.clone(), at },
+                        ));
                     }
                 }
             }
@@ -738,14 +965,36 @@ impl Player {
         }
         // Textures rebuilt on the workers: surface textures' finest levels, shells' cube maps.
         let drop_levels = self.options.reduction.trailing_zeros();
-        let is_shell = |k: &TextureKey| c.objects[k.object as usize].layers[k.layer as usize].mapping == Mapping::Shell;
-        let (shells, surfaces): (Vec<&TextureKey>, Vec<&TextureKey>) = missing.iter().partition(|k| is_shell(k));
+        let is_shell = |k: &TextureKey| {
+            c.objects[k.object as usize].layers[k.layer as usize].mapping == Mapping::Shell
+        };
+        let (shells, surfaces): (Vec<&TextureKey>, Vec<&TextureKey>) =
+            missing.iter().partition(|k| is_shell(k));
         let job = |k: &&TextureKey| {
             let layer = &c.objects[k.object as usize].layers[k.layer as usize];
             let block = &layer.blocks[k.block as usize];
-            let levels = k.images.iter().enumerate().map(|(lv, &img)| have[&LevelKey { object: k.object, layer: k.layer, block: k.block, level: lv as u32, image: img }].clone()).collect();
+            let levels = k
+                .images
+                .iter()
+                .enumerate()
+                .map(|(lv, &img)| {
+                    have[&LevelKey {
+                        object: k.object,
+                        layer: k.layer,
+                        block: k.block,
+                        level: lv as u32,
+                        image: img,
+                    }]
+                        .clone()
+                })
+                .collect();
             let full = TextureLayout::full(block.width, block.height).levels;
-            AssembleJob { layer, layout: LevelLayout::of(layer, block), levels, drop_levels: drop_levels.min(full.saturating_sub(1)) }
+            AssembleJob {
+                layer,
+                layout: LevelLayout::of(layer, block),
+                levels,
+                drop_levels: drop_levels.min(full.saturating_sub(1)),
+            }
         };
         let images = self.decoder.assemble(&surfaces.iter().map(job).collect::<Vec<_>>());
         let cubes = self.decoder.assemble_cubes(&shells.iter().map(job).collect::<Vec<_>>());
@@ -755,27 +1004,45 @@ impl Player {
         stats.cache_misses += hits1.misses - hits0.misses;
         // Uploads, GPU MIP chains of surface textures, cube maps with their stored levels.
         let t = Instant::now();
-        let mut encoder = self.gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("uploads") });
+        let mut encoder = self
+            .gpu
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("uploads") });
         let mut made = Vec::with_capacity(missing.len());
         for (k, img) in surfaces.iter().zip(&images) {
             let texture = self.mips.texture(&self.gpu, TextureLayout::full(img.width, img.height));
             stats.upload_bytes += self.mips.upload(&self.gpu, &texture, img, &mut encoder)?;
-            made.push(((*k).clone(), Resident { texture: GpuTexture::Surface(texture), last_frame: frame }));
+            made.push((
+                (*k).clone(),
+                Resident { texture: GpuTexture::Surface(texture), last_frame: frame },
+            ));
         }
         for (k, cube) in shells.iter().zip(&cubes) {
-            let texture = ShellTexture::new(&self.gpu, cube.layout, &c.objects[k.object as usize].name)?;
+            let texture =
+                ShellTexture::new(&self.gpu, cube.layout, &c.objects[k.object as usize].name)?;
             texture.upload(&self.gpu, &cube.rgba)?;
             stats.upload_bytes += (cube.rgba.len() * 4) as u64;
-            made.push(((*k).clone(), Resident { texture: GpuTexture::Shell(texture), last_frame: frame }));
+            made.push((
+                (*k).clone(),
+                Resident { texture: GpuTexture::Shell(texture), last_frame: frame },
+            ));
         }
         self.gpu.queue.submit([encoder.finish()]);
-        self.gpu.device.poll(wgpu::PollType::wait_indefinitely()).map_err(|e| PlayError::Readback(e.to_string()))?;
+        self.gpu
+            .device
+            .poll(wgpu::PollType::wait_indefinitely())
+            .map_err(|e| PlayError::Readback(e.to_string()))?;
         self.resident.extend(made);
         stats.upload_ms += t.elapsed().as_secs_f64() * 1e3;
         Ok(())
     }
 
-    fn frame(&mut self, req: &FrameRequest, size: (u32, u32), target: Target) -> Result<(Option<Readout>, FrameStats), PlayError> {
+    fn frame(
+        &mut self,
+        req: &FrameRequest,
+        size: (u32, u32),
+        target: Target,
+    ) -> Result<(Option<Readout>, FrameStats), PlayError> {
         let t0 = Instant::now();
         let reads0 = self.reader.stats().codestreams;
         let mut stats = FrameStats::default();
@@ -794,7 +1061,8 @@ impl Player {
         let tau_px = self.options.tau_px;
         let gpu_for_lenses = self.gpu.clone();
         let (result, lens_work) = std::thread::scope(|scope| {
-            let lens_thread = scope.spawn(|| lens_corners(&gpu_for_lenses, &mut lens_states, &plan, size, tau_px));
+            let lens_thread = scope
+                .spawn(|| lens_corners(&gpu_for_lenses, &mut lens_states, &plan, size, tau_px));
             let result = self.make_resident(&plan.keys(), &mut stats);
             (result, lens_thread.join())
         });
@@ -826,19 +1094,36 @@ impl Player {
             self.readback = None;
         }
         let gpu = self.gpu.clone();
-        let objects: Vec<ObjectDraw> = self.objects.iter().zip(&plan.clips).enumerate().map(|(i, (o, &clip))| ObjectDraw { object: i as u32, mesh: &o.mesh, clip_from_object: clip }).collect();
+        let objects: Vec<ObjectDraw> = self
+            .objects
+            .iter()
+            .zip(&plan.clips)
+            .enumerate()
+            .map(|(i, (o, &clip))| ObjectDraw {
+                object: i as u32,
+                mesh: &o.mesh,
+                clip_from_object: clip,
+            })
+            .collect();
         for w in &plan.surfaces {
             self.samplers.entry(w.repeat).or_insert_with(|| {
-                let address = w.repeat.map(|r| if r { Address::Repeat } else { Address::ClampToEdge });
+                let address =
+                    w.repeat.map(|r| if r { Address::Repeat } else { Address::ClampToEdge });
                 create_sampler(&gpu, &Sampler { filter: self.filter, address })
             });
         }
         let mut layers = Vec::with_capacity(plan.surfaces.len());
         for w in &plan.surfaces {
             let GpuTexture::Surface(texture) = &self.resident[&w.key].texture else {
-                return Err(content(&self.reader, format!("{:?}: a shell's texture drawn as a surface layer", w.key)));
+                return Err(content(
+                    &self.reader,
+                    format!("{:?}: a shell's texture drawn as a surface layer", w.key),
+                ));
             };
-            let sampler = Sampler { filter: self.filter, address: w.repeat.map(|r| if r { Address::Repeat } else { Address::ClampToEdge }) };
+            let sampler = Sampler {
+                filter: self.filter,
+                address: w.repeat.map(|r| if r { Address::Repeat } else { Address::ClampToEdge }),
+            };
             for (axis, k, s) in [('s', 0, texture.layout.width), ('t', 1, texture.layout.height)] {
                 if w.repeat[k] && !s.is_power_of_two() {
                     return Err(PlayError::RepeatSize { axis, size: s });
@@ -858,16 +1143,30 @@ impl Player {
         let mut lenses = Vec::new();
         for r in &plan.lenses {
             let shells: Vec<Shell> = r.shells.iter().map(|(_, s, _)| *s).collect();
-            let Some((_, _, buffers)) = corner_sets.iter().find(|(d, s, _)| *d == r.draw && *s == shells) else { continue };
+            let Some((_, _, buffers)) =
+                corner_sets.iter().find(|(d, s, _)| *d == r.draw && *s == shells)
+            else {
+                continue;
+            };
             let mut cubes = Vec::with_capacity(r.shells.len());
             for (key, _, _) in &r.shells {
                 let GpuTexture::Shell(cube) = &self.resident[key].texture else {
-                    return Err(content(&self.reader, format!("{key:?}: a surface texture drawn as a shell")));
+                    return Err(content(
+                        &self.reader,
+                        format!("{key:?}: a surface texture drawn as a shell"),
+                    ));
                 };
                 cubes.push(cube);
             }
             for (corners, count) in buffers {
-                lenses.push(LensDraw { object: r.draw as u32, clip_from_world: plan.clip_from_world, weight: r.weight, corners, count: *count, shells: cubes.clone() });
+                lenses.push(LensDraw {
+                    object: r.draw as u32,
+                    clip_from_world: plan.clip_from_world,
+                    weight: r.weight,
+                    corners,
+                    count: *count,
+                    shells: cubes.clone(),
+                });
             }
         }
         stats.lens_draws = lenses.len() as u64;
@@ -875,7 +1174,9 @@ impl Player {
         stats.shell_draws = reflections.len() as u64;
         let targets = self.targets.as_mut().expect("targets made above");
         let t_draw = Instant::now();
-        let mut encoder = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("frame") });
+        let mut encoder = gpu
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("frame") });
         let offscreen_view;
         let (view, want_ids) = match target {
             Target::View(v, _) => (v, false),
@@ -889,7 +1190,20 @@ impl Player {
             }
         };
         let display = self.display.map(|(f, _)| f);
-        crate::frame::encode(&gpu, &mut self.pipes, targets, view, format, &objects, &layers, &reflections, &lenses, want_ids, display, &mut encoder);
+        crate::frame::encode(
+            &gpu,
+            &mut self.pipes,
+            targets,
+            view,
+            format,
+            &objects,
+            &layers,
+            &reflections,
+            &lenses,
+            want_ids,
+            display,
+            &mut encoder,
+        );
         let out = match target {
             Target::Offscreen { ids } => {
                 gpu.queue.submit([encoder.finish()]);
@@ -897,15 +1211,28 @@ impl Player {
                 stats.draw_ms = t_draw.elapsed().as_secs_f64() * 1e3;
                 let t_read = Instant::now();
                 let texel = if format == wgpu::TextureFormat::Rgba16Float { 8 } else { 16 };
-                let (rc, ri) = self.readback.get_or_insert_with(|| (Readback::new(&gpu, size, texel), Readback::new(&gpu, size, 4)));
-                let mut copy = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("readback") });
+                let (rc, ri) = self.readback.get_or_insert_with(|| {
+                    (Readback::new(&gpu, size, texel), Readback::new(&gpu, size, 4))
+                });
+                let mut copy = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                    label: Some("readback"),
+                });
                 rc.copy(&targets.colour, &mut copy);
                 if ids {
                     ri.copy(&targets.ids, &mut copy);
                 }
                 gpu.queue.submit([copy.finish()]);
                 let colour = colour_image(&rc.read(&gpu)?, format, size);
-                let ids = if ids { Some(ri.read(&gpu)?.chunks_exact(4).map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]])).collect()) } else { None };
+                let ids = if ids {
+                    Some(
+                        ri.read(&gpu)?
+                            .chunks_exact(4)
+                            .map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]]))
+                            .collect(),
+                    )
+                } else {
+                    None
+                };
                 stats.readback_ms = t_read.elapsed().as_secs_f64() * 1e3;
                 Some((colour, ids))
             }
@@ -953,7 +1280,13 @@ struct LensWork {
 /// Traces the vertex rays of every lens object `plan` draws through the object placed at
 /// the frame's transform, refines its tessellation down to `tau_px`, and builds both
 /// terms' corners once per object and shell geometry (`states`: the objects' lens states).
-fn lens_corners(gpu: &Gpu, states: &mut [(usize, LensState)], plan: &Plan, size: (u32, u32), tau_px: f32) -> LensWork {
+fn lens_corners(
+    gpu: &Gpu,
+    states: &mut [(usize, LensState)],
+    plan: &Plan,
+    size: (u32, u32),
+    tau_px: f32,
+) -> LensWork {
     let t = Instant::now();
     let settings = TessellationSettings { tau_px, ..TessellationSettings::default() };
     let mut work = LensWork { sets: Vec::new(), ms: 0.0, rays: 0, triangles: 0 };
@@ -963,19 +1296,28 @@ fn lens_corners(gpu: &Gpu, states: &mut [(usize, LensState)], plan: &Plan, size:
             continue;
         }
         let Some((_, state)) = states.iter_mut().find(|(d, _)| *d == r.draw) else { continue };
-        let key: TessellationKey = (plan.worlds[r.draw], plan.eye, plan.clip_from_world, size, tau_px);
+        let key: TessellationKey =
+            (plan.worlds[r.draw], plan.eye, plan.clip_from_world, size, tau_px);
         let tess = match &state.tessellated {
             Some((k, t)) if *k == key => t.clone(),
             _ => {
                 let lens = state.at(plan.worlds[r.draw]);
-                let t = std::sync::Arc::new(tessellate(lens, &HybridView { eye: plan.eye, clip_from_world: plan.clip_from_world, size }, &settings));
+                let t = std::sync::Arc::new(tessellate(
+                    lens,
+                    &HybridView { eye: plan.eye, clip_from_world: plan.clip_from_world, size },
+                    &settings,
+                ));
                 state.tessellated = Some((key, t.clone()));
                 work.rays += t.stats.rays;
                 t
             }
         };
-        let (reflection, refraction) = rayon::join(|| term_corners(&tess, TERMS[0], &shells), || term_corners(&tess, TERMS[1], &shells));
-        let buffers = [reflection, refraction].map(|corners| (corner_buffer(gpu, &corners), corners.len() as u32));
+        let (reflection, refraction) = rayon::join(
+            || term_corners(&tess, TERMS[0], &shells),
+            || term_corners(&tess, TERMS[1], &shells),
+        );
+        let buffers = [reflection, refraction]
+            .map(|corners| (corner_buffer(gpu, &corners), corners.len() as u32));
         work.triangles += buffers.iter().map(|b| b.1 as u64 / 3).max().unwrap_or(0);
         work.sets.push((r.draw, shells, buffers));
     }
@@ -985,5 +1327,8 @@ fn lens_corners(gpu: &Gpu, states: &mut [(usize, LensState)], plan: &Plan, size:
 
 /// Blocks until the GPU has finished everything submitted.
 fn wait_for_gpu(gpu: &Gpu) -> Result<(), PlayError> {
-    gpu.device.poll(wgpu::PollType::wait_indefinitely()).map(|_| ()).map_err(|e| PlayError::Readback(e.to_string()))
+    gpu.device
+        .poll(wgpu::PollType::wait_indefinitely())
+        .map(|_| ())
+        .map_err(|e| PlayError::Readback(e.to_string()))
 }

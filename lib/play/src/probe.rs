@@ -36,7 +36,9 @@
 
 use std::collections::BTreeMap;
 
-use pis_compile::{Address, DrawMesh, Filter, RenderMatrix, TextureLayout, TexturedObject, Viewport};
+use pis_compile::{
+    Address, DrawMesh, Filter, RenderMatrix, TextureLayout, TexturedObject, Viewport,
+};
 
 use crate::error::PlayError;
 use crate::gpu::Gpu;
@@ -80,7 +82,15 @@ fn neighbourhood(i_a: i64, level: u32, active: u32, s: i64, r: i64) -> (i64, i64
 
 /// Per axis, per level: the group of each texel (−1: none) for active level `active` and
 /// offset `o`.
-fn axis_groups(sizes: &[u32], active: u32, o: u32, s: u32, r: u32, address: Address, level: u32) -> Vec<i32> {
+fn axis_groups(
+    sizes: &[u32],
+    active: u32,
+    o: u32,
+    s: u32,
+    r: u32,
+    address: Address,
+    level: u32,
+) -> Vec<i32> {
     let n = sizes[level as usize] as i64;
     let active_n = sizes[active as usize] as i64;
     let mut g = vec![-1i32; n as usize];
@@ -108,7 +118,14 @@ fn axis_groups(sizes: &[u32], active: u32, o: u32, s: u32, r: u32, address: Addr
 
 /// The probe texture of one rendering: phase `p` (active levels m ≡ p mod 3), offsets (ox,
 /// oy), spacing `s` per axis for reach `r`.
-fn probe_texture(layout: &TextureLayout, address: [Address; 2], s: [u32; 2], r: [u32; 2], p: u32, o: [u32; 2]) -> Vec<f32> {
+fn probe_texture(
+    layout: &TextureLayout,
+    address: [Address; 2],
+    s: [u32; 2],
+    r: [u32; 2],
+    p: u32,
+    o: [u32; 2],
+) -> Vec<f32> {
     let widths: Vec<u32> = (0..layout.levels).map(|m| layout.level_size(m).0).collect();
     let heights: Vec<u32> = (0..layout.levels).map(|m| layout.level_size(m).1).collect();
     let mut rgba = vec![0.0f32; layout.texel_count() * 4];
@@ -160,7 +177,13 @@ pub const CHECK_TOLERANCE: f32 = 1e-3;
 
 /// The render matrix of `object` measured through wgpu with 3·S_x·S_y renderings. Rows are
 /// the pixels the object covers (alpha 1), coverage 1, columns sorted.
-pub fn probe_render_matrix(gpu: &Gpu, pipeline: &TexturedPipeline, viewport: Viewport, occluders: &[DrawMesh], object: &TexturedObject) -> Result<RenderMatrix, PlayError> {
+pub fn probe_render_matrix(
+    gpu: &Gpu,
+    pipeline: &TexturedPipeline,
+    viewport: Viewport,
+    occluders: &[DrawMesh],
+    object: &TexturedObject,
+) -> Result<RenderMatrix, PlayError> {
     probe(gpu, pipeline, viewport, occluders, object).map(|p| p.matrix)
 }
 
@@ -168,7 +191,13 @@ pub fn probe_render_matrix(gpu: &Gpu, pipeline: &TexturedPipeline, viewport: Vie
 /// isotropic filters), then at 1.5 times that up to [`max_reach`] of the sampler's filter,
 /// until A predicts a pseudo-random texture's rendering within [`CHECK_TOLERANCE`]; an
 /// error when no reach does.
-pub fn probe(gpu: &Gpu, pipeline: &TexturedPipeline, viewport: Viewport, occluders: &[DrawMesh], object: &TexturedObject) -> Result<Probe, PlayError> {
+pub fn probe(
+    gpu: &Gpu,
+    pipeline: &TexturedPipeline,
+    viewport: Viewport,
+    occluders: &[DrawMesh],
+    object: &TexturedObject,
+) -> Result<Probe, PlayError> {
     let layout = object.layout;
     if gpu.texture_format != wgpu::TextureFormat::Rgba32Float {
         return Err(PlayError::ProbeNeedsFloat32(gpu.info.name.clone()));
@@ -194,7 +223,12 @@ pub fn probe(gpu: &Gpu, pipeline: &TexturedPipeline, viewport: Viewport, occlude
             return Ok(Probe { matrix, reach, renderings, check_error });
         }
         if reach.iter().all(|&r| r >= top) {
-            return Err(PlayError::ProbeCheck { filter: format!("{:?}", object.sampler.filter), reach: reach[0].max(reach[1]), error: check_error, tolerance: CHECK_TOLERANCE });
+            return Err(PlayError::ProbeCheck {
+                filter: format!("{:?}", object.sampler.filter),
+                reach: reach[0].max(reach[1]),
+                error: check_error,
+                tolerance: CHECK_TOLERANCE,
+            });
         }
         reach = reach.map(|r| (r + 1).max(r * 3 / 2).min(top));
     }
@@ -202,7 +236,13 @@ pub fn probe(gpu: &Gpu, pipeline: &TexturedPipeline, viewport: Viewport, occlude
 
 /// The reach per axis of the widest footprint over the covered pixels, from the footprint's
 /// mean, second moment and level scale (see the module docs).
-fn footprint_reach(gpu: &Gpu, pipeline: &TexturedPipeline, scene: &ObjectScene, texture: &ObjectTexture, layout: &TextureLayout) -> Result<[u32; 2], PlayError> {
+fn footprint_reach(
+    gpu: &Gpu,
+    pipeline: &TexturedPipeline,
+    scene: &ObjectScene,
+    texture: &ObjectTexture,
+    layout: &TextureLayout,
+) -> Result<[u32; 2], PlayError> {
     // Texel centres in level-0 texel units, relative to the texture's centre (smaller
     // squares, less rounding).
     let (cx, cy) = (layout.width as f32 / 2.0, layout.height as f32 / 2.0);
@@ -290,7 +330,14 @@ fn prediction_error(a: &RenderMatrix, x: &[f32], rendered: &FloatImage) -> f32 {
 }
 
 /// One measurement of A at reach `reach` per axis; also the number of renderings it made.
-fn measure(gpu: &Gpu, pipeline: &TexturedPipeline, scene: &ObjectScene, texture: &ObjectTexture, object: &TexturedObject, reach: [u32; 2]) -> Result<(RenderMatrix, u32), PlayError> {
+fn measure(
+    gpu: &Gpu,
+    pipeline: &TexturedPipeline,
+    scene: &ObjectScene,
+    texture: &ObjectTexture,
+    object: &TexturedObject,
+    reach: [u32; 2],
+) -> Result<(RenderMatrix, u32), PlayError> {
     let layout = object.layout;
     let address = object.sampler.address;
     let s = [spacing(address[0], reach[0]), spacing(address[1], reach[1])];
@@ -309,7 +356,9 @@ fn measure(gpu: &Gpu, pipeline: &TexturedPipeline, scene: &ObjectScene, texture:
                 let img = scene.render(gpu, pipeline, texture)?;
                 renderings += 1;
                 if covered.is_none() {
-                    let c: Vec<u32> = (0..img.width * img.height).filter(|&q| img.pixel(q as usize)[3] > 0.5).collect();
+                    let c: Vec<u32> = (0..img.width * img.height)
+                        .filter(|&q| img.pixel(q as usize)[3] > 0.5)
+                        .collect();
                     for &q in &c {
                         rows.insert(q, BTreeMap::new());
                     }
@@ -336,7 +385,12 @@ fn measure(gpu: &Gpu, pipeline: &TexturedPipeline, scene: &ObjectScene, texture:
             }
         }
     }
-    let mut a = RenderMatrix { width: scene.viewport().width, height: scene.viewport().height, layout, ..Default::default() };
+    let mut a = RenderMatrix {
+        width: scene.viewport().width,
+        height: scene.viewport().height,
+        layout,
+        ..Default::default()
+    };
     a.row_start.push(0);
     for (q, row) in rows {
         a.pixels.push(q);
@@ -392,7 +446,10 @@ mod tests {
                 for level in [2, 3, 4] {
                     let (_, hi) = neighbourhood(i_a, level, 3, s, r);
                     let (lo, _) = neighbourhood(i_a + s, level, 3, s, r);
-                    assert!(hi < lo, "reach {r} spacing {s} level {level} texel {i_a}: {hi} ≥ {lo}");
+                    assert!(
+                        hi < lo,
+                        "reach {r} spacing {s} level {level} texel {i_a}: {hi} ≥ {lo}"
+                    );
                 }
                 // Every read within the reach: level 3 texels i_a − r − 1 ..= i_a + r + 1, and
                 // the coarser texels a lookup at those positions reads.
@@ -402,7 +459,10 @@ mod tests {
                 for k in 0..=100 {
                     let u = i_a as f64 - 0.5 - r as f64 + (2.0 + 2.0 * r as f64) * k as f64 / 100.0;
                     let v = u / 2.0 - 0.5;
-                    assert!(v.floor() as i64 >= clo && (v.floor() as i64) < chi, "reach {r}: u {u}");
+                    assert!(
+                        v.floor() as i64 >= clo && (v.floor() as i64) < chi,
+                        "reach {r}: u {u}"
+                    );
                 }
             }
         }

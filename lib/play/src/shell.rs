@@ -38,8 +38,19 @@ impl ShellTexture {
     pub fn new(gpu: &Gpu, layout: TextureLayout, object: &str) -> Result<ShellTexture, PlayError> {
         let side = layout.width.next_power_of_two();
         let limit = gpu.limits.max_texture_dimension_2d;
-        if layout.faces != 6 || layout.width != layout.height || layout.width == 0 || side > limit || layout.levels == 0 || layout.levels > TextureLayout::cube(layout.width).levels {
-            return Err(PlayError::TextureSize { object: object.to_string(), width: layout.width, height: layout.height, limit });
+        if layout.faces != 6
+            || layout.width != layout.height
+            || layout.width == 0
+            || side > limit
+            || layout.levels == 0
+            || layout.levels > TextureLayout::cube(layout.width).levels
+        {
+            return Err(PlayError::TextureSize {
+                object: object.to_string(),
+                width: layout.width,
+                height: layout.height,
+                limit,
+            });
         }
         let texture = gpu.device.create_texture(&wgpu::TextureDescriptor {
             label: Some("shell"),
@@ -51,7 +62,10 @@ impl ShellTexture {
             usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
             view_formats: &[],
         });
-        let view = texture.create_view(&wgpu::TextureViewDescriptor { dimension: Some(wgpu::TextureViewDimension::D2Array), ..Default::default() });
+        let view = texture.create_view(&wgpu::TextureViewDescriptor {
+            dimension: Some(wgpu::TextureViewDimension::D2Array),
+            ..Default::default()
+        });
         Ok(ShellTexture { layout, texture, view })
     }
 
@@ -60,7 +74,13 @@ impl ShellTexture {
         let l = self.layout;
         let want = l.texel_count() * 4;
         if rgba.len() != want {
-            return Err(PlayError::TextureData { got: rgba.len(), want, width: l.width, height: l.height, levels: l.levels });
+            return Err(PlayError::TextureData {
+                got: rgba.len(),
+                want,
+                width: l.width,
+                height: l.height,
+                levels: l.levels,
+            });
         }
         for face in 0..6 {
             for m in 0..l.levels {
@@ -68,9 +88,18 @@ impl ShellTexture {
                 let start = l.face_texel(face, m, 0, 0) * 4;
                 let data = &rgba[start..start + (w * h * 4) as usize];
                 gpu.queue.write_texture(
-                    wgpu::TexelCopyTextureInfo { texture: &self.texture, mip_level: m, origin: wgpu::Origin3d { x: 0, y: 0, z: face }, aspect: wgpu::TextureAspect::All },
+                    wgpu::TexelCopyTextureInfo {
+                        texture: &self.texture,
+                        mip_level: m,
+                        origin: wgpu::Origin3d { x: 0, y: 0, z: face },
+                        aspect: wgpu::TextureAspect::All,
+                    },
                     bytemuck::cast_slice(data),
-                    wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(w * 16), rows_per_image: Some(h) },
+                    wgpu::TexelCopyBufferLayout {
+                        offset: 0,
+                        bytes_per_row: Some(w * 16),
+                        rows_per_image: Some(h),
+                    },
                     wgpu::Extent3d { width: w, height: h, depth_or_array_layers: 1 },
                 );
             }
@@ -114,31 +143,53 @@ pub struct ShellPipeline {
 }
 
 /// A vertex buffer of `Float32x3` at shader location `location` (0 or 1).
-pub(crate) const VEC3_AT: fn(u32) -> wgpu::VertexBufferLayout<'static> = |location| wgpu::VertexBufferLayout {
-    array_stride: 12,
-    step_mode: wgpu::VertexStepMode::Vertex,
-    attributes: match location {
-        0 => &[wgpu::VertexAttribute { format: wgpu::VertexFormat::Float32x3, offset: 0, shader_location: 0 }],
-        _ => &[wgpu::VertexAttribute { format: wgpu::VertexFormat::Float32x3, offset: 0, shader_location: 1 }],
-    },
-};
+pub(crate) const VEC3_AT: fn(u32) -> wgpu::VertexBufferLayout<'static> =
+    |location| wgpu::VertexBufferLayout {
+        array_stride: 12,
+        step_mode: wgpu::VertexStepMode::Vertex,
+        attributes: match location {
+            0 => &[wgpu::VertexAttribute {
+                format: wgpu::VertexFormat::Float32x3,
+                offset: 0,
+                shader_location: 0,
+            }],
+            _ => &[wgpu::VertexAttribute {
+                format: wgpu::VertexFormat::Float32x3,
+                offset: 0,
+                shader_location: 1,
+            }],
+        },
+    };
 
 /// The pipelines of one object drawn with one cube map over `shell.wgsl` and `entries`
 /// (WGSL appended to it): the bind group layout (binding 0 the uniforms, 1 the cube map), the
 /// colour pipeline (vertex entry `vs` with two `Float32x3` buffers, fragment `fs`) and the
 /// depth-only one (`vs_depth` over positions, `fs_depth`, no colour written); depth test
 /// `Less`, no culling.
-pub(crate) fn object_pipelines(gpu: &Gpu, label: &str, entries: &str, (vs, fs): (&str, &str), (vs_depth, fs_depth): (&str, &str)) -> (wgpu::BindGroupLayout, wgpu::RenderPipeline, wgpu::RenderPipeline) {
+pub(crate) fn object_pipelines(
+    gpu: &Gpu,
+    label: &str,
+    entries: &str,
+    (vs, fs): (&str, &str),
+    (vs_depth, fs_depth): (&str, &str),
+) -> (wgpu::BindGroupLayout, wgpu::RenderPipeline, wgpu::RenderPipeline) {
     let device = &gpu.device;
     let source = format!("{SHELL_FUNCTIONS}\n{entries}");
-    let module = device.create_shader_module(wgpu::ShaderModuleDescriptor { label: Some(label), source: wgpu::ShaderSource::Wgsl(source.into()) });
+    let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+        label: Some(label),
+        source: wgpu::ShaderSource::Wgsl(source.into()),
+    });
     let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
         label: Some(label),
         entries: &[
             wgpu::BindGroupLayoutEntry {
                 binding: 0,
                 visibility: wgpu::ShaderStages::VERTEX_FRAGMENT,
-                ty: wgpu::BindingType::Buffer { ty: wgpu::BufferBindingType::Uniform, has_dynamic_offset: false, min_binding_size: None },
+                ty: wgpu::BindingType::Buffer {
+                    ty: wgpu::BufferBindingType::Uniform,
+                    has_dynamic_offset: false,
+                    min_binding_size: None,
+                },
                 count: None,
             },
             wgpu::BindGroupLayoutEntry {
@@ -153,8 +204,16 @@ pub(crate) fn object_pipelines(gpu: &Gpu, label: &str, entries: &str, (vs, fs): 
             },
         ],
     });
-    let pl = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor { label: Some(label), bind_group_layouts: &[Some(&layout)], immediate_size: 0 });
-    let primitive = wgpu::PrimitiveState { topology: wgpu::PrimitiveTopology::TriangleList, cull_mode: None, ..Default::default() };
+    let pl = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+        label: Some(label),
+        bind_group_layouts: &[Some(&layout)],
+        immediate_size: 0,
+    });
+    let primitive = wgpu::PrimitiveState {
+        topology: wgpu::PrimitiveTopology::TriangleList,
+        cull_mode: None,
+        ..Default::default()
+    };
     let depth_state = wgpu::DepthStencilState {
         format: DEPTH_FORMAT,
         depth_write_enabled: Some(true),
@@ -162,11 +221,18 @@ pub(crate) fn object_pipelines(gpu: &Gpu, label: &str, entries: &str, (vs, fs): 
         stencil: Default::default(),
         bias: Default::default(),
     };
-    let make = |vs, buffers: &[Option<wgpu::VertexBufferLayout>], fragment: Option<wgpu::FragmentState>| {
+    let make = |vs,
+                buffers: &[Option<wgpu::VertexBufferLayout>],
+                fragment: Option<wgpu::FragmentState>| {
         device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
             label: Some(label),
             layout: Some(&pl),
-            vertex: wgpu::VertexState { module: &module, entry_point: Some(vs), compilation_options: Default::default(), buffers },
+            vertex: wgpu::VertexState {
+                module: &module,
+                entry_point: Some(vs),
+                compilation_options: Default::default(),
+                buffers,
+            },
             primitive,
             depth_stencil: Some(depth_state.clone()),
             multisample: Default::default(),
@@ -175,18 +241,42 @@ pub(crate) fn object_pipelines(gpu: &Gpu, label: &str, entries: &str, (vs, fs): 
             cache: None,
         })
     };
-    let targets = [Some(wgpu::ColorTargetState { format: TARGET_FORMAT, blend: None, write_mask: wgpu::ColorWrites::ALL })];
-    let fragment = wgpu::FragmentState { module: &module, entry_point: Some(fs), compilation_options: Default::default(), targets: &targets };
+    let targets = [Some(wgpu::ColorTargetState {
+        format: TARGET_FORMAT,
+        blend: None,
+        write_mask: wgpu::ColorWrites::ALL,
+    })];
+    let fragment = wgpu::FragmentState {
+        module: &module,
+        entry_point: Some(fs),
+        compilation_options: Default::default(),
+        targets: &targets,
+    };
     let pipeline = make(vs, &[Some(VEC3_AT(0)), Some(VEC3_AT(1))], Some(fragment));
-    let silent = [Some(wgpu::ColorTargetState { format: TARGET_FORMAT, blend: None, write_mask: wgpu::ColorWrites::empty() })];
-    let none = wgpu::FragmentState { module: &module, entry_point: Some(fs_depth), compilation_options: Default::default(), targets: &silent };
+    let silent = [Some(wgpu::ColorTargetState {
+        format: TARGET_FORMAT,
+        blend: None,
+        write_mask: wgpu::ColorWrites::empty(),
+    })];
+    let none = wgpu::FragmentState {
+        module: &module,
+        entry_point: Some(fs_depth),
+        compilation_options: Default::default(),
+        targets: &silent,
+    };
     let depth_pipeline = make(vs_depth, &[Some(VEC3_AT(0))], Some(none));
     (layout, pipeline, depth_pipeline)
 }
 
 impl ShellPipeline {
     pub fn new(gpu: &Gpu) -> ShellPipeline {
-        let (layout, pipeline, depth_pipeline) = object_pipelines(gpu, "shell_object.wgsl", SHELL_OBJECT, ("vs_shell", "fs_shell"), ("vs_shell_depth", "fs_shell_depth"));
+        let (layout, pipeline, depth_pipeline) = object_pipelines(
+            gpu,
+            "shell_object.wgsl",
+            SHELL_OBJECT,
+            ("vs_shell", "fs_shell"),
+            ("vs_shell_depth", "fs_shell_depth"),
+        );
         ShellPipeline { layout, pipeline, depth_pipeline }
     }
 }
@@ -195,15 +285,36 @@ impl ShellPipeline {
 /// the occluders' depth; returns RGBA per pixel (rows from the top), alpha 1 where the object
 /// draws the shell, 0 elsewhere. Triangles that do not draw the shell (`object.drawn`) are
 /// left out of the colour pass but still write depth.
-pub fn render_shell(gpu: &Gpu, pipeline: &ShellPipeline, viewport: Viewport, occluders: &[DrawMesh], object: &ShellObject, rgba: &[f32]) -> Result<FloatImage, PlayError> {
+pub fn render_shell(
+    gpu: &Gpu,
+    pipeline: &ShellPipeline,
+    viewport: Viewport,
+    occluders: &[DrawMesh],
+    object: &ShellObject,
+    rgba: &[f32],
+) -> Result<FloatImage, PlayError> {
     let limit = gpu.limits.max_texture_dimension_2d;
-    if viewport.width == 0 || viewport.height == 0 || viewport.width > limit || viewport.height > limit {
-        return Err(PlayError::TargetSize { width: viewport.width, height: viewport.height, limit });
+    if viewport.width == 0
+        || viewport.height == 0
+        || viewport.width > limit
+        || viewport.height > limit
+    {
+        return Err(PlayError::TargetSize {
+            width: viewport.width,
+            height: viewport.height,
+            limit,
+        });
     }
     let cube = ShellTexture::new(gpu, object.layout, "shell")?;
     cube.upload(gpu, rgba)?;
     let d = &gpu.device;
-    let init = |label: &str, contents: &[u8], usage| d.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: Some(label), contents, usage });
+    let init = |label: &str, contents: &[u8], usage| {
+        d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some(label),
+            contents,
+            usage,
+        })
+    };
     let (origin_shape, a, b) = shell_uniform(&object.shell);
     let uniforms = |clip: glam::Mat4| ShellUniforms {
         clip_from_object: clip.to_cols_array(),
@@ -223,7 +334,10 @@ pub fn render_shell(gpu: &Gpu, pipeline: &ShellPipeline, viewport: Viewport, occ
             layout: &pipeline.layout,
             entries: &[
                 wgpu::BindGroupEntry { binding: 0, resource: u.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::TextureView(&cube.view) },
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: wgpu::BindingResource::TextureView(&cube.view),
+                },
             ],
         })
     };
@@ -239,27 +353,60 @@ pub fn render_shell(gpu: &Gpu, pipeline: &ShellPipeline, viewport: Viewport, occ
         if on { &mut shown } else { &mut hidden }.extend_from_slice(tri);
     }
     depth_draws.push((object.positions.to_vec(), hidden, object.clip_from_object));
-    let size = wgpu::Extent3d { width: viewport.width, height: viewport.height, depth_or_array_layers: 1 };
+    let size =
+        wgpu::Extent3d { width: viewport.width, height: viewport.height, depth_or_array_layers: 1 };
     let target = |label, format, usage| {
-        d.create_texture(&wgpu::TextureDescriptor { label: Some(label), size, mip_level_count: 1, sample_count: 1, dimension: wgpu::TextureDimension::D2, format, usage, view_formats: &[] })
+        d.create_texture(&wgpu::TextureDescriptor {
+            label: Some(label),
+            size,
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format,
+            usage,
+            view_formats: &[],
+        })
     };
-    let color = target("frame", TARGET_FORMAT, wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC);
+    let color = target(
+        "frame",
+        TARGET_FORMAT,
+        wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
+    );
     let depth = target("depth", DEPTH_FORMAT, wgpu::TextureUsages::RENDER_ATTACHMENT);
-    let (color_view, depth_view) = (color.create_view(&Default::default()), depth.create_view(&Default::default()));
+    let (color_view, depth_view) =
+        (color.create_view(&Default::default()), depth.create_view(&Default::default()));
     let pad3 = |v: &[[f32; 3]]| if v.is_empty() { vec![[0.0f32; 3]] } else { v.to_vec() };
     let pad1 = |v: &[u32]| if v.is_empty() { vec![0u32] } else { v.to_vec() };
-    let mut enc = d.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("shell") });
+    let mut enc =
+        d.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("shell") });
     let depth_buffers: Vec<_> = depth_draws
         .iter()
         .map(|(p, i, clip)| {
-            let u = init("uniforms", bytemuck::bytes_of(&uniforms(*clip)), wgpu::BufferUsages::UNIFORM);
+            let u =
+                init("uniforms", bytemuck::bytes_of(&uniforms(*clip)), wgpu::BufferUsages::UNIFORM);
             let bg = bind(&u);
-            (init("positions", bytemuck::cast_slice(&pad3(p)), wgpu::BufferUsages::VERTEX), init("indices", bytemuck::cast_slice(&pad1(i)), wgpu::BufferUsages::INDEX), i.len() as u32 / 3 * 3, bg)
+            (
+                init("positions", bytemuck::cast_slice(&pad3(p)), wgpu::BufferUsages::VERTEX),
+                init("indices", bytemuck::cast_slice(&pad1(i)), wgpu::BufferUsages::INDEX),
+                i.len() as u32 / 3 * 3,
+                bg,
+            )
         })
         .collect();
-    let ou = init("uniforms", bytemuck::bytes_of(&uniforms(object.clip_from_object)), wgpu::BufferUsages::UNIFORM);
+    let ou = init(
+        "uniforms",
+        bytemuck::bytes_of(&uniforms(object.clip_from_object)),
+        wgpu::BufferUsages::UNIFORM,
+    );
     let obg = bind(&ou);
-    let (op, on) = (init("positions", bytemuck::cast_slice(&pad3(object.positions)), wgpu::BufferUsages::VERTEX), init("normals", bytemuck::cast_slice(&pad3(object.normals)), wgpu::BufferUsages::VERTEX));
+    let (op, on) = (
+        init(
+            "positions",
+            bytemuck::cast_slice(&pad3(object.positions)),
+            wgpu::BufferUsages::VERTEX,
+        ),
+        init("normals", bytemuck::cast_slice(&pad3(object.normals)), wgpu::BufferUsages::VERTEX),
+    );
     let oi = init("indices", bytemuck::cast_slice(&pad1(&shown)), wgpu::BufferUsages::INDEX);
     {
         let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
@@ -268,11 +415,17 @@ pub fn render_shell(gpu: &Gpu, pipeline: &ShellPipeline, viewport: Viewport, occ
                 view: &color_view,
                 depth_slice: None,
                 resolve_target: None,
-                ops: wgpu::Operations { load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT), store: wgpu::StoreOp::Store },
+                ops: wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
+                    store: wgpu::StoreOp::Store,
+                },
             })],
             depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
                 view: &depth_view,
-                depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Clear(1.0), store: wgpu::StoreOp::Store }),
+                depth_ops: Some(wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(1.0),
+                    store: wgpu::StoreOp::Store,
+                }),
                 stencil_ops: None,
             }),
             timestamp_writes: None,

@@ -22,7 +22,9 @@
 
 use bytemuck::{Pod, Zeroable};
 use pis_compile::filter::max_level;
-use pis_compile::{Address, DrawMesh, Filter, TextureLayout, TextureTransform, TexturedObject, Viewport};
+use pis_compile::{
+    Address, DrawMesh, Filter, TextureLayout, TextureTransform, TexturedObject, Viewport,
+};
 use wgpu::util::DeviceExt;
 
 use crate::error::PlayError;
@@ -66,10 +68,19 @@ pub fn allocated_size(layout: &TextureLayout) -> (u32, u32) {
 /// The GPU image of every level: level m of the layout (RGBA per texel, `rgba` laid out as
 /// the layout's x with 4 values per texel) in the top-left corner of a `max(1, W/2^m) ×
 /// max(1, H/2^m)` image, the last used column and row repeated into the padding.
-pub fn gpu_levels(layout: &TextureLayout, rgba: &[f32]) -> Result<Vec<(u32, u32, Vec<f32>)>, PlayError> {
+pub fn gpu_levels(
+    layout: &TextureLayout,
+    rgba: &[f32],
+) -> Result<Vec<(u32, u32, Vec<f32>)>, PlayError> {
     let want = layout.texel_count() * 4;
     if rgba.len() != want {
-        return Err(PlayError::TextureData { got: rgba.len(), want, width: layout.width, height: layout.height, levels: layout.levels });
+        return Err(PlayError::TextureData {
+            got: rgba.len(),
+            want,
+            width: layout.width,
+            height: layout.height,
+            levels: layout.levels,
+        });
     }
     let (aw, ah) = allocated_size(layout);
     Ok((0..layout.levels)
@@ -135,7 +146,11 @@ impl ObjectTexture {
                     aspect: wgpu::TextureAspect::All,
                 },
                 bytes,
-                wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(w * texel_bytes), rows_per_image: Some(h) },
+                wgpu::TexelCopyBufferLayout {
+                    offset: 0,
+                    bytes_per_row: Some(w * texel_bytes),
+                    rows_per_image: Some(h),
+                },
                 wgpu::Extent3d { width: w, height: h, depth_or_array_layers: 1 },
             );
         }
@@ -155,7 +170,11 @@ fn uniform_entry() -> wgpu::BindGroupLayoutEntry {
     wgpu::BindGroupLayoutEntry {
         binding: 0,
         visibility: wgpu::ShaderStages::VERTEX_FRAGMENT,
-        ty: wgpu::BindingType::Buffer { ty: wgpu::BufferBindingType::Uniform, has_dynamic_offset: false, min_binding_size: None },
+        ty: wgpu::BindingType::Buffer {
+            ty: wgpu::BufferBindingType::Uniform,
+            has_dynamic_offset: false,
+            min_binding_size: None,
+        },
         count: None,
     }
 }
@@ -163,12 +182,20 @@ fn uniform_entry() -> wgpu::BindGroupLayoutEntry {
 const POSITION_LAYOUT: wgpu::VertexBufferLayout<'static> = wgpu::VertexBufferLayout {
     array_stride: 12,
     step_mode: wgpu::VertexStepMode::Vertex,
-    attributes: &[wgpu::VertexAttribute { format: wgpu::VertexFormat::Float32x3, offset: 0, shader_location: 0 }],
+    attributes: &[wgpu::VertexAttribute {
+        format: wgpu::VertexFormat::Float32x3,
+        offset: 0,
+        shader_location: 0,
+    }],
 };
 const UV_LAYOUT: wgpu::VertexBufferLayout<'static> = wgpu::VertexBufferLayout {
     array_stride: 8,
     step_mode: wgpu::VertexStepMode::Vertex,
-    attributes: &[wgpu::VertexAttribute { format: wgpu::VertexFormat::Float32x2, offset: 0, shader_location: 1 }],
+    attributes: &[wgpu::VertexAttribute {
+        format: wgpu::VertexFormat::Float32x2,
+        offset: 0,
+        shader_location: 1,
+    }],
 };
 
 impl TexturedPipeline {
@@ -279,8 +306,16 @@ pub fn create_sampler(gpu: &Gpu, sampler: &pis_compile::Sampler) -> wgpu::Sample
         Address::ClampToEdge => wgpu::AddressMode::ClampToEdge,
         Address::Repeat => wgpu::AddressMode::Repeat,
     };
-    let texel = if sampler.filter == Filter::Nearest { wgpu::FilterMode::Nearest } else { wgpu::FilterMode::Linear };
-    let mip = if sampler.filter.uses_mips() { wgpu::MipmapFilterMode::Linear } else { wgpu::MipmapFilterMode::Nearest };
+    let texel = if sampler.filter == Filter::Nearest {
+        wgpu::FilterMode::Nearest
+    } else {
+        wgpu::FilterMode::Linear
+    };
+    let mip = if sampler.filter.uses_mips() {
+        wgpu::MipmapFilterMode::Linear
+    } else {
+        wgpu::MipmapFilterMode::Nearest
+    };
     // Anisotropy needs linear filters everywhere (it is); WebGPU clamps to 1..=16.
     let anisotropy_clamp = match sampler.filter {
         Filter::Anisotropic(n) => u16::from(n.clamp(1, pis_compile::MAX_ANISOTROPY)),
@@ -312,10 +347,17 @@ struct MeshBuffers {
 
 fn mesh_buffers(gpu: &Gpu, mesh: &DrawMesh, uniforms: Uniforms) -> MeshBuffers {
     let d = &gpu.device;
-    let init = |label: &str, contents: &[u8], usage| d.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: Some(label), contents, usage });
+    let init = |label: &str, contents: &[u8], usage| {
+        d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some(label),
+            contents,
+            usage,
+        })
+    };
     // A zero-length buffer cannot be bound: pad empty inputs.
     let uvs: Vec<[f32; 2]> = if mesh.uvs.is_empty() { vec![[0.0; 2]] } else { mesh.uvs.to_vec() };
-    let positions: Vec<[f32; 3]> = if mesh.positions.is_empty() { vec![[0.0; 3]] } else { mesh.positions.to_vec() };
+    let positions: Vec<[f32; 3]> =
+        if mesh.positions.is_empty() { vec![[0.0; 3]] } else { mesh.positions.to_vec() };
     let indices: Vec<u32> = if mesh.indices.is_empty() { vec![0] } else { mesh.indices.to_vec() };
     MeshBuffers {
         positions: init("positions", bytemuck::cast_slice(&positions), wgpu::BufferUsages::VERTEX),
@@ -366,10 +408,24 @@ pub struct ObjectScene {
 
 impl ObjectScene {
     /// Uploads the occluders' and the object's meshes; checks them as the model does.
-    pub fn new(gpu: &Gpu, pipeline: &TexturedPipeline, viewport: Viewport, occluders: &[DrawMesh], object: &TexturedObject) -> Result<ObjectScene, PlayError> {
+    pub fn new(
+        gpu: &Gpu,
+        pipeline: &TexturedPipeline,
+        viewport: Viewport,
+        occluders: &[DrawMesh],
+        object: &TexturedObject,
+    ) -> Result<ObjectScene, PlayError> {
         let limit = gpu.limits.max_texture_dimension_2d;
-        if viewport.width == 0 || viewport.height == 0 || viewport.width > limit || viewport.height > limit {
-            return Err(PlayError::TargetSize { width: viewport.width, height: viewport.height, limit });
+        if viewport.width == 0
+            || viewport.height == 0
+            || viewport.width > limit
+            || viewport.height > limit
+        {
+            return Err(PlayError::TargetSize {
+                width: viewport.width,
+                height: viewport.height,
+                limit,
+            });
         }
         pis_compile::model::render_matrix_inputs_ok(viewport, object)?;
         for (axis, k, size) in [('s', 0, object.layout.width), ('t', 1, object.layout.height)] {
@@ -384,12 +440,23 @@ impl ObjectScene {
             let bg = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
                 label: Some("occluder"),
                 layout: &pipeline.depth_layout,
-                entries: &[wgpu::BindGroupEntry { binding: 0, resource: b.uniforms.as_entire_binding() }],
+                entries: &[wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: b.uniforms.as_entire_binding(),
+                }],
             });
             occ.push((b, bg));
         }
-        let object_buffers = mesh_buffers(gpu, &object.mesh, uniforms_of(object.mesh.clip_from_object, Some(object)));
-        let size = wgpu::Extent3d { width: viewport.width, height: viewport.height, depth_or_array_layers: 1 };
+        let object_buffers = mesh_buffers(
+            gpu,
+            &object.mesh,
+            uniforms_of(object.mesh.clip_from_object, Some(object)),
+        );
+        let size = wgpu::Extent3d {
+            width: viewport.width,
+            height: viewport.height,
+            depth_or_array_layers: 1,
+        };
         let target = |label, format, usage| {
             gpu.device.create_texture(&wgpu::TextureDescriptor {
                 label: Some(label),
@@ -402,7 +469,11 @@ impl ObjectScene {
                 view_formats: &[],
             })
         };
-        let color = target("frame", TARGET_FORMAT, wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC);
+        let color = target(
+            "frame",
+            TARGET_FORMAT,
+            wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
+        );
         let depth = target("depth", DEPTH_FORMAT, wgpu::TextureUsages::RENDER_ATTACHMENT);
         let row_bytes = (viewport.width * 16).div_ceil(256) * 256;
         let readback = gpu.device.create_buffer(&wgpu::BufferDescriptor {
@@ -430,26 +501,45 @@ impl ObjectScene {
 
     /// Renders the object with `texture` over the occluders' depth; returns RGBA per pixel
     /// (rows from the top), alpha 1 where the object is visible, 0 elsewhere.
-    pub fn render(&self, gpu: &Gpu, pipeline: &TexturedPipeline, texture: &ObjectTexture) -> Result<FloatImage, PlayError> {
+    pub fn render(
+        &self,
+        gpu: &Gpu,
+        pipeline: &TexturedPipeline,
+        texture: &ObjectTexture,
+    ) -> Result<FloatImage, PlayError> {
         let bind_group = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("textured"),
             layout: &pipeline.bind_group_layout,
             entries: &[
-                wgpu::BindGroupEntry { binding: 0, resource: self.object.uniforms.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::TextureView(&texture.view) },
-                wgpu::BindGroupEntry { binding: 2, resource: wgpu::BindingResource::Sampler(&self.sampler) },
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: self.object.uniforms.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: wgpu::BindingResource::TextureView(&texture.view),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 2,
+                    resource: wgpu::BindingResource::Sampler(&self.sampler),
+                },
             ],
         });
         let color_view = self.color.create_view(&Default::default());
         let depth_view = self.depth.create_view(&Default::default());
-        let mut enc = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("frame") });
+        let mut enc = gpu
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("frame") });
         {
             let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
                 label: Some("occluders"),
                 color_attachments: &[],
                 depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
                     view: &depth_view,
-                    depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Clear(1.0), store: wgpu::StoreOp::Store }),
+                    depth_ops: Some(wgpu::Operations {
+                        load: wgpu::LoadOp::Clear(1.0),
+                        store: wgpu::StoreOp::Store,
+                    }),
                     stencil_ops: None,
                 }),
                 timestamp_writes: None,
@@ -471,11 +561,17 @@ impl ObjectScene {
                     view: &color_view,
                     depth_slice: None,
                     resolve_target: None,
-                    ops: wgpu::Operations { load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT), store: wgpu::StoreOp::Store },
+                    ops: wgpu::Operations {
+                        load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
+                        store: wgpu::StoreOp::Store,
+                    },
                 })],
                 depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
                     view: &depth_view,
-                    depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Load, store: wgpu::StoreOp::Store }),
+                    depth_ops: Some(wgpu::Operations {
+                        load: wgpu::LoadOp::Load,
+                        store: wgpu::StoreOp::Store,
+                    }),
                     stencil_ops: None,
                 }),
                 timestamp_writes: None,
@@ -491,10 +587,19 @@ impl ObjectScene {
         }
         let (w, h) = (self.viewport.width, self.viewport.height);
         enc.copy_texture_to_buffer(
-            wgpu::TexelCopyTextureInfo { texture: &self.color, mip_level: 0, origin: wgpu::Origin3d::ZERO, aspect: wgpu::TextureAspect::All },
+            wgpu::TexelCopyTextureInfo {
+                texture: &self.color,
+                mip_level: 0,
+                origin: wgpu::Origin3d::ZERO,
+                aspect: wgpu::TextureAspect::All,
+            },
             wgpu::TexelCopyBufferInfo {
                 buffer: &self.readback,
-                layout: wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(self.row_bytes), rows_per_image: Some(h) },
+                layout: wgpu::TexelCopyBufferLayout {
+                    offset: 0,
+                    bytes_per_row: Some(self.row_bytes),
+                    rows_per_image: Some(h),
+                },
             },
             wgpu::Extent3d { width: w, height: h, depth_or_array_layers: 1 },
         );
@@ -505,7 +610,14 @@ impl ObjectScene {
 
 /// Renders one object once: uploads `rgba` (4 values per texel of the layout) and draws it
 /// over its occluders' depth.
-pub fn render_object(gpu: &Gpu, pipeline: &TexturedPipeline, viewport: Viewport, occluders: &[DrawMesh], object: &TexturedObject, rgba: &[f32]) -> Result<FloatImage, PlayError> {
+pub fn render_object(
+    gpu: &Gpu,
+    pipeline: &TexturedPipeline,
+    viewport: Viewport,
+    occluders: &[DrawMesh],
+    object: &TexturedObject,
+    rgba: &[f32],
+) -> Result<FloatImage, PlayError> {
     let scene = ObjectScene::new(gpu, pipeline, viewport, occluders, object)?;
     let texture = ObjectTexture::new(gpu, object.layout);
     texture.upload(gpu, rgba)?;

@@ -29,7 +29,8 @@ fn frame_multisampling_keeps_interiors_exactly() {
         return;
     }
     let mut pipes = FramePipelines::new(&gpu);
-    let clip = camera(Viewport { width: SIZE.0, height: SIZE.1 }, [0.3, 0.4, 3.0], [0.0, 0.0, 0.0], 0.8);
+    let clip =
+        camera(Viewport { width: SIZE.0, height: SIZE.1 }, [0.3, 0.4, 3.0], [0.0, 0.0, 0.0], 0.8);
     // Behind: a wide quad at z = −0.5, seen at an angle. In front: a smaller one turned
     // 25° about z so that its edges cross the pixel grid at every phase.
     let back = quad(-1.6, 1.6, -1.2, 1.2, -0.5);
@@ -43,7 +44,10 @@ fn frame_multisampling_keeps_interiors_exactly() {
     };
     let mesh = |m: &Mesh| MeshGpu::new(&gpu, &m.positions, None, &m.uvs, &m.indices);
     let scene = [(mesh(&back), clip, texture(1)), (mesh(&front), clip * turn, texture(2))];
-    let sampler = create_sampler(&gpu, &Sampler { filter: Filter::Bilinear, address: [Address::ClampToEdge; 2] });
+    let sampler = create_sampler(
+        &gpu,
+        &Sampler { filter: Filter::Bilinear, address: [Address::ClampToEdge; 2] },
+    );
     let (a, ids_a) = draw_scene(&gpu, &mut pipes, SIZE, 1, None, &scene, &sampler);
     let (b, ids_b) = draw_scene(&gpu, &mut pipes, SIZE, 4, None, &scene, &sampler);
     assert_eq!(ids_a, ids_b, "object indices at pixel centres");
@@ -54,7 +58,8 @@ fn frame_multisampling_keeps_interiors_exactly() {
         for x in 1..w - 1 {
             let p = y * w + x;
             let uniform = (0..9).all(|k| ids_a[(y + k / 3 - 1) * w + x + k % 3 - 1] == ids_a[p]);
-            let differ = (0..4).map(|c| (a.rgba[p * 4 + c] - b.rgba[p * 4 + c]).abs()).fold(0.0, f32::max);
+            let differ =
+                (0..4).map(|c| (a.rgba[p * 4 + c] - b.rgba[p * 4 + c]).abs()).fold(0.0, f32::max);
             if uniform && ids_a[p] != NO_OBJECT {
                 interior[ids_a[p] as usize] += 1;
                 // On a quad's diagonal the other triangle interpolates (s, t) at the centre
@@ -62,7 +67,13 @@ fn frame_multisampling_keeps_interiors_exactly() {
                 // that changes by up to 1 per texel over 16 texels, bounds the change by
                 // 16 · 2^-23 · a few ≈ 1e-5.
                 worst = worst.max(differ);
-                assert!(differ <= 1e-5, "pixel ({x}, {y}) inside object {}: 1 sample {:?}, 4 samples {:?}", ids_a[p], &a.rgba[p * 4..p * 4 + 4], &b.rgba[p * 4..p * 4 + 4]);
+                assert!(
+                    differ <= 1e-5,
+                    "pixel ({x}, {y}) inside object {}: 1 sample {:?}, 4 samples {:?}",
+                    ids_a[p],
+                    &a.rgba[p * 4..p * 4 + 4],
+                    &b.rgba[p * 4..p * 4 + 4]
+                );
             }
             if !uniform {
                 silhouette += 1;
@@ -85,7 +96,9 @@ fn frame_multisampling_keeps_interiors_exactly() {
 /// one sample per pixel with a note naming it; one sample asked for is one sample drawn.
 #[test]
 fn a_format_that_cannot_be_resolved_falls_back_to_one_sample() {
-    let Some(gpu) = gpu_or_skip("a_format_that_cannot_be_resolved_falls_back_to_one_sample") else { return };
+    let Some(gpu) = gpu_or_skip("a_format_that_cannot_be_resolved_falls_back_to_one_sample") else {
+        return;
+    };
     let m = choose(&gpu, 4, wgpu::TextureFormat::Rgba32Uint);
     assert_eq!((m.requested, m.samples), (4, 1));
     let note = m.note.expect("a note says why");

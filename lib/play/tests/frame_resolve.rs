@@ -51,13 +51,20 @@ fn display_filter_resolve_keeps_interiors_and_spreads_silhouettes() {
     let test = "display_filter_resolve_keeps_interiors_and_spreads_silhouettes";
     let Some(gpu) = multisampling_gpu(test) else { return };
     let mut pipes = FramePipelines::new(&gpu);
-    let clip = camera(Viewport { width: SIZE.0, height: SIZE.1 }, [0.3, 0.4, 3.0], [0.0, 0.0, 0.0], 0.8);
+    let clip =
+        camera(Viewport { width: SIZE.0, height: SIZE.1 }, [0.3, 0.4, 3.0], [0.0, 0.0, 0.0], 0.8);
     let back = quad(-1.6, 1.6, -1.2, 1.2, -0.5);
     let front = quad(-0.6, 0.6, -0.5, 0.5, 0.4);
     let turn = glam::Mat4::from_rotation_z(25f32.to_radians());
     let mesh = |m: &Mesh| MeshGpu::new(&gpu, &m.positions, None, &m.uvs, &m.indices);
-    let scene = [(mesh(&back), clip, texture(&gpu, &random_rgba(256, 1))), (mesh(&front), clip * turn, texture(&gpu, &random_rgba(256, 2)))];
-    let sampler = create_sampler(&gpu, &Sampler { filter: Filter::Bilinear, address: [Address::ClampToEdge; 2] });
+    let scene = [
+        (mesh(&back), clip, texture(&gpu, &random_rgba(256, 1))),
+        (mesh(&front), clip * turn, texture(&gpu, &random_rgba(256, 2))),
+    ];
+    let sampler = create_sampler(
+        &gpu,
+        &Sampler { filter: Filter::Bilinear, address: [Address::ClampToEdge; 2] },
+    );
     let (one, ids) = draw_scene(&gpu, &mut pipes, SIZE, 1, None, &scene, &sampler);
     let (box_, ids_box) = draw_scene(&gpu, &mut pipes, SIZE, 4, None, &scene, &sampler);
     let (filtered, ids_f) = draw_scene(&gpu, &mut pipes, SIZE, 4, Some(GAUSSIAN), &scene, &sampler);
@@ -65,7 +72,8 @@ fn display_filter_resolve_keeps_interiors_and_spreads_silhouettes() {
     assert_eq!(ids, ids_box, "object indices at pixel centres");
     let (w, h) = (SIZE.0 as usize, SIZE.1 as usize);
     let quarter = |a: f32| ((a * 4.0).round() - a * 4.0).abs() < 1e-6;
-    let (mut interior, mut exact, mut spread, mut box_quarters, mut same_as_box) = ([0usize; 2], 0usize, 0usize, true, 0usize);
+    let (mut interior, mut exact, mut spread, mut box_quarters, mut same_as_box) =
+        ([0usize; 2], 0usize, 0usize, true, 0usize);
     for y in 3..h - 3 {
         for x in 3..w - 3 {
             let p = y * w + x;
@@ -77,8 +85,15 @@ fn display_filter_resolve_keeps_interiors_and_spreads_silhouettes() {
                 // As frame_msaa.rs: on a quad's diagonal the other triangle interpolates
                 // (s, t) at the centre with its own barycentrics, a rounding of ~2^-23 in
                 // (s, t) times a texture changing by up to 1 per texel over 16 texels.
-                let differ = (0..4).map(|c| (px(&one)[c] - px(&filtered)[c]).abs()).fold(0.0, f32::max);
-                assert!(differ <= 1e-5, "pixel ({x}, {y}) inside object {}: 1 sample {:?}, filtered {:?}", ids[p], px(&one), px(&filtered));
+                let differ =
+                    (0..4).map(|c| (px(&one)[c] - px(&filtered)[c]).abs()).fold(0.0, f32::max);
+                assert!(
+                    differ <= 1e-5,
+                    "pixel ({x}, {y}) inside object {}: 1 sample {:?}, filtered {:?}",
+                    ids[p],
+                    px(&one),
+                    px(&filtered)
+                );
                 exact += (px(&one) == px(&filtered)) as usize;
                 same_as_box += (px(&box_) == px(&filtered)) as usize;
             }
@@ -113,7 +128,20 @@ fn gaussian_edge_coverage(f: DisplayFilter, t: f64) -> f64 {
             return 0.0;
         }
         let hh = (b - a) / n as f64;
-        (0..=n).map(|i| g(a + i as f64 * hh) * if i == 0 || i == n { 1.0 } else if i % 2 == 1 { 4.0 } else { 2.0 }).sum::<f64>() * hh / 3.0
+        (0..=n)
+            .map(|i| {
+                g(a + i as f64 * hh)
+                    * if i == 0 || i == n {
+                        1.0
+                    } else if i % 2 == 1 {
+                        4.0
+                    } else {
+                        2.0
+                    }
+            })
+            .sum::<f64>()
+            * hh
+            / 3.0
     };
     let marginal = |x: f64| {
         let half = (r * r - x * x).max(0.0).sqrt();
@@ -169,20 +197,39 @@ fn display_filter_resolve_matches_the_gaussian_coverage_of_an_edge() {
     let ndc = |x: f64, y: f64| [(x / wf * 2.0 - 1.0) as f32, (1.0 - y / hf * 2.0) as f32, 0.5];
     let (top, bottom) = (-10.0, hf + 10.0);
     let shape = Mesh {
-        positions: vec![ndc(-10.0, top), ndc(edge_x(top), top), ndc(edge_x(bottom), bottom), ndc(-10.0, bottom)],
+        positions: vec![
+            ndc(-10.0, top),
+            ndc(edge_x(top), top),
+            ndc(edge_x(bottom), bottom),
+            ndc(-10.0, bottom),
+        ],
         uvs: vec![[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]],
         indices: vec![0, 1, 2, 0, 2, 3],
     };
     let c = [0.8f32, 0.5, 0.25];
     let rgba: Vec<f32> = (0..256).flat_map(|_| [c[0], c[1], c[2], 1.0]).collect();
-    let scene = [(MeshGpu::new(&gpu, &shape.positions, None, &shape.uvs, &shape.indices), glam::Mat4::IDENTITY, texture(&gpu, &rgba))];
-    let sampler = create_sampler(&gpu, &Sampler { filter: Filter::Bilinear, address: [Address::ClampToEdge; 2] });
+    let scene = [(
+        MeshGpu::new(&gpu, &shape.positions, None, &shape.uvs, &shape.indices),
+        glam::Mat4::IDENTITY,
+        texture(&gpu, &rgba),
+    )];
+    let sampler = create_sampler(
+        &gpu,
+        &Sampler { filter: Filter::Bilinear, address: [Address::ClampToEdge; 2] },
+    );
     let (img, _) = draw_scene(&gpu, &mut pipes, SIZE, 4, Some(GAUSSIAN), &scene, &sampler);
     let (sigma, r) = (GAUSSIAN.sigma_px as f64, GAUSSIAN.radius_px as f64);
-    let weight = |dx: f64, dy: f64| if dx * dx + dy * dy <= r * r { (-(dx * dx + dy * dy) / (2.0 * sigma * sigma)).exp() } else { 0.0 };
+    let weight = |dx: f64, dy: f64| {
+        if dx * dx + dy * dy <= r * r {
+            (-(dx * dx + dy * dy) / (2.0 * sigma * sigma)).exp()
+        } else {
+            0.0
+        }
+    };
     let norm = (1.0 + b * b).sqrt();
     let (w, h) = (SIZE.0 as usize, SIZE.1 as usize);
-    let (mut tested, mut partial, mut skipped, mut worst, mut widest) = (0usize, 0usize, 0usize, 0.0f64, 0.0f64);
+    let (mut tested, mut partial, mut skipped, mut worst, mut widest) =
+        (0usize, 0usize, 0usize, 0.0f64, 0.0f64);
     let total_mass = cell_mass_total(GAUSSIAN);
     for y in 2..h - 2 {
         for x in 2..w - 2 {
@@ -207,7 +254,10 @@ fn display_filter_resolve_matches_the_gaussian_coverage_of_an_edge() {
                             win += ws;
                         }
                         // The cell: the quadrant of pixel q holding the sample.
-                        let (x0, y0) = (qx as f64 - 0.5 + if sx > 0.5 { 0.5 } else { 0.0 }, qy as f64 - 0.5 + if sy > 0.5 { 0.5 } else { 0.0 });
+                        let (x0, y0) = (
+                            qx as f64 - 0.5 + if sx > 0.5 { 0.5 } else { 0.0 },
+                            qy as f64 - 0.5 + if sy > 0.5 { 0.5 } else { 0.0 },
+                        );
                         cells.push((ws, x0, y0));
                         // Vertices snap to the rasteriser's sub-pixel grid (1/256 px in
                         // Vulkan): a sample that close to the edge may fall either side.
@@ -222,7 +272,8 @@ fn display_filter_resolve_matches_the_gaussian_coverage_of_an_edge() {
             let q = win / wall;
             let (mut inner, mut cut_w, mut cut_mu) = (0.0f64, 0.0f64, 0.0f64);
             for &(ws, x0, y0) in &cells {
-                let corners = [(x0, y0), (x0 + 0.5, y0), (x0, y0 + 0.5), (x0 + 0.5, y0 + 0.5)].map(|(u, v)| inside(u, v));
+                let corners = [(x0, y0), (x0 + 0.5, y0), (x0, y0 + 0.5), (x0 + 0.5, y0 + 0.5)]
+                    .map(|(u, v)| inside(u, v));
                 let mu = cell_mass(GAUSSIAN, x0, y0) / total_mass;
                 if corners.iter().all(|&k| k) {
                     inner += ws / wall - mu;
@@ -238,7 +289,11 @@ fn display_filter_resolve_matches_the_gaussian_coverage_of_an_edge() {
             partial += (q > 0.0 && q < 1.0) as usize;
             for (ch, &cc) in c.iter().enumerate() {
                 let got = img.rgba[p * 4 + ch] as f64;
-                assert!((got - q * cc as f64).abs() <= 1e-5, "pixel ({x}, {y}) channel {ch}: {got}, the 36-sample quadrature gives {}", q * cc as f64);
+                assert!(
+                    (got - q * cc as f64).abs() <= 1e-5,
+                    "pixel ({x}, {y}) channel {ch}: {got}, the 36-sample quadrature gives {}",
+                    q * cc as f64
+                );
                 let err = (got - exact * cc as f64).abs();
                 assert!(err <= bound * cc as f64 + 1e-5, "pixel ({x}, {y}) at t = {t:.3}: {got}, Gaussian coverage {exact:.4} × {cc} = {}, quadrature bound {bound:.4}", exact * cc as f64);
                 worst = worst.max(err / cc as f64);
@@ -251,7 +306,10 @@ fn display_filter_resolve_matches_the_gaussian_coverage_of_an_edge() {
     eprintln!("{test}: {tested} pixels near the edge ({partial} partly covered, {skipped} with a sample on the edge skipped): coverage error at most {worst:.4}, bounds up to {widest:.4}");
     // About 2R + 2 pixels per row lie near the edge, 2R + 1 of them partly covered; a
     // sample within 0.01 px of the edge takes a row's pixels out about one time in six.
-    assert!(tested >= (h - 4) * 3 && partial >= (h - 4) * 2, "{tested} tested, {partial} partly covered, {skipped} skipped");
+    assert!(
+        tested >= (h - 4) * 3 && partial >= (h - 4) * 2,
+        "{tested} tested, {partial} partly covered, {skipped} skipped"
+    );
 }
 
 /// The filter's mass over the whole disc (the 36 cells cover [−1.5, 1.5]² ⊇ the disc).

@@ -11,7 +11,10 @@ mod common;
 
 use common::*;
 use glam::Vec3;
-use pis_compile::hybrid::{hybrid_pixels, hybrid_render_matrix, term_radiance, tessellate, vertex_modulation, vertex_vectors, HybridView, LensMaterial, LensObject, Missing, TessellationSettings, TERMS};
+use pis_compile::hybrid::{
+    hybrid_pixels, hybrid_render_matrix, term_radiance, tessellate, vertex_modulation,
+    vertex_vectors, HybridView, LensMaterial, LensObject, Missing, TessellationSettings, TERMS,
+};
 use pis_compile::{TextureLayout, Viewport};
 use pis_play::{render_hybrid, HybridPipeline};
 
@@ -23,13 +26,27 @@ fn hybrid_frames_match_the_model() {
     // A glass ball: refraction bends every path, total internal reflection inside cuts some.
     let ball = uv_sphere(40, 20);
     let positions: Vec<Vec3> = ball.positions.iter().map(|&p| Vec3::from(p)).collect();
-    let lens = LensObject::new(LensMaterial { ior: 1.5, base: Vec3::ONE, sigma_a: Vec3::splat(0.3) }, positions.clone(), positions, &ball.indices);
-    let views: [(&str, [f32; 3], f32, u32); 2] = [("close", [0.4, 0.6, 2.6], 1.0, 24), ("far", [-2.5, 1.8, 8.0], 0.4, 64)];
+    let lens = LensObject::new(
+        LensMaterial { ior: 1.5, base: Vec3::ONE, sigma_a: Vec3::splat(0.3) },
+        positions.clone(),
+        positions,
+        &ball.indices,
+    );
+    let views: [(&str, [f32; 3], f32, u32); 2] =
+        [("close", [0.4, 0.6, 2.6], 1.0, 24), ("far", [-2.5, 1.8, 8.0], 0.4, 64)];
     let mut worst = f64::INFINITY;
     let mut failures = vec![];
     for (vname, eye, fovy, size) in views {
         let clip = camera(vp, eye, [0.0, 0.0, 0.0], fovy);
-        let tess = tessellate(&lens, &HybridView { eye: Vec3::from(eye), clip_from_world: clip, size: (vp.width, vp.height) }, &TessellationSettings { tau_px: 2.0, ..Default::default() });
+        let tess = tessellate(
+            &lens,
+            &HybridView {
+                eye: Vec3::from(eye),
+                clip_from_world: clip,
+                size: (vp.width, vp.height),
+            },
+            &TessellationSettings { tau_px: 2.0, ..Default::default() },
+        );
         let layout = TextureLayout::cube(size);
         let x = random_rgba(layout.texel_count(), 7 + size as u64);
         for (sname, shell) in shells() {
@@ -37,15 +54,27 @@ fn hybrid_frames_match_the_model() {
                 let vectors = vertex_vectors(&tess, term, &shell);
                 let a = hybrid_render_matrix(vp, &tess, clip, &vectors, layout, None);
                 let want = predict(&a, &x);
-                let got = render_hybrid(&gpu, &pipeline, vp, &tess, clip, &vectors, layout, &x).unwrap();
+                let got =
+                    render_hybrid(&gpu, &pipeline, vp, &tess, clip, &vectors, layout, &x).unwrap();
                 // The same frame twice: the same tessellation (pis-compile's tests) and pixels.
                 if sname == "sphere" {
-                    let again = render_hybrid(&gpu, &pipeline, vp, &tess, clip, &vectors, layout, &x).unwrap();
-                    assert!(again.rgba.iter().zip(&got.rgba).all(|(a, b)| a.to_bits() == b.to_bits()), "{vname} {term:?}: two draws differ");
+                    let again =
+                        render_hybrid(&gpu, &pipeline, vp, &tess, clip, &vectors, layout, &x)
+                            .unwrap();
+                    assert!(
+                        again.rgba.iter().zip(&got.rgba).all(|(a, b)| a.to_bits() == b.to_bits()),
+                        "{vname} {term:?}: two draws differ"
+                    );
                 }
                 let c = compare(&want, &got);
                 let name = format!("hybrid-{vname}-{sname}-{term:?}");
-                eprintln!("{name}: PSNR {:.2} dB over {} pixels, {} coverage mismatches, {:.2} taps/row", c.psnr_db, c.both, c.coverage_mismatch, a.cols.len() as f64 / a.rows().max(1) as f64);
+                eprintln!(
+                    "{name}: PSNR {:.2} dB over {} pixels, {} coverage mismatches, {:.2} taps/row",
+                    c.psnr_db,
+                    c.both,
+                    c.coverage_mismatch,
+                    a.cols.len() as f64 / a.rows().max(1) as f64
+                );
                 worst = worst.min(c.psnr_db);
                 if c.psnr_db < 60.0 || c.coverage_mismatch * 1000 > c.both || c.both < 500 {
                     let dir = write_failure_images(&name, &want, &got);
@@ -66,43 +95,100 @@ fn lens_terms_in_the_frame_match_the_model() {
     let vp = Viewport { width: 160, height: 120 };
     let ball = uv_sphere(40, 20);
     let positions: Vec<Vec3> = ball.positions.iter().map(|&p| Vec3::from(p)).collect();
-    let lens = LensObject::new(LensMaterial { ior: 1.5, base: Vec3::ONE, sigma_a: Vec3::splat(0.3) }, positions.clone(), positions, &ball.indices);
+    let lens = LensObject::new(
+        LensMaterial { ior: 1.5, base: Vec3::ONE, sigma_a: Vec3::splat(0.3) },
+        positions.clone(),
+        positions,
+        &ball.indices,
+    );
     let eye = [0.4f32, 0.6, 2.6];
     let clip = camera(vp, eye, [0.0, 0.0, 0.0], 1.0);
-    let tess = tessellate(&lens, &HybridView { eye: Vec3::from(eye), clip_from_world: clip, size: (vp.width, vp.height) }, &TessellationSettings { tau_px: 2.0, ..Default::default() });
+    let tess = tessellate(
+        &lens,
+        &HybridView { eye: Vec3::from(eye), clip_from_world: clip, size: (vp.width, vp.height) },
+        &TessellationSettings { tau_px: 2.0, ..Default::default() },
+    );
     // Shells nearest first: ellipsoid, cylinder, box, sphere; each cube with alpha in [0, 1]
     // and its colour premultiplied.
     let all = shells();
     let order = ["ellipsoid", "cylinder", "box", "sphere"];
-    let layouts = [TextureLayout::cube(16), TextureLayout::cube(32), TextureLayout::cube(8), TextureLayout::cube(24)];
+    let layouts = [
+        TextureLayout::cube(16),
+        TextureLayout::cube(32),
+        TextureLayout::cube(8),
+        TextureLayout::cube(24),
+    ];
     let cubes: Vec<Vec<f32>> = layouts
         .iter()
         .enumerate()
         .map(|(k, l)| {
             let c = random_rgba(l.texel_count(), 31 + k as u64);
             let a = random_rgba(l.texel_count(), 97 + k as u64);
-            (0..l.texel_count()).flat_map(|t| [c[4 * t] * a[4 * t], c[4 * t + 1] * a[4 * t], c[4 * t + 2] * a[4 * t], a[4 * t]]).collect()
+            (0..l.texel_count())
+                .flat_map(|t| {
+                    [
+                        c[4 * t] * a[4 * t],
+                        c[4 * t + 1] * a[4 * t],
+                        c[4 * t + 2] * a[4 * t],
+                        a[4 * t],
+                    ]
+                })
+                .collect()
         })
         .collect();
-    let geometry: Vec<_> = order.iter().map(|n| all.iter().find(|(s, _)| s == n).expect("shell").1).collect();
+    let geometry: Vec<_> =
+        order.iter().map(|n| all.iter().find(|(s, _)| s == n).expect("shell").1).collect();
     let mut worst = f64::INFINITY;
     for count in [1usize, 4] {
         for term in TERMS {
-            let fg = hybrid_pixels(vp, &tess, clip, &vertex_modulation(&tess, term), Missing::Zero, None);
-            let a: Vec<_> = geometry[..count].iter().zip(&layouts).map(|(s, l)| hybrid_render_matrix(vp, &tess, clip, &vertex_vectors(&tess, term, s), *l, None)).collect();
+            let fg = hybrid_pixels(
+                vp,
+                &tess,
+                clip,
+                &vertex_modulation(&tess, term),
+                Missing::Zero,
+                None,
+            );
+            let a: Vec<_> = geometry[..count]
+                .iter()
+                .zip(&layouts)
+                .map(|(s, l)| {
+                    hybrid_render_matrix(vp, &tess, clip, &vertex_vectors(&tess, term, s), *l, None)
+                })
+                .collect();
             let refs: Vec<&_> = a.iter().collect();
             let cube_refs: Vec<&[f32]> = cubes[..count].iter().map(Vec::as_slice).collect();
-            let mut want = pis_play::FloatImage { width: vp.width, height: vp.height, rgba: vec![0.0; (vp.width * vp.height * 4) as usize] };
+            let mut want = pis_play::FloatImage {
+                width: vp.width,
+                height: vp.height,
+                rgba: vec![0.0; (vp.width * vp.height * 4) as usize],
+            };
             for (&p, c) in fg.pixels.iter().zip(term_radiance(&fg, &refs, &cube_refs)) {
-                want.rgba[4 * p as usize..4 * p as usize + 4].copy_from_slice(&[c[0], c[1], c[2], 1.0]);
+                want.rgba[4 * p as usize..4 * p as usize + 4]
+                    .copy_from_slice(&[c[0], c[1], c[2], 1.0]);
             }
-            let shells: Vec<_> = geometry[..count].iter().zip(&layouts).zip(&cubes).map(|((s, l), c)| (*s, *l, c.as_slice())).collect();
-            let got = pis_play::frame_hybrid::render_lens_term(&gpu, vp, &tess, clip, term, &shells).unwrap();
-            let again = pis_play::frame_hybrid::render_lens_term(&gpu, vp, &tess, clip, term, &shells).unwrap();
-            assert!(again.rgba.iter().zip(&got.rgba).all(|(a, b)| a.to_bits() == b.to_bits()), "{count} shells {term:?}: two frames differ");
+            let shells: Vec<_> = geometry[..count]
+                .iter()
+                .zip(&layouts)
+                .zip(&cubes)
+                .map(|((s, l), c)| (*s, *l, c.as_slice()))
+                .collect();
+            let got =
+                pis_play::frame_hybrid::render_lens_term(&gpu, vp, &tess, clip, term, &shells)
+                    .unwrap();
+            let again =
+                pis_play::frame_hybrid::render_lens_term(&gpu, vp, &tess, clip, term, &shells)
+                    .unwrap();
+            assert!(
+                again.rgba.iter().zip(&got.rgba).all(|(a, b)| a.to_bits() == b.to_bits()),
+                "{count} shells {term:?}: two frames differ"
+            );
             let c = compare(&want, &got);
             let name = format!("lens-term-{count}-{term:?}");
-            eprintln!("{name}: PSNR {:.2} dB over {} pixels, {} coverage mismatches", c.psnr_db, c.both, c.coverage_mismatch);
+            eprintln!(
+                "{name}: PSNR {:.2} dB over {} pixels, {} coverage mismatches",
+                c.psnr_db, c.both, c.coverage_mismatch
+            );
             worst = worst.min(c.psnr_db);
             if c.psnr_db < 60.0 || c.coverage_mismatch * 1000 > c.both || c.both < 500 {
                 let dir = write_failure_images(&name, &want, &got);

@@ -7,7 +7,10 @@
 mod common;
 
 use common::*;
-use pis_compile::{render_matrix, scene_depth, Address, DrawMesh, Filter, Sampler, TextureLayout, TextureTransform, TexturedObject, Viewport};
+use pis_compile::{
+    render_matrix, scene_depth, Address, DrawMesh, Filter, Sampler, TextureLayout,
+    TextureTransform, TexturedObject, Viewport,
+};
 use pis_play::{render_object, TexturedPipeline};
 
 struct View {
@@ -31,7 +34,9 @@ fn model_matches_wgpu() {
 #[test]
 fn model_matches_wgpu_with_half_float_textures() {
     let options = pis_play::GpuOptions { half_textures: true };
-    let Some(gpu) = gpu_with_or_skip("model_matches_wgpu_with_half_float_textures", options) else { return };
+    let Some(gpu) = gpu_with_or_skip("model_matches_wgpu_with_half_float_textures", options) else {
+        return;
+    };
     run_views(&gpu, "model_vs_wgpu_half");
 }
 
@@ -42,11 +47,29 @@ fn run_views(gpu: &pis_play::Gpu, test: &str) {
     let occluder = quad(-2.0, -0.2, -2.0, -0.3, 1.3);
     let views = [
         // Close: the texture is magnified in the middle and minified towards the silhouette.
-        View { name: "close", eye: [0.3, 0.6, 2.2], fovy: 1.0, layout: TextureLayout::full(181, 97), address: CLAMP },
+        View {
+            name: "close",
+            eye: [0.3, 0.6, 2.2],
+            fovy: 1.0,
+            layout: TextureLayout::full(181, 97),
+            address: CLAMP,
+        },
         // Far: the whole sphere small on screen, strongly minified (many MIP levels).
-        View { name: "far", eye: [-2.0, 1.5, 6.5], fovy: 0.5, layout: TextureLayout::full(300, 170), address: CLAMP },
+        View {
+            name: "far",
+            eye: [-2.0, 1.5, 6.5],
+            fovy: 0.5,
+            layout: TextureLayout::full(300, 170),
+            address: CLAMP,
+        },
         // Magnified: a small texture seen up close.
-        View { name: "magnified", eye: [1.2, -0.4, 1.9], fovy: 0.9, layout: TextureLayout::full(23, 13), address: CLAMP },
+        View {
+            name: "magnified",
+            eye: [1.2, -0.4, 1.9],
+            fovy: 0.9,
+            layout: TextureLayout::full(23, 13),
+            address: CLAMP,
+        },
         // Near-plane clipped: the camera 0.05 from the surface (near plane 0.1) looks through
         // the clipped hole at the inside; s wraps around the sphere (repeat, power-of-two width).
         View {
@@ -64,11 +87,21 @@ fn run_views(gpu: &pis_play::Gpu, test: &str) {
     let mut failures = vec![];
     for view in &views {
         let clip = camera(vp, view.eye, [0.0, 0.0, 0.0], view.fovy);
-        let occ = DrawMesh { positions: &occluder.positions, uvs: &occluder.uvs, indices: &occluder.indices, clip_from_object: clip };
+        let occ = DrawMesh {
+            positions: &occluder.positions,
+            uvs: &occluder.uvs,
+            indices: &occluder.indices,
+            clip_from_object: clip,
+        };
         let transform = if view.address[0] == Address::Repeat { wrapped } else { skewed };
         for filter in [Filter::Nearest, Filter::Bilinear, Filter::Trilinear] {
             let object = TexturedObject {
-                mesh: DrawMesh { positions: &sphere.positions, uvs: &sphere.uvs, indices: &sphere.indices, clip_from_object: clip },
+                mesh: DrawMesh {
+                    positions: &sphere.positions,
+                    uvs: &sphere.uvs,
+                    indices: &sphere.indices,
+                    clip_from_object: clip,
+                },
                 transform,
                 layout: view.layout,
                 sampler: Sampler { filter, address: view.address },
@@ -113,14 +146,21 @@ fn model_matches_wgpu_with_branch_cuts() {
     let layout = TextureLayout::full(97, 61);
     let clip = camera(vp, [2.3, 0.5, 0.4], [0.0, 0.0, 0.0], 0.9);
     // After the cut the visible part is w' ∈ [0.45, 0.95]: the affine map spreads it over s.
-    let along_u = TextureTransform { values: [1.6, 0.02, 0.0, 0.9, -0.68, 0.05], cut: [Some(0.3), None] };
-    let along_v = TextureTransform { values: [0.9, 0.0, 0.02, 1.6, 0.05, -0.68], cut: [None, Some(0.3)] };
+    let along_u =
+        TextureTransform { values: [1.6, 0.02, 0.0, 0.9, -0.68, 0.05], cut: [Some(0.3), None] };
+    let along_v =
+        TextureTransform { values: [0.9, 0.0, 0.02, 1.6, 0.05, -0.68], cut: [None, Some(0.3)] };
     let x = random_rgba(layout.texel_count(), 11);
     let mut failures = vec![];
     for (name, uvs, transform) in [("cut-u", &sphere.uvs, along_u), ("cut-v", &swapped, along_v)] {
         for filter in [Filter::Nearest, Filter::Bilinear, Filter::Trilinear] {
             let object = |transform| TexturedObject {
-                mesh: DrawMesh { positions: &sphere.positions, uvs, indices: &sphere.indices, clip_from_object: clip },
+                mesh: DrawMesh {
+                    positions: &sphere.positions,
+                    uvs,
+                    indices: &sphere.indices,
+                    clip_from_object: clip,
+                },
                 transform,
                 layout,
                 sampler: Sampler { filter, address: CLAMP },
@@ -129,15 +169,23 @@ fn model_matches_wgpu_with_branch_cuts() {
             let got = render_object(&gpu, &pipeline, vp, &[], &object(transform), &x).unwrap();
             let c = compare(&want, &got);
             let uncut = TextureTransform::affine(transform.values);
-            let without = compare(&predict(&render_matrix(vp, &object(uncut), None).unwrap(), &x), &got);
+            let without =
+                compare(&predict(&render_matrix(vp, &object(uncut), None).unwrap(), &x), &got);
             eprintln!(
                 "branch cuts {name} {filter:?}: PSNR {:.2} dB over {} pixels, {} coverage mismatches; {:.2} dB against the image without the cut",
                 c.psnr_db, c.both, c.coverage_mismatch, without.psnr_db
             );
             let threshold = if filter == Filter::Nearest { 40.0 } else { 50.0 };
-            if c.psnr_db < threshold || c.coverage_mismatch * 1000 > c.both || without.psnr_db > 20.0 {
-                let dir = write_failure_images(&format!("branch-cuts-{name}-{filter:?}"), &want, &got);
-                failures.push(format!("{name} {filter:?}: {c:?}, without the cut {without:?} (images in {})", dir.display()));
+            if c.psnr_db < threshold
+                || c.coverage_mismatch * 1000 > c.both
+                || without.psnr_db > 20.0
+            {
+                let dir =
+                    write_failure_images(&format!("branch-cuts-{name}-{filter:?}"), &want, &got);
+                failures.push(format!(
+                    "{name} {filter:?}: {c:?}, without the cut {without:?} (images in {})",
+                    dir.display()
+                ));
             }
         }
     }

@@ -43,15 +43,23 @@ fn path_streams(player: &Player, points: &[Vec<u32>]) -> Vec<(u32, u64)> {
 }
 
 fn at(player: &Player, samples: &[u32]) -> FrameRequest {
-    let point = player.dimensions().iter().zip(samples).map(|(d, &s)| d.values[s as usize]).collect();
+    let point =
+        player.dimensions().iter().zip(samples).map(|(d, &s)| d.values[s as usize]).collect();
     FrameRequest { point, camera: CameraChoice::Sample }
 }
 
 #[test]
 fn a_frame_reads_only_the_codestreams_of_its_pyramid_paths() {
-    let Some(gpu) = gpu_or_skip("a_frame_reads_only_the_codestreams_of_its_pyramid_paths") else { return };
+    let Some(gpu) = gpu_or_skip("a_frame_reads_only_the_codestreams_of_its_pyramid_paths") else {
+        return;
+    };
     // One sample per pixel: alpha is 1 exactly where the object index is drawn.
-    let mut player = Player::open(Arc::new(gpu), &tiny(), PlayerOptions { workers: 2, msaa: 1, ..Default::default() }).unwrap();
+    let mut player = Player::open(
+        Arc::new(gpu),
+        &tiny(),
+        PlayerOptions { workers: 2, msaa: 1, ..Default::default() },
+    )
+    .unwrap();
     let size = player.image_size();
     // tiny.pis: dimensions (view, light); the surface layer varies with light, the shell
     // with the view.
@@ -82,7 +90,11 @@ fn a_frame_reads_only_the_codestreams_of_its_pyramid_paths() {
     let second = vec![1, 1];
     let (_, s) = player.render_image(&at(&player, &second), size).unwrap();
     let all = path_streams(&player, &[first, view, second]);
-    assert_eq!(s.codestreams_read, (all.len() - seen.len()) as u64, "shared pyramid levels come from the cache");
+    assert_eq!(
+        s.codestreams_read,
+        (all.len() - seen.len()) as u64,
+        "shared pyramid levels come from the cache"
+    );
     assert!(s.cache_hits >= 1, "the top level is shared");
     assert_eq!(player.reader().stats().codestreams, all.len() as u64);
 }
@@ -98,8 +110,11 @@ fn a_lossless_master_changes_no_frame_and_no_read() {
     let dir = tempfile::tempdir().unwrap();
     let with = dir.path().join("tiny-master.pis");
     pis_format::write_with_masters(&with, &c, &masters).unwrap();
-    let mut plain = Player::open(gpu.clone(), &tiny(), PlayerOptions { workers: 1, ..Default::default() }).unwrap();
-    let mut mastered = Player::open(gpu, &with, PlayerOptions { workers: 1, ..Default::default() }).unwrap();
+    let mut plain =
+        Player::open(gpu.clone(), &tiny(), PlayerOptions { workers: 1, ..Default::default() })
+            .unwrap();
+    let mut mastered =
+        Player::open(gpu, &with, PlayerOptions { workers: 1, ..Default::default() }).unwrap();
     assert!(mastered.reader().has_master() && mastered.reader().master_bytes() > 0);
     let size = plain.image_size();
     for samples in [[0, 0], [1, 0], [1, 1], [0, 1], [0, 0]] {
@@ -107,7 +122,11 @@ fn a_lossless_master_changes_no_frame_and_no_read() {
         let (b, sb) = mastered.render_image(&at(&mastered, &samples), size).unwrap();
         let differ = a.rgba.iter().zip(&b.rgba).filter(|(x, y)| x.to_bits() != y.to_bits()).count();
         assert_eq!(differ, 0, "point {samples:?}: {differ} values differ");
-        assert_eq!((sa.codestreams_read, sa.cache_hits, sa.cache_misses, sa.cache_bytes), (sb.codestreams_read, sb.cache_hits, sb.cache_misses, sb.cache_bytes), "point {samples:?}");
+        assert_eq!(
+            (sa.codestreams_read, sa.cache_hits, sa.cache_misses, sa.cache_bytes),
+            (sb.codestreams_read, sb.cache_hits, sb.cache_misses, sb.cache_bytes),
+            "point {samples:?}"
+        );
     }
     // Only level images were read: the same count and bytes as without the master.
     assert_eq!(plain.reader().stats(), mastered.reader().stats());
@@ -115,19 +134,35 @@ fn a_lossless_master_changes_no_frame_and_no_read() {
 
 #[test]
 fn multilinear_blend_is_the_weighted_sum_of_the_sample_frames() {
-    let Some(gpu) = gpu_or_skip("multilinear_blend_is_the_weighted_sum_of_the_sample_frames") else { return };
+    let Some(gpu) = gpu_or_skip("multilinear_blend_is_the_weighted_sum_of_the_sample_frames")
+    else {
+        return;
+    };
     let gpu = Arc::new(gpu);
-    let mut player = Player::open(gpu, &tiny(), PlayerOptions { blend: Blend::Multilinear, workers: 1, ..Default::default() }).unwrap();
+    let mut player = Player::open(
+        gpu,
+        &tiny(),
+        PlayerOptions { blend: Blend::Multilinear, workers: 1, ..Default::default() },
+    )
+    .unwrap();
     let size = player.image_size();
     let light = player.dimensions()[1].values.clone();
     let view = player.dimensions()[0].values[0];
     let camera = CameraChoice::Free(player.sample_camera(&[view, light[0]]));
-    let frame = |p: &mut Player, l: f32| p.render_image(&FrameRequest { point: vec![view, l], camera }, size).unwrap().0;
+    let frame = |p: &mut Player, l: f32| {
+        p.render_image(&FrameRequest { point: vec![view, l], camera }, size).unwrap().0
+    };
     let a = frame(&mut player, light[0]);
     let b = frame(&mut player, light[1]);
     let w = 0.3f32;
     let mid = frame(&mut player, light[0] + w * (light[1] - light[0]));
-    let want: Vec<f32> = a.rgba.iter().zip(&b.rgba).enumerate().map(|(k, (x, y))| if k % 4 == 3 { x.max(*y) } else { (1.0 - w) * x + w * y }).collect();
+    let want: Vec<f32> = a
+        .rgba
+        .iter()
+        .zip(&b.rgba)
+        .enumerate()
+        .map(|(k, (x, y))| if k % 4 == 3 { x.max(*y) } else { (1.0 - w) * x + w * y })
+        .collect();
     let differ = a.rgba.iter().zip(&b.rgba).filter(|(x, y)| (*x - *y).abs() > 1e-3).count();
     assert!(differ > 10, "the two light samples differ ({differ} values)");
     let p = psnr(&mid.rgba, &want);
@@ -139,7 +174,8 @@ fn gpu_mip_chain_equals_cpu_decimation() {
     let Some(gpu) = gpu_or_skip("gpu_mip_chain_equals_cpu_decimation") else { return };
     let mips = MipBuilder::new(&gpu);
     for (w, h) in [(13u32, 7u32), (16, 16), (1, 5), (37, 20)] {
-        let values: Vec<f32> = (0..w * h * 4).map(|k| ((k as u64 * 2654435761u64 % 1000) as f32) / 997.0).collect();
+        let values: Vec<f32> =
+            (0..w * h * 4).map(|k| ((k as u64 * 2654435761u64 % 1000) as f32) / 997.0).collect();
         let layout = pis_compile::TextureLayout::full(w, h);
         let (pw, ph) = (w.next_power_of_two(), h.next_power_of_two());
         let mut rgba = vec![0.0; (pw * ph * 4) as usize];
@@ -200,7 +236,10 @@ fn multisampling_changes_silhouettes_of_played_frames() {
     let test = "multisampling_changes_silhouettes_of_played_frames";
     let Some(gpu) = gpu_or_skip(test) else { return };
     let gpu = Arc::new(gpu);
-    let open = |msaa| Player::open(gpu.clone(), &tiny(), PlayerOptions { workers: 1, msaa, ..Default::default() }).unwrap();
+    let open = |msaa| {
+        Player::open(gpu.clone(), &tiny(), PlayerOptions { workers: 1, msaa, ..Default::default() })
+            .unwrap()
+    };
     let (mut one, mut four) = (open(1), open(4));
     assert_eq!((one.multisample().requested, one.multisample().samples), (1, 1));
     let ms = four.multisample().clone();
@@ -226,17 +265,30 @@ fn multisampling_changes_silhouettes_of_played_frames() {
             area += (ids_a[p] != u32::MAX) as usize;
             if alpha > 0.0 && alpha < 1.0 {
                 partial += 1;
-                assert!(!uniform, "pixel ({x}, {y}) is partly covered ({alpha}) away from the silhouette");
-                let differ = (0..3).map(|c| (a.rgba[p * 4 + c] - b.rgba[p * 4 + c]).abs()).fold(0.0, f32::max);
-                assert!(differ > 1e-4, "partly covered pixel ({x}, {y}) keeps its single-sample colour");
+                assert!(
+                    !uniform,
+                    "pixel ({x}, {y}) is partly covered ({alpha}) away from the silhouette"
+                );
+                let differ = (0..3)
+                    .map(|c| (a.rgba[p * 4 + c] - b.rgba[p * 4 + c]).abs())
+                    .fold(0.0, f32::max);
+                assert!(
+                    differ > 1e-4,
+                    "partly covered pixel ({x}, {y}) keeps its single-sample colour"
+                );
             }
             if uniform && ids_a[p] != u32::MAX {
                 interior += 1;
                 assert_eq!(alpha, 1.0, "pixel ({x}, {y}) inside the ball is wholly covered");
-                let same = (0..3).all(|c| (a.rgba[p * 4 + c] - b.rgba[p * 4 + c]).abs() <= 1e-6 * a.rgba[p * 4 + c].abs().max(1e-3));
+                let same = (0..3).all(|c| {
+                    (a.rgba[p * 4 + c] - b.rgba[p * 4 + c]).abs()
+                        <= 1e-6 * a.rgba[p * 4 + c].abs().max(1e-3)
+                });
                 exact += same as usize;
                 for c in 0..3 {
-                    let (lo, hi) = hood().map(|q| a.rgba[q * 4 + c]).fold((f32::MAX, f32::MIN), |(l, u), v| (l.min(v), u.max(v)));
+                    let (lo, hi) = hood()
+                        .map(|q| a.rgba[q * 4 + c])
+                        .fold((f32::MAX, f32::MIN), |(l, u), v| (l.min(v), u.max(v)));
                     let v = b.rgba[p * 4 + c];
                     assert!(v >= lo - 1e-3 && v <= hi + 1e-3, "pixel ({x}, {y}) channel {c}: {v} outside its neighbourhood's [{lo}, {hi}]");
                 }
@@ -246,19 +298,31 @@ fn multisampling_changes_silhouettes_of_played_frames() {
     eprintln!("{test}: {area} pixels covered, {interior} inside ({exact} unchanged), {partial} partly covered");
     assert!(interior > 200, "{interior} interior pixels");
     // A closed silhouette around `area` pixels is at least 2·sqrt(π·area) long.
-    assert!(partial as f64 >= (area as f64).sqrt(), "{partial} partly covered pixels for {area} covered");
+    assert!(
+        partial as f64 >= (area as f64).sqrt(),
+        "{partial} partly covered pixels for {area} covered"
+    );
     assert!(exact * 2 > interior, "{exact} of {interior} interior pixels unchanged");
 }
 
 /// PSNR of linear values, peak 1.
 fn psnr(a: &[f32], b: &[f32]) -> f64 {
-    let mse = a.iter().zip(b).map(|(x, y)| (*x as f64 - *y as f64).powi(2)).sum::<f64>() / a.len().max(1) as f64;
-    if mse == 0.0 { f64::INFINITY } else { -10.0 * mse.log10() }
+    let mse = a.iter().zip(b).map(|(x, y)| (*x as f64 - *y as f64).powi(2)).sum::<f64>()
+        / a.len().max(1) as f64;
+    if mse == 0.0 {
+        f64::INFINITY
+    } else {
+        -10.0 * mse.log10()
+    }
 }
 
 fn srgb(v: f32) -> f32 {
     let l = v.clamp(0.0, 1.0);
-    if l <= 0.003_130_8 { 12.92 * l } else { 1.055 * l.powf(1.0 / 2.4) - 0.055 }
+    if l <= 0.003_130_8 {
+        12.92 * l
+    } else {
+        1.055 * l.powf(1.0 / 2.4) - 0.055
+    }
 }
 
 /// A window's surface is an sRGB texture: the frame drawn into one is the offscreen frame,
@@ -271,7 +335,10 @@ fn srgb(v: f32) -> f32 {
 /// than the offscreen frame's.
 #[test]
 fn render_to_view_draws_the_offscreen_frame_into_an_srgb_target() {
-    let Some(gpu) = gpu_or_skip("render_to_view_draws_the_offscreen_frame_into_an_srgb_target") else { return };
+    let Some(gpu) = gpu_or_skip("render_to_view_draws_the_offscreen_frame_into_an_srgb_target")
+    else {
+        return;
+    };
     let gpu = Arc::new(gpu);
     let mut c = pis_format::PisReader::open(&tiny()).unwrap().load_all().unwrap();
     c.objects.iter_mut().for_each(|o| o.layers.retain(|l| !l.kind.is_shell()));
@@ -287,8 +354,14 @@ fn render_to_view_draws_the_offscreen_frame_into_an_srgb_target() {
 
 /// Checks the frame of `file` drawn into an sRGB view against its offscreen frame; returns
 /// how many pixel channels lie near radiance above 1 (checked one-sided).
-fn view_frame_is_the_offscreen_frame(gpu: &Arc<pis_play::Gpu>, file: &std::path::Path, msaa: u32) -> usize {
-    let mut player = Player::open(gpu.clone(), file, PlayerOptions { workers: 1, msaa, ..Default::default() }).unwrap();
+fn view_frame_is_the_offscreen_frame(
+    gpu: &Arc<pis_play::Gpu>,
+    file: &std::path::Path,
+    msaa: u32,
+) -> usize {
+    let mut player =
+        Player::open(gpu.clone(), file, PlayerOptions { workers: 1, msaa, ..Default::default() })
+            .unwrap();
     let size = (48, 36);
     let req = at(&player, &[1, 1]);
     let (img, _) = player.render_image(&req, size).unwrap();
@@ -304,15 +377,38 @@ fn view_frame_is_the_offscreen_frame(gpu: &Arc<pis_play::Gpu>, file: &std::path:
         view_formats: &[],
     });
     let samples = player.multisample_for(format).samples;
-    assert_eq!(samples, player.multisample().samples, "the sRGB view format is multisampled as the offscreen format is");
-    let stats = player.render_to_view(&req, &target.create_view(&Default::default()), format, size).unwrap();
+    assert_eq!(
+        samples,
+        player.multisample().samples,
+        "the sRGB view format is multisampled as the offscreen format is"
+    );
+    let stats = player
+        .render_to_view(&req, &target.create_view(&Default::default()), format, size)
+        .unwrap();
     assert_eq!(stats.codestreams_read, 0, "the textures are still on the GPU");
     let row = (size.0 * 4).div_ceil(256) * 256;
-    let buf = gpu.device.create_buffer(&wgpu::BufferDescriptor { label: None, size: (row * size.1) as u64, usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ, mapped_at_creation: false });
+    let buf = gpu.device.create_buffer(&wgpu::BufferDescriptor {
+        label: None,
+        size: (row * size.1) as u64,
+        usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+        mapped_at_creation: false,
+    });
     let mut enc = gpu.device.create_command_encoder(&Default::default());
     enc.copy_texture_to_buffer(
-        wgpu::TexelCopyTextureInfo { texture: &target, mip_level: 0, origin: wgpu::Origin3d::ZERO, aspect: wgpu::TextureAspect::All },
-        wgpu::TexelCopyBufferInfo { buffer: &buf, layout: wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(row), rows_per_image: Some(size.1) } },
+        wgpu::TexelCopyTextureInfo {
+            texture: &target,
+            mip_level: 0,
+            origin: wgpu::Origin3d::ZERO,
+            aspect: wgpu::TextureAspect::All,
+        },
+        wgpu::TexelCopyBufferInfo {
+            buffer: &buf,
+            layout: wgpu::TexelCopyBufferLayout {
+                offset: 0,
+                bytes_per_row: Some(row),
+                rows_per_image: Some(size.1),
+            },
+        },
         wgpu::Extent3d { width: size.0, height: size.1, depth_or_array_layers: 1 },
     );
     gpu.queue.submit([enc.finish()]);
@@ -321,8 +417,17 @@ fn view_frame_is_the_offscreen_frame(gpu: &Arc<pis_play::Gpu>, file: &std::path:
     // Whether the ball's radiance in channel c exceeds 1 around (x, y): some pixel of the
     // 3×3 neighbourhood whose colour over its coverage does (a covered sample's radiance,
     // where they agree).
-    let radiance = |q: usize, c: usize| if img.rgba[q * 4 + 3] > 0.0 { img.rgba[q * 4 + c] / img.rgba[q * 4 + 3] } else { 0.0 };
-    let bright = |x: usize, y: usize, c: usize| (y.saturating_sub(1)..(y + 2).min(h)).any(|j| (x.saturating_sub(1)..(x + 2).min(w)).any(|i| radiance(j * w + i, c) > 1.0));
+    let radiance = |q: usize, c: usize| {
+        if img.rgba[q * 4 + 3] > 0.0 {
+            img.rgba[q * 4 + c] / img.rgba[q * 4 + 3]
+        } else {
+            0.0
+        }
+    };
+    let bright = |x: usize, y: usize, c: usize| {
+        (y.saturating_sub(1)..(y + 2).min(h))
+            .any(|j| (x.saturating_sub(1)..(x + 2).min(w)).any(|i| radiance(j * w + i, c) > 1.0))
+    };
     let (mut drawn, mut exact, mut clamped) = (0, 0, 0);
     for y in 0..h {
         for x in 0..w {
@@ -342,7 +447,10 @@ fn view_frame_is_the_offscreen_frame(gpu: &Arc<pis_play::Gpu>, file: &std::path:
         }
     }
     eprintln!("{}, {samples} samples: {drawn} pixels drawn; channels: {exact} drawn as the offscreen frame, {clamped} near radiance above 1", file.display());
-    assert!(drawn > 20 && exact > 100, "{drawn} pixels drawn, {exact} channels as the offscreen frame");
+    assert!(
+        drawn > 20 && exact > 100,
+        "{drawn} pixels drawn, {exact} channels as the offscreen frame"
+    );
     clamped
 }
 
@@ -366,7 +474,14 @@ fn the_files_display_filter_selects_the_resolve() {
     let dir = tempfile::tempdir().unwrap();
     let with = dir.path().join("tiny-display-filter.pis");
     pis_format::write(&with, &c).unwrap();
-    let open = |path: &PathBuf, msaa, display_filter| Player::open(gpu.clone(), path, PlayerOptions { workers: 1, msaa, display_filter, ..Default::default() }).unwrap();
+    let open = |path: &PathBuf, msaa, display_filter| {
+        Player::open(
+            gpu.clone(),
+            path,
+            PlayerOptions { workers: 1, msaa, display_filter, ..Default::default() },
+        )
+        .unwrap()
+    };
     let mut plain = open(&tiny(), 4, None);
     if plain.multisample().samples != 4 {
         assert!(!in_ci(), "{test}: {:?}", plain.multisample());
@@ -386,11 +501,19 @@ fn the_files_display_filter_selects_the_resolve() {
     let (b, ids_b, _) = filtered.render_ids(&req, size).unwrap();
     assert_eq!(ids, ids_b);
     // The box resolve, as before the display filter existed: a fresh player, default options.
-    let (again, _) = Player::open(gpu.clone(), &tiny(), PlayerOptions { workers: 1, ..Default::default() }).unwrap().render_image(&req, size).unwrap();
-    assert!(a.rgba.iter().zip(&again.rgba).all(|(x, y)| x.to_bits() == y.to_bits()), "frames without a display filter differ");
+    let (again, _) =
+        Player::open(gpu.clone(), &tiny(), PlayerOptions { workers: 1, ..Default::default() })
+            .unwrap()
+            .render_image(&req, size)
+            .unwrap();
+    assert!(
+        a.rgba.iter().zip(&again.rgba).all(|(x, y)| x.to_bits() == y.to_bits()),
+        "frames without a display filter differ"
+    );
     let quarter = |v: f32| ((v * 4.0).round() - v * 4.0).abs() < 1e-6;
     let (w, h) = (size.0 as usize, size.1 as usize);
-    let (mut box_partial, mut gauss_partial, mut off_quarter, mut interior) = (0usize, 0usize, 0usize, 0usize);
+    let (mut box_partial, mut gauss_partial, mut off_quarter, mut interior) =
+        (0usize, 0usize, 0usize, 0usize);
     for y in 0..h {
         for x in 0..w {
             let p = y * w + x;
@@ -399,14 +522,21 @@ fn the_files_display_filter_selects_the_resolve() {
             box_partial += (aa > 0.0 && aa < 1.0) as usize;
             gauss_partial += (ab > 0.0 && ab < 1.0) as usize;
             off_quarter += !quarter(ab) as usize;
-            let inside = x >= 3 && y >= 3 && x + 3 < w && y + 3 < h && (0..49).all(|k| ids[(y + k / 7 - 3) * w + x + k % 7 - 3] == ids[p]);
+            let inside = x >= 3
+                && y >= 3
+                && x + 3 < w
+                && y + 3 < h
+                && (0..49).all(|k| ids[(y + k / 7 - 3) * w + x + k % 7 - 3] == ids[p]);
             if inside && ids[p] != u32::MAX {
                 interior += 1;
                 // Where two triangles of the ball's mesh shade a pixel's samples, the box
                 // and the resolve's running mean average the same 4 values in another order.
                 for ch in 0..4 {
                     let (va, vb) = (a.rgba[p * 4 + ch], b.rgba[p * 4 + ch]);
-                    assert!((va - vb).abs() <= 1e-6 * va.abs() + 1e-7, "pixel ({x}, {y}) inside the ball: box {va}, Gaussian {vb}");
+                    assert!(
+                        (va - vb).abs() <= 1e-6 * va.abs() + 1e-7,
+                        "pixel ({x}, {y}) inside the ball: box {va}, Gaussian {vb}"
+                    );
                 }
             }
         }
@@ -414,17 +544,28 @@ fn the_files_display_filter_selects_the_resolve() {
     eprintln!("{test}: partly covered pixels: box {box_partial}, Gaussian {gauss_partial} ({off_quarter} off the quarters); {interior} interior pixels unchanged");
     assert!(interior > 200, "{interior} interior pixels");
     // The Gaussian reaches 1.5 px: about three pixels across the silhouette against the box's one.
-    assert!(gauss_partial > box_partial * 2, "partly covered: box {box_partial}, Gaussian {gauss_partial}");
+    assert!(
+        gauss_partial > box_partial * 2,
+        "partly covered: box {box_partial}, Gaussian {gauss_partial}"
+    );
     assert!(off_quarter * 2 > gauss_partial, "{off_quarter} of {gauss_partial} off the quarters");
     // Single-sample frames ignore the display filter.
     let (one_plain, _) = open(&tiny(), 1, None).render_image(&req, size).unwrap();
     let (one_with, _) = open(&with, 1, None).render_image(&req, size).unwrap();
-    assert!(one_plain.rgba.iter().zip(&one_with.rgba).all(|(x, y)| x.to_bits() == y.to_bits()), "single-sample frames differ");
+    assert!(
+        one_plain.rgba.iter().zip(&one_with.rgba).all(|(x, y)| x.to_bits() == y.to_bits()),
+        "single-sample frames differ"
+    );
 }
 
 /// tiny.pis with `texcoords` as every object's mesh texture coordinates and `cut` as every
 /// surface block's branch cuts, written into `dir` as `name`.
-fn tiny_with(dir: &std::path::Path, name: &str, uv: impl Fn([f32; 2], [f32; 6]) -> [f32; 2], cut: [Option<f32>; 2]) -> PathBuf {
+fn tiny_with(
+    dir: &std::path::Path,
+    name: &str,
+    uv: impl Fn([f32; 2], [f32; 6]) -> [f32; 2],
+    cut: [Option<f32>; 2],
+) -> PathBuf {
     let mut c = pis_format::PisReader::open(&tiny()).unwrap().load_all().unwrap();
     for o in &mut c.objects {
         let affine = o.layers.iter().flat_map(|l| &l.blocks).find_map(|b| match b.placement {
@@ -457,9 +598,16 @@ fn branch_cuts_play_as_cut_mesh_coordinates() {
     let shift = |[u, v]: [f32; 2], _| [u + 0.3, v + 0.55];
     let dir = tempfile::tempdir().unwrap();
     let with_cut = tiny_with(dir.path(), "cut.pis", shift, cut);
-    let pre_cut = tiny_with(dir.path(), "pre-cut.pis", |w, affine| pis_compile::TextureTransform { values: affine, cut }.cut_uv(shift(w, affine)), [None; 2]);
+    let pre_cut = tiny_with(
+        dir.path(),
+        "pre-cut.pis",
+        |w, affine| pis_compile::TextureTransform { values: affine, cut }.cut_uv(shift(w, affine)),
+        [None; 2],
+    );
     let uncut = tiny_with(dir.path(), "uncut.pis", shift, [None; 2]);
-    let open = |p: &PathBuf| Player::open(gpu.clone(), p, PlayerOptions { workers: 1, ..Default::default() }).unwrap();
+    let open = |p: &PathBuf| {
+        Player::open(gpu.clone(), p, PlayerOptions { workers: 1, ..Default::default() }).unwrap()
+    };
     let (mut a, mut b, mut u) = (open(&with_cut), open(&pre_cut), open(&uncut));
     let size = a.image_size();
     for samples in [[0, 0], [1, 1]] {
@@ -470,6 +618,9 @@ fn branch_cuts_play_as_cut_mesh_coordinates() {
         let (same, differ) = (psnr(&x.rgba, &y.rgba), psnr(&z.rgba, &y.rgba));
         eprintln!("{test} {samples:?}: {same:.2} dB against the coordinates cut beforehand, {differ:.2} dB against the file without its cuts");
         assert!(same >= 50.0, "point {samples:?}: cut {same:.2} dB against pre-cut coordinates");
-        assert!(differ < 30.0, "point {samples:?}: the cuts change the frame ({differ:.2} dB without them)");
+        assert!(
+            differ < 30.0,
+            "point {samples:?}: the cuts change the frame ({differ:.2} dB without them)"
+        );
     }
 }

@@ -10,7 +10,10 @@ mod common;
 use common::*;
 use glam::Vec3;
 use pis_compile::transform::{look_at, perspective};
-use pis_compile::{render_matrix, Address, DrawMesh, Filter, Sampler, TextureLayout, TextureTransform, TexturedObject, Viewport};
+use pis_compile::{
+    render_matrix, Address, DrawMesh, Filter, Sampler, TextureLayout, TextureTransform,
+    TexturedObject, Viewport,
+};
 use pis_play::{probe, render_object, TexturedPipeline};
 
 #[test]
@@ -21,11 +24,17 @@ fn anisotropic_probe_predicts_the_anisotropic_draw() {
     // A floor (z = 0 plane, 8 × 8 units) seen from just above it: texels per pixel grow
     // along the view direction much faster than across it.
     let floor = quad(-4.0, 4.0, -4.0, 4.0, 0.0);
-    let clip = perspective(0.8, 4.0 / 3.0, 0.1, 50.0) * look_at(Vec3::new(0.0, -4.0, 1.0), Vec3::new(0.0, 0.5, 0.0), Vec3::Z);
+    let clip = perspective(0.8, 4.0 / 3.0, 0.1, 50.0)
+        * look_at(Vec3::new(0.0, -4.0, 1.0), Vec3::new(0.0, 0.5, 0.0), Vec3::Z);
     let layout = TextureLayout::full(64, 64);
     let x = random_rgba(layout.texel_count(), 5);
     let object = |filter| TexturedObject {
-        mesh: DrawMesh { positions: &floor.positions, uvs: &floor.uvs, indices: &floor.indices, clip_from_object: clip },
+        mesh: DrawMesh {
+            positions: &floor.positions,
+            uvs: &floor.uvs,
+            indices: &floor.indices,
+            clip_from_object: clip,
+        },
         transform: TextureTransform::affine([1.0, 0.0, 0.0, 1.0, 0.0, 0.0]),
         layout,
         sampler: Sampler { filter, address: [Address::ClampToEdge; 2] },
@@ -33,7 +42,8 @@ fn anisotropic_probe_predicts_the_anisotropic_draw() {
     let t = std::time::Instant::now();
     let aniso = probe(&gpu, &pipeline, vp, &[], &object(Filter::Anisotropic(4))).unwrap();
     let ms = t.elapsed().as_secs_f64() * 1e3;
-    let drawn = render_object(&gpu, &pipeline, vp, &[], &object(Filter::Anisotropic(4)), &x).unwrap();
+    let drawn =
+        render_object(&gpu, &pipeline, vp, &[], &object(Filter::Anisotropic(4)), &x).unwrap();
     let c = compare(&predict(&aniso.matrix, &x), &drawn);
     eprintln!(
         "anisotropic 4: A·x vs draw {:.2} dB over {} pixels, {} coverage mismatches; reach {:?}, {} renderings, check error {:.1e}, nnz {}, {ms:.0} ms",

@@ -4,18 +4,23 @@
 mod common;
 
 use common::*;
-use pis_compile::{render_matrix, scene_depth, Address, DrawMesh, Filter, RenderMatrix, Sampler, TextureLayout, TextureTransform, TexturedObject, Viewport};
+use pis_compile::{
+    render_matrix, scene_depth, Address, DrawMesh, Filter, RenderMatrix, Sampler, TextureLayout,
+    TextureTransform, TexturedObject, Viewport,
+};
 use pis_play::{probe_render_matrix, TexturedPipeline};
 
 /// Largest |A_model − A_probe| entry over the rows both have.
 fn max_entry_difference(a: &RenderMatrix, b: &RenderMatrix) -> f32 {
     let mut worst = 0.0f32;
-    let rows_b: std::collections::HashMap<u32, usize> = b.pixels.iter().enumerate().map(|(r, &p)| (p, r)).collect();
+    let rows_b: std::collections::HashMap<u32, usize> =
+        b.pixels.iter().enumerate().map(|(r, &p)| (p, r)).collect();
     for r in 0..a.rows() {
         let Some(&rb) = rows_b.get(&a.pixels[r]) else { continue };
         let (ca, va) = a.row(r);
         let (cb, vb) = b.row(rb);
-        let mut m: std::collections::BTreeMap<u32, f32> = ca.iter().copied().zip(va.iter().copied()).collect();
+        let mut m: std::collections::BTreeMap<u32, f32> =
+            ca.iter().copied().zip(va.iter().copied()).collect();
         for (&c, &v) in cb.iter().zip(vb) {
             *m.entry(c).or_insert(0.0) -= v;
         }
@@ -34,19 +39,58 @@ fn probe_matches_model() {
     let skewed = TextureTransform::affine([0.93, 0.05, -0.04, 0.88, 0.03, 0.06]);
     let wrapped = TextureTransform::affine([1.0, 0.0, 0.0, 0.9, 0.0, 0.05]);
     // Seen across the texture seam (u = 0 and 1 at +x): contiguous after a branch cut at 0.3.
-    let cut = TextureTransform { values: [1.6, 0.02, 0.0, 0.9, -0.68, 0.05], cut: [Some(0.3), None] };
+    let cut =
+        TextureTransform { values: [1.6, 0.02, 0.0, 0.9, -0.68, 0.05], cut: [Some(0.3), None] };
     let cases = [
-        ("trilinear-clamp", Filter::Trilinear, [Address::ClampToEdge; 2], TextureLayout::full(151, 77), [0.3, 0.6, 2.4], skewed),
-        ("bilinear-clamp", Filter::Bilinear, [Address::ClampToEdge; 2], TextureLayout::full(45, 29), [0.3, 0.6, 2.4], skewed),
-        ("trilinear-repeat-s", Filter::Trilinear, [Address::Repeat, Address::ClampToEdge], TextureLayout::full(128, 37), [-1.5, 1.0, 3.5], wrapped),
-        ("trilinear-branch-cut-u", Filter::Trilinear, [Address::ClampToEdge; 2], TextureLayout::full(97, 61), [2.3, 0.5, 0.4], cut),
+        (
+            "trilinear-clamp",
+            Filter::Trilinear,
+            [Address::ClampToEdge; 2],
+            TextureLayout::full(151, 77),
+            [0.3, 0.6, 2.4],
+            skewed,
+        ),
+        (
+            "bilinear-clamp",
+            Filter::Bilinear,
+            [Address::ClampToEdge; 2],
+            TextureLayout::full(45, 29),
+            [0.3, 0.6, 2.4],
+            skewed,
+        ),
+        (
+            "trilinear-repeat-s",
+            Filter::Trilinear,
+            [Address::Repeat, Address::ClampToEdge],
+            TextureLayout::full(128, 37),
+            [-1.5, 1.0, 3.5],
+            wrapped,
+        ),
+        (
+            "trilinear-branch-cut-u",
+            Filter::Trilinear,
+            [Address::ClampToEdge; 2],
+            TextureLayout::full(97, 61),
+            [2.3, 0.5, 0.4],
+            cut,
+        ),
     ];
     let mut failures = vec![];
     for (name, filter, address, layout, eye, transform) in cases {
         let clip = camera(vp, eye, [0.0; 3], 0.9);
-        let occ = DrawMesh { positions: &occluder.positions, uvs: &occluder.uvs, indices: &occluder.indices, clip_from_object: clip };
+        let occ = DrawMesh {
+            positions: &occluder.positions,
+            uvs: &occluder.uvs,
+            indices: &occluder.indices,
+            clip_from_object: clip,
+        };
         let object = TexturedObject {
-            mesh: DrawMesh { positions: &sphere.positions, uvs: &sphere.uvs, indices: &sphere.indices, clip_from_object: clip },
+            mesh: DrawMesh {
+                positions: &sphere.positions,
+                uvs: &sphere.uvs,
+                indices: &sphere.indices,
+                clip_from_object: clip,
+            },
             transform,
             layout,
             sampler: Sampler { filter, address },

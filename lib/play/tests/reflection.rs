@@ -27,7 +27,9 @@ use pis_compile::{TextureLayout, Viewport};
 use pis_format::samples::{encode_block, uv_sphere};
 use pis_format::*;
 use pis_play::camera::{mat4_from_rows, projection};
-use pis_play::{Blend, CameraChoice, FloatImage, FrameRequest, PlayError, Player, PlayerOptions, ViewCamera};
+use pis_play::{
+    Blend, CameraChoice, FloatImage, FrameRequest, PlayError, Player, PlayerOptions, ViewCamera,
+};
 
 const SIZE: (u32, u32) = (96, 72);
 const CAMERA_EYE: [f32; 3] = [0.4, 0.6, 3.2];
@@ -46,9 +48,25 @@ struct ShellSpec {
 }
 
 /// The local shell: an ellipsoid around the sphere.
-const LOCAL: ShellSpec = ShellSpec { kind: LayerKind::EnvLocal, channels: 4, shape: ShellShape::Ellipsoid, origin: [0.05, -0.1, 0.02], params: [1.6, 1.3, 1.5, 0.0, 0.0, 0.0], size: 12, lookups: 1 };
+const LOCAL: ShellSpec = ShellSpec {
+    kind: LayerKind::EnvLocal,
+    channels: 4,
+    shape: ShellShape::Ellipsoid,
+    origin: [0.05, -0.1, 0.02],
+    params: [1.6, 1.3, 1.5, 0.0, 0.0, 0.0],
+    size: 12,
+    lookups: 1,
+};
 /// The distant shell: a box.
-const DISTANT: ShellSpec = ShellSpec { kind: LayerKind::EnvDistant, channels: 3, shape: ShellShape::Box, origin: [0.0, 0.2, 0.0], params: [-3.0, -1.5, -4.0, 4.0, 3.0, 3.5], size: 20, lookups: 1 };
+const DISTANT: ShellSpec = ShellSpec {
+    kind: LayerKind::EnvDistant,
+    channels: 3,
+    shape: ShellShape::Box,
+    origin: [0.0, 0.2, 0.0],
+    params: [-3.0, -1.5, -4.0, 4.0, 3.0, 3.5],
+    size: 20,
+    lookups: 1,
+};
 
 impl ShellSpec {
     fn layout(&self) -> TextureLayout {
@@ -66,7 +84,8 @@ impl ShellSpec {
 
 /// The camera of the file: at `eye`, looking at the origin.
 fn file_camera(eye: [f32; 3]) -> Camera {
-    let world_from_camera = pis_compile::transform::look_at(Vec3::from(eye), Vec3::ZERO, Vec3::Y).inverse();
+    let world_from_camera =
+        pis_compile::transform::look_at(Vec3::from(eye), Vec3::ZERO, Vec3::Y).inverse();
     let mut rows = [0.0; 12];
     for r in 0..3 {
         rows[r * 4..r * 4 + 4].copy_from_slice(&world_from_camera.row(r).to_array());
@@ -91,24 +110,66 @@ fn shell_layer(spec: &ShellSpec, order: u8, textures: &[Vec<f32>]) -> Layer<Code
         depends_on: if varies { DepMask::of(&[0]) } else { DepMask::NONE },
         blocks: vec![],
     };
-    let block = Block { width: spec.size, height: spec.size, placement: Placement::Shell { shape: spec.shape, origin: spec.origin, params: spec.params, lookups: spec.lookups }, levels: vec![] };
-    let (extent, counts): (Vec<u32>, Vec<Vec<u32>>) = if varies { (vec![textures.len() as u32], vec![vec![1], vec![textures.len() as u32]]) } else { (vec![], vec![vec![]]) };
-    let block = encode_block(&layer, block, &extent, &counts, textures, CodecId::Lossless).expect("encodes");
+    let block = Block {
+        width: spec.size,
+        height: spec.size,
+        placement: Placement::Shell {
+            shape: spec.shape,
+            origin: spec.origin,
+            params: spec.params,
+            lookups: spec.lookups,
+        },
+        levels: vec![],
+    };
+    let (extent, counts): (Vec<u32>, Vec<Vec<u32>>) = if varies {
+        (vec![textures.len() as u32], vec![vec![1], vec![textures.len() as u32]])
+    } else {
+        (vec![], vec![vec![]])
+    };
+    let block = encode_block(&layer, block, &extent, &counts, textures, CodecId::Lossless)
+        .expect("encodes");
     Layer { blocks: vec![block], ..layer }
 }
 
 /// A file of one reflective unit sphere (normals from its mesh) with `f0`, placed by
 /// `world`, with `layers`, over a dimension of `samples` values, seen by one camera.
-fn write_file(dir: &Path, name: &str, f0: [f32; 3], world: [f32; 12], samples: usize, layers: Vec<Layer<Codestream>>) -> PathBuf {
+fn write_file(
+    dir: &Path,
+    name: &str,
+    f0: [f32; 3],
+    world: [f32; 12],
+    samples: usize,
+    layers: Vec<Layer<Codestream>>,
+) -> PathBuf {
     write_mesh_file(dir, name, f0, world, samples, layers, uv_sphere(1.0, 48, 24))
 }
 
 /// [`write_file`] with `mesh` for the sphere.
-fn write_mesh_file(dir: &Path, name: &str, f0: [f32; 3], world: [f32; 12], samples: usize, layers: Vec<Layer<Codestream>>, mesh: pis_format::Mesh) -> PathBuf {
+fn write_mesh_file(
+    dir: &Path,
+    name: &str,
+    f0: [f32; 3],
+    world: [f32; 12],
+    samples: usize,
+    layers: Vec<Layer<Codestream>>,
+    mesh: pis_format::Mesh,
+) -> PathBuf {
     let space = ParameterSpace {
-        dims: vec![Dimension { name: "light".into(), kind: DimensionKind::Light, periodic: false, unit: String::new(), block_size: 2, values: (0..samples).map(|k| k as f32).collect() }],
+        dims: vec![Dimension {
+            name: "light".into(),
+            kind: DimensionKind::Light,
+            periodic: false,
+            unit: String::new(),
+            block_size: 2,
+            values: (0..samples).map(|k| k as f32).collect(),
+        }],
     };
-    let cameras = CameraTable { width: SIZE.0, height: SIZE.1, depends_on: DepMask::NONE, cameras: vec![file_camera(CAMERA_EYE)] };
+    let cameras = CameraTable {
+        width: SIZE.0,
+        height: SIZE.1,
+        depends_on: DepMask::NONE,
+        cameras: vec![file_camera(CAMERA_EYE)],
+    };
     let object = Object {
         name: "mirror".into(),
         role: ObjectRole::Reflective,
@@ -119,7 +180,8 @@ fn write_mesh_file(dir: &Path, name: &str, f0: [f32; 3], world: [f32; 12], sampl
         layers,
     };
     let path = dir.join(name);
-    write(&path, &Container { space, cameras, objects: vec![object], provenance: None }).expect("writes");
+    write(&path, &Container { space, cameras, objects: vec![object], provenance: None })
+        .expect("writes");
     path
 }
 
@@ -130,7 +192,8 @@ fn constant(spec: &ShellSpec, colour: &[f32]) -> Vec<f32> {
 }
 
 fn open(gpu: &Arc<pis_play::Gpu>, path: &Path, blend: Blend, msaa: u32) -> Player {
-    Player::open(gpu.clone(), path, PlayerOptions { workers: 1, blend, msaa, ..Default::default() }).expect("opens")
+    Player::open(gpu.clone(), path, PlayerOptions { workers: 1, blend, msaa, ..Default::default() })
+        .expect("opens")
 }
 
 fn at(point: f32, camera: CameraChoice) -> FrameRequest {
@@ -171,9 +234,18 @@ fn constant_shells_composite_over_and_blend_by_weight() {
     let Some(gpu) = gpu_or_skip(test) else { return };
     let gpu = Arc::new(gpu);
     let dir = tempfile::tempdir().unwrap();
-    let local = shell_layer(&LOCAL, 0, &[constant(&LOCAL, &LOCAL_RGBA[0]), constant(&LOCAL, &LOCAL_RGBA[1])]);
-    let distant = shell_layer(&DISTANT, 1, &[constant(&DISTANT, &DISTANT_RGB[0]), constant(&DISTANT, &DISTANT_RGB[1])]);
-    let path = write_file(dir.path(), "constant.pis", [1.0; 3], IDENTITY_3X4, 2, vec![local, distant]);
+    let local = shell_layer(
+        &LOCAL,
+        0,
+        &[constant(&LOCAL, &LOCAL_RGBA[0]), constant(&LOCAL, &LOCAL_RGBA[1])],
+    );
+    let distant = shell_layer(
+        &DISTANT,
+        1,
+        &[constant(&DISTANT, &DISTANT_RGB[0]), constant(&DISTANT, &DISTANT_RGB[1])],
+    );
+    let path =
+        write_file(dir.path(), "constant.pis", [1.0; 3], IDENTITY_3X4, 2, vec![local, distant]);
     let mut player = open(&gpu, &path, Blend::Multilinear, 1);
     for (point, w) in [(0.0f32, 0.0f32), (1.0, 1.0), (0.3, 0.3)] {
         let (img, ids, stats) = player.render_ids(&at(point, CameraChoice::Sample), SIZE).unwrap();
@@ -189,7 +261,10 @@ fn constant_shells_composite_over_and_blend_by_weight() {
     // Multisampled (the box resolve): each pixel is its covered fraction of the colour.
     let mut four = open(&gpu, &path, Blend::Nearest, 4);
     if four.multisample().samples != 4 {
-        eprintln!("{test}: multisampling skipped: {}", four.multisample().note.clone().unwrap_or_default());
+        eprintln!(
+            "{test}: multisampling skipped: {}",
+            four.multisample().note.clone().unwrap_or_default()
+        );
         return;
     }
     let (img, _) = four.render_image(&at(0.0, CameraChoice::Sample), SIZE).unwrap();
@@ -207,8 +282,17 @@ fn constant_shells_composite_over_and_blend_by_weight() {
 /// The surface point the centre of pixel (x, y) sees: the nearest hit of the ray from `eye`
 /// on the world-space triangles, with its position and the normal interpolated at the hit's
 /// barycentric coordinates (the perspective-correct interpolation the GPU does).
-fn surface_at(clip_from_world: Mat4, eye: DVec3, triangles: &[[(DVec3, DVec3); 3]], x: u32, y: u32) -> Option<(DVec3, DVec3)> {
-    let ndc = glam::Vec2::new((x as f32 + 0.5) / SIZE.0 as f32 * 2.0 - 1.0, 1.0 - (y as f32 + 0.5) / SIZE.1 as f32 * 2.0);
+fn surface_at(
+    clip_from_world: Mat4,
+    eye: DVec3,
+    triangles: &[[(DVec3, DVec3); 3]],
+    x: u32,
+    y: u32,
+) -> Option<(DVec3, DVec3)> {
+    let ndc = glam::Vec2::new(
+        (x as f32 + 0.5) / SIZE.0 as f32 * 2.0 - 1.0,
+        1.0 - (y as f32 + 0.5) / SIZE.1 as f32 * 2.0,
+    );
     let far = clip_from_world.inverse().project_point3(ndc.extend(0.5)).as_dvec3();
     let dir = (far - eye).normalize();
     let mut best: Option<(f64, DVec3, DVec3)> = None;
@@ -224,7 +308,12 @@ fn surface_at(clip_from_world: Mat4, eye: DVec3, triangles: &[[(DVec3, DVec3); 3
         let q = s.cross(e1);
         let b2 = dir.dot(q) / det;
         let dist = e2.dot(q) / det;
-        if b1 < -1e-9 || b2 < -1e-9 || b1 + b2 > 1.0 + 1e-9 || dist <= 0.0 || best.is_some_and(|b| b.0 <= dist) {
+        if b1 < -1e-9
+            || b2 < -1e-9
+            || b1 + b2 > 1.0 + 1e-9
+            || dist <= 0.0
+            || best.is_some_and(|b| b.0 <= dist)
+        {
             continue;
         }
         let n = t[0].1 * (1.0 - b1 - b2) + t[1].1 * b1 + t[2].1 * b2;
@@ -239,20 +328,41 @@ fn surface_at(clip_from_world: Mat4, eye: DVec3, triangles: &[[(DVec3, DVec3); 3
 /// distant shell on all.
 fn model_frame(object: &ShellObject, f0: [f32; 3], local: &[f32], distant: &[f32]) -> FloatImage {
     let vp = Viewport { width: SIZE.0, height: SIZE.1 };
-    let a_l = shell_render_matrix(vp, &ShellObject { shell: LOCAL.model(), layout: LOCAL.layout(), ..*object }, None).unwrap();
-    let a_d = shell_render_matrix(vp, &ShellObject { shell: DISTANT.model(), layout: DISTANT.layout(), drawn: None, ..*object }, None).unwrap();
+    let a_l = shell_render_matrix(
+        vp,
+        &ShellObject { shell: LOCAL.model(), layout: LOCAL.layout(), ..*object },
+        None,
+    )
+    .unwrap();
+    let a_d = shell_render_matrix(
+        vp,
+        &ShellObject { shell: DISTANT.model(), layout: DISTANT.layout(), drawn: None, ..*object },
+        None,
+    )
+    .unwrap();
     if object.drawn.is_none() {
         assert_eq!(a_l.pixels, a_d.pixels, "both shells are drawn on the same pixels");
     }
     let world = object.world_from_object;
     let corner = |i: u32| {
         let i = i as usize;
-        ((world * Vec3::from(object.positions[i]).extend(1.0)).truncate().as_dvec3(), world.transform_vector3(Vec3::from(object.normals[i])).as_dvec3())
+        (
+            (world * Vec3::from(object.positions[i]).extend(1.0)).truncate().as_dvec3(),
+            world.transform_vector3(Vec3::from(object.normals[i])).as_dvec3(),
+        )
     };
-    let triangles: Vec<[(DVec3, DVec3); 3]> = object.indices.chunks_exact(3).map(|t| [corner(t[0]), corner(t[1]), corner(t[2])]).collect();
+    let triangles: Vec<[(DVec3, DVec3); 3]> = object
+        .indices
+        .chunks_exact(3)
+        .map(|t| [corner(t[0]), corner(t[1]), corner(t[2])])
+        .collect();
     let clip_from_world = object.clip_from_object * world.inverse();
     let eye = object.eye.as_dvec3();
-    let mut img = FloatImage { width: SIZE.0, height: SIZE.1, rgba: vec![0.0; (SIZE.0 * SIZE.1 * 4) as usize] };
+    let mut img = FloatImage {
+        width: SIZE.0,
+        height: SIZE.1,
+        rgba: vec![0.0; (SIZE.0 * SIZE.1 * 4) as usize],
+    };
     for r in 0..a_d.rows() {
         let p = a_d.pixels[r];
         let lookup = |a: &pis_compile::RenderMatrix, x: &[f32], channels: usize| {
@@ -267,7 +377,10 @@ fn model_frame(object: &ShellObject, f0: [f32; 3], local: &[f32], distant: &[f32
             c
         };
         let (l, d) = (lookup(&a_l, local, 4), lookup(&a_d, distant, 3));
-        let Some((pos, n)) = surface_at(clip_from_world, eye, &triangles, p % SIZE.0, p / SIZE.0) else { continue };
+        let Some((pos, n)) = surface_at(clip_from_world, eye, &triangles, p % SIZE.0, p / SIZE.0)
+        else {
+            continue;
+        };
         let f = fresnel(DVec3::from(f0.map(f64::from)), pos, n, eye);
         for c in 0..3 {
             img.rgba[4 * p as usize + c] = (f[c] * (l[c] + (1.0 - l[3]) * d[c])) as f32;
@@ -280,7 +393,16 @@ fn model_frame(object: &ShellObject, f0: [f32; 3], local: &[f32], distant: &[f32
 /// Random premultiplied RGBA texels: α in [0, 1), colour in [0, α).
 fn random_premultiplied(texels: usize, seed: u64) -> Vec<f32> {
     let r = random(texels * 4, seed);
-    (0..texels).flat_map(|t| [r[4 * t] * r[4 * t + 3], r[4 * t + 1] * r[4 * t + 3], r[4 * t + 2] * r[4 * t + 3], r[4 * t + 3]]).collect()
+    (0..texels)
+        .flat_map(|t| {
+            [
+                r[4 * t] * r[4 * t + 3],
+                r[4 * t + 1] * r[4 * t + 3],
+                r[4 * t + 2] * r[4 * t + 3],
+                r[4 * t + 3],
+            ]
+        })
+        .collect()
 }
 
 /// Random local (premultiplied, from `seed`) and distant (from `seed + 1`) cube maps, and
@@ -294,13 +416,17 @@ fn random_shells_on_a_turned_sphere(seed: u64) -> (Vec<f32>, Vec<f32>, [f32; 12]
 
 /// The layers of one sample: the local shell `local` (order 0) over the distant `distant`.
 fn local_over_distant(local: &[f32], distant: &[f32], lookups: u32) -> Vec<Layer<Codestream>> {
-    vec![shell_layer(&ShellSpec { lookups, ..LOCAL }, 0, &[local.to_vec()]), shell_layer(&ShellSpec { lookups, ..DISTANT }, 1, &[distant.to_vec()])]
+    vec![
+        shell_layer(&ShellSpec { lookups, ..LOCAL }, 0, &[local.to_vec()]),
+        shell_layer(&ShellSpec { lookups, ..DISTANT }, 1, &[distant.to_vec()]),
+    ]
 }
 
 /// The file camera's clip-from-world matrix at [`SIZE`].
 fn file_clip_from_world() -> Mat4 {
     let cam = file_camera(CAMERA_EYE);
-    projection(cam.yfov, cam.znear, cam.zfar, SIZE.0, SIZE.1) * mat4_from_rows(&cam.world_from_camera).inverse()
+    projection(cam.yfov, cam.znear, cam.zfar, SIZE.0, SIZE.1)
+        * mat4_from_rows(&cam.world_from_camera).inverse()
 }
 
 #[test]
@@ -312,15 +438,36 @@ fn random_shells_match_the_hardware_model() {
     let (local, distant, world_rows, world) = random_shells_on_a_turned_sphere(11);
     let mesh = uv_sphere(1.0, 48, 24);
     let normals = mesh.normals.clone().unwrap();
-    let free = ViewCamera { eye: Vec3::new(-1.3, 0.9, 2.6), target: Vec3::new(0.1, 0.0, 0.0), up: Vec3::Y, yfov_rad: 0.9, near: 0.1, far: 50.0 };
+    let free = ViewCamera {
+        eye: Vec3::new(-1.3, 0.9, 2.6),
+        target: Vec3::new(0.1, 0.0, 0.0),
+        up: Vec3::Y,
+        yfov_rad: 0.9,
+        near: 0.1,
+        far: 50.0,
+    };
     let views = [
         ("file camera", CameraChoice::Sample, file_clip_from_world(), Vec3::from(CAMERA_EYE)),
-        ("free camera", CameraChoice::Free(free), free.projection(SIZE) * free.view_matrix(), free.eye),
+        (
+            "free camera",
+            CameraChoice::Free(free),
+            free.projection(SIZE) * free.view_matrix(),
+            free.eye,
+        ),
     ];
     let mut failures = Vec::new();
     // One lookup per pixel, then 2 × 2 and 3 × 3 (SPEC.md 8.2).
-    for (f0, lookups) in [([1.0f32; 3], 1), ([0.2, 0.5, 0.9], 1), ([1.0; 3], 2), ([0.2, 0.5, 0.9], 3)] {
-        let path = write_file(dir.path(), &format!("random-{lookups}.pis"), f0, world_rows, 1, local_over_distant(&local, &distant, lookups));
+    for (f0, lookups) in
+        [([1.0f32; 3], 1), ([0.2, 0.5, 0.9], 1), ([1.0; 3], 2), ([0.2, 0.5, 0.9], 3)]
+    {
+        let path = write_file(
+            dir.path(),
+            &format!("random-{lookups}.pis"),
+            f0,
+            world_rows,
+            1,
+            local_over_distant(&local, &distant, lookups),
+        );
         let mut player = open(&gpu, &path, Blend::Nearest, 1);
         for (vname, camera, clip_from_world, eye) in views {
             let object = ShellObject {
@@ -338,9 +485,14 @@ fn random_shells_match_the_hardware_model() {
             let want = model_frame(&object, f0, &local, &distant);
             let (got, stats) = player.render_image(&at(0.0, camera), SIZE).unwrap();
             let c = compare(&want, &got);
-            let name = format!("reflection-f0-{}-{}-lookups-{lookups}", f0[0], vname.replace(' ', "-"));
+            let name =
+                format!("reflection-f0-{}-{}-lookups-{lookups}", f0[0], vname.replace(' ', "-"));
             eprintln!("{test}: f0 {f0:?}, {lookups}×{lookups} lookups, {vname}: PSNR {:.2} dB over {} pixels, {} coverage mismatches; {} shell draw(s)", c.psnr_db, c.both, c.coverage_mismatch, stats.shell_draws);
-            if c.psnr_db < 50.0 || c.coverage_mismatch * 200 > c.both || c.both < 1000 || stats.shell_draws != 1 {
+            if c.psnr_db < 50.0
+                || c.coverage_mismatch * 200 > c.both
+                || c.both < 1000
+                || stats.shell_draws != 1
+            {
                 let dir = write_failure_images(&name, &want, &got);
                 failures.push(format!("{name}: {c:?} (images in {})", dir.display()));
             }
@@ -365,7 +517,15 @@ fn hull_triangles_draw_the_distant_shell_only() {
     let drawn: Vec<bool> = (0..triangles).map(|t| t >= triangles / 2).collect();
     let normals = mesh.normals.clone().unwrap();
     let f0 = [0.2f32, 0.5, 0.9];
-    let path = write_mesh_file(dir.path(), "hull.pis", f0, world_rows, 1, local_over_distant(&local, &distant, 2), mesh.clone());
+    let path = write_mesh_file(
+        dir.path(),
+        "hull.pis",
+        f0,
+        world_rows,
+        1,
+        local_over_distant(&local, &distant, 2),
+        mesh.clone(),
+    );
     let mut player = open(&gpu, &path, Blend::Nearest, 1);
     let object = ShellObject {
         positions: &mesh.positions,

@@ -71,7 +71,12 @@ fn shells_match_the_model() {
         let drawn: Vec<bool> = (0..indices.len() / 3).map(|t| t % 2 == 0).collect();
         for (vi, (vname, eye, fovy, size, split)) in views.into_iter().enumerate() {
             let clip = camera(vp, eye, [0.0, 0.0, 0.0], fovy);
-            let occ = DrawMesh { positions: &occluder.positions, uvs: &occluder.uvs, indices: &occluder.indices, clip_from_object: clip };
+            let occ = DrawMesh {
+                positions: &occluder.positions,
+                uvs: &occluder.uvs,
+                indices: &occluder.indices,
+                clip_from_object: clip,
+            };
             let depth = scene_depth(vp, &[occ], None).unwrap();
             let layout = TextureLayout::cube(size);
             let x = random_rgba(layout.texel_count(), 3 + size as u64);
@@ -95,7 +100,13 @@ fn shells_match_the_model() {
                 let got = render_shell(&gpu, &pipeline, vp, &[occ], &object, &x).unwrap();
                 let c = compare(&want, &got);
                 let name = format!("shell-{oname}-{vname}-{sname}-lookups-{lookups}");
-                eprintln!("{name}: PSNR {:.2} dB over {} pixels, {} coverage mismatches, {:.2} taps/row", c.psnr_db, c.both, c.coverage_mismatch, a.cols.len() as f64 / a.rows().max(1) as f64);
+                eprintln!(
+                    "{name}: PSNR {:.2} dB over {} pixels, {} coverage mismatches, {:.2} taps/row",
+                    c.psnr_db,
+                    c.both,
+                    c.coverage_mismatch,
+                    a.cols.len() as f64 / a.rows().max(1) as f64
+                );
                 worst = worst.min(c.psnr_db);
                 if c.psnr_db < 60.0 || c.coverage_mismatch * 1000 > c.both || c.both < 500 {
                     let dir = write_failure_images(&name, &want, &got);

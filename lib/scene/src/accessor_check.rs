@@ -40,11 +40,7 @@ pub(crate) fn check_accessor(
         return Err(invalid("accessor count is 0".into()));
     }
     let Some(view) = accessor.view() else {
-        return Err(SceneError::unsupported(
-            path,
-            &at,
-            "accessors without a buffer view",
-        ));
+        return Err(SceneError::unsupported(path, &at, "accessors without a buffer view"));
     };
     let size = accessor.size();
     let stride = view.stride().unwrap_or(size);
@@ -68,10 +64,7 @@ pub(crate) fn check_accessor(
             )))
         }
     }
-    let buffer_len = buffers
-        .get(view.buffer().index())
-        .map(|b| b.len())
-        .unwrap_or(0);
+    let buffer_len = buffers.get(view.buffer().index()).map(|b| b.len()).unwrap_or(0);
     match view.offset().checked_add(view.length()) {
         Some(end) if end <= buffer_len => Ok(()),
         _ => Err(invalid(format!(

@@ -89,11 +89,7 @@ impl Sampler {
     pub fn sample(&self, t: f32, rotation: bool) -> Vec4 {
         let n = self.times.len();
         if n == 0 {
-            return if rotation {
-                Vec4::new(0.0, 0.0, 0.0, 1.0)
-            } else {
-                Vec4::ZERO
-            };
+            return if rotation { Vec4::new(0.0, 0.0, 0.0, 1.0) } else { Vec4::ZERO };
         }
         if n == 1 || t <= self.times[0] {
             return self.value(0);
@@ -111,9 +107,7 @@ impl Sampler {
             Interpolation::Linear => {
                 let (a, b) = (self.value(k), self.value(k + 1));
                 if rotation {
-                    let q = Quat::from_vec4(a)
-                        .normalize()
-                        .slerp(Quat::from_vec4(b).normalize(), s);
+                    let q = Quat::from_vec4(a).normalize().slerp(Quat::from_vec4(b).normalize(), s);
                     Vec4::from(q)
                 } else {
                     a.lerp(b, s)
@@ -149,11 +143,7 @@ pub struct Trs {
 
 impl Default for Trs {
     fn default() -> Self {
-        Trs {
-            translation: Vec3::ZERO,
-            rotation: Quat::IDENTITY,
-            scale: Vec3::ONE,
-        }
+        Trs { translation: Vec3::ZERO, rotation: Quat::IDENTITY, scale: Vec3::ONE }
     }
 }
 
@@ -232,10 +222,7 @@ mod tests {
         assert!(q.angle_between(expected) < 1e-5, "{q:?} vs {expected:?}");
         // Hand-computed: sin(π/16), cos(π/16).
         let half = std::f32::consts::PI / 16.0;
-        assert!(close(
-            Vec4::from(q),
-            Vec4::new(0.0, half.sin(), 0.0, half.cos())
-        ));
+        assert!(close(Vec4::from(q), Vec4::new(0.0, half.sin(), 0.0, half.cos())));
     }
 
     #[test]
@@ -257,11 +244,7 @@ mod tests {
         // in-tangent a1 = -1. At t = 2 (s = 0.5): h00 = 0.5, h10 = 0.125, h01 = 0.5,
         // h11 = -0.125; m0 = 2·1 = 2, m1 = 2·(-1) = -2
         // → 0.5·0 + 0.125·2 + 0.5·2 + (-0.125)·(-2) = 1.5.
-        let s = scalar(
-            Interpolation::CubicSpline,
-            &[1.0, 3.0],
-            &[9.0, 0.0, 1.0, -1.0, 2.0, 9.0],
-        );
+        let s = scalar(Interpolation::CubicSpline, &[1.0, 3.0], &[9.0, 0.0, 1.0, -1.0, 2.0, 9.0]);
         assert!((s.sample(2.0, false).x - 1.5).abs() < 1e-6);
         // At s = 0.25: h00 = 0.84375, h10 = 0.140625, h01 = 0.15625, h11 = -0.046875
         // → 0 + 0.28125 + 0.3125 + 0.09375 = 0.6875.

@@ -51,18 +51,28 @@ fn find(cdf: &[f32], u: f32) -> (usize, f32) {
 impl Distribution2D {
     /// The distribution proportional to `weight(column, row)` (finite, ≥ 0) over a
     /// `width × height` grid; `None` when the grid is empty or every weight is 0.
-    pub fn new(width: usize, height: usize, weight: impl Fn(usize, usize) -> f32) -> Option<Distribution2D> {
+    pub fn new(
+        width: usize,
+        height: usize,
+        weight: impl Fn(usize, usize) -> f32,
+    ) -> Option<Distribution2D> {
         if width == 0 || height == 0 {
             return None;
         }
         let mut rows = Vec::with_capacity((width + 1) * height);
         let mut totals = Vec::with_capacity(height);
         for j in 0..height {
-            totals.push(cumulative((0..width).map(|i| f64::from(weight(i, j).max(0.0))), &mut rows));
+            totals
+                .push(cumulative((0..width).map(|i| f64::from(weight(i, j).max(0.0))), &mut rows));
         }
         let mut marginal = Vec::with_capacity(height + 1);
         let total = cumulative(totals.into_iter(), &mut marginal);
-        (total > 0.0 && total.is_finite()).then_some(Distribution2D { width, height, rows, marginal })
+        (total > 0.0 && total.is_finite()).then_some(Distribution2D {
+            width,
+            height,
+            rows,
+            marginal,
+        })
     }
 
     /// Grid size (columns, rows).
@@ -136,7 +146,10 @@ mod tests {
         let total = (n * n) as f32;
         for (j, row) in counts.iter().enumerate() {
             for (i, &c) in row.iter().enumerate() {
-                assert!((c as f32 / total - w[j][i] / 8.0).abs() < 2.0 / n as f32, "cell ({i},{j}): {c}");
+                assert!(
+                    (c as f32 / total - w[j][i] / 8.0).abs() < 2.0 / n as f32,
+                    "cell ({i},{j}): {c}"
+                );
             }
         }
         assert_eq!(d.density([1.5, 0.5]), 0.0);

@@ -19,7 +19,10 @@ pub(crate) fn read(file: &Path) -> Result<Texels, String> {
     match ext.as_deref() {
         Some("hdr") => read_hdr(file),
         Some("exr") => read_exr(file),
-        _ => Err("unsupported image format: expected a Radiance `.hdr` or an OpenEXR `.exr` file".into()),
+        _ => {
+            Err("unsupported image format: expected a Radiance `.hdr` or an OpenEXR `.exr` file"
+                .into())
+        }
     }
 }
 
@@ -37,18 +40,22 @@ fn check_size(width: u64, height: u64) -> Result<(u32, u32), String> {
 fn read_hdr(file: &Path) -> Result<Texels, String> {
     use image::ImageDecoder;
     let f = std::fs::File::open(file).map_err(|e| format!("cannot read file: {e}"))?;
-    let decoder = image::codecs::hdr::HdrDecoder::new(std::io::BufReader::new(f)).map_err(|e| format!("not a Radiance HDR image: {e}"))?;
+    let decoder = image::codecs::hdr::HdrDecoder::new(std::io::BufReader::new(f))
+        .map_err(|e| format!("not a Radiance HDR image: {e}"))?;
     let (w, h) = decoder.dimensions();
     let (w, h) = check_size(w.into(), h.into())?;
     if decoder.color_type() != image::ColorType::Rgb32F {
         return Err(format!("unexpected HDR colour type {:?}", decoder.color_type()));
     }
     let mut bytes = vec![0u8; w as usize * h as usize * 12];
-    decoder.read_image(&mut bytes).map_err(|e| format!("cannot decode the Radiance HDR image: {e}"))?;
+    decoder
+        .read_image(&mut bytes)
+        .map_err(|e| format!("cannot decode the Radiance HDR image: {e}"))?;
     let texels = bytes
         .chunks_exact(12)
         .map(|b| {
-            let c = |k: usize| f32::from_ne_bytes([b[4 * k], b[4 * k + 1], b[4 * k + 2], b[4 * k + 3]]);
+            let c =
+                |k: usize| f32::from_ne_bytes([b[4 * k], b[4 * k + 1], b[4 * k + 2], b[4 * k + 3]]);
             [c(0), c(1), c(2)]
         })
         .collect();
@@ -57,7 +64,8 @@ fn read_hdr(file: &Path) -> Result<Texels, String> {
 
 fn read_exr(file: &Path) -> Result<Texels, String> {
     use exr::prelude::*;
-    let meta = exr::meta::MetaData::read_from_file(file, false).map_err(|e| format!("not a readable OpenEXR image: {e}"))?;
+    let meta = exr::meta::MetaData::read_from_file(file, false)
+        .map_err(|e| format!("not a readable OpenEXR image: {e}"))?;
     for header in meta.headers.iter() {
         check_size(header.layer_size.width() as u64, header.layer_size.height() as u64)?;
     }
@@ -66,12 +74,16 @@ fn read_exr(file: &Path) -> Result<Texels, String> {
         .largest_resolution_level()
         .rgba_channels(
             |size, _| (size.width(), vec![[0.0f32; 3]; size.area()]),
-            |(w, px): &mut (usize, Vec<[f32; 3]>), at: Vec2<usize>, (r, g, b, _): (f32, f32, f32, f32)| px[at.y() * *w + at.x()] = [r, g, b],
+            |(w, px): &mut (usize, Vec<[f32; 3]>),
+             at: Vec2<usize>,
+             (r, g, b, _): (f32, f32, f32, f32)| px[at.y() * *w + at.x()] = [r, g, b],
         )
         .first_valid_layer()
         .all_attributes()
         .from_file(file)
-        .map_err(|e| format!("cannot decode the OpenEXR image (it needs R, G and B channels): {e}"))?;
+        .map_err(|e| {
+            format!("cannot decode the OpenEXR image (it needs R, G and B channels): {e}")
+        })?;
     let size = image.layer_data.size;
     let (w, h) = check_size(size.width() as u64, size.height() as u64)?;
     Ok((w, h, image.layer_data.channel_data.pixels.1))

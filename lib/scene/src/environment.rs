@@ -155,7 +155,11 @@ impl Environment {
 /// Resolves `[environment]` of the scene.toml at `path`: validates every key (errors name
 /// `environment.KEY`) and reads the image, which must lie in scene.toml's folder unless
 /// `allow_outside` (`allow_outside_files`).
-pub(crate) fn load(spec: &EnvironmentSpec, path: &Path, allow_outside: bool) -> Result<Environment, SceneError> {
+pub(crate) fn load(
+    spec: &EnvironmentSpec,
+    path: &Path,
+    allow_outside: bool,
+) -> Result<Environment, SceneError> {
     let bad = |key: &str, why: String| SceneError::invalid(path, format!("environment.{key}"), why);
     let strength = spec.strength.unwrap_or(1.0);
     if !(strength.is_finite() && strength >= 0.0) {
@@ -163,11 +167,22 @@ pub(crate) fn load(spec: &EnvironmentSpec, path: &Path, allow_outside: bool) -> 
     }
     let rotation_deg = spec.rotation_deg.unwrap_or(0.0);
     if !rotation_deg.is_finite() {
-        return Err(bad("rotation_deg", format!("{rotation_deg}: expected a finite angle in degrees")));
+        return Err(bad(
+            "rotation_deg",
+            format!("{rotation_deg}: expected a finite angle in degrees"),
+        ));
     }
     let radiance = match (&spec.color, &spec.image) {
-        (Some(_), Some(_)) => return Err(bad("image", "give either `color` or `image`, not both".into())),
-        (None, None) => return Err(SceneError::invalid(path, "environment", "needs `color = [r, g, b]` or `image = \"FILE.hdr\"`")),
+        (Some(_), Some(_)) => {
+            return Err(bad("image", "give either `color` or `image`, not both".into()))
+        }
+        (None, None) => {
+            return Err(SceneError::invalid(
+                path,
+                "environment",
+                "needs `color = [r, g, b]` or `image = \"FILE.hdr\"`",
+            ))
+        }
         (Some(c), None) => {
             if c.iter().any(|x| !(x.is_finite() && *x >= 0.0)) {
                 return Err(bad("color", format!("{c:?}: expected finite values ≥ 0")));
@@ -176,10 +191,14 @@ pub(crate) fn load(spec: &EnvironmentSpec, path: &Path, allow_outside: bool) -> 
         }
         (None, Some(name)) => {
             let file = image_path(name, path, allow_outside)?;
-            let (w, h, mut texels) = crate::env_image::read(&file).map_err(|why| bad("image", format!("{}: {why}", file.display())))?;
+            let (w, h, mut texels) = crate::env_image::read(&file)
+                .map_err(|why| bad("image", format!("{}: {why}", file.display())))?;
             if let Some(k) = texels.iter().position(|t| t.iter().any(|x| !x.is_finite())) {
                 let (x, y) = (k % w as usize, k / w as usize);
-                return Err(bad("image", format!("{}: texel ({x}, {y}) is not finite (NaN or infinity)", file.display())));
+                return Err(bad(
+                    "image",
+                    format!("{}: texel ({x}, {y}) is not finite (NaN or infinity)", file.display()),
+                ));
             }
             // Negative values (ringing of a resampled image) emit nothing.
             for t in &mut texels {
@@ -188,7 +207,11 @@ pub(crate) fn load(spec: &EnvironmentSpec, path: &Path, allow_outside: bool) -> 
             EnvironmentRadiance::Image(Arc::new(LatLongImage::new(file, w, h, texels)))
         }
     };
-    Ok(Environment { radiance, rotation: rotation_deg.to_radians(), background: spec.background.unwrap_or(false) })
+    Ok(Environment {
+        radiance,
+        rotation: rotation_deg.to_radians(),
+        background: spec.background.unwrap_or(false),
+    })
 }
 
 /// The file `name` names beside the scene.toml at `path`, refused when it is absolute or
@@ -196,7 +219,11 @@ pub(crate) fn load(spec: &EnvironmentSpec, path: &Path, allow_outside: bool) -> 
 fn image_path(name: &str, path: &Path, allow_outside: bool) -> Result<PathBuf, SceneError> {
     let base = path.parent().unwrap_or(Path::new(""));
     let refuse = |why: &str| {
-        SceneError::invalid(path, "environment.image", format!("{name:?} {why}; refused (scene.toml `allow_outside_files = true` allows it)"))
+        SceneError::invalid(
+            path,
+            "environment.image",
+            format!("{name:?} {why}; refused (scene.toml `allow_outside_files = true` allows it)"),
+        )
     };
     if name.trim().is_empty() {
         return Err(SceneError::invalid(path, "environment.image", "the image path is empty"));
@@ -224,7 +251,8 @@ mod tests {
     /// −Z, edges −X, top +Y, bottom −Y; `rotation_deg = 90` moves the centre to −Z.
     #[test]
     fn the_lat_long_convention_is_the_documented_one() {
-        let close = |a: [f32; 2], b: [f32; 2]| (a[0] - b[0]).abs() < 1e-6 && (a[1] - b[1]).abs() < 1e-6;
+        let close =
+            |a: [f32; 2], b: [f32; 2]| (a[0] - b[0]).abs() < 1e-6 && (a[1] - b[1]).abs() < 1e-6;
         assert!(close(lat_long_uv(Vec3::X), [0.5, 0.5]));
         assert!(close(lat_long_uv(Vec3::Z), [0.75, 0.5]));
         assert!(close(lat_long_uv(Vec3::NEG_Z), [0.25, 0.5]));
@@ -232,14 +260,25 @@ mod tests {
         let edge = lat_long_uv(Vec3::NEG_X)[0];
         assert!(edge < 1e-6 || edge > 1.0 - 1e-6, "−X at u = {edge}");
         for k in 0..100 {
-            let uv = [(k as f32 * 0.618_034).fract(), (k as f32 * 0.414_213_5 + 0.01).fract() * 0.98 + 0.01];
+            let uv = [
+                (k as f32 * 0.618_034).fract(),
+                (k as f32 * 0.414_213_5 + 0.01).fract() * 0.98 + 0.01,
+            ];
             let back = lat_long_uv(lat_long_direction(uv));
             // u = 0 and u = 1 are the same meridian (−X).
             let du = (back[0] - uv[0]).abs();
             assert!(du.min(1.0 - du) < 1e-5 && (back[1] - uv[1]).abs() < 1e-5, "{uv:?} → {back:?}");
         }
-        let turned = Environment { radiance: EnvironmentRadiance::Uniform([1.0; 3]), rotation: 90f32.to_radians(), background: false };
-        assert!(turned.to_world(Vec3::X).abs_diff_eq(Vec3::NEG_Z, 1e-6), "{}", turned.to_world(Vec3::X));
+        let turned = Environment {
+            radiance: EnvironmentRadiance::Uniform([1.0; 3]),
+            rotation: 90f32.to_radians(),
+            background: false,
+        };
+        assert!(
+            turned.to_world(Vec3::X).abs_diff_eq(Vec3::NEG_Z, 1e-6),
+            "{}",
+            turned.to_world(Vec3::X)
+        );
         assert!(turned.to_image(Vec3::NEG_Z).abs_diff_eq(Vec3::X, 1e-6));
     }
 
@@ -253,7 +292,11 @@ mod tests {
         texels[w as usize + 6] = [2.0, 3.0, 4.0];
         let image = LatLongImage::new("sky.hdr".into(), w, h, texels);
         let centre = lat_long_direction([6.5 / 8.0, 1.5 / 4.0]);
-        let env = Environment { radiance: EnvironmentRadiance::Image(Arc::new(image)), rotation: 0.0, background: false };
+        let env = Environment {
+            radiance: EnvironmentRadiance::Image(Arc::new(image)),
+            rotation: 0.0,
+            background: false,
+        };
         assert_eq!(env.radiance(centre), [2.0, 3.0, 4.0]);
         assert!(centre.y > 0.0 && centre.z > 0.0 && centre.x < 0.0, "{centre}");
         assert_eq!(env.radiance(-centre), [0.0; 3]);

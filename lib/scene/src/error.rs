@@ -24,25 +24,13 @@ pub enum SceneError {
     Gltf { path: PathBuf, message: String },
     /// The input uses a feature PIS does not support.
     #[error("{path}: field `{field}`: unsupported: {what}")]
-    Unsupported {
-        path: PathBuf,
-        field: String,
-        what: String,
-    },
+    Unsupported { path: PathBuf, field: String, what: String },
     /// A buffer or value holds NaN or infinity.
     #[error("{path}: field `{field}`: non-finite value (NaN or infinity) at element {element}")]
-    NonFinite {
-        path: PathBuf,
-        field: String,
-        element: usize,
-    },
+    NonFinite { path: PathBuf, field: String, element: usize },
     /// A parameter dimension has no samples.
     #[error("{path}: field `{field}`: dimension `{dimension}` has zero samples")]
-    ZeroSamples {
-        path: PathBuf,
-        field: String,
-        dimension: String,
-    },
+    ZeroSamples { path: PathBuf, field: String, dimension: String },
     /// A name in scene.toml matches nothing in the glTF (camera, light, animation, object) or
     /// in scene.toml itself (preset, dimension).
     #[error("{path}: field `{field}`: unknown {what} `{name}`; known: [{known}]")]
@@ -57,18 +45,10 @@ pub enum SceneError {
     },
     /// A value is present and well-typed but not acceptable (out of range, inconsistent).
     #[error("{path}: field `{field}`: {message}")]
-    Invalid {
-        path: PathBuf,
-        field: String,
-        message: String,
-    },
+    Invalid { path: PathBuf, field: String, message: String },
     /// A parameter point that does not belong to the parameter space.
     #[error("scene `{scene}`: parameter point {point:?} is outside the space with sample counts {counts:?}")]
-    PointOutOfRange {
-        scene: String,
-        point: Vec<u32>,
-        counts: Vec<u32>,
-    },
+    PointOutOfRange { scene: String, point: Vec<u32>, counts: Vec<u32> },
 }
 
 impl SceneError {
@@ -78,11 +58,7 @@ impl SceneError {
         field: impl Into<String>,
         message: impl Into<String>,
     ) -> Self {
-        SceneError::Invalid {
-            path: path.into(),
-            field: field.into(),
-            message: message.into(),
-        }
+        SceneError::Invalid { path: path.into(), field: field.into(), message: message.into() }
     }
 
     /// Shorthand for [`SceneError::Unsupported`].
@@ -91,11 +67,7 @@ impl SceneError {
         field: impl Into<String>,
         what: impl Into<String>,
     ) -> Self {
-        SceneError::Unsupported {
-            path: path.into(),
-            field: field.into(),
-            what: what.into(),
-        }
+        SceneError::Unsupported { path: path.into(), field: field.into(), what: what.into() }
     }
 
     /// Shorthand for [`SceneError::UnknownName`].

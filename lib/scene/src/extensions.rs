@@ -27,7 +27,11 @@ pub const IGNORABLE_WHEN_REQUIRED: &[&str] = &["KHR_materials_variants"];
 /// An error naming the first extension of `extensionsRequired` that PIS neither implements
 /// nor may ignore.
 pub(crate) fn check_required(path: &Path, required: &[String]) -> Result<(), SceneError> {
-    let known = |e: &str| IMPLEMENTED.contains(&e) || WITHOUT_EFFECT.contains(&e) || IGNORABLE_WHEN_REQUIRED.contains(&e);
+    let known = |e: &str| {
+        IMPLEMENTED.contains(&e)
+            || WITHOUT_EFFECT.contains(&e)
+            || IGNORABLE_WHEN_REQUIRED.contains(&e)
+    };
     match required.iter().enumerate().find(|(_, e)| !known(e)) {
         Some((i, e)) => Err(SceneError::unsupported(
             path,
@@ -48,7 +52,9 @@ pub(crate) fn unimplemented_warnings<'a>(used: impl IntoIterator<Item = &'a str>
         }
     }
     seen.into_iter()
-        .map(|e| format!("the glTF uses extension {e}, which PIS does not implement: it is ignored"))
+        .map(|e| {
+            format!("the glTF uses extension {e}, which PIS does not implement: it is ignored")
+        })
         .collect()
 }
 
@@ -58,19 +64,35 @@ mod tests {
 
     #[test]
     fn unsupported_extension_is_named_once() {
-        let used = ["KHR_materials_clearcoat", "KHR_texture_transform", "KHR_materials_sheen", "KHR_materials_clearcoat", "KHR_xmp_json_ld"];
+        let used = [
+            "KHR_materials_clearcoat",
+            "KHR_texture_transform",
+            "KHR_materials_sheen",
+            "KHR_materials_clearcoat",
+            "KHR_xmp_json_ld",
+        ];
         let w = unimplemented_warnings(used);
         assert_eq!(w.len(), 2, "{w:?}");
-        assert!(w[0].contains("KHR_materials_clearcoat") && w[1].contains("KHR_materials_sheen"), "{w:?}");
+        assert!(
+            w[0].contains("KHR_materials_clearcoat") && w[1].contains("KHR_materials_sheen"),
+            "{w:?}"
+        );
     }
 
     #[test]
     fn required_extension_not_implemented_is_an_error_naming_it() {
         let path = Path::new("a.gltf");
-        let ok: Vec<String> = ["KHR_materials_volume", "KHR_texture_transform", "KHR_materials_variants"].map(String::from).to_vec();
+        let ok: Vec<String> =
+            ["KHR_materials_volume", "KHR_texture_transform", "KHR_materials_variants"]
+                .map(String::from)
+                .to_vec();
         assert!(check_required(path, &ok).is_ok());
-        let bad: Vec<String> = ["KHR_materials_ior", "KHR_draco_mesh_compression"].map(String::from).to_vec();
+        let bad: Vec<String> =
+            ["KHR_materials_ior", "KHR_draco_mesh_compression"].map(String::from).to_vec();
         let e = check_required(path, &bad).unwrap_err().to_string();
-        assert!(e.contains("extensionsRequired[1]") && e.contains("KHR_draco_mesh_compression"), "{e}");
+        assert!(
+            e.contains("extensionsRequired[1]") && e.contains("KHR_draco_mesh_compression"),
+            "{e}"
+        );
     }
 }

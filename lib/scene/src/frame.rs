@@ -43,11 +43,7 @@ impl Scene {
                     };
                     a.apply(value, &mut locals);
                 }
-                Driver::Orbit {
-                    target,
-                    radius,
-                    elevation_deg,
-                } => {
+                Driver::Orbit { target, radius, elevation_deg } => {
                     orbit = Some(orbit_camera(*target, *radius, *elevation_deg, value));
                 }
                 Driver::LightPath { light, path } => {
@@ -104,11 +100,7 @@ impl Scene {
                     .unwrap_or(Mat4::IDENTITY),
             })
             .collect();
-        Ok(Frame {
-            camera,
-            lights,
-            instances,
-        })
+        Ok(Frame { camera, lights, instances })
     }
 
     /// [`Scene::frame`] at the point with linear index `index` ([`crate::ParameterSpace::point`]).

@@ -27,11 +27,15 @@ fn reference(uri: &str) -> Reference<'_> {
         return Reference::File(percent_decode(rest), true);
     }
     // A scheme is letters before a colon, as in `http:`; a Windows drive is one letter.
-    if uri.split_once(':').is_some_and(|(s, _)| s.len() > 1 && s.chars().all(|c| c.is_ascii_alphabetic())) {
+    if uri
+        .split_once(':')
+        .is_some_and(|(s, _)| s.len() > 1 && s.chars().all(|c| c.is_ascii_alphabetic()))
+    {
         return Reference::Other;
     }
     let path = percent_decode(uri);
-    let absolute = Path::new(&path).is_absolute() || path.starts_with('/') || path.starts_with('\\');
+    let absolute =
+        Path::new(&path).is_absolute() || path.starts_with('/') || path.starts_with('\\');
     Reference::File(path, absolute)
 }
 
@@ -48,19 +52,34 @@ fn base64_len(data: &str) -> usize {
 
 /// The file `rel` names beside the glTF at `gltf`, refused when it leaves the glTF's folder
 /// and `allow_outside` is false.
-fn resolve(gltf: &Path, field: &str, uri: &str, rel: &str, absolute: bool, allow_outside: bool) -> Result<PathBuf, SceneError> {
+fn resolve(
+    gltf: &Path,
+    field: &str,
+    uri: &str,
+    rel: &str,
+    absolute: bool,
+    allow_outside: bool,
+) -> Result<PathBuf, SceneError> {
     let base = gltf.parent().unwrap_or(Path::new(""));
     let target = base.join(rel);
     if allow_outside {
         return Ok(target);
     }
     let refuse = |why: &str| {
-        SceneError::invalid(gltf, format!("{field}.uri"), format!("{uri:?} {why}; refused (scene.toml `allow_outside_files = true` allows it)"))
+        SceneError::invalid(
+            gltf,
+            format!("{field}.uri"),
+            format!("{uri:?} {why}; refused (scene.toml `allow_outside_files = true` allows it)"),
+        )
     };
     if absolute {
         return Err(refuse("is an absolute path, outside the glTF's folder"));
     }
-    if stays_inside(base, &target, rel) { Ok(target) } else { Err(refuse("leaves the glTF's folder")) }
+    if stays_inside(base, &target, rel) {
+        Ok(target)
+    } else {
+        Err(refuse("leaves the glTF's folder"))
+    }
 }
 
 /// Whether `target`, the relative path `rel` joined to the folder `base`, lies inside
@@ -84,7 +103,11 @@ pub(crate) fn stays_inside(base: &Path, target: &Path, rel: &str) -> bool {
 }
 
 /// Checks the buffer and image references of `gltf`, read from `path`.
-pub(crate) fn check_files(path: &Path, gltf: &gltf::Gltf, allow_outside: bool) -> Result<(), SceneError> {
+pub(crate) fn check_files(
+    path: &Path,
+    gltf: &gltf::Gltf,
+    allow_outside: bool,
+) -> Result<(), SceneError> {
     for b in gltf.buffers() {
         let field = format!("buffers[{}]", b.index());
         let have = match b.source() {
@@ -106,7 +129,14 @@ pub(crate) fn check_files(path: &Path, gltf: &gltf::Gltf, allow_outside: bool) -
     for image in gltf.images() {
         if let gltf::image::Source::Uri { uri, .. } = image.source() {
             if let Reference::File(rel, absolute) = reference(uri) {
-                resolve(path, &format!("images[{}]", image.index()), uri, &rel, absolute, allow_outside)?;
+                resolve(
+                    path,
+                    &format!("images[{}]", image.index()),
+                    uri,
+                    &rel,
+                    absolute,
+                    allow_outside,
+                )?;
             }
         }
     }
@@ -119,8 +149,13 @@ mod tests {
 
     #[test]
     fn uris_name_data_files_or_other_schemes() {
-        assert!(matches!(reference("data:application/octet-stream;base64,AAAA"), Reference::Data("AAAA")));
-        assert!(matches!(reference("scene%20one.bin"), Reference::File(p, false) if p == "scene one.bin"));
+        assert!(matches!(
+            reference("data:application/octet-stream;base64,AAAA"),
+            Reference::Data("AAAA")
+        ));
+        assert!(
+            matches!(reference("scene%20one.bin"), Reference::File(p, false) if p == "scene one.bin")
+        );
         assert!(matches!(reference("/etc/passwd"), Reference::File(_, true)));
         assert!(matches!(reference("file:///etc/passwd"), Reference::File(_, true)));
         assert!(matches!(reference("https://example.com/a.bin"), Reference::Other));

@@ -46,10 +46,7 @@ pub(crate) struct GltfCamera {
 /// panic becomes a [`SceneError::Gltf`].
 pub(crate) fn read_gltf(path: &Path, allow_outside: bool) -> Result<GltfScene, SceneError> {
     if let Err(source) = std::fs::metadata(path) {
-        return Err(SceneError::Io {
-            path: path.to_owned(),
-            source,
-        });
+        return Err(SceneError::Io { path: path.to_owned(), source });
     }
     let read = || {
         // Parsed once: the files it names are checked before any is read.
@@ -57,8 +54,10 @@ pub(crate) fn read_gltf(path: &Path, allow_outside: bool) -> Result<GltfScene, S
         crate::gltf_files::check_files(path, &gltf, allow_outside)?;
         let base = path.parent().unwrap_or(Path::new("./"));
         let gltf::Gltf { document: doc, blob } = gltf;
-        let buffers = gltf::import_buffers(&doc, Some(base), blob).map_err(|e| import_error(path, e))?;
-        let images = gltf::import_images(&doc, Some(base), &buffers).map_err(|e| import_error(path, e))?;
+        let buffers =
+            gltf::import_buffers(&doc, Some(base), blob).map_err(|e| import_error(path, e))?;
+        let images =
+            gltf::import_images(&doc, Some(base), &buffers).map_err(|e| import_error(path, e))?;
         check_animation_indices(path, &doc)?;
         convert(path, &doc, &buffers, &images)
     };
@@ -79,7 +78,8 @@ pub(crate) fn read_gltf(path: &Path, allow_outside: bool) -> Result<GltfScene, S
 /// ignore (naming it), then validates the rest (the glTF reader's own list of extensions it
 /// accepts as required is narrower than what PIS reads).
 fn open_gltf(path: &Path) -> Result<gltf::Gltf, SceneError> {
-    let file = std::fs::File::open(path).map_err(|source| SceneError::Io { path: path.to_owned(), source })?;
+    let file = std::fs::File::open(path)
+        .map_err(|source| SceneError::Io { path: path.to_owned(), source })?;
     let parsed = gltf::Gltf::from_reader_without_validation(std::io::BufReader::new(file));
     let gltf::Gltf { document, blob } = parsed.map_err(|e| import_error(path, e))?;
     let mut root = document.into_json();
@@ -99,11 +99,7 @@ fn check_animation_indices(path: &Path, doc: &gltf::Document) -> Result<(), Scen
             let node = c.target.node.value();
             if node >= root.nodes.len() {
                 let msg = format!("node {node} does not exist");
-                return Err(SceneError::invalid(
-                    path,
-                    format!("{field}.target.node"),
-                    msg,
-                ));
+                return Err(SceneError::invalid(path, format!("{field}.target.node"), msg));
             }
             let sampler = c.sampler.value();
             if sampler >= a.samplers.len() {
@@ -122,10 +118,7 @@ fn convert(
     buffers: &[gltf::buffer::Data],
     images: &[gltf::image::Data],
 ) -> Result<GltfScene, SceneError> {
-    let ctx = Ctx {
-        path: path.to_owned(),
-        buffers,
-    };
+    let ctx = Ctx { path: path.to_owned(), buffers };
 
     let scene = doc
         .default_scene()
@@ -161,12 +154,7 @@ fn convert(
                 element: 0,
             });
         }
-        rig.nodes.push(Node {
-            name: node_name(&node),
-            gltf_index: node.index(),
-            parent,
-            local,
-        });
+        rig.nodes.push(Node { name: node_name(&node), gltf_index: node.index(), parent, local });
         for child in node.children().collect::<Vec<_>>().into_iter().rev() {
             stack.push((child, Some(here)));
         }
@@ -181,12 +169,12 @@ fn convert(
         materials.push(mat);
     }
     let TextureSet { textures, warnings: texture_warnings, .. } = texture_set;
-    let mut warnings = crate::extensions::unimplemented_warnings(
-        doc.extensions_used().chain(
-            (doc.as_json().materials.iter())
-                .flat_map(|m| m.extensions.iter().flat_map(|e| e.others.keys().map(String::as_str))),
-        ),
-    );
+    let mut warnings =
+        crate::extensions::unimplemented_warnings(doc.extensions_used().chain(
+            (doc.as_json().materials.iter()).flat_map(|m| {
+                m.extensions.iter().flat_map(|e| e.others.keys().map(String::as_str))
+            }),
+        ));
     warnings.extend(texture_warnings);
     let mut default_material = None;
 
@@ -206,16 +194,15 @@ fn convert(
             let material = match p.material().index() {
                 Some(i) => i,
                 None => *default_material.get_or_insert_with(|| {
-                    materials.push(Material {
-                        name: "default".into(),
-                        ..Material::default()
-                    });
+                    materials.push(Material { name: "default".into(), ..Material::default() });
                     materials.len() - 1
                 }),
             };
             let field = format!("meshes[{}].primitives[{}]", mesh.index(), p.index());
             let prim = ctx.read_primitive(&p, material, &field)?;
-            if prim.uvs1.is_empty() && materials.get(material).is_some_and(|m| m.textures().any(|t| t.tex_coord == 1)) {
+            if prim.uvs1.is_empty()
+                && materials.get(material).is_some_and(|m| m.textures().any(|t| t.tex_coord == 1))
+            {
                 let w = format!("{field} has no TEXCOORD_1, which the textures of materials[{material}] read: TEXCOORD_0 is read instead");
                 if !warnings.contains(&w) {
                     warnings.push(w);
@@ -241,12 +228,7 @@ fn convert(
         if *count > 1 {
             name = format!("{name}.{g}");
         }
-        objects.push(SceneObject {
-            name,
-            role: infer_role(&mats),
-            reflector: None,
-            primitives,
-        });
+        objects.push(SceneObject { name, role: infer_role(&mats), reflector: None, primitives });
         rig.object_nodes.push(r);
     }
 
@@ -257,8 +239,7 @@ fn convert(
             continue;
         };
         if let Some(light) = node.light() {
-            rig.lights
-                .push(ctx.read_light(&light, &rig.nodes[r].name, r)?);
+            rig.lights.push(ctx.read_light(&light, &rig.nodes[r].name, r)?);
         }
         if let Some(camera) = node.camera() {
             if let gltf::camera::Projection::Perspective(p) = camera.projection() {
@@ -275,10 +256,7 @@ fn convert(
     // Animations.
     let mut unsupported_animations = BTreeMap::new();
     for a in doc.animations() {
-        let name = a
-            .name()
-            .map(str::to_owned)
-            .unwrap_or_else(|| format!("animation{}", a.index()));
+        let name = a.name().map(str::to_owned).unwrap_or_else(|| format!("animation{}", a.index()));
         match ctx.read_animation(&a, &name, &rig_index)? {
             Ok(anim) => rig.animations.push(anim),
             Err(why) => {
@@ -287,24 +265,15 @@ fn convert(
         }
     }
 
-    Ok(GltfScene {
-        objects,
-        materials,
-        textures,
-        rig,
-        cameras,
-        unsupported_animations,
-        warnings,
-    })
+    Ok(GltfScene { objects, materials, textures, rig, cameras, unsupported_animations, warnings })
 }
 
 /// Maps a gltf crate error to a [`SceneError`] that names the file.
 fn import_error(path: &Path, e: gltf::Error) -> SceneError {
     match e {
         gltf::Error::Validation(errors) => {
-            if let Some((p, _)) = errors
-                .iter()
-                .find(|(p, _)| p.as_str().starts_with("extensionsRequired"))
+            if let Some((p, _)) =
+                errors.iter().find(|(p, _)| p.as_str().starts_with("extensionsRequired"))
             {
                 return SceneError::unsupported(
                     path,
@@ -312,30 +281,20 @@ fn import_error(path: &Path, e: gltf::Error) -> SceneError {
                     "required glTF extension is not supported by PIS",
                 );
             }
-            let list: Vec<String> = errors
-                .iter()
-                .map(|(p, err)| format!("{}: {err}", p.as_str()))
-                .collect();
-            SceneError::Gltf {
-                path: path.to_owned(),
-                message: list.join("; "),
-            }
+            let list: Vec<String> =
+                errors.iter().map(|(p, err)| format!("{}: {err}", p.as_str())).collect();
+            SceneError::Gltf { path: path.to_owned(), message: list.join("; ") }
         }
         gltf::Error::Io(source) => SceneError::Gltf {
             path: path.to_owned(),
             message: format!("cannot read a buffer or image it references: {source}"),
         },
-        other => SceneError::Gltf {
-            path: path.to_owned(),
-            message: other.to_string(),
-        },
+        other => SceneError::Gltf { path: path.to_owned(), message: other.to_string() },
     }
 }
 
 fn node_name(node: &gltf::Node) -> String {
-    node.name()
-        .map(str::to_owned)
-        .unwrap_or_else(|| format!("node{}", node.index()))
+    node.name().map(str::to_owned).unwrap_or_else(|| format!("node{}", node.index()))
 }
 
 /// What the readers need: the file (for errors) and the buffers.
@@ -346,11 +305,7 @@ struct Ctx<'b> {
 
 impl Ctx<'_> {
     fn non_finite(&self, field: String, element: usize) -> SceneError {
-        SceneError::NonFinite {
-            path: self.path.clone(),
-            field,
-            element,
-        }
+        SceneError::NonFinite { path: self.path.clone(), field, element }
     }
 
     fn check_finite<const N: usize>(
@@ -365,7 +320,12 @@ impl Ctx<'_> {
     }
 
     /// A vertex attribute beside POSITION's `n` values: finite, and one per vertex.
-    fn check_vertex_attribute<const N: usize>(&self, values: &[[f32; N]], n: usize, field: impl Fn() -> String) -> Result<(), SceneError> {
+    fn check_vertex_attribute<const N: usize>(
+        &self,
+        values: &[[f32; N]],
+        n: usize,
+        field: impl Fn() -> String,
+    ) -> Result<(), SceneError> {
         self.check_finite(values, &field)?;
         if values.len() != n {
             return Err(SceneError::invalid(&self.path, field(), "count differs from POSITION"));
@@ -384,18 +344,8 @@ impl Ctx<'_> {
         for (semantic, name, dims, types) in [
             (Semantic::Positions, "POSITION", D::Vec3, &[T::F32][..]),
             (Semantic::Normals, "NORMAL", D::Vec3, &[T::F32][..]),
-            (
-                Semantic::TexCoords(0),
-                "TEXCOORD_0",
-                D::Vec2,
-                &[T::F32, T::U8, T::U16][..],
-            ),
-            (
-                Semantic::TexCoords(1),
-                "TEXCOORD_1",
-                D::Vec2,
-                &[T::F32, T::U8, T::U16][..],
-            ),
+            (Semantic::TexCoords(0), "TEXCOORD_0", D::Vec2, &[T::F32, T::U8, T::U16][..]),
+            (Semantic::TexCoords(1), "TEXCOORD_1", D::Vec2, &[T::F32, T::U8, T::U16][..]),
             (Semantic::Tangents, "TANGENT", D::Vec4, &[T::F32][..]),
         ] {
             if let Some(a) = p.get(&semantic) {
@@ -418,11 +368,7 @@ impl Ctx<'_> {
         let positions: Vec<[f32; 3]> = reader
             .read_positions()
             .ok_or_else(|| {
-                SceneError::invalid(
-                    &self.path,
-                    format!("{field}.attributes.POSITION"),
-                    "missing",
-                )
+                SceneError::invalid(&self.path, format!("{field}.attributes.POSITION"), "missing")
             })?
             .collect();
         self.check_finite(&positions, || format!("{field}.attributes.POSITION"))?;
@@ -449,10 +395,7 @@ impl Ctx<'_> {
             return Err(SceneError::invalid(
                 &self.path,
                 format!("{field}.indices"),
-                format!(
-                    "index {} at element {i} is out of range for {n} vertices",
-                    raw[i]
-                ),
+                format!("index {} at element {i} is out of range for {n} vertices", raw[i]),
             ));
         }
         let indices = triangle_list(p.mode(), &raw).ok_or_else(|| {
@@ -468,7 +411,8 @@ impl Ctx<'_> {
             Some(u) => u.into_iter().map(Vec2::from).collect(),
             None => vec![Vec2::ZERO; n],
         };
-        let uvs1: Vec<Vec2> = uvs1.map_or_else(Vec::new, |u| u.into_iter().map(Vec2::from).collect());
+        let uvs1: Vec<Vec2> =
+            uvs1.map_or_else(Vec::new, |u| u.into_iter().map(Vec2::from).collect());
         match normals {
             Some(ns) => {
                 let smooth = smooth_normals(&positions, &indices);
@@ -483,7 +427,8 @@ impl Ctx<'_> {
                     uvs,
                     uvs1,
                     // The glTF rule: tangents are read only beside normals.
-                    tangents: tangents.map_or_else(Vec::new, |t| t.into_iter().map(Vec4::from).collect()),
+                    tangents: tangents
+                        .map_or_else(Vec::new, |t| t.into_iter().map(Vec4::from).collect()),
                     indices,
                     material,
                 })
@@ -503,46 +448,30 @@ impl Ctx<'_> {
         let kind = match light.kind() {
             Kind::Point => LightKind::Point,
             Kind::Directional => LightKind::Directional,
-            Kind::Spot {
-                inner_cone_angle,
-                outer_cone_angle,
-            } => LightKind::Spot {
-                inner_cone: inner_cone_angle,
-                outer_cone: outer_cone_angle,
-            },
+            Kind::Spot { inner_cone_angle, outer_cone_angle } => {
+                LightKind::Spot { inner_cone: inner_cone_angle, outer_cone: outer_cone_angle }
+            }
         };
         let c = light.color();
-        let radiance = [
-            c[0] * light.intensity(),
-            c[1] * light.intensity(),
-            c[2] * light.intensity(),
-        ];
+        let radiance =
+            [c[0] * light.intensity(), c[1] * light.intensity(), c[2] * light.intensity()];
         let mut radius = 0.0;
         if let Some(raw) = light.extras() {
             let value: serde_json::Value = serde_json::from_str(raw.get()).map_err(|e| {
                 SceneError::invalid(&self.path, format!("{field}.extras"), e.to_string())
             })?;
             if let Some(r) = value.get("radius") {
-                radius = r
-                    .as_f64()
-                    .filter(|r| r.is_finite() && *r >= 0.0)
-                    .ok_or_else(|| {
-                        SceneError::invalid(
-                            &self.path,
-                            format!("{field}.extras.radius"),
-                            format!("expected a number ≥ 0, found {r}"),
-                        )
-                    })? as f32;
+                radius = r.as_f64().filter(|r| r.is_finite() && *r >= 0.0).ok_or_else(|| {
+                    SceneError::invalid(
+                        &self.path,
+                        format!("{field}.extras.radius"),
+                        format!("expected a number ≥ 0, found {r}"),
+                    )
+                })? as f32;
             }
         }
         let name = light.name().unwrap_or(node_name).to_owned();
-        Ok(LightRig {
-            name,
-            node,
-            kind,
-            radiance,
-            radius,
-        })
+        Ok(LightRig { name, node, kind, radiance, radius })
     }
 
     /// Reads an animation; the inner `Err` holds (field, reason) when it uses something PIS
@@ -560,11 +489,7 @@ impl Ctx<'_> {
             let Some(&node) = rig_index.get(&c.target().node().index()) else {
                 continue;
             };
-            let sfield = format!(
-                "animations[{}].samplers[{}]",
-                a.index(),
-                c.sampler().index()
-            );
+            let sfield = format!("animations[{}].samplers[{}]", a.index(), c.sampler().index());
             {
                 use gltf::accessor::{DataType as T, Dimensions as D};
                 use gltf::animation::Property;
@@ -628,14 +553,12 @@ impl Ctx<'_> {
                 )
             })?;
             let (path, values): (TargetPath, Vec<Vec4>) = match outputs {
-                ReadOutputs::Translations(t) => (
-                    TargetPath::Translation,
-                    t.map(|v| Vec3::from(v).extend(0.0)).collect(),
-                ),
-                ReadOutputs::Scales(s) => (
-                    TargetPath::Scale,
-                    s.map(|v| Vec3::from(v).extend(0.0)).collect(),
-                ),
+                ReadOutputs::Translations(t) => {
+                    (TargetPath::Translation, t.map(|v| Vec3::from(v).extend(0.0)).collect())
+                }
+                ReadOutputs::Scales(s) => {
+                    (TargetPath::Scale, s.map(|v| Vec3::from(v).extend(0.0)).collect())
+                }
                 ReadOutputs::Rotations(r) => {
                     (TargetPath::Rotation, r.into_f32().map(Vec4::from).collect())
                 }
@@ -654,11 +577,7 @@ impl Ctx<'_> {
                 gltf::animation::Interpolation::Linear => Interpolation::Linear,
                 gltf::animation::Interpolation::CubicSpline => Interpolation::CubicSpline,
             };
-            let per_key = if interpolation == Interpolation::CubicSpline {
-                3
-            } else {
-                1
-            };
+            let per_key = if interpolation == Interpolation::CubicSpline { 3 } else { 1 };
             if values.len() != per_key * times.len() {
                 return Err(SceneError::invalid(
                     &self.path,
@@ -674,17 +593,10 @@ impl Ctx<'_> {
             channels.push(Channel {
                 node,
                 path,
-                sampler: Sampler {
-                    interpolation,
-                    times,
-                    values,
-                },
+                sampler: Sampler { interpolation, times, values },
             });
         }
-        Ok(Ok(Animation {
-            name: name.to_owned(),
-            channels,
-        }))
+        Ok(Ok(Animation { name: name.to_owned(), channels }))
     }
 }
 
@@ -703,11 +615,9 @@ fn triangle_list(mode: Mode, idx: &[u32]) -> Option<Vec<u32>> {
                 })
                 .collect(),
         ),
-        Mode::TriangleFan => Some(
-            (2..idx.len())
-                .flat_map(|i| [idx[0], idx[i - 1], idx[i]])
-                .collect(),
-        ),
+        Mode::TriangleFan => {
+            Some((2..idx.len()).flat_map(|i| [idx[0], idx[i - 1], idx[i]]).collect())
+        }
         _ => None,
     }
 }
@@ -727,13 +637,18 @@ fn smooth_normals(positions: &[Vec3], indices: &[u32]) -> Vec<Vec3> {
 
 /// Unshares vertices so each triangle gets its face normal (the glTF rule for missing
 /// normals, which also has tangents ignored).
-fn flat_shaded(positions: &[Vec3], uvs: &[Vec2], uvs1: &[Vec2], indices: &[u32], material: usize) -> Primitive {
+fn flat_shaded(
+    positions: &[Vec3],
+    uvs: &[Vec2],
+    uvs1: &[Vec2],
+    indices: &[u32],
+    material: usize,
+) -> Primitive {
     let mut out = Primitive { material, ..Primitive::default() };
     for t in indices.chunks_exact(3) {
         let [a, b, c] = [t[0] as usize, t[1] as usize, t[2] as usize];
-        let n = (positions[b] - positions[a])
-            .cross(positions[c] - positions[a])
-            .normalize_or(Vec3::Y);
+        let n =
+            (positions[b] - positions[a]).cross(positions[c] - positions[a]).normalize_or(Vec3::Y);
         for v in [a, b, c] {
             out.indices.push(out.positions.len() as u32);
             out.positions.push(positions[v]);
@@ -753,14 +668,8 @@ mod tests {
 
     #[test]
     fn strips_and_fans_become_lists() {
-        assert_eq!(
-            triangle_list(Mode::TriangleStrip, &[0, 1, 2, 3]),
-            Some(vec![0, 1, 2, 2, 1, 3])
-        );
-        assert_eq!(
-            triangle_list(Mode::TriangleFan, &[0, 1, 2, 3]),
-            Some(vec![0, 1, 2, 0, 2, 3])
-        );
+        assert_eq!(triangle_list(Mode::TriangleStrip, &[0, 1, 2, 3]), Some(vec![0, 1, 2, 2, 1, 3]));
+        assert_eq!(triangle_list(Mode::TriangleFan, &[0, 1, 2, 3]), Some(vec![0, 1, 2, 0, 2, 3]));
         assert_eq!(triangle_list(Mode::Lines, &[0, 1]), None);
     }
 

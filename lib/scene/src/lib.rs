@@ -24,6 +24,8 @@ pub mod animation;
 pub mod distribution;
 mod env_image;
 pub mod environment;
+#[cfg(test)]
+mod environment_tests;
 mod error;
 pub mod extensions;
 mod frame;
@@ -32,14 +34,12 @@ mod gltf_load;
 pub mod light_path;
 mod load;
 #[cfg(test)]
-mod environment_tests;
-#[cfg(test)]
 mod load_tests;
 pub mod manifest;
 pub mod material;
-mod material_textures;
 #[cfg(test)]
 mod material_load_tests;
+mod material_textures;
 pub mod model;
 pub mod orbit;
 pub mod rig;

@@ -25,13 +25,7 @@ pub struct LoadOptions {
 
 /// Loads `scene.toml` at `path` (and the glTF it names) with an optional preset.
 pub fn load(path: &Path, preset: Option<&str>) -> Result<Scene, SceneError> {
-    load_with(
-        path,
-        &LoadOptions {
-            preset: preset.map(str::to_owned),
-            ..LoadOptions::default()
-        },
-    )
+    load_with(path, &LoadOptions { preset: preset.map(str::to_owned), ..LoadOptions::default() })
 }
 
 /// Loads `scene.toml` at `path` with the given overrides.
@@ -40,9 +34,7 @@ pub fn load_with(path: &Path, options: &LoadOptions) -> Result<Scene, SceneError
     if let Some(preset) = &options.preset {
         m.apply_preset(preset, path)?;
     }
-    let (width, height) = options
-        .resolution
-        .unwrap_or((m.resolution[0], m.resolution[1]));
+    let (width, height) = options.resolution.unwrap_or((m.resolution[0], m.resolution[1]));
     if width == 0 || height == 0 {
         return Err(SceneError::invalid(
             path,
@@ -63,13 +55,7 @@ pub fn load_with(path: &Path, options: &LoadOptions) -> Result<Scene, SceneError
     for (name, spec) in &m.objects {
         let Some(obj) = g.objects.iter_mut().find(|o| &o.name == name) else {
             let known = g.objects.iter().map(|o| o.name.as_str());
-            return Err(SceneError::unknown(
-                path,
-                format!("object.{name}"),
-                "object",
-                name,
-                known,
-            ));
+            return Err(SceneError::unknown(path, format!("object.{name}"), "object", name, known));
         };
         if let Some(role) = spec.role {
             obj.role = match role {
@@ -80,23 +66,28 @@ pub fn load_with(path: &Path, options: &LoadOptions) -> Result<Scene, SceneError
         }
         if let Some(reflector) = &spec.reflector {
             if reflector.trim().is_empty() {
-                return Err(SceneError::invalid(path, format!("object.{name}.reflector"), "a reflector name must not be empty"));
+                return Err(SceneError::invalid(
+                    path,
+                    format!("object.{name}.reflector"),
+                    "a reflector name must not be empty",
+                ));
             }
             obj.reflector = Some(reflector.clone());
         }
     }
 
     crate::toml_lights::add_lights(&mut g.rig, &m.lights, path)?;
-    let environment = m.environment.as_ref().map(|e| crate::environment::load(e, path, m.allow_outside_files)).transpose()?;
+    let environment = m
+        .environment
+        .as_ref()
+        .map(|e| crate::environment::load(e, path, m.allow_outside_files))
+        .transpose()?;
     let space = build_space(&m.dimensions, &g, path)?;
     g.rig.camera = resolve_camera(
         &m,
         &g,
         path,
-        space
-            .dims
-            .iter()
-            .any(|d| matches!(d.driver, crate::Driver::Orbit { .. })),
+        space.dims.iter().any(|d| matches!(d.driver, crate::Driver::Orbit { .. })),
     )?;
 
     let name = m.name.clone().unwrap_or_else(|| {
@@ -124,17 +115,27 @@ pub fn load_with(path: &Path, options: &LoadOptions) -> Result<Scene, SceneError
 fn check_limits(m: &Manifest, (width, height): (u32, u32), path: &Path) -> Result<(), SceneError> {
     use pis_format::checks::{MAX_DIMS, MAX_IMAGE_SIDE, MAX_POINTS};
     if width > MAX_IMAGE_SIDE || height > MAX_IMAGE_SIDE {
-        let msg = format!("{width}x{height}: a .pis file holds images of at most {MAX_IMAGE_SIDE} pixels a side");
+        let msg = format!(
+            "{width}x{height}: a .pis file holds images of at most {MAX_IMAGE_SIDE} pixels a side"
+        );
         return Err(SceneError::invalid(path, "resolution", msg));
     }
     if m.dimensions.len() > MAX_DIMS as usize {
-        let msg = format!("{} dimensions: a .pis file holds at most {MAX_DIMS}", m.dimensions.len());
+        let msg =
+            format!("{} dimensions: a .pis file holds at most {MAX_DIMS}", m.dimensions.len());
         return Err(SceneError::invalid(path, "dimension", msg));
     }
-    let points = m.dimensions.iter().try_fold(1u64, |n, d| n.checked_mul(d.samples as u64).filter(|&n| n <= MAX_POINTS));
+    let points = m
+        .dimensions
+        .iter()
+        .try_fold(1u64, |n, d| n.checked_mul(d.samples as u64).filter(|&n| n <= MAX_POINTS));
     if points.is_none() {
-        let counts: Vec<String> = m.dimensions.iter().map(|d| format!("{} {}", d.samples, d.name)).collect();
-        let msg = format!("{}: more than {MAX_POINTS} parameter points, the most a .pis file holds", counts.join(" × "));
+        let counts: Vec<String> =
+            m.dimensions.iter().map(|d| format!("{} {}", d.samples, d.name)).collect();
+        let msg = format!(
+            "{}: more than {MAX_POINTS} parameter points, the most a .pis file holds",
+            counts.join(" × ")
+        );
         return Err(SceneError::invalid(path, "dimension", msg));
     }
     Ok(())
@@ -154,13 +155,7 @@ fn resolve_camera(
         let found = g.cameras.iter().find(|c| &g.rig.nodes[c.node].name == name);
         let Some(c) = found else {
             let known = g.cameras.iter().map(|c| g.rig.nodes[c.node].name.as_str());
-            return Err(SceneError::unknown(
-                path,
-                "camera.node",
-                "camera",
-                name,
-                known,
-            ));
+            return Err(SceneError::unknown(path, "camera.node", "camera", name, known));
         };
         if spec.eye.is_some() || spec.target.is_some() {
             return Err(SceneError::invalid(
@@ -176,19 +171,11 @@ fn resolve_camera(
             .ok_or_else(|| SceneError::invalid(path, "camera.target", "required with `eye`"))?;
         let up = spec.up.map(Vec3::from).unwrap_or(Vec3::Y);
         if Vec3::from(eye) == Vec3::from(target) {
-            return Err(SceneError::invalid(
-                path,
-                "camera.target",
-                "equals camera.eye",
-            ));
+            return Err(SceneError::invalid(path, "camera.target", "equals camera.eye"));
         }
         rig.placement = CameraPlacement::Fixed(look_at(eye.into(), target.into(), up));
     } else if spec.target.is_some() {
-        return Err(SceneError::invalid(
-            path,
-            "camera.eye",
-            "required with `target`",
-        ));
+        return Err(SceneError::invalid(path, "camera.eye", "required with `target`"));
     } else if let Some(c) = g.cameras.first() {
         gltf_camera = Some(c);
     } else if !has_orbit {
@@ -224,10 +211,7 @@ fn resolve_camera(
         return Err(SceneError::invalid(
             path,
             "camera.znear",
-            format!(
-                "need 0 < znear < zfar, found {} and {}",
-                rig.znear, rig.zfar
-            ),
+            format!("need 0 < znear < zfar, found {} and {}", rig.znear, rig.zfar),
         ));
     }
     Ok(rig)

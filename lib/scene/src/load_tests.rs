@@ -48,7 +48,10 @@ pub(crate) fn f32s(v: &[f32]) -> Vec<u8> {
 
 impl Fixture {
     /// Writes the fixture; `edit` may change the glTF JSON and the buffer before writing.
-    pub(crate) fn new(toml: &str, edit: impl FnOnce(&mut serde_json::Value, &mut Vec<u8>)) -> Fixture {
+    pub(crate) fn new(
+        toml: &str,
+        edit: impl FnOnce(&mut serde_json::Value, &mut Vec<u8>),
+    ) -> Fixture {
         let positions = [0.0f32, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0];
         let times = [0.0f32, 1.0, 2.0];
         let half = std::f32::consts::FRAC_PI_4; // rotations 0°, 90°, 180° about +Y
@@ -164,11 +167,8 @@ fn preset_and_overrides() {
     let s = load(&f.toml(), Some("paper")).unwrap();
     assert_eq!(s.resolution, (64, 48));
     assert_eq!(s.space.point_count(), 24);
-    let opts = LoadOptions {
-        preset: Some("paper".into()),
-        resolution: Some((10, 5)),
-        spp: Some(9),
-    };
+    let opts =
+        LoadOptions { preset: Some("paper".into()), resolution: Some((10, 5)), spp: Some(9) };
     let s = load_with(&f.toml(), &opts).unwrap();
     assert_eq!((s.resolution, s.spp), ((10, 5), 9));
 }
@@ -189,17 +189,9 @@ fn frame_poses_animation_and_orbit() {
     // spin sample 1 (t = 1): 90° about +Y; the node keeps its translation.
     let frame = s.frame(&[1, 0]).unwrap();
     let m = frame.instances[0].world_from_object;
-    assert!(
-        m.transform_point3(Vec3::X)
-            .distance(Vec3::new(1.0, 0.0, -1.0))
-            < 1e-5
-    );
+    assert!(m.transform_point3(Vec3::X).distance(Vec3::new(1.0, 0.0, -1.0)) < 1e-5);
     let (_, r, _) = m.to_scale_rotation_translation();
-    assert!(
-        r.dot(Quat::from_rotation_y(std::f32::consts::FRAC_PI_2))
-            .abs()
-            > 1.0 - 1e-6
-    );
+    assert!(r.dot(Quat::from_rotation_y(std::f32::consts::FRAC_PI_2)).abs() > 1.0 - 1e-6);
     // The light stays at its node (hop is not a dimension).
     assert_eq!(frame.lights[0].position, Vec3::new(0.0, 2.0, 0.0));
     assert_eq!(frame.lights[0].name, "Lamp");
@@ -230,14 +222,8 @@ time = [0, 2]
     );
     // STEP: t = 0.5 holds the first keyframe, t = 1.5 the second.
     assert_eq!(frame.lights[0].position, Vec3::new(0.0, 2.0, 0.0));
-    assert_eq!(
-        s.frame(&[3]).unwrap().lights[0].position,
-        Vec3::new(0.0, 3.0, 0.0)
-    );
-    assert_eq!(
-        s.frame(&[4]).unwrap().lights[0].position,
-        Vec3::new(0.0, 4.0, 0.0)
-    );
+    assert_eq!(s.frame(&[3]).unwrap().lights[0].position, Vec3::new(0.0, 3.0, 0.0));
+    assert_eq!(s.frame(&[4]).unwrap().lights[0].position, Vec3::new(0.0, 4.0, 0.0));
 }
 
 #[test]
@@ -257,12 +243,7 @@ time = [0, 1]
     let s = load(&f.toml(), None).unwrap();
     assert_eq!(s.space.dims[0].kind, crate::DimensionKind::Time);
     // Hermite at s = 0.5, dt = 1: 0.125·m0 + 0.5·p1 = 0.125·1 + 0.5·1 = 0.625.
-    let x = |i: u32| {
-        s.frame(&[i]).unwrap().instances[0]
-            .world_from_object
-            .w_axis
-            .x
-    };
+    let x = |i: u32| s.frame(&[i]).unwrap().instances[0].world_from_object.w_axis.x;
     assert_eq!(x(0), 0.0);
     assert!((x(1) - 0.625).abs() < 1e-6, "{}", x(1));
     assert_eq!(x(2), 1.0);
@@ -331,17 +312,32 @@ outer_cone_deg = 30
     let names: Vec<&str> = frame.lights.iter().map(|l| l.name.as_str()).collect();
     assert_eq!(names, ["Lamp", "Key", "Sun", "Spot"]);
     let (key, sun, spot) = (&frame.lights[1], &frame.lights[2], &frame.lights[3]);
-    assert_eq!((key.kind, key.position, key.radius, key.radiance), (crate::LightKind::Point, Vec3::new(1.0, 2.0, 3.0), 0.5, [4.0, 2.0, 1.0]));
+    assert_eq!(
+        (key.kind, key.position, key.radius, key.radiance),
+        (crate::LightKind::Point, Vec3::new(1.0, 2.0, 3.0), 0.5, [4.0, 2.0, 1.0])
+    );
     assert_eq!(sun.kind, crate::LightKind::Directional);
     assert!(sun.direction.abs_diff_eq(Vec3::NEG_Y, 1e-6), "{}", sun.direction);
-    assert!(spot.direction.abs_diff_eq(Vec3::X, 1e-6) && spot.position.abs_diff_eq(Vec3::new(0.0, 3.0, 0.0), 1e-6), "{spot:?}");
-    assert!(matches!(spot.kind, crate::LightKind::Spot { outer_cone, .. } if (outer_cone - 30f32.to_radians()).abs() < 1e-6));
+    assert!(
+        spot.direction.abs_diff_eq(Vec3::X, 1e-6)
+            && spot.position.abs_diff_eq(Vec3::new(0.0, 3.0, 0.0), 1e-6),
+        "{spot:?}"
+    );
+    assert!(
+        matches!(spot.kind, crate::LightKind::Spot { outer_cone, .. } if (outer_cone - 30f32.to_radians()).abs() < 1e-6)
+    );
     for (bad, field) in [
         ("[[light]]\nname = \"A\"\nkind = \"sphere\"\nposition = [0, 1, 0]\n", "light[1].radius"),
         ("[[light]]\nname = \"A\"\nkind = \"spot\"\nposition = [0, 1, 0]\n", "light[1].direction"),
-        ("[[light]]\nname = \"A\"\nkind = \"directional\"\ndirection = [0, 0, 0]\n", "light[1].direction"),
+        (
+            "[[light]]\nname = \"A\"\nkind = \"directional\"\ndirection = [0, 0, 0]\n",
+            "light[1].direction",
+        ),
         ("[[light]]\nname = \"Lamp\"\nkind = \"point\"\nposition = [0, 1, 0]\n", "light[1].name"),
-        ("[[light]]\nname = \"A\"\nkind = \"point\"\nposition = [0, 1, 0]\nintensity = -1\n", "light[1].intensity"),
+        (
+            "[[light]]\nname = \"A\"\nkind = \"point\"\nposition = [0, 1, 0]\nintensity = -1\n",
+            "light[1].intensity",
+        ),
     ] {
         let f = Fixture::new(&format!("{TOML}\n{bad}"), |_, _| {});
         let err = load_err(&f).to_string();
@@ -368,24 +364,15 @@ path = [[-1, 3, 0], [1, 3, 0]]
     let f = Fixture::new(toml, |_, _| {});
     let s = load(&f.toml(), None).unwrap();
     assert_eq!(s.space.dims[0].kind, crate::DimensionKind::Light);
-    assert_eq!(
-        s.frame(&[1]).unwrap().lights[0].position,
-        Vec3::new(0.0, 3.0, 0.0)
-    );
-    assert_eq!(
-        s.frame(&[2]).unwrap().lights[0].position,
-        Vec3::new(1.0, 3.0, 0.0)
-    );
+    assert_eq!(s.frame(&[1]).unwrap().lights[0].position, Vec3::new(0.0, 3.0, 0.0));
+    assert_eq!(s.frame(&[2]).unwrap().lights[0].position, Vec3::new(1.0, 3.0, 0.0));
 }
 
 #[test]
 fn role_override() {
     let toml = format!("{TOML}\n[object.Tri]\nrole = \"diffuse\"\n");
     let f = Fixture::new(&toml, |_, _| {});
-    assert_eq!(
-        load(&f.toml(), None).unwrap().objects[0].role,
-        ObjectRole::Diffuse
-    );
+    assert_eq!(load(&f.toml(), None).unwrap().objects[0].role, ObjectRole::Diffuse);
 }
 
 #[test]
@@ -402,8 +389,19 @@ fn reflector_names_the_object_a_part_of() {
 #[test]
 fn parts_naming_one_reflector_share_its_first_part() {
     let mut s = crate::Scene::default();
-    for (name, reflector) in [("Body", None), ("Box", None), ("Lid", Some("Body")), ("Knob", Some("Pot")), ("Spout", Some("Pot"))] {
-        s.objects.push(crate::SceneObject { name: name.into(), role: ObjectRole::Reflective, reflector: reflector.map(String::from), primitives: vec![] });
+    for (name, reflector) in [
+        ("Body", None),
+        ("Box", None),
+        ("Lid", Some("Body")),
+        ("Knob", Some("Pot")),
+        ("Spout", Some("Pot")),
+    ] {
+        s.objects.push(crate::SceneObject {
+            name: name.into(),
+            role: ObjectRole::Reflective,
+            reflector: reflector.map(String::from),
+            primitives: vec![],
+        });
     }
     let of: Vec<u32> = (0..5).map(|o| s.reflector_of(o)).collect();
     assert_eq!(s.reflectors(), of);
@@ -441,33 +439,15 @@ fn error_missing_buffer() {
 fn error_unknown_camera() {
     let f = Fixture::new(&TOML.replace("node = \"Cam\"", "node = \"Kam\""), |_, _| {});
     let err = load_err(&f);
-    assert!(
-        matches!(err, SceneError::UnknownName { what: "camera", .. }),
-        "{err}"
-    );
-    assert!(
-        err.to_string().contains("camera.node") && err.to_string().contains("Cam"),
-        "{err}"
-    );
+    assert!(matches!(err, SceneError::UnknownName { what: "camera", .. }), "{err}");
+    assert!(err.to_string().contains("camera.node") && err.to_string().contains("Cam"), "{err}");
 }
 
 #[test]
 fn error_unknown_animation() {
-    let f = Fixture::new(
-        &TOML.replace("animation = \"spin\"", "animation = \"spun\""),
-        |_, _| {},
-    );
+    let f = Fixture::new(&TOML.replace("animation = \"spin\"", "animation = \"spun\""), |_, _| {});
     let err = load_err(&f);
-    assert!(
-        matches!(
-            err,
-            SceneError::UnknownName {
-                what: "animation",
-                ..
-            }
-        ),
-        "{err}"
-    );
+    assert!(matches!(err, SceneError::UnknownName { what: "animation", .. }), "{err}");
     assert!(err.to_string().contains("dimension[0].animation"), "{err}");
 }
 
@@ -476,22 +456,13 @@ fn error_unknown_light() {
     let toml = "gltf = \"scene.gltf\"\nresolution = [8, 8]\nspp = 1\n[[dimension]]\nname = \"l\"\ndriver = \"light_path\"\nlight = \"Sun\"\nsamples = 2\npath = [[0, 0, 0]]\n";
     let f = Fixture::new(toml, |_, _| {});
     let err = load_err(&f);
-    assert!(
-        matches!(err, SceneError::UnknownName { what: "light", .. }),
-        "{err}"
-    );
+    assert!(matches!(err, SceneError::UnknownName { what: "light", .. }), "{err}");
 }
 
 #[test]
 fn error_unknown_object() {
-    let f = Fixture::new(
-        &format!("{TOML}\n[object.Vase]\nrole = \"reflective\"\n"),
-        |_, _| {},
-    );
-    assert!(matches!(
-        load_err(&f),
-        SceneError::UnknownName { what: "object", .. }
-    ));
+    let f = Fixture::new(&format!("{TOML}\n[object.Vase]\nrole = \"reflective\"\n"), |_, _| {});
+    assert!(matches!(load_err(&f), SceneError::UnknownName { what: "object", .. }));
 }
 
 #[test]
@@ -509,49 +480,30 @@ fn error_zero_samples() {
 fn error_unknown_toml_key() {
     let f = Fixture::new(&TOML.replace("spp = 2", "spp = 2\nspf = 3"), |_, _| {});
     let err = load_err(&f);
-    assert!(
-        matches!(err, SceneError::Toml { .. }) && err.to_string().contains("spf"),
-        "{err}"
-    );
+    assert!(matches!(err, SceneError::Toml { .. }) && err.to_string().contains("spf"), "{err}");
 }
 
 #[test]
 fn error_key_of_another_driver() {
-    let f = Fixture::new(
-        &TOML.replace("radius = 4", "radius = 4\nanimation = \"spin\""),
-        |_, _| {},
-    );
+    let f =
+        Fixture::new(&TOML.replace("radius = 4", "radius = 4\nanimation = \"spin\""), |_, _| {});
     let err = load_err(&f);
     assert!(err.to_string().contains("dimension[1].animation"), "{err}");
 }
 
 #[test]
 fn error_nan_in_buffer() {
-    let f = Fixture::new(TOML, |_, bin| {
-        bin[12..16].copy_from_slice(&f32::NAN.to_le_bytes())
-    });
+    let f = Fixture::new(TOML, |_, bin| bin[12..16].copy_from_slice(&f32::NAN.to_le_bytes()));
     let err = load_err(&f);
-    assert!(
-        matches!(err, SceneError::NonFinite { element: 1, .. }),
-        "{err}"
-    );
-    assert!(
-        err.to_string()
-            .contains("meshes[0].primitives[0].attributes.POSITION"),
-        "{err}"
-    );
+    assert!(matches!(err, SceneError::NonFinite { element: 1, .. }), "{err}");
+    assert!(err.to_string().contains("meshes[0].primitives[0].attributes.POSITION"), "{err}");
 }
 
 #[test]
 fn error_inf_in_animation() {
-    let f = Fixture::new(TOML, |_, bin| {
-        bin[52..56].copy_from_slice(&f32::INFINITY.to_le_bytes())
-    });
+    let f = Fixture::new(TOML, |_, bin| bin[52..56].copy_from_slice(&f32::INFINITY.to_le_bytes()));
     let err = load_err(&f);
-    assert!(
-        err.to_string().contains("animations[0].samplers[0].output"),
-        "{err}"
-    );
+    assert!(err.to_string().contains("animations[0].samplers[0].output"), "{err}");
 }
 
 #[test]
@@ -566,29 +518,18 @@ fn error_required_extension() {
 
 #[test]
 fn error_non_triangle_primitive() {
-    let f = Fixture::new(TOML, |doc, _| {
-        doc["meshes"][0]["primitives"][0]["mode"] = json!(1)
-    });
+    let f = Fixture::new(TOML, |doc, _| doc["meshes"][0]["primitives"][0]["mode"] = json!(1));
     let err = load_err(&f);
     assert!(matches!(err, SceneError::Unsupported { .. }), "{err}");
-    assert!(
-        err.to_string().contains("meshes[0].primitives[0].mode"),
-        "{err}"
-    );
+    assert!(err.to_string().contains("meshes[0].primitives[0].mode"), "{err}");
 }
 
 #[test]
 fn error_point_out_of_range() {
     let f = Fixture::new(TOML, |_, _| {});
     let s = load(&f.toml(), None).unwrap();
-    assert!(matches!(
-        s.frame(&[3, 0]),
-        Err(SceneError::PointOutOfRange { .. })
-    ));
-    assert!(matches!(
-        s.frame(&[0]),
-        Err(SceneError::PointOutOfRange { .. })
-    ));
+    assert!(matches!(s.frame(&[3, 0]), Err(SceneError::PointOutOfRange { .. })));
+    assert!(matches!(s.frame(&[0]), Err(SceneError::PointOutOfRange { .. })));
 }
 
 #[test]
@@ -646,14 +587,7 @@ fn damaged_gltf_errors_without_panicking() {
     let mut paths = Vec::new();
     numeric_paths(&doc, vec![], &mut paths);
     for path in &paths {
-        for value in [
-            json!(0),
-            json!(1),
-            json!(7),
-            json!(1_000_000),
-            json!(-1),
-            json!(0.5),
-        ] {
+        for value in [json!(0), json!(1), json!(7), json!(1_000_000), json!(-1), json!(0.5)] {
             let f = Fixture::new(TOML, |d, _| {
                 let mut slot = &mut *d;
                 for key in path {
@@ -670,9 +604,7 @@ fn damaged_gltf_errors_without_panicking() {
             assert!(result.is_ok(), "panic with {} = {value}", path.join("."));
         }
     }
-    let bin_len = std::fs::read(base.dir.path().join("scene.bin"))
-        .unwrap()
-        .len();
+    let bin_len = std::fs::read(base.dir.path().join("scene.bin")).unwrap().len();
     for len in 0..bin_len {
         let f = Fixture::new(TOML, |_, bin| bin.truncate(len));
         let result = std::panic::catch_unwind(|| load(&f.toml(), None).map(|_| ()));
@@ -685,10 +617,7 @@ fn error_accessor_past_its_buffer_view() {
     let f = Fixture::new(TOML, |doc, _| doc["accessors"][0]["count"] = json!(1000));
     let err = load_err(&f);
     let msg = err.to_string();
-    assert!(
-        msg.contains("meshes[0].primitives[0].attributes.POSITION (accessors[0])"),
-        "{msg}"
-    );
+    assert!(msg.contains("meshes[0].primitives[0].attributes.POSITION (accessors[0])"), "{msg}");
     assert!(msg.contains("exceed buffer view 0"), "{msg}");
 }
 
@@ -698,11 +627,7 @@ fn error_animation_target_node_missing() {
         doc["animations"][0]["channels"][0]["target"]["node"] = json!(9)
     });
     let err = load_err(&f);
-    assert!(
-        err.to_string()
-            .contains("animations[0].channels[0].target.node"),
-        "{err}"
-    );
+    assert!(err.to_string().contains("animations[0].channels[0].target.node"), "{err}");
 }
 
 #[test]
@@ -711,10 +636,7 @@ fn error_normal_accessor_of_wrong_type() {
         doc["meshes"][0]["primitives"][0]["attributes"]["NORMAL"] = json!(1)
     });
     let err = load_err(&f);
-    assert!(
-        err.to_string().contains("expected [Vec3] of [F32]"),
-        "{err}"
-    );
+    assert!(err.to_string().contains("expected [Vec3] of [F32]"), "{err}");
 }
 
 /// A glTF from elsewhere once read `../../etc/passwd`: references that leave the glTF's
@@ -734,7 +656,8 @@ fn buffer_uri_leaving_the_scene_folder_is_refused() {
     let f = Fixture::new(TOML, |_, _| {});
     let back = format!("../{}/scene.bin", f.dir.path().file_name().unwrap().to_string_lossy());
     let gltf = f.dir.path().join("scene.gltf");
-    let mut doc: serde_json::Value = serde_json::from_slice(&std::fs::read(&gltf).unwrap()).unwrap();
+    let mut doc: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(&gltf).unwrap()).unwrap();
     doc["buffers"][0]["uri"] = json!(back);
     std::fs::write(&gltf, serde_json::to_vec(&doc).unwrap()).unwrap();
     assert!(load(&f.toml(), None).is_ok(), "{back}: inside the folder");
@@ -767,7 +690,10 @@ fn buffer_shorter_than_its_byte_length_is_refused() {
             bin.truncate(bin.len() - short);
         });
         let e = load_err(&f).to_string();
-        assert!(e.contains("buffers[0].byteLength") && e.contains("the data holds"), "{short} bytes short: {e}");
+        assert!(
+            e.contains("buffers[0].byteLength") && e.contains("the data holds"),
+            "{short} bytes short: {e}"
+        );
     }
 }
 
@@ -775,7 +701,9 @@ fn buffer_shorter_than_its_byte_length_is_refused() {
 #[test]
 fn more_dimensions_than_a_file_holds_are_refused_at_load() {
     let dims: String = (0..9).map(|k| format!("\n[[dimension]]\nname = \"d{k}\"\ndriver = \"animation\"\nanimation = \"spin\"\nkind = \"other\"\nsamples = 1\n")).collect();
-    let toml = format!("gltf = \"scene.gltf\"\nresolution = [32, 24]\nspp = 1\n[camera]\nnode = \"Cam\"\n{dims}");
+    let toml = format!(
+        "gltf = \"scene.gltf\"\nresolution = [32, 24]\nspp = 1\n[camera]\nnode = \"Cam\"\n{dims}"
+    );
     let e = load_err(&Fixture::new(&toml, |_, _| {})).to_string();
     assert!(e.contains("9 dimensions: a .pis file holds at most 8"), "{e}");
 }

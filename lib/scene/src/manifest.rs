@@ -146,19 +146,15 @@ pub struct PresetSpec {
 impl Manifest {
     /// Reads and parses scene.toml.
     pub fn read(path: &Path) -> Result<Manifest, SceneError> {
-        let text = std::fs::read_to_string(path).map_err(|source| SceneError::Io {
-            path: path.to_owned(),
-            source,
-        })?;
+        let text = std::fs::read_to_string(path)
+            .map_err(|source| SceneError::Io { path: path.to_owned(), source })?;
         Self::parse(&text, path)
     }
 
     /// Parses scene.toml text; `path` is used in error messages.
     pub fn parse(text: &str, path: &Path) -> Result<Manifest, SceneError> {
-        let manifest: Manifest = toml::from_str(text).map_err(|e| SceneError::Toml {
-            path: path.to_owned(),
-            message: e.to_string(),
-        })?;
+        let manifest: Manifest = toml::from_str(text)
+            .map_err(|e| SceneError::Toml { path: path.to_owned(), message: e.to_string() })?;
         manifest.check_finite(path)?;
         Ok(manifest)
     }
@@ -200,11 +196,9 @@ impl Manifest {
     fn check_finite(&self, path: &Path) -> Result<(), SceneError> {
         let check = |field: String, values: &[f32]| -> Result<(), SceneError> {
             match values.iter().position(|v| !v.is_finite()) {
-                Some(element) => Err(SceneError::NonFinite {
-                    path: path.to_owned(),
-                    field,
-                    element,
-                }),
+                Some(element) => {
+                    Err(SceneError::NonFinite { path: path.to_owned(), field, element })
+                }
                 None => Ok(()),
             }
         };
@@ -230,11 +224,7 @@ impl Manifest {
                     check(f(key), &[v])?;
                 }
             }
-            for (key, v) in [
-                ("azimuth_deg", d.azimuth_deg),
-                ("time", d.time),
-                ("range", d.range),
-            ] {
+            for (key, v) in [("azimuth_deg", d.azimuth_deg), ("time", d.time), ("range", d.range)] {
                 if let Some(v) = v {
                     check(f(key), &v)?;
                 }
@@ -295,10 +285,7 @@ mod tests {
         assert_eq!(m.dimensions[0].driver, DriverSpec::Animation);
         assert_eq!(m.dimensions[0].kind, Some(KindSpec::Light));
         assert_eq!(m.dimensions[1].azimuth_deg, Some([0.0, 45.0]));
-        assert_eq!(
-            m.camera.as_ref().and_then(|c| c.node.as_deref()),
-            Some("Camera")
-        );
+        assert_eq!(m.camera.as_ref().and_then(|c| c.node.as_deref()), Some("Camera"));
     }
 
     #[test]
@@ -310,10 +297,7 @@ mod tests {
         assert_eq!(m.dimensions[0].samples, 8);
         assert_eq!(m.dimensions[1].samples, 8);
         let err = m.apply_preset("huge", Path::new("scene.toml")).unwrap_err();
-        assert!(
-            matches!(err, SceneError::UnknownName { what: "preset", .. }),
-            "{err}"
-        );
+        assert!(matches!(err, SceneError::UnknownName { what: "preset", .. }), "{err}");
     }
 
     #[test]
@@ -322,10 +306,7 @@ mod tests {
         let err = Manifest::parse(&text, Path::new("dir/scene.toml")).unwrap_err();
         let msg = err.to_string();
         assert!(matches!(err, SceneError::Toml { .. }));
-        assert!(
-            msg.contains("dir/scene.toml") && msg.contains("radios"),
-            "{msg}"
-        );
+        assert!(msg.contains("dir/scene.toml") && msg.contains("radios"), "{msg}");
     }
 
     #[test]
@@ -339,9 +320,7 @@ mod tests {
     fn preset_naming_an_unknown_dimension_fails() {
         let text = TOML.replace("view = 8,", "veiw = 8,");
         let mut m = Manifest::parse(&text, Path::new("scene.toml")).unwrap();
-        let err = m
-            .apply_preset("paper", Path::new("scene.toml"))
-            .unwrap_err();
+        let err = m.apply_preset("paper", Path::new("scene.toml")).unwrap_err();
         assert!(err.to_string().contains("veiw"), "{err}");
     }
 }

@@ -20,18 +20,15 @@ pub fn convert_material(m: &gltf::Material) -> Material {
         metallic: pbr.metallic_factor(),
         roughness: pbr.roughness_factor(),
         emissive: [e[0] * strength, e[1] * strength, e[2] * strength],
-        transmission: m
-            .transmission()
-            .map(|t| t.transmission_factor())
-            .unwrap_or(0.0),
+        transmission: m.transmission().map(|t| t.transmission_factor()).unwrap_or(0.0),
         ior: m.ior().unwrap_or(1.5),
         ..Material::default()
     };
     mat.alpha_mode = match m.alpha_mode() {
         gltf::material::AlphaMode::Opaque => AlphaMode::Opaque,
-        gltf::material::AlphaMode::Mask => AlphaMode::Mask {
-            cutoff: m.alpha_cutoff().filter(|c| c.is_finite()).unwrap_or(0.5),
-        },
+        gltf::material::AlphaMode::Mask => {
+            AlphaMode::Mask { cutoff: m.alpha_cutoff().filter(|c| c.is_finite()).unwrap_or(0.5) }
+        }
         gltf::material::AlphaMode::Blend => AlphaMode::Blend,
     };
     if let Some(v) = m.volume() {
@@ -50,7 +47,9 @@ pub fn convert_material(m: &gltf::Material) -> Material {
 /// metallic-roughness texture, emission × the mean emissive texel; the normal map dropped.
 /// What a per-object description (the role, the packed shading constants) reads.
 pub fn mean_material(m: &Material, textures: &[TextureImage]) -> Material {
-    let mean = |t: &Option<crate::TextureRef>| t.and_then(|t| textures.get(t.texture)).map(TextureImage::mean);
+    let mean = |t: &Option<crate::TextureRef>| {
+        t.and_then(|t| textures.get(t.texture)).map(TextureImage::mean)
+    };
     let mut flat = m.clone();
     if let Some(c) = mean(&m.base_color_texture) {
         flat.base_color.iter_mut().zip(c).for_each(|(f, c)| *f *= c);
@@ -105,12 +104,7 @@ mod tests {
     use super::*;
 
     fn mat(metallic: f32, roughness: f32, transmission: f32) -> Material {
-        Material {
-            metallic,
-            roughness,
-            transmission,
-            ..Material::default()
-        }
+        Material { metallic, roughness, transmission, ..Material::default() }
     }
 
     #[test]
@@ -130,7 +124,12 @@ mod tests {
         // Factors 1 (as exporters write them) with a map of rough dielectric texels: the
         // object is not a mirror-like metal.
         let rough = TextureImage { width: 1, height: 1, texels: vec![[0.0, 0.9, 0.1, 1.0]] };
-        let m = Material { metallic: 1.0, roughness: 1.0, metallic_roughness_texture: Some(crate::TextureRef::new(0)), ..Material::default() };
+        let m = Material {
+            metallic: 1.0,
+            roughness: 1.0,
+            metallic_roughness_texture: Some(crate::TextureRef::new(0)),
+            ..Material::default()
+        };
         let flat = mean_material(&m, &[rough]);
         assert!((flat.roughness - 0.9).abs() < 1e-6 && (flat.metallic - 0.1).abs() < 1e-6);
         assert_eq!(material_role(&flat), ObjectRole::Diffuse);

@@ -21,9 +21,12 @@ fn textured(material: Value, second_set: bool, edit: impl FnOnce(&mut Value)) ->
             views.push(json!({"buffer": 0, "byteOffset": offset, "byteLength": 24}));
             let view = views.len() - 1;
             let accessors = doc["accessors"].as_array_mut().unwrap();
-            accessors.push(json!({"bufferView": view, "componentType": 5126, "count": 3, "type": "VEC2"}));
+            accessors.push(
+                json!({"bufferView": view, "componentType": 5126, "count": 3, "type": "VEC2"}),
+            );
             let accessor = accessors.len() - 1;
-            doc["meshes"][0]["primitives"][0]["attributes"][format!("TEXCOORD_{k}")] = json!(accessor);
+            doc["meshes"][0]["primitives"][0]["attributes"][format!("TEXCOORD_{k}")] =
+                json!(accessor);
         }
         doc["buffers"][0]["byteLength"] = json!(bin.len());
         doc["images"] = json!([{"uri": "a.png"}, {"uri": "b.png"}]);
@@ -59,12 +62,19 @@ fn material_maps_are_read_with_their_sets_and_transforms() {
     assert!(s.warnings.is_empty(), "{:?}", s.warnings);
     let m = &s.materials[0];
     let base = m.base_color_texture.expect("base colour texture");
-    assert_eq!((base.tex_coord, base.transform), (0, UvTransform { offset: [0.5, 0.0], rotation: 0.0, scale: [2.0, 2.0] }));
+    assert_eq!(
+        (base.tex_coord, base.transform),
+        (0, UvTransform { offset: [0.5, 0.0], rotation: 0.0, scale: [2.0, 2.0] })
+    );
     let mr = m.metallic_roughness_texture.expect("metallic-roughness texture");
     assert_eq!(mr.tex_coord, 1);
     // One image, two colour spaces: sRGB for base colour, linear for metallic-roughness.
     assert_ne!(base.texture, mr.texture);
-    assert!((s.textures[base.texture].texels[0][0] - crate::texture::srgb_to_linear(128.0 / 255.0)).abs() < 1e-6);
+    assert!(
+        (s.textures[base.texture].texels[0][0] - crate::texture::srgb_to_linear(128.0 / 255.0))
+            .abs()
+            < 1e-6
+    );
     assert!((s.textures[mr.texture].texels[0][0] - 128.0 / 255.0).abs() < 1e-6);
     assert_eq!(s.textures[base.texture].texels[0][3], 0.0, "alpha is read");
     assert!(m.emissive_texture.is_some());
@@ -78,7 +88,10 @@ fn material_maps_are_read_with_their_sets_and_transforms() {
 #[test]
 fn alpha_modes_and_cutoff_are_read() {
     let f = textured(json!({"alphaMode": "MASK", "alphaCutoff": 0.25}), false, |_| {});
-    assert_eq!(load(&f.toml(), None).unwrap().materials[0].alpha_mode, AlphaMode::Mask { cutoff: 0.25 });
+    assert_eq!(
+        load(&f.toml(), None).unwrap().materials[0].alpha_mode,
+        AlphaMode::Mask { cutoff: 0.25 }
+    );
     let f = textured(json!({"alphaMode": "BLEND"}), false, |_| {});
     assert_eq!(load(&f.toml(), None).unwrap().materials[0].alpha_mode, AlphaMode::Blend);
     let f = textured(json!({}), false, |_| {});
@@ -89,37 +102,72 @@ fn alpha_modes_and_cutoff_are_read() {
 fn unsupported_extension_is_named_once() {
     let material = json!({"extensions": {"KHR_materials_clearcoat": {"clearcoatFactor": 1}}});
     let f = textured(material, false, |doc| {
-        doc["materials"].as_array_mut().unwrap().push(json!({"extensions": {"KHR_materials_clearcoat": {"clearcoatFactor": 0.5}}}));
+        doc["materials"]
+            .as_array_mut()
+            .unwrap()
+            .push(json!({"extensions": {"KHR_materials_clearcoat": {"clearcoatFactor": 0.5}}}));
         let used = doc["extensionsUsed"].as_array_mut().unwrap();
-        used.extend([json!("KHR_materials_clearcoat"), json!("KHR_materials_sheen"), json!("KHR_xmp_json_ld")]);
+        used.extend([
+            json!("KHR_materials_clearcoat"),
+            json!("KHR_materials_sheen"),
+            json!("KHR_xmp_json_ld"),
+        ]);
     });
     let s = load(&f.toml(), None).unwrap();
     assert_eq!(s.warnings.len(), 2, "{:?}", s.warnings);
-    assert!(s.warnings[0].contains("KHR_materials_clearcoat") && s.warnings[1].contains("KHR_materials_sheen"), "{:?}", s.warnings);
+    assert!(
+        s.warnings[0].contains("KHR_materials_clearcoat")
+            && s.warnings[1].contains("KHR_materials_sheen"),
+        "{:?}",
+        s.warnings
+    );
 }
 
 /// The glTF reader accepts only its own extensions as required; PIS reads more.
 #[test]
 fn required_extensions_pis_reads_are_accepted() {
     let f = textured(json!({}), false, |doc| {
-        doc["extensionsRequired"] = json!(["KHR_texture_transform", "KHR_materials_volume", "KHR_materials_specular", "KHR_materials_variants"]);
+        doc["extensionsRequired"] = json!([
+            "KHR_texture_transform",
+            "KHR_materials_volume",
+            "KHR_materials_specular",
+            "KHR_materials_variants"
+        ]);
     });
     load(&f.toml(), None).expect("loads");
-    let f = textured(json!({}), false, |doc| doc["extensionsRequired"] = json!(["KHR_materials_ior", "KHR_materials_clearcoat"]));
+    let f = textured(json!({}), false, |doc| {
+        doc["extensionsRequired"] = json!(["KHR_materials_ior", "KHR_materials_clearcoat"])
+    });
     let e = load_err(&f);
     assert!(matches!(e, SceneError::Unsupported { .. }), "{e}");
-    assert!(e.to_string().contains("extensionsRequired[1]") && e.to_string().contains("KHR_materials_clearcoat"), "{e}");
+    assert!(
+        e.to_string().contains("extensionsRequired[1]")
+            && e.to_string().contains("KHR_materials_clearcoat"),
+        "{e}"
+    );
 }
 
 #[test]
 fn second_texture_set_missing_from_the_mesh_is_warned_of() {
-    let f = textured(json!({"emissiveTexture": {"index": 1, "texCoord": 1}, "emissiveFactor": [1, 1, 1]}), false, |_| {});
+    let f = textured(
+        json!({"emissiveTexture": {"index": 1, "texCoord": 1}, "emissiveFactor": [1, 1, 1]}),
+        false,
+        |_| {},
+    );
     let s = load(&f.toml(), None).unwrap();
     assert_eq!(s.warnings.len(), 1, "{:?}", s.warnings);
-    assert!(s.warnings[0].contains("meshes[0].primitives[0] has no TEXCOORD_1"), "{:?}", s.warnings);
+    assert!(
+        s.warnings[0].contains("meshes[0].primitives[0] has no TEXCOORD_1"),
+        "{:?}",
+        s.warnings
+    );
     let f = textured(json!({"emissiveTexture": {"index": 1, "texCoord": 3}}), true, |_| {});
     let s = load(&f.toml(), None).unwrap();
-    assert!(s.warnings.iter().any(|w| w.contains("emissiveTexture reads TEXCOORD_3")), "{:?}", s.warnings);
+    assert!(
+        s.warnings.iter().any(|w| w.contains("emissiveTexture reads TEXCOORD_3")),
+        "{:?}",
+        s.warnings
+    );
     assert_eq!(s.materials[0].emissive_texture.unwrap().tex_coord, 0);
 }
 
@@ -127,7 +175,10 @@ fn second_texture_set_missing_from_the_mesh_is_warned_of() {
 fn bad_texture_transform_is_an_error_naming_the_field() {
     let material = json!({"emissiveTexture": {"index": 1, "extensions": {"KHR_texture_transform": {"scale": "big"}}}});
     let e = load_err(&textured(material, false, |_| {})).to_string();
-    assert!(e.contains("materials[0].emissiveTexture.extensions.KHR_texture_transform.scale"), "{e}");
+    assert!(
+        e.contains("materials[0].emissiveTexture.extensions.KHR_texture_transform.scale"),
+        "{e}"
+    );
 }
 
 /// Damaged material and texture fields, and a damaged image, give an error or load; never a
@@ -144,9 +195,28 @@ fn damaged_material_textures_error_without_panicking() {
     let paths: Vec<Vec<Value>> = vec![
         vec![json!("pbrMetallicRoughness"), json!("baseColorTexture"), json!("index")],
         vec![json!("pbrMetallicRoughness"), json!("baseColorTexture"), json!("texCoord")],
-        vec![json!("pbrMetallicRoughness"), json!("baseColorTexture"), json!("extensions"), json!("KHR_texture_transform"), json!("rotation")],
-        vec![json!("pbrMetallicRoughness"), json!("baseColorTexture"), json!("extensions"), json!("KHR_texture_transform"), json!("texCoord")],
-        vec![json!("pbrMetallicRoughness"), json!("baseColorTexture"), json!("extensions"), json!("KHR_texture_transform"), json!("offset"), json!(0)],
+        vec![
+            json!("pbrMetallicRoughness"),
+            json!("baseColorTexture"),
+            json!("extensions"),
+            json!("KHR_texture_transform"),
+            json!("rotation"),
+        ],
+        vec![
+            json!("pbrMetallicRoughness"),
+            json!("baseColorTexture"),
+            json!("extensions"),
+            json!("KHR_texture_transform"),
+            json!("texCoord"),
+        ],
+        vec![
+            json!("pbrMetallicRoughness"),
+            json!("baseColorTexture"),
+            json!("extensions"),
+            json!("KHR_texture_transform"),
+            json!("offset"),
+            json!(0),
+        ],
         vec![json!("pbrMetallicRoughness"), json!("metallicRoughnessTexture"), json!("index")],
         vec![json!("normalTexture"), json!("index")],
         vec![json!("normalTexture"), json!("scale")],
@@ -154,7 +224,16 @@ fn damaged_material_textures_error_without_panicking() {
         vec![json!("alphaCutoff")],
     ];
     for path in &paths {
-        for value in [json!(0), json!(7), json!(1_000_000), json!(-1), json!(0.5), json!(1e39), json!("x"), json!(null)] {
+        for value in [
+            json!(0),
+            json!(7),
+            json!(1_000_000),
+            json!(-1),
+            json!(0.5),
+            json!(1e39),
+            json!("x"),
+            json!(null),
+        ] {
             let mut m = material.clone();
             let mut slot = &mut m;
             for key in path {

@@ -53,14 +53,20 @@ impl Scene {
     /// a reflector of its own, named after itself, unless it names another (`reflector`);
     /// objects of the same reflector name share the index of the first of them.
     pub fn reflector_of(&self, o: usize) -> u32 {
-        let Some(name) = self.objects.get(o).map(SceneObject::reflector_name) else { return o as u32 };
+        let Some(name) = self.objects.get(o).map(SceneObject::reflector_name) else {
+            return o as u32;
+        };
         self.objects.iter().position(|x| x.reflector_name() == name).unwrap_or(o) as u32
     }
 
     /// [`Scene::reflector_of`] every object, in one pass.
     pub fn reflectors(&self) -> Vec<u32> {
         let mut first = std::collections::HashMap::new();
-        self.objects.iter().enumerate().map(|(o, x)| *first.entry(x.reflector_name()).or_insert(o as u32)).collect()
+        self.objects
+            .iter()
+            .enumerate()
+            .map(|(o, x)| *first.entry(x.reflector_name()).or_insert(o as u32))
+            .collect()
     }
 }
 
@@ -169,9 +175,14 @@ impl Default for Material {
 impl Material {
     /// Every texture the material reads.
     pub fn textures(&self) -> impl Iterator<Item = &TextureRef> {
-        [&self.base_color_texture, &self.metallic_roughness_texture, &self.emissive_texture, &self.normal_texture]
-            .into_iter()
-            .flatten()
+        [
+            &self.base_color_texture,
+            &self.metallic_roughness_texture,
+            &self.emissive_texture,
+            &self.normal_texture,
+        ]
+        .into_iter()
+        .flatten()
     }
 }
 
@@ -260,11 +271,7 @@ impl Dimension {
 pub enum Driver {
     /// The camera orbits `target` at `radius` and `elevation` (degrees); the sample value is
     /// the azimuth in degrees.
-    Orbit {
-        target: Vec3,
-        radius: f32,
-        elevation_deg: f32,
-    },
+    Orbit { target: Vec3, radius: f32, elevation_deg: f32 },
     /// A named glTF animation; the sample value is the time in seconds.
     Animation { animation: String },
     /// A named light moves along a polyline (world space); the sample value is the path

@@ -25,21 +25,12 @@ pub fn look_at(eye: Vec3, target: Vec3, up: Vec3) -> Mat4 {
     }
     let right = right.normalize();
     let true_up = right.cross(forward);
-    Mat4::from_cols(
-        right.extend(0.0),
-        true_up.extend(0.0),
-        (-forward).extend(0.0),
-        eye.extend(1.0),
-    )
+    Mat4::from_cols(right.extend(0.0), true_up.extend(0.0), (-forward).extend(0.0), eye.extend(1.0))
 }
 
 /// The camera transform at `azimuth_deg` on the orbit: [`orbit_eye`] looking at `target`.
 pub fn orbit_camera(target: Vec3, radius: f32, elevation_deg: f32, azimuth_deg: f32) -> Mat4 {
-    look_at(
-        orbit_eye(target, radius, elevation_deg, azimuth_deg),
-        target,
-        Vec3::Y,
-    )
+    look_at(orbit_eye(target, radius, elevation_deg, azimuth_deg), target, Vec3::Y)
 }
 
 #[cfg(test)]
@@ -56,10 +47,7 @@ mod tests {
                 assert!((eye.distance(target) - 3.0).abs() < 1e-5);
                 // The target is straight ahead, on the local -Z axis.
                 let local = m.inverse().transform_point3(target);
-                assert!(
-                    local.x.abs() < 1e-5 && local.y.abs() < 1e-5 && local.z < 0.0,
-                    "{local}"
-                );
+                assert!(local.x.abs() < 1e-5 && local.y.abs() < 1e-5 && local.z < 0.0, "{local}");
                 // Rigid and upright: local +X stays horizontal.
                 assert!(m.transform_vector3(Vec3::X).y.abs() < 1e-5);
                 assert!((m.determinant() - 1.0).abs() < 1e-5);

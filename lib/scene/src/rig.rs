@@ -111,10 +111,7 @@ pub fn rigid_part(m: Mat4) -> Mat4 {
 
 /// Position and pointing direction (local -Z) of a light node's world transform.
 pub fn light_pose(m: Mat4) -> (Vec3, Vec3) {
-    (
-        m.transform_point3(Vec3::ZERO),
-        m.transform_vector3(Vec3::NEG_Z).normalize_or(Vec3::NEG_Z),
-    )
+    (m.transform_point3(Vec3::ZERO), m.transform_vector3(Vec3::NEG_Z).normalize_or(Vec3::NEG_Z))
 }
 
 #[cfg(test)]
@@ -130,10 +127,7 @@ mod tests {
                     name: "a".into(),
                     gltf_index: 0,
                     parent: None,
-                    local: Trs {
-                        translation: Vec3::X,
-                        ..Trs::default()
-                    },
+                    local: Trs { translation: Vec3::X, ..Trs::default() },
                 },
                 Node {
                     name: "b".into(),
@@ -149,11 +143,7 @@ mod tests {
             ..Rig::default()
         };
         let w = rig.world_transforms(&rig.rest_pose());
-        assert!(
-            w[1].transform_point3(Vec3::ZERO)
-                .distance(Vec3::new(1.0, 1.0, 0.0))
-                < 1e-6
-        );
+        assert!(w[1].transform_point3(Vec3::ZERO).distance(Vec3::new(1.0, 1.0, 0.0)) < 1e-6);
     }
 
     #[test]

@@ -81,11 +81,7 @@ pub(crate) fn build_space(
             ));
         }
         let required = |key: &str| {
-            SceneError::invalid(
-                path,
-                field(key),
-                format!("required by driver {:?}", d.driver),
-            )
+            SceneError::invalid(path, field(key), format!("required by driver {:?}", d.driver))
         };
         let periodic = d.periodic.unwrap_or(false);
         let check_kind = |expected: KindSpec| match d.kind {
@@ -121,18 +117,11 @@ pub(crate) fn build_space(
                     check_kind(KindSpec::View)?,
                     "deg",
                     (range, "azimuth_deg"),
-                    Driver::Orbit {
-                        target,
-                        radius,
-                        elevation_deg,
-                    },
+                    Driver::Orbit { target, radius, elevation_deg },
                 )
             }
             DriverSpec::Animation => {
-                let name = d
-                    .animation
-                    .as_deref()
-                    .ok_or_else(|| required("animation"))?;
+                let name = d.animation.as_deref().ok_or_else(|| required("animation"))?;
                 if let Some((f, why)) = g.unsupported_animations.get(name) {
                     return Err(SceneError::unsupported(
                         path,
@@ -153,31 +142,14 @@ pub(crate) fn build_space(
                 let (t0, t1) = anim.time_range();
                 let range = d.time.unwrap_or([t0, t1]);
                 let kind = kind_of(d.kind.unwrap_or(KindSpec::Time));
-                (
-                    kind,
-                    "s",
-                    (range, "time"),
-                    Driver::Animation {
-                        animation: name.to_owned(),
-                    },
-                )
+                (kind, "s", (range, "time"), Driver::Animation { animation: name.to_owned() })
             }
             DriverSpec::LightPath => {
                 let name = d.light.as_deref().ok_or_else(|| required("light"))?;
-                if !g
-                    .rig
-                    .lights
-                    .iter()
-                    .any(|l| l.name == name || g.rig.nodes[l.node].name == name)
+                if !g.rig.lights.iter().any(|l| l.name == name || g.rig.nodes[l.node].name == name)
                 {
                     let known = g.rig.lights.iter().map(|l| l.name.as_str());
-                    return Err(SceneError::unknown(
-                        path,
-                        field("light"),
-                        "light",
-                        name,
-                        known,
-                    ));
+                    return Err(SceneError::unknown(path, field("light"), "light", name, known));
                 }
                 let pts: Vec<Vec3> = d
                     .path
@@ -198,10 +170,7 @@ pub(crate) fn build_space(
                     check_kind(KindSpec::Light)?,
                     "",
                     (range, "range"),
-                    Driver::LightPath {
-                        light: name.to_owned(),
-                        path: pts,
-                    },
+                    Driver::LightPath { light: name.to_owned(), path: pts },
                 )
             }
         };
@@ -231,14 +200,8 @@ mod tests {
 
     #[test]
     fn values_inclusive_and_periodic() {
-        assert_eq!(
-            sample_values(0.0, 30.0, 4, false),
-            vec![0.0, 10.0, 20.0, 30.0]
-        );
-        assert_eq!(
-            sample_values(0.0, 360.0, 4, true),
-            vec![0.0, 90.0, 180.0, 270.0]
-        );
+        assert_eq!(sample_values(0.0, 30.0, 4, false), vec![0.0, 10.0, 20.0, 30.0]);
+        assert_eq!(sample_values(0.0, 360.0, 4, true), vec![0.0, 90.0, 180.0, 270.0]);
         assert_eq!(sample_values(5.0, 9.0, 1, false), vec![5.0]);
     }
 }

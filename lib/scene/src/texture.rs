@@ -137,7 +137,11 @@ mod tests {
 
     #[test]
     fn mean_of_texels() {
-        let t = TextureImage { width: 2, height: 1, texels: vec![[1.0, 0.0, 0.5, 1.0], [0.0, 0.0, 0.5, 0.0]] };
+        let t = TextureImage {
+            width: 2,
+            height: 1,
+            texels: vec![[1.0, 0.0, 0.5, 1.0], [0.0, 0.0, 0.5, 0.0]],
+        };
         assert_eq!(t.mean(), [0.5, 0.0, 0.5, 0.5]);
         assert_eq!(TextureImage { width: 2, height: 2, texels: vec![] }.mean(), [1.0; 4]);
     }

@@ -40,7 +40,8 @@ pub struct UvTransform {
 }
 
 impl UvTransform {
-    pub const IDENTITY: UvTransform = UvTransform { offset: [0.0; 2], rotation: 0.0, scale: [1.0; 2] };
+    pub const IDENTITY: UvTransform =
+        UvTransform { offset: [0.0; 2], rotation: 0.0, scale: [1.0; 2] };
 
     /// `uv` transformed.
     #[inline]
@@ -84,7 +85,11 @@ mod tests {
     /// scale ½ read the lower-left quadrant of the image, turned clockwise by 90°.
     #[test]
     fn texture_transform_rotation_follows_the_specification_example() {
-        let t = UvTransform { offset: [0.0, 1.0], rotation: std::f32::consts::FRAC_PI_2, scale: [0.5, 0.5] };
+        let t = UvTransform {
+            offset: [0.0, 1.0],
+            rotation: std::f32::consts::FRAC_PI_2,
+            scale: [0.5, 0.5],
+        };
         assert!(close(t.apply(Vec2::new(0.0, 0.0)), Vec2::new(0.0, 1.0)));
         assert!(close(t.apply(Vec2::new(1.0, 0.0)), Vec2::new(0.0, 0.5)));
         assert!(close(t.apply(Vec2::new(0.0, 1.0)), Vec2::new(0.5, 1.0)));

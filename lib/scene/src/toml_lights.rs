@@ -65,11 +65,15 @@ pub fn add_lights(rig: &mut Rig, specs: &[LightSpec], path: &Path) -> Result<(),
                 None => Ok(None),
             }
         };
-        let needs = |f: &str, v: Option<Vec3>| v.ok_or_else(|| bad(f, format!("a {:?} light needs `{f}`", s.kind).to_lowercase()));
+        let needs = |f: &str, v: Option<Vec3>| {
+            v.ok_or_else(|| bad(f, format!("a {:?} light needs `{f}`", s.kind).to_lowercase()))
+        };
         let position = finite3("position", s.position)?;
         let direction = finite3("direction", s.direction)?;
         let (position, direction) = match s.kind {
-            LightKindSpec::Point | LightKindSpec::Sphere => (needs("position", position)?, Vec3::NEG_Z),
+            LightKindSpec::Point | LightKindSpec::Sphere => {
+                (needs("position", position)?, Vec3::NEG_Z)
+            }
             LightKindSpec::Spot => (needs("position", position)?, needs("direction", direction)?),
             LightKindSpec::Directional => (Vec3::ZERO, needs("direction", direction)?),
         };
@@ -86,7 +90,12 @@ pub fn add_lights(rig: &mut Rig, specs: &[LightSpec], path: &Path) -> Result<(),
         }
         let radius = match (s.kind, s.radius) {
             (LightKindSpec::Sphere, Some(r)) if r.is_finite() && r > 0.0 => r,
-            (LightKindSpec::Sphere, r) => return Err(bad("radius", format!("a sphere light needs a radius > 0, found {r:?}"))),
+            (LightKindSpec::Sphere, r) => {
+                return Err(bad(
+                    "radius",
+                    format!("a sphere light needs a radius > 0, found {r:?}"),
+                ))
+            }
             (_, Some(_)) => return Err(bad("radius", "only a sphere light has a radius".into())),
             (_, None) => 0.0,
         };
@@ -95,11 +104,18 @@ pub fn add_lights(rig: &mut Rig, specs: &[LightSpec], path: &Path) -> Result<(),
                 let inner = s.inner_cone_deg.unwrap_or(0.0);
                 let outer = s.outer_cone_deg.unwrap_or(45.0);
                 if !(0.0 <= inner && inner < outer && outer <= 90.0) {
-                    return Err(bad("outer_cone_deg", format!("cone angles {inner}° and {outer}°: expected 0 ≤ inner < outer ≤ 90")));
+                    return Err(bad(
+                        "outer_cone_deg",
+                        format!(
+                            "cone angles {inner}° and {outer}°: expected 0 ≤ inner < outer ≤ 90"
+                        ),
+                    ));
                 }
                 LightKind::Spot { inner_cone: inner.to_radians(), outer_cone: outer.to_radians() }
             }
-            _ if s.inner_cone_deg.is_some() || s.outer_cone_deg.is_some() => return Err(bad("outer_cone_deg", "only a spot light has cone angles".into())),
+            _ if s.inner_cone_deg.is_some() || s.outer_cone_deg.is_some() => {
+                return Err(bad("outer_cone_deg", "only a spot light has cone angles".into()))
+            }
             LightKindSpec::Directional => LightKind::Directional,
             LightKindSpec::Point | LightKindSpec::Sphere => LightKind::Point,
         };
@@ -108,9 +124,19 @@ pub fn add_lights(rig: &mut Rig, specs: &[LightSpec], path: &Path) -> Result<(),
             name: s.name.clone(),
             gltf_index: usize::MAX,
             parent: None,
-            local: Trs { translation: position, rotation: Quat::from_rotation_arc(Vec3::NEG_Z, direction.normalize()), scale: Vec3::ONE },
+            local: Trs {
+                translation: position,
+                rotation: Quat::from_rotation_arc(Vec3::NEG_Z, direction.normalize()),
+                scale: Vec3::ONE,
+            },
         });
-        rig.lights.push(LightRig { name: s.name.clone(), node, kind, radiance: color.map(|c| c * intensity), radius });
+        rig.lights.push(LightRig {
+            name: s.name.clone(),
+            node,
+            kind,
+            radiance: color.map(|c| c * intensity),
+            radius,
+        });
     }
     Ok(())
 }

@@ -111,7 +111,8 @@ impl<'s> SceneGeometry<'s> {
             });
             for (p, prim) in object.primitives.iter().enumerate() {
                 let holes = scene.materials.get(prim.material).is_some_and(has_holes);
-                let world: Vec<Vec3> = prim.positions.iter().map(|&v| m.transform_point3(v)).collect();
+                let world: Vec<Vec3> =
+                    prim.positions.iter().map(|&v| m.transform_point3(v)).collect();
                 for (k, tri) in prim.indices.chunks_exact(3).enumerate() {
                     let v = |i: u32| world.get(i as usize).copied();
                     let (Some(a), Some(b), Some(c)) = (v(tri[0]), v(tri[1]), v(tri[2])) else {
@@ -140,7 +141,11 @@ impl<'s> SceneGeometry<'s> {
             hi = Vec3::ZERO;
             None
         } else {
-            Some(build_cwbvh_from_tris(&triangles, BvhBuildParams::medium_build(), &mut Duration::default()))
+            Some(build_cwbvh_from_tris(
+                &triangles,
+                BvhBuildParams::medium_build(),
+                &mut Duration::default(),
+            ))
         };
         SceneGeometry { scene, triangles, sources, placements, reflectors, bvh, bounds: (lo, hi) }
     }
@@ -241,7 +246,11 @@ impl<'s> SceneGeometry<'s> {
             (Some(&n0), Some(&n1), Some(&n2)) => {
                 let ns = place.normal_matrix * (n0 * w[0] + n1 * w[1] + n2 * w[2]);
                 let ns = ns.normalize_or_zero();
-                if ns == Vec3::ZERO { ng } else { ns }
+                if ns == Vec3::ZERO {
+                    ng
+                } else {
+                    ns
+                }
             }
             _ => ng,
         };
@@ -273,7 +282,16 @@ impl<'s> SceneGeometry<'s> {
     /// `idx` (world positions `p`) about the world shading normal `n`: the TANGENT
     /// attribute's where the primitive has one, else the triangle's own ([`crate::tangent`]).
     #[allow(clippy::too_many_arguments)]
-    fn tangent_frame(&self, prim: &Primitive, place: &Placement, idx: [usize; 3], w: [f32; 3], p: [Vec3; 3], n: Vec3, map: &TextureRef) -> (Vec3, Vec3) {
+    fn tangent_frame(
+        &self,
+        prim: &Primitive,
+        place: &Placement,
+        idx: [usize; 3],
+        w: [f32; 3],
+        p: [Vec3; 3],
+        n: Vec3,
+        map: &TextureRef,
+    ) -> (Vec3, Vec3) {
         let frame = match idx.map(|i| prim.tangents.get(i)) {
             [Some(t0), Some(t1), Some(t2)] => {
                 let t = *t0 * w[0] + *t1 * w[1] + *t2 * w[2];
@@ -281,7 +299,11 @@ impl<'s> SceneGeometry<'s> {
             }
             _ => {
                 let uv = idx.map(|i| {
-                    let set = if map.tex_coord == 1 && !prim.uvs1.is_empty() { &prim.uvs1 } else { &prim.uvs };
+                    let set = if map.tex_coord == 1 && !prim.uvs1.is_empty() {
+                        &prim.uvs1
+                    } else {
+                        &prim.uvs
+                    };
                     map.transform.apply(set.get(i).copied().unwrap_or(Vec2::ZERO))
                 });
                 triangle_frame(p, uv, n)
@@ -337,5 +359,9 @@ fn interpolated_uvs(prim: &Primitive, idx: [usize; 3], w: [f32; 3]) -> [Vec2; 2]
 /// Origin offset for a ray leaving surface point `p` with geometric normal `ng` towards `dir`.
 pub fn offset_origin(p: Vec3, ng: Vec3, dir: Vec3) -> Vec3 {
     let eps = 1e-4 * (1.0 + p.abs().max_element());
-    if dir.dot(ng) >= 0.0 { p + ng * eps } else { p - ng * eps }
+    if dir.dot(ng) >= 0.0 {
+        p + ng * eps
+    } else {
+        p - ng * eps
+    }
 }

@@ -56,7 +56,8 @@ pub fn projection_matrix(camera: &Camera, resolution: (u32, u32)) -> Mat4 {
     let aspect = resolution.0.max(1) as f32 / resolution.1.max(1) as f32;
     let f = 1.0 / (camera.yfov * 0.5).tan();
     let (n, far) = (camera.znear, camera.zfar);
-    let (c2z, c3z) = if far.is_finite() { (far / (n - far), n * far / (n - far)) } else { (-1.0, -n) };
+    let (c2z, c3z) =
+        if far.is_finite() { (far / (n - far), n * far / (n - far)) } else { (-1.0, -n) };
     Mat4::from_cols(
         Vec4::new(f / aspect, 0.0, 0.0, 0.0),
         Vec4::new(0.0, f, 0.0, 0.0),
@@ -93,7 +94,12 @@ mod tests {
             let r = f.cross(Vec3::Y).normalize();
             let u = r.cross(f);
             let cam = Camera {
-                world_from_camera: Mat4::from_cols(r.extend(0.0), u.extend(0.0), (-f).extend(0.0), eye.extend(1.0)),
+                world_from_camera: Mat4::from_cols(
+                    r.extend(0.0),
+                    u.extend(0.0),
+                    (-f).extend(0.0),
+                    eye.extend(1.0),
+                ),
                 yfov: 0.7,
                 znear: 0.1,
                 zfar,
@@ -101,11 +107,16 @@ mod tests {
             let (w, h) = (80u32, 60u32);
             let pc = PerspectiveCamera::new(&cam, (w, h));
             let clip_from_world = projection_matrix(&cam, (w, h)) * cam.world_from_camera.inverse();
-            for (px, depth) in [(Vec2::new(3.25, 7.5), 1.0f32), (Vec2::new(70.0, 55.5), 4.0), (Vec2::new(40.0, 30.0), 20.0)] {
+            for (px, depth) in [
+                (Vec2::new(3.25, 7.5), 1.0f32),
+                (Vec2::new(70.0, 55.5), 4.0),
+                (Vec2::new(40.0, 30.0), 20.0),
+            ] {
                 let p = pc.origin + pc.direction(px) * depth;
                 let c = clip_from_world * p.extend(1.0);
                 let ndc = c.truncate() / c.w;
-                let back = Vec2::new((ndc.x + 1.0) * 0.5 * w as f32, (1.0 - ndc.y) * 0.5 * h as f32);
+                let back =
+                    Vec2::new((ndc.x + 1.0) * 0.5 * w as f32, (1.0 - ndc.y) * 0.5 * h as f32);
                 assert!((back - px).length() < 1e-3, "{back} vs {px}");
                 assert!((0.0..=1.0).contains(&ndc.z), "depth {}", ndc.z);
             }

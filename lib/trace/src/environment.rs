@@ -80,7 +80,11 @@ impl<'s> EnvironmentLight<'s> {
 /// The balance heuristic: the weight of the strategy of density `a` against one of density
 /// `b` (0 when neither can draw the direction).
 pub fn balance(a: f32, b: f32) -> f32 {
-    if a + b > 0.0 { a / (a + b) } else { 0.0 }
+    if a + b > 0.0 {
+        a / (a + b)
+    } else {
+        0.0
+    }
 }
 
 #[cfg(test)]
@@ -90,10 +94,20 @@ mod tests {
     use pis_scene::LatLongImage;
     use std::sync::Arc;
 
-    fn image_environment(w: u32, h: u32, texel: impl Fn(u32, u32) -> [f32; 3], rotation_deg: f32) -> Environment {
-        let texels = (0..h).flat_map(|j| (0..w).map(move |i| (i, j))).map(|(i, j)| texel(i, j)).collect();
+    fn image_environment(
+        w: u32,
+        h: u32,
+        texel: impl Fn(u32, u32) -> [f32; 3],
+        rotation_deg: f32,
+    ) -> Environment {
+        let texels =
+            (0..h).flat_map(|j| (0..w).map(move |i| (i, j))).map(|(i, j)| texel(i, j)).collect();
         let image = LatLongImage::new("test.exr".into(), w, h, texels);
-        Environment { radiance: EnvironmentRadiance::Image(Arc::new(image)), rotation: rotation_deg.to_radians(), background: false }
+        Environment {
+            radiance: EnvironmentRadiance::Image(Arc::new(image)),
+            rotation: rotation_deg.to_radians(),
+            background: false,
+        }
     }
 
     /// Σ L cos / pdf over drawn directions estimates the irradiance: for an image bright in
@@ -103,7 +117,12 @@ mod tests {
     #[test]
     fn sampled_directions_integrate_the_image() {
         let l = 3.0;
-        let env = image_environment(64, 32, |i, _| if (16..48).contains(&i) { [l; 3] } else { [0.0; 3] }, 0.0);
+        let env = image_environment(
+            64,
+            32,
+            |i, _| if (16..48).contains(&i) { [l; 3] } else { [0.0; 3] },
+            0.0,
+        );
         let light = EnvironmentLight::new(&env).unwrap();
         let mut rng = Rng::new(5);
         let n_samples = 40_000;
@@ -121,11 +140,17 @@ mod tests {
                 sum += e as f64;
                 max = max.max(e);
             }
-            assert!(other_cell <= n_samples / 1000, "{other_cell} densities differ from the lookup");
+            assert!(
+                other_cell <= n_samples / 1000,
+                "{other_cell} densities differ from the lookup"
+            );
             let mean = sum / n_samples as f64;
             // Values lie in [0, max]: σ ≤ max/2; allow 4σ of the mean.
             let tolerance = 4.0 * (max as f64 / 2.0) / (n_samples as f64).sqrt() + 1e-6;
-            assert!((mean - expect as f64).abs() <= tolerance, "normal {normal}: {mean} vs {expect} ± {tolerance}");
+            assert!(
+                (mean - expect as f64).abs() <= tolerance,
+                "normal {normal}: {mean} vs {expect} ± {tolerance}"
+            );
         }
     }
 
@@ -133,7 +158,12 @@ mod tests {
     #[test]
     fn rotation_turns_the_image_about_up() {
         // Bright only in the centre column pair (u ≈ 0.5: +X in the image frame).
-        let env = image_environment(64, 32, |i, j| if (31..33).contains(&i) && (15..17).contains(&j) { [1.0; 3] } else { [0.0; 3] }, 90.0);
+        let env = image_environment(
+            64,
+            32,
+            |i, j| if (31..33).contains(&i) && (15..17).contains(&j) { [1.0; 3] } else { [0.0; 3] },
+            90.0,
+        );
         let light = EnvironmentLight::new(&env).unwrap();
         assert_eq!(light.radiance(Vec3::NEG_Z), Vec3::ONE);
         assert_eq!(light.radiance(Vec3::X), Vec3::ZERO);
@@ -146,7 +176,11 @@ mod tests {
 
     #[test]
     fn a_black_environment_is_not_sampled() {
-        let env = Environment { radiance: EnvironmentRadiance::Uniform([0.0; 3]), rotation: 0.0, background: false };
+        let env = Environment {
+            radiance: EnvironmentRadiance::Uniform([0.0; 3]),
+            rotation: 0.0,
+            background: false,
+        };
         assert!(EnvironmentLight::new(&env).is_none());
         let black = image_environment(4, 2, |_, _| [0.0; 3], 0.0);
         assert!(EnvironmentLight::new(&black).is_none());

@@ -134,7 +134,11 @@ impl<'s> Integrator<'s> {
             Some(c) => c.max(0.0),
             None => {
                 let diag = (geometry.bounds.1 - geometry.bounds.0).length();
-                if diag > 0.0 { diag / 4096.0 } else { 0.0 }
+                if diag > 0.0 {
+                    diag / 4096.0
+                } else {
+                    0.0
+                }
             }
         };
         let environment = scene.environment.as_ref().and_then(EnvironmentLight::new);
@@ -161,7 +165,16 @@ impl<'s> Integrator<'s> {
     /// normal the environment was drawn for); where it hits, as [`Self::radiance`] with light
     /// spheres unseen.
     #[allow(clippy::too_many_arguments)]
-    fn radiance_mis(&self, origin: Vec3, dir: Vec3, depth: u32, diffuse_left: u32, lobe_pdf: f32, n: Vec3, ctx: &mut PathContext) -> Vec3 {
+    fn radiance_mis(
+        &self,
+        origin: Vec3,
+        dir: Vec3,
+        depth: u32,
+        diffuse_left: u32,
+        lobe_pdf: f32,
+        n: Vec3,
+        ctx: &mut PathContext,
+    ) -> Vec3 {
         if depth > self.settings.max_depth {
             return Vec3::ZERO;
         }
@@ -196,7 +209,13 @@ impl<'s> Integrator<'s> {
     }
 
     /// Closest hit along a ray, counting it.
-    fn trace(&self, origin: Vec3, dir: Vec3, skip: Option<u32>, ctx: &mut PathContext) -> Option<Hit> {
+    fn trace(
+        &self,
+        origin: Vec3,
+        dir: Vec3,
+        skip: Option<u32>,
+        ctx: &mut PathContext,
+    ) -> Option<Hit> {
         ctx.rays += 1;
         self.geometry.closest(origin, dir, f32::INFINITY, skip)
     }
@@ -283,7 +302,16 @@ impl<'s> Integrator<'s> {
         if picks_first(u, p_d, rest.0 + rest.1) {
             self.diffuse(sp, m, depth, diffuse_left, rng, ctx) * (total / p_d)
         } else {
-            self.scatter_nondiffuse(sp, m, dir, depth, diffuse_left, rng, ctx, Some((u - p_d, rest))) * (total / (rest.0 + rest.1))
+            self.scatter_nondiffuse(
+                sp,
+                m,
+                dir,
+                depth,
+                diffuse_left,
+                rng,
+                ctx,
+                Some((u - p_d, rest)),
+            ) * (total / (rest.0 + rest.1))
         }
     }
 
@@ -332,19 +360,30 @@ impl<'s> Integrator<'s> {
             // Rough lobes reach the lights by next-event estimation, their sampled rays do
             // not see light spheres; glossy and mirror lobes see them along sampled rays.
             let rough = m.alpha >= NEE_ALPHA;
-            let direct = if rough { self.specular_direct(sp, m, dir, rng, ctx) } else { Vec3::ZERO };
+            let direct =
+                if rough { self.specular_direct(sp, m, dir, rng, ctx) } else { Vec3::ZERO };
             let Some((d, f, g)) = self.sample_specular(sp, m, dir, rng) else {
                 return direct * (1.0 - m.transmission) * (total / p_s);
             };
             let o = offset_origin(sp.position, sp.geometric_normal, d);
             let l = if rough && self.environment.is_some() {
-                self.radiance_mis(o, d, depth + 1, diffuse_left, ggx_reflection_pdf(sp.normal, -dir, d, m.alpha), sp.normal, ctx)
+                self.radiance_mis(
+                    o,
+                    d,
+                    depth + 1,
+                    diffuse_left,
+                    ggx_reflection_pdf(sp.normal, -dir, d, m.alpha),
+                    sp.normal,
+                    ctx,
+                )
             } else {
                 self.radiance(o, d, depth + 1, diffuse_left, !rough, None, ctx)
             };
             (direct + l * f * g) * (1.0 - m.transmission) * (total / p_s)
         } else {
-            self.dielectric(sp, m, dir, depth, diffuse_left, rng, ctx) * m.transmission * (total / p_t)
+            self.dielectric(sp, m, dir, depth, diffuse_left, rng, ctx)
+                * m.transmission
+                * (total / p_t)
         }
     }
 
@@ -387,7 +426,11 @@ impl<'s> Integrator<'s> {
                 }
                 let o = offset_origin(sp.position, sp.geometric_normal, ls.direction);
                 ctx.rays += 1;
-                let tmax = if ls.distance.is_finite() { ls.distance * (1.0 - 1e-4) } else { f32::INFINITY };
+                let tmax = if ls.distance.is_finite() {
+                    ls.distance * (1.0 - 1e-4)
+                } else {
+                    f32::INFINITY
+                };
                 if !self.geometry.occluded(o, ls.direction, tmax) {
                     direct += ls.weight * cos;
                 }
@@ -403,7 +446,15 @@ impl<'s> Integrator<'s> {
                 }
                 let o = offset_origin(sp.position, sp.geometric_normal, d);
                 indirect += if self.environment.is_some() {
-                    self.radiance_mis(o, d, depth + 1, diffuse_left - 1, diffuse_pdf(n, sp.geometric_normal, d), n, ctx)
+                    self.radiance_mis(
+                        o,
+                        d,
+                        depth + 1,
+                        diffuse_left - 1,
+                        diffuse_pdf(n, sp.geometric_normal, d),
+                        n,
+                        ctx,
+                    )
                 } else {
                     self.radiance(o, d, depth + 1, diffuse_left - 1, false, None, ctx)
                 };
@@ -416,7 +467,13 @@ impl<'s> Integrator<'s> {
     /// the diffuse lobe's sampled ray when `bounce` (that ray is traced). Both estimate
     /// ∫ L p_d with p_d the diffuse lobe's density ([`diffuse_pdf`]): each contributes
     /// L · p_d / (p_env + p_d) with the balance heuristic.
-    fn environment_direct(&self, sp: &SurfacePoint, bounce: bool, rng: &mut Rng, ctx: &mut PathContext) -> Vec3 {
+    fn environment_direct(
+        &self,
+        sp: &SurfacePoint,
+        bounce: bool,
+        rng: &mut Rng,
+        ctx: &mut PathContext,
+    ) -> Vec3 {
         let Some(env) = &self.environment else { return Vec3::ZERO };
         let Some(s) = env.sample(sp.normal, rng.next_2d()) else { return Vec3::ZERO };
         let p_d = diffuse_pdf(sp.normal, sp.geometric_normal, s.direction);
@@ -436,7 +493,12 @@ impl<'s> Integrator<'s> {
     /// the cell) at the first point that reaches the cell, and reused by later camera samples
     /// of the same image row (the cache lives in `ctx`, one per row, so the result does not
     /// depend on the thread count).
-    fn first_irradiance(&self, sp: &SurfacePoint, diffuse_left: u32, ctx: &mut PathContext) -> Vec3 {
+    fn first_irradiance(
+        &self,
+        sp: &SurfacePoint,
+        diffuse_left: u32,
+        ctx: &mut PathContext,
+    ) -> Vec3 {
         let samples = self.settings.diffuse_samples.max(1);
         if self.cell <= 0.0 {
             let mut rng = Rng::at_surface(sp.object_position, 0.0, sp.object, 0, ctx.fallback_seed);
@@ -447,14 +509,22 @@ impl<'s> Integrator<'s> {
         if let Some(&e) = ctx.irradiance_cache.get(&key) {
             return e;
         }
-        let mut rng = Rng::at_surface(sp.object_position, self.cell, sp.object, 0, ctx.fallback_seed);
+        let mut rng =
+            Rng::at_surface(sp.object_position, self.cell, sp.object, 0, ctx.fallback_seed);
         let e = self.irradiance(sp, 0, diffuse_left, samples, &mut rng, ctx);
         ctx.irradiance_cache.insert(key, e);
         e
     }
 
     /// Next-event estimation for the opaque GGX lobe: Σ lights f_s(v, l) L cos θ_l / pdf.
-    fn specular_direct(&self, sp: &SurfacePoint, m: &ShadingMaterial, dir: Vec3, rng: &mut Rng, ctx: &mut PathContext) -> Vec3 {
+    fn specular_direct(
+        &self,
+        sp: &SurfacePoint,
+        m: &ShadingMaterial,
+        dir: Vec3,
+        rng: &mut Rng,
+        ctx: &mut PathContext,
+    ) -> Vec3 {
         let (wo, n) = (-dir, sp.normal);
         let cos_o = wo.dot(n);
         if cos_o <= 0.0 {
@@ -467,7 +537,8 @@ impl<'s> Integrator<'s> {
             let Some((f, lobe)) = ggx_reflection(sp, m, wo, l, cos_o) else { continue };
             let o = offset_origin(sp.position, sp.geometric_normal, l);
             ctx.rays += 1;
-            let tmax = if ls.distance.is_finite() { ls.distance * (1.0 - 1e-4) } else { f32::INFINITY };
+            let tmax =
+                if ls.distance.is_finite() { ls.distance * (1.0 - 1e-4) } else { f32::INFINITY };
             if !self.geometry.occluded(o, l, tmax) {
                 sum += f * ls.weight * lobe;
             }
@@ -489,7 +560,13 @@ impl<'s> Integrator<'s> {
 
     /// Samples the opaque specular lobe: (direction, Fresnel, geometric weight), so that the
     /// estimator of the reflected radiance is F · g · L(direction).
-    fn sample_specular(&self, sp: &SurfacePoint, m: &ShadingMaterial, dir: Vec3, rng: &mut Rng) -> Option<(Vec3, Vec3, f32)> {
+    fn sample_specular(
+        &self,
+        sp: &SurfacePoint,
+        m: &ShadingMaterial,
+        dir: Vec3,
+        rng: &mut Rng,
+    ) -> Option<(Vec3, Vec3, f32)> {
         let wo = -dir;
         let n = sp.normal;
         let cos_o = wo.dot(n);
@@ -530,11 +607,20 @@ impl<'s> Integrator<'s> {
             // At a camera ray's first hit both children are traced (weights F and 1 − F),
             // deeper interfaces choose one by Fresnel.
             let r = reflect(dir, n);
-            let reflected = self.radiance(offset_origin(sp.position, sp.geometric_normal, r), r, 1, diffuse_left, true, None, ctx);
+            let reflected = self.radiance(
+                offset_origin(sp.position, sp.geometric_normal, r),
+                r,
+                1,
+                diffuse_left,
+                true,
+                None,
+                ctx,
+            );
             let refracted = match refract(dir, n, eta) {
                 Some(t) => {
                     let o = offset_origin(sp.position, sp.geometric_normal, t);
-                    self.radiance(o, t, 1, diffuse_left, true, None, ctx) * if sp.front_face { m.base } else { Vec3::ONE }
+                    self.radiance(o, t, 1, diffuse_left, true, None, ctx)
+                        * if sp.front_face { m.base } else { Vec3::ONE }
                 }
                 None => reflected / f.max(1e-6) * (1.0 - f),
             };
@@ -554,7 +640,13 @@ impl<'s> Integrator<'s> {
 
     /// Traces one camera ray and segments its radiance (thesis 3.1, 5.7, 6.2).
     /// `record` asks for the outgoing-ray records of refractive objects.
-    pub fn camera_sample(&self, origin: Vec3, dir: Vec3, record: bool, ctx: &mut PathContext) -> CameraSample {
+    pub fn camera_sample(
+        &self,
+        origin: Vec3,
+        dir: Vec3,
+        record: bool,
+        ctx: &mut PathContext,
+    ) -> CameraSample {
         let hit = self.trace(origin, dir, None, ctx);
         let tmax = hit.map_or(f32::INFINITY, |h| h.t);
         if let Some((_, l)) = hit_light_sphere(&self.frame.lights, origin, dir, tmax) {
@@ -584,21 +676,26 @@ impl<'s> Integrator<'s> {
         let mut specular = m.emission;
         match role {
             ObjectRole::Reflective => {
-                let (refl, contrib) = self.reflective_layers(&sp, &m, dir, hit.object, diffuse_left, &mut rng, ctx);
+                let (refl, contrib) =
+                    self.reflective_layers(&sp, &m, dir, hit.object, diffuse_left, &mut rng, ctx);
                 out.reflective = Some(refl);
                 specular += contrib;
                 if m.transmission > 0.0 {
-                    specular += self.dielectric(&sp, &m, dir, 0, diffuse_left, &mut rng, ctx) * m.transmission;
+                    specular += self.dielectric(&sp, &m, dir, 0, diffuse_left, &mut rng, ctx)
+                        * m.transmission;
                 }
             }
             ObjectRole::Refractive => {
-                let terms = [GreedyTerm::ReflectionFirst, GreedyTerm::RefractionFirst]
-                    .map(|t| self.greedy_term(&sp, &m, dir, hit.object, t, record, diffuse_left, ctx));
+                let terms = [GreedyTerm::ReflectionFirst, GreedyTerm::RefractionFirst].map(|t| {
+                    self.greedy_term(&sp, &m, dir, hit.object, t, record, diffuse_left, ctx)
+                });
                 out.lens = Some(terms);
-                specular += self.scatter_nondiffuse(&sp, &m, dir, 0, diffuse_left, &mut rng, ctx, None);
+                specular +=
+                    self.scatter_nondiffuse(&sp, &m, dir, 0, diffuse_left, &mut rng, ctx, None);
             }
             ObjectRole::Diffuse => {
-                specular += self.scatter_nondiffuse(&sp, &m, dir, 0, diffuse_left, &mut rng, ctx, None);
+                specular +=
+                    self.scatter_nondiffuse(&sp, &m, dir, 0, diffuse_left, &mut rng, ctx, None);
             }
         }
         out.specular = specular;
@@ -625,7 +722,9 @@ impl<'s> Integrator<'s> {
         let Some((d, f, g)) = self.sample_specular(sp, m, dir, rng) else { return (s, Vec3::ZERO) };
         let o = offset_origin(sp.position, sp.geometric_normal, d);
         let hit = self.trace(o, d, None, ctx);
-        let light_first = hit_light_sphere(&self.frame.lights, o, d, hit.map_or(f32::INFINITY, |h| h.t)).is_some();
+        let light_first =
+            hit_light_sphere(&self.frame.lights, o, d, hit.map_or(f32::INFINITY, |h| h.t))
+                .is_some();
         let incident = self.radiance_from(hit, o, d, 1, diffuse_left, true, ctx) * g;
         let reflectors = &self.geometry.reflectors;
         let reflector = reflectors[object as usize];
@@ -659,7 +758,9 @@ impl<'s> Integrator<'s> {
         let (mut d, mut modulation) = match term {
             GreedyTerm::ReflectionFirst => (reflect(dir, sp.normal), Vec3::splat(f)),
             GreedyTerm::RefractionFirst => match refract(dir, sp.normal, eta) {
-                Some(t) => (t, Vec3::splat(1.0 - f) * if sp.front_face { m.base } else { Vec3::ONE }),
+                Some(t) => {
+                    (t, Vec3::splat(1.0 - f) * if sp.front_face { m.base } else { Vec3::ONE })
+                }
                 None => return out,
             },
         };
@@ -667,7 +768,9 @@ impl<'s> Integrator<'s> {
         for _ in 0..self.settings.max_depth {
             let o = offset_origin(p, ng, d);
             let hit = self.trace(o, d, None, ctx);
-            let light_first = hit_light_sphere(&self.frame.lights, o, d, hit.map_or(f32::INFINITY, |h| h.t)).is_some();
+            let light_first =
+                hit_light_sphere(&self.frame.lights, o, d, hit.map_or(f32::INFINITY, |h| h.t))
+                    .is_some();
             match hit {
                 Some(h) if h.object == object && !light_first => {
                     let mut s2 = self.geometry.surface(&h, o, d);
@@ -678,7 +781,8 @@ impl<'s> Integrator<'s> {
                     let refracted = if f2 < 0.5 { refract(d, s2.normal, eta2) } else { None };
                     match refracted {
                         Some(t) => {
-                            modulation *= (1.0 - f2) * if s2.front_face { m2.base } else { Vec3::ONE };
+                            modulation *=
+                                (1.0 - f2) * if s2.front_face { m2.base } else { Vec3::ONE };
                             d = t;
                         }
                         None => {
@@ -705,7 +809,14 @@ impl<'s> Integrator<'s> {
 
     /// Every front-facing hit on environment geometry (not `object`) along a continued ray,
     /// nearest first, with the radiance leaving each towards the ray origin (thesis 6.3.1).
-    fn continued_hits(&self, o: Vec3, d: Vec3, object: u32, diffuse_left: u32, ctx: &mut PathContext) -> Vec<ContinuedHit> {
+    fn continued_hits(
+        &self,
+        o: Vec3,
+        d: Vec3,
+        object: u32,
+        diffuse_left: u32,
+        ctx: &mut PathContext,
+    ) -> Vec<ContinuedHit> {
         ctx.rays += 1;
         let mut hits = Vec::new();
         for h in self.geometry.all_hits(o, d, f32::INFINITY) {
@@ -745,7 +856,13 @@ pub fn diffuse_pdf(n: Vec3, ng: Vec3, d: Vec3) -> f32 {
 /// n·wo > 0): its Fresnel factor and D G / (4 cos_o), so that the reflected radiance of light
 /// L arriving along `l` is F · L · that; `None` where `l` is below the shading or the
 /// geometric surface.
-fn ggx_reflection(sp: &SurfacePoint, m: &ShadingMaterial, wo: Vec3, l: Vec3, cos_o: f32) -> Option<(Vec3, f32)> {
+fn ggx_reflection(
+    sp: &SurfacePoint,
+    m: &ShadingMaterial,
+    wo: Vec3,
+    l: Vec3,
+    cos_o: f32,
+) -> Option<(Vec3, f32)> {
     let n = sp.normal;
     let cos_l = n.dot(l);
     if cos_l <= 0.0 || sp.geometric_normal.dot(l) <= 0.0 {
@@ -789,7 +906,11 @@ mod tests {
         let u = 0.999_999_94f32 * total;
         assert!(!picks_first(u, p_d, p_s + p_t));
         assert!(picks_first(u - p_d, p_s, p_t), "u − p_d = {} against p_s = {p_s}", u - p_d);
-        assert!(picks_first(total, p_s, 0.0) && !picks_first(0.0, 0.0, 0.5) && picks_first(1.0, 1.0, 0.0));
+        assert!(
+            picks_first(total, p_s, 0.0)
+                && !picks_first(0.0, 0.0, 0.5)
+                && picks_first(1.0, 1.0, 0.0)
+        );
         assert!(picks_first(0.2, 0.5, 0.5) && !picks_first(0.7, 0.5, 0.5));
         for k in 0..1000 {
             let u = k as f32 / 1000.0 * total;

@@ -259,7 +259,12 @@ pub fn confidence(dirs: &[Vec3]) -> f32 {
 
 /// Fills the images of one point from per-pixel accumulators (row-major).
 /// `objects` gives each object's channel name and role, in scene order.
-pub fn resolve(pixels: &[PixelAccum], width: u32, height: u32, objects: &[(String, ObjectRole)]) -> PointImages {
+pub fn resolve(
+    pixels: &[PixelAccum],
+    width: u32,
+    height: u32,
+    objects: &[(String, ObjectRole)],
+) -> PointImages {
     let mut layers = vec![LayerImage::new("combined".into(), &["R", "G", "B"], width, height)];
     let mut first_layer = Vec::with_capacity(objects.len());
     for (name, role) in objects {
@@ -294,10 +299,14 @@ pub fn resolve(pixels: &[PixelAccum], width: u32, height: u32, objects: &[(Strin
                     LayerKind::Distant => put(img, i, a.distant / c),
                     LayerKind::Reflection => put(img, i, a.term_value[0] / c),
                     LayerKind::ReflectionModulation => put(img, i, a.term_modulation[0] / c),
-                    LayerKind::ReflectionConfidence => img.planes[0][i] = confidence(&a.exit_dirs[0]),
+                    LayerKind::ReflectionConfidence => {
+                        img.planes[0][i] = confidence(&a.exit_dirs[0])
+                    }
                     LayerKind::Refraction => put(img, i, a.term_value[1] / c),
                     LayerKind::RefractionModulation => put(img, i, a.term_modulation[1] / c),
-                    LayerKind::RefractionConfidence => img.planes[0][i] = confidence(&a.exit_dirs[1]),
+                    LayerKind::RefractionConfidence => {
+                        img.planes[0][i] = confidence(&a.exit_dirs[1])
+                    }
                 }
             }
         }
@@ -317,6 +326,9 @@ mod tests {
         assert!((confidence(&[a, b]) - 0.75).abs() < 1e-3);
         let c = glam::Quat::from_rotation_x(6f32.to_radians()) * a;
         assert_eq!(confidence(&[a, b, c]), 0.0);
-        assert_eq!(LayerKind::from_name("refraction_modulation"), Some(LayerKind::RefractionModulation));
+        assert_eq!(
+            LayerKind::from_name("refraction_modulation"),
+            Some(LayerKind::RefractionModulation)
+        );
     }
 }

@@ -28,7 +28,13 @@ fn spot_factor(light: &Light, to_point: Vec3) -> f32 {
         LightKind::Spot { inner_cone, outer_cone } => {
             let c = to_point.dot(light.direction.normalize_or_zero());
             let (ci, co) = (inner_cone.cos(), outer_cone.cos());
-            let t = if ci - co > 1e-6 { ((c - co) / (ci - co)).clamp(0.0, 1.0) } else if c >= co { 1.0 } else { 0.0 };
+            let t = if ci - co > 1e-6 {
+                ((c - co) / (ci - co)).clamp(0.0, 1.0)
+            } else if c >= co {
+                1.0
+            } else {
+                0.0
+            };
             t * t
         }
         _ => 1.0,
@@ -46,7 +52,11 @@ pub fn sample_light(light: &Light, p: Vec3, rng: &mut Rng) -> Option<LightSample
     match light.kind {
         LightKind::Directional => {
             let d = -light.direction.normalize_or_zero();
-            (d != Vec3::ZERO).then_some(LightSample { direction: d, distance: f32::INFINITY, weight: intensity })
+            (d != Vec3::ZERO).then_some(LightSample {
+                direction: d,
+                distance: f32::INFINITY,
+                weight: intensity,
+            })
         }
         _ => {
             let to_light = light.position - p;
@@ -61,7 +71,11 @@ pub fn sample_light(light: &Light, p: Vec3, rng: &mut Rng) -> Option<LightSample
                 return None;
             }
             if light.radius <= 0.0 {
-                return Some(LightSample { direction: axis, distance: dist, weight: intensity * spot / d2 });
+                return Some(LightSample {
+                    direction: axis,
+                    distance: dist,
+                    weight: intensity * spot / d2,
+                });
             }
             let r = light.radius;
             if dist <= r * 1.0001 {
@@ -74,13 +88,22 @@ pub fn sample_light(light: &Light, p: Vec3, rng: &mut Rng) -> Option<LightSample
             let disc = b * b - (d2 - r * r);
             let t = b - disc.max(0.0).sqrt();
             let solid_angle = 2.0 * PI * (1.0 - cos_max);
-            Some(LightSample { direction: dir, distance: t.max(0.0), weight: sphere_radiance(light) * spot * solid_angle })
+            Some(LightSample {
+                direction: dir,
+                distance: t.max(0.0),
+                weight: sphere_radiance(light) * spot * solid_angle,
+            })
         }
     }
 }
 
 /// The nearest visible light sphere along a ray within `tmax`: (t, emitted radiance).
-pub fn hit_light_sphere(lights: &[Light], origin: Vec3, dir: Vec3, tmax: f32) -> Option<(f32, Vec3)> {
+pub fn hit_light_sphere(
+    lights: &[Light],
+    origin: Vec3,
+    dir: Vec3,
+    tmax: f32,
+) -> Option<(f32, Vec3)> {
     let mut best: Option<(f32, Vec3)> = None;
     for light in lights {
         if light.radius <= 0.0 || light.kind == LightKind::Directional {

@@ -48,7 +48,8 @@ impl ShadingMaterial {
     /// Evaluates `material` at a point whose texture-coordinate sets are `uvs` (TEXCOORD_0,
     /// TEXCOORD_1).
     pub fn at_uvs(scene: &Scene, material: &Material, uvs: [Vec2; 2]) -> ShadingMaterial {
-        let mut base = Vec3::new(material.base_color[0], material.base_color[1], material.base_color[2]);
+        let mut base =
+            Vec3::new(material.base_color[0], material.base_color[1], material.base_color[2]);
         if let Some(t) = lookup(scene, material.base_color_texture.as_ref(), uvs) {
             base *= t.truncate();
         }
@@ -67,12 +68,16 @@ impl ShadingMaterial {
         let r0 = ((ior - 1.0) / (ior + 1.0)).powi(2);
         let dielectric_f0 = (Vec3::from(material.specular_color) * r0).min(Vec3::ONE);
         let roughness = roughness.clamp(0.0, 1.0);
-        let sigma_a = if material.attenuation_distance.is_finite() && material.attenuation_distance > 0.0 {
-            Vec3::from(material.attenuation_color).max(Vec3::splat(1e-6)).min(Vec3::ONE).map(|c| -c.ln())
-                / material.attenuation_distance
-        } else {
-            Vec3::ZERO
-        };
+        let sigma_a =
+            if material.attenuation_distance.is_finite() && material.attenuation_distance > 0.0 {
+                Vec3::from(material.attenuation_color)
+                    .max(Vec3::splat(1e-6))
+                    .min(Vec3::ONE)
+                    .map(|c| -c.ln())
+                    / material.attenuation_distance
+            } else {
+                Vec3::ZERO
+            };
         ShadingMaterial {
             base,
             diffuse: base * (1.0 - metallic) * (1.0 - transmission),
@@ -116,7 +121,11 @@ pub fn has_holes(material: &Material) -> bool {
 pub fn alpha(scene: &Scene, material: &Material, uvs: [Vec2; 2]) -> f32 {
     let t = lookup(scene, material.base_color_texture.as_ref(), uvs).map_or(1.0, |t| t.w);
     let a = material.base_color[3] * t;
-    if a.is_finite() { a.clamp(0.0, 1.0) } else { 1.0 }
+    if a.is_finite() {
+        a.clamp(0.0, 1.0)
+    } else {
+        1.0
+    }
 }
 
 /// Whether a ray passes through `material` where its coverage is `alpha`: below the cutoff
@@ -205,23 +214,38 @@ mod tests {
 
     fn texture(texels: Vec<[f32; 4]>) -> Scene {
         let width = texels.len() as u32;
-        Scene { textures: vec![pis_scene::TextureImage { width, height: 1, texels }], ..Scene::default() }
+        Scene {
+            textures: vec![pis_scene::TextureImage { width, height: 1, texels }],
+            ..Scene::default()
+        }
     }
 
     #[test]
     fn emissive_map_modulates_emissive_factor() {
         // Emissive factor 1 with a map black on its left half: the left does not glow.
         let s = texture(vec![[0.0, 0.0, 0.0, 1.0], [1.0, 0.5, 0.25, 1.0]]);
-        let m = Material { emissive: [1.0; 3], emissive_texture: Some(pis_scene::TextureRef::new(0)), ..Material::default() };
+        let m = Material {
+            emissive: [1.0; 3],
+            emissive_texture: Some(pis_scene::TextureRef::new(0)),
+            ..Material::default()
+        };
         assert_eq!(ShadingMaterial::at(&s, &m, Vec2::new(0.25, 0.5)).emission, Vec3::ZERO);
-        assert_eq!(ShadingMaterial::at(&s, &m, Vec2::new(0.75, 0.5)).emission, Vec3::new(1.0, 0.5, 0.25));
+        assert_eq!(
+            ShadingMaterial::at(&s, &m, Vec2::new(0.75, 0.5)).emission,
+            Vec3::new(1.0, 0.5, 0.25)
+        );
     }
 
     #[test]
     fn metallic_roughness_map_is_read_per_texel() {
         // Factors 1 with a map of a rough dielectric texel beside a polished metal one.
         let s = texture(vec![[0.0, 0.9, 0.0, 1.0], [0.0, 0.1, 1.0, 1.0]]);
-        let m = Material { metallic: 1.0, roughness: 1.0, metallic_roughness_texture: Some(pis_scene::TextureRef::new(0)), ..Material::default() };
+        let m = Material {
+            metallic: 1.0,
+            roughness: 1.0,
+            metallic_roughness_texture: Some(pis_scene::TextureRef::new(0)),
+            ..Material::default()
+        };
         let left = ShadingMaterial::at(&s, &m, Vec2::new(0.25, 0.5));
         let right = ShadingMaterial::at(&s, &m, Vec2::new(0.75, 0.5));
         assert_eq!(left.metallic, 0.0);
@@ -234,13 +258,20 @@ mod tests {
     fn alpha_modes_decide_which_rays_pass() {
         let s = texture(vec![[1.0, 1.0, 1.0, 0.2], [1.0, 1.0, 1.0, 0.8]]);
         let tex = Some(pis_scene::TextureRef::new(0));
-        let mask = Material { base_color_texture: tex, alpha_mode: AlphaMode::Mask { cutoff: 0.5 }, ..Material::default() };
+        let mask = Material {
+            base_color_texture: tex,
+            alpha_mode: AlphaMode::Mask { cutoff: 0.5 },
+            ..Material::default()
+        };
         let (low, high) = ([Vec2::new(0.25, 0.5); 2], [Vec2::new(0.75, 0.5); 2]);
         assert!(has_holes(&mask));
         assert!(passes(&mask, alpha(&s, &mask, low), 0.0));
         assert!(!passes(&mask, alpha(&s, &mask, high), 0.99));
         let blend = Material { alpha_mode: AlphaMode::Blend, ..mask.clone() };
-        assert!(passes(&blend, alpha(&s, &blend, high), 0.9) && !passes(&blend, alpha(&s, &blend, high), 0.7));
+        assert!(
+            passes(&blend, alpha(&s, &blend, high), 0.9)
+                && !passes(&blend, alpha(&s, &blend, high), 0.7)
+        );
         let opaque = Material { alpha_mode: AlphaMode::Opaque, ..mask.clone() };
         assert!(!has_holes(&opaque) && !passes(&opaque, 0.0, 0.5));
         // Without a texture, an opaque factor makes no holes.

@@ -26,12 +26,19 @@ pub fn peak_resident() -> Option<u64> {
 
 /// Float channels of one point's images: `combined` and every object's layers for its role.
 pub fn point_channels(roles: impl IntoIterator<Item = ObjectRole>) -> u64 {
-    3 + roles.into_iter().map(|r| LayerKind::for_role(r).iter().map(|l| l.channels().len() as u64).sum::<u64>()).sum::<u64>()
+    3 + roles
+        .into_iter()
+        .map(|r| LayerKind::for_role(r).iter().map(|l| l.channels().len() as u64).sum::<u64>())
+        .sum::<u64>()
 }
 
 /// Bytes of `channels` float images of `width`×`height` pixels, `copies` times.
 pub fn image_bytes(width: u32, height: u32, channels: u64, copies: u64) -> u64 {
-    (width as u64).saturating_mul(height as u64).saturating_mul(channels).saturating_mul(4).saturating_mul(copies)
+    (width as u64)
+        .saturating_mul(height as u64)
+        .saturating_mul(channels)
+        .saturating_mul(4)
+        .saturating_mul(copies)
 }
 
 /// `bytes` as GiB with two decimals.
@@ -48,6 +55,10 @@ mod tests {
         // combined RGB + diffuse object: coverage A, diffuse RGB, specular RGB
         assert_eq!(point_channels([ObjectRole::Diffuse]), 3 + 7);
         assert_eq!(image_bytes(640, 480, 10, 1), 640 * 480 * 10 * 4);
-        assert_eq!(image_bytes(u32::MAX, u32::MAX, u64::MAX, 3), u64::MAX, "saturates, never wraps");
+        assert_eq!(
+            image_bytes(u32::MAX, u32::MAX, u64::MAX, 3),
+            u64::MAX,
+            "saturates, never wraps"
+        );
     }
 }

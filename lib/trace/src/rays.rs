@@ -39,7 +39,10 @@ pub fn trace_rays(
     }
     if frame.instances.len() != scene.objects.len() {
         return Err(TraceError::InvalidInput(format!(
-            "frame places {} objects, the scene has {}", frame.instances.len(), scene.objects.len())));
+            "frame places {} objects, the scene has {}",
+            frame.instances.len(),
+            scene.objects.len()
+        )));
     }
     let integrator = Integrator::new(scene, frame, settings);
     let out = rays
@@ -48,22 +51,31 @@ pub fn trace_rays(
         .flat_map_iter(|(c, chunk)| {
             let mut ctx = PathContext::default();
             let integrator = &integrator;
-            chunk.iter().enumerate().map(move |(k, &(origin, dir))| {
-                let mut acc = RayRadiance::default();
-                let seed = hash_keys(&[(c * CHUNK + k) as u64, 0x7261_7973]);
-                for s in 0..samples {
-                    ctx.fallback_seed = hash_keys(&[seed, s as u64]);
-                    let sample = integrator.camera_sample(origin, dir, false, &mut ctx);
-                    if s == 0 {
-                        acc.object = sample.object;
+            chunk
+                .iter()
+                .enumerate()
+                .map(move |(k, &(origin, dir))| {
+                    let mut acc = RayRadiance::default();
+                    let seed = hash_keys(&[(c * CHUNK + k) as u64, 0x7261_7973]);
+                    for s in 0..samples {
+                        ctx.fallback_seed = hash_keys(&[seed, s as u64]);
+                        let sample = integrator.camera_sample(origin, dir, false, &mut ctx);
+                        if s == 0 {
+                            acc.object = sample.object;
+                        }
+                        acc.combined += sample.combined;
+                        acc.diffuse += sample.diffuse;
+                        acc.specular += sample.specular;
                     }
-                    acc.combined += sample.combined;
-                    acc.diffuse += sample.diffuse;
-                    acc.specular += sample.specular;
-                }
-                let k = 1.0 / samples as f32;
-                RayRadiance { combined: acc.combined * k, diffuse: acc.diffuse * k, specular: acc.specular * k, ..acc }
-            }).collect::<Vec<_>>()
+                    let k = 1.0 / samples as f32;
+                    RayRadiance {
+                        combined: acc.combined * k,
+                        diffuse: acc.diffuse * k,
+                        specular: acc.specular * k,
+                        ..acc
+                    }
+                })
+                .collect::<Vec<_>>()
         })
         .collect();
     Ok(out)

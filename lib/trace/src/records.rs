@@ -86,9 +86,15 @@ struct Cursor<'a> {
 
 impl Cursor<'_> {
     fn take(&mut self, n: usize) -> Result<&[u8], TraceError> {
-        let end = self.at.checked_add(n).filter(|&e| e <= self.bytes.len()).ok_or_else(|| TraceError::InvalidSet {
-            path: self.path.to_path_buf(),
-            message: format!("truncated ray records: need {n} bytes at offset {}, file has {}", self.at, self.bytes.len()),
+        let end = self.at.checked_add(n).filter(|&e| e <= self.bytes.len()).ok_or_else(|| {
+            TraceError::InvalidSet {
+                path: self.path.to_path_buf(),
+                message: format!(
+                    "truncated ray records: need {n} bytes at offset {}, file has {}",
+                    self.at,
+                    self.bytes.len()
+                ),
+            }
         })?;
         let s = &self.bytes[self.at..end];
         self.at = end;
@@ -119,11 +125,16 @@ pub fn decode_records(bytes: &[u8], path: &Path) -> Result<Vec<RayRecord>, Trace
     }
     let version = c.u32()?;
     if version != RAYS_VERSION {
-        return Err(bad(format!("ray-record version {version} is not supported (expected {RAYS_VERSION})")));
+        return Err(bad(format!(
+            "ray-record version {version} is not supported (expected {RAYS_VERSION})"
+        )));
     }
     let count = c.u32()? as usize;
     if count > bytes.len() / RECORD_HEADER_BYTES {
-        return Err(bad(format!("record count {count} exceeds what {} bytes can hold", bytes.len())));
+        return Err(bad(format!(
+            "record count {count} exceeds what {} bytes can hold",
+            bytes.len()
+        )));
     }
     let mut records = Vec::with_capacity(count);
     for _ in 0..count {
@@ -131,7 +142,11 @@ pub fn decode_records(bytes: &[u8], path: &Path) -> Result<Vec<RayRecord>, Trace
         let head = c.take(4)?;
         let (term, n_hits) = (head[0], u16::from_le_bytes([head[2], head[3]]) as usize);
         if term > 1 {
-            return Err(bad(format!("record {} has term {term} at offset {}; expected 0 or 1", records.len(), c.at - 4)));
+            return Err(bad(format!(
+                "record {} has term {term} at offset {}; expected 0 or 1",
+                records.len(),
+                c.at - 4
+            )));
         }
         let pixel = c.f32s::<2>()?;
         let exit_origin = c.f32s::<3>()?;
@@ -146,7 +161,15 @@ pub fn decode_records(bytes: &[u8], path: &Path) -> Result<Vec<RayRecord>, Trace
             let colour = c.f32s::<3>()?;
             hits.push(RecordHit { t, position, object, colour });
         }
-        records.push(RayRecord { object, term, pixel, exit_origin, exit_direction, modulation, hits });
+        records.push(RayRecord {
+            object,
+            term,
+            pixel,
+            exit_origin,
+            exit_direction,
+            modulation,
+            hits,
+        });
     }
     if c.at != bytes.len() {
         return Err(bad(format!("{} trailing bytes after {count} records", bytes.len() - c.at)));
@@ -167,7 +190,12 @@ mod tests {
             exit_origin: [0.0, 1.0, 2.0],
             exit_direction: [0.0, 0.0, -1.0],
             modulation: [0.9, 0.8, 0.7],
-            hits: vec![RecordHit { t: 2.0, position: [0.0, 1.0, 0.0], object: 1, colour: [0.5, 0.25, 0.125] }],
+            hits: vec![RecordHit {
+                t: 2.0,
+                position: [0.0, 1.0, 0.0],
+                object: 1,
+                colour: [0.5, 0.25, 0.125],
+            }],
         };
         let bytes = encode_records(&[r.clone(), RayRecord { hits: vec![], ..r.clone() }]);
         assert_eq!(bytes.len(), 16 + 2 * RECORD_HEADER_BYTES + HIT_BYTES);

@@ -48,8 +48,11 @@ pub struct PointRender {
 pub fn channel_names(scene: &Scene) -> Vec<String> {
     let mut out: Vec<String> = Vec::with_capacity(scene.objects.len());
     for (i, o) in scene.objects.iter().enumerate() {
-        let mut s: String =
-            o.name.chars().map(|c| if c.is_ascii_alphanumeric() || c == '_' || c == '-' { c } else { '_' }).collect();
+        let mut s: String = o
+            .name
+            .chars()
+            .map(|c| if c.is_ascii_alphanumeric() || c == '_' || c == '-' { c } else { '_' })
+            .collect();
         if s.is_empty() {
             s = format!("object{i}");
         }
@@ -115,7 +118,8 @@ pub fn render_point(
         total_rays += n;
     }
     let names = channel_names(scene);
-    let objects: Vec<(String, ObjectRole)> = names.into_iter().zip(scene.objects.iter().map(|o| o.role)).collect();
+    let objects: Vec<(String, ObjectRole)> =
+        names.into_iter().zip(scene.objects.iter().map(|o| o.role)).collect();
     let images = resolve(&pixels, w, h, &objects);
     let stats = RenderStats {
         camera_rays: w as u64 * h as u64 * settings.spp as u64,

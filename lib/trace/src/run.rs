@@ -126,7 +126,12 @@ pub fn render_shard(
     // A point's samples, images and EXR in memory at once: refused before any work when
     // the machine has not that much.
     let (w, h) = settings.resolution;
-    let need = crate::memory::image_bytes(w, h, crate::memory::point_channels(scene.objects.iter().map(|o| o.role)), 3);
+    let need = crate::memory::image_bytes(
+        w,
+        h,
+        crate::memory::point_channels(scene.objects.iter().map(|o| o.role)),
+        3,
+    );
     if let Some(have) = crate::memory::available_memory().filter(|&have| need > have) {
         return Err(TraceError::Memory(format!(
             "a point of {w}x{h} pixels needs about {} of memory, {} are available: trace at a smaller resolution",
@@ -163,8 +168,15 @@ pub fn render_shard(
         return Ok(report);
     }
     let joins = run.resume || run.shard != Shard::WHOLE;
-    let mut writer = SetWriter::begin(out, scene, settings, count, if joins { Begin::Join } else { Begin::Fresh })?;
-    let todo: Vec<usize> = mine.iter().copied().filter(|&i| !(run.resume && writer.done(i).is_some())).collect();
+    let mut writer = SetWriter::begin(
+        out,
+        scene,
+        settings,
+        count,
+        if joins { Begin::Join } else { Begin::Fresh },
+    )?;
+    let todo: Vec<usize> =
+        mine.iter().copied().filter(|&i| !(run.resume && writer.done(i).is_some())).collect();
     report.resumed = mine.len() - todo.len();
     report.points = todo.len();
     progress.start(todo.len(), settings.resolution.1);
@@ -204,21 +216,45 @@ mod darkness_tests {
 
     #[test]
     fn a_scene_that_nothing_lights_is_warned_of() {
-        let mut s = Scene { name: "dark".into(), materials: vec![Material::default()], ..Default::default() };
+        let mut s = Scene {
+            name: "dark".into(),
+            materials: vec![Material::default()],
+            ..Default::default()
+        };
         let w = darkness_warning(&s).expect("a warning");
         assert!(w.contains("dark") && w.contains("[[light]]"), "{w}");
         s.materials[0].emissive = [0.0, 0.2, 0.0];
         assert_eq!(darkness_warning(&s), None, "an emissive material lights it");
         s.materials[0].emissive = [0.0; 3];
-        s.rig.lights.push(LightRig { name: "Key".into(), node: 0, kind: LightKind::Point, radiance: [1.0; 3], radius: 0.0 });
+        s.rig.lights.push(LightRig {
+            name: "Key".into(),
+            node: 0,
+            kind: LightKind::Point,
+            radiance: [1.0; 3],
+            radius: 0.0,
+        });
         assert_eq!(darkness_warning(&s), None, "a light lights it");
     }
 
     #[test]
     fn an_environment_alone_lights_a_scene_unless_it_is_black() {
-        let sky = |c: [f32; 3]| Some(Environment { radiance: EnvironmentRadiance::Uniform(c), rotation: 0.0, background: false });
-        let mut s = Scene { name: "sky".into(), materials: vec![Material::default()], environment: sky([0.0; 3]), ..Default::default() };
-        assert!(darkness_warning(&s).is_some_and(|w| w.contains("[environment]")), "a black environment lights nothing");
+        let sky = |c: [f32; 3]| {
+            Some(Environment {
+                radiance: EnvironmentRadiance::Uniform(c),
+                rotation: 0.0,
+                background: false,
+            })
+        };
+        let mut s = Scene {
+            name: "sky".into(),
+            materials: vec![Material::default()],
+            environment: sky([0.0; 3]),
+            ..Default::default()
+        };
+        assert!(
+            darkness_warning(&s).is_some_and(|w| w.contains("[environment]")),
+            "a black environment lights nothing"
+        );
         s.environment = sky([0.2, 0.3, 0.4]);
         assert_eq!(darkness_warning(&s), None);
     }

@@ -27,7 +27,9 @@ pub fn mix64(mut z: u64) -> u64 {
 pub fn hash_keys(keys: &[u64]) -> u64 {
     let mut h = 0x9e37_79b9_7f4a_7c15u64;
     for &k in keys {
-        h = mix64(h ^ k.wrapping_add(0x9e37_79b9_7f4a_7c15).wrapping_add(h << 6).wrapping_add(h >> 2));
+        h = mix64(
+            h ^ k.wrapping_add(0x9e37_79b9_7f4a_7c15).wrapping_add(h << 6).wrapping_add(h >> 2),
+        );
     }
     h
 }
@@ -45,7 +47,13 @@ impl Rng {
     /// A generator for shading at a surface point: seeded from the object-space point
     /// quantized to cells of size `cell`, the object and the bounce `depth`.
     /// With `cell <= 0` the seed falls back to `fallback` (per pixel sample).
-    pub fn at_surface(object_point: Vec3, cell: f32, object: u32, depth: u32, fallback: u64) -> Rng {
+    pub fn at_surface(
+        object_point: Vec3,
+        cell: f32,
+        object: u32,
+        depth: u32,
+        fallback: u64,
+    ) -> Rng {
         if cell > 0.0 {
             let q = (object_point / cell).floor();
             let key = [
@@ -65,7 +73,8 @@ impl Rng {
     #[inline]
     pub fn next_u32(&mut self) -> u32 {
         let old = self.state;
-        self.state = old.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1_442_695_040_888_963_407);
+        self.state =
+            old.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1_442_695_040_888_963_407);
         let xorshifted = (((old >> 18) ^ old) >> 27) as u32;
         let rot = (old >> 59) as u32;
         xorshifted.rotate_right(rot)

@@ -72,7 +72,11 @@ impl ShadingSeed {
 impl TraceSettings {
     /// What seeds the shading: a cell size of 0 seeds per camera sample.
     pub fn shading_seed(&self) -> ShadingSeed {
-        if self.coherence_cell == Some(0.0) { ShadingSeed::Sample } else { ShadingSeed::Cell }
+        if self.coherence_cell == Some(0.0) {
+            ShadingSeed::Sample
+        } else {
+            ShadingSeed::Cell
+        }
     }
 
     /// The same settings with shading seeded by `seed` (`Cell`: the default cell size).

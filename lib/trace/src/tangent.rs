@@ -73,7 +73,10 @@ mod tests {
         assert!((up - Vec3::new(0.0, 0.6, 0.8)).length() < 1e-6, "{up}");
         assert_eq!(bend(Vec3::Z, t, b, Vec3::Z), Vec3::Z);
         // The attribute's frame agrees, its sign flipping the bitangent.
-        assert_eq!(attribute_frame(Vec3::Z, Vec3::new(1.0, 0.0, 0.3), 1.0), Some((Vec3::X, Vec3::Y)));
+        assert_eq!(
+            attribute_frame(Vec3::Z, Vec3::new(1.0, 0.0, 0.3), 1.0),
+            Some((Vec3::X, Vec3::Y))
+        );
         assert_eq!(attribute_frame(Vec3::Z, Vec3::X, -1.0), Some((Vec3::X, -Vec3::Y)));
     }
 }

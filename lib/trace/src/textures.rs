@@ -50,12 +50,22 @@ mod tests {
     fn texture_transform_offsets_and_scales_uvs_at_lookup() {
         let s = halves();
         let plain = TextureRef::new(0);
-        assert_eq!(lookup(&s, Some(&plain), [Vec2::new(0.25, 0.5), Vec2::ZERO]), Some(Vec4::new(0.0, 0.0, 0.0, 1.0)));
+        assert_eq!(
+            lookup(&s, Some(&plain), [Vec2::new(0.25, 0.5), Vec2::ZERO]),
+            Some(Vec4::new(0.0, 0.0, 0.0, 1.0))
+        );
         // Offset ½: the left half reads the right texel.
-        let shifted = TextureRef { transform: UvTransform { offset: [0.5, 0.0], ..UvTransform::IDENTITY }, ..plain };
+        let shifted = TextureRef {
+            transform: UvTransform { offset: [0.5, 0.0], ..UvTransform::IDENTITY },
+            ..plain
+        };
         assert_eq!(lookup(&s, Some(&shifted), [Vec2::new(0.25, 0.5), Vec2::ZERO]), Some(Vec4::ONE));
         // Set 1 with a scale of 3: u = 0.25 reads u = 0.75.
-        let scaled = TextureRef { tex_coord: 1, transform: UvTransform { scale: [3.0, 1.0], ..UvTransform::IDENTITY }, ..plain };
+        let scaled = TextureRef {
+            tex_coord: 1,
+            transform: UvTransform { scale: [3.0, 1.0], ..UvTransform::IDENTITY },
+            ..plain
+        };
         assert_eq!(lookup(&s, Some(&scaled), [Vec2::ZERO, Vec2::new(0.25, 0.5)]), Some(Vec4::ONE));
         assert_eq!(lookup(&s, None, [Vec2::ZERO; 2]), None);
         assert_eq!(lookup(&s, Some(&TextureRef::new(7)), [Vec2::ZERO; 2]), None);

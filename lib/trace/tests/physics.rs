@@ -8,7 +8,11 @@ use pis_scene::ObjectRole;
 use pis_trace::camera::PerspectiveCamera;
 use pis_trace::{render_point, LayerKind, PointRender, TraceSettings};
 
-fn render(scene: &pis_scene::Scene, frame: &pis_scene::Frame, settings: &TraceSettings) -> PointRender {
+fn render(
+    scene: &pis_scene::Scene,
+    frame: &pis_scene::Frame,
+    settings: &TraceSettings,
+) -> PointRender {
     render_point(scene, frame, settings, &|| {}).expect("render")
 }
 
@@ -20,7 +24,11 @@ fn white_furnace() {
         let le = [0.7, 0.7, 0.7];
         let s = scene(
             vec![
-                object("ball", ObjectRole::Diffuse, vec![sphere(Vec3::ZERO, 1.0, 24, 48, 0, false)]),
+                object(
+                    "ball",
+                    ObjectRole::Diffuse,
+                    vec![sphere(Vec3::ZERO, 1.0, 24, 48, 0, false)],
+                ),
                 object("sky", ObjectRole::Diffuse, vec![sphere(Vec3::ZERO, 6.0, 16, 32, 1, true)]),
             ],
             vec![matte([albedo; 3]), emitter(le)],
@@ -43,7 +51,10 @@ fn white_furnace() {
                 let c = combined.rgb(x, y);
                 let d = diffuse.rgb(x, y);
                 for v in [c.x, c.y, c.z, d.x] {
-                    assert!((v - expect).abs() <= 0.02 * expect, "pixel ({x},{y}): {v} vs {expect} (albedo {albedo})");
+                    assert!(
+                        (v - expect).abs() <= 0.02 * expect,
+                        "pixel ({x},{y}): {v} vs {expect} (albedo {albedo})"
+                    );
                 }
             }
         }
@@ -61,8 +72,16 @@ fn glass_reflectance_at_normal_incidence() {
         let s = scene(
             vec![
                 // A thick, strongly absorbing slab: light refracted into it never returns.
-                object("slab", ObjectRole::Refractive, cuboid(Vec3::new(-5.0, -5.0, -10.0), Vec3::new(5.0, 5.0, 0.0), 0, false)),
-                object("lamp", ObjectRole::Diffuse, vec![quad(Vec3::new(0.0, 0.0, 3.0), Vec3::Y * 5.0, Vec3::X * 5.0, 1)]),
+                object(
+                    "slab",
+                    ObjectRole::Refractive,
+                    cuboid(Vec3::new(-5.0, -5.0, -10.0), Vec3::new(5.0, 5.0, 0.0), 0, false),
+                ),
+                object(
+                    "lamp",
+                    ObjectRole::Diffuse,
+                    vec![quad(Vec3::new(0.0, 0.0, 3.0), Vec3::Y * 5.0, Vec3::X * 5.0, 1)],
+                ),
             ],
             vec![glass(ior, [0.01; 3], 0.05), emitter([le; 3])],
             (12, 12),
@@ -74,10 +93,19 @@ fn glass_reflectance_at_normal_incidence() {
         let r = render(&s, &f, &settings);
         let modulation = r.images.object_layer("slab", LayerKind::ReflectionModulation).unwrap();
         let term = r.images.object_layer("slab", LayerKind::Reflection).unwrap();
-        let refraction_mod = r.images.object_layer("slab", LayerKind::RefractionModulation).unwrap();
+        let refraction_mod =
+            r.images.object_layer("slab", LayerKind::RefractionModulation).unwrap();
         let (cx, cy) = (6, 6);
-        assert!((modulation.value("R", cx, cy) - r0).abs() < 1e-4 * r0.max(1e-3) + 1e-6, "ior {ior}: F_R = {}", modulation.value("R", cx, cy));
-        assert!((term.value("G", cx, cy) - r0 * le).abs() < 1e-4 * le, "ior {ior}: R term {}", term.value("G", cx, cy));
+        assert!(
+            (modulation.value("R", cx, cy) - r0).abs() < 1e-4 * r0.max(1e-3) + 1e-6,
+            "ior {ior}: F_R = {}",
+            modulation.value("R", cx, cy)
+        );
+        assert!(
+            (term.value("G", cx, cy) - r0 * le).abs() < 1e-4 * le,
+            "ior {ior}: R term {}",
+            term.value("G", cx, cy)
+        );
         // The refraction-first path is absorbed by the slab (Beer): F_T·G_T vanishes.
         assert!(refraction_mod.value("B", cx, cy).abs() < 1e-6);
         // The path-traced image: at the first hit both children are traced, the refracted
@@ -95,7 +123,11 @@ fn mirror_reflects_analytic_scene() {
     let (panel_c, panel_u, panel_v) = (Vec3::new(0.0, 1.0, -3.0), Vec3::X * 1.5, Vec3::Y * 0.8);
     let s = scene(
         vec![
-            object("mirror", ObjectRole::Reflective, vec![quad(Vec3::ZERO, Vec3::Z * 10.0, Vec3::X * 10.0, 0)]),
+            object(
+                "mirror",
+                ObjectRole::Reflective,
+                vec![quad(Vec3::ZERO, Vec3::Z * 10.0, Vec3::X * 10.0, 0)],
+            ),
             object("panel", ObjectRole::Diffuse, vec![quad(panel_c, panel_u, panel_v, 1)]),
         ],
         vec![metal([1.0; 3], 0.0), emitter(le.to_array())],
@@ -144,7 +176,11 @@ fn mirror_reflects_analytic_scene() {
             let want = if e { le } else { Vec3::ZERO };
             let got = combined.rgb(x, y);
             assert!((got - want).abs().max_element() < 1e-4, "pixel ({x},{y}): {got} vs {want}");
-            if e { lit += 1 } else { dark += 1 }
+            if e {
+                lit += 1
+            } else {
+                dark += 1
+            }
         }
     }
     assert!(lit > 20 && dark > 20, "lit {lit}, dark {dark}");
@@ -165,10 +201,26 @@ fn mirror_reflects_analytic_scene() {
 fn diffuse_and_specular_layers_composite_to_combined() {
     let s = scene(
         vec![
-            object("floor", ObjectRole::Diffuse, vec![quad(Vec3::ZERO, Vec3::Z * 3.0, Vec3::X * 3.0, 0)]),
-            object("ball", ObjectRole::Reflective, vec![sphere(Vec3::new(0.0, 0.6, 0.0), 0.6, 12, 24, 1, false)]),
-            object("lens", ObjectRole::Refractive, vec![sphere(Vec3::new(0.9, 0.4, 0.6), 0.4, 12, 24, 2, false)]),
-            object("wall", ObjectRole::Diffuse, vec![quad(Vec3::new(0.0, 1.5, -2.0), Vec3::X * 3.0, Vec3::Y * 1.5, 3)]),
+            object(
+                "floor",
+                ObjectRole::Diffuse,
+                vec![quad(Vec3::ZERO, Vec3::Z * 3.0, Vec3::X * 3.0, 0)],
+            ),
+            object(
+                "ball",
+                ObjectRole::Reflective,
+                vec![sphere(Vec3::new(0.0, 0.6, 0.0), 0.6, 12, 24, 1, false)],
+            ),
+            object(
+                "lens",
+                ObjectRole::Refractive,
+                vec![sphere(Vec3::new(0.9, 0.4, 0.6), 0.4, 12, 24, 2, false)],
+            ),
+            object(
+                "wall",
+                ObjectRole::Diffuse,
+                vec![quad(Vec3::new(0.0, 1.5, -2.0), Vec3::X * 3.0, Vec3::Y * 1.5, 3)],
+            ),
         ],
         vec![
             matte([0.7, 0.6, 0.5]),
@@ -242,7 +294,10 @@ fn distant_layer_has_no_holes() {
             covered += 1;
             max_alpha = max_alpha.max(local.value("A", x, y));
             let d = distant.rgb(x, y);
-            assert!((d - Vec3::splat(le)).abs().max_element() < 1e-4, "distant hole at ({x},{y}): {d}");
+            assert!(
+                (d - Vec3::splat(le)).abs().max_element() < 1e-4,
+                "distant hole at ({x},{y}): {d}"
+            );
         }
     }
     assert!(covered > 50, "corner covers {covered} pixels");
@@ -290,11 +345,17 @@ fn parts_of_one_reflector_reflect_each_other_locally() {
         }
         if joined {
             assert!(max_alpha > 0.9, "joined: no reflection of the other part seen locally (max local alpha {max_alpha})");
-            assert!((darkest - le).abs() < 1e-4, "joined: the distant layer shows a part ({darkest})");
+            assert!(
+                (darkest - le).abs() < 1e-4,
+                "joined: the distant layer shows a part ({darkest})"
+            );
         } else {
             assert_eq!(max_alpha, 0.0, "apart: a panel reflects the other locally");
             // The other panel reflects the sky at about F0 = 0.5.
-            assert!(darkest < le - 0.2, "apart: the distant layer sees through the other panel ({darkest})");
+            assert!(
+                darkest < le - 0.2,
+                "apart: the distant layer sees through the other panel ({darkest})"
+            );
         }
     }
 }
@@ -304,9 +365,21 @@ fn parts_of_one_reflector_reflect_each_other_locally() {
 fn renders_are_deterministic_across_thread_counts() {
     let s = scene(
         vec![
-            object("floor", ObjectRole::Diffuse, vec![quad(Vec3::ZERO, Vec3::Z * 3.0, Vec3::X * 3.0, 0)]),
-            object("ball", ObjectRole::Reflective, vec![sphere(Vec3::new(-0.4, 0.5, 0.0), 0.5, 10, 20, 1, false)]),
-            object("lens", ObjectRole::Refractive, vec![sphere(Vec3::new(0.6, 0.4, 0.4), 0.4, 10, 20, 2, false)]),
+            object(
+                "floor",
+                ObjectRole::Diffuse,
+                vec![quad(Vec3::ZERO, Vec3::Z * 3.0, Vec3::X * 3.0, 0)],
+            ),
+            object(
+                "ball",
+                ObjectRole::Reflective,
+                vec![sphere(Vec3::new(-0.4, 0.5, 0.0), 0.5, 10, 20, 1, false)],
+            ),
+            object(
+                "lens",
+                ObjectRole::Refractive,
+                vec![sphere(Vec3::new(0.6, 0.4, 0.4), 0.4, 10, 20, 2, false)],
+            ),
         ],
         vec![matte([0.7, 0.6, 0.5]), metal([0.9, 0.8, 0.6], 0.3), glass(1.5, [0.8, 0.9, 0.8], 1.0)],
         (16, 12),
@@ -339,8 +412,16 @@ fn renders_are_deterministic_across_thread_counts() {
 fn lit_block_on_a_floor() -> (pis_scene::Scene, pis_scene::Frame) {
     let s = scene(
         vec![
-            object("floor", ObjectRole::Diffuse, vec![quad(Vec3::ZERO, Vec3::Z * 3.0, Vec3::X * 3.0, 0)]),
-            object("block", ObjectRole::Diffuse, cuboid(Vec3::new(-0.5, 0.0, -0.5), Vec3::new(0.5, 1.0, 0.5), 1, false)),
+            object(
+                "floor",
+                ObjectRole::Diffuse,
+                vec![quad(Vec3::ZERO, Vec3::Z * 3.0, Vec3::X * 3.0, 0)],
+            ),
+            object(
+                "block",
+                ObjectRole::Diffuse,
+                cuboid(Vec3::new(-0.5, 0.0, -0.5), Vec3::new(0.5, 1.0, 0.5), 1, false),
+            ),
         ],
         vec![matte([0.7; 3]), matte([0.2, 0.6, 0.3])],
         (8, 8),
@@ -367,7 +448,8 @@ fn diffuse_noise_is_fixed_to_the_surface() {
         eyes.iter()
             .enumerate()
             .map(|(i, &e)| {
-                let mut ctx = PathContext { fallback_seed: seed_base + i as u64, ..Default::default() };
+                let mut ctx =
+                    PathContext { fallback_seed: seed_base + i as u64, ..Default::default() };
                 let sample = integ.camera_sample(e, (target - e).normalize(), false, &mut ctx);
                 assert_eq!(sample.object, Some(0));
                 sample.diffuse
@@ -393,16 +475,24 @@ fn diffuse_noise_is_fixed_to_the_surface() {
 fn shading_seeded_per_sample_converges_as_one_over_spp() {
     use pis_trace::ShadingSeed;
     let (s, f) = lit_block_on_a_floor();
-    assert_eq!(TraceSettings::new(s.resolution, 1).with_shading_seed(ShadingSeed::Cell), TraceSettings::new(s.resolution, 1));
+    assert_eq!(
+        TraceSettings::new(s.resolution, 1).with_shading_seed(ShadingSeed::Cell),
+        TraceSettings::new(s.resolution, 1)
+    );
     let image = |spp: u32| -> Vec<f32> {
         let settings = TraceSettings::new(s.resolution, spp).with_shading_seed(ShadingSeed::Sample);
         assert_eq!(settings.coherence_cell, Some(0.0));
         let r = render(&s, &f, &settings);
         let c = r.images.layer("combined").unwrap();
-        (0..8).flat_map(|y| (0..8).map(move |x| (x, y))).map(|(x, y)| c.rgb(x, y).element_sum()).collect()
+        (0..8)
+            .flat_map(|y| (0..8).map(move |x| (x, y)))
+            .map(|(x, y)| c.rgb(x, y).element_sum())
+            .collect()
     };
     let truth = image(2048);
-    let mse = |a: &[f32]| a.iter().zip(&truth).map(|(a, t)| ((a - t) as f64).powi(2)).sum::<f64>() / a.len() as f64;
+    let mse = |a: &[f32]| {
+        a.iter().zip(&truth).map(|(a, t)| ((a - t) as f64).powi(2)).sum::<f64>() / a.len() as f64
+    };
     let (e4, e64) = (mse(&image(4)), mse(&image(64)));
     assert!(e64 > 0.0 && e4 > 8.0 * e64, "squared error {e4} at 4 spp, {e64} at 64 spp");
 }
@@ -415,14 +505,24 @@ fn shading_seeded_per_sample_converges_as_one_over_spp() {
 fn renders_from_two_streams_have_independent_noise() {
     use pis_trace::ShadingSeed;
     let (s, f) = lit_block_on_a_floor();
-    assert_eq!(TraceSettings::new(s.resolution, 1).with_seed(0), TraceSettings::new(s.resolution, 1));
+    assert_eq!(
+        TraceSettings::new(s.resolution, 1).with_seed(0),
+        TraceSettings::new(s.resolution, 1)
+    );
     let image = |spp: u32, stream: u64| -> Vec<f32> {
-        let settings = TraceSettings::new(s.resolution, spp).with_shading_seed(ShadingSeed::Sample).with_seed(stream);
+        let settings = TraceSettings::new(s.resolution, spp)
+            .with_shading_seed(ShadingSeed::Sample)
+            .with_seed(stream);
         let r = render(&s, &f, &settings);
         let c = r.images.layer("combined").unwrap();
-        (0..8).flat_map(|y| (0..8).map(move |x| (x, y))).map(|(x, y)| c.rgb(x, y).element_sum()).collect()
+        (0..8)
+            .flat_map(|y| (0..8).map(move |x| (x, y)))
+            .map(|(x, y)| c.rgb(x, y).element_sum())
+            .collect()
     };
-    let mse = |a: &[f32], b: &[f32]| a.iter().zip(b).map(|(a, b)| ((a - b) as f64).powi(2)).sum::<f64>() / a.len() as f64;
+    let mse = |a: &[f32], b: &[f32]| {
+        a.iter().zip(b).map(|(a, b)| ((a - b) as f64).powi(2)).sum::<f64>() / a.len() as f64
+    };
     let truth = image(2048, 7);
     let (a, b) = (image(16, 0), image(16, 1));
     assert_eq!(a, image(16, 0));

@@ -12,9 +12,21 @@ use pis_trace::{render_point, LayerKind, TraceSettings};
 fn set_round_trips_images_records_and_metadata() {
     let mut s = scene(
         vec![
-            object("floor", ObjectRole::Diffuse, vec![quad(Vec3::ZERO, Vec3::Z * 3.0, Vec3::X * 3.0, 0)]),
-            object("ball", ObjectRole::Reflective, vec![sphere(Vec3::new(-0.4, 0.5, 0.0), 0.5, 8, 16, 1, false)]),
-            object("lens.1", ObjectRole::Refractive, vec![sphere(Vec3::new(0.6, 0.4, 0.4), 0.4, 8, 16, 2, false)]),
+            object(
+                "floor",
+                ObjectRole::Diffuse,
+                vec![quad(Vec3::ZERO, Vec3::Z * 3.0, Vec3::X * 3.0, 0)],
+            ),
+            object(
+                "ball",
+                ObjectRole::Reflective,
+                vec![sphere(Vec3::new(-0.4, 0.5, 0.0), 0.5, 8, 16, 1, false)],
+            ),
+            object(
+                "lens.1",
+                ObjectRole::Refractive,
+                vec![sphere(Vec3::new(0.6, 0.4, 0.4), 0.4, 8, 16, 2, false)],
+            ),
         ],
         vec![matte([0.7, 0.6, 0.5]), metal([0.9, 0.8, 0.6], 0.0), glass(1.5, [0.8, 0.9, 0.8], 1.0)],
         (10, 8),
@@ -36,7 +48,11 @@ fn set_round_trips_images_records_and_metadata() {
     let mut renders = Vec::new();
     for i in 0..2 {
         let eye = Vec3::new(i as f32, 1.2, 3.0);
-        let f = frame(&s, camera(eye, Vec3::new(0.0, 0.4, 0.0), 50.0), vec![sphere_light("key", Vec3::new(1.0, 3.0, 2.0), [20.0; 3], 0.25)]);
+        let f = frame(
+            &s,
+            camera(eye, Vec3::new(0.0, 0.4, 0.0), 50.0),
+            vec![sphere_light("key", Vec3::new(1.0, 3.0, 2.0), [20.0; 3], 0.25)],
+        );
         let r = render_point(&s, &f, &settings, &|| {}).unwrap();
         writer.write_point(&s, i, &f, &r).unwrap();
         renders.push(r);
@@ -60,7 +76,11 @@ fn set_round_trips_images_records_and_metadata() {
             let b = back.layer(&layer.name).unwrap_or_else(|| panic!("missing {}", layer.name));
             assert_eq!(b.channels, layer.channels, "{}", layer.name);
             for (p, q) in layer.planes.iter().zip(&b.planes) {
-                assert!(p.iter().zip(q).all(|(x, y)| x.to_bits() == y.to_bits()), "{} differs", layer.name);
+                assert!(
+                    p.iter().zip(q).all(|(x, y)| x.to_bits() == y.to_bits()),
+                    "{} differs",
+                    layer.name
+                );
             }
         }
         assert!(back.object_layer("ball", LayerKind::Local).is_some());

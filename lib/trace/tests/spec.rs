@@ -15,7 +15,9 @@ fn section<'a>(text: &'a str, heading: &str) -> Vec<&'a str> {
     let first = lines.next().expect("section exists");
     let level = first.chars().take_while(|&c| c == '#').count();
     lines
-        .take_while(|l| !(l.starts_with('#') && l.chars().take_while(|&c| c == '#').count() <= level))
+        .take_while(|l| {
+            !(l.starts_with('#') && l.chars().take_while(|&c| c == '#').count() <= level)
+        })
         .collect()
 }
 
@@ -34,7 +36,8 @@ fn layer_table_lists_every_layer_with_its_channels() {
             continue;
         }
         for name in quoted(cells[1]) {
-            let kind = LayerKind::from_name(&name).unwrap_or_else(|| panic!("spec layer {name} unknown to the code"));
+            let kind = LayerKind::from_name(&name)
+                .unwrap_or_else(|| panic!("spec layer {name} unknown to the code"));
             if cells[2] != "as above" {
                 let channels: Vec<&str> = cells[2].split_whitespace().collect();
                 assert_eq!(channels, kind.channels(), "channels of {name}");
@@ -71,6 +74,8 @@ fn role_table_matches_the_code() {
 #[test]
 fn record_sizes_match_the_spec() {
     let text = spec();
-    assert!(text.contains(&format!("Record {{                        // {RECORD_HEADER_BYTES} bytes + {HIT_BYTES} per hit")));
+    assert!(text.contains(&format!(
+        "Record {{                        // {RECORD_HEADER_BYTES} bytes + {HIT_BYTES} per hit"
+    )));
     assert!(text.contains(&format!("Hit {{                           // {HIT_BYTES} bytes")));
 }

@@ -19,7 +19,11 @@ fn wall(z: f32, m: usize) -> pis_scene::Primitive {
     quad(Vec3::new(0.0, 0.0, z), Vec3::X, Vec3::Y, m)
 }
 
-fn scene_of(prims: Vec<pis_scene::Primitive>, materials: Vec<Material>, textures: Vec<TextureImage>) -> Scene {
+fn scene_of(
+    prims: Vec<pis_scene::Primitive>,
+    materials: Vec<Material>,
+    textures: Vec<TextureImage>,
+) -> Scene {
     let mut s = scene(vec![object("o", ObjectRole::Diffuse, prims)], materials, (16, 8), 4);
     s.textures = textures;
     s
@@ -28,7 +32,11 @@ fn scene_of(prims: Vec<pis_scene::Primitive>, materials: Vec<Material>, textures
 #[test]
 fn emissive_map_modulates_emissive_factor() {
     // emissiveFactor 1 with a map black on its left half: only the right half glows.
-    let m = Material { emissive: [1.0; 3], emissive_texture: Some(TextureRef::new(0)), ..matte([0.0; 3]) };
+    let m = Material {
+        emissive: [1.0; 3],
+        emissive_texture: Some(TextureRef::new(0)),
+        ..matte([0.0; 3])
+    };
     let s = scene_of(vec![wall(0.0, 0)], vec![m], vec![halves([0.0, 0.0, 0.0, 1.0], [1.0; 4])]);
     // From 2 m away the camera sees x ∈ [−1, 1] across the 16 columns, y ∈ [−½, ½] down the 8 rows.
     let fov = 2.0 * 0.25f32.atan().to_degrees();
@@ -37,10 +45,18 @@ fn emissive_map_modulates_emissive_factor() {
     let combined = r.images.layer("combined").unwrap();
     for y in 2..6 {
         for x in 2..6 {
-            assert!(combined.rgb(x, y).max_element() < 0.05, "({x},{y}) glows: {}", combined.rgb(x, y));
+            assert!(
+                combined.rgb(x, y).max_element() < 0.05,
+                "({x},{y}) glows: {}",
+                combined.rgb(x, y)
+            );
         }
         for x in 10..14 {
-            assert!((combined.rgb(x, y) - Vec3::ONE).abs().max_element() < 0.05, "({x},{y}): {}", combined.rgb(x, y));
+            assert!(
+                (combined.rgb(x, y) - Vec3::ONE).abs().max_element() < 0.05,
+                "({x},{y}): {}",
+                combined.rgb(x, y)
+            );
         }
     }
 }
@@ -53,7 +69,11 @@ fn alpha_mask_lets_rays_through_cut_texels() {
         alpha_mode: AlphaMode::Mask { cutoff: 0.5 },
         ..matte([1.0; 3])
     };
-    let s = scene_of(vec![wall(0.0, 0), wall(-1.0, 1)], vec![mask.clone(), matte([1.0; 3])], vec![halves([1.0, 1.0, 1.0, 0.0], [1.0; 4])]);
+    let s = scene_of(
+        vec![wall(0.0, 0), wall(-1.0, 1)],
+        vec![mask.clone(), matte([1.0; 3])],
+        vec![halves([1.0, 1.0, 1.0, 0.0], [1.0; 4])],
+    );
     let f = frame(&s, camera(Vec3::Z, Vec3::ZERO, 40.0), vec![]);
     let g = SceneGeometry::build(&s, &f);
     let (hole, solid) = (Vec3::new(-0.5, 0.0, 1.0), Vec3::new(0.5, 0.0, 1.0));
@@ -66,24 +86,32 @@ fn alpha_mask_lets_rays_through_cut_texels() {
     assert_eq!(g.all_hits(solid, Vec3::NEG_Z, f32::INFINITY).len(), 2);
     // OPAQUE ignores alpha.
     let opaque = Material { alpha_mode: AlphaMode::Opaque, ..mask };
-    let s = scene_of(vec![wall(0.0, 0)], vec![opaque], vec![halves([1.0, 1.0, 1.0, 0.0], [1.0; 4])]);
+    let s =
+        scene_of(vec![wall(0.0, 0)], vec![opaque], vec![halves([1.0, 1.0, 1.0, 0.0], [1.0; 4])]);
     let g = SceneGeometry::build(&s, &f);
     assert!(g.occluded(hole, Vec3::NEG_Z, 1.5));
 }
 
 #[test]
 fn alpha_blend_passes_rays_with_probability_one_minus_alpha() {
-    let blend = Material { base_color: [1.0, 1.0, 1.0, 0.25], alpha_mode: AlphaMode::Blend, ..matte([1.0; 3]) };
+    let blend = Material {
+        base_color: [1.0, 1.0, 1.0, 0.25],
+        alpha_mode: AlphaMode::Blend,
+        ..matte([1.0; 3])
+    };
     let s = scene_of(vec![wall(0.0, 0)], vec![blend], vec![]);
     let f = frame(&s, camera(Vec3::Z, Vec3::ZERO, 40.0), vec![]);
     let g = SceneGeometry::build(&s, &f);
     let n = 4000;
-    let origin = |k: usize| Vec3::new((k % 63) as f32 / 63.0 - 0.5, (k / 63) as f32 / 64.0 - 0.5, 1.0);
+    let origin =
+        |k: usize| Vec3::new((k % 63) as f32 / 63.0 - 0.5, (k / 63) as f32 / 64.0 - 0.5, 1.0);
     let passed = (0..n).filter(|&k| !g.occluded(origin(k), Vec3::NEG_Z, 2.0)).count();
     let fraction = passed as f32 / n as f32;
     assert!((fraction - 0.75).abs() < 0.03, "{fraction} of the rays passed, expected 0.75");
     // The choice is a function of the ray: the same ray, the same answer.
-    assert!((0..64).all(|k| g.occluded(origin(k), Vec3::NEG_Z, 2.0) == g.occluded(origin(k), Vec3::NEG_Z, 2.0)));
+    assert!((0..64).all(
+        |k| g.occluded(origin(k), Vec3::NEG_Z, 2.0) == g.occluded(origin(k), Vec3::NEG_Z, 2.0)
+    ));
 }
 
 /// The shading normal at the centre of a wall with a normal map of one texel `texel`.
@@ -93,7 +121,11 @@ fn mapped_normal_at_hit(texel: [f32; 4], tangents: Option<Vec4>) -> Vec3 {
         prim.tangents = vec![t; 4];
     }
     let m = Material { normal_texture: Some(TextureRef::new(0)), ..matte([1.0; 3]) };
-    let s = scene_of(vec![prim], vec![m], vec![TextureImage { width: 1, height: 1, texels: vec![texel] }]);
+    let s = scene_of(
+        vec![prim],
+        vec![m],
+        vec![TextureImage { width: 1, height: 1, texels: vec![texel] }],
+    );
     let f = frame(&s, camera(Vec3::Z, Vec3::ZERO, 40.0), vec![]);
     let g = SceneGeometry::build(&s, &f);
     let o = Vec3::new(0.1, 0.2, 1.0);

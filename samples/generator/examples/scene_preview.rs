@@ -56,7 +56,9 @@ fn trace(
     let uv = t.uv[0] * w + t.uv[1] * u + t.uv[2] * v;
     let m = &scene.materials[t.material];
     let mut albedo = Vec3::new(m.base_color[0], m.base_color[1], m.base_color[2]);
-    if let Some((r, tex)) = m.base_color_texture.and_then(|r| scene.textures.get(r.texture).map(|t| (r, t))) {
+    if let Some((r, tex)) =
+        m.base_color_texture.and_then(|r| scene.textures.get(r.texture).map(|t| (r, t)))
+    {
         let uv = r.transform.apply(uv);
         let x = ((uv.x.rem_euclid(1.0)) * tex.width as f32) as usize % tex.width as usize;
         let y = ((uv.y.rem_euclid(1.0)) * tex.height as f32) as usize % tex.height as usize;
@@ -65,14 +67,7 @@ fn trace(
     }
     if depth < 2 && t.role != ObjectRole::Diffuse {
         let r = d - 2.0 * d.dot(n) * n;
-        let bounce = trace(
-            scene,
-            tris,
-            lights,
-            p + n * 1e-3 * r.dot(n).signum(),
-            r,
-            depth + 1,
-        );
+        let bounce = trace(scene, tris, lights, p + n * 1e-3 * r.dot(n).signum(), r, depth + 1);
         return if t.role == ObjectRole::Refractive {
             bounce * Vec3::new(0.7, 0.8, 0.9)
         } else {
@@ -95,14 +90,8 @@ fn main() {
         .get(3)
         .and_then(|s| s.split_once('x'))
         .and_then(|(w, h)| Some((w.parse().ok()?, h.parse().ok()?)));
-    let scene = load_with(
-        toml,
-        &LoadOptions {
-            resolution,
-            ..LoadOptions::default()
-        },
-    )
-    .unwrap_or_else(|e| panic!("{e}"));
+    let scene = load_with(toml, &LoadOptions { resolution, ..LoadOptions::default() })
+        .unwrap_or_else(|e| panic!("{e}"));
     let frame = scene.frame_at(index).unwrap_or_else(|e| panic!("{e}"));
     let mut tris = Vec::new();
     for (obj, inst) in scene.objects.iter().zip(&frame.instances) {
@@ -126,16 +115,10 @@ fn main() {
     let img = image::RgbImage::from_fn(w, h, |x, y| {
         let sx = (2.0 * (x as f32 + 0.5) / w as f32 - 1.0) * tan * w as f32 / h as f32;
         let sy = (1.0 - 2.0 * (y as f32 + 0.5) / h as f32) * tan;
-        let d = cam
-            .world_from_camera
-            .transform_vector3(Vec3::new(sx, sy, -1.0))
-            .normalize();
+        let d = cam.world_from_camera.transform_vector3(Vec3::new(sx, sy, -1.0)).normalize();
         let o = cam.world_from_camera.transform_point3(Vec3::ZERO);
         let c = trace(&scene, &tris, &frame.lights, o, d, 0);
-        image::Rgb(
-            c.to_array()
-                .map(|v| (v.clamp(0.0, 1.0).powf(1.0 / 2.2) * 255.0) as u8),
-        )
+        image::Rgb(c.to_array().map(|v| (v.clamp(0.0, 1.0).powf(1.0 / 2.2) * 255.0) as u8))
     });
     img.save(out).expect("write png");
     println!("{} triangles, wrote {out}", tris.len());

@@ -69,10 +69,7 @@ impl MaterialDesc {
 
     /// A metal (metallic 1) of the given colour and roughness.
     pub fn metal(name: &'static str, rgb: [f32; 3], roughness: f32) -> MaterialDesc {
-        MaterialDesc {
-            metallic: 1.0,
-            ..MaterialDesc::plain(name, rgb, roughness)
-        }
+        MaterialDesc { metallic: 1.0, ..MaterialDesc::plain(name, rgb, roughness) }
     }
 
     /// Clear glass: full transmission, the given IOR and Beer absorption towards `tint`
@@ -195,13 +192,7 @@ impl GltfWriter {
 
     fn index_accessor(&mut self, indices: &[u32], vertex_count: usize) -> usize {
         let (bytes, component): (Vec<u8>, u32) = if vertex_count <= u16::MAX as usize {
-            (
-                indices
-                    .iter()
-                    .flat_map(|&i| (i as u16).to_le_bytes())
-                    .collect(),
-                5123,
-            )
+            (indices.iter().flat_map(|&i| (i as u16).to_le_bytes()).collect(), 5123)
         } else {
             (indices.iter().flat_map(|i| i.to_le_bytes()).collect(), 5125)
         };
@@ -228,10 +219,7 @@ impl GltfWriter {
         }
         let mut ext: Vec<(&'static str, Value)> = Vec::new();
         if let Some(t) = m.transmission {
-            ext.push((
-                "KHR_materials_transmission",
-                json!({"transmissionFactor": t}),
-            ));
+            ext.push(("KHR_materials_transmission", json!({"transmissionFactor": t})));
         }
         if let Some(ior) = m.ior {
             ext.push(("KHR_materials_ior", json!({"ior": ior})));
@@ -247,10 +235,7 @@ impl GltfWriter {
         }
         if let Some((color, strength)) = m.emissive {
             v["emissiveFactor"] = json!(color);
-            ext.push((
-                "KHR_materials_emissive_strength",
-                json!({"emissiveStrength": strength}),
-            ));
+            ext.push(("KHR_materials_emissive_strength", json!({"emissiveStrength": strength})));
         }
         if !ext.is_empty() {
             let mut map = Map::new();
@@ -305,10 +290,8 @@ impl GltfWriter {
     /// Adds a PNG image (a file beside the .gltf) and a texture sampling it with repeat wrap
     /// and trilinear filtering; returns the texture index.
     pub fn add_png_texture(&mut self, uri: &str) -> usize {
-        self.images
-            .push(json!({"uri": uri, "mimeType": "image/png"}));
-        self.textures
-            .push(json!({"source": self.images.len() - 1, "sampler": 0}));
+        self.images.push(json!({"uri": uri, "mimeType": "image/png"}));
+        self.textures.push(json!({"source": self.images.len() - 1, "sampler": 0}));
         self.textures.len() - 1
     }
 
@@ -355,11 +338,7 @@ impl GltfWriter {
         let mut chans = Vec::new();
         for c in channels {
             let input = self.float_accessor(&c.times, "SCALAR", 1, true, None);
-            let (kind, comps) = if c.path == "rotation" {
-                ("VEC4", 4)
-            } else {
-                ("VEC3", 3)
-            };
+            let (kind, comps) = if c.path == "rotation" { ("VEC4", 4) } else { ("VEC3", 3) };
             let output = self.float_accessor(&c.values, kind, comps, false, None);
             let interpolation = match c.interpolation {
                 Interp::Step => "STEP",
@@ -372,8 +351,7 @@ impl GltfWriter {
                 json!({"sampler": samplers.len() - 1, "target": {"node": c.node, "path": c.path}}),
             );
         }
-        self.animations
-            .push(json!({"name": name, "samplers": samplers, "channels": chans}));
+        self.animations.push(json!({"name": name, "samplers": samplers, "channels": chans}));
     }
 
     /// Writes `dir/NAME.gltf` and `dir/NAME.bin`.

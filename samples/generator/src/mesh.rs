@@ -84,11 +84,7 @@ impl Mesh {
 /// right of its direction of travel is the outside (so an outer wall goes up, an inner wall
 /// down). UVs: u = turn fraction around the axis, v = arc length along all strips, 0..1.
 pub fn lathe(strips: &[Vec<Vec2>], segments: usize) -> Mesh {
-    let total: f32 = strips
-        .iter()
-        .map(|s| polyline_length(s))
-        .sum::<f32>()
-        .max(1e-9);
+    let total: f32 = strips.iter().map(|s| polyline_length(s)).sum::<f32>().max(1e-9);
     let mut mesh = Mesh::default();
     let mut walked = 0.0;
     for strip in strips {
@@ -111,11 +107,7 @@ pub fn lathe(strips: &[Vec<Vec2>], segments: usize) -> Mesh {
             let n2 = Vec2::new(t.y, -t.x); // right of travel
             let p = Vec3::new(q.x * c, q.y, -q.x * s);
             let n = Vec3::new(n2.x * c, n2.y, -n2.x * s);
-            (
-                p,
-                n,
-                Vec2::new(i as f32 / segments as f32, (walked + lengths[j]) / total),
-            )
+            (p, n, Vec2::new(i as f32 / segments as f32, (walked + lengths[j]) / total))
         });
         walked += lengths[lengths.len() - 1];
     }
@@ -133,11 +125,7 @@ pub fn quad(origin: Vec3, du: Vec3, dv: Vec3, cols: usize, rows: usize, uv_scale
     let mut mesh = Mesh::default();
     mesh.add_grid(cols, rows, |i, j| {
         let (s, t) = (i as f32 / cols as f32, j as f32 / rows as f32);
-        (
-            origin + du * s + dv * t,
-            n,
-            Vec2::new(s, 1.0 - t) * uv_scale,
-        )
+        (origin + du * s + dv * t, n, Vec2::new(s, 1.0 - t) * uv_scale)
     });
     mesh
 }
@@ -207,9 +195,6 @@ mod tests {
                 assert!(n.dot(Vec3::new(p.x, 0.0, p.z)) > 0.0);
             }
         }
-        assert!(m
-            .uvs
-            .iter()
-            .all(|uv| (0.0..=1.0).contains(&uv.x) && (0.0..=1.0).contains(&uv.y)));
+        assert!(m.uvs.iter().all(|uv| (0.0..=1.0).contains(&uv.x) && (0.0..=1.0).contains(&uv.y)));
     }
 }

@@ -18,12 +18,7 @@ fn bernstein(t: f32) -> ([f32; 4], [f32; 4]) {
     let s = 1.0 - t;
     (
         [s * s * s, 3.0 * t * s * s, 3.0 * t * t * s, t * t * t],
-        [
-            -3.0 * s * s,
-            3.0 * s * s - 6.0 * t * s,
-            6.0 * t * s - 3.0 * t * t,
-            3.0 * t * t,
-        ],
+        [-3.0 * s * s, 3.0 * s * s - 6.0 * t * s, 6.0 * t * s - 3.0 * t * t, 3.0 * t * t],
     )
 }
 
@@ -174,10 +169,7 @@ mod tests {
         let max = m.positions.iter().fold(Vec3::splat(-9.0), |a, p| a.max(*p));
         let min = m.positions.iter().fold(Vec3::splat(9.0), |a, p| a.min(*p));
         // Spout tip at x ≈ 3.4–3.5, handle at x = -3, lid knob at y = 3.15, base at y = 0.
-        assert!(
-            max.y > 3.1 && max.y < 3.2 && min.y.abs() < 1e-6,
-            "{min} {max}"
-        );
+        assert!(max.y > 3.1 && max.y < 3.2 && min.y.abs() < 1e-6, "{min} {max}");
         assert!(min.x < -2.9 && max.x > 3.3, "{min} {max}");
     }
 

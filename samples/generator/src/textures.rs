@@ -7,8 +7,7 @@ use image::{ImageFormat, Rgb, RgbImage};
 
 fn save(img: &RgbImage, path: &Path) -> io::Result<()> {
     let mut bytes = io::Cursor::new(Vec::new());
-    img.write_to(&mut bytes, ImageFormat::Png)
-        .map_err(io::Error::other)?;
+    img.write_to(&mut bytes, ImageFormat::Png).map_err(io::Error::other)?;
     std::fs::write(path, bytes.into_inner())
 }
 

@@ -27,12 +27,7 @@ fn target(scene: &Scene) -> Vec3 {
 fn check(scene: &Scene) {
     for object in &scene.objects {
         let triangles: usize = object.primitives.iter().map(|p| p.indices.len() / 3).sum();
-        assert!(
-            triangles > 0,
-            "{}: object {} has no triangles",
-            scene.name,
-            object.name
-        );
+        assert!(triangles > 0, "{}: object {} has no triangles", scene.name, object.name);
         for p in &object.primitives {
             assert!(p.positions.iter().all(|v| v.is_finite()));
             assert!(p.normals.iter().all(|n| (n.length() - 1.0).abs() < 1e-3));
@@ -42,31 +37,20 @@ fn check(scene: &Scene) {
     for index in 0..scene.space.point_count() {
         let frame = scene.frame_at(index).expect("frame");
         let m = frame.camera.world_from_camera;
-        assert!(
-            m.is_finite(),
-            "{} point {index}: camera not finite",
-            scene.name
-        );
+        assert!(m.is_finite(), "{} point {index}: camera not finite", scene.name);
         let eye = m.transform_point3(Vec3::ZERO);
         let forward = m.transform_vector3(Vec3::NEG_Z).normalize();
         // The view ray passes within 5 cm of the target, in front of the camera.
         let to_target = target - eye;
         let along = to_target.dot(forward);
-        assert!(
-            along > 0.5,
-            "{} point {index}: target behind the camera",
-            scene.name
-        );
+        assert!(along > 0.5, "{} point {index}: target behind the camera", scene.name);
         assert!(
             (to_target - forward * along).length() < 0.05,
             "{} point {index}: camera misses the target",
             scene.name
         );
         assert_eq!(frame.instances.len(), scene.objects.len());
-        assert!(frame
-            .instances
-            .iter()
-            .all(|i| i.world_from_object.is_finite()));
+        assert!(frame.instances.iter().all(|i| i.world_from_object.is_finite()));
         assert!(!frame.lights.is_empty(), "{}: no light", scene.name);
         for l in &frame.lights {
             assert!(l.position.is_finite() && l.radius > 0.0);
@@ -98,10 +82,7 @@ fn demo_spaces_have_the_seed_kinds() {
         s.space.dims.iter().map(|d| d.kind).collect()
     };
     assert_eq!(kinds("demo1"), [DimensionKind::Light, DimensionKind::View]);
-    assert_eq!(
-        kinds("demo2"),
-        [DimensionKind::View, DimensionKind::ObjectMotion]
-    );
+    assert_eq!(kinds("demo2"), [DimensionKind::View, DimensionKind::ObjectMotion]);
     assert_eq!(kinds("teapot-pem"), [DimensionKind::View]);
     assert_eq!(kinds("teapot-glossy"), [DimensionKind::View]);
     assert_eq!(kinds("glass"), [DimensionKind::View]);
@@ -153,10 +134,7 @@ fn teapot_glossy_is_teapot_pem_with_a_glossy_reflective_teapot() {
                     assert_eq!(g.role, ObjectRole::Reflective);
                     assert_eq!(gm.base_color, pm.base_color);
                     assert_eq!(gm.metallic, 1.0);
-                    assert!(
-                        pm.roughness < MIRROR_ROUGHNESS,
-                        "teapot-pem's teapot is a mirror"
-                    );
+                    assert!(pm.roughness < MIRROR_ROUGHNESS, "teapot-pem's teapot is a mirror");
                     // Glossy, not a mirror, yet still inferred reflective.
                     assert!(gm.roughness > MIRROR_ROUGHNESS, "{}", gm.roughness);
                     assert_eq!(material_role(gm), ObjectRole::Reflective);
@@ -167,10 +145,7 @@ fn teapot_glossy_is_teapot_pem_with_a_glossy_reflective_teapot() {
             }
         }
         for index in 0..pem.space.point_count() {
-            let (g, p) = (
-                glossy.frame_at(index).unwrap(),
-                pem.frame_at(index).unwrap(),
-            );
+            let (g, p) = (glossy.frame_at(index).unwrap(), pem.frame_at(index).unwrap());
             assert_eq!(g.camera.world_from_camera, p.camera.world_from_camera);
             assert_eq!(g.lights.len(), p.lights.len());
         }
@@ -186,15 +161,12 @@ fn close(a: f64, b: f64) -> bool {
 fn same_json(a: &serde_json::Value, b: &serde_json::Value) -> bool {
     use serde_json::Value::*;
     match (a, b) {
-        (Number(x), Number(y)) => close(
-            x.as_f64().unwrap_or(f64::NAN),
-            y.as_f64().unwrap_or(f64::NAN),
-        ),
+        (Number(x), Number(y)) => {
+            close(x.as_f64().unwrap_or(f64::NAN), y.as_f64().unwrap_or(f64::NAN))
+        }
         (Array(x), Array(y)) => x.len() == y.len() && x.iter().zip(y).all(|(x, y)| same_json(x, y)),
         (Object(x), Object(y)) => {
-            x.len() == y.len()
-                && x.iter()
-                    .all(|(k, v)| y.get(k).is_some_and(|w| same_json(v, w)))
+            x.len() == y.len() && x.iter().all(|(k, v)| y.get(k).is_some_and(|w| same_json(v, w)))
         }
         _ => a == b,
     }

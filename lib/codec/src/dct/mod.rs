@@ -48,10 +48,7 @@ pub fn encode_quality(
 ) -> Result<Vec<u8>, CodecError> {
     let n = value_count(planes)?;
     if values.len() != n {
-        return Err(CodecError::Length {
-            expected: n,
-            found: values.len(),
-        });
+        return Err(CodecError::Length { expected: n, found: values.len() });
     }
     if let Some(i) = values.iter().position(|v| !v.is_finite()) {
         return Err(CodecError::Input(format!("value {i} is not finite")));
@@ -62,9 +59,7 @@ pub fn encode_quality(
     let (lo, hi) = chans
         .iter()
         .flatten()
-        .fold((f32::INFINITY, f32::NEG_INFINITY), |(lo, hi), v| {
-            (lo.min(*v), hi.max(*v))
-        });
+        .fold((f32::INFINITY, f32::NEG_INFINITY), |(lo, hi), v| (lo.min(*v), hi.max(*v)));
     let range = hi - lo;
     if !range.is_finite() {
         return Err(CodecError::Input("colour transform overflows f32".into()));
@@ -170,7 +165,10 @@ pub fn decode(planes: &[PlaneShape], bytes: &[u8]) -> Result<Vec<f32>, CodecErro
     // every one.
     let body = bytes.len() - hl;
     if !dec.exhausted() && dec.position() < body {
-        return Err(CodecError::TrailingBytes { extra: body - dec.position(), length: bytes.len() });
+        return Err(CodecError::TrailingBytes {
+            extra: body - dec.position(),
+            length: bytes.len(),
+        });
     }
     let mut out = Vec::with_capacity(n);
     colour::merge(planes, &chans, colour, &mut out);
@@ -201,17 +199,11 @@ pub fn rd_curve_weighted(
 ) -> Result<RdCurve, CodecError> {
     value_count(planes)?;
     let zero = crate::weighted_mse(values, &vec![0.0; values.len()], weights);
-    let mut points = vec![RdPoint {
-        bytes: 0,
-        mse: zero,
-    }];
+    let mut points = vec![RdPoint { bytes: 0, mse: zero }];
     for &q in qualities {
         let s = encode_quality(planes, values, q)?;
         let back = decode(planes, &s)?;
-        points.push(RdPoint {
-            bytes: s.len(),
-            mse: crate::weighted_mse(values, &back, weights),
-        });
+        points.push(RdPoint { bytes: s.len(), mse: crate::weighted_mse(values, &back, weights) });
     }
     Ok(RdCurve { points }.monotone())
 }

@@ -24,11 +24,7 @@ pub const ZIGZAG: [usize; 64] = [
 /// `step = unit · max(BASE · s / 100, 1/4)` with `s = 5000 / q` below 50, else `200 − 2q`.
 pub fn steps(quality: u8, unit: f32) -> [f32; 64] {
     let q = quality.clamp(1, 100) as f32;
-    let s = if q < 50.0 {
-        5000.0 / q
-    } else {
-        200.0 - 2.0 * q
-    };
+    let s = if q < 50.0 { 5000.0 / q } else { 200.0 - 2.0 * q };
     let mut out = [0.0f32; 64];
     for (o, b) in out.iter_mut().zip(BASE) {
         *o = unit * (b as f32 * s / 100.0).max(0.25);
@@ -38,7 +34,5 @@ pub fn steps(quality: u8, unit: f32) -> [f32; 64] {
 
 /// Nearest integer of `c / step`, clamped to ±2³⁰.
 pub fn quantize(c: f32, step: f32) -> i32 {
-    (c / step)
-        .round()
-        .clamp(-(1 << 30) as f32, (1 << 30) as f32) as i32
+    (c / step).round().clamp(-(1 << 30) as f32, (1 << 30) as f32) as i32
 }

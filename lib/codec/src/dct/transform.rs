@@ -8,11 +8,7 @@ fn table() -> &'static [[f32; 8]; 8] {
     T.get_or_init(|| {
         let mut t = [[0.0f32; 8]; 8];
         for (u, row) in t.iter_mut().enumerate() {
-            let c = if u == 0 {
-                (1.0f64 / 8.0).sqrt()
-            } else {
-                (2.0f64 / 8.0).sqrt()
-            };
+            let c = if u == 0 { (1.0f64 / 8.0).sqrt() } else { (2.0f64 / 8.0).sqrt() };
             for (x, v) in row.iter_mut().enumerate() {
                 *v = (c * (((2 * x + 1) * u) as f64 * std::f64::consts::PI / 16.0).cos()) as f32;
             }

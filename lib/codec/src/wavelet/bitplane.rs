@@ -105,19 +105,15 @@ pub struct Checkpoint {
 /// Returns the body and the error after each prefix length where it changes.
 pub fn encode(bands: &[Band], a: &[f64], neg: &[bool], top: u32) -> (Vec<u8>, Vec<Checkpoint>) {
     let n = a.len();
-    let m: Vec<u32> = a
-        .iter()
-        .map(|v| v.floor().min((1u64 << 31) as f64 - 1.0) as u32)
-        .collect();
+    let m: Vec<u32> = a.iter().map(|v| v.floor().min((1u64 << 31) as f64 - 1.0) as u32).collect();
     let mut sig = vec![0u8; n];
     let bases = tile_bases(bands);
-    let mut tsig = vec![
-        false;
-        bases.last().map_or(0, |&b| b)
-            + bands
-                .last()
-                .map_or(0, |b| b.width.div_ceil(TILE) * b.height.div_ceil(TILE))
-    ];
+    let mut tsig =
+        vec![
+            false;
+            bases.last().map_or(0, |&b| b)
+                + bands.last().map_or(0, |b| b.width.div_ceil(TILE) * b.height.div_ceil(TILE))
+        ];
     let mut tctx = [Context::default(); TILE_CONTEXTS];
     let mut enc = Encoder::new();
     let mut sctx = [Context::default(); SIG_CONTEXTS];
@@ -226,19 +222,14 @@ impl Decoded {
 /// Decodes as much of `body` as it holds (any prefix of an encoder's output is valid).
 pub fn decode(bands: &[Band], n: usize, top: u32, body: &[u8]) -> Decoded {
     let mut sig = vec![0u8; n];
-    let mut out = Decoded {
-        mag: vec![0u32; n],
-        low: vec![255u8; n],
-        used: 0,
-    };
+    let mut out = Decoded { mag: vec![0u32; n], low: vec![255u8; n], used: 0 };
     let bases = tile_bases(bands);
-    let mut tsig = vec![
-        false;
-        bases.last().map_or(0, |&b| b)
-            + bands
-                .last()
-                .map_or(0, |b| b.width.div_ceil(TILE) * b.height.div_ceil(TILE))
-    ];
+    let mut tsig =
+        vec![
+            false;
+            bases.last().map_or(0, |&b| b)
+                + bands.last().map_or(0, |b| b.width.div_ceil(TILE) * b.height.div_ceil(TILE))
+        ];
     let mut tctx = [Context::default(); TILE_CONTEXTS];
     let mut dec = Decoder::new(body);
     let mut sctx = [Context::default(); SIG_CONTEXTS];

@@ -54,11 +54,7 @@ pub fn inverse_1d(x: &mut [f32], tmp: &mut Vec<f32>) {
     tmp.clear();
     tmp.resize(n, 0.0);
     for i in 0..n {
-        tmp[i] = if i % 2 == 0 {
-            x[i / 2] * K
-        } else {
-            x[lo + i / 2] / K
-        };
+        tmp[i] = if i % 2 == 0 { x[i / 2] * K } else { x[lo + i / 2] / K };
     }
     x.copy_from_slice(tmp);
     lift(x, false, -DELTA);
@@ -111,11 +107,8 @@ fn inverse_cols(a: &mut [f32], w: usize, cw: usize, ch: usize, tmp: &mut Vec<f32
     tmp.resize(cw * ch, 0.0);
     for y in 0..ch {
         for x in 0..cw {
-            tmp[y * cw + x] = if y % 2 == 0 {
-                a[(y / 2) * w + x] * K
-            } else {
-                a[(lo + y / 2) * w + x] / K
-            };
+            tmp[y * cw + x] =
+                if y % 2 == 0 { a[(y / 2) * w + x] * K } else { a[(lo + y / 2) * w + x] / K };
         }
     }
     for y in 0..ch {
@@ -187,11 +180,8 @@ pub fn basis_energies(n: usize, levels: u32) -> Vec<(f64, f64)> {
         let mut e = [0.0f64; 2];
         for (band, energy) in e.iter_mut().enumerate() {
             let mut x = vec![0.0f32; n];
-            let pos = if band == 0 {
-                sizes[j] / 2
-            } else {
-                sizes[j] + (sizes[j - 1] - sizes[j]) / 2
-            };
+            let pos =
+                if band == 0 { sizes[j] / 2 } else { sizes[j] + (sizes[j - 1] - sizes[j]) / 2 };
             x[pos] = 1.0;
             for l in (1..=j).rev() {
                 inverse_1d(&mut x[..sizes[l - 1]], &mut tmp);
@@ -210,9 +200,8 @@ mod tests {
     #[test]
     fn perfect_reconstruction_any_size() {
         for (w, h) in [(1, 1), (2, 2), (3, 5), (17, 9), (64, 33), (1, 7)] {
-            let orig: Vec<f32> = (0..w * h)
-                .map(|i| ((i * 7919) % 101) as f32 * 0.1 - 3.0)
-                .collect();
+            let orig: Vec<f32> =
+                (0..w * h).map(|i| ((i * 7919) % 101) as f32 * 0.1 - 3.0).collect();
             let mut a = orig.clone();
             let l = plane_levels(w as u32, h as u32, 6);
             forward_2d(&mut a, w, h, l);

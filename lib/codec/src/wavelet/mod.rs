@@ -76,10 +76,7 @@ impl Encoded {
         let mut out = Vec::with_capacity(cuts.len());
         for c in cuts {
             let back = decode(planes, &self.bytes[..c])?;
-            out.push(RdPoint {
-                bytes: c,
-                mse: crate::weighted_mse(values, &back, weights),
-            });
+            out.push(RdPoint { bytes: c, mse: crate::weighted_mse(values, &back, weights) });
         }
         Ok(RdCurve { points: out })
     }
@@ -120,18 +117,9 @@ fn layout(planes: &[PlaneShape], levels: u32) -> (Vec<Band>, Vec<f32>, Vec<Array
         for _ in 0..p.channels {
             arrays.push((w, h, lev));
             let (lw, lh) = sizes[lev as usize];
-            let ll_scale = if lev == 0 {
-                1.0
-            } else {
-                ex[lev as usize - 1].0 * ey[lev as usize - 1].0
-            };
-            bands.push(Band {
-                offset,
-                width: lw,
-                height: lh,
-                class: 0,
-                parent: None,
-            });
+            let ll_scale =
+                if lev == 0 { 1.0 } else { ex[lev as usize - 1].0 * ey[lev as usize - 1].0 };
+            bands.push(Band { offset, width: lw, height: lh, class: 0, parent: None });
             scales.push(ll_scale.sqrt() as f32);
             offset += lw * lh;
             // Bands of the previous (coarser) level, per orientation.
@@ -151,13 +139,7 @@ fn layout(planes: &[PlaneShape], levels: u32) -> (Vec<Band>, Vec<f32>, Vec<Array
                 for o in 0..3 {
                     let (bw, bh) = dims[o];
                     let idx = bands.len();
-                    bands.push(Band {
-                        offset,
-                        width: bw,
-                        height: bh,
-                        class,
-                        parent: coarser[o],
-                    });
+                    bands.push(Band { offset, width: bw, height: bh, class, parent: coarser[o] });
                     scales.push(energy[o].sqrt() as f32);
                     coarser[o] = Some(idx);
                     offset += bw * bh;
@@ -214,10 +196,7 @@ pub fn encode_full(
 ) -> Result<Encoded, CodecError> {
     let n = value_count(planes)?;
     if values.len() != n {
-        return Err(CodecError::Length {
-            expected: n,
-            found: values.len(),
-        });
+        return Err(CodecError::Length { expected: n, found: values.len() });
     }
     if let Some(i) = values.iter().position(|v| !v.is_finite()) {
         return Err(CodecError::Input(format!("value {i} is not finite")));
@@ -247,49 +226,26 @@ pub fn encode_full(
     let hl = header_len(planes);
     if peak == 0.0 {
         // Every value is 0: the empty stream says it.
-        let curve = RdCurve {
-            points: vec![RdPoint { bytes: 0, mse: 0.0 }],
-        };
-        return Ok(Encoded {
-            bytes: Vec::new(),
-            curve,
-        });
+        let curve = RdCurve { points: vec![RdPoint { bytes: 0, mse: 0.0 }] };
+        return Ok(Encoded { bytes: Vec::new(), curve });
     }
     let step = (peak / (1u64 << bits) as f32).max(f32::MIN_POSITIVE);
-    let a: Vec<f64> = coefs
-        .iter()
-        .map(|c| (c.abs() as f64) / step as f64)
-        .collect();
-    let neg: Vec<bool> = coefs
-        .iter()
-        .map(|c| c.is_sign_negative() && *c != 0.0)
-        .collect();
-    let max_m = a
-        .iter()
-        .fold(0.0f64, |m, v| m.max(*v))
-        .floor()
-        .min((1u64 << 31) as f64 - 1.0) as u32;
+    let a: Vec<f64> = coefs.iter().map(|c| (c.abs() as f64) / step as f64).collect();
+    let neg: Vec<bool> = coefs.iter().map(|c| c.is_sign_negative() && *c != 0.0).collect();
+    let max_m =
+        a.iter().fold(0.0f64, |m, v| m.max(*v)).floor().min((1u64 << 31) as f64 - 1.0) as u32;
     let top = 31 - max_m.max(1).leading_zeros();
     header.push(top as u8);
     header.extend(step.to_le_bytes());
     let (body, trace) = bitplane::encode(&bands, &a, &neg, top);
     let unit = (step as f64) * (step as f64) / n as f64;
-    let mut points = vec![RdPoint {
-        bytes: 0,
-        mse: zero_mse,
-    }];
+    let mut points = vec![RdPoint { bytes: 0, mse: zero_mse }];
     for c in trace {
-        points.push(RdPoint {
-            bytes: hl + c.needed as usize,
-            mse: c.error * unit,
-        });
+        points.push(RdPoint { bytes: hl + c.needed as usize, mse: c.error * unit });
     }
     let mut bytes = header;
     bytes.extend(body);
-    Ok(Encoded {
-        bytes,
-        curve: RdCurve { points },
-    })
+    Ok(Encoded { bytes, curve: RdCurve { points } })
 }
 
 /// Encodes with a [`Rate`].
@@ -316,7 +272,8 @@ pub fn decode(planes: &[PlaneShape], bytes: &[u8]) -> Result<Vec<f32>, CodecErro
     }
     let hl = header_len(planes);
     let header = lossy_header::read(bytes, "step")?;
-    let (levels, colour, top, step) = (header.param as u32, header.colour, header.param2, header.scale);
+    let (levels, colour, top, step) =
+        (header.param as u32, header.colour, header.param2, header.scale);
     if levels > MAX_LEVELS {
         return Err(CodecError::Corrupt(format!("{levels} levels (at most {MAX_LEVELS})")));
     }
@@ -334,10 +291,7 @@ pub fn decode(planes: &[PlaneShape], bytes: &[u8]) -> Result<Vec<f32>, CodecErro
     if used < body.len() {
         return Err(CodecError::TrailingBytes { extra: body.len() - used, length: bytes.len() });
     }
-    let mut chans: Vec<Vec<f32>> = arrays
-        .iter()
-        .map(|&(w, h, _)| vec![0.0f32; w * h])
-        .collect();
+    let mut chans: Vec<Vec<f32>> = arrays.iter().map(|&(w, h, _)| vec![0.0f32; w * h]).collect();
     if let Some(dec) = dec {
         for_each_band_coef(&bands, &arrays, |b, ai, pos, k| {
             chans[ai][pos] = (dec.value(k) * step as f64 / scales[b] as f64) as f32;

@@ -22,13 +22,20 @@ pub fn demo1(resolution: (u32, u32)) -> (Vec<Mesh>, Mat4) {
     let frame = scene.frame_at(0).expect("point 0");
     let cam = frame.camera;
     let aspect = resolution.0 as f32 / resolution.1 as f32;
-    let clip_from_world = perspective(cam.yfov, aspect, cam.znear, cam.zfar.min(100.0)) * cam.world_from_camera.inverse();
+    let clip_from_world = perspective(cam.yfov, aspect, cam.znear, cam.zfar.min(100.0))
+        * cam.world_from_camera.inverse();
     let meshes = scene
         .objects
         .iter()
         .zip(&frame.instances)
         .map(|(o, inst)| {
-            let mut m = Mesh { name: o.name.clone(), positions: vec![], uvs: vec![], indices: vec![], world_from_object: inst.world_from_object };
+            let mut m = Mesh {
+                name: o.name.clone(),
+                positions: vec![],
+                uvs: vec![],
+                indices: vec![],
+                world_from_object: inst.world_from_object,
+            };
             for p in &o.primitives {
                 let base = m.positions.len() as u32;
                 m.positions.extend(p.positions.iter().map(|v: &Vec3| v.to_array()));

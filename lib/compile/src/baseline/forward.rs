@@ -23,7 +23,11 @@ pub fn forward_map(
 ) -> Result<Vec<f32>, CompileError> {
     let n = layer.width as usize * layer.height as usize;
     if layer.rgb.len() != n * 3 || layer.covered.len() != n {
-        return Err(CompileError::Size { what: "layer image (pixels × 3)".into(), expected: n * 3, found: layer.rgb.len() });
+        return Err(CompileError::Size {
+            what: "layer image (pixels × 3)".into(),
+            expected: n * 3,
+            found: layer.rgb.len(),
+        });
     }
     crate::error::check_finite("layer image", &layer.rgb)?;
     let mut image = layer.rgb.clone();
@@ -40,12 +44,24 @@ pub fn forward_map(
             let Some(p) = on_screen(k) else { continue };
             // the texel's footprint: distance to its neighbours on screen
             let mut foot = 1.0f64;
-            for q in [(i + 1 < w as usize).then(|| k + 1), (j + 1 < h as usize).then(|| k + w as usize)].into_iter().flatten() {
+            for q in
+                [(i + 1 < w as usize).then(|| k + 1), (j + 1 < h as usize).then(|| k + w as usize)]
+                    .into_iter()
+                    .flatten()
+            {
                 if let Some(r) = on_screen(q) {
                     foot = foot.max(((r[0] - p[0]) as f64).hypot((r[1] - p[1]) as f64));
                 }
             }
-            let v = filter_at(&image, layer.width, layer.height, p[0] as f64, p[1] as f64, FORWARD_LANCZOS, foot.min(16.0));
+            let v = filter_at(
+                &image,
+                layer.width,
+                layer.height,
+                p[0] as f64,
+                p[1] as f64,
+                FORWARD_LANCZOS,
+                foot.min(16.0),
+            );
             level0[k * 3..k * 3 + 3].copy_from_slice(&v);
             defined[k] = true;
         }

@@ -17,11 +17,21 @@ pub fn lanczos(x: f64, a: f64) -> f64 {
 
 /// The separable Lanczos filter of half-width `a · scale` pixels, evaluated at (x, y) in
 /// pixel units (pixel centres at i + ½) over an RGB image, normalized by its weight sum.
-pub fn filter_at(rgb: &[f32], width: u32, height: u32, x: f64, y: f64, a: f64, scale: f64) -> [f32; 3] {
+pub fn filter_at(
+    rgb: &[f32],
+    width: u32,
+    height: u32,
+    x: f64,
+    y: f64,
+    a: f64,
+    scale: f64,
+) -> [f32; 3] {
     let (cx, cy) = (x - 0.5, y - 0.5);
     let r = a * scale;
-    let (x0, x1) = ((cx - r).ceil().max(0.0) as i64, ((cx + r).floor() as i64).min(width as i64 - 1));
-    let (y0, y1) = ((cy - r).ceil().max(0.0) as i64, ((cy + r).floor() as i64).min(height as i64 - 1));
+    let (x0, x1) =
+        ((cx - r).ceil().max(0.0) as i64, ((cx + r).floor() as i64).min(width as i64 - 1));
+    let (y0, y1) =
+        ((cy - r).ceil().max(0.0) as i64, ((cy + r).floor() as i64).min(height as i64 - 1));
     let mut acc = [0.0f64; 3];
     let mut wsum = 0.0;
     for j in y0..=y1 {

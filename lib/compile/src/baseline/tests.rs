@@ -24,7 +24,8 @@ fn psnr(a: &[f32], b: &[f32]) -> f64 {
 #[test]
 fn forward_mapping_and_traced_textures_reproduce_a_smooth_layer() {
     let n = 32u32;
-    let mesh = DrawMesh { positions: &POS, uvs: &UV, indices: &IDX, clip_from_object: Mat4::IDENTITY };
+    let mesh =
+        DrawMesh { positions: &POS, uvs: &UV, indices: &IDX, clip_from_object: Mat4::IDENTITY };
     let layout = TextureLayout::full(n, n);
     let mut rgb = vec![];
     for y in 0..n {
@@ -39,20 +40,38 @@ fn forward_mapping_and_traced_textures_reproduce_a_smooth_layer() {
     assert_eq!(tex.len(), layout.texel_count() * 3);
     assert!(tex.iter().all(|v| v.is_finite()));
     let right = |img: &[f32]| -> Vec<f32> {
-        (0..(n * n) as usize).filter(|k| k % n as usize >= n as usize / 4 + 4)
-            .flat_map(|k| img[k * 3..k * 3 + 3].to_vec()).collect()
+        (0..(n * n) as usize)
+            .filter(|k| k % n as usize >= n as usize / 4 + 4)
+            .flat_map(|k| img[k * 3..k * 3 + 3].to_vec())
+            .collect()
     };
     assert!(psnr(&right(&tex), &right(&rgb)) > 35.0);
 
     // traced: the "radiance" is f at the point the ray reaches, in pixel units of the quad
-    let traced = trace_into_texture(&mesh, &TextureTransform::IDENTITY, Mat4::IDENTITY, Vec3::new(0.0, 0.0, 5.0), &layout,
-        |rays| rays.iter().map(|r| {
-            let p = r.origin + r.direction * r.distance;
-            f((p.x + 1.0) * 0.5 * n as f32, (1.0 - p.y) * 0.5 * n as f32)
-        }).collect()).unwrap();
+    let traced = trace_into_texture(
+        &mesh,
+        &TextureTransform::IDENTITY,
+        Mat4::IDENTITY,
+        Vec3::new(0.0, 0.0, 5.0),
+        &layout,
+        |rays| {
+            rays.iter()
+                .map(|r| {
+                    let p = r.origin + r.direction * r.distance;
+                    f((p.x + 1.0) * 0.5 * n as f32, (1.0 - p.y) * 0.5 * n as f32)
+                })
+                .collect()
+        },
+    )
+    .unwrap();
     let inner = |img: &[f32]| -> Vec<f32> {
-        (0..(n * n) as usize).filter(|k| { let (x, y) = (k % n as usize, k / n as usize); (3..29).contains(&x) && (3..29).contains(&y) })
-            .flat_map(|k| img[k * 3..k * 3 + 3].to_vec()).collect()
+        (0..(n * n) as usize)
+            .filter(|k| {
+                let (x, y) = (k % n as usize, k / n as usize);
+                (3..29).contains(&x) && (3..29).contains(&y)
+            })
+            .flat_map(|k| img[k * 3..k * 3 + 3].to_vec())
+            .collect()
     };
     assert!(psnr(&inner(&traced), &inner(&rgb)) > 35.0, "{}", psnr(&inner(&traced), &inner(&rgb)));
 }

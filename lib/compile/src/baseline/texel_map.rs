@@ -17,8 +17,13 @@ pub struct TexelPoint {
 }
 
 /// Maps the centres of a `width × height` sample grid over (s, t) ∈ [0, 1]² to the object.
-pub fn map_texels(mesh: &DrawMesh, transform: &TextureTransform, viewport: Viewport, width: u32, height: u32)
-    -> Vec<Option<TexelPoint>> {
+pub fn map_texels(
+    mesh: &DrawMesh,
+    transform: &TextureTransform,
+    viewport: Viewport,
+    width: u32,
+    height: u32,
+) -> Vec<Option<TexelPoint>> {
     let mut out: Vec<Option<TexelPoint>> = vec![None; width as usize * height as usize];
     let (fw, fh) = (width as f64, height as f64);
     for tri in mesh.indices.chunks_exact(3) {
@@ -27,11 +32,15 @@ pub fn map_texels(mesh: &DrawMesh, transform: &TextureTransform, viewport: Viewp
             continue;
         }
         // triangle in sample-grid coordinates
-        let st: Vec<[f64; 2]> = idx.iter().map(|&i| {
-            let p = transform.texcoord(mesh.uvs[i]);
-            [p[0] as f64 * fw, p[1] as f64 * fh]
-        }).collect();
-        let area = (st[1][0] - st[0][0]) * (st[2][1] - st[0][1]) - (st[1][1] - st[0][1]) * (st[2][0] - st[0][0]);
+        let st: Vec<[f64; 2]> = idx
+            .iter()
+            .map(|&i| {
+                let p = transform.texcoord(mesh.uvs[i]);
+                [p[0] as f64 * fw, p[1] as f64 * fh]
+            })
+            .collect();
+        let area = (st[1][0] - st[0][0]) * (st[2][1] - st[0][1])
+            - (st[1][1] - st[0][1]) * (st[2][0] - st[0][0]);
         if area.abs() < 1e-12 {
             continue;
         }
@@ -45,7 +54,9 @@ pub fn map_texels(mesh: &DrawMesh, transform: &TextureTransform, viewport: Viewp
         for y in y0..=y1 {
             for x in x0..=x1 {
                 let (px, py) = (x as f64 + 0.5, y as f64 + 0.5);
-                let e = |a: [f64; 2], b: [f64; 2]| (b[0] - a[0]) * (py - a[1]) - (b[1] - a[1]) * (px - a[0]);
+                let e = |a: [f64; 2], b: [f64; 2]| {
+                    (b[0] - a[0]) * (py - a[1]) - (b[1] - a[1]) * (px - a[0])
+                };
                 let l = [e(st[1], st[2]) / area, e(st[2], st[0]) / area, e(st[0], st[1]) / area];
                 if l.iter().any(|&v| v < -1e-9) {
                     continue;
@@ -55,10 +66,14 @@ pub fn map_texels(mesh: &DrawMesh, transform: &TextureTransform, viewport: Viewp
                 let k = y as usize * width as usize + x as usize;
                 let nearer = match &out[k] {
                     None => true,
-                    Some(old) => clip.w > 0.0 && (old.clip.w <= 0.0 || clip.z / clip.w < old.clip.z / old.clip.w),
+                    Some(old) => {
+                        clip.w > 0.0
+                            && (old.clip.w <= 0.0 || clip.z / clip.w < old.clip.z / old.clip.w)
+                    }
                 };
                 if nearer {
-                    let f = if clip.w > 0.0 { to_framebuffer(clip, viewport) } else { [f32::NAN; 3] };
+                    let f =
+                        if clip.w > 0.0 { to_framebuffer(clip, viewport) } else { [f32::NAN; 3] };
                     out[k] = Some(TexelPoint { object, clip, screen: [f[0], f[1]] });
                 }
             }

@@ -53,7 +53,11 @@ pub fn trace_into_texture(
     }
     let radiance = trace(&rays);
     if radiance.len() != rays.len() {
-        return Err(CompileError::Size { what: "traced radiance".into(), expected: rays.len(), found: radiance.len() });
+        return Err(CompileError::Size {
+            what: "traced radiance".into(),
+            expected: rays.len(),
+            found: radiance.len(),
+        });
     }
     let mut fine = vec![0.0f32; w as usize * h as usize * 3];
     let mut defined = vec![false; w as usize * h as usize];

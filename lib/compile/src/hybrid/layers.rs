@@ -52,14 +52,20 @@ fn hit_distance(ray: &OutgoingRay, t: f64, origin: DVec3) -> f64 {
 /// iterated until no hit changes layer; then whole objects assigned and each ray counted
 /// once per layer (its frontmost hit there), the layer distances the means of those.
 pub fn cluster(rays: &[OutgoingRay], origin: DVec3, n: usize) -> Layers {
-    let mut all: Vec<(f64, u32)> = rays.iter().flat_map(|r| r.hits.iter().map(move |&(t, o)| (hit_distance(r, t, origin), o))).collect();
+    let mut all: Vec<(f64, u32)> = rays
+        .iter()
+        .flat_map(|r| r.hits.iter().map(move |&(t, o)| (hit_distance(r, t, origin), o)))
+        .collect();
     if all.is_empty() || n == 0 {
         return Layers { distances: Vec::new(), layer_of: BTreeMap::new(), counted: 0 };
     }
     all.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
     let n = n.min(all.len());
-    let mut centres: Vec<f64> = (0..n).map(|k| all[((2 * k + 1) * all.len() / (2 * n)).min(all.len() - 1)].0).collect();
-    let nearest = |d: f64, c: &[f64]| (0..c.len()).min_by(|&a, &b| (d - c[a]).abs().total_cmp(&(d - c[b]).abs())).unwrap_or(0);
+    let mut centres: Vec<f64> =
+        (0..n).map(|k| all[((2 * k + 1) * all.len() / (2 * n)).min(all.len() - 1)].0).collect();
+    let nearest = |d: f64, c: &[f64]| {
+        (0..c.len()).min_by(|&a, &b| (d - c[a]).abs().total_cmp(&(d - c[b]).abs())).unwrap_or(0)
+    };
     let mut assign: Vec<usize> = all.iter().map(|h| nearest(h.0, &centres)).collect();
     for _ in 0..1000 {
         let mut sum = vec![(0.0, 0usize); n];
@@ -83,13 +89,21 @@ pub fn cluster(rays: &[OutgoingRay], origin: DVec3, n: usize) -> Layers {
     for (h, &a) in all.iter().zip(&assign) {
         votes.entry(h.1).or_insert_with(|| vec![0; n])[a] += 1;
     }
-    let layer_of: BTreeMap<u32, usize> = votes.iter().map(|(&o, v)| (o, (0..n).max_by_key(|&k| (v[k], std::cmp::Reverse(k))).unwrap_or(0))).collect();
+    let layer_of: BTreeMap<u32, usize> = votes
+        .iter()
+        .map(|(&o, v)| (o, (0..n).max_by_key(|&k| (v[k], std::cmp::Reverse(k))).unwrap_or(0)))
+        .collect();
     finish_layers(rays, layer_of, origin, n)
 }
 
 /// [`Layers`] of an assignment of objects to `n` layers: layer distances from the frontmost
 /// hit of each ray in each layer, empty layers dropped, the rest renumbered by distance.
-fn finish_layers(rays: &[OutgoingRay], mut layer_of: BTreeMap<u32, usize>, origin: DVec3, n: usize) -> Layers {
+fn finish_layers(
+    rays: &[OutgoingRay],
+    mut layer_of: BTreeMap<u32, usize>,
+    origin: DVec3,
+    n: usize,
+) -> Layers {
     let mut per: Vec<Vec<f64>> = vec![Vec::new(); n];
     for r in rays {
         let mut seen = vec![false; n];
@@ -101,9 +115,15 @@ fn finish_layers(rays: &[OutgoingRay], mut layer_of: BTreeMap<u32, usize>, origi
             }
         }
     }
-    let mut kept: Vec<(f64, usize)> = per.iter().enumerate().filter(|(_, v)| !v.is_empty()).map(|(k, v)| (v.iter().sum::<f64>() / v.len() as f64, k)).collect();
+    let mut kept: Vec<(f64, usize)> = per
+        .iter()
+        .enumerate()
+        .filter(|(_, v)| !v.is_empty())
+        .map(|(k, v)| (v.iter().sum::<f64>() / v.len() as f64, k))
+        .collect();
     kept.sort_by(|a, b| a.0.total_cmp(&b.0));
-    let renumber: BTreeMap<usize, usize> = kept.iter().enumerate().map(|(new, &(_, old))| (old, new)).collect();
+    let renumber: BTreeMap<usize, usize> =
+        kept.iter().enumerate().map(|(new, &(_, old))| (old, new)).collect();
     layer_of.values_mut().for_each(|l| *l = renumber[l]);
     let distances: Vec<f64> = kept.iter().map(|k| k.0).collect();
     let counted = rays.iter().map(|r| r.hits.len()).sum();
@@ -113,7 +133,12 @@ fn finish_layers(rays: &[OutgoingRay], mut layer_of: BTreeMap<u32, usize>, origi
 /// The number of layers (1..=`max`) after which one more no longer halves the error of the
 /// fitted shells ([`shells_error`]), its clustering and its shells. `scale`: the lens
 /// object's size (its bounding radius), below which distances count as that size.
-pub fn choose_layers(rays: &[OutgoingRay], origin: DVec3, max: usize, scale: f64) -> (Layers, Vec<FittedShell>) {
+pub fn choose_layers(
+    rays: &[OutgoingRay],
+    origin: DVec3,
+    max: usize,
+    scale: f64,
+) -> (Layers, Vec<FittedShell>) {
     let (mut best, mut best_shells) = refine(rays, cluster(rays, origin, 1), origin, scale);
     let mut best_error = shells_error(rays, &best, &best_shells, origin, scale);
     for n in 2..=max.max(1) {
@@ -134,8 +159,17 @@ pub fn choose_layers(rays: &[OutgoingRay], origin: DVec3, max: usize, scale: f64
 /// Shells fitted to `layers`, then each object moved to the layer whose shell puts its hits
 /// nearest where they are, the shells fitted again, until no object moves (at most 8 times):
 /// LBG's iteration with the shells for centres, from LBG's clustering by distance.
-fn refine(rays: &[OutgoingRay], mut layers: Layers, origin: DVec3, scale: f64) -> (Layers, Vec<FittedShell>) {
-    let fitted = |layers: &Layers| -> Vec<FittedShell> { (0..layers.distances.len()).filter_map(|l| fit_shell(rays, &layer_hits(rays, layers, l), origin, scale)).collect() };
+fn refine(
+    rays: &[OutgoingRay],
+    mut layers: Layers,
+    origin: DVec3,
+    scale: f64,
+) -> (Layers, Vec<FittedShell>) {
+    let fitted = |layers: &Layers| -> Vec<FittedShell> {
+        (0..layers.distances.len())
+            .filter_map(|l| fit_shell(rays, &layer_hits(rays, layers, l), origin, scale))
+            .collect()
+    };
     let mut shells = fitted(&layers);
     for _ in 0..8 {
         if shells.len() != layers.distances.len() {
@@ -146,11 +180,20 @@ fn refine(rays: &[OutgoingRay], mut layers: Layers, origin: DVec3, scale: f64) -
             for &(t, o) in &r.hits {
                 let c = cost.entry(o).or_insert_with(|| vec![0.0; shells.len()]);
                 for (k, f) in shells.iter().enumerate() {
-                    c[k] += relative_error(r, t, shell_hit(&f.shell, r.origin, r.direction), origin, scale);
+                    c[k] += relative_error(
+                        r,
+                        t,
+                        shell_hit(&f.shell, r.origin, r.direction),
+                        origin,
+                        scale,
+                    );
                 }
             }
         }
-        let moved: BTreeMap<u32, usize> = cost.iter().map(|(&o, c)| (o, (0..c.len()).min_by(|&a, &b| c[a].total_cmp(&c[b])).unwrap_or(0))).collect();
+        let moved: BTreeMap<u32, usize> = cost
+            .iter()
+            .map(|(&o, c)| (o, (0..c.len()).min_by(|&a, &b| c[a].total_cmp(&c[b])).unwrap_or(0)))
+            .collect();
         if moved == layers.layer_of {
             break;
         }
@@ -167,13 +210,21 @@ fn refine(rays: &[OutgoingRay], mut layers: Layers, origin: DVec3, scale: f64) -
 
 /// How far the shells put the environment from where it is: over every hit of every ray
 /// (hidden ones too), [`relative_error`] summed.
-pub fn shells_error(rays: &[OutgoingRay], layers: &Layers, shells: &[FittedShell], origin: DVec3, scale: f64) -> f64 {
+pub fn shells_error(
+    rays: &[OutgoingRay],
+    layers: &Layers,
+    shells: &[FittedShell],
+    origin: DVec3,
+    scale: f64,
+) -> f64 {
     rays.iter()
         .map(|r| {
             r.hits
                 .iter()
                 .map(|&(t, o)| {
-                    let Some(f) = layers.layer_of.get(&o).and_then(|&l| shells.get(l)) else { return 1.0 };
+                    let Some(f) = layers.layer_of.get(&o).and_then(|&l| shells.get(l)) else {
+                        return 1.0;
+                    };
                     relative_error(r, t, shell_hit(&f.shell, r.origin, r.direction), origin, scale)
                 })
                 .sum::<f64>()
@@ -185,7 +236,12 @@ pub fn shells_error(rays: &[OutgoingRay], layers: &Layers, shells: &[FittedShell
 pub fn layer_hits(rays: &[OutgoingRay], layers: &Layers, layer: usize) -> Vec<(usize, f64)> {
     rays.iter()
         .enumerate()
-        .filter_map(|(i, r)| r.hits.iter().find(|(_, o)| layers.layer_of.get(o) == Some(&layer)).map(|&(t, _)| (i, t)))
+        .filter_map(|(i, r)| {
+            r.hits
+                .iter()
+                .find(|(_, o)| layers.layer_of.get(o) == Some(&layer))
+                .map(|&(t, _)| (i, t))
+        })
         .collect()
 }
 
@@ -214,15 +270,27 @@ pub struct FittedShell {
 /// axis-aligned box whose faces lie at the mean distance of the hits nearest each; the one
 /// whose intersection with each ray is nearest the recorded hit (in distance along the ray,
 /// relative to the hit's, squared).
-pub fn fit_shell(rays: &[OutgoingRay], hits: &[(usize, f64)], origin: DVec3, scale: f64) -> Option<FittedShell> {
+pub fn fit_shell(
+    rays: &[OutgoingRay],
+    hits: &[(usize, f64)],
+    origin: DVec3,
+    scale: f64,
+) -> Option<FittedShell> {
     if hits.is_empty() {
         return None;
     }
-    let points: Vec<DVec3> = hits.iter().map(|&(i, t)| rays[i].origin + rays[i].direction * t).collect();
+    let points: Vec<DVec3> =
+        hits.iter().map(|&(i, t)| rays[i].origin + rays[i].direction * t).collect();
     let n = points.len() as f64;
     let radius = points.iter().map(|p| (*p - origin).length()).sum::<f64>() / n;
-    let horizontal = points.iter().map(|p| ((p.x - origin.x).powi(2) + (p.z - origin.z).powi(2)).sqrt()).sum::<f64>() / n;
-    let (y_min, y_max) = points.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| (lo.min(p.y), hi.max(p.y)));
+    let horizontal = points
+        .iter()
+        .map(|p| ((p.x - origin.x).powi(2) + (p.z - origin.z).powi(2)).sqrt())
+        .sum::<f64>()
+        / n;
+    let (y_min, y_max) = points
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| (lo.min(p.y), hi.max(p.y)));
     // Box: its bottom on the lowest hit (the supporting plane, where the layer has one), its
     // top on the highest; each other hit votes for the side its horizontal offset from the
     // origin points at most, a side's plane at its voters' mean, a side without voters at
@@ -236,12 +304,27 @@ pub fn fit_shell(rays: &[OutgoingRay], hits: &[(usize, f64)], origin: DVec3, sca
         sums[face][0] += axis;
         sums[face][1] += 1.0;
     }
-    let side = |f: usize| if sums[f][1] > 0.0 { sums[f][0] / sums[f][1] } else if f % 2 == 1 { radius } else { -radius };
+    let side = |f: usize| {
+        if sums[f][1] > 0.0 {
+            sums[f][0] / sums[f][1]
+        } else if f % 2 == 1 {
+            radius
+        } else {
+            -radius
+        }
+    };
     let lo = DVec3::new(side(0).min(-1e-6), (y_min - origin.y).min(-1e-6), side(2).min(-1e-6));
     let hi = DVec3::new(side(1).max(1e-6), (y_max - origin.y).max(1e-6), side(3).max(1e-6));
     let candidates = [
         Shell { origin, shape: ShellShape::Sphere { radius } },
-        Shell { origin, shape: ShellShape::Cylinder { radius: horizontal.max(1e-6), y_min: y_min.min(origin.y - 1e-6), y_max: y_max.max(origin.y + 1e-6) } },
+        Shell {
+            origin,
+            shape: ShellShape::Cylinder {
+                radius: horizontal.max(1e-6),
+                y_min: y_min.min(origin.y - 1e-6),
+                y_max: y_max.max(origin.y + 1e-6),
+            },
+        },
         Shell { origin, shape: ShellShape::Box { min: origin + lo, max: origin + hi } },
     ];
     candidates
@@ -272,7 +355,11 @@ mod tests {
                 let a = k as f64 * 0.0314;
                 let d = DVec3::new(a.cos(), 0.2 * (k as f64 * 0.7).sin(), a.sin()).normalize();
                 let horizontal = (d.x * d.x + d.z * d.z).sqrt();
-                OutgoingRay { origin: DVec3::ZERO, direction: d, hits: vec![(r, 1 + (k % 3) as u32), (r2 / horizontal, 9)] }
+                OutgoingRay {
+                    origin: DVec3::ZERO,
+                    direction: d,
+                    hits: vec![(r, 1 + (k % 3) as u32), (r2 / horizontal, 9)],
+                }
             })
             .collect()
     }
@@ -289,15 +376,27 @@ mod tests {
         assert_eq!(layers.layer_of.values().copied().collect::<Vec<_>>(), vec![0, 0, 0, 1]);
         // The near layer fits a sphere, the far one a cylinder, exactly.
         let near = fit_shell(&rays, &layer_hits(&rays, &layers, 0), DVec3::ZERO, 0.1).unwrap();
-        assert!(matches!(near.shell.shape, ShellShape::Sphere { .. }) && near.mse < 1e-12, "{near:?}");
+        assert!(
+            matches!(near.shell.shape, ShellShape::Sphere { .. }) && near.mse < 1e-12,
+            "{near:?}"
+        );
         let far = fit_shell(&rays, &layer_hits(&rays, &layers, 1), DVec3::ZERO, 0.1).unwrap();
-        assert!(matches!(far.shell.shape, ShellShape::Cylinder { .. }) && far.mse < 1e-9, "{far:?}");
+        assert!(
+            matches!(far.shell.shape, ShellShape::Cylinder { .. }) && far.mse < 1e-9,
+            "{far:?}"
+        );
     }
 
     #[test]
     fn an_object_is_never_torn_between_layers() {
         // Object 7's hits spread from 1 to 6: LBG alone would split them.
-        let rays: Vec<OutgoingRay> = (0..100).map(|k| OutgoingRay { origin: DVec3::ZERO, direction: DVec3::X, hits: vec![(1.0 + 0.05 * k as f64, 7), (20.0, 8)] }).collect();
+        let rays: Vec<OutgoingRay> = (0..100)
+            .map(|k| OutgoingRay {
+                origin: DVec3::ZERO,
+                direction: DVec3::X,
+                hits: vec![(1.0 + 0.05 * k as f64, 7), (20.0, 8)],
+            })
+            .collect();
         let layers = cluster(&rays, DVec3::ZERO, 3);
         let near: Vec<usize> = layers.layer_of.values().copied().collect();
         assert_eq!(near.len(), 2);
@@ -307,12 +406,17 @@ mod tests {
 
     #[test]
     fn one_layer_when_a_second_does_not_halve_the_error() {
-        let rays: Vec<OutgoingRay> = (0..50).map(|k| OutgoingRay { origin: DVec3::ZERO, direction: DVec3::Y, hits: vec![(3.0 + 0.01 * (k % 5) as f64, k % 4)] }).collect();
+        let rays: Vec<OutgoingRay> = (0..50)
+            .map(|k| OutgoingRay {
+                origin: DVec3::ZERO,
+                direction: DVec3::Y,
+                hits: vec![(3.0 + 0.01 * (k % 5) as f64, k % 4)],
+            })
+            .collect();
         let (layers, _) = choose_layers(&rays, DVec3::ZERO, 4, 0.1);
         // Four objects, each with hits spread over 3.00–3.04: whole objects in two layers
         // hardly lower the error, so one layer is kept.
         assert_eq!(layers.distances.len(), 1, "{layers:?}");
         assert!((layers.distances[0] - 3.02).abs() < 1e-9, "{layers:?}");
-
     }
 }

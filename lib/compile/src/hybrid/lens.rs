@@ -58,7 +58,12 @@ impl LensObject {
     /// A lens object from world positions, per-vertex normals (zero or missing: the face
     /// normal) and triangle indices; triangles with an index out of range, a zero area or a
     /// non-finite corner are dropped.
-    pub fn new(material: LensMaterial, positions: Vec<Vec3>, normals: Vec<Vec3>, indices: &[u32]) -> LensObject {
+    pub fn new(
+        material: LensMaterial,
+        positions: Vec<Vec3>,
+        normals: Vec<Vec3>,
+        indices: &[u32],
+    ) -> LensObject {
         let mut triangles = Vec::with_capacity(indices.len() / 3);
         let mut bvh_triangles = Vec::with_capacity(indices.len() / 3);
         for t in indices.chunks_exact(3) {
@@ -70,7 +75,13 @@ impl LensObject {
             triangles.push([t[0], t[1], t[2]]);
             bvh_triangles.push(Triangle { v0: a.into(), v1: b.into(), v2: c.into() });
         }
-        let bvh = (!bvh_triangles.is_empty()).then(|| build_cwbvh_from_tris(&bvh_triangles, BvhBuildParams::medium_build(), &mut Duration::default()));
+        let bvh = (!bvh_triangles.is_empty()).then(|| {
+            build_cwbvh_from_tris(
+                &bvh_triangles,
+                BvhBuildParams::medium_build(),
+                &mut Duration::default(),
+            )
+        });
         LensObject { material, positions, normals, triangles, bvh_triangles, bvh }
     }
 
@@ -79,7 +90,9 @@ impl LensObject {
         let bvh = self.bvh.as_ref()?;
         let ray = Ray::new(Vec3A::from(origin), Vec3A::from(dir), 0.0, tmax);
         let mut hit = RayHit::none();
-        if !bvh.ray_traverse(ray, &mut hit, |r, id| self.bvh_triangles[bvh.primitive_indices[id] as usize].intersect(r)) {
+        if !bvh.ray_traverse(ray, &mut hit, |r, id| {
+            self.bvh_triangles[bvh.primitive_indices[id] as usize].intersect(r)
+        }) {
             return None;
         }
         Some(LensHit { t: hit.t, triangle: bvh.primitive_indices[hit.primitive_id as usize] })
@@ -89,7 +102,8 @@ impl LensObject {
     /// barycentric blend of the corners' normals, the face normal where they cancel).
     pub fn surface(&self, hit: &LensHit, origin: Vec3, dir: Vec3) -> LensSurface {
         let [i0, i1, i2] = self.triangles[hit.triangle as usize];
-        let (a, b, c) = (self.positions[i0 as usize], self.positions[i1 as usize], self.positions[i2 as usize]);
+        let (a, b, c) =
+            (self.positions[i0 as usize], self.positions[i1 as usize], self.positions[i2 as usize]);
         let p = origin + dir * hit.t;
         let w = barycentric([a, b, c], p);
         let ng = (b - a).cross(c - a).normalize();
@@ -99,7 +113,11 @@ impl LensObject {
         let mut normal = match (n(i0), n(i1), n(i2)) {
             (Some(n0), Some(n1), Some(n2)) => {
                 let ns = (n0 * w[0] + n1 * w[1] + n2 * w[2]).normalize_or_zero();
-                if ns == Vec3::ZERO { ng } else { ns }
+                if ns == Vec3::ZERO {
+                    ng
+                } else {
+                    ns
+                }
             }
             _ => ng,
         };
@@ -119,7 +137,11 @@ impl LensObject {
             sum += (a + b + c) * (w / 3.0);
             area += w;
         }
-        if area > 0.0 { (sum / area).as_vec3() } else { Vec3::ZERO }
+        if area > 0.0 {
+            (sum / area).as_vec3()
+        } else {
+            Vec3::ZERO
+        }
     }
 
     /// The winding normal of triangle `t` (unit).
@@ -143,5 +165,9 @@ pub fn barycentric(v: [Vec3; 3], p: Vec3) -> [f32; 3] {
 /// side `dir` leaves by.
 pub fn offset_origin(p: Vec3, ng: Vec3, dir: Vec3) -> Vec3 {
     let eps = 1e-4 * (1.0 + p.abs().max_element());
-    if dir.dot(ng) >= 0.0 { p + ng * eps } else { p - ng * eps }
+    if dir.dot(ng) >= 0.0 {
+        p + ng * eps
+    } else {
+        p - ng * eps
+    }
 }

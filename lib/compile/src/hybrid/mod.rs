@@ -11,8 +11,17 @@ pub mod model;
 pub mod path;
 pub mod tessellate;
 
-pub use layers::{choose_layers, cluster, fit_shell, layer_hits, relative_error, shells_error, FittedShell, Layers, OutgoingRay};
+pub use layers::{
+    choose_layers, cluster, fit_shell, layer_hits, relative_error, shells_error, FittedShell,
+    Layers, OutgoingRay,
+};
 pub use lens::{LensMaterial, LensObject};
-pub use model::{corner_values, hybrid_pixels, hybrid_render_matrix, shell_vector, term_radiance, vertex_modulation, vertex_vectors, HybridPixels, Missing};
+pub use model::{
+    corner_values, hybrid_pixels, hybrid_render_matrix, shell_vector, term_radiance,
+    vertex_modulation, vertex_vectors, HybridPixels, Missing,
+};
 pub use path::{greedy_path, LensPath, Term, Topology, TERMS};
-pub use tessellate::{tessellate, tessellate_timed, HybridVertex, HybridView, Tessellation, TessellationSettings, TessellationStats, TessellationTimes};
+pub use tessellate::{
+    tessellate, tessellate_timed, HybridVertex, HybridView, Tessellation, TessellationSettings,
+    TessellationStats, TessellationTimes,
+};

@@ -34,7 +34,10 @@ pub fn shell_vector(shell: &Shell, path: &LensPath) -> Option<[f32; 3]> {
 /// Per vertex of `tess`, the cube-map vector of `shell` for `term`, `None` where the vertex
 /// has no such path or its ray misses the shell.
 pub fn vertex_vectors(tess: &Tessellation, term: Term, shell: &Shell) -> Vec<Option<[f32; 3]>> {
-    tess.vertices.par_iter().map(|v| v.paths[term as usize].as_ref().and_then(|p| shell_vector(shell, p))).collect()
+    tess.vertices
+        .par_iter()
+        .map(|v| v.paths[term as usize].as_ref().and_then(|p| shell_vector(shell, p)))
+        .collect()
 }
 
 /// What a triangle's corner without a value takes, where its other corners have one: the
@@ -51,7 +54,11 @@ pub enum Missing {
 /// Per triangle of `tess`, its corners' values for one term (`None`: no corner has one,
 /// the triangle does not draw the term); corners without a value take `missing`, the mean
 /// computed in `f32`. What the player's vertex buffer holds, corner by corner.
-pub fn corner_values(tess: &Tessellation, values: &[Option<[f32; 3]>], missing: Missing) -> Vec<Option<[[f32; 3]; 3]>> {
+pub fn corner_values(
+    tess: &Tessellation,
+    values: &[Option<[f32; 3]>],
+    missing: Missing,
+) -> Vec<Option<[[f32; 3]; 3]>> {
     tess.triangles
         .par_iter()
         .map(|t| {
@@ -64,7 +71,10 @@ pub fn corner_values(tess: &Tessellation, values: &[Option<[f32; 3]>], missing: 
                 Missing::Zero => [0.0; 3],
                 Missing::Mean => {
                     // The valid corners summed in corner order, then divided.
-                    let s = v.iter().flatten().fold([0.0f32; 3], |a, x| [a[0] + x[0], a[1] + x[1], a[2] + x[2]]);
+                    let s = v
+                        .iter()
+                        .flatten()
+                        .fold([0.0f32; 3], |a, x| [a[0] + x[0], a[1] + x[1], a[2] + x[2]]);
                     let n = n as f32;
                     [s[0] / n, s[1] / n, s[2] / n]
                 }
@@ -85,16 +95,42 @@ pub struct HybridPixels {
 /// with per-vertex values `vectors` (a triangle draws where at least one corner has a
 /// value; the others take `missing`), depth-tested against the tessellation itself and
 /// `occluders`.
-pub fn hybrid_pixels(viewport: Viewport, tess: &Tessellation, clip_from_world: Mat4, vectors: &[Option<[f32; 3]>], missing: Missing, occluders: Option<&DepthBuffer>) -> HybridPixels {
+pub fn hybrid_pixels(
+    viewport: Viewport,
+    tess: &Tessellation,
+    clip_from_world: Mat4,
+    vectors: &[Option<[f32; 3]>],
+    missing: Missing,
+    occluders: Option<&DepthBuffer>,
+) -> HybridPixels {
     // Each triangle's corners carry barycentric (s, t) = (λ1, λ2), interpolated
     // perspective-correct like the player's vertex attributes.
-    let corners: Vec<[f32; 3]> = tess.triangles.iter().flat_map(|t| t.map(|i| tess.vertices[i as usize].position.to_array())).collect();
-    let bary: Vec<[f32; 2]> = tess.triangles.iter().flat_map(|_| [[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]]).collect();
+    let corners: Vec<[f32; 3]> = tess
+        .triangles
+        .iter()
+        .flat_map(|t| t.map(|i| tess.vertices[i as usize].position.to_array()))
+        .collect();
+    let bary: Vec<[f32; 2]> =
+        tess.triangles.iter().flat_map(|_| [[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]]).collect();
     let order: Vec<u32> = (0..corners.len() as u32).collect();
-    let mesh = DrawMesh { positions: &corners, uvs: &bary, indices: &order, clip_from_object: clip_from_world };
+    let mesh = DrawMesh {
+        positions: &corners,
+        uvs: &bary,
+        indices: &order,
+        clip_from_object: clip_from_world,
+    };
     let frags = Fragments::rasterize(&mesh, &TextureTransform::IDENTITY, viewport, occluders);
-    let corner_vectors: Vec<Option<[DVec3; 3]>> = corner_values(tess, vectors, missing).into_iter().map(|c| c.map(|c| c.map(|x| DVec3::from(x.map(f64::from))))).collect();
-    let pixels: Vec<u32> = frags.pixels().into_iter().filter(|&p| corner_vectors[frags.source[frags.triangle[p as usize] as usize] as usize].is_some()).collect();
+    let corner_vectors: Vec<Option<[DVec3; 3]>> = corner_values(tess, vectors, missing)
+        .into_iter()
+        .map(|c| c.map(|c| c.map(|x| DVec3::from(x.map(f64::from)))))
+        .collect();
+    let pixels: Vec<u32> = frags
+        .pixels()
+        .into_iter()
+        .filter(|&p| {
+            corner_vectors[frags.source[frags.triangle[p as usize] as usize] as usize].is_some()
+        })
+        .collect();
     let vectors = pixels
         .par_iter()
         .map(|&p| {
@@ -115,7 +151,14 @@ pub fn hybrid_pixels(viewport: Viewport, tess: &Tessellation, clip_from_world: M
 
 /// The render matrix of one shell (per-vertex vectors `vectors`, cube layout `layout`) for
 /// one term of the tessellated lens object; rows are [`hybrid_pixels`]'s pixels.
-pub fn hybrid_render_matrix(viewport: Viewport, tess: &Tessellation, clip_from_world: Mat4, vectors: &[Option<[f32; 3]>], layout: TextureLayout, occluders: Option<&DepthBuffer>) -> RenderMatrix {
+pub fn hybrid_render_matrix(
+    viewport: Viewport,
+    tess: &Tessellation,
+    clip_from_world: Mat4,
+    vectors: &[Option<[f32; 3]>],
+    layout: TextureLayout,
+    occluders: Option<&DepthBuffer>,
+) -> RenderMatrix {
     let px = hybrid_pixels(viewport, tess, clip_from_world, vectors, Missing::Mean, occluders);
     let max_level = layout.levels.saturating_sub(1) as f64;
     let rows: Vec<Taps> = px
@@ -166,7 +209,10 @@ pub fn term_radiance(fg: &HybridPixels, a: &[&RenderMatrix], cubes: &[&[f32]]) -
             through[k] *= 1.0 - c[3].clamp(0.0, 1.0);
         }
     }
-    acc.iter().zip(&fg.vectors).map(|(c, v)| [c[0] * v[0].x as f32, c[1] * v[0].y as f32, c[2] * v[0].z as f32]).collect()
+    acc.iter()
+        .zip(&fg.vectors)
+        .map(|(c, v)| [c[0] * v[0].x as f32, c[1] * v[0].y as f32, c[2] * v[0].z as f32])
+        .collect()
 }
 
 /// Per vertex of `tess`, the F·G modulation of `term` (`None` where the vertex has no such

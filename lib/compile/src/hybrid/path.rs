@@ -46,7 +46,13 @@ pub struct LensPath {
 /// (unit) meets it, until the path leaves the object; `None` where the term does not exist
 /// (refraction-first under total internal reflection) or the path is still inside after
 /// `max_depth` more interfaces.
-pub fn greedy_path(lens: &LensObject, first: &LensSurface, dir: Vec3, term: Term, max_depth: u32) -> Option<LensPath> {
+pub fn greedy_path(
+    lens: &LensObject,
+    first: &LensSurface,
+    dir: Vec3,
+    term: Term,
+    max_depth: u32,
+) -> Option<LensPath> {
     let m = lens.material;
     let eta = if first.front_face { 1.0 / m.ior } else { m.ior };
     let f = fresnel_dielectric(-dir.dot(first.normal), eta);
@@ -56,7 +62,10 @@ pub fn greedy_path(lens: &LensObject, first: &LensSurface, dir: Vec3, term: Term
             topology.reflected = 1;
             (reflect(dir, first.normal), Vec3::splat(f))
         }
-        Term::RefractionFirst => (refract(dir, first.normal, eta)?, Vec3::splat(1.0 - f) * if first.front_face { m.base } else { Vec3::ONE }),
+        Term::RefractionFirst => (
+            refract(dir, first.normal, eta)?,
+            Vec3::splat(1.0 - f) * if first.front_face { m.base } else { Vec3::ONE },
+        ),
     };
     let (mut p, mut ng) = (first.position, first.geometric_normal);
     for _ in 0..max_depth {
@@ -129,10 +138,19 @@ pub fn refract(d: Vec3, n: Vec3, eta: f32) -> Option<Vec3> {
 /// F·G differing by more than `max_modulation` in a channel (F·G is interpolated linearly
 /// across a triangle, and Fresnel's factors change fast towards grazing angles, faster
 /// than the directions do).
-pub fn paths_differ(a: Option<&LensPath>, b: Option<&LensPath>, cos_max_angle: f32, max_modulation: f32) -> bool {
+pub fn paths_differ(
+    a: Option<&LensPath>,
+    b: Option<&LensPath>,
+    cos_max_angle: f32,
+    max_modulation: f32,
+) -> bool {
     match (a, b) {
         (None, None) => false,
-        (Some(a), Some(b)) => a.topology != b.topology || a.exit_direction.dot(b.exit_direction) < cos_max_angle || (a.modulation - b.modulation).abs().max_element() > max_modulation,
+        (Some(a), Some(b)) => {
+            a.topology != b.topology
+                || a.exit_direction.dot(b.exit_direction) < cos_max_angle
+                || (a.modulation - b.modulation).abs().max_element() > max_modulation
+        }
         _ => true,
     }
 }
@@ -146,12 +164,24 @@ mod tests {
     fn slab(ior: f32, sigma: f32) -> LensObject {
         let s = 10.0;
         let positions = vec![
-            Vec3::new(-s, -s, 0.0), Vec3::new(s, -s, 0.0), Vec3::new(s, s, 0.0), Vec3::new(-s, s, 0.0),
-            Vec3::new(-s, -s, -1.0), Vec3::new(s, -s, -1.0), Vec3::new(s, s, -1.0), Vec3::new(-s, s, -1.0),
+            Vec3::new(-s, -s, 0.0),
+            Vec3::new(s, -s, 0.0),
+            Vec3::new(s, s, 0.0),
+            Vec3::new(-s, s, 0.0),
+            Vec3::new(-s, -s, -1.0),
+            Vec3::new(s, -s, -1.0),
+            Vec3::new(s, s, -1.0),
+            Vec3::new(-s, s, -1.0),
         ];
-        let normals = vec![Vec3::Z, Vec3::Z, Vec3::Z, Vec3::Z, -Vec3::Z, -Vec3::Z, -Vec3::Z, -Vec3::Z];
+        let normals =
+            vec![Vec3::Z, Vec3::Z, Vec3::Z, Vec3::Z, -Vec3::Z, -Vec3::Z, -Vec3::Z, -Vec3::Z];
         let indices = [0, 1, 2, 0, 2, 3, 4, 6, 5, 4, 7, 6];
-        LensObject::new(LensMaterial { ior, base: Vec3::ONE, sigma_a: Vec3::splat(sigma) }, positions, normals, &indices)
+        LensObject::new(
+            LensMaterial { ior, base: Vec3::ONE, sigma_a: Vec3::splat(sigma) },
+            positions,
+            normals,
+            &indices,
+        )
     }
 
     fn entering(lens: &LensObject, dir: Vec3) -> LensSurface {
@@ -165,7 +195,8 @@ mod tests {
         let lens = slab(1.5, 0.5);
         let dir = Vec3::new(0.3, 0.0, -1.0).normalize();
         let first = entering(&lens, dir);
-        let t = greedy_path(&lens, &first, dir, Term::RefractionFirst, 8).expect("refraction-first path");
+        let t = greedy_path(&lens, &first, dir, Term::RefractionFirst, 8)
+            .expect("refraction-first path");
         // Out of a parallel slab the ray keeps its direction, displaced.
         assert!(t.exit_direction.dot(dir) > 1.0 - 1e-6, "{:?}", t.exit_direction);
         assert!(t.exit_origin.z < -0.999, "{:?}", t.exit_origin);
@@ -178,7 +209,8 @@ mod tests {
         let d = 1.0 / -inside.z;
         let want = (1.0 - f1) * (1.0 - f2) * (-0.5 * d).exp();
         assert!((t.modulation.x - want).abs() < 1e-3 * want, "{} against {want}", t.modulation.x);
-        let r = greedy_path(&lens, &first, dir, Term::ReflectionFirst, 8).expect("reflection-first path");
+        let r = greedy_path(&lens, &first, dir, Term::ReflectionFirst, 8)
+            .expect("reflection-first path");
         assert!((r.exit_direction - reflect(dir, Vec3::Z)).length() < 1e-6);
         assert_eq!(r.topology, Topology { interfaces: 1, reflected: 1 });
         assert!((r.modulation.x - f1).abs() < 1e-7);
@@ -190,17 +222,27 @@ mod tests {
         // incidence, meets the hypotenuse at 45° (beyond glass's 41.8° critical angle),
         // reflects there, and leaves through the other short face turned by 90°.
         let positions = vec![
-            Vec3::new(0.0, 0.0, 0.5), Vec3::new(1.0, 0.0, 0.5), Vec3::new(0.0, 1.0, 0.5),
-            Vec3::new(0.0, 0.0, -0.5), Vec3::new(1.0, 0.0, -0.5), Vec3::new(0.0, 1.0, -0.5),
+            Vec3::new(0.0, 0.0, 0.5),
+            Vec3::new(1.0, 0.0, 0.5),
+            Vec3::new(0.0, 1.0, 0.5),
+            Vec3::new(0.0, 0.0, -0.5),
+            Vec3::new(1.0, 0.0, -0.5),
+            Vec3::new(0.0, 1.0, -0.5),
         ];
         // Faces: y = 0 (normal −y), x = 0 (normal −x), hypotenuse (normal (1,1)/√2), caps.
         let indices = [0, 3, 4, 0, 4, 1, 0, 2, 5, 0, 5, 3, 1, 4, 5, 1, 5, 2, 0, 1, 2, 3, 5, 4];
-        let lens = LensObject::new(LensMaterial { ior: 1.5, base: Vec3::ONE, sigma_a: Vec3::ZERO }, positions, vec![], &indices);
+        let lens = LensObject::new(
+            LensMaterial { ior: 1.5, base: Vec3::ONE, sigma_a: Vec3::ZERO },
+            positions,
+            vec![],
+            &indices,
+        );
         let dir = Vec3::Y;
         let o = Vec3::new(0.3, -2.0, 0.0);
         let hit = lens.closest(o, dir, f32::INFINITY).expect("hits the prism");
         let first = lens.surface(&hit, o, dir);
-        let t = greedy_path(&lens, &first, dir, Term::RefractionFirst, 8).expect("refraction-first path");
+        let t = greedy_path(&lens, &first, dir, Term::RefractionFirst, 8)
+            .expect("refraction-first path");
         assert_eq!(t.topology, Topology { interfaces: 3, reflected: 0b010 });
         assert!(t.exit_direction.dot(-Vec3::X) > 1.0 - 1e-5, "{:?}", t.exit_direction);
         assert!(t.exit_origin.x < 1e-3, "{:?}", t.exit_origin);
@@ -209,7 +251,12 @@ mod tests {
 
     #[test]
     fn paths_differ_by_topology_existence_angle_and_modulation() {
-        let a = LensPath { exit_origin: Vec3::ZERO, exit_direction: Vec3::Z, modulation: Vec3::ONE, topology: Topology { interfaces: 2, reflected: 0 } };
+        let a = LensPath {
+            exit_origin: Vec3::ZERO,
+            exit_direction: Vec3::Z,
+            modulation: Vec3::ONE,
+            topology: Topology { interfaces: 2, reflected: 0 },
+        };
         let mut b = a;
         let cos3 = 3f32.to_radians().cos();
         fn paths_differ(a: Option<&LensPath>, b: Option<&LensPath>, c: f32) -> bool {

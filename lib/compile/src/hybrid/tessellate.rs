@@ -48,7 +48,13 @@ pub struct TessellationSettings {
 
 impl Default for TessellationSettings {
     fn default() -> Self {
-        TessellationSettings { tau_px: 1.0, max_angle_deg: 3.0, max_modulation: 0.05, max_depth: 8, max_levels: 12 }
+        TessellationSettings {
+            tau_px: 1.0,
+            max_angle_deg: 3.0,
+            max_modulation: 0.05,
+            max_depth: 8,
+            max_levels: 12,
+        }
     }
 }
 
@@ -96,7 +102,14 @@ pub struct Tessellation {
 
 /// Traces the paths of a surface point seen from `eye` (thesis 6.4.1: the vertex ray), on
 /// the outside of the surface (`front_face`, the side `normal` faces) or on its inside.
-pub fn trace_vertex(lens: &LensObject, eye: Vec3, position: Vec3, normal: Vec3, front_face: bool, max_depth: u32) -> (HybridVertex, u64) {
+pub fn trace_vertex(
+    lens: &LensObject,
+    eye: Vec3,
+    position: Vec3,
+    normal: Vec3,
+    front_face: bool,
+    max_depth: u32,
+) -> (HybridVertex, u64) {
     let to = position - eye;
     let distance = to.length();
     let dir = to / distance;
@@ -135,12 +148,20 @@ pub struct TessellationTimes {
 }
 
 /// Tessellates `lens` for `view`.
-pub fn tessellate(lens: &LensObject, view: &HybridView, settings: &TessellationSettings) -> Tessellation {
+pub fn tessellate(
+    lens: &LensObject,
+    view: &HybridView,
+    settings: &TessellationSettings,
+) -> Tessellation {
     tessellate_timed(lens, view, settings).0
 }
 
 /// [`tessellate()`], and where its time went.
-pub fn tessellate_timed(lens: &LensObject, view: &HybridView, settings: &TessellationSettings) -> (Tessellation, TessellationTimes) {
+pub fn tessellate_timed(
+    lens: &LensObject,
+    view: &HybridView,
+    settings: &TessellationSettings,
+) -> (Tessellation, TessellationTimes) {
     let start = Instant::now();
     let cos_max = settings.max_angle_deg.to_radians().cos();
     let mut stats = TessellationStats::default();
@@ -164,20 +185,40 @@ pub fn tessellate_timed(lens: &LensObject, view: &HybridView, settings: &Tessell
         })
         .map(|t| lens.triangles[t])
         .collect();
-    let mut back_vertex: Vec<u32> = back_candidates.iter().flatten().copied().filter(|&v| !used[v as usize]).collect();
+    let mut back_vertex: Vec<u32> =
+        back_candidates.iter().flatten().copied().filter(|&v| !used[v as usize]).collect();
     back_vertex.sort_unstable();
     back_vertex.dedup();
-    let seen: Vec<bool> = back_vertex.par_iter().map(|&v| sees(lens, view.eye, lens.positions[v as usize])).collect();
+    let seen: Vec<bool> =
+        back_vertex.par_iter().map(|&v| sees(lens, view.eye, lens.positions[v as usize])).collect();
     let mut visible_back = vec![false; lens.positions.len()];
     back_vertex.iter().zip(&seen).for_each(|(&v, &s)| visible_back[v as usize] = s);
-    let back: Vec<[u32; 3]> = back_candidates.into_iter().filter(|t| t.iter().any(|&v| visible_back[v as usize])).collect();
+    let back: Vec<[u32; 3]> = back_candidates
+        .into_iter()
+        .filter(|t| t.iter().any(|&v| visible_back[v as usize]))
+        .collect();
     stats.back_triangles = back.len() as u64;
-    let mut mesh = Mesh { lens, view, settings, vertices: Vec::new(), midpoints: HashMap::new(), stats, trace_time: Duration::ZERO };
+    let mut mesh = Mesh {
+        lens,
+        view,
+        settings,
+        vertices: Vec::new(),
+        midpoints: HashMap::new(),
+        stats,
+        trace_time: Duration::ZERO,
+    };
     mesh.vertices = (0..lens.positions.len())
-        .map(|i| HybridVertex { position: lens.positions[i], normal: lens.normals.get(i).copied().unwrap_or(Vec3::ZERO), visible: false, front_face: used[i], paths: [None, None] })
+        .map(|i| HybridVertex {
+            position: lens.positions[i],
+            normal: lens.normals.get(i).copied().unwrap_or(Vec3::ZERO),
+            visible: false,
+            front_face: used[i],
+            paths: [None, None],
+        })
         .collect();
     back.iter().flatten().for_each(|&v| used[v as usize] = true);
-    let first_vertices: Vec<u32> = (0..lens.positions.len() as u32).filter(|&i| used[i as usize]).collect();
+    let first_vertices: Vec<u32> =
+        (0..lens.positions.len() as u32).filter(|&i| used[i as usize]).collect();
     mesh.trace(&first_vertices);
     // Split level by level.
     let mut current = front;
@@ -194,7 +235,9 @@ pub fn tessellate_timed(lens: &LensObject, view: &HybridView, settings: &Tessell
                 None => leaves.push(tri),
                 Some(split) => {
                     mesh.stats.splits += 1;
-                    let mids = [0, 1, 2].map(|e| split[e].then(|| mesh.midpoint(tri[e], tri[(e + 1) % 3], &mut new_vertices)));
+                    let mids = [0, 1, 2].map(|e| {
+                        split[e].then(|| mesh.midpoint(tri[e], tri[(e + 1) % 3], &mut new_vertices))
+                    });
                     next.extend(children(tri, mids));
                 }
             }
@@ -226,7 +269,11 @@ pub fn tessellate_timed(lens: &LensObject, view: &HybridView, settings: &Tessell
                 // A centre vertex, fanned to every boundary segment.
                 let c = mesh.vertices.len() as u32 + centres.len() as u32;
                 let [a, b, d] = tri.map(|v| mesh.vertices[v as usize]);
-                centres.push(((a.position + b.position + d.position) / 3.0, (a.normal + b.normal + d.normal).normalize_or_zero(), a.front_face || b.front_face || d.front_face));
+                centres.push((
+                    (a.position + b.position + d.position) / 3.0,
+                    (a.normal + b.normal + d.normal).normalize_or_zero(),
+                    a.front_face || b.front_face || d.front_face,
+                ));
                 let mut ring = Vec::new();
                 for e in 0..3 {
                     ring.push(tri[e]);
@@ -239,7 +286,13 @@ pub fn tessellate_timed(lens: &LensObject, view: &HybridView, settings: &Tessell
     }
     if !centres.is_empty() {
         let first = mesh.vertices.len() as u32;
-        mesh.vertices.extend(centres.iter().map(|&(p, n, front_face)| HybridVertex { position: p, normal: n, visible: false, front_face, paths: [None, None] }));
+        mesh.vertices.extend(centres.iter().map(|&(p, n, front_face)| HybridVertex {
+            position: p,
+            normal: n,
+            visible: false,
+            front_face,
+            paths: [None, None],
+        }));
         let ids: Vec<u32> = (first..mesh.vertices.len() as u32).collect();
         mesh.trace(&ids);
     }
@@ -248,7 +301,10 @@ pub fn tessellate_timed(lens: &LensObject, view: &HybridView, settings: &Tessell
     }
     let mut stats = mesh.stats;
     stats.triangles = triangles.len() as u64;
-    let times = TessellationTimes { trace: mesh.trace_time, tessellate: start.elapsed().saturating_sub(mesh.trace_time) };
+    let times = TessellationTimes {
+        trace: mesh.trace_time,
+        tessellate: start.elapsed().saturating_sub(mesh.trace_time),
+    };
     (Tessellation { vertices: mesh.vertices, triangles, stats }, times)
 }
 
@@ -307,12 +363,21 @@ impl Mesh<'_> {
         }
         let differ = (0..3).any(|e| {
             let (p, q) = (v[e], v[(e + 1) % 3]);
-            (0..2).any(|t| paths_differ(p.paths[t].as_ref(), q.paths[t].as_ref(), cos_max, self.settings.max_modulation))
+            (0..2).any(|t| {
+                paths_differ(
+                    p.paths[t].as_ref(),
+                    q.paths[t].as_ref(),
+                    cos_max,
+                    self.settings.max_modulation,
+                )
+            })
         });
         if !differ {
             return None;
         }
-        let split = [0, 1, 2].map(|e| self.screen_length(v[e].position, v[(e + 1) % 3].position) > self.settings.tau_px);
+        let split = [0, 1, 2].map(|e| {
+            self.screen_length(v[e].position, v[(e + 1) % 3].position) > self.settings.tau_px
+        });
         split.iter().any(|&s| s).then_some(split)
     }
 
@@ -337,7 +402,13 @@ impl Mesh<'_> {
         }
         let (p, q) = (self.vertices[key.0 as usize], self.vertices[key.1 as usize]);
         let m = self.vertices.len() as u32;
-        self.vertices.push(HybridVertex { position: (p.position + q.position) * 0.5, normal: (p.normal + q.normal).normalize_or_zero(), visible: false, front_face: p.front_face || q.front_face, paths: [None, None] });
+        self.vertices.push(HybridVertex {
+            position: (p.position + q.position) * 0.5,
+            normal: (p.normal + q.normal).normalize_or_zero(),
+            visible: false,
+            front_face: p.front_face || q.front_face,
+            paths: [None, None],
+        });
         self.midpoints.insert(key, m);
         made.push(m);
         m

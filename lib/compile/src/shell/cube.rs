@@ -19,9 +19,17 @@ use crate::TextureLayout;
 pub fn cube_face(d: DVec3) -> u32 {
     let a = d.abs();
     if a.x >= a.y && a.x >= a.z {
-        if d.x >= 0.0 { 0 } else { 1 }
+        if d.x >= 0.0 {
+            0
+        } else {
+            1
+        }
     } else if a.y >= a.z {
-        if d.y >= 0.0 { 2 } else { 3 }
+        if d.y >= 0.0 {
+            2
+        } else {
+            3
+        }
     } else if d.z >= 0.0 {
         4
     } else {
@@ -181,7 +189,9 @@ mod tests {
             let v = face_vector(face, 0.3, -0.6);
             assert_eq!(cube_face(v), face);
             let [sc, tc, ma] = face_components(face, v);
-            assert!((sc - 0.3).abs() < 1e-12 && (tc + 0.6).abs() < 1e-12 && (ma - 1.0).abs() < 1e-12);
+            assert!(
+                (sc - 0.3).abs() < 1e-12 && (tc + 0.6).abs() < 1e-12 && (ma - 1.0).abs() < 1e-12
+            );
         }
     }
 
@@ -197,11 +207,19 @@ mod tests {
                 assert_ne!(f2, face);
                 assert!(i2 == 0 || i2 == n - 1 || j2 == 0 || j2 == n - 1);
                 let centre = |f: u32, i: u32, j: u32| {
-                    face_vector(f, 2.0 * (i as f64 + 0.5) / n as f64 - 1.0, 2.0 * (j as f64 + 0.5) / n as f64 - 1.0).normalize()
+                    face_vector(
+                        f,
+                        2.0 * (i as f64 + 0.5) / n as f64 - 1.0,
+                        2.0 * (j as f64 + 0.5) / n as f64 - 1.0,
+                    )
+                    .normalize()
                 };
                 let a = centre(face, n - 1, j as u32);
                 let b = centre(f2, i2, j2);
-                assert!(a.angle_between(b) < 2.5 * std::f64::consts::FRAC_PI_2 / n as f64, "face {face} j {j}");
+                assert!(
+                    a.angle_between(b) < 2.5 * std::f64::consts::FRAC_PI_2 / n as f64,
+                    "face {face} j {j}"
+                );
             }
         }
     }
@@ -225,7 +243,8 @@ mod tests {
     #[test]
     fn lookups_are_continuous_across_edges_and_corners() {
         let layout = TextureLayout::cube(6);
-        let x: Vec<f64> = (0..layout.texel_count()).map(|k| ((k * 7919) % 1013) as f64 / 1013.0).collect();
+        let x: Vec<f64> =
+            (0..layout.texel_count()).map(|k| ((k * 7919) % 1013) as f64 / 1013.0).collect();
         let value = |d: DVec3, lambda: f64| {
             let mut taps = Taps::default();
             cube_taps(&layout, d, lambda, &mut taps);
@@ -276,7 +295,11 @@ mod tests {
                             let texels = if beyond(i, n) && beyond(j, n) {
                                 corners += 1;
                                 let (ci, cj) = (i.clamp(0, n as i64 - 1), j.clamp(0, n as i64 - 1));
-                                vec![(cube_texel(cube_face(d), ci, cj, n), w / 3.0), (cube_texel(cube_face(d), i, cj, n), w / 3.0), (cube_texel(cube_face(d), ci, j, n), w / 3.0)]
+                                vec![
+                                    (cube_texel(cube_face(d), ci, cj, n), w / 3.0),
+                                    (cube_texel(cube_face(d), i, cj, n), w / 3.0),
+                                    (cube_texel(cube_face(d), ci, j, n), w / 3.0),
+                                ]
                             } else {
                                 vec![(cube_texel(cube_face(d), i, j, n), w)]
                             };
@@ -289,9 +312,15 @@ mod tests {
                     let got: Vec<(u32, f32)> = taps.sorted().collect();
                     let exp: Vec<(u32, f32)> = want.sorted().collect();
                     assert_eq!(got.len(), 3);
-                    assert_eq!(got.iter().map(|t| t.0).collect::<Vec<_>>(), exp.iter().map(|t| t.0).collect::<Vec<_>>());
+                    assert_eq!(
+                        got.iter().map(|t| t.0).collect::<Vec<_>>(),
+                        exp.iter().map(|t| t.0).collect::<Vec<_>>()
+                    );
                     for (g, e) in got.iter().zip(&exp) {
-                        assert!((g.1 - e.1).abs() < 1e-6, "face {face} level {m}: {got:?} against {exp:?}");
+                        assert!(
+                            (g.1 - e.1).abs() < 1e-6,
+                            "face {face} level {m}: {got:?} against {exp:?}"
+                        );
                     }
                 }
             }
@@ -302,8 +331,20 @@ mod tests {
     fn one_texel_per_pixel_is_level_zero_and_two_is_level_one() {
         // At the centre of +Z, s = (x + 1)/2: ∂s/∂x = ½ ∂(d.x).
         let d = DVec3::Z;
-        let l0 = cube_lod(d, DVec3::new(2.0 / 64.0, 0.0, 0.0), DVec3::new(0.0, 2.0 / 64.0, 0.0), 64.0, 6.0);
-        let l1 = cube_lod(d, DVec3::new(4.0 / 64.0, 0.0, 0.0), DVec3::new(0.0, 2.0 / 64.0, 0.0), 64.0, 6.0);
+        let l0 = cube_lod(
+            d,
+            DVec3::new(2.0 / 64.0, 0.0, 0.0),
+            DVec3::new(0.0, 2.0 / 64.0, 0.0),
+            64.0,
+            6.0,
+        );
+        let l1 = cube_lod(
+            d,
+            DVec3::new(4.0 / 64.0, 0.0, 0.0),
+            DVec3::new(0.0, 2.0 / 64.0, 0.0),
+            64.0,
+            6.0,
+        );
         assert!(l0.abs() < 1e-9 && (l1 - 1.0).abs() < 1e-9);
     }
 }

@@ -77,7 +77,9 @@ impl Shell {
             1 => ShellShape::Sphere { radius: v[3] as f64 },
             2 => ShellShape::Ellipsoid { radii: d(3) },
             3 => ShellShape::Box { min: d(3), max: d(6) },
-            4 => ShellShape::Cylinder { radius: v[3] as f64, y_min: v[4] as f64, y_max: v[5] as f64 },
+            4 => {
+                ShellShape::Cylinder { radius: v[3] as f64, y_min: v[4] as f64, y_max: v[5] as f64 }
+            }
             _ => return None,
         };
         Some(Shell { origin: d(0), shape })
@@ -89,7 +91,9 @@ impl Shell {
 pub fn shell_hit(shell: &Shell, p: DVec3, r: DVec3) -> f64 {
     let q = p - shell.origin;
     match shell.shape {
-        ShellShape::Sphere { radius } => quadratic_far(r.dot(r), q.dot(r), q.dot(q) - radius * radius),
+        ShellShape::Sphere { radius } => {
+            quadratic_far(r.dot(r), q.dot(r), q.dot(q) - radius * radius)
+        }
         ShellShape::Ellipsoid { radii } => {
             let (qs, rs) = (q / radii, r / radii);
             quadratic_far(rs.dot(rs), qs.dot(rs), qs.dot(qs) - 1.0)
@@ -103,7 +107,11 @@ pub fn shell_hit(shell: &Shell, p: DVec3, r: DVec3) -> f64 {
                 near = near.max(a);
                 far = far.min(b);
             }
-            if near <= far { far } else { -1.0 }
+            if near <= far {
+                far
+            } else {
+                -1.0
+            }
         }
         ShellShape::Cylinder { radius, y_min, y_max } => {
             let a = r.x * r.x + r.z * r.z;
@@ -124,7 +132,11 @@ pub fn shell_hit(shell: &Shell, p: DVec3, r: DVec3) -> f64 {
             let (a2, b2) = slab(q.y, r.y, y_min - shell.origin.y, y_max - shell.origin.y);
             near = near.max(a2);
             far = far.min(b2);
-            if near <= far { far } else { -1.0 }
+            if near <= far {
+                far
+            } else {
+                -1.0
+            }
         }
     }
 }
@@ -141,7 +153,11 @@ fn quadratic_far(a: f64, b: f64, c: f64) -> f64 {
 /// The interval of t where `q + t·r` lies in [lo, hi] along one axis.
 fn slab(q: f64, r: f64, lo: f64, hi: f64) -> (f64, f64) {
     if r == 0.0 {
-        return if q >= lo && q <= hi { (f64::NEG_INFINITY, f64::INFINITY) } else { (f64::INFINITY, f64::NEG_INFINITY) };
+        return if q >= lo && q <= hi {
+            (f64::NEG_INFINITY, f64::INFINITY)
+        } else {
+            (f64::INFINITY, f64::NEG_INFINITY)
+        };
     }
     let (t0, t1) = ((lo - q) / r, (hi - q) / r);
     (t0.min(t1), t0.max(t1))
@@ -161,7 +177,11 @@ pub fn lookup_direction(shell: &Shell, p: DVec3, normal: DVec3, eye: DVec3) -> D
     let v = (p - eye).normalize_or_zero();
     let r = reflect_about(v, n);
     let t = shell_hit(shell, p, r);
-    if t >= 0.0 { p + r * t - shell.origin } else { r }
+    if t >= 0.0 {
+        p + r * t - shell.origin
+    } else {
+        r
+    }
 }
 
 /// Schlick's Fresnel factor at a surface point seen from `eye` (SPEC.md 9):
@@ -186,12 +206,16 @@ mod tests {
             ShellShape::Ellipsoid { radii } => ((q / radii).length() - 1.0).abs() < 1e-9,
             ShellShape::Box { min, max } => {
                 let inside = (0..3).all(|k| x[k] >= min[k] - 1e-9 && x[k] <= max[k] + 1e-9);
-                inside && (0..3).any(|k| (x[k] - min[k]).abs() < 1e-9 || (x[k] - max[k]).abs() < 1e-9)
+                inside
+                    && (0..3).any(|k| (x[k] - min[k]).abs() < 1e-9 || (x[k] - max[k]).abs() < 1e-9)
             }
             ShellShape::Cylinder { radius, y_min, y_max } => {
                 let rho = (q.x * q.x + q.z * q.z).sqrt();
                 let inside = rho <= radius + 1e-9 && x.y >= y_min - 1e-9 && x.y <= y_max + 1e-9;
-                inside && ((rho - radius).abs() < 1e-9 || (x.y - y_min).abs() < 1e-9 || (x.y - y_max).abs() < 1e-9)
+                inside
+                    && ((rho - radius).abs() < 1e-9
+                        || (x.y - y_min).abs() < 1e-9
+                        || (x.y - y_max).abs() < 1e-9)
             }
         }
     }
@@ -201,8 +225,17 @@ mod tests {
         vec![
             Shell { origin: o, shape: ShellShape::Sphere { radius: 3.0 } },
             Shell { origin: o, shape: ShellShape::Ellipsoid { radii: DVec3::new(1.0, 0.5, 2.0) } },
-            Shell { origin: o, shape: ShellShape::Box { min: DVec3::new(-4.0, 0.0, -3.0), max: DVec3::new(5.0, 3.0, 2.0) } },
-            Shell { origin: o, shape: ShellShape::Cylinder { radius: 2.0, y_min: 0.0, y_max: 2.5 } },
+            Shell {
+                origin: o,
+                shape: ShellShape::Box {
+                    min: DVec3::new(-4.0, 0.0, -3.0),
+                    max: DVec3::new(5.0, 3.0, 2.0),
+                },
+            },
+            Shell {
+                origin: o,
+                shape: ShellShape::Cylinder { radius: 2.0, y_min: 0.0, y_max: 2.5 },
+            },
         ]
     }
 
@@ -228,15 +261,28 @@ mod tests {
     fn a_ray_that_misses_looks_up_its_own_direction() {
         let shell = Shell { origin: DVec3::ZERO, shape: ShellShape::Sphere { radius: 1.0 } };
         // A point outside the sphere reflecting away from it.
-        let d = lookup_direction(&shell, DVec3::new(0.0, 5.0, 0.0), DVec3::Y, DVec3::new(0.0, 10.0, 0.0));
+        let d = lookup_direction(
+            &shell,
+            DVec3::new(0.0, 5.0, 0.0),
+            DVec3::Y,
+            DVec3::new(0.0, 10.0, 0.0),
+        );
         assert!((d - DVec3::Y).length() < 1e-12);
     }
 
     #[test]
     fn a_large_sphere_looks_up_nearly_the_reflection_direction() {
         let shell = Shell { origin: DVec3::ZERO, shape: ShellShape::Sphere { radius: 1e6 } };
-        let d = lookup_direction(&shell, DVec3::new(0.1, 0.0, 0.0), DVec3::Z, DVec3::new(0.0, 0.0, 5.0));
-        let r = reflect_about((DVec3::new(0.1, 0.0, 0.0) - DVec3::new(0.0, 0.0, 5.0)).normalize(), DVec3::Z);
+        let d = lookup_direction(
+            &shell,
+            DVec3::new(0.1, 0.0, 0.0),
+            DVec3::Z,
+            DVec3::new(0.0, 0.0, 5.0),
+        );
+        let r = reflect_about(
+            (DVec3::new(0.1, 0.0, 0.0) - DVec3::new(0.0, 0.0, 5.0)).normalize(),
+            DVec3::Z,
+        );
         assert!(d.normalize().dot(r) > 1.0 - 1e-9);
     }
 

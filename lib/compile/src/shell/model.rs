@@ -55,11 +55,21 @@ struct WorldCorners {
 }
 
 fn check(viewport: Viewport, o: &ShellObject) -> Result<(), ModelError> {
-    if viewport.width == 0 || viewport.height == 0 || viewport.width > 16384 || viewport.height > 16384 {
+    if viewport.width == 0
+        || viewport.height == 0
+        || viewport.width > 16384
+        || viewport.height > 16384
+    {
         return Err(ModelError::Viewport { width: viewport.width, height: viewport.height });
     }
     let l = o.layout;
-    if l.faces != 6 || l.width != l.height || l.width == 0 || l.width > 16384 || l.levels == 0 || l.levels > TextureLayout::cube(l.width).levels {
+    if l.faces != 6
+        || l.width != l.height
+        || l.width == 0
+        || l.width > 16384
+        || l.levels == 0
+        || l.levels > TextureLayout::cube(l.width).levels
+    {
         return Err(ModelError::Layout { width: l.width, height: l.height, levels: l.levels });
     }
     if o.normals.len() != o.positions.len() {
@@ -68,10 +78,14 @@ fn check(viewport: Viewport, o: &ShellObject) -> Result<(), ModelError> {
     if o.indices.len() % 3 != 0 {
         return Err(ModelError::IndexCount(o.indices.len()));
     }
-    if let Some((at, &index)) = o.indices.iter().enumerate().find(|(_, &i)| i as usize >= o.positions.len()) {
+    if let Some((at, &index)) =
+        o.indices.iter().enumerate().find(|(_, &i)| i as usize >= o.positions.len())
+    {
         return Err(ModelError::Index { at, index, positions: o.positions.len() });
     }
-    if let Some(k) = (0..o.positions.len()).find(|&k| !o.positions[k].iter().chain(o.normals[k].iter()).all(|v| v.is_finite())) {
+    if let Some(k) = (0..o.positions.len())
+        .find(|&k| !o.positions[k].iter().chain(o.normals[k].iter()).all(|v| v.is_finite()))
+    {
         return Err(ModelError::NotFinite(k));
     }
     Ok(())
@@ -80,7 +94,11 @@ fn check(viewport: Viewport, o: &ShellObject) -> Result<(), ModelError> {
 /// The render matrix of `object`'s shell in `viewport`, its fragments tested against
 /// `occluders`; every row has coverage 1 (see [`crate::antialias`]). Rows are the pixels
 /// that draw the shell, in increasing order.
-pub fn shell_render_matrix(viewport: Viewport, object: &ShellObject, occluders: Option<&DepthBuffer>) -> Result<RenderMatrix, ModelError> {
+pub fn shell_render_matrix(
+    viewport: Viewport,
+    object: &ShellObject,
+    occluders: Option<&DepthBuffer>,
+) -> Result<RenderMatrix, ModelError> {
     check(viewport, object)?;
     if let Some(o) = occluders {
         if o.viewport != viewport {
@@ -134,8 +152,10 @@ pub fn shell_render_matrix(viewport: Viewport, object: &ShellObject, occluders: 
     let chunks: Vec<(Vec<u32>, Vec<f32>, Vec<u32>)> = pixels
         .par_chunks(ROWS_PER_CHUNK)
         .map(|chunk| {
-            let (mut cols, mut vals, mut lens) = (Vec::new(), Vec::new(), Vec::with_capacity(chunk.len()));
-            let mut row: Vec<(u32, f32)> = Vec::with_capacity(k as usize * k as usize * crate::filter::MAX_TAPS);
+            let (mut cols, mut vals, mut lens) =
+                (Vec::new(), Vec::new(), Vec::with_capacity(chunk.len()));
+            let mut row: Vec<(u32, f32)> =
+                Vec::with_capacity(k as usize * k as usize * crate::filter::MAX_TAPS);
             let mut taps = Taps::default();
             for &p in chunk {
                 let (x, y, at) = fragment(p);
@@ -153,7 +173,12 @@ pub fn shell_render_matrix(viewport: Viewport, object: &ShellObject, occluders: 
                     for i in 0..k {
                         let ox = (i as f64 + 0.5) / kf - 0.5;
                         let ds = dir(pos + ox * dpx + oy * dpy, n + ox * dnx + oy * dny);
-                        cube_taps(&layout, ds, cube_lod(ds, sx, sy, layout.width as f64, max_level), &mut taps);
+                        cube_taps(
+                            &layout,
+                            ds,
+                            cube_lod(ds, sx, sy, layout.width as f64, max_level),
+                            &mut taps,
+                        );
                         for (c, v) in taps.sorted() {
                             match row.iter_mut().find(|e| e.0 == c) {
                                 Some(e) => e.1 += v * w,
@@ -178,15 +203,26 @@ const ROWS_PER_CHUNK: usize = 256;
 
 /// The object rasterized as the player draws it, each triangle's world corners, and the
 /// pixels that draw the shell (in increasing order).
-fn shell_fragments(viewport: Viewport, object: &ShellObject, occluders: Option<&DepthBuffer>) -> (Fragments, WorldCorners, Vec<u32>) {
+fn shell_fragments(
+    viewport: Viewport,
+    object: &ShellObject,
+    occluders: Option<&DepthBuffer>,
+) -> (Fragments, WorldCorners, Vec<u32>) {
     // Each triangle's corners carry barycentric (s, t) = (λ1, λ2): interpolated
     // perspective-correct, they weight the corners' world attributes as the GPU's
     // interpolation of those attributes does.
     let triangles = object.indices.len() / 3;
-    let corners: Vec<[f32; 3]> = object.indices.iter().map(|&i| object.positions[i as usize]).collect();
-    let bary: Vec<[f32; 2]> = (0..triangles).flat_map(|_| [[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]]).collect();
+    let corners: Vec<[f32; 3]> =
+        object.indices.iter().map(|&i| object.positions[i as usize]).collect();
+    let bary: Vec<[f32; 2]> =
+        (0..triangles).flat_map(|_| [[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]]).collect();
     let order: Vec<u32> = (0..corners.len() as u32).collect();
-    let mesh = DrawMesh { positions: &corners, uvs: &bary, indices: &order, clip_from_object: object.clip_from_object };
+    let mesh = DrawMesh {
+        positions: &corners,
+        uvs: &bary,
+        indices: &order,
+        clip_from_object: object.clip_from_object,
+    };
     let frags = Fragments::rasterize(&mesh, &TextureTransform::IDENTITY, viewport, occluders);
     let world = world_corners(object);
     let pixels: Vec<u32> = frags
@@ -203,7 +239,12 @@ fn shell_fragments(viewport: Viewport, object: &ShellObject, occluders: Option<&
 /// Schlick's Fresnel factor ([`super::geometry::fresnel`]) at every pixel that draws the
 /// shell, in the rows' order of [`shell_render_matrix`]: the factor the player multiplies
 /// the reflection term by. Returns the pixels and one RGB factor per pixel.
-pub fn shell_fresnel(viewport: Viewport, object: &ShellObject, occluders: Option<&DepthBuffer>, f0: [f32; 3]) -> Result<(Vec<u32>, Vec<[f32; 3]>), ModelError> {
+pub fn shell_fresnel(
+    viewport: Viewport,
+    object: &ShellObject,
+    occluders: Option<&DepthBuffer>,
+    f0: [f32; 3],
+) -> Result<(Vec<u32>, Vec<[f32; 3]>), ModelError> {
     check(viewport, object)?;
     let (frags, world, pixels) = shell_fragments(viewport, object, occluders);
     let (eye, f0) = (object.eye.as_dvec3(), Vec3::from(f0).as_dvec3());
@@ -211,7 +252,13 @@ pub fn shell_fresnel(viewport: Viewport, object: &ShellObject, occluders: Option
         .par_iter()
         .map(|&p| {
             let k = frags.triangle[p as usize] as usize;
-            let (pos, n) = attributes_at(&frags.triangles[k], &world, frags.source[k] as usize, p % viewport.width, p / viewport.width);
+            let (pos, n) = attributes_at(
+                &frags.triangles[k],
+                &world,
+                frags.source[k] as usize,
+                p % viewport.width,
+                p / viewport.width,
+            );
             fresnel(f0, pos, n, eye).as_vec3().to_array()
         })
         .collect();
@@ -225,8 +272,12 @@ fn world_corners(o: &ShellObject) -> WorldCorners {
         .chunks_exact(3)
         .map(|t| {
             let t = [t[0], t[1], t[2]];
-            let p = t.map(|i| (m * Vec4::from((Vec3::from(o.positions[i as usize]), 1.0))).truncate().as_dvec3());
-            let n = t.map(|i| (m * Vec4::from((Vec3::from(o.normals[i as usize]), 0.0))).truncate().as_dvec3());
+            let p = t.map(|i| {
+                (m * Vec4::from((Vec3::from(o.positions[i as usize]), 1.0))).truncate().as_dvec3()
+            });
+            let n = t.map(|i| {
+                (m * Vec4::from((Vec3::from(o.normals[i as usize]), 0.0))).truncate().as_dvec3()
+            });
             (p, n)
         })
         .unzip();
@@ -235,7 +286,13 @@ fn world_corners(o: &ShellObject) -> WorldCorners {
 
 /// The interpolated world position and (unnormalized) normal at the centre of pixel (x, y)
 /// of screen triangle `tri`, set up from mesh triangle `src`.
-fn attributes_at(tri: &ScreenTriangle, world: &WorldCorners, src: usize, x: u32, y: u32) -> (DVec3, DVec3) {
+fn attributes_at(
+    tri: &ScreenTriangle,
+    world: &WorldCorners,
+    src: usize,
+    x: u32,
+    y: u32,
+) -> (DVec3, DVec3) {
     let [b1, b2] = texcoord_at(tri, x as f64 + 0.5, y as f64 + 0.5);
     let b0 = 1.0 - b1 - b2;
     let (p, n) = (&world.positions[src], &world.normals[src]);
@@ -277,7 +334,18 @@ mod tests {
         let clip = perspective(0.7, 96.0 / 72.0, 0.1, 100.0) * look_at(eye, Vec3::ZERO, Vec3::Y);
         let shell = Shell { origin: DVec3::ZERO, shape: ShellShape::Sphere { radius: 4.0 } };
         let layout = TextureLayout::cube(16);
-        let o = ShellObject { positions: &p, normals: &n, indices: &idx, clip_from_object: clip, world_from_object: Mat4::IDENTITY, eye, shell, layout, drawn: None, lookups: 1 };
+        let o = ShellObject {
+            positions: &p,
+            normals: &n,
+            indices: &idx,
+            clip_from_object: clip,
+            world_from_object: Mat4::IDENTITY,
+            eye,
+            shell,
+            layout,
+            drawn: None,
+            lookups: 1,
+        };
         let a = shell_render_matrix(vp, &o, None).unwrap();
         assert!(a.rows() > 1000);
         for r in 0..a.rows() {
@@ -298,9 +366,23 @@ mod tests {
         let vp = Viewport { width: 48, height: 48 };
         let eye = Vec3::new(0.0, 0.0, 3.0);
         let clip = perspective(0.9, 1.0, 0.1, 100.0) * look_at(eye, Vec3::ZERO, Vec3::Y);
-        let shell = Shell { origin: DVec3::ZERO, shape: ShellShape::Ellipsoid { radii: DVec3::new(1.5, 1.2, 1.5) } };
+        let shell = Shell {
+            origin: DVec3::ZERO,
+            shape: ShellShape::Ellipsoid { radii: DVec3::new(1.5, 1.2, 1.5) },
+        };
         let none = vec![false; idx.len() / 3];
-        let mut o = ShellObject { positions: &p, normals: &n, indices: &idx, clip_from_object: clip, world_from_object: Mat4::IDENTITY, eye, shell, layout: TextureLayout::cube(8), drawn: None, lookups: 1 };
+        let mut o = ShellObject {
+            positions: &p,
+            normals: &n,
+            indices: &idx,
+            clip_from_object: clip,
+            world_from_object: Mat4::IDENTITY,
+            eye,
+            shell,
+            layout: TextureLayout::cube(8),
+            drawn: None,
+            lookups: 1,
+        };
         assert!(shell_render_matrix(vp, &o, None).unwrap().rows() > 0);
         o.drawn = Some(&none);
         assert_eq!(shell_render_matrix(vp, &o, None).unwrap().rows(), 0);

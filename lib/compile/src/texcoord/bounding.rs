@@ -21,10 +21,13 @@ pub fn min_area_rectangle(points: &[DVec2], directions: u32) -> (f64, DVec2, DVe
 /// Bounding box of the points rotated by −θ.
 pub fn bounds(points: &[DVec2], theta: f64) -> (DVec2, DVec2) {
     let rot = DVec2::from_angle(-theta);
-    points.iter().fold((DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY)), |(lo, hi), p| {
-        let q = rot.rotate(*p);
-        (lo.min(q), hi.max(q))
-    })
+    points.iter().fold(
+        (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY)),
+        |(lo, hi), p| {
+            let q = rot.rotate(*p);
+            (lo.min(q), hi.max(q))
+        },
+    )
 }
 
 #[cfg(test)]
@@ -35,7 +38,9 @@ mod tests {
     fn a_rotated_rectangle_is_found() {
         let rot = DVec2::from_angle(0.3);
         let pts: Vec<DVec2> = [(0.0, 0.0), (10.0, 0.0), (10.0, 2.0), (0.0, 2.0)]
-            .iter().map(|&(x, y)| rot.rotate(DVec2::new(x, y))).collect();
+            .iter()
+            .map(|&(x, y)| rot.rotate(DVec2::new(x, y)))
+            .collect();
         let (theta, lo, hi) = min_area_rectangle(&pts, 90);
         let area = (hi.x - lo.x) * (hi.y - lo.y);
         assert!(area < 20.0 * 1.02, "θ {theta} area {area}");

@@ -28,7 +28,11 @@ pub fn find_cut(extents: &[(f64, f64)]) -> Option<f64> {
     let mut merged: Vec<(f64, f64)> = vec![spans[0]];
     for &(s, e) in &spans[1..] {
         let last = merged.last_mut().expect("merged starts non-empty");
-        if s <= last.1 { last.1 = last.1.max(e) } else { merged.push((s, e)) }
+        if s <= last.1 {
+            last.1 = last.1.max(e)
+        } else {
+            merged.push((s, e))
+        }
     }
     let mut best: Option<(f64, f64)> = None; // (gap length, gap middle)
     for k in 0..merged.len() {

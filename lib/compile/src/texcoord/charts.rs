@@ -46,14 +46,17 @@ pub fn charts(indices: &[u32], vertices: usize) -> (Vec<u32>, usize) {
     }
     let mut id = vec![u32::MAX; vertices];
     let mut count = 0;
-    let tri_chart = indices.chunks_exact(3).map(|tri| {
-        let r = root(&mut parent, tri[0]) as usize;
-        if id[r] == u32::MAX {
-            id[r] = count;
-            count += 1;
-        }
-        id[r]
-    }).collect();
+    let tri_chart = indices
+        .chunks_exact(3)
+        .map(|tri| {
+            let r = root(&mut parent, tri[0]) as usize;
+            if id[r] == u32::MAX {
+                id[r] = count;
+                count += 1;
+            }
+            id[r]
+        })
+        .collect();
     (tri_chart, count as usize)
 }
 
@@ -79,7 +82,8 @@ pub struct Unfolded {
 /// folds.
 pub fn unfold_charts(uvs: &[Vec2], indices: &[u32]) -> Option<Unfolded> {
     let turn = |t: &[u32]| -> usize {
-        let [a, b, c] = [t[0], t[1], t[2]].map(|v| uvs.get(v as usize).copied().unwrap_or(Vec2::ZERO).as_dvec2());
+        let [a, b, c] = [t[0], t[1], t[2]]
+            .map(|v| uvs.get(v as usize).copied().unwrap_or(Vec2::ZERO).as_dvec2());
         usize::from(super::visibility::edge(a, b, c) < 0.0)
     };
     // Which turnings use each vertex.
@@ -107,7 +111,13 @@ pub fn unfold_charts(uvs: &[Vec2], indices: &[u32]) -> Option<Unfolded> {
     let mut out = Vec::with_capacity(indices.len());
     for t in indices.chunks_exact(3) {
         let s = turn(t);
-        out.extend(t.iter().map(|&v| if s == 1 && copy.get(v as usize).is_some_and(|&c| c != u32::MAX) { copy[v as usize] } else { v }));
+        out.extend(t.iter().map(|&v| {
+            if s == 1 && copy.get(v as usize).is_some_and(|&c| c != u32::MAX) {
+                copy[v as usize]
+            } else {
+                v
+            }
+        }));
     }
     Some(Unfolded { indices: out, copies })
 }
@@ -139,19 +149,29 @@ fn overlapping(uvs: &[Vec2], indices: &[u32], tri_chart: &[u32], take: &[bool]) 
         if !take[c as usize] {
             continue;
         }
-        let p: Vec<DVec2> = tri.iter().map(|&v| (uvs[v as usize].as_dvec2() - lo) / ext * n as f64).collect();
+        let p: Vec<DVec2> =
+            tri.iter().map(|&v| (uvs[v as usize].as_dvec2() - lo) / ext * n as f64).collect();
         let area = super::visibility::edge(p[0], p[1], p[2]);
         if area.abs() < 1e-12 {
             continue;
         }
         let (a, b) = (p[0].min(p[1]).min(p[2]), p[0].max(p[1]).max(p[2]));
-        let (x0, x1) = ((a.x - 0.5).ceil().max(0.0) as usize, ((b.x - 0.5).floor().max(-1.0) as i64).min(n as i64 - 1));
-        let (y0, y1) = ((a.y - 0.5).ceil().max(0.0) as usize, ((b.y - 0.5).floor().max(-1.0) as i64).min(n as i64 - 1));
+        let (x0, x1) = (
+            (a.x - 0.5).ceil().max(0.0) as usize,
+            ((b.x - 0.5).floor().max(-1.0) as i64).min(n as i64 - 1),
+        );
+        let (y0, y1) = (
+            (a.y - 0.5).ceil().max(0.0) as usize,
+            ((b.y - 0.5).floor().max(-1.0) as i64).min(n as i64 - 1),
+        );
         for y in y0 as i64..=y1 {
             for x in x0 as i64..=x1 {
                 let q = DVec2::new(x as f64 + 0.5, y as f64 + 0.5);
-                let l = [super::visibility::edge(p[1], p[2], q), super::visibility::edge(p[2], p[0], q),
-                         super::visibility::edge(p[0], p[1], q)];
+                let l = [
+                    super::visibility::edge(p[1], p[2], q),
+                    super::visibility::edge(p[2], p[0], q),
+                    super::visibility::edge(p[0], p[1], q),
+                ];
                 let inside = l.iter().all(|&l| l * area.signum() > 0.0);
                 if !inside {
                     continue;
@@ -174,7 +194,11 @@ fn overlapping(uvs: &[Vec2], indices: &[u32], tri_chart: &[u32], take: &[bool]) 
 /// `None` when the mesh's coordinates already give every visible surface point its own
 /// texel at a density close to the others'. Charts no view sees collapse to the atlas
 /// origin.
-pub fn separate_overlapping_charts(uvs: &[Vec2], indices: &[u32], views: &[ViewGeometry]) -> Option<Vec<Vec2>> {
+pub fn separate_overlapping_charts(
+    uvs: &[Vec2],
+    indices: &[u32],
+    views: &[ViewGeometry],
+) -> Option<Vec<Vec2>> {
     let (tri_chart, n) = charts(indices, uvs.len());
     if n < 2 {
         return None;
@@ -190,7 +214,10 @@ pub fn separate_overlapping_charts(uvs: &[Vec2], indices: &[u32], views: &[ViewG
             seen[c] = true;
             let tri = &indices[3 * *t as usize..3 * *t as usize + 3];
             let Some(sv) = screen_triangle(view, tri) else { continue };
-            let p = DVec2::new((k % view.width as usize) as f64 + 0.5, (k / view.width as usize) as f64 + 0.5);
+            let p = DVec2::new(
+                (k % view.width as usize) as f64 + 0.5,
+                (k / view.width as usize) as f64 + 0.5,
+            );
             let tuv = [uvs[tri[0] as usize], uvs[tri[1] as usize], uvs[tri[2] as usize]];
             if let Some(d) = uv_jacobian(&sv, tuv, p).and_then(density) {
                 need[c] = need[c].max(d);
@@ -200,7 +227,9 @@ pub fn separate_overlapping_charts(uvs: &[Vec2], indices: &[u32], views: &[ViewG
     if seen.iter().filter(|&&s| s).count() < 2 {
         return None;
     }
-    let dense = |f: fn(f64, f64) -> f64, init: f64| need.iter().zip(&seen).filter(|(d, s)| **s && **d > 0.0).map(|(d, _)| *d).fold(init, f);
+    let dense = |f: fn(f64, f64) -> f64, init: f64| {
+        need.iter().zip(&seen).filter(|(d, s)| **s && **d > 0.0).map(|(d, _)| *d).fold(init, f)
+    };
     let uneven = dense(f64::max, 0.0) > NONUNIFORM * dense(f64::min, f64::INFINITY);
     if !uneven && !overlapping(uvs, indices, &tri_chart, &seen) {
         return None;
@@ -271,7 +300,11 @@ mod tests {
             let base = pos.len() as u32;
             for (dx, dy) in [(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)] {
                 pos.push(Vec3::new(x0 + dx, dy - 0.5, 0.0));
-                uvs.push(if separate_vertices { Vec2::new(dx, dy) } else { Vec2::new((x0 + dx + 1.0) / 2.0, dy) });
+                uvs.push(if separate_vertices {
+                    Vec2::new(dx, dy)
+                } else {
+                    Vec2::new((x0 + dx + 1.0) / 2.0, dy)
+                });
             }
             idx.extend([base, base + 1, base + 2, base, base + 2, base + 3]);
         }
@@ -291,17 +324,30 @@ mod tests {
     #[test]
     fn overlapping_visible_charts_are_laid_out_apart() {
         let (uvs, idx, view) = two_quads(true);
-        let new = separate_overlapping_charts(&uvs, &idx, &[view.clone()]).expect("the quads overlap in (u, v)");
+        let new = separate_overlapping_charts(&uvs, &idx, &[view.clone()])
+            .expect("the quads overlap in (u, v)");
         // The two quads' (u, v) bounds no longer intersect.
         let bounds = |q: usize| {
             let vs = &new[q * 4..q * 4 + 4];
-            (vs.iter().fold(Vec2::splat(f32::INFINITY), |a, v| a.min(*v)), vs.iter().fold(Vec2::splat(f32::NEG_INFINITY), |a, v| a.max(*v)))
+            (
+                vs.iter().fold(Vec2::splat(f32::INFINITY), |a, v| a.min(*v)),
+                vs.iter().fold(Vec2::splat(f32::NEG_INFINITY), |a, v| a.max(*v)),
+            )
         };
         let ((a0, a1), (b0, b1)) = (bounds(0), bounds(1));
-        assert!(a1.x <= b0.x || b1.x <= a0.x || a1.y <= b0.y || b1.y <= a0.y, "{a0} {a1} / {b0} {b1}");
+        assert!(
+            a1.x <= b0.x || b1.x <= a0.x || a1.y <= b0.y || b1.y <= a0.y,
+            "{a0} {a1} / {b0} {b1}"
+        );
         // Each chart keeps its shape (a square stays a square, same size: same density).
-        assert!(((a1 - a0).x - (a1 - a0).y).abs() < 1e-4 && ((a1 - a0) - (b1 - b0)).length() < 1e-3);
-        assert!(new.iter().all(|v| v.is_finite() && v.x >= 0.0 && v.y >= 0.0 && v.x <= 1.0 && v.y <= 1.0));
+        assert!(
+            ((a1 - a0).x - (a1 - a0).y).abs() < 1e-4 && ((a1 - a0) - (b1 - b0)).length() < 1e-3
+        );
+        assert!(new.iter().all(|v| v.is_finite()
+            && v.x >= 0.0
+            && v.y >= 0.0
+            && v.x <= 1.0
+            && v.y <= 1.0));
     }
 
     /// The two quads of [`two_quads`] sharing their middle edge, the right one mirroring the
@@ -315,7 +361,14 @@ mod tests {
         uvs.extend([Vec2::new(0.0, 0.0), Vec2::new(0.0, 1.0)]);
         let idx = vec![0, 1, 2, 0, 2, 3, 1, 4, 5, 1, 5, 2];
         // Clip positions: left quad x ∈ [−1, 0], right quad's outer edge at x = 1.
-        let clip = vec![view.clip[0], view.clip[1], view.clip[2], view.clip[3], view.clip[5], view.clip[6]];
+        let clip = vec![
+            view.clip[0],
+            view.clip[1],
+            view.clip[2],
+            view.clip[3],
+            view.clip[5],
+            view.clip[6],
+        ];
         (uvs, idx, ViewGeometry { clip, ..view })
     }
 
@@ -329,17 +382,25 @@ mod tests {
         // The shared edge's two vertices are copied for the mirrored quad, nothing else.
         assert_eq!(u.copies, vec![1, 2]);
         assert_eq!(u.indices, vec![0, 1, 2, 0, 2, 3, 6, 4, 5, 6, 5, 7]);
-        let uvs2: Vec<Vec2> = uvs.iter().copied().chain(u.copies.iter().map(|&v| uvs[v as usize])).collect();
+        let uvs2: Vec<Vec2> =
+            uvs.iter().copied().chain(u.copies.iter().map(|&v| uvs[v as usize])).collect();
         let mut clip = view.clip.clone();
         clip.extend(u.copies.iter().map(|&v| view.clip[v as usize]));
         assert_eq!(charts(&u.indices, uvs2.len()).1, 2);
-        let new = separate_overlapping_charts(&uvs2, &u.indices, &[ViewGeometry { clip, ..view }]).expect("the halves overlap");
+        let new = separate_overlapping_charts(&uvs2, &u.indices, &[ViewGeometry { clip, ..view }])
+            .expect("the halves overlap");
         let bounds = |vs: &[u32]| {
             let p: Vec<Vec2> = vs.iter().map(|&v| new[v as usize]).collect();
-            (p.iter().fold(Vec2::splat(f32::INFINITY), |a, v| a.min(*v)), p.iter().fold(Vec2::splat(f32::NEG_INFINITY), |a, v| a.max(*v)))
+            (
+                p.iter().fold(Vec2::splat(f32::INFINITY), |a, v| a.min(*v)),
+                p.iter().fold(Vec2::splat(f32::NEG_INFINITY), |a, v| a.max(*v)),
+            )
         };
         let ((a0, a1), (b0, b1)) = (bounds(&[0, 1, 2, 3]), bounds(&[6, 4, 5, 7]));
-        assert!(a1.x <= b0.x || b1.x <= a0.x || a1.y <= b0.y || b1.y <= a0.y, "{a0} {a1} / {b0} {b1}");
+        assert!(
+            a1.x <= b0.x || b1.x <= a0.x || a1.y <= b0.y || b1.y <= a0.y,
+            "{a0} {a1} / {b0} {b1}"
+        );
     }
 
     #[test]
@@ -356,7 +417,8 @@ mod tests {
         // texels per unit of (u, v).
         let (mut uvs, idx, view) = two_quads(true);
         uvs[4..].iter_mut().for_each(|v| *v = Vec2::new(2.0, 0.0) + *v / 16.0);
-        let new = separate_overlapping_charts(&uvs, &idx, &[view.clone()]).expect("the densities differ 16 times");
+        let new = separate_overlapping_charts(&uvs, &idx, &[view.clone()])
+            .expect("the densities differ 16 times");
         let side = |q: usize| new[q * 4 + 1].x - new[q * 4].x;
         // Same screen size, so the same size in the atlas.
         assert!((side(0) / side(1) - 1.0).abs() < 1e-3, "{} {}", side(0), side(1));

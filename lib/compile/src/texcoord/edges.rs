@@ -6,7 +6,9 @@ use std::collections::BTreeMap;
 
 use glam::{DVec2, Vec2};
 
-use super::visibility::{edge, rasterize_ids, screen_triangle, IdBuffer, ScreenVertex, ViewGeometry};
+use super::visibility::{
+    edge, rasterize_ids, screen_triangle, IdBuffer, ScreenVertex, ViewGeometry,
+};
 
 /// One visible edge in one view, after clipping to the screen.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -20,7 +22,11 @@ pub struct VisibleEdge {
 }
 
 /// The visible edges of `indices` in `view`, and the z-buffer that selected them.
-pub fn visible_edges(view: &ViewGeometry, uvs: &[Vec2], indices: &[u32]) -> (Vec<VisibleEdge>, IdBuffer) {
+pub fn visible_edges(
+    view: &ViewGeometry,
+    uvs: &[Vec2],
+    indices: &[u32],
+) -> (Vec<VisibleEdge>, IdBuffer) {
     let ids = rasterize_ids(view, indices);
     let mut visible: Vec<u32> = ids.ids.iter().flatten().copied().collect();
     visible.sort_unstable();
@@ -41,9 +47,13 @@ pub fn visible_edges(view: &ViewGeometry, uvs: &[Vec2], indices: &[u32]) -> (Vec
         let (Some(va), Some(vb)) = (
             screen_triangle(view, &[a, a, a]).map(|v| v[0]),
             screen_triangle(view, &[b, b, b]).map(|v| v[0]),
-        ) else { continue };
+        ) else {
+            continue;
+        };
         let (Some(&ua), Some(&ub)) = (uvs.get(a as usize), uvs.get(b as usize)) else { continue };
-        if let Some(e) = clip_edge(va, vb, ua.as_dvec2(), ub.as_dvec2(), view.width, view.height, weight) {
+        if let Some(e) =
+            clip_edge(va, vb, ua.as_dvec2(), ub.as_dvec2(), view.width, view.height, weight)
+        {
             out.push(e);
         }
     }
@@ -52,8 +62,15 @@ pub fn visible_edges(view: &ViewGeometry, uvs: &[Vec2], indices: &[u32]) -> (Vec
 
 /// Clips the screen segment to the screen rectangle (Liang–Barsky) and interpolates the
 /// texture coordinates perspective-correctly at the new endpoints.
-fn clip_edge(a: ScreenVertex, b: ScreenVertex, ua: DVec2, ub: DVec2, w: u32, h: u32,
-             weight: f64) -> Option<VisibleEdge> {
+fn clip_edge(
+    a: ScreenVertex,
+    b: ScreenVertex,
+    ua: DVec2,
+    ub: DVec2,
+    w: u32,
+    h: u32,
+    weight: f64,
+) -> Option<VisibleEdge> {
     let d = b.p - a.p;
     let (mut t0, mut t1) = (0.0f64, 1.0f64);
     for (p, q) in [(-d.x, a.p.x), (d.x, w as f64 - a.p.x), (-d.y, a.p.y), (d.y, h as f64 - a.p.y)] {
@@ -63,7 +80,11 @@ fn clip_edge(a: ScreenVertex, b: ScreenVertex, ua: DVec2, ub: DVec2, w: u32, h: 
             }
         } else {
             let r = q / p;
-            if p < 0.0 { t0 = t0.max(r) } else { t1 = t1.min(r) }
+            if p < 0.0 {
+                t0 = t0.max(r)
+            } else {
+                t1 = t1.min(r)
+            }
         }
     }
     if t0 >= t1 {
@@ -73,9 +94,5 @@ fn clip_edge(a: ScreenVertex, b: ScreenVertex, ua: DVec2, ub: DVec2, w: u32, h: 
         let (wa, wb) = ((1.0 - t) * a.inv_w, t * b.inv_w);
         (ua * wa + ub * wb) / (wa + wb)
     };
-    Some(VisibleEdge {
-        screen_length: d.length() * (t1 - t0),
-        uv: [uv_at(t0), uv_at(t1)],
-        weight,
-    })
+    Some(VisibleEdge { screen_length: d.length() * (t1 - t0), uv: [uv_at(t0), uv_at(t1)], weight })
 }

@@ -98,7 +98,8 @@ pub fn most_isometric(edges: &[EdgeTerm], scale_only: bool) -> [f64; 4] {
         let Some((rn, fnew, mut gnew)) = accepted else { break };
         gnew.iter_mut().zip(mask).for_each(|(g, m)| *g *= m);
         let gg: f64 = g.iter().map(|v| v * v).sum();
-        let beta = ((0..4).map(|i| gnew[i] * (gnew[i] - g[i])).sum::<f64>() / gg.max(1e-300)).max(0.0);
+        let beta =
+            ((0..4).map(|i| gnew[i] * (gnew[i] - g[i])).sum::<f64>() / gg.max(1e-300)).max(0.0);
         d = std::array::from_fn(|i| -gnew[i] + beta * d[i]);
         let done = (f - fnew) <= 1e-12 * f;
         r = rn;
@@ -139,7 +140,12 @@ mod tests {
         // screen = M · uv with M = (40 10; 0 20): edges along u, v and the diagonal
         let m = [40.0, 10.0, 0.0, 20.0];
         let mut edges = vec![];
-        for duv in [DVec2::new(0.1, 0.0), DVec2::new(0.0, 0.1), DVec2::new(0.1, 0.1), DVec2::new(0.1, -0.1)] {
+        for duv in [
+            DVec2::new(0.1, 0.0),
+            DVec2::new(0.0, 0.1),
+            DVec2::new(0.1, 0.1),
+            DVec2::new(0.1, -0.1),
+        ] {
             let s = DVec2::new(m[0] * duv.x + m[1] * duv.y, m[2] * duv.x + m[3] * duv.y).length();
             edges.push(EdgeTerm { screen_length: s, duv, weight: 1.0 });
         }

@@ -55,7 +55,13 @@ pub struct TexcoordSettings {
 
 impl Default for TexcoordSettings {
     fn default() -> Self {
-        TexcoordSettings { max_stretch: 1.25, directions: 90, reduction: 1.0, max_size: 16384, texels_per_pixel: None }
+        TexcoordSettings {
+            max_stretch: 1.25,
+            directions: 90,
+            reduction: 1.0,
+            max_size: 16384,
+            texels_per_pixel: None,
+        }
     }
 }
 
@@ -110,14 +116,21 @@ pub fn optimize_placement(
 ) -> Result<TexturePlacement, CompileError> {
     let fail = |message: String| CompileError::Geometry { object: mesh.name.to_string(), message };
     if mesh.indices.len() % 3 != 0 {
-        return Err(fail(format!("{} indices is not a whole number of triangles", mesh.indices.len())));
+        return Err(fail(format!(
+            "{} indices is not a whole number of triangles",
+            mesh.indices.len()
+        )));
     }
     if let Some(&i) = mesh.indices.iter().find(|&&i| i as usize >= mesh.uvs.len()) {
         return Err(fail(format!("index {i} past {} texture coordinates", mesh.uvs.len())));
     }
     for (k, v) in views.iter().enumerate() {
         if v.clip.len() != mesh.uvs.len() {
-            return Err(fail(format!("view {k} has {} vertices, the mesh {}", v.clip.len(), mesh.uvs.len())));
+            return Err(fail(format!(
+                "view {k} has {} vertices, the mesh {}",
+                v.clip.len(),
+                mesh.uvs.len()
+            )));
         }
         if v.clip.iter().any(|c| !c.is_finite()) || mesh.uvs.iter().any(|u| !u.is_finite()) {
             return Err(fail(format!("view {k}: non-finite vertex or texture coordinate")));
@@ -135,10 +148,13 @@ pub fn optimize_placement(
     // entry per pixel) is not: steps 3–4 rasterize each view again, one at a time, so that
     // memory does not grow with the number of views.
     let edges_of = |uvs: &[Vec2]| -> Vec<(Vec<edges::VisibleEdge>, usize)> {
-        views.iter().map(|v| {
-            let (e, ids) = visible_edges(v, uvs, mesh.indices);
-            (e, ids.ids.iter().filter(|id| id.is_some()).count())
-        }).collect()
+        views
+            .iter()
+            .map(|v| {
+                let (e, ids) = visible_edges(v, uvs, mesh.indices);
+                (e, ids.ids.iter().filter(|id| id.is_some()).count())
+            })
+            .collect()
     };
     let first = edges_of(mesh.uvs);
     let mut cut = [None, None];
@@ -147,10 +163,14 @@ pub fn optimize_placement(
         if !mesh.wrap[dim] {
             continue;
         }
-        let extents: Vec<(f64, f64)> = first.iter().flat_map(|(e, _)| e.iter()).map(|e| {
-            let (p, q) = (e.uv[0][dim], e.uv[1][dim]);
-            (p.min(q), p.max(q))
-        }).collect();
+        let extents: Vec<(f64, f64)> = first
+            .iter()
+            .flat_map(|(e, _)| e.iter())
+            .map(|e| {
+                let (p, q) = (e.uv[0][dim], e.uv[1][dim]);
+                (p.min(q), p.max(q))
+            })
+            .collect();
         cut[dim] = branch_cut::find_cut(&extents);
         repeat[dim] = cut[dim].is_none();
         if cut[dim].is_some_and(|c| branch_cut::gap_holds_the_seam(&extents, c)) {
@@ -160,29 +180,45 @@ pub fn optimize_placement(
             cut[dim] = None;
         }
     }
-    let uvs: Vec<Vec2> = mesh.uvs.iter().map(|uv| {
-        let mut w = uv.as_dvec2();
-        for dim in 0..2 {
-            if let Some(c) = cut[dim] {
-                w[dim] = branch_cut::apply_cut(w[dim], c);
+    let uvs: Vec<Vec2> = mesh
+        .uvs
+        .iter()
+        .map(|uv| {
+            let mut w = uv.as_dvec2();
+            for dim in 0..2 {
+                if let Some(c) = cut[dim] {
+                    w[dim] = branch_cut::apply_cut(w[dim], c);
+                }
             }
-        }
-        w.as_vec2()
-    }).collect();
+            w.as_vec2()
+        })
+        .collect();
     let per_view = if cut.iter().any(Option::is_some) { edges_of(&uvs) } else { first };
     let edges: Vec<_> = per_view.iter().flat_map(|(e, _)| e.iter().copied()).collect();
     if edges.is_empty() {
         return Ok(TexturePlacement {
-            affine: [1.0, 0.0, 0.0, 1.0, 0.0, 0.0], width: 1, height: 1, repeat,
-            branch_cut: cut, stretch: 0.0, visible_edges: 0, reduction: settings.reduction, covered_pixels: 0,
+            affine: [1.0, 0.0, 0.0, 1.0, 0.0, 0.0],
+            width: 1,
+            height: 1,
+            repeat,
+            branch_cut: cut,
+            stretch: 0.0,
+            visible_edges: 0,
+            reduction: settings.reduction,
+            covered_pixels: 0,
         });
     }
 
     // Step 2: the most isometric linear map.
     let scale_only = repeat[0] || repeat[1];
-    let terms: Vec<EdgeTerm> = edges.iter().map(|e| EdgeTerm {
-        screen_length: e.screen_length, duv: e.uv[1] - e.uv[0], weight: e.weight,
-    }).collect();
+    let terms: Vec<EdgeTerm> = edges
+        .iter()
+        .map(|e| EdgeTerm {
+            screen_length: e.screen_length,
+            duv: e.uv[1] - e.uv[0],
+            weight: e.weight,
+        })
+        .collect();
     let r = isometry::most_isometric(&terms, scale_only);
     let r = DMat2::from_cols(DVec2::new(r[0], r[2]), DVec2::new(r[1], r[3]));
 
@@ -197,7 +233,10 @@ pub fn optimize_placement(
             let Some(t) = id else { continue };
             let tri = &mesh.indices[3 * *t as usize..3 * *t as usize + 3];
             let Some(sv) = visibility::screen_triangle(view, tri) else { continue };
-            let p = DVec2::new((k % view.width as usize) as f64 + 0.5, (k / view.width as usize) as f64 + 0.5);
+            let p = DVec2::new(
+                (k % view.width as usize) as f64 + 0.5,
+                (k / view.width as usize) as f64 + 0.5,
+            );
             let tuv = [uvs[tri[0] as usize], uvs[tri[1] as usize], uvs[tri[2] as usize]];
             if let Some(j) = visibility::uv_jacobian(&sv, tuv, p) {
                 in_view.push(j);
@@ -236,14 +275,19 @@ pub fn optimize_placement(
             reduction *= (budget / texels).sqrt();
         }
     }
-    let size = |e: f64| ((e * reduction).ceil().max(1.0) as u64).min(settings.max_size as u64) as u32;
+    let size =
+        |e: f64| ((e * reduction).ceil().max(1.0) as u64).min(settings.max_size as u64) as u32;
     let (mut width, mut height) = (size(ext.x), size(ext.y));
     // A wrapped dimension keeps repeat addressing, which the player supports only on a
     // power-of-two used size (thesis 3.2: the next power of two above the optimum).
     for (dim, side) in [&mut width, &mut height].into_iter().enumerate() {
         if repeat[dim] {
             let p = side.next_power_of_two();
-            *side = if p > settings.max_size { (settings.max_size + 1).next_power_of_two() / 2 } else { p };
+            *side = if p > settings.max_size {
+                (settings.max_size + 1).next_power_of_two() / 2
+            } else {
+                p
+            };
         }
     }
     let mut affine = [0.0f64; 6];

@@ -37,12 +37,20 @@ pub fn max_stretch(r: DMat2, j: DMat2) -> Option<(f64, DVec2)> {
 /// largest stretch over all `jacobians` is at most `threshold`. Returns the new R and the
 /// final largest stretch. With `axis_aligned` (a scale-only map, thesis 3.2) the scaling
 /// keeps R diagonal: diag(1 + (σ − 1)v_x², 1 + (σ − 1)v_y²).
-pub fn limit_stretch(mut r: DMat2, jacobians: &[DMat2], threshold: f64, axis_aligned: bool) -> (DMat2, f64) {
+pub fn limit_stretch(
+    mut r: DMat2,
+    jacobians: &[DMat2],
+    threshold: f64,
+    axis_aligned: bool,
+) -> (DMat2, f64) {
     let worst = |r: DMat2| {
-        jacobians
-            .iter()
-            .filter_map(|&j| max_stretch(r, j))
-            .fold((0.0f64, DVec2::X), |a, b| if b.0 > a.0 { b } else { a })
+        jacobians.iter().filter_map(|&j| max_stretch(r, j)).fold((0.0f64, DVec2::X), |a, b| {
+            if b.0 > a.0 {
+                b
+            } else {
+                a
+            }
+        })
     };
     let mut w = worst(r);
     for _ in 0..200 {
@@ -94,7 +102,9 @@ pub fn envelope(jacobians: &[DMat2]) -> Vec<DMat2> {
             }
         }
     }
-    let Some(best) = best.into_iter().collect::<Option<Vec<(f64, usize)>>>() else { return Vec::new() };
+    let Some(best) = best.into_iter().collect::<Option<Vec<(f64, usize)>>>() else {
+        return Vec::new();
+    };
     let of = |k: usize| curves[best[k % N].1].expect("a maximizer has a curve");
     let at_best: Vec<[f64; N + 1]> = (0..N).map(|k| values(&of(k))).collect();
     // Between two samples Δ apart a sinusoid of amplitude A rises at most A(1 − cos Δ/2) above
@@ -110,18 +120,29 @@ pub fn envelope(jacobians: &[DMat2]) -> Vec<DMat2> {
         let fc = values(c);
         (0..N).any(|k| {
             let ends = [k, (k + 1) % N];
-            ends.iter().any(|&e| best[e].1 == i) || ends.iter().all(|&e| {
-                let (d, v) = (of(e), &at_best[e]);
-                let (g0, g1) = (fc[k] - v[k], fc[k + 1] - v[k + 1]);
-                // Under this end's maximizer on the interval: at once when even the largest
-                // rise keeps the difference under zero, else by the exact test.
-                let under = g0.max(g1) + rise * (amplitude(c) + amplitude(&d)) <= 0.0
-                    || nowhere_above([c[0] - d[0], c[1] - d[1], c[2] - d[2]], angles[k], angles[k + 1]);
-                !under
-            })
+            ends.iter().any(|&e| best[e].1 == i)
+                || ends.iter().all(|&e| {
+                    let (d, v) = (of(e), &at_best[e]);
+                    let (g0, g1) = (fc[k] - v[k], fc[k + 1] - v[k + 1]);
+                    // Under this end's maximizer on the interval: at once when even the largest
+                    // rise keeps the difference under zero, else by the exact test.
+                    let under = g0.max(g1) + rise * (amplitude(c) + amplitude(&d)) <= 0.0
+                        || nowhere_above(
+                            [c[0] - d[0], c[1] - d[1], c[2] - d[2]],
+                            angles[k],
+                            angles[k + 1],
+                        );
+                    !under
+                })
         })
     };
-    jacobians.iter().zip(&curves).enumerate().filter(|(i, (_, c))| c.as_ref().is_some_and(|c| keep(*i, c))).map(|(_, (&j, _))| j).collect()
+    jacobians
+        .iter()
+        .zip(&curves)
+        .enumerate()
+        .filter(|(i, (_, c))| c.as_ref().is_some_and(|c| keep(*i, c)))
+        .map(|(_, (&j, _))| j)
+        .collect()
 }
 
 /// The number of angles 2φ ∈ [0, 2π) at which [`envelope`] samples the upper envelope.
@@ -161,12 +182,17 @@ mod tests {
     /// The Jacobians of a plane seen in perspective, as a view's pixels give them: they vary
     /// smoothly with depth and screen position, a continuum of a hundred thousand.
     fn plane_in_perspective(n: usize, tilt: f64) -> Vec<DMat2> {
-        (0..n * n).map(|k| {
-            let (x, y) = ((k % n) as f64 / n as f64 - 0.5, (k / n) as f64 / n as f64 - 0.5);
-            let depth = 1.0 + tilt * (y + 0.5);
-            let shear = 0.3 * x * y;
-            DMat2::from_cols(DVec2::new(depth * 0.01, shear * 0.004), DVec2::new(x * 0.002, depth * depth * 0.013))
-        }).collect()
+        (0..n * n)
+            .map(|k| {
+                let (x, y) = ((k % n) as f64 / n as f64 - 0.5, (k / n) as f64 / n as f64 - 0.5);
+                let depth = 1.0 + tilt * (y + 0.5);
+                let shear = 0.3 * x * y;
+                DMat2::from_cols(
+                    DVec2::new(depth * 0.01, shear * 0.004),
+                    DVec2::new(x * 0.002, depth * depth * 0.013),
+                )
+            })
+            .collect()
     }
 
     #[test]
@@ -177,7 +203,9 @@ mod tests {
         all.push(all[5]); // a duplicate
         let kept = envelope(&all);
         assert!(kept.len() * 100 < all.len(), "kept {} of {}", kept.len(), all.len());
-        let worst = |js: &[DMat2], r: DMat2| js.iter().filter_map(|&j| max_stretch(r, j)).map(|s| s.0).fold(0.0f64, f64::max);
+        let worst = |js: &[DMat2], r: DMat2| {
+            js.iter().filter_map(|&j| max_stretch(r, j)).map(|s| s.0).fold(0.0f64, f64::max)
+        };
         let mut seed = 0x9e37_79b9_7f4a_7c15u64;
         let mut next = || {
             seed ^= seed << 13;
@@ -195,7 +223,10 @@ mod tests {
         }
         for axis_aligned in [false, true] {
             let r0 = DMat2::from_diagonal(DVec2::splat(30.0));
-            assert_eq!(limit_stretch(r0, &all, 1.1, axis_aligned), limit_stretch(r0, &kept, 1.1, axis_aligned));
+            assert_eq!(
+                limit_stretch(r0, &all, 1.1, axis_aligned),
+                limit_stretch(r0, &kept, 1.1, axis_aligned)
+            );
         }
     }
 
@@ -203,8 +234,16 @@ mod tests {
     fn every_curve_that_reaches_the_envelope_is_kept_and_no_other() {
         // Two axis-aligned pixels stretched along u and v, and a third, less stretched along
         // either axis, that is the most stretched along the diagonal.
-        let along = |su: f64, sv: f64, angle: f64| DMat2::from_angle(angle) * DMat2::from_diagonal(DVec2::new(su, sv)) * DMat2::from_angle(-angle);
-        let js = [along(0.5, 1.0, 0.0), along(1.0, 0.5, 0.0), along(0.45, 1.0, std::f64::consts::FRAC_PI_4 + 0.01)];
+        let along = |su: f64, sv: f64, angle: f64| {
+            DMat2::from_angle(angle)
+                * DMat2::from_diagonal(DVec2::new(su, sv))
+                * DMat2::from_angle(-angle)
+        };
+        let js = [
+            along(0.5, 1.0, 0.0),
+            along(1.0, 0.5, 0.0),
+            along(0.45, 1.0, std::f64::consts::FRAC_PI_4 + 0.01),
+        ];
         assert_eq!(envelope(&js).len(), 3);
         assert_eq!(envelope(&[js[0], js[0] * 1.5]), vec![js[0]]);
     }

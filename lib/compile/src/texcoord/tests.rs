@@ -71,7 +71,12 @@ fn cylinder(n: u32) -> (Vec<Vec3>, Vec<Vec2>, Vec<u32>) {
     (p, uv, idx)
 }
 
-fn check_visible_inside(placement: &TexturePlacement, uvs: &[Vec2], views: &[ViewGeometry], idx: &[u32]) {
+fn check_visible_inside(
+    placement: &TexturePlacement,
+    uvs: &[Vec2],
+    views: &[ViewGeometry],
+    idx: &[u32],
+) {
     for v in views {
         for e in edges::visible_edges(v, uvs, idx).0 {
             for uv in e.uv {
@@ -96,7 +101,10 @@ fn a_square_seen_head_on_gets_about_its_screen_resolution() {
     // the reduction factor halves the size
     let half = TexcoordSettings { reduction: 0.5, ..Default::default() };
     let h = optimize_placement(&mesh, &views, &half).unwrap();
-    assert!(h.width.abs_diff(pl.width.div_ceil(2)) <= 1 && h.height.abs_diff(pl.height.div_ceil(2)) <= 1);
+    assert!(
+        h.width.abs_diff(pl.width.div_ceil(2)) <= 1
+            && h.height.abs_diff(pl.height.div_ceil(2)) <= 1
+    );
     assert_eq!(h.affine, pl.affine);
 }
 
@@ -122,7 +130,10 @@ fn the_texel_budget_reduces_a_grazing_floor_to_its_covered_pixels() {
     let mesh = ObjectMesh { name: "floor", uvs: &uv, indices: &idx, wrap: [false; 2] };
     let free = optimize_placement(&mesh, &views, &TexcoordSettings::default()).unwrap();
     let texels = |pl: &TexturePlacement| pl.width as f64 * pl.height as f64;
-    assert!(free.covered_pixels > 0 && texels(&free) > 4.0 * free.covered_pixels as f64, "{free:?}");
+    assert!(
+        free.covered_pixels > 0 && texels(&free) > 4.0 * free.covered_pixels as f64,
+        "{free:?}"
+    );
     assert_eq!(free.reduction, 1.0);
     for k in [1.0, 2.0] {
         let budget = TexcoordSettings { texels_per_pixel: Some(k), ..Default::default() };
@@ -137,7 +148,10 @@ fn the_texel_budget_reduces_a_grazing_floor_to_its_covered_pixels() {
         check_visible_inside(&pl, &uv, &views, &idx);
     }
     // a budget the optimal texture already meets changes nothing
-    let loose = TexcoordSettings { texels_per_pixel: Some(texels(&free) / free.covered_pixels as f64 + 1.0), ..Default::default() };
+    let loose = TexcoordSettings {
+        texels_per_pixel: Some(texels(&free) / free.covered_pixels as f64 + 1.0),
+        ..Default::default()
+    };
     let same = optimize_placement(&mesh, &views, &loose).unwrap();
     assert_eq!((same.width, same.height, same.reduction), (free.width, free.height, 1.0));
     // a non-positive budget is a settings error
@@ -155,7 +169,8 @@ fn the_seam_of_a_cylinder_seen_from_one_side_gets_a_branch_cut() {
     let cut = pl.branch_cut[0].expect("a cut along u");
     assert!((cut - 0.5).abs() < 0.1, "cut at {cut}");
     assert_eq!(pl.repeat, [false, false]);
-    let cut_uv: Vec<Vec2> = uv.iter().map(|w| Vec2::new(branch_cut::apply_cut(w.x as f64, cut) as f32, w.y)).collect();
+    let cut_uv: Vec<Vec2> =
+        uv.iter().map(|w| Vec2::new(branch_cut::apply_cut(w.x as f64, cut) as f32, w.y)).collect();
     check_visible_inside(&pl, &cut_uv, &views, &idx);
     assert!(pl.stretch <= 1.25);
 }
@@ -178,10 +193,12 @@ fn a_wall_of_a_wrapping_room_seen_in_its_middle_is_not_cut_at_the_seam() {
 #[test]
 fn a_cylinder_seen_all_around_keeps_wrapping_with_a_scale_only_map() {
     let (p, uv, idx) = cylinder(32);
-    let views: Vec<_> = (0..4).map(|k| {
-        let a = k as f32 * std::f32::consts::FRAC_PI_2;
-        view(camera(Vec3::new(3.0 * a.cos(), 0.0, 3.0 * a.sin()), Vec3::ZERO), &p)
-    }).collect();
+    let views: Vec<_> = (0..4)
+        .map(|k| {
+            let a = k as f32 * std::f32::consts::FRAC_PI_2;
+            view(camera(Vec3::new(3.0 * a.cos(), 0.0, 3.0 * a.sin()), Vec3::ZERO), &p)
+        })
+        .collect();
     let mesh = ObjectMesh { name: "cylinder", uvs: &uv, indices: &idx, wrap: [true, false] };
     let pl = optimize_placement(&mesh, &views, &TexcoordSettings::default()).unwrap();
     assert_eq!(pl.branch_cut[0], None);

@@ -65,8 +65,11 @@ pub fn rasterize_ids(view: &ViewGeometry, indices: &[u32]) -> IdBuffer {
         for y in y0..=y1 {
             for x in x0..=x1 {
                 let p = DVec2::new(x as f64 + 0.5, y as f64 + 0.5);
-                let l = [edge(v[1].p, v[2].p, p) / area, edge(v[2].p, v[0].p, p) / area,
-                         edge(v[0].p, v[1].p, p) / area];
+                let l = [
+                    edge(v[1].p, v[2].p, p) / area,
+                    edge(v[2].p, v[0].p, p) / area,
+                    edge(v[0].p, v[1].p, p) / area,
+                ];
                 if l.iter().any(|&l| l < 0.0) {
                     continue;
                 }
@@ -85,7 +88,8 @@ pub fn rasterize_ids(view: &ViewGeometry, indices: &[u32]) -> IdBuffer {
 /// The triangle's three screen vertices, or `None` if any lies behind the eye or an index
 /// is out of range.
 pub fn screen_triangle(view: &ViewGeometry, tri: &[u32]) -> Option<[ScreenVertex; 3]> {
-    let get = |i: u32| view.clip.get(i as usize).and_then(|&c| to_screen(c, view.width, view.height));
+    let get =
+        |i: u32| view.clip.get(i as usize).and_then(|&c| to_screen(c, view.width, view.height));
     Some([get(tri[0])?, get(tri[1])?, get(tri[2])?])
 }
 
@@ -103,8 +107,11 @@ pub fn uv_jacobian(v: &[ScreenVertex; 3], uv: [Vec2; 3], p: DVec2) -> Option<DMa
         return None;
     }
     // λ and its constant gradient.
-    let lam = [edge(v[1].p, v[2].p, p) / area, edge(v[2].p, v[0].p, p) / area,
-               edge(v[0].p, v[1].p, p) / area];
+    let lam = [
+        edge(v[1].p, v[2].p, p) / area,
+        edge(v[2].p, v[0].p, p) / area,
+        edge(v[0].p, v[1].p, p) / area,
+    ];
     let grad = |a: DVec2, b: DVec2| DVec2::new(a.y - b.y, b.x - a.x) / area;
     let dl = [grad(v[1].p, v[2].p), grad(v[2].p, v[0].p), grad(v[0].p, v[1].p)];
     let mut n = DVec2::ZERO;

@@ -12,7 +12,8 @@ pub fn zigzag(counts: &[u32]) -> Vec<Vec<u32>> {
     let mut out = Vec::with_capacity(inner.len() * counts[0] as usize);
     for i in 0..counts[0] {
         let forward = i % 2 == 0;
-        let rows: Box<dyn Iterator<Item = &Vec<u32>>> = if forward { Box::new(inner.iter()) } else { Box::new(inner.iter().rev()) };
+        let rows: Box<dyn Iterator<Item = &Vec<u32>>> =
+            if forward { Box::new(inner.iter()) } else { Box::new(inner.iter().rev()) };
         for r in rows {
             let mut p = Vec::with_capacity(counts.len());
             p.push(i);

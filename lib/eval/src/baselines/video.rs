@@ -112,7 +112,9 @@ pub fn coded_size(width: u32, height: u32) -> (u32, u32) {
 
 /// Checks that ffmpeg runs and has `codec`'s encoder; the error says what is missing.
 pub fn available(codec: VideoCodec) -> Result<()> {
-    let out = Command::new("ffmpeg").args(["-hide_banner", "-encoders"]).output()
+    let out = Command::new("ffmpeg")
+        .args(["-hide_banner", "-encoders"])
+        .output()
         .map_err(|e| anyhow!("ffmpeg is not installed or not on PATH ({e})"))?;
     let list = String::from_utf8_lossy(&out.stdout);
     if !list.lines().any(|l| l.split_whitespace().nth(1) == Some(codec.encoder())) {
@@ -124,9 +126,13 @@ pub fn available(codec: VideoCodec) -> Result<()> {
 /// Runs ffmpeg with `args`, `input` on stdin, and returns stdout.
 fn ffmpeg(args: &[String], input: Vec<u8>) -> Result<Vec<u8>> {
     let mut child = Command::new("ffmpeg")
-        .args(["-hide_banner", "-loglevel", "error"]).args(args)
-        .stdin(Stdio::piped()).stdout(Stdio::piped()).stderr(Stdio::piped())
-        .spawn().context("starting ffmpeg")?;
+        .args(["-hide_banner", "-loglevel", "error"])
+        .args(args)
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .context("starting ffmpeg")?;
     let mut stdin = child.stdin.take().ok_or_else(|| anyhow!("ffmpeg stdin"))?;
     let writer = std::thread::spawn(move || stdin.write_all(&input));
     let mut stdout = Vec::new();
@@ -144,19 +150,61 @@ fn ffmpeg(args: &[String], input: Vec<u8>) -> Result<Vec<u8>> {
 /// Encodes `frames` at constant rate factor `crf`; returns the elementary stream.
 pub fn encode(frames: &Frames, codec: VideoCodec, crf: f64) -> Result<Vec<u8>> {
     let (w, h, rgb) = frames.padded();
-    let mut args: Vec<String> = ["-f", "rawvideo", "-pix_fmt", "rgb24", "-s", &format!("{w}x{h}"), "-r", "25", "-i", "-",
-                                 "-c:v", codec.encoder(), "-pix_fmt", "yuv420p"].iter().map(|s| s.to_string()).collect();
+    let mut args: Vec<String> = [
+        "-f",
+        "rawvideo",
+        "-pix_fmt",
+        "rgb24",
+        "-s",
+        &format!("{w}x{h}"),
+        "-r",
+        "25",
+        "-i",
+        "-",
+        "-c:v",
+        codec.encoder(),
+        "-pix_fmt",
+        "yuv420p",
+    ]
+    .iter()
+    .map(|s| s.to_string())
+    .collect();
     match codec {
-        VideoCodec::X265 => args.extend(["-x265-params".into(), format!("crf={crf:.2}:info=0:log-level=error")]),
-        VideoCodec::Av1 => args.extend(["-crf", &format!("{}", crf.round() as i64), "-b:v", "0", "-cpu-used", "6", "-row-mt", "1"].iter().map(|s| s.to_string())),
+        VideoCodec::X265 => {
+            args.extend(["-x265-params".into(), format!("crf={crf:.2}:info=0:log-level=error")])
+        }
+        VideoCodec::Av1 => args.extend(
+            [
+                "-crf",
+                &format!("{}", crf.round() as i64),
+                "-b:v",
+                "0",
+                "-cpu-used",
+                "6",
+                "-row-mt",
+                "1",
+            ]
+            .iter()
+            .map(|s| s.to_string()),
+        ),
     }
     args.extend(["-f".to_string(), codec.format().to_string(), "-".to_string()]);
     ffmpeg(&args, rgb)
 }
 
 /// Decodes an elementary stream of `codec` back to rgb24 frames of `width`×`height`.
-pub fn decode(stream: &[u8], codec: VideoCodec, width: u32, height: u32, count: usize) -> Result<Frames> {
-    let args: Vec<String> = ["-f", codec.format(), "-i", "-", "-f", "rawvideo", "-pix_fmt", "rgb24", "-"].iter().map(|s| s.to_string()).collect();
+pub fn decode(
+    stream: &[u8],
+    codec: VideoCodec,
+    width: u32,
+    height: u32,
+    count: usize,
+) -> Result<Frames> {
+    let args: Vec<String> =
+        ["-f", codec.format(), "-i", "-", "-f", "rawvideo", "-pix_fmt", "rgb24", "-"]
+            .iter()
+            .map(|s| s.to_string())
+            .collect();
     let out = ffmpeg(&args, stream.to_vec())?;
     let (pw, ph) = coded_size(width, height);
     let frame = pw as usize * ph as usize * 3;
@@ -201,7 +249,14 @@ pub fn encode_to_budget(videos: &[Frames], codec: VideoCodec, budget: usize) -> 
     let coarsest = encode_all(videos, codec, hi)?;
     encodes += 1;
     if total(&coarsest) > budget {
-        return Ok(Matched { crf: hi, bytes: total(&coarsest), streams: coarsest, budget, reached: false, encodes });
+        return Ok(Matched {
+            crf: hi,
+            bytes: total(&coarsest),
+            streams: coarsest,
+            budget,
+            reached: false,
+            encodes,
+        });
     }
     let mut best = (hi, coarsest);
     loop {

@@ -33,10 +33,26 @@ struct Settings {
 
 fn settings(p: Preset) -> Settings {
     match p {
-        Preset::Ci => Settings { preset: None, resolution: Some((80, 60)), spp: Some(1), rd_ratios: vec![24.0, 48.0, 96.0, 192.0],
-                                 caps: vec![10, 50, 400], stability_ratios: vec![96.0, 384.0, 2000.0], frames: 9, reference_spp: 4 },
-        Preset::Paper => Settings { preset: Some("paper"), resolution: None, spp: None, rd_ratios: vec![96.0, 192.0, 384.0, 768.0],
-                                    caps: vec![25, 100, 400], stability_ratios: vec![96.0, 384.0, 2000.0], frames: 33, reference_spp: 16 },
+        Preset::Ci => Settings {
+            preset: None,
+            resolution: Some((80, 60)),
+            spp: Some(1),
+            rd_ratios: vec![24.0, 48.0, 96.0, 192.0],
+            caps: vec![10, 50, 400],
+            stability_ratios: vec![96.0, 384.0, 2000.0],
+            frames: 9,
+            reference_spp: 4,
+        },
+        Preset::Paper => Settings {
+            preset: Some("paper"),
+            resolution: None,
+            spp: None,
+            rd_ratios: vec![96.0, 192.0, 384.0, 768.0],
+            caps: vec![25, 100, 400],
+            stability_ratios: vec![96.0, 384.0, 2000.0],
+            frames: 33,
+            reference_spp: 16,
+        },
     }
 }
 
@@ -47,11 +63,14 @@ pub fn demo1() -> PathBuf {
 
 /// Removes the traced set of an earlier run so that the charts start from tracing.
 fn clear_cache(scene: &Path, s: &Settings) -> Result<(), Failure> {
-    let options = LoadOptions { preset: s.preset.map(str::to_string), resolution: s.resolution, spp: s.spp };
-    let loaded = pis_scene::load_with(scene, &options).map_err(|e| Failure::new(Exit::Invalid, e))?;
+    let options =
+        LoadOptions { preset: s.preset.map(str::to_string), resolution: s.resolution, spp: s.spp };
+    let loaded =
+        pis_scene::load_with(scene, &options).map_err(|e| Failure::new(Exit::Invalid, e))?;
     let dir = pis_pack::cache_dir(scene, &loaded);
     if dir.exists() {
-        std::fs::remove_dir_all(&dir).map_err(|e| Failure::new(Exit::Io, anyhow!("removing {}: {e}", dir.display())))?;
+        std::fs::remove_dir_all(&dir)
+            .map_err(|e| Failure::new(Exit::Io, anyhow!("removing {}: {e}", dir.display())))?;
     }
     Ok(())
 }
@@ -64,17 +83,50 @@ pub fn run(preset: Preset, scene: &Path, out: &Path, record: bool) -> Result<(),
     let s = settings(preset);
     clear_cache(scene, &s)?;
     let preset_name = s.preset.map(str::to_string);
-    let rd_req = RdRequest { input: scene.to_path_buf(), scene: None, ratios: s.rd_ratios.clone(), out: out.to_path_buf(), resolution: s.resolution,
-                             spp: s.spp, max_texture: pis_pack::DEFAULT_MAX_TEXTURE, preset: preset_name.clone(), record, methods: vec![], max_mse: pis_pack::PackSettings::new().max_mse, stagger: pis_pack::Stagger::Auto };
+    let rd_req = RdRequest {
+        input: scene.to_path_buf(),
+        scene: None,
+        ratios: s.rd_ratios.clone(),
+        out: out.to_path_buf(),
+        resolution: s.resolution,
+        spp: s.spp,
+        max_texture: pis_pack::DEFAULT_MAX_TEXTURE,
+        preset: preset_name.clone(),
+        record,
+        methods: vec![],
+        max_mse: pis_pack::PackSettings::new().max_mse,
+        stagger: pis_pack::Stagger::Auto,
+    };
     let r = rd::run(&rd_req)?;
     rd::print(&r, &mut std::io::stderr()).map_err(|e| Failure::new(Exit::Io, e))?;
-    let speed_req = SpeedRequest { input: scene.to_path_buf(), scene: None, caps: s.caps.clone(), ratio: 384.0, out: out.to_path_buf(),
-                                   resolution: s.resolution, spp: s.spp, preset: preset_name.clone(), max_texture: pis_pack::DEFAULT_MAX_TEXTURE, record };
+    let speed_req = SpeedRequest {
+        input: scene.to_path_buf(),
+        scene: None,
+        caps: s.caps.clone(),
+        ratio: 384.0,
+        out: out.to_path_buf(),
+        resolution: s.resolution,
+        spp: s.spp,
+        preset: preset_name.clone(),
+        max_texture: pis_pack::DEFAULT_MAX_TEXTURE,
+        record,
+    };
     let r = speed::run(&speed_req)?;
     speed::print(&r, &mut std::io::stderr()).map_err(|e| Failure::new(Exit::Io, e))?;
-    let st_req = StabilityRequest { input: scene.to_path_buf(), scene: None, ratios: s.stability_ratios.clone(), frames: s.frames, reference_seed: pis_trace::ShadingSeed::Cell,
-                                    spp: s.reference_spp, out: out.to_path_buf(), resolution: s.resolution, trace_spp: s.spp,
-                                    max_texture: pis_pack::DEFAULT_MAX_TEXTURE, preset: preset_name, record };
+    let st_req = StabilityRequest {
+        input: scene.to_path_buf(),
+        scene: None,
+        ratios: s.stability_ratios.clone(),
+        frames: s.frames,
+        reference_seed: pis_trace::ShadingSeed::Cell,
+        spp: s.reference_spp,
+        out: out.to_path_buf(),
+        resolution: s.resolution,
+        trace_spp: s.spp,
+        max_texture: pis_pack::DEFAULT_MAX_TEXTURE,
+        preset: preset_name,
+        record,
+    };
     let r = stability::run(&st_req)?;
     stability::print(&r, &mut std::io::stderr()).map_err(|e| Failure::new(Exit::Io, e))?;
     Ok(())

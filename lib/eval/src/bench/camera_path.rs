@@ -49,9 +49,13 @@ pub const AWAY_ELEVATION_DEG: f32 = 8.0;
 /// sample; every other dimension at its middle sample. Also returns the view dimension.
 pub fn paths(scene: &Scene, frames: usize, kinds: &[PathKind]) -> Result<(usize, Vec<PathFrame>)> {
     let dims = &scene.space.dims;
-    let v = dims.iter().position(|d| matches!(d.driver, Driver::Orbit { .. }))
-        .ok_or_else(|| anyhow!("scene {} has no orbit (view) dimension to move the camera along", scene.name))?;
-    let Driver::Orbit { target, radius, elevation_deg } = dims[v].driver.clone() else { unreachable!() };
+    let v =
+        dims.iter().position(|d| matches!(d.driver, Driver::Orbit { .. })).ok_or_else(|| {
+            anyhow!("scene {} has no orbit (view) dimension to move the camera along", scene.name)
+        })?;
+    let Driver::Orbit { target, radius, elevation_deg } = dims[v].driver.clone() else {
+        unreachable!()
+    };
     let values = &dims[v].values;
     let n = values.len();
     let base: Vec<u32> = dims.iter().map(|d| (d.values.len() / 2) as u32).collect();

@@ -15,7 +15,10 @@ use std::time::Instant;
 
 use anyhow::{anyhow, Result};
 use glam::{DVec3, Vec2, Vec3};
-use pis_compile::hybrid::{greedy_path, hybrid_pixels, Missing, shell_vector, tessellate_timed, vertex_vectors, HybridView, LensObject, TessellationSettings, TERMS};
+use pis_compile::hybrid::{
+    greedy_path, hybrid_pixels, shell_vector, tessellate_timed, vertex_vectors, HybridView,
+    LensObject, Missing, TessellationSettings, TERMS,
+};
 use pis_compile::shell::geometry::{Shell, ShellShape};
 use pis_compile::Viewport;
 use pis_scene::{LoadOptions, ObjectRole};
@@ -107,16 +110,26 @@ pub struct HybridReport {
 
 /// Per pixel covered by the lens object, the two terms' paths through its centre; with the
 /// rays cast.
-fn trace_pixels(lens: &LensObject, camera: &PerspectiveCamera, size: (u32, u32), max_depth: u32) -> (Vec<Option<[Option<pis_compile::hybrid::LensPath>; 2]>>, u64) {
+fn trace_pixels(
+    lens: &LensObject,
+    camera: &PerspectiveCamera,
+    size: (u32, u32),
+    max_depth: u32,
+) -> (Vec<Option<[Option<pis_compile::hybrid::LensPath>; 2]>>, u64) {
     let out: Vec<(Option<[Option<pis_compile::hybrid::LensPath>; 2]>, u64)> = (0..size.0 * size.1)
         .into_par_iter()
         .map(|p| {
             let centre = Vec2::new((p % size.0) as f32 + 0.5, (p / size.0) as f32 + 0.5);
             let dir = camera.direction(centre);
-            let Some(hit) = lens.closest(camera.origin, dir, f32::INFINITY) else { return (None, 1) };
+            let Some(hit) = lens.closest(camera.origin, dir, f32::INFINITY) else {
+                return (None, 1);
+            };
             let first = lens.surface(&hit, camera.origin, dir);
             let paths = TERMS.map(|t| greedy_path(lens, &first, dir, t, max_depth));
-            let rays = 1 + paths.iter().map(|p| p.map_or(0, |p| p.topology.interfaces as u64)).sum::<u64>();
+            let rays = 1 + paths
+                .iter()
+                .map(|p| p.map_or(0, |p| p.topology.interfaces as u64))
+                .sum::<u64>();
             (Some(paths), rays)
         })
         .collect();
@@ -134,15 +147,27 @@ fn percentile(mut v: Vec<f64>, f: f64) -> f64 {
 
 pub fn run(req: &HybridRequest) -> Result<HybridReport, Failure> {
     let options = LoadOptions { preset: req.preset.clone(), resolution: req.resolution, spp: None };
-    let scene = pis_scene::load_with(&req.scene, &options).map_err(|e| Failure::new(pis_pack::scene_exit(&e), anyhow!("{}: {e}", req.scene.display())))?;
-    let lenses: Vec<usize> = scene.objects.iter().enumerate().filter(|(_, o)| o.role == ObjectRole::Refractive).map(|(i, _)| i).collect();
+    let scene = pis_scene::load_with(&req.scene, &options).map_err(|e| {
+        Failure::new(pis_pack::scene_exit(&e), anyhow!("{}: {e}", req.scene.display()))
+    })?;
+    let lenses: Vec<usize> = scene
+        .objects
+        .iter()
+        .enumerate()
+        .filter(|(_, o)| o.role == ObjectRole::Refractive)
+        .map(|(i, _)| i)
+        .collect();
     if lenses.is_empty() {
-        return Err(Failure::new(Exit::Usage, anyhow!("{}: no refractive (lens) object to measure", req.scene.display())));
+        return Err(Failure::new(
+            Exit::Usage,
+            anyhow!("{}: no refractive (lens) object to measure", req.scene.display()),
+        ));
     }
     if req.taus.is_empty() || req.taus.iter().any(|t| !(t.is_finite() && *t > 0.0)) {
         return Err(Failure::new(Exit::Usage, anyhow!("--tau: give positive values in pixels")));
     }
-    let (_, frames) = paths(&scene, req.frames.max(1), &[PathKind::Between]).map_err(|e| Failure::new(Exit::Usage, e))?;
+    let (_, frames) = paths(&scene, req.frames.max(1), &[PathKind::Between])
+        .map_err(|e| Failure::new(Exit::Usage, e))?;
     let size = scene.resolution;
     let viewport = Viewport { width: size.0, height: size.1 };
     let max_depth = pis_trace::TraceSettings::new(size, 1).max_depth;
@@ -152,12 +177,32 @@ pub fn run(req: &HybridRequest) -> Result<HybridReport, Failure> {
     for &o in &lenses {
         let name = scene.objects[o].name.clone();
         let mut base = (0.0, 0.0, 0.0);
-        let mut acc: Vec<HybridRow> = req.taus.iter().map(|&tau| HybridRow { object: name.clone(), tau_px: tau, vertex_rays: 0.0, traced_vertices: 0.0, front_triangles: 0.0, triangles: 0.0, trace_ms: 0.0, tessellate_ms: 0.0, texgen_ms: 0.0, cpu_ms: 0.0, ray_reduction: 0.0, time_reduction: 0.0, p90_angle_deg: [0.0; 2] }).collect();
-        let mut angles: Vec<[Vec<f64>; 2]> = req.taus.iter().map(|_| [Vec::new(), Vec::new()]).collect();
+        let mut acc: Vec<HybridRow> = req
+            .taus
+            .iter()
+            .map(|&tau| HybridRow {
+                object: name.clone(),
+                tau_px: tau,
+                vertex_rays: 0.0,
+                traced_vertices: 0.0,
+                front_triangles: 0.0,
+                triangles: 0.0,
+                trace_ms: 0.0,
+                tessellate_ms: 0.0,
+                texgen_ms: 0.0,
+                cpu_ms: 0.0,
+                ray_reduction: 0.0,
+                time_reduction: 0.0,
+                p90_angle_deg: [0.0; 2],
+            })
+            .collect();
+        let mut angles: Vec<[Vec<f64>; 2]> =
+            req.taus.iter().map(|_| [Vec::new(), Vec::new()]).collect();
         for pf in &frames {
             let lens = pis_pack::lens::lens_object(&scene, &pf.frame, o);
             let camera = PerspectiveCamera::new(&pf.frame.camera, size);
-            let clip_from_world = projection_matrix(&pf.frame.camera, size) * pf.frame.camera.world_from_camera.inverse();
+            let clip_from_world = projection_matrix(&pf.frame.camera, size)
+                * pf.frame.camera.world_from_camera.inverse();
             let view = HybridView { eye: camera.origin, clip_from_world, size };
             let t = Instant::now();
             let (traced, rays) = trace_pixels(&lens, &camera, size, max_depth);
@@ -165,10 +210,17 @@ pub fn run(req: &HybridRequest) -> Result<HybridReport, Failure> {
             base.0 += traced.iter().filter(|p| p.is_some()).count() as f64;
             base.1 += rays as f64;
             // A far shell: its vectors are nearly the outgoing directions.
-            let (lo, hi) = lens.positions.iter().fold((Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)), |(lo, hi), &p| (lo.min(p), hi.max(p)));
-            let shell = Shell { origin: ((lo + hi) * 0.5).as_dvec3(), shape: ShellShape::Sphere { radius: 20.0 * ((hi - lo).length() as f64).max(1e-3) } };
+            let (lo, hi) = lens.positions.iter().fold(
+                (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
+                |(lo, hi), &p| (lo.min(p), hi.max(p)),
+            );
+            let shell = Shell {
+                origin: ((lo + hi) * 0.5).as_dvec3(),
+                shape: ShellShape::Sphere { radius: 20.0 * ((hi - lo).length() as f64).max(1e-3) },
+            };
             for (k, &tau) in req.taus.iter().enumerate() {
-                let settings = TessellationSettings { tau_px: tau, max_depth, ..Default::default() };
+                let settings =
+                    TessellationSettings { tau_px: tau, max_depth, ..Default::default() };
                 let (tess, times) = tessellate_timed(&lens, &view, &settings);
                 let t = Instant::now();
                 let vectors = TERMS.map(|term| vertex_vectors(&tess, term, &shell));
@@ -182,19 +234,38 @@ pub fn run(req: &HybridRequest) -> Result<HybridReport, Failure> {
                 r.tessellate_ms += times.tessellate.as_secs_f64() * 1e3;
                 r.texgen_ms += texgen;
                 for (term, v) in vectors.iter().enumerate() {
-                    let px = hybrid_pixels(viewport, &tess, clip_from_world, v, Missing::Mean, None);
+                    let px =
+                        hybrid_pixels(viewport, &tess, clip_from_world, v, Missing::Mean, None);
                     for (&p, d) in px.pixels.iter().zip(&px.vectors) {
-                        let Some(Some(path)) = traced[p as usize].map(|t| t[term]) else { continue };
+                        let Some(Some(path)) = traced[p as usize].map(|t| t[term]) else {
+                            continue;
+                        };
                         let Some(w) = shell_vector(&shell, &path) else { continue };
                         let w = DVec3::from(w.map(f64::from));
-                        angles[k][term].push((2.0 * (0.5 * (d[0].normalize() - w.normalize()).length()).asin()).to_degrees());
+                        angles[k][term].push(
+                            (2.0 * (0.5 * (d[0].normalize() - w.normalize()).length()).asin())
+                                .to_degrees(),
+                        );
                     }
                 }
             }
         }
-        per_pixel.push(PixelTracing { object: name.clone(), pixels: base.0 / n, rays: base.1 / n, ms: base.2 / n });
+        per_pixel.push(PixelTracing {
+            object: name.clone(),
+            pixels: base.0 / n,
+            rays: base.1 / n,
+            ms: base.2 / n,
+        });
         for (mut r, a) in acc.into_iter().zip(angles) {
-            for v in [&mut r.vertex_rays, &mut r.traced_vertices, &mut r.front_triangles, &mut r.triangles, &mut r.trace_ms, &mut r.tessellate_ms, &mut r.texgen_ms] {
+            for v in [
+                &mut r.vertex_rays,
+                &mut r.traced_vertices,
+                &mut r.front_triangles,
+                &mut r.triangles,
+                &mut r.trace_ms,
+                &mut r.tessellate_ms,
+                &mut r.texgen_ms,
+            ] {
                 *v /= n;
             }
             r.cpu_ms = r.trace_ms + r.tessellate_ms + r.texgen_ms;
@@ -213,32 +284,77 @@ pub fn run(req: &HybridRequest) -> Result<HybridReport, Failure> {
         }
         None => (Vec::new(), None, 0),
     };
-    Ok(HybridReport { scene: scene.name.clone(), size: [size.0, size.1], frames: frames.len(), threads: rayon::current_num_threads(), per_pixel, rows, played, adapter, msaa, stamp: Stamp::here(&scene.name) })
+    Ok(HybridReport {
+        scene: scene.name.clone(),
+        size: [size.0, size.1],
+        frames: frames.len(),
+        threads: rayon::current_num_threads(),
+        per_pixel,
+        rows,
+        played,
+        adapter,
+        msaa,
+        stamp: Stamp::here(&scene.name),
+    })
 }
 
 /// `file` played at every frame's camera with each τ; before them the last frame is drawn
 /// once, not counted, so that the file is opened, its first textures decoded and uploaded
 /// and its pipelines compiled (and the first counted frame, at another camera, traces its
 /// own vertex rays).
-fn play(scene: &pis_scene::Scene, file: &std::path::Path, frames: &[super::camera_path::PathFrame], taus: &[f32], msaa: u32, base_ms: f64) -> Result<(Vec<PlayedRow>, String, u32), Failure> {
+fn play(
+    scene: &pis_scene::Scene,
+    file: &std::path::Path,
+    frames: &[super::camera_path::PathFrame],
+    taus: &[f32],
+    msaa: u32,
+    base_ms: f64,
+) -> Result<(Vec<PlayedRow>, String, u32), Failure> {
     use pis_play::{CameraChoice, FrameRequest, Gpu, Player, PlayerOptions};
-    let gpu = std::sync::Arc::new(Gpu::new().map_err(|e| Failure::new(Exit::NotSupported, anyhow!("{e}")))?);
-    let view_dim = scene.space.dims.iter().position(|d| d.kind == pis_format::DimensionKind::View).unwrap_or(0);
+    let gpu = std::sync::Arc::new(
+        Gpu::new().map_err(|e| Failure::new(Exit::NotSupported, anyhow!("{e}")))?,
+    );
+    let view_dim = scene
+        .space
+        .dims
+        .iter()
+        .position(|d| d.kind == pis_format::DimensionKind::View)
+        .unwrap_or(0);
     let mut rows = Vec::new();
     let mut samples = msaa;
     for &tau in taus {
-        let mut player = Player::open(gpu.clone(), file, PlayerOptions { tau_px: tau, msaa, ..PlayerOptions::default() }).map_err(|e| Failure::new(Exit::Invalid, anyhow!("{}: {e}", file.display())))?;
+        let mut player = Player::open(
+            gpu.clone(),
+            file,
+            PlayerOptions { tau_px: tau, msaa, ..PlayerOptions::default() },
+        )
+        .map_err(|e| Failure::new(Exit::Invalid, anyhow!("{}: {e}", file.display())))?;
         if player.image_size() != scene.resolution {
             return Err(Failure::new(Exit::Usage, anyhow!("{}: {}x{} frames, the scene's are {}x{} (pass the same --preset or --resolution)", file.display(), player.image_size().0, player.image_size().1, scene.resolution.0, scene.resolution.1)));
         }
         samples = player.multisample().samples;
-        let mut row = PlayedRow { tau_px: tau, lens_ms: 0.0, lens_rays: 0.0, decode_ms: 0.0, draw_ms: 0.0, frame_ms: 0.0, frame_reduction: 0.0 };
-        let request = |pf: &super::camera_path::PathFrame| FrameRequest { point: super::reflective::point(scene, pf, view_dim), camera: CameraChoice::Free(super::reflective::camera(scene, pf)) };
+        let mut row = PlayedRow {
+            tau_px: tau,
+            lens_ms: 0.0,
+            lens_rays: 0.0,
+            decode_ms: 0.0,
+            draw_ms: 0.0,
+            frame_ms: 0.0,
+            frame_reduction: 0.0,
+        };
+        let request = |pf: &super::camera_path::PathFrame| FrameRequest {
+            point: super::reflective::point(scene, pf, view_dim),
+            camera: CameraChoice::Free(super::reflective::camera(scene, pf)),
+        };
         if let Some(last) = frames.last() {
-            player.render_timed(&request(last), scene.resolution).map_err(|e| Failure::new(Exit::Runtime, anyhow!("{e}")))?;
+            player
+                .render_timed(&request(last), scene.resolution)
+                .map_err(|e| Failure::new(Exit::Runtime, anyhow!("{e}")))?;
         }
         for pf in frames {
-            let s = player.render_timed(&request(pf), scene.resolution).map_err(|e| Failure::new(Exit::Runtime, anyhow!("{e}")))?;
+            let s = player
+                .render_timed(&request(pf), scene.resolution)
+                .map_err(|e| Failure::new(Exit::Runtime, anyhow!("{e}")))?;
             row.lens_ms += s.lens_ms;
             row.lens_rays += s.lens_rays as f64;
             row.decode_ms += s.decode_ms;
@@ -246,7 +362,13 @@ fn play(scene: &pis_scene::Scene, file: &std::path::Path, frames: &[super::camer
             row.frame_ms += s.frame_ms;
         }
         let n = frames.len().max(1) as f64;
-        for v in [&mut row.lens_ms, &mut row.lens_rays, &mut row.decode_ms, &mut row.draw_ms, &mut row.frame_ms] {
+        for v in [
+            &mut row.lens_ms,
+            &mut row.lens_rays,
+            &mut row.decode_ms,
+            &mut row.draw_ms,
+            &mut row.frame_ms,
+        ] {
             *v /= n;
         }
         row.frame_reduction = base_ms / row.frame_ms.max(1e-9);
@@ -256,19 +378,55 @@ fn play(scene: &pis_scene::Scene, file: &std::path::Path, frames: &[super::camer
 }
 
 pub fn print(r: &HybridReport, w: &mut impl std::io::Write) -> std::io::Result<()> {
-    writeln!(w, "pis-bench hybrid: {} at {}x{}, {} frames between the sampled views, {} threads", r.scene, r.size[0], r.size[1], r.frames, r.threads)?;
+    writeln!(
+        w,
+        "pis-bench hybrid: {} at {}x{}, {} frames between the sampled views, {} threads",
+        r.scene, r.size[0], r.size[1], r.frames, r.threads
+    )?;
     for p in &r.per_pixel {
-        writeln!(w, "  {}: traced at every pixel centre: {:.0} pixels, {:.0} rays, {:.2} ms", p.object, p.pixels, p.rays, p.ms)?;
-        writeln!(w, "    {:>6} {:>10} {:>9} {:>9} {:>9} {:>11} {:>9} {:>9} {:>8} {:>8} {:>15}", "τ px", "rays", "vertices", "triangles", "trace ms", "tessel. ms", "texgen ms", "total ms", "rays ÷", "time ÷", "90 % angle R/T")?;
+        writeln!(
+            w,
+            "  {}: traced at every pixel centre: {:.0} pixels, {:.0} rays, {:.2} ms",
+            p.object, p.pixels, p.rays, p.ms
+        )?;
+        writeln!(
+            w,
+            "    {:>6} {:>10} {:>9} {:>9} {:>9} {:>11} {:>9} {:>9} {:>8} {:>8} {:>15}",
+            "τ px",
+            "rays",
+            "vertices",
+            "triangles",
+            "trace ms",
+            "tessel. ms",
+            "texgen ms",
+            "total ms",
+            "rays ÷",
+            "time ÷",
+            "90 % angle R/T"
+        )?;
         for x in r.rows.iter().filter(|x| x.object == p.object) {
             writeln!(w, "    {:>6} {:>10.0} {:>9.0} {:>9.0} {:>9.2} {:>11.2} {:>9.2} {:>9.2} {:>8.1} {:>8.1} {:>7.2}°/{:.2}°", x.tau_px, x.vertex_rays, x.traced_vertices, x.triangles, x.trace_ms, x.tessellate_ms, x.texgen_ms, x.cpu_ms, x.ray_reduction, x.time_reduction, x.p90_angle_deg[0], x.p90_angle_deg[1])?;
         }
     }
     if let Some(a) = &r.adapter {
         writeln!(w, "  played ({a}, {} sample(s) per pixel), means per frame:", r.msaa)?;
-        writeln!(w, "    {:>6} {:>10} {:>8} {:>9} {:>8} {:>9} {:>13}", "τ px", "lens rays", "lens ms", "decode ms", "draw ms", "frame ms", "per-pixel ÷")?;
+        writeln!(
+            w,
+            "    {:>6} {:>10} {:>8} {:>9} {:>8} {:>9} {:>13}",
+            "τ px", "lens rays", "lens ms", "decode ms", "draw ms", "frame ms", "per-pixel ÷"
+        )?;
         for p in &r.played {
-            writeln!(w, "    {:>6} {:>10.0} {:>8.2} {:>9.2} {:>8.2} {:>9.2} {:>13.2}", p.tau_px, p.lens_rays, p.lens_ms, p.decode_ms, p.draw_ms, p.frame_ms, p.frame_reduction)?;
+            writeln!(
+                w,
+                "    {:>6} {:>10.0} {:>8.2} {:>9.2} {:>8.2} {:>9.2} {:>13.2}",
+                p.tau_px,
+                p.lens_rays,
+                p.lens_ms,
+                p.decode_ms,
+                p.draw_ms,
+                p.frame_ms,
+                p.frame_reduction
+            )?;
         }
     }
     Ok(())

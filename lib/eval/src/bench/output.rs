@@ -3,17 +3,24 @@
 
 use std::path::{Path, PathBuf};
 
-use anyhow::{anyhow, Result};
 use crate::chart::{write_svg, Chart, Series};
 use crate::report::{record_row, write_atomic, Csv, Stamp};
+use anyhow::{anyhow, Result};
 
 /// Creates the output folder when missing.
 pub fn ensure_dir(dir: &Path) -> Result<()> {
-    std::fs::create_dir_all(dir).map_err(|e| anyhow!("cannot create the output folder {}: {e}", dir.display()))
+    std::fs::create_dir_all(dir)
+        .map_err(|e| anyhow!("cannot create the output folder {}: {e}", dir.display()))
 }
 
 /// Writes `NAME.csv` and `NAME.svg` into `dir`; returns their paths.
-pub fn write_chart(dir: &Path, name: &str, csv: &Csv, chart: &Chart, series: &[Series]) -> Result<(PathBuf, PathBuf)> {
+pub fn write_chart(
+    dir: &Path,
+    name: &str,
+    csv: &Csv,
+    chart: &Chart,
+    series: &[Series],
+) -> Result<(PathBuf, PathBuf)> {
     let (c, s) = (dir.join(format!("{name}.csv")), dir.join(format!("{name}.svg")));
     write_atomic(&c, csv.text().as_bytes())?;
     write_svg(&s, chart, series)?;
@@ -30,6 +37,10 @@ pub fn benchmarks_md() -> PathBuf {
 pub fn record(eval: &str, stamp: &Stamp, summary: &str) -> Result<()> {
     let head = "| evaluation · scene | summary | machine | command |\n|---|---|---|---|";
     let key = format!("{eval} · {}", stamp.scene);
-    let row = format!("| {key} | {summary} | {} | `{}` |", stamp.machine, stamp.command.replace('|', "\\|"));
+    let row = format!(
+        "| {key} | {summary} | {} | `{}` |",
+        stamp.machine,
+        stamp.command.replace('|', "\\|")
+    );
     record_row(&benchmarks_md(), "pis-bench runs", head, &key, &row)
 }

@@ -15,11 +15,11 @@
 use std::path::PathBuf;
 use std::time::Instant;
 
-use anyhow::anyhow;
-use pis_codec::CodecId;
 use crate::baselines::video::{available, VideoCodec};
 use crate::chart::{Chart, Series};
 use crate::report::{Csv, Stamp};
+use anyhow::anyhow;
+use pis_codec::CodecId;
 use serde::Serialize;
 
 use super::mpeg_texture::texture_point;
@@ -96,11 +96,30 @@ pub struct RdReport {
 }
 
 /// Every method's curve name, in chart order.
-pub const METHODS: [&str; 7] = ["pis-wavelet", "pis-dct", "pis-wavelet-full-pyramid", "pis-wavelet-combined-layers", "mpeg-texture-x265", "view-x265", "view-av1"];
+pub const METHODS: [&str; 7] = [
+    "pis-wavelet",
+    "pis-dct",
+    "pis-wavelet-full-pyramid",
+    "pis-wavelet-combined-layers",
+    "mpeg-texture-x265",
+    "view-x265",
+    "view-av1",
+];
 
 fn pack_request(req: &RdRequest) -> PackRequest {
-    let settings = PackSettings { max_texture: req.max_texture, resolution: req.resolution, spp: req.spp, preset: req.preset.clone(), max_mse: req.max_mse, stagger: req.stagger, ..PackSettings::new() };
-    PackRequest { scene: req.scene.clone(), ..PackRequest::new(req.input.clone(), req.out.join("unused.pis"), settings) }
+    let settings = PackSettings {
+        max_texture: req.max_texture,
+        resolution: req.resolution,
+        spp: req.spp,
+        preset: req.preset.clone(),
+        max_mse: req.max_mse,
+        stagger: req.stagger,
+        ..PackSettings::new()
+    };
+    PackRequest {
+        scene: req.scene.clone(),
+        ..PackRequest::new(req.input.clone(), req.out.join("unused.pis"), settings)
+    }
 }
 
 fn runtime(e: anyhow::Error) -> Failure {
@@ -110,16 +129,25 @@ fn runtime(e: anyhow::Error) -> Failure {
 /// Checks the request before any work.
 pub fn check(req: &RdRequest) -> Result<(), Failure> {
     if !req.input.exists() {
-        return Err(Failure::new(Exit::Io, anyhow!("{}: no such set directory or scene file", req.input.display())));
+        return Err(Failure::new(
+            Exit::Io,
+            anyhow!("{}: no such set directory or scene file", req.input.display()),
+        ));
     }
     if req.ratios.is_empty() {
         return Err(Failure::new(Exit::Usage, anyhow!("--ratios needs at least one ratio")));
     }
     if let Some(r) = req.ratios.iter().find(|r| !(r.is_finite() && **r >= 1.0)) {
-        return Err(Failure::new(Exit::Usage, anyhow!("--ratios: every ratio must be at least 1, got {r}")));
+        return Err(Failure::new(
+            Exit::Usage,
+            anyhow!("--ratios: every ratio must be at least 1, got {r}"),
+        ));
     }
     if let Some(m) = req.methods.iter().find(|m| !METHODS.contains(&m.as_str())) {
-        return Err(Failure::new(Exit::Usage, anyhow!("--methods: unknown method {m:?} (one of {})", METHODS.join(", "))));
+        return Err(Failure::new(
+            Exit::Usage,
+            anyhow!("--methods: unknown method {m:?} (one of {})", METHODS.join(", ")),
+        ));
     }
     if req.max_texture == 0 || req.max_texture > 16384 {
         return Err(Failure::new(Exit::Usage, anyhow!("--max-texture must be in 1..=16384")));
@@ -129,7 +157,11 @@ pub fn check(req: &RdRequest) -> Result<(), Failure> {
 
 /// Whether the video baselines may be skipped when ffmpeg lacks an encoder: locally yes
 /// (with a message), never under CI (env `CI` set).
-fn video_or_skip(codec: VideoCodec, skipped: &mut Vec<String>, method: &str) -> Result<bool, Failure> {
+fn video_or_skip(
+    codec: VideoCodec,
+    skipped: &mut Vec<String>,
+    method: &str,
+) -> Result<bool, Failure> {
     match available(codec) {
         Ok(()) => Ok(true),
         Err(e) if std::env::var_os("CI").is_none() => {
@@ -138,7 +170,10 @@ fn video_or_skip(codec: VideoCodec, skipped: &mut Vec<String>, method: &str) -> 
             skipped.push(why);
             Ok(false)
         }
-        Err(e) => Err(Failure::new(Exit::NotSupported, anyhow!("{method}: {e}; CI requires it (add ffmpeg to the CI packages)"))),
+        Err(e) => Err(Failure::new(
+            Exit::NotSupported,
+            anyhow!("{method}: {e}; CI requires it (add ffmpeg to the CI packages)"),
+        )),
     }
 }
 
@@ -163,12 +198,22 @@ pub fn run(req: &RdRequest) -> Result<RdReport, Failure> {
             None
         }
     };
-    let pis = |name: &str, inf: &Inferred, codec: CodecId, pyramid: PyramidMode, rows: &mut Vec<RdRow>, skipped: &mut Vec<String>| -> Result<(), Failure> {
+    let pis = |name: &str,
+               inf: &Inferred,
+               codec: CodecId,
+               pyramid: PyramidMode,
+               rows: &mut Vec<RdRow>,
+               skipped: &mut Vec<String>|
+     -> Result<(), Failure> {
         if !wanted(name) {
             return Ok(());
         }
         for &r in &req.ratios {
-            let preq = base.with(|s| { s.ratio = Some(r); s.codec = codec; s.pyramid = pyramid; });
+            let preq = base.with(|s| {
+                s.ratio = Some(r);
+                s.codec = codec;
+                s.pyramid = pyramid;
+            });
             // A budget below what the level images' headers need is a point the method
             // cannot reach: reported, not fatal.
             let p = match inf.pack_point(&preq) {
@@ -191,32 +236,87 @@ pub fn run(req: &RdRequest) -> Result<RdReport, Failure> {
                 }
                 None => None,
             };
-            let (psnr, scope) = played.map_or((p.psnr_db, "covered-predicted"), |c| (c.0, "whole-image-played"));
+            let (psnr, scope) =
+                played.map_or((p.psnr_db, "covered-predicted"), |c| (c.0, "whole-image-played"));
             eprintln!("pis-bench: rd: {name:<28} {r:>7.1}:1 → {:>7.1}:1  {psnr:6.2} dB {scope} (predicted {:.2} dB)", p.ratio(), p.psnr_db);
-            rows.push(RdRow { method: name.into(), target_ratio: r, ratio: p.ratio(), bytes: p.texture_bytes, budget: budget(r), psnr_db: psnr,
-                              psnr_scope: scope.into(), psnr_db_predicted: Some(p.psnr_db), psnr_db_covered: played.map(|c| c.1),
-                              file_ratio: Some(p.file_ratio()), crf: None, reached: p.texture_bytes <= budget(r) + budget(r) / 20, ms: p.encode_ms });
+            rows.push(RdRow {
+                method: name.into(),
+                target_ratio: r,
+                ratio: p.ratio(),
+                bytes: p.texture_bytes,
+                budget: budget(r),
+                psnr_db: psnr,
+                psnr_scope: scope.into(),
+                psnr_db_predicted: Some(p.psnr_db),
+                psnr_db_covered: played.map(|c| c.1),
+                file_ratio: Some(p.file_ratio()),
+                crf: None,
+                reached: p.texture_bytes <= budget(r) + budget(r) / 20,
+                ms: p.encode_ms,
+            });
         }
         Ok(())
     };
-    pis("pis-wavelet", &separate, CodecId::Wavelet, PyramidMode::Adaptive, &mut rows, &mut skipped)?;
+    pis(
+        "pis-wavelet",
+        &separate,
+        CodecId::Wavelet,
+        PyramidMode::Adaptive,
+        &mut rows,
+        &mut skipped,
+    )?;
     pis("pis-dct", &separate, CodecId::Dct, PyramidMode::Adaptive, &mut rows, &mut skipped)?;
-    pis("pis-wavelet-full-pyramid", &separate, CodecId::Wavelet, PyramidMode::Full, &mut rows, &mut skipped)?;
+    pis(
+        "pis-wavelet-full-pyramid",
+        &separate,
+        CodecId::Wavelet,
+        PyramidMode::Full,
+        &mut rows,
+        &mut skipped,
+    )?;
     if wanted("pis-wavelet-combined-layers") {
         eprintln!("pis-bench: rd: inferring again with one combined lighting layer");
-        let combined = Inferred::new(&base.with(|s| s.layers = LayerMode::Combined), &StderrProgress)?;
-        pis("pis-wavelet-combined-layers", &combined, CodecId::Wavelet, PyramidMode::Adaptive, &mut rows, &mut skipped)?;
+        let combined =
+            Inferred::new(&base.with(|s| s.layers = LayerMode::Combined), &StderrProgress)?;
+        pis(
+            "pis-wavelet-combined-layers",
+            &combined,
+            CodecId::Wavelet,
+            PyramidMode::Adaptive,
+            &mut rows,
+            &mut skipped,
+        )?;
     }
 
-    if wanted("mpeg-texture-x265") && video_or_skip(VideoCodec::X265, &mut skipped, "mpeg-texture-x265")? {
+    if wanted("mpeg-texture-x265")
+        && video_or_skip(VideoCodec::X265, &mut skipped, "mpeg-texture-x265")?
+    {
         for &r in &req.ratios {
             let t = Instant::now();
             let p = texture_point(&separate, budget(r)).map_err(runtime)?;
-            eprintln!("pis-bench: rd: {:<28} {r:>7.1}:1 → {:>7.1}:1  {:6.2} dB  ({} videos, CRF {:.2})", "mpeg-texture-x265",
-                      raw as f64 / p.bytes as f64, p.psnr_db, p.videos, p.matched.crf);
-            rows.push(RdRow { method: "mpeg-texture-x265".into(), target_ratio: r, ratio: raw as f64 / p.bytes.max(1) as f64, bytes: p.bytes,
-                              budget: budget(r), psnr_db: p.psnr_db, psnr_scope: "covered-predicted".into(), psnr_db_predicted: None, psnr_db_covered: None, file_ratio: None,
-                              crf: Some(p.matched.crf), reached: p.matched.reached, ms: t.elapsed().as_secs_f64() * 1e3 });
+            eprintln!(
+                "pis-bench: rd: {:<28} {r:>7.1}:1 → {:>7.1}:1  {:6.2} dB  ({} videos, CRF {:.2})",
+                "mpeg-texture-x265",
+                raw as f64 / p.bytes as f64,
+                p.psnr_db,
+                p.videos,
+                p.matched.crf
+            );
+            rows.push(RdRow {
+                method: "mpeg-texture-x265".into(),
+                target_ratio: r,
+                ratio: raw as f64 / p.bytes.max(1) as f64,
+                bytes: p.bytes,
+                budget: budget(r),
+                psnr_db: p.psnr_db,
+                psnr_scope: "covered-predicted".into(),
+                psnr_db_predicted: None,
+                psnr_db_covered: None,
+                file_ratio: None,
+                crf: Some(p.matched.crf),
+                reached: p.matched.reached,
+                ms: t.elapsed().as_secs_f64() * 1e3,
+            });
         }
     }
     let frames = view_frames(&separate).map_err(runtime)?;
@@ -227,27 +327,80 @@ pub fn run(req: &RdRequest) -> Result<RdReport, Failure> {
         for &r in &req.ratios {
             let t = Instant::now();
             let p = view_point(&frames, codec, budget(r)).map_err(runtime)?;
-            eprintln!("pis-bench: rd: {name:<28} {r:>7.1}:1 → {:>7.1}:1  {:6.2} dB  (CRF {:.2})", raw as f64 / p.matched.bytes as f64, p.psnr_db, p.matched.crf);
-            rows.push(RdRow { method: name.into(), target_ratio: r, ratio: raw as f64 / p.matched.bytes.max(1) as f64, bytes: p.matched.bytes,
-                              budget: budget(r), psnr_db: p.psnr_db, psnr_scope: "whole-image".into(), psnr_db_predicted: None, psnr_db_covered: None, file_ratio: None,
-                              crf: Some(p.matched.crf), reached: p.matched.reached, ms: t.elapsed().as_secs_f64() * 1e3 });
+            eprintln!(
+                "pis-bench: rd: {name:<28} {r:>7.1}:1 → {:>7.1}:1  {:6.2} dB  (CRF {:.2})",
+                raw as f64 / p.matched.bytes as f64,
+                p.psnr_db,
+                p.matched.crf
+            );
+            rows.push(RdRow {
+                method: name.into(),
+                target_ratio: r,
+                ratio: raw as f64 / p.matched.bytes.max(1) as f64,
+                bytes: p.matched.bytes,
+                budget: budget(r),
+                psnr_db: p.psnr_db,
+                psnr_scope: "whole-image".into(),
+                psnr_db_predicted: None,
+                psnr_db_covered: None,
+                file_ratio: None,
+                crf: Some(p.matched.crf),
+                reached: p.matched.reached,
+                ms: t.elapsed().as_secs_f64() * 1e3,
+            });
         }
     }
 
     let set = &separate.set;
-    let scene = format!("{} ({} points, {}x{})", set.scene.name, set.samples.len(), set.resolution.0, set.resolution.1);
+    let scene = format!(
+        "{} ({} points, {}x{})",
+        set.scene.name,
+        set.samples.len(),
+        set.resolution.0,
+        set.resolution.1
+    );
     let stamp = Stamp::here(&scene);
-    let mut csv = Csv::new(&["method", "target_ratio", "ratio", "bytes", "budget", "psnr_db", "psnr_scope", "psnr_db_predicted", "psnr_db_covered", "file_ratio", "crf", "reached", "ms"]);
+    let mut csv = Csv::new(&[
+        "method",
+        "target_ratio",
+        "ratio",
+        "bytes",
+        "budget",
+        "psnr_db",
+        "psnr_scope",
+        "psnr_db_predicted",
+        "psnr_db_covered",
+        "file_ratio",
+        "crf",
+        "reached",
+        "ms",
+    ]);
     let opt = |v: Option<f64>| v.map_or(String::new(), |x| format!("{x:.3}"));
     for r in &rows {
-        csv.push(vec![r.method.clone(), format!("{}", r.target_ratio), format!("{:.2}", r.ratio), r.bytes.to_string(), r.budget.to_string(),
-                      format!("{:.3}", r.psnr_db), r.psnr_scope.clone(), opt(r.psnr_db_predicted), opt(r.psnr_db_covered), r.file_ratio.map_or(String::new(), |f| format!("{f:.2}")),
-                      r.crf.map_or(String::new(), |c| format!("{c:.2}")), r.reached.to_string(), format!("{:.0}", r.ms)]);
+        csv.push(vec![
+            r.method.clone(),
+            format!("{}", r.target_ratio),
+            format!("{:.2}", r.ratio),
+            r.bytes.to_string(),
+            r.budget.to_string(),
+            format!("{:.3}", r.psnr_db),
+            r.psnr_scope.clone(),
+            opt(r.psnr_db_predicted),
+            opt(r.psnr_db_covered),
+            r.file_ratio.map_or(String::new(), |f| format!("{f:.2}")),
+            r.crf.map_or(String::new(), |c| format!("{c:.2}")),
+            r.reached.to_string(),
+            format!("{:.0}", r.ms),
+        ]);
     }
-    let series: Vec<Series> = METHODS.iter().filter(|m| rows.iter().any(|r| &r.method == *m)).map(|m| Series {
-        name: m.to_string(),
-        points: rows.iter().filter(|r| &r.method == m).map(|r| (r.ratio, r.psnr_db)).collect(),
-    }).collect();
+    let series: Vec<Series> = METHODS
+        .iter()
+        .filter(|m| rows.iter().any(|r| &r.method == *m))
+        .map(|m| Series {
+            name: m.to_string(),
+            points: rows.iter().filter(|r| &r.method == m).map(|r| (r.ratio, r.psnr_db)).collect(),
+        })
+        .collect();
     let chart = Chart {
         title: format!("Compression ratio vs PSNR — {scene}"),
         subtitle: if gpu.is_some() {
@@ -260,7 +413,8 @@ pub fn run(req: &RdRequest) -> Result<RdReport, Failure> {
         x_log: true,
         stamp: stamp.lines(),
     };
-    let (c, s) = write_chart(&req.out, "rd", &csv, &chart, &series).map_err(|e| Failure::new(Exit::Io, e))?;
+    let (c, s) = write_chart(&req.out, "rd", &csv, &chart, &series)
+        .map_err(|e| Failure::new(Exit::Io, e))?;
     let notes = vec![
         "budget = raw image bytes (points × width × height × 3) / target ratio; ratio = raw / bytes spent".into(),
         "PIS bytes: level images (as pis-pack's --ratio counts them); file_ratio adds geometry, tables and headers".into(),
@@ -268,8 +422,16 @@ pub fn run(req: &RdRequest) -> Result<RdReport, Failure> {
         "PIS PSNR: the file played by the player (crate::compare), whole image (psnr_db_covered: covered pixels); without a GPU adapter pis-pack's prediction over covered pixels. mpeg-texture: predicted through the hardware model over covered pixels; view-based: whole image".into(),
     ];
     let report = RdReport {
-        scene, points: set.samples.len(), resolution: [set.resolution.0, set.resolution.1], raw_image_bytes: raw, rows, skipped,
-        csv: c.display().to_string(), svg: s.display().to_string(), stamp, notes,
+        scene,
+        points: set.samples.len(),
+        resolution: [set.resolution.0, set.resolution.1],
+        raw_image_bytes: raw,
+        rows,
+        skipped,
+        csv: c.display().to_string(),
+        svg: s.display().to_string(),
+        stamp,
+        notes,
     };
     if req.record {
         record("rd", &report.stamp, &summary(&report)).map_err(|e| Failure::new(Exit::Io, e))?;
@@ -279,19 +441,45 @@ pub fn run(req: &RdRequest) -> Result<RdReport, Failure> {
 
 /// PSNR per method at the ratio closest to 384:1 (or the middle ratio).
 pub fn summary(r: &RdReport) -> String {
-    let target = r.rows.iter().map(|x| x.target_ratio).min_by(|a, b| (a.ln() - 384f64.ln()).abs().total_cmp(&(b.ln() - 384f64.ln()).abs())).unwrap_or(384.0);
-    let parts: Vec<String> = METHODS.iter().filter_map(|m| r.rows.iter().find(|x| &x.method == m && x.target_ratio == target)
-        .map(|x| format!("{m} {:.2} dB @ {:.0}:1", x.psnr_db, x.ratio))).collect();
+    let target = r
+        .rows
+        .iter()
+        .map(|x| x.target_ratio)
+        .min_by(|a, b| (a.ln() - 384f64.ln()).abs().total_cmp(&(b.ln() - 384f64.ln()).abs()))
+        .unwrap_or(384.0);
+    let parts: Vec<String> = METHODS
+        .iter()
+        .filter_map(|m| {
+            r.rows
+                .iter()
+                .find(|x| &x.method == m && x.target_ratio == target)
+                .map(|x| format!("{m} {:.2} dB @ {:.0}:1", x.psnr_db, x.ratio))
+        })
+        .collect();
     format!("target {target}:1 — {}", parts.join("; "))
 }
 
 /// Human-readable lines.
 pub fn print(r: &RdReport, out: &mut impl std::io::Write) -> std::io::Result<()> {
     writeln!(out, "rd: {} — raw image bytes {}", r.scene, r.raw_image_bytes)?;
-    writeln!(out, "  {:<28} {:>8} {:>8} {:>9} {:>8} {:>7}  scope", "method", "target", "ratio", "bytes", "PSNR dB", "CRF")?;
+    writeln!(
+        out,
+        "  {:<28} {:>8} {:>8} {:>9} {:>8} {:>7}  scope",
+        "method", "target", "ratio", "bytes", "PSNR dB", "CRF"
+    )?;
     for x in &r.rows {
-        writeln!(out, "  {:<28} {:>8.1} {:>8.1} {:>9} {:>8.2} {:>7}  {}{}", x.method, x.target_ratio, x.ratio, x.bytes, x.psnr_db,
-                 x.crf.map_or("-".into(), |c| format!("{c:.2}")), x.psnr_scope, if x.reached { "" } else { "  (budget not reachable)" })?;
+        writeln!(
+            out,
+            "  {:<28} {:>8.1} {:>8.1} {:>9} {:>8.2} {:>7}  {}{}",
+            x.method,
+            x.target_ratio,
+            x.ratio,
+            x.bytes,
+            x.psnr_db,
+            x.crf.map_or("-".into(), |c| format!("{c:.2}")),
+            x.psnr_scope,
+            if x.reached { "" } else { "  (budget not reachable)" }
+        )?;
     }
     for s in &r.skipped {
         writeln!(out, "  {s}")?;

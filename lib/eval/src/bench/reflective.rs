@@ -108,7 +108,14 @@ struct Reference {
 /// The stream of the second render of a reference pair (the first is the default, 0).
 const SECOND_STREAM: u64 = 1;
 
-fn reference(scene: &Scene, pf: &PathFrame, spp: u32, seed: ShadingSeed, pair: bool, objects: &[usize]) -> Result<Reference> {
+fn reference(
+    scene: &Scene,
+    pf: &PathFrame,
+    spp: u32,
+    seed: ShadingSeed,
+    pair: bool,
+    objects: &[usize],
+) -> Result<Reference> {
     let first = render_reference(scene, pf, spp, seed, 0, objects)?;
     if !pair {
         return Ok(first);
@@ -118,10 +125,21 @@ fn reference(scene: &Scene, pf: &PathFrame, spp: u32, seed: ShadingSeed, pair: b
     Ok(Reference { rgb, mask: first.mask, pair: Some([first.rgb, second.rgb]) })
 }
 
-fn render_reference(scene: &Scene, pf: &PathFrame, spp: u32, seed: ShadingSeed, stream: u64, objects: &[usize]) -> Result<Reference> {
-    let settings = TraceSettings::new(scene.resolution, spp).with_shading_seed(seed).with_seed(stream);
+fn render_reference(
+    scene: &Scene,
+    pf: &PathFrame,
+    spp: u32,
+    seed: ShadingSeed,
+    stream: u64,
+    objects: &[usize],
+) -> Result<Reference> {
+    let settings =
+        TraceSettings::new(scene.resolution, spp).with_shading_seed(seed).with_seed(stream);
     let r = pis_trace::render_point(scene, &pf.frame, &settings, &|| {})?;
-    let l = r.images.layer("combined").ok_or_else(|| anyhow!("the traced frame has no combined image"))?;
+    let l = r
+        .images
+        .layer("combined")
+        .ok_or_else(|| anyhow!("the traced frame has no combined image"))?;
     let n = l.width as usize * l.height as usize;
     let mut rgb = vec![0.0f32; n * 3];
     for (c, name) in ["R", "G", "B"].iter().enumerate() {
@@ -131,7 +149,9 @@ fn render_reference(scene: &Scene, pf: &PathFrame, spp: u32, seed: ShadingSeed, 
     let channels = pis_trace::channel_names(scene);
     let mut mask = vec![false; n];
     for &o in objects {
-        if let Some(a) = r.images.object_layer(&channels[o], LayerKind::Coverage).and_then(|l| l.channel("A")) {
+        if let Some(a) =
+            r.images.object_layer(&channels[o], LayerKind::Coverage).and_then(|l| l.channel("A"))
+        {
             mask.iter_mut().zip(a).for_each(|(m, &c)| *m |= c > 0.5);
         }
     }
@@ -143,21 +163,34 @@ pub(crate) fn camera(scene: &Scene, pf: &PathFrame) -> ViewCamera {
     let c = &pf.frame.camera;
     let m = c.world_from_camera;
     let eye = m.w_axis.truncate();
-    ViewCamera { eye, target: eye - m.z_axis.truncate(), up: m.y_axis.truncate().normalize_or(Vec3::Y), yfov_rad: c.yfov, near: c.znear, far: if c.zfar.is_finite() { c.zfar } else { 1.0e4_f32.max(scene.resolution.0 as f32) } }
+    ViewCamera {
+        eye,
+        target: eye - m.z_axis.truncate(),
+        up: m.y_axis.truncate().normalize_or(Vec3::Y),
+        yfov_rad: c.yfov,
+        near: c.znear,
+        far: if c.zfar.is_finite() { c.zfar } else { 1.0e4_f32.max(scene.resolution.0 as f32) },
+    }
 }
 
 /// The path frame's point in the dimensions' units: the view value between its samples,
 /// the other dimensions at the frame's samples.
 pub(crate) fn point(scene: &Scene, pf: &PathFrame, view_dim: usize) -> Vec<f32> {
-    scene.space.dims.iter().enumerate().map(|(d, dim)| {
-        if d == view_dim {
-            let (k0, f) = (pf.view.floor() as usize, pf.view.fract());
-            let k1 = (k0 + 1).min(dim.values.len() - 1);
-            dim.values[k0] + (dim.values[k1] - dim.values[k0]) * f
-        } else {
-            dim.values[pf.point[d] as usize]
-        }
-    }).collect()
+    scene
+        .space
+        .dims
+        .iter()
+        .enumerate()
+        .map(|(d, dim)| {
+            if d == view_dim {
+                let (k0, f) = (pf.view.floor() as usize, pf.view.fract());
+                let k1 = (k0 + 1).min(dim.values.len() - 1);
+                dim.values[k0] + (dim.values[k1] - dim.values[k0]) * f
+            } else {
+                dim.values[pf.point[d] as usize]
+            }
+        })
+        .collect()
 }
 
 /// A played frame (left) beside its traced reference (right), sRGB.
@@ -197,42 +230,92 @@ fn runtime(e: impl Into<anyhow::Error>) -> Failure {
 /// Plays every file along both paths and measures it against the traced references.
 pub fn run(req: &ReflectiveRequest) -> Result<ReflectiveReport, Failure> {
     if req.files.is_empty() || req.frames < 2 || req.spp == 0 {
-        return Err(Failure::new(Exit::Usage, anyhow!("give at least one file, --frames ≥ 2 and --spp ≥ 1")));
+        return Err(Failure::new(
+            Exit::Usage,
+            anyhow!("give at least one file, --frames ≥ 2 and --spp ≥ 1"),
+        ));
     }
     if req.reference_pair && req.reference_seed != ShadingSeed::Sample {
         return Err(Failure::new(Exit::Usage, anyhow!("--reference-pair needs --reference-seed sample: seeded per cell, both renders carry the same surface noise, so their difference cannot measure it")));
     }
     let options = LoadOptions { preset: req.preset.clone(), resolution: req.resolution, spp: None };
-    let scene = pis_scene::load_with(&req.scene, &options).map_err(|e| Failure::new(pis_pack::scene_exit(&e), anyhow!("{}: {e}", req.scene.display())))?;
-    let objects: Vec<usize> = scene.objects.iter().enumerate().filter(|(_, o)| o.role == req.role).map(|(i, _)| i).collect();
+    let scene = pis_scene::load_with(&req.scene, &options).map_err(|e| {
+        Failure::new(pis_pack::scene_exit(&e), anyhow!("{}: {e}", req.scene.display()))
+    })?;
+    let objects: Vec<usize> = scene
+        .objects
+        .iter()
+        .enumerate()
+        .filter(|(_, o)| o.role == req.role)
+        .map(|(i, _)| i)
+        .collect();
     if objects.is_empty() {
-        return Err(Failure::new(Exit::Usage, anyhow!("scene {} has no {} object", scene.name, role_name(req.role))));
+        return Err(Failure::new(
+            Exit::Usage,
+            anyhow!("scene {} has no {} object", scene.name, role_name(req.role)),
+        ));
     }
-    let (view_dim, frames) = paths(&scene, req.frames, &PATHS).map_err(|e| Failure::new(Exit::NotSupported, e))?;
+    let (view_dim, frames) =
+        paths(&scene, req.frames, &PATHS).map_err(|e| Failure::new(Exit::NotSupported, e))?;
     let twice = if req.reference_pair { ", each twice from independent streams" } else { "" };
-    eprintln!("pis-bench: reflective: tracing {} reference frames at {} spp{twice}", frames.len(), req.spp);
-    let refs: Vec<Reference> = frames.iter().map(|f| reference(&scene, f, req.spp, req.reference_seed, req.reference_pair, &objects)).collect::<Result<_>>().map_err(runtime)?;
+    eprintln!(
+        "pis-bench: reflective: tracing {} reference frames at {} spp{twice}",
+        frames.len(),
+        req.spp
+    );
+    let refs: Vec<Reference> = frames
+        .iter()
+        .map(|f| reference(&scene, f, req.spp, req.reference_seed, req.reference_pair, &objects))
+        .collect::<Result<_>>()
+        .map_err(runtime)?;
     let gpu = Arc::new(Gpu::new().map_err(|e| Failure::new(Exit::NotSupported, anyhow!("{e}")))?);
     let size = scene.resolution;
-    let mut csv = Csv::new(&["file", "path", "frame", "view", "psnr_db", "change_played", "change_reference", "psnr_noise_removed_db", "reference_psnr_db"]);
+    let mut csv = Csv::new(&[
+        "file",
+        "path",
+        "frame",
+        "view",
+        "psnr_db",
+        "change_played",
+        "change_reference",
+        "psnr_noise_removed_db",
+        "reference_psnr_db",
+    ]);
     let mut summaries = Vec::new();
     for file in &req.files {
-        let mut player = Player::open(gpu.clone(), file, PlayerOptions { tau_px: req.tau_px, ..PlayerOptions::default() }).map_err(|e| Failure::new(Exit::Invalid, anyhow!("{}: {e}", file.display())))?;
+        let mut player = Player::open(
+            gpu.clone(),
+            file,
+            PlayerOptions { tau_px: req.tau_px, ..PlayerOptions::default() },
+        )
+        .map_err(|e| Failure::new(Exit::Invalid, anyhow!("{}: {e}", file.display())))?;
         if player.image_size() != size {
             return Err(Failure::new(Exit::Usage, anyhow!("{}: {}x{} frames, the scene's are {}x{} (pass the same --preset or --resolution)", file.display(), player.image_size().0, player.image_size().1, size.0, size.1)));
         }
-        let played: Vec<Vec<f32>> = frames.iter().map(|pf| {
-            let req = FrameRequest { point: point(&scene, pf, view_dim), camera: CameraChoice::Free(camera(&scene, pf)) };
-            let (img, _) = player.render_image(&req, size)?;
-            Ok(img.rgba.chunks_exact(4).flat_map(|p| [p[0], p[1], p[2]]).collect())
-        }).collect::<Result<_, pis_play::PlayError>>().map_err(runtime)?;
-        let name = file.file_name().map_or_else(|| file.display().to_string(), |n| n.to_string_lossy().into_owned());
+        let played: Vec<Vec<f32>> = frames
+            .iter()
+            .map(|pf| {
+                let req = FrameRequest {
+                    point: point(&scene, pf, view_dim),
+                    camera: CameraChoice::Free(camera(&scene, pf)),
+                };
+                let (img, _) = player.render_image(&req, size)?;
+                Ok(img.rgba.chunks_exact(4).flat_map(|p| [p[0], p[1], p[2]]).collect())
+            })
+            .collect::<Result<_, pis_play::PlayError>>()
+            .map_err(runtime)?;
+        let name = file
+            .file_name()
+            .map_or_else(|| file.display().to_string(), |n| n.to_string_lossy().into_owned());
         if req.images {
-            std::fs::create_dir_all(&req.out).map_err(|e| Failure::new(Exit::Io, anyhow!("{}: {e}", req.out.display())))?;
+            std::fs::create_dir_all(&req.out)
+                .map_err(|e| Failure::new(Exit::Io, anyhow!("{}: {e}", req.out.display())))?;
             for (i, (pf, pl)) in frames.iter().zip(&played).enumerate() {
                 let j = frames[..i].iter().filter(|f| f.kind == pf.kind).count();
                 let path = req.out.join(format!("{name}-{}-{j}.png", pf.kind.name()));
-                side_by_side(pl, &refs[i].rgb, size).save(&path).map_err(|e| Failure::new(Exit::Io, anyhow!("{}: {e}", path.display())))?;
+                side_by_side(pl, &refs[i].rgb, size)
+                    .save(&path)
+                    .map_err(|e| Failure::new(Exit::Io, anyhow!("{}: {e}", path.display())))?;
             }
         }
         for kind in PATHS {
@@ -252,21 +335,36 @@ pub fn run(req: &ReflectiveRequest) -> Result<ReflectiveReport, Failure> {
                 let paired = PairedError { against_mean: e, between };
                 pooled.merge(&paired);
                 let paired_cells = match refs[i].pair {
-                    Some(_) => [format!("{:.3}", paired.psnr_noise_removed()), format!("{:.3}", paired.reference_psnr())],
+                    Some(_) => [
+                        format!("{:.3}", paired.psnr_noise_removed()),
+                        format!("{:.3}", paired.reference_psnr()),
+                    ],
                     None => [String::new(), String::new()],
                 };
                 let change = (j > 0).then(|| {
                     let prev = idx[j - 1];
-                    let both: Vec<bool> = refs[i].mask.iter().zip(&refs[prev].mask).map(|(a, b)| *a && *b).collect();
-                    [rms_change(&played[i], &played[prev], &both), rms_change(&refs[i].rgb, &refs[prev].rgb, &both)]
+                    let both: Vec<bool> =
+                        refs[i].mask.iter().zip(&refs[prev].mask).map(|(a, b)| *a && *b).collect();
+                    [
+                        rms_change(&played[i], &played[prev], &both),
+                        rms_change(&refs[i].rgb, &refs[prev].rgb, &both),
+                    ]
                 });
                 if let Some([p, r]) = change {
                     popping = popping.max(p / r.max(0.5 / 255.0));
                 }
                 psnrs.push(e.psnr());
-                csv.push(vec![name.clone(), kind.name().into(), j.to_string(), format!("{:.3}", frames[i].view), format!("{:.3}", e.psnr()),
-                              change.map_or(String::new(), |c| format!("{:.5}", c[0])), change.map_or(String::new(), |c| format!("{:.5}", c[1])),
-                              paired_cells[0].clone(), paired_cells[1].clone()]);
+                csv.push(vec![
+                    name.clone(),
+                    kind.name().into(),
+                    j.to_string(),
+                    format!("{:.3}", frames[i].view),
+                    format!("{:.3}", e.psnr()),
+                    change.map_or(String::new(), |c| format!("{:.5}", c[0])),
+                    change.map_or(String::new(), |c| format!("{:.5}", c[1])),
+                    paired_cells[0].clone(),
+                    paired_cells[1].clone(),
+                ]);
             }
             let mean = psnrs.iter().sum::<f64>() / psnrs.len().max(1) as f64;
             let min = psnrs.iter().copied().fold(f64::INFINITY, f64::min);
@@ -283,10 +381,18 @@ pub fn run(req: &ReflectiveRequest) -> Result<ReflectiveReport, Failure> {
             });
         }
     }
-    std::fs::create_dir_all(&req.out).map_err(|e| Failure::new(Exit::Io, anyhow!("{}: {e}", req.out.display())))?;
+    std::fs::create_dir_all(&req.out)
+        .map_err(|e| Failure::new(Exit::Io, anyhow!("{}: {e}", req.out.display())))?;
     let csv_path = req.out.join("reflective.csv");
-    crate::report::write_atomic(&csv_path, csv.text().as_bytes()).map_err(|e| Failure::new(Exit::Io, e))?;
-    let scene_s = format!("{} ({}x{}, {} views)", scene.name, size.0, size.1, scene.space.dims[view_dim].values.len());
+    crate::report::write_atomic(&csv_path, csv.text().as_bytes())
+        .map_err(|e| Failure::new(Exit::Io, e))?;
+    let scene_s = format!(
+        "{} ({}x{}, {} views)",
+        scene.name,
+        size.0,
+        size.1,
+        scene.space.dims[view_dim].values.len()
+    );
     Ok(ReflectiveReport {
         stamp: Stamp::here(&scene_s),
         scene: scene_s,
@@ -301,12 +407,30 @@ pub fn run(req: &ReflectiveRequest) -> Result<ReflectiveReport, Failure> {
 }
 
 pub fn print(r: &ReflectiveReport, out: &mut impl std::io::Write) -> std::io::Result<()> {
-    let pair = if r.reference_pair { ", each traced twice: the gold standard is their mean, its noise measured from their difference" } else { "" };
+    let pair = if r.reference_pair {
+        ", each traced twice: the gold standard is their mean, its noise measured from their difference"
+    } else {
+        ""
+    };
     writeln!(out, "reflective: {} — played frames vs pis-trace over the pixels of {}, {} frames between and away, references at {} spp (shading seeded per {}{pair})", r.scene, r.objects.join(", "), r.frames, r.reference_spp, r.reference_seed)?;
     for s in &r.summaries {
-        write!(out, "  {:<28} {:<8} mean {:6.2} dB  min {:6.2} dB  popping {:5.2}", s.file, s.path.name(), s.mean_psnr_db, s.min_psnr_db, s.popping)?;
-        if let (Some(pooled), Some(removed), Some(reference)) = (s.pooled_psnr_db, s.noise_removed_psnr_db, s.reference_psnr_db) {
-            let removed = if removed.is_finite() { format!("{removed:6.2} dB") } else { "within the references' noise".to_string() };
+        write!(
+            out,
+            "  {:<28} {:<8} mean {:6.2} dB  min {:6.2} dB  popping {:5.2}",
+            s.file,
+            s.path.name(),
+            s.mean_psnr_db,
+            s.min_psnr_db,
+            s.popping
+        )?;
+        if let (Some(pooled), Some(removed), Some(reference)) =
+            (s.pooled_psnr_db, s.noise_removed_psnr_db, s.reference_psnr_db)
+        {
+            let removed = if removed.is_finite() {
+                format!("{removed:6.2} dB")
+            } else {
+                "within the references' noise".to_string()
+            };
             write!(out, "  pooled {pooled:6.2} dB  noise removed {removed}  (gold standard's noise {reference:.2} dB)")?;
         }
         writeln!(out)?;

@@ -11,10 +11,10 @@
 
 use std::path::PathBuf;
 
-use anyhow::anyhow;
-use pis_codec::CodecId;
 use crate::chart::{Chart, Series};
 use crate::report::{Csv, Stamp};
+use anyhow::anyhow;
+use pis_codec::CodecId;
 use serde::Serialize;
 
 use super::output::{ensure_dir, record, write_chart};
@@ -64,13 +64,22 @@ pub struct SpeedReport {
 
 pub fn check(req: &SpeedRequest) -> Result<(), Failure> {
     if !req.input.exists() {
-        return Err(Failure::new(Exit::Io, anyhow!("{}: no such set directory or scene file", req.input.display())));
+        return Err(Failure::new(
+            Exit::Io,
+            anyhow!("{}: no such set directory or scene file", req.input.display()),
+        ));
     }
     if req.caps.is_empty() || req.caps.contains(&0) {
-        return Err(Failure::new(Exit::Usage, anyhow!("--caps needs iteration caps of at least 1")));
+        return Err(Failure::new(
+            Exit::Usage,
+            anyhow!("--caps needs iteration caps of at least 1"),
+        ));
     }
     if !(req.ratio.is_finite() && req.ratio >= 1.0) {
-        return Err(Failure::new(Exit::Usage, anyhow!("--ratio must be at least 1, got {}", req.ratio)));
+        return Err(Failure::new(
+            Exit::Usage,
+            anyhow!("--ratio must be at least 1, got {}", req.ratio),
+        ));
     }
     Ok(())
 }
@@ -78,8 +87,17 @@ pub fn check(req: &SpeedRequest) -> Result<(), Failure> {
 pub fn run(req: &SpeedRequest) -> Result<SpeedReport, Failure> {
     check(req)?;
     ensure_dir(&req.out).map_err(|e| Failure::new(Exit::Io, e))?;
-    let settings = PackSettings { max_texture: req.max_texture, resolution: req.resolution, spp: req.spp, preset: req.preset.clone(), ..PackSettings::new().with_ratio(req.ratio) };
-    let base = PackRequest { scene: req.scene.clone(), ..PackRequest::new(req.input.clone(), req.out.join("unused.pis"), settings) };
+    let settings = PackSettings {
+        max_texture: req.max_texture,
+        resolution: req.resolution,
+        spp: req.spp,
+        preset: req.preset.clone(),
+        ..PackSettings::new().with_ratio(req.ratio)
+    };
+    let base = PackRequest {
+        scene: req.scene.clone(),
+        ..PackRequest::new(req.input.clone(), req.out.join("unused.pis"), settings)
+    };
     let mut rows = Vec::new();
     let mut scene = String::new();
     let mut points = 0;
@@ -89,9 +107,21 @@ pub fn run(req: &SpeedRequest) -> Result<SpeedReport, Failure> {
         let p = inf.pack_point(&base)?;
         points = inf.points();
         let set = &inf.set;
-        scene = format!("{} ({} points, {}x{})", set.scene.name, set.samples.len(), set.resolution.0, set.resolution.1);
-        let row = CompileRow { max_iterations: cap, ms_per_point: inf.infer_ms / points.max(1) as f64, solver_iterations: inf.solver_iterations(),
-                               psnr_db_solved: p.psnr_db_solved, psnr_db: p.psnr_db, ratio: p.ratio() };
+        scene = format!(
+            "{} ({} points, {}x{})",
+            set.scene.name,
+            set.samples.len(),
+            set.resolution.0,
+            set.resolution.1
+        );
+        let row = CompileRow {
+            max_iterations: cap,
+            ms_per_point: inf.infer_ms / points.max(1) as f64,
+            solver_iterations: inf.solver_iterations(),
+            psnr_db_solved: p.psnr_db_solved,
+            psnr_db: p.psnr_db,
+            ratio: p.ratio(),
+        };
         eprintln!("pis-bench: speed: cap {cap:>5}: {:8.1} ms per point, {} iterations, {:.2} dB solved, {:.2} dB at {:.0}:1",
                   row.ms_per_point, row.solver_iterations, row.psnr_db_solved, row.psnr_db, row.ratio);
         rows.push(row);
@@ -103,7 +133,10 @@ pub fn run(req: &SpeedRequest) -> Result<SpeedReport, Failure> {
             for codec in [CodecId::Wavelet, CodecId::Dct] {
                 let file = req.out.join(format!("speed-{}.pis", codec.name()));
                 inf.write(&PackRequest { output: file.clone(), ..base.with(|s| s.codec = codec) })?;
-                playback.extend(measure(&g, &file, inf.set_dir(), codec.name(), &[1, 2, 4]).map_err(|e| Failure::new(Exit::Runtime, e))?);
+                playback.extend(
+                    measure(&g, &file, inf.set_dir(), codec.name(), &[1, 2, 4])
+                        .map_err(|e| Failure::new(Exit::Runtime, e))?,
+                );
             }
         }
         (Err(e), _) => {
@@ -113,24 +146,58 @@ pub fn run(req: &SpeedRequest) -> Result<SpeedReport, Failure> {
         (_, None) => {}
     }
     let stamp = Stamp::here(&scene);
-    let mut csv = Csv::new(&["measure", "max_iterations", "ms_per_point", "solver_iterations", "psnr_db_solved", "psnr_db", "ratio"]);
+    let mut csv = Csv::new(&[
+        "measure",
+        "max_iterations",
+        "ms_per_point",
+        "solver_iterations",
+        "psnr_db_solved",
+        "psnr_db",
+        "ratio",
+    ]);
     for r in &rows {
-        csv.push(vec!["compile".into(), r.max_iterations.to_string(), format!("{:.2}", r.ms_per_point), r.solver_iterations.to_string(),
-                      format!("{:.3}", r.psnr_db_solved), format!("{:.3}", r.psnr_db), format!("{:.2}", r.ratio)]);
+        csv.push(vec![
+            "compile".into(),
+            r.max_iterations.to_string(),
+            format!("{:.2}", r.ms_per_point),
+            r.solver_iterations.to_string(),
+            format!("{:.3}", r.psnr_db_solved),
+            format!("{:.3}", r.psnr_db),
+            format!("{:.2}", r.ratio),
+        ]);
     }
     for p in &playback {
-        csv.push(vec![format!("playback {} reduction {}", p.codec, p.reduction), String::new(), format!("mean {:.2} worst {:.2}", p.frame_ms_mean, p.frame_ms_worst),
-                      p.frames.to_string(), String::new(), format!("{:.3}", p.psnr_db), format!("{}", req.ratio)]);
+        csv.push(vec![
+            format!("playback {} reduction {}", p.codec, p.reduction),
+            String::new(),
+            format!("mean {:.2} worst {:.2}", p.frame_ms_mean, p.frame_ms_worst),
+            p.frames.to_string(),
+            String::new(),
+            format!("{:.3}", p.psnr_db),
+            format!("{}", req.ratio),
+        ]);
     }
     let mut series = vec![
-        Series { name: "compile: textures as solved (ms per point)".into(), points: rows.iter().map(|r| (r.ms_per_point, r.psnr_db_solved)).collect() },
-        Series { name: format!("compile: wavelet at {}:1 (ms per point)", req.ratio), points: rows.iter().map(|r| (r.ms_per_point, r.psnr_db)).collect() },
+        Series {
+            name: "compile: textures as solved (ms per point)".into(),
+            points: rows.iter().map(|r| (r.ms_per_point, r.psnr_db_solved)).collect(),
+        },
+        Series {
+            name: format!("compile: wavelet at {}:1 (ms per point)", req.ratio),
+            points: rows.iter().map(|r| (r.ms_per_point, r.psnr_db)).collect(),
+        },
     ];
     for codec in ["wavelet", "dct"] {
         let mine: Vec<&PlaybackRow> = playback.iter().filter(|p| p.codec == codec).collect();
         if !mine.is_empty() {
-            series.push(Series { name: format!("playback {codec}: mean frame ms (reduction 1, 2, 4)"), points: mine.iter().map(|p| (p.frame_ms_mean, p.psnr_db)).collect() });
-            series.push(Series { name: format!("playback {codec}: worst frame ms"), points: mine.iter().map(|p| (p.frame_ms_worst, p.psnr_db)).collect() });
+            series.push(Series {
+                name: format!("playback {codec}: mean frame ms (reduction 1, 2, 4)"),
+                points: mine.iter().map(|p| (p.frame_ms_mean, p.psnr_db)).collect(),
+            });
+            series.push(Series {
+                name: format!("playback {codec}: worst frame ms"),
+                points: mine.iter().map(|p| (p.frame_ms_worst, p.psnr_db)).collect(),
+            });
         }
     }
     let caps: Vec<String> = req.caps.iter().map(u32::to_string).collect();
@@ -142,15 +209,37 @@ pub fn run(req: &SpeedRequest) -> Result<SpeedReport, Failure> {
         x_log: true,
         stamp: stamp.lines(),
     };
-    let (c, s) = write_chart(&req.out, "speed", &csv, &chart, &series).map_err(|e| Failure::new(Exit::Io, e))?;
+    let (c, s) = write_chart(&req.out, "speed", &csv, &chart, &series)
+        .map_err(|e| Failure::new(Exit::Io, e))?;
     let report = SpeedReport {
-        scene, points, compile: rows, csv: c.display().to_string(), svg: s.display().to_string(), stamp,
-        playback, playback_skipped,
+        scene,
+        points,
+        compile: rows,
+        csv: c.display().to_string(),
+        svg: s.display().to_string(),
+        stamp,
+        playback,
+        playback_skipped,
     };
     if req.record {
-        let mut summary: Vec<String> = report.compile.iter().map(|r| format!("cap {}: {:.0} ms/point, {:.2} dB", r.max_iterations, r.ms_per_point, r.psnr_db)).collect();
-        summary.extend(report.playback.iter().map(|p| format!("play {} r{}: {:.1}/{:.1} ms mean/worst, {:.2} dB", p.codec, p.reduction, p.frame_ms_mean, p.frame_ms_worst, p.psnr_db)));
-        record("speed", &report.stamp, &summary.join("; ")).map_err(|e| Failure::new(Exit::Io, e))?;
+        let mut summary: Vec<String> = report
+            .compile
+            .iter()
+            .map(|r| {
+                format!(
+                    "cap {}: {:.0} ms/point, {:.2} dB",
+                    r.max_iterations, r.ms_per_point, r.psnr_db
+                )
+            })
+            .collect();
+        summary.extend(report.playback.iter().map(|p| {
+            format!(
+                "play {} r{}: {:.1}/{:.1} ms mean/worst, {:.2} dB",
+                p.codec, p.reduction, p.frame_ms_mean, p.frame_ms_worst, p.psnr_db
+            )
+        }));
+        record("speed", &report.stamp, &summary.join("; "))
+            .map_err(|e| Failure::new(Exit::Io, e))?;
     }
     Ok(report)
 }

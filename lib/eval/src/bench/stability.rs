@@ -12,11 +12,13 @@
 use std::collections::btree_map::{BTreeMap, Entry};
 use std::path::PathBuf;
 
-use anyhow::{anyhow, Result};
-use pis_compile::{render, render_matrix, scene_depth, DrawMesh, Filter, RenderMatrix, TexturedObject, Viewport};
 use crate::chart::{Chart, Series};
 use crate::metrics::{display, SquaredError};
 use crate::report::{Csv, Stamp};
+use anyhow::{anyhow, Result};
+use pis_compile::{
+    render, render_matrix, scene_depth, DrawMesh, Filter, RenderMatrix, TexturedObject, Viewport,
+};
 use pis_format::DepMask;
 use pis_trace::{ShadingSeed, TraceSettings};
 use rayon::prelude::*;
@@ -24,9 +26,9 @@ use serde::Serialize;
 
 use super::camera_path::{paths, PathFrame, PathKind, AWAY_ELEVATION_DEG, AWAY_RADIUS};
 use super::output::{ensure_dir, record, write_chart};
-use pis_pack::{Exit, Failure};
-use pis_pack::infer::{merged_mesh, sampler, Mesh};
 use pis_pack::encode::LayerTextures;
+use pis_pack::infer::{merged_mesh, sampler, Mesh};
+use pis_pack::{Exit, Failure};
 use pis_pack::{Inferred, PackRequest, PackSettings, StderrProgress};
 
 /// What to measure.
@@ -96,8 +98,16 @@ struct Rendered {
 /// The samples of one layer at a fractional view position, with their weights: the two
 /// neighbouring view samples blended linearly (the nearest alone when the layer does not
 /// depend on the view).
-fn layer_samples(mask: DepMask, view_dim: usize, point: &[u32], view: f32, views: u32) -> Vec<(Vec<u32>, f32)> {
-    let key_at = |v: u32| -> Vec<u32> { mask.dims().map(|d| if d == view_dim { v } else { point[d] }).collect() };
+fn layer_samples(
+    mask: DepMask,
+    view_dim: usize,
+    point: &[u32],
+    view: f32,
+    views: u32,
+) -> Vec<(Vec<u32>, f32)> {
+    let key_at = |v: u32| -> Vec<u32> {
+        mask.dims().map(|d| if d == view_dim { v } else { point[d] }).collect()
+    };
     if !mask.dims().any(|d| d == view_dim) {
         return vec![(key_at(0), 1.0)];
     }
@@ -107,17 +117,32 @@ fn layer_samples(mask: DepMask, view_dim: usize, point: &[u32], view: f32, views
     vec![(key_at(k0), 1.0 - f), (key_at(k1), f)]
 }
 
-fn render_frame(inf: &Inferred, meshes: &[Mesh], tex: &[Vec<LayerTextures>], pf: &PathFrame, view_dim: usize) -> Result<Rendered> {
+fn render_frame(
+    inf: &Inferred,
+    meshes: &[Mesh],
+    tex: &[Vec<LayerTextures>],
+    pf: &PathFrame,
+    view_dim: usize,
+) -> Result<Rendered> {
     let set = &inf.set;
     let (w, h) = set.resolution;
     let viewport = Viewport { width: w, height: h };
     let frame = &pf.frame;
     let clip_from = |k: usize| {
-        pis_trace::camera::projection_matrix(&frame.camera, (w, h)) * frame.camera.world_from_camera.inverse() * frame.instances[k].world_from_object
+        pis_trace::camera::projection_matrix(&frame.camera, (w, h))
+            * frame.camera.world_from_camera.inverse()
+            * frame.instances[k].world_from_object
     };
-    let draw: Vec<DrawMesh> = meshes.iter().enumerate().map(|(k, m)| DrawMesh {
-        positions: &m.positions, uvs: &m.uvs, indices: &m.indices, clip_from_object: clip_from(k),
-    }).collect();
+    let draw: Vec<DrawMesh> = meshes
+        .iter()
+        .enumerate()
+        .map(|(k, m)| DrawMesh {
+            positions: &m.positions,
+            uvs: &m.uvs,
+            indices: &m.indices,
+            clip_from_object: clip_from(k),
+        })
+        .collect();
     let views = set.scene.space.dims[view_dim].values.len() as u32;
     let mut rgb = vec![0.0f32; w as usize * h as usize * 3];
     let mut mask = vec![false; w as usize * h as usize];
@@ -130,7 +155,9 @@ fn render_frame(inf: &Inferred, meshes: &[Mesh], tex: &[Vec<LayerTextures>], pf:
         let mut img: Vec<f32> = Vec::new();
         for (li, l) in m.layers.iter().enumerate() {
             for (k, weight) in layer_samples(l.depends_on, view_dim, &pf.point, pf.view, views) {
-                let x = tex[mi][li].get(&k).ok_or_else(|| anyhow!("object {}: no texture near view {}", m.name, pf.view))?;
+                let x = tex[mi][li].get(&k).ok_or_else(|| {
+                    anyhow!("object {}: no texture near view {}", m.name, pf.view)
+                })?;
                 if weight == 0.0 {
                     continue;
                 }
@@ -139,7 +166,12 @@ fn render_frame(inf: &Inferred, meshes: &[Mesh], tex: &[Vec<LayerTextures>], pf:
                     Entry::Occupied(e) => e.into_mut(),
                     Entry::Vacant(e) => {
                         let pl = &m.placements[pid];
-                        let obj = TexturedObject { mesh, transform: pl.transform, layout: pl.layout, sampler: sampler(Filter::Trilinear, pl.repeat) };
+                        let obj = TexturedObject {
+                            mesh,
+                            transform: pl.transform,
+                            layout: pl.layout,
+                            sampler: sampler(Filter::Trilinear, pl.repeat),
+                        };
                         e.insert(render_matrix(viewport, &obj, Some(&occluders))?)
                     }
                 };
@@ -163,7 +195,10 @@ fn render_frame(inf: &Inferred, meshes: &[Mesh], tex: &[Vec<LayerTextures>], pf:
 fn reference(inf: &Inferred, pf: &PathFrame, spp: u32, seed: ShadingSeed) -> Result<Vec<f32>> {
     let settings = TraceSettings::new(inf.set.resolution, spp).with_shading_seed(seed);
     let r = pis_trace::render_point(&inf.set.scene, &pf.frame, &settings, &|| {})?;
-    let l = r.images.layer("combined").ok_or_else(|| anyhow!("the traced frame has no combined image"))?;
+    let l = r
+        .images
+        .layer("combined")
+        .ok_or_else(|| anyhow!("the traced frame has no combined image"))?;
     let n = l.width as usize * l.height as usize;
     let mut rgb = vec![0.0f32; n * 3];
     for (c, name) in ["R", "G", "B"].iter().enumerate() {
@@ -194,13 +229,22 @@ fn runtime(e: anyhow::Error) -> Failure {
 
 pub fn check(req: &StabilityRequest) -> Result<(), Failure> {
     if !req.input.exists() {
-        return Err(Failure::new(Exit::Io, anyhow!("{}: no such set directory or scene file", req.input.display())));
+        return Err(Failure::new(
+            Exit::Io,
+            anyhow!("{}: no such set directory or scene file", req.input.display()),
+        ));
     }
     if let Some(r) = req.ratios.iter().find(|r| !(r.is_finite() && **r >= 1.0)) {
-        return Err(Failure::new(Exit::Usage, anyhow!("--ratios: every ratio must be at least 1, got {r}")));
+        return Err(Failure::new(
+            Exit::Usage,
+            anyhow!("--ratios: every ratio must be at least 1, got {r}"),
+        ));
     }
     if req.frames < 2 || req.frames > 10_000 || req.spp == 0 {
-        return Err(Failure::new(Exit::Usage, anyhow!("--frames must be in 2..=10000 and --spp at least 1")));
+        return Err(Failure::new(
+            Exit::Usage,
+            anyhow!("--frames must be in 2..=10000 and --spp at least 1"),
+        ));
     }
     Ok(())
 }
@@ -209,17 +253,37 @@ pub fn check(req: &StabilityRequest) -> Result<(), Failure> {
 pub fn run(req: &StabilityRequest) -> Result<StabilityReport, Failure> {
     check(req)?;
     ensure_dir(&req.out).map_err(|e| Failure::new(Exit::Io, e))?;
-    let settings = PackSettings { max_texture: req.max_texture, resolution: req.resolution, spp: req.trace_spp, preset: req.preset.clone(), ..PackSettings::new() };
-    let base = PackRequest { scene: req.scene.clone(), ..PackRequest::new(req.input.clone(), req.out.join("unused.pis"), settings) };
+    let settings = PackSettings {
+        max_texture: req.max_texture,
+        resolution: req.resolution,
+        spp: req.trace_spp,
+        preset: req.preset.clone(),
+        ..PackSettings::new()
+    };
+    let base = PackRequest {
+        scene: req.scene.clone(),
+        ..PackRequest::new(req.input.clone(), req.out.join("unused.pis"), settings)
+    };
     eprintln!("pis-bench: stability: loading and inferring");
     let inf = Inferred::new(&base, &StderrProgress)?;
     let scene = &inf.set.scene;
-    let (view_dim, frames) = paths(scene, req.frames, &[PathKind::Between, PathKind::Away]).map_err(|e| Failure::new(Exit::NotSupported, e))?;
-    eprintln!("pis-bench: stability: tracing {} reference frames at {} spp (shading seeded per {})", frames.len(), req.spp, req.reference_seed.name());
-    let refs: Vec<Vec<f32>> = frames.iter().map(|f| reference(&inf, f, req.spp, req.reference_seed)).collect::<Result<_>>().map_err(runtime)?;
+    let (view_dim, frames) = paths(scene, req.frames, &[PathKind::Between, PathKind::Away])
+        .map_err(|e| Failure::new(Exit::NotSupported, e))?;
+    eprintln!(
+        "pis-bench: stability: tracing {} reference frames at {} spp (shading seeded per {})",
+        frames.len(),
+        req.spp,
+        req.reference_seed.name()
+    );
+    let refs: Vec<Vec<f32>> = frames
+        .iter()
+        .map(|f| reference(&inf, f, req.spp, req.reference_seed))
+        .collect::<Result<_>>()
+        .map_err(runtime)?;
     let meshes: Vec<Mesh> = (0..scene.objects.len()).map(|o| merged_mesh(scene, o)).collect();
     let raw = inf.raw_image_bytes();
-    let mut reps: Vec<(String, Option<f64>, Vec<Vec<LayerTextures>>)> = vec![("solved".into(), None, inf.solved().map_err(runtime)?)];
+    let mut reps: Vec<(String, Option<f64>, Vec<Vec<LayerTextures>>)> =
+        vec![("solved".into(), None, inf.solved().map_err(runtime)?)];
     for &r in &req.ratios {
         let (t, bytes) = inf.decoded(&base.with(|s| s.ratio = Some(r)))?;
         reps.push((format!("wavelet {r}:1"), Some(raw as f64 / bytes.max(1) as f64), t));
@@ -227,7 +291,11 @@ pub fn run(req: &StabilityRequest) -> Result<StabilityReport, Failure> {
     let mut rows = Vec::new();
     let mut summaries = Vec::new();
     for (name, ratio, tex) in &reps {
-        let rendered: Vec<Rendered> = frames.par_iter().map(|f| render_frame(&inf, &meshes, tex, f, view_dim)).collect::<Result<_>>().map_err(runtime)?;
+        let rendered: Vec<Rendered> = frames
+            .par_iter()
+            .map(|f| render_frame(&inf, &meshes, tex, f, view_dim))
+            .collect::<Result<_>>()
+            .map_err(runtime)?;
         for kind in [PathKind::Between, PathKind::Away] {
             let idx: Vec<usize> = (0..frames.len()).filter(|&i| frames[i].kind == kind).collect();
             let (mut psnrs, mut popping) = (Vec::new(), 0.0f64);
@@ -235,42 +303,102 @@ pub fn run(req: &StabilityRequest) -> Result<StabilityReport, Failure> {
                 let mut e = SquaredError::default();
                 for (p, &m) in rendered[i].mask.iter().enumerate() {
                     if m {
-                        e.add_slices(&rendered[i].rgb[p * 3..p * 3 + 3], &refs[i][p * 3..p * 3 + 3]);
+                        e.add_slices(
+                            &rendered[i].rgb[p * 3..p * 3 + 3],
+                            &refs[i][p * 3..p * 3 + 3],
+                        );
                     }
                 }
                 let change = (j > 0).then(|| {
                     let prev = idx[j - 1];
-                    let both: Vec<bool> = rendered[i].mask.iter().zip(&rendered[prev].mask).map(|(a, b)| *a && *b).collect();
-                    [rms_change(&rendered[i].rgb, &rendered[prev].rgb, &both), rms_change(&refs[i], &refs[prev], &both)]
+                    let both: Vec<bool> = rendered[i]
+                        .mask
+                        .iter()
+                        .zip(&rendered[prev].mask)
+                        .map(|(a, b)| *a && *b)
+                        .collect();
+                    [
+                        rms_change(&rendered[i].rgb, &rendered[prev].rgb, &both),
+                        rms_change(&refs[i], &refs[prev], &both),
+                    ]
                 });
                 if let Some([p, r]) = change {
                     popping = popping.max(p / r.max(0.5 / 255.0));
                 }
                 psnrs.push(e.psnr());
-                rows.push(FrameRow { representation: name.clone(), path: kind, frame: j, view: frames[i].view, psnr_db: e.psnr(), change });
+                rows.push(FrameRow {
+                    representation: name.clone(),
+                    path: kind,
+                    frame: j,
+                    view: frames[i].view,
+                    psnr_db: e.psnr(),
+                    change,
+                });
             }
             let mean = psnrs.iter().sum::<f64>() / psnrs.len().max(1) as f64;
             let min = psnrs.iter().copied().fold(f64::INFINITY, f64::min);
             eprintln!("pis-bench: stability: {name:<16} {:<8} mean {mean:6.2} dB, min {min:6.2} dB, popping {popping:5.2}", kind.name());
-            summaries.push(PathSummary { representation: name.clone(), path: kind, ratio: *ratio, mean_psnr_db: mean, min_psnr_db: min, popping });
+            summaries.push(PathSummary {
+                representation: name.clone(),
+                path: kind,
+                ratio: *ratio,
+                mean_psnr_db: mean,
+                min_psnr_db: min,
+                popping,
+            });
         }
     }
     let set = &inf.set;
-    let scene_s = format!("{} ({} points, {}x{})", set.scene.name, set.samples.len(), set.resolution.0, set.resolution.1);
+    let scene_s = format!(
+        "{} ({} points, {}x{})",
+        set.scene.name,
+        set.samples.len(),
+        set.resolution.0,
+        set.resolution.1
+    );
     let stamp = Stamp::here(&scene_s);
-    let mut csv = Csv::new(&["representation", "path", "frame", "view", "psnr_db", "change_pis", "change_reference"]);
+    let mut csv = Csv::new(&[
+        "representation",
+        "path",
+        "frame",
+        "view",
+        "psnr_db",
+        "change_pis",
+        "change_reference",
+    ]);
     for r in &rows {
-        csv.push(vec![r.representation.clone(), r.path.name().into(), r.frame.to_string(), format!("{:.3}", r.view), format!("{:.3}", r.psnr_db),
-                      r.change.map_or(String::new(), |c| format!("{:.5}", c[0])), r.change.map_or(String::new(), |c| format!("{:.5}", c[1]))]);
+        csv.push(vec![
+            r.representation.clone(),
+            r.path.name().into(),
+            r.frame.to_string(),
+            format!("{:.3}", r.view),
+            format!("{:.3}", r.psnr_db),
+            r.change.map_or(String::new(), |c| format!("{:.5}", c[0])),
+            r.change.map_or(String::new(), |c| format!("{:.5}", c[1])),
+        ]);
     }
     for s in &summaries {
-        csv.push(vec![s.representation.clone(), format!("{}-summary", s.path.name()), String::new(), String::new(), format!("{:.3}", s.mean_psnr_db),
-                      format!("popping {:.3}", s.popping), format!("min {:.3}", s.min_psnr_db)]);
+        csv.push(vec![
+            s.representation.clone(),
+            format!("{}-summary", s.path.name()),
+            String::new(),
+            String::new(),
+            format!("{:.3}", s.mean_psnr_db),
+            format!("popping {:.3}", s.popping),
+            format!("min {:.3}", s.min_psnr_db),
+        ]);
     }
-    let series: Vec<Series> = summaries.iter().map(|s| Series {
-        name: format!("{} · {} (popping {:.2})", s.representation, s.path.name(), s.popping),
-        points: rows.iter().filter(|r| r.representation == s.representation && r.path == s.path).map(|r| (r.view as f64, r.psnr_db)).collect(),
-    }).collect();
+    let series: Vec<Series> = summaries
+        .iter()
+        .map(|s| Series {
+            name: format!("{} · {} (popping {:.2})", s.representation, s.path.name(), s.popping),
+            points: rows
+                .iter()
+                .filter(|r| r.representation == s.representation && r.path == s.path)
+                .map(|r| (r.view as f64, r.psnr_db))
+                .collect(),
+        })
+        .collect();
     let chart = Chart {
         title: format!("Stability off the samples — {scene_s}"),
         subtitle: format!("through the hardware model at each exact camera vs pis-trace ({} spp, shading seeded per {}) over covered pixels; between: fractional view, away: radius ×{AWAY_RADIUS}, elevation +{AWAY_ELEVATION_DEG}°", req.spp, req.reference_seed.name()),
@@ -279,7 +407,8 @@ pub fn run(req: &StabilityRequest) -> Result<StabilityReport, Failure> {
         x_log: false,
         stamp: stamp.lines(),
     };
-    let (c, s) = write_chart(&req.out, "stability", &csv, &chart, &series).map_err(|e| Failure::new(Exit::Io, e))?;
+    let (c, s) = write_chart(&req.out, "stability", &csv, &chart, &series)
+        .map_err(|e| Failure::new(Exit::Io, e))?;
     let report = StabilityReport {
         scene: scene_s, frames: req.frames, summaries, rows, csv: c.display().to_string(), svg: s.display().to_string(), stamp,
         notes: vec![
@@ -289,8 +418,22 @@ pub fn run(req: &StabilityRequest) -> Result<StabilityReport, Failure> {
         ],
     };
     if req.record {
-        let summary: Vec<String> = report.summaries.iter().map(|s| format!("{} {} {:.2} dB (min {:.2}, popping {:.2})", s.representation, s.path.name(), s.mean_psnr_db, s.min_psnr_db, s.popping)).collect();
-        record("stability", &report.stamp, &summary.join("; ")).map_err(|e| Failure::new(Exit::Io, e))?;
+        let summary: Vec<String> = report
+            .summaries
+            .iter()
+            .map(|s| {
+                format!(
+                    "{} {} {:.2} dB (min {:.2}, popping {:.2})",
+                    s.representation,
+                    s.path.name(),
+                    s.mean_psnr_db,
+                    s.min_psnr_db,
+                    s.popping
+                )
+            })
+            .collect();
+        record("stability", &report.stamp, &summary.join("; "))
+            .map_err(|e| Failure::new(Exit::Io, e))?;
     }
     Ok(report)
 }
@@ -298,8 +441,16 @@ pub fn run(req: &StabilityRequest) -> Result<StabilityReport, Failure> {
 pub fn print(r: &StabilityReport, out: &mut impl std::io::Write) -> std::io::Result<()> {
     writeln!(out, "stability: {} — {} frames per path", r.scene, r.frames)?;
     for s in &r.summaries {
-        writeln!(out, "  {:<16} {:<8} {:>8} mean {:6.2} dB  min {:6.2} dB  popping {:5.2}", s.representation, s.path.name(),
-                 s.ratio.map_or("-".into(), |x| format!("{x:.0}:1")), s.mean_psnr_db, s.min_psnr_db, s.popping)?;
+        writeln!(
+            out,
+            "  {:<16} {:<8} {:>8} mean {:6.2} dB  min {:6.2} dB  popping {:5.2}",
+            s.representation,
+            s.path.name(),
+            s.ratio.map_or("-".into(), |x| format!("{x:.0}:1")),
+            s.mean_psnr_db,
+            s.min_psnr_db,
+            s.popping
+        )?;
     }
     writeln!(out, "  wrote {} and {}", r.csv, r.svg)
 }

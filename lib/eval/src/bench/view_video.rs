@@ -2,10 +2,10 @@
 //! order through the parameter space, encoded as one video at a byte budget and compared
 //! with the gold standard after decoding, over the whole image.
 
-use anyhow::{anyhow, Result};
 use crate::baselines::path::{linear_index, zigzag};
 use crate::baselines::video::{decode, encode_to_budget, Frames, Matched, VideoCodec};
 use crate::metrics::{srgb_encode, SquaredError};
+use anyhow::{anyhow, Result};
 
 use pis_pack::Inferred;
 
@@ -20,7 +20,11 @@ pub struct ViewFrames {
 /// The linear value of an 8-bit display value (sRGB decoding).
 pub fn linear_of(d: u8) -> f32 {
     let v = d as f32 / 255.0;
-    if v <= 0.040_45 { v / 12.92 } else { ((v + 0.055) / 1.055).powf(2.4) }
+    if v <= 0.040_45 {
+        v / 12.92
+    } else {
+        ((v + 0.055) / 1.055).powf(2.4)
+    }
 }
 
 /// Collects the frames along the zig-zag path.
@@ -34,10 +38,13 @@ pub fn view_frames(set: &Inferred) -> Result<ViewFrames> {
     for p in zigzag(&counts) {
         let i = linear_index(&p, &counts);
         let img = set.images.shared(i).map_err(|e| anyhow!("point {p:?}: {e}"))?;
-        let l = img.layer("combined").ok_or_else(|| anyhow!("point {p:?} has no combined image"))?;
+        let l =
+            img.layer("combined").ok_or_else(|| anyhow!("point {p:?} has no combined image"))?;
         let mut lin = vec![0.0f32; n * 3];
         for (c, name) in ["R", "G", "B"].iter().enumerate() {
-            let plane = l.channel(name).ok_or_else(|| anyhow!("point {p:?}: the combined image has no {name} channel"))?;
+            let plane = l
+                .channel(name)
+                .ok_or_else(|| anyhow!("point {p:?}: the combined image has no {name} channel"))?;
             for k in 0..n {
                 lin[k * 3 + c] = plane[k];
             }

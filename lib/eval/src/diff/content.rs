@@ -161,12 +161,20 @@ fn weighted(total: &mut SquaredError, e: &SquaredError, points: u64) {
 }
 
 /// Why layer `q` of the second file cannot be compared texel by texel with layer `p`.
-fn incomparable(a: &Container<StreamRef>, b: &Container<StreamRef>, p: &pis_format::Layer<StreamRef>, q: &pis_format::Layer<StreamRef>) -> Option<String> {
+fn incomparable(
+    a: &Container<StreamRef>,
+    b: &Container<StreamRef>,
+    p: &pis_format::Layer<StreamRef>,
+    q: &pis_format::Layer<StreamRef>,
+) -> Option<String> {
     if (p.kind, p.mapping, p.channels, p.mip_mode) != (q.kind, q.mapping, q.channels, q.mip_mode) {
         return Some("kind, mapping, channels or mip mode differ".into());
     }
     let dims = |c: &Container<StreamRef>, l: &pis_format::Layer<StreamRef>| {
-        l.depends_on.dims().map(|k| (c.space.dims[k].name.clone(), c.space.dims[k].values.len())).collect::<Vec<_>>()
+        l.depends_on
+            .dims()
+            .map(|k| (c.space.dims[k].name.clone(), c.space.dims[k].values.len()))
+            .collect::<Vec<_>>()
     };
     if dims(a, p) != dims(b, q) || a.space.dims.len() != b.space.dims.len() {
         return Some("the layers vary over different dimensions or samples".into());
@@ -177,7 +185,12 @@ fn incomparable(a: &Container<StreamRef>, b: &Container<StreamRef>, p: &pis_form
 /// Compares every layer of every object of `a` with the layer at the same position of the
 /// object of the same name in `b`. With `maps`, also returns an [`ErrorMap`] per compared
 /// layer. `progress` gets one line per layer.
-pub fn compare(a: &PisReader, b: &PisReader, maps: bool, progress: &mut dyn FnMut(&str)) -> Result<(ContentDiff, Vec<ErrorMap>), FileError> {
+pub fn compare(
+    a: &PisReader,
+    b: &PisReader,
+    maps: bool,
+    progress: &mut dyn FnMut(&str),
+) -> Result<(ContentDiff, Vec<ErrorMap>), FileError> {
     let (ca, cb) = (a.container(), b.container());
     let fa = |error| FileError { path: a.path().to_path_buf(), error };
     let fb = |error| FileError { path: b.path().to_path_buf(), error };
@@ -202,18 +215,33 @@ pub fn compare(a: &PisReader, b: &PisReader, maps: bool, progress: &mut dyn FnMu
                 complete = false;
                 obj_exact = false;
                 total_exact = false;
-                layers.push(LayerDiff { layer: li, kind: la.kind.name(), compared: false, note: Some(note), score: Score::of(&SquaredError::default(), false), blocks: vec![] });
+                layers.push(LayerDiff {
+                    layer: li,
+                    kind: la.kind.name(),
+                    compared: false,
+                    note: Some(note),
+                    score: Score::of(&SquaredError::default(), false),
+                    blocks: vec![],
+                });
                 continue;
             }
             let (oj, lb) = lb.expect("checked above");
-            progress(&format!("object '{}' layer {li} ({}): {} blocks", oa.name, la.kind.name(), la.blocks.len()));
+            progress(&format!(
+                "object '{}' layer {li} ({}): {} blocks",
+                oa.name,
+                la.kind.name(),
+                la.blocks.len()
+            ));
             let multiplicity = points / ca.space.table_len(la.depends_on).max(1);
             let grid_a = BlockGrid::new(&ca.space, la.depends_on, &oa.stagger);
             let grid_b = BlockGrid::new(&cb.space, lb.depends_on, &cb.objects[oj].stagger);
             let same_grid = grid_a.blocks_per_axis() == grid_b.blocks_per_axis()
                 && (0..la.blocks.len()).all(|k| grid_a.extent(k) == grid_b.extent(k))
                 && la.depends_on.dims().all(|d| oa.stagger[d] == cb.objects[oj].stagger[d])
-                && la.depends_on.dims().all(|d| ca.space.dims[d].block_size == cb.space.dims[d].block_size);
+                && la
+                    .depends_on
+                    .dims()
+                    .all(|d| ca.space.dims[d].block_size == cb.space.dims[d].block_size);
             let mut layer_err = SquaredError::default();
             let mut layer_exact = true;
             let mut layout_note = None;
@@ -228,19 +256,34 @@ pub fn compare(a: &PisReader, b: &PisReader, maps: bool, progress: &mut dyn FnMu
                     let mut textures = Vec::with_capacity(ta.keys.len());
                     let mut layout = ta.layout.clone();
                     for k in &ta.keys {
-                        let t = b.texture(oj, li, &point_of(cb.space.dims.len(), lb.depends_on, k)).map_err(fb)?;
+                        let t = b
+                            .texture(oj, li, &point_of(cb.space.dims.len(), lb.depends_on, k))
+                            .map_err(fb)?;
                         if t.layout != ta.layout {
                             layout = t.layout.clone();
                         }
                         textures.push(t.data);
                     }
-                    BlockTextures { layout, extent: ta.extent.clone(), keys: ta.keys.clone(), textures }
+                    BlockTextures {
+                        layout,
+                        extent: ta.extent.clone(),
+                        keys: ta.keys.clone(),
+                        textures,
+                    }
                 };
                 if tb.layout != ta.layout {
-                    layout_note = Some(format!("texture layout differs in block {bi}: {}x{} → {}x{}", ta.layout.width, ta.layout.height, tb.layout.width, tb.layout.height));
+                    layout_note = Some(format!(
+                        "texture layout differs in block {bi}: {}x{} → {}x{}",
+                        ta.layout.width, ta.layout.height, tb.layout.width, tb.layout.height
+                    ));
                     break;
                 }
-                let per: Vec<SampleError> = ta.textures.par_iter().zip(&tb.textures).map(|(x, y)| sample_error(&ta.layout, x, y, maps)).collect();
+                let per: Vec<SampleError> = ta
+                    .textures
+                    .par_iter()
+                    .zip(&tb.textures)
+                    .map(|(x, y)| sample_error(&ta.layout, x, y, maps))
+                    .collect();
                 let mut block_err = SquaredError::default();
                 let mut block_exact = true;
                 let mut block_map = None;
@@ -249,9 +292,17 @@ pub fn compare(a: &PisReader, b: &PisReader, maps: bool, progress: &mut dyn FnMu
                     block_exact &= s.exact;
                     if let Some(t) = &s.texels {
                         let k = *block_map.get_or_insert_with(|| {
-                            let same = layer_maps.iter().position(|m| m.layout == ta.layout && la.blocks[m.blocks[0]].same_placement(&la.blocks[bi]));
+                            let same = layer_maps.iter().position(|m| {
+                                m.layout == ta.layout
+                                    && la.blocks[m.blocks[0]].same_placement(&la.blocks[bi])
+                            });
                             same.unwrap_or_else(|| {
-                                layer_maps.push(MapSum { layout: ta.layout.clone(), sums: vec![0.0; t.len()], values: 0, blocks: vec![] });
+                                layer_maps.push(MapSum {
+                                    layout: ta.layout.clone(),
+                                    sums: vec![0.0; t.len()],
+                                    values: 0,
+                                    blocks: vec![],
+                                });
                                 layer_maps.len() - 1
                             })
                         });
@@ -265,13 +316,24 @@ pub fn compare(a: &PisReader, b: &PisReader, maps: bool, progress: &mut dyn FnMu
                 }
                 weighted(&mut layer_err, &block_err, 1);
                 layer_exact &= block_exact;
-                blocks.push(BlockDiff { block: bi, samples: per.len(), score: Score::of(&block_err, block_exact) });
+                blocks.push(BlockDiff {
+                    block: bi,
+                    samples: per.len(),
+                    score: Score::of(&block_err, block_exact),
+                });
             }
             if let Some(note) = layout_note {
                 complete = false;
                 obj_exact = false;
                 total_exact = false;
-                layers.push(LayerDiff { layer: li, kind: la.kind.name(), compared: false, note: Some(note), score: Score::of(&SquaredError::default(), false), blocks: vec![] });
+                layers.push(LayerDiff {
+                    layer: li,
+                    kind: la.kind.name(),
+                    compared: false,
+                    note: Some(note),
+                    score: Score::of(&SquaredError::default(), false),
+                    blocks: vec![],
+                });
                 continue;
             }
             weighted(&mut obj_err, &layer_err, multiplicity);
@@ -279,9 +341,25 @@ pub fn compare(a: &PisReader, b: &PisReader, maps: bool, progress: &mut dyn FnMu
             let placements = layer_maps.len();
             for MapSum { layout, sums, values: n, blocks } in layer_maps {
                 let values = sums.iter().map(|s| (s / n.max(1) as f64).sqrt() as f32).collect();
-                out_maps.push(ErrorMap { object: oa.name.clone(), layer: li, kind: la.kind.name(), blocks, placements, width: layout.width * layout.faces, height: layout.height, values });
+                out_maps.push(ErrorMap {
+                    object: oa.name.clone(),
+                    layer: li,
+                    kind: la.kind.name(),
+                    blocks,
+                    placements,
+                    width: layout.width * layout.faces,
+                    height: layout.height,
+                    values,
+                });
             }
-            layers.push(LayerDiff { layer: li, kind: la.kind.name(), compared: true, note: None, score: Score::of(&layer_err, layer_exact), blocks });
+            layers.push(LayerDiff {
+                layer: li,
+                kind: la.kind.name(),
+                compared: true,
+                note: None,
+                score: Score::of(&layer_err, layer_exact),
+                blocks,
+            });
         }
         if ob.is_some_and(|j| cb.objects[j].layers.len() > oa.layers.len()) {
             complete = false;
@@ -289,7 +367,11 @@ pub fn compare(a: &PisReader, b: &PisReader, maps: bool, progress: &mut dyn FnMu
         }
         total.merge(&obj_err);
         total_exact &= obj_exact;
-        objects.push(ObjectDiff { name: oa.name.clone(), score: Score::of(&obj_err, obj_exact), layers });
+        objects.push(ObjectDiff {
+            name: oa.name.clone(),
+            score: Score::of(&obj_err, obj_exact),
+            layers,
+        });
     }
     if cb.objects.iter().any(|o| !ca.objects.iter().any(|p| p.name == o.name)) {
         complete = false;

@@ -54,17 +54,20 @@ fn block_start(r: &PisReader, object: usize, layer: usize, block: usize) -> Vec<
 }
 
 /// Decodes every sample of block `block` of layer `layer` of object `object`.
-pub fn decode_block(r: &PisReader, object: usize, layer: usize, block: usize) -> Result<BlockTextures, Error> {
+pub fn decode_block(
+    r: &PisReader,
+    object: usize,
+    layer: usize,
+    block: usize,
+) -> Result<BlockTextures, Error> {
     let c = r.container();
-    let l = c
-        .objects
-        .get(object)
-        .and_then(|o| o.layers.get(layer))
-        .ok_or_else(|| Error::Request(format!("object {object} layer {layer} does not exist")))?;
-    let b = l
-        .blocks
-        .get(block)
-        .ok_or_else(|| Error::Request(format!("object {object} layer {layer} has no block {block}")))?;
+    let l =
+        c.objects.get(object).and_then(|o| o.layers.get(layer)).ok_or_else(|| {
+            Error::Request(format!("object {object} layer {layer} does not exist"))
+        })?;
+    let b = l.blocks.get(block).ok_or_else(|| {
+        Error::Request(format!("object {object} layer {layer} has no block {block}"))
+    })?;
     let layout = LevelLayout::of(l, b);
     let planes = layout.planes();
     let start = block_start(r, object, layer, block);

@@ -10,13 +10,13 @@
 use std::fmt::Write;
 use std::path::{Path, PathBuf};
 
-use anyhow::anyhow;
 use crate::diff::{compare, differences, ChunkBytes, ObjectDiff, Score};
 use crate::heatmap::write_heatmap;
+use anyhow::anyhow;
 use serde::Serialize;
 
-use pis_pack::{Exit, Failure};
 use crate::reencode::{in_file, open};
+use pis_pack::{Exit, Failure};
 
 /// What to compare.
 #[derive(Clone, Debug, Default)]
@@ -98,7 +98,8 @@ impl DiffReport {
 
 fn same_bytes(a: &Path, b: &Path) -> Result<bool, Failure> {
     let io = |p: &Path, e: std::io::Error| Failure::new(Exit::Io, anyhow!("{}: {e}", p.display()));
-    let (ma, mb) = (std::fs::metadata(a).map_err(|e| io(a, e))?, std::fs::metadata(b).map_err(|e| io(b, e))?);
+    let (ma, mb) =
+        (std::fs::metadata(a).map_err(|e| io(a, e))?, std::fs::metadata(b).map_err(|e| io(b, e))?);
     if ma.len() != mb.len() {
         return Ok(false);
     }
@@ -107,19 +108,29 @@ fn same_bytes(a: &Path, b: &Path) -> Result<bool, Failure> {
 
 /// A file name from an object name: letters, digits, `-` and `_` kept.
 fn file_part(s: &str) -> String {
-    s.chars().map(|c| if c.is_ascii_alphanumeric() || c == '-' || c == '_' { c } else { '_' }).collect()
+    s.chars()
+        .map(|c| if c.is_ascii_alphanumeric() || c == '-' || c == '_' { c } else { '_' })
+        .collect()
 }
 
 /// Evaluates the gates on a whole-file PSNR (`None`: infinite).
 pub fn min_psnr_gate(limit: f64, psnr: Option<f64>) -> Gate {
-    Gate { name: "min-psnr".into(), limit_db: limit, value_db: psnr, passed: psnr.is_none_or(|p| p >= limit) }
+    Gate {
+        name: "min-psnr".into(),
+        limit_db: limit,
+        value_db: psnr,
+        passed: psnr.is_none_or(|p| p >= limit),
+    }
 }
 
 /// Compares two containers.
 pub fn diff(req: &DiffRequest) -> Result<DiffReport, Failure> {
     if let Some(p) = req.min_psnr {
         if !p.is_finite() {
-            return Err(Failure::new(Exit::Usage, anyhow!("--min-psnr must be a number of dB, got {p}")));
+            return Err(Failure::new(
+                Exit::Usage,
+                anyhow!("--min-psnr must be a number of dB, got {p}"),
+            ));
         }
     }
     let a = open(&req.a)?;
@@ -132,23 +143,39 @@ pub fn diff(req: &DiffRequest) -> Result<DiffReport, Failure> {
         _ => {}
     }
     let bytes_identical = same_bytes(&req.a, &req.b)?;
-    let (content, maps) = compare(&a, &b, req.heatmaps.is_some(), &mut |line| eprintln!("pis-diff: {line}")).map_err(|e| in_file(&e.path, e.error))?;
+    let (content, maps) =
+        compare(&a, &b, req.heatmaps.is_some(), &mut |line| eprintln!("pis-diff: {line}"))
+            .map_err(|e| in_file(&e.path, e.error))?;
     let mut heatmaps = Vec::new();
     if let Some(dir) = &req.heatmaps {
-        std::fs::create_dir_all(dir).map_err(|e| Failure::new(Exit::Io, anyhow!("{}: {e}", dir.display())))?;
+        std::fs::create_dir_all(dir)
+            .map_err(|e| Failure::new(Exit::Io, anyhow!("{}: {e}", dir.display())))?;
         for m in &maps {
             let scale = m.values.iter().fold(0.0f32, |a, &v| a.max(v));
             // A layer whose blocks place the texture differently gets a map per placement,
             // named by its first block.
-            let part = if m.placements > 1 { format!("-block{}", m.blocks.first().copied().unwrap_or(0)) } else { String::new() };
-            let file = dir.join(format!("{}-layer{}-{}{part}.png", file_part(&m.object), m.layer, m.kind));
-            write_heatmap(&file, m.width, m.height, &m.values, scale).map_err(|e| Failure::new(Exit::Io, e))?;
-            heatmaps.push(Heatmap { object: m.object.clone(), layer: m.layer, blocks: m.blocks.clone(), file: file.display().to_string(), scale });
+            let part = if m.placements > 1 {
+                format!("-block{}", m.blocks.first().copied().unwrap_or(0))
+            } else {
+                String::new()
+            };
+            let file =
+                dir.join(format!("{}-layer{}-{}{part}.png", file_part(&m.object), m.layer, m.kind));
+            write_heatmap(&file, m.width, m.height, &m.values, scale)
+                .map_err(|e| Failure::new(Exit::Io, e))?;
+            heatmaps.push(Heatmap {
+                object: m.object.clone(),
+                layer: m.layer,
+                blocks: m.blocks.clone(),
+                file: file.display().to_string(),
+                scale,
+            });
         }
     }
     let textures_identical = content.score.exact && content.complete;
     let identical = structure.is_empty() && textures_identical;
-    let gates: Vec<Gate> = req.min_psnr.map(|l| min_psnr_gate(l, content.score.psnr_db)).into_iter().collect();
+    let gates: Vec<Gate> =
+        req.min_psnr.map(|l| min_psnr_gate(l, content.score.psnr_db)).into_iter().collect();
     let verdict = match (identical, gates.is_empty(), gates.iter().all(|g| g.passed)) {
         (true, true, _) => "identical",
         (false, true, _) => "different",
@@ -201,18 +228,54 @@ pub fn render(r: &DiffReport) -> String {
         let _ = writeln!(s, "  {k:<26} {x:>10} {y:>12}{mark}");
     }
     let _ = writeln!(s, "\nTextures (display values, every parameter point):");
-    let whole = Score { psnr_db: r.psnr_db, mse: r.mse, max_error: r.max_error, exact: r.textures_identical };
-    let _ = writeln!(s, "  whole file: PSNR {}, MSE {:.3e}, max error {:.4}", db(&whole), r.mse, r.max_error);
+    let whole = Score {
+        psnr_db: r.psnr_db,
+        mse: r.mse,
+        max_error: r.max_error,
+        exact: r.textures_identical,
+    };
+    let _ = writeln!(
+        s,
+        "  whole file: PSNR {}, MSE {:.3e}, max error {:.4}",
+        db(&whole),
+        r.mse,
+        r.max_error
+    );
     for o in &r.objects {
-        let _ = writeln!(s, "  object {:<14} {:>12}  max error {:.4}", o.name, db(&o.score), o.score.max_error);
+        let _ = writeln!(
+            s,
+            "  object {:<14} {:>12}  max error {:.4}",
+            o.name,
+            db(&o.score),
+            o.score.max_error
+        );
         for l in &o.layers {
             if !l.compared {
-                let _ = writeln!(s, "    layer {} {:<12} not compared: {}", l.layer, l.kind, l.note.as_deref().unwrap_or(""));
+                let _ = writeln!(
+                    s,
+                    "    layer {} {:<12} not compared: {}",
+                    l.layer,
+                    l.kind,
+                    l.note.as_deref().unwrap_or("")
+                );
                 continue;
             }
-            let worst = l.blocks.iter().filter(|b| !b.score.exact).min_by(|x, y| x.score.psnr_db.partial_cmp(&y.score.psnr_db).unwrap_or(std::cmp::Ordering::Equal));
-            let worst = worst.map_or(String::new(), |b| format!(", worst block {} at {}", b.block, db(&b.score)));
-            let _ = writeln!(s, "    layer {} {:<12} {:>12}  MSE {:.3e}  max error {:.4}  ({} blocks{worst})", l.layer, l.kind, db(&l.score), l.score.mse, l.score.max_error, l.blocks.len());
+            let worst = l.blocks.iter().filter(|b| !b.score.exact).min_by(|x, y| {
+                x.score.psnr_db.partial_cmp(&y.score.psnr_db).unwrap_or(std::cmp::Ordering::Equal)
+            });
+            let worst = worst.map_or(String::new(), |b| {
+                format!(", worst block {} at {}", b.block, db(&b.score))
+            });
+            let _ = writeln!(
+                s,
+                "    layer {} {:<12} {:>12}  MSE {:.3e}  max error {:.4}  ({} blocks{worst})",
+                l.layer,
+                l.kind,
+                db(&l.score),
+                l.score.mse,
+                l.score.max_error,
+                l.blocks.len()
+            );
         }
     }
     for h in &r.heatmaps {
@@ -220,9 +283,21 @@ pub fn render(r: &DiffReport) -> String {
     }
     for g in &r.gates {
         let v = g.value_db.map_or("inf".to_string(), |v| format!("{v:.2}"));
-        let _ = writeln!(s, "Gate {}: {v} dB against {:.2} dB: {}", g.name, g.limit_db, if g.passed { "passed" } else { "FAILED" });
+        let _ = writeln!(
+            s,
+            "Gate {}: {v} dB against {:.2} dB: {}",
+            g.name,
+            g.limit_db,
+            if g.passed { "passed" } else { "FAILED" }
+        );
     }
-    let bytes = if r.bytes_identical { " (the bytes are identical)" } else if r.identical { " (the bytes differ)" } else { "" };
+    let bytes = if r.bytes_identical {
+        " (the bytes are identical)"
+    } else if r.identical {
+        " (the bytes differ)"
+    } else {
+        ""
+    };
     let _ = writeln!(s, "Verdict: {}{bytes}", r.verdict);
     s
 }

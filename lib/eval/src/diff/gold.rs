@@ -13,16 +13,16 @@
 use std::path::PathBuf;
 use std::sync::Arc;
 
-use anyhow::anyhow;
 use crate::compare::{compare_with_set, CompareOptions};
 use crate::flip::{flip_map, means, FlipMean};
 use crate::heatmap::write_heatmap;
+use anyhow::anyhow;
 use pis_play::{Gpu, PlayError, Player, PlayerOptions};
 use serde::Serialize;
 
 use super::files::{min_psnr_gate, Gate};
-use pis_pack::{Exit, Failure};
 use crate::reencode::open;
+use pis_pack::{Exit, Failure};
 
 /// The provenance setting that holds a writer's predicted PSNR (dB), the reference of
 /// `--max-psnr-drop` when `--reference-psnr` is not given.
@@ -144,7 +144,11 @@ fn failure(e: anyhow::Error) -> Failure {
 
 /// Measures `req.file` against the set `req.set`.
 pub fn gold(req: &GoldRequest) -> Result<GoldReport, Failure> {
-    for (name, v) in [("--min-psnr", req.min_psnr), ("--max-psnr-drop", req.max_psnr_drop), ("--reference-psnr", req.reference_psnr)] {
+    for (name, v) in [
+        ("--min-psnr", req.min_psnr),
+        ("--max-psnr-drop", req.max_psnr_drop),
+        ("--reference-psnr", req.reference_psnr),
+    ] {
         if v.is_some_and(|v| !v.is_finite()) {
             return Err(Failure::new(Exit::Usage, anyhow!("{name} must be a number of dB")));
         }
@@ -152,7 +156,10 @@ pub fn gold(req: &GoldRequest) -> Result<GoldReport, Failure> {
     // The reference of the drop gate, before any drawing.
     let reader = open(&req.file)?;
     let recorded = reader.container().provenance.as_ref().and_then(|p| {
-        p.settings.iter().find(|(k, _)| k == PREDICTED_PSNR_SETTING).and_then(|(_, v)| v.trim().parse::<f64>().ok())
+        p.settings
+            .iter()
+            .find(|(k, _)| k == PREDICTED_PSNR_SETTING)
+            .and_then(|(_, v)| v.trim().parse::<f64>().ok())
     });
     let (reference, reference_from) = match (req.reference_psnr, recorded) {
         (Some(r), _) => (Some(r), Some("--reference-psnr".to_string())),
@@ -166,13 +173,23 @@ pub fn gold(req: &GoldRequest) -> Result<GoldReport, Failure> {
         ));
     }
     if let Some(dir) = &req.heatmaps {
-        std::fs::create_dir_all(dir).map_err(|e| Failure::new(Exit::Io, anyhow!("{}: {e}", dir.display())))?;
+        std::fs::create_dir_all(dir)
+            .map_err(|e| Failure::new(Exit::Io, anyhow!("{}: {e}", dir.display())))?;
     }
     drop(reader);
 
     let gpu = Arc::new(Gpu::new().map_err(|e| failure(e.into()))?);
     let device = gpu.describe();
-    let mut player = Player::open(gpu, &req.file, PlayerOptions { msaa: req.msaa, display_filter: crate::headless::set_display_filter(&req.set), ..PlayerOptions::default() }).map_err(|e| failure(e.into()))?;
+    let mut player = Player::open(
+        gpu,
+        &req.file,
+        PlayerOptions {
+            msaa: req.msaa,
+            display_filter: crate::headless::set_display_filter(&req.set),
+            ..PlayerOptions::default()
+        },
+    )
+    .map_err(|e| failure(e.into()))?;
     let msaa_samples = player.multisample().samples;
     let resolve = crate::headless::Resolve::of(&player);
     if let Some(note) = &player.multisample().note {
@@ -182,25 +199,26 @@ pub fn gold(req: &GoldRequest) -> Result<GoldReport, Failure> {
     let mut flips: Vec<(usize, FlipMean, Vec<FlipMean>)> = Vec::new();
     let mut heatmaps = Vec::new();
     let mut side_error: Option<anyhow::Error> = None;
-    let comparison = compare_with_set(&mut player, &req.set, &CompareOptions::default(), &mut |pair| {
-        if side_error.is_some() {
-            return;
-        }
-        let result = flip_map(pair.gold, pair.rendered).and_then(|map| {
-            let (whole, per) = means(&map, pair.object_ids, names.len());
-            flips.push((pair.index, whole, per));
-            if let Some(dir) = &req.heatmaps {
-                let file = dir.join(format!("point_{:05}_flip.png", pair.index));
-                write_heatmap(&file, pair.rendered.width, pair.rendered.height, &map, 1.0)?;
-                heatmaps.push(file.display().to_string());
+    let comparison =
+        compare_with_set(&mut player, &req.set, &CompareOptions::default(), &mut |pair| {
+            if side_error.is_some() {
+                return;
             }
-            Ok(())
-        });
-        if let Err(e) = result {
-            side_error = Some(e);
-        }
-    })
-    .map_err(failure)?;
+            let result = flip_map(pair.gold, pair.rendered).and_then(|map| {
+                let (whole, per) = means(&map, pair.object_ids, names.len());
+                flips.push((pair.index, whole, per));
+                if let Some(dir) = &req.heatmaps {
+                    let file = dir.join(format!("point_{:05}_flip.png", pair.index));
+                    write_heatmap(&file, pair.rendered.width, pair.rendered.height, &map, 1.0)?;
+                    heatmaps.push(file.display().to_string());
+                }
+                Ok(())
+            });
+            if let Err(e) = result {
+                side_error = Some(e);
+            }
+        })
+        .map_err(failure)?;
     if let Some(e) = side_error {
         return Err(Failure::new(Exit::Runtime, e));
     }
@@ -212,27 +230,49 @@ pub fn gold(req: &GoldRequest) -> Result<GoldReport, Failure> {
         object_flip.iter_mut().zip(per).for_each(|(a, b)| a.merge(b));
     }
     let object_index = |name: &str| names.iter().position(|n| n == name);
-    let objects = comparison.objects.iter().map(|o| GoldObject {
-        name: o.name.clone(),
-        psnr_db: finite(o.psnr_db),
-        mse: o.error.mse(),
-        flip_mean: object_index(&o.name).and_then(|i| object_flip[i].mean()),
-        blocks: o.blocks.iter().map(|b| GoldBlock { block: b.block, psnr_db: finite(b.psnr_db), mse: b.error.mse() }).collect(),
-    }).collect();
-    let points = comparison.points.iter().map(|p| {
-        let f = flips.iter().find(|(i, _, _)| *i == p.index);
-        GoldPoint {
-            index: p.index,
-            point: p.point.clone(),
-            psnr_db: finite(p.psnr_db),
-            flip_mean: f.and_then(|(_, w, _)| w.mean()),
-            objects: p.objects.iter().map(|o| GoldPointObject {
-                name: o.name.clone(),
-                psnr_db: finite(o.psnr_db),
-                flip_mean: f.and_then(|(_, _, per)| object_index(&o.name).and_then(|i| per[i].mean())),
-            }).collect(),
-        }
-    }).collect();
+    let objects = comparison
+        .objects
+        .iter()
+        .map(|o| GoldObject {
+            name: o.name.clone(),
+            psnr_db: finite(o.psnr_db),
+            mse: o.error.mse(),
+            flip_mean: object_index(&o.name).and_then(|i| object_flip[i].mean()),
+            blocks: o
+                .blocks
+                .iter()
+                .map(|b| GoldBlock {
+                    block: b.block,
+                    psnr_db: finite(b.psnr_db),
+                    mse: b.error.mse(),
+                })
+                .collect(),
+        })
+        .collect();
+    let points = comparison
+        .points
+        .iter()
+        .map(|p| {
+            let f = flips.iter().find(|(i, _, _)| *i == p.index);
+            GoldPoint {
+                index: p.index,
+                point: p.point.clone(),
+                psnr_db: finite(p.psnr_db),
+                flip_mean: f.and_then(|(_, w, _)| w.mean()),
+                objects: p
+                    .objects
+                    .iter()
+                    .map(|o| GoldPointObject {
+                        name: o.name.clone(),
+                        psnr_db: finite(o.psnr_db),
+                        flip_mean: f.and_then(|(_, _, per)| {
+                            object_index(&o.name).and_then(|i| per[i].mean())
+                        }),
+                    })
+                    .collect(),
+            }
+        })
+        .collect();
 
     let psnr = finite(comparison.psnr_db);
     let covered = finite(comparison.covered_psnr_db);
@@ -242,7 +282,12 @@ pub fn gold(req: &GoldRequest) -> Result<GoldReport, Failure> {
         gates.push(min_psnr_gate(limit, psnr));
     }
     if let (Some(limit), Some(d)) = (req.max_psnr_drop, drop) {
-        gates.push(Gate { name: "max-psnr-drop".into(), limit_db: limit, value_db: finite(d), passed: d <= limit });
+        gates.push(Gate {
+            name: "max-psnr-drop".into(),
+            limit_db: limit,
+            value_db: finite(d),
+            passed: d <= limit,
+        });
     }
     let verdict = match (gates.is_empty(), gates.iter().all(|g| g.passed)) {
         (true, _) => "measured",
@@ -260,7 +305,8 @@ pub fn gold(req: &GoldRequest) -> Result<GoldReport, Failure> {
         covered_psnr_db: covered,
         silhouette_psnr_db: finite(comparison.silhouette.psnr()),
         interior_psnr_db: finite(comparison.interior.psnr()),
-        silhouette_fraction: comparison.silhouette.count as f64 / (comparison.silhouette.count + comparison.interior.count).max(1) as f64,
+        silhouette_fraction: comparison.silhouette.count as f64
+            / (comparison.silhouette.count + comparison.interior.count).max(1) as f64,
         flip_mean: total_flip.mean(),
         reference_psnr_db: reference,
         reference_from,
@@ -285,20 +331,51 @@ fn fl(v: Option<f64>) -> String {
 pub fn render(r: &GoldReport) -> String {
     use std::fmt::Write;
     let mut s = String::new();
-    let _ = writeln!(s, "{} against the gold-standard set {} ({} points, {}, {}{})", r.file, r.set, r.points.len(), r.device, crate::headless::msaa_label(r.msaa_samples, r.msaa_requested), r.resolve.label());
-    let _ = writeln!(s, "  PSNR (display values): whole image {} dB, objects' covered pixels {} dB", db(r.psnr_db), db(r.covered_psnr_db));
+    let _ = writeln!(
+        s,
+        "{} against the gold-standard set {} ({} points, {}, {}{})",
+        r.file,
+        r.set,
+        r.points.len(),
+        r.device,
+        crate::headless::msaa_label(r.msaa_samples, r.msaa_requested),
+        r.resolve.label()
+    );
+    let _ = writeln!(
+        s,
+        "  PSNR (display values): whole image {} dB, objects' covered pixels {} dB",
+        db(r.psnr_db),
+        db(r.covered_psnr_db)
+    );
     let _ = writeln!(s, "  whole image at silhouettes {} dB ({:.1} % of the pixels: partly covered in the gold standard), elsewhere {} dB", db(r.silhouette_psnr_db), 100.0 * r.silhouette_fraction, db(r.interior_psnr_db));
     let _ = writeln!(s, "  mean FLIP (sRGB images): {}", fl(r.flip_mean));
     let _ = writeln!(s, "  objects:                PSNR (dB)   mean FLIP   worst block");
     for o in &r.objects {
-        let worst = o.blocks.iter().filter(|b| b.psnr_db.is_some()).min_by(|a, b| a.psnr_db.partial_cmp(&b.psnr_db).unwrap_or(std::cmp::Ordering::Equal));
-        let worst = worst.map_or(String::new(), |b| format!("block {} at {} dB", b.block, db(b.psnr_db)));
-        let _ = writeln!(s, "    {:<20} {:>10} {:>11}   {worst}", o.name, db(o.psnr_db), fl(o.flip_mean));
+        let worst =
+            o.blocks.iter().filter(|b| b.psnr_db.is_some()).min_by(|a, b| {
+                a.psnr_db.partial_cmp(&b.psnr_db).unwrap_or(std::cmp::Ordering::Equal)
+            });
+        let worst =
+            worst.map_or(String::new(), |b| format!("block {} at {} dB", b.block, db(b.psnr_db)));
+        let _ = writeln!(
+            s,
+            "    {:<20} {:>10} {:>11}   {worst}",
+            o.name,
+            db(o.psnr_db),
+            fl(o.flip_mean)
+        );
     }
     let _ = writeln!(s, "  points:");
     for p in &r.points {
         let values: Vec<String> = p.point.iter().map(|v| format!("{v:.3}")).collect();
-        let _ = writeln!(s, "    {:>5} ({:<14}) PSNR {:>7} dB  FLIP {}", p.index, values.join(", "), db(p.psnr_db), fl(p.flip_mean));
+        let _ = writeln!(
+            s,
+            "    {:>5} ({:<14}) PSNR {:>7} dB  FLIP {}",
+            p.index,
+            values.join(", "),
+            db(p.psnr_db),
+            fl(p.flip_mean)
+        );
     }
     if let (Some(r0), Some(from)) = (r.reference_psnr_db, &r.reference_from) {
         let _ = writeln!(s, "  reference {r0:.2} dB ({from}): drop {} dB", db(r.psnr_drop_db));
@@ -307,7 +384,14 @@ pub fn render(r: &GoldReport) -> String {
         let _ = writeln!(s, "  FLIP map {h}");
     }
     for g in &r.gates {
-        let _ = writeln!(s, "Gate {}: {} dB against {:.2} dB: {}", g.name, db(g.value_db), g.limit_db, if g.passed { "passed" } else { "FAILED" });
+        let _ = writeln!(
+            s,
+            "Gate {}: {} dB against {:.2} dB: {}",
+            g.name,
+            db(g.value_db),
+            g.limit_db,
+            if g.passed { "passed" } else { "FAILED" }
+        );
     }
     let _ = writeln!(s, "Verdict: {}", r.verdict);
     s

@@ -15,8 +15,8 @@
 
 use std::path::{Path, PathBuf};
 
-use anyhow::anyhow;
 use crate::metrics::SquaredError;
+use anyhow::anyhow;
 use pis_trace::layers::{LayerKind, PointImages};
 use pis_trace::set::RaySet;
 use serde::Serialize;
@@ -91,7 +91,12 @@ impl LayeredModel {
         let d = get(LayerKind::Diffuse, c)?;
         match self {
             LayeredModel::Environment => {
-                let (f, l, a, t) = (get(LayerKind::Fresnel, c)?, get(LayerKind::Local, c)?, get(LayerKind::Local, "A")?, get(LayerKind::Distant, c)?);
+                let (f, l, a, t) = (
+                    get(LayerKind::Fresnel, c)?,
+                    get(LayerKind::Local, c)?,
+                    get(LayerKind::Local, "A")?,
+                    get(LayerKind::Distant, c)?,
+                );
                 let n = d.len().min(f.len()).min(l.len()).min(a.len()).min(t.len());
                 Some((0..n).map(|k| d[k] + f[k] * (l[k] + (1.0 - a[k]) * t[k])).collect())
             }
@@ -125,7 +130,11 @@ pub struct SetsReport {
 
 impl SetsReport {
     pub fn exit(&self) -> Exit {
-        if self.passed { Exit::Ok } else { Exit::Different }
+        if self.passed {
+            Exit::Ok
+        } else {
+            Exit::Different
+        }
     }
 }
 
@@ -134,7 +143,12 @@ fn finite(p: f64) -> Option<f64> {
 }
 
 fn open(p: &Path) -> Result<RaySet, Failure> {
-    RaySet::open(p).map_err(|e| Failure::new(pis_pack::trace_exit(&e), anyhow::Error::new(e).context(format!("opening the ray-traced set {}", p.display()))))
+    RaySet::open(p).map_err(|e| {
+        Failure::new(
+            pis_pack::trace_exit(&e),
+            anyhow::Error::new(e).context(format!("opening the ray-traced set {}", p.display())),
+        )
+    })
 }
 
 /// Compares the sets of `req`.
@@ -142,13 +156,32 @@ pub fn compare_sets(req: &SetsRequest) -> Result<SetsReport, Failure> {
     let (sa, sb) = (open(&req.a)?, open(&req.b)?);
     let invalid = |e: anyhow::Error| Failure::new(Exit::Invalid, e);
     if sa.meta.resolution != sb.meta.resolution {
-        return Err(invalid(anyhow!("{} is {}x{}, {} is {}x{}: sets of one size compare pixel by pixel", req.a.display(),
-            sa.meta.resolution[0], sa.meta.resolution[1], req.b.display(), sb.meta.resolution[0], sb.meta.resolution[1])));
+        return Err(invalid(anyhow!(
+            "{} is {}x{}, {} is {}x{}: sets of one size compare pixel by pixel",
+            req.a.display(),
+            sa.meta.resolution[0],
+            sa.meta.resolution[1],
+            req.b.display(),
+            sb.meta.resolution[0],
+            sb.meta.resolution[1]
+        )));
     }
     let npx = sa.meta.resolution[0] as usize * sa.meta.resolution[1] as usize;
     // Objects of A that B also has, with both channel names.
-    let objects: Vec<(String, String, String, Option<LayeredModel>)> = sa.meta.objects.iter()
-        .filter_map(|o| sb.meta.objects.iter().find(|p| p.name == o.name).map(|p| (o.name.clone(), o.channel_name.clone(), p.channel_name.clone(), LayeredModel::of(&p.layers))))
+    let objects: Vec<(String, String, String, Option<LayeredModel>)> = sa
+        .meta
+        .objects
+        .iter()
+        .filter_map(|o| {
+            sb.meta.objects.iter().find(|p| p.name == o.name).map(|p| {
+                (
+                    o.name.clone(),
+                    o.channel_name.clone(),
+                    p.channel_name.clone(),
+                    LayeredModel::of(&p.layers),
+                )
+            })
+        })
         .collect();
     let mut total = SquaredError::default();
     let mut per_object = vec![SquaredError::default(); objects.len()];
@@ -157,28 +190,64 @@ pub fn compare_sets(req: &SetsRequest) -> Result<SetsReport, Failure> {
     for pa in &sa.meta.points {
         let Some(pb) = sb.meta.points.iter().find(|p| p.index == pa.index) else { continue };
         if pa.values != pb.values {
-            return Err(invalid(anyhow!("point {} is {:?} in {} and {:?} in {}: not the same parameter space", pa.index, pa.values, req.a.display(), pb.values, req.b.display())));
+            return Err(invalid(anyhow!(
+                "point {} is {:?} in {} and {:?} in {}: not the same parameter space",
+                pa.index,
+                pa.values,
+                req.a.display(),
+                pb.values,
+                req.b.display()
+            )));
         }
-        let read = |s: &RaySet, i: usize, dir: &Path| s.read_point(i).map_err(|e| Failure::new(pis_pack::trace_exit(&e), anyhow::Error::new(e).context(format!("reading point {i} of {}", dir.display()))));
+        let read = |s: &RaySet, i: usize, dir: &Path| {
+            s.read_point(i).map_err(|e| {
+                Failure::new(
+                    pis_pack::trace_exit(&e),
+                    anyhow::Error::new(e)
+                        .context(format!("reading point {i} of {}", dir.display())),
+                )
+            })
+        };
         let (ia, ib) = (read(&sa, pa.index, &req.a)?, read(&sb, pb.index, &req.b)?);
         let mut e = SquaredError::default();
         let (ca, cb) = match (ia.layer("combined"), ib.layer("combined")) {
             (Some(a), Some(b)) => (a, b),
-            _ => return Err(invalid(anyhow!("point {}: a set without its combined image", pa.index))),
+            _ => {
+                return Err(invalid(anyhow!(
+                    "point {}: a set without its combined image",
+                    pa.index
+                )))
+            }
         };
         for c in ["R", "G", "B"] {
             match (ca.channel(c), cb.channel(c)) {
                 (Some(x), Some(y)) if x.len() == npx && y.len() == npx => e.add_slices(y, x),
-                _ => return Err(invalid(anyhow!("point {}: combined image without a full {c} channel", pa.index))),
+                _ => {
+                    return Err(invalid(anyhow!(
+                        "point {}: combined image without a full {c} channel",
+                        pa.index
+                    )))
+                }
             }
         }
-        for (((_, cha, chb, model), acc), macc) in objects.iter().zip(per_object.iter_mut()).zip(per_model.iter_mut()) {
-            let cov = |im: &PointImages, ch: &str| im.object_layer(ch, LayerKind::Coverage).and_then(|l| l.channel("A")).map(<[f32]>::to_vec);
+        for (((_, cha, chb, model), acc), macc) in
+            objects.iter().zip(per_object.iter_mut()).zip(per_model.iter_mut())
+        {
+            let cov = |im: &PointImages, ch: &str| {
+                im.object_layer(ch, LayerKind::Coverage)
+                    .and_then(|l| l.channel("A"))
+                    .map(<[f32]>::to_vec)
+            };
             let (Some(cova), Some(covb)) = (cov(&ia, cha), cov(&ib, chb)) else { continue };
             let surface = |im: &PointImages, ch: &str, c: &str| -> Vec<f32> {
                 let get = |k| im.object_layer(ch, k).and_then(|l| l.channel(c));
                 let (d, s) = (get(LayerKind::Diffuse), get(LayerKind::Specular));
-                (0..npx).map(|k| d.and_then(|p| p.get(k)).copied().unwrap_or(0.0) + s.and_then(|p| p.get(k)).copied().unwrap_or(0.0)).collect()
+                (0..npx)
+                    .map(|k| {
+                        d.and_then(|p| p.get(k)).copied().unwrap_or(0.0)
+                            + s.and_then(|p| p.get(k)).copied().unwrap_or(0.0)
+                    })
+                    .collect()
             };
             for c in ["R", "G", "B"] {
                 let (x, y) = (surface(&ia, cha, c), surface(&ib, chb, c));
@@ -194,10 +263,18 @@ pub fn compare_sets(req: &SetsRequest) -> Result<SetsReport, Failure> {
             }
         }
         total.merge(&e);
-        per_point.push(PointRow { index: pa.index, point: pa.values.clone(), psnr_db: finite(e.psnr()) });
+        per_point.push(PointRow {
+            index: pa.index,
+            point: pa.values.clone(),
+            psnr_db: finite(e.psnr()),
+        });
     }
     if per_point.is_empty() {
-        return Err(invalid(anyhow!("{} and {} hold no point in common", req.a.display(), req.b.display())));
+        return Err(invalid(anyhow!(
+            "{} and {} hold no point in common",
+            req.a.display(),
+            req.b.display()
+        )));
     }
     let psnr = finite(total.psnr());
     let passed = req.min_psnr.is_none_or(|m| psnr.is_none_or(|p| p >= m));
@@ -210,10 +287,18 @@ pub fn compare_sets(req: &SetsRequest) -> Result<SetsReport, Failure> {
         points: [sa.meta.points.len(), sb.meta.points.len()],
         psnr_db: psnr,
         max_error: total.max,
-        objects: objects.iter().zip(per_object.iter().zip(&per_model))
+        objects: objects
+            .iter()
+            .zip(per_object.iter().zip(&per_model))
             .map(|((n, _, _, model), (e, m))| {
                 let model = model.filter(|_| m.count > 0);
-                ObjectRow { name: n.clone(), psnr_db: finite(e.psnr()), pixels: e.count / 3, model: model.map(LayeredModel::formula), model_psnr_db: model.and_then(|_| finite(m.psnr())) }
+                ObjectRow {
+                    name: n.clone(),
+                    psnr_db: finite(e.psnr()),
+                    pixels: e.count / 3,
+                    model: model.map(LayeredModel::formula),
+                    model_psnr_db: model.and_then(|_| finite(m.psnr())),
+                }
             })
             .collect(),
         per_point,
@@ -229,15 +314,27 @@ pub fn render(r: &SetsReport) -> String {
     let mut s = String::new();
     let _ = writeln!(s, "ray-traced set {} ({} spp) against {} ({} spp), {}x{}: {} point(s) compared ({} and {} held)",
         r.a, r.spp[0], r.b, r.spp[1], r.resolution[0], r.resolution[1], r.points_compared, r.points[0], r.points[1]);
-    let _ = writeln!(s, "  combined images: {} (largest display error {:.4})", db(r.psnr_db), r.max_error);
+    let _ = writeln!(
+        s,
+        "  combined images: {} (largest display error {:.4})",
+        db(r.psnr_db),
+        r.max_error
+    );
     for o in &r.objects {
-        let _ = writeln!(s, "    {:<14} {}  ({} pixels both cover)", o.name, db(o.psnr_db), o.pixels);
+        let _ =
+            writeln!(s, "    {:<14} {}  ({} pixels both cover)", o.name, db(o.psnr_db), o.pixels);
         if let Some(m) = o.model {
-            let _ = writeln!(s, "    {:<14} {}  the second set's layers composed as the player's model, {m}", "", db(o.model_psnr_db));
+            let _ = writeln!(
+                s,
+                "    {:<14} {}  the second set's layers composed as the player's model, {m}",
+                "",
+                db(o.model_psnr_db)
+            );
         }
     }
     if let Some(m) = r.min_psnr_db {
-        let _ = writeln!(s, "  gate --min-psnr {m}: {}", if r.passed { "passed" } else { "failed" });
+        let _ =
+            writeln!(s, "  gate --min-psnr {m}: {}", if r.passed { "passed" } else { "failed" });
     }
     s
 }
@@ -259,8 +356,14 @@ mod tests {
     #[test]
     fn the_model_of_an_object_is_read_from_its_layers() {
         let names = |ks: &[LayerKind]| ks.iter().map(|k| k.name().to_string()).collect::<Vec<_>>();
-        assert_eq!(LayeredModel::of(&names(&LayerKind::for_role(ObjectRole::Reflective))), Some(LayeredModel::Environment));
-        assert_eq!(LayeredModel::of(&names(&LayerKind::for_role(ObjectRole::Refractive))), Some(LayeredModel::TwoPath));
+        assert_eq!(
+            LayeredModel::of(&names(&LayerKind::for_role(ObjectRole::Reflective))),
+            Some(LayeredModel::Environment)
+        );
+        assert_eq!(
+            LayeredModel::of(&names(&LayerKind::for_role(ObjectRole::Refractive))),
+            Some(LayeredModel::TwoPath)
+        );
         assert_eq!(LayeredModel::of(&names(&LayerKind::for_role(ObjectRole::Diffuse))), None);
     }
 
@@ -284,7 +387,10 @@ mod tests {
         // 0.1 + 0.5 · (0.25 + 0.75 · 0.4); the fully covering local layer hides the distant one.
         let m = LayeredModel::Environment.compose(&im, "m", "G").expect("all layers");
         assert!((m[0] - 0.375).abs() < 1e-6 && (m[1] - 1.0).abs() < 1e-6, "{m:?}");
-        assert_eq!(LayeredModel::TwoPath.compose(&im, "g", "B").expect("all layers"), vec![0.9, 0.45]);
+        assert_eq!(
+            LayeredModel::TwoPath.compose(&im, "g", "B").expect("all layers"),
+            vec![0.9, 0.45]
+        );
         assert!(LayeredModel::TwoPath.compose(&im, "m", "R").is_none(), "no reflection layer");
     }
 }

@@ -67,7 +67,12 @@ impl ChunkBytes {
 struct Lines(Vec<String>);
 
 impl Lines {
-    fn check<T: PartialEq + std::fmt::Debug>(&mut self, what: impl FnOnce() -> String, a: &T, b: &T) {
+    fn check<T: PartialEq + std::fmt::Debug>(
+        &mut self,
+        what: impl FnOnce() -> String,
+        a: &T,
+        b: &T,
+    ) {
         if a != b {
             self.0.push(format!("{}: {a:?} → {b:?}", what()));
         }
@@ -106,15 +111,25 @@ pub fn differences(a: &Container<StreamRef>, b: &Container<StreamRef>) -> Vec<St
         d.check(|| format!("{} unit", n()), &x.unit, &y.unit);
     }
     // Cameras.
-    d.check(|| "image size".into(), &(a.cameras.width, a.cameras.height), &(b.cameras.width, b.cameras.height));
-    d.check(|| "cameras vary with".into(), &dim_names(&a.space, a.cameras.depends_on), &dim_names(&b.space, b.cameras.depends_on));
+    d.check(
+        || "image size".into(),
+        &(a.cameras.width, a.cameras.height),
+        &(b.cameras.width, b.cameras.height),
+    );
+    d.check(
+        || "cameras vary with".into(),
+        &dim_names(&a.space, a.cameras.depends_on),
+        &dim_names(&b.space, b.cameras.depends_on),
+    );
     d.check(|| "camera count".into(), &a.cameras.cameras.len(), &b.cameras.cameras.len());
-    if a.cameras.cameras.len() == b.cameras.cameras.len() && a.cameras.cameras != b.cameras.cameras {
+    if a.cameras.cameras.len() == b.cameras.cameras.len() && a.cameras.cameras != b.cameras.cameras
+    {
         let n = a.cameras.cameras.iter().zip(&b.cameras.cameras).filter(|(x, y)| x != y).count();
         d.0.push(format!("cameras: {n} of {} differ", a.cameras.cameras.len()));
     }
     // Objects.
-    let names = |c: &Container<StreamRef>| c.objects.iter().map(|o| o.name.clone()).collect::<Vec<_>>();
+    let names =
+        |c: &Container<StreamRef>| c.objects.iter().map(|o| o.name.clone()).collect::<Vec<_>>();
     for o in &a.objects {
         if !b.objects.iter().any(|p| p.name == o.name) {
             d.0.push(format!("object '{}' only in the first file", o.name));
@@ -150,7 +165,12 @@ pub fn differences(a: &Container<StreamRef>, b: &Container<StreamRef>) -> Vec<St
         }
         d.check(|| format!("{} layer count", n()), &x.layers.len(), &y.layers.len());
         for (li, (p, q)) in x.layers.iter().zip(&y.layers).enumerate() {
-            layer_differences(&mut d, &format!("{} layer {li} ({})", n(), p.kind.name()), (&a.space, p), (&b.space, q));
+            layer_differences(
+                &mut d,
+                &format!("{} layer {li} ({})", n(), p.kind.name()),
+                (&a.space, p),
+                (&b.space, q),
+            );
         }
     }
     // Provenance.
@@ -181,7 +201,12 @@ pub fn differences(a: &Container<StreamRef>, b: &Container<StreamRef>) -> Vec<St
     d.0
 }
 
-fn layer_differences(d: &mut Lines, n: &str, (sa, p): (&ParameterSpace, &Layer<StreamRef>), (sb, q): (&ParameterSpace, &Layer<StreamRef>)) {
+fn layer_differences(
+    d: &mut Lines,
+    n: &str,
+    (sa, p): (&ParameterSpace, &Layer<StreamRef>),
+    (sb, q): (&ParameterSpace, &Layer<StreamRef>),
+) {
     d.check(|| format!("{n} kind"), &p.kind.name(), &q.kind.name());
     d.check(|| format!("{n} mapping"), &p.mapping.name(), &q.mapping.name());
     d.check(|| format!("{n} term"), &p.term.name(), &q.term.name());
@@ -190,7 +215,11 @@ fn layer_differences(d: &mut Lines, n: &str, (sa, p): (&ParameterSpace, &Layer<S
     d.check(|| format!("{n} channels"), &p.channels, &q.channels);
     d.check(|| format!("{n} mip mode"), &p.mip_mode.name(), &q.mip_mode.name());
     d.check(|| format!("{n} gamma"), &p.gamma, &q.gamma);
-    d.check(|| format!("{n} varies with"), &dim_names(sa, p.depends_on), &dim_names(sb, q.depends_on));
+    d.check(
+        || format!("{n} varies with"),
+        &dim_names(sa, p.depends_on),
+        &dim_names(sb, q.depends_on),
+    );
     d.check(|| format!("{n} codecs"), &layer_codecs(p), &layer_codecs(q));
     d.check(|| format!("{n} block count"), &p.blocks.len(), &q.blocks.len());
     let (mut size, mut place, mut shells, mut pyramids) = (0, 0, 0, 0);
@@ -202,20 +231,29 @@ fn layer_differences(d: &mut Lines, n: &str, (sa, p): (&ParameterSpace, &Layer<S
         };
         shells += usize::from(shape(x) != shape(y));
         place += usize::from(x.placement != y.placement && shape(x) == shape(y));
-        let counts = |b: &Block<StreamRef>| b.levels.iter().map(|l| l.counts.clone()).collect::<Vec<_>>();
+        let counts =
+            |b: &Block<StreamRef>| b.levels.iter().map(|l| l.counts.clone()).collect::<Vec<_>>();
         pyramids += usize::from(counts(x) != counts(y));
     }
     let m = p.blocks.len().min(q.blocks.len());
     if size > 0 {
         let dims = |b: Option<&Block<StreamRef>>| b.map(|b| (b.width, b.height));
-        d.0.push(format!("{n}: texture size differs in {size} of {m} blocks ({:?} → {:?} in the first block)", dims(p.blocks.first()), dims(q.blocks.first())));
+        d.0.push(format!(
+            "{n}: texture size differs in {size} of {m} blocks ({:?} → {:?} in the first block)",
+            dims(p.blocks.first()),
+            dims(q.blocks.first())
+        ));
     }
     if shells > 0 {
         let shape = |b: Option<&Block<StreamRef>>| match b.map(|b| b.placement) {
             Some(Placement::Shell { shape, .. }) => shape.name(),
             _ => "surface",
         };
-        d.0.push(format!("{n}: shell shape differs in {shells} of {m} blocks ({} → {})", shape(p.blocks.first()), shape(q.blocks.first())));
+        d.0.push(format!(
+            "{n}: shell shape differs in {shells} of {m} blocks ({} → {})",
+            shape(p.blocks.first()),
+            shape(q.blocks.first())
+        ));
     }
     if place > 0 {
         d.0.push(format!("{n}: placement differs in {place} of {m} blocks"));

@@ -23,7 +23,8 @@ fn projection(c: &Camera, width: u32, height: u32) -> Mat4 {
     let aspect = width.max(1) as f32 / height.max(1) as f32;
     let f = 1.0 / (c.yfov * 0.5).tan();
     let (n, far) = (c.znear, c.zfar);
-    let (c2z, c3z) = if far.is_finite() { (far / (n - far), n * far / (n - far)) } else { (-1.0, -n) };
+    let (c2z, c3z) =
+        if far.is_finite() { (far / (n - far), n * far / (n - far)) } else { (-1.0, -n) };
     Mat4::from_cols(
         Vec4::new(f / aspect, 0.0, 0.0, 0.0),
         Vec4::new(0.0, f, 0.0, 0.0),
@@ -37,24 +38,50 @@ fn projection(c: &Camera, width: u32, height: u32) -> Mat4 {
 pub fn screen_areas(c: &Container<StreamRef>) -> Vec<f64> {
     let vp = Viewport { width: c.cameras.width, height: c.cameras.height };
     let points = c.space.point_count();
-    let uvs: Vec<Vec<[f32; 2]>> = c.objects.iter().map(|o| o.mesh.texcoords.clone().unwrap_or_else(|| vec![[0.0; 2]; o.mesh.positions.len()])).collect();
-    let totals = (0..points).into_par_iter().map(|p| {
-        let point = c.space.point(p);
-        let cam = &c.cameras.cameras[c.space.table_index(c.cameras.depends_on, &point)];
-        let clip_from_world = projection(cam, vp.width, vp.height) * mat4(&cam.world_from_camera).inverse();
-        let meshes: Vec<DrawMesh> = c.objects.iter().zip(&uvs).map(|(o, uv)| {
-            let t = &o.transforms;
-            DrawMesh {
-                positions: &o.mesh.positions,
-                uvs: uv,
-                indices: &o.mesh.indices,
-                clip_from_object: clip_from_world * mat4(&t.transforms[c.space.table_index(t.depends_on, &point)]),
-            }
-        }).collect();
-        (0..meshes.len()).map(|o| match scene_depth(vp, &meshes, Some(o)) {
-            Ok(depth) => Fragments::rasterize(&meshes[o], &TextureTransform::IDENTITY, vp, Some(&depth)).pixels().len() as f64,
-            Err(_) => 0.0,
-        }).collect::<Vec<f64>>()
-    }).reduce(|| vec![0.0; c.objects.len()], |a, b| a.iter().zip(&b).map(|(x, y)| x + y).collect());
+    let uvs: Vec<Vec<[f32; 2]>> = c
+        .objects
+        .iter()
+        .map(|o| o.mesh.texcoords.clone().unwrap_or_else(|| vec![[0.0; 2]; o.mesh.positions.len()]))
+        .collect();
+    let totals = (0..points)
+        .into_par_iter()
+        .map(|p| {
+            let point = c.space.point(p);
+            let cam = &c.cameras.cameras[c.space.table_index(c.cameras.depends_on, &point)];
+            let clip_from_world =
+                projection(cam, vp.width, vp.height) * mat4(&cam.world_from_camera).inverse();
+            let meshes: Vec<DrawMesh> = c
+                .objects
+                .iter()
+                .zip(&uvs)
+                .map(|(o, uv)| {
+                    let t = &o.transforms;
+                    DrawMesh {
+                        positions: &o.mesh.positions,
+                        uvs: uv,
+                        indices: &o.mesh.indices,
+                        clip_from_object: clip_from_world
+                            * mat4(&t.transforms[c.space.table_index(t.depends_on, &point)]),
+                    }
+                })
+                .collect();
+            (0..meshes.len())
+                .map(|o| match scene_depth(vp, &meshes, Some(o)) {
+                    Ok(depth) => Fragments::rasterize(
+                        &meshes[o],
+                        &TextureTransform::IDENTITY,
+                        vp,
+                        Some(&depth),
+                    )
+                    .pixels()
+                    .len() as f64,
+                    Err(_) => 0.0,
+                })
+                .collect::<Vec<f64>>()
+        })
+        .reduce(
+            || vec![0.0; c.objects.len()],
+            |a, b| a.iter().zip(&b).map(|(x, y)| x + y).collect(),
+        );
     totals.iter().map(|t| (t / points.max(1) as f64).max(1.0)).collect()
 }

@@ -32,9 +32,17 @@ pub fn block_sizes(block: &[u32], dims: usize) -> Result<Vec<u32>> {
 /// samples into two blocks, each coding its own top level, and add a decode on the way
 /// across.
 pub fn stagger(i: usize, n: usize, sizes: &[u32], samples: &[usize], mode: Stagger) -> Vec<u32> {
-    sizes.iter().zip(samples).map(|(&b, &k)| {
-        if mode == Stagger::Auto && k <= b as usize { 0 } else { (i as u64 * b as u64 / n.max(1) as u64) as u32 }
-    }).collect()
+    sizes
+        .iter()
+        .zip(samples)
+        .map(|(&b, &k)| {
+            if mode == Stagger::Auto && k <= b as usize {
+                0
+            } else {
+                (i as u64 * b as u64 / n.max(1) as u64) as u32
+            }
+        })
+        .collect()
 }
 
 /// The samples along each dimension of the set's parameter space ([`stagger`]'s `samples`).
@@ -46,16 +54,26 @@ pub fn samples_per_dimension(set: &LoadedSet) -> Vec<usize> {
 pub fn geometry(set: &LoadedSet, sizes: &[u32]) -> (ParameterSpace, CameraTable) {
     let scene = &set.scene;
     let space = ParameterSpace {
-        dims: scene.space.dims.iter().zip(sizes).map(|(d, &b)| Dimension {
-            name: d.name.clone(),
-            kind: d.kind,
-            periodic: d.periodic,
-            unit: d.unit.clone(),
-            block_size: b,
-            values: d.values.clone(),
-        }).collect(),
+        dims: scene
+            .space
+            .dims
+            .iter()
+            .zip(sizes)
+            .map(|(d, &b)| Dimension {
+                name: d.name.clone(),
+                kind: d.kind,
+                periodic: d.periodic,
+                unit: d.unit.clone(),
+                block_size: b,
+                values: d.values.clone(),
+            })
+            .collect(),
     };
-    let view = DepMask::of(&(0..space.dims.len()).filter(|&k| space.dims[k].kind == DimensionKind::View).collect::<Vec<_>>());
+    let view = DepMask::of(
+        &(0..space.dims.len())
+            .filter(|&k| space.dims[k].kind == DimensionKind::View)
+            .collect::<Vec<_>>(),
+    );
     let mut cameras = vec![None; space.table_len(view) as usize];
     for (s, f) in set.samples.iter().zip(&set.frames) {
         let c = f.camera;
@@ -70,7 +88,17 @@ pub fn geometry(set: &LoadedSet, sizes: &[u32]) -> (ParameterSpace, CameraTable)
         width: set.resolution.0,
         height: set.resolution.1,
         depends_on: view,
-        cameras: cameras.into_iter().map(|c| c.unwrap_or(Camera { world_from_camera: IDENTITY_3X4, yfov: 0.8, znear: 0.1, zfar: 100.0 })).collect(),
+        cameras: cameras
+            .into_iter()
+            .map(|c| {
+                c.unwrap_or(Camera {
+                    world_from_camera: IDENTITY_3X4,
+                    yfov: 0.8,
+                    znear: 0.1,
+                    zfar: 100.0,
+                })
+            })
+            .collect(),
     };
     (space, cameras)
 }
@@ -118,7 +146,10 @@ pub fn check_transforms(scene: &pis_scene::Scene, frames: &[pis_scene::Frame]) -
     for (o, object) in scene.objects.iter().enumerate() {
         let bake = baked(frames, o);
         if bake.is_some_and(|b| !b.is_finite() || b.determinant().abs() < 1e-12) {
-            return Err(anyhow!("object {}: its transform at the first point is singular or not finite", object.name));
+            return Err(anyhow!(
+                "object {}: its transform at the first point is singular or not finite",
+                object.name
+            ));
         }
         for (p, f) in frames.iter().enumerate() {
             let m = row3x4(stored_transform(f, o, bake));
@@ -132,7 +163,6 @@ pub fn check_transforms(scene: &pis_scene::Scene, frames: &[pis_scene::Frame]) -
     }
     Ok(())
 }
-
 
 #[cfg(test)]
 mod tests {

@@ -15,10 +15,10 @@
 use anyhow::anyhow;
 
 use super::encode::{encode_all, Packed};
-use super::predict::{predicted_psnr, Quality};
 use super::infer_layers::Inferred;
 use super::input::LoadedSet;
 use super::model::ObjectModel;
+use super::predict::{predicted_psnr, Quality};
 use super::{PackRequest, Stages};
 use crate::error::{Exit, Failure};
 
@@ -60,10 +60,15 @@ fn label(m: &ObjectModel) -> String {
     }
 }
 
-fn encoded(set: &LoadedSet, models: &[ObjectModel], req: &PackRequest) -> Result<(Packed, Quality, Outcome), Failure> {
+fn encoded(
+    set: &LoadedSet,
+    models: &[ObjectModel],
+    req: &PackRequest,
+) -> Result<(Packed, Quality, Outcome), Failure> {
     let mut stages = Stages::quiet();
     let packed = encode_all(set, models, req, &mut stages)?;
-    let quality = predicted_psnr(set, models, &packed).map_err(|e| Failure::new(Exit::Runtime, e))?;
+    let quality =
+        predicted_psnr(set, models, &packed).map_err(|e| Failure::new(Exit::Runtime, e))?;
     let bytes = packed.layer_bytes.iter().flatten().sum();
     let outcome = Outcome { bytes, psnr_db: quality.overall };
     Ok((packed, quality, outcome))
@@ -71,7 +76,12 @@ fn encoded(set: &LoadedSet, models: &[ObjectModel], req: &PackRequest) -> Result
 
 /// The models chosen from `inferred` for `req`, each alternative's decision added to its
 /// object's `why`; with alternatives, also the chosen file as encoded and predicted.
-pub fn choose(set: &LoadedSet, inferred: Inferred, req: &PackRequest, stages: &mut Stages) -> Result<(Vec<ObjectModel>, Option<(Packed, Quality)>), Failure> {
+pub fn choose(
+    set: &LoadedSet,
+    inferred: Inferred,
+    req: &PackRequest,
+    stages: &mut Stages,
+) -> Result<(Vec<ObjectModel>, Option<(Packed, Quality)>), Failure> {
     let Inferred { mut models, alternatives } = inferred;
     if alternatives.is_empty() {
         return Ok((models, None));
@@ -86,7 +96,10 @@ pub fn choose(set: &LoadedSet, inferred: Inferred, req: &PackRequest, stages: &m
     let mut kept = 0;
     for (mi, mut alt) in alternatives {
         if mi >= models.len() {
-            return Err(Failure::new(Exit::Runtime, anyhow!("an alternative names object model {mi} of {}", models.len())));
+            return Err(Failure::new(
+                Exit::Runtime,
+                anyhow!("an alternative names object model {mi} of {}", models.len()),
+            ));
         }
         std::mem::swap(&mut models[mi], &mut alt);
         let (first, second) = (label(&alt), label(&models[mi]));
@@ -94,14 +107,22 @@ pub fn choose(set: &LoadedSet, inferred: Inferred, req: &PackRequest, stages: &m
         let said = |o: Outcome| format!("{:.2} dB with {} bytes", o.psnr_db, o.bytes);
         let why = match trial {
             Ok((p, q, o)) if better(o, current, target) => {
-                let why = format!("auto: {second}, the file {} {budget} against {} as {first}", said(o), said(current));
+                let why = format!(
+                    "auto: {second}, the file {} {budget} against {} as {first}",
+                    said(o),
+                    said(current)
+                );
                 (packed, quality, current) = (p, q, o);
                 kept += 1;
                 why
             }
             Ok((_, _, o)) => {
                 std::mem::swap(&mut models[mi], &mut alt);
-                format!("auto: {first}, the file {} {budget} against {} as {second}", said(current), said(o))
+                format!(
+                    "auto: {first}, the file {} {budget} against {} as {second}",
+                    said(current),
+                    said(o)
+                )
             }
             Err(e) => {
                 std::mem::swap(&mut models[mi], &mut alt);
@@ -112,7 +133,10 @@ pub fn choose(set: &LoadedSet, inferred: Inferred, req: &PackRequest, stages: &m
         m.why = format!("{}; {why}", m.why);
         stages.note(&format!("object {}: {why}", m.name));
     }
-    stages.done("choose", &format!("{kept} object(s) in their alternative representation, by whole-file encodes"));
+    stages.done(
+        "choose",
+        &format!("{kept} object(s) in their alternative representation, by whole-file encodes"),
+    );
     Ok((models, Some((packed, quality))))
 }
 
@@ -127,7 +151,10 @@ mod tests {
     #[test]
     fn under_a_budget_the_higher_psnr_wins_by_a_margin() {
         assert!(better(o(1000, 25.0), o(1000, 24.0), None));
-        assert!(!better(o(900, 24.02), o(1000, 24.0), None), "within the margin the first representation stays");
+        assert!(
+            !better(o(900, 24.02), o(1000, 24.0), None),
+            "within the margin the first representation stays"
+        );
         assert!(!better(o(1000, 23.0), o(500, 24.0), None));
     }
 

@@ -13,14 +13,14 @@ use pis_format::blocks::BlockGrid;
 use pis_format::reconstruct::prepare;
 use pis_format::*;
 
-use super::model::{key, ObjectModel};
-use super::input::LoadedSet;
 use super::blocks::{block_sizes, geometry, stagger, transforms};
-use super::shading::object_shading;
-use super::stored_mesh::stored_mesh;
-use super::storage::{allocate_storage, build_pyramid, level_streams, BlockPyramid, CodedLevel};
-pub use super::surface::{finest, mip_chain};
+use super::input::LoadedSet;
+use super::model::{key, ObjectModel};
 use super::predict::{predicted_psnr, solved_error, Quality};
+use super::shading::object_shading;
+use super::storage::{allocate_storage, build_pyramid, level_streams, BlockPyramid, CodedLevel};
+use super::stored_mesh::stored_mesh;
+pub use super::surface::{finest, mip_chain};
 use super::{PackRequest, Stages};
 use crate::error::{Exit, Failure};
 
@@ -114,7 +114,12 @@ fn sample_weights(per_point: &[Vec<f64>]) -> Vec<f32> {
 /// The screen weights of sample `k` of layer `li` of `m`: [`sample_weights`] over `points`,
 /// the points that read it, through the render matrices of its placement. Made as each
 /// block's pyramid is built, so that a pack holds the weights of one block at a time.
-fn sample_screen_weights(m: &ObjectModel, li: usize, k: &[u32], points: &[usize]) -> Result<Vec<f32>> {
+fn sample_screen_weights(
+    m: &ObjectModel,
+    li: usize,
+    k: &[u32],
+    points: &[usize],
+) -> Result<Vec<f32>> {
     let il = &m.layers[li];
     Ok(if points.is_empty() {
         vec![0.0; il.form.stored_texels(k)]
@@ -124,7 +129,12 @@ fn sample_screen_weights(m: &ObjectModel, li: usize, k: &[u32], points: &[usize]
         shell_weights(m, s, li, k, points)
     } else {
         let pid = il.placement_of[k];
-        sample_weights(&points.iter().map(|&p| Ok(screen_weights_at(m.views.get(p)?.a(pid)))).collect::<Result<Vec<_>>>()?)
+        sample_weights(
+            &points
+                .iter()
+                .map(|&p| Ok(screen_weights_at(m.views.get(p)?.a(pid))))
+                .collect::<Result<Vec<_>>>()?,
+        )
     })
 }
 
@@ -153,9 +163,15 @@ fn shell_weights(m: &ObjectModel, s: usize, li: usize, k: &[u32], points: &[usiz
 }
 
 /// Builds pyramids, allocates storage, encodes, and assembles the container.
-pub fn encode_all(set: &LoadedSet, models: &[ObjectModel], req: &PackRequest, stages: &mut Stages) -> Result<Packed, Failure> {
+pub fn encode_all(
+    set: &LoadedSet,
+    models: &[ObjectModel],
+    req: &PackRequest,
+    stages: &mut Stages,
+) -> Result<Packed, Failure> {
     let runtime = |e: anyhow::Error| Failure::new(Exit::Runtime, e);
-    let sizes = block_sizes(req.block.as_slice(), set.scene.space.dims.len()).map_err(|e| Failure::new(Exit::Usage, e))?;
+    let sizes = block_sizes(req.block.as_slice(), set.scene.space.dims.len())
+        .map_err(|e| Failure::new(Exit::Usage, e))?;
     let samples = super::blocks::samples_per_dimension(set);
     let (space, cameras) = geometry(set, &sizes);
     if pis_codec::codec(req.codec).is_none() {
@@ -178,7 +194,8 @@ pub fn encode_all(set: &LoadedSet, models: &[ObjectModel], req: &PackRequest, st
         }
         // The weights go to the pyramids; the master (`--keep-master`) keeps a copy.
         let screen = req.allocation == super::Allocation::Screen;
-        let mut master_by_layer: Vec<BTreeMap<Vec<u32>, Vec<f32>>> = m.layers.iter().map(|_| BTreeMap::new()).collect();
+        let mut master_by_layer: Vec<BTreeMap<Vec<u32>, Vec<f32>>> =
+            m.layers.iter().map(|_| BTreeMap::new()).collect();
         let mut layers = Vec::new();
         let mut layer_blocks = Vec::new();
         for (li, il) in m.layers.iter().enumerate() {
@@ -214,7 +231,11 @@ pub fn encode_all(set: &LoadedSet, models: &[ObjectModel], req: &PackRequest, st
                         continue;
                     }
                     let x = il.textures.get(k).map_err(runtime)?;
-                    let idx = pos.local.iter().zip(&pos.extent).fold(0usize, |a, (&l, &e)| a * e as usize + l as usize);
+                    let idx = pos
+                        .local
+                        .iter()
+                        .zip(&pos.extent)
+                        .fold(0usize, |a, (&l, &e)| a * e as usize + l as usize);
                     keys[idx] = k.clone();
                     samples[idx] = prepare(&layer, &layout, &il.form.stored(k, &x));
                     if screen {
@@ -227,9 +248,22 @@ pub fn encode_all(set: &LoadedSet, models: &[ObjectModel], req: &PackRequest, st
                     }
                 }
                 if samples.iter().any(Vec::is_empty) {
-                    return Err(runtime(anyhow!("object {} layer {} block {b}: a sample has no texture", m.name, il.kind.name())));
+                    return Err(runtime(anyhow!(
+                        "object {} layer {} block {b}: a sample has no texture",
+                        m.name,
+                        il.kind.name()
+                    )));
                 }
-                let mut pyramid = build_pyramid(mi, planes, &extent, &samples, layer_samples, !req.codec.is_lossy(), req.pyramid == super::PyramidMode::Full).map_err(runtime)?;
+                let mut pyramid = build_pyramid(
+                    mi,
+                    planes,
+                    &extent,
+                    &samples,
+                    layer_samples,
+                    !req.codec.is_lossy(),
+                    req.pyramid == super::PyramidMode::Full,
+                )
+                .map_err(runtime)?;
                 // The level images hold the samples from here on.
                 drop(samples);
                 if weighed {
@@ -272,10 +306,13 @@ pub fn encode_all(set: &LoadedSet, models: &[ObjectModel], req: &PackRequest, st
         ("block".to_string(), sizes.iter().map(u32::to_string).collect::<Vec<_>>().join("x")),
         ("matrix".to_string(), req.matrix.name().to_string()),
         ("gamma".to_string(), req.gamma.to_string()),
-        ("target".to_string(), match (req.ratio, req.psnr) {
-            (_, Some(p)) => format!("psnr {p} dB"),
-            (r, None) => format!("ratio {}", r.unwrap_or(super::DEFAULT_RATIO)),
-        }),
+        (
+            "target".to_string(),
+            match (req.ratio, req.psnr) {
+                (_, Some(p)) => format!("psnr {p} dB"),
+                (r, None) => format!("ratio {}", r.unwrap_or(super::DEFAULT_RATIO)),
+            },
+        ),
     ];
     let mut settings = settings;
     settings.splice(2..2, file_filter(req.filter).settings());
@@ -322,10 +359,17 @@ pub fn encode_all(set: &LoadedSet, models: &[ObjectModel], req: &PackRequest, st
             for (b, block) in layer.blocks.iter_mut().enumerate() {
                 // Blocks come in the order their pyramids were built.
                 debug_assert_eq!(where_[next], (o, l, b));
-                block.levels = pyramids[next].levels.iter().map(|(c, imgs, _)| Level {
-                    counts: c.clone(),
-                    images: imgs.iter().map(|_| Codestream { codec: req.codec, bytes: vec![] }).collect(),
-                }).collect();
+                block.levels = pyramids[next]
+                    .levels
+                    .iter()
+                    .map(|(c, imgs, _)| Level {
+                        counts: c.clone(),
+                        images: imgs
+                            .iter()
+                            .map(|_| Codestream { codec: req.codec, bytes: vec![] })
+                            .collect(),
+                    })
+                    .collect();
                 next += 1;
             }
         }
@@ -339,13 +383,26 @@ pub fn encode_all(set: &LoadedSet, models: &[ObjectModel], req: &PackRequest, st
         (r, None) => Target::Bytes((raw as f64 / r.unwrap_or(super::DEFAULT_RATIO)) as usize),
     };
     let areas: Vec<f64> = models.iter().map(|m| m.area).collect();
-    let storage = allocate_storage(&pyramids, req.codec, target, &areas, req.max_mse).map_err(|e| target_failure(e, raw))?;
+    let storage = allocate_storage(&pyramids, req.codec, target, &areas, req.max_mse)
+        .map_err(|e| target_failure(e, raw))?;
     if let Some(total) = storage.allocated {
-        stages.done("allocate", &format!("{total} bytes over {} level images", storage.level_images));
+        stages
+            .done("allocate", &format!("{total} bytes over {} level images", storage.level_images));
     }
     // Per object, its solved textures drawn and measured, then dropped.
-    let solved_error = models.iter().map(|m| solved_error(set, m)).collect::<Result<Vec<_>>>().map_err(runtime)?;
-    let packed = Packed { container, blocks: blocks_out, overhead, layer_bytes: Vec::new(), stagger: staggers, screen_weights, solved_error, max_mse: None, quality: None };
+    let solved_error =
+        models.iter().map(|m| solved_error(set, m)).collect::<Result<Vec<_>>>().map_err(runtime)?;
+    let packed = Packed {
+        container,
+        blocks: blocks_out,
+        overhead,
+        layer_bytes: Vec::new(),
+        stagger: staggers,
+        screen_weights,
+        solved_error,
+        max_mse: None,
+        quality: None,
+    };
     let Some((free_rates, free_bytes)) = &storage.free else {
         let mut packed = emit(packed, &pyramids, &where_, models, req.codec, &storage.rates)?;
         drop(pyramids);
@@ -361,12 +418,20 @@ pub fn encode_all(set: &LoadedSet, models: &[ObjectModel], req: &PackRequest, st
     let with = emit(packed.clone(), &pyramids, &where_, models, req.codec, &storage.rates)?;
     let without = emit(packed, &pyramids, &where_, models, req.codec, free_rates)?;
     drop(pyramids);
-    let (q_with, q_without) = (predicted_psnr(set, models, &with).map_err(runtime)?, predicted_psnr(set, models, &without).map_err(runtime)?);
+    let (q_with, q_without) = (
+        predicted_psnr(set, models, &with).map_err(runtime)?,
+        predicted_psnr(set, models, &without).map_err(runtime)?,
+    );
     let (db_with, db_without) = (q_with.overall, q_without.overall);
     let keep = db_with >= db_without;
     let (mut packed, quality) = if keep { (with, q_with) } else { (without, q_without) };
     packed.quality = Some(quality);
-    packed.max_mse = Some(MaxMseChoice { alpha, constrained: keep, psnr_db_constrained: db_with, psnr_db_free: db_without });
+    packed.max_mse = Some(MaxMseChoice {
+        alpha,
+        constrained: keep,
+        psnr_db_constrained: db_with,
+        psnr_db_free: db_without,
+    });
     record_max_mse(&mut packed, keep.then_some(alpha));
     stages.done("encode", &format!(
         "{level_images} level images with {}, twice: the max-MSE constraint (alpha {alpha}) predicts {db_with:.2} dB, the free allocation ({free_bytes} bytes) {db_without:.2} dB: {} kept",
@@ -378,14 +443,25 @@ pub fn encode_all(set: &LoadedSet, models: &[ObjectModel], req: &PackRequest, st
 /// Provenance: the max-MSE constraint the allocation applied (`off`, or its α).
 fn record_max_mse(packed: &mut Packed, alpha: Option<f64>) {
     if let Some(p) = packed.container.provenance.as_mut() {
-        p.settings.push(("max_mse_ratio".to_string(), alpha.map_or_else(|| "off".to_string(), |a| a.to_string())));
+        p.settings.push((
+            "max_mse_ratio".to_string(),
+            alpha.map_or_else(|| "off".to_string(), |a| a.to_string()),
+        ));
     }
 }
 
 /// The codestreams of `pyramids` at `rates`, put into `packed`'s container and blocks (with
 /// the level images as encoded where the codec is exact, which [`check_lossless`] reads).
-fn emit(mut packed: Packed, pyramids: &[BlockPyramid], where_: &[(usize, usize, usize)], models: &[ObjectModel], codec: CodecId, rates: &[pis_codec::Rate]) -> Result<Packed, Failure> {
-    let streams = level_streams(pyramids, codec, rates).map_err(|e| Failure::new(Exit::Runtime, e))?;
+fn emit(
+    mut packed: Packed,
+    pyramids: &[BlockPyramid],
+    where_: &[(usize, usize, usize)],
+    models: &[ObjectModel],
+    codec: CodecId,
+    rates: &[pis_codec::Rate],
+) -> Result<Packed, Failure> {
+    let streams =
+        level_streams(pyramids, codec, rates).map_err(|e| Failure::new(Exit::Runtime, e))?;
     let mut layer_bytes: Vec<Vec<usize>> = models.iter().map(|m| vec![0; m.layers.len()]).collect();
     for ((mi, li, b), (pyramid, streams)) in where_.iter().zip(pyramids.iter().zip(streams)) {
         let block = &mut packed.container.objects[*mi].layers[*li].blocks[*b];
@@ -395,10 +471,20 @@ fn emit(mut packed: Packed, pyramids: &[BlockPyramid], where_: &[(usize, usize, 
                 image.bytes = bytes.clone();
             }
         }
-        let images = if codec.is_lossy() { None } else { Some(pyramid.level_images().map_err(|e| Failure::new(Exit::Runtime, e))?) };
-        packed.blocks[*mi][*li][*b].levels = pyramid.levels.iter().zip(streams).enumerate().map(|(lv, ((counts, _, _), streams))| {
-            (counts.clone(), images.as_ref().map_or_else(Vec::new, |i| i[lv].to_vec()), streams)
-        }).collect();
+        let images = if codec.is_lossy() {
+            None
+        } else {
+            Some(pyramid.level_images().map_err(|e| Failure::new(Exit::Runtime, e))?)
+        };
+        packed.blocks[*mi][*li][*b].levels = pyramid
+            .levels
+            .iter()
+            .zip(streams)
+            .enumerate()
+            .map(|(lv, ((counts, _, _), streams))| {
+                (counts.clone(), images.as_ref().map_or_else(Vec::new, |i| i[lv].to_vec()), streams)
+            })
+            .collect();
     }
     packed.layer_bytes = layer_bytes;
     Ok(packed)
@@ -407,19 +493,28 @@ fn emit(mut packed: Packed, pyramids: &[BlockPyramid], where_: &[(usize, usize, 
 /// The lossless master of every object (SPEC.md 6.7): each layer sample's finest solved
 /// texture, linear as solved, and the object's screen-area weight of allocation.
 pub fn masters(models: &[ObjectModel], packed: &Packed) -> Result<Vec<Master>> {
-    models.iter().enumerate().map(|(mi, m)| {
-        // Keys are sample indices over the layer's dimensions: their order is table order.
-        let textures: Vec<Vec<Vec<f32>>> = m.layers.iter().map(|l| l.textures.iter().map(|r| r.map(|(k, x)| l.form.stored(k, &x))).collect()).collect::<Result<_>>()?;
-        // The screen weights the allocation used, so that coding the master again allocates
-        // as this pack did.
-        let by_layer = &packed.screen_weights[mi];
-        // SPEC.md 6.7's screen weights are one surface plane per sample: an object with
-        // shells keeps none in its master.
-        let surfaces = m.layers.iter().all(|l| l.shell.is_none());
-        let weights: Option<Vec<Vec<Vec<f32>>>> = (surfaces && by_layer.iter().all(|w| !w.is_empty()))
+    models
+        .iter()
+        .enumerate()
+        .map(|(mi, m)| {
+            // Keys are sample indices over the layer's dimensions: their order is table order.
+            let textures: Vec<Vec<Vec<f32>>> = m
+                .layers
+                .iter()
+                .map(|l| l.textures.iter().map(|r| r.map(|(k, x)| l.form.stored(k, &x))).collect())
+                .collect::<Result<_>>()?;
+            // The screen weights the allocation used, so that coding the master again allocates
+            // as this pack did.
+            let by_layer = &packed.screen_weights[mi];
+            // SPEC.md 6.7's screen weights are one surface plane per sample: an object with
+            // shells keeps none in its master.
+            let surfaces = m.layers.iter().all(|l| l.shell.is_none());
+            let weights: Option<Vec<Vec<Vec<f32>>>> = (surfaces
+                && by_layer.iter().all(|w| !w.is_empty()))
             .then(|| by_layer.iter().map(|w| w.values().cloned().collect()).collect());
-        Ok(Master::encode(&packed.container, mi, m.area, &textures, weights.as_deref())?)
-    }).collect()
+            Ok(Master::encode(&packed.container, mi, m.area, &textures, weights.as_deref())?)
+        })
+        .collect()
 }
 
 /// Reads the written file's master back; returns its bytes and whether every texture decodes
@@ -435,7 +530,8 @@ pub fn check_master(path: &Path, models: &[ObjectModel]) -> Result<(u64, bool)> 
                 let (k, x) = r?;
                 let got = m.texture(c, li, s)?;
                 let want = l.form.stored(k, &x);
-                exact &= got.len() == want.len() && got.iter().zip(&want).all(|(a, b)| a.to_bits() == b.to_bits());
+                exact &= got.len() == want.len()
+                    && got.iter().zip(&want).all(|(a, b)| a.to_bits() == b.to_bits());
             }
         }
     }
@@ -456,7 +552,9 @@ pub fn check_lossless(path: &Path, packed: &Packed) -> Result<bool> {
                         let bytes = reader.codestream(r)?;
                         let got = pis_codec::decode(r.codec, &planes, &bytes)?;
                         let want = &packed.blocks[mi][li][b].levels[lv].1[ii];
-                        if got.len() != want.len() || got.iter().zip(want).any(|(a, b)| a.to_bits() != b.to_bits()) {
+                        if got.len() != want.len()
+                            || got.iter().zip(want).any(|(a, b)| a.to_bits() != b.to_bits())
+                        {
                             return Ok(false);
                         }
                     }
@@ -483,7 +581,8 @@ mod tests {
 
     #[test]
     fn sample_weights_sum_the_points_that_read_a_sample_scaled_to_mean_one() {
-        let per_point = vec![vec![2.0, 0.0, 0.0, 2.0], vec![0.0, 0.0, 4.0, 0.0], vec![1.0, 1.0, 1.0, 1.0]];
+        let per_point =
+            vec![vec![2.0, 0.0, 0.0, 2.0], vec![0.0, 0.0, 4.0, 0.0], vec![1.0, 1.0, 1.0, 1.0]];
         // two views of a view-independent sample: texels seen by both weigh most, the
         // texel no view reads weighs nothing
         let w = sample_weights(&per_point[..2]);

@@ -14,12 +14,14 @@ use pis_compile::hybrid::HybridPixels;
 use pis_compile::TextureLayout;
 use pis_scene::ObjectRole;
 
+use super::input::LoadedSet;
 use super::model::{key, InferredLayer, ObjectModel};
 use super::pem::form::ShellForm;
 use super::represent::{Job, Planned, Representation, Surveyed};
-use super::input::LoadedSet;
 use super::surface::survey_surface;
-use crate::lens_infer::{infer_lens_views, lens_terms, term_pixels, LensInferSettings, LensViewModel, TracedView};
+use crate::lens_infer::{
+    infer_lens_views, lens_terms, term_pixels, LensInferSettings, LensViewModel, TracedView,
+};
 
 /// Hybrid rendering: refractive objects whose set has outgoing-ray records of them.
 pub struct HybridRendering;
@@ -71,8 +73,17 @@ impl Planned for HybridPlanned {
         let scene = &set.scene;
         // A lens object's views read every point's images at once (held in memory, also for a
         // pack that streams).
-        let images = (0..set.frames.len()).map(|p| set.images.object(p, o)).collect::<Result<Vec<_>>>()?;
-        let views: Vec<Vec<TracedView>> = (0..set.frames.len()).map(|p| vec![TracedView { frame: &set.frames[p], images: &images[p], records: &set.records[p] }]).collect();
+        let images =
+            (0..set.frames.len()).map(|p| set.images.object(p, o)).collect::<Result<Vec<_>>>()?;
+        let views: Vec<Vec<TracedView>> = (0..set.frames.len())
+            .map(|p| {
+                vec![TracedView {
+                    frame: &set.frames[p],
+                    images: &images[p],
+                    records: &set.records[p],
+                }]
+            })
+            .collect();
         let mut settings = LensInferSettings::default();
         settings.solve.cg = job.settings.cg;
         settings.solver = job.solver.clone();
@@ -88,20 +99,50 @@ impl Planned for HybridPlanned {
         let inference = infer_lens_views(scene, o, &views, &settings)?;
         let layout = TextureLayout::cube(inference.face);
         for (l, fitted) in inference.shells.iter().enumerate() {
-            let textures: std::collections::BTreeMap<Vec<u32>, Vec<f32>> = set.samples.iter().zip(&inference.views).map(|(s, v)| (key(s, job.all), v.cubes[l].clone())).collect();
-            let form = Box::new(ShellForm { shell: fitted.shell, layout, lookups: 1, channels: 4, order: l as u8, term: pis_format::Term::Refraction });
-            model.layers.push(InferredLayer::shell(pis_format::LayerKind::EnvShell, job, &model.stagger, textures, 0, form, l));
+            let textures: std::collections::BTreeMap<Vec<u32>, Vec<f32>> = set
+                .samples
+                .iter()
+                .zip(&inference.views)
+                .map(|(s, v)| (key(s, job.all), v.cubes[l].clone()))
+                .collect();
+            let form = Box::new(ShellForm {
+                shell: fitted.shell,
+                layout,
+                lookups: 1,
+                channels: 4,
+                order: l as u8,
+                term: pis_format::Term::Refraction,
+            });
+            model.layers.push(InferredLayer::shell(
+                pis_format::LayerKind::EnvShell,
+                job,
+                &model.stagger,
+                textures,
+                0,
+                form,
+                l,
+            ));
         }
         let layers: Vec<String> = (0..inference.shells.len())
             .map(|l| {
-                let names: Vec<&str> = inference.layers.layer_of.iter().filter(|(_, &k)| k == l).filter_map(|(&obj, _)| scene.objects.get(obj as usize).map(|x| x.name.as_str())).collect();
+                let names: Vec<&str> = inference
+                    .layers
+                    .layer_of
+                    .iter()
+                    .filter(|(_, &k)| k == l)
+                    .filter_map(|(&obj, _)| {
+                        scene.objects.get(obj as usize).map(|x| x.name.as_str())
+                    })
+                    .collect();
                 format!("{} {{{}}}", inference.shells[l].shell.shape.name(), names.join(", "))
             })
             .collect();
         let both: Vec<f64> = inference.views.iter().map(|v| v.both.psnr_db).collect();
-        let (lo, hi) = both.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |a, &x| (a.0.min(x), a.1.max(x)));
+        let (lo, hi) =
+            both.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |a, &x| (a.0.min(x), a.1.max(x)));
         model.lens = inference.models.into_iter().map(LensPoint::new).collect();
-        model.representation = if one { "hybrid rendering, one shell" } else { "hybrid rendering" }.to_string();
+        model.representation =
+            if one { "hybrid rendering, one shell" } else { "hybrid rendering" }.to_string();
         model.why = format!(
             "refractive: {} shell(s) from the ray records' hit distances ({}), cube faces {}², both terms {lo:.1}–{hi:.1} dB at the samples as solved; vertex rays traced per frame (τ {} px)",
             layers.len(),
@@ -122,7 +163,10 @@ impl Planned for HybridPlanned {
 /// clamped to [0, 1], which the file records (SPEC.md 6.6 `transmission_tint`) and the
 /// player's paths multiply in as the tracer's do.
 pub fn transmission_tint(set: &LoadedSet, o: usize) -> [f32; 3] {
-    let base = set.frames.first().map_or(glam::Vec3::ONE, |f| crate::lens::lens_object(&set.scene, f, o).material.base);
+    let base = set
+        .frames
+        .first()
+        .map_or(glam::Vec3::ONE, |f| crate::lens::lens_object(&set.scene, f, o).material.base);
     base.clamp(glam::Vec3::ZERO, glam::Vec3::ONE).to_array()
 }
 
@@ -143,10 +187,12 @@ impl LensPoint {
     pub fn render(&self, rows: &[u32], maps: &[(&[f32], usize)]) -> Vec<f32> {
         let cubes: Vec<&[f32]> = maps.iter().map(|(m, _)| *m).collect();
         let [r, t] = lens_terms(&self.model, &self.fg, &cubes);
-        rows.iter().flat_map(|&p| {
-            let k = p as usize * 3;
-            [r[k] + t[k], r[k + 1] + t[k + 1], r[k + 2] + t[k + 2]]
-        }).collect()
+        rows.iter()
+            .flat_map(|&p| {
+                let k = p as usize * 3;
+                [r[k] + t[k], r[k + 1] + t[k + 1], r[k + 2] + t[k + 2]]
+            })
+            .collect()
     }
 }
 
@@ -165,7 +211,11 @@ pub fn shell_weights(m: &ObjectModel, s: usize, texels: usize, points: &[usize])
                 while k < fg.pixels.len() && fg.pixels[k] < a.pixels[r] {
                     k += 1;
                 }
-                let f2 = fg.vectors.get(k).filter(|_| fg.pixels.get(k) == Some(&a.pixels[r])).map_or(0.0, |v| ((v[0].x + v[0].y + v[0].z) / 3.0).powi(2));
+                let f2 = fg
+                    .vectors
+                    .get(k)
+                    .filter(|_| fg.pixels.get(k) == Some(&a.pixels[r]))
+                    .map_or(0.0, |v| ((v[0].x + v[0].y + v[0].z) / 3.0).powi(2));
                 let (cols, vals) = a.row(r);
                 for (&c, &w) in cols.iter().zip(vals) {
                     if let Some(x) = weighed.get_mut(c as usize) {

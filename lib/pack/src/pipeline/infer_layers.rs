@@ -24,14 +24,23 @@ pub struct Inferred {
 
 /// Infers every object that covers a pixel somewhere in the set, in its representation and
 /// in its alternative, if any.
-pub fn infer_all(set: &LoadedSet, req: &PackRequest, matrices: &mut Matrices, stages: &mut Stages) -> Result<Inferred> {
+pub fn infer_all(
+    set: &LoadedSet,
+    req: &PackRequest,
+    matrices: &mut Matrices,
+    stages: &mut Stages,
+) -> Result<Inferred> {
     let scene = &set.scene;
     let mut job = Job::new(set, req, matrices, stages.progress())?;
     let mut surveyed = Vec::new();
     for (o, object) in scene.objects.iter().enumerate() {
-        let rep = choose(object.role, req.representation).ok_or_else(|| anyhow!("object {}: no representation stores a {:?} object", object.name, object.role))?;
+        let rep = choose(object.role, req.representation).ok_or_else(|| {
+            anyhow!("object {}: no representation stores a {:?} object", object.name, object.role)
+        })?;
         if let Some(s) = rep.survey(&mut job, o)? {
-            let other = match alternative(object.role, req.representation).filter(|_| super::pem::layered(set, o) || object.role == pis_scene::ObjectRole::Refractive) {
+            let other = match alternative(object.role, req.representation).filter(|_| {
+                super::pem::layered(set, o) || object.role == pis_scene::ObjectRole::Refractive
+            }) {
                 Some(alt) => alt.survey(&mut job, o)?,
                 None => None,
             };
@@ -62,8 +71,18 @@ pub fn infer_all(set: &LoadedSet, req: &PackRequest, matrices: &mut Matrices, st
     let mut models = Vec::with_capacity(n);
     let mut alternatives = Vec::new();
     let note = |m: &ObjectModel| {
-        let sizes_text: Vec<String> = m.used_placements().iter().map(|&p| format!("{}x{}", m.placements[p].layout.width, m.placements[p].layout.height)).collect();
-        progress.note(&format!("object {}: {} texels, {} ({})", m.name, sizes_text.join(", "), m.representation, m.why));
+        let sizes_text: Vec<String> = m
+            .used_placements()
+            .iter()
+            .map(|&p| format!("{}x{}", m.placements[p].layout.width, m.placements[p].layout.height))
+            .collect();
+        progress.note(&format!(
+            "object {}: {} texels, {} ({})",
+            m.name,
+            sizes_text.join(", "),
+            m.representation,
+            m.why
+        ));
     };
     for (mi, (p, other)) in planned.into_iter().enumerate() {
         // A solve shard solves its objects only (pis-pack solve --shard).
@@ -86,7 +105,11 @@ pub fn infer_all(set: &LoadedSet, req: &PackRequest, matrices: &mut Matrices, st
             alternatives.push((mi, m));
         }
     }
-    let also = if alternatives.is_empty() { String::new() } else { format!(", {} of them also as the alternative", alternatives.len()) };
+    let also = if alternatives.is_empty() {
+        String::new()
+    } else {
+        format!(", {} of them also as the alternative", alternatives.len())
+    };
     stages.done("infer", &format!("{} objects solved{also}", models.len()));
     Ok(Inferred { models, alternatives })
 }

@@ -60,7 +60,10 @@ fn invalid(msg: String) -> Failure {
 /// The cache directory a scene.toml is traced into: beside it, named by size and spp.
 pub fn cache_dir(scene_toml: &Path, scene: &Scene) -> PathBuf {
     let dir = scene_toml.parent().unwrap_or(Path::new("."));
-    dir.join(".pis-cache").join(format!("{}-{}x{}-spp{}", scene.name, scene.resolution.0, scene.resolution.1, scene.spp))
+    dir.join(".pis-cache").join(format!(
+        "{}-{}x{}-spp{}",
+        scene.name, scene.resolution.0, scene.resolution.1, scene.spp
+    ))
 }
 
 /// True when a scene's parameter space is the one a set was traced over: the same
@@ -71,18 +74,30 @@ fn same_space(scene: &Scene, set: &RaySet) -> bool {
             d.name == m.name
                 && d.kind.name() == m.kind
                 && d.values.len() == m.values.len()
-                && d.values.iter().zip(&m.values).all(|(a, b)| (a - b).abs() <= 1e-4 * a.abs().max(b.abs()).max(1.0))
+                && d.values
+                    .iter()
+                    .zip(&m.values)
+                    .all(|(a, b)| (a - b).abs() <= 1e-4 * a.abs().max(b.abs()).max(1.0))
         })
 }
 
 /// Loads the scene a set was traced from at the set's resolution: scene.toml as written, or,
 /// when the set's parameter space is that of one of its `[preset.NAME]`s (a set traced with
 /// `pis-trace --preset NAME`), with that preset. A preset named by the caller is used as is.
-pub fn set_scene(set: &RaySet, scene_path: &Path, res: (u32, u32), preset: Option<&str>) -> Result<Scene, Failure> {
+pub fn set_scene(
+    set: &RaySet,
+    scene_path: &Path,
+    res: (u32, u32),
+    preset: Option<&str>,
+) -> Result<Scene, Failure> {
     let load = |preset: Option<String>| {
         let options = LoadOptions { preset, resolution: Some(res), ..LoadOptions::default() };
-        pis_scene::load_with(scene_path, &options)
-            .map_err(|e| Failure::new(crate::error::scene_exit(&e), anyhow!("loading {} (the set's scene; pass --scene): {e}", scene_path.display())))
+        pis_scene::load_with(scene_path, &options).map_err(|e| {
+            Failure::new(
+                crate::error::scene_exit(&e),
+                anyhow!("loading {} (the set's scene; pass --scene): {e}", scene_path.display()),
+            )
+        })
     };
     if let Some(p) = preset {
         return load(Some(p.to_string()));
@@ -91,7 +106,9 @@ pub fn set_scene(set: &RaySet, scene_path: &Path, res: (u32, u32), preset: Optio
     if same_space(&scene, set) {
         return Ok(scene);
     }
-    let presets = pis_scene::manifest::Manifest::read(scene_path).map(|m| m.presets.into_keys().collect::<Vec<_>>()).unwrap_or_default();
+    let presets = pis_scene::manifest::Manifest::read(scene_path)
+        .map(|m| m.presets.into_keys().collect::<Vec<_>>())
+        .unwrap_or_default();
     for name in presets {
         if let Ok(s) = load(Some(name)) {
             if same_space(&s, set) {
@@ -113,7 +130,11 @@ pub fn reads_layer(mode: super::RepresentationMode, kind: pis_trace::LayerKind) 
 /// Whether the pack reads the layer named `name` (`combined`, `object.<object>.<layer>`;
 /// layers of unknown kind are kept).
 fn reads_layer_named(mode: super::RepresentationMode, name: &str) -> bool {
-    match name.strip_prefix("object.").and_then(|n| n.rsplit_once('.')).and_then(|(_, l)| pis_trace::LayerKind::from_name(l)) {
+    match name
+        .strip_prefix("object.")
+        .and_then(|n| n.rsplit_once('.'))
+        .and_then(|(_, l)| pis_trace::LayerKind::from_name(l))
+    {
         Some(kind) => reads_layer(mode, kind),
         None => true,
     }
@@ -125,15 +146,21 @@ pub fn load(req: &PackRequest, stages: &mut Stages) -> Result<LoadedSet, Failure
         let set = RaySet::open(&req.input).map_err(trace_failure)?;
         (req.input.clone(), set.default_scene())
     } else if req.input.is_file() {
-        let options = LoadOptions { preset: req.preset.clone(), resolution: req.resolution, spp: req.spp };
+        let options =
+            LoadOptions { preset: req.preset.clone(), resolution: req.resolution, spp: req.spp };
         let scene = pis_scene::load_with(&req.input, &options).map_err(Failure::from)?;
         let dir = cache_dir(&req.input, &scene);
         if !dir.join("set.json").is_file() {
             // What the container cannot store is refused before the trace.
-            let frames = (0..scene.space.point_count()).map(|i| scene.frame(&scene.space.point(i))).collect::<Result<Vec<_>, _>>().map_err(|e| Failure::new(Exit::Invalid, e))?;
-            super::blocks::check_transforms(&scene, &frames).map_err(|e| Failure::new(Exit::NotSupported, e))?;
+            let frames = (0..scene.space.point_count())
+                .map(|i| scene.frame(&scene.space.point(i)))
+                .collect::<Result<Vec<_>, _>>()
+                .map_err(|e| Failure::new(Exit::Invalid, e))?;
+            super::blocks::check_transforms(&scene, &frames)
+                .map_err(|e| Failure::new(Exit::NotSupported, e))?;
             let settings = TraceSettings::new(scene.resolution, scene.spp);
-            let r = pis_trace::render_set(&scene, &dir, &settings, None, &pis_trace::NoProgress).map_err(trace_failure)?;
+            let r = pis_trace::render_set(&scene, &dir, &settings, None, &pis_trace::NoProgress)
+                .map_err(trace_failure)?;
             for w in &r.warnings {
                 stages.note(&format!("warning: {w}"));
             }
@@ -141,20 +168,44 @@ pub fn load(req: &PackRequest, stages: &mut Stages) -> Result<LoadedSet, Failure
         }
         (dir, req.input.clone())
     } else {
-        return Err(Failure::new(Exit::Io, anyhow!("{}: no such set directory or scene file", req.input.display())));
+        return Err(Failure::new(
+            Exit::Io,
+            anyhow!("{}: no such set directory or scene file", req.input.display()),
+        ));
     };
     let scene_path = req.scene.clone().unwrap_or(scene_path);
     let set = RaySet::open(&dir).map_err(trace_failure)?;
     let res = (set.meta.resolution[0], set.meta.resolution[1]);
-    let channels: u64 = 3 + set.meta.objects.iter().flat_map(|o| &o.layers).filter_map(|l| pis_trace::LayerKind::from_name(l)).filter(|&k| reads_layer(req.representation, k)).map(|k| k.channels().len() as u64).sum::<u64>();
-    let memory = MemoryPlan::new(pis_trace::memory::image_bytes(res.0, res.1, channels, set.meta.points.len() as u64), req.memory, pis_trace::memory::available_memory());
+    let channels: u64 = 3 + set
+        .meta
+        .objects
+        .iter()
+        .flat_map(|o| &o.layers)
+        .filter_map(|l| pis_trace::LayerKind::from_name(l))
+        .filter(|&k| reads_layer(req.representation, k))
+        .map(|k| k.channels().len() as u64)
+        .sum::<u64>();
+    let memory = MemoryPlan::new(
+        pis_trace::memory::image_bytes(res.0, res.1, channels, set.meta.points.len() as u64),
+        req.memory,
+        pis_trace::memory::available_memory(),
+    );
     if memory.stream {
         stages.note(&format!("the set is {}", memory.describe()));
     }
-    let scratch = if memory.stream { Some(Arc::new(Scratch::beside(&req.output).map_err(|e| Failure::new(Exit::Io, e))?)) } else { None };
+    let scratch = if memory.stream {
+        Some(Arc::new(Scratch::beside(&req.output).map_err(|e| Failure::new(Exit::Io, e))?))
+    } else {
+        None
+    };
     let scene = set_scene(&set, &scene_path, res, req.preset.as_deref())?;
     if set.meta.points.len() != scene.space.point_count() {
-        return Err(invalid(format!("{}: the set has {} points, the scene's space {}", dir.display(), set.meta.points.len(), scene.space.point_count())));
+        return Err(invalid(format!(
+            "{}: the set has {} points, the scene's space {}",
+            dir.display(),
+            set.meta.points.len(),
+            scene.space.point_count()
+        )));
     }
     let mut samples = Vec::new();
     let mut frames = Vec::new();
@@ -163,30 +214,62 @@ pub fn load(req: &PackRequest, stages: &mut Stages) -> Result<LoadedSet, Failure
     let channel_names = pis_trace::channel_names(&scene);
     let mut records = Vec::new();
     // Only the layers (and ray records) the pack reads are kept, as each point is read.
-    let with_records = set.meta.objects.iter().any(|o| o.records) && req.representation != super::RepresentationMode::Texture;
+    let with_records = set.meta.objects.iter().any(|o| o.records)
+        && req.representation != super::RepresentationMode::Texture;
     for (i, p) in set.meta.points.iter().enumerate() {
         if p.samples != scene.space.point(i) {
-            return Err(invalid(format!("{}: point {i} has samples {:?}, expected {:?}", dir.display(), p.samples, scene.space.point(i))));
+            return Err(invalid(format!(
+                "{}: point {i} has samples {:?}, expected {:?}",
+                dir.display(),
+                p.samples,
+                scene.space.point(i)
+            )));
         }
         let mut img = set.read_point(i).map_err(trace_failure)?;
         img.layers.retain(|l| reads_layer_named(req.representation, &l.name));
         if (img.width, img.height) != res {
-            return Err(invalid(format!("{}: point {i} is {}x{}, the set declares {}x{}", dir.display(), img.width, img.height, res.0, res.1)));
+            return Err(invalid(format!(
+                "{}: point {i} is {}x{}, the set declares {}x{}",
+                dir.display(),
+                img.width,
+                img.height,
+                res.0,
+                res.1
+            )));
         }
         for l in &img.layers {
             if l.width != res.0 || l.height != res.1 {
-                return Err(invalid(format!("{}: point {i} layer {} is {}x{}, the set declares {}x{}", dir.display(), l.name, l.width, l.height, res.0, res.1)));
+                return Err(invalid(format!(
+                    "{}: point {i} layer {} is {}x{}, the set declares {}x{}",
+                    dir.display(),
+                    l.name,
+                    l.width,
+                    l.height,
+                    res.0,
+                    res.1
+                )));
             }
         }
         frames.push(scene.frame(&p.samples).map_err(|e| Failure::new(Exit::Invalid, e))?);
         samples.push(p.samples.clone());
         match &scratch {
-            Some(sc) => spans.push(spill_point(sc, &img, &channel_names).map_err(|e| Failure::new(Exit::Io, e))?),
+            Some(sc) => spans.push(
+                spill_point(sc, &img, &channel_names).map_err(|e| Failure::new(Exit::Io, e))?,
+            ),
             None => images.push(img),
         }
-        records.push(if with_records { set.read_records(i).map_err(trace_failure)? } else { Vec::new() });
+        records.push(if with_records {
+            set.read_records(i).map_err(trace_failure)?
+        } else {
+            Vec::new()
+        });
     }
-    let trace = set.meta.renderer.as_ref().and_then(|r| r.settings.clone()).unwrap_or_else(|| TraceSettings::new(res, set.meta.spp.max(1)));
+    let trace = set
+        .meta
+        .renderer
+        .as_ref()
+        .and_then(|r| r.settings.clone())
+        .unwrap_or_else(|| TraceSettings::new(res, set.meta.spp.max(1)));
     if trace.shading_seed() == pis_trace::ShadingSeed::Sample {
         stages.note(&format!(
             "warning: {} was traced with shading seeded per camera sample (pis-trace --shading-seed sample): a surface's noise differs between its images, so the solved textures average it rather than match it; a set to pack is traced with the default seeding",
@@ -197,9 +280,32 @@ pub fn load(req: &PackRequest, stages: &mut Stages) -> Result<LoadedSet, Failure
         Some(sc) => SetImages::Spilled { scratch: sc.clone(), width: res.0, height: res.1, spans },
         None => SetImages::Held(images),
     };
-    let loaded = LoadedSet { dir, scene, resolution: res, samples, frames, images, scratch, memory, channels: channel_names, display_filter: set.meta.filter, trace, records };
-    super::blocks::check_transforms(&loaded.scene, &loaded.frames).map_err(|e| Failure::new(Exit::NotSupported, e))?;
-    stages.done("read", &format!("{} points of {}x{} from {}", loaded.samples.len(), res.0, res.1, loaded.dir.display()));
+    let loaded = LoadedSet {
+        dir,
+        scene,
+        resolution: res,
+        samples,
+        frames,
+        images,
+        scratch,
+        memory,
+        channels: channel_names,
+        display_filter: set.meta.filter,
+        trace,
+        records,
+    };
+    super::blocks::check_transforms(&loaded.scene, &loaded.frames)
+        .map_err(|e| Failure::new(Exit::NotSupported, e))?;
+    stages.done(
+        "read",
+        &format!(
+            "{} points of {}x{} from {}",
+            loaded.samples.len(),
+            res.0,
+            res.1,
+            loaded.dir.display()
+        ),
+    );
     Ok(loaded)
 }
 
@@ -211,14 +317,36 @@ mod tests {
     #[test]
     fn surface_textures_keep_the_surface_layers_and_the_combined_image() {
         let t = RepresentationMode::Texture;
-        for name in ["combined", "object.vase.coverage", "object.vase.diffuse", "object.glass_cup.specular", "object.a.b.diffuse", "object.vase.unknown"] {
+        for name in [
+            "combined",
+            "object.vase.coverage",
+            "object.vase.diffuse",
+            "object.glass_cup.specular",
+            "object.a.b.diffuse",
+            "object.vase.unknown",
+        ] {
             assert!(reads_layer_named(t, name), "{name}");
         }
-        for name in ["object.vase.local", "object.vase.distant", "object.vase.fresnel", "object.cup.refraction", "object.cup.reflection_confidence"] {
+        for name in [
+            "object.vase.local",
+            "object.vase.distant",
+            "object.vase.fresnel",
+            "object.cup.refraction",
+            "object.cup.reflection_confidence",
+        ] {
             assert!(!reads_layer_named(t, name), "{name}");
         }
-        for mode in [RepresentationMode::Pem, RepresentationMode::Auto, RepresentationMode::PemInfinity, RepresentationMode::StaticEnv] {
-            assert!(reads_layer_named(mode, "object.vase.local") && reads_layer_named(mode, "object.cup.refraction_modulation"), "{mode:?}");
+        for mode in [
+            RepresentationMode::Pem,
+            RepresentationMode::Auto,
+            RepresentationMode::PemInfinity,
+            RepresentationMode::StaticEnv,
+        ] {
+            assert!(
+                reads_layer_named(mode, "object.vase.local")
+                    && reads_layer_named(mode, "object.cup.refraction_modulation"),
+                "{mode:?}"
+            );
         }
     }
 }

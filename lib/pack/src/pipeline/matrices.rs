@@ -4,7 +4,9 @@
 //! on, anisotropic filtering included). The same A serves the solves and the predicted PSNR.
 
 use anyhow::Result;
-use pis_compile::{render_matrix, scene_depth, DrawMesh, Filter, RenderMatrix, TexturedObject, Viewport};
+use pis_compile::{
+    render_matrix, scene_depth, DrawMesh, Filter, RenderMatrix, TexturedObject, Viewport,
+};
 use pis_play::{Gpu, PlayError, TexturedPipeline};
 
 use crate::error::{Exit, Failure};
@@ -65,29 +67,46 @@ impl Matrices {
             MatrixSource::Model => Ok(Matrices::Model),
             MatrixSource::Probe => {
                 let gpu = Gpu::new().map_err(|e| match e {
-                    PlayError::NoAdapter(_) => Failure::new(Exit::NotSupported, anyhow::anyhow!("--matrix probe: {e}")),
+                    PlayError::NoAdapter(_) => {
+                        Failure::new(Exit::NotSupported, anyhow::anyhow!("--matrix probe: {e}"))
+                    }
                     e => Failure::new(Exit::Runtime, anyhow::anyhow!("--matrix probe: {e}")),
                 })?;
                 if gpu.texture_format != wgpu::TextureFormat::Rgba32Float {
                     let e = PlayError::ProbeNeedsFloat32(gpu.info.name.clone());
-                    return Err(Failure::new(Exit::NotSupported, anyhow::anyhow!("--matrix probe: {e}")));
+                    return Err(Failure::new(
+                        Exit::NotSupported,
+                        anyhow::anyhow!("--matrix probe: {e}"),
+                    ));
                 }
                 let pipeline = TexturedPipeline::new(&gpu);
-                Ok(Matrices::Probe { gpu: Box::new(gpu), pipeline: Box::new(pipeline), renderings: 0, matrices: 0 })
+                Ok(Matrices::Probe {
+                    gpu: Box::new(gpu),
+                    pipeline: Box::new(pipeline),
+                    renderings: 0,
+                    matrices: 0,
+                })
             }
         }
     }
 
     /// The render matrix of object `o` of `draw` (the scene's meshes at this point; `object`
     /// is `draw[o]` with its block texture), every other mesh occluding it.
-    pub fn matrix(&mut self, viewport: Viewport, draw: &[DrawMesh], o: usize, object: &TexturedObject) -> Result<RenderMatrix> {
+    pub fn matrix(
+        &mut self,
+        viewport: Viewport,
+        draw: &[DrawMesh],
+        o: usize,
+        object: &TexturedObject,
+    ) -> Result<RenderMatrix> {
         match self {
             Matrices::Model => {
                 let occluders = scene_depth(viewport, draw, Some(o))?;
                 Ok(render_matrix(viewport, object, Some(&occluders))?)
             }
             Matrices::Probe { gpu, pipeline, renderings, matrices } => {
-                let occluders: Vec<DrawMesh> = draw.iter().enumerate().filter(|&(k, _)| k != o).map(|(_, m)| *m).collect();
+                let occluders: Vec<DrawMesh> =
+                    draw.iter().enumerate().filter(|&(k, _)| k != o).map(|(_, m)| *m).collect();
                 let p = pis_play::probe(gpu, pipeline, viewport, &occluders, object)?;
                 *renderings += u64::from(p.renderings);
                 *matrices += 1;
@@ -100,7 +119,9 @@ impl Matrices {
     pub fn describe(&self) -> String {
         match self {
             Matrices::Model => "hardware model".into(),
-            Matrices::Probe { renderings, matrices, .. } => format!("probe mode: {matrices} matrices measured with {renderings} renderings"),
+            Matrices::Probe { renderings, matrices, .. } => {
+                format!("probe mode: {matrices} matrices measured with {renderings} renderings")
+            }
         }
     }
 

@@ -36,7 +36,12 @@ impl MemoryPlan {
     pub fn new(image_bytes: u64, memory: Option<f64>, available: Option<u64>) -> MemoryPlan {
         let budget = memory.map(|gib| (gib * (1u64 << 30) as f64) as u64).or(available);
         let held = image_bytes.saturating_mul(HELD_PER_IMAGE_BYTE);
-        MemoryPlan { budget, asked: memory.is_some(), held, stream: budget.is_some_and(|b| held > b) }
+        MemoryPlan {
+            budget,
+            asked: memory.is_some(),
+            held,
+            stream: budget.is_some_and(|b| held > b),
+        }
     }
 
     /// What the report and the progress say.
@@ -64,7 +69,10 @@ mod tests {
         let gb = 1u64 << 30;
         assert!(!MemoryPlan::new(gb, Some(4.0), None).stream, "3 GB held fits 4 GB");
         assert!(MemoryPlan::new(gb, Some(2.0), None).stream);
-        assert!(MemoryPlan::new(gb, None, Some(2 * gb)).stream, "without --memory, the available memory is the budget");
+        assert!(
+            MemoryPlan::new(gb, None, Some(2 * gb)).stream,
+            "without --memory, the available memory is the budget"
+        );
         assert!(!MemoryPlan::new(gb, None, None).stream, "an unknown budget holds");
         assert!(!MemoryPlan::new(gb, Some(2.0), None).describe().contains("available"));
         assert!(MemoryPlan::new(gb, Some(2.0), None).describe().starts_with("streamed"));

@@ -31,7 +31,12 @@ pub struct PointView {
 impl PointView {
     /// The render matrix of placement `placement` (of [`ObjectModel::placements`]).
     pub fn a(&self, placement: usize) -> &RenderMatrix {
-        &self.a.iter().find(|(p, _)| *p == placement).expect("a render matrix for every placement a layer reads at the point").1
+        &self
+            .a
+            .iter()
+            .find(|(p, _)| *p == placement)
+            .expect("a render matrix for every placement a layer reads at the point")
+            .1
     }
 
     /// Covered pixels.
@@ -89,7 +94,9 @@ impl Views {
     pub fn new(scratch: Option<Arc<Scratch>>) -> Views {
         Views {
             store: match scratch {
-                Some(scratch) => ViewStore::Spilled { scratch, spans: Vec::new(), rows: Vec::new() },
+                Some(scratch) => {
+                    ViewStore::Spilled { scratch, spans: Vec::new(), rows: Vec::new() }
+                }
                 None => ViewStore::Held(Vec::new()),
             },
         }
@@ -108,9 +115,15 @@ impl Views {
     }
 
     /// Changes point `p` by `change`.
-    pub fn update(&mut self, p: usize, change: impl FnOnce(&mut PointView) -> Result<()>) -> Result<()> {
+    pub fn update(
+        &mut self,
+        p: usize,
+        change: impl FnOnce(&mut PointView) -> Result<()>,
+    ) -> Result<()> {
         match &mut self.store {
-            ViewStore::Held(h) => change(h.get_mut(p).ok_or_else(|| anyhow!("no view of point {p}"))?),
+            ViewStore::Held(h) => {
+                change(h.get_mut(p).ok_or_else(|| anyhow!("no view of point {p}"))?)
+            }
             ViewStore::Spilled { scratch, spans, rows } => {
                 let span = *spans.get(p).ok_or_else(|| anyhow!("no view of point {p}"))?;
                 let mut v = PointView::read(&scratch.get(span)?)?;
@@ -137,7 +150,9 @@ impl Views {
     /// Point `p`'s view (read back from the scratch file where spilled).
     pub fn get(&self, p: usize) -> Result<Cow<'_, PointView>> {
         match &self.store {
-            ViewStore::Held(h) => h.get(p).map(Cow::Borrowed).ok_or_else(|| anyhow!("no view of point {p}")),
+            ViewStore::Held(h) => {
+                h.get(p).map(Cow::Borrowed).ok_or_else(|| anyhow!("no view of point {p}"))
+            }
             ViewStore::Spilled { scratch, spans, .. } => {
                 let span = *spans.get(p).ok_or_else(|| anyhow!("no view of point {p}"))?;
                 Ok(Cow::Owned(PointView::read(&scratch.get(span)?)?))
@@ -187,8 +202,17 @@ impl InferredLayer {
     /// Shell `shell` of an object as a layer over every dimension of `job`'s space: one
     /// texture per parameter sample (`textures`, keyed by sample), every block of its grid
     /// (origins `stagger`) on the one shell and cube layout that `form` describes.
-    pub fn shell(kind: pis_format::LayerKind, job: &super::represent::Job<'_>, stagger: &[u32], textures: BTreeMap<Vec<u32>, Vec<f32>>, iterations: u64, form: Box<dyn LayerForm>, shell: usize) -> InferredLayer {
-        let grid_blocks = pis_format::blocks::BlockGrid::new(&job.space, job.all, stagger).block_count() as usize;
+    pub fn shell(
+        kind: pis_format::LayerKind,
+        job: &super::represent::Job<'_>,
+        stagger: &[u32],
+        textures: BTreeMap<Vec<u32>, Vec<f32>>,
+        iterations: u64,
+        form: Box<dyn LayerForm>,
+        shell: usize,
+    ) -> InferredLayer {
+        let grid_blocks =
+            pis_format::blocks::BlockGrid::new(&job.space, job.all, stagger).block_count() as usize;
         InferredLayer {
             kind,
             depends_on: job.all,
@@ -209,7 +233,13 @@ impl InferredLayer {
 pub trait LayerForm: Send + Sync {
     /// The container layer, without blocks, of a layer of `kind` drawn in `order` over the
     /// dimensions `depends_on`, stored with gamma `gamma`.
-    fn layer(&self, kind: pis_format::LayerKind, order: u8, depends_on: DepMask, gamma: f32) -> pis_format::Layer;
+    fn layer(
+        &self,
+        kind: pis_format::LayerKind,
+        order: u8,
+        depends_on: DepMask,
+        gamma: f32,
+    ) -> pis_format::Layer;
     /// Block `b` of the layer's grid as the container holds it (size, placement), without
     /// levels.
     fn block(&self, b: usize) -> pis_format::Block;
@@ -269,7 +299,8 @@ impl ObjectModel {
 
     /// The placements the layers' blocks carry, in increasing order.
     pub fn used_placements(&self) -> Vec<usize> {
-        let mut used: Vec<usize> = self.layers.iter().flat_map(|l| l.block_placements.iter().copied()).collect();
+        let mut used: Vec<usize> =
+            self.layers.iter().flat_map(|l| l.block_placements.iter().copied()).collect();
         used.sort_unstable();
         used.dedup();
         used
@@ -284,13 +315,24 @@ impl ObjectModel {
     /// player draws it from `textures[l]`, layer l's sample at the point (the whole drawn
     /// texture; `None` where the layer has none): the surface layers added, then the
     /// reflection term of the shells, or a lens object's two terms (SPEC.md 9).
-    pub fn render(&self, p: usize, keys: &[Vec<u32>], textures: &[Option<&[f32]>]) -> Result<Vec<f32>> {
+    pub fn render(
+        &self,
+        p: usize,
+        keys: &[Vec<u32>],
+        textures: &[Option<&[f32]>],
+    ) -> Result<Vec<f32>> {
         let v = self.views.get(p)?;
         Ok(self.render_view(&v, p, keys, textures))
     }
 
     /// [`ObjectModel::render`] with point `p`'s view `v` read already.
-    pub fn render_view(&self, v: &PointView, p: usize, keys: &[Vec<u32>], textures: &[Option<&[f32]>]) -> Vec<f32> {
+    pub fn render_view(
+        &self,
+        v: &PointView,
+        p: usize,
+        keys: &[Vec<u32>],
+        textures: &[Option<&[f32]>],
+    ) -> Vec<f32> {
         let mut img = vec![0.0f32; v.rows() * 3];
         let mut maps = Vec::new();
         for ((il, k), x) in self.layers.iter().zip(keys).zip(textures) {
@@ -326,8 +368,14 @@ mod tests {
 
     fn view(p: u32) -> PointView {
         let a = RenderMatrix {
-            width: 8, height: 8, layout: TextureLayout::full(2, 2),
-            pixels: vec![p, p + 3], coverage: vec![1.0, 0.5], row_start: vec![0, 1, 3], cols: vec![0, 1, 4], vals: vec![1.0, 0.25, 0.75],
+            width: 8,
+            height: 8,
+            layout: TextureLayout::full(2, 2),
+            pixels: vec![p, p + 3],
+            coverage: vec![1.0, 0.5],
+            row_start: vec![0, 1, 3],
+            cols: vec![0, 1, 4],
+            vals: vec![1.0, 0.25, 0.75],
         };
         PointView { a: vec![(0, a)], diffuse: vec![0.1 * p as f32; 6], specular: vec![-0.0; 6] }
     }
@@ -368,6 +416,10 @@ mod tests {
             assert_eq!((held.rows(p), spilled.rows(p)), (2, 2));
         }
         assert_eq!(spilled.get(1).unwrap().a[0].0, 2);
-        assert!(held.get(3).is_err() && spilled.get(3).is_err() && spilled.update(5, |_| Ok(())).is_err());
+        assert!(
+            held.get(3).is_err()
+                && spilled.get(3).is_err()
+                && spilled.update(5, |_| Ok(())).is_err()
+        );
     }
 }

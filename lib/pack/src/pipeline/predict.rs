@@ -36,7 +36,11 @@ impl Chains for [LayerTextures] {
 impl Chains for [Textures] {
     fn chain(&self, li: usize, k: &[u32]) -> Result<Option<Cow<'_, [f32]>>> {
         let t = &self[li];
-        if t.contains_key(k) { t.get(k).map(Some) } else { Ok(None) }
+        if t.contains_key(k) {
+            t.get(k).map(Some)
+        } else {
+            Ok(None)
+        }
     }
 }
 
@@ -62,17 +66,27 @@ fn solved_chain(l: &InferredLayer, k: &[u32], x: &[f32]) -> Vec<f32> {
 /// The solved textures of `m` per layer, each as the MIP chain the player rebuilds from its
 /// finest level.
 pub fn solved_chains(m: &ObjectModel) -> Result<Vec<LayerTextures>> {
-    m.layers.iter().map(|l| l.textures.iter().map(|r| r.map(|(k, x)| (k.clone(), solved_chain(l, k, &x)))).collect()).collect()
+    m.layers
+        .iter()
+        .map(|l| {
+            l.textures.iter().map(|r| r.map(|(k, x)| (k.clone(), solved_chain(l, k, &x)))).collect()
+        })
+        .collect()
 }
 
 /// The squared display error of object `m` drawn with `chains` through A at every point,
 /// against the gold-standard layers, and the number of values it sums.
-pub fn display_error(set: &LoadedSet, m: &ObjectModel, chains: &(impl Chains + ?Sized)) -> Result<(f64, usize)> {
+pub fn display_error(
+    set: &LoadedSet,
+    m: &ObjectModel,
+    chains: &(impl Chains + ?Sized),
+) -> Result<(f64, usize)> {
     let d = |v: f32| crate::images::srgb_encode(v.clamp(0.0, 1.0)) as f64;
     let (mut sse, mut n) = (0.0f64, 0usize);
     // The chain each layer read last: consecutive points share the samples of a layer that
     // does not depend on the fastest dimension.
-    let mut last: Vec<Option<(Vec<u32>, Option<Cow<'_, [f32]>>)>> = m.layers.iter().map(|_| None).collect();
+    let mut last: Vec<Option<(Vec<u32>, Option<Cow<'_, [f32]>>)>> =
+        m.layers.iter().map(|_| None).collect();
     for (p, s) in set.samples.iter().enumerate() {
         let v = m.views.get(p)?;
         let keys: Vec<Vec<u32>> = m.layers.iter().map(|il| key(s, il.depends_on)).collect();
@@ -81,7 +95,8 @@ pub fn display_error(set: &LoadedSet, m: &ObjectModel, chains: &(impl Chains + ?
                 last[li] = Some((k.clone(), chains.chain(li, k)?));
             }
         }
-        let at: Vec<Option<&[f32]>> = last.iter().map(|l| l.as_ref().and_then(|(_, c)| c.as_deref())).collect();
+        let at: Vec<Option<&[f32]>> =
+            last.iter().map(|l| l.as_ref().and_then(|(_, c)| c.as_deref())).collect();
         let img = m.render_view(&v, p, &keys, &at);
         for (k, g) in img.iter().enumerate() {
             let gold = v.diffuse[k] + v.specular[k];
@@ -103,29 +118,48 @@ pub fn solved_error(set: &LoadedSet, m: &ObjectModel) -> Result<(f64, usize)> {
 
 /// Decoded linear textures (whole MIP chain, rebuilt by decimation as the player does), per
 /// object model and layer, keyed like [`super::model::InferredLayer::textures`].
-pub fn decoded_textures(models: &[ObjectModel], packed: &Packed) -> Result<Vec<Vec<LayerTextures>>> {
-    models.iter().enumerate().map(|(mi, m)| {
-        let mut per_layer = vec![BTreeMap::new(); m.layers.len()];
-        for_each_decoded(mi, m, packed, |li, k, x| {
-            per_layer[li].insert(k, x);
-            Ok(())
-        })?;
-        Ok(per_layer)
-    }).collect()
+pub fn decoded_textures(
+    models: &[ObjectModel],
+    packed: &Packed,
+) -> Result<Vec<Vec<LayerTextures>>> {
+    models
+        .iter()
+        .enumerate()
+        .map(|(mi, m)| {
+            let mut per_layer = vec![BTreeMap::new(); m.layers.len()];
+            for_each_decoded(mi, m, packed, |li, k, x| {
+                per_layer[li].insert(k, x);
+                Ok(())
+            })?;
+            Ok(per_layer)
+        })
+        .collect()
 }
 
 /// Calls `f(layer, key, chain)` with every decoded chain of object model `mi`, `m`, one
 /// block's level images decoded at a time.
-fn for_each_decoded(mi: usize, m: &ObjectModel, packed: &Packed, mut f: impl FnMut(usize, Vec<u32>, Vec<f32>) -> Result<()>) -> Result<()> {
+fn for_each_decoded(
+    mi: usize,
+    m: &ObjectModel,
+    packed: &Packed,
+    mut f: impl FnMut(usize, Vec<u32>, Vec<f32>) -> Result<()>,
+) -> Result<()> {
     for li in 0..m.layers.len() {
         let layer = &packed.container.objects[mi].layers[li];
         for (b, pb) in packed.blocks[mi][li].iter().enumerate() {
             let block = &layer.blocks[b];
             let layout = LevelLayout::of(layer, block);
             let planes = layout.planes();
-            let decoded: Vec<Vec<Vec<f32>>> = pb.levels.iter().map(|(_, _, streams)| {
-                streams.iter().map(|s| pis_codec::decode(layer_codec(block), &planes, s)).collect::<Result<Vec<_>, _>>()
-            }).collect::<Result<_, _>>()?;
+            let decoded: Vec<Vec<Vec<f32>>> = pb
+                .levels
+                .iter()
+                .map(|(_, _, streams)| {
+                    streams
+                        .iter()
+                        .map(|s| pis_codec::decode(layer_codec(block), &planes, s))
+                        .collect::<Result<Vec<_>, _>>()
+                })
+                .collect::<Result<_, _>>()?;
             for (s, k) in pb.keys.iter().enumerate() {
                 let local = unflatten(s, &pb.extent);
                 let mut sum = vec![0.0f32; pis_codec::value_count(&planes)?];
@@ -171,7 +205,8 @@ pub fn predicted_psnr(set: &LoadedSet, models: &[ObjectModel], packed: &Packed) 
     let mut e_dec = Vec::with_capacity(models.len());
     for (mi, m) in models.iter().enumerate() {
         let solved = SolvedChains(m);
-        let mut decoded: Vec<Textures> = m.layers.iter().map(|_| Textures::new(set.scratch.as_ref())).collect();
+        let mut decoded: Vec<Textures> =
+            m.layers.iter().map(|_| Textures::new(set.scratch.as_ref())).collect();
         for_each_decoded(mi, m, packed, |li, k, y| {
             if let Some(x) = solved.chain(li, &k)? {
                 let n = m.layers[li].form.stored_texels(&k) * m.layers[li].form.channels();

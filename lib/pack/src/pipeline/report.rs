@@ -5,9 +5,9 @@ use std::collections::BTreeMap;
 use serde::Serialize;
 
 use super::encode::Packed;
-use super::predict::Quality;
-use super::model::ObjectModel;
 use super::input::LoadedSet;
+use super::model::ObjectModel;
+use super::predict::Quality;
 use super::{PackRequest, Stages};
 
 /// One object's part of the report.
@@ -146,7 +146,8 @@ impl MemoryReport {
     /// Whether the pack's peak went above the budget asked for: what a streamed pack still
     /// holds did not fit it.
     pub fn over_budget(&self) -> bool {
-        self.budget_asked && matches!((self.peak_bytes, self.budget_bytes), (Some(p), Some(b)) if p > b)
+        self.budget_asked
+            && matches!((self.peak_bytes, self.budget_bytes), (Some(p), Some(b)) if p > b)
     }
 }
 
@@ -158,32 +159,62 @@ pub struct MaxMsePsnr {
 }
 
 #[allow(clippy::too_many_arguments)]
-pub fn build(set: &LoadedSet, models: &[ObjectModel], packed: &Packed, q: &Quality, bytes: u64,
-                    exact: Option<bool>, req: &PackRequest, stages: Stages) -> PackReport {
+pub fn build(
+    set: &LoadedSet,
+    models: &[ObjectModel],
+    packed: &Packed,
+    q: &Quality,
+    bytes: u64,
+    exact: Option<bool>,
+    req: &PackRequest,
+    stages: Stages,
+) -> PackReport {
     let raw = set.raw_image_bytes();
     let texture_bytes: usize = packed.layer_bytes.iter().flatten().sum();
-    let objects = models.iter().enumerate().map(|(mi, m)| {
-        let ob = &packed.container.objects[mi];
-        let used = m.used_placements();
-        let largest = used.iter().map(|&p| &m.placements[p]).max_by_key(|p| p.layout.width as u64 * p.layout.height as u64).unwrap_or(&m.placements[0]);
-        ObjectReport {
-            name: m.name.clone(),
-            representation: m.representation.clone(),
-            why: m.why.clone(),
-            bytes: packed.layer_bytes[mi].iter().sum(),
-            layer_bytes: m.layers.iter().zip(&packed.layer_bytes[mi]).map(|(l, b)| (l.kind.name().to_string(), *b)).collect(),
-            psnr_db: q.objects[mi].0,
-            psnr_db_solved: q.objects[mi].1,
-            texture: [largest.layout.width, largest.layout.height],
-            reduction: largest.reduction,
-            placements: used.iter().map(|&p| [m.placements[p].layout.width, m.placements[p].layout.height]).collect(),
-            stagger: packed.stagger[mi].clone(),
-            blocks: ob.layers.iter().map(|l| l.blocks.len()).sum(),
-            level_images: ob.layers.iter().flat_map(|l| &l.blocks).flat_map(|b| &b.levels).map(|l| l.images.len()).sum(),
-            solver_iterations: m.layers.iter().map(|l| l.iterations).sum(),
-            area_px: m.area,
-        }
-    }).collect();
+    let objects = models
+        .iter()
+        .enumerate()
+        .map(|(mi, m)| {
+            let ob = &packed.container.objects[mi];
+            let used = m.used_placements();
+            let largest = used
+                .iter()
+                .map(|&p| &m.placements[p])
+                .max_by_key(|p| p.layout.width as u64 * p.layout.height as u64)
+                .unwrap_or(&m.placements[0]);
+            ObjectReport {
+                name: m.name.clone(),
+                representation: m.representation.clone(),
+                why: m.why.clone(),
+                bytes: packed.layer_bytes[mi].iter().sum(),
+                layer_bytes: m
+                    .layers
+                    .iter()
+                    .zip(&packed.layer_bytes[mi])
+                    .map(|(l, b)| (l.kind.name().to_string(), *b))
+                    .collect(),
+                psnr_db: q.objects[mi].0,
+                psnr_db_solved: q.objects[mi].1,
+                texture: [largest.layout.width, largest.layout.height],
+                reduction: largest.reduction,
+                placements: used
+                    .iter()
+                    .map(|&p| [m.placements[p].layout.width, m.placements[p].layout.height])
+                    .collect(),
+                stagger: packed.stagger[mi].clone(),
+                blocks: ob.layers.iter().map(|l| l.blocks.len()).sum(),
+                level_images: ob
+                    .layers
+                    .iter()
+                    .flat_map(|l| &l.blocks)
+                    .flat_map(|b| &b.levels)
+                    .map(|l| l.images.len())
+                    .sum(),
+                solver_iterations: m.layers.iter().map(|l| l.iterations).sum(),
+                area_px: m.area,
+            }
+        })
+        .collect();
     PackReport {
         output: req.output.display().to_string(),
         source: set.dir.display().to_string(),
@@ -237,22 +268,40 @@ impl PackReport {
     pub fn set_master(&mut self, master_bytes: u64, exact: bool) {
         self.master_bytes = master_bytes;
         self.master_exact = Some(exact);
-        self.ratio = self.raw_image_bytes as f64 / self.bytes.saturating_sub(master_bytes).max(1) as f64;
+        self.ratio =
+            self.raw_image_bytes as f64 / self.bytes.saturating_sub(master_bytes).max(1) as f64;
     }
 }
 
 /// Human-readable lines of the report.
 pub fn print_report(r: &PackReport, out: &mut impl std::io::Write) -> std::io::Result<()> {
-    writeln!(out, "{}: {} points of {}x{}, codec {}", r.output, r.points, r.resolution[0], r.resolution[1], r.codec)?;
+    writeln!(
+        out,
+        "{}: {} points of {}x{}, codec {}",
+        r.output, r.points, r.resolution[0], r.resolution[1], r.codec
+    )?;
     let anisotropy = r.anisotropy.map(|n| format!(" {n}x")).unwrap_or_default();
-    let probe = if r.matrix == "probe" { format!(", {} probe renderings", r.probe_renderings) } else { String::new() };
-    writeln!(out, "  filter {}{anisotropy}, render matrices from the {}{probe}", r.filter, if r.matrix == "probe" { "GPU (probe mode)" } else { "hardware model" })?;
+    let probe = if r.matrix == "probe" {
+        format!(", {} probe renderings", r.probe_renderings)
+    } else {
+        String::new()
+    };
+    writeln!(
+        out,
+        "  filter {}{anisotropy}, render matrices from the {}{probe}",
+        r.filter,
+        if r.matrix == "probe" { "GPU (probe mode)" } else { "hardware model" }
+    )?;
     writeln!(out, "  {} bytes (level images {}), raw {} bytes: ratio {:.1} (level images alone {:.1}, the ratio --ratio aims at)",
              r.bytes, r.texture_bytes, r.raw_image_bytes, r.ratio, r.ratio_without_geometry)?;
     if let Some(e) = r.master_exact {
         writeln!(out, "  lossless master: {} bytes, not counted by the ratio; decodes to the solved textures bit-exactly: {e}", r.master_bytes)?;
     }
-    writeln!(out, "  predicted PSNR {:.2} dB (textures as solved {:.2} dB)", r.psnr_db, r.psnr_db_solved)?;
+    writeln!(
+        out,
+        "  predicted PSNR {:.2} dB (textures as solved {:.2} dB)",
+        r.psnr_db, r.psnr_db_solved
+    )?;
     match (&r.max_mse_ratio, &r.max_mse_psnr_db) {
         (Some(a), Some(p)) => writeln!(out, "  allocation: max-MSE constraint {} (predicted {:.2} dB with the constraint, {:.2} dB free: the higher kept)", if a == "off" { "dropped" } else { "kept" }, p.constrained, p.free)?,
         (Some(a), None) if a == "off" => writeln!(out, "  allocation: free (no max-MSE constraint)")?,
@@ -263,11 +312,19 @@ pub fn print_report(r: &PackReport, out: &mut impl std::io::Write) -> std::io::R
         writeln!(out, "  lossless: file decodes to the solved textures bit-exactly: {e} (max texel error {:.3e})", r.max_texel_error)?;
     }
     if let Some(f) = &r.fragments {
-        writeln!(out, "  fragments: {} files, {} solutions; {} solves read from them, {} solved here", f.files, f.solutions, f.read, f.solved)?;
+        writeln!(
+            out,
+            "  fragments: {} files, {} solutions; {} solves read from them, {} solved here",
+            f.files, f.solutions, f.read, f.solved
+        )?;
     }
     for o in &r.objects {
         let layers: Vec<String> = o.layer_bytes.iter().map(|(k, b)| format!("{k} {b}")).collect();
-        let sizes = if o.placements.len() > 1 { format!(" up to, {} placements", o.placements.len()) } else { String::new() };
+        let sizes = if o.placements.len() > 1 {
+            format!(" up to, {} placements", o.placements.len())
+        } else {
+            String::new()
+        };
         writeln!(out, "  {:<10} {:<17} {:>8} bytes ({}), {:.2} dB (solved {:.2}), {}x{}{sizes} (reduction {:.2}), stagger {:?}, {} blocks, {} level images",
                  o.name, o.representation, o.bytes, layers.join(", "), o.psnr_db, o.psnr_db_solved, o.texture[0], o.texture[1],
                  o.reduction, o.stagger, o.blocks, o.level_images)?;
@@ -276,14 +333,20 @@ pub fn print_report(r: &PackReport, out: &mut impl std::io::Write) -> std::io::R
     let stages: Vec<String> = r.stage_ms.iter().map(|(k, v)| format!("{k} {v:.0}")).collect();
     writeln!(out, "  stages (ms): {}", stages.join(", "))?;
     if r.memory.streamed {
-        writeln!(out, "  memory: {}; scratch file {:.0} MiB", r.memory.why, r.memory.scratch_bytes as f64 / (1 << 20) as f64)?;
+        writeln!(
+            out,
+            "  memory: {}; scratch file {:.0} MiB",
+            r.memory.why,
+            r.memory.scratch_bytes as f64 / (1 << 20) as f64
+        )?;
     }
     if r.memory.over_budget() {
         let gib = |b: Option<u64>| b.unwrap_or(0) as f64 / (1u64 << 30) as f64;
         writeln!(out, "  memory: the peak of {:.2} GiB is above --memory {:.2} GiB: what a streamed pack still holds (meshes, placements, the codestreams, shell render matrices, a lens object's layers) did not fit", gib(r.memory.peak_bytes), gib(r.memory.budget_bytes))?;
     }
     if !r.stage_peak_mib.is_empty() {
-        let peaks: Vec<String> = r.stage_peak_mib.iter().map(|(k, v)| format!("{k} {v:.0}")).collect();
+        let peaks: Vec<String> =
+            r.stage_peak_mib.iter().map(|(k, v)| format!("{k} {v:.0}")).collect();
         writeln!(out, "  peak memory after each stage (MiB): {}", peaks.join(", "))?;
     }
     Ok(())

@@ -14,10 +14,10 @@ use pis_format::{DepMask, DimensionKind, ParameterSpace};
 use pis_scene::ObjectRole;
 
 use super::blocks::{block_sizes, geometry};
+use super::hybrid::HybridRendering;
 use super::input::LoadedSet;
 use super::matrices::Matrices;
 use super::model::ObjectModel;
-use super::hybrid::HybridRendering;
 use super::pem::LayeredPem;
 use super::surface::SurfaceTextures;
 use super::RepresentationMode;
@@ -49,7 +49,8 @@ pub trait Planned {
 }
 
 /// The representations pis-pack knows, in the order they are tried.
-pub const REPRESENTATIONS: &[&dyn Representation] = &[&HybridRendering, &LayeredPem, &SurfaceTextures];
+pub const REPRESENTATIONS: &[&dyn Representation] =
+    &[&HybridRendering, &LayeredPem, &SurfaceTextures];
 
 /// The representations that store an object as environment-map shells.
 const SHELLS: &[&dyn Representation] = &[&HybridRendering, &LayeredPem];
@@ -60,13 +61,20 @@ const SHELLS: &[&dyn Representation] = &[&HybridRendering, &LayeredPem];
 /// `mode` says).
 pub fn choose(role: ObjectRole, mode: RepresentationMode) -> Option<&'static dyn Representation> {
     let textures_only = matches!(mode, RepresentationMode::Texture | RepresentationMode::Auto);
-    REPRESENTATIONS.iter().copied().filter(|r| !textures_only || !SHELLS.iter().any(|s| s.name() == r.name())).find(|r| r.applies(role))
+    REPRESENTATIONS
+        .iter()
+        .copied()
+        .filter(|r| !textures_only || !SHELLS.iter().any(|s| s.name() == r.name()))
+        .find(|r| r.applies(role))
 }
 
 /// The representation also solved for an object of `role` under `mode`, to be chosen
 /// between by [`super::choice`]: in `auto`, layered environment maps for a reflective object
 /// and hybrid rendering for a refractive one.
-pub fn alternative(role: ObjectRole, mode: RepresentationMode) -> Option<&'static dyn Representation> {
+pub fn alternative(
+    role: ObjectRole,
+    mode: RepresentationMode,
+) -> Option<&'static dyn Representation> {
     if mode != RepresentationMode::Auto {
         return None;
     }
@@ -98,22 +106,49 @@ pub struct Job<'a> {
 }
 
 impl<'a> Job<'a> {
-    pub fn new(set: &'a LoadedSet, req: &'a PackRequest, matrices: &'a mut Matrices, progress: &'a dyn Progress) -> Result<Self> {
+    pub fn new(
+        set: &'a LoadedSet,
+        req: &'a PackRequest,
+        matrices: &'a mut Matrices,
+        progress: &'a dyn Progress,
+    ) -> Result<Self> {
         let scene = &set.scene;
         let meshes: Vec<Mesh> = (0..scene.objects.len()).map(|o| merged_mesh(scene, o)).collect();
         let ndims = scene.space.dims.len();
         let sizes = block_sizes(req.block.as_slice(), ndims)?;
         let (space, _) = geometry(set, &sizes);
-        let view_dims: Vec<usize> = scene.space.dims.iter().enumerate().filter(|(_, d)| d.kind == DimensionKind::View).map(|(k, _)| k).collect();
+        let view_dims: Vec<usize> = scene
+            .space
+            .dims
+            .iter()
+            .enumerate()
+            .filter(|(_, d)| d.kind == DimensionKind::View)
+            .map(|(k, _)| k)
+            .collect();
         let all = DepMask::of(&(0..ndims).collect::<Vec<_>>());
-        let non_view = DepMask::of(&(0..ndims).filter(|k| !view_dims.contains(k)).collect::<Vec<_>>());
+        let non_view =
+            DepMask::of(&(0..ndims).filter(|k| !view_dims.contains(k)).collect::<Vec<_>>());
         // Level 0 solved through the MIP chain the player decimates from it (thesis 3.6): the
         // solved textures are the drawn ones.
         let mut settings = SolveSettings::decimated();
         if let Some(n) = req.max_iterations {
             settings.cg.max_iterations = n.max(1);
         }
-        Ok(Job { set, req, matrices, progress, meshes, sizes, space, all, non_view, settings, solver: req.solver.clone(), placements: 0, extra_matrices: 0 })
+        Ok(Job {
+            set,
+            req,
+            matrices,
+            progress,
+            meshes,
+            sizes,
+            space,
+            all,
+            non_view,
+            settings,
+            solver: req.solver.clone(),
+            placements: 0,
+            extra_matrices: 0,
+        })
     }
 
     /// A note on the work.

@@ -33,14 +33,20 @@ impl Scratch {
     /// they could remove their own) are removed first.
     pub fn beside(output: &Path) -> Result<Scratch> {
         let dir = output.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
-        let name = output.file_name().map_or_else(|| "pack".into(), |n| n.to_string_lossy().into_owned());
+        let name =
+            output.file_name().map_or_else(|| "pack".into(), |n| n.to_string_lossy().into_owned());
         remove_stale(dir, &name);
         Scratch::create(&dir.join(format!(".{name}.scratch{}", std::process::id())))
     }
 
     /// A new scratch file at `path` (replaced if it exists).
     pub fn create(path: &Path) -> Result<Scratch> {
-        let file = std::fs::OpenOptions::new().read(true).write(true).create(true).truncate(true).open(path)
+        let file = std::fs::OpenOptions::new()
+            .read(true)
+            .write(true)
+            .create(true)
+            .truncate(true)
+            .open(path)
             .with_context(|| format!("creating the scratch file {}", path.display()))?;
         Ok(Scratch { path: path.to_path_buf(), file: Mutex::new((file, 0)) })
     }
@@ -50,7 +56,8 @@ impl Scratch {
         let mut g = self.file.lock().map_err(|_| anyhow!("the scratch file's lock is poisoned"))?;
         let offset = g.1;
         g.0.seek(SeekFrom::Start(offset))?;
-        g.0.write_all(bytes).with_context(|| format!("writing the scratch file {}", self.path.display()))?;
+        g.0.write_all(bytes)
+            .with_context(|| format!("writing the scratch file {}", self.path.display()))?;
         g.1 += bytes.len() as u64;
         Ok(Span { offset, len: bytes.len() as u64 })
     }
@@ -59,11 +66,16 @@ impl Scratch {
     pub fn get(&self, span: Span) -> Result<Vec<u8>> {
         let mut g = self.file.lock().map_err(|_| anyhow!("the scratch file's lock is poisoned"))?;
         if span.offset + span.len > g.1 {
-            bail!("scratch record {span:?} lies past the end of {} ({} bytes)", self.path.display(), g.1);
+            bail!(
+                "scratch record {span:?} lies past the end of {} ({} bytes)",
+                self.path.display(),
+                g.1
+            );
         }
         let mut out = vec![0u8; span.len as usize];
         g.0.seek(SeekFrom::Start(span.offset))?;
-        g.0.read_exact(&mut out).with_context(|| format!("reading the scratch file {}", self.path.display()))?;
+        g.0.read_exact(&mut out)
+            .with_context(|| format!("reading the scratch file {}", self.path.display()))?;
         Ok(out)
     }
 
@@ -90,7 +102,9 @@ fn remove_stale(dir: &Path, name: &str) -> usize {
     let mut removed = 0;
     for e in entries.filter_map(Result::ok) {
         let file = e.file_name().to_string_lossy().into_owned();
-        let Some(pid) = file.strip_prefix(&prefix).and_then(|p| p.parse::<u32>().ok()) else { continue };
+        let Some(pid) = file.strip_prefix(&prefix).and_then(|p| p.parse::<u32>().ok()) else {
+            continue;
+        };
         if pid != std::process::id() && !running(pid) && std::fs::remove_file(e.path()).is_ok() {
             removed += 1;
         }
@@ -193,19 +207,37 @@ impl<'a> Reader<'a> {
 
     pub fn u32s(&mut self) -> Result<Vec<u32>> {
         let n = self.count(4)?;
-        Ok(self.take(n * 4)?.chunks_exact(4).map(|c| u32::from_le_bytes([c[0], c[1], c[2], c[3]])).collect())
+        Ok(self
+            .take(n * 4)?
+            .chunks_exact(4)
+            .map(|c| u32::from_le_bytes([c[0], c[1], c[2], c[3]]))
+            .collect())
     }
 
     pub fn f32s(&mut self) -> Result<Vec<f32>> {
         let n = self.count(4)?;
-        Ok(self.take(n * 4)?.chunks_exact(4).map(|c| f32::from_bits(u32::from_le_bytes([c[0], c[1], c[2], c[3]]))).collect())
+        Ok(self
+            .take(n * 4)?
+            .chunks_exact(4)
+            .map(|c| f32::from_bits(u32::from_le_bytes([c[0], c[1], c[2], c[3]])))
+            .collect())
     }
 
     pub fn matrix(&mut self) -> Result<RenderMatrix> {
         let (width, height) = (self.u32()?, self.u32()?);
-        let layout = TextureLayout { width: self.u32()?, height: self.u32()?, levels: self.u32()?, faces: self.u32()? };
-        let (pixels, coverage, row_start, cols, vals) = (self.u32s()?, self.f32s()?, self.u32s()?, self.u32s()?, self.f32s()?);
-        if coverage.len() != pixels.len() || row_start.len() != pixels.len() + 1 || cols.len() != vals.len() || row_start.last().is_some_and(|&e| e as usize != cols.len()) {
+        let layout = TextureLayout {
+            width: self.u32()?,
+            height: self.u32()?,
+            levels: self.u32()?,
+            faces: self.u32()?,
+        };
+        let (pixels, coverage, row_start, cols, vals) =
+            (self.u32s()?, self.f32s()?, self.u32s()?, self.u32s()?, self.f32s()?);
+        if coverage.len() != pixels.len()
+            || row_start.len() != pixels.len() + 1
+            || cols.len() != vals.len()
+            || row_start.last().is_some_and(|&e| e as usize != cols.len())
+        {
             bail!("a scratch render matrix is inconsistent");
         }
         Ok(RenderMatrix { width, height, layout, pixels, coverage, row_start, cols, vals })
@@ -229,10 +261,19 @@ mod tests {
         let dir = tempfile::tempdir().unwrap();
         let s = Scratch::beside(&dir.path().join("out.pis")).unwrap();
         let path = s.path().to_path_buf();
-        assert!(path.is_file() && path.file_name().unwrap().to_string_lossy().starts_with(".out.pis.scratch"));
+        assert!(
+            path.is_file()
+                && path.file_name().unwrap().to_string_lossy().starts_with(".out.pis.scratch")
+        );
         let a = RenderMatrix {
-            width: 4, height: 3, layout: TextureLayout::full(2, 2),
-            pixels: vec![1, 5], coverage: vec![1.0, 0.5], row_start: vec![0, 2, 3], cols: vec![0, 3, 4], vals: vec![0.25, 0.75, -0.0],
+            width: 4,
+            height: 3,
+            layout: TextureLayout::full(2, 2),
+            pixels: vec![1, 5],
+            coverage: vec![1.0, 0.5],
+            row_start: vec![0, 2, 3],
+            cols: vec![0, 3, 4],
+            vals: vec![0.25, 0.75, -0.0],
         };
         let mut w = Writer::default();
         w.str("object.vase");
@@ -245,8 +286,14 @@ mod tests {
         let mut r = Reader::new(&bytes);
         assert_eq!(r.str().unwrap(), "object.vase");
         let b = r.matrix().unwrap();
-        assert_eq!((b.pixels, b.cols, b.row_start), (a.pixels.clone(), a.cols.clone(), a.row_start.clone()));
-        assert!(b.vals.iter().zip(&a.vals).all(|(x, y)| x.to_bits() == y.to_bits()), "values bit for bit, -0 included");
+        assert_eq!(
+            (b.pixels, b.cols, b.row_start),
+            (a.pixels.clone(), a.cols.clone(), a.row_start.clone())
+        );
+        assert!(
+            b.vals.iter().zip(&a.vals).all(|(x, y)| x.to_bits() == y.to_bits()),
+            "values bit for bit, -0 included"
+        );
         let v = r.f32s().unwrap();
         assert!(v[0].is_nan() && v[1] == 1.5);
         r.done().unwrap();
@@ -276,7 +323,10 @@ mod tests {
         if Path::new("/proc/self").exists() {
             assert!(!gone.exists(), "a dead pack's scratch file is removed");
         }
-        assert!(other.exists() && kept.exists(), "other outputs' files and other names are left alone");
+        assert!(
+            other.exists() && kept.exists(),
+            "other outputs' files and other names are left alone"
+        );
         assert!(s.path().exists(), "this pack's own file is there");
         // A pack that is running keeps its file: this process's is not removed by another.
         assert_eq!(remove_stale(dir.path(), "out.pis"), 0);

@@ -39,7 +39,9 @@ impl SetImages {
                 None => bail!("the set has no point {p}"),
             },
             SetImages::Spilled { scratch, width, height, spans } => {
-                let Some(&span) = spans.get(p).and_then(|s| s.get(o)) else { bail!("the set has no object {o} at point {p}") };
+                let Some(&span) = spans.get(p).and_then(|s| s.get(o)) else {
+                    bail!("the set has no object {o} at point {p}")
+                };
                 Ok(Cow::Owned(read_object(&scratch.get(span)?, *width, *height)?))
             }
         }
@@ -49,7 +51,9 @@ impl SetImages {
     pub fn shared(&self, p: usize) -> Result<Cow<'_, PointImages>> {
         match self {
             SetImages::Held(_) => self.object(p, 0),
-            SetImages::Spilled { spans, .. } => self.object(p, spans.get(p).map_or(0, |s| s.len().saturating_sub(1))),
+            SetImages::Spilled { spans, .. } => {
+                self.object(p, spans.get(p).map_or(0, |s| s.len().saturating_sub(1)))
+            }
         }
     }
 }
@@ -64,11 +68,16 @@ fn of_object(name: &str, channel: &str) -> bool {
 /// one record per object, then one of the layers of no object (`combined`).
 pub fn spill_point(scratch: &Scratch, img: &PointImages, channels: &[String]) -> Result<Vec<Span>> {
     let n = (img.width * img.height) as usize;
-    let mut spans = channels.iter().map(|c| {
-        let layers: Vec<&LayerImage> = img.layers.iter().filter(|l| of_object(&l.name, c)).collect();
-        scratch.put(&object_record(&layers, n))
-    }).collect::<Result<Vec<_>>>()?;
-    let shared: Vec<&LayerImage> = img.layers.iter().filter(|l| !channels.iter().any(|c| of_object(&l.name, c))).collect();
+    let mut spans = channels
+        .iter()
+        .map(|c| {
+            let layers: Vec<&LayerImage> =
+                img.layers.iter().filter(|l| of_object(&l.name, c)).collect();
+            scratch.put(&object_record(&layers, n))
+        })
+        .collect::<Result<Vec<_>>>()?;
+    let shared: Vec<&LayerImage> =
+        img.layers.iter().filter(|l| !channels.iter().any(|c| of_object(&l.name, c))).collect();
     spans.push(scratch.put(&object_record(&shared, n))?);
     Ok(spans)
 }
@@ -76,7 +85,10 @@ pub fn spill_point(scratch: &Scratch, img: &PointImages, channels: &[String]) ->
 /// An object's layers over the pixels where one of them is not zero (by bits: -0 is kept):
 /// the layers' names and channels, the pixels, then each plane at those pixels.
 fn object_record(layers: &[&LayerImage], n: usize) -> Vec<u8> {
-    let pixels: Vec<u32> = (0..n).filter(|&k| layers.iter().flat_map(|l| &l.planes).any(|p| p[k].to_bits() != 0)).map(|k| k as u32).collect();
+    let pixels: Vec<u32> = (0..n)
+        .filter(|&k| layers.iter().flat_map(|l| &l.planes).any(|p| p[k].to_bits() != 0))
+        .map(|k| k as u32)
+        .collect();
     let mut w = Writer::default();
     w.u32(layers.len() as u32);
     for l in layers {
@@ -141,7 +153,15 @@ mod tests {
             layers: vec![
                 layer("combined", &["R", "G", "B"], |c, k| (c + k) as f32),
                 layer("object.a.coverage", &["A"], |_, k| if k % 3 == 0 { 1.0 } else { 0.0 }),
-                layer("object.a.diffuse", &["R", "G", "B"], |c, k| if k % 3 == 0 { 0.1 * (c + 1) as f32 } else if k == 4 { -0.0 } else { 0.0 }),
+                layer("object.a.diffuse", &["R", "G", "B"], |c, k| {
+                    if k % 3 == 0 {
+                        0.1 * (c + 1) as f32
+                    } else if k == 4 {
+                        -0.0
+                    } else {
+                        0.0
+                    }
+                }),
                 layer("object.a.b.diffuse", &["R", "G", "B"], |c, k| (c * k) as f32 * 0.5),
             ],
         };
@@ -155,7 +175,12 @@ mod tests {
         for (o, c) in channels.iter().enumerate() {
             let (h, s) = (held.object(0, o).unwrap(), spilled.object(0, o).unwrap());
             let names: Vec<&str> = s.layers.iter().map(|l| l.name.as_str()).collect();
-            let want: Vec<&str> = img.layers.iter().filter(|l| of_object(&l.name, c)).map(|l| l.name.as_str()).collect();
+            let want: Vec<&str> = img
+                .layers
+                .iter()
+                .filter(|l| of_object(&l.name, c))
+                .map(|l| l.name.as_str())
+                .collect();
             assert_eq!(names, want, "object {c}: its layers only");
             for l in &s.layers {
                 let hl = h.layer(&l.name).unwrap();
@@ -167,7 +192,15 @@ mod tests {
         }
         let shared = spilled.shared(0).unwrap();
         assert_eq!(shared.layers.len(), 1);
-        assert!(shared.layers[0].planes.iter().flatten().zip(img.layers[0].planes.iter().flatten()).all(|(a, b)| a.to_bits() == b.to_bits()), "combined comes back whole");
+        assert!(
+            shared.layers[0]
+                .planes
+                .iter()
+                .flatten()
+                .zip(img.layers[0].planes.iter().flatten())
+                .all(|(a, b)| a.to_bits() == b.to_bits()),
+            "combined comes back whole"
+        );
         assert!(held.shared(0).unwrap().layer("combined").is_some());
         assert!(spilled.object(1, 0).is_err() && spilled.object(0, 4).is_err());
     }

@@ -386,4 +386,3 @@ pub const DEFAULT_GAMMA: f32 = pis_codec::gamma::DEFAULT_GAMMA;
 
 /// The default compression ratio when neither `--ratio` nor `--psnr` is given.
 pub const DEFAULT_RATIO: f64 = 384.0;
-

@@ -18,7 +18,8 @@ use pis_trace::material::ShadingMaterial;
 /// the tracer shades it.
 pub fn object_shading(scene: &Scene, o: usize) -> Shading {
     let default = Material::default();
-    let material = dominant_material(scene, o).and_then(|m| scene.materials.get(m)).unwrap_or(&default);
+    let material =
+        dominant_material(scene, o).and_then(|m| scene.materials.get(m)).unwrap_or(&default);
     material_shading(scene, material)
 }
 
@@ -50,19 +51,26 @@ pub fn material_shading(scene: &Scene, material: &Material) -> Shading {
 pub fn dominant_material(scene: &Scene, o: usize) -> Option<usize> {
     let mut area: Vec<(usize, f64)> = Vec::new();
     for p in &scene.objects[o].primitives {
-        let a: f64 = p.indices.chunks_exact(3).map(|t| {
-            let [a, b, c] = [t[0], t[1], t[2]].map(|i| p.positions.get(i as usize).copied().unwrap_or(Vec3::ZERO));
-            0.5 * (b - a).cross(c - a).length() as f64
-        }).sum();
+        let a: f64 = p
+            .indices
+            .chunks_exact(3)
+            .map(|t| {
+                let [a, b, c] = [t[0], t[1], t[2]]
+                    .map(|i| p.positions.get(i as usize).copied().unwrap_or(Vec3::ZERO));
+                0.5 * (b - a).cross(c - a).length() as f64
+            })
+            .sum();
         match area.iter_mut().find(|(m, _)| *m == p.material) {
             Some(e) => e.1 += a,
             None => area.push((p.material, a)),
         }
     }
-    area.into_iter().fold(None, |best: Option<(usize, f64)>, (m, a)| match best {
-        Some((_, b)) if b >= a => best,
-        _ => Some((m, a)),
-    }).map(|(m, _)| m)
+    area.into_iter()
+        .fold(None, |best: Option<(usize, f64)>, (m, a)| match best {
+            Some((_, b)) if b >= a => best,
+            _ => Some((m, a)),
+        })
+        .map(|(m, _)| m)
 }
 
 #[cfg(test)]
@@ -90,7 +98,12 @@ mod tests {
     fn scene(materials: Vec<Material>, primitives: Vec<Primitive>) -> Scene {
         Scene {
             materials,
-            objects: vec![SceneObject { name: "o".into(), role: ObjectRole::Reflective, reflector: None, primitives }],
+            objects: vec![SceneObject {
+                name: "o".into(),
+                role: ObjectRole::Reflective,
+                reflector: None,
+                primitives,
+            }],
             ..Scene::default()
         }
     }
@@ -106,15 +119,27 @@ mod tests {
 
     #[test]
     fn f0_mixes_the_dielectric_and_the_base_colour_by_metallic() {
-        let m = Material { base_color: [0.8, 0.5, 0.2, 1.0], metallic: 0.25, specular: 0.5, specular_color: [1.0, 0.5, 1.0], ..Material::default() };
+        let m = Material {
+            base_color: [0.8, 0.5, 0.2, 1.0],
+            metallic: 0.25,
+            specular: 0.5,
+            specular_color: [1.0, 0.5, 1.0],
+            ..Material::default()
+        };
         let s = material_shading(&Scene::default(), &m);
-        let want = [0, 1, 2].map(|c| 0.04 * m.specular_color[c] * 0.75 * 0.5 + m.base_color[c] * 0.25);
+        let want =
+            [0, 1, 2].map(|c| 0.04 * m.specular_color[c] * 0.75 * 0.5 + m.base_color[c] * 0.25);
         assert!(close(s.f0, want), "{:?} vs {want:?}", s.f0);
     }
 
     #[test]
     fn f0_reproduces_the_tracers_fresnel_with_a_unit_specular_factor() {
-        let m = Material { base_color: [0.9, 0.6, 0.3, 1.0], metallic: 0.4, ior: 1.7, ..Material::default() };
+        let m = Material {
+            base_color: [0.9, 0.6, 0.3, 1.0],
+            metallic: 0.4,
+            ior: 1.7,
+            ..Material::default()
+        };
         let s = material_shading(&Scene::default(), &m);
         let traced = ShadingMaterial::at(&Scene::default(), &m, Vec2::ZERO);
         for cos in [1.0f32, 0.7, 0.3, 0.05] {
@@ -126,7 +151,13 @@ mod tests {
 
     #[test]
     fn absorption_is_beer_lambert_of_the_attenuation() {
-        let m = Material { transmission: 1.0, metallic: 0.0, attenuation_color: [0.5, 1.0, 0.25], attenuation_distance: 2.0, ..Material::default() };
+        let m = Material {
+            transmission: 1.0,
+            metallic: 0.0,
+            attenuation_color: [0.5, 1.0, 0.25],
+            attenuation_distance: 2.0,
+            ..Material::default()
+        };
         let s = material_shading(&Scene::default(), &m);
         let want = [0.5f32, 1.0, 0.25].map(|c| -c.ln() / 2.0);
         assert!(close(s.absorption, want), "{:?} vs {want:?}", s.absorption);
@@ -135,8 +166,17 @@ mod tests {
     #[test]
     fn a_base_colour_texture_counts_as_its_mean() {
         let mut sc = Scene::default();
-        sc.textures.push(TextureImage { width: 2, height: 1, texels: vec![[1.0, 0.0, 0.5, 1.0], [0.0, 0.0, 0.5, 1.0]] });
-        let m = Material { base_color: [0.8, 1.0, 1.0, 1.0], base_color_texture: Some(TextureRef::new(0)), metallic: 1.0, ..Material::default() };
+        sc.textures.push(TextureImage {
+            width: 2,
+            height: 1,
+            texels: vec![[1.0, 0.0, 0.5, 1.0], [0.0, 0.0, 0.5, 1.0]],
+        });
+        let m = Material {
+            base_color: [0.8, 1.0, 1.0, 1.0],
+            base_color_texture: Some(TextureRef::new(0)),
+            metallic: 1.0,
+            ..Material::default()
+        };
         let s = material_shading(&sc, &m);
         assert!(close(s.f0, [0.4, 0.0, 0.5]), "{:?}", s.f0);
     }
@@ -145,8 +185,17 @@ mod tests {
     fn a_metallic_roughness_texture_counts_as_its_mean_metallic() {
         // metallicFactor 1 with a map half dielectric, half metal: metallic ½, not 1.
         let mut sc = Scene::default();
-        sc.textures.push(TextureImage { width: 2, height: 1, texels: vec![[0.0, 1.0, 0.0, 1.0], [0.0, 1.0, 1.0, 1.0]] });
-        let m = Material { base_color: [0.8, 0.8, 0.8, 1.0], metallic: 1.0, metallic_roughness_texture: Some(TextureRef::new(0)), ..Material::default() };
+        sc.textures.push(TextureImage {
+            width: 2,
+            height: 1,
+            texels: vec![[0.0, 1.0, 0.0, 1.0], [0.0, 1.0, 1.0, 1.0]],
+        });
+        let m = Material {
+            base_color: [0.8, 0.8, 0.8, 1.0],
+            metallic: 1.0,
+            metallic_roughness_texture: Some(TextureRef::new(0)),
+            ..Material::default()
+        };
         let s = material_shading(&sc, &m);
         assert!(close(s.f0, [0.04 * 0.5 + 0.8 * 0.5; 3]), "{:?}", s.f0);
     }
@@ -154,13 +203,18 @@ mod tests {
     #[test]
     fn the_material_covering_the_largest_area_describes_the_object() {
         let glass = Material { transmission: 1.0, metallic: 0.0, ior: 1.33, ..Material::default() };
-        let steel = Material { metallic: 1.0, base_color: [0.6, 0.6, 0.6, 1.0], ..Material::default() };
+        let steel =
+            Material { metallic: 1.0, base_color: [0.6, 0.6, 0.6, 1.0], ..Material::default() };
         // Material 0 in two small triangles (area 2 · 0.5), material 1 in one of area 2.
-        let sc = scene(vec![glass, steel], vec![triangle(1.0, 0), triangle(2.0, 1), triangle(1.0, 0)]);
+        let sc =
+            scene(vec![glass, steel], vec![triangle(1.0, 0), triangle(2.0, 1), triangle(1.0, 0)]);
         assert_eq!(dominant_material(&sc, 0), Some(1));
         assert!(close(object_shading(&sc, 0).f0, [0.6; 3]));
         // Equal areas: the first.
-        let sc = scene(vec![Material::default(), Material::default()], vec![triangle(1.0, 1), triangle(1.0, 0)]);
+        let sc = scene(
+            vec![Material::default(), Material::default()],
+            vec![triangle(1.0, 1), triangle(1.0, 0)],
+        );
         assert_eq!(dominant_material(&sc, 0), Some(1));
         // No primitives, or a material index out of range: the default material.
         let sc = scene(vec![], vec![]);

@@ -32,7 +32,12 @@ pub struct SolveReport {
 
 /// The fragment file of shard `shard` in the folder `fragments`.
 pub fn fragment_path(fragments: &std::path::Path, shard: Shard) -> PathBuf {
-    fragments.join(format!("solve-{:04}-of-{:04}.{}", shard.index, shard.count, crate::solutions::FRAGMENT_EXTENSION))
+    fragments.join(format!(
+        "solve-{:04}-of-{:04}.{}",
+        shard.index,
+        shard.count,
+        crate::solutions::FRAGMENT_EXTENSION
+    ))
 }
 
 /// The solve of a pack split over processes: runs `req`'s inference for the objects of
@@ -40,11 +45,27 @@ pub fn fragment_path(fragments: &std::path::Path, shard: Shard) -> PathBuf {
 /// writes the solutions to a fragment file in the folder `fragments` (atomically); with
 /// `resume`, a fragment that is there already is kept and nothing is done.
 /// [`merge_fragments`] then writes the file.
-pub fn solve_shard(req: &PackRequest, shard: Shard, fragments: &std::path::Path, resume: bool, progress: &dyn Progress) -> Result<SolveReport, Failure> {
+pub fn solve_shard(
+    req: &PackRequest,
+    shard: Shard,
+    fragments: &std::path::Path,
+    resume: bool,
+    progress: &dyn Progress,
+) -> Result<SolveReport, Failure> {
     let start = Instant::now();
-    std::fs::create_dir_all(fragments).map_err(|e| Failure::new(Exit::Io, anyhow::anyhow!("{}: {e}", fragments.display())))?;
+    std::fs::create_dir_all(fragments)
+        .map_err(|e| Failure::new(Exit::Io, anyhow::anyhow!("{}: {e}", fragments.display())))?;
     let path = fragment_path(fragments, shard);
-    let mut report = SolveReport { shard: shard.to_string(), fragment: path.display().to_string(), objects: Vec::new(), solutions: 0, bytes: 0, resumed: false, seconds: 0.0, stage_ms: BTreeMap::new() };
+    let mut report = SolveReport {
+        shard: shard.to_string(),
+        fragment: path.display().to_string(),
+        objects: Vec::new(),
+        solutions: 0,
+        bytes: 0,
+        resumed: false,
+        seconds: 0.0,
+        stage_ms: BTreeMap::new(),
+    };
     if resume && path.is_file() {
         report.resumed = true;
         report.bytes = std::fs::metadata(&path).map(|m| m.len()).unwrap_or(0);
@@ -58,11 +79,21 @@ pub fn solve_shard(req: &PackRequest, shard: Shard, fragments: &std::path::Path,
     req.output = path.clone();
     let mut stages = Stages::new(progress);
     let (set, mut matrices) = begin(&req, &mut stages)?;
-    let inferred = infer_layers::infer_all(&set, &req, &mut matrices, &mut stages).map_err(|e| Failure::new(Exit::Runtime, e))?;
+    let inferred = infer_layers::infer_all(&set, &req, &mut matrices, &mut stages)
+        .map_err(|e| Failure::new(Exit::Runtime, e))?;
     report.objects = inferred.models.iter().map(|m| m.name.clone()).collect();
     report.solutions = store.len();
     report.bytes = store.write_fragment(&path).map_err(|e| Failure::new(Exit::Io, e))?;
-    stages.done("fragment", &format!("{} solutions of {} objects ({} bytes) to {}", report.solutions, report.objects.len(), report.bytes, path.display()));
+    stages.done(
+        "fragment",
+        &format!(
+            "{} solutions of {} objects ({} bytes) to {}",
+            report.solutions,
+            report.objects.len(),
+            report.bytes,
+            path.display()
+        ),
+    );
     report.stage_ms = stages.ms.into_iter().collect();
     report.seconds = start.elapsed().as_secs_f64();
     Ok(report)
@@ -70,10 +101,13 @@ pub fn solve_shard(req: &PackRequest, shard: Shard, fragments: &std::path::Path,
 
 /// The fragment files in the folder `fragments`, in name order.
 pub fn fragment_files(fragments: &std::path::Path) -> Result<Vec<PathBuf>, Failure> {
-    let read = std::fs::read_dir(fragments).map_err(|e| Failure::new(Exit::Io, anyhow::anyhow!("{}: {e}", fragments.display())))?;
+    let read = std::fs::read_dir(fragments)
+        .map_err(|e| Failure::new(Exit::Io, anyhow::anyhow!("{}: {e}", fragments.display())))?;
     let mut files: Vec<PathBuf> = read
         .filter_map(|e| e.ok().map(|e| e.path()))
-        .filter(|p| p.extension().is_some_and(|x| x == crate::solutions::FRAGMENT_EXTENSION) && p.is_file())
+        .filter(|p| {
+            p.extension().is_some_and(|x| x == crate::solutions::FRAGMENT_EXTENSION) && p.is_file()
+        })
         .collect();
     files.sort();
     Ok(files)
@@ -82,7 +116,11 @@ pub fn fragment_files(fragments: &std::path::Path) -> Result<Vec<PathBuf>, Failu
 /// The merge of a pack split over processes: packs `req` as [`pack_request`] does, every
 /// solve the fragments in the folder `fragments` hold read from them instead of solved
 /// (a solve none holds is solved here). The file is the one a single process writes.
-pub fn merge_fragments(req: &PackRequest, fragments: &std::path::Path, progress: &dyn Progress) -> Result<PackReport, Failure> {
+pub fn merge_fragments(
+    req: &PackRequest,
+    fragments: &std::path::Path,
+    progress: &dyn Progress,
+) -> Result<PackReport, Failure> {
     let t = Instant::now();
     let files = fragment_files(fragments)?;
     if files.is_empty() {
@@ -94,7 +132,11 @@ pub fn merge_fragments(req: &PackRequest, fragments: &std::path::Path, progress:
         held += store.read_fragment(f).map_err(|e| Failure::new(Exit::Invalid, e))?;
     }
     let read_ms = t.elapsed().as_secs_f64() * 1e3;
-    progress.stage("fragments", read_ms, &format!("{held} solutions from {} fragment files in {}", files.len(), fragments.display()));
+    progress.stage(
+        "fragments",
+        read_ms,
+        &format!("{held} solutions from {} fragment files in {}", files.len(), fragments.display()),
+    );
     let mut req = req.clone();
     req.solver = crate::solutions::Solver::with(store.clone());
     let mut report = pack_request(&req, progress)?;

@@ -8,13 +8,14 @@ use std::sync::Arc;
 
 use anyhow::{anyhow, bail, Result};
 use pis_codec::allocate::{allocate, Item, Target};
-use pis_codec::pyramid::{adaptive, build, l1_cost, level_image_index, unflatten, Pyramid, PyramidFilter, PyramidLevel};
+use pis_codec::pyramid::{
+    adaptive, build, l1_cost, level_image_index, unflatten, Pyramid, PyramidFilter, PyramidLevel,
+};
 use pis_codec::{CodecId, LevelCodec, PlaneShape, Rate};
 use rayon::prelude::*;
 
 use super::scratch::{Reader, Scratch, Span, Writer};
 use super::settings::MaxMse;
-
 
 /// One pyramid level as coded: counts, the images as encoded, their codestreams.
 pub type CodedLevel = (Vec<u32>, Vec<Vec<f32>>, Vec<Vec<u8>>);
@@ -64,14 +65,19 @@ impl BlockPyramid {
         };
         let mut spans = spans.iter();
         let mut read = || -> Result<Vec<f32>> {
-            let span = spans.next().ok_or_else(|| anyhow!("a spilled block has fewer level images than its levels count"))?;
+            let span = spans.next().ok_or_else(|| {
+                anyhow!("a spilled block has fewer level images than its levels count")
+            })?;
             let bytes = scratch.get(*span)?;
             let mut r = Reader::new(&bytes);
             let img = r.f32s()?;
             r.done()?;
             Ok(img)
         };
-        self.levels.iter().map(|l| (0..l.1.len()).map(|_| read()).collect::<Result<Vec<_>>>().map(Cow::Owned)).collect()
+        self.levels
+            .iter()
+            .map(|l| (0..l.1.len()).map(|_| read()).collect::<Result<Vec<_>>>().map(Cow::Owned))
+            .collect()
     }
 
     /// The allocation's item of every level image, in level and image order (with `c`, a
@@ -82,20 +88,36 @@ impl BlockPyramid {
             return Ok(rd.clone());
         }
         let count: usize = self.extent.iter().map(|&e| e as usize).product();
-        let members: Vec<Vec<usize>> = self.levels.iter().map(|(counts, images, _)| {
-            let mut m = vec![0usize; images.len()];
-            for s in 0..count {
-                m[level_image_index(counts, &unflatten(s, &self.extent), &self.extent)] += 1;
-            }
-            m
-        }).collect();
-        let refs: Vec<(usize, usize)> = self.levels.iter().enumerate().flat_map(|(lv, l)| (0..l.1.len()).map(move |ii| (lv, ii))).collect();
-        Ok(refs.par_iter().map(|&(lv, ii)| {
-            let values = &self.levels[lv].1[ii];
-            let weights = level_image_weights(self, lv, ii, values.len());
-            let curve = c.rd_curve_weighted(&self.planes, values, weights.as_deref())?;
-            Ok(Item { curve, object: self.object, weight: members[lv][ii] as f64 / self.layer_samples })
-        }).collect::<Result<Vec<Item>, pis_codec::CodecError>>()?)
+        let members: Vec<Vec<usize>> = self
+            .levels
+            .iter()
+            .map(|(counts, images, _)| {
+                let mut m = vec![0usize; images.len()];
+                for s in 0..count {
+                    m[level_image_index(counts, &unflatten(s, &self.extent), &self.extent)] += 1;
+                }
+                m
+            })
+            .collect();
+        let refs: Vec<(usize, usize)> = self
+            .levels
+            .iter()
+            .enumerate()
+            .flat_map(|(lv, l)| (0..l.1.len()).map(move |ii| (lv, ii)))
+            .collect();
+        Ok(refs
+            .par_iter()
+            .map(|&(lv, ii)| {
+                let values = &self.levels[lv].1[ii];
+                let weights = level_image_weights(self, lv, ii, values.len());
+                let curve = c.rd_curve_weighted(&self.planes, values, weights.as_deref())?;
+                Ok(Item {
+                    curve,
+                    object: self.object,
+                    weight: members[lv][ii] as f64 / self.layer_samples,
+                })
+            })
+            .collect::<Result<Vec<Item>, pis_codec::CodecError>>()?)
     }
 
     /// Moves the level images to `scratch`, having measured their rate–distortion items
@@ -105,7 +127,8 @@ impl BlockPyramid {
             return Ok(());
         }
         if codec.is_lossy() {
-            let c = pis_codec::codec(codec).ok_or_else(|| anyhow!("codec {codec} is not in this build"))?;
+            let c = pis_codec::codec(codec)
+                .ok_or_else(|| anyhow!("codec {codec} is not in this build"))?;
             self.rd = Some(self.items(c)?);
         }
         // The screen weights served the curves only.
@@ -131,7 +154,15 @@ impl BlockPyramid {
 ///
 /// `full`: every level of the pyramid over the block, without adaptive subdivision (the
 /// baseline `pis-pack --pyramid full` compares against).
-pub fn build_pyramid(object: usize, planes: Vec<PlaneShape>, extent: &[u32], samples: &[Vec<f32>], layer_samples: f64, exact: bool, full: bool) -> Result<BlockPyramid> {
+pub fn build_pyramid(
+    object: usize,
+    planes: Vec<PlaneShape>,
+    extent: &[u32],
+    samples: &[Vec<f32>],
+    layer_samples: f64,
+    exact: bool,
+    full: bool,
+) -> Result<BlockPyramid> {
     let mut pyr = if full {
         build(extent, samples, &full_levels(extent), PyramidFilter::Gaussian)?
     } else {
@@ -140,11 +171,24 @@ pub fn build_pyramid(object: usize, planes: Vec<PlaneShape>, extent: &[u32], sam
     if exact {
         exact_finest(&mut pyr, samples, extent);
     }
-    let levels = pyr.levels.into_iter().map(|l| {
-        let n = l.images.len();
-        (l.counts, l.images, vec![Vec::new(); n])
-    }).collect();
-    Ok(BlockPyramid { object, planes, extent: extent.to_vec(), layer_samples, levels, texel_weights: None, spilled: None, rd: None })
+    let levels = pyr
+        .levels
+        .into_iter()
+        .map(|l| {
+            let n = l.images.len();
+            (l.counts, l.images, vec![Vec::new(); n])
+        })
+        .collect();
+    Ok(BlockPyramid {
+        object,
+        planes,
+        extent: extent.to_vec(),
+        layer_samples,
+        levels,
+        texel_weights: None,
+        spilled: None,
+        rd: None,
+    })
 }
 
 /// What the allocation gave: bytes per level image (in block, level, image order), or the
@@ -163,25 +207,58 @@ pub struct Storage {
 /// `codec`: each level image's rate–distortion curve, weighted by the share of its layer's
 /// samples it reaches and by its object's screen area `areas[object]`, with the max-MSE
 /// constraint as `max_mse` asks (thesis 4.8). Exact codecs need no allocation.
-pub fn allocate_storage(blocks: &[BlockPyramid], codec: CodecId, target: Target, areas: &[f64], max_mse: MaxMse) -> Result<Storage> {
-    let refs: Vec<(usize, usize, usize)> = blocks.iter().enumerate()
-        .flat_map(|(b, pb)| pb.levels.iter().enumerate().flat_map(move |(lv, l)| (0..l.1.len()).map(move |ii| (b, lv, ii))))
+pub fn allocate_storage(
+    blocks: &[BlockPyramid],
+    codec: CodecId,
+    target: Target,
+    areas: &[f64],
+    max_mse: MaxMse,
+) -> Result<Storage> {
+    let refs: Vec<(usize, usize, usize)> = blocks
+        .iter()
+        .enumerate()
+        .flat_map(|(b, pb)| {
+            pb.levels
+                .iter()
+                .enumerate()
+                .flat_map(move |(lv, l)| (0..l.1.len()).map(move |ii| (b, lv, ii)))
+        })
         .collect();
     if !codec.is_lossy() {
-        return Ok(Storage { rates: vec![Rate::Default; refs.len()], allocated: None, level_images: refs.len(), free: None });
+        return Ok(Storage {
+            rates: vec![Rate::Default; refs.len()],
+            allocated: None,
+            level_images: refs.len(),
+            free: None,
+        });
     }
     let c = pis_codec::codec(codec).ok_or_else(|| anyhow!("codec {codec} is not in this build"))?;
     // Blocks in parallel where their items are to be measured, their level images in
     // parallel within each.
-    let items: Vec<Item> = blocks.par_iter().map(|pb| pb.items(c)).collect::<Result<Vec<_>>>()?.into_iter().flatten().collect();
+    let items: Vec<Item> = blocks
+        .par_iter()
+        .map(|pb| pb.items(c))
+        .collect::<Result<Vec<_>>>()?
+        .into_iter()
+        .flatten()
+        .collect();
     let a = allocate(&items, areas, target, max_mse.alpha())?;
     // Two allocations of one byte budget compare by their predictions; a PSNR target asks
     // for the fewest bytes instead, and keeps the constraint.
     let free = match max_mse {
-        MaxMse::Best(_) if matches!(target, Target::Bytes(_)) => Some(allocate(&items, areas, target, None)?).filter(|f| f.bytes != a.bytes).map(|f| (f.bytes.into_iter().map(Rate::Bytes).collect(), f.total_bytes)),
+        MaxMse::Best(_) if matches!(target, Target::Bytes(_)) => {
+            Some(allocate(&items, areas, target, None)?)
+                .filter(|f| f.bytes != a.bytes)
+                .map(|f| (f.bytes.into_iter().map(Rate::Bytes).collect(), f.total_bytes))
+        }
         _ => None,
     };
-    Ok(Storage { rates: a.bytes.into_iter().map(Rate::Bytes).collect(), allocated: Some(a.total_bytes), level_images: refs.len(), free })
+    Ok(Storage {
+        rates: a.bytes.into_iter().map(Rate::Bytes).collect(),
+        allocated: Some(a.total_bytes),
+        level_images: refs.len(),
+        free,
+    })
 }
 
 /// The screen weight of every value of level image `ii` of level `lv`: the mean of the
@@ -228,7 +305,11 @@ pub fn encode_levels(blocks: &mut [BlockPyramid], codec: CodecId, rates: &[Rate]
 
 /// The codestreams of every level image of `blocks` at `rates` (in block, level, image
 /// order), per block, level and image; the pyramids are left as they are.
-pub fn level_streams(blocks: &[BlockPyramid], codec: CodecId, rates: &[Rate]) -> Result<Vec<Vec<Vec<Vec<u8>>>>> {
+pub fn level_streams(
+    blocks: &[BlockPyramid],
+    codec: CodecId,
+    rates: &[Rate],
+) -> Result<Vec<Vec<Vec<Vec<u8>>>>> {
     let c = pis_codec::codec(codec).ok_or_else(|| anyhow!("codec {codec} is not in this build"))?;
     // Each block's first rate.
     let mut first = Vec::with_capacity(blocks.len());
@@ -240,16 +321,30 @@ pub fn level_streams(blocks: &[BlockPyramid], codec: CodecId, rates: &[Rate]) ->
     if rates.len() < n {
         bail!("fewer rates ({}) than level images ({n})", rates.len());
     }
-    blocks.par_iter().zip(first).map(|(pb, first)| {
-        let images = pb.level_images()?;
-        let jobs: Vec<(usize, usize, Rate)> = images.iter().enumerate().flat_map(|(lv, l)| (0..l.len()).map(move |ii| (lv, ii))).enumerate().map(|(k, (lv, ii))| (lv, ii, rates[first + k])).collect();
-        let streams = jobs.par_iter().map(|&(lv, ii, rate)| c.encode(&pb.planes, &images[lv][ii], rate)).collect::<Result<Vec<Vec<u8>>, pis_codec::CodecError>>()?;
-        let mut out: Vec<Vec<Vec<u8>>> = images.iter().map(|l| vec![Vec::new(); l.len()]).collect();
-        for ((lv, ii, _), bytes) in jobs.into_iter().zip(streams) {
-            out[lv][ii] = bytes;
-        }
-        Ok(out)
-    }).collect()
+    blocks
+        .par_iter()
+        .zip(first)
+        .map(|(pb, first)| {
+            let images = pb.level_images()?;
+            let jobs: Vec<(usize, usize, Rate)> = images
+                .iter()
+                .enumerate()
+                .flat_map(|(lv, l)| (0..l.len()).map(move |ii| (lv, ii)))
+                .enumerate()
+                .map(|(k, (lv, ii))| (lv, ii, rates[first + k]))
+                .collect();
+            let streams = jobs
+                .par_iter()
+                .map(|&(lv, ii, rate)| c.encode(&pb.planes, &images[lv][ii], rate))
+                .collect::<Result<Vec<Vec<u8>>, pis_codec::CodecError>>()?;
+            let mut out: Vec<Vec<Vec<u8>>> =
+                images.iter().map(|l| vec![Vec::new(); l.len()]).collect();
+            for ((lv, ii, _), bytes) in jobs.into_iter().zip(streams) {
+                out[lv][ii] = bytes;
+            }
+            Ok(out)
+        })
+        .collect()
 }
 
 /// Makes the finest level's residuals such that the decoder's f32 sum of the levels, top
@@ -315,7 +410,9 @@ mod tests {
         // A 1-D block of 4 samples, 2 texels each, RGB; pyramid levels: 1 image, then 4.
         let extent = [4u32];
         let samples: Vec<Vec<f32>> = (0..4).map(|s| vec![s as f32; 6]).collect();
-        let mut pb = build_pyramid(0, vec![PlaneShape::new(2, 1, 3)], &extent, &samples, 4.0, false, true).unwrap();
+        let mut pb =
+            build_pyramid(0, vec![PlaneShape::new(2, 1, 3)], &extent, &samples, 4.0, false, true)
+                .unwrap();
         let maps = vec![vec![1.0, 0.0], vec![3.0, 0.0], vec![0.0, 2.0], vec![0.0, 2.0]];
         assert!(level_image_weights(&pb, 0, 0, 6).is_none(), "no weights: uniform");
         pb.texel_weights = Some(maps.clone());
@@ -323,10 +420,16 @@ mod tests {
         let finest = pb.levels.len() - 1;
         assert_eq!(pb.levels[top].1.len(), 1);
         // the top image reaches all four samples: the mean of the maps, per channel
-        assert_eq!(level_image_weights(&pb, top, 0, 6).unwrap(), vec![1.0, 1.0, 1.0, 1.0, 1.0, 1.0]);
+        assert_eq!(
+            level_image_weights(&pb, top, 0, 6).unwrap(),
+            vec![1.0, 1.0, 1.0, 1.0, 1.0, 1.0]
+        );
         // a finest image reaches its own sample only
         let idx = level_image_index(&pb.levels[finest].0, &[1], &extent);
-        assert_eq!(level_image_weights(&pb, finest, idx, 6).unwrap(), vec![3.0, 3.0, 3.0, 0.0, 0.0, 0.0]);
+        assert_eq!(
+            level_image_weights(&pb, finest, idx, 6).unwrap(),
+            vec![3.0, 3.0, 3.0, 0.0, 0.0, 0.0]
+        );
         // maps of the wrong size are ignored rather than misread
         pb.texel_weights = Some(vec![vec![1.0; 3]; 4]);
         assert!(level_image_weights(&pb, top, 0, 6).is_none());

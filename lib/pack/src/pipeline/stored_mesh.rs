@@ -27,7 +27,9 @@ pub fn stored_mesh(set: &LoadedSet, m: &ObjectModel, role: ObjectRole) -> Mesh {
 /// Object-space positions moved by the baked linear part `bake`, if any.
 fn stored_positions(bake: Option<Mat4>, positions: &[[f32; 3]]) -> Vec<[f32; 3]> {
     match bake {
-        Some(b) => positions.iter().map(|&p| b.transform_point3(Vec3::from(p)).to_array()).collect(),
+        Some(b) => {
+            positions.iter().map(|&p| b.transform_point3(Vec3::from(p)).to_array()).collect()
+        }
         None => positions.to_vec(),
     }
 }
@@ -37,11 +39,14 @@ fn stored_positions(bake: Option<Mat4>, positions: &[[f32; 3]]) -> Vec<[f32; 3]>
 /// renormalized. A normal that collapses keeps its direction before the bake.
 pub fn stored_normals(bake: Option<Mat4>, normals: &[[f32; 3]]) -> Vec<[f32; 3]> {
     let inverse_transpose = bake.map(|b| Mat3::from_mat4(b).inverse().transpose());
-    normals.iter().map(|&n| {
-        let n = Vec3::from(n);
-        let before = n.normalize_or(Vec3::Y);
-        inverse_transpose.map_or(before, |m| (m * n).normalize_or(before)).to_array()
-    }).collect()
+    normals
+        .iter()
+        .map(|&n| {
+            let n = Vec3::from(n);
+            let before = n.normalize_or(Vec3::Y);
+            inverse_transpose.map_or(before, |m| (m * n).normalize_or(before)).to_array()
+        })
+        .collect()
 }
 
 #[cfg(test)]

@@ -13,7 +13,10 @@ use std::borrow::Cow;
 use std::collections::BTreeMap;
 
 use anyhow::{anyhow, Result};
-use pis_compile::{CompileError, DrawMesh, RenderMatrix, SolveSettings, TextureLayout, TexturedObject, View, ViewSource, Viewport};
+use pis_compile::{
+    CompileError, DrawMesh, RenderMatrix, SolveSettings, TextureLayout, TexturedObject, View,
+    ViewSource, Viewport,
+};
 use pis_format::blocks::BlockGrid;
 use pis_format::DepMask;
 use pis_scene::ObjectRole;
@@ -26,8 +29,10 @@ use super::model::{key, InferredLayer, LayerForm, ObjectModel, PointView, Views}
 use super::represent::{Job, Planned, Representation, Surveyed};
 use super::textures::Textures;
 use super::{PackRequest, PlacementMode};
+use crate::infer::{
+    atlas, gather, merged_mesh, place_in, restrict_rows, sampler, Atlas, Mesh, Placed,
+};
 use crate::solutions::Solver;
-use crate::infer::{atlas, gather, merged_mesh, place_in, restrict_rows, sampler, Atlas, Mesh, Placed};
 
 /// Largest linear radiance below which a layer counts as black.
 pub const BLACK: f32 = 1e-4;
@@ -56,37 +61,82 @@ pub(super) fn coverage(set: &LoadedSet, p: usize, o: usize) -> Result<Vec<f32>> 
 /// Object `o`'s coverage per pixel in `images` (a point of `set`).
 fn coverage_in(set: &LoadedSet, images: &PointImages, o: usize) -> Vec<f32> {
     let (w, h) = set.resolution;
-    images.object_layer(&set.channels[o], TraceLayer::Coverage).and_then(|l| l.channel("A"))
-        .map(<[f32]>::to_vec).unwrap_or_else(|| vec![0.0; (w * h) as usize])
+    images
+        .object_layer(&set.channels[o], TraceLayer::Coverage)
+        .and_then(|l| l.channel("A"))
+        .map(<[f32]>::to_vec)
+        .unwrap_or_else(|| vec![0.0; (w * h) as usize])
 }
 
 /// The render matrix of object `o` at point `p` with texture coordinates `uvs` and placement
 /// `placed`, every other mesh occluding it; rows where the tracer covers no pixel (of
 /// `coverage`, the object's there) removed.
 #[allow(clippy::too_many_arguments)]
-fn matrix_at(set: &LoadedSet, p: usize, o: usize, meshes: &[Mesh], uvs: &[[f32; 2]], placed: &Placed, req: &PackRequest, matrices: &mut Matrices, coverage: &[f32]) -> Result<RenderMatrix> {
+fn matrix_at(
+    set: &LoadedSet,
+    p: usize,
+    o: usize,
+    meshes: &[Mesh],
+    uvs: &[[f32; 2]],
+    placed: &Placed,
+    req: &PackRequest,
+    matrices: &mut Matrices,
+    coverage: &[f32],
+) -> Result<RenderMatrix> {
     let (w, h) = set.resolution;
     let frame = &set.frames[p];
     let clip_from = |k: usize| {
-        pis_trace::camera::projection_matrix(&frame.camera, (w, h)) * frame.camera.world_from_camera.inverse() * frame.instances[k].world_from_object
+        pis_trace::camera::projection_matrix(&frame.camera, (w, h))
+            * frame.camera.world_from_camera.inverse()
+            * frame.instances[k].world_from_object
     };
-    let draw: Vec<DrawMesh> = meshes.iter().enumerate().map(|(k, m)| DrawMesh {
-        positions: &m.positions, uvs: &m.uvs, indices: &m.indices, clip_from_object: clip_from(k),
-    }).collect();
+    let draw: Vec<DrawMesh> = meshes
+        .iter()
+        .enumerate()
+        .map(|(k, m)| DrawMesh {
+            positions: &m.positions,
+            uvs: &m.uvs,
+            indices: &m.indices,
+            clip_from_object: clip_from(k),
+        })
+        .collect();
     let mut mesh = draw[o];
     mesh.uvs = uvs;
-    let obj = TexturedObject { mesh, transform: placed.transform, layout: placed.layout, sampler: sampler(req.filter, placed.repeat) };
+    let obj = TexturedObject {
+        mesh,
+        transform: placed.transform,
+        layout: placed.layout,
+        sampler: sampler(req.filter, placed.repeat),
+    };
     let a = matrices.matrix(Viewport { width: w, height: h }, &draw, o, &obj)?;
     Ok(restrict_rows(&a, coverage))
 }
 
 /// Every point with placement 0 (over all views): the rows, the gold standard there.
-fn views_of(set: &LoadedSet, o: usize, uvs: &[[f32; 2]], placed: &Placed, meshes: &[Mesh], req: &PackRequest, matrices: &mut Matrices) -> Result<Views> {
+fn views_of(
+    set: &LoadedSet,
+    o: usize,
+    uvs: &[[f32; 2]],
+    placed: &Placed,
+    meshes: &[Mesh],
+    req: &PackRequest,
+    matrices: &mut Matrices,
+) -> Result<Views> {
     let channel = &set.channels[o];
     let mut views = Views::new(set.scratch.clone());
     for p in 0..set.frames.len() {
         let images = set.images.object(p, o)?;
-        let a = matrix_at(set, p, o, meshes, uvs, placed, req, matrices, &coverage_in(set, &images, o))?;
+        let a = matrix_at(
+            set,
+            p,
+            o,
+            meshes,
+            uvs,
+            placed,
+            req,
+            matrices,
+            &coverage_in(set, &images, o),
+        )?;
         let pick = |kind| gather(&a.pixels, &layer_rgb(&images, channel, kind));
         let (diffuse, specular) = (pick(TraceLayer::Diffuse), pick(TraceLayer::Specular));
         views.push(PointView { a: vec![(0, a)], diffuse, specular })?;
@@ -100,11 +150,19 @@ pub const DISPLAY_STEP: f32 = 0.5 / 255.0;
 
 /// True when the layer `pick` is black for the display: zero (below [`BLACK`]), or so dark
 /// beside the other layer `other` that leaving it out changes no 8-bit pixel.
-fn is_black(views: &Views, pick: impl Fn(&PointView) -> &[f32], other: impl Fn(&PointView) -> &[f32]) -> Result<bool> {
+fn is_black(
+    views: &Views,
+    pick: impl Fn(&PointView) -> &[f32],
+    other: impl Fn(&PointView) -> &[f32],
+) -> Result<bool> {
     let d = |v: f32| crate::images::srgb_encode(v.clamp(0.0, 1.0));
     for p in 0..views.len() {
         let v = views.get(p)?;
-        if !pick(&v).iter().zip(other(&v)).all(|(x, o)| x.abs() < BLACK || (d(x + o) - d(*o)).abs() < DISPLAY_STEP) {
+        if !pick(&v)
+            .iter()
+            .zip(other(&v))
+            .all(|(x, o)| x.abs() < BLACK || (d(x + o) - d(*o)).abs() < DISPLAY_STEP)
+        {
             return Ok(false);
         }
     }
@@ -127,7 +185,9 @@ impl Radiance {
         match self {
             Radiance::Diffuse => Cow::Borrowed(&v.diffuse),
             Radiance::Specular => Cow::Borrowed(&v.specular),
-            Radiance::Sum => Cow::Owned(v.diffuse.iter().zip(&v.specular).map(|(d, s)| d + s).collect()),
+            Radiance::Sum => {
+                Cow::Owned(v.diffuse.iter().zip(&v.specular).map(|(d, s)| d + s).collect())
+            }
         }
     }
 }
@@ -162,11 +222,26 @@ fn plan_layer(
     let mut block_placements = vec![0usize; blocks];
     if req.placement == PlacementMode::Block {
         for (b, slot) in block_placements.iter_mut().enumerate() {
-            let frames: Vec<&pis_scene::Frame> = point_block.iter().zip(&set.frames).filter(|(pb, _)| **pb == b).map(|(_, f)| f).collect();
+            let frames: Vec<&pis_scene::Frame> = point_block
+                .iter()
+                .zip(&set.frames)
+                .filter(|(pb, _)| **pb == b)
+                .map(|(_, f)| f)
+                .collect();
             if frames.is_empty() || frames.len() == set.frames.len() {
                 continue;
             }
-            let pl = place_in(&set.scene, &frames, set.resolution, o, mesh, at, req.max_texture, 1.0, req.texels_per_pixel)?;
+            let pl = place_in(
+                &set.scene,
+                &frames,
+                set.resolution,
+                o,
+                mesh,
+                at,
+                req.max_texture,
+                1.0,
+                req.texels_per_pixel,
+            )?;
             *slot = match placements.iter().position(|q| q.same(&pl)) {
                 Some(i) => i,
                 None => {
@@ -183,7 +258,14 @@ fn plan_layer(
 /// One texture per key of `plan`'s mask: each key's sample solved (or, for a view-independent
 /// layer, its views stacked, eq. 3.7) with the render matrices of its block's placement,
 /// warm-started from the last sample solved with the same placement.
-fn solve_layer(set: &LoadedSet, views: &Views, placements: &[Placed], plan: &LayerPlan, settings: &SolveSettings, solver: &Solver) -> Result<InferredLayer> {
+fn solve_layer(
+    set: &LoadedSet,
+    views: &Views,
+    placements: &[Placed],
+    plan: &LayerPlan,
+    settings: &SolveSettings,
+    solver: &Solver,
+) -> Result<InferredLayer> {
     let mut groups: BTreeMap<Vec<u32>, Vec<usize>> = BTreeMap::new();
     for (p, s) in set.samples.iter().enumerate() {
         groups.entry(key(s, plan.depends_on)).or_default().push(p);
@@ -198,7 +280,8 @@ fn solve_layer(set: &LoadedSet, views: &Views, placements: &[Placed], plan: &Lay
         let start = warm.get(&pid).map(Vec::as_slice);
         let x = if plan.radiance == Radiance::Diffuse {
             // One texture for the views of the sample, stacked (eq. 3.7), read one at a time.
-            let source = SampleViews { views, points: &points, placement: pid, radiance: plan.radiance };
+            let source =
+                SampleViews { views, points: &points, placement: pid, radiance: plan.radiance };
             let s = solver.solve_view_source(&source, start, settings)?;
             iterations += s.iterations as u64;
             s.texels
@@ -209,7 +292,10 @@ fn solve_layer(set: &LoadedSet, views: &Views, placements: &[Placed], plan: &Lay
             let a = v.a(pid);
             if a.rows() == 0 {
                 // The object covers no pixel.
-                start.map_or_else(|| vec![0.0; placements[pid].layout.texel_count() * 3], <[f32]>::to_vec)
+                start.map_or_else(
+                    || vec![0.0; placements[pid].layout.texel_count() * 3],
+                    <[f32]>::to_vec,
+                )
             } else {
                 let s = solver.solve(a, &b, start, settings)?;
                 iterations += s.iterations as u64;
@@ -220,8 +306,21 @@ fn solve_layer(set: &LoadedSet, views: &Views, placements: &[Placed], plan: &Lay
         placement_of.insert(k.clone(), pid);
         textures.insert(k, x)?;
     }
-    let form = Box::new(TextureForm { placements: placements.to_vec(), block_placements: plan.block_placements.clone(), placement_of: placement_of.clone() });
-    Ok(InferredLayer { kind: plan.kind, depends_on: plan.depends_on, textures, block_placements: plan.block_placements.clone(), placement_of, iterations, form, shell: None })
+    let form = Box::new(TextureForm {
+        placements: placements.to_vec(),
+        block_placements: plan.block_placements.clone(),
+        placement_of: placement_of.clone(),
+    });
+    Ok(InferredLayer {
+        kind: plan.kind,
+        depends_on: plan.depends_on,
+        textures,
+        block_placements: plan.block_placements.clone(),
+        placement_of,
+        iterations,
+        form,
+        shell: None,
+    })
 }
 
 /// The views of a view-independent sample: its points' render matrices for one placement
@@ -239,8 +338,13 @@ impl ViewSource for SampleViews<'_> {
         self.points.len()
     }
 
-    fn visit(&self, k: usize, f: &mut dyn FnMut(View<'_>) -> Result<(), CompileError>) -> Result<(), CompileError> {
-        let v = self.views.get(self.points[k]).map_err(|e| CompileError::Source(format!("{e:#}")))?;
+    fn visit(
+        &self,
+        k: usize,
+        f: &mut dyn FnMut(View<'_>) -> Result<(), CompileError>,
+    ) -> Result<(), CompileError> {
+        let v =
+            self.views.get(self.points[k]).map_err(|e| CompileError::Source(format!("{e:#}")))?;
         let b = self.radiance.at(&v);
         f(View { a: v.a(self.placement), b: &b })
     }
@@ -265,7 +369,13 @@ impl TextureForm {
 }
 
 impl LayerForm for TextureForm {
-    fn layer(&self, kind: pis_format::LayerKind, order: u8, depends_on: DepMask, gamma: f32) -> pis_format::Layer {
+    fn layer(
+        &self,
+        kind: pis_format::LayerKind,
+        order: u8,
+        depends_on: DepMask,
+        gamma: f32,
+    ) -> pis_format::Layer {
         surface_layer(kind, order, depends_on, gamma)
     }
 
@@ -274,7 +384,11 @@ impl LayerForm for TextureForm {
         pis_format::Block {
             width: placed.layout.width,
             height: placed.layout.height,
-            placement: pis_format::Placement::Surface { affine: placed.transform.values, repeat: placed.repeat, cut: placed.transform.cut },
+            placement: pis_format::Placement::Surface {
+                affine: placed.transform.values,
+                repeat: placed.repeat,
+                cut: placed.transform.cut,
+            },
             levels: vec![],
         }
     }
@@ -293,7 +407,12 @@ impl LayerForm for TextureForm {
     }
 }
 
-fn surface_layer(kind: pis_format::LayerKind, order: u8, depends_on: DepMask, gamma: f32) -> pis_format::Layer {
+fn surface_layer(
+    kind: pis_format::LayerKind,
+    order: u8,
+    depends_on: DepMask,
+    gamma: f32,
+) -> pis_format::Layer {
     pis_format::Layer {
         kind,
         mapping: pis_format::Mapping::Surface,
@@ -347,18 +466,36 @@ impl Representation for SurfaceTextures {
 /// [`SurfaceTextures`]' survey of object `o`; without `with_specular`, the object's surface
 /// part is its diffuse layer alone (another representation stores the rest) and the object
 /// is surveyed even when that layer is black, for its views' rows and gold standard.
-pub fn survey_surface(job: &mut Job<'_>, o: usize, with_specular: bool) -> Result<Option<Box<dyn Surveyed>>> {
+pub fn survey_surface(
+    job: &mut Job<'_>,
+    o: usize,
+    with_specular: bool,
+) -> Result<Option<Box<dyn Surveyed>>> {
     {
         let (set, req) = (job.set, job.req);
         let scene = &set.scene;
         let frames: Vec<&pis_scene::Frame> = set.frames.iter().collect();
         let name = &scene.objects[o].name;
         let at = atlas(&frames, set.resolution, o, &job.meshes[o]);
-        let whole = place_in(scene, &frames, set.resolution, o, &job.meshes[o], &at, req.max_texture, 1.0, req.texels_per_pixel)?;
+        let whole = place_in(
+            scene,
+            &frames,
+            set.resolution,
+            o,
+            &job.meshes[o],
+            &at,
+            req.max_texture,
+            1.0,
+            req.texels_per_pixel,
+        )?;
         let before = job.matrices.renderings();
         let views = views_of(set, o, &at.uvs, &whole, &job.meshes, req, job.matrices)?;
         if job.matrices.renderings() > before {
-            job.note(&format!("object {name}: {} probe renderings over {} points", job.matrices.renderings() - before, views.len()));
+            job.note(&format!(
+                "object {name}: {} probe renderings over {} points",
+                job.matrices.renderings() - before,
+                views.len()
+            ));
         }
         if (0..views.len()).all(|p| views.rows(p) == 0) {
             job.note(&format!("object {name} covers no pixel of the set; left out"));
@@ -370,7 +507,15 @@ pub fn survey_surface(job: &mut Job<'_>, o: usize, with_specular: bool) -> Resul
             job.note(&format!("object {name} is black in every layer; nothing stored"));
             return Ok(None);
         }
-        Ok(Some(Box::new(Covered { o, atlas: at, views, whole, diffuse_black, specular_black, diffuse_only: !with_specular })))
+        Ok(Some(Box::new(Covered {
+            o,
+            atlas: at,
+            views,
+            whole,
+            diffuse_black,
+            specular_black,
+            diffuse_only: !with_specular,
+        })))
     }
 }
 
@@ -399,13 +544,30 @@ impl Surveyed for Covered {
         let wanted = if req.layers == super::LayerMode::Combined && !c.diffuse_only {
             vec![(pis_format::LayerKind::Specular, Radiance::Sum, job.all)]
         } else {
-            let diffuse = (!c.diffuse_black).then_some((pis_format::LayerKind::Diffuse, Radiance::Diffuse, job.non_view));
-            let specular = (!c.specular_black).then_some((pis_format::LayerKind::Specular, Radiance::Specular, job.all));
+            let diffuse = (!c.diffuse_black).then_some((
+                pis_format::LayerKind::Diffuse,
+                Radiance::Diffuse,
+                job.non_view,
+            ));
+            let specular = (!c.specular_black).then_some((
+                pis_format::LayerKind::Specular,
+                Radiance::Specular,
+                job.all,
+            ));
             diffuse.into_iter().chain(specular).collect()
         };
         for layer in wanted {
             let grid = BlockGrid::new(&job.space, layer.2, &st);
-            plans.push(plan_layer(set, &grid, layer, c.o, &job.meshes[c.o], &c.atlas, &mut placements, req)?);
+            plans.push(plan_layer(
+                set,
+                &grid,
+                layer,
+                c.o,
+                &job.meshes[c.o],
+                &c.atlas,
+                &mut placements,
+                req,
+            )?);
         }
         job.placements += placements.len();
         let mut views = c.views;
@@ -413,14 +575,28 @@ impl Surveyed for Covered {
             let mut read: Vec<usize> = plans.iter().map(|pl| pl.point_placement[p]).collect();
             read.sort_unstable();
             read.dedup();
-            let extra: Vec<usize> = read.iter().copied().filter(|&pid| pid != 0 && views.rows(p) > 0).collect();
+            let extra: Vec<usize> =
+                read.iter().copied().filter(|&pid| pid != 0 && views.rows(p) > 0).collect();
             if extra.is_empty() && read.contains(&0) {
                 continue;
             }
             let cov = if extra.is_empty() { Vec::new() } else { coverage(set, p, c.o)? };
             let mut made = Vec::new();
             for &pid in &extra {
-                made.push((pid, matrix_at(set, p, c.o, &job.meshes, &c.atlas.uvs, &placements[pid], req, job.matrices, &cov)?));
+                made.push((
+                    pid,
+                    matrix_at(
+                        set,
+                        p,
+                        c.o,
+                        &job.meshes,
+                        &c.atlas.uvs,
+                        &placements[pid],
+                        req,
+                        job.matrices,
+                        &cov,
+                    )?,
+                ));
                 job.extra_matrices += 1;
             }
             let name = &scene.objects[c.o].name;
@@ -459,7 +635,10 @@ impl Planned for Layers {
         let name = scene.objects[o].name.clone();
         let covered: usize = (0..views.len()).map(|p| views.rows(p)).sum();
         let area = covered as f64 / views.len() as f64;
-        let layers = plans.iter().map(|plan| solve_layer(set, &views, &placements, plan, &job.settings, &job.solver)).collect::<Result<Vec<_>>>()?;
+        let layers = plans
+            .iter()
+            .map(|plan| solve_layer(set, &views, &placements, plan, &job.settings, &job.solver))
+            .collect::<Result<Vec<_>>>()?;
         let radiances: Vec<Radiance> = plans.iter().map(|p| p.radiance).collect();
         let (representation, why) = match radiances.as_slice() {
             [Radiance::Sum] => ("combined", "--layers combined: one view-dependent layer of diffuse + specular radiance per parameter sample"),
@@ -468,8 +647,21 @@ impl Planned for Layers {
             _ => ("diffuse+specular", "view-independent diffuse layer over the non-view dimensions plus a view-dependent specular layer per parameter sample"),
         };
         Ok(ObjectModel {
-            index: o, name, mesh: merged_mesh(scene, o), mesh_uvs: at.uvs, placements, stagger: st, block_sizes: job.sizes.clone(),
-            area, views, layers, shell_views: vec![], lens: vec![], hull_triangles: 0, representation: representation.to_string(), why: why.to_string(),
+            index: o,
+            name,
+            mesh: merged_mesh(scene, o),
+            mesh_uvs: at.uvs,
+            placements,
+            stagger: st,
+            block_sizes: job.sizes.clone(),
+            area,
+            views,
+            layers,
+            shell_views: vec![],
+            lens: vec![],
+            hull_triangles: 0,
+            representation: representation.to_string(),
+            why: why.to_string(),
         })
     }
 }
@@ -480,7 +672,12 @@ mod tests {
 
     /// Two placements: 8×4 and 5×3 texels, each with its full MIP chain.
     fn form() -> TextureForm {
-        let placed = |w, h| Placed { transform: pis_compile::TextureTransform::IDENTITY, layout: TextureLayout::full(w, h), repeat: [false; 2], reduction: 1.0 };
+        let placed = |w, h| Placed {
+            transform: pis_compile::TextureTransform::IDENTITY,
+            layout: TextureLayout::full(w, h),
+            repeat: [false; 2],
+            reduction: 1.0,
+        };
         TextureForm {
             placements: vec![placed(8, 4), placed(5, 3)],
             block_placements: vec![0, 1],
@@ -498,7 +695,11 @@ mod tests {
             assert_eq!(chain.len(), layout.texel_count() * 3, "the whole chain is drawn");
             assert_eq!(f.stored_texels(&key), w * h);
             assert_eq!(f.stored(&key, &chain), finest, "level images hold level 0 only");
-            assert_eq!(f.drawn(&key, f.stored(&key, &chain)), chain, "the player's decimation rebuilds the chain");
+            assert_eq!(
+                f.drawn(&key, f.stored(&key, &chain)),
+                chain,
+                "the player's decimation rebuilds the chain"
+            );
         }
     }
 
@@ -507,21 +708,36 @@ mod tests {
         let f = form();
         let b = f.block(1);
         assert_eq!((b.width, b.height), (5, 3));
-        assert!(matches!(b.placement, pis_format::Placement::Surface { .. }) && b.levels.is_empty());
+        assert!(
+            matches!(b.placement, pis_format::Placement::Surface { .. }) && b.levels.is_empty()
+        );
         let l = f.layer(pis_format::LayerKind::Diffuse, 0, DepMask::of(&[0]), 2.2);
-        assert_eq!((l.mapping, l.mip_mode, l.channels), (pis_format::Mapping::Surface, pis_format::MipMode::Decimated, 3));
+        assert_eq!(
+            (l.mapping, l.mip_mode, l.channels),
+            (pis_format::Mapping::Surface, pis_format::MipMode::Decimated, 3)
+        );
     }
 
     #[test]
     fn every_object_role_has_a_representation() {
         for role in [ObjectRole::Diffuse, ObjectRole::Reflective, ObjectRole::Refractive] {
-            assert_eq!(super::super::represent::choose(role, super::super::RepresentationMode::Texture).map(|r| r.name()), Some("surface textures"), "{role:?}");
+            assert_eq!(
+                super::super::represent::choose(role, super::super::RepresentationMode::Texture)
+                    .map(|r| r.name()),
+                Some("surface textures"),
+                "{role:?}"
+            );
             let pem = match role {
                 ObjectRole::Reflective => "layered environment maps",
                 ObjectRole::Refractive => "hybrid rendering",
                 ObjectRole::Diffuse => "surface textures",
             };
-            assert_eq!(super::super::represent::choose(role, super::super::RepresentationMode::Pem).map(|r| r.name()), Some(pem), "{role:?}");
+            assert_eq!(
+                super::super::represent::choose(role, super::super::RepresentationMode::Pem)
+                    .map(|r| r.name()),
+                Some(pem),
+                "{role:?}"
+            );
         }
     }
 }

@@ -6,10 +6,10 @@ use std::time::Instant;
 use serde::Serialize;
 
 use super::encode::{encode_all, LayerTextures};
-use super::predict::{decoded_textures, predicted_psnr, solved_chains};
 use super::infer_layers::infer_all;
-use super::model::ObjectModel;
 use super::input::{load, LoadedSet};
+use super::model::ObjectModel;
+use super::predict::{decoded_textures, predicted_psnr, solved_chains};
 use super::{PackRequest, Stages};
 use crate::error::{Exit, Failure};
 
@@ -64,7 +64,8 @@ impl Inferred {
         if let Some(device) = matrices.device() {
             stages.note(&format!("probe mode on {device}"));
         }
-        let inferred = infer_all(&set, req, &mut matrices, &mut stages).map_err(|e| Failure::new(Exit::Runtime, e))?;
+        let inferred = infer_all(&set, req, &mut matrices, &mut stages)
+            .map_err(|e| Failure::new(Exit::Runtime, e))?;
         // `auto` chooses once, for the request's own target.
         let (models, _) = super::choice::choose(&set, inferred, req, &mut stages)?;
         let infer_ms = t.elapsed().as_secs_f64() * 1e3;
@@ -93,7 +94,8 @@ impl Inferred {
         let mut stages = Stages::quiet();
         let packed = encode_all(&self.set, &self.models, req, &mut stages)?;
         let file_bytes = pis_format::to_bytes_unchecked(&packed.container).len();
-        let q = predicted_psnr(&self.set, &self.models, &packed).map_err(|e| Failure::new(Exit::Runtime, e))?;
+        let q = predicted_psnr(&self.set, &self.models, &packed)
+            .map_err(|e| Failure::new(Exit::Runtime, e))?;
         Ok(PackPoint {
             texture_bytes: packed.layer_bytes.iter().flatten().sum(),
             file_bytes,
@@ -115,7 +117,10 @@ impl Inferred {
         let mut stages = Stages::quiet();
         let packed = encode_all(&self.set, &self.models, req, &mut stages)?;
         let bytes = packed.layer_bytes.iter().flatten().sum();
-        Ok((decoded_textures(&self.models, &packed).map_err(|e| Failure::new(Exit::Runtime, e))?, bytes))
+        Ok((
+            decoded_textures(&self.models, &packed).map_err(|e| Failure::new(Exit::Runtime, e))?,
+            bytes,
+        ))
     }
 
     /// Encodes with `req`'s codec, pyramid and target and writes the container to

@@ -81,9 +81,13 @@ impl Textures {
     /// The texture of sample `key`.
     pub fn get(&self, key: &[u32]) -> Result<Cow<'_, [f32]>> {
         match &self.store {
-            Store::Held(t) => t.get(key).map(|x| Cow::Borrowed(x.as_slice())).ok_or_else(|| anyhow!("no texture for sample {key:?}")),
+            Store::Held(t) => t
+                .get(key)
+                .map(|x| Cow::Borrowed(x.as_slice()))
+                .ok_or_else(|| anyhow!("no texture for sample {key:?}")),
             Store::Spilled { scratch, spans } => {
-                let span = *spans.get(key).ok_or_else(|| anyhow!("no texture for sample {key:?}"))?;
+                let span =
+                    *spans.get(key).ok_or_else(|| anyhow!("no texture for sample {key:?}"))?;
                 let bytes = scratch.get(span)?;
                 let mut r = Reader::new(&bytes);
                 let x = r.f32s()?;
@@ -117,13 +121,25 @@ mod tests {
 
     #[test]
     fn spilled_textures_read_back_bit_for_bit_in_key_order() {
-        let held: BTreeMap<Vec<u32>, Vec<f32>> = [(vec![1, 0], vec![0.5, -0.0, f32::MIN_POSITIVE]), (vec![0, 2], vec![1.0; 5])].into_iter().collect();
+        let held: BTreeMap<Vec<u32>, Vec<f32>> =
+            [(vec![1, 0], vec![0.5, -0.0, f32::MIN_POSITIVE]), (vec![0, 2], vec![1.0; 5])]
+                .into_iter()
+                .collect();
         let dir = tempfile::tempdir().unwrap();
         let scratch = Arc::new(Scratch::create(&dir.path().join("s")).unwrap());
         let mut t = Textures::from(held.clone());
         t.spill(&scratch).unwrap();
-        assert!(scratch.len() > 0 && t.len() == 2 && t.contains_key(&[0, 2]) && !t.contains_key(&[2, 0]));
-        let back: Vec<(Vec<u32>, Vec<f32>)> = t.iter().map(|r| r.map(|(k, x)| (k.clone(), x.into_owned()))).collect::<Result<_>>().unwrap();
+        assert!(
+            scratch.len() > 0
+                && t.len() == 2
+                && t.contains_key(&[0, 2])
+                && !t.contains_key(&[2, 0])
+        );
+        let back: Vec<(Vec<u32>, Vec<f32>)> = t
+            .iter()
+            .map(|r| r.map(|(k, x)| (k.clone(), x.into_owned())))
+            .collect::<Result<_>>()
+            .unwrap();
         let want: Vec<(Vec<u32>, Vec<f32>)> = held.into_iter().collect();
         assert_eq!(back.len(), want.len());
         for ((ka, a), (kb, b)) in back.iter().zip(&want) {

@@ -6,8 +6,8 @@
 //! distance along the view. Orbiting turns the direction and moves the eye so that the target
 //! stays; looking turns the direction and keeps the eye; so switching modes never jumps.
 
-use glam::Vec3;
 use crate::ViewCamera;
+use glam::Vec3;
 
 /// Largest pitch, short of the pole, where the view direction would be along the up vector.
 const MAX_PITCH: f32 = 89.0 * std::f32::consts::PI / 180.0;
@@ -41,8 +41,20 @@ impl FreeCamera {
         let dir = (cam.target - cam.eye).try_normalize().unwrap_or(-b);
         let pitch = dir.dot(up).clamp(-1.0, 1.0).asin().clamp(-MAX_PITCH, MAX_PITCH);
         let yaw = dir.dot(b).atan2(dir.dot(a));
-        let distance = if focus_distance.is_finite() && focus_distance > 0.0 { focus_distance } else { 1.0 };
-        FreeCamera { up, a, b, eye: cam.eye, yaw, pitch, distance, yfov_rad: cam.yfov_rad, near: cam.near, far: cam.far }
+        let distance =
+            if focus_distance.is_finite() && focus_distance > 0.0 { focus_distance } else { 1.0 };
+        FreeCamera {
+            up,
+            a,
+            b,
+            eye: cam.eye,
+            yaw,
+            pitch,
+            distance,
+            yfov_rad: cam.yfov_rad,
+            near: cam.near,
+            far: cam.far,
+        }
     }
 
     /// Unit view direction.
@@ -80,7 +92,8 @@ impl FreeCamera {
     pub fn zoom(&mut self, steps: f32) {
         let target = self.target();
         let far = if self.far.is_finite() { self.far * 0.5 } else { f32::MAX };
-        self.distance = (self.distance * (-0.1 * steps).exp()).clamp(2.0 * self.near, far.max(2.0 * self.near));
+        self.distance =
+            (self.distance * (-0.1 * steps).exp()).clamp(2.0 * self.near, far.max(2.0 * self.near));
         self.eye = target - self.distance * self.direction();
     }
 
@@ -96,7 +109,14 @@ impl FreeCamera {
 
     /// The camera the player draws from.
     pub fn view_camera(&self) -> ViewCamera {
-        ViewCamera { eye: self.eye, target: self.target(), up: self.up, yfov_rad: self.yfov_rad, near: self.near, far: self.far }
+        ViewCamera {
+            eye: self.eye,
+            target: self.target(),
+            up: self.up,
+            yfov_rad: self.yfov_rad,
+            near: self.near,
+            far: self.far,
+        }
     }
 }
 
@@ -175,7 +195,11 @@ mod tests {
         // A quarter turn about +Y takes an eye on +Z to ±X, at the same height.
         let mut g = FreeCamera::new(&cam(Vec3::new(0.0, 0.0, 2.0), Vec3::ZERO), 2.0);
         g.orbit(std::f32::consts::FRAC_PI_2, 0.0);
-        assert!((g.eye.x.abs() - 2.0).abs() < 1e-4 && g.eye.y.abs() < 1e-4 && g.eye.z.abs() < 1e-4, "{:?}", g.eye);
+        assert!(
+            (g.eye.x.abs() - 2.0).abs() < 1e-4 && g.eye.y.abs() < 1e-4 && g.eye.z.abs() < 1e-4,
+            "{:?}",
+            g.eye
+        );
     }
 
     #[test]
@@ -186,11 +210,17 @@ mod tests {
         let dir = (target - eye).normalize();
         let up = dir.cross(Vec3::Y).normalize().cross(dir);
         assert!(up.y > 0.9 && up.z < -0.3, "{up:?}");
-        let mut f = FreeCamera::new(&ViewCamera { eye, target, up, yfov_rad: 0.7, near: 0.05, far: 50.0 }, 1.7);
+        let mut f = FreeCamera::new(
+            &ViewCamera { eye, target, up, yfov_rad: 0.7, near: 0.05, far: 50.0 },
+            1.7,
+        );
         f.orbit(1.0, 0.0);
         assert!((f.eye.y - eye.y).abs() < 1e-4, "the eye stays at its height: {:?}", f.eye);
         assert!(close(f.target(), target));
-        assert_eq!((world_up(Vec3::new(0.1, -0.9, 0.3)), world_up(Vec3::ZERO)), (-Vec3::Y, Vec3::Y));
+        assert_eq!(
+            (world_up(Vec3::new(0.1, -0.9, 0.3)), world_up(Vec3::ZERO)),
+            (-Vec3::Y, Vec3::Y)
+        );
     }
 
     #[test]

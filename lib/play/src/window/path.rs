@@ -62,7 +62,8 @@ impl Playback {
                 PathKind::Along(j) => j == k,
             };
             if moves && k < out.len() {
-                let t = if axis.periodic { self.phase.rem_euclid(1.0) } else { triangle(self.phase) };
+                let t =
+                    if axis.periodic { self.phase.rem_euclid(1.0) } else { triangle(self.phase) };
                 out[k] = axis.value_at(t);
             }
         }
@@ -73,7 +74,11 @@ impl Playback {
 /// 0 → 1 over the first traverse, back to 0 over the second.
 fn triangle(phase: f32) -> f32 {
     let p = phase.rem_euclid(2.0);
-    if p <= 1.0 { p } else { 2.0 - p }
+    if p <= 1.0 {
+        p
+    } else {
+        2.0 - p
+    }
 }
 
 #[cfg(test)]
@@ -90,7 +95,10 @@ mod tests {
             block_size: 1,
             values,
         };
-        Space::new(&[dim("light", vec![0.0, 0.5, 1.0], false), dim("view", vec![0.0, 90.0, 180.0, 270.0], true)])
+        Space::new(&[
+            dim("light", vec![0.0, 0.5, 1.0], false),
+            dim("view", vec![0.0, 90.0, 180.0, 270.0], true),
+        ])
     }
 
     #[test]
@@ -104,7 +112,11 @@ mod tests {
         // Bounded light turns back at its last sample; periodic view goes round.
         assert_eq!(p.advance(&s, &[0.0, 0.0], 3.0), vec![0.75, 67.5]);
         assert!((p.phase - 1.25).abs() < 1e-6);
-        assert_eq!(p.advance(&s, &[0.0, 0.0], 3.0), vec![0.0, 0.0], "after two traverses it is back");
+        assert_eq!(
+            p.advance(&s, &[0.0, 0.0], 3.0),
+            vec![0.0, 0.0],
+            "after two traverses it is back"
+        );
     }
 
     #[test]

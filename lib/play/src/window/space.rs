@@ -21,7 +21,14 @@ impl Axis {
     pub fn new(d: &Dimension) -> Axis {
         let min = d.values.first().copied().unwrap_or(0.0);
         let max = d.values.last().copied().unwrap_or(min).max(min);
-        Axis { name: d.name.clone(), unit: d.unit.clone(), samples: d.values.clone(), min, max, periodic: d.periodic && d.values.len() >= 2 }
+        Axis {
+            name: d.name.clone(),
+            unit: d.unit.clone(),
+            samples: d.values.clone(),
+            min,
+            max,
+            periodic: d.periodic && d.values.len() >= 2,
+        }
     }
 
     /// Length of the range (0 for a dimension with one sample).
@@ -124,12 +131,18 @@ mod tests {
     fn nearest_sample_ties_to_the_lower_one() {
         let a = Axis::new(&dim("azimuth", &[0.0, 90.0, 180.0, 270.0], true));
         assert!(a.periodic);
-        assert_eq!((a.nearest_sample(45.0), a.nearest_sample(45.1), a.nearest_sample(400.0)), (0, 1, 3));
+        assert_eq!(
+            (a.nearest_sample(45.0), a.nearest_sample(45.1), a.nearest_sample(400.0)),
+            (0, 1, 3)
+        );
     }
 
     #[test]
     fn nearest_samples_and_snapping() {
-        let s = Space::new(&[dim("light", &[0.0, 1.0 / 3.0, 2.0 / 3.0, 1.0], false), dim("view", &[-6.0, 6.0], false)]);
+        let s = Space::new(&[
+            dim("light", &[0.0, 1.0 / 3.0, 2.0 / 3.0, 1.0], false),
+            dim("view", &[-6.0, 6.0], false),
+        ]);
         assert_eq!(s.nearest_samples(&[0.4, 1.0]), vec![1, 1]);
         assert_eq!(s.snap(&[0.9, -5.0]), vec![1.0, -6.0]);
         let start = s.start_point();

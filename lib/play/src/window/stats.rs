@@ -43,11 +43,23 @@ pub struct StatsMeter {
 impl StatsMeter {
     /// A meter over a `window_s`-second window whose averages forget with weight `alpha`.
     pub fn new(window_s: f64, alpha: f64) -> StatsMeter {
-        StatsMeter { window_s, alpha: alpha.clamp(0.0, 1.0), recent: VecDeque::new(), shown: Shown::default(), frames: 0 }
+        StatsMeter {
+            window_s,
+            alpha: alpha.clamp(0.0, 1.0),
+            recent: VecDeque::new(),
+            shown: Shown::default(),
+            frames: 0,
+        }
     }
 
     pub fn add(&mut self, s: FrameSample) {
-        let ema = |old: f64, new: f64| if self.frames == 0 { new } else { old + self.alpha * (new - old) };
+        let ema = |old: f64, new: f64| {
+            if self.frames == 0 {
+                new
+            } else {
+                old + self.alpha * (new - old)
+            }
+        };
         self.shown.frame_ms = ema(self.shown.frame_ms, s.frame_ms);
         self.shown.decode_ms = ema(self.shown.decode_ms, s.decode_ms);
         self.shown.cache_mb = s.cache_bytes as f64 / 1e6;
@@ -81,7 +93,13 @@ mod tests {
     use super::*;
 
     fn frame(at_s: f64, frame_ms: f64, upload_bytes: u64) -> FrameSample {
-        FrameSample { at_s, frame_ms, decode_ms: frame_ms / 2.0, upload_bytes, cache_bytes: 3_000_000 }
+        FrameSample {
+            at_s,
+            frame_ms,
+            decode_ms: frame_ms / 2.0,
+            upload_bytes,
+            cache_bytes: 3_000_000,
+        }
     }
 
     #[test]

@@ -60,7 +60,11 @@ impl ViewState {
     /// The point frames are drawn at: the slider point, or its nearest sample when blending
     /// is off (the player draws a point on a sample from that sample alone).
     pub fn draw_point(&self) -> Vec<f32> {
-        if self.multilinear { self.point.clone() } else { self.space.snap(&self.point) }
+        if self.multilinear {
+            self.point.clone()
+        } else {
+            self.space.snap(&self.point)
+        }
     }
 
     /// Switches the camera mode; leaving the sample camera the first time starts the free
@@ -127,12 +131,30 @@ mod tests {
     use pis_format::{Dimension, DimensionKind};
 
     fn state() -> ViewState {
-        let d = |name: &str, values: Vec<f32>| Dimension { name: name.into(), kind: DimensionKind::Other, periodic: false, unit: String::new(), block_size: 1, values };
-        ViewState::new(Space::new(&[d("light", vec![0.0, 0.5, 1.0]), d("view", vec![-6.0, 6.0])]), vec![0.3, 1.0], 2.0)
+        let d = |name: &str, values: Vec<f32>| Dimension {
+            name: name.into(),
+            kind: DimensionKind::Other,
+            periodic: false,
+            unit: String::new(),
+            block_size: 1,
+            values,
+        };
+        ViewState::new(
+            Space::new(&[d("light", vec![0.0, 0.5, 1.0]), d("view", vec![-6.0, 6.0])]),
+            vec![0.3, 1.0],
+            2.0,
+        )
     }
 
     fn sample() -> ViewCamera {
-        ViewCamera { eye: Vec3::new(0.0, 0.0, 2.0), target: Vec3::new(0.0, 0.0, 1.0), up: Vec3::Y, yfov_rad: 0.7, near: 0.05, far: 50.0 }
+        ViewCamera {
+            eye: Vec3::new(0.0, 0.0, 2.0),
+            target: Vec3::new(0.0, 0.0, 1.0),
+            up: Vec3::Y,
+            yfov_rad: 0.7,
+            near: 0.05,
+            far: 50.0,
+        }
     }
 
     #[test]
@@ -152,7 +174,11 @@ mod tests {
         v.set_mode(CameraMode::Orbit, &sample());
         let CameraChoice::Free(c) = v.request().camera else { panic!("free camera expected") };
         assert!((c.eye - sample().eye).length() < 1e-5);
-        assert!((c.target - Vec3::ZERO).length() < 1e-5, "orbit target at the focus distance: {:?}", c.target);
+        assert!(
+            (c.target - Vec3::ZERO).length() < 1e-5,
+            "orbit target at the focus distance: {:?}",
+            c.target
+        );
         v.drag(50.0, 20.0);
         let CameraChoice::Free(d) = v.request().camera else { panic!() };
         assert!((d.target - c.target).length() < 1e-4 && (d.eye - c.eye).length() > 0.1);

@@ -25,7 +25,9 @@ pub fn gpu_with_or_skip(test: &str, options: pis_play::GpuOptions) -> Option<Gpu
             eprintln!("{test}: adapter {}", g.describe());
             Some(g)
         }
-        Err(e) if std::env::var("CI").map(|v| v == "true").unwrap_or(false) => panic!("{test}: {e}"),
+        Err(e) if std::env::var("CI").map(|v| v == "true").unwrap_or(false) => {
+            panic!("{test}: {e}")
+        }
         Err(e) => {
             eprintln!("{test}: skipped: {e}");
             None
@@ -55,7 +57,8 @@ pub fn uv_sphere(slices: u32, stacks: u32) -> Mesh {
     let row = slices + 1;
     for j in 0..stacks {
         for i in 0..slices {
-            let (a, b, c, d) = (j * row + i, j * row + i + 1, (j + 1) * row + i + 1, (j + 1) * row + i);
+            let (a, b, c, d) =
+                (j * row + i, j * row + i + 1, (j + 1) * row + i + 1, (j + 1) * row + i);
             m.indices.extend([a, b, c, a, c, d]);
         }
     }
@@ -73,7 +76,8 @@ pub fn quad(x0: f32, x1: f32, y0: f32, y1: f32, z: f32) -> Mesh {
 
 /// A camera: clip-from-world of a perspective view at `eye` looking at `target`.
 pub fn camera(vp: Viewport, eye: [f32; 3], target: [f32; 3], fovy: f32) -> Mat4 {
-    perspective(fovy, vp.width as f32 / vp.height as f32, 0.1, 50.0) * look_at(Vec3::from(eye), Vec3::from(target), Vec3::Y)
+    perspective(fovy, vp.width as f32 / vp.height as f32, 0.1, 50.0)
+        * look_at(Vec3::from(eye), Vec3::from(target), Vec3::Y)
 }
 
 /// Deterministic random values in [0, 1) (xorshift).
@@ -97,12 +101,17 @@ pub fn random_rgba(texels: usize, seed: u64) -> Vec<f32> {
 
 /// A·x per channel for an RGBA texture: the image the model predicts (alpha = coverage).
 pub fn predict(a: &RenderMatrix, rgba: &[f32]) -> FloatImage {
-    let mut img = FloatImage { width: a.width, height: a.height, rgba: vec![0.0; a.width as usize * a.height as usize * 4] };
+    let mut img = FloatImage {
+        width: a.width,
+        height: a.height,
+        rgba: vec![0.0; a.width as usize * a.height as usize * 4],
+    };
     for r in 0..a.rows() {
         let (c, v) = a.row(r);
         let p = a.pixels[r] as usize;
         for ch in 0..3 {
-            img.rgba[4 * p + ch] = c.iter().zip(v).map(|(&c, &v)| v * rgba[4 * c as usize + ch]).sum();
+            img.rgba[4 * p + ch] =
+                c.iter().zip(v).map(|(&c, &v)| v * rgba[4 * c as usize + ch]).sum();
         }
         img.rgba[4 * p + 3] = a.coverage[r];
     }
@@ -134,7 +143,11 @@ pub fn compare(want: &FloatImage, got: &FloatImage) -> Comparison {
         }
     }
     let mse = se / n.max(1) as f64;
-    Comparison { psnr_db: if mse == 0.0 { f64::INFINITY } else { -10.0 * mse.log10() }, both: n / 3, coverage_mismatch: mismatch }
+    Comparison {
+        psnr_db: if mse == 0.0 { f64::INFINITY } else { -10.0 * mse.log10() },
+        both: n / 3,
+        coverage_mismatch: mismatch,
+    }
 }
 
 /// Writes `NAME-actual.png` (the GPU image) and `NAME-difference.png` (|want − got| × 64)
@@ -171,21 +184,57 @@ pub fn draw_scene(
     scene: &[(pis_play::frame::MeshGpu, Mat4, pis_play::ObjectTexture)],
     sampler: &wgpu::Sampler,
 ) -> (FloatImage, Vec<u32>) {
-    use pis_play::frame::{colour_image, encode, offscreen_format, LayerDraw, ObjectDraw, Readback, Targets};
+    use pis_play::frame::{
+        colour_image, encode, offscreen_format, LayerDraw, ObjectDraw, Readback, Targets,
+    };
     let format = offscreen_format(gpu);
     let mut targets = Targets::new(gpu, pipes, size, samples).unwrap();
-    let objects: Vec<ObjectDraw> = scene.iter().enumerate().map(|(i, (mesh, clip, _))| ObjectDraw { object: i as u32, mesh, clip_from_object: *clip }).collect();
-    let layers: Vec<LayerDraw> = scene.iter().enumerate().map(|(i, (_, _, texture))| LayerDraw { draw: i, texture, sampler, transform: pis_compile::TextureTransform::IDENTITY, max_level: 0.0, weight: 1.0, anisotropic: false }).collect();
+    let objects: Vec<ObjectDraw> = scene
+        .iter()
+        .enumerate()
+        .map(|(i, (mesh, clip, _))| ObjectDraw { object: i as u32, mesh, clip_from_object: *clip })
+        .collect();
+    let layers: Vec<LayerDraw> = scene
+        .iter()
+        .enumerate()
+        .map(|(i, (_, _, texture))| LayerDraw {
+            draw: i,
+            texture,
+            sampler,
+            transform: pis_compile::TextureTransform::IDENTITY,
+            max_level: 0.0,
+            weight: 1.0,
+            anisotropic: false,
+        })
+        .collect();
     let mut encoder = gpu.device.create_command_encoder(&Default::default());
     let view = targets.colour.create_view(&Default::default());
-    encode(gpu, pipes, &mut targets, &view, format, &objects, &layers, &[], &[], true, display, &mut encoder);
+    encode(
+        gpu,
+        pipes,
+        &mut targets,
+        &view,
+        format,
+        &objects,
+        &layers,
+        &[],
+        &[],
+        true,
+        display,
+        &mut encoder,
+    );
     let texel = if format == wgpu::TextureFormat::Rgba16Float { 8 } else { 16 };
     let (rc, ri) = (Readback::new(gpu, size, texel), Readback::new(gpu, size, 4));
     rc.copy(&targets.colour, &mut encoder);
     ri.copy(&targets.ids, &mut encoder);
     gpu.queue.submit([encoder.finish()]);
     let colour = colour_image(&rc.read(gpu).unwrap(), format, size);
-    let ids = ri.read(gpu).unwrap().chunks_exact(4).map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]])).collect();
+    let ids = ri
+        .read(gpu)
+        .unwrap()
+        .chunks_exact(4)
+        .map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]]))
+        .collect();
     (colour, ids)
 }
 
@@ -195,8 +244,26 @@ pub fn shells() -> Vec<(&'static str, Shell)> {
     let o = DVec3::new(0.05, -0.1, 0.02);
     vec![
         ("sphere", Shell { origin: o, shape: ShellShape::Sphere { radius: 3.0 } }),
-        ("ellipsoid", Shell { origin: o, shape: ShellShape::Ellipsoid { radii: DVec3::new(1.6, 1.3, 1.5) } }),
-        ("box", Shell { origin: o, shape: ShellShape::Box { min: DVec3::new(-3.0, -1.3, -4.0), max: DVec3::new(4.0, 3.0, 3.5) } }),
-        ("cylinder", Shell { origin: o, shape: ShellShape::Cylinder { radius: 2.5, y_min: -1.3, y_max: 2.0 } }),
+        (
+            "ellipsoid",
+            Shell { origin: o, shape: ShellShape::Ellipsoid { radii: DVec3::new(1.6, 1.3, 1.5) } },
+        ),
+        (
+            "box",
+            Shell {
+                origin: o,
+                shape: ShellShape::Box {
+                    min: DVec3::new(-3.0, -1.3, -4.0),
+                    max: DVec3::new(4.0, 3.0, 3.5),
+                },
+            },
+        ),
+        (
+            "cylinder",
+            Shell {
+                origin: o,
+                shape: ShellShape::Cylinder { radius: 2.5, y_min: -1.3, y_max: 2.0 },
+            },
+        ),
     ]
 }

@@ -13,7 +13,10 @@ pub fn encode_exr(images: &PointImages, path: &Path) -> std::result::Result<Vec<
     let mut channels: Vec<AnyChannel<FlatSamples>> = Vec::new();
     for layer in &images.layers {
         for (c, plane) in layer.channels.iter().zip(&layer.planes) {
-            channels.push(AnyChannel::new(format!("{}.{}", layer.name, c).as_str(), FlatSamples::F32(plane.clone())));
+            channels.push(AnyChannel::new(
+                format!("{}.{}", layer.name, c).as_str(),
+                FlatSamples::F32(plane.clone()),
+            ));
         }
     }
     let encoding = Encoding {
@@ -21,7 +24,12 @@ pub fn encode_exr(images: &PointImages, path: &Path) -> std::result::Result<Vec<
         blocks: Blocks::ScanLines,
         line_order: LineOrder::Increasing,
     };
-    let layer = Layer::new(size, LayerAttributes::default(), encoding, AnyChannels::sort(SmallVec::from_vec(channels)));
+    let layer = Layer::new(
+        size,
+        LayerAttributes::default(),
+        encoding,
+        AnyChannels::sort(SmallVec::from_vec(channels)),
+    );
     let image = Image::from_layer(layer);
     let mut out = Cursor::new(Vec::new());
     image
@@ -35,7 +43,8 @@ pub fn encode_exr(images: &PointImages, path: &Path) -> std::result::Result<Vec<
 /// Decodes an OpenEXR file into layers, grouping channels `<layer>.<channel>` by layer
 /// (the channel is the part after the last dot). Channels are converted to f32.
 pub fn decode_exr(bytes: &[u8], path: &Path) -> std::result::Result<PointImages, TraceError> {
-    let err = |e: exr::error::Error| TraceError::Exr { path: path.to_path_buf(), message: e.to_string() };
+    let err =
+        |e: exr::error::Error| TraceError::Exr { path: path.to_path_buf(), message: e.to_string() };
     let image = read()
         .no_deep_data()
         .largest_resolution_level()
@@ -70,7 +79,13 @@ pub fn decode_exr(bytes: &[u8], path: &Path) -> std::result::Result<PointImages,
                 l.channels.push(c);
                 l.planes.push(plane);
             }
-            None => layers.push(LayerImage { name: layer, channels: vec![c], width, height, planes: vec![plane] }),
+            None => layers.push(LayerImage {
+                name: layer,
+                channels: vec![c],
+                width,
+                height,
+                planes: vec![plane],
+            }),
         }
     }
     // Channel order within a layer: R, G, B, A, then the rest alphabetically.
@@ -83,7 +98,9 @@ pub fn decode_exr(bytes: &[u8], path: &Path) -> std::result::Result<PointImages,
             _ => 4,
         };
         let mut idx: Vec<usize> = (0..l.channels.len()).collect();
-        idx.sort_by(|&a, &b| rank(&l.channels[a]).cmp(&rank(&l.channels[b])).then(l.channels[a].cmp(&l.channels[b])));
+        idx.sort_by(|&a, &b| {
+            rank(&l.channels[a]).cmp(&rank(&l.channels[b])).then(l.channels[a].cmp(&l.channels[b]))
+        });
         l.channels = idx.iter().map(|&i| l.channels[i].clone()).collect();
         let mut planes = std::mem::take(&mut l.planes);
         l.planes = idx.iter().map(|&i| std::mem::take(&mut planes[i])).collect();

@@ -41,10 +41,16 @@ impl RaySet {
             .map_err(|e| TraceError::InvalidSet { path: path.clone(), message: e.to_string() })?;
         let bad = |message: String| TraceError::InvalidSet { path: path.clone(), message };
         if meta.format != SET_FORMAT {
-            return Err(bad(format!("field `format` is {:?}, expected {SET_FORMAT:?}", meta.format)));
+            return Err(bad(format!(
+                "field `format` is {:?}, expected {SET_FORMAT:?}",
+                meta.format
+            )));
         }
         if meta.version != SET_VERSION {
-            return Err(bad(format!("field `version` is {}, only {SET_VERSION} is supported", meta.version)));
+            return Err(bad(format!(
+                "field `version` is {}, only {SET_VERSION} is supported",
+                meta.version
+            )));
         }
         if meta.resolution[0] == 0 || meta.resolution[1] == 0 {
             return Err(bad(format!("field `resolution` is {:?}: no pixels", meta.resolution)));
@@ -56,20 +62,41 @@ impl RaySet {
         }
         for (i, p) in meta.points.iter().enumerate() {
             if p.samples.len() != meta.space.len() || p.values.len() != meta.space.len() {
-                return Err(bad(format!("points[{i}]: {} samples for {} dimensions", p.samples.len(), meta.space.len())));
+                return Err(bad(format!(
+                    "points[{i}]: {} samples for {} dimensions",
+                    p.samples.len(),
+                    meta.space.len()
+                )));
             }
             if p.objects.len() != meta.objects.len() {
-                return Err(bad(format!("points[{i}]: {} object placements for {} objects", p.objects.len(), meta.objects.len())));
+                return Err(bad(format!(
+                    "points[{i}]: {} object placements for {} objects",
+                    p.objects.len(),
+                    meta.objects.len()
+                )));
             }
-            if p.image.contains(['/', '\\']) || p.rays.as_deref().is_some_and(|r| r.contains(['/', '\\'])) {
-                return Err(bad(format!("points[{i}]: file names must not contain path separators")));
+            if p.image.contains(['/', '\\'])
+                || p.rays.as_deref().is_some_and(|r| r.contains(['/', '\\']))
+            {
+                return Err(bad(format!(
+                    "points[{i}]: file names must not contain path separators"
+                )));
             }
-            for (k, (d, (&s, &v))) in meta.space.iter().zip(p.samples.iter().zip(&p.values)).enumerate() {
+            for (k, (d, (&s, &v))) in
+                meta.space.iter().zip(p.samples.iter().zip(&p.values)).enumerate()
+            {
                 let Some(&want) = d.values.get(s as usize) else {
-                    return Err(bad(format!("points[{i}].samples[{k}] is {s}; dimension `{}` has {} samples", d.name, d.values.len())));
+                    return Err(bad(format!(
+                        "points[{i}].samples[{k}] is {s}; dimension `{}` has {} samples",
+                        d.name,
+                        d.values.len()
+                    )));
                 };
                 if !v.is_finite() || (v - want).abs() > 1e-4 * want.abs().max(1.0) {
-                    return Err(bad(format!("points[{i}].values[{k}] is {v}; sample {s} of dimension `{}` is {want}", d.name)));
+                    return Err(bad(format!(
+                        "points[{i}].values[{k}] is {v}; sample {s} of dimension `{}` is {want}",
+                        d.name
+                    )));
                 }
             }
         }
@@ -118,11 +145,20 @@ impl RaySet {
             let coverage = layer.name.ends_with(".coverage");
             for (c, plane) in layer.channels.iter().zip(&layer.planes) {
                 if let Some(k) = plane.iter().position(|v| !v.is_finite()) {
-                    return Err(bad(format!("layer `{}` channel {c}: pixel {k} is {}", layer.name, plane[k])));
+                    return Err(bad(format!(
+                        "layer `{}` channel {c}: pixel {k} is {}",
+                        layer.name, plane[k]
+                    )));
                 }
                 if coverage {
-                    if let Some(k) = plane.iter().position(|v| !(-COVERAGE_SLACK..=1.0 + COVERAGE_SLACK).contains(v)) {
-                        return Err(bad(format!("layer `{}` channel {c}: pixel {k} covers {}, outside [0, 1]", layer.name, plane[k])));
+                    if let Some(k) = plane
+                        .iter()
+                        .position(|v| !(-COVERAGE_SLACK..=1.0 + COVERAGE_SLACK).contains(v))
+                    {
+                        return Err(bad(format!(
+                            "layer `{}` channel {c}: pixel {k} covers {}, outside [0, 1]",
+                            layer.name, plane[k]
+                        )));
                     }
                 }
             }
@@ -140,7 +176,11 @@ impl RaySet {
         if let Some(r) = records.iter().find(|r| r.object as usize >= self.meta.objects.len()) {
             return Err(TraceError::InvalidSet {
                 path,
-                message: format!("record names object {} but the set has {}", r.object, self.meta.objects.len()),
+                message: format!(
+                    "record names object {} but the set has {}",
+                    r.object,
+                    self.meta.objects.len()
+                ),
             });
         }
         Ok(records)

@@ -45,11 +45,15 @@ impl std::str::FromStr for Shard {
 
     /// `I/N`: shard I (counted from 0) of N.
     fn from_str(s: &str) -> Result<Shard, String> {
-        let (i, n) = s.split_once('/').ok_or_else(|| format!("expected I/N (shard I of N, from 0), got {s:?}"))?;
+        let (i, n) = s
+            .split_once('/')
+            .ok_or_else(|| format!("expected I/N (shard I of N, from 0), got {s:?}"))?;
         let index: usize = i.trim().parse().map_err(|_| format!("bad shard index in {s:?}"))?;
         let count: usize = n.trim().parse().map_err(|_| format!("bad shard count in {s:?}"))?;
         if count == 0 || index >= count {
-            return Err(format!("shard {s:?}: the index counts from 0 and must be below the count"));
+            return Err(format!(
+                "shard {s:?}: the index counts from 0 and must be below the count"
+            ));
         }
         Ok(Shard { index, count })
     }
@@ -87,17 +91,24 @@ pub struct Records {
 
 fn read_json<T: for<'de> Deserialize<'de>>(path: &Path) -> Result<T, TraceError> {
     let bytes = fs::read(path).map_err(|e| TraceError::io(path, e))?;
-    serde_json::from_slice(&bytes).map_err(|e| TraceError::InvalidSet { path: path.to_path_buf(), message: e.to_string() })
+    serde_json::from_slice(&bytes)
+        .map_err(|e| TraceError::InvalidSet { path: path.to_path_buf(), message: e.to_string() })
 }
 
 fn encode<T: Serialize>(value: &T, path: &Path) -> Result<Vec<u8>, TraceError> {
-    serde_json::to_vec_pretty(value).map_err(|e| TraceError::InvalidInput(format!("cannot encode {}: {e}", path.display())))
+    serde_json::to_vec_pretty(value)
+        .map_err(|e| TraceError::InvalidInput(format!("cannot encode {}: {e}", path.display())))
 }
 
 impl Records {
     /// The records of the trace `meta` (points left empty) of `points` points in the set
     /// directory `set_dir`, taken up as `begin` says.
-    pub fn begin(set_dir: &Path, meta: &SetMeta, points: usize, begin: Begin) -> Result<Records, TraceError> {
+    pub fn begin(
+        set_dir: &Path,
+        meta: &SetMeta,
+        points: usize,
+        begin: Begin,
+    ) -> Result<Records, TraceError> {
         let dir = set_dir.join(SHARDS_DIR);
         let path = dir.join(SHARD_META);
         let want = ShardMeta { points, set: SetMeta { points: Vec::new(), ..meta.clone() } };
@@ -145,7 +156,8 @@ impl Records {
         let path = self.point_path(index);
         let point: PointMeta = read_json(&path).ok()?;
         let files = std::iter::once(&point.image).chain(point.rays.as_ref());
-        (point.index == index && files.into_iter().all(|f| self.set_dir.join(f).is_file())).then_some(point)
+        (point.index == index && files.into_iter().all(|f| self.set_dir.join(f).is_file()))
+            .then_some(point)
     }
 }
 
@@ -171,7 +183,9 @@ pub fn merge_set(set_dir: &Path) -> Result<MergeReport, TraceError> {
         // before it records a point: a set.json there now, after records went missing under
         // this merge, is another process's merge of the same records.
         match read_json::<SetMeta>(&set_dir.join(SET_JSON)) {
-            Ok(meta) => Ok(MergeReport { points: meta.points.len(), already_complete: true, bytes: 0 }),
+            Ok(meta) => {
+                Ok(MergeReport { points: meta.points.len(), already_complete: true, bytes: 0 })
+            }
             Err(_) => Err(e),
         }
     })
@@ -203,7 +217,11 @@ fn merge_records(set_dir: &Path) -> Result<MergeReport, TraceError> {
     }
     if !missing.is_empty() {
         let list: Vec<String> = missing.iter().take(12).map(usize::to_string).collect();
-        let more = if missing.len() > 12 { format!(" and {} more", missing.len() - 12) } else { String::new() };
+        let more = if missing.len() > 12 {
+            format!(" and {} more", missing.len() - 12)
+        } else {
+            String::new()
+        };
         return Err(TraceError::InvalidSet {
             path: set_dir.to_path_buf(),
             message: format!(
@@ -231,7 +249,9 @@ pub fn is_complete(set_dir: &Path, meta: &SetMeta, points: usize) -> bool {
         return false;
     }
     let Ok(have) = read_json::<SetMeta>(&set_dir.join(SET_JSON)) else { return false };
-    have.points.len() == points && have.points.iter().enumerate().all(|(i, p)| p.index == i) && SetMeta { points: Vec::new(), ..have } == SetMeta { points: Vec::new(), ..meta.clone() }
+    have.points.len() == points
+        && have.points.iter().enumerate().all(|(i, p)| p.index == i)
+        && SetMeta { points: Vec::new(), ..have } == SetMeta { points: Vec::new(), ..meta.clone() }
 }
 
 /// Whether every one of the trace's points in `set_dir` is recorded.
@@ -249,11 +269,13 @@ mod tests {
     /// A set's metadata of `points` points, as set.json holds it.
     fn meta(points: usize) -> SetMeta {
         let m = vec![0.0f32; 16];
-        let point = |i: usize| serde_json::json!({
-            "index": i, "samples": [i], "values": [i as f32], "image": format!("point_{i:05}.exr"), "rays": null,
-            "camera": {"world_from_camera": m, "camera_from_world": m, "projection": m, "yfov": 0.7, "znear": 0.1, "zfar": null},
-            "lights": [], "objects": []
-        });
+        let point = |i: usize| {
+            serde_json::json!({
+                "index": i, "samples": [i], "values": [i as f32], "image": format!("point_{i:05}.exr"), "rays": null,
+                "camera": {"world_from_camera": m, "camera_from_world": m, "projection": m, "yfov": 0.7, "znear": 0.1, "zfar": null},
+                "lights": [], "objects": []
+            })
+        };
         serde_json::from_value(serde_json::json!({
             "format": "pis-rayset", "version": 1, "scene": "s", "resolution": [4, 3], "spp": 1,
             "filter": {"sigma_px": 0.5, "radius_px": 1.5},
@@ -273,10 +295,12 @@ mod tests {
                 std::fs::write(dir.path().join(&p.image), b"exr").unwrap();
                 records.record(p).unwrap();
             }
-            let merges: Vec<_> = (0..4).map(|_| {
-                let d = dir.path().to_path_buf();
-                std::thread::spawn(move || merge_set(&d))
-            }).collect();
+            let merges: Vec<_> = (0..4)
+                .map(|_| {
+                    let d = dir.path().to_path_buf();
+                    std::thread::spawn(move || merge_set(&d))
+                })
+                .collect();
             for m in merges {
                 let r = m.join().unwrap().unwrap_or_else(|e| panic!("round {round}: {e}"));
                 assert_eq!(r.points, 6);
@@ -301,10 +325,19 @@ mod tests {
         let e = merge_set(dir.path()).unwrap_err().to_string();
         assert!(e.contains("3 of 5 points are not traced yet (points 1, 2, 4;"), "{e}");
         let other = SetMeta { spp: 2, ..full.clone() };
-        let e = Records::begin(dir.path(), &other, 5, Begin::Join).err().expect("another trace is refused").to_string();
+        let e = Records::begin(dir.path(), &other, 5, Begin::Join)
+            .err()
+            .expect("another trace is refused")
+            .to_string();
         assert!(e.contains("another trace"), "{e}");
-        assert!(Records::begin(dir.path(), &full, 6, Begin::Join).is_err(), "another point count is another trace");
-        assert!(Records::begin(dir.path(), &other, 5, Begin::Fresh).is_ok(), "a fresh trace starts over");
+        assert!(
+            Records::begin(dir.path(), &full, 6, Begin::Join).is_err(),
+            "another point count is another trace"
+        );
+        assert!(
+            Records::begin(dir.path(), &other, 5, Begin::Fresh).is_ok(),
+            "a fresh trace starts over"
+        );
         assert!(merge_set(dir.path()).is_err(), "the fresh trace has recorded nothing");
     }
 
@@ -318,7 +351,11 @@ mod tests {
         for bad in ["3/3", "1/0", "1", "a/2", "-1/2"] {
             assert!(bad.parse::<Shard>().is_err(), "{bad}");
         }
-        let all: Vec<usize> = (0..3).flat_map(|i| Shard { index: i, count: 3 }.points(8)).collect::<std::collections::BTreeSet<_>>().into_iter().collect();
+        let all: Vec<usize> = (0..3)
+            .flat_map(|i| Shard { index: i, count: 3 }.points(8))
+            .collect::<std::collections::BTreeSet<_>>()
+            .into_iter()
+            .collect();
         assert_eq!(all, (0..8).collect::<Vec<_>>(), "the shards cover every point once");
     }
 }

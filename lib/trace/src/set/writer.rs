@@ -66,7 +66,11 @@ pub struct SetWriter {
 impl SetWriter {
     /// Creates the directory `dir` (if needed) for a set of every point of `scene` rendered
     /// with `settings`, by this process alone.
-    pub fn create(dir: &Path, scene: &Scene, settings: &TraceSettings) -> Result<SetWriter, TraceError> {
+    pub fn create(
+        dir: &Path,
+        scene: &Scene,
+        settings: &TraceSettings,
+    ) -> Result<SetWriter, TraceError> {
         SetWriter::begin(dir, scene, settings, scene.space.point_count(), Begin::Fresh)
     }
 
@@ -126,7 +130,13 @@ impl SetWriter {
     /// Creates the directory `dir` (if needed) for a set of the first `points` points of
     /// `scene` rendered with `settings`, taking up the records there as `begin` says
     /// (several processes may write one set, each its own points).
-    pub fn begin(dir: &Path, scene: &Scene, settings: &TraceSettings, points: usize, begin: Begin) -> Result<SetWriter, TraceError> {
+    pub fn begin(
+        dir: &Path,
+        scene: &Scene,
+        settings: &TraceSettings,
+        points: usize,
+        begin: Begin,
+    ) -> Result<SetWriter, TraceError> {
         fs::create_dir_all(dir).map_err(|e| TraceError::io(dir, e))?;
         let meta = SetWriter::meta(dir, scene, settings);
         let records = Records::begin(dir, &meta, points, begin)?;

@@ -43,7 +43,14 @@ pub fn cuboid(lo: Vec3, hi: Vec3, material: usize, inward: bool) -> Vec<Primitiv
 }
 
 /// A UV sphere with smooth normals (pointing outwards, or inwards with `inward`).
-pub fn sphere(c: Vec3, r: f32, rings: u32, segments: u32, material: usize, inward: bool) -> Primitive {
+pub fn sphere(
+    c: Vec3,
+    r: f32,
+    rings: u32,
+    segments: u32,
+    material: usize,
+    inward: bool,
+) -> Primitive {
     let mut p = Primitive { material, ..Primitive::default() };
     for i in 0..=rings {
         let th = PI * i as f32 / rings as f32;
@@ -58,7 +65,8 @@ pub fn sphere(c: Vec3, r: f32, rings: u32, segments: u32, material: usize, inwar
     let row = segments + 1;
     for i in 0..rings {
         for j in 0..segments {
-            let (a, b, c2, d) = (i * row + j, i * row + j + 1, (i + 1) * row + j, (i + 1) * row + j + 1);
+            let (a, b, c2, d) =
+                (i * row + j, i * row + j + 1, (i + 1) * row + j, (i + 1) * row + j + 1);
             if inward {
                 p.indices.extend([a, c2, b, b, c2, d]);
             } else {
@@ -87,7 +95,12 @@ pub fn emitter(l: [f32; 3]) -> Material {
 
 /// A metal with base colour `c` and roughness `r`.
 pub fn metal(c: [f32; 3], r: f32) -> Material {
-    Material { base_color: [c[0], c[1], c[2], 1.0], metallic: 1.0, roughness: r, ..Default::default() }
+    Material {
+        base_color: [c[0], c[1], c[2], 1.0],
+        metallic: 1.0,
+        roughness: r,
+        ..Default::default()
+    }
 }
 
 /// Clear glass of index `ior` (absorbing with `attenuation` colour at `distance`).
@@ -108,7 +121,12 @@ pub fn object(name: &str, role: ObjectRole, primitives: Vec<Primitive>) -> Scene
 }
 
 /// A scene without parameter space (one point) at `res` and `spp`.
-pub fn scene(objects: Vec<SceneObject>, materials: Vec<Material>, res: (u32, u32), spp: u32) -> Scene {
+pub fn scene(
+    objects: Vec<SceneObject>,
+    materials: Vec<Material>,
+    res: (u32, u32),
+    spp: u32,
+) -> Scene {
     Scene {
         name: "test".into(),
         resolution: res,
@@ -141,10 +159,21 @@ pub fn look_at(eye: Vec3, target: Vec3) -> Mat4 {
 
 /// A frame with identity instances.
 pub fn frame(scene: &Scene, camera: Camera, lights: Vec<Light>) -> Frame {
-    Frame { camera, lights, instances: vec![Instance { world_from_object: Mat4::IDENTITY }; scene.objects.len()] }
+    Frame {
+        camera,
+        lights,
+        instances: vec![Instance { world_from_object: Mat4::IDENTITY }; scene.objects.len()],
+    }
 }
 
 /// A sphere light of intensity `i` (W/sr-like) and radius `r`.
 pub fn sphere_light(name: &str, pos: Vec3, i: [f32; 3], r: f32) -> Light {
-    Light { name: name.into(), kind: LightKind::Point, radiance: i, radius: r, position: pos, direction: Vec3::NEG_Y }
+    Light {
+        name: name.into(),
+        kind: LightKind::Point,
+        radiance: i,
+        radius: r,
+        position: pos,
+        direction: Vec3::NEG_Y,
+    }
 }

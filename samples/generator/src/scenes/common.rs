@@ -23,12 +23,7 @@ pub fn object(
     let m = w.add_mesh(name, mesh, material);
     let t = (translation != Vec3::ZERO).then_some(translation);
     w.add_node(
-        NodeDesc {
-            name: name.into(),
-            mesh: Some(m),
-            translation: t,
-            ..NodeDesc::default()
-        },
+        NodeDesc { name: name.into(), mesh: Some(m), translation: t, ..NodeDesc::default() },
         true,
     )
 }
@@ -39,12 +34,8 @@ pub fn smooth(points: &[Vec2], per_segment: usize) -> Vec<Vec2> {
     let at = |k: isize| points[k.clamp(0, n as isize - 1) as usize];
     let mut out = Vec::new();
     for k in 0..n - 1 {
-        let (p0, p1, p2, p3) = (
-            at(k as isize - 1),
-            at(k as isize),
-            at(k as isize + 1),
-            at(k as isize + 2),
-        );
+        let (p0, p1, p2, p3) =
+            (at(k as isize - 1), at(k as isize), at(k as isize + 1), at(k as isize + 2));
         for s in 0..per_segment {
             let t = s as f32 / per_segment as f32;
             let (t2, t3) = (t * t, t * t * t);
@@ -67,12 +58,7 @@ fn v2(r: f32, y: f32) -> Vec2 {
 /// Walls and ceiling of a room (inward-facing), and its floor, spanning x and z in
 /// [-half, half] and y in [0, height]. The floor has a 1 × 1 UV square over its whole area.
 pub fn room(half: f32, height: f32) -> (Mesh, Mesh) {
-    let mut walls = cuboid(
-        Vec3::new(-half, 0.0, -half),
-        Vec3::new(half, height, half),
-        3,
-        true,
-    );
+    let mut walls = cuboid(Vec3::new(-half, 0.0, -half), Vec3::new(half, height, half), 3, true);
     // Drop the bottom face (the floor is its own object): it is the fourth of six faces.
     let per_face = walls.indices.len() / 6;
     walls.indices.drain(3 * per_face..4 * per_face);
@@ -90,20 +76,8 @@ pub fn room(half: f32, height: f32) -> (Mesh, Mesh) {
 /// Writes floor.png (a checkerboard) and wallpaper.png (green stripes) into `dir` and adds
 /// the floor and wall materials. Returns (floor material, wall material).
 pub fn room_materials(w: &mut GltfWriter, dir: &Path) -> io::Result<(usize, usize)> {
-    textures::checker(
-        &dir.join("floor.png"),
-        128,
-        16,
-        [205, 200, 190],
-        [70, 60, 55],
-    )?;
-    textures::wallpaper(
-        &dir.join("wallpaper.png"),
-        128,
-        32,
-        [96, 150, 96],
-        [130, 180, 120],
-    )?;
+    textures::checker(&dir.join("floor.png"), 128, 16, [205, 200, 190], [70, 60, 55])?;
+    textures::wallpaper(&dir.join("wallpaper.png"), 128, 32, [96, 150, 96], [130, 180, 120])?;
     let floor_tex = w.add_png_texture("floor.png");
     let wall_tex = w.add_png_texture("wallpaper.png");
     let floor = w.add_material(&MaterialDesc::textured("Floor", floor_tex, 0.8));
@@ -139,10 +113,7 @@ pub fn table() -> (Mesh, Mesh) {
     let stand = lathe(
         &[
             vec![v2(0.0, 0.0), v2(0.3, 0.0)],
-            smooth(
-                &[v2(0.3, 0.0), v2(0.3, 0.03), v2(0.12, 0.07), v2(0.05, 0.12)],
-                3,
-            ),
+            smooth(&[v2(0.3, 0.0), v2(0.3, 0.03), v2(0.12, 0.07), v2(0.05, 0.12)], 3),
             vec![v2(0.05, 0.12), v2(0.045, h - 0.1)],
             smooth(&[v2(0.045, h - 0.1), v2(0.08, h - 0.04), v2(0.16, h)], 3),
             vec![v2(0.16, h), v2(0.0, h)],
@@ -237,14 +208,7 @@ pub fn column(radius: f32, height: f32) -> Mesh {
         &[
             vec![v2(0.0, 0.0), v2(radius * 1.5, 0.0)],
             vec![v2(radius * 1.5, 0.0), v2(radius * 1.5, b * 0.6)],
-            smooth(
-                &[
-                    v2(radius * 1.5, b * 0.6),
-                    v2(radius * 1.2, b * 0.8),
-                    v2(radius, b),
-                ],
-                2,
-            ),
+            smooth(&[v2(radius * 1.5, b * 0.6), v2(radius * 1.2, b * 0.8), v2(radius, b)], 2),
             vec![v2(radius, b), v2(radius * 0.92, c)],
             smooth(
                 &[
@@ -254,10 +218,7 @@ pub fn column(radius: f32, height: f32) -> Mesh {
                 ],
                 2,
             ),
-            vec![
-                v2(radius * 1.5, c + 0.6 * (height - c)),
-                v2(radius * 1.5, height),
-            ],
+            vec![v2(radius * 1.5, c + 0.6 * (height - c)), v2(radius * 1.5, height)],
             vec![v2(radius * 1.5, height), v2(0.0, height)],
         ],
         24,
@@ -354,10 +315,7 @@ mod tests {
             for t in m.indices.chunks_exact(3) {
                 let [a, b, c] = [t[0], t[1], t[2]].map(|k| k as usize);
                 let face = (m.positions[b] - m.positions[a]).cross(m.positions[c] - m.positions[a]);
-                assert!(
-                    face.dot(m.normals[a] + m.normals[b] + m.normals[c]) >= 0.0,
-                    "{name}"
-                );
+                assert!(face.dot(m.normals[a] + m.normals[b] + m.normals[c]) >= 0.0, "{name}");
             }
         }
         let (walls, floor) = room(3.0, 3.0);

@@ -20,48 +20,17 @@ pub const ELEVATION_DEG: f32 = 22.0;
 pub fn furnished_room(dir: &Path, first_azimuth: f32) -> io::Result<GltfWriter> {
     let mut w = GltfWriter::new();
     let (floor_mat, wall_mat) = room_materials(&mut w, dir)?;
-    let vase_mat = w.add_material(&MaterialDesc::plain(
-        "GlazedCeramic",
-        [0.08, 0.18, 0.55],
-        0.05,
-    ));
-    let glass_mat = w.add_material(&MaterialDesc::glass(
-        "Glass",
-        1.5,
-        0.006,
-        0.5,
-        [0.85, 0.95, 0.9],
-    ));
-    let top_mat = w.add_material(&MaterialDesc::plain(
-        "PolishedWood",
-        [0.30, 0.11, 0.05],
-        0.04,
-    ));
+    let vase_mat = w.add_material(&MaterialDesc::plain("GlazedCeramic", [0.08, 0.18, 0.55], 0.05));
+    let glass_mat =
+        w.add_material(&MaterialDesc::glass("Glass", 1.5, 0.006, 0.5, [0.85, 0.95, 0.9]));
+    let top_mat = w.add_material(&MaterialDesc::plain("PolishedWood", [0.30, 0.11, 0.05], 0.04));
     let stand_mat = w.add_material(&MaterialDesc::plain("StandPaint", [0.55, 0.52, 0.48], 0.6));
 
     let (walls, floor) = room(3.0, 3.0);
     let (top, stand) = table();
-    object(
-        &mut w,
-        "Vase",
-        &vase(),
-        vase_mat,
-        Vec3::new(-0.2, TABLE_HEIGHT, -0.08),
-    );
-    object(
-        &mut w,
-        "GlassCup",
-        &cup(1.0),
-        glass_mat,
-        Vec3::new(0.2, TABLE_HEIGHT, 0.14),
-    );
-    object(
-        &mut w,
-        "TableTop",
-        &top,
-        top_mat,
-        Vec3::new(0.0, TABLE_HEIGHT, 0.0),
-    );
+    object(&mut w, "Vase", &vase(), vase_mat, Vec3::new(-0.2, TABLE_HEIGHT, -0.08));
+    object(&mut w, "GlassCup", &cup(1.0), glass_mat, Vec3::new(0.2, TABLE_HEIGHT, 0.14));
+    object(&mut w, "TableTop", &top, top_mat, Vec3::new(0.0, TABLE_HEIGHT, 0.0));
     object(&mut w, "TableStand", &stand, stand_mat, Vec3::ZERO);
     object(&mut w, "Walls", &walls, wall_mat, Vec3::ZERO);
     object(&mut w, "Floor", &floor, floor_mat, Vec3::ZERO);
@@ -86,10 +55,8 @@ pub fn write(dir: &Path) -> io::Result<()> {
         true,
     );
     let angles = [60f32, 0.0, -60.0];
-    let values: Vec<f32> = angles
-        .iter()
-        .flat_map(|a| Quat::from_rotation_z(a.to_radians()).to_array())
-        .collect();
+    let values: Vec<f32> =
+        angles.iter().flat_map(|a| Quat::from_rotation_z(a.to_radians()).to_array()).collect();
     w.add_animation(
         "swing",
         &[ChannelDesc {

@@ -31,19 +31,11 @@ pub fn write(dir: &Path) -> io::Result<()> {
     // One turn about +Y; the time is in degrees of rotation (keys every 120°, so each
     // LINEAR slerp takes the intended way round).
     let times = vec![0.0, 120.0, 240.0, 360.0];
-    let values: Vec<f32> = times
-        .iter()
-        .flat_map(|a: &f32| Quat::from_rotation_y(a.to_radians()).to_array())
-        .collect();
+    let values: Vec<f32> =
+        times.iter().flat_map(|a: &f32| Quat::from_rotation_y(a.to_radians()).to_array()).collect();
     w.add_animation(
         "spin",
-        &[ChannelDesc {
-            node,
-            path: "rotation",
-            interpolation: Interp::Linear,
-            times,
-            values,
-        }],
+        &[ChannelDesc { node, path: "rotation", interpolation: Interp::Linear, times, values }],
     );
     w.write(dir, "demo2")?;
 

@@ -19,13 +19,8 @@ pub fn write(dir: &Path) -> io::Result<()> {
     std::fs::create_dir_all(dir)?;
     let mut w = crate::gltf_writer::GltfWriter::new();
     let (floor_mat, wall_mat) = room_materials(&mut w, dir)?;
-    let glass = w.add_material(&MaterialDesc::glass(
-        "TeapotGlass",
-        1.5,
-        0.3,
-        1.0,
-        [0.9, 0.95, 1.0],
-    ));
+    let glass =
+        w.add_material(&MaterialDesc::glass("TeapotGlass", 1.5, 0.3, 1.0, [0.9, 0.95, 1.0]));
     let silver = w.add_material(&MaterialDesc::metal("Silver", [0.95, 0.93, 0.88], 0.03));
     let stone = w.add_material(&MaterialDesc::plain("Marble", [0.8, 0.78, 0.74], 0.5));
     let platform_mat = w.add_material(&MaterialDesc::plain("PlatformWood", [0.45, 0.3, 0.18], 0.7));
@@ -46,13 +41,7 @@ pub fn write(dir: &Path) -> io::Result<()> {
         glass,
         Vec3::new(-0.05, top, -0.05),
     );
-    object(
-        &mut w,
-        "SilverCup",
-        &cup(1.5),
-        silver,
-        Vec3::new(0.45, top, 0.2),
-    );
+    object(&mut w, "SilverCup", &cup(1.5), silver, Vec3::new(0.45, top, 0.2));
     object(&mut w, "Platform", &platform, platform_mat, Vec3::ZERO);
     let mut columns = Mesh::default();
     for k in 0..8 {

@@ -48,62 +48,31 @@ pub fn write_variant(dir: &Path, variant: &Variant) -> io::Result<()> {
     let mut w = crate::gltf_writer::GltfWriter::new();
     let (floor_mat, wall_mat) = room_materials(&mut w, dir)?;
     let teapot_mat = w.add_material(&variant.teapot);
-    let pedestal_mat = w.add_material(&MaterialDesc::plain(
-        "PedestalStone",
-        [0.7, 0.68, 0.62],
-        0.7,
-    ));
+    let pedestal_mat =
+        w.add_material(&MaterialDesc::plain("PedestalStone", [0.7, 0.68, 0.62], 0.7));
     let red = w.add_material(&MaterialDesc::plain("RedPaint", [0.7, 0.1, 0.08], 0.6));
     let blue = w.add_material(&MaterialDesc::plain("BluePaint", [0.1, 0.2, 0.6], 0.6));
 
     let pedestal_top = 0.5;
     let (scale, base) = (0.1, Vec3::new(0.0, pedestal_top, 0.0));
     let body_patches = RIM.chain(BODY).chain(HANDLE).chain(SPOUT).chain(BOTTOM);
-    object(
-        &mut w,
-        "TeapotBody",
-        &teapot(body_patches, 8, scale, Vec3::ZERO),
-        teapot_mat,
-        base,
-    );
-    object(
-        &mut w,
-        "TeapotLid",
-        &teapot(LID, 8, scale, Vec3::ZERO),
-        teapot_mat,
-        base,
-    );
+    object(&mut w, "TeapotBody", &teapot(body_patches, 8, scale, Vec3::ZERO), teapot_mat, base);
+    object(&mut w, "TeapotLid", &teapot(LID, 8, scale, Vec3::ZERO), teapot_mat, base);
     object(
         &mut w,
         "Pedestal",
-        &cuboid(
-            Vec3::new(-0.3, 0.0, -0.3),
-            Vec3::new(0.3, pedestal_top, 0.3),
-            2,
-            false,
-        ),
+        &cuboid(Vec3::new(-0.3, 0.0, -0.3), Vec3::new(0.3, pedestal_top, 0.3), 2, false),
         pedestal_mat,
         Vec3::ZERO,
     );
     object(
         &mut w,
         "RedBox",
-        &cuboid(
-            Vec3::new(-0.25, 0.0, -0.25),
-            Vec3::new(0.25, 0.5, 0.25),
-            2,
-            false,
-        ),
+        &cuboid(Vec3::new(-0.25, 0.0, -0.25), Vec3::new(0.25, 0.5, 0.25), 2, false),
         red,
         Vec3::new(-1.6, 0.0, -1.9),
     );
-    object(
-        &mut w,
-        "BlueColumn",
-        &column(0.12, 2.0),
-        blue,
-        Vec3::new(1.7, 0.0, -1.5),
-    );
+    object(&mut w, "BlueColumn", &column(0.12, 2.0), blue, Vec3::new(1.7, 0.0, -1.5));
     let (walls, floor) = room(3.0, 3.0);
     object(&mut w, "Walls", &walls, wall_mat, Vec3::ZERO);
     object(&mut w, "Floor", &floor, floor_mat, Vec3::ZERO);

@@ -65,7 +65,12 @@ fn smoothstep(e0: f32, e1: f32, x: f32) -> f32 {
 
 /// A tangent-space normal map (linear, +Y up the image) of the height field `h(u, v)` over
 /// [0, 1)², `strength` scaling its slopes.
-fn normal_map(path: &Path, size: u32, strength: f32, h: impl Fn(f32, f32) -> f32) -> io::Result<()> {
+fn normal_map(
+    path: &Path,
+    size: u32,
+    strength: f32,
+    h: impl Fn(f32, f32) -> f32,
+) -> io::Result<()> {
     let d = 1.0 / size as f32;
     from_fn(path, size, |x, y| {
         let (u, v) = ((x as f32 + 0.5) * d, (y as f32 + 0.5) * d);
@@ -92,7 +97,14 @@ fn header(title: &str, what: &str) -> String {
     s
 }
 
-fn orbit(name: &str, samples: u32, target: Vec3, radius: f32, elevation: f32, az: [f32; 2]) -> String {
+fn orbit(
+    name: &str,
+    samples: u32,
+    target: Vec3,
+    radius: f32,
+    elevation: f32,
+    az: [f32; 2],
+) -> String {
     format!(
         "[[dimension]]\nname = \"{name}\"\ndriver = \"orbit\"\nsamples = {samples}\ntarget = [{}, {}, {}]\nradius = {radius}\nelevation_deg = {elevation}\nazimuth_deg = [{}, {}]\n",
         target.x, target.y, target.z, az[0], az[1]
@@ -115,7 +127,11 @@ fn cm_export(dir: &Path) -> io::Result<()> {
     from_fn(&dir.join("floor_basecolor.png"), 128, |x, y| {
         let (i, j) = (x / 32, y / 32);
         let grain = ((x / 4 * 7 + y / 4 * 13) % 11) as u8;
-        if (i + j) % 2 == 0 { [190 + grain, 178 + grain, 160] } else { [120 + grain, 96, 74] }
+        if (i + j) % 2 == 0 {
+            [190 + grain, 178 + grain, 160]
+        } else {
+            [120 + grain, 96, 74]
+        }
     })?;
     from_fn(&dir.join("wood_basecolor.png"), 128, |x, y| {
         let ring = ((x as f32 * 0.21 + (y as f32 * 0.05).sin() * 3.0).sin() * 0.5 + 0.5) * 40.0;
@@ -124,7 +140,11 @@ fn cm_export(dir: &Path) -> io::Result<()> {
     from_fn(&dir.join("spines_basecolor.png"), 64, |x, _| {
         let colours = [[150, 40, 40], [40, 70, 140], [60, 120, 60], [180, 150, 60]];
         let c = colours[(x / 32) as usize % 4];
-        if x % 32 < 3 { [230, 220, 200] } else { c }
+        if x % 32 < 3 {
+            [230, 220, 200]
+        } else {
+            c
+        }
     })?;
     let floor_tex = w.add_png_texture("floor_basecolor.png");
     let wood_tex = w.add_png_texture("wood_basecolor.png");
@@ -137,14 +157,28 @@ fn cm_export(dir: &Path) -> io::Result<()> {
     // Everything below is in centimetres.
     let floor = w.add_mesh(
         "SM_Floor",
-        &quad(Vec3::new(-60.0, 0.0, 60.0), Vec3::new(120.0, 0.0, 0.0), Vec3::new(0.0, 0.0, -120.0), 4, 4, Vec2::splat(2.0)),
+        &quad(
+            Vec3::new(-60.0, 0.0, 60.0),
+            Vec3::new(120.0, 0.0, 0.0),
+            Vec3::new(0.0, 0.0, -120.0),
+            4,
+            4,
+            Vec2::splat(2.0),
+        ),
         floor_mat,
     );
     let bookend = w.add_mesh("SM_Bookend", &bookend_cm(), wood_mat);
     let mut books = Mesh::default();
-    for (k, (width, height)) in [(3.0, 17.0), (4.0, 15.0), (2.5, 18.0), (3.5, 14.0)].into_iter().enumerate() {
+    for (k, (width, height)) in
+        [(3.0, 17.0), (4.0, 15.0), (2.5, 18.0), (3.5, 14.0)].into_iter().enumerate()
+    {
         let x = -10.0 + [0.0, 3.2, 7.4, 10.1][k];
-        books.append(&cuboid(Vec3::new(x, 1.5, -5.0), Vec3::new(x + width, 1.5 + height, 5.0), 1, false));
+        books.append(&cuboid(
+            Vec3::new(x, 1.5, -5.0),
+            Vec3::new(x + width, 1.5 + height, 5.0),
+            1,
+            false,
+        ));
     }
     let books = w.add_mesh("SM_Books", &books, book_mat);
     let globe = w.add_mesh("SM_Globe", &sphere(9.0, 12, 24), globe_mat);
@@ -152,12 +186,48 @@ fn cm_export(dir: &Path) -> io::Result<()> {
     let floor_node = leaf(&mut w, "Floor", floor, Vec3::ZERO);
     let left = leaf(&mut w, "Bookend_L", bookend, Vec3::new(-14.0, 0.0, 0.0));
     // The right bookend is the same mesh mirrored in X, as a "mirror modifier" exports it.
-    let right = node(&mut w, "Bookend_R", Some(bookend), Vec3::new(14.0, 0.0, 0.0), Quat::IDENTITY, Vec3::new(-1.0, 1.0, 1.0), vec![], false);
+    let right = node(
+        &mut w,
+        "Bookend_R",
+        Some(bookend),
+        Vec3::new(14.0, 0.0, 0.0),
+        Quat::IDENTITY,
+        Vec3::new(-1.0, 1.0, 1.0),
+        vec![],
+        false,
+    );
     let books_node = leaf(&mut w, "Books", books, Vec3::ZERO);
     let globe_node = leaf(&mut w, "Globe", globe, Vec3::new(0.0, 9.0, 0.0));
-    let pivot = node(&mut w, "GlobePivot", None, Vec3::new(26.0, 0.0, 16.0), Quat::from_rotation_y(0.6), Vec3::ONE, vec![globe_node], false);
-    let shelf = node(&mut w, "Shelf", None, Vec3::ZERO, Quat::from_rotation_y(-0.3), Vec3::ONE, vec![left, right, books_node, pivot], false);
-    node(&mut w, "RootNode", None, Vec3::ZERO, Quat::IDENTITY, Vec3::splat(0.01), vec![floor_node, shelf], true);
+    let pivot = node(
+        &mut w,
+        "GlobePivot",
+        None,
+        Vec3::new(26.0, 0.0, 16.0),
+        Quat::from_rotation_y(0.6),
+        Vec3::ONE,
+        vec![globe_node],
+        false,
+    );
+    let shelf = node(
+        &mut w,
+        "Shelf",
+        None,
+        Vec3::ZERO,
+        Quat::from_rotation_y(-0.3),
+        Vec3::ONE,
+        vec![left, right, books_node, pivot],
+        false,
+    );
+    node(
+        &mut w,
+        "RootNode",
+        None,
+        Vec3::ZERO,
+        Quat::IDENTITY,
+        Vec3::splat(0.01),
+        vec![floor_node, shelf],
+        true,
+    );
     w.write(dir, "cm-export")?;
 
     let target = Vec3::new(0.05, 0.1, 0.0);
@@ -231,7 +301,11 @@ fn pbr_props(dir: &Path) -> io::Result<()> {
         }
     })?;
     from_fn(&dir.join("crate_metallicroughness.png"), n, |x, y| {
-        if frame(x, y) { [255, 90, 255] } else { [255, 200, 0] }
+        if frame(x, y) {
+            [255, 90, 255]
+        } else {
+            [255, 200, 0]
+        }
     })?;
     normal_map(&dir.join("crate_normal.png"), n, 0.04, |_, v| {
         let groove = (v * 6.4).fract();
@@ -241,7 +315,13 @@ fn pbr_props(dir: &Path) -> io::Result<()> {
     from_fn(&dir.join("tiles_basecolor.png"), n, |x, y| {
         let (i, j) = (x / 32, y / 32);
         let mortar = x % 32 < 3 || y % 32 < 3;
-        if mortar { [170, 165, 160] } else if (i + j) % 2 == 0 { [70, 110, 150] } else { [220, 215, 200] }
+        if mortar {
+            [170, 165, 160]
+        } else if (i + j) % 2 == 0 {
+            [70, 110, 150]
+        } else {
+            [220, 215, 200]
+        }
     })?;
     normal_map(&dir.join("tiles_normal.png"), n, 0.05, |u, v| {
         let (fu, fv) = ((u * 4.0).fract(), (v * 4.0).fract());
@@ -253,10 +333,18 @@ fn pbr_props(dir: &Path) -> io::Result<()> {
     from_fn(&dir.join("sign_emissive.png"), n, |x, y| {
         let bar = (16..40).contains(&y) || (88..112).contains(&y);
         let dot = (y > 52 && y < 76) && ((x / 24) % 2 == 1) && x < 120;
-        if bar || dot { [255, 190, 90] } else { [0, 0, 0] }
+        if bar || dot {
+            [255, 190, 90]
+        } else {
+            [0, 0, 0]
+        }
     })?;
     let t = |w: &mut GltfWriter, f: &str| w.add_png_texture(f);
-    let (crate_bc, crate_mr, crate_n) = (t(&mut w, "crate_basecolor.png"), t(&mut w, "crate_metallicroughness.png"), t(&mut w, "crate_normal.png"));
+    let (crate_bc, crate_mr, crate_n) = (
+        t(&mut w, "crate_basecolor.png"),
+        t(&mut w, "crate_metallicroughness.png"),
+        t(&mut w, "crate_normal.png"),
+    );
     let (tiles_bc, tiles_n) = (t(&mut w, "tiles_basecolor.png"), t(&mut w, "tiles_normal.png"));
     let (sign_bc, sign_e) = (t(&mut w, "sign_basecolor.png"), t(&mut w, "sign_emissive.png"));
     let crate_mat = w.add_material(&MaterialDesc {
@@ -279,16 +367,72 @@ fn pbr_props(dir: &Path) -> io::Result<()> {
     });
     let floor_mat = w.add_material(&MaterialDesc::plain("Concrete", [0.45, 0.44, 0.42], 0.9));
 
-    let crate_mesh = w.add_mesh("Crate", &cuboid(Vec3::splat(-0.2), Vec3::splat(0.2), 1, false), crate_mat);
-    let panel_mesh = w.add_mesh("Panel", &cuboid(Vec3::new(-0.5, 0.0, -0.02), Vec3::new(0.5, 0.75, 0.02), 1, false), tiles_mat);
-    let sign_mesh = w.add_mesh("Sign", &cuboid(Vec3::new(-0.18, -0.07, -0.01), Vec3::new(0.18, 0.07, 0.01), 1, false), sign_mat);
-    let floor_mesh = w.add_mesh("Floor", &quad(Vec3::new(-1.2, 0.0, 1.2), Vec3::new(2.4, 0.0, 0.0), Vec3::new(0.0, 0.0, -2.4), 2, 2, Vec2::ONE), floor_mat);
-    let crate_node = node(&mut w, "Crate", Some(crate_mesh), Vec3::new(0.15, 0.2, 0.1), Quat::from_rotation_y(0.5), Vec3::ONE, vec![], false);
-    let small = node(&mut w, "CrateSmall", Some(crate_mesh), Vec3::new(-0.3, 0.1, 0.25), Quat::from_rotation_y(-0.3), Vec3::splat(0.5), vec![], false);
+    let crate_mesh =
+        w.add_mesh("Crate", &cuboid(Vec3::splat(-0.2), Vec3::splat(0.2), 1, false), crate_mat);
+    let panel_mesh = w.add_mesh(
+        "Panel",
+        &cuboid(Vec3::new(-0.5, 0.0, -0.02), Vec3::new(0.5, 0.75, 0.02), 1, false),
+        tiles_mat,
+    );
+    let sign_mesh = w.add_mesh(
+        "Sign",
+        &cuboid(Vec3::new(-0.18, -0.07, -0.01), Vec3::new(0.18, 0.07, 0.01), 1, false),
+        sign_mat,
+    );
+    let floor_mesh = w.add_mesh(
+        "Floor",
+        &quad(
+            Vec3::new(-1.2, 0.0, 1.2),
+            Vec3::new(2.4, 0.0, 0.0),
+            Vec3::new(0.0, 0.0, -2.4),
+            2,
+            2,
+            Vec2::ONE,
+        ),
+        floor_mat,
+    );
+    let crate_node = node(
+        &mut w,
+        "Crate",
+        Some(crate_mesh),
+        Vec3::new(0.15, 0.2, 0.1),
+        Quat::from_rotation_y(0.5),
+        Vec3::ONE,
+        vec![],
+        false,
+    );
+    let small = node(
+        &mut w,
+        "CrateSmall",
+        Some(crate_mesh),
+        Vec3::new(-0.3, 0.1, 0.25),
+        Quat::from_rotation_y(-0.3),
+        Vec3::splat(0.5),
+        vec![],
+        false,
+    );
     let panel = leaf(&mut w, "Panel", panel_mesh, Vec3::new(0.0, 0.0, -0.35));
-    let sign = node(&mut w, "Sign", Some(sign_mesh), Vec3::new(0.0, 0.55, -0.32), Quat::from_rotation_x(-0.1), Vec3::ONE, vec![], false);
+    let sign = node(
+        &mut w,
+        "Sign",
+        Some(sign_mesh),
+        Vec3::new(0.0, 0.55, -0.32),
+        Quat::from_rotation_x(-0.1),
+        Vec3::ONE,
+        vec![],
+        false,
+    );
     let floor = leaf(&mut w, "Floor", floor_mesh, Vec3::ZERO);
-    node(&mut w, "Props", None, Vec3::ZERO, Quat::IDENTITY, Vec3::ONE, vec![floor, panel, sign, crate_node, small], true);
+    node(
+        &mut w,
+        "Props",
+        None,
+        Vec3::ZERO,
+        Quat::IDENTITY,
+        Vec3::ONE,
+        vec![floor, panel, sign, crate_node, small],
+        true,
+    );
     w.write(dir, "pbr-props")?;
 
     let target = Vec3::new(0.0, 0.3, 0.0);
@@ -337,7 +481,11 @@ fn glass_shelf(dir: &Path) -> io::Result<()> {
     let mut w = GltfWriter::new();
     from_fn(&dir.join("backdrop_basecolor.png"), 128, |x, y| {
         let stripe = ((x + y / 2) / 16) % 2 == 0;
-        if stripe { [200, 190, 170] } else { [120, 60, 50] }
+        if stripe {
+            [200, 190, 170]
+        } else {
+            [120, 60, 50]
+        }
     })?;
     let back_tex = w.add_png_texture("backdrop_basecolor.png");
     let glass = |name| MaterialDesc {
@@ -346,27 +494,59 @@ fn glass_shelf(dir: &Path) -> io::Result<()> {
         ..MaterialDesc::plain(name, [1.0, 1.0, 1.0], 0.0)
     };
     let clear = w.add_material(&glass("Glass_Clear"));
-    let tinted = w.add_material(&MaterialDesc {
-        base_color: [0.7, 0.9, 0.75, 1.0],
-        ..glass("Glass_Green")
-    });
+    let tinted =
+        w.add_material(&MaterialDesc { base_color: [0.7, 0.9, 0.75, 1.0], ..glass("Glass_Green") });
     let back_mat = w.add_material(&MaterialDesc::textured("Backdrop", back_tex, 0.9));
     let shelf_mat = w.add_material(&MaterialDesc::plain("ShelfOak", [0.55, 0.38, 0.22], 0.7));
     let cube_mat = w.add_material(&MaterialDesc::plain("RedPaint", [0.75, 0.1, 0.08], 0.5));
 
     let ball = w.add_mesh("GlassBall", &sphere(0.08, 16, 32), clear);
     let tumbler = w.add_mesh("Tumbler", &cup(1.2), tinted);
-    let cube = w.add_mesh("Cube", &cuboid(Vec3::splat(-0.06), Vec3::splat(0.06), 1, false), cube_mat);
-    let shelf = w.add_mesh("Shelf", &cuboid(Vec3::new(-0.5, -0.03, -0.2), Vec3::new(0.5, 0.0, 0.2), 1, false), shelf_mat);
-    let back = w.add_mesh("Backdrop", &quad(Vec3::new(-0.7, 0.0, -0.2), Vec3::new(1.4, 0.0, 0.0), Vec3::new(0.0, 0.8, 0.0), 2, 2, Vec2::ONE), back_mat);
+    let cube =
+        w.add_mesh("Cube", &cuboid(Vec3::splat(-0.06), Vec3::splat(0.06), 1, false), cube_mat);
+    let shelf = w.add_mesh(
+        "Shelf",
+        &cuboid(Vec3::new(-0.5, -0.03, -0.2), Vec3::new(0.5, 0.0, 0.2), 1, false),
+        shelf_mat,
+    );
+    let back = w.add_mesh(
+        "Backdrop",
+        &quad(
+            Vec3::new(-0.7, 0.0, -0.2),
+            Vec3::new(1.4, 0.0, 0.0),
+            Vec3::new(0.0, 0.8, 0.0),
+            2,
+            2,
+            Vec2::ONE,
+        ),
+        back_mat,
+    );
     let nodes = vec![
         leaf(&mut w, "GlassBall", ball, Vec3::new(-0.12, 0.08, 0.05)),
         leaf(&mut w, "Tumbler", tumbler, Vec3::new(0.13, 0.0, 0.02)),
-        node(&mut w, "Cube", Some(cube), Vec3::new(0.0, 0.06, -0.1), Quat::from_rotation_y(0.7), Vec3::ONE, vec![], false),
+        node(
+            &mut w,
+            "Cube",
+            Some(cube),
+            Vec3::new(0.0, 0.06, -0.1),
+            Quat::from_rotation_y(0.7),
+            Vec3::ONE,
+            vec![],
+            false,
+        ),
         leaf(&mut w, "Shelf", shelf, Vec3::ZERO),
         leaf(&mut w, "Backdrop", back, Vec3::new(0.0, -0.03, 0.0)),
     ];
-    node(&mut w, "Scene_Root", None, Vec3::new(0.0, 0.5, 0.0), Quat::IDENTITY, Vec3::ONE, nodes, true);
+    node(
+        &mut w,
+        "Scene_Root",
+        None,
+        Vec3::new(0.0, 0.5, 0.0),
+        Quat::IDENTITY,
+        Vec3::ONE,
+        nodes,
+        true,
+    );
     w.write(dir, "glass-shelf")?;
 
     let target = Vec3::new(0.0, 0.58, 0.0);
@@ -423,7 +603,13 @@ fn still_life(dir: &Path) -> io::Result<()> {
     from_fn(&dir.join("cloth_basecolor.png"), 128, |x, y| {
         let check = ((x / 32) + (y / 32)) % 2 == 0;
         let line = x % 64 < 4 || y % 64 < 4;
-        if line { [200, 40, 40] } else if check { [235, 230, 215] } else { [210, 200, 185] }
+        if line {
+            [200, 40, 40]
+        } else if check {
+            [235, 230, 215]
+        } else {
+            [210, 200, 185]
+        }
     })?;
     let glaze_tex = w.add_png_texture("glaze_basecolor.png");
     let cloth_tex = w.add_png_texture("cloth_basecolor.png");
@@ -434,24 +620,99 @@ fn still_life(dir: &Path) -> io::Result<()> {
     let clay = w.add_material(&MaterialDesc::plain("Clay", [0.6, 0.4, 0.3], 0.8));
     let ground = w.add_material(&MaterialDesc::plain("Ground", [0.35, 0.35, 0.33], 0.9));
 
-    let unit_box = w.add_mesh("UnitBox", &cuboid(Vec3::splat(-0.5), Vec3::splat(0.5), 2, false), cloth);
+    let unit_box =
+        w.add_mesh("UnitBox", &cuboid(Vec3::splat(-0.5), Vec3::splat(0.5), 2, false), cloth);
     let vase_mesh = w.add_mesh("Vase", &vase(), glaze);
     let fruit_mesh = w.add_mesh("Fruit", &sphere(0.04, 10, 20), fruit);
     let ring_mesh = w.add_mesh("Ring", &torus(0.06, 0.012, 10, 32), brass);
     let bowl_mesh = w.add_mesh("Bowl", &cup(1.6), clay);
-    let ground_mesh = w.add_mesh("Ground", &quad(Vec3::new(-1.5, 0.0, 1.5), Vec3::new(3.0, 0.0, 0.0), Vec3::new(0.0, 0.0, -3.0), 2, 2, Vec2::ONE), ground);
+    let ground_mesh = w.add_mesh(
+        "Ground",
+        &quad(
+            Vec3::new(-1.5, 0.0, 1.5),
+            Vec3::new(3.0, 0.0, 0.0),
+            Vec3::new(0.0, 0.0, -3.0),
+            2,
+            2,
+            Vec2::ONE,
+        ),
+        ground,
+    );
 
     // A unit box squashed into a low table top by its node's scale (normals need the
     // inverse transpose), and objects on it under a group scaled 1.25 and turned 30°.
-    let top = node(&mut w, "TableTop", Some(unit_box), Vec3::new(0.0, 0.05, 0.0), Quat::IDENTITY, Vec3::new(0.7, 0.1, 0.45), vec![], false);
+    let top = node(
+        &mut w,
+        "TableTop",
+        Some(unit_box),
+        Vec3::new(0.0, 0.05, 0.0),
+        Quat::IDENTITY,
+        Vec3::new(0.7, 0.1, 0.45),
+        vec![],
+        false,
+    );
     let vase_node = leaf(&mut w, "Vase", vase_mesh, Vec3::new(-0.15, 0.1, -0.05));
-    let apple = node(&mut w, "Apple", Some(fruit_mesh), Vec3::new(0.1, 0.135, 0.1), Quat::IDENTITY, Vec3::new(1.0, 0.85, 1.0), vec![], false);
-    let pear = node(&mut w, "Pear", Some(fruit_mesh), Vec3::new(0.2, 0.14, 0.02), Quat::from_rotation_z(0.4), Vec3::new(0.8, 1.2, 0.8), vec![], false);
-    let ring = node(&mut w, "Ring", Some(ring_mesh), Vec3::new(0.05, 0.115, -0.12), Quat::from_rotation_x(0.25), Vec3::ONE, vec![], false);
-    let bowl = node(&mut w, "Bowl", Some(bowl_mesh), Vec3::new(0.16, 0.1, 0.06), Quat::IDENTITY, Vec3::new(1.0, 0.6, 1.0), vec![], false);
-    let group = node(&mut w, "StillLife", None, Vec3::ZERO, Quat::from_rotation_y(30f32.to_radians()), Vec3::splat(1.25), vec![top, vase_node, apple, pear, ring, bowl], false);
+    let apple = node(
+        &mut w,
+        "Apple",
+        Some(fruit_mesh),
+        Vec3::new(0.1, 0.135, 0.1),
+        Quat::IDENTITY,
+        Vec3::new(1.0, 0.85, 1.0),
+        vec![],
+        false,
+    );
+    let pear = node(
+        &mut w,
+        "Pear",
+        Some(fruit_mesh),
+        Vec3::new(0.2, 0.14, 0.02),
+        Quat::from_rotation_z(0.4),
+        Vec3::new(0.8, 1.2, 0.8),
+        vec![],
+        false,
+    );
+    let ring = node(
+        &mut w,
+        "Ring",
+        Some(ring_mesh),
+        Vec3::new(0.05, 0.115, -0.12),
+        Quat::from_rotation_x(0.25),
+        Vec3::ONE,
+        vec![],
+        false,
+    );
+    let bowl = node(
+        &mut w,
+        "Bowl",
+        Some(bowl_mesh),
+        Vec3::new(0.16, 0.1, 0.06),
+        Quat::IDENTITY,
+        Vec3::new(1.0, 0.6, 1.0),
+        vec![],
+        false,
+    );
+    let group = node(
+        &mut w,
+        "StillLife",
+        None,
+        Vec3::ZERO,
+        Quat::from_rotation_y(30f32.to_radians()),
+        Vec3::splat(1.25),
+        vec![top, vase_node, apple, pear, ring, bowl],
+        false,
+    );
     let ground_node = leaf(&mut w, "Ground", ground_mesh, Vec3::ZERO);
-    node(&mut w, "Root", None, Vec3::ZERO, Quat::IDENTITY, Vec3::ONE, vec![ground_node, group], true);
+    node(
+        &mut w,
+        "Root",
+        None,
+        Vec3::ZERO,
+        Quat::IDENTITY,
+        Vec3::ONE,
+        vec![ground_node, group],
+        true,
+    );
     w.write(dir, "still-life")?;
 
     let target = Vec3::new(0.0, 0.22, 0.0);

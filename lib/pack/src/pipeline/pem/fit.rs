@@ -10,7 +10,9 @@ use pis_compile::shell::{Shell, ShellShape};
 use pis_trace::bvh::SceneGeometry;
 
 use super::super::input::LoadedSet;
-use super::super::shell_fit::{bounding_ellipsoid, distant_box, distant_sphere, hit_points, origin, support_plane};
+use super::super::shell_fit::{
+    bounding_ellipsoid, distant_box, distant_sphere, hit_points, origin, support_plane,
+};
 use crate::infer::Mesh;
 
 /// Cameras whose reflections size the distant shell: at most this many, evenly spread over
@@ -42,21 +44,36 @@ pub fn fit_shells(set: &LoadedSet, o: usize, mesh: &Mesh) -> Result<FittedShells
     let centre = origin(&world, &mesh.indices)?;
     let ellipsoid = bounding_ellipsoid(&world, centre);
     let geometry = SceneGeometry::build(&set.scene, &set.frames[0]);
-    let cast = |from: Vec3, dir: Vec3| geometry.closest(from, dir, f32::INFINITY, Some(o as u32)).map(|h| h.t);
+    let cast = |from: Vec3, dir: Vec3| {
+        geometry.closest(from, dir, f32::INFINITY, Some(o as u32)).map(|h| h.t)
+    };
     let support = support_plane(&world, cast);
     let step = set.frames.len().div_ceil(MAX_EYES).max(1);
-    let eyes: Vec<Vec3> = set.frames.iter().step_by(step).map(|f| f.camera.world_from_camera.w_axis.truncate()).collect();
+    let eyes: Vec<Vec3> = set
+        .frames
+        .iter()
+        .step_by(step)
+        .map(|f| f.camera.world_from_camera.w_axis.truncate())
+        .collect();
     let hits = hit_points(&world, &mesh.indices, &eyes, cast)?;
     if hits.is_empty() && support.is_none() {
-        return Err(anyhow!("object {name}: no reflection ray meets the scene, so no distant shell can be placed"));
+        return Err(anyhow!(
+            "object {name}: no reflection ray meets the scene, so no distant shell can be placed"
+        ));
     }
     let b = distant_box(centre, support, &hits)?;
     let s = if hits.is_empty() { None } else { Some(distant_sphere(centre, &hits)?) };
     let o3 = centre.as_dvec3();
-    let box_shell = Shell { origin: o3, shape: ShellShape::Box { min: b.min.as_dvec3(), max: b.max.as_dvec3() } };
+    let box_shell = Shell {
+        origin: o3,
+        shape: ShellShape::Box { min: b.min.as_dvec3(), max: b.max.as_dvec3() },
+    };
     let radius = s.map_or_else(|| (b.max - b.min).length() as f64 * 0.5, |s| s.radius as f64);
     Ok(FittedShells {
-        local: Shell { origin: o3, shape: ShellShape::Ellipsoid { radii: ellipsoid.radii.as_dvec3() } },
+        local: Shell {
+            origin: o3,
+            shape: ShellShape::Ellipsoid { radii: ellipsoid.radii.as_dvec3() },
+        },
         distant_box: box_shell,
         distant_sphere: Shell { origin: o3, shape: ShellShape::Sphere { radius } },
         supported: support.is_some(),

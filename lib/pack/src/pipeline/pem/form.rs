@@ -25,7 +25,13 @@ pub struct ShellForm {
 }
 
 impl LayerForm for ShellForm {
-    fn layer(&self, kind: pis_format::LayerKind, _order: u8, depends_on: DepMask, gamma: f32) -> pis_format::Layer {
+    fn layer(
+        &self,
+        kind: pis_format::LayerKind,
+        _order: u8,
+        depends_on: DepMask,
+        gamma: f32,
+    ) -> pis_format::Layer {
         pis_format::Layer {
             kind,
             mapping: pis_format::Mapping::Shell,
@@ -53,7 +59,12 @@ impl LayerForm for ShellForm {
         pis_format::Block {
             width: self.layout.width,
             height: self.layout.height,
-            placement: pis_format::Placement::Shell { shape, origin: [v[0], v[1], v[2]], params, lookups: self.lookups },
+            placement: pis_format::Placement::Shell {
+                shape,
+                origin: [v[0], v[1], v[2]],
+                params,
+                lookups: self.lookups,
+            },
             levels: vec![],
         }
     }
@@ -84,10 +95,30 @@ mod tests {
 
     #[test]
     fn a_shell_layer_is_stored_whole_on_its_shell() {
-        let shell = Shell { origin: DVec3::new(0.5, 1.0, -2.0), shape: ShellShape::Ellipsoid { radii: DVec3::new(1.0, 2.0, 3.0) } };
-        let f = ShellForm { shell, layout: TextureLayout::cube(8), lookups: 2, channels: 4, order: 0, term: pis_format::Term::Reflection };
+        let shell = Shell {
+            origin: DVec3::new(0.5, 1.0, -2.0),
+            shape: ShellShape::Ellipsoid { radii: DVec3::new(1.0, 2.0, 3.0) },
+        };
+        let f = ShellForm {
+            shell,
+            layout: TextureLayout::cube(8),
+            lookups: 2,
+            channels: 4,
+            order: 0,
+            term: pis_format::Term::Reflection,
+        };
         let l = f.layer(pis_format::LayerKind::EnvLocal, 3, DepMask::of(&[0]), 1.0);
-        assert_eq!((l.mapping, l.mip_mode, l.term, l.combine, l.channels, l.order), (pis_format::Mapping::Shell, pis_format::MipMode::Stored, pis_format::Term::Reflection, pis_format::Combine::Over, 4, 0));
+        assert_eq!(
+            (l.mapping, l.mip_mode, l.term, l.combine, l.channels, l.order),
+            (
+                pis_format::Mapping::Shell,
+                pis_format::MipMode::Stored,
+                pis_format::Term::Reflection,
+                pis_format::Combine::Over,
+                4,
+                0
+            )
+        );
         let b = f.block(0);
         assert_eq!((b.width, b.height), (8, 8));
         match b.placement {

@@ -33,7 +33,11 @@ use views::{face_resolution, shell_views, ShellView};
 
 /// The report's words for `--shell-lookups` above 1.
 fn lookups_text(lookups: u32) -> String {
-    if lookups > 1 { format!(", {lookups}×{lookups} lookups per pixel") } else { String::new() }
+    if lookups > 1 {
+        format!(", {lookups}×{lookups} lookups per pixel")
+    } else {
+        String::new()
+    }
 }
 
 /// The largest cube face tried when choosing a shell's resolution (thesis 5.8.2).
@@ -102,7 +106,9 @@ impl Planned for PemPlanned {
         let mut model = surface.solve(job)?;
         let set = job.set;
         let f0 = super::shading::object_shading(&set.scene, o).f0;
-        let pixels: Vec<Vec<u32>> = (0..model.views.len()).map(|p| model.views.pixels(p).map(|x| x.into_owned())).collect::<Result<_>>()?;
+        let pixels: Vec<Vec<u32>> = (0..model.views.len())
+            .map(|p| model.views.pixels(p).map(|x| x.into_owned()))
+            .collect::<Result<_>>()?;
         let keys: Vec<Vec<u32>> = set.samples.iter().map(|s| key(s, job.all)).collect();
         let mut settings = SolveSettings::pyramidal();
         settings.cg = job.settings.cg;
@@ -120,13 +126,44 @@ impl Planned for PemPlanned {
         };
         let lookups = job.req.shell_lookups;
         match job.req.representation {
-            super::RepresentationMode::PemInfinity => return single_shell(model, job, o, f0, &pixels, &keys, &settings, largest, fitted.local.origin).map(with_note),
-            super::RepresentationMode::StaticEnv => return traced::static_env(model, job, o, f0, &pixels, &keys, largest, fitted.local.origin).map(with_note),
+            super::RepresentationMode::PemInfinity => {
+                return single_shell(
+                    model,
+                    job,
+                    o,
+                    f0,
+                    &pixels,
+                    &keys,
+                    &settings,
+                    largest,
+                    fitted.local.origin,
+                )
+                .map(with_note)
+            }
+            super::RepresentationMode::StaticEnv => {
+                return traced::static_env(
+                    model,
+                    job,
+                    o,
+                    f0,
+                    &pixels,
+                    &keys,
+                    largest,
+                    fitted.local.origin,
+                )
+                .map(with_note)
+            }
             _ => {}
         }
         let local_n = face_resolution(set, o, &job.meshes, fitted.local, largest)?;
         let local_layout = TextureLayout::cube(local_n);
-        let has_local = pixels.iter().enumerate().map(|(p, px)| local_alpha(set, p, o, px)).collect::<Result<Vec<f32>>>()?.iter().any(|&a| a > 1e-3);
+        let has_local = pixels
+            .iter()
+            .enumerate()
+            .map(|(p, px)| local_alpha(set, p, o, px))
+            .collect::<Result<Vec<f32>>>()?
+            .iter()
+            .any(|&a| a > 1e-3);
         // The distant shell: a box and a sphere, each solved at a few points spread over the
         // set; the one nearer the traced distant layer there is kept and solved everywhere.
         let probe: Vec<usize> = probe_points(set.frames.len());
@@ -135,8 +172,25 @@ impl Planned for PemPlanned {
         let mut trial: Vec<(f64, &str, Shell, u32)> = Vec::new();
         for (label, shell) in [("box", fitted.distant_box), ("sphere", fitted.distant_sphere)] {
             let n = face_resolution(set, o, &job.meshes, shell, largest)?;
-            let views = shell_views(set, o, &job.meshes, &[(shell, TextureLayout::cube(n), None)], lookups, f0, &probe_pixels, &probe)?;
-            let solved = solve_shell(&views, 0, TextureLayout::cube(n), Target::Distant, &probe_keys, &settings, &job.solver)?;
+            let views = shell_views(
+                set,
+                o,
+                &job.meshes,
+                &[(shell, TextureLayout::cube(n), None)],
+                lookups,
+                f0,
+                &probe_pixels,
+                &probe,
+            )?;
+            let solved = solve_shell(
+                &views,
+                0,
+                TextureLayout::cube(n),
+                Target::Distant,
+                &probe_keys,
+                &settings,
+                &job.solver,
+            )?;
             trial.push((solved.residual_rms, label, shell, n));
         }
         trial.sort_by(|a, b| a.0.total_cmp(&b.0));
@@ -150,8 +204,12 @@ impl Planned for PemPlanned {
         // The convex-hull split (thesis 5.7): triangles on the hull never see the object, so
         // they draw the distant shell alone; the file stores them first.
         let hull = if has_local { hull_split(job, o)? } else { None };
-        let local_drawn: Option<Vec<bool>> = hull.as_ref().map(|h| h.iter().map(|&on| !on).collect());
-        let geometry: Vec<(Shell, TextureLayout, Option<&[bool]>)> = shells.iter().map(|s| (s.0, s.1, if s.2 == Target::Local { local_drawn.as_deref() } else { None })).collect();
+        let local_drawn: Option<Vec<bool>> =
+            hull.as_ref().map(|h| h.iter().map(|&on| !on).collect());
+        let geometry: Vec<(Shell, TextureLayout, Option<&[bool]>)> = shells
+            .iter()
+            .map(|s| (s.0, s.1, if s.2 == Target::Local { local_drawn.as_deref() } else { None }))
+            .collect();
         let all: Vec<usize> = (0..set.frames.len()).collect();
         let views = shell_views(set, o, &job.meshes, &geometry, lookups, f0, &pixels, &all)?;
         let mut solved = Vec::new();
@@ -161,18 +219,49 @@ impl Planned for PemPlanned {
         let hull_text = match &hull {
             Some(h) => {
                 model.hull_triangles = hull_first(&mut model.mesh.indices, h);
-                format!(", {} of {} triangles on the convex hull draw the distant shell only", model.hull_triangles, h.len())
+                format!(
+                    ", {} of {} triangles on the convex hull draw the distant shell only",
+                    model.hull_triangles,
+                    h.len()
+                )
             }
-            None if has_local => ", no convex-hull split (a part of a reflector of several objects)".to_string(),
+            None if has_local => {
+                ", no convex-hull split (a part of a reflector of several objects)".to_string()
+            }
             None => String::new(),
         };
-        let local_text = if has_local { format!(", local ellipsoid {local_n}²{hull_text}") } else { String::new() };
+        let local_text = if has_local {
+            format!(", local ellipsoid {local_n}²{hull_text}")
+        } else {
+            String::new()
+        };
         let why = format!("distant {label} {n}² (traced distant layer residual {residual:.4}, {} {:.4}){local_text}{}", other.1, other.0, lookups_text(lookups));
         let chosen = Chosen { shells, views, solved, why };
-        for (s, ((shell, layout, target), solved)) in chosen.shells.iter().zip(chosen.solved).enumerate() {
-            let kind = if *target == Target::Local { pis_format::LayerKind::EnvLocal } else { pis_format::LayerKind::EnvDistant };
-            let form = Box::new(ShellForm { shell: *shell, layout: *layout, lookups, channels: target.channels() as u8, order: s as u8, term: pis_format::Term::Reflection });
-            model.layers.push(InferredLayer::shell(kind, job, &model.stagger, solved.textures, solved.iterations, form, s));
+        for (s, ((shell, layout, target), solved)) in
+            chosen.shells.iter().zip(chosen.solved).enumerate()
+        {
+            let kind = if *target == Target::Local {
+                pis_format::LayerKind::EnvLocal
+            } else {
+                pis_format::LayerKind::EnvDistant
+            };
+            let form = Box::new(ShellForm {
+                shell: *shell,
+                layout: *layout,
+                lookups,
+                channels: target.channels() as u8,
+                order: s as u8,
+                term: pis_format::Term::Reflection,
+            });
+            model.layers.push(InferredLayer::shell(
+                kind,
+                job,
+                &model.stagger,
+                solved.textures,
+                solved.iterations,
+                form,
+                s,
+            ));
         }
         model.shell_views = chosen.views;
         model.representation = "layered environment maps".to_string();
@@ -184,17 +273,43 @@ impl Planned for PemPlanned {
 /// The single-shell baseline (thesis 5.10): one sphere-at-infinity map per sample against
 /// all the traced incident light.
 #[allow(clippy::too_many_arguments)]
-fn single_shell(mut model: ObjectModel, job: &Job<'_>, o: usize, f0: [f32; 3], pixels: &[Vec<u32>], keys: &[Vec<u32>], settings: &SolveSettings, largest: u32, origin: glam::DVec3) -> Result<ObjectModel> {
+fn single_shell(
+    mut model: ObjectModel,
+    job: &Job<'_>,
+    o: usize,
+    f0: [f32; 3],
+    pixels: &[Vec<u32>],
+    keys: &[Vec<u32>],
+    settings: &SolveSettings,
+    largest: u32,
+    origin: glam::DVec3,
+) -> Result<ObjectModel> {
     let set = job.set;
     let shell = fit::sphere_at_infinity(origin);
     let lookups = job.req.shell_lookups;
     let n = face_resolution(set, o, &job.meshes, shell, largest)?;
     let layout = TextureLayout::cube(n);
     let all: Vec<usize> = (0..set.frames.len()).collect();
-    let views = shell_views(set, o, &job.meshes, &[(shell, layout, None)], lookups, f0, pixels, &all)?;
+    let views =
+        shell_views(set, o, &job.meshes, &[(shell, layout, None)], lookups, f0, pixels, &all)?;
     let solved = solve_shell(&views, 0, layout, Target::Incident, keys, settings, &job.solver)?;
-    let form = Box::new(ShellForm { shell, layout, lookups, channels: 3, order: 0, term: pis_format::Term::Reflection });
-    model.layers.push(InferredLayer::shell(pis_format::LayerKind::EnvDistant, job, &model.stagger, solved.textures, solved.iterations, form, 0));
+    let form = Box::new(ShellForm {
+        shell,
+        layout,
+        lookups,
+        channels: 3,
+        order: 0,
+        term: pis_format::Term::Reflection,
+    });
+    model.layers.push(InferredLayer::shell(
+        pis_format::LayerKind::EnvDistant,
+        job,
+        &model.stagger,
+        solved.textures,
+        solved.iterations,
+        form,
+        0,
+    ));
     model.shell_views = views;
     model.representation = "environment map at infinity".to_string();
     model.why = format!("--representation pem-infinity: one sphere-at-infinity map {n}² per sample (traced incident light residual {:.4}){}, Fresnel from F0 {f0:?}", solved.residual_rms, lookups_text(lookups));
@@ -227,7 +342,10 @@ fn hull_first(indices: &mut Vec<u32>, hull: &[bool]) -> u32 {
 /// Whether the set has the tracer's local and distant layers of object `o`, which layered
 /// environment maps are solved against.
 pub fn layered(set: &super::input::LoadedSet, o: usize) -> bool {
-    set.images.object(0, o).is_ok_and(|i| i.object_layer(&set.channels[o], TraceLayer::Local).is_some() && i.object_layer(&set.channels[o], TraceLayer::Distant).is_some())
+    set.images.object(0, o).is_ok_and(|i| {
+        i.object_layer(&set.channels[o], TraceLayer::Local).is_some()
+            && i.object_layer(&set.channels[o], TraceLayer::Distant).is_some()
+    })
 }
 
 /// At most three points spread over `n`: first, middle, last.
@@ -239,7 +357,9 @@ fn probe_points(n: usize) -> Vec<usize> {
 
 /// The largest traced local alpha of object `o` over `pixels` at point `p`.
 fn local_alpha(set: &super::input::LoadedSet, p: usize, o: usize, pixels: &[u32]) -> Result<f32> {
-    Ok(set.images.object(p, o)?
+    Ok(set
+        .images
+        .object(p, o)?
         .object_layer(&set.channels[o], TraceLayer::Local)
         .and_then(|l| l.channel("A"))
         .map_or(0.0, |a| pixels.iter().map(|&px| a[px as usize]).fold(0.0, f32::max)))

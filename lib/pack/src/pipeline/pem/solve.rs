@@ -48,7 +48,15 @@ pub struct SolvedShell {
 /// Solves shell `s` (of the views' shells) for `target` at every point, keyed by `keys`
 /// (one key per point: shells are view-dependent), each point's rows stacked with its
 /// neighbours' (the points before and after it) weighed by [`NEIGHBOUR_SCALE`].
-pub fn solve_shell(views: &[ShellView], s: usize, layout: TextureLayout, target: Target, keys: &[Vec<u32>], settings: &SolveSettings, solver: &Solver) -> Result<SolvedShell> {
+pub fn solve_shell(
+    views: &[ShellView],
+    s: usize,
+    layout: TextureLayout,
+    target: Target,
+    keys: &[Vec<u32>],
+    settings: &SolveSettings,
+    solver: &Solver,
+) -> Result<SolvedShell> {
     let n = layout.texel_count();
     let c = target.channels();
     let mut textures = BTreeMap::new();
@@ -58,20 +66,28 @@ pub fn solve_shell(views: &[ShellView], s: usize, layout: TextureLayout, target:
     // Each neighbour's rows, weighed down: the parts of the environment a sample's view does
     // not see are inferred from its neighbours' views (thesis 6.3: matching over several
     // nearby viewpoints keeps the maps complete for cameras off the samples).
-    let scaled: Vec<(RenderMatrix, Vec<f32>, Option<Vec<f32>>)> = views.iter().map(|v| {
-        let mut a = v.a[s].clone();
-        a.vals.iter_mut().for_each(|x| *x *= NEIGHBOUR_SCALE);
-        let (rgb, alpha) = split(v, target);
-        let scale = |b: Vec<f32>| b.into_iter().map(|x| x * NEIGHBOUR_SCALE).collect::<Vec<f32>>();
-        (a, scale(rgb), alpha.map(scale))
-    }).collect();
+    let scaled: Vec<(RenderMatrix, Vec<f32>, Option<Vec<f32>>)> = views
+        .iter()
+        .map(|v| {
+            let mut a = v.a[s].clone();
+            a.vals.iter_mut().for_each(|x| *x *= NEIGHBOUR_SCALE);
+            let (rgb, alpha) = split(v, target);
+            let scale =
+                |b: Vec<f32>| b.into_iter().map(|x| x * NEIGHBOUR_SCALE).collect::<Vec<f32>>();
+            (a, scale(rgb), alpha.map(scale))
+        })
+        .collect();
     for (i, (v, k)) in views.iter().zip(keys).enumerate() {
         let a = &v.a[s];
         let mut texels = vec![0.0f32; n * c];
-        let neighbours: Vec<usize> = [i.wrapping_sub(1), i + 1].into_iter().filter(|&j| j < views.len() && scaled[j].0.rows() > 0).collect();
+        let neighbours: Vec<usize> = [i.wrapping_sub(1), i + 1]
+            .into_iter()
+            .filter(|&j| j < views.len() && scaled[j].0.rows() > 0)
+            .collect();
         if a.rows() > 0 {
             let (rgb, alpha) = split(v, target);
-            let rgb_n: Vec<(&RenderMatrix, &[f32])> = neighbours.iter().map(|&j| (&scaled[j].0, scaled[j].1.as_slice())).collect();
+            let rgb_n: Vec<(&RenderMatrix, &[f32])> =
+                neighbours.iter().map(|&j| (&scaled[j].0, scaled[j].1.as_slice())).collect();
             let x = solve_stacked(a, &rgb, &rgb_n, warm_rgb.as_deref(), settings, solver)?;
             iterations += x.iterations as u64;
             sq += x.residual_rms * x.residual_rms * a.rows() as f64;
@@ -81,8 +97,12 @@ pub fn solve_shell(views: &[ShellView], s: usize, layout: TextureLayout, target:
             }
             warm_rgb = Some(x.texels);
             if let Some(alpha) = alpha {
-                let alpha_n: Vec<(&RenderMatrix, &[f32])> = neighbours.iter().filter_map(|&j| scaled[j].2.as_deref().map(|b| (&scaled[j].0, b))).collect();
-                let y = solve_stacked(a, &alpha, &alpha_n, warm_alpha.as_deref(), settings, solver)?;
+                let alpha_n: Vec<(&RenderMatrix, &[f32])> = neighbours
+                    .iter()
+                    .filter_map(|&j| scaled[j].2.as_deref().map(|b| (&scaled[j].0, b)))
+                    .collect();
+                let y =
+                    solve_stacked(a, &alpha, &alpha_n, warm_alpha.as_deref(), settings, solver)?;
                 iterations += y.iterations as u64;
                 for t in 0..n {
                     texels[t * c + 3] = y.texels[t * 3];
@@ -105,11 +125,20 @@ pub fn solve_shell(views: &[ShellView], s: usize, layout: TextureLayout, target:
 
 /// One sample's solve: its own rows, stacked with its weighed-down neighbours' when it has
 /// any (eq. 3.7's stacking, in the AᵀA form).
-fn solve_stacked(a: &RenderMatrix, b: &[f32], neighbours: &[(&RenderMatrix, &[f32])], warm: Option<&[f32]>, settings: &SolveSettings, solver: &Solver) -> Result<pis_compile::Solution> {
+fn solve_stacked(
+    a: &RenderMatrix,
+    b: &[f32],
+    neighbours: &[(&RenderMatrix, &[f32])],
+    warm: Option<&[f32]>,
+    settings: &SolveSettings,
+    solver: &Solver,
+) -> Result<pis_compile::Solution> {
     if neighbours.is_empty() {
         return Ok(solver.solve(a, b, warm, settings)?);
     }
-    let views: Vec<View> = std::iter::once(View { a, b }).chain(neighbours.iter().map(|&(a, b)| View { a, b })).collect();
+    let views: Vec<View> = std::iter::once(View { a, b })
+        .chain(neighbours.iter().map(|&(a, b)| View { a, b }))
+        .collect();
     Ok(solver.solve_view_independent(&views, warm, settings)?)
 }
 
@@ -122,15 +151,26 @@ fn solve_stacked(a: &RenderMatrix, b: &[f32], neighbours: &[(&RenderMatrix, &[f3
 fn split(v: &ShellView, target: Target) -> (Vec<f32>, Option<Vec<f32>>) {
     let clip = |x: f32, f: f32| if f > 0.0 { x.min(1.0 / f) } else { x };
     match target {
-        Target::Distant => (v.distant.iter().zip(&v.fresnel).map(|(&x, &f)| clip(x, f)).collect(), None),
+        Target::Distant => {
+            (v.distant.iter().zip(&v.fresnel).map(|(&x, &f)| clip(x, f)).collect(), None)
+        }
         Target::Incident => {
-            let rgb = v.local.chunks_exact(4).zip(v.distant.chunks_exact(3)).zip(v.fresnel.chunks_exact(3))
+            let rgb = v
+                .local
+                .chunks_exact(4)
+                .zip(v.distant.chunks_exact(3))
+                .zip(v.fresnel.chunks_exact(3))
                 .flat_map(|((l, d), f)| [0, 1, 2].map(|c| clip(l[c] + (1.0 - l[3]) * d[c], f[c])))
                 .collect();
             (rgb, None)
         }
         Target::Local => {
-            let rgb = v.local.chunks_exact(4).zip(v.fresnel.chunks_exact(3)).flat_map(|(p, f)| [clip(p[0], f[0]), clip(p[1], f[1]), clip(p[2], f[2])]).collect();
+            let rgb = v
+                .local
+                .chunks_exact(4)
+                .zip(v.fresnel.chunks_exact(3))
+                .flat_map(|(p, f)| [clip(p[0], f[0]), clip(p[1], f[1]), clip(p[2], f[2])])
+                .collect();
             let alpha = v.local.chunks_exact(4).flat_map(|p| [p[3], 0.0, 0.0]).collect();
             (rgb, Some(alpha))
         }

@@ -53,10 +53,17 @@ pub fn texel_footprints(n: u32) -> Vec<Footprint> {
 pub fn cube_map(layout: TextureLayout, finest: &[Vec3]) -> Vec<f32> {
     let (w0, h0) = layout.level_size(0);
     let per_face = w0 as usize * h0 as usize;
-    assert_eq!(finest.len(), per_face * layout.faces as usize, "one value per level-0 texel of every face");
+    assert_eq!(
+        finest.len(),
+        per_face * layout.faces as usize,
+        "one value per level-0 texel of every face"
+    );
     let mut x = vec![0.0f32; layout.texel_count() * 3];
     for face in 0..layout.faces {
-        let mut level: Vec<f32> = finest[face as usize * per_face..(face as usize + 1) * per_face].iter().flat_map(|v| v.to_array()).collect();
+        let mut level: Vec<f32> = finest[face as usize * per_face..(face as usize + 1) * per_face]
+            .iter()
+            .flat_map(|v| v.to_array())
+            .collect();
         for m in 0..layout.levels {
             if m > 0 {
                 let (w, h) = layout.level_size(m - 1);
@@ -73,8 +80,17 @@ pub fn cube_map(layout: TextureLayout, finest: &[Vec3]) -> Vec<f32> {
 /// of `layout` traced over its patch of directions with `settings` (their samples per
 /// pixel are the samples per texel), object `omit` taken out of the scene, each channel
 /// clipped at `clip`; then the MIP chain.
-pub fn traced_cube(scene: &Scene, frame: &Frame, settings: &TraceSettings, origin: Vec3, layout: TextureLayout, omit: Option<u32>, clip: Vec3) -> Result<Vec<f32>> {
-    let radiance = incident_radiance(scene, frame, settings, origin, &texel_footprints(layout.width), omit)?;
+pub fn traced_cube(
+    scene: &Scene,
+    frame: &Frame,
+    settings: &TraceSettings,
+    origin: Vec3,
+    layout: TextureLayout,
+    omit: Option<u32>,
+    clip: Vec3,
+) -> Result<Vec<f32>> {
+    let radiance =
+        incident_radiance(scene, frame, settings, origin, &texel_footprints(layout.width), omit)?;
     Ok(cube_map(layout, &radiance.into_iter().map(|l| l.min(clip)).collect::<Vec<_>>()))
 }
 
@@ -94,7 +110,16 @@ pub fn radiance_clip(f0: [f32; 3]) -> Vec3 {
 /// infinity about `origin`, its face size chosen as the inferred maps' is; `model` already
 /// holds the object's surface part.
 #[allow(clippy::too_many_arguments)]
-pub fn static_env(mut model: ObjectModel, job: &Job<'_>, o: usize, f0: [f32; 3], pixels: &[Vec<u32>], keys: &[Vec<u32>], largest: u32, origin: DVec3) -> Result<ObjectModel> {
+pub fn static_env(
+    mut model: ObjectModel,
+    job: &Job<'_>,
+    o: usize,
+    f0: [f32; 3],
+    pixels: &[Vec<u32>],
+    keys: &[Vec<u32>],
+    largest: u32,
+    origin: DVec3,
+) -> Result<ObjectModel> {
     let set = job.set;
     let shell = sphere_at_infinity(origin);
     let n = face_resolution(set, o, &job.meshes, shell, largest)?;
@@ -106,18 +131,44 @@ pub fn static_env(mut model: ObjectModel, job: &Job<'_>, o: usize, f0: [f32; 3],
     // (every point of a view-only space) share one trace.
     let mut textures: BTreeMap<Vec<u32>, Vec<f32>> = BTreeMap::new();
     for (p, (frame, k)) in set.frames.iter().zip(keys).enumerate() {
-        let same = (0..p).find(|&q| set.frames[q].instances == frame.instances && set.frames[q].lights == frame.lights);
+        let same = (0..p).find(|&q| {
+            set.frames[q].instances == frame.instances && set.frames[q].lights == frame.lights
+        });
         let cube = match same {
             Some(q) => textures[&keys[q]].clone(),
             None => {
-                let centre = (frame.instances[o].world_from_object * first).transform_point3(origin.as_vec3());
-                traced_cube(&set.scene, frame, &set.trace, centre, layout, Some(o as u32), radiance_clip(f0))?
+                let centre = (frame.instances[o].world_from_object * first)
+                    .transform_point3(origin.as_vec3());
+                traced_cube(
+                    &set.scene,
+                    frame,
+                    &set.trace,
+                    centre,
+                    layout,
+                    Some(o as u32),
+                    radiance_clip(f0),
+                )?
             }
         };
         textures.insert(k.clone(), cube);
     }
-    let form = Box::new(ShellForm { shell, layout, lookups: 1, channels: 3, order: 0, term: pis_format::Term::Reflection });
-    model.layers.push(InferredLayer::shell(pis_format::LayerKind::EnvDistant, job, &model.stagger, textures, 0, form, 0));
+    let form = Box::new(ShellForm {
+        shell,
+        layout,
+        lookups: 1,
+        channels: 3,
+        order: 0,
+        term: pis_format::Term::Reflection,
+    });
+    model.layers.push(InferredLayer::shell(
+        pis_format::LayerKind::EnvDistant,
+        job,
+        &model.stagger,
+        textures,
+        0,
+        form,
+        0,
+    ));
     model.shell_views = views;
     model.representation = "static environment map".to_string();
     model.why = format!(
@@ -138,7 +189,9 @@ mod tests {
     #[test]
     fn coarser_levels_are_the_decimation_of_the_finest() {
         let layout = TextureLayout::cube(8);
-        let finest: Vec<Vec3> = (0..6 * 64).map(|k| Vec3::new(k as f32, (k * 7 % 13) as f32, -(k as f32).sqrt())).collect();
+        let finest: Vec<Vec3> = (0..6 * 64)
+            .map(|k| Vec3::new(k as f32, (k * 7 % 13) as f32, -(k as f32).sqrt()))
+            .collect();
         let x = cube_map(layout, &finest);
         assert_eq!(x.len(), layout.texel_count() * 3);
         for face in 0..6 {
@@ -147,10 +200,15 @@ mod tests {
                 for j in 0..w {
                     for i in 0..w {
                         for c in 0..3 {
-                            let fine = |di: u32, dj: u32| x[layout.face_texel(face, m - 1, 2 * i + di, 2 * j + dj) * 3 + c];
+                            let fine = |di: u32, dj: u32| {
+                                x[layout.face_texel(face, m - 1, 2 * i + di, 2 * j + dj) * 3 + c]
+                            };
                             let mean = 0.25 * (fine(0, 0) + fine(1, 0) + fine(0, 1) + fine(1, 1));
                             let coarse = x[layout.face_texel(face, m, i, j) * 3 + c];
-                            assert!((coarse - mean).abs() <= 1e-4 * mean.abs().max(1.0), "face {face} level {m} ({i}, {j})");
+                            assert!(
+                                (coarse - mean).abs() <= 1e-4 * mean.abs().max(1.0),
+                                "face {face} level {m} ({i}, {j})"
+                            );
                         }
                     }
                 }
@@ -166,11 +224,25 @@ mod tests {
 
     /// A quad emitting `l` with corners `c ± u ± v`.
     fn quad(c: Vec3, u: Vec3, v: Vec3, material: usize) -> Primitive {
-        Primitive { positions: vec![c - u - v, c + u - v, c + u + v, c - u + v], normals: vec![u.cross(v).normalize(); 4], uvs: vec![Vec2::ZERO; 4], indices: vec![0, 1, 2, 0, 2, 3], material, ..Primitive::default() }
+        Primitive {
+            positions: vec![c - u - v, c + u - v, c + u + v, c - u + v],
+            normals: vec![u.cross(v).normalize(); 4],
+            uvs: vec![Vec2::ZERO; 4],
+            indices: vec![0, 1, 2, 0, 2, 3],
+            material,
+            ..Primitive::default()
+        }
     }
 
     fn emitter(l: Vec3) -> Material {
-        Material { base_color: [0.0, 0.0, 0.0, 1.0], metallic: 0.0, roughness: 1.0, specular: 0.0, emissive: l.to_array(), ..Default::default() }
+        Material {
+            base_color: [0.0, 0.0, 0.0, 1.0],
+            metallic: 0.0,
+            roughness: 1.0,
+            specular: 0.0,
+            emissive: l.to_array(),
+            ..Default::default()
+        }
     }
 
     /// The colour of wall half `k` (0..12) of the room below.
@@ -194,7 +266,9 @@ mod tests {
         for face in 0..6 {
             let (a, sign) = (face / 2, if face % 2 == 0 { 1.0 } else { -1.0 });
             let (b, c) = ((a + 1) % 3, (a + 2) % 3);
-            let axis = |k: usize, s: f32| Vec3::from_array(std::array::from_fn(|i| if i == k { s } else { 0.0 }));
+            let axis = |k: usize, s: f32| {
+                Vec3::from_array(std::array::from_fn(|i| if i == k { s } else { 0.0 }))
+            };
             for half in 0..2 {
                 let centre = axis(a, sign) + axis(b, if half == 1 { 0.5 } else { -0.5 });
                 walls.push(quad(centre, axis(b, 0.5), axis(c, 1.0), face * 2 + half));
@@ -204,19 +278,51 @@ mod tests {
         materials.push(emitter(Vec3::ZERO));
         let block = quad(Vec3::Z * 0.5, Vec3::X * 0.3, Vec3::Y * 0.3, 12);
         let objects = vec![
-            SceneObject { name: "room".into(), role: ObjectRole::Diffuse, reflector: None, primitives: walls },
-            SceneObject { name: "mirror".into(), role: ObjectRole::Reflective, reflector: None, primitives: vec![block] },
+            SceneObject {
+                name: "room".into(),
+                role: ObjectRole::Diffuse,
+                reflector: None,
+                primitives: walls,
+            },
+            SceneObject {
+                name: "mirror".into(),
+                role: ObjectRole::Reflective,
+                reflector: None,
+                primitives: vec![block],
+            },
         ];
-        let scene = Scene { name: "room".into(), resolution: (1, 1), spp: 4, objects, materials, ..Default::default() };
-        let camera = Camera { world_from_camera: Mat4::IDENTITY, yfov: 1.0, znear: 0.01, zfar: f32::INFINITY };
-        (scene, Frame { camera, lights: vec![], instances: vec![Instance { world_from_object: Mat4::IDENTITY }; 2] })
+        let scene = Scene {
+            name: "room".into(),
+            resolution: (1, 1),
+            spp: 4,
+            objects,
+            materials,
+            ..Default::default()
+        };
+        let camera = Camera {
+            world_from_camera: Mat4::IDENTITY,
+            yfov: 1.0,
+            znear: 0.01,
+            zfar: f32::INFINITY,
+        };
+        (
+            scene,
+            Frame {
+                camera,
+                lights: vec![],
+                instances: vec![Instance { world_from_object: Mat4::IDENTITY }; 2],
+            },
+        )
     }
 
     /// What the player reads from the traced map in direction `d` at level of detail λ.
     fn lookup(layout: &TextureLayout, x: &[f32], d: Vec3, lambda: f64) -> Vec3 {
         let mut taps = Taps::default();
         cube_taps(layout, d.as_dvec3(), lambda, &mut taps);
-        (0..taps.len).fold(Vec3::ZERO, |s, k| s + Vec3::from_slice(&x[taps.cols[k] as usize * 3..taps.cols[k] as usize * 3 + 3]) * taps.weights[k])
+        (0..taps.len).fold(Vec3::ZERO, |s, k| {
+            s + Vec3::from_slice(&x[taps.cols[k] as usize * 3..taps.cols[k] as usize * 3 + 3])
+                * taps.weights[k]
+        })
     }
 
     /// The player's lookup of the traced map in a direction reads what the room shows in
@@ -227,11 +333,21 @@ mod tests {
     fn the_lookup_reads_what_was_traced_in_its_direction() {
         let (scene, frame) = room();
         let layout = TextureLayout::cube(16);
-        let x = traced_cube(&scene, &frame, &TraceSettings::new((1, 1), 4), Vec3::ZERO, layout, Some(1), Vec3::INFINITY).unwrap();
+        let x = traced_cube(
+            &scene,
+            &frame,
+            &TraceSettings::new((1, 1), 4),
+            Vec3::ZERO,
+            layout,
+            Some(1),
+            Vec3::INFINITY,
+        )
+        .unwrap();
         let mut checked = 0;
         for k in 0..400 {
             let a = k as f32 * 0.713;
-            let d = Vec3::new(a.sin() * (a * 1.3).cos(), (a * 0.7).cos(), (a * 2.1).sin() - 0.3).normalize();
+            let d = Vec3::new(a.sin() * (a * 1.3).cos(), (a * 0.7).cos(), (a * 2.1).sin() - 0.3)
+                .normalize();
             // Directions a texel and a half or more from a colour edge read one wall half.
             let face = cube_face(d.as_dvec3()) as usize;
             let m = d.abs().max_element();
@@ -241,12 +357,28 @@ mod tests {
                 continue;
             }
             let got = lookup(&layout, &x, d, 0.0);
-            assert!((got - colour(wall(d))).abs().max_element() < 1e-4, "{d}: read {got}, the room shows {}", colour(wall(d)));
+            assert!(
+                (got - colour(wall(d))).abs().max_element() < 1e-4,
+                "{d}: read {got}, the room shows {}",
+                colour(wall(d))
+            );
             checked += 1;
         }
         assert!(checked > 100, "{checked} directions checked");
-        let seen = traced_cube(&scene, &frame, &TraceSettings::new((1, 1), 4), Vec3::ZERO, layout, None, Vec3::INFINITY).unwrap();
-        assert!(lookup(&layout, &seen, Vec3::new(0.01, 0.02, 1.0), 0.0).max_element() < 1e-6, "the square, not left out, is black");
+        let seen = traced_cube(
+            &scene,
+            &frame,
+            &TraceSettings::new((1, 1), 4),
+            Vec3::ZERO,
+            layout,
+            None,
+            Vec3::INFINITY,
+        )
+        .unwrap();
+        assert!(
+            lookup(&layout, &seen, Vec3::new(0.01, 0.02, 1.0), 0.0).max_element() < 1e-6,
+            "the square, not left out, is black"
+        );
     }
 
     #[test]
@@ -255,7 +387,16 @@ mod tests {
         let l = Vec3::new(0.3, 0.6, 1.2);
         scene.materials.iter_mut().take(12).for_each(|m| *m = emitter(l));
         let layout = TextureLayout::cube(8);
-        let x = traced_cube(&scene, &frame, &TraceSettings::new((1, 1), 2), Vec3::new(0.1, -0.2, 0.3), layout, Some(1), Vec3::INFINITY).unwrap();
+        let x = traced_cube(
+            &scene,
+            &frame,
+            &TraceSettings::new((1, 1), 2),
+            Vec3::new(0.1, -0.2, 0.3),
+            layout,
+            Some(1),
+            Vec3::INFINITY,
+        )
+        .unwrap();
         assert_eq!(x.len(), layout.texel_count() * 3);
         for t in x.chunks_exact(3) {
             assert!((Vec3::from_slice(t) - l).abs().max_element() < 1e-5, "{t:?}");
@@ -264,7 +405,19 @@ mod tests {
         // nothing.
         let clip = radiance_clip([0.95, 0.95, 0.0]);
         assert_eq!(clip, Vec3::new(1.0 / 0.95, 1.0 / 0.95, f32::INFINITY));
-        let x = traced_cube(&scene, &frame, &TraceSettings::new((1, 1), 2), Vec3::ZERO, layout, Some(1), Vec3::new(clip.x, clip.y, 1.0 / 0.95)).unwrap();
-        assert!(x.chunks_exact(3).all(|t| (Vec3::from_slice(t) - Vec3::new(0.3, 0.6, 1.0 / 0.95)).abs().max_element() < 1e-5));
+        let x = traced_cube(
+            &scene,
+            &frame,
+            &TraceSettings::new((1, 1), 2),
+            Vec3::ZERO,
+            layout,
+            Some(1),
+            Vec3::new(clip.x, clip.y, 1.0 / 0.95),
+        )
+        .unwrap();
+        assert!(x
+            .chunks_exact(3)
+            .all(|t| (Vec3::from_slice(t) - Vec3::new(0.3, 0.6, 1.0 / 0.95)).abs().max_element()
+                < 1e-5));
     }
 }

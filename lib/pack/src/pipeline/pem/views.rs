@@ -30,7 +30,13 @@ pub struct ShellView {
 
 /// The tracer's layer `kind` of object channel `channel` at point `p`, `channels` values per
 /// pixel (missing channels 0).
-fn layer_values(set: &LoadedSet, p: usize, o: usize, kind: TraceLayer, names: &[&str]) -> Result<Vec<f32>> {
+fn layer_values(
+    set: &LoadedSet,
+    p: usize,
+    o: usize,
+    kind: TraceLayer,
+    names: &[&str],
+) -> Result<Vec<f32>> {
     let (w, h) = set.resolution;
     let n = (w * h) as usize;
     let mut out = vec![0.0f32; n * names.len()];
@@ -47,16 +53,30 @@ fn layer_values(set: &LoadedSet, p: usize, o: usize, kind: TraceLayer, names: &[
 }
 
 fn gather_n(pixels: &[u32], values: &[f32], n: usize) -> Vec<f32> {
-    pixels.iter().flat_map(|&p| values[p as usize * n..p as usize * n + n].iter().copied()).collect()
+    pixels
+        .iter()
+        .flat_map(|&p| values[p as usize * n..p as usize * n + n].iter().copied())
+        .collect()
 }
 
 /// The shell object of `o` at point `p` for `shell` with `layout`, its eye and its
 /// clip-from-object, as the player draws it.
-fn shell_object<'m>(set: &LoadedSet, p: usize, o: usize, mesh: &'m Mesh, shell: Shell, layout: TextureLayout, drawn: Option<&'m [bool]>, lookups: u32) -> ShellObject<'m> {
+fn shell_object<'m>(
+    set: &LoadedSet,
+    p: usize,
+    o: usize,
+    mesh: &'m Mesh,
+    shell: Shell,
+    layout: TextureLayout,
+    drawn: Option<&'m [bool]>,
+    lookups: u32,
+) -> ShellObject<'m> {
     let (w, h) = set.resolution;
     let frame = &set.frames[p];
     let world = frame.instances[o].world_from_object;
-    let clip = pis_trace::camera::projection_matrix(&frame.camera, (w, h)) * frame.camera.world_from_camera.inverse() * world;
+    let clip = pis_trace::camera::projection_matrix(&frame.camera, (w, h))
+        * frame.camera.world_from_camera.inverse()
+        * world;
     ShellObject {
         positions: &mesh.positions,
         normals: &mesh.normals,
@@ -72,14 +92,25 @@ fn shell_object<'m>(set: &LoadedSet, p: usize, o: usize, mesh: &'m Mesh, shell: 
 }
 
 /// The scene's depth at point `p` without object `o`: its occluders.
-fn occluders(set: &LoadedSet, p: usize, o: usize, meshes: &[Mesh]) -> Result<pis_compile::DepthBuffer> {
+fn occluders(
+    set: &LoadedSet,
+    p: usize,
+    o: usize,
+    meshes: &[Mesh],
+) -> Result<pis_compile::DepthBuffer> {
     let (w, h) = set.resolution;
     let frame = &set.frames[p];
-    let view_proj = pis_trace::camera::projection_matrix(&frame.camera, (w, h)) * frame.camera.world_from_camera.inverse();
+    let view_proj = pis_trace::camera::projection_matrix(&frame.camera, (w, h))
+        * frame.camera.world_from_camera.inverse();
     let draw: Vec<DrawMesh> = meshes
         .iter()
         .enumerate()
-        .map(|(k, m)| DrawMesh { positions: &m.positions, uvs: &m.uvs, indices: &m.indices, clip_from_object: view_proj * frame.instances[k].world_from_object })
+        .map(|(k, m)| DrawMesh {
+            positions: &m.positions,
+            uvs: &m.uvs,
+            indices: &m.indices,
+            clip_from_object: view_proj * frame.instances[k].world_from_object,
+        })
         .collect();
     Ok(scene_depth(Viewport { width: w, height: h }, &draw, Some(o))?)
 }
@@ -87,7 +118,13 @@ fn occluders(set: &LoadedSet, p: usize, o: usize, meshes: &[Mesh]) -> Result<pis
 /// `a` with a row at every pixel of `pixels` (ascending, a superset of `a`'s): its own row
 /// where it has one, else an empty row (the shell is not drawn there).
 fn with_rows_at(a: &RenderMatrix, pixels: &[u32]) -> RenderMatrix {
-    let mut out = RenderMatrix { width: a.width, height: a.height, layout: a.layout, row_start: vec![0], ..Default::default() };
+    let mut out = RenderMatrix {
+        width: a.width,
+        height: a.height,
+        layout: a.layout,
+        row_start: vec![0],
+        ..Default::default()
+    };
     let mut r = 0;
     for &p in pixels {
         while r < a.rows() && a.pixels[r] < p {
@@ -112,7 +149,16 @@ fn with_rows_at(a: &RenderMatrix, pixels: &[u32]) -> RenderMatrix {
 /// object's surface render matrices at point `points[k]`, which the shells' rows must equal;
 /// a pixel whose triangle does not draw a shell has an empty row in its matrix.
 /// Each pixel looks every shell up `lookups` × `lookups` times (SPEC.md 8.2).
-pub fn shell_views(set: &LoadedSet, o: usize, meshes: &[Mesh], shells: &[(Shell, TextureLayout, Option<&[bool]>)], lookups: u32, f0: [f32; 3], pixels: &[Vec<u32>], points: &[usize]) -> Result<Vec<ShellView>> {
+pub fn shell_views(
+    set: &LoadedSet,
+    o: usize,
+    meshes: &[Mesh],
+    shells: &[(Shell, TextureLayout, Option<&[bool]>)],
+    lookups: u32,
+    f0: [f32; 3],
+    pixels: &[Vec<u32>],
+    points: &[usize],
+) -> Result<Vec<ShellView>> {
     let (w, h) = set.resolution;
     let vp = Viewport { width: w, height: h };
     let name = &set.scene.objects[o].name;
@@ -158,7 +204,13 @@ pub fn shell_views(set: &LoadedSet, o: usize, meshes: &[Mesh], shells: &[(Shell,
 /// footprint, they do not make the pixel see finer detail (measured at the teapot-pem paper
 /// preset at 384:1: sized from 2 × 2 lookups, the faces doubled and the lid's local shell
 /// was left no bytes).
-pub fn face_resolution(set: &LoadedSet, o: usize, meshes: &[Mesh], shell: Shell, largest: u32) -> Result<u32> {
+pub fn face_resolution(
+    set: &LoadedSet,
+    o: usize,
+    meshes: &[Mesh],
+    shell: Shell,
+    largest: u32,
+) -> Result<u32> {
     let (w, h) = set.resolution;
     let vp = Viewport { width: w, height: h };
     let layout = TextureLayout::cube(largest);
@@ -166,10 +218,22 @@ pub fn face_resolution(set: &LoadedSet, o: usize, meshes: &[Mesh], shell: Shell,
     let mut finest = vec![0usize; layout.levels as usize];
     for p in (0..set.frames.len()).step_by(step) {
         let depth = occluders(set, p, o, meshes)?;
-        let a = restrict_rows(&shell_render_matrix(vp, &shell_object(set, p, o, &meshes[o], shell, layout, None, 1), Some(&depth))?, &coverage(set, p, o)?);
+        let a = restrict_rows(
+            &shell_render_matrix(
+                vp,
+                &shell_object(set, p, o, &meshes[o], shell, layout, None, 1),
+                Some(&depth),
+            )?,
+            &coverage(set, p, o)?,
+        );
         for r in 0..a.rows() {
             let (cols, vals) = a.row(r);
-            let level = cols.iter().zip(vals).filter(|(_, &v)| v > 0.0).map(|(&c, _)| level_of(&layout, c as usize)).min();
+            let level = cols
+                .iter()
+                .zip(vals)
+                .filter(|(_, &v)| v > 0.0)
+                .map(|(&c, _)| level_of(&layout, c as usize))
+                .min();
             if let Some(l) = level {
                 finest[l] += 1;
             }
@@ -203,7 +267,16 @@ mod tests {
 
     #[test]
     fn rows_are_placed_at_their_pixels_and_the_others_left_empty() {
-        let a = RenderMatrix { width: 4, height: 1, layout: TextureLayout::cube(1), row_start: vec![0, 2, 3], cols: vec![0, 1, 5], vals: vec![0.25, 0.75, 1.0], pixels: vec![1, 3], coverage: vec![1.0, 0.5] };
+        let a = RenderMatrix {
+            width: 4,
+            height: 1,
+            layout: TextureLayout::cube(1),
+            row_start: vec![0, 2, 3],
+            cols: vec![0, 1, 5],
+            vals: vec![0.25, 0.75, 1.0],
+            pixels: vec![1, 3],
+            coverage: vec![1.0, 0.5],
+        };
         let b = with_rows_at(&a, &[0, 1, 2, 3]);
         assert_eq!(b.pixels, [0, 1, 2, 3]);
         assert_eq!(b.coverage, [0.0, 1.0, 0.0, 0.5]);

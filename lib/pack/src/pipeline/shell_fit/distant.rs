@@ -25,7 +25,10 @@ pub const MIN_DISTANCE: f64 = 1e-6;
 
 /// The mean distance of the finite hits from `centre`, and their count.
 fn mean_distance(centre: Vec3, hits: &[Vec3]) -> (f64, usize) {
-    let (sum, n) = hits.iter().filter(|h| h.is_finite()).fold((0.0, 0), |(s, n), h| (s + (*h - centre).as_dvec3().length(), n + 1));
+    let (sum, n) = hits
+        .iter()
+        .filter(|h| h.is_finite())
+        .fold((0.0, 0), |(s, n), h| (s + (*h - centre).as_dvec3().length(), n + 1));
     (if n > 0 { sum / n as f64 } else { 0.0 }, n)
 }
 
@@ -54,7 +57,8 @@ pub fn distant_box(centre: Vec3, support_y: Option<f32>, hits: &[Vec3]) -> Resul
         sum[side] += d[axis].abs();
         count[side] += 1;
     }
-    let mut distance: [Option<f64>; 6] = std::array::from_fn(|s| (count[s] > 0).then(|| sum[s] / count[s] as f64));
+    let mut distance: [Option<f64>; 6] =
+        std::array::from_fn(|s| (count[s] > 0).then(|| sum[s] / count[s] as f64));
     if let Some(y) = support_y.filter(|y| y.is_finite()) {
         distance[2] = Some(f64::from(centre.y) - f64::from(y));
     }
@@ -80,7 +84,9 @@ pub fn distant_box(centre: Vec3, support_y: Option<f32>, hits: &[Vec3]) -> Resul
 pub fn distant_sphere(centre: Vec3, hits: &[Vec3]) -> Result<SphereShell> {
     let (mean, n) = mean_distance(centre, hits);
     if n == 0 {
-        return Err(anyhow!("no reflected ray met the environment: the distant sphere has no size"));
+        return Err(anyhow!(
+            "no reflected ray met the environment: the distant sphere has no size"
+        ));
     }
     Ok(SphereShell { centre, radius: mean.max(minimum(mean)) as f32 })
 }
@@ -97,12 +103,14 @@ mod tests {
     fn sides_at_the_mean_distance_of_their_hits() {
         let c = Vec3::new(1.0, 1.0, 1.0);
         let hits = [
-            c + Vec3::new(4.0, 1.0, -2.0), c + Vec3::new(6.0, -3.0, 0.0), // +X: 4, 6
-            c + Vec3::new(-3.0, 0.5, 0.5),                                  // −X: 3
-            c + Vec3::new(0.0, 2.0, 1.0),                                   // +Y: 2
+            c + Vec3::new(4.0, 1.0, -2.0),
+            c + Vec3::new(6.0, -3.0, 0.0), // +X: 4, 6
+            c + Vec3::new(-3.0, 0.5, 0.5), // −X: 3
+            c + Vec3::new(0.0, 2.0, 1.0),  // +Y: 2
             c + Vec3::new(1.0, -1.0, 0.0), // tie: the first axis, −X is not it: +X
-            c + Vec3::new(0.0, -1.5, 0.0),                                  // −Y: 1.5
-            c + Vec3::new(0.0, 0.0, 7.0), c + Vec3::new(1.0, 0.0, -5.0),    // +Z: 7, −Z: 5
+            c + Vec3::new(0.0, -1.5, 0.0), // −Y: 1.5
+            c + Vec3::new(0.0, 0.0, 7.0),
+            c + Vec3::new(1.0, 0.0, -5.0), // +Z: 7, −Z: 5
         ];
         let b = distant_box(c, None, &hits).unwrap();
         assert!(close(b.min, c - Vec3::new(3.0, 1.5, 5.0)), "{b:?}");
@@ -119,7 +127,10 @@ mod tests {
         assert!(close(b.max, Vec3::new(4.0, 4.0, 2.5)), "{b:?}");
         // A support alone sizes the box.
         let b = distant_box(c, Some(0.0), &[]).unwrap();
-        assert!(close(b.min, Vec3::new(-1.0, 0.0, -1.0)) && close(b.max, Vec3::new(1.0, 2.0, 1.0)), "{b:?}");
+        assert!(
+            close(b.min, Vec3::new(-1.0, 0.0, -1.0)) && close(b.max, Vec3::new(1.0, 2.0, 1.0)),
+            "{b:?}"
+        );
         assert!(distant_box(c, None, &[]).is_err());
     }
 
@@ -133,7 +144,11 @@ mod tests {
 
     #[test]
     fn sphere_radius_is_the_mean_distance() {
-        let s = distant_sphere(Vec3::ONE, &[Vec3::ONE + Vec3::X * 2.0, Vec3::ONE - Vec3::Z * 4.0, Vec3::NAN]).unwrap();
+        let s = distant_sphere(
+            Vec3::ONE,
+            &[Vec3::ONE + Vec3::X * 2.0, Vec3::ONE - Vec3::Z * 4.0, Vec3::NAN],
+        )
+        .unwrap();
         assert_eq!(s, SphereShell { centre: Vec3::ONE, radius: 3.0 });
         assert!(distant_sphere(Vec3::ONE, &[Vec3::ONE]).unwrap().radius > 0.0);
         assert!(distant_sphere(Vec3::ONE, &[]).is_err());

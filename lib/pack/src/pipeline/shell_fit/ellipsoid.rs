@@ -48,7 +48,8 @@ const ROUNDS: usize = 8;
 /// needs it) so that every point is strictly inside in f32. Without points, or with all
 /// points at the centre, the result is a sphere of radius [`MIN_RADIUS`].
 pub fn bounding_ellipsoid(positions: &[Vec3], centre: Vec3) -> Ellipsoid {
-    let d: Vec<DVec3> = positions.iter().map(|&p| (p - centre).as_dvec3()).filter(|d| d.is_finite()).collect();
+    let d: Vec<DVec3> =
+        positions.iter().map(|&p| (p - centre).as_dvec3()).filter(|d| d.is_finite()).collect();
     let extent = d.iter().fold(DVec3::ZERO, |e, v| e.max(v.abs()));
     let largest = extent.max_element();
     if largest <= 0.0 {
@@ -57,7 +58,8 @@ pub fn bounding_ellipsoid(positions: &[Vec3], centre: Vec3) -> Ellipsoid {
     // Every containing ellipsoid has r_k ≥ extent_k, so a point inside the ellipsoid with
     // radii `extent` is inside all of them and never sets the scale.
     let inv = DVec3::select(extent.cmpgt(DVec3::ZERO), extent.recip(), DVec3::ZERO);
-    let d: Vec<DVec3> = d.into_iter().filter(|v| (*v * inv).length_squared() >= 1.0 - 1e-9).collect();
+    let d: Vec<DVec3> =
+        d.into_iter().filter(|v| (*v * inv).length_squared() >= 1.0 - 1e-9).collect();
     let floor = (largest * MIN_AXIS_RATIO).max(MIN_RADIUS as f64);
     let e = extent.max(DVec3::splat(floor));
     // An optimum's volume is at most that of the ellipsoid through the corners of the
@@ -70,7 +72,9 @@ pub fn bounding_ellipsoid(positions: &[Vec3], centre: Vec3) -> Ellipsoid {
     for _ in 0..ROUNDS {
         let cells: Vec<[f64; 2]> = (0..GRID * GRID)
             .map(|k| {
-                let at = |i: usize, a: usize| (best[a] + half[a] * (step * i as f64 - 1.0)).clamp(lo[a], hi[a]);
+                let at = |i: usize, a: usize| {
+                    (best[a] + half[a] * (step * i as f64 - 1.0)).clamp(lo[a], hi[a])
+                };
                 [at(k % GRID, 0), at(k / GRID, 1)]
             })
             .collect();
@@ -113,7 +117,8 @@ mod tests {
     fn recovers_a_known_ellipsoid() {
         let centre = Vec3::new(1.0, -2.0, 0.5);
         let radii = Vec3::new(3.0, 1.0, 0.5);
-        let points: Vec<Vec3> = sphere_points(2000).into_iter().map(|u| centre + u * radii).collect();
+        let points: Vec<Vec3> =
+            sphere_points(2000).into_iter().map(|u| centre + u * radii).collect();
         let e = bounding_ellipsoid(&points, centre);
         contains_all(&e, &points);
         let rel = (e.radii / radii - Vec3::ONE).abs().max_element();
@@ -133,9 +138,26 @@ mod tests {
     fn never_larger_than_the_bounding_sphere() {
         // A box's corners, an off-centre blob and a flat disc.
         let clouds: [(Vec<Vec3>, Vec3); 3] = [
-            ((0..8).map(|k| Vec3::new((k & 1) as f32 * 4.0, (k >> 1 & 1) as f32, (k >> 2) as f32 * 0.25)).collect(), Vec3::new(2.0, 0.5, 0.125)),
-            (sphere_points(500).iter().enumerate().map(|(k, u)| *u * (1.0 + (k % 7) as f32 * 0.3) + Vec3::X * 0.4).collect(), Vec3::ZERO),
-            (sphere_points(300).iter().map(|u| Vec3::new(u.x, 0.0, u.z) * 5.0).collect(), Vec3::ZERO),
+            (
+                (0..8)
+                    .map(|k| {
+                        Vec3::new((k & 1) as f32 * 4.0, (k >> 1 & 1) as f32, (k >> 2) as f32 * 0.25)
+                    })
+                    .collect(),
+                Vec3::new(2.0, 0.5, 0.125),
+            ),
+            (
+                sphere_points(500)
+                    .iter()
+                    .enumerate()
+                    .map(|(k, u)| *u * (1.0 + (k % 7) as f32 * 0.3) + Vec3::X * 0.4)
+                    .collect(),
+                Vec3::ZERO,
+            ),
+            (
+                sphere_points(300).iter().map(|u| Vec3::new(u.x, 0.0, u.z) * 5.0).collect(),
+                Vec3::ZERO,
+            ),
         ];
         for (points, centre) in &clouds {
             let e = bounding_ellipsoid(points, *centre);

@@ -63,7 +63,12 @@ pub fn surface_samples(positions: &[Vec3], indices: &[u32]) -> Result<Vec<Surfac
 /// closed object they are hidden behind its front. The hits come sample by sample, eye by
 /// eye, so the result is deterministic for a deterministic `cast`. A non-finite eye or
 /// indices that do not make whole triangles of the vertices are an error.
-pub fn hit_points(positions: &[Vec3], indices: &[u32], eyes: &[Vec3], cast: impl Fn(Vec3, Vec3) -> Option<f32> + Sync) -> Result<Vec<Vec3>> {
+pub fn hit_points(
+    positions: &[Vec3],
+    indices: &[u32],
+    eyes: &[Vec3],
+    cast: impl Fn(Vec3, Vec3) -> Option<f32> + Sync,
+) -> Result<Vec<Vec3>> {
     if let Some(e) = eyes.iter().find(|e| !e.is_finite()) {
         return Err(anyhow!("camera position {e} is not finite"));
     }
@@ -109,7 +114,9 @@ mod tests {
         let first = s.iter().filter(|s| s.point.z == 0.0).count();
         assert_eq!(first, MAX_SURFACE_SAMPLES / 4);
         assert!(s.iter().all(|s| s.normal == Vec3::Z));
-        assert!(s[..first].iter().all(|s| s.point.x >= 0.0 && s.point.y >= 0.0 && s.point.x + s.point.y <= 1.0 + 1e-6));
+        assert!(s[..first]
+            .iter()
+            .all(|s| s.point.x >= 0.0 && s.point.y >= 0.0 && s.point.x + s.point.y <= 1.0 + 1e-6));
         assert!(surface_samples(&p, &[0, 0, 1]).unwrap().is_empty());
     }
 
@@ -121,10 +128,16 @@ mod tests {
         // Roughly half the sphere faces each eye.
         let n = hits.len() as f32 / (MAX_SURFACE_SAMPLES * eyes.len()) as f32;
         assert!(n > 0.3 && n < 0.6, "{n}");
-        assert!(hits.iter().all(|h| (h.abs().max_element() - 6.0).abs() < 1e-3), "a hit is off the walls");
+        assert!(
+            hits.iter().all(|h| (h.abs().max_element() - 6.0).abs() < 1e-3),
+            "a hit is off the walls"
+        );
         assert_eq!(hits, hit_points(&p, &i, &eyes, room(6.0)).unwrap());
         let b = distant_box(Vec3::ZERO, None, &hits).unwrap();
-        assert!(b.min.distance(Vec3::splat(-6.0)) < 1e-2 && b.max.distance(Vec3::splat(6.0)) < 1e-2, "{b:?}");
+        assert!(
+            b.min.distance(Vec3::splat(-6.0)) < 1e-2 && b.max.distance(Vec3::splat(6.0)) < 1e-2,
+            "{b:?}"
+        );
         let s = distant_sphere(Vec3::ZERO, &hits).unwrap();
         assert!(s.radius > 6.0 && s.radius < 6.0 * 3f32.sqrt(), "{s:?}");
     }
@@ -132,13 +145,20 @@ mod tests {
     #[test]
     fn mirror_reflects_and_back_faces_are_skipped() {
         // A square mirror in z = 0 facing +Z under a ceiling at z = 10.
-        let p = [Vec3::new(-1.0, -1.0, 0.0), Vec3::new(1.0, -1.0, 0.0), Vec3::new(1.0, 1.0, 0.0), Vec3::new(-1.0, 1.0, 0.0)];
+        let p = [
+            Vec3::new(-1.0, -1.0, 0.0),
+            Vec3::new(1.0, -1.0, 0.0),
+            Vec3::new(1.0, 1.0, 0.0),
+            Vec3::new(-1.0, 1.0, 0.0),
+        ];
         let i = [0, 1, 2, 0, 2, 3];
         let ceiling = |o: Vec3, d: Vec3| (d.z > 0.0).then(|| (10.0 - o.z) / d.z);
         let hits = hit_points(&p, &i, &[Vec3::new(0.0, 0.0, 5.0)], ceiling).unwrap();
         assert_eq!(hits.len(), MAX_SURFACE_SAMPLES);
         // Seen from the eye's mirror image (0, 0, −5), the hits are the mirror scaled by 3.
-        assert!(hits.iter().all(|h| (h.z - 10.0).abs() < 1e-4 && h.x.abs() <= 3.0 + 1e-4 && h.y.abs() <= 3.0 + 1e-4));
+        assert!(hits.iter().all(|h| (h.z - 10.0).abs() < 1e-4
+            && h.x.abs() <= 3.0 + 1e-4
+            && h.y.abs() <= 3.0 + 1e-4));
         assert!(hit_points(&p, &i, &[Vec3::new(0.0, 0.0, -5.0)], ceiling).unwrap().is_empty());
         assert!(hit_points(&p, &i, &[Vec3::NAN], ceiling).is_err());
         assert!(hit_points(&p, &[0, 1, 7], &[Vec3::Z], ceiling).is_err());

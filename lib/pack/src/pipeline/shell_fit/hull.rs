@@ -43,7 +43,10 @@ pub fn convex_hull_triangles(positions: &[Vec3], indices: &[u32]) -> Result<Vec<
         .map(|t| {
             let c = corners(positions, indices, t).map(|p| p - mid);
             let normal = area_normal(c);
-            let longest = (c[1] - c[0]).length_squared().max((c[2] - c[1]).length_squared()).max((c[0] - c[2]).length_squared());
+            let longest = (c[1] - c[0])
+                .length_squared()
+                .max((c[2] - c[1]).length_squared())
+                .max((c[0] - c[2]).length_squared());
             if !normal.is_finite() || normal.length() <= DEGENERATE * longest || longest == 0.0 {
                 return false;
             }

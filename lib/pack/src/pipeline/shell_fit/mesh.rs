@@ -11,7 +11,10 @@ pub fn triangle_count(positions: &[Vec3], indices: &[u32]) -> Result<usize> {
         return Err(anyhow!("{} indices do not make whole triangles", indices.len()));
     }
     if let Some(&i) = indices.iter().find(|&&i| i as usize >= positions.len()) {
-        return Err(anyhow!("index {i} names no vertex: the mesh has {} vertices", positions.len()));
+        return Err(anyhow!(
+            "index {i} names no vertex: the mesh has {} vertices",
+            positions.len()
+        ));
     }
     Ok(indices.len() / 3)
 }

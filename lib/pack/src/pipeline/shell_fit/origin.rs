@@ -42,8 +42,12 @@ mod tests {
     fn weights_centroids_by_area() {
         // A unit right triangle at x = 0 and one four times its area at x = 10.
         let p = [
-            Vec3::ZERO, Vec3::X, Vec3::Y,
-            Vec3::new(10.0, 0.0, 0.0), Vec3::new(12.0, 0.0, 0.0), Vec3::new(10.0, 2.0, 0.0),
+            Vec3::ZERO,
+            Vec3::X,
+            Vec3::Y,
+            Vec3::new(10.0, 0.0, 0.0),
+            Vec3::new(12.0, 0.0, 0.0),
+            Vec3::new(10.0, 2.0, 0.0),
         ];
         let o = origin(&p, &[0, 1, 2, 3, 4, 5]).unwrap();
         let c1 = Vec3::new(1.0 / 3.0, 1.0 / 3.0, 0.0);
@@ -53,7 +57,10 @@ mod tests {
 
     #[test]
     fn closed_box_centre() {
-        let (p, i) = crate::pipeline::shell_fit::test_meshes::cuboid(Vec3::new(1.0, 2.0, 3.0), Vec3::new(2.0, 1.0, 0.5));
+        let (p, i) = crate::pipeline::shell_fit::test_meshes::cuboid(
+            Vec3::new(1.0, 2.0, 3.0),
+            Vec3::new(2.0, 1.0, 0.5),
+        );
         assert!(origin(&p, &i).unwrap().distance(Vec3::new(1.0, 2.0, 3.0)) < 1e-5);
     }
 

@@ -35,7 +35,8 @@ impl PointTree {
 
     fn build(&mut self, node: usize, start: usize, end: usize) {
         let slice = &mut self.points[start..end];
-        let (lo, hi) = slice.iter().fold((slice[0], slice[0]), |(lo, hi), &p| (lo.min(p), hi.max(p)));
+        let (lo, hi) =
+            slice.iter().fold((slice[0], slice[0]), |(lo, hi), &p| (lo.min(p), hi.max(p)));
         self.nodes[node].centre = (lo + hi) * 0.5;
         self.nodes[node].half = (hi - lo) * 0.5;
         if slice.len() <= LEAF {
@@ -94,7 +95,11 @@ mod tests {
 
     #[test]
     fn agrees_with_a_scan() {
-        let points: Vec<Vec3> = sphere_points(1000).iter().enumerate().map(|(k, p)| *p * (0.5 + (k % 5) as f32 * 0.1)).collect();
+        let points: Vec<Vec3> = sphere_points(1000)
+            .iter()
+            .enumerate()
+            .map(|(k, p)| *p * (0.5 + (k % 5) as f32 * 0.1))
+            .collect();
         let tree = PointTree::new(&points);
         for (k, n) in sphere_points(50).into_iter().enumerate() {
             let limit = (k % 10) as f32 * 0.1;

@@ -6,7 +6,15 @@ use std::f32::consts::{PI, TAU};
 /// An axis-aligned box: 8 vertices, 12 triangles.
 pub fn cuboid(centre: Vec3, half: Vec3) -> (Vec<Vec3>, Vec<u32>) {
     let p = (0..8)
-        .map(|k| centre + half * Vec3::new(if k & 1 == 0 { -1.0 } else { 1.0 }, if k & 2 == 0 { -1.0 } else { 1.0 }, if k & 4 == 0 { -1.0 } else { 1.0 }))
+        .map(|k| {
+            centre
+                + half
+                    * Vec3::new(
+                        if k & 1 == 0 { -1.0 } else { 1.0 },
+                        if k & 2 == 0 { -1.0 } else { 1.0 },
+                        if k & 4 == 0 { -1.0 } else { 1.0 },
+                    )
+        })
         .collect();
     #[rustfmt::skip]
     let i = vec![
@@ -28,7 +36,11 @@ pub fn uv_sphere(centre: Vec3, radius: f32, segments: u32, rings: u32) -> (Vec<V
         let phi = PI * r as f32 / rings as f32;
         for s in 0..segments {
             let theta = TAU * s as f32 / segments as f32;
-            p.push(centre + radius * Vec3::new(phi.sin() * theta.cos(), phi.cos(), -phi.sin() * theta.sin()));
+            p.push(
+                centre
+                    + radius
+                        * Vec3::new(phi.sin() * theta.cos(), phi.cos(), -phi.sin() * theta.sin()),
+            );
         }
     }
     p.push(centre - radius * Vec3::Y);
