@@ -47,6 +47,7 @@ pub mod stacked;
 pub mod synthetic;
 pub mod texcoord;
 pub mod transform;
+pub mod view;
 
 pub use antialias::{antialias, antialiased_render_matrix, DisplayFilter};
 pub use error::CompileError;

@@ -18,10 +18,8 @@ use crate::normal_equations::{
 use crate::regularize::{barrier_d2, pyramid_operator, RangeRegularization};
 use crate::sparse::Csr;
 use crate::stacked::{assemble, residual2 as residual2_of, view_matrix, ViewSource};
+pub use crate::view::{View, CHANNELS};
 use crate::{CompileError, RenderMatrix, TextureLayout};
-
-/// Colour channels per texel and per pixel (RGB, interleaved).
-pub const CHANNELS: usize = 3;
 
 /// Which form of the normal equations to iterate on.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Default)]
@@ -128,13 +126,6 @@ pub struct Solution {
     pub undefined: usize,
     pub converged: bool,
     pub solve_ms: f64,
-}
-
-/// One view's render matrix and its ray-traced pixels (`rows × 3`, interleaved RGB).
-#[derive(Clone, Copy, Debug)]
-pub struct View<'a> {
-    pub a: &'a RenderMatrix,
-    pub b: &'a [f32],
 }
 
 /// Solves for one object's texture at one parameter point. `initial` (n_t × 3) is a warm

@@ -8,8 +8,8 @@
 use rayon::prelude::*;
 
 use crate::error::check_finite;
-use crate::solve::{View, CHANNELS};
 use crate::sparse::Csr;
+use crate::view::{View, CHANNELS};
 use crate::{CompileError, TextureLayout};
 
 /// The views of a view-independent solve, served one at a time and as often as the solve

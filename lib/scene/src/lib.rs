@@ -31,6 +31,7 @@ pub mod extensions;
 mod frame;
 mod gltf_files;
 mod gltf_load;
+mod light;
 pub mod light_path;
 mod load;
 #[cfg(test)]

@@ -6,6 +6,7 @@
 use glam::{Mat4, Vec2, Vec3, Vec4};
 use pis_format::{DimensionKind, ObjectRole};
 
+pub use crate::light::{Light, LightKind};
 use crate::rig::Rig;
 pub use crate::texture_ref::{TextureRef, UvTransform};
 
@@ -298,27 +299,6 @@ pub struct Camera {
     pub znear: f32,
     /// f32::INFINITY when the glTF camera has no far plane.
     pub zfar: f32,
-}
-
-/// A light from KHR_lights_punctual, placed in the world.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Light {
-    pub name: String,
-    pub kind: LightKind,
-    /// Linear RGB colour times intensity (W/sr-like units for point/spot, lux for directional).
-    pub radiance: [f32; 3],
-    /// Sphere radius for area lights and soft shadows (glTF extras `radius`), 0 = point.
-    pub radius: f32,
-    pub position: Vec3,
-    /// Direction the light points to (unit), for spot and directional lights.
-    pub direction: Vec3,
-}
-
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub enum LightKind {
-    Point,
-    Spot { inner_cone: f32, outer_cone: f32 },
-    Directional,
 }
 
 /// An object placed in the world at one parameter point.

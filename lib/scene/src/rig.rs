@@ -4,7 +4,7 @@
 use glam::{Mat4, Vec3};
 
 use crate::animation::{Animation, Trs};
-use crate::model::LightKind;
+use crate::light::LightKind;
 
 /// Node hierarchy, camera, lights and animations of a scene.
 ///

@@ -2,17 +2,19 @@
 //! per parameter point and little-endian ray-record side files; while a trace is under way,
 //! one record per point done in `shards/` ([`Shard`], [`merge_set`]).
 
+mod atomic;
 mod exr_io;
 mod meta;
 mod reader;
 mod shards;
 mod writer;
 
+pub use atomic::write_atomic;
 pub use exr_io::{decode_exr, encode_exr};
 pub use meta::*;
 pub use reader::RaySet;
 pub use shards::{is_complete, merge_set, Begin, MergeReport, Shard, SHARDS_DIR};
-pub use writer::{write_atomic, SetWriter};
+pub use writer::SetWriter;
 
 /// Name of the metadata file inside a set directory.
 pub const SET_JSON: &str = "set.json";

@@ -4,8 +4,8 @@
 //! interrupted trace resumes from and what shards of one trace, run as separate processes
 //! on separate machines sharing the directory, meet in.
 
+use super::atomic::write_atomic;
 use super::meta::{PointMeta, SetMeta};
-use super::writer::write_atomic;
 use super::SET_JSON;
 use crate::error::TraceError;
 use serde::{Deserialize, Serialize};

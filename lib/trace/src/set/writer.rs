@@ -1,6 +1,7 @@
 //! Writing a ray-traced set. Every file is written to a temporary name and renamed into
 //! place, so an interrupted run never leaves a half-written file under a final name.
 
+use super::atomic::write_atomic;
 use super::exr_io::encode_exr;
 use super::meta::*;
 use super::shards::{all_recorded, merge_set, Begin, Records};
@@ -13,29 +14,7 @@ use crate::render::{channel_names, PointRender};
 use crate::settings::TraceSettings;
 use pis_scene::{DimensionKind, Driver, Frame, LightKind, ObjectRole, Scene};
 use std::fs;
-use std::io::Write;
 use std::path::{Path, PathBuf};
-
-/// Writes `bytes` to `path` atomically (temporary file in the same directory, then rename).
-/// The temporary name is the process's and the call's own, so that writers of one file in
-/// several processes or threads never share one.
-pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), TraceError> {
-    static CALLS: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
-    let call = CALLS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-    let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
-    let tmp = path.with_file_name(format!(".{name}.tmp{}.{call}", std::process::id()));
-    let result = (|| {
-        let mut f = fs::File::create(&tmp)?;
-        f.write_all(bytes)?;
-        f.sync_all()?;
-        fs::rename(&tmp, path)
-    })();
-    if let Err(e) = result {
-        let _ = fs::remove_file(&tmp);
-        return Err(TraceError::io(path, e));
-    }
-    Ok(())
-}
 
 fn role_name(role: ObjectRole) -> &'static str {
     match role {
