@@ -42,6 +42,7 @@ pub mod material;
 mod material_load_tests;
 mod material_textures;
 pub mod model;
+pub mod optics;
 pub mod orbit;
 pub mod rig;
 mod space;

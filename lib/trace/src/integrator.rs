@@ -12,10 +12,11 @@
 use crate::bvh::{offset_origin, Hit, SceneGeometry, SurfacePoint};
 use crate::environment::{balance, EnvironmentLight};
 use crate::lights::{hit_light_sphere, sample_light};
-use crate::material::{fresnel_dielectric, reflect, refract, ShadingMaterial};
+use crate::material::ShadingMaterial;
 use crate::sampling::{cosine_hemisphere, ggx_g1, ggx_half_vector, luminance, Rng};
 use crate::settings::TraceSettings;
 use glam::Vec3;
+use pis_scene::optics::{fresnel_dielectric, reflect, refract};
 use pis_scene::{Frame, ObjectRole, Scene};
 use std::f32::consts::PI;
 

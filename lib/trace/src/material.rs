@@ -8,6 +8,7 @@
 
 use crate::textures::lookup;
 use glam::{Vec2, Vec3};
+pub use pis_scene::optics::{fresnel_dielectric, reflect, refract, schlick};
 use pis_scene::{AlphaMode, Material, Scene};
 
 pub use crate::textures::sample_texture;
@@ -148,69 +149,9 @@ pub fn mapped_normal(scene: &Scene, material: &Material, uvs: [Vec2; 2]) -> Opti
     n.try_normalize()
 }
 
-/// Schlick's approximation of the Fresnel reflectance for reflectance `f0` at normal incidence.
-pub fn schlick(f0: Vec3, cos_theta: f32) -> Vec3 {
-    let m = (1.0 - cos_theta.clamp(0.0, 1.0)).powi(5);
-    f0 + (Vec3::ONE - f0) * m
-}
-
-/// Exact unpolarised Fresnel reflectance of a dielectric interface. `cos_i` is the cosine
-/// between the incident direction (reversed) and the normal on the incident side; `eta` is
-/// n_incident / n_transmitted. Returns 1 under total internal reflection.
-pub fn fresnel_dielectric(cos_i: f32, eta: f32) -> f32 {
-    let cos_i = cos_i.clamp(0.0, 1.0);
-    let sin2_t = eta * eta * (1.0 - cos_i * cos_i);
-    if sin2_t >= 1.0 {
-        return 1.0;
-    }
-    let cos_t = (1.0 - sin2_t).sqrt();
-    let rs = (eta * cos_i - cos_t) / (eta * cos_i + cos_t);
-    let rp = (cos_i - eta * cos_t) / (cos_i + eta * cos_t);
-    0.5 * (rs * rs + rp * rp)
-}
-
-/// Mirror reflection of direction `d` about normal `n`.
-pub fn reflect(d: Vec3, n: Vec3) -> Vec3 {
-    d - n * (2.0 * d.dot(n))
-}
-
-/// Refraction of unit direction `d` through the interface with unit normal `n` (facing
-/// against `d`) and relative index `eta` = n_incident / n_transmitted; `None` under total
-/// internal reflection.
-pub fn refract(d: Vec3, n: Vec3, eta: f32) -> Option<Vec3> {
-    let cos_i = -d.dot(n);
-    let sin2_t = eta * eta * (1.0 - cos_i * cos_i);
-    if sin2_t >= 1.0 {
-        return None;
-    }
-    let cos_t = (1.0 - sin2_t).sqrt();
-    Some((d * eta + n * (eta * cos_i - cos_t)).normalize())
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn fresnel_at_normal_incidence_and_tir() {
-        for n in [1.33f32, 1.5, 2.4] {
-            let r0 = ((n - 1.0) / (n + 1.0)).powi(2);
-            assert!((fresnel_dielectric(1.0, 1.0 / n) - r0).abs() < 1e-6);
-            assert!((fresnel_dielectric(1.0, n) - r0).abs() < 1e-6);
-        }
-        // Beyond the critical angle inside glass.
-        assert_eq!(fresnel_dielectric(0.3, 1.5), 1.0);
-        assert!(refract(Vec3::new(0.95, -0.3122499, 0.0).normalize(), Vec3::Y, 1.5).is_none());
-    }
-
-    #[test]
-    fn refraction_obeys_snell() {
-        let d = Vec3::new(0.5, -0.8660254, 0.0);
-        let t = refract(d, Vec3::Y, 1.0 / 1.5).unwrap();
-        let sin_i = 0.5f32;
-        let sin_t = t.x;
-        assert!((sin_i - 1.5 * sin_t).abs() < 1e-5);
-    }
 
     fn texture(texels: Vec<[f32; 4]>) -> Scene {
         let width = texels.len() as u32;

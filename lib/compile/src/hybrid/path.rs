@@ -4,9 +4,11 @@
 //! with the Fresnel factors, the base colour on entering and the absorption inside
 //! multiplied along (F·G). The same model, in the same order of operations, as pis-trace's
 //! greedy terms (`Integrator::greedy_term`), which compile the traced set's `reflection` and
-//! `refraction` layers and ray records; a test keeps the two identical.
+//! `refraction` layers and ray records; a test keeps the two identical. Both meet an interface
+//! through the same functions, [`pis_scene::optics`].
 
 use glam::Vec3;
+pub use pis_scene::optics::{fresnel_dielectric, reflect, refract};
 
 use super::lens::{offset_origin, LensObject, LensSurface};
 
@@ -98,39 +100,6 @@ pub fn greedy_path(
         ng = s.geometric_normal;
     }
     None
-}
-
-/// Exact unpolarised Fresnel reflectance of a dielectric interface (pis-trace's
-/// `material::fresnel_dielectric`): `cos_i` between the reversed incident direction and the
-/// normal on the incident side, `eta` = n_incident / n_transmitted; 1 under total internal
-/// reflection.
-pub fn fresnel_dielectric(cos_i: f32, eta: f32) -> f32 {
-    let cos_i = cos_i.clamp(0.0, 1.0);
-    let sin2_t = eta * eta * (1.0 - cos_i * cos_i);
-    if sin2_t >= 1.0 {
-        return 1.0;
-    }
-    let cos_t = (1.0 - sin2_t).sqrt();
-    let rs = (eta * cos_i - cos_t) / (eta * cos_i + cos_t);
-    let rp = (cos_i - eta * cos_t) / (cos_i + eta * cos_t);
-    0.5 * (rs * rs + rp * rp)
-}
-
-/// Mirror reflection of direction `d` about normal `n`.
-pub fn reflect(d: Vec3, n: Vec3) -> Vec3 {
-    d - n * (2.0 * d.dot(n))
-}
-
-/// Refraction of unit direction `d` through the interface with unit normal `n` (facing
-/// against `d`) and relative index `eta`; `None` under total internal reflection.
-pub fn refract(d: Vec3, n: Vec3, eta: f32) -> Option<Vec3> {
-    let cos_i = -d.dot(n);
-    let sin2_t = eta * eta * (1.0 - cos_i * cos_i);
-    if sin2_t >= 1.0 {
-        return None;
-    }
-    let cos_t = (1.0 - sin2_t).sqrt();
-    Some((d * eta + n * (eta * cos_i - cos_t)).normalize())
 }
 
 /// Whether two paths of one term differ (thesis 6.4.1): one exists and the other not,
@@ -246,7 +215,6 @@ mod tests {
         assert_eq!(t.topology, Topology { interfaces: 3, reflected: 0b010 });
         assert!(t.exit_direction.dot(-Vec3::X) > 1.0 - 1e-5, "{:?}", t.exit_direction);
         assert!(t.exit_origin.x < 1e-3, "{:?}", t.exit_origin);
-        assert_eq!(fresnel_dielectric(45f32.to_radians().cos(), 1.5), 1.0);
     }
 
     #[test]
