@@ -124,8 +124,29 @@ fn convert(
         .default_scene()
         .or_else(|| doc.scenes().next())
         .ok_or_else(|| SceneError::invalid(path, "scenes", "the glTF has no scene"))?;
+    let (mut rig, rig_index) = read_nodes(path, &scene)?;
+    let (mut materials, textures, mut warnings) = read_materials(path, doc, images)?;
 
-    // Nodes, depth-first from the scene roots, so that parents precede children.
+    // The scene's nodes with their index in the rig, in glTF node order.
+    let gltf_nodes: Vec<gltf::Node> = doc.nodes().collect();
+    let mut by_gltf: Vec<(usize, usize)> = rig_index.iter().map(|(&g, &r)| (g, r)).collect();
+    by_gltf.sort();
+    let placed: Vec<(&gltf::Node, usize)> =
+        by_gltf.iter().filter_map(|&(g, r)| Some((gltf_nodes.get(g)?, r))).collect();
+
+    let objects = ctx.read_objects(&placed, &mut rig, &mut materials, &textures, &mut warnings)?;
+    let cameras = ctx.read_lights_and_cameras(&placed, &mut rig)?;
+    let unsupported_animations = ctx.read_animations(doc, &rig_index, &mut rig)?;
+
+    Ok(GltfScene { objects, materials, textures, rig, cameras, unsupported_animations, warnings })
+}
+
+/// The rig's nodes, depth-first from the scene roots, so that parents precede children;
+/// also the rig index of each glTF node index.
+fn read_nodes(
+    path: &Path,
+    scene: &gltf::Scene,
+) -> Result<(Rig, BTreeMap<usize, usize>), SceneError> {
     let mut rig = Rig::default();
     let mut rig_index: BTreeMap<usize, usize> = BTreeMap::new();
     let mut stack: Vec<(gltf::Node, Option<usize>)> = scene.nodes().map(|n| (n, None)).collect();
@@ -159,8 +180,16 @@ fn convert(
             stack.push((child, Some(here)));
         }
     }
+    Ok((rig, rig_index))
+}
 
-    // Materials in glTF order; a default material is appended if a primitive has none.
+/// Materials in glTF order with the textures they read, and the warnings so far: the
+/// extensions PIS does not implement, then what reading the textures found.
+fn read_materials(
+    path: &Path,
+    doc: &gltf::Document,
+    images: &[gltf::image::Data],
+) -> Result<(Vec<Material>, Vec<TextureImage>, Vec<String>), SceneError> {
     let mut texture_set = TextureSet::new(path, images);
     let mut materials = Vec::new();
     for m in doc.materials() {
@@ -176,96 +205,124 @@ fn convert(
             }),
         ));
     warnings.extend(texture_warnings);
-    let mut default_material = None;
+    Ok((materials, textures, warnings))
+}
 
-    // Objects: one per node with a mesh, in glTF node order.
-    let gltf_nodes: Vec<gltf::Node> = doc.nodes().collect();
-    let mut objects = Vec::new();
-    let mut by_gltf: Vec<(usize, usize)> = rig_index.iter().map(|(&g, &r)| (g, r)).collect();
-    by_gltf.sort();
-    let mut used_names: BTreeMap<String, usize> = BTreeMap::new();
-    for &(g, r) in &by_gltf {
-        let Some(node) = gltf_nodes.get(g) else {
-            continue;
-        };
-        let Some(mesh) = node.mesh() else { continue };
-        let mut primitives = Vec::new();
-        for p in mesh.primitives() {
-            let material = match p.material().index() {
-                Some(i) => i,
-                None => *default_material.get_or_insert_with(|| {
-                    materials.push(Material { name: "default".into(), ..Material::default() });
-                    materials.len() - 1
-                }),
-            };
-            let field = format!("meshes[{}].primitives[{}]", mesh.index(), p.index());
-            let prim = ctx.read_primitive(&p, material, &field)?;
-            if prim.uvs1.is_empty()
-                && materials.get(material).is_some_and(|m| m.textures().any(|t| t.tex_coord == 1))
-            {
-                let w = format!("{field} has no TEXCOORD_1, which the textures of materials[{material}] read: TEXCOORD_0 is read instead");
-                if !warnings.contains(&w) {
-                    warnings.push(w);
+impl Ctx<'_> {
+    /// Objects: one per placed node with a mesh, in glTF node order, each with its role.
+    /// A default material is appended to `materials` if a primitive has none.
+    fn read_objects(
+        &self,
+        placed: &[(&gltf::Node, usize)],
+        rig: &mut Rig,
+        materials: &mut Vec<Material>,
+        textures: &[TextureImage],
+        warnings: &mut Vec<String>,
+    ) -> Result<Vec<SceneObject>, SceneError> {
+        let mut default_material = None;
+        let mut objects = Vec::new();
+        let mut used_names: BTreeMap<String, usize> = BTreeMap::new();
+        for &(node, r) in placed {
+            let g = node.index();
+            let Some(mesh) = node.mesh() else { continue };
+            let mut primitives = Vec::new();
+            for p in mesh.primitives() {
+                let material = match p.material().index() {
+                    Some(i) => i,
+                    None => *default_material.get_or_insert_with(|| {
+                        materials.push(Material { name: "default".into(), ..Material::default() });
+                        materials.len() - 1
+                    }),
+                };
+                let field = format!("meshes[{}].primitives[{}]", mesh.index(), p.index());
+                let prim = self.read_primitive(&p, material, &field)?;
+                if prim.uvs1.is_empty()
+                    && materials
+                        .get(material)
+                        .is_some_and(|m| m.textures().any(|t| t.tex_coord == 1))
+                {
+                    let w = format!("{field} has no TEXCOORD_1, which the textures of materials[{material}] read: TEXCOORD_0 is read instead");
+                    if !warnings.contains(&w) {
+                        warnings.push(w);
+                    }
+                }
+                primitives.push(prim);
+            }
+            // Roles are judged on the materials with their textures' means.
+            let flat: Vec<Material> = primitives
+                .iter()
+                .filter_map(|p: &Primitive| materials.get(p.material))
+                .map(|m| mean_material(m, textures))
+                .collect();
+            let mats: Vec<&Material> = flat.iter().collect();
+            let mut name = rig.nodes[r].name.clone();
+            if node.name().is_none() {
+                if let Some(mesh_name) = mesh.name() {
+                    name = mesh_name.to_owned();
                 }
             }
-            primitives.push(prim);
-        }
-        // Roles are judged on the materials with their textures' means.
-        let flat: Vec<Material> = primitives
-            .iter()
-            .filter_map(|p: &Primitive| materials.get(p.material))
-            .map(|m| mean_material(m, &textures))
-            .collect();
-        let mats: Vec<&Material> = flat.iter().collect();
-        let mut name = rig.nodes[r].name.clone();
-        if node.name().is_none() {
-            if let Some(mesh_name) = mesh.name() {
-                name = mesh_name.to_owned();
+            let count = used_names.entry(name.clone()).or_insert(0);
+            *count += 1;
+            if *count > 1 {
+                name = format!("{name}.{g}");
             }
+            objects.push(SceneObject {
+                name,
+                role: infer_role(&mats),
+                reflector: None,
+                primitives,
+            });
+            rig.object_nodes.push(r);
         }
-        let count = used_names.entry(name.clone()).or_insert(0);
-        *count += 1;
-        if *count > 1 {
-            name = format!("{name}.{g}");
-        }
-        objects.push(SceneObject { name, role: infer_role(&mats), reflector: None, primitives });
-        rig.object_nodes.push(r);
+        Ok(objects)
     }
 
-    // Lights and cameras on nodes.
-    let mut cameras = Vec::new();
-    for &(g, r) in &by_gltf {
-        let Some(node) = gltf_nodes.get(g) else {
-            continue;
-        };
-        if let Some(light) = node.light() {
-            rig.lights.push(ctx.read_light(&light, &rig.nodes[r].name, r)?);
-        }
-        if let Some(camera) = node.camera() {
-            if let gltf::camera::Projection::Perspective(p) = camera.projection() {
-                cameras.push(GltfCamera {
-                    node: r,
-                    yfov: p.yfov(),
-                    znear: p.znear(),
-                    zfar: p.zfar(),
-                });
+    /// Lights (into the rig) and perspective cameras on the placed nodes.
+    fn read_lights_and_cameras(
+        &self,
+        placed: &[(&gltf::Node, usize)],
+        rig: &mut Rig,
+    ) -> Result<Vec<GltfCamera>, SceneError> {
+        let mut cameras = Vec::new();
+        for &(node, r) in placed {
+            if let Some(light) = node.light() {
+                rig.lights.push(self.read_light(&light, &rig.nodes[r].name, r)?);
+            }
+            if let Some(camera) = node.camera() {
+                if let gltf::camera::Projection::Perspective(p) = camera.projection() {
+                    cameras.push(GltfCamera {
+                        node: r,
+                        yfov: p.yfov(),
+                        znear: p.znear(),
+                        zfar: p.zfar(),
+                    });
+                }
             }
         }
+        Ok(cameras)
     }
 
-    // Animations.
-    let mut unsupported_animations = BTreeMap::new();
-    for a in doc.animations() {
-        let name = a.name().map(str::to_owned).unwrap_or_else(|| format!("animation{}", a.index()));
-        match ctx.read_animation(&a, &name, &rig_index)? {
-            Ok(anim) => rig.animations.push(anim),
-            Err(why) => {
-                unsupported_animations.insert(name, why);
+    /// Animations into the rig; those that cannot be sampled by name, with the field and
+    /// reason.
+    fn read_animations(
+        &self,
+        doc: &gltf::Document,
+        rig_index: &BTreeMap<usize, usize>,
+        rig: &mut Rig,
+    ) -> Result<BTreeMap<String, (String, String)>, SceneError> {
+        let mut unsupported_animations = BTreeMap::new();
+        for a in doc.animations() {
+            let name =
+                a.name().map(str::to_owned).unwrap_or_else(|| format!("animation{}", a.index()));
+            match self.read_animation(&a, &name, rig_index)? {
+                Ok(anim) => rig.animations.push(anim),
+                Err(why) => {
+                    unsupported_animations.insert(name, why);
+                }
             }
         }
+        Ok(unsupported_animations)
     }
-
-    Ok(GltfScene { objects, materials, textures, rig, cameras, unsupported_animations, warnings })
 }
 
 /// Maps a gltf crate error to a [`SceneError`] that names the file.

@@ -40,145 +40,27 @@ pub(crate) fn build_space(
 ) -> Result<ParameterSpace, SceneError> {
     let mut dims = Vec::with_capacity(specs.len());
     let mut orbits = 0;
-    for (i, d) in specs.iter().enumerate() {
-        let field = |key: &str| format!("dimension[{i}].{key}");
-        if d.samples == 0 {
-            return Err(SceneError::ZeroSamples {
-                path: path.to_owned(),
-                field: field("samples"),
-                dimension: d.name.clone(),
-            });
-        }
-        if specs[..i].iter().any(|e| e.name == d.name) {
-            return Err(SceneError::invalid(
-                path,
-                field("name"),
-                format!("dimension name `{}` is used twice", d.name),
-            ));
-        }
-        // Keys each driver may use; any other driver-specific key is an error.
-        let present: [(&str, bool); 9] = [
-            ("target", d.target.is_some()),
-            ("radius", d.radius.is_some()),
-            ("elevation_deg", d.elevation_deg.is_some()),
-            ("azimuth_deg", d.azimuth_deg.is_some()),
-            ("animation", d.animation.is_some()),
-            ("time", d.time.is_some()),
-            ("light", d.light.is_some()),
-            ("path", d.path.is_some()),
-            ("range", d.range.is_some()),
-        ];
-        let allowed: &[&str] = match d.driver {
-            DriverSpec::Orbit => &["target", "radius", "elevation_deg", "azimuth_deg"],
-            DriverSpec::Animation => &["animation", "time"],
-            DriverSpec::LightPath => &["light", "path", "range"],
-        };
-        if let Some((key, _)) = present.iter().find(|(k, p)| *p && !allowed.contains(k)) {
-            return Err(SceneError::invalid(
-                path,
-                field(key),
-                format!("key not used by driver {:?}", d.driver),
-            ));
-        }
-        let required = |key: &str| {
-            SceneError::invalid(path, field(key), format!("required by driver {:?}", d.driver))
-        };
+    for (index, d) in specs.iter().enumerate() {
+        let at = At { path, index, d };
+        check_keys(&at, &specs[..index])?;
         let periodic = d.periodic.unwrap_or(false);
-        let check_kind = |expected: KindSpec| match d.kind {
-            Some(k) if k != expected => Err(SceneError::invalid(
-                path,
-                field("kind"),
-                format!("driver {:?} always has kind {:?}", d.driver, expected),
-            )),
-            _ => Ok(kind_of(expected)),
-        };
-        let (kind, unit, range, driver) = match d.driver {
+        let resolved = match d.driver {
             DriverSpec::Orbit => {
                 orbits += 1;
                 if orbits > 1 {
-                    return Err(SceneError::invalid(
-                        path,
-                        field("driver"),
-                        "only one orbit dimension may move the camera",
-                    ));
+                    return Err(
+                        at.invalid("driver", "only one orbit dimension may move the camera")
+                    );
                 }
-                let target = Vec3::from(d.target.ok_or_else(|| required("target"))?);
-                let radius = d.radius.ok_or_else(|| required("radius"))?;
-                if radius <= 0.0 {
-                    return Err(SceneError::invalid(
-                        path,
-                        field("radius"),
-                        format!("must be > 0, found {radius}"),
-                    ));
-                }
-                let elevation_deg = d.elevation_deg.unwrap_or(0.0);
-                let range = d.azimuth_deg.ok_or_else(|| required("azimuth_deg"))?;
-                (
-                    check_kind(KindSpec::View)?,
-                    "deg",
-                    (range, "azimuth_deg"),
-                    Driver::Orbit { target, radius, elevation_deg },
-                )
+                orbit(&at)?
             }
-            DriverSpec::Animation => {
-                let name = d.animation.as_deref().ok_or_else(|| required("animation"))?;
-                if let Some((f, why)) = g.unsupported_animations.get(name) {
-                    return Err(SceneError::unsupported(
-                        path,
-                        f.clone(),
-                        format!("animation `{name}`: {why}"),
-                    ));
-                }
-                let Some(anim) = g.rig.animations.iter().find(|a| a.name == name) else {
-                    let known = g.rig.animations.iter().map(|a| a.name.as_str());
-                    return Err(SceneError::unknown(
-                        path,
-                        field("animation"),
-                        "animation",
-                        name,
-                        known,
-                    ));
-                };
-                let (t0, t1) = anim.time_range();
-                let range = d.time.unwrap_or([t0, t1]);
-                let kind = kind_of(d.kind.unwrap_or(KindSpec::Time));
-                (kind, "s", (range, "time"), Driver::Animation { animation: name.to_owned() })
-            }
-            DriverSpec::LightPath => {
-                let name = d.light.as_deref().ok_or_else(|| required("light"))?;
-                if !g.rig.lights.iter().any(|l| l.name == name || g.rig.nodes[l.node].name == name)
-                {
-                    let known = g.rig.lights.iter().map(|l| l.name.as_str());
-                    return Err(SceneError::unknown(path, field("light"), "light", name, known));
-                }
-                let pts: Vec<Vec3> = d
-                    .path
-                    .as_ref()
-                    .ok_or_else(|| required("path"))?
-                    .iter()
-                    .map(|&p| Vec3::from(p))
-                    .collect();
-                if pts.is_empty() {
-                    return Err(SceneError::invalid(
-                        path,
-                        field("path"),
-                        "needs at least one point",
-                    ));
-                }
-                let range = d.range.unwrap_or([0.0, 1.0]);
-                (
-                    check_kind(KindSpec::Light)?,
-                    "",
-                    (range, "range"),
-                    Driver::LightPath { light: name.to_owned(), path: pts },
-                )
-            }
+            DriverSpec::Animation => animation(&at, g)?,
+            DriverSpec::LightPath => light_path(&at, g)?,
         };
-        let ([a, b], range_key) = range;
+        let Resolved { kind, unit, range: ([a, b], range_key), driver } = resolved;
         if d.samples > 1 && b <= a {
-            return Err(SceneError::invalid(
-                path,
-                field(range_key),
+            return Err(at.invalid(
+                range_key,
                 format!("[{a}, {b}] must increase for {} samples", d.samples),
             ));
         }
@@ -192,6 +74,154 @@ pub(crate) fn build_space(
         });
     }
     Ok(ParameterSpace { dims })
+}
+
+/// One `[[dimension]]` table where its errors point: scene.toml and the table's index.
+struct At<'a> {
+    path: &'a Path,
+    index: usize,
+    d: &'a DimensionSpec,
+}
+
+impl At<'_> {
+    fn field(&self, key: &str) -> String {
+        format!("dimension[{}].{key}", self.index)
+    }
+
+    fn invalid(&self, key: &str, message: impl Into<String>) -> SceneError {
+        SceneError::invalid(self.path, self.field(key), message)
+    }
+
+    fn required(&self, key: &str) -> SceneError {
+        self.invalid(key, format!("required by driver {:?}", self.d.driver))
+    }
+
+    /// The kind of a driver that always has `expected`; an explicit other kind is an error.
+    fn fixed_kind(&self, expected: KindSpec) -> Result<DimensionKind, SceneError> {
+        match self.d.kind {
+            Some(k) if k != expected => Err(self.invalid(
+                "kind",
+                format!("driver {:?} always has kind {:?}", self.d.driver, expected),
+            )),
+            _ => Ok(kind_of(expected)),
+        }
+    }
+}
+
+/// A driver resolved against the glTF: the dimension's kind, unit, range with the key it
+/// came from, and what it moves.
+struct Resolved {
+    kind: DimensionKind,
+    unit: &'static str,
+    range: ([f32; 2], &'static str),
+    driver: Driver,
+}
+
+/// At least one sample, a name not used by an `earlier` dimension, and only the keys of
+/// its driver.
+fn check_keys(at: &At, earlier: &[DimensionSpec]) -> Result<(), SceneError> {
+    let d = at.d;
+    if d.samples == 0 {
+        return Err(SceneError::ZeroSamples {
+            path: at.path.to_owned(),
+            field: at.field("samples"),
+            dimension: d.name.clone(),
+        });
+    }
+    if earlier.iter().any(|e| e.name == d.name) {
+        return Err(at.invalid("name", format!("dimension name `{}` is used twice", d.name)));
+    }
+    // Keys each driver may use; any other driver-specific key is an error.
+    let present: [(&str, bool); 9] = [
+        ("target", d.target.is_some()),
+        ("radius", d.radius.is_some()),
+        ("elevation_deg", d.elevation_deg.is_some()),
+        ("azimuth_deg", d.azimuth_deg.is_some()),
+        ("animation", d.animation.is_some()),
+        ("time", d.time.is_some()),
+        ("light", d.light.is_some()),
+        ("path", d.path.is_some()),
+        ("range", d.range.is_some()),
+    ];
+    let allowed: &[&str] = match d.driver {
+        DriverSpec::Orbit => &["target", "radius", "elevation_deg", "azimuth_deg"],
+        DriverSpec::Animation => &["animation", "time"],
+        DriverSpec::LightPath => &["light", "path", "range"],
+    };
+    if let Some((key, _)) = present.iter().find(|(k, p)| *p && !allowed.contains(k)) {
+        return Err(at.invalid(key, format!("key not used by driver {:?}", d.driver)));
+    }
+    Ok(())
+}
+
+/// The camera on a circle about `target` (azimuth in degrees).
+fn orbit(at: &At) -> Result<Resolved, SceneError> {
+    let d = at.d;
+    let target = Vec3::from(d.target.ok_or_else(|| at.required("target"))?);
+    let radius = d.radius.ok_or_else(|| at.required("radius"))?;
+    if radius <= 0.0 {
+        return Err(at.invalid("radius", format!("must be > 0, found {radius}")));
+    }
+    let elevation_deg = d.elevation_deg.unwrap_or(0.0);
+    let range = d.azimuth_deg.ok_or_else(|| at.required("azimuth_deg"))?;
+    Ok(Resolved {
+        kind: at.fixed_kind(KindSpec::View)?,
+        unit: "deg",
+        range: (range, "azimuth_deg"),
+        driver: Driver::Orbit { target, radius, elevation_deg },
+    })
+}
+
+/// A glTF animation sampled in time (seconds; its whole time range by default).
+fn animation(at: &At, g: &GltfScene) -> Result<Resolved, SceneError> {
+    let d = at.d;
+    let name = d.animation.as_deref().ok_or_else(|| at.required("animation"))?;
+    if let Some((f, why)) = g.unsupported_animations.get(name) {
+        return Err(SceneError::unsupported(
+            at.path,
+            f.clone(),
+            format!("animation `{name}`: {why}"),
+        ));
+    }
+    let Some(anim) = g.rig.animations.iter().find(|a| a.name == name) else {
+        let known = g.rig.animations.iter().map(|a| a.name.as_str());
+        return Err(SceneError::unknown(at.path, at.field("animation"), "animation", name, known));
+    };
+    let (t0, t1) = anim.time_range();
+    let range = d.time.unwrap_or([t0, t1]);
+    Ok(Resolved {
+        kind: kind_of(d.kind.unwrap_or(KindSpec::Time)),
+        unit: "s",
+        range: (range, "time"),
+        driver: Driver::Animation { animation: name.to_owned() },
+    })
+}
+
+/// A light moved along a polyline (the range in normalised arc length, [0, 1] by default).
+fn light_path(at: &At, g: &GltfScene) -> Result<Resolved, SceneError> {
+    let d = at.d;
+    let name = d.light.as_deref().ok_or_else(|| at.required("light"))?;
+    if !g.rig.lights.iter().any(|l| l.name == name || g.rig.nodes[l.node].name == name) {
+        let known = g.rig.lights.iter().map(|l| l.name.as_str());
+        return Err(SceneError::unknown(at.path, at.field("light"), "light", name, known));
+    }
+    let pts: Vec<Vec3> = d
+        .path
+        .as_ref()
+        .ok_or_else(|| at.required("path"))?
+        .iter()
+        .map(|&p| Vec3::from(p))
+        .collect();
+    if pts.is_empty() {
+        return Err(at.invalid("path", "needs at least one point"));
+    }
+    let range = d.range.unwrap_or([0.0, 1.0]);
+    Ok(Resolved {
+        kind: at.fixed_kind(KindSpec::Light)?,
+        unit: "",
+        range: (range, "range"),
+        driver: Driver::LightPath { light: name.to_owned(), path: pts },
+    })
 }
 
 #[cfg(test)]
