@@ -6,9 +6,9 @@
 //! chains, and frames of every object with its surface layers and, for reflective objects,
 //! its reflection term (environment-map shells, `shell.rs`, looked up as the hardware model
 //! does, composited "over", times Fresnel), for lens objects both terms of hybrid rendering
-//! (`frame_hybrid.rs`: vertex rays traced through the object each frame), multisampled on
+//! (`frame/hybrid.rs`: vertex rays traced through the object each frame), multisampled on
 //! silhouettes (`multisample.rs`)
-//! and resolved with the ray-traced set's display filter (`resolve.rs`).
+//! and resolved with the ray-traced set's display filter (`frame/resolve.rs`).
 //!
 //! Without a GPU, wgpu runs on Mesa's lavapipe: `apt-get install -y mesa-vulkan-drivers`.
 
@@ -18,8 +18,6 @@ pub mod camera;
 pub mod decode;
 pub mod error;
 pub mod frame;
-pub mod frame_hybrid;
-pub mod frame_reflection;
 pub mod gpu;
 pub mod hybrid;
 pub mod image;
@@ -27,7 +25,6 @@ pub mod mip;
 pub mod multisample;
 pub mod player;
 pub mod probe;
-pub mod resolve;
 pub mod shell;
 pub mod textured;
 pub mod window;

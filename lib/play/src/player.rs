@@ -9,7 +9,7 @@
 //! weight. A lens object (role `refractive`, its shells in the refraction term) is drawn by
 //! hybrid rendering (thesis 6.4): per frame its vertex rays are traced through it on the
 //! workers, its tessellation refined where they diverge, and both terms drawn from its
-//! shells per parameter sample ([`crate::frame_hybrid`]).
+//! shells per parameter sample ([`crate::frame::hybrid`]).
 
 use std::collections::HashMap;
 use std::path::Path;
@@ -30,11 +30,11 @@ use crate::cache::{LevelCache, LevelKey};
 use crate::camera::{mat4_from_rows, projection, CameraChoice, ViewCamera};
 use crate::decode::{AssembleJob, Decoder, LevelJob};
 use crate::error::PlayError;
+use crate::frame::hybrid::{corner_buffer, term_corners, LensDraw, MAX_LENS_SHELLS};
 use crate::frame::{
     colour_image, offscreen_format, FramePipelines, LayerDraw, MeshGpu, ObjectDraw, Readback,
     ReflectionDraw, Targets, TermShell, MAX_TERM_SHELLS,
 };
-use crate::frame_hybrid::{corner_buffer, term_corners, LensDraw, MAX_LENS_SHELLS};
 use crate::gpu::Gpu;
 use crate::image::FloatImage;
 use crate::mip::MipBuilder;

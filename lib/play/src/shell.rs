@@ -2,8 +2,8 @@
 //! texture read with `textureLoad` and filtered in the shader exactly as pis-compile's
 //! hardware model filters it (`pis_compile::shell`), and the pipeline that draws one object
 //! with one shell — the rendering a shell's render matrix predicts. The player's frames
-//! draw a reflective object's shells with the same functions (`frame_reflection.wgsl`,
-//! `frame.rs`).
+//! draw a reflective object's shells with the same functions (`frame/reflection.wgsl`,
+//! `frame/reflection.rs`).
 //!
 //! Level m of a face of size N holds `mip_size(N, m)` used texels at the top left of a GPU
 //! level of `next_pow2(N) >> m` texels, which is never smaller.
@@ -18,8 +18,10 @@ use crate::gpu::Gpu;
 use crate::image::FloatImage;
 use crate::textured::{DEPTH_FORMAT, TARGET_FORMAT};
 
-/// The shell functions every shell pipeline appends its entry points to.
-pub const SHELL_FUNCTIONS: &str = include_str!("shell.wgsl");
+/// The shell functions every shell pipeline appends its entry points to: the isotropic LOD
+/// (`texture_lod.wgsl`, shared with the textured pipeline and the frame), then `shell.wgsl`.
+pub const SHELL_FUNCTIONS: &str =
+    concat!(include_str!("texture_lod.wgsl"), include_str!("shell.wgsl"));
 /// The one-shell object pipeline's entry points.
 pub const SHELL_OBJECT: &str = include_str!("shell_object.wgsl");
 

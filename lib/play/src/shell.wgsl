@@ -3,9 +3,8 @@
 // name in pis-compile's hardware model, with the same order of operations (reflect_about,
 // shell_hit, lookup_direction, fresnel: shell/geometry.rs; cube_face, face_components, face_st,
 // face_vector, cube_texel, beyond, bilinear_corner, cube_lod, cube_bilinear, cube_sample:
-// shell/cube.rs;
-// texture_lod: lod.rs). Change both together. Pipelines append their entry points to this
-// source.
+// shell/cube.rs). Change both together. texture_lod.wgsl is prepended to this source
+// (shell.rs), and pipelines append their entry points to it.
 //
 // A cube map is a 2D array texture of six layers (+X, −X, +Y, −Y, +Z, −Z) whose level m
 // holds the used mip_size(N, m) texels at its top left; texels are read with textureLoad
@@ -179,14 +178,6 @@ fn cube_texel(face: u32, i: i32, j: i32, n: u32) -> vec3<i32> {
     let st = face_st(f2, d);
     let k = clamp(vec2<i32>(floor(st * nf)), vec2<i32>(0), vec2<i32>(ni - 1));
     return vec3<i32>(i32(f2), k.x, k.y);
-}
-
-// The Vulkan LOD for isotropic filtering: λ = clamp(log2(max(ρx, ρy)), 0, max_level).
-fn texture_lod(ddx: vec2<f32>, ddy: vec2<f32>, size: vec2<f32>, max_level: f32) -> f32 {
-    let rho_x = sqrt((ddx.x * size.x) * (ddx.x * size.x) + (ddx.y * size.y) * (ddx.y * size.y));
-    let rho_y = sqrt((ddy.x * size.x) * (ddy.x * size.x) + (ddy.y * size.y) * (ddy.y * size.y));
-    let rho = max(max(rho_x, rho_y), 1e-30);
-    return clamp(log2(rho), 0.0, max(max_level, 0.0));
 }
 
 // λ of a lookup with vector d and fine derivatives ddx, ddy: (s, t)'s derivatives on d's

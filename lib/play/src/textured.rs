@@ -36,8 +36,13 @@ pub const TARGET_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
 /// Format of the depth buffer (the model's depth is f32 too).
 pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
 
-/// The WGSL source.
-pub const SHADER: &str = include_str!("textured.wgsl");
+/// The WGSL source: the texture math shared with the player's frame (`texture_lod.wgsl`,
+/// `texture_transform.wgsl`), then `textured.wgsl`.
+pub const SHADER: &str = concat!(
+    include_str!("texture_lod.wgsl"),
+    include_str!("texture_transform.wgsl"),
+    include_str!("textured.wgsl")
+);
 
 /// `Uniforms` of `textured.wgsl` (128 bytes, std140-compatible order).
 #[repr(C)]

@@ -10,9 +10,9 @@ mod common;
 use common::*;
 use pis_compile::{Address, Filter, Sampler, TextureLayout, Viewport};
 use pis_format::DisplayFilter;
+use pis_play::frame::resolve::SAMPLE_POSITIONS;
 use pis_play::frame::{offscreen_format, FramePipelines, MeshGpu, NO_OBJECT};
 use pis_play::multisample::choose;
-use pis_play::resolve::SAMPLE_POSITIONS;
 use pis_play::textured::create_sampler;
 use pis_play::{FloatImage, Gpu, ObjectTexture};
 

@@ -174,11 +174,9 @@ fn lens_terms_in_the_frame_match_the_model() {
                 .map(|((s, l), c)| (*s, *l, c.as_slice()))
                 .collect();
             let got =
-                pis_play::frame_hybrid::render_lens_term(&gpu, vp, &tess, clip, term, &shells)
-                    .unwrap();
+                pis_play::frame::render_lens_term(&gpu, vp, &tess, clip, term, &shells).unwrap();
             let again =
-                pis_play::frame_hybrid::render_lens_term(&gpu, vp, &tess, clip, term, &shells)
-                    .unwrap();
+                pis_play::frame::render_lens_term(&gpu, vp, &tess, clip, term, &shells).unwrap();
             assert!(
                 again.rgba.iter().zip(&got.rgba).all(|(a, b)| a.to_bits() == b.to_bits()),
                 "{count} shells {term:?}: two frames differ"

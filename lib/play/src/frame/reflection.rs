@@ -1,21 +1,21 @@
 //! The reflection term of an object (SPEC.md 9, thesis ch. 5) in the player's frame: the
 //! uniforms and bind group of one draw that looks up the term's environment-map shells
-//! (`frame_reflection.wgsl`, appended to `shell.wgsl`), composites them "over" and
-//! multiplies by the object's Fresnel factor. [`crate::frame`] encodes the draws.
+//! (`reflection.wgsl`, appended to `shell.wgsl`), composites them "over" and
+//! multiplies by the object's Fresnel factor. `encode.rs` encodes the draws.
 
 use bytemuck::{Pod, Zeroable};
 use wgpu::util::DeviceExt;
 
-use crate::frame::ObjectDraw;
+use super::draw::ObjectDraw;
 use crate::gpu::Gpu;
 use crate::shell::{shell_uniform, ShellTexture};
 
 /// The reflection term's entry points, appended to [`crate::shell::SHELL_FUNCTIONS`].
-pub const REFLECTION: &str = include_str!("frame_reflection.wgsl");
+pub const REFLECTION: &str = include_str!("reflection.wgsl");
 /// The most shells a reflection term draws in one pass (orders 0 and 1).
 pub const MAX_TERM_SHELLS: usize = 2;
 
-/// `ShellSlot` of `frame_reflection.wgsl` (64 bytes).
+/// `ShellSlot` of `reflection.wgsl` (64 bytes).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
 struct ShellSlot {
@@ -25,7 +25,7 @@ struct ShellSlot {
     size_levels: [u32; 4],
 }
 
-/// `ReflectionUniforms` of `frame_reflection.wgsl` (304 bytes).
+/// `ReflectionUniforms` of `reflection.wgsl` (304 bytes).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
 struct ReflectionUniforms {

@@ -8,10 +8,11 @@
 // the samples whose nearest surface is this object; the resolve averages the samples.
 //
 // The reflection term of reflective objects is drawn in the same additive pass by
-// frame_reflection.wgsl, whose vertex shader computes the clip position as `vs_main` does.
+// reflection.wgsl, whose vertex shader computes the clip position as `vs_main` does.
 //
-// `cut_uv`, `texcoord` and `texture_lod` are textured.wgsl's, character for character (a test
-// compares them): the twins of pis-compile's hardware model. Change them together.
+// `cut_uv`, `texcoord` and `texture_lod`, the twins of pis-compile's hardware model, are
+// textured.wgsl's: texture_lod.wgsl and texture_transform.wgsl, prepended at build time
+// (pipelines.rs).
 
 struct Uniforms {
     // projection · view · world of the object.
@@ -50,38 +51,6 @@ struct VsOut {
     // (s, t), interpolated perspective-correct.
     @location(0) st: vec2<f32>,
 };
-
-// The branch cuts (SPEC.md 7.3): w' = (w − w_cut) − floor(w − w_cut) along u where cut.z
-// is 1, along v where cut.w is 1; the other coordinate as it is.
-fn cut_uv(uv: vec2<f32>) -> vec2<f32> {
-    var w = uv;
-    if (u.cut.z != 0.0) {
-        let d = w.x - u.cut.x;
-        w.x = d - floor(d);
-    }
-    if (u.cut.w != 0.0) {
-        let d = w.y - u.cut.y;
-        w.y = d - floor(d);
-    }
-    return w;
-}
-
-// The cuts, then s = a·u + b·v + e, t = c·u + d·v + f.
-fn texcoord(mesh_uv: vec2<f32>) -> vec2<f32> {
-    let uv = cut_uv(mesh_uv);
-    return vec2<f32>(
-        u.affine_abcd.x * uv.x + u.affine_abcd.y * uv.y + u.affine_ef.x,
-        u.affine_abcd.z * uv.x + u.affine_abcd.w * uv.y + u.affine_ef.y,
-    );
-}
-
-// The Vulkan LOD for isotropic filtering: λ = clamp(log2(max(ρx, ρy)), 0, max_level).
-fn texture_lod(ddx: vec2<f32>, ddy: vec2<f32>, size: vec2<f32>, max_level: f32) -> f32 {
-    let rho_x = sqrt((ddx.x * size.x) * (ddx.x * size.x) + (ddx.y * size.y) * (ddx.y * size.y));
-    let rho_y = sqrt((ddy.x * size.x) * (ddy.x * size.x) + (ddy.y * size.y) * (ddy.y * size.y));
-    let rho = max(max(rho_x, rho_y), 1e-30);
-    return clamp(log2(rho), 0.0, max(max_level, 0.0));
-}
 
 // textured.wgsl's lookup: at the model's LOD, or, for anisotropic filtering, from the same
 // fine derivatives so that the adapter chooses its anisotropic footprint and LOD.

@@ -17,7 +17,7 @@ use bytemuck::{Pod, Zeroable};
 use pis_format::DisplayFilter;
 use wgpu::util::DeviceExt;
 
-use crate::frame::ID_FORMAT;
+use super::draw::ID_FORMAT;
 use crate::gpu::Gpu;
 
 /// The WGSL source.

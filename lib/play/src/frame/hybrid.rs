@@ -1,10 +1,10 @@
 //! A lens object in the player's frame (SPEC.md 9, thesis 6.4): the frame's tessellation of
 //! the object, traced on the workers ([`pis_compile::hybrid::tessellate`]), turned into one
 //! vertex buffer per term — per corner its triangle's F·G and, per shell, the cube-map
-//! vector of the outgoing ray — and drawn additively by `frame_hybrid.wgsl` (appended to
+//! vector of the outgoing ray — and drawn additively by `hybrid.wgsl` (appended to
 //! `shell.wgsl`) once per term and parameter sample, the term's shells composited "over".
 //! Both terms look up the same shells (a lens object's shells are stored in its refraction
-//! term; SPEC.md 9). [`crate::frame`] encodes the draws.
+//! term; SPEC.md 9). `encode.rs` encodes the draws.
 
 use bytemuck::{Pod, Zeroable};
 use pis_compile::hybrid::{
@@ -18,11 +18,11 @@ use crate::gpu::Gpu;
 use crate::shell::ShellTexture;
 
 /// The lens-term entry points, appended to [`crate::shell::SHELL_FUNCTIONS`].
-pub const HYBRID_FRAME: &str = include_str!("frame_hybrid.wgsl");
+pub const HYBRID_FRAME: &str = include_str!("hybrid.wgsl");
 /// The most shells a lens object's term draws in one pass.
 pub const MAX_LENS_SHELLS: usize = 4;
 
-/// `HybridFrameUniforms` of `frame_hybrid.wgsl` (160 bytes).
+/// `HybridFrameUniforms` of `hybrid.wgsl` (160 bytes).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
 struct HybridFrameUniforms {
@@ -175,79 +175,6 @@ pub fn lens_bind(gpu: &Gpu, layout: &wgpu::BindGroupLayout, draw: &LensDraw) -> 
         layout,
         entries: &entries,
     })
-}
-
-/// One term of the tessellated lens object `tess` drawn through the frame's own path
-/// ([`crate::frame::encode`], one sample per pixel): the id pass of the tessellation, then
-/// the term with `shells` (each its geometry, cube layout and RGBA texels: premultiplied
-/// colour, then alpha) at weight 1. Returns RGBA per pixel (rows from the top; alpha 1 where
-/// the term is drawn). pis-compile's [`pis_compile::hybrid::term_radiance`] is its twin.
-pub fn render_lens_term(
-    gpu: &Gpu,
-    viewport: pis_compile::Viewport,
-    tess: &Tessellation,
-    clip_from_world: glam::Mat4,
-    term: Term,
-    shells: &[(Shell, pis_compile::TextureLayout, &[f32])],
-) -> Result<crate::FloatImage, crate::PlayError> {
-    use crate::frame::{
-        colour_image, encode, offscreen_format, FramePipelines, MeshGpu, ObjectDraw, Readback,
-        Targets,
-    };
-    if shells.is_empty() || shells.len() > MAX_LENS_SHELLS {
-        return Err(crate::PlayError::Request(format!(
-            "{} shells: a lens term draws 1 to {MAX_LENS_SHELLS}",
-            shells.len()
-        )));
-    }
-    let size = (viewport.width, viewport.height);
-    let mut pipes = FramePipelines::new(gpu);
-    let mut targets = Targets::new(gpu, &pipes, size, 1)?;
-    let mut cubes = Vec::with_capacity(shells.len());
-    for (_, layout, rgba) in shells {
-        let cube = ShellTexture::new(gpu, *layout, "lens object")?;
-        cube.upload(gpu, rgba)?;
-        cubes.push(cube);
-    }
-    let geometry: Vec<Shell> = shells.iter().map(|s| s.0).collect();
-    let corners = term_corners(tess, term, &geometry);
-    let buffer = corner_buffer(gpu, &corners);
-    let positions: Vec<[f32; 3]> = tess.vertices.iter().map(|v| v.position.to_array()).collect();
-    let indices: Vec<u32> = tess.triangles.iter().flatten().copied().collect();
-    let mesh = MeshGpu::new(gpu, &positions, None, &vec![[0.0; 2]; positions.len()], &indices);
-    let objects = [ObjectDraw { object: 0, mesh: &mesh, clip_from_object: clip_from_world }];
-    let lenses = [LensDraw {
-        object: 0,
-        clip_from_world,
-        weight: 1.0,
-        corners: &buffer,
-        count: corners.len() as u32,
-        shells: cubes.iter().collect(),
-    }];
-    let format = offscreen_format(gpu);
-    let view = targets.colour.create_view(&Default::default());
-    let mut encoder = gpu
-        .device
-        .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("lens term") });
-    encode(
-        gpu,
-        &mut pipes,
-        &mut targets,
-        &view,
-        format,
-        &objects,
-        &[],
-        &[],
-        &lenses,
-        false,
-        None,
-        &mut encoder,
-    );
-    let texel = if format == wgpu::TextureFormat::Rgba16Float { 8 } else { 16 };
-    let readback = Readback::new(gpu, size, texel);
-    readback.copy(&targets.colour, &mut encoder);
-    gpu.queue.submit([encoder.finish()]);
-    Ok(colour_image(&readback.read(gpu)?, format, size))
 }
 
 #[cfg(test)]

@@ -1,0 +1,127 @@
+//! The per-size targets a frame is drawn into: object indices, depth and the offscreen
+//! colour target, and for more than one sample per pixel the multisampled attachments.
+
+use std::collections::HashMap;
+
+use super::draw::ID_FORMAT;
+use super::pipelines::FramePipelines;
+use crate::error::PlayError;
+use crate::gpu::Gpu;
+use crate::textured::DEPTH_FORMAT;
+
+/// The format offscreen frames accumulate in: `Rgba32Float` where the device can blend it,
+/// else `Rgba16Float`.
+pub fn offscreen_format(gpu: &Gpu) -> wgpu::TextureFormat {
+    if gpu.device.features().contains(wgpu::Features::FLOAT32_BLENDABLE) {
+        wgpu::TextureFormat::Rgba32Float
+    } else {
+        wgpu::TextureFormat::Rgba16Float
+    }
+}
+
+/// The multisampled attachments of a frame drawn with more than one sample per pixel: object
+/// indices and depth per sample, and colour attachments resolved into the frame's target:
+/// per target format for the hardware resolve, in the offscreen format (kept, for the shader
+/// to read) for the display-filter resolve.
+pub(super) struct SampleTargets {
+    pub(super) ids: wgpu::Texture,
+    pub(super) depth: wgpu::Texture,
+    pub(super) ids_bind: wgpu::BindGroup,
+    /// Keyed by format and whether the display-filter resolve reads it.
+    pub(super) colour: HashMap<(wgpu::TextureFormat, bool), wgpu::Texture>,
+    /// The display-filter resolve's per-pixel shared object index (made on first use).
+    pub(super) shared_ids: Option<wgpu::Texture>,
+}
+
+/// The per-size targets: object indices (one per pixel, at its centre), depth, the offscreen
+/// colour target, and with `samples` > 1 the multisampled attachments.
+pub struct Targets {
+    pub size: (u32, u32),
+    pub samples: u32,
+    pub ids: wgpu::Texture,
+    pub depth: wgpu::Texture,
+    pub colour: wgpu::Texture,
+    pub(super) ids_bind: wgpu::BindGroup,
+    pub(super) multi: Option<SampleTargets>,
+}
+
+pub(super) fn target_texture(
+    gpu: &Gpu,
+    label: &str,
+    size: (u32, u32),
+    samples: u32,
+    format: wgpu::TextureFormat,
+    usage: wgpu::TextureUsages,
+) -> wgpu::Texture {
+    gpu.device.create_texture(&wgpu::TextureDescriptor {
+        label: Some(label),
+        size: wgpu::Extent3d { width: size.0, height: size.1, depth_or_array_layers: 1 },
+        mip_level_count: 1,
+        sample_count: samples,
+        dimension: wgpu::TextureDimension::D2,
+        format,
+        usage,
+        view_formats: &[],
+    })
+}
+
+impl Targets {
+    /// Targets of `size` for frames of `samples` per pixel (1, or a count
+    /// [`crate::multisample::choose`] found supported).
+    pub fn new(
+        gpu: &Gpu,
+        pipes: &FramePipelines,
+        size: (u32, u32),
+        samples: u32,
+    ) -> Result<Targets, PlayError> {
+        let limit = gpu.limits.max_texture_dimension_2d;
+        if size.0 == 0 || size.1 == 0 || size.0 > limit || size.1 > limit {
+            return Err(PlayError::TargetSize { width: size.0, height: size.1, limit });
+        }
+        let attach = wgpu::TextureUsages::RENDER_ATTACHMENT;
+        let ids = target_texture(
+            gpu,
+            "object ids",
+            size,
+            1,
+            ID_FORMAT,
+            attach | wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_SRC,
+        );
+        let depth = target_texture(gpu, "depth", size, 1, DEPTH_FORMAT, attach);
+        let colour = target_texture(
+            gpu,
+            "frame",
+            size,
+            1,
+            offscreen_format(gpu),
+            attach | wgpu::TextureUsages::COPY_SRC,
+        );
+        let bind = |texture: &wgpu::Texture, layout, binding| {
+            let view = texture.create_view(&Default::default());
+            gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("object ids"),
+                layout,
+                entries: &[wgpu::BindGroupEntry {
+                    binding,
+                    resource: wgpu::BindingResource::TextureView(&view),
+                }],
+            })
+        };
+        let ids_bind = bind(&ids, &pipes.ids_layout, 0);
+        let multi = (samples > 1).then(|| {
+            let ids = target_texture(
+                gpu,
+                "object ids per sample",
+                size,
+                samples,
+                ID_FORMAT,
+                attach | wgpu::TextureUsages::TEXTURE_BINDING,
+            );
+            let depth =
+                target_texture(gpu, "depth per sample", size, samples, DEPTH_FORMAT, attach);
+            let ids_bind = bind(&ids, &pipes.ids_ms_layout, 1);
+            SampleTargets { ids, depth, ids_bind, colour: HashMap::new(), shared_ids: None }
+        });
+        Ok(Targets { size, samples, ids, depth, colour, ids_bind, multi })
+    }
+}
