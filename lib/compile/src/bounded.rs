@@ -58,142 +58,209 @@ pub fn minimize_bounded(
     x: &mut [f64],
     settings: &CgSettings,
 ) -> CgReport {
-    let n = x.len();
     x.iter_mut().for_each(|v| *v = v.clamp(lo, hi));
-    let mut g = vec![0.0; n];
-    let mut f = q.value_gradient(x, &mut g);
-    let mut report = CgReport { objective: vec![f], ..Default::default() };
+    let mut s = Gpcg::new(q, lo, hi, inv_diag, x, settings.max_iterations);
     // The convergence reference: the preconditioned gradient at the cold start x = 0.
-    let gz0 = {
-        let mut g0 = vec![0.0; n];
-        q.value_gradient(&vec![0.0; n], &mut g0);
-        let cold: f64 = g0.iter().zip(inv_diag).map(|(g, m)| g * g * m).sum();
-        if cold > 0.0 {
-            cold
-        } else {
-            projected_measure(x, &g, inv_diag, lo, hi)
-        }
-    };
-    let goal = settings.tolerance * settings.tolerance * gz0;
-    let (mut trial, mut g_trial) = (vec![0.0; n], vec![0.0; n]);
-    let mut d = vec![0.0; n];
-    let mut hd = vec![0.0; n];
-    'outer: while report.iterations < settings.max_iterations {
-        let measure = projected_measure(x, &g, inv_diag, lo, hi);
+    let goal = settings.tolerance * settings.tolerance * s.cold_start_measure();
+    while s.report.iterations < settings.max_iterations {
+        let measure = projected_measure(s.x, &s.g, inv_diag, lo, hi);
         if !(measure > goal) {
-            report.converged = measure.is_finite();
+            s.report.converged = measure.is_finite();
             break;
         }
-        let before = report.iterations;
+        let before = s.report.iterations;
         // 1. Gradient projection.
-        for _ in 0..PROJECTION_STEPS {
-            for i in 0..n {
-                d[i] = if held(x[i], g[i], lo, hi) { 0.0 } else { -g[i] * inv_diag[i] };
-            }
-            q.hess_mul(&d, &mut hd);
-            let (slope, curv) = (dot(&g, &d), dot(&d, &hd));
-            if !(slope < 0.0) {
-                break;
-            }
-            let mut t = if curv > 0.0 { -slope / (2.0 * curv) } else { 1.0 };
-            let mut accepted = None;
-            for _ in 0..BACKTRACKS {
-                for i in 0..n {
-                    trial[i] = (x[i] + t * d[i]).clamp(lo, hi);
-                }
-                let ft = q.value_gradient(&trial, &mut g_trial);
-                let moved: f64 =
-                    g.iter().zip(&trial).zip(x.iter()).map(|((g, t), x)| g * (t - x)).sum();
-                if ft.is_finite() && ft <= f + ARMIJO * moved && ft < f {
-                    accepted = Some(ft);
-                    break;
-                }
-                t *= 0.5;
-            }
-            let Some(ft) = accepted else { break };
-            let face_changed =
-                (0..n).any(|i| (x[i] > lo && x[i] < hi) != (trial[i] > lo && trial[i] < hi));
-            let decrease = f - ft;
-            x.copy_from_slice(&trial);
-            std::mem::swap(&mut g, &mut g_trial);
-            f = ft;
-            report.iterations += 1;
-            report.objective.push(f);
-            if report.iterations >= settings.max_iterations {
-                break 'outer;
-            }
-            // Moré–Toraldo: leave projection once the face settles or progress is small.
-            if !face_changed || decrease <= 0.25 * ARMIJO * f.abs().max(1e-300) {
-                break;
-            }
+        if s.project() {
+            break; // the iterations are spent
         }
         // 2. CG on the face: the coordinates strictly inside the box.
-        let free: Vec<bool> = x.iter().map(|&v| v > lo && v < hi).collect();
-        let mut r: Vec<f64> =
-            g.iter().zip(&free).map(|(&g, &f)| if f { -g } else { 0.0 }).collect();
-        let mut z: Vec<f64> = r.iter().zip(inv_diag).map(|(r, m)| r * m).collect();
-        let mut rz = dot(&r, &z);
-        if !(rz > 0.0) {
-            if report.iterations == before {
+        if !s.cg_on_face(goal) {
+            if s.report.iterations == before {
                 break; // nothing free and no projected step lowers f: stalled
             }
             continue;
         }
+        s.refresh();
+        if s.report.iterations == before {
+            break; // no step lowered f: stalled short of the tolerance
+        }
+    }
+    s.report
+}
+
+/// [`minimize_bounded`]'s iterate, objective, gradient and work vectors.
+struct Gpcg<'a> {
+    q: &'a dyn Quadratic,
+    lo: f64,
+    hi: f64,
+    inv_diag: &'a [f64],
+    max_iterations: u32,
+    x: &'a mut [f64],
+    f: f64,
+    g: Vec<f64>,
+    trial: Vec<f64>,
+    g_trial: Vec<f64>,
+    d: Vec<f64>,
+    hd: Vec<f64>,
+    report: CgReport,
+}
+
+impl<'a> Gpcg<'a> {
+    fn new(
+        q: &'a dyn Quadratic,
+        lo: f64,
+        hi: f64,
+        inv_diag: &'a [f64],
+        x: &'a mut [f64],
+        max_iterations: u32,
+    ) -> Self {
+        let n = x.len();
+        let mut g = vec![0.0; n];
+        let f = q.value_gradient(x, &mut g);
+        let report = CgReport { objective: vec![f], ..Default::default() };
+        let work = vec![0.0; n];
+        Gpcg {
+            q,
+            lo,
+            hi,
+            inv_diag,
+            max_iterations,
+            x,
+            f,
+            g,
+            trial: work.clone(),
+            g_trial: work.clone(),
+            d: work.clone(),
+            hd: work,
+            report,
+        }
+    }
+
+    /// Σ M⁻¹·g² at x = 0, or where that is 0 the projected measure at the start.
+    fn cold_start_measure(&self) -> f64 {
+        let n = self.x.len();
+        let mut g0 = vec![0.0; n];
+        self.q.value_gradient(&vec![0.0; n], &mut g0);
+        let cold: f64 = g0.iter().zip(self.inv_diag).map(|(g, m)| g * g * m).sum();
+        if cold > 0.0 {
+            cold
+        } else {
+            projected_measure(self.x, &self.g, self.inv_diag, self.lo, self.hi)
+        }
+    }
+
+    /// Moves to `trial` (objective `ft`, gradient `g_trial`) and counts the iteration.
+    fn accept_trial(&mut self, ft: f64) {
+        self.x.copy_from_slice(&self.trial);
+        std::mem::swap(&mut self.g, &mut self.g_trial);
+        self.f = ft;
+        self.report.iterations += 1;
+        self.report.objective.push(self.f);
+    }
+
+    /// Up to [`PROJECTION_STEPS`] projected-gradient steps with Armijo backtracking; true
+    /// when they spent the iterations.
+    fn project(&mut self) -> bool {
+        let (lo, hi, n) = (self.lo, self.hi, self.x.len());
+        for _ in 0..PROJECTION_STEPS {
+            for i in 0..n {
+                self.d[i] = if held(self.x[i], self.g[i], lo, hi) {
+                    0.0
+                } else {
+                    -self.g[i] * self.inv_diag[i]
+                };
+            }
+            self.q.hess_mul(&self.d, &mut self.hd);
+            let (slope, curv) = (dot(&self.g, &self.d), dot(&self.d, &self.hd));
+            if !(slope < 0.0) {
+                break;
+            }
+            let t = if curv > 0.0 { -slope / (2.0 * curv) } else { 1.0 };
+            let Some(ft) = self.backtrack(t) else { break };
+            let x = &*self.x;
+            let face_changed = (0..n)
+                .any(|i| (x[i] > lo && x[i] < hi) != (self.trial[i] > lo && self.trial[i] < hi));
+            let decrease = self.f - ft;
+            self.accept_trial(ft);
+            if self.report.iterations >= self.max_iterations {
+                return true;
+            }
+            // Moré–Toraldo: leave projection once the face settles or progress is small.
+            if !face_changed || decrease <= 0.25 * ARMIJO * self.f.abs().max(1e-300) {
+                break;
+            }
+        }
+        false
+    }
+
+    /// Armijo backtracking along the projected path P(x + t·d) from step `t`, halving it:
+    /// the first trial's objective that decreases enough (the trial left in `trial`).
+    fn backtrack(&mut self, mut t: f64) -> Option<f64> {
+        let (lo, hi) = (self.lo, self.hi);
+        for _ in 0..BACKTRACKS {
+            for i in 0..self.x.len() {
+                self.trial[i] = (self.x[i] + t * self.d[i]).clamp(lo, hi);
+            }
+            let ft = self.q.value_gradient(&self.trial, &mut self.g_trial);
+            let moved: f64 = (self.g.iter().zip(&self.trial).zip(self.x.iter()))
+                .map(|((g, t), x)| g * (t - x))
+                .sum();
+            if ft.is_finite() && ft <= self.f + ARMIJO * moved && ft < self.f {
+                return Some(ft);
+            }
+            t *= 0.5;
+        }
+        None
+    }
+
+    /// Preconditioned CG on the coordinates strictly inside the box, until a step reaches a
+    /// bound or the face's residual has fallen by [`FACE_REDUCTION`]; false when nothing on
+    /// the face is left to lower (no step taken).
+    fn cg_on_face(&mut self, goal: f64) -> bool {
+        let (lo, hi, n) = (self.lo, self.hi, self.x.len());
+        let free: Vec<bool> = self.x.iter().map(|&v| v > lo && v < hi).collect();
+        let mut r: Vec<f64> =
+            self.g.iter().zip(&free).map(|(&g, &f)| if f { -g } else { 0.0 }).collect();
+        let mut z: Vec<f64> = r.iter().zip(self.inv_diag).map(|(r, m)| r * m).collect();
+        let mut rz = dot(&r, &z);
+        if !(rz > 0.0) {
+            return false;
+        }
         let rz_face = rz;
-        d.copy_from_slice(&z);
-        while report.iterations < settings.max_iterations {
-            q.hess_mul(&d, &mut hd);
-            let curv = dot(&d, &hd);
+        self.d.copy_from_slice(&z);
+        while self.report.iterations < self.max_iterations {
+            self.q.hess_mul(&self.d, &mut self.hd);
+            let curv = dot(&self.d, &self.hd);
             if !(curv > 0.0) {
                 break;
             }
             // Along d: f(x + αd) = f − α·rᵀd + α²·dᵀHd (r = −g on the face), so
             // α* = rᵀd / (2·dᵀHd).
-            let rd = dot(&r, &d);
+            let rd = dot(&r, &self.d);
             let alpha_star = rd / (2.0 * curv);
-            let mut alpha_max = f64::INFINITY;
-            for i in 0..n {
-                if d[i] > 0.0 {
-                    alpha_max = alpha_max.min((hi - x[i]) / d[i]);
-                } else if d[i] < 0.0 {
-                    alpha_max = alpha_max.min((lo - x[i]) / d[i]);
-                }
-            }
+            let alpha_max = self.step_to_bound();
             let hit = alpha_star >= alpha_max;
             let alpha = if hit { alpha_max.max(0.0) } else { alpha_star };
             let change = -alpha * rd + alpha * alpha * curv;
             if !(change < 0.0) {
                 break;
             }
-            if hit {
-                // The projected full step P(x + α*·d) fixes every bound it crosses at once;
-                // taken when it lowers f below the step to the first bound.
-                for i in 0..n {
-                    trial[i] = (x[i] + alpha_star * d[i]).clamp(lo, hi);
-                }
-                let ft = q.value_gradient(&trial, &mut g_trial);
-                if ft.is_finite() && ft < f + change {
-                    x.copy_from_slice(&trial);
-                    std::mem::swap(&mut g, &mut g_trial);
-                    f = ft;
-                    report.iterations += 1;
-                    report.objective.push(f);
-                    break;
-                }
+            if hit && self.full_step_projected(alpha_star, change) {
+                break;
             }
             for i in 0..n {
-                x[i] = (x[i] + alpha * d[i]).clamp(lo, hi);
-                g[i] += 2.0 * alpha * hd[i];
+                self.x[i] = (self.x[i] + alpha * self.d[i]).clamp(lo, hi);
+                self.g[i] += 2.0 * alpha * self.hd[i];
             }
-            f += change;
-            report.iterations += 1;
-            report.objective.push(f);
+            self.f += change;
+            self.report.iterations += 1;
+            self.report.objective.push(self.f);
             if hit {
                 break;
             }
             for i in 0..n {
-                r[i] = if free[i] { -g[i] } else { 0.0 };
-                z[i] = r[i] * inv_diag[i];
+                r[i] = if free[i] { -self.g[i] } else { 0.0 };
+                z[i] = r[i] * self.inv_diag[i];
             }
             let rz_new = dot(&r, &z);
             if rz_new <= FACE_REDUCTION * FACE_REDUCTION * rz_face || rz_new <= goal {
@@ -201,23 +268,50 @@ pub fn minimize_bounded(
             }
             let beta = rz_new / rz;
             for i in 0..n {
-                d[i] = z[i] + beta * d[i];
+                self.d[i] = z[i] + beta * self.d[i];
             }
             rz = rz_new;
         }
-        // The running gradient drifts; start each outer iteration from an exact one.
-        let fresh = q.value_gradient(x, &mut g);
-        if fresh.is_finite() && fresh <= f * (1.0 + 1e-12) + 1e-300 {
-            f = fresh;
-            if let Some(last) = report.objective.last_mut() {
-                *last = last.min(f);
+        true
+    }
+
+    /// The largest α with x + α·d inside the box.
+    fn step_to_bound(&self) -> f64 {
+        let mut alpha_max = f64::INFINITY;
+        for (x, d) in self.x.iter().zip(&self.d) {
+            if *d > 0.0 {
+                alpha_max = alpha_max.min((self.hi - x) / d);
+            } else if *d < 0.0 {
+                alpha_max = alpha_max.min((self.lo - x) / d);
             }
         }
-        if report.iterations == before {
-            break; // no step lowered f: stalled short of the tolerance
+        alpha_max
+    }
+
+    /// The projected full step P(x + α*·d) fixes every bound it crosses at once; taken (and
+    /// true returned) when it lowers f below the step to the first bound, f + `change`.
+    fn full_step_projected(&mut self, alpha_star: f64, change: f64) -> bool {
+        for i in 0..self.x.len() {
+            self.trial[i] = (self.x[i] + alpha_star * self.d[i]).clamp(self.lo, self.hi);
+        }
+        let ft = self.q.value_gradient(&self.trial, &mut self.g_trial);
+        if ft.is_finite() && ft < self.f + change {
+            self.accept_trial(ft);
+            return true;
+        }
+        false
+    }
+
+    /// The running gradient drifts; each outer iteration starts from an exact one.
+    fn refresh(&mut self) {
+        let fresh = self.q.value_gradient(self.x, &mut self.g);
+        if fresh.is_finite() && fresh <= self.f * (1.0 + 1e-12) + 1e-300 {
+            self.f = fresh;
+            if let Some(last) = self.report.objective.last_mut() {
+                *last = last.min(self.f);
+            }
         }
     }
-    report
 }
 
 #[cfg(test)]
