@@ -115,6 +115,66 @@ pub fn optimize_placement(
     settings: &TexcoordSettings,
 ) -> Result<TexturePlacement, CompileError> {
     let fail = |message: String| CompileError::Geometry { object: mesh.name.to_string(), message };
+    check_inputs(mesh, views, settings)?;
+
+    // Step 1: branch cuts.
+    let Cut { cut, repeat, uvs, per_view } = cut_branches(mesh, views);
+    let edges: Vec<_> = per_view.iter().flat_map(|(e, _)| e.iter().copied()).collect();
+    if edges.is_empty() {
+        return Ok(TexturePlacement {
+            affine: [1.0, 0.0, 0.0, 1.0, 0.0, 0.0],
+            width: 1,
+            height: 1,
+            repeat,
+            branch_cut: cut,
+            stretch: 0.0,
+            visible_edges: 0,
+            reduction: settings.reduction,
+            covered_pixels: 0,
+        });
+    }
+
+    // Step 2: the most isometric linear map.
+    let scale_only = repeat[0] || repeat[1];
+    let r = most_isometric_map(&edges, scale_only);
+
+    // Steps 3–4: scale until the stretch is under the threshold at every covered pixel.
+    let jacobians = stretch_envelopes(mesh, views, &uvs);
+    let (r, stretch) = stretch::limit_stretch(r, &jacobians, settings.max_stretch, scale_only);
+
+    // Step 5: the minimum-area rectangle (no rotation when a dimension wraps).
+    let (m, lo, hi) = bounding_rectangle(&edges, r, repeat, settings.directions);
+
+    // Step 6: the used resolution, reduced to the texel budget.
+    let ext = hi - lo;
+    let covered_pixels = per_view.iter().map(|&(_, covered)| covered).max().unwrap_or(0);
+    let (width, height, reduction) = used_resolution(ext, covered_pixels, repeat, settings);
+    let affine = affine_of(m, lo, ext, repeat);
+    let det = affine[0] * affine[3] - affine[1] * affine[2];
+    if !(det.is_finite() && det != 0.0) {
+        return Err(fail(format!("degenerate texture transform (determinant {det})")));
+    }
+    Ok(TexturePlacement {
+        affine: affine.map(|v| v as f32),
+        width,
+        height,
+        repeat,
+        branch_cut: cut,
+        stretch,
+        visible_edges: edges.len(),
+        reduction,
+        covered_pixels,
+    })
+}
+
+/// Indices within the mesh, one clip-space vertex per texture coordinate in every view, all
+/// finite, and settings in range.
+fn check_inputs(
+    mesh: &ObjectMesh<'_>,
+    views: &[ViewGeometry],
+    settings: &TexcoordSettings,
+) -> Result<(), CompileError> {
+    let fail = |message: String| CompileError::Geometry { object: mesh.name.to_string(), message };
     if mesh.indices.len() % 3 != 0 {
         return Err(fail(format!(
             "{} indices is not a whole number of triangles",
@@ -142,11 +202,24 @@ pub fn optimize_placement(
     if settings.texels_per_pixel.is_some_and(|k| !(k > 0.0 && k.is_finite())) {
         return Err(CompileError::Setting("the texel budget per pixel must be > 0".into()));
     }
+    Ok(())
+}
 
-    // Step 1: branch cuts, from the visible edges' extents in the original coordinates. Each
-    // view's edges are kept, and the pixels it covers counted; its triangle-id buffer (one
-    // entry per pixel) is not: steps 3–4 rasterize each view again, one at a time, so that
-    // memory does not grow with the number of views.
+/// Step 1's result: the cut along u and v, where one was made; whether a dimension wraps;
+/// the texture coordinates after the cuts; and each view's visible edges in them, with the
+/// pixels it covers.
+struct Cut {
+    cut: [Option<f64>; 2],
+    repeat: [bool; 2],
+    uvs: Vec<Vec2>,
+    per_view: Vec<(Vec<edges::VisibleEdge>, usize)>,
+}
+
+/// Step 1: branch cuts, from the visible edges' extents in the original coordinates. Each
+/// view's edges are kept, and the pixels it covers counted; its triangle-id buffer (one
+/// entry per pixel) is not: steps 3–4 rasterize each view again, one at a time, so that
+/// memory does not grow with the number of views.
+fn cut_branches(mesh: &ObjectMesh<'_>, views: &[ViewGeometry]) -> Cut {
     let edges_of = |uvs: &[Vec2]| -> Vec<(Vec<edges::VisibleEdge>, usize)> {
         views
             .iter()
@@ -194,23 +267,12 @@ pub fn optimize_placement(
         })
         .collect();
     let per_view = if cut.iter().any(Option::is_some) { edges_of(&uvs) } else { first };
-    let edges: Vec<_> = per_view.iter().flat_map(|(e, _)| e.iter().copied()).collect();
-    if edges.is_empty() {
-        return Ok(TexturePlacement {
-            affine: [1.0, 0.0, 0.0, 1.0, 0.0, 0.0],
-            width: 1,
-            height: 1,
-            repeat,
-            branch_cut: cut,
-            stretch: 0.0,
-            visible_edges: 0,
-            reduction: settings.reduction,
-            covered_pixels: 0,
-        });
-    }
+    Cut { cut, repeat, uvs, per_view }
+}
 
-    // Step 2: the most isometric linear map.
-    let scale_only = repeat[0] || repeat[1];
+/// Step 2: the most isometric linear map of the visible edges (eq. 3.1), a scale only
+/// when a dimension wraps.
+fn most_isometric_map(edges: &[edges::VisibleEdge], scale_only: bool) -> DMat2 {
     let terms: Vec<EdgeTerm> = edges
         .iter()
         .map(|e| EdgeTerm {
@@ -220,10 +282,12 @@ pub fn optimize_placement(
         })
         .collect();
     let r = isometry::most_isometric(&terms, scale_only);
-    let r = DMat2::from_cols(DVec2::new(r[0], r[2]), DVec2::new(r[1], r[3]));
+    DMat2::from_cols(DVec2::new(r[0], r[2]), DVec2::new(r[1], r[3]))
+}
 
-    // Steps 3–4: scale until the stretch is under the threshold at every covered pixel, of
-    // which each view keeps those that can be the most stretched.
+/// Steps 3–4's input: the texture→screen Jacobians at the covered pixels of every view, of
+/// which each view keeps those that can be the most stretched.
+fn stretch_envelopes(mesh: &ObjectMesh<'_>, views: &[ViewGeometry], uvs: &[Vec2]) -> Vec<DMat2> {
     let mut jacobians = Vec::new();
     let mut in_view = Vec::new();
     for view in views {
@@ -244,15 +308,23 @@ pub fn optimize_placement(
         }
         jacobians.extend(stretch::envelope(&in_view));
     }
-    let (r, stretch) = stretch::limit_stretch(r, &jacobians, settings.max_stretch, scale_only);
+    jacobians
+}
 
-    // Step 5: the minimum-area rectangle (no rotation when a dimension wraps).
+/// Step 5: the map `r` turned by the minimum-area rectangle of the mapped edges (not turned
+/// when a dimension wraps, which keeps one whole period), with the rectangle's corners.
+fn bounding_rectangle(
+    edges: &[edges::VisibleEdge],
+    r: DMat2,
+    repeat: [bool; 2],
+    directions: u32,
+) -> (DMat2, DVec2, DVec2) {
     let points: Vec<DVec2> = edges.iter().flat_map(|e| [r * e.uv[0], r * e.uv[1]]).collect();
-    let (theta, mut lo, mut hi) = if scale_only {
+    let (theta, mut lo, mut hi) = if repeat[0] || repeat[1] {
         let (lo, hi) = bounding::bounds(&points, 0.0);
         (0.0, lo, hi)
     } else {
-        bounding::min_area_rectangle(&points, settings.directions)
+        bounding::min_area_rectangle(&points, directions)
     };
     let m = DMat2::from_angle(-theta) * r;
     for dim in 0..2 {
@@ -263,10 +335,17 @@ pub fn optimize_placement(
             hi[dim] = k;
         }
     }
+    (m, lo, hi)
+}
 
-    // Step 6: the used resolution, reduced to the texel budget.
-    let ext = hi - lo;
-    let covered_pixels = per_view.iter().map(|&(_, covered)| covered).max().unwrap_or(0);
+/// Step 6: the used width and height for the extent `ext` in texels, and the reduction
+/// factor applied: the settings', times the texel budget's for `covered_pixels`.
+fn used_resolution(
+    ext: DVec2,
+    covered_pixels: usize,
+    repeat: [bool; 2],
+    settings: &TexcoordSettings,
+) -> (u32, u32, f64) {
     let mut reduction = settings.reduction;
     if let Some(k) = settings.texels_per_pixel {
         let texels = ext.x.max(1.0) * ext.y.max(1.0) * reduction * reduction;
@@ -290,6 +369,12 @@ pub fn optimize_placement(
             };
         }
     }
+    (width, height, reduction)
+}
+
+/// [a, b, c, d, e, f] of SPEC.md 7.3: the rows of `m` and the offset `−lo`, over the extent;
+/// s = u (or t = v) along a wrapped dimension.
+fn affine_of(m: DMat2, lo: DVec2, ext: DVec2, repeat: [bool; 2]) -> [f64; 6] {
     let mut affine = [0.0f64; 6];
     for dim in 0..2 {
         let e = if ext[dim] > 1e-12 { ext[dim] } else { 1.0 };
@@ -302,21 +387,7 @@ pub fn optimize_placement(
         affine[2 * dim + 1] = m.col(1)[dim] / e;
         affine[4 + dim] = -lo[dim] / e;
     }
-    let det = affine[0] * affine[3] - affine[1] * affine[2];
-    if !(det.is_finite() && det != 0.0) {
-        return Err(fail(format!("degenerate texture transform (determinant {det})")));
-    }
-    Ok(TexturePlacement {
-        affine: affine.map(|v| v as f32),
-        width,
-        height,
-        repeat,
-        branch_cut: cut,
-        stretch,
-        visible_edges: edges.len(),
-        reduction,
-        covered_pixels,
-    })
+    affine
 }
 
 #[cfg(test)]
