@@ -34,7 +34,11 @@ pub fn antialias(
         && filter.sigma_px.is_finite()
         && filter.radius_px > 0.0
         && filter.radius_px.is_finite());
-    if bad || factor == 0 || supersampled.width % factor != 0 || supersampled.height % factor != 0 {
+    if bad
+        || factor == 0
+        || !supersampled.width.is_multiple_of(factor)
+        || !supersampled.height.is_multiple_of(factor)
+    {
         return Err(ModelError::Filter {
             sigma: filter.sigma_px,
             radius: filter.radius_px,

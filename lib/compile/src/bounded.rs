@@ -267,8 +267,8 @@ impl<'a> Gpcg<'a> {
                 break;
             }
             let beta = rz_new / rz;
-            for i in 0..n {
-                self.d[i] = z[i] + beta * self.d[i];
+            for (d, z) in self.d.iter_mut().zip(&z) {
+                *d = z + beta * *d;
             }
             rz = rz_new;
         }

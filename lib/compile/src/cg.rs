@@ -119,7 +119,7 @@ pub fn minimize(
         f += delta;
         report.iterations += 1;
         report.objective.push(f);
-        if settings.refresh_every > 0 && report.iterations % settings.refresh_every == 0 {
+        if settings.refresh_every > 0 && report.iterations.is_multiple_of(settings.refresh_every) {
             q.value_gradient(x, &mut gq);
         }
         let g_new = full_grad(&gq, x);

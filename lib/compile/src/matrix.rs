@@ -113,10 +113,10 @@ impl RenderMatrix {
     /// y = Aᵀ·x, summed in row order (deterministic).
     pub fn mul_t(&self, x: &[f32], y: &mut [f32]) {
         y.iter_mut().for_each(|v| *v = 0.0);
-        for r in 0..self.rows() {
+        for (r, &xr) in x[..self.rows()].iter().enumerate() {
             let (c, v) = self.row(r);
             for (&c, &v) in c.iter().zip(v) {
-                y[c as usize] += v * x[r];
+                y[c as usize] += v * xr;
             }
         }
     }

@@ -44,7 +44,7 @@ pub fn check_mesh(mesh: &DrawMesh) -> Result<(), ModelError> {
     if mesh.uvs.len() != mesh.positions.len() {
         return Err(ModelError::Uvs { positions: mesh.positions.len(), uvs: mesh.uvs.len() });
     }
-    if mesh.indices.len() % 3 != 0 {
+    if !mesh.indices.len().is_multiple_of(3) {
         return Err(ModelError::IndexCount(mesh.indices.len()));
     }
     if let Some((at, &index)) =

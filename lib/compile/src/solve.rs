@@ -197,8 +197,11 @@ enum Pixels<'a> {
     /// Per channel, held with the operator.
     Held(Vec<Vec<f64>>),
     /// Read again from the views: per channel, the residual of the channels' texels.
-    Read(&'a dyn Fn(&[&[f64]]) -> Result<Vec<f64>, CompileError>),
+    Read(&'a Residual2<'a>),
 }
+
+/// Per channel, ‖Ax − b‖² of the channels' texels x.
+type Residual2<'a> = dyn Fn(&[&[f64]]) -> Result<Vec<f64>, CompileError> + 'a;
 
 /// A solve's data term: the operator, its right-hand side per channel, and what the
 /// preconditioner and the regularization read of it.

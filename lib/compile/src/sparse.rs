@@ -221,10 +221,10 @@ mod tests {
         let g = m.gram(&mt);
         // MᵀM = [[1 2 0], [2 13 12], [0 12 16]]
         let mut dense = [[0.0; 3]; 3];
-        for i in 0..3 {
+        for (i, row) in dense.iter_mut().enumerate() {
             let (c, v) = g.row(i);
             for (&c, &v) in c.iter().zip(v) {
-                dense[i][c as usize] = v;
+                row[c as usize] = v;
             }
         }
         assert_eq!(dense, [[1.0, 2.0, 0.0], [2.0, 13.0, 12.0], [0.0, 12.0, 16.0]]);

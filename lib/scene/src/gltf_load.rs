@@ -125,7 +125,7 @@ fn convert(
         .or_else(|| doc.scenes().next())
         .ok_or_else(|| SceneError::invalid(path, "scenes", "the glTF has no scene"))?;
     let (mut rig, rig_index) = read_nodes(path, &scene)?;
-    let (mut materials, textures, mut warnings) = read_materials(path, doc, images)?;
+    let Materials { mut materials, textures, mut warnings } = read_materials(path, doc, images)?;
 
     // The scene's nodes with their index in the rig, in glTF node order.
     let gltf_nodes: Vec<gltf::Node> = doc.nodes().collect();
@@ -183,13 +183,20 @@ fn read_nodes(
     Ok((rig, rig_index))
 }
 
-/// Materials in glTF order with the textures they read, and the warnings so far: the
-/// extensions PIS does not implement, then what reading the textures found.
+/// The glTF's materials in its order with the textures they read, and the warnings so far:
+/// the extensions PIS does not implement, then what reading the textures found.
+struct Materials {
+    materials: Vec<Material>,
+    textures: Vec<TextureImage>,
+    warnings: Vec<String>,
+}
+
+/// Reads the [`Materials`].
 fn read_materials(
     path: &Path,
     doc: &gltf::Document,
     images: &[gltf::image::Data],
-) -> Result<(Vec<Material>, Vec<TextureImage>, Vec<String>), SceneError> {
+) -> Result<Materials, SceneError> {
     let mut texture_set = TextureSet::new(path, images);
     let mut materials = Vec::new();
     for m in doc.materials() {
@@ -205,7 +212,7 @@ fn read_materials(
             }),
         ));
     warnings.extend(texture_warnings);
-    Ok((materials, textures, warnings))
+    Ok(Materials { materials, textures, warnings })
 }
 
 impl Ctx<'_> {

@@ -259,10 +259,10 @@ fn loads_binary_gltf() {
     let mut bin = std::fs::read(dir.join("scene.bin")).unwrap();
     doc["buffers"][0].as_object_mut().unwrap().remove("uri");
     let mut json = serde_json::to_vec(&doc).unwrap();
-    while json.len() % 4 != 0 {
+    while !json.len().is_multiple_of(4) {
         json.push(b' ');
     }
-    while bin.len() % 4 != 0 {
+    while !bin.len().is_multiple_of(4) {
         bin.push(0);
     }
     let total = 12 + 8 + json.len() + 8 + bin.len();
@@ -721,6 +721,6 @@ fn more_points_than_a_file_holds_are_refused_at_load() {
 fn a_resolution_over_the_file_limit_is_refused_at_load() {
     let f = Fixture::new(TOML, |_, _| {});
     let options = LoadOptions { resolution: Some((70000, 10)), ..LoadOptions::default() };
-    let e = load_with(&f.toml(), &options).err().expect("refused").to_string();
+    let e = load_with(&f.toml(), &options).expect_err("refused").to_string();
     assert!(e.contains("70000x10: a .pis file holds images of at most 65536 pixels a side"), "{e}");
 }

@@ -148,7 +148,7 @@ impl GltfWriter {
     }
 
     fn view(&mut self, bytes: &[u8], target: Option<u32>) -> usize {
-        while self.bin.len() % 4 != 0 {
+        while !self.bin.len().is_multiple_of(4) {
             self.bin.push(0);
         }
         let mut v = json!({"buffer": 0, "byteOffset": self.bin.len(), "byteLength": bytes.len()});
@@ -356,7 +356,7 @@ impl GltfWriter {
 
     /// Writes `dir/NAME.gltf` and `dir/NAME.bin`.
     pub fn write(mut self, dir: &Path, name: &str) -> io::Result<()> {
-        while self.bin.len() % 4 != 0 {
+        while !self.bin.len().is_multiple_of(4) {
             self.bin.push(0);
         }
         let mut doc = json!({

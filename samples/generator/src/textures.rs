@@ -15,7 +15,7 @@ fn save(img: &RgbImage, path: &Path) -> io::Result<()> {
 pub fn checker(path: &Path, size: u32, checks: u32, a: [u8; 3], b: [u8; 3]) -> io::Result<()> {
     let cell = (size / checks).max(1);
     let img = RgbImage::from_fn(size, size, |x, y| {
-        if ((x / cell) + (y / cell)) % 2 == 0 {
+        if ((x / cell) + (y / cell)).is_multiple_of(2) {
             Rgb(a)
         } else {
             Rgb(b)
@@ -32,7 +32,7 @@ pub fn wallpaper(path: &Path, size: u32, stripes: u32, a: [u8; 3], b: [u8; 3]) -
         let k = x % width;
         if k == 0 {
             Rgb([a[0] / 2, a[1] / 2, a[2] / 2])
-        } else if (x / width) % 2 == 0 {
+        } else if (x / width).is_multiple_of(2) {
             Rgb(a)
         } else {
             Rgb(b)

@@ -79,10 +79,10 @@ pub fn beyond(x: i64, n: u32) -> bool {
 /// coordinates beyond the face) at (i0, j0), or 0 when none is.
 pub fn bilinear_corner(i0: i64, j0: i64, n: u32, wi: [f64; 2], wj: [f64; 2]) -> f64 {
     let mut w = 0.0;
-    for dj in 0..2 {
-        for di in 0..2 {
+    for (dj, &w_j) in wj.iter().enumerate() {
+        for (di, &w_i) in wi.iter().enumerate() {
             if beyond(i0 + di as i64, n) && beyond(j0 + dj as i64, n) {
-                w = wi[di] * wj[dj];
+                w = w_i * w_j;
             }
         }
     }
@@ -139,14 +139,14 @@ pub fn cube_bilinear(layout: &TextureLayout, d: DVec3, m: u32, scale: f64, taps:
     let wi = [1.0 - a, a];
     let wj = [1.0 - b, b];
     let third = bilinear_corner(i0, j0, n, wi, wj) / 3.0;
-    for dj in 0..2 {
-        for di in 0..2 {
+    for (dj, &w_j) in wj.iter().enumerate() {
+        for (di, &w_i) in wi.iter().enumerate() {
             let (i, j) = (i0 + di as i64, j0 + dj as i64);
             if beyond(i, n) && beyond(j, n) {
                 continue;
             }
             let (f, ti, tj) = cube_texel(face, i, j, n);
-            taps.add(layout.face_texel(f, m, ti, tj) as u32, scale * (wi[di] * wj[dj] + third));
+            taps.add(layout.face_texel(f, m, ti, tj) as u32, scale * (w_i * w_j + third));
         }
     }
 }

@@ -75,7 +75,7 @@ fn check(viewport: Viewport, o: &ShellObject) -> Result<(), ModelError> {
     if o.normals.len() != o.positions.len() {
         return Err(ModelError::Uvs { positions: o.positions.len(), uvs: o.normals.len() });
     }
-    if o.indices.len() % 3 != 0 {
+    if !o.indices.len().is_multiple_of(3) {
         return Err(ModelError::IndexCount(o.indices.len()));
     }
     if let Some((at, &index)) =

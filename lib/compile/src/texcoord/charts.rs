@@ -324,7 +324,7 @@ mod tests {
     #[test]
     fn overlapping_visible_charts_are_laid_out_apart() {
         let (uvs, idx, view) = two_quads(true);
-        let new = separate_overlapping_charts(&uvs, &idx, &[view.clone()])
+        let new = separate_overlapping_charts(&uvs, &idx, std::slice::from_ref(&view))
             .expect("the quads overlap in (u, v)");
         // The two quads' (u, v) bounds no longer intersect.
         let bounds = |q: usize| {
@@ -377,7 +377,7 @@ mod tests {
         let (uvs, idx, view) = mirrored_quads();
         // One chart, so the overlap between charts alone finds nothing.
         assert_eq!(charts(&idx, uvs.len()).1, 1);
-        assert_eq!(separate_overlapping_charts(&uvs, &idx, &[view.clone()]), None);
+        assert_eq!(separate_overlapping_charts(&uvs, &idx, std::slice::from_ref(&view)), None);
         let u = unfold_charts(&uvs, &idx).expect("the chart folds at the shared edge");
         // The shared edge's two vertices are copied for the mirrored quad, nothing else.
         assert_eq!(u.copies, vec![1, 2]);
@@ -417,7 +417,7 @@ mod tests {
         // texels per unit of (u, v).
         let (mut uvs, idx, view) = two_quads(true);
         uvs[4..].iter_mut().for_each(|v| *v = Vec2::new(2.0, 0.0) + *v / 16.0);
-        let new = separate_overlapping_charts(&uvs, &idx, &[view.clone()])
+        let new = separate_overlapping_charts(&uvs, &idx, std::slice::from_ref(&view))
             .expect("the densities differ 16 times");
         let side = |q: usize| new[q * 4 + 1].x - new[q * 4].x;
         // Same screen size, so the same size in the atlas.

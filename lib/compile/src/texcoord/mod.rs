@@ -175,7 +175,7 @@ fn check_inputs(
     settings: &TexcoordSettings,
 ) -> Result<(), CompileError> {
     let fail = |message: String| CompileError::Geometry { object: mesh.name.to_string(), message };
-    if mesh.indices.len() % 3 != 0 {
+    if !mesh.indices.len().is_multiple_of(3) {
         return Err(fail(format!(
             "{} indices is not a whole number of triangles",
             mesh.indices.len()

@@ -28,14 +28,13 @@ pub fn write_all(root: &Path) -> io::Result<()> {
 const LICENCE: &str =
     "# Licence: the project's own scene (generated here, no outside assets), under the project's licence.\n";
 
-/// A node (not a scene root) with an optional mesh and transform.
+/// A node with an optional mesh and its transform (translation, rotation, scale); a scene
+/// root when `root`.
 fn node(
     w: &mut GltfWriter,
     name: &str,
     mesh: Option<usize>,
-    translation: Vec3,
-    rotation: Quat,
-    scale: Vec3,
+    (translation, rotation, scale): (Vec3, Quat, Vec3),
     children: Vec<usize>,
     root: bool,
 ) -> usize {
@@ -55,7 +54,7 @@ fn node(
 
 /// A mesh node at `translation` (child of some group).
 fn leaf(w: &mut GltfWriter, name: &str, mesh: usize, translation: Vec3) -> usize {
-    node(w, name, Some(mesh), translation, Quat::IDENTITY, Vec3::ONE, vec![], false)
+    node(w, name, Some(mesh), (translation, Quat::IDENTITY, Vec3::ONE), vec![], false)
 }
 
 fn smoothstep(e0: f32, e1: f32, x: f32) -> f32 {
@@ -190,9 +189,7 @@ fn cm_export(dir: &Path) -> io::Result<()> {
         &mut w,
         "Bookend_R",
         Some(bookend),
-        Vec3::new(14.0, 0.0, 0.0),
-        Quat::IDENTITY,
-        Vec3::new(-1.0, 1.0, 1.0),
+        (Vec3::new(14.0, 0.0, 0.0), Quat::IDENTITY, Vec3::new(-1.0, 1.0, 1.0)),
         vec![],
         false,
     );
@@ -202,9 +199,7 @@ fn cm_export(dir: &Path) -> io::Result<()> {
         &mut w,
         "GlobePivot",
         None,
-        Vec3::new(26.0, 0.0, 16.0),
-        Quat::from_rotation_y(0.6),
-        Vec3::ONE,
+        (Vec3::new(26.0, 0.0, 16.0), Quat::from_rotation_y(0.6), Vec3::ONE),
         vec![globe_node],
         false,
     );
@@ -212,9 +207,7 @@ fn cm_export(dir: &Path) -> io::Result<()> {
         &mut w,
         "Shelf",
         None,
-        Vec3::ZERO,
-        Quat::from_rotation_y(-0.3),
-        Vec3::ONE,
+        (Vec3::ZERO, Quat::from_rotation_y(-0.3), Vec3::ONE),
         vec![left, right, books_node, pivot],
         false,
     );
@@ -222,9 +215,7 @@ fn cm_export(dir: &Path) -> io::Result<()> {
         &mut w,
         "RootNode",
         None,
-        Vec3::ZERO,
-        Quat::IDENTITY,
-        Vec3::splat(0.01),
+        (Vec3::ZERO, Quat::IDENTITY, Vec3::splat(0.01)),
         vec![floor_node, shelf],
         true,
     );
@@ -395,9 +386,7 @@ fn pbr_props(dir: &Path) -> io::Result<()> {
         &mut w,
         "Crate",
         Some(crate_mesh),
-        Vec3::new(0.15, 0.2, 0.1),
-        Quat::from_rotation_y(0.5),
-        Vec3::ONE,
+        (Vec3::new(0.15, 0.2, 0.1), Quat::from_rotation_y(0.5), Vec3::ONE),
         vec![],
         false,
     );
@@ -405,9 +394,7 @@ fn pbr_props(dir: &Path) -> io::Result<()> {
         &mut w,
         "CrateSmall",
         Some(crate_mesh),
-        Vec3::new(-0.3, 0.1, 0.25),
-        Quat::from_rotation_y(-0.3),
-        Vec3::splat(0.5),
+        (Vec3::new(-0.3, 0.1, 0.25), Quat::from_rotation_y(-0.3), Vec3::splat(0.5)),
         vec![],
         false,
     );
@@ -416,9 +403,7 @@ fn pbr_props(dir: &Path) -> io::Result<()> {
         &mut w,
         "Sign",
         Some(sign_mesh),
-        Vec3::new(0.0, 0.55, -0.32),
-        Quat::from_rotation_x(-0.1),
-        Vec3::ONE,
+        (Vec3::new(0.0, 0.55, -0.32), Quat::from_rotation_x(-0.1), Vec3::ONE),
         vec![],
         false,
     );
@@ -427,9 +412,7 @@ fn pbr_props(dir: &Path) -> io::Result<()> {
         &mut w,
         "Props",
         None,
-        Vec3::ZERO,
-        Quat::IDENTITY,
-        Vec3::ONE,
+        (Vec3::ZERO, Quat::IDENTITY, Vec3::ONE),
         vec![floor, panel, sign, crate_node, small],
         true,
     );
@@ -528,9 +511,7 @@ fn glass_shelf(dir: &Path) -> io::Result<()> {
             &mut w,
             "Cube",
             Some(cube),
-            Vec3::new(0.0, 0.06, -0.1),
-            Quat::from_rotation_y(0.7),
-            Vec3::ONE,
+            (Vec3::new(0.0, 0.06, -0.1), Quat::from_rotation_y(0.7), Vec3::ONE),
             vec![],
             false,
         ),
@@ -541,9 +522,7 @@ fn glass_shelf(dir: &Path) -> io::Result<()> {
         &mut w,
         "Scene_Root",
         None,
-        Vec3::new(0.0, 0.5, 0.0),
-        Quat::IDENTITY,
-        Vec3::ONE,
+        (Vec3::new(0.0, 0.5, 0.0), Quat::IDENTITY, Vec3::ONE),
         nodes,
         true,
     );
@@ -645,9 +624,7 @@ fn still_life(dir: &Path) -> io::Result<()> {
         &mut w,
         "TableTop",
         Some(unit_box),
-        Vec3::new(0.0, 0.05, 0.0),
-        Quat::IDENTITY,
-        Vec3::new(0.7, 0.1, 0.45),
+        (Vec3::new(0.0, 0.05, 0.0), Quat::IDENTITY, Vec3::new(0.7, 0.1, 0.45)),
         vec![],
         false,
     );
@@ -656,9 +633,7 @@ fn still_life(dir: &Path) -> io::Result<()> {
         &mut w,
         "Apple",
         Some(fruit_mesh),
-        Vec3::new(0.1, 0.135, 0.1),
-        Quat::IDENTITY,
-        Vec3::new(1.0, 0.85, 1.0),
+        (Vec3::new(0.1, 0.135, 0.1), Quat::IDENTITY, Vec3::new(1.0, 0.85, 1.0)),
         vec![],
         false,
     );
@@ -666,9 +641,7 @@ fn still_life(dir: &Path) -> io::Result<()> {
         &mut w,
         "Pear",
         Some(fruit_mesh),
-        Vec3::new(0.2, 0.14, 0.02),
-        Quat::from_rotation_z(0.4),
-        Vec3::new(0.8, 1.2, 0.8),
+        (Vec3::new(0.2, 0.14, 0.02), Quat::from_rotation_z(0.4), Vec3::new(0.8, 1.2, 0.8)),
         vec![],
         false,
     );
@@ -676,9 +649,7 @@ fn still_life(dir: &Path) -> io::Result<()> {
         &mut w,
         "Ring",
         Some(ring_mesh),
-        Vec3::new(0.05, 0.115, -0.12),
-        Quat::from_rotation_x(0.25),
-        Vec3::ONE,
+        (Vec3::new(0.05, 0.115, -0.12), Quat::from_rotation_x(0.25), Vec3::ONE),
         vec![],
         false,
     );
@@ -686,9 +657,7 @@ fn still_life(dir: &Path) -> io::Result<()> {
         &mut w,
         "Bowl",
         Some(bowl_mesh),
-        Vec3::new(0.16, 0.1, 0.06),
-        Quat::IDENTITY,
-        Vec3::new(1.0, 0.6, 1.0),
+        (Vec3::new(0.16, 0.1, 0.06), Quat::IDENTITY, Vec3::new(1.0, 0.6, 1.0)),
         vec![],
         false,
     );
@@ -696,9 +665,7 @@ fn still_life(dir: &Path) -> io::Result<()> {
         &mut w,
         "StillLife",
         None,
-        Vec3::ZERO,
-        Quat::from_rotation_y(30f32.to_radians()),
-        Vec3::splat(1.25),
+        (Vec3::ZERO, Quat::from_rotation_y(30f32.to_radians()), Vec3::splat(1.25)),
         vec![top, vase_node, apple, pear, ring, bowl],
         false,
     );
@@ -707,9 +674,7 @@ fn still_life(dir: &Path) -> io::Result<()> {
         &mut w,
         "Root",
         None,
-        Vec3::ZERO,
-        Quat::IDENTITY,
-        Vec3::ONE,
+        (Vec3::ZERO, Quat::IDENTITY, Vec3::ONE),
         vec![ground_node, group],
         true,
     );
