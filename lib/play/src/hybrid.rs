@@ -13,7 +13,7 @@ use wgpu::util::DeviceExt;
 use crate::error::PlayError;
 use crate::gpu::Gpu;
 use crate::image::FloatImage;
-use crate::shell::{object_pipelines, ShellTexture};
+use crate::shell::{check_viewport, object_pipelines, ShellTexture};
 use crate::textured::{DEPTH_FORMAT, TARGET_FORMAT};
 
 /// The hybrid pipeline's entry points.
@@ -50,8 +50,8 @@ impl HybridPipeline {
 }
 
 /// Draws the tessellation `tess` (world positions, `clip_from_world`) with one shell's cube
-/// map `rgba` (4 values per texel of `layout`) looked up along the per-vertex cube vectors
-/// `vectors` of one term; returns RGBA per pixel (rows from the top), alpha 1 where the
+/// map (its layout, and 4 values per texel: RGBA) looked up along the per-vertex cube
+/// vectors `vectors` of one term; returns RGBA per pixel (rows from the top), alpha 1 where the
 /// term is drawn. Triangles without the term write depth only.
 pub fn render_hybrid(
     gpu: &Gpu,
@@ -60,21 +60,9 @@ pub fn render_hybrid(
     tess: &Tessellation,
     clip_from_world: Mat4,
     vectors: &[Option<[f32; 3]>],
-    layout: TextureLayout,
-    rgba: &[f32],
+    (layout, rgba): (TextureLayout, &[f32]),
 ) -> Result<FloatImage, PlayError> {
-    let limit = gpu.limits.max_texture_dimension_2d;
-    if viewport.width == 0
-        || viewport.height == 0
-        || viewport.width > limit
-        || viewport.height > limit
-    {
-        return Err(PlayError::TargetSize {
-            width: viewport.width,
-            height: viewport.height,
-            limit,
-        });
-    }
+    check_viewport(gpu, viewport)?;
     if vectors.len() != tess.vertices.len() {
         return Err(PlayError::Request(format!(
             "{} cube vectors for {} vertices",

@@ -295,54 +295,9 @@ pub fn render_shell(
     object: &ShellObject,
     rgba: &[f32],
 ) -> Result<FloatImage, PlayError> {
-    let limit = gpu.limits.max_texture_dimension_2d;
-    if viewport.width == 0
-        || viewport.height == 0
-        || viewport.width > limit
-        || viewport.height > limit
-    {
-        return Err(PlayError::TargetSize {
-            width: viewport.width,
-            height: viewport.height,
-            limit,
-        });
-    }
+    check_viewport(gpu, viewport)?;
     let cube = ShellTexture::new(gpu, object.layout, "shell")?;
     cube.upload(gpu, rgba)?;
-    let d = &gpu.device;
-    let init = |label: &str, contents: &[u8], usage| {
-        d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some(label),
-            contents,
-            usage,
-        })
-    };
-    let (origin_shape, a, b) = shell_uniform(&object.shell);
-    let uniforms = |clip: glam::Mat4| ShellUniforms {
-        clip_from_object: clip.to_cols_array(),
-        world_from_object: object.world_from_object.to_cols_array(),
-        eye: [object.eye.x, object.eye.y, object.eye.z, 1.0],
-        origin_shape,
-        a,
-        b,
-        size: object.layout.width,
-        levels: object.layout.levels,
-        lookups: object.lookups.max(1),
-        _pad: 0,
-    };
-    let bind = |u: &wgpu::Buffer| {
-        d.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("shell"),
-            layout: &pipeline.layout,
-            entries: &[
-                wgpu::BindGroupEntry { binding: 0, resource: u.as_entire_binding() },
-                wgpu::BindGroupEntry {
-                    binding: 1,
-                    resource: wgpu::BindingResource::TextureView(&cube.view),
-                },
-            ],
-        })
-    };
     // Occluders, then the object's hidden triangles, write depth only.
     let mut depth_draws = Vec::new();
     for m in occluders {
@@ -355,10 +310,37 @@ pub fn render_shell(
         if on { &mut shown } else { &mut hidden }.extend_from_slice(tri);
     }
     depth_draws.push((object.positions.to_vec(), hidden, object.clip_from_object));
+    let (color, depth) = frame_targets(gpu, viewport);
+    let mut enc =
+        gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("shell") });
+    let draws = ShellDraws::new(gpu, pipeline, &cube, object, &depth_draws, &shown);
+    shell_pass(&mut enc, pipeline, (&color, &depth), &draws);
+    crate::image::read_back(gpu, enc, &color, viewport)
+}
+
+/// A viewport the adapter can draw: not empty, within its largest 2D texture.
+pub(crate) fn check_viewport(gpu: &Gpu, viewport: Viewport) -> Result<(), PlayError> {
+    let limit = gpu.limits.max_texture_dimension_2d;
+    if viewport.width == 0
+        || viewport.height == 0
+        || viewport.width > limit
+        || viewport.height > limit
+    {
+        return Err(PlayError::TargetSize {
+            width: viewport.width,
+            height: viewport.height,
+            limit,
+        });
+    }
+    Ok(())
+}
+
+/// The colour ([`TARGET_FORMAT`], copied out) and depth targets of a viewport.
+fn frame_targets(gpu: &Gpu, viewport: Viewport) -> (wgpu::Texture, wgpu::Texture) {
     let size =
         wgpu::Extent3d { width: viewport.width, height: viewport.height, depth_or_array_layers: 1 };
     let target = |label, format, usage| {
-        d.create_texture(&wgpu::TextureDescriptor {
+        gpu.device.create_texture(&wgpu::TextureDescriptor {
             label: Some(label),
             size,
             mip_level_count: 1,
@@ -375,78 +357,147 @@ pub fn render_shell(
         wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
     );
     let depth = target("depth", DEPTH_FORMAT, wgpu::TextureUsages::RENDER_ATTACHMENT);
+    (color, depth)
+}
+
+/// A mesh drawn for depth only: positions, indices and clip transform.
+type DepthMesh = (Vec<[f32; 3]>, Vec<u32>, glam::Mat4);
+
+/// One depth-only draw: positions, indices, index count, bind group.
+type DepthDraw = (wgpu::Buffer, wgpu::Buffer, u32, wgpu::BindGroup);
+
+/// The buffers and bind groups of a shell frame: the depth-only draws, then the object's
+/// shown triangles (bind group, positions, normals, indices, index count).
+struct ShellDraws {
+    depth: Vec<DepthDraw>,
+    object: (wgpu::BindGroup, wgpu::Buffer, wgpu::Buffer, wgpu::Buffer, u32),
+}
+
+impl ShellDraws {
+    /// `depth_draws`: positions, indices and clip transform of each depth-only draw;
+    /// `shown`: the indices of the object's triangles that draw the shell.
+    fn new(
+        gpu: &Gpu,
+        pipeline: &ShellPipeline,
+        cube: &ShellTexture,
+        object: &ShellObject,
+        depth_draws: &[DepthMesh],
+        shown: &[u32],
+    ) -> ShellDraws {
+        let d = &gpu.device;
+        let init = |label: &str, contents: &[u8], usage| {
+            d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some(label),
+                contents,
+                usage,
+            })
+        };
+        let (origin_shape, a, b) = shell_uniform(&object.shell);
+        let uniforms = |clip: glam::Mat4| ShellUniforms {
+            clip_from_object: clip.to_cols_array(),
+            world_from_object: object.world_from_object.to_cols_array(),
+            eye: [object.eye.x, object.eye.y, object.eye.z, 1.0],
+            origin_shape,
+            a,
+            b,
+            size: object.layout.width,
+            levels: object.layout.levels,
+            lookups: object.lookups.max(1),
+            _pad: 0,
+        };
+        let bind = |clip: glam::Mat4| {
+            let u =
+                init("uniforms", bytemuck::bytes_of(&uniforms(clip)), wgpu::BufferUsages::UNIFORM);
+            d.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("shell"),
+                layout: &pipeline.layout,
+                entries: &[
+                    wgpu::BindGroupEntry { binding: 0, resource: u.as_entire_binding() },
+                    wgpu::BindGroupEntry {
+                        binding: 1,
+                        resource: wgpu::BindingResource::TextureView(&cube.view),
+                    },
+                ],
+            })
+        };
+        let pad3 = |v: &[[f32; 3]]| if v.is_empty() { vec![[0.0f32; 3]] } else { v.to_vec() };
+        let pad1 = |v: &[u32]| if v.is_empty() { vec![0u32] } else { v.to_vec() };
+        let depth = depth_draws
+            .iter()
+            .map(|(p, i, clip)| {
+                let bg = bind(*clip);
+                (
+                    init("positions", bytemuck::cast_slice(&pad3(p)), wgpu::BufferUsages::VERTEX),
+                    init("indices", bytemuck::cast_slice(&pad1(i)), wgpu::BufferUsages::INDEX),
+                    i.len() as u32 / 3 * 3,
+                    bg,
+                )
+            })
+            .collect();
+        let object = (
+            bind(object.clip_from_object),
+            init(
+                "positions",
+                bytemuck::cast_slice(&pad3(object.positions)),
+                wgpu::BufferUsages::VERTEX,
+            ),
+            init(
+                "normals",
+                bytemuck::cast_slice(&pad3(object.normals)),
+                wgpu::BufferUsages::VERTEX,
+            ),
+            init("indices", bytemuck::cast_slice(&pad1(shown)), wgpu::BufferUsages::INDEX),
+            shown.len() as u32 / 3 * 3,
+        );
+        ShellDraws { depth, object }
+    }
+}
+
+/// The shell frame's one pass into `(color, depth)`, both cleared: the depth-only draws,
+/// then the object's shown triangles with the shell.
+fn shell_pass(
+    enc: &mut wgpu::CommandEncoder,
+    pipeline: &ShellPipeline,
+    (color, depth): (&wgpu::Texture, &wgpu::Texture),
+    draws: &ShellDraws,
+) {
     let (color_view, depth_view) =
         (color.create_view(&Default::default()), depth.create_view(&Default::default()));
-    let pad3 = |v: &[[f32; 3]]| if v.is_empty() { vec![[0.0f32; 3]] } else { v.to_vec() };
-    let pad1 = |v: &[u32]| if v.is_empty() { vec![0u32] } else { v.to_vec() };
-    let mut enc =
-        d.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("shell") });
-    let depth_buffers: Vec<_> = depth_draws
-        .iter()
-        .map(|(p, i, clip)| {
-            let u =
-                init("uniforms", bytemuck::bytes_of(&uniforms(*clip)), wgpu::BufferUsages::UNIFORM);
-            let bg = bind(&u);
-            (
-                init("positions", bytemuck::cast_slice(&pad3(p)), wgpu::BufferUsages::VERTEX),
-                init("indices", bytemuck::cast_slice(&pad1(i)), wgpu::BufferUsages::INDEX),
-                i.len() as u32 / 3 * 3,
-                bg,
-            )
-        })
-        .collect();
-    let ou = init(
-        "uniforms",
-        bytemuck::bytes_of(&uniforms(object.clip_from_object)),
-        wgpu::BufferUsages::UNIFORM,
-    );
-    let obg = bind(&ou);
-    let (op, on) = (
-        init(
-            "positions",
-            bytemuck::cast_slice(&pad3(object.positions)),
-            wgpu::BufferUsages::VERTEX,
-        ),
-        init("normals", bytemuck::cast_slice(&pad3(object.normals)), wgpu::BufferUsages::VERTEX),
-    );
-    let oi = init("indices", bytemuck::cast_slice(&pad1(&shown)), wgpu::BufferUsages::INDEX);
-    {
-        let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: Some("shell"),
-            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                view: &color_view,
-                depth_slice: None,
-                resolve_target: None,
-                ops: wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
-                    store: wgpu::StoreOp::Store,
-                },
-            })],
-            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                view: &depth_view,
-                depth_ops: Some(wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(1.0),
-                    store: wgpu::StoreOp::Store,
-                }),
-                stencil_ops: None,
+    let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
+        label: Some("shell"),
+        color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+            view: &color_view,
+            depth_slice: None,
+            resolve_target: None,
+            ops: wgpu::Operations {
+                load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
+                store: wgpu::StoreOp::Store,
+            },
+        })],
+        depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+            view: &depth_view,
+            depth_ops: Some(wgpu::Operations {
+                load: wgpu::LoadOp::Clear(1.0),
+                store: wgpu::StoreOp::Store,
             }),
-            timestamp_writes: None,
-            occlusion_query_set: None,
-            multiview_mask: None,
-        });
-        pass.set_pipeline(&pipeline.depth_pipeline);
-        for (p, i, n, bg) in &depth_buffers {
-            pass.set_bind_group(0, bg, &[]);
-            pass.set_vertex_buffer(0, p.slice(..));
-            pass.set_index_buffer(i.slice(..), wgpu::IndexFormat::Uint32);
-            pass.draw_indexed(0..*n, 0, 0..1);
-        }
-        pass.set_pipeline(&pipeline.pipeline);
-        pass.set_bind_group(0, &obg, &[]);
-        pass.set_vertex_buffer(0, op.slice(..));
-        pass.set_vertex_buffer(1, on.slice(..));
-        pass.set_index_buffer(oi.slice(..), wgpu::IndexFormat::Uint32);
-        pass.draw_indexed(0..shown.len() as u32 / 3 * 3, 0, 0..1);
+            stencil_ops: None,
+        }),
+        timestamp_writes: None,
+        occlusion_query_set: None,
+        multiview_mask: None,
+    });
+    pass.set_pipeline(&pipeline.depth_pipeline);
+    for (p, i, n, bg) in &draws.depth {
+        pass.set_bind_group(0, bg, &[]);
+        pass.set_vertex_buffer(0, p.slice(..));
+        pass.set_index_buffer(i.slice(..), wgpu::IndexFormat::Uint32);
+        pass.draw_indexed(0..*n, 0, 0..1);
     }
-    crate::image::read_back(gpu, enc, &color, viewport)
+    let (bg, positions, normals, indices, count) = &draws.object;
+    pass.set_pipeline(&pipeline.pipeline);
+    pass.set_bind_group(0, bg, &[]);
+    pass.set_vertex_buffer(0, positions.slice(..));
+    pass.set_vertex_buffer(1, normals.slice(..));
+    pass.set_index_buffer(indices.slice(..), wgpu::IndexFormat::Uint32);
+    pass.draw_indexed(0..*count, 0, 0..1);
 }

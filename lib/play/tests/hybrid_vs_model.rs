@@ -54,12 +54,12 @@ fn hybrid_frames_match_the_model() {
                 let vectors = vertex_vectors(&tess, term, &shell);
                 let a = hybrid_render_matrix(vp, &tess, clip, &vectors, layout, None);
                 let want = predict(&a, &x);
-                let got =
-                    render_hybrid(&gpu, &pipeline, vp, &tess, clip, &vectors, layout, &x).unwrap();
+                let got = render_hybrid(&gpu, &pipeline, vp, &tess, clip, &vectors, (layout, &x))
+                    .unwrap();
                 // The same frame twice: the same tessellation (pis-compile's tests) and pixels.
                 if sname == "sphere" {
                     let again =
-                        render_hybrid(&gpu, &pipeline, vp, &tess, clip, &vectors, layout, &x)
+                        render_hybrid(&gpu, &pipeline, vp, &tess, clip, &vectors, (layout, &x))
                             .unwrap();
                     assert!(
                         again.rgba.iter().zip(&got.rgba).all(|(a, b)| a.to_bits() == b.to_bits()),

@@ -155,16 +155,14 @@ pub fn encode(
         pipes.hybrid_pipeline(gpu, sample_format, samples);
     }
     let binds = Binds::new(gpu, pipes, &draws);
-    let attachments = id_passes(
-        gpu,
-        pipes,
-        targets,
-        (sample_format, display.is_some()),
-        object_ids,
-        &draws,
-        &binds.ids,
-        encoder,
-    );
+    let sample_colour = sample_colour(gpu, targets, sample_format, display.is_some());
+    let (depth, ids_bind) = id_passes(pipes, targets, object_ids, objects, &binds.ids, encoder);
+    let attachments = Attachments {
+        keep_samples: sample_colour.is_some() && display.is_some(),
+        sample_colour,
+        depth,
+        ids_bind,
+    };
     additive_pass(pipes, (sample_format, samples), &attachments, colour, &draws, &binds, encoder);
     if let (Some(filter), Some(m)) = (display, &mut targets.multi) {
         let size = targets.size;
@@ -290,67 +288,52 @@ struct Attachments<'t> {
     ids_bind: &'t wgpu::BindGroup,
 }
 
-/// The object-index passes: per sample for multisampled frames (then, with `object_ids`, one
-/// more at pixel centres into `targets.ids`), else at pixel centres. `sample`: the format the
-/// samples are drawn in and whether the display-filter resolve reads them. Returns the
-/// attachments of the additive pass.
-#[allow(clippy::too_many_arguments)]
-fn id_passes<'t>(
+/// The colour attachment of a multisampled frame's samples (made on first use): in
+/// `sample_format`, kept for the display-filter resolve to read where `display`. `None` for a
+/// single-sample frame.
+fn sample_colour(
     gpu: &Gpu,
+    targets: &mut Targets,
+    sample_format: wgpu::TextureFormat,
+    display: bool,
+) -> Option<wgpu::TextureView> {
+    let (size, samples) = (targets.size, targets.samples);
+    let m = targets.multi.as_mut()?;
+    let usage = if display {
+        wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING
+    } else {
+        wgpu::TextureUsages::RENDER_ATTACHMENT
+    };
+    let c = m.colour.entry((sample_format, display)).or_insert_with(|| {
+        target_texture(gpu, "frame per sample", size, samples, sample_format, usage)
+    });
+    Some(c.create_view(&Default::default()))
+}
+
+/// The object-index passes: per sample for multisampled frames (then, with `object_ids`, one
+/// more at pixel centres into `targets.ids`), else at pixel centres. Returns the depth and
+/// the object indices' bind group the additive pass tests against.
+fn id_passes<'t>(
     pipes: &FramePipelines,
-    targets: &'t mut Targets,
-    sample: (wgpu::TextureFormat, bool),
+    targets: &'t Targets,
     object_ids: bool,
-    draws: &Draws,
+    objects: &[ObjectDraw],
     id_binds: &[wgpu::BindGroup],
     encoder: &mut wgpu::CommandEncoder,
-) -> Attachments<'t> {
-    let (size, samples) = (targets.size, targets.samples);
-    let (sample_format, display) = sample;
-    let objects = draws.objects;
-    match &mut targets.multi {
+) -> (&'t wgpu::Texture, &'t wgpu::BindGroup) {
+    let centres = &pipes.id_pipelines[&1];
+    match &targets.multi {
         Some(m) => {
-            let usage = if display {
-                wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING
-            } else {
-                wgpu::TextureUsages::RENDER_ATTACHMENT
-            };
-            let c = m.colour.entry((sample_format, display)).or_insert_with(|| {
-                target_texture(gpu, "frame per sample", size, samples, sample_format, usage)
-            });
-            id_pass(&pipes.id_pipelines[&samples], &m.ids, &m.depth, objects, id_binds, encoder);
+            let per_sample = &pipes.id_pipelines[&targets.samples];
+            id_pass(per_sample, &m.ids, &m.depth, objects, id_binds, encoder);
             if object_ids {
-                id_pass(
-                    &pipes.id_pipelines[&1],
-                    &targets.ids,
-                    &targets.depth,
-                    objects,
-                    id_binds,
-                    encoder,
-                );
+                id_pass(centres, &targets.ids, &targets.depth, objects, id_binds, encoder);
             }
-            Attachments {
-                sample_colour: Some(c.create_view(&Default::default())),
-                keep_samples: display,
-                depth: &m.depth,
-                ids_bind: &m.ids_bind,
-            }
+            (&m.depth, &m.ids_bind)
         }
         None => {
-            id_pass(
-                &pipes.id_pipelines[&1],
-                &targets.ids,
-                &targets.depth,
-                objects,
-                id_binds,
-                encoder,
-            );
-            Attachments {
-                sample_colour: None,
-                keep_samples: false,
-                depth: &targets.depth,
-                ids_bind: &targets.ids_bind,
-            }
+            id_pass(centres, &targets.ids, &targets.depth, objects, id_binds, encoder);
+            (&targets.depth, &targets.ids_bind)
         }
     }
 }

@@ -1,0 +1,124 @@
+//! The draws of a frame from its plan and its textures on the GPU: the objects placed, the
+//! surface layers with their samplers and largest LOD, and the reflection terms with their
+//! cube maps.
+
+use std::collections::HashMap;
+
+use pis_compile::{Address, Filter, Sampler};
+use pis_format::PisReader;
+
+use super::objects::{content, ObjectGpu};
+use super::plan::{Plan, Wanted};
+use super::resident::{GpuTexture, Textures};
+use crate::error::PlayError;
+use crate::frame::{LayerDraw, ObjectDraw, ReflectionDraw, TermShell};
+use crate::gpu::Gpu;
+use crate::textured::create_sampler;
+
+/// The player's samplers, one per repeat mode (s, t).
+pub(super) type Samplers = HashMap<[bool; 2], wgpu::Sampler>;
+
+/// Every object at its clip transform (`clips`, one per object).
+pub(super) fn object_draws<'a>(
+    objects: &'a [ObjectGpu],
+    clips: &[glam::Mat4],
+) -> Vec<ObjectDraw<'a>> {
+    objects
+        .iter()
+        .zip(clips)
+        .enumerate()
+        .map(|(i, (o, &clip))| ObjectDraw {
+            object: i as u32,
+            mesh: &o.mesh,
+            clip_from_object: clip,
+        })
+        .collect()
+}
+
+/// The addressing of a texture repeated (or not) along s and t.
+fn address(repeat: [bool; 2]) -> [Address; 2] {
+    repeat.map(|r| if r { Address::Repeat } else { Address::ClampToEdge })
+}
+
+/// Makes the samplers `surfaces` need that `samplers` lacks: the file's `filter`, each
+/// surface's repeat mode.
+pub(super) fn make_samplers(
+    gpu: &Gpu,
+    samplers: &mut Samplers,
+    filter: Filter,
+    surfaces: &[Wanted],
+) {
+    for w in surfaces {
+        samplers.entry(w.repeat).or_insert_with(|| {
+            create_sampler(gpu, &Sampler { filter, address: address(w.repeat) })
+        });
+    }
+}
+
+/// The surface layers of `surfaces` with their textures on the GPU (`textures`) and their
+/// samplers (`samplers`, made by [`make_samplers`]), filtered with `filter`. A repeated
+/// axis must be a power of two.
+pub(super) fn layer_draws<'a>(
+    reader: &PisReader,
+    textures: &'a Textures,
+    samplers: &'a Samplers,
+    filter: Filter,
+    surfaces: &[Wanted],
+) -> Result<Vec<LayerDraw<'a>>, PlayError> {
+    let mut layers = Vec::with_capacity(surfaces.len());
+    for w in surfaces {
+        let GpuTexture::Surface(texture) = textures.get(&w.key) else {
+            return Err(content(
+                reader,
+                format!("{:?}: a shell's texture drawn as a surface layer", w.key),
+            ));
+        };
+        let sampler = Sampler { filter, address: address(w.repeat) };
+        for (axis, k, s) in [('s', 0, texture.layout.width), ('t', 1, texture.layout.height)] {
+            if w.repeat[k] && !s.is_power_of_two() {
+                return Err(PlayError::RepeatSize { axis, size: s });
+            }
+        }
+        layers.push(LayerDraw {
+            draw: w.draw,
+            texture,
+            sampler: &samplers[&w.repeat],
+            transform: w.transform,
+            max_level: pis_compile::filter::max_level(&texture.layout, &sampler) as f32,
+            weight: w.weight,
+            anisotropic: matches!(filter, Filter::Anisotropic(_)),
+        });
+    }
+    Ok(layers)
+}
+
+/// The reflection terms of a plan, with their cube maps on the GPU (`textures`).
+pub(super) fn reflection_draws<'a>(
+    reader: &PisReader,
+    textures: &'a Textures,
+    plan: &Plan,
+) -> Result<Vec<ReflectionDraw<'a>>, PlayError> {
+    let c = reader.container();
+    let mut out = Vec::with_capacity(plan.reflections.len());
+    for r in &plan.reflections {
+        let mut shells = Vec::with_capacity(r.shells.len());
+        for (key, shell, lookups) in &r.shells {
+            let GpuTexture::Shell(cube) = textures.get(key) else {
+                return Err(content(
+                    reader,
+                    format!("{key:?}: a surface texture drawn as a shell"),
+                ));
+            };
+            shells.push(TermShell { shell: *shell, lookups: *lookups, cube });
+        }
+        out.push(ReflectionDraw {
+            draw: r.draw,
+            world_from_object: plan.worlds[r.draw],
+            eye: plan.eye,
+            f0: c.objects[r.draw].shading.f0,
+            weight: r.weight,
+            shells,
+        });
+    }
+    Ok(out)
+}

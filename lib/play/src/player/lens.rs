@@ -1,0 +1,118 @@
+//! Lens objects in the player's frame (thesis 6.4): per frame each one's vertex rays traced
+//! through the object at its transform (on the workers), its tessellation refined where they
+//! diverge (or the last frame's drawn again when nothing it depends on changed), both terms'
+//! corner buffers built once per shell geometry, and the lens draws of the frame's
+//! parameter samples.
+
+use std::time::Instant;
+
+use pis_compile::hybrid::{tessellate, HybridView, TessellationSettings, TERMS};
+use pis_compile::shell::Shell;
+use pis_format::PisReader;
+
+use super::objects::{content, LensState, TessellationKey};
+use super::plan::Plan;
+use super::resident::{GpuTexture, Textures};
+use crate::error::PlayError;
+use crate::frame::hybrid::{corner_buffer, term_corners, LensDraw};
+use crate::gpu::Gpu;
+
+/// A frame's lens work: per lens object and shell geometry, both terms' corner buffers
+/// (and their corner counts); the time it took, its rays and triangles.
+pub(super) struct LensWork {
+    pub(super) sets: Vec<LensSet>,
+    pub(super) ms: f64,
+    pub(super) rays: u64,
+    pub(super) triangles: u64,
+}
+
+/// One lens object's terms for one shell geometry: the object's draw index, the shells, and
+/// both terms' corner buffers with their corner counts.
+pub(super) type LensSet = (usize, Vec<Shell>, [(wgpu::Buffer, u32); 2]);
+
+/// Traces the vertex rays of every lens object `plan` draws through the object placed at
+/// the frame's transform, refines its tessellation down to `tau_px`, and builds both
+/// terms' corners once per object and shell geometry (`states`: the objects' lens states).
+pub(super) fn lens_corners(
+    gpu: &Gpu,
+    states: &mut [(usize, LensState)],
+    plan: &Plan,
+    size: (u32, u32),
+    tau_px: f32,
+) -> LensWork {
+    let t = Instant::now();
+    let settings = TessellationSettings { tau_px, ..TessellationSettings::default() };
+    let mut work = LensWork { sets: Vec::new(), ms: 0.0, rays: 0, triangles: 0 };
+    for r in &plan.lenses {
+        let shells: Vec<Shell> = r.shells.iter().map(|(_, s, _)| *s).collect();
+        if work.sets.iter().any(|(d, s, _)| *d == r.draw && *s == shells) {
+            continue;
+        }
+        let Some((_, state)) = states.iter_mut().find(|(d, _)| *d == r.draw) else { continue };
+        let key: TessellationKey =
+            (plan.worlds[r.draw], plan.eye, plan.clip_from_world, size, tau_px);
+        let tess = match &state.tessellated {
+            Some((k, t)) if *k == key => t.clone(),
+            _ => {
+                let lens = state.at(plan.worlds[r.draw]);
+                let t = std::sync::Arc::new(tessellate(
+                    lens,
+                    &HybridView { eye: plan.eye, clip_from_world: plan.clip_from_world, size },
+                    &settings,
+                ));
+                state.tessellated = Some((key, t.clone()));
+                work.rays += t.stats.rays;
+                t
+            }
+        };
+        let (reflection, refraction) = rayon::join(
+            || term_corners(&tess, TERMS[0], &shells),
+            || term_corners(&tess, TERMS[1], &shells),
+        );
+        let buffers = [reflection, refraction]
+            .map(|corners| (corner_buffer(gpu, &corners), corners.len() as u32));
+        work.triangles += buffers.iter().map(|b| b.1 as u64 / 3).max().unwrap_or(0);
+        work.sets.push((r.draw, shells, buffers));
+    }
+    work.ms = t.elapsed().as_secs_f64() * 1e3;
+    work
+}
+
+/// The lens draws of `plan`: per lens term and parameter sample, both terms' corner buffers
+/// of its shell geometry (`sets`, from [`lens_corners`]) with the shells' cube maps.
+pub(super) fn lens_draws<'a>(
+    reader: &PisReader,
+    textures: &'a Textures,
+    plan: &Plan,
+    sets: &'a [LensSet],
+) -> Result<Vec<LensDraw<'a>>, PlayError> {
+    let mut lenses = Vec::new();
+    for r in &plan.lenses {
+        let shells: Vec<Shell> = r.shells.iter().map(|(_, s, _)| *s).collect();
+        let Some((_, _, buffers)) = sets.iter().find(|(d, s, _)| *d == r.draw && *s == shells)
+        else {
+            continue;
+        };
+        let mut cubes = Vec::with_capacity(r.shells.len());
+        for (key, _, _) in &r.shells {
+            let GpuTexture::Shell(cube) = textures.get(key) else {
+                return Err(content(
+                    reader,
+                    format!("{key:?}: a surface texture drawn as a shell"),
+                ));
+            };
+            cubes.push(cube);
+        }
+        for (corners, count) in buffers {
+            lenses.push(LensDraw {
+                object: r.draw as u32,
+                clip_from_world: plan.clip_from_world,
+                weight: r.weight,
+                corners,
+                count: *count,
+                shells: cubes.clone(),
+            });
+        }
+    }
+    Ok(lenses)
+}

@@ -1,0 +1,304 @@
+//! The file's objects as the player draws them, checked and uploaded at open: each object's
+//! mesh, its surface layers, its reflection term's shells, and, for a lens object, what its
+//! tessellation is traced from; and the checks of the file's textures against the adapter.
+
+use pis_compile::hybrid::{LensMaterial, LensObject};
+use pis_compile::{Filter, TextureLayout};
+use pis_format::{Container, Mapping, PisReader, Placement, StreamRef, Term};
+
+use crate::error::PlayError;
+use crate::frame::hybrid::MAX_LENS_SHELLS;
+use crate::frame::{MeshGpu, MAX_TERM_SHELLS};
+use crate::gpu::Gpu;
+use crate::textured::allocated_size;
+
+/// An object's mesh on the GPU and the layers the player draws.
+pub(super) struct ObjectGpu {
+    pub(super) mesh: MeshGpu,
+    /// Surface layers.
+    pub(super) layers: Vec<usize>,
+    /// The reflection term's shell layers in increasing order (at most
+    /// [`MAX_TERM_SHELLS`]); empty for an object without them or without normals.
+    pub(super) reflection: Vec<usize>,
+    /// A lens object drawn by hybrid rendering.
+    pub(super) lens: Option<LensState>,
+}
+
+/// A lens object: its shell layers (the refraction term's, in increasing order, at most
+/// [`MAX_LENS_SHELLS`]; both terms look them up), its triangles in object space, its
+/// material, and the object placed in world space at the last transform drawn.
+pub(super) struct LensState {
+    pub(super) layers: Vec<usize>,
+    positions: Vec<glam::Vec3>,
+    normals: Vec<glam::Vec3>,
+    indices: Vec<u32>,
+    material: LensMaterial,
+    placed: Option<(glam::Mat4, LensObject)>,
+    /// The last frame's tessellation and what it was made for (transform, eye, view and
+    /// projection, frame size, τ): a frame that changes none of them draws it again.
+    pub(super) tessellated:
+        Option<(TessellationKey, std::sync::Arc<pis_compile::hybrid::Tessellation>)>,
+}
+
+/// What a lens object's tessellation depends on.
+pub(super) type TessellationKey = (glam::Mat4, glam::Vec3, glam::Mat4, (u32, u32), f32);
+
+impl LensState {
+    /// The lens object at `world` (rigid), built once per transform.
+    pub(super) fn at(&mut self, world: glam::Mat4) -> &LensObject {
+        if self.placed.as_ref().is_none_or(|(m, _)| *m != world) {
+            let positions = self.positions.iter().map(|&p| world.transform_point3(p)).collect();
+            let normals = self.normals.iter().map(|&n| world.transform_vector3(n)).collect();
+            self.placed =
+                Some((world, LensObject::new(self.material, positions, normals, &self.indices)));
+        }
+        &self.placed.as_ref().expect("placed above").1
+    }
+}
+
+/// The texture filter the file's textures were solved for: pis-pack records it in the
+/// provenance settings (`filter`, `anisotropy`; SPEC.md 6.6); trilinear when absent. The
+/// reader has checked the settings (rule 9001).
+pub(super) fn file_filter(c: &Container<StreamRef>) -> Filter {
+    match pis_format::FileFilter::of(c.provenance.as_ref()).unwrap_or_default() {
+        pis_format::FileFilter::Nearest => Filter::Nearest,
+        pis_format::FileFilter::Bilinear => Filter::Bilinear,
+        pis_format::FileFilter::Trilinear => Filter::Trilinear,
+        pis_format::FileFilter::Anisotropic(n) => Filter::Anisotropic(n),
+    }
+}
+
+pub(super) fn content(reader: &PisReader, message: String) -> PlayError {
+    PlayError::Content { path: reader.path().display().to_string(), message }
+}
+
+/// Checks what the player relies on beyond the reader's validation and uploads the meshes.
+pub(super) fn prepare_objects(gpu: &Gpu, reader: &PisReader) -> Result<Vec<ObjectGpu>, PlayError> {
+    let c = reader.container();
+    let mut out = Vec::with_capacity(c.objects.len());
+    let mut skipped = Vec::new();
+    // The reader has checked the tints (rule 9004).
+    let named: Vec<(&str, pis_format::ObjectRole)> =
+        c.objects.iter().map(|o| (o.name.as_str(), o.role)).collect();
+    let tints = pis_format::tint::tints(c.provenance.as_ref(), &named)
+        .unwrap_or_else(|_| vec![[1.0; 3]; c.objects.len()]);
+    for (oi, o) in c.objects.iter().enumerate() {
+        let n = o.mesh.positions.len();
+        let uvs: Vec<[f32; 2]> = match &o.mesh.texcoords {
+            Some(t) if t.len() == n => t.clone(),
+            Some(t) => {
+                return Err(content(
+                    reader,
+                    format!(
+                        "object {oi} '{}': {} texture coordinates for {n} positions",
+                        o.name,
+                        t.len()
+                    ),
+                ))
+            }
+            None => vec![[0.0; 2]; n],
+        };
+        if let Some(bad) = o.mesh.indices.iter().find(|&&i| i as usize >= n) {
+            return Err(content(
+                reader,
+                format!("object {oi} '{}': index {bad} with {n} positions", o.name),
+            ));
+        }
+        if let Some(normals) = o.mesh.normals.as_ref().filter(|v| v.len() != n) {
+            return Err(content(
+                reader,
+                format!("object {oi} '{}': {} normals for {n} positions", o.name, normals.len()),
+            ));
+        }
+        let mut layers = Vec::new();
+        for (li, l) in o.layers.iter().enumerate() {
+            if !(1..=4).contains(&l.channels) {
+                return Err(content(
+                    reader,
+                    format!("object {oi} '{}' layer {li} has {} channels", o.name, l.channels),
+                ));
+            }
+            if l.mapping == Mapping::Shell {
+                continue;
+            }
+            if o.mesh.texcoords.is_none() {
+                return Err(content(
+                    reader,
+                    format!(
+                        "object {oi} '{}' has a surface layer but no texture coordinates",
+                        o.name
+                    ),
+                ));
+            }
+            layers.push(li);
+        }
+        let lens = lens_state(reader, oi, tints[oi], &mut skipped)?;
+        let reflection =
+            if lens.is_some() { Vec::new() } else { reflection_shells(reader, oi, &mut skipped)? };
+        let mesh =
+            MeshGpu::new(gpu, &o.mesh.positions, o.mesh.normals.as_deref(), &uvs, &o.mesh.indices)
+                .with_hull(o.mesh.hull_triangles);
+        out.push(ObjectGpu { mesh, layers, reflection, lens });
+    }
+    if !skipped.is_empty() {
+        eprintln!(
+            "pis-play: note: shell layers are not drawn by this player: {}",
+            skipped.join(", ")
+        );
+    }
+    Ok(out)
+}
+
+/// The shell layers of object `oi`'s reflection term in increasing order, the player draws
+/// them all in one pass: at most [`MAX_TERM_SHELLS`] (more is not supported), each block a
+/// closed shell (sphere, ellipsoid, box or cylinder; a quad is not supported). Shell layers
+/// the player does not draw — the refraction term's, and every shell of an object without
+/// normals — are listed in `skipped` (`object/kind (why)`).
+fn reflection_shells(
+    reader: &PisReader,
+    oi: usize,
+    skipped: &mut Vec<String>,
+) -> Result<Vec<usize>, PlayError> {
+    let o = &reader.container().objects[oi];
+    let shells = |term| {
+        o.layers
+            .iter()
+            .enumerate()
+            .filter(move |(_, l)| l.mapping == Mapping::Shell && l.term == term)
+    };
+    let mut note = |li: usize, why: &str| {
+        skipped.push(format!("{}/{} ({why})", o.name, o.layers[li].kind.name()))
+    };
+    shells(Term::Refraction).for_each(|(li, _)| note(li, "refraction term"));
+    let term: Vec<usize> = shells(Term::Reflection).map(|(li, _)| li).collect();
+    if o.mesh.normals.is_none() {
+        term.iter().for_each(|&li| note(li, "the mesh has no normals"));
+        return Ok(Vec::new());
+    }
+    ordered_closed_shells(reader, oi, term, "reflection", MAX_TERM_SHELLS)
+}
+
+/// Shell layers `layers` of object `oi`'s `term` in increasing order, checked drawable: at
+/// most `max` of them, each block a closed shell (sphere, ellipsoid, box or cylinder; a quad
+/// is not supported).
+fn ordered_closed_shells(
+    reader: &PisReader,
+    oi: usize,
+    mut layers: Vec<usize>,
+    term: &str,
+    max: usize,
+) -> Result<Vec<usize>, PlayError> {
+    let o = &reader.container().objects[oi];
+    layers.sort_by_key(|&li| o.layers[li].order);
+    let not_supported = |message: String| {
+        PlayError::File(pis_format::Error::NotSupported(format!(
+            "{}: object {oi} '{}': {message}",
+            reader.path().display(),
+            o.name
+        )))
+    };
+    if layers.len() > max {
+        return Err(not_supported(format!(
+            "{} shells in the {term} term; this player draws at most {max}",
+            layers.len()
+        )));
+    }
+    for &li in &layers {
+        let closed = o.layers[li]
+            .blocks
+            .iter()
+            .all(|b| matches!(b.placement, Placement::Shell { shape, .. } if shape.faces() == 6));
+        if !closed {
+            return Err(not_supported(format!("layer {li} ({}) is not a closed shell (sphere, ellipsoid, box or cylinder): quad shells are not drawn", o.layers[li].kind.name())));
+        }
+    }
+    Ok(layers)
+}
+
+/// Object `oi` as a lens object, when it is one: role `refractive`, shell layers in the
+/// refraction term (at most [`MAX_LENS_SHELLS`], closed shells), normals; its transmission
+/// tint `tint`. Its reflection term's own shells, if any, are not drawn (listed in
+/// `skipped`), nor are the shells of a refractive object without normals.
+fn lens_state(
+    reader: &PisReader,
+    oi: usize,
+    tint: [f32; 3],
+    skipped: &mut Vec<String>,
+) -> Result<Option<LensState>, PlayError> {
+    let o = &reader.container().objects[oi];
+    if o.role != pis_format::ObjectRole::Refractive {
+        return Ok(None);
+    }
+    let shells = |term| {
+        o.layers
+            .iter()
+            .enumerate()
+            .filter(move |(_, l)| l.mapping == Mapping::Shell && l.term == term)
+            .map(|(li, _)| li)
+    };
+    let layers: Vec<usize> = shells(Term::Refraction).collect();
+    if layers.is_empty() {
+        return Ok(None);
+    }
+    let Some(normals) = &o.mesh.normals else {
+        layers.iter().for_each(|&li| {
+            skipped.push(format!(
+                "{}/{} (the mesh has no normals)",
+                o.name,
+                o.layers[li].kind.name()
+            ))
+        });
+        return Ok(None);
+    };
+    shells(Term::Reflection).for_each(|li| {
+        skipped.push(format!(
+            "{}/{} (a lens object's reflection term reads its refraction term's shells)",
+            o.name,
+            o.layers[li].kind.name()
+        ))
+    });
+    let layers = ordered_closed_shells(reader, oi, layers, "refraction", MAX_LENS_SHELLS)?;
+    let v3 = |v: &[f32; 3]| glam::Vec3::from_array(*v);
+    // The runtime's paths take the file's constants: IOR, absorption and the transmission
+    // tint (SPEC.md 6.4, 6.6, 9).
+    let material = LensMaterial {
+        ior: o.shading.ior,
+        base: glam::Vec3::from_array(tint),
+        sigma_a: v3(&o.shading.absorption),
+    };
+    Ok(Some(LensState {
+        layers,
+        positions: o.mesh.positions.iter().map(v3).collect(),
+        normals: normals.iter().map(v3).collect(),
+        indices: o.mesh.indices.clone(),
+        material,
+        placed: None,
+        tessellated: None,
+    }))
+}
+
+/// Every surface texture and cube-map face of the file, as the player allocates it (padded
+/// to powers of two), fits the adapter's largest 2D texture: checked at open, before any
+/// frame.
+pub(super) fn check_texture_sizes(gpu: &Gpu, reader: &PisReader) -> Result<(), PlayError> {
+    let limit = gpu.limits.max_texture_dimension_2d;
+    for o in &reader.container().objects {
+        for l in &o.layers {
+            for b in &l.blocks {
+                let (w, h) = match l.mapping {
+                    Mapping::Surface => allocated_size(&TextureLayout::full(b.width, b.height)),
+                    Mapping::Shell => (b.width.next_power_of_two(), b.height.next_power_of_two()),
+                };
+                if w > limit || h > limit {
+                    return Err(PlayError::TextureSize {
+                        object: o.name.clone(),
+                        width: b.width,
+                        height: b.height,
+                        limit,
+                    });
+                }
+            }
+        }
+    }
+    Ok(())
+}

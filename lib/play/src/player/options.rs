@@ -1,0 +1,101 @@
+//! The player's settings, the frame a caller asks for, and what a frame cost.
+
+use pis_compile::hybrid::TessellationSettings;
+
+use crate::blend::Blend;
+use crate::multisample::DEFAULT_SAMPLES;
+
+/// The player's settings.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PlayerOptions {
+    /// Memory for decoded level images (default 512 MiB).
+    pub cache_budget_bytes: u64,
+    /// Lifetime of a leaf level image in frames (thesis a, default 20).
+    pub lifetime_a: u32,
+    /// Lifetime growth per pyramid level up (thesis b, default 4).
+    pub lifetime_b: u32,
+    /// Decoding threads (default: one per core; a frame waits for its textures, so the
+    /// render thread is idle while they decode).
+    pub workers: usize,
+    /// Texture resolution reduction: 1 draws full resolution; 2, 4, … draw MIP level
+    /// log2(r) as the finest level (textures at 1/r resolution per side).
+    pub reduction: u32,
+    pub blend: Blend,
+    /// Samples per pixel (multisample antialiasing of object silhouettes): 1 or 4 (default
+    /// 4). Where the device cannot multisample a frame's formats that many times, frames
+    /// are drawn with 1 ([`crate::Player::multisample`] says which and why).
+    pub msaa: u32,
+    /// The display filter multisampled frames are resolved with when the file records none
+    /// (SPEC.md 6.6 `display_filter`): the ray-traced set's filter (RAYSET.md section 4).
+    /// With neither, each pixel's own samples are averaged.
+    pub display_filter: Option<pis_format::DisplayFilter>,
+    /// Lens objects: the screen edge length in pixels down to which the tessellation is
+    /// refined where vertex rays diverge (thesis 6.4.1's τ; default 1).
+    pub tau_px: f32,
+}
+
+impl Default for PlayerOptions {
+    fn default() -> Self {
+        let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+        PlayerOptions {
+            cache_budget_bytes: 512 << 20,
+            lifetime_a: 20,
+            lifetime_b: 4,
+            workers: cores.max(1),
+            reduction: 1,
+            blend: Blend::Nearest,
+            msaa: DEFAULT_SAMPLES,
+            display_filter: None,
+            tau_px: TessellationSettings::default().tau_px,
+        }
+    }
+}
+
+/// One frame to draw.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FrameRequest {
+    /// Per dimension, a value in the dimension's own values and units (as stored in PSPC);
+    /// values between samples are allowed.
+    pub point: Vec<f32>,
+    pub camera: crate::camera::CameraChoice,
+}
+
+/// What one frame cost.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct FrameStats {
+    /// Whole frame, request to drawn (and read back, for offscreen frames).
+    pub frame_ms: f64,
+    /// Recording and submitting the frame's draws and waiting for the GPU to finish them
+    /// (offscreen frames; a window's frame is not waited for, and this stays 0).
+    pub draw_ms: f64,
+    /// Copying an offscreen frame to memory and converting it to linear RGBA.
+    pub readback_ms: f64,
+    /// Waiting for the workers: level images decoded and textures rebuilt.
+    pub decode_ms: f64,
+    /// Texture uploads and GPU MIP chains.
+    pub upload_ms: f64,
+    pub upload_bytes: u64,
+    /// Level-image cache lookups of this frame.
+    pub cache_hits: u64,
+    pub cache_misses: u64,
+    /// Bytes of decoded level images cached after the frame.
+    pub cache_bytes: u64,
+    /// Codestreams read from the file for this frame.
+    pub codestreams_read: u64,
+    /// Draws of surface layers (one per object, layer and parameter sample).
+    pub surface_draws: u64,
+    /// Draws of reflection terms (one per reflective object and parameter sample, each
+    /// looking up all the term's shells).
+    pub shell_draws: u64,
+    /// Lens objects: tracing their vertex rays, refining the tessellation and building the
+    /// terms' vertex buffers (texture-coordinate generation), on a thread of its own (the
+    /// tracing on the workers) while the frame's textures are decoded.
+    pub lens_ms: f64,
+    /// Lens objects: rays traced for the frame's vertices (none where the frame draws the
+    /// previous frame's tessellation again: same camera, transform, size and τ), and the
+    /// triangles drawn.
+    pub lens_rays: u64,
+    pub lens_triangles: u64,
+    /// Draws of lens terms (two per lens object and parameter sample).
+    pub lens_draws: u64,
+}

@@ -1,0 +1,245 @@
+//! The frame's textures on the GPU and the decoding behind them (thesis 4.7): the level
+//! images a missing texture sums, taken from the level-image cache or decoded on the
+//! workers; the textures rebuilt from them on the workers (surface textures' finest levels,
+//! shells' cube maps); their uploads and GPU MIP chains; and the textures a frame did not
+//! draw released when it ends.
+
+use std::collections::HashMap;
+use std::sync::Arc;
+use std::time::Instant;
+
+use pis_compile::TextureLayout;
+use pis_format::texture::LevelLayout;
+use pis_format::{Mapping, PisReader};
+
+use super::objects::content;
+use super::options::FrameStats;
+use super::plan::TextureKey;
+use crate::cache::{LevelCache, LevelKey};
+use crate::decode::{AssembleJob, CubeImage, Decoder, LevelJob, TextureImage};
+use crate::error::PlayError;
+use crate::gpu::Gpu;
+use crate::mip::MipBuilder;
+use crate::shell::ShellTexture;
+use crate::textured::ObjectTexture;
+
+/// A texture on the GPU: a surface texture with its MIP chain, or a shell's cube map.
+pub(super) enum GpuTexture {
+    Surface(ObjectTexture),
+    Shell(ShellTexture),
+}
+
+/// A texture on the GPU and the frame that last drew it.
+struct Resident {
+    texture: GpuTexture,
+    last_frame: u64,
+}
+
+/// The textures on the GPU, the level-image cache and the workers that decode into it.
+pub(super) struct Textures {
+    decoder: Decoder,
+    pub(super) cache: LevelCache,
+    mips: MipBuilder,
+    resident: HashMap<TextureKey, Resident>,
+    /// The frame being drawn.
+    frame: u64,
+}
+
+/// The level images of missing textures, by level key.
+type Levels = HashMap<LevelKey, Arc<Vec<f32>>>;
+
+impl Textures {
+    pub(super) fn new(decoder: Decoder, cache: LevelCache, mips: MipBuilder) -> Textures {
+        Textures { decoder, cache, mips, resident: HashMap::new(), frame: 0 }
+    }
+
+    /// The texture of `key` on the GPU (made resident this frame).
+    pub(super) fn get(&self, key: &TextureKey) -> &GpuTexture {
+        &self.resident[key].texture
+    }
+
+    /// Decodes (on the workers) and uploads every wanted texture not on the GPU.
+    /// `reduction`: the texture resolution reduction ([`super::options::PlayerOptions`]).
+    pub(super) fn make_resident(
+        &mut self,
+        gpu: &Gpu,
+        reader: &PisReader,
+        reduction: u32,
+        wanted: &[&TextureKey],
+        stats: &mut FrameStats,
+    ) -> Result<(), PlayError> {
+        let frame = self.frame;
+        let mut missing: Vec<&TextureKey> = Vec::new();
+        for &key in wanted {
+            match self.resident.get_mut(key) {
+                Some(r) => r.last_frame = frame,
+                None if !missing.contains(&key) => missing.push(key),
+                None => {}
+            }
+        }
+        if missing.is_empty() {
+            return Ok(());
+        }
+        let t = Instant::now();
+        let hits0 = self.cache.counters();
+        let have = self.level_images(reader, &missing)?;
+        // Textures rebuilt on the workers: surface textures' finest levels, shells' cube maps.
+        let c = reader.container();
+        let is_shell = |k: &TextureKey| {
+            c.objects[k.object as usize].layers[k.layer as usize].mapping == Mapping::Shell
+        };
+        let (shells, surfaces): (Vec<&TextureKey>, Vec<&TextureKey>) =
+            missing.iter().partition(|k| is_shell(k));
+        let drop_levels = reduction.trailing_zeros();
+        let job = |k: &&TextureKey| assemble_job(reader, &have, k, drop_levels);
+        let images = self.decoder.assemble(&surfaces.iter().map(job).collect::<Vec<_>>());
+        let cubes = self.decoder.assemble_cubes(&shells.iter().map(job).collect::<Vec<_>>());
+        stats.decode_ms += t.elapsed().as_secs_f64() * 1e3;
+        let hits1 = self.cache.counters();
+        stats.cache_hits += hits1.hits - hits0.hits;
+        stats.cache_misses += hits1.misses - hits0.misses;
+        self.upload(gpu, reader, (&surfaces, &images), (&shells, &cubes), stats)
+    }
+
+    /// The level images of the `missing` textures: cached, or decoded on the workers (each
+    /// once) and cached.
+    fn level_images(
+        &mut self,
+        reader: &PisReader,
+        missing: &[&TextureKey],
+    ) -> Result<Levels, PlayError> {
+        let c = reader.container();
+        let mut have: Levels = HashMap::new();
+        let mut jobs: Vec<(LevelKey, u32, LevelJob)> = Vec::new();
+        for k in missing {
+            let layer = &c.objects[k.object as usize].layers[k.layer as usize];
+            let block = &layer.blocks[k.block as usize];
+            let planes = LevelLayout::of(layer, block).planes();
+            let n = block.levels.len() as u32;
+            for (lv, (level, &img)) in block.levels.iter().zip(&k.images).enumerate() {
+                let key = level_key(k, lv, img);
+                if have.contains_key(&key) || jobs.iter().any(|j| j.0 == key) {
+                    continue;
+                }
+                match self.cache.get(&key) {
+                    Some(v) => {
+                        have.insert(key, v);
+                    }
+                    None => {
+                        let stream = *level.images.get(img as usize).ok_or_else(|| {
+                            content(reader, format!("{key:?}: no such level image"))
+                        })?;
+                        let at = (k.object as usize, k.layer as usize, k.block as usize, lv);
+                        jobs.push((
+                            key,
+                            n - 1 - lv as u32,
+                            LevelJob { stream, planes: planes.clone(), at },
+                        ));
+                    }
+                }
+            }
+        }
+        let level_jobs: Vec<LevelJob> = jobs.iter().map(|j| j.2.clone()).collect();
+        let decoded = self.decoder.decode_levels(reader, &level_jobs);
+        let mut first_error = None;
+        for ((key, height, _), r) in jobs.into_iter().zip(decoded) {
+            match r {
+                Ok(v) => {
+                    let v = Arc::new(v);
+                    self.cache.insert(key, height, v.clone());
+                    have.insert(key, v);
+                }
+                Err(e) => {
+                    first_error.get_or_insert(e);
+                }
+            }
+        }
+        match first_error {
+            Some(e) => Err(e),
+            None => Ok(have),
+        }
+    }
+
+    /// Uploads the rebuilt textures: surface textures with their GPU MIP chains, cube maps
+    /// with their stored levels; waits for the GPU and keeps them as drawn this frame.
+    fn upload(
+        &mut self,
+        gpu: &Gpu,
+        reader: &PisReader,
+        (surfaces, images): (&[&TextureKey], &[TextureImage]),
+        (shells, cubes): (&[&TextureKey], &[CubeImage]),
+        stats: &mut FrameStats,
+    ) -> Result<(), PlayError> {
+        let c = reader.container();
+        let frame = self.frame;
+        let t = Instant::now();
+        let mut encoder = gpu
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("uploads") });
+        let mut made = Vec::with_capacity(surfaces.len() + shells.len());
+        for (k, img) in surfaces.iter().zip(images) {
+            let texture = self.mips.texture(gpu, TextureLayout::full(img.width, img.height));
+            stats.upload_bytes += self.mips.upload(gpu, &texture, img, &mut encoder)?;
+            made.push((
+                (*k).clone(),
+                Resident { texture: GpuTexture::Surface(texture), last_frame: frame },
+            ));
+        }
+        for (k, cube) in shells.iter().zip(cubes) {
+            let texture = ShellTexture::new(gpu, cube.layout, &c.objects[k.object as usize].name)?;
+            texture.upload(gpu, &cube.rgba)?;
+            stats.upload_bytes += (cube.rgba.len() * 4) as u64;
+            made.push((
+                (*k).clone(),
+                Resident { texture: GpuTexture::Shell(texture), last_frame: frame },
+            ));
+        }
+        gpu.queue.submit([encoder.finish()]);
+        gpu.device
+            .poll(wgpu::PollType::wait_indefinitely())
+            .map_err(|e| PlayError::Readback(e.to_string()))?;
+        self.resident.extend(made);
+        stats.upload_ms += t.elapsed().as_secs_f64() * 1e3;
+        Ok(())
+    }
+
+    /// Ends the frame: level-image lifetimes and budget, and GPU textures the frame did not
+    /// draw released.
+    pub(super) fn end_frame(&mut self) {
+        let frame = self.frame;
+        self.resident.retain(|_, r| r.last_frame == frame);
+        self.cache.end_frame();
+        self.frame += 1;
+    }
+}
+
+/// The cache key of level `lv`'s image `img` of texture `k`.
+fn level_key(k: &TextureKey, lv: usize, img: u32) -> LevelKey {
+    LevelKey { object: k.object, layer: k.layer, block: k.block, level: lv as u32, image: img }
+}
+
+/// The job that rebuilds texture `k` from its level images (`have`), its `drop_levels`
+/// finest levels dropped (at most all but one).
+fn assemble_job<'r>(
+    reader: &'r PisReader,
+    have: &Levels,
+    k: &TextureKey,
+    drop_levels: u32,
+) -> AssembleJob<'r> {
+    let c = reader.container();
+    let layer = &c.objects[k.object as usize].layers[k.layer as usize];
+    let block = &layer.blocks[k.block as usize];
+    let levels = k
+        .images
+        .iter()
+        .enumerate()
+        .map(|(lv, &img)| have[&level_key(k, lv, img)].clone())
+        .collect();
+    let full = TextureLayout::full(block.width, block.height).levels;
+    AssembleJob {
+        layer,
+        layout: LevelLayout::of(layer, block),
+        levels,
+        drop_levels: drop_levels.min(full.saturating_sub(1)),
+    }
+}
