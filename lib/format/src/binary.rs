@@ -1,6 +1,7 @@
 //! Little-endian encoding: a bounds-checked payload cursor for reading and a byte sink that
 //! can record a label per field (for the annotated hex dump in format-spec/examples/).
 
+use crate::issue::id;
 use crate::Issue;
 
 /// Reads one chunk payload. Every read is checked against the payload's end; failures name
@@ -118,9 +119,12 @@ impl<'a> Cursor<'a> {
         let at = self.offset();
         let b = self.take(bytes, what)?;
         if b.iter().any(|&x| x != 0) {
-            let issue = Issue::new(3006, format!("{what} must be 0, found {b:02x?}"))
-                .in_chunk(self.chunk.0, self.chunk.1)
-                .at(at);
+            let issue = Issue::new(
+                id::chunk::RESERVED_NOT_ZERO,
+                format!("{what} must be 0, found {b:02x?}"),
+            )
+            .in_chunk(self.chunk.0, self.chunk.1)
+            .at(at);
             return self.flag(issue);
         }
         Ok(())

@@ -4,6 +4,7 @@
 use std::collections::HashSet;
 
 use crate::blocks::BlockGrid;
+use crate::issue::id;
 use crate::model::*;
 pub use crate::payload_read::MAX_DIMS;
 use crate::Issue;
@@ -79,13 +80,19 @@ pub fn decoded_sizes<S>(c: &Container<S>, codestream_bytes: u64) -> Option<Issue
                 let what = || format!("object {oi} '{}' layer {li} block {bi}", o.name);
                 if bytes > limit {
                     let detail = format!("{}: {bytes} bytes per level image; {codestream_bytes} bytes of codestream allow {limit}", what());
-                    return Some(chunk(Issue::new(6009, detail), "LAYR"));
+                    return Some(chunk(
+                        Issue::new(id::layers::LEVEL_IMAGE_TOO_LARGE, detail),
+                        "LAYR",
+                    ));
                 }
                 let images = b.levels.iter().map(|level| level.images.len() as u64).sum::<u64>();
                 total = total.saturating_add(bytes.saturating_mul(images));
                 if total > total_limit {
                     let detail = format!("{}: the level images up to this block decode to {total} bytes; {codestream_bytes} bytes of codestream allow {total_limit}", what());
-                    return Some(chunk(Issue::new(6010, detail), "LAYR"));
+                    return Some(chunk(
+                        Issue::new(id::layers::LEVEL_IMAGES_TOO_LARGE, detail),
+                        "LAYR",
+                    ));
                 }
             }
         }
@@ -144,7 +151,7 @@ pub(crate) fn check_parsed<S>(p: &Parsed<S>) -> Vec<Issue> {
             let named: Vec<(&str, crate::ObjectRole)> =
                 objects.iter().map(|o| (o.name.as_str(), o.role)).collect();
             if let Err(detail) = crate::tint::tints(prov, &named) {
-                out.push(chunk(Issue::new(9004, detail), "PROV"));
+                out.push(chunk(Issue::new(id::provenance::TINT, detail), "PROV"));
             }
         }
     }
@@ -159,15 +166,21 @@ fn provenance(p: Option<&Provenance>, out: &mut Vec<Issue>) {
         for (k, _) in &p.settings {
             if !seen.insert(k.as_str()) && repeated.insert(k.as_str()) {
                 let n = p.settings.iter().filter(|(key, _)| key == k).count();
-                out.push(chunk(Issue::new(9003, format!("key {k:?} appears {n} times")), "PROV"));
+                out.push(chunk(
+                    Issue::new(
+                        id::provenance::KEY_REPEATED,
+                        format!("key {k:?} appears {n} times"),
+                    ),
+                    "PROV",
+                ));
             }
         }
     }
     if let Err(detail) = crate::FileFilter::of(p) {
-        out.push(chunk(Issue::new(9001, detail), "PROV"));
+        out.push(chunk(Issue::new(id::provenance::FILTER, detail), "PROV"));
     }
     if let Err(detail) = crate::DisplayFilter::of(p) {
-        out.push(chunk(Issue::new(9002, detail), "PROV"));
+        out.push(chunk(Issue::new(id::provenance::DISPLAY_FILTER, detail), "PROV"));
     }
 }
 
@@ -180,27 +193,42 @@ fn space(s: &ParameterSpace, out: &mut Vec<Issue>) {
     let e = |id, d: String| chunk(Issue::new(id, d), "PSPC");
     let n = s.dims.len() as u32;
     if n == 0 || n > MAX_DIMS {
-        out.push(e(4001, format!("{n} dimensions, expected 1 to {MAX_DIMS}")));
+        out.push(e(
+            id::space::DIMENSION_COUNT,
+            format!("{n} dimensions, expected 1 to {MAX_DIMS}"),
+        ));
         return;
     }
     let mut names = HashSet::new();
     for (k, d) in s.dims.iter().enumerate() {
         if d.name.is_empty() || !names.insert(d.name.as_str()) {
-            out.push(e(4002, format!("dimension {k} name {:?} is empty or repeated", d.name)));
+            out.push(e(
+                id::space::DIMENSION_NAME,
+                format!("dimension {k} name {:?} is empty or repeated", d.name),
+            ));
         }
         if d.values.is_empty() {
-            out.push(e(4004, format!("dimension {k} '{}' has no samples", d.name)));
+            out.push(e(
+                id::space::NO_SAMPLES,
+                format!("dimension {k} '{}' has no samples", d.name),
+            ));
         }
         if d.block_size == 0 {
-            out.push(e(4005, format!("dimension {k} '{}' has block size 0", d.name)));
+            out.push(e(
+                id::space::ZERO_BLOCK_SIZE,
+                format!("dimension {k} '{}' has block size 0", d.name),
+            ));
         }
         if d.values.iter().any(|v| !v.is_finite()) || d.values.windows(2).any(|w| w[1] <= w[0]) {
-            out.push(e(4006, format!("dimension {k} '{}' values {:?}", d.name, d.values)));
+            out.push(e(
+                id::space::VALUES_NOT_INCREASING,
+                format!("dimension {k} '{}' values {:?}", d.name, d.values),
+            ));
         }
     }
     let points = s.dims.iter().try_fold(1u64, |p, d| p.checked_mul(d.values.len() as u64));
     if points.is_none_or(|p| p > MAX_POINTS) {
-        out.push(e(4007, format!("more than {MAX_POINTS} points")));
+        out.push(e(id::space::TOO_MANY_POINTS, format!("more than {MAX_POINTS} points")));
     }
 }
 
@@ -220,7 +248,7 @@ fn table(
     if !mask_ok(s, mask) {
         out.push(chunk(
             Issue::new(
-                5002,
+                id::cameras::MASK_NAMES_MISSING_DIMENSION,
                 format!("{what} mask {:#x}, the space has {} dimensions", mask.0, s.dims.len()),
             ),
             fourcc,
@@ -230,7 +258,10 @@ fn table(
     let expected = s.table_len(mask);
     if len as u64 != expected {
         out.push(chunk(
-            Issue::new(5001, format!("{what}: {len} entries, expected {expected}")),
+            Issue::new(
+                id::cameras::TABLE_SIZE,
+                format!("{what}: {len} entries, expected {expected}"),
+            ),
             fourcc,
         ));
         return false;
@@ -265,7 +296,7 @@ fn cameras(s: Option<&ParameterSpace>, t: &CameraTable, out: &mut Vec<Issue>) {
     let e = |id, d: String| chunk(Issue::new(id, d), "CAMS");
     if t.width == 0 || t.height == 0 || t.width > MAX_IMAGE_SIDE || t.height > MAX_IMAGE_SIDE {
         out.push(e(
-            5004,
+            id::cameras::IMAGE_SIZE,
             format!("{}×{} pixels, each side must be 1 to {MAX_IMAGE_SIDE}", t.width, t.height),
         ));
     }
@@ -283,7 +314,7 @@ fn cameras(s: Option<&ParameterSpace>, t: &CameraTable, out: &mut Vec<Issue>) {
             && c.zfar > c.znear
             && !c.zfar.is_nan();
         if !ok {
-            out.push(e(5003, format!("camera {i}: {c:?}")));
+            out.push(e(id::cameras::INVALID_CAMERA, format!("camera {i}: {c:?}")));
         }
     }
 }
@@ -297,27 +328,30 @@ fn objects<S>(
 ) {
     let n = objects.len();
     if n == 0 || n > 65535 {
-        out.push(chunk(Issue::new(5101, format!("{n} objects, expected 1 to 65535")), "OBJS"));
+        out.push(chunk(
+            Issue::new(id::objects::OBJECT_COUNT, format!("{n} objects, expected 1 to 65535")),
+            "OBJS",
+        ));
     }
     let mut names = HashSet::new();
     for (oi, o) in objects.iter().enumerate() {
         let e =
             |id, d: String| chunk(Issue::new(id, format!("object {oi} '{}': {d}", o.name)), "OBJS");
         if o.name.is_empty() || !names.insert(o.name.as_str()) {
-            out.push(e(5102, "name is empty or repeated".into()));
+            out.push(e(id::objects::OBJECT_NAME, "name is empty or repeated".into()));
         }
         let sh = &o.shading;
         let unit = |v: &f32| (0.0..=1.0).contains(v);
         let ior_ok = sh.ior.is_finite() && sh.ior >= 1.0;
         let absorption_ok = sh.absorption.iter().all(|v| v.is_finite() && *v >= 0.0);
         if !(sh.f0.iter().all(unit) && ior_ok && absorption_ok) {
-            out.push(e(5104, format!("{sh:?}")));
+            out.push(e(id::objects::SHADING_OUT_OF_RANGE, format!("{sh:?}")));
         }
         let mut stagger_ok = s.is_some_and(|s| o.stagger.len() == s.dims.len());
         for (k, (&off, d)) in o.stagger.iter().zip(s.map_or(&[][..], |s| &s.dims)).enumerate() {
             if off >= d.block_size {
                 out.push(e(
-                    5105,
+                    id::objects::STAGGER_NOT_BELOW_BLOCK,
                     format!("offset {off} along dimension {k} with block size {}", d.block_size),
                 ));
                 stagger_ok = false;
@@ -330,7 +364,7 @@ fn objects<S>(
             for (t, m) in o.transforms.transforms.iter().enumerate() {
                 if !finite(m) || !rigid(m) {
                     out.push(e(
-                        5106,
+                        id::objects::TRANSFORM_NOT_RIGID,
                         format!("transform {t} is not a finite rigid transform: {m:?}"),
                     ));
                 }
@@ -352,15 +386,15 @@ fn mesh<S>(oi: usize, o: &Object<S>, out: &mut Vec<Issue>) {
     };
     let m = &o.mesh;
     if m.positions.is_empty() {
-        out.push(e(5207, "vertex count 0".into()));
+        out.push(e(id::mesh::NO_VERTICES, "vertex count 0".into()));
         return;
     }
     if m.indices.is_empty() || m.indices.len() % 3 != 0 {
-        out.push(e(5203, format!("{} indices", m.indices.len())));
+        out.push(e(id::mesh::INDEX_COUNT, format!("{} indices", m.indices.len())));
     }
     if let Some(i) = m.indices.iter().position(|&i| i as usize >= m.positions.len()) {
         out.push(e(
-            5204,
+            id::mesh::INDEX_OUT_OF_RANGE,
             format!("index {i} is {}, there are {} vertices", m.indices[i], m.positions.len()),
         ));
     }
@@ -370,11 +404,14 @@ fn mesh<S>(oi: usize, o: &Object<S>, out: &mut Vec<Issue>) {
     let lengths = m.normals.as_ref().is_none_or(|n| n.len() == m.positions.len())
         && m.texcoords.as_ref().is_none_or(|t| t.len() == m.positions.len());
     if !all_finite || !lengths {
-        out.push(e(5205, "non-finite values, or attribute arrays of unequal length".into()));
+        out.push(e(
+            id::mesh::VERTEX_NOT_FINITE,
+            "non-finite values, or attribute arrays of unequal length".into(),
+        ));
     }
     if m.hull_triangles as usize > m.indices.len() / 3 {
         out.push(e(
-            5206,
+            id::mesh::TOO_MANY_HULL_TRIANGLES,
             format!("{} hull triangles, the mesh has {}", m.hull_triangles, m.indices.len() / 3),
         ));
     }
@@ -420,7 +457,7 @@ fn layers<S>(
         };
         if !combo {
             out.push(e(
-                6003,
+                id::layers::INVALID_COMBINATION,
                 format!(
                     "mapping {}, term {}, combine {}, {} channels on a {} object{}",
                     l.mapping.name(),
@@ -437,17 +474,20 @@ fn layers<S>(
             ));
         }
         if !slots.insert((l.term as u8, l.order)) {
-            out.push(e(6008, format!("term {} order {} is already used", l.term.name(), l.order)));
+            out.push(e(
+                id::layers::TERM_ORDER_REPEATED,
+                format!("term {} order {} is already used", l.term.name(), l.order),
+            ));
         }
         if !(l.gamma.is_finite() && l.gamma > 0.0) {
-            out.push(e(6004, format!("gamma {}", l.gamma)));
+            out.push(e(id::layers::GAMMA, format!("gamma {}", l.gamma)));
         }
         let Some(s) = grid else {
             continue;
         };
         if !mask_ok(s, l.depends_on) {
             out.push(e(
-                5002,
+                id::cameras::MASK_NAMES_MISSING_DIMENSION,
                 format!("mask {:#x}, the space has {} dimensions", l.depends_on.0, s.dims.len()),
             ));
             continue;
@@ -455,7 +495,7 @@ fn layers<S>(
         let grid = BlockGrid::new(s, l.depends_on, &o.stagger);
         if l.blocks.len() as u64 != grid.block_count() {
             out.push(e(
-                6005,
+                id::layers::BLOCK_COUNT,
                 format!("{} blocks, the grid has {}", l.blocks.len(), grid.block_count()),
             ));
             continue;
@@ -472,15 +512,15 @@ fn layers<S>(
                 || b.height > MAX_TEXTURE_SIDE
                 || !square
             {
-                out.push(e(6006, format!("{}×{} texels", b.width, b.height)));
+                out.push(e(id::layers::TEXTURE_SIZE, format!("{}×{} texels", b.width, b.height)));
             }
             if let Some(why) = placement(&b.placement, l.mapping) {
-                out.push(e(6007, why));
+                out.push(e(id::layers::BLOCK_PLACEMENT, why));
             }
             if let Placement::Surface { repeat, .. } = b.placement {
                 for (axis, wraps, side) in [("s", repeat[0], b.width), ("t", repeat[1], b.height)] {
                     if wraps && !side.is_power_of_two() {
-                        out.push(e(6007, format!("the texture wraps along {axis} but its side {side} is not a power of two")));
+                        out.push(e(id::layers::BLOCK_PLACEMENT, format!("the texture wraps along {axis} but its side {side} is not a power of two")));
                     }
                 }
             }
@@ -541,12 +581,15 @@ fn placement(p: &Placement, mapping: Mapping) -> Option<String> {
 /// Rules 7001–7004 for one block's levels.
 fn pyramid<S>(extent: &[u32], dims: usize, levels: &[Level<S>], push: &mut dyn FnMut(u16, String)) {
     if levels.is_empty() || levels.len() > MAX_LEVELS {
-        push(7001, format!("{} levels, expected 1 to {MAX_LEVELS}", levels.len()));
+        push(
+            id::pyramid::LEVEL_COUNT,
+            format!("{} levels, expected 1 to {MAX_LEVELS}", levels.len()),
+        );
         return;
     }
     if dims == 0 && levels.len() > 1 {
         push(
-            7005,
+            id::pyramid::STATIC_LAYER_LEVELS,
             format!("{} levels; a layer with dependency mask 0 has exactly 1", levels.len()),
         );
     }
@@ -554,7 +597,7 @@ fn pyramid<S>(extent: &[u32], dims: usize, levels: &[Level<S>], push: &mut dyn F
         let images: u64 = level.counts.iter().map(|&c| c as u64).product();
         if level.counts.len() != dims || level.images.len() as u64 != images {
             push(
-                7003,
+                id::pyramid::LEVEL_COUNTS,
                 format!(
                     "level {lv} has {} counts and {} images",
                     level.counts.len(),
@@ -565,24 +608,33 @@ fn pyramid<S>(extent: &[u32], dims: usize, levels: &[Level<S>], push: &mut dyn F
         }
     }
     if levels[0].counts.iter().any(|&c| c != 1) {
-        push(7002, format!("top level counts {:?}", levels[0].counts));
+        push(
+            id::pyramid::TOP_LEVEL_NOT_ONE_SAMPLE,
+            format!("top level counts {:?}", levels[0].counts),
+        );
     }
     for (lv, w) in levels.windows(2).enumerate() {
         let bad = w[0].counts.iter().zip(&w[1].counts).any(|(a, b)| b < a);
         if bad {
             push(
-                7003,
+                id::pyramid::LEVEL_COUNTS,
                 format!("level {} counts {:?} after {:?}", lv + 1, w[1].counts, w[0].counts),
             );
         }
     }
     for (lv, level) in levels.iter().enumerate() {
         if level.counts.iter().zip(extent).any(|(&c, &e)| c == 0 || c > e) {
-            push(7003, format!("level {lv} counts {:?} for block extent {extent:?}", level.counts));
+            push(
+                id::pyramid::LEVEL_COUNTS,
+                format!("level {lv} counts {:?} for block extent {extent:?}", level.counts),
+            );
         }
     }
     let last = &levels[levels.len() - 1].counts;
     if last.as_slice() != extent {
-        push(7004, format!("finest level counts {last:?}, block extent {extent:?}"));
+        push(
+            id::pyramid::FINEST_LEVEL_EXTENT,
+            format!("finest level counts {last:?}, block extent {extent:?}"),
+        );
     }
 }

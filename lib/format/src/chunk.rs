@@ -1,5 +1,6 @@
 //! The file header and the chunk table (SPEC.md sections "File header" and "Chunk table").
 
+use crate::issue::id;
 use crate::Issue;
 
 /// `\x89PIS\r\n\x1a\n`: a non-ASCII first byte, the name, and line-ending and EOF bytes
@@ -38,14 +39,56 @@ pub struct ChunkRule {
 }
 
 pub const KNOWN: [ChunkRule; 8] = [
-    ChunkRule { fourcc: PSPC, required: true, min: 1, max: Some(1), malformed: 4000 },
-    ChunkRule { fourcc: CAMS, required: true, min: 1, max: Some(1), malformed: 5000 },
-    ChunkRule { fourcc: OBJS, required: true, min: 1, max: Some(1), malformed: 5100 },
-    ChunkRule { fourcc: MESH, required: true, min: 1, max: None, malformed: 5200 },
-    ChunkRule { fourcc: LAYR, required: true, min: 1, max: Some(1), malformed: 6000 },
-    ChunkRule { fourcc: CSTR, required: true, min: 0, max: None, malformed: 8002 },
-    ChunkRule { fourcc: PROV, required: false, min: 0, max: Some(1), malformed: 9000 },
-    ChunkRule { fourcc: MSTR, required: false, min: 0, max: None, malformed: 9100 },
+    ChunkRule {
+        fourcc: PSPC,
+        required: true,
+        min: 1,
+        max: Some(1),
+        malformed: id::space::MALFORMED,
+    },
+    ChunkRule {
+        fourcc: CAMS,
+        required: true,
+        min: 1,
+        max: Some(1),
+        malformed: id::cameras::MALFORMED,
+    },
+    ChunkRule {
+        fourcc: OBJS,
+        required: true,
+        min: 1,
+        max: Some(1),
+        malformed: id::objects::MALFORMED,
+    },
+    ChunkRule { fourcc: MESH, required: true, min: 1, max: None, malformed: id::mesh::MALFORMED },
+    ChunkRule {
+        fourcc: LAYR,
+        required: true,
+        min: 1,
+        max: Some(1),
+        malformed: id::layers::MALFORMED,
+    },
+    ChunkRule {
+        fourcc: CSTR,
+        required: true,
+        min: 0,
+        max: None,
+        malformed: id::codestream::OUTSIDE_CHUNK,
+    },
+    ChunkRule {
+        fourcc: PROV,
+        required: false,
+        min: 0,
+        max: Some(1),
+        malformed: id::provenance::MALFORMED,
+    },
+    ChunkRule {
+        fourcc: MSTR,
+        required: false,
+        min: 0,
+        max: None,
+        malformed: id::master::MALFORMED,
+    },
 ];
 
 pub fn rule(fourcc: FourCC) -> Option<&'static ChunkRule> {
@@ -107,13 +150,13 @@ impl ChunkEntry {
 pub fn parse_header(b: &[u8], actual_len: u64) -> Result<Header, Issue> {
     if actual_len < HEADER_LEN || b.len() < HEADER_LEN as usize {
         return Err(Issue::new(
-            1002,
+            id::io::FILE_TOO_SHORT,
             format!("file has {actual_len} bytes, the header alone needs {HEADER_LEN}"),
         ));
     }
     if b[0..8] != MAGIC {
         return Err(Issue::new(
-            2001,
+            id::header::BAD_MAGIC,
             format!("first 8 bytes are {:02x?}, expected {MAGIC:02x?}", &b[0..8]),
         )
         .at(0));
@@ -130,14 +173,14 @@ pub fn parse_header(b: &[u8], actual_len: u64) -> Result<Header, Issue> {
     };
     if h.major != VERSION_MAJOR {
         return Err(Issue::new(
-            2002,
+            id::header::UNSUPPORTED_VERSION,
             format!("major version {}, this reader reads {VERSION_MAJOR}", h.major),
         )
         .at(8));
     }
     if h.file_length != actual_len {
         return Err(Issue::new(
-            1003,
+            id::io::FILE_LENGTH_MISMATCH,
             format!(
                 "header says {} bytes, the file has {actual_len} (truncated or extended)",
                 h.file_length
@@ -150,7 +193,7 @@ pub fn parse_header(b: &[u8], actual_len: u64) -> Result<Header, Issue> {
     match table_end {
         Some(end) if end <= actual_len => Ok(h),
         _ => Err(Issue::new(
-            2005,
+            id::header::CHUNK_TABLE_OUTSIDE_FILE,
             format!("{} chunk entries do not fit in {actual_len} bytes", h.chunk_count),
         )
         .at(24)),
@@ -175,13 +218,22 @@ pub fn parse_table(
 ) -> Vec<ChunkEntry> {
     if h.flags != 0 {
         issues.push(
-            Issue::new(2003, format!("flags are {:#x}, version 1 defines none", h.flags)).at(12),
+            Issue::new(
+                id::header::RESERVED_FLAGS_SET,
+                format!("flags are {:#x}, version 1 defines none", h.flags),
+            )
+            .at(12),
         );
     }
     let crc = header_crc(header_bytes, table);
     if crc != h.crc {
-        issues
-            .push(Issue::new(2004, format!("stored {:#010x}, computed {crc:#010x}", h.crc)).at(28));
+        issues.push(
+            Issue::new(
+                id::header::CHECKSUM_MISMATCH,
+                format!("stored {:#010x}, computed {crc:#010x}", h.crc),
+            )
+            .at(28),
+        );
     }
     let mut entries = Vec::with_capacity(h.chunk_count as usize);
     let table_end = HEADER_LEN + h.chunk_count as u64 * ENTRY_LEN;
@@ -199,16 +251,27 @@ pub fn parse_table(
         let name = entry.name();
         let tag = |id: u16, d: String| Issue::new(id, d).in_chunk(&name, i);
         if reserved != 0 {
-            issues.push(tag(3006, format!("entry's reserved word is {reserved:#x}")).at(at + 28));
+            issues.push(
+                tag(
+                    id::chunk::RESERVED_NOT_ZERO,
+                    format!("entry's reserved word is {reserved:#x}"),
+                )
+                .at(at + 28),
+            );
         }
         if entry.flags & !FLAG_REQUIRED != 0 {
-            issues
-                .push(tag(3006, format!("flags {:#x} set undefined bits", entry.flags)).at(at + 4));
+            issues.push(
+                tag(
+                    id::chunk::RESERVED_NOT_ZERO,
+                    format!("flags {:#x} set undefined bits", entry.flags),
+                )
+                .at(at + 4),
+            );
         }
         match rule(entry.fourcc) {
             Some(r) if r.required != entry.required() => issues.push(
                 tag(
-                    3010,
+                    id::chunk::FLAGS_MISMATCH,
                     format!(
                         "'{name}' must {}carry the required flag",
                         if r.required { "" } else { "not " }
@@ -216,20 +279,28 @@ pub fn parse_table(
                 )
                 .at(at + 4),
             ),
-            None if entry.required() => issues
-                .push(tag(3007, format!("chunk type '{name}' is not defined by version 1")).at(at)),
+            None if entry.required() => issues.push(
+                tag(
+                    id::chunk::UNKNOWN_REQUIRED,
+                    format!("chunk type '{name}' is not defined by version 1"),
+                )
+                .at(at),
+            ),
             _ => {}
         }
         if entry.offset % ALIGN != 0 {
             issues.push(
-                tag(3001, format!("offset {} is not a multiple of {ALIGN}", entry.offset))
-                    .at(at + 8),
+                tag(
+                    id::chunk::OFFSET_MISALIGNED,
+                    format!("offset {} is not a multiple of {ALIGN}", entry.offset),
+                )
+                .at(at + 8),
             );
         }
         if entry.offset.checked_add(entry.length).is_none_or(|end| end > h.file_length) {
             issues.push(
                 tag(
-                    3002,
+                    id::chunk::PAST_END_OF_FILE,
                     format!(
                         "{} bytes at offset {} end past the file's {} bytes",
                         entry.length, entry.offset, h.file_length
@@ -240,7 +311,7 @@ pub fn parse_table(
         } else if entry.offset != prev_end.next_multiple_of(ALIGN) {
             issues.push(
                 tag(
-                    3003,
+                    id::chunk::NOT_AT_NEXT_ALIGNED_OFFSET,
                     format!(
                     "starts at {}; the previous data ends at {prev_end}, so it must start at {}",
                     entry.offset,
@@ -255,10 +326,12 @@ pub fn parse_table(
         }
         entries.push(entry);
     }
-    if issues.iter().all(|i| !(3001..=3003).contains(&i.id)) && prev_end != h.file_length {
+    if issues.iter().all(|i| !(3001..=id::chunk::NOT_AT_NEXT_ALIGNED_OFFSET).contains(&i.id))
+        && prev_end != h.file_length
+    {
         issues.push(
             Issue::new(
-                3011,
+                id::chunk::BYTES_AFTER_LAST_CHUNK,
                 format!("last chunk ends at {prev_end}, the file at {}", h.file_length),
             )
             .at(prev_end),
@@ -269,11 +342,11 @@ pub fn parse_table(
         let n = entries.iter().filter(|e| e.fourcc == r.fourcc).count();
         let name = fourcc_str(r.fourcc);
         if n < r.min {
-            issues.push(Issue::new(3008, format!("no '{name}' chunk")));
+            issues.push(Issue::new(id::chunk::REQUIRED_MISSING, format!("no '{name}' chunk")));
         }
         if r.max.is_some_and(|m| n > m) {
             issues.push(Issue::new(
-                3009,
+                id::chunk::REPEATED,
                 format!("{n} '{name}' chunks, at most {} allowed", r.max.unwrap_or(0)),
             ));
         }
@@ -293,8 +366,11 @@ pub fn check_padding(
             if let Some(pad) = read(pos, (e.offset - pos) as usize) {
                 if let Some(k) = pad.iter().position(|&b| b != 0) {
                     issues.push(
-                        Issue::new(3005, format!("padding byte is {:#04x}", pad[k]))
-                            .at(pos + k as u64),
+                        Issue::new(
+                            id::chunk::PADDING_NOT_ZERO,
+                            format!("padding byte is {:#04x}", pad[k]),
+                        )
+                        .at(pos + k as u64),
                     );
                 }
             }

@@ -9,6 +9,7 @@ use pis_codec::{CodecError, CodecId, PlaneShape, Rate};
 use crate::binary::{Cursor, Sink};
 use crate::blocks::BlockGrid;
 use crate::chunk::{self, ChunkEntry};
+use crate::issue::id;
 use crate::model::{Container, Layer, Object};
 use crate::source::Source;
 use crate::texture::LevelLayout;
@@ -183,13 +184,17 @@ impl Master {
                 Error::NotSupported(format!("codec '{codec}' ({what})"))
             }
             e => Error::Invalid(
-                Issue::new(9105, format!("{what}: {e}")).in_chunk("MSTR", usize::MAX),
+                Issue::new(id::master::PLANES_MISMATCH, format!("{what}: {e}"))
+                    .in_chunk("MSTR", usize::MAX),
             ),
         })?;
         if let Some(bad) = values.iter().position(|v| !v.is_finite()) {
             return Err(Error::Invalid(
-                Issue::new(9106, format!("{what}: value {bad} is {}", values[bad]))
-                    .in_chunk("MSTR", usize::MAX),
+                Issue::new(
+                    id::master::VALUE_NOT_FINITE,
+                    format!("{what}: value {bad} is {}", values[bad]),
+                )
+                .in_chunk("MSTR", usize::MAX),
             ));
         }
         Ok(values)
@@ -225,13 +230,17 @@ impl Master {
                     Error::NotSupported(format!("codec '{codec}' ({what})"))
                 }
                 e => Error::Invalid(
-                    Issue::new(9108, format!("{what}: {e}")).in_chunk("MSTR", usize::MAX),
+                    Issue::new(id::master::SCREEN_WEIGHTS, format!("{what}: {e}"))
+                        .in_chunk("MSTR", usize::MAX),
                 ),
             })?;
         if let Some(bad) = values.iter().position(|v| !(v.is_finite() && *v >= 0.0)) {
             return Err(Error::Invalid(
-                Issue::new(9108, format!("{what}: value {bad} is {}", values[bad]))
-                    .in_chunk("MSTR", usize::MAX),
+                Issue::new(
+                    id::master::SCREEN_WEIGHTS,
+                    format!("{what}: value {bad} is {}", values[bad]),
+                )
+                .in_chunk("MSTR", usize::MAX),
             ));
         }
         Ok(Some(values))
@@ -300,15 +309,18 @@ pub(crate) fn parse(c: &mut Cursor) -> Result<Master, Issue> {
         let flags = c.u8("flags")?;
         if flags & !HAS_WEIGHTS != 0 {
             c.flag(
-                Issue::new(9100, format!("layer {li}: unknown flags {flags:#04x}"))
-                    .in_chunk("MSTR", usize::MAX)
-                    .at(at + 1),
+                Issue::new(
+                    id::master::MALFORMED,
+                    format!("layer {li}: unknown flags {flags:#04x}"),
+                )
+                .in_chunk("MSTR", usize::MAX)
+                .at(at + 1),
             )?;
         }
         c.reserved(2, "reserved")?;
         let codec = CodecId::from_code(code as u16).filter(|k| !k.is_lossy()).ok_or_else(|| {
             Issue::new(
-                9103,
+                id::master::CODEC_NOT_EXACT,
                 format!("layer {li}: codec id {code}; a master uses raw (0) or lossless (1)"),
             )
             .in_chunk("MSTR", usize::MAX)
@@ -345,7 +357,7 @@ pub fn check<S>(c: &Container<S>, masters: &[Master]) -> Vec<Issue> {
             Some(s @ false) => *s = true,
             _ => {
                 out.push(e(
-                    9101,
+                    id::master::UNMATCHED_MASTER,
                     format!(
                         "names object {oi}; {} objects, this one missing or already given a master",
                         c.objects.len()
@@ -356,11 +368,14 @@ pub fn check<S>(c: &Container<S>, masters: &[Master]) -> Vec<Issue> {
         }
         let o = &c.objects[oi];
         if !(m.area.is_finite() && m.area > 0.0) {
-            out.push(e(9104, format!("object {oi} '{}': screen area {}", o.name, m.area)));
+            out.push(e(
+                id::master::SCREEN_AREA,
+                format!("object {oi} '{}': screen area {}", o.name, m.area),
+            ));
         }
         if m.layers.len() != o.layers.len() {
             out.push(e(
-                9102,
+                id::master::LAYOUT_MISMATCH,
                 format!(
                     "object {oi} '{}': {} master layers, the object has {}",
                     o.name,
@@ -372,12 +387,15 @@ pub fn check<S>(c: &Container<S>, masters: &[Master]) -> Vec<Issue> {
         }
         for (li, (ml, l)) in m.layers.iter().zip(&o.layers).enumerate() {
             if ml.codec.is_lossy() {
-                out.push(e(9103, format!("object {oi} layer {li}: codec {} is lossy", ml.codec)));
+                out.push(e(
+                    id::master::CODEC_NOT_EXACT,
+                    format!("object {oi} layer {li}: codec {} is lossy", ml.codec),
+                ));
             }
             let want = c.space.table_len(l.depends_on);
             if ml.samples.len() as u64 != want {
                 out.push(e(
-                    9102,
+                    id::master::LAYOUT_MISMATCH,
                     format!(
                         "object {oi} '{}' layer {li}: {} master samples, the layer has {want}",
                         o.name,
@@ -387,7 +405,7 @@ pub fn check<S>(c: &Container<S>, masters: &[Master]) -> Vec<Issue> {
             }
             if !ml.weights.is_empty() && ml.weights.len() != ml.samples.len() {
                 out.push(e(
-                    9102,
+                    id::master::LAYOUT_MISMATCH,
                     format!(
                         "object {oi} '{}' layer {li}: {} screen weight maps for {} master samples",
                         o.name,
@@ -401,7 +419,7 @@ pub fn check<S>(c: &Container<S>, masters: &[Master]) -> Vec<Issue> {
     if !masters.is_empty() {
         if let Some(oi) = seen.iter().position(|&s| !s) {
             out.push(e(
-                9107,
+                id::master::NOT_EVERY_OBJECT,
                 format!("object {oi} '{}' has no master while others have one", c.objects[oi].name),
             ));
         }
@@ -426,19 +444,27 @@ pub(crate) fn load<S>(
         }
         let mut bytes = vec![0; e.length as usize];
         if let Err(err) = src.read_at(e.offset, &mut bytes) {
-            issues.push(Issue::new(1001, err.to_string()).in_chunk("MSTR", i).at(e.offset));
-            continue;
-        }
-        let crc = crc32fast::hash(&bytes);
-        if crc != e.crc {
             issues.push(
-                Issue::new(3004, format!("stored {:#010x}, computed {crc:#010x}", e.crc))
+                Issue::new(id::io::FILE_UNREADABLE, err.to_string())
                     .in_chunk("MSTR", i)
                     .at(e.offset),
             );
             continue;
         }
-        let mut cursor = Cursor::new(&bytes, e.offset, 9100, ("MSTR", i)).collecting();
+        let crc = crc32fast::hash(&bytes);
+        if crc != e.crc {
+            issues.push(
+                Issue::new(
+                    id::chunk::CHECKSUM_MISMATCH,
+                    format!("stored {:#010x}, computed {crc:#010x}", e.crc),
+                )
+                .in_chunk("MSTR", i)
+                .at(e.offset),
+            );
+            continue;
+        }
+        let mut cursor =
+            Cursor::new(&bytes, e.offset, id::master::MALFORMED, ("MSTR", i)).collecting();
         let parsed = parse(&mut cursor);
         issues.extend(cursor.take_flagged());
         match parsed {

@@ -7,6 +7,7 @@
 use pis_codec::CodecId;
 
 use crate::binary::Cursor;
+use crate::issue::id;
 use crate::model::*;
 use crate::payload_write::{MESH_HULL, MESH_NORMALS, MESH_TEXCOORDS};
 use crate::Issue;
@@ -17,21 +18,31 @@ pub const MAX_DIMS: u32 = 8;
 pub fn pspc(c: &mut Cursor) -> Result<ParameterSpace, Issue> {
     let n = c.u32("dimension count")?;
     if n == 0 || n > MAX_DIMS {
-        return Err(c.issue(4001, format!("{n} dimensions, expected 1 to {MAX_DIMS}")));
+        return Err(c.issue(
+            id::space::DIMENSION_COUNT,
+            format!("{n} dimensions, expected 1 to {MAX_DIMS}"),
+        ));
     }
     c.reserved(4, "reserved")?;
     let mut dims = Vec::with_capacity(n as usize);
     for k in 0..n {
-        let name = c.string(&format!("dimension {k} name"), 4002)?;
-        let unit = c.string(&format!("dimension {k} unit"), 4002)?;
+        let name = c.string(&format!("dimension {k} name"), id::space::DIMENSION_NAME)?;
+        let unit = c.string(&format!("dimension {k} unit"), id::space::DIMENSION_NAME)?;
         let at = c.offset();
         let kind_code = c.u8("kind")?;
         let kind = DimensionKind::from_code(kind_code).ok_or_else(|| {
-            c.issue(4003, format!("dimension {k} kind {kind_code}; 0 to 4 are defined")).at(at)
+            c.issue(
+                id::space::UNKNOWN_DIMENSION_KIND,
+                format!("dimension {k} kind {kind_code}; 0 to 4 are defined"),
+            )
+            .at(at)
         })?;
         let flags = c.u8("flags")?;
         if flags & !1 != 0 {
-            let issue = c.issue(3006, format!("dimension {k} flags {flags:#x} set undefined bits"));
+            let issue = c.issue(
+                id::chunk::RESERVED_NOT_ZERO,
+                format!("dimension {k} flags {flags:#x} set undefined bits"),
+            );
             c.flag(issue)?;
         }
         c.reserved(2, "reserved")?;
@@ -69,18 +80,22 @@ pub fn cams(c: &mut Cursor) -> Result<CameraTable, Issue> {
 pub fn objs(c: &mut Cursor, dim_count: usize) -> Result<Vec<Object<StreamRef>>, Issue> {
     let n = c.u32("object count")?;
     if n == 0 || n > 65535 {
-        return Err(c.issue(5101, format!("{n} objects, expected 1 to 65535")));
+        return Err(c.issue(id::objects::OBJECT_COUNT, format!("{n} objects, expected 1 to 65535")));
     }
     // name length + role + reserved + shading + stagger + mask + count
     let min = 4 + 4 + 28 + 4 * dim_count as u64 + 8;
     let n = c.expect_records(n as u64, min, "objects")?;
     let mut objects = Vec::with_capacity(n);
     for i in 0..n {
-        let name = c.string(&format!("object {i} name"), 5102)?;
+        let name = c.string(&format!("object {i} name"), id::objects::OBJECT_NAME)?;
         let at = c.offset();
         let role_code = c.u8("role")?;
         let role = ObjectRole::from_code(role_code).ok_or_else(|| {
-            c.issue(5103, format!("object {i} role {role_code}; 0 to 2 are defined")).at(at)
+            c.issue(
+                id::objects::UNKNOWN_ROLE,
+                format!("object {i} role {role_code}; 0 to 2 are defined"),
+            )
+            .at(at)
         })?;
         c.reserved(3, "object reserved")?;
         let f0 = c.f32s::<3>("f0")?;
@@ -118,7 +133,10 @@ pub fn mesh(c: &mut Cursor) -> Result<(u32, Mesh), Issue> {
     let ic = c.u32("index count")?;
     let attrs = c.u32("attributes")?;
     if attrs & !(MESH_NORMALS | MESH_TEXCOORDS | MESH_HULL) != 0 {
-        let issue = c.issue(3006, format!("attributes {attrs:#x} set undefined bits"));
+        let issue = c.issue(
+            id::chunk::RESERVED_NOT_ZERO,
+            format!("attributes {attrs:#x} set undefined bits"),
+        );
         c.flag(issue)?;
     }
     let per_vertex = 12
@@ -141,7 +159,7 @@ pub fn mesh(c: &mut Cursor) -> Result<(u32, Mesh), Issue> {
         let h = c.u32("hull triangles")?;
         if h == 0 {
             let issue = c.issue(
-                5200,
+                id::mesh::MALFORMED,
                 "attribute bit 2 (hull) set with a hull triangle count of 0".to_string(),
             );
             c.flag(issue)?;
@@ -163,7 +181,10 @@ pub fn layr(c: &mut Cursor, objects: &mut [Object<StreamRef>]) -> Result<(), Iss
         let oi = c.u32("object index")? as usize;
         if oi >= objects.len() {
             return Err(c
-                .issue(6001, format!("layer {li} names object {oi}; there are {}", objects.len()))
+                .issue(
+                    id::layers::UNKNOWN_OBJECT,
+                    format!("layer {li} names object {oi}; there are {}", objects.len()),
+                )
                 .at(at));
         }
         let codes_at = c.offset();
@@ -176,7 +197,8 @@ pub fn layr(c: &mut Cursor, objects: &mut [Object<StreamRef>]) -> Result<(), Iss
         let combine = c.u8("combine")?;
         c.reserved(1, "layer reserved")?;
         let bad = |what: &str, v: u8| {
-            c.issue(6002, format!("layer {li} {what} {v} is not defined")).at(codes_at)
+            c.issue(id::layers::UNKNOWN_CODE, format!("layer {li} {what} {v} is not defined"))
+                .at(codes_at)
         };
         let kind = LayerKind::from_code(kind).ok_or_else(|| bad("kind", kind))?;
         let mapping = Mapping::from_code(mapping).ok_or_else(|| bad("mapping", mapping))?;
@@ -198,7 +220,10 @@ pub fn layr(c: &mut Cursor, objects: &mut [Object<StreamRef>]) -> Result<(), Iss
             // Shells: the lookups per pixel side less one (0 to MAX_SHELL_LOOKUPS − 1).
             if flags & !15 != 0 || (shape != 0 && flags as u32 >= crate::model::MAX_SHELL_LOOKUPS) {
                 let issue = c
-                    .issue(3006, format!("layer {li} block {bi} placement flags {flags:#x}"))
+                    .issue(
+                        id::chunk::RESERVED_NOT_ZERO,
+                        format!("layer {li} block {bi} placement flags {flags:#x}"),
+                    )
                     .at(shape_at + 2);
                 c.flag(issue)?;
             }
@@ -215,7 +240,7 @@ pub fn layr(c: &mut Cursor, objects: &mut [Object<StreamRef>]) -> Result<(), Iss
             } else {
                 let shape = ShellShape::from_code(shape).ok_or_else(|| {
                     c.issue(
-                        6007,
+                        id::layers::BLOCK_PLACEMENT,
                         format!("layer {li} block {bi} shell shape {shape}; 0 to 5 are defined"),
                     )
                     .at(shape_at)
@@ -238,7 +263,7 @@ pub fn layr(c: &mut Cursor, objects: &mut [Object<StreamRef>]) -> Result<(), Iss
             if unused.iter().any(|v| v.to_bits() != 0) {
                 let issue = c
                     .issue(
-                        3006,
+                        id::chunk::RESERVED_NOT_ZERO,
                         format!("layer {li} block {bi} unused placement values are not +0.0"),
                     )
                     .at(shape_at + 4);
@@ -247,7 +272,7 @@ pub fn layr(c: &mut Cursor, objects: &mut [Object<StreamRef>]) -> Result<(), Iss
             let lc = c.u32("level count")?;
             if lc == 0 || lc > 32 {
                 return Err(c.issue(
-                    7001,
+                    id::pyramid::LEVEL_COUNT,
                     format!("layer {li} block {bi} has {lc} levels, expected 1 to 32"),
                 ));
             }
@@ -266,7 +291,11 @@ pub fn layr(c: &mut Cursor, objects: &mut [Object<StreamRef>]) -> Result<(), Iss
                     let at = c.offset();
                     let code = c.u16("codec")?;
                     let codec = CodecId::from_code(code).ok_or_else(|| {
-                        c.issue(8004, format!("codec id {code}; 0 to 3 are defined")).at(at)
+                        c.issue(
+                            id::codestream::UNKNOWN_CODEC,
+                            format!("codec id {code}; 0 to 3 are defined"),
+                        )
+                        .at(at)
                     })?;
                     c.reserved(2, "reference reserved")?;
                     let chunk = c.u32("chunk index")?;
@@ -296,15 +325,15 @@ pub fn layr(c: &mut Cursor, objects: &mut [Object<StreamRef>]) -> Result<(), Iss
 }
 
 pub fn prov(c: &mut Cursor) -> Result<Provenance, Issue> {
-    let tool = c.string("tool", 9000)?;
-    let source = c.string("source", 9000)?;
+    let tool = c.string("tool", id::provenance::MALFORMED)?;
+    let source = c.string("source", id::provenance::MALFORMED)?;
     let raw_image_bytes = c.u64("raw image bytes")?;
     let n = c.u32("setting count")?;
     let n = c.expect_records(n as u64, 8, "settings")?;
     let mut settings = Vec::with_capacity(n);
     for _ in 0..n {
-        let k = c.string("setting key", 9000)?;
-        let v = c.string("setting value", 9000)?;
+        let k = c.string("setting key", id::provenance::MALFORMED)?;
+        let v = c.string("setting value", id::provenance::MALFORMED)?;
         settings.push((k, v));
     }
     c.finish()?;

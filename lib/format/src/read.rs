@@ -16,6 +16,7 @@ use pis_codec::CodecError;
 use crate::binary::Cursor;
 use crate::blocks::{level_image_index, BlockGrid};
 use crate::chunk::{self, ChunkEntry, Header, ENTRY_LEN, HEADER_LEN};
+use crate::issue::id;
 use crate::master::Master;
 use crate::model::*;
 use crate::source::{FileSource, Source};
@@ -69,7 +70,9 @@ impl PisReader {
         let loaded = load(source.as_ref(), false, &mut issues);
         if let Some(first) = issues.into_iter().find(|i| i.severity == Severity::Error) {
             return Err(match first.id {
-                1001 => Error::Io { path, source: std::io::Error::other(first.detail) },
+                id::io::FILE_UNREADABLE => {
+                    Error::Io { path, source: std::io::Error::other(first.detail) }
+                }
                 _ => Error::Invalid(first),
             });
         }
@@ -83,7 +86,9 @@ impl PisReader {
                 reads: AtomicU64::new(0),
                 read_bytes: AtomicU64::new(0),
             }),
-            _ => Err(Error::Invalid(Issue::new(1001, "file could not be parsed"))),
+            _ => {
+                Err(Error::Invalid(Issue::new(id::io::FILE_UNREADABLE, "file could not be parsed")))
+            }
         }
     }
 
@@ -131,9 +136,12 @@ impl PisReader {
         let crc = crc32fast::hash(&buf);
         if crc != r.crc {
             return Err(Error::Invalid(
-                Issue::new(8003, format!("stored {:#010x}, computed {crc:#010x}", r.crc))
-                    .in_chunk("CSTR", r.chunk as usize)
-                    .at(entry.offset + r.offset),
+                Issue::new(
+                    id::codestream::CHECKSUM_MISMATCH,
+                    format!("stored {:#010x}, computed {crc:#010x}", r.crc),
+                )
+                .in_chunk("CSTR", r.chunk as usize)
+                .at(entry.offset + r.offset),
             ));
         }
         Ok(buf)
@@ -211,14 +219,14 @@ impl PisReader {
                 }
                 e @ CodecError::TrailingBytes { .. } => Error::Invalid(
                     Issue::new(
-                        8008,
+                        id::codestream::TRAILING_BYTES,
                         format!("object {object} layer {layer} block {bi} level {lv}: {e}"),
                     )
                     .in_chunk("CSTR", r.chunk as usize),
                 ),
                 e => Error::Invalid(
                     Issue::new(
-                        8005,
+                        id::codestream::PLANES_MISMATCH,
                         format!("object {object} layer {layer} block {bi} level {lv}: {e}"),
                     )
                     .in_chunk("CSTR", r.chunk as usize),
@@ -226,7 +234,7 @@ impl PisReader {
             })?;
             if let Some(bad) = values.iter().position(|v| !v.is_finite()) {
                 return Err(Error::Invalid(
-                    Issue::new(8006, format!("object {object} layer {layer} block {bi} level {lv}: value {bad} is {}", values[bad]))
+                    Issue::new(id::codestream::VALUE_NOT_FINITE, format!("object {object} layer {layer} block {bi} level {lv}: value {bad} is {}", values[bad]))
                         .in_chunk("CSTR", r.chunk as usize),
                 ));
             }
@@ -262,7 +270,7 @@ impl PisReader {
             &mut issues,
         );
         match issues.into_iter().next() {
-            Some(i) if i.id == 1001 => {
+            Some(i) if i.id == id::io::FILE_UNREADABLE => {
                 Err(Error::Io { path: self.path.clone(), source: std::io::Error::other(i.detail) })
             }
             Some(i) => Err(Error::Invalid(i)),
@@ -292,7 +300,7 @@ pub(crate) fn load(src: &dyn Source, full: bool, issues: &mut Vec<Issue>) -> Loa
     let len = src.len();
     let mut head = vec![0u8; len.min(HEADER_LEN) as usize];
     if let Err(e) = src.read_at(0, &mut head) {
-        issues.push(Issue::new(1001, e.to_string()));
+        issues.push(Issue::new(id::io::FILE_UNREADABLE, e.to_string()));
         return out;
     }
     let header = match chunk::parse_header(&head, len) {
@@ -305,7 +313,7 @@ pub(crate) fn load(src: &dyn Source, full: bool, issues: &mut Vec<Issue>) -> Loa
     // parse_header checked that the table fits in the file.
     let mut table = vec![0u8; header.chunk_count as usize * ENTRY_LEN as usize];
     if let Err(e) = src.read_at(HEADER_LEN, &mut table) {
-        issues.push(Issue::new(1001, e.to_string()));
+        issues.push(Issue::new(id::io::FILE_UNREADABLE, e.to_string()));
         return out;
     }
     let entries = chunk::parse_table(&head, &header, &table, issues);
@@ -329,16 +337,23 @@ pub(crate) fn load(src: &dyn Source, full: bool, issues: &mut Vec<Issue>) -> Loa
             continue;
         }
         let Some(bytes) = read(e.offset, e.length as usize) else {
-            issues.push(Issue::new(1001, "read failed").in_chunk(&e.name(), i).at(e.offset));
+            issues.push(
+                Issue::new(id::io::FILE_UNREADABLE, "read failed")
+                    .in_chunk(&e.name(), i)
+                    .at(e.offset),
+            );
             ok = false;
             continue;
         };
         let crc = crc32fast::hash(&bytes);
         if crc != e.crc {
             issues.push(
-                Issue::new(3004, format!("stored {:#010x}, computed {crc:#010x}", e.crc))
-                    .in_chunk(&e.name(), i)
-                    .at(e.offset),
+                Issue::new(
+                    id::chunk::CHECKSUM_MISMATCH,
+                    format!("stored {:#010x}, computed {crc:#010x}", e.crc),
+                )
+                .in_chunk(&e.name(), i)
+                .at(e.offset),
             );
             ok = false;
             continue;
@@ -368,7 +383,7 @@ fn parse_chunk<T>(
 ) -> Option<T> {
     let data = payloads[i].as_deref()?;
     let e = &entries[i];
-    let malformed = chunk::rule(e.fourcc).map_or(3004, |r| r.malformed);
+    let malformed = chunk::rule(e.fourcc).map_or(id::chunk::CHECKSUM_MISMATCH, |r| r.malformed);
     let mut c = Cursor::new(data, e.offset, malformed, (chunk_name(e), i)).collecting();
     let parsed = f(&mut c);
     issues.extend(c.take_flagged());
@@ -381,11 +396,11 @@ fn parse_chunk<T>(
 fn guards_decoding(i: &Issue) -> bool {
     let layr = i.chunk.as_ref().is_some_and(|(t, _)| t == "LAYR");
     (4000..5000).contains(&i.id)
-        || i.id == 5105
-        || (i.id == 5002 && layr)
+        || i.id == id::objects::STAGGER_NOT_BELOW_BLOCK
+        || (i.id == id::cameras::MASK_NAMES_MISSING_DIMENSION && layr)
         || (6000..8000).contains(&i.id)
-        || i.id == 8001
-        || i.id == 8002
+        || i.id == id::codestream::NOT_CSTR
+        || i.id == id::codestream::OUTSIDE_CHUNK
 }
 
 fn parse(
@@ -425,7 +440,7 @@ fn parse(
             _ => {
                 issues.push(
                     Issue::new(
-                        5201,
+                        id::mesh::UNMATCHED_MESH,
                         format!(
                             "names object {oi}; {} objects, this one already meshed or missing",
                             objects.len()
@@ -442,7 +457,7 @@ fn parse(
         if every_mesh_parsed {
             for (oi, _) in has_mesh.iter().enumerate().filter(|(_, &m)| !m) {
                 issues.push(Issue::new(
-                    5202,
+                    id::mesh::OBJECT_WITHOUT_MESH,
                     format!("object {oi} '{}' has no MESH chunk", objects[oi].name),
                 ));
             }
@@ -529,7 +544,7 @@ fn stream_ranges(entries: &[ChunkEntry], c: &Container<StreamRef>, issues: &mut 
             if r.offset.checked_add(r.length as u64).is_none_or(|end| end > e.length) {
                 issues.push(
                     Issue::new(
-                        8002,
+                        id::codestream::OUTSIDE_CHUNK,
                         format!(
                             "{what}: {} bytes at {} in a chunk of {}",
                             r.length, r.offset, e.length
@@ -540,7 +555,8 @@ fn stream_ranges(entries: &[ChunkEntry], c: &Container<StreamRef>, issues: &mut 
             }
         }
         _ => issues.push(
-            Issue::new(8001, format!("{what}: chunk {}", r.chunk)).in_chunk("LAYR", usize::MAX),
+            Issue::new(id::codestream::NOT_CSTR, format!("{what}: chunk {}", r.chunk))
+                .in_chunk("LAYR", usize::MAX),
         ),
     });
 }

@@ -6,6 +6,7 @@ use std::path::Path;
 
 use pis_codec::CodecError;
 
+use crate::issue::id;
 use crate::model::StreamRef;
 use crate::read::{for_each_ref, load};
 use crate::source::{FileSource, Source};
@@ -32,7 +33,7 @@ pub fn validate_file(path: &Path) -> Validation {
     match std::fs::File::open(path).and_then(FileSource::new) {
         Ok(src) => validate_source(&src),
         Err(e) => Validation {
-            issues: vec![Issue::new(1001, format!("{}: {e}", path.display()))],
+            issues: vec![Issue::new(id::io::FILE_UNREADABLE, format!("{}: {e}", path.display()))],
             ..Default::default()
         },
     }
@@ -105,27 +106,32 @@ fn check_stream(
     let tag = |i: Issue| i.in_chunk("CSTR", r.chunk as usize).at(at);
     let mut bytes = vec![0; r.length as usize];
     if let Err(err) = src.read_at(at, &mut bytes) {
-        return Some(tag(Issue::new(1001, format!("{what}: {err}"))));
+        return Some(tag(Issue::new(id::io::FILE_UNREADABLE, format!("{what}: {err}"))));
     }
     let crc = crc32fast::hash(&bytes);
     if crc != r.crc {
         return Some(tag(Issue::new(
-            8003,
+            id::codestream::CHECKSUM_MISMATCH,
             format!("{what}: stored {:#010x}, computed {crc:#010x}", r.crc),
         )));
     }
     match pis_codec::decode(r.codec, &layout.planes(), &bytes) {
         Ok(values) => {
             let bad = values.iter().position(|v| !v.is_finite())?;
-            Some(tag(Issue::new(8006, format!("{what}: value {bad} is {}", values[bad]))))
+            Some(tag(Issue::new(
+                id::codestream::VALUE_NOT_FINITE,
+                format!("{what}: value {bad} is {}", values[bad]),
+            )))
         }
         Err(err @ CodecError::TrailingBytes { .. }) => {
-            Some(tag(Issue::new(8008, format!("{what}: {err}"))))
+            Some(tag(Issue::new(id::codestream::TRAILING_BYTES, format!("{what}: {err}"))))
         }
         Err(CodecError::NotSupported(c)) => Some(tag(Issue::warning(
-            8007,
+            id::codestream::RESERVED_CODEC,
             format!("{what}: codec '{c}' cannot be checked by this build"),
         ))),
-        Err(err) => Some(tag(Issue::new(8005, format!("{what}: {err}")))),
+        Err(err) => {
+            Some(tag(Issue::new(id::codestream::PLANES_MISMATCH, format!("{what}: {err}"))))
+        }
     }
 }

@@ -5,6 +5,7 @@
 
 use pis_codec::CodecError;
 use pis_format::blocks::{level_image_index, BlockGrid};
+use pis_format::issue::id;
 use pis_format::reconstruct::finish;
 use pis_format::{Error, Issue, LevelLayout, PisReader};
 use rayon::prelude::*;
@@ -89,14 +90,14 @@ pub fn decode_block(
                     Error::NotSupported(format!("codec '{codec}' (object {object}, layer {layer})"))
                 }
                 e => Error::Invalid(
-                    Issue::new(8005, format!("object {object} layer {layer} block {block} level {lv}: {e}"))
+                    Issue::new(id::codestream::PLANES_MISMATCH, format!("object {object} layer {layer} block {block} level {lv}: {e}"))
                         .in_chunk("CSTR", s.chunk as usize),
                 ),
             })?;
             if let Some(bad) = values.iter().position(|v| !v.is_finite()) {
                 return Err(Error::Invalid(
                     Issue::new(
-                        8006,
+                        id::codestream::VALUE_NOT_FINITE,
                         format!("object {object} layer {layer} block {block} level {lv}: value {bad} is {}", values[bad]),
                     )
                     .in_chunk("CSTR", s.chunk as usize),
