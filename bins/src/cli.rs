@@ -52,3 +52,20 @@ pub fn parse_shading_seed(s: &str) -> Result<pis_trace::ShadingSeed, String> {
     pis_trace::ShadingSeed::from_name(s)
         .ok_or_else(|| format!("unknown shading seed {s:?} (cell or sample)"))
 }
+
+/// A clap parser for one of `all`, by the names `name` gives them: `--help` lists the names
+/// and a name not among them is refused with the list, so that the library's names are the
+/// only spelling of a mode.
+pub fn one_of<T>(
+    all: &'static [T],
+    name: fn(T) -> &'static str,
+) -> impl clap::builder::TypedValueParser<Value = T>
+where
+    T: Copy + Send + Sync + 'static,
+{
+    use clap::builder::TypedValueParser;
+    clap::builder::PossibleValuesParser::new(all.iter().map(|&v| name(v))).map(move |s| {
+        let found = all.iter().copied().find(|&v| name(v) == s);
+        found.expect("the parser takes only the listed names")
+    })
+}

@@ -8,7 +8,7 @@ use clap::Args;
 use pis_codec::CodecId;
 use pis_compile::{Filter, MAX_ANISOTROPY};
 
-use crate::cli::{Exit, Failure};
+use crate::cli::{one_of, Exit, Failure};
 use pis_pack::{
     filter_needs_probe, Allocation, BlockSize, LayerMode, MatrixSource, MaxMse, PackRequest,
     PackSettings, PlacementMode, PyramidMode, RepresentationMode, Stagger,
@@ -25,8 +25,8 @@ pub struct PackOptions {
     /// textures, screen-area weighted; the predicted screen PSNR is also bounded by inference.
     #[arg(long)]
     pub psnr: Option<f64>,
-    /// Level-image codec: wavelet, dct or lossless.
-    #[arg(long, default_value = "wavelet", value_parser = parse_codec)]
+    /// Level-image codec.
+    #[arg(long, default_value = "wavelet", value_parser = one_of(&CodecId::ALL, CodecId::name))]
     pub codec: CodecId,
     /// Samples per parameter block: one size for every dimension (8) or one per dimension (8x8).
     #[arg(long, default_value = "8", value_parser = parse_block)]
@@ -34,7 +34,7 @@ pub struct PackOptions {
     /// Texture filtering the player uses: trilinear, bilinear, or anisotropic (trilinear lookups
     /// along the footprint's major axis, as the adapter's sampler takes them; needs
     /// `--matrix probe`, since no specification pins the footprint down).
-    #[arg(long, default_value = "trilinear", value_parser = parse_filter)]
+    #[arg(long, default_value = "trilinear", value_parser = one_of(&FILTERS, Filter::name))]
     pub filter: Filter,
     /// Anisotropic filtering: the sampler's anisotropy clamp, 1 to 16 (the most lookups per
     /// pixel; an adapter may ignore it: Mesa 22.3's lavapipe filters the same for any clamp
@@ -45,7 +45,7 @@ pub struct PackOptions {
     /// `probe` (measured through the player's wgpu pipeline on this machine's GPU adapter with
     /// texel-identifier renderings, thesis 3.4.3: slower, but exact for whatever the adapter
     /// does; needs an adapter, Mesa's lavapipe without a GPU).
-    #[arg(long, default_value = "model", value_parser = parse_matrix)]
+    #[arg(long, default_value = "model", value_parser = one_of(&MATRIX_SOURCES, MatrixSource::name))]
     pub matrix: MatrixSource,
     /// Largest used texture side.
     #[arg(long, default_value_t = pis_pack::DEFAULT_MAX_TEXTURE)]
@@ -56,7 +56,7 @@ pub struct PackOptions {
     /// --max-texture only.
     #[arg(long, default_value = "1", value_parser = parse_budget)]
     pub texels_per_pixel: Budget,
-    /// Display gamma of the compensation (1: linear storage; lossless packs always use 1).
+    /// Display gamma of the compensation (1: linear storage; lossless and raw packs always use 1).
     #[arg(long, default_value_t = pis_pack::DEFAULT_GAMMA)]
     pub gamma: f32,
     /// Tracing a scene.toml: image size WIDTHxHEIGHT.
@@ -90,7 +90,7 @@ pub struct PackOptions {
     /// the object: the static environment map of thesis 5.1); `pem-infinity` stores
     /// refractive objects by hybrid rendering with a single shell (the single-shell
     /// baseline of thesis 6.5), `static-env` as `pem` does.
-    #[arg(long, default_value = "texture", value_parser = parse_representation)]
+    #[arg(long, default_value = "texture", value_parser = one_of(&REPRESENTATIONS, RepresentationMode::name))]
     pub representation: RepresentationMode,
     /// Conjugate-gradient iteration cap per colour channel of every texture solve
     /// (default: the solver's own).
@@ -111,13 +111,13 @@ pub struct PackOptions {
     /// Which views each texture placement (branch cuts, affine map, used size; thesis 3.2)
     /// is optimized over: `block` (per object per parameter block, the views of the
     /// block's samples) or `object` (one placement per object over every view of the set).
-    #[arg(long, default_value = "block", value_parser = parse_placement)]
+    #[arg(long, default_value = "block", value_parser = one_of(&PLACEMENTS, PlacementMode::name))]
     pub placement: PlacementMode,
     /// Which dimensions the objects' block origins are staggered along (thesis 4.7), so that
     /// crossing a block boundary decodes one object's block at a time: `auto`, those with
     /// more samples than a block (one that fits in a block has no boundary, and an offset
     /// would only split each object's samples in two); `always`, every dimension.
-    #[arg(long, value_name = "auto|always", default_value = "auto", value_parser = parse_stagger)]
+    #[arg(long, value_name = "auto|always", default_value = "auto", value_parser = one_of(&Stagger::ALL, Stagger::name))]
     pub stagger: Stagger,
     /// Layered environment maps and one shell at infinity: lookups per pixel side, 1 to 3.
     /// Each pixel averages k × k lookups of a shell at sub-pixel offsets (SPEC.md 8.2), as a
@@ -172,7 +172,7 @@ impl PackOptions {
             matrix: self.matrix,
             max_texture: self.max_texture,
             texels_per_pixel: self.texels_per_pixel.0,
-            gamma: if self.codec == CodecId::Lossless { 1.0 } else { self.gamma },
+            gamma: if self.codec.is_lossy() { self.gamma } else { 1.0 },
             pyramid: self.pyramid,
             layers: self.layers,
             representation: self.representation,
@@ -203,12 +203,18 @@ impl PackOptions {
 
     /// pis-pack's defaults.
     pub fn defaults() -> Self {
+        Self::try_parse(&[]).expect("the defaults parse")
+    }
+
+    /// The options `args` (flags only) give.
+    fn try_parse(args: &[&str]) -> Result<Self, clap::Error> {
         #[derive(clap::Parser)]
         struct Only {
             #[command(flatten)]
             pack: PackOptions,
         }
-        <Only as clap::Parser>::parse_from(["pis-pack"]).pack
+        let args = std::iter::once("pis-pack").chain(args.iter().copied());
+        <Only as clap::Parser>::try_parse_from(args).map(|o| o.pack)
     }
 }
 
@@ -219,14 +225,6 @@ fn parse_memory(s: &str) -> Result<f64, String> {
         .ok_or_else(|| format!("bad memory budget {s:?}: expected a number of GB above 0"))
 }
 
-fn parse_codec(s: &str) -> Result<CodecId, String> {
-    match s {
-        "wavelet" => Ok(CodecId::Wavelet),
-        "dct" => Ok(CodecId::Dct),
-        "lossless" => Ok(CodecId::Lossless),
-        _ => Err(format!("unknown codec {s:?} (wavelet, dct or lossless)")),
-    }
-}
 
 fn parse_pyramid(s: &str) -> Result<PyramidMode, String> {
     match s {
@@ -244,30 +242,8 @@ fn parse_layers(s: &str) -> Result<LayerMode, String> {
     }
 }
 
-fn parse_representation(s: &str) -> Result<RepresentationMode, String> {
-    match s {
-        "texture" => Ok(RepresentationMode::Texture),
-        "pem" => Ok(RepresentationMode::Pem),
-        "pem-infinity" => Ok(RepresentationMode::PemInfinity),
-        "static-env" => Ok(RepresentationMode::StaticEnv),
-        "auto" => Ok(RepresentationMode::Auto),
-        _ => Err(format!(
-            "unknown representation {s:?} (auto, texture, pem, pem-infinity or static-env)"
-        )),
-    }
-}
 
-pub fn parse_stagger(s: &str) -> Result<Stagger, String> {
-    Stagger::from_name(s).ok_or_else(|| format!("unknown stagger {s:?} (auto or always)"))
-}
 
-fn parse_placement(s: &str) -> Result<PlacementMode, String> {
-    match s {
-        "block" => Ok(PlacementMode::Block),
-        "object" => Ok(PlacementMode::Object),
-        _ => Err(format!("unknown placement {s:?} (block or object)")),
-    }
-}
 
 /// `--max-mse-ratio`: `auto`, `off`, or α above 1.
 pub fn parse_max_mse_ratio(s: &str) -> Result<MaxMse, String> {
@@ -291,23 +267,27 @@ fn parse_allocation(s: &str) -> Result<Allocation, String> {
     }
 }
 
-fn parse_filter(s: &str) -> Result<Filter, String> {
-    match s {
-        "trilinear" => Ok(Filter::Trilinear),
-        "bilinear" => Ok(Filter::Bilinear),
-        // The clamp comes from --anisotropy.
-        "anisotropic" => Ok(Filter::Anisotropic(MAX_ANISOTROPY)),
-        _ => Err(format!("unknown filter {s:?} (trilinear, bilinear or anisotropic)")),
-    }
-}
 
-fn parse_matrix(s: &str) -> Result<MatrixSource, String> {
-    match s {
-        "model" => Ok(MatrixSource::Model),
-        "probe" => Ok(MatrixSource::Probe),
-        _ => Err(format!("unknown render matrix source {s:?} (model or probe)")),
-    }
-}
+
+/// The values of `--filter`, by [`Filter::name`] (the anisotropy clamp comes from
+/// `--anisotropy`).
+const FILTERS: [Filter; 3] =
+    [Filter::Trilinear, Filter::Bilinear, Filter::Anisotropic(MAX_ANISOTROPY)];
+
+/// The values of `--matrix`, by [`MatrixSource::name`].
+const MATRIX_SOURCES: [MatrixSource; 2] = [MatrixSource::Model, MatrixSource::Probe];
+
+/// The values of `--representation`, by [`RepresentationMode::name`].
+const REPRESENTATIONS: [RepresentationMode; 5] = [
+    RepresentationMode::Texture,
+    RepresentationMode::Pem,
+    RepresentationMode::PemInfinity,
+    RepresentationMode::StaticEnv,
+    RepresentationMode::Auto,
+];
+
+/// The values of `--placement`, by [`PlacementMode::name`].
+const PLACEMENTS: [PlacementMode; 2] = [PlacementMode::Block, PlacementMode::Object];
 
 /// `--texels-per-pixel`: a positive number or `none`.
 #[derive(Clone, Copy, Debug)]
@@ -350,18 +330,19 @@ mod tests {
         assert_eq!(req.settings, PackSettings::new());
     }
 
-    /// `--representation` takes every mode by the name the library gives it.
+    /// Every mode parses by the name the library gives it, and a wrong name is refused.
     #[test]
-    fn every_representation_parses_by_its_name() {
-        for mode in [
-            RepresentationMode::Texture,
-            RepresentationMode::Pem,
-            RepresentationMode::PemInfinity,
-            RepresentationMode::StaticEnv,
-            RepresentationMode::Auto,
-        ] {
-            assert_eq!(parse_representation(mode.name()), Ok(mode));
+    fn every_mode_parses_by_its_name() {
+        for mode in REPRESENTATIONS {
+            let o = PackOptions::try_parse(&["--representation", mode.name()]).unwrap();
+            assert_eq!(o.representation, mode);
         }
-        assert!(parse_representation("static").unwrap_err().contains("static-env"));
+        for codec in CodecId::ALL {
+            assert_eq!(PackOptions::try_parse(&["--codec", codec.name()]).unwrap().codec, codec);
+        }
+        for (flag, value) in [("--representation", "static"), ("--codec", "jpeg")] {
+            let err = PackOptions::try_parse(&[flag, value]).unwrap_err().to_string();
+            assert!(err.contains("possible values"), "{err}");
+        }
     }
 }

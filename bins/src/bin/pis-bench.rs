@@ -143,7 +143,7 @@ enum Command {
         max_mse_ratio: pis_pack::MaxMse,
         /// The PIS packs' block staggering, as pis-pack's --stagger: `auto` (the dimensions
         /// with more samples than a block) or `always` (every dimension).
-        #[arg(long, value_name = "auto|always", default_value = "auto", value_parser = pis::pack_args::parse_stagger)]
+        #[arg(long, value_name = "auto|always", default_value = "auto", value_parser = pis::cli::one_of(&pis_pack::Stagger::ALL, pis_pack::Stagger::name))]
         stagger: pis_pack::Stagger,
         /// Record the run (machine, scene, command, PSNR near 384:1) in docs/BENCHMARKS.md.
         #[arg(long)]

@@ -28,8 +28,8 @@ struct Cli {
     /// The container to write (atomically; nothing is left on error).
     #[arg(short, long)]
     output: PathBuf,
-    /// Level-image codec: wavelet, dct, lossless or raw.
-    #[arg(long, default_value = "wavelet", value_parser = parse_codec)]
+    /// Level-image codec.
+    #[arg(long, default_value = "wavelet", value_parser = pis::cli::one_of(&CodecId::ALL, CodecId::name))]
     codec: CodecId,
     /// Target compression ratio: level-image bytes = raw image bytes / R. Default (lossy
     /// codecs): the input's level-image bytes.
@@ -63,12 +63,6 @@ struct Cli {
     json: bool,
 }
 
-fn parse_codec(s: &str) -> Result<CodecId, String> {
-    CodecId::ALL
-        .into_iter()
-        .find(|c| c.name() == s)
-        .ok_or_else(|| format!("unknown codec {s:?} (wavelet, dct, lossless or raw)"))
-}
 
 /// `--block`: one size, or one per dimension.
 #[derive(Clone, Debug)]

@@ -65,6 +65,7 @@ impl CodecId {
         Self::ALL.into_iter().find(|c| c.code() == code)
     }
 
+    /// The name the tools take (`--codec`) and print.
     pub fn name(self) -> &'static str {
         match self {
             CodecId::Raw => "raw",
@@ -72,6 +73,11 @@ impl CodecId {
             CodecId::Wavelet => "wavelet",
             CodecId::Dct => "dct",
         }
+    }
+
+    /// The codec named `name`, if any.
+    pub fn from_name(name: &str) -> Option<Self> {
+        Self::ALL.into_iter().find(|c| c.name() == name)
     }
 
     /// True when this build can decode the codec (every defined id in this build).
@@ -90,6 +96,27 @@ impl std::fmt::Display for CodecId {
         f.write_str(self.name())
     }
 }
+
+impl std::str::FromStr for CodecId {
+    type Err = UnknownCodec;
+
+    fn from_str(s: &str) -> Result<Self, UnknownCodec> {
+        CodecId::from_name(s).ok_or_else(|| UnknownCodec(s.to_string()))
+    }
+}
+
+/// A codec name that is none of [`CodecId::ALL`]'s; its message lists those.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct UnknownCodec(pub String);
+
+impl std::fmt::Display for UnknownCodec {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let names: Vec<&str> = CodecId::ALL.iter().map(|c| c.name()).collect();
+        write!(f, "unknown codec {:?} ({})", self.0, names.join(", "))
+    }
+}
+
+impl std::error::Error for UnknownCodec {}
 
 /// A level-image codec. Implementations check `values.len()` against the shapes, take
 /// signed float data, and never trust the codestream for sizes.

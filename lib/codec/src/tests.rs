@@ -89,6 +89,16 @@ fn every_codec_is_registered_under_its_id() {
     assert_eq!(CodecId::from_code(99), None);
 }
 
+/// `--codec` takes every codec by its name, and a wrong name's error lists them.
+#[test]
+fn every_codec_parses_by_its_name() {
+    for c in CodecId::ALL {
+        assert_eq!(c.name().parse::<CodecId>(), Ok(c));
+    }
+    let err = "jpeg".parse::<CodecId>().unwrap_err().to_string();
+    assert_eq!(err, r#"unknown codec "jpeg" (raw, lossless, wavelet, dct)"#);
+}
+
 /// A smooth float texture with noise, signed (like a pyramid residual) when `offset` is 0.
 fn texture(w: u32, h: u32, c: u32, offset: f32) -> Vec<f32> {
     let mut seed = 0x9E37_79B9_u32;
