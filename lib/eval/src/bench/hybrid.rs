@@ -145,11 +145,8 @@ fn percentile(mut v: Vec<f64>, f: f64) -> f64 {
     v[((v.len() - 1) as f64 * f).round() as usize]
 }
 
-pub fn run(req: &HybridRequest) -> Result<HybridReport, Failure> {
-    let options = LoadOptions { preset: req.preset.clone(), resolution: req.resolution, spp: None };
-    let scene = pis_scene::load_with(&req.scene, &options).map_err(|e| {
-        Failure::new(pis_pack::scene_exit(&e), anyhow!("{}: {e}", req.scene.display()))
-    })?;
+/// The scene's lens objects (at least one), once the request's τ are checked.
+fn lenses(scene: &pis_scene::Scene, req: &HybridRequest) -> Result<Vec<usize>, Failure> {
     let lenses: Vec<usize> = scene
         .objects
         .iter()
@@ -166,6 +163,15 @@ pub fn run(req: &HybridRequest) -> Result<HybridReport, Failure> {
     if req.taus.is_empty() || req.taus.iter().any(|t| !(t.is_finite() && *t > 0.0)) {
         return Err(Failure::new(Exit::Usage, anyhow!("--tau: give positive values in pixels")));
     }
+    Ok(lenses)
+}
+
+pub fn run(req: &HybridRequest) -> Result<HybridReport, Failure> {
+    let options = LoadOptions { preset: req.preset.clone(), resolution: req.resolution, spp: None };
+    let scene = pis_scene::load_with(&req.scene, &options).map_err(|e| {
+        Failure::new(pis_pack::scene_exit(&e), anyhow!("{}: {e}", req.scene.display()))
+    })?;
+    let lenses = lenses(&scene, req)?;
     let (_, frames) = paths(&scene, req.frames.max(1), &[PathKind::Between])
         .map_err(|e| Failure::new(Exit::Usage, e))?;
     let size = scene.resolution;

@@ -12,7 +12,7 @@
 //! objects cover (as `pis-pack` reports it); view-based PSNR is over the whole image. Both
 //! are on display values (crate::metrics) against the gold standard.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use crate::baselines::video::{available, VideoCodec};
@@ -288,12 +288,57 @@ pub fn run(req: &RdRequest) -> Result<RdReport, Failure> {
         )?;
     }
 
-    if wanted("mpeg-texture-x265")
-        && video_or_skip(VideoCodec::X265, &mut skipped, "mpeg-texture-x265")?
+    video_points(req, &separate, &wanted, &mut rows, &mut skipped)?;
+    let set = &separate.set;
+    let scene = format!(
+        "{} ({} points, {}x{})",
+        set.scene.name,
+        set.samples.len(),
+        set.resolution.0,
+        set.resolution.1
+    );
+    let stamp = Stamp::here(&scene);
+    let (c, s) = write_rd(&req.out, &rows, &scene, &stamp, gpu.is_some())?;
+    let notes = vec![
+        "budget = raw image bytes (points × width × height × 3) / target ratio; ratio = raw / bytes spent".into(),
+        "PIS bytes: level images (as pis-pack's --ratio counts them); file_ratio adds geometry, tables and headers".into(),
+        "videos: 8-bit yuv420p, BT.601 limited range, elementary streams (HEVC Annex B, AV1 OBUs), one common CRF searched per point".into(),
+        "PIS PSNR: the file played by the player (crate::compare), whole image (psnr_db_covered: covered pixels); without a GPU adapter pis-pack's prediction over covered pixels. mpeg-texture: predicted through the hardware model over covered pixels; view-based: whole image".into(),
+    ];
+    let report = RdReport {
+        scene,
+        points: set.samples.len(),
+        resolution: [set.resolution.0, set.resolution.1],
+        raw_image_bytes: raw,
+        rows,
+        skipped,
+        csv: c.display().to_string(),
+        svg: s.display().to_string(),
+        stamp,
+        notes,
+    };
+    if req.record {
+        record("rd", &report.stamp, &summary(&report)).map_err(|e| Failure::new(Exit::Io, e))?;
+    }
+    Ok(report)
+}
+
+/// The video baselines' points: MPEG-coded textures (x265) and MPEG-coded views (x265, AV1),
+/// each skipped (and said so) when its encoder is missing outside CI.
+fn video_points(
+    req: &RdRequest,
+    separate: &Inferred,
+    wanted: &dyn Fn(&str) -> bool,
+    rows: &mut Vec<RdRow>,
+    skipped: &mut Vec<String>,
+) -> Result<(), Failure> {
+    let raw = separate.raw_image_bytes();
+    let budget = |r: f64| (raw as f64 / r) as usize;
+    if wanted("mpeg-texture-x265") && video_or_skip(VideoCodec::X265, skipped, "mpeg-texture-x265")?
     {
         for &r in &req.ratios {
             let t = Instant::now();
-            let p = texture_point(&separate, budget(r)).map_err(runtime)?;
+            let p = texture_point(separate, budget(r)).map_err(runtime)?;
             eprintln!(
                 "pis-bench: rd: {:<28} {r:>7.1}:1 → {:>7.1}:1  {:6.2} dB  ({} videos, CRF {:.2})",
                 "mpeg-texture-x265",
@@ -319,9 +364,9 @@ pub fn run(req: &RdRequest) -> Result<RdReport, Failure> {
             });
         }
     }
-    let frames = view_frames(&separate).map_err(runtime)?;
+    let frames = view_frames(separate).map_err(runtime)?;
     for (codec, name) in [(VideoCodec::X265, "view-x265"), (VideoCodec::Av1, "view-av1")] {
-        if !wanted(name) || !video_or_skip(codec, &mut skipped, name)? {
+        if !wanted(name) || !video_or_skip(codec, skipped, name)? {
             continue;
         }
         for &r in &req.ratios {
@@ -351,15 +396,18 @@ pub fn run(req: &RdRequest) -> Result<RdReport, Failure> {
         }
     }
 
-    let set = &separate.set;
-    let scene = format!(
-        "{} ({} points, {}x{})",
-        set.scene.name,
-        set.samples.len(),
-        set.resolution.0,
-        set.resolution.1
-    );
-    let stamp = Stamp::here(&scene);
+    Ok(())
+}
+
+/// Writes rd.csv and rd.svg into `out`: a row per point, a series per method; `played`: the
+/// PIS points' PSNR was measured by playing the files.
+fn write_rd(
+    out: &Path,
+    rows: &[RdRow],
+    scene: &str,
+    stamp: &Stamp,
+    played: bool,
+) -> Result<(PathBuf, PathBuf), Failure> {
     let mut csv = Csv::new(&[
         "method",
         "target_ratio",
@@ -376,7 +424,7 @@ pub fn run(req: &RdRequest) -> Result<RdReport, Failure> {
         "ms",
     ]);
     let opt = |v: Option<f64>| v.map_or(String::new(), |x| format!("{x:.3}"));
-    for r in &rows {
+    for r in rows {
         csv.push(vec![
             r.method.clone(),
             format!("{}", r.target_ratio),
@@ -403,7 +451,7 @@ pub fn run(req: &RdRequest) -> Result<RdReport, Failure> {
         .collect();
     let chart = Chart {
         title: format!("Compression ratio vs PSNR — {scene}"),
-        subtitle: if gpu.is_some() {
+        subtitle: if played {
             "PIS: files played by the player, whole image; mpeg-texture: predicted through the hardware model over covered pixels; view-*: whole decoded image".into()
         } else {
             "PIS and mpeg-texture: PSNR predicted through the hardware model over covered pixels (no GPU adapter); view-*: whole decoded image".into()
@@ -413,30 +461,7 @@ pub fn run(req: &RdRequest) -> Result<RdReport, Failure> {
         x_log: true,
         stamp: stamp.lines(),
     };
-    let (c, s) = write_chart(&req.out, "rd", &csv, &chart, &series)
-        .map_err(|e| Failure::new(Exit::Io, e))?;
-    let notes = vec![
-        "budget = raw image bytes (points × width × height × 3) / target ratio; ratio = raw / bytes spent".into(),
-        "PIS bytes: level images (as pis-pack's --ratio counts them); file_ratio adds geometry, tables and headers".into(),
-        "videos: 8-bit yuv420p, BT.601 limited range, elementary streams (HEVC Annex B, AV1 OBUs), one common CRF searched per point".into(),
-        "PIS PSNR: the file played by the player (crate::compare), whole image (psnr_db_covered: covered pixels); without a GPU adapter pis-pack's prediction over covered pixels. mpeg-texture: predicted through the hardware model over covered pixels; view-based: whole image".into(),
-    ];
-    let report = RdReport {
-        scene,
-        points: set.samples.len(),
-        resolution: [set.resolution.0, set.resolution.1],
-        raw_image_bytes: raw,
-        rows,
-        skipped,
-        csv: c.display().to_string(),
-        svg: s.display().to_string(),
-        stamp,
-        notes,
-    };
-    if req.record {
-        record("rd", &report.stamp, &summary(&report)).map_err(|e| Failure::new(Exit::Io, e))?;
-    }
-    Ok(report)
+    write_chart(out, "rd", &csv, &chart, &series).map_err(|e| Failure::new(Exit::Io, e))
 }
 
 /// PSNR per method at the ratio closest to 384:1 (or the middle ratio).
