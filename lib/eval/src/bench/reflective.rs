@@ -227,6 +227,81 @@ fn runtime(e: impl Into<anyhow::Error>) -> Failure {
     Failure::new(Exit::Runtime, e.into())
 }
 
+/// One played file's frames along each path against the references: a CSV row per frame
+/// and a summary per path.
+fn measure(
+    req: &ReflectiveRequest,
+    name: &str,
+    frames: &[PathFrame],
+    refs: &[Reference],
+    played: &[Vec<f32>],
+    csv: &mut Csv,
+    summaries: &mut Vec<ReflectiveSummary>,
+) {
+    for kind in PATHS {
+        let idx: Vec<usize> = (0..frames.len()).filter(|&i| frames[i].kind == kind).collect();
+        let (mut psnrs, mut popping, mut pooled) = (Vec::new(), 0.0f64, PairedError::default());
+        for (j, &i) in idx.iter().enumerate() {
+            // Against the gold standard (with a pair, the pair's mean), and between the
+            // pair's renders: together the pair's error (`PairedError`).
+            let (mut e, mut between) = (SquaredError::default(), SquaredError::default());
+            for (p, _) in refs[i].mask.iter().enumerate().filter(|(_, m)| **m) {
+                let k = p * 3..p * 3 + 3;
+                e.add_slices(&played[i][k.clone()], &refs[i].rgb[k.clone()]);
+                if let Some([a, b]) = &refs[i].pair {
+                    between.add_slices(&a[k.clone()], &b[k]);
+                }
+            }
+            let paired = PairedError { against_mean: e, between };
+            pooled.merge(&paired);
+            let paired_cells = match refs[i].pair {
+                Some(_) => [
+                    format!("{:.3}", paired.psnr_noise_removed()),
+                    format!("{:.3}", paired.reference_psnr()),
+                ],
+                None => [String::new(), String::new()],
+            };
+            let change = (j > 0).then(|| {
+                let prev = idx[j - 1];
+                let both: Vec<bool> =
+                    refs[i].mask.iter().zip(&refs[prev].mask).map(|(a, b)| *a && *b).collect();
+                [
+                    rms_change(&played[i], &played[prev], &both),
+                    rms_change(&refs[i].rgb, &refs[prev].rgb, &both),
+                ]
+            });
+            if let Some([p, r]) = change {
+                popping = popping.max(p / r.max(0.5 / 255.0));
+            }
+            psnrs.push(e.psnr());
+            csv.push(vec![
+                name.to_string(),
+                kind.name().into(),
+                j.to_string(),
+                format!("{:.3}", frames[i].view),
+                format!("{:.3}", e.psnr()),
+                change.map_or(String::new(), |c| format!("{:.5}", c[0])),
+                change.map_or(String::new(), |c| format!("{:.5}", c[1])),
+                paired_cells[0].clone(),
+                paired_cells[1].clone(),
+            ]);
+        }
+        let mean = psnrs.iter().sum::<f64>() / psnrs.len().max(1) as f64;
+        let min = psnrs.iter().copied().fold(f64::INFINITY, f64::min);
+        let pair = |v: f64| req.reference_pair.then_some(v);
+        summaries.push(ReflectiveSummary {
+            file: name.to_string(),
+            path: kind,
+            mean_psnr_db: mean,
+            min_psnr_db: min,
+            popping,
+            pooled_psnr_db: pair(pooled.against_mean.psnr()),
+            noise_removed_psnr_db: pair(pooled.psnr_noise_removed()),
+            reference_psnr_db: pair(pooled.reference_psnr()),
+        });
+    }
+}
+
 /// Plays every file along both paths and measures it against the traced references.
 pub fn run(req: &ReflectiveRequest) -> Result<ReflectiveReport, Failure> {
     if req.files.is_empty() || req.frames < 2 || req.spp == 0 {
@@ -318,68 +393,7 @@ pub fn run(req: &ReflectiveRequest) -> Result<ReflectiveReport, Failure> {
                     .map_err(|e| Failure::new(Exit::Io, anyhow!("{}: {e}", path.display())))?;
             }
         }
-        for kind in PATHS {
-            let idx: Vec<usize> = (0..frames.len()).filter(|&i| frames[i].kind == kind).collect();
-            let (mut psnrs, mut popping, mut pooled) = (Vec::new(), 0.0f64, PairedError::default());
-            for (j, &i) in idx.iter().enumerate() {
-                // Against the gold standard (with a pair, the pair's mean), and between the
-                // pair's renders: together the pair's error (`PairedError`).
-                let (mut e, mut between) = (SquaredError::default(), SquaredError::default());
-                for (p, _) in refs[i].mask.iter().enumerate().filter(|(_, m)| **m) {
-                    let k = p * 3..p * 3 + 3;
-                    e.add_slices(&played[i][k.clone()], &refs[i].rgb[k.clone()]);
-                    if let Some([a, b]) = &refs[i].pair {
-                        between.add_slices(&a[k.clone()], &b[k]);
-                    }
-                }
-                let paired = PairedError { against_mean: e, between };
-                pooled.merge(&paired);
-                let paired_cells = match refs[i].pair {
-                    Some(_) => [
-                        format!("{:.3}", paired.psnr_noise_removed()),
-                        format!("{:.3}", paired.reference_psnr()),
-                    ],
-                    None => [String::new(), String::new()],
-                };
-                let change = (j > 0).then(|| {
-                    let prev = idx[j - 1];
-                    let both: Vec<bool> =
-                        refs[i].mask.iter().zip(&refs[prev].mask).map(|(a, b)| *a && *b).collect();
-                    [
-                        rms_change(&played[i], &played[prev], &both),
-                        rms_change(&refs[i].rgb, &refs[prev].rgb, &both),
-                    ]
-                });
-                if let Some([p, r]) = change {
-                    popping = popping.max(p / r.max(0.5 / 255.0));
-                }
-                psnrs.push(e.psnr());
-                csv.push(vec![
-                    name.clone(),
-                    kind.name().into(),
-                    j.to_string(),
-                    format!("{:.3}", frames[i].view),
-                    format!("{:.3}", e.psnr()),
-                    change.map_or(String::new(), |c| format!("{:.5}", c[0])),
-                    change.map_or(String::new(), |c| format!("{:.5}", c[1])),
-                    paired_cells[0].clone(),
-                    paired_cells[1].clone(),
-                ]);
-            }
-            let mean = psnrs.iter().sum::<f64>() / psnrs.len().max(1) as f64;
-            let min = psnrs.iter().copied().fold(f64::INFINITY, f64::min);
-            let pair = |v: f64| req.reference_pair.then_some(v);
-            summaries.push(ReflectiveSummary {
-                file: name.clone(),
-                path: kind,
-                mean_psnr_db: mean,
-                min_psnr_db: min,
-                popping,
-                pooled_psnr_db: pair(pooled.against_mean.psnr()),
-                noise_removed_psnr_db: pair(pooled.psnr_noise_removed()),
-                reference_psnr_db: pair(pooled.reference_psnr()),
-            });
-        }
+        measure(req, &name, &frames, &refs, &played, &mut csv, &mut summaries);
     }
     std::fs::create_dir_all(&req.out)
         .map_err(|e| Failure::new(Exit::Io, anyhow!("{}: {e}", req.out.display())))?;

@@ -84,6 +84,81 @@ pub fn check(req: &SpeedRequest) -> Result<(), Failure> {
     Ok(())
 }
 
+/// Writes speed.csv and speed.svg: a row per CG cap and per playback measurement, the
+/// compile points and the playback frame times as series.
+fn write_speed(
+    req: &SpeedRequest,
+    scene: &str,
+    stamp: &Stamp,
+    rows: &[CompileRow],
+    playback: &[PlaybackRow],
+) -> Result<(PathBuf, PathBuf), Failure> {
+    let mut csv = Csv::new(&[
+        "measure",
+        "max_iterations",
+        "ms_per_point",
+        "solver_iterations",
+        "psnr_db_solved",
+        "psnr_db",
+        "ratio",
+    ]);
+    for r in rows {
+        csv.push(vec![
+            "compile".into(),
+            r.max_iterations.to_string(),
+            format!("{:.2}", r.ms_per_point),
+            r.solver_iterations.to_string(),
+            format!("{:.3}", r.psnr_db_solved),
+            format!("{:.3}", r.psnr_db),
+            format!("{:.2}", r.ratio),
+        ]);
+    }
+    for p in playback {
+        csv.push(vec![
+            format!("playback {} reduction {}", p.codec, p.reduction),
+            String::new(),
+            format!("mean {:.2} worst {:.2}", p.frame_ms_mean, p.frame_ms_worst),
+            p.frames.to_string(),
+            String::new(),
+            format!("{:.3}", p.psnr_db),
+            format!("{}", req.ratio),
+        ]);
+    }
+    let mut series = vec![
+        Series {
+            name: "compile: textures as solved (ms per point)".into(),
+            points: rows.iter().map(|r| (r.ms_per_point, r.psnr_db_solved)).collect(),
+        },
+        Series {
+            name: format!("compile: wavelet at {}:1 (ms per point)", req.ratio),
+            points: rows.iter().map(|r| (r.ms_per_point, r.psnr_db)).collect(),
+        },
+    ];
+    for codec in ["wavelet", "dct"] {
+        let mine: Vec<&PlaybackRow> = playback.iter().filter(|p| p.codec == codec).collect();
+        if !mine.is_empty() {
+            series.push(Series {
+                name: format!("playback {codec}: mean frame ms (reduction 1, 2, 4)"),
+                points: mine.iter().map(|p| (p.frame_ms_mean, p.psnr_db)).collect(),
+            });
+            series.push(Series {
+                name: format!("playback {codec}: worst frame ms"),
+                points: mine.iter().map(|p| (p.frame_ms_worst, p.psnr_db)).collect(),
+            });
+        }
+    }
+    let caps: Vec<String> = req.caps.iter().map(u32::to_string).collect();
+    let chart = Chart {
+        title: format!("Time vs PSNR — {scene}"),
+        subtitle: format!("compile: inference per point across CG caps {}, PSNR predicted over covered pixels; playback: player frames, whole-image PSNR vs the set", caps.join(", ")),
+        x_label: "milliseconds (compile: per parameter point; playback: per frame), log".into(),
+        y_label: "PSNR (dB)".into(),
+        x_log: true,
+        stamp: stamp.lines(),
+    };
+    write_chart(&req.out, "speed", &csv, &chart, &series).map_err(|e| Failure::new(Exit::Io, e))
+}
+
 pub fn run(req: &SpeedRequest) -> Result<SpeedReport, Failure> {
     check(req)?;
     ensure_dir(&req.out).map_err(|e| Failure::new(Exit::Io, e))?;
@@ -146,71 +221,7 @@ pub fn run(req: &SpeedRequest) -> Result<SpeedReport, Failure> {
         (_, None) => {}
     }
     let stamp = Stamp::here(&scene);
-    let mut csv = Csv::new(&[
-        "measure",
-        "max_iterations",
-        "ms_per_point",
-        "solver_iterations",
-        "psnr_db_solved",
-        "psnr_db",
-        "ratio",
-    ]);
-    for r in &rows {
-        csv.push(vec![
-            "compile".into(),
-            r.max_iterations.to_string(),
-            format!("{:.2}", r.ms_per_point),
-            r.solver_iterations.to_string(),
-            format!("{:.3}", r.psnr_db_solved),
-            format!("{:.3}", r.psnr_db),
-            format!("{:.2}", r.ratio),
-        ]);
-    }
-    for p in &playback {
-        csv.push(vec![
-            format!("playback {} reduction {}", p.codec, p.reduction),
-            String::new(),
-            format!("mean {:.2} worst {:.2}", p.frame_ms_mean, p.frame_ms_worst),
-            p.frames.to_string(),
-            String::new(),
-            format!("{:.3}", p.psnr_db),
-            format!("{}", req.ratio),
-        ]);
-    }
-    let mut series = vec![
-        Series {
-            name: "compile: textures as solved (ms per point)".into(),
-            points: rows.iter().map(|r| (r.ms_per_point, r.psnr_db_solved)).collect(),
-        },
-        Series {
-            name: format!("compile: wavelet at {}:1 (ms per point)", req.ratio),
-            points: rows.iter().map(|r| (r.ms_per_point, r.psnr_db)).collect(),
-        },
-    ];
-    for codec in ["wavelet", "dct"] {
-        let mine: Vec<&PlaybackRow> = playback.iter().filter(|p| p.codec == codec).collect();
-        if !mine.is_empty() {
-            series.push(Series {
-                name: format!("playback {codec}: mean frame ms (reduction 1, 2, 4)"),
-                points: mine.iter().map(|p| (p.frame_ms_mean, p.psnr_db)).collect(),
-            });
-            series.push(Series {
-                name: format!("playback {codec}: worst frame ms"),
-                points: mine.iter().map(|p| (p.frame_ms_worst, p.psnr_db)).collect(),
-            });
-        }
-    }
-    let caps: Vec<String> = req.caps.iter().map(u32::to_string).collect();
-    let chart = Chart {
-        title: format!("Time vs PSNR — {scene}"),
-        subtitle: format!("compile: inference per point across CG caps {}, PSNR predicted over covered pixels; playback: player frames, whole-image PSNR vs the set", caps.join(", ")),
-        x_label: "milliseconds (compile: per parameter point; playback: per frame), log".into(),
-        y_label: "PSNR (dB)".into(),
-        x_log: true,
-        stamp: stamp.lines(),
-    };
-    let (c, s) = write_chart(&req.out, "speed", &csv, &chart, &series)
-        .map_err(|e| Failure::new(Exit::Io, e))?;
+    let (c, s) = write_speed(req, &scene, &stamp, &rows, &playback)?;
     let report = SpeedReport {
         scene,
         points,

@@ -249,6 +249,68 @@ pub fn check(req: &StabilityRequest) -> Result<(), Failure> {
     Ok(())
 }
 
+/// Writes stability.csv and stability.svg: a row per frame and per path's summary, a series
+/// per representation and path.
+fn write_stability(
+    req: &StabilityRequest,
+    scene_s: &str,
+    stamp: &Stamp,
+    rows: &[FrameRow],
+    summaries: &[PathSummary],
+) -> Result<(PathBuf, PathBuf), Failure> {
+    let mut csv = Csv::new(&[
+        "representation",
+        "path",
+        "frame",
+        "view",
+        "psnr_db",
+        "change_pis",
+        "change_reference",
+    ]);
+    for r in rows {
+        csv.push(vec![
+            r.representation.clone(),
+            r.path.name().into(),
+            r.frame.to_string(),
+            format!("{:.3}", r.view),
+            format!("{:.3}", r.psnr_db),
+            r.change.map_or(String::new(), |c| format!("{:.5}", c[0])),
+            r.change.map_or(String::new(), |c| format!("{:.5}", c[1])),
+        ]);
+    }
+    for s in summaries {
+        csv.push(vec![
+            s.representation.clone(),
+            format!("{}-summary", s.path.name()),
+            String::new(),
+            String::new(),
+            format!("{:.3}", s.mean_psnr_db),
+            format!("popping {:.3}", s.popping),
+            format!("min {:.3}", s.min_psnr_db),
+        ]);
+    }
+    let series: Vec<Series> = summaries
+        .iter()
+        .map(|s| Series {
+            name: format!("{} · {} (popping {:.2})", s.representation, s.path.name(), s.popping),
+            points: rows
+                .iter()
+                .filter(|r| r.representation == s.representation && r.path == s.path)
+                .map(|r| (r.view as f64, r.psnr_db))
+                .collect(),
+        })
+        .collect();
+    let chart = Chart {
+        title: format!("Stability off the samples — {scene_s}"),
+        subtitle: format!("through the hardware model at each exact camera vs pis-trace ({} spp, shading seeded per {}) over covered pixels; between: fractional view, away: radius ×{AWAY_RADIUS}, elevation +{AWAY_ELEVATION_DEG}°", req.spp, req.reference_seed.name()),
+        x_label: "position along the view dimension (samples)".into(),
+        y_label: "PSNR (dB)".into(),
+        x_log: false,
+        stamp: stamp.lines(),
+    };
+    write_chart(&req.out, "stability", &csv, &chart, &series).map_err(|e| Failure::new(Exit::Io, e))
+}
+
 /// Runs the paths for every representation and writes stability.csv and stability.svg.
 pub fn run(req: &StabilityRequest) -> Result<StabilityReport, Failure> {
     check(req)?;
@@ -357,58 +419,7 @@ pub fn run(req: &StabilityRequest) -> Result<StabilityReport, Failure> {
         set.resolution.1
     );
     let stamp = Stamp::here(&scene_s);
-    let mut csv = Csv::new(&[
-        "representation",
-        "path",
-        "frame",
-        "view",
-        "psnr_db",
-        "change_pis",
-        "change_reference",
-    ]);
-    for r in &rows {
-        csv.push(vec![
-            r.representation.clone(),
-            r.path.name().into(),
-            r.frame.to_string(),
-            format!("{:.3}", r.view),
-            format!("{:.3}", r.psnr_db),
-            r.change.map_or(String::new(), |c| format!("{:.5}", c[0])),
-            r.change.map_or(String::new(), |c| format!("{:.5}", c[1])),
-        ]);
-    }
-    for s in &summaries {
-        csv.push(vec![
-            s.representation.clone(),
-            format!("{}-summary", s.path.name()),
-            String::new(),
-            String::new(),
-            format!("{:.3}", s.mean_psnr_db),
-            format!("popping {:.3}", s.popping),
-            format!("min {:.3}", s.min_psnr_db),
-        ]);
-    }
-    let series: Vec<Series> = summaries
-        .iter()
-        .map(|s| Series {
-            name: format!("{} · {} (popping {:.2})", s.representation, s.path.name(), s.popping),
-            points: rows
-                .iter()
-                .filter(|r| r.representation == s.representation && r.path == s.path)
-                .map(|r| (r.view as f64, r.psnr_db))
-                .collect(),
-        })
-        .collect();
-    let chart = Chart {
-        title: format!("Stability off the samples — {scene_s}"),
-        subtitle: format!("through the hardware model at each exact camera vs pis-trace ({} spp, shading seeded per {}) over covered pixels; between: fractional view, away: radius ×{AWAY_RADIUS}, elevation +{AWAY_ELEVATION_DEG}°", req.spp, req.reference_seed.name()),
-        x_label: "position along the view dimension (samples)".into(),
-        y_label: "PSNR (dB)".into(),
-        x_log: false,
-        stamp: stamp.lines(),
-    };
-    let (c, s) = write_chart(&req.out, "stability", &csv, &chart, &series)
-        .map_err(|e| Failure::new(Exit::Io, e))?;
+    let (c, s) = write_stability(req, &scene_s, &stamp, &rows, &summaries)?;
     let report = StabilityReport {
         scene: scene_s, frames: req.frames, summaries, rows, csv: c.display().to_string(), svg: s.display().to_string(), stamp,
         notes: vec![
