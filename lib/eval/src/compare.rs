@@ -12,7 +12,7 @@ use std::path::Path;
 use anyhow::{anyhow, bail, Context, Result};
 use pis_format::blocks::BlockGrid;
 use pis_play::{CameraChoice, FloatImage, FrameRequest, Player};
-use pis_trace::layers::LayerKind;
+use pis_trace::layers::{LayerKind, PointImages};
 use pis_trace::set::RaySet;
 
 use crate::metrics::SquaredError;
@@ -104,37 +104,8 @@ pub fn compare_with_set(
     }
     let dims = player.dimensions().len();
     let names = player.object_names();
-    // Per object of the file: the set's channel name.
-    let channels: Vec<String> = names
-        .iter()
-        .map(|n| {
-            set.meta
-                .objects
-                .iter()
-                .find(|o| &o.name == n)
-                .map(|o| o.channel_name.clone())
-                .ok_or_else(|| {
-                    anyhow!("object '{n}' of the file is not in the set {}", set_dir.display())
-                })
-        })
-        .collect::<Result<_>>()?;
-    // Per object: the grid of its layer that depends on the most dimensions (the blocks a
-    // score is reported for).
-    let grids: Vec<BlockGrid> = {
-        let c = player.reader().container();
-        c.objects
-            .iter()
-            .map(|o| {
-                let mask = o
-                    .layers
-                    .iter()
-                    .map(|l| l.depends_on)
-                    .max_by_key(|m| m.count())
-                    .unwrap_or(pis_format::DepMask::NONE);
-                BlockGrid::new(&c.space, mask, &o.stagger)
-            })
-            .collect()
-    };
+    let channels = channels(&set, &names, set_dir)?;
+    let grids = score_grids(player);
     let block_count = |o: usize| grids[o].block_count() as usize;
     let mut total = SquaredError::default();
     let (mut interior, mut silhouette) = (SquaredError::default(), SquaredError::default());
@@ -169,29 +140,8 @@ pub fn compare_with_set(
         let (rendered, ids, _) = player
             .render_ids(&req, size)
             .with_context(|| format!("drawing point {i} {:?}", p.values))?;
-        let combined = images
-            .layer("combined")
-            .ok_or_else(|| anyhow!("point {i} of {} has no combined image", set_dir.display()))?;
-        let mut gold = FloatImage { width: res.0, height: res.1, rgba: vec![1.0; npx * 4] };
-        for (c, name) in ["R", "G", "B"].iter().enumerate() {
-            let plane = combined
-                .channel(name)
-                .ok_or_else(|| anyhow!("point {i}: combined image without {name}"))?;
-            for (px, v) in gold.rgba.chunks_exact_mut(4).zip(plane) {
-                px[c] = *v;
-            }
-        }
-        partial.clear();
-        partial.resize(npx, false);
-        for ch in &channels {
-            if let Some(cov) =
-                images.object_layer(ch, LayerKind::Coverage).and_then(|l| l.channel("A"))
-            {
-                for (p, &c) in partial.iter_mut().zip(cov) {
-                    *p |= c > COVERAGE_EPS && c < 1.0 - COVERAGE_EPS;
-                }
-            }
-        }
+        let gold = gold_image(&images, res, i, set_dir)?;
+        silhouette_pixels(&images, &channels, &mut partial);
         let mut whole = SquaredError::default();
         for k in 0..npx {
             let mut px = SquaredError::default();
@@ -207,25 +157,7 @@ pub fn compare_with_set(
         }
         let mut objects = Vec::with_capacity(names.len());
         for (o, ch) in channels.iter().enumerate() {
-            let layer = |kind: LayerKind| images.object_layer(ch, kind);
-            let cov = layer(LayerKind::Coverage).and_then(|l| l.channel("A"));
-            let (d, s) = (layer(LayerKind::Diffuse), layer(LayerKind::Specular));
-            let planes: Vec<[Option<&[f32]>; 2]> = ["R", "G", "B"]
-                .iter()
-                .map(|c| [d.and_then(|l| l.channel(c)), s.and_then(|l| l.channel(c))])
-                .collect();
-            let mut e = SquaredError::default();
-            if let Some(cov) = cov {
-                for k in 0..npx {
-                    if ids[k] != o as u32 || cov[k] <= 0.0 {
-                        continue;
-                    }
-                    for (c, [dp, sp]) in planes.iter().enumerate() {
-                        let g = dp.map_or(0.0, |p| p[k]) + sp.map_or(0.0, |p| p[k]);
-                        e.add(rendered.rgba[k * 4 + c], g);
-                    }
-                }
-            }
+            let e = object_error(&images, ch, o, &ids, &rendered);
             let block = grids[o].locate(&p.samples).block;
             per_object[o].0.merge(&e);
             if let Some(b) = per_object[o].1.get_mut(block) {
@@ -280,4 +212,109 @@ pub fn compare_with_set(
         objects,
         points,
     })
+}
+
+/// Per object of the file: the set's channel name.
+fn channels(set: &RaySet, names: &[String], set_dir: &Path) -> Result<Vec<String>> {
+    names
+        .iter()
+        .map(|n| {
+            set.meta
+                .objects
+                .iter()
+                .find(|o| &o.name == n)
+                .map(|o| o.channel_name.clone())
+                .ok_or_else(|| {
+                    anyhow!("object '{n}' of the file is not in the set {}", set_dir.display())
+                })
+        })
+        .collect()
+}
+
+/// Per object: the grid of its layer that depends on the most dimensions (the blocks a
+/// score is reported for).
+fn score_grids(player: &Player) -> Vec<BlockGrid> {
+    let c = player.reader().container();
+    c.objects
+        .iter()
+        .map(|o| {
+            let mask = o
+                .layers
+                .iter()
+                .map(|l| l.depends_on)
+                .max_by_key(|m| m.count())
+                .unwrap_or(pis_format::DepMask::NONE);
+            BlockGrid::new(&c.space, mask, &o.stagger)
+        })
+        .collect()
+}
+
+/// Point `i`'s gold image: the set's combined image, alpha 1.
+fn gold_image(
+    images: &PointImages,
+    res: (u32, u32),
+    i: usize,
+    set_dir: &Path,
+) -> Result<FloatImage> {
+    let npx = res.0 as usize * res.1 as usize;
+    let combined = images
+        .layer("combined")
+        .ok_or_else(|| anyhow!("point {i} of {} has no combined image", set_dir.display()))?;
+    let mut gold = FloatImage { width: res.0, height: res.1, rgba: vec![1.0; npx * 4] };
+    for (c, name) in ["R", "G", "B"].iter().enumerate() {
+        let plane = combined
+            .channel(name)
+            .ok_or_else(|| anyhow!("point {i}: combined image without {name}"))?;
+        for (px, v) in gold.rgba.chunks_exact_mut(4).zip(plane) {
+            px[c] = *v;
+        }
+    }
+    Ok(gold)
+}
+
+/// Marks in `partial` the silhouette pixels: those some object covers partly.
+fn silhouette_pixels(images: &PointImages, channels: &[String], partial: &mut Vec<bool>) {
+    let npx = images.width as usize * images.height as usize;
+    partial.clear();
+    partial.resize(npx, false);
+    for ch in channels {
+        if let Some(cov) = images.object_layer(ch, LayerKind::Coverage).and_then(|l| l.channel("A"))
+        {
+            for (p, &c) in partial.iter_mut().zip(cov) {
+                *p |= c > COVERAGE_EPS && c < 1.0 - COVERAGE_EPS;
+            }
+        }
+    }
+}
+
+/// Object `o`'s error over the pixels the player draws it at and the tracer's coverage says
+/// it covers, against its gold surface radiance (diffuse + specular).
+fn object_error(
+    images: &PointImages,
+    ch: &str,
+    o: usize,
+    ids: &[u32],
+    rendered: &FloatImage,
+) -> SquaredError {
+    let npx = images.width as usize * images.height as usize;
+    let layer = |kind: LayerKind| images.object_layer(ch, kind);
+    let cov = layer(LayerKind::Coverage).and_then(|l| l.channel("A"));
+    let (d, s) = (layer(LayerKind::Diffuse), layer(LayerKind::Specular));
+    let planes: Vec<[Option<&[f32]>; 2]> = ["R", "G", "B"]
+        .iter()
+        .map(|c| [d.and_then(|l| l.channel(c)), s.and_then(|l| l.channel(c))])
+        .collect();
+    let mut e = SquaredError::default();
+    if let Some(cov) = cov {
+        for k in 0..npx {
+            if ids[k] != o as u32 || cov[k] <= 0.0 {
+                continue;
+            }
+            for (c, [dp, sp]) in planes.iter().enumerate() {
+                let g = dp.map_or(0.0, |p| p[k]) + sp.map_or(0.0, |p| p[k]);
+                e.add(rendered.rgba[k * 4 + c], g);
+            }
+        }
+    }
+    e
 }
