@@ -182,6 +182,99 @@ fn incomparable(
     None
 }
 
+/// A layer that was not compared, with why.
+fn not_compared(li: usize, la: &pis_format::Layer<StreamRef>, note: String) -> LayerDiff {
+    LayerDiff {
+        layer: li,
+        kind: la.kind.name(),
+        compared: false,
+        note: Some(note),
+        score: Score::of(&SquaredError::default(), false),
+        blocks: vec![],
+    }
+}
+
+/// Whether layer `la` of object `oa` and layer `lb` of object `ob` group their samples into
+/// the same blocks (so a block of one can be decoded against the same block of the other).
+fn same_grid(
+    ca: &Container<StreamRef>,
+    cb: &Container<StreamRef>,
+    oa: &pis_format::Object<StreamRef>,
+    ob: &pis_format::Object<StreamRef>,
+    la: &pis_format::Layer<StreamRef>,
+    lb: &pis_format::Layer<StreamRef>,
+) -> bool {
+    let grid_a = BlockGrid::new(&ca.space, la.depends_on, &oa.stagger);
+    let grid_b = BlockGrid::new(&cb.space, lb.depends_on, &ob.stagger);
+    grid_a.blocks_per_axis() == grid_b.blocks_per_axis()
+        && (0..la.blocks.len()).all(|k| grid_a.extent(k) == grid_b.extent(k))
+        && la.depends_on.dims().all(|d| oa.stagger[d] == ob.stagger[d])
+        && la.depends_on.dims().all(|d| ca.space.dims[d].block_size == cb.space.dims[d].block_size)
+}
+
+/// Layer `li` of object `oj` of `b` at the samples of `ta`, a block of the first file, one
+/// texture at a time (the second file blocks them differently).
+fn samples_of(
+    b: &PisReader,
+    oj: usize,
+    li: usize,
+    ta: &BlockTextures,
+) -> Result<BlockTextures, Error> {
+    let cb = b.container();
+    let depends_on = cb.objects[oj].layers[li].depends_on;
+    let mut textures = Vec::with_capacity(ta.keys.len());
+    let mut layout = ta.layout.clone();
+    for k in &ta.keys {
+        let t = b.texture(oj, li, &point_of(cb.space.dims.len(), depends_on, k))?;
+        if t.layout != ta.layout {
+            layout = t.layout.clone();
+        }
+        textures.push(t.data);
+    }
+    Ok(BlockTextures { layout, extent: ta.extent.clone(), keys: ta.keys.clone(), textures })
+}
+
+/// Block `bi`'s error from its samples' errors; their per-texel errors, when measured, are
+/// added to the layer's map of the block's texture placement (a new map for a new one).
+fn block_error(
+    per: &[SampleError],
+    la: &pis_format::Layer<StreamRef>,
+    bi: usize,
+    layout: &LevelLayout,
+    layer_maps: &mut Vec<MapSum>,
+) -> (SquaredError, bool) {
+    let mut block_err = SquaredError::default();
+    let mut block_exact = true;
+    let mut block_map = None;
+    for s in per {
+        block_err.merge(&s.error);
+        block_exact &= s.exact;
+        if let Some(t) = &s.texels {
+            let k = *block_map.get_or_insert_with(|| {
+                let same = layer_maps.iter().position(|m| {
+                    m.layout == *layout && la.blocks[m.blocks[0]].same_placement(&la.blocks[bi])
+                });
+                same.unwrap_or_else(|| {
+                    layer_maps.push(MapSum {
+                        layout: layout.clone(),
+                        sums: vec![0.0; t.len()],
+                        values: 0,
+                        blocks: vec![],
+                    });
+                    layer_maps.len() - 1
+                })
+            });
+            let m = &mut layer_maps[k];
+            m.sums.iter_mut().zip(t).for_each(|(acc, v)| *acc += v);
+            m.values += layout.channels as u64;
+        }
+    }
+    if let Some(k) = block_map {
+        layer_maps[k].blocks.push(bi);
+    }
+    (block_err, block_exact)
+}
+
 /// Compares every layer of every object of `a` with the layer at the same position of the
 /// object of the same name in `b`. With `maps`, also returns an [`ErrorMap`] per compared
 /// layer. `progress` gets one line per layer.
@@ -215,14 +308,7 @@ pub fn compare(
                 complete = false;
                 obj_exact = false;
                 total_exact = false;
-                layers.push(LayerDiff {
-                    layer: li,
-                    kind: la.kind.name(),
-                    compared: false,
-                    note: Some(note),
-                    score: Score::of(&SquaredError::default(), false),
-                    blocks: vec![],
-                });
+                layers.push(not_compared(li, la, note));
                 continue;
             }
             let (oj, lb) = lb.expect("checked above");
@@ -233,15 +319,7 @@ pub fn compare(
                 la.blocks.len()
             ));
             let multiplicity = points / ca.space.table_len(la.depends_on).max(1);
-            let grid_a = BlockGrid::new(&ca.space, la.depends_on, &oa.stagger);
-            let grid_b = BlockGrid::new(&cb.space, lb.depends_on, &cb.objects[oj].stagger);
-            let same_grid = grid_a.blocks_per_axis() == grid_b.blocks_per_axis()
-                && (0..la.blocks.len()).all(|k| grid_a.extent(k) == grid_b.extent(k))
-                && la.depends_on.dims().all(|d| oa.stagger[d] == cb.objects[oj].stagger[d])
-                && la
-                    .depends_on
-                    .dims()
-                    .all(|d| ca.space.dims[d].block_size == cb.space.dims[d].block_size);
+            let same_grid = same_grid(ca, cb, oa, &cb.objects[oj], la, lb);
             let mut layer_err = SquaredError::default();
             let mut layer_exact = true;
             let mut layout_note = None;
@@ -250,26 +328,10 @@ pub fn compare(
             let mut blocks = Vec::new();
             for bi in 0..la.blocks.len() {
                 let ta = decode_block(a, oi, li, bi).map_err(fa)?;
-                let tb: BlockTextures = if same_grid {
+                let tb = if same_grid {
                     decode_block(b, oj, li, bi).map_err(fb)?
                 } else {
-                    let mut textures = Vec::with_capacity(ta.keys.len());
-                    let mut layout = ta.layout.clone();
-                    for k in &ta.keys {
-                        let t = b
-                            .texture(oj, li, &point_of(cb.space.dims.len(), lb.depends_on, k))
-                            .map_err(fb)?;
-                        if t.layout != ta.layout {
-                            layout = t.layout.clone();
-                        }
-                        textures.push(t.data);
-                    }
-                    BlockTextures {
-                        layout,
-                        extent: ta.extent.clone(),
-                        keys: ta.keys.clone(),
-                        textures,
-                    }
+                    samples_of(b, oj, li, &ta).map_err(fb)?
                 };
                 if tb.layout != ta.layout {
                     layout_note = Some(format!(
@@ -284,36 +346,8 @@ pub fn compare(
                     .zip(&tb.textures)
                     .map(|(x, y)| sample_error(&ta.layout, x, y, maps))
                     .collect();
-                let mut block_err = SquaredError::default();
-                let mut block_exact = true;
-                let mut block_map = None;
-                for s in &per {
-                    block_err.merge(&s.error);
-                    block_exact &= s.exact;
-                    if let Some(t) = &s.texels {
-                        let k = *block_map.get_or_insert_with(|| {
-                            let same = layer_maps.iter().position(|m| {
-                                m.layout == ta.layout
-                                    && la.blocks[m.blocks[0]].same_placement(&la.blocks[bi])
-                            });
-                            same.unwrap_or_else(|| {
-                                layer_maps.push(MapSum {
-                                    layout: ta.layout.clone(),
-                                    sums: vec![0.0; t.len()],
-                                    values: 0,
-                                    blocks: vec![],
-                                });
-                                layer_maps.len() - 1
-                            })
-                        });
-                        let m = &mut layer_maps[k];
-                        m.sums.iter_mut().zip(t).for_each(|(acc, v)| *acc += v);
-                        m.values += ta.layout.channels as u64;
-                    }
-                }
-                if let Some(k) = block_map {
-                    layer_maps[k].blocks.push(bi);
-                }
+                let (block_err, block_exact) =
+                    block_error(&per, la, bi, &ta.layout, &mut layer_maps);
                 weighted(&mut layer_err, &block_err, 1);
                 layer_exact &= block_exact;
                 blocks.push(BlockDiff {
@@ -326,14 +360,7 @@ pub fn compare(
                 complete = false;
                 obj_exact = false;
                 total_exact = false;
-                layers.push(LayerDiff {
-                    layer: li,
-                    kind: la.kind.name(),
-                    compared: false,
-                    note: Some(note),
-                    score: Score::of(&SquaredError::default(), false),
-                    blocks: vec![],
-                });
+                layers.push(not_compared(li, la, note));
                 continue;
             }
             weighted(&mut obj_err, &layer_err, multiplicity);
