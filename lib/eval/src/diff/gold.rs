@@ -13,7 +13,7 @@
 use std::path::PathBuf;
 use std::sync::Arc;
 
-use crate::compare::{compare_with_set, CompareOptions};
+use crate::compare::{compare_with_set, CompareOptions, Comparison};
 use crate::flip::{flip_map, means, FlipMean};
 use crate::heatmap::write_heatmap;
 use anyhow::anyhow;
@@ -142,8 +142,10 @@ fn failure(e: anyhow::Error) -> Failure {
     Failure::new(exit, e)
 }
 
-/// Measures `req.file` against the set `req.set`.
-pub fn gold(req: &GoldRequest) -> Result<GoldReport, Failure> {
+/// Checks the gates' figures and returns the reference of the drop gate, with where it came
+/// from: `--reference-psnr`, else the prediction the file's provenance records. Creates the
+/// heatmap folder.
+fn drop_reference(req: &GoldRequest) -> Result<(Option<f64>, Option<String>), Failure> {
     for (name, v) in [
         ("--min-psnr", req.min_psnr),
         ("--max-psnr-drop", req.max_psnr_drop),
@@ -153,7 +155,6 @@ pub fn gold(req: &GoldRequest) -> Result<GoldReport, Failure> {
             return Err(Failure::new(Exit::Usage, anyhow!("{name} must be a number of dB")));
         }
     }
-    // The reference of the drop gate, before any drawing.
     let reader = open(&req.file)?;
     let recorded = reader.container().provenance.as_ref().and_then(|p| {
         p.settings
@@ -177,6 +178,74 @@ pub fn gold(req: &GoldRequest) -> Result<GoldReport, Failure> {
             .map_err(|e| Failure::new(Exit::Io, anyhow!("{}: {e}", dir.display())))?;
     }
     drop(reader);
+    Ok((reference, reference_from))
+}
+
+/// The objects' figures: PSNR and MSE from the comparison, FLIP from each point's.
+fn gold_objects(
+    comparison: &Comparison,
+    names: &[String],
+    object_flip: &[FlipMean],
+) -> Vec<GoldObject> {
+    let object_index = |name: &str| names.iter().position(|n| n == name);
+    comparison
+        .objects
+        .iter()
+        .map(|o| GoldObject {
+            name: o.name.clone(),
+            psnr_db: finite(o.psnr_db),
+            mse: o.error.mse(),
+            flip_mean: object_index(&o.name).and_then(|i| object_flip[i].mean()),
+            blocks: o
+                .blocks
+                .iter()
+                .map(|b| GoldBlock {
+                    block: b.block,
+                    psnr_db: finite(b.psnr_db),
+                    mse: b.error.mse(),
+                })
+                .collect(),
+        })
+        .collect()
+}
+
+/// The points' figures, each with its objects'.
+fn gold_points(
+    comparison: &Comparison,
+    names: &[String],
+    flips: &[(usize, FlipMean, Vec<FlipMean>)],
+) -> Vec<GoldPoint> {
+    let object_index = |name: &str| names.iter().position(|n| n == name);
+    comparison
+        .points
+        .iter()
+        .map(|p| {
+            let f = flips.iter().find(|(i, _, _)| *i == p.index);
+            GoldPoint {
+                index: p.index,
+                point: p.point.clone(),
+                psnr_db: finite(p.psnr_db),
+                flip_mean: f.and_then(|(_, w, _)| w.mean()),
+                objects: p
+                    .objects
+                    .iter()
+                    .map(|o| GoldPointObject {
+                        name: o.name.clone(),
+                        psnr_db: finite(o.psnr_db),
+                        flip_mean: f.and_then(|(_, _, per)| {
+                            object_index(&o.name).and_then(|i| per[i].mean())
+                        }),
+                    })
+                    .collect(),
+            }
+        })
+        .collect()
+}
+
+/// Measures `req.file` against the set `req.set`.
+pub fn gold(req: &GoldRequest) -> Result<GoldReport, Failure> {
+    // The reference of the drop gate, before any drawing.
+    let (reference, reference_from) = drop_reference(req)?;
 
     let gpu = Arc::new(Gpu::new().map_err(|e| failure(e.into()))?);
     let device = gpu.describe();
@@ -229,50 +298,8 @@ pub fn gold(req: &GoldRequest) -> Result<GoldReport, Failure> {
         total_flip.merge(whole);
         object_flip.iter_mut().zip(per).for_each(|(a, b)| a.merge(b));
     }
-    let object_index = |name: &str| names.iter().position(|n| n == name);
-    let objects = comparison
-        .objects
-        .iter()
-        .map(|o| GoldObject {
-            name: o.name.clone(),
-            psnr_db: finite(o.psnr_db),
-            mse: o.error.mse(),
-            flip_mean: object_index(&o.name).and_then(|i| object_flip[i].mean()),
-            blocks: o
-                .blocks
-                .iter()
-                .map(|b| GoldBlock {
-                    block: b.block,
-                    psnr_db: finite(b.psnr_db),
-                    mse: b.error.mse(),
-                })
-                .collect(),
-        })
-        .collect();
-    let points = comparison
-        .points
-        .iter()
-        .map(|p| {
-            let f = flips.iter().find(|(i, _, _)| *i == p.index);
-            GoldPoint {
-                index: p.index,
-                point: p.point.clone(),
-                psnr_db: finite(p.psnr_db),
-                flip_mean: f.and_then(|(_, w, _)| w.mean()),
-                objects: p
-                    .objects
-                    .iter()
-                    .map(|o| GoldPointObject {
-                        name: o.name.clone(),
-                        psnr_db: finite(o.psnr_db),
-                        flip_mean: f.and_then(|(_, _, per)| {
-                            object_index(&o.name).and_then(|i| per[i].mean())
-                        }),
-                    })
-                    .collect(),
-            }
-        })
-        .collect();
+    let objects = gold_objects(&comparison, &names, &object_flip);
+    let points = gold_points(&comparison, &names, &flips);
 
     let psnr = finite(comparison.psnr_db);
     let covered = finite(comparison.covered_psnr_db);
