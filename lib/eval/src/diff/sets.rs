@@ -151,6 +151,46 @@ fn open(p: &Path) -> Result<RaySet, Failure> {
     })
 }
 
+/// Adds one object's errors at a point to `acc` (A's surface radiance against B's, over
+/// the pixels both cover) and `macc` (A's against B's composed by B's layered model): the
+/// object's channels in A and B are `cha` and `chb`.
+fn add_object(
+    ia: &PointImages,
+    ib: &PointImages,
+    (cha, chb): (&str, &str),
+    model: Option<LayeredModel>,
+    npx: usize,
+    acc: &mut SquaredError,
+    macc: &mut SquaredError,
+) {
+    let cov = |im: &PointImages, ch: &str| {
+        im.object_layer(ch, LayerKind::Coverage).and_then(|l| l.channel("A")).map(<[f32]>::to_vec)
+    };
+    let (Some(cova), Some(covb)) = (cov(ia, cha), cov(ib, chb)) else { return };
+    let surface = |im: &PointImages, ch: &str, c: &str| -> Vec<f32> {
+        let get = |k| im.object_layer(ch, k).and_then(|l| l.channel(c));
+        let (d, s) = (get(LayerKind::Diffuse), get(LayerKind::Specular));
+        (0..npx)
+            .map(|k| {
+                d.and_then(|p| p.get(k)).copied().unwrap_or(0.0)
+                    + s.and_then(|p| p.get(k)).copied().unwrap_or(0.0)
+            })
+            .collect()
+    };
+    for c in ["R", "G", "B"] {
+        let (x, y) = (surface(ia, cha, c), surface(ib, chb, c));
+        let composed = model.and_then(|m| m.compose(ib, chb, c));
+        for k in 0..npx.min(cova.len()).min(covb.len()) {
+            if cova[k] > 0.0 && covb[k] > 0.0 {
+                acc.add(y[k], x[k]);
+                if let Some(m) = composed.as_ref().and_then(|m| m.get(k)) {
+                    macc.add(*m, x[k]);
+                }
+            }
+        }
+    }
+}
+
 /// Compares the sets of `req`.
 pub fn compare_sets(req: &SetsRequest) -> Result<SetsReport, Failure> {
     let (sa, sb) = (open(&req.a)?, open(&req.b)?);
@@ -233,34 +273,7 @@ pub fn compare_sets(req: &SetsRequest) -> Result<SetsReport, Failure> {
         for (((_, cha, chb, model), acc), macc) in
             objects.iter().zip(per_object.iter_mut()).zip(per_model.iter_mut())
         {
-            let cov = |im: &PointImages, ch: &str| {
-                im.object_layer(ch, LayerKind::Coverage)
-                    .and_then(|l| l.channel("A"))
-                    .map(<[f32]>::to_vec)
-            };
-            let (Some(cova), Some(covb)) = (cov(&ia, cha), cov(&ib, chb)) else { continue };
-            let surface = |im: &PointImages, ch: &str, c: &str| -> Vec<f32> {
-                let get = |k| im.object_layer(ch, k).and_then(|l| l.channel(c));
-                let (d, s) = (get(LayerKind::Diffuse), get(LayerKind::Specular));
-                (0..npx)
-                    .map(|k| {
-                        d.and_then(|p| p.get(k)).copied().unwrap_or(0.0)
-                            + s.and_then(|p| p.get(k)).copied().unwrap_or(0.0)
-                    })
-                    .collect()
-            };
-            for c in ["R", "G", "B"] {
-                let (x, y) = (surface(&ia, cha, c), surface(&ib, chb, c));
-                let composed = model.and_then(|m| m.compose(&ib, chb, c));
-                for k in 0..npx.min(cova.len()).min(covb.len()) {
-                    if cova[k] > 0.0 && covb[k] > 0.0 {
-                        acc.add(y[k], x[k]);
-                        if let Some(m) = composed.as_ref().and_then(|m| m.get(k)) {
-                            macc.add(*m, x[k]);
-                        }
-                    }
-                }
-            }
+            add_object(&ia, &ib, (cha, chb), *model, npx, acc, macc);
         }
         total.merge(&e);
         per_point.push(PointRow {
