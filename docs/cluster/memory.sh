@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Peak memory of pis-pack in memory and streamed under a budget (--memory), at demo1's paper
-# preset and at a 16 × 16-point space at 640×480 (docs/BENCHMARKS.md, "Bounded memory").
+# preset and at a 16 × 16-point space at 640×480 (docs/benchmarks/scale.md, "Bounded memory").
 #
 # Usage: docs/cluster/memory.sh WORK_DIR [paper|grid|points|all]
 #   WORK_DIR  scratch folder (sets of several GB)

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # How pis-trace and pis-pack scale with the number of parameter points and the resolution,
-# and what splitting them over two local processes gains (docs/BENCHMARKS.md, "Scale").
+# and what splitting them over two local processes gains (docs/benchmarks/scale.md, "Scale").
 #
 # Usage: docs/cluster/scaling.sh WORK_DIR [SIDES]
 #   WORK_DIR  scratch folder (scene copies, sets, files; several GB at the largest sizes)
