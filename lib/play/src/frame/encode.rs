@@ -111,40 +111,52 @@ fn id_pass(
     }
 }
 
-/// Records a frame into `encoder`: clears `colour` (format `format`, size `targets.size`) to
-/// transparent black, then draws with `targets.samples` per pixel (multisampled frames are
-/// drawn into the sample attachments and resolved into `colour`: with `display`, the
-/// ray-traced set's display filter, by the display-filter resolve over each pixel's 3×3
-/// neighbourhood, the samples drawn in the offscreen format; without, by the hardware's
-/// average of each pixel's own samples). `object_ids`: also leave every pixel's object index
-/// at its centre in `targets.ids` (single-sample frames always do; multisampled ones draw one
-/// more index pass for it). Single-sample frames ignore `display`. The additive pass draws
-/// `layers`, then `reflections` (a draw without shells draws nothing).
-#[allow(clippy::too_many_arguments)]
+/// What a frame draws: its objects, the surface layers drawn on them, and their reflection
+/// and lens terms (a term without shells, or a lens term without corners, draws nothing).
+pub struct FrameDraws<'d, 'a> {
+    pub objects: &'d [ObjectDraw<'a>],
+    pub layers: &'d [LayerDraw<'a>],
+    pub reflections: &'d [ReflectionDraw<'a>],
+    pub lenses: &'d [LensDraw<'a>],
+}
+
+/// Where a frame is drawn: `colour`, of format `format` and size `targets.size`; with
+/// `object_ids`, every pixel's object index at its centre is also left in `targets.ids`
+/// (single-sample frames always do; multisampled ones draw one more index pass for it);
+/// `display`: the ray-traced set's display filter multisampled frames are resolved with.
+pub struct FrameTarget<'v> {
+    pub colour: &'v wgpu::TextureView,
+    pub format: wgpu::TextureFormat,
+    pub object_ids: bool,
+    pub display: Option<pis_format::DisplayFilter>,
+}
+
+/// Records a frame into `encoder`: clears `target.colour` to transparent black, then draws
+/// with `targets.samples` per pixel (multisampled frames are drawn into the sample
+/// attachments and resolved into the colour target: with a display filter by the
+/// display-filter resolve over each pixel's 3×3 neighbourhood, the samples drawn in the
+/// offscreen format; without, by the hardware's average of each pixel's own samples).
+/// Single-sample frames ignore the display filter. The additive pass draws the layers, then
+/// the reflection terms, then the lens terms.
 pub fn encode(
     gpu: &Gpu,
     pipes: &mut FramePipelines,
     targets: &mut Targets,
-    colour: &wgpu::TextureView,
-    format: wgpu::TextureFormat,
-    objects: &[ObjectDraw],
-    layers: &[LayerDraw],
-    reflections: &[ReflectionDraw],
-    lenses: &[LensDraw],
-    object_ids: bool,
-    display: Option<pis_format::DisplayFilter>,
+    target: FrameTarget,
+    frame: FrameDraws,
     encoder: &mut wgpu::CommandEncoder,
 ) {
+    let FrameTarget { colour, format, object_ids, display } = target;
     let samples = targets.samples;
     // The display filter applies to multisampled frames; their samples are then drawn in
     // the offscreen (float) format, whatever the target's.
     let display = display.filter(|_| samples > 1);
     let sample_format = if display.is_some() { offscreen_format(gpu) } else { format };
     let draws = Draws {
-        objects,
-        layers,
-        reflections: reflections.iter().filter(|r| !r.shells.is_empty()).collect(),
-        lenses: lenses.iter().filter(|l| !l.shells.is_empty() && l.count > 0).collect(),
+        objects: frame.objects,
+        layers: frame.layers,
+        reflections: frame.reflections.iter().filter(|r| !r.shells.is_empty()).collect(),
+        lenses: frame.lenses.iter().filter(|l| !l.shells.is_empty() && l.count > 0).collect(),
     };
     pipes.id_pipeline(gpu, samples);
     pipes.layer_pipeline(gpu, sample_format, samples);
@@ -156,7 +168,8 @@ pub fn encode(
     }
     let binds = Binds::new(gpu, pipes, &draws);
     let sample_colour = sample_colour(gpu, targets, sample_format, display.is_some());
-    let (depth, ids_bind) = id_passes(pipes, targets, object_ids, objects, &binds.ids, encoder);
+    let (depth, ids_bind) =
+        id_passes(pipes, targets, object_ids, draws.objects, &binds.ids, encoder);
     let attachments = Attachments {
         keep_samples: sample_colour.is_some() && display.is_some(),
         sample_colour,
@@ -176,21 +189,12 @@ pub fn encode(
                 wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
             )
         });
-        pipes.resolve.encode(
-            gpu,
-            filter,
-            &m.colour[&(sample_format, true)],
-            &m.ids,
-            shared,
-            colour,
-            format,
-            encoder,
-        );
+        let samples = (&m.colour[&(sample_format, true)], &m.ids, &*shared);
+        pipes.resolve.encode(gpu, filter, samples, (colour, format), encoder);
     }
 }
 
-/// What a frame draws: its objects, surface layers, and the reflection and lens terms that
-/// draw something.
+/// What a frame draws, its reflection and lens terms those that draw something.
 struct Draws<'d, 'a> {
     objects: &'d [ObjectDraw<'a>],
     layers: &'d [LayerDraw<'a>],

@@ -5,7 +5,7 @@ use pis_compile::hybrid::{Term, Tessellation};
 use pis_compile::shell::Shell;
 
 use super::draw::{MeshGpu, ObjectDraw};
-use super::encode::encode;
+use super::encode::{encode, FrameDraws, FrameTarget};
 use super::hybrid::{corner_buffer, term_corners, LensDraw, MAX_LENS_SHELLS};
 use super::pipelines::FramePipelines;
 use super::readback::{colour_image, Readback};
@@ -63,20 +63,9 @@ pub fn render_lens_term(
     let mut encoder = gpu
         .device
         .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("lens term") });
-    encode(
-        gpu,
-        &mut pipes,
-        &mut targets,
-        &view,
-        format,
-        &objects,
-        &[],
-        &[],
-        &lenses,
-        false,
-        None,
-        &mut encoder,
-    );
+    let target = FrameTarget { colour: &view, format, object_ids: false, display: None };
+    let frame = FrameDraws { objects: &objects, layers: &[], reflections: &[], lenses: &lenses };
+    encode(gpu, &mut pipes, &mut targets, target, frame, &mut encoder);
     let texel = if format == wgpu::TextureFormat::Rgba16Float { 8 } else { 16 };
     let readback = Readback::new(gpu, size, texel);
     readback.copy(&targets.colour, &mut encoder);

@@ -27,7 +27,7 @@ pub mod resolve;
 mod targets;
 
 pub use draw::{LayerDraw, MeshGpu, ObjectDraw, ID_FORMAT, NO_OBJECT};
-pub use encode::encode;
+pub use encode::{encode, FrameDraws, FrameTarget};
 pub use lens_term::render_lens_term;
 pub use pipelines::{FramePipelines, SHADER};
 pub use readback::{colour_image, map_read, Readback};

@@ -120,9 +120,9 @@ fn additive_target(format: wgpu::TextureFormat) -> wgpu::ColorTargetState {
 }
 
 /// An additive pipeline of the frame's layer pass: `module`'s vertex entry point with its
-/// vertex buffers, fragment entry point `fragment`, triangles unculled, tested against the id
-/// pass's depth without writing it, colour added ([`additive_target`]).
-#[allow(clippy::too_many_arguments)]
+/// vertex buffers, fragment entry point `fragment`, for a target format and samples per pixel;
+/// triangles unculled, tested against the id pass's depth without writing it, colour added
+/// ([`additive_target`]).
 fn additive_pipeline(
     gpu: &Gpu,
     label: &str,
@@ -130,8 +130,7 @@ fn additive_pipeline(
     module: &wgpu::ShaderModule,
     vertex: (&str, &[Option<wgpu::VertexBufferLayout>]),
     fragment: &str,
-    format: wgpu::TextureFormat,
-    samples: u32,
+    (format, samples): (wgpu::TextureFormat, u32),
 ) -> wgpu::RenderPipeline {
     gpu.device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
         label: Some(label),
@@ -372,8 +371,7 @@ impl FramePipelines {
                 module,
                 ("vs_main", &[Some(POSITION_LAYOUT), Some(UV_LAYOUT)]),
                 entry_point,
-                format,
-                samples,
+                (format, samples),
             )
         })
     }
@@ -401,8 +399,7 @@ impl FramePipelines {
                 module,
                 ("vs_reflection", &[Some(POSITION_LAYOUT), Some(NORMAL_LAYOUT)]),
                 entry_point,
-                format,
-                samples,
+                (format, samples),
             )
         })
     }
@@ -430,8 +427,7 @@ impl FramePipelines {
                 module,
                 ("vs_hybrid_frame", &[Some(LENS_CORNER_LAYOUT)]),
                 entry_point,
-                format,
-                samples,
+                (format, samples),
             )
         })
     }

@@ -202,20 +202,16 @@ impl ResolvePipelines {
     }
 
     /// Records the resolve of `colour` (multisampled, float) and `ids` (multisampled object
-    /// indices, [`ID_FORMAT`], as many samples) into `target` (format `format`, same size):
-    /// every pixel written. `shared` (single-sample, [`SHARED_ID_FORMAT`], same size,
+    /// indices, [`ID_FORMAT`], as many samples) into `target` (of format `format`, same
+    /// size): every pixel written. `shared` (single-sample, [`SHARED_ID_FORMAT`], same size,
     /// render attachment and texture binding) holds each pixel's shared object index
     /// between the two passes.
-    #[allow(clippy::too_many_arguments)]
     pub fn encode(
         &mut self,
         gpu: &Gpu,
         filter: DisplayFilter,
-        colour: &wgpu::Texture,
-        ids: &wgpu::Texture,
-        shared: &wgpu::Texture,
-        target: &wgpu::TextureView,
-        format: wgpu::TextureFormat,
+        (colour, ids, shared): (&wgpu::Texture, &wgpu::Texture, &wgpu::Texture),
+        (target, format): (&wgpu::TextureView, wgpu::TextureFormat),
         encoder: &mut wgpu::CommandEncoder,
     ) {
         debug_assert_eq!(ids.format(), ID_FORMAT);

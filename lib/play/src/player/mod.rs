@@ -45,7 +45,7 @@ use crate::cache::LevelCache;
 use crate::camera::ViewCamera;
 use crate::decode::Decoder;
 use crate::error::PlayError;
-use crate::frame::{encode, offscreen_format, FramePipelines, Targets};
+use crate::frame::{encode, offscreen_format, FrameDraws, FramePipelines, FrameTarget, Targets};
 use crate::gpu::Gpu;
 use crate::image::FloatImage;
 use crate::mip::MipBuilder;
@@ -370,20 +370,14 @@ impl Player {
             }
         };
         let display = self.display.map(|(f, _)| f);
-        encode(
-            &gpu,
-            &mut self.pipes,
-            targets,
-            view,
-            format,
-            &objects,
-            &layers,
-            &reflections,
-            &lenses,
-            want_ids,
-            display,
-            &mut encoder,
-        );
+        let frame = FrameDraws {
+            objects: &objects,
+            layers: &layers,
+            reflections: &reflections,
+            lenses: &lenses,
+        };
+        let to = FrameTarget { colour: view, format, object_ids: want_ids, display };
+        encode(&gpu, &mut self.pipes, targets, to, frame, &mut encoder);
         gpu.queue.submit([encoder.finish()]);
         let ids = match target {
             Target::View(..) => return Ok(None),

@@ -185,7 +185,8 @@ pub fn draw_scene(
     sampler: &wgpu::Sampler,
 ) -> (FloatImage, Vec<u32>) {
     use pis_play::frame::{
-        colour_image, encode, offscreen_format, LayerDraw, ObjectDraw, Readback, Targets,
+        colour_image, encode, offscreen_format, FrameDraws, FrameTarget, LayerDraw, ObjectDraw,
+        Readback, Targets,
     };
     let format = offscreen_format(gpu);
     let mut targets = Targets::new(gpu, pipes, size, samples).unwrap();
@@ -209,20 +210,9 @@ pub fn draw_scene(
         .collect();
     let mut encoder = gpu.device.create_command_encoder(&Default::default());
     let view = targets.colour.create_view(&Default::default());
-    encode(
-        gpu,
-        pipes,
-        &mut targets,
-        &view,
-        format,
-        &objects,
-        &layers,
-        &[],
-        &[],
-        true,
-        display,
-        &mut encoder,
-    );
+    let target = FrameTarget { colour: &view, format, object_ids: true, display };
+    let frame = FrameDraws { objects: &objects, layers: &layers, reflections: &[], lenses: &[] };
+    encode(gpu, pipes, &mut targets, target, frame, &mut encoder);
     let texel = if format == wgpu::TextureFormat::Rgba16Float { 8 } else { 16 };
     let (rc, ri) = (Readback::new(gpu, size, texel), Readback::new(gpu, size, 4));
     rc.copy(&targets.colour, &mut encoder);
