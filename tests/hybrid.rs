@@ -335,8 +335,8 @@ fn shells_inferred_at_the_sampled_views_reproduce_the_traced_terms() {
     );
     for (v, (r, s)) in result.views.iter().zip(&one.views).enumerate() {
         eprintln!("view {v}: reflection {:.2} dB, refraction {:.2} dB, both {:.2} dB over {} pixels; one shell: {:.2}, {:.2}, {:.2} dB", r.reflection.psnr_db, r.refraction.psnr_db, r.both.psnr_db, r.both.pixels, s.reflection.psnr_db, s.refraction.psnr_db, s.both.psnr_db);
-        // Regression guards below the measured figures (docs/BENCHMARKS.md: 18.2–19.4 dB for
-        // both terms, 22.3–26.6 dB for the reflection-first term at CI size).
+        // Regression guards below the measured figures (docs/benchmarks/hybrid.md: 18.2–19.4 dB
+        // for both terms, 22.3–26.6 dB for the reflection-first term at CI size).
         assert!(r.both.pixels > 1500);
         assert!(
             r.both.psnr_db > 17.0 && r.reflection.psnr_db > 21.0,

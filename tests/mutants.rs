@@ -5,8 +5,8 @@
 //! file. Each must end in a result or an error: no panic, no mutant running longer than
 //! [`HANG_S`], and the process's peak resident memory under [`RSS_LIMIT_BYTES`].
 //!
-//! The test runs `PIS_MUTANTS` mutants (default 300); the figure in docs/BENCHMARKS.md comes
-//! from `PIS_MUTANTS=100000 cargo test --release --test mutants -- --nocapture`.
+//! The test runs `PIS_MUTANTS` mutants (default 300); the figure in docs/benchmarks/container.md
+//! comes from `PIS_MUTANTS=100000 cargo test --release --test mutants -- --nocapture`.
 
 use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::path::{Path, PathBuf};

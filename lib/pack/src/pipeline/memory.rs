@@ -10,7 +10,7 @@
 //! Whether to stream is decided before the set is read, from the bytes of its images: a pack
 //! in memory holds [`HELD_PER_IMAGE_BYTE`] bytes per byte of the float images it reads
 //! (measured on demo1: the images, the render matrices, the solves, the pyramids and the
-//! level images; docs/BENCHMARKS.md "Scale").
+//! level images; docs/benchmarks/scale.md "Scale").
 
 use pis_trace::memory::gib;
 

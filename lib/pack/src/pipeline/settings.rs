@@ -223,7 +223,7 @@ pub enum PyramidMode {
 /// the display clips (a glass object's refracted highlights) that measure ranks objects
 /// wrongly and the constraint starves objects the screen shows; where the free allocation
 /// leaves a small object no bytes at all, the constraint is what keeps it from decoding to
-/// black. Neither wins everywhere (docs/BENCHMARKS.md), so pis-pack's default tries both.
+/// black. Neither wins everywhere (docs/benchmarks/pack.md), so pis-pack's default tries both.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum MaxMse {
     /// The free equal-slope allocation: the least texture error for the bytes.
