@@ -111,3 +111,42 @@ fn hull_triangles_round_trip_and_too_many_are_refused() {
         ),
     }
 }
+
+/// A shell block's lookups per pixel side (SPEC.md 7.3 flags, 8.2) survive writing and
+/// reading, and a file written with 1 has the flags of a file from before the field.
+#[test]
+fn shell_lookups_round_trip() {
+    fn lookups<S>(c: &Container<S>) -> Vec<u32> {
+        c.objects
+            .iter()
+            .flat_map(|o| &o.layers)
+            .flat_map(|l| &l.blocks)
+            .filter_map(|b| match b.placement {
+                Placement::Shell { lookups, .. } => Some(lookups),
+                Placement::Surface { .. } => None,
+            })
+            .collect()
+    }
+    let mut c = tiny().unwrap();
+    let plain = to_bytes(&c).unwrap();
+    assert!(
+        !lookups(&c).is_empty() && lookups(&c).iter().all(|&k| k == 1),
+        "the sample has shell blocks, each looked up once"
+    );
+    for (k, b) in c
+        .objects
+        .iter_mut()
+        .flat_map(|o| o.layers.iter_mut())
+        .flat_map(|l| l.blocks.iter_mut())
+        .enumerate()
+    {
+        if let Placement::Shell { lookups, .. } = &mut b.placement {
+            *lookups = 1 + (k as u32 % 3);
+        }
+    }
+    let want = lookups(&c);
+    assert!(want.iter().any(|&k| k > 1));
+    let read = PisReader::from_bytes(to_bytes(&c).unwrap()).unwrap();
+    assert_eq!(lookups(read.container()), want);
+    assert_ne!(plain, to_bytes(&c).unwrap());
+}
