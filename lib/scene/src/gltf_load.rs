@@ -25,10 +25,13 @@ pub(crate) struct GltfScene {
     /// glTF cameras attached to nodes: (index into `rig.nodes`, perspective parameters).
     pub cameras: Vec<GltfCamera>,
     /// Animations that cannot be sampled, with the field and reason (used only if referenced).
-    pub unsupported_animations: BTreeMap<String, (String, String)>,
+    pub unsupported_animations: BTreeMap<String, Unsupported>,
     /// What the glTF uses that PIS ignores or reads otherwise, one line each.
     pub warnings: Vec<String>,
 }
+
+/// What PIS cannot sample in an animation: the field, and why.
+pub(crate) type Unsupported = (String, String);
 
 /// A perspective glTF camera on a node.
 #[derive(Clone, Debug)]
@@ -316,7 +319,7 @@ impl Ctx<'_> {
         doc: &gltf::Document,
         rig_index: &BTreeMap<usize, usize>,
         rig: &mut Rig,
-    ) -> Result<BTreeMap<String, (String, String)>, SceneError> {
+    ) -> Result<BTreeMap<String, Unsupported>, SceneError> {
         let mut unsupported_animations = BTreeMap::new();
         for a in doc.animations() {
             let name =
@@ -540,13 +543,12 @@ impl Ctx<'_> {
 
     /// Reads an animation; the inner `Err` holds (field, reason) when it uses something PIS
     /// cannot sample (morph-target weights), which matters only if a dimension uses it.
-    #[allow(clippy::type_complexity)]
     fn read_animation(
         &self,
         a: &gltf::Animation,
         name: &str,
         rig_index: &BTreeMap<usize, usize>,
-    ) -> Result<Result<Animation, (String, String)>, SceneError> {
+    ) -> Result<Result<Animation, Unsupported>, SceneError> {
         let mut channels = Vec::new();
         for (ci, c) in a.channels().enumerate() {
             let field = format!("animations[{}].channels[{ci}]", a.index());

@@ -281,7 +281,10 @@ impl<'s> SceneGeometry<'s> {
     /// The normal map's tangent frame at barycentrics `w` of the triangle with corners
     /// `idx` (world positions `p`) about the world shading normal `n`: the TANGENT
     /// attribute's where the primitive has one, else the triangle's own ([`crate::tangent`]).
-    #[allow(clippy::too_many_arguments)]
+    #[allow(
+        clippy::too_many_arguments,
+        reason = "the triangle's corners, weights, positions and normal map, each apart"
+    )]
     fn tangent_frame(
         &self,
         prim: &Primitive,

@@ -147,7 +147,10 @@ impl Integrator<'_> {
 
     /// Fresnel modulation and local/distant incident specular radiance at a reflective
     /// object's first hit; also returns the specular reflection's contribution to the image.
-    #[allow(clippy::too_many_arguments)]
+    #[allow(
+        clippy::too_many_arguments,
+        reason = "the first hit's surface, material and object, the ray and the path's state, each apart"
+    )]
     fn reflective_layers(
         &self,
         sp: &SurfacePoint,
@@ -182,7 +185,10 @@ impl Integrator<'_> {
 
     /// Follows one term of the greedy two-path model from the first hit on lens object
     /// `object` until the path leaves the object (thesis 6.2, 6.3.1).
-    #[allow(clippy::too_many_arguments)]
+    #[allow(
+        clippy::too_many_arguments,
+        reason = "the first hit's surface, material and object, the term and the path's state, each apart"
+    )]
     fn greedy_term(
         &self,
         sp: &SurfacePoint,

@@ -96,7 +96,10 @@ impl<'s> Integrator<'s> {
     /// by the balance heuristic (`lobe_pdf` the lobe's density of `dir`, `n` the shading
     /// normal the environment was drawn for); where it hits, as [`Self::radiance`] with light
     /// spheres unseen.
-    #[allow(clippy::too_many_arguments)]
+    #[allow(
+        clippy::too_many_arguments,
+        reason = "the ray, the path's state and the density to weigh the environment by, each apart"
+    )]
     fn radiance_mis(
         &self,
         origin: Vec3,
@@ -156,7 +159,10 @@ impl<'s> Integrator<'s> {
     /// `sees_lights`: whether light spheres are visible to this ray (camera and specular rays
     /// of paths without a diffuse bounce; diffuse paths reach lights through next-event
     /// estimation instead).
-    #[allow(clippy::too_many_arguments)]
+    #[allow(
+        clippy::too_many_arguments,
+        reason = "the ray, the path's state and what the ray sees, each apart"
+    )]
     pub fn radiance(
         &self,
         origin: Vec3,
@@ -175,7 +181,10 @@ impl<'s> Integrator<'s> {
     }
 
     /// Like [`Self::radiance`] for a ray whose closest hit is already known.
-    #[allow(clippy::too_many_arguments)]
+    #[allow(
+        clippy::too_many_arguments,
+        reason = "the ray with its hit, the path's state and what the ray sees, each apart"
+    )]
     fn radiance_from(
         &self,
         hit: Option<Hit>,

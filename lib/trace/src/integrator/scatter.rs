@@ -24,7 +24,10 @@ fn picks_first(u: f32, first: f32, second: f32) -> bool {
 
 impl Integrator<'_> {
     /// One stochastic scattering event at `sp` for a ray arriving with direction `dir`.
-    #[allow(clippy::too_many_arguments)]
+    #[allow(
+        clippy::too_many_arguments,
+        reason = "a scattering event reads the surface, its material, the ray and the path's state, each apart"
+    )]
     pub(super) fn scatter(
         &self,
         sp: &SurfacePoint,
@@ -67,7 +70,10 @@ impl Integrator<'_> {
 
     /// The non-diffuse lobes at `sp`, one chosen stochastically; returns their estimated sum.
     /// `choice` carries a uniform already drawn in [0, p_s + p_t) with the weights.
-    #[allow(clippy::too_many_arguments)]
+    #[allow(
+        clippy::too_many_arguments,
+        reason = "the path's state, the surface and the lobe already chosen are each read apart"
+    )]
     pub(super) fn scatter_nondiffuse(
         &self,
         sp: &SurfacePoint,
@@ -162,7 +168,10 @@ impl Integrator<'_> {
     }
 
     /// The smooth dielectric lobe: Fresnel-weighted choice of reflection or refraction.
-    #[allow(clippy::too_many_arguments)]
+    #[allow(
+        clippy::too_many_arguments,
+        reason = "a scattering event reads the surface, its material, the ray and the path's state, each apart"
+    )]
     pub(super) fn dielectric(
         &self,
         sp: &SurfacePoint,

@@ -1,5 +1,5 @@
 //! Programmatic test scenes built from the pis-scene model types.
-#![allow(dead_code)]
+#![allow(dead_code, reason = "each test file uses a part of these scenes")]
 
 use glam::{Mat4, Vec2, Vec3};
 use pis_scene::*;
