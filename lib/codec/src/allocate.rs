@@ -230,7 +230,7 @@ impl Problem {
         let none = vec![0usize; items.len()];
         let mut floor = none.clone();
         let mut beyond = vec![false; objects];
-        for o in 0..objects {
+        for (o, cannot) in beyond.iter_mut().enumerate() {
             let mine: Vec<bool> = items.iter().map(|it| it.object == o).collect();
             let object_mse = |p: &[usize]| -> f64 {
                 items
@@ -245,7 +245,7 @@ impl Problem {
                 hi *= 16.0;
             }
             if object_mse(&self.choose(0.0, &mine, &none)) > limit {
-                beyond[o] = true;
+                *cannot = true;
                 continue;
             }
             if object_mse(&self.choose(hi, &mine, &none)) <= limit {

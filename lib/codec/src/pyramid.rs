@@ -363,7 +363,7 @@ mod tests {
                         let b = l.get(1).copied().unwrap_or(0) as f32;
                         (t as f32 * 0.3).sin()
                             + 0.05 * a
-                            + if b as u32 % 2 == 0 { 0.5 } else { -0.5 }
+                            + if (b as u32).is_multiple_of(2) { 0.5 } else { -0.5 }
                     })
                     .collect()
             })

@@ -389,7 +389,7 @@ fn mesh<S>(oi: usize, o: &Object<S>, out: &mut Vec<Issue>) {
         out.push(e(id::mesh::NO_VERTICES, "vertex count 0".into()));
         return;
     }
-    if m.indices.is_empty() || m.indices.len() % 3 != 0 {
+    if m.indices.is_empty() || !m.indices.len().is_multiple_of(3) {
         out.push(e(id::mesh::INDEX_COUNT, format!("{} indices", m.indices.len())));
     }
     if let Some(i) = m.indices.iter().position(|&i| i as usize >= m.positions.len()) {

@@ -288,7 +288,7 @@ pub fn parse_table(
             ),
             _ => {}
         }
-        if entry.offset % ALIGN != 0 {
+        if !entry.offset.is_multiple_of(ALIGN) {
             issues.push(
                 tag(
                     id::chunk::OFFSET_MISALIGNED,

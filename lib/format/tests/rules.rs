@@ -618,7 +618,7 @@ fn master_cases() -> Vec<(u16, Vec<u8>)> {
             layer.weights = layer
                 .samples
                 .iter()
-                .map(|_| vec![1.0f32; 3].iter().flat_map(|x| x.to_le_bytes()).collect())
+                .map(|_| [1.0f32; 3].iter().flat_map(|x| x.to_le_bytes()).collect())
                 .collect();
         }),
     ));
