@@ -13,6 +13,7 @@
 //! back and compared with the input's decoded textures (and, with a master, both files with
 //! the master).
 
+mod container;
 mod master;
 mod screen_area;
 
@@ -269,33 +270,12 @@ fn stream_bytes<S>(o: &Object<S>, len: impl Fn(&S) -> u64) -> u64 {
         .sum()
 }
 
-/// Re-encodes `req.input` into `req.output`; on error no output file is left.
-pub fn reencode(req: &ReencodeRequest) -> Result<ReencodeReport, Failure> {
-    check(req)?;
-    let runtime = |e: anyhow::Error| Failure::new(Exit::Runtime, e);
-    let mut t = Timer(Vec::new(), Instant::now());
-    let input = open(&req.input)?;
-    let c = input.container();
-    let masters_in = if input.has_master() {
-        input.masters().map_err(|e| in_file(&req.input, e))?
-    } else {
-        Vec::new()
-    };
-    let from_master = !masters_in.is_empty();
-    let input_exact = c
-        .objects
-        .iter()
-        .flat_map(|o| &o.layers)
-        .flat_map(|l| &l.blocks)
-        .flat_map(|b| &b.levels)
-        .flat_map(|l| &l.images)
-        .all(|s| !s.codec.is_lossy());
-    if req.keep_master && !from_master && !input_exact {
-        return Err(usage(format!(
-            "--keep-master: {} carries no master and its level images are lossy: a master is carried over from a file that has one (pis-pack --keep-master) or made from a losslessly coded file",
-            req.input.display())));
-    }
-    // The parameter blocks: the input's, or new sizes with origins staggered per object.
+/// The parameter blocks of the output: the input's, or `--block`'s sizes with the origins
+/// staggered per object as pis-pack staggers them.
+fn new_blocks<S>(
+    c: &Container<S>,
+    req: &ReencodeRequest,
+) -> Result<(ParameterSpace, Vec<Vec<u32>>), Failure> {
     let mut space = c.space.clone();
     let staggers: Vec<Vec<u32>> = match &req.block {
         None => c.objects.iter().map(|o| o.stagger.clone()).collect(),
@@ -310,18 +290,33 @@ pub fn reencode(req: &ReencodeRequest) -> Result<ReencodeReport, Failure> {
                 .collect()
         }
     };
-    let exact = !req.codec.is_lossy();
-    let gamma = if exact { 1.0 } else { req.gamma.unwrap_or(DEFAULT_GAMMA) };
-    let texture_bytes_before: u64 =
-        c.objects.iter().map(|o| stream_bytes(o, |s| s.length as u64)).sum();
-    let raw =
-        c.provenance.as_ref().map(|p| p.raw_image_bytes).filter(|&b| b > 0).unwrap_or(
-            c.space.point_count() * c.cameras.width as u64 * c.cameras.height as u64 * 3,
-        );
+    Ok((space, staggers))
+}
 
-    // Every block's textures (the master's, or decoded), gamma compensated again, into its
-    // pyramid.
-    let source = if from_master { "master" } else { "decoded textures" };
+/// Every block's textures, gamma compensated again, in their pyramids (in the order of the
+/// objects, layers and blocks), with the layers' gammas.
+struct Pyramids {
+    blocks: Vec<BlockPyramid>,
+    /// Per object, per layer.
+    gammas: Vec<Vec<f32>>,
+    /// A master made from an exactly coded input: per object, layer and table sample.
+    made: Vec<Vec<Vec<Vec<f32>>>>,
+}
+
+/// Every block's textures (the master's, or decoded), gamma compensated again, into its
+/// pyramid.
+fn build_pyramids(
+    req: &ReencodeRequest,
+    input: &PisReader,
+    masters_in: &[Master],
+    space: &ParameterSpace,
+    staggers: &[Vec<u32>],
+    gamma: f32,
+) -> Result<Pyramids, Failure> {
+    let runtime = |e: anyhow::Error| Failure::new(Exit::Runtime, e);
+    let c = input.container();
+    let exact = !req.codec.is_lossy();
+    let from_master = !masters_in.is_empty();
     let mut pyramids: Vec<BlockPyramid> = Vec::new();
     let mut layers_out = Vec::new();
     // A master made from an exactly coded input: per object, layer and table sample.
@@ -335,11 +330,11 @@ pub fn reencode(req: &ReencodeRequest) -> Result<ReencodeReport, Failure> {
             let layer_samples = c.space.table_len(l.depends_on).max(1) as f64;
             let sources = match masters_in.iter().find(|m| m.object as usize == oi) {
                 Some(m) => master::from_master(c, m, oi, li),
-                None => master::from_decoded(&input, oi, li),
+                None => master::from_decoded(input, oi, li),
             }
             .map_err(|e| in_file(&req.input, e))?;
             let sources = if req.block.is_some() {
-                master::regroup(c, &space, &staggers[oi], oi, li, sources)
+                master::regroup(c, space, &staggers[oi], oi, li, sources)
                     .map_err(|e| Failure::new(Exit::NotSupported, anyhow::Error::from(e)))?
             } else {
                 sources
@@ -382,26 +377,32 @@ pub fn reencode(req: &ReencodeRequest) -> Result<ReencodeReport, Failure> {
         layers_out.push(per_layer);
         made.push(made_layers);
     }
-    let level_images: usize = pyramids.iter().flat_map(|p| &p.levels).map(|l| l.1.len()).sum();
-    t.done(
-        "pyramid",
-        &format!(
-            "{} blocks from the {source}, {level_images} level images in adaptive pyramids",
-            pyramids.len()
-        ),
-    );
+    Ok(Pyramids { blocks: pyramids, gammas: layers_out, made })
+}
 
-    let (target, target_text) = match (req.psnr, req.ratio) {
+/// The allocation's target, and how the provenance records it.
+fn target(req: &ReencodeRequest, raw: u64, texture_bytes_before: u64) -> (Target, String) {
+    let exact = !req.codec.is_lossy();
+    match (req.psnr, req.ratio) {
         _ if exact => (Target::Bytes(usize::MAX), "exact".to_string()),
         (Some(db), _) => (Target::Psnr { db, peak: 1.0 }, format!("psnr {db} dB")),
         (None, Some(r)) => (Target::Bytes((raw as f64 / r) as usize), format!("ratio {r}")),
         (None, None) => {
             (Target::Bytes(texture_bytes_before as usize), format!("bytes {texture_bytes_before}"))
         }
-    };
-    // A master carries the allocation weights its writer used; otherwise they are measured.
-    let need_areas = !exact || (req.keep_master && !from_master);
-    let areas = if from_master {
+    }
+}
+
+/// The objects' allocation weights: a master's (those its writer used), else measured
+/// screen areas when `needed`.
+fn allocation_areas(
+    c: &Container<StreamRef>,
+    masters_in: &[Master],
+    needed: bool,
+    t: &mut Timer,
+) -> Option<Vec<f64>> {
+    let from_master = !masters_in.is_empty();
+    if from_master {
         Some(
             c.objects
                 .iter()
@@ -411,7 +412,7 @@ pub fn reencode(req: &ReencodeRequest) -> Result<ReencodeReport, Failure> {
                 })
                 .collect::<Vec<f64>>(),
         )
-    } else if need_areas {
+    } else if needed {
         let a = screen_areas(c);
         t.done(
             "areas",
@@ -420,7 +421,135 @@ pub fn reencode(req: &ReencodeRequest) -> Result<ReencodeReport, Failure> {
         Some(a)
     } else {
         None
+    }
+}
+
+/// The input's master, if it carries one; refused for `--keep-master` when it has none
+/// and cannot make one (its level images are lossy).
+fn masters_in(req: &ReencodeRequest, input: &PisReader) -> Result<Vec<Master>, Failure> {
+    let c = input.container();
+    let masters_in = if input.has_master() {
+        input.masters().map_err(|e| in_file(&req.input, e))?
+    } else {
+        Vec::new()
     };
+    let input_exact = c
+        .objects
+        .iter()
+        .flat_map(|o| &o.layers)
+        .flat_map(|l| &l.blocks)
+        .flat_map(|b| &b.levels)
+        .flat_map(|l| &l.images)
+        .all(|s| !s.codec.is_lossy());
+    if req.keep_master && masters_in.is_empty() && !input_exact {
+        return Err(usage(format!(
+            "--keep-master: {} carries no master and its level images are lossy: a master is carried over from a file that has one (pis-pack --keep-master) or made from a losslessly coded file",
+            req.input.display())));
+    }
+    Ok(masters_in)
+}
+
+/// The master the output carries: none without `--keep-master`; the input's; or one made
+/// from the exactly coded input's textures (`made`), with the measured `areas`.
+fn masters_out(
+    req: &ReencodeRequest,
+    out: &Container,
+    masters_in: &[Master],
+    made: &[Vec<Vec<Vec<f32>>>],
+    areas: Option<&[f64]>,
+    t: &mut Timer,
+) -> Result<Vec<Master>, Failure> {
+    Ok(if !req.keep_master {
+        Vec::new()
+    } else if !masters_in.is_empty() {
+        masters_in.to_vec()
+    } else {
+        let a = areas.unwrap_or(&[]);
+        let m = made
+            .iter()
+            .enumerate()
+            .map(|(oi, textures)| {
+                Master::encode(out, oi, a.get(oi).copied().unwrap_or(1.0), textures, None)
+            })
+            .collect::<Result<Vec<Master>, Error>>()
+            .map_err(|e| Failure::new(Exit::Runtime, anyhow::Error::from(e)))?;
+        t.done("master", &format!("decoded textures of {} objects coded losslessly", m.len()));
+        m
+    })
+}
+
+/// Scores against the master: the pooled error and each object's.
+type MasterScores = Option<(SquaredError, Vec<SquaredError>)>;
+
+/// Per object: bytes before and after, the output's error against the input, and with a
+/// master both files' errors against it.
+fn object_reports(
+    c: &Container<StreamRef>,
+    output: &PisReader,
+    diff: &crate::diff::ContentDiff,
+    areas: Option<&[f64]>,
+    (vs_before, vs_after): (&MasterScores, &MasterScores),
+) -> Vec<ObjectReport> {
+    let finite = |p: f64| p.is_finite().then_some(p);
+    let object_psnr = |s: &MasterScores, i: usize| s.as_ref().and_then(|s| finite(s.1[i].psnr()));
+    c.objects
+        .iter()
+        .zip(&output.container().objects)
+        .zip(&diff.objects)
+        .enumerate()
+        .map(|(i, ((a, b), d))| ObjectReport {
+            name: a.name.clone(),
+            bytes_before: stream_bytes(a, |s| s.length as u64),
+            bytes_after: stream_bytes(b, |s| s.length as u64),
+            psnr_db: d.score.psnr_db,
+            mse: d.score.mse,
+            max_error: d.score.max_error,
+            exact: d.score.exact,
+            area_px: areas.map(|a| a[i]),
+            psnr_master_before_db: object_psnr(vs_before, i),
+            psnr_master_after_db: object_psnr(vs_after, i),
+        })
+        .collect()
+}
+
+/// Re-encodes `req.input` into `req.output`; on error no output file is left.
+pub fn reencode(req: &ReencodeRequest) -> Result<ReencodeReport, Failure> {
+    check(req)?;
+    let runtime = |e: anyhow::Error| Failure::new(Exit::Runtime, e);
+    let mut t = Timer(Vec::new(), Instant::now());
+    let input = open(&req.input)?;
+    let c = input.container();
+    let masters_in = masters_in(req, &input)?;
+    let from_master = !masters_in.is_empty();
+    // The parameter blocks: the input's, or new sizes with origins staggered per object.
+    let (space, staggers) = new_blocks(c, req)?;
+    let exact = !req.codec.is_lossy();
+    let gamma = if exact { 1.0 } else { req.gamma.unwrap_or(DEFAULT_GAMMA) };
+    let texture_bytes_before: u64 =
+        c.objects.iter().map(|o| stream_bytes(o, |s| s.length as u64)).sum();
+    let raw =
+        c.provenance.as_ref().map(|p| p.raw_image_bytes).filter(|&b| b > 0).unwrap_or(
+            c.space.point_count() * c.cameras.width as u64 * c.cameras.height as u64 * 3,
+        );
+
+    // Every block's textures (the master's, or decoded), gamma compensated again, into its
+    // pyramid.
+    let source = if from_master { "master" } else { "decoded textures" };
+    let Pyramids { blocks: mut pyramids, gammas: layers_out, made } =
+        build_pyramids(req, &input, &masters_in, &space, &staggers, gamma)?;
+    let level_images: usize = pyramids.iter().flat_map(|p| &p.levels).map(|l| l.1.len()).sum();
+    t.done(
+        "pyramid",
+        &format!(
+            "{} blocks from the {source}, {level_images} level images in adaptive pyramids",
+            pyramids.len()
+        ),
+    );
+
+    let (target, target_text) = target(req, raw, texture_bytes_before);
+    // A master carries the allocation weights its writer used; otherwise they are measured.
+    let need_areas = !exact || (req.keep_master && !from_master);
+    let areas = allocation_areas(c, &masters_in, need_areas, &mut t);
     // The constraint as asked, else as the writer applied it (a best-of choice needs the
     // traced set, which a re-encoding does not have).
     let max_mse = match req.max_mse {
@@ -444,125 +573,19 @@ pub fn reencode(req: &ReencodeRequest) -> Result<ReencodeReport, Failure> {
     t.done("encode", &format!("{level_images} level images with {}", req.codec));
 
     // The container: everything copied but gamma and pyramids.
-    let mut out: Container = c
-        .try_map(&mut |_| Ok::<_, Error>(Codestream { codec: req.codec, bytes: vec![] }))
-        .map_err(Failure::from)?;
-    out.space = space.clone();
-    let mut next = pyramids.into_iter();
-    for ((o, gammas), st) in out.objects.iter_mut().zip(&layers_out).zip(&staggers) {
-        o.stagger = st.clone();
-        for (l, &g) in o.layers.iter_mut().zip(gammas) {
-            l.gamma = g;
-            if req.block.is_some() {
-                // Every new block keeps the layer's one placement (checked by the regrouping).
-                let template = l
-                    .blocks
-                    .first()
-                    .cloned()
-                    .ok_or_else(|| runtime(anyhow!("a layer without blocks")))?;
-                let count = pis_format::blocks::BlockGrid::new(&space, l.depends_on, st)
-                    .block_count() as usize;
-                l.blocks = vec![Block { levels: Vec::new(), ..template }; count];
-            }
-            for b in &mut l.blocks {
-                let p =
-                    next.next().ok_or_else(|| runtime(anyhow!("fewer pyramids than blocks")))?;
-                b.levels = p
-                    .levels
-                    .into_iter()
-                    .map(|(counts, _, streams)| Level {
-                        counts,
-                        images: streams
-                            .into_iter()
-                            .map(|bytes| Codestream { codec: req.codec, bytes })
-                            .collect(),
-                    })
-                    .collect();
-            }
-        }
-    }
-    let before = c.provenance.clone().unwrap_or_default();
-    let mut settings: Vec<(String, String)> = before
-        .settings
-        .iter()
-        .filter(|(k, _)| !(req.block.is_some() && k == "block"))
-        .filter(|(k, _)| {
-            !matches!(
-                k.as_str(),
-                "codec"
-                    | "gamma"
-                    | "target"
-                    | "reencoded_from"
-                    | "source_tool"
-                    | "source_codec"
-                    | pis_pack::PREDICTED_PSNR_SETTING
-            )
-        })
-        // An exact output carries the writer's constraint on, for the next lossy coding.
-        .filter(|(k, _)| exact || k != "max_mse_ratio")
-        .cloned()
-        .collect();
-    let codecs_before: Vec<String> = {
-        let mut v: Vec<String> = c
-            .objects
-            .iter()
-            .flat_map(|o| &o.layers)
-            .flat_map(|l| &l.blocks)
-            .flat_map(|b| &b.levels)
-            .flat_map(|l| &l.images)
-            .map(|s| s.codec.name().to_string())
-            .collect();
-        v.sort();
-        v.dedup();
-        v
-    };
-    if req.block.is_some() {
-        settings.push((
-            "block".to_string(),
-            space.dims.iter().map(|d| d.block_size.to_string()).collect::<Vec<_>>().join("x"),
-        ));
-    }
-    settings.extend([
-        ("codec".to_string(), req.codec.name().to_string()),
-        ("gamma".to_string(), gamma.to_string()),
-        ("target".to_string(), target_text.clone()),
-        ("reencoded_from".to_string(), req.input.display().to_string()),
-        ("source_tool".to_string(), before.tool.clone()),
-        ("source_codec".to_string(), codecs_before.join("+")),
-    ]);
-    if !exact {
-        settings.push((
-            "max_mse_ratio".to_string(),
-            max_mse.alpha().map_or_else(|| "off".to_string(), |a| a.to_string()),
-        ));
-    }
-    out.provenance = Some(Provenance {
-        tool: format!("pis-reencode {}", env!("CARGO_PKG_VERSION")),
-        source: if before.source.is_empty() {
-            req.input.display().to_string()
-        } else {
-            before.source.clone()
-        },
-        raw_image_bytes: raw,
-        settings,
-    });
-    let masters_out = if !req.keep_master {
-        Vec::new()
-    } else if from_master {
-        masters_in.clone()
-    } else {
-        let a = areas.as_deref().unwrap_or(&[]);
-        let m = made
-            .iter()
-            .enumerate()
-            .map(|(oi, textures)| {
-                Master::encode(&out, oi, a.get(oi).copied().unwrap_or(1.0), textures, None)
-            })
-            .collect::<Result<Vec<Master>, Error>>()
-            .map_err(|e| runtime(e.into()))?;
-        t.done("master", &format!("decoded textures of {} objects coded losslessly", m.len()));
-        m
-    };
+    let mut out = container::assemble(c, req, &space, &staggers, &layers_out, pyramids)?;
+    let codecs_before = container::codecs(c);
+    out.provenance = Some(container::provenance(
+        c,
+        req,
+        &space,
+        &target_text,
+        max_mse,
+        gamma,
+        &codecs_before,
+        raw,
+    ));
+    let masters_out = masters_out(req, &out, &masters_in, &made, areas.as_deref(), &mut t)?;
     let bytes_after =
         pis_format::write_with_masters(&req.output, &out, &masters_out).map_err(|e| match e {
             Error::Io { .. } => Failure::from(e),
@@ -585,28 +608,7 @@ pub fn reencode(req: &ReencodeRequest) -> Result<ReencodeReport, Failure> {
         (None, None)
     };
     let finite = |p: f64| p.is_finite().then_some(p);
-    let object_psnr = |s: &Option<(SquaredError, Vec<SquaredError>)>, i: usize| {
-        s.as_ref().and_then(|s| finite(s.1[i].psnr()))
-    };
-    let objects = c
-        .objects
-        .iter()
-        .zip(&output.container().objects)
-        .zip(&diff.objects)
-        .enumerate()
-        .map(|(i, ((a, b), d))| ObjectReport {
-            name: a.name.clone(),
-            bytes_before: stream_bytes(a, |s| s.length as u64),
-            bytes_after: stream_bytes(b, |s| s.length as u64),
-            psnr_db: d.score.psnr_db,
-            mse: d.score.mse,
-            max_error: d.score.max_error,
-            exact: d.score.exact,
-            area_px: areas.as_ref().map(|a| a[i]),
-            psnr_master_before_db: object_psnr(&vs_before, i),
-            psnr_master_after_db: object_psnr(&vs_after, i),
-        })
-        .collect();
+    let objects = object_reports(c, &output, &diff, areas.as_deref(), (&vs_before, &vs_after));
     let bytes_before = input.len();
     let (master_bytes_before, master_bytes_after) = (input.master_bytes(), output.master_bytes());
     let psnr_master_before_db = vs_before.as_ref().and_then(|s| finite(s.0.psnr()));

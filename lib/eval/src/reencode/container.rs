@@ -1,0 +1,143 @@
+//! The output container: the input's, its blocks' level images and the layers' gammas
+//! replaced, and the provenance of the re-encoding.
+
+use anyhow::anyhow;
+use pis_format::*;
+use pis_pack::storage::BlockPyramid;
+use pis_pack::{Exit, Failure, MaxMse};
+
+use super::ReencodeRequest;
+
+/// The input's container `c` with the new blocks (`space`, `staggers`), gammas and level
+/// images (`pyramids`, in the order of the objects, layers and blocks); everything else
+/// copied.
+pub fn assemble<S>(
+    c: &Container<S>,
+    req: &ReencodeRequest,
+    space: &ParameterSpace,
+    staggers: &[Vec<u32>],
+    gammas: &[Vec<f32>],
+    pyramids: Vec<BlockPyramid>,
+) -> Result<Container, Failure> {
+    let runtime = |e: anyhow::Error| Failure::new(Exit::Runtime, e);
+    let mut out: Container = c
+        .try_map(&mut |_| Ok::<_, Error>(Codestream { codec: req.codec, bytes: vec![] }))
+        .map_err(Failure::from)?;
+    out.space = space.clone();
+    let mut next = pyramids.into_iter();
+    for ((o, gammas), st) in out.objects.iter_mut().zip(gammas).zip(staggers) {
+        o.stagger = st.clone();
+        for (l, &g) in o.layers.iter_mut().zip(gammas) {
+            l.gamma = g;
+            if req.block.is_some() {
+                // Every new block keeps the layer's one placement (checked by the regrouping).
+                let template = l
+                    .blocks
+                    .first()
+                    .cloned()
+                    .ok_or_else(|| runtime(anyhow!("a layer without blocks")))?;
+                let count = pis_format::blocks::BlockGrid::new(space, l.depends_on, st)
+                    .block_count() as usize;
+                l.blocks = vec![Block { levels: Vec::new(), ..template }; count];
+            }
+            for b in &mut l.blocks {
+                let p =
+                    next.next().ok_or_else(|| runtime(anyhow!("fewer pyramids than blocks")))?;
+                b.levels = p
+                    .levels
+                    .into_iter()
+                    .map(|(counts, _, streams)| Level {
+                        counts,
+                        images: streams
+                            .into_iter()
+                            .map(|bytes| Codestream { codec: req.codec, bytes })
+                            .collect(),
+                    })
+                    .collect();
+            }
+        }
+    }
+    Ok(out)
+}
+
+/// The codecs of the input's level images, by name, sorted.
+pub fn codecs(c: &Container<StreamRef>) -> Vec<String> {
+    let mut v: Vec<String> = c
+        .objects
+        .iter()
+        .flat_map(|o| &o.layers)
+        .flat_map(|l| &l.blocks)
+        .flat_map(|b| &b.levels)
+        .flat_map(|l| &l.images)
+        .map(|s| s.codec.name().to_string())
+        .collect();
+    v.sort();
+    v.dedup();
+    v
+}
+
+/// The output's provenance: the input's settings but those the re-encoding changes, and
+/// the re-encoding's own.
+pub fn provenance<S>(
+    c: &Container<S>,
+    req: &ReencodeRequest,
+    space: &ParameterSpace,
+    target_text: &str,
+    max_mse: MaxMse,
+    gamma: f32,
+    codecs_before: &[String],
+    raw: u64,
+) -> Provenance {
+    let exact = !req.codec.is_lossy();
+    let before = c.provenance.clone().unwrap_or_default();
+    let mut settings: Vec<(String, String)> = before
+        .settings
+        .iter()
+        .filter(|(k, _)| !(req.block.is_some() && k == "block"))
+        .filter(|(k, _)| {
+            !matches!(
+                k.as_str(),
+                "codec"
+                    | "gamma"
+                    | "target"
+                    | "reencoded_from"
+                    | "source_tool"
+                    | "source_codec"
+                    | pis_pack::PREDICTED_PSNR_SETTING
+            )
+        })
+        // An exact output carries the writer's constraint on, for the next lossy coding.
+        .filter(|(k, _)| exact || k != "max_mse_ratio")
+        .cloned()
+        .collect();
+    if req.block.is_some() {
+        settings.push((
+            "block".to_string(),
+            space.dims.iter().map(|d| d.block_size.to_string()).collect::<Vec<_>>().join("x"),
+        ));
+    }
+    settings.extend([
+        ("codec".to_string(), req.codec.name().to_string()),
+        ("gamma".to_string(), gamma.to_string()),
+        ("target".to_string(), target_text.to_string()),
+        ("reencoded_from".to_string(), req.input.display().to_string()),
+        ("source_tool".to_string(), before.tool.clone()),
+        ("source_codec".to_string(), codecs_before.join("+")),
+    ]);
+    if !exact {
+        settings.push((
+            "max_mse_ratio".to_string(),
+            max_mse.alpha().map_or_else(|| "off".to_string(), |a| a.to_string()),
+        ));
+    }
+    Provenance {
+        tool: format!("pis-reencode {}", env!("CARGO_PKG_VERSION")),
+        source: if before.source.is_empty() {
+            req.input.display().to_string()
+        } else {
+            before.source.clone()
+        },
+        raw_image_bytes: raw,
+        settings,
+    }
+}
