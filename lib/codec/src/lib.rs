@@ -15,12 +15,13 @@
 //! Beside the codecs, the crate holds what turns a block of textures into level images and
 //! bytes: the adaptive Laplacian pyramid over parameter space ([`pyramid`], thesis 4.3),
 //! storage allocation by equal slopes ([`allocate`], thesis 4.5) and gamma compensation
-//! ([`gamma`], thesis 4.6).
+//! ([`gamma`], thesis 4.6); and the display values PSNR is measured on ([`display`]).
 
 pub mod allocate;
 mod arith;
 mod colour;
 pub mod dct;
+pub mod display;
 mod error;
 pub mod gamma;
 mod lossless;

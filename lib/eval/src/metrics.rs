@@ -1,20 +1,7 @@
 //! Display metrics. PSNR is measured on display values: linear radiance clamped to [0, 1],
-//! sRGB-encoded (IEC 61966-2-1), peak 1 — the values a viewer sees.
+//! sRGB-encoded (IEC 61966-2-1), peak 1 — the values a viewer sees ([`pis_codec::display`]).
 
-/// The sRGB encoding of a linear value clamped to [0, 1]; non-finite values display as 0.
-pub fn srgb_encode(linear: f32) -> f32 {
-    let l = if linear.is_finite() { linear.clamp(0.0, 1.0) } else { 0.0 };
-    if l <= 0.003_130_8 {
-        12.92 * l
-    } else {
-        1.055 * l.powf(1.0 / 2.4) - 0.055
-    }
-}
-
-/// The display value of a linear radiance value.
-pub fn display(linear: f32) -> f64 {
-    srgb_encode(linear) as f64
-}
+pub use pis_codec::display::{display, psnr_display, srgb_encode};
 
 /// A running sum of squared display errors, for PSNR over any set of values.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -127,13 +114,6 @@ fn psnr_of(mse: f64) -> f64 {
     }
 }
 
-/// PSNR in dB (peak 1) of two equally long slices of linear values, on display values.
-pub fn psnr_display(values: &[f32], reference: &[f32]) -> f64 {
-    let mut e = SquaredError::default();
-    e.add_slices(values, reference);
-    e.psnr()
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -145,7 +125,11 @@ mod tests {
         let a = vec![lin(0.5); 12];
         let b = vec![lin(0.6); 12];
         assert!((psnr_display(&a, &b) - 20.0).abs() < 1e-3, "{}", psnr_display(&a, &b));
-        assert_eq!(psnr_display(&a, &a), f64::INFINITY);
+        // No error: 200 dB on display values (a number in JSON), infinity in a running sum.
+        assert!((psnr_display(&a, &a) - pis_codec::display::MAX_PSNR_DB).abs() < 1e-9);
+        let mut same = SquaredError::default();
+        same.add_slices(&a, &a);
+        assert_eq!(same.psnr(), f64::INFINITY);
     }
 
     /// A deterministic stream of uniforms in [0, 1) (splitmix64).

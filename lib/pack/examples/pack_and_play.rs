@@ -74,16 +74,8 @@ fn main() -> Result<(), Box<dyn Error>> {
 /// PSNR (dB, peak 1) of an RGBA frame against RGB planes, both linear radiance, compared
 /// as sRGB display values clamped to [0, 1].
 fn psnr_display(rgba: &[f32], planes: &[Vec<f32>]) -> f64 {
-    let display = |v: f32| {
-        let v = v.clamp(0.0, 1.0);
-        (if v <= 0.003_130_8 { 12.92 * v } else { 1.055 * v.powf(1.0 / 2.4) - 0.055 }) as f64
-    };
-    let mut sum = 0.0;
-    let pixels = planes[0].len();
-    for p in 0..pixels {
-        for c in 0..3 {
-            sum += (display(rgba[p * 4 + c]) - display(planes[c][p])).powi(2);
-        }
-    }
-    10.0 * (1.0 / (sum / (3 * pixels) as f64).max(1e-12)).log10()
+    let frame: Vec<f32> = rgba.chunks_exact(4).flat_map(|px| [px[0], px[1], px[2]]).collect();
+    let gold: Vec<f32> =
+        (0..planes[0].len()).flat_map(|p| [0, 1, 2].map(|c| planes[c][p])).collect();
+    pis_codec::display::psnr_display(&frame, &gold)
 }

@@ -5,15 +5,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::Context;
 
-/// Linear → sRGB transfer function (IEC 61966-2-1), clamped to [0, 1].
-pub fn srgb_encode(linear: f32) -> f32 {
-    let l = if linear.is_finite() { linear.clamp(0.0, 1.0) } else { 0.0 };
-    if l <= 0.003_130_8 {
-        12.92 * l
-    } else {
-        1.055 * l.powf(1.0 / 2.4) - 0.055
-    }
-}
+pub use pis_codec::display::srgb_encode;
 
 fn temp_beside(path: &Path) -> PathBuf {
     let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
@@ -77,18 +69,4 @@ pub fn write_png(
         return Err(e).with_context(|| format!("cannot write {}", path.display()));
     }
     rename_into_place(&tmp, path)
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn srgb_matches_the_standard() {
-        assert_eq!(srgb_encode(0.0), 0.0);
-        assert!((srgb_encode(1.0) - 1.0).abs() < 1e-6);
-        assert!((srgb_encode(0.18) - 0.4614).abs() < 1e-3);
-        assert_eq!(srgb_encode(f32::NAN), 0.0);
-        assert_eq!(srgb_encode(7.0), srgb_encode(1.0));
-    }
 }

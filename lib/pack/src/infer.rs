@@ -19,14 +19,10 @@ use glam::Vec3;
 use pis_compile::baseline::forward::forward_map;
 use pis_compile::baseline::traced::trace_into_texture;
 use pis_compile::baseline::LayerImage;
-use pis_compile::texcoord::{
-    charts::{separate_overlapping_charts, unfold_charts},
-    optimize_placement, ObjectMesh, TexcoordSettings, ViewGeometry,
-};
 use pis_compile::{
-    antialiased_render_matrix, render, render_matrix, scene_depth, solve, Address, DisplayFilter,
-    DrawMesh, Filter, MipSolve, RenderMatrix, Sampler, SolveSettings, TextureLayout,
-    TextureTransform, TexturedObject, Viewport,
+    antialiased_render_matrix, render, render_matrix, scene_depth, solve, DisplayFilter, DrawMesh,
+    Filter, MipSolve, RenderMatrix, SolveSettings, TextureLayout, TextureTransform, TexturedObject,
+    Viewport,
 };
 use pis_play::{render_object, Gpu, TexturedPipeline};
 use pis_scene::{Frame, LoadOptions, Scene};
@@ -34,7 +30,11 @@ use pis_trace::layers::LayerKind;
 use pis_trace::{PointImages, TraceSettings};
 use serde::Serialize;
 
-use crate::images::srgb_encode;
+pub use pis_codec::display::psnr_display;
+
+use crate::pipeline::mesh::{atlas, place_in};
+pub use crate::pipeline::mesh::{merged_mesh, sampler, Mesh};
+use crate::pipeline::rows::restrict;
 
 /// What to infer.
 #[derive(Clone, Debug, Default)]
@@ -130,90 +130,6 @@ pub struct InferReport {
     /// With `neighbour`: the parameter point the textures were also drawn at.
     pub neighbour_point: Option<Vec<u32>>,
     pub notes: Vec<String>,
-}
-
-/// One object's mesh, all primitives merged, in object space.
-pub struct Mesh {
-    pub positions: Vec<[f32; 3]>,
-    /// Unit vertex normals, one per position.
-    pub normals: Vec<[f32; 3]>,
-    pub uvs: Vec<[f32; 2]>,
-    pub indices: Vec<u32>,
-}
-
-/// Object `o`'s primitives merged into one mesh, in primitive order, its folded charts cut
-/// apart ([`unfold_charts`]: vertices copied, triangles kept in order).
-pub fn merged_mesh(scene: &Scene, o: usize) -> Mesh {
-    let mut m = Mesh { positions: vec![], normals: vec![], uvs: vec![], indices: vec![] };
-    for p in &scene.objects[o].primitives {
-        let base = m.positions.len() as u32;
-        m.positions.extend(p.positions.iter().map(|v| v.to_array()));
-        // The scene gives one unit normal per vertex; a primitive built otherwise gets its
-        // triangles' normals.
-        if p.normals.len() == p.positions.len() {
-            m.normals.extend(p.normals.iter().map(|v| v.to_array()));
-        } else {
-            m.normals.extend(vertex_normals(&p.positions, &p.indices));
-        }
-        if p.uvs.len() == p.positions.len() {
-            m.uvs.extend(p.uvs.iter().map(|v| v.to_array()));
-        } else {
-            m.uvs.extend(std::iter::repeat_n([0.0, 0.0], p.positions.len()));
-        }
-        m.indices.extend(p.indices.iter().map(|i| i + base));
-    }
-    // A chart folded onto itself (mirrored coordinates) is cut where it turns over, so that
-    // its halves can get texels of their own.
-    let uvs: Vec<glam::Vec2> = m.uvs.iter().map(|u| glam::Vec2::from(*u)).collect();
-    if let Some(u) = unfold_charts(&uvs, &m.indices) {
-        for &v in &u.copies {
-            let v = v as usize;
-            m.positions.push(m.positions[v]);
-            m.normals.push(m.normals[v]);
-            m.uvs.push(m.uvs[v]);
-        }
-        m.indices = u.indices;
-    }
-    m
-}
-
-/// Area-weighted vertex normals of a triangle list (+Y where a vertex has no area).
-fn vertex_normals(positions: &[Vec3], indices: &[u32]) -> Vec<[f32; 3]> {
-    let mut n = vec![Vec3::ZERO; positions.len()];
-    for t in indices.chunks_exact(3) {
-        let [a, b, c] = [t[0], t[1], t[2]].map(|i| i as usize);
-        if let (Some(&pa), Some(&pb), Some(&pc)) =
-            (positions.get(a), positions.get(b), positions.get(c))
-        {
-            let f = (pb - pa).cross(pc - pa);
-            [a, b, c].iter().for_each(|&v| n[v] += f);
-        }
-    }
-    n.iter().map(|v| v.normalize_or(Vec3::Y).to_array()).collect()
-}
-
-/// Whether the texture wraps along u / v: the mesh has a seam, vertices at u = 0 and u = 1
-/// (v = 0 and v = 1) at the same position.
-pub fn seam_wraps(mesh: &Mesh) -> [bool; 2] {
-    let mut out = [false; 2];
-    for (dim, flag) in out.iter_mut().enumerate() {
-        let key = |p: [f32; 3]| p.map(|c| (c * 1e4).round() as i64);
-        let lo: std::collections::BTreeSet<_> = mesh
-            .positions
-            .iter()
-            .zip(&mesh.uvs)
-            .filter(|(_, uv)| uv[dim].abs() < 1e-4)
-            .map(|(p, _)| key(*p))
-            .collect();
-        let matches = mesh
-            .positions
-            .iter()
-            .zip(&mesh.uvs)
-            .filter(|(p, uv)| (uv[dim] - 1.0).abs() < 1e-4 && lo.contains(&key(**p)))
-            .count();
-        *flag = matches >= 2;
-    }
-    out
 }
 
 struct Point {
@@ -316,61 +232,6 @@ fn object_layer(images: &PointImages, channel: &str) -> Result<(Vec<f32>, Vec<f3
     Ok((cov, rgb))
 }
 
-fn display(v: f32) -> f64 {
-    srgb_encode(v.clamp(0.0, 1.0)) as f64
-}
-
-/// PSNR of display values, peak 1.
-pub fn psnr_display(a: &[f32], b: &[f32]) -> f64 {
-    let mse = a.iter().zip(b).map(|(x, y)| (display(*x) - display(*y)).powi(2)).sum::<f64>()
-        / a.len().max(1) as f64;
-    10.0 * (1.0 / mse.max(1e-20)).log10()
-}
-
-/// Keeps the rows of A whose pixels the tracer covers; returns the reduced A and its b.
-pub fn restrict(a: &RenderMatrix, cov: &[f32], rgb: &[f32]) -> (RenderMatrix, Vec<f32>) {
-    let out = restrict_rows(a, cov);
-    let b = gather(&out.pixels, rgb);
-    (out, b)
-}
-
-/// The RGB values of `rgb` (3 per pixel of the image) at `pixels`: a row's b.
-pub fn gather(pixels: &[u32], rgb: &[f32]) -> Vec<f32> {
-    let mut b = Vec::with_capacity(pixels.len() * 3);
-    for &p in pixels {
-        b.extend_from_slice(&rgb[p as usize * 3..p as usize * 3 + 3]);
-    }
-    b
-}
-
-/// The rows of A whose pixels the tracer covers.
-pub fn restrict_rows(a: &RenderMatrix, cov: &[f32]) -> RenderMatrix {
-    select_rows(a, |p| !cov.get(p as usize).is_none_or(|&c| c <= 0.0))
-}
-
-/// The rows of `a` whose pixel `keep` marks, in their order.
-pub fn select_rows(a: &RenderMatrix, keep: impl Fn(u32) -> bool) -> RenderMatrix {
-    let mut out = RenderMatrix {
-        width: a.width,
-        height: a.height,
-        layout: a.layout,
-        row_start: vec![0],
-        ..Default::default()
-    };
-    for r in 0..a.rows() {
-        if !keep(a.pixels[r]) {
-            continue;
-        }
-        let (c, v) = a.row(r);
-        out.cols.extend_from_slice(c);
-        out.vals.extend_from_slice(v);
-        out.row_start.push(out.cols.len() as u32);
-        out.pixels.push(a.pixels[r]);
-        out.coverage.push(a.coverage[r]);
-    }
-    out
-}
-
 pub struct Prepared {
     pub mesh_uvs: Vec<[f32; 2]>,
     pub transform: TextureTransform,
@@ -422,115 +283,6 @@ pub fn place(
         repeat: pl.repeat,
         texcoord_ms: t.elapsed().as_secs_f64() * 1e3,
     })
-}
-
-/// An object's texture coordinates as its mesh carries them in the file, and which of them
-/// are periodic.
-pub struct Atlas {
-    pub uvs: Vec<[f32; 2]>,
-    pub wrap: [bool; 2],
-}
-
-/// The mesh of object `o` as the views of `frames` see it (clip-space vertices).
-fn view_geometry(frames: &[&Frame], res: (u32, u32), o: usize, mesh: &Mesh) -> Vec<ViewGeometry> {
-    frames
-        .iter()
-        .map(|frame| {
-            let proj = pis_trace::camera::projection_matrix(&frame.camera, res);
-            let clip_from_object = proj
-                * frame.camera.world_from_camera.inverse()
-                * frame.instances[o].world_from_object;
-            ViewGeometry {
-                clip: mesh
-                    .positions
-                    .iter()
-                    .map(|p| clip_from_object * Vec3::from(*p).extend(1.0))
-                    .collect(),
-                width: res.0,
-                height: res.1,
-            }
-        })
-        .collect()
-}
-
-/// The object's texture coordinates over the views of `frames`: visible parts sharing (u, v)
-/// (a room's walls each mapped onto the whole wallpaper) laid out side by side, one texel per
-/// surface point ([`separate_overlapping_charts`]); else the mesh's own, periodic where the
-/// mesh has a seam.
-pub fn atlas(frames: &[&Frame], res: (u32, u32), o: usize, mesh: &Mesh) -> Atlas {
-    let views = view_geometry(frames, res, o, mesh);
-    let uvs: Vec<glam::Vec2> = mesh.uvs.iter().map(|u| glam::Vec2::from(*u)).collect();
-    match separate_overlapping_charts(&uvs, &mesh.indices, &views) {
-        Some(atlas) => {
-            Atlas { uvs: atlas.iter().map(|uv| uv.to_array()).collect(), wrap: [false, false] }
-        }
-        None => Atlas { uvs: mesh.uvs.clone(), wrap: seam_wraps(mesh) },
-    }
-}
-
-/// An object's texture placement for the views of one parameter block (thesis 3.2): branch
-/// cuts and affine map, used size with its MIP chain, wrapping, the reduction applied.
-#[derive(Clone, Debug)]
-pub struct Placed {
-    pub transform: TextureTransform,
-    pub layout: TextureLayout,
-    pub repeat: [bool; 2],
-    pub reduction: f64,
-}
-
-impl Placed {
-    /// Whether textures placed by `self` and `other` are drawn alike (the same texture
-    /// transform, size and wrapping).
-    pub fn same(&self, other: &Placed) -> bool {
-        self.transform == other.transform
-            && self.layout == other.layout
-            && self.repeat == other.repeat
-    }
-}
-
-/// Branch cuts, the most isometric map, the stretch limit, the bounding rectangle and the
-/// used resolution of object `o` with the texture coordinates of `atlas`, over the views of
-/// `frames` (one parameter block's).
-#[allow(clippy::too_many_arguments)]
-pub fn place_in(
-    scene: &Scene,
-    frames: &[&Frame],
-    res: (u32, u32),
-    o: usize,
-    mesh: &Mesh,
-    atlas: &Atlas,
-    max_texture: u32,
-    reduction: f64,
-    texels_per_pixel: Option<f64>,
-) -> Result<Placed> {
-    let views = view_geometry(frames, res, o, mesh);
-    let uvs: Vec<glam::Vec2> = atlas.uvs.iter().map(|u| glam::Vec2::from(*u)).collect();
-    let name = &scene.objects[o].name;
-    let om = ObjectMesh { name, uvs: &uvs, indices: &mesh.indices, wrap: atlas.wrap };
-    let settings = TexcoordSettings {
-        max_size: max_texture,
-        reduction,
-        texels_per_pixel,
-        ..TexcoordSettings::default()
-    };
-    let pl = optimize_placement(&om, &views, &settings)?;
-    Ok(Placed {
-        // A cut rounded up to 1 in f32 is the cut at 0.
-        transform: TextureTransform {
-            values: pl.affine,
-            cut: pl.branch_cut.map(|c| c.map(|c| if (c as f32) < 1.0 { c as f32 } else { 0.0 })),
-        },
-        layout: TextureLayout::full(pl.width, pl.height),
-        repeat: pl.repeat,
-        reduction: pl.reduction,
-    })
-}
-
-pub fn sampler(filter: Filter, repeat: [bool; 2]) -> Sampler {
-    Sampler {
-        filter,
-        address: repeat.map(|r| if r { Address::Repeat } else { Address::ClampToEdge }),
-    }
 }
 
 /// Runs the comparison.

@@ -18,10 +18,9 @@
 mod error;
 pub mod images;
 pub mod infer;
-pub mod lens;
-pub mod lens_infer;
 pub mod pipeline;
 pub mod solutions;
 
 pub use error::{exit_of, format_exit, scene_exit, trace_exit, Exit, Failure};
+pub use pipeline::hybrid::{lens, lens_infer};
 pub use pipeline::*;

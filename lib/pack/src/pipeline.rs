@@ -31,11 +31,15 @@ pub mod infer_layers;
 pub mod input;
 pub mod matrices;
 pub mod memory;
+pub mod mesh;
 pub mod model;
+pub mod packed;
 pub mod pem;
 pub mod predict;
+pub mod registry;
 pub mod report;
 pub mod represent;
+pub mod rows;
 pub mod scratch;
 pub mod set_images;
 pub mod settings;
@@ -47,6 +51,7 @@ pub mod stored_mesh;
 pub mod surface;
 pub mod sweep;
 pub mod textures;
+pub mod transforms;
 
 use std::path::PathBuf;
 use std::time::Instant;
@@ -55,9 +60,9 @@ pub use pis_trace::set::Shard;
 
 use pis_codec::CodecId;
 
-pub use encode::LayerTextures;
 pub use input::cache_dir;
 pub use matrices::{filter_needs_probe, MatrixSource};
+pub use packed::LayerTextures;
 pub use report::{print_report, FragmentsReport, MemoryReport, ObjectReport, PackReport};
 pub use settings::*;
 pub use sharded::{fragment_files, fragment_path, merge_fragments, solve_shard, SolveReport};

@@ -14,11 +14,13 @@
 
 use anyhow::anyhow;
 
-use super::encode::{encode_all, Packed};
+use super::encode::encode_all;
 use super::infer_layers::Inferred;
 use super::input::LoadedSet;
 use super::model::ObjectModel;
-use super::predict::{predicted_psnr, Quality};
+use super::packed::Packed;
+use super::packed::Quality;
+use super::predict::predicted_psnr;
 use super::{PackRequest, Stages};
 use crate::error::{Exit, Failure};
 
@@ -53,7 +55,7 @@ pub fn better(b: Outcome, a: Outcome, target_db: Option<f64>) -> bool {
 
 /// How the report names a model's representation.
 fn label(m: &ObjectModel) -> String {
-    if m.shell_views.is_empty() && m.lens.is_empty() {
+    if m.shells.is_none() {
         format!("surface textures ({})", m.representation)
     } else {
         m.representation.clone()

@@ -16,64 +16,15 @@ use pis_format::*;
 use super::blocks::{block_sizes, geometry, stagger, transforms};
 use super::input::LoadedSet;
 use super::model::{key, ObjectModel};
-use super::predict::{predicted_psnr, solved_error, Quality};
+pub use super::packed::LayerTextures;
+use super::packed::{MaxMseChoice, Packed, PackedBlock};
+use super::predict::{predicted_psnr, solved_error};
 use super::shading::object_shading;
-use super::storage::{allocate_storage, build_pyramid, level_streams, BlockPyramid, CodedLevel};
+use super::storage::{allocate_storage, build_pyramid, level_streams, BlockPyramid};
 use super::stored_mesh::stored_mesh;
 pub use super::surface::{finest, mip_chain};
 use super::{PackRequest, Stages};
 use crate::error::{Exit, Failure};
-
-/// Linear textures of one layer, keyed like [`super::model::InferredLayer::textures`].
-pub type LayerTextures = std::collections::BTreeMap<Vec<u32>, Vec<f32>>;
-
-/// One block of one layer as coded: which layer sample each block-local sample is, and the
-/// level images (gamma-compensated residuals) with their codestreams.
-#[derive(Clone)]
-pub struct PackedBlock {
-    pub extent: Vec<u32>,
-    /// Per block-local sample (row-major over the extent), the layer key.
-    pub keys: Vec<Vec<u32>>,
-    /// Per level: counts, images as encoded, codestreams.
-    pub levels: Vec<CodedLevel>,
-}
-
-/// The container and what the report and checks need to know about it.
-#[derive(Clone)]
-pub struct Packed {
-    pub container: Container,
-    /// Per object model, per layer, per block.
-    pub blocks: Vec<Vec<Vec<PackedBlock>>>,
-    /// Bytes of everything but the level images.
-    pub overhead: usize,
-    /// Per object model, per layer: codestream bytes.
-    pub layer_bytes: Vec<Vec<usize>>,
-    pub stagger: Vec<Vec<u32>>,
-    /// Per object model, per layer: each layer sample's screen weights, by key, kept for
-    /// the master (empty without screen-error allocation or `--keep-master`; the
-    /// allocation reads them from the pyramids).
-    pub screen_weights: Vec<Vec<BTreeMap<Vec<u32>, Vec<f32>>>>,
-    /// Per object model: the solved textures' squared display error against the traced
-    /// images and the number of values it sums ([`super::predict::display_error`]).
-    pub solved_error: Vec<(f64, usize)>,
-    /// With [`super::MaxMse::Best`], where the constraint changed the allocation: which
-    /// allocation was kept and why.
-    pub max_mse: Option<MaxMseChoice>,
-    /// The prediction made while choosing the allocation, which [`predicted_psnr`] returns
-    /// instead of rendering the same textures again.
-    pub quality: Option<Quality>,
-}
-
-/// The choice between the max-MSE constrained and the free allocation.
-#[derive(Clone, Debug, PartialEq)]
-pub struct MaxMseChoice {
-    pub alpha: f64,
-    /// The constrained allocation was kept.
-    pub constrained: bool,
-    /// Predicted PSNR (dB) of each.
-    pub psnr_db_constrained: f64,
-    pub psnr_db_free: f64,
-}
 
 /// The screen weight of every level-0 texel of a texture placed by `placement` at one
 /// point: the column sums of its render matrix `a` (how much of the covered pixels each
@@ -123,10 +74,8 @@ fn sample_screen_weights(
     let il = &m.layers[li];
     Ok(if points.is_empty() {
         vec![0.0; il.form.stored_texels(k)]
-    } else if let (Some(s), false) = (il.shell, m.lens.is_empty()) {
-        super::hybrid::shell_weights(m, s, il.form.stored_texels(k), points)
-    } else if let Some(s) = il.shell {
-        shell_weights(m, s, li, k, points)
+    } else if let (Some(s), Some(shells)) = (il.shell, &m.shells) {
+        shells.weights(s, il.form.stored_texels(k), points)
     } else {
         let pid = il.placement_of[k];
         sample_weights(
@@ -136,30 +85,6 @@ fn sample_screen_weights(
                 .collect::<Result<Vec<_>>>()?,
         )
     })
-}
-
-/// The screen weights of a shell sample: every level is stored, so each texel's column sums
-/// as they are, each row weighed by its squared Fresnel factor (the reflection term's error
-/// reaches the screen multiplied by F); scaled as [`sample_weights`] scales the unweighed
-/// sums, so that a shell's error counts F² times a surface texture's.
-fn shell_weights(m: &ObjectModel, s: usize, li: usize, k: &[u32], points: &[usize]) -> Vec<f32> {
-    let n = m.layers[li].form.stored_texels(k);
-    let (mut weighed, mut plain) = (vec![0.0f64; n], 0.0f64);
-    for &p in points {
-        let v = &m.shell_views[p];
-        let a = &v.a[s];
-        for r in 0..a.rows() {
-            let f = &v.fresnel[r * 3..r * 3 + 3];
-            let f2 = ((f[0] + f[1] + f[2]) as f64 / 3.0).powi(2);
-            let (cols, vals) = a.row(r);
-            for (&c, &w) in cols.iter().zip(vals) {
-                weighed[c as usize] += w as f64 * f2;
-                plain += w as f64;
-            }
-        }
-    }
-    let scale = if plain > 0.0 { n as f64 / plain } else { 0.0 };
-    weighed.iter().map(|w| (w * scale) as f32).collect()
 }
 
 /// Builds pyramids, allocates storage, encodes, and assembles the container.
@@ -335,7 +260,7 @@ pub fn encode_all(
         settings.extend(display.settings());
     }
     // The tint lens objects give the light they transmit (SPEC.md 6.6), where not white.
-    for m in models.iter().filter(|m| !m.lens.is_empty()) {
+    for m in models.iter().filter(|m| m.shells.as_ref().is_some_and(|s| s.transmits())) {
         let tint = super::hybrid::transmission_tint(set, m.index);
         if tint != [1.0; 3] {
             settings.push(pis_format::tint::tint_setting(&m.name, tint));

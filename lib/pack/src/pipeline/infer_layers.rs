@@ -8,7 +8,8 @@ use super::blocks::stagger;
 use super::input::LoadedSet;
 use super::matrices::Matrices;
 use super::model::ObjectModel;
-use super::represent::{alternative, choose, Job};
+use super::registry::{alternative, choose};
+use super::represent::Job;
 use super::{PackRequest, Stages};
 
 pub use super::model::{key, InferredLayer, PointView};

@@ -156,7 +156,7 @@ pub fn load(req: &PackRequest, stages: &mut Stages) -> Result<LoadedSet, Failure
                 .map(|i| scene.frame(&scene.space.point(i)))
                 .collect::<Result<Vec<_>, _>>()
                 .map_err(|e| Failure::new(Exit::Invalid, e))?;
-            super::blocks::check_transforms(&scene, &frames)
+            super::transforms::check_transforms(&scene, &frames)
                 .map_err(|e| Failure::new(Exit::NotSupported, e))?;
             let settings = TraceSettings::new(scene.resolution, scene.spp);
             let r = pis_trace::render_set(&scene, &dir, &settings, None, &pis_trace::NoProgress)
@@ -294,7 +294,7 @@ pub fn load(req: &PackRequest, stages: &mut Stages) -> Result<LoadedSet, Failure
         trace,
         records,
     };
-    super::blocks::check_transforms(&loaded.scene, &loaded.frames)
+    super::transforms::check_transforms(&loaded.scene, &loaded.frames)
         .map_err(|e| Failure::new(Exit::NotSupported, e))?;
     stages.done(
         "read",

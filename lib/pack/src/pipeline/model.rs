@@ -10,12 +10,11 @@ use std::sync::Arc;
 use anyhow::{anyhow, Result};
 
 use pis_compile::{RenderMatrix, TextureLayout};
-use pis_format::DepMask;
+use pis_format::{DepMask, ParameterSpace};
 
-use super::pem::views::ShellView;
+use super::mesh::{Mesh, Placed};
 use super::scratch::{Reader, Scratch, Span, Writer};
 use super::textures::Textures;
-use crate::infer::{Mesh, Placed};
 
 /// One point as the render matrices see an object (hardware model or probe mode): the rows
 /// of A per placement its layers read there (the rows, the covered pixels, are the same for
@@ -193,18 +192,18 @@ pub struct InferredLayer {
     /// How the layer's samples are stored and rebuilt: its representation's part of
     /// encoding.
     pub form: Box<dyn LayerForm>,
-    /// For a shell layer, its index among the object's shells ([`ShellView::a`]); `None`
+    /// For a shell layer, its index among the object's shells ([`ShellTerms`]); `None`
     /// for a surface layer.
     pub shell: Option<usize>,
 }
 
 impl InferredLayer {
-    /// Shell `shell` of an object as a layer over every dimension of `job`'s space: one
+    /// Shell `shell` of an object as a layer over every dimension (`all`) of `space`: one
     /// texture per parameter sample (`textures`, keyed by sample), every block of its grid
     /// (origins `stagger`) on the one shell and cube layout that `form` describes.
     pub fn shell(
         kind: pis_format::LayerKind,
-        job: &super::represent::Job<'_>,
+        (space, all): (&ParameterSpace, DepMask),
         stagger: &[u32],
         textures: BTreeMap<Vec<u32>, Vec<f32>>,
         iterations: u64,
@@ -212,10 +211,10 @@ impl InferredLayer {
         shell: usize,
     ) -> InferredLayer {
         let grid_blocks =
-            pis_format::blocks::BlockGrid::new(&job.space, job.all, stagger).block_count() as usize;
+            pis_format::blocks::BlockGrid::new(space, all, stagger).block_count() as usize;
         InferredLayer {
             kind,
-            depends_on: job.all,
+            depends_on: all,
             placement_of: textures.keys().map(|k| (k.clone(), 0)).collect(),
             textures: textures.into(),
             block_placements: vec![0; grid_blocks],
@@ -256,6 +255,23 @@ pub trait LayerForm: Send + Sync {
     }
 }
 
+/// An object's environment-map shells drawn at every point of the set, as its representation
+/// draws them (layered environment maps, [`super::pem`]; hybrid rendering, [`super::hybrid`]):
+/// what the prediction and the screen-error allocation ask of a representation's shells.
+pub trait ShellTerms: Send + Sync {
+    /// The shells' terms at point `p` over its covered pixels `rows` (increasing), RGB per
+    /// row, drawn from the shells' cube maps `maps` (each with its channel count).
+    fn render(&self, p: usize, rows: &[u32], maps: &[(&[f32], usize)]) -> Vec<f32>;
+    /// The screen weights of shell `s`'s sample (`texels` texels, every level stored) at
+    /// `points`, scaled as a surface texture's are ([`super::encode`]).
+    fn weights(&self, s: usize, texels: usize, points: &[usize]) -> Vec<f32>;
+    /// Whether the object transmits light through its shells (a lens object, whose tint the
+    /// file records).
+    fn transmits(&self) -> bool {
+        false
+    }
+}
+
 /// An object's inferred representation.
 pub struct ObjectModel {
     pub index: usize,
@@ -273,11 +289,8 @@ pub struct ObjectModel {
     /// Per point of the set.
     pub views: Views,
     pub layers: Vec<InferredLayer>,
-    /// Per point of the set, as the object's shells see it (empty without shells).
-    pub shell_views: Vec<ShellView>,
-    /// Per point of the set, a lens object as hybrid rendering draws it (empty for other
-    /// objects; [`super::hybrid`]).
-    pub lens: Vec<super::hybrid::LensPoint>,
+    /// The object's shells at every point of the set (`None` without shells).
+    pub shells: Option<Box<dyn ShellTerms>>,
     /// The first `hull_triangles` triangles of `mesh` lie on its convex hull and draw the
     /// most distant shell only (thesis 5.7; SPEC.md 6.5).
     pub hull_triangles: u32,
@@ -345,11 +358,8 @@ impl ObjectModel {
                 Some(_) => maps.push((*x, il.form.channels())),
             }
         }
-        if !maps.is_empty() && !self.lens.is_empty() {
-            let r = self.lens[p].render(v.pixels(), &maps);
-            img.iter_mut().zip(&r).for_each(|(a, b)| *a += b);
-        } else if !maps.is_empty() {
-            let r = super::pem::solve::reflection(&self.shell_views[p], &maps);
+        if let (false, Some(shells)) = (maps.is_empty(), &self.shells) {
+            let r = shells.render(p, v.pixels(), &maps);
             img.iter_mut().zip(&r).for_each(|(a, b)| *a += b);
         }
         img

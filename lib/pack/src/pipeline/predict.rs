@@ -16,9 +16,9 @@ use pis_codec::CodecId;
 use pis_format::reconstruct::finish;
 use pis_format::{Block, LevelLayout};
 
-use super::encode::{LayerTextures, Packed};
 use super::input::LoadedSet;
 use super::model::{key, InferredLayer, ObjectModel};
+use super::packed::{LayerTextures, Packed, Quality};
 use super::textures::Textures;
 
 /// Where [`display_error`] reads an object's texture chains, one sample at a time.
@@ -182,16 +182,6 @@ fn layer_codec(block: &Block) -> CodecId {
 /// PSNR in dB (peak 1) of a squared error sum over `n` values.
 pub fn psnr(sse: f64, n: usize) -> f64 {
     10.0 * (1.0 / (sse / n.max(1) as f64).max(1e-20)).log10()
-}
-
-/// Predicted quality: per object (decoded, as solved) and overall, plus the largest
-/// difference between decoded and solved finest texels.
-#[derive(Clone)]
-pub struct Quality {
-    pub objects: Vec<(f64, f64)>,
-    pub overall: f64,
-    pub overall_solved: f64,
-    pub max_texel_error: f32,
 }
 
 /// Renders the decoded and the solved textures through the render matrices (the hardware

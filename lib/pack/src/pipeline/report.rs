@@ -4,10 +4,10 @@ use std::collections::BTreeMap;
 
 use serde::Serialize;
 
-use super::encode::Packed;
 use super::input::LoadedSet;
 use super::model::ObjectModel;
-use super::predict::Quality;
+use super::packed::Packed;
+use super::packed::Quality;
 use super::{PackRequest, Stages};
 
 /// One object's part of the report.

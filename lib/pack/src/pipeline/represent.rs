@@ -1,7 +1,7 @@
 //! The seam between pis-pack and the ways it can store an object. A [`Representation`] is
-//! one of them: parameterized surface textures (thesis ch. 3, [`super::surface`]); layered
-//! environment-map shells (ch. 5) and lens objects (ch. 6) are each to be one more module
-//! behind this trait. The pack chooses a representation per object, then runs its three
+//! one of them: parameterized surface textures (thesis ch. 3, [`super::surface`]), layered
+//! environment-map shells (ch. 5, [`super::pem`]) and lens objects (ch. 6, [`super::hybrid`]),
+//! each a module behind this trait and one line of [`super::registry`]. The pack chooses a representation per object, then runs its three
 //! steps over every object in turn: [`Representation::survey`] (what the object covers and
 //! needs over the set's views), [`Surveyed::plan`] (its layers' parameter blocks, with the
 //! block origins the pack staggers across objects, and the render matrices the solve reads),
@@ -14,15 +14,11 @@ use pis_format::{DepMask, DimensionKind, ParameterSpace};
 use pis_scene::ObjectRole;
 
 use super::blocks::{block_sizes, geometry};
-use super::hybrid::HybridRendering;
 use super::input::LoadedSet;
 use super::matrices::Matrices;
+use super::mesh::{merged_mesh, Mesh};
 use super::model::ObjectModel;
-use super::pem::LayeredPem;
-use super::surface::SurfaceTextures;
-use super::RepresentationMode;
 use super::{PackRequest, Progress};
-use crate::infer::{merged_mesh, Mesh};
 
 /// A way to store an object and draw it.
 pub trait Representation: Sync {
@@ -46,39 +42,6 @@ pub trait Surveyed {
 pub trait Planned {
     /// Solves every layer sample.
     fn solve(self: Box<Self>, job: &Job<'_>) -> Result<ObjectModel>;
-}
-
-/// The representations pis-pack knows, in the order they are tried.
-pub const REPRESENTATIONS: &[&dyn Representation] =
-    &[&HybridRendering, &LayeredPem, &SurfaceTextures];
-
-/// The representations that store an object as environment-map shells.
-const SHELLS: &[&dyn Representation] = &[&HybridRendering, &LayeredPem];
-
-/// The representation of an object of `role` under `mode`: the first that applies
-/// (environment maps, for reflective and refractive objects, only when `mode` asks for
-/// them; the layered representation of reflective objects then makes one or two shells as
-/// `mode` says).
-pub fn choose(role: ObjectRole, mode: RepresentationMode) -> Option<&'static dyn Representation> {
-    let textures_only = matches!(mode, RepresentationMode::Texture | RepresentationMode::Auto);
-    REPRESENTATIONS
-        .iter()
-        .copied()
-        .filter(|r| !textures_only || !SHELLS.iter().any(|s| s.name() == r.name()))
-        .find(|r| r.applies(role))
-}
-
-/// The representation also solved for an object of `role` under `mode`, to be chosen
-/// between by [`super::choice`]: in `auto`, layered environment maps for a reflective object
-/// and hybrid rendering for a refractive one.
-pub fn alternative(
-    role: ObjectRole,
-    mode: RepresentationMode,
-) -> Option<&'static dyn Representation> {
-    if mode != RepresentationMode::Auto {
-        return None;
-    }
-    SHELLS.iter().copied().find(|r| r.applies(role))
 }
 
 /// What every representation works with: the set and the request, the render-matrix

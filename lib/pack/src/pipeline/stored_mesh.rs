@@ -6,9 +6,9 @@
 use glam::{Mat3, Mat4, Vec3};
 use pis_format::{Mesh, ObjectRole};
 
-use super::blocks::baked;
 use super::input::LoadedSet;
 use super::model::ObjectModel;
+use super::transforms::baked;
 
 /// The container mesh of `m`, an object of `role`: normals for reflective and refractive
 /// objects (their shells are looked up along the reflected and refracted rays), none for

@@ -25,13 +25,12 @@ use pis_trace::PointImages;
 
 use super::input::LoadedSet;
 use super::matrices::Matrices;
+use super::mesh::{atlas, merged_mesh, place_in, sampler, Atlas, Mesh, Placed};
 use super::model::{key, InferredLayer, LayerForm, ObjectModel, PointView, Views};
 use super::represent::{Job, Planned, Representation, Surveyed};
+use super::rows::{gather, restrict_rows};
 use super::textures::Textures;
 use super::{PackRequest, PlacementMode};
-use crate::infer::{
-    atlas, gather, merged_mesh, place_in, restrict_rows, sampler, Atlas, Mesh, Placed,
-};
 use crate::solutions::Solver;
 
 /// Largest linear radiance below which a layer counts as black.
@@ -657,8 +656,7 @@ impl Planned for Layers {
             area,
             views,
             layers,
-            shell_views: vec![],
-            lens: vec![],
+            shells: None,
             hull_triangles: 0,
             representation: representation.to_string(),
             why: why.to_string(),
@@ -716,28 +714,5 @@ mod tests {
             (l.mapping, l.mip_mode, l.channels),
             (pis_format::Mapping::Surface, pis_format::MipMode::Decimated, 3)
         );
-    }
-
-    #[test]
-    fn every_object_role_has_a_representation() {
-        for role in [ObjectRole::Diffuse, ObjectRole::Reflective, ObjectRole::Refractive] {
-            assert_eq!(
-                super::super::represent::choose(role, super::super::RepresentationMode::Texture)
-                    .map(|r| r.name()),
-                Some("surface textures"),
-                "{role:?}"
-            );
-            let pem = match role {
-                ObjectRole::Reflective => "layered environment maps",
-                ObjectRole::Refractive => "hybrid rendering",
-                ObjectRole::Diffuse => "surface textures",
-            };
-            assert_eq!(
-                super::super::represent::choose(role, super::super::RepresentationMode::Pem)
-                    .map(|r| r.name()),
-                Some(pem),
-                "{role:?}"
-            );
-        }
     }
 }

@@ -5,10 +5,11 @@ use std::time::Instant;
 
 use serde::Serialize;
 
-use super::encode::{encode_all, LayerTextures};
+use super::encode::encode_all;
 use super::infer_layers::infer_all;
 use super::input::{load, LoadedSet};
 use super::model::ObjectModel;
+use super::packed::LayerTextures;
 use super::predict::{decoded_textures, predicted_psnr, solved_chains};
 use super::{PackRequest, Stages};
 use crate::error::{Exit, Failure};

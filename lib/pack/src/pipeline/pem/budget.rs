@@ -10,7 +10,7 @@ use pis_format::checks::MAX_EXPANSION;
 
 use super::super::input::LoadedSet;
 use super::super::{PackRequest, DEFAULT_RATIO};
-use super::views::MIN_FACE;
+use super::views::{LARGEST_FACE, MIN_FACE};
 
 /// Bytes one level image of a cube map with `face`-texel faces decodes to: six faces, every
 /// MIP level down to 1 × 1, `channels` values of 4 bytes per texel.
@@ -51,7 +51,7 @@ pub fn face_cap(set: &LoadedSet, req: &PackRequest) -> Option<FaceCap> {
 /// The largest power-of-two face, at least [`MIN_FACE`], whose four-channel level image
 /// decodes to at most `bytes`.
 fn largest_face_within(bytes: u64) -> u32 {
-    let mut face = super::LARGEST_FACE;
+    let mut face = LARGEST_FACE;
     while face > MIN_FACE && cube_level_image_bytes(face, 4) > bytes {
         face /= 2;
     }
@@ -77,7 +77,7 @@ mod tests {
         let exact = cube_level_image_bytes(64, 4);
         assert_eq!(largest_face_within(exact), 64);
         assert_eq!(largest_face_within(exact - 1), 32);
-        assert_eq!(largest_face_within(u64::MAX), super::super::LARGEST_FACE);
+        assert_eq!(largest_face_within(u64::MAX), LARGEST_FACE);
         assert_eq!(largest_face_within(0), MIN_FACE);
         // 150 bytes (a 160 × 120 view at 384:1): half of 8192 × 150 fits 64² but not 128²
         assert_eq!(largest_face_within(MAX_EXPANSION * 150 / 2), 64);

@@ -10,10 +10,10 @@ use pis_compile::shell::{Shell, ShellShape};
 use pis_trace::bvh::SceneGeometry;
 
 use super::super::input::LoadedSet;
+use super::super::mesh::Mesh;
 use super::super::shell_fit::{
     bounding_ellipsoid, distant_box, distant_sphere, hit_points, origin, support_plane,
 };
-use crate::infer::Mesh;
 
 /// Cameras whose reflections size the distant shell: at most this many, evenly spread over
 /// the set's points.

@@ -14,6 +14,7 @@ pub mod budget;
 pub mod fit;
 pub mod form;
 pub mod solve;
+pub mod terms;
 pub mod traced;
 pub mod views;
 
@@ -29,7 +30,8 @@ use super::surface::survey_surface;
 use fit::{fit_shells, FittedShells};
 use form::ShellForm;
 use solve::{solve_shell, SolvedShell, Target};
-use views::{face_resolution, shell_views, ShellView};
+use terms::ReflectionTerms;
+use views::{face_resolution, shell_views, ShellView, LARGEST_FACE};
 
 /// The report's words for `--shell-lookups` above 1.
 fn lookups_text(lookups: u32) -> String {
@@ -39,9 +41,6 @@ fn lookups_text(lookups: u32) -> String {
         String::new()
     }
 }
-
-/// The largest cube face tried when choosing a shell's resolution (thesis 5.8.2).
-pub const LARGEST_FACE: u32 = 256;
 
 /// Layered environment maps: reflective objects whose set has the tracer's local and
 /// distant layers.
@@ -255,7 +254,7 @@ impl Planned for PemPlanned {
             });
             model.layers.push(InferredLayer::shell(
                 kind,
-                job,
+                (&job.space, job.all),
                 &model.stagger,
                 solved.textures,
                 solved.iterations,
@@ -263,7 +262,7 @@ impl Planned for PemPlanned {
                 s,
             ));
         }
-        model.shell_views = chosen.views;
+        model.shells = Some(Box::new(ReflectionTerms(chosen.views)));
         model.representation = "layered environment maps".to_string();
         model.why = format!("reflective: {}, Fresnel from F0 {:?}", chosen.why, f0);
         Ok(with_note(model))
@@ -303,14 +302,14 @@ fn single_shell(
     });
     model.layers.push(InferredLayer::shell(
         pis_format::LayerKind::EnvDistant,
-        job,
+        (&job.space, job.all),
         &model.stagger,
         solved.textures,
         solved.iterations,
         form,
         0,
     ));
-    model.shell_views = views;
+    model.shells = Some(Box::new(ReflectionTerms(views)));
     model.representation = "environment map at infinity".to_string();
     model.why = format!("--representation pem-infinity: one sphere-at-infinity map {n}² per sample (traced incident light residual {:.4}){}, Fresnel from F0 {f0:?}", solved.residual_rms, lookups_text(lookups));
     Ok(model)

@@ -176,30 +176,3 @@ fn split(v: &ShellView, target: Target) -> (Vec<f32>, Option<Vec<f32>>) {
         }
     }
 }
-
-/// The reflection term of a point per row, from its shells' cube maps (local first when
-/// there is one): F ⊙ (L + (1 − α_L)·D), premultiplied "over" (SPEC.md 9).
-pub fn reflection(v: &ShellView, maps: &[(&[f32], usize)]) -> Vec<f32> {
-    let rows = v.fresnel.len() / 3;
-    let mut acc = vec![0.0f32; rows * 3];
-    let mut through = vec![1.0f32; rows];
-    for (s, &(x, c)) in maps.iter().enumerate() {
-        let a = &v.a[s];
-        for r in 0..rows {
-            let (cols, vals) = a.row(r);
-            let mut px = [0.0f32; 4];
-            for (&col, &w) in cols.iter().zip(vals) {
-                for ch in 0..c {
-                    px[ch] += w * x[col as usize * c + ch];
-                }
-            }
-            let alpha = if c == 4 { px[3] } else { 1.0 };
-            for ch in 0..3 {
-                acc[r * 3 + ch] += through[r] * px[ch];
-            }
-            through[r] *= 1.0 - alpha;
-        }
-    }
-    acc.iter_mut().zip(&v.fresnel).for_each(|(a, f)| *a *= f);
-    acc
-}

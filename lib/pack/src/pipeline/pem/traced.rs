@@ -162,14 +162,14 @@ pub fn static_env(
     });
     model.layers.push(InferredLayer::shell(
         pis_format::LayerKind::EnvDistant,
-        job,
+        (&job.space, job.all),
         &model.stagger,
         textures,
         0,
         form,
         0,
     ));
-    model.shell_views = views;
+    model.shells = Some(Box::new(super::terms::ReflectionTerms(views)));
     model.representation = "static environment map".to_string();
     model.why = format!(
         "--representation static-env: traced from the object's centre ({:.3}, {:.3}, {:.3}), {n}² per sample, {} rays per texel, object omitted, Fresnel from F0 {f0:?}",

@@ -12,8 +12,9 @@ use pis_trace::layers::LayerKind as TraceLayer;
 use rayon::prelude::*;
 
 use super::super::input::LoadedSet;
+use super::super::mesh::Mesh;
+use super::super::rows::restrict_rows;
 use super::super::surface::coverage;
-use crate::infer::{restrict_rows, Mesh};
 
 /// One point as the shells see it: the rows are the covered pixels, in the order of the
 /// object's surface render matrices at the point.
@@ -254,6 +255,8 @@ pub fn face_resolution(
 pub const ACCESS_SHARE: f64 = 0.02;
 /// The smallest cube face chosen.
 pub const MIN_FACE: u32 = 8;
+/// The largest cube face tried when choosing a shell's resolution (thesis 5.8.2).
+pub const LARGEST_FACE: u32 = 256;
 
 /// The MIP level of column `c` of a cube layout.
 fn level_of(layout: &TextureLayout, c: usize) -> usize {

@@ -1,6 +1,6 @@
 //! Hybrid rendering of lens objects (thesis ch. 6) as a representation: a refractive
 //! object's layered environment map, inferred from the set's outgoing-ray records at every
-//! parameter sample ([`crate::lens_infer`]: the layers clustered from the records' hit
+//! parameter sample ([`lens_infer`]: the layers clustered from the records' hit
 //! distances, one shell fitted per layer, each shell's RGBA cube map solved against both
 //! greedy terms at once, eq. 6.1). The file stores each shell as an `env_shell` layer of the
 //! refraction term, every MIP level inferred and stored (SPEC.md 7.1, 8.3); the player
@@ -14,12 +14,15 @@ use pis_compile::hybrid::HybridPixels;
 use pis_compile::TextureLayout;
 use pis_scene::ObjectRole;
 
+pub mod lens;
+pub mod lens_infer;
+
 use super::input::LoadedSet;
-use super::model::{key, InferredLayer, ObjectModel};
+use super::model::{key, InferredLayer, ObjectModel, ShellTerms};
 use super::pem::form::ShellForm;
 use super::represent::{Job, Planned, Representation, Surveyed};
 use super::surface::survey_surface;
-use crate::lens_infer::{
+use lens_infer::{
     infer_lens_views, lens_terms, term_pixels, LensInferSettings, LensViewModel, TracedView,
 };
 
@@ -115,7 +118,7 @@ impl Planned for HybridPlanned {
             });
             model.layers.push(InferredLayer::shell(
                 pis_format::LayerKind::EnvShell,
-                job,
+                (&job.space, job.all),
                 &model.stagger,
                 textures,
                 0,
@@ -140,7 +143,8 @@ impl Planned for HybridPlanned {
         let both: Vec<f64> = inference.views.iter().map(|v| v.both.psnr_db).collect();
         let (lo, hi) =
             both.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |a, &x| (a.0.min(x), a.1.max(x)));
-        model.lens = inference.models.into_iter().map(LensPoint::new).collect();
+        model.shells =
+            Some(Box::new(LensPoints(inference.models.into_iter().map(LensPoint::new).collect())));
         model.representation =
             if one { "hybrid rendering, one shell" } else { "hybrid rendering" }.to_string();
         model.why = format!(
@@ -151,7 +155,7 @@ impl Planned for HybridPlanned {
             settings.tessellation.tau_px
         );
         if inference.face == settings.max_face {
-            if let Some(note) = cap.and_then(|c| c.note(crate::lens_infer::MAX_FACE)) {
+            if let Some(note) = cap.and_then(|c| c.note(lens_infer::MAX_FACE)) {
                 model.why.push_str(&note);
             }
         }
@@ -166,7 +170,7 @@ pub fn transmission_tint(set: &LoadedSet, o: usize) -> [f32; 3] {
     let base = set
         .frames
         .first()
-        .map_or(glam::Vec3::ONE, |f| crate::lens::lens_object(&set.scene, f, o).material.base);
+        .map_or(glam::Vec3::ONE, |f| lens::lens_object(&set.scene, f, o).material.base);
     base.clamp(glam::Vec3::ZERO, glam::Vec3::ONE).to_array()
 }
 
@@ -196,14 +200,31 @@ impl LensPoint {
     }
 }
 
+/// A lens object at every point of the set, its two terms drawn from the same shells.
+pub struct LensPoints(pub Vec<LensPoint>);
+
+impl ShellTerms for LensPoints {
+    fn render(&self, p: usize, rows: &[u32], maps: &[(&[f32], usize)]) -> Vec<f32> {
+        self.0[p].render(rows, maps)
+    }
+
+    fn weights(&self, s: usize, texels: usize, points: &[usize]) -> Vec<f32> {
+        shell_weights(&self.0, s, texels, points)
+    }
+
+    fn transmits(&self) -> bool {
+        true
+    }
+}
+
 /// The screen weights of shell `s`'s sample at `points` (`texels` texels, every level
 /// stored): each texel's column sums over both terms' rows, each row weighed by its squared
 /// F·G (the term reaches the screen multiplied by it); scaled as the reflection shells'
 /// weights are.
-pub fn shell_weights(m: &ObjectModel, s: usize, texels: usize, points: &[usize]) -> Vec<f32> {
+fn shell_weights(lens: &[LensPoint], s: usize, texels: usize, points: &[usize]) -> Vec<f32> {
     let (mut weighed, mut plain) = (vec![0.0f64; texels], 0.0f64);
     for &p in points {
-        let lp = &m.lens[p];
+        let lp = &lens[p];
         for (t, fg) in lp.fg.iter().enumerate() {
             let a = &lp.model.a[t][s];
             let mut k = 0;

@@ -31,8 +31,10 @@ use pis_trace::camera::{projection_matrix, PerspectiveCamera};
 use pis_trace::layers::LayerKind;
 use pis_trace::{PointImages, PointRender, RayRecord};
 
-use crate::infer::{psnr_display, select_rows};
-use crate::lens::lens_object;
+use pis_codec::display::psnr_display;
+
+use super::super::rows::select_rows;
+use super::lens::lens_object;
 
 /// The largest cube face the views' lookups choose (thesis 5.8.2).
 pub const MAX_FACE: u32 = 256;
