@@ -4,7 +4,9 @@
 //! shader and the hardware model's LOD and sampler in the fragment shader, and one additive
 //! draw of the reflection term per reflective object and parameter sample
 //! (`reflection.wgsl`: the environment-map shells looked up as the hardware model
-//! does, composited "over", times Fresnel). Layers and terms add in linear space (SPEC.md 9:
+//! does, composited "over", times Fresnel), and of both terms of each lens object per
+//! parameter sample (`hybrid.wgsl`: the cube-map vectors of the rays traced through it at its
+//! vertices). Layers and terms add in linear space (SPEC.md 9:
 //! surface layers combine by addition, radiance = surface + F · reflection). With more than
 //! one sample per pixel (`multisample.rs`) depth and object indices are kept per sample and
 //! the colour is resolved into the target: by the hardware's average of each pixel's own
