@@ -114,7 +114,6 @@ pub fn compare_with_set(
         .map(|o| (SquaredError::default(), vec![SquaredError::default(); block_count(o)]))
         .collect();
     let mut points = Vec::with_capacity(set.meta.points.len());
-    let npx = res.0 as usize * res.1 as usize;
     for (i, p) in set.meta.points.iter().enumerate() {
         if p.values.len() != dims || p.samples.len() != dims {
             bail!(
@@ -143,13 +142,13 @@ pub fn compare_with_set(
         let gold = gold_image(&images, res, i, set_dir)?;
         silhouette_pixels(&images, &channels, &mut partial);
         let mut whole = SquaredError::default();
-        for k in 0..npx {
+        for (k, &edge) in partial.iter().enumerate() {
             let mut px = SquaredError::default();
             for c in 0..3 {
                 px.add(rendered.rgba[k * 4 + c], gold.rgba[k * 4 + c]);
             }
             whole.merge(&px);
-            if partial[k] {
+            if edge {
                 silhouette.merge(&px)
             } else {
                 interior.merge(&px)

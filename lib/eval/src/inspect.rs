@@ -505,6 +505,9 @@ pub fn parse_point(space: &ParameterSpace, at: Option<&str>) -> anyhow::Result<V
 /// Cube faces in the order stored (SPEC.md, "Shell faces").
 pub const FACE_NAMES: [&str; 6] = ["px", "nx", "py", "ny", "pz", "nz"];
 
+/// Writes one plane of `width` × `height` × `channels` values to a file.
+type PlaneWriter = fn(&Path, u32, u32, u32, &[f32]) -> anyhow::Result<()>;
+
 /// Writes the textures (and environment-map faces) of every layer at `point` into `dir` as
 /// linear EXR and sRGB PNG; returns the file names. Every texture is decoded before a file
 /// is written, and the files written before an error are removed (the folder too, when this
@@ -533,8 +536,7 @@ pub fn extract(r: &PisReader, point: &[u32], dir: &Path) -> Result<Vec<String>, 
         .with_context(|| format!("cannot create {}", dir.display()))
         .map_err(|e| Failure::new(Exit::Io, e))?;
     let mut written = Vec::new();
-    let writers: [(&str, fn(&Path, u32, u32, u32, &[f32]) -> anyhow::Result<()>); 2] =
-        [("exr", write_exr), ("png", write_png)];
+    let writers: [(&str, PlaneWriter); 2] = [("exr", write_exr), ("png", write_png)];
     for (stem, width, height, channels, plane) in &images {
         for (ext, f) in writers {
             let name = format!("{stem}.{ext}");

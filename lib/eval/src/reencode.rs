@@ -579,9 +579,7 @@ pub fn reencode(req: &ReencodeRequest) -> Result<ReencodeReport, Failure> {
         c,
         req,
         &space,
-        &target_text,
-        max_mse,
-        gamma,
+        container::Applied { gamma, target: &target_text, max_mse },
         &codecs_before,
         raw,
     ));

@@ -370,14 +370,14 @@ mod tests {
     fn the_model_of_an_object_is_read_from_its_layers() {
         let names = |ks: &[LayerKind]| ks.iter().map(|k| k.name().to_string()).collect::<Vec<_>>();
         assert_eq!(
-            LayeredModel::of(&names(&LayerKind::for_role(ObjectRole::Reflective))),
+            LayeredModel::of(&names(LayerKind::for_role(ObjectRole::Reflective))),
             Some(LayeredModel::Environment)
         );
         assert_eq!(
-            LayeredModel::of(&names(&LayerKind::for_role(ObjectRole::Refractive))),
+            LayeredModel::of(&names(LayerKind::for_role(ObjectRole::Refractive))),
             Some(LayeredModel::TwoPath)
         );
-        assert_eq!(LayeredModel::of(&names(&LayerKind::for_role(ObjectRole::Diffuse))), None);
+        assert_eq!(LayeredModel::of(&names(LayerKind::for_role(ObjectRole::Diffuse))), None);
     }
 
     #[test]

@@ -76,18 +76,25 @@ pub fn codecs(c: &Container<StreamRef>) -> Vec<String> {
     v
 }
 
+/// What a re-encoding applied, as its provenance records it.
+pub struct Applied<'a> {
+    pub gamma: f32,
+    /// The allocation's target (`ratio 96`, `psnr 40 dB`, `exact`, ...).
+    pub target: &'a str,
+    pub max_mse: MaxMse,
+}
+
 /// The output's provenance: the input's settings but those the re-encoding changes, and
 /// the re-encoding's own.
 pub fn provenance<S>(
     c: &Container<S>,
     req: &ReencodeRequest,
     space: &ParameterSpace,
-    target_text: &str,
-    max_mse: MaxMse,
-    gamma: f32,
+    applied: Applied,
     codecs_before: &[String],
     raw: u64,
 ) -> Provenance {
+    let Applied { gamma, target: target_text, max_mse } = applied;
     let exact = !req.codec.is_lossy();
     let before = c.provenance.clone().unwrap_or_default();
     let mut settings: Vec<(String, String)> = before
