@@ -472,11 +472,10 @@ fn hybrid_reports_the_vertex_rays_and_their_accuracy_per_tau() {
     // from the traced ones.
     assert!(f(&rows[0], "vertex_rays") > f(&rows[1], "vertex_rays"), "{rows:?}");
     assert!(f(&rows[0], "triangles") > f(&rows[1], "triangles"));
-    for t in 0..2 {
-        let (a, b) = (
-            rows[0]["p90_angle_deg"][t].as_f64().unwrap(),
-            rows[1]["p90_angle_deg"][t].as_f64().unwrap(),
-        );
+    let angles = |r: &serde_json::Value| -> [f64; 2] {
+        [0, 1].map(|t| r["p90_angle_deg"][t].as_f64().unwrap())
+    };
+    for (t, (a, b)) in angles(&rows[0]).into_iter().zip(angles(&rows[1])).enumerate() {
         assert!(a.is_finite() && a < b, "term {t}: τ 2 {a}°, τ 8 {b}°");
     }
     assert!(f(&v["per_pixel"][0], "pixels") > 1000.0);

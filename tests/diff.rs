@@ -581,7 +581,9 @@ fn one_fault_gives_one_exit_code_in_every_tool() {
 /// set of checks, exit 3 from both tools.
 #[test]
 fn damaged_sets_are_refused_alike_by_pis_pack_and_pis_diff() {
-    let cases: [(&str, fn(&Path)); 3] = [
+    /// Damages the set in a folder.
+    type Damage = fn(&Path);
+    let cases: [(&str, Damage); 3] = [
         ("is NaN", |d| edit_point(d, |img| img.layers[0].planes[1][7] = f32::NAN)),
         ("outside [0, 1]", |d| {
             edit_point(d, |img| {

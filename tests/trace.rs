@@ -242,13 +242,13 @@ fn a_sample_stream_is_recorded_and_changes_the_noise() {
         assert_eq!(report["seed"], if name == "one" { 1 } else { 0 });
     }
     let combined = |n: &str| {
-        RaySet::open(&dir(n)).unwrap().read_point(0).unwrap().layer("combined").unwrap().planes[0]
+        RaySet::open(dir(n)).unwrap().read_point(0).unwrap().layer("combined").unwrap().planes[0]
             .clone()
     };
     assert_eq!(combined("default"), combined("zero"));
     assert_ne!(combined("default"), combined("one"));
     let settings =
-        |n: &str| RaySet::open(&dir(n)).unwrap().meta.renderer.and_then(|r| r.settings).unwrap();
+        |n: &str| RaySet::open(dir(n)).unwrap().meta.renderer.and_then(|r| r.settings).unwrap();
     assert_eq!(settings("one").seed, 1);
     assert_eq!(settings("zero").seed, 0);
     // The default stream leaves set.json as it was before streams were recorded.
