@@ -225,7 +225,6 @@ fn parse_memory(s: &str) -> Result<f64, String> {
         .ok_or_else(|| format!("bad memory budget {s:?}: expected a number of GB above 0"))
 }
 
-
 fn parse_pyramid(s: &str) -> Result<PyramidMode, String> {
     match s {
         "adaptive" => Ok(PyramidMode::Adaptive),
@@ -241,9 +240,6 @@ fn parse_layers(s: &str) -> Result<LayerMode, String> {
         _ => Err(format!("unknown layers {s:?} (separate or combined)")),
     }
 }
-
-
-
 
 /// `--max-mse-ratio`: `auto`, `off`, or α above 1.
 pub fn parse_max_mse_ratio(s: &str) -> Result<MaxMse, String> {
@@ -266,8 +262,6 @@ fn parse_allocation(s: &str) -> Result<Allocation, String> {
         _ => Err(format!("unknown allocation {s:?} (screen or texture)")),
     }
 }
-
-
 
 /// The values of `--filter`, by [`Filter::name`] (the anisotropy clamp comes from
 /// `--anisotropy`).

@@ -63,7 +63,6 @@ struct Cli {
     json: bool,
 }
 
-
 /// `--block`: one size, or one per dimension.
 #[derive(Clone, Debug)]
 struct BlockSizes(Vec<u32>);
