@@ -164,8 +164,8 @@ impl PackOptions {
             return Err(Failure::new(Exit::Usage, anyhow::anyhow!(why)));
         }
         let settings = PackSettings {
-            ratio: self.ratio,
-            psnr: self.psnr,
+            target: pis_pack::Target::from_flags(self.ratio, self.psnr)
+                .map_err(|e| Failure::new(Exit::Usage, anyhow::anyhow!(e)))?,
             codec: self.codec,
             block: BlockSize::from_sizes(self.block.0.clone()),
             filter,

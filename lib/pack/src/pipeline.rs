@@ -1,17 +1,19 @@
 //! `pis-pack`: a ray-traced set to a `.pis` container (thesis ch. 4).
 //!
-//! The stages, one module each: [`input`] reads (or traces) the set; [`infer_layers`]
-//! chooses each object's representation and runs it ([`represent`] is the seam: layered
-//! environment maps for reflective objects, [`pem`], and hybrid rendering for refractive
-//! ones, [`hybrid`], where asked; otherwise parameterized surface textures, [`surface`]: texture
-//! coordinates per block (3.2), a view-independent diffuse layer solved over all views by
-//! stacking and a view-dependent specular layer per parameter sample, warm-started, black
-//! layers left out (3.5)), giving an [`model::ObjectModel`] per object; [`encode`] cuts each
-//! layer into parameter-space blocks whose origins are staggered per object ([`blocks`],
-//! 4.7), builds an adaptive Laplacian pyramid (4.3) of gamma-compensated samples (4.6) per
-//! block and allocates storage by equal slopes across levels, objects and layers
-//! ([`storage`], 4.5), whatever representation made them, and writes each object with its
-//! scene role, its material's shading constants ([`shading`]) and its mesh ([`stored_mesh`]);
+//! The stages, one module each: [`input`] reads (or traces) the set and [`plan`] resolves
+//! the settings against it once (blocks, space, staggering, the allocation's aim);
+//! [`infer_layers`] chooses each object's representation ([`registry`]) and runs it
+//! ([`represent`] is the seam: layered environment maps for reflective objects, [`pem`], and
+//! hybrid rendering for refractive ones, [`hybrid`], where asked; otherwise parameterized
+//! surface textures, [`surface`]: texture coordinates per block (3.2), a view-independent
+//! diffuse layer solved over all views by stacking and a view-dependent specular layer per
+//! parameter sample, warm-started, black layers left out (3.5)), giving an
+//! [`model::ObjectModel`] per object; [`encode`] cuts each layer into parameter-space blocks
+//! whose origins are staggered per object ([`blocks`], 4.7), builds an adaptive Laplacian
+//! pyramid (4.3) of gamma-compensated samples (4.6) per block and allocates storage by equal
+//! slopes across levels, objects and layers ([`storage`], 4.5), whatever representation made
+//! them, and writes each object with its scene role, its material's shading constants
+//! ([`shading`]) and its mesh ([`stored_mesh`]);
 //! [`report`] says what came out.
 //! The container is written atomically. MIP levels are not stored: the player decimates
 //! (3.6). [`sharded`] splits the solves over processes and merges them into the same file.
@@ -20,8 +22,8 @@
 //! through the player's pipeline on the GPU (probe mode, thesis 3.4.3; [`matrices`]), which
 //! anisotropic filtering needs. The predicted PSNR renders the decoded textures through the
 //! same A (with the MIP chain rebuilt by decimation as the player does) and compares with
-//! the gold-standard layers over the pixels the tracer covers, on display values (see
-//! [`crate::infer`]).
+//! the gold-standard layers over the pixels the tracer covers, on display values
+//! ([`pis_codec::display`]).
 
 pub mod blocks;
 pub mod choice;
@@ -35,6 +37,7 @@ pub mod mesh;
 pub mod model;
 pub mod packed;
 pub mod pem;
+pub mod plan;
 pub mod predict;
 pub mod registry;
 pub mod report;
@@ -198,15 +201,13 @@ pub fn pack(
     pack_request(&PackRequest::new(input, output, settings.clone()), progress)
 }
 
-/// The checks before any work, the set read (or traced) and the render-matrix source opened.
+/// The checks before any work, the set read (or traced), the settings resolved against it
+/// ([`plan::Plan`]) and the render-matrix source opened.
 fn begin(
     req: &PackRequest,
     stages: &mut Stages,
-) -> Result<(input::LoadedSet, matrices::Matrices), Failure> {
-    if req.ratio.is_some() && req.psnr.is_some() {
-        return Err(Failure::new(Exit::Usage, anyhow::anyhow!("give --ratio or --psnr, not both")));
-    }
-    if let Some(r) = req.ratio {
+) -> Result<(input::LoadedSet, plan::Plan, matrices::Matrices), Failure> {
+    if let Some(r) = req.target.ratio() {
         if !(r.is_finite() && r >= 1.0) {
             return Err(Failure::new(
                 Exit::Usage,
@@ -228,16 +229,18 @@ fn begin(
         ));
     }
     let set = input::load(req, stages)?;
-    // A ratio is checked before any work: it must leave the level images a byte.
+    // A ratio is checked before any work: it must leave a lossy codec's level images a byte.
     let raw = set.raw_image_bytes();
-    if let Some(r) = req.ratio.filter(|r| raw as f64 / r < 1.0) {
+    let binding = req.target.ratio().filter(|_| req.codec.is_lossy());
+    if let Some(r) = binding.filter(|r| raw as f64 / r < 1.0) {
         return Err(Failure::new(Exit::Usage, anyhow::anyhow!("--ratio {r} leaves no byte for the level images of this set (raw images {raw} bytes): the highest ratio is {raw}:1")));
     }
+    let plan = plan::Plan::new(&set, req).map_err(|e| Failure::new(Exit::Usage, e))?;
     let matrices = matrices::Matrices::open(req.matrix, req.filter)?;
     if let Some(device) = matrices.device() {
         stages.note(&format!("probe mode on {device}"));
     }
-    Ok((set, matrices))
+    Ok((set, plan, matrices))
 }
 
 /// [`pack`] of a [`PackRequest`] (which may name the set's scene.toml).
@@ -254,16 +257,16 @@ pub fn pack_request(req: &PackRequest, progress: &dyn Progress) -> Result<PackRe
         ));
     }
     let mut stages = Stages::new(progress);
-    let (set, mut matrices) = begin(req, &mut stages)?;
-    let inferred = infer_layers::infer_all(&set, req, &mut matrices, &mut stages)
+    let (set, plan, mut matrices) = begin(req, &mut stages)?;
+    let inferred = infer_layers::infer_all(&set, req, &plan, &mut matrices, &mut stages)
         .map_err(|e| Failure::new(Exit::Runtime, e))?;
     let probe_renderings = matrices.renderings();
     drop(matrices);
-    let (inferred, chosen) = choice::choose(&set, inferred, req, &mut stages)?;
+    let (inferred, chosen) = choice::choose(&set, inferred, &plan, req, &mut stages)?;
     let (mut packed, quality) = match chosen {
         Some(done) => done,
         None => {
-            let packed = encode::encode_all(&set, &inferred, req, &mut stages)?;
+            let packed = encode::encode_all(&set, &inferred, &plan, req, &mut stages)?;
             let quality = predict::predicted_psnr(&set, &inferred, &packed)
                 .map_err(|e| Failure::new(Exit::Runtime, e))?;
             stages.done(

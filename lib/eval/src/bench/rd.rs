@@ -210,7 +210,7 @@ pub fn run(req: &RdRequest) -> Result<RdReport, Failure> {
         }
         for &r in &req.ratios {
             let preq = base.with(|s| {
-                s.ratio = Some(r);
+                s.target = pis_pack::Target::Ratio(r);
                 s.codec = codec;
                 s.pyramid = pyramid;
             });

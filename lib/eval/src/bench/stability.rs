@@ -347,7 +347,7 @@ pub fn run(req: &StabilityRequest) -> Result<StabilityReport, Failure> {
     let mut reps: Vec<(String, Option<f64>, Vec<Vec<LayerTextures>>)> =
         vec![("solved".into(), None, inf.solved().map_err(runtime)?)];
     for &r in &req.ratios {
-        let (t, bytes) = inf.decoded(&base.with(|s| s.ratio = Some(r)))?;
+        let (t, bytes) = inf.decoded(&base.with(|s| s.target = pis_pack::Target::Ratio(r)))?;
         reps.push((format!("wavelet {r}:1"), Some(raw as f64 / bytes.max(1) as f64), t));
     }
     let mut rows = Vec::new();

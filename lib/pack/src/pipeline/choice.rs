@@ -20,6 +20,7 @@ use super::input::LoadedSet;
 use super::model::ObjectModel;
 use super::packed::Packed;
 use super::packed::Quality;
+use super::plan::Plan;
 use super::predict::predicted_psnr;
 use super::{PackRequest, Stages};
 use crate::error::{Exit, Failure};
@@ -65,10 +66,11 @@ fn label(m: &ObjectModel) -> String {
 fn encoded(
     set: &LoadedSet,
     models: &[ObjectModel],
+    plan: &Plan,
     req: &PackRequest,
 ) -> Result<(Packed, Quality, Outcome), Failure> {
     let mut stages = Stages::quiet();
-    let packed = encode_all(set, models, req, &mut stages)?;
+    let packed = encode_all(set, models, plan, req, &mut stages)?;
     let quality =
         predicted_psnr(set, models, &packed).map_err(|e| Failure::new(Exit::Runtime, e))?;
     let bytes = packed.layer_bytes.iter().flatten().sum();
@@ -81,6 +83,7 @@ fn encoded(
 pub fn choose(
     set: &LoadedSet,
     inferred: Inferred,
+    plan: &Plan,
     req: &PackRequest,
     stages: &mut Stages,
 ) -> Result<(Vec<ObjectModel>, Option<(Packed, Quality)>), Failure> {
@@ -88,8 +91,8 @@ pub fn choose(
     if alternatives.is_empty() {
         return Ok((models, None));
     }
-    let (mut packed, mut quality, mut current) = encoded(set, &models, req)?;
-    let target = req.psnr;
+    let (mut packed, mut quality, mut current) = encoded(set, &models, plan, req)?;
+    let target = req.target.psnr();
     let budget = match target {
         Some(t) => format!("for {t} dB"),
         None if req.codec == pis_codec::CodecId::Lossless => "lossless".to_string(),
@@ -105,7 +108,7 @@ pub fn choose(
         }
         std::mem::swap(&mut models[mi], &mut alt);
         let (first, second) = (label(&alt), label(&models[mi]));
-        let trial = encoded(set, &models, req);
+        let trial = encoded(set, &models, plan, req);
         let said = |o: Outcome| format!("{:.2} dB with {} bytes", o.psnr_db, o.bytes);
         let why = match trial {
             Ok((p, q, o)) if better(o, current, target) => {

@@ -7,17 +7,17 @@ use std::collections::BTreeMap;
 use std::path::Path;
 
 use anyhow::{anyhow, Result};
-use pis_codec::allocate::Target;
 use pis_codec::CodecId;
 use pis_format::blocks::BlockGrid;
 use pis_format::reconstruct::prepare;
 use pis_format::*;
 
-use super::blocks::{block_sizes, geometry, stagger, transforms};
+use super::blocks::transforms;
 use super::input::LoadedSet;
 use super::model::{key, ObjectModel};
 pub use super::packed::LayerTextures;
 use super::packed::{MaxMseChoice, Packed, PackedBlock};
+use super::plan::Plan;
 use super::predict::{predicted_psnr, solved_error};
 use super::shading::object_shading;
 use super::storage::{allocate_storage, build_pyramid, level_streams, BlockPyramid};
@@ -91,14 +91,12 @@ fn sample_screen_weights(
 pub fn encode_all(
     set: &LoadedSet,
     models: &[ObjectModel],
+    plan: &Plan,
     req: &PackRequest,
     stages: &mut Stages,
 ) -> Result<Packed, Failure> {
     let runtime = |e: anyhow::Error| Failure::new(Exit::Runtime, e);
-    let sizes = block_sizes(req.block.as_slice(), set.scene.space.dims.len())
-        .map_err(|e| Failure::new(Exit::Usage, e))?;
-    let samples = super::blocks::samples_per_dimension(set);
-    let (space, cameras) = geometry(set, &sizes);
+    let (space, sizes) = (&plan.space, &plan.sizes);
     if pis_codec::codec(req.codec).is_none() {
         return Err(runtime(anyhow!("codec {} is not in this build", req.codec)));
     }
@@ -110,13 +108,7 @@ pub fn encode_all(
     let mut where_ = Vec::new();
     let mut screen_weights = Vec::new();
     for (mi, m) in models.iter().enumerate() {
-        let st = stagger(mi, models.len(), &sizes, &samples, req.stagger);
-        if st != m.stagger || sizes != m.block_sizes {
-            return Err(runtime(anyhow!(
-                "object {}: its textures were placed for blocks of {:?} samples staggered by {:?}, the encoding asks for blocks of {sizes:?} staggered by {st:?}",
-                m.name, m.block_sizes, m.stagger,
-            )));
-        }
+        let st = &m.stagger;
         // The weights go to the pyramids; the master (`--keep-master`) keeps a copy.
         let screen = req.allocation == super::Allocation::Screen;
         let mut master_by_layer: Vec<BTreeMap<Vec<u32>, Vec<f32>>> =
@@ -220,7 +212,7 @@ pub fn encode_all(
         });
         blocks_out.push(layer_blocks);
         screen_weights.push(master_by_layer);
-        staggers.push(st);
+        staggers.push(st.clone());
     }
     let level_images: usize = pyramids.iter().flat_map(|p| &p.levels).map(|l| l.1.len()).sum();
     stages.done("pyramid", &format!("{level_images} level images in adaptive pyramids"));
@@ -231,13 +223,7 @@ pub fn encode_all(
         ("block".to_string(), sizes.iter().map(u32::to_string).collect::<Vec<_>>().join("x")),
         ("matrix".to_string(), req.matrix.name().to_string()),
         ("gamma".to_string(), req.gamma.to_string()),
-        (
-            "target".to_string(),
-            match (req.ratio, req.psnr) {
-                (_, Some(p)) => format!("psnr {p} dB"),
-                (r, None) => format!("ratio {}", r.unwrap_or(super::DEFAULT_RATIO)),
-            },
-        ),
+        ("target".to_string(), req.target.describe()),
     ];
     let mut settings = settings;
     settings.splice(2..2, file_filter(req.filter).settings());
@@ -267,8 +253,8 @@ pub fn encode_all(
         }
     }
     let mut container = Container {
-        space,
-        cameras,
+        space: space.clone(),
+        cameras: plan.cameras.clone(),
         objects,
         provenance: Some(Provenance {
             tool: format!("pis-pack {}", env!("CARGO_PKG_VERSION")),
@@ -301,12 +287,9 @@ pub fn encode_all(
     }
     let overhead = pis_format::to_bytes_unchecked(&container).len();
 
-    let target = match (req.ratio, req.psnr) {
-        (_, Some(db)) => Target::Psnr { db, peak: 1.0 },
-        // The ratio counts level images against the raw images (thesis 4.8); geometry and
-        // tables come on top and are reported apart.
-        (r, None) => Target::Bytes((raw as f64 / r.unwrap_or(super::DEFAULT_RATIO)) as usize),
-    };
+    // The ratio counts level images against the raw images (thesis 4.8); geometry and
+    // tables come on top and are reported apart.
+    let target = plan.target;
     let areas: Vec<f64> = models.iter().map(|m| m.area).collect();
     let storage = allocate_storage(&pyramids, req.codec, target, &areas, req.max_mse)
         .map_err(|e| target_failure(e, raw))?;

@@ -4,10 +4,10 @@
 
 use anyhow::{anyhow, Result};
 
-use super::blocks::stagger;
 use super::input::LoadedSet;
 use super::matrices::Matrices;
 use super::model::ObjectModel;
+use super::plan::Plan;
 use super::registry::{alternative, choose};
 use super::represent::Job;
 use super::{PackRequest, Stages};
@@ -28,11 +28,12 @@ pub struct Inferred {
 pub fn infer_all(
     set: &LoadedSet,
     req: &PackRequest,
+    plan: &Plan,
     matrices: &mut Matrices,
     stages: &mut Stages,
 ) -> Result<Inferred> {
     let scene = &set.scene;
-    let mut job = Job::new(set, req, matrices, stages.progress())?;
+    let mut job = Job::new(set, req, plan, matrices, stages.progress());
     let mut surveyed = Vec::new();
     for (o, object) in scene.objects.iter().enumerate() {
         let rep = choose(object.role, req.representation).ok_or_else(|| {
@@ -52,10 +53,9 @@ pub fn infer_all(
         return Err(anyhow!("no object covers a pixel of the set"));
     }
     let n = surveyed.len();
-    let samples = super::blocks::samples_per_dimension(set);
     let mut planned = Vec::with_capacity(n);
     for (mi, (s, other)) in surveyed.into_iter().enumerate() {
-        let st = stagger(mi, n, &job.sizes, &samples, req.stagger);
+        let st = plan.stagger(mi, n);
         let other = match other {
             Some(a) => Some(a.plan(&mut job, st.clone())?),
             None => None,

@@ -281,9 +281,8 @@ pub struct ObjectModel {
     pub mesh_uvs: Vec<[f32; 2]>,
     /// The distinct placements of the object's blocks.
     pub placements: Vec<Placed>,
-    /// Block origin offsets (thesis 4.7) and the samples per block the placements are for.
+    /// Block origin offsets (thesis 4.7), of the blocks of [`super::plan::Plan::sizes`].
     pub stagger: Vec<u32>,
-    pub block_sizes: Vec<u32>,
     /// Mean covered pixels per point: the screen-area weight of allocation.
     pub area: f64,
     /// Per point of the set.

@@ -10,14 +10,14 @@
 
 use anyhow::Result;
 use pis_compile::SolveSettings;
-use pis_format::{DepMask, DimensionKind, ParameterSpace};
+use pis_format::{DepMask, DimensionKind};
 use pis_scene::ObjectRole;
 
-use super::blocks::{block_sizes, geometry};
 use super::input::LoadedSet;
 use super::matrices::Matrices;
 use super::mesh::{merged_mesh, Mesh};
 use super::model::ObjectModel;
+use super::plan::Plan;
 use super::{PackRequest, Progress};
 
 /// A way to store an object and draw it.
@@ -50,13 +50,11 @@ pub trait Planned {
 pub struct Job<'a> {
     pub set: &'a LoadedSet,
     pub req: &'a PackRequest,
+    /// The blocks, the container's parameter space and the staggering, resolved once.
+    pub plan: &'a Plan,
     pub matrices: &'a mut Matrices,
     pub progress: &'a dyn Progress,
     pub meshes: Vec<Mesh>,
-    /// Samples per block along each dimension.
-    pub sizes: Vec<u32>,
-    /// The container's parameter space for blocks of `sizes`.
-    pub space: ParameterSpace,
     /// Every dimension, and the dimensions that are not a view.
     pub all: DepMask,
     pub non_view: DepMask,
@@ -72,14 +70,13 @@ impl<'a> Job<'a> {
     pub fn new(
         set: &'a LoadedSet,
         req: &'a PackRequest,
+        plan: &'a Plan,
         matrices: &'a mut Matrices,
         progress: &'a dyn Progress,
-    ) -> Result<Self> {
+    ) -> Self {
         let scene = &set.scene;
         let meshes: Vec<Mesh> = (0..scene.objects.len()).map(|o| merged_mesh(scene, o)).collect();
         let ndims = scene.space.dims.len();
-        let sizes = block_sizes(req.block.as_slice(), ndims)?;
-        let (space, _) = geometry(set, &sizes);
         let view_dims: Vec<usize> = scene
             .space
             .dims
@@ -97,21 +94,20 @@ impl<'a> Job<'a> {
         if let Some(n) = req.max_iterations {
             settings.cg.max_iterations = n.max(1);
         }
-        Ok(Job {
+        Job {
             set,
             req,
+            plan,
             matrices,
             progress,
             meshes,
-            sizes,
-            space,
             all,
             non_view,
             settings,
             solver: req.solver.clone(),
             placements: 0,
             extra_matrices: 0,
-        })
+        }
     }
 
     /// A note on the work.

@@ -33,16 +33,63 @@ impl BlockSize {
     }
 }
 
+/// What a pack aims at: a compression ratio or a PSNR of the coded textures, one or the
+/// other. [`super::plan::Plan`] turns it into the storage allocation's aim
+/// ([`pis_codec::allocate::Target`]: a ratio is a byte budget of level images).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Target {
+    /// Level-image bytes = raw image bytes / ratio (thesis 4.8; geometry and tables come on
+    /// top).
+    Ratio(f64),
+    /// The fewest bytes that reach this PSNR (dB) of the coded textures.
+    Psnr(f64),
+}
+
+impl Target {
+    /// pis-pack's default: [`DEFAULT_RATIO`].
+    pub const DEFAULT: Target = Target::Ratio(DEFAULT_RATIO);
+
+    /// `--ratio` or `--psnr` as given: neither is the default ratio, both an error.
+    pub fn from_flags(ratio: Option<f64>, psnr: Option<f64>) -> Result<Target, String> {
+        match (ratio, psnr) {
+            (Some(_), Some(_)) => Err("give --ratio or --psnr, not both".to_string()),
+            (Some(r), None) => Ok(Target::Ratio(r)),
+            (None, Some(db)) => Ok(Target::Psnr(db)),
+            (None, None) => Ok(Target::DEFAULT),
+        }
+    }
+
+    /// The ratio aimed at, if any.
+    pub const fn ratio(self) -> Option<f64> {
+        match self {
+            Target::Ratio(r) => Some(r),
+            Target::Psnr(_) => None,
+        }
+    }
+
+    /// The PSNR (dB) aimed at, if any.
+    pub const fn psnr(self) -> Option<f64> {
+        match self {
+            Target::Psnr(db) => Some(db),
+            Target::Ratio(_) => None,
+        }
+    }
+
+    /// As the file's provenance records it: `ratio R` or `psnr P dB`.
+    pub fn describe(self) -> String {
+        match self {
+            Target::Ratio(r) => format!("ratio {r}"),
+            Target::Psnr(db) => format!("psnr {db} dB"),
+        }
+    }
+}
+
 /// Every setting of a pack. [`PackSettings::new`] gives pis-pack's defaults; the presets
 /// and the `with_*` methods change them, `const` where they can be.
 #[derive(Clone, Debug, PartialEq)]
 pub struct PackSettings {
-    /// Target compression ratio: level-image bytes = raw image bytes / ratio (thesis 4.8;
-    /// geometry and tables come on top). `None` with no `psnr`: [`DEFAULT_RATIO`].
-    pub ratio: Option<f64>,
-    /// Target PSNR (dB) of the coded textures instead of a ratio: the fewest bytes that
-    /// reach it.
-    pub psnr: Option<f64>,
+    /// What the pack aims at: a compression ratio (default [`DEFAULT_RATIO`]) or a PSNR.
+    pub target: Target,
     /// The level-image codec: wavelet (default), dct, or lossless.
     pub codec: CodecId,
     /// Samples per parameter block (default 8 along every dimension).
@@ -112,8 +159,7 @@ impl PackSettings {
     /// allocation, texture placements per block.
     pub const fn new() -> Self {
         PackSettings {
-            ratio: None,
-            psnr: None,
+            target: Target::DEFAULT,
             codec: CodecId::Wavelet,
             block: BlockSize::Uniform(DEFAULT_BLOCK),
             filter: Filter::Trilinear,
@@ -162,15 +208,13 @@ impl PackSettings {
 
     /// Aim at a compression ratio.
     pub const fn with_ratio(mut self, ratio: f64) -> Self {
-        self.ratio = Some(ratio);
-        self.psnr = None;
+        self.target = Target::Ratio(ratio);
         self
     }
 
     /// Aim at a PSNR (dB) of the coded textures.
     pub const fn with_psnr(mut self, db: f64) -> Self {
-        self.psnr = Some(db);
-        self.ratio = None;
+        self.target = Target::Psnr(db);
         self
     }
 

@@ -78,8 +78,8 @@ pub fn solve_shard(
     // A streamed solve keeps its scratch file beside its fragment.
     req.output = path.clone();
     let mut stages = Stages::new(progress);
-    let (set, mut matrices) = begin(&req, &mut stages)?;
-    let inferred = infer_layers::infer_all(&set, &req, &mut matrices, &mut stages)
+    let (set, plan, mut matrices) = begin(&req, &mut stages)?;
+    let inferred = infer_layers::infer_all(&set, &req, &plan, &mut matrices, &mut stages)
         .map_err(|e| Failure::new(Exit::Runtime, e))?;
     report.objects = inferred.models.iter().map(|m| m.name.clone()).collect();
     report.solutions = store.len();

@@ -556,7 +556,7 @@ impl Surveyed for Covered {
             diffuse.into_iter().chain(specular).collect()
         };
         for layer in wanted {
-            let grid = BlockGrid::new(&job.space, layer.2, &st);
+            let grid = BlockGrid::new(&job.plan.space, layer.2, &st);
             plans.push(plan_layer(
                 set,
                 &grid,
@@ -652,7 +652,6 @@ impl Planned for Layers {
             mesh_uvs: at.uvs,
             placements,
             stagger: st,
-            block_sizes: job.sizes.clone(),
             area,
             views,
             layers,

@@ -10,6 +10,7 @@ use super::infer_layers::infer_all;
 use super::input::{load, LoadedSet};
 use super::model::ObjectModel;
 use super::packed::LayerTextures;
+use super::plan::Plan;
 use super::predict::{decoded_textures, predicted_psnr, solved_chains};
 use super::{PackRequest, Stages};
 use crate::error::{Exit, Failure};
@@ -18,6 +19,8 @@ use crate::error::{Exit, Failure};
 /// filter, texture size, iteration cap).
 pub struct Inferred {
     pub set: LoadedSet,
+    /// The blocks, space and staggering the models were inferred for, resolved once.
+    pub plan: Plan,
     pub models: Vec<ObjectModel>,
     /// Wall-clock milliseconds of loading and of inference.
     pub load_ms: f64,
@@ -61,16 +64,17 @@ impl Inferred {
         let set = load(req, &mut stages)?;
         let load_ms = t.elapsed().as_secs_f64() * 1e3;
         let t = Instant::now();
+        let plan = Plan::new(&set, req).map_err(|e| Failure::new(Exit::Usage, e))?;
         let mut matrices = super::matrices::Matrices::open(req.matrix, req.filter)?;
         if let Some(device) = matrices.device() {
             stages.note(&format!("probe mode on {device}"));
         }
-        let inferred = infer_all(&set, req, &mut matrices, &mut stages)
+        let inferred = infer_all(&set, req, &plan, &mut matrices, &mut stages)
             .map_err(|e| Failure::new(Exit::Runtime, e))?;
         // `auto` chooses once, for the request's own target.
-        let (models, _) = super::choice::choose(&set, inferred, req, &mut stages)?;
+        let (models, _) = super::choice::choose(&set, inferred, &plan, req, &mut stages)?;
         let infer_ms = t.elapsed().as_secs_f64() * 1e3;
-        Ok(Inferred { set, models, load_ms, infer_ms })
+        Ok(Inferred { set, plan, models, load_ms, infer_ms })
     }
 
     /// Parameter points of the set.
@@ -93,7 +97,7 @@ impl Inferred {
     pub fn pack_point(&self, req: &PackRequest) -> Result<PackPoint, Failure> {
         let t = Instant::now();
         let mut stages = Stages::quiet();
-        let packed = encode_all(&self.set, &self.models, req, &mut stages)?;
+        let packed = encode_all(&self.set, &self.models, &self.aiming_at(req), req, &mut stages)?;
         let file_bytes = pis_format::to_bytes_unchecked(&packed.container).len();
         let q = predicted_psnr(&self.set, &self.models, &packed)
             .map_err(|e| Failure::new(Exit::Runtime, e))?;
@@ -116,7 +120,7 @@ impl Inferred {
     /// The textures after encoding with `req`'s codec, pyramid and target and decoding.
     pub fn decoded(&self, req: &PackRequest) -> Result<(Vec<Vec<LayerTextures>>, usize), Failure> {
         let mut stages = Stages::quiet();
-        let packed = encode_all(&self.set, &self.models, req, &mut stages)?;
+        let packed = encode_all(&self.set, &self.models, &self.aiming_at(req), req, &mut stages)?;
         let bytes = packed.layer_bytes.iter().flatten().sum();
         Ok((
             decoded_textures(&self.models, &packed).map_err(|e| Failure::new(Exit::Runtime, e))?,
@@ -128,8 +132,14 @@ impl Inferred {
     /// `req.output` (atomically); returns the file's bytes.
     pub fn write(&self, req: &PackRequest) -> Result<u64, Failure> {
         let mut stages = Stages::quiet();
-        let packed = encode_all(&self.set, &self.models, req, &mut stages)?;
+        let packed = encode_all(&self.set, &self.models, &self.aiming_at(req), req, &mut stages)?;
         Ok(pis_format::write(&req.output, &packed.container)?)
+    }
+
+    /// The plan of the inference aiming at `req`'s target (its blocks and staggering are the
+    /// inference's).
+    fn aiming_at(&self, req: &PackRequest) -> Plan {
+        self.plan.aiming_at(req.target, self.set.raw_image_bytes())
     }
 
     /// The set's directory.

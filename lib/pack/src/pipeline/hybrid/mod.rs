@@ -90,7 +90,7 @@ impl Planned for HybridPlanned {
         let mut settings = LensInferSettings::default();
         settings.solve.cg = job.settings.cg;
         settings.solver = job.solver.clone();
-        let cap = super::pem::budget::face_cap(set, job.req);
+        let cap = super::pem::budget::face_cap(job.plan, job.req.codec);
         if let Some(c) = cap {
             settings.max_face = c.face.min(settings.max_face);
         }
@@ -118,7 +118,7 @@ impl Planned for HybridPlanned {
             });
             model.layers.push(InferredLayer::shell(
                 pis_format::LayerKind::EnvShell,
-                (&job.space, job.all),
+                (&job.plan.space, job.all),
                 &model.stagger,
                 textures,
                 0,

@@ -8,8 +8,7 @@
 use pis_codec::CodecId;
 use pis_format::checks::MAX_EXPANSION;
 
-use super::super::input::LoadedSet;
-use super::super::{PackRequest, DEFAULT_RATIO};
+use super::super::plan::Plan;
 use super::views::{LARGEST_FACE, MIN_FACE};
 
 /// Bytes one level image of a cube map with `face`-texel faces decodes to: six faces, every
@@ -36,15 +35,15 @@ impl FaceCap {
     }
 }
 
-/// The face cap under `req`'s ratio: a four-channel shell's level image within half of
+/// The face cap under `plan`'s ratio: a four-channel shell's level image within half of
 /// [`MAX_EXPANSION`] times the level-image budget (the allocation may spend a little less
 /// than the budget). `None` where no budget is set beforehand: a PSNR target, or the
 /// lossless codec.
-pub fn face_cap(set: &LoadedSet, req: &PackRequest) -> Option<FaceCap> {
-    if req.psnr.is_some() || req.codec == CodecId::Lossless {
+pub fn face_cap(plan: &Plan, codec: CodecId) -> Option<FaceCap> {
+    if codec == CodecId::Lossless {
         return None;
     }
-    let budget = (set.raw_image_bytes() as f64 / req.ratio.unwrap_or(DEFAULT_RATIO)) as u64;
+    let budget = plan.budget()?;
     Some(FaceCap { face: largest_face_within(MAX_EXPANSION.saturating_mul(budget) / 2), budget })
 }
 

@@ -112,7 +112,7 @@ impl Planned for PemPlanned {
         let mut settings = SolveSettings::pyramidal();
         settings.cg = job.settings.cg;
         let unbudgeted = LARGEST_FACE.min(job.req.max_texture.next_power_of_two() / 2).max(8);
-        let cap = budget::face_cap(set, job.req);
+        let cap = budget::face_cap(job.plan, job.req.codec);
         let largest = cap.map_or(unbudgeted, |c| c.face.min(unbudgeted));
         let cap_note = cap.and_then(|c| c.note(unbudgeted)).unwrap_or_default();
         // The report says so where a shell's face is at the cap the budget set.
@@ -254,7 +254,7 @@ impl Planned for PemPlanned {
             });
             model.layers.push(InferredLayer::shell(
                 kind,
-                (&job.space, job.all),
+                (&job.plan.space, job.all),
                 &model.stagger,
                 solved.textures,
                 solved.iterations,
@@ -302,7 +302,7 @@ fn single_shell(
     });
     model.layers.push(InferredLayer::shell(
         pis_format::LayerKind::EnvDistant,
-        (&job.space, job.all),
+        (&job.plan.space, job.all),
         &model.stagger,
         solved.textures,
         solved.iterations,

@@ -162,7 +162,7 @@ pub fn static_env(
     });
     model.layers.push(InferredLayer::shell(
         pis_format::LayerKind::EnvDistant,
-        (&job.space, job.all),
+        (&job.plan.space, job.all),
         &model.stagger,
         textures,
         0,

@@ -1,0 +1,72 @@
+//! A pack's settings resolved against its set, once, before any work: the high-level half of
+//! [`super::PackSettings`] (as ripgrep's `hiargs` follow its `lowargs`). The parameter
+//! blocks and the container's parameter space, how objects' block origins are staggered
+//! (thesis 4.7), and what the storage allocation aims at: every stage reads them here and
+//! none resolves them again.
+
+use anyhow::Result;
+use pis_codec::allocate;
+use pis_format::{CameraTable, ParameterSpace};
+
+use super::blocks::{block_sizes, geometry, samples_per_dimension, stagger};
+use super::input::LoadedSet;
+use super::settings::{PackSettings, Stagger, Target};
+
+/// The resolved layout and budget of a pack.
+#[derive(Clone, Debug)]
+pub struct Plan {
+    /// Samples per block along each dimension.
+    pub sizes: Vec<u32>,
+    /// The samples along each dimension of the set's parameter space.
+    pub samples: Vec<usize>,
+    /// The container's parameter space for blocks of `sizes`, and its camera table.
+    pub space: ParameterSpace,
+    pub cameras: CameraTable,
+    /// How the objects' block origins are offset.
+    pub stagger: Stagger,
+    /// What the allocation aims at: a ratio as its byte budget of level images against the
+    /// set's raw images (thesis 4.8; geometry and tables come on top), or a PSNR.
+    pub target: allocate::Target,
+}
+
+impl Plan {
+    /// `settings` resolved against `set`: fails where `--block` does not fit the space.
+    pub fn new(set: &LoadedSet, settings: &PackSettings) -> Result<Plan> {
+        let sizes = block_sizes(settings.block.as_slice(), set.scene.space.dims.len())?;
+        let (space, cameras) = geometry(set, &sizes);
+        Ok(Plan {
+            samples: samples_per_dimension(set),
+            sizes,
+            space,
+            cameras,
+            stagger: settings.stagger,
+            target: allocation_target(settings.target, set.raw_image_bytes()),
+        })
+    }
+
+    /// The same layout aiming at `target` (a sweep over the targets of one inference).
+    pub fn aiming_at(&self, target: Target, raw_image_bytes: u64) -> Plan {
+        Plan { target: allocation_target(target, raw_image_bytes), ..self.clone() }
+    }
+
+    /// Block origin offsets of object model `i` of `n` ([`stagger`]).
+    pub fn stagger(&self, i: usize, n: usize) -> Vec<u32> {
+        stagger(i, n, &self.sizes, &self.samples, self.stagger)
+    }
+
+    /// The level-image bytes the allocation may spend, where it aims at a ratio.
+    pub fn budget(&self) -> Option<u64> {
+        match self.target {
+            allocate::Target::Bytes(b) => Some(b as u64),
+            allocate::Target::Psnr { .. } => None,
+        }
+    }
+}
+
+/// The allocation's aim for `target` over raw images of `raw` bytes.
+fn allocation_target(target: Target, raw: u64) -> allocate::Target {
+    match target {
+        Target::Psnr(db) => allocate::Target::Psnr { db, peak: 1.0 },
+        Target::Ratio(r) => allocate::Target::Bytes((raw as f64 / r) as usize),
+    }
+}
