@@ -14,23 +14,28 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use anyhow::{anyhow, bail, Context, Result};
+use anyhow::{anyhow, bail, Result};
 use glam::Vec3;
 use pis_compile::baseline::forward::forward_map;
 use pis_compile::baseline::traced::trace_into_texture;
 use pis_compile::baseline::LayerImage;
+use pis_compile::solve::Solution;
 use pis_compile::{
     antialiased_render_matrix, render, render_matrix, scene_depth, solve, DisplayFilter, DrawMesh,
     Filter, MipSolve, RenderMatrix, SolveSettings, TextureLayout, TextureTransform, TexturedObject,
     Viewport,
 };
 use pis_play::{render_object, Gpu, TexturedPipeline};
-use pis_scene::{Frame, LoadOptions, Scene};
+use pis_scene::{Frame, Scene};
 use pis_trace::layers::LayerKind;
-use pis_trace::{PointImages, TraceSettings};
+
 use serde::Serialize;
 
 pub use pis_codec::display::psnr_display;
+
+mod point;
+
+use point::{load_point, object_layer, Point};
 
 use crate::pipeline::mesh::{atlas, place_in};
 pub use crate::pipeline::mesh::{merged_mesh, sampler, Mesh};
@@ -132,106 +137,6 @@ pub struct InferReport {
     pub notes: Vec<String>,
 }
 
-struct Point {
-    scene: Scene,
-    frame: Frame,
-    images: PointImages,
-    samples: Vec<u32>,
-    values: Vec<f32>,
-    settings: TraceSettings,
-    trace_ms: f64,
-}
-
-fn nearest_samples(scene: &Scene, at: Option<&[f32]>) -> Result<Vec<u32>> {
-    let dims = &scene.space.dims;
-    match at {
-        None => Ok(dims.iter().map(|d| d.samples() / 2).collect()),
-        Some(v) => {
-            if v.len() != dims.len() {
-                bail!(
-                    "--at gives {} values, the parameter space has {} dimensions ({})",
-                    v.len(),
-                    dims.len(),
-                    dims.iter().map(|d| d.name.as_str()).collect::<Vec<_>>().join(", ")
-                );
-            }
-            Ok(dims
-                .iter()
-                .zip(v)
-                .map(|(d, &x)| {
-                    d.values
-                        .iter()
-                        .enumerate()
-                        .min_by(|a, b| (a.1 - x).abs().total_cmp(&(b.1 - x).abs()))
-                        .map_or(0, |(i, _)| i as u32)
-                })
-                .collect())
-        }
-    }
-}
-
-fn load_point(req: &InferRequest) -> Result<Point> {
-    let is_set = req.input.is_dir();
-    if is_set {
-        let set = pis_trace::set::RaySet::open(&req.input)?;
-        let scene_path = req.scene.clone().unwrap_or_else(|| set.default_scene());
-        let res = (set.meta.resolution[0], set.meta.resolution[1]);
-        let options = LoadOptions { resolution: Some(res), ..LoadOptions::default() };
-        let scene = pis_scene::load_with(&scene_path, &options).with_context(|| {
-            format!("loading {} (the set's scene; pass --scene)", scene_path.display())
-        })?;
-        let samples = nearest_samples(&scene, req.at.as_deref())?;
-        let index = set
-            .meta
-            .points
-            .iter()
-            .position(|p| p.samples == samples)
-            .ok_or_else(|| anyhow!("the set has no point at samples {samples:?}"))?;
-        let images = set.read_point(index)?;
-        let frame = scene.frame(&samples)?;
-        let values = set.meta.points[index].values.clone();
-        let mut settings = TraceSettings::new(res, set.meta.spp.max(1));
-        settings.filter = set.meta.filter;
-        Ok(Point { scene, frame, images, samples, values, settings, trace_ms: 0.0 })
-    } else {
-        let options =
-            LoadOptions { preset: req.preset.clone(), resolution: req.resolution, spp: req.spp };
-        let scene = pis_scene::load_with(&req.input, &options)?;
-        let samples = nearest_samples(&scene, req.at.as_deref())?;
-        let frame = scene.frame(&samples)?;
-        let values =
-            scene.space.dims.iter().zip(&samples).map(|(d, &s)| d.values[s as usize]).collect();
-        let settings = TraceSettings::new(scene.resolution, scene.spp);
-        let t = Instant::now();
-        let render = pis_trace::render_point(&scene, &frame, &settings, &|| {})?;
-        let trace_ms = t.elapsed().as_secs_f64() * 1e3;
-        Ok(Point { scene, frame, images: render.images, samples, values, settings, trace_ms })
-    }
-}
-
-/// Per pixel: coverage and the object's surface radiance (diffuse + specular).
-fn object_layer(images: &PointImages, channel: &str) -> Result<(Vec<f32>, Vec<f32>)> {
-    let get = |k: LayerKind| {
-        images
-            .object_layer(channel, k)
-            .ok_or_else(|| anyhow!("the point has no {} layer for object {channel}", k.name()))
-    };
-    let cov = get(LayerKind::Coverage)?
-        .channel("A")
-        .ok_or_else(|| anyhow!("coverage without A"))?
-        .to_vec();
-    let (d, s) = (get(LayerKind::Diffuse)?, get(LayerKind::Specular)?);
-    let n = cov.len();
-    let mut rgb = vec![0.0f32; n * 3];
-    for (c, name) in ["R", "G", "B"].iter().enumerate() {
-        let (dp, sp) = (d.channel(name), s.channel(name));
-        for k in 0..n {
-            rgb[k * 3 + c] = dp.map_or(0.0, |p| p[k]) + sp.map_or(0.0, |p| p[k]);
-        }
-    }
-    Ok((cov, rgb))
-}
-
 pub struct Prepared {
     pub mesh_uvs: Vec<[f32; 2]>,
     pub transform: TextureTransform,
@@ -285,32 +190,12 @@ pub fn place(
     })
 }
 
-/// Runs the comparison.
-pub fn infer(req: &InferRequest) -> Result<InferReport> {
-    let pt = load_point(req)?;
+/// The object compared: `req.object` by name, or the most specular (largest specular share
+/// of its radiance at the point).
+fn chosen_object(req: &InferRequest, pt: &Point, names: &[String]) -> Result<usize> {
     let scene = &pt.scene;
-    let names = pis_trace::channel_names(scene);
-    let (w, h) = pt.settings.resolution;
-    let viewport = Viewport { width: w, height: h };
-    let meshes: Vec<Mesh> = (0..scene.objects.len()).map(|o| merged_mesh(scene, o)).collect();
-    let clip_from = |o: usize| {
-        pis_trace::camera::projection_matrix(&pt.frame.camera, (w, h))
-            * pt.frame.camera.world_from_camera.inverse()
-            * pt.frame.instances[o].world_from_object
-    };
-    let draw: Vec<DrawMesh> = meshes
-        .iter()
-        .enumerate()
-        .map(|(o, m)| DrawMesh {
-            positions: &m.positions,
-            uvs: &m.uvs,
-            indices: &m.indices,
-            clip_from_object: clip_from(o),
-        })
-        .collect();
-
-    // The object: named, or the most specular (largest specular share of its radiance).
-    let o = match &req.object {
+    let w = pt.settings.resolution.0;
+    Ok(match &req.object {
         Some(n) => scene
             .objects
             .iter()
@@ -340,51 +225,57 @@ pub fn infer(req: &InferRequest) -> Result<InferReport> {
             }
             best.1
         }
+    })
+}
+
+/// Every object's mesh as the point's camera draws it.
+fn draw_meshes<'m>(pt: &Point, meshes: &'m [Mesh]) -> Vec<DrawMesh<'m>> {
+    let clip_from = |o: usize| {
+        pis_trace::camera::projection_matrix(&pt.frame.camera, pt.settings.resolution)
+            * pt.frame.camera.world_from_camera.inverse()
+            * pt.frame.instances[o].world_from_object
     };
-    let (cov, rgb) = object_layer(&pt.images, &names[o])?;
-    let reduction = if req.reduction > 0.0 { req.reduction } else { 1.0 };
-    let display_filter = DisplayFilter {
-        sigma_px: pt.settings.filter.sigma_px,
-        radius_px: pt.settings.filter.radius_px,
-    };
-    let all_but = |k: usize| -> Vec<DrawMesh> {
-        draw.iter().enumerate().filter(|(j, _)| *j != k).map(|(_, m)| *m).collect()
-    };
-    // A for one object: antialiased (thesis 3.4.4) or at pixel centres.
-    let build = |obj: &TexturedObject,
-                 k: usize,
-                 occ: &pis_compile::DepthBuffer|
-     -> Result<RenderMatrix> {
-        Ok(if req.antialias > 1 {
-            antialiased_render_matrix(viewport, req.antialias, display_filter, obj, &all_but(k))?
-        } else {
-            render_matrix(viewport, obj, Some(occ))?
+    meshes
+        .iter()
+        .enumerate()
+        .map(|(o, m)| DrawMesh {
+            positions: &m.positions,
+            uvs: &m.uvs,
+            indices: &m.indices,
+            clip_from_object: clip_from(o),
         })
-    };
-    let prep = prepare(&pt, o, &meshes[o], req, reduction)?;
-    let t = Instant::now();
-    let occluders = scene_depth(viewport, &draw, Some(o))?;
-    let mut mesh_o = draw[o];
-    mesh_o.uvs = &prep.mesh_uvs;
-    let matrix = |filter| -> Result<RenderMatrix> {
-        let obj = TexturedObject {
-            mesh: mesh_o,
-            transform: prep.transform,
-            layout: prep.layout,
-            sampler: sampler(filter, prep.repeat),
+        .collect()
+}
+
+/// The render matrix A of `obj`, object `k` of `draw`: antialiased (thesis 3.4.4) or at
+/// pixel centres, occluded by `occ`.
+fn object_matrix(
+    req: &InferRequest,
+    pt: &Point,
+    draw: &[DrawMesh],
+    obj: &TexturedObject,
+    k: usize,
+    occ: &pis_compile::DepthBuffer,
+) -> Result<RenderMatrix> {
+    let (w, h) = pt.settings.resolution;
+    let viewport = Viewport { width: w, height: h };
+    Ok(if req.antialias > 1 {
+        let display_filter = DisplayFilter {
+            sigma_px: pt.settings.filter.sigma_px,
+            radius_px: pt.settings.filter.radius_px,
         };
-        build(&obj, o, &occluders)
-    };
-    let (a_bil, b) = restrict(&matrix(Filter::Bilinear)?, &cov, &rgb);
-    let (a_tri, _) = restrict(&matrix(Filter::Trilinear)?, &cov, &rgb);
-    let matrix_ms = t.elapsed().as_secs_f64() * 1e3;
-    if a_tri.rows() == 0 {
-        bail!("object {} covers no pixel at this point", names[o]);
-    }
-    // The player's pipeline, where an adapter exists (Mesa's lavapipe on a machine without
-    // a GPU).
-    let mut notes = Vec::new();
-    let gpu_state: Result<(Gpu, TexturedPipeline), String> = if req.wgpu {
+        let others: Vec<DrawMesh> =
+            draw.iter().enumerate().filter(|(j, _)| *j != k).map(|(_, m)| *m).collect();
+        antialiased_render_matrix(viewport, req.antialias, display_filter, obj, &others)?
+    } else {
+        render_matrix(viewport, obj, Some(occ))?
+    })
+}
+
+/// The player's pipeline, where an adapter exists (Mesa's lavapipe on a machine without a
+/// GPU), and the report's note on it.
+fn player_pipeline(req: &InferRequest) -> (Result<(Gpu, TexturedPipeline), String>, String) {
+    let state: Result<(Gpu, TexturedPipeline), String> = if req.wgpu {
         Gpu::new()
             .map(|g| {
                 let p = TexturedPipeline::new(&g);
@@ -394,22 +285,45 @@ pub fn infer(req: &InferRequest) -> Result<InferReport> {
     } else {
         Err("not asked for (--no-wgpu)".into())
     };
-    match &gpu_state {
-        Ok((g, _)) => notes.push(format!("psnr_db_wgpu: rendered by pis-play on {}", g.describe())),
-        Err(e) => notes.push(format!("psnr_db_wgpu is null: no wgpu rendering ({e})")),
-    }
-    let occluder_meshes: Vec<DrawMesh> =
-        draw.iter().enumerate().filter(|(k, _)| *k != o).map(|(_, m)| *m).collect();
-    let wgpu_psnr = |a: &RenderMatrix, filter: Filter, x: &[f32]| -> Result<Option<f64>, String> {
-        let Ok((gpu, pipeline)) = gpu_state.as_ref() else { return Ok(None) };
+    let note = match &state {
+        Ok((g, _)) => format!("psnr_db_wgpu: rendered by pis-play on {}", g.describe()),
+        Err(e) => format!("psnr_db_wgpu is null: no wgpu rendering ({e})"),
+    };
+    (state, note)
+}
+
+/// The compared object drawn with each method's texture and scored against the gold
+/// standard `b`: through its render matrix, and through the player's pipeline where there is
+/// one.
+struct Scores<'a> {
+    b: &'a [f32],
+    gpu: &'a Result<(Gpu, TexturedPipeline), String>,
+    viewport: Viewport,
+    mesh: DrawMesh<'a>,
+    prep: &'a Prepared,
+    occluders: Vec<DrawMesh<'a>>,
+    methods: BTreeMap<String, MethodReport>,
+    kept: Vec<Kept>,
+    notes: Vec<String>,
+}
+
+impl Scores<'_> {
+    /// PSNR of texture `x` drawn by the player with `filter` over the rows of `a`.
+    fn wgpu_psnr(
+        &self,
+        a: &RenderMatrix,
+        filter: Filter,
+        x: &[f32],
+    ) -> Result<Option<f64>, String> {
+        let Ok((gpu, pipeline)) = self.gpu.as_ref() else { return Ok(None) };
         let obj = TexturedObject {
-            mesh: mesh_o,
-            transform: prep.transform,
-            layout: prep.layout,
-            sampler: sampler(filter, prep.repeat),
+            mesh: self.mesh,
+            transform: self.prep.transform,
+            layout: self.prep.layout,
+            sampler: sampler(filter, self.prep.repeat),
         };
         let rgba: Vec<f32> = x.chunks_exact(3).flat_map(|c| [c[0], c[1], c[2], 1.0]).collect();
-        let img = render_object(gpu, pipeline, viewport, &occluder_meshes, &obj, &rgba)
+        let img = render_object(gpu, pipeline, self.viewport, &self.occluders, &obj, &rgba)
             .map_err(|e| e.to_string())?;
         let got: Vec<f32> = a
             .pixels
@@ -419,23 +333,27 @@ pub fn infer(req: &InferRequest) -> Result<InferReport> {
                 [v[0], v[1], v[2]]
             })
             .collect();
-        Ok(Some(psnr_display(&got, &b)))
-    };
-    let mut methods = BTreeMap::new();
-    let mut kept: Vec<Kept> = Vec::new();
-    let mut method = |name: &str,
-                      a: &RenderMatrix,
-                      filter: Filter,
-                      x: &[f32],
-                      ms: f64,
-                      it: Option<(u32, bool)>| {
+        Ok(Some(psnr_display(&got, self.b)))
+    }
+
+    /// Method `name`'s texture `x`, drawn through `a` with `filter`, made in `ms`
+    /// milliseconds (in `it` iterations, converged or not, for a solve).
+    fn add(
+        &mut self,
+        name: &str,
+        a: &RenderMatrix,
+        filter: Filter,
+        x: &[f32],
+        ms: f64,
+        it: Option<(u32, bool)>,
+    ) {
         let (it, converged) = (it.map(|i| i.0), it.map(|i| i.1));
-        let p = psnr_display(&render(a, x), &b);
-        let w = wgpu_psnr(a, filter, x).unwrap_or_else(|e| {
-            notes.push(format!("{name}: wgpu rendering failed: {e}"));
+        let p = psnr_display(&render(a, x), self.b);
+        let w = self.wgpu_psnr(a, filter, x).unwrap_or_else(|e| {
+            self.notes.push(format!("{name}: wgpu rendering failed: {e}"));
             None
         });
-        methods.insert(
+        self.methods.insert(
             name.to_string(),
             MethodReport {
                 psnr_db: p,
@@ -449,101 +367,81 @@ pub fn infer(req: &InferRequest) -> Result<InferReport> {
                 converged,
             },
         );
-        kept.push((name.to_string(), filter, x.to_vec()));
-    };
+        self.kept.push((name.to_string(), filter, x.to_vec()));
+    }
+
+    /// A solve's texture as method `name`.
+    fn add_solution(&mut self, name: &str, a: &RenderMatrix, filter: Filter, s: &Solution) {
+        self.add(name, a, filter, &s.texels, s.solve_ms, Some((s.iterations, s.converged)));
+    }
+}
+
+/// The pyramidal settings of `req` (ε_F and the pyramidal ε_B).
+fn pyramidal(req: &InferRequest) -> SolveSettings {
+    SolveSettings { epsilon_f: req.epsilon_f, epsilon_b: req.pyramidal_epsilon_b, ..req.solver }
+}
+
+/// The least-squares methods (thesis 3.4–3.6) through the bilinear and trilinear matrices;
+/// returns the trilinear solve, whose counts the report gives.
+fn least_squares(
+    req: &InferRequest,
+    scores: &mut Scores,
+    a_bil: &RenderMatrix,
+    a_tri: &RenderMatrix,
+) -> Result<Solution> {
+    let b = scores.b;
     let plain = req.solver;
-    let pyramidal = SolveSettings {
-        epsilon_f: req.epsilon_f,
-        epsilon_b: req.pyramidal_epsilon_b,
-        ..req.solver
-    };
+    let pyramidal = pyramidal(req);
     let unconstrained = SolveSettings { epsilon_b: 0.0, epsilon_f: 0.0, ..req.solver };
-    let bil = solve(&a_bil, &b, None, &plain)?;
-    method(
-        "ls-bilinear",
-        &a_bil,
-        Filter::Bilinear,
-        &bil.texels,
-        bil.solve_ms,
-        Some((bil.iterations, bil.converged)),
-    );
-    let tri = solve(&a_tri, &b, None, &plain)?;
-    method(
-        "ls-trilinear",
-        &a_tri,
-        Filter::Trilinear,
-        &tri.texels,
-        tri.solve_ms,
-        Some((tri.iterations, tri.converged)),
-    );
+    let bil = solve(a_bil, b, None, &plain)?;
+    scores.add_solution("ls-bilinear", a_bil, Filter::Bilinear, &bil);
+    let tri = solve(a_tri, b, None, &plain)?;
+    scores.add_solution("ls-trilinear", a_tri, Filter::Trilinear, &tri);
     if plain.epsilon_b > 0.0 {
         // Plain least squares without the constraint 0 ≤ x ≤ R of eq. 3.4: a diagnostic.
-        let u = solve(&a_tri, &b, None, &unconstrained)?;
-        method(
-            "ls-trilinear-unconstrained",
-            &a_tri,
-            Filter::Trilinear,
-            &u.texels,
-            u.solve_ms,
-            Some((u.iterations, u.converged)),
-        );
+        let u = solve(a_tri, b, None, &unconstrained)?;
+        scores.add_solution("ls-trilinear-unconstrained", a_tri, Filter::Trilinear, &u);
     }
     if plain.epsilon_b == 0.0 {
         // Eq. 3.4 as written: plain least squares under the box 0 ≤ x ≤ 1.1 · max(b), and
         // the same box with the pyramidal term.
         let bounded = SolveSettings { bounded: true, ..plain };
-        let t = solve(&a_tri, &b, None, &bounded)?;
-        method(
-            "ls-trilinear-bounded",
-            &a_tri,
-            Filter::Trilinear,
-            &t.texels,
-            t.solve_ms,
-            Some((t.iterations, t.converged)),
-        );
+        let t = solve(a_tri, b, None, &bounded)?;
+        scores.add_solution("ls-trilinear-bounded", a_tri, Filter::Trilinear, &t);
         if pyramidal.epsilon_b == 0.0 {
-            let t = solve(&a_tri, &b, None, &SolveSettings { bounded: true, ..pyramidal })?;
-            method(
-                "ls-pyramidal-bounded",
-                &a_tri,
-                Filter::Trilinear,
-                &t.texels,
-                t.solve_ms,
-                Some((t.iterations, t.converged)),
-            );
+            let t = solve(a_tri, b, None, &SolveSettings { bounded: true, ..pyramidal })?;
+            scores.add_solution("ls-pyramidal-bounded", a_tri, Filter::Trilinear, &t);
         }
     }
-    let pyr = solve(&a_tri, &b, None, &pyramidal)?;
-    method(
-        "ls-pyramidal",
-        &a_tri,
-        Filter::Trilinear,
-        &pyr.texels,
-        pyr.solve_ms,
-        Some((pyr.iterations, pyr.converged)),
-    );
+    let pyr = solve(a_tri, b, None, &pyramidal)?;
+    scores.add_solution("ls-pyramidal", a_tri, Filter::Trilinear, &pyr);
     // The same in the decimated parameterization (what pis-pack solves): level 0 through the
     // MIP chain the player decimates from it.
-    let dec = solve(&a_tri, &b, None, &SolveSettings { mip: MipSolve::Decimated, ..pyramidal })?;
-    method(
-        "ls-decimated",
-        &a_tri,
-        Filter::Trilinear,
-        &dec.texels,
-        dec.solve_ms,
-        Some((dec.iterations, dec.converged)),
-    );
+    let dec = solve(a_tri, b, None, &SolveSettings { mip: MipSolve::Decimated, ..pyramidal })?;
+    scores.add_solution("ls-decimated", a_tri, Filter::Trilinear, &dec);
+    Ok(tri)
+}
 
-    // Baselines, rendered with trilinear filtering as the player would draw them.
+/// The baselines, forward mapping and ray tracing into the texture, rendered with trilinear
+/// filtering as the player would draw them.
+fn baselines(
+    pt: &Point,
+    o: usize,
+    (cov, rgb): (&[f32], &[f32]),
+    scores: &mut Scores,
+    a_tri: &RenderMatrix,
+) -> Result<()> {
+    let (w, h) = pt.settings.resolution;
+    let (mesh_o, prep) = (scores.mesh, scores.prep);
     let t = Instant::now();
     let layer = LayerImage {
         width: w,
         height: h,
-        rgb: rgb.clone(),
+        rgb: rgb.to_vec(),
         covered: cov.iter().map(|&c| c > 0.0).collect(),
     };
     let fwd = forward_map(&mesh_o, &prep.transform, &layer, &prep.layout)?;
-    method("forward", &a_tri, Filter::Trilinear, &fwd, t.elapsed().as_secs_f64() * 1e3, None);
+    scores.add("forward", a_tri, Filter::Trilinear, &fwd, t.elapsed().as_secs_f64() * 1e3, None);
     let t = Instant::now();
     let eye = pt.frame.camera.world_from_camera.w_axis.truncate();
     let mut trace_err = None;
@@ -561,7 +459,7 @@ pub fn infer(req: &InferRequest) -> Result<InferReport> {
                 .map(|r| (r.origin + r.direction * (r.distance * 0.999), r.direction))
                 .collect();
             match pis_trace::rays::trace_rays(
-                scene,
+                &pt.scene,
                 &pt.frame,
                 &pt.settings,
                 &r,
@@ -578,7 +476,104 @@ pub fn infer(req: &InferRequest) -> Result<InferReport> {
     if let Some(e) = trace_err {
         return Err(e.into());
     }
-    method("traced", &a_tri, Filter::Trilinear, &traced, t.elapsed().as_secs_f64() * 1e3, None);
+    scores.add("traced", a_tri, Filter::Trilinear, &traced, t.elapsed().as_secs_f64() * 1e3, None);
+    Ok(())
+}
+
+/// With `--all-objects`: every object's placement, render matrix and pyramidal solve timed.
+fn object_timings(
+    req: &InferRequest,
+    pt: &Point,
+    names: &[String],
+    meshes: &[Mesh],
+    draw: &[DrawMesh],
+    reduction: f64,
+) -> Result<Vec<ObjectTiming>> {
+    let (w, h) = pt.settings.resolution;
+    let viewport = Viewport { width: w, height: h };
+    let mut objects = Vec::new();
+    for k in 0..pt.scene.objects.len() {
+        let t0 = Instant::now();
+        let Ok((cov_k, rgb_k)) = object_layer(&pt.images, &names[k]) else { continue };
+        let prep_k = prepare(pt, k, &meshes[k], req, reduction)?;
+        let t1 = Instant::now();
+        let occ = scene_depth(viewport, draw, Some(k))?;
+        let mut m = draw[k];
+        m.uvs = &prep_k.mesh_uvs;
+        let obj = TexturedObject {
+            mesh: m,
+            transform: prep_k.transform,
+            layout: prep_k.layout,
+            sampler: sampler(Filter::Trilinear, prep_k.repeat),
+        };
+        let (a, bk) = restrict(&object_matrix(req, pt, draw, &obj, k, &occ)?, &cov_k, &rgb_k);
+        let matrix_ms = t1.elapsed().as_secs_f64() * 1e3;
+        if a.rows() == 0 {
+            continue;
+        }
+        let s = solve(&a, &bk, None, &pyramidal(req))?;
+        objects.push(ObjectTiming {
+            object: pt.scene.objects[k].name.clone(),
+            n_s: s.n_s,
+            n_t: s.n_t,
+            texture: [prep_k.layout.width, prep_k.layout.height],
+            texcoord_ms: prep_k.texcoord_ms,
+            matrix_ms,
+            solve_ms: s.solve_ms,
+            iterations: s.iterations,
+            total_ms: t0.elapsed().as_secs_f64() * 1e3,
+        });
+    }
+    Ok(objects)
+}
+
+/// Runs the comparison.
+pub fn infer(req: &InferRequest) -> Result<InferReport> {
+    let pt = load_point(req)?;
+    let scene = &pt.scene;
+    let names = pis_trace::channel_names(scene);
+    let (w, h) = pt.settings.resolution;
+    let viewport = Viewport { width: w, height: h };
+    let meshes: Vec<Mesh> = (0..scene.objects.len()).map(|o| merged_mesh(scene, o)).collect();
+    let draw = draw_meshes(&pt, &meshes);
+    let o = chosen_object(req, &pt, &names)?;
+    let (cov, rgb) = object_layer(&pt.images, &names[o])?;
+    let reduction = if req.reduction > 0.0 { req.reduction } else { 1.0 };
+    let prep = prepare(&pt, o, &meshes[o], req, reduction)?;
+    let t = Instant::now();
+    let occluders = scene_depth(viewport, &draw, Some(o))?;
+    let mut mesh_o = draw[o];
+    mesh_o.uvs = &prep.mesh_uvs;
+    let matrix = |filter| -> Result<RenderMatrix> {
+        let obj = TexturedObject {
+            mesh: mesh_o,
+            transform: prep.transform,
+            layout: prep.layout,
+            sampler: sampler(filter, prep.repeat),
+        };
+        object_matrix(req, &pt, &draw, &obj, o, &occluders)
+    };
+    let (a_bil, b) = restrict(&matrix(Filter::Bilinear)?, &cov, &rgb);
+    let (a_tri, _) = restrict(&matrix(Filter::Trilinear)?, &cov, &rgb);
+    let matrix_ms = t.elapsed().as_secs_f64() * 1e3;
+    if a_tri.rows() == 0 {
+        bail!("object {} covers no pixel at this point", names[o]);
+    }
+    let (gpu, gpu_note) = player_pipeline(req);
+    let mut scores = Scores {
+        b: &b,
+        gpu: &gpu,
+        viewport,
+        mesh: mesh_o,
+        prep: &prep,
+        occluders: draw.iter().enumerate().filter(|(k, _)| *k != o).map(|(_, m)| *m).collect(),
+        methods: BTreeMap::new(),
+        kept: Vec::new(),
+        notes: vec![gpu_note],
+    };
+    let tri = least_squares(req, &mut scores, &a_bil, &a_tri)?;
+    baselines(&pt, o, (&cov, &rgb), &mut scores, &a_tri)?;
+    let Scores { mut methods, kept, notes, .. } = scores;
 
     let mut neighbour_point = None;
     if req.neighbour {
@@ -590,42 +585,11 @@ pub fn infer(req: &InferRequest) -> Result<InferReport> {
         }
         neighbour_point = Some(np);
     }
-
-    let mut objects = Vec::new();
-    if req.all_objects {
-        for k in 0..scene.objects.len() {
-            let t0 = Instant::now();
-            let Ok((cov_k, rgb_k)) = object_layer(&pt.images, &names[k]) else { continue };
-            let prep_k = prepare(&pt, k, &meshes[k], req, reduction)?;
-            let t1 = Instant::now();
-            let occ = scene_depth(viewport, &draw, Some(k))?;
-            let mut m = draw[k];
-            m.uvs = &prep_k.mesh_uvs;
-            let obj = TexturedObject {
-                mesh: m,
-                transform: prep_k.transform,
-                layout: prep_k.layout,
-                sampler: sampler(Filter::Trilinear, prep_k.repeat),
-            };
-            let (a, bk) = restrict(&build(&obj, k, &occ)?, &cov_k, &rgb_k);
-            let matrix_ms = t1.elapsed().as_secs_f64() * 1e3;
-            if a.rows() == 0 {
-                continue;
-            }
-            let s = solve(&a, &bk, None, &pyramidal)?;
-            objects.push(ObjectTiming {
-                object: scene.objects[k].name.clone(),
-                n_s: s.n_s,
-                n_t: s.n_t,
-                texture: [prep_k.layout.width, prep_k.layout.height],
-                texcoord_ms: prep_k.texcoord_ms,
-                matrix_ms,
-                solve_ms: s.solve_ms,
-                iterations: s.iterations,
-                total_ms: t0.elapsed().as_secs_f64() * 1e3,
-            });
-        }
-    }
+    let objects = if req.all_objects {
+        object_timings(req, &pt, &names, &meshes, &draw, reduction)?
+    } else {
+        Vec::new()
+    };
     Ok(InferReport {
         object: scene.objects[o].name.clone(),
         point: pt.samples.clone(),
