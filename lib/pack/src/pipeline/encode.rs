@@ -87,145 +87,191 @@ fn sample_screen_weights(
     })
 }
 
-/// Builds pyramids, allocates storage, encodes, and assembles the container.
-pub fn encode_all(
+/// Every block's pyramid, in (object model, layer, block) order, and where each goes.
+#[derive(Default)]
+struct Pyramids {
+    built: Vec<BlockPyramid>,
+    at: Vec<(usize, usize, usize)>,
+}
+
+/// A layer sample's texel weights, by key, kept for the master.
+type MasterWeights = BTreeMap<Vec<u32>, Vec<f32>>;
+
+/// Block `b` of `grid`'s samples of layer `li` of `m`: per block-local sample its key, its
+/// stored values prepared for the pyramid of `layer` (`layout`), and, with screen-error
+/// allocation (`points_of`: the points that read each sample), its texel weights, which
+/// `master` keeps a copy of where given.
+fn block_samples(
+    (m, li): (&ObjectModel, usize),
+    (grid, b): (&BlockGrid, usize),
+    (layer, layout): (&Layer, &LevelLayout),
+    ndims: usize,
+    points_of: Option<&BTreeMap<Vec<u32>, Vec<usize>>>,
+    mut master: Option<&mut MasterWeights>,
+) -> Result<BlockSamples, Failure> {
+    let runtime = |e: anyhow::Error| Failure::new(Exit::Runtime, e);
+    let il = &m.layers[li];
+    let count: usize = grid.extent(b).iter().map(|&e| e as usize).product();
+    let mut keys = vec![Vec::new(); count];
+    let mut samples = vec![Vec::new(); count];
+    let mut weights = vec![Vec::new(); count];
+    for k in il.textures.keys() {
+        let mut point = vec![0u32; ndims];
+        for (d, &v) in il.depends_on.dims().zip(k) {
+            point[d] = v;
+        }
+        let pos = grid.locate(&point);
+        if pos.block != b {
+            continue;
+        }
+        let x = il.textures.get(k).map_err(runtime)?;
+        let idx = pos
+            .local
+            .iter()
+            .zip(&pos.extent)
+            .fold(0usize, |a, (&l, &e)| a * e as usize + l as usize);
+        keys[idx] = k.clone();
+        samples[idx] = prepare(layer, layout, &il.form.stored(k, &x));
+        if let Some(points_of) = points_of {
+            let points = points_of.get(k).map_or(&[][..], Vec::as_slice);
+            let w = sample_screen_weights(m, li, k, points).map_err(runtime)?;
+            if let Some(master) = master.as_deref_mut() {
+                master.insert(k.clone(), w.clone());
+            }
+            weights[idx] = w;
+        }
+    }
+    if samples.iter().any(Vec::is_empty) {
+        return Err(runtime(anyhow!(
+            "object {} layer {} block {b}: a sample has no texture",
+            m.name,
+            il.kind.name()
+        )));
+    }
+    Ok(BlockSamples { keys, samples, weights })
+}
+
+/// One block's samples: per block-local sample its key, prepared values and texel weights.
+struct BlockSamples {
+    keys: Vec<Vec<u32>>,
+    samples: Vec<Vec<f32>>,
+    weights: Vec<Vec<f32>>,
+}
+
+/// Layer `li` of object model `mi` cut into the blocks of `plan`, each block's adaptive
+/// Laplacian pyramid built into `out`: the container layer (levels empty) and its blocks as
+/// coded.
+fn layer_pyramids(
+    set: &LoadedSet,
+    (m, mi, li): (&ObjectModel, usize, usize),
+    plan: &Plan,
+    req: &PackRequest,
+    master: &mut MasterWeights,
+    out: &mut Pyramids,
+) -> Result<(Layer, Vec<PackedBlock>), Failure> {
+    let runtime = |e: anyhow::Error| Failure::new(Exit::Runtime, e);
+    let il = &m.layers[li];
+    // The weights go to the pyramids; the master (`--keep-master`) keeps a copy.
+    let screen = req.allocation == super::Allocation::Screen;
+    let weighed = screen && !il.textures.is_empty() && req.codec.is_lossy();
+    // The points that read each sample of the layer.
+    let mut points_of: BTreeMap<Vec<u32>, Vec<usize>> = BTreeMap::new();
+    if screen {
+        for (p, s) in set.samples.iter().enumerate() {
+            points_of.entry(key(s, il.depends_on)).or_default().push(p);
+        }
+    }
+    let mut layer = il.form.layer(il.kind, li as u8, il.depends_on, req.gamma);
+    let grid = BlockGrid::new(&plan.space, il.depends_on, &m.stagger);
+    let layer_samples = il.textures.len().max(1) as f64;
+    let mut pblocks = Vec::new();
+    for b in 0..grid.block_count() as usize {
+        let extent = grid.extent(b);
+        let block = il.form.block(b);
+        let layout = LevelLayout::of(&layer, &block);
+        let BlockSamples { keys, samples, weights } = block_samples(
+            (m, li),
+            (&grid, b),
+            (&layer, &layout),
+            plan.space.dims.len(),
+            screen.then_some(&points_of),
+            req.keep_master.then_some(&mut *master),
+        )?;
+        let mut pyramid = build_pyramid(
+            mi,
+            layout.planes(),
+            &extent,
+            &samples,
+            layer_samples,
+            !req.codec.is_lossy(),
+            req.pyramid == super::PyramidMode::Full,
+        )
+        .map_err(runtime)?;
+        // The level images hold the samples from here on.
+        drop(samples);
+        if weighed {
+            pyramid.texel_weights = Some(weights);
+        }
+        // A pack that streams keeps the level images in its scratch file, their
+        // rate–distortion curves measured.
+        if let Some(scratch) = &set.scratch {
+            pyramid.spill(scratch, req.codec).map_err(runtime)?;
+        }
+        out.built.push(pyramid);
+        out.at.push((mi, li, b));
+        pblocks.push(PackedBlock { extent, keys, levels: vec![] });
+        layer.blocks.push(block);
+    }
+    Ok((layer, pblocks))
+}
+
+/// Object model `mi` as the container stores it (levels empty), its layers' blocks as coded
+/// and their screen weights kept for the master, the pyramids built into `out`.
+fn object_pyramids(
+    set: &LoadedSet,
+    (m, mi): (&ObjectModel, usize),
+    plan: &Plan,
+    req: &PackRequest,
+    out: &mut Pyramids,
+) -> Result<(Object, Vec<Vec<PackedBlock>>, Vec<MasterWeights>), Failure> {
+    let mut master_by_layer: Vec<MasterWeights> =
+        m.layers.iter().map(|_| BTreeMap::new()).collect();
+    let mut layers = Vec::new();
+    let mut layer_blocks = Vec::new();
+    for li in 0..m.layers.len() {
+        let (layer, pblocks) =
+            layer_pyramids(set, (m, mi, li), plan, req, &mut master_by_layer[li], out)?;
+        layers.push(layer);
+        layer_blocks.push(pblocks);
+    }
+    // The object's role and shading constants as the scene gives them (SPEC.md 6.4).
+    let role = set.scene.objects[m.index].role;
+    let object = Object {
+        name: m.name.clone(),
+        role,
+        shading: object_shading(&set.scene, m.index),
+        stagger: m.stagger.clone(),
+        transforms: transforms(set, &plan.space, m.index),
+        mesh: stored_mesh(set, m, role),
+        layers,
+    };
+    Ok((object, layer_blocks, master_by_layer))
+}
+
+/// The settings the file's provenance records.
+fn provenance_settings(
     set: &LoadedSet,
     models: &[ObjectModel],
     plan: &Plan,
     req: &PackRequest,
-    stages: &mut Stages,
-) -> Result<Packed, Failure> {
-    let runtime = |e: anyhow::Error| Failure::new(Exit::Runtime, e);
-    let (space, sizes) = (&plan.space, &plan.sizes);
-    if pis_codec::codec(req.codec).is_none() {
-        return Err(runtime(anyhow!("codec {} is not in this build", req.codec)));
-    }
-    let mut objects = Vec::new();
-    let mut blocks_out = Vec::new();
-    let mut staggers = Vec::new();
-    // Every block's pyramid, in (object model, layer, block) order, and where it goes.
-    let mut pyramids = Vec::new();
-    let mut where_ = Vec::new();
-    let mut screen_weights = Vec::new();
-    for (mi, m) in models.iter().enumerate() {
-        let st = &m.stagger;
-        // The weights go to the pyramids; the master (`--keep-master`) keeps a copy.
-        let screen = req.allocation == super::Allocation::Screen;
-        let mut master_by_layer: Vec<BTreeMap<Vec<u32>, Vec<f32>>> =
-            m.layers.iter().map(|_| BTreeMap::new()).collect();
-        let mut layers = Vec::new();
-        let mut layer_blocks = Vec::new();
-        for (li, il) in m.layers.iter().enumerate() {
-            let master_weights = &mut master_by_layer[li];
-            let weighed = screen && !il.textures.is_empty() && req.codec.is_lossy();
-            // The points that read each sample of the layer.
-            let mut points_of: BTreeMap<Vec<u32>, Vec<usize>> = BTreeMap::new();
-            if screen {
-                for (p, s) in set.samples.iter().enumerate() {
-                    points_of.entry(key(s, il.depends_on)).or_default().push(p);
-                }
-            }
-            let mut layer = il.form.layer(il.kind, li as u8, il.depends_on, req.gamma);
-            let grid = BlockGrid::new(&space, il.depends_on, &st);
-            let layer_samples = il.textures.len().max(1) as f64;
-            let mut pblocks = Vec::new();
-            for b in 0..grid.block_count() as usize {
-                let extent = grid.extent(b);
-                let block = il.form.block(b);
-                let layout = LevelLayout::of(&layer, &block);
-                let planes = layout.planes();
-                let count: usize = extent.iter().map(|&e| e as usize).product();
-                let mut keys = vec![Vec::new(); count];
-                let mut samples = vec![Vec::new(); count];
-                let mut weights = vec![Vec::new(); count];
-                for k in il.textures.keys() {
-                    let mut point = vec![0u32; space.dims.len()];
-                    for (d, &v) in il.depends_on.dims().zip(k) {
-                        point[d] = v;
-                    }
-                    let pos = grid.locate(&point);
-                    if pos.block != b {
-                        continue;
-                    }
-                    let x = il.textures.get(k).map_err(runtime)?;
-                    let idx = pos
-                        .local
-                        .iter()
-                        .zip(&pos.extent)
-                        .fold(0usize, |a, (&l, &e)| a * e as usize + l as usize);
-                    keys[idx] = k.clone();
-                    samples[idx] = prepare(&layer, &layout, &il.form.stored(k, &x));
-                    if screen {
-                        let points = points_of.get(k).map_or(&[][..], Vec::as_slice);
-                        let w = sample_screen_weights(m, li, k, points).map_err(runtime)?;
-                        if req.keep_master {
-                            master_weights.insert(k.clone(), w.clone());
-                        }
-                        weights[idx] = w;
-                    }
-                }
-                if samples.iter().any(Vec::is_empty) {
-                    return Err(runtime(anyhow!(
-                        "object {} layer {} block {b}: a sample has no texture",
-                        m.name,
-                        il.kind.name()
-                    )));
-                }
-                let mut pyramid = build_pyramid(
-                    mi,
-                    planes,
-                    &extent,
-                    &samples,
-                    layer_samples,
-                    !req.codec.is_lossy(),
-                    req.pyramid == super::PyramidMode::Full,
-                )
-                .map_err(runtime)?;
-                // The level images hold the samples from here on.
-                drop(samples);
-                if weighed {
-                    pyramid.texel_weights = Some(weights);
-                }
-                // A pack that streams keeps the level images in its scratch file, their
-                // rate–distortion curves measured.
-                if let Some(scratch) = &set.scratch {
-                    pyramid.spill(scratch, req.codec).map_err(runtime)?;
-                }
-                pyramids.push(pyramid);
-                where_.push((mi, li, b));
-                pblocks.push(PackedBlock { extent, keys, levels: vec![] });
-                layer.blocks.push(block);
-            }
-            layers.push(layer);
-            layer_blocks.push(pblocks);
-        }
-        // The object's role and shading constants as the scene gives them (SPEC.md 6.4).
-        let role = set.scene.objects[m.index].role;
-        objects.push(Object {
-            name: m.name.clone(),
-            role,
-            shading: object_shading(&set.scene, m.index),
-            stagger: st.clone(),
-            transforms: transforms(set, &space, m.index),
-            mesh: stored_mesh(set, m, role),
-            layers,
-        });
-        blocks_out.push(layer_blocks);
-        screen_weights.push(master_by_layer);
-        staggers.push(st.clone());
-    }
-    let level_images: usize = pyramids.iter().flat_map(|p| &p.levels).map(|l| l.1.len()).sum();
-    stages.done("pyramid", &format!("{level_images} level images in adaptive pyramids"));
-
-    let raw = set.raw_image_bytes();
-    let settings = vec![
+) -> Vec<(String, String)> {
+    let mut settings = vec![
         ("codec".to_string(), req.codec.name().to_string()),
-        ("block".to_string(), sizes.iter().map(u32::to_string).collect::<Vec<_>>().join("x")),
+        ("block".to_string(), plan.sizes.iter().map(u32::to_string).collect::<Vec<_>>().join("x")),
         ("matrix".to_string(), req.matrix.name().to_string()),
         ("gamma".to_string(), req.gamma.to_string()),
         ("target".to_string(), req.target.describe()),
     ];
-    let mut settings = settings;
     settings.splice(2..2, file_filter(req.filter).settings());
     if req.pyramid != super::PyramidMode::Adaptive {
         settings.push(("pyramid".to_string(), "full".to_string()));
@@ -252,46 +298,75 @@ pub fn encode_all(
             settings.push(pis_format::tint::tint_setting(&m.name, tint));
         }
     }
-    let mut container = Container {
-        space: space.clone(),
-        cameras: plan.cameras.clone(),
-        objects,
-        provenance: Some(Provenance {
-            tool: format!("pis-pack {}", env!("CARGO_PKG_VERSION")),
-            source: set.dir.display().to_string(),
-            raw_image_bytes: raw,
-            settings,
-        }),
-    };
-    // Level lists with empty codestreams: the bytes everything but the images takes.
+    settings
+}
+
+/// Level lists with empty codestreams in every block of `container`: what the bytes of
+/// everything but the images are measured on.
+fn empty_levels(container: &mut Container, pyramids: &Pyramids, codec: CodecId) {
     let mut next = 0;
     for (o, ob) in container.objects.iter_mut().enumerate() {
         for (l, layer) in ob.layers.iter_mut().enumerate() {
             for (b, block) in layer.blocks.iter_mut().enumerate() {
                 // Blocks come in the order their pyramids were built.
-                debug_assert_eq!(where_[next], (o, l, b));
-                block.levels = pyramids[next]
+                debug_assert_eq!(pyramids.at[next], (o, l, b));
+                block.levels = pyramids.built[next]
                     .levels
                     .iter()
                     .map(|(c, imgs, _)| Level {
                         counts: c.clone(),
-                        images: imgs
-                            .iter()
-                            .map(|_| Codestream { codec: req.codec, bytes: vec![] })
-                            .collect(),
+                        images: imgs.iter().map(|_| Codestream { codec, bytes: vec![] }).collect(),
                     })
                     .collect();
                 next += 1;
             }
         }
     }
+}
+
+/// Builds pyramids, allocates storage, encodes, and assembles the container.
+pub fn encode_all(
+    set: &LoadedSet,
+    models: &[ObjectModel],
+    plan: &Plan,
+    req: &PackRequest,
+    stages: &mut Stages,
+) -> Result<Packed, Failure> {
+    let runtime = |e: anyhow::Error| Failure::new(Exit::Runtime, e);
+    if pis_codec::codec(req.codec).is_none() {
+        return Err(runtime(anyhow!("codec {} is not in this build", req.codec)));
+    }
+    let mut pyramids = Pyramids::default();
+    let (mut objects, mut blocks_out, mut screen_weights) = (Vec::new(), Vec::new(), Vec::new());
+    for (mi, m) in models.iter().enumerate() {
+        let (object, blocks, weights) = object_pyramids(set, (m, mi), plan, req, &mut pyramids)?;
+        objects.push(object);
+        blocks_out.push(blocks);
+        screen_weights.push(weights);
+    }
+    let level_images: usize =
+        pyramids.built.iter().flat_map(|p| &p.levels).map(|l| l.1.len()).sum();
+    stages.done("pyramid", &format!("{level_images} level images in adaptive pyramids"));
+
+    let raw = set.raw_image_bytes();
+    let mut container = Container {
+        space: plan.space.clone(),
+        cameras: plan.cameras.clone(),
+        objects,
+        provenance: Some(Provenance {
+            tool: format!("pis-pack {}", env!("CARGO_PKG_VERSION")),
+            source: set.dir.display().to_string(),
+            raw_image_bytes: raw,
+            settings: provenance_settings(set, models, plan, req),
+        }),
+    };
+    empty_levels(&mut container, &pyramids, req.codec);
     let overhead = pis_format::to_bytes_unchecked(&container).len();
 
     // The ratio counts level images against the raw images (thesis 4.8); geometry and
     // tables come on top and are reported apart.
-    let target = plan.target;
     let areas: Vec<f64> = models.iter().map(|m| m.area).collect();
-    let storage = allocate_storage(&pyramids, req.codec, target, &areas, req.max_mse)
+    let storage = allocate_storage(&pyramids.built, req.codec, plan.target, &areas, req.max_mse)
         .map_err(|e| target_failure(e, raw))?;
     if let Some(total) = storage.allocated {
         stages
@@ -305,27 +380,49 @@ pub fn encode_all(
         blocks: blocks_out,
         overhead,
         layer_bytes: Vec::new(),
-        stagger: staggers,
+        stagger: models.iter().map(|m| m.stagger.clone()).collect(),
         screen_weights,
         solved_error,
         max_mse: None,
         quality: None,
     };
     let Some((free_rates, free_bytes)) = &storage.free else {
-        let mut packed = emit(packed, &pyramids, &where_, models, req.codec, &storage.rates)?;
-        drop(pyramids);
+        let (built, at) = (pyramids.built, pyramids.at);
+        let mut packed = emit(packed, &built, &at, models, req.codec, &storage.rates)?;
+        drop(built);
         if req.codec.is_lossy() {
             record_max_mse(&mut packed, req.max_mse.alpha());
         }
         stages.done("encode", &format!("{level_images} level images with {}", req.codec));
         return Ok(packed);
     };
-    // Both allocations encoded; the decoded textures of each rendered through the render
-    // matrices against the traced images: the higher predicted PSNR is kept.
+    let packed =
+        constrained_or_free(set, models, packed, pyramids, (&storage.rates, free_rates), req)?;
+    let c = packed.max_mse.clone().expect("the choice between the allocations");
+    stages.done("encode", &format!(
+        "{level_images} level images with {}, twice: the max-MSE constraint (alpha {}) predicts {:.2} dB, the free allocation ({free_bytes} bytes) {:.2} dB: {} kept",
+        req.codec, c.alpha, c.psnr_db_constrained, c.psnr_db_free, if c.constrained { "the constraint" } else { "the free allocation" },
+    ));
+    Ok(packed)
+}
+
+/// Both allocations, with the max-MSE constraint (`rates.0`) and without (`rates.1`),
+/// encoded; the decoded textures of each rendered through the render matrices against the
+/// traced images: the higher predicted PSNR is kept.
+fn constrained_or_free(
+    set: &LoadedSet,
+    models: &[ObjectModel],
+    packed: Packed,
+    pyramids: Pyramids,
+    (constrained, free): (&[pis_codec::Rate], &[pis_codec::Rate]),
+    req: &PackRequest,
+) -> Result<Packed, Failure> {
+    let runtime = |e: anyhow::Error| Failure::new(Exit::Runtime, e);
     let alpha = req.max_mse.alpha().unwrap_or(pis_codec::allocate::DEFAULT_ALPHA);
-    let with = emit(packed.clone(), &pyramids, &where_, models, req.codec, &storage.rates)?;
-    let without = emit(packed, &pyramids, &where_, models, req.codec, free_rates)?;
-    drop(pyramids);
+    let (built, at) = (pyramids.built, pyramids.at);
+    let with = emit(packed.clone(), &built, &at, models, req.codec, constrained)?;
+    let without = emit(packed, &built, &at, models, req.codec, free)?;
+    drop(built);
     let (q_with, q_without) = (
         predicted_psnr(set, models, &with).map_err(runtime)?,
         predicted_psnr(set, models, &without).map_err(runtime)?,
@@ -341,10 +438,6 @@ pub fn encode_all(
         psnr_db_free: db_without,
     });
     record_max_mse(&mut packed, keep.then_some(alpha));
-    stages.done("encode", &format!(
-        "{level_images} level images with {}, twice: the max-MSE constraint (alpha {alpha}) predicts {db_with:.2} dB, the free allocation ({free_bytes} bytes) {db_without:.2} dB: {} kept",
-        req.codec, if keep { "the constraint" } else { "the free allocation" },
-    ));
     Ok(packed)
 }
 

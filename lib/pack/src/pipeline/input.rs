@@ -140,9 +140,10 @@ fn reads_layer_named(mode: super::RepresentationMode, name: &str) -> bool {
     }
 }
 
-/// Opens (or traces) the set, loads its scene and reads and checks every point.
-pub fn load(req: &PackRequest, stages: &mut Stages) -> Result<LoadedSet, Failure> {
-    let (dir, scene_path) = if req.input.is_dir() {
+/// The set's directory and its scene.toml: the input set's, or the input scene.toml traced
+/// into its cache first (what the container cannot store refused before the trace).
+fn set_dir(req: &PackRequest, stages: &mut Stages) -> Result<(PathBuf, PathBuf), Failure> {
+    Ok(if req.input.is_dir() {
         let set = RaySet::open(&req.input).map_err(trace_failure)?;
         (req.input.clone(), set.default_scene())
     } else if req.input.is_file() {
@@ -172,9 +173,16 @@ pub fn load(req: &PackRequest, stages: &mut Stages) -> Result<LoadedSet, Failure
             Exit::Io,
             anyhow!("{}: no such set directory or scene file", req.input.display()),
         ));
-    };
-    let scene_path = req.scene.clone().unwrap_or(scene_path);
-    let set = RaySet::open(&dir).map_err(trace_failure)?;
+    })
+}
+
+/// How the set's images are held, as `req.memory` and this machine allow, and the scratch
+/// file beside the output where they stream.
+fn memory_plan(
+    req: &PackRequest,
+    set: &RaySet,
+    stages: &mut Stages,
+) -> Result<(MemoryPlan, Option<Arc<Scratch>>), Failure> {
     let res = (set.meta.resolution[0], set.meta.resolution[1]);
     let channels: u64 = 3 + set
         .meta
@@ -198,6 +206,49 @@ pub fn load(req: &PackRequest, stages: &mut Stages) -> Result<LoadedSet, Failure
     } else {
         None
     };
+    Ok((memory, scratch))
+}
+
+/// Point `i`'s image and each of its layers are `res`, as the set at `dir` declares.
+fn check_point_size(
+    dir: &Path,
+    i: usize,
+    img: &pis_trace::PointImages,
+    res: (u32, u32),
+) -> Result<(), Failure> {
+    if (img.width, img.height) != res {
+        return Err(invalid(format!(
+            "{}: point {i} is {}x{}, the set declares {}x{}",
+            dir.display(),
+            img.width,
+            img.height,
+            res.0,
+            res.1
+        )));
+    }
+    for l in &img.layers {
+        if l.width != res.0 || l.height != res.1 {
+            return Err(invalid(format!(
+                "{}: point {i} layer {} is {}x{}, the set declares {}x{}",
+                dir.display(),
+                l.name,
+                l.width,
+                l.height,
+                res.0,
+                res.1
+            )));
+        }
+    }
+    Ok(())
+}
+
+/// Opens (or traces) the set, loads its scene and reads and checks every point.
+pub fn load(req: &PackRequest, stages: &mut Stages) -> Result<LoadedSet, Failure> {
+    let (dir, scene_path) = set_dir(req, stages)?;
+    let scene_path = req.scene.clone().unwrap_or(scene_path);
+    let set = RaySet::open(&dir).map_err(trace_failure)?;
+    let res = (set.meta.resolution[0], set.meta.resolution[1]);
+    let (memory, scratch) = memory_plan(req, &set, stages)?;
     let scene = set_scene(&set, &scene_path, res, req.preset.as_deref())?;
     if set.meta.points.len() != scene.space.point_count() {
         return Err(invalid(format!(
@@ -227,29 +278,7 @@ pub fn load(req: &PackRequest, stages: &mut Stages) -> Result<LoadedSet, Failure
         }
         let mut img = set.read_point(i).map_err(trace_failure)?;
         img.layers.retain(|l| reads_layer_named(req.representation, &l.name));
-        if (img.width, img.height) != res {
-            return Err(invalid(format!(
-                "{}: point {i} is {}x{}, the set declares {}x{}",
-                dir.display(),
-                img.width,
-                img.height,
-                res.0,
-                res.1
-            )));
-        }
-        for l in &img.layers {
-            if l.width != res.0 || l.height != res.1 {
-                return Err(invalid(format!(
-                    "{}: point {i} layer {} is {}x{}, the set declares {}x{}",
-                    dir.display(),
-                    l.name,
-                    l.width,
-                    l.height,
-                    res.0,
-                    res.1
-                )));
-            }
-        }
+        check_point_size(&dir, i, &img, res)?;
         frames.push(scene.frame(&p.samples).map_err(|e| Failure::new(Exit::Invalid, e))?);
         samples.push(p.samples.clone());
         match &scratch {
