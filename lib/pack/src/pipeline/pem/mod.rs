@@ -163,36 +163,7 @@ impl Planned for PemPlanned {
             .collect::<Result<Vec<f32>>>()?
             .iter()
             .any(|&a| a > 1e-3);
-        // The distant shell: a box and a sphere, each solved at a few points spread over the
-        // set; the one nearer the traced distant layer there is kept and solved everywhere.
-        let probe: Vec<usize> = probe_points(set.frames.len());
-        let probe_pixels: Vec<Vec<u32>> = probe.iter().map(|&p| pixels[p].clone()).collect();
-        let probe_keys: Vec<Vec<u32>> = probe.iter().map(|&p| keys[p].clone()).collect();
-        let mut trial: Vec<(f64, &str, Shell, u32)> = Vec::new();
-        for (label, shell) in [("box", fitted.distant_box), ("sphere", fitted.distant_sphere)] {
-            let n = face_resolution(set, o, &job.meshes, shell, largest)?;
-            let views = shell_views(
-                set,
-                o,
-                &job.meshes,
-                &[(shell, TextureLayout::cube(n), None)],
-                lookups,
-                f0,
-                &probe_pixels,
-                &probe,
-            )?;
-            let solved = solve_shell(
-                &views,
-                0,
-                TextureLayout::cube(n),
-                Target::Distant,
-                &probe_keys,
-                &settings,
-                &job.solver,
-            )?;
-            trial.push((solved.residual_rms, label, shell, n));
-        }
-        trial.sort_by(|a, b| a.0.total_cmp(&b.0));
+        let trial = distant_trial(job, o, &fitted, f0, (&pixels, &keys), &settings, largest)?;
         let (residual, label, shell, n) = trial[0];
         let other = trial[1];
         let mut shells = Vec::new();
@@ -236,36 +207,89 @@ impl Planned for PemPlanned {
         };
         let why = format!("distant {label} {n}² (traced distant layer residual {residual:.4}, {} {:.4}){local_text}{}", other.1, other.0, lookups_text(lookups));
         let chosen = Chosen { shells, views, solved, why };
-        for (s, ((shell, layout, target), solved)) in
-            chosen.shells.iter().zip(chosen.solved).enumerate()
-        {
-            let kind = if *target == Target::Local {
-                pis_format::LayerKind::EnvLocal
-            } else {
-                pis_format::LayerKind::EnvDistant
-            };
-            let form = Box::new(ShellForm {
-                shell: *shell,
-                layout: *layout,
-                lookups,
-                channels: target.channels() as u8,
-                order: s as u8,
-                term: pis_format::Term::Reflection,
-            });
-            model.layers.push(InferredLayer::shell(
-                kind,
-                (&job.plan.space, job.all),
-                &model.stagger,
-                solved.textures,
-                solved.iterations,
-                form,
-                s,
-            ));
-        }
+        push_shell_layers(&mut model, job, chosen.shells.iter().zip(chosen.solved));
         model.shells = Some(Box::new(ReflectionTerms(chosen.views)));
         model.representation = "layered environment maps".to_string();
         model.why = format!("reflective: {}, Fresnel from F0 {:?}", chosen.why, f0);
         Ok(with_note(model))
+    }
+}
+
+/// A distant shell of each form, a box and a sphere, solved at a few points spread over the
+/// set (`pixels` and `keys` per point): the two with their residual against the traced
+/// distant layer there, nearer first, each with its face size. The nearer is kept and solved
+/// everywhere.
+fn distant_trial(
+    job: &Job<'_>,
+    o: usize,
+    fitted: &FittedShells,
+    f0: [f32; 3],
+    (pixels, keys): (&[Vec<u32>], &[Vec<u32>]),
+    settings: &SolveSettings,
+    largest: u32,
+) -> Result<Vec<(f64, &'static str, Shell, u32)>> {
+    let set = job.set;
+    let probe: Vec<usize> = probe_points(set.frames.len());
+    let probe_pixels: Vec<Vec<u32>> = probe.iter().map(|&p| pixels[p].clone()).collect();
+    let probe_keys: Vec<Vec<u32>> = probe.iter().map(|&p| keys[p].clone()).collect();
+    let mut trial: Vec<(f64, &str, Shell, u32)> = Vec::new();
+    for (label, shell) in [("box", fitted.distant_box), ("sphere", fitted.distant_sphere)] {
+        let n = face_resolution(set, o, &job.meshes, shell, largest)?;
+        let views = shell_views(
+            set,
+            o,
+            &job.meshes,
+            &[(shell, TextureLayout::cube(n), None)],
+            job.req.shell_lookups,
+            f0,
+            &probe_pixels,
+            &probe,
+        )?;
+        let solved = solve_shell(
+            &views,
+            0,
+            TextureLayout::cube(n),
+            Target::Distant,
+            &probe_keys,
+            settings,
+            &job.solver,
+        )?;
+        trial.push((solved.residual_rms, label, shell, n));
+    }
+    trial.sort_by(|a, b| a.0.total_cmp(&b.0));
+    Ok(trial)
+}
+
+/// Each solved shell as a layer of `model`, in order (the local shell first where there is
+/// one), looked up in the reflection term.
+fn push_shell_layers<'s>(
+    model: &mut ObjectModel,
+    job: &Job<'_>,
+    shells: impl Iterator<Item = (&'s (Shell, TextureLayout, Target), SolvedShell)>,
+) {
+    for (s, ((shell, layout, target), solved)) in shells.enumerate() {
+        let kind = if *target == Target::Local {
+            pis_format::LayerKind::EnvLocal
+        } else {
+            pis_format::LayerKind::EnvDistant
+        };
+        let form = Box::new(ShellForm {
+            shell: *shell,
+            layout: *layout,
+            lookups: job.req.shell_lookups,
+            channels: target.channels() as u8,
+            order: s as u8,
+            term: pis_format::Term::Reflection,
+        });
+        model.layers.push(InferredLayer::shell(
+            kind,
+            (&job.plan.space, job.all),
+            &model.stagger,
+            solved.textures,
+            solved.iterations,
+            form,
+            s,
+        ));
     }
 }
 
