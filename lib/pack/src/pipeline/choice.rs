@@ -78,6 +78,10 @@ fn encoded(
     Ok((packed, quality, outcome))
 }
 
+/// The models chosen, and, where alternatives were weighed, the chosen file as encoded and
+/// predicted.
+pub type Choice = (Vec<ObjectModel>, Option<(Packed, Quality)>);
+
 /// The models chosen from `inferred` for `req`, each alternative's decision added to its
 /// object's `why`; with alternatives, also the chosen file as encoded and predicted.
 pub fn choose(
@@ -86,7 +90,7 @@ pub fn choose(
     plan: &Plan,
     req: &PackRequest,
     stages: &mut Stages,
-) -> Result<(Vec<ObjectModel>, Option<(Packed, Quality)>), Failure> {
+) -> Result<Choice, Failure> {
     let Inferred { mut models, alternatives } = inferred;
     if alternatives.is_empty() {
         return Ok((models, None));

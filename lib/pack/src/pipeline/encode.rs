@@ -151,6 +151,10 @@ fn block_samples(
     Ok(BlockSamples { keys, samples, weights })
 }
 
+/// An object as the container stores it (levels empty), its layers' blocks as coded and
+/// their screen weights kept for the master.
+type PackedObject = (Object, Vec<Vec<PackedBlock>>, Vec<MasterWeights>);
+
 /// One block's samples: per block-local sample its key, prepared values and texel weights.
 struct BlockSamples {
     keys: Vec<Vec<u32>>,
@@ -233,14 +237,13 @@ fn object_pyramids(
     plan: &Plan,
     req: &PackRequest,
     out: &mut Pyramids,
-) -> Result<(Object, Vec<Vec<PackedBlock>>, Vec<MasterWeights>), Failure> {
+) -> Result<PackedObject, Failure> {
     let mut master_by_layer: Vec<MasterWeights> =
         m.layers.iter().map(|_| BTreeMap::new()).collect();
     let mut layers = Vec::new();
     let mut layer_blocks = Vec::new();
-    for li in 0..m.layers.len() {
-        let (layer, pblocks) =
-            layer_pyramids(set, (m, mi, li), plan, req, &mut master_by_layer[li], out)?;
+    for (li, master) in master_by_layer.iter_mut().enumerate() {
+        let (layer, pblocks) = layer_pyramids(set, (m, mi, li), plan, req, master, out)?;
         layers.push(layer);
         layer_blocks.push(pblocks);
     }
@@ -576,26 +579,6 @@ fn file_filter(f: pis_compile::Filter) -> pis_format::FileFilter {
     }
 }
 
-#[cfg(test)]
-mod tests {
-    use super::sample_weights;
-
-    #[test]
-    fn sample_weights_sum_the_points_that_read_a_sample_scaled_to_mean_one() {
-        let per_point =
-            vec![vec![2.0, 0.0, 0.0, 2.0], vec![0.0, 0.0, 4.0, 0.0], vec![1.0, 1.0, 1.0, 1.0]];
-        // two views of a view-independent sample: texels seen by both weigh most, the
-        // texel no view reads weighs nothing
-        let w = sample_weights(&per_point[..2]);
-        assert_eq!(w, vec![1.0, 0.0, 2.0, 1.0]);
-        assert!((w.iter().sum::<f32>() / 4.0 - 1.0).abs() < 1e-6);
-        assert_eq!(sample_weights(&per_point[2..]), vec![1.0; 4]);
-        // a sample no point shows weighs nothing anywhere
-        assert_eq!(sample_weights(&[vec![0.0; 3]]), vec![0.0; 3]);
-        assert!(sample_weights(&[]).is_empty());
-    }
-}
-
 /// An allocation that cannot meet its target says which target to ask for instead
 /// (exit 1: the request, not the input, is at fault); other failures are runtime errors.
 fn target_failure(e: anyhow::Error, raw: u64) -> Failure {
@@ -609,5 +592,25 @@ fn target_failure(e: anyhow::Error, raw: u64) -> Failure {
             "--psnr {db} dB is out of reach: the stored textures reach at most {best_db:.2} dB (coding PSNR at the codec's full rate); ask for at most that, or use --codec lossless"
         )),
         _ => Failure::new(Exit::Runtime, e),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::sample_weights;
+
+    #[test]
+    fn sample_weights_sum_the_points_that_read_a_sample_scaled_to_mean_one() {
+        let per_point =
+            [vec![2.0, 0.0, 0.0, 2.0], vec![0.0, 0.0, 4.0, 0.0], vec![1.0, 1.0, 1.0, 1.0]];
+        // two views of a view-independent sample: texels seen by both weigh most, the
+        // texel no view reads weighs nothing
+        let w = sample_weights(&per_point[..2]);
+        assert_eq!(w, vec![1.0, 0.0, 2.0, 1.0]);
+        assert!((w.iter().sum::<f32>() / 4.0 - 1.0).abs() < 1e-6);
+        assert_eq!(sample_weights(&per_point[2..]), vec![1.0; 4]);
+        // a sample no point shows weighs nothing anywhere
+        assert_eq!(sample_weights(&[vec![0.0; 3]]), vec![0.0; 3]);
+        assert!(sample_weights(&[]).is_empty());
     }
 }

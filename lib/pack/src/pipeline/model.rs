@@ -407,7 +407,7 @@ mod tests {
             held.push(view(p)).unwrap();
             spilled.push(view(p)).unwrap();
         }
-        assert!(scratch.len() > 0, "the views went to the scratch file");
+        assert!(!scratch.is_empty(), "the views went to the scratch file");
         // A second placement's matrix added at point 1, the first one dropped.
         let change = |v: &mut PointView| {
             let mut b = v.a[0].1.clone();

@@ -85,8 +85,7 @@ pub fn display_error(
     let (mut sse, mut n) = (0.0f64, 0usize);
     // The chain each layer read last: consecutive points share the samples of a layer that
     // does not depend on the fastest dimension.
-    let mut last: Vec<Option<(Vec<u32>, Option<Cow<'_, [f32]>>)>> =
-        m.layers.iter().map(|_| None).collect();
+    let mut last: Vec<Option<LastChain>> = m.layers.iter().map(|_| None).collect();
     for (p, s) in set.samples.iter().enumerate() {
         let v = m.views.get(p)?;
         let keys: Vec<Vec<u32>> = m.layers.iter().map(|il| key(s, il.depends_on)).collect();
@@ -183,6 +182,10 @@ fn layer_codec(block: &Block) -> CodecId {
 pub fn psnr(sse: f64, n: usize) -> f64 {
     10.0 * (1.0 / (sse / n.max(1) as f64).max(1e-20)).log10()
 }
+
+/// The chain a layer read last: its key, and the chain (none where the layer has no sample
+/// there).
+type LastChain<'a> = (Vec<u32>, Option<Cow<'a, [f32]>>);
 
 /// Renders the decoded and the solved textures through the render matrices (the hardware
 /// model's or probe mode's). Object by object, each decoded chain is compared with the

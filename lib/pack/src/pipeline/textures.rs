@@ -130,7 +130,7 @@ mod tests {
         let mut t = Textures::from(held.clone());
         t.spill(&scratch).unwrap();
         assert!(
-            scratch.len() > 0
+            !scratch.is_empty()
                 && t.len() == 2
                 && t.contains_key(&[0, 2])
                 && !t.contains_key(&[2, 0])

@@ -354,8 +354,7 @@ pub fn infer_lens_views(
     let mut out = Vec::with_capacity(samples.len());
     for (sample, models) in samples.iter().zip(&models) {
         let render = &sample[0];
-        let mut sub_all: Vec<Vec<(RenderMatrix, Vec<f32>, Vec<f32>)>> =
-            vec![Vec::new(); shells.len()];
+        let mut sub_all: Vec<Vec<ShellRow>> = vec![Vec::new(); shells.len()];
         for (render, model) in sample.iter().zip(models) {
             for (l, sub) in
                 view_rows(scene, o, model, render, &layers, settings).into_iter().enumerate()
@@ -393,6 +392,10 @@ pub fn infer_lens_views(
     Ok(LensInference { face, layers, shells, views: out, models })
 }
 
+/// A term's rows of one shell: the render matrix's rows of the pixels the records reach,
+/// with their colour and alpha targets.
+type ShellRow = (RenderMatrix, Vec<f32>, Vec<f32>);
+
 /// One view's rows for each shell: per term, the render matrix's rows of the pixels the
 /// records reach, with their colour and alpha targets.
 fn view_rows(
@@ -402,7 +405,7 @@ fn view_rows(
     render: &TracedView,
     layers: &Layers,
     settings: &LensInferSettings,
-) -> Vec<Vec<(RenderMatrix, Vec<f32>, Vec<f32>)>> {
+) -> Vec<Vec<ShellRow>> {
     let (w, h) = (render.images.width, render.images.height);
     let n = (w * h) as usize;
     // Per term, the records' targets.

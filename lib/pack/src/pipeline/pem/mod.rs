@@ -181,7 +181,7 @@ impl Planned for PemPlanned {
             .map(|s| (s.0, s.1, if s.2 == Target::Local { local_drawn.as_deref() } else { None }))
             .collect();
         let all: Vec<usize> = (0..set.frames.len()).collect();
-        let views = shell_views(set, o, &job.meshes, &geometry, lookups, f0, &pixels, &all)?;
+        let views = shell_views(set, o, &job.meshes, &geometry, lookups, f0, (&pixels, &all))?;
         let mut solved = Vec::new();
         for (s, &(_, layout, target)) in shells.iter().enumerate() {
             solved.push(solve_shell(&views, s, layout, target, &keys, &settings, &job.solver)?);
@@ -242,8 +242,7 @@ fn distant_trial(
             &[(shell, TextureLayout::cube(n), None)],
             job.req.shell_lookups,
             f0,
-            &probe_pixels,
-            &probe,
+            (&probe_pixels, &probe),
         )?;
         let solved = solve_shell(
             &views,
@@ -314,7 +313,7 @@ fn single_shell(
     let layout = TextureLayout::cube(n);
     let all: Vec<usize> = (0..set.frames.len()).collect();
     let views =
-        shell_views(set, o, &job.meshes, &[(shell, layout, None)], lookups, f0, pixels, &all)?;
+        shell_views(set, o, &job.meshes, &[(shell, layout, None)], lookups, f0, (pixels, &all))?;
     let solved = solve_shell(&views, 0, layout, Target::Incident, keys, settings, &job.solver)?;
     let form = Box::new(ShellForm {
         shell,

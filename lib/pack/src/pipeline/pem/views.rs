@@ -67,9 +67,7 @@ fn shell_object<'m>(
     p: usize,
     o: usize,
     mesh: &'m Mesh,
-    shell: Shell,
-    layout: TextureLayout,
-    drawn: Option<&'m [bool]>,
+    (shell, layout, drawn): (Shell, TextureLayout, Option<&'m [bool]>),
     lookups: u32,
 ) -> ShellObject<'m> {
     let (w, h) = set.resolution;
@@ -157,8 +155,7 @@ pub fn shell_views(
     shells: &[(Shell, TextureLayout, Option<&[bool]>)],
     lookups: u32,
     f0: [f32; 3],
-    pixels: &[Vec<u32>],
-    points: &[usize],
+    (pixels, points): (&[Vec<u32>], &[usize]),
 ) -> Result<Vec<ShellView>> {
     let (w, h) = set.resolution;
     let vp = Viewport { width: w, height: h };
@@ -171,7 +168,7 @@ pub fn shell_views(
             let cov = coverage(set, p, o)?;
             let mut a = Vec::with_capacity(shells.len());
             for &(shell, layout, drawn) in shells {
-                let m = shell_render_matrix(vp, &shell_object(set, p, o, &meshes[o], shell, layout, drawn, lookups), Some(&depth))?;
+                let m = shell_render_matrix(vp, &shell_object(set, p, o, &meshes[o], (shell, layout, drawn), lookups), Some(&depth))?;
                 let mut m = restrict_rows(&m, &cov);
                 if drawn.is_some() {
                     m = with_rows_at(&m, pixels);
@@ -181,7 +178,7 @@ pub fn shell_views(
                 }
                 a.push(m);
             }
-            let (fp, f) = shell_fresnel(vp, &shell_object(set, p, o, &meshes[o], shells[0].0, shells[0].1, None, 1), Some(&depth), f0)?;
+            let (fp, f) = shell_fresnel(vp, &shell_object(set, p, o, &meshes[o], (shells[0].0, shells[0].1, None), 1), Some(&depth), f0)?;
             let mut fresnel = Vec::with_capacity(pixels.len() * 3);
             let mut k = 0;
             for &px in pixels {
@@ -222,7 +219,7 @@ pub fn face_resolution(
         let a = restrict_rows(
             &shell_render_matrix(
                 vp,
-                &shell_object(set, p, o, &meshes[o], shell, layout, None, 1),
+                &shell_object(set, p, o, &meshes[o], (shell, layout, None), 1),
                 Some(&depth),
             )?,
             &coverage(set, p, o)?,
