@@ -224,3 +224,17 @@ rules! {
 pub fn summary(id: u16) -> &'static str {
     RULES.iter().find(|(i, _)| *i == id).map(|(_, m)| *m).unwrap_or("unknown rule")
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A named id prints as its number, and every id is listed once, in spec order.
+    #[test]
+    fn named_ids_are_the_spec_numbers() {
+        assert_eq!(id::layers::LEVEL_IMAGE_TOO_LARGE, 6009);
+        assert_eq!(Issue::new(id::layers::LEVEL_IMAGE_TOO_LARGE, "").code(), "error-6009");
+        assert_eq!(Issue::warning(id::codestream::RESERVED_CODEC, "").code(), "warning-8007");
+        assert!(RULES.windows(2).all(|w| w[0].0 < w[1].0), "ids repeated or out of order");
+    }
+}

@@ -84,6 +84,9 @@ pub fn check(req: &SpeedRequest) -> Result<(), Failure> {
     Ok(())
 }
 
+/// The codecs whose files are played.
+const PLAYED: [CodecId; 2] = [CodecId::Wavelet, CodecId::Dct];
+
 /// Writes speed.csv and speed.svg: a row per CG cap and per playback measurement, the
 /// compile points and the playback frame times as series.
 fn write_speed(
@@ -134,7 +137,7 @@ fn write_speed(
             points: rows.iter().map(|r| (r.ms_per_point, r.psnr_db)).collect(),
         },
     ];
-    for codec in ["wavelet", "dct"] {
+    for codec in PLAYED.map(CodecId::name) {
         let mine: Vec<&PlaybackRow> = playback.iter().filter(|p| p.codec == codec).collect();
         if !mine.is_empty() {
             series.push(Series {
@@ -205,7 +208,7 @@ pub fn run(req: &SpeedRequest) -> Result<SpeedReport, Failure> {
     let (mut playback, mut playback_skipped) = (Vec::new(), None);
     match (gpu(), last) {
         (Ok(g), Some(inf)) => {
-            for codec in [CodecId::Wavelet, CodecId::Dct] {
+            for codec in PLAYED {
                 let file = req.out.join(format!("speed-{}.pis", codec.name()));
                 inf.write(&PackRequest { output: file.clone(), ..base.with(|s| s.codec = codec) })?;
                 playback.extend(
