@@ -8,6 +8,11 @@
 //! subcommands, each subcommand's `### pis-X SUB` subsection) holds tables whose header's first cell is
 //! `flag`; the first cell of every row names the flag (`--ratio`, or `-o`, `--output`). Those
 //! cells are what is checked against `--help`, both ways.
+//!
+//! The benchmarks: docs/BENCHMARKS.md is a one-page summary (under 15 KB) whose rows link to
+//! the notebook's sections in docs/benchmarks/; every relative link of those pages reaches a
+//! file and, with `#anchor`, one of its headings; and every table generated from a committed
+//! `pis-bench --json` report (docs/benchmarks/results/) is that report's rendering.
 
 use std::collections::BTreeSet;
 use std::io::Read;
@@ -371,4 +376,245 @@ fn readme_commands_run_as_written() {
         dir.path().join("demo1.pis").is_file(),
         "README's step-by-step commands write demo1.pis"
     );
+}
+
+/// The benchmark summary's limit: one page a reader takes in, the notebook holds the rest.
+const SUMMARY_LIMIT: usize = 15 * 1024;
+/// The lines around a block of the notebook rendered from a committed `pis-bench --json`
+/// report: a line `<!-- generated from results/NAME.json: do not edit -->`, the table, a line
+/// [`GENERATED_END`].
+const GENERATED_START: &str = "<!-- generated from ";
+const GENERATED_END: &str = "<!-- end generated -->";
+
+/// docs/BENCHMARKS.md and every page of docs/benchmarks/, as paths relative to the repository.
+fn benchmark_pages() -> Vec<String> {
+    let mut pages = vec!["docs/BENCHMARKS.md".to_string()];
+    let dir = repo().join("docs/benchmarks");
+    let mut names: Vec<String> = std::fs::read_dir(&dir)
+        .unwrap_or_else(|e| panic!("{}: {e}", dir.display()))
+        .map(|e| e.expect("entry").file_name().to_string_lossy().into_owned())
+        .filter(|n| n.ends_with(".md"))
+        .collect();
+    names.sort();
+    pages.extend(names.into_iter().map(|n| format!("docs/benchmarks/{n}")));
+    pages
+}
+
+/// Lines outside fenced code blocks.
+fn prose_lines(md: &str) -> Vec<&str> {
+    let mut fenced = false;
+    md.lines()
+        .filter(|l| {
+            if l.trim_start().starts_with("```") {
+                fenced = !fenced;
+                return false;
+            }
+            !fenced
+        })
+        .collect()
+}
+
+/// GitHub's anchor of a heading: lower case, every character but letters, digits, `-`, `_`
+/// and spaces dropped, spaces turned into `-`.
+fn slug(heading: &str) -> String {
+    heading
+        .trim()
+        .to_lowercase()
+        .chars()
+        .filter(|c| c.is_alphanumeric() || matches!(c, '-' | '_' | ' '))
+        .map(|c| if c == ' ' { '-' } else { c })
+        .collect()
+}
+
+/// The anchors of a page's headings; a repeated one gets `-1`, `-2`, … as on GitHub.
+fn anchors(md: &str) -> BTreeSet<String> {
+    let mut seen = BTreeSet::new();
+    for line in prose_lines(md) {
+        let hashes = line.chars().take_while(|&c| c == '#').count();
+        let Some(text) = line.get(hashes..).and_then(|t| t.strip_prefix(' ')) else { continue };
+        if hashes == 0 || hashes > 6 {
+            continue;
+        }
+        let base = slug(text);
+        let mut anchor = base.clone();
+        let mut n = 0;
+        while seen.contains(&anchor) {
+            n += 1;
+            anchor = format!("{base}-{n}");
+        }
+        seen.insert(anchor);
+    }
+    seen
+}
+
+/// The targets of a page's inline links `[text](target)`, outside fenced code.
+fn link_targets(md: &str) -> Vec<String> {
+    let mut targets = Vec::new();
+    for line in prose_lines(md) {
+        let mut rest = line;
+        while let Some(i) = rest.find("](") {
+            rest = &rest[i + 2..];
+            let Some(end) = rest.find(')') else { break };
+            targets.push(rest[..end].trim().to_string());
+            rest = &rest[end..];
+        }
+    }
+    targets
+}
+
+#[test]
+fn benchmark_summary_is_one_page() {
+    let md = read("docs/BENCHMARKS.md");
+    assert!(
+        md.len() < SUMMARY_LIMIT,
+        "docs/BENCHMARKS.md is {} bytes: the summary stays under {SUMMARY_LIMIT} (measurements belong in docs/benchmarks/)",
+        md.len()
+    );
+}
+
+/// Every relative link of the summary and the notebook names a file that exists and, with
+/// `#anchor`, a heading of that file.
+#[test]
+fn benchmark_links_resolve_to_files_and_headings() {
+    let mut broken = Vec::new();
+    for page in benchmark_pages() {
+        let md = read(&page);
+        let dir = Path::new(&page).parent().expect("a folder").to_path_buf();
+        for target in link_targets(&md) {
+            if target.contains("://") || target.starts_with("mailto:") {
+                continue;
+            }
+            let (file, anchor) = target.split_once('#').unwrap_or((&target, ""));
+            let rel = if file.is_empty() { PathBuf::from(&page) } else { dir.join(file) };
+            let path = repo().join(&rel);
+            if !path.exists() {
+                broken.push(format!("{page}: ({target}): no file {}", rel.display()));
+            } else if !anchor.is_empty() {
+                let text = std::fs::read_to_string(&path).unwrap_or_default();
+                if !anchors(&text).contains(anchor) {
+                    broken.push(format!("{page}: ({target}): no heading #{anchor}"));
+                }
+            }
+        }
+    }
+    assert!(broken.is_empty(), "{} broken link(s):\n{}", broken.len(), broken.join("\n"));
+}
+
+/// A PSNR cell of a `pis-bench rd` report's row: the PSNR, pis-pack's prediction in
+/// parentheses, the achieved ratio and the CRF where the report gives them.
+fn rd_cell(row: &serde_json::Value) -> String {
+    let num = |k: &str| row.get(k).and_then(serde_json::Value::as_f64);
+    let mut cell = format!("{:.2}", num("psnr_db").expect("psnr_db"));
+    if let Some(p) = num("psnr_db_predicted") {
+        cell += &format!(" ({p:.2})");
+    }
+    if let Some(r) = num("ratio") {
+        cell += &format!(" at {r}:1");
+    }
+    if let Some(c) = num("crf") {
+        cell += &format!(", CRF {c}");
+    }
+    if row.get("reached").and_then(serde_json::Value::as_bool) == Some(false) {
+        cell += ", budget not reached";
+    }
+    cell
+}
+
+/// The markdown table of a `pis-bench rd --json` report: a row per method, a column per
+/// target ratio, and the PSNR's scope.
+fn rd_table(report: &serde_json::Value) -> String {
+    let rows = report["rows"].as_array().expect("rows");
+    let mut ratios: Vec<f64> = Vec::new();
+    let mut methods: Vec<&str> = Vec::new();
+    for r in rows {
+        let t = r["target_ratio"].as_f64().expect("target_ratio");
+        if !ratios.contains(&t) {
+            ratios.push(t);
+        }
+        let m = r["method"].as_str().expect("method");
+        if !methods.contains(&m) {
+            methods.push(m);
+        }
+    }
+    ratios.sort_by(f64::total_cmp);
+    let mut out = String::from("| method |");
+    for t in &ratios {
+        out += &format!(" {t}:1 |");
+    }
+    out += " scope |\n|---|";
+    out += &"---|".repeat(ratios.len() + 1);
+    for m in methods {
+        let of = |t: f64| rows.iter().find(|r| r["method"] == m && r["target_ratio"] == t);
+        out += &format!("\n| {m} |");
+        for &t in &ratios {
+            out += &format!(" {} |", of(t).map_or("—".to_string(), rd_cell));
+        }
+        let scope = rows.iter().find(|r| r["method"] == m).and_then(|r| r["psnr_scope"].as_str());
+        out += match scope {
+            Some("whole-image-played") => " played, whole image (predicted, covered pixels) |",
+            Some("covered-predicted") => " predicted, covered pixels |",
+            Some("whole-image") => " decoded, whole image |",
+            _ => " |",
+        };
+    }
+    out
+}
+
+/// Every generated block of the notebook is the rendering of the report it names, so that
+/// its figures are the committed result file's. `PIS_BLESS=1 cargo test --release -p pis
+/// --test docs` rewrites the blocks from the files instead (docs/benchmarks/README.md).
+#[test]
+fn generated_benchmark_tables_are_current() {
+    let bless = std::env::var("PIS_BLESS").is_ok_and(|v| v == "1");
+    let mut stale = Vec::new();
+    let mut blocks = 0;
+    for page in benchmark_pages() {
+        let md = read(&page);
+        let dir = Path::new(&page).parent().expect("a folder").to_path_buf();
+        let mut out = String::new();
+        let mut rest = md.as_str();
+        while let Some(i) = rest.find(&format!("\n{GENERATED_START}")).map(|i| i + 1) {
+            let line_end = i + rest[i..].find('\n').expect("the marker's line ends");
+            let marker = &rest[i..line_end];
+            let name = marker[GENERATED_START.len()..].split(':').next().expect("a file name");
+            let end = rest[line_end..].find(GENERATED_END).map(|j| line_end + j);
+            let end = end.unwrap_or_else(|| panic!("{page}: `{marker}` has no `{GENERATED_END}`"));
+            let json = read(&dir.join(name).to_string_lossy());
+            let report: serde_json::Value =
+                serde_json::from_str(&json).unwrap_or_else(|e| panic!("{page}: {name}: {e}"));
+            let table = rd_table(&report);
+            if rest[line_end + 1..end].trim_end() != table {
+                stale.push(format!("{page}: the table from {name}"));
+            }
+            out += &format!("{}\n{table}\n", &rest[..line_end]);
+            rest = &rest[end..];
+            blocks += 1;
+        }
+        out += rest;
+        if bless && out != md {
+            let tmp = repo().join(format!("{page}.bless"));
+            std::fs::write(&tmp, out).expect("write the page");
+            std::fs::rename(&tmp, repo().join(&page)).expect("replace the page");
+        }
+    }
+    assert!(blocks > 0, "the notebook holds generated tables");
+    assert!(
+        bless || stale.is_empty(),
+        "generated tables differ from their result files (regenerate: PIS_BLESS=1 cargo test --release -p pis --test docs):\n{}",
+        stale.join("\n")
+    );
+}
+
+#[test]
+fn heading_anchors_follow_githubs_rule() {
+    assert_eq!(slug("`paper` preset (640×480, 16 spp)"), "paper-preset-640480-16-spp");
+    assert_eq!(
+        slug("Parameter blocks: which dimensions are staggered (`--stagger auto|always`)"),
+        "parameter-blocks-which-dimensions-are-staggered---stagger-autoalways"
+    );
+    assert_eq!(
+        anchors("# A\n```\n# not a heading\n```\n## A\n").into_iter().collect::<Vec<_>>(),
+        ["a", "a-1"]
+    );
+    assert_eq!(link_targets("[x](a.md#b) and [y](../c.md)"), ["a.md#b", "../c.md"]);
 }
