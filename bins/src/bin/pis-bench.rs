@@ -258,7 +258,7 @@ enum Command {
         images: bool,
         /// The objects measured: `reflective` or `refractive` (the lens objects, drawn by
         /// hybrid rendering).
-        #[arg(long, default_value = "reflective", value_parser = parse_role)]
+        #[arg(long, default_value = "reflective", value_parser = pis::cli::one_of(&reflective::ROLES, reflective::role_name))]
         role: pis_scene::ObjectRole,
         /// The player's τ for lens objects (pis-play --tau), pixels.
         #[arg(long, default_value_t = 1.0)]
@@ -297,7 +297,7 @@ enum Command {
     /// Every chart (rd, speed, stability) from scratch on demo1: trace, pack, evaluate.
     All {
         /// `ci` (80×60, 1 spp: minutes on 2 cores) or `paper` (demo1's paper preset).
-        #[arg(long, value_parser = parse_preset)]
+        #[arg(long, value_parser = pis::cli::one_of(&Preset::ALL, Preset::name))]
         preset: Preset,
         /// demo1's scene.toml (default: samples/demo1/scene.toml of the source tree).
         #[arg(long)]
@@ -308,14 +308,6 @@ enum Command {
         #[arg(long)]
         record: bool,
     },
-}
-
-fn parse_preset(s: &str) -> Result<Preset, String> {
-    match s {
-        "ci" => Ok(Preset::Ci),
-        "paper" => Ok(Preset::Paper),
-        _ => Err(format!("unknown preset {s:?} (ci or paper)")),
-    }
 }
 
 fn json_out<T: serde::Serialize>(v: &T) -> Result<(), Failure> {
@@ -606,12 +598,4 @@ fn main() -> ExitCode {
         Err(code) => return code,
     };
     finish("pis-bench", run(cli))
-}
-
-fn parse_role(s: &str) -> Result<pis_scene::ObjectRole, String> {
-    match s {
-        "reflective" => Ok(pis_scene::ObjectRole::Reflective),
-        "refractive" => Ok(pis_scene::ObjectRole::Refractive),
-        _ => Err(format!("unknown role {s:?} (reflective or refractive)")),
-    }
 }

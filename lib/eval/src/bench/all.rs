@@ -19,6 +19,19 @@ pub enum Preset {
     Paper,
 }
 
+impl Preset {
+    /// Every preset, in the order the tools list them.
+    pub const ALL: [Preset; 2] = [Preset::Ci, Preset::Paper];
+
+    /// The name `pis-bench all --preset` takes.
+    pub fn name(self) -> &'static str {
+        match self {
+            Preset::Ci => "ci",
+            Preset::Paper => "paper",
+        }
+    }
+}
+
 /// Settings of one preset.
 struct Settings {
     preset: Option<&'static str>,

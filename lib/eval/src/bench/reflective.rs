@@ -214,6 +214,9 @@ fn rms_change(a: &[f32], b: &[f32], mask: &[bool]) -> f64 {
     (s / n.max(1) as f64).sqrt()
 }
 
+/// The roles whose objects can be measured (`--role`), by [`role_name`].
+pub const ROLES: [ObjectRole; 2] = [ObjectRole::Reflective, ObjectRole::Refractive];
+
 /// The name `--role` takes.
 pub fn role_name(role: ObjectRole) -> &'static str {
     match role {
