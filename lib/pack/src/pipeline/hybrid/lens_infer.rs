@@ -51,7 +51,7 @@ pub struct LensInferSettings {
     pub max_layers: usize,
     pub solve: SolveSettings,
     /// Weigh each pixel's rows by the traced confidence of its exit directions (thesis 6.3.3;
-    /// off by default: measured worse on the glass sample, docs/BENCHMARKS.md).
+    /// off by default: measured worse on the glass sample, docs/benchmarks/hybrid.md).
     pub confidence: bool,
     /// Where the cube maps' solves go (a sharded pack's store of solutions, [`Solver`]).
     pub solver: Solver,
