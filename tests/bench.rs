@@ -420,7 +420,7 @@ fn speed_stability_and_all_argument_errors() {
     }
     let out = bench(&["all", "--preset", "huge"]);
     assert_eq!(out.status.code(), Some(1));
-    assert!(String::from_utf8_lossy(&out.stderr).contains("ci or paper"));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("[possible values: ci, paper]"));
     let out = bench(&["all", "--preset", "ci", "--scene", "/no/such/scene.toml"]);
     assert_eq!(out.status.code(), Some(2));
 }
