@@ -13,9 +13,6 @@ use super::RepresentationMode;
 pub const REPRESENTATIONS: &[&dyn Representation] =
     &[&HybridRendering, &LayeredPem, &SurfaceTextures];
 
-/// The representations that store an object as environment-map shells.
-const SHELLS: &[&dyn Representation] = &[&HybridRendering, &LayeredPem];
-
 /// The representation of an object of `role` under `mode`: the first that applies
 /// (environment maps, for reflective and refractive objects, only when `mode` asks for
 /// them; the layered representation of reflective objects then makes one or two shells as
@@ -25,7 +22,7 @@ pub fn choose(role: ObjectRole, mode: RepresentationMode) -> Option<&'static dyn
     REPRESENTATIONS
         .iter()
         .copied()
-        .filter(|r| !textures_only || !SHELLS.iter().any(|s| s.name() == r.name()))
+        .filter(|r| !textures_only || !r.shells())
         .find(|r| r.applies(role))
 }
 
@@ -39,7 +36,7 @@ pub fn alternative(
     if mode != RepresentationMode::Auto {
         return None;
     }
-    SHELLS.iter().copied().find(|r| r.applies(role))
+    REPRESENTATIONS.iter().copied().filter(|r| r.shells()).find(|r| r.applies(role))
 }
 
 #[cfg(test)]
@@ -65,5 +62,17 @@ mod tests {
                 "{role:?}"
             );
         }
+    }
+
+    #[test]
+    fn auto_weighs_shells_against_textures_for_reflective_and_refractive_objects() {
+        let alt = |role, mode| alternative(role, mode).map(|r| r.name());
+        assert_eq!(
+            alt(ObjectRole::Reflective, RepresentationMode::Auto),
+            Some("layered environment maps")
+        );
+        assert_eq!(alt(ObjectRole::Refractive, RepresentationMode::Auto), Some("hybrid rendering"));
+        assert_eq!(alt(ObjectRole::Diffuse, RepresentationMode::Auto), None);
+        assert_eq!(alt(ObjectRole::Reflective, RepresentationMode::Pem), None);
     }
 }

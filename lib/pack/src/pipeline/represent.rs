@@ -26,6 +26,11 @@ pub trait Representation: Sync {
     fn name(&self) -> &'static str;
     /// Whether it can store an object of `role`.
     fn applies(&self, role: ObjectRole) -> bool;
+    /// Whether it stores an object as environment-map shells (used only where the
+    /// representation mode asks for shells, [`super::registry::choose`]).
+    fn shells(&self) -> bool {
+        false
+    }
     /// Object `o` over the set's views: `None` when nothing of it is to be stored (a note
     /// says why).
     fn survey(&self, job: &mut Job<'_>, o: usize) -> Result<Option<Box<dyn Surveyed>>>;

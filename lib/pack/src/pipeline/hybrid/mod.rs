@@ -34,6 +34,10 @@ impl Representation for HybridRendering {
         "hybrid rendering"
     }
 
+    fn shells(&self) -> bool {
+        true
+    }
+
     fn applies(&self, role: ObjectRole) -> bool {
         role == ObjectRole::Refractive
     }

@@ -51,6 +51,10 @@ impl Representation for LayeredPem {
         "layered environment maps"
     }
 
+    fn shells(&self) -> bool {
+        true
+    }
+
     fn applies(&self, role: ObjectRole) -> bool {
         role == ObjectRole::Reflective
     }
