@@ -463,35 +463,6 @@ fn layered_shells_off_the_sampled_views() {
     assert_eq!(sums.len(), 2);
 }
 
-/// The runtime's copies of pis-trace's interface functions (pis-compile does not depend on
-/// the tracer) are the same functions: bit for bit over a grid of inputs.
-#[test]
-fn the_runtimes_interface_functions_are_the_tracers() {
-    use pis_compile::hybrid::lens::offset_origin;
-    use pis_compile::hybrid::path::{fresnel_dielectric, reflect, refract};
-    use pis_trace::material as m;
-    let mut compared = 0;
-    for i in 0..=40 {
-        let cos_i = -0.1 + i as f32 * 0.0275;
-        for eta in [1.0 / 1.5, 1.0 / 1.33, 1.0, 1.33, 1.5, 2.4] {
-            assert_eq!(
-                fresnel_dielectric(cos_i, eta).to_bits(),
-                m::fresnel_dielectric(cos_i, eta).to_bits(),
-                "cos {cos_i}, eta {eta}"
-            );
-            let sin = (1.0 - cos_i * cos_i).max(0.0).sqrt();
-            let d = Vec3::new(sin, -cos_i, 0.3 * sin).normalize();
-            let n = Vec3::Y;
-            assert_eq!(reflect(d, n), m::reflect(d, n));
-            assert_eq!(refract(d, n, eta), m::refract(d, n, eta));
-            let p = d * (7.0 * cos_i) + Vec3::splat(eta);
-            assert_eq!(offset_origin(p, n, d), pis_trace::bvh::offset_origin(p, n, d));
-            compared += 1;
-        }
-    }
-    assert_eq!(compared, 41 * 6);
-}
-
 /// Copies the files (not the cache) of the sample at `rel` under samples/ into `dir`;
 /// returns the scene.toml.
 fn copy_sample(rel: &str, dir: &Path) -> std::path::PathBuf {

@@ -8,10 +8,11 @@
 //! (which consumes them).
 //!
 //! The hardware model, stage by stage (each the twin of a function in the player's WGSL,
-//! `lib/play/src/textured.wgsl`): [`transform`] (vertex shader, clipping, viewport),
-//! [`raster`] (coverage with the top-left rule, depth), [`interpolate`] (perspective-correct
-//! (s, t) and fine derivatives), [`lod`] (the Vulkan LOD), [`filter`] (sampler weights),
-//! [`model`] (the render matrix), [`mod@antialias`] (thesis 3.4.4).
+//! `lib/play/src/textured.wgsl` and the files it is composed with): [`transform`] (vertex
+//! shader, clipping, viewport), [`raster`] (coverage with the top-left rule, depth),
+//! [`interpolate`] (perspective-correct (s, t) and fine derivatives), [`lod`] (the Vulkan
+//! LOD), [`filter`] (sampler weights), [`model`] (the render matrix), [`mod@antialias`]
+//! (thesis 3.4.4).
 //!
 //! The solver (thesis 3.5): [`solve()`] (one view), [`solve_view_independent`] (eq. 3.7;
 //! [`solve_view_source`] with the views read one at a time, [`stacked`]),

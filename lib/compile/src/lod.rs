@@ -8,7 +8,7 @@
 //! ```
 //!
 //! The player's fragment shader evaluates the same formula (`texture_lod` in
-//! `textured.wgsl`) and passes λ to `textureSampleLevel`, so no implementation's
+//! `texture_lod.wgsl`) and passes λ to `textureSampleLevel`, so no implementation's
 //! approximation of ρ (the spec allows several) or per-quad LOD enters.
 
 /// λ for derivatives `ddx`, `ddy` of (s, t), a base level of `size` texels, clamped to

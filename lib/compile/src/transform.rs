@@ -2,7 +2,8 @@
 //! clip space → framebuffer, with wgpu's conventions: clip-space depth in [0, w], NDC y up,
 //! framebuffer y down with the origin at the top-left corner, pixel centres at (i + ½, j + ½).
 //!
-//! WGSL twin: `vs_main` and `texcoord` in `lib/play/src/textured.wgsl`.
+//! WGSL twin: `vs_main` in `lib/play/src/textured.wgsl` and `texcoord` in
+//! `lib/play/src/texture_transform.wgsl`.
 
 use glam::{Mat4, Vec3, Vec4};
 

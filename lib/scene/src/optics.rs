@@ -55,6 +55,18 @@ pub fn refract(d: Vec3, n: Vec3, eta: f32) -> Option<Vec3> {
     Some((d * eta + n * (eta * cos_i - cos_t)).normalize())
 }
 
+/// The origin of a ray leaving surface point `p` (geometric normal `ng`) towards `dir`: `p`
+/// moved off the surface, to the side `dir` leaves by, by 10⁻⁴ · (1 + the largest |coordinate|
+/// of `p`), so that the ray does not hit the surface it starts on.
+pub fn offset_origin(p: Vec3, ng: Vec3, dir: Vec3) -> Vec3 {
+    let eps = 1e-4 * (1.0 + p.abs().max_element());
+    if dir.dot(ng) >= 0.0 {
+        p + ng * eps
+    } else {
+        p - ng * eps
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -14,6 +14,8 @@ use obvhs::cwbvh::CwBvh;
 use obvhs::ray::{Ray, RayHit};
 use obvhs::triangle::Triangle;
 use obvhs::BvhBuildParams;
+/// The tracer's ray origin offset: one function for the tracer and the compiler.
+pub use pis_scene::optics::offset_origin;
 use pis_scene::{Frame, Material, Primitive, Scene, TextureRef};
 use std::time::Duration;
 
@@ -357,14 +359,4 @@ fn interpolated_uvs(prim: &Primitive, idx: [usize; 3], w: [f32; 3]) -> [Vec2; 2]
     };
     let uv = at(&prim.uvs).unwrap_or(Vec2::ZERO);
     [uv, at(&prim.uvs1).unwrap_or(uv)]
-}
-
-/// Origin offset for a ray leaving surface point `p` with geometric normal `ng` towards `dir`.
-pub fn offset_origin(p: Vec3, ng: Vec3, dir: Vec3) -> Vec3 {
-    let eps = 1e-4 * (1.0 + p.abs().max_element());
-    if dir.dot(ng) >= 0.0 {
-        p + ng * eps
-    } else {
-        p - ng * eps
-    }
 }

@@ -10,6 +10,8 @@ use obvhs::cwbvh::CwBvh;
 use obvhs::ray::{Ray, RayHit};
 use obvhs::triangle::Triangle;
 use obvhs::BvhBuildParams;
+/// The tracer's ray origin offset: one function for the tracer and the compiler.
+pub use pis_scene::optics::offset_origin;
 
 /// What the greedy paths need of a lens object's material (glTF transmission, IOR and
 /// volume; pis-trace's `ShadingMaterial` for the same object).
@@ -159,15 +161,4 @@ pub fn barycentric(v: [Vec3; 3], p: Vec3) -> [f32; 3] {
     let w1 = (p - a).cross(c - a).dot(n) * inv;
     let w2 = (b - a).cross(p - a).dot(n) * inv;
     [1.0 - w1 - w2, w1, w2]
-}
-
-/// pis-trace's ray origin offset: `p` moved off the surface (geometric normal `ng`) to the
-/// side `dir` leaves by.
-pub fn offset_origin(p: Vec3, ng: Vec3, dir: Vec3) -> Vec3 {
-    let eps = 1e-4 * (1.0 + p.abs().max_element());
-    if dir.dot(ng) >= 0.0 {
-        p + ng * eps
-    } else {
-        p - ng * eps
-    }
 }

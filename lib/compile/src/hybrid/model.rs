@@ -174,7 +174,7 @@ pub fn hybrid_render_matrix(
     RenderMatrix::from_taps(viewport, layout, px.pixels, &rows)
 }
 
-/// One term of a lens object as the player draws it (SPEC.md 9; `frame_hybrid.wgsl`'s
+/// One term of a lens object as the player draws it (SPEC.md 9; `frame/hybrid.wgsl`'s
 /// `hybrid_term` is its twin): at every pixel of `fg` (the pixels that draw the term, each
 /// with its interpolated F·G in `vectors[k][0]`), the term's shells looked up through their
 /// render matrices `a` (one per shell, in order, order 0 nearest; rows a subset of `fg`'s
