@@ -29,7 +29,7 @@ use pis_pack::infer::{infer, print_report, InferRequest};
 
 /// The PIS evaluation harness: speed charted against accuracy, PIS against the codecs a user
 /// would pick instead. Each chart subcommand writes CSV and SVG into --out (default
-/// reports/); `--record` adds a stamped row to docs/BENCHMARKS.md.
+/// reports/); `--record` adds a stamped row to docs/benchmarks/bench.md.
 #[derive(Parser, Debug)]
 #[command(name = "pis-bench", version, after_help = EXIT_CODES_HELP)]
 struct Cli {
@@ -145,7 +145,8 @@ enum Command {
         /// with more samples than a block) or `always` (every dimension).
         #[arg(long, value_name = "auto|always", default_value = "auto", value_parser = pis::cli::one_of(&pis_pack::Stagger::ALL, pis_pack::Stagger::name))]
         stagger: pis_pack::Stagger,
-        /// Record the run (machine, scene, command, PSNR near 384:1) in docs/BENCHMARKS.md.
+        /// Record the run (machine, scene, command, PSNR near 384:1) in
+        /// docs/benchmarks/bench.md.
         #[arg(long)]
         record: bool,
         /// Print the report as JSON on stdout.
@@ -176,7 +177,7 @@ enum Command {
         preset: Option<String>,
         #[arg(long, default_value_t = pis_pack::DEFAULT_MAX_TEXTURE)]
         max_texture: u32,
-        /// Record the run in docs/BENCHMARKS.md.
+        /// Record the run in docs/benchmarks/bench.md.
         #[arg(long)]
         record: bool,
         #[arg(long)]
@@ -214,7 +215,7 @@ enum Command {
         preset: Option<String>,
         #[arg(long, default_value_t = pis_pack::DEFAULT_MAX_TEXTURE)]
         max_texture: u32,
-        /// Record the run in docs/BENCHMARKS.md.
+        /// Record the run in docs/benchmarks/bench.md.
         #[arg(long)]
         record: bool,
         #[arg(long)]
@@ -304,7 +305,7 @@ enum Command {
         scene: Option<PathBuf>,
         #[arg(long, default_value = "reports")]
         out: PathBuf,
-        /// Record every run in docs/BENCHMARKS.md.
+        /// Record every run in docs/benchmarks/bench.md.
         #[arg(long)]
         record: bool,
     },

@@ -1,5 +1,5 @@
 //! Report files: atomic writes, CSV tables, the stamp (machine, scene, command) every figure
-//! carries, and rows recorded in docs/BENCHMARKS.md.
+//! carries, and rows recorded in docs/benchmarks/bench.md.
 
 use std::path::Path;
 

@@ -1,5 +1,5 @@
 //! The files an evaluation writes into its output folder (CSV, SVG, JSON) and the row it
-//! records in docs/BENCHMARKS.md when asked.
+//! records in docs/benchmarks/bench.md when asked.
 
 use std::path::{Path, PathBuf};
 
@@ -27,13 +27,14 @@ pub fn write_chart(
     Ok((c, s))
 }
 
-/// The docs/BENCHMARKS.md of the source tree this binary was built from.
-pub fn benchmarks_md() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../docs/BENCHMARKS.md")
+/// The benchmark notebook's page of pis-bench runs, docs/benchmarks/bench.md, in the source
+/// tree this binary was built from.
+pub fn notebook_page() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../docs/benchmarks/bench.md")
 }
 
-/// Records one run under "pis-bench runs" in docs/BENCHMARKS.md: keyed by evaluation and
-/// scene, stamped with the machine and the exact command.
+/// Records one run under "pis-bench runs" in docs/benchmarks/bench.md: keyed by evaluation
+/// and scene, stamped with the machine and the exact command.
 pub fn record(eval: &str, stamp: &Stamp, summary: &str) -> Result<()> {
     let head = "| evaluation · scene | summary | machine | command |\n|---|---|---|---|";
     let key = format!("{eval} · {}", stamp.scene);
@@ -42,5 +43,5 @@ pub fn record(eval: &str, stamp: &Stamp, summary: &str) -> Result<()> {
         stamp.machine,
         stamp.command.replace('|', "\\|")
     );
-    record_row(&benchmarks_md(), "pis-bench runs", head, &key, &row)
+    record_row(&notebook_page(), "pis-bench runs", head, &key, &row)
 }

@@ -42,7 +42,7 @@ pub struct RdRequest {
     pub max_texture: u32,
     /// Tracing a scene.toml: a `[preset.NAME]`.
     pub preset: Option<String>,
-    /// Record a row in docs/BENCHMARKS.md.
+    /// Record a row in docs/benchmarks/bench.md.
     pub record: bool,
     /// The methods to run (empty: all of [`METHODS`]).
     pub methods: Vec<String>,
