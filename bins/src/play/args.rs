@@ -17,14 +17,6 @@ fn parse_size(s: &str) -> Result<(u32, u32), String> {
     }
 }
 
-fn parse_blend(s: &str) -> Result<pis_play::Blend, String> {
-    match s {
-        "nearest" => Ok(pis_play::Blend::Nearest),
-        "multilinear" => Ok(pis_play::Blend::Multilinear),
-        _ => Err(format!("unknown blend {s:?} (nearest or multilinear)")),
-    }
-}
-
 pub fn parse_tau(s: &str) -> Result<f32, String> {
     match s.parse::<f32>() {
         Ok(t) if t.is_finite() && t >= 0.25 => Ok(t),
@@ -91,7 +83,7 @@ pub struct PlayArgs {
     pub size: Option<(u32, u32)>,
     /// Between parameter samples: `nearest` sample, or `multilinear` blend of the 2^d
     /// nearest.
-    #[arg(long, default_value = "nearest", value_parser = parse_blend)]
+    #[arg(long, default_value = "nearest", value_parser = crate::cli::one_of(&pis_play::Blend::ALL, pis_play::Blend::name))]
     pub blend: pis_play::Blend,
     /// Texture resolution reduction (power of two): 2 draws textures at half resolution.
     #[arg(long, default_value = "1", value_parser = parse_reduction)]
@@ -182,5 +174,25 @@ impl PlayArgs {
                 .and_then(set_display_filter),
             ..d
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `--blend` takes the names the player gives its blends, and refuses any other.
+    #[test]
+    fn blend_parses_by_its_name() {
+        let parse = |blend: &str| PlayArgs::try_parse_from(["pis-play", "f.pis", "--blend", blend]);
+        for blend in pis_play::Blend::ALL {
+            assert_eq!(parse(blend.name()).unwrap().blend, blend);
+        }
+        let err = parse("linear").unwrap_err().to_string();
+        assert!(err.contains("possible values"), "{err}");
+        assert_eq!(
+            PlayArgs::try_parse_from(["pis-play", "f.pis"]).unwrap().blend,
+            Default::default()
+        );
     }
 }

@@ -15,6 +15,19 @@ pub enum Blend {
     Multilinear,
 }
 
+impl Blend {
+    /// The name `--blend` takes.
+    pub fn name(self) -> &'static str {
+        match self {
+            Blend::Nearest => "nearest",
+            Blend::Multilinear => "multilinear",
+        }
+    }
+
+    /// Every blend, in the order the tools list them.
+    pub const ALL: [Blend; 2] = [Blend::Nearest, Blend::Multilinear];
+}
+
 /// Along one dimension: the samples bracketing `x` and the weight of the upper one. Values
 /// outside the sampled range clamp to the end samples.
 fn bracket(values: &[f32], x: f32) -> (u32, u32, f32) {

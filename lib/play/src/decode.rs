@@ -8,6 +8,7 @@ use std::sync::Arc;
 
 use pis_codec::{CodecError, PlaneShape};
 use pis_compile::TextureLayout;
+use pis_format::issue::id;
 use pis_format::mip::{decimate, mip_size};
 use pis_format::reconstruct::{add_stored_mips, face_len};
 use pis_format::texture::LevelLayout;
@@ -70,18 +71,21 @@ pub fn decode_level(reader: &PisReader, job: &LevelJob) -> Result<Vec<f32>, Play
             Error::NotSupported(format!("codec '{c}' (object {o}, layer {l})"))
         }
         e => Error::Invalid(
-            Issue::new(8005, format!("object {o} layer {l} block {b} level {lv}: {e}"))
-                .in_chunk("CSTR", job.stream.chunk as usize),
+            Issue::new(
+                id::codestream::PLANES_MISMATCH,
+                format!("object {o} layer {l} block {b} level {lv}: {e}"),
+            )
+            .in_chunk("CSTR", job.stream.chunk as usize),
         ),
     })?;
     let want =
         pis_codec::value_count(&job.planes).map_err(|e| PlayError::Request(e.to_string()))?;
     if values.len() != want {
-        return Err(Error::Invalid(Issue::new(8005, format!("object {o} layer {l} block {b} level {lv}: {} values decoded, the planes hold {want}", values.len()))).into());
+        return Err(Error::Invalid(Issue::new(id::codestream::PLANES_MISMATCH, format!("object {o} layer {l} block {b} level {lv}: {} values decoded, the planes hold {want}", values.len()))).into());
     }
     if let Some(bad) = values.iter().position(|v| !v.is_finite()) {
         return Err(Error::Invalid(Issue::new(
-            8006,
+            id::codestream::VALUE_NOT_FINITE,
             format!("object {o} layer {l} block {b} level {lv}: value {bad} is {}", values[bad]),
         ))
         .into());
