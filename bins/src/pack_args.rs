@@ -71,11 +71,11 @@ pub struct PackOptions {
     pub preset: Option<String>,
     /// Pyramid levels per block: `adaptive` (greedy search, thesis 4.3) or `full` (every
     /// dimension halved per level down to one sample).
-    #[arg(long, default_value = "adaptive", value_parser = parse_pyramid)]
+    #[arg(long, default_value = "adaptive", value_parser = one_of(&PyramidMode::ALL, PyramidMode::name))]
     pub pyramid: PyramidMode,
     /// Lighting layers: `separate` (view-independent diffuse + view-dependent specular) or
     /// `combined` (one view-dependent layer of diffuse + specular per parameter sample).
-    #[arg(long, default_value = "separate", value_parser = parse_layers)]
+    #[arg(long, default_value = "separate", value_parser = one_of(&LayerMode::ALL, LayerMode::name))]
     pub layers: LayerMode,
     /// Reflective and refractive objects: `auto` (per object, textures or environment-map
     /// shells, whichever does better for the whole file: both are solved and the file
@@ -99,7 +99,7 @@ pub struct PackOptions {
     /// What the storage allocation minimizes: `screen` (texture error weighted per texel by
     /// the screen pixels it reaches through the render matrices) or `texture` (texture MSE
     /// weighted by each object's screen area).
-    #[arg(long, default_value = "screen", value_parser = parse_allocation)]
+    #[arg(long, default_value = "screen", value_parser = one_of(&Allocation::ALL, Allocation::name))]
     pub allocation: Allocation,
     /// The allocation's max-MSE constraint (thesis 4.8): no object's coding MSE above ALPHA
     /// times the mean object MSE, storage taken from the objects with low MSE. `auto`: the
@@ -225,42 +225,9 @@ fn parse_memory(s: &str) -> Result<f64, String> {
         .ok_or_else(|| format!("bad memory budget {s:?}: expected a number of GB above 0"))
 }
 
-fn parse_pyramid(s: &str) -> Result<PyramidMode, String> {
-    match s {
-        "adaptive" => Ok(PyramidMode::Adaptive),
-        "full" => Ok(PyramidMode::Full),
-        _ => Err(format!("unknown pyramid {s:?} (adaptive or full)")),
-    }
-}
-
-fn parse_layers(s: &str) -> Result<LayerMode, String> {
-    match s {
-        "separate" => Ok(LayerMode::Separate),
-        "combined" => Ok(LayerMode::Combined),
-        _ => Err(format!("unknown layers {s:?} (separate or combined)")),
-    }
-}
-
-/// `--max-mse-ratio`: `auto`, `off`, or α above 1.
+/// `--max-mse-ratio`: [`MaxMse`]'s grammar (`auto`, `off`, or α above 1).
 pub fn parse_max_mse_ratio(s: &str) -> Result<MaxMse, String> {
-    match s {
-        "auto" => Ok(MaxMse::Best(pis_codec::allocate::DEFAULT_ALPHA)),
-        "off" => Ok(MaxMse::Off),
-        _ => match s.parse::<f64>() {
-            Ok(a) if a.is_finite() && a > 1.0 => Ok(MaxMse::On(a)),
-            _ => {
-                Err(format!("{s:?} is not `auto`, `off` or a ratio above 1 (the thesis uses 1.25)"))
-            }
-        },
-    }
-}
-
-fn parse_allocation(s: &str) -> Result<Allocation, String> {
-    match s {
-        "screen" => Ok(Allocation::Screen),
-        "texture" => Ok(Allocation::Texture),
-        _ => Err(format!("unknown allocation {s:?} (screen or texture)")),
-    }
+    s.parse()
 }
 
 /// The values of `--filter`, by [`Filter::name`] (the anisotropy clamp comes from
@@ -334,7 +301,22 @@ mod tests {
         for codec in CodecId::ALL {
             assert_eq!(PackOptions::try_parse(&["--codec", codec.name()]).unwrap().codec, codec);
         }
-        for (flag, value) in [("--representation", "static"), ("--codec", "jpeg")] {
+        for mode in PyramidMode::ALL {
+            assert_eq!(PackOptions::try_parse(&["--pyramid", mode.name()]).unwrap().pyramid, mode);
+        }
+        for mode in LayerMode::ALL {
+            assert_eq!(PackOptions::try_parse(&["--layers", mode.name()]).unwrap().layers, mode);
+        }
+        for a in Allocation::ALL {
+            assert_eq!(PackOptions::try_parse(&["--allocation", a.name()]).unwrap().allocation, a);
+        }
+        for (flag, value) in [
+            ("--representation", "static"),
+            ("--codec", "jpeg"),
+            ("--pyramid", "dyadic"),
+            ("--layers", "split"),
+            ("--allocation", "pixel"),
+        ] {
             let err = PackOptions::try_parse(&[flag, value]).unwrap_err().to_string();
             assert!(err.contains("possible values"), "{err}");
         }

@@ -72,12 +72,13 @@ fn parse_block(s: &str) -> Result<BlockSizes, String> {
 }
 
 fn run(cli: Cli) -> Result<Exit, Failure> {
+    let target = pis_pack::Target::given(cli.ratio, cli.psnr)
+        .map_err(|e| Failure::new(Exit::Usage, anyhow::anyhow!(e)))?;
     let req = ReencodeRequest {
         input: cli.input,
         output: cli.output,
         codec: cli.codec,
-        ratio: cli.ratio,
-        psnr: cli.psnr,
+        target,
         gamma: cli.gamma,
         keep_master: cli.keep_master,
         block: cli.block.map(|b| b.0),

@@ -23,7 +23,7 @@ use std::time::Instant;
 
 use crate::metrics::SquaredError;
 use anyhow::anyhow;
-use pis_codec::allocate::Target;
+use pis_codec::allocate;
 use pis_codec::CodecId;
 use pis_format::reconstruct::{finish, prepare};
 use pis_format::*;
@@ -34,7 +34,7 @@ pub use screen_area::screen_areas;
 
 use pis_pack::blocks::{block_sizes, stagger};
 use pis_pack::storage::{allocate_storage, build_pyramid, encode_levels, nudge, BlockPyramid};
-use pis_pack::{Exit, Failure, MaxMse};
+use pis_pack::{Exit, Failure, MaxMse, Target};
 
 /// What to re-encode.
 #[derive(Clone, Debug)]
@@ -42,10 +42,10 @@ pub struct ReencodeRequest {
     pub input: PathBuf,
     pub output: PathBuf,
     pub codec: CodecId,
-    /// Target compression ratio: level-image bytes = raw image bytes / ratio.
-    pub ratio: Option<f64>,
-    /// Target PSNR (dB) of the stored textures instead of a ratio.
-    pub psnr: Option<f64>,
+    /// What the lossy codecs aim at, as pis-pack's `--ratio` or `--psnr` give it
+    /// ([`Target::given`]): a compression ratio (level-image bytes = raw image bytes /
+    /// ratio) or a PSNR (dB) of the stored textures. None: the input's level-image bytes.
+    pub target: Option<Target>,
     /// Gamma of the compensation (lossy codecs; default [`DEFAULT_GAMMA`]).
     pub gamma: Option<f32>,
     /// Write the lossless master into the output: the input's, or one made from the decoded
@@ -61,22 +61,13 @@ pub struct ReencodeRequest {
 }
 
 /// The max-MSE constraint the input's writer applied, from its provenance setting
-/// `max_mse_ratio` (`off` or α); α = 1.25 where none is recorded.
+/// `max_mse_ratio` (`off` or α, as [`MaxMse`] parses it); α = 1.25 where none is recorded.
 fn writer_max_mse<S>(c: &pis_format::Container<S>) -> MaxMse {
-    let recorded = c
-        .provenance
+    c.provenance
         .as_ref()
         .and_then(|p| p.settings.iter().rev().find(|(k, _)| k == "max_mse_ratio"))
-        .map(|(_, v)| v.as_str());
-    match recorded {
-        Some("off") => MaxMse::Off,
-        Some(v) => v
-            .parse::<f64>()
-            .ok()
-            .filter(|a| a.is_finite() && *a > 1.0)
-            .map_or(MaxMse::On(pis_codec::allocate::DEFAULT_ALPHA), MaxMse::On),
-        None => MaxMse::On(pis_codec::allocate::DEFAULT_ALPHA),
-    }
+        .and_then(|(_, v)| v.parse::<MaxMse>().ok())
+        .unwrap_or(MaxMse::On(pis_codec::allocate::DEFAULT_ALPHA))
 }
 
 /// The gamma lossy re-encodings use unless told otherwise (as `pis-pack`).
@@ -168,18 +159,8 @@ fn usage(msg: String) -> Failure {
 
 /// Checks the request before anything is read.
 fn check(req: &ReencodeRequest) -> Result<(), Failure> {
-    if req.ratio.is_some() && req.psnr.is_some() {
-        return Err(usage("give --ratio or --psnr, not both".into()));
-    }
-    if let Some(r) = req.ratio {
-        if !(r.is_finite() && r >= 1.0) {
-            return Err(usage(format!("--ratio must be at least 1, got {r}")));
-        }
-    }
-    if let Some(p) = req.psnr {
-        if !(p.is_finite() && p > 0.0) {
-            return Err(usage(format!("--psnr must be a positive number of dB, got {p}")));
-        }
+    if let Some(t) = req.target {
+        t.check().map_err(usage)?;
     }
     if let Some(g) = req.gamma {
         if !(g.is_finite() && g > 0.0) {
@@ -187,7 +168,7 @@ fn check(req: &ReencodeRequest) -> Result<(), Failure> {
         }
     }
     if !req.codec.is_lossy() {
-        if req.ratio.is_some() || req.psnr.is_some() {
+        if req.target.is_some() {
             return Err(usage(format!(
                 "--ratio and --psnr apply to the lossy codecs; {} stores textures exactly",
                 req.codec
@@ -381,14 +362,18 @@ fn build_pyramids(
 }
 
 /// The allocation's target, and how the provenance records it.
-fn target(req: &ReencodeRequest, raw: u64, texture_bytes_before: u64) -> (Target, String) {
+fn target(
+    req: &ReencodeRequest,
+    raw: u64,
+    texture_bytes_before: u64,
+) -> (allocate::Target, String) {
     let exact = !req.codec.is_lossy();
-    match (req.psnr, req.ratio) {
-        _ if exact => (Target::Bytes(usize::MAX), "exact".to_string()),
-        (Some(db), _) => (Target::Psnr { db, peak: 1.0 }, format!("psnr {db} dB")),
-        (None, Some(r)) => (Target::Bytes((raw as f64 / r) as usize), format!("ratio {r}")),
-        (None, None) => {
-            (Target::Bytes(texture_bytes_before as usize), format!("bytes {texture_bytes_before}"))
+    match req.target {
+        _ if exact => (allocate::Target::Bytes(usize::MAX), "exact".to_string()),
+        Some(t) => (t.allocation(raw), t.describe()),
+        None => {
+            let bytes = allocate::Target::Bytes(texture_bytes_before as usize);
+            (bytes, format!("bytes {texture_bytes_before}"))
         }
     }
 }
@@ -552,10 +537,9 @@ pub fn reencode(req: &ReencodeRequest) -> Result<ReencodeReport, Failure> {
     let areas = allocation_areas(c, &masters_in, need_areas, &mut t);
     // The constraint as asked, else as the writer applied it (a best-of choice needs the
     // traced set, which a re-encoding does not have).
-    let max_mse = match req.max_mse {
-        Some(MaxMse::Best(a)) => MaxMse::On(a),
-        Some(m) => m,
-        None => writer_max_mse(c),
+    let max_mse = match req.max_mse.unwrap_or_else(|| writer_max_mse(c)) {
+        MaxMse::Best(a) => MaxMse::On(a),
+        m => m,
     };
     let storage = allocate_storage(
         &pyramids,

@@ -207,14 +207,7 @@ fn begin(
     req: &PackRequest,
     stages: &mut Stages,
 ) -> Result<(input::LoadedSet, plan::Plan, matrices::Matrices), Failure> {
-    if let Some(r) = req.target.ratio() {
-        if !(r.is_finite() && r >= 1.0) {
-            return Err(Failure::new(
-                Exit::Usage,
-                anyhow::anyhow!("--ratio must be at least 1, got {r}"),
-            ));
-        }
-    }
+    req.target.check().map_err(|e| Failure::new(Exit::Usage, anyhow::anyhow!(e)))?;
     if let Some(why) = filter_needs_probe(req.filter, req.matrix) {
         return Err(Failure::new(Exit::Usage, anyhow::anyhow!(why)));
     }

@@ -132,10 +132,7 @@ pub fn provenance<S>(
         ("source_codec".to_string(), codecs_before.join("+")),
     ]);
     if !exact {
-        settings.push((
-            "max_mse_ratio".to_string(),
-            max_mse.alpha().map_or_else(|| "off".to_string(), |a| a.to_string()),
-        ));
+        settings.push(("max_mse_ratio".to_string(), max_mse.name()));
     }
     Provenance {
         tool: format!("pis-reencode {}", env!("CARGO_PKG_VERSION")),

@@ -23,7 +23,7 @@ use super::shading::object_shading;
 use super::storage::{allocate_storage, build_pyramid, level_streams, BlockPyramid};
 use super::stored_mesh::stored_mesh;
 pub use super::surface::{finest, mip_chain};
-use super::{PackRequest, Stages};
+use super::{MaxMse, PackRequest, Stages};
 use crate::error::{Exit, Failure};
 
 /// The screen weight of every level-0 texel of a texture placed by `placement` at one
@@ -277,13 +277,13 @@ fn provenance_settings(
     ];
     settings.splice(2..2, file_filter(req.filter).settings());
     if req.pyramid != super::PyramidMode::Adaptive {
-        settings.push(("pyramid".to_string(), "full".to_string()));
+        settings.push(("pyramid".to_string(), req.pyramid.name().to_string()));
     }
     if req.layers != super::LayerMode::Separate {
-        settings.push(("layers".to_string(), "combined".to_string()));
+        settings.push(("layers".to_string(), req.layers.name().to_string()));
     }
     if req.allocation != super::Allocation::Screen {
-        settings.push(("allocation".to_string(), "texture".to_string()));
+        settings.push(("allocation".to_string(), req.allocation.name().to_string()));
     }
     if req.stagger != super::Stagger::Auto {
         settings.push(("stagger".to_string(), req.stagger.name().to_string()));
@@ -394,7 +394,7 @@ pub fn encode_all(
         let mut packed = emit(packed, &built, &at, models, req.codec, &storage.rates)?;
         drop(built);
         if req.codec.is_lossy() {
-            record_max_mse(&mut packed, req.max_mse.alpha());
+            record_max_mse(&mut packed, req.max_mse.alpha().map_or(MaxMse::Off, MaxMse::On));
         }
         stages.done("encode", &format!("{level_images} level images with {}", req.codec));
         return Ok(packed);
@@ -440,17 +440,15 @@ fn constrained_or_free(
         psnr_db_constrained: db_with,
         psnr_db_free: db_without,
     });
-    record_max_mse(&mut packed, keep.then_some(alpha));
+    record_max_mse(&mut packed, if keep { MaxMse::On(alpha) } else { MaxMse::Off });
     Ok(packed)
 }
 
-/// Provenance: the max-MSE constraint the allocation applied (`off`, or its α).
-fn record_max_mse(packed: &mut Packed, alpha: Option<f64>) {
+/// Provenance: the max-MSE constraint the allocation applied (`off`, or its α), by its
+/// [`MaxMse::name`].
+fn record_max_mse(packed: &mut Packed, applied: MaxMse) {
     if let Some(p) = packed.container.provenance.as_mut() {
-        p.settings.push((
-            "max_mse_ratio".to_string(),
-            alpha.map_or_else(|| "off".to_string(), |a| a.to_string()),
-        ));
+        p.settings.push(("max_mse_ratio".to_string(), applied.name()));
     }
 }
 

@@ -40,13 +40,13 @@ impl Plan {
             space,
             cameras,
             stagger: settings.stagger,
-            target: allocation_target(settings.target, set.raw_image_bytes()),
+            target: settings.target.allocation(set.raw_image_bytes()),
         })
     }
 
     /// The same layout aiming at `target` (a sweep over the targets of one inference).
     pub fn aiming_at(&self, target: Target, raw_image_bytes: u64) -> Plan {
-        Plan { target: allocation_target(target, raw_image_bytes), ..self.clone() }
+        Plan { target: target.allocation(raw_image_bytes), ..self.clone() }
     }
 
     /// Block origin offsets of object model `i` of `n` ([`stagger`]).
@@ -60,13 +60,5 @@ impl Plan {
             allocate::Target::Bytes(b) => Some(b as u64),
             allocate::Target::Psnr { .. } => None,
         }
-    }
-}
-
-/// The allocation's aim for `target` over raw images of `raw` bytes.
-fn allocation_target(target: Target, raw: u64) -> allocate::Target {
-    match target {
-        Target::Psnr(db) => allocate::Target::Psnr { db, peak: 1.0 },
-        Target::Ratio(r) => allocate::Target::Bytes((raw as f64 / r) as usize),
     }
 }

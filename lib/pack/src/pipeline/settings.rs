@@ -49,13 +49,43 @@ impl Target {
     /// pis-pack's default: [`DEFAULT_RATIO`].
     pub const DEFAULT: Target = Target::Ratio(DEFAULT_RATIO);
 
-    /// `--ratio` or `--psnr` as given: neither is the default ratio, both an error.
+    /// `--ratio` or `--psnr` as given: neither is the default ratio, both an error, and the
+    /// one given must [`Target::check`].
     pub fn from_flags(ratio: Option<f64>, psnr: Option<f64>) -> Result<Target, String> {
-        match (ratio, psnr) {
-            (Some(_), Some(_)) => Err("give --ratio or --psnr, not both".to_string()),
-            (Some(r), None) => Ok(Target::Ratio(r)),
-            (None, Some(db)) => Ok(Target::Psnr(db)),
-            (None, None) => Ok(Target::DEFAULT),
+        Ok(Target::given(ratio, psnr)?.unwrap_or(Target::DEFAULT))
+    }
+
+    /// `--ratio` or `--psnr` as given, checked ([`Target::check`]): `None` where neither
+    /// is (each tool has its own default), an error where both are.
+    pub fn given(ratio: Option<f64>, psnr: Option<f64>) -> Result<Option<Target>, String> {
+        let target = match (ratio, psnr) {
+            (Some(_), Some(_)) => return Err("give --ratio or --psnr, not both".to_string()),
+            (Some(r), None) => Target::Ratio(r),
+            (None, Some(db)) => Target::Psnr(db),
+            (None, None) => return Ok(None),
+        };
+        target.check().map(|()| Some(target))
+    }
+
+    /// A ratio of at least 1, or a positive number of dB; both finite.
+    pub fn check(self) -> Result<(), String> {
+        match self {
+            Target::Ratio(r) if !(r.is_finite() && r >= 1.0) => {
+                Err(format!("--ratio must be at least 1, got {r}"))
+            }
+            Target::Psnr(db) if !(db.is_finite() && db > 0.0) => {
+                Err(format!("--psnr must be a positive number of dB, got {db}"))
+            }
+            _ => Ok(()),
+        }
+    }
+
+    /// The storage allocation's aim over raw images of `raw` bytes: a ratio as the byte
+    /// budget of level images (raw / ratio), a PSNR of the coded textures at peak 1.
+    pub fn allocation(self, raw: u64) -> pis_codec::allocate::Target {
+        match self {
+            Target::Psnr(db) => pis_codec::allocate::Target::Psnr { db, peak: 1.0 },
+            Target::Ratio(r) => pis_codec::allocate::Target::Bytes((raw as f64 / r) as usize),
         }
     }
 
@@ -260,6 +290,19 @@ pub enum PyramidMode {
     Full,
 }
 
+impl PyramidMode {
+    /// The name `--pyramid` and the provenance use.
+    pub fn name(self) -> &'static str {
+        match self {
+            PyramidMode::Adaptive => "adaptive",
+            PyramidMode::Full => "full",
+        }
+    }
+
+    /// Every mode, in the order the tools list them.
+    pub const ALL: [PyramidMode; 2] = [PyramidMode::Adaptive, PyramidMode::Full];
+}
+
 /// The storage allocation's max-MSE constraint (thesis 4.8): no object's coding MSE above
 /// α times the mean object MSE, storage taken from the objects with low MSE.
 ///
@@ -289,12 +332,39 @@ impl MaxMse {
         }
     }
 
-    /// Its name in provenance and reports: `off`, `1.25`, `best of 1.25 and off`.
+    /// Its name in provenance and reports ([`std::fmt::Display`]): `off`, `1.25`, `best of
+    /// 1.25 and off`. A file's provenance records the constraint its allocation applied
+    /// (`max_mse_ratio`: `off` or α), which [`str::parse`] reads back.
     pub fn name(self) -> String {
+        self.to_string()
+    }
+}
+
+impl std::fmt::Display for MaxMse {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match self {
-            MaxMse::Off => "off".to_string(),
-            MaxMse::On(a) => a.to_string(),
-            MaxMse::Best(a) => format!("best of {a} and off"),
+            MaxMse::Off => f.write_str("off"),
+            MaxMse::On(a) => write!(f, "{a}"),
+            MaxMse::Best(a) => write!(f, "best of {a} and off"),
+        }
+    }
+}
+
+/// `--max-mse-ratio`'s grammar, also the provenance's `max_mse_ratio`: `auto` (the best of
+/// the constraint at the thesis's α and none), `off`, or α above 1.
+impl std::str::FromStr for MaxMse {
+    type Err = String;
+
+    fn from_str(s: &str) -> Result<MaxMse, String> {
+        match s {
+            "auto" => Ok(MaxMse::Best(pis_codec::allocate::DEFAULT_ALPHA)),
+            "off" => Ok(MaxMse::Off),
+            _ => match s.parse::<f64>() {
+                Ok(a) if a.is_finite() && a > 1.0 => Ok(MaxMse::On(a)),
+                _ => Err(format!(
+                    "{s:?} is not `auto`, `off` or a ratio above 1 (the thesis uses 1.25)"
+                )),
+            },
         }
     }
 }
@@ -310,6 +380,19 @@ pub enum Allocation {
     Screen,
     /// Texture MSE weighted by each object's screen area (every texel of an object alike).
     Texture,
+}
+
+impl Allocation {
+    /// The name `--allocation` and the provenance use.
+    pub fn name(self) -> &'static str {
+        match self {
+            Allocation::Screen => "screen",
+            Allocation::Texture => "texture",
+        }
+    }
+
+    /// Every choice, in the order the tools list them.
+    pub const ALL: [Allocation; 2] = [Allocation::Screen, Allocation::Texture];
 }
 
 /// Which views a texture placement (thesis 3.2) is optimized over.
@@ -411,6 +494,19 @@ pub enum LayerMode {
     Combined,
 }
 
+impl LayerMode {
+    /// The name `--layers` and the provenance use.
+    pub fn name(self) -> &'static str {
+        match self {
+            LayerMode::Separate => "separate",
+            LayerMode::Combined => "combined",
+        }
+    }
+
+    /// Every mode, in the order the tools list them.
+    pub const ALL: [LayerMode; 2] = [LayerMode::Separate, LayerMode::Combined];
+}
+
 /// The provenance setting holding the predicted PSNR (dB, display values over the pixels the
 /// objects cover) of a packed file.
 pub const PREDICTED_PSNR_SETTING: &str = "predicted_psnr_db";
@@ -430,3 +526,61 @@ pub const DEFAULT_GAMMA: f32 = pis_codec::gamma::DEFAULT_GAMMA;
 
 /// The default compression ratio when neither `--ratio` nor `--psnr` is given.
 pub const DEFAULT_RATIO: f64 = 384.0;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `--ratio` and `--psnr`: one or neither, in range; every tool checks them here.
+    #[test]
+    fn a_target_is_one_flag_in_range() {
+        assert_eq!(Target::given(None, None), Ok(None));
+        assert_eq!(Target::from_flags(None, None), Ok(Target::DEFAULT));
+        assert_eq!(Target::from_flags(Some(96.0), None), Ok(Target::Ratio(96.0)));
+        assert_eq!(Target::given(None, Some(40.0)), Ok(Some(Target::Psnr(40.0))));
+        assert_eq!(
+            Target::given(Some(96.0), Some(40.0)),
+            Err("give --ratio or --psnr, not both".to_string())
+        );
+        assert_eq!(
+            Target::from_flags(Some(0.5), None),
+            Err("--ratio must be at least 1, got 0.5".to_string())
+        );
+        assert_eq!(
+            Target::given(None, Some(f64::NAN)),
+            Err("--psnr must be a positive number of dB, got NaN".to_string())
+        );
+        assert!(Target::Psnr(0.0).check().is_err() && Target::Ratio(1.0).check().is_ok());
+    }
+
+    /// `--max-mse-ratio` reads what a file's provenance records of the constraint applied,
+    /// and refuses what is neither a name nor an α above 1.
+    #[test]
+    fn max_mse_parses_its_provenance_names() {
+        for m in [MaxMse::Off, MaxMse::On(1.25), MaxMse::On(2.0)] {
+            assert_eq!(m.name().parse::<MaxMse>(), Ok(m));
+        }
+        assert_eq!("auto".parse::<MaxMse>(), Ok(PackSettings::new().max_mse));
+        assert_eq!(MaxMse::Best(1.25).name(), "best of 1.25 and off");
+        for bad in ["1", "0.5", "inf", "on", ""] {
+            assert!(bad.parse::<MaxMse>().is_err(), "{bad:?}");
+        }
+    }
+
+    /// Each mode's name is its own, and the default is listed first.
+    #[test]
+    fn mode_names_are_distinct_and_the_default_first() {
+        fn check<T: Copy + Default + PartialEq + std::fmt::Debug>(
+            all: &[T],
+            name: fn(T) -> &'static str,
+        ) {
+            assert_eq!(all[0], T::default());
+            let names: std::collections::BTreeSet<_> = all.iter().map(|&m| name(m)).collect();
+            assert_eq!(names.len(), all.len(), "{all:?}");
+        }
+        check(&PyramidMode::ALL, PyramidMode::name);
+        check(&LayerMode::ALL, LayerMode::name);
+        check(&Allocation::ALL, Allocation::name);
+        check(&Stagger::ALL, Stagger::name);
+    }
+}
