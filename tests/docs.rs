@@ -502,6 +502,16 @@ fn benchmark_links_resolve_to_files_and_headings() {
 
 /// A PSNR cell of a `pis-bench rd` report's row: the PSNR, pis-pack's prediction in
 /// parentheses, the achieved ratio and the CRF where the report gives them.
+/// `x` to `digits` decimals, without the trailing zeros (96.04 → "96", 98.17 → "98.2" at one).
+fn rounded(x: f64, digits: usize) -> String {
+    let s = format!("{x:.digits$}");
+    if s.contains('.') {
+        s.trim_end_matches('0').trim_end_matches('.').to_string()
+    } else {
+        s
+    }
+}
+
 fn rd_cell(row: &serde_json::Value) -> String {
     let num = |k: &str| row.get(k).and_then(serde_json::Value::as_f64);
     let mut cell = format!("{:.2}", num("psnr_db").expect("psnr_db"));
@@ -509,10 +519,10 @@ fn rd_cell(row: &serde_json::Value) -> String {
         cell += &format!(" ({p:.2})");
     }
     if let Some(r) = num("ratio") {
-        cell += &format!(" at {r}:1");
+        cell += &format!(" at {}:1", rounded(r, 1));
     }
     if let Some(c) = num("crf") {
-        cell += &format!(", CRF {c}");
+        cell += &format!(", CRF {}", rounded(c, 2));
     }
     if row.get("reached").and_then(serde_json::Value::as_bool) == Some(false) {
         cell += ", budget not reached";
