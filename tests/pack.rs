@@ -503,6 +503,67 @@ fn scaled_and_mirrored_nodes_pack_into_a_valid_file() {
     assert!(names.contains(&"SilverCup") && names.contains(&"Columns"), "{names:?}");
 }
 
+/// A node scaled by 10⁻⁴ over a mesh in tenths of a millimetre (an exporter's unit scale)
+/// once failed with "its transform at the first point is singular or not finite" (exit 5):
+/// its determinant, 10⁻¹², was under the absolute threshold. The same cup in those units
+/// packs, and solves as well as in metres.
+#[test]
+fn a_node_scaled_1e_4_packs_as_its_unit_scaled_twin() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let pack = |name: &str, scene: &Path| {
+        let file = dir.path().join(format!("{name}.pis"));
+        let out = Command::new(env!("CARGO_BIN_EXE_pis-pack"))
+            .arg(scene)
+            .arg("-o")
+            .arg(&file)
+            .args(["--resolution", "48x36", "--spp", "1", "--ratio", "24", "--json"])
+            .output()
+            .expect("pis-pack runs");
+        let r = json(&out);
+        validate(&file);
+        let cup = r["objects"].as_array().unwrap().iter().find(|o| o["name"] == "SilverCup");
+        cup.expect("the cup is stored")["psnr_db_solved"].as_f64().expect("a figure")
+    };
+    let metres = pack("metres", &common::sample_copy("glass", &dir.path().join("m"), |_, _| {}));
+    let scaled = common::sample_copy("glass", &dir.path().join("s"), |doc, folder| {
+        scale_positions(doc, &folder.join("glass.bin"), "SilverCup", 1e4);
+        common::set_node(doc, "SilverCup", "scale", serde_json::json!([1e-4, 1e-4, 1e-4]));
+    });
+    let tiny = pack("scaled", &scaled);
+    assert!((tiny - metres).abs() < 0.5, "scaled 1e-4: {tiny:.2} dB, in metres: {metres:.2} dB");
+}
+
+/// Multiplies the POSITION accessor of `mesh`'s primitives (tightly packed `f32` VEC3, as
+/// the samples write them) and its bounds by `k`.
+fn scale_positions(doc: &mut serde_json::Value, bin: &Path, mesh: &str, k: f32) {
+    let mut bytes = std::fs::read(bin).expect("the buffer");
+    let m = doc["meshes"].as_array().unwrap().iter().find(|m| m["name"] == mesh).unwrap();
+    let accessors: Vec<usize> = m["primitives"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|p| p["attributes"]["POSITION"].as_u64().unwrap() as usize)
+        .collect();
+    for a in accessors {
+        let acc = &doc["accessors"][a];
+        let view = &doc["bufferViews"][acc["bufferView"].as_u64().unwrap() as usize];
+        let start = view["byteOffset"].as_u64().unwrap_or(0) as usize
+            + acc["byteOffset"].as_u64().unwrap_or(0) as usize;
+        let count = acc["count"].as_u64().unwrap() as usize;
+        let acc = &mut doc["accessors"][a];
+        for v in bytes[start..start + count * 12].chunks_exact_mut(4) {
+            let x = f32::from_le_bytes(v.try_into().unwrap()) * k;
+            v.copy_from_slice(&x.to_le_bytes());
+        }
+        for bound in ["min", "max"] {
+            for c in acc[bound].as_array_mut().unwrap() {
+                *c = serde_json::json!(c.as_f64().unwrap() * k as f64);
+            }
+        }
+    }
+    std::fs::write(bin, bytes).expect("write the buffer");
+}
+
 /// A scale that changes over the parameter space cannot be baked into one mesh: refused
 /// before any work (the trace of a scene.toml included), naming the object, with no output.
 #[test]
