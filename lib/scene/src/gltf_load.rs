@@ -360,6 +360,10 @@ fn import_error(path: &Path, e: gltf::Error) -> SceneError {
     }
 }
 
+/// The largest |coordinate| of a vertex position: 10¹⁸, so that a squared distance or a dot
+/// product of positions stays well inside `f32` (whose largest value is 3.4 · 10³⁸).
+pub const MAX_COORDINATE: f32 = 1e18;
+
 fn node_name(node: &gltf::Node) -> String {
     node.name().map(str::to_owned).unwrap_or_else(|| format!("node{}", node.index()))
 }
@@ -382,6 +386,27 @@ impl Ctx<'_> {
     ) -> Result<(), SceneError> {
         match values.iter().position(|v| v.iter().any(|x| !x.is_finite())) {
             Some(i) => Err(self.non_finite(field(), i)),
+            None => Ok(()),
+        }
+    }
+
+    /// Positions within ±[`MAX_COORDINATE`].
+    fn check_in_range(
+        &self,
+        positions: &[[f32; 3]],
+        field: impl Fn() -> String,
+    ) -> Result<(), SceneError> {
+        let out = |p: &[f32; 3]| p.iter().any(|x| x.abs() > MAX_COORDINATE);
+        match positions.iter().position(out) {
+            Some(i) => Err(SceneError::invalid(
+                &self.path,
+                field(),
+                format!(
+                    "element {i}: {:?} lies beyond ±{MAX_COORDINATE:e}, where squared distances \
+                     no longer fit a 32-bit float",
+                    positions[i]
+                ),
+            )),
             None => Ok(()),
         }
     }
@@ -439,6 +464,7 @@ impl Ctx<'_> {
             })?
             .collect();
         self.check_finite(&positions, || format!("{field}.attributes.POSITION"))?;
+        self.check_in_range(&positions, || format!("{field}.attributes.POSITION"))?;
         let n = positions.len();
         let normals: Option<Vec<[f32; 3]>> = reader.read_normals().map(|r| r.collect());
         if let Some(ns) = &normals {

@@ -499,6 +499,18 @@ fn error_nan_in_buffer() {
     assert!(err.to_string().contains("meshes[0].primitives[0].attributes.POSITION"), "{err}");
 }
 
+/// A position of 3 · 10³⁸ once traced and failed only at pack: refused at load, naming
+/// the accessor and the element.
+#[test]
+fn error_position_out_of_range() {
+    let f = Fixture::new(TOML, |_, bin| bin[12..16].copy_from_slice(&3e38f32.to_le_bytes()));
+    let err = load_err(&f);
+    let text = err.to_string();
+    assert!(matches!(err, SceneError::Invalid { .. }), "{err}");
+    assert!(text.contains("meshes[0].primitives[0].attributes.POSITION"), "{err}");
+    assert!(text.contains("element 1"), "{err}");
+}
+
 #[test]
 fn error_inf_in_animation() {
     let f = Fixture::new(TOML, |_, bin| bin[52..56].copy_from_slice(&f32::INFINITY.to_le_bytes()));
