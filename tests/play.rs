@@ -33,7 +33,7 @@ fn play_env(args: &[&std::ffi::OsStr], env: &[(&str, Option<&str>)]) -> Output {
 fn gpu_or_skip(test: &str) -> bool {
     let out = play(&[os(&tiny()), os("--headless")]);
     let err = String::from_utf8_lossy(&out.stderr);
-    if out.status.code() == Some(4) && err.contains("no GPU adapter") {
+    if out.status.code() == Some(5) && err.contains("no GPU adapter") {
         assert!(!in_ci(), "{test}: {err}");
         eprintln!("{test}: skipped: {err}");
         return false;
@@ -333,6 +333,17 @@ fn damaged_files_fail_with_a_clear_error() {
     let bad = dir.path().join("meta.pis");
     std::fs::write(&bad, &meta).expect("write");
     assert_fails(&play(&[os(&bad), os("--headless")]), 3, "flipped metadata", "PSPC");
+}
+
+/// A frame larger than the adapter can render into once exited 4 (a runtime error); what
+/// this machine cannot do is 5 (not supported), as docs/TOOLS.md's exit-code table says.
+#[test]
+fn a_frame_beyond_the_adapters_limit_is_not_supported() {
+    if !gpu_or_skip("a_frame_beyond_the_adapters_limit_is_not_supported") {
+        return;
+    }
+    let out = play(&[os(&tiny()), os("--headless"), os("--size"), os("1048576x8")]);
+    assert_fails(&out, 5, "a 1048576-pixel-wide frame", "exceeds the adapter's limit");
 }
 
 #[test]

@@ -58,7 +58,7 @@ fn window_or_skip(test: &str) -> bool {
     let tiny = Path::new(env!("CARGO_MANIFEST_DIR")).join("../samples/tiny.pis");
     let out = headless(&[os(&tiny)]);
     let err = String::from_utf8_lossy(&out.stderr);
-    if out.status.code() == Some(4) && err.contains("no GPU adapter") {
+    if out.status.code() == Some(5) && err.contains("no GPU adapter") {
         assert!(!in_ci(), "{test}: {err}");
         eprintln!("{test}: skipped: {err}");
         return false;

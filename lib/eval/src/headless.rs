@@ -64,16 +64,25 @@ pub fn set_display_filter(dir: &std::path::Path) -> Option<pis_format::DisplayFi
     pis_format::DisplayFilter::new(f.sigma_px, f.radius_px).ok()
 }
 
-/// The exit code of a player error.
-pub fn play_failure(e: PlayError) -> Failure {
+/// The exit code of a player error, the one table every tool that plays uses: a request
+/// that does not fit the file is a usage error, a file the player cannot draw is invalid,
+/// what this machine cannot do (no adapter, a texture or render target beyond its limits)
+/// is not supported, and the rest is a runtime error.
+pub fn play_exit(e: &PlayError) -> Exit {
     match e {
-        PlayError::File(f) => f.into(),
-        e @ PlayError::Request(_) => Failure::new(Exit::Usage, e),
-        e @ PlayError::Content { .. } => Failure::new(Exit::Invalid, e),
-        e @ PlayError::RepeatSize { .. } => Failure::new(Exit::Invalid, e),
-        e @ PlayError::TextureSize { .. } => Failure::new(Exit::NotSupported, e),
-        e => Failure::new(Exit::Runtime, e),
+        PlayError::File(f) => pis_pack::format_exit(f),
+        PlayError::Request(_) => Exit::Usage,
+        PlayError::Content { .. } | PlayError::RepeatSize { .. } => Exit::Invalid,
+        PlayError::NoAdapter(_) | PlayError::TextureSize { .. } | PlayError::TargetSize { .. } => {
+            Exit::NotSupported
+        }
+        _ => Exit::Runtime,
     }
+}
+
+/// A player error as a failure with its exit code ([`play_exit`]).
+pub fn play_failure(e: PlayError) -> Failure {
+    Failure::new(play_exit(&e), e)
 }
 
 /// Timings of a run of frames.

@@ -131,11 +131,7 @@ fn finite(v: f64) -> Option<f64> {
 /// supported", file errors keep theirs, a set that cannot be read is an I/O error.
 fn failure(e: anyhow::Error) -> Failure {
     let exit = if let Some(p) = e.downcast_ref::<PlayError>() {
-        match p {
-            PlayError::NoAdapter(_) | PlayError::TextureSize { .. } => Exit::NotSupported,
-            PlayError::File(f) => pis_pack::format_exit(f),
-            _ => Exit::Runtime,
-        }
+        crate::headless::play_exit(p)
     } else {
         pis_pack::exit_of(&e, Exit::Runtime)
     };
