@@ -37,10 +37,11 @@ pub const TARGET_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
 pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
 
 /// The WGSL source: the texture math shared with the player's frame (`texture_lod.wgsl`,
-/// `texture_transform.wgsl`), then `textured.wgsl`.
+/// `texture_transform.wgsl`, `texture_sample.wgsl`), then `textured.wgsl`.
 pub const SHADER: &str = concat!(
     include_str!("texture_lod.wgsl"),
     include_str!("texture_transform.wgsl"),
+    include_str!("texture_sample.wgsl"),
     include_str!("textured.wgsl")
 );
 
@@ -54,7 +55,7 @@ struct Uniforms {
     size: [f32; 2],
     scale: [f32; 2],
     max_level: f32,
-    anisotropic: f32,
+    anisotropic: u32,
     cut: [f32; 4],
 }
 
@@ -381,7 +382,7 @@ fn uniforms_of(clip_from_object: glam::Mat4, object: Option<&TexturedObject>) ->
         size: [1.0; 2],
         scale: [1.0; 2],
         max_level: 0.0,
-        anisotropic: 0.0,
+        anisotropic: 0,
         cut: [0.0; 4],
     };
     if let Some(o) = object {
@@ -392,7 +393,7 @@ fn uniforms_of(clip_from_object: glam::Mat4, object: Option<&TexturedObject>) ->
         u.size = [o.layout.width as f32, o.layout.height as f32];
         u.scale = [o.layout.width as f32 / aw as f32, o.layout.height as f32 / ah as f32];
         u.max_level = max_level(&o.layout, &o.sampler) as f32;
-        u.anisotropic = if matches!(o.sampler.filter, Filter::Anisotropic(_)) { 1.0 } else { 0.0 };
+        u.anisotropic = u32::from(matches!(o.sampler.filter, Filter::Anisotropic(_)));
         u.cut = cut_uniform(&o.transform);
     }
     u

@@ -19,7 +19,7 @@ struct Uniforms {
     // bilinear.
     max_level: f32,
     // 1 for anisotropic filtering: the adapter picks footprint and LOD (no model twin).
-    anisotropic: f32,
+    anisotropic: u32,
     // The block's branch cuts (SPEC.md 7.3): (u_cut, v_cut, 1 if cut along u, 1 if cut
     // along v).
     cut: vec4<f32>,
@@ -34,16 +34,6 @@ struct VsOut {
     // (s, t), interpolated perspective-correct.
     @location(0) st: vec2<f32>,
 };
-
-// The lookup: at the model's LOD, or, for anisotropic filtering, from the same fine
-// derivatives (scaled onto the allocated texture like the coordinates) so that the adapter
-// chooses its anisotropic footprint and LOD as an implicit-derivative lookup would.
-fn sample(st: vec2<f32>, ddx: vec2<f32>, ddy: vec2<f32>, lambda: f32) -> vec4<f32> {
-    if (u.anisotropic != 0.0) {
-        return textureSampleGrad(tex, samp, st * u.scale, ddx * u.scale, ddy * u.scale);
-    }
-    return textureSampleLevel(tex, samp, st * u.scale, lambda);
-}
 
 @vertex
 fn vs_main(@location(0) position: vec3<f32>, @location(1) uv: vec2<f32>) -> VsOut {

@@ -52,15 +52,6 @@ struct VsOut {
     @location(0) st: vec2<f32>,
 };
 
-// textured.wgsl's lookup: at the model's LOD, or, for anisotropic filtering, from the same
-// fine derivatives so that the adapter chooses its anisotropic footprint and LOD.
-fn sample(st: vec2<f32>, ddx: vec2<f32>, ddy: vec2<f32>, lambda: f32) -> vec4<f32> {
-    if (u.anisotropic != 0u) {
-        return textureSampleGrad(tex, samp, st * u.scale, ddx * u.scale, ddy * u.scale);
-    }
-    return textureSampleLevel(tex, samp, st * u.scale, lambda);
-}
-
 @vertex
 fn vs_main(@location(0) position: vec3<f32>, @location(1) uv: vec2<f32>) -> VsOut {
     var out: VsOut;

@@ -14,10 +14,11 @@ use crate::shell::SHELL_FUNCTIONS;
 use crate::textured::DEPTH_FORMAT;
 
 /// The WGSL source: the texture math shared with `textured.wgsl` (`texture_lod.wgsl`,
-/// `texture_transform.wgsl`), then `frame.wgsl`.
+/// `texture_transform.wgsl`, `texture_sample.wgsl`), then `frame.wgsl`.
 pub const SHADER: &str = concat!(
     include_str!("../texture_lod.wgsl"),
     include_str!("../texture_transform.wgsl"),
+    include_str!("../texture_sample.wgsl"),
     include_str!("frame.wgsl")
 );
 
