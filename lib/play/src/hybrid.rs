@@ -141,29 +141,7 @@ pub fn render_hybrid(
     let mut enc =
         d.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("hybrid") });
     {
-        let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: Some("hybrid"),
-            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                view: &color_view,
-                depth_slice: None,
-                resolve_target: None,
-                ops: wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
-                    store: wgpu::StoreOp::Store,
-                },
-            })],
-            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                view: &depth_view,
-                depth_ops: Some(wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(1.0),
-                    store: wgpu::StoreOp::Store,
-                }),
-                stencil_ops: None,
-            }),
-            timestamp_writes: None,
-            occlusion_query_set: None,
-            multiview_mask: None,
-        });
+        let mut pass = crate::gpu::cleared_pass(&mut enc, "hybrid", &color_view, &depth_view);
         pass.set_bind_group(0, &bind, &[]);
         pass.set_pipeline(&pipeline.depth_pipeline);
         pass.set_vertex_buffer(0, hp.slice(..));

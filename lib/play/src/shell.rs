@@ -463,29 +463,7 @@ fn shell_pass(
 ) {
     let (color_view, depth_view) =
         (color.create_view(&Default::default()), depth.create_view(&Default::default()));
-    let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
-        label: Some("shell"),
-        color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-            view: &color_view,
-            depth_slice: None,
-            resolve_target: None,
-            ops: wgpu::Operations {
-                load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
-                store: wgpu::StoreOp::Store,
-            },
-        })],
-        depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-            view: &depth_view,
-            depth_ops: Some(wgpu::Operations {
-                load: wgpu::LoadOp::Clear(1.0),
-                store: wgpu::StoreOp::Store,
-            }),
-            stencil_ops: None,
-        }),
-        timestamp_writes: None,
-        occlusion_query_set: None,
-        multiview_mask: None,
-    });
+    let mut pass = crate::gpu::cleared_pass(enc, "shell", &color_view, &depth_view);
     pass.set_pipeline(&pipeline.depth_pipeline);
     for (p, i, n, bg) in &draws.depth {
         pass.set_bind_group(0, bg, &[]);
