@@ -106,7 +106,7 @@ pub struct PackOptions {
     /// constraint at the thesis's 1.25 and the free allocation are both encoded, and the one
     /// whose decoded textures predict the higher PSNR is kept (the report says which);
     /// `off`: the free equal-slope allocation; a number above 1: the constraint at that α.
-    #[arg(long, value_name = "auto|off|ALPHA", default_value = "auto", value_parser = parse_max_mse_ratio)]
+    #[arg(long, value_name = "auto|off|ALPHA", default_value = "auto")]
     pub max_mse_ratio: MaxMse,
     /// Which views each texture placement (branch cuts, affine map, used size; thesis 3.2)
     /// is optimized over: `block` (per object per parameter block, the views of the
@@ -223,11 +223,6 @@ fn parse_memory(s: &str) -> Result<f64, String> {
         .ok()
         .filter(|v| v.is_finite() && *v > 0.0)
         .ok_or_else(|| format!("bad memory budget {s:?}: expected a number of GB above 0"))
-}
-
-/// `--max-mse-ratio`: [`MaxMse`]'s grammar (`auto`, `off`, or α above 1).
-pub fn parse_max_mse_ratio(s: &str) -> Result<MaxMse, String> {
-    s.parse()
 }
 
 /// The values of `--filter`, by [`Filter::name`] (the anisotropy clamp comes from

@@ -139,7 +139,7 @@ enum Command {
         /// The PIS packs' max-MSE constraint, as pis-pack's --max-mse-ratio: `auto` (the
         /// better prediction of the constraint at 1.25 and the free allocation), `off`, or
         /// the constraint at ALPHA.
-        #[arg(long, value_name = "auto|off|ALPHA", default_value = "auto", value_parser = pis::pack_args::parse_max_mse_ratio)]
+        #[arg(long, value_name = "auto|off|ALPHA", default_value = "auto")]
         max_mse_ratio: pis_pack::MaxMse,
         /// The PIS packs' block staggering, as pis-pack's --stagger: `auto` (the dimensions
         /// with more samples than a block) or `always` (every dimension).

@@ -56,7 +56,7 @@ struct Cli {
     /// The allocation's max-MSE constraint (thesis 4.8), as pis-pack's --max-mse-ratio: `off`
     /// or α above 1 (`auto` needs the traced set and means 1.25 here). Default: what the
     /// input's provenance records its writer applied (1.25 where it records nothing).
-    #[arg(long, value_name = "off|ALPHA", value_parser = pis::pack_args::parse_max_mse_ratio)]
+    #[arg(long, value_name = "off|ALPHA")]
     max_mse_ratio: Option<pis_pack::MaxMse>,
     /// Print the report as JSON on stdout.
     #[arg(long)]
