@@ -22,6 +22,7 @@ pub mod branch_cut;
 pub mod charts;
 pub mod edges;
 pub mod isometry;
+pub mod rechart;
 pub mod stretch;
 pub mod visibility;
 

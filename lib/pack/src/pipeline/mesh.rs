@@ -6,7 +6,7 @@ use anyhow::Result;
 use glam::Vec3;
 use pis_compile::texcoord::{
     charts::{separate_overlapping_charts, unfold_charts},
-    optimize_placement, ObjectMesh, TexcoordSettings, ViewGeometry,
+    optimize_placement, rechart, ObjectMesh, TexcoordSettings, ViewGeometry,
 };
 use pis_compile::{Address, Filter, Sampler, TextureLayout, TextureTransform};
 use pis_scene::{Frame, Scene};
@@ -18,12 +18,22 @@ pub struct Mesh {
     pub normals: Vec<[f32; 3]>,
     pub uvs: Vec<[f32; 2]>,
     pub indices: Vec<u32>,
+    /// What [`rechart::rechart`] did to texture coordinates that could not hold a texture,
+    /// for the report; `None` where the mesh's own were kept.
+    pub recharted: Option<String>,
 }
 
 /// Object `o`'s primitives merged into one mesh, in primitive order, its folded charts cut
-/// apart ([`unfold_charts`]: vertices copied, triangles kept in order).
+/// apart ([`unfold_charts`]: vertices copied, triangles kept in order) and its triangles of
+/// degenerate texture coordinates charted again ([`rechart::rechart`]).
 pub fn merged_mesh(scene: &Scene, o: usize) -> Mesh {
-    let mut m = Mesh { positions: vec![], normals: vec![], uvs: vec![], indices: vec![] };
+    let mut m = Mesh {
+        positions: vec![],
+        normals: vec![],
+        uvs: vec![],
+        indices: vec![],
+        recharted: None,
+    };
     for p in &scene.objects[o].primitives {
         let base = m.positions.len() as u32;
         m.positions.extend(p.positions.iter().map(|v| v.to_array()));
@@ -53,6 +63,23 @@ pub fn merged_mesh(scene: &Scene, o: usize) -> Mesh {
         }
         m.indices = u.indices;
     }
+    recharted(m)
+}
+
+/// `m` with its triangles of degenerate texture coordinates charted again (vertices copied,
+/// triangles kept in order), and a note saying so.
+fn recharted(mut m: Mesh) -> Mesh {
+    let positions: Vec<Vec3> = m.positions.iter().map(|p| Vec3::from(*p)).collect();
+    let uvs: Vec<glam::Vec2> = m.uvs.iter().map(|u| glam::Vec2::from(*u)).collect();
+    let Some(r) = rechart::rechart(&positions, &uvs, &m.indices) else { return m };
+    for &v in &r.copies {
+        let v = v as usize;
+        m.positions.push(m.positions[v]);
+        m.normals.push(m.normals[v]);
+    }
+    m.recharted = Some(r.describe(m.indices.len() / 3));
+    m.uvs = r.uvs.iter().map(|u| u.to_array()).collect();
+    m.indices = r.indices;
     m
 }
 

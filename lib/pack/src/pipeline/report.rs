@@ -5,6 +5,7 @@ use std::collections::BTreeMap;
 use serde::Serialize;
 
 use super::input::LoadedSet;
+use super::mesh::merged_mesh;
 use super::model::ObjectModel;
 use super::packed::Packed;
 use super::packed::Quality;
@@ -18,6 +19,9 @@ pub struct ObjectReport {
     pub representation: String,
     /// Why this representation was chosen.
     pub why: String,
+    /// Where the mesh's texture coordinates could not hold a texture: what was charted
+    /// again, and how.
+    pub recharted: Option<String>,
     /// Codestream bytes of the object's level images.
     pub bytes: usize,
     /// Codestream bytes per stored layer.
@@ -186,6 +190,7 @@ pub fn build(
                 name: m.name.clone(),
                 representation: m.representation.clone(),
                 why: m.why.clone(),
+                recharted: merged_mesh(&set.scene, m.index).recharted,
                 bytes: packed.layer_bytes[mi].iter().sum(),
                 layer_bytes: m
                     .layers

@@ -81,6 +81,11 @@ impl<'a> Job<'a> {
     ) -> Self {
         let scene = &set.scene;
         let meshes: Vec<Mesh> = (0..scene.objects.len()).map(|o| merged_mesh(scene, o)).collect();
+        for (object, mesh) in scene.objects.iter().zip(&meshes) {
+            if let Some(note) = &mesh.recharted {
+                progress.note(&format!("object {}: {note}", object.name));
+            }
+        }
         let ndims = scene.space.dims.len();
         let view_dims: Vec<usize> = scene
             .space
