@@ -49,6 +49,7 @@ impl Scene {
                 Driver::LightPath { light, path } => {
                     moved_lights.push((light, point_on_path(path, value)))
                 }
+                Driver::Still => {}
             }
         }
         let world = rig.world_transforms(&locals);

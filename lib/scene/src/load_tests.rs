@@ -198,6 +198,26 @@ fn frame_poses_animation_and_orbit() {
 }
 
 #[test]
+fn a_scene_without_dimensions_is_one_still_point() {
+    let toml = "gltf = \"scene.gltf\"\nresolution = [8, 8]\nspp = 1\n";
+    let f = Fixture::new(toml, |_, _| {});
+    let s = load(&f.toml(), None).unwrap();
+    assert_eq!(s.space.dims.len(), 1);
+    let d = &s.space.dims[0];
+    assert_eq!(
+        (d.name.as_str(), d.kind, &d.values[..]),
+        ("point", crate::DimensionKind::Other, &[0.0][..])
+    );
+    assert_eq!(s.space.point_count(), 1);
+    // The glTF camera, unmoved.
+    let frame = s.frame(&[0]).unwrap();
+    assert_eq!(
+        frame.camera.world_from_camera.transform_point3(Vec3::ZERO),
+        Vec3::new(0.0, 1.0, 5.0)
+    );
+}
+
+#[test]
 fn camera_node_and_animated_light() {
     let toml = r#"
 gltf = "scene.gltf"

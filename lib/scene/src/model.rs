@@ -278,6 +278,9 @@ pub enum Driver {
     /// A named light moves along a polyline (world space); the sample value is the path
     /// parameter in [0, 1] (arc-length).
     LightPath { light: String, path: Vec<Vec3> },
+    /// Nothing moves: the one sample of the dimension a scene without `[[dimension]]` gets,
+    /// since a container holds 1 to 8 dimensions.
+    Still,
 }
 
 /// Everything that varies over the parameter space, evaluated at one point.

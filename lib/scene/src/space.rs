@@ -73,7 +73,22 @@ pub(crate) fn build_space(
             driver,
         });
     }
+    if dims.is_empty() {
+        dims.push(still());
+    }
     Ok(ParameterSpace { dims })
+}
+
+/// The one dimension of a scene without `[[dimension]]`: `point`, one sample, nothing moves.
+fn still() -> Dimension {
+    Dimension {
+        name: "point".to_owned(),
+        kind: DimensionKind::Other,
+        periodic: false,
+        unit: String::new(),
+        values: vec![0.0],
+        driver: Driver::Still,
+    }
 }
 
 /// One `[[dimension]]` table where its errors point: scene.toml and the table's index.

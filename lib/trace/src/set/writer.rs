@@ -80,6 +80,7 @@ impl SetWriter {
                     Driver::Orbit { .. } => "orbit",
                     Driver::Animation { .. } => "animation",
                     Driver::LightPath { .. } => "light_path",
+                    Driver::Still => "still",
                 }
                 .into(),
                 periodic: d.periodic,
