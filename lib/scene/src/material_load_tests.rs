@@ -257,3 +257,27 @@ fn damaged_material_textures_error_without_panicking() {
         assert!(cut > 20 || matches!(result, Ok(Err(_))), "a.png cut to {cut} bytes loads");
     }
 }
+
+#[test]
+fn an_image_that_cannot_be_read_leaves_its_texture_unread_with_a_warning() {
+    let material = json!({
+        "pbrMetallicRoughness": {"baseColorTexture": {"index": 0}, "baseColorFactor": [1, 0.5, 0.25, 1]},
+        "emissiveTexture": {"index": 1}
+    });
+    // Image 0 names a file that is not there (as an exporter writes a Windows path), image 1
+    // one of a format PIS does not decode.
+    let f = textured(material, false, |doc| {
+        doc["images"] = json!([{"uri": "textures%5Cwood.tga"}, {"uri": "b.png"}]);
+    });
+    let s = load(&f.toml(), None).unwrap();
+    let m = &s.materials[0];
+    assert!(m.base_color_texture.is_none());
+    assert_eq!(m.base_color, [1.0, 0.5, 0.25, 1.0]);
+    assert!(m.emissive_texture.is_some(), "the readable image is still read");
+    assert_eq!(s.warnings.len(), 1, "{:?}", s.warnings);
+    let w = &s.warnings[0];
+    assert!(
+        w.contains("images[0]") && w.contains("wood.tga") && w.contains("baseColorTexture"),
+        "{w}"
+    );
+}

@@ -6,6 +6,7 @@ use std::path::Path;
 
 use serde_json::Value;
 
+use crate::gltf_load::ImageData;
 use crate::model::{Material, TextureImage};
 use crate::texture_ref::{TextureRef, UvTransform};
 use crate::SceneError;
@@ -13,7 +14,7 @@ use crate::SceneError;
 /// The textures decoded so far and what reading them found to warn of.
 pub(crate) struct TextureSet<'a> {
     path: &'a Path,
-    images: &'a [gltf::image::Data],
+    images: &'a [ImageData],
     pub textures: Vec<TextureImage>,
     /// (image, sRGB) → index into `textures`.
     decoded: BTreeMap<(usize, bool), usize>,
@@ -21,7 +22,7 @@ pub(crate) struct TextureSet<'a> {
 }
 
 impl<'a> TextureSet<'a> {
-    pub fn new(path: &'a Path, images: &'a [gltf::image::Data]) -> Self {
+    pub fn new(path: &'a Path, images: &'a [ImageData]) -> Self {
         TextureSet {
             path,
             images,
@@ -52,22 +53,17 @@ impl<'a> TextureSet<'a> {
         if let Some(t) = pbr.base_color_texture() {
             let f = format!("{field}.pbrMetallicRoughness.baseColorTexture");
             mat.base_color_texture =
-                Some(self.read(&f, t.texture(), t.tex_coord(), transform(t.extensions()), true)?);
+                self.read(&f, t.texture(), t.tex_coord(), transform(t.extensions()), true)?;
         }
         if let Some(t) = pbr.metallic_roughness_texture() {
             let f = format!("{field}.pbrMetallicRoughness.metallicRoughnessTexture");
-            mat.metallic_roughness_texture = Some(self.read(
-                &f,
-                t.texture(),
-                t.tex_coord(),
-                transform(t.extensions()),
-                false,
-            )?);
+            mat.metallic_roughness_texture =
+                self.read(&f, t.texture(), t.tex_coord(), transform(t.extensions()), false)?;
         }
         if let Some(t) = m.emissive_texture() {
             let f = format!("{field}.emissiveTexture");
             mat.emissive_texture =
-                Some(self.read(&f, t.texture(), t.tex_coord(), transform(t.extensions()), true)?);
+                self.read(&f, t.texture(), t.tex_coord(), transform(t.extensions()), true)?;
         }
         if let Some(t) = m.normal_texture() {
             let f = format!("{field}.normalTexture");
@@ -78,13 +74,8 @@ impl<'a> TextureSet<'a> {
                     element: 0,
                 });
             }
-            mat.normal_texture = Some(self.read(
-                &f,
-                t.texture(),
-                t.tex_coord(),
-                transform(t.extensions()),
-                false,
-            )?);
+            mat.normal_texture =
+                self.read(&f, t.texture(), t.tex_coord(), transform(t.extensions()), false)?;
             mat.normal_scale = t.scale();
         }
         self.warn_unread(m);
@@ -125,7 +116,8 @@ impl<'a> TextureSet<'a> {
     }
 
     /// The reference of texture info `field`: its image decoded (once per colour space), its
-    /// texture-coordinate set and transform.
+    /// texture-coordinate set and transform; `None`, with a warning, where the image could not
+    /// be read (the material's factor then applies alone).
     fn read(
         &mut self,
         field: &str,
@@ -133,7 +125,7 @@ impl<'a> TextureSet<'a> {
         tex_coord: u32,
         transform: Option<Value>,
         srgb: bool,
-    ) -> Result<TextureRef, SceneError> {
+    ) -> Result<Option<TextureRef>, SceneError> {
         let (transform, set) = match &transform {
             Some(v) => texture_transform(
                 self.path,
@@ -151,6 +143,13 @@ impl<'a> TextureSet<'a> {
         let data = self.images.get(image).ok_or_else(|| {
             SceneError::invalid(self.path, field, format!("image {image} does not exist"))
         })?;
+        let data = match data {
+            Ok(data) => data,
+            Err(why) => {
+                self.warn(format!("{why}: {field} is not read (its factor applies alone)"));
+                return Ok(None);
+            }
+        };
         let next = self.textures.len();
         let t = *self.decoded.entry((image, srgb)).or_insert(next);
         if t == next {
@@ -158,7 +157,7 @@ impl<'a> TextureSet<'a> {
                 .map_err(|why| SceneError::invalid(self.path, format!("images[{image}]"), why))?;
             self.textures.push(decoded);
         }
-        Ok(TextureRef { texture: t, tex_coord, transform })
+        Ok(Some(TextureRef { texture: t, tex_coord, transform }))
     }
 }
 
