@@ -361,6 +361,9 @@ fn import_images(
                 Err(gltf::Error::Io(source)) => {
                     Ok(Err(format!("{field}{uri} cannot be read: {source}")))
                 }
+                Err(gltf::Error::UnsupportedScheme) => Ok(Err(format!(
+                    "{field}{uri} cannot be read: a URI scheme or drive PIS does not read"
+                ))),
                 Err(gltf::Error::UnsupportedImageEncoding) => Ok(Err(format!(
                     "{field}{uri} is of a format PIS does not decode (PNG and JPEG only)"
                 ))),
