@@ -75,7 +75,7 @@ pub fn geometry(set: &LoadedSet, sizes: &[u32]) -> (ParameterSpace, CameraTable)
             world_from_camera: row3x4(c.world_from_camera),
             yfov: c.yfov,
             znear: c.znear,
-            zfar: if c.zfar.is_finite() { c.zfar } else { 1e4 },
+            zfar: if c.zfar.is_finite() { c.zfar } else { far_plane(set, f) },
         });
     }
     let cameras = CameraTable {
@@ -95,6 +95,31 @@ pub fn geometry(set: &LoadedSet, sizes: &[u32]) -> (ParameterSpace, CameraTable)
             .collect(),
     };
     (space, cameras)
+}
+
+/// The far plane the player draws with where the camera has none (glTF's infinite
+/// projection): 10⁴, or twice the distance of the farthest corner of any object's bounds where
+/// the scene reaches beyond it (a model in millimetres or centimetres, unscaled).
+fn far_plane(set: &LoadedSet, frame: &pis_scene::Frame) -> f32 {
+    let eye = frame.camera.world_from_camera.transform_point3(glam::Vec3::ZERO).as_dvec3();
+    let mut far = 0.0f64;
+    for (object, instance) in set.scene.objects.iter().zip(&frame.instances) {
+        let points = object.primitives.iter().flat_map(|p| p.positions.iter());
+        let (lo, hi) = points.fold(
+            (glam::Vec3::splat(f32::INFINITY), glam::Vec3::splat(f32::NEG_INFINITY)),
+            |(lo, hi), p| (lo.min(*p), hi.max(*p)),
+        );
+        if !(lo.is_finite() && hi.is_finite()) {
+            continue;
+        }
+        for k in 0..8 {
+            let corner =
+                glam::Vec3::select(glam::BVec3::new(k & 1 != 0, k & 2 != 0, k & 4 != 0), hi, lo);
+            let world = instance.world_from_object.as_dmat4().transform_point3(corner.as_dvec3());
+            far = far.max(world.distance(eye));
+        }
+    }
+    (2.0 * far).max(1e4).min(f32::MAX as f64 / 4.0) as f32
 }
 
 /// Object `o`'s transform table over the space.
