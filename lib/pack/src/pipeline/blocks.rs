@@ -71,11 +71,12 @@ pub fn geometry(set: &LoadedSet, sizes: &[u32]) -> (ParameterSpace, CameraTable)
     let mut cameras = vec![None; space.table_len(view) as usize];
     for (s, f) in set.samples.iter().zip(&set.frames) {
         let c = f.camera;
+        let (znear, zfar) = depth_range(set, f);
         cameras[space.table_index(view, s)] = Some(Camera {
             world_from_camera: row3x4(c.world_from_camera),
             yfov: c.yfov,
-            znear: c.znear,
-            zfar: if c.zfar.is_finite() { c.zfar } else { far_plane(set, f) },
+            znear,
+            zfar,
         });
     }
     let cameras = CameraTable {
@@ -97,12 +98,17 @@ pub fn geometry(set: &LoadedSet, sizes: &[u32]) -> (ParameterSpace, CameraTable)
     (space, cameras)
 }
 
-/// The far plane the player draws with where the camera has none (glTF's infinite
-/// projection): 10⁴, or twice the distance of the farthest corner of any object's bounds where
-/// the scene reaches beyond it (a model in millimetres or centimetres, unscaled).
-fn far_plane(set: &LoadedSet, frame: &pis_scene::Frame) -> f32 {
-    let eye = frame.camera.world_from_camera.transform_point3(glam::Vec3::ZERO).as_dvec3();
-    let mut far = 0.0f64;
+/// The depth range the player draws with: the camera's near plane, raised to half the
+/// distance of the nearest object's bounds where that is farther (a depth buffer resolves
+/// about z² / near of depth at distance z: a model in units of 10⁴ seen from 3.6 · 10⁴ with
+/// glTF's usual near plane of 0.01 resolved 8000 units, and its parts fought); and its far
+/// plane, or where it has none (glTF's infinite projection) 10⁴ or twice the distance of the
+/// farthest object corner, whichever is larger (a model in millimetres or centimetres,
+/// unscaled, lay beyond 10⁴ and drew nothing).
+fn depth_range(set: &LoadedSet, frame: &pis_scene::Frame) -> (f32, f32) {
+    let c = &frame.camera;
+    let eye = c.world_from_camera.transform_point3(glam::Vec3::ZERO).as_dvec3();
+    let (mut near, mut far) = (f64::INFINITY, 0.0f64);
     for (object, instance) in set.scene.objects.iter().zip(&frame.instances) {
         let points = object.primitives.iter().flat_map(|p| p.positions.iter());
         let (lo, hi) = points.fold(
@@ -112,14 +118,23 @@ fn far_plane(set: &LoadedSet, frame: &pis_scene::Frame) -> f32 {
         if !(lo.is_finite() && hi.is_finite()) {
             continue;
         }
+        let m = instance.world_from_object.as_dmat4();
+        let (mut wlo, mut whi) = (glam::DVec3::INFINITY, glam::DVec3::NEG_INFINITY);
         for k in 0..8 {
-            let corner =
-                glam::Vec3::select(glam::BVec3::new(k & 1 != 0, k & 2 != 0, k & 4 != 0), hi, lo);
-            let world = instance.world_from_object.as_dmat4().transform_point3(corner.as_dvec3());
+            let pick = glam::BVec3::new(k & 1 != 0, k & 2 != 0, k & 4 != 0);
+            let world = m.transform_point3(glam::Vec3::select(pick, hi, lo).as_dvec3());
             far = far.max(world.distance(eye));
+            (wlo, whi) = (wlo.min(world), whi.max(world));
         }
+        near = near.min(eye.clamp(wlo, whi).distance(eye));
     }
-    (2.0 * far).max(1e4).min(f32::MAX as f64 / 4.0) as f32
+    let far = if c.zfar.is_finite() {
+        c.zfar as f64
+    } else {
+        (2.0 * far).clamp(1e4, f32::MAX as f64 / 4.0)
+    };
+    let raised = if near.is_finite() { (0.5 * near).min(1e-3 * far) } else { 0.0 };
+    (raised.max(c.znear as f64) as f32, far as f32)
 }
 
 /// Object `o`'s transform table over the space.
