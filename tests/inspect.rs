@@ -209,3 +209,32 @@ fn missing_file_is_an_io_error() {
     let out = Command::new(env!("CARGO_BIN_EXE_pis-inspect")).arg("--bogus").output().unwrap();
     assert_eq!(out.status.code(), Some(1));
 }
+
+/// `--validate` names the rule whose field is wrong where that field decides how the rest
+/// of `LAYR` is laid out: a layer's mask naming a missing dimension (5002, once reported as
+/// 6000 or 8004) and a block count other than the layer's grid (6005, once reported as
+/// 6000, 3006 or 7001).
+#[test]
+fn validate_names_the_layer_mask_and_block_count_rules() {
+    let dir = tempfile::tempdir().unwrap();
+    let c = pis_format::samples::tiny().unwrap();
+    let (good, spans) = pis_format::to_bytes_labelled(&c).unwrap();
+    for (label, value, id) in [
+        ("layer 0 dependency mask", 0b101u32, 5002),
+        ("layer 1 dependency mask", 0b100, 5002),
+        ("layer 0 block count", 2, 6005),
+        ("layer 1 block count", 3, 6005),
+    ] {
+        let mut bad = good.clone();
+        let at = spans.iter().find(|s| s.label.starts_with(label)).unwrap().start;
+        bad[at..at + 4].copy_from_slice(&value.to_le_bytes());
+        pis_format::chunk::reseal(&mut bad);
+        let path = dir.path().join("bad.pis");
+        std::fs::write(&path, &bad).unwrap();
+        let out = inspect(&["--validate"], &path);
+        assert_eq!(out.status.code(), Some(3));
+        let lines: Vec<String> = text(&out.stdout).lines().map(str::to_string).collect();
+        assert_eq!(lines.len(), 1, "{label} = {value}: {lines:?}");
+        assert!(lines[0].starts_with(&format!("error-{id}: ")), "{label} = {value}: {lines:?}");
+    }
+}

@@ -27,6 +27,31 @@ pub const MAX_EXPANSION: u64 = 1 << 13;
 /// time proportional to the codestreams.
 pub const MAX_TOTAL_EXPANSION: u64 = 1 << 17;
 
+/// The least C the limits of rules 6009 and 6010 count (SPEC.md 12): a file whose level
+/// images read fewer codestream bytes (all of them empty, SPEC.md 11.2, in the extreme) is
+/// measured as if they read this many, so that such a file may still declare level images
+/// of up to 8 MiB each and 128 MiB in all.
+pub const MIN_COUNTED_CODESTREAM_BYTES: u64 = 1 << 10;
+
+/// The least number of codestream bytes a file whose level images decode to `images` (per
+/// block: the bytes one level image decodes to and the number of level images) must read
+/// for rules 6009 and 6010 to hold: 0 when [`MIN_COUNTED_CODESTREAM_BYTES`] suffices.
+pub fn required_codestream_bytes(images: impl IntoIterator<Item = (u64, u64)>) -> u64 {
+    let (mut largest, mut total) = (0u64, 0u64);
+    for (bytes, count) in images {
+        if count > 0 {
+            largest = largest.max(bytes);
+            total = total.saturating_add(bytes.saturating_mul(count));
+        }
+    }
+    let need = largest.div_ceil(MAX_EXPANSION).max(total.div_ceil(MAX_TOTAL_EXPANSION));
+    if need <= MIN_COUNTED_CODESTREAM_BYTES {
+        0
+    } else {
+        need
+    }
+}
+
 /// Bytes one level image of `layer`'s block `block` decodes to (4 bytes per value, all
 /// planes); `u64::MAX` when its planes are malformed.
 pub fn level_image_bytes<S>(layer: &Layer<S>, block: &Block<S>) -> u64 {
@@ -64,14 +89,22 @@ pub fn referenced_bytes(c: &Container<StreamRef>) -> u64 {
 }
 
 /// Rules 6009 and 6010 for a file whose level images read `codestream_bytes` bytes of
-/// codestream ([`referenced_bytes`]): every level image decodes to at most
-/// [`MAX_EXPANSION`] × `codestream_bytes`, all of them together to at most
-/// [`MAX_TOTAL_EXPANSION`] × `codestream_bytes`. Checked before anything is decoded, so
-/// every allocation and all the decoding a file can ask for are bounded by its codestreams,
-/// not by bytes a writer could pad the file with.
+/// codestream ([`referenced_bytes`]): with C = max(`codestream_bytes`,
+/// [`MIN_COUNTED_CODESTREAM_BYTES`]), every level image decodes to at most
+/// [`MAX_EXPANSION`] × C, all of them together to at most [`MAX_TOTAL_EXPANSION`] × C.
+/// Checked before anything is decoded, so every allocation and all the decoding a file can
+/// ask for are bounded by its codestreams, not by bytes a writer could pad the file with.
 pub fn decoded_sizes<S>(c: &Container<S>, codestream_bytes: u64) -> Option<Issue> {
-    let limit = MAX_EXPANSION.saturating_mul(codestream_bytes);
-    let total_limit = MAX_TOTAL_EXPANSION.saturating_mul(codestream_bytes);
+    let counted = codestream_bytes.max(MIN_COUNTED_CODESTREAM_BYTES);
+    let limit = MAX_EXPANSION.saturating_mul(counted);
+    let total_limit = MAX_TOTAL_EXPANSION.saturating_mul(counted);
+    let of = || {
+        if counted == codestream_bytes {
+            format!("{codestream_bytes} bytes of codestream")
+        } else {
+            format!("{codestream_bytes} bytes of codestream (counted as {counted})")
+        }
+    };
     let mut total = 0u64;
     for (oi, o) in c.objects.iter().enumerate() {
         for (li, l) in o.layers.iter().enumerate() {
@@ -79,7 +112,11 @@ pub fn decoded_sizes<S>(c: &Container<S>, codestream_bytes: u64) -> Option<Issue
                 let bytes = level_image_bytes(l, b);
                 let what = || format!("object {oi} '{}' layer {li} block {bi}", o.name);
                 if bytes > limit {
-                    let detail = format!("{}: {bytes} bytes per level image; {codestream_bytes} bytes of codestream allow {limit}", what());
+                    let detail = format!(
+                        "{}: {bytes} bytes per level image; {} allow {limit}",
+                        what(),
+                        of()
+                    );
                     return Some(chunk(
                         Issue::new(id::layers::LEVEL_IMAGE_TOO_LARGE, detail),
                         "LAYR",
@@ -88,7 +125,7 @@ pub fn decoded_sizes<S>(c: &Container<S>, codestream_bytes: u64) -> Option<Issue
                 let images = b.levels.iter().map(|level| level.images.len() as u64).sum::<u64>();
                 total = total.saturating_add(bytes.saturating_mul(images));
                 if total > total_limit {
-                    let detail = format!("{}: the level images up to this block decode to {total} bytes; {codestream_bytes} bytes of codestream allow {total_limit}", what());
+                    let detail = format!("{}: the level images up to this block decode to {total} bytes; {} allow {total_limit}", what(), of());
                     return Some(chunk(
                         Issue::new(id::layers::LEVEL_IMAGES_TOO_LARGE, detail),
                         "LAYR",
@@ -187,6 +224,13 @@ fn provenance(p: Option<&Provenance>, out: &mut Vec<Issue>) {
 fn chunk(i: Issue, fourcc: &str) -> Issue {
     // Chunk indices follow the writer's order; the reader re-tags with the real index.
     Issue { chunk: Some((fourcc.to_string(), usize::MAX)), ..i }
+}
+
+/// Whether `s` holds every 4xxx rule: the block grids measured on it are then defined.
+pub(crate) fn space_holds(s: &ParameterSpace) -> bool {
+    let mut out = Vec::new();
+    space(s, &mut out);
+    out.is_empty()
 }
 
 fn space(s: &ParameterSpace, out: &mut Vec<Issue>) {

@@ -172,8 +172,16 @@ pub fn mesh(c: &mut Cursor) -> Result<(u32, Mesh), Issue> {
     Ok((object, Mesh { positions, normals, texcoords, indices, hull_triangles }))
 }
 
-/// Parses `LAYR` into the objects' layer lists.
-pub fn layr(c: &mut Cursor, objects: &mut [Object<StreamRef>]) -> Result<(), Issue> {
+/// Parses `LAYR` into the objects' layer lists. A layer's dependency mask decides how many
+/// sample counts each of its levels holds, and its block count how many blocks follow, so
+/// a mask that names a missing dimension (rule 5002) or, where `grid` gives the parameter
+/// space (when it holds every 4xxx rule), a block count other than the layer's block grid
+/// (rule 6005) leaves the rest of the payload unreadable: parsing stops there.
+pub fn layr(
+    c: &mut Cursor,
+    objects: &mut [Object<StreamRef>],
+    grid: Option<&ParameterSpace>,
+) -> Result<(), Issue> {
     let n = c.u32("layer count")?;
     let n = c.expect_records(n as u64, 28, "layers")?;
     for li in 0..n {
@@ -206,107 +214,41 @@ pub fn layr(c: &mut Cursor, objects: &mut [Object<StreamRef>]) -> Result<(), Iss
         let term = Term::from_code(term).ok_or_else(|| bad("term", term))?;
         let combine = Combine::from_code(combine).ok_or_else(|| bad("combine mode", combine))?;
         let [gamma] = c.f32s::<1>("gamma")?;
+        let mask_at = c.offset();
         let depends_on = DepMask(c.u32("dependency mask")?);
-        let dims = depends_on.count();
+        let stagger = &objects[oi].stagger;
+        if depends_on.0 >> stagger.len() != 0 {
+            return Err(c
+                .issue(
+                    id::cameras::MASK_NAMES_MISSING_DIMENSION,
+                    format!(
+                        "layer {li} mask {:#x}, the space has {} dimensions: its blocks cannot be read",
+                        depends_on.0,
+                        stagger.len()
+                    ),
+                )
+                .at(mask_at));
+        }
+        let count_at = c.offset();
         let nb = c.u32("block count")?;
+        // The grid is defined where the space and the object's block origins hold.
+        let origins_hold =
+            |s: &ParameterSpace| s.dims.iter().zip(stagger).all(|(d, &o)| o < d.block_size);
+        if let Some(s) = grid.filter(|s| origins_hold(s)) {
+            let expected = crate::blocks::BlockGrid::new(s, depends_on, stagger).block_count();
+            if nb as u64 != expected {
+                return Err(c
+                    .issue(
+                        id::layers::BLOCK_COUNT,
+                        format!("layer {li}: {nb} blocks, the grid has {expected}"),
+                    )
+                    .at(count_at));
+            }
+        }
         let nb = c.expect_records(nb as u64, 68, "blocks")?;
         let mut blocks = Vec::with_capacity(nb);
         for bi in 0..nb {
-            let width = c.u32("width")?;
-            let height = c.u32("height")?;
-            let shape_at = c.offset();
-            let shape = c.u16("shell shape")? as u32;
-            let flags = c.u16("placement flags")?;
-            // Shells: the lookups per pixel side less one (0 to MAX_SHELL_LOOKUPS − 1).
-            if flags & !15 != 0 || (shape != 0 && flags as u32 >= crate::model::MAX_SHELL_LOOKUPS) {
-                let issue = c
-                    .issue(
-                        id::chunk::RESERVED_NOT_ZERO,
-                        format!("layer {li} block {bi} placement flags {flags:#x}"),
-                    )
-                    .at(shape_at + 2);
-                c.flag(issue)?;
-            }
-            let values = c.f32s::<12>("placement values")?;
-            let placement = if shape == 0 {
-                Placement::Surface {
-                    affine: values[0..6].try_into().expect("6 values"),
-                    repeat: [flags & 1 != 0, flags & 2 != 0],
-                    cut: [
-                        (flags & 4 != 0).then_some(values[6]),
-                        (flags & 8 != 0).then_some(values[7]),
-                    ],
-                }
-            } else {
-                let shape = ShellShape::from_code(shape).ok_or_else(|| {
-                    c.issue(
-                        id::layers::BLOCK_PLACEMENT,
-                        format!("layer {li} block {bi} shell shape {shape}; 0 to 5 are defined"),
-                    )
-                    .at(shape_at)
-                })?;
-                Placement::Shell {
-                    shape,
-                    origin: values[0..3].try_into().expect("3 values"),
-                    params: values[3..9].try_into().expect("6 values"),
-                    lookups: (flags as u32).min(crate::model::MAX_SHELL_LOOKUPS - 1) + 1,
-                }
-            };
-            let unused = if shape == 0 {
-                // A branch-cut slot without its flag is unused too.
-                let cuts =
-                    [(flags & 4 == 0).then_some(values[6]), (flags & 8 == 0).then_some(values[7])];
-                cuts.into_iter().flatten().chain(values[8..].iter().copied()).collect::<Vec<f32>>()
-            } else {
-                values[9..].to_vec()
-            };
-            if unused.iter().any(|v| v.to_bits() != 0) {
-                let issue = c
-                    .issue(
-                        id::chunk::RESERVED_NOT_ZERO,
-                        format!("layer {li} block {bi} unused placement values are not +0.0"),
-                    )
-                    .at(shape_at + 4);
-                c.flag(issue)?;
-            }
-            let lc = c.u32("level count")?;
-            if lc == 0 || lc > 32 {
-                return Err(c.issue(
-                    id::pyramid::LEVEL_COUNT,
-                    format!("layer {li} block {bi} has {lc} levels, expected 1 to 32"),
-                ));
-            }
-            let mut levels = Vec::with_capacity(lc as usize);
-            for lv in 0..lc {
-                let mut counts = Vec::with_capacity(dims);
-                let mut images: u64 = 1;
-                for _ in 0..dims {
-                    let n = c.u32("level sample count")?;
-                    counts.push(n);
-                    images = images.saturating_mul(n as u64);
-                }
-                let ni = c.expect_records(images, 24, &format!("level {lv} image references"))?;
-                let mut refs = Vec::with_capacity(ni);
-                for _ in 0..ni {
-                    let at = c.offset();
-                    let code = c.u16("codec")?;
-                    let codec = CodecId::from_code(code).ok_or_else(|| {
-                        c.issue(
-                            id::codestream::UNKNOWN_CODEC,
-                            format!("codec id {code}; 0 to 3 are defined"),
-                        )
-                        .at(at)
-                    })?;
-                    c.reserved(2, "reference reserved")?;
-                    let chunk = c.u32("chunk index")?;
-                    let offset = c.u64("offset")?;
-                    let length = c.u32("length")?;
-                    let crc = c.u32("crc32")?;
-                    refs.push(StreamRef { codec, chunk, offset, length, crc });
-                }
-                levels.push(Level { counts, images: refs });
-            }
-            blocks.push(Block { width, height, placement, levels });
+            blocks.push(block(c, li, bi, depends_on.count())?);
         }
         objects[oi].layers.push(Layer {
             kind,
@@ -322,6 +264,101 @@ pub fn layr(c: &mut Cursor, objects: &mut [Object<StreamRef>]) -> Result<(), Iss
         });
     }
     c.finish()
+}
+
+/// Parses block `bi` of layer `li`, whose levels hold `dims` sample counts each.
+fn block(c: &mut Cursor, li: usize, bi: usize, dims: usize) -> Result<Block<StreamRef>, Issue> {
+    let width = c.u32("width")?;
+    let height = c.u32("height")?;
+    let shape_at = c.offset();
+    let shape = c.u16("shell shape")? as u32;
+    let flags = c.u16("placement flags")?;
+    // Shells: the lookups per pixel side less one (0 to MAX_SHELL_LOOKUPS − 1).
+    if flags & !15 != 0 || (shape != 0 && flags as u32 >= crate::model::MAX_SHELL_LOOKUPS) {
+        let issue = c
+            .issue(
+                id::chunk::RESERVED_NOT_ZERO,
+                format!("layer {li} block {bi} placement flags {flags:#x}"),
+            )
+            .at(shape_at + 2);
+        c.flag(issue)?;
+    }
+    let values = c.f32s::<12>("placement values")?;
+    let placement = if shape == 0 {
+        Placement::Surface {
+            affine: values[0..6].try_into().expect("6 values"),
+            repeat: [flags & 1 != 0, flags & 2 != 0],
+            cut: [(flags & 4 != 0).then_some(values[6]), (flags & 8 != 0).then_some(values[7])],
+        }
+    } else {
+        let shape = ShellShape::from_code(shape).ok_or_else(|| {
+            c.issue(
+                id::layers::BLOCK_PLACEMENT,
+                format!("layer {li} block {bi} shell shape {shape}; 0 to 5 are defined"),
+            )
+            .at(shape_at)
+        })?;
+        Placement::Shell {
+            shape,
+            origin: values[0..3].try_into().expect("3 values"),
+            params: values[3..9].try_into().expect("6 values"),
+            lookups: (flags as u32).min(crate::model::MAX_SHELL_LOOKUPS - 1) + 1,
+        }
+    };
+    let unused = if shape == 0 {
+        // A branch-cut slot without its flag is unused too.
+        let cuts = [(flags & 4 == 0).then_some(values[6]), (flags & 8 == 0).then_some(values[7])];
+        cuts.into_iter().flatten().chain(values[8..].iter().copied()).collect::<Vec<f32>>()
+    } else {
+        values[9..].to_vec()
+    };
+    if unused.iter().any(|v| v.to_bits() != 0) {
+        let issue = c
+            .issue(
+                id::chunk::RESERVED_NOT_ZERO,
+                format!("layer {li} block {bi} unused placement values are not +0.0"),
+            )
+            .at(shape_at + 4);
+        c.flag(issue)?;
+    }
+    let lc = c.u32("level count")?;
+    if lc == 0 || lc > 32 {
+        return Err(c.issue(
+            id::pyramid::LEVEL_COUNT,
+            format!("layer {li} block {bi} has {lc} levels, expected 1 to 32"),
+        ));
+    }
+    let mut levels = Vec::with_capacity(lc as usize);
+    for lv in 0..lc {
+        let mut counts = Vec::with_capacity(dims);
+        let mut images: u64 = 1;
+        for _ in 0..dims {
+            let n = c.u32("level sample count")?;
+            counts.push(n);
+            images = images.saturating_mul(n as u64);
+        }
+        let ni = c.expect_records(images, 24, &format!("level {lv} image references"))?;
+        let mut refs = Vec::with_capacity(ni);
+        for _ in 0..ni {
+            let at = c.offset();
+            let code = c.u16("codec")?;
+            let codec = CodecId::from_code(code).ok_or_else(|| {
+                c.issue(
+                    id::codestream::UNKNOWN_CODEC,
+                    format!("codec id {code}; 0 to 3 are defined"),
+                )
+                .at(at)
+            })?;
+            c.reserved(2, "reference reserved")?;
+            let chunk = c.u32("chunk index")?;
+            let offset = c.u64("offset")?;
+            let length = c.u32("length")?;
+            let crc = c.u32("crc32")?;
+            refs.push(StreamRef { codec, chunk, offset, length, crc });
+        }
+        levels.push(Level { counts, images: refs });
+    }
+    Ok(Block { width, height, placement, levels })
 }
 
 pub fn prov(c: &mut Cursor) -> Result<Provenance, Issue> {

@@ -465,7 +465,8 @@ fn parse(
     }
     let layers = match (objects.as_mut(), find(chunk::LAYR)) {
         (Some(objects), Some(i)) => {
-            parse_chunk(entries, payloads, i, issues, |c| pr::layr(c, objects)).is_some()
+            let grid = space.as_ref().filter(|s| checks::space_holds(s));
+            parse_chunk(entries, payloads, i, issues, |c| pr::layr(c, objects, grid)).is_some()
         }
         _ => false,
     };

@@ -62,6 +62,15 @@ mod tests {
             Ok(vec![[0.7, 0.9, 0.75], [1.0; 3]])
         );
         assert_eq!(tints(None, &objects), Ok(vec![[1.0; 3]; 2]));
+        // The number syntax of SPEC.md 6.6: white space around fields, signs, a point with
+        // digits on either side, exponents; −0 lies in [0, 1].
+        let (k, _) = tint_setting("Cup", [0.0; 3]);
+        assert_eq!(
+            tints(Some(&prov(&[(k.as_str(), " .5 ,1., +5E-1\t")])), &objects),
+            Ok(vec![[0.5, 1.0, 0.5], [1.0; 3]])
+        );
+        let t = tints(Some(&prov(&[(k.as_str(), "-0,0,0")])), &objects).unwrap();
+        assert!(t[0][0] == 0.0 && t[0][0].is_sign_negative());
         for (key, value, why) in [
             ("transmission_tint.Table", "1,1,1", "not refractive"),
             ("transmission_tint.Lamp", "1,1,1", "no object"),
@@ -69,6 +78,10 @@ mod tests {
             ("transmission_tint.Cup", "1,1,2", "three decimal"),
             ("transmission_tint.Cup", "1,NaN,1", "three decimal"),
             ("transmission_tint.Cup", "1,1,1,1", "three decimal"),
+            ("transmission_tint.Cup", "0x1,0,0", "three decimal"),
+            ("transmission_tint.Cup", "1e,0,0", "three decimal"),
+            ("transmission_tint.Cup", "inf,0,0", "three decimal"),
+            ("transmission_tint.Cup", "1_0,0,0", "three decimal"),
         ] {
             let e = tints(Some(&prov(&[(key, value)])), &objects).unwrap_err();
             assert!(e.contains(why), "{key}={value}: {e}");
