@@ -27,13 +27,8 @@ pub struct Mesh {
 /// apart ([`unfold_charts`]: vertices copied, triangles kept in order) and its triangles of
 /// degenerate texture coordinates charted again ([`rechart::rechart`]).
 pub fn merged_mesh(scene: &Scene, o: usize) -> Mesh {
-    let mut m = Mesh {
-        positions: vec![],
-        normals: vec![],
-        uvs: vec![],
-        indices: vec![],
-        recharted: None,
-    };
+    let mut m =
+        Mesh { positions: vec![], normals: vec![], uvs: vec![], indices: vec![], recharted: None };
     for p in &scene.objects[o].primitives {
         let base = m.positions.len() as u32;
         m.positions.extend(p.positions.iter().map(|v| v.to_array()));
