@@ -505,3 +505,78 @@ fn lossless_reblocking_keeps_every_texture() {
     assert_eq!(out.status.code(), Some(1), "{}", String::from_utf8_lossy(&out.stderr));
     assert!(!bad.exists());
 }
+
+/// samples/tiny.pis with its diffuse texture made 1024 × 1024 texels of one colour, coded
+/// losslessly: a valid file (DEFLATE holds each 12 MiB level image in about 12 KB), whose
+/// level images need at least 1536 bytes of codestream (SPEC.md section 12: a level image
+/// decodes to at most 8192 times the codestream bytes of the file).
+fn flat_large_texture(dir: &Path) -> PathBuf {
+    use pis_format::{samples, Block, CodecId};
+    let mut c = samples::tiny().expect("tiny");
+    let layer = c.objects[0].layers[0].clone();
+    let counts: Vec<Vec<u32>> = layer.blocks[0].levels.iter().map(|l| l.counts.clone()).collect();
+    let extent = counts.last().expect("a finest level").clone();
+    let block = Block { width: 1024, height: 1024, levels: vec![], ..layer.blocks[0].clone() };
+    let textures = vec![vec![0.25f32; 1024 * 1024 * 3]; extent.iter().product::<u32>() as usize];
+    let block =
+        samples::encode_block(&layer, block, &extent, &counts, &textures, CodecId::Lossless)
+            .expect("encode");
+    c.objects[0].layers[0].blocks = vec![block];
+    let path = dir.join("flat.pis");
+    pis_format::write(&path, &c).expect("a valid input");
+    validate(&path);
+    path
+}
+
+/// The folder holds only `input` (no output, no temporary file).
+fn only_input(dir: &Path) {
+    let names: Vec<_> =
+        std::fs::read_dir(dir).expect("dir").map(|e| e.expect("entry").file_name()).collect();
+    assert_eq!(names, ["flat.pis"], "{names:?}");
+}
+
+/// A ratio whose byte budget cannot hold codestreams large enough for the textures they
+/// decode to (SPEC.md section 12) is refused with the reason before anything is encoded:
+/// the re-encoding once ran and failed at the write with error-6009.
+#[test]
+fn a_budget_too_small_for_the_textures_is_refused_before_encoding() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let input = flat_large_texture(dir.path());
+    let out =
+        reencode(&input, &dir.path().join("out.pis"), &["--codec", "wavelet", "--ratio", "10"]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(err.contains("SPEC.md section 12") && err.contains("a ratio of at most"), "{err}");
+    assert!(!err.contains("pis-reencode: encode"), "refused before encoding: {err}");
+    only_input(dir.path());
+}
+
+/// A codec that codes a large flat texture in a few bytes, whatever the budget, gives
+/// codestreams too small for section 12's limits: refused before anything is written.
+#[test]
+fn codestreams_too_small_for_their_textures_are_refused_before_writing() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let input = flat_large_texture(dir.path());
+    let out = reencode(&input, &dir.path().join("out.pis"), &["--codec", "wavelet"]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(err.contains("SPEC.md section 12") && err.contains("nothing was written"), "{err}");
+    assert!(!err.contains("pis-reencode: write"), "{err}");
+    only_input(dir.path());
+}
+
+/// A ratio so high that every level image gets no byte: every codestream is empty (SPEC.md
+/// 11.2, decoding to zeros), and section 12 counts such a file's codestreams as 1024 bytes,
+/// so the output is written and valid; it was once refused with error-6009 (8192 × 0 bytes).
+#[test]
+fn an_output_whose_codestreams_are_all_empty_is_valid() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let out = dir.path().join("empty.pis");
+    let r = json(&reencode(
+        &repo("samples/tiny.pis"),
+        &out,
+        &["--codec", "wavelet", "--ratio", "1000000"],
+    ));
+    assert_eq!(r["texture_bytes_after"], 0, "{r}");
+    validate(&out);
+}

@@ -532,6 +532,9 @@ pub fn reencode(req: &ReencodeRequest) -> Result<ReencodeReport, Failure> {
     );
 
     let (target, target_text) = target(req, raw, texture_bytes_before);
+    // A budget too small for section 12's limits is refused before encoding; what the codec
+    // makes of a budget that suffices is checked before writing (`check_limits`).
+    let need = container::check_budget(&pyramids, &target, &target_text, raw)?;
     // A master carries the allocation weights its writer used; otherwise they are measured.
     let need_areas = !exact || (req.keep_master && !from_master);
     let areas = allocation_areas(c, &masters_in, need_areas, &mut t);
@@ -567,6 +570,7 @@ pub fn reencode(req: &ReencodeRequest) -> Result<ReencodeReport, Failure> {
         &codecs_before,
         raw,
     ));
+    container::check_limits(&out, need)?;
     let masters_out = masters_out(req, &out, &masters_in, &made, areas.as_deref(), &mut t)?;
     let bytes_after =
         pis_format::write_with_masters(&req.output, &out, &masters_out).map_err(|e| match e {

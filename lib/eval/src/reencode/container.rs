@@ -2,6 +2,8 @@
 //! replaced, and the provenance of the re-encoding.
 
 use anyhow::anyhow;
+use pis_codec::allocate;
+use pis_format::checks::{decoded_sizes, required_codestream_bytes};
 use pis_format::*;
 use pis_pack::storage::BlockPyramid;
 use pis_pack::{Exit, Failure, MaxMse};
@@ -58,6 +60,63 @@ pub fn assemble<S>(
         }
     }
     Ok(out)
+}
+
+/// What the output's level images decode to, per block: the bytes of one level image and
+/// their number.
+fn decoded(pyramids: &[BlockPyramid]) -> impl Iterator<Item = (u64, u64)> + '_ {
+    pyramids.iter().map(|p| {
+        let values = pis_codec::value_count(&p.planes).map_or(u64::MAX, |n| n as u64);
+        let images = p.levels.iter().map(|l| l.0.iter().map(|&c| c as u64).product::<u64>());
+        (values.saturating_mul(4), images.sum())
+    })
+}
+
+/// The least codestream bytes the output's level images need (SPEC.md section 12 bounds
+/// what they decode to by the codestream bytes they read: 8192 × C per level image,
+/// 131072 × C for all); refused, before anything is encoded, where the byte budget of
+/// `target` is smaller, since no allocation within it could make the file valid.
+pub fn check_budget(
+    pyramids: &[BlockPyramid],
+    target: &allocate::Target,
+    target_text: &str,
+    raw: u64,
+) -> Result<u64, Failure> {
+    let need = required_codestream_bytes(decoded(pyramids));
+    match *target {
+        allocate::Target::Bytes(budget) if need > budget as u64 => Err(Failure::new(
+            Exit::Usage,
+            anyhow!(
+                "the target ({target_text}) leaves the level images {budget} bytes of codestream, and the textures they decode to need at least {need}: a file's level images decode to at most 8192 times the bytes of its codestreams, and all of them together to at most 131072 times (SPEC.md section 12); a ratio of at most {:.0} or an exact codec stores them; nothing was written",
+                (raw as f64 / need as f64).floor()
+            ),
+        )),
+        _ => Ok(need),
+    }
+}
+
+/// Refuses an encoded output that breaks section 12's limits (rules 6009 and 6010: codecs
+/// may code large flat textures in fewer bytes than the limits need, whatever the budget),
+/// before anything is written.
+pub fn check_limits(out: &Container, need: u64) -> Result<(), Failure> {
+    let bytes: u64 = out
+        .objects
+        .iter()
+        .flat_map(|o| &o.layers)
+        .flat_map(|l| &l.blocks)
+        .flat_map(|b| &b.levels)
+        .flat_map(|l| &l.images)
+        .map(|r| r.bytes.len() as u64)
+        .sum();
+    match decoded_sizes(out, bytes) {
+        None => Ok(()),
+        Some(issue) => Err(Failure::new(
+            Exit::Usage,
+            anyhow!(
+                "the re-encoded level images hold {bytes} bytes of codestream and the textures they decode to need at least {need} (a file's level images decode to at most 8192 times the bytes of its codestreams, and all of them together to at most 131072 times: SPEC.md section 12; {issue}); a lower ratio or an exact codec stores them; nothing was written"
+            ),
+        )),
+    }
 }
 
 /// The codecs of the input's level images, by name, sorted.
