@@ -59,7 +59,7 @@ pub(crate) fn read_gltf(path: &Path, allow_outside: bool) -> Result<GltfScene, S
         let gltf::Gltf { document: doc, blob } = gltf;
         let buffers =
             gltf::import_buffers(&doc, Some(base), blob).map_err(|e| import_error(path, e))?;
-        let images = import_images(path, &doc, base, &buffers)?;
+        let images = crate::gltf_images::import_images(path, &doc, base, &buffers)?;
         check_animation_indices(path, &doc)?;
         convert(path, &doc, &buffers, &images)
     };
@@ -118,7 +118,7 @@ fn convert(
     path: &Path,
     doc: &gltf::Document,
     buffers: &[gltf::buffer::Data],
-    images: &[ImageData],
+    images: &[crate::gltf_images::ImageData],
 ) -> Result<GltfScene, SceneError> {
     let ctx = Ctx { path: path.to_owned(), buffers };
 
@@ -197,7 +197,7 @@ struct Materials {
 fn read_materials(
     path: &Path,
     doc: &gltf::Document,
-    images: &[ImageData],
+    images: &[crate::gltf_images::ImageData],
 ) -> Result<Materials, SceneError> {
     let mut texture_set = TextureSet::new(path, images);
     let mut materials = Vec::new();
@@ -332,45 +332,6 @@ impl Ctx<'_> {
         }
         Ok(unsupported_animations)
     }
-}
-
-/// An image of the glTF as read: its data, or why it could not be read (its file missing, or
-/// of a format PIS does not decode, such as TGA: exporters write such references).
-pub(crate) type ImageData = Result<gltf::image::Data, String>;
-
-/// Every image of `doc`, each read on its own: one whose file is missing or of a format PIS
-/// does not decode leaves the textures using it unread, with a warning, instead of failing
-/// the whole scene; damaged data of a format it decodes is an error naming the image.
-fn import_images(
-    path: &Path,
-    doc: &gltf::Document,
-    base: &Path,
-    buffers: &[gltf::buffer::Data],
-) -> Result<Vec<ImageData>, SceneError> {
-    doc.images()
-        .map(|image| {
-            let uri = match image.source() {
-                gltf::image::Source::Uri { uri, .. } if !uri.starts_with("data:") => {
-                    format!(" ('{uri}')")
-                }
-                _ => String::new(),
-            };
-            let field = format!("images[{}]", image.index());
-            match gltf::image::Data::from_source(image.source(), Some(base), buffers) {
-                Ok(data) => Ok(Ok(data)),
-                Err(gltf::Error::Io(source)) => {
-                    Ok(Err(format!("{field}{uri} cannot be read: {source}")))
-                }
-                Err(gltf::Error::UnsupportedScheme) => Ok(Err(format!(
-                    "{field}{uri} cannot be read: a URI scheme or drive PIS does not read"
-                ))),
-                Err(gltf::Error::UnsupportedImageEncoding) => Ok(Err(format!(
-                    "{field}{uri} is of a format PIS does not decode (PNG and JPEG only)"
-                ))),
-                Err(other) => Err(SceneError::invalid(path, field, other.to_string())),
-            }
-        })
-        .collect()
 }
 
 /// Maps a gltf crate error to a [`SceneError`] that names the file.

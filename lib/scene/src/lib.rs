@@ -30,6 +30,7 @@ mod error;
 pub mod extensions;
 mod frame;
 mod gltf_files;
+mod gltf_images;
 mod gltf_load;
 mod light;
 pub mod light_path;

@@ -6,7 +6,7 @@ use std::path::Path;
 
 use serde_json::Value;
 
-use crate::gltf_load::ImageData;
+use crate::gltf_images::ImageData;
 use crate::model::{Material, TextureImage};
 use crate::texture_ref::{TextureRef, UvTransform};
 use crate::SceneError;
