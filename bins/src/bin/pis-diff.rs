@@ -66,6 +66,11 @@ struct Cli {
     /// samples by their Gaussian coverage, as the gold standard's pixels are filtered.
     #[arg(long, default_value_t = pis_play::multisample::DEFAULT_SAMPLES, value_name = "1|4", value_parser = pis::play::args::parse_msaa)]
     msaa: u32,
+    /// Memory budget in GiB for two files' decoded textures (a block of each at a time): a
+    /// pair whose largest blocks would take more is refused before decoding (exit 5).
+    /// Default: 4, or half the memory available where that is less.
+    #[arg(long, value_name = "GB", value_parser = pis_eval::budget::parse_memory)]
+    memory: Option<f64>,
 }
 
 fn run(cli: Cli) -> Result<Exit, Failure> {
@@ -113,6 +118,7 @@ fn run(cli: Cli) -> Result<Exit, Failure> {
     if cli.max_psnr_drop.is_some() || cli.reference_psnr.is_some() {
         return Err(Failure::new(Exit::Usage, anyhow::anyhow!("--max-psnr-drop compares with a gold-standard set: give a set folder as the second argument")));
     }
+    pis_eval::budget::check_diff(&cli.a, &cli.b, pis_eval::budget::budget_bytes(cli.memory))?;
     let req = DiffRequest { a: cli.a, b: cli.b, heatmaps: cli.heatmaps, min_psnr: cli.min_psnr };
     let report = diff(&req)?;
     if cli.json {

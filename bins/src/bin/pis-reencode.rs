@@ -58,6 +58,11 @@ struct Cli {
     /// input's provenance records its writer applied (1.25 where it records nothing).
     #[arg(long, value_name = "off|ALPHA")]
     max_mse_ratio: Option<pis_pack::MaxMse>,
+    /// Memory budget in GiB for the decoded textures and the new pyramids: an input that
+    /// would take more is refused before decoding (exit 5). Default: 4, or half the memory
+    /// available where that is less.
+    #[arg(long, value_name = "GB", value_parser = pis_eval::budget::parse_memory)]
+    memory: Option<f64>,
     /// Print the report as JSON on stdout.
     #[arg(long)]
     json: bool,
@@ -74,6 +79,7 @@ fn parse_block(s: &str) -> Result<BlockSizes, String> {
 fn run(cli: Cli) -> Result<Exit, Failure> {
     let target = pis_pack::Target::given(cli.ratio, cli.psnr)
         .map_err(|e| Failure::new(Exit::Usage, anyhow::anyhow!(e)))?;
+    pis_eval::budget::check_reencode(&cli.input, pis_eval::budget::budget_bytes(cli.memory))?;
     let req = ReencodeRequest {
         input: cli.input,
         output: cli.output,

@@ -66,16 +66,18 @@ pub fn set_display_filter(dir: &std::path::Path) -> Option<pis_format::DisplayFi
 
 /// The exit code of a player error, the one table every tool that plays uses: a request
 /// that does not fit the file is a usage error, a file the player cannot draw is invalid,
-/// what this machine cannot do (no adapter, a texture or render target beyond its limits)
-/// is not supported, and the rest is a runtime error.
+/// what this machine cannot do (no adapter, a texture or render target beyond its limits,
+/// textures beyond the cache budget or the adapter's largest buffer) is not supported, and
+/// the rest is a runtime error.
 pub fn play_exit(e: &PlayError) -> Exit {
     match e {
         PlayError::File(f) => pis_pack::format_exit(f),
         PlayError::Request(_) => Exit::Usage,
         PlayError::Content { .. } | PlayError::RepeatSize { .. } => Exit::Invalid,
-        PlayError::NoAdapter(_) | PlayError::TextureSize { .. } | PlayError::TargetSize { .. } => {
-            Exit::NotSupported
-        }
+        PlayError::NoAdapter(_)
+        | PlayError::TextureSize { .. }
+        | PlayError::TargetSize { .. }
+        | PlayError::Memory(_) => Exit::NotSupported,
         _ => Exit::Runtime,
     }
 }

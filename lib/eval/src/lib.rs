@@ -23,6 +23,7 @@
 
 pub mod baselines;
 pub mod bench;
+pub mod budget;
 pub mod chart;
 pub mod compare;
 pub mod diff;

@@ -26,6 +26,10 @@ pub enum PlayError {
     TextureSize { object: String, width: u32, height: u32, limit: u32 },
     #[error("render target {width}×{height} is empty or exceeds the adapter's limit {limit}")]
     TargetSize { width: u32, height: u32, limit: u32 },
+    /// The file's textures need more memory than the player may use or the adapter holds
+    /// (a texture, its sizes and the limit, in words).
+    #[error("{0}")]
+    Memory(String),
     #[error("reading back the frame failed: {0}")]
     Readback(String),
     #[error(transparent)]

@@ -17,6 +17,7 @@
 //! tessellation and draws), `draws.rs` (the frame's draws), `readout.rs` (submitting and
 //! reading back); this file opens the player and runs a frame through them.
 
+mod budget;
 mod draws;
 mod lens;
 mod objects;
@@ -84,6 +85,7 @@ impl Player {
         check_samples(options.msaa).map_err(PlayError::Request)?;
         let reader = PisReader::open(path)?;
         check_texture_sizes(&gpu, &reader)?;
+        budget::check_frame_memory(&gpu, reader.container(), &options)?;
         let objects = prepare_objects(&gpu, &reader)?;
         let filter = file_filter(reader.container());
         // The reader has checked the settings (rule 9002).
