@@ -206,6 +206,14 @@ fn the_player_refuses_a_frame_beyond_its_cache_budget() {
         &names,
         &["cache budget for decoded level images, 512.0 MiB (pis-play --cache-mb)"],
     );
+    // In a window (under Xvfb, where it is installed; CI has it) the player opens the same way.
+    let xvfb = std::process::Command::new("xvfb-run").arg("--help").output().is_ok();
+    if xvfb || std::env::var_os("CI").is_some_and(|v| !v.is_empty()) {
+        let window = code_and_stderr("xvfb-run", &["-a", PLAY, f, "--frames", "1"]);
+        assert_refused("pis-play (window)", window, &names, &["(pis-play --cache-mb)"]);
+    } else {
+        eprintln!("xvfb-run is not installed: the window's refusal is not checked");
+    }
     // Each texture fits 1.5 GiB, the frame's two do not.
     let play = code_and_stderr(PLAY, &[f, "--headless", "--frames", "1", "--cache-mb", "1536"]);
     assert_refused(
