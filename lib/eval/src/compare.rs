@@ -3,9 +3,16 @@
 //! image.
 //!
 //! Per object, the measure is pis-pack's prediction's: the pixels the player draws the
-//! object at (its object index) that the tracer's coverage says the object covers, against
-//! the object's gold surface radiance there (diffuse + specular layers, both stored divided
-//! by coverage). The whole image is measured against the set's combined image.
+//! object at (its object index at the pixel's centre) that the tracer's coverage says the
+//! object covers, the object's radiance there against its gold surface radiance (diffuse +
+//! specular layers, both stored divided by coverage: the object's own radiance, unmixed with
+//! what lies around it). A multisampled frame's resolved pixel mixes the objects of its
+//! neighbourhood as the gold standard's combined image does, not as its layers do: at a
+//! silhouette it is mostly the background's, and a small object's pixels are nearly all
+//! silhouette. So the objects are measured on the frame's single-sample twin
+//! ([`Player::render_centres`]: each pixel wholly the surface at its centre), and only the
+//! whole image (with its silhouette and interior split) on the multisampled frame, against
+//! the set's combined image.
 
 use std::path::Path;
 
@@ -139,6 +146,15 @@ pub fn compare_with_set(
         let (rendered, ids, _) = player
             .render_ids(&req, size)
             .with_context(|| format!("drawing point {i} {:?}", p.values))?;
+        let centres = if player.multisample().samples > 1 {
+            let (img, ids, _) = player
+                .render_centres(&req, size)
+                .with_context(|| format!("drawing point {i} {:?}", p.values))?;
+            Some((img, ids))
+        } else {
+            None
+        };
+        let (own, own_ids) = centres.as_ref().map_or((&rendered, &ids), |(img, ids)| (img, ids));
         let gold = gold_image(&images, res, i, set_dir)?;
         silhouette_pixels(&images, &channels, &mut partial);
         let mut whole = SquaredError::default();
@@ -156,7 +172,7 @@ pub fn compare_with_set(
         }
         let mut objects = Vec::with_capacity(names.len());
         for (o, ch) in channels.iter().enumerate() {
-            let e = object_error(&images, ch, o, &ids, &rendered);
+            let e = object_error(&images, ch, o, own_ids, own);
             let block = grids[o].locate(&p.samples).block;
             per_object[o].0.merge(&e);
             if let Some(b) = per_object[o].1.get_mut(block) {

@@ -63,6 +63,9 @@ pub struct Player {
     filter: Filter,
     pipes: FramePipelines,
     targets: Option<Targets>,
+    /// The targets of the other sample count, kept while frames alternate between the
+    /// multisampled frame and its single-sample twin ([`Player::render_centres`]).
+    spare_targets: Option<Targets>,
     /// The multisampling of frames per target format (offscreen first).
     multisample: HashMap<wgpu::TextureFormat, Multisample>,
     readback: Readbacks,
@@ -118,6 +121,7 @@ impl Player {
             filter,
             pipes,
             targets: None,
+            spare_targets: None,
             multisample: HashMap::from([(offscreen, ms)]),
             readback: None,
             display,
@@ -227,6 +231,22 @@ impl Player {
         Ok((img, ids.unwrap_or_default(), stats))
     }
 
+    /// Draws a frame offscreen with one sample per pixel, whatever the player's
+    /// multisampling: every pixel wholly the nearest surface at its centre, at that surface's
+    /// radiance there, unmixed with its neighbours (what pis-compile's hardware model draws),
+    /// and the object index per pixel as [`Player::render_ids`]. A resolved multisampled
+    /// pixel mixes the objects around it; this is each object's own radiance, which an
+    /// object's ray-traced surface layers (divided by its coverage) are compared with.
+    pub fn render_centres(
+        &mut self,
+        req: &FrameRequest,
+        size: (u32, u32),
+    ) -> Result<(FloatImage, Vec<u32>, FrameStats), PlayError> {
+        let (out, stats) = self.frame(req, size, Target::Centres)?;
+        let (img, ids) = out.ok_or_else(|| PlayError::Readback("no offscreen frame".into()))?;
+        Ok((img, ids.unwrap_or_default(), stats))
+    }
+
     /// Draws a frame offscreen and waits for the GPU to finish it, without reading it back:
     /// what the frame costs where it is shown rather than copied to memory (timings).
     pub fn render_timed(
@@ -265,20 +285,43 @@ impl Player {
         let plan = Plan::new(&self.reader, &self.objects, self.options.blend, req, size)?;
         let corner_sets = self.textures_and_lenses(&plan, size, &mut stats)?;
         let format = match target {
-            Target::Offscreen { .. } | Target::Timed => offscreen_format(&self.gpu),
+            Target::Offscreen { .. } | Target::Centres | Target::Timed => {
+                offscreen_format(&self.gpu)
+            }
             Target::View(_, f) => f,
         };
-        let samples = self.multisample_for(format).samples;
-        if self.targets.as_ref().is_none_or(|t| t.size != size || t.samples != samples) {
-            self.targets = Some(Targets::new(&self.gpu, &self.pipes, size, samples)?);
-            self.readback = None;
-        }
+        let samples = match target {
+            Target::Centres => 1,
+            _ => self.multisample_for(format).samples,
+        };
+        self.make_targets(size, samples)?;
         let out = self.draw(&plan, &corner_sets, target, (format, size), &mut stats)?;
         self.textures.end_frame();
         stats.cache_bytes = self.textures.cache.bytes();
         stats.codestreams_read = self.reader.stats().codestreams - reads0;
         stats.frame_ms = t0.elapsed().as_secs_f64() * 1e3;
         Ok((out, stats))
+    }
+
+    /// Makes the targets of `size` and `samples` current: those of the other sample count
+    /// are kept aside while their size holds (frames alternating with their single-sample
+    /// twins), any others made anew.
+    fn make_targets(&mut self, size: (u32, u32), samples: u32) -> Result<(), PlayError> {
+        let fits = |t: &Option<Targets>| t.as_ref().is_some_and(|t| t.size == size);
+        if fits(&self.targets) && self.targets.as_ref().is_some_and(|t| t.samples == samples) {
+            return Ok(());
+        }
+        if fits(&self.targets) {
+            std::mem::swap(&mut self.targets, &mut self.spare_targets);
+            if self.targets.as_ref().is_some_and(|t| t.size == size && t.samples == samples) {
+                return Ok(());
+            }
+        } else {
+            self.spare_targets = None;
+            self.readback = None;
+        }
+        self.targets = Some(Targets::new(&self.gpu, &self.pipes, size, samples)?);
+        Ok(())
     }
 
     /// Makes the textures `plan` draws resident while, on a thread of their own (the tracing
@@ -366,6 +409,10 @@ impl Player {
                 offscreen_view = targets.colour.create_view(&Default::default());
                 (&offscreen_view, ids)
             }
+            Target::Centres => {
+                offscreen_view = targets.colour.create_view(&Default::default());
+                (&offscreen_view, true)
+            }
             Target::Timed => {
                 offscreen_view = targets.colour.create_view(&Default::default());
                 (&offscreen_view, false)
@@ -385,6 +432,7 @@ impl Player {
             Target::View(..) => return Ok(None),
             Target::Timed => None,
             Target::Offscreen { ids } => Some(ids),
+            Target::Centres => Some(true),
         };
         wait_for_gpu(&gpu)?;
         stats.draw_ms = t_draw.elapsed().as_secs_f64() * 1e3;

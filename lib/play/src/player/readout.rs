@@ -18,6 +18,9 @@ pub(super) type Readout = (FloatImage, Option<Vec<u32>>);
 pub(super) enum Target<'a> {
     /// The offscreen target, read back (with every pixel's object index if `ids`).
     Offscreen { ids: bool },
+    /// The offscreen target drawn with one sample per pixel, read back with every pixel's
+    /// object index.
+    Centres,
     /// The offscreen target, drawn and waited for but not read back: a frame's cost as
     /// playback pays it, where the frame is shown rather than copied to memory.
     Timed,
