@@ -418,14 +418,7 @@ fn masters_in(req: &ReencodeRequest, input: &PisReader) -> Result<Vec<Master>, F
     } else {
         Vec::new()
     };
-    let input_exact = c
-        .objects
-        .iter()
-        .flat_map(|o| &o.layers)
-        .flat_map(|l| &l.blocks)
-        .flat_map(|b| &b.levels)
-        .flat_map(|l| &l.images)
-        .all(|s| !s.codec.is_lossy());
+    let input_exact = c.level_images().all(|s| !s.codec.is_lossy());
     if req.keep_master && masters_in.is_empty() && !input_exact {
         return Err(usage(format!(
             "--keep-master: {} carries no master and its level images are lossy: a master is carried over from a file that has one (pis-pack --keep-master) or made from a losslessly coded file",

@@ -466,6 +466,16 @@ pub struct Provenance {
 }
 
 impl<S> Container<S> {
+    /// Every level image of the file, in file order (object, layer, block, level).
+    pub fn level_images(&self) -> impl Iterator<Item = &S> {
+        self.objects
+            .iter()
+            .flat_map(|o| &o.layers)
+            .flat_map(|l| &l.blocks)
+            .flat_map(|b| &b.levels)
+            .flat_map(|l| &l.images)
+    }
+
     /// The same container with every level image converted by `f` (in file order).
     pub fn try_map<T, E>(&self, f: &mut impl FnMut(&S) -> Result<T, E>) -> Result<Container<T>, E> {
         let mut objects = Vec::with_capacity(self.objects.len());

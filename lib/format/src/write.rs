@@ -161,14 +161,7 @@ fn serialize(c: &Container, masters: &[Master], labelled: bool) -> Result<Sink, 
             s.len()
         )));
     }
-    for r in c
-        .objects
-        .iter()
-        .flat_map(|o| &o.layers)
-        .flat_map(|l| &l.blocks)
-        .flat_map(|b| &b.levels)
-        .flat_map(|l| &l.images)
-    {
+    for r in c.level_images() {
         if u32::try_from(r.bytes.len()).is_err() {
             return Err(Error::Request(format!(
                 "a codestream of {} bytes exceeds 4 GiB",
@@ -177,15 +170,7 @@ fn serialize(c: &Container, masters: &[Master], labelled: bool) -> Result<Sink, 
         }
     }
     // The writer stores every codestream once, in one CSTR chunk (see `serialize_inner`).
-    let codestream_bytes = c
-        .objects
-        .iter()
-        .flat_map(|o| &o.layers)
-        .flat_map(|l| &l.blocks)
-        .flat_map(|b| &b.levels)
-        .flat_map(|l| &l.images)
-        .map(|r| r.bytes.len() as u64)
-        .sum();
+    let codestream_bytes = c.level_images().map(|r| r.bytes.len() as u64).sum();
     if let Some(issue) = checks::decoded_sizes(c, codestream_bytes) {
         return Err(Error::InvalidModel(issue));
     }

@@ -99,15 +99,7 @@ pub fn check_budget(
 /// may code large flat textures in fewer bytes than the limits need, whatever the budget),
 /// before anything is written.
 pub fn check_limits(out: &Container, need: u64) -> Result<(), Failure> {
-    let bytes: u64 = out
-        .objects
-        .iter()
-        .flat_map(|o| &o.layers)
-        .flat_map(|l| &l.blocks)
-        .flat_map(|b| &b.levels)
-        .flat_map(|l| &l.images)
-        .map(|r| r.bytes.len() as u64)
-        .sum();
+    let bytes: u64 = out.level_images().map(|r| r.bytes.len() as u64).sum();
     match decoded_sizes(out, bytes) {
         None => Ok(()),
         Some(issue) => Err(Failure::new(
@@ -121,15 +113,7 @@ pub fn check_limits(out: &Container, need: u64) -> Result<(), Failure> {
 
 /// The codecs of the input's level images, by name, sorted.
 pub fn codecs(c: &Container<StreamRef>) -> Vec<String> {
-    let mut v: Vec<String> = c
-        .objects
-        .iter()
-        .flat_map(|o| &o.layers)
-        .flat_map(|l| &l.blocks)
-        .flat_map(|b| &b.levels)
-        .flat_map(|l| &l.images)
-        .map(|s| s.codec.name().to_string())
-        .collect();
+    let mut v: Vec<String> = c.level_images().map(|s| s.codec.name().to_string()).collect();
     v.sort();
     v.dedup();
     v
