@@ -136,6 +136,7 @@ fn exercise(file: &Path, original: &Path, scratch: &Path, gpu: &Arc<Gpu>) {
         keep_master: false,
         block: None,
         max_mse: None,
+        memory: pis_eval::budget::DEFAULT_BUDGET,
     });
     let _ = std::fs::remove_file(&out);
     // pis-diff against the file it came from.
@@ -144,6 +145,7 @@ fn exercise(file: &Path, original: &Path, scratch: &Path, gpu: &Arc<Gpu>) {
         b: file.to_path_buf(),
         heatmaps: None,
         min_psnr: None,
+        memory: pis_eval::budget::DEFAULT_BUDGET,
     });
     // pis-play: two frames along the diagonal.
     let options = PlayerOptions { workers: 1, ..PlayerOptions::default() };
@@ -193,6 +195,7 @@ fn seeds(dir: &Path) -> Vec<PathBuf> {
             keep_master,
             block: None,
             max_mse: None,
+            memory: pis_eval::budget::DEFAULT_BUDGET,
         })
         .unwrap_or_else(|e| panic!("seed {name}: {}", e.error));
         out.push(path);

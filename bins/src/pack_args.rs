@@ -135,7 +135,7 @@ pub struct PackOptions {
     /// more (about three times its float images) is streamed: its images, render matrices
     /// and gold standard go to a scratch file beside the output, read back an object and
     /// point at a time, and removed at the end. The file written is the same byte for byte.
-    #[arg(long, value_name = "GB", value_parser = parse_memory)]
+    #[arg(long, value_name = "GB", value_parser = pis_eval::budget::parse_memory)]
     pub memory: Option<f64>,
 }
 
@@ -216,13 +216,6 @@ impl PackOptions {
         let args = std::iter::once("pis-pack").chain(args.iter().copied());
         <Only as clap::Parser>::try_parse_from(args).map(|o| o.pack)
     }
-}
-
-fn parse_memory(s: &str) -> Result<f64, String> {
-    s.parse::<f64>()
-        .ok()
-        .filter(|v| v.is_finite() && *v > 0.0)
-        .ok_or_else(|| format!("bad memory budget {s:?}: expected a number of GB above 0"))
 }
 
 /// The values of `--filter`, by [`Filter::name`] (the anisotropy clamp comes from

@@ -118,8 +118,9 @@ fn run(cli: Cli) -> Result<Exit, Failure> {
     if cli.max_psnr_drop.is_some() || cli.reference_psnr.is_some() {
         return Err(Failure::new(Exit::Usage, anyhow::anyhow!("--max-psnr-drop compares with a gold-standard set: give a set folder as the second argument")));
     }
-    pis_eval::budget::check_diff(&cli.a, &cli.b, pis_eval::budget::budget_bytes(cli.memory))?;
-    let req = DiffRequest { a: cli.a, b: cli.b, heatmaps: cli.heatmaps, min_psnr: cli.min_psnr };
+    let memory = pis_eval::budget::budget_bytes(cli.memory);
+    let req =
+        DiffRequest { a: cli.a, b: cli.b, heatmaps: cli.heatmaps, min_psnr: cli.min_psnr, memory };
     let report = diff(&req)?;
     if cli.json {
         let s =

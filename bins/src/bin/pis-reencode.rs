@@ -79,7 +79,6 @@ fn parse_block(s: &str) -> Result<BlockSizes, String> {
 fn run(cli: Cli) -> Result<Exit, Failure> {
     let target = pis_pack::Target::given(cli.ratio, cli.psnr)
         .map_err(|e| Failure::new(Exit::Usage, anyhow::anyhow!(e)))?;
-    pis_eval::budget::check_reencode(&cli.input, pis_eval::budget::budget_bytes(cli.memory))?;
     let req = ReencodeRequest {
         input: cli.input,
         output: cli.output,
@@ -89,6 +88,7 @@ fn run(cli: Cli) -> Result<Exit, Failure> {
         keep_master: cli.keep_master,
         block: cli.block.map(|b| b.0),
         max_mse: cli.max_mse_ratio,
+        memory: pis_eval::budget::budget_bytes(cli.memory),
     };
     let report = reencode(&req)?;
     print_report(&report, &mut std::io::stderr()).map_err(|e| Failure::new(Exit::Io, e))?;

@@ -58,6 +58,9 @@ pub struct ReencodeRequest {
     /// input's provenance records its writer applied (`max_mse_ratio`), α = 1.25 where it
     /// records nothing.
     pub max_mse: Option<MaxMse>,
+    /// The memory budget in bytes for the decoded textures and the new pyramids
+    /// ([`crate::budget`]): an input that would take more is refused before decoding (exit 5).
+    pub memory: u64,
 }
 
 /// The max-MSE constraint the input's writer applied, from its provenance setting
@@ -493,6 +496,7 @@ fn object_reports(
 /// Re-encodes `req.input` into `req.output`; on error no output file is left.
 pub fn reencode(req: &ReencodeRequest) -> Result<ReencodeReport, Failure> {
     check(req)?;
+    crate::budget::check_reencode(&req.input, req.memory)?;
     let runtime = |e: anyhow::Error| Failure::new(Exit::Runtime, e);
     let mut t = Timer(Vec::new(), Instant::now());
     let input = open(&req.input)?;

@@ -27,6 +27,9 @@ pub struct DiffRequest {
     pub heatmaps: Option<PathBuf>,
     /// Gate: the whole-file PSNR must reach this many dB.
     pub min_psnr: Option<f64>,
+    /// The memory budget in bytes for both files' decoded blocks ([`crate::budget`]): a pair
+    /// that would take more is refused before decoding (exit 5).
+    pub memory: u64,
 }
 
 /// A quality gate and how it went.
@@ -125,6 +128,7 @@ pub fn min_psnr_gate(limit: f64, psnr: Option<f64>) -> Gate {
 
 /// Compares two containers.
 pub fn diff(req: &DiffRequest) -> Result<DiffReport, Failure> {
+    crate::budget::check_diff(&req.a, &req.b, req.memory)?;
     if let Some(p) = req.min_psnr {
         if !p.is_finite() {
             return Err(Failure::new(
