@@ -124,7 +124,11 @@ fn areas(positions: &[Vec3], uvs: &[Vec2], indices: &[u32]) -> Vec<(f64, f64)> {
 /// Per triangle, whether its texture coordinates are degenerate (see the module's text).
 /// Triangles of no object-space area are not: nothing of them is seen.
 pub fn degenerate_triangles(positions: &[Vec3], uvs: &[Vec2], indices: &[u32]) -> Vec<bool> {
-    let a = areas(positions, uvs, indices);
+    degenerate(&areas(positions, uvs, indices))
+}
+
+/// [`degenerate_triangles`] of the triangles' (object-space area, (u, v) area).
+fn degenerate(a: &[(f64, f64)]) -> Vec<bool> {
     let (world, texture) = a.iter().fold((0.0, 0.0), |s, &(w, t)| (s.0 + w, s.1 + t));
     let density = if world > 0.0 { texture / world } else { 0.0 };
     a.iter().map(|&(w, t)| w > 0.0 && !(t > DEGENERATE * density * w && t > 0.0)).collect()
@@ -158,19 +162,18 @@ fn project(p: Vec3, g: usize) -> Vec2 {
 
 /// The mesh charted again where its coordinates are degenerate; `None` when no triangle is.
 pub fn rechart(positions: &[Vec3], uvs: &[Vec2], indices: &[u32]) -> Option<Recharted> {
-    let mut bad = degenerate_triangles(positions, uvs, indices);
+    let a = areas(positions, uvs, indices);
+    let mut bad = degenerate(&a);
     // The spread of the triangles kept: degenerate ones are charted again either way.
-    let kept: Vec<(f64, f64)> = (areas(positions, uvs, indices).into_iter().zip(&bad))
-        .map(|(a, &b)| if b { (0.0, 0.0) } else { a })
-        .collect();
+    let kept: Vec<(f64, f64)> =
+        a.iter().zip(&bad).map(|(&a, &b)| if b { (0.0, 0.0) } else { a }).collect();
     let spread = density_spread(&kept);
     if spread > NONUNIFORM_DENSITY {
-        bad = areas(positions, uvs, indices).iter().map(|&(w, _)| w > 0.0).collect();
+        bad = a.iter().map(|&(w, _)| w > 0.0).collect();
     }
     if !bad.contains(&true) {
         return None;
     }
-    let a = areas(positions, uvs, indices);
     let total: f64 = a.iter().map(|&(w, _)| w).sum();
     let groups: Vec<Option<usize>> = indices
         .chunks_exact(3)

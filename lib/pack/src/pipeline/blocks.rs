@@ -3,9 +3,11 @@
 //! ([`super::transforms`]).
 
 use anyhow::{anyhow, Result};
+use glam::Vec3;
 use pis_format::*;
 
 use super::input::LoadedSet;
+use super::shell_fit::mesh::bounds;
 use super::transforms::{baked, row3x4, stored_transform};
 use super::Stagger;
 
@@ -69,9 +71,17 @@ pub fn geometry(set: &LoadedSet, sizes: &[u32]) -> (ParameterSpace, CameraTable)
             .collect::<Vec<_>>(),
     );
     let mut cameras = vec![None; space.table_len(view) as usize];
+    // Each object's bounds in object space, once: every frame places them.
+    let bounds: Vec<Option<(Vec3, Vec3)>> = (set.scene.objects.iter())
+        .map(|o| {
+            (o.primitives.iter().filter_map(|p| bounds(&p.positions)))
+                .reduce(|a, b| (a.0.min(b.0), a.1.max(b.1)))
+                .filter(|(lo, hi)| lo.is_finite() && hi.is_finite())
+        })
+        .collect();
     for (s, f) in set.samples.iter().zip(&set.frames) {
         let c = f.camera;
-        let (znear, zfar) = depth_range(set, f);
+        let (znear, zfar) = depth_range(&bounds, f);
         cameras[space.table_index(view, s)] = Some(Camera {
             world_from_camera: row3x4(c.world_from_camera),
             yfov: c.yfov,
@@ -105,24 +115,18 @@ pub fn geometry(set: &LoadedSet, sizes: &[u32]) -> (ParameterSpace, CameraTable)
 /// plane, or where it has none (glTF's infinite projection) 10⁴ or twice the distance of the
 /// farthest object corner, whichever is larger (a model in millimetres or centimetres,
 /// unscaled, lay beyond 10⁴ and drew nothing).
-fn depth_range(set: &LoadedSet, frame: &pis_scene::Frame) -> (f32, f32) {
+fn depth_range(bounds: &[Option<(Vec3, Vec3)>], frame: &pis_scene::Frame) -> (f32, f32) {
     let c = &frame.camera;
-    let eye = c.world_from_camera.transform_point3(glam::Vec3::ZERO).as_dvec3();
+    let eye = c.world_from_camera.transform_point3(Vec3::ZERO).as_dvec3();
     let (mut near, mut far) = (f64::INFINITY, 0.0f64);
-    for (object, instance) in set.scene.objects.iter().zip(&frame.instances) {
-        let points = object.primitives.iter().flat_map(|p| p.positions.iter());
-        let (lo, hi) = points.fold(
-            (glam::Vec3::splat(f32::INFINITY), glam::Vec3::splat(f32::NEG_INFINITY)),
-            |(lo, hi), p| (lo.min(*p), hi.max(*p)),
-        );
-        if !(lo.is_finite() && hi.is_finite()) {
-            continue;
-        }
+    for (&(lo, hi), instance) in
+        bounds.iter().zip(&frame.instances).filter_map(|(b, i)| Some((b.as_ref()?, i)))
+    {
         let m = instance.world_from_object.as_dmat4();
         let (mut wlo, mut whi) = (glam::DVec3::INFINITY, glam::DVec3::NEG_INFINITY);
         for k in 0..8 {
             let pick = glam::BVec3::new(k & 1 != 0, k & 2 != 0, k & 4 != 0);
-            let world = m.transform_point3(glam::Vec3::select(pick, hi, lo).as_dvec3());
+            let world = m.transform_point3(Vec3::select(pick, hi, lo).as_dvec3());
             far = far.max(world.distance(eye));
             (wlo, whi) = (wlo.min(world), whi.max(world));
         }

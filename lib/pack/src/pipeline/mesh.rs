@@ -12,6 +12,7 @@ use pis_compile::{Address, Filter, Sampler, TextureLayout, TextureTransform};
 use pis_scene::{Frame, Scene};
 
 /// One object's mesh, all primitives merged, in object space.
+#[derive(Clone, Debug)]
 pub struct Mesh {
     pub positions: Vec<[f32; 3]>,
     /// Unit vertex normals, one per position.

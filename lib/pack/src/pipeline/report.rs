@@ -5,7 +5,6 @@ use std::collections::BTreeMap;
 use serde::Serialize;
 
 use super::input::LoadedSet;
-use super::mesh::merged_mesh;
 use super::model::ObjectModel;
 use super::packed::Packed;
 use super::packed::Quality;
@@ -190,7 +189,7 @@ pub fn build(
                 name: m.name.clone(),
                 representation: m.representation.clone(),
                 why: m.why.clone(),
-                recharted: merged_mesh(&set.scene, m.index).recharted,
+                recharted: m.mesh.recharted.clone(),
                 bytes: packed.layer_bytes[mi].iter().sum(),
                 layer_bytes: m
                     .layers

@@ -25,7 +25,7 @@ use pis_trace::PointImages;
 
 use super::input::LoadedSet;
 use super::matrices::Matrices;
-use super::mesh::{atlas, merged_mesh, place_in, sampler, Atlas, Mesh, Placed};
+use super::mesh::{atlas, place_in, sampler, Atlas, Mesh, Placed};
 use super::model::{key, InferredLayer, LayerForm, ObjectModel, PointView, Views};
 use super::represent::{Job, Planned, Representation, Surveyed};
 use super::rows::{gather, restrict_rows};
@@ -648,7 +648,7 @@ impl Planned for Layers {
         Ok(ObjectModel {
             index: o,
             name,
-            mesh: merged_mesh(scene, o),
+            mesh: job.meshes[o].clone(),
             mesh_uvs: at.uvs,
             placements,
             stagger: st,
