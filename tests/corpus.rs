@@ -13,9 +13,13 @@
 //! scene) is printed beside them. `cargo test --release --test corpus -- --nocapture` prints
 //! the table; `PIS_CORPUS=NAME` runs one model.
 
+mod common;
+
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 use std::time::Instant;
+
+use common::os;
 
 /// How far an object's lossless figure may lie below its set's noise level (dB).
 const BELOW_NOISE_DB: f64 = 6.0;
@@ -44,13 +48,9 @@ fn corpus() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../samples/corpus")
 }
 
-fn os<S: AsRef<std::ffi::OsStr> + ?Sized>(s: &S) -> &std::ffi::OsStr {
-    s.as_ref()
-}
-
+/// `program args`, which must succeed (common::run: killed after 120 s).
 fn run(program: &str, args: &[&std::ffi::OsStr]) -> Output {
-    let out =
-        Command::new(program).args(args).output().unwrap_or_else(|e| panic!("{program} runs: {e}"));
+    let out = common::run(program, args, &[]);
     assert!(
         out.status.success(),
         "{program} {args:?} failed ({}): {}",
@@ -138,10 +138,8 @@ fn check(name: &str) -> (Vec<String>, Vec<String>) {
         [os(&set), os("--scene"), os(&toml), os("--codec"), os("lossless"), os("-o"), os(&l)];
     run(pack, &lossless);
     let played = json(&run(diff, &[os(&at("d.pis")), os(&at("gold")), os("--json")]));
-    let solved_at = |msaa: &str| {
-        objects(&json(&run(diff, &[os(&l), os(&at("gold")), os("--msaa"), os(msaa), os("--json")])))
-    };
-    let (solved, solved_msaa4) = (solved_at("1"), solved_at("4"));
+    // Per object, pis-diff measures each pixel's own surface (the same at any --msaa).
+    let solved = objects(&json(&run(diff, &[os(&l), os(&at("gold")), os("--json")])));
 
     let mut lines = vec![format!(
         "{name}: ratio {:.0}:1, whole image {:.2} dB, {:.0} s",
@@ -161,9 +159,8 @@ fn check(name: &str) -> (Vec<String>, Vec<String>) {
     }
     for (object, default_db) in drawn {
         let (noise_db, lossless_db) = (figure(&noise, &object), figure(&solved, &object));
-        let lossless4 = figure(&solved_msaa4, &object);
         lines.push(format!(
-            "  {object:<28} noise {noise_db:6.2}  lossless {lossless_db:6.2} (msaa 4: {lossless4:6.2})  default {default_db:6.2} dB"
+            "  {object:<28} noise {noise_db:6.2}  lossless {lossless_db:6.2}  default {default_db:6.2} dB"
         ));
         let known = KNOWN_BELOW.iter().find(|(m, o, _)| *m == name && *o == object);
         let floor = noise_db.min(60.0) - known.map_or(BELOW_NOISE_DB, |_| KNOWN_BELOW_DB);
