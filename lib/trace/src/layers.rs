@@ -206,6 +206,9 @@ pub struct PixelAccum {
     pub samples: u32,
     pub combined: Vec3,
     pub objects: Vec<ObjectAccum>,
+    /// Sums of the denoiser's guides (renders that denoise only).
+    pub albedo: Vec3,
+    pub normal: Vec3,
 }
 
 impl PixelAccum {
@@ -214,6 +217,8 @@ impl PixelAccum {
     pub fn add(&mut self, s: &CameraSample) {
         self.samples += 1;
         self.combined += s.combined;
+        self.albedo += s.guide.albedo;
+        self.normal += s.guide.normal;
         let Some(o) = s.object else { return };
         let idx = match self.objects.iter().position(|a| a.object == o) {
             Some(i) => i,
@@ -242,6 +247,21 @@ impl PixelAccum {
             }
         }
     }
+}
+
+/// The denoiser's guide images of a point: `guide.albedo` and `guide.normal` (the mean of the
+/// pixel's samples; RGB; the normal not renormalised, as the denoiser expects it filtered).
+pub fn resolve_guides(pixels: &[PixelAccum], width: u32, height: u32) -> [LayerImage; 2] {
+    let mut albedo = LayerImage::new("guide.albedo".into(), &["R", "G", "B"], width, height);
+    let mut normal = LayerImage::new("guide.normal".into(), &["R", "G", "B"], width, height);
+    for (i, px) in pixels.iter().enumerate() {
+        let n = px.samples.max(1) as f32;
+        for c in 0..3 {
+            albedo.planes[c][i] = px.albedo[c] / n;
+            normal.planes[c][i] = px.normal[c] / n;
+        }
+    }
+    [albedo, normal]
 }
 
 /// Confidence 1 − min(θm², θc²)/θc² where θm is the largest angle between any two of `dirs`.

@@ -20,6 +20,7 @@
 //! coherence off, of the pixel sample); work is split into fixed bands of rows and every sum
 //! runs in a fixed order, so the output is byte-identical for any thread count.
 
+pub mod adaptive;
 pub mod bvh;
 pub mod camera;
 pub mod environment;
@@ -45,6 +46,6 @@ pub use error::TraceError;
 pub use film::GaussianFilter;
 pub use layers::{LayerImage, LayerKind, PointImages};
 pub use records::{RayRecord, RecordHit};
-pub use render::{channel_names, render_point, PointRender, RenderStats};
+pub use render::{channel_names, render_point, DenoiseInput, PointRender, RenderStats};
 pub use run::{render_set, render_shard, NoProgress, Progress, SetReport, TraceRun};
 pub use settings::{ShadingSeed, TraceSettings};

@@ -1,10 +1,11 @@
 //! Rendering one parameter point: camera samples over the Gaussian filter, rows in parallel,
 //! accumulated in a fixed order so the result is byte-identical for any thread count.
 
+use crate::adaptive::{first_round, next_round, pixel_error};
 use crate::camera::PerspectiveCamera;
 use crate::error::TraceError;
-use crate::integrator::{Integrator, PathContext};
-use crate::layers::{resolve, PixelAccum, PointImages};
+use crate::integrator::{CameraSample, Integrator, PathContext};
+use crate::layers::{resolve, resolve_guides, LayerImage, PixelAccum, PointImages};
 use crate::records::{RayRecord, RecordHit};
 use crate::sampling::{hash_keys, r2_point, Rng};
 use crate::settings::TraceSettings;
@@ -13,8 +14,18 @@ use pis_scene::{Frame, ObjectRole, Scene};
 use rayon::prelude::*;
 use std::time::Instant;
 
-/// One rendered row: pixel sums, ray records, rays traced.
-type RowResult = (Vec<PixelAccum>, Vec<RayRecord>, u64);
+/// One rendered row: its pixels, ray records, rays traced.
+type RowResult = (Vec<PixelSamples>, Vec<RayRecord>, u64);
+
+/// One pixel's camera samples.
+struct PixelSamples {
+    /// Every sample, summed in sample order.
+    whole: PixelAccum,
+    /// The even and the odd samples apart (kept for renders that denoise).
+    halves: Option<Box<[PixelAccum; 2]>>,
+    /// The estimated relative error when the pixel stopped ([`pixel_error`]).
+    error: f32,
+}
 
 /// Image rows per parallel work unit (they share the first-hit irradiance cache).
 pub const BAND_ROWS: u32 = 8;
@@ -41,6 +52,21 @@ pub struct PointRender {
     /// Outgoing-ray records of refractive lens objects, in pixel and sample order.
     pub records: Vec<RayRecord>,
     pub stats: RenderStats,
+    /// Adaptive renders: each pixel's camera samples (`samples.Y`) and its estimated
+    /// relative error when it stopped (`error.Y`).
+    pub sampling: Option<[LayerImage; 2]>,
+    /// Renders that denoise: the guides (`guide.albedo`, `guide.normal`) and the images of
+    /// the even and of the odd samples apart.
+    pub denoise_input: Option<Box<DenoiseInput>>,
+}
+
+/// What denoising a point reads besides its images.
+#[derive(Clone, Debug)]
+pub struct DenoiseInput {
+    /// `guide.albedo`, `guide.normal`.
+    pub guides: [LayerImage; 2],
+    /// The point's images from its even and from its odd camera samples.
+    pub halves: [PointImages; 2],
 }
 
 /// Channel-safe, unique object names: characters other than `[A-Za-z0-9_-]` become `_`,
@@ -120,15 +146,66 @@ pub fn render_point(
     let names = channel_names(scene);
     let objects: Vec<(String, ObjectRole)> =
         names.into_iter().zip(scene.objects.iter().map(|o| o.role)).collect();
-    let images = resolve(&pixels, w, h, &objects);
+    let whole: Vec<PixelAccum> = pixels.iter().map(|p| p.whole.clone()).collect();
+    let images = resolve(&whole, w, h, &objects);
+    let sampling = settings.adaptive().then(|| sampling_maps(&pixels, w, h));
+    let denoise_input = settings.denoise.then(|| {
+        let half = |k: usize| -> Vec<PixelAccum> {
+            pixels
+                .iter()
+                .map(|p| p.halves.as_ref().map(|x| x[k].clone()).unwrap_or_default())
+                .collect()
+        };
+        Box::new(DenoiseInput {
+            guides: resolve_guides(&whole, w, h),
+            halves: [resolve(&half(0), w, h, &objects), resolve(&half(1), w, h, &objects)],
+        })
+    });
     let stats = RenderStats {
-        camera_rays: w as u64 * h as u64 * settings.spp as u64,
+        camera_rays: whole.iter().map(|p| p.samples as u64).sum(),
         total_rays,
         triangles: integrator.geometry.triangle_count() as u64,
         build_seconds,
         trace_seconds,
     };
-    Ok(PointRender { images, records, stats })
+    Ok(PointRender { images, records, stats, sampling, denoise_input })
+}
+
+/// `samples.Y` and `error.Y` of an adaptive render.
+fn sampling_maps(pixels: &[PixelSamples], w: u32, h: u32) -> [LayerImage; 2] {
+    let mut samples = LayerImage::new("samples".into(), &["Y"], w, h);
+    let mut error = LayerImage::new("error".into(), &["Y"], w, h);
+    for (i, p) in pixels.iter().enumerate() {
+        samples.planes[0][i] = p.whole.samples as f32;
+        error.planes[0][i] = p.error;
+    }
+    [samples, error]
+}
+
+/// The outgoing-ray records of a camera sample through image position `pos`.
+fn push_records(records: &mut Vec<RayRecord>, sample: &CameraSample, pos: Vec2) {
+    let (Some(o), Some(terms)) = (sample.object, &sample.lens) else { return };
+    for (k, t) in terms.iter().enumerate() {
+        let Some((eo, ed)) = t.exit else { continue };
+        records.push(RayRecord {
+            object: o,
+            term: k as u8,
+            pixel: pos.to_array(),
+            exit_origin: eo.to_array(),
+            exit_direction: ed.to_array(),
+            modulation: t.modulation.to_array(),
+            hits: t
+                .hits
+                .iter()
+                .map(|h| RecordHit {
+                    t: h.t,
+                    position: h.position.to_array(),
+                    object: h.object,
+                    colour: h.colour.to_array(),
+                })
+                .collect(),
+        });
+    }
 }
 
 fn render_row(
@@ -148,42 +225,36 @@ fn render_row(
             seed => hash_keys(&[x as u64, y as u64, seed]),
         };
         let shift = Rng::new(pixel_seed).next_2d();
-        let mut acc = PixelAccum::default();
-        for s in 0..settings.spp {
-            let offset = settings.filter.sample_offset(r2_point(s, shift));
-            let pos = Vec2::new(x as f32 + 0.5, y as f32 + 0.5) + offset;
-            let dir = camera.direction(pos);
-            ctx.fallback_seed = hash_keys(&[pixel_seed, s as u64]);
-            let record = s < settings.records_per_pixel;
-            let sample = integrator.camera_sample(camera.origin, dir, record, ctx);
-            if record {
-                if let (Some(o), Some(terms)) = (sample.object, &sample.lens) {
-                    for (k, t) in terms.iter().enumerate() {
-                        let Some((eo, ed)) = t.exit else { continue };
-                        records.push(RayRecord {
-                            object: o,
-                            term: k as u8,
-                            pixel: pos.to_array(),
-                            exit_origin: eo.to_array(),
-                            exit_direction: ed.to_array(),
-                            modulation: t.modulation.to_array(),
-                            hits: t
-                                .hits
-                                .iter()
-                                .map(|h| RecordHit {
-                                    t: h.t,
-                                    position: h.position.to_array(),
-                                    object: h.object,
-                                    colour: h.colour.to_array(),
-                                })
-                                .collect(),
-                        });
-                    }
+        let mut whole = PixelAccum::default();
+        let keep_halves = settings.adaptive() || settings.denoise;
+        let mut halves: [PixelAccum; 2] = Default::default();
+        let mut end = first_round(settings.spp, settings.min_spp, settings.adaptive());
+        let mut s = 0;
+        let error = loop {
+            while s < end {
+                let offset = settings.filter.sample_offset(r2_point(s, shift));
+                let pos = Vec2::new(x as f32 + 0.5, y as f32 + 0.5) + offset;
+                let dir = camera.direction(pos);
+                ctx.fallback_seed = hash_keys(&[pixel_seed, s as u64]);
+                let record = s < settings.records_per_pixel;
+                let sample = integrator.camera_sample(camera.origin, dir, record, ctx);
+                if record {
+                    push_records(&mut records, &sample, pos);
                 }
+                whole.add(&sample);
+                if keep_halves {
+                    halves[(s % 2) as usize].add(&sample);
+                }
+                s += 1;
             }
-            acc.add(&sample);
-        }
-        pixels.push(acc);
+            let error = if keep_halves { pixel_error(&halves) } else { 0.0 };
+            if end >= settings.spp || error < settings.noise_threshold {
+                break error;
+            }
+            end = next_round(end, settings.spp);
+        };
+        let halves = settings.denoise.then(|| Box::new(halves));
+        pixels.push(PixelSamples { whole, halves, error });
     }
     (pixels, records, ctx.rays - rays_before)
 }

@@ -34,9 +34,33 @@ pub struct TraceSettings {
     /// seeded per cell, the surfaces' noise stays the same). 0 is the default stream.
     #[serde(default, skip_serializing_if = "is_zero")]
     pub seed: u64,
+    /// Adaptive sampling: a pixel stops taking camera samples once its estimated relative
+    /// error ([`crate::adaptive::pixel_error`]) is below this; `spp` is then each pixel's
+    /// most samples and `min_spp` its fewest. 0: every pixel takes `spp` samples.
+    #[serde(default, skip_serializing_if = "is_zero_f32")]
+    pub noise_threshold: f32,
+    /// Adaptive sampling: the samples every pixel takes before its error is first estimated.
+    #[serde(default, skip_serializing_if = "is_zero_u32")]
+    pub min_spp: u32,
+    /// Denoise the layers (OIDN): the render also keeps its two half buffers and the
+    /// denoiser's guides, albedo and normal at the first non-specular hit.
+    #[serde(default, skip_serializing_if = "is_false")]
+    pub denoise: bool,
+}
+
+fn is_false(v: &bool) -> bool {
+    !*v
 }
 
 fn is_zero(v: &u64) -> bool {
+    *v == 0
+}
+
+fn is_zero_f32(v: &f32) -> bool {
+    *v == 0.0
+}
+
+fn is_zero_u32(v: &u32) -> bool {
     *v == 0
 }
 
@@ -94,6 +118,19 @@ impl TraceSettings {
         self
     }
 
+    /// The same settings sampling adaptively: each pixel takes `min_spp` to `spp` samples
+    /// and stops once its estimated error is below `threshold` (0: fixed `spp`).
+    pub fn with_adaptive(mut self, threshold: f32, min_spp: u32) -> TraceSettings {
+        self.noise_threshold = threshold.max(0.0);
+        self.min_spp = min_spp;
+        self
+    }
+
+    /// Whether pixels sample adaptively.
+    pub fn adaptive(&self) -> bool {
+        self.noise_threshold > 0.0
+    }
+
     /// Defaults for a render at `resolution` with `spp` samples per pixel.
     pub fn new(resolution: (u32, u32), spp: u32) -> TraceSettings {
         TraceSettings {
@@ -107,6 +144,9 @@ impl TraceSettings {
             records_per_pixel: 2,
             max_record_hits: 4,
             seed: 0,
+            noise_threshold: 0.0,
+            min_spp: 0,
+            denoise: false,
         }
     }
 }

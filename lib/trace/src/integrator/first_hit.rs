@@ -2,6 +2,7 @@
 //! 6.2): diffuse and specular, a reflective object's local and distant reflections, and a
 //! lens object's two greedy terms with the hits along their continued exit rays.
 
+use super::guide::Guide;
 use super::{Integrator, PathContext};
 use crate::bvh::{offset_origin, SurfacePoint};
 use crate::lights::hit_light_sphere;
@@ -77,6 +78,8 @@ pub struct CameraSample {
     pub reflective: Option<ReflectiveSample>,
     /// The greedy terms, reflection-first then refraction-first, for refractive objects.
     pub lens: Option<[TermSample; 2]>,
+    /// The denoiser's guides (renders that denoise only; else zero).
+    pub guide: Guide,
 }
 
 impl Integrator<'_> {
@@ -113,7 +116,10 @@ impl Integrator<'_> {
         };
         // The specular lobes draw from their own stream of the surface point.
         let mut rng = self.rng_at(&sp, FIRST_HIT_SPECULAR_STREAM, ctx);
-        let mut out = CameraSample { object: Some(hit.object), diffuse, ..Default::default() };
+        let guide =
+            if self.settings.denoise { self.guide(&sp, &m, dir, ctx) } else { Guide::default() };
+        let mut out =
+            CameraSample { object: Some(hit.object), diffuse, guide, ..Default::default() };
         let role = self.role(hit.object);
         let mut specular = m.emission;
         match role {
