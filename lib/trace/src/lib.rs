@@ -31,6 +31,7 @@ pub mod layers;
 pub mod lights;
 pub mod material;
 pub mod memory;
+pub mod oidn;
 pub mod probe;
 pub mod rays;
 pub mod records;
