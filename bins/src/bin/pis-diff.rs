@@ -71,6 +71,10 @@ struct Cli {
     /// Default: 4, or half the memory available where that is less.
     #[arg(long, value_name = "GB", value_parser = pis_eval::budget::parse_memory)]
     memory: Option<f64>,
+    /// Two sets: read their raw layers where they hold denoised twins (pis-trace
+    /// --denoise); by default a layer with a twin reads as the twin.
+    #[arg(long)]
+    raw: bool,
 }
 
 fn run(cli: Cli) -> Result<Exit, Failure> {
@@ -85,6 +89,7 @@ fn run(cli: Cli) -> Result<Exit, Failure> {
             a: cli.a,
             b: cli.b,
             min_psnr: cli.min_psnr,
+            raw: cli.raw,
         })?;
         if cli.json {
             let s = serde_json::to_string_pretty(&report)

@@ -47,9 +47,27 @@ struct Cli {
     /// Image size WIDTHxHEIGHT, overriding scene.toml and the preset.
     #[arg(long, value_parser = parse_resolution)]
     resolution: Option<(u32, u32)>,
-    /// Camera samples per pixel, overriding scene.toml and the preset.
+    /// Camera samples per pixel, overriding scene.toml and the preset: with adaptive
+    /// sampling (--noise-threshold above 0) each pixel's most.
     #[arg(long)]
     spp: Option<u32>,
+    /// Adaptive sampling: a pixel stops taking samples once its estimated relative error
+    /// (its even against its odd samples, over the combined image and every object layer
+    /// the inference reads, on display values) is below this. 0 turns it off: every pixel
+    /// takes --spp samples.
+    #[arg(long, value_name = "T", default_value_t = 0.0, value_parser = parse_threshold)]
+    noise_threshold: f32,
+    /// Adaptive sampling: the samples every pixel takes before its error is first estimated
+    /// (rounded up to even; then rounds double it up to --spp).
+    #[arg(long, value_name = "N", default_value_t = 4)]
+    min_spp: u32,
+    /// Denoise the layers with Open Image Denoise, guided by albedo and normal at the
+    /// first non-specular hit; the raw layers stay in the set beside the `denoised.` ones.
+    /// `auto`: when the library is found (`pip install pyoidn`, a system OIDN 2.x, or
+    /// PIS_OIDN_LIBRARY naming it), else a warning and raw layers only. `on`: an error
+    /// without it. `off`: raw layers only.
+    #[arg(long, value_name = "auto|on|off", default_value = "auto", value_parser = ["auto", "on", "off"])]
+    denoise: String,
     /// A `[preset.NAME]` of scene.toml (e.g. `paper`).
     #[arg(long)]
     preset: Option<String>,
@@ -90,6 +108,13 @@ enum Command {
     },
 }
 
+fn parse_threshold(s: &str) -> Result<f32, String> {
+    match s.trim().parse::<f32>() {
+        Ok(t) if t.is_finite() && t >= 0.0 => Ok(t),
+        _ => Err(format!("expected a noise threshold of 0 or more (e.g. 0.02), got {s:?}")),
+    }
+}
+
 fn parse_resolution(s: &str) -> Result<(u32, u32), String> {
     let (w, h) =
         s.split_once(['x', 'X']).ok_or_else(|| format!("expected WIDTHxHEIGHT, got {s:?}"))?;
@@ -127,9 +152,14 @@ fn run(cli: &Cli, scene: &Path, output: &Path) -> anyhow::Result<SetReport> {
     let options =
         LoadOptions { preset: cli.preset.clone(), resolution: cli.resolution, spp: cli.spp };
     let scene = pis_scene::load_with(scene, &options).map_err(TraceError::from)?;
-    let settings = TraceSettings::new(scene.resolution, scene.spp)
+    let mut settings = TraceSettings::new(scene.resolution, scene.spp)
         .with_shading_seed(cli.shading_seed)
-        .with_seed(cli.seed);
+        .with_seed(cli.seed)
+        .with_adaptive(cli.noise_threshold, cli.min_spp);
+    settings.denoise = cli.denoise != "off";
+    if cli.denoise == "on" {
+        pis_trace::oidn::shared().map_err(|e| anyhow::anyhow!("--denoise on: {e}"))?;
+    }
     let bar = ProgressBar::new(0);
     bar.set_style(
         ProgressStyle::with_template(
@@ -168,6 +198,27 @@ fn print_report(r: &SetReport) {
         r.camera_rays,
         r.total_rays
     );
+    if r.noise_threshold > 0.0 {
+        eprintln!(
+            "  adaptive: {:.1} samples per pixel on average ({} to {}, noise threshold {})",
+            r.mean_spp, r.min_spp, r.spp, r.noise_threshold
+        );
+    }
+    match &r.denoiser {
+        Some(d) => eprintln!(
+            "  denoised: {d}, {:.1} ms per point; {}",
+            r.denoise_ms_per_point,
+            if r.kept_raw.is_empty() {
+                "every object's layers denoised".to_string()
+            } else {
+                format!(
+                    "kept raw where denoising was estimated to be worse: {}",
+                    r.kept_raw.join(", ")
+                )
+            }
+        ),
+        None => eprintln!("  denoised: no (raw layers only)"),
+    }
     eprintln!(
         "  time: {:.1} ms per point ({:.1} ms tracing), {:.2} s in all; output {:.2} MiB",
         r.ms_per_point, r.trace_ms_per_point, r.seconds, mib

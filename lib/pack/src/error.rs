@@ -81,7 +81,7 @@ pub fn trace_exit(e: &pis_trace::TraceError) -> Exit {
         TraceError::Io { .. } => Exit::Io,
         TraceError::Exr { .. } | TraceError::InvalidSet { .. } => Exit::Invalid,
         TraceError::Scene(s) => scene_exit(s),
-        TraceError::InvalidInput(_) => Exit::Runtime,
+        TraceError::InvalidInput(_) | TraceError::Denoise(_) => Exit::Runtime,
         TraceError::Memory(_) => Exit::NotSupported,
     }
 }

@@ -15,9 +15,11 @@
 //! them. Relative to the square root of the value it is display-referred in the way noise is
 //! seen: an error of 0.01 is about 1 % in a mid-grey pixel.
 //!
-//! Rounds double the pixel's samples, from `min_spp` to `spp`, and a pixel's samples are
-//! always its first N of the fixed sequence, so a pixel that stopped at N samples holds
-//! exactly what a fixed render of N samples would, on any thread count.
+//! Rounds double the pixel's samples, from `min_spp` to `spp`. A pixel's samples are always
+//! the first N of its fixed sequence and its decision reads its own samples only, so an
+//! adaptive render is the same on any thread count (the band's first-hit irradiance cache,
+//! whose cells keep the estimate of the first sample that reaches them, is filled in the
+//! same order too).
 
 use crate::layers::{ObjectAccum, PixelAccum};
 use glam::Vec3;

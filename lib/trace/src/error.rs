@@ -23,6 +23,9 @@ pub enum TraceError {
     /// The work would need more memory than the machine has available.
     #[error("{0}")]
     Memory(String),
+    /// The denoiser failed on an image.
+    #[error("denoising: {0}")]
+    Denoise(String),
 }
 
 impl TraceError {

@@ -23,6 +23,7 @@
 pub mod adaptive;
 pub mod bvh;
 pub mod camera;
+pub mod denoise;
 pub mod environment;
 pub mod error;
 pub mod film;

@@ -58,6 +58,8 @@ pub struct PointRender {
     /// Renders that denoise: the guides (`guide.albedo`, `guide.normal`) and the images of
     /// the even and of the odd samples apart.
     pub denoise_input: Option<Box<DenoiseInput>>,
+    /// What denoising did, once the point's images carry their `denoised.` twins.
+    pub denoised: Option<crate::denoise::PointDenoise>,
 }
 
 /// What denoising a point reads besides its images.
@@ -168,7 +170,7 @@ pub fn render_point(
         build_seconds,
         trace_seconds,
     };
-    Ok(PointRender { images, records, stats, sampling, denoise_input })
+    Ok(PointRender { images, records, stats, sampling, denoise_input, denoised: None })
 }
 
 /// `samples.Y` and `error.Y` of an adaptive render.

@@ -1,7 +1,7 @@
 //! Rendering a whole ray-traced set: every parameter point of a scene, written as it is done.
 
 use crate::error::TraceError;
-use crate::render::render_point;
+use crate::render::{channel_names, render_point, PointRender};
 use crate::set::{Begin, SetWriter, Shard};
 use crate::settings::TraceSettings;
 use pis_scene::Scene;
@@ -54,6 +54,20 @@ pub struct SetReport {
     /// What the trace found wrong with the scene without failing (also told to
     /// [`Progress::note`] as found).
     pub warnings: Vec<String>,
+    /// Adaptive sampling's noise threshold (0: every pixel took `spp` samples).
+    pub noise_threshold: f32,
+    /// Adaptive sampling's fewest samples per pixel.
+    pub min_spp: u32,
+    /// Camera samples per pixel, averaged over the points this process rendered.
+    pub mean_spp: f64,
+    /// The denoiser of the `denoised.` layers; absent when the set is not denoised.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub denoiser: Option<String>,
+    /// Objects kept raw at a point because denoising was estimated to move them further
+    /// from the converged image (`point 3: TeapotLid`).
+    pub kept_raw: Vec<String>,
+    /// Milliseconds per point spent denoising (included in `ms_per_point`).
+    pub denoise_ms_per_point: f64,
 }
 
 /// Progress notifications from [`render_set`], called from worker threads.
@@ -75,6 +89,37 @@ pub fn darkness_warning(scene: &Scene) -> Option<String> {
         "nothing in scene {} emits light (no light in the glTF or in scene.toml, no [environment], no emissive material): every image will be black; add a [[light]] or an [environment] to scene.toml (docs/SCENE.md)",
         scene.name
     ))
+}
+
+/// `settings`, with denoising turned off where it was asked for and Open Image Denoise
+/// cannot be loaded, and then the warning that says why.
+fn denoise_or_not(settings: &TraceSettings) -> (TraceSettings, Option<String>) {
+    let mut settings = settings.clone();
+    let mut note = None;
+    if settings.denoise {
+        if let Err(why) = crate::oidn::shared() {
+            note = Some(format!("the layers are not denoised: {why}"));
+            settings.denoise = false;
+        }
+    }
+    (settings, note)
+}
+
+/// Adds to a rendered point's images the layers the set stores beside the segmented ones:
+/// adaptive sampling's `samples` and `error`, and with denoising the guides and the
+/// `denoised.` twins (RAYSET.md 5.4).
+fn add_set_layers(
+    render: &mut PointRender,
+    objects: &[(String, pis_scene::ObjectRole)],
+) -> Result<(), TraceError> {
+    render.images.layers.extend(render.sampling.take().into_iter().flatten());
+    let Some(input) = render.denoise_input.take() else { return Ok(()) };
+    let oidn = crate::oidn::shared().map_err(|e| TraceError::Denoise(e.to_string()))?;
+    let denoised = crate::denoise::denoise_point(oidn, &render.images, &input, objects)?;
+    render.images.layers.extend(denoised.images);
+    render.images.layers.extend(input.guides);
+    render.denoised = Some(denoised.summary);
+    Ok(())
 }
 
 /// No progress display.
@@ -140,6 +185,10 @@ pub fn render_shard(
         )));
     }
     let start = Instant::now();
+    let (settings, denoise_note) = denoise_or_not(settings);
+    let settings = &settings;
+    let objects: Vec<(String, pis_scene::ObjectRole)> =
+        channel_names(scene).into_iter().zip(scene.objects.iter().map(|o| o.role)).collect();
     let total_points = scene.space.point_count();
     let count = run.limit.map_or(total_points, |l| l.min(total_points));
     let mine: Vec<usize> = run.shard.points(count).collect();
@@ -154,9 +203,16 @@ pub fn render_shard(
         shading_seed: settings.shading_seed().name().into(),
         seed: settings.seed,
         threads: rayon::current_num_threads(),
+        noise_threshold: settings.noise_threshold,
+        min_spp: settings.min_spp,
+        denoiser: settings
+            .denoise
+            .then(crate::oidn::shared)
+            .and_then(Result::ok)
+            .map(|o| format!("Open Image Denoise {}", o.version())),
         ..Default::default()
     };
-    for w in scene.warnings.iter().cloned().chain(darkness_warning(scene)) {
+    for w in scene.warnings.iter().cloned().chain(darkness_warning(scene)).chain(denoise_note) {
         progress.note(&w);
         report.warnings.push(w);
     }
@@ -181,11 +237,17 @@ pub fn render_shard(
     report.points = todo.len();
     progress.start(todo.len(), settings.resolution.1);
     let mut trace_seconds = 0.0;
+    let mut denoise_seconds = 0.0;
     for (k, &index) in todo.iter().enumerate() {
         progress.point(k, todo.len());
         let point = scene.space.point(index);
         let frame = scene.frame(&point)?;
-        let render = render_point(scene, &frame, settings, &|| progress.row())?;
+        let mut render = render_point(scene, &frame, settings, &|| progress.row())?;
+        let t = Instant::now();
+        add_set_layers(&mut render, &objects)?;
+        denoise_seconds += t.elapsed().as_secs_f64();
+        let kept = render.denoised.iter().flat_map(|d| &d.kept_raw);
+        report.kept_raw.extend(kept.map(|o| format!("point {index}: {o}")));
         report.output_bytes += writer.write_point(scene, index, &frame, &render)?;
         report.camera_rays += render.stats.camera_rays;
         report.total_rays += render.stats.total_rays;
@@ -204,6 +266,9 @@ pub fn render_shard(
     if !todo.is_empty() {
         report.ms_per_point = report.seconds * 1000.0 / todo.len() as f64;
         report.trace_ms_per_point = trace_seconds * 1000.0 / todo.len() as f64;
+        report.denoise_ms_per_point = denoise_seconds * 1000.0 / todo.len() as f64;
+        let pixels = settings.resolution.0 as f64 * settings.resolution.1 as f64;
+        report.mean_spp = report.camera_rays as f64 / pixels / todo.len() as f64;
     }
     Ok(report)
 }

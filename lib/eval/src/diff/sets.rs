@@ -30,6 +30,8 @@ pub struct SetsRequest {
     pub b: PathBuf,
     /// Gate: exit 7 when the whole-image PSNR is below this.
     pub min_psnr: Option<f64>,
+    /// Read both sets' raw layers where they hold denoised twins (RAYSET.md 5.4).
+    pub raw: bool,
 }
 
 /// One point of both sets.
@@ -126,6 +128,9 @@ pub struct SetsReport {
     pub per_point: Vec<PointRow>,
     pub min_psnr_db: Option<f64>,
     pub passed: bool,
+    /// Which layers of each set were read: `denoised` (the set's denoised twins), `raw`
+    /// (asked for, or a set without twins).
+    pub layers: [&'static str; 2],
 }
 
 impl SetsReport {
@@ -193,7 +198,9 @@ fn add_object(
 
 /// Compares the sets of `req`.
 pub fn compare_sets(req: &SetsRequest) -> Result<SetsReport, Failure> {
-    let (sa, sb) = (open(&req.a)?, open(&req.b)?);
+    let (sa, sb) = (open(&req.a)?.with_raw(req.raw), open(&req.b)?.with_raw(req.raw));
+    let read = |s: &RaySet| if !s.raw && s.is_denoised() { "denoised" } else { "raw" };
+    let layers = [read(&sa), read(&sb)];
     let invalid = |e: anyhow::Error| Failure::new(Exit::Invalid, e);
     if sa.meta.resolution != sb.meta.resolution {
         return Err(invalid(anyhow!(
@@ -292,6 +299,7 @@ pub fn compare_sets(req: &SetsRequest) -> Result<SetsReport, Failure> {
     let psnr = finite(total.psnr());
     let passed = req.min_psnr.is_none_or(|m| psnr.is_none_or(|p| p >= m));
     Ok(SetsReport {
+        layers,
         a: req.a.display().to_string(),
         b: req.b.display().to_string(),
         resolution: sa.meta.resolution,
@@ -325,8 +333,8 @@ pub fn render(r: &SetsReport) -> String {
     use std::fmt::Write;
     let db = |v: Option<f64>| v.map_or("inf (identical)".to_string(), |v| format!("{v:.2} dB"));
     let mut s = String::new();
-    let _ = writeln!(s, "ray-traced set {} ({} spp) against {} ({} spp), {}x{}: {} point(s) compared ({} and {} held)",
-        r.a, r.spp[0], r.b, r.spp[1], r.resolution[0], r.resolution[1], r.points_compared, r.points[0], r.points[1]);
+    let _ = writeln!(s, "ray-traced set {} ({} spp, {} layers) against {} ({} spp, {} layers), {}x{}: {} point(s) compared ({} and {} held)",
+        r.a, r.spp[0], r.layers[0], r.b, r.spp[1], r.layers[1], r.resolution[0], r.resolution[1], r.points_compared, r.points[0], r.points[1]);
     let _ = writeln!(
         s,
         "  combined images: {} (largest display error {:.4})",

@@ -32,6 +32,10 @@ pub struct SetMeta {
     /// lie under one root, else absolute (RAYSET.md section 3). Absent when unknown.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub scene_file: Option<String>,
+    /// The denoiser whose `denoised.` layers the points hold (`Open Image Denoise 2.5.1`);
+    /// absent when the set was not denoised by its renderer.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub denoiser: Option<String>,
 }
 
 /// The renderer that produced a set.
@@ -97,6 +101,9 @@ pub struct PointMeta {
     pub lights: Vec<LightMeta>,
     /// Placement of every object, same order as the set's `objects`.
     pub objects: Vec<ObjectStateMeta>,
+    /// Which layers of the point have a denoised twin, and which objects were kept raw.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub denoise: Option<crate::denoise::PointDenoise>,
 }
 
 /// The camera at one point. Matrices are column-major, 16 numbers.

@@ -17,6 +17,9 @@ const COVERAGE_SLACK: f32 = 1e-4;
 pub struct RaySet {
     pub dir: PathBuf,
     pub meta: SetMeta,
+    /// Read the raw layers even where the set holds `denoised.` twins (RAYSET.md 5.4);
+    /// by default a layer with a twin reads as the twin.
+    pub raw: bool,
 }
 
 impl RaySet {
@@ -100,7 +103,7 @@ impl RaySet {
                 }
             }
         }
-        Ok(RaySet { dir, meta })
+        Ok(RaySet { dir, meta, raw: false })
     }
 
     /// Number of points.
@@ -113,13 +116,30 @@ impl RaySet {
         self.meta.points.is_empty()
     }
 
+    /// The same set, read raw (`raw`) or with its denoised twins where it has them.
+    pub fn with_raw(mut self, raw: bool) -> RaySet {
+        self.raw = raw;
+        self
+    }
+
+    /// Whether the points hold denoised twins of their layers.
+    pub fn is_denoised(&self) -> bool {
+        self.meta.points.iter().any(|p| p.denoise.as_ref().is_some_and(|d| !d.layers.is_empty()))
+    }
+
     /// Reads the images of the `i`-th entry of `points` and checks their size and that every
-    /// layer set.json lists is present.
+    /// layer set.json lists is present. A layer with a `denoised.` twin reads as the twin
+    /// unless the set is read raw ([`RaySet::raw`]); the twins themselves are not listed.
     pub fn read_point(&self, i: usize) -> Result<PointImages, TraceError> {
         let p = self.point_meta(i)?;
         let path = self.dir.join(&p.image);
         let bytes = fs::read(&path).map_err(|e| TraceError::io(&path, e))?;
-        let images = decode_exr(&bytes, &path)?;
+        let mut images = decode_exr(&bytes, &path)?;
+        if self.raw {
+            crate::denoise::drop_denoised(&mut images);
+        } else {
+            crate::denoise::prefer_denoised(&mut images);
+        }
         let bad = |message: String| TraceError::InvalidSet { path: path.clone(), message };
         if [images.width, images.height] != self.meta.resolution {
             return Err(bad(format!(

@@ -104,6 +104,11 @@ impl SetWriter {
             objects,
             points: Vec::new(),
             scene_file: scene.source.as_deref().map(|s| relative_to(s, dir)),
+            denoiser: settings
+                .denoise
+                .then(crate::oidn::shared)
+                .and_then(Result::ok)
+                .map(|oidn| format!("Open Image Denoise {}", oidn.version())),
         }
     }
 
@@ -205,6 +210,7 @@ impl SetWriter {
                     world_from_object: i.world_from_object.to_cols_array(),
                 })
                 .collect(),
+            denoise: render.denoised.clone(),
         };
         self.records.record(&point)?;
         Ok(bytes)

@@ -1,0 +1,344 @@
+//! Denoised layers (RAYSET.md 5.4): every radiance layer the inference reads, and the
+//! combined image, denoised with Open Image Denoise guided by the albedo and normal at the
+//! first non-specular hit.
+//!
+//! **Segmented layers.** An object's layer is divided by its coverage; it is denoised
+//! premultiplied (layer × coverage), where every pixel the object does not cover is 0, so the
+//! filter sees the object's own radiance fading to black at its silhouette and nothing of
+//! the objects beside it. The result is cleared where the coverage is 0 and divided by the
+//! coverage again. Only the rectangle the object covers (and a margin) is filtered.
+//!
+//! **Never worse.** The denoised layer must not be further from the converged image than the
+//! raw one. The render keeps its even and odd samples apart (two independent half images, A
+//! and B). The raw error of a half is estimated as ½·mean|A − B|² and the denoised error as
+//! mean|D(A) − B|² − ½·mean|A − B|² (B is unbiased and independent of D(A)), both over the
+//! pixels the object covers, on display values (clamped to [0, 1]). Where the denoised
+//! estimate is not below the raw one (fine texture, thin features), every layer of that
+//! object stays raw at that point, and the point's set.json entry says so.
+
+use crate::error::TraceError;
+use crate::layers::{object_layer_name, LayerImage, LayerKind, PointImages};
+use crate::oidn::{DenoiseImage, Oidn};
+use crate::render::DenoiseInput;
+use pis_scene::ObjectRole;
+use serde::{Deserialize, Serialize};
+
+/// The layers denoised per object: the radiance layers. Coverage, Fresnel, the greedy
+/// terms' modulations and confidences are coefficients, not radiance, and stay raw.
+pub const DENOISED_KINDS: [LayerKind; 6] = [
+    LayerKind::Diffuse,
+    LayerKind::Specular,
+    LayerKind::Local,
+    LayerKind::Distant,
+    LayerKind::Reflection,
+    LayerKind::Refraction,
+];
+
+/// Prefix of a denoised layer's name: `denoised.combined`, `denoised.object.vase.diffuse`.
+pub const DENOISED_PREFIX: &str = "denoised.";
+
+/// Pixels of margin around an object's covered rectangle that the filter also sees.
+const MARGIN: u32 = 8;
+
+/// What denoising did at one point (set.json `points[].denoise`).
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct PointDenoise {
+    /// The layers that have a denoised twin (`combined`, `object.vase.diffuse`).
+    pub layers: Vec<String>,
+    /// Objects (channel names) kept raw: denoising was estimated to move them further from
+    /// the converged image.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub kept_raw: Vec<String>,
+}
+
+/// The denoised layers of one point and what was decided.
+#[derive(Clone, Debug, Default)]
+pub struct DenoisedPoint {
+    /// `denoised.<layer>` images, to be written beside the raw ones.
+    pub images: Vec<LayerImage>,
+    pub summary: PointDenoise,
+}
+
+/// Per object the estimates behind the decision, as mean squared display errors.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+struct Estimate {
+    raw: f64,
+    denoised: f64,
+}
+
+/// A rectangle of pixels `[x0, x1) × [y0, y1)`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+struct Window {
+    x0: u32,
+    y0: u32,
+    x1: u32,
+    y1: u32,
+}
+
+impl Window {
+    fn width(&self) -> u32 {
+        self.x1 - self.x0
+    }
+    fn height(&self) -> u32 {
+        self.y1 - self.y0
+    }
+    /// Image indices of the window's pixels, row by row.
+    fn pixels(self, image_width: u32) -> impl Iterator<Item = usize> {
+        (self.y0..self.y1)
+            .flat_map(move |y| (self.x0..self.x1).map(move |x| (y * image_width + x) as usize))
+    }
+}
+
+/// The covered rectangle of a coverage plane, grown by [`MARGIN`]; `None` when nothing is
+/// covered.
+fn covered_window(coverage: &[f32], width: u32, height: u32) -> Option<Window> {
+    let (mut x0, mut y0, mut x1, mut y1) = (u32::MAX, u32::MAX, 0, 0);
+    for (i, _) in coverage.iter().enumerate().filter(|(_, &c)| c > 0.0) {
+        let (x, y) = ((i as u32) % width, (i as u32) / width);
+        (x0, y0, x1, y1) = (x0.min(x), y0.min(y), x1.max(x + 1), y1.max(y + 1));
+    }
+    (x1 > 0).then(|| Window {
+        x0: x0.saturating_sub(MARGIN),
+        y0: y0.saturating_sub(MARGIN),
+        x1: (x1 + MARGIN).min(width),
+        y1: (y1 + MARGIN).min(height),
+    })
+}
+
+/// The RGB of `layer` in `window`, interleaved, each pixel times `weight` (1 without).
+fn interleave(layer: &LayerImage, window: Window, weight: Option<&[f32]>) -> Vec<f32> {
+    let mut out = Vec::with_capacity(window.width() as usize * window.height() as usize * 3);
+    for i in window.pixels(layer.width) {
+        let w = weight.map_or(1.0, |p| p[i]);
+        out.extend(layer.planes.iter().take(3).map(|p| p[i] * w));
+    }
+    out
+}
+
+/// Denoises the RGB of `layer` (times `weight`) in `window` with the point's guides.
+fn filter(
+    oidn: &Oidn,
+    layer: &LayerImage,
+    weight: Option<&[f32]>,
+    guides: &[LayerImage; 2],
+    window: Window,
+) -> Result<Vec<f32>, TraceError> {
+    let color = interleave(layer, window, weight);
+    let albedo = interleave(&guides[0], window, None);
+    let normal = interleave(&guides[1], window, None);
+    oidn.denoise(&DenoiseImage {
+        width: window.width(),
+        height: window.height(),
+        color: &color,
+        albedo: Some(&albedo),
+        normal: Some(&normal),
+        hdr: true,
+        clean_aux: false,
+    })
+    .map_err(|e| TraceError::Denoise(e.to_string()))
+}
+
+/// Squared display difference of two RGB triples.
+fn display_error(a: &[f32], b: &[f32]) -> f64 {
+    a.iter()
+        .zip(b)
+        .map(|(&x, &y)| {
+            let d = x.clamp(0.0, 1.0) - y.clamp(0.0, 1.0);
+            (d * d) as f64
+        })
+        .sum()
+}
+
+/// The premultiplied RGB of half `k`'s layer `name` in `window`.
+fn half_premultiplied(
+    halves: &[PointImages; 2],
+    k: usize,
+    name: &str,
+    coverage: Option<&str>,
+    window: Window,
+) -> Option<Vec<f32>> {
+    let layer = halves[k].layer(name)?;
+    let weight = match coverage {
+        Some(c) => Some(halves[k].layer(c)?.planes[0].as_slice()),
+        None => None,
+    };
+    Some(interleave(layer, window, weight))
+}
+
+/// The raw and denoised errors of layer `name` (premultiplied by `coverage` when given),
+/// accumulated over the covered pixels of `window` (`mask`).
+#[allow(clippy::too_many_arguments, reason = "the layer, its window, and where to add")]
+fn estimate(
+    oidn: &Oidn,
+    input: &DenoiseInput,
+    name: &str,
+    coverage: Option<&str>,
+    window: Window,
+    mask: &[bool],
+    est: &mut Estimate,
+) -> Result<(), TraceError> {
+    let (Some(a), Some(b)) = (
+        half_premultiplied(&input.halves, 0, name, coverage, window),
+        half_premultiplied(&input.halves, 1, name, coverage, window),
+    ) else {
+        return Ok(());
+    };
+    let half_a = input.halves[0].layer(name).expect("read above");
+    let weight = coverage.and_then(|c| input.halves[0].layer(c)).map(|l| l.planes[0].as_slice());
+    let da = filter(oidn, half_a, weight, &input.guides, window)?;
+    for (k, _) in mask.iter().enumerate().filter(|(_, &m)| m) {
+        let px = k * 3..k * 3 + 3;
+        let noise = display_error(&a[px.clone()], &b[px.clone()]) / 2.0;
+        est.raw += noise;
+        est.denoised += display_error(&da[px.clone()], &b[px]) - noise;
+    }
+    Ok(())
+}
+
+/// A denoised image named `denoised.<layer.name>`: the filtered values in `window` divided by
+/// `coverage` (cleared where it is 0), the raw values elsewhere outside the window.
+fn denoised_image(
+    layer: &LayerImage,
+    filtered: &[f32],
+    window: Window,
+    coverage: Option<&[f32]>,
+) -> LayerImage {
+    let mut out = LayerImage::new(
+        format!("{DENOISED_PREFIX}{}", layer.name),
+        &["R", "G", "B"],
+        layer.width,
+        layer.height,
+    );
+    for c in 0..3 {
+        out.planes[c].clone_from(&layer.planes[c]);
+    }
+    for (k, i) in window.pixels(layer.width).enumerate() {
+        let cov = coverage.map_or(1.0, |p| p[i]);
+        for c in 0..3 {
+            out.planes[c][i] = if cov > 0.0 { filtered[k * 3 + c].max(0.0) / cov } else { 0.0 };
+        }
+    }
+    out
+}
+
+/// Denoises one point's combined image and its objects' radiance layers (`objects`: each
+/// object's channel name and role, in scene order).
+pub fn denoise_point(
+    oidn: &Oidn,
+    images: &PointImages,
+    input: &DenoiseInput,
+    objects: &[(String, ObjectRole)],
+) -> Result<DenoisedPoint, TraceError> {
+    let (w, h) = (images.width, images.height);
+    let mut out = DenoisedPoint::default();
+    let whole = Window { x0: 0, y0: 0, x1: w, y1: h };
+    if let Some(combined) = images.layer("combined") {
+        let filtered = filter(oidn, combined, None, &input.guides, whole)?;
+        out.images.push(denoised_image(combined, &filtered, whole, None));
+        out.summary.layers.push(combined.name.clone());
+    }
+    for (name, role) in objects {
+        let coverage_name = object_layer_name(name, LayerKind::Coverage);
+        let Some(coverage) = images.layer(&coverage_name).map(|l| &l.planes[0]) else { continue };
+        let Some(window) = covered_window(coverage, w, h) else { continue };
+        let mask: Vec<bool> = window.pixels(w).map(|i| coverage[i] > 0.0).collect();
+        let mut est = Estimate::default();
+        let mut layers = Vec::new();
+        for kind in DENOISED_KINDS.into_iter().filter(|k| LayerKind::for_role(*role).contains(k)) {
+            let layer_name = object_layer_name(name, kind);
+            let Some(layer) = images.layer(&layer_name) else { continue };
+            if layer.planes.iter().take(3).all(|p| p.iter().all(|&v| v == 0.0)) {
+                continue;
+            }
+            estimate(oidn, input, &layer_name, Some(&coverage_name), window, &mask, &mut est)?;
+            let filtered = filter(oidn, layer, Some(coverage), &input.guides, window)?;
+            layers.push(denoised_image(layer, &filtered, window, Some(coverage)));
+        }
+        if layers.is_empty() {
+            continue;
+        }
+        if est.denoised < est.raw {
+            out.summary
+                .layers
+                .extend(layers.iter().map(|l| l.name[DENOISED_PREFIX.len()..].into()));
+            out.images.extend(layers);
+        } else {
+            out.summary.kept_raw.push(name.clone());
+        }
+    }
+    Ok(out)
+}
+
+/// Replaces every layer that has a `denoised.` twin in `images` by it (its RGB; a `local`
+/// layer keeps its raw A) and drops the twins.
+pub fn prefer_denoised(images: &mut PointImages) {
+    let (twins, mut layers): (Vec<LayerImage>, Vec<LayerImage>) =
+        std::mem::take(&mut images.layers)
+            .into_iter()
+            .partition(|l| l.name.starts_with(DENOISED_PREFIX));
+    for twin in twins {
+        let target = &twin.name[DENOISED_PREFIX.len()..];
+        let Some(layer) = layers.iter_mut().find(|l| l.name == target) else { continue };
+        for (c, plane) in twin.channels.iter().zip(twin.planes) {
+            if let Some(k) = layer.channels.iter().position(|x| x == c) {
+                layer.planes[k] = plane;
+            }
+        }
+    }
+    images.layers = layers;
+}
+
+/// Drops every `denoised.` twin from `images` (a set read raw).
+pub fn drop_denoised(images: &mut PointImages) {
+    images.layers.retain(|l| !l.name.starts_with(DENOISED_PREFIX));
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_covered_window_is_grown_by_the_margin_and_clipped() {
+        let (w, h) = (40, 30);
+        let mut cov = vec![0.0; (w * h) as usize];
+        assert_eq!(covered_window(&cov, w, h), None);
+        cov[(12 * w + 20) as usize] = 0.5;
+        cov[(14 * w + 3) as usize] = 1.0;
+        let win = covered_window(&cov, w, h).expect("covered");
+        assert_eq!(win, Window { x0: 0, y0: 4, x1: 29, y1: 23 });
+        assert_eq!(win.pixels(w).count(), 29 * 19);
+    }
+
+    #[test]
+    fn twins_replace_their_layers_and_a_local_layer_keeps_its_alpha() {
+        let mut images = PointImages {
+            width: 1,
+            height: 1,
+            layers: vec![
+                LayerImage::new("object.t.local".into(), &["R", "G", "B", "A"], 1, 1),
+                LayerImage::new("denoised.object.t.local".into(), &["R", "G", "B"], 1, 1),
+            ],
+        };
+        images.layers[0].planes[3][0] = 0.25;
+        images.layers[1].planes[1][0] = 2.0;
+        let mut raw = images.clone();
+        prefer_denoised(&mut images);
+        assert_eq!(images.layers.len(), 1);
+        assert_eq!(images.layers[0].planes[1][0], 2.0);
+        assert_eq!(images.layers[0].planes[3][0], 0.25);
+        drop_denoised(&mut raw);
+        assert_eq!(raw.layers.len(), 1);
+        assert_eq!(raw.layers[0].planes[1][0], 0.0);
+    }
+
+    #[test]
+    fn a_denoised_image_is_divided_by_coverage_and_cleared_where_nothing_is_covered() {
+        let mut layer = LayerImage::new("object.t.diffuse".into(), &["R", "G", "B"], 2, 1);
+        layer.planes[0] = vec![7.0, 7.0];
+        let window = Window { x0: 0, y0: 0, x1: 2, y1: 1 };
+        let filtered = [0.25, 0.0, 0.0, 0.5, 0.0, 0.0];
+        let out = denoised_image(&layer, &filtered, window, Some(&[0.5, 0.0]));
+        assert_eq!(out.name, "denoised.object.t.diffuse");
+        assert_eq!(out.planes[0], [0.5, 0.0]);
+    }
+}
