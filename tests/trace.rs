@@ -335,3 +335,78 @@ fn a_point_larger_than_memory_is_refused_before_tracing() {
     );
     assert!(!dir.path().join("set").join("set.json").exists());
 }
+
+fn trace_with(args: &[&str], env: &[(&str, &str)]) -> Output {
+    let mut cmd = Command::new(env!("CARGO_BIN_EXE_pis-trace"));
+    cmd.args(args);
+    for (k, v) in env {
+        cmd.env(k, v);
+    }
+    cmd.output().expect("pis-trace runs")
+}
+
+/// Where Open Image Denoise is not found the trace says once how to install it and writes
+/// raw layers; `--denoise on` refuses instead.
+#[test]
+fn without_open_image_denoise_a_set_is_raw_and_the_trace_says_how_to_install_it() {
+    let tmp = tempfile::tempdir().unwrap();
+    let scene = tiny_scene(tmp.path());
+    let missing = tmp.path().join("no-such-dir/libOpenImageDenoise.so.2");
+    let env = [("PIS_OIDN_LIBRARY", missing.to_str().unwrap())];
+    let out_dir = tmp.path().join("raw");
+    let out =
+        trace_with(&[scene.to_str().unwrap(), "-o", out_dir.to_str().unwrap(), "--json"], &env);
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+    let stderr = text(&out.stderr);
+    assert_eq!(stderr.matches("pip install pyoidn").count(), 1, "{stderr}");
+    let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert!(report.get("denoiser").is_none(), "{report}");
+    let set = RaySet::open(&out_dir).unwrap();
+    assert_eq!((set.meta.denoiser.as_deref(), set.is_denoised()), (None, false));
+    let img = set.read_point(0).unwrap();
+    assert!(img
+        .layers
+        .iter()
+        .all(|l| !l.name.starts_with("denoised.") && !l.name.starts_with("guide.")));
+
+    let on = tmp.path().join("on");
+    let out =
+        trace_with(&[scene.to_str().unwrap(), "-o", on.to_str().unwrap(), "--denoise", "on"], &env);
+    assert_ne!(out.status.code(), Some(0));
+    assert!(text(&out.stderr).contains("pip install pyoidn"), "{}", text(&out.stderr));
+    assert!(!on.join("set.json").exists());
+}
+
+/// An adaptive, denoised set records each pixel's samples and error, the guides, and the
+/// denoised twins that a reader takes in place of the raw layers.
+#[test]
+fn an_adaptive_denoised_set_records_samples_guides_and_twins() {
+    if let Err(why) = pis_trace::oidn::shared() {
+        assert!(std::env::var_os("PIS_REQUIRE_OIDN").is_none(), "Open Image Denoise: {why}");
+        eprintln!("skipped: Open Image Denoise is not found: {why}");
+        return;
+    }
+    let tmp = tempfile::tempdir().unwrap();
+    let scene = tiny_scene(tmp.path());
+    let dir = tmp.path().join("set");
+    let args = ["--spp", "8", "--noise-threshold", "0.05", "--min-spp", "2", "--json"];
+    let out = trace(&[&[scene.to_str().unwrap(), "-o", dir.to_str().unwrap()], &args[..]].concat());
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+    let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let mean = report["mean_spp"].as_f64().unwrap();
+    assert!((2.0..=8.0).contains(&mean), "{report}");
+    assert!(report["denoiser"].as_str().is_some_and(|d| d.starts_with("Open Image Denoise 2.")));
+    let set = RaySet::open(&dir).unwrap();
+    assert!(set.is_denoised() && set.meta.denoiser.is_some());
+    let denoise = set.meta.points[0].denoise.as_ref().expect("the point says what was denoised");
+    assert!(denoise.layers.iter().any(|l| l == "combined"));
+    let raw = RaySet::open(&dir).unwrap().with_raw(true).read_point(0).unwrap();
+    let clean = set.read_point(0).unwrap();
+    for name in ["samples", "error", "guide.albedo", "guide.normal"] {
+        assert!(raw.layer(name).is_some(), "layer {name}");
+    }
+    let samples = &raw.layer("samples").unwrap().planes[0];
+    assert!(samples.iter().all(|&n| (2.0..=8.0).contains(&n)));
+    assert_ne!(raw.layer("combined"), clean.layer("combined"), "the twin is read in its place");
+    assert!(clean.layers.iter().all(|l| !l.name.starts_with("denoised.")));
+}
