@@ -19,7 +19,6 @@
 use crate::error::TraceError;
 use crate::layers::{object_layer_name, LayerImage, LayerKind, PointImages};
 use crate::oidn::{DenoiseImage, Oidn};
-use crate::render::DenoiseInput;
 use pis_scene::ObjectRole;
 use serde::{Deserialize, Serialize};
 
@@ -39,6 +38,15 @@ pub const DENOISED_PREFIX: &str = "denoised.";
 
 /// Pixels of margin around an object's covered rectangle that the filter also sees.
 const MARGIN: u32 = 8;
+
+/// What denoising a point reads besides its images.
+#[derive(Clone, Debug)]
+pub struct DenoiseInput {
+    /// `guide.albedo`, `guide.normal`.
+    pub guides: [LayerImage; 2],
+    /// The point's images from its even and from its odd camera samples.
+    pub halves: [PointImages; 2],
+}
 
 /// What denoising did at one point (set.json `points[].denoise`).
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]

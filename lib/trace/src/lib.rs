@@ -44,10 +44,11 @@ pub mod settings;
 pub mod tangent;
 pub mod textures;
 
+pub use denoise::DenoiseInput;
 pub use error::TraceError;
 pub use film::GaussianFilter;
 pub use layers::{LayerImage, LayerKind, PointImages};
 pub use records::{RayRecord, RecordHit};
-pub use render::{channel_names, render_point, DenoiseInput, PointRender, RenderStats};
+pub use render::{channel_names, render_point, PointRender, RenderStats};
 pub use run::{render_set, render_shard, NoProgress, Progress, SetReport, TraceRun};
 pub use settings::{ShadingSeed, TraceSettings};

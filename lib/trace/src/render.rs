@@ -3,6 +3,7 @@
 
 use crate::adaptive::{first_round, next_round, pixel_error};
 use crate::camera::PerspectiveCamera;
+use crate::denoise::{DenoiseInput, PointDenoise};
 use crate::error::TraceError;
 use crate::integrator::{CameraSample, Integrator, PathContext};
 use crate::layers::{resolve, resolve_guides, LayerImage, PixelAccum, PointImages};
@@ -59,16 +60,7 @@ pub struct PointRender {
     /// the even and of the odd samples apart.
     pub denoise_input: Option<Box<DenoiseInput>>,
     /// What denoising did, once the point's images carry their `denoised.` twins.
-    pub denoised: Option<crate::denoise::PointDenoise>,
-}
-
-/// What denoising a point reads besides its images.
-#[derive(Clone, Debug)]
-pub struct DenoiseInput {
-    /// `guide.albedo`, `guide.normal`.
-    pub guides: [LayerImage; 2],
-    /// The point's images from its even and from its odd camera samples.
-    pub halves: [PointImages; 2],
+    pub denoised: Option<PointDenoise>,
 }
 
 /// Channel-safe, unique object names: characters other than `[A-Za-z0-9_-]` become `_`,
