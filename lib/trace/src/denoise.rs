@@ -12,13 +12,14 @@
 //! raw one. The render keeps its even and odd samples apart (two independent half images, A
 //! and B). The raw error of a half is estimated as ½·mean|A − B|² and the denoised error as
 //! mean|D(A) − B|² − ½·mean|A − B|² (B is unbiased and independent of D(A)), both over the
-//! pixels the object covers, on display values (clamped to [0, 1]). Where the denoised
+//! pixels the object covers, on display values (sRGB, peak 1). Where the denoised
 //! estimate is not below the raw one (fine texture, thin features), every layer of that
 //! object stays raw at that point, and the point's set.json entry says so.
 
 use crate::error::TraceError;
 use crate::layers::{object_layer_name, LayerImage, LayerKind, PointImages};
 use crate::oidn::{DenoiseImage, Oidn};
+use pis_codec::display::display;
 use pis_scene::ObjectRole;
 use serde::{Deserialize, Serialize};
 
@@ -146,35 +147,14 @@ fn filter(
     .map_err(|e| TraceError::Denoise(e.to_string()))
 }
 
-/// Squared display difference of two RGB triples.
+/// Squared display difference (sRGB, peak 1, as every PSNR of the toolchain) of two RGB
+/// triples.
 fn display_error(a: &[f32], b: &[f32]) -> f64 {
-    a.iter()
-        .zip(b)
-        .map(|(&x, &y)| {
-            let d = x.clamp(0.0, 1.0) - y.clamp(0.0, 1.0);
-            (d * d) as f64
-        })
-        .sum()
+    a.iter().zip(b).map(|(&x, &y)| (display(x) - display(y)).powi(2)).sum()
 }
 
-/// The premultiplied RGB of half `k`'s layer `name` in `window`.
-fn half_premultiplied(
-    halves: &[PointImages; 2],
-    k: usize,
-    name: &str,
-    coverage: Option<&str>,
-    window: Window,
-) -> Option<Vec<f32>> {
-    let layer = halves[k].layer(name)?;
-    let weight = match coverage {
-        Some(c) => Some(halves[k].layer(c)?.planes[0].as_slice()),
-        None => None,
-    };
-    Some(interleave(layer, window, weight))
-}
-
-/// The raw and denoised errors of layer `name` (premultiplied by `coverage` when given),
-/// accumulated over the covered pixels of `window` (`mask`).
+/// The raw and denoised errors of layer `name` (filtered premultiplied by `coverage` when
+/// given, compared divided by it), accumulated over the covered pixels of `window` (`mask`).
 #[allow(clippy::too_many_arguments, reason = "the layer, its window, and where to add")]
 fn estimate(
     oidn: &Oidn,
@@ -185,20 +165,23 @@ fn estimate(
     mask: &[bool],
     est: &mut Estimate,
 ) -> Result<(), TraceError> {
-    let (Some(a), Some(b)) = (
-        half_premultiplied(&input.halves, 0, name, coverage, window),
-        half_premultiplied(&input.halves, 1, name, coverage, window),
-    ) else {
-        return Ok(());
-    };
-    let half_a = input.halves[0].layer(name).expect("read above");
-    let weight = coverage.and_then(|c| input.halves[0].layer(c)).map(|l| l.planes[0].as_slice());
-    let da = filter(oidn, half_a, weight, &input.guides, window)?;
-    for (k, _) in mask.iter().enumerate().filter(|(_, &m)| m) {
+    let [ha, hb] = &input.halves;
+    let (Some(la), Some(lb)) = (ha.layer(name), hb.layer(name)) else { return Ok(()) };
+    let cov = |h: &PointImages| coverage.and_then(|c| h.layer(c)).map(|l| l.planes[0].clone());
+    let (ca, cb) = (cov(ha), cov(hb));
+    // Compared as the layers are read, divided by coverage, where both halves cover.
+    let (a, b) = (interleave(la, window, None), interleave(lb, window, None));
+    let da = filter(oidn, la, ca.as_deref(), &input.guides, window)?;
+    for (k, i) in window.pixels(la.width).enumerate().filter(|&(k, _)| mask[k]) {
+        let (wa, wb) = (ca.as_ref().map_or(1.0, |c| c[i]), cb.as_ref().map_or(1.0, |c| c[i]));
+        if wa <= 0.0 || wb <= 0.0 {
+            continue;
+        }
         let px = k * 3..k * 3 + 3;
+        let d: Vec<f32> = da[px.clone()].iter().map(|v| v.max(0.0) / wa).collect();
         let noise = display_error(&a[px.clone()], &b[px.clone()]) / 2.0;
         est.raw += noise;
-        est.denoised += display_error(&da[px.clone()], &b[px]) - noise;
+        est.denoised += display_error(&d, &b[px]) - noise;
     }
     Ok(())
 }
