@@ -65,8 +65,8 @@ struct Cli {
     /// first non-specular hit; the raw layers stay in the set beside the `denoised.` ones.
     /// `auto`: when the library is found (`pip install pyoidn`, a system OIDN 2.x, or
     /// PIS_OIDN_LIBRARY naming it), else a warning and raw layers only. `on`: an error
-    /// without it. `off` (the default): raw layers only.
-    #[arg(long, value_name = "auto|on|off", default_value = "off", value_parser = ["auto", "on", "off"])]
+    /// without it. `off`: raw layers only.
+    #[arg(long, value_name = "auto|on|off", default_value = "auto", value_parser = ["auto", "on", "off"])]
     denoise: String,
     /// A `[preset.NAME]` of scene.toml (e.g. `paper`).
     #[arg(long)]

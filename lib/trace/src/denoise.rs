@@ -8,18 +8,28 @@
 //! the objects beside it. The result is cleared where the coverage is 0 and divided by the
 //! coverage again. Only the rectangle the object covers (and a margin) is filtered.
 //!
-//! **Never worse.** The denoised layer must not be further from the converged image than the
-//! raw one. The render keeps its even and odd samples apart (two independent half images, A
-//! and B). The raw error of a half is estimated as ½·mean|A − B|² and the denoised error as
-//! mean|D(A) − B|² − ½·mean|A − B|² (B is unbiased and independent of D(A)), both over the
-//! pixels the object covers, on display values (sRGB, peak 1). Where the denoised
-//! estimate is not below the raw one (fine texture, thin features), every layer of that
-//! object stays raw at that point, and the point's set.json entry says so.
+//! **Never worse.** A denoised layer must not be further from the converged image than the
+//! raw one. The render keeps its even and odd samples apart: two independent half images A
+//! and B, each from its own rotation of the sample sequence. Per layer and object, over the
+//! pixels both halves cover, as the layer is read (divided by coverage), and weighed by the
+//! slope of the display encoding (sRGB) at the object's surface radiance (diffuse +
+//! specular), so that each layer's error counts as much as it moves what is seen:
+//!
+//! ```text
+//! raw      = ½|A − B|²                       (a half's variance)
+//! denoised = |D(A) − B|² − ½|A − B|²         (B is unbiased and independent of D(A))
+//! ```
+//!
+//! both at half the samples, standing for the layers at all of them (measured on corpus
+//! box-textured and tests/clean.rs's room: a logo's diffuse layer kept raw, matte walls
+//! denoised; docs/benchmarks/clean-sets.md).
+//!
+//! A layer whose `denoised` is not below `raw` (fine texture the filter blurs, thin
+//! features) keeps no twin at that point, and the point's set.json entry lists it.
 
 use crate::error::TraceError;
 use crate::layers::{object_layer_name, LayerImage, LayerKind, PointImages};
 use crate::oidn::{DenoiseImage, Oidn};
-use pis_codec::display::display;
 use pis_scene::ObjectRole;
 use serde::{Deserialize, Serialize};
 
@@ -54,8 +64,8 @@ pub struct DenoiseInput {
 pub struct PointDenoise {
     /// The layers that have a denoised twin (`combined`, `object.vase.diffuse`).
     pub layers: Vec<String>,
-    /// Objects (channel names) kept raw: denoising was estimated to move them further from
-    /// the converged image.
+    /// Layers kept raw (`object.vase.diffuse`): denoising was estimated to move them further
+    /// from the converged image.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub kept_raw: Vec<String>,
 }
@@ -68,11 +78,26 @@ pub struct DenoisedPoint {
     pub summary: PointDenoise,
 }
 
-/// Per object the estimates behind the decision, as mean squared display errors.
+/// Per layer the sums behind the decision, squared display errors over its object's pixels.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 struct Estimate {
-    raw: f64,
-    denoised: f64,
+    /// ½|A − B|²: a half's variance.
+    half_noise: f64,
+    /// |D(A) − B|²: the denoised half's error plus B's variance.
+    denoised_half: f64,
+}
+
+impl Estimate {
+    /// The raw half's error: its variance.
+    fn raw(&self) -> f64 {
+        self.half_noise
+    }
+
+    /// The denoised half's error. Both halves at half the samples stand for the layers at
+    /// all of them: the comparison is made where both are measured without a reference.
+    fn denoised(&self) -> f64 {
+        self.denoised_half - self.half_noise
+    }
 }
 
 /// A rectangle of pixels `[x0, x1) × [y0, y1)`.
@@ -147,10 +172,37 @@ fn filter(
     .map_err(|e| TraceError::Denoise(e.to_string()))
 }
 
-/// Squared display difference (sRGB, peak 1, as every PSNR of the toolchain) of two RGB
-/// triples.
-fn display_error(a: &[f32], b: &[f32]) -> f64 {
-    a.iter().zip(b).map(|(&x, &y)| (display(x) - display(y)).powi(2)).sum()
+/// The slope of the display encoding (sRGB, peak 1) at linear value `v`: 0 above white
+/// (clipped), the linear segment's 12.92 near black.
+fn display_slope(v: f32) -> f32 {
+    if v >= 1.0 || v.is_nan() {
+        0.0
+    } else if v <= 0.003_130_8 {
+        12.92
+    } else {
+        1.055 / 2.4 * v.powf(1.0 / 2.4 - 1.0)
+    }
+}
+
+/// The object's surface radiance as read (diffuse + specular, divided by coverage) in
+/// `window`, as display slopes per pixel and channel: a layer's error is weighed by how much
+/// it moves the surface's display value, not its own (a dim specular layer is not seen
+/// through the steep sRGB curve at its own level, but at the surface's).
+fn surface_slopes(images: &PointImages, object: &str, window: Window) -> Vec<f32> {
+    let layer = |k| images.object_layer(object, k);
+    let (diffuse, specular) = (layer(LayerKind::Diffuse), layer(LayerKind::Specular));
+    let value = |l: Option<&LayerImage>, c: usize, i: usize| l.map_or(0.0, |l| l.planes[c][i]);
+    window
+        .pixels(images.width)
+        .flat_map(|i| (0..3).map(move |c| (i, c)))
+        .map(|(i, c)| display_slope(value(diffuse, c, i) + value(specular, c, i)))
+        .collect()
+}
+
+/// Squared display difference of two RGB triples of a layer, weighed by the surface's
+/// display slopes at that pixel.
+fn display_error(a: &[f32], b: &[f32], slopes: &[f32]) -> f64 {
+    a.iter().zip(b).zip(slopes).map(|((&x, &y), &k)| ((x - y) as f64 * k as f64).powi(2)).sum()
 }
 
 /// The raw and denoised errors of layer `name` (filtered premultiplied by `coverage` when
@@ -161,12 +213,11 @@ fn estimate(
     input: &DenoiseInput,
     name: &str,
     coverage: Option<&str>,
-    window: Window,
-    mask: &[bool],
-    est: &mut Estimate,
-) -> Result<(), TraceError> {
+    (window, mask, slopes): (Window, &[bool], &[f32]),
+) -> Result<Estimate, TraceError> {
+    let mut est = Estimate::default();
     let [ha, hb] = &input.halves;
-    let (Some(la), Some(lb)) = (ha.layer(name), hb.layer(name)) else { return Ok(()) };
+    let (Some(la), Some(lb)) = (ha.layer(name), hb.layer(name)) else { return Ok(est) };
     let cov = |h: &PointImages| coverage.and_then(|c| h.layer(c)).map(|l| l.planes[0].clone());
     let (ca, cb) = (cov(ha), cov(hb));
     // Compared as the layers are read, divided by coverage, where both halves cover.
@@ -178,12 +229,14 @@ fn estimate(
             continue;
         }
         let px = k * 3..k * 3 + 3;
-        let d: Vec<f32> = da[px.clone()].iter().map(|v| v.max(0.0) / wa).collect();
-        let noise = display_error(&a[px.clone()], &b[px.clone()]) / 2.0;
-        est.raw += noise;
-        est.denoised += display_error(&d, &b[px]) - noise;
+        let divided =
+            |d: &[f32], w: f32| -> Vec<f32> { d.iter().map(|v| v.max(0.0) / w).collect() };
+        let dak = divided(&da[px.clone()], wa);
+        let k = &slopes[px.clone()];
+        est.half_noise += display_error(&a[px.clone()], &b[px.clone()], k) / 2.0;
+        est.denoised_half += display_error(&dak, &b[px], k);
     }
-    Ok(())
+    Ok(est)
 }
 
 /// A denoised image named `denoised.<layer.name>`: the filtered values in `window` divided by
@@ -233,28 +286,22 @@ pub fn denoise_point(
         let Some(coverage) = images.layer(&coverage_name).map(|l| &l.planes[0]) else { continue };
         let Some(window) = covered_window(coverage, w, h) else { continue };
         let mask: Vec<bool> = window.pixels(w).map(|i| coverage[i] > 0.0).collect();
-        let mut est = Estimate::default();
-        let mut layers = Vec::new();
+        let slopes = surface_slopes(images, name, window);
         for kind in DENOISED_KINDS.into_iter().filter(|k| LayerKind::for_role(*role).contains(k)) {
             let layer_name = object_layer_name(name, kind);
             let Some(layer) = images.layer(&layer_name) else { continue };
             if layer.planes.iter().take(3).all(|p| p.iter().all(|&v| v == 0.0)) {
                 continue;
             }
-            estimate(oidn, input, &layer_name, Some(&coverage_name), window, &mask, &mut est)?;
-            let filtered = filter(oidn, layer, Some(coverage), &input.guides, window)?;
-            layers.push(denoised_image(layer, &filtered, window, Some(coverage)));
-        }
-        if layers.is_empty() {
-            continue;
-        }
-        if est.denoised < est.raw {
-            out.summary
-                .layers
-                .extend(layers.iter().map(|l| l.name[DENOISED_PREFIX.len()..].into()));
-            out.images.extend(layers);
-        } else {
-            out.summary.kept_raw.push(name.clone());
+            let at = (window, mask.as_slice(), slopes.as_slice());
+            let est = estimate(oidn, input, &layer_name, Some(&coverage_name), at)?;
+            if est.denoised() < est.raw() {
+                let filtered = filter(oidn, layer, Some(coverage), &input.guides, window)?;
+                out.images.push(denoised_image(layer, &filtered, window, Some(coverage)));
+                out.summary.layers.push(layer_name);
+            } else {
+                out.summary.kept_raw.push(layer_name);
+            }
         }
     }
     Ok(out)

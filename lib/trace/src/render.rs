@@ -28,6 +28,9 @@ struct PixelSamples {
     error: f32,
 }
 
+/// Seed stream of the odd half's sample positions (renders that keep their halves apart).
+const ODD_HALF_STREAM: u64 = 0x0dd_5a3b1e;
+
 /// Image rows per parallel work unit (they share the first-hit irradiance cache).
 pub const BAND_ROWS: u32 = 8;
 
@@ -219,14 +222,23 @@ fn render_row(
             seed => hash_keys(&[x as u64, y as u64, seed]),
         };
         let shift = Rng::new(pixel_seed).next_2d();
-        let mut whole = PixelAccum::default();
         let keep_halves = settings.adaptive() || settings.denoise;
+        // Kept apart, the halves are two independently rotated sequences (even samples on
+        // one, odd on the other), so that their difference measures the error of the
+        // whole: halves of one low-discrepancy sequence differ by more than its error.
+        let odd_shift = Rng::new(hash_keys(&[pixel_seed, ODD_HALF_STREAM])).next_2d();
+        let position = |s: u32| match (keep_halves, s % 2) {
+            (false, _) => r2_point(s, shift),
+            (true, 0) => r2_point(s / 2, shift),
+            (true, _) => r2_point(s / 2, odd_shift),
+        };
+        let mut whole = PixelAccum::default();
         let mut halves: [PixelAccum; 2] = Default::default();
         let mut end = first_round(settings.spp, settings.min_spp, settings.adaptive());
         let mut s = 0;
         let error = loop {
             while s < end {
-                let offset = settings.filter.sample_offset(r2_point(s, shift));
+                let offset = settings.filter.sample_offset(position(s));
                 let pos = Vec2::new(x as f32 + 0.5, y as f32 + 0.5) + offset;
                 let dir = camera.direction(pos);
                 ctx.fallback_seed = hash_keys(&[pixel_seed, s as u64]);

@@ -123,7 +123,7 @@ fn denoised_layers_are_closer_to_the_converged_image_than_the_raw_ones() {
         let after = layer_error(&denoised, &reference, name, kind);
         let db = 10.0 * (before / after).log10();
         eprintln!("{name} {}: {db:+.2} dB", kind.name());
-        if out.summary.kept_raw.contains(&name.to_string()) {
+        if out.summary.kept_raw.contains(&pis_trace::layers::object_layer_name(name, kind)) {
             assert_eq!(before, after, "{name} kept raw reads raw");
         } else {
             assert!(
