@@ -11,9 +11,11 @@
 //! **Never worse.** A denoised layer must not be further from the converged image than the
 //! raw one. The render keeps its even and odd samples apart: two independent half images A
 //! and B, each from its own rotation of the sample sequence. Per layer and object, over the
-//! pixels both halves cover, as the layer is read (divided by coverage), and weighed by the
-//! slope of the display encoding (sRGB) at the object's surface radiance (diffuse +
-//! specular), so that each layer's error counts as much as it moves what is seen:
+//! pixels both halves cover, as the layer is read (divided by coverage), each difference
+//! taken as what it changes of the object's surface on display (sRGB, clipped at white: the
+//! surface radiance, diffuse + specular, with the layer's value swapped; `local` and
+//! `distant` enter times their Fresnel modulation), so that each layer's error counts as much
+//! as it moves what is seen:
 //!
 //! ```text
 //! raw      = ½|A − B|²                       (a half's variance)
@@ -24,12 +26,13 @@
 //! box-textured and tests/clean.rs's room: a logo's diffuse layer kept raw, matte walls
 //! denoised; docs/benchmarks/clean-sets.md).
 //!
-//! A layer whose `denoised` is not below `raw` (fine texture the filter blurs, thin
+//! A layer whose `denoised` is above `raw` (fine texture the filter blurs, thin
 //! features) keeps no twin at that point, and the point's set.json entry lists it.
 
 use crate::error::TraceError;
 use crate::layers::{object_layer_name, LayerImage, LayerKind, PointImages};
 use crate::oidn::{DenoiseImage, Oidn};
+use pis_codec::display::display;
 use pis_scene::ObjectRole;
 use serde::{Deserialize, Serialize};
 
@@ -172,37 +175,50 @@ fn filter(
     .map_err(|e| TraceError::Denoise(e.to_string()))
 }
 
-/// The slope of the display encoding (sRGB, peak 1) at linear value `v`: 0 above white
-/// (clipped), the linear segment's 12.92 near black.
-fn display_slope(v: f32) -> f32 {
-    if v >= 1.0 || v.is_nan() {
-        0.0
-    } else if v <= 0.003_130_8 {
-        12.92
-    } else {
-        1.055 / 2.4 * v.powf(1.0 / 2.4 - 1.0)
-    }
+/// How one layer's value moves what is seen of its object, per pixel and channel of a window:
+/// the surface radiance as read (diffuse + specular, divided by coverage), the layer's own
+/// value in it and the weight it enters with (the Fresnel modulation for the incident
+/// `local` and `distant` layers, the latter also times 1 − local alpha; 1 for the others).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+struct SurfaceTerm {
+    surface: f32,
+    layer: f32,
+    weight: f32,
 }
 
-/// The object's surface radiance as read (diffuse + specular, divided by coverage) in
-/// `window`, as display slopes per pixel and channel: a layer's error is weighed by how much
-/// it moves the surface's display value, not its own (a dim specular layer is not seen
-/// through the steep sRGB curve at its own level, but at the surface's).
-fn surface_slopes(images: &PointImages, object: &str, window: Window) -> Vec<f32> {
+/// The [`SurfaceTerm`]s of `object`'s layer `kind` in `window`, pixel by pixel, RGB.
+fn surface_terms(
+    images: &PointImages,
+    object: &str,
+    kind: LayerKind,
+    window: Window,
+) -> Vec<SurfaceTerm> {
     let layer = |k| images.object_layer(object, k);
-    let (diffuse, specular) = (layer(LayerKind::Diffuse), layer(LayerKind::Specular));
+    let (diffuse, specular, own) =
+        (layer(LayerKind::Diffuse), layer(LayerKind::Specular), layer(kind));
+    let (fresnel, local) = (layer(LayerKind::Fresnel), layer(LayerKind::Local));
     let value = |l: Option<&LayerImage>, c: usize, i: usize| l.map_or(0.0, |l| l.planes[c][i]);
+    let weight = |c: usize, i: usize| match kind {
+        LayerKind::Local => value(fresnel, c, i),
+        LayerKind::Distant => value(fresnel, c, i) * (1.0 - value(local, 3, i)),
+        _ => 1.0,
+    };
     window
         .pixels(images.width)
         .flat_map(|i| (0..3).map(move |c| (i, c)))
-        .map(|(i, c)| display_slope(value(diffuse, c, i) + value(specular, c, i)))
+        .map(|(i, c)| SurfaceTerm {
+            surface: value(diffuse, c, i) + value(specular, c, i),
+            layer: value(own, c, i),
+            weight: weight(c, i),
+        })
         .collect()
 }
 
-/// Squared display difference of two RGB triples of a layer, weighed by the surface's
-/// display slopes at that pixel.
-fn display_error(a: &[f32], b: &[f32], slopes: &[f32]) -> f64 {
-    a.iter().zip(b).zip(slopes).map(|((&x, &y), &k)| ((x - y) as f64 * k as f64).powi(2)).sum()
+/// Squared display difference (sRGB, peak 1, clipped) between the surface with the layer at
+/// `a` and with it at `b`, summed over one pixel's RGB.
+fn display_error(a: &[f32], b: &[f32], terms: &[SurfaceTerm]) -> f64 {
+    let seen = |v: f32, t: &SurfaceTerm| display(t.surface + t.weight * (v - t.layer));
+    a.iter().zip(b).zip(terms).map(|((&x, &y), t)| (seen(x, t) - seen(y, t)).powi(2)).sum()
 }
 
 /// The raw and denoised errors of layer `name` (filtered premultiplied by `coverage` when
@@ -213,7 +229,7 @@ fn estimate(
     input: &DenoiseInput,
     name: &str,
     coverage: Option<&str>,
-    (window, mask, slopes): (Window, &[bool], &[f32]),
+    (window, mask, terms): (Window, &[bool], &[SurfaceTerm]),
 ) -> Result<Estimate, TraceError> {
     let mut est = Estimate::default();
     let [ha, hb] = &input.halves;
@@ -232,7 +248,7 @@ fn estimate(
         let divided =
             |d: &[f32], w: f32| -> Vec<f32> { d.iter().map(|v| v.max(0.0) / w).collect() };
         let dak = divided(&da[px.clone()], wa);
-        let k = &slopes[px.clone()];
+        let k = &terms[px.clone()];
         est.half_noise += display_error(&a[px.clone()], &b[px.clone()], k) / 2.0;
         est.denoised_half += display_error(&dak, &b[px], k);
     }
@@ -286,16 +302,16 @@ pub fn denoise_point(
         let Some(coverage) = images.layer(&coverage_name).map(|l| &l.planes[0]) else { continue };
         let Some(window) = covered_window(coverage, w, h) else { continue };
         let mask: Vec<bool> = window.pixels(w).map(|i| coverage[i] > 0.0).collect();
-        let slopes = surface_slopes(images, name, window);
         for kind in DENOISED_KINDS.into_iter().filter(|k| LayerKind::for_role(*role).contains(k)) {
             let layer_name = object_layer_name(name, kind);
             let Some(layer) = images.layer(&layer_name) else { continue };
             if layer.planes.iter().take(3).all(|p| p.iter().all(|&v| v == 0.0)) {
                 continue;
             }
-            let at = (window, mask.as_slice(), slopes.as_slice());
+            let terms = surface_terms(images, name, kind, window);
+            let at = (window, mask.as_slice(), terms.as_slice());
             let est = estimate(oidn, input, &layer_name, Some(&coverage_name), at)?;
-            if est.denoised() < est.raw() {
+            if est.denoised() <= est.raw() {
                 let filtered = filter(oidn, layer, Some(coverage), &input.guides, window)?;
                 out.images.push(denoised_image(layer, &filtered, window, Some(coverage)));
                 out.summary.layers.push(layer_name);
