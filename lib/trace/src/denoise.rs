@@ -32,6 +32,7 @@
 use crate::error::TraceError;
 use crate::layers::{object_layer_name, LayerImage, LayerKind, PointImages};
 use crate::oidn::{DenoiseImage, Oidn};
+use crate::settings::TraceSettings;
 use pis_codec::display::display;
 use pis_scene::ObjectRole;
 use serde::{Deserialize, Serialize};
@@ -152,23 +153,35 @@ fn interleave(layer: &LayerImage, window: Window, weight: Option<&[f32]>) -> Vec
     out
 }
 
-/// Denoises the RGB of `layer` (times `weight`) in `window` with the point's guides.
+/// The point's guides cut to one window, interleaved once for every layer filtered there.
+struct WindowGuides {
+    window: Window,
+    albedo: Vec<f32>,
+    normal: Vec<f32>,
+}
+
+impl WindowGuides {
+    fn new(guides: &[LayerImage; 2], window: Window) -> WindowGuides {
+        let [albedo, normal] = guides.each_ref().map(|g| interleave(g, window, None));
+        WindowGuides { window, albedo, normal }
+    }
+}
+
+/// Denoises the RGB of `layer` (times `weight`) in the guides' window.
 fn filter(
     oidn: &Oidn,
     layer: &LayerImage,
     weight: Option<&[f32]>,
-    guides: &[LayerImage; 2],
-    window: Window,
+    guides: &WindowGuides,
 ) -> Result<Vec<f32>, TraceError> {
+    let window = guides.window;
     let color = interleave(layer, window, weight);
-    let albedo = interleave(&guides[0], window, None);
-    let normal = interleave(&guides[1], window, None);
     oidn.denoise(&DenoiseImage {
         width: window.width(),
         height: window.height(),
         color: &color,
-        albedo: Some(&albedo),
-        normal: Some(&normal),
+        albedo: Some(&guides.albedo),
+        normal: Some(&guides.normal),
         hdr: true,
         clean_aux: false,
     })
@@ -221,36 +234,34 @@ fn display_error(a: &[f32], b: &[f32], terms: &[SurfaceTerm]) -> f64 {
     a.iter().zip(b).zip(terms).map(|((&x, &y), t)| (seen(x, t) - seen(y, t)).powi(2)).sum()
 }
 
-/// The raw and denoised errors of layer `name` (filtered premultiplied by `coverage` when
-/// given, compared divided by it), accumulated over the covered pixels of `window` (`mask`).
-#[allow(clippy::too_many_arguments, reason = "the layer, its window, and where to add")]
+/// The raw and denoised errors of layer `name` (filtered premultiplied by the coverage layer
+/// `coverage`, compared divided by it), accumulated over the covered pixels of the guides'
+/// window (`mask`).
 fn estimate(
     oidn: &Oidn,
     input: &DenoiseInput,
-    name: &str,
-    coverage: Option<&str>,
-    (window, mask, terms): (Window, &[bool], &[SurfaceTerm]),
+    (name, coverage): (&str, &str),
+    (guides, mask, terms): (&WindowGuides, &[bool], &[SurfaceTerm]),
 ) -> Result<Estimate, TraceError> {
     let mut est = Estimate::default();
     let [ha, hb] = &input.halves;
     let (Some(la), Some(lb)) = (ha.layer(name), hb.layer(name)) else { return Ok(est) };
-    let cov = |h: &PointImages| coverage.and_then(|c| h.layer(c)).map(|l| l.planes[0].clone());
-    let (ca, cb) = (cov(ha), cov(hb));
+    let (Some(ca), Some(cb)) = (ha.layer(coverage), hb.layer(coverage)) else { return Ok(est) };
+    let (ca, cb) = (&ca.planes[0], &cb.planes[0]);
     // Compared as the layers are read, divided by coverage, where both halves cover.
+    let window = guides.window;
     let (a, b) = (interleave(la, window, None), interleave(lb, window, None));
-    let da = filter(oidn, la, ca.as_deref(), &input.guides, window)?;
+    let da = filter(oidn, la, Some(ca), guides)?;
     for (k, i) in window.pixels(la.width).enumerate().filter(|&(k, _)| mask[k]) {
-        let (wa, wb) = (ca.as_ref().map_or(1.0, |c| c[i]), cb.as_ref().map_or(1.0, |c| c[i]));
+        let (wa, wb) = (ca[i], cb[i]);
         if wa <= 0.0 || wb <= 0.0 {
             continue;
         }
         let px = k * 3..k * 3 + 3;
-        let divided =
-            |d: &[f32], w: f32| -> Vec<f32> { d.iter().map(|v| v.max(0.0) / w).collect() };
-        let dak = divided(&da[px.clone()], wa);
-        let k = &terms[px.clone()];
-        est.half_noise += display_error(&a[px.clone()], &b[px.clone()], k) / 2.0;
-        est.denoised_half += display_error(&dak, &b[px], k);
+        let dak: [f32; 3] = std::array::from_fn(|c| da[k * 3 + c].max(0.0) / wa);
+        let t = &terms[px.clone()];
+        est.half_noise += display_error(&a[px.clone()], &b[px.clone()], t) / 2.0;
+        est.denoised_half += display_error(&dak, &b[px], t);
     }
     Ok(est)
 }
@@ -293,7 +304,7 @@ pub fn denoise_point(
     let mut out = DenoisedPoint::default();
     let whole = Window { x0: 0, y0: 0, x1: w, y1: h };
     if let Some(combined) = images.layer("combined") {
-        let filtered = filter(oidn, combined, None, &input.guides, whole)?;
+        let filtered = filter(oidn, combined, None, &WindowGuides::new(&input.guides, whole))?;
         out.images.push(denoised_image(combined, &filtered, whole, None));
         out.summary.layers.push(combined.name.clone());
     }
@@ -302,6 +313,7 @@ pub fn denoise_point(
         let Some(coverage) = images.layer(&coverage_name).map(|l| &l.planes[0]) else { continue };
         let Some(window) = covered_window(coverage, w, h) else { continue };
         let mask: Vec<bool> = window.pixels(w).map(|i| coverage[i] > 0.0).collect();
+        let guides = WindowGuides::new(&input.guides, window);
         for kind in DENOISED_KINDS.into_iter().filter(|k| LayerKind::for_role(*role).contains(k)) {
             let layer_name = object_layer_name(name, kind);
             let Some(layer) = images.layer(&layer_name) else { continue };
@@ -309,10 +321,10 @@ pub fn denoise_point(
                 continue;
             }
             let terms = surface_terms(images, name, kind, window);
-            let at = (window, mask.as_slice(), terms.as_slice());
-            let est = estimate(oidn, input, &layer_name, Some(&coverage_name), at)?;
+            let at = (&guides, mask.as_slice(), terms.as_slice());
+            let est = estimate(oidn, input, (&layer_name, &coverage_name), at)?;
             if est.denoised() <= est.raw() {
-                let filtered = filter(oidn, layer, Some(coverage), &input.guides, window)?;
+                let filtered = filter(oidn, layer, Some(coverage), &guides)?;
                 out.images.push(denoised_image(layer, &filtered, window, Some(coverage)));
                 out.summary.layers.push(layer_name);
             } else {
@@ -321,6 +333,16 @@ pub fn denoise_point(
         }
     }
     Ok(out)
+}
+
+/// The denoiser a render with `settings` denoises with, as set.json and the report name it
+/// (`Open Image Denoise 2.5.1`); `None` when it does not denoise.
+pub fn denoiser(settings: &TraceSettings) -> Option<String> {
+    if !settings.denoise {
+        return None;
+    }
+    let oidn = crate::oidn::shared().ok()?;
+    Some(format!("Open Image Denoise {}", oidn.version()))
 }
 
 /// Replaces every layer that has a `denoised.` twin in `images` by it (its RGB; a `local`

@@ -23,7 +23,7 @@ struct PixelSamples {
     /// Every sample, summed in sample order.
     whole: PixelAccum,
     /// The even and the odd samples apart (kept for renders that denoise).
-    halves: Option<Box<[PixelAccum; 2]>>,
+    halves: Option<[PixelAccum; 2]>,
     /// The estimated relative error when the pixel stopped ([`pixel_error`]).
     error: f32,
 }
@@ -87,6 +87,11 @@ pub fn channel_names(scene: &Scene) -> Vec<String> {
     out
 }
 
+/// Every object's channel name ([`channel_names`]) and role, in scene order.
+pub fn object_channels(scene: &Scene) -> Vec<(String, ObjectRole)> {
+    channel_names(scene).into_iter().zip(scene.objects.iter().map(|o| o.role)).collect()
+}
+
 /// Renders `scene` at `frame`. `row_done` is called once per finished image row (from any
 /// thread), for progress display. Runs on the current rayon pool.
 pub fn render_point(
@@ -140,22 +145,21 @@ pub fn render_point(
         records.extend(r);
         total_rays += n;
     }
-    let names = channel_names(scene);
-    let objects: Vec<(String, ObjectRole)> =
-        names.into_iter().zip(scene.objects.iter().map(|o| o.role)).collect();
-    let whole: Vec<PixelAccum> = pixels.iter().map(|p| p.whole.clone()).collect();
-    let images = resolve(&whole, w, h, &objects);
+    let objects = object_channels(scene);
     let sampling = settings.adaptive().then(|| sampling_maps(&pixels, w, h));
+    let (mut whole, mut even, mut odd) = (Vec::with_capacity(pixels.len()), Vec::new(), Vec::new());
+    for p in pixels {
+        whole.push(p.whole);
+        if let Some([a, b]) = p.halves {
+            even.push(a);
+            odd.push(b);
+        }
+    }
+    let images = resolve(&whole, w, h, &objects);
     let denoise_input = settings.denoise.then(|| {
-        let half = |k: usize| -> Vec<PixelAccum> {
-            pixels
-                .iter()
-                .map(|p| p.halves.as_ref().map(|x| x[k].clone()).unwrap_or_default())
-                .collect()
-        };
         Box::new(DenoiseInput {
             guides: resolve_guides(&whole, w, h),
-            halves: [resolve(&half(0), w, h, &objects), resolve(&half(1), w, h, &objects)],
+            halves: [resolve(&even, w, h, &objects), resolve(&odd, w, h, &objects)],
         })
     });
     let stats = RenderStats {
@@ -259,7 +263,7 @@ fn render_row(
             }
             end = next_round(end, settings.spp);
         };
-        let halves = settings.denoise.then(|| Box::new(halves));
+        let halves = settings.denoise.then_some(halves);
         pixels.push(PixelSamples { whole, halves, error });
     }
     (pixels, records, ctx.rays - rays_before)

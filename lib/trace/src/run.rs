@@ -1,7 +1,7 @@
 //! Rendering a whole ray-traced set: every parameter point of a scene, written as it is done.
 
 use crate::error::TraceError;
-use crate::render::{channel_names, render_point, PointRender};
+use crate::render::{object_channels, render_point, PointRender};
 use crate::set::{Begin, SetWriter, Shard};
 use crate::settings::TraceSettings;
 use pis_scene::Scene;
@@ -63,8 +63,8 @@ pub struct SetReport {
     /// The denoiser of the `denoised.` layers; absent when the set is not denoised.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub denoiser: Option<String>,
-    /// Objects kept raw at a point because denoising was estimated to move them further
-    /// from the converged image (`point 3: TeapotLid`).
+    /// Layers kept raw at a point because denoising was estimated to move them further
+    /// from the converged image (`point 3: object.TeapotLid.specular`).
     pub kept_raw: Vec<String>,
     /// Milliseconds per point spent denoising (included in `ms_per_point`).
     pub denoise_ms_per_point: f64,
@@ -187,8 +187,7 @@ pub fn render_shard(
     let start = Instant::now();
     let (settings, denoise_note) = denoise_or_not(settings);
     let settings = &settings;
-    let objects: Vec<(String, pis_scene::ObjectRole)> =
-        channel_names(scene).into_iter().zip(scene.objects.iter().map(|o| o.role)).collect();
+    let objects = object_channels(scene);
     let total_points = scene.space.point_count();
     let count = run.limit.map_or(total_points, |l| l.min(total_points));
     let mine: Vec<usize> = run.shard.points(count).collect();
@@ -205,11 +204,7 @@ pub fn render_shard(
         threads: rayon::current_num_threads(),
         noise_threshold: settings.noise_threshold,
         min_spp: settings.min_spp,
-        denoiser: settings
-            .denoise
-            .then(crate::oidn::shared)
-            .and_then(Result::ok)
-            .map(|o| format!("Open Image Denoise {}", o.version())),
+        denoiser: crate::denoise::denoiser(settings),
         ..Default::default()
     };
     for w in scene.warnings.iter().cloned().chain(darkness_warning(scene)).chain(denoise_note) {

@@ -91,17 +91,8 @@ fn layer_error(image: &PointImages, reference: &PointImages, object: &str, kind:
 
 #[test]
 fn denoised_layers_are_closer_to_the_converged_image_than_the_raw_ones() {
-    let oidn = match pis_trace::oidn::shared() {
-        Ok(o) => o,
-        Err(why) => {
-            assert!(
-                std::env::var_os("PIS_REQUIRE_OIDN").is_none(),
-                "PIS_REQUIRE_OIDN is set and Open Image Denoise is not found: {why}"
-            );
-            eprintln!("skipped: Open Image Denoise is not found: {why}");
-            return;
-        }
-    };
+    let test = "denoised_layers_are_closer_to_the_converged_image_than_the_raw_ones";
+    let Some(oidn) = pis_trace::oidn::shared_or_skip(test) else { return };
     let (s, f) = room((64, 48), 4);
     let mut noisy = TraceSettings::new(s.resolution, 4);
     noisy.denoise = true;

@@ -284,6 +284,22 @@ fn validate(image: &DenoiseImage) -> Result<usize, OidnError> {
     Ok(values)
 }
 
+/// For tests: the shared instance, or `None` after printing why `test` is skipped. Where
+/// `PIS_REQUIRE_OIDN` is set (CI sets it) a missing library fails the test instead.
+pub fn shared_or_skip(test: &str) -> Option<&'static Oidn> {
+    match shared() {
+        Ok(oidn) => Some(oidn),
+        Err(reason) => {
+            assert!(
+                std::env::var_os("PIS_REQUIRE_OIDN").is_none(),
+                "PIS_REQUIRE_OIDN is set but Open Image Denoise did not load: {reason}"
+            );
+            println!("skipped {test}: {reason}");
+            None
+        }
+    }
+}
+
 /// OIDN loaded once per process: `Ok(&'static Oidn)`, or the reason it is unavailable
 /// (found once too, and kept).
 pub fn shared() -> Result<&'static Oidn, &'static OidnUnavailable> {

@@ -2,21 +2,6 @@ use super::*;
 
 use rayon::prelude::*;
 
-/// The shared instance, or `None` after printing why the test is skipped. With
-/// `PIS_REQUIRE_OIDN=1` a missing library fails the test instead.
-fn oidn_or_skip(test: &str) -> Option<&'static Oidn> {
-    match shared() {
-        Ok(oidn) => Some(oidn),
-        Err(reason) => {
-            if std::env::var("PIS_REQUIRE_OIDN").is_ok_and(|value| value == "1") {
-                panic!("PIS_REQUIRE_OIDN=1 but OIDN did not load: {reason}");
-            }
-            println!("skipped {test}: {reason}");
-            None
-        }
-    }
-}
-
 /// A deterministic hash of `seed` and `index` (splitmix64 finaliser).
 fn hash(seed: u64, index: u64) -> u64 {
     let mut z = seed ^ index.wrapping_mul(0x9e37_79b9_7f4a_7c15);
@@ -142,7 +127,7 @@ const MIN_GAIN_DB: f64 = 10.0;
 
 #[test]
 fn denoise_raises_psnr_colour_only() {
-    let Some(oidn) = oidn_or_skip("denoise_raises_psnr_colour_only") else { return };
+    let Some(oidn) = shared_or_skip("denoise_raises_psnr_colour_only") else { return };
     let (before, after) = psnr_gain(oidn, &scene(160, 120), false, false);
     println!("colour only (LDR): noisy {before:.2} dB, denoised {after:.2} dB");
     assert!(after >= before + MIN_GAIN_DB, "noisy {before:.2} dB, denoised {after:.2} dB");
@@ -150,7 +135,7 @@ fn denoise_raises_psnr_colour_only() {
 
 #[test]
 fn denoise_raises_psnr_with_guides() {
-    let Some(oidn) = oidn_or_skip("denoise_raises_psnr_with_guides") else { return };
+    let Some(oidn) = shared_or_skip("denoise_raises_psnr_with_guides") else { return };
     let (before, after) = psnr_gain(oidn, &scene(160, 120), true, false);
     println!("albedo + normal (LDR): noisy {before:.2} dB, denoised {after:.2} dB");
     assert!(after >= before + MIN_GAIN_DB, "noisy {before:.2} dB, denoised {after:.2} dB");
@@ -158,7 +143,7 @@ fn denoise_raises_psnr_with_guides() {
 
 #[test]
 fn denoise_raises_psnr_hdr_with_guides() {
-    let Some(oidn) = oidn_or_skip("denoise_raises_psnr_hdr_with_guides") else { return };
+    let Some(oidn) = shared_or_skip("denoise_raises_psnr_hdr_with_guides") else { return };
     let (before, after) = psnr_gain(oidn, &scene(160, 120), true, true);
     println!("albedo + normal (HDR): noisy {before:.2} dB, denoised {after:.2} dB");
     assert!(after >= before + MIN_GAIN_DB, "noisy {before:.2} dB, denoised {after:.2} dB");
@@ -166,7 +151,7 @@ fn denoise_raises_psnr_hdr_with_guides() {
 
 #[test]
 fn shared_instance_reports_its_library_and_version() {
-    let Some(oidn) = oidn_or_skip("shared_instance_reports_its_library_and_version") else {
+    let Some(oidn) = shared_or_skip("shared_instance_reports_its_library_and_version") else {
         return;
     };
     assert!(std::ptr::eq(oidn, shared().unwrap()));
@@ -186,7 +171,7 @@ fn oidn_can_be_shared_between_threads() {
 
 #[test]
 fn denoise_from_rayon_workers_matches_a_single_call() {
-    let Some(oidn) = oidn_or_skip("denoise_from_rayon_workers_matches_a_single_call") else {
+    let Some(oidn) = shared_or_skip("denoise_from_rayon_workers_matches_a_single_call") else {
         return;
     };
     let scene = scene(64, 48);
@@ -236,7 +221,7 @@ fn bad_inputs_are_errors_before_oidn_is_called() {
         assert!(matches!(validate(image), Err(OidnError::InvalidInput(_))), "{name}");
     }
     // The same through a loaded library: an Err, no panic, and the device stays usable.
-    let Some(oidn) = oidn_or_skip("bad_inputs_are_errors_before_oidn_is_called") else {
+    let Some(oidn) = shared_or_skip("bad_inputs_are_errors_before_oidn_is_called") else {
         return;
     };
     for (name, image) in &cases {
@@ -254,7 +239,7 @@ fn oidn_timing() {
     let threads = || std::fs::read_dir("/proc/self/task").map(|d| d.count()).unwrap_or(0);
     let before = threads();
     let start = std::time::Instant::now();
-    let Some(oidn) = oidn_or_skip("oidn_timing") else { return };
+    let Some(oidn) = shared_or_skip("oidn_timing") else { return };
     println!("OIDN {} from {}", oidn.version(), oidn.library().display());
     println!("first load (search, dlopen, device): {:.2?}", start.elapsed());
     let start = std::time::Instant::now();

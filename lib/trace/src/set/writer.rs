@@ -104,11 +104,7 @@ impl SetWriter {
             objects,
             points: Vec::new(),
             scene_file: scene.source.as_deref().map(|s| relative_to(s, dir)),
-            denoiser: settings
-                .denoise
-                .then(crate::oidn::shared)
-                .and_then(Result::ok)
-                .map(|oidn| format!("Open Image Denoise {}", oidn.version())),
+            denoiser: crate::denoise::denoiser(settings),
         }
     }
 
