@@ -444,6 +444,16 @@ fn against_the_set_gates_and_flip_maps() {
     let (whole, covered) =
         (r["psnr_db"].as_f64().expect("PSNR"), r["covered_psnr_db"].as_f64().expect("covered"));
     assert_eq!(r["verdict"], "measured");
+    // The set as its own reference pair: no noise between them, every figure stands.
+    let paired =
+        diff(packed(), set(), &["--json", "--reference-pair", set().to_str().expect("utf-8")]);
+    let figures = json(&paired)["reference_noise"]["figures"].clone();
+    assert_eq!(figures[0]["name"], "whole image", "{figures}");
+    let stands = |f: &serde_json::Value, v: f64| {
+        f["noise_removed_psnr_db"].as_f64().is_some_and(|r| (r - v).abs() < 1e-9)
+    };
+    assert!(stands(&figures[0], whole) && stands(&figures[1], covered), "{figures}");
+    assert!(figures[1]["noise_psnr_db"].is_null(), "{figures}");
     let dir = tempfile::tempdir().expect("temp dir");
     let maps = dir.path().join("flip");
     let pass = diff(
@@ -704,4 +714,60 @@ fn edit_point(d: &Path, edit: impl FnOnce(&mut pis_trace::PointImages)) {
     edit(&mut img);
     let path = d.join(&set.meta.points[1].image);
     std::fs::write(&path, pis_trace::set::encode_exr(&img, &path).expect("encode")).expect("write");
+}
+
+/// The reference pair: a set judged by a noisy reference traced twice, from independent
+/// streams, gets the reference's own noise beside each figure and an estimate with that noise
+/// taken out, which lands nearer the figure a far cleaner reference measures than the raw one.
+#[test]
+fn a_reference_pair_takes_the_reference_noise_out() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let trace = |name: &str, spp: &str, seed: &str| {
+        let out_dir = dir.path().join(name);
+        let out = Command::new(env!("CARGO_BIN_EXE_pis-trace"))
+            .arg(repo("samples/demo1/scene.toml"))
+            .arg("-o")
+            .arg(&out_dir)
+            .args(["--resolution", "40x30", "--points", "2", "--denoise", "off"])
+            .args(["--shading-seed", "sample", "--spp", spp, "--seed", seed])
+            .output()
+            .expect("pis-trace runs");
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        out_dir
+    };
+    let (set, first, second, clean) = (
+        trace("set", "8", "2"),
+        trace("r1", "8", "0"),
+        trace("r2", "8", "1"),
+        trace("c", "256", "3"),
+    );
+    let judged = |reference: &Path, args: &[&str]| {
+        let out = diff(reference, &set, &[&["--json"], args].concat());
+        assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
+        json(&out)
+    };
+    let truth = judged(&clean, &[])["psnr_db"].as_f64().expect("finite");
+    let v = judged(&first, &["--reference-pair", second.to_str().expect("utf-8")]);
+    let whole = &v["reference_noise"]["figures"][0];
+    assert_eq!(whole["name"], "whole image", "{v}");
+    let (measured, removed) = (
+        whole["psnr_db"].as_f64().expect("finite"),
+        whole["noise_removed_psnr_db"].as_f64().expect("an estimate"),
+    );
+    assert_eq!(Some(measured), v["psnr_db"].as_f64(), "{v}");
+    eprintln!(
+        "against 8 spp {measured:.2} dB, noise taken out {removed:.2}, against 256 spp {truth:.2}"
+    );
+    assert!(
+        (removed - truth).abs() < 0.25 * (measured - truth).abs() && (measured - truth).abs() > 1.0,
+        "against 8 spp {measured:.2} dB, noise taken out {removed:.2}, against 256 spp {truth:.2}"
+    );
+    // The reference's noise is its own distance from the clean trace.
+    let noise = whole["noise_psnr_db"].as_f64().expect("noisy reference");
+    let own = diff(&clean, &first, &["--json"]);
+    let own = json(&own)["psnr_db"].as_f64().expect("finite");
+    assert!((noise - own).abs() < 1.0, "pair says {noise:.2} dB, the clean trace {own:.2}");
+    // Without a set there is no gold standard to pair.
+    let packed = packed();
+    assert_eq!(diff(packed, packed, &["--reference-pair", "x"]).status.code(), Some(1));
 }

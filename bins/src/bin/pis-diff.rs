@@ -75,6 +75,13 @@ struct Cli {
     /// --denoise); by default a layer with a twin reads as the twin.
     #[arg(long)]
     raw: bool,
+    /// Against a set: a second trace of the gold-standard set (the set folder a file is
+    /// measured against, or the first of two sets) from an independent sample stream
+    /// (`pis-trace --seed 1 --shading-seed sample`). Their difference measures the gold
+    /// standard's own noise, printed beside each figure with the figure's estimate with that
+    /// noise taken out (what a converged reference would measure).
+    #[arg(long, value_name = "SET_DIR")]
+    reference_pair: Option<PathBuf>,
 }
 
 fn run(cli: Cli) -> Result<Exit, Failure> {
@@ -90,6 +97,7 @@ fn run(cli: Cli) -> Result<Exit, Failure> {
             b: cli.b,
             min_psnr: cli.min_psnr,
             raw: cli.raw,
+            pair: cli.reference_pair,
         })?;
         if cli.json {
             let s = serde_json::to_string_pretty(&report)
@@ -109,6 +117,7 @@ fn run(cli: Cli) -> Result<Exit, Failure> {
             max_psnr_drop: cli.max_psnr_drop,
             reference_psnr: cli.reference_psnr,
             msaa: cli.msaa,
+            pair: cli.reference_pair,
         };
         let report = gold(&req)?;
         if cli.json {
@@ -120,8 +129,8 @@ fn run(cli: Cli) -> Result<Exit, Failure> {
         }
         return Ok(report.exit());
     }
-    if cli.max_psnr_drop.is_some() || cli.reference_psnr.is_some() {
-        return Err(Failure::new(Exit::Usage, anyhow::anyhow!("--max-psnr-drop compares with a gold-standard set: give a set folder as the second argument")));
+    if cli.max_psnr_drop.is_some() || cli.reference_psnr.is_some() || cli.reference_pair.is_some() {
+        return Err(Failure::new(Exit::Usage, anyhow::anyhow!("--max-psnr-drop and --reference-pair compare with a gold-standard set: give a set folder as the second argument")));
     }
     let memory = pis_eval::budget::budget_bytes(cli.memory);
     let req =

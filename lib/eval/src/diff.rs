@@ -6,6 +6,7 @@ pub mod content;
 pub mod decode;
 pub mod files;
 pub mod gold;
+pub mod noise;
 pub mod sets;
 pub mod structure;
 

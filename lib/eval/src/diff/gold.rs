@@ -21,6 +21,7 @@ use pis_play::{Gpu, PlayError, Player, PlayerOptions};
 use serde::Serialize;
 
 use super::files::{min_psnr_gate, Gate};
+use super::noise::{self, judge, ReferenceNoise};
 use crate::reencode::open;
 use pis_pack::{Exit, Failure};
 
@@ -40,6 +41,9 @@ pub struct GoldRequest {
     pub reference_psnr: Option<f64>,
     /// Samples per pixel the player draws with (1 or 4, as `pis-play --msaa`).
     pub msaa: u32,
+    /// A second trace of the set from an independent sample stream: measures the set's own
+    /// noise ([`super::noise`]).
+    pub pair: Option<PathBuf>,
 }
 
 #[derive(Clone, Debug, Serialize)]
@@ -111,6 +115,9 @@ pub struct GoldReport {
     pub gates: Vec<Gate>,
     /// `measured` (no gate), `within gates` or `gate failed`.
     pub verdict: String,
+    /// With a reference pair: the set's own noise beside each figure.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub reference_noise: Option<ReferenceNoise>,
 }
 
 impl GoldReport {
@@ -240,8 +247,9 @@ fn gold_points(
 
 /// Measures `req.file` against the set `req.set`.
 pub fn gold(req: &GoldRequest) -> Result<GoldReport, Failure> {
-    // The reference of the drop gate, before any drawing.
+    // The reference of the drop gate and the set's own noise, before any drawing.
     let (reference, reference_from) = drop_reference(req)?;
+    let pair = req.pair.as_ref().map(|p| noise::pair(&req.set, p, false)).transpose()?;
 
     let gpu = Arc::new(Gpu::new().map_err(|e| failure(e.into()))?);
     let device = gpu.describe();
@@ -334,11 +342,27 @@ pub fn gold(req: &GoldRequest) -> Result<GoldReport, Failure> {
         reference_psnr_db: reference,
         reference_from,
         psnr_drop_db: drop.and_then(finite),
-        objects,
         points,
         heatmaps,
         gates,
         verdict: verdict.to_string(),
+        reference_noise: pair.map(|p| ReferenceNoise {
+            pair: p.b.clone(),
+            points: p.points_compared,
+            figures: [
+                judge("whole image", psnr, p.psnr_db),
+                judge("objects' covered pixels", covered, noise::pooled_objects(&p)),
+            ]
+            .into_iter()
+            .chain(
+                objects
+                    .iter()
+                    .filter(|o| o.mse > 0.0)
+                    .map(|o| judge(&o.name, o.psnr_db, noise::object(&p, &o.name))),
+            )
+            .collect(),
+        }),
+        objects,
     })
 }
 
@@ -402,6 +426,9 @@ pub fn render(r: &GoldReport) -> String {
     }
     if let (Some(r0), Some(from)) = (r.reference_psnr_db, &r.reference_from) {
         let _ = writeln!(s, "  reference {r0:.2} dB ({from}): drop {} dB", db(r.psnr_drop_db));
+    }
+    if let Some(n) = &r.reference_noise {
+        s.push_str(&noise::render(n));
     }
     for h in &r.heatmaps {
         let _ = writeln!(s, "  FLIP map {h}");

@@ -15,6 +15,7 @@
 
 use std::path::{Path, PathBuf};
 
+use super::noise::{self, judge, ReferenceNoise};
 use crate::metrics::SquaredError;
 use anyhow::anyhow;
 use pis_trace::layers::{LayerKind, PointImages};
@@ -32,6 +33,9 @@ pub struct SetsRequest {
     pub min_psnr: Option<f64>,
     /// Read both sets' raw layers where they hold denoised twins (RAYSET.md 5.4).
     pub raw: bool,
+    /// A second trace of `a` from an independent sample stream: measures `a`'s own noise
+    /// ([`super::noise`]).
+    pub pair: Option<PathBuf>,
 }
 
 /// One point of both sets.
@@ -131,6 +135,9 @@ pub struct SetsReport {
     /// Which layers of each set were read: `denoised` (the set's denoised twins), `raw`
     /// (asked for, or a set without twins).
     pub layers: [&'static str; 2],
+    /// With a reference pair: the first set's own noise beside each figure.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub reference_noise: Option<ReferenceNoise>,
 }
 
 impl SetsReport {
@@ -298,7 +305,8 @@ pub fn compare_sets(req: &SetsRequest) -> Result<SetsReport, Failure> {
     }
     let psnr = finite(total.psnr());
     let passed = req.min_psnr.is_none_or(|m| psnr.is_none_or(|p| p >= m));
-    Ok(SetsReport {
+    let mut report = SetsReport {
+        reference_noise: None,
         layers,
         a: req.a.display().to_string(),
         b: req.b.display().to_string(),
@@ -325,7 +333,29 @@ pub fn compare_sets(req: &SetsRequest) -> Result<SetsReport, Failure> {
         per_point,
         min_psnr_db: req.min_psnr,
         passed,
-    })
+    };
+    if let Some(second) = &req.pair {
+        report.reference_noise = Some(reference_noise(&report, &req.a, second, req.raw)?);
+    }
+    Ok(report)
+}
+
+/// The first set's own noise, from its second trace, beside the report's figures.
+fn reference_noise(
+    r: &SetsReport,
+    first: &Path,
+    second: &Path,
+    raw: bool,
+) -> Result<ReferenceNoise, Failure> {
+    let pair = noise::pair(first, second, raw)?;
+    let mut figures = vec![judge("whole image", r.psnr_db, pair.psnr_db)];
+    figures.extend(
+        r.objects
+            .iter()
+            .filter(|o| o.pixels > 0)
+            .map(|o| judge(&o.name, o.psnr_db, noise::object(&pair, &o.name))),
+    );
+    Ok(ReferenceNoise { pair: second.display().to_string(), points: pair.points_compared, figures })
 }
 
 /// The readable report.
@@ -352,6 +382,9 @@ pub fn render(r: &SetsReport) -> String {
                 db(o.model_psnr_db)
             );
         }
+    }
+    if let Some(n) = &r.reference_noise {
+        s.push_str(&noise::render(n));
     }
     if let Some(m) = r.min_psnr_db {
         let _ =
