@@ -16,12 +16,13 @@
 use std::path::PathBuf;
 use std::process::ExitCode;
 
-use clap::{Parser, Subcommand};
+use clap::{Args, Parser, Subcommand};
 use pis::cli::{finish, parse, parse_shading_seed, Exit, Failure, EXIT_CODES_HELP};
 use pis_compile::SolveSettings;
 use pis_eval::bench::all::{self, Preset};
 use pis_eval::bench::hybrid::{self, HybridRequest};
 use pis_eval::bench::rd::{self, RdRequest};
+use pis_eval::bench::reference::ReferenceSampling;
 use pis_eval::bench::reflective::{self, ReflectiveRequest};
 use pis_eval::bench::speed::{self, SpeedRequest};
 use pis_eval::bench::stability::{self, StabilityRequest};
@@ -35,6 +36,33 @@ use pis_pack::infer::{infer, print_report, InferRequest};
 struct Cli {
     #[command(subcommand)]
     command: Command,
+}
+
+/// How the reference frames sample and whether they are denoised.
+#[derive(Args, Debug)]
+struct ReferenceArgs {
+    /// Trace the reference frames with adaptive sampling: a pixel stops once its estimated
+    /// relative error is below T (as pis-trace --noise-threshold); --reference-spp is then
+    /// each pixel's most samples. 0: every pixel takes --reference-spp.
+    #[arg(long, value_name = "T", default_value_t = 0.0)]
+    reference_noise_threshold: f32,
+    /// With --reference-noise-threshold: the samples every reference pixel takes first.
+    #[arg(long, value_name = "N", default_value_t = 4)]
+    reference_min_spp: u32,
+    /// Denoise each reference frame's combined image with Open Image Denoise (albedo and
+    /// normal guides at the first non-specular hit); refused where the library is not found.
+    #[arg(long)]
+    reference_denoise: bool,
+}
+
+impl ReferenceArgs {
+    fn sampling(&self) -> ReferenceSampling {
+        ReferenceSampling {
+            noise_threshold: self.reference_noise_threshold,
+            min_spp: self.reference_min_spp,
+            denoise: self.reference_denoise,
+        }
+    }
 }
 
 #[derive(Subcommand, Debug)]
@@ -204,6 +232,8 @@ enum Command {
         /// 1/spp: a gold standard).
         #[arg(long, value_name = "cell|sample", default_value = "cell", value_parser = parse_shading_seed)]
         reference_seed: pis_trace::ShadingSeed,
+        #[command(flatten)]
+        reference: ReferenceArgs,
         #[arg(long, default_value = "reports")]
         out: PathBuf,
         #[arg(long, value_parser = parse_resolution)]
@@ -248,6 +278,8 @@ enum Command {
         /// (an estimate of the PSNR against the converged image).
         #[arg(long)]
         reference_pair: bool,
+        #[command(flatten)]
+        reference: ReferenceArgs,
         #[arg(long, default_value = "reports")]
         out: PathBuf,
         #[arg(long, value_parser = parse_resolution)]
@@ -502,6 +534,7 @@ fn run(cli: Cli) -> Result<Exit, Failure> {
             frames,
             reference_spp,
             reference_seed,
+            reference,
             out,
             resolution,
             spp,
@@ -511,6 +544,7 @@ fn run(cli: Cli) -> Result<Exit, Failure> {
             json,
         } => {
             let req = StabilityRequest {
+                sampling: reference.sampling(),
                 input,
                 scene,
                 ratios,
@@ -539,6 +573,7 @@ fn run(cli: Cli) -> Result<Exit, Failure> {
             reference_spp,
             reference_seed,
             reference_pair,
+            reference,
             out,
             resolution,
             preset,
@@ -556,6 +591,7 @@ fn run(cli: Cli) -> Result<Exit, Failure> {
                 spp: reference_spp,
                 reference_seed,
                 reference_pair,
+                sampling: reference.sampling(),
                 out,
                 images,
                 role,

@@ -9,6 +9,7 @@ pub mod mpeg_texture;
 pub mod output;
 pub mod playback;
 pub mod rd;
+pub mod reference;
 pub mod reflective;
 pub mod speed;
 pub mod stability;

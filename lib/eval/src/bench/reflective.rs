@@ -21,10 +21,11 @@ use glam::Vec3;
 use pis_play::{CameraChoice, FrameRequest, Gpu, Player, PlayerOptions, ViewCamera};
 use pis_scene::{LoadOptions, ObjectRole, Scene};
 use pis_trace::layers::LayerKind;
-use pis_trace::{ShadingSeed, TraceSettings};
+use pis_trace::ShadingSeed;
 use serde::Serialize;
 
 use super::camera_path::{paths, PathFrame, PathKind};
+use super::reference::ReferenceSampling;
 use crate::metrics::{display, PairedError, SquaredError};
 use crate::report::{Csv, Stamp};
 use pis_pack::{Exit, Failure};
@@ -51,6 +52,8 @@ pub struct ReflectiveRequest {
     /// Trace every reference twice, from independent sample streams, to measure and take out
     /// its noise (needs `reference_seed` `Sample`).
     pub reference_pair: bool,
+    /// Adaptive sampling and denoising of the reference frames.
+    pub sampling: ReferenceSampling,
     /// Where reflective.csv goes.
     pub out: PathBuf,
     /// Also write every played frame beside its traced reference as an sRGB PNG.
@@ -92,6 +95,8 @@ pub struct ReflectiveReport {
     /// Whether each reference was traced twice from independent streams (its noise taken
     /// out of the figures: [`ReflectiveSummary::noise_removed_psnr_db`]).
     pub reference_pair: bool,
+    /// How the reference frames were traced (samples, seeding, adaptive sampling, denoising).
+    pub reference: String,
     pub summaries: Vec<ReflectiveSummary>,
     pub csv: String,
     pub stamp: Stamp,
@@ -109,48 +114,35 @@ struct Reference {
 const SECOND_STREAM: u64 = 1;
 
 fn reference(
+    req: &ReflectiveRequest,
     scene: &Scene,
     pf: &PathFrame,
-    spp: u32,
-    seed: ShadingSeed,
-    pair: bool,
     objects: &[usize],
 ) -> Result<Reference> {
-    let first = render_reference(scene, pf, spp, seed, 0, objects)?;
-    if !pair {
+    let first = render_reference(req, scene, pf, 0, objects)?;
+    if !req.reference_pair {
         return Ok(first);
     }
-    let second = render_reference(scene, pf, spp, seed, SECOND_STREAM, objects)?;
+    let second = render_reference(req, scene, pf, SECOND_STREAM, objects)?;
     let rgb = first.rgb.iter().zip(&second.rgb).map(|(a, b)| 0.5 * (a + b)).collect();
     Ok(Reference { rgb, mask: first.mask, pair: Some([first.rgb, second.rgb]) })
 }
 
 fn render_reference(
+    req: &ReflectiveRequest,
     scene: &Scene,
     pf: &PathFrame,
-    spp: u32,
-    seed: ShadingSeed,
     stream: u64,
     objects: &[usize],
 ) -> Result<Reference> {
-    let settings =
-        TraceSettings::new(scene.resolution, spp).with_shading_seed(seed).with_seed(stream);
-    let r = pis_trace::render_point(scene, &pf.frame, &settings, &|| {})?;
-    let l = r
-        .images
-        .layer("combined")
-        .ok_or_else(|| anyhow!("the traced frame has no combined image"))?;
-    let n = l.width as usize * l.height as usize;
-    let mut rgb = vec![0.0f32; n * 3];
-    for (c, name) in ["R", "G", "B"].iter().enumerate() {
-        let p = l.channel(name).ok_or_else(|| anyhow!("the traced frame has no {name}"))?;
-        (0..n).for_each(|k| rgb[k * 3 + c] = p[k]);
-    }
+    let settings = req.sampling.settings(scene.resolution, req.spp, req.reference_seed, stream);
+    let images = super::reference::trace(scene, &pf.frame, &settings)?;
+    let rgb = super::reference::combined_rgb(&images)?;
     let channels = pis_trace::channel_names(scene);
-    let mut mask = vec![false; n];
+    let mut mask = vec![false; rgb.len() / 3];
     for &o in objects {
         if let Some(a) =
-            r.images.object_layer(&channels[o], LayerKind::Coverage).and_then(|l| l.channel("A"))
+            images.object_layer(&channels[o], LayerKind::Coverage).and_then(|l| l.channel("A"))
         {
             mask.iter_mut().zip(a).for_each(|(m, &c)| *m |= c > 0.5);
         }
@@ -335,15 +327,16 @@ pub fn run(req: &ReflectiveRequest) -> Result<ReflectiveReport, Failure> {
     }
     let (view_dim, frames) =
         paths(&scene, req.frames, &PATHS).map_err(|e| Failure::new(Exit::NotSupported, e))?;
+    req.sampling.check().map_err(|e| Failure::new(Exit::NotSupported, e))?;
     let twice = if req.reference_pair { ", each twice from independent streams" } else { "" };
     eprintln!(
-        "pis-bench: reflective: tracing {} reference frames at {} spp{twice}",
+        "pis-bench: reflective: tracing {} reference frames ({}){twice}",
         frames.len(),
-        req.spp
+        req.sampling.describe(req.spp, req.reference_seed)
     );
     let refs: Vec<Reference> = frames
         .iter()
-        .map(|f| reference(&scene, f, req.spp, req.reference_seed, req.reference_pair, &objects))
+        .map(|f| reference(req, &scene, f, &objects))
         .collect::<Result<_>>()
         .map_err(runtime)?;
     let gpu = Arc::new(Gpu::new().map_err(|e| Failure::new(Exit::NotSupported, anyhow!("{e}")))?);
@@ -418,6 +411,7 @@ pub fn run(req: &ReflectiveRequest) -> Result<ReflectiveReport, Failure> {
         reference_spp: req.spp,
         reference_seed: req.reference_seed.name().into(),
         reference_pair: req.reference_pair,
+        reference: req.sampling.describe(req.spp, req.reference_seed),
         summaries,
         csv: csv_path.display().to_string(),
     })
@@ -429,7 +423,7 @@ pub fn print(r: &ReflectiveReport, out: &mut impl std::io::Write) -> std::io::Re
     } else {
         ""
     };
-    writeln!(out, "reflective: {} — played frames vs pis-trace over the pixels of {}, {} frames between and away, references at {} spp (shading seeded per {}{pair})", r.scene, r.objects.join(", "), r.frames, r.reference_spp, r.reference_seed)?;
+    writeln!(out, "reflective: {} — played frames vs pis-trace over the pixels of {}, {} frames between and away, references at {}{pair}", r.scene, r.objects.join(", "), r.frames, r.reference)?;
     for s in &r.summaries {
         write!(
             out,

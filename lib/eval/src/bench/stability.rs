@@ -20,7 +20,9 @@ use pis_compile::{
     render, render_matrix, scene_depth, DrawMesh, Filter, RenderMatrix, TexturedObject, Viewport,
 };
 use pis_format::DepMask;
-use pis_trace::{ShadingSeed, TraceSettings};
+use pis_trace::ShadingSeed;
+
+use super::reference::ReferenceSampling;
 use rayon::prelude::*;
 use serde::Serialize;
 
@@ -44,6 +46,8 @@ pub struct StabilityRequest {
     pub spp: u32,
     /// What seeds the reference frames' shading.
     pub reference_seed: ShadingSeed,
+    /// Adaptive sampling and denoising of the reference frames.
+    pub sampling: ReferenceSampling,
     pub out: PathBuf,
     pub resolution: Option<(u32, u32)>,
     pub trace_spp: Option<u32>,
@@ -81,6 +85,8 @@ pub struct PathSummary {
 pub struct StabilityReport {
     pub scene: String,
     pub frames: usize,
+    /// How the reference frames were traced (samples, seeding, adaptive sampling, denoising).
+    pub reference: String,
     pub summaries: Vec<PathSummary>,
     pub rows: Vec<FrameRow>,
     pub csv: String,
@@ -192,22 +198,9 @@ fn render_frame(
     Ok(Rendered { rgb, mask })
 }
 
-fn reference(inf: &Inferred, pf: &PathFrame, spp: u32, seed: ShadingSeed) -> Result<Vec<f32>> {
-    let settings = TraceSettings::new(inf.set.resolution, spp).with_shading_seed(seed);
-    let r = pis_trace::render_point(&inf.set.scene, &pf.frame, &settings, &|| {})?;
-    let l = r
-        .images
-        .layer("combined")
-        .ok_or_else(|| anyhow!("the traced frame has no combined image"))?;
-    let n = l.width as usize * l.height as usize;
-    let mut rgb = vec![0.0f32; n * 3];
-    for (c, name) in ["R", "G", "B"].iter().enumerate() {
-        let p = l.channel(name).ok_or_else(|| anyhow!("the traced frame has no {name}"))?;
-        for k in 0..n {
-            rgb[k * 3 + c] = p[k];
-        }
-    }
-    Ok(rgb)
+fn reference(req: &StabilityRequest, inf: &Inferred, pf: &PathFrame) -> Result<Vec<f32>> {
+    let settings = req.sampling.settings(inf.set.resolution, req.spp, req.reference_seed, 0);
+    super::reference::combined_rgb(&super::reference::trace(&inf.set.scene, &pf.frame, &settings)?)
 }
 
 fn rms_change(a: &[f32], b: &[f32], mask: &[bool]) -> f64 {
@@ -302,7 +295,7 @@ fn write_stability(
         .collect();
     let chart = Chart {
         title: format!("Stability off the samples — {scene_s}"),
-        subtitle: format!("through the hardware model at each exact camera vs pis-trace ({} spp, shading seeded per {}) over covered pixels; between: fractional view, away: radius ×{AWAY_RADIUS}, elevation +{AWAY_ELEVATION_DEG}°", req.spp, req.reference_seed.name()),
+        subtitle: format!("through the hardware model at each exact camera vs pis-trace ({}) over covered pixels; between: fractional view, away: radius ×{AWAY_RADIUS}, elevation +{AWAY_ELEVATION_DEG}°", req.sampling.describe(req.spp, req.reference_seed)),
         x_label: "position along the view dimension (samples)".into(),
         y_label: "PSNR (dB)".into(),
         x_log: false,
@@ -314,6 +307,7 @@ fn write_stability(
 /// Runs the paths for every representation and writes stability.csv and stability.svg.
 pub fn run(req: &StabilityRequest) -> Result<StabilityReport, Failure> {
     check(req)?;
+    req.sampling.check().map_err(|e| Failure::new(Exit::NotSupported, e))?;
     ensure_dir(&req.out).map_err(|e| Failure::new(Exit::Io, e))?;
     let settings = PackSettings {
         max_texture: req.max_texture,
@@ -332,16 +326,12 @@ pub fn run(req: &StabilityRequest) -> Result<StabilityReport, Failure> {
     let (view_dim, frames) = paths(scene, req.frames, &[PathKind::Between, PathKind::Away])
         .map_err(|e| Failure::new(Exit::NotSupported, e))?;
     eprintln!(
-        "pis-bench: stability: tracing {} reference frames at {} spp (shading seeded per {})",
+        "pis-bench: stability: tracing {} reference frames ({})",
         frames.len(),
-        req.spp,
-        req.reference_seed.name()
+        req.sampling.describe(req.spp, req.reference_seed)
     );
-    let refs: Vec<Vec<f32>> = frames
-        .iter()
-        .map(|f| reference(&inf, f, req.spp, req.reference_seed))
-        .collect::<Result<_>>()
-        .map_err(runtime)?;
+    let refs: Vec<Vec<f32>> =
+        frames.iter().map(|f| reference(req, &inf, f)).collect::<Result<_>>().map_err(runtime)?;
     let meshes: Vec<Mesh> = (0..scene.objects.len()).map(|o| merged_mesh(scene, o)).collect();
     let raw = inf.raw_image_bytes();
     let mut reps: Vec<(String, Option<f64>, Vec<Vec<LayerTextures>>)> =
@@ -421,7 +411,7 @@ pub fn run(req: &StabilityRequest) -> Result<StabilityReport, Failure> {
     let stamp = Stamp::here(&scene_s);
     let (c, s) = write_stability(req, &scene_s, &stamp, &rows, &summaries)?;
     let report = StabilityReport {
-        scene: scene_s, frames: req.frames, summaries, rows, csv: c.display().to_string(), svg: s.display().to_string(), stamp,
+        scene: scene_s, frames: req.frames, reference: req.sampling.describe(req.spp, req.reference_seed), summaries, rows, csv: c.display().to_string(), svg: s.display().to_string(), stamp,
         notes: vec![
             "frames rendered through the hardware model (CPU), textures blended linearly between the two neighbouring view samples".into(),
             "PSNR on display values over the pixels the model covers, against pis-trace's combined image at the same camera".into(),
@@ -450,7 +440,11 @@ pub fn run(req: &StabilityRequest) -> Result<StabilityReport, Failure> {
 }
 
 pub fn print(r: &StabilityReport, out: &mut impl std::io::Write) -> std::io::Result<()> {
-    writeln!(out, "stability: {} — {} frames per path", r.scene, r.frames)?;
+    writeln!(
+        out,
+        "stability: {} — {} frames per path, references at {}",
+        r.scene, r.frames, r.reference
+    )?;
     for s in &r.summaries {
         writeln!(
             out,

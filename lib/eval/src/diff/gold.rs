@@ -249,7 +249,7 @@ fn gold_points(
 pub fn gold(req: &GoldRequest) -> Result<GoldReport, Failure> {
     // The reference of the drop gate and the set's own noise, before any drawing.
     let (reference, reference_from) = drop_reference(req)?;
-    let pair = req.pair.as_ref().map(|p| noise::pair(&req.set, p, false)).transpose()?;
+    let pair = req.pair.as_ref().map(|p| super::sets::pair(&req.set, p, false)).transpose()?;
 
     let gpu = Arc::new(Gpu::new().map_err(|e| failure(e.into()))?);
     let device = gpu.describe();
@@ -351,14 +351,14 @@ pub fn gold(req: &GoldRequest) -> Result<GoldReport, Failure> {
             points: p.points_compared,
             figures: [
                 judge("whole image", psnr, p.psnr_db),
-                judge("objects' covered pixels", covered, noise::pooled_objects(&p)),
+                judge("objects' covered pixels", covered, p.pooled_objects_psnr()),
             ]
             .into_iter()
             .chain(
                 objects
                     .iter()
                     .filter(|o| o.mse > 0.0)
-                    .map(|o| judge(&o.name, o.psnr_db, noise::object(&p, &o.name))),
+                    .map(|o| judge(&o.name, o.psnr_db, p.object_psnr(&o.name))),
             )
             .collect(),
         }),

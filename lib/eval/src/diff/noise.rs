@@ -10,12 +10,7 @@
 //! denoiser's blur, a bias of the renderer, a set seeded per surface cell (both traces then
 //! carry the same surface noise; trace gold standards with `--shading-seed sample`).
 
-use std::path::Path;
-
 use serde::Serialize;
-
-use super::sets::{compare_sets, SetsReport, SetsRequest};
-use pis_pack::Failure;
 
 /// 10 log₁₀ 2: a pair's difference has twice the variance of one trace's noise.
 const PAIR_DB: f64 = std::f64::consts::LN_2 * 10.0 / std::f64::consts::LN_10;
@@ -46,11 +41,11 @@ pub struct ReferenceNoise {
 }
 
 /// Mean squared error of a PSNR (peak 1); `None` (an exact match) is 0.
-fn mse(psnr: Option<f64>) -> f64 {
+pub(crate) fn mse(psnr: Option<f64>) -> f64 {
     psnr.map_or(0.0, |p| 10f64.powf(-p / 10.0))
 }
 
-fn psnr(mse: f64) -> Option<f64> {
+pub(crate) fn psnr(mse: f64) -> Option<f64> {
     (mse > 0.0).then(|| -10.0 * mse.log10())
 }
 
@@ -63,31 +58,6 @@ pub fn judge(name: &str, measured: Option<f64>, between: Option<f64>) -> Judged 
         noise_psnr_db: noise,
         noise_removed_psnr_db: psnr(mse(measured) - mse(noise)),
     }
-}
-
-/// Compares the reference `first` with its second trace `second` (their layers read as
-/// `raw` asks): the pair's own figures, whole image and per object.
-pub fn pair(first: &Path, second: &Path, raw: bool) -> Result<SetsReport, Failure> {
-    compare_sets(&SetsRequest {
-        a: first.to_path_buf(),
-        b: second.to_path_buf(),
-        min_psnr: None,
-        raw,
-        pair: None,
-    })
-}
-
-/// The pair's PSNR over every object's covered pixels pooled (the objects' MSEs weighted by
-/// their pixels).
-pub fn pooled_objects(pair: &SetsReport) -> Option<f64> {
-    let pixels: u64 = pair.objects.iter().map(|o| o.pixels).sum();
-    let sum: f64 = pair.objects.iter().map(|o| mse(o.psnr_db) * o.pixels as f64).sum();
-    psnr(sum / pixels.max(1) as f64)
-}
-
-/// The pair's PSNR on the object `name` (`None` when it has no such object or an exact match).
-pub fn object(pair: &SetsReport, name: &str) -> Option<f64> {
-    pair.objects.iter().find(|o| o.name == name).and_then(|o| o.psnr_db)
 }
 
 /// The readable lines: each figure beside its reference's noise.

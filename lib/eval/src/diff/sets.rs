@@ -141,6 +141,19 @@ pub struct SetsReport {
 }
 
 impl SetsReport {
+    /// The PSNR on the object `name` (`None`: no such object, or an exact match).
+    pub fn object_psnr(&self, name: &str) -> Option<f64> {
+        self.objects.iter().find(|o| o.name == name).and_then(|o| o.psnr_db)
+    }
+
+    /// The PSNR over every object's covered pixels pooled (the objects' MSEs weighted by
+    /// their pixels).
+    pub fn pooled_objects_psnr(&self) -> Option<f64> {
+        let pixels: u64 = self.objects.iter().map(|o| o.pixels).sum();
+        let sum: f64 = self.objects.iter().map(|o| noise::mse(o.psnr_db) * o.pixels as f64).sum();
+        noise::psnr(sum / pixels.max(1) as f64)
+    }
+
     pub fn exit(&self) -> Exit {
         if self.passed {
             Exit::Ok
@@ -340,6 +353,18 @@ pub fn compare_sets(req: &SetsRequest) -> Result<SetsReport, Failure> {
     Ok(report)
 }
 
+/// Compares the reference `first` with its second trace `second` (their layers read as
+/// `raw` asks): the pair's own figures, whole image and per object.
+pub fn pair(first: &Path, second: &Path, raw: bool) -> Result<SetsReport, Failure> {
+    compare_sets(&SetsRequest {
+        a: first.to_path_buf(),
+        b: second.to_path_buf(),
+        min_psnr: None,
+        raw,
+        pair: None,
+    })
+}
+
 /// The first set's own noise, from its second trace, beside the report's figures.
 fn reference_noise(
     r: &SetsReport,
@@ -347,13 +372,13 @@ fn reference_noise(
     second: &Path,
     raw: bool,
 ) -> Result<ReferenceNoise, Failure> {
-    let pair = noise::pair(first, second, raw)?;
+    let pair = pair(first, second, raw)?;
     let mut figures = vec![judge("whole image", r.psnr_db, pair.psnr_db)];
     figures.extend(
         r.objects
             .iter()
             .filter(|o| o.pixels > 0)
-            .map(|o| judge(&o.name, o.psnr_db, noise::object(&pair, &o.name))),
+            .map(|o| judge(&o.name, o.psnr_db, pair.object_psnr(&o.name))),
     );
     Ok(ReferenceNoise { pair: second.display().to_string(), points: pair.points_compared, figures })
 }
