@@ -570,6 +570,19 @@ fn two_sets_compare_their_noise() {
     };
     let (p2, p8) = (score(&s2), score(&s8));
     assert!(p8 > p2 + 2.0, "8 spp {p8:.2} dB should be well above 2 spp {p2:.2} dB against 32 spp");
+    // Per kind of radiance layer, every object pooled: each kind demo1's roles have, each
+    // noisy one nearer the 32-spp set with more samples.
+    let kinds = |a: &Path| json(&diff(a, &s32, &["--json"]))["layers_by_kind"].clone();
+    let (k2, k8) = (kinds(&s2), kinds(&s8));
+    let names: Vec<&str> =
+        k2.as_array().expect("kinds").iter().filter_map(|k| k["kind"].as_str()).collect();
+    assert_eq!(names, ["diffuse", "specular", "local", "distant", "reflection", "refraction"]);
+    for (a, b) in k2.as_array().expect("kinds").iter().zip(k8.as_array().expect("kinds")) {
+        let (a, b) =
+            (a["psnr_db"].as_f64().expect("finite"), b["psnr_db"].as_f64().expect("finite"));
+        // (demo1's local layers are nearly empty: 60-70 dB either way, no noise to fall.)
+        assert!(b > a || a > 50.0, "{k2} {k8}");
+    }
     // A gate on the PSNR, and sets of other sizes.
     assert_eq!(diff(&s2, &s32, &["--min-psnr", &format!("{}", p2 + 1.0)]).status.code(), Some(7));
     assert_eq!(diff(&s2, &small, &[]).status.code(), Some(3));

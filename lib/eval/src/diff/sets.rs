@@ -18,6 +18,7 @@ use std::path::{Path, PathBuf};
 use super::noise::{self, judge, ReferenceNoise};
 use crate::metrics::SquaredError;
 use anyhow::anyhow;
+use pis_trace::denoise::DENOISED_KINDS;
 use pis_trace::layers::{LayerKind, PointImages};
 use pis_trace::set::RaySet;
 use serde::Serialize;
@@ -60,6 +61,17 @@ pub struct ObjectRow {
     /// That composition against the first set's surface radiance, over the same pixels.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub model_psnr_db: Option<f64>,
+}
+
+/// One kind of radiance layer, every object that has it pooled.
+#[derive(Clone, Debug, Serialize)]
+pub struct LayerRow {
+    /// `diffuse`, `specular`, `local` (its RGB), `distant`, `reflection` or `refraction`.
+    pub kind: &'static str,
+    /// The layer's values (stored divided by coverage) of B against A's, display values,
+    /// over the pixels both sets cover.
+    pub psnr_db: Option<f64>,
+    pub pixels: u64,
 }
 
 /// The layered model of an object's role, as the player composes its layers.
@@ -129,6 +141,8 @@ pub struct SetsReport {
     pub psnr_db: Option<f64>,
     pub max_error: f64,
     pub objects: Vec<ObjectRow>,
+    /// Per kind of radiance layer, every object pooled (the kinds some object has).
+    pub layers_by_kind: Vec<LayerRow>,
     pub per_point: Vec<PointRow>,
     pub min_psnr_db: Option<f64>,
     pub passed: bool,
@@ -177,16 +191,17 @@ fn open(p: &Path) -> Result<RaySet, Failure> {
 }
 
 /// Adds one object's errors at a point to `acc` (A's surface radiance against B's, over
-/// the pixels both cover) and `macc` (A's against B's composed by B's layered model): the
-/// object's channels in A and B are `cha` and `chb`.
+/// the pixels both cover), `macc` (A's against B's composed by B's layered model) and
+/// `kinds` (each radiance layer, [`add_layers`]): the object's channels in A and B are
+/// `cha` and `chb`.
 fn add_object(
     ia: &PointImages,
     ib: &PointImages,
     (cha, chb): (&str, &str),
     model: Option<LayeredModel>,
     npx: usize,
-    acc: &mut SquaredError,
-    macc: &mut SquaredError,
+    (acc, macc): (&mut SquaredError, &mut SquaredError),
+    kinds: &mut [SquaredError],
 ) {
     let cov = |im: &PointImages, ch: &str| {
         im.object_layer(ch, LayerKind::Coverage).and_then(|l| l.channel("A")).map(<[f32]>::to_vec)
@@ -202,6 +217,8 @@ fn add_object(
             })
             .collect()
     };
+    let both: Vec<bool> = cova.iter().zip(&covb).map(|(a, b)| *a > 0.0 && *b > 0.0).collect();
+    add_layers(ia, ib, (cha, chb), &both, kinds);
     for c in ["R", "G", "B"] {
         let (x, y) = (surface(ia, cha, c), surface(ib, chb, c));
         let composed = model.and_then(|m| m.compose(ib, chb, c));
@@ -211,6 +228,29 @@ fn add_object(
                 if let Some(m) = composed.as_ref().and_then(|m| m.get(k)) {
                     macc.add(*m, x[k]);
                 }
+            }
+        }
+    }
+}
+
+/// Adds each radiance layer of one object at a point to `kinds` (indexed as
+/// [`DENOISED_KINDS`]): B's values against A's at the pixels `both` marks.
+fn add_layers(
+    ia: &PointImages,
+    ib: &PointImages,
+    (cha, chb): (&str, &str),
+    both: &[bool],
+    kinds: &mut [SquaredError],
+) {
+    for (kind, acc) in DENOISED_KINDS.iter().zip(kinds.iter_mut()) {
+        let (Some(la), Some(lb)) = (ia.object_layer(cha, *kind), ib.object_layer(chb, *kind))
+        else {
+            continue;
+        };
+        for c in ["R", "G", "B"] {
+            let (Some(x), Some(y)) = (la.channel(c), lb.channel(c)) else { continue };
+            for ((x, y), _) in x.iter().zip(y).zip(both).filter(|(_, b)| **b) {
+                acc.add(*y, *x);
             }
         }
     }
@@ -253,6 +293,7 @@ pub fn compare_sets(req: &SetsRequest) -> Result<SetsReport, Failure> {
     let mut total = SquaredError::default();
     let mut per_object = vec![SquaredError::default(); objects.len()];
     let mut per_model = vec![SquaredError::default(); objects.len()];
+    let mut per_kind = vec![SquaredError::default(); DENOISED_KINDS.len()];
     let mut per_point = Vec::new();
     for pa in &sa.meta.points {
         let Some(pb) = sb.meta.points.iter().find(|p| p.index == pa.index) else { continue };
@@ -300,7 +341,7 @@ pub fn compare_sets(req: &SetsRequest) -> Result<SetsReport, Failure> {
         for (((_, cha, chb, model), acc), macc) in
             objects.iter().zip(per_object.iter_mut()).zip(per_model.iter_mut())
         {
-            add_object(&ia, &ib, (cha, chb), *model, npx, acc, macc);
+            add_object(&ia, &ib, (cha, chb), *model, npx, (acc, macc), &mut per_kind);
         }
         total.merge(&e);
         per_point.push(PointRow {
@@ -341,6 +382,16 @@ pub fn compare_sets(req: &SetsRequest) -> Result<SetsReport, Failure> {
                     model: model.map(LayeredModel::formula),
                     model_psnr_db: model.and_then(|_| finite(m.psnr())),
                 }
+            })
+            .collect(),
+        layers_by_kind: DENOISED_KINDS
+            .iter()
+            .zip(&per_kind)
+            .filter(|(_, e)| e.count > 0)
+            .map(|(k, e)| LayerRow {
+                kind: k.name(),
+                psnr_db: finite(e.psnr()),
+                pixels: e.count / 3,
             })
             .collect(),
         per_point,
@@ -407,6 +458,12 @@ pub fn render(r: &SetsReport) -> String {
                 db(o.model_psnr_db)
             );
         }
+    }
+    if !r.layers_by_kind.is_empty() {
+        let _ = writeln!(s, "  radiance layers, every object pooled, over the pixels both cover:");
+    }
+    for l in &r.layers_by_kind {
+        let _ = writeln!(s, "    {:<14} {}  ({} pixels)", l.kind, db(l.psnr_db), l.pixels);
     }
     if let Some(n) = &r.reference_noise {
         s.push_str(&noise::render(n));
