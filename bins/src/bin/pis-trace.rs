@@ -9,7 +9,9 @@ use indicatif::{ProgressBar, ProgressStyle};
 use pis::cli::parse_shading_seed;
 use pis_scene::LoadOptions;
 use pis_trace::set::{merge_set, MergeReport, Shard};
-use pis_trace::{render_shard, Progress, SetReport, TraceError, TraceRun, TraceSettings};
+use pis_trace::{
+    render_shard, DenoiseMode, Progress, SetReport, TraceError, TraceRun, TraceSettings,
+};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
@@ -66,8 +68,8 @@ struct Cli {
     /// `auto`: when the library is found (`pip install pyoidn`, a system OIDN 2.x, or
     /// PIS_OIDN_LIBRARY naming it), else a warning and raw layers only. `on`: an error
     /// without it. `off`: raw layers only.
-    #[arg(long, value_name = "auto|on|off", default_value = "auto", value_parser = ["auto", "on", "off"])]
-    denoise: String,
+    #[arg(long, default_value = "auto", value_parser = pis::cli::one_of(&DenoiseMode::ALL, DenoiseMode::name))]
+    denoise: DenoiseMode,
     /// A `[preset.NAME]` of scene.toml (e.g. `paper`).
     #[arg(long)]
     preset: Option<String>,
@@ -152,14 +154,12 @@ fn run(cli: &Cli, scene: &Path, output: &Path) -> anyhow::Result<SetReport> {
     let options =
         LoadOptions { preset: cli.preset.clone(), resolution: cli.resolution, spp: cli.spp };
     let scene = pis_scene::load_with(scene, &options).map_err(TraceError::from)?;
-    let mut settings = TraceSettings::new(scene.resolution, scene.spp)
-        .with_shading_seed(cli.shading_seed)
-        .with_seed(cli.seed)
-        .with_adaptive(cli.noise_threshold, cli.min_spp);
-    settings.denoise = cli.denoise != "off";
-    if cli.denoise == "on" {
-        pis_trace::oidn::shared().map_err(|e| anyhow::anyhow!("--denoise on: {e}"))?;
-    }
+    let settings = cli.denoise.apply(
+        TraceSettings::new(scene.resolution, scene.spp)
+            .with_shading_seed(cli.shading_seed)
+            .with_seed(cli.seed)
+            .with_adaptive(cli.noise_threshold, cli.min_spp),
+    )?;
     let bar = ProgressBar::new(0);
     bar.set_style(
         ProgressStyle::with_template(
@@ -205,18 +205,21 @@ fn print_report(r: &SetReport) {
         );
     }
     match &r.denoiser {
-        Some(d) => eprintln!(
-            "  denoised: {d}, {:.1} ms per point; {}",
-            r.denoise_ms_per_point,
-            if r.kept_raw.is_empty() {
-                "every object's layers denoised".to_string()
-            } else {
-                format!(
-                    "kept raw where denoising was estimated to be worse: {}",
-                    r.kept_raw.join(", ")
-                )
+        Some(d) => {
+            eprintln!(
+                "  denoised: {d}, {:.1} ms per point; {} layers denoised, {} kept raw (denoising estimated to be worse)",
+                r.denoise_ms_per_point,
+                r.denoised_layers,
+                r.kept_raw.len()
+            );
+            const LISTED: usize = 8;
+            for k in r.kept_raw.iter().take(LISTED) {
+                eprintln!("    kept raw: {k}");
             }
-        ),
+            if r.kept_raw.len() > LISTED {
+                eprintln!("    ... and {} more (--json lists them all)", r.kept_raw.len() - LISTED);
+            }
+        }
         None => eprintln!("  denoised: no (raw layers only)"),
     }
     eprintln!(

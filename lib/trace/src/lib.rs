@@ -51,4 +51,4 @@ pub use layers::{LayerImage, LayerKind, PointImages};
 pub use records::{RayRecord, RecordHit};
 pub use render::{channel_names, render_point, PointRender, RenderStats};
 pub use run::{render_set, render_shard, NoProgress, Progress, SetReport, TraceRun};
-pub use settings::{ShadingSeed, TraceSettings};
+pub use settings::{DenoiseMode, ShadingSeed, TraceSettings};

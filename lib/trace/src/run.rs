@@ -63,6 +63,8 @@ pub struct SetReport {
     /// The denoiser of the `denoised.` layers; absent when the set is not denoised.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub denoiser: Option<String>,
+    /// Layers given a denoised twin, summed over the points this process rendered.
+    pub denoised_layers: usize,
     /// Layers kept raw at a point because denoising was estimated to move them further
     /// from the converged image (`point 3: object.TeapotLid.specular`).
     pub kept_raw: Vec<String>,
@@ -241,6 +243,7 @@ pub fn render_shard(
         let t = Instant::now();
         add_set_layers(&mut render, &objects)?;
         denoise_seconds += t.elapsed().as_secs_f64();
+        report.denoised_layers += render.denoised.iter().map(|d| d.layers.len()).sum::<usize>();
         let kept = render.denoised.iter().flat_map(|d| &d.kept_raw);
         report.kept_raw.extend(kept.map(|o| format!("point {index}: {o}")));
         report.output_bytes += writer.write_point(scene, index, &frame, &render)?;

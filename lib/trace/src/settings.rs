@@ -93,6 +93,42 @@ impl ShadingSeed {
     }
 }
 
+/// When a trace denoises its layers (`pis-trace --denoise`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum DenoiseMode {
+    /// Where Open Image Denoise is found; else the run warns once and writes raw layers.
+    Auto,
+    /// Always: a run without the library is refused before anything is traced.
+    On,
+    /// Never: raw layers only.
+    Off,
+}
+
+impl DenoiseMode {
+    /// Every mode, in the order the tools list them.
+    pub const ALL: [DenoiseMode; 3] = [DenoiseMode::Auto, DenoiseMode::On, DenoiseMode::Off];
+
+    /// `auto`, `on` or `off`, as the tools spell it.
+    pub fn name(self) -> &'static str {
+        match self {
+            DenoiseMode::Auto => "auto",
+            DenoiseMode::On => "on",
+            DenoiseMode::Off => "off",
+        }
+    }
+
+    /// The settings denoising as this mode says: `On` where the library cannot be loaded is
+    /// an error naming why (`Auto` leaves that to the run, which warns and writes raw layers).
+    pub fn apply(self, mut settings: TraceSettings) -> Result<TraceSettings, crate::TraceError> {
+        settings.denoise = self != DenoiseMode::Off;
+        if self == DenoiseMode::On {
+            crate::oidn::shared()
+                .map_err(|e| crate::TraceError::Denoise(format!("--denoise on: {e}")))?;
+        }
+        Ok(settings)
+    }
+}
+
 impl TraceSettings {
     /// What seeds the shading: a cell size of 0 seeds per camera sample.
     pub fn shading_seed(&self) -> ShadingSeed {
