@@ -507,6 +507,20 @@ fn against_the_set_gates_and_flip_maps() {
     assert!(String::from_utf8_lossy(&out.stderr).contains("--reference-psnr"));
 }
 
+/// Traces demo1's first two points into `out` with `args`.
+fn trace_demo1(out: &Path, args: &[&str]) -> PathBuf {
+    let run = Command::new(env!("CARGO_BIN_EXE_pis-trace"))
+        .arg(repo("samples/demo1/scene.toml"))
+        .arg("-o")
+        .arg(out)
+        .args(["--points", "2"])
+        .args(args)
+        .output()
+        .expect("pis-trace runs");
+    assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
+    out.to_path_buf()
+}
+
 /// Two ray-traced sets: a set against itself is identical; against the same scene traced with
 /// more samples per pixel the noise shows as a finite PSNR that rises with the samples; sets of
 /// other sizes are refused.
@@ -514,16 +528,7 @@ fn against_the_set_gates_and_flip_maps() {
 fn two_sets_compare_their_noise() {
     let dir = tempfile::tempdir().expect("temp dir");
     let trace = |name: &str, spp: &str, size: &str| {
-        let out_dir = dir.path().join(name);
-        let out = Command::new(env!("CARGO_BIN_EXE_pis-trace"))
-            .arg(repo("samples/demo1/scene.toml"))
-            .arg("-o")
-            .arg(&out_dir)
-            .args(["--resolution", size, "--spp", spp, "--points", "2"])
-            .output()
-            .expect("pis-trace runs");
-        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
-        out_dir
+        trace_demo1(&dir.path().join(name), &["--resolution", size, "--spp", spp])
     };
     let (s2, s8, s32, small) = (
         trace("s2", "2", "40x30"),
@@ -736,17 +741,8 @@ fn edit_point(d: &Path, edit: impl FnOnce(&mut pis_trace::PointImages)) {
 fn a_reference_pair_takes_the_reference_noise_out() {
     let dir = tempfile::tempdir().expect("temp dir");
     let trace = |name: &str, spp: &str, seed: &str| {
-        let out_dir = dir.path().join(name);
-        let out = Command::new(env!("CARGO_BIN_EXE_pis-trace"))
-            .arg(repo("samples/demo1/scene.toml"))
-            .arg("-o")
-            .arg(&out_dir)
-            .args(["--resolution", "40x30", "--points", "2", "--denoise", "off"])
-            .args(["--shading-seed", "sample", "--spp", spp, "--seed", seed])
-            .output()
-            .expect("pis-trace runs");
-        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
-        out_dir
+        let args = ["--resolution", "40x30", "--denoise", "off", "--shading-seed", "sample"];
+        trace_demo1(&dir.path().join(name), &[&args[..], &["--spp", spp, "--seed", seed]].concat())
     };
     let (set, first, second, clean) = (
         trace("set", "8", "2"),
