@@ -402,6 +402,24 @@ fn stability_reports_every_representation_on_both_paths() {
     }
     for x in s {
         assert!(x["popping"].as_f64().is_some_and(|p| p.is_finite() && p > 0.0), "{x}");
+        assert!(x.get("reference_psnr_db").is_none(), "no pair, no noise figure: {x}");
+    }
+    // A reference pair: each path's figure pooled against the pair's mean, with the pair's
+    // noise and the figure with it taken out; a pair seeded per cell is refused.
+    let pair = |seed: &str| {
+        let args = ["stability", set.to_str().unwrap(), "--ratios", "200", "--frames", "3"];
+        let more = ["--reference-spp", "2", "--reference-pair", "--reference-seed", seed];
+        bench(&[&args[..], &more, &["--out", out_dir.to_str().unwrap(), "--json"]].concat())
+    };
+    assert_eq!(pair("cell").status.code(), Some(1));
+    let out = pair("sample");
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("JSON on stdout");
+    for x in v["summaries"].as_array().expect("summaries") {
+        let f = |k: &str| x[k].as_f64();
+        let (pooled, noise) = (f("pooled_psnr_db").expect("pooled"), f("reference_psnr_db"));
+        assert!(noise.is_some_and(|n| n.is_finite()), "{x}");
+        assert!(f("noise_removed_psnr_db").is_none_or(|r| r > pooled), "{x}");
     }
 }
 

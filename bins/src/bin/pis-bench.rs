@@ -232,6 +232,11 @@ enum Command {
         /// 1/spp: a gold standard).
         #[arg(long, value_name = "cell|sample", default_value = "cell", value_parser = parse_shading_seed)]
         reference_seed: pis_trace::ShadingSeed,
+        /// Trace every reference twice from independent sample streams (needs
+        /// --reference-seed sample): the gold standard is their mean, their difference
+        /// measures its own noise, and the report adds each figure with that noise taken out.
+        #[arg(long)]
+        reference_pair: bool,
         #[command(flatten)]
         reference: ReferenceArgs,
         #[arg(long, default_value = "reports")]
@@ -534,6 +539,7 @@ fn run(cli: Cli) -> Result<Exit, Failure> {
             frames,
             reference_spp,
             reference_seed,
+            reference_pair,
             reference,
             out,
             resolution,
@@ -545,6 +551,7 @@ fn run(cli: Cli) -> Result<Exit, Failure> {
         } => {
             let req = StabilityRequest {
                 sampling: reference.sampling(),
+                reference_pair,
                 input,
                 scene,
                 ratios,

@@ -61,6 +61,40 @@ impl ReferenceSampling {
     }
 }
 
+/// The stream of the second trace of a reference pair (the first is the default, 0).
+pub const SECOND_STREAM: u64 = 1;
+
+/// A reference frame: its (first) trace's images, and its combined image as interleaved
+/// linear RGB: with a pair, the mean of two traces from independent streams, and both.
+pub struct ReferenceFrame {
+    pub images: PointImages,
+    pub rgb: Vec<f32>,
+    pub pair: Option<[Vec<f32>; 2]>,
+}
+
+impl ReferenceSampling {
+    /// Traces the reference frame at `frame`: `spp` samples (the most, when adaptive),
+    /// shading seeded by `seed`, and with `pair` a second time from [`SECOND_STREAM`].
+    pub fn frame(
+        &self,
+        scene: &Scene,
+        frame: &Frame,
+        (spp, seed): (u32, ShadingSeed),
+        pair: bool,
+    ) -> Result<ReferenceFrame> {
+        let images = trace(scene, frame, &self.settings(scene.resolution, spp, seed, 0))?;
+        let rgb = combined_rgb(&images)?;
+        if !pair {
+            return Ok(ReferenceFrame { images, rgb, pair: None });
+        }
+        let second =
+            trace(scene, frame, &self.settings(scene.resolution, spp, seed, SECOND_STREAM))?;
+        let second = combined_rgb(&second)?;
+        let mean = rgb.iter().zip(&second).map(|(a, b)| 0.5 * (a + b)).collect();
+        Ok(ReferenceFrame { images, rgb: mean, pair: Some([rgb, second]) })
+    }
+}
+
 /// Traces one reference frame: its images, the combined image denoised in place where the
 /// settings denoise.
 pub fn trace(scene: &Scene, frame: &Frame, settings: &TraceSettings) -> Result<PointImages> {

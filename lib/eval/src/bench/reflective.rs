@@ -110,44 +110,25 @@ struct Reference {
     pair: Option<[Vec<f32>; 2]>,
 }
 
-/// The stream of the second render of a reference pair (the first is the default, 0).
-const SECOND_STREAM: u64 = 1;
-
+/// The reference frame at `pf`, with the mask of the measured objects' pixels.
 fn reference(
     req: &ReflectiveRequest,
     scene: &Scene,
     pf: &PathFrame,
     objects: &[usize],
 ) -> Result<Reference> {
-    let first = render_reference(req, scene, pf, 0, objects)?;
-    if !req.reference_pair {
-        return Ok(first);
-    }
-    let second = render_reference(req, scene, pf, SECOND_STREAM, objects)?;
-    let rgb = first.rgb.iter().zip(&second.rgb).map(|(a, b)| 0.5 * (a + b)).collect();
-    Ok(Reference { rgb, mask: first.mask, pair: Some([first.rgb, second.rgb]) })
-}
-
-fn render_reference(
-    req: &ReflectiveRequest,
-    scene: &Scene,
-    pf: &PathFrame,
-    stream: u64,
-    objects: &[usize],
-) -> Result<Reference> {
-    let settings = req.sampling.settings(scene.resolution, req.spp, req.reference_seed, stream);
-    let images = super::reference::trace(scene, &pf.frame, &settings)?;
-    let rgb = super::reference::combined_rgb(&images)?;
+    let f =
+        req.sampling.frame(scene, &pf.frame, (req.spp, req.reference_seed), req.reference_pair)?;
     let channels = pis_trace::channel_names(scene);
-    let mut mask = vec![false; rgb.len() / 3];
+    let mut mask = vec![false; f.rgb.len() / 3];
     for &o in objects {
         if let Some(a) =
-            images.object_layer(&channels[o], LayerKind::Coverage).and_then(|l| l.channel("A"))
+            f.images.object_layer(&channels[o], LayerKind::Coverage).and_then(|l| l.channel("A"))
         {
             mask.iter_mut().zip(a).for_each(|(m, &c)| *m |= c > 0.5);
         }
     }
-    Ok(Reference { rgb, mask, pair: None })
+    Ok(Reference { rgb: f.rgb, mask, pair: f.pair })
 }
 
 /// The player's camera for a path frame.

@@ -13,7 +13,7 @@ use std::collections::btree_map::{BTreeMap, Entry};
 use std::path::PathBuf;
 
 use crate::chart::{Chart, Series};
-use crate::metrics::{display, SquaredError};
+use crate::metrics::{display, PairedError, SquaredError};
 use crate::report::{Csv, Stamp};
 use anyhow::{anyhow, Result};
 use pis_compile::{
@@ -22,7 +22,7 @@ use pis_compile::{
 use pis_format::DepMask;
 use pis_trace::ShadingSeed;
 
-use super::reference::ReferenceSampling;
+use super::reference::{ReferenceFrame, ReferenceSampling};
 use rayon::prelude::*;
 use serde::Serialize;
 
@@ -48,6 +48,9 @@ pub struct StabilityRequest {
     pub reference_seed: ShadingSeed,
     /// Adaptive sampling and denoising of the reference frames.
     pub sampling: ReferenceSampling,
+    /// Trace every reference twice from independent sample streams (needs
+    /// `reference_seed` `Sample`): the gold standard is their mean, their difference its noise.
+    pub reference_pair: bool,
     pub out: PathBuf,
     pub resolution: Option<(u32, u32)>,
     pub trace_spp: Option<u32>,
@@ -79,6 +82,15 @@ pub struct PathSummary {
     pub mean_psnr_db: f64,
     pub min_psnr_db: f64,
     pub popping: f64,
+    /// With a reference pair, over the path's frames pooled: the PSNR against the
+    /// references' mean, the same with their noise taken out (`null`: within it), and the
+    /// mean's own noise ([`PairedError`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub pooled_psnr_db: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub noise_removed_psnr_db: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub reference_psnr_db: Option<f64>,
 }
 
 #[derive(Clone, Debug, Serialize)]
@@ -198,9 +210,80 @@ fn render_frame(
     Ok(Rendered { rgb, mask })
 }
 
-fn reference(req: &StabilityRequest, inf: &Inferred, pf: &PathFrame) -> Result<Vec<f32>> {
-    let settings = req.sampling.settings(inf.set.resolution, req.spp, req.reference_seed, 0);
-    super::reference::combined_rgb(&super::reference::trace(&inf.set.scene, &pf.frame, &settings)?)
+/// The reference frame at `pf` (with a pair, the mean of two traces, and both).
+fn reference(req: &StabilityRequest, inf: &Inferred, pf: &PathFrame) -> Result<ReferenceFrame> {
+    let mut f = req.sampling.frame(
+        &inf.set.scene,
+        &pf.frame,
+        (req.spp, req.reference_seed),
+        req.reference_pair,
+    )?;
+    f.images.layers.clear();
+    Ok(f)
+}
+
+/// One representation's frames on one path against the references: a row per frame into
+/// `rows`, and the path's summary.
+fn measure_path(
+    (name, ratio): (&str, Option<f64>),
+    kind: PathKind,
+    frames: &[PathFrame],
+    rendered: &[Rendered],
+    refs: &[ReferenceFrame],
+    rows: &mut Vec<FrameRow>,
+) -> PathSummary {
+    let idx: Vec<usize> = (0..frames.len()).filter(|&i| frames[i].kind == kind).collect();
+    let (mut psnrs, mut popping, mut pooled) = (Vec::new(), 0.0f64, PairedError::default());
+    for (j, &i) in idx.iter().enumerate() {
+        let (mut e, r) = (SquaredError::default(), &refs[i]);
+        for (p, _) in rendered[i].mask.iter().enumerate().filter(|(_, m)| **m) {
+            let px = p * 3..p * 3 + 3;
+            e.add_slices(&rendered[i].rgb[px.clone()], &r.rgb[px.clone()]);
+            if let Some([a, b]) = &r.pair {
+                pooled.add_slices(&rendered[i].rgb[px.clone()], &a[px.clone()], &b[px]);
+            }
+        }
+        let change = (j > 0).then(|| {
+            let prev = idx[j - 1];
+            let both: Vec<bool> =
+                rendered[i].mask.iter().zip(&rendered[prev].mask).map(|(a, b)| *a && *b).collect();
+            [
+                rms_change(&rendered[i].rgb, &rendered[prev].rgb, &both),
+                rms_change(&r.rgb, &refs[prev].rgb, &both),
+            ]
+        });
+        if let Some([p, r]) = change {
+            popping = popping.max(p / r.max(0.5 / 255.0));
+        }
+        psnrs.push(e.psnr());
+        rows.push(FrameRow {
+            representation: name.to_string(),
+            path: kind,
+            frame: j,
+            view: frames[i].view,
+            psnr_db: e.psnr(),
+            change,
+        });
+    }
+    let mean = psnrs.iter().sum::<f64>() / psnrs.len().max(1) as f64;
+    let min = psnrs.iter().copied().fold(f64::INFINITY, f64::min);
+    eprintln!(
+        "pis-bench: stability: {name:<16} {:<8} mean {mean:6.2} dB, min {min:6.2} dB, popping {popping:5.2}",
+        kind.name()
+    );
+    let paired = refs.first().is_some_and(|r| r.pair.is_some());
+    let pair = |v: f64| paired.then_some(v);
+    PathSummary {
+        representation: name.to_string(),
+        path: kind,
+        ratio,
+        mean_psnr_db: mean,
+        min_psnr_db: min,
+        popping,
+        pooled_psnr_db: pair(pooled.against_mean.psnr()),
+        noise_removed_psnr_db: pair(pooled.psnr_noise_removed()).filter(|v| v.is_finite()),
+        reference_psnr_db: pair(pooled.reference_psnr()),
+    }
 }
 
 fn rms_change(a: &[f32], b: &[f32], mask: &[bool]) -> f64 {
@@ -232,6 +315,9 @@ pub fn check(req: &StabilityRequest) -> Result<(), Failure> {
             Exit::Usage,
             anyhow!("--ratios: every ratio must be at least 1, got {r}"),
         ));
+    }
+    if req.reference_pair && req.reference_seed != ShadingSeed::Sample {
+        return Err(Failure::new(Exit::Usage, anyhow!("--reference-pair needs --reference-seed sample: seeded per cell, both renders carry the same surface noise, so their difference cannot measure it")));
     }
     if req.frames < 2 || req.frames > 10_000 || req.spp == 0 {
         return Err(Failure::new(
@@ -325,12 +411,13 @@ pub fn run(req: &StabilityRequest) -> Result<StabilityReport, Failure> {
     let scene = &inf.set.scene;
     let (view_dim, frames) = paths(scene, req.frames, &[PathKind::Between, PathKind::Away])
         .map_err(|e| Failure::new(Exit::NotSupported, e))?;
+    let twice = if req.reference_pair { ", each twice from independent streams" } else { "" };
     eprintln!(
-        "pis-bench: stability: tracing {} reference frames ({})",
+        "pis-bench: stability: tracing {} reference frames ({}){twice}",
         frames.len(),
         req.sampling.describe(req.spp, req.reference_seed)
     );
-    let refs: Vec<Vec<f32>> =
+    let refs: Vec<ReferenceFrame> =
         frames.iter().map(|f| reference(req, &inf, f)).collect::<Result<_>>().map_err(runtime)?;
     let meshes: Vec<Mesh> = (0..scene.objects.len()).map(|o| merged_mesh(scene, o)).collect();
     let raw = inf.raw_image_bytes();
@@ -349,55 +436,8 @@ pub fn run(req: &StabilityRequest) -> Result<StabilityReport, Failure> {
             .collect::<Result<_>>()
             .map_err(runtime)?;
         for kind in [PathKind::Between, PathKind::Away] {
-            let idx: Vec<usize> = (0..frames.len()).filter(|&i| frames[i].kind == kind).collect();
-            let (mut psnrs, mut popping) = (Vec::new(), 0.0f64);
-            for (j, &i) in idx.iter().enumerate() {
-                let mut e = SquaredError::default();
-                for (p, &m) in rendered[i].mask.iter().enumerate() {
-                    if m {
-                        e.add_slices(
-                            &rendered[i].rgb[p * 3..p * 3 + 3],
-                            &refs[i][p * 3..p * 3 + 3],
-                        );
-                    }
-                }
-                let change = (j > 0).then(|| {
-                    let prev = idx[j - 1];
-                    let both: Vec<bool> = rendered[i]
-                        .mask
-                        .iter()
-                        .zip(&rendered[prev].mask)
-                        .map(|(a, b)| *a && *b)
-                        .collect();
-                    [
-                        rms_change(&rendered[i].rgb, &rendered[prev].rgb, &both),
-                        rms_change(&refs[i], &refs[prev], &both),
-                    ]
-                });
-                if let Some([p, r]) = change {
-                    popping = popping.max(p / r.max(0.5 / 255.0));
-                }
-                psnrs.push(e.psnr());
-                rows.push(FrameRow {
-                    representation: name.clone(),
-                    path: kind,
-                    frame: j,
-                    view: frames[i].view,
-                    psnr_db: e.psnr(),
-                    change,
-                });
-            }
-            let mean = psnrs.iter().sum::<f64>() / psnrs.len().max(1) as f64;
-            let min = psnrs.iter().copied().fold(f64::INFINITY, f64::min);
-            eprintln!("pis-bench: stability: {name:<16} {:<8} mean {mean:6.2} dB, min {min:6.2} dB, popping {popping:5.2}", kind.name());
-            summaries.push(PathSummary {
-                representation: name.clone(),
-                path: kind,
-                ratio: *ratio,
-                mean_psnr_db: mean,
-                min_psnr_db: min,
-                popping,
-            });
+            let summary = measure_path((name, *ratio), kind, &frames, &rendered, &refs, &mut rows);
+            summaries.push(summary);
         }
     }
     let set = &inf.set;
@@ -446,7 +486,7 @@ pub fn print(r: &StabilityReport, out: &mut impl std::io::Write) -> std::io::Res
         r.scene, r.frames, r.reference
     )?;
     for s in &r.summaries {
-        writeln!(
+        write!(
             out,
             "  {:<16} {:<8} {:>8} mean {:6.2} dB  min {:6.2} dB  popping {:5.2}",
             s.representation,
@@ -456,6 +496,13 @@ pub fn print(r: &StabilityReport, out: &mut impl std::io::Write) -> std::io::Res
             s.min_psnr_db,
             s.popping
         )?;
+        if let (Some(pooled), Some(reference)) = (s.pooled_psnr_db, s.reference_psnr_db) {
+            let removed = s
+                .noise_removed_psnr_db
+                .map_or("within the references' noise".into(), |v| format!("{v:6.2} dB"));
+            write!(out, "  pooled {pooled:6.2} dB  noise removed {removed}  (gold standard's noise {reference:.2} dB)")?;
+        }
+        writeln!(out)?;
     }
     writeln!(out, "  wrote {} and {}", r.csv, r.svg)
 }
