@@ -431,6 +431,10 @@ fn reference_noise(
             .filter(|o| o.pixels > 0)
             .map(|o| judge(&o.name, o.psnr_db, pair.object_psnr(&o.name))),
     );
+    figures.extend(r.layers_by_kind.iter().map(|l| {
+        let between = pair.layers_by_kind.iter().find(|p| p.kind == l.kind).and_then(|p| p.psnr_db);
+        judge(&format!("{} layers", l.kind), l.psnr_db, between)
+    }));
     Ok(ReferenceNoise { pair: second.display().to_string(), points: pair.points_compared, figures })
 }
 
