@@ -507,6 +507,31 @@ fn against_the_set_gates_and_flip_maps() {
     assert!(String::from_utf8_lossy(&out.stderr).contains("--reference-psnr"));
 }
 
+/// A set whose cameras are not the file's (traced from another scene or preset) is refused
+/// as invalid, naming the point and what differs, before any figure is measured.
+#[test]
+fn a_set_traced_with_other_cameras_is_refused() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let copy = dir.path().join("set");
+    std::fs::create_dir(&copy).expect("mkdir");
+    for e in std::fs::read_dir(set()).expect("set dir") {
+        let e = e.expect("entry");
+        std::fs::copy(e.path(), copy.join(e.file_name())).expect("copy");
+    }
+    let path = copy.join("set.json");
+    let mut meta: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(&path).expect("set.json")).expect("JSON");
+    meta["points"][0]["camera"]["yfov"] = serde_json::json!(1.2);
+    std::fs::write(&path, serde_json::to_vec(&meta).expect("JSON")).expect("write");
+    let out = diff(packed(), &copy, &[]);
+    if out.status.code() == Some(5) && !std::env::var("CI").is_ok_and(|v| v == "true") {
+        return;
+    }
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(3), "{err}");
+    assert!(err.contains("point 0: the file's camera") && err.contains("field of view"), "{err}");
+}
+
 /// Traces demo1's first two points into `out` with `args`.
 fn trace_demo1(out: &Path, args: &[&str]) -> PathBuf {
     let run = Command::new(env!("CARGO_BIN_EXE_pis-trace"))

@@ -195,6 +195,24 @@ fn mismatched_resolution_is_an_error_without_output() {
     );
 }
 
+/// A scene.toml whose cameras are not those the set was traced with (another orbit radius,
+/// another preset) is refused, naming the point and what differs.
+#[test]
+fn cameras_other_than_the_traced_ones_are_an_error_without_output() {
+    fails_without_output(
+        |d| {
+            let path = d.join("set.json");
+            let mut meta: serde_json::Value =
+                serde_json::from_slice(&std::fs::read(&path).expect("set.json")).expect("JSON");
+            let x = &mut meta["points"][1]["camera"]["world_from_camera"][12];
+            *x = serde_json::json!(x.as_f64().expect("a number") + 0.3);
+            std::fs::write(&path, serde_json::to_vec(&meta).expect("JSON")).expect("write");
+        },
+        3,
+        "point 1: ",
+    );
+}
+
 #[test]
 fn nan_pixels_are_an_error_without_output() {
     fails_without_output(

@@ -142,6 +142,14 @@ pub fn compare_with_set(
                 res.1
             );
         }
+        let (pose, yfov) = player.sample_pose(&p.values);
+        if let Some(d) = p.camera.differs_from(pose, yfov) {
+            return Err(pis_trace::TraceError::InvalidSet {
+                path: set_dir.to_path_buf(),
+                message: format!("point {i}: the file's camera is not the one the set was traced with ({d}): the file was packed from another scene or preset"),
+            }
+            .into());
+        }
         let req = FrameRequest { point: p.values.clone(), camera: CameraChoice::Sample };
         let (rendered, ids, _) = player
             .render_ids(&req, size)

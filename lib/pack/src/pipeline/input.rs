@@ -279,7 +279,15 @@ pub fn load(req: &PackRequest, stages: &mut Stages) -> Result<LoadedSet, Failure
         let mut img = set.read_point(i).map_err(trace_failure)?;
         img.layers.retain(|l| reads_layer_named(req.representation, &l.name));
         check_point_size(&dir, i, &img, res)?;
-        frames.push(scene.frame(&p.samples).map_err(|e| Failure::new(Exit::Invalid, e))?);
+        let frame = scene.frame(&p.samples).map_err(|e| Failure::new(Exit::Invalid, e))?;
+        if let Some(d) = p.camera.differs_from(frame.camera.world_from_camera, frame.camera.yfov) {
+            return Err(invalid(format!(
+                "{}: point {i}: {} places the camera otherwise than the set was traced ({d}); pass the scene.toml the set was traced from (--scene, and --preset where it was traced with one)",
+                dir.display(),
+                scene_path.display()
+            )));
+        }
+        frames.push(frame);
         samples.push(p.samples.clone());
         match &scratch {
             Some(sc) => spans.push(

@@ -200,6 +200,13 @@ impl Player {
         nearest_sample(dims, &full)
     }
 
+    /// The world-from-camera transform and vertical field of view (radians) of the file's
+    /// camera at `point` (its nearest view sample): what `CameraChoice::Sample` draws from.
+    pub fn sample_pose(&self, point: &[f32]) -> (glam::Mat4, f32) {
+        let cam = camera_record(&self.reader, &self.nearest(point));
+        (crate::camera::mat4_from_rows(&cam.world_from_camera), cam.yfov)
+    }
+
     /// The file's camera at `point` (its nearest view sample).
     pub fn sample_camera(&self, point: &[f32]) -> ViewCamera {
         ViewCamera::from_file(&camera_record(&self.reader, &self.nearest(point)))

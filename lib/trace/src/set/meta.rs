@@ -143,3 +143,86 @@ pub struct ObjectStateMeta {
     /// Column-major object-to-world matrix.
     pub world_from_object: [f32; 16],
 }
+
+/// Position differences below this fraction of the camera's distance from the origin (at
+/// least 1 unit) are rounding.
+const POSITION_TOLERANCE: f32 = 1e-4;
+/// Angle differences (view direction, up, field of view) below this are rounding, degrees.
+const ANGLE_TOLERANCE_DEG: f32 = 0.01;
+
+impl CameraMeta {
+    /// What differs between this recorded camera and one placed by `world_from_camera` with
+    /// vertical field of view `yfov` (radians) beyond rounding (position, view direction, up,
+    /// field of view), in words; `None` when they agree.
+    pub fn differs_from(&self, world_from_camera: glam::Mat4, yfov: f32) -> Option<String> {
+        let (a, b) = (glam::Mat4::from_cols_array(&self.world_from_camera), world_from_camera);
+        let (pa, pb) = (a.w_axis.truncate(), b.w_axis.truncate());
+        let scale = pa.length().max(pb.length()).max(1.0);
+        let angle = |u: glam::Vec3, v: glam::Vec3| {
+            u.normalize_or_zero().dot(v.normalize_or_zero()).clamp(-1.0, 1.0).acos().to_degrees()
+        };
+        let mut what = Vec::new();
+        if pa.distance(pb) > POSITION_TOLERANCE * scale {
+            what.push(format!("position {pa} against {pb} ({:.4} apart)", pa.distance(pb)));
+        }
+        let view = angle(-a.z_axis.truncate(), -b.z_axis.truncate());
+        if view > ANGLE_TOLERANCE_DEG {
+            what.push(format!("view direction {view:.3}° apart"));
+        }
+        let up = angle(a.y_axis.truncate(), b.y_axis.truncate());
+        if up > ANGLE_TOLERANCE_DEG {
+            what.push(format!("up {up:.3}° apart"));
+        }
+        let fov = (self.yfov - yfov).abs().to_degrees();
+        if fov > ANGLE_TOLERANCE_DEG {
+            what.push(format!(
+                "vertical field of view {:.3}° against {:.3}°",
+                self.yfov.to_degrees(),
+                yfov.to_degrees()
+            ));
+        }
+        (!what.is_empty()).then(|| what.join(", "))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::{Mat4, Vec3};
+
+    fn camera(eye: Vec3, yfov: f32) -> pis_scene::Camera {
+        let back = eye.normalize();
+        let right = Vec3::Y.cross(back).normalize();
+        let up = back.cross(right);
+        let world_from_camera =
+            Mat4::from_cols(right.extend(0.0), up.extend(0.0), back.extend(0.0), eye.extend(1.0));
+        pis_scene::Camera { world_from_camera, yfov, znear: 0.1, zfar: f32::INFINITY }
+    }
+
+    fn meta(c: &pis_scene::Camera) -> CameraMeta {
+        CameraMeta {
+            world_from_camera: c.world_from_camera.to_cols_array(),
+            camera_from_world: c.world_from_camera.inverse().to_cols_array(),
+            projection: Mat4::IDENTITY.to_cols_array(),
+            yfov: c.yfov,
+            znear: c.znear,
+            zfar: None,
+        }
+    }
+
+    #[test]
+    fn a_camera_differs_beyond_rounding_only() {
+        let traced = camera(Vec3::new(0.0, 1.0, 4.0), 0.8);
+        let recorded = meta(&traced);
+        let differs = |c: pis_scene::Camera| recorded.differs_from(c.world_from_camera, c.yfov);
+        assert_eq!(differs(traced), None);
+        assert_eq!(differs(camera(Vec3::new(0.0, 1.0, 4.0001), 0.8)), None);
+        // Another orbit radius: the position moves along the view direction.
+        let farther = differs(camera(Vec3::new(0.0, 1.2, 4.8), 0.8));
+        assert!(farther.as_deref().is_some_and(|d| d.starts_with("position")), "{farther:?}");
+        let wider = differs(camera(Vec3::new(0.0, 1.0, 4.0), 0.9));
+        assert!(wider.as_deref().is_some_and(|d| d.contains("field of view")), "{wider:?}");
+        let turned = differs(camera(Vec3::new(4.0, 1.0, 0.0), 0.8));
+        assert!(turned.as_deref().is_some_and(|d| d.contains("view direction")), "{turned:?}");
+    }
+}
