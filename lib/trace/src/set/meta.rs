@@ -158,9 +158,9 @@ impl CameraMeta {
         let (a, b) = (glam::Mat4::from_cols_array(&self.world_from_camera), world_from_camera);
         let (pa, pb) = (a.w_axis.truncate(), b.w_axis.truncate());
         let scale = pa.length().max(pb.length()).max(1.0);
-        let angle = |u: glam::Vec3, v: glam::Vec3| {
-            u.normalize_or_zero().dot(v.normalize_or_zero()).clamp(-1.0, 1.0).acos().to_degrees()
-        };
+        // atan2 of the sine and cosine: accurate at small angles, where the arc cosine of a
+        // dot product of unit vectors rounded to f32 reads 0.02° between equal directions.
+        let angle = |u: glam::Vec3, v: glam::Vec3| u.cross(v).length().atan2(u.dot(v)).to_degrees();
         let mut what = Vec::new();
         if pa.distance(pb) > POSITION_TOLERANCE * scale {
             what.push(format!("position {pa} against {pb} ({:.4} apart)", pa.distance(pb)));
