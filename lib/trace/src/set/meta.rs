@@ -222,6 +222,15 @@ mod tests {
         assert!(farther.as_deref().is_some_and(|d| d.starts_with("position")), "{farther:?}");
         let wider = differs(camera(Vec3::new(0.0, 1.0, 4.0), 0.9));
         assert!(wider.as_deref().is_some_and(|d| d.contains("field of view")), "{wider:?}");
+        // A roll of 0.005° is rounding, one of 0.05° is not (the arc cosine of an f32 dot
+        // product read 0.02° between equal directions).
+        let rolled = |deg: f32| {
+            let mut c = traced;
+            c.world_from_camera *= Mat4::from_rotation_z(deg.to_radians());
+            recorded.differs_from(c.world_from_camera, c.yfov)
+        };
+        assert_eq!(rolled(0.005), None);
+        assert!(rolled(0.05).is_some_and(|d| d.starts_with("up")), "{:?}", rolled(0.05));
         let turned = differs(camera(Vec3::new(4.0, 1.0, 0.0), 0.8));
         assert!(turned.as_deref().is_some_and(|d| d.contains("view direction")), "{turned:?}");
     }
