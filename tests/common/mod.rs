@@ -107,3 +107,24 @@ pub fn fixture_tempdir() -> tempfile::TempDir {
     std::fs::create_dir_all(&root).expect("fixture folder");
     tempfile::tempdir_in(&root).expect("temp dir")
 }
+
+/// Runs pis-diff on `a` and `b` with `args`.
+pub fn pis_diff(a: &Path, b: &Path, args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_pis-diff"))
+        .arg(a)
+        .arg(b)
+        .args(args)
+        .output()
+        .expect("pis-diff runs")
+}
+
+/// A tool's `--json` report on standard output.
+pub fn json_report(out: &Output) -> serde_json::Value {
+    serde_json::from_slice(&out.stdout).unwrap_or_else(|e| {
+        panic!(
+            "JSON report ({e}): {}{}",
+            String::from_utf8_lossy(&out.stdout),
+            String::from_utf8_lossy(&out.stderr)
+        )
+    })
+}
