@@ -22,7 +22,7 @@ use pis_compile::SolveSettings;
 use pis_eval::bench::all::{self, Preset};
 use pis_eval::bench::hybrid::{self, HybridRequest};
 use pis_eval::bench::rd::{self, RdRequest};
-use pis_eval::bench::reference::ReferenceSampling;
+use pis_eval::bench::reference::ReferenceTrace;
 use pis_eval::bench::reflective::{self, ReflectiveRequest};
 use pis_eval::bench::speed::{self, SpeedRequest};
 use pis_eval::bench::stability::{self, StabilityRequest};
@@ -38,9 +38,15 @@ struct Cli {
     command: Command,
 }
 
-/// How the reference frames sample and whether they are denoised.
+/// How the reference frames are traced beyond their samples per pixel and seeding.
 #[derive(Args, Debug)]
 struct ReferenceArgs {
+    /// Trace every reference twice from independent sample streams (needs --reference-seed
+    /// sample): the gold standard is their mean, their difference measures its own noise, and
+    /// the report adds each figure with that noise taken out (an estimate of the PSNR against
+    /// the converged image).
+    #[arg(long)]
+    reference_pair: bool,
     /// Trace the reference frames with adaptive sampling: a pixel stops once its estimated
     /// relative error is below T (as pis-trace --noise-threshold); --reference-spp is then
     /// each pixel's most samples. 0: every pixel takes --reference-spp.
@@ -56,11 +62,14 @@ struct ReferenceArgs {
 }
 
 impl ReferenceArgs {
-    fn sampling(&self) -> ReferenceSampling {
-        ReferenceSampling {
+    /// The reference trace at `spp` samples per pixel, shading seeded by `seed`.
+    fn trace(&self, spp: u32, seed: pis_trace::ShadingSeed) -> ReferenceTrace {
+        ReferenceTrace {
+            pair: self.reference_pair,
             noise_threshold: self.reference_noise_threshold,
             min_spp: self.reference_min_spp,
             denoise: self.reference_denoise,
+            ..ReferenceTrace::new(spp, seed)
         }
     }
 }
@@ -232,11 +241,6 @@ enum Command {
         /// 1/spp: a gold standard).
         #[arg(long, value_name = "cell|sample", default_value = "cell", value_parser = parse_shading_seed)]
         reference_seed: pis_trace::ShadingSeed,
-        /// Trace every reference twice from independent sample streams (needs
-        /// --reference-seed sample): the gold standard is their mean, their difference
-        /// measures its own noise, and the report adds each figure with that noise taken out.
-        #[arg(long)]
-        reference_pair: bool,
         #[command(flatten)]
         reference: ReferenceArgs,
         #[arg(long, default_value = "reports")]
@@ -277,12 +281,6 @@ enum Command {
         /// 1/spp: a gold standard).
         #[arg(long, value_name = "cell|sample", default_value = "cell", value_parser = parse_shading_seed)]
         reference_seed: pis_trace::ShadingSeed,
-        /// Trace every reference twice from independent sample streams (needs
-        /// --reference-seed sample): the gold standard is their mean, their difference
-        /// measures its own noise, and the report adds each figure with that noise taken out
-        /// (an estimate of the PSNR against the converged image).
-        #[arg(long)]
-        reference_pair: bool,
         #[command(flatten)]
         reference: ReferenceArgs,
         #[arg(long, default_value = "reports")]
@@ -539,7 +537,6 @@ fn run(cli: Cli) -> Result<Exit, Failure> {
             frames,
             reference_spp,
             reference_seed,
-            reference_pair,
             reference,
             out,
             resolution,
@@ -550,14 +547,11 @@ fn run(cli: Cli) -> Result<Exit, Failure> {
             json,
         } => {
             let req = StabilityRequest {
-                sampling: reference.sampling(),
-                reference_pair,
+                reference: reference.trace(reference_spp, reference_seed),
                 input,
                 scene,
                 ratios,
                 frames,
-                spp: reference_spp,
-                reference_seed,
                 out,
                 resolution,
                 trace_spp: spp,
@@ -579,7 +573,6 @@ fn run(cli: Cli) -> Result<Exit, Failure> {
             frames,
             reference_spp,
             reference_seed,
-            reference_pair,
             reference,
             out,
             resolution,
@@ -595,10 +588,7 @@ fn run(cli: Cli) -> Result<Exit, Failure> {
                 resolution,
                 files,
                 frames,
-                spp: reference_spp,
-                reference_seed,
-                reference_pair,
-                sampling: reference.sampling(),
+                reference: reference.trace(reference_spp, reference_seed),
                 out,
                 images,
                 role,

@@ -8,6 +8,7 @@ use anyhow::anyhow;
 use pis_scene::LoadOptions;
 
 use super::rd::{self, RdRequest};
+use super::reference::ReferenceTrace;
 use super::speed::{self, SpeedRequest};
 use super::stability::{self, StabilityRequest};
 use pis_pack::{Exit, Failure};
@@ -131,10 +132,7 @@ pub fn run(preset: Preset, scene: &Path, out: &Path, record: bool) -> Result<(),
         scene: None,
         ratios: s.stability_ratios.clone(),
         frames: s.frames,
-        reference_seed: pis_trace::ShadingSeed::Cell,
-        sampling: Default::default(),
-        reference_pair: false,
-        spp: s.reference_spp,
+        reference: ReferenceTrace::new(s.reference_spp, pis_trace::ShadingSeed::Cell),
         out: out.to_path_buf(),
         resolution: s.resolution,
         trace_spp: s.spp,

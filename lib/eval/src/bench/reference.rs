@@ -1,64 +1,31 @@
-//! The gold-standard frames pis-bench traces at exact cameras: fixed or adaptive samples
+//! The gold-standard frames pis-bench traces at exact cameras: fixed or adaptive samples,
+//! once or as a pair from independent streams
 //! (`--reference-noise-threshold`, pis-trace's adaptive sampling) and, as an option,
 //! denoised (`--reference-denoise`: the combined image through Open Image Denoise with its
 //! albedo and normal guides, as pis-trace denoises a set's combined image, RAYSET.md 5.4).
 
 use anyhow::{anyhow, Result};
+use pis_pack::{Exit, Failure};
 use pis_scene::{Frame, Scene};
 use pis_trace::{PointImages, ShadingSeed, TraceSettings};
 
-/// How the reference frames sample beyond their samples per pixel and seeding.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct ReferenceSampling {
+/// How pis-bench traces its gold-standard frames.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ReferenceTrace {
+    /// Samples per pixel (each pixel's most, when adaptive).
+    pub spp: u32,
+    /// What seeds the shading (`Sample` for a gold standard whose noise falls as 1/spp).
+    pub seed: ShadingSeed,
+    /// Trace every frame twice from independent sample streams: the gold standard is their
+    /// mean, their difference measures its noise (needs `seed` `Sample`).
+    pub pair: bool,
     /// Adaptive sampling: a pixel stops once its estimated relative error is below this
-    /// (0: every pixel takes the reference's samples per pixel, its most otherwise).
+    /// (0: every pixel takes `spp`).
     pub noise_threshold: f32,
     /// Adaptive sampling: the samples every pixel takes first.
     pub min_spp: u32,
-    /// Denoise each reference frame's combined image.
+    /// Denoise each frame's combined image.
     pub denoise: bool,
-}
-
-impl ReferenceSampling {
-    /// Refuses a denoised reference where Open Image Denoise cannot be loaded, before any
-    /// frame is traced.
-    pub fn check(&self) -> Result<()> {
-        if self.denoise {
-            pis_trace::oidn::shared().map_err(|e| anyhow!("--reference-denoise: {e}"))?;
-        }
-        Ok(())
-    }
-
-    /// The reference's trace settings: `spp` samples (the most, when adaptive), shading
-    /// seeded by `seed`, camera samples from stream `stream`.
-    pub fn settings(
-        &self,
-        resolution: (u32, u32),
-        spp: u32,
-        seed: ShadingSeed,
-        stream: u64,
-    ) -> TraceSettings {
-        let mut s = TraceSettings::new(resolution, spp)
-            .with_shading_seed(seed)
-            .with_seed(stream)
-            .with_adaptive(self.noise_threshold, self.min_spp.min(spp));
-        s.denoise = self.denoise;
-        s
-    }
-
-    /// How the references are traced, for reports: `16 spp, shading seeded per sample`,
-    /// with `, adaptive (threshold 0.02, 4–16 spp)` and `, denoised` as they apply.
-    pub fn describe(&self, spp: u32, seed: ShadingSeed) -> String {
-        let mut s = format!("{spp} spp, shading seeded per {}", seed.name());
-        if self.noise_threshold > 0.0 {
-            let min = self.min_spp.min(spp);
-            s += &format!(", adaptive (threshold {}, {min}–{spp} spp)", self.noise_threshold);
-        }
-        if self.denoise {
-            s += ", denoised";
-        }
-        s
-    }
 }
 
 /// The stream of the second trace of a reference pair (the first is the default, 0).
@@ -72,23 +39,70 @@ pub struct ReferenceFrame {
     pub pair: Option<[Vec<f32>; 2]>,
 }
 
-impl ReferenceSampling {
-    /// Traces the reference frame at `frame`: `spp` samples (the most, when adaptive),
-    /// shading seeded by `seed`, and with `pair` a second time from [`SECOND_STREAM`].
-    pub fn frame(
-        &self,
-        scene: &Scene,
-        frame: &Frame,
-        (spp, seed): (u32, ShadingSeed),
-        pair: bool,
-    ) -> Result<ReferenceFrame> {
-        let images = trace(scene, frame, &self.settings(scene.resolution, spp, seed, 0))?;
+impl ReferenceTrace {
+    /// `spp` fixed samples per pixel seeded by `seed`, traced once, not denoised.
+    pub fn new(spp: u32, seed: ShadingSeed) -> ReferenceTrace {
+        ReferenceTrace { spp, seed, pair: false, noise_threshold: 0.0, min_spp: 0, denoise: false }
+    }
+
+    /// Refuses, before any frame is traced, a pair seeded per cell (both traces would carry
+    /// the same surface noise) and a denoised reference where Open Image Denoise cannot be
+    /// loaded.
+    pub fn check(&self) -> Result<(), Failure> {
+        if self.pair && self.seed != ShadingSeed::Sample {
+            return Err(Failure::new(Exit::Usage, anyhow!("--reference-pair needs --reference-seed sample: seeded per cell, both renders carry the same surface noise, so their difference cannot measure it")));
+        }
+        if self.denoise {
+            pis_trace::oidn::shared().map_err(|e| {
+                Failure::new(Exit::NotSupported, anyhow!("--reference-denoise: {e}"))
+            })?;
+        }
+        Ok(())
+    }
+
+    /// The trace settings of stream `stream` at `resolution`.
+    pub fn settings(&self, resolution: (u32, u32), stream: u64) -> TraceSettings {
+        let mut s = TraceSettings::new(resolution, self.spp)
+            .with_shading_seed(self.seed)
+            .with_seed(stream)
+            .with_adaptive(self.noise_threshold, self.min_spp.min(self.spp));
+        s.denoise = self.denoise;
+        s
+    }
+
+    /// How the references are traced, for reports: `16 spp, shading seeded per sample`,
+    /// with `, adaptive (threshold 0.02, 4–16 spp)` and `, denoised` as they apply.
+    pub fn describe(&self) -> String {
+        let (spp, mut s) =
+            (self.spp, format!("{} spp, shading seeded per {}", self.spp, self.seed.name()));
+        if self.noise_threshold > 0.0 {
+            let min = self.min_spp.min(spp);
+            s += &format!(", adaptive (threshold {}, {min}–{spp} spp)", self.noise_threshold);
+        }
+        if self.denoise {
+            s += ", denoised";
+        }
+        s
+    }
+
+    /// Says on stderr that `tool` traces `frames` reference frames, and how.
+    pub fn announce(&self, tool: &str, frames: usize) {
+        let twice = if self.pair { ", each twice from independent streams" } else { "" };
+        eprintln!(
+            "pis-bench: {tool}: tracing {frames} reference frames ({}){twice}",
+            self.describe()
+        );
+    }
+
+    /// Traces the reference frame at `frame` (with a pair, a second time from
+    /// [`SECOND_STREAM`]).
+    pub fn frame(&self, scene: &Scene, frame: &Frame) -> Result<ReferenceFrame> {
+        let images = trace(scene, frame, &self.settings(scene.resolution, 0))?;
         let rgb = combined_rgb(&images)?;
-        if !pair {
+        if !self.pair {
             return Ok(ReferenceFrame { images, rgb, pair: None });
         }
-        let second =
-            trace(scene, frame, &self.settings(scene.resolution, spp, seed, SECOND_STREAM))?;
+        let second = trace(scene, frame, &self.settings(scene.resolution, SECOND_STREAM))?;
         let second = combined_rgb(&second)?;
         let mean = rgb.iter().zip(&second).map(|(a, b)| 0.5 * (a + b)).collect();
         Ok(ReferenceFrame { images, rgb: mean, pair: Some([rgb, second]) })
@@ -127,17 +141,26 @@ mod tests {
     use super::*;
 
     #[test]
-    fn the_settings_and_their_description_follow_the_sampling() {
-        let fixed = ReferenceSampling::default();
-        let s = fixed.settings((8, 6), 16, ShadingSeed::Sample, 1);
+    fn the_settings_and_their_description_follow_the_trace() {
+        let fixed = ReferenceTrace::new(16, ShadingSeed::Sample);
+        let s = fixed.settings((8, 6), 1);
         assert_eq!((s.spp, s.seed, s.adaptive(), s.denoise), (16, 1, false, false));
-        assert_eq!(fixed.describe(16, ShadingSeed::Sample), "16 spp, shading seeded per sample");
-        let adaptive = ReferenceSampling { noise_threshold: 0.02, min_spp: 32, denoise: true };
-        let s = adaptive.settings((8, 6), 16, ShadingSeed::Cell, 0);
+        assert_eq!(fixed.describe(), "16 spp, shading seeded per sample");
+        let adaptive = ReferenceTrace {
+            noise_threshold: 0.02,
+            min_spp: 32,
+            denoise: true,
+            ..ReferenceTrace::new(16, ShadingSeed::Cell)
+        };
+        let s = adaptive.settings((8, 6), 0);
         assert_eq!((s.min_spp, s.adaptive(), s.denoise), (16, true, true));
         assert_eq!(
-            adaptive.describe(16, ShadingSeed::Cell),
+            adaptive.describe(),
             "16 spp, shading seeded per cell, adaptive (threshold 0.02, 16–16 spp), denoised"
         );
+        let pair = ReferenceTrace { pair: true, ..fixed };
+        assert!(pair.check().is_ok());
+        let cell = ReferenceTrace { pair: true, ..ReferenceTrace::new(16, ShadingSeed::Cell) };
+        assert!(cell.check().is_err_and(|f| f.exit == Exit::Usage));
     }
 }

@@ -21,11 +21,10 @@ use glam::Vec3;
 use pis_play::{CameraChoice, FrameRequest, Gpu, Player, PlayerOptions, ViewCamera};
 use pis_scene::{LoadOptions, ObjectRole, Scene};
 use pis_trace::layers::LayerKind;
-use pis_trace::ShadingSeed;
 use serde::Serialize;
 
 use super::camera_path::{paths, PathFrame, PathKind};
-use super::reference::ReferenceSampling;
+use super::reference::ReferenceTrace;
 use crate::metrics::{display, PairedError, SquaredError};
 use crate::report::{Csv, Stamp};
 use pis_pack::{Exit, Failure};
@@ -44,16 +43,8 @@ pub struct ReflectiveRequest {
     pub files: Vec<PathBuf>,
     /// Frames on the between and away paths.
     pub frames: usize,
-    /// Samples per pixel of the reference frames.
-    pub spp: u32,
-    /// What seeds the reference frames' shading (`Sample` for a gold standard whose noise
-    /// falls as 1/spp).
-    pub reference_seed: ShadingSeed,
-    /// Trace every reference twice, from independent sample streams, to measure and take out
-    /// its noise (needs `reference_seed` `Sample`).
-    pub reference_pair: bool,
-    /// Adaptive sampling and denoising of the reference frames.
-    pub sampling: ReferenceSampling,
+    /// How the reference frames are traced.
+    pub reference: ReferenceTrace,
     /// Where reflective.csv goes.
     pub out: PathBuf,
     /// Also write every played frame beside its traced reference as an sRGB PNG.
@@ -117,8 +108,7 @@ fn reference(
     pf: &PathFrame,
     objects: &[usize],
 ) -> Result<Reference> {
-    let f =
-        req.sampling.frame(scene, &pf.frame, (req.spp, req.reference_seed), req.reference_pair)?;
+    let f = req.reference.frame(scene, &pf.frame)?;
     let channels = pis_trace::channel_names(scene);
     let mut mask = vec![false; f.rgb.len() / 3];
     for &o in objects {
@@ -264,7 +254,7 @@ fn measure(
         }
         let mean = psnrs.iter().sum::<f64>() / psnrs.len().max(1) as f64;
         let min = psnrs.iter().copied().fold(f64::INFINITY, f64::min);
-        let pair = |v: f64| req.reference_pair.then_some(v);
+        let pair = |v: f64| req.reference.pair.then_some(v);
         summaries.push(ReflectiveSummary {
             file: name.to_string(),
             path: kind,
@@ -280,15 +270,13 @@ fn measure(
 
 /// Plays every file along both paths and measures it against the traced references.
 pub fn run(req: &ReflectiveRequest) -> Result<ReflectiveReport, Failure> {
-    if req.files.is_empty() || req.frames < 2 || req.spp == 0 {
+    if req.files.is_empty() || req.frames < 2 || req.reference.spp == 0 {
         return Err(Failure::new(
             Exit::Usage,
             anyhow!("give at least one file, --frames ≥ 2 and --spp ≥ 1"),
         ));
     }
-    if req.reference_pair && req.reference_seed != ShadingSeed::Sample {
-        return Err(Failure::new(Exit::Usage, anyhow!("--reference-pair needs --reference-seed sample: seeded per cell, both renders carry the same surface noise, so their difference cannot measure it")));
-    }
+    req.reference.check()?;
     let options = LoadOptions { preset: req.preset.clone(), resolution: req.resolution, spp: None };
     let scene = pis_scene::load_with(&req.scene, &options).map_err(|e| {
         Failure::new(pis_pack::scene_exit(&e), anyhow!("{}: {e}", req.scene.display()))
@@ -308,13 +296,7 @@ pub fn run(req: &ReflectiveRequest) -> Result<ReflectiveReport, Failure> {
     }
     let (view_dim, frames) =
         paths(&scene, req.frames, &PATHS).map_err(|e| Failure::new(Exit::NotSupported, e))?;
-    req.sampling.check().map_err(|e| Failure::new(Exit::NotSupported, e))?;
-    let twice = if req.reference_pair { ", each twice from independent streams" } else { "" };
-    eprintln!(
-        "pis-bench: reflective: tracing {} reference frames ({}){twice}",
-        frames.len(),
-        req.sampling.describe(req.spp, req.reference_seed)
-    );
+    req.reference.announce("reflective", frames.len());
     let refs: Vec<Reference> = frames
         .iter()
         .map(|f| reference(req, &scene, f, &objects))
@@ -389,10 +371,10 @@ pub fn run(req: &ReflectiveRequest) -> Result<ReflectiveReport, Failure> {
         scene: scene_s,
         objects: objects.iter().map(|&o| scene.objects[o].name.clone()).collect(),
         frames: req.frames,
-        reference_spp: req.spp,
-        reference_seed: req.reference_seed.name().into(),
-        reference_pair: req.reference_pair,
-        reference: req.sampling.describe(req.spp, req.reference_seed),
+        reference_spp: req.reference.spp,
+        reference_seed: req.reference.seed.name().into(),
+        reference_pair: req.reference.pair,
+        reference: req.reference.describe(),
         summaries,
         csv: csv_path.display().to_string(),
     })

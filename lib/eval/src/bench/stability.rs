@@ -20,9 +20,8 @@ use pis_compile::{
     render, render_matrix, scene_depth, DrawMesh, Filter, RenderMatrix, TexturedObject, Viewport,
 };
 use pis_format::DepMask;
-use pis_trace::ShadingSeed;
 
-use super::reference::{ReferenceFrame, ReferenceSampling};
+use super::reference::{ReferenceFrame, ReferenceTrace};
 use rayon::prelude::*;
 use serde::Serialize;
 
@@ -42,15 +41,8 @@ pub struct StabilityRequest {
     pub ratios: Vec<f64>,
     /// Frames per path.
     pub frames: usize,
-    /// Samples per pixel of the reference frames.
-    pub spp: u32,
-    /// What seeds the reference frames' shading.
-    pub reference_seed: ShadingSeed,
-    /// Adaptive sampling and denoising of the reference frames.
-    pub sampling: ReferenceSampling,
-    /// Trace every reference twice from independent sample streams (needs
-    /// `reference_seed` `Sample`): the gold standard is their mean, their difference its noise.
-    pub reference_pair: bool,
+    /// How the reference frames are traced.
+    pub reference: ReferenceTrace,
     pub out: PathBuf,
     pub resolution: Option<(u32, u32)>,
     pub trace_spp: Option<u32>,
@@ -212,12 +204,7 @@ fn render_frame(
 
 /// The reference frame at `pf` (with a pair, the mean of two traces, and both).
 fn reference(req: &StabilityRequest, inf: &Inferred, pf: &PathFrame) -> Result<ReferenceFrame> {
-    let mut f = req.sampling.frame(
-        &inf.set.scene,
-        &pf.frame,
-        (req.spp, req.reference_seed),
-        req.reference_pair,
-    )?;
+    let mut f = req.reference.frame(&inf.set.scene, &pf.frame)?;
     f.images.layers.clear();
     Ok(f)
 }
@@ -316,10 +303,8 @@ pub fn check(req: &StabilityRequest) -> Result<(), Failure> {
             anyhow!("--ratios: every ratio must be at least 1, got {r}"),
         ));
     }
-    if req.reference_pair && req.reference_seed != ShadingSeed::Sample {
-        return Err(Failure::new(Exit::Usage, anyhow!("--reference-pair needs --reference-seed sample: seeded per cell, both renders carry the same surface noise, so their difference cannot measure it")));
-    }
-    if req.frames < 2 || req.frames > 10_000 || req.spp == 0 {
+    req.reference.check()?;
+    if req.frames < 2 || req.frames > 10_000 || req.reference.spp == 0 {
         return Err(Failure::new(
             Exit::Usage,
             anyhow!("--frames must be in 2..=10000 and --spp at least 1"),
@@ -381,7 +366,7 @@ fn write_stability(
         .collect();
     let chart = Chart {
         title: format!("Stability off the samples — {scene_s}"),
-        subtitle: format!("through the hardware model at each exact camera vs pis-trace ({}) over covered pixels; between: fractional view, away: radius ×{AWAY_RADIUS}, elevation +{AWAY_ELEVATION_DEG}°", req.sampling.describe(req.spp, req.reference_seed)),
+        subtitle: format!("through the hardware model at each exact camera vs pis-trace ({}) over covered pixels; between: fractional view, away: radius ×{AWAY_RADIUS}, elevation +{AWAY_ELEVATION_DEG}°", req.reference.describe()),
         x_label: "position along the view dimension (samples)".into(),
         y_label: "PSNR (dB)".into(),
         x_log: false,
@@ -393,7 +378,6 @@ fn write_stability(
 /// Runs the paths for every representation and writes stability.csv and stability.svg.
 pub fn run(req: &StabilityRequest) -> Result<StabilityReport, Failure> {
     check(req)?;
-    req.sampling.check().map_err(|e| Failure::new(Exit::NotSupported, e))?;
     ensure_dir(&req.out).map_err(|e| Failure::new(Exit::Io, e))?;
     let settings = PackSettings {
         max_texture: req.max_texture,
@@ -411,12 +395,7 @@ pub fn run(req: &StabilityRequest) -> Result<StabilityReport, Failure> {
     let scene = &inf.set.scene;
     let (view_dim, frames) = paths(scene, req.frames, &[PathKind::Between, PathKind::Away])
         .map_err(|e| Failure::new(Exit::NotSupported, e))?;
-    let twice = if req.reference_pair { ", each twice from independent streams" } else { "" };
-    eprintln!(
-        "pis-bench: stability: tracing {} reference frames ({}){twice}",
-        frames.len(),
-        req.sampling.describe(req.spp, req.reference_seed)
-    );
+    req.reference.announce("stability", frames.len());
     let refs: Vec<ReferenceFrame> =
         frames.iter().map(|f| reference(req, &inf, f)).collect::<Result<_>>().map_err(runtime)?;
     let meshes: Vec<Mesh> = (0..scene.objects.len()).map(|o| merged_mesh(scene, o)).collect();
@@ -451,7 +430,7 @@ pub fn run(req: &StabilityRequest) -> Result<StabilityReport, Failure> {
     let stamp = Stamp::here(&scene_s);
     let (c, s) = write_stability(req, &scene_s, &stamp, &rows, &summaries)?;
     let report = StabilityReport {
-        scene: scene_s, frames: req.frames, reference: req.sampling.describe(req.spp, req.reference_seed), summaries, rows, csv: c.display().to_string(), svg: s.display().to_string(), stamp,
+        scene: scene_s, frames: req.frames, reference: req.reference.describe(), summaries, rows, csv: c.display().to_string(), svg: s.display().to_string(), stamp,
         notes: vec![
             "frames rendered through the hardware model (CPU), textures blended linearly between the two neighbouring view samples".into(),
             "PSNR on display values over the pixels the model covers, against pis-trace's combined image at the same camera".into(),
