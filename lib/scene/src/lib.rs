@@ -32,6 +32,7 @@ mod frame;
 mod gltf_files;
 mod gltf_images;
 mod gltf_load;
+pub mod lens_tree;
 mod light;
 pub mod light_path;
 mod load;

@@ -71,8 +71,8 @@ fn object_error(a: Option<&ObjectAccum>, na: f32, b: Option<&ObjectAccum>, nb: f
 }
 
 /// An object's sums the inference reads, each premultiplied by its coverage: coverage (as
-/// grey), diffuse, specular, local, distant, reflection, refraction.
-fn object_values(o: &ObjectAccum) -> [Vec3; 7] {
+/// grey), diffuse, specular, local, distant, and the lens terms.
+fn object_values(o: &ObjectAccum) -> [Vec3; 9] {
     [
         Vec3::splat(o.count as f32),
         o.diffuse,
@@ -81,6 +81,8 @@ fn object_values(o: &ObjectAccum) -> [Vec3; 7] {
         o.distant,
         o.term_value[0],
         o.term_value[1],
+        o.term_value[2],
+        o.term_value[3],
     ]
 }
 

@@ -30,22 +30,24 @@
 //! features) keeps no twin at that point, and the point's set.json entry lists it.
 
 use crate::error::TraceError;
-use crate::layers::{object_layer_name, LayerImage, LayerKind, PointImages};
+use crate::layers::{object_layer_name, LayerImage, LayerKind, PointImages, TermPart};
 use crate::oidn::{DenoiseImage, Oidn};
 use crate::settings::TraceSettings;
 use pis_codec::display::display;
 use pis_scene::ObjectRole;
 use serde::{Deserialize, Serialize};
 
-/// The layers denoised per object: the radiance layers. Coverage, Fresnel, the greedy
+/// The layers denoised per object: the radiance layers. Coverage, Fresnel, the lens
 /// terms' modulations and confidences are coefficients, not radiance, and stay raw.
-pub const DENOISED_KINDS: [LayerKind; 6] = [
+pub const DENOISED_KINDS: [LayerKind; 8] = [
     LayerKind::Diffuse,
     LayerKind::Specular,
     LayerKind::Local,
     LayerKind::Distant,
     LayerKind::Reflection,
     LayerKind::Refraction,
+    LayerKind::Internal(1, TermPart::Value),
+    LayerKind::Internal(2, TermPart::Value),
 ];
 
 /// Prefix of a denoised layer's name: `denoised.combined`, `denoised.object.vase.diffuse`.
@@ -327,7 +329,8 @@ pub fn denoise_point(
         let Some(window) = covered_window(coverage, w, h) else { continue };
         let mask: Vec<bool> = window.pixels(w).map(|i| coverage[i] > 0.0).collect();
         let guides = WindowGuides::new(&input.guides, window);
-        for kind in DENOISED_KINDS.into_iter().filter(|k| LayerKind::for_role(*role).contains(k)) {
+        for kind in DENOISED_KINDS.into_iter().filter(|k| LayerKind::for_role(*role, 4).contains(k))
+        {
             let layer_name = object_layer_name(name, kind);
             let Some(layer) = images.layer(&layer_name) else { continue };
             if layer.planes.iter().take(3).all(|p| p.iter().all(|&v| v == 0.0)) {

@@ -3,6 +3,7 @@
 
 use crate::integrator::CameraSample;
 use glam::Vec3;
+use pis_scene::lens_tree::MAX_TERMS;
 use pis_scene::ObjectRole;
 
 /// θc of the confidence image (thesis 6.3.3): 5 degrees.
@@ -37,6 +38,20 @@ pub enum LayerKind {
     RefractionModulation,
     /// Refractive: confidence of the refraction-first exit rays (Y).
     RefractionConfidence,
+    /// Refractive, tree model: the refraction-first term with k = 1 or 2 internal
+    /// reflections, its modulation and its confidence (as `Refraction…`).
+    Internal(u8, TermPart),
+}
+
+/// Which image of a lens term a layer holds.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum TermPart {
+    /// The term's radiance × F·G (RGB).
+    Value,
+    /// F·G (RGB).
+    Modulation,
+    /// The confidence of its exit rays (Y).
+    Confidence,
 }
 
 impl LayerKind {
@@ -55,6 +70,27 @@ impl LayerKind {
             LayerKind::Refraction => "refraction",
             LayerKind::RefractionModulation => "refraction_modulation",
             LayerKind::RefractionConfidence => "refraction_confidence",
+            LayerKind::Internal(1, TermPart::Value) => "refraction_1",
+            LayerKind::Internal(1, TermPart::Modulation) => "refraction_1_modulation",
+            LayerKind::Internal(1, TermPart::Confidence) => "refraction_1_confidence",
+            LayerKind::Internal(_, TermPart::Value) => "refraction_2",
+            LayerKind::Internal(_, TermPart::Modulation) => "refraction_2_modulation",
+            LayerKind::Internal(_, TermPart::Confidence) => "refraction_2_confidence",
+        }
+    }
+
+    /// The lens term (0 reflection-first, 1 refraction-first, 2 and 3 the tree's terms with
+    /// one and two internal reflections) and the part of it the layer holds.
+    pub fn term(self) -> Option<(usize, TermPart)> {
+        match self {
+            LayerKind::Reflection => Some((0, TermPart::Value)),
+            LayerKind::ReflectionModulation => Some((0, TermPart::Modulation)),
+            LayerKind::ReflectionConfidence => Some((0, TermPart::Confidence)),
+            LayerKind::Refraction => Some((1, TermPart::Value)),
+            LayerKind::RefractionModulation => Some((1, TermPart::Modulation)),
+            LayerKind::RefractionConfidence => Some((1, TermPart::Confidence)),
+            LayerKind::Internal(k, part) => Some((1 + k.clamp(1, 2) as usize, part)),
+            _ => None,
         }
     }
 
@@ -63,7 +99,9 @@ impl LayerKind {
         match self {
             LayerKind::Coverage => &["A"],
             LayerKind::Local => &["R", "G", "B", "A"],
-            LayerKind::ReflectionConfidence | LayerKind::RefractionConfidence => &["Y"],
+            LayerKind::ReflectionConfidence
+            | LayerKind::RefractionConfidence
+            | LayerKind::Internal(_, TermPart::Confidence) => &["Y"],
             _ => &["R", "G", "B"],
         }
     }
@@ -73,42 +111,39 @@ impl LayerKind {
         ALL_LAYERS.iter().copied().find(|l| l.name() == name)
     }
 
-    /// The layers an object of `role` has, in file order.
-    pub fn for_role(role: ObjectRole) -> &'static [LayerKind] {
+    /// The layers an object of `role` has, in file order, in a set whose lens model has
+    /// `lens_terms` terms (2 greedy, up to 4 tree): three layers a term.
+    pub fn for_role(role: ObjectRole, lens_terms: usize) -> &'static [LayerKind] {
         use LayerKind::*;
         match role {
             ObjectRole::Diffuse => &[Coverage, Diffuse, Specular],
             ObjectRole::Reflective => &[Coverage, Diffuse, Specular, Fresnel, Local, Distant],
-            ObjectRole::Refractive => &[
-                Coverage,
-                Diffuse,
-                Specular,
-                Reflection,
-                ReflectionModulation,
-                ReflectionConfidence,
-                Refraction,
-                RefractionModulation,
-                RefractionConfidence,
-            ],
+            ObjectRole::Refractive => &ALL_LAYERS[..3 + 3 * lens_terms.clamp(2, MAX_TERMS)],
         }
     }
 }
 
-const ALL_LAYERS: [LayerKind; 12] = {
+const ALL_LAYERS: [LayerKind; 18] = {
     use LayerKind::*;
     [
         Coverage,
         Diffuse,
         Specular,
-        Fresnel,
-        Local,
-        Distant,
         Reflection,
         ReflectionModulation,
         ReflectionConfidence,
         Refraction,
         RefractionModulation,
         RefractionConfidence,
+        Internal(1, TermPart::Value),
+        Internal(1, TermPart::Modulation),
+        Internal(1, TermPart::Confidence),
+        Internal(2, TermPart::Value),
+        Internal(2, TermPart::Modulation),
+        Internal(2, TermPart::Confidence),
+        Fresnel,
+        Local,
+        Distant,
     ]
 };
 
@@ -193,11 +228,12 @@ pub struct ObjectAccum {
     pub local: Vec3,
     pub local_alpha: f32,
     pub distant: Vec3,
-    /// Sums of term values and modulations, reflection-first then refraction-first.
-    pub term_value: [Vec3; 2],
-    pub term_modulation: [Vec3; 2],
+    /// Sums of term values and modulations: reflection-first, refraction-first, and the
+    /// tree's refraction-first terms with one and two internal reflections.
+    pub term_value: [Vec3; MAX_TERMS],
+    pub term_modulation: [Vec3; MAX_TERMS],
     /// Exit directions per term (for the confidence image).
-    pub exit_dirs: [Vec<Vec3>; 2],
+    pub exit_dirs: [Vec<Vec3>; MAX_TERMS],
 }
 
 /// Everything one pixel accumulates.
@@ -284,12 +320,13 @@ pub fn resolve(
     width: u32,
     height: u32,
     objects: &[(String, ObjectRole)],
+    lens_terms: usize,
 ) -> PointImages {
     let mut layers = vec![LayerImage::new("combined".into(), &["R", "G", "B"], width, height)];
     let mut first_layer = Vec::with_capacity(objects.len());
     for (name, role) in objects {
         first_layer.push(layers.len());
-        for &k in LayerKind::for_role(*role) {
+        for &k in LayerKind::for_role(*role, lens_terms) {
             layers.push(LayerImage::new(object_layer_name(name, k), k.channels(), width, height));
         }
     }
@@ -305,7 +342,7 @@ pub fn resolve(
             let Some((_, role)) = objects.get(a.object as usize) else { continue };
             let base = first_layer[a.object as usize];
             let c = a.count.max(1) as f32;
-            for (j, &k) in LayerKind::for_role(*role).iter().enumerate() {
+            for (j, &k) in LayerKind::for_role(*role, lens_terms).iter().enumerate() {
                 let img = &mut layers[base + j];
                 match k {
                     LayerKind::Coverage => img.planes[0][i] = a.count as f32 / n,
@@ -317,16 +354,14 @@ pub fn resolve(
                         img.planes[3][i] = a.local_alpha / c;
                     }
                     LayerKind::Distant => put(img, i, a.distant / c),
-                    LayerKind::Reflection => put(img, i, a.term_value[0] / c),
-                    LayerKind::ReflectionModulation => put(img, i, a.term_modulation[0] / c),
-                    LayerKind::ReflectionConfidence => {
-                        img.planes[0][i] = confidence(&a.exit_dirs[0])
-                    }
-                    LayerKind::Refraction => put(img, i, a.term_value[1] / c),
-                    LayerKind::RefractionModulation => put(img, i, a.term_modulation[1] / c),
-                    LayerKind::RefractionConfidence => {
-                        img.planes[0][i] = confidence(&a.exit_dirs[1])
-                    }
+                    _ => match k.term() {
+                        Some((t, TermPart::Value)) => put(img, i, a.term_value[t] / c),
+                        Some((t, TermPart::Modulation)) => put(img, i, a.term_modulation[t] / c),
+                        Some((t, TermPart::Confidence)) => {
+                            img.planes[0][i] = confidence(&a.exit_dirs[t])
+                        }
+                        None => {}
+                    },
                 }
             }
         }

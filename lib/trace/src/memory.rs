@@ -24,11 +24,17 @@ pub fn peak_resident() -> Option<u64> {
     Some(kib.saturating_mul(1024))
 }
 
-/// Float channels of one point's images: `combined` and every object's layers for its role.
-pub fn point_channels(roles: impl IntoIterator<Item = ObjectRole>) -> u64 {
+/// Float channels of one point's images: `combined` and every object's layers for its role
+/// (a lens model of `lens_terms` terms).
+pub fn point_channels(roles: impl IntoIterator<Item = ObjectRole>, lens_terms: usize) -> u64 {
     3 + roles
         .into_iter()
-        .map(|r| LayerKind::for_role(r).iter().map(|l| l.channels().len() as u64).sum::<u64>())
+        .map(|r| {
+            LayerKind::for_role(r, lens_terms)
+                .iter()
+                .map(|l| l.channels().len() as u64)
+                .sum::<u64>()
+        })
         .sum::<u64>()
 }
 
@@ -53,7 +59,7 @@ mod tests {
     #[test]
     fn a_point_holds_combined_and_each_objects_layers() {
         // combined RGB + diffuse object: coverage A, diffuse RGB, specular RGB
-        assert_eq!(point_channels([ObjectRole::Diffuse]), 3 + 7);
+        assert_eq!(point_channels([ObjectRole::Diffuse], 2), 3 + 7);
         assert_eq!(image_bytes(640, 480, 10, 1), 640 * 480 * 10 * 4);
         assert_eq!(
             image_bytes(u32::MAX, u32::MAX, u64::MAX, 3),

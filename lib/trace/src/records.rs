@@ -2,6 +2,7 @@
 //! side file (`*.rays.bin`, layout in format-spec/RAYSET.md).
 
 use crate::error::TraceError;
+use pis_scene::lens_tree::MAX_TERMS;
 use std::path::Path;
 
 /// File magic of a ray-record side file.
@@ -26,12 +27,13 @@ pub struct RecordHit {
     pub colour: [f32; 3],
 }
 
-/// One incoming camera ray of a lens object and the outgoing ray of one greedy term.
+/// One incoming camera ray of a lens object and the outgoing ray of one term of its model.
 #[derive(Clone, Debug, PartialEq)]
 pub struct RayRecord {
     /// Index of the lens object (set.json `objects`).
     pub object: u32,
-    /// 0 = reflection-first term, 1 = refraction-first term.
+    /// 0 = reflection-first term, 1 = refraction-first term; the tree model's 2 and 3: the
+    /// refraction-first terms with one and two internal reflections.
     pub term: u8,
     /// Continuous image position of the incoming camera ray (pixels, origin top-left).
     pub pixel: [f32; 2],
@@ -141,9 +143,9 @@ pub fn decode_records(bytes: &[u8], path: &Path) -> Result<Vec<RayRecord>, Trace
         let object = c.u32()?;
         let head = c.take(4)?;
         let (term, n_hits) = (head[0], u16::from_le_bytes([head[2], head[3]]) as usize);
-        if term > 1 {
+        if term as usize >= MAX_TERMS {
             return Err(bad(format!(
-                "record {} has term {term} at offset {}; expected 0 or 1",
+                "record {} has term {term} at offset {}; expected 0 to 3",
                 records.len(),
                 c.at - 4
             )));

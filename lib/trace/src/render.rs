@@ -155,11 +155,12 @@ pub fn render_point(
             odd.push(b);
         }
     }
-    let images = resolve(&whole, w, h, &objects);
+    let terms = settings.lens_model.terms();
+    let images = resolve(&whole, w, h, &objects, terms);
     let denoise_input = settings.denoise.then(|| {
         Box::new(DenoiseInput {
             guides: resolve_guides(&whole, w, h),
-            halves: [resolve(&even, w, h, &objects), resolve(&odd, w, h, &objects)],
+            halves: [resolve(&even, w, h, &objects, terms), resolve(&odd, w, h, &objects, terms)],
         })
     });
     let stats = RenderStats {

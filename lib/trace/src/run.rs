@@ -176,7 +176,10 @@ pub fn render_shard(
     let need = crate::memory::image_bytes(
         w,
         h,
-        crate::memory::point_channels(scene.objects.iter().map(|o| o.role)),
+        crate::memory::point_channels(
+            scene.objects.iter().map(|o| o.role),
+            settings.lens_model.terms(),
+        ),
         3,
     );
     if let Some(have) = crate::memory::available_memory().filter(|&have| need > have) {

@@ -1,6 +1,7 @@
 //! Render settings.
 
 use crate::film::GaussianFilter;
+use pis_scene::lens_tree::LensModel;
 use serde::{Deserialize, Serialize};
 
 /// What a render does, beyond the scene itself.
@@ -46,6 +47,10 @@ pub struct TraceSettings {
     /// denoiser's guides, albedo and normal at the first non-specular hit.
     #[serde(default, skip_serializing_if = "is_false")]
     pub denoise: bool,
+    /// How the paths through lens objects are followed and grouped into terms (the greedy
+    /// two paths of thesis 6.2, or the ray tree).
+    #[serde(default, skip_serializing_if = "LensModel::is_greedy")]
+    pub lens_model: LensModel,
 }
 
 fn is_false(v: &bool) -> bool {
@@ -162,6 +167,12 @@ impl TraceSettings {
         self
     }
 
+    /// The same settings with lens objects followed by `model`.
+    pub fn with_lens_model(mut self, model: LensModel) -> TraceSettings {
+        self.lens_model = model;
+        self
+    }
+
     /// Whether pixels sample adaptively.
     pub fn adaptive(&self) -> bool {
         self.noise_threshold > 0.0
@@ -183,6 +194,7 @@ impl TraceSettings {
             noise_threshold: 0.0,
             min_spp: 0,
             denoise: false,
+            lens_model: LensModel::Greedy,
         }
     }
 }

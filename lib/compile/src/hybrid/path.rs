@@ -1,18 +1,17 @@
-//! The greedy two-path model (thesis 6.2) traced through a lens object alone: from a point
-//! of its surface seen along `dir`, the reflection-first and the refraction-first paths,
-//! each following at every later interface the child with the larger Fresnel coefficient,
-//! with the Fresnel factors, the base colour on entering and the absorption inside
-//! multiplied along (F·G). The same model, in the same order of operations, as pis-trace's
-//! greedy terms (`Integrator::greedy_term`), which compile the traced set's `reflection` and
-//! `refraction` layers and ray records; a test keeps the two identical. Both meet an interface
-//! through the same functions, [`pis_scene::optics`].
+//! The paths through a lens object traced against the object alone: from a point of its
+//! surface seen along `dir`, the terms of the greedy two-path model (thesis 6.2) or of the
+//! ray tree (7.3). The walk is pis-trace's own ([`pis_scene::lens_tree`]), which compiles the
+//! traced set's term layers and ray records; only the intersection differs (the lens
+//! object's triangles here, the scene's BVH there), and a test keeps the two identical.
 
 use glam::Vec3;
+use pis_scene::lens_tree::{LensInterface, Step};
+pub use pis_scene::lens_tree::{LensModel, Topology, MAX_TERMS};
 pub use pis_scene::optics::{fresnel_dielectric, reflect, refract};
 
-use super::lens::{offset_origin, LensObject, LensSurface};
+use super::lens::{LensObject, LensSurface};
 
-/// The two terms (thesis 6.2).
+/// The two terms of the greedy model (thesis 6.2), the first two of the tree's.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum Term {
     /// The path that starts with a reflection.
@@ -23,16 +22,7 @@ pub enum Term {
 
 pub const TERMS: [Term; 2] = [Term::ReflectionFirst, Term::RefractionFirst];
 
-/// A path's "topology" (thesis 6.4.1): how many interfaces it met and, at each, whether it
-/// reflected. Two paths with different topologies are different whatever their directions.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
-pub struct Topology {
-    pub interfaces: u8,
-    /// Bit i: the path reflected at interface i (the first is the vertex itself).
-    pub reflected: u32,
-}
-
-/// Where a greedy path leaves the lens object.
+/// Where a path leaves the lens object.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct LensPath {
     /// The outgoing ray: its origin (offset off the last interface, as pis-trace's) and unit
@@ -44,10 +34,59 @@ pub struct LensPath {
     pub topology: Topology,
 }
 
-/// Follows `term` from `first`, the lens object's surface where a ray of direction `dir`
-/// (unit) meets it, until the path leaves the object; `None` where the term does not exist
-/// (refraction-first under total internal reflection) or the path is still inside after
-/// `max_depth` more interfaces.
+/// The terms of `model` from `first`, the lens object's surface where a ray of direction
+/// `dir` (unit) meets it: the walk pis-trace's lens terms take ([`pis_scene::lens_tree`]),
+/// with the lens object's own triangles and material for the interfaces it meets.
+pub fn lens_paths(
+    lens: &LensObject,
+    first: &LensSurface,
+    dir: Vec3,
+    model: LensModel,
+    max_depth: u32,
+) -> [Option<LensPath>; MAX_TERMS] {
+    let m = lens.material;
+    let interface = |s: &LensSurface, absorption: Vec3| LensInterface {
+        position: s.position,
+        normal: s.normal,
+        geometric_normal: s.geometric_normal,
+        front_face: s.front_face,
+        ior: m.ior,
+        base: m.base,
+        absorption,
+    };
+    let paths = pis_scene::lens_tree::lens_paths(
+        &interface(first, Vec3::ONE),
+        dir,
+        model,
+        max_depth,
+        |o, d| match lens.closest(o, d, f32::INFINITY) {
+            None => Step::Exit(()),
+            Some(hit) => {
+                let s = lens.surface(&hit, o, d);
+                let absorption = if !s.front_face && m.sigma_a != Vec3::ZERO {
+                    (-m.sigma_a * hit.t).exp()
+                } else {
+                    Vec3::ONE
+                };
+                Step::Interface(interface(&s, absorption))
+            }
+        },
+    );
+    paths.map(|p| {
+        p.map(|p| LensPath {
+            exit_origin: p.exit_origin,
+            exit_direction: p.exit_direction,
+            modulation: p.modulation,
+            topology: p.topology,
+        })
+    })
+}
+
+/// One term of the greedy two-path model (thesis 6.2) from `first`: the path that starts
+/// as `term` says and follows at every later interface the child with the larger Fresnel
+/// coefficient, with the Fresnel factors, the base colour on entering and the absorption
+/// inside multiplied along (F·G); `None` where the term does not exist (refraction-first under
+/// total internal reflection) or the path is still inside after `max_depth` more interfaces.
 pub fn greedy_path(
     lens: &LensObject,
     first: &LensSurface,
@@ -55,51 +94,11 @@ pub fn greedy_path(
     term: Term,
     max_depth: u32,
 ) -> Option<LensPath> {
-    let m = lens.material;
-    let eta = if first.front_face { 1.0 / m.ior } else { m.ior };
-    let f = fresnel_dielectric(-dir.dot(first.normal), eta);
-    let mut topology = Topology { interfaces: 1, reflected: 0 };
-    let (mut d, mut modulation) = match term {
-        Term::ReflectionFirst => {
-            topology.reflected = 1;
-            (reflect(dir, first.normal), Vec3::splat(f))
-        }
-        Term::RefractionFirst => (
-            refract(dir, first.normal, eta)?,
-            Vec3::splat(1.0 - f) * if first.front_face { m.base } else { Vec3::ONE },
-        ),
-    };
-    let (mut p, mut ng) = (first.position, first.geometric_normal);
-    for _ in 0..max_depth {
-        let o = offset_origin(p, ng, d);
-        let Some(hit) = lens.closest(o, d, f32::INFINITY) else {
-            return Some(LensPath { exit_origin: o, exit_direction: d, modulation, topology });
-        };
-        let s = lens.surface(&hit, o, d);
-        if !s.front_face && m.sigma_a != Vec3::ZERO {
-            modulation *= (-m.sigma_a * hit.t).exp();
-        }
-        let eta2 = if s.front_face { 1.0 / m.ior } else { m.ior };
-        let f2 = fresnel_dielectric(-d.dot(s.normal), eta2);
-        let refracted = if f2 < 0.5 { refract(d, s.normal, eta2) } else { None };
-        match refracted {
-            Some(t) => {
-                modulation *= (1.0 - f2) * if s.front_face { m.base } else { Vec3::ONE };
-                d = t;
-            }
-            None => {
-                modulation *= f2;
-                d = reflect(d, s.normal);
-                if topology.interfaces < 32 {
-                    topology.reflected |= 1 << topology.interfaces;
-                }
-            }
-        }
-        topology.interfaces = topology.interfaces.saturating_add(1);
-        p = s.position;
-        ng = s.geometric_normal;
+    let [r, t, ..] = lens_paths(lens, first, dir, LensModel::Greedy, max_depth);
+    match term {
+        Term::ReflectionFirst => r,
+        Term::RefractionFirst => t,
     }
-    None
 }
 
 /// Whether two paths of one term differ (thesis 6.4.1): one exists and the other not,
@@ -215,6 +214,11 @@ mod tests {
         assert_eq!(t.topology, Topology { interfaces: 3, reflected: 0b010 });
         assert!(t.exit_direction.dot(-Vec3::X) > 1.0 - 1e-5, "{:?}", t.exit_direction);
         assert!(t.exit_origin.x < 1e-3, "{:?}", t.exit_origin);
+        // A total internal reflection has no lesser branch: the tree keeps the same path as
+        // its refraction-first term, and the light the short faces reflect in its others.
+        let tree = lens_paths(&lens, &first, dir, LensModel::TREE, 8);
+        assert_eq!(tree[1], Some(t));
+        assert!(tree[2].is_some(), "a path reflected once at a short face");
     }
 
     #[test]

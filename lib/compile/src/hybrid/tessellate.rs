@@ -17,7 +17,7 @@ use glam::{Mat4, Vec3};
 use rayon::prelude::*;
 
 use super::lens::{LensObject, LensSurface};
-use super::path::{greedy_path, paths_differ, LensPath, TERMS};
+use super::path::{lens_paths, paths_differ, LensModel, LensPath};
 
 /// The camera of a frame.
 #[derive(Clone, Copy, Debug)]
@@ -121,12 +121,9 @@ pub fn trace_vertex(
     let n = if n == Vec3::ZERO { -dir } else { n };
     let facing = if front_face { n } else { -n };
     let first = LensSurface { position, normal: facing, geometric_normal: facing, front_face };
-    let mut rays = 1;
-    let paths = TERMS.map(|t| {
-        let p = greedy_path(lens, &first, dir, t, max_depth);
-        rays += p.map_or(0, |p| p.topology.interfaces as u64);
-        p
-    });
+    let [r, t, ..] = lens_paths(lens, &first, dir, LensModel::Greedy, max_depth);
+    let paths = [r, t];
+    let rays = 1 + paths.iter().flatten().map(|p| p.topology.interfaces as u64).sum::<u64>();
     (HybridVertex { position, normal: n, visible, front_face, paths }, rays)
 }
 

@@ -16,8 +16,8 @@ use std::time::Instant;
 use anyhow::{anyhow, Result};
 use glam::{DVec3, Vec2, Vec3};
 use pis_compile::hybrid::{
-    greedy_path, hybrid_pixels, shell_vector, tessellate_timed, vertex_vectors, HybridView,
-    LensObject, Missing, TessellationSettings, TERMS,
+    hybrid_pixels, lens_paths, shell_vector, tessellate_timed, vertex_vectors, HybridView,
+    LensModel, LensObject, Missing, TessellationSettings, TERMS,
 };
 use pis_compile::shell::geometry::{Shell, ShellShape};
 use pis_compile::Viewport;
@@ -125,7 +125,8 @@ fn trace_pixels(
                 return (None, 1);
             };
             let first = lens.surface(&hit, camera.origin, dir);
-            let paths = TERMS.map(|t| greedy_path(lens, &first, dir, t, max_depth));
+            let [r, t, ..] = lens_paths(lens, &first, dir, LensModel::Greedy, max_depth);
+            let paths = [r, t];
             let rays = 1 + paths
                 .iter()
                 .map(|p| p.map_or(0, |p| p.topology.interfaces as u64))

@@ -19,7 +19,7 @@ use super::noise::{self, judge, ReferenceNoise};
 use crate::metrics::SquaredError;
 use anyhow::anyhow;
 use pis_trace::denoise::DENOISED_KINDS;
-use pis_trace::layers::{LayerKind, PointImages};
+use pis_trace::layers::{LayerKind, PointImages, TermPart};
 use pis_trace::set::RaySet;
 use serde::Serialize;
 
@@ -61,6 +61,10 @@ pub struct ObjectRow {
     /// That composition against the first set's surface radiance, over the same pixels.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub model_psnr_db: Option<f64>,
+    /// Lens objects of a ray-tree set: the greedy model's two terms alone (the tree's first
+    /// two) against the same surface, so one set gives the ceiling of both models.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub greedy_psnr_db: Option<f64>,
 }
 
 /// One kind of radiance layer, every object that has it pooled.
@@ -79,18 +83,35 @@ pub struct LayerRow {
 pub enum LayeredModel {
     /// Reflective: diffuse + fresnel · (local + (1 − α_L) · distant).
     Environment,
-    /// Refractive: diffuse + reflection + refraction.
-    TwoPath,
+    /// Refractive: diffuse + the lens model's terms (2 greedy: reflection + refraction; the
+    /// tree's 3 or 4 add refraction_1 and refraction_2).
+    Lens { terms: usize },
 }
 
+/// The lens terms' value layers, in term order.
+const TERM_LAYERS: [LayerKind; 4] = [
+    LayerKind::Reflection,
+    LayerKind::Refraction,
+    LayerKind::Internal(1, TermPart::Value),
+    LayerKind::Internal(2, TermPart::Value),
+];
+
 impl LayeredModel {
+    /// The greedy model's two terms, where this is a tree of more.
+    pub fn greedy_part(self) -> Option<LayeredModel> {
+        match self {
+            LayeredModel::Lens { terms } if terms > 2 => Some(LayeredModel::Lens { terms: 2 }),
+            _ => None,
+        }
+    }
+
     /// The model an object's layers carry, if any.
     pub fn of(layers: &[String]) -> Option<LayeredModel> {
         let has = |k: LayerKind| layers.iter().any(|l| l == k.name());
         if has(LayerKind::Fresnel) && has(LayerKind::Local) && has(LayerKind::Distant) {
             Some(LayeredModel::Environment)
         } else if has(LayerKind::Reflection) && has(LayerKind::Refraction) {
-            Some(LayeredModel::TwoPath)
+            Some(LayeredModel::Lens { terms: TERM_LAYERS.iter().take_while(|&&k| has(k)).count() })
         } else {
             None
         }
@@ -99,7 +120,11 @@ impl LayeredModel {
     pub fn formula(self) -> &'static str {
         match self {
             LayeredModel::Environment => "diffuse + fresnel * (local + (1 - alpha) * distant)",
-            LayeredModel::TwoPath => "diffuse + reflection + refraction",
+            LayeredModel::Lens { terms: 2 } => "diffuse + reflection + refraction",
+            LayeredModel::Lens { terms: 3 } => "diffuse + reflection + refraction + refraction_1",
+            LayeredModel::Lens { .. } => {
+                "diffuse + reflection + refraction + refraction_1 + refraction_2"
+            }
         }
     }
 
@@ -118,10 +143,14 @@ impl LayeredModel {
                 let n = d.len().min(f.len()).min(l.len()).min(a.len()).min(t.len());
                 Some((0..n).map(|k| d[k] + f[k] * (l[k] + (1.0 - a[k]) * t[k])).collect())
             }
-            LayeredModel::TwoPath => {
-                let (r, t) = (get(LayerKind::Reflection, c)?, get(LayerKind::Refraction, c)?);
-                let n = d.len().min(r.len()).min(t.len());
-                Some((0..n).map(|k| d[k] + r[k] + t[k]).collect())
+            LayeredModel::Lens { terms } => {
+                let mut sum = d.to_vec();
+                for &kind in &TERM_LAYERS[..terms.min(TERM_LAYERS.len())] {
+                    let t = get(kind, c)?;
+                    sum.truncate(t.len());
+                    sum.iter_mut().zip(t).for_each(|(s, v)| *s += v);
+                }
+                Some(sum)
             }
         }
     }
@@ -191,16 +220,16 @@ fn open(p: &Path) -> Result<RaySet, Failure> {
 }
 
 /// Adds one object's errors at a point to `acc` (A's surface radiance against B's, over
-/// the pixels both cover), `macc` (A's against B's composed by B's layered model) and
-/// `kinds` (each radiance layer, [`add_layers`]): the object's channels in A and B are
-/// `cha` and `chb`.
+/// the pixels both cover), `macc` (A's against B's composed by B's layered model and, for a
+/// tree, by its greedy part) and `kinds` (each radiance layer, [`add_layers`]): the object's
+/// channels in A and B are `cha` and `chb`.
 fn add_object(
     ia: &PointImages,
     ib: &PointImages,
     (cha, chb): (&str, &str),
     model: Option<LayeredModel>,
     npx: usize,
-    (acc, macc): (&mut SquaredError, &mut SquaredError),
+    (acc, macc): (&mut SquaredError, &mut [SquaredError; 2]),
     kinds: &mut [SquaredError],
 ) {
     let cov = |im: &PointImages, ch: &str| {
@@ -221,12 +250,15 @@ fn add_object(
     add_layers(ia, ib, (cha, chb), &both, kinds);
     for c in ["R", "G", "B"] {
         let (x, y) = (surface(ia, cha, c), surface(ib, chb, c));
-        let composed = model.and_then(|m| m.compose(ib, chb, c));
+        let composed = [model, model.and_then(LayeredModel::greedy_part)]
+            .map(|m| m.and_then(|m| m.compose(ib, chb, c)));
         for k in 0..npx.min(cova.len()).min(covb.len()) {
             if cova[k] > 0.0 && covb[k] > 0.0 {
                 acc.add(y[k], x[k]);
-                if let Some(m) = composed.as_ref().and_then(|m| m.get(k)) {
-                    macc.add(*m, x[k]);
+                for (composed, macc) in composed.iter().zip(macc.iter_mut()) {
+                    if let Some(m) = composed.as_ref().and_then(|m| m.get(k)) {
+                        macc.add(*m, x[k]);
+                    }
                 }
             }
         }
@@ -292,7 +324,7 @@ pub fn compare_sets(req: &SetsRequest) -> Result<SetsReport, Failure> {
         .collect();
     let mut total = SquaredError::default();
     let mut per_object = vec![SquaredError::default(); objects.len()];
-    let mut per_model = vec![SquaredError::default(); objects.len()];
+    let mut per_model = vec![<[SquaredError; 2]>::default(); objects.len()];
     let mut per_kind = vec![SquaredError::default(); DENOISED_KINDS.len()];
     let mut per_point = Vec::new();
     for pa in &sa.meta.points {
@@ -373,7 +405,7 @@ pub fn compare_sets(req: &SetsRequest) -> Result<SetsReport, Failure> {
         objects: objects
             .iter()
             .zip(per_object.iter().zip(&per_model))
-            .map(|((n, _, _, model), (e, m))| {
+            .map(|((n, _, _, model), (e, [m, g]))| {
                 let model = model.filter(|_| m.count > 0);
                 ObjectRow {
                     name: n.clone(),
@@ -381,6 +413,7 @@ pub fn compare_sets(req: &SetsRequest) -> Result<SetsReport, Failure> {
                     pixels: e.count / 3,
                     model: model.map(LayeredModel::formula),
                     model_psnr_db: model.and_then(|_| finite(m.psnr())),
+                    greedy_psnr_db: (g.count > 0).then(|| finite(g.psnr())).flatten(),
                 }
             })
             .collect(),
@@ -462,6 +495,14 @@ pub fn render(r: &SetsReport) -> String {
                 db(o.model_psnr_db)
             );
         }
+        if o.greedy_psnr_db.is_some() {
+            let _ = writeln!(
+                s,
+                "    {:<14} {}  its greedy model's terms alone (the tree's first two), diffuse + reflection + refraction",
+                "",
+                db(o.greedy_psnr_db)
+            );
+        }
     }
     if !r.layers_by_kind.is_empty() {
         let _ = writeln!(s, "  radiance layers, every object pooled, over the pixels both cover:");
@@ -497,14 +538,18 @@ mod tests {
     fn the_model_of_an_object_is_read_from_its_layers() {
         let names = |ks: &[LayerKind]| ks.iter().map(|k| k.name().to_string()).collect::<Vec<_>>();
         assert_eq!(
-            LayeredModel::of(&names(LayerKind::for_role(ObjectRole::Reflective))),
+            LayeredModel::of(&names(LayerKind::for_role(ObjectRole::Reflective, 2))),
             Some(LayeredModel::Environment)
         );
         assert_eq!(
-            LayeredModel::of(&names(LayerKind::for_role(ObjectRole::Refractive))),
-            Some(LayeredModel::TwoPath)
+            LayeredModel::of(&names(LayerKind::for_role(ObjectRole::Refractive, 2))),
+            Some(LayeredModel::Lens { terms: 2 })
         );
-        assert_eq!(LayeredModel::of(&names(LayerKind::for_role(ObjectRole::Diffuse))), None);
+        assert_eq!(
+            LayeredModel::of(&names(LayerKind::for_role(ObjectRole::Refractive, 4))),
+            Some(LayeredModel::Lens { terms: 4 })
+        );
+        assert_eq!(LayeredModel::of(&names(LayerKind::for_role(ObjectRole::Diffuse, 2))), None);
     }
 
     #[test]
@@ -522,15 +567,20 @@ mod tests {
                 layer("g", LayerKind::Diffuse, &rgb, &[0.1, 0.2]),
                 layer("g", LayerKind::Reflection, &rgb, &[0.3, 0.0]),
                 layer("g", LayerKind::Refraction, &rgb, &[0.5, 0.25]),
+                layer("g", LayerKind::Internal(1, TermPart::Value), &rgb, &[0.0, 0.5]),
             ],
         };
         // 0.1 + 0.5 · (0.25 + 0.75 · 0.4); the fully covering local layer hides the distant one.
         let m = LayeredModel::Environment.compose(&im, "m", "G").expect("all layers");
         assert!((m[0] - 0.375).abs() < 1e-6 && (m[1] - 1.0).abs() < 1e-6, "{m:?}");
-        assert_eq!(
-            LayeredModel::TwoPath.compose(&im, "g", "B").expect("all layers"),
-            vec![0.9, 0.45]
+        let two = LayeredModel::Lens { terms: 2 };
+        assert_eq!(two.compose(&im, "g", "B").expect("all layers"), vec![0.9, 0.45]);
+        let three = LayeredModel::Lens { terms: 3 };
+        assert_eq!(three.compose(&im, "g", "B").expect("all layers"), vec![0.9, 0.95]);
+        assert!(
+            LayeredModel::Lens { terms: 4 }.compose(&im, "g", "B").is_none(),
+            "no refraction_2"
         );
-        assert!(LayeredModel::TwoPath.compose(&im, "m", "R").is_none(), "no reflection layer");
+        assert!(two.compose(&im, "m", "R").is_none(), "no reflection layer");
     }
 }

@@ -1,6 +1,6 @@
 //! A camera ray's first hit, segmented into the layers of its object (thesis 3.1, 5.7,
 //! 6.2): diffuse and specular, a reflective object's local and distant reflections, and a
-//! lens object's two greedy terms with the hits along their continued exit rays.
+//! lens object's terms with the hits along their continued exit rays.
 
 use super::guide::Guide;
 use super::{Integrator, PathContext};
@@ -9,21 +9,12 @@ use crate::lights::hit_light_sphere;
 use crate::material::ShadingMaterial;
 use crate::sampling::{luminance, Rng};
 use glam::Vec3;
-use pis_scene::optics::{fresnel_dielectric, reflect, refract};
+use pis_scene::lens_tree::{lens_paths, LensInterface, Step, MAX_TERMS};
 use pis_scene::ObjectRole;
 
 /// Seed stream of the specular lobes at a camera ray's first hit (the depth slot of
 /// [`Rng::at_surface`]; paths use their depth, the first-hit irradiance depth 0).
 const FIRST_HIT_SPECULAR_STREAM: u32 = 0x8000_0000;
-
-/// The two terms of the greedy two-path model (thesis 6.2).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum GreedyTerm {
-    /// The path that starts with a reflection.
-    ReflectionFirst = 0,
-    /// The path that starts with a refraction.
-    RefractionFirst = 1,
-}
 
 /// A front-facing hit along a continued outgoing ray.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -36,7 +27,7 @@ pub struct ContinuedHit {
     pub colour: Vec3,
 }
 
-/// One term of the greedy two-path model for one camera sample.
+/// One term of the lens model for one camera sample.
 #[derive(Clone, Debug, Default)]
 pub struct TermSample {
     /// Product of the Fresnel coefficients and transparency attenuation along the path (F·G).
@@ -76,8 +67,9 @@ pub struct CameraSample {
     /// Everything else (emission, specular reflection, transmission).
     pub specular: Vec3,
     pub reflective: Option<ReflectiveSample>,
-    /// The greedy terms, reflection-first then refraction-first, for refractive objects.
-    pub lens: Option<[TermSample; 2]>,
+    /// The lens model's terms for refractive objects: reflection-first, refraction-first and
+    /// (the tree) refraction-first with one and two internal reflections.
+    pub lens: Option<[TermSample; MAX_TERMS]>,
     /// The denoiser's guides (renders that denoise only; else zero).
     pub guide: Guide,
 }
@@ -134,10 +126,8 @@ impl Integrator<'_> {
                 }
             }
             ObjectRole::Refractive => {
-                let terms = [GreedyTerm::ReflectionFirst, GreedyTerm::RefractionFirst].map(|t| {
-                    self.greedy_term(&sp, &m, dir, hit.object, t, record, diffuse_left, ctx)
-                });
-                out.lens = Some(terms);
+                out.lens =
+                    Some(self.lens_terms(&sp, &m, dir, hit.object, record, diffuse_left, ctx));
                 specular +=
                     self.scatter_nondiffuse(&sp, &m, dir, 0, diffuse_left, &mut rng, ctx, None);
             }
@@ -189,84 +179,81 @@ impl Integrator<'_> {
         (s, incident * f * opaque)
     }
 
-    /// Follows one term of the greedy two-path model from the first hit on lens object
-    /// `object` until the path leaves the object (thesis 6.2, 6.3.1).
+    /// The terms of the lens model from the first hit on lens object `object`, each path
+    /// followed until it leaves the object (thesis 6.2, 6.3.1, 7.3; [`lens_paths`]), with the
+    /// radiance along its exit ray.
     #[allow(
         clippy::too_many_arguments,
-        reason = "the first hit's surface, material and object, the term and the path's state, each apart"
+        reason = "the first hit's surface, material and object, the ray and the path's state, each apart"
     )]
-    fn greedy_term(
+    fn lens_terms(
         &self,
         sp: &SurfacePoint,
         m: &ShadingMaterial,
         dir: Vec3,
         object: u32,
-        term: GreedyTerm,
         record: bool,
         diffuse_left: u32,
         ctx: &mut PathContext,
-    ) -> TermSample {
-        let mut out = TermSample::default();
-        let eta = if sp.front_face { 1.0 / m.ior } else { m.ior };
-        let f = fresnel_dielectric(-dir.dot(sp.normal), eta);
-        let (mut d, mut modulation) = match term {
-            GreedyTerm::ReflectionFirst => (reflect(dir, sp.normal), Vec3::splat(f)),
-            GreedyTerm::RefractionFirst => match refract(dir, sp.normal, eta) {
-                Some(t) => {
-                    (t, Vec3::splat(1.0 - f) * if sp.front_face { m.base } else { Vec3::ONE })
-                }
-                None => return out,
-            },
+    ) -> [TermSample; MAX_TERMS] {
+        let first = LensInterface {
+            position: sp.position,
+            normal: sp.normal,
+            geometric_normal: sp.geometric_normal,
+            front_face: sp.front_face,
+            ior: m.ior,
+            base: m.base,
+            absorption: Vec3::ONE,
         };
-        let (mut p, mut ng) = (sp.position, sp.geometric_normal);
-        for _ in 0..self.settings.max_depth {
-            let o = offset_origin(p, ng, d);
-            let hit = self.trace(o, d, None, ctx);
-            let light_first =
-                hit_light_sphere(&self.frame.lights, o, d, hit.map_or(f32::INFINITY, |h| h.t))
-                    .is_some();
-            match hit {
-                Some(h) if h.object == object && !light_first => {
-                    let mut s2 = self.geometry.surface(&h, o, d);
-                    let m2 = self.material(&mut s2);
-                    modulation *= self.absorption(&s2, &m2, h.t);
-                    let eta2 = if s2.front_face { 1.0 / m2.ior } else { m2.ior };
-                    let f2 = fresnel_dielectric(-d.dot(s2.normal), eta2);
-                    let refracted = if f2 < 0.5 { refract(d, s2.normal, eta2) } else { None };
-                    match refracted {
-                        Some(t) => {
-                            modulation *=
-                                (1.0 - f2) * if s2.front_face { m2.base } else { Vec3::ONE };
-                            d = t;
-                        }
-                        None => {
-                            modulation *= f2;
-                            d = reflect(d, s2.normal);
-                        }
+        let paths =
+            lens_paths(&first, dir, self.settings.lens_model, self.settings.max_depth, |o, d| {
+                let hit = self.trace(o, d, None, ctx);
+                let light_first =
+                    hit_light_sphere(&self.frame.lights, o, d, hit.map_or(f32::INFINITY, |h| h.t))
+                        .is_some();
+                match hit {
+                    Some(h) if h.object == object && !light_first => {
+                        let mut s2 = self.geometry.surface(&h, o, d);
+                        let m2 = self.material(&mut s2);
+                        Step::Interface(LensInterface {
+                            position: s2.position,
+                            normal: s2.normal,
+                            geometric_normal: s2.geometric_normal,
+                            front_face: s2.front_face,
+                            ior: m2.ior,
+                            base: m2.base,
+                            absorption: self.absorption(&s2, &m2, h.t),
+                        })
                     }
-                    p = s2.position;
-                    ng = s2.geometric_normal;
+                    _ => Step::Exit(hit),
                 }
-                _ => {
-                    out.radiance = self.radiance_from(hit, o, d, 1, diffuse_left, true, ctx);
-                    out.modulation = modulation;
-                    out.exit = Some((o, d));
-                    if record {
-                        out.hits = self.continued_hits(o, d, object, diffuse_left, ctx);
-                    }
-                    return out;
-                }
+            });
+        paths.map(|path| {
+            let Some(p) = path else { return TermSample::default() };
+            let (o, d) = (p.exit_origin, p.exit_direction);
+            // The exit ray at the depth a path tracer reaches it (one per interface), so
+            // that the term sees what the traced image sees of long paths.
+            let depth = p.topology.interfaces as u32;
+            TermSample {
+                modulation: p.modulation,
+                radiance: self.radiance_from(p.exit, o, d, depth, diffuse_left, true, ctx),
+                exit: Some((o, d)),
+                hits: if record {
+                    self.continued_hits((o, d), depth, object, diffuse_left, ctx)
+                } else {
+                    Vec::new()
+                },
             }
-        }
-        out
+        })
     }
 
     /// Every front-facing hit on environment geometry (not `object`) along a continued ray,
-    /// nearest first, with the radiance leaving each towards the ray origin (thesis 6.3.1).
+    /// nearest first, with the radiance leaving each towards the ray origin (thesis 6.3.1),
+    /// shaded at the exit ray's `depth` (as the term's radiance).
     fn continued_hits(
         &self,
-        o: Vec3,
-        d: Vec3,
+        (o, d): (Vec3, Vec3),
+        depth: u32,
         object: u32,
         diffuse_left: u32,
         ctx: &mut PathContext,
@@ -285,8 +272,8 @@ impl Integrator<'_> {
                 continue;
             }
             let m = self.material(&mut sp);
-            let mut rng = self.rng_at(&sp, 1, ctx);
-            let colour = m.emission + self.scatter(&sp, &m, d, 1, diffuse_left, &mut rng, ctx);
+            let mut rng = self.rng_at(&sp, depth, ctx);
+            let colour = m.emission + self.scatter(&sp, &m, d, depth, diffuse_left, &mut rng, ctx);
             hits.push(ContinuedHit { t: h.t, position: sp.position, object: h.object, colour });
         }
         hits

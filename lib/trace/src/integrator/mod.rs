@@ -29,7 +29,7 @@ mod guide;
 mod pdf;
 mod scatter;
 
-pub use first_hit::{CameraSample, ContinuedHit, GreedyTerm, ReflectiveSample, TermSample};
+pub use first_hit::{CameraSample, ContinuedHit, ReflectiveSample, TermSample};
 pub use guide::Guide;
 pub use pdf::{diffuse_pdf, ggx_reflection_pdf};
 pub use scatter::{NEE_ALPHA, ROULETTE_WEIGHT};

@@ -12,6 +12,10 @@ use pis_scene::optics::{fresnel_dielectric, reflect, refract};
 /// GGX alpha from which the opaque specular lobe samples lights explicitly.
 pub const NEE_ALPHA: f32 = 0.1;
 
+/// Interfaces of a smooth dielectric (counted from the camera ray's first hit) at which both
+/// children are traced rather than one chosen by Fresnel.
+pub const SPLIT_DEPTH: u32 = 3;
+
 /// Lobe weight (luminance) below which first-hit specular lobes are sampled by Russian roulette.
 pub const ROULETTE_WEIGHT: f32 = 0.25;
 
@@ -184,14 +188,17 @@ impl Integrator<'_> {
     ) -> Vec3 {
         let (eta, n) = (if sp.front_face { 1.0 / m.ior } else { m.ior }, sp.normal);
         let f = fresnel_dielectric(-dir.dot(n), eta);
-        if depth == 0 && f < 1.0 {
-            // At a camera ray's first hit both children are traced (weights F and 1 − F),
-            // deeper interfaces choose one by Fresnel.
+        if depth < SPLIT_DEPTH && f < 1.0 {
+            // Near the camera both children are traced (weights F and 1 − F), deeper
+            // interfaces choose one by Fresnel: a lesser branch chosen with probability F
+            // that meets a light carries L/F into one sample, and at 256 samples a glass
+            // teapot's glints of the lamp (through its internal reflections) stayed 24 dB
+            // from converged.
             let r = reflect(dir, n);
             let reflected = self.radiance(
                 offset_origin(sp.position, sp.geometric_normal, r),
                 r,
-                1,
+                depth + 1,
                 diffuse_left,
                 true,
                 None,
@@ -200,7 +207,7 @@ impl Integrator<'_> {
             let refracted = match refract(dir, n, eta) {
                 Some(t) => {
                     let o = offset_origin(sp.position, sp.geometric_normal, t);
-                    self.radiance(o, t, 1, diffuse_left, true, None, ctx)
+                    self.radiance(o, t, depth + 1, diffuse_left, true, None, ctx)
                         * if sp.front_face { m.base } else { Vec3::ONE }
                 }
                 None => reflected / f.max(1e-6) * (1.0 - f),

@@ -64,7 +64,10 @@ impl SetWriter {
                 name: o.name.clone(),
                 channel_name,
                 role: role_name(o.role).into(),
-                layers: LayerKind::for_role(o.role).iter().map(|l| l.name().to_string()).collect(),
+                layers: LayerKind::for_role(o.role, settings.lens_model.terms())
+                    .iter()
+                    .map(|l| l.name().to_string())
+                    .collect(),
                 records: o.role == ObjectRole::Refractive,
                 reflector: o.reflector.clone(),
             })
