@@ -161,13 +161,7 @@ fn the_ray_tree_carries_the_glass_teapots_light() {
             .expect("pis-trace runs");
         assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
         let v = json(&diff(&set, &set, &["--json"]));
-        let teapot = v["objects"]
-            .as_array()
-            .expect("objects")
-            .iter()
-            .find(|o| o["name"] == "GlassTeapot")
-            .expect("the glass teapot")
-            .clone();
+        let teapot = common::report_object(&v, "GlassTeapot").clone();
         let db = |key: &str| teapot[key].as_f64();
         (
             teapot["model"].clone(),

@@ -1,6 +1,9 @@
-//! Hybrid rendering's per-frame tracer (pis-compile `hybrid`) against pis-trace: the greedy
-//! two-path model is one model, so the runtime's paths through the lens object alone must
-//! leave it where the tracer's outgoing-ray records say, for the same camera rays.
+//! Hybrid rendering's per-frame tracer (pis-compile `hybrid`) against pis-trace: each lens
+//! model (the greedy two paths, the ray tree) is one walk, so the runtime's paths through the
+//! lens object alone must leave it where the tracer's outgoing-ray records say, for the same
+//! camera rays.
+
+mod common;
 
 use std::path::Path;
 
@@ -528,13 +531,7 @@ fn a_glass_teapot_packed_and_played_by_hybrid_rendering() {
                 "--json".as_ref(),
             ],
         );
-        let o = r["objects"]
-            .as_array()
-            .expect("objects")
-            .iter()
-            .find(|o| o["name"] == "GlassTeapot")
-            .expect("the glass teapot")
-            .clone();
+        let o = common::report_object(&r, "GlassTeapot").clone();
         (out, o)
     };
     let (tex, t) = pack("texture.pis", "texture");

@@ -118,6 +118,16 @@ pub fn pis_diff(a: &Path, b: &Path, args: &[&str]) -> Output {
         .expect("pis-diff runs")
 }
 
+/// The entry named `name` of a JSON report's `objects` array.
+pub fn report_object<'a>(report: &'a serde_json::Value, name: &str) -> &'a serde_json::Value {
+    report["objects"]
+        .as_array()
+        .expect("objects")
+        .iter()
+        .find(|o| o["name"] == name)
+        .unwrap_or_else(|| panic!("no object {name} in the report"))
+}
+
 /// A tool's `--json` report on standard output.
 pub fn json_report(out: &Output) -> serde_json::Value {
     serde_json::from_slice(&out.stdout).unwrap_or_else(|e| {

@@ -32,7 +32,8 @@ pub enum LensModel {
     /// Thesis 6.2: two paths, each following the larger Fresnel branch.
     Greedy,
     /// The ray tree: both branches while the weight stays at or above `min_weight`; terms
-    /// reflection-first and refraction-first with 0 … `internal_terms` − 1 internal reflections.
+    /// reflection-first and refraction-first having taken the lesser branch 0 …
+    /// `internal_terms` − 1 times.
     Tree { min_weight: f32, internal_terms: u8 },
 }
 
@@ -51,16 +52,9 @@ impl LensModel {
         }
     }
 
+    /// Whether this is the greedy model (which set.json leaves unrecorded).
     pub fn is_greedy(&self) -> bool {
         *self == LensModel::Greedy
-    }
-
-    /// `greedy` or `tree`.
-    pub fn name(self) -> &'static str {
-        match self {
-            LensModel::Greedy => "greedy",
-            LensModel::Tree { .. } => "tree",
-        }
     }
 }
 
@@ -181,8 +175,6 @@ pub fn lens_paths<H>(
         LensModel::Greedy => 0.0,
         LensModel::Tree { min_weight, .. } => min_weight,
     };
-    let eta = if first.front_face { 1.0 / first.ior } else { first.ior };
-    let f = fresnel_dielectric(-dir.dot(first.normal), eta);
     let root = Branch {
         position: first.position,
         geometric_normal: first.geometric_normal,
@@ -192,21 +184,17 @@ pub fn lens_paths<H>(
         lesser: 0,
         depth: 0,
     };
-    let tint = if first.front_face { first.base } else { Vec3::ONE };
     let mut stack = Stack::default();
-    // The first interface: both children, whatever the model (thesis 6.2's two terms).
-    if let Some(t) = refract(dir, first.normal, eta) {
-        stack.push(root.child((t, Vec3::splat(1.0 - f) * tint, false, false)));
+    // The first interface: both children, neither the lesser, whatever the model (thesis
+    // 6.2's two terms).
+    for (d, factor, reflected, _) in children(first, dir).into_iter().flatten() {
+        stack.push(root.child((d, factor, reflected, false)));
     }
-    stack.push(root.child((reflect(dir, first.normal), Vec3::splat(f), true, false)));
     let terms_kept = model.terms();
     let max_depth = max_depth.min(MAX_DEPTH);
     while let Some(b) = stack.pop() {
         let term = b.term();
-        if term >= terms_kept || b.modulation.max_element() < min_weight {
-            continue;
-        }
-        if b.depth > max_depth {
+        if term >= terms_kept || b.modulation.max_element() < min_weight || b.depth > max_depth {
             continue;
         }
         let o = offset_origin(b.position, b.geometric_normal, b.direction);

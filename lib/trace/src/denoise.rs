@@ -34,6 +34,7 @@ use crate::layers::{object_layer_name, LayerImage, LayerKind, PointImages, TermP
 use crate::oidn::{DenoiseImage, Oidn};
 use crate::settings::TraceSettings;
 use pis_codec::display::display;
+use pis_scene::lens_tree::MAX_TERMS;
 use pis_scene::ObjectRole;
 use serde::{Deserialize, Serialize};
 
@@ -329,7 +330,8 @@ pub fn denoise_point(
         let Some(window) = covered_window(coverage, w, h) else { continue };
         let mask: Vec<bool> = window.pixels(w).map(|i| coverage[i] > 0.0).collect();
         let guides = WindowGuides::new(&input.guides, window);
-        for kind in DENOISED_KINDS.into_iter().filter(|k| LayerKind::for_role(*role, 4).contains(k))
+        for kind in
+            DENOISED_KINDS.into_iter().filter(|k| LayerKind::for_role(*role, MAX_TERMS).contains(k))
         {
             let layer_name = object_layer_name(name, kind);
             let Some(layer) = images.layer(&layer_name) else { continue };

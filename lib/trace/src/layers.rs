@@ -43,6 +43,14 @@ pub enum LayerKind {
     Internal(u8, TermPart),
 }
 
+/// The lens terms' value layers, in term order (RAYSET.md 5.3).
+pub const TERM_VALUES: [LayerKind; MAX_TERMS] = [
+    LayerKind::Reflection,
+    LayerKind::Refraction,
+    LayerKind::Internal(1, TermPart::Value),
+    LayerKind::Internal(2, TermPart::Value),
+];
+
 /// Which image of a lens term a layer holds.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum TermPart {

@@ -22,17 +22,8 @@ pub enum Term {
 
 pub const TERMS: [Term; 2] = [Term::ReflectionFirst, Term::RefractionFirst];
 
-/// Where a path leaves the lens object.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct LensPath {
-    /// The outgoing ray: its origin (offset off the last interface, as pis-trace's) and unit
-    /// direction.
-    pub exit_origin: Vec3,
-    pub exit_direction: Vec3,
-    /// F·G: the Fresnel coefficients, base colour and absorption along the path.
-    pub modulation: Vec3,
-    pub topology: Topology,
-}
+/// Where a path leaves the lens object (the runtime model keeps nothing of the exit itself).
+pub type LensPath = pis_scene::lens_tree::LensPath<()>;
 
 /// The terms of `model` from `first`, the lens object's surface where a ray of direction
 /// `dir` (unit) meets it: the walk pis-trace's lens terms take ([`pis_scene::lens_tree`]),
@@ -54,12 +45,8 @@ pub fn lens_paths(
         base: m.base,
         absorption,
     };
-    let paths = pis_scene::lens_tree::lens_paths(
-        &interface(first, Vec3::ONE),
-        dir,
-        model,
-        max_depth,
-        |o, d| match lens.closest(o, d, f32::INFINITY) {
+    pis_scene::lens_tree::lens_paths(&interface(first, Vec3::ONE), dir, model, max_depth, |o, d| {
+        match lens.closest(o, d, f32::INFINITY) {
             None => Step::Exit(()),
             Some(hit) => {
                 let s = lens.surface(&hit, o, d);
@@ -70,15 +57,7 @@ pub fn lens_paths(
                 };
                 Step::Interface(interface(&s, absorption))
             }
-        },
-    );
-    paths.map(|p| {
-        p.map(|p| LensPath {
-            exit_origin: p.exit_origin,
-            exit_direction: p.exit_direction,
-            modulation: p.modulation,
-            topology: p.topology,
-        })
+        }
     })
 }
 
@@ -228,6 +207,7 @@ mod tests {
             exit_direction: Vec3::Z,
             modulation: Vec3::ONE,
             topology: Topology { interfaces: 2, reflected: 0 },
+            exit: (),
         };
         let mut b = a;
         let cos3 = 3f32.to_radians().cos();

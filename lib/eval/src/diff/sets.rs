@@ -19,7 +19,7 @@ use super::noise::{self, judge, ReferenceNoise};
 use crate::metrics::SquaredError;
 use anyhow::anyhow;
 use pis_trace::denoise::DENOISED_KINDS;
-use pis_trace::layers::{LayerKind, PointImages, TermPart};
+use pis_trace::layers::{LayerKind, PointImages, TERM_VALUES};
 use pis_trace::set::RaySet;
 use serde::Serialize;
 
@@ -88,14 +88,6 @@ pub enum LayeredModel {
     Lens { terms: usize },
 }
 
-/// The lens terms' value layers, in term order.
-const TERM_LAYERS: [LayerKind; 4] = [
-    LayerKind::Reflection,
-    LayerKind::Refraction,
-    LayerKind::Internal(1, TermPart::Value),
-    LayerKind::Internal(2, TermPart::Value),
-];
-
 impl LayeredModel {
     /// The greedy model's two terms, where this is a tree of more.
     pub fn greedy_part(self) -> Option<LayeredModel> {
@@ -111,7 +103,7 @@ impl LayeredModel {
         if has(LayerKind::Fresnel) && has(LayerKind::Local) && has(LayerKind::Distant) {
             Some(LayeredModel::Environment)
         } else if has(LayerKind::Reflection) && has(LayerKind::Refraction) {
-            Some(LayeredModel::Lens { terms: TERM_LAYERS.iter().take_while(|&&k| has(k)).count() })
+            Some(LayeredModel::Lens { terms: TERM_VALUES.iter().take_while(|&&k| has(k)).count() })
         } else {
             None
         }
@@ -145,7 +137,7 @@ impl LayeredModel {
             }
             LayeredModel::Lens { terms } => {
                 let mut sum = d.to_vec();
-                for &kind in &TERM_LAYERS[..terms.min(TERM_LAYERS.len())] {
+                for &kind in &TERM_VALUES[..terms.min(TERM_VALUES.len())] {
                     let t = get(kind, c)?;
                     sum.truncate(t.len());
                     sum.iter_mut().zip(t).for_each(|(s, v)| *s += v);
@@ -524,7 +516,7 @@ pub fn render(r: &SetsReport) -> String {
 mod tests {
     use super::*;
     use pis_scene::ObjectRole;
-    use pis_trace::layers::LayerImage;
+    use pis_trace::layers::{LayerImage, TermPart};
 
     fn layer(object: &str, kind: LayerKind, channels: &[&str], values: &[f32]) -> LayerImage {
         let mut l = LayerImage::new(format!("object.{object}.{}", kind.name()), channels, 2, 1);
