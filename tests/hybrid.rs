@@ -214,19 +214,23 @@ fn interpolated_shell_vectors_follow_the_paths_traced_at_each_pixel() {
             eprintln!("τ = {tau}, {term:?}: {} pixels, {} traced; angle to the traced vector: median {:.3}°, 90 % {:.3}°, 99 % {:.2}°", px.pixels.len(), errors.len(), q(0.5), q(0.9), q(0.99));
             assert!(errors.len() > 5000, "{} pixels compared", errors.len());
             p90.push(q(0.9));
-            // Every row is a full cube lookup.
-            let a = hybrid_render_matrix(
-                viewport,
-                &tess,
-                clip_from_world,
-                &vectors,
-                TextureLayout::cube(32),
-                None,
-            );
-            assert_eq!(a.rows(), px.pixels.len());
-            for r in 0..a.rows() {
-                let s: f32 = a.row(r).1.iter().sum();
-                assert!((s - 1.0).abs() < 1e-4, "row {r} sums to {s}");
+            // Every row is a full cube lookup, or the mean of 3 × 3 over the footprint.
+            for lookups in [1, 3] {
+                let layout = TextureLayout::cube(32);
+                let a = hybrid_render_matrix(
+                    viewport,
+                    &tess,
+                    clip_from_world,
+                    &vectors,
+                    layout,
+                    lookups,
+                    None,
+                );
+                assert_eq!(a.rows(), px.pixels.len());
+                for r in 0..a.rows() {
+                    let s: f32 = a.row(r).1.iter().sum();
+                    assert!((s - 1.0).abs() < 1e-4, "{lookups}² lookups: row {r} sums to {s}");
+                }
             }
         }
     }

@@ -119,10 +119,11 @@ pub struct PackOptions {
     /// would only split each object's samples in two); `always`, every dimension.
     #[arg(long, value_name = "auto|always", default_value = "auto", value_parser = one_of(&Stagger::ALL, Stagger::name))]
     pub stagger: Stagger,
-    /// Layered environment maps and one shell at infinity: lookups per pixel side, 1 to 3.
-    /// Each pixel averages k × k lookups of a shell at sub-pixel offsets (SPEC.md 8.2), as a
-    /// traced pixel averages its samples where the reflected direction turns fast across it;
-    /// the shells are solved through the same lookups and the player draws them so.
+    /// Layered environment maps, one shell at infinity and lens objects' shells: lookups per
+    /// pixel side, 1 to 3. Each pixel averages k × k lookups of a shell at sub-pixel offsets
+    /// (SPEC.md 8.2), as a traced pixel averages its samples where the reflected or refracted
+    /// direction turns fast across it; the shells are solved through the same lookups and
+    /// the player draws them so.
     #[arg(long, value_name = "1|2|3", default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=pis_format::MAX_SHELL_LOOKUPS as i64))]
     pub shell_lookups: u32,
     /// Also store the lossless master: every solved texture, before gamma compensation and

@@ -190,12 +190,15 @@ pub(crate) fn check_parsed<S>(p: &Parsed<S>) -> Vec<Issue> {
             if let Err(detail) = crate::tint::tints(prov, &named) {
                 out.push(chunk(Issue::new(id::provenance::TINT, detail), "PROV"));
             }
+            if let Err(detail) = crate::lens_model::lens_models(prov, &named) {
+                out.push(chunk(Issue::new(id::provenance::LENS_MODEL, detail), "PROV"));
+            }
         }
     }
     out
 }
 
-/// Rules 9001–9003 on the provenance settings (9004, which needs the objects, above).
+/// Rules 9001–9003 on the provenance settings (9004 and 9005, which need the objects, above).
 fn provenance(p: Option<&Provenance>, out: &mut Vec<Issue>) {
     if let Some(p) = p {
         let mut seen = HashSet::new();

@@ -205,6 +205,7 @@ rules! {
         DISPLAY_FILTER = 9002, "display filter setting is unknown, or its sigma or radius is missing or not a number of pixels in (0, 64]";
         KEY_REPEATED = 9003, "setting key appears more than once";
         TINT = 9004, "transmission tint setting names no refractive object, or is not three numbers in [0, 1]";
+        LENS_MODEL = 9005, "lens model setting names no refractive object, or is neither greedy nor tree,W,N";
     }
     /// 91xx: the lossless master (`MSTR`, section 6.7), checked when a reader reads it.
     pub mod master {

@@ -18,6 +18,7 @@ mod error;
 pub mod filter;
 pub mod hexdump;
 pub mod issue;
+pub mod lens_model;
 pub mod master;
 pub mod mip;
 pub mod model;

@@ -511,6 +511,13 @@ fn codestream_provenance_cases() -> Vec<(u16, Vec<u8>)> {
             p.settings.push(("transmission_tint.nobody".into(), "1,1,1".into()));
         }),
     ));
+    v.push((
+        9005,
+        unchecked(|c| {
+            let p = c.provenance.as_mut().unwrap();
+            p.settings.push(("lens_model.nobody".into(), "greedy".into()));
+        }),
+    ));
     v
 }
 

@@ -434,7 +434,10 @@ fn view_frame_is_the_offscreen_frame(
             let p = y * w + x;
             let alpha = img.rgba[p * 4 + 3];
             drawn += (alpha > 0.0) as usize;
-            let levels = if samples > 1 { 2.0 } else { 1.0 };
+            // One level of quantization, and the driver's encoding to sRGB: llvmpipe's
+            // (Mesa 22.3.6 on a Xeon) put one channel in 1908 at 1.014 levels from the exact
+            // value.
+            let levels = if samples > 1 { 2.0 } else { 1.1 };
             for c in 0..3 {
                 let want = srgb(img.rgba[p * 4 + c]) * 255.0;
                 let got = bytes[y * row as usize + x * 4 + c] as f32;

@@ -38,8 +38,8 @@ pub enum LayerKind {
     RefractionModulation,
     /// Refractive: confidence of the refraction-first exit rays (Y).
     RefractionConfidence,
-    /// Refractive, tree model: the refraction-first term with k = 1 or 2 internal
-    /// reflections, its modulation and its confidence (as `Refraction…`).
+    /// Refractive, tree model: the refraction-first term that took the lesser branch
+    /// k = 1 or 2 times, its modulation and its confidence (as `Refraction…`).
     Internal(u8, TermPart),
 }
 
@@ -87,8 +87,22 @@ impl LayerKind {
         }
     }
 
-    /// The lens term (0 reflection-first, 1 refraction-first, 2 and 3 the tree's terms with
-    /// one and two internal reflections) and the part of it the layer holds.
+    /// The layer of lens term `t` (as [`LayerKind::term`] numbers them) holding `part`.
+    pub fn of_term(t: usize, part: TermPart) -> LayerKind {
+        match (t, part) {
+            (0, TermPart::Value) => LayerKind::Reflection,
+            (0, TermPart::Modulation) => LayerKind::ReflectionModulation,
+            (0, TermPart::Confidence) => LayerKind::ReflectionConfidence,
+            (1, TermPart::Value) => LayerKind::Refraction,
+            (1, TermPart::Modulation) => LayerKind::RefractionModulation,
+            (1, TermPart::Confidence) => LayerKind::RefractionConfidence,
+            (t, part) => LayerKind::Internal(t.clamp(2, MAX_TERMS - 1) as u8 - 1, part),
+        }
+    }
+
+    /// The lens term (0 reflection-first, 1 refraction-first, 2 and 3 the tree's
+    /// refraction-first terms that took the lesser branch once and twice) and the part of it
+    /// the layer holds.
     pub fn term(self) -> Option<(usize, TermPart)> {
         match self {
             LayerKind::Reflection => Some((0, TermPart::Value)),
@@ -393,5 +407,15 @@ mod tests {
             LayerKind::from_name("refraction_modulation"),
             Some(LayerKind::RefractionModulation)
         );
+    }
+
+    #[test]
+    fn every_term_layer_is_named_by_its_term_and_part() {
+        for &k in LayerKind::for_role(ObjectRole::Refractive, MAX_TERMS) {
+            if let Some((t, part)) = k.term() {
+                assert_eq!(LayerKind::of_term(t, part), k, "{}", k.name());
+            }
+        }
+        assert_eq!(LayerKind::of_term(3, TermPart::Value).name(), "refraction_2");
     }
 }

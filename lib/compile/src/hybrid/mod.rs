@@ -20,7 +20,10 @@ pub use model::{
     corner_values, hybrid_pixels, hybrid_render_matrix, shell_vector, term_radiance,
     vertex_modulation, vertex_vectors, HybridPixels, Missing,
 };
-pub use path::{greedy_path, lens_paths, LensModel, LensPath, Term, Topology, MAX_TERMS, TERMS};
+pub use path::{
+    file_lens_model, file_lens_terms, greedy_path, lens_paths, LensModel, LensPath, Term, Topology,
+    MAX_TERMS, TERMS,
+};
 pub use tessellate::{
     tessellate, tessellate_timed, HybridVertex, HybridView, Tessellation, TessellationSettings,
     TessellationStats, TessellationTimes,

@@ -17,8 +17,9 @@ use super::tessellate::Tessellation;
 use crate::filter::Taps;
 use crate::interpolate::texcoord_at;
 use crate::raster::{DepthBuffer, Fragments};
-use crate::shell::cube::{cube_lod, cube_taps};
+use crate::shell::cube::{cube_lod, cube_taps, footprint_row};
 use crate::shell::geometry::{shell_hit, Shell};
+use crate::shell::model::ROWS_PER_CHUNK;
 use crate::transform::{DrawMesh, TextureTransform, Viewport};
 use crate::{RenderMatrix, TextureLayout};
 
@@ -150,28 +151,57 @@ pub fn hybrid_pixels(
 }
 
 /// The render matrix of one shell (per-vertex vectors `vectors`, cube layout `layout`) for
-/// one term of the tessellated lens object; rows are [`hybrid_pixels`]'s pixels.
+/// one term of the tessellated lens object; rows are [`hybrid_pixels`]'s pixels. With
+/// `lookups` k > 1 a row is the mean of k × k lookups at the sub-pixel offsets
+/// o = ((i + ½)/k − ½, (j + ½)/k − ½), each along d + o_x·∂d/∂x + o_y·∂d/∂y (the vector moved
+/// by its fine derivatives) at the LOD of the derivatives divided by k, as the reflection
+/// shells' `cube_sample_pixel` (SPEC.md 8.2): the pixel's footprint, which the tracer's
+/// samples average, instead of its centre.
 pub fn hybrid_render_matrix(
     viewport: Viewport,
     tess: &Tessellation,
     clip_from_world: Mat4,
     vectors: &[Option<[f32; 3]>],
     layout: TextureLayout,
+    lookups: u32,
     occluders: Option<&DepthBuffer>,
 ) -> RenderMatrix {
     let px = hybrid_pixels(viewport, tess, clip_from_world, vectors, Missing::Mean, occluders);
-    let max_level = layout.levels.saturating_sub(1) as f64;
-    let rows: Vec<Taps> = px
+    let k = lookups.max(1);
+    if k == 1 {
+        let max_level = layout.levels.saturating_sub(1) as f64;
+        let rows: Vec<Taps> = px
+            .vectors
+            .par_iter()
+            .map(|&[d, ddx, ddy]| {
+                let lambda = cube_lod(d, ddx, ddy, layout.width as f64, max_level);
+                let mut taps = Taps::default();
+                cube_taps(&layout, d, lambda, &mut taps);
+                taps
+            })
+            .collect();
+        return RenderMatrix::from_taps(viewport, layout, px.pixels, &rows);
+    }
+    let kf = k as f64;
+    let chunks: Vec<(Vec<u32>, Vec<f32>, Vec<u32>)> = px
         .vectors
-        .par_iter()
-        .map(|&[d, ddx, ddy]| {
-            let lambda = cube_lod(d, ddx, ddy, layout.width as f64, max_level);
+        .par_chunks(ROWS_PER_CHUNK)
+        .map(|chunk| {
+            let (mut cols, mut vals, mut lens) =
+                (Vec::new(), Vec::new(), Vec::with_capacity(chunk.len()));
+            let mut row = Vec::with_capacity(k as usize * k as usize * crate::filter::MAX_TAPS);
             let mut taps = Taps::default();
-            cube_taps(&layout, d, lambda, &mut taps);
-            taps
+            for &[d, ddx, ddy] in chunk {
+                let moved = |ox: f64, oy: f64| d + ox * ddx + oy * ddy;
+                footprint_row(&layout, k, (ddx / kf, ddy / kf), moved, &mut taps, &mut row);
+                cols.extend(row.iter().map(|e| e.0));
+                vals.extend(row.iter().map(|e| e.1));
+                lens.push(row.len() as u32);
+            }
+            (cols, vals, lens)
         })
         .collect();
-    RenderMatrix::from_taps(viewport, layout, px.pixels, &rows)
+    RenderMatrix::from_row_chunks(viewport, layout, px.pixels, chunks)
 }
 
 /// One term of a lens object as the player draws it (SPEC.md 9; `frame/hybrid.wgsl`'s

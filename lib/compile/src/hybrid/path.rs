@@ -11,16 +11,58 @@ pub use pis_scene::optics::{fresnel_dielectric, reflect, refract};
 
 use super::lens::{LensObject, LensSurface};
 
-/// The two terms of the greedy model (thesis 6.2), the first two of the tree's.
+/// The terms of a lens model: the greedy model's two (thesis 6.2), the first two of the
+/// tree's, then the tree's refraction-first paths that took the branch the greedy model
+/// drops once and twice (pis-trace's `refraction_1` and `refraction_2` layers).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum Term {
     /// The path that starts with a reflection.
     ReflectionFirst = 0,
     /// The path that starts with a refraction.
     RefractionFirst = 1,
+    /// A refraction-first path that took the lesser branch once.
+    RefractionLesser1 = 2,
+    /// A refraction-first path that took the lesser branch twice.
+    RefractionLesser2 = 3,
 }
 
+/// The greedy model's terms.
 pub const TERMS: [Term; 2] = [Term::ReflectionFirst, Term::RefractionFirst];
+
+impl Term {
+    /// Every term, in order.
+    pub const ALL: [Term; MAX_TERMS] = [
+        Term::ReflectionFirst,
+        Term::RefractionFirst,
+        Term::RefractionLesser1,
+        Term::RefractionLesser2,
+    ];
+
+    /// The terms `model` fills, in order.
+    pub fn of(model: LensModel) -> &'static [Term] {
+        &Term::ALL[..model.terms()]
+    }
+}
+
+/// The lens model a file's `lens_model` setting records (SPEC.md 6.6).
+pub fn file_lens_model(terms: pis_format::lens_model::LensTerms) -> LensModel {
+    match terms {
+        pis_format::lens_model::LensTerms::Greedy => LensModel::Greedy,
+        pis_format::lens_model::LensTerms::Tree { min_weight, terms } => {
+            LensModel::Tree { min_weight, internal_terms: terms.saturating_sub(1) }
+        }
+    }
+}
+
+/// What a file records of `model` (SPEC.md 6.6 `lens_model`).
+pub fn file_lens_terms(model: LensModel) -> pis_format::lens_model::LensTerms {
+    match model {
+        LensModel::Greedy => pis_format::lens_model::LensTerms::Greedy,
+        LensModel::Tree { min_weight, .. } => {
+            pis_format::lens_model::LensTerms::Tree { min_weight, terms: model.terms() as u8 }
+        }
+    }
+}
 
 /// Where a path leaves the lens object (the runtime model keeps nothing of the exit itself).
 pub type LensPath = pis_scene::lens_tree::LensPath<()>;
@@ -35,7 +77,19 @@ pub fn lens_paths(
     model: LensModel,
     max_depth: u32,
 ) -> [Option<LensPath>; MAX_TERMS] {
+    lens_paths_counted(lens, first, dir, model, max_depth).0
+}
+
+/// [`lens_paths`] and the number of rays the walk cast through the lens object.
+pub fn lens_paths_counted(
+    lens: &LensObject,
+    first: &LensSurface,
+    dir: Vec3,
+    model: LensModel,
+    max_depth: u32,
+) -> ([Option<LensPath>; MAX_TERMS], u64) {
     let m = lens.material;
+    let mut rays = 0u64;
     let interface = |s: &LensSurface, absorption: Vec3| LensInterface {
         position: s.position,
         normal: s.normal,
@@ -45,20 +99,28 @@ pub fn lens_paths(
         base: m.base,
         absorption,
     };
-    pis_scene::lens_tree::lens_paths(&interface(first, Vec3::ONE), dir, model, max_depth, |o, d| {
-        match lens.closest(o, d, f32::INFINITY) {
-            None => Step::Exit(()),
-            Some(hit) => {
-                let s = lens.surface(&hit, o, d);
-                let absorption = if !s.front_face && m.sigma_a != Vec3::ZERO {
-                    (-m.sigma_a * hit.t).exp()
-                } else {
-                    Vec3::ONE
-                };
-                Step::Interface(interface(&s, absorption))
+    let paths = pis_scene::lens_tree::lens_paths(
+        &interface(first, Vec3::ONE),
+        dir,
+        model,
+        max_depth,
+        |o, d| {
+            rays += 1;
+            match lens.closest(o, d, f32::INFINITY) {
+                None => Step::Exit(()),
+                Some(hit) => {
+                    let s = lens.surface(&hit, o, d);
+                    let absorption = if !s.front_face && m.sigma_a != Vec3::ZERO {
+                        (-m.sigma_a * hit.t).exp()
+                    } else {
+                        Vec3::ONE
+                    };
+                    Step::Interface(interface(&s, absorption))
+                }
             }
-        }
-    })
+        },
+    );
+    (paths, rays)
 }
 
 /// One term of the greedy two-path model (thesis 6.2) from `first`: the path that starts
@@ -73,11 +135,7 @@ pub fn greedy_path(
     term: Term,
     max_depth: u32,
 ) -> Option<LensPath> {
-    let [r, t, ..] = lens_paths(lens, first, dir, LensModel::Greedy, max_depth);
-    match term {
-        Term::ReflectionFirst => r,
-        Term::RefractionFirst => t,
-    }
+    lens_paths(lens, first, dir, LensModel::Greedy, max_depth)[term as usize]
 }
 
 /// Whether two paths of one term differ (thesis 6.4.1): one exists and the other not,

@@ -1,5 +1,5 @@
-//! Adaptive tessellation of a lens object for one frame (thesis 6.4.1): the greedy paths
-//! traced at the vertices of the front-facing triangles — and of the back-facing ones the
+//! Adaptive tessellation of a lens object for one frame (thesis 6.4.1): the paths of the
+//! lens model (the greedy two, or the ray tree's terms) traced at the vertices of the front-facing triangles — and of the back-facing ones the
 //! eye sees through an open mesh's holes, entered from inside as pis-trace enters them — triangles split at their edges' midpoints (1-to-4,
 //! 1-to-3 or 1-to-2) where their vertices' paths differ in topology or in exit direction by
 //! more than 3° (or, beyond the thesis, in F·G by more than 0.05), down to a screen edge
@@ -17,7 +17,7 @@ use glam::{Mat4, Vec3};
 use rayon::prelude::*;
 
 use super::lens::{LensObject, LensSurface};
-use super::path::{lens_paths, paths_differ, LensModel, LensPath};
+use super::path::{lens_paths_counted, paths_differ, LensModel, LensPath, MAX_TERMS};
 
 /// The camera of a frame.
 #[derive(Clone, Copy, Debug)]
@@ -44,6 +44,8 @@ pub struct TessellationSettings {
     pub max_depth: u32,
     /// Splits of an original triangle at most.
     pub max_levels: u32,
+    /// The paths traced at each vertex, and the terms they are grouped into.
+    pub model: LensModel,
 }
 
 impl Default for TessellationSettings {
@@ -54,6 +56,7 @@ impl Default for TessellationSettings {
             max_modulation: 0.05,
             max_depth: 8,
             max_levels: 12,
+            model: LensModel::Greedy,
         }
     }
 }
@@ -69,8 +72,9 @@ pub struct HybridVertex {
     /// Traced as the outside of the surface (the eye on the side its normal faces); else
     /// as its inside, seen through a hole of an open mesh.
     pub front_face: bool,
-    /// The reflection-first and refraction-first paths.
-    pub paths: [Option<LensPath>; 2],
+    /// Per term of the lens model, its path (reflection-first, refraction-first, then the
+    /// tree's); `None` past the model's terms.
+    pub paths: [Option<LensPath>; MAX_TERMS],
 }
 
 /// What the tessellation did.
@@ -108,6 +112,7 @@ pub fn trace_vertex(
     position: Vec3,
     normal: Vec3,
     front_face: bool,
+    model: LensModel,
     max_depth: u32,
 ) -> (HybridVertex, u64) {
     let to = position - eye;
@@ -121,9 +126,8 @@ pub fn trace_vertex(
     let n = if n == Vec3::ZERO { -dir } else { n };
     let facing = if front_face { n } else { -n };
     let first = LensSurface { position, normal: facing, geometric_normal: facing, front_face };
-    let [r, t, ..] = lens_paths(lens, &first, dir, LensModel::Greedy, max_depth);
-    let paths = [r, t];
-    let rays = 1 + paths.iter().flatten().map(|p| p.topology.interfaces as u64).sum::<u64>();
+    let (paths, rays) = lens_paths_counted(lens, &first, dir, model, max_depth);
+    let rays = 1 + rays;
     (HybridVertex { position, normal: n, visible, front_face, paths }, rays)
 }
 
@@ -210,7 +214,7 @@ pub fn tessellate_timed(
             normal: lens.normals.get(i).copied().unwrap_or(Vec3::ZERO),
             visible: false,
             front_face: used[i],
-            paths: [None, None],
+            paths: [None; MAX_TERMS],
         })
         .collect();
     back.iter().flatten().for_each(|&v| used[v as usize] = true);
@@ -288,7 +292,7 @@ pub fn tessellate_timed(
             normal: n,
             visible: false,
             front_face,
-            paths: [None, None],
+            paths: [None; MAX_TERMS],
         }));
         let ids: Vec<u32> = (first..mesh.vertices.len() as u32).collect();
         mesh.trace(&ids);
@@ -335,12 +339,13 @@ impl Mesh<'_> {
     /// Traces the paths of vertices `ids` (their position and normal set) on the workers.
     fn trace(&mut self, ids: &[u32]) {
         let start = Instant::now();
-        let (lens, eye, depth) = (self.lens, self.view.eye, self.settings.max_depth);
+        let (lens, eye) = (self.lens, self.view.eye);
+        let (model, depth) = (self.settings.model, self.settings.max_depth);
         let traced: Vec<(HybridVertex, u64)> = ids
             .par_iter()
             .map(|&i| {
                 let v = self.vertices[i as usize];
-                trace_vertex(lens, eye, v.position, v.normal, v.front_face, depth)
+                trace_vertex(lens, eye, v.position, v.normal, v.front_face, model, depth)
             })
             .collect();
         for (&i, (v, rays)) in ids.iter().zip(traced) {
@@ -352,7 +357,7 @@ impl Mesh<'_> {
     }
 
     /// The edges of `tri` to split, or `None` when it stays whole: its vertices' paths agree
-    /// for both terms, all three are hidden, or no edge is longer than τ on screen.
+    /// for every term, all three are hidden, or no edge is longer than τ on screen.
     fn split_edges(&self, tri: [u32; 3], cos_max: f32) -> Option<[bool; 3]> {
         let v = tri.map(|i| &self.vertices[i as usize]);
         if v.iter().all(|v| !v.visible) {
@@ -360,7 +365,7 @@ impl Mesh<'_> {
         }
         let differ = (0..3).any(|e| {
             let (p, q) = (v[e], v[(e + 1) % 3]);
-            (0..2).any(|t| {
+            (0..self.settings.model.terms()).any(|t| {
                 paths_differ(
                     p.paths[t].as_ref(),
                     q.paths[t].as_ref(),
@@ -404,7 +409,7 @@ impl Mesh<'_> {
             normal: (p.normal + q.normal).normalize_or_zero(),
             visible: false,
             front_face: p.front_face || q.front_face,
-            paths: [None, None],
+            paths: [None; MAX_TERMS],
         });
         self.midpoints.insert(key, m);
         made.push(m);

@@ -166,6 +166,38 @@ pub fn cube_taps(layout: &TextureLayout, d: DVec3, lambda: f64, taps: &mut Taps)
     }
 }
 
+/// The row of one pixel's k × k lookups (SPEC.md 8.2), merged by column and sorted: the
+/// lookup at sub-pixel offset o = ((i + ½)/k − ½, (j + ½)/k − ½) along `direction(o_x, o_y)`
+/// at the LOD of the derivatives `sx`, `sy` (the pixel's divided by k), each of weight 1/k².
+pub fn footprint_row(
+    layout: &TextureLayout,
+    k: u32,
+    (sx, sy): (DVec3, DVec3),
+    direction: impl Fn(f64, f64) -> DVec3,
+    taps: &mut Taps,
+    row: &mut Vec<(u32, f32)>,
+) {
+    let kf = k as f64;
+    let w = (1.0 / (kf * kf)) as f32;
+    let max_level = layout.levels.saturating_sub(1) as f64;
+    row.clear();
+    for j in 0..k {
+        let oy = (j as f64 + 0.5) / kf - 0.5;
+        for i in 0..k {
+            let ox = (i as f64 + 0.5) / kf - 0.5;
+            let ds = direction(ox, oy);
+            cube_taps(layout, ds, cube_lod(ds, sx, sy, layout.width as f64, max_level), taps);
+            for (c, v) in taps.sorted() {
+                match row.iter_mut().find(|e| e.0 == c) {
+                    Some(e) => e.1 += v * w,
+                    None => row.push((c, v * w)),
+                }
+            }
+        }
+    }
+    row.sort_unstable_by_key(|e| e.0);
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

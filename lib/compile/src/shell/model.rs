@@ -11,7 +11,7 @@
 use glam::{DVec3, Mat4, Vec3, Vec4};
 use rayon::prelude::*;
 
-use super::cube::{cube_lod, cube_taps};
+use super::cube::{cube_lod, cube_taps, footprint_row};
 use super::geometry::{fresnel, lookup_direction, Shell};
 use crate::filter::Taps;
 use crate::interpolate::texcoord_at;
@@ -148,7 +148,6 @@ pub fn shell_render_matrix(
     // k × k lookups per pixel (SPEC.md 8.2): each chunk of pixels fills its own entries,
     // one row buffer reused from pixel to pixel.
     let kf = k as f64;
-    let w = (1.0 / (kf * kf)) as f32;
     let chunks: Vec<(Vec<u32>, Vec<f32>, Vec<u32>)> = pixels
         .par_chunks(ROWS_PER_CHUNK)
         .map(|chunk| {
@@ -166,28 +165,9 @@ pub fn shell_render_matrix(
                 let (dpx, dnx, dpy, dny) = (px1 - px0, nx1 - nx0, py1 - py0, ny1 - ny0);
                 let ddx = dir(px1, nx1) - dir(px0, nx0);
                 let ddy = dir(py1, ny1) - dir(py0, ny0);
-                let (sx, sy) = (ddx / kf, ddy / kf);
-                row.clear();
-                for j in 0..k {
-                    let oy = (j as f64 + 0.5) / kf - 0.5;
-                    for i in 0..k {
-                        let ox = (i as f64 + 0.5) / kf - 0.5;
-                        let ds = dir(pos + ox * dpx + oy * dpy, n + ox * dnx + oy * dny);
-                        cube_taps(
-                            &layout,
-                            ds,
-                            cube_lod(ds, sx, sy, layout.width as f64, max_level),
-                            &mut taps,
-                        );
-                        for (c, v) in taps.sorted() {
-                            match row.iter_mut().find(|e| e.0 == c) {
-                                Some(e) => e.1 += v * w,
-                                None => row.push((c, v * w)),
-                            }
-                        }
-                    }
-                }
-                row.sort_unstable_by_key(|e| e.0);
+                let moved =
+                    |ox: f64, oy: f64| dir(pos + ox * dpx + oy * dpy, n + ox * dnx + oy * dny);
+                footprint_row(&layout, k, (ddx / kf, ddy / kf), moved, &mut taps, &mut row);
                 cols.extend(row.iter().map(|e| e.0));
                 vals.extend(row.iter().map(|e| e.1));
                 lens.push(row.len() as u32);
@@ -199,7 +179,7 @@ pub fn shell_render_matrix(
 }
 
 /// Pixels per parallel chunk of a render matrix with several lookups per pixel.
-const ROWS_PER_CHUNK: usize = 256;
+pub(crate) const ROWS_PER_CHUNK: usize = 256;
 
 /// The object rasterized as the player draws it, each triangle's world corners, and the
 /// pixels that draw the shell (in increasing order).

@@ -300,6 +300,12 @@ fn provenance_settings(
         if tint != [1.0; 3] {
             settings.push(pis_format::tint::tint_setting(&m.name, tint));
         }
+        // The paths its shells are drawn along, where not the greedy two.
+        let model = m.shells.as_ref().map(|s| s.lens_model()).unwrap_or_default();
+        if !model.is_greedy() {
+            let terms = pis_compile::hybrid::file_lens_terms(model);
+            settings.push(pis_format::lens_model::lens_model_setting(&m.name, terms));
+        }
     }
     settings
 }

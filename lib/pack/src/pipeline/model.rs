@@ -270,6 +270,11 @@ pub trait ShellTerms: Send + Sync {
     fn transmits(&self) -> bool {
         false
     }
+    /// The paths a lens object's shells are drawn along, which the file records (SPEC.md
+    /// 6.6 `lens_model`).
+    fn lens_model(&self) -> pis_compile::hybrid::LensModel {
+        pis_compile::hybrid::LensModel::Greedy
+    }
 }
 
 /// An object's inferred representation.

@@ -126,8 +126,9 @@ pub struct LensDraw<'a> {
     /// The term's corners ([`term_corners`]) on the GPU, and how many.
     pub corners: &'a wgpu::Buffer,
     pub count: u32,
-    /// The term's shells in order, each its cube map (1 to [`MAX_LENS_SHELLS`]).
-    pub shells: Vec<&'a ShellTexture>,
+    /// The term's shells in order, each its cube map and its lookups per pixel side
+    /// (SPEC.md 8.2; 1 to [`MAX_LENS_SHELLS`] shells).
+    pub shells: Vec<(&'a ShellTexture, u32)>,
 }
 
 /// The corners on the GPU (at least one corner's worth of bytes).
@@ -146,8 +147,8 @@ pub fn corner_buffer(gpu: &Gpu, corners: &[LensCorner]) -> wgpu::Buffer {
 pub fn lens_bind(gpu: &Gpu, layout: &wgpu::BindGroupLayout, draw: &LensDraw) -> wgpu::BindGroup {
     let d = &gpu.device;
     let mut shells = [[0u32; 4]; MAX_LENS_SHELLS];
-    for (slot, cube) in shells.iter_mut().zip(&draw.shells) {
-        *slot = [cube.layout.width, cube.layout.levels, 0, 0];
+    for (slot, (cube, lookups)) in shells.iter_mut().zip(&draw.shells) {
+        *slot = [cube.layout.width, cube.layout.levels, (*lookups).max(1), 0];
     }
     let u = HybridFrameUniforms {
         clip_from_world: draw.clip_from_world.to_cols_array(),
@@ -163,7 +164,7 @@ pub fn lens_bind(gpu: &Gpu, layout: &wgpu::BindGroupLayout, draw: &LensDraw) -> 
         usage: wgpu::BufferUsages::UNIFORM,
     });
     let cube = |k: usize| {
-        wgpu::BindingResource::TextureView(&draw.shells[k.min(draw.shells.len() - 1)].view)
+        wgpu::BindingResource::TextureView(&draw.shells[k.min(draw.shells.len() - 1)].0.view)
     };
     let mut entries = vec![wgpu::BindGroupEntry { binding: 0, resource: ub.as_entire_binding() }];
     entries.extend(

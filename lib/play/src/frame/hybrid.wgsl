@@ -12,7 +12,7 @@
 
 struct HybridFrameUniforms {
     clip_from_world: mat4x4<f32>,
-    // Per shell slot: cube face size N and MIP level count (x, y).
+    // Per shell slot: cube face size N, MIP level count and lookups per pixel side (x, y, z).
     shells: array<vec4<u32>, 4>,
     // The sample's blending weight (x).
     weight: vec4<f32>,
@@ -63,12 +63,32 @@ fn vs_hybrid_frame(@location(0) position: vec3<f32>, @location(1) fg: vec3<f32>,
 }
 
 // Shell k's premultiplied RGBA along the interpolated vector v (xyz) with derivatives
-// ddx, ddy, looked up in `cube`.
+// ddx, ddy, looked up in `cube`: with the shell's lookups L = 1 one trilinear lookup at the
+// LOD of the derivatives; with L > 1 the mean of L × L lookups along v + o.x·ddx + o.y·ddy
+// at the sub-pixel offsets o = ((i + ½)/L − ½, (j + ½)/L − ½), at the LOD of the
+// derivatives divided by L (SPEC.md 8.2; pis-compile's `hybrid_render_matrix` is its twin).
 fn lens_shell(k: u32, cube: texture_2d_array<f32>, v: vec3<f32>, ddx: vec3<f32>, ddy: vec3<f32>) -> vec4<f32> {
     let size = hf.shells[k].x;
     let levels = hf.shells[k].y;
-    let lambda = cube_lod(v, ddx, ddy, f32(size), f32(levels - 1u));
-    return cube_sample(cube, size, levels, v, lambda);
+    let lookups = hf.shells[k].z;
+    let max_level = f32(levels - 1u);
+    if (lookups <= 1u) {
+        return cube_sample(cube, size, levels, v, cube_lod(v, ddx, ddy, f32(size), max_level));
+    }
+    let kf = f32(lookups);
+    let sx = ddx / kf;
+    let sy = ddy / kf;
+    let w = 1.0 / (kf * kf);
+    var acc = vec4<f32>(0.0);
+    for (var j = 0u; j < lookups; j = j + 1u) {
+        let oy = (f32(j) + 0.5) / kf - 0.5;
+        for (var i = 0u; i < lookups; i = i + 1u) {
+            let ox = (f32(i) + 0.5) / kf - 0.5;
+            let d = v + ox * ddx + oy * ddy;
+            acc = acc + w * cube_sample(cube, size, levels, d, cube_lod(d, sx, sy, f32(size), max_level));
+        }
+    }
+    return acc;
 }
 
 // One step of "over": the running colour and transmittance after shell colour c.

@@ -18,7 +18,7 @@ use crate::shell::ShellTexture;
 /// One term of the tessellated lens object `tess` drawn through the frame's own path
 /// ([`encode`], one sample per pixel): the id pass of the tessellation, then
 /// the term with `shells` (each its geometry, cube layout and RGBA texels: premultiplied
-/// colour, then alpha) at weight 1. Returns RGBA per pixel (rows from the top; alpha 1 where
+/// colour, then alpha), each looked up `lookups` × `lookups` times per pixel, at weight 1. Returns RGBA per pixel (rows from the top; alpha 1 where
 /// the term is drawn). pis-compile's [`pis_compile::hybrid::term_radiance`] is its twin.
 pub fn render_lens_term(
     gpu: &Gpu,
@@ -27,6 +27,7 @@ pub fn render_lens_term(
     clip_from_world: glam::Mat4,
     term: Term,
     shells: &[(Shell, pis_compile::TextureLayout, &[f32])],
+    lookups: u32,
 ) -> Result<FloatImage, PlayError> {
     if shells.is_empty() || shells.len() > MAX_LENS_SHELLS {
         return Err(PlayError::Request(format!(
@@ -56,7 +57,7 @@ pub fn render_lens_term(
         weight: 1.0,
         corners: &buffer,
         count: corners.len() as u32,
-        shells: cubes.iter().collect(),
+        shells: cubes.iter().map(|c| (c, lookups)).collect(),
     }];
     let format = offscreen_format(gpu);
     let view = targets.colour.create_view(&Default::default());

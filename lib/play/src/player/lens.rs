@@ -1,12 +1,14 @@
 //! Lens objects in the player's frame (thesis 6.4): per frame each one's vertex rays traced
 //! through the object at its transform (on the workers), its tessellation refined where they
-//! diverge (or the last frame's drawn again when nothing it depends on changed), both terms'
-//! corner buffers built once per shell geometry, and the lens draws of the frame's
-//! parameter samples.
+//! diverge (or the last frame's drawn again when nothing it depends on changed), its lens
+//! model's terms' corner buffers built once per shell geometry, and the lens draws of the
+//! frame's parameter samples.
 
 use std::time::Instant;
 
-use pis_compile::hybrid::{tessellate, HybridView, TessellationSettings, TERMS};
+use rayon::prelude::*;
+
+use pis_compile::hybrid::{tessellate, HybridView, Term, TessellationSettings};
 use pis_compile::shell::Shell;
 use pis_format::PisReader;
 
@@ -17,7 +19,7 @@ use crate::error::PlayError;
 use crate::frame::hybrid::{corner_buffer, term_corners, LensDraw};
 use crate::gpu::Gpu;
 
-/// A frame's lens work: per lens object and shell geometry, both terms' corner buffers
+/// A frame's lens work: per lens object and shell geometry, its terms' corner buffers
 /// (and their corner counts); the time it took, its rays and triangles.
 pub(super) struct LensWork {
     pub(super) sets: Vec<LensSet>,
@@ -27,12 +29,12 @@ pub(super) struct LensWork {
 }
 
 /// One lens object's terms for one shell geometry: the object's draw index, the shells, and
-/// both terms' corner buffers with their corner counts.
-pub(super) type LensSet = (usize, Vec<Shell>, [(wgpu::Buffer, u32); 2]);
+/// per term of its lens model the corner buffer with its corner count.
+pub(super) type LensSet = (usize, Vec<Shell>, Vec<(wgpu::Buffer, u32)>);
 
 /// Traces the vertex rays of every lens object `plan` draws through the object placed at
-/// the frame's transform, refines its tessellation down to `tau_px`, and builds both
-/// terms' corners once per object and shell geometry (`states`: the objects' lens states).
+/// the frame's transform, refines its tessellation down to `tau_px`, and builds its lens
+/// model's terms' corners once per object and shell geometry (`states`: the objects' lens states).
 pub(super) fn lens_corners(
     gpu: &Gpu,
     states: &mut [(usize, LensState)],
@@ -41,7 +43,6 @@ pub(super) fn lens_corners(
     tau_px: f32,
 ) -> LensWork {
     let t = Instant::now();
-    let settings = TessellationSettings { tau_px, ..TessellationSettings::default() };
     let mut work = LensWork { sets: Vec::new(), ms: 0.0, rays: 0, triangles: 0 };
     for r in &plan.lenses {
         let shells: Vec<Shell> = r.shells.iter().map(|(_, s, _)| *s).collect();
@@ -54,6 +55,11 @@ pub(super) fn lens_corners(
         let tess = match &state.tessellated {
             Some((k, t)) if *k == key => t.clone(),
             _ => {
+                let settings = TessellationSettings {
+                    tau_px,
+                    model: state.model,
+                    ..TessellationSettings::default()
+                };
                 let lens = state.at(plan.worlds[r.draw]);
                 let t = std::sync::Arc::new(tessellate(
                     lens,
@@ -65,12 +71,14 @@ pub(super) fn lens_corners(
                 t
             }
         };
-        let (reflection, refraction) = rayon::join(
-            || term_corners(&tess, TERMS[0], &shells),
-            || term_corners(&tess, TERMS[1], &shells),
-        );
-        let buffers = [reflection, refraction]
-            .map(|corners| (corner_buffer(gpu, &corners), corners.len() as u32));
+        let corners: Vec<_> = Term::of(state.model)
+            .par_iter()
+            .map(|&term| term_corners(&tess, term, &shells))
+            .collect();
+        let buffers: Vec<(wgpu::Buffer, u32)> = corners
+            .iter()
+            .map(|corners| (corner_buffer(gpu, corners), corners.len() as u32))
+            .collect();
         work.triangles += buffers.iter().map(|b| b.1 as u64 / 3).max().unwrap_or(0);
         work.sets.push((r.draw, shells, buffers));
     }
@@ -78,7 +86,7 @@ pub(super) fn lens_corners(
     work
 }
 
-/// The lens draws of `plan`: per lens term and parameter sample, both terms' corner buffers
+/// The lens draws of `plan`: per lens term and parameter sample, the terms' corner buffers
 /// of its shell geometry (`sets`, from [`lens_corners`]) with the shells' cube maps.
 pub(super) fn lens_draws<'a>(
     reader: &PisReader,
@@ -94,14 +102,14 @@ pub(super) fn lens_draws<'a>(
             continue;
         };
         let mut cubes = Vec::with_capacity(r.shells.len());
-        for (key, _, _) in &r.shells {
+        for (key, _, lookups) in &r.shells {
             let GpuTexture::Shell(cube) = textures.get(key) else {
                 return Err(content(
                     reader,
                     format!("{key:?}: a surface texture drawn as a shell"),
                 ));
             };
-            cubes.push(cube);
+            cubes.push((cube, *lookups));
         }
         for (corners, count) in buffers {
             lenses.push(LensDraw {

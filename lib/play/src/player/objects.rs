@@ -33,6 +33,8 @@ pub(super) struct LensState {
     normals: Vec<glam::Vec3>,
     indices: Vec<u32>,
     material: LensMaterial,
+    /// The paths traced at its vertices and the terms drawn (SPEC.md 6.6 `lens_model`).
+    pub(super) model: pis_compile::hybrid::LensModel,
     placed: Option<(glam::Mat4, LensObject)>,
     /// The last frame's tessellation and what it was made for (transform, eye, view and
     /// projection, frame size, τ): a frame that changes none of them draws it again.
@@ -82,6 +84,9 @@ pub(super) fn prepare_objects(gpu: &Gpu, reader: &PisReader) -> Result<Vec<Objec
         c.objects.iter().map(|o| (o.name.as_str(), o.role)).collect();
     let tints = pis_format::tint::tints(c.provenance.as_ref(), &named)
         .unwrap_or_else(|_| vec![[1.0; 3]; c.objects.len()]);
+    // And the lens models (rule 9005).
+    let models = pis_format::lens_model::lens_models(c.provenance.as_ref(), &named)
+        .unwrap_or_else(|_| vec![Default::default(); c.objects.len()]);
     for (oi, o) in c.objects.iter().enumerate() {
         let n = o.mesh.positions.len();
         let uvs: Vec<[f32; 2]> = match &o.mesh.texcoords {
@@ -132,7 +137,7 @@ pub(super) fn prepare_objects(gpu: &Gpu, reader: &PisReader) -> Result<Vec<Objec
             }
             layers.push(li);
         }
-        let lens = lens_state(reader, oi, tints[oi], &mut skipped)?;
+        let lens = lens_state(reader, oi, (tints[oi], models[oi]), &mut skipped)?;
         let reflection =
             if lens.is_some() { Vec::new() } else { reflection_shells(reader, oi, &mut skipped)? };
         let mesh =
@@ -217,12 +222,12 @@ fn ordered_closed_shells(
 
 /// Object `oi` as a lens object, when it is one: role `refractive`, shell layers in the
 /// refraction term (at most [`MAX_LENS_SHELLS`], closed shells), normals; its transmission
-/// tint `tint`. Its reflection term's own shells, if any, are not drawn (listed in
+/// tint and lens model `(tint, model)`. Its reflection term's own shells, if any, are not drawn (listed in
 /// `skipped`), nor are the shells of a refractive object without normals.
 fn lens_state(
     reader: &PisReader,
     oi: usize,
-    tint: [f32; 3],
+    (tint, model): ([f32; 3], pis_format::lens_model::LensTerms),
     skipped: &mut Vec<String>,
 ) -> Result<Option<LensState>, PlayError> {
     let o = &reader.container().objects[oi];
@@ -272,6 +277,7 @@ fn lens_state(
         normals: normals.iter().map(v3).collect(),
         indices: o.mesh.indices.clone(),
         material,
+        model: pis_compile::hybrid::file_lens_model(model),
         placed: None,
         tessellated: None,
     }))

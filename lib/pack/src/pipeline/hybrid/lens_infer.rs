@@ -7,8 +7,15 @@
 //! tracer's outgoing-ray records of each pixel recombined per layer (alpha: the fraction of
 //! the pixel's rays that meet the layer, colour: what they meet there, premultiplied); the
 //! prediction composites each term's shells "over", nearest first, multiplies by the F·G the
-//! player interpolates per vertex, and is compared with the traced `reflection` and
-//! `refraction` layers over the lens object's pixels.
+//! player interpolates per vertex, and is compared with the traced term layers
+//! (`reflection`, `refraction`, and for a set traced with the ray tree `refraction_1` and
+//! `refraction_2`) over the lens object's pixels. The terms drawn are the set's lens
+//! model's (`renderer.settings.lens_model`, [`LensInferSettings::tessellation`]); the
+//! shells are built and solved from the greedy terms' records and rows alone (eq. 6.1's
+//! two), and the ray tree's further terms look the same shells up: with their rows in the
+//! solve, the glass teapot's shells split into one layer instead of three, chose 256² faces
+//! for 64², and its refraction-first term fell 1–5 dB at the samples (the further terms'
+//! exit rays, interpolated per vertex, land where their pixels' paths do not).
 //!
 //! The cube-face size is chosen from the finest level the sample views read (5.8.2).
 //! Simultaneous inference over nearby viewpoints ([`infer_lens_nearby`], 6.3.3.1) and the
@@ -19,8 +26,8 @@ use anyhow::{anyhow, Result};
 use glam::Vec3;
 use pis_compile::hybrid::{
     choose_layers, hybrid_pixels, hybrid_render_matrix, term_radiance, tessellate,
-    vertex_modulation, vertex_vectors, FittedShell, HybridPixels, HybridView, Layers, Missing,
-    OutgoingRay, Term, Tessellation, TessellationSettings, TERMS,
+    vertex_modulation, vertex_vectors, FittedShell, HybridPixels, HybridView, Layers, LensModel,
+    Missing, OutgoingRay, Term, Tessellation, TessellationSettings, TERMS,
 };
 use pis_compile::solve::View;
 
@@ -28,7 +35,7 @@ use crate::solutions::Solver;
 use pis_compile::{RenderMatrix, SolveSettings, TextureLayout, Viewport};
 use pis_scene::{Frame, Scene};
 use pis_trace::camera::{projection_matrix, PerspectiveCamera};
-use pis_trace::layers::LayerKind;
+use pis_trace::layers::{LayerKind, TermPart};
 use pis_trace::{PointImages, PointRender, RayRecord};
 
 use pis_codec::display::psnr_display;
@@ -55,6 +62,9 @@ pub struct LensInferSettings {
     pub confidence: bool,
     /// Where the cube maps' solves go (a sharded pack's store of solutions, [`Solver`]).
     pub solver: Solver,
+    /// Lookups per pixel side (SPEC.md 8.2): each pixel's row is the mean of k × k lookups
+    /// over its footprint ([`hybrid_render_matrix`]).
+    pub lookups: u32,
 }
 
 impl Default for LensInferSettings {
@@ -67,6 +77,7 @@ impl Default for LensInferSettings {
             solve: SolveSettings::pyramidal(),
             confidence: false,
             solver: Solver::default(),
+            lookups: 1,
         }
     }
 }
@@ -83,8 +94,11 @@ pub struct TermFit {
 pub struct LensView {
     pub reflection: TermFit,
     pub refraction: TermFit,
-    /// The two terms summed, against the traced terms summed.
+    /// Every term of the lens model summed, against the traced terms summed.
     pub both: TermFit,
+    /// The greedy model's two terms summed, against the traced terms summed (`both` for
+    /// the greedy model).
+    pub greedy: TermFit,
     /// Per shell, its RGBA cube map (texels × 4, premultiplied colour then alpha).
     pub cubes: Vec<Vec<f32>>,
 }
@@ -98,6 +112,10 @@ pub struct LensInference {
     pub views: Vec<LensView>,
     /// Per view sample, its own view as the model draws it.
     pub models: Vec<LensViewModel>,
+    /// For a set traced with the ray tree, what its further terms added at the samples (mean
+    /// PSNR of every term against the greedy two): the tree is drawn where at least
+    /// [`MIN_TREE_GAIN_DB`], else the greedy model.
+    pub tree_gain_db: Option<f64>,
 }
 
 /// One traced view of a lens object: its frame, the traced images and the outgoing-ray
@@ -115,12 +133,13 @@ impl<'a> From<&'a (Frame, PointRender)> for TracedView<'a> {
     }
 }
 
-/// Object `o`'s outgoing rays in `render`'s records.
+/// Object `o`'s outgoing rays in `render`'s records of the greedy terms (the shells are
+/// built from them: [`infer_lens_views`]).
 fn outgoing_rays(render: &TracedView, o: usize) -> Vec<OutgoingRay> {
     render
         .records
         .iter()
-        .filter(|r| r.object == o as u32)
+        .filter(|r| r.object == o as u32 && (r.term as usize) < TERMS.len())
         .map(|r| OutgoingRay {
             origin: Vec3::from(r.exit_origin).as_dvec3(),
             direction: Vec3::from(r.exit_direction).as_dvec3(),
@@ -217,12 +236,15 @@ fn traced_rgb(
 }
 
 /// A view as the model draws it: the frame's tessellation of the lens object (its vertex
-/// rays) and, once the face size is known, per term and shell the render matrix.
+/// rays) and, once the face size is known, per term of the lens model and shell the render
+/// matrix.
 #[derive(Clone, Debug)]
 pub struct LensViewModel {
     pub viewport: Viewport,
     pub clip: glam::Mat4,
     pub tess: Tessellation,
+    /// The lens model whose terms the vertices carry.
+    pub model: LensModel,
     /// Per term, per shell.
     pub a: Vec<Vec<RenderMatrix>>,
 }
@@ -251,14 +273,15 @@ impl LensViewModel {
             viewport: Viewport { width: size.0, height: size.1 },
             clip,
             tess,
+            model: settings.tessellation.model,
             a: Vec::new(),
         }
     }
 
     /// Per term and shell, the render matrix of cube faces of `face` texels.
-    fn with_matrices(mut self, shells: &[FittedShell], face: u32) -> ViewModel {
+    fn with_matrices(mut self, shells: &[FittedShell], face: u32, lookups: u32) -> ViewModel {
         let layout = TextureLayout::cube(face);
-        self.a = TERMS
+        self.a = Term::of(self.model)
             .iter()
             .map(|&term| {
                 shells
@@ -270,6 +293,7 @@ impl LensViewModel {
                             self.clip,
                             &vertex_vectors(&self.tess, term, &s.shell),
                             layout,
+                            lookups,
                             None,
                         )
                     })
@@ -348,7 +372,7 @@ pub fn infer_lens_views(
     };
     models = models
         .into_iter()
-        .map(|m| m.into_iter().map(|v| v.with_matrices(&shells, face)).collect())
+        .map(|m| m.into_iter().map(|v| v.with_matrices(&shells, face, settings.lookups)).collect())
         .collect();
     let layout = TextureLayout::cube(face);
     let mut out = Vec::with_capacity(samples.len());
@@ -383,21 +407,43 @@ pub fn infer_lens_views(
             }
             cubes.push(cube);
         }
-        let (reflection, refraction, both) =
+        let (reflection, refraction, both, greedy) =
             predict_with(scene, o, &models[0], render.images, face, &[(&cubes, 1.0)]);
-        out.push(LensView { reflection, refraction, both, cubes });
+        out.push(LensView { reflection, refraction, both, greedy, cubes });
     }
     let models =
         models.into_iter().map(|m| m.into_iter().next().expect("a sample's own view")).collect();
-    Ok(LensInference { face, layers, shells, views: out, models })
+    let mut inference =
+        LensInference { face, layers, shells, views: out, models, tree_gain_db: None };
+    if !settings.tessellation.model.is_greedy() {
+        // The tree's further terms are drawn where they bring the samples nearer the traced
+        // image than the greedy two do; else the greedy model, its vertices traced and its
+        // triangles split for two terms.
+        let mean = |f: fn(&LensView) -> f64| {
+            inference.views.iter().map(f).sum::<f64>() / inference.views.len().max(1) as f64
+        };
+        let gain = mean(|v| v.both.psnr_db) - mean(|v| v.greedy.psnr_db);
+        if gain.is_nan() || gain < MIN_TREE_GAIN_DB {
+            let mut greedy = settings.clone();
+            greedy.tessellation.model = LensModel::Greedy;
+            inference = infer_lens_views(scene, o, samples, &greedy)?;
+        }
+        inference.tree_gain_db = Some(gain);
+    }
+    Ok(inference)
 }
+
+/// The least the ray tree's further terms must add at the samples (mean PSNR of every term
+/// against the greedy two, both against the traced terms) to be drawn: each costs a draw
+/// and its vertex paths per frame.
+pub const MIN_TREE_GAIN_DB: f64 = 0.1;
 
 /// A term's rows of one shell: the render matrix's rows of the pixels the records reach,
 /// with their colour and alpha targets.
 type ShellRow = (RenderMatrix, Vec<f32>, Vec<f32>);
 
-/// One view's rows for each shell: per term, the render matrix's rows of the pixels the
-/// records reach, with their colour and alpha targets.
+/// One view's rows for each shell: per greedy term, the render matrix's rows of the pixels
+/// the records reach, with their colour and alpha targets.
 fn view_rows(
     scene: &Scene,
     o: usize,
@@ -411,11 +457,7 @@ fn view_rows(
     // Per term, the records' targets.
     let mut targets = Vec::new();
     for term in TERMS {
-        let (kind, modulation) = if term == Term::ReflectionFirst {
-            (LayerKind::Reflection, LayerKind::ReflectionModulation)
-        } else {
-            (LayerKind::Refraction, LayerKind::RefractionModulation)
-        };
+        let [kind, modulation, _] = term_layers(term);
         let (value, fg) = (
             traced_rgb(scene, render.images, o, kind, n),
             traced_rgb(scene, render.images, o, modulation, n),
@@ -430,21 +472,20 @@ fn view_rows(
     }
     // Confidence (thesis 6.3.3): 1 − min(θm², θc²)/θc² from the spread of each pixel's exit
     // directions, multiplied into both sides of each row.
-    let confidence: Vec<Vec<f32>> =
-        [LayerKind::ReflectionConfidence, LayerKind::RefractionConfidence]
-            .iter()
-            .map(|&k| {
-                let plane = render
-                    .images
-                    .object_layer(&scene.objects[o].name, k)
-                    .and_then(|l| l.channel("Y"))
-                    .map(|c| c.to_vec());
-                plane.filter(|_| settings.confidence).unwrap_or_else(|| vec![1.0; n])
-            })
-            .collect();
+    let confidence: Vec<Vec<f32>> = TERMS
+        .iter()
+        .map(|&term| {
+            let plane = render
+                .images
+                .object_layer(&scene.objects[o].name, term_layers(term)[2])
+                .and_then(|l| l.channel("Y"))
+                .map(|c| c.to_vec());
+            plane.filter(|_| settings.confidence).unwrap_or_else(|| vec![1.0; n])
+        })
+        .collect();
     (0..layers.distances.len())
         .map(|l| {
-            (0..2)
+            (0..TERMS.len())
                 .map(|t| {
                     let (weight, per) = &targets[t];
                     let c = &confidence[t];
@@ -509,10 +550,11 @@ fn face_size(views: &[&ViewModel], shells: &[FittedShell]) -> u32 {
     2f64.powf((-p10).round().clamp(3.0, MAX_FACE.ilog2() as f64)) as u32
 }
 
-/// The lens object's two terms drawn at `frame` by hybrid rendering (the frame's own
+/// The lens object's terms drawn at `frame` by hybrid rendering (the frame's own
 /// tessellation and vertex rays) from `inference`'s cube maps at view samples `samples`
-/// (sample index and blending weight), against `render` traced at that frame: per term and
-/// for both, over the pixels the traced object covers.
+/// (sample index and blending weight), against `render` traced at that frame: the
+/// reflection-first and refraction-first terms, and every term of `settings`' lens model
+/// summed, over the pixels the traced object covers.
 pub fn predict_view(
     scene: &Scene,
     o: usize,
@@ -528,41 +570,42 @@ pub fn predict_view(
         .collect();
     let model =
         ViewModel::new(scene, o, frame, (render.images.width, render.images.height), settings)
-            .with_matrices(&inference.shells, inference.face);
-    predict_with(scene, o, &model, &render.images, inference.face, &cubes)
+            .with_matrices(&inference.shells, inference.face, settings.lookups);
+    let (reflection, refraction, both, _) =
+        predict_with(scene, o, &model, &render.images, inference.face, &cubes);
+    (reflection, refraction, both)
 }
 
-/// The lens object's two terms as the player draws them at a view of `model` from the
+/// The lens object's terms as the player draws them at a view of `model` from the
 /// per-shell RGBA cube maps `cubes` (each shell's cube already blended over the view
-/// samples): per term, [`term_radiance`] at the pixels that draw it. Returns per term the
-/// RGB image (`width · height · 3`, zero where the term is not drawn).
-pub fn lens_image(model: &LensViewModel, cubes: &[&[f32]]) -> [Vec<f32>; 2] {
+/// samples): per term, [`term_radiance`] at the pixels that draw it. Returns per term of the
+/// lens model the RGB image (`width · height · 3`, zero where the term is not drawn).
+pub fn lens_image(model: &LensViewModel, cubes: &[&[f32]]) -> Vec<Vec<f32>> {
     lens_terms(model, &term_pixels(model), cubes)
 }
 
 /// Per term, the pixels of `model` that draw it with their interpolated F·G
 /// ([`hybrid_pixels`] of the modulation, [`Missing::Zero`]).
-pub fn term_pixels(model: &LensViewModel) -> [HybridPixels; 2] {
-    TERMS.map(|term| {
-        hybrid_pixels(
-            model.viewport,
-            &model.tess,
-            model.clip,
-            &vertex_modulation(&model.tess, term),
-            Missing::Zero,
-            None,
-        )
-    })
+pub fn term_pixels(model: &LensViewModel) -> Vec<HybridPixels> {
+    Term::of(model.model)
+        .iter()
+        .map(|&term| {
+            hybrid_pixels(
+                model.viewport,
+                &model.tess,
+                model.clip,
+                &vertex_modulation(&model.tess, term),
+                Missing::Zero,
+                None,
+            )
+        })
+        .collect()
 }
 
 /// [`lens_image`] with each term's pixels and F·G ([`term_pixels`]) made.
-pub fn lens_terms(
-    model: &LensViewModel,
-    fg: &[HybridPixels; 2],
-    cubes: &[&[f32]],
-) -> [Vec<f32>; 2] {
+pub fn lens_terms(model: &LensViewModel, fg: &[HybridPixels], cubes: &[&[f32]]) -> Vec<Vec<f32>> {
     let n = (model.viewport.width * model.viewport.height) as usize;
-    let mut out = [vec![0.0f32; n * 3], vec![0.0f32; n * 3]];
+    let mut out = vec![vec![0.0f32; n * 3]; fg.len()];
     for (t, fg) in fg.iter().enumerate() {
         let a: Vec<&RenderMatrix> = model.a[t].iter().collect();
         for (&p, c) in fg.pixels.iter().zip(term_radiance(fg, &a, cubes)) {
@@ -580,7 +623,7 @@ fn predict_with(
     images: &PointImages,
     face: u32,
     samples: &[(&Vec<Vec<f32>>, f32)],
-) -> (TermFit, TermFit, TermFit) {
+) -> (TermFit, TermFit, TermFit, TermFit) {
     let (w, h) = (images.width, images.height);
     let n = (w * h) as usize;
     let layout = TextureLayout::cube(face);
@@ -599,10 +642,10 @@ fn predict_with(
         .map(|c| c.to_vec())
         .unwrap_or_else(|| vec![0.0; n]);
     let predicted = lens_image(model, &cubes.iter().map(Vec::as_slice).collect::<Vec<_>>());
-    let traced = [
-        traced_rgb(scene, images, o, LayerKind::Reflection, n),
-        traced_rgb(scene, images, o, LayerKind::Refraction, n),
-    ];
+    let traced: Vec<Vec<f32>> = Term::of(model.model)
+        .iter()
+        .map(|&t| traced_rgb(scene, images, o, term_layers(t)[0], n))
+        .collect();
     let fit = |pred: &[f32], truth: &[f32]| {
         let pixels: Vec<usize> = (0..n).filter(|&p| cover[p] > 0.5).collect();
         let gather = |v: &[f32]| {
@@ -613,10 +656,22 @@ fn predict_with(
         };
         TermFit { psnr_db: psnr_display(&gather(pred), &gather(truth)), pixels: pixels.len() }
     };
-    let sum = |a: &[f32], b: &[f32]| a.iter().zip(b).map(|(x, y)| x + y).collect::<Vec<f32>>();
+    let sum = |terms: &[Vec<f32>]| {
+        let mut all = vec![0.0f32; n * 3];
+        terms.iter().for_each(|t| all.iter_mut().zip(t).for_each(|(a, x)| *a += x));
+        all
+    };
+    let all = sum(&traced);
     (
         fit(&predicted[0], &traced[0]),
         fit(&predicted[1], &traced[1]),
-        fit(&sum(&predicted[0], &predicted[1]), &sum(&traced[0], &traced[1])),
+        fit(&sum(&predicted), &all),
+        fit(&sum(&predicted[..TERMS.len()]), &all),
     )
+}
+
+/// The traced layers of `term`: its value, its F·G modulation and its confidence.
+fn term_layers(term: Term) -> [LayerKind; 3] {
+    [TermPart::Value, TermPart::Modulation, TermPart::Confidence]
+        .map(|part| LayerKind::of_term(term as usize, part))
 }

@@ -10,7 +10,7 @@
 //! player does, through the per-point render matrices of hybrid rendering ([`LensPoint`]).
 
 use anyhow::Result;
-use pis_compile::hybrid::HybridPixels;
+use pis_compile::hybrid::{HybridPixels, LensModel};
 use pis_compile::TextureLayout;
 use pis_scene::ObjectRole;
 
@@ -92,8 +92,10 @@ impl Planned for HybridPlanned {
             })
             .collect();
         let mut settings = LensInferSettings::default();
+        settings.tessellation.model = set.trace.lens_model;
         settings.solve.cg = job.settings.cg;
         settings.solver = job.solver.clone();
+        settings.lookups = job.req.shell_lookups;
         let cap = super::pem::budget::face_cap(job.plan, job.req.codec);
         if let Some(c) = cap {
             settings.max_face = c.face.min(settings.max_face);
@@ -115,7 +117,7 @@ impl Planned for HybridPlanned {
             let form = Box::new(ShellForm {
                 shell: fitted.shell,
                 layout,
-                lookups: 1,
+                lookups: settings.lookups,
                 channels: 4,
                 order: l as u8,
                 term: pis_format::Term::Refraction,
@@ -147,15 +149,17 @@ impl Planned for HybridPlanned {
         let both: Vec<f64> = inference.views.iter().map(|v| v.both.psnr_db).collect();
         let (lo, hi) =
             both.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |a, &x| (a.0.min(x), a.1.max(x)));
+        let terms = lens_model_words(&inference);
         model.shells =
             Some(Box::new(LensPoints(inference.models.into_iter().map(LensPoint::new).collect())));
         model.representation =
             if one { "hybrid rendering, one shell" } else { "hybrid rendering" }.to_string();
         model.why = format!(
-            "refractive: {} shell(s) from the ray records' hit distances ({}), cube faces {}², both terms {lo:.1}–{hi:.1} dB at the samples as solved; vertex rays traced per frame (τ {} px)",
+            "refractive: {} shell(s) from the ray records' hit distances ({}), cube faces {}², {}, {lo:.1}–{hi:.1} dB at the samples as solved; vertex rays traced per frame (τ {} px)",
             layers.len(),
             layers.join(", "),
             inference.face,
+            terms,
             settings.tessellation.tau_px
         );
         if inference.face == settings.max_face {
@@ -164,6 +168,22 @@ impl Planned for HybridPlanned {
             }
         }
         Ok(model)
+    }
+}
+
+/// What the report says of the lens model drawn: which, how many terms, and why.
+fn lens_model_words(inference: &lens_infer::LensInference) -> String {
+    let model = inference.models.first().map_or(LensModel::Greedy, |m| m.model);
+    let gain = inference.tree_gain_db;
+    match (model, gain) {
+        (LensModel::Tree { min_weight, .. }, Some(g)) => format!(
+            "the ray tree's {} terms down to weight {min_weight}, {g:+.2} dB over its greedy two at the samples",
+            model.terms()
+        ),
+        (_, Some(g)) => format!(
+            "the greedy model's two terms: the set's ray tree drew its further terms at {g:+.2} dB at the samples"
+        ),
+        _ => "the greedy model's two terms (the set's lens model)".to_string(),
     }
 }
 
@@ -182,7 +202,7 @@ pub fn transmission_tint(set: &LoadedSet, o: usize) -> [f32; 3] {
 /// tessellation and render matrices, and per term the pixels that draw it with their F·G.
 pub struct LensPoint {
     pub model: LensViewModel,
-    pub fg: [HybridPixels; 2],
+    pub fg: Vec<HybridPixels>,
 }
 
 impl LensPoint {
@@ -190,21 +210,21 @@ impl LensPoint {
         LensPoint { fg: term_pixels(&model), model }
     }
 
-    /// The two terms summed at `rows` (pixels, increasing), RGB per row, drawn from the
-    /// shells' RGBA cube maps `maps` (each with its channel count, 4).
+    /// The lens model's terms summed at `rows` (pixels, increasing), RGB per row, drawn
+    /// from the shells' RGBA cube maps `maps` (each with its channel count, 4).
     pub fn render(&self, rows: &[u32], maps: &[(&[f32], usize)]) -> Vec<f32> {
         let cubes: Vec<&[f32]> = maps.iter().map(|(m, _)| *m).collect();
-        let [r, t] = lens_terms(&self.model, &self.fg, &cubes);
+        let terms = lens_terms(&self.model, &self.fg, &cubes);
         rows.iter()
             .flat_map(|&p| {
                 let k = p as usize * 3;
-                [r[k] + t[k], r[k + 1] + t[k + 1], r[k + 2] + t[k + 2]]
+                [0, 1, 2].map(|c| terms.iter().map(|t| t[k + c]).sum::<f32>())
             })
             .collect()
     }
 }
 
-/// A lens object at every point of the set, its two terms drawn from the same shells.
+/// A lens object at every point of the set, its terms drawn from the same shells.
 pub struct LensPoints(pub Vec<LensPoint>);
 
 impl ShellTerms for LensPoints {
@@ -219,10 +239,14 @@ impl ShellTerms for LensPoints {
     fn transmits(&self) -> bool {
         true
     }
+
+    fn lens_model(&self) -> LensModel {
+        self.0.first().map_or(LensModel::Greedy, |p| p.model.model)
+    }
 }
 
 /// The screen weights of shell `s`'s sample at `points` (`texels` texels, every level
-/// stored): each texel's column sums over both terms' rows, each row weighed by its squared
+/// stored): each texel's column sums over every term's rows, each row weighed by its squared
 /// F·G (the term reaches the screen multiplied by it); scaled as the reflection shells'
 /// weights are.
 fn shell_weights(lens: &[LensPoint], s: usize, texels: usize, points: &[usize]) -> Vec<f32> {
