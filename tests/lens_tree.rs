@@ -2,27 +2,6 @@
 
 mod common;
 
-use std::path::Path;
-
-/// Copies the files (not the cache) of the sample at `rel` under samples/ into `dir`;
-/// returns the scene.toml.
-fn copy_sample(rel: &str, dir: &Path) -> std::path::PathBuf {
-    let sample = Path::new(env!("CARGO_MANIFEST_DIR")).join("../samples").join(rel);
-    for e in std::fs::read_dir(&sample).expect("sample folder") {
-        let p = e.expect("entry").path();
-        if p.is_file() {
-            std::fs::copy(&p, dir.join(p.file_name().expect("name"))).expect("copy");
-        }
-    }
-    dir.join("scene.toml")
-}
-
-fn run_json(tool: &str, args: &[&std::ffi::OsStr]) -> serde_json::Value {
-    let o = std::process::Command::new(tool).args(args).output().expect("the tool runs");
-    assert!(o.status.success(), "{tool}: {}", String::from_utf8_lossy(&o.stderr));
-    serde_json::from_slice(&o.stdout).expect("JSON report")
-}
-
 /// The glass sample traced with the ray tree and with the greedy model (the same samples:
 /// the traced images are identical, the tree adding the layers of its further terms), each
 /// packed losslessly by hybrid rendering: the tree's file records its lens model (SPEC.md
@@ -32,7 +11,12 @@ fn run_json(tool: &str, args: &[&std::ffi::OsStr]) -> serde_json::Value {
 #[test]
 fn the_ray_tree_is_drawn_by_the_player() {
     let dir = tempfile::tempdir().expect("temp dir");
-    let scene = copy_sample("glass", dir.path());
+    let scene = common::sample_copy("glass", dir.path(), |_, _| {});
+    let run_json = |tool: &str, args: &[&std::ffi::OsStr]| {
+        let out = common::run(tool, args, &[]);
+        assert!(out.status.success(), "{tool}: {}", String::from_utf8_lossy(&out.stderr));
+        common::json_report(&out)
+    };
     let file = |model: &str| {
         let set = dir.path().join(format!("{model}.set"));
         let out = common::run(

@@ -5,6 +5,7 @@
 //! 6.2, also without the setting) or the ray tree's terms.
 
 use crate::model::{ObjectRole, Provenance};
+use crate::object_setting::refractive_settings;
 
 /// The settings' key prefix; the object's name follows.
 pub const LENS_MODEL_PREFIX: &str = "lens_model.";
@@ -58,22 +59,14 @@ pub fn lens_models(
     p: Option<&Provenance>,
     objects: &[(&str, ObjectRole)],
 ) -> Result<Vec<LensTerms>, String> {
-    let mut out = vec![LensTerms::Greedy; objects.len()];
-    let Some(p) = p else { return Ok(out) };
-    for (k, v) in &p.settings {
-        let Some(name) = k.strip_prefix(LENS_MODEL_PREFIX) else { continue };
-        let o = objects
-            .iter()
-            .position(|o| o.0 == name)
-            .ok_or_else(|| format!("{k}: no object is named {name:?}"))?;
-        if objects[o].1 != ObjectRole::Refractive {
-            return Err(format!("{k}: object {name:?} is not refractive"));
-        }
-        out[o] = LensTerms::parse(v).ok_or_else(|| {
-            format!("{k} {v:?} is neither \"greedy\" nor \"tree,W,N\" (W in (0, 1], N 2 to 4)")
-        })?;
-    }
-    Ok(out)
+    refractive_settings(
+        p,
+        objects,
+        LENS_MODEL_PREFIX,
+        LensTerms::Greedy,
+        LensTerms::parse,
+        "is neither \"greedy\" nor \"tree,W,N\" (W in (0, 1], N 2 to 4)",
+    )
 }
 
 #[cfg(test)]

@@ -22,6 +22,7 @@ pub mod lens_model;
 pub mod master;
 pub mod mip;
 pub mod model;
+mod object_setting;
 mod payload_read;
 mod payload_write;
 mod read;

@@ -4,6 +4,7 @@
 //! surface, as pis-trace shades it); the player's hybrid rendering applies the same tint.
 
 use crate::model::{ObjectRole, Provenance};
+use crate::object_setting::refractive_settings;
 
 /// The settings' key prefix; the object's name follows.
 pub const TINT_PREFIX: &str = "transmission_tint.";
@@ -21,31 +22,25 @@ pub fn tints(
     p: Option<&Provenance>,
     objects: &[(&str, ObjectRole)],
 ) -> Result<Vec<[f32; 3]>, String> {
-    let mut out = vec![[1.0f32; 3]; objects.len()];
-    let Some(p) = p else { return Ok(out) };
-    for (k, v) in &p.settings {
-        let Some(name) = k.strip_prefix(TINT_PREFIX) else { continue };
-        let o = objects
-            .iter()
-            .position(|o| o.0 == name)
-            .ok_or_else(|| format!("{k}: no object is named {name:?}"))?;
-        if objects[o].1 != ObjectRole::Refractive {
-            return Err(format!("{k}: object {name:?} is not refractive"));
-        }
-        let parts: Vec<&str> = v.split(',').collect();
-        let rgb: Vec<f32> = parts
-            .iter()
-            .filter_map(|s| s.trim().parse::<f32>().ok())
-            .filter(|x| x.is_finite() && (0.0..=1.0).contains(x))
-            .collect();
-        if parts.len() != 3 || rgb.len() != 3 {
-            return Err(format!(
-                "{k} {v:?} is not three decimal numbers in [0, 1] separated by commas"
-            ));
-        }
-        out[o] = [rgb[0], rgb[1], rgb[2]];
-    }
-    Ok(out)
+    refractive_settings(
+        p,
+        objects,
+        TINT_PREFIX,
+        [1.0; 3],
+        parse_tint,
+        "is not three decimal numbers in [0, 1] separated by commas",
+    )
+}
+
+/// `r,g,b`, each a decimal number in [0, 1].
+fn parse_tint(v: &str) -> Option<[f32; 3]> {
+    let parts: Vec<&str> = v.split(',').collect();
+    let rgb: Vec<f32> = parts
+        .iter()
+        .filter_map(|s| s.trim().parse::<f32>().ok())
+        .filter(|x| x.is_finite() && (0.0..=1.0).contains(x))
+        .collect();
+    (parts.len() == 3 && rgb.len() == 3).then(|| [rgb[0], rgb[1], rgb[2]])
 }
 
 #[cfg(test)]

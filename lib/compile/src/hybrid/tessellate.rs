@@ -1,11 +1,12 @@
 //! Adaptive tessellation of a lens object for one frame (thesis 6.4.1): the paths of the
-//! lens model (the greedy two, or the ray tree's terms) traced at the vertices of the front-facing triangles — and of the back-facing ones the
-//! eye sees through an open mesh's holes, entered from inside as pis-trace enters them — triangles split at their edges' midpoints (1-to-4,
-//! 1-to-3 or 1-to-2) where their vertices' paths differ in topology or in exit direction by
-//! more than 3° (or, beyond the thesis, in F·G by more than 0.05), down to a screen edge
-//! length τ; the T-junctions left between triangles split
-//! to different depths removed afterwards through the same edge table, which also keeps each
-//! vertex's rays from being traced twice.
+//! lens model (the greedy two, or the ray tree's terms) traced at the vertices of the
+//! front-facing triangles — and of the back-facing ones the eye sees through an open mesh's
+//! holes, entered from inside as pis-trace enters them — triangles split at their edges'
+//! midpoints (1-to-4, 1-to-3 or 1-to-2) where their vertices' paths differ in topology or in
+//! exit direction by more than 3° (or, beyond the thesis, in F·G by more than 0.05), down to
+//! a screen edge length τ; the T-junctions left between triangles split to different depths
+//! removed afterwards through the same edge table, which also keeps each vertex's rays from
+//! being traced twice.
 //!
 //! Deterministic: triangles are split level by level in mesh order, new vertices numbered in
 //! that order, and their rays traced in parallel into their own slots.
