@@ -9,9 +9,11 @@
 //!   [`KNOWN_BELOW`] are not there yet: each says why, and must stay within 8 dB);
 //! - every object the file stores is drawn.
 //!
-//! The default file's figure (384:1 at CI size leaves about 1.2 KB for every level image of a
-//! scene) is printed beside them. `cargo test --release --test corpus -- --nocapture` prints
-//! the table; `PIS_CORPUS=NAME` runs one model.
+//! The default file's figure (the fewest bytes that play within 1 dB of the textures as solved,
+//! over every object's pixels together) is printed beside them, with how many objects play
+//! within [`DEFAULT_WITHIN_LOSSLESS_DB`] of their lossless figure.
+//! `cargo test --release --test corpus -- --nocapture` prints the table; `PIS_CORPUS=NAME` runs
+//! one model.
 
 mod common;
 
@@ -20,6 +22,11 @@ use std::process::{Command, Output};
 use std::time::Instant;
 
 use common::os;
+
+/// How far an object's default figure is counted as playing as solved: within this many dB
+/// of its lossless figure (counted and printed, not asserted: the default target holds the
+/// file's figure, not each object's).
+const DEFAULT_WITHIN_LOSSLESS_DB: f64 = 3.0;
 
 /// How far an object's lossless figure may lie below its set's noise level (dB).
 const BELOW_NOISE_DB: f64 = 6.0;
@@ -116,7 +123,9 @@ fn scene_toml(name: &str, dir: &Path) -> PathBuf {
 const PACKAGES: &str = "Debian's assimp-testmodels and assimp-utils: samples/corpus/README.md";
 
 /// Traces, packs and plays one model; returns the lines of its table and its failures.
-fn check(name: &str) -> (Vec<String>, Vec<String>) {
+/// A model's printed lines, its failures, and its objects (drawn, and playing with the
+/// defaults within [`DEFAULT_WITHIN_LOSSLESS_DB`] of lossless).
+fn check(name: &str) -> (Vec<String>, Vec<String>, (usize, usize)) {
     let start = Instant::now();
     let dir = tempfile::tempdir().expect("temp dir");
     let toml = scene_toml(name, dir.path());
@@ -158,6 +167,7 @@ fn check(name: &str) -> (Vec<String>, Vec<String>) {
     )];
     let mut failures = Vec::new();
     let drawn = objects(&played);
+    let mut counts = (0, 0);
     // Objects the file stores that the player does not draw (an object whose pixels no pixel
     // centre sees, as the hardware model draws, is left out by pis-pack, which says so).
     for o in packed["objects"].as_array().expect("objects") {
@@ -171,6 +181,8 @@ fn check(name: &str) -> (Vec<String>, Vec<String>) {
         lines.push(format!(
             "  {object:<28} noise {noise_db:6.2}  lossless {lossless_db:6.2}  default {default_db:6.2} dB"
         ));
+        counts.0 += (default_db >= lossless_db - DEFAULT_WITHIN_LOSSLESS_DB) as usize;
+        counts.1 += 1;
         let known = KNOWN_BELOW.iter().find(|(m, o, _)| *m == name && *o == object);
         let floor = noise_db.min(60.0) - known.map_or(BELOW_NOISE_DB, |_| KNOWN_BELOW_DB);
         if lossless_db.is_nan() {
@@ -189,7 +201,7 @@ fn check(name: &str) -> (Vec<String>, Vec<String>) {
             ));
         }
     }
-    (lines, failures)
+    (lines, failures, counts)
 }
 
 fn models() -> Vec<String> {
@@ -211,11 +223,16 @@ fn every_model_plays_as_it_traces() {
     let names = models();
     assert!(!names.is_empty(), "no model in samples/corpus");
     let mut all_failures = Vec::new();
+    let (mut within, mut objects) = (0, 0);
     for name in &names {
-        let (lines, failures) = check(name);
+        let (lines, failures, counts) = check(name);
         println!("{}", lines.join("\n"));
         all_failures.extend(failures);
+        (within, objects) = (within + counts.0, objects + counts.1);
     }
+    println!(
+        "default within {DEFAULT_WITHIN_LOSSLESS_DB} dB of lossless: {within} of {objects} objects"
+    );
     assert!(all_failures.is_empty(), "{}", all_failures.join("\n"));
 }
 

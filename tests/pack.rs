@@ -389,6 +389,47 @@ fn pack_degrades_monotonically_with_the_ratio() {
     }
 }
 
+/// The default target is a played quality: the fewest bytes whose predicted played PSNR is
+/// within 1 dB of the textures as solved. A looser target takes fewer bytes and a tighter one
+/// more, each meets its own goal, every trial with fewer bytes than the one kept misses it,
+/// and the file records the target it was packed for.
+#[test]
+fn the_default_target_is_the_fewest_bytes_within_1_db_of_the_solved_textures() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let mut last: Option<(f64, u64)> = None;
+    for within in ["3", "1", "0.5"] {
+        let file = dir.path().join(format!("within-{within}.pis"));
+        let args: &[&str] = if within == "1" { &[] } else { &["--within", within] };
+        let r = json(&pack(set(), &file, args));
+        validate(&file);
+        let d: f64 = within.parse().unwrap();
+        assert_eq!(r["target_within_db"].as_f64(), Some(d), "{r}");
+        let (psnr, solved) =
+            (r["psnr_db"].as_f64().unwrap(), r["psnr_db_solved"].as_f64().unwrap());
+        let played = &r["played"];
+        let goal = played["goal_db"].as_f64().expect("goal_db");
+        assert!(
+            (goal - (solved - d)).abs() < 1e-9,
+            "--within {within}: goal {goal}, solved {solved}"
+        );
+        assert_eq!(played["reached"], true, "--within {within}: {played}");
+        assert!(psnr >= goal - 1e-3, "--within {within}: {psnr:.3} dB for a goal of {goal:.3}");
+        let bytes = r["texture_bytes"].as_u64().unwrap();
+        for t in played["trials"].as_array().expect("trials") {
+            if t["bytes"].as_u64().unwrap() < bytes {
+                assert!(t["psnr_db"].as_f64().unwrap() < goal - 1e-3, "--within {within}: {t}");
+            }
+        }
+        if let Some((prev_psnr, prev_bytes)) = last {
+            assert!(psnr > prev_psnr && bytes > prev_bytes, "--within {within}: {psnr:.2} dB with {bytes} bytes after {prev_psnr:.2} with {prev_bytes}");
+        }
+        last = Some((psnr, bytes));
+        let info = Command::new(env!("CARGO_BIN_EXE_pis-inspect")).arg(&file).output().unwrap();
+        let text = String::from_utf8_lossy(&info.stdout);
+        assert!(text.contains(&format!("target=within {within} dB")), "{text}");
+    }
+}
+
 #[test]
 fn pack_refuses_a_ratio_that_leaves_no_byte_and_names_the_highest() {
     let dir = tempfile::tempdir().expect("temp dir");
@@ -471,8 +512,14 @@ fn auto_max_mse_keeps_the_better_of_the_constraint_and_the_free_allocation() {
 /// smooth glass and the lens terms' exit rays at their depth (RAYSET.md 5.3): the glass cup's
 /// traced layers changed, the file's size did not. Recorded again when the minor version
 /// became 2 (the `lens_model` setting, SPEC.md 10.1): the header's version and checksum
-/// bytes only (with them set back, the file's CRC-32 is the earlier 0xd745f345).
-const DEMO1_CI_PACK: (usize, u32) = (195_789, 0x430f_d704);
+/// bytes only (with them set back, the file's CRC-32 is the earlier 0xd745f345). Recorded
+/// again when the default target became a played quality (`--within 1`): the allocation
+/// searched for the fewest bytes within 1 dB of the textures as solved; `--ratio 384`, the
+/// earlier default, still writes the earlier bytes ([`DEMO1_CI_PACK_384`]).
+const DEMO1_CI_PACK: (usize, u32) = (230_544, 0x4d51_571d);
+
+/// The same at `--ratio 384`: the bytes the default wrote before it became a played quality.
+const DEMO1_CI_PACK_384: (usize, u32) = (195_789, 0x430f_d704);
 
 #[test]
 fn pack_output_is_byte_identical_to_the_recorded_checksum() {
@@ -486,22 +533,26 @@ fn pack_output_is_byte_identical_to_the_recorded_checksum() {
         .output()
         .expect("pis-trace runs");
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
-    // Relative paths: the provenance records the input as given.
-    let out = Command::new(env!("CARGO_BIN_EXE_pis-pack"))
-        .args(["set", "--scene"])
-        .arg(demo1())
-        .args(["-o", "out.pis"])
-        .current_dir(dir.path())
-        .output()
-        .expect("pis-pack runs");
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
-    let bytes = std::fs::read(dir.path().join("out.pis")).expect("the packed file");
-    let got = (bytes.len(), crc32fast::hash(&bytes));
-    assert_eq!(
-        got, DEMO1_CI_PACK,
-        "pis-pack's output changed: {} bytes, CRC-32 {:#010x}",
-        got.0, got.1
-    );
+    for (args, recorded) in [(&[][..], DEMO1_CI_PACK), (&["--ratio", "384"][..], DEMO1_CI_PACK_384)]
+    {
+        // Relative paths: the provenance records the input as given.
+        let out = Command::new(env!("CARGO_BIN_EXE_pis-pack"))
+            .args(["set", "--scene"])
+            .arg(demo1())
+            .args(["-o", "out.pis"])
+            .args(args)
+            .current_dir(dir.path())
+            .output()
+            .expect("pis-pack runs");
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        let bytes = std::fs::read(dir.path().join("out.pis")).expect("the packed file");
+        let got = (bytes.len(), crc32fast::hash(&bytes));
+        assert_eq!(
+            got, recorded,
+            "pis-pack {args:?}: the output changed: {} bytes, CRC-32 {:#010x}",
+            got.0, got.1
+        );
+    }
 }
 
 /// Any scaled node once made pis-pack fail after the whole solve with "error-5106:

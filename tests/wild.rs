@@ -1,10 +1,9 @@
 //! Scenes from the wild (samples/wild: glTF as exporters write it: centimetre root scales, a
 //! mirrored instance, PBR texture maps, transmission glass, lights from scene.toml only),
-//! each traced at its scene.toml (CI) size, packed at the default ratio and played: the
-//! player's frames are measured against a 64-spp gold standard with `pis-diff FILE GOLD`:
-//! the whole image at 25 dB or more. Each object's figure is printed beside it: at CI size
-//! the default ratio leaves about 1.2 KB for every level image of a scene, and a small
-//! object's share of it is tens of bytes.
+//! each traced at its scene.toml (CI) size, packed with the defaults (within
+//! `pis_pack::DEFAULT_WITHIN_DB` of the textures as solved) and played: the player's frames
+//! are measured against a 64-spp gold standard with `pis-diff FILE GOLD`: the whole image at
+//! 25 dB or more. Each object's figure is printed beside it.
 //!
 //! `cargo test --release --test wild -- --nocapture` prints the figures.
 
@@ -35,8 +34,8 @@ fn os<S: AsRef<std::ffi::OsStr> + ?Sized>(s: &S) -> &std::ffi::OsStr {
     s.as_ref()
 }
 
-/// Traces `name` (the set at its own spp, the gold standard at 64), packs the set at the
-/// default ratio, measures the file against the gold standard and checks every figure.
+/// Traces `name` (the set at its own spp, the gold standard at 64), packs the set with the
+/// defaults, measures the file against the gold standard and checks every figure.
 fn check(name: &str) {
     let start = Instant::now();
     let dir = tempfile::tempdir().expect("temp dir");
@@ -53,7 +52,12 @@ fn check(name: &str) {
     );
     let pack: serde_json::Value = serde_json::from_slice(&pack.stdout).expect("pis-pack JSON");
     let ratio = pack["ratio_without_geometry"].as_f64().expect("ratio_without_geometry");
-    assert!((ratio / 384.0 - 1.0).abs() < 0.05, "{name}: ratio {ratio:.1}, default 384");
+    let (predicted, solved) = (pack["psnr_db"].as_f64(), pack["psnr_db_solved"].as_f64());
+    let within = pis_pack::DEFAULT_WITHIN_DB;
+    assert!(
+        matches!((predicted, solved), (Some(p), Some(s)) if p >= s - within - 1e-3),
+        "{name}: predicted {predicted:?} dB against {solved:?} as solved"
+    );
     let diff = run(env!("CARGO_BIN_EXE_pis-diff"), &[os(&file), os(&gold), os("--json")]);
     let diff: serde_json::Value = serde_json::from_slice(&diff.stdout).expect("pis-diff JSON");
 

@@ -164,6 +164,9 @@ fn usage(msg: String) -> Failure {
 fn check(req: &ReencodeRequest) -> Result<(), Failure> {
     if let Some(t) = req.target {
         t.check().map_err(usage)?;
+        if t.within().is_some() {
+            return Err(usage("a played-quality target needs the traced set to predict against: give pis-reencode --ratio or --psnr".to_string()));
+        }
     }
     if let Some(g) = req.gamma {
         if !(g.is_finite() && g > 0.0) {
@@ -370,10 +373,10 @@ fn target(
     raw: u64,
     texture_bytes_before: u64,
 ) -> (allocate::Target, String) {
-    let exact = !req.codec.is_lossy();
-    match req.target {
-        _ if exact => (allocate::Target::Bytes(usize::MAX), "exact".to_string()),
-        Some(t) => (t.allocation(raw), t.describe()),
+    let given = req.target.and_then(|t| Some((t.fixed_allocation(raw)?, t.describe())));
+    match given {
+        _ if !req.codec.is_lossy() => (allocate::Target::Bytes(usize::MAX), "exact".to_string()),
+        Some(fixed) => fixed,
         None => {
             let bytes = allocate::Target::Bytes(texture_bytes_before as usize);
             (bytes, format!("bytes {texture_bytes_before}"))

@@ -38,6 +38,7 @@ pub mod model;
 pub mod packed;
 pub mod pem;
 pub mod plan;
+pub mod played;
 pub mod predict;
 pub mod registry;
 pub mod report;

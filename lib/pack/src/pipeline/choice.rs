@@ -6,6 +6,9 @@
 //!
 //! - under a PSNR target: it meets the target and the file is at least [`BYTES_MARGIN`]
 //!   smaller, or it meets the target and the other does not;
+//! - under a played quality (pis-pack's default): the same, every file searched for one
+//!   goal, the target below the best solved figure either representation gives, so that a
+//!   representation that plays better wins unless the other meets its goal with fewer bytes;
 //! - under a byte budget (a ratio) or lossless: the file's predicted PSNR is at least
 //!   [`PSNR_MARGIN_DB`] higher (on the rate–distortion front, the same error for fewer bytes).
 //!
@@ -20,8 +23,8 @@ use super::input::LoadedSet;
 use super::model::ObjectModel;
 use super::packed::Packed;
 use super::packed::Quality;
-use super::plan::Plan;
-use super::predict::predicted_psnr;
+use super::plan::{Aim, Plan};
+use super::predict::{predicted_psnr, solved_error, total_psnr};
 use super::{PackRequest, Stages};
 use crate::error::{Exit, Failure};
 
@@ -63,6 +66,19 @@ fn label(m: &ObjectModel) -> String {
     }
 }
 
+/// The solved PSNR of the file `packed` encodes with object model `mi` replaced by
+/// `models[mi]`: the other objects' solved errors as measured, this one drawn again.
+fn solved_with(
+    set: &LoadedSet,
+    packed: &Packed,
+    models: &[ObjectModel],
+    mi: usize,
+) -> Result<f64, Failure> {
+    let mut e = packed.solved_error.clone();
+    e[mi] = solved_error(set, &models[mi]).map_err(|e| Failure::new(Exit::Runtime, e))?;
+    Ok(total_psnr(&e))
+}
+
 fn encoded(
     set: &LoadedSet,
     models: &[ObjectModel],
@@ -96,11 +112,18 @@ pub fn choose(
         return Ok((models, None));
     }
     let (mut packed, mut quality, mut current) = encoded(set, &models, plan, req)?;
-    let target = req.target.psnr();
-    let budget = match target {
-        Some(t) => format!("for {t} dB"),
-        None if req.codec == pis_codec::CodecId::Lossless => "lossless".to_string(),
-        None => "at the same budget".to_string(),
+    // Under a played quality, every file is weighed at one goal: within the target of the
+    // best solved figure met so far, so that a representation that plays better raises it.
+    let within = match plan.target {
+        Aim::Played { within_db, goal_db: None } if req.codec.is_lossy() => Some(within_db),
+        _ => None,
+    };
+    let mut goal = within.map(|d| quality.overall_solved - d);
+    let budget = |goal: Option<f64>| match (goal, req.target.psnr()) {
+        (Some(g), _) => format!("for {g:.2} dB played"),
+        (None, Some(t)) => format!("for {t} dB"),
+        (None, None) if req.codec == pis_codec::CodecId::Lossless => "lossless".to_string(),
+        (None, None) => "at the same budget".to_string(),
     };
     let mut kept = 0;
     for (mi, mut alt) in alternatives {
@@ -112,7 +135,19 @@ pub fn choose(
         }
         std::mem::swap(&mut models[mi], &mut alt);
         let (first, second) = (label(&alt), label(&models[mi]));
-        let trial = encoded(set, &models, plan, req);
+        if let (Some(d), Some(g)) = (within, goal) {
+            let raised = solved_with(set, &packed, &models, mi)? - d;
+            if raised > g {
+                goal = Some(raised);
+                std::mem::swap(&mut models[mi], &mut alt);
+                (packed, quality, current) = encoded(set, &models, &plan.played_at(raised), req)?;
+                std::mem::swap(&mut models[mi], &mut alt);
+            }
+        }
+        let at = goal.map_or_else(|| plan.clone(), |g| plan.played_at(g));
+        let trial = encoded(set, &models, &at, req);
+        let target = goal.or(req.target.psnr());
+        let budget = budget(goal);
         let said = |o: Outcome| format!("{:.2} dB with {} bytes", o.psnr_db, o.bytes);
         let why = match trial {
             Ok((p, q, o)) if better(o, current, target) => {

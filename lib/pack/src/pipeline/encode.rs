@@ -17,10 +17,14 @@ use super::input::LoadedSet;
 use super::model::{key, ObjectModel};
 pub use super::packed::LayerTextures;
 use super::packed::{MaxMseChoice, Packed, PackedBlock};
-use super::plan::Plan;
-use super::predict::{predicted_psnr, solved_error};
+use super::plan::{Aim, Plan};
+use super::played;
+use super::predict::{predicted_psnr, solved_error, total_psnr};
 use super::shading::object_shading;
-use super::storage::{allocate_storage, build_pyramid, level_streams, BlockPyramid};
+use super::storage::{
+    allocate_storage, build_pyramid, level_streams, measure_items, reachable_coding_db,
+    BlockPyramid,
+};
 use super::stored_mesh::stored_mesh;
 pub use super::surface::{finest, mip_chain};
 use super::{MaxMse, PackRequest, Stages};
@@ -372,15 +376,6 @@ pub fn encode_all(
     empty_levels(&mut container, &pyramids, req.codec);
     let overhead = pis_format::to_bytes_unchecked(&container).len();
 
-    // The ratio counts level images against the raw images (thesis 4.8); geometry and
-    // tables come on top and are reported apart.
-    let areas: Vec<f64> = models.iter().map(|m| m.area).collect();
-    let storage = allocate_storage(&pyramids.built, req.codec, plan.target, &areas, req.max_mse)
-        .map_err(|e| target_failure(e, raw))?;
-    if let Some(total) = storage.allocated {
-        stages
-            .done("allocate", &format!("{total} bytes over {} level images", storage.level_images));
-    }
     // Per object, its solved textures drawn and measured, then dropped.
     let solved_error =
         models.iter().map(|m| solved_error(set, m)).collect::<Result<Vec<_>>>().map_err(runtime)?;
@@ -394,7 +389,26 @@ pub fn encode_all(
         solved_error,
         max_mse: None,
         quality: None,
+        played: None,
     };
+    // The ratio counts level images against the raw images (thesis 4.8); geometry and
+    // tables come on top and are reported apart.
+    let areas: Vec<f64> = models.iter().map(|m| m.area).collect();
+    let target = match plan.target {
+        Aim::Played { within_db, goal_db } if req.codec.is_lossy() => {
+            let goal = (within_db, goal_db);
+            return played_file(set, models, packed, pyramids, goal, &areas, req, stages);
+        }
+        Aim::Fixed(target) => target,
+        // An exact codec takes no allocation.
+        Aim::Played { .. } => pis_codec::allocate::Target::Bytes(usize::MAX),
+    };
+    let storage = allocate_storage(&pyramids.built, req.codec, target, &areas, req.max_mse)
+        .map_err(|e| target_failure(e, raw))?;
+    if let Some(total) = storage.allocated {
+        stages
+            .done("allocate", &format!("{total} bytes over {} level images", storage.level_images));
+    }
     let Some((free_rates, free_bytes)) = &storage.free else {
         let (built, at) = (pyramids.built, pyramids.at);
         let mut packed = emit(packed, &built, &at, models, req.codec, &storage.rates)?;
@@ -413,6 +427,52 @@ pub fn encode_all(
         req.codec, c.alpha, c.psnr_db_constrained, c.psnr_db_free, if c.constrained { "the constraint" } else { "the free allocation" },
     ));
     Ok(packed)
+}
+
+/// The file under a played-quality target (`goal`: dB within the solved textures, or a
+/// predicted played PSNR to reach): the fewest bytes [`played::search`] finds, each trial
+/// allocated for a coding PSNR, encoded and predicted.
+#[allow(clippy::too_many_arguments)]
+fn played_file(
+    set: &LoadedSet,
+    models: &[ObjectModel],
+    packed: Packed,
+    mut pyramids: Pyramids,
+    (within_db, goal_db): (f64, Option<f64>),
+    areas: &[f64],
+    req: &PackRequest,
+    stages: &mut Stages,
+) -> Result<Packed, Failure> {
+    let runtime = |e: anyhow::Error| Failure::new(Exit::Runtime, e);
+    measure_items(&mut pyramids.built, req.codec).map_err(runtime)?;
+    let reachable = reachable_coding_db(&pyramids.built, req.codec, areas).map_err(runtime)?;
+    let solved_db = total_psnr(&packed.solved_error);
+    let goal_db = goal_db.unwrap_or(solved_db - within_db);
+    let goal = played::Goal { goal_db, solved_db, reachable_coding_db: reachable };
+    let mut files = Vec::new();
+    let found = played::search(goal, |c| -> Result<played::Trial, Failure> {
+        let aim = pis_codec::allocate::Target::Psnr { db: c, peak: 1.0 };
+        let storage = allocate_storage(&pyramids.built, req.codec, aim, areas, req.max_mse)
+            .map_err(runtime)?;
+        let file =
+            emit(packed.clone(), &pyramids.built, &pyramids.at, models, req.codec, &storage.rates)?;
+        let q = predicted_psnr(set, models, &file).map_err(runtime)?;
+        let bytes = file.layer_bytes.iter().flatten().sum();
+        let trial = played::Trial { coding_db: c, bytes, psnr_db: q.overall };
+        files.push((file, q));
+        Ok(trial)
+    })?;
+    let (mut file, quality) = files.swap_remove(found.kept);
+    let t = found.trial();
+    stages.done("encode", &format!(
+        "{} allocations encoded and predicted for {goal_db:.2} dB played ({solved_db:.2} dB as solved): {} bytes predict {:.2} dB{}",
+        found.trials.len(), t.bytes, t.psnr_db,
+        if found.reached { "" } else { ", the closest the codec reaches" },
+    ));
+    file.quality = Some(quality);
+    file.played = Some(found);
+    record_max_mse(&mut file, req.max_mse.alpha().map_or(MaxMse::Off, MaxMse::On));
+    Ok(file)
 }
 
 /// Both allocations, with the max-MSE constraint (`rates.0`) and without (`rates.1`),

@@ -45,6 +45,8 @@ pub struct Packed {
     /// The prediction made while choosing the allocation, which [`super::predict::predicted_psnr`] returns
     /// instead of rendering the same textures again.
     pub quality: Option<Quality>,
+    /// Under a played-quality target: the search's trials and the one kept.
+    pub played: Option<super::played::Found>,
 }
 
 /// The choice between the max-MSE constrained and the free allocation.

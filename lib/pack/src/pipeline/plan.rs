@@ -25,8 +25,20 @@ pub struct Plan {
     /// How the objects' block origins are offset.
     pub stagger: Stagger,
     /// What the allocation aims at: a ratio as its byte budget of level images against the
-    /// set's raw images (thesis 4.8; geometry and tables come on top), or a PSNR.
-    pub target: allocate::Target,
+    /// set's raw images (thesis 4.8; geometry and tables come on top), a PSNR of the coded
+    /// textures, or a played quality.
+    pub target: Aim,
+}
+
+/// The storage allocation's aim.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Aim {
+    /// One allocation: a byte budget or a PSNR of the coded textures.
+    Fixed(allocate::Target),
+    /// The fewest bytes whose predicted played PSNR reaches `goal_db`, or, where no goal is
+    /// set, comes within `within_db` of the file's textures as solved: a search over
+    /// allocations, each encoded and predicted ([`super::played`]).
+    Played { within_db: f64, goal_db: Option<f64> },
 }
 
 impl Plan {
@@ -49,6 +61,16 @@ impl Plan {
         Plan { target: target.allocation(raw_image_bytes), ..self.clone() }
     }
 
+    /// The same layout aiming at a predicted played PSNR of `goal_db` (`--representation
+    /// auto` weighing files at one goal); a fixed aim is kept.
+    pub fn played_at(&self, goal_db: f64) -> Plan {
+        let target = match self.target {
+            Aim::Played { within_db, .. } => Aim::Played { within_db, goal_db: Some(goal_db) },
+            fixed => fixed,
+        };
+        Plan { target, ..self.clone() }
+    }
+
     /// Block origin offsets of object model `i` of `n` ([`stagger`]).
     pub fn stagger(&self, i: usize, n: usize) -> Vec<u32> {
         stagger(i, n, &self.sizes, &self.samples, self.stagger)
@@ -57,8 +79,8 @@ impl Plan {
     /// The level-image bytes the allocation may spend, where it aims at a ratio.
     pub fn budget(&self) -> Option<u64> {
         match self.target {
-            allocate::Target::Bytes(b) => Some(b as u64),
-            allocate::Target::Psnr { .. } => None,
+            Aim::Fixed(allocate::Target::Bytes(b)) => Some(b as u64),
+            _ => None,
         }
     }
 }

@@ -178,6 +178,12 @@ fn layer_codec(block: &Block) -> CodecId {
     block.levels.first().and_then(|l| l.images.first()).map_or(CodecId::Raw, |c| c.codec)
 }
 
+/// PSNR in dB (peak 1) of squared error sums over their numbers of values, summed.
+pub fn total_psnr(e: &[(f64, usize)]) -> f64 {
+    let (s, n) = e.iter().fold((0.0, 0), |a, x| (a.0 + x.0, a.1 + x.1));
+    psnr(s, n)
+}
+
 /// PSNR in dB (peak 1) of a squared error sum over `n` values.
 pub fn psnr(sse: f64, n: usize) -> f64 {
     10.0 * (1.0 / (sse / n.max(1) as f64).max(1e-20)).log10()
@@ -212,14 +218,10 @@ pub fn predicted_psnr(set: &LoadedSet, models: &[ObjectModel], packed: &Packed) 
         e_dec.push(display_error(set, m, decoded.as_slice())?);
     }
     let e_sol = &packed.solved_error;
-    let total = |e: &[(f64, usize)]| {
-        let (s, n) = e.iter().fold((0.0, 0), |a, x| (a.0 + x.0, a.1 + x.1));
-        psnr(s, n)
-    };
     Ok(Quality {
         objects: e_dec.iter().zip(e_sol).map(|(a, b)| (psnr(a.0, a.1), psnr(b.0, b.1))).collect(),
-        overall: total(&e_dec),
-        overall_solved: total(e_sol),
+        overall: total_psnr(&e_dec),
+        overall_solved: total_psnr(e_sol),
         max_texel_error: max_err,
     })
 }

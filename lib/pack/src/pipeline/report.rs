@@ -98,6 +98,11 @@ pub struct PackReport {
     /// images, `ratio_without_geometry`.
     pub target_ratio: Option<f64>,
     pub target_psnr_db: Option<f64>,
+    /// The played-quality target (the default): dB below the textures as solved.
+    pub target_within_db: Option<f64>,
+    /// Under a played-quality target: the predicted played PSNR aimed at, whether the file
+    /// reaches it, and every allocation the search encoded and predicted.
+    pub played: Option<PlayedReport>,
     /// Predicted PSNR over every object's covered pixels, decoded textures.
     pub psnr_db: f64,
     /// The same with the textures as solved.
@@ -152,6 +157,18 @@ impl MemoryReport {
         self.budget_asked
             && matches!((self.peak_bytes, self.budget_bytes), (Some(p), Some(b)) if p > b)
     }
+}
+
+/// The search of a played-quality target.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct PlayedReport {
+    /// The predicted played PSNR aimed at (dB).
+    pub goal_db: f64,
+    /// The file meets it; otherwise the codec's richest allocation falls short.
+    pub reached: bool,
+    /// Each allocation tried, in order: the coding PSNR it aimed at, its level-image bytes,
+    /// its predicted played PSNR.
+    pub trials: Vec<super::played::Trial>,
 }
 
 /// Both allocations' predicted PSNR, when `auto` encoded both.
@@ -241,6 +258,12 @@ pub fn build(
         ratio_without_geometry: raw as f64 / texture_bytes.max(1) as f64,
         target_ratio: req.target.ratio().filter(|_| req.codec.is_lossy()),
         target_psnr_db: req.target.psnr(),
+        target_within_db: req.target.within().filter(|_| req.codec.is_lossy()),
+        played: packed.played.as_ref().map(|f| PlayedReport {
+            goal_db: f.goal.goal_db,
+            reached: f.reached,
+            trials: f.trials.clone(),
+        }),
         psnr_db: q.overall,
         psnr_db_solved: q.overall_solved,
         max_texel_error: q.max_texel_error,
@@ -306,6 +329,19 @@ pub fn print_report(r: &PackReport, out: &mut impl std::io::Write) -> std::io::R
         "  predicted PSNR {:.2} dB (textures as solved {:.2} dB)",
         r.psnr_db, r.psnr_db_solved
     )?;
+    if let Some(p) = &r.played {
+        let within = r.target_within_db.unwrap_or_default();
+        let how = if p.reached {
+            format!("met with the fewest bytes of {} allocations tried", p.trials.len())
+        } else {
+            format!("out of reach: the richest of {} allocations tried kept", p.trials.len())
+        };
+        writeln!(
+            out,
+            "  target: within {within} dB of the textures as solved, {:.2} dB played: {how}",
+            p.goal_db
+        )?;
+    }
     match (&r.max_mse_ratio, &r.max_mse_psnr_db) {
         (Some(a), Some(p)) => writeln!(out, "  allocation: max-MSE constraint {} (predicted {:.2} dB with the constraint, {:.2} dB free: the higher kept)", if a == "off" { "dropped" } else { "kept" }, p.constrained, p.free)?,
         (Some(a), None) if a == "off" => writeln!(out, "  allocation: free (no max-MSE constraint)")?,

@@ -203,6 +203,39 @@ pub struct Storage {
     pub free: Option<(Vec<Rate>, usize)>,
 }
 
+/// Measures every level image's rate–distortion item for a lossy `codec` once, so that
+/// allocations that follow (a played-quality search) reuse them.
+pub fn measure_items(blocks: &mut [BlockPyramid], codec: CodecId) -> Result<()> {
+    if !codec.is_lossy() {
+        return Ok(());
+    }
+    let c = pis_codec::codec(codec).ok_or_else(|| anyhow!("codec {codec} is not in this build"))?;
+    blocks.par_iter_mut().try_for_each(|pb| -> Result<()> {
+        pb.rd = Some(pb.items(c)?);
+        Ok(())
+    })
+}
+
+/// The highest PSNR (dB, peak 1) of the coded textures an allocation over `blocks` reaches:
+/// every level image at its richest point, weighed as the allocation weighs it.
+pub fn reachable_coding_db(blocks: &[BlockPyramid], codec: CodecId, areas: &[f64]) -> Result<f64> {
+    /// Far above any codec's reach: its error is what the allocation reports back.
+    const BEYOND_DB: f64 = 1000.0;
+    let c = pis_codec::codec(codec).ok_or_else(|| anyhow!("codec {codec} is not in this build"))?;
+    let items: Vec<Item> = blocks
+        .par_iter()
+        .map(|pb| pb.items(c))
+        .collect::<Result<Vec<_>>>()?
+        .into_iter()
+        .flatten()
+        .collect();
+    match allocate(&items, areas, Target::Psnr { db: BEYOND_DB, peak: 1.0 }, None) {
+        Ok(_) => Ok(BEYOND_DB),
+        Err(pis_codec::allocate::AllocError::Unreachable { best_db, .. }) => Ok(best_db),
+        Err(e) => Err(e.into()),
+    }
+}
+
 /// Equal-slope allocation (thesis 4.5) over every level image of `blocks` for a lossy
 /// `codec`: each level image's rate–distortion curve, weighted by the share of its layer's
 /// samples it reaches and by its object's screen area `areas[object]`, with the max-MSE
