@@ -380,8 +380,7 @@ fn a_scene_is_traced_packed_and_played_in_one_command() {
         return;
     }
     let dir = tempfile::tempdir().expect("temp dir");
-    // The scene's own size, 160×120 (pis-pack's default ratio, 384:1, needs a few hundred
-    // bytes).
+    // The scene's own size, 160×120.
     let scene = common::demo1_copy(
         dir.path(),
         &[
@@ -410,6 +409,28 @@ fn a_scene_is_traced_packed_and_played_in_one_command() {
     let r = json(&again);
     assert!(!err.contains("tracing and packing") && err.contains("playing"), "{err}");
     assert_eq!(r["frames"], 1, "{r}");
+    // A cached pack made for another target (an earlier default, 384:1) is packed again.
+    let set = dir.path().join(".pis-cache/demo1-160x120-spp1");
+    let out = Command::new(env!("CARGO_BIN_EXE_pis-pack"))
+        .args([
+            os(&set),
+            os("--scene"),
+            os(&scene),
+            os("-o"),
+            os(&packed),
+            os("--ratio"),
+            os("384"),
+        ])
+        .output()
+        .expect("pis-pack runs");
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let third = play(&[os(&scene), os("--headless"), os("--path"), os("diagonal"), os("--json")]);
+    let err = String::from_utf8_lossy(&third.stderr).to_string();
+    json(&third);
+    assert!(err.contains("tracing and packing"), "{err}");
+    let reader = pis_format::PisReader::open(&packed).expect("container");
+    let settings = &reader.container().provenance.as_ref().expect("provenance").settings;
+    assert!(settings.iter().any(|(k, v)| k == "target" && v.starts_with("within")), "{settings:?}");
 }
 
 /// The values of a container's first sample point, one per dimension.

@@ -50,7 +50,8 @@ fn pack_default(name: &str) -> serde_json::Value {
 /// The default target is met: the file's predicted played PSNR within
 /// [`pis_pack::DEFAULT_WITHIN_DB`] of its textures as solved, by the fewest bytes of the
 /// allocations searched, every object gets bytes, and the predicted PSNR is at least
-/// `floor_db` (measured at the sample's CI size, 4 spp, less 1 dB).
+/// `floor_db` (measured at the sample's CI size, 4 spp, less 1 dB: pis-pack traces a
+/// scene.toml without denoising).
 fn check(name: &str, floor_db: f64) {
     let r = pack_default(name);
     let (psnr, solved) =
@@ -79,20 +80,20 @@ fn check(name: &str, floor_db: f64) {
 
 #[test]
 fn demo1_packs_at_the_default_target() {
-    check("demo1", 33.2);
+    check("demo1", 30.0);
 }
 
 #[test]
 fn demo2_packs_at_the_default_target() {
-    check("demo2", 33.0);
+    check("demo2", 28.4);
 }
 
 #[test]
 fn teapot_pem_packs_at_the_default_target() {
-    check("teapot-pem", 32.1);
+    check("teapot-pem", 24.1);
 }
 
 #[test]
 fn glass_packs_at_the_default_target() {
-    check("glass", 28.4);
+    check("glass", 23.6);
 }

@@ -16,7 +16,7 @@ fn is_scene(path: &Path) -> bool {
 
 /// Traces (when not cached) and packs a scene.toml with `options` (pis-pack's); returns the
 /// container, kept in `.pis-cache/` beside the scene and reused while it is newer than the
-/// scene.toml. Options other than the defaults pack into a file of their own, named by a
+/// scene.toml and records the target asked for. Options other than the defaults pack into a file of their own, named by a
 /// hash of the options.
 fn pack_scene(scene_toml: &Path, options: &PackOptions) -> Result<PathBuf, Failure> {
     let load = pis_scene::LoadOptions {
@@ -34,8 +34,9 @@ fn pack_scene(scene_toml: &Path, options: &PackOptions) -> Result<PathBuf, Failu
     name.push(".pis");
     let output = set_dir.with_file_name(name);
     let modified = |p: &Path| std::fs::metadata(p).and_then(|m| m.modified()).ok();
+    let target = options.request(scene_toml.to_path_buf(), None, output.clone())?.target;
     if let (Some(pis), Some(toml)) = (modified(&output), modified(scene_toml)) {
-        if pis >= toml {
+        if pis >= toml && packed_for(&output, &target.describe()) {
             eprintln!(
                 "pis-play: playing {} (packed from {})",
                 output.display(),
@@ -56,6 +57,14 @@ fn pack_scene(scene_toml: &Path, options: &PackOptions) -> Result<PathBuf, Failu
     pis_pack::print_report(&report, &mut std::io::stderr())
         .map_err(|e| Failure::new(Exit::Io, e))?;
     Ok(output)
+}
+
+/// Whether the file at `path` records the target `target` (a cached pack made under an
+/// earlier default is packed again).
+fn packed_for(path: &Path, target: &str) -> bool {
+    let Ok(reader) = pis_format::PisReader::open(path) else { return false };
+    let settings = reader.container().provenance.as_ref().map(|p| p.settings.as_slice());
+    settings.unwrap_or_default().iter().any(|(k, v)| k == "target" && v == target)
 }
 
 /// 64-bit FNV-1a: a stable name for a set of options.

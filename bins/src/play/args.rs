@@ -53,7 +53,8 @@ fn parse_reduction(s: &str) -> Result<u32, String> {
 /// Given a scene.toml instead of a .pis file, the whole job runs first: the scene is traced
 /// (once, into `.pis-cache/` beside it) and packed with pis-pack's options (its defaults
 /// unless given) into `.pis-cache/NAME-WxH-sppN.pis` (`…-sppN-HASH.pis` for other pack
-/// options), reused while it is newer than the scene.toml; without
+/// options), reused while it is newer than the scene.toml and records the target asked for;
+/// without
 /// `--at`, `--path` or `--compare` it then plays along the diagonal (`--path diagonal`).
 #[derive(Parser, Debug, Clone)]
 #[command(name = "pis-play", version, about, after_help = crate::cli::EXIT_CODES_HELP)]

@@ -16,7 +16,7 @@ use super::blocks::transforms;
 use super::input::LoadedSet;
 use super::model::{key, ObjectModel};
 pub use super::packed::LayerTextures;
-use super::packed::{MaxMseChoice, Packed, PackedBlock};
+use super::packed::{MaxMseChoice, Packed, PackedBlock, Quality};
 use super::plan::{Aim, Plan};
 use super::played;
 use super::predict::{predicted_psnr, solved_error, total_psnr};
@@ -431,7 +431,10 @@ pub fn encode_all(
 
 /// The file under a played-quality target (`goal`: dB within the solved textures, or a
 /// predicted played PSNR to reach): the fewest bytes [`played::search`] finds, each trial
-/// allocated for a coding PSNR, encoded and predicted.
+/// allocated for a coding PSNR, encoded and predicted. Where an object plays more than
+/// [`played::OBJECT_WITHIN_FACTOR`] times the target below its own solved figure, its
+/// allocation weight is raised and the search runs again (at most
+/// [`played::OBJECT_ROUNDS`] searches).
 #[allow(clippy::too_many_arguments)]
 fn played_file(
     set: &LoadedSet,
@@ -445,14 +448,64 @@ fn played_file(
 ) -> Result<Packed, Failure> {
     let runtime = |e: anyhow::Error| Failure::new(Exit::Runtime, e);
     measure_items(&mut pyramids.built, req.codec).map_err(runtime)?;
-    let reachable = reachable_coding_db(&pyramids.built, req.codec, areas).map_err(runtime)?;
     let solved_db = total_psnr(&packed.solved_error);
     let goal_db = goal_db.unwrap_or(solved_db - within_db);
+    let object_limit = within_db * played::OBJECT_WITHIN_FACTOR;
+    let mut weights = areas.to_vec();
+    let mut held: Vec<String> = Vec::new();
+    let mut searches = Vec::new();
+    let (mut file, quality, found) = loop {
+        let (file, quality, found) =
+            search_file(set, models, &packed, &pyramids, (goal_db, solved_db), &weights, req)?;
+        searches.push(found.trials.len());
+        let raise = played::raised_weights(&quality.objects, object_limit);
+        if raise.is_empty() || searches.len() == played::OBJECT_ROUNDS {
+            break (file, quality, found);
+        }
+        for (o, factor) in raise {
+            weights[o] *= factor;
+            if !held.contains(&models[o].name) {
+                held.push(models[o].name.clone());
+            }
+        }
+    };
+    let t = found.trial();
+    let held_words = match held.is_empty() {
+        true => String::new(),
+        false => format!(
+            ", the weight of {} raised to hold it within {object_limit} dB of its solved figure",
+            held.join(", ")
+        ),
+    };
+    stages.done("encode", &format!(
+        "{} allocations encoded and predicted for {goal_db:.2} dB played ({solved_db:.2} dB as solved){held_words}: {} bytes predict {:.2} dB{}",
+        searches.iter().sum::<usize>(), t.bytes, t.psnr_db,
+        if found.reached { "" } else { ", the closest the codec reaches" },
+    ));
+    file.quality = Some(quality);
+    file.played = Some(played::Played { found, held, searches: searches.len() });
+    record_max_mse(&mut file, req.max_mse.alpha().map_or(MaxMse::Off, MaxMse::On));
+    Ok(file)
+}
+
+/// One [`played::search`] for `goal_db` (the file's solved figure `solved_db`) with the
+/// objects' allocation weights `weights`: the file kept, its prediction and the search.
+fn search_file(
+    set: &LoadedSet,
+    models: &[ObjectModel],
+    packed: &Packed,
+    pyramids: &Pyramids,
+    (goal_db, solved_db): (f64, f64),
+    weights: &[f64],
+    req: &PackRequest,
+) -> Result<(Packed, Quality, played::Found), Failure> {
+    let runtime = |e: anyhow::Error| Failure::new(Exit::Runtime, e);
+    let reachable = reachable_coding_db(&pyramids.built, req.codec, weights).map_err(runtime)?;
     let goal = played::Goal { goal_db, solved_db, reachable_coding_db: reachable };
     let mut files = Vec::new();
     let found = played::search(goal, |c| -> Result<played::Trial, Failure> {
         let aim = pis_codec::allocate::Target::Psnr { db: c, peak: 1.0 };
-        let storage = allocate_storage(&pyramids.built, req.codec, aim, areas, req.max_mse)
+        let storage = allocate_storage(&pyramids.built, req.codec, aim, weights, req.max_mse)
             .map_err(runtime)?;
         let file =
             emit(packed.clone(), &pyramids.built, &pyramids.at, models, req.codec, &storage.rates)?;
@@ -462,17 +515,8 @@ fn played_file(
         files.push((file, q));
         Ok(trial)
     })?;
-    let (mut file, quality) = files.swap_remove(found.kept);
-    let t = found.trial();
-    stages.done("encode", &format!(
-        "{} allocations encoded and predicted for {goal_db:.2} dB played ({solved_db:.2} dB as solved): {} bytes predict {:.2} dB{}",
-        found.trials.len(), t.bytes, t.psnr_db,
-        if found.reached { "" } else { ", the closest the codec reaches" },
-    ));
-    file.quality = Some(quality);
-    file.played = Some(found);
-    record_max_mse(&mut file, req.max_mse.alpha().map_or(MaxMse::Off, MaxMse::On));
-    Ok(file)
+    let (file, quality) = files.swap_remove(found.kept);
+    Ok((file, quality, found))
 }
 
 /// Both allocations, with the max-MSE constraint (`rates.0`) and without (`rates.1`),

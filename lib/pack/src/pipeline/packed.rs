@@ -46,7 +46,7 @@ pub struct Packed {
     /// instead of rendering the same textures again.
     pub quality: Option<Quality>,
     /// Under a played-quality target: the search's trials and the one kept.
-    pub played: Option<super::played::Found>,
+    pub played: Option<super::played::Played>,
 }
 
 /// The choice between the max-MSE constrained and the free allocation.

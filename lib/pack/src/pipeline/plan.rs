@@ -41,6 +41,19 @@ pub enum Aim {
     Played { within_db: f64, goal_db: Option<f64> },
 }
 
+impl Aim {
+    /// The aim of `target` over raw images of `raw` bytes: a ratio as the byte budget of
+    /// level images (raw / ratio), a PSNR of the coded textures at peak 1, a played quality
+    /// as the search it asks for.
+    pub fn of(target: Target, raw: u64) -> Aim {
+        match target.fixed_allocation(raw) {
+            Some(fixed) => Aim::Fixed(fixed),
+            // The one target without a fixed allocation: a played quality.
+            None => Aim::Played { within_db: target.within().unwrap_or_default(), goal_db: None },
+        }
+    }
+}
+
 impl Plan {
     /// `settings` resolved against `set`: fails where `--block` does not fit the space.
     pub fn new(set: &LoadedSet, settings: &PackSettings) -> Result<Plan> {
@@ -52,13 +65,13 @@ impl Plan {
             space,
             cameras,
             stagger: settings.stagger,
-            target: settings.target.allocation(set.raw_image_bytes()),
+            target: Aim::of(settings.target, set.raw_image_bytes()),
         })
     }
 
     /// The same layout aiming at `target` (a sweep over the targets of one inference).
     pub fn aiming_at(&self, target: Target, raw_image_bytes: u64) -> Plan {
-        Plan { target: target.allocation(raw_image_bytes), ..self.clone() }
+        Plan { target: Aim::of(target, raw_image_bytes), ..self.clone() }
     }
 
     /// The same layout aiming at a predicted played PSNR of `goal_db` (`--representation

@@ -11,6 +11,38 @@
 //! trials that met and missed the goal, by bisection where the model steps out of it. The
 //! file kept is the trial that meets the goal with the fewest bytes.
 
+/// No object plays more than this many times the file's target below its own solved
+/// figure: the target holds the file over every object's pixels together, where a small
+/// object's error weighs little, so an object that falls further has its allocation weight
+/// raised and the search runs again.
+pub const OBJECT_WITHIN_FACTOR: f64 = 3.0;
+/// Searches one pack makes at most: the first, and again after raising weights.
+pub const OBJECT_ROUNDS: usize = 3;
+/// An object that plays at or above this PSNR (dB) is held as it is, whatever its solved
+/// figure: its error is below what 8-bit display values show.
+const FINE_DB: f64 = 50.0;
+/// How far inside the object limit a raised weight aims (a factor on the coding error).
+const OBJECT_AIM: f64 = 0.7;
+/// The most one round raises a weight by.
+const MOST_RAISE: f64 = 1e4;
+
+/// The objects (by index) that play more than `limit_db` below their own solved figure,
+/// from `objects`' (decoded, solved) PSNR, each with the factor to raise its allocation
+/// weight by: under equal-slope allocation an object's coding error falls as its weight
+/// rises, so the factor is its coding error over what the limit allows.
+pub fn raised_weights(objects: &[(f64, f64)], limit_db: f64) -> Vec<(usize, f64)> {
+    objects
+        .iter()
+        .enumerate()
+        .filter(|(_, (decoded, solved))| solved - decoded > limit_db && *decoded < FINE_DB)
+        .map(|(o, &(decoded, solved))| {
+            let coding = mse(decoded) - mse(solved);
+            let allowed = mse(solved) * (10f64.powf(limit_db / 10.0) - 1.0) * OBJECT_AIM;
+            (o, (coding / allowed).clamp(1.0, MOST_RAISE))
+        })
+        .collect()
+}
+
 /// Most trials (allocations encoded and predicted) one search makes.
 pub const MAX_TRIALS: usize = 8;
 /// A trial within this many dB above the goal ends the search: fewer bytes would miss it.
@@ -22,6 +54,21 @@ const AIM_ABOVE_DB: f64 = 0.02;
 const LOWEST_CODING_DB: f64 = 1.0;
 /// A bracket this narrow (dB of coding PSNR) ends the search.
 const NARROWEST_DB: f64 = 0.01;
+/// A bracket whose files differ by less than this share of the smaller file that meets the
+/// goal ends the search: the allocation's rate–distortion points are discrete, and between
+/// two neighbours the played PSNR steps without a file in between worth the trials.
+const BYTES_GAP: f64 = 0.02;
+
+/// How much smaller than the smallest file that meets the goal the largest that misses it
+/// is, as a share of the former.
+fn bytes_gap(trials: &[Trial], goal: Goal) -> f64 {
+    let met = trials.iter().filter(|t| meets(t.psnr_db, goal.goal_db)).map(|t| t.bytes).min();
+    let missed = trials.iter().filter(|t| !meets(t.psnr_db, goal.goal_db)).map(|t| t.bytes).max();
+    match (met, missed) {
+        (Some(m), Some(x)) if m > 0 => m.saturating_sub(x) as f64 / m as f64,
+        _ => 1.0,
+    }
+}
 
 /// What the search aims at: the predicted played PSNR to reach, the file's solved PSNR
 /// (the most coding can leave), and the highest coding PSNR the codec reaches.
@@ -49,6 +96,16 @@ pub struct Found {
     pub trials: Vec<Trial>,
     pub kept: usize,
     pub reached: bool,
+}
+
+/// A pack's played-quality search as the report tells it: the last search, the objects
+/// whose allocation weight was raised to hold them near their solved figure, and how many
+/// searches were made.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Played {
+    pub found: Found,
+    pub held: Vec<String>,
+    pub searches: usize,
 }
 
 impl Found {
@@ -107,7 +164,7 @@ pub fn search<E>(goal: Goal, mut trial: impl FnMut(f64) -> Result<Trial, E>) -> 
                 break;
             }
         }
-        if hi - lo < NARROWEST_DB && met_hi && missed_lo {
+        if met_hi && missed_lo && (hi - lo < NARROWEST_DB || bytes_gap(&trials, goal) < BYTES_GAP) {
             break;
         }
         let step = modelled(&t, solved_mse, aim_mse).unwrap_or(c - 3.0);
@@ -179,6 +236,20 @@ mod tests {
     }
 
     #[test]
+    fn a_staircase_ends_once_the_bracket_holds_neighbouring_files() {
+        // discrete rate–distortion points: a file per dB of coding PSNR, 1 % apart in bytes
+        let stairs = |c: f64| -> Result<Trial, ()> {
+            let psnr_db = (c.floor() - 10.0).min(30.0);
+            Ok(Trial { coding_db: c, bytes: 10_000 + (c.floor() * 100.0) as usize, psnr_db })
+        };
+        let found = search(goal(25.5, 30.0), stairs).unwrap();
+        // the smallest file that meets 25.5 dB is 26 dB, 13 600 bytes: the one kept is
+        // within 2 % of it
+        assert!(found.reached && found.trial().bytes as f64 <= 13_600.0 * 1.02, "{found:?}");
+        assert!(found.trials.len() < MAX_TRIALS, "{} trials: {found:?}", found.trials.len());
+    }
+
+    #[test]
     fn a_goal_out_of_reach_keeps_the_richest_file_and_says_so() {
         // the codec reaches 32 dB of coding PSNR: 29.6 dB played at most
         let g = Goal { goal_db: 29.9, solved_db: 30.0, reachable_coding_db: 32.0 };
@@ -192,6 +263,21 @@ mod tests {
         let found = search(goal(31.0, 30.0), file(30.0, 1.0)).unwrap();
         assert!(!found.reached && found.trial().coding_db == 60.0, "{found:?}");
         assert_eq!(found.trials.len(), 1);
+    }
+
+    #[test]
+    fn objects_far_below_their_solved_figure_get_their_weight_raised() {
+        // (decoded, solved): within 3 dB; 6 dB below; 10 dB below but above the fine
+        // level; 20 dB below
+        let objects = [(30.0, 32.0), (24.0, 30.0), (55.0, 65.0), (20.0, 40.0)];
+        let raised = raised_weights(&objects, 3.0);
+        assert_eq!(raised.iter().map(|r| r.0).collect::<Vec<_>>(), vec![1, 3]);
+        // 6 dB below a 3 dB limit: coding error 3 × the solved error against 0.995 × 0.7
+        let (_, f) = raised[0];
+        let want = (mse(24.0) - mse(30.0)) / (mse(30.0) * (10f64.powf(0.3) - 1.0) * OBJECT_AIM);
+        assert!((f - want).abs() < 1e-9 && f > 4.0, "{f}");
+        assert!(raised[1].1 > f);
+        assert!(raised_weights(&[(29.0, 30.0)], 3.0).is_empty());
     }
 
     #[test]

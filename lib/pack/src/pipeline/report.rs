@@ -166,9 +166,14 @@ pub struct PlayedReport {
     pub goal_db: f64,
     /// The file meets it; otherwise the codec's richest allocation falls short.
     pub reached: bool,
-    /// Each allocation tried, in order: the coding PSNR it aimed at, its level-image bytes,
-    /// its predicted played PSNR.
+    /// Each allocation the last search tried, in order: the coding PSNR it aimed at, its
+    /// level-image bytes, its predicted played PSNR.
     pub trials: Vec<super::played::Trial>,
+    /// Objects that played more than 3 times the target below their own solved figure, whose
+    /// allocation weight was raised for the next search.
+    pub held: Vec<String>,
+    /// Searches made (1 where no object needed holding).
+    pub searches: usize,
 }
 
 /// Both allocations' predicted PSNR, when `auto` encoded both.
@@ -259,10 +264,12 @@ pub fn build(
         target_ratio: req.target.ratio().filter(|_| req.codec.is_lossy()),
         target_psnr_db: req.target.psnr(),
         target_within_db: req.target.within().filter(|_| req.codec.is_lossy()),
-        played: packed.played.as_ref().map(|f| PlayedReport {
-            goal_db: f.goal.goal_db,
-            reached: f.reached,
-            trials: f.trials.clone(),
+        played: packed.played.as_ref().map(|p| PlayedReport {
+            goal_db: p.found.goal.goal_db,
+            reached: p.found.reached,
+            trials: p.found.trials.clone(),
+            held: p.held.clone(),
+            searches: p.searches,
         }),
         psnr_db: q.overall,
         psnr_db_solved: q.overall_solved,
@@ -341,6 +348,10 @@ pub fn print_report(r: &PackReport, out: &mut impl std::io::Write) -> std::io::R
             "  target: within {within} dB of the textures as solved, {:.2} dB played: {how}",
             p.goal_db
         )?;
+        if !p.held.is_empty() {
+            let limit = within * super::played::OBJECT_WITHIN_FACTOR;
+            writeln!(out, "  held within {limit} dB of their solved figure by a raised allocation weight ({} searches): {}", p.searches, p.held.join(", "))?;
+        }
     }
     match (&r.max_mse_ratio, &r.max_mse_psnr_db) {
         (Some(a), Some(p)) => writeln!(out, "  allocation: max-MSE constraint {} (predicted {:.2} dB with the constraint, {:.2} dB free: the higher kept)", if a == "off" { "dropped" } else { "kept" }, p.constrained, p.free)?,

@@ -35,8 +35,8 @@ impl BlockSize {
 
 /// What a pack aims at: a played quality (the default), a compression ratio or a PSNR of the
 /// coded textures, one of them. [`super::plan::Plan`] turns it into the storage
-/// allocation's aim ([`super::plan::Aim`]: a ratio is a byte budget of level images, a
-/// played quality a search over allocations).
+/// allocation's aim (`plan::Aim`: a ratio is a byte budget of level images, a played
+/// quality a search over allocations).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Target {
     /// The fewest level-image bytes whose predicted played PSNR (the decoded textures drawn
@@ -98,17 +98,6 @@ impl Target {
                 Err(format!("--within must be a positive number of dB, got {db}"))
             }
             _ => Ok(()),
-        }
-    }
-
-    /// The storage allocation's aim over raw images of `raw` bytes: a ratio as the byte
-    /// budget of level images (raw / ratio), a PSNR of the coded textures at peak 1, a
-    /// played quality as the search it asks for.
-    pub fn allocation(self, raw: u64) -> super::plan::Aim {
-        match (self, self.fixed_allocation(raw)) {
-            (Target::Within(db), _) => super::plan::Aim::Played { within_db: db, goal_db: None },
-            (_, Some(fixed)) => super::plan::Aim::Fixed(fixed),
-            (_, None) => unreachable!("a ratio and a PSNR are fixed allocations"),
         }
     }
 
