@@ -63,8 +63,8 @@ fn pack_scene(scene_toml: &Path, options: &PackOptions) -> Result<PathBuf, Failu
 /// earlier default is packed again).
 fn packed_for(path: &Path, target: &str) -> bool {
     let Ok(reader) = pis_format::PisReader::open(path) else { return false };
-    let settings = reader.container().provenance.as_ref().map(|p| p.settings.as_slice());
-    settings.unwrap_or_default().iter().any(|(k, v)| k == "target" && v == target)
+    reader.container().provenance.as_ref().and_then(|p| p.setting(pis_pack::TARGET_SETTING))
+        == Some(target)
 }
 
 /// 64-bit FNV-1a: a stable name for a set of options.

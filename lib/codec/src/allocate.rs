@@ -103,6 +103,34 @@ struct Problem {
 const BISECTIONS: usize = 100;
 
 impl Problem {
+    /// The hulls and gains of `items` over objects with screen `areas`; an item without a
+    /// curve, or naming an object without an area, is an error.
+    fn new(items: &[Item], areas: &[f64]) -> Result<Problem, AllocError> {
+        for (i, it) in items.iter().enumerate() {
+            if it.curve.points.is_empty() {
+                return Err(AllocError::EmptyCurve(i));
+            }
+            if it.object >= areas.len() {
+                return Err(AllocError::Object {
+                    item: i,
+                    object: it.object,
+                    objects: areas.len(),
+                });
+            }
+        }
+        Ok(Problem {
+            hulls: items.iter().map(|it| convex_hull(&it.curve)).collect(),
+            gain: items.iter().map(|it| areas[it.object] * it.weight).collect(),
+        })
+    }
+
+    /// The least screen MSE any allocation above `floor` reaches: every item at its
+    /// richest point.
+    fn best_screen_mse(&self, items: &[Item], areas: &[f64], floor: &[usize]) -> f64 {
+        let all = vec![true; self.hulls.len()];
+        screen_mse(&self.mses(&self.choose(0.0, &all, floor)), items, areas).1
+    }
+
     /// Point index per item minimising `gain · D + λ · R`, never below `floor` (on a convex
     /// hull the walk from the floor ends where the free walk would, or at the floor).
     /// Items not `active` stay at their floor.
@@ -200,7 +228,7 @@ impl Problem {
             Target::Psnr { db, peak } => {
                 let goal = peak * peak / 10f64.powf(db / 10.0);
                 let screen = |pick: &[usize]| screen_mse(&self.mses(pick), items, areas).1;
-                let best = screen(&self.choose(0.0, &all, floor));
+                let best = self.best_screen_mse(items, areas, floor);
                 if best > goal {
                     let best_db = 10.0 * (peak * peak / best).log10();
                     return Err(AllocError::Unreachable { db, best_db });
@@ -301,18 +329,7 @@ pub fn allocate(
     target: Target,
     alpha: Option<f64>,
 ) -> Result<Allocation, AllocError> {
-    for (i, it) in items.iter().enumerate() {
-        if it.curve.points.is_empty() {
-            return Err(AllocError::EmptyCurve(i));
-        }
-        if it.object >= areas.len() {
-            return Err(AllocError::Object { item: i, object: it.object, objects: areas.len() });
-        }
-    }
-    let problem = Problem {
-        hulls: items.iter().map(|it| convex_hull(&it.curve)).collect(),
-        gain: items.iter().map(|it| areas[it.object] * it.weight).collect(),
-    };
+    let problem = Problem::new(items, areas)?;
     let no_floor = vec![0usize; items.len()];
     let mut pick = problem.solve(target, areas, items, &no_floor)?;
     if let Some(alpha) = alpha {
@@ -324,6 +341,15 @@ pub fn allocate(
     let bytes: Vec<usize> = problem.hulls.iter().zip(&pick).map(|(h, &k)| h[k].bytes).collect();
     let (object_mse, screen) = screen_mse(&mse, items, areas);
     Ok(Allocation { total_bytes: bytes.iter().sum(), bytes, mse, object_mse, screen_mse: screen })
+}
+
+/// The highest PSNR (dB, for a signal `peak`) of the area-weighted screen MSE that an
+/// allocation of `items` reaches: every item at its richest point (infinite where that is
+/// exact).
+pub fn reachable_psnr(items: &[Item], areas: &[f64], peak: f64) -> Result<f64, AllocError> {
+    let problem = Problem::new(items, areas)?;
+    let best = problem.best_screen_mse(items, areas, &vec![0; items.len()]);
+    Ok(10.0 * (peak * peak / best).log10())
 }
 
 /// The objects that hold any item: objects without level images have no MSE to balance.
@@ -523,6 +549,17 @@ mod tests {
             allocate(&items, &areas, Target::Psnr { db: 400.0, peak: 1.0 }, None),
             Err(AllocError::Unreachable { .. })
         ));
+    }
+
+    /// The reachable PSNR is the one an out-of-reach target reports, and a target at it is
+    /// met.
+    #[test]
+    fn the_reachable_psnr_is_the_richest_allocations() {
+        let (items, areas) = items();
+        let best = reachable_psnr(&items, &areas, 1.0).unwrap();
+        let err = allocate(&items, &areas, Target::Psnr { db: best + 1.0, peak: 1.0 }, None);
+        assert_eq!(err, Err(AllocError::Unreachable { db: best + 1.0, best_db: best }));
+        assert!(allocate(&items, &areas, Target::Psnr { db: best - 1e-9, peak: 1.0 }, None).is_ok());
     }
 
     #[test]

@@ -50,9 +50,7 @@ impl DisplayFilter {
     /// `display_filter` setting; an error naming what is wrong for an unknown filter, a
     /// missing or malformed σ or R, or σ or R without `display_filter`.
     pub fn of(p: Option<&Provenance>) -> Result<Option<DisplayFilter>, String> {
-        let get = |k: &str| {
-            p.and_then(|p| p.settings.iter().find(|(key, _)| key == k)).map(|(_, v)| v.as_str())
-        };
+        let get = |k: &str| p.and_then(|p| p.setting(k));
         let number = |k: &str| -> Result<f32, String> {
             let v = get(k).ok_or_else(|| {
                 format!("{DISPLAY_FILTER_SETTING} \"gaussian\" without a {k} setting")

@@ -47,9 +47,7 @@ impl FileFilter {
     /// setting; an error naming what is wrong for an unknown name, or an `anisotropic`
     /// filter without an anisotropy of 1 to 16.
     pub fn of(p: Option<&Provenance>) -> Result<FileFilter, String> {
-        let get = |k: &str| {
-            p.and_then(|p| p.settings.iter().find(|(key, _)| key == k)).map(|(_, v)| v.as_str())
-        };
+        let get = |k: &str| p.and_then(|p| p.setting(k));
         match get(FILTER_SETTING) {
             None | Some("trilinear") => Ok(FileFilter::Trilinear),
             Some("nearest") => Ok(FileFilter::Nearest),

@@ -465,6 +465,13 @@ pub struct Provenance {
     pub settings: Vec<(String, String)>,
 }
 
+impl Provenance {
+    /// The value of the first setting named `key`, if any.
+    pub fn setting(&self, key: &str) -> Option<&str> {
+        self.settings.iter().find(|(k, _)| k == key).map(|(_, v)| v.as_str())
+    }
+}
+
 impl<S> Container<S> {
     /// Every level image of the file, in file order (object, layer, block, level).
     pub fn level_images(&self) -> impl Iterator<Item = &S> {

@@ -66,16 +66,16 @@ fn label(m: &ObjectModel) -> String {
     }
 }
 
-/// The solved PSNR of the file `packed` encodes with object model `mi` replaced by
-/// `models[mi]`: the other objects' solved errors as measured, this one drawn again.
+/// The solved PSNR of the file `packed` encodes with object model `mi` replaced by `alt`:
+/// the other objects' solved errors as measured, this one drawn again.
 fn solved_with(
     set: &LoadedSet,
     packed: &Packed,
-    models: &[ObjectModel],
     mi: usize,
+    alt: &ObjectModel,
 ) -> Result<f64, Failure> {
     let mut e = packed.solved_error.clone();
-    e[mi] = solved_error(set, &models[mi]).map_err(|e| Failure::new(Exit::Runtime, e))?;
+    e[mi] = solved_error(set, alt).map_err(|e| Failure::new(Exit::Runtime, e))?;
     Ok(total_psnr(&e))
 }
 
@@ -133,17 +133,16 @@ pub fn choose(
                 anyhow!("an alternative names object model {mi} of {}", models.len()),
             ));
         }
-        std::mem::swap(&mut models[mi], &mut alt);
-        let (first, second) = (label(&alt), label(&models[mi]));
+        // A better solved figure raises the goal: the current file is searched again for it.
         if let (Some(d), Some(g)) = (within, goal) {
-            let raised = solved_with(set, &packed, &models, mi)? - d;
+            let raised = solved_with(set, &packed, mi, &alt)? - d;
             if raised > g {
                 goal = Some(raised);
-                std::mem::swap(&mut models[mi], &mut alt);
                 (packed, quality, current) = encoded(set, &models, &plan.played_at(raised), req)?;
-                std::mem::swap(&mut models[mi], &mut alt);
             }
         }
+        std::mem::swap(&mut models[mi], &mut alt);
+        let (first, second) = (label(&alt), label(&models[mi]));
         let at = goal.map_or_else(|| plan.clone(), |g| plan.played_at(g));
         let trial = encoded(set, &models, &at, req);
         let target = goal.or(req.target.psnr());

@@ -277,7 +277,7 @@ fn provenance_settings(
         ("block".to_string(), plan.sizes.iter().map(u32::to_string).collect::<Vec<_>>().join("x")),
         ("matrix".to_string(), req.matrix.name().to_string()),
         ("gamma".to_string(), req.gamma.to_string()),
-        ("target".to_string(), req.target.describe()),
+        (super::TARGET_SETTING.to_string(), req.target.describe()),
     ];
     settings.splice(2..2, file_filter(req.filter).settings());
     if req.pyramid != super::PyramidMode::Adaptive {

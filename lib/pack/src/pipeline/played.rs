@@ -143,9 +143,8 @@ pub fn search<E>(goal: Goal, mut trial: impl FnMut(f64) -> Result<Trial, E>) -> 
     let solved_mse = mse(goal.solved_db);
     let aim_mse = mse(goal.goal_db + AIM_ABOVE_DB);
     let top = goal.reachable_coding_db.max(LOWEST_CODING_DB);
-    // Trials at or below `lo` missed the goal, at or above `hi` met it.
-    let (mut lo, mut hi) = (LOWEST_CODING_DB, top);
-    let (mut missed_lo, mut met_hi) = (false, false);
+    // The highest coding PSNR that missed the goal, and the lowest that met it.
+    let (mut lo, mut hi): (Option<f64>, Option<f64>) = (None, None);
     // The first guess: coding error as it stands, added to the solved error.
     let first = (aim_mse > solved_mse).then(|| -10.0 * (aim_mse - solved_mse).log10());
     let mut c = first.unwrap_or(top).clamp(LOWEST_CODING_DB, top);
@@ -154,25 +153,26 @@ pub fn search<E>(goal: Goal, mut trial: impl FnMut(f64) -> Result<Trial, E>) -> 
         let t = trial(c)?;
         trials.push(t);
         if meets(t.psnr_db, goal.goal_db) {
-            (hi, met_hi) = (c, true);
+            hi = Some(c);
             if t.psnr_db - goal.goal_db < CLOSE_DB {
                 break;
             }
         } else {
-            (lo, missed_lo) = (c, true);
+            lo = Some(c);
             if c >= top {
                 break;
             }
         }
-        if met_hi && missed_lo && (hi - lo < NARROWEST_DB || bytes_gap(&trials, goal) < BYTES_GAP) {
-            break;
+        if let (Some(l), Some(h)) = (lo, hi) {
+            if h - l < NARROWEST_DB || bytes_gap(&trials, goal) < BYTES_GAP {
+                break;
+            }
         }
         let step = modelled(&t, solved_mse, aim_mse).unwrap_or(c - 3.0);
-        let (floor, ceiling) =
-            (if missed_lo { lo } else { LOWEST_CODING_DB }, if met_hi { hi } else { top });
+        let (floor, ceiling) = (lo.unwrap_or(LOWEST_CODING_DB), hi.unwrap_or(top));
         c = if step > floor && step < ceiling {
             step
-        } else if !met_hi && step >= ceiling {
+        } else if hi.is_none() && step >= ceiling {
             top
         } else {
             0.5 * (floor + ceiling)
@@ -181,12 +181,14 @@ pub fn search<E>(goal: Goal, mut trial: impl FnMut(f64) -> Result<Trial, E>) -> 
             break;
         }
     }
-    let met = |t: &&Trial| meets(t.psnr_db, goal.goal_db);
-    let kept = match trials.iter().filter(met).min_by_key(|t| t.bytes) {
-        Some(best) => trials.iter().position(|t| t == best),
-        None => (0..trials.len()).max_by(|&a, &b| trials[a].psnr_db.total_cmp(&trials[b].psnr_db)),
-    }
-    .expect("a search makes at least one trial");
+    // The fewest bytes among the trials that meet the goal, else the highest PSNR.
+    let index = 0..trials.len();
+    let kept = index
+        .clone()
+        .filter(|&i| meets(trials[i].psnr_db, goal.goal_db))
+        .min_by_key(|&i| trials[i].bytes)
+        .or_else(|| index.max_by(|&a, &b| trials[a].psnr_db.total_cmp(&trials[b].psnr_db)))
+        .expect("a search makes at least one trial");
     let reached = meets(trials[kept].psnr_db, goal.goal_db);
     Ok(Found { goal, trials, kept, reached })
 }

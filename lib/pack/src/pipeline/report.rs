@@ -276,7 +276,7 @@ pub fn build(
         max_texel_error: q.max_texel_error,
         lossless_exact: exact,
         fragments: None,
-        max_mse_ratio: packed.container.provenance.as_ref().and_then(|p| p.settings.iter().find(|(k, _)| k == "max_mse_ratio")).map(|(_, v)| v.clone()),
+        max_mse_ratio: packed.container.provenance.as_ref().and_then(|p| p.setting("max_mse_ratio")).map(str::to_string),
         max_mse_psnr_db: packed.max_mse.as_ref().map(|c| MaxMsePsnr { constrained: c.psnr_db_constrained, free: c.psnr_db_free }),
         objects,
         stage_ms: stages.ms.into_iter().collect(),

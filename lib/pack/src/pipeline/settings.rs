@@ -542,6 +542,9 @@ impl LayerMode {
     pub const ALL: [LayerMode; 2] = [LayerMode::Separate, LayerMode::Combined];
 }
 
+/// The provenance setting recording what a pack aimed at ([`Target::describe`]).
+pub const TARGET_SETTING: &str = "target";
+
 /// The provenance setting holding the predicted PSNR (dB, display values over the pixels the
 /// objects cover) of a packed file.
 pub const PREDICTED_PSNR_SETTING: &str = "predicted_psnr_db";

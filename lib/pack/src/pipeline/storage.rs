@@ -203,13 +203,31 @@ pub struct Storage {
     pub free: Option<(Vec<Rate>, usize)>,
 }
 
+/// The codec of a lossy `codec` id, or an error where this build lacks it.
+fn lossy_codec(codec: CodecId) -> Result<&'static dyn LevelCodec> {
+    pis_codec::codec(codec).ok_or_else(|| anyhow!("codec {codec} is not in this build"))
+}
+
+/// The allocation's items of every level image of `blocks` (with `c`, a lossy codec), in
+/// block, level and image order; blocks in parallel, their level images in parallel within
+/// each.
+fn level_items(blocks: &[BlockPyramid], c: &dyn LevelCodec) -> Result<Vec<Item>> {
+    Ok(blocks
+        .par_iter()
+        .map(|pb| pb.items(c))
+        .collect::<Result<Vec<_>>>()?
+        .into_iter()
+        .flatten()
+        .collect())
+}
+
 /// Measures every level image's rate–distortion item for a lossy `codec` once, so that
 /// allocations that follow (a played-quality search) reuse them.
 pub fn measure_items(blocks: &mut [BlockPyramid], codec: CodecId) -> Result<()> {
     if !codec.is_lossy() {
         return Ok(());
     }
-    let c = pis_codec::codec(codec).ok_or_else(|| anyhow!("codec {codec} is not in this build"))?;
+    let c = lossy_codec(codec)?;
     blocks.par_iter_mut().try_for_each(|pb| -> Result<()> {
         pb.rd = Some(pb.items(c)?);
         Ok(())
@@ -217,24 +235,15 @@ pub fn measure_items(blocks: &mut [BlockPyramid], codec: CodecId) -> Result<()> 
 }
 
 /// The highest PSNR (dB, peak 1) of the coded textures an allocation over `blocks` reaches:
-/// every level image at its richest point, weighed as the allocation weighs it.
+/// every level image at its richest point, weighed as the allocation weighs it (at most
+/// [`BEYOND_DB`], for a codec that reaches the textures exactly).
 pub fn reachable_coding_db(blocks: &[BlockPyramid], codec: CodecId, areas: &[f64]) -> Result<f64> {
-    /// Far above any codec's reach: its error is what the allocation reports back.
-    const BEYOND_DB: f64 = 1000.0;
-    let c = pis_codec::codec(codec).ok_or_else(|| anyhow!("codec {codec} is not in this build"))?;
-    let items: Vec<Item> = blocks
-        .par_iter()
-        .map(|pb| pb.items(c))
-        .collect::<Result<Vec<_>>>()?
-        .into_iter()
-        .flatten()
-        .collect();
-    match allocate(&items, areas, Target::Psnr { db: BEYOND_DB, peak: 1.0 }, None) {
-        Ok(_) => Ok(BEYOND_DB),
-        Err(pis_codec::allocate::AllocError::Unreachable { best_db, .. }) => Ok(best_db),
-        Err(e) => Err(e.into()),
-    }
+    let items = level_items(blocks, lossy_codec(codec)?)?;
+    Ok(pis_codec::allocate::reachable_psnr(&items, areas, 1.0)?.min(BEYOND_DB))
 }
+
+/// Far above any lossy codec's reach (dB).
+const BEYOND_DB: f64 = 1000.0;
 
 /// Equal-slope allocation (thesis 4.5) over every level image of `blocks` for a lossy
 /// `codec`: each level image's rate–distortion curve, weighted by the share of its layer's
@@ -265,16 +274,7 @@ pub fn allocate_storage(
             free: None,
         });
     }
-    let c = pis_codec::codec(codec).ok_or_else(|| anyhow!("codec {codec} is not in this build"))?;
-    // Blocks in parallel where their items are to be measured, their level images in
-    // parallel within each.
-    let items: Vec<Item> = blocks
-        .par_iter()
-        .map(|pb| pb.items(c))
-        .collect::<Result<Vec<_>>>()?
-        .into_iter()
-        .flatten()
-        .collect();
+    let items = level_items(blocks, lossy_codec(codec)?)?;
     let a = allocate(&items, areas, target, max_mse.alpha())?;
     // Two allocations of one byte budget compare by their predictions; a PSNR target asks
     // for the fewest bytes instead, and keeps the constraint.
