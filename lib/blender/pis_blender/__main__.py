@@ -1,0 +1,63 @@
+"""`python3 -m pis_blender SCENE.blend -o SET_DIR [--spp N] [--json]`: the add-on headless,
+with Blender's `bpy` module (PyPI `bpy`, Python 3.11). The .blend's PIS settings say what to
+render; --spp replaces its samples."""
+
+import argparse
+import json
+import os
+import sys
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(prog="python3 -m pis_blender", description=__doc__.split("\n\n")[0])
+    parser.add_argument("blend", help="the .blend file, its PIS settings set (Properties > Render > PIS set)")
+    parser.add_argument("-o", "--output", required=True, help="the set folder to write")
+    parser.add_argument("--spp", type=int, help="Cycles samples per pixel (default: the file's)")
+    parser.add_argument("--seed", type=int, help="Cycles' seed series (default: the file's); another seed renders an independent set")
+    parser.add_argument("--json", action="store_true", help="print the report as JSON")
+    args = parser.parse_args(argv)
+    # Blender and its glTF exporter write their logs to standard output: they go to standard
+    # error, and standard output carries the report alone.
+    sys.stdout.flush()
+    report_out = os.fdopen(os.dup(1), "w")
+    os.dup2(2, 1)
+    try:
+        import bpy
+    except ImportError:
+        print("pis_blender: Blender's bpy module is not installed (python3 -m pip install bpy==4.5.4)", file=sys.stderr)
+        return 2
+    import pis_blender
+    from pis_blender import scene_file, space
+
+    pis_blender.register()
+    try:
+        bpy.ops.wm.open_mainfile(filepath=args.blend)
+    except RuntimeError as e:
+        print(f"pis_blender: {args.blend}: {e}", file=sys.stderr)
+        return 3
+    scene = bpy.context.scene
+    if args.spp is not None:
+        scene.pis.spp = args.spp
+    if args.seed is not None:
+        scene.pis.seed = args.seed
+    try:
+        report = pis_blender.export_set(scene, args.output, progress=lambda line: print(line, file=sys.stderr, flush=True))
+    except (scene_file.ExportError, space.SpaceError) as e:
+        print(f"pis_blender: {args.blend}: {e}", file=sys.stderr)
+        return 3
+    if args.json:
+        print(json.dumps(report), file=report_out)
+    else:
+        roles = ", ".join(f"{o['name']} ({o['role']})" for o in report["objects"])
+        print(f"{report['set']}: {report['points']} points, {report['renders']} Cycles renders, {report['seconds']} s", file=report_out)
+        print(f"objects: {roles}", file=report_out)
+    report_out.flush()
+    return 0
+
+
+if __name__ == "__main__":
+    code = main()
+    # bpy can hang in its exit handlers; every file is written, so leave at once.
+    sys.stdout.flush()
+    sys.stderr.flush()
+    os._exit(code)

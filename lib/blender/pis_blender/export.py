@@ -1,0 +1,192 @@
+"""Renders the scene's parameter space with Cycles into a ray-traced set (RAYSET.md) with the
+glTF and scene.toml pis-pack reads beside it.
+
+SET_DIR/ holds scene.toml, scene.gltf (+ .bin, textures), point_NNNNN.exr and set.json,
+written last: a folder without set.json is an unfinished export. Every file is written under a
+temporary name and renamed into place.
+"""
+
+import json
+import os
+import shutil
+import tempfile
+import time
+
+import bpy
+
+from . import coords, cycles, layers, scene_file, space
+
+GEOMETRY = ("MESH", "CURVE", "SURFACE", "META", "FONT")
+
+
+def export_set(scene, out_dir, progress=print):
+    """Writes the set of `scene` (its `scene.pis` settings) into `out_dir`; returns a report."""
+    s = scene.pis
+    if scene.camera is None:
+        raise scene_file.ExportError("the scene has no camera")
+    dims = space.dimensions(scene)
+    os.makedirs(out_dir, exist_ok=True)
+    for stale in ("set.json",):
+        if os.path.exists(os.path.join(out_dir, stale)):
+            os.remove(os.path.join(out_dir, stale))
+    start = time.time()
+    saved = cycles.Settings()
+    scratch = tempfile.mkdtemp(prefix="pis-blender-")
+    try:
+        frame = scene.frame_current
+        gltf = os.path.join(out_dir, "scene.gltf")
+        scene_file.export_gltf(gltf, with_animation=s.frames_on, with_camera=s.frames_on)
+        names, animations = scene_file.gltf_objects(gltf)
+        objects = _objects(scene, names)
+        for d in dims:
+            if d.driver == "animation":
+                if not animations:
+                    raise scene_file.ExportError("animation frames: the glTF exporter wrote no animation")
+                d.table["animation"] = animations[0]
+        roles = [scene_file.role(o) for o in objects]
+        lights = [o for o in scene.objects if o.type == "LIGHT" and not o.hide_render]
+        _write_scene_toml(scene, out_dir, objects, roles, lights, dims)
+        cycles.configure(scene, saved, s.spp, s.filter_sigma_px, 0, s.caustics)
+        for light in lights:
+            if hasattr(light.data, "use_soft_falloff"):
+                saved.set(light.data, "use_soft_falloff", False)
+        report = _render_points(scene, out_dir, scratch, dims, objects, roles, lights, progress)
+        scene.frame_set(frame)
+    finally:
+        saved.restore()
+        shutil.rmtree(scratch, ignore_errors=True)
+    report["seconds"] = round(time.time() - start, 2)
+    return report
+
+
+def _objects(scene, names):
+    objects = []
+    for name in names:
+        obj = scene.objects.get(name)
+        if obj is None:
+            raise scene_file.ExportError(f"the glTF exporter wrote object {name!r}, which the scene lacks")
+        objects.append(obj)
+    return objects
+
+
+def _parts(obj, objects):
+    key = lambda o: o.pis_reflector or o.name  # noqa: E731
+    return [o for o in objects if key(o) == key(obj)]
+
+
+def _write_scene_toml(scene, out_dir, objects, roles, lights, dims):
+    animated = any(d.driver == "animation" for d in dims)
+    orbit = any(d.driver == "orbit" for d in dims)
+    camera = scene_file.camera_table(scene, orbit, animated)
+    tables = []
+    for o, role in zip(objects, roles):
+        t = {"role": role}
+        if o.pis_reflector:
+            t["reflector"] = o.pis_reflector
+        tables.append((o.name, t))
+    light_tables = [scene_file.light_entry(light)[0] for light in lights]
+    environment = scene_file.world_light(scene)
+    res = (scene.render.resolution_x, scene.render.resolution_y)
+    scene_file.write_toml(
+        os.path.join(out_dir, "scene.toml"), scene.name, "scene.gltf", res, scene.pis.spp,
+        camera, tables, light_tables, environment, dims,
+    )
+
+
+def _layer_names(role):
+    base = ["coverage", "diffuse", "specular"]
+    return base + ["fresnel", "local", "distant"] if role == "reflective" else base
+
+
+CHANNELS = {1: ["A"], 3: ["R", "G", "B"], 4: ["R", "G", "B", "A"]}
+
+
+def _render_points(scene, out_dir, scratch, dims, objects, roles, lights, progress):
+    w, h = scene.render.resolution_x, scene.render.resolution_y
+    channels = scene_file.channel_names([o.name for o in objects])
+    geometry = [o for o in scene.objects if o.type in GEOMETRY and not o.hide_render]
+    fraction = layers.fraction_material_maker()
+    renderer = layers.Renderer(scene, scratch, geometry)
+    points = space.points(dims)
+    metas = []
+    for index, point in enumerate(points):
+        t0 = time.time()
+        space.place(scene, dims, point)
+        scene.cycles.seed = scene.pis.seed * len(points) + index
+        bpy.context.view_layer.update()
+        images = {}
+        combined = renderer.full()
+        for c, name in enumerate("RGB"):
+            images[f"combined.{name}"] = combined[..., c]
+        for obj, role, ch in zip(objects, roles, channels):
+            out = layers.object_layers(renderer, obj, role, _parts(obj, objects), fraction)
+            for layer, value in out.items():
+                for c, name in enumerate(CHANNELS[value.shape[-1]]):
+                    images[f"object.{ch}.{layer}.{name}"] = value[..., c]
+        image = f"point_{index:05d}.exr"
+        tmp = os.path.join(out_dir, f".{image}.tmp{os.getpid()}")
+        from . import exr
+
+        exr.write(tmp, images, w, h)
+        os.replace(tmp, os.path.join(out_dir, image))
+        metas.append(_point_meta(scene, index, point, dims, image, objects, channels, lights))
+        progress(f"point {index + 1}/{len(points)}: {renderer.count} renders so far, {time.time() - t0:.1f} s")
+    meta = {
+        "format": "pis-rayset",
+        "version": 1,
+        "scene": scene.name,
+        "resolution": [w, h],
+        "spp": scene.pis.spp,
+        "filter": {"sigma_px": scene.pis.filter_sigma_px, "radius_px": cycles.filter_radius(scene.pis.filter_sigma_px)},
+        "renderer": {"name": "Blender Cycles", "version": bpy.app.version_string},
+        "scene_file": "scene.toml",
+        "space": [d.meta() for d in dims] or [_still()],
+        "objects": [
+            {"name": o.name, "channel_name": ch, "role": role, "layers": _layer_names(role), "records": False}
+            | ({"reflector": o.pis_reflector} if o.pis_reflector else {})
+            for o, ch, role in zip(objects, channels, roles)
+        ],
+        "points": metas,
+    }
+    tmp = os.path.join(out_dir, f".set.json.tmp{os.getpid()}")
+    with open(tmp, "w") as f:
+        json.dump(meta, f, indent=1)
+    os.replace(tmp, os.path.join(out_dir, "set.json"))
+    return {
+        "set": out_dir,
+        "points": len(points),
+        "renders": renderer.count,
+        "objects": [{"name": o.name, "role": r} for o, r in zip(objects, roles)],
+    }
+
+
+def _still():
+    return {"name": "point", "kind": "other", "driver": "still", "periodic": False, "unit": "", "values": [0.0]}
+
+
+def _point_meta(scene, index, point, dims, image, objects, channels, lights):
+    cam = scene.camera
+    w, h = scene.render.resolution_x, scene.render.resolution_y
+    m = coords.camera_to_gltf(cam.matrix_world)
+    yfov = coords.yfov(cam.data, w, h)
+    znear, zfar = float(cam.data.clip_start), float(cam.data.clip_end)
+    return {
+        "index": index,
+        "samples": point if dims else [0],
+        "values": [float(d.values[i]) for d, i in zip(dims, point)] if dims else [0.0],
+        "image": image,
+        "rays": None,
+        "camera": {
+            "world_from_camera": coords.column_major(m),
+            "camera_from_world": coords.column_major(coords.np.linalg.inv(m)),
+            "projection": coords.projection(yfov, w / h, znear, zfar),
+            "yfov": yfov,
+            "znear": znear,
+            "zfar": zfar,
+        },
+        "lights": [scene_file.light_entry(light)[1] for light in lights],
+        "objects": [
+            {"name": ch, "world_from_object": coords.column_major(coords.object_to_gltf(o.matrix_world))}
+            for o, ch in zip(objects, channels)
+        ],
+    }
