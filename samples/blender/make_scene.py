@@ -2,7 +2,9 @@
 a textured floor, a mirror ball, a glass ball and a textured box, lit by a sphere light that
 takes 2 places on a path, seen from 4 views on an orbit (2 × 4 points).
 
-    python3 samples/blender/make_scene.py OUT.blend [--resolution 160x120] [--spp 64]
+    python3 samples/blender/make_scene.py OUT.blend [--resolution 160x120] [--spp 64] [--turning]
+
+With --turning the camera stands still and the box turns and slides over 3 animation frames.
 
 Needs Blender's `bpy` module (python3 -m pip install bpy==4.5.4). The textures are written
 as PNG files beside OUT.blend.
@@ -51,7 +53,7 @@ def add(obj, mat):
     return obj
 
 
-def build(out, resolution, spp):
+def build(out, resolution, spp, turning):
     bpy.ops.wm.read_factory_settings(use_empty=True)
     folder = os.path.dirname(os.path.abspath(out))
     checker = image(
@@ -72,7 +74,8 @@ def build(out, resolution, spp):
     bpy.ops.object.shade_smooth()
     add(bpy.context.object, material("Glass", color=(1.0, 1.0, 1.0), roughness=0.0, transmission=1.0)).name = "GlassBall"
     bpy.ops.mesh.primitive_cube_add(size=0.7, location=(0.3, 1.0, 0.35), rotation=(0.0, 0.0, math.radians(25)))
-    add(bpy.context.object, material("Box", texture=stripes, roughness=0.6)).name = "Box"
+    box = add(bpy.context.object, material("Box", texture=stripes, roughness=0.6))
+    box.name = "Box"
 
     bpy.ops.object.light_add(type="POINT", location=(1.5, -1.5, 3.0))
     lamp = bpy.context.object
@@ -104,9 +107,20 @@ def build(out, resolution, spp):
 
     s = scene.pis
     s.spp = spp
-    s.light_path_on, s.light_path_light, s.light_path_curve, s.light_path_samples = True, lamp, path, 2
-    s.orbit_on, s.orbit_target, s.orbit_radius = True, (0.0, 0.2, 0.4), 4.5
-    s.orbit_elevation_deg, s.orbit_azimuth_deg, s.orbit_samples = 28.0, (-20.0, 20.0), 4
+    if turning:
+        # The box turns a quarter about Z from frame 1 to 25 and slides 0.4 along X; the
+        # camera stays where it was placed; the space is 3 frames.
+        cam.location, cam.rotation_euler = (0.0, -4.5, 2.4), (math.radians(62), 0.0, 0.0)
+        for frame, angle, x in ((1, 25.0, 0.3), (25, 115.0, 0.7)):
+            box.rotation_euler.z, box.location.x = math.radians(angle), x
+            box.keyframe_insert("rotation_euler", index=2, frame=frame)
+            box.keyframe_insert("location", index=0, frame=frame)
+        scene.frame_start, scene.frame_end = 1, 25
+        s.frames_on, s.frames_range, s.frames_samples, s.frames_kind = True, (1.0, 25.0), 3, "OBJECT_MOTION"
+    else:
+        s.light_path_on, s.light_path_light, s.light_path_curve, s.light_path_samples = True, lamp, path, 2
+        s.orbit_on, s.orbit_target, s.orbit_radius = True, (0.0, 0.2, 0.4), 4.5
+        s.orbit_elevation_deg, s.orbit_azimuth_deg, s.orbit_samples = 28.0, (-20.0, 20.0), 4
     bpy.ops.wm.save_as_mainfile(filepath=os.path.abspath(out))
 
 
@@ -117,9 +131,10 @@ def main():
     parser.add_argument("out")
     parser.add_argument("--resolution", default="160x120")
     parser.add_argument("--spp", type=int, default=64)
+    parser.add_argument("--turning", action="store_true", help="a fixed camera and the box turning over 3 animation frames instead")
     args = parser.parse_args()
     pis_blender.register()
-    build(args.out, tuple(int(x) for x in args.resolution.split("x")), args.spp)
+    build(args.out, tuple(int(x) for x in args.resolution.split("x")), args.spp, args.turning)
 
 
 if __name__ == "__main__":
