@@ -229,7 +229,9 @@ impl Problem {
                 let goal = peak * peak / 10f64.powf(db / 10.0);
                 let screen = |pick: &[usize]| screen_mse(&self.mses(pick), items, areas).1;
                 let best = self.best_screen_mse(items, areas, floor);
-                if best > goal {
+                // A goal at the reachable PSNR itself is met (by the richest allocation): the
+                // dB → MSE round trip may put it a rounding error beyond `best`.
+                if best > goal * (1.0 + 1e-9) {
                     let best_db = 10.0 * (peak * peak / best).log10();
                     return Err(AllocError::Unreachable { db, best_db });
                 }
@@ -560,6 +562,9 @@ mod tests {
         let err = allocate(&items, &areas, Target::Psnr { db: best + 1.0, peak: 1.0 }, None);
         assert_eq!(err, Err(AllocError::Unreachable { db: best + 1.0, best_db: best }));
         assert!(allocate(&items, &areas, Target::Psnr { db: best - 1e-9, peak: 1.0 }, None).is_ok());
+        for db in [best, best + 1e-12, best * (1.0 + 1e-15)] {
+            assert!(allocate(&items, &areas, Target::Psnr { db, peak: 1.0 }, None).is_ok(), "{db}");
+        }
     }
 
     #[test]
