@@ -8,6 +8,7 @@
 //! - pis-trace, tracing the scene.toml the add-on wrote, puts every object where Cycles did:
 //!   coverage centroids within 0.1 px, areas as equal as sampling allows, and edges as wide (the Gaussian
 //!   filter recorded as Cycles applies it);
+//! - the lights it records at every point are those pis-trace computes from that scene.toml;
 //! - pis-pack packs the set with default settings (against the cameras it records) and
 //!   pis-play draws the file as pis-pack predicted, within 1.5 dB of its textures as solved.
 //!
@@ -28,6 +29,8 @@ const SPP: &str = "32";
 
 struct Fixture {
     _dir: tempfile::TempDir,
+    /// The .blend made by samples/blender/make_scene.py.
+    blend: PathBuf,
     /// The add-on's set (with scene.toml and the glTF beside its points).
     set: PathBuf,
     /// pis-trace's set of the scene.toml the add-on wrote.
@@ -103,7 +106,7 @@ fn render(make_args: &[&str], spp: &str) -> Fixture {
         Some(RaySet::open(&traced).expect("traced").len() as u64),
         "{report}"
     );
-    Fixture { _dir: dir, set, traced }
+    Fixture { _dir: dir, blend, set, traced }
 }
 
 /// The scene: 2 light places × 4 views.
@@ -245,6 +248,48 @@ fn pis_trace_puts_every_object_where_cycles_rendered_it() {
     same_coverage(f, 0.1);
 }
 
+/// The lights the add-on recorded at every point (Blender's light, moved along its path) are
+/// the ones pis-trace computes from the scene.toml it wrote: kind, position, radius and
+/// radiance (P/(4π) W/sr for a point light of P watts).
+#[test]
+fn the_lights_are_where_and_as_bright_as_blender_put_them() {
+    let Some(f) = fixture() else { return };
+    let (ours, theirs) =
+        (RaySet::open(&f.set).expect("set"), RaySet::open(&f.traced).expect("traced"));
+    let close = |a: &[f32], b: &[f32]| {
+        a.iter().zip(b).all(|(x, y)| (x - y).abs() <= 1e-4 * (1.0 + y.abs()))
+    };
+    for (p, q) in ours.meta.points.iter().zip(&theirs.meta.points) {
+        assert_eq!(p.lights.len(), q.lights.len(), "point {}", p.index);
+        for (a, b) in p.lights.iter().zip(&q.lights) {
+            assert_eq!((&a.name, &a.kind), (&b.name, &b.kind), "point {}", p.index);
+            assert!(
+                close(&a.position, &b.position),
+                "point {}: light at {:?}, pis-trace {:?}",
+                p.index,
+                a.position,
+                b.position
+            );
+            assert!(
+                close(&a.radiance, &b.radiance),
+                "point {}: radiance {:?}, pis-trace {:?}",
+                p.index,
+                a.radiance,
+                b.radiance
+            );
+            assert!(
+                (a.radius - b.radius).abs() < 1e-6,
+                "point {}: radius {} against {}",
+                p.index,
+                a.radius,
+                b.radius
+            );
+        }
+    }
+    let moved = ours.meta.points.iter().map(|p| p.lights[0].position).collect::<Vec<_>>();
+    assert!(moved.first() != moved.last(), "the light path moves the light");
+}
+
 /// Animation frames: the glTF's animation at the times the add-on wrote moves the box where
 /// Blender's frames put it (80×60, so 0.1 px here is 0.2 px of the 160×120 scene), and the
 /// set packs against the camera node's placement.
@@ -285,4 +330,24 @@ fn the_add_ons_set_packs_with_defaults_and_plays_as_predicted() {
         covered >= solved - 1.5,
         "the add-on's set plays at {covered:.2} dB over the objects' pixels, {solved:.2} dB as solved"
     );
+}
+
+/// A scene the add-on cannot render as PIS would (an area light) is refused before any render,
+/// with the reason, exit 5, and no set.json.
+#[test]
+fn an_area_light_is_refused_with_the_reason() {
+    let Some(f) = fixture() else { return };
+    let bad = f.blend.with_file_name("area.blend");
+    let edit = format!(
+        "import bpy, os, sys\nbpy.ops.wm.open_mainfile(filepath={:?})\nbpy.data.objects['Lamp'].data.type = 'AREA'\nbpy.ops.wm.save_as_mainfile(filepath={:?})\nsys.stdout.flush()\nos._exit(0)",
+        f.blend, bad
+    );
+    let made = python(&[os("-c"), os(&edit)]);
+    assert!(made.status.success(), "{}", String::from_utf8_lossy(&made.stderr));
+    let set = bad.with_file_name("area-set");
+    let out = python(&[os("-m"), os("pis_blender"), bad.as_os_str(), os("-o"), set.as_os_str()]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(5), "{err}");
+    assert!(err.contains("light Lamp: area lights are not supported"), "{err}");
+    assert!(!set.join("set.json").exists(), "no set.json after a refusal");
 }

@@ -8,6 +8,10 @@ import os
 import sys
 
 
+# The tools' exit codes (README.md): bad settings, I/O, not supported.
+EXIT_USAGE, EXIT_IO, EXIT_UNSUPPORTED = 1, 2, 5
+
+
 def main(argv=None):
     parser = argparse.ArgumentParser(prog="python3 -m pis_blender", description=__doc__.split("\n\n")[0])
     parser.add_argument("blend", help="the .blend file, its PIS settings set (Properties > Render > PIS set)")
@@ -25,7 +29,7 @@ def main(argv=None):
         import bpy
     except ImportError:
         print("pis_blender: Blender's bpy module is not installed (python3 -m pip install bpy==4.5.4)", file=sys.stderr)
-        return 2
+        return EXIT_UNSUPPORTED
     import pis_blender
     from pis_blender import scene_file, space
 
@@ -34,7 +38,7 @@ def main(argv=None):
         bpy.ops.wm.open_mainfile(filepath=args.blend)
     except RuntimeError as e:
         print(f"pis_blender: {args.blend}: {e}", file=sys.stderr)
-        return 3
+        return EXIT_IO
     scene = bpy.context.scene
     if args.spp is not None:
         scene.pis.spp = args.spp
@@ -42,9 +46,15 @@ def main(argv=None):
         scene.pis.seed = args.seed
     try:
         report = pis_blender.export_set(scene, args.output, progress=lambda line: print(line, file=sys.stderr, flush=True))
-    except (scene_file.ExportError, space.SpaceError) as e:
+    except space.SpaceError as e:
+        print(f"pis_blender: {args.blend}: the parameter space: {e}", file=sys.stderr)
+        return EXIT_USAGE
+    except scene_file.ExportError as e:
         print(f"pis_blender: {args.blend}: {e}", file=sys.stderr)
-        return 3
+        return EXIT_UNSUPPORTED
+    except OSError as e:
+        print(f"pis_blender: {args.output}: {e}", file=sys.stderr)
+        return EXIT_IO
     if args.json:
         print(json.dumps(report), file=report_out)
     else:

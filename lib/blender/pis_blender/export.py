@@ -14,7 +14,7 @@ import time
 
 import bpy
 
-from . import coords, cycles, layers, scene_file, space
+from . import coords, cycles, exr, layers, scene_file, space
 
 GEOMETRY = ("MESH", "CURVE", "SURFACE", "META", "FONT")
 
@@ -26,9 +26,11 @@ def export_set(scene, out_dir, progress=print):
         raise scene_file.ExportError("the scene has no camera")
     dims = space.dimensions(scene)
     os.makedirs(out_dir, exist_ok=True)
-    for stale in ("set.json",):
-        if os.path.exists(os.path.join(out_dir, stale)):
-            os.remove(os.path.join(out_dir, stale))
+    # The points are about to be rewritten: until set.json is written again, the folder is
+    # an unfinished set.
+    stale = os.path.join(out_dir, "set.json")
+    if os.path.exists(stale):
+        os.remove(stale)
     start = time.time()
     saved = cycles.Settings()
     scratch = tempfile.mkdtemp(prefix="pis-blender-")
@@ -69,9 +71,13 @@ def _objects(scene, names):
     return objects
 
 
+def _reflector(obj):
+    return obj.pis_reflector or obj.name
+
+
 def _parts(obj, objects):
-    key = lambda o: o.pis_reflector or o.name  # noqa: E731
-    return [o for o in objects if key(o) == key(obj)]
+    """The objects of `obj`'s reflector (scene.toml `reflector`), itself included."""
+    return [o for o in objects if _reflector(o) == _reflector(obj)]
 
 
 def _write_scene_toml(scene, out_dir, objects, roles, lights, dims):
@@ -125,8 +131,6 @@ def _render_points(scene, out_dir, scratch, dims, objects, roles, lights, progre
                     images[f"object.{ch}.{layer}.{name}"] = value[..., c]
         image = f"point_{index:05d}.exr"
         tmp = os.path.join(out_dir, f".{image}.tmp{os.getpid()}")
-        from . import exr
-
         exr.write(tmp, images, w, h)
         os.replace(tmp, os.path.join(out_dir, image))
         metas.append(_point_meta(scene, index, point, dims, image, objects, channels, lights))

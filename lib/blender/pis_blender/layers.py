@@ -45,18 +45,19 @@ class Renderer:
         self.scene, self.scratch, self.objects = scene, scratch, objects
         self.count = 0
 
-    def _render(self):
+    def render(self):
+        """The passes of the scene as it stands."""
         self.count += 1
         return cycles.render(self.scene, f"{self.scratch}/render_{self.count}.exr")
 
     def full(self):
-        return rgb(self._render(), "Combined")
+        return rgb(self.render(), "Combined")
 
     def alone(self, target, saved):
         """The passes of `target` with every other object a holdout."""
         for o in self.objects:
             saved.set(o, "is_holdout", o is not target)
-        return self._render()
+        return self.render()
 
 
 def object_layers(renderer, obj, role, parts, fraction_material):
@@ -77,8 +78,8 @@ def object_layers(renderer, obj, role, parts, fraction_material):
         if role == "reflective":
             incident = rgb(p, "GlossDir") + rgb(p, "GlossInd")
             out["fresnel"] = over_coverage(rgb(p, "GlossCol"), coverage)
-            distant = _distant(renderer, parts, saved)
-            alpha = _local_fraction(renderer, obj, parts, fraction_material, saved)
+            distant = _distant(renderer, parts)
+            alpha = _local_fraction(renderer, obj, parts, fraction_material)
             local = np.maximum(incident - (1.0 - alpha)[..., None] * distant, 0.0)
             mask = (coverage > EPS)[..., None]
             out["local"] = np.concatenate([local, alpha[..., None]], axis=-1) * mask
@@ -88,18 +89,18 @@ def object_layers(renderer, obj, role, parts, fraction_material):
         saved.restore()
 
 
-def _distant(renderer, parts, saved):
+def _distant(renderer, parts):
     inner = cycles.Settings()
     try:
         for o in parts:
             inner.set(o, "visible_glossy", False)
-        p = renderer._render()
+        p = renderer.render()
     finally:
         inner.restore()
     return rgb(p, "GlossDir") + rgb(p, "GlossInd")
 
 
-def _local_fraction(renderer, obj, parts, fraction_material, saved):
+def _local_fraction(renderer, obj, parts, fraction_material):
     scene = renderer.scene
     inner = cycles.Settings()
     try:
@@ -109,7 +110,7 @@ def _local_fraction(renderer, obj, parts, fraction_material, saved):
             inner.set(light, "hide_render", True)
         inner.set(scene, "world", None)
         inner.set(scene.view_layers[0], "material_override", fraction_material(roughness(obj)))
-        p = renderer._render()
+        p = renderer.render()
     finally:
         inner.restore()
     return np.clip(p["GlossDir.R"] + p["GlossInd.R"], 0.0, 1.0)

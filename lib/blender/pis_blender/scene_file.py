@@ -83,10 +83,12 @@ def role(obj):
         node = _principled(slot.material)
         if node is None:
             continue
-        value = lambda name: float(node.inputs[name].default_value)  # noqa: E731
-        if value("Transmission Weight") > 0:
+        transmission, metallic, roughness = (
+            float(node.inputs[name].default_value) for name in ("Transmission Weight", "Metallic", "Roughness")
+        )
+        if transmission > 0:
             return "refractive"
-        if (value("Metallic") >= 0.5 and value("Roughness") <= 0.3) or value("Roughness") < 0.1:
+        if (metallic >= 0.5 and roughness <= 0.3) or roughness < 0.1:
             best = "reflective"
     return best
 
