@@ -8,6 +8,7 @@
 //! - pis-trace, tracing the scene.toml the add-on wrote, puts every object where Cycles did:
 //!   coverage centroids within 0.1 px, areas as equal as sampling allows, and edges as wide (the Gaussian
 //!   filter recorded as Cycles applies it);
+//! - with two mirror walls in a corner, each part's local fraction A is pis-trace's;
 //! - the lights it records at every point are those pis-trace computes from that scene.toml;
 //! - pis-pack packs the set with default settings (against the cameras it records) and
 //!   pis-play draws the file as pis-pack predicted, within 1.5 dB of its textures as solved.
@@ -120,6 +121,14 @@ fn turning() -> Option<&'static Fixture> {
     static FIXTURE: OnceLock<Option<Fixture>> = OnceLock::new();
     FIXTURE
         .get_or_init(|| has_bpy().then(|| render(&["--turning", "--resolution", "80x60"], SPP)))
+        .as_ref()
+}
+
+/// Two mirror walls meeting at a right angle, one reflector, added to the scene, 80×60.
+fn corner() -> Option<&'static Fixture> {
+    static FIXTURE: OnceLock<Option<Fixture>> = OnceLock::new();
+    FIXTURE
+        .get_or_init(|| has_bpy().then(|| render(&["--corner", "--resolution", "80x60"], SPP)))
         .as_ref()
 }
 
@@ -350,4 +359,40 @@ fn an_area_light_is_refused_with_the_reason() {
     assert_eq!(out.status.code(), Some(5), "{err}");
     assert!(err.contains("light Lamp: area lights are not supported"), "{err}");
     assert!(!set.join("set.json").exists(), "no set.json after a refusal");
+}
+
+/// The local layer's A, the fraction of reflected rays that meet the reflector again, which
+/// the add-on renders with a material that lights only the reflector's parts, is pis-trace's:
+/// two mirror walls in a corner see each other over a quarter to a half of their pixels.
+#[test]
+fn the_local_fraction_is_the_one_pis_trace_traces() {
+    let Some(f) = corner() else { return };
+    let (ours, theirs) =
+        (RaySet::open(&f.set).expect("set"), RaySet::open(&f.traced).expect("traced"));
+    let mut largest = 0.0f64;
+    for i in 0..ours.len() {
+        for o in ours.meta.objects.iter().filter(|o| o.role == "reflective") {
+            let name = |l: &str| format!("object.{}.{l}", o.channel_name);
+            let (ca, cb) =
+                (plane(&ours, i, &name("coverage"), 0), plane(&theirs, i, &name("coverage"), 0));
+            let (aa, ab) =
+                (plane(&ours, i, &name("local"), 3), plane(&theirs, i, &name("local"), 3));
+            let inside: Vec<usize> =
+                (0..ca.len()).filter(|&p| ca[p] > 0.99 && cb[p] > 0.99).collect();
+            if inside.is_empty() {
+                continue;
+            }
+            let n = inside.len() as f64;
+            let mean = |a: &[f32]| inside.iter().map(|&p| a[p] as f64).sum::<f64>() / n;
+            let apart = inside.iter().map(|&p| (aa[p] - ab[p]).abs() as f64).sum::<f64>() / n;
+            let (ma, mb) = (mean(&aa), mean(&ab));
+            largest = largest.max(mb);
+            assert!(
+                (ma - mb).abs() < 0.02 && apart < 0.05,
+                "point {i} {}: local A {ma:.3} against pis-trace's {mb:.3}, {apart:.3} apart per pixel",
+                o.name
+            );
+        }
+    }
+    assert!(largest > 0.25, "the walls see each other: the largest mean A is {largest:.3}");
 }

@@ -4,7 +4,8 @@ takes 2 places on a path, seen from 4 views on an orbit (2 × 4 points).
 
     python3 samples/blender/make_scene.py OUT.blend [--resolution 160x120] [--spp 64] [--turning]
 
-With --turning the camera stands still and the box turns and slides over 3 animation frames.
+With --turning the camera stands still and the box turns and slides over 3 animation frames;
+with --corner two mirror walls meeting at a right angle, parts of one reflector, stand behind.
 
 Needs Blender's `bpy` module (python3 -m pip install bpy==4.5.4). The textures are written
 as PNG files beside OUT.blend.
@@ -53,7 +54,7 @@ def add(obj, mat):
     return obj
 
 
-def build(out, resolution, spp, turning):
+def build(out, resolution, spp, turning, corner):
     bpy.ops.wm.read_factory_settings(use_empty=True)
     folder = os.path.dirname(os.path.abspath(out))
     checker = image(
@@ -107,6 +108,15 @@ def build(out, resolution, spp, turning):
 
     s = scene.pis
     s.spp = spp
+    if corner:
+        # Two mirror walls meeting at a right angle behind the balls, one reflector: each
+        # sees the other (RAYSET.md's local layer).
+        for name, loc, rot in (("MirrorLeft", (-1.2, 1.6, 0.6), (math.radians(90), 0, math.radians(45))),
+                               ("MirrorRight", (0.4, 2.0, 0.6), (math.radians(90), 0, math.radians(-45)))):
+            bpy.ops.mesh.primitive_plane_add(size=1.2, location=loc, rotation=rot)
+            wall = add(bpy.context.object, material(name, color=(0.9, 0.9, 0.9), metallic=1.0, roughness=0.0))
+            wall.name = name
+            wall.pis_reflector = "Corner"
     if turning:
         # The box turns a quarter about Z from frame 1 to 25 and slides 0.4 along X; the
         # camera stays where it was placed; the space is 3 frames.
@@ -132,9 +142,10 @@ def main():
     parser.add_argument("--resolution", default="160x120")
     parser.add_argument("--spp", type=int, default=64)
     parser.add_argument("--turning", action="store_true", help="a fixed camera and the box turning over 3 animation frames instead")
+    parser.add_argument("--corner", action="store_true", help="add two mirror walls meeting at a right angle, one reflector")
     args = parser.parse_args()
     pis_blender.register()
-    build(args.out, tuple(int(x) for x in args.resolution.split("x")), args.spp, args.turning)
+    build(args.out, tuple(int(x) for x in args.resolution.split("x")), args.spp, args.turning, args.corner)
 
 
 if __name__ == "__main__":
