@@ -31,8 +31,9 @@ def unregister():
     props.unregister()
 
 
-def export_set(scene, out_dir, progress=print):
-    """Renders `scene`'s parameter space into the set folder `out_dir` and returns a report."""
+def export_set(scene, out_dir, progress=lambda line, done: print(line)):
+    """Renders `scene`'s parameter space into the set folder `out_dir` and returns a report;
+    `progress(line, done)` hears of each point, `done` the share of points rendered."""
     from . import export
 
     return export.export_set(scene, out_dir, progress)

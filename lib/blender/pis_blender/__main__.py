@@ -45,7 +45,7 @@ def main(argv=None):
     if args.seed is not None:
         scene.pis.seed = args.seed
     try:
-        report = pis_blender.export_set(scene, args.output, progress=lambda line: print(line, file=sys.stderr, flush=True))
+        report = pis_blender.export_set(scene, args.output, progress=lambda line, _done: print(line, file=sys.stderr, flush=True))
     except space.SpaceError as e:
         print(f"pis_blender: {args.blend}: the parameter space: {e}", file=sys.stderr)
         return EXIT_USAGE

@@ -19,8 +19,9 @@ from . import coords, cycles, exr, layers, scene_file, space
 GEOMETRY = ("MESH", "CURVE", "SURFACE", "META", "FONT")
 
 
-def export_set(scene, out_dir, progress=print):
-    """Writes the set of `scene` (its `scene.pis` settings) into `out_dir`; returns a report."""
+def export_set(scene, out_dir, progress=lambda line, done: print(line)):
+    """Writes the set of `scene` (its `scene.pis` settings) into `out_dir`; returns a report.
+    `progress(line, done)` hears of every point rendered, `done` the share of points so far."""
     s = scene.pis
     if scene.camera is None:
         raise scene_file.ExportError("the scene has no camera")
@@ -134,7 +135,7 @@ def _render_points(scene, out_dir, scratch, dims, objects, roles, lights, progre
         exr.write(tmp, images, w, h)
         os.replace(tmp, os.path.join(out_dir, image))
         metas.append(_point_meta(scene, index, point, dims, image, objects, channels, lights))
-        progress(f"point {index + 1}/{len(points)}: {renderer.count} renders so far, {time.time() - t0:.1f} s")
+        progress(f"point {index + 1}/{len(points)}: {renderer.count} renders so far, {time.time() - t0:.1f} s", (index + 1) / len(points))
     meta = {
         "format": "pis-rayset",
         "version": 1,

@@ -16,8 +16,13 @@ class PIS_OT_render_set(bpy.types.Operator):
         out = bpy.path.abspath(scene.pis.output_dir)
         wm = context.window_manager
         wm.progress_begin(0, 1)
+
+        def progress(line, done):
+            self.report({"INFO"}, line)
+            wm.progress_update(done)
+
         try:
-            report = export.export_set(scene, out, progress=lambda line: self.report({"INFO"}, line))
+            report = export.export_set(scene, out, progress=progress)
         except (scene_file.ExportError, space.SpaceError) as e:
             self.report({"ERROR"}, str(e))
             return {"CANCELLED"}
