@@ -121,28 +121,45 @@ def _render_points(scene, out_dir, scratch, dims, objects, roles, lights, progre
         space.place(scene, dims, point)
         scene.cycles.seed = scene.pis.seed * len(points) + index
         bpy.context.view_layer.update()
-        images = {}
-        combined = renderer.full()
-        for c, name in enumerate("RGB"):
-            images[f"combined.{name}"] = combined[..., c]
-        for obj, role, ch in zip(objects, roles, channels):
-            out = layers.object_layers(renderer, obj, role, _parts(obj, objects), fraction)
-            for layer, value in out.items():
-                for c, name in enumerate(CHANNELS[value.shape[-1]]):
-                    images[f"object.{ch}.{layer}.{name}"] = value[..., c]
+        images = _point_images(renderer, objects, roles, channels, fraction)
         image = f"point_{index:05d}.exr"
         tmp = os.path.join(out_dir, f".{image}.tmp{os.getpid()}")
         exr.write(tmp, images, w, h)
         os.replace(tmp, os.path.join(out_dir, image))
         metas.append(_point_meta(scene, index, point, dims, image, objects, channels, lights))
         progress(f"point {index + 1}/{len(points)}: {renderer.count} renders so far, {time.time() - t0:.1f} s", (index + 1) / len(points))
+    _write_set_json(scene, out_dir, dims, objects, roles, channels, metas)
+    return {
+        "set": out_dir,
+        "points": len(points),
+        "renders": renderer.count,
+        "objects": [{"name": o.name, "role": r} for o, r in zip(objects, roles)],
+    }
+
+
+def _point_images(renderer, objects, roles, channels, fraction):
+    """The point's EXR channels (RAYSET.md 5.1) as the scene stands: the full render's
+    combined image, then every object's layers."""
+    combined = renderer.full()
+    images = {f"combined.{name}": combined[..., c] for c, name in enumerate("RGB")}
+    for obj, role, ch in zip(objects, roles, channels):
+        out = layers.object_layers(renderer, obj, role, _parts(obj, objects), fraction)
+        for layer, value in out.items():
+            for c, name in enumerate(CHANNELS[value.shape[-1]]):
+                images[f"object.{ch}.{layer}.{name}"] = value[..., c]
+    return images
+
+
+def _write_set_json(scene, out_dir, dims, objects, roles, channels, points):
+    """set.json (RAYSET.md 3), written last and atomically: the set is complete."""
+    sigma = scene.pis.filter_sigma_px
     meta = {
         "format": "pis-rayset",
         "version": 1,
         "scene": scene.name,
-        "resolution": [w, h],
+        "resolution": [scene.render.resolution_x, scene.render.resolution_y],
         "spp": scene.pis.spp,
-        "filter": {"sigma_px": scene.pis.filter_sigma_px, "radius_px": cycles.filter_radius(scene.pis.filter_sigma_px)},
+        "filter": {"sigma_px": sigma, "radius_px": cycles.filter_radius(sigma)},
         "renderer": {"name": "Blender Cycles", "version": bpy.app.version_string},
         "scene_file": "scene.toml",
         "space": [d.meta() for d in dims] or [_still()],
@@ -151,18 +168,12 @@ def _render_points(scene, out_dir, scratch, dims, objects, roles, lights, progre
             | ({"reflector": o.pis_reflector} if o.pis_reflector else {})
             for o, ch, role in zip(objects, channels, roles)
         ],
-        "points": metas,
+        "points": points,
     }
     tmp = os.path.join(out_dir, f".set.json.tmp{os.getpid()}")
     with open(tmp, "w") as f:
         json.dump(meta, f, indent=1)
     os.replace(tmp, os.path.join(out_dir, "set.json"))
-    return {
-        "set": out_dir,
-        "points": len(points),
-        "renders": renderer.count,
-        "objects": [{"name": o.name, "role": r} for o, r in zip(objects, roles)],
-    }
 
 
 def _still():
