@@ -19,9 +19,6 @@ class ExportError(Exception):
     """A scene the add-on cannot export as it stands, saying what to change."""
 
 
-ROLES = ("diffuse", "reflective", "refractive")
-
-
 def export_gltf(path, with_animation, with_camera):
     import bpy
 
@@ -39,7 +36,6 @@ def export_gltf(path, with_animation, with_camera):
         export_anim_slide_to_zero=True,
         export_frame_range=True,
         export_force_sampling=True,
-        export_import_convert_lighting_mode="COMPAT",
     )
 
 
