@@ -83,10 +83,13 @@ pub struct PackOptions {
     /// `combined` (one view-dependent layer of diffuse + specular per parameter sample).
     #[arg(long, default_value = "separate", value_parser = one_of(&LayerMode::ALL, LayerMode::name))]
     pub layers: LayerMode,
-    /// Reflective and refractive objects: `auto` (per object, textures or environment-map
-    /// shells, whichever does better for the whole file: both are solved and the file
-    /// encoded with each; under `--psnr` the one that meets it with fewer bytes, under a
-    /// ratio the one whose file predicts a PSNR at least 0.05 dB higher), `texture`
+    /// Reflective and refractive objects: `auto` (the default: per object, surface textures,
+    /// or environment-map shells where they do better; the alternative is solved only for an
+    /// object whose textures solved 6 dB or more below the whole file's solved figure, kept
+    /// for weighing only if it solves within 1 dB of the textures, then weighed by encoding
+    /// the whole file each way: at the default target and under `--psnr` the one that meets
+    /// the goal with fewer bytes, under a ratio the one whose file predicts a PSNR at least
+    /// 0.05 dB higher; the report says for each object what it chose and why), `texture`
     /// (parameterized surface textures), `pem` (reflective objects as layered environment
     /// maps, thesis ch. 5: a local and a distant shell per parameter sample; refractive objects by hybrid rendering, thesis ch. 6: shells from
     /// the set's ray records, looked up through the lens object's vertex rays traced each
@@ -96,7 +99,7 @@ pub struct PackOptions {
     /// the object: the static environment map of thesis 5.1); `pem-infinity` stores
     /// refractive objects by hybrid rendering with a single shell (the single-shell
     /// baseline of thesis 6.5), `static-env` as `pem` does.
-    #[arg(long, default_value = "texture", value_parser = one_of(&REPRESENTATIONS, RepresentationMode::name))]
+    #[arg(long, default_value = "auto", value_parser = one_of(&REPRESENTATIONS, RepresentationMode::name))]
     pub representation: RepresentationMode,
     /// Conjugate-gradient iteration cap per colour channel of every texture solve
     /// (default: the solver's own).

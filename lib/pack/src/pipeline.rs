@@ -45,6 +45,7 @@ pub mod report;
 pub mod represent;
 pub mod rows;
 pub mod scratch;
+pub mod screen;
 pub mod set_images;
 pub mod settings;
 pub mod shading;

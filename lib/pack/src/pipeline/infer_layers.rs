@@ -8,8 +8,10 @@ use super::input::LoadedSet;
 use super::matrices::Matrices;
 use super::model::ObjectModel;
 use super::plan::Plan;
+use super::predict::{solved_error, total_psnr};
 use super::registry::{alternative, choose};
 use super::represent::Job;
+use super::screen;
 use super::{PackRequest, Stages};
 
 pub use super::model::{key, InferredLayer, PointView};
@@ -23,8 +25,9 @@ pub struct Inferred {
     pub alternatives: Vec<(usize, ObjectModel)>,
 }
 
-/// Infers every object that covers a pixel somewhere in the set, in its representation and
-/// in its alternative, if any.
+/// Infers every object that covers a pixel somewhere in the set, in its representation and,
+/// where [`super::screen`] finds its textures fall short (or, in a solve shard, wherever
+/// there is one), in its alternative.
 pub fn infer_all(
     set: &LoadedSet,
     req: &PackRequest,
@@ -33,6 +36,9 @@ pub fn infer_all(
     stages: &mut Stages,
 ) -> Result<Inferred> {
     let scene = &set.scene;
+    // A solve shard holds some objects only, not the whole file's solved figure the screen
+    // reads: it solves every alternative, and the merge screens them as one process would.
+    let screened = req.shard.is_none();
     let mut job = Job::new(set, req, plan, matrices, stages.progress());
     let mut surveyed = Vec::new();
     for (o, object) in scene.objects.iter().enumerate() {
@@ -40,13 +46,12 @@ pub fn infer_all(
             anyhow!("object {}: no representation stores a {:?} object", object.name, object.role)
         })?;
         if let Some(s) = rep.survey(&mut job, o)? {
-            let other = match alternative(object.role, req.representation).filter(|_| {
-                super::pem::layered(set, o) || object.role == pis_scene::ObjectRole::Refractive
-            }) {
+            let other = alternative_of(set, req, o);
+            let other = match other.filter(|_| !screened) {
                 Some(alt) => alt.survey(&mut job, o)?,
                 None => None,
             };
-            surveyed.push((s, other));
+            surveyed.push((o, s, other));
         }
     }
     if surveyed.is_empty() {
@@ -54,57 +59,36 @@ pub fn infer_all(
     }
     let n = surveyed.len();
     let mut planned = Vec::with_capacity(n);
-    for (mi, (s, other)) in surveyed.into_iter().enumerate() {
+    for (mi, (o, s, other)) in surveyed.into_iter().enumerate() {
         let st = plan.stagger(mi, n);
         let other = match other {
             Some(a) => Some(a.plan(&mut job, st.clone())?),
             None => None,
         };
-        planned.push((s.plan(&mut job, st)?, other));
+        planned.push((o, s.plan(&mut job, st)?, other));
     }
     let (made, extra) = (job.placements, job.extra_matrices);
     let matrices_text = format!(
         "texture coordinates of {} objects ({made} placements, per {}) and render matrices at {} points ({}; {extra} for block placements)",
         scene.objects.len(), req.placement.name(), set.frames.len(), job.matrices.describe(),
     );
-    let progress = job.progress;
     stages.done("matrices", &matrices_text);
     let mut models = Vec::with_capacity(n);
     let mut alternatives = Vec::new();
-    let note = |m: &ObjectModel| {
-        let sizes_text: Vec<String> = m
-            .used_placements()
-            .iter()
-            .map(|&p| format!("{}x{}", m.placements[p].layout.width, m.placements[p].layout.height))
-            .collect();
-        progress.note(&format!(
-            "object {}: {} texels, {} ({})",
-            m.name,
-            sizes_text.join(", "),
-            m.representation,
-            m.why
-        ));
-    };
-    for (mi, (p, other)) in planned.into_iter().enumerate() {
+    let mut objects = Vec::with_capacity(n);
+    for (mi, (o, p, other)) in planned.into_iter().enumerate() {
         // A solve shard solves its objects only (pis-pack solve --shard).
         if req.shard.is_some_and(|s| !s.has(mi)) {
             continue;
         }
-        // A pack that streams keeps the solved textures in its scratch file.
-        let spill = |mut m: ObjectModel| -> Result<ObjectModel> {
-            if let Some(scratch) = &set.scratch {
-                m.spill_textures(scratch)?;
-            }
-            Ok(m)
-        };
-        let m = spill(p.solve(&job)?)?;
-        note(&m);
-        models.push(m);
+        models.push(solved(&job, p)?);
+        objects.push(o);
         if let Some(a) = other {
-            let m = spill(a.solve(&job)?)?;
-            note(&m);
-            alternatives.push((mi, m));
+            alternatives.push((models.len() - 1, solved(&job, a)?));
         }
+    }
+    if screened {
+        alternatives = screen(&mut job, &mut models, &objects, plan)?;
     }
     let also = if alternatives.is_empty() {
         String::new()
@@ -113,4 +97,91 @@ pub fn infer_all(
     };
     stages.done("infer", &format!("{} objects solved{also}", models.len()));
     Ok(Inferred { models, alternatives })
+}
+
+/// The alternative representation of object `o` under `req`, where it has the layers it
+/// needs (the reflective layers for layered shells; a refractive object's hybrid rendering
+/// says itself when the set has no ray records).
+fn alternative_of(
+    set: &LoadedSet,
+    req: &PackRequest,
+    o: usize,
+) -> Option<&'static dyn super::represent::Representation> {
+    let role = set.scene.objects[o].role;
+    alternative(role, req.representation)
+        .filter(|_| super::pem::layered(set, o) || role == pis_scene::ObjectRole::Refractive)
+}
+
+/// `p` solved, its textures kept in the scratch file of a pack that streams, and noted.
+fn solved(job: &Job<'_>, p: Box<dyn super::represent::Planned>) -> Result<ObjectModel> {
+    let mut m = p.solve(job)?;
+    if let Some(scratch) = &job.set.scratch {
+        m.spill_textures(scratch)?;
+    }
+    let sizes_text: Vec<String> = m
+        .used_placements()
+        .iter()
+        .map(|&p| format!("{}x{}", m.placements[p].layout.width, m.placements[p].layout.height))
+        .collect();
+    job.note(&format!(
+        "object {}: {} texels, {} ({})",
+        m.name,
+        sizes_text.join(", "),
+        m.representation,
+        m.why
+    ));
+    Ok(m)
+}
+
+/// [`super::screen`]: the alternatives worth weighing, solved for the objects whose textures
+/// solved far below the whole file; each object with an alternative is told why in `why`.
+fn screen(
+    job: &mut Job<'_>,
+    models: &mut [ObjectModel],
+    objects: &[usize],
+    plan: &Plan,
+) -> Result<Vec<(usize, ObjectModel)>> {
+    let set = job.set;
+    let n = models.len();
+    let with_alternative: Vec<usize> =
+        (0..n).filter(|&mi| alternative_of(set, job.req, objects[mi]).is_some()).collect();
+    if with_alternative.is_empty() {
+        return Ok(Vec::new());
+    }
+    let errors: Vec<(f64, usize)> =
+        models.iter().map(|m| solved_error(set, m)).collect::<Result<_>>()?;
+    let file_db = total_psnr(&errors);
+    let mut kept = Vec::new();
+    for mi in with_alternative {
+        let object_db = screen::solved_db(errors[mi]);
+        let alt = alternative_of(set, job.req, objects[mi]).expect("an alternative");
+        let why = match screen::solve_alternative(object_db, file_db) {
+            Err(why) => format!("auto: surface textures: {why}"),
+            Ok(why) => {
+                let planned = match alt.survey(job, objects[mi])? {
+                    Some(s) => Some(s.plan(job, plan.stagger(mi, n))?),
+                    None => None,
+                };
+                match planned {
+                    None => format!("auto: surface textures: {why}; {} does not apply", alt.name()),
+                    Some(p) => {
+                        let m = solved(job, p)?;
+                        let alt_db = screen::solved_db(solved_error(set, &m)?);
+                        match screen::weigh_alternative(alt_db, object_db, alt.name()) {
+                            Ok(weighed) => {
+                                let mut m = m;
+                                m.why = format!("{}; {why}; {weighed}", m.why);
+                                kept.push((mi, m));
+                                format!("{why}; {weighed}")
+                            }
+                            Err(dropped) => format!("auto: surface textures: {why}; {dropped}"),
+                        }
+                    }
+                }
+            }
+        };
+        let m = &mut models[mi];
+        m.why = format!("{}; {why}", m.why);
+    }
+    Ok(kept)
 }

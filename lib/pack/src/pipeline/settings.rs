@@ -236,7 +236,7 @@ impl PackSettings {
             layers: LayerMode::Separate,
             allocation: Allocation::Screen,
             max_mse: MaxMse::Best(pis_codec::allocate::DEFAULT_ALPHA),
-            representation: RepresentationMode::Texture,
+            representation: RepresentationMode::Auto,
             placement: PlacementMode::Block,
             stagger: Stagger::Auto,
             shell_lookups: 1,
@@ -487,7 +487,6 @@ impl Stagger {
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum RepresentationMode {
     /// Parameterized surface textures, as every other object (thesis ch. 3–4).
-    #[default]
     Texture,
     /// Layered, parameterized environment maps: a local and a distant shell per parameter
     /// sample, plus a diffuse surface layer when the object has one (thesis ch. 5).
@@ -500,9 +499,10 @@ pub enum RepresentationMode {
     /// map on a sphere at infinity, ray-traced from the object's centre with the object left
     /// out (its reflections of itself are lost), not inferred from the images.
     StaticEnv,
-    /// Per reflective object, surface textures or layered environment maps, whichever meets
-    /// the target with fewer bytes: both are solved and the whole file encoded with each
-    /// ([`super::choice`]).
+    /// Per reflective or refractive object, surface textures, or its environment-map shells
+    /// where they do better: the shells are solved where the textures fall short
+    /// ([`super::screen`]) and the whole file encoded with each ([`super::choice`]).
+    #[default]
     Auto,
 }
 
