@@ -191,10 +191,12 @@ fn a_pack_split_over_processes_writes_the_bytes_one_process_writes() {
         &[&["merge", s, "--fragments", f, "-o", merged.to_str().unwrap(), "--json"][..], &flags]
             .concat(),
     ));
-    assert_eq!(
-        (m["fragments"]["read"].as_u64(), m["fragments"]["solved"].as_u64()),
-        (Some(held), Some(0)),
-        "every solve read from the fragments: {}",
+    // The shards solve every alternative (they lack the whole file's solved figure that
+    // `auto` screens by); the merge reads those the screen takes and solves nothing.
+    let read = m["fragments"]["read"].as_u64().unwrap();
+    assert!(
+        m["fragments"]["solved"].as_u64() == Some(0) && read > 0 && read <= held,
+        "every solve read from the fragments ({held} held): {}",
         m["fragments"]
     );
     assert!(
@@ -216,7 +218,9 @@ fn a_pack_split_over_processes_writes_the_bytes_one_process_writes() {
         &[&["merge", s, "--fragments", f, "-o", partial.to_str().unwrap(), "--json"][..], &flags]
             .concat(),
     ));
-    assert_eq!(p["fragments"]["solved"].as_u64(), rb["solutions"].as_u64(), "{}", p["fragments"]);
+    // It solves what the screen takes of them: at most what the shard solved.
+    let solved = p["fragments"]["solved"].as_u64().unwrap();
+    assert!(solved > 0 && solved <= rb["solutions"].as_u64().unwrap(), "{}", p["fragments"]);
     assert!(std::fs::read(&whole).unwrap() == std::fs::read(&partial).unwrap());
     // No fragments at all is an error that names the folder, and writes nothing.
     let empty = dir.path().join("empty");

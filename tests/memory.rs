@@ -92,8 +92,9 @@ fn a_streamed_pack_writes_the_bytes_of_a_pack_in_memory() {
         "demo1-lossless",
         &["--block", "2", "--codec", "lossless", "--keep-master"],
     );
-    // Environment-map shells and hybrid rendering under `auto` (demo1's vase and glass
-    // cup), each against its surface textures.
+    // Environment-map shells and hybrid rendering (demo1's vase, table top and glass cup),
+    // and under `auto` the objects its screen solves again, each against its textures.
+    held_and_streamed(dir.path(), set, "demo1-pem", &["--representation", "pem", "--ratio", "100"]);
     held_and_streamed(
         dir.path(),
         set,

@@ -96,7 +96,7 @@ fn object<'a>(r: &'a serde_json::Value, name: &str) -> &'a serde_json::Value {
 fn a_mirror_teapot_as_layered_environment_maps() {
     let dir = tempfile::tempdir().expect("temp dir");
     let scene = copy_sample(dir.path());
-    let (tex, t) = pack(&scene, "tex.pis", &[]);
+    let (tex, t) = pack(&scene, "tex.pis", &["--representation", "texture"]);
     let (pem, p) = pack(&scene, "pem.pis", &["--representation", "pem"]);
     let (inf, i) = pack(&scene, "inf.pis", &["--representation", "pem-infinity"]);
     let (stat, s) = pack(&scene, "stat.pis", &["--representation", "static-env"]);
@@ -320,7 +320,7 @@ fn sub_pixel_lookups_follow_the_traced_footprint() {
 fn a_reference_pair_takes_its_own_noise_out() {
     let dir = tempfile::tempdir().expect("temp dir");
     let scene = copy_sample(dir.path());
-    let (tex, _) = pack(&scene, "tex.pis", &[]);
+    let (tex, _) = pack(&scene, "tex.pis", &["--representation", "texture"]);
     let bench = |spp: &str, extra: &[&str]| {
         Command::new(env!("CARGO_BIN_EXE_pis-bench"))
             .arg("reflective")
@@ -381,7 +381,7 @@ fn a_denoised_adaptive_reference_is_cleaner() {
     }
     let dir = tempfile::tempdir().expect("temp dir");
     let scene = copy_sample(dir.path());
-    let (tex, _) = pack(&scene, "tex.pis", &[]);
+    let (tex, _) = pack(&scene, "tex.pis", &["--representation", "texture"]);
     let noise = |extra: &[&str]| -> (f64, String) {
         let b = Command::new(env!("CARGO_BIN_EXE_pis-bench"))
             .arg("reflective")
