@@ -85,8 +85,8 @@ pub struct PackOptions {
     pub layers: LayerMode,
     /// Reflective and refractive objects: `auto` (the default: per object, surface textures,
     /// or environment-map shells where they do better; the alternative is solved only for an
-    /// object whose textures solved 6 dB or more below the whole file's solved figure, kept
-    /// for weighing only if it solves within 1 dB of the textures, then weighed by encoding
+    /// object whose textures solved 6 dB or more below the other objects (or the only one),
+    /// kept for weighing only if it solves within 1 dB of the textures, then weighed by encoding
     /// the whole file each way: at the default target and under `--psnr` the one that meets
     /// the goal with fewer bytes, under a ratio the one whose file predicts a PSNR at least
     /// 0.05 dB higher; the report says for each object what it chose and why), `texture`

@@ -36,7 +36,7 @@ pub fn infer_all(
     stages: &mut Stages,
 ) -> Result<Inferred> {
     let scene = &set.scene;
-    // A solve shard holds some objects only, not the whole file's solved figure the screen
+    // A solve shard holds some objects only, not the other objects' solved figures the screen
     // reads: it solves every alternative, and the merge screens them as one process would.
     let screened = req.shard.is_none();
     let mut job = Job::new(set, req, plan, matrices, stages.progress());
@@ -134,7 +134,7 @@ fn solved(job: &Job<'_>, p: Box<dyn super::represent::Planned>) -> Result<Object
 }
 
 /// [`super::screen`]: the alternatives worth weighing, solved for the objects whose textures
-/// solved far below the whole file; each object with an alternative is told why in `why`.
+/// solved far below the other objects; each object with an alternative is told why in `why`.
 fn screen(
     job: &mut Job<'_>,
     models: &mut [ObjectModel],
@@ -150,12 +150,14 @@ fn screen(
     }
     let errors: Vec<(f64, usize)> =
         models.iter().map(|m| solved_error(set, m)).collect::<Result<_>>()?;
-    let file_db = total_psnr(&errors);
     let mut kept = Vec::new();
     for mi in with_alternative {
         let object_db = screen::solved_db(errors[mi]);
+        let others: Vec<(f64, usize)> =
+            errors.iter().enumerate().filter(|&(i, _)| i != mi).map(|(_, e)| *e).collect();
+        let others_db = (!others.is_empty()).then(|| total_psnr(&others));
         let alt = alternative_of(set, job.req, objects[mi]).expect("an alternative");
-        let why = match screen::solve_alternative(object_db, file_db) {
+        let why = match screen::solve_alternative(object_db, others_db) {
             Err(why) => format!("auto: surface textures: {why}"),
             Ok(why) => {
                 let planned = match alt.survey(job, objects[mi])? {

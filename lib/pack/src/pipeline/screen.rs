@@ -7,15 +7,15 @@
 //! it shows (a mirror ball's reflections squeezed towards its silhouette). Measured on the
 //! bundled, wild and Blender scenes at CI size (docs/benchmarks/defaults.md, "The
 //! representation of each object"), every object whose textures solved within
-//! [`SOLVE_BELOW_DB`] of the whole file's solved figure solved worse in its alternative
+//! [`SOLVE_BELOW_DB`] of the other objects' solved figure solved worse in its alternative
 //! (0.5–10 dB), and only objects far below it solved better; an alternative that solves
 //! more than [`KEEP_BELOW_DB`] below the textures on its object is dropped without the
 //! whole-file encodes of [`super::choice`].
 
 use super::predict::psnr;
 
-/// An object whose textures solved at least this far (dB) below the whole file's solved
-/// figure is also solved in its alternative representation.
+/// An object whose textures solved at least this far (dB) below the other objects of the
+/// file together is also solved in its alternative representation.
 pub const SOLVE_BELOW_DB: f64 = 6.0;
 
 /// An alternative whose solved figure on its object is more than this (dB) below the
@@ -23,12 +23,17 @@ pub const SOLVE_BELOW_DB: f64 = 6.0;
 /// the file as solved, it would need more bytes to play the object as well.
 pub const KEEP_BELOW_DB: f64 = 1.0;
 
-/// Why an object whose textures solved to `object_db` in a file that solved to `file_db` is
-/// (`Ok`) or is not (`Err`) also solved in its alternative, in words.
-pub fn solve_alternative(object_db: f64, file_db: f64) -> Result<String, String> {
-    let below = file_db - object_db;
+/// Why an object whose textures solved to `object_db`, beside other objects that solved to
+/// `others_db` together (`None`: it is the only object), is (`Ok`) or is not (`Err`) also
+/// solved in its alternative, in words. The only object is: nothing tells its textures fall
+/// short but the alternative itself.
+pub fn solve_alternative(object_db: f64, others_db: Option<f64>) -> Result<String, String> {
+    let Some(others_db) = others_db else {
+        return Ok(format!("its textures solved to {object_db:.2} dB, the only object"));
+    };
+    let below = others_db - object_db;
     let said = format!(
-        "its textures solved to {object_db:.2} dB, {below:.2} dB below the file's {file_db:.2}"
+        "its textures solved to {object_db:.2} dB, {below:.2} dB below the other objects' {others_db:.2}"
     );
     if below >= SOLVE_BELOW_DB {
         Ok(said)
@@ -60,9 +65,10 @@ mod tests {
     #[test]
     fn only_objects_far_below_the_file_are_solved_again() {
         // The Blender scene's mirror ball as textures, and demo1's table top.
-        assert!(solve_alternative(16.51, 25.35).is_ok());
-        let kept = solve_alternative(32.74, 35.23).unwrap_err();
-        assert!(kept.contains("2.49 dB below the file's 35.23"), "{kept}");
+        assert!(solve_alternative(16.51, Some(25.35)).is_ok());
+        let kept = solve_alternative(32.74, Some(35.23)).unwrap_err();
+        assert!(kept.contains("2.49 dB below the other objects' 35.23"), "{kept}");
+        assert!(solve_alternative(30.0, None).unwrap().contains("the only object"));
     }
 
     #[test]
