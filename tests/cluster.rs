@@ -191,7 +191,7 @@ fn a_pack_split_over_processes_writes_the_bytes_one_process_writes() {
         &[&["merge", s, "--fragments", f, "-o", merged.to_str().unwrap(), "--json"][..], &flags]
             .concat(),
     ));
-    // The shards solve every alternative (they lack the whole file's solved figure that
+    // The shards solve every alternative (they lack the other objects' solved figures that
     // `auto` screens by); the merge reads those the screen takes and solves nothing.
     let read = m["fragments"]["read"].as_u64().unwrap();
     assert!(
