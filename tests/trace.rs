@@ -280,7 +280,7 @@ fn errors_have_documented_exit_codes() {
     }
 }
 
-/// The acceptance run, once samples/demo1 is in the tree.
+/// The acceptance run of samples/demo1.
 #[test]
 fn demo1_at_80x60_gives_identical_bytes_twice() {
     let scene = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../samples/demo1/scene.toml");

@@ -157,6 +157,9 @@ pub fn choose(
                 );
                 (packed, quality, current) = (p, q, o);
                 kept += 1;
+                if let Some(a) = models[mi].auto.as_mut() {
+                    a.kept = true;
+                }
                 why
             }
             Ok((_, _, o)) => {

@@ -157,6 +157,14 @@ fn screen(
             errors.iter().enumerate().filter(|&(i, _)| i != mi).map(|(_, e)| *e).collect();
         let others_db = (!others.is_empty()).then(|| total_psnr(&others));
         let alt = alternative_of(set, job.req, objects[mi]).expect("an alternative");
+        let mut auto = screen::AutoChoice {
+            alternative: alt.name().to_string(),
+            textures_solved_db: object_db,
+            others_solved_db: others_db,
+            alternative_solved_db: None,
+            weighed: false,
+            kept: false,
+        };
         let why = match screen::solve_alternative(object_db, others_db) {
             Err(why) => format!("auto: surface textures: {why}"),
             Ok(why) => {
@@ -167,12 +175,14 @@ fn screen(
                 match planned {
                     None => format!("auto: surface textures: {why}; {} does not apply", alt.name()),
                     Some(p) => {
-                        let m = solved(job, p)?;
+                        let mut m = solved(job, p)?;
                         let alt_db = screen::solved_db(solved_error(set, &m)?);
+                        auto.alternative_solved_db = Some(alt_db);
                         match screen::weigh_alternative(alt_db, object_db, alt.name()) {
                             Ok(weighed) => {
-                                let mut m = m;
+                                auto.weighed = true;
                                 m.why = format!("{}; {why}; {weighed}", m.why);
+                                m.auto = Some(auto.clone());
                                 kept.push((mi, m));
                                 format!("{why}; {weighed}")
                             }
@@ -184,6 +194,7 @@ fn screen(
         };
         let m = &mut models[mi];
         m.why = format!("{}; {why}", m.why);
+        m.auto = Some(auto);
     }
     Ok(kept)
 }

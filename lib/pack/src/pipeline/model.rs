@@ -301,6 +301,9 @@ pub struct ObjectModel {
     /// What was chosen and why.
     pub representation: String,
     pub why: String,
+    /// Under `--representation auto`, for an object that has an alternative: what the
+    /// screen and the whole-file encodes found ([`super::screen`]).
+    pub auto: Option<super::screen::AutoChoice>,
 }
 
 impl ObjectModel {

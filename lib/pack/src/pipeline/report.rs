@@ -18,6 +18,11 @@ pub struct ObjectReport {
     pub representation: String,
     /// Why this representation was chosen.
     pub why: String,
+    /// Under `--representation auto`, for an object with an alternative representation:
+    /// the solved figures the screen read, whether the alternative was solved, weighed by
+    /// whole-file encodes and kept.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub auto: Option<super::screen::AutoChoice>,
     /// Where the mesh's texture coordinates could not hold a texture: what was charted
     /// again, and how.
     pub recharted: Option<String>,
@@ -211,6 +216,7 @@ pub fn build(
                 name: m.name.clone(),
                 representation: m.representation.clone(),
                 why: m.why.clone(),
+                auto: m.auto.clone(),
                 recharted: m.mesh.recharted.clone(),
                 bytes: packed.layer_bytes[mi].iter().sum(),
                 layer_bytes: m

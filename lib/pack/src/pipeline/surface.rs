@@ -659,6 +659,7 @@ impl Planned for Layers {
             hull_triangles: 0,
             representation: representation.to_string(),
             why: why.to_string(),
+            auto: None,
         })
     }
 }
