@@ -303,7 +303,25 @@ pub struct ObjectModel {
     pub why: String,
     /// Under `--representation auto`, for an object that has an alternative: what the
     /// screen and the whole-file encodes found ([`super::screen`]).
-    pub auto: Option<super::screen::AutoChoice>,
+    pub auto: Option<AutoChoice>,
+}
+
+/// What `auto` found for an object that has an alternative representation (pis-pack's
+/// `--json`: each object's `auto`).
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct AutoChoice {
+    /// The alternative's name.
+    pub alternative: String,
+    /// The object's textures, solved (dB over the pixels it covers).
+    pub textures_solved_db: f64,
+    /// The other objects of the file together, solved (`None`: the only object).
+    pub others_solved_db: Option<f64>,
+    /// The alternative, solved; `None` where the screen did not solve it.
+    pub alternative_solved_db: Option<f64>,
+    /// Whether the whole file was encoded with the alternative.
+    pub weighed: bool,
+    /// Whether the alternative is what the file stores.
+    pub kept: bool,
 }
 
 impl ObjectModel {

@@ -22,7 +22,7 @@ pub struct ObjectReport {
     /// the solved figures the screen read, whether the alternative was solved, weighed by
     /// whole-file encodes and kept.
     #[serde(skip_serializing_if = "Option::is_none")]
-    pub auto: Option<super::screen::AutoChoice>,
+    pub auto: Option<super::model::AutoChoice>,
     /// Where the mesh's texture coordinates could not hold a texture: what was charted
     /// again, and how.
     pub recharted: Option<String>,

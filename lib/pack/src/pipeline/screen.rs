@@ -12,27 +12,9 @@
 //! more than [`KEEP_BELOW_DB`] below the textures on its object is dropped without the
 //! whole-file encodes of [`super::choice`].
 
-use serde::Serialize;
-
 use super::predict::psnr;
 
-/// What `auto` found for an object that has an alternative representation (pis-pack's
-/// `--json`: each object's `auto`).
-#[derive(Clone, Debug, PartialEq, Serialize)]
-pub struct AutoChoice {
-    /// The alternative's name.
-    pub alternative: String,
-    /// The object's textures, solved (dB over the pixels it covers).
-    pub textures_solved_db: f64,
-    /// The other objects of the file together, solved (`None`: the only object).
-    pub others_solved_db: Option<f64>,
-    /// The alternative, solved; `None` where the screen did not solve it.
-    pub alternative_solved_db: Option<f64>,
-    /// Whether the whole file was encoded with the alternative.
-    pub weighed: bool,
-    /// Whether the alternative is what the file stores.
-    pub kept: bool,
-}
+pub use super::model::AutoChoice;
 
 /// An object whose textures solved at least this far (dB) below the other objects of the
 /// file together is also solved in its alternative representation.
