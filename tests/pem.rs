@@ -7,6 +7,8 @@
 //! lists the shells, and the player draws the shells as pis-pack predicted them (pis-diff
 //! against the traced set).
 
+mod common;
+
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
@@ -233,6 +235,48 @@ fn auto_keeps_the_representation_that_does_better_for_the_whole_file() {
     assert!(why("TeapotLid").contains("auto: surface textures"), "{}", why("TeapotLid"));
     let (pa, pp) = (a["psnr_db"].as_f64().expect("psnr"), p["psnr_db"].as_f64().expect("psnr"));
     assert!(pa >= pp - 2.0 * 0.05, "auto {pa:.2} dB, all layered PEM {pp:.2} dB");
+}
+
+/// A mirror alone in an empty world reflects nothing: its layered environment maps cannot be
+/// made (no reflection ray meets the scene to place a distant shell). The default pack
+/// (`auto`, which tries them on the only object of a file) stores it as textures and says
+/// why, instead of failing.
+#[test]
+fn a_mirror_that_reflects_nothing_is_stored_as_textures_with_the_reason() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let scene = common::sample_copy("teapot-pem", dir.path(), |doc, _| {
+        let names: Vec<String> = doc["nodes"]
+            .as_array()
+            .expect("nodes")
+            .iter()
+            .map(|n| n["name"].as_str().unwrap_or_default().to_string())
+            .collect();
+        let keep = |i: &serde_json::Value| {
+            let name = &names[i.as_u64().expect("node index") as usize];
+            ["TeapotBody", "LampNode", "Camera"].contains(&name.as_str())
+        };
+        let scene = &mut doc["scenes"][0]["nodes"];
+        let kept: Vec<serde_json::Value> =
+            scene.as_array().expect("scene nodes").iter().filter(|i| keep(i)).cloned().collect();
+        *scene = serde_json::Value::Array(kept);
+    });
+    let toml = std::fs::read_to_string(&scene).expect("scene.toml");
+    std::fs::write(&scene, toml.replace("[object.TeapotLid]\nrole = \"reflective\"\n", ""))
+        .expect("scene.toml");
+    let (file, r) = pack_coded(&scene, "alone.pis", &[]);
+    assert_valid(&file);
+    let objects = r["objects"].as_array().expect("objects");
+    assert_eq!(objects.len(), 1, "{r}");
+    let body = object(&r, "TeapotBody");
+    assert_eq!(body["representation"], "specular", "{body}");
+    let why = body["why"].as_str().expect("why");
+    assert!(
+        why.contains("the only object")
+            && why.contains("as layered environment maps it could not be made")
+            && why.contains("no reflection ray meets the scene"),
+        "{why}"
+    );
+    assert!(body["auto"]["alternative_solved_db"].is_null(), "{body}");
 }
 
 /// A reader refuses a level image that decodes to more than 8192 times the file's codestream

@@ -46,12 +46,7 @@ pub fn infer_all(
             anyhow!("object {}: no representation stores a {:?} object", object.name, object.role)
         })?;
         if let Some(s) = rep.survey(&mut job, o)? {
-            let other = alternative_of(set, req, o);
-            let other = match other.filter(|_| !screened) {
-                Some(alt) => alt.survey(&mut job, o)?,
-                None => None,
-            };
-            surveyed.push((o, s, other));
+            surveyed.push((o, s));
         }
     }
     if surveyed.is_empty() {
@@ -59,13 +54,8 @@ pub fn infer_all(
     }
     let n = surveyed.len();
     let mut planned = Vec::with_capacity(n);
-    for (mi, (o, s, other)) in surveyed.into_iter().enumerate() {
-        let st = plan.stagger(mi, n);
-        let other = match other {
-            Some(a) => Some(a.plan(&mut job, st.clone())?),
-            None => None,
-        };
-        planned.push((o, s.plan(&mut job, st)?, other));
+    for (mi, (o, s)) in surveyed.into_iter().enumerate() {
+        planned.push((o, s.plan(&mut job, plan.stagger(mi, n))?));
     }
     let (made, extra) = (job.placements, job.extra_matrices);
     let matrices_text = format!(
@@ -76,19 +66,20 @@ pub fn infer_all(
     let mut models = Vec::with_capacity(n);
     let mut alternatives = Vec::new();
     let mut objects = Vec::with_capacity(n);
-    for (mi, (o, p, other)) in planned.into_iter().enumerate() {
+    for (mi, (o, p)) in planned.into_iter().enumerate() {
         // A solve shard solves its objects only (pis-pack solve --shard).
         if req.shard.is_some_and(|s| !s.has(mi)) {
             continue;
         }
         models.push(solved(&job, p)?);
         objects.push(o);
-        if let Some(a) = other {
-            alternatives.push((models.len() - 1, solved(&job, a)?));
+        let alt = alternative_of(set, req, o).filter(|_| !screened);
+        if let Some(Ok(Some(m))) = alt.map(|a| alternative_model(&mut job, a, o, mi, n)) {
+            alternatives.push((models.len() - 1, m));
         }
     }
     if screened {
-        alternatives = screen(&mut job, &mut models, &objects, plan)?;
+        alternatives = screen(&mut job, &mut models, &objects)?;
     }
     let also = if alternatives.is_empty() {
         String::new()
@@ -133,13 +124,35 @@ fn solved(job: &Job<'_>, p: Box<dyn super::represent::Planned>) -> Result<Object
     Ok(m)
 }
 
+/// Object `o` (object model `mi` of `n`) in its alternative `alt`: surveyed, planned and
+/// solved; `Ok(None)` where the alternative does not apply, `Err` with the reason where it
+/// cannot be made (a mirror that reflects nothing has no distant shell): the object is then
+/// stored as textures and the pack goes on.
+fn alternative_model(
+    job: &mut Job<'_>,
+    alt: &dyn super::represent::Representation,
+    o: usize,
+    mi: usize,
+    n: usize,
+) -> std::result::Result<Option<ObjectModel>, String> {
+    let made = (|| -> Result<Option<ObjectModel>> {
+        let Some(s) = alt.survey(job, o)? else { return Ok(None) };
+        let p = s.plan(job, job.plan.stagger(mi, n))?;
+        Ok(Some(solved(job, p)?))
+    })();
+    made.map_err(|e| {
+        let e = format!("{e:#}");
+        job.note(&format!("object {}: as {}: {e}", job.set.scene.objects[o].name, alt.name()));
+        e
+    })
+}
+
 /// [`super::screen`]: the alternatives worth weighing, solved for the objects whose textures
 /// solved far below the other objects; each object with an alternative is told why in `why`.
 fn screen(
     job: &mut Job<'_>,
     models: &mut [ObjectModel],
     objects: &[usize],
-    plan: &Plan,
 ) -> Result<Vec<(usize, ObjectModel)>> {
     let set = job.set;
     let n = models.len();
@@ -168,14 +181,15 @@ fn screen(
         let why = match screen::solve_alternative(object_db, others_db) {
             Err(why) => format!("auto: surface textures: {why}"),
             Ok(why) => {
-                let planned = match alt.survey(job, objects[mi])? {
-                    Some(s) => Some(s.plan(job, plan.stagger(mi, n))?),
-                    None => None,
-                };
-                match planned {
-                    None => format!("auto: surface textures: {why}; {} does not apply", alt.name()),
-                    Some(p) => {
-                        let mut m = solved(job, p)?;
+                let name = alt.name();
+                match alternative_model(job, alt, objects[mi], mi, n) {
+                    Ok(None) => format!("auto: surface textures: {why}; {name} does not apply"),
+                    Err(e) => {
+                        format!(
+                            "auto: surface textures: {why}; as {name} it could not be made: {e}"
+                        )
+                    }
+                    Ok(Some(mut m)) => {
                         let alt_db = screen::solved_db(solved_error(set, &m)?);
                         auto.alternative_solved_db = Some(alt_db);
                         match screen::weigh_alternative(alt_db, object_db, alt.name()) {
