@@ -6,9 +6,9 @@ use anyhow::{anyhow, Result};
 
 use super::input::LoadedSet;
 use super::matrices::Matrices;
-use super::model::ObjectModel;
+use super::model::{AutoChoice, ObjectModel};
 use super::plan::Plan;
-use super::predict::{solved_error, total_psnr};
+use super::predict::{psnr, solved_error};
 use super::registry::{alternative, choose};
 use super::represent::Job;
 use super::screen;
@@ -156,21 +156,21 @@ fn screen(
 ) -> Result<Vec<(usize, ObjectModel)>> {
     let set = job.set;
     let n = models.len();
-    let with_alternative: Vec<usize> =
-        (0..n).filter(|&mi| alternative_of(set, job.req, objects[mi]).is_some()).collect();
+    let with_alternative: Vec<(usize, &'static dyn super::represent::Representation)> = (0..n)
+        .filter_map(|mi| alternative_of(set, job.req, objects[mi]).map(|alt| (mi, alt)))
+        .collect();
     if with_alternative.is_empty() {
         return Ok(Vec::new());
     }
     let errors: Vec<(f64, usize)> =
         models.iter().map(|m| solved_error(set, m)).collect::<Result<_>>()?;
+    let (sse, count) = errors.iter().fold((0.0, 0), |t, e| (t.0 + e.0, t.1 + e.1));
     let mut kept = Vec::new();
-    for mi in with_alternative {
-        let object_db = screen::solved_db(errors[mi]);
-        let others: Vec<(f64, usize)> =
-            errors.iter().enumerate().filter(|&(i, _)| i != mi).map(|(_, e)| *e).collect();
-        let others_db = (!others.is_empty()).then(|| total_psnr(&others));
-        let alt = alternative_of(set, job.req, objects[mi]).expect("an alternative");
-        let mut auto = screen::AutoChoice {
+    for (mi, alt) in with_alternative {
+        let (e, c) = errors[mi];
+        let object_db = psnr(e, c);
+        let others_db = (count > c).then(|| psnr(sse - e, count - c));
+        let mut auto = AutoChoice {
             alternative: alt.name().to_string(),
             textures_solved_db: object_db,
             others_solved_db: others_db,
@@ -180,35 +180,44 @@ fn screen(
         };
         let why = match screen::solve_alternative(object_db, others_db) {
             Err(why) => format!("auto: surface textures: {why}"),
-            Ok(why) => {
-                let name = alt.name();
-                match alternative_model(job, alt, objects[mi], mi, n) {
-                    Ok(None) => format!("auto: surface textures: {why}; {name} does not apply"),
-                    Err(e) => {
-                        format!(
-                            "auto: surface textures: {why}; as {name} it could not be made: {e}"
-                        )
-                    }
-                    Ok(Some(mut m)) => {
-                        let alt_db = screen::solved_db(solved_error(set, &m)?);
-                        auto.alternative_solved_db = Some(alt_db);
-                        match screen::weigh_alternative(alt_db, object_db, alt.name()) {
-                            Ok(weighed) => {
-                                auto.weighed = true;
-                                m.why = format!("{}; {why}; {weighed}", m.why);
-                                m.auto = Some(auto.clone());
-                                kept.push((mi, m));
-                                format!("{why}; {weighed}")
-                            }
-                            Err(dropped) => format!("auto: surface textures: {why}; {dropped}"),
-                        }
-                    }
+            Ok(why) => match weighed_alternative(job, alt, objects[mi], mi, n, &mut auto)? {
+                Ok((mut m, weighed)) => {
+                    m.why = format!("{}; {why}; {weighed}", m.why);
+                    m.auto = Some(auto.clone());
+                    kept.push((mi, m));
+                    format!("{why}; {weighed}")
                 }
-            }
+                Err(not) => format!("auto: surface textures: {why}; {not}"),
+            },
         };
         let m = &mut models[mi];
         m.why = format!("{}; {why}", m.why);
         m.auto = Some(auto);
     }
     Ok(kept)
+}
+
+/// Object `o`'s alternative `alt`, made and solved, with why it is weighed (`Ok`), or why not
+/// (`Err`: it does not apply, cannot be made, or solves more than
+/// [`screen::KEEP_BELOW_DB`] below the textures); `auto` records its figure and the outcome.
+fn weighed_alternative(
+    job: &mut Job<'_>,
+    alt: &dyn super::represent::Representation,
+    o: usize,
+    mi: usize,
+    n: usize,
+    auto: &mut AutoChoice,
+) -> Result<std::result::Result<(ObjectModel, String), String>> {
+    let name = alt.name();
+    let m = match alternative_model(job, alt, o, mi, n) {
+        Ok(Some(m)) => m,
+        Ok(None) => return Ok(Err(format!("{name} does not apply"))),
+        Err(e) => return Ok(Err(format!("as {name} it could not be made: {e}"))),
+    };
+    let (e, c) = solved_error(job.set, &m)?;
+    let alt_db = psnr(e, c);
+    auto.alternative_solved_db = Some(alt_db);
+    let weighed = screen::weigh_alternative(alt_db, auto.textures_solved_db, name);
+    auto.weighed = weighed.is_ok();
+    Ok(weighed.map(|w| (m, w)))
 }

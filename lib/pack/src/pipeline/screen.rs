@@ -12,10 +12,6 @@
 //! more than [`KEEP_BELOW_DB`] below the textures on its object is dropped without the
 //! whole-file encodes of [`super::choice`].
 
-use super::predict::psnr;
-
-pub use super::model::AutoChoice;
-
 /// An object whose textures solved at least this far (dB) below the other objects of the
 /// file together is also solved in its alternative representation.
 pub const SOLVE_BELOW_DB: f64 = 6.0;
@@ -53,11 +49,6 @@ pub fn weigh_alternative(alt_db: f64, textures_db: f64, alt: &str) -> Result<Str
     } else {
         Err(format!("{said} (more than {KEEP_BELOW_DB} dB below)"))
     }
-}
-
-/// The PSNR (dB) of a squared error sum over its number of values.
-pub fn solved_db(e: (f64, usize)) -> f64 {
-    psnr(e.0, e.1)
 }
 
 #[cfg(test)]
