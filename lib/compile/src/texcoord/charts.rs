@@ -35,12 +35,15 @@ pub fn charts(indices: &[u32], vertices: usize) -> (Vec<u32>, usize) {
         i
     }
     for tri in indices.chunks_exact(3) {
-        let a = root(&mut parent, tri[0]);
+        let mut a = root(&mut parent, tri[0]);
         for &v in &tri[1..] {
             let b = root(&mut parent, v);
             if a != b {
+                // Join under the lower root, which the next vertex then joins: linking the
+                // triangle's first root again once it has a parent would undo the first join.
                 let (lo, hi) = (a.min(b), a.max(b));
                 parent[hi as usize] = lo;
+                a = lo;
             }
         }
     }
@@ -436,5 +439,12 @@ mod tests {
         let (uvs, idx, mut view) = two_quads(true);
         view.clip[4..].iter_mut().for_each(|c| *c = Vec4::new(0.0, 0.0, 0.0, -1.0));
         assert_eq!(separate_overlapping_charts(&uvs, &idx, &[view]), None);
+    }
+
+    #[test]
+    fn a_triangle_that_joins_three_sets_makes_one_chart() {
+        // The first triangle joins vertex 2 to 0, then to 1; the second uses vertex 0 again.
+        // Joining 2's set to 1's must not undo its joining to 0's.
+        assert_eq!(charts(&[2, 0, 1, 0, 3, 4], 5), (vec![0, 0], 1));
     }
 }
