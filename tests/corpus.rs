@@ -13,7 +13,10 @@
 //! over every object's pixels together) is printed beside them, with how many objects play
 //! within [`DEFAULT_WITHIN_LOSSLESS_DB`] of their lossless figure.
 //! `cargo test --release --test corpus -- --nocapture` prints the table; `PIS_CORPUS=NAME` runs
-//! one model.
+//! one model. Models that cannot live in this repository (a licence that forbids it, no package
+//! that carries them) join the corpus from a folder of model folders laid out as
+//! samples/corpus's: `../shared/corpus` beside the checkout where it exists, and the folder
+//! `PIS_CORPUS_DIR` names.
 
 mod common;
 
@@ -54,6 +57,16 @@ fn corpus() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../samples/corpus")
 }
 
+/// The folders of model folders: samples/corpus, then `../shared/corpus` and `PIS_CORPUS_DIR`
+/// where they exist.
+fn corpora() -> Vec<PathBuf> {
+    let shared = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../shared/corpus");
+    let extra = std::env::var_os("PIS_CORPUS_DIR").map(PathBuf::from);
+    let mut all = vec![corpus()];
+    all.extend([Some(shared), extra].into_iter().flatten().filter(|d| d.is_dir()));
+    all
+}
+
 /// `program args`, which must succeed (common::run: killed after 120 s).
 fn run(program: &str, args: &[&std::ffi::OsStr]) -> Output {
     let out = common::run(program, args, &[]);
@@ -89,9 +102,10 @@ fn figure(list: &[(String, f64)], name: &str) -> f64 {
 /// holds (.ci/run installs it), or, for a model that is converted (a `convert` file naming the
 /// source beside its scene.toml), a copy of it in `dir` beside the source converted to glTF 2.0
 /// by the Open Asset Import Library's exporter (`assimp export SOURCE model.gltf -fgltf2`).
-fn scene_toml(name: &str, dir: &Path) -> PathBuf {
-    let toml = corpus().join(name).join("scene.toml");
-    let convert = corpus().join(name).join("convert");
+fn scene_toml(model: &Path, dir: &Path) -> PathBuf {
+    let name = model.display();
+    let toml = model.join("scene.toml");
+    let convert = model.join("convert");
     let toml = if convert.is_file() {
         let source = std::fs::read_to_string(&convert).expect("convert");
         let (source, copy) = (source.trim(), dir.join("scene.toml"));
@@ -124,10 +138,11 @@ const PACKAGES: &str = "Debian's assimp-testmodels and assimp-utils: samples/cor
 /// Traces, packs and plays one model; returns the lines of its table and its failures.
 /// A model's printed lines, its failures, and its objects (drawn, and playing with the
 /// defaults within [`DEFAULT_WITHIN_LOSSLESS_DB`] of lossless).
-fn check(name: &str) -> (Vec<String>, Vec<String>, (usize, usize)) {
+fn check(model: &Path) -> (Vec<String>, Vec<String>, (usize, usize)) {
     let start = Instant::now();
+    let name = &*model.file_name().expect("a model folder").to_string_lossy();
     let dir = tempfile::tempdir().expect("temp dir");
-    let toml = scene_toml(name, dir.path());
+    let toml = scene_toml(model, dir.path());
     let at = |f: &str| dir.path().join(f);
     let (trace, pack, diff) = (
         env!("CARGO_BIN_EXE_pis-trace"),
@@ -203,28 +218,31 @@ fn check(name: &str) -> (Vec<String>, Vec<String>, (usize, usize)) {
     (lines, failures, counts)
 }
 
-fn models() -> Vec<String> {
+/// The model folders of every corpus, each corpus's in name order.
+fn models() -> Vec<PathBuf> {
     let only = std::env::var("PIS_CORPUS").ok();
-    let mut names: Vec<String> = std::fs::read_dir(corpus())
-        .expect("samples/corpus")
-        .filter_map(|e| {
-            let e = e.ok()?;
-            e.path().join("scene.toml").is_file().then(|| e.file_name().to_string_lossy().into())
-        })
-        .filter(|n: &String| only.as_ref().is_none_or(|o| o == n))
-        .collect();
-    names.sort();
-    names
+    let mut models = Vec::new();
+    for corpus in corpora() {
+        let mut these: Vec<PathBuf> = std::fs::read_dir(&corpus)
+            .unwrap_or_else(|e| panic!("{}: {e}", corpus.display()))
+            .filter_map(|e| Some(e.ok()?.path()))
+            .filter(|m| m.join("scene.toml").is_file())
+            .filter(|m| only.as_ref().is_none_or(|o| m.file_name().is_some_and(|n| n == &**o)))
+            .collect();
+        these.sort();
+        models.extend(these);
+    }
+    models
 }
 
 #[test]
 fn every_model_plays_as_it_traces() {
-    let names = models();
-    assert!(!names.is_empty(), "no model in samples/corpus");
+    let models = models();
+    assert!(!models.is_empty(), "no model in samples/corpus");
     let mut all_failures = Vec::new();
     let (mut within, mut objects) = (0, 0);
-    for name in &names {
-        let (lines, failures, counts) = check(name);
+    for model in &models {
+        let (lines, failures, counts) = check(model);
         println!("{}", lines.join("\n"));
         all_failures.extend(failures);
         (within, objects) = (within + counts.0, objects + counts.1);
@@ -245,7 +263,7 @@ fn denoising_keeps_a_sharp_logo_raw() {
         return;
     }
     let dir = tempfile::tempdir().expect("temp dir");
-    let toml = scene_toml("box-textured", dir.path());
+    let toml = scene_toml(&corpus().join("box-textured"), dir.path());
     let (set, gold) = (dir.path().join("set"), dir.path().join("gold"));
     let (trace, diff) = (env!("CARGO_BIN_EXE_pis-trace"), env!("CARGO_BIN_EXE_pis-diff"));
     run(trace, &[os(&toml), os("-o"), os(&set), os("--denoise"), os("on")]);
