@@ -57,10 +57,9 @@ pub struct PackOptions {
     #[arg(long, default_value_t = pis_pack::DEFAULT_MAX_TEXTURE)]
     pub max_texture: u32,
     /// Texel budget: at most K level-0 texels per pixel an object covers in its most covered
-    /// view (where its charts are laid out apart, K for the charts, their gutters on top); an
-    /// object's texture over budget is reduced uniformly (thesis 3.2's per-object reduction
-    /// factor, chosen automatically). `none`: the optimal resolution, capped by --max-texture
-    /// only.
+    /// view; an object's texture over budget is reduced uniformly (thesis 3.2's per-object
+    /// reduction factor, chosen automatically). `none`: the optimal resolution, capped by
+    /// --max-texture only.
     #[arg(long, default_value = "1", value_parser = parse_budget)]
     pub texels_per_pixel: Budget,
     /// Display gamma of the compensation (1: linear storage; lossless and raw packs always use 1).

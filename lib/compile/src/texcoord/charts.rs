@@ -191,19 +191,6 @@ fn overlapping(uvs: &[Vec2], indices: &[u32], tri_chart: &[u32], take: &[bool]) 
     false
 }
 
-/// An atlas laid out by [`separate_overlapping_charts`]: every vertex's new texture
-/// coordinates, and the share of the atlas's rectangle that its charts' own rectangles fill
-/// (the rest is gutters and the gaps of the packing). A texel budget meant for the surface
-/// (texels per pixel of its most covered view) is divided by it for the whole atlas, so
-/// that the charts get the texels and the gutters come on top: counted on the atlas, the
-/// budget went mostly to gutters where a mesh has many small charts (DamagedHelmet's 557
-/// seen charts fill 38 % of their atlas).
-#[derive(Clone, Debug, PartialEq)]
-pub struct Separated {
-    pub uvs: Vec<Vec2>,
-    pub chart_share: f64,
-}
-
 /// New texture coordinates that lay the visible charts out side by side when two of them
 /// overlap in (u, v), or when the texel densities they need differ by more than
 /// [`NONUNIFORM`] (an artist's atlas with one part at a fraction of the others' scale);
@@ -214,7 +201,7 @@ pub fn separate_overlapping_charts(
     uvs: &[Vec2],
     indices: &[u32],
     views: &[ViewGeometry],
-) -> Option<Separated> {
+) -> Option<Vec<Vec2>> {
     let (tri_chart, n) = charts(indices, uvs.len());
     if n < 2 {
         return None;
@@ -268,7 +255,7 @@ pub fn separate_overlapping_charts(
     let area: f64 = order.iter().map(|&c| size(c).x * size(c).y).sum();
     let row_width = area.sqrt().max(order.iter().map(|&c| size(c).x).fold(0.0, f64::max));
     let mut offset = vec![DVec2::ZERO; n];
-    let (mut x, mut y, mut row_h, mut used_width) = (0.0f64, 0.0f64, 0.0f64, 0.0f64);
+    let (mut x, mut y, mut row_h) = (0.0f64, 0.0f64, 0.0f64);
     for &c in &order {
         let s = size(c);
         if x > 0.0 && x + s.x > row_width {
@@ -279,11 +266,7 @@ pub fn separate_overlapping_charts(
         offset[c] = DVec2::new(x, y) + DVec2::splat(GUTTER);
         x += s.x;
         row_h = row_h.max(s.y);
-        used_width = used_width.max(x);
     }
-    let charts_area: f64 =
-        order.iter().map(|&c| ((hi[c] - lo[c]) * scale[c]).element_product()).sum();
-    let chart_share = (charts_area / (used_width * (y + row_h))).clamp(1e-6, 1.0);
     let extent = row_width.max(y + row_h);
     let mut out = vec![Vec2::ZERO; uvs.len()];
     let mut chart_of_vertex = vec![u32::MAX; uvs.len()];
@@ -301,7 +284,7 @@ pub fn separate_overlapping_charts(
         let p = offset[c] + (uv.as_dvec2() - lo[c]) * scale[c];
         out[v] = (p / extent).as_vec2();
     }
-    Some(Separated { uvs: out, chart_share })
+    Some(out)
 }
 
 #[cfg(test)]
@@ -345,8 +328,7 @@ mod tests {
     fn overlapping_visible_charts_are_laid_out_apart() {
         let (uvs, idx, view) = two_quads(true);
         let new = separate_overlapping_charts(&uvs, &idx, std::slice::from_ref(&view))
-            .expect("the quads overlap in (u, v)")
-            .uvs;
+            .expect("the quads overlap in (u, v)");
         // The two quads' (u, v) bounds no longer intersect.
         let bounds = |q: usize| {
             let vs = &new[q * 4..q * 4 + 4];
@@ -409,8 +391,7 @@ mod tests {
         clip.extend(u.copies.iter().map(|&v| view.clip[v as usize]));
         assert_eq!(charts(&u.indices, uvs2.len()).1, 2);
         let new = separate_overlapping_charts(&uvs2, &u.indices, &[ViewGeometry { clip, ..view }])
-            .expect("the halves overlap")
-            .uvs;
+            .expect("the halves overlap");
         let bounds = |vs: &[u32]| {
             let p: Vec<Vec2> = vs.iter().map(|&v| new[v as usize]).collect();
             (
@@ -440,8 +421,7 @@ mod tests {
         let (mut uvs, idx, view) = two_quads(true);
         uvs[4..].iter_mut().for_each(|v| *v = Vec2::new(2.0, 0.0) + *v / 16.0);
         let new = separate_overlapping_charts(&uvs, &idx, std::slice::from_ref(&view))
-            .expect("the densities differ 16 times")
-            .uvs;
+            .expect("the densities differ 16 times");
         let side = |q: usize| new[q * 4 + 1].x - new[q * 4].x;
         // Same screen size, so the same size in the atlas.
         assert!((side(0) / side(1) - 1.0).abs() < 1e-3, "{} {}", side(0), side(1));
@@ -459,22 +439,6 @@ mod tests {
         let (uvs, idx, mut view) = two_quads(true);
         view.clip[4..].iter_mut().for_each(|c| *c = Vec4::new(0.0, 0.0, 0.0, -1.0));
         assert_eq!(separate_overlapping_charts(&uvs, &idx, &[view]), None);
-    }
-
-    #[test]
-    fn the_chart_share_is_what_the_charts_fill_of_the_atlas() {
-        let (uvs, idx, view) = two_quads(true);
-        let atlas = separate_overlapping_charts(&uvs, &idx, std::slice::from_ref(&view))
-            .expect("the quads overlap");
-        // Two equal squares of side d, each in a cell of side d + 2·GUTTER, stacked (a row
-        // is √2 cells wide): the atlas is 2 cells tall, so a square's side in the atlas's
-        // coordinates is d / (2(d + 2·GUTTER)), and the squares fill d² / (d + 2·GUTTER)².
-        let v = &atlas.uvs[..4];
-        let lo = v.iter().fold(Vec2::splat(f32::INFINITY), |a, v| a.min(*v));
-        let hi = v.iter().fold(Vec2::splat(f32::NEG_INFINITY), |a, v| a.max(*v));
-        let side = f64::from((hi - lo).x);
-        assert!((atlas.chart_share - (2.0 * side).powi(2)).abs() < 1e-4, "{}", atlas.chart_share);
-        assert!(atlas.chart_share < 1.0);
     }
 
     #[test]

@@ -123,9 +123,6 @@ pub fn seam_wraps(mesh: &Mesh) -> [bool; 2] {
 pub struct Atlas {
     pub uvs: Vec<[f32; 2]>,
     pub wrap: [bool; 2],
-    /// Where charts were laid out apart, the share of the atlas their own rectangles fill
-    /// ([`pis_compile::texcoord::charts::Separated::chart_share`]); else 1.
-    pub chart_share: f64,
 }
 
 /// The mesh of object `o` as the views of `frames` see it (clip-space vertices).
@@ -158,12 +155,10 @@ pub fn atlas(frames: &[&Frame], res: (u32, u32), o: usize, mesh: &Mesh) -> Atlas
     let views = view_geometry(frames, res, o, mesh);
     let uvs: Vec<glam::Vec2> = mesh.uvs.iter().map(|u| glam::Vec2::from(*u)).collect();
     match separate_overlapping_charts(&uvs, &mesh.indices, &views) {
-        Some(atlas) => Atlas {
-            uvs: atlas.uvs.iter().map(|uv| uv.to_array()).collect(),
-            wrap: [false, false],
-            chart_share: atlas.chart_share,
-        },
-        None => Atlas { uvs: mesh.uvs.clone(), wrap: seam_wraps(mesh), chart_share: 1.0 },
+        Some(atlas) => {
+            Atlas { uvs: atlas.iter().map(|uv| uv.to_array()).collect(), wrap: [false, false] }
+        }
+        None => Atlas { uvs: mesh.uvs.clone(), wrap: seam_wraps(mesh) },
     }
 }
 
@@ -209,8 +204,7 @@ pub fn place_in(
     let settings = TexcoordSettings {
         max_size: max_texture,
         reduction,
-        // The budget is for the surface: an atlas's gutters and gaps come on top.
-        texels_per_pixel: texels_per_pixel.map(|k| k / atlas.chart_share),
+        texels_per_pixel,
         ..TexcoordSettings::default()
     };
     let pl = optimize_placement(&om, &views, &settings)?;
