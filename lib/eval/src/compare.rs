@@ -12,7 +12,9 @@
 //! silhouette. So the objects are measured on the frame's single-sample twin
 //! ([`Player::render_centres`]: each pixel wholly the surface at its centre), and only the
 //! whole image (with its silhouette and interior split) on the multisampled frame, against
-//! the set's combined image.
+//! the set's combined image. A translucent object (SPEC.md 9) has no radiance of its own
+//! on screen: it is measured on what shows where it is nearest, itself over what lies
+//! behind it, against the combined image.
 
 use std::path::Path;
 
@@ -111,6 +113,7 @@ pub fn compare_with_set(
     }
     let dims = player.dimensions().len();
     let names = player.object_names();
+    let translucent = player.translucent_objects();
     let channels = channels(&set, &names, set_dir)?;
     let grids = score_grids(player);
     let block_count = |o: usize| grids[o].block_count() as usize;
@@ -180,7 +183,11 @@ pub fn compare_with_set(
         }
         let mut objects = Vec::with_capacity(names.len());
         for (o, ch) in channels.iter().enumerate() {
-            let e = object_error(&images, ch, o, own_ids, own);
+            let e = if translucent[o] {
+                seen_through_error(&images, ch, o, own_ids, own, &gold)
+            } else {
+                object_error(&images, ch, o, own_ids, own)
+            };
             let block = grids[o].locate(&p.samples).block;
             per_object[o].0.merge(&e);
             if let Some(b) = per_object[o].1.get_mut(block) {
@@ -308,6 +315,29 @@ fn silhouette_pixels(images: &PointImages, channels: &[String], partial: &mut Ve
             }
         }
     }
+}
+
+/// A translucent object `o`'s error over the pixels the player draws it at (its surface
+/// nearest at the centre) and the tracer's coverage says it covers: what shows there, the
+/// object over what lies behind it, against the gold standard's combined image.
+fn seen_through_error(
+    images: &PointImages,
+    ch: &str,
+    o: usize,
+    ids: &[u32],
+    rendered: &FloatImage,
+    gold: &FloatImage,
+) -> SquaredError {
+    let cov = images.object_layer(ch, LayerKind::Coverage).and_then(|l| l.channel("A"));
+    let mut e = SquaredError::default();
+    if let Some(cov) = cov {
+        for (k, (&id, &c)) in ids.iter().zip(cov).enumerate() {
+            if id == o as u32 && c > 0.0 {
+                (0..3).for_each(|i| e.add(rendered.rgba[k * 4 + i], gold.rgba[k * 4 + i]));
+            }
+        }
+    }
+    e
 }
 
 /// Object `o`'s error over the pixels the player draws it at and the tracer's coverage says

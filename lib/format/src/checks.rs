@@ -475,6 +475,8 @@ fn layers<S>(
     out: &mut Vec<Issue>,
 ) {
     let mut slots = HashSet::new();
+    // A translucent object (SPEC.md 7.1, 9): its first surface layer carries its opacity.
+    let translucent = o.layers.iter().any(|l| l.mapping == Mapping::Surface && l.channels == 4);
     for (li, l) in o.layers.iter().enumerate() {
         let e = |id, d: String| {
             chunk(
@@ -489,11 +491,17 @@ fn layers<S>(
         let combo = if surface {
             !l.kind.is_shell()
                 && l.term == Term::Surface
-                && matches!(l.combine, Combine::Add | Combine::Multiply)
-                && l.channels == 3
+                && match l.channels {
+                    3 => {
+                        l.combine == Combine::Add || !translucent && l.combine == Combine::Multiply
+                    }
+                    4 => l.combine == Combine::Add && l.order == 0,
+                    _ => false,
+                }
                 && (o.mesh.texcoords.is_some() || !has_mesh)
         } else {
-            l.kind.is_shell()
+            !translucent
+                && l.kind.is_shell()
                 && l.combine == Combine::Over
                 && matches!(l.channels, 3 | 4)
                 && match l.term {

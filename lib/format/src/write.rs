@@ -10,7 +10,7 @@ use crate::chunk::{
     self, FourCC, ALIGN, ENTRY_LEN, HEADER_LEN, MAGIC, VERSION_MAJOR, VERSION_MINOR,
 };
 use crate::master::Master;
-use crate::model::{Codestream, Container, StreamRef};
+use crate::model::{Codestream, Container, Mapping, StreamRef};
 use crate::{checks, payload_write as pw, Error};
 
 /// The bytes of a `.pis` file holding `c`. Fails if `c` breaks a rule of the spec.
@@ -218,7 +218,22 @@ fn serialize_inner(c: &Container, masters: &[Master], labelled: bool) -> Sink {
     for m in masters {
         chunks.push(chunk(chunk::MSTR, &mut |s| crate::master::write(s, m)));
     }
-    assemble(chunks, labelled)
+    assemble(chunks, minor_version(c), labelled)
+}
+
+/// The lowest minor version whose rules the file needs (SPEC.md 10.1): 3 where an object is
+/// translucent (a surface layer of 4 channels, 7.1), else 2.
+fn minor_version(c: &Container) -> u16 {
+    let translucent = c
+        .objects
+        .iter()
+        .flat_map(|o| &o.layers)
+        .any(|l| l.mapping == Mapping::Surface && l.channels == 4);
+    if translucent {
+        VERSION_MINOR
+    } else {
+        VERSION_MINOR - 1
+    }
 }
 
 fn place(cstr: &mut Sink, chunk: u32, img: &Codestream) -> StreamRef {
@@ -236,11 +251,11 @@ fn place(cstr: &mut Sink, chunk: u32, img: &Codestream) -> StreamRef {
     r
 }
 
-fn assemble(chunks: Vec<Chunk>, labelled: bool) -> Sink {
+fn assemble(chunks: Vec<Chunk>, minor: u16, labelled: bool) -> Sink {
     let mut out = Sink::new(labelled);
     out.raw(&MAGIC, || "magic \\x89 P I S \\r \\n \\x1a \\n".into());
     out.u16(VERSION_MAJOR, "major version");
-    out.u16(VERSION_MINOR, "minor version");
+    out.u16(minor, "minor version");
     out.u32(0, "flags");
     out.u64(0, "file length");
     out.u32(chunks.len() as u32, "chunk count");

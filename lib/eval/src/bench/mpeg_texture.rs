@@ -14,7 +14,7 @@ use std::collections::BTreeMap;
 
 use crate::baselines::path::zigzag;
 use crate::baselines::video::{decode, encode_to_budget, Frames, Matched, VideoCodec};
-use anyhow::Result;
+use anyhow::{bail, Result};
 
 use pis_pack::encode::{finest, mip_chain, LayerTextures};
 use pis_pack::predict::{display_error, psnr};
@@ -35,6 +35,13 @@ fn videos(inf: &Inferred) -> Result<Vec<LayerVideo>> {
     let mut out = Vec::new();
     for (mi, m) in inf.models.iter().enumerate() {
         for (li, l) in m.layers.iter().enumerate() {
+            if l.form.channels() != 3 {
+                bail!(
+                    "object {}: the video baseline codes RGB textures, and its layer {li} has {} channels (a translucent object's opacity)",
+                    m.name,
+                    l.form.channels()
+                );
+            }
             let counts: Vec<u32> =
                 l.depends_on.dims().map(|d| dims[d].values.len() as u32).collect();
             let path: Vec<Vec<u32>> =
@@ -50,12 +57,12 @@ fn videos(inf: &Inferred) -> Result<Vec<LayerVideo>> {
                     keys.iter().map(|k| l.textures.get(k)).collect::<Result<Vec<_>>>()?;
                 let scale = textures
                     .iter()
-                    .flat_map(|x| finest(layout, x))
+                    .flat_map(|x| finest(layout, x, 3))
                     .fold(0.0f32, f32::max)
                     .max(1e-6);
                 let mut rgb = Vec::new();
                 for x in &textures {
-                    rgb.extend(finest(layout, x).iter().map(|&v| {
+                    rgb.extend(finest(layout, x, 3).iter().map(|&v| {
                         ((v.max(0.0) / scale).powf(1.0 / GAMMA) * 255.0).round().clamp(0.0, 255.0)
                             as u8
                     }));
@@ -95,7 +102,7 @@ pub fn texture_point(inf: &Inferred, budget: usize) -> Result<TexturePoint> {
                 .iter()
                 .map(|&b| v.scale * (b as f32 / 255.0).powf(GAMMA))
                 .collect();
-            textures[v.model][v.layer].insert(k.clone(), mip_chain(m.layout(v.layer, k), lin));
+            textures[v.model][v.layer].insert(k.clone(), mip_chain(m.layout(v.layer, k), lin, 3));
         }
     }
     let e = inf

@@ -12,7 +12,7 @@ use super::predict::{psnr, solved_error};
 use super::registry::{alternative, choose};
 use super::represent::Job;
 use super::screen;
-use super::{PackRequest, Stages};
+use super::{PackRequest, RepresentationMode, Stages};
 
 pub use super::model::{key, InferredLayer, PointView};
 pub use super::surface::{BLACK, DISPLAY_STEP};
@@ -42,7 +42,21 @@ pub fn infer_all(
     let mut job = Job::new(set, req, plan, matrices, stages.progress());
     let mut surveyed = Vec::new();
     for (o, object) in scene.objects.iter().enumerate() {
-        let rep = choose(object.role, req.representation).ok_or_else(|| {
+        // A translucent object is stored as surface textures with its opacity, whatever the
+        // representation asked for (shells are composited over an opaque surface).
+        let mode = if job.meshes[o].translucent {
+            if !matches!(req.representation, RepresentationMode::Texture | RepresentationMode::Auto)
+            {
+                job.note(&format!(
+                    "object {}: translucent (glTF alpha mode MASK or BLEND): stored as surface textures with its opacity",
+                    object.name
+                ));
+            }
+            RepresentationMode::Texture
+        } else {
+            req.representation
+        };
+        let rep = choose(object.role, mode).ok_or_else(|| {
             anyhow!("object {}: no representation stores a {:?} object", object.name, object.role)
         })?;
         if let Some(s) = rep.survey(&mut job, o)? {
@@ -99,6 +113,9 @@ fn alternative_of(
     o: usize,
 ) -> Option<&'static dyn super::represent::Representation> {
     let role = set.scene.objects[o].role;
+    if super::mesh::is_translucent(&set.scene, o) {
+        return None;
+    }
     alternative(role, req.representation)
         .filter(|_| super::pem::layered(set, o) || role == pis_scene::ObjectRole::Refractive)
 }

@@ -22,14 +22,25 @@ pub struct Mesh {
     /// What [`rechart::rechart`] did to texture coordinates that could not hold a texture,
     /// for the report; `None` where the mesh's own were kept.
     pub recharted: Option<String>,
+    /// Some material of the object lets light through part of its surface (glTF alpha mode
+    /// MASK or BLEND): the object is stored with its opacity and the player composites it
+    /// over the opaque surfaces behind it (SPEC.md 9).
+    pub translucent: bool,
 }
 
 /// Object `o`'s primitives merged into one mesh, in primitive order, its folded charts cut
 /// apart ([`unfold_charts`]: vertices copied, triangles kept in order) and its triangles of
 /// degenerate texture coordinates charted again ([`rechart::rechart`]).
 pub fn merged_mesh(scene: &Scene, o: usize) -> Mesh {
-    let mut m =
-        Mesh { positions: vec![], normals: vec![], uvs: vec![], indices: vec![], recharted: None };
+    let translucent = is_translucent(scene, o);
+    let mut m = Mesh {
+        positions: vec![],
+        normals: vec![],
+        uvs: vec![],
+        indices: vec![],
+        recharted: None,
+        translucent,
+    };
     for p in &scene.objects[o].primitives {
         let base = m.positions.len() as u32;
         m.positions.extend(p.positions.iter().map(|v| v.to_array()));
@@ -60,6 +71,26 @@ pub fn merged_mesh(scene: &Scene, o: usize) -> Mesh {
         m.indices = u.indices;
     }
     recharted(m)
+}
+
+/// Whether some material of object `o` lets light through part of its surface
+/// ([`Mesh::translucent`]).
+pub fn is_translucent(scene: &Scene, o: usize) -> bool {
+    scene.objects[o]
+        .primitives
+        .iter()
+        .any(|p| scene.materials.get(p.material).is_some_and(pis_trace::material::has_holes))
+}
+
+/// The triangles of mesh `k` that hide object `o` from the camera: none where `k` is
+/// translucent and `o` is not, since the player draws the opaque surfaces first and
+/// composites the translucent ones over them (SPEC.md 9).
+pub fn occluding_indices(meshes: &[Mesh], o: usize, k: usize) -> &[u32] {
+    if k != o && meshes[k].translucent && !meshes[o].translucent {
+        &[]
+    } else {
+        &meshes[k].indices
+    }
 }
 
 /// `m` with its triangles of degenerate texture coordinates charted again (vertices copied,

@@ -25,6 +25,9 @@ pub struct PointView {
     pub(super) a: Vec<(usize, RenderMatrix)>,
     pub diffuse: Vec<f32>,
     pub specular: Vec<f32>,
+    /// A translucent object's opacity per row, in each of 3 channels (empty for an opaque
+    /// object; its radiance is then premultiplied by it).
+    pub alpha: Vec<f32>,
 }
 
 impl PointView {
@@ -58,6 +61,7 @@ impl PointView {
         }
         w.f32s(&self.diffuse);
         w.f32s(&self.specular);
+        w.f32s(&self.alpha);
         w.0
     }
 
@@ -70,9 +74,9 @@ impl PointView {
             let p = r.u64()? as usize;
             a.push((p, r.matrix()?));
         }
-        let (diffuse, specular) = (r.f32s()?, r.f32s()?);
+        let (diffuse, specular, alpha) = (r.f32s()?, r.f32s()?, r.f32s()?);
         r.done()?;
-        Ok(PointView { a, diffuse, specular })
+        Ok(PointView { a, diffuse, specular, alpha })
     }
 }
 
@@ -377,7 +381,13 @@ impl ObjectModel {
             let Some(x) = x else { continue };
             match il.shell {
                 None => {
-                    let r = pis_compile::render(v.a(il.placement_of[k]), x);
+                    // A translucent object's first layer carries its opacity: the image is
+                    // its premultiplied colour.
+                    let rgb: Cow<[f32]> = match il.form.channels() {
+                        4 => x.chunks_exact(4).flat_map(|t| [t[0], t[1], t[2]]).collect(),
+                        _ => Cow::Borrowed(x),
+                    };
+                    let r = pis_compile::render(v.a(il.placement_of[k]), &rgb);
                     img.iter_mut().zip(&r).for_each(|(a, b)| *a += b);
                 }
                 Some(_) => maps.push((*x, il.form.channels())),
@@ -412,7 +422,12 @@ mod tests {
             cols: vec![0, 1, 4],
             vals: vec![1.0, 0.25, 0.75],
         };
-        PointView { a: vec![(0, a)], diffuse: vec![0.1 * p as f32; 6], specular: vec![-0.0; 6] }
+        PointView {
+            a: vec![(0, a)],
+            diffuse: vec![0.1 * p as f32; 6],
+            specular: vec![-0.0; 6],
+            alpha: vec![0.5; 6],
+        }
     }
 
     fn same(a: &PointView, b: &PointView) -> bool {
@@ -421,6 +436,7 @@ mod tests {
             && a.a.iter().zip(&b.a).all(|((pa, ma), (pb, mb))| pa == pb && ma == mb)
             && bits(&a.diffuse) == bits(&b.diffuse)
             && bits(&a.specular) == bits(&b.specular)
+            && bits(&a.alpha) == bits(&b.alpha)
     }
 
     #[test]

@@ -25,7 +25,7 @@ use pis_trace::PointImages;
 
 use super::input::LoadedSet;
 use super::matrices::Matrices;
-use super::mesh::{atlas, place_in, sampler, Atlas, Mesh, Placed};
+use super::mesh::{atlas, occluding_indices, place_in, sampler, Atlas, Mesh, Placed};
 use super::model::{key, InferredLayer, LayerForm, ObjectModel, PointView, Views};
 use super::represent::{Job, Planned, Representation, Surveyed};
 use super::rows::{gather, restrict_rows};
@@ -95,7 +95,7 @@ fn matrix_at(
         .map(|(k, m)| DrawMesh {
             positions: &m.positions,
             uvs: &m.uvs,
-            indices: &m.indices,
+            indices: occluding_indices(meshes, o, k),
             clip_from_object: clip_from(k),
         })
         .collect();
@@ -108,7 +108,34 @@ fn matrix_at(
         sampler: sampler(req.filter, placed.repeat),
     };
     let a = matrices.matrix(Viewport { width: w, height: h }, &draw, o, &obj)?;
-    Ok(restrict_rows(&a, coverage))
+    // A translucent object keeps the pixels the tracer sees through it: its opacity is 0
+    // there.
+    Ok(if meshes[o].translucent { a } else { restrict_rows(&a, coverage) })
+}
+
+/// A translucent object's opacity per row of `a`: the tracer's coverage over the model's
+/// (the fraction of the pixel's area the surface covers), in [0, 1].
+fn opacity(a: &RenderMatrix, coverage: &[f32]) -> Vec<f32> {
+    a.pixels
+        .iter()
+        .zip(&a.coverage)
+        .map(|(&p, &m)| {
+            let c = coverage.get(p as usize).copied().unwrap_or(0.0);
+            if m > 0.0 {
+                (c / m).clamp(0.0, 1.0)
+            } else {
+                0.0
+            }
+        })
+        .collect()
+}
+
+/// Values per row (`channels` each) multiplied by the row's opacity.
+fn premultiplied(values: &mut [f32], alpha: &[f32], channels: usize) {
+    values
+        .chunks_exact_mut(channels)
+        .zip(alpha)
+        .for_each(|(v, a)| v.iter_mut().for_each(|x| *x *= a));
 }
 
 /// Every point with placement 0 (over all views): the rows, the gold standard there.
@@ -125,20 +152,19 @@ fn views_of(
     let mut views = Views::new(set.scratch.clone());
     for p in 0..set.frames.len() {
         let images = set.images.object(p, o)?;
-        let a = matrix_at(
-            set,
-            p,
-            o,
-            meshes,
-            uvs,
-            placed,
-            req,
-            matrices,
-            &coverage_in(set, &images, o),
-        )?;
+        let cov = coverage_in(set, &images, o);
+        let a = matrix_at(set, p, o, meshes, uvs, placed, req, matrices, &cov)?;
         let pick = |kind| gather(&a.pixels, &layer_rgb(&images, channel, kind));
-        let (diffuse, specular) = (pick(TraceLayer::Diffuse), pick(TraceLayer::Specular));
-        views.push(PointView { a: vec![(0, a)], diffuse, specular })?;
+        let (mut diffuse, mut specular) = (pick(TraceLayer::Diffuse), pick(TraceLayer::Specular));
+        let mut alpha = Vec::new();
+        if meshes[o].translucent {
+            // Premultiplied by the opacity, as the player composites them (SPEC.md 9).
+            let opacity = opacity(&a, &cov);
+            premultiplied(&mut diffuse, &opacity, 3);
+            premultiplied(&mut specular, &opacity, 3);
+            alpha = opacity.iter().flat_map(|&x| [x; 3]).collect();
+        }
+        views.push(PointView { a: vec![(0, a)], diffuse, specular, alpha })?;
     }
     Ok(views)
 }
@@ -169,13 +195,15 @@ fn is_black(
 }
 
 /// The traced radiance a layer is solved for.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
 enum Radiance {
     /// The diffuse layer: view-independent, its views stacked (eq. 3.7).
     Diffuse,
     Specular,
     /// Diffuse + specular (`--layers combined`).
     Sum,
+    /// A translucent object's opacity (in every channel), solved with its first layer.
+    Alpha,
 }
 
 impl Radiance {
@@ -187,6 +215,7 @@ impl Radiance {
             Radiance::Sum => {
                 Cow::Owned(v.diffuse.iter().zip(&v.specular).map(|(d, s)| d + s).collect())
             }
+            Radiance::Alpha => Cow::Borrowed(&v.alpha),
         }
     }
 }
@@ -200,6 +229,8 @@ struct LayerPlan {
     block_placements: Vec<usize>,
     /// Per point of the set, its sample's placement.
     point_placement: Vec<usize>,
+    /// The layer carries the object's opacity (a translucent object's first layer).
+    alpha: bool,
 }
 
 /// Places the blocks of a layer with mask `mask` (thesis 3.2 per parameter block): each
@@ -251,7 +282,14 @@ fn plan_layer(
         }
     }
     let point_placement = point_block.iter().map(|&b| block_placements[b]).collect();
-    Ok(LayerPlan { kind, radiance, depends_on: mask, block_placements, point_placement })
+    Ok(LayerPlan {
+        kind,
+        radiance,
+        depends_on: mask,
+        block_placements,
+        point_placement,
+        alpha: false,
+    })
 }
 
 /// One texture per key of `plan`'s mask: each key's sample solved (or, for a view-independent
@@ -272,36 +310,23 @@ fn solve_layer(
     // Spilled as solved when the pack streams: a layer's samples grow with the points.
     let mut textures = Textures::new(set.scratch.as_ref());
     let mut placement_of = BTreeMap::new();
-    let mut warm: BTreeMap<usize, Vec<f32>> = BTreeMap::new();
+    let mut warm: BTreeMap<(Radiance, usize), Vec<f32>> = BTreeMap::new();
     let mut iterations = 0u64;
+    let view_independent = plan.radiance == Radiance::Diffuse;
     for (k, points) in groups {
         let pid = plan.point_placement[points[0]];
-        let start = warm.get(&pid).map(Vec::as_slice);
-        let x = if plan.radiance == Radiance::Diffuse {
-            // One texture for the views of the sample, stacked (eq. 3.7), read one at a time.
-            let source =
-                SampleViews { views, points: &points, placement: pid, radiance: plan.radiance };
-            let s = solver.solve_view_source(&source, start, settings)?;
-            iterations += s.iterations as u64;
-            s.texels
-        } else {
-            // A view-dependent sample: one point per key.
-            let v = views.get(points[0])?;
-            let b = plan.radiance.at(&v);
-            let a = v.a(pid);
-            if a.rows() == 0 {
-                // The object covers no pixel.
-                start.map_or_else(
-                    || vec![0.0; placements[pid].layout.texel_count() * 3],
-                    <[f32]>::to_vec,
-                )
-            } else {
-                let s = solver.solve(a, &b, start, settings)?;
-                iterations += s.iterations as u64;
-                s.texels
-            }
+        let sample = Sample { views, points: &points, placement: &placements[pid], pid };
+        let mut solve = |radiance: Radiance| -> Result<Vec<f32>> {
+            let start = warm.get(&(radiance, pid)).map(Vec::as_slice);
+            let (x, n) = sample.solve(radiance, view_independent, start, settings, solver)?;
+            iterations += n;
+            warm.insert((radiance, pid), x.clone());
+            Ok(x)
         };
-        warm.insert(pid, x.clone());
+        let mut x = solve(plan.radiance)?;
+        if plan.alpha {
+            x = with_alpha(&x, &solve(Radiance::Alpha)?);
+        }
         placement_of.insert(k.clone(), pid);
         textures.insert(k, x)?;
     }
@@ -309,6 +334,7 @@ fn solve_layer(
         placements: placements.to_vec(),
         block_placements: plan.block_placements.clone(),
         placement_of: placement_of.clone(),
+        channels: if plan.alpha { 4 } else { 3 },
     });
     Ok(InferredLayer {
         kind: plan.kind,
@@ -320,6 +346,58 @@ fn solve_layer(
         form,
         shell: None,
     })
+}
+
+/// One parameter sample of a layer: the points whose views it is solved from, with the
+/// render matrices of placement `pid`.
+struct Sample<'a> {
+    views: &'a Views,
+    points: &'a [usize],
+    placement: &'a Placed,
+    pid: usize,
+}
+
+impl Sample<'_> {
+    /// The sample's texture (RGB over the whole chain) fitted to `radiance`, warm-started
+    /// from `start`, and the solver's iterations: one texture for the views of the sample
+    /// stacked (eq. 3.7) where `view_independent`, else the one point of the key's.
+    fn solve(
+        &self,
+        radiance: Radiance,
+        view_independent: bool,
+        start: Option<&[f32]>,
+        settings: &SolveSettings,
+        solver: &Solver,
+    ) -> Result<(Vec<f32>, u64)> {
+        if view_independent {
+            let source = SampleViews {
+                views: self.views,
+                points: self.points,
+                placement: self.pid,
+                radiance,
+            };
+            let s = solver.solve_view_source(&source, start, settings)?;
+            return Ok((s.texels, s.iterations as u64));
+        }
+        let v = self.views.get(self.points[0])?;
+        let a = v.a(self.pid);
+        if a.rows() == 0 {
+            // The object covers no pixel.
+            let zero = || vec![0.0; self.placement.layout.texel_count() * 3];
+            return Ok((start.map_or_else(zero, <[f32]>::to_vec), 0));
+        }
+        let s = solver.solve(a, &radiance.at(&v), start, settings)?;
+        Ok((s.texels, s.iterations as u64))
+    }
+}
+
+/// RGBA texels: the colour of `rgb` and, as alpha, the first channel of `alpha` clamped to
+/// [0, 1] (an opacity).
+fn with_alpha(rgb: &[f32], alpha: &[f32]) -> Vec<f32> {
+    rgb.chunks_exact(3)
+        .zip(alpha.chunks_exact(3))
+        .flat_map(|(c, a)| [c[0], c[1], c[2], a[0].clamp(0.0, 1.0)])
+        .collect()
 }
 
 /// The views of a view-independent sample: its points' render matrices for one placement
@@ -359,6 +437,8 @@ pub struct TextureForm {
     pub block_placements: Vec<usize>,
     /// Per sample key, its block's placement.
     pub placement_of: BTreeMap<Vec<u32>, usize>,
+    /// 3 (RGB), or 4: premultiplied RGB and the opacity of a translucent object.
+    pub channels: usize,
 }
 
 impl TextureForm {
@@ -375,7 +455,7 @@ impl LayerForm for TextureForm {
         depends_on: DepMask,
         gamma: f32,
     ) -> pis_format::Layer {
-        surface_layer(kind, order, depends_on, gamma)
+        surface_layer(kind, order, depends_on, gamma, self.channels as u8)
     }
 
     fn block(&self, b: usize) -> pis_format::Block {
@@ -393,16 +473,20 @@ impl LayerForm for TextureForm {
     }
 
     fn stored(&self, key: &[u32], solved: &[f32]) -> Vec<f32> {
-        finest(self.layout(key), solved)
+        finest(self.layout(key), solved, self.channels)
     }
 
     fn drawn(&self, key: &[u32], stored: Vec<f32>) -> Vec<f32> {
-        mip_chain(self.layout(key), stored)
+        mip_chain(self.layout(key), stored, self.channels)
     }
 
     fn stored_texels(&self, key: &[u32]) -> usize {
         let l = self.layout(key);
         l.width as usize * l.height as usize
+    }
+
+    fn channels(&self) -> usize {
+        self.channels
     }
 }
 
@@ -411,11 +495,12 @@ fn surface_layer(
     order: u8,
     depends_on: DepMask,
     gamma: f32,
+    channels: u8,
 ) -> pis_format::Layer {
     pis_format::Layer {
         kind,
         mapping: pis_format::Mapping::Surface,
-        channels: 3,
+        channels,
         mip_mode: pis_format::MipMode::Decimated,
         term: pis_format::Term::Surface,
         order,
@@ -426,18 +511,19 @@ fn surface_layer(
     }
 }
 
-/// The finest level of a solved texture of layout `layout` (the chain's level 0).
-pub fn finest(layout: pis_compile::TextureLayout, x: &[f32]) -> Vec<f32> {
-    x[..layout.width as usize * layout.height as usize * 3].to_vec()
+/// The finest level of a solved texture of layout `layout`, `c` channels (the chain's
+/// level 0).
+pub fn finest(layout: pis_compile::TextureLayout, x: &[f32], c: usize) -> Vec<f32> {
+    x[..layout.width as usize * layout.height as usize * c].to_vec()
 }
 
 /// The MIP chain of layout `l` from the finest level, by decimation (thesis 3.6).
-pub fn mip_chain(l: pis_compile::TextureLayout, finest: Vec<f32>) -> Vec<f32> {
+pub fn mip_chain(l: pis_compile::TextureLayout, finest: Vec<f32>, c: usize) -> Vec<f32> {
     let mut x = finest.clone();
     let mut cur = finest;
     for lv in 1..l.levels {
         let (w, h) = l.level_size(lv - 1);
-        cur = pis_format::mip::decimate(&cur, w, h, 3);
+        cur = pis_format::mip::decimate(&cur, w, h, c as u32);
         x.extend_from_slice(&cur);
     }
     x
@@ -500,7 +586,11 @@ pub fn survey_surface(
             job.note(&format!("object {name} covers no pixel of the set; left out"));
             return Ok(None);
         }
-        let diffuse_black = is_black(&views, |v| &v.diffuse, |v| &v.specular)?;
+        // A translucent object's first layer carries its opacity: kept wherever the object
+        // hides some of what lies behind it, even in black.
+        let hides = |v: &PointView| v.alpha.iter().any(|&a| a > DISPLAY_STEP);
+        let diffuse_black = is_black(&views, |v| &v.diffuse, |v| &v.specular)?
+            && !(0..views.len()).any(|p| views.get(p).is_ok_and(|v| hides(&v)));
         let specular_black = !with_specular || is_black(&views, |v| &v.specular, |v| &v.diffuse)?;
         if diffuse_black && specular_black && with_specular {
             job.note(&format!("object {name} is black in every layer; nothing stored"));
@@ -567,6 +657,9 @@ impl Surveyed for Covered {
                 &mut placements,
                 req,
             )?);
+        }
+        if let Some(first) = plans.first_mut() {
+            first.alpha = job.meshes[c.o].translucent;
         }
         job.placements += placements.len();
         let mut views = c.views;
@@ -639,6 +732,7 @@ impl Planned for Layers {
             .map(|plan| solve_layer(set, &views, &placements, plan, &job.settings, &job.solver))
             .collect::<Result<Vec<_>>>()?;
         let radiances: Vec<Radiance> = plans.iter().map(|p| p.radiance).collect();
+        let translucent = plans.first().is_some_and(|p| p.alpha);
         let (representation, why) = match radiances.as_slice() {
             [Radiance::Sum] => ("combined", "--layers combined: one view-dependent layer of diffuse + specular radiance per parameter sample"),
             [Radiance::Diffuse] => ("diffuse", "the specular layer changes no displayed pixel: one view-independent diffuse texture per non-view sample"),
@@ -657,8 +751,16 @@ impl Planned for Layers {
             layers,
             shells: None,
             hull_triangles: 0,
-            representation: representation.to_string(),
-            why: why.to_string(),
+            representation: if translucent {
+                format!("{representation}, translucent")
+            } else {
+                representation.to_string()
+            },
+            why: if translucent {
+                format!("{why}; translucent (glTF alpha mode MASK or BLEND): its first layer carries its opacity, and the player composites it over what lies behind it")
+            } else {
+                why.to_string()
+            },
             auto: None,
         })
     }
@@ -680,6 +782,7 @@ mod tests {
             placements: vec![placed(8, 4), placed(5, 3)],
             block_placements: vec![0, 1],
             placement_of: BTreeMap::from([(vec![0], 0), (vec![1], 1)]),
+            channels: 3,
         }
     }
 
@@ -689,7 +792,7 @@ mod tests {
         for (key, (w, h)) in [(vec![0u32], (8usize, 4usize)), (vec![1], (5, 3))] {
             let layout = f.placements[f.placement_of[&key]].layout;
             let finest: Vec<f32> = (0..w * h * 3).map(|i| (i % 7) as f32 * 0.1).collect();
-            let chain = mip_chain(layout, finest.clone());
+            let chain = mip_chain(layout, finest.clone(), 3);
             assert_eq!(chain.len(), layout.texel_count() * 3, "the whole chain is drawn");
             assert_eq!(f.stored_texels(&key), w * h);
             assert_eq!(f.stored(&key, &chain), finest, "level images hold level 0 only");

@@ -73,6 +73,9 @@ pub struct ObjectDraw<'a> {
     pub object: u32,
     pub mesh: &'a MeshGpu,
     pub clip_from_object: glam::Mat4,
+    /// Composited over the opaque surfaces behind it (SPEC.md 9) rather than drawn as the
+    /// nearest surface.
+    pub translucent: bool,
 }
 
 /// One texture drawn on an object: a layer at one parameter sample, with its weight.
@@ -87,4 +90,6 @@ pub struct LayerDraw<'a> {
     pub weight: f32,
     /// Anisotropic filtering: the lookup takes the derivatives, the sampler its clamp.
     pub anisotropic: bool,
+    /// The texture's alpha is its translucent object's opacity (a 4-channel surface layer).
+    pub opacity: bool,
 }

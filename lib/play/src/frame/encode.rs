@@ -11,6 +11,7 @@ use super::pipelines::FramePipelines;
 use super::reflection::{reflection_bind, ReflectionDraw};
 use super::resolve::SHARED_ID_FORMAT;
 use super::targets::{offscreen_format, target_texture, Targets};
+use super::translucent::composite;
 use crate::gpu::Gpu;
 use crate::textured::{allocated_size, cut_uniform};
 
@@ -27,7 +28,8 @@ struct Uniforms {
     weight: f32,
     object: u32,
     anisotropic: u32,
-    _pad: [u32; 2],
+    alpha_mode: u32,
+    _pad: u32,
     cut: [f32; 4],
 }
 
@@ -42,7 +44,8 @@ fn uniforms(clip_from_object: glam::Mat4, object: u32, layer: Option<&LayerDraw>
         weight: 0.0,
         object,
         anisotropic: 0,
-        _pad: [0; 2],
+        alpha_mode: 0,
+        _pad: 0,
         cut: [0.0; 4],
     };
     if let Some(l) = layer {
@@ -61,14 +64,36 @@ fn uniforms(clip_from_object: glam::Mat4, object: u32, layer: Option<&LayerDraw>
     u
 }
 
-/// The object-index pass: clears `ids` and `depth`, then draws every object's index and
-/// depth, nearest surface winning.
+/// Which objects an object-index pass draws.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Drawn {
+    /// The opaque objects, into cleared depth: the surfaces the additive pass draws.
+    Opaque,
+    /// The translucent objects, over the opaque objects' depth: the nearest translucent
+    /// surface in front of them.
+    Translucent,
+    /// Every object, into cleared depth: the nearest surface, for the readback and the
+    /// display-filter resolve of a frame with translucent objects.
+    All,
+}
+
+impl Drawn {
+    fn has(self, o: &ObjectDraw) -> bool {
+        match self {
+            Drawn::Opaque => !o.translucent,
+            Drawn::Translucent => o.translucent,
+            Drawn::All => true,
+        }
+    }
+}
+
+/// The object-index pass: clears `ids` (and `depth`, except for [`Drawn::Translucent`]),
+/// then draws the index and depth of the objects `drawn` names, nearest surface winning.
 fn id_pass(
     pipeline: &wgpu::RenderPipeline,
-    ids: &wgpu::Texture,
-    depth: &wgpu::Texture,
-    objects: &[ObjectDraw],
-    binds: &[wgpu::BindGroup],
+    (ids, depth): (&wgpu::Texture, &wgpu::Texture),
+    (objects, binds): (&[ObjectDraw], &[wgpu::BindGroup]),
+    drawn: Drawn,
     encoder: &mut wgpu::CommandEncoder,
 ) {
     let ids_view = ids.create_view(&Default::default());
@@ -92,7 +117,11 @@ fn id_pass(
         depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
             view: &depth_view,
             depth_ops: Some(wgpu::Operations {
-                load: wgpu::LoadOp::Clear(1.0),
+                load: if drawn == Drawn::Translucent {
+                    wgpu::LoadOp::Load
+                } else {
+                    wgpu::LoadOp::Clear(1.0)
+                },
                 store: wgpu::StoreOp::Store,
             }),
             stencil_ops: None,
@@ -102,7 +131,7 @@ fn id_pass(
         multiview_mask: None,
     });
     pass.set_pipeline(pipeline);
-    for (o, bg) in objects.iter().zip(binds) {
+    for (o, bg) in objects.iter().zip(binds).filter(|(o, _)| drawn.has(o)) {
         pass.set_bind_group(0, bg, &[]);
         pass.set_vertex_buffer(0, o.mesh.positions.slice(..));
         pass.set_vertex_buffer(1, o.mesh.uvs.slice(..));
@@ -158,8 +187,13 @@ pub fn encode(
         reflections: frame.reflections.iter().filter(|r| !r.shells.is_empty()).collect(),
         lenses: frame.lenses.iter().filter(|l| !l.shells.is_empty() && l.count > 0).collect(),
     };
+    let translucent = draws.objects.iter().any(|o| o.translucent);
     pipes.id_pipeline(gpu, samples);
     pipes.layer_pipeline(gpu, sample_format, samples);
+    if translucent {
+        pipes.translucent_pipelines(gpu, sample_format, samples);
+        targets.translucent_targets(gpu, pipes, sample_format);
+    }
     if !draws.reflections.is_empty() {
         pipes.reflection_pipeline(gpu, sample_format, samples);
     }
@@ -169,14 +203,33 @@ pub fn encode(
     let binds = Binds::new(gpu, pipes, &draws);
     let sample_colour = sample_colour(gpu, targets, sample_format, display.is_some());
     let (depth, ids_bind) =
-        id_passes(pipes, targets, object_ids, draws.objects, &binds.ids, encoder);
+        id_passes(pipes, targets, object_ids && !translucent, (draws.objects, &binds.ids), encoder);
     let attachments = Attachments {
-        keep_samples: sample_colour.is_some() && display.is_some(),
+        // Kept for the display-filter resolve, or for the composite to resolve.
+        keep_samples: sample_colour.is_some() && (display.is_some() || translucent),
         sample_colour,
+        keep_depth: translucent,
         depth,
         ids_bind,
     };
-    additive_pass(pipes, (sample_format, samples), &attachments, colour, &draws, &binds, encoder);
+    let key = (sample_format, samples);
+    additive_pass(pipes, key, &attachments, colour, &draws, &binds, encoder);
+    if translucent {
+        let frame = match &attachments.sample_colour {
+            Some(v) if display.is_none() => (v, Some(colour), wgpu::StoreOp::Discard),
+            Some(v) => (v, None, wgpu::StoreOp::Store),
+            None => (colour, None, wgpu::StoreOp::Store),
+        };
+        translucent_passes(pipes, targets, key, &attachments, frame, &draws, &binds, encoder);
+        nearest_ids(
+            pipes,
+            targets,
+            object_ids,
+            display.is_some(),
+            (draws.objects, &binds.ids),
+            encoder,
+        );
+    }
     if let (Some(filter), Some(m)) = (display, &mut targets.multi) {
         let size = targets.size;
         let shared = m.shared_ids.get_or_insert_with(|| {
@@ -248,7 +301,13 @@ impl Binds {
             .iter()
             .map(|l| {
                 let o = &draws.objects[l.draw];
-                let b = ubuf(uniforms(o.clip_from_object, o.object, Some(l)));
+                let mut u = uniforms(o.clip_from_object, o.object, Some(l));
+                u.alpha_mode = match (o.translucent, l.opacity) {
+                    (false, _) => 0,
+                    (true, true) => 1,
+                    (true, false) => 2,
+                };
+                let b = ubuf(u);
                 d.create_bind_group(&wgpu::BindGroupDescriptor {
                     label: Some("layer"),
                     layout: &pipes.draw_layout,
@@ -285,9 +344,11 @@ impl Binds {
 /// depth, and the object indices' bind group.
 struct Attachments<'t> {
     sample_colour: Option<wgpu::TextureView>,
-    /// The samples are kept for the display-filter resolve (else the hardware resolves them
-    /// into the frame's target).
+    /// The samples are kept for the display-filter resolve or the translucent composite
+    /// (else the hardware resolves them into the frame's target).
     keep_samples: bool,
+    /// The depth is kept for the translucent draws.
+    keep_depth: bool,
     depth: &'t wgpu::Texture,
     ids_bind: &'t wgpu::BindGroup,
 }
@@ -321,24 +382,98 @@ fn id_passes<'t>(
     pipes: &FramePipelines,
     targets: &'t Targets,
     object_ids: bool,
-    objects: &[ObjectDraw],
-    id_binds: &[wgpu::BindGroup],
+    drawn: (&[ObjectDraw], &[wgpu::BindGroup]),
     encoder: &mut wgpu::CommandEncoder,
 ) -> (&'t wgpu::Texture, &'t wgpu::BindGroup) {
     let centres = &pipes.id_pipelines[&1];
+    let opaque = Drawn::Opaque;
     match &targets.multi {
         Some(m) => {
             let per_sample = &pipes.id_pipelines[&targets.samples];
-            id_pass(per_sample, &m.ids, &m.depth, objects, id_binds, encoder);
+            id_pass(per_sample, (&m.ids, &m.depth), drawn, opaque, encoder);
             if object_ids {
-                id_pass(centres, &targets.ids, &targets.depth, objects, id_binds, encoder);
+                id_pass(centres, (&targets.ids, &targets.depth), drawn, opaque, encoder);
             }
             (&m.depth, &m.ids_bind)
         }
         None => {
-            id_pass(centres, &targets.ids, &targets.depth, objects, id_binds, encoder);
+            id_pass(centres, (&targets.ids, &targets.depth), drawn, opaque, encoder);
             (&targets.depth, &targets.ids_bind)
         }
+    }
+}
+
+/// The translucent draws of a frame whose opaque surfaces `at` holds: the nearest
+/// translucent surface per sample in front of the opaque ones, its layers' colour and
+/// opacity added into the translucent target, and that target composited over `frame` (the
+/// frame's samples or pixels, the view it resolves into, and whether it is kept).
+#[allow(clippy::too_many_arguments)]
+fn translucent_passes(
+    pipes: &FramePipelines,
+    targets: &Targets,
+    key: (wgpu::TextureFormat, u32),
+    at: &Attachments,
+    frame: (&wgpu::TextureView, Option<&wgpu::TextureView>, wgpu::StoreOp),
+    draws: &Draws,
+    binds: &Binds,
+    encoder: &mut wgpu::CommandEncoder,
+) {
+    let t = targets.translucent.as_ref().expect("translucent targets made");
+    let ids = &t.ids;
+    let per_sample = &pipes.id_pipelines[&targets.samples];
+    id_pass(per_sample, (ids, at.depth), (draws.objects, &binds.ids), Drawn::Translucent, encoder);
+    let (layer, layer_bind) = &t.colour[&key.0];
+    let layer_view = layer.create_view(&Default::default());
+    let depth_view = at.depth.create_view(&Default::default());
+    {
+        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("translucent layers"),
+            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                view: &layer_view,
+                depth_slice: None,
+                resolve_target: None,
+                ops: wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
+                    store: wgpu::StoreOp::Store,
+                },
+            })],
+            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                view: &depth_view,
+                depth_ops: Some(wgpu::Operations {
+                    load: wgpu::LoadOp::Load,
+                    store: wgpu::StoreOp::Discard,
+                }),
+                stencil_ops: None,
+            }),
+            timestamp_writes: None,
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        pass.set_pipeline(&pipes.translucent.layers[&key]);
+        pass.set_bind_group(1, &t.ids_bind, &[]);
+        draw_layers(&mut pass, draws, binds, true);
+    }
+    composite(&pipes.translucent.composites[&key], layer_bind, frame, encoder);
+}
+
+/// After translucent draws: the object indices of every object's nearest surface, per sample
+/// for the display-filter resolve (`display`) and at pixel centres for the readback
+/// (`object_ids`).
+fn nearest_ids(
+    pipes: &FramePipelines,
+    targets: &Targets,
+    object_ids: bool,
+    display: bool,
+    drawn: (&[ObjectDraw], &[wgpu::BindGroup]),
+    encoder: &mut wgpu::CommandEncoder,
+) {
+    if let (Some(m), true) = (&targets.multi, display) {
+        let per_sample = &pipes.id_pipelines[&targets.samples];
+        id_pass(per_sample, (&m.ids, &m.depth), drawn, Drawn::All, encoder);
+    }
+    if object_ids {
+        let centres = &pipes.id_pipelines[&1];
+        id_pass(centres, (&targets.ids, &targets.depth), drawn, Drawn::All, encoder);
     }
 }
 
@@ -374,7 +509,7 @@ fn additive_pass(
             view: &depth_view,
             depth_ops: Some(wgpu::Operations {
                 load: wgpu::LoadOp::Load,
-                store: if at.sample_colour.is_some() {
+                store: if at.sample_colour.is_some() && !at.keep_depth {
                     wgpu::StoreOp::Discard
                 } else {
                     wgpu::StoreOp::Store
@@ -388,7 +523,7 @@ fn additive_pass(
     });
     pass.set_pipeline(&pipes.layer_pipelines[&key]);
     pass.set_bind_group(1, at.ids_bind, &[]);
-    draw_layers(&mut pass, draws, binds);
+    draw_layers(&mut pass, draws, binds, false);
     if !draws.reflections.is_empty() {
         pass.set_pipeline(&pipes.reflection_pipelines[&key]);
         pass.set_bind_group(1, at.ids_bind, &[]);
@@ -405,10 +540,14 @@ fn additive_pass(
     }
 }
 
-/// Every surface layer on its object's mesh.
-fn draw_layers(pass: &mut wgpu::RenderPass, draws: &Draws, binds: &Binds) {
+/// The surface layers of the translucent objects, or of the opaque ones, on their meshes.
+fn draw_layers(pass: &mut wgpu::RenderPass, draws: &Draws, binds: &Binds, translucent: bool) {
     for (l, bg) in draws.layers.iter().zip(&binds.layers) {
-        let m = draws.objects[l.draw].mesh;
+        let o = &draws.objects[l.draw];
+        if o.translucent != translucent {
+            continue;
+        }
+        let m = o.mesh;
         pass.set_bind_group(0, bg, &[]);
         pass.set_vertex_buffer(0, m.positions.slice(..));
         pass.set_vertex_buffer(1, m.uvs.slice(..));

@@ -3,6 +3,11 @@
 // `fs_id` writes depth and the object index (nearest surface wins), then `fs_layer` adds
 // weight × texture wherever the pixel's nearest surface is this object.
 //
+// A translucent object (SPEC.md 9) is left out of the id pass and drawn after the opaque
+// ones: its own id pass, nearest translucent surface in front of the opaque ones winning,
+// then `fs_layer` adds its premultiplied colour and opacity into a target of its own
+// (`alpha_mode`), which `composite.wgsl` lays over the opaque surfaces.
+//
 // Multisampled frames (multisample.rs) run the same passes with depth and object indices
 // per sample: `fs_layer_ms` shades once per pixel, exactly as `fs_layer` does, and covers
 // the samples whose nearest surface is this object; the resolve averages the samples.
@@ -33,7 +38,10 @@ struct Uniforms {
     object: u32,
     // 1 for anisotropic filtering: the adapter picks footprint and LOD (no model twin).
     anisotropic: u32,
-    _pad1: u32,
+    // What the output's alpha is (`layer_alpha`): 0, an opaque object's layer; 1, the
+    // layer that carries a translucent object's opacity; 2, a translucent object's other
+    // layers.
+    alpha_mode: u32,
     _pad2: u32,
     // The block's branch cuts (SPEC.md 7.3): (u_cut, v_cut, 1 if cut along u, 1 if cut
     // along v).
@@ -75,8 +83,18 @@ fn fs_layer(in: VsOut) -> @location(0) vec4<f32> {
     if (textureLoad(ids, vec2<i32>(in.clip.xy), 0).r != u.object) {
         discard;
     }
-    // Colour adds up over layers and samples; alpha (blended with max) marks coverage.
-    return vec4<f32>(c.rgb * u.weight, 1.0);
+    return vec4<f32>(c.rgb * u.weight, layer_alpha(c.a));
+}
+
+// The output's alpha for texel alpha `a`: an opaque object's layers mark coverage (blended
+// with max); a translucent object's opacity adds up over samples (weight × opacity), its
+// other layers add none.
+fn layer_alpha(a: f32) -> f32 {
+    switch u.alpha_mode {
+        case 1u: { return a * u.weight; }
+        case 2u: { return 0.0; }
+        default: { return 1.0; }
+    }
 }
 
 struct LayerSamples {
@@ -105,7 +123,7 @@ fn fs_layer_ms(in: VsOut, @builtin(sample_mask) covered: u32) -> LayerSamples {
         discard;
     }
     var out: LayerSamples;
-    out.colour = vec4<f32>(c.rgb * u.weight, 1.0);
+    out.colour = vec4<f32>(c.rgb * u.weight, layer_alpha(c.a));
     out.mask = mask;
     return out;
 }

@@ -50,7 +50,12 @@ pub fn render_lens_term(
     let positions: Vec<[f32; 3]> = tess.vertices.iter().map(|v| v.position.to_array()).collect();
     let indices: Vec<u32> = tess.triangles.iter().flatten().copied().collect();
     let mesh = MeshGpu::new(gpu, &positions, None, &vec![[0.0; 2]; positions.len()], &indices);
-    let objects = [ObjectDraw { object: 0, mesh: &mesh, clip_from_object: clip_from_world }];
+    let objects = [ObjectDraw {
+        object: 0,
+        mesh: &mesh,
+        clip_from_object: clip_from_world,
+        translucent: false,
+    }];
     let lenses = [LensDraw {
         object: 0,
         clip_from_world,

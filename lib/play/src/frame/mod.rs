@@ -27,6 +27,7 @@ mod readback;
 pub mod reflection;
 pub mod resolve;
 mod targets;
+mod translucent;
 
 pub use draw::{LayerDraw, MeshGpu, ObjectDraw, ID_FORMAT, NO_OBJECT};
 pub use encode::{encode, FrameDraws, FrameTarget};

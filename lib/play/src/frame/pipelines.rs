@@ -9,6 +9,7 @@ use super::draw::ID_FORMAT;
 use super::hybrid::{HYBRID_FRAME, LENS_CORNER_LAYOUT, MAX_LENS_SHELLS};
 use super::reflection::REFLECTION;
 use super::resolve::ResolvePipelines;
+use super::translucent::TranslucentPipelines;
 use crate::gpu::Gpu;
 use crate::shell::SHELL_FUNCTIONS;
 use crate::textured::DEPTH_FORMAT;
@@ -25,7 +26,7 @@ pub const SHADER: &str = concat!(
 /// The frame's pipelines: object index and depth per sample count, and additive layers and
 /// reflection terms per target format and sample count.
 pub struct FramePipelines {
-    module: wgpu::ShaderModule,
+    pub(super) module: wgpu::ShaderModule,
     reflection_module: wgpu::ShaderModule,
     hybrid_module: wgpu::ShaderModule,
     pub(super) uniform_layout: wgpu::BindGroupLayout,
@@ -35,8 +36,8 @@ pub struct FramePipelines {
     pub(super) ids_layout: wgpu::BindGroupLayout,
     pub(super) ids_ms_layout: wgpu::BindGroupLayout,
     id_layout: wgpu::PipelineLayout,
-    layer_layout: wgpu::PipelineLayout,
-    layer_ms_layout: wgpu::PipelineLayout,
+    pub(super) layer_layout: wgpu::PipelineLayout,
+    pub(super) layer_ms_layout: wgpu::PipelineLayout,
     reflection_layout: wgpu::PipelineLayout,
     reflection_ms_layout: wgpu::PipelineLayout,
     hybrid_layout: wgpu::PipelineLayout,
@@ -46,9 +47,10 @@ pub struct FramePipelines {
     pub(super) reflection_pipelines: HashMap<(wgpu::TextureFormat, u32), wgpu::RenderPipeline>,
     pub(super) hybrid_pipelines: HashMap<(wgpu::TextureFormat, u32), wgpu::RenderPipeline>,
     pub(super) resolve: ResolvePipelines,
+    pub(super) translucent: TranslucentPipelines,
 }
 
-const POSITION_LAYOUT: wgpu::VertexBufferLayout<'static> = wgpu::VertexBufferLayout {
+pub(super) const POSITION_LAYOUT: wgpu::VertexBufferLayout<'static> = wgpu::VertexBufferLayout {
     array_stride: 12,
     step_mode: wgpu::VertexStepMode::Vertex,
     attributes: &[wgpu::VertexAttribute {
@@ -57,7 +59,7 @@ const POSITION_LAYOUT: wgpu::VertexBufferLayout<'static> = wgpu::VertexBufferLay
         shader_location: 0,
     }],
 };
-const UV_LAYOUT: wgpu::VertexBufferLayout<'static> = wgpu::VertexBufferLayout {
+pub(super) const UV_LAYOUT: wgpu::VertexBufferLayout<'static> = wgpu::VertexBufferLayout {
     array_stride: 8,
     step_mode: wgpu::VertexStepMode::Vertex,
     attributes: &[wgpu::VertexAttribute {
@@ -121,17 +123,17 @@ fn additive_target(format: wgpu::TextureFormat) -> wgpu::ColorTargetState {
 }
 
 /// An additive pipeline of the frame's layer pass: `module`'s vertex entry point with its
-/// vertex buffers, fragment entry point `fragment`, for a target format and samples per pixel;
-/// triangles unculled, tested against the id pass's depth without writing it, colour added
-/// ([`additive_target`]).
-fn additive_pipeline(
+/// vertex buffers, fragment entry point `fragment`, for a colour target (its format and
+/// blending: [`additive_target`], or a translucent object's) and samples per pixel;
+/// triangles unculled, tested against the id pass's depth without writing it.
+pub(super) fn additive_pipeline(
     gpu: &Gpu,
     label: &str,
     layout: &wgpu::PipelineLayout,
     module: &wgpu::ShaderModule,
     vertex: (&str, &[Option<wgpu::VertexBufferLayout>]),
     fragment: &str,
-    (format, samples): (wgpu::TextureFormat, u32),
+    (target, samples): (wgpu::ColorTargetState, u32),
 ) -> wgpu::RenderPipeline {
     gpu.device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
         label: Some(label),
@@ -153,7 +155,7 @@ fn additive_pipeline(
             module,
             entry_point: Some(fragment),
             compilation_options: Default::default(),
-            targets: &[Some(additive_target(format))],
+            targets: &[Some(target)],
         }),
         multiview_mask: None,
         cache: None,
@@ -303,6 +305,7 @@ impl FramePipelines {
             reflection_pipelines: HashMap::new(),
             hybrid_pipelines: HashMap::new(),
             resolve: ResolvePipelines::new(gpu),
+            translucent: TranslucentPipelines::default(),
         };
         pipes.id_pipeline(gpu, 1);
         pipes
@@ -372,7 +375,7 @@ impl FramePipelines {
                 module,
                 ("vs_main", &[Some(POSITION_LAYOUT), Some(UV_LAYOUT)]),
                 entry_point,
-                (format, samples),
+                (additive_target(format), samples),
             )
         })
     }
@@ -400,7 +403,7 @@ impl FramePipelines {
                 module,
                 ("vs_reflection", &[Some(POSITION_LAYOUT), Some(NORMAL_LAYOUT)]),
                 entry_point,
-                (format, samples),
+                (additive_target(format), samples),
             )
         })
     }
@@ -428,7 +431,7 @@ impl FramePipelines {
                 module,
                 ("vs_hybrid_frame", &[Some(LENS_CORNER_LAYOUT)]),
                 entry_point,
-                (format, samples),
+                (additive_target(format), samples),
             )
         })
     }

@@ -5,6 +5,7 @@ use std::collections::HashMap;
 
 use super::draw::ID_FORMAT;
 use super::pipelines::FramePipelines;
+use super::translucent::TranslucentTargets;
 use crate::error::PlayError;
 use crate::gpu::Gpu;
 use crate::textured::DEPTH_FORMAT;
@@ -43,6 +44,8 @@ pub struct Targets {
     pub colour: wgpu::Texture,
     pub(super) ids_bind: wgpu::BindGroup,
     pub(super) multi: Option<SampleTargets>,
+    /// The translucent draws' targets (made on first use).
+    pub(super) translucent: Option<TranslucentTargets>,
 }
 
 pub(super) fn target_texture(
@@ -122,6 +125,6 @@ impl Targets {
             let ids_bind = bind(&ids, &pipes.ids_ms_layout, 1);
             SampleTargets { ids, depth, ids_bind, colour: HashMap::new(), shared_ids: None }
         });
-        Ok(Targets { size, samples, ids, depth, colour, ids_bind, multi })
+        Ok(Targets { size, samples, ids, depth, colour, ids_bind, multi, translucent: None })
     }
 }

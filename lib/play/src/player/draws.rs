@@ -31,6 +31,7 @@ pub(super) fn object_draws<'a>(
             object: i as u32,
             mesh: &o.mesh,
             clip_from_object: clip,
+            translucent: o.translucent,
         })
         .collect()
 }
@@ -87,6 +88,12 @@ pub(super) fn layer_draws<'a>(
             max_level: pis_compile::filter::max_level(&texture.layout, &sampler) as f32,
             weight: w.weight,
             anisotropic: matches!(filter, Filter::Anisotropic(_)),
+            opacity: reader
+                .container()
+                .objects
+                .get(w.key.object as usize)
+                .and_then(|o| o.layers.get(w.key.layer as usize))
+                .is_some_and(|l| l.channels == 4),
         });
     }
     Ok(layers)

@@ -139,6 +139,12 @@ impl Player {
         self.reader.container().objects.iter().map(|o| o.name.clone()).collect()
     }
 
+    /// Per object of the file: whether it is translucent (a surface layer carries its
+    /// opacity; SPEC.md 7.1), composited over what lies behind it.
+    pub fn translucent_objects(&self) -> Vec<bool> {
+        self.objects.iter().map(|o| o.translucent).collect()
+    }
+
     /// The image size of the file's cameras (the ray-traced set's resolution).
     pub fn image_size(&self) -> (u32, u32) {
         let c = &self.reader.container().cameras;

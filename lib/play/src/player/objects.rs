@@ -22,6 +22,9 @@ pub(super) struct ObjectGpu {
     pub(super) reflection: Vec<usize>,
     /// A lens object drawn by hybrid rendering.
     pub(super) lens: Option<LensState>,
+    /// A surface layer carries the object's opacity (4 channels, SPEC.md 7.1): the object
+    /// is composited over the opaque surfaces behind it (SPEC.md 9).
+    pub(super) translucent: bool,
 }
 
 /// A lens object: its shell layers (the refraction term's, in increasing order, at most
@@ -143,7 +146,8 @@ pub(super) fn prepare_objects(gpu: &Gpu, reader: &PisReader) -> Result<Vec<Objec
         let mesh =
             MeshGpu::new(gpu, &o.mesh.positions, o.mesh.normals.as_deref(), &uvs, &o.mesh.indices)
                 .with_hull(o.mesh.hull_triangles);
-        out.push(ObjectGpu { mesh, layers, reflection, lens });
+        let translucent = layers.iter().any(|&li| o.layers[li].channels == 4);
+        out.push(ObjectGpu { mesh, layers, reflection, lens, translucent });
     }
     if !skipped.is_empty() {
         eprintln!(

@@ -184,6 +184,21 @@ pub fn draw_scene(
     scene: &[(pis_play::frame::MeshGpu, Mat4, pis_play::ObjectTexture)],
     sampler: &wgpu::Sampler,
 ) -> (FloatImage, Vec<u32>) {
+    draw_scene_with(gpu, pipes, (size, samples), display, scene, sampler, &[])
+}
+
+/// [`draw_scene`] with the objects `translucent` marks (missing entries: opaque) drawn as
+/// translucent objects, their texture's alpha their opacity.
+pub fn draw_scene_with(
+    gpu: &Gpu,
+    pipes: &mut pis_play::frame::FramePipelines,
+    (size, samples): ((u32, u32), u32),
+    display: Option<pis_format::DisplayFilter>,
+    scene: &[(pis_play::frame::MeshGpu, Mat4, pis_play::ObjectTexture)],
+    sampler: &wgpu::Sampler,
+    translucent: &[bool],
+) -> (FloatImage, Vec<u32>) {
+    let is = |i: usize| translucent.get(i).copied().unwrap_or(false);
     use pis_play::frame::{
         colour_image, encode, offscreen_format, FrameDraws, FrameTarget, LayerDraw, ObjectDraw,
         Readback, Targets,
@@ -193,7 +208,12 @@ pub fn draw_scene(
     let objects: Vec<ObjectDraw> = scene
         .iter()
         .enumerate()
-        .map(|(i, (mesh, clip, _))| ObjectDraw { object: i as u32, mesh, clip_from_object: *clip })
+        .map(|(i, (mesh, clip, _))| ObjectDraw {
+            object: i as u32,
+            mesh,
+            clip_from_object: *clip,
+            translucent: is(i),
+        })
         .collect();
     let layers: Vec<LayerDraw> = scene
         .iter()
@@ -206,6 +226,7 @@ pub fn draw_scene(
             max_level: 0.0,
             weight: 1.0,
             anisotropic: false,
+            opacity: is(i),
         })
         .collect();
     let mut encoder = gpu.device.create_command_encoder(&Default::default());

@@ -12,7 +12,7 @@ use pis_trace::layers::LayerKind as TraceLayer;
 use rayon::prelude::*;
 
 use super::super::input::LoadedSet;
-use super::super::mesh::Mesh;
+use super::super::mesh::{occluding_indices, Mesh};
 use super::super::rows::restrict_rows;
 use super::super::surface::coverage;
 
@@ -107,7 +107,7 @@ fn occluders(
         .map(|(k, m)| DrawMesh {
             positions: &m.positions,
             uvs: &m.uvs,
-            indices: &m.indices,
+            indices: occluding_indices(meshes, o, k),
             clip_from_object: view_proj * frame.instances[k].world_from_object,
         })
         .collect();
