@@ -55,6 +55,8 @@ pub struct ImageSummary {
 pub struct ObjectSummary {
     pub name: String,
     pub role: &'static str,
+    /// A surface layer carries the object's opacity (SPEC.md 7.1).
+    pub translucent: bool,
     /// Shading constants (SPEC.md 6.4): reflectance at normal incidence (Schlick's F0),
     /// linear RGB.
     pub f0: [f32; 3],
@@ -181,6 +183,10 @@ pub fn summarize(r: &PisReader) -> Summary {
             ObjectSummary {
                 name: o.name.clone(),
                 role: o.role.name(),
+                translucent: o
+                    .layers
+                    .iter()
+                    .any(|l| l.mapping == pis_format::Mapping::Surface && l.channels == 4),
                 f0: o.shading.f0,
                 ior: o.shading.ior,
                 absorption: o.shading.absorption,
@@ -322,9 +328,10 @@ pub fn render(s: &Summary) -> String {
     for ob in &s.objects {
         let _ = writeln!(
             o,
-            "  {} ({}): {} vertices{}, {} triangles{}, {} transform(s), block origins {:?}, {}",
+            "  {} ({}{}): {} vertices{}, {} triangles{}, {} transform(s), block origins {:?}, {}",
             ob.name,
             ob.role,
+            if ob.translucent { ", translucent" } else { "" },
             ob.vertices,
             if ob.normals { " with normals" } else { "" },
             ob.triangles,
