@@ -68,6 +68,25 @@ pub(super) fn target_texture(
     })
 }
 
+/// A bind group of `texture`'s whole view alone, at `binding` of `layout`.
+pub(super) fn texture_bind(
+    gpu: &Gpu,
+    label: &str,
+    texture: &wgpu::Texture,
+    layout: &wgpu::BindGroupLayout,
+    binding: u32,
+) -> wgpu::BindGroup {
+    let view = texture.create_view(&Default::default());
+    gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some(label),
+        layout,
+        entries: &[wgpu::BindGroupEntry {
+            binding,
+            resource: wgpu::BindingResource::TextureView(&view),
+        }],
+    })
+}
+
 impl Targets {
     /// Targets of `size` for frames of `samples` per pixel (1, or a count
     /// [`crate::multisample::choose`] found supported).
@@ -100,15 +119,7 @@ impl Targets {
             attach | wgpu::TextureUsages::COPY_SRC,
         );
         let bind = |texture: &wgpu::Texture, layout, binding| {
-            let view = texture.create_view(&Default::default());
-            gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some("object ids"),
-                layout,
-                entries: &[wgpu::BindGroupEntry {
-                    binding,
-                    resource: wgpu::BindingResource::TextureView(&view),
-                }],
-            })
+            texture_bind(gpu, "object ids", texture, layout, binding)
         };
         let ids_bind = bind(&ids, &pipes.ids_layout, 0);
         let multi = (samples > 1).then(|| {

@@ -10,7 +10,7 @@ use std::collections::HashMap;
 
 use super::draw::ID_FORMAT;
 use super::pipelines::{additive_pipeline, FramePipelines, POSITION_LAYOUT, UV_LAYOUT};
-use super::targets::{target_texture, Targets};
+use super::targets::{target_texture, texture_bind, Targets};
 use crate::gpu::Gpu;
 
 /// The WGSL source of the composite.
@@ -172,15 +172,7 @@ impl Targets {
         let (size, samples) = (self.size, self.samples);
         let attach = wgpu::TextureUsages::RENDER_ATTACHMENT;
         let bind = |texture: &wgpu::Texture, layout, binding| {
-            let view = texture.create_view(&Default::default());
-            gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some("frame translucent"),
-                layout,
-                entries: &[wgpu::BindGroupEntry {
-                    binding,
-                    resource: wgpu::BindingResource::TextureView(&view),
-                }],
-            })
+            texture_bind(gpu, "frame translucent", texture, layout, binding)
         };
         let multisampled = samples > 1;
         let t = self.translucent.get_or_insert_with(|| {
