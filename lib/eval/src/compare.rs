@@ -111,7 +111,6 @@ pub fn compare_with_set(
             res.1
         );
     }
-    let dims = player.dimensions().len();
     let names = player.object_names();
     let translucent = player.translucent_objects();
     let channels = channels(&set, &names, set_dir)?;
@@ -125,34 +124,7 @@ pub fn compare_with_set(
         .collect();
     let mut points = Vec::with_capacity(set.meta.points.len());
     for (i, p) in set.meta.points.iter().enumerate() {
-        if p.values.len() != dims || p.samples.len() != dims {
-            bail!(
-                "point {i} of {} has {} values, the file's parameter space {dims} dimensions",
-                set_dir.display(),
-                p.values.len()
-            );
-        }
-        let images = set
-            .read_point(i)
-            .with_context(|| format!("reading point {i} of {}", set_dir.display()))?;
-        if (images.width, images.height) != res {
-            bail!(
-                "point {i} of {} is {}x{}, the set declares {}x{}",
-                set_dir.display(),
-                images.width,
-                images.height,
-                res.0,
-                res.1
-            );
-        }
-        let (pose, yfov) = player.sample_pose(&p.values);
-        if let Some(d) = p.camera.differs_from(pose, yfov) {
-            return Err(pis_trace::TraceError::InvalidSet {
-                path: set_dir.to_path_buf(),
-                message: format!("point {i}: the file's camera is not the one the set was traced with ({d}): the file was packed from another scene or preset"),
-            }
-            .into());
-        }
+        let images = checked_point(&set, set_dir, i, player)?;
         let req = FrameRequest { point: p.values.clone(), camera: CameraChoice::Sample };
         let (rendered, ids, _) = player
             .render_ids(&req, size)
@@ -242,6 +214,42 @@ pub fn compare_with_set(
         objects,
         points,
     })
+}
+
+/// Point `i` of the set at `set_dir`, read, once its parameter values, size and camera are
+/// checked against the file `player` plays.
+fn checked_point(set: &RaySet, set_dir: &Path, i: usize, player: &Player) -> Result<PointImages> {
+    let p = &set.meta.points[i];
+    let dims = player.dimensions().len();
+    let res = (set.meta.resolution[0], set.meta.resolution[1]);
+    if p.values.len() != dims || p.samples.len() != dims {
+        bail!(
+            "point {i} of {} has {} values, the file's parameter space {dims} dimensions",
+            set_dir.display(),
+            p.values.len()
+        );
+    }
+    let images =
+        set.read_point(i).with_context(|| format!("reading point {i} of {}", set_dir.display()))?;
+    if (images.width, images.height) != res {
+        bail!(
+            "point {i} of {} is {}x{}, the set declares {}x{}",
+            set_dir.display(),
+            images.width,
+            images.height,
+            res.0,
+            res.1
+        );
+    }
+    let (pose, yfov) = player.sample_pose(&p.values);
+    if let Some(d) = p.camera.differs_from(pose, yfov) {
+        return Err(pis_trace::TraceError::InvalidSet {
+            path: set_dir.to_path_buf(),
+            message: format!("point {i}: the file's camera is not the one the set was traced with ({d}): the file was packed from another scene or preset"),
+        }
+        .into());
+    }
+    Ok(images)
 }
 
 /// Per object of the file: the set's channel name.

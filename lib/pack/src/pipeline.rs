@@ -35,6 +35,7 @@ pub mod matrices;
 pub mod memory;
 pub mod mesh;
 pub mod model;
+pub mod opacity;
 pub mod packed;
 pub mod pem;
 pub mod plan;

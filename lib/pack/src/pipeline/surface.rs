@@ -27,6 +27,7 @@ use super::input::LoadedSet;
 use super::matrices::Matrices;
 use super::mesh::{atlas, occluding_indices, place_in, sampler, Atlas, Mesh, Placed};
 use super::model::{key, InferredLayer, LayerForm, ObjectModel, PointView, Views};
+use super::opacity::{premultiply, with_alpha};
 use super::represent::{Job, Planned, Representation, Surveyed};
 use super::rows::{gather, restrict_rows};
 use super::textures::Textures;
@@ -113,31 +114,6 @@ fn matrix_at(
     Ok(if meshes[o].translucent { a } else { restrict_rows(&a, coverage) })
 }
 
-/// A translucent object's opacity per row of `a`: the tracer's coverage over the model's
-/// (the fraction of the pixel's area the surface covers), in [0, 1].
-fn opacity(a: &RenderMatrix, coverage: &[f32]) -> Vec<f32> {
-    a.pixels
-        .iter()
-        .zip(&a.coverage)
-        .map(|(&p, &m)| {
-            let c = coverage.get(p as usize).copied().unwrap_or(0.0);
-            if m > 0.0 {
-                (c / m).clamp(0.0, 1.0)
-            } else {
-                0.0
-            }
-        })
-        .collect()
-}
-
-/// Values per row (`channels` each) multiplied by the row's opacity.
-fn premultiplied(values: &mut [f32], alpha: &[f32], channels: usize) {
-    values
-        .chunks_exact_mut(channels)
-        .zip(alpha)
-        .for_each(|(v, a)| v.iter_mut().for_each(|x| *x *= a));
-}
-
 /// Every point with placement 0 (over all views): the rows, the gold standard there.
 fn views_of(
     set: &LoadedSet,
@@ -156,14 +132,11 @@ fn views_of(
         let a = matrix_at(set, p, o, meshes, uvs, placed, req, matrices, &cov)?;
         let pick = |kind| gather(&a.pixels, &layer_rgb(&images, channel, kind));
         let (mut diffuse, mut specular) = (pick(TraceLayer::Diffuse), pick(TraceLayer::Specular));
-        let mut alpha = Vec::new();
-        if meshes[o].translucent {
-            // Premultiplied by the opacity, as the player composites them (SPEC.md 9).
-            let opacity = opacity(&a, &cov);
-            premultiplied(&mut diffuse, &opacity, 3);
-            premultiplied(&mut specular, &opacity, 3);
-            alpha = opacity.iter().flat_map(|&x| [x; 3]).collect();
-        }
+        let alpha = if meshes[o].translucent {
+            premultiply(&a, &cov, [&mut diffuse, &mut specular])
+        } else {
+            Vec::new()
+        };
         views.push(PointView { a: vec![(0, a)], diffuse, specular, alpha })?;
     }
     Ok(views)
@@ -389,15 +362,6 @@ impl Sample<'_> {
         let s = solver.solve(a, &radiance.at(&v), start, settings)?;
         Ok((s.texels, s.iterations as u64))
     }
-}
-
-/// RGBA texels: the colour of `rgb` and, as alpha, the first channel of `alpha` clamped to
-/// [0, 1] (an opacity).
-fn with_alpha(rgb: &[f32], alpha: &[f32]) -> Vec<f32> {
-    rgb.chunks_exact(3)
-        .zip(alpha.chunks_exact(3))
-        .flat_map(|(c, a)| [c[0], c[1], c[2], a[0].clamp(0.0, 1.0)])
-        .collect()
 }
 
 /// The views of a view-independent sample: its points' render matrices for one placement

@@ -14,10 +14,13 @@
 //! (`resolve.rs`).
 //!
 //! One file per stage, each importing only those below it: `draw.rs` (what a frame draws),
-//! `reflection.rs` and `hybrid.rs` (the reflection and lens terms' uniforms and bind
-//! groups), `resolve.rs`, `pipelines.rs`, `targets.rs`, `encode.rs` (recording the passes),
-//! `readback.rs`, and `lens_term.rs` (one lens term drawn through the frame on its own).
+//! `additive.rs` (the additive pass's pipeline pieces), `translucent.rs` (the translucent
+//! objects' pipelines and composite), `reflection.rs` and `hybrid.rs` (the reflection and
+//! lens terms' uniforms and bind groups), `resolve.rs`, `pipelines.rs`, `targets.rs`,
+//! `encode.rs` (recording the passes), `readback.rs`, and `lens_term.rs` (one lens term drawn
+//! through the frame on its own).
 
+mod additive;
 mod draw;
 mod encode;
 pub mod hybrid;

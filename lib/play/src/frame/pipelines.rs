@@ -5,6 +5,7 @@
 
 use std::collections::HashMap;
 
+use super::additive::{additive_pipeline, multisample, POSITION_LAYOUT, UV_LAYOUT};
 use super::draw::ID_FORMAT;
 use super::hybrid::{HYBRID_FRAME, LENS_CORNER_LAYOUT, MAX_LENS_SHELLS};
 use super::reflection::REFLECTION;
@@ -50,24 +51,6 @@ pub struct FramePipelines {
     pub(super) translucent: TranslucentPipelines,
 }
 
-pub(super) const POSITION_LAYOUT: wgpu::VertexBufferLayout<'static> = wgpu::VertexBufferLayout {
-    array_stride: 12,
-    step_mode: wgpu::VertexStepMode::Vertex,
-    attributes: &[wgpu::VertexAttribute {
-        format: wgpu::VertexFormat::Float32x3,
-        offset: 0,
-        shader_location: 0,
-    }],
-};
-pub(super) const UV_LAYOUT: wgpu::VertexBufferLayout<'static> = wgpu::VertexBufferLayout {
-    array_stride: 8,
-    step_mode: wgpu::VertexStepMode::Vertex,
-    attributes: &[wgpu::VertexAttribute {
-        format: wgpu::VertexFormat::Float32x2,
-        offset: 0,
-        shader_location: 1,
-    }],
-};
 const NORMAL_LAYOUT: wgpu::VertexBufferLayout<'static> = wgpu::VertexBufferLayout {
     array_stride: 12,
     step_mode: wgpu::VertexStepMode::Vertex,
@@ -98,11 +81,6 @@ const UNIFORM: wgpu::BindingType = wgpu::BindingType::Buffer {
     min_binding_size: None,
 };
 
-/// `count` samples per pixel, every sample written.
-fn multisample(count: u32) -> wgpu::MultisampleState {
-    wgpu::MultisampleState { count, mask: !0, alpha_to_coverage_enabled: false }
-}
-
 /// The additive pass's colour target: colour adds, alpha (coverage) takes the maximum.
 fn additive_target(format: wgpu::TextureFormat) -> wgpu::ColorTargetState {
     let add = wgpu::BlendComponent {
@@ -119,58 +97,6 @@ fn additive_target(format: wgpu::TextureFormat) -> wgpu::ColorTargetState {
         format,
         blend: Some(wgpu::BlendState { color: add, alpha: max }),
         write_mask: wgpu::ColorWrites::ALL,
-    }
-}
-
-/// An additive pipeline of the frame's layer pass: `module`'s vertex entry point with its
-/// vertex buffers, fragment entry point `fragment`, for a colour target (its format and
-/// blending: [`additive_target`], or a translucent object's) and samples per pixel;
-/// triangles unculled, tested against the id pass's depth without writing it.
-pub(super) fn additive_pipeline(
-    gpu: &Gpu,
-    label: &str,
-    layout: &wgpu::PipelineLayout,
-    module: &wgpu::ShaderModule,
-    vertex: (&str, &[Option<wgpu::VertexBufferLayout>]),
-    fragment: &str,
-    (target, samples): (wgpu::ColorTargetState, u32),
-) -> wgpu::RenderPipeline {
-    gpu.device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-        label: Some(label),
-        layout: Some(layout),
-        vertex: wgpu::VertexState {
-            module,
-            entry_point: Some(vertex.0),
-            compilation_options: Default::default(),
-            buffers: vertex.1,
-        },
-        primitive: wgpu::PrimitiveState {
-            topology: wgpu::PrimitiveTopology::TriangleList,
-            cull_mode: None,
-            ..Default::default()
-        },
-        depth_stencil: Some(additive_depth()),
-        multisample: multisample(samples),
-        fragment: Some(wgpu::FragmentState {
-            module,
-            entry_point: Some(fragment),
-            compilation_options: Default::default(),
-            targets: &[Some(target)],
-        }),
-        multiview_mask: None,
-        cache: None,
-    })
-}
-
-/// The additive pass's depth state: tested against the id pass's depth (equal passes), not
-/// written.
-fn additive_depth() -> wgpu::DepthStencilState {
-    wgpu::DepthStencilState {
-        format: DEPTH_FORMAT,
-        depth_write_enabled: Some(false),
-        depth_compare: Some(wgpu::CompareFunction::LessEqual),
-        stencil: Default::default(),
-        bias: Default::default(),
     }
 }
 
@@ -434,5 +360,12 @@ impl FramePipelines {
                 (additive_target(format), samples),
             )
         })
+    }
+
+    /// Compiles the translucent layers' pipeline and the composite for a target format and
+    /// `samples` per pixel, where not compiled yet.
+    pub fn translucent_pipelines(&mut self, gpu: &Gpu, format: wgpu::TextureFormat, samples: u32) {
+        let layout = if samples > 1 { &self.layer_ms_layout } else { &self.layer_layout };
+        self.translucent.compile(gpu, (&self.module, layout), format, samples);
     }
 }

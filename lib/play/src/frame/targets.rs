@@ -5,7 +5,6 @@ use std::collections::HashMap;
 
 use super::draw::ID_FORMAT;
 use super::pipelines::FramePipelines;
-use super::translucent::TranslucentTargets;
 use crate::error::PlayError;
 use crate::gpu::Gpu;
 use crate::textured::DEPTH_FORMAT;
@@ -137,5 +136,58 @@ impl Targets {
             SampleTargets { ids, depth, ids_bind, colour: HashMap::new(), shared_ids: None }
         });
         Ok(Targets { size, samples, ids, depth, colour, ids_bind, multi, translucent: None })
+    }
+}
+
+/// What the translucent draws draw into, per size and samples per pixel: the nearest
+/// translucent surface's object index per sample (and the bind group the layers test it
+/// with), and per format the translucent colour and opacity with the composite's bind group.
+pub(super) struct TranslucentTargets {
+    pub(super) ids: wgpu::Texture,
+    pub(super) ids_bind: wgpu::BindGroup,
+    pub(super) colour: HashMap<wgpu::TextureFormat, (wgpu::Texture, wgpu::BindGroup)>,
+}
+
+impl Targets {
+    /// Makes the translucent draws' targets in `format` where missing (after
+    /// [`FramePipelines::translucent_pipelines`]).
+    pub(super) fn translucent_targets(
+        &mut self,
+        gpu: &Gpu,
+        pipes: &FramePipelines,
+        format: wgpu::TextureFormat,
+    ) {
+        let (size, samples) = (self.size, self.samples);
+        let attach = wgpu::TextureUsages::RENDER_ATTACHMENT;
+        let bind = |texture: &wgpu::Texture, layout, binding| {
+            texture_bind(gpu, "frame translucent", texture, layout, binding)
+        };
+        let multisampled = samples > 1;
+        let t = self.translucent.get_or_insert_with(|| {
+            let ids = target_texture(
+                gpu,
+                "translucent object ids",
+                size,
+                samples,
+                ID_FORMAT,
+                attach | wgpu::TextureUsages::TEXTURE_BINDING,
+            );
+            let layout = if multisampled { &pipes.ids_ms_layout } else { &pipes.ids_layout };
+            let ids_bind = bind(&ids, layout, multisampled as u32);
+            TranslucentTargets { ids, ids_bind, colour: HashMap::new() }
+        });
+        t.colour.entry(format).or_insert_with(|| {
+            let texture = target_texture(
+                gpu,
+                "translucent colour and opacity",
+                size,
+                samples,
+                format,
+                attach | wgpu::TextureUsages::TEXTURE_BINDING,
+            );
+            let b =
+                bind(&texture, pipes.translucent.composite_layout(samples), multisampled as u32);
+            (texture, b)
+        });
     }
 }

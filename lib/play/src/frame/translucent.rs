@@ -8,9 +8,7 @@
 
 use std::collections::HashMap;
 
-use super::draw::ID_FORMAT;
-use super::pipelines::{additive_pipeline, FramePipelines, POSITION_LAYOUT, UV_LAYOUT};
-use super::targets::{target_texture, texture_bind, Targets};
+use super::additive::{additive_pipeline, POSITION_LAYOUT, UV_LAYOUT};
 use crate::gpu::Gpu;
 
 /// The WGSL source of the composite.
@@ -72,18 +70,20 @@ fn layer_layout(gpu: &Gpu, multisampled: bool) -> wgpu::BindGroupLayout {
     })
 }
 
-impl FramePipelines {
-    /// Compiles the translucent layers' pipeline and the composite for a target format and
-    /// `samples` per pixel, where not compiled yet.
-    pub fn translucent_pipelines(&mut self, gpu: &Gpu, format: wgpu::TextureFormat, samples: u32) {
+impl TranslucentPipelines {
+    /// Compiles the translucent layers' pipeline (`module`'s layer entry point, through the
+    /// frame's layer pipeline `layout` for `samples` per pixel) and the composite for a
+    /// target format and `samples` per pixel, where not compiled yet.
+    pub(super) fn compile(
+        &mut self,
+        gpu: &Gpu,
+        (module, layout): (&wgpu::ShaderModule, &wgpu::PipelineLayout),
+        format: wgpu::TextureFormat,
+        samples: u32,
+    ) {
         let key = (format, samples);
-        let (layout, entry_point) = if samples > 1 {
-            (&self.layer_ms_layout, "fs_layer_ms")
-        } else {
-            (&self.layer_layout, "fs_layer")
-        };
-        let module = &self.module;
-        self.translucent.layers.entry(key).or_insert_with(|| {
+        let entry_point = if samples > 1 { "fs_layer_ms" } else { "fs_layer" };
+        self.layers.entry(key).or_insert_with(|| {
             additive_pipeline(
                 gpu,
                 "frame translucent layers",
@@ -94,8 +94,7 @@ impl FramePipelines {
                 (accumulate_target(format), samples),
             )
         });
-        let t = &mut self.translucent;
-        let (module, single, multi) = t.composite.get_or_insert_with(|| {
+        let (module, single, multi) = self.composite.get_or_insert_with(|| {
             let module = gpu.device.create_shader_module(wgpu::ShaderModuleDescriptor {
                 label: Some("frame/composite.wgsl"),
                 source: wgpu::ShaderSource::Wgsl(COMPOSITE.into()),
@@ -104,7 +103,7 @@ impl FramePipelines {
         });
         let (bind_layout, entry_point) =
             if samples > 1 { (&*multi, "fs_composite_ms") } else { (&*single, "fs_composite") };
-        t.composites.entry(key).or_insert_with(|| {
+        self.composites.entry(key).or_insert_with(|| {
             let layout = gpu.device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
                 label: Some("frame composite"),
                 bind_group_layouts: &[Some(bind_layout)],
@@ -139,67 +138,14 @@ impl FramePipelines {
     }
 
     /// The composite's bind group layout for `samples` per pixel (after
-    /// [`FramePipelines::translucent_pipelines`]).
-    fn composite_layout(&self, samples: u32) -> &wgpu::BindGroupLayout {
-        let (_, single, multi) =
-            self.translucent.composite.as_ref().expect("translucent pipelines compiled");
+    /// [`TranslucentPipelines::compile`]).
+    pub(super) fn composite_layout(&self, samples: u32) -> &wgpu::BindGroupLayout {
+        let (_, single, multi) = self.composite.as_ref().expect("translucent pipelines compiled");
         if samples > 1 {
             multi
         } else {
             single
         }
-    }
-}
-
-/// What the translucent draws draw into, per size and samples per pixel: the nearest
-/// translucent surface's object index per sample (and the bind group the layers test it
-/// with), and per format the translucent colour and opacity with the composite's bind group.
-pub(super) struct TranslucentTargets {
-    pub(super) ids: wgpu::Texture,
-    pub(super) ids_bind: wgpu::BindGroup,
-    pub(super) colour: HashMap<wgpu::TextureFormat, (wgpu::Texture, wgpu::BindGroup)>,
-}
-
-impl Targets {
-    /// Makes the translucent draws' targets in `format` where missing (after
-    /// [`FramePipelines::translucent_pipelines`]).
-    pub(super) fn translucent_targets(
-        &mut self,
-        gpu: &Gpu,
-        pipes: &FramePipelines,
-        format: wgpu::TextureFormat,
-    ) {
-        let (size, samples) = (self.size, self.samples);
-        let attach = wgpu::TextureUsages::RENDER_ATTACHMENT;
-        let bind = |texture: &wgpu::Texture, layout, binding| {
-            texture_bind(gpu, "frame translucent", texture, layout, binding)
-        };
-        let multisampled = samples > 1;
-        let t = self.translucent.get_or_insert_with(|| {
-            let ids = target_texture(
-                gpu,
-                "translucent object ids",
-                size,
-                samples,
-                ID_FORMAT,
-                attach | wgpu::TextureUsages::TEXTURE_BINDING,
-            );
-            let layout = if multisampled { &pipes.ids_ms_layout } else { &pipes.ids_layout };
-            let ids_bind = bind(&ids, layout, multisampled as u32);
-            TranslucentTargets { ids, ids_bind, colour: HashMap::new() }
-        });
-        t.colour.entry(format).or_insert_with(|| {
-            let texture = target_texture(
-                gpu,
-                "translucent colour and opacity",
-                size,
-                samples,
-                format,
-                attach | wgpu::TextureUsages::TEXTURE_BINDING,
-            );
-            let b = bind(&texture, pipes.composite_layout(samples), multisampled as u32);
-            (texture, b)
-        });
     }
 }
 
