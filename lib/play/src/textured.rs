@@ -185,7 +185,8 @@ fn uniform_entry() -> wgpu::BindGroupLayoutEntry {
     }
 }
 
-const POSITION_LAYOUT: wgpu::VertexBufferLayout<'static> = wgpu::VertexBufferLayout {
+/// A mesh's positions as the vertex shaders read them (location 0).
+pub(crate) const POSITION_LAYOUT: wgpu::VertexBufferLayout<'static> = wgpu::VertexBufferLayout {
     array_stride: 12,
     step_mode: wgpu::VertexStepMode::Vertex,
     attributes: &[wgpu::VertexAttribute {
@@ -194,7 +195,8 @@ const POSITION_LAYOUT: wgpu::VertexBufferLayout<'static> = wgpu::VertexBufferLay
         shader_location: 0,
     }],
 };
-const UV_LAYOUT: wgpu::VertexBufferLayout<'static> = wgpu::VertexBufferLayout {
+/// A mesh's texture coordinates as the vertex shaders read them (location 1).
+pub(crate) const UV_LAYOUT: wgpu::VertexBufferLayout<'static> = wgpu::VertexBufferLayout {
     array_stride: 8,
     step_mode: wgpu::VertexStepMode::Vertex,
     attributes: &[wgpu::VertexAttribute {

@@ -4,25 +4,8 @@
 
 use crate::gpu::Gpu;
 use crate::textured::DEPTH_FORMAT;
+pub(super) use crate::textured::{POSITION_LAYOUT, UV_LAYOUT};
 
-pub(super) const POSITION_LAYOUT: wgpu::VertexBufferLayout<'static> = wgpu::VertexBufferLayout {
-    array_stride: 12,
-    step_mode: wgpu::VertexStepMode::Vertex,
-    attributes: &[wgpu::VertexAttribute {
-        format: wgpu::VertexFormat::Float32x3,
-        offset: 0,
-        shader_location: 0,
-    }],
-};
-pub(super) const UV_LAYOUT: wgpu::VertexBufferLayout<'static> = wgpu::VertexBufferLayout {
-    array_stride: 8,
-    step_mode: wgpu::VertexStepMode::Vertex,
-    attributes: &[wgpu::VertexAttribute {
-        format: wgpu::VertexFormat::Float32x2,
-        offset: 0,
-        shader_location: 1,
-    }],
-};
 /// `count` samples per pixel, every sample written.
 pub(super) fn multisample(count: u32) -> wgpu::MultisampleState {
     wgpu::MultisampleState { count, mask: !0, alpha_to_coverage_enabled: false }
