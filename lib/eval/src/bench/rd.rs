@@ -114,7 +114,7 @@ fn pack_request(req: &RdRequest) -> PackRequest {
         preset: req.preset.clone(),
         max_mse: req.max_mse,
         stagger: req.stagger,
-        ..super::pack_defaults()
+        ..PackSettings::new()
     };
     PackRequest {
         scene: req.scene.clone(),

@@ -384,7 +384,7 @@ pub fn run(req: &StabilityRequest) -> Result<StabilityReport, Failure> {
         resolution: req.resolution,
         spp: req.trace_spp,
         preset: req.preset.clone(),
-        ..super::pack_defaults()
+        ..PackSettings::new()
     };
     let base = PackRequest {
         scene: req.scene.clone(),
