@@ -258,6 +258,7 @@ fn scene_toml_is_traced_into_a_cache_beside_it() {
         .arg("-o")
         .arg(&file)
         .args(["--resolution", "32x24", "--spp", "1", "--codec", "dct", "--ratio", "12", "--json"])
+        .args(["--denoise", "off"])
         .output()
         .expect("pis-pack runs");
     let r = json(&out);

@@ -395,9 +395,17 @@ fn a_scene_is_traced_packed_and_played_in_one_command() {
     assert!(err.contains("tracing and packing"), "{err}");
     // 2 × 2 samples: the diagonal tour visits each once.
     assert_eq!(r["frames"], 4, "{r}");
-    let packed = dir.path().join(".pis-cache/demo1-160x120-spp1.pis");
+    // Traced as pis-trace traces by default: denoised where Open Image Denoise is found,
+    // into a cache named so.
+    let found = pis_trace::oidn::shared().is_ok();
+    assert!(found || std::env::var_os("PIS_REQUIRE_OIDN").is_none(), "PIS_REQUIRE_OIDN is set");
+    let cached = if found { "demo1-160x120-spp1-denoised" } else { "demo1-160x120-spp1" };
+    let says = if found { "(denoised by Open Image Denoise" } else { "(raw layers)" };
+    assert!(err.contains(says), "{err}");
+    let packed = dir.path().join(format!(".pis-cache/{cached}.pis"));
     assert!(packed.is_file(), "no pack at {}", packed.display());
-    assert!(dir.path().join(".pis-cache/demo1-160x120-spp1/set.json").is_file());
+    let set = dir.path().join(".pis-cache").join(cached);
+    assert!(set.join("set.json").is_file());
     let again = play(&[
         os(&scene),
         os("--headless"),
@@ -410,7 +418,6 @@ fn a_scene_is_traced_packed_and_played_in_one_command() {
     assert!(!err.contains("tracing and packing") && err.contains("playing"), "{err}");
     assert_eq!(r["frames"], 1, "{r}");
     // A cached pack made for another target (an earlier default, 384:1) is packed again.
-    let set = dir.path().join(".pis-cache/demo1-160x120-spp1");
     let out = Command::new(env!("CARGO_BIN_EXE_pis-pack"))
         .args([
             os(&set),

@@ -50,8 +50,7 @@ fn pack_default(name: &str) -> serde_json::Value {
 /// The default target is met: the file's predicted played PSNR within
 /// [`pis_pack::DEFAULT_WITHIN_DB`] of its textures as solved, by the fewest bytes of the
 /// allocations searched, every object gets bytes, and the predicted PSNR is at least
-/// `floor_db` (measured at the sample's CI size, 4 spp, less 1 dB: pis-pack traces a
-/// scene.toml without denoising).
+/// `floor_db` (measured at the sample's CI size, 4 spp, from a raw set, less 1 dB).
 fn check(name: &str, floor_db: f64) {
     let r = pack_default(name);
     let (psnr, solved) =

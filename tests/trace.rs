@@ -410,3 +410,41 @@ fn an_adaptive_denoised_set_records_samples_guides_and_twins() {
     assert_ne!(raw.layer("combined"), clean.layer("combined"), "the twin is read in its place");
     assert!(clean.layers.iter().all(|l| !l.name.starts_with("denoised.")));
 }
+
+/// A scene.toml given to pis-pack is traced as pis-trace traces it by default: denoised
+/// where Open Image Denoise loads, into a cache of its own (`-denoised`), the report saying
+/// so; raw with `--denoise off`, and raw, with a warning, where the library is missing.
+#[test]
+fn a_scene_toml_given_to_pis_pack_is_denoised_as_pis_trace_denoises_it() {
+    let found = pis_trace::oidn::shared().is_ok();
+    assert!(found || std::env::var_os("PIS_REQUIRE_OIDN").is_none(), "PIS_REQUIRE_OIDN is set");
+    let tmp = tempfile::tempdir().unwrap();
+    let scene = tiny_scene(tmp.path());
+    let pack = |denoise: &str, file: &str| {
+        let out = Command::new(env!("CARGO_BIN_EXE_pis-pack"))
+            .arg(&scene)
+            .args(["--resolution", "24x18", "--spp", "2", "--ratio", "8", "--denoise", denoise])
+            .arg("-o")
+            .arg(tmp.path().join(file))
+            .output()
+            .expect("pis-pack runs");
+        assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+        text(&out.stderr)
+    };
+    let cache = scene.parent().unwrap().join(".pis-cache");
+    let name = |suffix: &str| {
+        let s = pis_scene::load(&scene, None).unwrap();
+        cache.join(format!("{}-24x18-spp2{suffix}", s.name))
+    };
+    let report = pack("auto", "auto.pis");
+    let dir = if found { name("-denoised") } else { name("") };
+    let set = RaySet::open(&dir).unwrap_or_else(|e| panic!("{}: {e}\n{report}", dir.display()));
+    assert_eq!(set.meta.denoiser.is_some(), found, "{report}");
+    let says = if found { "(denoised by Open Image Denoise 2." } else { "pip install pyoidn" };
+    assert!(report.contains(says), "{report}");
+    let report = pack("off", "off.pis");
+    let raw = RaySet::open(name("")).unwrap();
+    assert!(raw.meta.denoiser.is_none(), "{report}");
+    // Where the library is missing, the raw set traced above is the one taken again.
+    assert_eq!(report.contains("(raw layers)"), found, "{report}");
+}

@@ -7,6 +7,7 @@ use std::path::PathBuf;
 use clap::Args;
 use pis_codec::CodecId;
 use pis_compile::{Filter, MAX_ANISOTROPY};
+use pis_trace::settings::DenoiseMode;
 
 use crate::cli::{one_of, Exit, Failure};
 use pis_pack::{
@@ -71,6 +72,11 @@ pub struct PackOptions {
     /// Tracing a scene.toml: camera samples per pixel.
     #[arg(long)]
     pub spp: Option<u32>,
+    /// Tracing a scene.toml: denoise its layers with Open Image Denoise, as pis-trace does.
+    /// `auto`: when the library is found (`pip install pyoidn`), else a warning and raw
+    /// layers only. `on`: an error without it. `off`: raw layers only.
+    #[arg(long, default_value = "auto", value_parser = one_of(&DenoiseMode::ALL, DenoiseMode::name))]
+    pub denoise: DenoiseMode,
     /// Tracing a scene.toml: a `[preset.NAME]` of the scene (e.g. `paper`), applied before
     /// --resolution and --spp; with a set, the preset its scene is read with.
     #[arg(long, value_name = "NAME")]
@@ -196,6 +202,7 @@ impl PackOptions {
             preset: self.preset.clone(),
             resolution: self.resolution,
             spp: self.spp,
+            denoise: self.denoise,
             memory: self.memory,
         };
         let mut req = PackRequest::new(input, output, settings);

@@ -25,7 +25,8 @@ fn pack_scene(scene_toml: &Path, options: &PackOptions) -> Result<PathBuf, Failu
         spp: options.spp,
     };
     let scene = pis_scene::load_with(scene_toml, &load).map_err(Failure::from)?;
-    let set_dir = pis_pack::cache_dir(scene_toml, &scene);
+    let trace = pis_pack::scene_trace_settings(&scene, options.denoise)?;
+    let set_dir = pis_pack::cache_dir(scene_toml, &scene, &trace);
     let mut name = set_dir.file_name().map(|n| n.to_os_string()).unwrap_or_default();
     let fingerprint = options.fingerprint();
     if fingerprint != PackOptions::defaults().fingerprint() {

@@ -66,7 +66,7 @@ pub use pis_trace::set::Shard;
 
 use pis_codec::CodecId;
 
-pub use input::cache_dir;
+pub use input::{cache_dir, scene_trace_settings};
 pub use matrices::{filter_needs_probe, MatrixSource};
 pub use packed::LayerTextures;
 pub use report::{print_report, FragmentsReport, MemoryReport, ObjectReport, PackReport};

@@ -81,7 +81,8 @@ fn clear_cache(scene: &Path, s: &Settings) -> Result<(), Failure> {
         LoadOptions { preset: s.preset.map(str::to_string), resolution: s.resolution, spp: s.spp };
     let loaded =
         pis_scene::load_with(scene, &options).map_err(|e| Failure::new(Exit::Invalid, e))?;
-    let dir = pis_pack::cache_dir(scene, &loaded);
+    let trace = pis_pack::scene_trace_settings(&loaded, super::TRACE_DENOISE)?;
+    let dir = pis_pack::cache_dir(scene, &loaded, &trace);
     if dir.exists() {
         std::fs::remove_dir_all(&dir)
             .map_err(|e| Failure::new(Exit::Io, anyhow!("removing {}: {e}", dir.display())))?;

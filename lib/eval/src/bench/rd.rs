@@ -114,7 +114,7 @@ fn pack_request(req: &RdRequest) -> PackRequest {
         preset: req.preset.clone(),
         max_mse: req.max_mse,
         stagger: req.stagger,
-        ..PackSettings::new()
+        ..super::pack_defaults()
     };
     PackRequest {
         scene: req.scene.clone(),

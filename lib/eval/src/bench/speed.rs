@@ -170,7 +170,7 @@ pub fn run(req: &SpeedRequest) -> Result<SpeedReport, Failure> {
         resolution: req.resolution,
         spp: req.spp,
         preset: req.preset.clone(),
-        ..PackSettings::new().with_ratio(req.ratio)
+        ..super::pack_defaults().with_ratio(req.ratio)
     };
     let base = PackRequest {
         scene: req.scene.clone(),

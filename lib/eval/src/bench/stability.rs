@@ -384,7 +384,7 @@ pub fn run(req: &StabilityRequest) -> Result<StabilityReport, Failure> {
         resolution: req.resolution,
         spp: req.trace_spp,
         preset: req.preset.clone(),
-        ..PackSettings::new()
+        ..super::pack_defaults()
     };
     let base = PackRequest {
         scene: req.scene.clone(),

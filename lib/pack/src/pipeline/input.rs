@@ -7,6 +7,7 @@ use std::sync::Arc;
 use anyhow::anyhow;
 use pis_scene::{Frame, LoadOptions, Scene};
 use pis_trace::set::RaySet;
+use pis_trace::settings::DenoiseMode;
 use pis_trace::{TraceError, TraceSettings};
 
 use super::memory::MemoryPlan;
@@ -57,11 +58,21 @@ fn invalid(msg: String) -> Failure {
     Failure::new(Exit::Invalid, anyhow!(msg))
 }
 
-/// The cache directory a scene.toml is traced into: beside it, named by size and spp.
-pub fn cache_dir(scene_toml: &Path, scene: &Scene) -> PathBuf {
+/// The tracer's settings a scene.toml given to the pack (or the player) is traced with:
+/// pis-trace's defaults at the scene's size and samples per pixel, denoised as `denoise`
+/// says (`On` without the library is an error naming why).
+pub fn scene_trace_settings(scene: &Scene, denoise: DenoiseMode) -> Result<TraceSettings, Failure> {
+    denoise.apply(TraceSettings::new(scene.resolution, scene.spp)).map_err(trace_failure)
+}
+
+/// The cache directory a scene.toml is traced into with `settings`: beside it, named by size
+/// and spp, and `-denoised` where the trace denoises (a raw set traced before, or where the
+/// library is missing, is not taken for a denoised one).
+pub fn cache_dir(scene_toml: &Path, scene: &Scene, settings: &TraceSettings) -> PathBuf {
     let dir = scene_toml.parent().unwrap_or(Path::new("."));
+    let denoised = if pis_trace::denoise::denoiser(settings).is_some() { "-denoised" } else { "" };
     dir.join(".pis-cache").join(format!(
-        "{}-{}x{}-spp{}",
+        "{}-{}x{}-spp{}{denoised}",
         scene.name, scene.resolution.0, scene.resolution.1, scene.spp
     ))
 }
@@ -150,7 +161,8 @@ fn set_dir(req: &PackRequest, stages: &mut Stages) -> Result<(PathBuf, PathBuf),
         let options =
             LoadOptions { preset: req.preset.clone(), resolution: req.resolution, spp: req.spp };
         let scene = pis_scene::load_with(&req.input, &options).map_err(Failure::from)?;
-        let dir = cache_dir(&req.input, &scene);
+        let settings = scene_trace_settings(&scene, req.denoise)?;
+        let dir = cache_dir(&req.input, &scene, &settings);
         if !dir.join("set.json").is_file() {
             // What the container cannot store is refused before the trace.
             let frames = (0..scene.space.point_count())
@@ -159,13 +171,14 @@ fn set_dir(req: &PackRequest, stages: &mut Stages) -> Result<(PathBuf, PathBuf),
                 .map_err(|e| Failure::new(Exit::Invalid, e))?;
             super::transforms::check_transforms(&scene, &frames)
                 .map_err(|e| Failure::new(Exit::NotSupported, e))?;
-            let settings = TraceSettings::new(scene.resolution, scene.spp);
             let r = pis_trace::render_set(&scene, &dir, &settings, None, &pis_trace::NoProgress)
                 .map_err(trace_failure)?;
             for w in &r.warnings {
                 stages.note(&format!("warning: {w}"));
             }
-            stages.done("trace", &format!("{} points into {}", r.points, dir.display()));
+            let layers =
+                r.denoiser.map_or("raw layers".to_string(), |d| format!("denoised by {d}"));
+            stages.done("trace", &format!("{} points into {} ({layers})", r.points, dir.display()));
         }
         (dir, req.input.clone())
     } else {

@@ -205,6 +205,9 @@ pub struct PackSettings {
     pub resolution: Option<(u32, u32)>,
     /// Tracing a scene.toml: samples per pixel override.
     pub spp: Option<u32>,
+    /// Tracing a scene.toml: whether its layers are denoised (`pis-trace --denoise`; `Auto`,
+    /// the default, denoises where Open Image Denoise is found, as pis-trace does).
+    pub denoise: pis_trace::settings::DenoiseMode,
     /// The memory budget in GB (`None`: the memory available): a set whose pack would not
     /// fit is streamed through a scratch file ([`super::memory`]), with the same output.
     pub memory: Option<f64>,
@@ -245,6 +248,7 @@ impl PackSettings {
             preset: None,
             resolution: None,
             spp: None,
+            denoise: pis_trace::settings::DenoiseMode::Auto,
             memory: None,
         }
     }
