@@ -38,11 +38,14 @@ pub struct PackOptions {
     /// Samples per parameter block: one size for every dimension (8) or one per dimension (8x8).
     #[arg(long, default_value = "8", value_parser = parse_block)]
     pub block: BlockSizes,
-    /// Texture filtering the player uses: trilinear, bilinear, or anisotropic (trilinear lookups
-    /// along the footprint's major axis, as the adapter's sampler takes them; needs
-    /// `--matrix probe`, since no specification pins the footprint down).
-    #[arg(long, default_value = "trilinear", value_parser = one_of(&FILTERS, Filter::name))]
-    pub filter: Filter,
+    /// Texture filtering the player uses: auto (trilinear, or bilinear for an object whose
+    /// views between those its textures are solved from it predicts at least 0.5 dB better:
+    /// faces seen at a grazing angle), or one for every object: trilinear, bilinear, or
+    /// anisotropic (trilinear lookups along the footprint's major axis, as the adapter's
+    /// sampler takes them; needs `--matrix probe`, since no specification pins the footprint
+    /// down).
+    #[arg(long, default_value = "auto", value_parser = one_of(&FILTERS, FilterFlag::name))]
+    pub filter: FilterFlag,
     /// Anisotropic filtering: the sampler's anisotropy clamp, 1 to 16 (the most lookups per
     /// pixel; an adapter may ignore it: Mesa 22.3's lavapipe filters the same for any clamp
     /// above 1). Default 16; only with `--filter anisotropic`.
@@ -163,15 +166,15 @@ impl PackOptions {
         scene: Option<PathBuf>,
         output: PathBuf,
     ) -> Result<PackRequest, Failure> {
-        let filter = match (self.filter, self.anisotropy) {
+        let filter = match (self.filter.0.unwrap_or(Filter::Trilinear), self.anisotropy) {
             (Filter::Anisotropic(_), n) => Filter::Anisotropic(n.unwrap_or(MAX_ANISOTROPY)),
             (f, None) => f,
-            (f, Some(_)) => {
+            (_, Some(_)) => {
                 return Err(Failure::new(
                     Exit::Usage,
                     anyhow::anyhow!(
                         "--anisotropy applies to --filter anisotropic, not {}",
-                        f.name()
+                        self.filter.name()
                     ),
                 ))
             }
@@ -185,6 +188,7 @@ impl PackOptions {
             codec: self.codec,
             block: BlockSize::from_sizes(self.block.0.clone()),
             filter,
+            filter_choice: self.filter.0.is_none(),
             matrix: self.matrix,
             max_texture: self.max_texture,
             texels_per_pixel: self.texels_per_pixel.0,
@@ -235,10 +239,25 @@ impl PackOptions {
     }
 }
 
-/// The values of `--filter`, by [`Filter::name`] (the anisotropy clamp comes from
+/// `--filter`: `auto` (`None`: trilinear, bilinear per object where held-out views say so) or
+/// one filter for every object.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FilterFlag(pub Option<Filter>);
+
+impl FilterFlag {
+    fn name(self) -> &'static str {
+        self.0.map_or("auto", Filter::name)
+    }
+}
+
+/// The values of `--filter`, by [`FilterFlag::name`] (the anisotropy clamp comes from
 /// `--anisotropy`).
-const FILTERS: [Filter; 3] =
-    [Filter::Trilinear, Filter::Bilinear, Filter::Anisotropic(MAX_ANISOTROPY)];
+const FILTERS: [FilterFlag; 4] = [
+    FilterFlag(None),
+    FilterFlag(Some(Filter::Trilinear)),
+    FilterFlag(Some(Filter::Bilinear)),
+    FilterFlag(Some(Filter::Anisotropic(MAX_ANISOTROPY))),
+];
 
 /// The values of `--matrix`, by [`MatrixSource::name`].
 const MATRIX_SOURCES: [MatrixSource; 2] = [MatrixSource::Model, MatrixSource::Probe];

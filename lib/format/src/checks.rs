@@ -187,6 +187,12 @@ pub(crate) fn check_parsed<S>(p: &Parsed<S>) -> Vec<Issue> {
         if let Some(objects) = p.objects {
             let named: Vec<(&str, crate::ObjectRole)> =
                 objects.iter().map(|o| (o.name.as_str(), o.role)).collect();
+            let names: Vec<&str> = named.iter().map(|o| o.0).collect();
+            if let Err(detail) = crate::FileFilter::per_object(prov, &names) {
+                if crate::FileFilter::of(prov).is_ok() {
+                    out.push(chunk(Issue::new(id::provenance::FILTER, detail), "PROV"));
+                }
+            }
             if let Err(detail) = crate::tint::tints(prov, &named) {
                 out.push(chunk(Issue::new(id::provenance::TINT, detail), "PROV"));
             }

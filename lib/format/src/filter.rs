@@ -8,6 +8,8 @@ use crate::model::Provenance;
 pub const FILTER_SETTING: &str = "filter";
 /// The setting holding the anisotropy clamp of `anisotropic` (decimal 1 to 16).
 pub const ANISOTROPY_SETTING: &str = "anisotropy";
+/// The prefix of the settings naming one object's filter; the object's name follows.
+pub const OBJECT_FILTER_PREFIX: &str = "filter.";
 /// The largest anisotropy clamp (WebGPU and Vulkan samplers: 16).
 pub const MAX_ANISOTROPY: u8 = 16;
 
@@ -47,25 +49,57 @@ impl FileFilter {
     /// setting; an error naming what is wrong for an unknown name, or an `anisotropic`
     /// filter without an anisotropy of 1 to 16.
     pub fn of(p: Option<&Provenance>) -> Result<FileFilter, String> {
-        let get = |k: &str| p.and_then(|p| p.setting(k));
-        match get(FILTER_SETTING) {
-            None | Some("trilinear") => Ok(FileFilter::Trilinear),
-            Some("nearest") => Ok(FileFilter::Nearest),
-            Some("bilinear") => Ok(FileFilter::Bilinear),
-            Some("anisotropic") => match get(ANISOTROPY_SETTING).map(|v| v.parse::<u8>()) {
+        match p.and_then(|p| p.setting(FILTER_SETTING)) {
+            None => Ok(FileFilter::Trilinear),
+            Some(name) => FileFilter::named(name, p.and_then(|p| p.setting(ANISOTROPY_SETTING))),
+        }
+    }
+
+    /// The filter of the setting value `name`, with the `anisotropy` setting's value.
+    fn named(name: &str, anisotropy: Option<&str>) -> Result<FileFilter, String> {
+        match name {
+            "trilinear" => Ok(FileFilter::Trilinear),
+            "nearest" => Ok(FileFilter::Nearest),
+            "bilinear" => Ok(FileFilter::Bilinear),
+            "anisotropic" => match anisotropy.map(|v| v.parse::<u8>()) {
                 Some(Ok(n)) if (1..=MAX_ANISOTROPY).contains(&n) => Ok(FileFilter::Anisotropic(n)),
                 Some(_) => Err(format!(
                     "{ANISOTROPY_SETTING} {:?} is not an integer from 1 to {MAX_ANISOTROPY}",
-                    get(ANISOTROPY_SETTING).unwrap_or("")
+                    anisotropy.unwrap_or("")
                 )),
                 None => {
                     Err(format!("filter \"anisotropic\" without an {ANISOTROPY_SETTING} setting"))
                 }
             },
-            Some(other) => Err(format!(
+            other => Err(format!(
                 "unknown filter {other:?} (nearest, bilinear, trilinear or anisotropic)"
             )),
         }
+    }
+
+    /// The setting recording that object `object`'s textures were solved for this filter
+    /// rather than the file's (`filter.<object name>`; an anisotropic one takes the file's
+    /// `anisotropy`).
+    pub fn object_setting(self, object: &str) -> (String, String) {
+        (format!("{OBJECT_FILTER_PREFIX}{object}"), self.name().to_string())
+    }
+
+    /// Per object (`objects`: their names in file order), the filter its textures are drawn
+    /// with (rule 9001): its `filter.<name>` setting, else the file's filter. An error names
+    /// a setting that names no object, or whose value the file's `filter` could not take.
+    pub fn per_object(p: Option<&Provenance>, objects: &[&str]) -> Result<Vec<FileFilter>, String> {
+        let mut out = vec![FileFilter::of(p)?; objects.len()];
+        let Some(p) = p else { return Ok(out) };
+        for (k, v) in &p.settings {
+            let Some(name) = k.strip_prefix(OBJECT_FILTER_PREFIX) else { continue };
+            let o = objects
+                .iter()
+                .position(|&o| o == name)
+                .ok_or_else(|| format!("{k}: no object is named {name:?}"))?;
+            out[o] = FileFilter::named(v, p.setting(ANISOTROPY_SETTING))
+                .map_err(|e| format!("{k}: {e}"))?;
+        }
+        Ok(out)
     }
 }
 
@@ -112,5 +146,36 @@ pub(crate) mod tests {
         ] {
             assert!(FileFilter::of(Some(&prov(&bad))).is_err(), "{bad:?}");
         }
+    }
+
+    #[test]
+    fn an_object_may_have_a_filter_of_its_own() {
+        let objects = ["Box", "Floor"];
+        let (k, v) = FileFilter::Bilinear.object_setting("Box");
+        let p = prov(&[(k.as_str(), v.as_str())]);
+        assert_eq!(
+            FileFilter::per_object(Some(&p), &objects),
+            Ok(vec![FileFilter::Bilinear, FileFilter::Trilinear])
+        );
+        assert_eq!(FileFilter::per_object(None, &objects), Ok(vec![FileFilter::Trilinear; 2]));
+        let p = prov(&[("filter", "bilinear"), ("filter.Floor", "trilinear")]);
+        assert_eq!(
+            FileFilter::per_object(Some(&p), &objects),
+            Ok(vec![FileFilter::Bilinear, FileFilter::Trilinear])
+        );
+        for (bad, says) in [
+            (vec![("filter.Lamp", "bilinear")], "no object"),
+            (vec![("filter.Box", "cubic")], "unknown filter"),
+            (vec![("filter.Box", "anisotropic")], "anisotropy"),
+            (vec![("filter", "cubic")], "unknown filter"),
+        ] {
+            let e = FileFilter::per_object(Some(&prov(&bad)), &objects).unwrap_err();
+            assert!(e.contains(says), "{bad:?}: {e}");
+        }
+        let p = prov(&[("filter.Box", "anisotropic"), ("anisotropy", "8")]);
+        assert_eq!(
+            FileFilter::per_object(Some(&p), &objects).unwrap()[0],
+            FileFilter::Anisotropic(8)
+        );
     }
 }

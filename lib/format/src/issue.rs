@@ -201,7 +201,7 @@ rules! {
     /// 90xx: the provenance (`PROV`) and its settings.
     pub mod provenance {
         MALFORMED = 9000, "PROV payload is malformed";
-        FILTER = 9001, "filter setting is unknown, or anisotropic without an anisotropy of 1 to 16";
+        FILTER = 9001, "filter setting is unknown, names no object, or anisotropic without an anisotropy of 1 to 16";
         DISPLAY_FILTER = 9002, "display filter setting is unknown, or its sigma or radius is missing or not a number of pixels in (0, 64]";
         KEY_REPEATED = 9003, "setting key appears more than once";
         TINT = 9004, "transmission tint setting names no refractive object, or is not three numbers in [0, 1]";

@@ -221,18 +221,24 @@ fn serialize_inner(c: &Container, masters: &[Master], labelled: bool) -> Sink {
     assemble(chunks, minor_version(c), labelled)
 }
 
-/// The lowest minor version whose rules the file needs (SPEC.md 10.1): 3 where an object is
-/// translucent (a surface layer of 4 channels, 7.1), else 2.
+/// The lowest minor version whose rules the file needs (SPEC.md 10.1): 4 where an object has
+/// a filter of its own (a `filter.NAME` setting, 6.6), 3 where an object is translucent (a
+/// surface layer of 4 channels, 7.1), else 2.
 fn minor_version(c: &Container) -> u16 {
+    let own_filter = c.provenance.as_ref().is_some_and(|p| {
+        p.settings.iter().any(|(k, _)| k.starts_with(crate::filter::OBJECT_FILTER_PREFIX))
+    });
     let translucent = c
         .objects
         .iter()
         .flat_map(|o| &o.layers)
         .any(|l| l.mapping == Mapping::Surface && l.channels == 4);
-    if translucent {
+    if own_filter {
         VERSION_MINOR
+    } else if translucent {
+        3
     } else {
-        VERSION_MINOR - 1
+        2
     }
 }
 

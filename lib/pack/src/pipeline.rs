@@ -28,6 +28,7 @@
 pub mod blocks;
 pub mod choice;
 pub mod encode;
+pub mod filter_choice;
 pub mod hybrid;
 pub mod infer_layers;
 pub mod input;

@@ -280,6 +280,10 @@ fn provenance_settings(
         (super::TARGET_SETTING.to_string(), req.target.describe()),
     ];
     settings.splice(2..2, file_filter(req.filter).settings());
+    // An object whose textures were solved for another filter than the file's (6.6).
+    for m in models.iter().filter(|m| m.filter != req.filter) {
+        settings.push(file_filter(m.filter).object_setting(&m.name));
+    }
     if req.pyramid != super::PyramidMode::Adaptive {
         settings.push(("pyramid".to_string(), req.pyramid.name().to_string()));
     }

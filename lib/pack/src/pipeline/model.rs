@@ -305,6 +305,8 @@ pub struct ObjectModel {
     /// What was chosen and why.
     pub representation: String,
     pub why: String,
+    /// The texture filter its surface textures are solved for and drawn with.
+    pub filter: pis_compile::Filter,
     /// Under `--representation auto`, for an object that has an alternative: what the
     /// screen and the whole-file encodes found ([`super::screen`]).
     pub auto: Option<AutoChoice>,

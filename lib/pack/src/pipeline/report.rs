@@ -14,6 +14,9 @@ use super::{PackRequest, Stages};
 #[derive(Clone, Debug, Serialize)]
 pub struct ObjectReport {
     pub name: String,
+    /// The texture filter its surface textures were solved for (the file's, or its own:
+    /// `--filter auto`).
+    pub filter: String,
     /// The layers stored: `diffuse`, `specular` or `diffuse+specular`.
     pub representation: String,
     /// Why this representation was chosen.
@@ -214,6 +217,7 @@ pub fn build(
                 .unwrap_or(&m.placements[0]);
             ObjectReport {
                 name: m.name.clone(),
+                filter: m.filter.name().to_string(),
                 representation: m.representation.clone(),
                 why: m.why.clone(),
                 auto: m.auto.clone(),
@@ -326,9 +330,15 @@ pub fn print_report(r: &PackReport, out: &mut impl std::io::Write) -> std::io::R
     } else {
         String::new()
     };
+    let own: Vec<&str> =
+        r.objects.iter().filter(|o| o.filter != r.filter).map(|o| o.name.as_str()).collect();
+    let own = match own.as_slice() {
+        [] => String::new(),
+        names => format!(" (bilinear for {}, chosen by held-out views)", names.join(", ")),
+    };
     writeln!(
         out,
-        "  filter {}{anisotropy}, render matrices from the {}{probe}",
+        "  filter {}{anisotropy}{own}, render matrices from the {}{probe}",
         r.filter,
         if r.matrix == "probe" { "GPU (probe mode)" } else { "hardware model" }
     )?;

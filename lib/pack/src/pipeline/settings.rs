@@ -159,6 +159,10 @@ pub struct PackSettings {
     pub block: BlockSize,
     /// The player's texture filter; `Anisotropic` needs `matrix: Probe`.
     pub filter: Filter,
+    /// With a trilinear `filter`, choose per object between trilinear and bilinear lookups
+    /// by the views of the set the object's textures were not solved from
+    /// ([`super::filter_choice`]); the file records an object's own filter (SPEC.md 6.6).
+    pub filter_choice: bool,
     /// Where the render matrices come from: the hardware model (default) or probe mode,
     /// measured through the player's pipeline on a GPU adapter (thesis 3.4.3).
     pub matrix: MatrixSource,
@@ -223,7 +227,8 @@ impl PackSettings {
     /// pis-pack's defaults: the fewest bytes that play within [`DEFAULT_WITHIN_DB`] of the
     /// textures as solved, each reflective or refractive object in the representation that
     /// meets it with the fewest bytes, with the wavelet codec, 8-sample blocks, trilinear
-    /// filtering through the hardware model, one level-0 texel per covered pixel, screen-error
+    /// filtering through the hardware model (bilinear for an object whose held-out views it
+    /// predicts better), one level-0 texel per covered pixel, screen-error
     /// allocation, texture placements per block.
     pub const fn new() -> Self {
         PackSettings {
@@ -231,6 +236,7 @@ impl PackSettings {
             codec: CodecId::Wavelet,
             block: BlockSize::Uniform(DEFAULT_BLOCK),
             filter: Filter::Trilinear,
+            filter_choice: true,
             matrix: MatrixSource::Model,
             max_texture: DEFAULT_MAX_TEXTURE,
             texels_per_pixel: DEFAULT_TEXELS_PER_PIXEL,
@@ -260,9 +266,11 @@ impl PackSettings {
     }
 
     /// The thesis's own choices where they differ from the defaults: one texture placement
-    /// per object over every view, texture error weighted by screen area.
+    /// per object over every view, texture error weighted by screen area, trilinear lookups
+    /// for every object.
     pub const fn thesis() -> Self {
         let mut s = Self::new();
+        s.filter_choice = false;
         s.placement = PlacementMode::Object;
         s.allocation = Allocation::Texture;
         s

@@ -79,7 +79,7 @@ fn matrix_at(
     meshes: &[Mesh],
     uvs: &[[f32; 2]],
     placed: &Placed,
-    req: &PackRequest,
+    filter: pis_compile::Filter,
     matrices: &mut Matrices,
     coverage: &[f32],
 ) -> Result<RenderMatrix> {
@@ -106,7 +106,7 @@ fn matrix_at(
         mesh,
         transform: placed.transform,
         layout: placed.layout,
-        sampler: sampler(req.filter, placed.repeat),
+        sampler: sampler(filter, placed.repeat),
     };
     let a = matrices.matrix(Viewport { width: w, height: h }, &draw, o, &obj)?;
     // A translucent object keeps the pixels the tracer sees through it: its opacity is 0
@@ -114,14 +114,15 @@ fn matrix_at(
     Ok(if meshes[o].translucent { a } else { restrict_rows(&a, coverage) })
 }
 
-/// Every point with placement 0 (over all views): the rows, the gold standard there.
+/// Every point with placement 0 (over all views) drawn with `filter`: the rows, the gold
+/// standard there.
 fn views_of(
     set: &LoadedSet,
     o: usize,
     uvs: &[[f32; 2]],
     placed: &Placed,
     meshes: &[Mesh],
-    req: &PackRequest,
+    filter: pis_compile::Filter,
     matrices: &mut Matrices,
 ) -> Result<Views> {
     let channel = &set.channels[o];
@@ -129,7 +130,7 @@ fn views_of(
     for p in 0..set.frames.len() {
         let images = set.images.object(p, o)?;
         let cov = coverage_in(set, &images, o);
-        let a = matrix_at(set, p, o, meshes, uvs, placed, req, matrices, &cov)?;
+        let a = matrix_at(set, p, o, meshes, uvs, placed, filter, matrices, &cov)?;
         let pick = |kind| gather(&a.pixels, &layer_rgb(&images, channel, kind));
         let (mut diffuse, mut specular) = (pick(TraceLayer::Diffuse), pick(TraceLayer::Specular));
         let alpha = if meshes[o].translucent {
@@ -141,6 +142,9 @@ fn views_of(
     }
     Ok(views)
 }
+
+/// Why a translucent object's first layer has four channels.
+const TRANSLUCENT: &str = "translucent (glTF alpha mode MASK or BLEND): its first layer carries its opacity, and the player composites it over what lies behind it";
 
 /// Half a step of an 8-bit display value: a layer whose removal moves no covered pixel by
 /// more than this changes no displayed pixel.
@@ -512,9 +516,9 @@ impl Representation for SurfaceTextures {
     }
 }
 
-/// [`SurfaceTextures`]' survey of object `o`; without `with_specular`, the object's surface
-/// part is its diffuse layer alone (another representation stores the rest) and the object
-/// is surveyed even when that layer is black, for its views' rows and gold standard.
+/// [`SurfaceTextures`]' survey of object `o`, its filter chosen; without `with_specular`, its
+/// surface part is its diffuse layer alone, with the file's filter (another representation
+/// stores the rest), surveyed even when black, for its views' rows and gold standard.
 pub fn survey_surface(
     job: &mut Job<'_>,
     o: usize,
@@ -538,7 +542,7 @@ pub fn survey_surface(
             req.texels_per_pixel,
         )?;
         let before = job.matrices.renderings();
-        let views = views_of(set, o, &at.uvs, &whole, &job.meshes, req, job.matrices)?;
+        let views = views_of(set, o, &at.uvs, &whole, &job.meshes, req.filter, job.matrices)?;
         if job.matrices.renderings() > before {
             job.note(&format!(
                 "object {name}: {} probe renderings over {} points",
@@ -550,6 +554,11 @@ pub fn survey_surface(
             job.note(&format!("object {name} covers no pixel of the set; left out"));
             return Ok(None);
         }
+        let chosen = super::filter_choice::choose(job, with_specular, name, &whole, views, |j| {
+            let bilinear = pis_compile::Filter::Bilinear;
+            views_of(set, o, &at.uvs, &whole, &j.meshes, bilinear, j.matrices)
+        })?;
+        let views = chosen.views;
         // A translucent object's first layer carries its opacity: kept wherever the object
         // hides some of what lies behind it, even in black.
         let hides = |v: &PointView| v.alpha.iter().any(|&a| a > DISPLAY_STEP);
@@ -565,6 +574,7 @@ pub fn survey_surface(
             atlas: at,
             views,
             whole,
+            filter: (chosen.filter, chosen.why),
             diffuse_black,
             specular_black,
             diffuse_only: !with_specular,
@@ -579,6 +589,8 @@ struct Covered {
     atlas: Atlas,
     views: Views,
     whole: Placed,
+    /// The filter its textures are solved for, and why where it was chosen.
+    filter: (pis_compile::Filter, Option<String>),
     diffuse_black: bool,
     specular_black: bool,
     /// The diffuse layer is the object's only surface layer (whatever `--layers` says).
@@ -648,7 +660,7 @@ impl Surveyed for Covered {
                         &job.meshes,
                         &c.atlas.uvs,
                         &placements[pid],
-                        req,
+                        c.filter.0,
                         job.matrices,
                         &cov,
                     )?,
@@ -669,7 +681,8 @@ impl Surveyed for Covered {
                 Ok(())
             })?;
         }
-        Ok(Box::new(Layers { o: c.o, atlas: c.atlas, placements, stagger: st, views, plans }))
+        let (o, atlas, filter) = (c.o, c.atlas, c.filter);
+        Ok(Box::new(Layers { o, atlas, placements, stagger: st, views, plans, filter }))
     }
 }
 
@@ -682,11 +695,12 @@ struct Layers {
     stagger: Vec<u32>,
     views: Views,
     plans: Vec<LayerPlan>,
+    filter: (pis_compile::Filter, Option<String>),
 }
 
 impl Planned for Layers {
     fn solve(self: Box<Self>, job: &Job<'_>) -> Result<ObjectModel> {
-        let Layers { o, atlas: at, placements, stagger: st, views, plans } = *self;
+        let Layers { o, atlas: at, placements, stagger: st, views, plans, filter } = *self;
         let (set, scene) = (job.set, &job.set.scene);
         let name = scene.objects[o].name.clone();
         let covered: usize = (0..views.len()).map(|p| views.rows(p)).sum();
@@ -720,11 +734,12 @@ impl Planned for Layers {
             } else {
                 representation.to_string()
             },
-            why: if translucent {
-                format!("{why}; translucent (glTF alpha mode MASK or BLEND): its first layer carries its opacity, and the player composites it over what lies behind it")
-            } else {
-                why.to_string()
-            },
+            why: [Some(why.to_string()), translucent.then(|| TRANSLUCENT.to_string()), filter.1]
+                .into_iter()
+                .flatten()
+                .collect::<Vec<_>>()
+                .join("; "),
+            filter: filter.0,
             auto: None,
         })
     }

@@ -15,8 +15,13 @@ use crate::frame::{LayerDraw, ObjectDraw, ReflectionDraw, TermShell};
 use crate::gpu::Gpu;
 use crate::textured::create_sampler;
 
-/// The player's samplers, one per repeat mode (s, t).
-pub(super) type Samplers = HashMap<[bool; 2], wgpu::Sampler>;
+/// The player's samplers, one per filter and repeat mode (s, t).
+pub(super) type Samplers = HashMap<(Filter, [bool; 2]), wgpu::Sampler>;
+
+/// The filter of object `o` (`filters`: per object; trilinear past the end).
+fn filter_of(filters: &[Filter], o: u32) -> Filter {
+    filters.get(o as usize).copied().unwrap_or(Filter::Trilinear)
+}
 
 /// Every object at its clip transform (`clips`, one per object).
 pub(super) fn object_draws<'a>(
@@ -41,29 +46,30 @@ fn address(repeat: [bool; 2]) -> [Address; 2] {
     repeat.map(|r| if r { Address::Repeat } else { Address::ClampToEdge })
 }
 
-/// Makes the samplers `surfaces` need that `samplers` lacks: the file's `filter`, each
-/// surface's repeat mode.
+/// Makes the samplers `surfaces` need that `samplers` lacks: each surface's object's filter
+/// (`filters`, per object) and repeat mode.
 pub(super) fn make_samplers(
     gpu: &Gpu,
     samplers: &mut Samplers,
-    filter: Filter,
+    filters: &[Filter],
     surfaces: &[Wanted],
 ) {
     for w in surfaces {
-        samplers.entry(w.repeat).or_insert_with(|| {
+        let filter = filter_of(filters, w.key.object);
+        samplers.entry((filter, w.repeat)).or_insert_with(|| {
             create_sampler(gpu, &Sampler { filter, address: address(w.repeat) })
         });
     }
 }
 
 /// The surface layers of `surfaces` with their textures on the GPU (`textures`) and their
-/// samplers (`samplers`, made by [`make_samplers`]), filtered with `filter`. A repeated
-/// axis must be a power of two.
+/// samplers (`samplers`, made by [`make_samplers`]), each filtered with its object's filter
+/// (`filters`). A repeated axis must be a power of two.
 pub(super) fn layer_draws<'a>(
     reader: &PisReader,
     textures: &'a Textures,
     samplers: &'a Samplers,
-    filter: Filter,
+    filters: &[Filter],
     surfaces: &[Wanted],
 ) -> Result<Vec<LayerDraw<'a>>, PlayError> {
     let mut layers = Vec::with_capacity(surfaces.len());
@@ -74,6 +80,7 @@ pub(super) fn layer_draws<'a>(
                 format!("{:?}: a shell's texture drawn as a surface layer", w.key),
             ));
         };
+        let filter = filter_of(filters, w.key.object);
         let sampler = Sampler { filter, address: address(w.repeat) };
         for (axis, k, s) in [('s', 0, texture.layout.width), ('t', 1, texture.layout.height)] {
             if w.repeat[k] && !s.is_power_of_two() {
@@ -83,7 +90,7 @@ pub(super) fn layer_draws<'a>(
         layers.push(LayerDraw {
             draw: w.draw,
             texture,
-            sampler: &samplers[&w.repeat],
+            sampler: &samplers[&(filter, w.repeat)],
             transform: w.transform,
             max_level: pis_compile::filter::max_level(&texture.layout, &sampler) as f32,
             weight: w.weight,

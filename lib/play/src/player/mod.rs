@@ -36,7 +36,7 @@ use pis_format::PisReader;
 
 use self::draws::{layer_draws, make_samplers, object_draws, reflection_draws, Samplers};
 use self::lens::{lens_corners, lens_draws, LensSet};
-use self::objects::{check_texture_sizes, file_filter, prepare_objects, LensState, ObjectGpu};
+use self::objects::{check_texture_sizes, object_filters, prepare_objects, LensState, ObjectGpu};
 pub use self::options::{FrameRequest, FrameStats, PlayerOptions};
 use self::plan::{camera_record, Plan};
 use self::readout::{read_back, wait_for_gpu, Readbacks, Readout, Target};
@@ -60,7 +60,8 @@ pub struct Player {
     /// The frame's textures on the GPU, the level-image cache and the decoding workers.
     textures: Textures,
     objects: Vec<ObjectGpu>,
-    filter: Filter,
+    /// Per object, the texture filter its textures were solved for.
+    filters: Vec<Filter>,
     pipes: FramePipelines,
     targets: Option<Targets>,
     /// The targets of the other sample count, kept while frames alternate between the
@@ -90,7 +91,7 @@ impl Player {
         check_texture_sizes(&gpu, &reader)?;
         budget::check_frame_memory(&gpu, reader.container(), &options)?;
         let objects = prepare_objects(&gpu, &reader)?;
-        let filter = file_filter(reader.container());
+        let filters = object_filters(reader.container());
         // The reader has checked the settings (rule 9002).
         let file_display =
             pis_format::DisplayFilter::of(reader.container().provenance.as_ref()).ok().flatten();
@@ -118,7 +119,7 @@ impl Player {
             options,
             textures,
             objects,
-            filter,
+            filters,
             pipes,
             targets: None,
             spare_targets: None,
@@ -402,9 +403,9 @@ impl Player {
     ) -> Result<Option<Readout>, PlayError> {
         let gpu = self.gpu.clone();
         let objects = object_draws(&self.objects, &plan.clips);
-        make_samplers(&gpu, &mut self.samplers, self.filter, &plan.surfaces);
+        make_samplers(&gpu, &mut self.samplers, &self.filters, &plan.surfaces);
         let (reader, textures) = (&self.reader, &self.textures);
-        let layers = layer_draws(reader, textures, &self.samplers, self.filter, &plan.surfaces)?;
+        let layers = layer_draws(reader, textures, &self.samplers, &self.filters, &plan.surfaces)?;
         let reflections = reflection_draws(reader, textures, plan)?;
         let lenses = lens_draws(reader, textures, plan, corner_sets)?;
         stats.lens_draws = lenses.len() as u64;

@@ -61,16 +61,23 @@ impl LensState {
     }
 }
 
-/// The texture filter the file's textures were solved for: pis-pack records it in the
-/// provenance settings (`filter`, `anisotropy`; SPEC.md 6.6); trilinear when absent. The
-/// reader has checked the settings (rule 9001).
-pub(super) fn file_filter(c: &Container<StreamRef>) -> Filter {
-    match pis_format::FileFilter::of(c.provenance.as_ref()).unwrap_or_default() {
-        pis_format::FileFilter::Nearest => Filter::Nearest,
-        pis_format::FileFilter::Bilinear => Filter::Bilinear,
-        pis_format::FileFilter::Trilinear => Filter::Trilinear,
-        pis_format::FileFilter::Anisotropic(n) => Filter::Anisotropic(n),
-    }
+/// Per object, the texture filter its textures were solved for: pis-pack records the file's
+/// in the provenance settings (`filter`, `anisotropy`) and an object's own where it differs
+/// (`filter.NAME`; SPEC.md 6.6); trilinear when absent. The reader has checked the settings
+/// (rule 9001).
+pub(super) fn object_filters(c: &Container<StreamRef>) -> Vec<Filter> {
+    let names: Vec<&str> = c.objects.iter().map(|o| o.name.as_str()).collect();
+    let filters = pis_format::FileFilter::per_object(c.provenance.as_ref(), &names)
+        .unwrap_or_else(|_| vec![pis_format::FileFilter::default(); names.len()]);
+    filters
+        .into_iter()
+        .map(|f| match f {
+            pis_format::FileFilter::Nearest => Filter::Nearest,
+            pis_format::FileFilter::Bilinear => Filter::Bilinear,
+            pis_format::FileFilter::Trilinear => Filter::Trilinear,
+            pis_format::FileFilter::Anisotropic(n) => Filter::Anisotropic(n),
+        })
+        .collect()
 }
 
 pub(super) fn content(reader: &PisReader, message: String) -> PlayError {

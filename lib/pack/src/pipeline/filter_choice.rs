@@ -1,0 +1,223 @@
+//! The texture filter of an object's textures, chosen per object (thesis 3.4, figs. 3.7–3.11):
+//! trilinear lookups, or bilinear ones of level 0. Trilinear filtering takes its level of
+//! detail from the pixel footprint's major axis, so a face seen at a grazing angle reads
+//! coarse levels and is blurred along the minor axis, whatever texture the solve finds;
+//! bilinear lookups are sharp there, but textures solved for them are sharpest at the views
+//! they were solved from and may alias between them. So the choice is made on views the
+//! textures were not solved from: the object's radiance (diffuse and specular together,
+//! view-independently) solved from the other points of the set with each filter and drawn
+//! at the points between them; bilinear is kept where it predicts those at least
+//! [`HELD_OUT_MARGIN_DB`] better. Only an object whose trilinear render matrices put at least
+//! [`COARSE_SHARE`] of their weight on coarser levels is tried: elsewhere the two filters
+//! read the same texels.
+
+use anyhow::Result;
+use pis_compile::{CompileError, Filter, SolveSettings, View, ViewSource};
+
+use super::mesh::Placed;
+use super::model::{PointView, Views};
+use super::represent::Job;
+use crate::solutions::Solver;
+
+/// The least gain (dB) over the held-out views that makes bilinear lookups an object's filter.
+pub const HELD_OUT_MARGIN_DB: f64 = 0.5;
+/// The least share of the trilinear render matrices' weight on levels coarser than 0 for
+/// which bilinear lookups are tried.
+pub const COARSE_SHARE: f64 = 0.2;
+
+/// An object's filter and the views its textures are solved from with it.
+pub struct Chosen {
+    pub filter: Filter,
+    pub views: Views,
+    /// What the choice measured, where it was made.
+    pub why: Option<String>,
+}
+
+/// The filter of object `name` (placement `whole`) whose views with the request's filter
+/// are `views`, where it is `chosen` here; `bilinear` measures its views with bilinear
+/// lookups. The choice is noted.
+pub fn choose(
+    job: &mut Job<'_>,
+    chosen: bool,
+    name: &str,
+    whole: &Placed,
+    views: Views,
+    bilinear: impl FnOnce(&mut Job<'_>) -> Result<Views>,
+) -> Result<Chosen> {
+    let req = job.req;
+    if !chosen || !req.filter_choice || req.filter != Filter::Trilinear {
+        return Ok(Chosen { filter: req.filter, views, why: None });
+    }
+    let c = measure(job, whole, views, bilinear)?;
+    if let Some(why) = &c.why {
+        job.note(&format!("object {name}: {why}"));
+    }
+    Ok(c)
+}
+
+/// [`choose`]'s measurement, for an object whose filter is chosen.
+fn measure(
+    job: &mut Job<'_>,
+    whole: &Placed,
+    views: Views,
+    bilinear: impl FnOnce(&mut Job<'_>) -> Result<Views>,
+) -> Result<Chosen> {
+    let req = job.req;
+    let keep = |views, why| Ok(Chosen { filter: req.filter, views, why });
+    let level0 = whole.layout.width as usize * whole.layout.height as usize;
+    let share = coarse_share(&views, level0)?;
+    let (train, test) = held_out(&views);
+    if share < COARSE_SHARE || train.is_empty() || test.is_empty() {
+        return keep(views, None);
+    }
+    let psnr = |mse: f64| -10.0 * mse.max(1e-20).log10();
+    let trilinear = psnr(held_out_mse(&views, &train, &test, &job.settings, &job.solver)?);
+    let bilinear_views = bilinear(job)?;
+    let (settings, solver) = (&job.settings, &job.solver);
+    let bilinear = psnr(held_out_mse(&bilinear_views, &train, &test, settings, solver)?);
+    let measured = format!(
+        "{} of the views between the {} it was solved from: {bilinear:.2} dB with bilinear lookups, {trilinear:.2} dB with trilinear ones ({:.0}% of whose weight is on coarser levels)",
+        test.len(),
+        train.len(),
+        share * 100.0
+    );
+    if bilinear >= trilinear + HELD_OUT_MARGIN_DB {
+        let why = format!("filter bilinear, chosen by held-out views: {measured}");
+        Ok(Chosen { filter: Filter::Bilinear, views: bilinear_views, why: Some(why) })
+    } else {
+        keep(views, Some(format!("filter trilinear, chosen by held-out views: {measured}")))
+    }
+}
+
+/// The share of the render matrices' weight (every point's) on columns past `level0`, the
+/// texels of the coarser levels.
+pub fn coarse_share(views: &Views, level0: usize) -> Result<f64> {
+    let (mut coarse, mut all) = (0.0f64, 0.0f64);
+    for p in 0..views.len() {
+        let v = views.get(p)?;
+        let a = v.a(0);
+        for (&c, &w) in a.cols.iter().zip(&a.vals) {
+            all += f64::from(w.abs());
+            if c as usize >= level0 {
+                coarse += f64::from(w.abs());
+            }
+        }
+    }
+    Ok(if all > 0.0 { coarse / all } else { 0.0 })
+}
+
+/// The points the held-out textures are solved from, and those they are measured at: of the
+/// points where the object covers a pixel, every second one strictly between the first and
+/// the last is held out.
+pub fn held_out(views: &Views) -> (Vec<usize>, Vec<usize>) {
+    let covered: Vec<usize> = (0..views.len()).filter(|&p| views.rows(p) > 0).collect();
+    let n = covered.len();
+    let (mut train, mut test) = (Vec::new(), Vec::new());
+    for (i, &p) in covered.iter().enumerate() {
+        if i % 2 == 1 && i + 1 < n {
+            test.push(p);
+        } else {
+            train.push(p);
+        }
+    }
+    (train, test)
+}
+
+/// The mean squared error, over the covered pixels of the points `test`, of the texture
+/// solved view-independently for the object's radiance from the points `train`.
+fn held_out_mse(
+    views: &Views,
+    train: &[usize],
+    test: &[usize],
+    settings: &SolveSettings,
+    solver: &Solver,
+) -> Result<f64> {
+    let x = solver.solve_view_source(&Points { views, points: train }, None, settings)?.texels;
+    let (mut sum, mut n) = (0.0f64, 0usize);
+    for &p in test {
+        let v = views.get(p)?;
+        let (a, b) = (v.a(0), radiance(&v));
+        for r in 0..a.rows() {
+            let (cols, vals) = a.row(r);
+            for k in 0..3 {
+                let y: f32 = cols.iter().zip(vals).map(|(&c, &w)| w * x[c as usize * 3 + k]).sum();
+                sum += f64::from(y - b[r * 3 + k]).powi(2);
+            }
+        }
+        n += a.rows() * 3;
+    }
+    Ok(if n > 0 { sum / n as f64 } else { 0.0 })
+}
+
+/// The object's radiance at the covered pixels of `v`: diffuse and specular together.
+fn radiance(v: &PointView) -> Vec<f32> {
+    v.diffuse.iter().zip(&v.specular).map(|(d, s)| d + s).collect()
+}
+
+/// The points `points` of `views` (placement 0), their radiance read as the solve asks.
+struct Points<'a> {
+    views: &'a Views,
+    points: &'a [usize],
+}
+
+impl ViewSource for Points<'_> {
+    fn count(&self) -> usize {
+        self.points.len()
+    }
+
+    fn visit(
+        &self,
+        k: usize,
+        f: &mut dyn FnMut(View<'_>) -> Result<(), CompileError>,
+    ) -> Result<(), CompileError> {
+        let v =
+            self.views.get(self.points[k]).map_err(|e| CompileError::Source(format!("{e:#}")))?;
+        f(View { a: v.a(0), b: &radiance(&v) })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use pis_compile::{RenderMatrix, TextureLayout};
+
+    /// Views of `rows` covered pixels per point (0: the object covers none there).
+    fn views(rows: &[usize]) -> Views {
+        let mut v = Views::new(None);
+        for &n in rows {
+            let layout = TextureLayout::full(4, 4);
+            let taps: Vec<pis_compile::filter::Taps> = (0..n)
+                .map(|i| {
+                    let mut t = pis_compile::filter::Taps::default();
+                    t.add((i % 16) as u32, 0.75);
+                    t.add(16 + (i % 4) as u32, 0.25);
+                    t
+                })
+                .collect();
+            let a = RenderMatrix::from_taps(
+                pis_compile::Viewport { width: 8, height: 8 },
+                layout,
+                (0..n as u32).collect(),
+                &taps,
+            );
+            let b = vec![0.5; n * 3];
+            v.push(PointView { a: vec![(0, a)], diffuse: b.clone(), specular: b, alpha: vec![] })
+                .unwrap();
+        }
+        v
+    }
+
+    #[test]
+    fn every_second_covered_point_between_the_ends_is_held_out() {
+        assert_eq!(held_out(&views(&[4, 4, 4, 4])), (vec![0, 2, 3], vec![1]));
+        assert_eq!(held_out(&views(&[4, 0, 4, 4, 4, 4])), (vec![0, 3, 5], vec![2, 4]));
+        assert_eq!(held_out(&views(&[4, 4])), (vec![0, 1], vec![]), "two points: none");
+    }
+
+    #[test]
+    fn the_coarse_share_is_the_weight_past_level_0() {
+        let s = coarse_share(&views(&[4, 4]), 16).unwrap();
+        assert!((s - 0.25).abs() < 1e-6, "{s}");
+        assert_eq!(coarse_share(&views(&[4]), 21).unwrap(), 0.0);
+    }
+}
