@@ -42,6 +42,7 @@ pub mod pem;
 pub mod plan;
 pub mod played;
 pub mod predict;
+pub mod radiance;
 pub mod registry;
 pub mod report;
 pub mod represent;

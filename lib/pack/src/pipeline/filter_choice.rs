@@ -12,10 +12,11 @@
 //! read the same texels.
 
 use anyhow::Result;
-use pis_compile::{CompileError, Filter, SolveSettings, View, ViewSource};
+use pis_compile::{Filter, SolveSettings};
 
 use super::mesh::Placed;
-use super::model::{PointView, Views};
+use super::model::Views;
+use super::radiance::{Radiance, SampleViews};
 use super::represent::Job;
 use crate::solutions::Solver;
 
@@ -132,11 +133,12 @@ fn held_out_mse(
     settings: &SolveSettings,
     solver: &Solver,
 ) -> Result<f64> {
-    let x = solver.solve_view_source(&Points { views, points: train }, None, settings)?.texels;
+    let source = SampleViews { views, points: train, placement: 0, radiance: Radiance::Sum };
+    let x = solver.solve_view_source(&source, None, settings)?.texels;
     let (mut sum, mut n) = (0.0f64, 0usize);
     for &p in test {
         let v = views.get(p)?;
-        let (a, b) = (v.a(0), radiance(&v));
+        let (a, b) = (v.a(0), Radiance::Sum.at(&v));
         for r in 0..a.rows() {
             let (cols, vals) = a.row(r);
             for k in 0..3 {
@@ -149,36 +151,10 @@ fn held_out_mse(
     Ok(if n > 0 { sum / n as f64 } else { 0.0 })
 }
 
-/// The object's radiance at the covered pixels of `v`: diffuse and specular together.
-fn radiance(v: &PointView) -> Vec<f32> {
-    v.diffuse.iter().zip(&v.specular).map(|(d, s)| d + s).collect()
-}
-
-/// The points `points` of `views` (placement 0), their radiance read as the solve asks.
-struct Points<'a> {
-    views: &'a Views,
-    points: &'a [usize],
-}
-
-impl ViewSource for Points<'_> {
-    fn count(&self) -> usize {
-        self.points.len()
-    }
-
-    fn visit(
-        &self,
-        k: usize,
-        f: &mut dyn FnMut(View<'_>) -> Result<(), CompileError>,
-    ) -> Result<(), CompileError> {
-        let v =
-            self.views.get(self.points[k]).map_err(|e| CompileError::Source(format!("{e:#}")))?;
-        f(View { a: v.a(0), b: &radiance(&v) })
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::pipeline::model::PointView;
     use pis_compile::{RenderMatrix, TextureLayout};
 
     /// Views of `rows` covered pixels per point (0: the object covers none there).

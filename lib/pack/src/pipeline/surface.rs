@@ -9,14 +9,10 @@
 //! of a layer gets the branch cuts, affine map and used size that suit the views of its
 //! samples, so every point has one render matrix per placement its layers read.
 
-use std::borrow::Cow;
 use std::collections::BTreeMap;
 
 use anyhow::{anyhow, Result};
-use pis_compile::{
-    CompileError, DrawMesh, RenderMatrix, SolveSettings, TextureLayout, TexturedObject, View,
-    ViewSource, Viewport,
-};
+use pis_compile::{DrawMesh, RenderMatrix, SolveSettings, TextureLayout, TexturedObject, Viewport};
 use pis_format::blocks::BlockGrid;
 use pis_format::DepMask;
 use pis_scene::ObjectRole;
@@ -28,6 +24,7 @@ use super::matrices::Matrices;
 use super::mesh::{atlas, occluding_indices, place_in, sampler, Atlas, Mesh, Placed};
 use super::model::{key, InferredLayer, LayerForm, ObjectModel, PointView, Views};
 use super::opacity::{premultiply, with_alpha};
+use super::radiance::{Radiance, SampleViews};
 use super::represent::{Job, Planned, Representation, Surveyed};
 use super::rows::{gather, restrict_rows};
 use super::textures::Textures;
@@ -169,32 +166,6 @@ fn is_black(
         }
     }
     Ok(true)
-}
-
-/// The traced radiance a layer is solved for.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
-enum Radiance {
-    /// The diffuse layer: view-independent, its views stacked (eq. 3.7).
-    Diffuse,
-    Specular,
-    /// Diffuse + specular (`--layers combined`).
-    Sum,
-    /// A translucent object's opacity (in every channel), solved with its first layer.
-    Alpha,
-}
-
-impl Radiance {
-    /// b at the covered pixels of `v`.
-    fn at(self, v: &PointView) -> Cow<'_, [f32]> {
-        match self {
-            Radiance::Diffuse => Cow::Borrowed(&v.diffuse),
-            Radiance::Specular => Cow::Borrowed(&v.specular),
-            Radiance::Sum => {
-                Cow::Owned(v.diffuse.iter().zip(&v.specular).map(|(d, s)| d + s).collect())
-            }
-            Radiance::Alpha => Cow::Borrowed(&v.alpha),
-        }
-    }
 }
 
 /// What one object's layers are before solving: mask, the block each point's sample is in,
@@ -365,33 +336,6 @@ impl Sample<'_> {
         }
         let s = solver.solve(a, &radiance.at(&v), start, settings)?;
         Ok((s.texels, s.iterations as u64))
-    }
-}
-
-/// The views of a view-independent sample: its points' render matrices for one placement
-/// and their radiance, each read (from the scratch file when the pack streams) as the solve
-/// asks for it.
-struct SampleViews<'a> {
-    views: &'a Views,
-    points: &'a [usize],
-    placement: usize,
-    radiance: Radiance,
-}
-
-impl ViewSource for SampleViews<'_> {
-    fn count(&self) -> usize {
-        self.points.len()
-    }
-
-    fn visit(
-        &self,
-        k: usize,
-        f: &mut dyn FnMut(View<'_>) -> Result<(), CompileError>,
-    ) -> Result<(), CompileError> {
-        let v =
-            self.views.get(self.points[k]).map_err(|e| CompileError::Source(format!("{e:#}")))?;
-        let b = self.radiance.at(&v);
-        f(View { a: v.a(self.placement), b: &b })
     }
 }
 
