@@ -103,3 +103,52 @@ fn glass_shelf_plays_at_25_db() {
 fn still_life_plays_at_25_db() {
     check("still-life");
 }
+
+/// `--texels-per-pixel auto` (the default) raises the texel density of an object whose
+/// held-out views gain from it, and of no other: pbr-props' sign (lettering on a small board)
+/// is stored at more than one texel per pixel and plays nearer the gold standard, losslessly,
+/// than at one; every object whose density stays at one plays as it does at one.
+#[test]
+fn a_signs_texel_density_is_raised_by_its_held_out_views() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let toml = scene("pbr-props");
+    let at = |f: &str| dir.path().join(f);
+    let (set, gold) = (at("set"), at("gold"));
+    let raw = [os("--denoise"), os("off")];
+    let trace = env!("CARGO_BIN_EXE_pis-trace");
+    run(trace, &[&[os(&toml), os("-o"), os(&set)], &raw[..]].concat());
+    let golden = [os(&toml), os("--spp"), os("64"), os("-o"), os(&gold)];
+    run(trace, &[&golden[..], &raw[..]].concat());
+    let pack = |file: &str, budget: &str| -> (serde_json::Value, serde_json::Value) {
+        let path = at(file);
+        let args = [os(&set), os("--scene"), os(&toml), os("--codec"), os("lossless")];
+        let more = [os("--texels-per-pixel"), os(budget), os("-o"), os(&path), os("--json")];
+        let out = run(env!("CARGO_BIN_EXE_pis-pack"), &[&args[..], &more[..]].concat());
+        let diff = run(env!("CARGO_BIN_EXE_pis-diff"), &[os(&path), os(&gold), os("--json")]);
+        (
+            serde_json::from_slice(&out.stdout).expect("JSON"),
+            serde_json::from_slice(&diff.stdout).expect("JSON"),
+        )
+    };
+    let (auto, auto_diff) = pack("auto.pis", "auto");
+    let (one, one_diff) = pack("one.pis", "1");
+    let figure = |diff: &serde_json::Value, name: &str| {
+        let objects = diff["objects"].as_array().expect("objects");
+        let o = objects.iter().find(|o| o["name"] == name).expect("the object's figure");
+        o["psnr_db"].as_f64().expect("psnr_db")
+    };
+    for o in auto["objects"].as_array().expect("objects") {
+        let name = o["name"].as_str().expect("name");
+        let k = o["texels_per_pixel"].as_f64().expect("texels_per_pixel");
+        let (with_auto, with_one) = (figure(&auto_diff, name), figure(&one_diff, name));
+        println!("{name}: {k} texels per pixel, {with_auto:.2} dB (at one: {with_one:.2} dB)");
+        if name == "Sign" {
+            assert!(k > 1.0, "the sign's density stays at one: {}", o["why"]);
+            assert!(with_auto > with_one + 1.0, "{name}: {with_auto:.2} against {with_one:.2} dB");
+        } else if k == 1.0 {
+            assert!((with_auto - with_one).abs() < 0.01, "{name}: {with_auto} against {with_one}");
+        }
+    }
+    let ones = one["objects"].as_array().expect("objects");
+    assert!(ones.iter().all(|o| o["texels_per_pixel"].as_f64() == Some(1.0)), "{one}");
+}

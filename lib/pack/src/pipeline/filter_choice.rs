@@ -71,7 +71,6 @@ fn measure(
     if share < COARSE_SHARE || train.is_empty() || test.is_empty() {
         return keep(views, None);
     }
-    let psnr = |mse: f64| -10.0 * mse.max(1e-20).log10();
     let trilinear = psnr(held_out_mse(&views, &train, &test, &job.settings, &job.solver)?);
     let bilinear_views = bilinear(job)?;
     let (settings, solver) = (&job.settings, &job.solver);
@@ -88,6 +87,11 @@ fn measure(
     } else {
         keep(views, Some(format!("filter trilinear, chosen by held-out views: {measured}")))
     }
+}
+
+/// The PSNR (dB, peak 1) of a mean squared error.
+pub fn psnr(mse: f64) -> f64 {
+    -10.0 * mse.max(1e-20).log10()
 }
 
 /// The share of the render matrices' weight (every point's) on columns past `level0`, the
@@ -126,7 +130,7 @@ pub fn held_out(views: &Views) -> (Vec<usize>, Vec<usize>) {
 
 /// The mean squared error, over the covered pixels of the points `test`, of the texture
 /// solved view-independently for the object's radiance from the points `train`.
-fn held_out_mse(
+pub fn held_out_mse(
     views: &Views,
     train: &[usize],
     test: &[usize],

@@ -307,6 +307,8 @@ pub struct ObjectModel {
     pub why: String,
     /// The texture filter its surface textures are solved for and drawn with.
     pub filter: pis_compile::Filter,
+    /// The texel budget its placements were made under (`None`: no budget).
+    pub texels_per_pixel: Option<f64>,
     /// Under `--representation auto`, for an object that has an alternative: what the
     /// screen and the whole-file encodes found ([`super::screen`]).
     pub auto: Option<AutoChoice>,

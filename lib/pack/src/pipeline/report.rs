@@ -17,6 +17,9 @@ pub struct ObjectReport {
     /// The texture filter its surface textures were solved for (the file's, or its own:
     /// `--filter auto`).
     pub filter: String,
+    /// The texel budget its placements were made under (level-0 texels per pixel of its most
+    /// covered view: `--texels-per-pixel`, or its own under `auto`; `None`: no budget).
+    pub texels_per_pixel: Option<f64>,
     /// The layers stored: `diffuse`, `specular` or `diffuse+specular`.
     pub representation: String,
     /// Why this representation was chosen.
@@ -76,6 +79,9 @@ pub struct PackReport {
     pub codec: String,
     /// The player's texture filter the textures were solved for (`nearest`, `bilinear`,
     /// `trilinear`, `anisotropic`).
+    /// The texel budget of `--texels-per-pixel` (`None`: none); an object's own is in its
+    /// report.
+    pub texels_per_pixel: Option<f64>,
     pub filter: String,
     /// The anisotropy clamp of `anisotropic` filtering.
     pub anisotropy: Option<u8>,
@@ -218,6 +224,7 @@ pub fn build(
             ObjectReport {
                 name: m.name.clone(),
                 filter: m.filter.name().to_string(),
+                texels_per_pixel: m.texels_per_pixel,
                 representation: m.representation.clone(),
                 why: m.why.clone(),
                 auto: m.auto.clone(),
@@ -256,6 +263,7 @@ pub fn build(
         source: set.dir.display().to_string(),
         codec: req.codec.name().to_string(),
         filter: req.filter.name().to_string(),
+        texels_per_pixel: req.texels_per_pixel,
         anisotropy: match req.filter {
             pis_compile::Filter::Anisotropic(n) => Some(n),
             _ => None,
@@ -342,6 +350,9 @@ pub fn print_report(r: &PackReport, out: &mut impl std::io::Write) -> std::io::R
         r.filter,
         if r.matrix == "probe" { "GPU (probe mode)" } else { "hardware model" }
     )?;
+    if let Some(line) = denser_line(r) {
+        writeln!(out, "{line}")?;
+    }
     writeln!(out, "  {} bytes (level images {}), raw {} bytes: ratio {:.1} (level images alone {:.1}, the ratio --ratio aims at)",
              r.bytes, r.texture_bytes, r.raw_image_bytes, r.ratio, r.ratio_without_geometry)?;
     if let Some(e) = r.master_exact {
@@ -417,4 +428,19 @@ pub fn print_report(r: &PackReport, out: &mut impl std::io::Write) -> std::io::R
         writeln!(out, "  peak memory after each stage (MiB): {}", peaks.join(", "))?;
     }
     Ok(())
+}
+
+/// The report's line naming the objects whose texel budget was raised (`--texels-per-pixel
+/// auto`), where there are any.
+fn denser_line(r: &PackReport) -> Option<String> {
+    let raised: Vec<String> = r
+        .objects
+        .iter()
+        .filter(|o| o.texels_per_pixel != r.texels_per_pixel)
+        .filter_map(|o| Some(format!("{} for {}", o.texels_per_pixel?, o.name)))
+        .collect();
+    let k = r.texels_per_pixel?;
+    (!raised.is_empty()).then(|| {
+        format!("  texels per pixel {k} ({}, chosen by held-out views)", raised.join(", "))
+    })
 }

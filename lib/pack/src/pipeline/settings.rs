@@ -163,6 +163,10 @@ pub struct PackSettings {
     /// by the views of the set the object's textures were not solved from
     /// ([`super::filter_choice`]); the file records an object's own filter (SPEC.md 6.6).
     pub filter_choice: bool,
+    /// With a texel budget, raise it per object where the views of the set the object's
+    /// textures were not solved from say more texels predict them better
+    /// ([`super::density_choice`]).
+    pub density_choice: bool,
     /// Where the render matrices come from: the hardware model (default) or probe mode,
     /// measured through the player's pipeline on a GPU adapter (thesis 3.4.3).
     pub matrix: MatrixSource,
@@ -237,6 +241,7 @@ impl PackSettings {
             block: BlockSize::Uniform(DEFAULT_BLOCK),
             filter: Filter::Trilinear,
             filter_choice: true,
+            density_choice: true,
             matrix: MatrixSource::Model,
             max_texture: DEFAULT_MAX_TEXTURE,
             texels_per_pixel: DEFAULT_TEXELS_PER_PIXEL,
@@ -271,6 +276,7 @@ impl PackSettings {
     pub const fn thesis() -> Self {
         let mut s = Self::new();
         s.filter_choice = false;
+        s.density_choice = false;
         s.placement = PlacementMode::Object;
         s.allocation = Allocation::Texture;
         s

@@ -19,6 +19,7 @@ use pis_scene::ObjectRole;
 use pis_trace::layers::LayerKind as TraceLayer;
 use pis_trace::PointImages;
 
+use super::density_choice;
 use super::input::LoadedSet;
 use super::matrices::Matrices;
 use super::mesh::{atlas, occluding_indices, place_in, sampler, Atlas, Mesh, Placed};
@@ -193,7 +194,7 @@ fn plan_layer(
     mesh: &Mesh,
     at: &Atlas,
     placements: &mut Vec<Placed>,
-    req: &PackRequest,
+    (req, texels_per_pixel): (&PackRequest, Option<f64>),
 ) -> Result<LayerPlan> {
     let blocks = grid.block_count() as usize;
     let point_block: Vec<usize> = set.samples.iter().map(|s| grid.locate(s).block).collect();
@@ -218,7 +219,7 @@ fn plan_layer(
                 at,
                 req.max_texture,
                 1.0,
-                req.texels_per_pixel,
+                texels_per_pixel,
             )?;
             *slot = match placements.iter().position(|q| q.same(&pl)) {
                 Some(i) => i,
@@ -502,7 +503,26 @@ pub fn survey_surface(
             let bilinear = pis_compile::Filter::Bilinear;
             views_of(set, o, &at.uvs, &whole, &j.meshes, bilinear, j.matrices)
         })?;
-        let views = chosen.views;
+        let filter = chosen.filter;
+        let dense =
+            density_choice::choose(job, with_specular, name, (whole, chosen.views), |j, k| {
+                let frames: Vec<&pis_scene::Frame> = set.frames.iter().collect();
+                let (max, meshes) = (req.max_texture, &j.meshes);
+                let placed = place_in(
+                    scene,
+                    &frames,
+                    set.resolution,
+                    o,
+                    &meshes[o],
+                    &at,
+                    max,
+                    1.0,
+                    Some(k),
+                )?;
+                let views = views_of(set, o, &at.uvs, &placed, meshes, filter, j.matrices)?;
+                Ok((placed, views))
+            })?;
+        let (whole, views) = (dense.whole, dense.views);
         // A translucent object's first layer carries its opacity: kept wherever the object
         // hides some of what lies behind it, even in black.
         let hides = |v: &PointView| v.alpha.iter().any(|&a| a > DISPLAY_STEP);
@@ -519,6 +539,7 @@ pub fn survey_surface(
             views,
             whole,
             filter: (chosen.filter, chosen.why),
+            density: (dense.texels_per_pixel, dense.why),
             diffuse_black,
             specular_black,
             diffuse_only: !with_specular,
@@ -535,6 +556,8 @@ struct Covered {
     whole: Placed,
     /// The filter its textures are solved for, and why where it was chosen.
     filter: (pis_compile::Filter, Option<String>),
+    /// The texel budget its placements are made under, and why where it was chosen.
+    density: (Option<f64>, Option<String>),
     diffuse_black: bool,
     specular_black: bool,
     /// The diffuse layer is the object's only surface layer (whatever `--layers` says).
@@ -575,7 +598,7 @@ impl Surveyed for Covered {
                 &job.meshes[c.o],
                 &c.atlas,
                 &mut placements,
-                req,
+                (req, c.density.0),
             )?);
         }
         if let Some(first) = plans.first_mut() {
@@ -625,8 +648,18 @@ impl Surveyed for Covered {
                 Ok(())
             })?;
         }
-        let (o, atlas, filter) = (c.o, c.atlas, c.filter);
-        Ok(Box::new(Layers { o, atlas, placements, stagger: st, views, plans, filter }))
+        let (o, atlas, filter, texels_per_pixel) = (c.o, c.atlas, c.filter.0, c.density.0);
+        let chosen = [c.filter.1, c.density.1].into_iter().flatten().collect();
+        Ok(Box::new(Layers {
+            o,
+            atlas,
+            placements,
+            stagger: st,
+            views,
+            plans,
+            filter: (filter, texels_per_pixel),
+            chosen,
+        }))
     }
 }
 
@@ -639,12 +672,15 @@ struct Layers {
     stagger: Vec<u32>,
     views: Views,
     plans: Vec<LayerPlan>,
-    filter: (pis_compile::Filter, Option<String>),
+    /// The filter its textures are solved for, and the texel budget of its placements.
+    filter: (pis_compile::Filter, Option<f64>),
+    /// What the choices of its filter and texel density measured, where they were made.
+    chosen: Vec<String>,
 }
 
 impl Planned for Layers {
     fn solve(self: Box<Self>, job: &Job<'_>) -> Result<ObjectModel> {
-        let Layers { o, atlas: at, placements, stagger: st, views, plans, filter } = *self;
+        let Layers { o, atlas: at, placements, stagger: st, views, plans, filter, chosen } = *self;
         let (set, scene) = (job.set, &job.set.scene);
         let name = scene.objects[o].name.clone();
         let covered: usize = (0..views.len()).map(|p| views.rows(p)).sum();
@@ -678,12 +714,14 @@ impl Planned for Layers {
             } else {
                 representation.to_string()
             },
-            why: [Some(why.to_string()), translucent.then(|| TRANSLUCENT.to_string()), filter.1]
+            why: [Some(why.to_string()), translucent.then(|| TRANSLUCENT.to_string())]
                 .into_iter()
                 .flatten()
+                .chain(chosen)
                 .collect::<Vec<_>>()
                 .join("; "),
             filter: filter.0,
+            texels_per_pixel: filter.1,
             auto: None,
         })
     }
