@@ -8,12 +8,14 @@
 //! the budget reduced has its density raised [`STEP`] times at a time, up to [`MOST`] times
 //! the budget, while its radiance solved from the set's points less the held-out ones (those
 //! of [`super::filter_choice::held_out`]) predicts the held-out points at least
-//! [`HELD_OUT_MARGIN_DB`] better. An object the budget left alone, or whose held-out views
-//! gain less, keeps the budget and the same texture.
+//! [`HELD_OUT_MARGIN_DB`] better, by a fall of their pixels' squared errors of at least
+//! [`SIGNIFICANCE`] standard errors (a set of four views holds one view out, where a few
+//! pixels or the set's noise may carry a gain). An object the budget left alone, or whose
+//! held-out views gain less, keeps the budget and the same texture.
 
 use anyhow::Result;
 
-use super::filter_choice::{held_out, held_out_mse, psnr};
+use super::filter_choice::{held_out, held_out_errors, mean, psnr};
 use super::mesh::Placed;
 use super::model::Views;
 use super::represent::Job;
@@ -24,6 +26,10 @@ pub const HELD_OUT_MARGIN_DB: f64 = 0.5;
 pub const STEP: f64 = 2.0;
 /// The most the density is raised by, as a factor on the budget.
 pub const MOST: f64 = 4.0;
+/// The least a step's held-out pixels' squared errors must fall by, in standard errors of
+/// their pixel-by-pixel differences: a step kept by a few pixels, or by the set's noise at
+/// one held-out view, is not kept.
+pub const SIGNIFICANCE: f64 = 3.0;
 
 /// An object's texel budget, its placement over every view and the views it sees.
 pub struct Dense {
@@ -34,21 +40,24 @@ pub struct Dense {
     pub why: Option<String>,
 }
 
-/// One density tried: its budget, texture size and held-out figure (dB).
+/// One density tried: its budget, texture size, held-out figure (dB) and, past the first,
+/// how many standard errors its held-out pixels' squared errors lie below the last's.
 struct Tried {
     k: f64,
     size: (u32, u32),
     db: f64,
+    z: Option<f64>,
 }
 
 /// The texel density of object `name`, placed as `whole` under the request's budget with the
-/// views `views`, where it is `chosen` here; `place` places the object under a budget and
+/// views `views` (whose held-out squared errors are `measured` where the filter's choice
+/// measured them), where it is `chosen` here; `place` places the object under a budget and
 /// measures its views. The choice is noted.
 pub fn choose(
     job: &mut Job<'_>,
     chosen: bool,
     name: &str,
-    (whole, views): (Placed, Views),
+    (whole, views, measured): (Placed, Views, Option<Vec<f64>>),
     mut place: impl FnMut(&mut Job<'_>, f64) -> Result<(Placed, Views)>,
 ) -> Result<Dense> {
     let budget = job.req.texels_per_pixel;
@@ -60,25 +69,32 @@ pub fn choose(
     if whole.reduction >= 1.0 || train.is_empty() || test.is_empty() {
         return keep(whole, views);
     }
-    let held_out_db = |job: &Job<'_>, views: &Views| -> Result<f64> {
-        Ok(psnr(held_out_mse(views, &train, &test, &job.settings, &job.solver)?))
+    let errors = |job: &Job<'_>, views: &Views| {
+        held_out_errors(views, &train, &test, &job.settings, &job.solver)
     };
     let size = |p: &Placed| (p.layout.width, p.layout.height);
-    let first = Tried { k, size: size(&whole), db: held_out_db(job, &views)? };
+    // A solve made twice is read once from a merge's fragments: the filter's figure is reused.
+    let mut last = match measured {
+        Some(e) => e,
+        None => errors(job, &views)?,
+    };
+    let first = Tried { k, size: size(&whole), db: psnr(mean(&last)), z: None };
     let mut best = (first.k, whole, views);
     let mut tried = vec![first];
     while best.0 * STEP <= k * MOST {
-        let last = tried.last().expect("the budget's figure");
         let (placed, denser) = place(job, best.0 * STEP)?;
-        if size(&placed) == last.size {
+        if size(&placed) == tried.last().expect("the budget's figure").size {
             break;
         }
-        let t = Tried { k: best.0 * STEP, size: size(&placed), db: held_out_db(job, &denser)? };
-        let gain = t.db - last.db;
+        let e = errors(job, &denser)?;
+        let z = standard_errors_below(&last, &e);
+        let t = Tried { k: best.0 * STEP, size: size(&placed), db: psnr(mean(&e)), z };
+        let gain = t.db - tried.last().expect("the budget's figure").db;
         tried.push(t);
-        if gain < HELD_OUT_MARGIN_DB {
+        if gain < HELD_OUT_MARGIN_DB || z.is_none_or(|z| z < SIGNIFICANCE) {
             break;
         }
+        last = e;
         best = (best.0 * STEP, placed, denser);
         if best.1.reduction >= 1.0 {
             break;
@@ -89,11 +105,28 @@ pub fn choose(
     Ok(Dense { texels_per_pixel: Some(best.0), whole: best.1, views: best.2, why: Some(why) })
 }
 
+/// How many standard errors of the pixel-by-pixel differences the squared errors `after`
+/// lie below `before` (the same pixels); `None` where they are not the same pixels or do
+/// not differ.
+fn standard_errors_below(before: &[f64], after: &[f64]) -> Option<f64> {
+    let n = before.len();
+    if n != after.len() || n < 2 {
+        return None;
+    }
+    let d: Vec<f64> = before.iter().zip(after).map(|(b, a)| b - a).collect();
+    let m = mean(&d);
+    let var = d.iter().map(|x| (x - m).powi(2)).sum::<f64>() / (n - 1) as f64;
+    (var > 0.0).then(|| m / (var / n as f64).sqrt())
+}
+
 /// The report's words for the density `k` chosen among `tried`.
 fn describe(k: f64, tried: &[Tried], test: usize, train: usize) -> String {
     let figures: Vec<String> = tried
         .iter()
-        .map(|t| format!("{:.2} dB at {} ({} × {} texels)", t.db, t.k, t.size.0, t.size.1))
+        .map(|t| {
+            let z = t.z.map(|z| format!(", {z:.1} standard errors below")).unwrap_or_default();
+            format!("{:.2} dB at {} ({} × {} texels{z})", t.db, t.k, t.size.0, t.size.1)
+        })
         .collect();
     let texels = if k == 1.0 { "texel" } else { "texels" };
     format!(
@@ -109,17 +142,36 @@ mod tests {
     #[test]
     fn the_words_give_every_density_tried() {
         let tried = [
-            Tried { k: 1.0, size: (10, 8), db: 30.0 },
-            Tried { k: 2.0, size: (14, 11), db: 31.25 },
-            Tried { k: 4.0, size: (20, 16), db: 31.5 },
+            Tried { k: 1.0, size: (10, 8), db: 30.0, z: None },
+            Tried { k: 2.0, size: (14, 11), db: 31.25, z: Some(4.25) },
+            Tried { k: 4.0, size: (20, 16), db: 31.5, z: Some(1.0) },
         ];
         assert_eq!(
             describe(1.0, &tried[..2], 2, 3),
-            "1 texel per pixel, chosen by held-out views: 2 of the views between the 3 it was solved from, 30.00 dB at 1 (10 × 8 texels), 31.25 dB at 2 (14 × 11 texels)"
+            "1 texel per pixel, chosen by held-out views: 2 of the views between the 3 it was solved from, 30.00 dB at 1 (10 × 8 texels), 31.25 dB at 2 (14 × 11 texels, 4.2 standard errors below)"
         );
         assert_eq!(
             describe(2.0, &tried, 2, 3),
-            "2 texels per pixel, chosen by held-out views: 2 of the views between the 3 it was solved from, 30.00 dB at 1 (10 × 8 texels), 31.25 dB at 2 (14 × 11 texels), 31.50 dB at 4 (20 × 16 texels)"
+            "2 texels per pixel, chosen by held-out views: 2 of the views between the 3 it was solved from, 30.00 dB at 1 (10 × 8 texels), 31.25 dB at 2 (14 × 11 texels, 4.2 standard errors below), 31.50 dB at 4 (20 × 16 texels, 1.0 standard errors below)"
         );
+    }
+
+    #[test]
+    fn a_fall_carried_by_every_pixel_counts_and_one_carried_by_a_few_does_not() {
+        // Every pixel's error falls by about 1 (± 0.1): many standard errors.
+        let before: Vec<f64> = (0..100).map(|i| 2.0 + (i % 3) as f64 * 0.1).collect();
+        let after: Vec<f64> =
+            before.iter().enumerate().map(|(i, b)| b - 1.0 + (i % 2) as f64 * 0.1).collect();
+        assert!(standard_errors_below(&before, &after).unwrap() > 50.0);
+        // The same mean fall from two pixels of a hundred: under the threshold.
+        let mut few = before.clone();
+        few[3] -= 50.0;
+        few[7] -= 50.0;
+        let z = standard_errors_below(&before, &few).unwrap();
+        assert!((0.0..SIGNIFICANCE).contains(&z), "{z}");
+        // A rise is below zero; other pixels or no difference give none.
+        assert!(standard_errors_below(&after, &before).unwrap() < -50.0);
+        assert_eq!(standard_errors_below(&before, &before[1..]), None);
+        assert_eq!(standard_errors_below(&before, &before), None);
     }
 }

@@ -32,6 +32,9 @@ pub struct Chosen {
     pub views: Views,
     /// What the choice measured, where it was made.
     pub why: Option<String>,
+    /// Where it was measured, the squared errors of the held-out pixels with the filter
+    /// chosen ([`held_out_errors`]).
+    pub held_out: Option<Vec<f64>>,
 }
 
 /// The filter of object `name` (placement `whole`) whose views with the request's filter
@@ -47,7 +50,7 @@ pub fn choose(
 ) -> Result<Chosen> {
     let req = job.req;
     if !chosen || !req.filter_choice || req.filter != Filter::Trilinear {
-        return Ok(Chosen { filter: req.filter, views, why: None });
+        return Ok(Chosen { filter: req.filter, views, why: None, held_out: None });
     }
     let c = measure(job, whole, views, bilinear)?;
     if let Some(why) = &c.why {
@@ -64,17 +67,18 @@ fn measure(
     bilinear: impl FnOnce(&mut Job<'_>) -> Result<Views>,
 ) -> Result<Chosen> {
     let req = job.req;
-    let keep = |views, why| Ok(Chosen { filter: req.filter, views, why });
+    let keep = |views, why, held_out| Ok(Chosen { filter: req.filter, views, why, held_out });
     let level0 = whole.layout.width as usize * whole.layout.height as usize;
     let share = coarse_share(&views, level0)?;
     let (train, test) = held_out(&views);
     if share < COARSE_SHARE || train.is_empty() || test.is_empty() {
-        return keep(views, None);
+        return keep(views, None, None);
     }
-    let trilinear = psnr(held_out_mse(&views, &train, &test, &job.settings, &job.solver)?);
+    let trilinear_errors = held_out_errors(&views, &train, &test, &job.settings, &job.solver)?;
     let bilinear_views = bilinear(job)?;
     let (settings, solver) = (&job.settings, &job.solver);
-    let bilinear = psnr(held_out_mse(&bilinear_views, &train, &test, settings, solver)?);
+    let bilinear_errors = held_out_errors(&bilinear_views, &train, &test, settings, solver)?;
+    let (trilinear, bilinear) = (psnr(mean(&trilinear_errors)), psnr(mean(&bilinear_errors)));
     let measured = format!(
         "{} of the views between the {} it was solved from: {bilinear:.2} dB with bilinear lookups, {trilinear:.2} dB with trilinear ones ({:.0}% of whose weight is on coarser levels)",
         test.len(),
@@ -83,9 +87,11 @@ fn measure(
     );
     if bilinear >= trilinear + HELD_OUT_MARGIN_DB {
         let why = format!("filter bilinear, chosen by held-out views: {measured}");
-        Ok(Chosen { filter: Filter::Bilinear, views: bilinear_views, why: Some(why) })
+        let held_out = Some(bilinear_errors);
+        Ok(Chosen { filter: Filter::Bilinear, views: bilinear_views, why: Some(why), held_out })
     } else {
-        keep(views, Some(format!("filter trilinear, chosen by held-out views: {measured}")))
+        let why = format!("filter trilinear, chosen by held-out views: {measured}");
+        keep(views, Some(why), Some(trilinear_errors))
     }
 }
 
@@ -128,31 +134,42 @@ pub fn held_out(views: &Views) -> (Vec<usize>, Vec<usize>) {
     (train, test)
 }
 
-/// The mean squared error, over the covered pixels of the points `test`, of the texture
-/// solved view-independently for the object's radiance from the points `train`.
-pub fn held_out_mse(
+/// The squared error of each covered pixel of the points `test` (in order, its channels'
+/// mean) of the texture solved view-independently for the object's radiance from the points
+/// `train`.
+pub fn held_out_errors(
     views: &Views,
     train: &[usize],
     test: &[usize],
     settings: &SolveSettings,
     solver: &Solver,
-) -> Result<f64> {
+) -> Result<Vec<f64>> {
     let source = SampleViews { views, points: train, placement: 0, radiance: Radiance::Sum };
     let x = solver.solve_view_source(&source, None, settings)?.texels;
-    let (mut sum, mut n) = (0.0f64, 0usize);
+    let mut errors = Vec::new();
     for &p in test {
         let v = views.get(p)?;
         let (a, b) = (v.a(0), Radiance::Sum.at(&v));
         for r in 0..a.rows() {
             let (cols, vals) = a.row(r);
+            let mut e = 0.0f64;
             for k in 0..3 {
                 let y: f32 = cols.iter().zip(vals).map(|(&c, &w)| w * x[c as usize * 3 + k]).sum();
-                sum += f64::from(y - b[r * 3 + k]).powi(2);
+                e += f64::from(y - b[r * 3 + k]).powi(2);
             }
+            errors.push(e / 3.0);
         }
-        n += a.rows() * 3;
     }
-    Ok(if n > 0 { sum / n as f64 } else { 0.0 })
+    Ok(errors)
+}
+
+/// The mean of `v` (0 when empty).
+pub fn mean(v: &[f64]) -> f64 {
+    if v.is_empty() {
+        0.0
+    } else {
+        v.iter().sum::<f64>() / v.len() as f64
+    }
 }
 
 #[cfg(test)]

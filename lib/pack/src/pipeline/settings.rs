@@ -232,7 +232,8 @@ impl PackSettings {
     /// textures as solved, each reflective or refractive object in the representation that
     /// meets it with the fewest bytes, with the wavelet codec, 8-sample blocks, trilinear
     /// filtering through the hardware model (bilinear for an object whose held-out views it
-    /// predicts better), one level-0 texel per covered pixel, screen-error
+    /// predicts better), one level-0 texel per covered pixel (two or four for an object whose
+    /// held-out views they predict better), screen-error
     /// allocation, texture placements per block.
     pub const fn new() -> Self {
         PackSettings {
@@ -272,7 +273,7 @@ impl PackSettings {
 
     /// The thesis's own choices where they differ from the defaults: one texture placement
     /// per object over every view, texture error weighted by screen area, trilinear lookups
-    /// for every object.
+    /// and the one texel budget for every object.
     pub const fn thesis() -> Self {
         let mut s = Self::new();
         s.filter_choice = false;

@@ -504,24 +504,15 @@ pub fn survey_surface(
             views_of(set, o, &at.uvs, &whole, &j.meshes, bilinear, j.matrices)
         })?;
         let filter = chosen.filter;
-        let dense =
-            density_choice::choose(job, with_specular, name, (whole, chosen.views), |j, k| {
-                let frames: Vec<&pis_scene::Frame> = set.frames.iter().collect();
-                let (max, meshes) = (req.max_texture, &j.meshes);
-                let placed = place_in(
-                    scene,
-                    &frames,
-                    set.resolution,
-                    o,
-                    &meshes[o],
-                    &at,
-                    max,
-                    1.0,
-                    Some(k),
-                )?;
-                let views = views_of(set, o, &at.uvs, &placed, meshes, filter, j.matrices)?;
-                Ok((placed, views))
-            })?;
+        let base = (whole, chosen.views, chosen.held_out);
+        let dense = density_choice::choose(job, with_specular, name, base, |j, k| {
+            let frames: Vec<&pis_scene::Frame> = set.frames.iter().collect();
+            let (max, meshes) = (req.max_texture, &j.meshes);
+            let placed =
+                place_in(scene, &frames, set.resolution, o, &meshes[o], &at, max, 1.0, Some(k))?;
+            let views = views_of(set, o, &at.uvs, &placed, meshes, filter, j.matrices)?;
+            Ok((placed, views))
+        })?;
         let (whole, views) = (dense.whole, dense.views);
         // A translucent object's first layer carries its opacity: kept wherever the object
         // hides some of what lies behind it, even in black.
