@@ -64,8 +64,9 @@ pub struct PackOptions {
     /// view; an object's texture over budget is reduced uniformly (thesis 3.2's per-object
     /// reduction factor, chosen automatically). `auto`: 1, raised to 2 or 4 for an object
     /// whose views between those its textures are solved from it predicts at least 0.5 dB
-    /// and 3 standard errors better each step (fine shading detail on a dense mesh). K: that budget for every
-    /// object. `none`: the optimal resolution, capped by --max-texture only.
+    /// and 3 standard errors better each step (fine shading detail on a dense mesh). K:
+    /// that budget for every object. `none`: the optimal resolution, capped by
+    /// --max-texture only.
     #[arg(long, value_name = "auto|K|none", default_value = "auto", value_parser = parse_budget)]
     pub texels_per_pixel: Budget,
     /// Display gamma of the compensation (1: linear storage; lossless and raw packs always use 1).

@@ -83,13 +83,14 @@ pub fn choose(
     let mut tried = vec![first];
     while best.0 * STEP <= k * MOST {
         let (placed, denser) = place(job, best.0 * STEP)?;
-        if size(&placed) == tried.last().expect("the budget's figure").size {
+        let prev = tried.last().expect("the budget's figure");
+        if size(&placed) == prev.size {
             break;
         }
         let e = errors(job, &denser)?;
         let z = standard_errors_below(&last, &e);
         let t = Tried { k: best.0 * STEP, size: size(&placed), db: psnr(mean(&e)), z };
-        let gain = t.db - tried.last().expect("the budget's figure").db;
+        let gain = t.db - prev.db;
         tried.push(t);
         if gain < HELD_OUT_MARGIN_DB || z.is_none_or(|z| z < SIGNIFICANCE) {
             break;
