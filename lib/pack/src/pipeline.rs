@@ -30,6 +30,7 @@ pub mod choice;
 pub mod density_choice;
 pub mod encode;
 pub mod filter_choice;
+pub mod held_out;
 pub mod hybrid;
 pub mod infer_layers;
 pub mod input;

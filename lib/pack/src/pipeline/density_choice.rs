@@ -7,7 +7,7 @@
 //! what more texels would fit is the set's noise, they predict them worse. So an object that
 //! the budget reduced has its density raised [`STEP`] times at a time, up to [`MOST`] times
 //! the budget, while its radiance solved from the set's points less the held-out ones (those
-//! of [`super::filter_choice::held_out`]) predicts the held-out points at least
+//! of [`Split`], within each sample of the non-view dimensions) predicts the held-out points at least
 //! [`HELD_OUT_MARGIN_DB`] better, by a fall of their pixels' squared errors of at least
 //! [`SIGNIFICANCE`] standard errors (a set of four views holds one view out, where a few
 //! pixels or the set's noise may carry a gain). An object the budget left alone, or whose
@@ -15,7 +15,7 @@
 
 use anyhow::Result;
 
-use super::filter_choice::{held_out, held_out_errors, mean, psnr};
+use super::held_out::{mean, psnr, Split};
 use super::mesh::Placed;
 use super::model::Views;
 use super::represent::Job;
@@ -65,13 +65,11 @@ pub fn choose(
     let Some(k) = budget.filter(|_| chosen && job.req.density_choice) else {
         return keep(whole, views);
     };
-    let (train, test) = held_out(&views);
-    if whole.reduction >= 1.0 || train.is_empty() || test.is_empty() {
+    let split = Split::of(job, &views);
+    if whole.reduction >= 1.0 || split.is_empty() {
         return keep(whole, views);
     }
-    let errors = |job: &Job<'_>, views: &Views| {
-        held_out_errors(views, &train, &test, &job.settings, &job.solver)
-    };
+    let errors = |job: &Job<'_>, views: &Views| split.errors(views, &job.settings, &job.solver);
     let size = |p: &Placed| (p.layout.width, p.layout.height);
     // A solve made twice is read once from a merge's fragments: the filter's figure is reused.
     let mut last = match measured {
@@ -101,7 +99,8 @@ pub fn choose(
             break;
         }
     }
-    let why = describe(best.0, &tried, test.len(), train.len());
+    let (train, test) = split.counts();
+    let why = describe(best.0, &tried, test, train);
     job.note(&format!("object {name}: {why}"));
     Ok(Dense { texels_per_pixel: Some(best.0), whole: best.1, views: best.2, why: Some(why) })
 }

@@ -12,13 +12,12 @@
 //! read the same texels.
 
 use anyhow::Result;
-use pis_compile::{Filter, SolveSettings};
+use pis_compile::Filter;
 
+use super::held_out::{mean, psnr, Split};
 use super::mesh::Placed;
 use super::model::Views;
-use super::radiance::{Radiance, SampleViews};
 use super::represent::Job;
-use crate::solutions::Solver;
 
 /// The least gain (dB) over the held-out views that makes bilinear lookups an object's filter.
 pub const HELD_OUT_MARGIN_DB: f64 = 0.5;
@@ -33,7 +32,7 @@ pub struct Chosen {
     /// What the choice measured, where it was made.
     pub why: Option<String>,
     /// Where it was measured, the squared errors of the held-out pixels with the filter
-    /// chosen ([`held_out_errors`]).
+    /// chosen ([`Split::errors`]).
     pub held_out: Option<Vec<f64>>,
 }
 
@@ -70,19 +69,19 @@ fn measure(
     let keep = |views, why, held_out| Ok(Chosen { filter: req.filter, views, why, held_out });
     let level0 = whole.layout.width as usize * whole.layout.height as usize;
     let share = coarse_share(&views, level0)?;
-    let (train, test) = held_out(&views);
-    if share < COARSE_SHARE || train.is_empty() || test.is_empty() {
+    let split = Split::of(job, &views);
+    if share < COARSE_SHARE || split.is_empty() {
         return keep(views, None, None);
     }
-    let trilinear_errors = held_out_errors(&views, &train, &test, &job.settings, &job.solver)?;
+    let trilinear_errors = split.errors(&views, &job.settings, &job.solver)?;
     let bilinear_views = bilinear(job)?;
-    let (settings, solver) = (&job.settings, &job.solver);
-    let bilinear_errors = held_out_errors(&bilinear_views, &train, &test, settings, solver)?;
+    let bilinear_errors = split.errors(&bilinear_views, &job.settings, &job.solver)?;
+    let (train, test) = split.counts();
     let (trilinear, bilinear) = (psnr(mean(&trilinear_errors)), psnr(mean(&bilinear_errors)));
     let measured = format!(
         "{} of the views between the {} it was solved from: {bilinear:.2} dB with bilinear lookups, {trilinear:.2} dB with trilinear ones ({:.0}% of whose weight is on coarser levels)",
-        test.len(),
-        train.len(),
+        test,
+        train,
         share * 100.0
     );
     if bilinear >= trilinear + HELD_OUT_MARGIN_DB {
@@ -93,11 +92,6 @@ fn measure(
         let why = format!("filter trilinear, chosen by held-out views: {measured}");
         keep(views, Some(why), Some(trilinear_errors))
     }
-}
-
-/// The PSNR (dB, peak 1) of a mean squared error.
-pub fn psnr(mse: f64) -> f64 {
-    -10.0 * mse.max(1e-20).log10()
 }
 
 /// The share of the render matrices' weight (every point's) on columns past `level0`, the
@@ -117,99 +111,10 @@ pub fn coarse_share(views: &Views, level0: usize) -> Result<f64> {
     Ok(if all > 0.0 { coarse / all } else { 0.0 })
 }
 
-/// The points the held-out textures are solved from, and those they are measured at: of the
-/// points where the object covers a pixel, every second one strictly between the first and
-/// the last is held out.
-pub fn held_out(views: &Views) -> (Vec<usize>, Vec<usize>) {
-    let covered: Vec<usize> = (0..views.len()).filter(|&p| views.rows(p) > 0).collect();
-    let n = covered.len();
-    let (mut train, mut test) = (Vec::new(), Vec::new());
-    for (i, &p) in covered.iter().enumerate() {
-        if i % 2 == 1 && i + 1 < n {
-            test.push(p);
-        } else {
-            train.push(p);
-        }
-    }
-    (train, test)
-}
-
-/// The squared error of each covered pixel of the points `test` (in order, its channels'
-/// mean) of the texture solved view-independently for the object's radiance from the points
-/// `train`.
-pub fn held_out_errors(
-    views: &Views,
-    train: &[usize],
-    test: &[usize],
-    settings: &SolveSettings,
-    solver: &Solver,
-) -> Result<Vec<f64>> {
-    let source = SampleViews { views, points: train, placement: 0, radiance: Radiance::Sum };
-    let x = solver.solve_view_source(&source, None, settings)?.texels;
-    let mut errors = Vec::new();
-    for &p in test {
-        let v = views.get(p)?;
-        let (a, b) = (v.a(0), Radiance::Sum.at(&v));
-        for r in 0..a.rows() {
-            let (cols, vals) = a.row(r);
-            let mut e = 0.0f64;
-            for k in 0..3 {
-                let y: f32 = cols.iter().zip(vals).map(|(&c, &w)| w * x[c as usize * 3 + k]).sum();
-                e += f64::from(y - b[r * 3 + k]).powi(2);
-            }
-            errors.push(e / 3.0);
-        }
-    }
-    Ok(errors)
-}
-
-/// The mean of `v` (0 when empty).
-pub fn mean(v: &[f64]) -> f64 {
-    if v.is_empty() {
-        0.0
-    } else {
-        v.iter().sum::<f64>() / v.len() as f64
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::pipeline::model::PointView;
-    use pis_compile::{RenderMatrix, TextureLayout};
-
-    /// Views of `rows` covered pixels per point (0: the object covers none there).
-    fn views(rows: &[usize]) -> Views {
-        let mut v = Views::new(None);
-        for &n in rows {
-            let layout = TextureLayout::full(4, 4);
-            let taps: Vec<pis_compile::filter::Taps> = (0..n)
-                .map(|i| {
-                    let mut t = pis_compile::filter::Taps::default();
-                    t.add((i % 16) as u32, 0.75);
-                    t.add(16 + (i % 4) as u32, 0.25);
-                    t
-                })
-                .collect();
-            let a = RenderMatrix::from_taps(
-                pis_compile::Viewport { width: 8, height: 8 },
-                layout,
-                (0..n as u32).collect(),
-                &taps,
-            );
-            let b = vec![0.5; n * 3];
-            v.push(PointView { a: vec![(0, a)], diffuse: b.clone(), specular: b, alpha: vec![] })
-                .unwrap();
-        }
-        v
-    }
-
-    #[test]
-    fn every_second_covered_point_between_the_ends_is_held_out() {
-        assert_eq!(held_out(&views(&[4, 4, 4, 4])), (vec![0, 2, 3], vec![1]));
-        assert_eq!(held_out(&views(&[4, 0, 4, 4, 4, 4])), (vec![0, 3, 5], vec![2, 4]));
-        assert_eq!(held_out(&views(&[4, 4])), (vec![0, 1], vec![]), "two points: none");
-    }
+    use crate::pipeline::held_out::tests::views;
 
     #[test]
     fn the_coarse_share_is_the_weight_past_level_0() {
