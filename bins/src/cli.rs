@@ -53,6 +53,21 @@ pub fn parse_shading_seed(s: &str) -> Result<pis_trace::ShadingSeed, String> {
         .ok_or_else(|| format!("unknown shading seed {s:?} (cell or sample)"))
 }
 
+/// `--shading-cells`: `auto` (`None`) or a count of cells across the scene's diagonal.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct ShadingCells(pub Option<u32>);
+
+/// `--shading-cells`' parser.
+pub fn parse_shading_cells(s: &str) -> Result<ShadingCells, String> {
+    match s {
+        "auto" => Ok(ShadingCells(None)),
+        _ => match s.parse::<u32>() {
+            Ok(n) if n >= 1 => Ok(ShadingCells(Some(n))),
+            _ => Err(format!("{s:?} is neither auto nor a count of cells (1 or more)")),
+        },
+    }
+}
+
 /// A clap parser for one of `all`, by the names `name` gives them: `--help` lists the names
 /// and a name not among them is refused with the list, so that the library's names are the
 /// only spelling of a mode.
@@ -68,4 +83,17 @@ where
         let found = all.iter().copied().find(|&v| name(v) == s);
         found.expect("the parser takes only the listed names")
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn shading_cells_are_auto_or_a_count() {
+        assert_eq!(parse_shading_cells("auto"), Ok(ShadingCells(None)));
+        assert_eq!(parse_shading_cells("4096"), Ok(ShadingCells(Some(4096))));
+        assert!(parse_shading_cells("0").unwrap_err().contains("\"0\""));
+        assert!(parse_shading_cells("fine").is_err());
+    }
 }

@@ -31,7 +31,7 @@ measure() { # side resolution
     scene=$(scene_copy "$n")
     set="$work/set-$n-$res"
     rm -rf "$set"
-    read -r s m < <(timed "$bin/pis-trace" "$scene" -o "$set" --resolution "$res" --spp 1)
+    read -r s m < <(timed "$bin/pis-trace" "$scene" -o "$set" --resolution "$res" --shading-cells 4096 --spp 1)
     row "pis-trace" $((n * n)) "$res" "$s" "$m"
     read -r s m < <(timed "$bin/pis-pack" "$set" -o "$work/demo1-$n-$res.pis")
     row "pis-pack" $((n * n)) "$res" "$s" "$m"
@@ -48,11 +48,11 @@ n=8 res=320x240
 scene=$(scene_copy $n)
 set="$work/shards-$n-$res"
 rm -rf "$set" "$work/solved"
-read -r s m < <(timed "$bin/pis-trace" "$scene" -o "$set" --resolution $res --spp 1 --threads 1)
+read -r s m < <(timed "$bin/pis-trace" "$scene" -o "$set" --resolution $res --shading-cells 4096 --spp 1 --threads 1)
 row "pis-trace, 1 process, 1 thread" 64 $res "$s" "$m"
 start=$(date +%s.%N)
-"$bin/pis-trace" "$scene" -o "$set" --resolution $res --spp 1 --threads 1 --shard 0/2 > /dev/null 2>> "$work/log.txt" &
-"$bin/pis-trace" "$scene" -o "$set" --resolution $res --spp 1 --threads 1 --shard 1/2 > /dev/null 2>> "$work/log.txt" &
+"$bin/pis-trace" "$scene" -o "$set" --resolution $res --shading-cells 4096 --spp 1 --threads 1 --shard 0/2 > /dev/null 2>> "$work/log.txt" &
+"$bin/pis-trace" "$scene" -o "$set" --resolution $res --shading-cells 4096 --spp 1 --threads 1 --shard 1/2 > /dev/null 2>> "$work/log.txt" &
 wait
 row "pis-trace --shard I/2, 2 processes of 1 thread" 64 $res "$(awk -v a="$start" -v b="$(date +%s.%N)" 'BEGIN { printf "%.2f", b - a }')" "-"
 read -r s m < <(RAYON_NUM_THREADS=1 timed "$bin/pis-pack" "$set" -o "$work/one.pis")

@@ -6,7 +6,7 @@
 use anyhow::Context;
 use clap::Parser;
 use indicatif::{ProgressBar, ProgressStyle};
-use pis::cli::parse_shading_seed;
+use pis::cli::{parse_shading_cells, parse_shading_seed};
 use pis_scene::lens_tree::LensModel;
 use pis_scene::LoadOptions;
 use pis_trace::set::{merge_set, MergeReport, Shard};
@@ -87,6 +87,12 @@ struct Cli {
     /// standard to measure files against, not for a set to pack.
     #[arg(long, value_name = "cell|sample", default_value = "cell", value_parser = parse_shading_seed)]
     shading_seed: pis_trace::ShadingSeed,
+    /// With --shading-seed cell: the surface cells across the scene's bounding-box diagonal.
+    /// `auto` (default): 4096 for images up to 160 pixels on their longer side, more in
+    /// proportion beyond (16384 at 640×480), so that a pixel spans about as many cells, and its
+    /// noise stays as much its own, at every size. Recorded in set.json where given.
+    #[arg(long, value_name = "auto|N", default_value = "auto", value_parser = parse_shading_cells)]
+    shading_cells: pis::cli::ShadingCells,
     /// Stream of the camera samples' random numbers (0 default). Two traces that differ only
     /// in --seed, with --shading-seed sample, have independent noise: their difference
     /// measures it. Recorded in set.json; the shards of one set share it.
@@ -194,6 +200,7 @@ fn run(cli: &Cli, scene: &Path, output: &Path) -> anyhow::Result<SetReport> {
     let settings = cli.denoise.apply(
         TraceSettings::new(scene.resolution, scene.spp)
             .with_shading_seed(cli.shading_seed)
+            .with_shading_cells(cli.shading_cells.0)
             .with_seed(cli.seed)
             .with_adaptive(cli.noise_threshold, cli.min_spp)
             .with_lens_model(cli.lens_model()),

@@ -24,6 +24,11 @@ pub struct TraceSettings {
     /// shading; `None` picks 1/4096 of the scene's bounding-box diagonal; `Some(0.0)` seeds
     /// per pixel sample instead (no coherence across the parameter space).
     pub coherence_cell: Option<f32>,
+    /// Surface cells across the scene's bounding-box diagonal, where `coherence_cell` is
+    /// `None` (`pis-trace --shading-cells N`); `None`: 4096 for images up to 160 pixels on
+    /// their longer side, more in proportion beyond.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub shading_cells: Option<u32>,
     /// Camera samples per pixel (the first ones) that write outgoing-ray records for
     /// refractive lens objects.
     pub records_per_pixel: u32,
@@ -153,6 +158,13 @@ impl TraceSettings {
         self
     }
 
+    /// The same settings with surface cells of 1/`cells` of the scene's diagonal (`None`: by
+    /// the image's size, [`TraceSettings::shading_cells`]).
+    pub fn with_shading_cells(mut self, cells: Option<u32>) -> TraceSettings {
+        self.shading_cells = cells;
+        self
+    }
+
     /// The same settings drawing their camera samples from stream `seed`.
     pub fn with_seed(mut self, seed: u64) -> TraceSettings {
         self.seed = seed;
@@ -188,6 +200,7 @@ impl TraceSettings {
             diffuse_bounces: 1,
             diffuse_samples: 4,
             coherence_cell: None,
+            shading_cells: None,
             records_per_pixel: 2,
             max_record_hits: 4,
             seed: 0,

@@ -37,6 +37,31 @@ pub use scatter::{NEE_ALPHA, ROULETTE_WEIGHT};
 /// Key of a surface cell: quantized object-space point, object, front or back side.
 pub type CellKey = (i64, i64, i64, u32, bool);
 
+/// Pixels on an image's longer side up to which the default surface cell is 1/4096 of the
+/// scene's diagonal.
+const CELL_PIXELS: f32 = 160.0;
+
+/// The surface cell where [`TraceSettings::coherence_cell`] is `None`: 1/N of the scene's
+/// diagonal, N [`TraceSettings::shading_cells`] or by default 4096 for images up to
+/// [`CELL_PIXELS`] on their longer side and more in proportion beyond, so that a pixel spans
+/// about as many cells at every size. A pixel's camera samples then meet about as many
+/// independent first-hit irradiance estimates at 640×480 as at 160×120, and its noise stays
+/// its own rather than a pattern shared with its neighbours, which a denoiser cannot tell
+/// from texture.
+fn default_cell(diag: f32, settings: &TraceSettings) -> f32 {
+    if diag <= 0.0 {
+        return 0.0;
+    }
+    let cells = match settings.shading_cells {
+        Some(n) => n.max(1) as f32,
+        None => {
+            let (w, h) = settings.resolution;
+            4096.0 * (w.max(h) as f32 / CELL_PIXELS).max(1.0)
+        }
+    };
+    diag / cells
+}
+
 /// Per-path bookkeeping: ray counts, the fallback seed and the first-hit irradiance cache.
 #[derive(Clone, Debug, Default)]
 pub struct PathContext {
@@ -66,14 +91,7 @@ impl<'s> Integrator<'s> {
         let geometry = SceneGeometry::build(scene, frame);
         let cell = match settings.coherence_cell {
             Some(c) => c.max(0.0),
-            None => {
-                let diag = (geometry.bounds.1 - geometry.bounds.0).length();
-                if diag > 0.0 {
-                    diag / 4096.0
-                } else {
-                    0.0
-                }
-            }
+            None => default_cell((geometry.bounds.1 - geometry.bounds.0).length(), settings),
         };
         let environment = scene.environment.as_ref().and_then(EnvironmentLight::new);
         Integrator { scene, frame, geometry, settings: settings.clone(), cell, environment }
@@ -221,5 +239,22 @@ impl<'s> Integrator<'s> {
         } else {
             Vec3::ONE
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_default_cell_keeps_a_pixels_share_of_cells_at_every_size() {
+        let cell = |w, h| default_cell(4096.0, &TraceSettings::new((w, h), 16));
+        assert_eq!(cell(160, 120), 1.0);
+        assert_eq!(cell(80, 60), 1.0, "never coarser than at 160 pixels");
+        assert_eq!(cell(640, 480), 0.25, "four times the pixels across, a quarter the cell");
+        assert_eq!(cell(480, 640), 0.25, "the longer side counts");
+        assert_eq!(default_cell(0.0, &TraceSettings::new((640, 480), 16)), 0.0);
+        let set = TraceSettings::new((640, 480), 16).with_shading_cells(Some(4096));
+        assert_eq!(default_cell(4096.0, &set), 1.0, "--shading-cells 4096");
     }
 }
