@@ -7,6 +7,8 @@
 //! them, so the split is made within each such sample, and each sample's texture is solved
 //! from its own points and drawn at its own held-out ones.
 
+use std::collections::BTreeMap;
+
 use anyhow::Result;
 use pis_compile::SolveSettings;
 
@@ -26,16 +28,13 @@ pub struct Split {
 impl Split {
     /// The split of `views`, whose point `p` belongs to the sample keyed `keys[p]`.
     pub fn new(views: &Views, keys: &[Vec<u32>]) -> Split {
-        let mut samples: Vec<(&Vec<u32>, Vec<usize>)> = Vec::new();
+        let mut covered: BTreeMap<&Vec<u32>, Vec<usize>> = BTreeMap::new();
         for p in (0..views.len()).filter(|&p| views.rows(p) > 0) {
-            match samples.iter_mut().find(|(k, _)| *k == &keys[p]) {
-                Some((_, points)) => points.push(p),
-                None => samples.push((&keys[p], vec![p])),
-            }
+            covered.entry(&keys[p]).or_default().push(p);
         }
-        let samples = samples
-            .into_iter()
-            .map(|(_, covered)| {
+        let samples = covered
+            .into_values()
+            .map(|covered| {
                 let n = covered.len();
                 let (mut train, mut test) = (Vec::new(), Vec::new());
                 for (i, &p) in covered.iter().enumerate() {
