@@ -356,6 +356,56 @@ fn sub_pixel_lookups_follow_the_traced_footprint() {
     assert_plays_as_predicted(&four, &traced_set(dir.path()));
 }
 
+/// Depth shells (SPEC.md 8.5, `--distant-shell depth`): each reflective part's distant shell
+/// follows the other objects' surfaces, its one map solved over all the views (the layer
+/// depends on no dimension: a quarter of the per-view maps' bytes); the file is of minor
+/// version 5, validates, pis-inspect names the shells, and the player — which casts the
+/// depth cubes from the file's meshes when it opens it — draws them as pis-pack predicted.
+/// `auto` reports the depth shell's error between the samples beside the shell it keeps.
+#[test]
+fn depth_shells_follow_the_scene_and_play_as_predicted() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let scene = copy_sample(dir.path());
+    let (_, fitted) = pack(&scene, "auto.pis", &["--representation", "pem"]);
+    let (depth, r) =
+        pack(&scene, "depth.pis", &["--representation", "pem", "--distant-shell", "depth"]);
+    for name in ["TeapotBody", "TeapotLid"] {
+        let (a, b) = (object(&fitted, name), object(&r, name));
+        eprintln!(
+            "{name}: {:.2} dB ({}), depth shell {:.2} dB ({})",
+            a["psnr_db"], a["why"], b["psnr_db"], b["why"]
+        );
+        let why = a["why"].as_str().expect("why");
+        assert!(
+            why.contains("depth shell's error between the samples")
+                || why.contains("distant depth"),
+            "{why}"
+        );
+        assert!(b["why"].as_str().is_some_and(|w| w.contains("distant depth")), "{}", b["why"]);
+    }
+    assert_valid(&depth);
+    let i = Command::new(env!("CARGO_BIN_EXE_pis-inspect"))
+        .arg(&depth)
+        .arg("--json")
+        .output()
+        .expect("pis-inspect runs");
+    let j: serde_json::Value = serde_json::from_slice(&i.stdout).expect("JSON");
+    assert_eq!(j["version"], "1.5", "{}", j["version"]);
+    let distant: Vec<&serde_json::Value> = j["objects"]
+        .as_array()
+        .expect("objects")
+        .iter()
+        .flat_map(|o| o["layers"].as_array().expect("layers"))
+        .filter(|l| l["kind"] == "env_distant")
+        .collect();
+    assert_eq!(distant.len(), 2, "{distant:?}");
+    for l in distant {
+        assert_eq!(l["shell"], "depth", "{l}");
+        assert_eq!(l["depends_on"], serde_json::json!([]), "{l}");
+    }
+    assert_plays_as_predicted(&depth, &traced_set(dir.path()));
+}
+
 /// `pis-bench reflective --reference-pair`: every reference traced twice from independent
 /// sample streams, the pair's difference measures its noise, which the report takes out of
 /// each figure. Taken out of a noisy pair's figure, it brings the figure nearer what a pair

@@ -11,8 +11,8 @@ use pis_trace::settings::DenoiseMode;
 
 use crate::cli::{one_of, Exit, Failure};
 use pis_pack::{
-    filter_needs_probe, Allocation, BlockSize, LayerMode, MatrixSource, MaxMse, PackRequest,
-    PackSettings, PlacementMode, PyramidMode, RepresentationMode, Stagger,
+    filter_needs_probe, Allocation, BlockSize, DistantShell, LayerMode, MatrixSource, MaxMse,
+    PackRequest, PackSettings, PlacementMode, PyramidMode, RepresentationMode, Stagger,
 };
 
 /// pis-pack's settings on the command line.
@@ -147,6 +147,14 @@ pub struct PackOptions {
     /// the player draws them so.
     #[arg(long, value_name = "1|2|3", default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=pis_format::MAX_SHELL_LOOKUPS as i64))]
     pub shell_lookups: u32,
+    /// Layered environment maps: a reflective object's distant shell. `auto`: a box on the
+    /// surface the object rests on or a sphere, whichever is nearer the traced distant layer,
+    /// then a depth shell (SPEC.md 8.5: its radius in each direction the distance to the
+    /// other objects, one map over the views) where it predicts a view held out between two
+    /// samples better; `fitted`: the box or the sphere, as `auto` before the depth shell;
+    /// `box`, `sphere` or `depth`: that shell.
+    #[arg(long, default_value = "auto", value_parser = one_of(&DistantShell::ALL, DistantShell::name))]
+    pub distant_shell: DistantShell,
     /// Also store the lossless master: every solved texture, before gamma compensation and
     /// coding, losslessly coded in MSTR chunks a player never reads. pis-reencode codes
     /// again from it (as a direct pack at the new settings would) instead of from the decoded
@@ -205,6 +213,7 @@ impl PackOptions {
             placement: self.placement,
             stagger: self.stagger,
             shell_lookups: self.shell_lookups,
+            distant_shell: self.distant_shell,
             max_iterations: self.max_iterations,
             keep_master: self.keep_master,
             preset: self.preset.clone(),

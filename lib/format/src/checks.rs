@@ -627,6 +627,13 @@ fn placement(p: &Placement, mapping: Mapping) -> Option<String> {
                     ];
                     c.iter().any(|&x| x != 0.0)
                 }
+                ShellShape::Depth => {
+                    let int_in = |v: f32, hi: f32| v.fract() == 0.0 && (1.0..=hi).contains(&v);
+                    int_in(p[0], 256.0)
+                        && int_in(p[1], 64.0)
+                        && p[2] > 0.0
+                        && p[3..].iter().all(|&v| v == 0.0)
+                }
             };
             (!ok).then(|| format!("{} parameters {params:?} with origin {origin:?}", shape.name()))
         }

@@ -409,6 +409,11 @@ coded_enum! {
         Cylinder = 4 => "cylinder",
         /// A parallelogram: origin = corner, params[0..3] = edge s, params[3..6] = edge t.
         Quad = 5 => "quad",
+        /// A star-shaped shell whose radius in every direction is the distance to the scene
+        /// about the origin (a depth cube the reader computes from the file's meshes, SPEC.md
+        /// 8.5): params[0] = face size n of the depth cube, params[1] = march steps,
+        /// params[2] = far distance.
+        Depth = 6 => "depth",
     }
 }
 

@@ -294,7 +294,7 @@ fn block(c: &mut Cursor, li: usize, bi: usize, dims: usize) -> Result<Block<Stre
         let shape = ShellShape::from_code(shape).ok_or_else(|| {
             c.issue(
                 id::layers::BLOCK_PLACEMENT,
-                format!("layer {li} block {bi} shell shape {shape}; 0 to 5 are defined"),
+                format!("layer {li} block {bi} shell shape {shape}; 0 to 6 are defined"),
             )
             .at(shape_at)
         })?;

@@ -10,7 +10,7 @@ use crate::chunk::{
     self, FourCC, ALIGN, ENTRY_LEN, HEADER_LEN, MAGIC, VERSION_MAJOR, VERSION_MINOR,
 };
 use crate::master::Master;
-use crate::model::{Codestream, Container, Mapping, StreamRef};
+use crate::model::{Codestream, Container, Mapping, Placement, ShellShape, StreamRef};
 use crate::{checks, payload_write as pw, Error};
 
 /// The bytes of a `.pis` file holding `c`. Fails if `c` breaks a rule of the spec.
@@ -221,10 +221,17 @@ fn serialize_inner(c: &Container, masters: &[Master], labelled: bool) -> Sink {
     assemble(chunks, minor_version(c), labelled)
 }
 
-/// The lowest minor version whose rules the file needs (SPEC.md 10.1): 4 where an object has
-/// a filter of its own (a `filter.NAME` setting, 6.6), 3 where an object is translucent (a
-/// surface layer of 4 channels, 7.1), else 2.
+/// The lowest minor version whose rules the file needs (SPEC.md 10.1): 5 where a shell block
+/// has shape `depth` (7.3), 4 where an object has a filter of its own (a `filter.NAME`
+/// setting, 6.6), 3 where an object is translucent (a surface layer of 4 channels, 7.1),
+/// else 2.
 fn minor_version(c: &Container) -> u16 {
+    let depth_shell = c
+        .objects
+        .iter()
+        .flat_map(|o| &o.layers)
+        .flat_map(|l| &l.blocks)
+        .any(|b| matches!(b.placement, Placement::Shell { shape: ShellShape::Depth, .. }));
     let own_filter = c.provenance.as_ref().is_some_and(|p| {
         p.settings.iter().any(|(k, _)| k.starts_with(crate::filter::OBJECT_FILTER_PREFIX))
     });
@@ -233,8 +240,10 @@ fn minor_version(c: &Container) -> u16 {
         .iter()
         .flat_map(|o| &o.layers)
         .any(|l| l.mapping == Mapping::Surface && l.channels == 4);
-    if own_filter {
+    if depth_shell {
         VERSION_MINOR
+    } else if own_filter {
+        4
     } else if translucent {
         3
     } else {

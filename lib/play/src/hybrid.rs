@@ -44,6 +44,7 @@ impl HybridPipeline {
             HYBRID_OBJECT,
             ("vs_hybrid", "fs_hybrid"),
             ("vs_hybrid_depth", "fs_hybrid_depth"),
+            false,
         );
         HybridPipeline { layout, pipeline, depth_pipeline }
     }

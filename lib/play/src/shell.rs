@@ -110,6 +110,73 @@ impl ShellTexture {
     }
 }
 
+/// Texel format of depth cubes: one distance per texel, read with `textureLoad`.
+pub const DEPTH_CUBE_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Float;
+
+/// A depth shell's depth cube on the GPU (one level, six layers), or a one-texel stand-in
+/// for the shaders' `depth` argument where the shell has another shape.
+pub struct DepthTexture {
+    pub texture: wgpu::Texture,
+    pub view: wgpu::TextureView,
+}
+
+impl DepthTexture {
+    /// The depth cube of `shell` (SPEC.md 8.5), uploaded; [`Self::none`] for a shell of
+    /// another shape.
+    pub fn new(gpu: &Gpu, shell: &pis_compile::shell::Shell) -> DepthTexture {
+        match &shell.shape {
+            pis_compile::shell::ShellShape::Depth { cube, .. } => {
+                DepthTexture::upload(gpu, cube.size, &cube.distances)
+            }
+            _ => DepthTexture::none(gpu),
+        }
+    }
+
+    /// The stand-in bound where a shell is not a depth shell: one zero texel per face.
+    pub fn none(gpu: &Gpu) -> DepthTexture {
+        DepthTexture::upload(gpu, 1, &[0.0; 6])
+    }
+
+    /// `data`: `n × n` distances per face, face after face, rows from the top.
+    fn upload(gpu: &Gpu, n: u32, data: &[f32]) -> DepthTexture {
+        let texture = gpu.device.create_texture_with_data(
+            &gpu.queue,
+            &wgpu::TextureDescriptor {
+                label: Some("depth cube"),
+                size: wgpu::Extent3d { width: n, height: n, depth_or_array_layers: 6 },
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format: DEPTH_CUBE_FORMAT,
+                usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+                view_formats: &[],
+            },
+            wgpu::util::TextureDataOrder::LayerMajor,
+            bytemuck::cast_slice(data),
+        );
+        let view = texture.create_view(&wgpu::TextureViewDescriptor {
+            dimension: Some(wgpu::TextureViewDimension::D2Array),
+            ..Default::default()
+        });
+        DepthTexture { texture, view }
+    }
+}
+
+/// The bind group layout entry of a cube map or depth cube at `binding`: a 2D array read
+/// with `textureLoad` in the fragment stage.
+pub(crate) fn cube_layout_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::FRAGMENT,
+        ty: wgpu::BindingType::Texture {
+            sample_type: wgpu::TextureSampleType::Float { filterable: false },
+            view_dimension: wgpu::TextureViewDimension::D2Array,
+            multisampled: false,
+        },
+        count: None,
+    }
+}
+
 /// `ShellUniforms` of `shell_object.wgsl` (208 bytes).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
@@ -164,7 +231,8 @@ pub(crate) const VEC3_AT: fn(u32) -> wgpu::VertexBufferLayout<'static> =
     };
 
 /// The pipelines of one object drawn with one cube map over `shell.wgsl` and `entries`
-/// (WGSL appended to it): the bind group layout (binding 0 the uniforms, 1 the cube map), the
+/// (WGSL appended to it): the bind group layout (binding 0 the uniforms, 1 the cube map,
+/// 2 a depth cube where `depth_cube`), the
 /// colour pipeline (vertex entry `vs` with two `Float32x3` buffers, fragment `fs`) and the
 /// depth-only one (`vs_depth` over positions, `fs_depth`, no colour written); depth test
 /// `Less`, no culling.
@@ -174,6 +242,7 @@ pub(crate) fn object_pipelines(
     entries: &str,
     (vs, fs): (&str, &str),
     (vs_depth, fs_depth): (&str, &str),
+    depth_cube: bool,
 ) -> (wgpu::BindGroupLayout, wgpu::RenderPipeline, wgpu::RenderPipeline) {
     let device = &gpu.device;
     let source = format!("{SHELL_FUNCTIONS}\n{entries}");
@@ -194,17 +263,9 @@ pub(crate) fn object_pipelines(
                 },
                 count: None,
             },
-            wgpu::BindGroupLayoutEntry {
-                binding: 1,
-                visibility: wgpu::ShaderStages::FRAGMENT,
-                ty: wgpu::BindingType::Texture {
-                    sample_type: wgpu::TextureSampleType::Float { filterable: false },
-                    view_dimension: wgpu::TextureViewDimension::D2Array,
-                    multisampled: false,
-                },
-                count: None,
-            },
-        ],
+            cube_layout_entry(1),
+            cube_layout_entry(2),
+        ][..if depth_cube { 3 } else { 2 }],
     });
     let pl = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
         label: Some(label),
@@ -278,6 +339,7 @@ impl ShellPipeline {
             SHELL_OBJECT,
             ("vs_shell", "fs_shell"),
             ("vs_shell_depth", "fs_shell_depth"),
+            true,
         );
         ShellPipeline { layout, pipeline, depth_pipeline }
     }
@@ -298,6 +360,7 @@ pub fn render_shell(
     check_viewport(gpu, viewport)?;
     let cube = ShellTexture::new(gpu, object.layout, "shell")?;
     cube.upload(gpu, rgba)?;
+    let depth_cube = DepthTexture::new(gpu, &object.shell);
     // Occluders, then the object's hidden triangles, write depth only.
     let mut depth_draws = Vec::new();
     for m in occluders {
@@ -313,7 +376,7 @@ pub fn render_shell(
     let (color, depth) = frame_targets(gpu, viewport);
     let mut enc =
         gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("shell") });
-    let draws = ShellDraws::new(gpu, pipeline, &cube, object, &depth_draws, &shown);
+    let draws = ShellDraws::new(gpu, pipeline, (&cube, &depth_cube), object, &depth_draws, &shown);
     shell_pass(&mut enc, pipeline, (&color, &depth), &draws);
     crate::image::read_back(gpu, enc, &color, viewport)
 }
@@ -379,7 +442,7 @@ impl ShellDraws {
     fn new(
         gpu: &Gpu,
         pipeline: &ShellPipeline,
-        cube: &ShellTexture,
+        (cube, depth_cube): (&ShellTexture, &DepthTexture),
         object: &ShellObject,
         depth_draws: &[DepthMesh],
         shown: &[u32],
@@ -416,6 +479,10 @@ impl ShellDraws {
                     wgpu::BindGroupEntry {
                         binding: 1,
                         resource: wgpu::BindingResource::TextureView(&cube.view),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 2,
+                        resource: wgpu::BindingResource::TextureView(&depth_cube.view),
                     },
                 ],
             })

@@ -1,7 +1,8 @@
 // Environment-map shells (SPEC.md 7.3, 8.2): the lookup of one shell's cube map from a
 // surface point. One function written twice: every function here has a twin of the same
 // name in pis-compile's hardware model, with the same order of operations (reflect_about,
-// shell_hit, lookup_direction, fresnel: shell/geometry.rs; cube_face, face_components, face_st,
+// shell_hit, lookup_direction, fresnel: shell/geometry.rs; depth_distance, depth_hit:
+// shell/depth.rs; cube_face, face_components, face_st,
 // face_vector, cube_texel, beyond, bilinear_corner, cube_lod, cube_bilinear, cube_sample:
 // shell/cube.rs). Change both together. texture_lod.wgsl is prepended to this source
 // (shell.rs), and pipelines append their entry points to it.
@@ -11,7 +12,10 @@
 // and filtered here, so the weights are the model's on every adapter.
 
 // One shell: origin; shape 1 sphere (a.x radius), 2 ellipsoid (a radii), 3 box (a min,
-// b max corner, world space), 4 cylinder (a.x radius, a.y y min, a.z y max).
+// b max corner, world space), 4 cylinder (a.x radius, a.y y min, a.z y max), 6 depth
+// (a.x the depth cube's face size, a.y march steps, a.z far distance). A depth shell's
+// depth cube is the `depth` texture the lookups take (one level, distance in x); other
+// shapes ignore it.
 struct ShellGeometry {
     origin: vec3<f32>,
     shape: u32,
@@ -46,9 +50,71 @@ fn slab(q: f32, r: f32, lo: f32, hi: f32) -> vec2<f32> {
     return vec2<f32>(min(t0, t1), max(t0, t1));
 }
 
+// Regula-falsi iterations after a depth shell's march finds a step behind its surface.
+const DEPTH_REFINE: u32 = 4u;
+
+// The distance of depth cube `depth` (face size n) in direction q (not normalized): its
+// bilinear, seamless lookup.
+fn depth_distance(depth: texture_2d_array<f32>, n: u32, q: vec3<f32>) -> f32 {
+    return cube_bilinear(depth, n, q, 0u).x;
+}
+
+// f(t) = |q0 + t·r| − D(q0 + t·r): negative in front of a depth shell, ≥ 0 behind it.
+fn depth_behind(g: ShellGeometry, depth: texture_2d_array<f32>, q0: vec3<f32>, r: vec3<f32>, t: f32) -> f32 {
+    let q = q0 + r * t;
+    return length(q) - depth_distance(depth, u32(g.a.x), q);
+}
+
+// Where p + t·r meets the depth shell: the first of the steps t_i = t_end·(i/steps)² with
+// f ≥ 0 (t_end on the far sphere), DEPTH_REFINE regula-falsi steps, the last bracket's
+// secant root; 0 where f(0) ≥ 0, −1 where p lies outside the far sphere.
+fn depth_hit(g: ShellGeometry, depth: texture_2d_array<f32>, p: vec3<f32>, r: vec3<f32>) -> f32 {
+    let q0 = p - g.origin;
+    let far = g.a.z;
+    let steps = u32(g.a.y);
+    let t_end = quadratic_far(dot(r, r), dot(q0, r), dot(q0, q0) - far * far);
+    if (t_end < 0.0) {
+        return -1.0;
+    }
+    var t0 = 0.0;
+    var f0 = depth_behind(g, depth, q0, r, 0.0);
+    if (f0 >= 0.0) {
+        return 0.0;
+    }
+    var t1 = t_end;
+    var f1 = 0.0;
+    for (var i = 1u; i <= steps; i = i + 1u) {
+        let s = f32(i) / f32(steps);
+        let t = t_end * s * s;
+        let ft = depth_behind(g, depth, q0, r, t);
+        if (ft >= 0.0) {
+            t1 = t;
+            f1 = ft;
+            break;
+        }
+        t0 = t;
+        f0 = ft;
+    }
+    for (var k = 0u; k < DEPTH_REFINE; k = k + 1u) {
+        let tm = t0 + (t1 - t0) * f0 / (f0 - f1);
+        let fm = depth_behind(g, depth, q0, r, tm);
+        if (fm >= 0.0) {
+            t1 = tm;
+            f1 = fm;
+        } else {
+            t0 = tm;
+            f0 = fm;
+        }
+    }
+    return t0 + (t1 - t0) * f0 / (f0 - f1);
+}
+
 // The far intersection (largest t ≥ 0) of p + t·r with the shell, or a negative value.
-fn shell_hit(g: ShellGeometry, p: vec3<f32>, r: vec3<f32>) -> f32 {
+fn shell_hit(g: ShellGeometry, depth: texture_2d_array<f32>, p: vec3<f32>, r: vec3<f32>) -> f32 {
     let q = p - g.origin;
+    if (g.shape == 6u) {
+        return depth_hit(g, depth, p, r);
+    }
     if (g.shape == 1u) {
         return quadratic_far(dot(r, r), dot(q, r), dot(q, q) - g.a.x * g.a.x);
     }
@@ -101,11 +167,11 @@ fn shell_hit(g: ShellGeometry, p: vec3<f32>, r: vec3<f32>) -> f32 {
 // The cube-map lookup vector of surface point p with interpolated normal `normal` seen from
 // `eye`: the far hit of the reflection ray on the shell minus its origin, or the ray's
 // direction where it does not meet the shell.
-fn lookup_direction(g: ShellGeometry, p: vec3<f32>, normal: vec3<f32>, eye: vec3<f32>) -> vec3<f32> {
+fn lookup_direction(g: ShellGeometry, depth: texture_2d_array<f32>, p: vec3<f32>, normal: vec3<f32>, eye: vec3<f32>) -> vec3<f32> {
     let n = normalize(normal);
     let v = normalize(p - eye);
     let r = reflect_about(v, n);
-    let t = shell_hit(g, p, r);
+    let t = shell_hit(g, depth, p, r);
     if (t >= 0.0) {
         return p + r * t - g.origin;
     }
@@ -264,10 +330,10 @@ fn cube_sample(cube: texture_2d_array<f32>, size: u32, levels: u32, d: vec3<f32>
 // trilinear lookup of D at λ from D's fine derivatives (differences across the pixel's 2×2
 // quad); with k > 1 the mean of k × k lookups at the sub-pixel offsets
 // o = ((i + ½)/k − ½, (j + ½)/k − ½), each from p and n moved by o times their fine
-// derivatives, at λ from D's derivatives divided by k. Call it in uniform control flow with
-// a uniform k (it takes derivatives).
-fn cube_sample_pixel(g: ShellGeometry, cube: texture_2d_array<f32>, size: u32, levels: u32, k: u32, eye: vec3<f32>, p: vec3<f32>, n: vec3<f32>) -> vec4<f32> {
-    let d = lookup_direction(g, p, n, eye);
+// derivatives, at λ from D's derivatives divided by k. `depth` is a depth shell's depth
+// cube. Call it in uniform control flow with a uniform k (it takes derivatives).
+fn cube_sample_pixel(g: ShellGeometry, cube: texture_2d_array<f32>, depth: texture_2d_array<f32>, size: u32, levels: u32, k: u32, eye: vec3<f32>, p: vec3<f32>, n: vec3<f32>) -> vec4<f32> {
+    let d = lookup_direction(g, depth, p, n, eye);
     let ddx = dpdxFine(d);
     let ddy = dpdyFine(d);
     let max_level = f32(levels - 1u);
@@ -287,7 +353,7 @@ fn cube_sample_pixel(g: ShellGeometry, cube: texture_2d_array<f32>, size: u32, l
         let oy = (f32(j) + 0.5) / kf - 0.5;
         for (var i = 0u; i < k; i = i + 1u) {
             let ox = (f32(i) + 0.5) / kf - 0.5;
-            let ds = lookup_direction(g, p + ox * dpx + oy * dpy, n + ox * dnx + oy * dny, eye);
+            let ds = lookup_direction(g, depth, p + ox * dpx + oy * dpy, n + ox * dnx + oy * dny, eye);
             acc = acc + w * cube_sample(cube, size, levels, ds, cube_lod(ds, sx, sy, f32(size), max_level));
         }
     }

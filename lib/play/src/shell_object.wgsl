@@ -23,6 +23,8 @@ struct ShellUniforms {
 
 @group(0) @binding(0) var<uniform> su: ShellUniforms;
 @group(0) @binding(1) var cube: texture_2d_array<f32>;
+// A depth shell's depth cube (one level; a 1-texel stand-in for other shapes).
+@group(0) @binding(2) var depth_cube: texture_2d_array<f32>;
 
 struct ShellVsOut {
     @builtin(position) clip: vec4<f32>,
@@ -52,7 +54,7 @@ fn vs_shell_depth(@location(0) position: vec3<f32>) -> @builtin(position) vec4<f
 
 @fragment
 fn fs_shell(in: ShellVsOut) -> @location(0) vec4<f32> {
-    let c = cube_sample_pixel(shell_geometry(), cube, su.size, su.levels, su.lookups, su.eye.xyz, in.world, in.normal);
+    let c = cube_sample_pixel(shell_geometry(), cube, depth_cube, su.size, su.levels, su.lookups, su.eye.xyz, in.world, in.normal);
     // Alpha 1 marks coverage.
     return vec4<f32>(c.rgb, 1.0);
 }

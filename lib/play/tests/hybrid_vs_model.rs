@@ -143,7 +143,7 @@ fn lens_terms_in_the_frame_match_the_model() {
         })
         .collect();
     let geometry: Vec<_> =
-        order.iter().map(|n| all.iter().find(|(s, _)| s == n).expect("shell").1).collect();
+        order.iter().map(|n| all.iter().find(|(s, _)| s == n).expect("shell").1.clone()).collect();
     let mut worst = f64::INFINITY;
     // One shell, four, and four each looked up 3 × 3 times per pixel (SPEC.md 8.2).
     for ((model, tess), (count, lookups)) in
@@ -182,7 +182,7 @@ fn lens_terms_in_the_frame_match_the_model() {
                 .iter()
                 .zip(&layouts)
                 .zip(&cubes)
-                .map(|((s, l), c)| (*s, *l, c.as_slice()))
+                .map(|((s, l), c)| (s.clone(), *l, c.as_slice()))
                 .collect();
             let got =
                 pis_play::frame::render_lens_term(&gpu, vp, tess, clip, term, &shells, lookups)

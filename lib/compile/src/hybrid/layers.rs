@@ -258,7 +258,7 @@ pub fn relative_error(ray: &OutgoingRay, t: f64, s: f64, origin: DVec3, scale: f
 }
 
 /// A fitted shell and its mean squared relative distance error along the rays.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct FittedShell {
     pub shell: Shell,
     pub mse: f64,

@@ -6,10 +6,14 @@
 //! WGSL twin: `reflect_about`, `shell_hit`, `lookup_direction` and `fresnel` in
 //! `lib/play/src/shell.wgsl`, same names and order of operations.
 
+use std::sync::Arc;
+
 use glam::DVec3;
 
-/// A shell's shape and parameters, in world space (SPEC.md 7.3, shapes 1–4).
-#[derive(Clone, Copy, Debug, PartialEq)]
+use super::depth::{depth_hit, DepthCube};
+
+/// A shell's shape and parameters, in world space (SPEC.md 7.3, shapes 1–4 and 6).
+#[derive(Clone, Debug, PartialEq)]
 pub enum ShellShape {
     /// Centred on the origin.
     Sphere { radius: f64 },
@@ -19,6 +23,9 @@ pub enum ShellShape {
     Box { min: DVec3, max: DVec3 },
     /// Capped cylinder with its axis parallel to +Y through the origin.
     Cylinder { radius: f64, y_min: f64, y_max: f64 },
+    /// Star-shaped about the origin, its radius per direction the depth cube's distance,
+    /// met by marching `steps` steps ([`super::depth`]).
+    Depth { cube: Arc<DepthCube>, steps: u32 },
 }
 
 impl ShellShape {
@@ -29,12 +36,13 @@ impl ShellShape {
             ShellShape::Ellipsoid { .. } => "ellipsoid",
             ShellShape::Box { .. } => "box",
             ShellShape::Cylinder { .. } => "cylinder",
+            ShellShape::Depth { .. } => "depth",
         }
     }
 }
 
 /// A closed shell: its shape and the origin lookup vectors start from.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct Shell {
     pub origin: DVec3,
     pub shape: ShellShape,
@@ -45,32 +53,39 @@ impl Shell {
     pub fn placement_values(&self) -> (u16, [f32; 12]) {
         let mut v = [0.0f32; 12];
         v[..3].copy_from_slice(&self.origin.as_vec3().to_array());
-        let id = match self.shape {
-            ShellShape::Sphere { radius } => {
+        let id = match &self.shape {
+            &ShellShape::Sphere { radius } => {
                 v[3] = radius as f32;
                 1
             }
-            ShellShape::Ellipsoid { radii } => {
+            &ShellShape::Ellipsoid { radii } => {
                 v[3..6].copy_from_slice(&radii.as_vec3().to_array());
                 2
             }
-            ShellShape::Box { min, max } => {
+            &ShellShape::Box { min, max } => {
                 v[3..6].copy_from_slice(&min.as_vec3().to_array());
                 v[6..9].copy_from_slice(&max.as_vec3().to_array());
                 3
             }
-            ShellShape::Cylinder { radius, y_min, y_max } => {
+            &ShellShape::Cylinder { radius, y_min, y_max } => {
                 v[3] = radius as f32;
                 v[4] = y_min as f32;
                 v[5] = y_max as f32;
                 4
+            }
+            ShellShape::Depth { cube, steps } => {
+                v[3] = cube.size as f32;
+                v[4] = *steps as f32;
+                v[5] = cube.far;
+                6
             }
         };
         (id, v)
     }
 
     /// The shell of shape id `id` and placement values `v` (the inverse of
-    /// [`Self::placement_values`]); `None` for quads and unknown ids.
+    /// [`Self::placement_values`]); `None` for quads, depth shells (whose depth cube is cast
+    /// from the scene: [`Shell::depth`]) and unknown ids.
     pub fn from_placement(id: u16, v: &[f32; 12]) -> Option<Shell> {
         let d = |k: usize| DVec3::new(v[k] as f64, v[k + 1] as f64, v[k + 2] as f64);
         let shape = match id {
@@ -84,6 +99,11 @@ impl Shell {
         };
         Some(Shell { origin: d(0), shape })
     }
+
+    /// The depth shell about `origin` with depth cube `cube`, marched in `steps` steps.
+    pub fn depth(origin: DVec3, cube: DepthCube, steps: u32) -> Shell {
+        Shell { origin, shape: ShellShape::Depth { cube: Arc::new(cube), steps } }
+    }
 }
 
 /// The far intersection (largest t ≥ 0) of the ray `p + t·r` with the shell, or a negative
@@ -91,6 +111,7 @@ impl Shell {
 pub fn shell_hit(shell: &Shell, p: DVec3, r: DVec3) -> f64 {
     let q = p - shell.origin;
     match shell.shape {
+        ShellShape::Depth { ref cube, steps } => depth_hit(cube, steps, shell.origin, p, r),
         ShellShape::Sphere { radius } => {
             quadratic_far(r.dot(r), q.dot(r), q.dot(q) - radius * radius)
         }
@@ -217,6 +238,7 @@ mod tests {
                         || (x.y - y_min).abs() < 1e-9
                         || (x.y - y_max).abs() < 1e-9)
             }
+            ShellShape::Depth { .. } => false,
         }
     }
 

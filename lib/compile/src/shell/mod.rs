@@ -5,8 +5,10 @@
 //! a shell's render matrix A, which the chapter 3 solver inverts as for a surface texture.
 
 pub mod cube;
+pub mod depth;
 pub mod geometry;
 pub mod model;
 
+pub use depth::DepthCube;
 pub use geometry::{fresnel, lookup_direction, Shell, ShellShape};
 pub use model::{shell_fresnel, shell_render_matrix, ShellObject};

@@ -21,7 +21,7 @@ use crate::transform::{DrawMesh, TextureTransform, Viewport};
 use crate::{RenderMatrix, TextureLayout};
 
 /// One object drawn with one shell: what the model needs to build the shell's A.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Debug)]
 pub struct ShellObject<'a> {
     /// Object-space positions, normals (one per position) and the triangle list.
     pub positions: &'a [[f32; 3]],

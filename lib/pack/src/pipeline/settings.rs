@@ -200,6 +200,8 @@ pub struct PackSettings {
     /// [`pis_format::MAX_SHELL_LOOKUPS`]; SPEC.md 8.2): k × k sub-pixel lookups averaged,
     /// recorded in each shell block for the player.
     pub shell_lookups: u32,
+    /// Layered environment maps: which distant shell a reflective object gets.
+    pub distant_shell: DistantShell,
     /// Conjugate-gradient iteration cap per colour channel of every solve (`None`: the
     /// solver's default).
     pub max_iterations: Option<u32>,
@@ -255,6 +257,7 @@ impl PackSettings {
             placement: PlacementMode::Block,
             stagger: Stagger::Auto,
             shell_lookups: 1,
+            distant_shell: DistantShell::Auto,
             max_iterations: None,
             keep_master: false,
             preset: None,
@@ -498,6 +501,46 @@ impl Stagger {
     pub fn from_name(name: &str) -> Option<Stagger> {
         Stagger::ALL.into_iter().find(|m| m.name() == name)
     }
+}
+
+/// The distant shell of a reflective object's layered environment maps (thesis 5.4; SPEC.md
+/// 7.3, 8.5).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum DistantShell {
+    /// The box or the sphere, whichever is nearer the traced distant layer at a few points;
+    /// then the depth shell where it predicts a point held out between two samples better.
+    #[default]
+    Auto,
+    /// The box or the sphere, whichever is nearer the traced distant layer (thesis 5.4).
+    Fitted,
+    /// A box with its bottom on the surface the object rests on.
+    Box,
+    /// A sphere at the mean distance of the reflected environment.
+    Sphere,
+    /// A depth shell (where the scene has other objects to cast its depth cube from).
+    Depth,
+}
+
+impl DistantShell {
+    /// The name `--distant-shell` uses.
+    pub fn name(self) -> &'static str {
+        match self {
+            DistantShell::Auto => "auto",
+            DistantShell::Fitted => "fitted",
+            DistantShell::Box => "box",
+            DistantShell::Sphere => "sphere",
+            DistantShell::Depth => "depth",
+        }
+    }
+
+    /// Every choice, in the order the tools list them.
+    pub const ALL: [DistantShell; 5] = [
+        DistantShell::Auto,
+        DistantShell::Fitted,
+        DistantShell::Box,
+        DistantShell::Sphere,
+        DistantShell::Depth,
+    ];
 }
 
 /// How reflective objects are stored; refractive objects are stored by hybrid rendering

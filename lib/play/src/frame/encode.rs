@@ -325,7 +325,7 @@ impl Binds {
                 })
             })
             .collect();
-        let layout = &pipes.reflection_draw_layout;
+        let layout = (&pipes.reflection_draw_layout, &pipes.no_depth);
         let reflections = draws
             .reflections
             .iter()

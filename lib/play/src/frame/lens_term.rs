@@ -44,7 +44,7 @@ pub fn render_lens_term(
         cube.upload(gpu, rgba)?;
         cubes.push(cube);
     }
-    let geometry: Vec<Shell> = shells.iter().map(|s| s.0).collect();
+    let geometry: Vec<Shell> = shells.iter().map(|s| s.0.clone()).collect();
     let corners = term_corners(tess, term, &geometry);
     let buffer = corner_buffer(gpu, &corners);
     let positions: Vec<[f32; 3]> = tess.vertices.iter().map(|v| v.position.to_array()).collect();

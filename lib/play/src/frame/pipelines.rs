@@ -12,7 +12,7 @@ use super::reflection::REFLECTION;
 use super::resolve::ResolvePipelines;
 use super::translucent::TranslucentPipelines;
 use crate::gpu::Gpu;
-use crate::shell::SHELL_FUNCTIONS;
+use crate::shell::{DepthTexture, SHELL_FUNCTIONS};
 use crate::textured::DEPTH_FORMAT;
 
 /// The WGSL source: the texture math shared with `textured.wgsl` (`texture_lod.wgsl`,
@@ -49,6 +49,8 @@ pub struct FramePipelines {
     pub(super) hybrid_pipelines: HashMap<(wgpu::TextureFormat, u32), wgpu::RenderPipeline>,
     pub(super) resolve: ResolvePipelines,
     pub(super) translucent: TranslucentPipelines,
+    /// The depth cube bound for a shell that is not a depth shell.
+    pub(super) no_depth: DepthTexture,
 }
 
 const NORMAL_LAYOUT: wgpu::VertexBufferLayout<'static> = wgpu::VertexBufferLayout {
@@ -145,7 +147,13 @@ impl FramePipelines {
         let fragment = wgpu::ShaderStages::FRAGMENT;
         let reflection_draw_layout = d.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("frame reflection"),
-            entries: &[entry(0, vf, UNIFORM), entry(1, fragment, CUBE), entry(2, fragment, CUBE)],
+            entries: &[
+                entry(0, vf, UNIFORM),
+                entry(1, fragment, CUBE),
+                entry(2, fragment, CUBE),
+                entry(3, fragment, CUBE),
+                entry(4, fragment, CUBE),
+            ],
         });
         let hybrid_entries: Vec<wgpu::BindGroupLayoutEntry> =
             std::iter::once(entry(0, vf, UNIFORM))
@@ -232,6 +240,7 @@ impl FramePipelines {
             hybrid_pipelines: HashMap::new(),
             resolve: ResolvePipelines::new(gpu),
             translucent: TranslucentPipelines::default(),
+            no_depth: DepthTexture::none(gpu),
         };
         pipes.id_pipeline(gpu, 1);
         pipes

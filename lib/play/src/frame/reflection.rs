@@ -8,7 +8,7 @@ use wgpu::util::DeviceExt;
 
 use super::draw::ObjectDraw;
 use crate::gpu::Gpu;
-use crate::shell::{shell_uniform, ShellTexture};
+use crate::shell::{shell_uniform, DepthTexture, ShellTexture};
 
 /// The reflection term's entry points, appended to [`crate::shell::SHELL_FUNCTIONS`].
 pub const REFLECTION: &str = include_str!("reflection.wgsl");
@@ -57,13 +57,14 @@ pub struct ReflectionDraw<'a> {
     pub shells: Vec<TermShell<'a>>,
 }
 
-/// One shell of a reflection term: its geometry, its lookups per pixel side (SPEC.md 8.2)
-/// and its cube map.
-#[derive(Clone, Copy)]
+/// One shell of a reflection term: its geometry, its lookups per pixel side (SPEC.md 8.2),
+/// its cube map and, for a depth shell, its depth cube (SPEC.md 8.5).
+#[derive(Clone)]
 pub struct TermShell<'a> {
     pub shell: pis_compile::shell::Shell,
     pub lookups: u32,
     pub cube: &'a ShellTexture,
+    pub depth: Option<&'a DepthTexture>,
 }
 
 /// The uniforms of a reflection term drawn on `object` with `shells` (the term's, or the
@@ -96,11 +97,11 @@ fn reflection_uniforms(
 }
 
 /// The bind group of a reflection term drawn on `object` with `shells` (one or two of the
-/// term's, in order): its uniforms and the cube maps of shells 0 and 1 (shell 0's twice for
-/// one shell).
+/// term's, in order): its uniforms, the cube maps of shells 0 and 1 (shell 0's twice for
+/// one shell) and their depth cubes (`no_depth` for a shell of another shape).
 pub fn reflection_bind(
     gpu: &Gpu,
-    layout: &wgpu::BindGroupLayout,
+    (layout, no_depth): (&wgpu::BindGroupLayout, &DepthTexture),
     object: &ObjectDraw,
     r: &ReflectionDraw,
     shells: &[TermShell],
@@ -111,8 +112,10 @@ pub fn reflection_bind(
         contents: bytemuck::bytes_of(&reflection_uniforms(object, r, shells)),
         usage: wgpu::BufferUsages::UNIFORM,
     });
-    let cube =
-        |k: usize| wgpu::BindingResource::TextureView(&shells[k.min(shells.len() - 1)].cube.view);
+    let shell = |k: usize| &shells[k.min(shells.len() - 1)];
+    let cube = |k: usize| wgpu::BindingResource::TextureView(&shell(k).cube.view);
+    let depth =
+        |k: usize| wgpu::BindingResource::TextureView(&shell(k).depth.unwrap_or(no_depth).view);
     d.create_bind_group(&wgpu::BindGroupDescriptor {
         label: Some("reflection"),
         layout,
@@ -120,6 +123,8 @@ pub fn reflection_bind(
             wgpu::BindGroupEntry { binding: 0, resource: u.as_entire_binding() },
             wgpu::BindGroupEntry { binding: 1, resource: cube(0) },
             wgpu::BindGroupEntry { binding: 2, resource: cube(1) },
+            wgpu::BindGroupEntry { binding: 3, resource: depth(0) },
+            wgpu::BindGroupEntry { binding: 4, resource: depth(1) },
         ],
     })
 }

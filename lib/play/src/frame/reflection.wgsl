@@ -40,6 +40,9 @@ struct ReflectionUniforms {
 // The cube maps of shells 0 and 1 (shell 0's again when the term has one shell).
 @group(0) @binding(1) var cube0: texture_2d_array<f32>;
 @group(0) @binding(2) var cube1: texture_2d_array<f32>;
+// The depth cubes of shells 0 and 1 where they are depth shells (a 1-texel stand-in else).
+@group(0) @binding(3) var depth0: texture_2d_array<f32>;
+@group(0) @binding(4) var depth1: texture_2d_array<f32>;
 @group(1) @binding(0) var ids: texture_2d<u32>;
 @group(1) @binding(1) var ids_ms: texture_multisampled_2d<u32>;
 
@@ -56,20 +59,21 @@ fn shell_geometry_of(k: u32) -> ShellGeometry {
 }
 
 // Shell k's premultiplied RGBA at world position p with normal n: the trilinear, seamless
-// lookup of `cube`, once or k × k times over the pixel (size_levels.z; `cube_sample_pixel`).
-fn shell_colour(k: u32, cube: texture_2d_array<f32>, p: vec3<f32>, n: vec3<f32>) -> vec4<f32> {
+// lookup of `cube`, once or k × k times over the pixel (size_levels.z; `cube_sample_pixel`),
+// a depth shell marched against `depth`.
+fn shell_colour(k: u32, cube: texture_2d_array<f32>, depth: texture_2d_array<f32>, p: vec3<f32>, n: vec3<f32>) -> vec4<f32> {
     let sl = ru.shells[k].size_levels;
-    return cube_sample_pixel(shell_geometry_of(k), cube, sl.x, sl.y, sl.z, ru.eye.xyz, p, n);
+    return cube_sample_pixel(shell_geometry_of(k), cube, depth, sl.x, sl.y, sl.z, ru.eye.xyz, p, n);
 }
 
 // The reflection term (SPEC.md 9): the shells composited "over" in increasing order,
 // rgb = rgb₀ + (1 − α₀)·rgb₁ (a 3-channel shell's texels have α = 1).
 fn reflection_term(p: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
-    let c0 = shell_colour(0u, cube0, p, n);
+    let c0 = shell_colour(0u, cube0, depth0, p, n);
     if (ru.count < 2u) {
         return c0.rgb;
     }
-    let c1 = shell_colour(1u, cube1, p, n);
+    let c1 = shell_colour(1u, cube1, depth1, p, n);
     return c0.rgb + (1.0 - c0.a) * c1.rgb;
 }
 

@@ -109,7 +109,7 @@ pub(super) fn layer_draws<'a>(
 /// The reflection terms of a plan, with their cube maps on the GPU (`textures`).
 pub(super) fn reflection_draws<'a>(
     reader: &PisReader,
-    textures: &'a Textures,
+    (textures, objects): (&'a Textures, &'a [ObjectGpu]),
     plan: &Plan,
 ) -> Result<Vec<ReflectionDraw<'a>>, PlayError> {
     let c = reader.container();
@@ -123,7 +123,8 @@ pub(super) fn reflection_draws<'a>(
                     format!("{key:?}: a surface texture drawn as a shell"),
                 ));
             };
-            shells.push(TermShell { shell: *shell, lookups: *lookups, cube });
+            let depth = objects[r.draw].depth.get(&(key.layer as usize, key.block)).map(|d| &d.1);
+            shells.push(TermShell { shell: shell.clone(), lookups: *lookups, cube, depth });
         }
         out.push(ReflectionDraw {
             draw: r.draw,

@@ -45,7 +45,7 @@ pub(super) fn lens_corners(
     let t = Instant::now();
     let mut work = LensWork { sets: Vec::new(), ms: 0.0, rays: 0, triangles: 0 };
     for r in &plan.lenses {
-        let shells: Vec<Shell> = r.shells.iter().map(|(_, s, _)| *s).collect();
+        let shells: Vec<Shell> = r.shells.iter().map(|(_, s, _)| s.clone()).collect();
         if work.sets.iter().any(|(d, s, _)| *d == r.draw && *s == shells) {
             continue;
         }
@@ -96,7 +96,7 @@ pub(super) fn lens_draws<'a>(
 ) -> Result<Vec<LensDraw<'a>>, PlayError> {
     let mut lenses = Vec::new();
     for r in &plan.lenses {
-        let shells: Vec<Shell> = r.shells.iter().map(|(_, s, _)| *s).collect();
+        let shells: Vec<Shell> = r.shells.iter().map(|(_, s, _)| s.clone()).collect();
         let Some((_, _, buffers)) = sets.iter().find(|(d, s, _)| *d == r.draw && *s == shells)
         else {
             continue;

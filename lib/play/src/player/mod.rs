@@ -18,6 +18,7 @@
 //! reading back); this file opens the player and runs a frame through them.
 
 mod budget;
+mod depth;
 mod draws;
 mod lens;
 mod objects;
@@ -406,7 +407,7 @@ impl Player {
         make_samplers(&gpu, &mut self.samplers, &self.filters, &plan.surfaces);
         let (reader, textures) = (&self.reader, &self.textures);
         let layers = layer_draws(reader, textures, &self.samplers, &self.filters, &plan.surfaces)?;
-        let reflections = reflection_draws(reader, textures, plan)?;
+        let reflections = reflection_draws(reader, (textures, &self.objects), plan)?;
         let lenses = lens_draws(reader, textures, plan, corner_sets)?;
         stats.lens_draws = lenses.len() as u64;
         stats.surface_draws = layers.len() as u64;

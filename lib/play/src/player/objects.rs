@@ -6,6 +6,7 @@ use pis_compile::hybrid::{LensMaterial, LensObject};
 use pis_compile::{Filter, TextureLayout};
 use pis_format::{Container, Mapping, PisReader, Placement, StreamRef, Term};
 
+use super::depth::{object_depth_shells, DepthShells};
 use crate::error::PlayError;
 use crate::frame::hybrid::MAX_LENS_SHELLS;
 use crate::frame::{MeshGpu, MAX_TERM_SHELLS};
@@ -25,6 +26,8 @@ pub(super) struct ObjectGpu {
     /// A surface layer carries the object's opacity (4 channels, SPEC.md 7.1): the object
     /// is composited over the opaque surfaces behind it (SPEC.md 9).
     pub(super) translucent: bool,
+    /// The depth shells of its reflection term, by (layer, block).
+    pub(super) depth: DepthShells,
 }
 
 /// A lens object: its shell layers (the refraction term's, in increasing order, at most
@@ -154,7 +157,8 @@ pub(super) fn prepare_objects(gpu: &Gpu, reader: &PisReader) -> Result<Vec<Objec
             MeshGpu::new(gpu, &o.mesh.positions, o.mesh.normals.as_deref(), &uvs, &o.mesh.indices)
                 .with_hull(o.mesh.hull_triangles);
         let translucent = layers.iter().any(|&li| o.layers[li].channels == 4);
-        out.push(ObjectGpu { mesh, layers, reflection, lens, translucent });
+        let depth = object_depth_shells(gpu, c, oi);
+        out.push(ObjectGpu { mesh, layers, reflection, lens, translucent, depth });
     }
     if !skipped.is_empty() {
         eprintln!(

@@ -116,9 +116,9 @@ impl Plan {
                     });
                 }
             }
-            plan.reflections.extend(shell_terms(reader, oi, &og.reflection, &samples)?);
+            plan.reflections.extend(shell_terms(reader, (oi, og), &og.reflection, &samples)?);
             if let Some(lens) = &og.lens {
-                plan.lenses.extend(shell_terms(reader, oi, &lens.layers, &samples)?);
+                plan.lenses.extend(shell_terms(reader, (oi, og), &lens.layers, &samples)?);
             }
         }
         Ok(plan)
@@ -163,7 +163,7 @@ fn texture_key<'r>(
 /// layers are blended.
 fn shell_terms(
     reader: &PisReader,
-    oi: usize,
+    (oi, og): (usize, &ObjectGpu),
     term: &[usize],
     samples: &[(Vec<u32>, f32)],
 ) -> Result<Vec<WantedReflection>, PlayError> {
@@ -177,7 +177,8 @@ fn shell_terms(
         let mut shells = Vec::with_capacity(term.len());
         for &li in term {
             let (key, block) = texture_key(reader, oi, li, &s)?;
-            let (shell, lookups) = shell_of(&block.placement).ok_or_else(|| {
+            let depth = og.depth.get(&(li, key.block)).map(|d| d.0.clone());
+            let (shell, lookups) = shell_of(&block.placement, depth).ok_or_else(|| {
                 content(
                     reader,
                     format!("object {oi} layer {li} block {}: not a closed shell", key.block),
@@ -204,9 +205,13 @@ pub(super) fn camera_record(reader: &PisReader, sample: &[u32]) -> pis_format::C
 }
 
 /// The cube-map geometry of a shell block's placement (SPEC.md 7.3) and its lookups per
-/// pixel side (8.2); `None` for a quad or a surface placement.
-fn shell_of(placement: &Placement) -> Option<(Shell, u32)> {
+/// pixel side (8.2): `depth` for a depth shell (its cube cast when the file was opened);
+/// `None` for a quad or a surface placement.
+fn shell_of(placement: &Placement, depth: Option<Shell>) -> Option<(Shell, u32)> {
     let Placement::Shell { shape, origin, params, lookups } = placement else { return None };
+    if let Some(shell) = depth {
+        return Some((shell, *lookups));
+    }
     let mut values = [0.0f32; 12];
     values[..3].copy_from_slice(origin);
     values[3..9].copy_from_slice(params);

@@ -7,7 +7,7 @@ use std::f32::consts::PI;
 use std::path::PathBuf;
 
 use glam::{DVec3, Mat4, Vec3};
-use pis_compile::shell::{Shell, ShellShape};
+use pis_compile::shell::{DepthCube, Shell, ShellShape};
 use pis_compile::transform::{look_at, perspective};
 use pis_compile::{RenderMatrix, Viewport};
 use pis_play::{FloatImage, Gpu};
@@ -276,5 +276,29 @@ pub fn shells() -> Vec<(&'static str, Shell)> {
                 shape: ShellShape::Cylinder { radius: 2.5, y_min: -1.3, y_max: 2.0 },
             },
         ),
+        ("depth", Shell::depth(o, DepthCube::cast(o.as_vec3(), 24, 12.0, &depth_scene()), 24)),
     ]
+}
+
+/// The 12 triangles of the axis-aligned box between `lo` and `hi`.
+pub fn box_triangles(lo: Vec3, hi: Vec3) -> Vec<[Vec3; 3]> {
+    let c = |k: u32| {
+        Vec3::new(
+            if k & 1 == 0 { lo.x } else { hi.x },
+            if k & 2 == 0 { lo.y } else { hi.y },
+            if k & 4 == 0 { lo.z } else { hi.z },
+        )
+    };
+    let quads =
+        [[0, 2, 6, 4], [1, 5, 7, 3], [0, 4, 5, 1], [2, 3, 7, 6], [0, 1, 3, 2], [4, 6, 7, 5]];
+    quads.iter().flat_map(|q| [[c(q[0]), c(q[1]), c(q[2])], [c(q[0]), c(q[2]), c(q[3])]]).collect()
+}
+
+/// What the depth shell of [`shells`] is cast from: a room with a crate on its floor beside
+/// the object and a column behind it, so reflection rays stop at several depths.
+pub fn depth_scene() -> Vec<[Vec3; 3]> {
+    let mut scene = box_triangles(Vec3::new(-3.0, -1.3, -4.0), Vec3::new(4.0, 3.0, 3.5));
+    scene.extend(box_triangles(Vec3::new(1.3, -1.3, -0.6), Vec3::new(2.1, -0.5, 0.4)));
+    scene.extend(box_triangles(Vec3::new(-1.2, -1.3, -2.6), Vec3::new(-0.7, 3.0, -2.1)));
+    scene
 }

@@ -125,7 +125,7 @@ impl Planned for HybridPlanned {
                 .map(|(s, v)| (key(s, job.all), v.cubes[l].clone()))
                 .collect();
             let form = Box::new(ShellForm {
-                shell: fitted.shell,
+                shell: fitted.shell.clone(),
                 layout,
                 lookups: settings.lookups,
                 channels: 4,

@@ -1,12 +1,14 @@
 //! An object's shells (thesis 5.4, 5.7): the environment-map origin, the local shell — the
-//! least-volume axis-aligned ellipsoid about the origin that bounds the object — and the two
-//! candidates for the distant shell, a box with its bottom on the surface the object rests
-//! on and its sides at the mean distance of the reflected environment, and a sphere at that
-//! mean distance. Fitted where the object stands at the set's first point.
+//! least-volume axis-aligned ellipsoid about the origin that bounds the object — and the
+//! candidates for the distant shell: a box with its bottom on the surface the object rests
+//! on and its sides at the mean distance of the reflected environment, a sphere at that
+//! mean distance, and a depth shell whose radius in every direction is the distance to the
+//! scene's diffuse objects (SPEC.md 8.5). Fitted where the object stands at the set's first
+//! point.
 
 use anyhow::{anyhow, Result};
 use glam::{DVec3, Vec3};
-use pis_compile::shell::{Shell, ShellShape};
+use pis_compile::shell::{DepthCube, Shell, ShellShape};
 use pis_trace::bvh::SceneGeometry;
 
 use super::super::input::LoadedSet;
@@ -19,6 +21,16 @@ use super::super::shell_fit::{
 /// the set's points.
 pub const MAX_EYES: usize = 16;
 
+/// Face size of a depth shell's depth cube.
+pub const DEPTH_CUBE_SIZE: u32 = 64;
+
+/// March steps of a depth shell's lookups.
+pub const DEPTH_STEPS: u32 = 32;
+
+/// A depth shell's far sphere is at most this many times the mean distance of the
+/// reflected environment (a scene's ground plane would otherwise spread the steps thin).
+pub const DEPTH_FAR_SPREAD: f32 = 8.0;
+
 /// The fitted shells of one object.
 #[derive(Clone, Debug)]
 pub struct FittedShells {
@@ -27,6 +39,8 @@ pub struct FittedShells {
     /// The distant shell candidates: a box and a sphere about the origin.
     pub distant_box: Shell,
     pub distant_sphere: Shell,
+    /// The depth shell, where the scene has diffuse objects to cast its depth cube from.
+    pub distant_depth: Option<Shell>,
     /// Whether the box's bottom lies on a supporting surface.
     pub supported: bool,
 }
@@ -38,8 +52,9 @@ fn world_positions(set: &LoadedSet, p: usize, o: usize, mesh: &Mesh) -> Vec<Vec3
 }
 
 /// Fits the shells of object `o` (mesh `mesh`) where it stands at the set's first point.
-pub fn fit_shells(set: &LoadedSet, o: usize, mesh: &Mesh) -> Result<FittedShells> {
+pub fn fit_shells(set: &LoadedSet, o: usize, meshes: &[Mesh]) -> Result<FittedShells> {
     let name = &set.scene.objects[o].name;
+    let mesh = &meshes[o];
     let world = world_positions(set, 0, o, mesh);
     let centre = origin(&world, &mesh.indices)?;
     let ellipsoid = bounding_ellipsoid(&world, centre);
@@ -76,8 +91,45 @@ pub fn fit_shells(set: &LoadedSet, o: usize, mesh: &Mesh) -> Result<FittedShells
         },
         distant_box: box_shell,
         distant_sphere: Shell { origin: o3, shape: ShellShape::Sphere { radius } },
+        distant_depth: distant_depth(set, meshes, o, centre, radius as f32),
         supported: support.is_some(),
     })
+}
+
+/// The depth shell about `centre`: its depth cube cast from the diffuse objects' triangles
+/// at the set's first point, as a reader casts it from the file (SPEC.md 8.5); the far
+/// sphere just beyond the farthest of their vertices, at most [`DEPTH_FAR_SPREAD`] times
+/// `mean` (the mean distance of the reflected environment). `None` without diffuse objects.
+fn distant_depth(
+    set: &LoadedSet,
+    meshes: &[Mesh],
+    o: usize,
+    centre: Vec3,
+    mean: f32,
+) -> Option<Shell> {
+    let mut triangles = Vec::new();
+    for (k, mesh) in meshes.iter().enumerate() {
+        if k == o {
+            continue;
+        }
+        let world = world_positions(set, 0, k, mesh);
+        triangles.extend(mesh.indices.chunks_exact(3).filter_map(|t| {
+            let v = |i: u32| world.get(i as usize).copied();
+            Some([v(t[0])?, v(t[1])?, v(t[2])?])
+        }));
+    }
+    let farthest = triangles.iter().flatten().map(|v| v.distance(centre)).fold(0.0f32, f32::max);
+    let far = (farthest * 1.01).min(DEPTH_FAR_SPREAD * mean);
+    if triangles.is_empty() || !(far > 0.0 && far.is_finite()) {
+        return None;
+    }
+    let cube = DepthCube::cast(centre, DEPTH_CUBE_SIZE, far, &triangles);
+    Some(Shell::depth(centre.as_dvec3(), cube, DEPTH_STEPS))
+}
+
+/// Whether `shell` is a depth shell (SPEC.md 8.5).
+pub fn is_depth(shell: &Shell) -> bool {
+    matches!(shell.shape, ShellShape::Depth { .. })
 }
 
 /// A sphere so large that looking it up is looking up the reflection direction: the one

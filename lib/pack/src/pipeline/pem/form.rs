@@ -52,6 +52,7 @@ impl LayerForm for ShellForm {
             1 => pis_format::ShellShape::Sphere,
             2 => pis_format::ShellShape::Ellipsoid,
             3 => pis_format::ShellShape::Box,
+            6 => pis_format::ShellShape::Depth,
             _ => pis_format::ShellShape::Cylinder,
         };
         let mut params = [0.0f32; 6];

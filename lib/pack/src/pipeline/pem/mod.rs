@@ -10,6 +10,7 @@
 //! The baselines of thesis 5.10 and 5.1 are made here too: one map at infinity per sample,
 //! inferred (`single_shell`) or ray-traced from the object's centre ([`traced`]).
 
+pub mod between;
 pub mod budget;
 pub mod fit;
 pub mod form;
@@ -27,9 +28,11 @@ use pis_trace::layers::LayerKind as TraceLayer;
 use super::model::{key, InferredLayer, ObjectModel};
 use super::represent::{Job, Planned, Representation, Surveyed};
 use super::surface::survey_surface;
-use fit::{fit_shells, FittedShells};
+use super::DistantShell;
+use between::{between_error, held_out_points};
+use fit::{fit_shells, is_depth, FittedShells};
 use form::ShellForm;
-use solve::{solve_shell, SolvedShell, Target};
+use solve::{solve_shell, solve_shell_shared, SolvedShell, Target};
 use terms::ReflectionTerms;
 use views::{face_resolution, shell_views, ShellView, LARGEST_FACE};
 
@@ -70,7 +73,7 @@ impl Representation for LayeredPem {
             return survey_surface(job, o, true);
         }
         let Some(surface) = survey_surface(job, o, false)? else { return Ok(None) };
-        let fitted = fit_shells(set, o, &job.meshes[o])?;
+        let fitted = fit_shells(set, o, &job.meshes)?;
         Ok(Some(Box::new(PemSurveyed { o, surface, fitted })))
     }
 }
@@ -158,7 +161,7 @@ impl Planned for PemPlanned {
             }
             _ => {}
         }
-        let local_n = face_resolution(set, o, &job.meshes, fitted.local, largest)?;
+        let local_n = face_resolution(set, o, &job.meshes, &fitted.local, largest)?;
         let local_layout = TextureLayout::cube(local_n);
         let has_local = pixels
             .iter()
@@ -167,12 +170,11 @@ impl Planned for PemPlanned {
             .collect::<Result<Vec<f32>>>()?
             .iter()
             .any(|&a| a > 1e-3);
-        let trial = distant_trial(job, o, &fitted, f0, (&pixels, &keys), &settings, largest)?;
-        let (residual, label, shell, n) = trial[0];
-        let other = trial[1];
+        let distant = distant_trial(job, o, &fitted, f0, (&pixels, &keys), &settings, largest)?;
+        let (shell, n) = (distant.shell, distant.n);
         let mut shells = Vec::new();
         if has_local {
-            shells.push((fitted.local, local_layout, Target::Local));
+            shells.push((fitted.local.clone(), local_layout, Target::Local));
         }
         shells.push((shell, TextureLayout::cube(n), Target::Distant));
         // The convex-hull split (thesis 5.7): triangles on the hull never see the object, so
@@ -182,13 +184,20 @@ impl Planned for PemPlanned {
             hull.as_ref().map(|h| h.iter().map(|&on| !on).collect());
         let geometry: Vec<(Shell, TextureLayout, Option<&[bool]>)> = shells
             .iter()
-            .map(|s| (s.0, s.1, if s.2 == Target::Local { local_drawn.as_deref() } else { None }))
+            .map(|s| {
+                (s.0.clone(), s.1, if s.2 == Target::Local { local_drawn.as_deref() } else { None })
+            })
             .collect();
         let all: Vec<usize> = (0..set.frames.len()).collect();
         let views = shell_views(set, o, &job.meshes, &geometry, lookups, f0, (&pixels, &all))?;
+        let shared: Vec<Vec<u32>> = set.samples.iter().map(|s| key(s, job.non_view)).collect();
         let mut solved = Vec::new();
-        for (s, &(_, layout, target)) in shells.iter().enumerate() {
-            solved.push(solve_shell(&views, s, layout, target, &keys, &settings, &job.solver)?);
+        for (s, (shell, layout, target)) in shells.iter().enumerate() {
+            solved.push(if is_depth(shell) {
+                solve_shell_shared(&views, s, *layout, &shared, &settings, &job.solver)?
+            } else {
+                solve_shell(&views, s, *layout, *target, &keys, &settings, &job.solver)?
+            });
         }
         let hull_text = match &hull {
             Some(h) => {
@@ -209,7 +218,7 @@ impl Planned for PemPlanned {
         } else {
             String::new()
         };
-        let why = format!("distant {label} {n}² (traced distant layer residual {residual:.4}, {} {:.4}){local_text}{}", other.1, other.0, lookups_text(lookups));
+        let why = format!("{}{local_text}{}", distant.why, lookups_text(lookups));
         let chosen = Chosen { shells, views, solved, why };
         push_shell_layers(&mut model, job, chosen.shells.iter().zip(chosen.solved));
         model.shells = Some(Box::new(ReflectionTerms(chosen.views)));
@@ -219,10 +228,19 @@ impl Planned for PemPlanned {
     }
 }
 
-/// A distant shell of each form, a box and a sphere, solved at a few points spread over the
-/// set (`pixels` and `keys` per point): the two with their residual against the traced
-/// distant layer there, nearer first, each with its face size. The nearer is kept and solved
-/// everywhere.
+/// The distant shell chosen for an object, its face size, and why.
+struct DistantChoice {
+    shell: Shell,
+    n: u32,
+    why: String,
+}
+
+/// The distant shell (thesis 5.4): a box and a sphere solved at a few points spread over the
+/// set (`pixels` and `keys` per point), the one nearer the traced distant layer there kept;
+/// then, where the scene has a depth shell to offer, the kept one and the depth shell each
+/// judged between the samples ([`between::between_error`]) and the depth shell taken where
+/// its error there is lower. `--distant-shell box|sphere|depth` takes that shell instead (a
+/// depth shell where the scene has one to offer); `fitted` stops before the depth shell.
 fn distant_trial(
     job: &Job<'_>,
     o: usize,
@@ -231,36 +249,72 @@ fn distant_trial(
     (pixels, keys): (&[Vec<u32>], &[Vec<u32>]),
     settings: &SolveSettings,
     largest: u32,
-) -> Result<Vec<(f64, &'static str, Shell, u32)>> {
+) -> Result<DistantChoice> {
     let set = job.set;
+    let asked = match job.req.distant_shell {
+        DistantShell::Auto | DistantShell::Fitted => None,
+        DistantShell::Box => Some(("box", &fitted.distant_box)),
+        DistantShell::Sphere => Some(("sphere", &fitted.distant_sphere)),
+        DistantShell::Depth => fitted.distant_depth.as_ref().map(|d| ("depth", d)),
+    };
+    if let Some((label, shell)) = asked {
+        let n = face_resolution(set, o, &job.meshes, shell, largest)?;
+        let why = format!("distant {label} {n}² (--distant-shell {label})");
+        return Ok(DistantChoice { shell: shell.clone(), n, why });
+    }
     let probe: Vec<usize> = probe_points(set.frames.len());
     let probe_pixels: Vec<Vec<u32>> = probe.iter().map(|&p| pixels[p].clone()).collect();
     let probe_keys: Vec<Vec<u32>> = probe.iter().map(|&p| keys[p].clone()).collect();
-    let mut trial: Vec<(f64, &str, Shell, u32)> = Vec::new();
-    for (label, shell) in [("box", fitted.distant_box), ("sphere", fitted.distant_sphere)] {
+    let mut trial: Vec<(f64, &str, &Shell, u32)> = Vec::new();
+    for (label, shell) in [("box", &fitted.distant_box), ("sphere", &fitted.distant_sphere)] {
         let n = face_resolution(set, o, &job.meshes, shell, largest)?;
+        let layout = TextureLayout::cube(n);
         let views = shell_views(
             set,
             o,
             &job.meshes,
-            &[(shell, TextureLayout::cube(n), None)],
+            &[(shell.clone(), layout, None)],
             job.req.shell_lookups,
             f0,
             (&probe_pixels, &probe),
         )?;
-        let solved = solve_shell(
-            &views,
-            0,
-            TextureLayout::cube(n),
-            Target::Distant,
-            &probe_keys,
-            settings,
-            &job.solver,
-        )?;
+        let solved =
+            solve_shell(&views, 0, layout, Target::Distant, &probe_keys, settings, &job.solver)?;
         trial.push((solved.residual_rms, label, shell, n));
     }
     trial.sort_by(|a, b| a.0.total_cmp(&b.0));
-    Ok(trial)
+    let (residual, label, shell, n) = trial[0];
+    let mut choice = DistantChoice {
+        shell: shell.clone(),
+        n,
+        why: format!(
+            "distant {label} {n}² (traced distant layer residual {residual:.4}, {} {:.4})",
+            trial[1].1, trial[1].0
+        ),
+    };
+    let classes: Vec<Vec<u32>> = set.samples.iter().map(|s| key(s, job.non_view)).collect();
+    let depth =
+        fitted.distant_depth.as_ref().filter(|_| job.req.distant_shell == DistantShell::Auto);
+    let (Some(depth), Some(points)) = (depth, held_out_points(&classes)) else {
+        return Ok(choice);
+    };
+    let depth_n = face_resolution(set, o, &job.meshes, depth, largest)?;
+    let judge =
+        |shell: &Shell, n: u32| between_error(job, o, (shell, n), f0, (pixels, points), settings);
+    if let (Some(kept), Some(marched)) = (judge(shell, n)?, judge(depth, depth_n)?) {
+        let [a, m, b] = points;
+        let at = format!("at point {m} solved from {a} and {b}");
+        if marched < kept {
+            choice = DistantChoice {
+                shell: depth.clone(),
+                n: depth_n,
+                why: format!("distant depth {depth_n}² (error between the samples {marched:.4} {at}, {label} {kept:.4})"),
+            };
+        } else {
+            choice.why.push_str(&format!("; a depth shell's error between the samples {marched:.4} {at}, {label}'s {kept:.4}"));
+        }
+    }
+    Ok(choice)
 }
 
 /// Each solved shell as a layer of `model`, in order (the local shell first where there is
@@ -277,16 +331,18 @@ fn push_shell_layers<'s>(
             pis_format::LayerKind::EnvDistant
         };
         let form = Box::new(ShellForm {
-            shell: *shell,
+            shell: shell.clone(),
             layout: *layout,
             lookups: job.req.shell_lookups,
             channels: target.channels() as u8,
             order: s as u8,
             term: pis_format::Term::Reflection,
         });
+        // A depth shell's map is one over the views (`solve_shell_shared`).
+        let mask = if is_depth(shell) { job.non_view } else { job.all };
         model.layers.push(InferredLayer::shell(
             kind,
-            (&job.plan.space, job.all),
+            (&job.plan.space, mask),
             &model.stagger,
             solved.textures,
             solved.iterations,
@@ -313,11 +369,18 @@ fn single_shell(
     let set = job.set;
     let shell = fit::sphere_at_infinity(origin);
     let lookups = job.req.shell_lookups;
-    let n = face_resolution(set, o, &job.meshes, shell, largest)?;
+    let n = face_resolution(set, o, &job.meshes, &shell, largest)?;
     let layout = TextureLayout::cube(n);
     let all: Vec<usize> = (0..set.frames.len()).collect();
-    let views =
-        shell_views(set, o, &job.meshes, &[(shell, layout, None)], lookups, f0, (pixels, &all))?;
+    let views = shell_views(
+        set,
+        o,
+        &job.meshes,
+        &[(shell.clone(), layout, None)],
+        lookups,
+        f0,
+        (pixels, &all),
+    )?;
     let solved = solve_shell(&views, 0, layout, Target::Incident, keys, settings, &job.solver)?;
     let form = Box::new(ShellForm {
         shell,

@@ -123,6 +123,48 @@ pub fn solve_shell(
     Ok(SolvedShell { textures, iterations, residual_rms: (sq / count.max(1) as f64).sqrt() })
 }
 
+/// Solves shell `s` for the distant layer once per class of points with equal `keys`, over
+/// all the class's views at once (thesis eq. 3.7, as a view-independent texture): a depth
+/// shell's texels are points of the scene's surfaces, which every view sees alike, so one
+/// map serves the views between and beyond the samples too.
+pub fn solve_shell_shared(
+    views: &[ShellView],
+    s: usize,
+    layout: TextureLayout,
+    keys: &[Vec<u32>],
+    settings: &SolveSettings,
+    solver: &Solver,
+) -> Result<SolvedShell> {
+    let mut classes: BTreeMap<&Vec<u32>, Vec<usize>> = BTreeMap::new();
+    for (i, k) in keys.iter().enumerate() {
+        classes.entry(k).or_default().push(i);
+    }
+    let mut textures = BTreeMap::new();
+    let (mut iterations, mut sq, mut count) = (0u64, 0.0f64, 0usize);
+    for (k, members) in classes {
+        let rhs: Vec<Vec<f32>> =
+            members.iter().map(|&i| split(&views[i], Target::Distant).0).collect();
+        let stacked: Vec<View> = members
+            .iter()
+            .zip(&rhs)
+            .filter(|(&i, _)| views[i].a[s].rows() > 0)
+            .map(|(&i, b)| View { a: &views[i].a[s], b })
+            .collect();
+        let texels = if stacked.is_empty() {
+            vec![0.0; layout.texel_count() * 3]
+        } else {
+            let rows: usize = stacked.iter().map(|v| v.a.rows()).sum();
+            let x = solver.solve_view_independent(&stacked, None, settings)?;
+            iterations += x.iterations as u64;
+            sq += x.residual_rms * x.residual_rms * rows as f64;
+            count += rows;
+            x.texels
+        };
+        textures.insert(k.clone(), texels);
+    }
+    Ok(SolvedShell { textures, iterations, residual_rms: (sq / count.max(1) as f64).sqrt() })
+}
+
 /// One sample's solve: its own rows, stacked with its weighed-down neighbours' when it has
 /// any (eq. 3.7's stacking, in the AᵀA form).
 fn solve_stacked(
@@ -140,6 +182,11 @@ fn solve_stacked(
         .chain(neighbours.iter().map(|&(a, b)| View { a, b }))
         .collect();
     Ok(solver.solve_view_independent(&views, warm, settings)?)
+}
+
+/// The traced distant layer of a point's rows, clipped as its solve clips it (RGB per row).
+pub fn distant_values(v: &ShellView) -> Vec<f32> {
+    split(v, Target::Distant).0
 }
 
 /// The right-hand sides of a point: RGB per row, and for the local layer its alpha in the

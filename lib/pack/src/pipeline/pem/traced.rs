@@ -122,10 +122,11 @@ pub fn static_env(
 ) -> Result<ObjectModel> {
     let set = job.set;
     let shell = sphere_at_infinity(origin);
-    let n = face_resolution(set, o, &job.meshes, shell, largest)?;
+    let n = face_resolution(set, o, &job.meshes, &shell, largest)?;
     let layout = TextureLayout::cube(n);
     let all: Vec<usize> = (0..set.frames.len()).collect();
-    let views = shell_views(set, o, &job.meshes, &[(shell, layout, None)], 1, f0, (pixels, &all))?;
+    let views =
+        shell_views(set, o, &job.meshes, &[(shell.clone(), layout, None)], 1, f0, (pixels, &all))?;
     let first = set.frames[0].instances[o].world_from_object.inverse();
     // The map does not depend on the camera: points whose objects and lights stand alike
     // (every point of a view-only space) share one trace.

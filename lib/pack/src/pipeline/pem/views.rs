@@ -67,7 +67,7 @@ fn shell_object<'m>(
     p: usize,
     o: usize,
     mesh: &'m Mesh,
-    (shell, layout, drawn): (Shell, TextureLayout, Option<&'m [bool]>),
+    (shell, layout, drawn): (&Shell, TextureLayout, Option<&'m [bool]>),
     lookups: u32,
 ) -> ShellObject<'m> {
     let (w, h) = set.resolution;
@@ -83,7 +83,7 @@ fn shell_object<'m>(
         clip_from_object: clip,
         world_from_object: world,
         eye: frame.camera.world_from_camera.w_axis.truncate(),
-        shell,
+        shell: shell.clone(),
         layout,
         drawn,
         lookups,
@@ -167,8 +167,8 @@ pub fn shell_views(
             let depth = occluders(set, p, o, meshes)?;
             let cov = coverage(set, p, o)?;
             let mut a = Vec::with_capacity(shells.len());
-            for &(shell, layout, drawn) in shells {
-                let m = shell_render_matrix(vp, &shell_object(set, p, o, &meshes[o], (shell, layout, drawn), lookups), Some(&depth))?;
+            for (shell, layout, drawn) in shells {
+                let m = shell_render_matrix(vp, &shell_object(set, p, o, &meshes[o], (shell, *layout, *drawn), lookups), Some(&depth))?;
                 let mut m = restrict_rows(&m, &cov);
                 if drawn.is_some() {
                     m = with_rows_at(&m, pixels);
@@ -178,7 +178,7 @@ pub fn shell_views(
                 }
                 a.push(m);
             }
-            let (fp, f) = shell_fresnel(vp, &shell_object(set, p, o, &meshes[o], (shells[0].0, shells[0].1, None), 1), Some(&depth), f0)?;
+            let (fp, f) = shell_fresnel(vp, &shell_object(set, p, o, &meshes[o], (&shells[0].0, shells[0].1, None), 1), Some(&depth), f0)?;
             let mut fresnel = Vec::with_capacity(pixels.len() * 3);
             let mut k = 0;
             for &px in pixels {
@@ -206,7 +206,7 @@ pub fn face_resolution(
     set: &LoadedSet,
     o: usize,
     meshes: &[Mesh],
-    shell: Shell,
+    shell: &Shell,
     largest: u32,
 ) -> Result<u32> {
     let (w, h) = set.resolution;
