@@ -2,11 +2,13 @@
 //! specular light as two environment-map shells per parameter sample — a local shell, the
 //! least-volume ellipsoid bounding the object, with alpha for the object's reflections of
 //! itself, over a distant shell, a box on the supporting surface or a sphere, whichever
-//! reproduces the traced distant layer better ([`fit`]) — modulated by the Fresnel factor
-//! the player evaluates from the object's F0; plus a diffuse surface texture when the object
-//! has one ([`super::surface`]). Each shell's render matrix comes from the hardware model's
-//! environment-map lookup ([`views`]); the cube maps are solved, every MIP level together,
-//! against the tracer's local and distant layers ([`solve`]) and stored whole ([`form`]).
+//! reproduces the traced distant layer better ([`fit`]), or a depth shell, one map over the
+//! views, where it predicts a point between two samples better ([`between`]) — modulated by
+//! the Fresnel factor the player evaluates from the object's F0; plus a diffuse surface
+//! texture when the object has one ([`super::surface`]). Each shell's render matrix comes
+//! from the hardware model's environment-map lookup ([`views`]); the cube maps are solved,
+//! every MIP level together, against the tracer's local and distant layers ([`solve`]) and
+//! stored whole ([`form`]).
 //! The baselines of thesis 5.10 and 5.1 are made here too: one map at infinity per sample,
 //! inferred (`single_shell`) or ray-traced from the object's centre ([`traced`]).
 
