@@ -361,12 +361,14 @@ fn sub_pixel_lookups_follow_the_traced_footprint() {
 /// depends on no dimension: a quarter of the per-view maps' bytes); the file is of minor
 /// version 5, validates, pis-inspect names the shells, and the player — which casts the
 /// depth cubes from the file's meshes when it opens it — draws them as pis-pack predicted.
-/// `auto` reports the depth shell's error between the samples beside the shell it keeps.
+/// `--distant-shell auto` reports the depth shell's error between the samples beside the
+/// shell it keeps.
 #[test]
 fn depth_shells_follow_the_scene_and_play_as_predicted() {
     let dir = tempfile::tempdir().expect("temp dir");
     let scene = copy_sample(dir.path());
-    let (_, fitted) = pack(&scene, "auto.pis", &["--representation", "pem"]);
+    let (_, fitted) =
+        pack(&scene, "auto.pis", &["--representation", "pem", "--distant-shell", "auto"]);
     let (depth, r) =
         pack(&scene, "depth.pis", &["--representation", "pem", "--distant-shell", "depth"]);
     for name in ["TeapotBody", "TeapotLid"] {

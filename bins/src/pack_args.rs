@@ -147,13 +147,13 @@ pub struct PackOptions {
     /// the player draws them so.
     #[arg(long, value_name = "1|2|3", default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=pis_format::MAX_SHELL_LOOKUPS as i64))]
     pub shell_lookups: u32,
-    /// Layered environment maps: a reflective object's distant shell. `auto`: a box on the
-    /// surface the object rests on or a sphere, whichever is nearer the traced distant layer,
-    /// then a depth shell (SPEC.md 8.5: its radius in each direction the distance to the
-    /// other objects, one map over the views) where it predicts a view held out between two
-    /// samples better; `fitted`: the box or the sphere, as `auto` before the depth shell;
-    /// `box`, `sphere` or `depth`: that shell.
-    #[arg(long, default_value = "auto", value_parser = one_of(&DistantShell::ALL, DistantShell::name))]
+    /// Layered environment maps: a reflective object's distant shell. `fitted`: a box on the
+    /// surface the object rests on or a sphere, whichever is nearer the traced distant layer
+    /// (thesis 5.4); `auto`: that, then a depth shell (SPEC.md 8.5: its radius in each
+    /// direction the distance to the other objects, one map over the views) where it
+    /// predicts a view held out between two samples better, at some cost at the sampled
+    /// views; `box`, `sphere` or `depth`: that shell.
+    #[arg(long, default_value = "fitted", value_parser = one_of(&DistantShell::ALL, DistantShell::name))]
     pub distant_shell: DistantShell,
     /// Also store the lossless master: every solved texture, before gamma compensation and
     /// coding, losslessly coded in MSTR chunks a player never reads. pis-reencode codes
