@@ -39,7 +39,8 @@ pub struct FittedShells {
     /// The distant shell candidates: a box and a sphere about the origin.
     pub distant_box: Shell,
     pub distant_sphere: Shell,
-    /// The depth shell, where the scene has diffuse objects to cast its depth cube from.
+    /// The depth shell, where one was asked for and the scene has other objects to cast its
+    /// depth cube from.
     pub distant_depth: Option<Shell>,
     /// Whether the box's bottom lies on a supporting surface.
     pub supported: bool,
@@ -51,8 +52,14 @@ fn world_positions(set: &LoadedSet, p: usize, o: usize, mesh: &Mesh) -> Vec<Vec3
     mesh.positions.iter().map(|&q| m.transform_point3(Vec3::from(q))).collect()
 }
 
-/// Fits the shells of object `o` (mesh `mesh`) where it stands at the set's first point.
-pub fn fit_shells(set: &LoadedSet, o: usize, meshes: &[Mesh]) -> Result<FittedShells> {
+/// Fits the shells of object `o` (mesh `meshes[o]`) where it stands at the set's first point,
+/// the depth shell only `with_depth`.
+pub fn fit_shells(
+    set: &LoadedSet,
+    o: usize,
+    meshes: &[Mesh],
+    with_depth: bool,
+) -> Result<FittedShells> {
     let name = &set.scene.objects[o].name;
     let mesh = &meshes[o];
     let world = world_positions(set, 0, o, mesh);
@@ -91,7 +98,9 @@ pub fn fit_shells(set: &LoadedSet, o: usize, meshes: &[Mesh]) -> Result<FittedSh
         },
         distant_box: box_shell,
         distant_sphere: Shell { origin: o3, shape: ShellShape::Sphere { radius } },
-        distant_depth: distant_depth(set, meshes, o, centre, radius as f32),
+        distant_depth: with_depth
+            .then(|| distant_depth(set, meshes, o, centre, radius as f32))
+            .flatten(),
         supported: support.is_some(),
     })
 }

@@ -75,7 +75,9 @@ impl Representation for LayeredPem {
             return survey_surface(job, o, true);
         }
         let Some(surface) = survey_surface(job, o, false)? else { return Ok(None) };
-        let fitted = fit_shells(set, o, &job.meshes)?;
+        // The depth shell's cube is cast only where `--distant-shell` may take it.
+        let with_depth = matches!(job.req.distant_shell, DistantShell::Auto | DistantShell::Depth);
+        let fitted = fit_shells(set, o, &job.meshes, with_depth)?;
         Ok(Some(Box::new(PemSurveyed { o, surface, fitted })))
     }
 }
@@ -295,8 +297,7 @@ fn distant_trial(
         ),
     };
     let classes: Vec<Vec<u32>> = set.samples.iter().map(|s| key(s, job.non_view)).collect();
-    let depth =
-        fitted.distant_depth.as_ref().filter(|_| job.req.distant_shell == DistantShell::Auto);
+    let depth = fitted.distant_depth.as_ref();
     let (Some(depth), Some(points)) = (depth, held_out_points(&classes)) else {
         return Ok(choice);
     };
