@@ -40,6 +40,7 @@ pub mod model;
 pub mod normal_equations;
 pub mod raster;
 pub mod regularize;
+pub mod relight;
 pub mod sampler;
 pub mod shell;
 pub mod solve;

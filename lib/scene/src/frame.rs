@@ -3,10 +3,17 @@
 use glam::Mat4;
 
 use crate::light_path::point_on_path;
-use crate::model::{Camera, Driver, Frame, Instance, Light, Scene};
+use crate::model::{Camera, Driver, Frame, Instance, Light, LightKind, Scene};
 use crate::orbit::orbit_camera;
 use crate::rig::{light_pose, rigid_part, CameraPlacement};
 use crate::SceneError;
+
+/// Where a dimension moves a light: to a place, or turned to shine from direction `w`
+/// (a placed light standing at `at`).
+enum Moved {
+    To(glam::Vec3),
+    Turned { w: glam::Vec3, at: glam::Vec3 },
+}
 
 impl Scene {
     /// The camera, lights and object placements at the parameter point `point` (one sample
@@ -14,7 +21,7 @@ impl Scene {
     ///
     /// Dimensions apply in order: animations pose the nodes (a later animation overrides an
     /// earlier one on the same node), an orbit dimension then places the camera, and a light
-    /// path moves its light.
+    /// path or a light direction moves its light.
     pub fn frame(&self, point: &[u32]) -> Result<Frame, SceneError> {
         let dims = &self.space.dims;
         if point.len() != dims.len() || point.iter().zip(dims).any(|(&i, d)| i >= d.samples()) {
@@ -47,7 +54,11 @@ impl Scene {
                     orbit = Some(orbit_camera(*target, *radius, *elevation_deg, value));
                 }
                 Driver::LightPath { light, path } => {
-                    moved_lights.push((light, point_on_path(path, value)))
+                    moved_lights.push((light, Moved::To(point_on_path(path, value))))
+                }
+                Driver::LightDirection { light, directions, center, distance } => {
+                    let w = directions[i as usize];
+                    moved_lights.push((light, Moved::Turned { w, at: *center + *distance * w }))
                 }
                 Driver::Still => {}
             }
@@ -72,12 +83,18 @@ impl Scene {
             .lights
             .iter()
             .map(|l| {
-                let (mut position, direction) =
+                let (mut position, mut direction) =
                     light_pose(world.get(l.node).copied().unwrap_or(Mat4::IDENTITY));
                 let node_name = rig.nodes.get(l.node).map(|n| n.name.as_str());
-                for (name, p) in &moved_lights {
+                for (name, moved) in &moved_lights {
                     if **name == l.name || Some(name.as_str()) == node_name {
-                        position = *p;
+                        match *moved {
+                            Moved::To(p) => position = p,
+                            Moved::Turned { w, at } if l.kind == LightKind::Directional => {
+                                (direction, position) = (-w, at);
+                            }
+                            Moved::Turned { at, .. } => position = at,
+                        }
                     }
                 }
                 Light {

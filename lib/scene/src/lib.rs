@@ -34,6 +34,7 @@ mod gltf_images;
 mod gltf_load;
 pub mod lens_tree;
 mod light;
+pub mod light_direction;
 pub mod light_path;
 mod load;
 #[cfg(test)]

@@ -90,6 +90,7 @@ pub enum DriverSpec {
     Orbit,
     Animation,
     LightPath,
+    LightDirection,
 }
 
 /// A dimension kind as written in scene.toml.
@@ -111,7 +112,8 @@ pub struct DimensionSpec {
     pub name: String,
     pub driver: DriverSpec,
     pub samples: u32,
-    /// Only for `animation` (default `time`); `orbit` is always `view`, `light_path` `light`.
+    /// Only for `animation` (default `time`); `orbit` is always `view`, `light_path` and
+    /// `light_direction` `light`.
     pub kind: Option<KindSpec>,
     /// The samples cover a closed loop: the end of the range is not sampled again.
     pub periodic: Option<bool>,
@@ -130,6 +132,23 @@ pub struct DimensionSpec {
     pub path: Option<Vec<[f32; 3]>>,
     /// First and last sampled arc-length fraction, default `[0, 1]`.
     pub range: Option<[f32; 2]>,
+    // light_direction (with `light`)
+    /// `hemisphere` (default) or `sphere`.
+    pub directions: Option<CoverSpec>,
+    /// The hemisphere's pole, default `[0, 1, 0]`.
+    pub up: Option<[f32; 3]>,
+    /// A point, spot or sphere light's centre of turning.
+    pub center: Option<[f32; 3]>,
+    /// A point, spot or sphere light's distance from `center`.
+    pub distance: Option<f32>,
+}
+
+/// Which directions a `light_direction` dimension covers, as written in scene.toml.
+#[derive(Clone, Copy, Debug, Deserialize, PartialEq, Eq)]
+#[serde(rename_all = "snake_case")]
+pub enum CoverSpec {
+    Hemisphere,
+    Sphere,
 }
 
 /// `[preset.NAME]`: overrides applied when the preset is selected.

@@ -278,6 +278,10 @@ pub enum Driver {
     /// A named light moves along a polyline (world space); the sample value is the path
     /// parameter in [0, 1] (arc-length).
     LightPath { light: String, path: Vec<Vec3> },
+    /// A named light turned over a set of directions (unit, from the scene towards the
+    /// light); the sample value is the sample's index. A directional light shines along
+    /// −direction; a point, spot or sphere light stands at `center + distance · direction`.
+    LightDirection { light: String, directions: Vec<Vec3>, center: Vec3, distance: f32 },
     /// Nothing moves: the one sample of the dimension a scene without `[[dimension]]` gets,
     /// since a container holds 1 to 8 dimensions.
     Still,

@@ -5,9 +5,10 @@ use std::path::Path;
 use glam::Vec3;
 
 use crate::gltf_load::GltfScene;
-use crate::manifest::{DimensionSpec, DriverSpec, KindSpec};
+use crate::light_direction::{light_directions, Cover};
+use crate::manifest::{CoverSpec, DimensionSpec, DriverSpec, KindSpec};
 use crate::model::{Dimension, Driver, ParameterSpace};
-use crate::{DimensionKind, SceneError};
+use crate::{DimensionKind, LightKind, SceneError};
 
 /// `n` sample values from `a` to `b`: inclusive of `b`, or for a periodic dimension
 /// (a closed loop) stopping one step short of it.
@@ -56,6 +57,7 @@ pub(crate) fn build_space(
             }
             DriverSpec::Animation => animation(&at, g)?,
             DriverSpec::LightPath => light_path(&at, g)?,
+            DriverSpec::LightDirection => light_direction(&at, g)?,
         };
         let Resolved { kind, unit, range: ([a, b], range_key), driver } = resolved;
         if d.samples > 1 && b <= a {
@@ -147,7 +149,7 @@ fn check_keys(at: &At, earlier: &[DimensionSpec]) -> Result<(), SceneError> {
         return Err(at.invalid("name", format!("dimension name `{}` is used twice", d.name)));
     }
     // Keys each driver may use; any other driver-specific key is an error.
-    let present: [(&str, bool); 9] = [
+    let present: [(&str, bool); 13] = [
         ("target", d.target.is_some()),
         ("radius", d.radius.is_some()),
         ("elevation_deg", d.elevation_deg.is_some()),
@@ -157,11 +159,16 @@ fn check_keys(at: &At, earlier: &[DimensionSpec]) -> Result<(), SceneError> {
         ("light", d.light.is_some()),
         ("path", d.path.is_some()),
         ("range", d.range.is_some()),
+        ("directions", d.directions.is_some()),
+        ("up", d.up.is_some()),
+        ("center", d.center.is_some()),
+        ("distance", d.distance.is_some()),
     ];
     let allowed: &[&str] = match d.driver {
         DriverSpec::Orbit => &["target", "radius", "elevation_deg", "azimuth_deg"],
         DriverSpec::Animation => &["animation", "time"],
         DriverSpec::LightPath => &["light", "path", "range"],
+        DriverSpec::LightDirection => &["light", "directions", "up", "center", "distance"],
     };
     if let Some((key, _)) = present.iter().find(|(k, p)| *p && !allowed.contains(k)) {
         return Err(at.invalid(key, format!("key not used by driver {:?}", d.driver)));
@@ -212,14 +219,69 @@ fn animation(at: &At, g: &GltfScene) -> Result<Resolved, SceneError> {
     })
 }
 
+/// The light named by `light`, or the error naming the lights there are.
+fn named_light<'a>(at: &At<'a>, g: &GltfScene) -> Result<(&'a str, LightKind), SceneError> {
+    let name = at.d.light.as_deref().ok_or_else(|| at.required("light"))?;
+    match g.rig.lights.iter().find(|l| l.name == name || g.rig.nodes[l.node].name == name) {
+        Some(l) => Ok((name, l.kind)),
+        None => {
+            let known = g.rig.lights.iter().map(|l| l.name.as_str());
+            Err(SceneError::unknown(at.path, at.field("light"), "light", name, known))
+        }
+    }
+}
+
+/// A light turned over the directions of a hemisphere or the sphere; the sample values are
+/// the samples' indices. A directional light needs no `center` or `distance`; any other
+/// light needs both.
+fn light_direction(at: &At, g: &GltfScene) -> Result<Resolved, SceneError> {
+    let d = at.d;
+    let (name, kind) = named_light(at, g)?;
+    let up = Vec3::from(d.up.unwrap_or([0.0, 1.0, 0.0]));
+    if !up.is_finite() || up.length() < 1e-6 {
+        return Err(at.invalid("up", format!("must be a finite direction, found {up}")));
+    }
+    let (center, distance) = match (kind, d.center, d.distance) {
+        (LightKind::Directional, None, None) => (Vec3::ZERO, 0.0),
+        (LightKind::Directional, _, _) => {
+            let key = if d.center.is_some() { "center" } else { "distance" };
+            return Err(at.invalid(key, format!("light `{name}` is directional: it has no place")));
+        }
+        (_, Some(c), Some(r)) if r > 0.0 && r.is_finite() => (Vec3::from(c), r),
+        (_, Some(_), Some(r)) => {
+            return Err(at.invalid("distance", format!("must be > 0, found {r}")));
+        }
+        (_, None, _) => {
+            return Err(at.invalid("center", format!("required: light `{name}` has a place")))
+        }
+        (_, _, None) => {
+            return Err(at.invalid("distance", format!("required: light `{name}` has a place")))
+        }
+    };
+    let cover = match d.directions.unwrap_or(CoverSpec::Hemisphere) {
+        CoverSpec::Hemisphere => Cover::Hemisphere,
+        CoverSpec::Sphere => Cover::Sphere,
+    };
+    if d.periodic == Some(true) {
+        return Err(at.invalid("periodic", "a set of directions has no loop to close"));
+    }
+    Ok(Resolved {
+        kind: at.fixed_kind(KindSpec::Light)?,
+        unit: "",
+        range: ([0.0, d.samples.saturating_sub(1) as f32], "samples"),
+        driver: Driver::LightDirection {
+            light: name.to_owned(),
+            directions: light_directions(d.samples, cover, up.normalize()),
+            center,
+            distance,
+        },
+    })
+}
+
 /// A light moved along a polyline (the range in normalised arc length, [0, 1] by default).
 fn light_path(at: &At, g: &GltfScene) -> Result<Resolved, SceneError> {
     let d = at.d;
-    let name = d.light.as_deref().ok_or_else(|| at.required("light"))?;
-    if !g.rig.lights.iter().any(|l| l.name == name || g.rig.nodes[l.node].name == name) {
-        let known = g.rig.lights.iter().map(|l| l.name.as_str());
-        return Err(SceneError::unknown(at.path, at.field("light"), "light", name, known));
-    }
+    let (name, _) = named_light(at, g)?;
     let pts: Vec<Vec3> = d
         .path
         .as_ref()

@@ -55,7 +55,7 @@ pub struct DimensionMeta {
     pub name: String,
     /// `view`, `light`, `object_motion`, `time` or `other`.
     pub kind: String,
-    /// `orbit`, `animation` or `light_path`.
+    /// `orbit`, `animation`, `light_path`, `light_direction` or `still`.
     pub driver: String,
     /// True when the dimension wraps around.
     pub periodic: bool,
@@ -63,6 +63,10 @@ pub struct DimensionMeta {
     pub unit: String,
     /// The value of every sample.
     pub values: Vec<f32>,
+    /// A `light_direction` dimension's direction of every sample: unit, world space, from
+    /// the scene towards the light.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub directions: Option<Vec<[f32; 3]>>,
 }
 
 /// One object and the layers it has.

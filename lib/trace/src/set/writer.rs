@@ -83,12 +83,19 @@ impl SetWriter {
                     Driver::Orbit { .. } => "orbit",
                     Driver::Animation { .. } => "animation",
                     Driver::LightPath { .. } => "light_path",
+                    Driver::LightDirection { .. } => "light_direction",
                     Driver::Still => "still",
                 }
                 .into(),
                 periodic: d.periodic,
                 unit: d.unit.clone(),
                 values: d.values.clone(),
+                directions: match &d.driver {
+                    Driver::LightDirection { directions, .. } => {
+                        Some(directions.iter().map(|w| w.to_array()).collect())
+                    }
+                    _ => None,
+                },
             })
             .collect();
         SetMeta {

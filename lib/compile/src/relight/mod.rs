@@ -1,0 +1,13 @@
+//! Relighting by spherical harmonics (Wong et al., seed 003): a texel's radiance as a function
+//! of the direction ω of one light, `f(ω) = Σ_c Y_c(ω) x_c`, with the real spherical
+//! harmonics Y_c up to band `l_max` ([`basis`]), fitted by least squares to the radiance the
+//! set holds at its sampled directions ([`fit`]), and relit by superposition: lights of other
+//! directions and colours add, and a sky projected into the same basis ([`sky`]) is one more
+//! light.
+
+pub mod basis;
+pub mod fit;
+pub mod sky;
+
+pub use basis::{basis, coefficients, MAX_BAND};
+pub use fit::{Cover, LightFit};
