@@ -33,4 +33,5 @@ pub mod heatmap;
 pub mod inspect;
 pub mod metrics;
 pub mod reencode;
+pub mod relight;
 pub mod report;

@@ -715,6 +715,7 @@ mod tests {
             term: Term::Reflection,
             order: 0,
             combine: Combine::Over,
+            basis: 0,
             gamma: 1.0,
             depends_on: DepMask::NONE,
             blocks: vec![],

@@ -42,6 +42,7 @@ fn container() -> Container {
         term: Term::Surface,
         order: 0,
         combine: Combine::Add,
+        basis: 0,
         gamma: 2.2,
         depends_on: DepMask::of(&[0, 1]),
         blocks: vec![],

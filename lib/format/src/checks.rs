@@ -201,7 +201,26 @@ pub(crate) fn check_parsed<S>(p: &Parsed<S>) -> Vec<Issue> {
             }
         }
     }
+    light_basis(p, &mut out);
     out
+}
+
+/// Rules 9006 (the light directions, which need the space) and 6011 (the layers that span
+/// them).
+fn light_basis<S>(p: &Parsed<S>, out: &mut Vec<Issue>) {
+    let (Some(space), Some(prov)) = (p.space, p.provenance) else { return };
+    let lights = match crate::relight::light_directions(prov, space) {
+        Ok(l) => l,
+        Err(detail) => {
+            out.push(chunk(Issue::new(id::provenance::LIGHT_DIRECTIONS, detail), "PROV"));
+            return;
+        }
+    };
+    if let Some(objects) = p.objects {
+        if let Err(detail) = crate::relight::check_basis_layers(objects, lights.as_ref()) {
+            out.push(chunk(Issue::new(id::layers::LIGHT_BASIS, detail), "LAYR"));
+        }
+    }
 }
 
 /// Rules 9001–9003 on the provenance settings (9004 and 9005, which need the objects, above).
@@ -534,10 +553,28 @@ fn layers<S>(
                 ),
             ));
         }
-        if !slots.insert((l.term as u8, l.order)) {
+        if l.basis != 0 && !crate::relight::basis_layer_fits(l) {
+            out.push(e(
+                id::layers::INVALID_COMBINATION,
+                format!(
+                    "light basis {} on a {}-channel {} layer combined by {} (a 3-channel surface layer added, basis at most {})",
+                    l.basis,
+                    l.channels,
+                    l.mapping.name(),
+                    l.combine.name(),
+                    crate::relight::MAX_COEFFICIENTS
+                ),
+            ));
+        }
+        if !slots.insert((l.term as u8, l.order, l.basis)) {
             out.push(e(
                 id::layers::TERM_ORDER_REPEATED,
-                format!("term {} order {} is already used", l.term.name(), l.order),
+                format!(
+                    "term {} order {} light basis {} is already used",
+                    l.term.name(),
+                    l.order,
+                    l.basis
+                ),
             ));
         }
         if !(l.gamma.is_finite() && l.gamma > 0.0) {

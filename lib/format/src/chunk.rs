@@ -8,7 +8,7 @@ use crate::Issue;
 pub const MAGIC: [u8; 8] = [0x89, b'P', b'I', b'S', 0x0D, 0x0A, 0x1A, 0x0A];
 pub const VERSION_MAJOR: u16 = 1;
 /// The minor version of this text (SPEC.md 10.1); writers write the lowest one a file needs.
-pub const VERSION_MINOR: u16 = 5;
+pub const VERSION_MINOR: u16 = 6;
 pub const HEADER_LEN: u64 = 32;
 pub const ENTRY_LEN: u64 = 32;
 /// Chunk payloads start at multiples of this.

@@ -175,9 +175,10 @@ rules! {
         BLOCK_COUNT = 6005, "block count differs from the layer's block grid";
         TEXTURE_SIZE = 6006, "texture size is zero, too large, or a shell face is not square";
         BLOCK_PLACEMENT = 6007, "block placement is invalid";
-        TERM_ORDER_REPEATED = 6008, "two layers of one object share a term and order";
+        TERM_ORDER_REPEATED = 6008, "two layers of one object share a term, order and light basis";
         LEVEL_IMAGE_TOO_LARGE = 6009, "a level image decodes to more than 8192 × C bytes (section 12)";
         LEVEL_IMAGES_TOO_LARGE = 6010, "the level images together decode to more than 131072 × C bytes (section 12)";
+        LIGHT_BASIS = 6011, "a light-basis layer has no light directions to span, or depends on their dimension";
     }
     /// 7xxx: a block's pyramid levels.
     pub mod pyramid {
@@ -206,6 +207,7 @@ rules! {
         KEY_REPEATED = 9003, "setting key appears more than once";
         TINT = 9004, "transmission tint setting names no refractive object, or is not three numbers in [0, 1]";
         LENS_MODEL = 9005, "lens model setting names no refractive object, or is neither greedy nor tree,W,N";
+        LIGHT_DIRECTIONS = 9006, "light directions name no light dimension, differ from its samples in count, are not unit, or lack a positive radiance";
     }
     /// 91xx: the lossless master (`MSTR`, section 6.7), checked when a reader reads it.
     pub mod master {

@@ -27,6 +27,7 @@ mod payload_read;
 mod payload_write;
 mod read;
 pub mod reconstruct;
+pub mod relight;
 pub mod samples;
 mod source;
 pub mod texture;

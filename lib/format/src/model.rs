@@ -343,6 +343,9 @@ pub struct Layer<S = Codestream> {
     /// from order 0 (nearest) outwards.
     pub order: u8,
     pub combine: Combine,
+    /// 0, or c + 1: the layer holds coefficient c of the spherical harmonics of the object's
+    /// radiance over the file's light directions (since 1.6; section 7.1).
+    pub basis: u8,
     /// Stored values are γ(L) = sign(L)·|L|^(1/gamma); 1 means linear (section 4.6).
     pub gamma: f32,
     /// The dimensions this layer varies over; blocks tile only these.
@@ -517,6 +520,7 @@ impl<S> Container<S> {
                     term: l.term,
                     order: l.order,
                     combine: l.combine,
+                    basis: l.basis,
                     gamma: l.gamma,
                     depends_on: l.depends_on,
                     blocks,

@@ -203,7 +203,7 @@ pub fn layr(
         let term = c.u8("term")?;
         let order = c.u8("order")?;
         let combine = c.u8("combine")?;
-        c.reserved(1, "layer reserved")?;
+        let basis = c.u8("light basis")?;
         let bad = |what: &str, v: u8| {
             c.issue(id::layers::UNKNOWN_CODE, format!("layer {li} {what} {v} is not defined"))
                 .at(codes_at)
@@ -258,6 +258,7 @@ pub fn layr(
             term,
             order,
             combine,
+            basis,
             gamma,
             depends_on,
             blocks,

@@ -97,7 +97,7 @@ pub fn layr<S>(s: &mut Sink, objects: &[Object<S>], mut stream_ref: impl FnMut(&
             s.u8(l.term as u8, &format!("{p} term ({})", l.term.name()));
             s.u8(l.order, &format!("{p} order"));
             s.u8(l.combine as u8, &format!("{p} combine ({})", l.combine.name()));
-            s.zeros(1, &format!("{p} reserved"));
+            s.u8(l.basis, &format!("{p} light basis"));
             s.f32s(&[l.gamma], &format!("{p} gamma"));
             s.u32(l.depends_on.0, &format!("{p} dependency mask"));
             s.u32(l.blocks.len() as u32, &format!("{p} block count"));

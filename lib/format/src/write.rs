@@ -221,11 +221,15 @@ fn serialize_inner(c: &Container, masters: &[Master], labelled: bool) -> Sink {
     assemble(chunks, minor_version(c), labelled)
 }
 
-/// The lowest minor version whose rules the file needs (SPEC.md 10.1): 5 where a shell block
+/// The lowest minor version whose rules the file needs (SPEC.md 10.1): 6 where a layer holds
+/// a light-basis coefficient (7.1), 5 where a shell block
 /// has shape `depth` (7.3), 4 where an object has a filter of its own (a `filter.NAME`
 /// setting, 6.6), 3 where an object is translucent (a surface layer of 4 channels, 7.1),
 /// else 2.
 fn minor_version(c: &Container) -> u16 {
+    if c.objects.iter().flat_map(|o| &o.layers).any(|l| l.basis != 0) {
+        return VERSION_MINOR;
+    }
     let depth_shell = c
         .objects
         .iter()
@@ -241,7 +245,7 @@ fn minor_version(c: &Container) -> u16 {
         .flat_map(|o| &o.layers)
         .any(|l| l.mapping == Mapping::Surface && l.channels == 4);
     if depth_shell {
-        VERSION_MINOR
+        5
     } else if own_filter {
         4
     } else if translucent {

@@ -5,7 +5,11 @@
 
 use std::collections::BTreeSet;
 
+#[path = "rules/cases.rs"]
+mod cases;
 mod common;
+
+use cases::{light_basis_cases, many_large_level_images};
 
 use common::{reseal, u64_at};
 use pis_format::chunk::{ENTRY_LEN, HEADER_LEN};
@@ -14,7 +18,7 @@ use pis_format::samples::{master_of, minimal, tiny};
 use pis_format::*;
 
 /// A valid file with its field labels.
-struct File {
+pub(crate) struct File {
     bytes: Vec<u8>,
     spans: Vec<Span>,
 }
@@ -83,39 +87,10 @@ fn set_file_length(b: &mut [u8]) {
     b[16..24].copy_from_slice(&n.to_le_bytes());
 }
 
-fn unchecked(edit: impl FnOnce(&mut Container)) -> Vec<u8> {
+pub(crate) fn unchecked(edit: impl FnOnce(&mut Container)) -> Vec<u8> {
     let mut c = tiny().unwrap();
     edit(&mut c);
     to_bytes_unchecked(&c)
-}
-
-/// Rule 6010: the light dimension of `tiny` made 32 samples long, in one block, so that the
-/// diffuse layer's block holds 63 level images (1 + 2 + … + 32) of a few bytes each; its
-/// texture then declared 1024² texels. One level image (12 MiB) stays under 8192 × the
-/// file's codestream bytes (2.4 KB), all 63 together exceed 131072 × them.
-fn many_large_level_images() -> Vec<u8> {
-    let mut c = tiny().unwrap();
-    let light = &mut c.space.dims[1];
-    light.values = (0..32).map(|i| i as f32 / 31.0).collect();
-    light.block_size = 32;
-    let layer = c.objects[0].layers[0].clone();
-    let block = Block { levels: vec![], ..layer.blocks[0].clone() };
-    let (w, h) = (block.width, block.height);
-    let counts: Vec<Vec<u32>> = (0..6).map(|k| vec![1 << k]).collect();
-    let textures: Vec<Vec<f32>> =
-        (0..32).map(|i| vec![0.1 + 0.02 * i as f32; (w * h * 3) as usize]).collect();
-    let block = pis_format::samples::encode_block(
-        &layer,
-        block,
-        &[32],
-        &counts,
-        &textures,
-        CodecId::Lossless,
-    )
-    .unwrap();
-    c.objects[0].layers[0].blocks = vec![block];
-    let mut f = File::of(&c);
-    f.set_u32("layer 0 block 0 width", 1024).set_u32("layer 0 block 0 height", 1024).reseal()
 }
 
 /// Every case: (rule id, the crafted file), by the spec's groups of rules.
@@ -127,6 +102,7 @@ fn cases() -> Vec<(u16, Vec<u8>)> {
         layer_pyramid_cases(),
         codestream_provenance_cases(),
         master_cases(),
+        light_basis_cases(),
     ]
     .concat()
 }

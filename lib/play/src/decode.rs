@@ -272,6 +272,7 @@ mod tests {
             term: Term::Reflection,
             order: 0,
             combine: Combine::Over,
+            basis: 0,
             gamma: 2.2,
             depends_on: DepMask::NONE,
             blocks: vec![],

@@ -106,6 +106,7 @@ fn shell_layer(spec: &ShellSpec, order: u8, textures: &[Vec<f32>]) -> Layer<Code
         term: Term::Reflection,
         order,
         combine: Combine::Over,
+        basis: 0,
         gamma: 1.0,
         depends_on: if varies { DepMask::of(&[0]) } else { DepMask::NONE },
         blocks: vec![],

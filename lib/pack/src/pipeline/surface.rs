@@ -418,6 +418,7 @@ fn surface_layer(
         term: pis_format::Term::Surface,
         order,
         combine: pis_format::Combine::Add,
+        basis: 0,
         gamma,
         depends_on,
         blocks: vec![],

@@ -40,6 +40,7 @@ impl LayerForm for ShellForm {
             term: self.term,
             order: self.order,
             combine: pis_format::Combine::Over,
+            basis: 0,
             gamma,
             depends_on,
             blocks: vec![],
