@@ -81,7 +81,7 @@ pub fn light_directions(
         }
         if let Some(i) = directions.iter().position(|w| {
             let n = (w[0] * w[0] + w[1] * w[1] + w[2] * w[2]).sqrt();
-            !((n - 1.0).abs() <= 1e-3)
+            n.is_nan() || (n - 1.0).abs() > 1e-3
         }) {
             return Err(format!("{k}: direction {i} is not a unit vector"));
         }
