@@ -46,6 +46,7 @@ pub mod played;
 pub mod predict;
 pub mod radiance;
 pub mod registry;
+pub mod relit;
 pub mod report;
 pub mod represent;
 pub mod rows;
@@ -60,6 +61,7 @@ pub mod storage;
 pub mod stored_mesh;
 pub mod surface;
 pub mod sweep;
+pub mod texture_form;
 pub mod textures;
 pub mod transforms;
 

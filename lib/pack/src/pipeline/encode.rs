@@ -91,6 +91,13 @@ fn sample_screen_weights(
     })
 }
 
+/// Layer `li`'s order within its term: the object's layers in turn, a relightable layer's
+/// coefficients (SPEC.md 7.1) sharing their first one's.
+fn order_of(m: &ObjectModel, li: usize) -> u8 {
+    let starts = |l: &super::model::InferredLayer| l.light.as_ref().is_none_or(|b| b.c == 0);
+    (m.layers[..=li].iter().filter(|l| starts(l)).count() - 1) as u8
+}
+
 /// Every block's pyramid, in (object model, layer, block) order, and where each goes.
 #[derive(Default)]
 struct Pyramids {
@@ -189,7 +196,8 @@ fn layer_pyramids(
             points_of.entry(key(s, il.depends_on)).or_default().push(p);
         }
     }
-    let mut layer = il.form.layer(il.kind, li as u8, il.depends_on, req.gamma);
+    let mut layer = il.form.layer(il.kind, order_of(m, li), il.depends_on, req.gamma);
+    layer.basis = il.light.as_ref().map_or(0, |b| b.c as u8 + 1);
     let grid = BlockGrid::new(&plan.space, il.depends_on, &m.stagger);
     let layer_samples = il.textures.len().max(1) as f64;
     let mut pblocks = Vec::new();
@@ -301,6 +309,11 @@ fn provenance_settings(
     let f = set.display_filter;
     if let Ok(display) = pis_format::DisplayFilter::new(f.sigma_px, f.radius_px) {
         settings.extend(display.settings());
+    }
+    // The light directions relightable layers span (SPEC.md 6.6).
+    let relit = models.iter().flat_map(|m| &m.layers).any(|l| l.light.is_some());
+    if let Some(r) = super::relit::Relit::of(set).filter(|_| relit) {
+        settings.extend(r.settings());
     }
     // The tint lens objects give the light they transmit (SPEC.md 6.6), where not white.
     for m in models.iter().filter(|m| m.shells.as_ref().is_some_and(|s| s.transmits())) {

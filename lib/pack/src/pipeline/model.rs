@@ -199,6 +199,18 @@ pub struct InferredLayer {
     /// For a shell layer, its index among the object's shells ([`ShellTerms`]); `None`
     /// for a surface layer.
     pub shell: Option<usize>,
+    /// For a relightable layer's coefficient ([`super::relit`]): which, and its weight at
+    /// every point.
+    pub light: Option<LightBasis>,
+}
+
+/// A relightable layer's coefficient c: its texture is drawn times Y_c(ω) at a point whose
+/// light sample has direction ω.
+#[derive(Clone, Debug)]
+pub struct LightBasis {
+    pub c: usize,
+    /// Per point of the set, Y_c at its light sample's direction.
+    pub weights: Arc<Vec<f32>>,
 }
 
 impl InferredLayer {
@@ -225,6 +237,7 @@ impl InferredLayer {
             iterations,
             form,
             shell: Some(shell),
+            light: None,
         }
     }
 }
@@ -392,7 +405,8 @@ impl ObjectModel {
                         _ => Cow::Borrowed(x),
                     };
                     let r = pis_compile::render(v.a(il.placement_of[k]), &rgb);
-                    img.iter_mut().zip(&r).for_each(|(a, b)| *a += b);
+                    let w = il.light.as_ref().map_or(1.0, |b| b.weights[p]);
+                    img.iter_mut().zip(&r).for_each(|(a, b)| *a += w * b);
                 }
                 Some(_) => maps.push((*x, il.form.channels())),
             }

@@ -12,7 +12,7 @@
 use std::collections::BTreeMap;
 
 use anyhow::{anyhow, Result};
-use pis_compile::{DrawMesh, RenderMatrix, SolveSettings, TextureLayout, TexturedObject, Viewport};
+use pis_compile::{DrawMesh, RenderMatrix, SolveSettings, TexturedObject, Viewport};
 use pis_format::blocks::BlockGrid;
 use pis_format::DepMask;
 use pis_scene::ObjectRole;
@@ -23,11 +23,12 @@ use super::density_choice;
 use super::input::LoadedSet;
 use super::matrices::Matrices;
 use super::mesh::{atlas, occluding_indices, place_in, sampler, Atlas, Mesh, Placed};
-use super::model::{key, InferredLayer, LayerForm, ObjectModel, PointView, Views};
+use super::model::{key, InferredLayer, ObjectModel, PointView, Views};
 use super::opacity::{premultiply, with_alpha};
 use super::radiance::{Radiance, SampleViews};
 use super::represent::{Job, Planned, Representation, Surveyed};
 use super::rows::{gather, restrict_rows};
+pub use super::texture_form::{finest, mip_chain, TextureForm};
 use super::textures::Textures;
 use super::{PackRequest, PlacementMode};
 use crate::solutions::Solver;
@@ -171,13 +172,13 @@ fn is_black(
 
 /// What one object's layers are before solving: mask, the block each point's sample is in,
 /// each block's placement.
-struct LayerPlan {
-    kind: pis_format::LayerKind,
-    radiance: Radiance,
-    depends_on: DepMask,
-    block_placements: Vec<usize>,
+pub(super) struct LayerPlan {
+    pub kind: pis_format::LayerKind,
+    pub radiance: Radiance,
+    pub depends_on: DepMask,
+    pub block_placements: Vec<usize>,
     /// Per point of the set, its sample's placement.
-    point_placement: Vec<usize>,
+    pub point_placement: Vec<usize>,
     /// The layer carries the object's opacity (a translucent object's first layer).
     alpha: bool,
 }
@@ -294,23 +295,24 @@ fn solve_layer(
         iterations,
         form,
         shell: None,
+        light: None,
     })
 }
 
 /// One parameter sample of a layer: the points whose views it is solved from, with the
 /// render matrices of placement `pid`.
-struct Sample<'a> {
-    views: &'a Views,
-    points: &'a [usize],
-    placement: &'a Placed,
-    pid: usize,
+pub(super) struct Sample<'a> {
+    pub views: &'a Views,
+    pub points: &'a [usize],
+    pub placement: &'a Placed,
+    pub pid: usize,
 }
 
 impl Sample<'_> {
     /// The sample's texture (RGB over the whole chain) fitted to `radiance`, warm-started
     /// from `start`, and the solver's iterations: one texture for the views of the sample
     /// stacked (eq. 3.7) where `view_independent`, else the one point of the key's.
-    fn solve(
+    pub fn solve(
         &self,
         radiance: Radiance,
         view_independent: bool,
@@ -338,109 +340,6 @@ impl Sample<'_> {
         let s = solver.solve(a, &radiance.at(&v), start, settings)?;
         Ok((s.texels, s.iterations as u64))
     }
-}
-
-/// A surface texture layer as stored: every block's texture placed as thesis 3.2 places it
-/// (branch cuts, affine map, used size); level images hold level 0 and the player rebuilds
-/// the MIP chain by decimation (3.6).
-pub struct TextureForm {
-    /// The placements of the object (the layer's blocks index into them).
-    pub placements: Vec<Placed>,
-    /// Per block of the layer's grid, its placement.
-    pub block_placements: Vec<usize>,
-    /// Per sample key, its block's placement.
-    pub placement_of: BTreeMap<Vec<u32>, usize>,
-    /// 3 (RGB), or 4: premultiplied RGB and the opacity of a translucent object.
-    pub channels: usize,
-}
-
-impl TextureForm {
-    fn layout(&self, key: &[u32]) -> TextureLayout {
-        self.placements[self.placement_of[key]].layout
-    }
-}
-
-impl LayerForm for TextureForm {
-    fn layer(
-        &self,
-        kind: pis_format::LayerKind,
-        order: u8,
-        depends_on: DepMask,
-        gamma: f32,
-    ) -> pis_format::Layer {
-        surface_layer(kind, order, depends_on, gamma, self.channels as u8)
-    }
-
-    fn block(&self, b: usize) -> pis_format::Block {
-        let placed = &self.placements[self.block_placements[b]];
-        pis_format::Block {
-            width: placed.layout.width,
-            height: placed.layout.height,
-            placement: pis_format::Placement::Surface {
-                affine: placed.transform.values,
-                repeat: placed.repeat,
-                cut: placed.transform.cut,
-            },
-            levels: vec![],
-        }
-    }
-
-    fn stored(&self, key: &[u32], solved: &[f32]) -> Vec<f32> {
-        finest(self.layout(key), solved, self.channels)
-    }
-
-    fn drawn(&self, key: &[u32], stored: Vec<f32>) -> Vec<f32> {
-        mip_chain(self.layout(key), stored, self.channels)
-    }
-
-    fn stored_texels(&self, key: &[u32]) -> usize {
-        let l = self.layout(key);
-        l.width as usize * l.height as usize
-    }
-
-    fn channels(&self) -> usize {
-        self.channels
-    }
-}
-
-fn surface_layer(
-    kind: pis_format::LayerKind,
-    order: u8,
-    depends_on: DepMask,
-    gamma: f32,
-    channels: u8,
-) -> pis_format::Layer {
-    pis_format::Layer {
-        kind,
-        mapping: pis_format::Mapping::Surface,
-        channels,
-        mip_mode: pis_format::MipMode::Decimated,
-        term: pis_format::Term::Surface,
-        order,
-        combine: pis_format::Combine::Add,
-        basis: 0,
-        gamma,
-        depends_on,
-        blocks: vec![],
-    }
-}
-
-/// The finest level of a solved texture of layout `layout`, `c` channels (the chain's
-/// level 0).
-pub fn finest(layout: pis_compile::TextureLayout, x: &[f32], c: usize) -> Vec<f32> {
-    x[..layout.width as usize * layout.height as usize * c].to_vec()
-}
-
-/// The MIP chain of layout `l` from the finest level, by decimation (thesis 3.6).
-pub fn mip_chain(l: pis_compile::TextureLayout, finest: Vec<f32>, c: usize) -> Vec<f32> {
-    let mut x = finest.clone();
-    let mut cur = finest;
-    for lv in 1..l.levels {
-        let (w, h) = l.level_size(lv - 1);
-        cur = pis_format::mip::decimate(&cur, w, h, c as u32);
-        x.extend_from_slice(&cur);
-    }
-    x
 }
 
 /// Parameterized surface textures: any object.
@@ -535,6 +434,7 @@ pub fn survey_surface(
             diffuse_black,
             specular_black,
             diffuse_only: !with_specular,
+            relit: super::relit::Relit::of(set).filter(|_| with_specular),
         })))
     }
 }
@@ -554,6 +454,8 @@ struct Covered {
     specular_black: bool,
     /// The diffuse layer is the object's only surface layer (whatever `--layers` says).
     diffuse_only: bool,
+    /// The set's light directions, which the layers span as coefficients.
+    relit: Option<super::relit::Relit>,
 }
 
 impl Surveyed for Covered {
@@ -580,7 +482,10 @@ impl Surveyed for Covered {
             ));
             diffuse.into_iter().chain(specular).collect()
         };
-        for layer in wanted {
+        for mut layer in wanted {
+            if let Some(r) = &c.relit {
+                layer.2 = r.without(layer.2);
+            }
             let grid = BlockGrid::new(&job.plan.space, layer.2, &st);
             plans.push(plan_layer(
                 set,
@@ -651,6 +556,7 @@ impl Surveyed for Covered {
             plans,
             filter: (filter, texels_per_pixel),
             chosen,
+            relit: c.relit,
         }))
     }
 }
@@ -668,19 +574,45 @@ struct Layers {
     filter: (pis_compile::Filter, Option<f64>),
     /// What the choices of its filter and texel density measured, where they were made.
     chosen: Vec<String>,
+    relit: Option<super::relit::Relit>,
 }
 
 impl Planned for Layers {
     fn solve(self: Box<Self>, job: &Job<'_>) -> Result<ObjectModel> {
-        let Layers { o, atlas: at, placements, stagger: st, views, plans, filter, chosen } = *self;
+        let Layers {
+            o,
+            atlas: at,
+            placements,
+            stagger: st,
+            views,
+            plans,
+            filter,
+            mut chosen,
+            relit,
+        } = *self;
         let (set, scene) = (job.set, &job.set.scene);
         let name = scene.objects[o].name.clone();
         let covered: usize = (0..views.len()).map(|p| views.rows(p)).sum();
         let area = covered as f64 / views.len() as f64;
-        let layers = plans
-            .iter()
-            .map(|plan| solve_layer(set, &views, &placements, plan, &job.settings, &job.solver))
-            .collect::<Result<Vec<_>>>()?;
+        let mut layers = Vec::new();
+        for plan in &plans {
+            let (settings, solver) = (&job.settings, &job.solver);
+            match &relit {
+                Some(r) => {
+                    let (coefficients, why) = super::relit::solve_relit_layer(
+                        set,
+                        &views,
+                        &placements,
+                        plan,
+                        (settings, solver),
+                        r,
+                    )?;
+                    layers.extend(coefficients);
+                    chosen.push(why);
+                }
+                None => layers.push(solve_layer(set, &views, &placements, plan, settings, solver)?),
+            }
+        }
         let radiances: Vec<Radiance> = plans.iter().map(|p| p.radiance).collect();
         let translucent = plans.first().is_some_and(|p| p.alpha);
         let (representation, why) = match radiances.as_slice() {
@@ -701,10 +633,10 @@ impl Planned for Layers {
             layers,
             shells: None,
             hull_triangles: 0,
-            representation: if translucent {
-                format!("{representation}, translucent")
-            } else {
-                representation.to_string()
+            representation: match (translucent, &relit) {
+                (true, _) => format!("{representation}, translucent"),
+                (false, Some(r)) => format!("{representation}, relightable over {}", r.name),
+                (false, None) => representation.to_string(),
             },
             why: [Some(why.to_string()), translucent.then(|| TRANSLUCENT.to_string())]
                 .into_iter()
@@ -716,59 +648,5 @@ impl Planned for Layers {
             texels_per_pixel: filter.1,
             auto: None,
         })
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// Two placements: 8×4 and 5×3 texels, each with its full MIP chain.
-    fn form() -> TextureForm {
-        let placed = |w, h| Placed {
-            transform: pis_compile::TextureTransform::IDENTITY,
-            layout: TextureLayout::full(w, h),
-            repeat: [false; 2],
-            reduction: 1.0,
-        };
-        TextureForm {
-            placements: vec![placed(8, 4), placed(5, 3)],
-            block_placements: vec![0, 1],
-            placement_of: BTreeMap::from([(vec![0], 0), (vec![1], 1)]),
-            channels: 3,
-        }
-    }
-
-    #[test]
-    fn a_texture_layer_stores_level_0_and_draws_the_decimated_chain() {
-        let f = form();
-        for (key, (w, h)) in [(vec![0u32], (8usize, 4usize)), (vec![1], (5, 3))] {
-            let layout = f.placements[f.placement_of[&key]].layout;
-            let finest: Vec<f32> = (0..w * h * 3).map(|i| (i % 7) as f32 * 0.1).collect();
-            let chain = mip_chain(layout, finest.clone(), 3);
-            assert_eq!(chain.len(), layout.texel_count() * 3, "the whole chain is drawn");
-            assert_eq!(f.stored_texels(&key), w * h);
-            assert_eq!(f.stored(&key, &chain), finest, "level images hold level 0 only");
-            assert_eq!(
-                f.drawn(&key, f.stored(&key, &chain)),
-                chain,
-                "the player's decimation rebuilds the chain"
-            );
-        }
-    }
-
-    #[test]
-    fn a_texture_layer_describes_each_block_by_its_placement() {
-        let f = form();
-        let b = f.block(1);
-        assert_eq!((b.width, b.height), (5, 3));
-        assert!(
-            matches!(b.placement, pis_format::Placement::Surface { .. }) && b.levels.is_empty()
-        );
-        let l = f.layer(pis_format::LayerKind::Diffuse, 0, DepMask::of(&[0]), 2.2);
-        assert_eq!(
-            (l.mapping, l.mip_mode, l.channels),
-            (pis_format::Mapping::Surface, pis_format::MipMode::Decimated, 3)
-        );
     }
 }

@@ -88,6 +88,8 @@ pub struct LayerDraw<'a> {
     pub transform: pis_compile::TextureTransform,
     pub max_level: f32,
     pub weight: f32,
+    /// Per channel, a relightable layer's coefficient weight (SPEC.md 9); else 1.
+    pub tint: [f32; 3],
     /// Anisotropic filtering: the lookup takes the derivatives, the sampler its clamp.
     pub anisotropic: bool,
     /// The texture's alpha is its translucent object's opacity (a 4-channel surface layer).

@@ -15,7 +15,7 @@ use super::translucent::composite;
 use crate::gpu::Gpu;
 use crate::textured::{allocated_size, cut_uniform};
 
-/// `Uniforms` of `frame.wgsl` (144 bytes).
+/// `Uniforms` of `frame.wgsl` (160 bytes).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
 struct Uniforms {
@@ -31,6 +31,7 @@ struct Uniforms {
     alpha_mode: u32,
     _pad: u32,
     cut: [f32; 4],
+    tint: [f32; 4],
 }
 
 fn uniforms(clip_from_object: glam::Mat4, object: u32, layer: Option<&LayerDraw>) -> Uniforms {
@@ -47,6 +48,7 @@ fn uniforms(clip_from_object: glam::Mat4, object: u32, layer: Option<&LayerDraw>
         alpha_mode: 0,
         _pad: 0,
         cut: [0.0; 4],
+        tint: [1.0; 4],
     };
     if let Some(l) = layer {
         let [a, b, c, d, e, f] = l.transform.values;
@@ -58,6 +60,7 @@ fn uniforms(clip_from_object: glam::Mat4, object: u32, layer: Option<&LayerDraw>
         u.scale = [layout.width as f32 / aw as f32, layout.height as f32 / ah as f32];
         u.max_level = l.max_level;
         u.weight = l.weight;
+        u.tint = [l.tint[0], l.tint[1], l.tint[2], 1.0];
         u.anisotropic = l.anisotropic as u32;
         u.cut = cut_uniform(&l.transform);
     }

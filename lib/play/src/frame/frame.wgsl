@@ -46,6 +46,9 @@ struct Uniforms {
     // The block's branch cuts (SPEC.md 7.3): (u_cut, v_cut, 1 if cut along u, 1 if cut
     // along v).
     cut: vec4<f32>,
+    // Per channel, what the texture's colour is multiplied by besides `weight`: a
+    // relightable layer's coefficient weight for the frame's lights (SPEC.md 9), else 1.
+    tint: vec4<f32>,
 };
 
 @group(0) @binding(0) var<uniform> u: Uniforms;
@@ -83,7 +86,7 @@ fn fs_layer(in: VsOut) -> @location(0) vec4<f32> {
     if (textureLoad(ids, vec2<i32>(in.clip.xy), 0).r != u.object) {
         discard;
     }
-    return vec4<f32>(c.rgb * u.weight, layer_alpha(c.a));
+    return vec4<f32>(c.rgb * u.weight * u.tint.rgb, layer_alpha(c.a));
 }
 
 // The output's alpha for texel alpha `a`: an opaque object's layers mark coverage (blended
@@ -123,7 +126,7 @@ fn fs_layer_ms(in: VsOut, @builtin(sample_mask) covered: u32) -> LayerSamples {
         discard;
     }
     var out: LayerSamples;
-    out.colour = vec4<f32>(c.rgb * u.weight, layer_alpha(c.a));
+    out.colour = vec4<f32>(c.rgb * u.weight * u.tint.rgb, layer_alpha(c.a));
     out.mask = mask;
     return out;
 }

@@ -94,6 +94,7 @@ pub(super) fn layer_draws<'a>(
             transform: w.transform,
             max_level: pis_compile::filter::max_level(&texture.layout, &sampler) as f32,
             weight: w.weight,
+            tint: w.tint,
             anisotropic: matches!(filter, Filter::Anisotropic(_)),
             opacity: reader
                 .container()

@@ -25,6 +25,7 @@ mod objects;
 mod options;
 mod plan;
 mod readout;
+mod relight;
 mod resident;
 
 use std::collections::HashMap;
@@ -41,6 +42,7 @@ use self::objects::{check_texture_sizes, object_filters, prepare_objects, LensSt
 pub use self::options::{FrameRequest, FrameStats, PlayerOptions};
 use self::plan::{camera_record, Plan};
 use self::readout::{read_back, wait_for_gpu, Readbacks, Readout, Target};
+pub use self::relight::{DirectionalLight, Relight};
 use self::resident::Textures;
 use crate::blend::nearest_sample;
 use crate::cache::LevelCache;
@@ -75,6 +77,8 @@ pub struct Player {
     /// records it.
     display: Option<(pis_format::DisplayFilter, bool)>,
     samplers: Samplers,
+    /// The light directions the file's relightable layers span, and the lights shown.
+    relight: Option<Relight>,
 }
 
 impl Player {
@@ -114,6 +118,12 @@ impl Player {
             pipes.hybrid_pipeline(&gpu, offscreen, ms.samples);
         }
         let textures = Textures::new(decoder, cache, MipBuilder::new(&gpu));
+        // The reader has checked the settings (rule 9006).
+        let c = reader.container();
+        let relight = pis_format::relight::light_directions(c.provenance.as_ref(), &c.space)
+            .ok()
+            .flatten()
+            .map(|file| Relight { file, lights: None });
         Ok(Player {
             gpu,
             reader,
@@ -128,7 +138,29 @@ impl Player {
             readback: None,
             display,
             samplers: HashMap::new(),
+            relight,
         })
+    }
+
+    /// The lights relightable layers are drawn under: `None`, the file's own light at the
+    /// parameter point; else these directional lights (SPEC.md 9). Refused for a file
+    /// without relightable layers.
+    pub fn set_lights(&mut self, lights: Option<Vec<DirectionalLight>>) -> Result<(), PlayError> {
+        match &mut self.relight {
+            Some(r) => {
+                r.lights = lights;
+                Ok(())
+            }
+            None if lights.is_none() => Ok(()),
+            None => Err(PlayError::Request(
+                "the file has no relightable layers (no light directions, SPEC.md 6.6)".into(),
+            )),
+        }
+    }
+
+    /// The file's light directions, where it has relightable layers.
+    pub fn light_directions(&self) -> Option<&pis_format::relight::LightDirections> {
+        self.relight.as_ref().map(|r| &r.file)
     }
 
     /// The parameter space's dimensions.
@@ -297,7 +329,8 @@ impl Player {
         let t0 = Instant::now();
         let reads0 = self.reader.stats().codestreams;
         let mut stats = FrameStats::default();
-        let plan = Plan::new(&self.reader, &self.objects, self.options.blend, req, size)?;
+        let relight = self.relight.as_ref();
+        let plan = Plan::new(&self.reader, &self.objects, self.options.blend, req, size, relight)?;
         let corner_sets = self.textures_and_lenses(&plan, size, &mut stats)?;
         let format = match target {
             Target::Offscreen { .. } | Target::Centres | Target::Timed => {

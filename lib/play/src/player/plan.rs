@@ -10,6 +10,7 @@ use pis_format::{DepMask, PisReader, Placement, StreamRef};
 
 use super::objects::{content, ObjectGpu};
 use super::options::FrameRequest;
+use super::relight::Relight;
 use crate::blend::{check_point, merge_for_mask, nearest_sample, weighted_samples, Blend};
 use crate::camera::{mat4_from_rows, projection, CameraChoice};
 use crate::error::PlayError;
@@ -28,6 +29,8 @@ pub(super) struct Wanted {
     pub(super) draw: usize,
     pub(super) key: TextureKey,
     pub(super) weight: f32,
+    /// Per channel, a relightable layer's coefficient weight for the frame's lights.
+    pub(super) tint: [f32; 3],
     pub(super) transform: TextureTransform,
     pub(super) repeat: [bool; 2],
 }
@@ -63,6 +66,7 @@ impl Plan {
         blend: Blend,
         req: &FrameRequest,
         size: (u32, u32),
+        relight: Option<&Relight>,
     ) -> Result<Plan, PlayError> {
         let c = reader.container();
         let dims = &c.space.dims;
@@ -93,6 +97,7 @@ impl Plan {
             lenses: Vec::new(),
             clip_from_world,
         };
+        let lit = relight.map(|r| r.lit(&samples));
         for (oi, (o, og)) in c.objects.iter().zip(objects).enumerate() {
             let t = &o.transforms;
             let world = t
@@ -102,15 +107,28 @@ impl Plan {
             plan.clips.push(clip_from_world * world);
             plan.worlds.push(world);
             for &li in &og.layers {
+                let basis = o.layers[li].basis;
                 for (s, w) in merge_for_mask(&samples, o.layers[li].depends_on) {
                     let (key, block) = texture_key(reader, oi, li, &s)?;
                     let Placement::Surface { affine, repeat, cut } = block.placement else {
                         continue;
                     };
+                    let mask = o.layers[li].depends_on;
+                    let tint = match (&lit, basis) {
+                        (Some(lit), 1..) => {
+                            let members: Vec<&(Vec<u32>, f32)> = samples
+                                .iter()
+                                .filter(|(t, _)| mask.dims().all(|k| t[k] == s[k]))
+                                .collect();
+                            lit.weight(basis as usize - 1, &members)
+                        }
+                        _ => [1.0; 3],
+                    };
                     plan.surfaces.push(Wanted {
                         draw: oi,
                         key,
                         weight: w,
+                        tint,
                         transform: TextureTransform { values: affine, cut },
                         repeat,
                     });

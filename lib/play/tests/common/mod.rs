@@ -225,6 +225,7 @@ pub fn draw_scene_with(
             transform: pis_compile::TextureTransform::IDENTITY,
             max_level: 0.0,
             weight: 1.0,
+            tint: [1.0; 3],
             anisotropic: false,
             opacity: is(i),
         })
