@@ -155,6 +155,12 @@ pub struct PackOptions {
     /// views; `box`, `sphere` or `depth`: that shell.
     #[arg(long, default_value = "fitted", value_parser = one_of(&DistantShell::ALL, DistantShell::name))]
     pub distant_shell: DistantShell,
+    /// Where the set turns a light over directions (scene.toml `light_direction`): `on`
+    /// stores each surface layer as spherical-harmonic coefficients over them (Wong et al.:
+    /// relit under any directional lights, the band chosen per layer by held-out light
+    /// directions); `off` samples the light as any dimension.
+    #[arg(long, default_value = "on", value_name = "on|off", action = clap::ArgAction::Set, value_parser = parse_on_off)]
+    pub relight: bool,
     /// Also store the lossless master: every solved texture, before gamma compensation and
     /// coding, losslessly coded in MSTR chunks a player never reads. pis-reencode codes
     /// again from it (as a direct pack at the new settings would) instead of from the decoded
@@ -214,6 +220,7 @@ impl PackOptions {
             stagger: self.stagger,
             shell_lookups: self.shell_lookups,
             distant_shell: self.distant_shell,
+            relight: self.relight,
             max_iterations: self.max_iterations,
             keep_master: self.keep_master,
             preset: self.preset.clone(),
@@ -360,5 +367,14 @@ mod tests {
             let err = PackOptions::try_parse(&[flag, value]).unwrap_err().to_string();
             assert!(err.contains("possible values"), "{err}");
         }
+    }
+}
+
+/// `on` or `off`.
+fn parse_on_off(s: &str) -> Result<bool, String> {
+    match s {
+        "on" => Ok(true),
+        "off" => Ok(false),
+        _ => Err(format!("expected on or off, got {s:?}")),
     }
 }

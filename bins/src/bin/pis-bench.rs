@@ -330,6 +330,28 @@ enum Command {
         #[arg(long)]
         json: bool,
     },
+    /// Relighting (Wong et al.): packed files played at the light directions of a set traced
+    /// at directions they do not hold, against it, whole image; a relightable file under a
+    /// directional light from each direction, a file that samples the light at its nearest
+    /// sampled direction. With --fitted, first the ceiling of the spherical harmonics
+    /// themselves: that set's pixels fitted per band and drawn at the held-out directions.
+    Relight {
+        /// The packed files (e.g. with pis-pack --relight on and off).
+        #[arg(required = true)]
+        files: Vec<PathBuf>,
+        /// The set traced at held-out light directions (scene.toml `light_direction` with
+        /// another sample count; the other dimensions as the files').
+        #[arg(long, value_name = "SET_DIR")]
+        held: PathBuf,
+        /// The set the files were packed from: the per-pixel fit's ceiling per band.
+        #[arg(long, value_name = "SET_DIR")]
+        fitted: Option<PathBuf>,
+        /// Bands of the ceiling.
+        #[arg(long, value_delimiter = ',', default_value = "1,2,3,4,5,6")]
+        bands: Vec<u32>,
+        #[arg(long)]
+        json: bool,
+    },
     /// Every chart (rd, speed, stability) from scratch on demo1: trace, pack, evaluate.
     All {
         /// `ci` (80×60, 1 spp: minutes on 2 cores) or `paper` (demo1's paper preset).
@@ -614,6 +636,26 @@ fn run(cli: Cli) -> Result<Exit, Failure> {
             })?;
             hybrid::print(&report, &mut std::io::stderr())
                 .map_err(|e| Failure::new(Exit::Io, e))?;
+            if json {
+                json_out(&report)?;
+            }
+            Ok(Exit::Ok)
+        }
+        Command::Relight { files, held, fitted, bands, json } => {
+            let runtime = |e: anyhow::Error| Failure::new(Exit::Runtime, e);
+            if bands.iter().any(|&b| b > pis_compile::relight::MAX_BAND) {
+                return Err(Failure::new(
+                    Exit::Usage,
+                    anyhow::anyhow!("--bands: at most {}", pis_compile::relight::MAX_BAND),
+                ));
+            }
+            let ceiling = fitted
+                .map(|f| pis_eval::relight::ceiling_of(&f, &held, &bands))
+                .transpose()
+                .map_err(runtime)?;
+            let played = pis_eval::relight::held_out(&files, &held).map_err(runtime)?;
+            let report = pis_eval::relight::RelightReport { ceiling, played };
+            eprint!("{}", pis_eval::relight::render(&report));
             if json {
                 json_out(&report)?;
             }

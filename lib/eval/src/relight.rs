@@ -107,11 +107,6 @@ pub fn ceiling(set: &Path, held: &Path, bands: &[u32], cover: Cover) -> Result<V
                         .collect();
                     let e = if at == 0 { &mut errors[row].0 } else { &mut errors[row].1 };
                     e.add_slices(&img, t);
-                    if at == 0 && std::env::var("PIS_DEBUG").is_ok() {
-                        let mut one = SquaredError::default();
-                        one.add_slices(&img, t);
-                        eprintln!("l {} w {w} {:.2}", fit.l_max, one.psnr());
-                    }
                 }
             }
         }
@@ -140,4 +135,129 @@ pub fn ceiling(set: &Path, held: &Path, bands: &[u32], cover: Cover) -> Result<V
         samples_db: f64::INFINITY,
     });
     Ok(rows)
+}
+
+/// One file played at a held-out set's light directions.
+#[derive(Clone, Debug, Serialize)]
+pub struct HeldOutRow {
+    pub file: String,
+    pub bytes: u64,
+    /// Whether the file relights (its layers span the light directions), else it shows the
+    /// sampled light nearest each direction.
+    pub relightable: bool,
+    /// Whole image against the held-out set, display PSNR (dB).
+    pub psnr_db: f64,
+    /// Per held-out point, display PSNR (dB).
+    pub points_db: Vec<f64>,
+}
+
+/// Each of `files` played at every point of `held` (a set traced at light directions the
+/// files do not hold, the other dimensions at their samples): a relightable file under one
+/// directional light from the point's direction, of the file's traced radiance; a file that
+/// samples the light at its sample nearest that direction.
+pub fn held_out(files: &[std::path::PathBuf], held: &Path) -> Result<Vec<HeldOutRow>> {
+    use pis_play::{CameraChoice, DirectionalLight, FrameRequest, Gpu, Player, PlayerOptions};
+    let set = RaySet::open(held).context("the held-out set")?;
+    let (k, dirs) = light_dimension(&set)?;
+    let gpu = std::sync::Arc::new(Gpu::new()?);
+    let mut rows = Vec::new();
+    for file in files {
+        let options = PlayerOptions {
+            display_filter: crate::headless::set_display_filter(held),
+            ..PlayerOptions::default()
+        };
+        let mut player = Player::open(gpu.clone(), file, options)
+            .with_context(|| format!("{}", file.display()))?;
+        let c = player.reader().container();
+        let lights = pis_format::relight::light_directions(c.provenance.as_ref(), &c.space)
+            .map_err(|e| anyhow!("{}: {e}", file.display()))?
+            .ok_or_else(|| anyhow!("{}: records no light directions", file.display()))?;
+        let relightable = c.objects.iter().flat_map(|o| &o.layers).any(|l| l.basis != 0);
+        let values = c.space.dims.get(k).map(|d| d.values.clone()).unwrap_or_default();
+        let size = player.image_size();
+        let (mut whole, mut points_db) = (SquaredError::default(), Vec::new());
+        for (i, p) in set.meta.points.iter().enumerate() {
+            let w = dirs[p.samples[k] as usize];
+            let mut point = p.values.clone();
+            if relightable {
+                let light = DirectionalLight { direction: w, radiance: lights.radiance };
+                player.set_lights(Some(vec![light]))?;
+            } else {
+                let near = (0..lights.directions.len())
+                    .max_by(|&a, &b| {
+                        let d = |j: usize| Vec3::from(lights.directions[j]).dot(w);
+                        d(a).total_cmp(&d(b))
+                    })
+                    .unwrap_or(0);
+                point[k] = values.get(near).copied().unwrap_or(0.0);
+            }
+            let req = FrameRequest { point, camera: CameraChoice::Sample };
+            let (img, _) = player.render_image(&req, size)?;
+            let images = set.read_point(i)?;
+            let gold = images.layer("combined").ok_or_else(|| anyhow!("point {i}: no combined"))?;
+            let mut one = SquaredError::default();
+            for (px, rgba) in img.rgba.chunks_exact(4).enumerate() {
+                for ch in 0..3 {
+                    one.add(rgba[ch], gold.planes[ch][px]);
+                }
+            }
+            whole.merge(&one);
+            points_db.push(one.psnr());
+        }
+        rows.push(HeldOutRow {
+            file: file.display().to_string(),
+            bytes: std::fs::metadata(file)?.len(),
+            relightable,
+            psnr_db: whole.psnr(),
+            points_db,
+        });
+    }
+    Ok(rows)
+}
+
+/// What `pis-bench relight` measured.
+#[derive(Clone, Debug, Serialize)]
+pub struct RelightReport {
+    pub ceiling: Option<Vec<CeilingRow>>,
+    pub played: Vec<HeldOutRow>,
+}
+
+/// [`ceiling`] with the cover the fitted set's directions span (the upper hemisphere, or
+/// the sphere where a direction lies below the horizon).
+pub fn ceiling_of(set: &Path, held: &Path, bands: &[u32]) -> Result<Vec<CeilingRow>> {
+    let (_, dirs) = light_dimension(&RaySet::open(set).context("the fitted set")?)?;
+    let cover =
+        if dirs.iter().any(|w| w.y < -1e-6) { Cover::Sphere } else { Cover::Hemisphere(Vec3::Y) };
+    ceiling(set, held, bands, cover)
+}
+
+/// The report as text.
+pub fn render(r: &RelightReport) -> String {
+    let mut out = String::new();
+    if let Some(rows) = &r.ceiling {
+        out.push_str(
+            "the set's pixels fitted per band, at the held-out directions (at its own):\n",
+        );
+        for row in rows {
+            match row.band {
+                Some(b) => out.push_str(&format!(
+                    "  band {b} ({:>2} coefficients)  {:6.2} dB  ({:.2} dB)\n",
+                    row.coefficients, row.held_out_db, row.samples_db
+                )),
+                None => out.push_str(&format!(
+                    "  nearest sampled direction      {:6.2} dB\n",
+                    row.held_out_db
+                )),
+            }
+        }
+    }
+    out.push_str("played at the held-out directions:\n");
+    for row in &r.played {
+        let how = if row.relightable { "relit" } else { "nearest sample" };
+        out.push_str(&format!(
+            "  {}  {} bytes, {how}: {:.2} dB\n",
+            row.file, row.bytes, row.psnr_db
+        ));
+    }
+    out
 }

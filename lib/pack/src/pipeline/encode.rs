@@ -310,9 +310,9 @@ fn provenance_settings(
     if let Ok(display) = pis_format::DisplayFilter::new(f.sigma_px, f.radius_px) {
         settings.extend(display.settings());
     }
-    // The light directions relightable layers span (SPEC.md 6.6).
-    let relit = models.iter().flat_map(|m| &m.layers).any(|l| l.light.is_some());
-    if let Some(r) = super::relit::Relit::of(set).filter(|_| relit) {
+    // The light directions of the set (SPEC.md 6.6): what relightable layers span, and
+    // where the light is sampled, each sample's direction.
+    if let Some(r) = super::relit::Relit::of(set) {
         settings.extend(r.settings());
     }
     // The tint lens objects give the light they transmit (SPEC.md 6.6), where not white.

@@ -202,6 +202,10 @@ pub struct PackSettings {
     pub shell_lookups: u32,
     /// Layered environment maps: which distant shell a reflective object gets.
     pub distant_shell: DistantShell,
+    /// Where the set turns a light over directions (`light_direction`), store surface
+    /// layers as spherical-harmonic coefficients over them ([`super::relit`]); else sample
+    /// the light as any dimension.
+    pub relight: bool,
     /// Conjugate-gradient iteration cap per colour channel of every solve (`None`: the
     /// solver's default).
     pub max_iterations: Option<u32>,
@@ -258,6 +262,7 @@ impl PackSettings {
             stagger: Stagger::Auto,
             shell_lookups: 1,
             distant_shell: DistantShell::Fitted,
+            relight: true,
             max_iterations: None,
             keep_master: false,
             preset: None,

@@ -434,7 +434,7 @@ pub fn survey_surface(
             diffuse_black,
             specular_black,
             diffuse_only: !with_specular,
-            relit: super::relit::Relit::of(set).filter(|_| with_specular),
+            relit: super::relit::Relit::of(set).filter(|_| with_specular && req.relight),
         })))
     }
 }
