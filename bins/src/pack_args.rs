@@ -327,6 +327,15 @@ pub fn parse_resolution(s: &str) -> Result<(u32, u32), String> {
     }
 }
 
+/// `on` or `off`.
+fn parse_on_off(s: &str) -> Result<bool, String> {
+    match s {
+        "on" => Ok(true),
+        "off" => Ok(false),
+        _ => Err(format!("expected on or off, got {s:?}")),
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -367,14 +376,5 @@ mod tests {
             let err = PackOptions::try_parse(&[flag, value]).unwrap_err().to_string();
             assert!(err.contains("possible values"), "{err}");
         }
-    }
-}
-
-/// `on` or `off`.
-fn parse_on_off(s: &str) -> Result<bool, String> {
-    match s {
-        "on" => Ok(true),
-        "off" => Ok(false),
-        _ => Err(format!("expected on or off, got {s:?}")),
     }
 }

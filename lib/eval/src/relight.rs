@@ -197,8 +197,8 @@ pub fn held_out(files: &[std::path::PathBuf], held: &Path) -> Result<Vec<HeldOut
             let gold = images.layer("combined").ok_or_else(|| anyhow!("point {i}: no combined"))?;
             let mut one = SquaredError::default();
             for (px, rgba) in img.rgba.chunks_exact(4).enumerate() {
-                for ch in 0..3 {
-                    one.add(rgba[ch], gold.planes[ch][px]);
+                for (v, plane) in rgba.iter().zip(&gold.planes).take(3) {
+                    one.add(*v, plane[px]);
                 }
             }
             whole.merge(&one);

@@ -50,6 +50,7 @@ pub mod relit;
 pub mod report;
 pub mod represent;
 pub mod rows;
+pub mod sample;
 pub mod scratch;
 pub mod screen;
 pub mod set_images;

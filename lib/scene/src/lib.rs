@@ -35,6 +35,8 @@ mod gltf_load;
 pub mod lens_tree;
 mod light;
 pub mod light_direction;
+#[cfg(test)]
+mod light_direction_tests;
 pub mod light_path;
 mod load;
 #[cfg(test)]

@@ -26,7 +26,8 @@ use super::input::LoadedSet;
 use super::mesh::Placed;
 use super::model::{key, InferredLayer, LightBasis, Views};
 use super::radiance::Radiance;
-use super::surface::{LayerPlan, Sample, TextureForm};
+use super::sample::{LayerPlan, Sample};
+use super::texture_form::TextureForm;
 use super::textures::Textures;
 use crate::solutions::Solver;
 

@@ -25,9 +25,10 @@ use super::matrices::Matrices;
 use super::mesh::{atlas, occluding_indices, place_in, sampler, Atlas, Mesh, Placed};
 use super::model::{key, InferredLayer, ObjectModel, PointView, Views};
 use super::opacity::{premultiply, with_alpha};
-use super::radiance::{Radiance, SampleViews};
+use super::radiance::Radiance;
 use super::represent::{Job, Planned, Representation, Surveyed};
 use super::rows::{gather, restrict_rows};
+pub(super) use super::sample::{LayerPlan, Sample};
 pub use super::texture_form::{finest, mip_chain, TextureForm};
 use super::textures::Textures;
 use super::{PackRequest, PlacementMode};
@@ -170,19 +171,6 @@ fn is_black(
     Ok(true)
 }
 
-/// What one object's layers are before solving: mask, the block each point's sample is in,
-/// each block's placement.
-pub(super) struct LayerPlan {
-    pub kind: pis_format::LayerKind,
-    pub radiance: Radiance,
-    pub depends_on: DepMask,
-    pub block_placements: Vec<usize>,
-    /// Per point of the set, its sample's placement.
-    pub point_placement: Vec<usize>,
-    /// The layer carries the object's opacity (a translucent object's first layer).
-    alpha: bool,
-}
-
 /// Places the blocks of a layer with mask `mask` (thesis 3.2 per parameter block): each
 /// block over the views of the points whose samples it holds; placements equal to one
 /// already made are shared.
@@ -297,49 +285,6 @@ fn solve_layer(
         shell: None,
         light: None,
     })
-}
-
-/// One parameter sample of a layer: the points whose views it is solved from, with the
-/// render matrices of placement `pid`.
-pub(super) struct Sample<'a> {
-    pub views: &'a Views,
-    pub points: &'a [usize],
-    pub placement: &'a Placed,
-    pub pid: usize,
-}
-
-impl Sample<'_> {
-    /// The sample's texture (RGB over the whole chain) fitted to `radiance`, warm-started
-    /// from `start`, and the solver's iterations: one texture for the views of the sample
-    /// stacked (eq. 3.7) where `view_independent`, else the one point of the key's.
-    pub fn solve(
-        &self,
-        radiance: Radiance,
-        view_independent: bool,
-        start: Option<&[f32]>,
-        settings: &SolveSettings,
-        solver: &Solver,
-    ) -> Result<(Vec<f32>, u64)> {
-        if view_independent {
-            let source = SampleViews {
-                views: self.views,
-                points: self.points,
-                placement: self.pid,
-                radiance,
-            };
-            let s = solver.solve_view_source(&source, start, settings)?;
-            return Ok((s.texels, s.iterations as u64));
-        }
-        let v = self.views.get(self.points[0])?;
-        let a = v.a(self.pid);
-        if a.rows() == 0 {
-            // The object covers no pixel.
-            let zero = || vec![0.0; self.placement.layout.texel_count() * 3];
-            return Ok((start.map_or_else(zero, <[f32]>::to_vec), 0));
-        }
-        let s = solver.solve(a, &radiance.at(&v), start, settings)?;
-        Ok((s.texels, s.iterations as u64))
-    }
 }
 
 /// Parameterized surface textures: any object.
