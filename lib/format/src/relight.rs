@@ -141,6 +141,7 @@ pub fn check_basis_layers<S>(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::filter::tests::prov;
     use crate::model::Dimension;
 
     fn space() -> ParameterSpace {
@@ -154,15 +155,6 @@ mod tests {
         };
         ParameterSpace {
             dims: vec![dim("view", DimensionKind::View, 2), dim("sun", DimensionKind::Light, 2)],
-        }
-    }
-
-    fn prov(settings: &[(&str, &str)]) -> Provenance {
-        Provenance {
-            tool: "t".into(),
-            source: "s".into(),
-            raw_image_bytes: 0,
-            settings: settings.iter().map(|(k, v)| (k.to_string(), v.to_string())).collect(),
         }
     }
 

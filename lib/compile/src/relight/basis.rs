@@ -84,17 +84,11 @@ pub fn basis(l_max: u32, w: Vec3, out: &mut [f64]) {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use pis_scene::light_direction::{light_directions, Cover};
 
     /// A spherical Fibonacci set of `n` directions over the sphere (equal area).
-    fn sphere(n: usize) -> Vec<Vec3> {
-        (0..n)
-            .map(|i| {
-                let y = 1.0 - 2.0 * (i as f64 + 0.5) / n as f64;
-                let r = (1.0 - y * y).sqrt();
-                let phi = std::f64::consts::TAU * (i as f64 * 0.618_033_988_749_894_9).fract();
-                Vec3::new((r * phi.cos()) as f32, y as f32, (r * phi.sin()) as f32)
-            })
-            .collect()
+    fn sphere(n: u32) -> Vec<Vec3> {
+        light_directions(n, Cover::Sphere, Vec3::Y)
     }
 
     #[test]

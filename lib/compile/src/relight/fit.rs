@@ -204,17 +204,12 @@ fn solve_columns(normal: &mut [f64], c: usize, rhs: &mut [f64], n: usize) -> Opt
 #[cfg(test)]
 mod tests {
     use super::*;
+    use pis_scene::light_direction::{light_directions, Cover as Spread};
 
-    fn fibonacci(n: usize, hemisphere: bool) -> Vec<Vec3> {
-        let span = if hemisphere { 1.0 } else { 2.0 };
-        (0..n)
-            .map(|i| {
-                let y = 1.0 - span * (i as f64 + 0.5) / n as f64;
-                let r = (1.0 - y * y).sqrt();
-                let phi = std::f64::consts::TAU * (i as f64 * 0.618_033_988_749_894_9).fract();
-                Vec3::new((r * phi.cos()) as f32, y as f32, (r * phi.sin()) as f32)
-            })
-            .collect()
+    /// `n` spherical Fibonacci directions over the upper hemisphere or the sphere.
+    fn fibonacci(n: u32, hemisphere: bool) -> Vec<Vec3> {
+        let spread = if hemisphere { Spread::Hemisphere } else { Spread::Sphere };
+        light_directions(n, spread, Vec3::Y)
     }
 
     #[test]
