@@ -330,17 +330,19 @@ enum Command {
         #[arg(long)]
         json: bool,
     },
-    /// Relighting (Wong et al.): packed files played at the light directions of a set traced
-    /// at directions they do not hold, against it, whole image; a relightable file under a
-    /// directional light from each direction, a file that samples the light at its nearest
-    /// sampled direction. With --fitted, first the ceiling of the spherical harmonics
-    /// themselves: that set's pixels fitted per band and drawn at the held-out directions.
+    /// Relighting (Wong et al.): packed files played under the lights of a set traced with
+    /// lights they do not hold, against it, whole image: a relightable file relit by
+    /// superposition (the light from another direction, several coloured directional
+    /// lights, the scene's sky), a file that samples the light at its sampled direction
+    /// nearest each held-out one. With --fitted, first the ceiling of the spherical
+    /// harmonics themselves: that set's pixels fitted per band and drawn under those lights.
     Relight {
         /// The packed files (e.g. with pis-pack --relight on and off).
         #[arg(required = true)]
         files: Vec<PathBuf>,
-        /// The set traced at held-out light directions (scene.toml `light_direction` with
-        /// another sample count; the other dimensions as the files').
+        /// The set traced under held-out lights, its other dimensions as the files': the
+        /// same `light_direction` dimension with another sample count, or a scene of
+        /// directional lights and an `[environment]` without that dimension.
         #[arg(long, value_name = "SET_DIR")]
         held: PathBuf,
         /// The set the files were packed from: the per-pixel fit's ceiling per band.

@@ -37,7 +37,9 @@ pub use gpu::{Gpu, GpuOptions};
 pub use hybrid::{render_hybrid, HybridPipeline};
 pub use image::FloatImage;
 pub use multisample::Multisample;
-pub use player::{DirectionalLight, FrameRequest, FrameStats, Player, PlayerOptions, Relight};
+pub use player::{
+    DirectionalLight, FrameRequest, FrameStats, Lights, Player, PlayerOptions, Relight,
+};
 pub use probe::{probe, probe_render_matrix, Probe};
 pub use shell::{render_shell, ShellPipeline, ShellTexture};
 pub use textured::{render_object, ObjectScene, ObjectTexture, TexturedPipeline};

@@ -10,11 +10,11 @@ pub const MAX_SIDE: u32 = 16384;
 pub const MAX_TEXELS: u64 = 8192 * 4096;
 
 /// A decoded image: width, height and texels (linear RGB, row after row from the top).
-pub(crate) type Texels = (u32, u32, Vec<[f32; 3]>);
+pub type Texels = (u32, u32, Vec<[f32; 3]>);
 
 /// Reads `file` by its extension; the error says what is wrong with it (the caller names
 /// the file and the field).
-pub(crate) fn read(file: &Path) -> Result<Texels, String> {
+pub fn read(file: &Path) -> Result<Texels, String> {
     let ext = file.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
     match ext.as_deref() {
         Some("hdr") => read_hdr(file),

@@ -55,7 +55,10 @@ pub mod texture;
 mod texture_ref;
 pub mod toml_lights;
 
-pub use env_image::{MAX_SIDE as MAX_ENVIRONMENT_SIDE, MAX_TEXELS as MAX_ENVIRONMENT_TEXELS};
+pub use env_image::{
+    read as read_environment_image, MAX_SIDE as MAX_ENVIRONMENT_SIDE,
+    MAX_TEXELS as MAX_ENVIRONMENT_TEXELS,
+};
 pub use environment::{Environment, EnvironmentRadiance, LatLongImage};
 pub use error::SceneError;
 pub use load::{load, load_with, LoadOptions};

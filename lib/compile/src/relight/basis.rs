@@ -11,8 +11,8 @@
 //! orthonormal over the sphere. Coefficient c = l² + l + m. P is evaluated as P̃ · sinᵐθ with
 //! the polynomial P̃ of the paper's recurrences less their √(1 − x²) factors, and
 //! sinᵐθ·cos(mφ), sinᵐθ·sin(mφ) as the real and imaginary parts of (ω_x + i·ω_z)ᵐ: no
-//! angle is taken, so the basis is exact at the poles. The player's `sh_basis`
-//! (lib/play/src/relight.wgsl) is the same function written twice.
+//! angle is taken, so the basis is exact at the poles. The player weighs its coefficient
+//! layers with this same function ([`super::lights`]), once per frame.
 
 use glam::Vec3;
 

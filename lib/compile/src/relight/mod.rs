@@ -7,7 +7,10 @@
 
 pub mod basis;
 pub mod fit;
+pub mod lights;
 pub mod sky;
 
 pub use basis::{basis, coefficients, MAX_BAND};
 pub use fit::{Cover, LightFit};
+pub use lights::{DirectionalLight, Lights};
+pub use sky::{project_lat_long, rotate_about_pole};

@@ -62,6 +62,27 @@ pub fn project_lat_long(
     out
 }
 
+/// The coefficients of a sky `s` (as [`project_lat_long`] gives them) turned a further
+/// `angle` radians about +Y, the pole: a turn about the pole mixes only each band's ±m pair,
+/// by the angle mα, so a sky's rotation costs no new projection.
+pub fn rotate_about_pole(s: &[[f64; 3]], angle: f32) -> Vec<[f64; 3]> {
+    let mut out = s.to_vec();
+    let mut l = 0usize;
+    while coefficients(l as u32) <= s.len() {
+        let base = l * l + l;
+        for m in 1..=l {
+            let (sin, cos) = (m as f64 * angle as f64).sin_cos();
+            let (p, q) = (s[base + m], s[base - m]);
+            for ch in 0..3 {
+                out[base + m][ch] = cos * p[ch] + sin * q[ch];
+                out[base - m][ch] = cos * q[ch] - sin * p[ch];
+            }
+        }
+        l += 1;
+    }
+    out
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -103,6 +124,24 @@ mod tests {
         basis(1, Vec3::NEG_Z, &mut y);
         for c in 0..4 {
             assert!((turned[c][0] - y[c] * solid).abs() < 0.05 * solid, "turned {c}");
+        }
+    }
+
+    #[test]
+    fn turning_the_coefficients_about_the_pole_is_turning_the_sky() {
+        // A sky with structure in every band (two off-axis patches of different colours).
+        let (w, h) = (48, 24);
+        let mut rgb = vec![0.0f32; w * h * 3];
+        rgb[(5 * w + 7) * 3] = 4.0;
+        rgb[(9 * w + 30) * 3 + 2] = 2.0;
+        for angle in [0.4f32, -1.3, 2.9] {
+            let turned = project_lat_long(w, h, &rgb, angle, 4);
+            let rotated = rotate_about_pole(&project_lat_long(w, h, &rgb, 0.0, 4), angle);
+            for (a, b) in turned.iter().zip(&rotated) {
+                for ch in 0..3 {
+                    assert!((a[ch] - b[ch]).abs() < 2e-3, "angle {angle}: {a:?} against {b:?}");
+                }
+            }
         }
     }
 }

@@ -42,7 +42,7 @@ use self::objects::{check_texture_sizes, object_filters, prepare_objects, LensSt
 pub use self::options::{FrameRequest, FrameStats, PlayerOptions};
 use self::plan::{camera_record, Plan};
 use self::readout::{read_back, wait_for_gpu, Readbacks, Readout, Target};
-pub use self::relight::{DirectionalLight, Relight};
+pub use self::relight::Relight;
 use self::resident::Textures;
 use crate::blend::nearest_sample;
 use crate::cache::LevelCache;
@@ -54,6 +54,7 @@ use crate::gpu::Gpu;
 use crate::image::FloatImage;
 use crate::mip::MipBuilder;
 use crate::multisample::{check_samples, choose, Multisample};
+pub use pis_compile::relight::{DirectionalLight, Lights};
 
 /// An open `.pis` ready to draw frames.
 pub struct Player {
@@ -143,9 +144,9 @@ impl Player {
     }
 
     /// The lights relightable layers are drawn under: `None`, the file's own light at the
-    /// parameter point; else these directional lights (SPEC.md 9). Refused for a file
-    /// without relightable layers.
-    pub fn set_lights(&mut self, lights: Option<Vec<DirectionalLight>>) -> Result<(), PlayError> {
+    /// parameter point; else these directional lights and sky, by superposition (SPEC.md 9).
+    /// Refused for a file without relightable layers.
+    pub fn set_lights(&mut self, lights: Option<Lights>) -> Result<(), PlayError> {
         match &mut self.relight {
             Some(r) => {
                 r.lights = lights;

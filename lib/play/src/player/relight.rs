@@ -1,34 +1,27 @@
 //! Relightable layers (SPEC.md 7.1, 9; Wong et al.): a coefficient layer's texture is drawn
-//! times its weight for the frame's lights, w_c = Σ_j E_j / E₀ · Y_c(ω_j), the basis Y_c
-//! being the one the pack fitted with ([`pis_compile::relight::basis`]: the same function,
-//! not a twin). Without lights of the user's the frame shows the file's own light at the
-//! parameter point: each blended sample's direction, with the sample's blend weight.
+//! times its weight for the frame's lights, w_c = Σ_j E_j / E₀ · Y_c(ω_j) (+ s_c / E₀ for a
+//! sky), computed by [`pis_compile::relight::Lights::weights`], the function the pack's
+//! basis and `pis-bench relight` use: the same function, not a twin. Without lights of the
+//! user's the frame shows the file's own light at the parameter point: each blended
+//! sample's direction, with the sample's blend weight.
 
 use glam::Vec3;
-use pis_compile::relight::{basis, coefficients, MAX_BAND};
+use pis_compile::relight::{basis, coefficients, Lights, MAX_BAND};
 use pis_format::relight::LightDirections;
-
-/// A directional light of the user's: the direction it comes from (unit, from the scene
-/// towards the light) and its radiance (illuminance times colour, linear RGB).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct DirectionalLight {
-    pub direction: Vec3,
-    pub radiance: [f32; 3],
-}
 
 /// A file's light directions and the lights a frame shows.
 #[derive(Clone, Debug)]
 pub struct Relight {
     pub file: LightDirections,
     /// `None`: the file's own light at the parameter point.
-    pub lights: Option<Vec<DirectionalLight>>,
+    pub lights: Option<Lights>,
 }
 
-/// The lights of one frame, as per-light basis values and RGB scales.
+/// The lights of one frame, as coefficient weights.
 pub(super) struct Lit {
     dim: usize,
-    /// Per light: its scale E/E₀ per channel and Y_c for every c up to band 8.
-    lights: Vec<([f32; 3], Vec<f64>)>,
+    /// The user's lights: w_c (RGB) for every c up to band 8.
+    weights: Vec<[f64; 3]>,
     /// The file's light: Y_c at each sample of its dimension, where the frame shows it.
     samples: Option<Vec<Vec<f64>>>,
 }
@@ -42,17 +35,10 @@ fn basis_at(w: Vec3) -> Vec<f64> {
 impl Relight {
     /// The lights of a frame blended from `samples` (sample, weight).
     pub(super) fn lit(&self, samples: &[(Vec<u32>, f32)]) -> Lit {
-        let e0 = self.file.radiance;
         match &self.lights {
             Some(lights) => Lit {
                 dim: self.file.dim,
-                lights: lights
-                    .iter()
-                    .map(|l| {
-                        let scale = [0, 1, 2].map(|c| l.radiance[c] / e0[c]);
-                        (scale, basis_at(l.direction))
-                    })
-                    .collect(),
+                weights: lights.weights(self.file.radiance, MAX_BAND),
                 samples: None,
             },
             None => {
@@ -65,7 +51,7 @@ impl Relight {
                 }
                 Lit {
                     dim: self.file.dim,
-                    lights: Vec::new(),
+                    weights: Vec::new(),
                     samples: Some(used.into_iter().map(Option::unwrap_or_default).collect()),
                 }
             }
@@ -90,15 +76,7 @@ impl Lit {
                     .sum();
                 [(y / total.max(f32::MIN_POSITIVE) as f64) as f32; 3]
             }
-            None => {
-                let mut w = [0.0f64; 3];
-                for (scale, y) in &self.lights {
-                    for ch in 0..3 {
-                        w[ch] += scale[ch] as f64 * y.get(c).copied().unwrap_or(0.0);
-                    }
-                }
-                w.map(|v| v as f32)
-            }
+            None => self.weights.get(c).map_or([0.0; 3], |w| w.map(|v| v as f32)),
         }
     }
 }

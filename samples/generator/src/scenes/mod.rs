@@ -4,6 +4,7 @@ pub mod common;
 pub mod demo1;
 pub mod demo2;
 pub mod glass;
+pub mod relight;
 pub mod teapot_glossy;
 pub mod teapot_pem;
 pub mod wild;

@@ -82,7 +82,7 @@ fn normal_map(
     })
 }
 
-fn header(title: &str, what: &str) -> String {
+pub(super) fn header(title: &str, what: &str) -> String {
     let mut s = toml_header(title).replace(
         "`cargo run -p pis-samples --release -- samples/`",
         "`cargo run -p pis-samples --release -- samples/` (into samples/wild/)",
@@ -96,7 +96,7 @@ fn header(title: &str, what: &str) -> String {
     s
 }
 
-fn orbit(
+pub(super) fn orbit(
     name: &str,
     samples: u32,
     target: Vec3,
@@ -710,51 +710,5 @@ samples = {{ view = 8 }}
         view = orbit("view", 8, target, 1.1, 28.0, [-15.0, 15.0]),
     );
     std::fs::write(dir.join("scene.toml"), toml)?;
-    std::fs::write(dir.join("relight.toml"), relight_toml(target))
-}
-
-/// still-life relit: the sky replaced by a sun turned over the upper hemisphere, 64
-/// directions × 4 views; `--preset held` traces 12 other directions (a spherical Fibonacci
-/// set of another count shares none of them) to judge relighting between the samples.
-fn relight_toml(target: Vec3) -> String {
-    format!(
-        r#"{header}
-name = "still-life-relight"
-gltf = "still-life.gltf"
-resolution = [160, 120]
-spp = 16
-
-[camera]
-yfov_deg = 40
-
-# The only light: a sun whose direction is the light dimension.
-[[light]]
-name = "Sun"
-kind = "directional"
-direction = [0, -1, 0]
-intensity = 3
-
-{view}
-[[dimension]]
-name = "sun"
-driver = "light_direction"
-light = "Sun"
-samples = 64
-
-[preset.held]
-samples = {{ sun = 12 }}
-
-[preset.paper]
-resolution = [640, 480]
-spp = 16
-"#,
-        header = header(
-            "still-life-relight — still-life under a sun turned over the upper hemisphere",
-            "Exercises: a light_direction dimension (64 directions of the upper hemisphere) x 4\n\
-             views; pis-pack stores the objects' surface layers as spherical-harmonic\n\
-             coefficients over the sun's direction, and pis-bench relight judges them at the\n\
-             12 directions of --preset held.",
-        ),
-        view = orbit("view", 4, target, 1.1, 28.0, [-15.0, 15.0]),
-    )
+    super::relight::write(dir, target)
 }

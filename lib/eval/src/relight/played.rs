@@ -1,0 +1,87 @@
+//! Packed files played under the lights of each point of a held-out set: a relightable file
+//! relit by superposition (one directional light from another direction, two coloured
+//! lights, a sky); a file that samples the light at its sample nearest a held-out direction.
+
+use std::path::{Path, PathBuf};
+
+use anyhow::{anyhow, Context, Result};
+use glam::Vec3;
+use pis_play::{CameraChoice, FrameRequest, Gpu, Player, PlayerOptions};
+use pis_trace::set::RaySet;
+
+use super::held::HeldLights;
+use super::HeldOutRow;
+use crate::metrics::SquaredError;
+
+/// Each of `files` played at every point of `held`, its other dimensions at their samples.
+pub fn held_out(files: &[PathBuf], held: &Path) -> Result<Vec<HeldOutRow>> {
+    let set = RaySet::open(held).context("the held-out set")?;
+    let gpu = std::sync::Arc::new(Gpu::new()?);
+    let mut rows = Vec::new();
+    for file in files {
+        let options = PlayerOptions {
+            display_filter: crate::headless::set_display_filter(held),
+            ..PlayerOptions::default()
+        };
+        let mut player = Player::open(gpu.clone(), file, options)
+            .with_context(|| format!("{}", file.display()))?;
+        rows.push(play_file(&mut player, file, &set)?);
+    }
+    Ok(rows)
+}
+
+fn play_file(player: &mut Player, file: &Path, set: &RaySet) -> Result<HeldOutRow> {
+    let c = player.reader().container();
+    let file_lights = pis_format::relight::light_directions(c.provenance.as_ref(), &c.space)
+        .map_err(|e| anyhow!("{}: {e}", file.display()))?
+        .ok_or_else(|| anyhow!("{}: records no light directions", file.display()))?;
+    let relightable = c.objects.iter().flat_map(|o| &o.layers).any(|l| l.basis != 0);
+    let k = file_lights.dim;
+    let values = c.space.dims.get(k).map(|d| d.values.clone()).unwrap_or_default();
+    let lights = HeldLights::of(set, file_lights.radiance)?;
+    let mut row = HeldOutRow {
+        file: file.display().to_string(),
+        bytes: std::fs::metadata(file)?.len(),
+        relightable,
+        psnr_db: None,
+        points_db: Vec::new(),
+    };
+    if !relightable && lights.dim.is_none() {
+        // One sampled light cannot show the held-out set's lights.
+        return Ok(row);
+    }
+    let size = player.image_size();
+    let mut whole = SquaredError::default();
+    for (i, p) in set.meta.points.iter().enumerate() {
+        let mut point = p.values.clone();
+        if lights.dim.is_none() {
+            point.insert(k.min(point.len()), values.first().copied().unwrap_or(0.0));
+        }
+        if relightable {
+            player.set_lights(Some(lights.points[i].clone()))?;
+        } else {
+            let w = lights.points[i].directional[0].direction;
+            let near = (0..file_lights.directions.len())
+                .max_by(|&a, &b| {
+                    let d = |j: usize| Vec3::from(file_lights.directions[j]).dot(w);
+                    d(a).total_cmp(&d(b))
+                })
+                .unwrap_or(0);
+            point[k] = values.get(near).copied().unwrap_or(0.0);
+        }
+        let req = FrameRequest { point, camera: CameraChoice::Sample };
+        let (img, _) = player.render_image(&req, size)?;
+        let images = set.read_point(i)?;
+        let gold = images.layer("combined").ok_or_else(|| anyhow!("point {i}: no combined"))?;
+        let mut one = SquaredError::default();
+        for (px, rgba) in img.rgba.chunks_exact(4).enumerate() {
+            for (v, plane) in rgba.iter().zip(&gold.planes).take(3) {
+                one.add(*v, plane[px]);
+            }
+        }
+        whole.merge(&one);
+        row.points_db.push(one.psnr());
+    }
+    row.psnr_db = Some(whole.psnr());
+    Ok(row)
+}

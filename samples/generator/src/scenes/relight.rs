@@ -1,0 +1,166 @@
+//! still-life relit: the sky of still-life's scene.toml replaced by a sun turned over the
+//! upper hemisphere (relight.toml, 64 directions × 4 views), and the scenes its relit file
+//! is judged under, traced with exactly those lights: two coloured directional lights
+//! (relight-two.toml) and an HDR sky (relight-sky.toml with relight-sky.exr). Every
+//! direction they light from is one the 64 samples do not hold.
+
+use std::io;
+use std::path::Path;
+
+use glam::Vec3;
+
+use super::wild::{header, orbit};
+
+/// Writes relight.toml, relight-two.toml, relight-sky.toml and relight-sky.exr into `dir`.
+pub fn write(dir: &Path, target: Vec3) -> io::Result<()> {
+    std::fs::write(dir.join("relight.toml"), relight_toml(target))?;
+    std::fs::write(dir.join("relight-two.toml"), two_lights_toml(target))?;
+    std::fs::write(dir.join("relight-sky.toml"), sky_toml(target))?;
+    write_sky(&dir.join("relight-sky.exr"))
+}
+
+/// The views every relight scene shares.
+fn views(target: Vec3) -> String {
+    orbit("view", 4, target, 1.1, 28.0, [-15.0, 15.0])
+}
+
+/// The resolution, samples and paper preset every relight scene shares.
+const SIZE: &str = "resolution = [160, 120]\nspp = 16\n\n[camera]\nyfov_deg = 40\n";
+const PAPER: &str = "[preset.paper]\nresolution = [640, 480]\nspp = 16\n";
+
+/// The sun over 64 directions of the upper hemisphere; `--preset held` traces 12 other
+/// directions (a spherical Fibonacci set of another count shares none of them).
+fn relight_toml(target: Vec3) -> String {
+    format!(
+        r#"{header}
+name = "still-life-relight"
+gltf = "still-life.gltf"
+{SIZE}
+# The only light: a sun whose direction is the light dimension.
+[[light]]
+name = "Sun"
+kind = "directional"
+direction = [0, -1, 0]
+intensity = 3
+
+{views}
+[[dimension]]
+name = "sun"
+driver = "light_direction"
+light = "Sun"
+samples = 64
+
+[preset.held]
+samples = {{ sun = 12 }}
+
+{PAPER}"#,
+        header = header(
+            "still-life-relight — still-life under a sun turned over the upper hemisphere",
+            "Exercises: a light_direction dimension (64 directions of the upper hemisphere) x 4\n\
+             views; pis-pack stores the objects' surface layers as spherical-harmonic\n\
+             coefficients over the sun's direction, and pis-bench relight judges them at the\n\
+             12 directions of --preset held, under relight-two.toml's two lights and under\n\
+             relight-sky.toml's sky.",
+        ),
+        views = views(target),
+    )
+}
+
+/// The direction a light shines along, for one seen at azimuth `az` (from +X towards +Z)
+/// and elevation `el`, degrees.
+fn shining(az: f32, el: f32) -> String {
+    let (az, el) = (az.to_radians(), el.to_radians());
+    let w = Vec3::new(el.cos() * az.cos(), el.sin(), el.cos() * az.sin());
+    format!("[{:.4}, {:.4}, {:.4}]", -w.x, -w.y, -w.z)
+}
+
+/// A warm key light and a cool fill from directions the 64 samples do not hold.
+fn two_lights_toml(target: Vec3) -> String {
+    format!(
+        r#"{header}
+name = "still-life-relight-two"
+gltf = "still-life.gltf"
+{SIZE}
+# A warm key (azimuth 40°, elevation 50°) and a cool fill (azimuth -130°, elevation 25°).
+[[light]]
+name = "Key"
+kind = "directional"
+direction = {key}
+color = [1.0, 0.72, 0.45]
+intensity = 2.5
+
+[[light]]
+name = "Fill"
+kind = "directional"
+direction = {fill}
+color = [0.45, 0.62, 1.0]
+intensity = 1.6
+
+{views}
+{PAPER}"#,
+        header = header(
+            "still-life-relight-two — still-life under two coloured suns",
+            "Exercises: the reference for relighting relight.toml's file with two directional\n\
+             lights of different colours (pis-bench relight FILE --held SET).",
+        ),
+        key = shining(40.0, 50.0),
+        fill = shining(-130.0, 25.0),
+        views = views(target),
+    )
+}
+
+/// An HDR sky (relight-sky.exr), turned 30° about +Y, as the only light.
+fn sky_toml(target: Vec3) -> String {
+    format!(
+        r#"{header}
+name = "still-life-relight-sky"
+gltf = "still-life.gltf"
+{SIZE}
+[environment]
+image = "relight-sky.exr"
+rotation_deg = 30
+
+{views}
+{PAPER}"#,
+        header = header(
+            "still-life-relight-sky — still-life under an HDR sky",
+            "Exercises: the reference for relighting relight.toml's file with a sky projected\n\
+             into its basis (pis-bench relight FILE --held SET); relight-sky.exr is a blue\n\
+             sky over a black ground with a warm glow 10 degrees wide at elevation 35 degrees.",
+        ),
+        views = views(target),
+    )
+}
+
+/// The sky's width and height in texels.
+const SKY: (usize, usize) = (96, 48);
+
+/// Radiance of the sky towards the image-frame direction `d`: a blue gradient from a pale
+/// horizon to the zenith and a warm Gaussian glow (σ 10°) around azimuth 60°, elevation 35°;
+/// black below the horizon.
+fn sky_radiance(d: Vec3) -> [f32; 3] {
+    if d.y <= 0.0 {
+        return [0.0; 3];
+    }
+    let (horizon, zenith) = (Vec3::new(0.32, 0.36, 0.42), Vec3::new(0.10, 0.17, 0.36));
+    let sky = horizon.lerp(zenith, d.y.sqrt());
+    let (az, el) = (60f32.to_radians(), 35f32.to_radians());
+    let sun = Vec3::new(el.cos() * az.cos(), el.sin(), el.cos() * az.sin());
+    let angle = d.dot(sun).clamp(-1.0, 1.0).acos();
+    let sigma = 10f32.to_radians();
+    let glow = Vec3::new(10.0, 8.0, 5.5) * (-angle * angle / (2.0 * sigma * sigma)).exp();
+    (sky + glow).to_array()
+}
+
+/// Writes the sky as an equirectangular OpenEXR image (docs/SCENE.md's lat-long convention).
+fn write_sky(path: &Path) -> io::Result<()> {
+    let (w, h) = SKY;
+    let at = |x: usize, y: usize| {
+        let (u, v) = ((x as f32 + 0.5) / w as f32, (y as f32 + 0.5) / h as f32);
+        let phi = std::f32::consts::TAU * (u - 0.5);
+        let (sin_t, cos_t) = (std::f32::consts::PI * v).sin_cos();
+        let [r, g, b] = sky_radiance(Vec3::new(sin_t * phi.cos(), cos_t, sin_t * phi.sin()));
+        (r, g, b)
+    };
+    exr::prelude::write_rgb_file(path, w, h, at).map_err(io::Error::other)
+}
