@@ -56,7 +56,7 @@ impl Scene {
                 Driver::LightPath { light, path } => {
                     moved_lights.push((light, Moved::To(point_on_path(path, value))))
                 }
-                Driver::LightDirection { light, directions, center, distance } => {
+                Driver::LightDirection { light, directions, center, distance, .. } => {
                     let w = directions[i as usize];
                     moved_lights.push((light, Moved::Turned { w, at: *center + *distance * w }))
                 }

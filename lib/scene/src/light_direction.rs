@@ -38,6 +38,21 @@ pub fn light_directions(n: u32, cover: Cover, up: Vec3) -> Vec<Vec3> {
         .collect()
 }
 
+/// `n` unit directions along the arc of elevation `elevation_deg` above the horizon of `up`,
+/// from azimuth `azimuth_deg[0]` to `azimuth_deg[1]` inclusive (degrees, φ as in
+/// [`light_directions`]): a light moving continuously.
+pub fn arc_directions(n: u32, elevation_deg: f32, azimuth_deg: [f32; 2], up: Vec3) -> Vec<Vec3> {
+    let turn = Quat::from_rotation_arc(Vec3::Y, up.normalize());
+    let (sin_e, cos_e) = elevation_deg.to_radians().sin_cos();
+    (0..n)
+        .map(|i| {
+            let f = if n > 1 { i as f32 / (n - 1) as f32 } else { 0.0 };
+            let phi = (azimuth_deg[0] + (azimuth_deg[1] - azimuth_deg[0]) * f).to_radians();
+            (turn * Vec3::new(cos_e * phi.cos(), sin_e, cos_e * phi.sin())).normalize()
+        })
+        .collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -56,3 +56,27 @@ fn light_direction_errors_name_their_key() {
         assert!(err.contains(field), "{bad}: {err}");
     }
 }
+
+#[test]
+fn an_arc_moves_the_light_continuously_at_one_elevation() {
+    let spec = "[[dimension]]\nname = \"sun\"\ndriver = \"light_direction\"\nlight = \"Sun\"\nsamples = 5\ndirections = \"arc\"\nelevation_deg = 30\nazimuth_deg = [0, 90]\n";
+    let f = Fixture::new(&format!("{SUN_HEAD}{spec}"), |_, _| {});
+    let s = load(&f.toml(), None).unwrap();
+    let crate::Driver::LightDirection { directions, arc, .. } = &s.space.dims[0].driver else {
+        panic!()
+    };
+    assert!(*arc);
+    let (sin_e, cos_e) = 30f32.to_radians().sin_cos();
+    assert!(directions[0].distance(Vec3::new(cos_e, sin_e, 0.0)) < 1e-6);
+    assert!(directions[4].distance(Vec3::new(0.0, sin_e, cos_e)) < 1e-6);
+    for w in directions.windows(2) {
+        assert!((w[0].angle_between(w[1]) - (22.5f32.to_radians() * cos_e)).abs() < 0.01);
+    }
+    // The arc's keys belong to the arc only, and an arc needs its azimuths.
+    let cover = spec.replace("\"arc\"", "\"hemisphere\"");
+    let e = load_err(&Fixture::new(&format!("{SUN_HEAD}{cover}"), |_, _| {})).to_string();
+    assert!(e.contains("elevation_deg") && e.contains("arc"), "{e}");
+    let without = spec.replace("azimuth_deg = [0, 90]\n", "");
+    let e = load_err(&Fixture::new(&format!("{SUN_HEAD}{without}"), |_, _| {})).to_string();
+    assert!(e.contains("azimuth_deg"), "{e}");
+}

@@ -133,7 +133,7 @@ pub struct DimensionSpec {
     /// First and last sampled arc-length fraction, default `[0, 1]`.
     pub range: Option<[f32; 2]>,
     // light_direction (with `light`)
-    /// `hemisphere` (default) or `sphere`.
+    /// `hemisphere` (default), `sphere` or `arc` (with `elevation_deg` and `azimuth_deg`).
     pub directions: Option<CoverSpec>,
     /// The hemisphere's pole, default `[0, 1, 0]`.
     pub up: Option<[f32; 3]>,
@@ -149,6 +149,8 @@ pub struct DimensionSpec {
 pub enum CoverSpec {
     Hemisphere,
     Sphere,
+    /// Along a circle of constant elevation: the light moving continuously.
+    Arc,
 }
 
 /// `[preset.NAME]`: overrides applied when the preset is selected.

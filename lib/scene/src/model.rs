@@ -281,7 +281,14 @@ pub enum Driver {
     /// A named light turned over a set of directions (unit, from the scene towards the
     /// light); the sample value is the sample's index. A directional light shines along
     /// −direction; a point, spot or sphere light stands at `center + distance · direction`.
-    LightDirection { light: String, directions: Vec<Vec3>, center: Vec3, distance: f32 },
+    LightDirection {
+        light: String,
+        directions: Vec<Vec3>,
+        center: Vec3,
+        distance: f32,
+        /// The directions follow an arc (a light moving continuously), not a cover.
+        arc: bool,
+    },
     /// Nothing moves: the one sample of the dimension a scene without `[[dimension]]` gets,
     /// since a container holds 1 to 8 dimensions.
     Still,

@@ -5,7 +5,7 @@ use std::path::Path;
 use glam::Vec3;
 
 use crate::gltf_load::GltfScene;
-use crate::light_direction::{light_directions, Cover};
+use crate::light_direction::{arc_directions, light_directions, Cover};
 use crate::manifest::{CoverSpec, DimensionSpec, DriverSpec, KindSpec};
 use crate::model::{Dimension, Driver, ParameterSpace};
 use crate::{DimensionKind, LightKind, SceneError};
@@ -168,7 +168,9 @@ fn check_keys(at: &At, earlier: &[DimensionSpec]) -> Result<(), SceneError> {
         DriverSpec::Orbit => &["target", "radius", "elevation_deg", "azimuth_deg"],
         DriverSpec::Animation => &["animation", "time"],
         DriverSpec::LightPath => &["light", "path", "range"],
-        DriverSpec::LightDirection => &["light", "directions", "up", "center", "distance"],
+        DriverSpec::LightDirection => {
+            &["light", "directions", "up", "center", "distance", "elevation_deg", "azimuth_deg"]
+        }
     };
     if let Some((key, _)) = present.iter().find(|(k, p)| *p && !allowed.contains(k)) {
         return Err(at.invalid(key, format!("key not used by driver {:?}", d.driver)));
@@ -258,22 +260,42 @@ fn light_direction(at: &At, g: &GltfScene) -> Result<Resolved, SceneError> {
             return Err(at.invalid("distance", format!("required: light `{name}` has a place")))
         }
     };
-    let cover = match d.directions.unwrap_or(CoverSpec::Hemisphere) {
-        CoverSpec::Hemisphere => Cover::Hemisphere,
-        CoverSpec::Sphere => Cover::Sphere,
-    };
     if d.periodic == Some(true) {
         return Err(at.invalid("periodic", "a set of directions has no loop to close"));
     }
+    let cover = d.directions.unwrap_or(CoverSpec::Hemisphere);
+    if cover != CoverSpec::Arc {
+        for (key, given) in
+            [("elevation_deg", d.elevation_deg), ("azimuth_deg", d.azimuth_deg.map(|a| a[0]))]
+        {
+            if given.is_some() {
+                return Err(at.invalid(key, "only an arc (`directions = \"arc\"`) has it"));
+            }
+        }
+    }
+    let up = up.normalize();
+    let directions = match cover {
+        CoverSpec::Hemisphere => light_directions(d.samples, Cover::Hemisphere, up),
+        CoverSpec::Sphere => light_directions(d.samples, Cover::Sphere, up),
+        CoverSpec::Arc => {
+            let azimuth = d.azimuth_deg.ok_or_else(|| at.required("azimuth_deg"))?;
+            let elevation = d.elevation_deg.unwrap_or(0.0);
+            if !(azimuth.iter().all(|a| a.is_finite()) && elevation.abs() <= 90.0) {
+                return Err(at.invalid("elevation_deg", format!("must lie in [-90, 90] with a finite azimuth_deg, found {elevation} and {azimuth:?}")));
+            }
+            arc_directions(d.samples, elevation, azimuth, up)
+        }
+    };
     Ok(Resolved {
         kind: at.fixed_kind(KindSpec::Light)?,
         unit: "",
         range: ([0.0, d.samples.saturating_sub(1) as f32], "samples"),
         driver: Driver::LightDirection {
             light: name.to_owned(),
-            directions: light_directions(d.samples, cover, up.normalize()),
+            directions,
             center,
             distance,
+            arc: cover == CoverSpec::Arc,
         },
     })
 }

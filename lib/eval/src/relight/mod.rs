@@ -11,7 +11,7 @@ use serde::Serialize;
 
 pub use ceiling::{ceiling, ceiling_of};
 pub use held::{light_dimension, HeldLights};
-pub use played::held_out;
+pub use played::{held_out, reference_step};
 
 /// One band's figure, or the nearest sampled direction's (`band` `None`).
 #[derive(Clone, Debug, Serialize)]
@@ -37,6 +37,9 @@ pub struct HeldOutRow {
     pub psnr_db: Option<f64>,
     /// Per held-out point, display PSNR (dB).
     pub points_db: Vec<f64>,
+    /// Where the held-out set's light moves continuously: the largest change between
+    /// consecutive frames, as the PSNR of one against the other (dB; lower is a larger jump).
+    pub largest_step_db: Option<f64>,
 }
 
 /// What `pis-bench relight` measured.
@@ -44,6 +47,8 @@ pub struct HeldOutRow {
 pub struct RelightReport {
     pub ceiling: Option<Vec<CeilingRow>>,
     pub played: Vec<HeldOutRow>,
+    /// The held-out set's own largest step, where its light moves continuously.
+    pub reference_step_db: Option<f64>,
 }
 
 /// The report as text.
@@ -74,6 +79,17 @@ pub fn render(r: &RelightReport) -> String {
             None => "cannot show these lights (it samples one light)".into(),
         };
         out.push_str(&format!("  {}  {} bytes, {how}: {db}\n", row.file, row.bytes));
+    }
+    if let Some(reference) = r.reference_step_db {
+        out.push_str(&format!(
+            "largest change from one light step to the next (PSNR of a frame against the \
+             previous; lower is a larger jump):\n  traced  {reference:.2} dB\n"
+        ));
+        for row in &r.played {
+            if let Some(db) = row.largest_step_db {
+                out.push_str(&format!("  {}  {db:.2} dB\n", row.file));
+            }
+        }
     }
     out
 }

@@ -1,6 +1,8 @@
 //! Packed files played under the lights of each point of a held-out set: a relightable file
 //! relit by superposition (one directional light from another direction, two coloured
 //! lights, a sky); a file that samples the light at its sample nearest a held-out direction.
+//! Where the held-out set moves its light continuously (an arc), the frames' largest change
+//! from one light step to the next against the set's own: popping.
 
 use std::path::{Path, PathBuf};
 
@@ -9,7 +11,7 @@ use glam::Vec3;
 use pis_play::{CameraChoice, FrameRequest, Gpu, Player, PlayerOptions};
 use pis_trace::set::RaySet;
 
-use super::held::HeldLights;
+use super::held::{others, HeldLights};
 use super::HeldOutRow;
 use crate::metrics::SquaredError;
 
@@ -45,7 +47,10 @@ fn play_file(player: &mut Player, file: &Path, set: &RaySet) -> Result<HeldOutRo
         relightable,
         psnr_db: None,
         points_db: Vec::new(),
+        largest_step_db: None,
     };
+    let continuous = continuous(&lights);
+    let mut steps = Steps::default();
     if !relightable && lights.dim.is_none() {
         // One sampled light cannot show the held-out set's lights.
         return Ok(row);
@@ -81,7 +86,64 @@ fn play_file(player: &mut Player, file: &Path, set: &RaySet) -> Result<HeldOutRo
         }
         whole.merge(&one);
         row.points_db.push(one.psnr());
+        if continuous {
+            let rgb: Vec<f32> = img.rgba.chunks_exact(4).flat_map(|p| [p[0], p[1], p[2]]).collect();
+            steps.next(others(&p.samples, lights.dim.as_ref().map(|d| d.0)), rgb);
+        }
     }
     row.psnr_db = Some(whole.psnr());
+    row.largest_step_db = continuous.then_some(steps.largest_db);
     Ok(row)
+}
+
+/// Whether the held-out set's light moves continuously: a light dimension whose
+/// consecutive directions lie within 10° of each other.
+pub fn continuous(lights: &HeldLights) -> bool {
+    lights.dim.as_ref().is_some_and(|(_, dirs)| {
+        dirs.len() > 1 && dirs.windows(2).all(|w| w[0].angle_between(w[1]) < 10f32.to_radians())
+    })
+}
+
+/// The largest change from one frame to the next of the same other samples (the smallest
+/// PSNR between consecutive frames, dB).
+struct Steps {
+    last: Option<(Vec<u32>, Vec<f32>)>,
+    largest_db: f64,
+}
+
+impl Default for Steps {
+    fn default() -> Steps {
+        Steps { last: None, largest_db: f64::INFINITY }
+    }
+}
+
+impl Steps {
+    fn next(&mut self, group: Vec<u32>, rgb: Vec<f32>) {
+        if let Some((g, prev)) = &self.last {
+            if *g == group {
+                let mut e = SquaredError::default();
+                e.add_slices(&rgb, prev);
+                self.largest_db = self.largest_db.min(e.psnr());
+            }
+        }
+        self.last = Some((group, rgb));
+    }
+}
+
+/// The held-out set's own largest step where its light moves continuously.
+pub fn reference_step(held: &Path) -> Result<Option<f64>> {
+    let set = RaySet::open(held).context("the held-out set")?;
+    let lights = HeldLights::of(&set, [1.0; 3])?;
+    if !continuous(&lights) {
+        return Ok(None);
+    }
+    let mut steps = Steps::default();
+    for (i, p) in set.meta.points.iter().enumerate() {
+        let images = set.read_point(i)?;
+        let c = images.layer("combined").ok_or_else(|| anyhow!("point {i}: no combined"))?;
+        let n = c.planes[0].len();
+        let rgb = (0..n * 3).map(|v| c.planes[v % 3][v / 3]).collect();
+        steps.next(others(&p.samples, lights.dim.as_ref().map(|d| d.0)), rgb);
+    }
+    Ok(Some(steps.largest_db))
 }

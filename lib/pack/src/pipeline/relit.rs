@@ -59,9 +59,13 @@ impl Relit {
             .iter()
             .enumerate()
             .find(|(_, d)| matches!(d.driver, Driver::LightDirection { .. }))?;
-        let Driver::LightDirection { light, directions, distance, .. } = &d.driver else {
+        let Driver::LightDirection { light, directions, distance, arc, .. } = &d.driver else {
             return None;
         };
+        if *arc {
+            // An arc does not span the directions a basis is fitted over.
+            return None;
+        }
         let lit = set.frames.first()?.lights.iter().find(|l| &l.name == light)?;
         let scale =
             if lit.kind == LightKind::Directional { 1.0 } else { 1.0 / (distance * distance) };

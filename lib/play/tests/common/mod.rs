@@ -303,3 +303,47 @@ pub fn depth_scene() -> Vec<[Vec3; 3]> {
     scene.extend(box_triangles(Vec3::new(-1.2, -1.3, -2.6), Vec3::new(-0.7, 3.0, -2.1)));
     scene
 }
+
+/// A frame of one object (`mesh` at `clip`, one sample per pixel, the box resolve) drawn
+/// with `layers` added, each a texture times its per-channel tint (a relightable layer's
+/// coefficient weights, SPEC.md 9), with the identity affine and level 0.
+pub fn draw_tinted(
+    gpu: &Gpu,
+    pipes: &mut pis_play::frame::FramePipelines,
+    size: (u32, u32),
+    (mesh, clip): (&pis_play::frame::MeshGpu, Mat4),
+    layers: &[(&pis_play::ObjectTexture, [f32; 3])],
+    sampler: &wgpu::Sampler,
+) -> FloatImage {
+    use pis_play::frame::{
+        colour_image, encode, offscreen_format, FrameDraws, FrameTarget, LayerDraw, ObjectDraw,
+        Readback, Targets,
+    };
+    let format = offscreen_format(gpu);
+    let mut targets = Targets::new(gpu, pipes, size, 1).unwrap();
+    let objects = [ObjectDraw { object: 0, mesh, clip_from_object: clip, translucent: false }];
+    let layers: Vec<LayerDraw> = layers
+        .iter()
+        .map(|&(texture, tint)| LayerDraw {
+            draw: 0,
+            texture,
+            sampler,
+            transform: pis_compile::TextureTransform::IDENTITY,
+            max_level: 0.0,
+            weight: 1.0,
+            tint,
+            anisotropic: false,
+            opacity: false,
+        })
+        .collect();
+    let mut encoder = gpu.device.create_command_encoder(&Default::default());
+    let view = targets.colour.create_view(&Default::default());
+    let target = FrameTarget { colour: &view, format, object_ids: true, display: None };
+    let frame = FrameDraws { objects: &objects, layers: &layers, reflections: &[], lenses: &[] };
+    encode(gpu, pipes, &mut targets, target, frame, &mut encoder);
+    let texel = if format == wgpu::TextureFormat::Rgba16Float { 8 } else { 16 };
+    let rc = Readback::new(gpu, size, texel);
+    rc.copy(&targets.colour, &mut encoder);
+    gpu.queue.submit([encoder.finish()]);
+    colour_image(&rc.read(gpu).unwrap(), format, size)
+}

@@ -1,8 +1,9 @@
 //! still-life relit: the sky of still-life's scene.toml replaced by a sun turned over the
 //! upper hemisphere (relight.toml, 64 directions × 4 views), and the scenes its relit file
 //! is judged under, traced with exactly those lights: two coloured directional lights
-//! (relight-two.toml) and an HDR sky (relight-sky.toml with relight-sky.exr). Every
-//! direction they light from is one the 64 samples do not hold.
+//! (relight-two.toml) and an HDR sky (relight-sky.toml with relight-sky.exr); and the sun
+//! moving continuously along an arc (relight-arc.toml), to judge popping. Every direction
+//! they light from is one the 64 samples do not hold.
 
 use std::io;
 use std::path::Path;
@@ -11,9 +12,11 @@ use glam::Vec3;
 
 use super::wild::{header, orbit};
 
-/// Writes relight.toml, relight-two.toml, relight-sky.toml and relight-sky.exr into `dir`.
+/// Writes relight.toml, relight-two.toml, relight-sky.toml, relight-sky.exr and
+/// relight-arc.toml into `dir`.
 pub fn write(dir: &Path, target: Vec3) -> io::Result<()> {
     std::fs::write(dir.join("relight.toml"), relight_toml(target))?;
+    std::fs::write(dir.join("relight-arc.toml"), arc_toml(target))?;
     std::fs::write(dir.join("relight-two.toml"), two_lights_toml(target))?;
     std::fs::write(dir.join("relight-sky.toml"), sky_toml(target))?;
     write_sky(&dir.join("relight-sky.exr"))
@@ -61,6 +64,40 @@ samples = {{ sun = 12 }}
              coefficients over the sun's direction, and pis-bench relight judges them at the\n\
              12 directions of --preset held, under relight-two.toml's two lights and under\n\
              relight-sky.toml's sky.",
+        ),
+        views = views(target),
+    )
+}
+
+/// The sun along an arc at elevation 35°, azimuth 0° to 90° in 24 steps of 3.2°: the light
+/// moving continuously, its own frame-to-frame change the measure of a relit file's popping.
+fn arc_toml(target: Vec3) -> String {
+    format!(
+        r#"{header}
+name = "still-life-relight-arc"
+gltf = "still-life.gltf"
+{SIZE}
+[[light]]
+name = "Sun"
+kind = "directional"
+direction = [0, -1, 0]
+intensity = 3
+
+{views}
+[[dimension]]
+name = "sun"
+driver = "light_direction"
+light = "Sun"
+samples = 24
+directions = "arc"
+elevation_deg = 35
+azimuth_deg = [0, 90]
+
+{PAPER}"#,
+        header = header(
+            "still-life-relight-arc — still-life under a sun moving along an arc",
+            "Exercises: the reference for relight.toml's file as its light moves continuously\n\
+             (pis-bench relight FILE --held SET reports the frame-to-frame change).",
         ),
         views = views(target),
     )
@@ -162,5 +199,14 @@ fn write_sky(path: &Path) -> io::Result<()> {
         let [r, g, b] = sky_radiance(Vec3::new(sin_t * phi.cos(), cos_t, sin_t * phi.sin()));
         (r, g, b)
     };
-    exr::prelude::write_rgb_file(path, w, h, at).map_err(io::Error::other)
+    use exr::prelude::*;
+    // One thread, increasing scan lines: the same bytes on every run.
+    let encoding = Encoding {
+        compression: Compression::ZIP16,
+        blocks: Blocks::ScanLines,
+        line_order: LineOrder::Increasing,
+    };
+    let pixels = SpecificChannels::rgb(|p: Vec2<usize>| at(p.x(), p.y()));
+    let layer = Layer::new((w, h), LayerAttributes::default(), encoding, pixels);
+    Image::from_layer(layer).write().non_parallel().to_file(path).map_err(io::Error::other)
 }
