@@ -656,7 +656,8 @@ fn run(cli: Cli) -> Result<Exit, Failure> {
                 .transpose()
                 .map_err(runtime)?;
             let played = pis_eval::relight::held_out(&files, &held).map_err(runtime)?;
-            let report = pis_eval::relight::RelightReport { ceiling, played };
+            let reference_step_db = pis_eval::relight::reference_step(&held).map_err(runtime)?;
+            let report = pis_eval::relight::RelightReport { ceiling, played, reference_step_db };
             eprint!("{}", pis_eval::relight::render(&report));
             if json {
                 json_out(&report)?;
