@@ -1,7 +1,9 @@
 //! pis-play: the player's command line. Headless mode draws offscreen (`headless`); the
-//! arguments (`args`) are shared with a window mode.
+//! arguments (`args`) and the lights of a relightable file (`lights`) are shared with a
+//! window mode.
 
 pub mod args;
+pub mod lights;
 
 use std::path::{Path, PathBuf};
 
@@ -137,6 +139,10 @@ fn headless(args: &PlayArgs) -> Result<Exit, Failure> {
     };
     let req = args.headless();
     let (gpu, mut player) = open(&req)?;
+    let relightable = lights::relightable(&player).is_some();
+    if let Some(lights) = args.lights.relight(&args.file, relightable)? {
+        player.set_lights(Some(lights)).map_err(pis_eval::headless::play_failure)?;
+    }
     match &args.compare {
         Some(set) => {
             let r = run_compare(&req, set, &gpu, &mut player)?;

@@ -1,9 +1,11 @@
 //! pis-play's window mode (thesis 1.4, third step; 5.9): the player's frames in a window,
 //! with panels to move through the parameter space, play a path, switch blending and camera,
-//! compare with the ray-traced gold standard, and watch the frame rate.
+//! compare with the ray-traced gold standard, relight a relightable file, and watch the frame
+//! rate.
 
 pub mod app;
 pub mod gold;
+pub mod lights;
 pub mod screenshot;
 pub mod surface;
 pub mod ui;
@@ -55,6 +57,7 @@ pub fn window_options(args: &PlayArgs) -> Result<WindowOptions, Failure> {
         vsync: !args.no_vsync,
         gpu: pis_play::GpuOptions::default(),
         player: args.player_options(),
+        lights: args.lights.clone(),
     })
 }
 

@@ -50,6 +50,10 @@ fn parse_reduction(s: &str) -> Result<u32, String> {
 /// ray-traced gold standard. `--frames N` exits after N frames with a frame-rate report,
 /// `--screenshot` saves the last one.
 ///
+/// A file with relightable layers plays under its own light at the parameter point, or
+/// relit: with `--light` (any number) and `--sky` in headless frames and as the window's
+/// start; in the window, the Lights panel adds, drags and removes lights and loads a sky.
+///
 /// Given a scene.toml instead of a .pis file, the whole job runs first: the scene is traced
 /// (once, into `.pis-cache/` beside it) and packed with pis-pack's options (its defaults
 /// unless given) into `.pis-cache/NAME-WxH-sppN.pis` (`…-sppN-HASH.pis` for other pack
@@ -134,6 +138,9 @@ pub struct PlayArgs {
     /// Window mode: do not wait for the display refresh between frames (to measure speed).
     #[arg(long)]
     pub no_vsync: bool,
+    /// Relighting a file with relightable layers: directional lights and a sky.
+    #[command(flatten, next_help_heading = "Relighting (files with relightable layers)")]
+    pub lights: crate::play::lights::LightArgs,
     /// Given a scene.toml: how it is traced and packed (pis-pack's options; a .pis file is
     /// played as it is).
     #[command(
@@ -195,5 +202,28 @@ mod tests {
             PlayArgs::try_parse_from(["pis-play", "f.pis"]).unwrap().blend,
             Default::default()
         );
+    }
+
+    /// `--light` repeats and takes a negative azimuth; the sky's rotation and strength need
+    /// `--sky`; lights do not go with `--compare` (its gold standard is the file's light).
+    #[test]
+    fn lights_parse_from_the_command_line() {
+        let parse = |extra: &[&str]| {
+            PlayArgs::try_parse_from(["pis-play", "f.pis"].iter().chain(extra).copied())
+        };
+        let args =
+            parse(&["--light", "40,50,2.5,1.9,1.2", "--light", "-120,30,0.7,0.9,1.5"]).unwrap();
+        assert_eq!(args.lights.lights.len(), 2);
+        assert_eq!(args.lights.lights[1].azimuth_deg, -120.0);
+        assert!(!parse(&[]).unwrap().lights.given());
+        let sky = parse(&["--sky", "s.hdr", "--sky-rotation", "-90", "--sky-strength", "0.5"]);
+        let sky = sky.unwrap().lights;
+        assert_eq!((sky.sky_rotation, sky.sky_strength), (-90.0, 0.5));
+        assert!(sky.given());
+        let err = parse(&["--light", "40,50,1"]).unwrap_err().to_string();
+        assert!(err.contains("expected AZ,EL,R,G,B"), "{err}");
+        assert!(parse(&["--sky-rotation", "10"]).is_err());
+        assert!(parse(&["--sky", "s.hdr", "--sky-strength", "-1"]).is_err());
+        assert!(parse(&["--light", "0,45,1,1,1", "--compare", "set"]).is_err());
     }
 }

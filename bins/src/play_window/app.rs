@@ -17,10 +17,12 @@ use winit::event_loop::{ActiveEventLoop, ControlFlow, EventLoop};
 use winit::window::{Window, WindowId};
 
 use super::gold::GoldSet;
+use super::lights::LightsPanel;
 use super::screenshot::{write_png_rgba8, Capture};
 use super::surface::WindowSurface;
 use super::ui::{self, PanelInfo};
 use crate::cli::{Exit, Failure};
+use crate::play::lights::{relightable, LightArgs};
 use pis_eval::headless::play_failure;
 use pis_play::window::camera::sight_convergence;
 use pis_play::window::path::{PathKind, Playback};
@@ -58,6 +60,8 @@ pub struct WindowOptions {
     pub vsync: bool,
     pub gpu: GpuOptions,
     pub player: PlayerOptions,
+    /// The lights to start with (a relightable file; none given: the file's own light).
+    pub lights: LightArgs,
 }
 
 /// What a run with `frames` measured, printed at exit.
@@ -147,6 +151,8 @@ struct Running {
     meter: StatsMeter,
     gold: Option<GoldSet>,
     gold_texture: Option<GoldTexture>,
+    /// The Lights panel, for a relightable file.
+    lights: Option<LightsPanel>,
     file_label: String,
     adapter: String,
     message: Option<String>,
@@ -248,6 +254,14 @@ impl App {
             Some(dir) => Some(GoldSet::open(dir, player.dimensions())?),
             None => None,
         };
+        o.lights.check(&o.file, relightable(&player).is_some())?;
+        let lights = match relightable(&player) {
+            Some(file) => Some(LightsPanel::new(file, &view.space, &view.point, &o.lights)?),
+            None => None,
+        };
+        if let Some(panel) = &lights {
+            player.set_lights(panel.lights()).map_err(play_failure)?;
+        }
 
         let egui_ctx = egui::Context::default();
         let max_side = gpu.limits.max_texture_dimension_2d as usize;
@@ -278,6 +292,7 @@ impl App {
             meter: StatsMeter::new(1.0, 0.1),
             gold,
             gold_texture: None,
+            lights,
             file_label: o.file.display().to_string(),
             message: None,
             last_stats: FrameStats::default(),
@@ -408,15 +423,19 @@ impl Running {
         };
         let input = self.egui_state.take_egui_input(&self.window);
         let mut actions = ui::Actions::default();
+        let mut relight = false;
         let mut active = false;
         let view = &mut self.view;
+        let mut lights = self.lights.as_mut();
         let gold =
             self.gold_texture.as_ref().filter(|_| view.show_gold).map(|g| (g.texture.id(), g.size));
-        let full = self.egui_ctx.run_ui(input, |ui| {
+        let mut full = self.egui_ctx.run_ui(input, |ui| {
             if let Some((id, (w, h))) = gold {
                 paint_gold(ui, id, w, h);
             }
-            actions = ui::draw(ui, view, &info, dt);
+            actions = ui::draw(ui, view, &info, lights.as_deref_mut(), dt);
+            // A change in any pass of the frame relights it.
+            relight |= actions.relight;
             active = ui.input(|i| !i.keys_down.is_empty() || i.pointer.any_down());
         });
         self.active = active || self.view.playback.playing || actions.play;
@@ -430,6 +449,10 @@ impl Running {
         if actions.play {
             self.view.playback.play_from(&self.view.space, &self.view.point);
         }
+        if let (true, Some(panel)) = (relight, &self.lights) {
+            self.player.set_lights(panel.lights()).map_err(play_failure)?;
+            self.window.request_redraw();
+        }
         self.repaint_after = full
             .viewport_output
             .get(&egui::ViewportId::ROOT)
@@ -441,6 +464,14 @@ impl Running {
             size_in_pixels: [size.0, size.1],
             pixels_per_point: full.pixels_per_point,
         };
+        // egui's texture changes: uploaded now, whether or not the surface gives a frame, and
+        // freed after the frame.
+        let frees = std::mem::take(&mut full.textures_delta.free);
+        for (id, deltas) in std::mem::take(&mut full.textures_delta.set) {
+            for delta in &deltas {
+                self.renderer.update_texture(&self.gpu.device, &self.gpu.queue, id, delta);
+            }
+        }
 
         let frame = match self.surface.surface.get_current_texture() {
             wgpu::CurrentSurfaceTexture::Success(t) => t,
@@ -449,13 +480,13 @@ impl Running {
                 t
             }
             wgpu::CurrentSurfaceTexture::Timeout | wgpu::CurrentSurfaceTexture::Occluded => {
-                self.free_textures(&full.textures_delta);
+                self.free_textures(&frees);
                 self.window.request_redraw();
                 return Ok(None);
             }
             wgpu::CurrentSurfaceTexture::Outdated | wgpu::CurrentSurfaceTexture::Lost => {
                 self.surface.reconfigure(&self.gpu.device);
-                self.free_textures(&full.textures_delta);
+                self.free_textures(&frees);
                 self.window.request_redraw();
                 return Ok(None);
             }
@@ -467,11 +498,6 @@ impl Running {
             format: Some(self.surface.view_format),
             ..Default::default()
         });
-        for (id, deltas) in &full.textures_delta.set {
-            for delta in deltas {
-                self.renderer.update_texture(&self.gpu.device, &self.gpu.queue, *id, delta);
-            }
-        }
         let stats = self.draw(&target, size, &primitives, &screen)?;
         let last_frame = opts.frames.is_some_and(|n| self.frames + 1 >= n);
         if let (true, Some(path)) = (last_frame, &opts.screenshot) {
@@ -484,7 +510,7 @@ impl Running {
         }
         self.window.pre_present_notify();
         self.gpu.queue.present(frame);
-        self.free_textures(&full.textures_delta);
+        self.free_textures(&frees);
 
         let at = Instant::now();
         self.frames += 1;
@@ -585,8 +611,8 @@ impl Running {
         Ok(stats)
     }
 
-    fn free_textures(&mut self, delta: &egui::TexturesDelta) {
-        for id in &delta.free {
+    fn free_textures<'a>(&mut self, free: impl IntoIterator<Item = &'a egui::TextureId>) {
+        for id in free {
             self.renderer.free_texture(id);
         }
     }

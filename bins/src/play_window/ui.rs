@@ -1,11 +1,14 @@
 //! The egui panels over the frame: parameters (a slider per dimension, playback, blend),
-//! camera, gold standard, and stats; and the mouse and keys over the frame itself.
+//! camera, gold standard, stats, and lights for a relightable file; and the mouse and keys
+//! over the frame itself.
 
 use egui::{Key, Ui};
 
 use pis_play::window::path::PathKind;
 use pis_play::window::stats::Shown;
 use pis_play::window::view::{CameraMode, ViewState};
+
+use super::lights::LightsPanel;
 
 /// What the panels show besides the state they edit.
 pub struct PanelInfo<'a> {
@@ -36,6 +39,8 @@ pub struct Actions {
     pub reset_free: bool,
     /// Start playing from the current point.
     pub play: bool,
+    /// The Lights panel changed the lights: give them to the player.
+    pub relight: bool,
 }
 
 /// Movement keys held, as −1..1 per axis, and Shift.
@@ -80,8 +85,15 @@ fn shortcuts(ui: &Ui, v: &mut ViewState, has_gold: bool, actions: &mut Actions) 
     });
 }
 
-/// The panels and the frame's own input, for one egui pass over the whole window.
-pub fn draw(ui: &mut Ui, v: &mut ViewState, info: &PanelInfo, dt: f32) -> Actions {
+/// The panels and the frame's own input, for one egui pass over the whole window; the Lights
+/// panel where `lights` is given (a relightable file).
+pub fn draw(
+    ui: &mut Ui,
+    v: &mut ViewState,
+    info: &PanelInfo,
+    lights: Option<&mut LightsPanel>,
+    dt: f32,
+) -> Actions {
     let mut actions = Actions::default();
     // The frame under the panels: drags and the wheel move the free camera.
     let frame = ui.interact(ui.max_rect(), ui.scope_id().with("frame"), egui::Sense::drag());
@@ -116,6 +128,9 @@ pub fn draw(ui: &mut Ui, v: &mut ViewState, info: &PanelInfo, dt: f32) -> Action
         .anchor(egui::Align2::RIGHT_TOP, [-8.0, 8.0])
         .resizable(false)
         .show(&ctx, |ui| stats(ui, info));
+    if let Some(panel) = lights {
+        actions.relight = panel.window(&ctx, &v.space, &v.point);
+    }
     actions
 }
 

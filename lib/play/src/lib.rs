@@ -26,6 +26,7 @@ pub mod mip;
 pub mod multisample;
 pub mod player;
 pub mod probe;
+pub mod relit;
 pub mod shell;
 pub mod textured;
 pub mod window;

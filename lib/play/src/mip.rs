@@ -29,7 +29,7 @@ pub struct MipBuilder {
     pipeline: wgpu::ComputePipeline,
 }
 
-fn storage_name(format: wgpu::TextureFormat) -> &'static str {
+pub(crate) fn storage_name(format: wgpu::TextureFormat) -> &'static str {
     match format {
         wgpu::TextureFormat::Rgba16Float => "rgba16float",
         _ => "rgba32float",
@@ -163,6 +163,14 @@ impl MipBuilder {
             },
             wgpu::Extent3d { width: aw, height: ah, depth_or_array_layers: 1 },
         );
+        self.decimate(gpu, texture, encoder);
+        Ok(bytes.len() as u64)
+    }
+
+    /// Records the decimation of every level of `texture` below the finest into `encoder`.
+    pub fn decimate(&self, gpu: &Gpu, texture: &ObjectTexture, encoder: &mut wgpu::CommandEncoder) {
+        let layout = texture.layout;
+        let (aw, ah) = crate::textured::allocated_size(&layout);
         for m in 1..layout.levels {
             let view = |level: u32| {
                 texture.texture.create_view(&wgpu::TextureViewDescriptor {
@@ -204,7 +212,6 @@ impl MipBuilder {
             pass.set_bind_group(0, &bg, &[]);
             pass.dispatch_workgroups(gw.div_ceil(8), gh.div_ceil(8), 1);
         }
-        Ok(bytes.len() as u64)
     }
 }
 

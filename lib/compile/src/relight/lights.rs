@@ -50,6 +50,24 @@ impl Lights {
     }
 }
 
+/// A relightable layer's texture under weights `weights` (w_c, RGB, as
+/// [`Lights::weights`] gives them): Σ_c w_c · x_c per texel of the RGBA coefficient textures
+/// `textures` (one size), alpha 1, in f32 as the GPU sums it. The player's `relit.wgsl` is
+/// this function written twice.
+pub fn sum_coefficients(textures: &[&[f32]], weights: &[[f32; 3]]) -> Vec<f32> {
+    let n = textures.first().map_or(0, |t| t.len());
+    let mut out = vec![0.0f32; n];
+    for (t, w) in textures.iter().zip(weights) {
+        for (o, x) in out.chunks_exact_mut(4).zip(t.chunks_exact(4)) {
+            for ch in 0..3 {
+                o[ch] += x[ch] * w[ch];
+            }
+        }
+    }
+    out.chunks_exact_mut(4).for_each(|o| o[3] = 1.0);
+    out
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -12,5 +12,5 @@ pub mod sky;
 
 pub use basis::{basis, coefficients, MAX_BAND};
 pub use fit::{Cover, LightFit};
-pub use lights::{DirectionalLight, Lights};
+pub use lights::{sum_coefficients, DirectionalLight, Lights};
 pub use sky::{project_lat_long, rotate_about_pole};

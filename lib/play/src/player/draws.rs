@@ -9,6 +9,7 @@ use pis_format::PisReader;
 
 use super::objects::{content, ObjectGpu};
 use super::plan::{Plan, Wanted};
+use super::relit::{RelitTextures, SurfaceItem};
 use super::resident::{GpuTexture, Textures};
 use crate::error::PlayError;
 use crate::frame::{LayerDraw, ObjectDraw, ReflectionDraw, TermShell};
@@ -62,23 +63,31 @@ pub(super) fn make_samplers(
     }
 }
 
-/// The surface layers of `surfaces` with their textures on the GPU (`textures`) and their
-/// samplers (`samplers`, made by [`make_samplers`]), each filtered with its object's filter
-/// (`filters`). A repeated axis must be a power of two.
+/// The surface layers `items` of `surfaces` with their textures on the GPU (`textures`, or
+/// a relightable layer's sum in `relit`) and their samplers (`samplers`, made by
+/// [`make_samplers`]), each filtered with its object's filter (`filters`). A repeated axis
+/// must be a power of two.
 pub(super) fn layer_draws<'a>(
     reader: &PisReader,
-    textures: &'a Textures,
+    (textures, relit): (&'a Textures, &'a RelitTextures),
     samplers: &'a Samplers,
     filters: &[Filter],
-    surfaces: &[Wanted],
+    (surfaces, items): (&[Wanted], &[SurfaceItem]),
 ) -> Result<Vec<LayerDraw<'a>>, PlayError> {
-    let mut layers = Vec::with_capacity(surfaces.len());
-    for w in surfaces {
-        let GpuTexture::Surface(texture) = textures.get(&w.key) else {
-            return Err(content(
-                reader,
-                format!("{:?}: a shell's texture drawn as a surface layer", w.key),
-            ));
+    let mut layers = Vec::with_capacity(items.len());
+    for item in items {
+        let w = &surfaces[item.surface];
+        let (texture, tint) = match &item.sum {
+            Some(key) => (relit.get(key), [1.0; 3]),
+            None => match textures.get(&w.key) {
+                GpuTexture::Surface(texture) => (texture, w.tint),
+                GpuTexture::Shell(_) => {
+                    return Err(content(
+                        reader,
+                        format!("{:?}: a shell's texture drawn as a surface layer", w.key),
+                    ))
+                }
+            },
         };
         let filter = filter_of(filters, w.key.object);
         let sampler = Sampler { filter, address: address(w.repeat) };
@@ -94,7 +103,7 @@ pub(super) fn layer_draws<'a>(
             transform: w.transform,
             max_level: pis_compile::filter::max_level(&texture.layout, &sampler) as f32,
             weight: w.weight,
-            tint: w.tint,
+            tint,
             anisotropic: matches!(filter, Filter::Anisotropic(_)),
             opacity: reader
                 .container()

@@ -26,6 +26,7 @@ mod options;
 mod plan;
 mod readout;
 mod relight;
+mod relit;
 mod resident;
 
 use std::collections::HashMap;
@@ -43,6 +44,7 @@ pub use self::options::{FrameRequest, FrameStats, PlayerOptions};
 use self::plan::{camera_record, Plan};
 use self::readout::{read_back, wait_for_gpu, Readbacks, Readout, Target};
 pub use self::relight::Relight;
+use self::relit::RelitTextures;
 use self::resident::Textures;
 use crate::blend::nearest_sample;
 use crate::cache::LevelCache;
@@ -80,6 +82,8 @@ pub struct Player {
     samplers: Samplers,
     /// The light directions the file's relightable layers span, and the lights shown.
     relight: Option<Relight>,
+    /// Relightable layers' sums for the frame's lights.
+    relit: RelitTextures,
 }
 
 impl Player {
@@ -121,11 +125,16 @@ impl Player {
         let textures = Textures::new(decoder, cache, MipBuilder::new(&gpu));
         // The reader has checked the settings (rule 9006).
         let c = reader.container();
+        // Relightable where layers of coefficients span the recorded directions.
+        let coefficients = c.objects.iter().flat_map(|o| &o.layers).any(|l| l.basis != 0);
         let relight = pis_format::relight::light_directions(c.provenance.as_ref(), &c.space)
             .ok()
             .flatten()
+            .filter(|_| coefficients)
             .map(|file| Relight { file, lights: None });
+        let relit = RelitTextures::new(&gpu);
         Ok(Player {
+            relit,
             gpu,
             reader,
             options,
@@ -159,7 +168,8 @@ impl Player {
         }
     }
 
-    /// The file's light directions, where it has relightable layers.
+    /// The file's light directions, where it has relightable layers (a file that samples
+    /// its light over directions has none).
     pub fn light_directions(&self) -> Option<&pis_format::relight::LightDirections> {
         self.relight.as_ref().map(|r| &r.file)
     }
@@ -344,7 +354,9 @@ impl Player {
             _ => self.multisample_for(format).samples,
         };
         self.make_targets(size, samples)?;
-        let out = self.draw(&plan, &corner_sets, target, (format, size), &mut stats)?;
+        let out = self.draw(&plan, &corner_sets, target, (format, size), &mut stats);
+        self.relit.end_frame();
+        let out = out?;
         self.textures.end_frame();
         stats.cache_bytes = self.textures.cache.bytes();
         stats.codestreams_read = self.reader.stats().codestreams - reads0;
@@ -439,8 +451,18 @@ impl Player {
         let gpu = self.gpu.clone();
         let objects = object_draws(&self.objects, &plan.clips);
         make_samplers(&gpu, &mut self.samplers, &self.filters, &plan.surfaces);
+        let mut encoder = gpu
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("frame") });
+        let items = self.relit.items(&gpu, &self.textures, &plan.surfaces, &mut encoder);
         let (reader, textures) = (&self.reader, &self.textures);
-        let layers = layer_draws(reader, textures, &self.samplers, &self.filters, &plan.surfaces)?;
+        let layers = layer_draws(
+            reader,
+            (textures, &self.relit),
+            &self.samplers,
+            &self.filters,
+            (&plan.surfaces, &items),
+        )?;
         let reflections = reflection_draws(reader, (textures, &self.objects), plan)?;
         let lenses = lens_draws(reader, textures, plan, corner_sets)?;
         stats.lens_draws = lenses.len() as u64;
@@ -448,9 +470,6 @@ impl Player {
         stats.shell_draws = reflections.len() as u64;
         let targets = self.targets.as_mut().expect("targets made before the draws");
         let t_draw = Instant::now();
-        let mut encoder = gpu
-            .device
-            .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("frame") });
         let offscreen_view;
         let (view, want_ids) = match target {
             Target::View(v, _) => (v, false),

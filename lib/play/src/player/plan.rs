@@ -33,6 +33,10 @@ pub(super) struct Wanted {
     pub(super) tint: [f32; 3],
     pub(super) transform: TextureTransform,
     pub(super) repeat: [bool; 2],
+    /// A relightable layer's coefficient: the layer it sums into with the other
+    /// coefficients of its term, order, block and parameter sample (object, term, order,
+    /// block, then the sample), drawn as their sum (`relit.rs`).
+    pub(super) relit: Option<Vec<u32>>,
 }
 
 /// One reflection term a frame draws: an object's shells at one parameter sample.
@@ -124,6 +128,11 @@ impl Plan {
                         }
                         _ => [1.0; 3],
                     };
+                    let layer = &o.layers[li];
+                    let relit = (basis > 0).then(|| {
+                        let head = [oi as u32, layer.term.code() as u32, layer.order as u32];
+                        head.into_iter().chain([key.block]).chain(s.iter().copied()).collect()
+                    });
                     plan.surfaces.push(Wanted {
                         draw: oi,
                         key,
@@ -131,6 +140,7 @@ impl Plan {
                         tint,
                         transform: TextureTransform { values: affine, cut },
                         repeat,
+                        relit,
                     });
                 }
             }

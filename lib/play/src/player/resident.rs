@@ -53,6 +53,11 @@ impl Textures {
         Textures { decoder, cache, mips, resident: HashMap::new(), frame: 0 }
     }
 
+    /// The MIP chain builder of the frame's textures.
+    pub(super) fn mips(&self) -> &MipBuilder {
+        &self.mips
+    }
+
     /// The texture of `key` on the GPU (made resident this frame).
     pub(super) fn get(&self, key: &TextureKey) -> &GpuTexture {
         &self.resident[key].texture

@@ -8,3 +8,4 @@ pub mod relight;
 pub mod teapot_glossy;
 pub mod teapot_pem;
 pub mod wild;
+pub mod wild_toml;

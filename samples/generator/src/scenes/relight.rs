@@ -10,7 +10,7 @@ use std::path::Path;
 
 use glam::Vec3;
 
-use super::wild::{header, orbit};
+use super::wild_toml::{header, orbit};
 
 /// Writes relight.toml, relight-two.toml, relight-sky.toml, relight-sky.exr and
 /// relight-arc.toml into `dir`.

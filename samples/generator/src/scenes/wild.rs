@@ -9,7 +9,8 @@ use std::path::Path;
 
 use glam::{Quat, Vec2, Vec3};
 
-use super::common::{cup, sphere, toml_header, torus, vase};
+use super::common::{cup, sphere, torus, vase};
+use super::wild_toml::{header, orbit};
 use crate::gltf_writer::{GltfWriter, MaterialDesc, NodeDesc};
 use crate::mesh::{cuboid, quad, Mesh};
 use crate::textures::from_fn;
@@ -24,9 +25,6 @@ pub fn write_all(root: &Path) -> io::Result<()> {
     glass_shelf(&root.join("glass-shelf"))?;
     still_life(&root.join("still-life"))
 }
-
-const LICENCE: &str =
-    "# Licence: the project's own scene (generated here, no outside assets), under the project's licence.\n";
 
 /// A node with an optional mesh and its transform (translation, rotation, scale); a scene
 /// root when `root`.
@@ -80,34 +78,6 @@ fn normal_map(
         let e = (n * 0.5 + Vec3::splat(0.5)) * 255.0;
         [e.x.round() as u8, e.y.round() as u8, e.z.round() as u8]
     })
-}
-
-pub(super) fn header(title: &str, what: &str) -> String {
-    let mut s = toml_header(title).replace(
-        "`cargo run -p pis-samples --release -- samples/`",
-        "`cargo run -p pis-samples --release -- samples/` (into samples/wild/)",
-    );
-    s.push_str(LICENCE);
-    for line in what.lines() {
-        s.push_str("# ");
-        s.push_str(line.trim());
-        s.push('\n');
-    }
-    s
-}
-
-pub(super) fn orbit(
-    name: &str,
-    samples: u32,
-    target: Vec3,
-    radius: f32,
-    elevation: f32,
-    az: [f32; 2],
-) -> String {
-    format!(
-        "[[dimension]]\nname = \"{name}\"\ndriver = \"orbit\"\nsamples = {samples}\ntarget = [{}, {}, {}]\nradius = {radius}\nelevation_deg = {elevation}\nazimuth_deg = [{}, {}]\n",
-        target.x, target.y, target.z, az[0], az[1]
-    )
 }
 
 /// An L-shaped bookend in centimetres: a base plate and an upright at its -X end, a brace
