@@ -21,7 +21,7 @@ struct SumUniform {
     count: u32,
     _pad: u32,
     used: [u32; 2],
-    written: [u32; 2],
+    alloc: [u32; 2],
     _pad2: [u32; 2],
     weights: [[f32; 4]; MAX_COEFFICIENTS],
 }
@@ -139,12 +139,11 @@ impl RelitSum {
         let out = mips.texture(gpu, array.layout);
         let (w, h) = allocated_size(&array.layout);
         let used = [array.layout.width, array.layout.height];
-        let written = [(used[0] + 1).min(w), (used[1] + 1).min(h)];
         let mut u = SumUniform {
             count: array.count.min(weights.len() as u32),
             _pad: 0,
             used,
-            written,
+            alloc: [w, h],
             _pad2: [0; 2],
             weights: [[0.0; 4]; MAX_COEFFICIENTS],
         };
@@ -183,7 +182,7 @@ impl RelitSum {
             });
             pass.set_pipeline(&self.pipeline);
             pass.set_bind_group(0, &bg, &[]);
-            pass.dispatch_workgroups(written[0].div_ceil(8), written[1].div_ceil(8), 1);
+            pass.dispatch_workgroups(w.div_ceil(8), h.div_ceil(8), 1);
         }
         mips.decimate(gpu, &out, encoder);
         out

@@ -11,9 +11,9 @@ struct Sum {
     _pad: u32,
     // Used size of the finest level.
     used: vec2<u32>,
-    // Texels written per axis: the used size and the padding texel beyond it that filtering
-    // at the used region's edge reads (the decimation reads the used region only).
-    written: vec2<u32>,
+    // Its allocated size: the padding is written too, since a clamped lookup past the used
+    // region reads it.
+    alloc: vec2<u32>,
     _pad2: vec2<u32>,
     // Per slice c, w_c in rgb.
     weights: array<vec4<f32>, 81>,
@@ -25,7 +25,7 @@ struct Sum {
 
 @compute @workgroup_size(8, 8)
 fn sum(@builtin(global_invocation_id) id: vec3<u32>) {
-    if (id.x >= s.written.x || id.y >= s.written.y) {
+    if (id.x >= s.alloc.x || id.y >= s.alloc.y) {
         return;
     }
     // The padding repeats the last used column and row, as a decoded texture's does.
