@@ -139,7 +139,7 @@ fn headless(args: &PlayArgs) -> Result<Exit, Failure> {
     };
     let req = args.headless();
     let (gpu, mut player) = open(&req)?;
-    let relightable = lights::relightable(&player).is_some();
+    let relightable = player.light_directions().is_some();
     if let Some(lights) = args.lights.relight(&args.file, relightable)? {
         player.set_lights(Some(lights)).map_err(pis_eval::headless::play_failure)?;
     }

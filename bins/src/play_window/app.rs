@@ -22,7 +22,7 @@ use super::screenshot::{write_png_rgba8, Capture};
 use super::surface::WindowSurface;
 use super::ui::{self, PanelInfo};
 use crate::cli::{Exit, Failure};
-use crate::play::lights::{relightable, LightArgs};
+use crate::play::lights::LightArgs;
 use pis_eval::headless::play_failure;
 use pis_play::window::camera::sight_convergence;
 use pis_play::window::path::{PathKind, Playback};
@@ -254,8 +254,8 @@ impl App {
             Some(dir) => Some(GoldSet::open(dir, player.dimensions())?),
             None => None,
         };
-        o.lights.check(&o.file, relightable(&player).is_some())?;
-        let lights = match relightable(&player) {
+        o.lights.check(&o.file, player.light_directions().is_some())?;
+        let lights = match player.light_directions() {
             Some(file) => Some(LightsPanel::new(file, &view.space, &view.point, &o.lights)?),
             None => None,
         };

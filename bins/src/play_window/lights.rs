@@ -11,7 +11,9 @@ use pis_play::window::space::Space;
 use pis_play::Lights;
 
 use crate::cli::Failure;
-use crate::play::lights::{azimuth_elevation, load_sky, sky_coefficients, LightArgs, LightSpec};
+use pis_compile::relight::{azimuth_elevation, load_sky, sky_coefficients};
+
+use crate::play::lights::{LightArgs, LightSpec};
 
 /// One directional light of the panel: a colour (linear RGB, 0 to 1) times an intensity,
 /// from an azimuth (degrees from +X towards +Z) and elevation (degrees above the horizon).
@@ -363,7 +365,8 @@ fn hemisphere(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::play::lights::{direction, parse_light};
+    use crate::play::lights::parse_light;
+    use pis_compile::relight::direction_at;
     use pis_format::{Dimension, DimensionKind};
 
     fn file() -> LightDirections {
@@ -444,7 +447,7 @@ mod tests {
         let panel = LightsPanel::new(&file(), &space, &[1.2], &LightArgs::default()).unwrap();
         assert!(panel.own && panel.lights.len() == 1 && panel.sky.loaded.is_none());
         let l = panel.lights[0];
-        assert!(close(direction(l.azimuth_deg, l.elevation_deg), Vec3::X));
+        assert!(close(direction_at(l.azimuth_deg, l.elevation_deg), Vec3::X));
         assert_eq!(l.spec().radiance, [3.0, 2.0, 1.0]);
         assert_eq!(traced_direction(&file(), &space, &[1.7]), Some([0.0, 0.0, 1.0]));
         let args = LightArgs {

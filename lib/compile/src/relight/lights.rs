@@ -17,6 +17,23 @@ pub struct DirectionalLight {
     pub radiance: [f32; 3],
 }
 
+/// The unit direction towards a light at `azimuth_deg` (from +X towards +Z) and
+/// `elevation_deg` (above the horizon).
+pub fn direction_at(azimuth_deg: f32, elevation_deg: f32) -> Vec3 {
+    let (sin_az, cos_az) = azimuth_deg.to_radians().sin_cos();
+    let (sin_el, cos_el) = elevation_deg.to_radians().sin_cos();
+    Vec3::new(cos_el * cos_az, sin_el, cos_el * sin_az)
+}
+
+/// A direction's azimuth (degrees from +X towards +Z, −180 to 180) and elevation (degrees
+/// above the horizon); a direction straight up or down has azimuth 0.
+pub fn azimuth_elevation(d: Vec3) -> (f32, f32) {
+    let d = d.normalize_or(Vec3::Y);
+    let elevation = d.y.clamp(-1.0, 1.0).asin().to_degrees();
+    let azimuth = if d.x.hypot(d.z) < 1e-6 { 0.0 } else { d.z.atan2(d.x).to_degrees() };
+    (azimuth, elevation)
+}
+
 /// Lights a relightable file is drawn under: any number of directional lights and a sky.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Lights {
@@ -107,5 +124,25 @@ mod tests {
         let w = Lights { directional: Vec::new(), sky: Some(sky) }.weights(e0, 3);
         assert!((w[0][1] - std::f64::consts::PI.sqrt()).abs() < 1e-9);
         assert!(w[1..].iter().all(|c| c.iter().all(|x| x.abs() < 1e-6)));
+    }
+
+    fn close(a: Vec3, b: Vec3) -> bool {
+        (a - b).length() < 1e-6
+    }
+
+    #[test]
+    fn azimuth_runs_from_x_towards_z_and_elevation_from_the_horizon() {
+        assert!(close(direction_at(0.0, 0.0), Vec3::X));
+        assert!(close(direction_at(90.0, 0.0), Vec3::Z));
+        assert!(close(direction_at(180.0, 0.0), Vec3::NEG_X));
+        assert!(close(direction_at(-90.0, 0.0), Vec3::NEG_Z));
+        assert!(close(direction_at(123.0, 90.0), Vec3::Y));
+        let d = direction_at(40.0, 50.0);
+        assert!((d.length() - 1.0).abs() < 1e-6 && (d.y - 50f32.to_radians().sin()).abs() < 1e-6);
+        let (az, el) = azimuth_elevation(d);
+        assert!((az - 40.0).abs() < 1e-4 && (el - 50.0).abs() < 1e-4, "{az} {el}");
+        let (az, el) = azimuth_elevation(direction_at(-120.0, -30.0));
+        assert!((az + 120.0).abs() < 1e-4 && (el + 30.0).abs() < 1e-4, "{az} {el}");
+        assert_eq!(azimuth_elevation(Vec3::Y), (0.0, 90.0));
     }
 }

@@ -12,5 +12,8 @@ pub mod sky;
 
 pub use basis::{basis, coefficients, MAX_BAND};
 pub use fit::{Cover, LightFit};
-pub use lights::{sum_coefficients, DirectionalLight, Lights};
-pub use sky::{project_lat_long, rotate_about_pole};
+pub use lights::{azimuth_elevation, direction_at, sum_coefficients, DirectionalLight, Lights};
+pub use sky::{
+    load_sky, project_lat_long, reduce_lat_long, rotate_about_pole, sky_coefficients,
+    SKY_PROJECTED_SIZE,
+};

@@ -5,7 +5,9 @@
 
 use anyhow::{anyhow, bail, Context, Result};
 use glam::Vec3;
-use pis_compile::relight::{project_lat_long, DirectionalLight, Lights, MAX_BAND};
+use pis_compile::relight::{
+    project_lat_long, reduce_lat_long, DirectionalLight, Lights, MAX_BAND, SKY_PROJECTED_SIZE,
+};
 use pis_scene::EnvironmentRadiance;
 use pis_trace::set::RaySet;
 
@@ -93,14 +95,13 @@ fn scene_sky(held: &RaySet) -> Result<Option<Vec<[f64; 3]>>> {
     let s = match &env.radiance {
         EnvironmentRadiance::Uniform(c) => {
             // ∫ Y_0 dω = 2√π; every other coefficient integrates to zero.
-            let mut s = vec![[0.0f64; 3]; 1];
             let k = 2.0 * std::f64::consts::PI.sqrt();
-            s[0] = c.map(|v| v as f64 * k);
-            s
+            vec![c.map(|v| v as f64 * k)]
         }
         EnvironmentRadiance::Image(image) => {
             let rgb: Vec<f32> = image.texels.iter().flatten().copied().collect();
             let (w, h) = (image.width as usize, image.height as usize);
+            let (w, h, rgb) = reduce_lat_long(w, h, &rgb, SKY_PROJECTED_SIZE);
             project_lat_long(w, h, &rgb, env.rotation, MAX_BAND)
         }
     };

@@ -84,6 +84,9 @@ impl RelitTextures {
         members: &[usize],
         encoder: &mut wgpu::CommandEncoder,
     ) -> Option<SumKey> {
+        if members.len() < 2 || members.len() > MAX_COEFFICIENTS {
+            return None;
+        }
         let first = &surfaces[members[0]];
         let mut maps = Vec::with_capacity(members.len());
         for &i in members {
@@ -97,9 +100,6 @@ impl RelitTextures {
             if !same {
                 return None;
             }
-        }
-        if members.len() < 2 || members.len() > MAX_COEFFICIENTS {
-            return None;
         }
         let keys: Vec<TextureKey> = members.iter().map(|&i| surfaces[i].key.clone()).collect();
         let weights: Vec<[f32; 3]> = members.iter().map(|&i| surfaces[i].tint).collect();
