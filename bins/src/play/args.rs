@@ -107,7 +107,14 @@ pub struct PlayArgs {
     /// their tessellation is refined where the vertex rays' paths differ (thesis 6.4.1's τ).
     #[arg(long, default_value_t = 1.0, value_name = "PIXELS", value_parser = parse_tau)]
     pub tau: f32,
-    /// Memory for decoded level images, MiB.
+    /// Where surface textures are rebuilt from their decoded level images: `gpu` (a compute
+    /// pass; the decoding threads only decode, and each level image goes up once and stays
+    /// on the GPU while the cache keeps it) or `workers` (summed on the decoding threads and
+    /// uploaded as RGBA). Shells' cube maps and a --reduction are rebuilt on the workers.
+    #[arg(long, default_value = "gpu", value_parser = crate::cli::one_of(&pis_play::Rebuild::ALL, pis_play::Rebuild::name))]
+    pub rebuild: pis_play::Rebuild,
+    /// Memory for decoded level images, MiB (on the GPU, as much again for the level images
+    /// its rebuild reads).
     #[arg(long, default_value_t = 512)]
     pub cache_mb: u64,
     /// Decoding threads (default: one per core; the frame waits for its textures).
@@ -175,6 +182,7 @@ impl PlayArgs {
             blend: self.blend,
             msaa: self.msaa,
             tau_px: self.tau,
+            rebuild: self.rebuild,
             display_filter: self
                 .compare
                 .as_deref()

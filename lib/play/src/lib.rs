@@ -26,6 +26,7 @@ pub mod mip;
 pub mod multisample;
 pub mod player;
 pub mod probe;
+pub mod rebuild;
 pub mod relit;
 pub mod shell;
 pub mod textured;
@@ -39,7 +40,7 @@ pub use hybrid::{render_hybrid, HybridPipeline};
 pub use image::FloatImage;
 pub use multisample::Multisample;
 pub use player::{
-    DirectionalLight, FrameRequest, FrameStats, Lights, Player, PlayerOptions, Relight,
+    DirectionalLight, FrameRequest, FrameStats, Lights, Player, PlayerOptions, Rebuild, Relight,
 };
 pub use probe::{probe, probe_render_matrix, Probe};
 pub use shell::{render_shell, ShellPipeline, ShellTexture};

@@ -40,7 +40,7 @@ use pis_format::PisReader;
 use self::draws::{layer_draws, make_samplers, object_draws, reflection_draws, Samplers};
 use self::lens::{lens_corners, lens_draws, LensSet};
 use self::objects::{check_texture_sizes, object_filters, prepare_objects, LensState, ObjectGpu};
-pub use self::options::{FrameRequest, FrameStats, PlayerOptions};
+pub use self::options::{FrameRequest, FrameStats, PlayerOptions, Rebuild};
 use self::plan::{camera_record, Plan};
 use self::readout::{read_back, wait_for_gpu, Readbacks, Readout, Target};
 pub use self::relight::Relight;
@@ -122,7 +122,8 @@ impl Player {
         if objects.iter().any(|o| o.lens.is_some()) {
             pipes.hybrid_pipeline(&gpu, offscreen, ms.samples);
         }
-        let textures = Textures::new(decoder, cache, MipBuilder::new(&gpu));
+        let textures =
+            Textures::new(&gpu, (decoder, cache), MipBuilder::new(&gpu), options.rebuild);
         // The reader has checked the settings (rule 9006).
         let c = reader.container();
         // Relightable where layers of coefficients span the recorded directions.

@@ -32,6 +32,36 @@ pub struct PlayerOptions {
     /// Lens objects: the screen edge length in pixels down to which the tessellation is
     /// refined where vertex rays diverge (thesis 6.4.1's τ; default 1).
     pub tau_px: f32,
+    /// Where surface textures are rebuilt from their decoded level images (default: the
+    /// GPU).
+    pub rebuild: Rebuild,
+}
+
+/// Where surface textures are rebuilt from their decoded level images (SPEC.md 8.4: the
+/// level images summed, inverse gamma, the MIP chain).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Rebuild {
+    /// A compute pass on the GPU (rebuild.wgsl): the workers only decode, each decoded level
+    /// image goes up once, compact, and stays on the GPU while the level-image cache keeps
+    /// it.
+    #[default]
+    Gpu,
+    /// On the workers, the texture uploaded as RGBA (the reference the GPU rebuild is held
+    /// to). A resolution reduction, and shells' cube maps, are always rebuilt there.
+    Workers,
+}
+
+impl Rebuild {
+    /// The name `--rebuild` takes.
+    pub fn name(self) -> &'static str {
+        match self {
+            Rebuild::Gpu => "gpu",
+            Rebuild::Workers => "workers",
+        }
+    }
+
+    /// Every choice, in the order the tools list them.
+    pub const ALL: [Rebuild; 2] = [Rebuild::Gpu, Rebuild::Workers];
 }
 
 impl Default for PlayerOptions {
@@ -47,6 +77,7 @@ impl Default for PlayerOptions {
             msaa: DEFAULT_SAMPLES,
             display_filter: None,
             tau_px: TessellationSettings::default().tau_px,
+            rebuild: Rebuild::Gpu,
         }
     }
 }
@@ -72,7 +103,8 @@ pub struct FrameStats {
     pub readback_ms: f64,
     /// Waiting for the workers: level images decoded and textures rebuilt.
     pub decode_ms: f64,
-    /// Texture uploads and GPU MIP chains.
+    /// Texture uploads (RGBA textures rebuilt on the workers, level images for the GPU
+    /// rebuild), the GPU rebuilds and MIP chains: recorded, submitted and waited for.
     pub upload_ms: f64,
     pub upload_bytes: u64,
     /// Level-image cache lookups of this frame.

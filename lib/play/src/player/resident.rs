@@ -1,8 +1,9 @@
 //! The frame's textures on the GPU and the decoding behind them (thesis 4.7): the level
 //! images a missing texture sums, taken from the level-image cache or decoded on the
-//! workers; the textures rebuilt from them on the workers (surface textures' finest levels,
-//! shells' cube maps); their uploads and GPU MIP chains; and the textures a frame did not
-//! draw released when it ends.
+//! workers; surface textures rebuilt from them on the GPU (the level images uploaded once
+//! each, kept while the cache keeps them) or on the workers, and shells' cube maps on the
+//! workers; their uploads and GPU MIP chains; and the textures a frame did not draw
+//! released when it ends.
 
 use std::collections::HashMap;
 use std::sync::Arc;
@@ -13,13 +14,14 @@ use pis_format::texture::LevelLayout;
 use pis_format::{Mapping, PisReader};
 
 use super::objects::content;
-use super::options::FrameStats;
+use super::options::{FrameStats, Rebuild};
 use super::plan::TextureKey;
 use crate::cache::{LevelCache, LevelKey};
 use crate::decode::{AssembleJob, CubeImage, Decoder, LevelJob, TextureImage};
 use crate::error::PlayError;
 use crate::gpu::Gpu;
 use crate::mip::MipBuilder;
+use crate::rebuild::{fits, level_buffer, LevelRebuild, LevelStack};
 use crate::shell::ShellTexture;
 use crate::textured::ObjectTexture;
 
@@ -40,6 +42,11 @@ pub(super) struct Textures {
     decoder: Decoder,
     pub(super) cache: LevelCache,
     mips: MipBuilder,
+    rebuild: LevelRebuild,
+    rebuild_on: Rebuild,
+    /// Decoded level images on the GPU for its rebuild of surface textures, each kept while
+    /// the level-image cache keeps it (the thesis's lifetime rule for both copies).
+    gpu_levels: HashMap<LevelKey, wgpu::Buffer>,
     resident: HashMap<TextureKey, Resident>,
     /// The frame being drawn.
     frame: u64,
@@ -49,8 +56,22 @@ pub(super) struct Textures {
 type Levels = HashMap<LevelKey, Arc<Vec<f32>>>;
 
 impl Textures {
-    pub(super) fn new(decoder: Decoder, cache: LevelCache, mips: MipBuilder) -> Textures {
-        Textures { decoder, cache, mips, resident: HashMap::new(), frame: 0 }
+    pub(super) fn new(
+        gpu: &Gpu,
+        (decoder, cache): (Decoder, LevelCache),
+        mips: MipBuilder,
+        rebuild_on: Rebuild,
+    ) -> Textures {
+        Textures {
+            decoder,
+            cache,
+            mips,
+            rebuild: LevelRebuild::new(gpu),
+            rebuild_on,
+            gpu_levels: HashMap::new(),
+            resident: HashMap::new(),
+            frame: 0,
+        }
     }
 
     /// The MIP chain builder of the frame's textures.
@@ -96,6 +117,15 @@ impl Textures {
         let (shells, surfaces): (Vec<&TextureKey>, Vec<&TextureKey>) =
             missing.iter().partition(|k| is_shell(k));
         let drop_levels = reduction.trailing_zeros();
+        let on_gpu = |k: &&TextureKey| {
+            let layer = &c.objects[k.object as usize].layers[k.layer as usize];
+            let l = LevelLayout::of(layer, &layer.blocks[k.block as usize]);
+            self.rebuild_on == Rebuild::Gpu
+                && drop_levels == 0
+                && fits(gpu, (l.width, l.height, l.channels), k.images.len())
+        };
+        let (rebuilt, surfaces): (Vec<&TextureKey>, Vec<&TextureKey>) =
+            surfaces.into_iter().partition(on_gpu);
         let job = |k: &&TextureKey| assemble_job(reader, &have, k, drop_levels);
         let images = self.decoder.assemble(&surfaces.iter().map(job).collect::<Vec<_>>());
         let cubes = self.decoder.assemble_cubes(&shells.iter().map(job).collect::<Vec<_>>());
@@ -103,7 +133,7 @@ impl Textures {
         let hits1 = self.cache.counters();
         stats.cache_hits += hits1.hits - hits0.hits;
         stats.cache_misses += hits1.misses - hits0.misses;
-        self.upload(gpu, reader, (&surfaces, &images), (&shells, &cubes), stats)
+        self.upload(gpu, reader, (&surfaces, &images), (&shells, &cubes), (&rebuilt, &have), stats)
     }
 
     /// The level images of the `missing` textures: cached, or decoded on the workers (each
@@ -165,14 +195,17 @@ impl Textures {
         }
     }
 
-    /// Uploads the rebuilt textures: surface textures with their GPU MIP chains, cube maps
-    /// with their stored levels; waits for the GPU and keeps them as drawn this frame.
+    /// Uploads the textures rebuilt on the workers (surface textures with their GPU MIP
+    /// chains, cube maps with their stored levels) and records the GPU's rebuilds of the
+    /// `rebuilt` surface textures from their level images (in `have`); waits for the GPU
+    /// and keeps them as drawn this frame.
     fn upload(
         &mut self,
         gpu: &Gpu,
         reader: &PisReader,
         (surfaces, images): (&[&TextureKey], &[TextureImage]),
         (shells, cubes): (&[&TextureKey], &[CubeImage]),
+        (rebuilt, have): (&[&TextureKey], &Levels),
         stats: &mut FrameStats,
     ) -> Result<(), PlayError> {
         let c = reader.container();
@@ -181,7 +214,14 @@ impl Textures {
         let mut encoder = gpu
             .device
             .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("uploads") });
-        let mut made = Vec::with_capacity(surfaces.len() + shells.len());
+        let mut made = Vec::with_capacity(surfaces.len() + shells.len() + rebuilt.len());
+        for k in rebuilt {
+            let texture = self.rebuild_on_gpu(gpu, reader, k, have, &mut encoder, stats);
+            made.push((
+                (*k).clone(),
+                Resident { texture: GpuTexture::Surface(texture), last_frame: frame },
+            ));
+        }
         for (k, img) in surfaces.iter().zip(images) {
             let texture = self.mips.texture(gpu, TextureLayout::full(img.width, img.height));
             stats.upload_bytes += self.mips.upload(gpu, &texture, img, &mut encoder)?;
@@ -208,12 +248,43 @@ impl Textures {
         Ok(())
     }
 
-    /// Ends the frame: level-image lifetimes and budget, and GPU textures the frame did not
-    /// draw released.
+    /// Records the GPU's rebuild of surface texture `k` from its level images, uploading
+    /// those not yet on the GPU (from `have`).
+    fn rebuild_on_gpu(
+        &mut self,
+        gpu: &Gpu,
+        reader: &PisReader,
+        k: &TextureKey,
+        have: &Levels,
+        encoder: &mut wgpu::CommandEncoder,
+        stats: &mut FrameStats,
+    ) -> ObjectTexture {
+        let layer = &reader.container().objects[k.object as usize].layers[k.layer as usize];
+        let l = LevelLayout::of(layer, &layer.blocks[k.block as usize]);
+        let keys: Vec<LevelKey> =
+            k.images.iter().enumerate().map(|(lv, &img)| level_key(k, lv, img)).collect();
+        for key in &keys {
+            if !self.gpu_levels.contains_key(key) {
+                let values = &have[key];
+                stats.upload_bytes += (values.len() * 4) as u64;
+                self.gpu_levels.insert(*key, level_buffer(gpu, values));
+            }
+        }
+        let levels: Vec<&wgpu::Buffer> = keys.iter().map(|key| &self.gpu_levels[key]).collect();
+        let stack = LevelStack { levels: &levels, channels: l.channels, gamma: layer.gamma };
+        let texture = self.mips.texture(gpu, TextureLayout::full(l.width, l.height));
+        self.rebuild.record(gpu, (&texture, &stack), &self.mips, encoder);
+        texture
+    }
+
+    /// Ends the frame: level-image lifetimes and budget (the GPU's copies going with the
+    /// cache's), and GPU textures the frame did not draw released.
     pub(super) fn end_frame(&mut self) {
         let frame = self.frame;
         self.resident.retain(|_, r| r.last_frame == frame);
         self.cache.end_frame();
+        let cache = &self.cache;
+        self.gpu_levels.retain(|k, _| cache.contains(k));
         self.frame += 1;
     }
 }
