@@ -158,6 +158,7 @@ fn exercise(file: &Path, original: &Path, scratch: &Path, gpu: &Arc<Gpu>) {
             out: None,
             size: None,
             quiet: true,
+            prefetch: 1,
             options,
         };
         let _ = run_frames(&req, gpu, &mut player);

@@ -107,12 +107,18 @@ pub struct PlayArgs {
     /// their tessellation is refined where the vertex rays' paths differ (thesis 6.4.1's τ).
     #[arg(long, default_value_t = 1.0, value_name = "PIXELS", value_parser = parse_tau)]
     pub tau: f32,
-    /// Where surface textures are rebuilt from their decoded level images: `gpu` (a compute
-    /// pass; the decoding threads only decode, and each level image goes up once and stays
-    /// on the GPU while the cache keeps it) or `workers` (summed on the decoding threads and
-    /// uploaded as RGBA). Shells' cube maps and a --reduction are rebuilt on the workers.
-    #[arg(long, default_value = "gpu", value_parser = crate::cli::one_of(&pis_play::Rebuild::ALL, pis_play::Rebuild::name))]
+    /// Where textures are rebuilt from their decoded level images: `gpu` (compute passes;
+    /// the decoding threads only decode, and each level image goes up once and stays on the
+    /// GPU while the cache keeps it), `workers` (summed on the decoding threads and uploaded
+    /// as RGBA), or `auto`: `gpu` on a GPU, `workers` on a CPU rasterizer such as lavapipe.
+    /// A --reduction is rebuilt on the workers.
+    #[arg(long, default_value = "auto", value_parser = crate::cli::one_of(&pis_play::Rebuild::ALL, pis_play::Rebuild::name))]
     pub rebuild: pis_play::Rebuild,
+    /// Along a path: decode the textures of this many next frames on the decoding threads
+    /// while a frame draws, so that they need not wait (0: decode each frame's textures when
+    /// it asks for them).
+    #[arg(long, default_value_t = 1, value_name = "FRAMES")]
+    pub prefetch: usize,
     /// Memory for decoded level images, MiB (on the GPU, as much again for the level images
     /// its rebuild reads).
     #[arg(long, default_value_t = 512)]
@@ -168,6 +174,7 @@ impl PlayArgs {
             out: self.out.clone(),
             size: self.size,
             quiet: self.json,
+            prefetch: self.prefetch,
             options: self.player_options(),
         }
     }

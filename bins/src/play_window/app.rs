@@ -401,6 +401,8 @@ impl Running {
             let p = self.view.point.clone();
             self.view.point = self.view.playback.advance(&self.view.space, &p, dt);
         }
+        // The next samples along the path decode while this frame draws.
+        self.player.prefetch(&self.view.ahead(2));
         self.load_gold();
 
         let size = self.surface.size();

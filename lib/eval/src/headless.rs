@@ -52,6 +52,9 @@ pub struct HeadlessRequest {
     pub size: Option<(u32, u32)>,
     /// No progress lines on stderr.
     pub quiet: bool,
+    /// Along a path: how many of the next frames' points the player is told of, to decode
+    /// their textures ahead while a frame draws (0: none).
+    pub prefetch: usize,
     /// The player's settings.
     pub options: pis_play::PlayerOptions,
 }
@@ -102,7 +105,18 @@ pub struct PathReport {
     /// How multisampled frames are resolved.
     pub resolve: Resolve,
     pub workers: usize,
+    /// Where textures were rebuilt from their level images: `gpu` or `workers`.
+    pub rebuild: &'static str,
+    /// Frames ahead whose textures were decoded while a frame drew (`--prefetch`).
+    pub prefetch: usize,
     pub frames: usize,
+    /// Frames that waited on decoding: a level image decoded when the frame asked for it,
+    /// or still being decoded ahead.
+    pub frames_waited: usize,
+    /// Level images found decoded ahead, and dropped from decoding ahead because the
+    /// prediction changed before they started.
+    pub prefetched: u64,
+    pub prefetch_dropped: u64,
     pub frame_ms_mean: f64,
     pub frame_ms_worst: f64,
     pub fps_mean: f64,
@@ -423,6 +437,7 @@ pub fn run_frames(
     let mut rows = Vec::with_capacity(reqs.len());
     let mut all = Vec::with_capacity(reqs.len());
     for (k, req) in reqs.iter().enumerate() {
+        player.prefetch(&reqs[k + 1..(k + 1 + args.prefetch).min(reqs.len())]);
         // Frames that are not written are not read back: their time is the frame's cost
         // where it is shown.
         let stats = match out {
@@ -466,7 +481,12 @@ pub fn run_frames(
         msaa_requested: player.multisample().requested,
         resolve: Resolve::of(player),
         workers: o.workers,
+        rebuild: player.rebuild().name(),
+        prefetch: args.prefetch,
         frames: all.len(),
+        frames_waited: all.iter().filter(|s| s.decode_waits > 0).count(),
+        prefetched: all.iter().map(|s| s.prefetched).sum(),
+        prefetch_dropped: player.prefetch_dropped(),
         frame_ms_mean: fm,
         frame_ms_worst: fw,
         fps_mean: 1e3 / fm.max(1e-9),
@@ -496,7 +516,7 @@ pub fn run_frames(
 pub fn print_path_report(r: &PathReport, w: &mut impl std::io::Write) -> std::io::Result<()> {
     writeln!(
         w,
-        "pis-play {} ({}x{}, blend {}, reduction {}, {}{}, {} decoding threads)",
+        "pis-play {} ({}x{}, blend {}, reduction {}, {}{}, {} decoding threads, textures rebuilt on the {})",
         r.file,
         r.size[0],
         r.size[1],
@@ -504,7 +524,8 @@ pub fn print_path_report(r: &PathReport, w: &mut impl std::io::Write) -> std::io
         r.reduction,
         msaa_label(r.msaa_samples, r.msaa_requested),
         r.resolve.label(),
-        r.workers
+        r.workers,
+        if r.rebuild == "gpu" { "GPU" } else { "workers" }
     )?;
     writeln!(w, "  adapter: {}", r.adapter)?;
     writeln!(w, "  frames: {}", r.frames)?;
@@ -541,6 +562,11 @@ pub fn print_path_report(r: &PathReport, w: &mut impl std::io::Write) -> std::io
         r.cache_misses,
         r.cache_bytes_max as f64 / (1 << 20) as f64,
         r.codestreams_read
+    )?;
+    writeln!(
+        w,
+        "  frames that waited on decoding: {} of {}; decoding {} frames ahead: {} level images found decoded, {} dropped",
+        r.frames_waited, r.frames, r.prefetch, r.prefetched, r.prefetch_dropped
     )
 }
 

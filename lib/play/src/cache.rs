@@ -138,6 +138,11 @@ impl LevelCache {
         self.frame += 1;
     }
 
+    /// The memory budget in bytes.
+    pub fn budget(&self) -> u64 {
+        self.budget
+    }
+
     pub fn bytes(&self) -> u64 {
         self.bytes
     }

@@ -236,6 +236,11 @@ impl Decoder {
         Ok(Decoder { pool })
     }
 
+    /// Queues `work` on the workers; the caller does not wait.
+    pub fn spawn(&self, work: impl FnOnce() + Send + 'static) {
+        self.pool.spawn(work);
+    }
+
     /// Decodes `jobs` on the workers; the caller waits.
     pub fn decode_levels(
         &self,

@@ -61,7 +61,11 @@ impl ShellTexture {
             sample_count: 1,
             dimension: wgpu::TextureDimension::D2,
             format: CUBE_FORMAT,
-            usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+            // Storage and copies: the GPU's rebuild writes it (rebuild.rs).
+            usage: wgpu::TextureUsages::TEXTURE_BINDING
+                | wgpu::TextureUsages::COPY_DST
+                | wgpu::TextureUsages::COPY_SRC
+                | wgpu::TextureUsages::STORAGE_BINDING,
             view_formats: &[],
         });
         let view = texture.create_view(&wgpu::TextureViewDescriptor {
@@ -108,6 +112,50 @@ impl ShellTexture {
         }
         Ok(())
     }
+}
+
+/// Reads a cube map back (tests and diagnostics): RGBA texels in its layout's order, face
+/// after face and level after level, as [`ShellTexture::upload`] takes them.
+pub fn read_cube(gpu: &Gpu, cube: &ShellTexture) -> Result<Vec<f32>, PlayError> {
+    let l = cube.layout;
+    let mut out = Vec::with_capacity(l.texel_count() * 4);
+    for face in 0..6 {
+        for m in 0..l.levels {
+            let (w, h) = l.level_size(m);
+            let row = (w * 16).div_ceil(256) * 256;
+            let buf = gpu.device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("cube readback"),
+                size: row as u64 * h as u64,
+                usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+                mapped_at_creation: false,
+            });
+            let mut enc = gpu.device.create_command_encoder(&Default::default());
+            enc.copy_texture_to_buffer(
+                wgpu::TexelCopyTextureInfo {
+                    texture: &cube.texture,
+                    mip_level: m,
+                    origin: wgpu::Origin3d { x: 0, y: 0, z: face },
+                    aspect: wgpu::TextureAspect::All,
+                },
+                wgpu::TexelCopyBufferInfo {
+                    buffer: &buf,
+                    layout: wgpu::TexelCopyBufferLayout {
+                        offset: 0,
+                        bytes_per_row: Some(row),
+                        rows_per_image: Some(h),
+                    },
+                },
+                wgpu::Extent3d { width: w, height: h, depth_or_array_layers: 1 },
+            );
+            gpu.queue.submit([enc.finish()]);
+            let bytes = crate::frame::map_read(gpu, &buf)?;
+            for y in 0..h as usize {
+                let r = &bytes[y * row as usize..y * row as usize + (w * 16) as usize];
+                out.extend(r.chunks_exact(4).map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]])));
+            }
+        }
+    }
+    Ok(out)
 }
 
 /// Texel format of depth cubes: one distance per texel, read with `textureLoad`.

@@ -14,7 +14,7 @@ use common::*;
 use pis_format::mip::{decimate, mip_size};
 use pis_play::decode::TextureImage;
 use pis_play::mip::{read_levels, MipBuilder};
-use pis_play::{Blend, CameraChoice, FrameRequest, Player, PlayerOptions};
+use pis_play::{Blend, CameraChoice, FrameRequest, Player, PlayerOptions, Rebuild};
 
 fn in_ci() -> bool {
     std::env::var("CI").is_ok_and(|v| v == "true")
@@ -97,6 +97,54 @@ fn a_frame_reads_only_the_codestreams_of_its_pyramid_paths() {
     );
     assert!(s.cache_hits >= 1, "the top level is shared");
     assert_eq!(player.reader().stats().codestreams, all.len() as u64);
+}
+
+/// Decoding ahead: told of the next frame, the player decodes its level images while the
+/// current frame draws; the next frame finds them and waits on nothing, and draws the same
+/// image as a player that decoded when asked. A prediction that changes before its work
+/// starts drops that work, and a frame never waits on work it no longer needs.
+#[test]
+fn the_next_frame_decoded_ahead_waits_on_nothing_and_draws_the_same() {
+    let name = "the_next_frame_decoded_ahead_waits_on_nothing_and_draws_the_same";
+    let Some(gpu) = gpu_or_skip(name) else { return };
+    let gpu = Arc::new(gpu);
+    let options = PlayerOptions { workers: 1, msaa: 1, ..Default::default() };
+    let mut ahead = Player::open(gpu.clone(), &tiny(), options.clone()).unwrap();
+    let mut asked = Player::open(gpu, &tiny(), options).unwrap();
+    let size = ahead.image_size();
+    let (first, next) = (at(&ahead, &[0, 0]), at(&ahead, &[1, 1]));
+    ahead.prefetch(std::slice::from_ref(&next));
+    let (_, s) = ahead.render_image(&first, size).unwrap();
+    assert!(s.decode_waits > 0, "the first frame decodes when it asks");
+    ahead.prefetch(&[]);
+    let (got, s) = ahead.render_image(&next, size).unwrap();
+    assert_eq!(s.decode_waits, 0, "every level image of the next frame was decoded ahead");
+    assert!(s.prefetched > 0 && s.cache_misses == 0, "{s:?}");
+    asked.render_image(&first, size).unwrap();
+    let (want, s) = asked.render_image(&next, size).unwrap();
+    assert!(s.decode_waits > 0 && s.prefetched == 0);
+    assert_eq!(got.rgba, want.rgba, "decoded ahead or when asked, the same frame");
+}
+
+/// The GPU's rebuild and the workers' draw the same frames (every texture of tiny.pis: a
+/// surface texture and a shell's cube map with stored MIP levels).
+#[test]
+fn frames_rebuilt_on_the_gpu_equal_frames_rebuilt_on_the_workers() {
+    let name = "frames_rebuilt_on_the_gpu_equal_frames_rebuilt_on_the_workers";
+    let Some(gpu) = gpu_or_skip(name) else { return };
+    let gpu = Arc::new(gpu);
+    let open = |rebuild| {
+        let options = PlayerOptions { workers: 1, msaa: 1, rebuild, ..Default::default() };
+        Player::open(gpu.clone(), &tiny(), options).unwrap()
+    };
+    let (mut on_gpu, mut workers) = (open(Rebuild::Gpu), open(Rebuild::Workers));
+    assert_eq!((on_gpu.rebuild(), workers.rebuild()), (Rebuild::Gpu, Rebuild::Workers));
+    let size = on_gpu.image_size();
+    for samples in [[0, 0], [1, 0], [1, 1]] {
+        let (a, _) = on_gpu.render_image(&at(&on_gpu, &samples), size).unwrap();
+        let (b, _) = workers.render_image(&at(&workers, &samples), size).unwrap();
+        assert_eq!(a.rgba, b.rgba, "sample {samples:?}");
+    }
 }
 
 #[test]

@@ -1,9 +1,11 @@
-//! The GPU rebuild of surface textures (rebuild.wgsl) against the workers' rebuild it
-//! replaces (decode.rs's `assemble`, with pis-format's decimated MIP chain): every level of
-//! the padded layout, for 1 to 4 channels, one to five pyramid levels, odd and power-of-two
-//! sizes, and the three gamma paths (identity, the default 2.2's `pow_11_5`, a general
-//! power). Sums alone are bit-exact; with an inverse gamma the GPU's division and power may
-//! round differently, held to 90 dB.
+//! The GPU rebuild of textures (rebuild.wgsl) against the workers' rebuild it replaces
+//! (decode.rs): surface textures against `assemble` with pis-format's decimated MIP chain,
+//! every level of the padded layout, for 1 to 4 channels, one to five pyramid levels, odd
+//! and power-of-two sizes, and the three gamma paths (identity, the default 2.2's
+//! `pow_11_5`, a general power); shells' cube maps against `assemble_cube`, every face and
+//! level, with stored MIP levels (all of them or the finest few) and decimated ones. Sums
+//! alone are bit-exact; with an inverse gamma the GPU's division and power may round
+//! differently, held to 90 dB.
 
 mod common;
 
@@ -13,16 +15,22 @@ use common::*;
 use pis_format::mip::{decimate, mip_size};
 use pis_format::texture::LevelLayout;
 use pis_format::{Combine, DepMask, Layer, LayerKind, Mapping, MipMode, StreamRef, Term};
-use pis_play::decode::{assemble, AssembleJob};
+use pis_play::decode::{assemble, assemble_cube, AssembleJob};
 use pis_play::mip::{read_levels, MipBuilder};
 use pis_play::rebuild::{level_buffer, LevelRebuild, LevelStack};
+use pis_play::shell::read_cube;
+use pis_play::ShellTexture;
 
 fn surface_layer(channels: u8, gamma: f32) -> Layer<StreamRef> {
+    layer(Mapping::Surface, channels, MipMode::Decimated, gamma)
+}
+
+fn layer(mapping: Mapping, channels: u8, mip_mode: MipMode, gamma: f32) -> Layer<StreamRef> {
     Layer {
         kind: LayerKind::Diffuse,
-        mapping: Mapping::Surface,
+        mapping,
         channels,
-        mip_mode: MipMode::Decimated,
+        mip_mode,
         term: Term::Reflection,
         order: 0,
         combine: Combine::Over,
@@ -136,6 +144,61 @@ fn the_gpu_rebuild_equals_the_workers_rebuild() {
                 eprintln!("{what}, level {m}: {p:.1} dB");
                 assert!(p >= 90.0, "{what}, level {m}: {p:.1} dB from the workers' rebuild");
             }
+        }
+    }
+}
+
+#[test]
+fn the_gpu_rebuild_of_cube_maps_equals_the_workers_rebuild() {
+    let name = "the_gpu_rebuild_of_cube_maps_equals_the_workers_rebuild";
+    let Some(gpu) = gpu_or_skip(name) else { return };
+    let rebuild = LevelRebuild::new(&gpu);
+    // (face size, channels, stored MIP levels (0: every level), decimated, pyramid levels, gamma)
+    let cases: [(u32, u8, u32, bool, usize, f32); 6] = [
+        (5, 4, 0, false, 3, 2.2),
+        (8, 3, 0, false, 2, 2.2),
+        (6, 3, 2, false, 4, 2.2),
+        (7, 4, 1, true, 3, 2.2),
+        (16, 4, 0, false, 3, 1.0),
+        (9, 3, 0, false, 2, 1.8),
+    ];
+    for (seed, (n, c, mips, decimated, count, gamma)) in cases.into_iter().enumerate() {
+        let mips = match (decimated, mips) {
+            (true, _) => 1,
+            (false, 0) => pis_format::mip::mip_count(n, n),
+            (false, m) => m,
+        };
+        let mode = if decimated { MipMode::Decimated } else { MipMode::Stored };
+        let what = format!(
+            "{n}² × 6, {c} channels, {mips} stored levels, {mode:?}, {count} levels, gamma {gamma}"
+        );
+        let layer = layer(Mapping::Shell, c, mode, gamma);
+        let layout = LevelLayout { width: n, height: n, channels: c as u32, faces: 6, mips };
+        let values: usize =
+            layout.planes().iter().map(|p| (p.width * p.height * p.channels) as usize).sum();
+        let images = level_images(values, count, 31 * seed as u64 + 5);
+        let buffers: Vec<wgpu::Buffer> = images.iter().map(|v| level_buffer(&gpu, v)).collect();
+        let refs: Vec<&wgpu::Buffer> = buffers.iter().collect();
+        let stack = LevelStack { levels: &refs, channels: c as u32, gamma };
+        let job = AssembleJob {
+            layer: &layer,
+            layout: layout.clone(),
+            levels: images.into_iter().map(Arc::new).collect(),
+            drop_levels: 0,
+        };
+        let want = assemble_cube(&job);
+        let cube = ShellTexture::new(&gpu, want.layout, "test").unwrap();
+        let mut enc = gpu.device.create_command_encoder(&Default::default());
+        rebuild.record_cube(&gpu, (&cube, &stack), &layout, &mut enc);
+        gpu.queue.submit([enc.finish()]);
+        let got = read_cube(&gpu, &cube).unwrap();
+        assert_eq!(got.len(), want.rgba.len(), "{what}: texel count");
+        if gamma == 1.0 {
+            assert_eq!(got, want.rgba, "{what}: the sums differ");
+        } else {
+            let p = psnr(&got, &want.rgba);
+            eprintln!("{what}: {p:.1} dB");
+            assert!(p >= 90.0, "{what}: {p:.1} dB from the workers' rebuild");
         }
     }
 }

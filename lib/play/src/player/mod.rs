@@ -24,6 +24,7 @@ mod lens;
 mod objects;
 mod options;
 mod plan;
+mod prefetch;
 mod readout;
 mod relight;
 mod relit;
@@ -41,7 +42,7 @@ use self::draws::{layer_draws, make_samplers, object_draws, reflection_draws, Sa
 use self::lens::{lens_corners, lens_draws, LensSet};
 use self::objects::{check_texture_sizes, object_filters, prepare_objects, LensState, ObjectGpu};
 pub use self::options::{FrameRequest, FrameStats, PlayerOptions, Rebuild};
-use self::plan::{camera_record, Plan};
+use self::plan::{camera_record, Plan, TextureKey};
 use self::readout::{read_back, wait_for_gpu, Readbacks, Readout, Target};
 pub use self::relight::Relight;
 use self::relit::RelitTextures;
@@ -61,7 +62,7 @@ pub use pis_compile::relight::{DirectionalLight, Lights};
 /// An open `.pis` ready to draw frames.
 pub struct Player {
     gpu: Arc<Gpu>,
-    reader: PisReader,
+    reader: Arc<PisReader>,
     options: PlayerOptions,
     /// The frame's textures on the GPU, the level-image cache and the decoding workers.
     textures: Textures,
@@ -84,6 +85,9 @@ pub struct Player {
     relight: Option<Relight>,
     /// Relightable layers' sums for the frame's lights.
     relit: RelitTextures,
+    /// The frames the caller expects next ([`Player::prefetch`]), decoded ahead once the
+    /// next frame's textures are resident.
+    ahead: Vec<FrameRequest>,
 }
 
 impl Player {
@@ -97,7 +101,7 @@ impl Player {
             )));
         }
         check_samples(options.msaa).map_err(PlayError::Request)?;
-        let reader = PisReader::open(path)?;
+        let reader = Arc::new(PisReader::open(path)?);
         check_texture_sizes(&gpu, &reader)?;
         budget::check_frame_memory(&gpu, reader.container(), &options)?;
         let objects = prepare_objects(&gpu, &reader)?;
@@ -150,6 +154,7 @@ impl Player {
             display,
             samplers: HashMap::new(),
             relight,
+            ahead: Vec::new(),
         })
     }
 
@@ -200,6 +205,12 @@ impl Player {
     /// The options the player was opened with.
     pub fn options(&self) -> &PlayerOptions {
         &self.options
+    }
+
+    /// Where this player rebuilds textures from their level images (the options' choice,
+    /// [`Rebuild::Auto`] resolved for the adapter).
+    pub fn rebuild(&self) -> Rebuild {
+        self.textures.rebuild_on()
     }
 
     /// The open file (its container and read counters).
@@ -344,6 +355,7 @@ impl Player {
         let relight = self.relight.as_ref();
         let plan = Plan::new(&self.reader, &self.objects, self.options.blend, req, size, relight)?;
         let corner_sets = self.textures_and_lenses(&plan, size, &mut stats)?;
+        self.decode_ahead(size);
         let format = match target {
             Target::Offscreen { .. } | Target::Centres | Target::Timed => {
                 offscreen_format(&self.gpu)
@@ -363,6 +375,35 @@ impl Player {
         stats.codestreams_read = self.reader.stats().codestreams - reads0;
         stats.frame_ms = t0.elapsed().as_secs_f64() * 1e3;
         Ok((out, stats))
+    }
+
+    /// Says which frames the caller expects to draw next (the motion's next points; none
+    /// stops decoding ahead): after the next frame's textures are resident, and while it
+    /// draws, the workers decode their level images into the cache (within its budget), so
+    /// those frames need not wait on decoding. Work queued for an earlier prediction that
+    /// is no longer expected is dropped.
+    pub fn prefetch(&mut self, ahead: &[FrameRequest]) {
+        self.ahead = ahead.to_vec();
+    }
+
+    /// Level images dropped from decoding ahead so far because the prediction changed.
+    pub fn prefetch_dropped(&self) -> u64 {
+        self.textures.prefetch_dropped()
+    }
+
+    /// Starts decoding ahead the textures of the frames [`Player::prefetch`] expects. A
+    /// request that cannot be planned, or a texture whose level images cannot be found, is
+    /// not decoded ahead: the frame that asks for it reports why.
+    fn decode_ahead(&mut self, size: (u32, u32)) {
+        let relight = self.relight.as_ref();
+        let (reader, objects, blend) = (&self.reader, &self.objects, self.options.blend);
+        let plans: Vec<Plan> = self
+            .ahead
+            .iter()
+            .filter_map(|req| Plan::new(reader, objects, blend, req, size, relight).ok())
+            .collect();
+        let keys: Vec<&TextureKey> = plans.iter().flat_map(|p| p.keys()).collect();
+        self.textures.prefetch(&self.reader, &keys);
     }
 
     /// Makes the targets of `size` and `samples` current: those of the other sample count

@@ -32,22 +32,25 @@ pub struct PlayerOptions {
     /// Lens objects: the screen edge length in pixels down to which the tessellation is
     /// refined where vertex rays diverge (thesis 6.4.1's τ; default 1).
     pub tau_px: f32,
-    /// Where surface textures are rebuilt from their decoded level images (default: the
-    /// GPU).
+    /// Where textures are rebuilt from their decoded level images (default: on the GPU
+    /// where the adapter is one, on the workers where it is a CPU rasterizer).
     pub rebuild: Rebuild,
 }
 
-/// Where surface textures are rebuilt from their decoded level images (SPEC.md 8.4: the
-/// level images summed, inverse gamma, the MIP chain).
+/// Where textures are rebuilt from their decoded level images (SPEC.md 8.4: the level
+/// images summed, inverse gamma, stored MIP residuals, the MIP chain).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum Rebuild {
-    /// A compute pass on the GPU (rebuild.wgsl): the workers only decode, each decoded level
-    /// image goes up once, compact, and stays on the GPU while the level-image cache keeps
-    /// it.
+    /// [`Rebuild::Gpu`] on a GPU, [`Rebuild::Workers`] on a CPU rasterizer (Mesa's
+    /// lavapipe), where a compute pass runs on the same cores as the workers, slower.
     #[default]
+    Auto,
+    /// Compute passes on the GPU (rebuild.wgsl): the workers only decode, each decoded
+    /// level image goes up once, compact, and stays on the GPU while the level-image cache
+    /// keeps it.
     Gpu,
     /// On the workers, the texture uploaded as RGBA (the reference the GPU rebuild is held
-    /// to). A resolution reduction, and shells' cube maps, are always rebuilt there.
+    /// to). A resolution reduction is always rebuilt there.
     Workers,
 }
 
@@ -55,13 +58,23 @@ impl Rebuild {
     /// The name `--rebuild` takes.
     pub fn name(self) -> &'static str {
         match self {
+            Rebuild::Auto => "auto",
             Rebuild::Gpu => "gpu",
             Rebuild::Workers => "workers",
         }
     }
 
     /// Every choice, in the order the tools list them.
-    pub const ALL: [Rebuild; 2] = [Rebuild::Gpu, Rebuild::Workers];
+    pub const ALL: [Rebuild; 3] = [Rebuild::Auto, Rebuild::Gpu, Rebuild::Workers];
+
+    /// The choice made for an adapter of `device_type`: [`Rebuild::Auto`] resolved.
+    pub fn on(self, device_type: wgpu::DeviceType) -> Rebuild {
+        match (self, device_type) {
+            (Rebuild::Auto, wgpu::DeviceType::Cpu) => Rebuild::Workers,
+            (Rebuild::Auto, _) => Rebuild::Gpu,
+            (r, _) => r,
+        }
+    }
 }
 
 impl Default for PlayerOptions {
@@ -77,7 +90,7 @@ impl Default for PlayerOptions {
             msaa: DEFAULT_SAMPLES,
             display_filter: None,
             tau_px: TessellationSettings::default().tau_px,
-            rebuild: Rebuild::Gpu,
+            rebuild: Rebuild::Auto,
         }
     }
 }
@@ -112,6 +125,11 @@ pub struct FrameStats {
     pub cache_misses: u64,
     /// Bytes of decoded level images cached after the frame.
     pub cache_bytes: u64,
+    /// Level images this frame found decoded ahead ([`crate::Player::prefetch`]).
+    pub prefetched: u64,
+    /// Level images this frame waited for: decoded when it asked for them, or still being
+    /// decoded ahead. A frame with none did not wait on decoding.
+    pub decode_waits: u64,
     /// Codestreams read from the file for this frame.
     pub codestreams_read: u64,
     /// Draws of surface layers (one per object, layer and parameter sample).

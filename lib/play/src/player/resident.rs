@@ -5,7 +5,7 @@
 //! workers; their uploads and GPU MIP chains; and the textures a frame did not draw
 //! released when it ends.
 
-use std::collections::HashMap;
+use std::collections::{HashMap, HashSet};
 use std::sync::Arc;
 use std::time::Instant;
 
@@ -16,6 +16,7 @@ use pis_format::{Mapping, PisReader};
 use super::objects::content;
 use super::options::{FrameStats, Rebuild};
 use super::plan::TextureKey;
+use super::prefetch::{AheadJob, Prefetch};
 use crate::cache::{LevelCache, LevelKey};
 use crate::decode::{AssembleJob, CubeImage, Decoder, LevelJob, TextureImage};
 use crate::error::PlayError;
@@ -47,6 +48,7 @@ pub(super) struct Textures {
     /// Decoded level images on the GPU for its rebuild of surface textures, each kept while
     /// the level-image cache keeps it (the thesis's lifetime rule for both copies).
     gpu_levels: HashMap<LevelKey, wgpu::Buffer>,
+    prefetch: Prefetch,
     resident: HashMap<TextureKey, Resident>,
     /// The frame being drawn.
     frame: u64,
@@ -69,9 +71,15 @@ impl Textures {
             rebuild: LevelRebuild::new(gpu),
             rebuild_on,
             gpu_levels: HashMap::new(),
+            prefetch: Prefetch::new(),
             resident: HashMap::new(),
             frame: 0,
         }
+    }
+
+    /// Where textures are rebuilt.
+    pub(super) fn rebuild_on(&self) -> Rebuild {
+        self.rebuild_on
     }
 
     /// The MIP chain builder of the frame's textures.
@@ -108,7 +116,7 @@ impl Textures {
         }
         let t = Instant::now();
         let hits0 = self.cache.counters();
-        let have = self.level_images(reader, &missing)?;
+        let have = self.level_images(reader, &missing, stats)?;
         // Textures rebuilt on the workers: surface textures' finest levels, shells' cube maps.
         let c = reader.container();
         let is_shell = |k: &TextureKey| {
@@ -120,12 +128,14 @@ impl Textures {
         let on_gpu = |k: &&TextureKey| {
             let layer = &c.objects[k.object as usize].layers[k.layer as usize];
             let l = LevelLayout::of(layer, &layer.blocks[k.block as usize]);
-            self.rebuild_on == Rebuild::Gpu
-                && drop_levels == 0
-                && fits(gpu, (l.width, l.height, l.channels), k.images.len())
+            let values = l.planes().iter().map(|p| p.width as u64 * p.height as u64).sum::<u64>()
+                * l.channels as u64;
+            self.rebuild_on == Rebuild::Gpu && drop_levels == 0 && fits(gpu, values, k.images.len())
         };
         let (rebuilt, surfaces): (Vec<&TextureKey>, Vec<&TextureKey>) =
             surfaces.into_iter().partition(on_gpu);
+        let (rebuilt_shells, shells): (Vec<&TextureKey>, Vec<&TextureKey>) =
+            shells.into_iter().partition(on_gpu);
         let job = |k: &&TextureKey| assemble_job(reader, &have, k, drop_levels);
         let images = self.decoder.assemble(&surfaces.iter().map(job).collect::<Vec<_>>());
         let cubes = self.decoder.assemble_cubes(&shells.iter().map(job).collect::<Vec<_>>());
@@ -133,47 +143,48 @@ impl Textures {
         let hits1 = self.cache.counters();
         stats.cache_hits += hits1.hits - hits0.hits;
         stats.cache_misses += hits1.misses - hits0.misses;
-        self.upload(gpu, reader, (&surfaces, &images), (&shells, &cubes), (&rebuilt, &have), stats)
+        self.upload(
+            gpu,
+            reader,
+            (&surfaces, &images),
+            (&shells, &cubes),
+            (&rebuilt, &rebuilt_shells, &have),
+            stats,
+        )
     }
 
-    /// The level images of the `missing` textures: cached, or decoded on the workers (each
-    /// once) and cached.
+    /// The level images of the `missing` textures: cached (decoded ahead or drawn before),
+    /// or decoded on the workers (each once) and cached.
     fn level_images(
         &mut self,
         reader: &PisReader,
         missing: &[&TextureKey],
+        stats: &mut FrameStats,
     ) -> Result<Levels, PlayError> {
-        let c = reader.container();
-        let mut have: Levels = HashMap::new();
-        let mut jobs: Vec<(LevelKey, u32, LevelJob)> = Vec::new();
+        let mut needed: Vec<AheadJob> = Vec::new();
         for k in missing {
-            let layer = &c.objects[k.object as usize].layers[k.layer as usize];
-            let block = &layer.blocks[k.block as usize];
-            let planes = LevelLayout::of(layer, block).planes();
-            let n = block.levels.len() as u32;
-            for (lv, (level, &img)) in block.levels.iter().zip(&k.images).enumerate() {
-                let key = level_key(k, lv, img);
-                if have.contains_key(&key) || jobs.iter().any(|j| j.0 == key) {
-                    continue;
-                }
-                match self.cache.get(&key) {
-                    Some(v) => {
-                        have.insert(key, v);
-                    }
-                    None => {
-                        let stream = *level.images.get(img as usize).ok_or_else(|| {
-                            content(reader, format!("{key:?}: no such level image"))
-                        })?;
-                        let at = (k.object as usize, k.layer as usize, k.block as usize, lv);
-                        jobs.push((
-                            key,
-                            n - 1 - lv as u32,
-                            LevelJob { stream, planes: planes.clone(), at },
-                        ));
-                    }
+            for job in level_jobs(reader, k)? {
+                if !needed.iter().any(|j| j.0 == job.0) {
+                    needed.push(job);
                 }
             }
         }
+        let keys: Vec<LevelKey> = needed.iter().map(|j| j.0).collect();
+        let waited = self.prefetch.collect(&mut self.cache, &keys);
+        let mut have: Levels = HashMap::new();
+        let mut jobs: Vec<AheadJob> = Vec::new();
+        for job in needed {
+            match self.cache.get(&job.0) {
+                Some(v) => {
+                    if self.prefetch.take_ready(&job.0) {
+                        stats.prefetched += 1;
+                    }
+                    have.insert(job.0, v);
+                }
+                None => jobs.push(job),
+            }
+        }
+        stats.decode_waits += jobs.len() as u64 + waited as u64;
         let level_jobs: Vec<LevelJob> = jobs.iter().map(|j| j.2.clone()).collect();
         let decoded = self.decoder.decode_levels(reader, &level_jobs);
         let mut first_error = None;
@@ -195,17 +206,49 @@ impl Textures {
         }
     }
 
+    /// Starts decoding ahead the level images of `predicted` textures that are neither on
+    /// the GPU, cached nor in flight, within the cache's budget (what is cached and in
+    /// flight counted); queued work for an earlier prediction is dropped. A texture whose
+    /// level images the file lacks is left to the frame that draws it.
+    pub(super) fn prefetch(&mut self, reader: &Arc<PisReader>, predicted: &[&TextureKey]) {
+        let mut wanted = HashSet::new();
+        let mut jobs: Vec<AheadJob> = Vec::new();
+        let mut bytes = self.cache.bytes() + self.prefetch.in_flight_bytes();
+        for k in predicted {
+            if self.resident.contains_key(*k) {
+                continue;
+            }
+            for job in level_jobs(reader, k).unwrap_or_default() {
+                if self.cache.contains(&job.0) || !wanted.insert(job.0) {
+                    continue;
+                }
+                let size = pis_codec::value_count(&job.2.planes).unwrap_or(0) as u64 * 4;
+                if self.prefetch.in_flight(&job.0) || bytes + size > self.cache.budget() {
+                    continue;
+                }
+                bytes += size;
+                jobs.push(job);
+            }
+        }
+        self.prefetch.start(&self.decoder, reader, wanted, jobs);
+    }
+
+    /// Level images dropped from decoding ahead because the prediction changed.
+    pub(super) fn prefetch_dropped(&self) -> u64 {
+        self.prefetch.dropped()
+    }
+
     /// Uploads the textures rebuilt on the workers (surface textures with their GPU MIP
     /// chains, cube maps with their stored levels) and records the GPU's rebuilds of the
-    /// `rebuilt` surface textures from their level images (in `have`); waits for the GPU
-    /// and keeps them as drawn this frame.
+    /// `rebuilt` surface textures and cube maps from their level images (in `have`); waits
+    /// for the GPU and keeps them as drawn this frame.
     fn upload(
         &mut self,
         gpu: &Gpu,
         reader: &PisReader,
         (surfaces, images): (&[&TextureKey], &[TextureImage]),
         (shells, cubes): (&[&TextureKey], &[CubeImage]),
-        (rebuilt, have): (&[&TextureKey], &Levels),
+        (rebuilt, rebuilt_shells, have): (&[&TextureKey], &[&TextureKey], &Levels),
         stats: &mut FrameStats,
     ) -> Result<(), PlayError> {
         let c = reader.container();
@@ -215,12 +258,9 @@ impl Textures {
             .device
             .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("uploads") });
         let mut made = Vec::with_capacity(surfaces.len() + shells.len() + rebuilt.len());
-        for k in rebuilt {
-            let texture = self.rebuild_on_gpu(gpu, reader, k, have, &mut encoder, stats);
-            made.push((
-                (*k).clone(),
-                Resident { texture: GpuTexture::Surface(texture), last_frame: frame },
-            ));
+        for k in rebuilt.iter().chain(rebuilt_shells) {
+            let texture = self.rebuild_on_gpu(gpu, reader, k, have, &mut encoder, stats)?;
+            made.push(((*k).clone(), Resident { texture, last_frame: frame }));
         }
         for (k, img) in surfaces.iter().zip(images) {
             let texture = self.mips.texture(gpu, TextureLayout::full(img.width, img.height));
@@ -248,8 +288,8 @@ impl Textures {
         Ok(())
     }
 
-    /// Records the GPU's rebuild of surface texture `k` from its level images, uploading
-    /// those not yet on the GPU (from `have`).
+    /// Records the GPU's rebuild of texture `k` (a surface texture or a cube map) from its
+    /// level images, uploading those not yet on the GPU (from `have`).
     fn rebuild_on_gpu(
         &mut self,
         gpu: &Gpu,
@@ -258,8 +298,9 @@ impl Textures {
         have: &Levels,
         encoder: &mut wgpu::CommandEncoder,
         stats: &mut FrameStats,
-    ) -> ObjectTexture {
-        let layer = &reader.container().objects[k.object as usize].layers[k.layer as usize];
+    ) -> Result<GpuTexture, PlayError> {
+        let object = &reader.container().objects[k.object as usize];
+        let layer = &object.layers[k.layer as usize];
         let l = LevelLayout::of(layer, &layer.blocks[k.block as usize]);
         let keys: Vec<LevelKey> =
             k.images.iter().enumerate().map(|(lv, &img)| level_key(k, lv, img)).collect();
@@ -272,9 +313,14 @@ impl Textures {
         }
         let levels: Vec<&wgpu::Buffer> = keys.iter().map(|key| &self.gpu_levels[key]).collect();
         let stack = LevelStack { levels: &levels, channels: l.channels, gamma: layer.gamma };
+        if layer.mapping == Mapping::Shell {
+            let texture = ShellTexture::new(gpu, TextureLayout::cube(l.width), &object.name)?;
+            self.rebuild.record_cube(gpu, (&texture, &stack), &l, encoder);
+            return Ok(GpuTexture::Shell(texture));
+        }
         let texture = self.mips.texture(gpu, TextureLayout::full(l.width, l.height));
         self.rebuild.record(gpu, (&texture, &stack), &self.mips, encoder);
-        texture
+        Ok(GpuTexture::Surface(texture))
     }
 
     /// Ends the frame: level-image lifetimes and budget (the GPU's copies going with the
@@ -285,8 +331,29 @@ impl Textures {
         self.cache.end_frame();
         let cache = &self.cache;
         self.gpu_levels.retain(|k, _| cache.contains(k));
+        self.prefetch.end_frame(cache);
         self.frame += 1;
     }
+}
+
+/// The level images on texture `k`'s pyramid path as decoding jobs, top first.
+fn level_jobs(reader: &PisReader, k: &TextureKey) -> Result<Vec<AheadJob>, PlayError> {
+    let c = reader.container();
+    let layer = &c.objects[k.object as usize].layers[k.layer as usize];
+    let block = &layer.blocks[k.block as usize];
+    let planes = LevelLayout::of(layer, block).planes();
+    let n = block.levels.len() as u32;
+    let mut jobs = Vec::with_capacity(k.images.len());
+    for (lv, (level, &img)) in block.levels.iter().zip(&k.images).enumerate() {
+        let key = level_key(k, lv, img);
+        let stream = *level
+            .images
+            .get(img as usize)
+            .ok_or_else(|| content(reader, format!("{key:?}: no such level image")))?;
+        let at = (k.object as usize, k.layer as usize, k.block as usize, lv);
+        jobs.push((key, n - 1 - lv as u32, LevelJob { stream, planes: planes.clone(), at }));
+    }
+    Ok(jobs)
 }
 
 /// The cache key of level `lv`'s image `img` of texture `k`.

@@ -115,6 +115,33 @@ impl ViewState {
     }
 
     /// The request for the next frame.
+    /// The parameter samples playback reaches next, for the player to decode ahead
+    /// ([`crate::Player::prefetch`]): the nearest samples of the points ahead along the path
+    /// that differ from the current one, at most `count`, looked for over the time playback
+    /// takes to pass two samples; none while paused. Each is drawn with the frame's camera.
+    pub fn ahead(&self, count: usize) -> Vec<FrameRequest> {
+        let samples = self.space.axes.iter().map(|a| a.samples.len()).max().unwrap_or(1);
+        if !self.playback.playing || count == 0 || samples < 2 {
+            return Vec::new();
+        }
+        let step = self.playback.seconds_per_traverse / (8 * samples) as f32;
+        let now = self.space.snap(&self.point);
+        let camera = self.request().camera;
+        let mut playback = self.playback.clone();
+        let mut out: Vec<FrameRequest> = Vec::new();
+        // Two sample spacings of the densest dimension, in steps of an eighth of one.
+        for _ in 0..=(16 * samples).div_ceil(samples - 1) {
+            let next = self.space.snap(&playback.advance(&self.space, &self.point, step));
+            if next != now && out.last().is_none_or(|r| r.point != next) {
+                out.push(FrameRequest { point: next, camera });
+                if out.len() == count {
+                    break;
+                }
+            }
+        }
+        out
+    }
+
     pub fn request(&self) -> FrameRequest {
         let camera = match (self.mode, &self.free) {
             (CameraMode::Orbit | CameraMode::Fly, Some(f)) => CameraChoice::Free(f.view_camera()),
@@ -127,6 +154,27 @@ impl ViewState {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Playing along the diagonal of two dimensions, the samples ahead are the next ones on
+    /// the path, nearest first; paused, none.
+    #[test]
+    fn the_samples_ahead_are_the_next_on_the_path() {
+        use pis_format::{Dimension, DimensionKind};
+        let dim = |values: Vec<f32>| Dimension {
+            name: "d".into(),
+            kind: DimensionKind::Other,
+            periodic: false,
+            unit: String::new(),
+            block_size: 1,
+            values,
+        };
+        let space = Space::new(&[dim(vec![0.0, 1.0, 2.0, 3.0]), dim(vec![0.0, 10.0, 20.0, 30.0])]);
+        let mut v = ViewState::new(space, vec![0.0, 0.0], 1.0);
+        assert!(v.ahead(2).is_empty(), "paused");
+        v.playback.play_from(&v.space, &[0.0, 0.0]);
+        let points: Vec<Vec<f32>> = v.ahead(2).into_iter().map(|r| r.point).collect();
+        assert_eq!(points, vec![vec![1.0, 10.0], vec![2.0, 20.0]]);
+    }
     use glam::Vec3;
     use pis_format::{Dimension, DimensionKind};
 
