@@ -526,6 +526,7 @@ impl Running {
             decode_ms: s.decode_ms,
             upload_bytes: s.upload_bytes,
             cache_bytes: s.cache_bytes,
+            waited: s.decode_waits > 0,
         });
         if self.frames >= 2 {
             self.sum.0 += s.frame_ms;

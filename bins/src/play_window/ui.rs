@@ -243,6 +243,8 @@ fn stats(ui: &mut Ui, info: &PanelInfo) {
         row("fps", format!("{:.1}", s.fps));
         row("frame", format!("{:.2} ms", s.frame_ms));
         row("decode", format!("{:.2} ms", s.decode_ms));
+        // Frames of the last second that waited for level images to be decoded.
+        row("waited", format!("{} of {} frames", s.waited.0, s.waited.1));
         row("cache", format!("{:.1} MB", s.cache_mb));
         row("upload", format!("{:.1} MB/s", s.upload_mb_s));
         row("hits / misses", format!("{} / {}", info.cache_hits, info.cache_misses));

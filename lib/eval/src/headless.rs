@@ -160,6 +160,9 @@ pub struct FrameRow {
     pub draw_ms: f64,
     pub readback_ms: f64,
     pub codestreams_read: u64,
+    /// Level images the frame waited for, and found decoded ahead.
+    pub decode_waits: u64,
+    pub prefetched: u64,
     pub surface_draws: u64,
     pub shell_draws: u64,
     pub lens_ms: f64,
@@ -459,6 +462,8 @@ pub fn run_frames(
             draw_ms: stats.draw_ms,
             readback_ms: stats.readback_ms,
             codestreams_read: stats.codestreams_read,
+            decode_waits: stats.decode_waits,
+            prefetched: stats.prefetched,
             surface_draws: stats.surface_draws,
             shell_draws: stats.shell_draws,
             lens_ms: stats.lens_ms,

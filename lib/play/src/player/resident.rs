@@ -206,8 +206,8 @@ impl Textures {
         }
     }
 
-    /// Starts decoding ahead the level images of `predicted` textures that are neither on
-    /// the GPU, cached nor in flight, within the cache's budget (what is cached and in
+    /// Keeps the `predicted` textures already on the GPU through this frame, and starts
+    /// decoding ahead the level images of the others that are neither cached nor in flight, within the cache's budget (what is cached and in
     /// flight counted); queued work for an earlier prediction is dropped. A texture whose
     /// level images the file lacks is left to the frame that draws it.
     pub(super) fn prefetch(&mut self, reader: &Arc<PisReader>, predicted: &[&TextureKey]) {
@@ -215,7 +215,9 @@ impl Textures {
         let mut jobs: Vec<AheadJob> = Vec::new();
         let mut bytes = self.cache.bytes() + self.prefetch.in_flight_bytes();
         for k in predicted {
-            if self.resident.contains_key(*k) {
+            // A texture on the GPU that the motion needs again is kept through this frame.
+            if let Some(r) = self.resident.get_mut(*k) {
+                r.last_frame = self.frame;
                 continue;
             }
             for job in level_jobs(reader, k).unwrap_or_default() {

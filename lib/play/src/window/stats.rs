@@ -16,6 +16,8 @@ pub struct FrameSample {
     pub upload_bytes: u64,
     /// Bytes in the decode cache after the frame.
     pub cache_bytes: u64,
+    /// Whether the frame waited on decoding (`FrameStats::decode_waits` > 0).
+    pub waited: bool,
 }
 
 /// What the panel shows.
@@ -26,6 +28,8 @@ pub struct Shown {
     pub decode_ms: f64,
     pub cache_mb: f64,
     pub upload_mb_s: f64,
+    /// Frames of the window that waited on decoding, and frames in it.
+    pub waited: (usize, usize),
 }
 
 /// Smooths per-frame figures for display.
@@ -70,6 +74,7 @@ impl StatsMeter {
         }
         // n frames presented over the time between the first and the last: n - 1 intervals.
         let (first, n) = (self.recent.front().map_or(s.at_s, |f| f.at_s), self.recent.len());
+        self.shown.waited = (self.recent.iter().filter(|f| f.waited).count(), n);
         let span = s.at_s - first;
         if n >= 2 && span > 0.0 {
             self.shown.fps = (n - 1) as f64 / span;
@@ -99,6 +104,7 @@ mod tests {
             decode_ms: frame_ms / 2.0,
             upload_bytes,
             cache_bytes: 3_000_000,
+            waited: false,
         }
     }
 
@@ -112,6 +118,17 @@ mod tests {
         assert!((s.fps - 20.0).abs() < 1e-9, "{s:?}");
         assert!((s.upload_mb_s - 10.0).abs() < 1e-9, "{s:?}");
         assert_eq!(s.cache_mb, 3.0);
+    }
+
+    #[test]
+    fn frames_that_waited_are_counted_over_the_window() {
+        let mut m = StatsMeter::new(1.0, 0.1);
+        for i in 0..30 {
+            m.add(FrameSample { waited: i % 10 == 0, ..frame(i as f64 * 0.1, 10.0, 0) });
+        }
+        // The window holds the frames less than a second older than the last (2.0 to
+        // 2.9 s; 1.9 is a second and a rounding before it): 2.0 waited.
+        assert_eq!(m.shown().waited, (1, 10));
     }
 
     #[test]
