@@ -222,51 +222,62 @@ pub fn read_levels(
     texture: &ObjectTexture,
 ) -> Result<Vec<(u32, u32, Vec<f32>)>, PlayError> {
     let (aw, ah) = crate::textured::allocated_size(&texture.layout);
-    let half = texture.texture.format() == wgpu::TextureFormat::Rgba16Float;
-    let texel = if half { 8 } else { 16 };
     let mut out = Vec::new();
     for m in 0..texture.layout.levels {
         let (w, h) = ((aw >> m).max(1), (ah >> m).max(1));
-        let row = (w * texel).div_ceil(256) * 256;
-        let buf = gpu.device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("level readback"),
-            size: row as u64 * h as u64,
-            usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
-            mapped_at_creation: false,
-        });
-        let mut enc = gpu.device.create_command_encoder(&Default::default());
-        enc.copy_texture_to_buffer(
-            wgpu::TexelCopyTextureInfo {
-                texture: &texture.texture,
-                mip_level: m,
-                origin: wgpu::Origin3d::ZERO,
-                aspect: wgpu::TextureAspect::All,
-            },
-            wgpu::TexelCopyBufferInfo {
-                buffer: &buf,
-                layout: wgpu::TexelCopyBufferLayout {
-                    offset: 0,
-                    bytes_per_row: Some(row),
-                    rows_per_image: Some(h),
-                },
-            },
-            wgpu::Extent3d { width: w, height: h, depth_or_array_layers: 1 },
-        );
-        gpu.queue.submit([enc.finish()]);
-        let bytes = crate::frame::map_read(gpu, &buf)?;
-        let mut img = Vec::with_capacity((w * h * 4) as usize);
-        for y in 0..h as usize {
-            let r = &bytes[y * row as usize..y * row as usize + (w * texel) as usize];
-            if half {
-                img.extend(
-                    r.chunks_exact(2)
-                        .map(|b| half::f16::from_bits(u16::from_le_bytes([b[0], b[1]])).to_f32()),
-                );
-            } else {
-                img.extend(r.chunks_exact(4).map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]])));
-            }
-        }
-        out.push((w, h, img));
+        out.push((w, h, read_level(gpu, &texture.texture, (m, 0), (w, h))?));
     }
     Ok(out)
+}
+
+/// Reads one level of one layer of an RGBA float texture back (tests and diagnostics): the
+/// `w × h` texels at its origin, row after row, as f32 (half floats widened).
+pub(crate) fn read_level(
+    gpu: &Gpu,
+    texture: &wgpu::Texture,
+    (m, layer): (u32, u32),
+    (w, h): (u32, u32),
+) -> Result<Vec<f32>, PlayError> {
+    let half = texture.format() == wgpu::TextureFormat::Rgba16Float;
+    let texel = if half { 8 } else { 16 };
+    let row = (w * texel).div_ceil(256) * 256;
+    let buf = gpu.device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("level readback"),
+        size: row as u64 * h as u64,
+        usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+        mapped_at_creation: false,
+    });
+    let mut enc = gpu.device.create_command_encoder(&Default::default());
+    enc.copy_texture_to_buffer(
+        wgpu::TexelCopyTextureInfo {
+            texture,
+            mip_level: m,
+            origin: wgpu::Origin3d { x: 0, y: 0, z: layer },
+            aspect: wgpu::TextureAspect::All,
+        },
+        wgpu::TexelCopyBufferInfo {
+            buffer: &buf,
+            layout: wgpu::TexelCopyBufferLayout {
+                offset: 0,
+                bytes_per_row: Some(row),
+                rows_per_image: Some(h),
+            },
+        },
+        wgpu::Extent3d { width: w, height: h, depth_or_array_layers: 1 },
+    );
+    gpu.queue.submit([enc.finish()]);
+    let bytes = crate::frame::map_read(gpu, &buf)?;
+    let mut img = Vec::with_capacity((w * h * 4) as usize);
+    for y in 0..h as usize {
+        let r = &bytes[y * row as usize..y * row as usize + (w * texel) as usize];
+        if half {
+            img.extend(
+                r.chunks_exact(2)
+                    .map(|b| half::f16::from_bits(u16::from_le_bytes([b[0], b[1]])).to_f32()),
+            );
+        } else {
+            img.extend(r.chunks_exact(4).map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]])));
+        }
+    }
+    Ok(img)
 }

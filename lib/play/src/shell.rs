@@ -121,38 +121,7 @@ pub fn read_cube(gpu: &Gpu, cube: &ShellTexture) -> Result<Vec<f32>, PlayError> 
     let mut out = Vec::with_capacity(l.texel_count() * 4);
     for face in 0..6 {
         for m in 0..l.levels {
-            let (w, h) = l.level_size(m);
-            let row = (w * 16).div_ceil(256) * 256;
-            let buf = gpu.device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some("cube readback"),
-                size: row as u64 * h as u64,
-                usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
-                mapped_at_creation: false,
-            });
-            let mut enc = gpu.device.create_command_encoder(&Default::default());
-            enc.copy_texture_to_buffer(
-                wgpu::TexelCopyTextureInfo {
-                    texture: &cube.texture,
-                    mip_level: m,
-                    origin: wgpu::Origin3d { x: 0, y: 0, z: face },
-                    aspect: wgpu::TextureAspect::All,
-                },
-                wgpu::TexelCopyBufferInfo {
-                    buffer: &buf,
-                    layout: wgpu::TexelCopyBufferLayout {
-                        offset: 0,
-                        bytes_per_row: Some(row),
-                        rows_per_image: Some(h),
-                    },
-                },
-                wgpu::Extent3d { width: w, height: h, depth_or_array_layers: 1 },
-            );
-            gpu.queue.submit([enc.finish()]);
-            let bytes = crate::frame::map_read(gpu, &buf)?;
-            for y in 0..h as usize {
-                let r = &bytes[y * row as usize..y * row as usize + (w * 16) as usize];
-                out.extend(r.chunks_exact(4).map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]])));
-            }
+            out.extend(crate::mip::read_level(gpu, &cube.texture, (m, face), l.level_size(m))?);
         }
     }
     Ok(out)

@@ -354,16 +354,6 @@ fn multisampling_changes_silhouettes_of_played_frames() {
 }
 
 /// PSNR of linear values, peak 1.
-fn psnr(a: &[f32], b: &[f32]) -> f64 {
-    let mse = a.iter().zip(b).map(|(x, y)| (*x as f64 - *y as f64).powi(2)).sum::<f64>()
-        / a.len().max(1) as f64;
-    if mse == 0.0 {
-        f64::INFINITY
-    } else {
-        -10.0 * mse.log10()
-    }
-}
-
 fn srgb(v: f32) -> f32 {
     let l = v.clamp(0.0, 1.0);
     if l <= 0.003_130_8 {

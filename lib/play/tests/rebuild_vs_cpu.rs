@@ -89,16 +89,6 @@ fn cpu_levels(job: &AssembleJob, padded: &[(u32, u32)]) -> Vec<Vec<f32>> {
     out
 }
 
-fn psnr(a: &[f32], b: &[f32]) -> f64 {
-    let mse = a.iter().zip(b).map(|(x, y)| (*x as f64 - *y as f64).powi(2)).sum::<f64>()
-        / a.len().max(1) as f64;
-    if mse == 0.0 {
-        f64::INFINITY
-    } else {
-        -10.0 * mse.log10()
-    }
-}
-
 #[test]
 fn the_gpu_rebuild_equals_the_workers_rebuild() {
     let Some(gpu) = gpu_or_skip("the_gpu_rebuild_equals_the_workers_rebuild") else { return };

@@ -347,3 +347,14 @@ pub fn draw_tinted(
     gpu.queue.submit([encoder.finish()]);
     colour_image(&rc.read(gpu).unwrap(), format, size)
 }
+
+/// PSNR of `a` against `b` (peak 1; infinite where they are equal).
+pub fn psnr(a: &[f32], b: &[f32]) -> f64 {
+    let mse = a.iter().zip(b).map(|(x, y)| (*x as f64 - *y as f64).powi(2)).sum::<f64>()
+        / a.len().max(1) as f64;
+    if mse == 0.0 {
+        f64::INFINITY
+    } else {
+        -10.0 * mse.log10()
+    }
+}
