@@ -117,7 +117,7 @@ pub struct PlayArgs {
     /// Along a path: decode the textures of this many next frames on the decoding threads
     /// while a frame draws, so that they need not wait (0: decode each frame's textures when
     /// it asks for them).
-    #[arg(long, default_value_t = 1, value_name = "FRAMES")]
+    #[arg(long, default_value_t = 2, value_name = "FRAMES")]
     pub prefetch: usize,
     /// Memory for decoded level images, MiB (on the GPU, as much again for the level images
     /// its rebuild reads).

@@ -117,6 +117,8 @@ pub struct PathReport {
     /// prediction changed before they started.
     pub prefetched: u64,
     pub prefetch_dropped: u64,
+    /// Textures found rebuilt ahead on the workers.
+    pub rebuilt_ahead: u64,
     pub frame_ms_mean: f64,
     pub frame_ms_worst: f64,
     pub fps_mean: f64,
@@ -492,6 +494,7 @@ pub fn run_frames(
         frames_waited: all.iter().filter(|s| s.decode_waits > 0).count(),
         prefetched: all.iter().map(|s| s.prefetched).sum(),
         prefetch_dropped: player.prefetch_dropped(),
+        rebuilt_ahead: all.iter().map(|s| s.rebuilt_ahead).sum(),
         frame_ms_mean: fm,
         frame_ms_worst: fw,
         fps_mean: 1e3 / fm.max(1e-9),
@@ -570,8 +573,8 @@ pub fn print_path_report(r: &PathReport, w: &mut impl std::io::Write) -> std::io
     )?;
     writeln!(
         w,
-        "  frames that waited on decoding: {} of {}; decoding {} frames ahead: {} level images found decoded, {} dropped",
-        r.frames_waited, r.frames, r.prefetch, r.prefetched, r.prefetch_dropped
+        "  frames that waited on decoding: {} of {}; decoding {} frames ahead: {} level images found decoded, {} dropped, {} textures found rebuilt",
+        r.frames_waited, r.frames, r.prefetch, r.prefetched, r.prefetch_dropped, r.rebuilt_ahead
     )
 }
 

@@ -87,6 +87,11 @@ impl LevelCache {
         }
     }
 
+    /// The image of `key` if cached, with no effect on its lifetime or the counters.
+    pub fn peek(&self, key: &LevelKey) -> Option<Arc<Vec<f32>>> {
+        self.entries.get(key).map(|e| e.values.clone())
+    }
+
     /// Whether `key` is cached (no effect on its lifetime or the counters).
     pub fn contains(&self, key: &LevelKey) -> bool {
         self.entries.contains_key(key)

@@ -379,9 +379,10 @@ impl Player {
 
     /// Says which frames the caller expects to draw next (the motion's next points; none
     /// stops decoding ahead): after the next frame's textures are resident, and while it
-    /// draws, the workers decode their level images into the cache (within its budget), so
-    /// those frames need not wait on decoding. Work queued for an earlier prediction that
-    /// is no longer expected is dropped.
+    /// draws, the workers decode their level images into the cache (within its budget) and,
+    /// where the workers rebuild textures, rebuild them, so those frames need not wait on
+    /// decoding; their textures already on the GPU are kept. Work queued for textures no
+    /// longer expected is dropped before it starts.
     pub fn prefetch(&mut self, ahead: &[FrameRequest]) {
         self.ahead = ahead.to_vec();
     }
@@ -403,7 +404,7 @@ impl Player {
             .filter_map(|req| Plan::new(reader, objects, blend, req, size, relight).ok())
             .collect();
         let keys: Vec<&TextureKey> = plans.iter().flat_map(|p| p.keys()).collect();
-        self.textures.prefetch(&self.reader, &keys);
+        self.textures.prefetch(&self.gpu, &self.reader, &keys, self.options.reduction);
     }
 
     /// Makes the targets of `size` and `samples` current: those of the other sample count

@@ -125,8 +125,10 @@ pub struct FrameStats {
     pub cache_misses: u64,
     /// Bytes of decoded level images cached after the frame.
     pub cache_bytes: u64,
-    /// Level images this frame found decoded ahead ([`crate::Player::prefetch`]).
+    /// Level images this frame found decoded ahead ([`crate::Player::prefetch`]), and
+    /// textures it found rebuilt ahead on the workers.
     pub prefetched: u64,
+    pub rebuilt_ahead: u64,
     /// Level images this frame waited for: decoded when it asked for them, or still being
     /// decoded ahead. A frame with none did not wait on decoding.
     pub decode_waits: u64,

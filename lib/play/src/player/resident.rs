@@ -16,7 +16,7 @@ use pis_format::{Mapping, PisReader};
 use super::objects::content;
 use super::options::{FrameStats, Rebuild};
 use super::plan::TextureKey;
-use super::prefetch::{AheadJob, Prefetch};
+use super::prefetch::{AheadJob, AheadTexture, Prefetch, Rebuilt};
 use crate::cache::{LevelCache, LevelKey};
 use crate::decode::{AssembleJob, CubeImage, Decoder, LevelJob, TextureImage};
 use crate::error::PlayError;
@@ -116,29 +116,54 @@ impl Textures {
         }
         let t = Instant::now();
         let hits0 = self.cache.counters();
+        // Work prepared ahead: level images into the cache, textures rebuilt on the workers.
+        let mut needed: Vec<LevelKey> = Vec::new();
+        for k in &missing {
+            needed.extend(k.images.iter().enumerate().map(|(lv, &img)| level_key(k, lv, img)));
+        }
+        let waited = self.prefetch.collect(&mut self.cache, &needed);
+        stats.decode_waits += waited as u64;
+        let (mut surfaces, mut shells) = (Vec::new(), Vec::new());
+        let (mut images, mut cubes) = (Vec::new(), Vec::new());
+        let prefetch = &mut self.prefetch;
+        missing.retain(|k| match prefetch.take_image(k) {
+            Some(rebuilt) => {
+                let keys = k.images.iter().enumerate().map(|(lv, &img)| level_key(k, lv, img));
+                stats.prefetched += keys.filter(|key| prefetch.take_ready(key)).count() as u64;
+                stats.rebuilt_ahead += 1;
+                match rebuilt {
+                    Rebuilt::Surface(image) => {
+                        surfaces.push(*k);
+                        images.push(image);
+                    }
+                    Rebuilt::Cube(cube) => {
+                        shells.push(*k);
+                        cubes.push(cube);
+                    }
+                }
+                false
+            }
+            None => true,
+        });
         let have = self.level_images(reader, &missing, stats)?;
-        // Textures rebuilt on the workers: surface textures' finest levels, shells' cube maps.
+        // The rest rebuilt on the GPU, or on the workers: surface textures' finest levels,
+        // shells' cube maps.
+        let drop_levels = reduction.trailing_zeros();
+        let (rebuilt, on_workers): (Vec<&TextureKey>, Vec<&TextureKey>) =
+            missing.iter().partition(|k| self.rebuilds_on_gpu(gpu, reader, k, drop_levels));
         let c = reader.container();
-        let is_shell = |k: &TextureKey| {
+        let is_shell = |k: &&TextureKey| {
             c.objects[k.object as usize].layers[k.layer as usize].mapping == Mapping::Shell
         };
-        let (shells, surfaces): (Vec<&TextureKey>, Vec<&TextureKey>) =
-            missing.iter().partition(|k| is_shell(k));
-        let drop_levels = reduction.trailing_zeros();
-        let on_gpu = |k: &&TextureKey| {
-            let layer = &c.objects[k.object as usize].layers[k.layer as usize];
-            let l = LevelLayout::of(layer, &layer.blocks[k.block as usize]);
-            let values = l.planes().iter().map(|p| p.width as u64 * p.height as u64).sum::<u64>()
-                * l.channels as u64;
-            self.rebuild_on == Rebuild::Gpu && drop_levels == 0 && fits(gpu, values, k.images.len())
-        };
-        let (rebuilt, surfaces): (Vec<&TextureKey>, Vec<&TextureKey>) =
-            surfaces.into_iter().partition(on_gpu);
-        let (rebuilt_shells, shells): (Vec<&TextureKey>, Vec<&TextureKey>) =
-            shells.into_iter().partition(on_gpu);
-        let job = |k: &&TextureKey| assemble_job(reader, &have, k, drop_levels);
-        let images = self.decoder.assemble(&surfaces.iter().map(job).collect::<Vec<_>>());
-        let cubes = self.decoder.assemble_cubes(&shells.iter().map(job).collect::<Vec<_>>());
+        let (rebuilt_shells, rebuilt): (Vec<&TextureKey>, Vec<&TextureKey>) =
+            rebuilt.into_iter().partition(is_shell);
+        let (cube_keys, surface_keys): (Vec<&TextureKey>, Vec<&TextureKey>) =
+            on_workers.into_iter().partition(is_shell);
+        let job = |k: &&TextureKey| assemble_job(reader, path_levels(&have, k), k, drop_levels);
+        images.extend(self.decoder.assemble(&surface_keys.iter().map(job).collect::<Vec<_>>()));
+        cubes.extend(self.decoder.assemble_cubes(&cube_keys.iter().map(job).collect::<Vec<_>>()));
+        surfaces.extend(surface_keys);
+        shells.extend(cube_keys);
         stats.decode_ms += t.elapsed().as_secs_f64() * 1e3;
         let hits1 = self.cache.counters();
         stats.cache_hits += hits1.hits - hits0.hits;
@@ -153,8 +178,18 @@ impl Textures {
         )
     }
 
-    /// The level images of the `missing` textures: cached (decoded ahead or drawn before),
-    /// or decoded on the workers (each once) and cached.
+    /// Whether texture `k` is rebuilt on the GPU: where the player rebuilds there, at full
+    /// resolution, and its level images fit the device's storage buffers.
+    fn rebuilds_on_gpu(&self, gpu: &Gpu, reader: &PisReader, k: &TextureKey, drop: u32) -> bool {
+        let layer = &reader.container().objects[k.object as usize].layers[k.layer as usize];
+        let l = LevelLayout::of(layer, &layer.blocks[k.block as usize]);
+        let values = l.planes().iter().map(|p| p.width as u64 * p.height as u64).sum::<u64>()
+            * l.channels as u64;
+        self.rebuild_on == Rebuild::Gpu && drop == 0 && fits(gpu, values, k.images.len())
+    }
+
+    /// The level images of the `missing` textures (work prepared ahead collected): cached
+    /// (decoded ahead or drawn before), or decoded on the workers (each once) and cached.
     fn level_images(
         &mut self,
         reader: &PisReader,
@@ -169,8 +204,6 @@ impl Textures {
                 }
             }
         }
-        let keys: Vec<LevelKey> = needed.iter().map(|j| j.0).collect();
-        let waited = self.prefetch.collect(&mut self.cache, &keys);
         let mut have: Levels = HashMap::new();
         let mut jobs: Vec<AheadJob> = Vec::new();
         for job in needed {
@@ -184,7 +217,7 @@ impl Textures {
                 None => jobs.push(job),
             }
         }
-        stats.decode_waits += jobs.len() as u64 + waited as u64;
+        stats.decode_waits += jobs.len() as u64;
         let level_jobs: Vec<LevelJob> = jobs.iter().map(|j| j.2.clone()).collect();
         let decoded = self.decoder.decode_levels(reader, &level_jobs);
         let mut first_error = None;
@@ -206,13 +239,23 @@ impl Textures {
         }
     }
 
-    /// Keeps the `predicted` textures already on the GPU through this frame, and starts
-    /// decoding ahead the level images of the others that are neither cached nor in flight, within the cache's budget (what is cached and in
-    /// flight counted); queued work for an earlier prediction is dropped. A texture whose
-    /// level images the file lacks is left to the frame that draws it.
-    pub(super) fn prefetch(&mut self, reader: &Arc<PisReader>, predicted: &[&TextureKey]) {
+    /// Keeps the `predicted` textures already on the GPU through this frame, and queues the
+    /// preparation of the others on the workers: their level images neither cached nor in
+    /// flight decoded, within the cache's budget (what is cached and in flight counted), and
+    /// where the workers rebuild textures (`reduction` as the frame's), the texture rebuilt
+    /// once every level image is at hand. Queued work for an earlier prediction is dropped.
+    /// A texture whose level images the file lacks is left to the frame that draws it.
+    pub(super) fn prefetch(
+        &mut self,
+        gpu: &Gpu,
+        reader: &Arc<PisReader>,
+        predicted: &[&TextureKey],
+        reduction: u32,
+    ) {
+        let drop_levels = reduction.trailing_zeros();
         let mut wanted = HashSet::new();
-        let mut jobs: Vec<AheadJob> = Vec::new();
+        let mut owned = HashSet::new();
+        let mut jobs: Vec<AheadTexture> = Vec::new();
         let mut bytes = self.cache.bytes() + self.prefetch.in_flight_bytes();
         for k in predicted {
             // A texture on the GPU that the motion needs again is kept through this frame.
@@ -220,16 +263,36 @@ impl Textures {
                 r.last_frame = self.frame;
                 continue;
             }
+            if !wanted.insert((*k).clone()) || self.prefetch.has_image(k) {
+                continue;
+            }
+            let mut t = AheadTexture {
+                key: (*k).clone(),
+                decode: Vec::new(),
+                levels: Vec::new(),
+                rebuild: None,
+            };
+            let mut complete = true;
             for job in level_jobs(reader, k).unwrap_or_default() {
-                if self.cache.contains(&job.0) || !wanted.insert(job.0) {
+                let cached = self.cache.peek(&job.0);
+                t.levels.push((job.0, cached.clone()));
+                if cached.is_some() {
                     continue;
                 }
                 let size = pis_codec::value_count(&job.2.planes).unwrap_or(0) as u64 * 4;
-                if self.prefetch.in_flight(&job.0) || bytes + size > self.cache.budget() {
+                let ours = !self.prefetch.in_flight(&job.0) && !owned.contains(&job.0);
+                if !ours || bytes + size > self.cache.budget() {
+                    complete = false;
                     continue;
                 }
                 bytes += size;
-                jobs.push(job);
+                owned.insert(job.0);
+                t.decode.push(job);
+            }
+            let on_workers = !self.rebuilds_on_gpu(gpu, reader, k, drop_levels);
+            t.rebuild = (complete && on_workers && !t.levels.is_empty()).then_some(drop_levels);
+            if !t.decode.is_empty() || t.rebuild.is_some() {
+                jobs.push(t);
             }
         }
         self.prefetch.start(&self.decoder, reader, wanted, jobs);
@@ -363,23 +426,22 @@ fn level_key(k: &TextureKey, lv: usize, img: u32) -> LevelKey {
     LevelKey { object: k.object, layer: k.layer, block: k.block, level: lv as u32, image: img }
 }
 
-/// The job that rebuilds texture `k` from its level images (`have`), its `drop_levels`
-/// finest levels dropped (at most all but one).
-fn assemble_job<'r>(
+/// The level images of texture `k`'s pyramid path (in `have`), top first.
+fn path_levels(have: &Levels, k: &TextureKey) -> Vec<Arc<Vec<f32>>> {
+    k.images.iter().enumerate().map(|(lv, &img)| have[&level_key(k, lv, img)].clone()).collect()
+}
+
+/// The job that rebuilds texture `k` from its level images (`levels`, top first), its
+/// `drop_levels` finest levels dropped (at most all but one).
+pub(super) fn assemble_job<'r>(
     reader: &'r PisReader,
-    have: &Levels,
+    levels: Vec<Arc<Vec<f32>>>,
     k: &TextureKey,
     drop_levels: u32,
 ) -> AssembleJob<'r> {
     let c = reader.container();
     let layer = &c.objects[k.object as usize].layers[k.layer as usize];
     let block = &layer.blocks[k.block as usize];
-    let levels = k
-        .images
-        .iter()
-        .enumerate()
-        .map(|(lv, &img)| have[&level_key(k, lv, img)].clone())
-        .collect();
     let full = TextureLayout::full(block.width, block.height).levels;
     AssembleJob {
         layer,
