@@ -17,6 +17,7 @@
 //! tessellation and draws), `draws.rs` (the frame's draws), `readout.rs` (submitting and
 //! reading back); this file opens the player and runs a frame through them.
 
+mod assemble;
 mod budget;
 mod depth;
 mod draws;

@@ -12,8 +12,8 @@ use std::sync::{mpsc, Arc, Mutex};
 
 use pis_format::PisReader;
 
+use super::assemble::assemble_job;
 use super::plan::TextureKey;
-use super::resident::assemble_job;
 use crate::cache::{LevelCache, LevelKey};
 use crate::decode::TextureImage;
 use crate::decode::{assemble, assemble_cube, decode_level, CubeImage, Decoder, LevelJob};

@@ -13,12 +13,13 @@ use pis_compile::TextureLayout;
 use pis_format::texture::LevelLayout;
 use pis_format::{Mapping, PisReader};
 
+use super::assemble::assemble_job;
 use super::objects::content;
 use super::options::{FrameStats, Rebuild};
 use super::plan::TextureKey;
 use super::prefetch::{AheadJob, AheadTexture, Prefetch, Rebuilt};
 use crate::cache::{LevelCache, LevelKey};
-use crate::decode::{AssembleJob, CubeImage, Decoder, LevelJob, TextureImage};
+use crate::decode::{CubeImage, Decoder, LevelJob, TextureImage};
 use crate::error::PlayError;
 use crate::gpu::Gpu;
 use crate::mip::MipBuilder;
@@ -429,24 +430,4 @@ fn level_key(k: &TextureKey, lv: usize, img: u32) -> LevelKey {
 /// The level images of texture `k`'s pyramid path (in `have`), top first.
 fn path_levels(have: &Levels, k: &TextureKey) -> Vec<Arc<Vec<f32>>> {
     k.images.iter().enumerate().map(|(lv, &img)| have[&level_key(k, lv, img)].clone()).collect()
-}
-
-/// The job that rebuilds texture `k` from its level images (`levels`, top first), its
-/// `drop_levels` finest levels dropped (at most all but one).
-pub(super) fn assemble_job<'r>(
-    reader: &'r PisReader,
-    levels: Vec<Arc<Vec<f32>>>,
-    k: &TextureKey,
-    drop_levels: u32,
-) -> AssembleJob<'r> {
-    let c = reader.container();
-    let layer = &c.objects[k.object as usize].layers[k.layer as usize];
-    let block = &layer.blocks[k.block as usize];
-    let full = TextureLayout::full(block.width, block.height).levels;
-    AssembleJob {
-        layer,
-        layout: LevelLayout::of(layer, block),
-        levels,
-        drop_levels: drop_levels.min(full.saturating_sub(1)),
-    }
 }
