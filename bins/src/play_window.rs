@@ -78,7 +78,7 @@ pub fn try_run(args: &PlayArgs) -> Result<(), WindowFailure> {
             );
         }
         eprintln!(
-            "pis-play: {} frames at {}×{} ({}) in {:.2} s: {:.1} fps (first frame left out); player {:.2} ms per frame (decode {:.2} ms, upload {:.2} ms)",
+            "pis-play: {} frames at {}×{} ({}) in {:.2} s: {:.1} fps (first frame left out); player {:.2} ms per frame (decode {:.2} ms, upload {:.2} ms, GPU rebuild {:.2} ms)",
             r.frames,
             r.frame_size[0],
             r.frame_size[1],
@@ -87,7 +87,8 @@ pub fn try_run(args: &PlayArgs) -> Result<(), WindowFailure> {
             r.fps,
             r.frame_ms,
             r.decode_ms,
-            r.upload_ms
+            r.upload_ms,
+            r.rebuild_ms
         );
         if let Some(p) = &args.screenshot {
             eprintln!("pis-play: frame {} saved to {}", r.frames, p.display());

@@ -114,6 +114,12 @@ pub struct PlayArgs {
     /// A --reduction is rebuilt on the workers.
     #[arg(long, default_value = "auto", value_parser = crate::cli::one_of(&pis_play::Rebuild::ALL, pis_play::Rebuild::name))]
     pub rebuild: pis_play::Rebuild,
+    /// The precision textures are held in on the GPU: `half` (16-bit floats: half the
+    /// memory and upload), `full` (32-bit floats), or `auto`: half where the file records
+    /// that rounding to half floats stays 20 dB or more below its coding error (pis-pack
+    /// measures it), else full. The report says which and why.
+    #[arg(long, default_value = "auto", value_parser = crate::cli::one_of(&pis_play::TexturePrecision::ALL, pis_play::TexturePrecision::name))]
+    pub texture_precision: pis_play::TexturePrecision,
     /// Along a path: decode the textures of this many next frames on the decoding threads
     /// while a frame draws, so that they need not wait (0: decode each frame's textures when
     /// it asks for them).
@@ -190,6 +196,7 @@ impl PlayArgs {
             msaa: self.msaa,
             tau_px: self.tau,
             rebuild: self.rebuild,
+            precision: self.texture_precision,
             display_filter: self
                 .compare
                 .as_deref()

@@ -75,6 +75,7 @@ pub struct RunReport {
     pub frame_ms: f64,
     pub decode_ms: f64,
     pub upload_ms: f64,
+    pub rebuild_ms: f64,
     pub frame_size: [u32; 2],
     /// Samples per pixel drawn with (multisample antialiasing; 1: none).
     pub msaa_samples: u32,
@@ -162,7 +163,7 @@ struct Running {
     /// Frames presented.
     frames: u32,
     /// Sums over frames 2.. for the run report.
-    sum: (f64, f64, f64),
+    sum: (f64, f64, f64, f64),
     second_frame_at: Option<Instant>,
     /// Something moves (playback, held keys, a drag): draw again at once.
     active: bool,
@@ -299,7 +300,7 @@ impl App {
             started: now,
             last: now,
             frames: 0,
-            sum: (0.0, 0.0, 0.0),
+            sum: (0.0, 0.0, 0.0, 0.0),
             second_frame_at: None,
             active: true,
             repaint_after: None,
@@ -524,6 +525,8 @@ impl Running {
             at_s: (at - self.started).as_secs_f64(),
             frame_ms: s.frame_ms,
             decode_ms: s.decode_ms,
+            upload_ms: s.upload_ms,
+            rebuild_ms: s.rebuild_ms,
             upload_bytes: s.upload_bytes,
             cache_bytes: s.cache_bytes,
             waited: s.decode_waits > 0,
@@ -532,6 +535,7 @@ impl Running {
             self.sum.0 += s.frame_ms;
             self.sum.1 += s.decode_ms;
             self.sum.2 += s.upload_ms;
+            self.sum.3 += s.rebuild_ms;
         }
         if self.frames == 1 {
             self.second_frame_at = Some(at);
@@ -547,6 +551,7 @@ impl Running {
                 frame_ms: self.sum.0 / timed,
                 decode_ms: self.sum.1 / timed,
                 upload_ms: self.sum.2 / timed,
+                rebuild_ms: self.sum.3 / timed,
                 frame_size: [size.0, size.1],
                 msaa_samples: self.player.multisample_for(self.surface.view_format).samples,
                 msaa_requested: self.player.options().msaa,

@@ -242,11 +242,15 @@ fn stats(ui: &mut Ui, info: &PanelInfo) {
         };
         row("fps", format!("{:.1}", s.fps));
         row("frame", format!("{:.2} ms", s.frame_ms));
+        // The longest frame of the last second.
+        row("worst", format!("{:.2} ms", s.worst_ms));
         row("decode", format!("{:.2} ms", s.decode_ms));
+        row("upload", format!("{:.2} ms", s.upload_ms));
+        row("GPU rebuild", format!("{:.2} ms", s.rebuild_ms));
         // Frames of the last second that waited for level images to be decoded.
         row("waited", format!("{} of {} frames", s.waited.0, s.waited.1));
         row("cache", format!("{:.1} MB", s.cache_mb));
-        row("upload", format!("{:.1} MB/s", s.upload_mb_s));
+        row("upload rate", format!("{:.1} MB/s", s.upload_mb_s));
         row("hits / misses", format!("{} / {}", info.cache_hits, info.cache_misses));
         row("draws", format!("{} surface, {} shell", info.draws.0, info.draws.1));
         row("frame size", format!("{}×{}", info.frame_size.0, info.frame_size.1));

@@ -95,6 +95,7 @@ pub fn play_failure(e: PlayError) -> Failure {
 pub struct PathReport {
     pub file: String,
     pub adapter: String,
+    pub textures: TextureFormats,
     pub size: [u32; 2],
     pub blend: String,
     pub reduction: u32,
@@ -126,7 +127,11 @@ pub struct PathReport {
     pub decode_ms_mean: f64,
     pub decode_ms_worst: f64,
     pub upload_ms_mean: f64,
+    pub upload_ms_worst: f64,
     pub upload_bytes_mean: f64,
+    /// The GPU's rebuilds of textures from their level images (0 on the workers).
+    pub rebuild_ms_mean: f64,
+    pub rebuild_ms_worst: f64,
     /// Recording the draws and waiting for the GPU to finish them.
     pub draw_ms_mean: f64,
     pub draw_ms_worst: f64,
@@ -159,6 +164,7 @@ pub struct FrameRow {
     pub frame_ms: f64,
     pub decode_ms: f64,
     pub upload_ms: f64,
+    pub rebuild_ms: f64,
     pub draw_ms: f64,
     pub readback_ms: f64,
     pub codestreams_read: u64,
@@ -198,6 +204,7 @@ pub struct CompareReport {
     pub file: String,
     pub set: String,
     pub adapter: String,
+    pub textures: TextureFormats,
     pub blend: String,
     pub reduction: u32,
     /// Samples per pixel drawn with (multisample antialiasing; 1: none).
@@ -262,6 +269,31 @@ impl Resolve {
             ("box", _, _) => ", box resolve".to_string(),
             _ => String::new(),
         }
+    }
+}
+
+/// The formats a player holds the file's textures in (`Rgba32Float` or `Rgba16Float`) and
+/// why (`--texture-precision`, the file's half-float measurement, the adapter).
+#[derive(Clone, Debug, Serialize)]
+pub struct TextureFormats {
+    pub surfaces: String,
+    pub cube_maps: String,
+    pub why: String,
+}
+
+impl TextureFormats {
+    pub fn of(player: &Player) -> TextureFormats {
+        let p = player.texture_precision();
+        TextureFormats {
+            surfaces: format!("{:?}", p.surface),
+            cube_maps: format!("{:?}", p.cube),
+            why: p.why.clone(),
+        }
+    }
+
+    /// "textures Rgba16Float, cube maps Rgba16Float: WHY".
+    pub fn label(&self) -> String {
+        format!("textures {}, cube maps {}: {}", self.surfaces, self.cube_maps, self.why)
     }
 }
 
@@ -461,6 +493,7 @@ pub fn run_frames(
             frame_ms: stats.frame_ms,
             decode_ms: stats.decode_ms,
             upload_ms: stats.upload_ms,
+            rebuild_ms: stats.rebuild_ms,
             draw_ms: stats.draw_ms,
             readback_ms: stats.readback_ms,
             codestreams_read: stats.codestreams_read,
@@ -481,6 +514,7 @@ pub fn run_frames(
     Ok(PathReport {
         file: args.file.display().to_string(),
         adapter: gpu.describe(),
+        textures: TextureFormats::of(player),
         size: [size.0, size.1],
         blend: blend_name(o.blend),
         reduction: o.reduction,
@@ -502,6 +536,9 @@ pub fn run_frames(
         decode_ms_mean: mean(|s| s.decode_ms),
         decode_ms_worst: worst(|s| s.decode_ms),
         upload_ms_mean: mean(|s| s.upload_ms),
+        upload_ms_worst: worst(|s| s.upload_ms),
+        rebuild_ms_mean: mean(|s| s.rebuild_ms),
+        rebuild_ms_worst: worst(|s| s.rebuild_ms),
         upload_bytes_mean: mean(|s| s.upload_bytes as f64),
         draw_ms_mean: mean(|s| s.draw_ms),
         draw_ms_worst: worst(|s| s.draw_ms),
@@ -536,6 +573,7 @@ pub fn print_path_report(r: &PathReport, w: &mut impl std::io::Write) -> std::io
         if r.rebuild == "gpu" { "GPU" } else { "workers" }
     )?;
     writeln!(w, "  adapter: {}", r.adapter)?;
+    writeln!(w, "  {}", r.textures.label())?;
     writeln!(w, "  frames: {}", r.frames)?;
     writeln!(
         w,
@@ -544,12 +582,20 @@ pub fn print_path_report(r: &PathReport, w: &mut impl std::io::Write) -> std::io
     )?;
     writeln!(
         w,
-        "  decode ms: mean {:.2}, worst {:.2}; upload ms: mean {:.2} ({:.0} KiB per frame)",
+        "  decode ms: mean {:.2}, worst {:.2}; upload ms: mean {:.2}, worst {:.2} ({:.0} KiB per frame)",
         r.decode_ms_mean,
         r.decode_ms_worst,
         r.upload_ms_mean,
+        r.upload_ms_worst,
         r.upload_bytes_mean / 1024.0
     )?;
+    if r.rebuild == "gpu" {
+        writeln!(
+            w,
+            "  GPU rebuild ms (compute passes, submitted and finished): mean {:.2}, worst {:.2}",
+            r.rebuild_ms_mean, r.rebuild_ms_worst
+        )?;
+    }
     write!(
         w,
         "  draw ms (recorded, submitted, finished on the GPU): mean {:.2}, worst {:.2}",
@@ -612,6 +658,7 @@ pub fn run_compare(
         file: args.file.display().to_string(),
         set: set.display().to_string(),
         adapter: gpu.describe(),
+        textures: TextureFormats::of(player),
         blend: blend_name(o.blend),
         reduction: o.reduction,
         msaa_samples: player.multisample().samples,
@@ -657,6 +704,7 @@ pub fn print_compare_report(r: &CompareReport, w: &mut impl std::io::Write) -> s
         r.resolve.label()
     )?;
     writeln!(w, "  adapter: {}", r.adapter)?;
+    writeln!(w, "  {}", r.textures.label())?;
     writeln!(
         w,
         "  PSNR (display values): whole image {:.2} dB, objects' covered pixels {:.2} dB",

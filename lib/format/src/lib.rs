@@ -25,6 +25,7 @@ pub mod model;
 mod object_setting;
 mod payload_read;
 mod payload_write;
+pub mod precision;
 mod read;
 pub mod reconstruct;
 pub mod relight;

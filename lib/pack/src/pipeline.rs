@@ -287,6 +287,14 @@ pub fn pack_request(req: &PackRequest, progress: &dyn Progress) -> Result<PackRe
     if let Some(p) = packed.container.provenance.as_mut() {
         p.settings.push((PREDICTED_PSNR_SETTING.to_string(), format!("{:.4}", quality.overall)));
     }
+    // So does what half floats would cost: a player holds 16-bit textures where it is far
+    // below the coding error (SPEC.md 6.6).
+    let half_float_psnr = predict::half_float_psnr(&set, &inferred, &packed)
+        .map_err(|e| Failure::new(Exit::Runtime, e))?;
+    stages.done("half floats", &report::half_float_note(half_float_psnr, quality.overall));
+    if let (Some(p), Some(h)) = (packed.container.provenance.as_mut(), half_float_psnr) {
+        p.settings.push((HALF_FLOAT_PSNR_SETTING.to_string(), format!("{h:.4}")));
+    }
     let masters = if req.keep_master {
         let m = encode::masters(&inferred, &packed).map_err(|e| Failure::new(Exit::Runtime, e))?;
         let n: u64 = m.iter().map(pis_format::Master::payload_len).sum();
@@ -320,6 +328,7 @@ pub fn pack_request(req: &PackRequest, progress: &dyn Progress) -> Result<PackRe
     };
     let mut report = report::build(&set, &inferred, &packed, &quality, bytes, exact, req, stages);
     report.probe_renderings = probe_renderings;
+    report.half_float_psnr_db = half_float_psnr;
     if let Some((master_bytes, exact)) = master {
         report.set_master(master_bytes, exact);
     }

@@ -13,6 +13,10 @@ pub struct Gpu {
     /// sampler filters are exactly those the model's A multiplies; else `Rgba16Float`
     /// (always filterable; texels rounded to half floats, relative error ≤ 2^-11).
     pub texture_format: wgpu::TextureFormat,
+    /// Format of shells' cube maps (read with `textureLoad`, never filtered by the sampler):
+    /// `Rgba32Float`, or `Rgba16Float` for a file whose textures a player holds in half
+    /// floats ([`Gpu::with_half_textures`]).
+    pub cube_format: wgpu::TextureFormat,
     /// The adapter the device was opened on (its texture format features).
     adapter: wgpu::Adapter,
 }
@@ -151,7 +155,38 @@ impl Gpu {
             ..Default::default()
         }))
         .map_err(|e| PlayError::Device { adapter: info.name.clone(), message: e.to_string() })?;
-        Ok((Gpu { device, queue, info, limits, texture_format, adapter: adapter.clone() }, adapter))
+        let cube_format = wgpu::TextureFormat::Rgba32Float;
+        let gpu = Gpu {
+            device,
+            queue,
+            info,
+            limits,
+            texture_format,
+            cube_format,
+            adapter: adapter.clone(),
+        };
+        Ok((gpu, adapter))
+    }
+
+    /// The same device with surface textures and cube maps in `Rgba16Float`: half the
+    /// memory and upload of 32-bit floats, texels rounded to half floats (relative error
+    /// ≤ 2^-11), for a file whose frames that leaves within its coding error.
+    pub fn with_half_textures(&self) -> Gpu {
+        Gpu {
+            device: self.device.clone(),
+            queue: self.queue.clone(),
+            info: self.info.clone(),
+            limits: self.limits.clone(),
+            texture_format: wgpu::TextureFormat::Rgba16Float,
+            cube_format: wgpu::TextureFormat::Rgba16Float,
+            adapter: self.adapter.clone(),
+        }
+    }
+
+    /// Whether surface textures and cube maps are both `Rgba16Float`.
+    pub fn half_textures(&self) -> bool {
+        self.texture_format == wgpu::TextureFormat::Rgba16Float
+            && self.cube_format == wgpu::TextureFormat::Rgba16Float
     }
 
     /// What the device can do with `format`: the adapter's features where the device was

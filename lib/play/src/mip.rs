@@ -139,32 +139,27 @@ impl MipBuilder {
                 levels: layout.levels,
             });
         }
-        let half = texture.texture.format() == wgpu::TextureFormat::Rgba16Float;
-        let halves: Vec<u16>;
-        let bytes: &[u8] = if half {
-            halves = image.rgba.iter().map(|&v| half::f16::from_f32(v).to_bits()).collect();
-            bytemuck::cast_slice(&halves)
-        } else {
-            bytemuck::cast_slice(&image.rgba)
-        };
-        let texel_bytes = if half { 8 } else { 16 };
-        gpu.queue.write_texture(
-            wgpu::TexelCopyTextureInfo {
-                texture: &texture.texture,
-                mip_level: 0,
-                origin: wgpu::Origin3d::ZERO,
-                aspect: wgpu::TextureAspect::All,
-            },
-            bytes,
-            wgpu::TexelCopyBufferLayout {
-                offset: 0,
-                bytes_per_row: Some(aw * texel_bytes),
-                rows_per_image: Some(ah),
-            },
-            wgpu::Extent3d { width: aw, height: ah, depth_or_array_layers: 1 },
-        );
+        let format = texture.texture.format();
+        let texel_bytes = format.block_copy_size(None).unwrap_or(16);
+        crate::textured::with_texel_bytes(format, &image.rgba, |bytes| {
+            gpu.queue.write_texture(
+                wgpu::TexelCopyTextureInfo {
+                    texture: &texture.texture,
+                    mip_level: 0,
+                    origin: wgpu::Origin3d::ZERO,
+                    aspect: wgpu::TextureAspect::All,
+                },
+                bytes,
+                wgpu::TexelCopyBufferLayout {
+                    offset: 0,
+                    bytes_per_row: Some(aw * texel_bytes),
+                    rows_per_image: Some(ah),
+                },
+                wgpu::Extent3d { width: aw, height: ah, depth_or_array_layers: 1 },
+            )
+        });
         self.decimate(gpu, texture, encoder);
-        Ok(bytes.len() as u64)
+        Ok(u64::from(aw * ah * texel_bytes))
     }
 
     /// Records the decimation of every level of `texture` below the finest into `encoder`.

@@ -22,7 +22,7 @@ use pis_format::texture::LevelLayout;
 
 use crate::gpu::Gpu;
 use crate::mip::{storage_name, MipBuilder};
-use crate::shell::{ShellTexture, CUBE_FORMAT};
+use crate::shell::ShellTexture;
 use crate::textured::{allocated_size, ObjectTexture};
 
 #[repr(C)]
@@ -72,8 +72,8 @@ struct Pass {
     pipeline: wgpu::ComputePipeline,
 }
 
-/// The rebuilding pipelines: surface textures in the GPU's texture format, cube maps in
-/// [`CUBE_FORMAT`].
+/// The rebuilding pipelines: surface textures and cube maps in the GPU's formats
+/// ([`Gpu::texture_format`], [`Gpu::cube_format`]).
 pub struct LevelRebuild {
     surface: Pass,
     cube_level: Pass,
@@ -106,7 +106,7 @@ fn binding(gpu: &Gpu, n: u32) -> wgpu::BindGroupLayoutEntry {
         },
         3 => wgpu::BindingType::StorageTexture {
             access: wgpu::StorageTextureAccess::WriteOnly,
-            format: CUBE_FORMAT,
+            format: gpu.cube_format,
             view_dimension: wgpu::TextureViewDimension::D2Array,
         },
         _ => wgpu::BindingType::Texture {
@@ -255,7 +255,7 @@ impl LevelRebuild {
     pub fn new(gpu: &Gpu) -> LevelRebuild {
         let source = include_str!("rebuild.wgsl")
             .replace("SURFACE_FORMAT", storage_name(gpu.texture_format))
-            .replace("CUBE_FORMAT", storage_name(CUBE_FORMAT));
+            .replace("CUBE_FORMAT", storage_name(gpu.cube_format));
         let module = gpu.device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("rebuild.wgsl"),
             source: wgpu::ShaderSource::Wgsl(source.into()),
@@ -266,7 +266,7 @@ impl LevelRebuild {
             mip_level_count: 1,
             sample_count: 1,
             dimension: wgpu::TextureDimension::D2,
-            format: CUBE_FORMAT,
+            format: gpu.cube_format,
             usage: wgpu::TextureUsages::TEXTURE_BINDING,
             view_formats: &[],
         });
@@ -403,7 +403,7 @@ fn scratch_chain(gpu: &Gpu, n: u32, levels: u32) -> wgpu::Texture {
         mip_level_count: levels,
         sample_count: 1,
         dimension: wgpu::TextureDimension::D2,
-        format: CUBE_FORMAT,
+        format: gpu.cube_format,
         usage: wgpu::TextureUsages::TEXTURE_BINDING
             | wgpu::TextureUsages::STORAGE_BINDING
             | wgpu::TextureUsages::COPY_DST,

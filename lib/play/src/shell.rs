@@ -16,7 +16,7 @@ use wgpu::util::DeviceExt;
 use crate::error::PlayError;
 use crate::gpu::Gpu;
 use crate::image::FloatImage;
-use crate::textured::{DEPTH_FORMAT, TARGET_FORMAT};
+use crate::textured::{with_texel_bytes, DEPTH_FORMAT, TARGET_FORMAT};
 
 /// The shell functions every shell pipeline appends its entry points to: the isotropic LOD
 /// (`texture_lod.wgsl`, shared with the textured pipeline and the frame), then `shell.wgsl`.
@@ -24,9 +24,6 @@ pub const SHELL_FUNCTIONS: &str =
     concat!(include_str!("texture_lod.wgsl"), include_str!("shell.wgsl"));
 /// The one-shell object pipeline's entry points.
 pub const SHELL_OBJECT: &str = include_str!("shell_object.wgsl");
-
-/// Texel format of cube maps: read with `textureLoad`, so no filtering support is needed.
-pub const CUBE_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
 
 /// A cube map on the GPU.
 pub struct ShellTexture {
@@ -60,7 +57,7 @@ impl ShellTexture {
             mip_level_count: layout.levels,
             sample_count: 1,
             dimension: wgpu::TextureDimension::D2,
-            format: CUBE_FORMAT,
+            format: gpu.cube_format,
             // Storage and copies: the GPU's rebuild writes it (rebuild.rs).
             usage: wgpu::TextureUsages::TEXTURE_BINDING
                 | wgpu::TextureUsages::COPY_DST
@@ -88,26 +85,29 @@ impl ShellTexture {
                 levels: l.levels,
             });
         }
+        let texel_bytes = self.texture.format().block_copy_size(None).unwrap_or(16);
         for face in 0..6 {
             for m in 0..l.levels {
                 let (w, h) = l.level_size(m);
                 let start = l.face_texel(face, m, 0, 0) * 4;
                 let data = &rgba[start..start + (w * h * 4) as usize];
-                gpu.queue.write_texture(
-                    wgpu::TexelCopyTextureInfo {
-                        texture: &self.texture,
-                        mip_level: m,
-                        origin: wgpu::Origin3d { x: 0, y: 0, z: face },
-                        aspect: wgpu::TextureAspect::All,
-                    },
-                    bytemuck::cast_slice(data),
-                    wgpu::TexelCopyBufferLayout {
-                        offset: 0,
-                        bytes_per_row: Some(w * 16),
-                        rows_per_image: Some(h),
-                    },
-                    wgpu::Extent3d { width: w, height: h, depth_or_array_layers: 1 },
-                );
+                with_texel_bytes(self.texture.format(), data, |bytes| {
+                    gpu.queue.write_texture(
+                        wgpu::TexelCopyTextureInfo {
+                            texture: &self.texture,
+                            mip_level: m,
+                            origin: wgpu::Origin3d { x: 0, y: 0, z: face },
+                            aspect: wgpu::TextureAspect::All,
+                        },
+                        bytes,
+                        wgpu::TexelCopyBufferLayout {
+                            offset: 0,
+                            bytes_per_row: Some(w * texel_bytes),
+                            rows_per_image: Some(h),
+                        },
+                        wgpu::Extent3d { width: w, height: h, depth_or_array_layers: 1 },
+                    )
+                });
             }
         }
         Ok(())

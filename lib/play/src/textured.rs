@@ -134,33 +134,45 @@ impl ObjectTexture {
 
     /// Uploads every level: `rgba` holds 4 values per texel of the layout (its x order).
     pub fn upload(&self, gpu: &Gpu, rgba: &[f32]) -> Result<(), PlayError> {
-        let half = self.texture.format() == wgpu::TextureFormat::Rgba16Float;
+        let format = self.texture.format();
+        let texel_bytes = format.block_copy_size(None).unwrap_or(16);
         for (m, (w, h, img)) in gpu_levels(&self.layout, rgba)?.into_iter().enumerate() {
-            let halves: Vec<u16>;
-            let bytes: &[u8] = if half {
-                halves = img.iter().map(|&v| half::f16::from_f32(v).to_bits()).collect();
-                bytemuck::cast_slice(&halves)
-            } else {
-                bytemuck::cast_slice(&img)
-            };
-            let texel_bytes = if half { 8 } else { 16 };
-            gpu.queue.write_texture(
-                wgpu::TexelCopyTextureInfo {
-                    texture: &self.texture,
-                    mip_level: m as u32,
-                    origin: wgpu::Origin3d::ZERO,
-                    aspect: wgpu::TextureAspect::All,
-                },
-                bytes,
-                wgpu::TexelCopyBufferLayout {
-                    offset: 0,
-                    bytes_per_row: Some(w * texel_bytes),
-                    rows_per_image: Some(h),
-                },
-                wgpu::Extent3d { width: w, height: h, depth_or_array_layers: 1 },
-            );
+            with_texel_bytes(format, &img, |bytes| {
+                gpu.queue.write_texture(
+                    wgpu::TexelCopyTextureInfo {
+                        texture: &self.texture,
+                        mip_level: m as u32,
+                        origin: wgpu::Origin3d::ZERO,
+                        aspect: wgpu::TextureAspect::All,
+                    },
+                    bytes,
+                    wgpu::TexelCopyBufferLayout {
+                        offset: 0,
+                        bytes_per_row: Some(w * texel_bytes),
+                        rows_per_image: Some(h),
+                    },
+                    wgpu::Extent3d { width: w, height: h, depth_or_array_layers: 1 },
+                )
+            });
         }
         Ok(())
+    }
+}
+
+/// Calls `f` with RGBA values as the bytes of a texture of `format`: `Rgba32Float` as they
+/// are, `Rgba16Float` rounded to the nearest half floats.
+pub(crate) fn with_texel_bytes<R>(
+    format: wgpu::TextureFormat,
+    rgba: &[f32],
+    f: impl FnOnce(&[u8]) -> R,
+) -> R {
+    use half::slice::{HalfBitsSliceExt, HalfFloatSliceExt};
+    if format == wgpu::TextureFormat::Rgba16Float {
+        let mut bits = vec![0u16; rgba.len()];
+        bits.reinterpret_cast_mut::<half::f16>().convert_from_f32_slice(rgba);
+        f(bytemuck::cast_slice(&bits))
+    } else {
+        f(bytemuck::cast_slice(rgba))
     }
 }
 

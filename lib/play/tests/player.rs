@@ -670,3 +670,43 @@ fn branch_cuts_play_as_cut_mesh_coordinates() {
         );
     }
 }
+
+/// Half floats (SPEC.md 6.6, `--texture-precision`): tiny.pis's diffuse texture and shell
+/// held in `Rgba16Float` draw every sample within half floats' rounding of the frames drawn
+/// from `Rgba32Float` textures, rebuilt on the GPU and on the workers, and the workers
+/// upload half the bytes. A texel below 1 rounds to half floats within 2^-12, and a pixel
+/// is a weighted mean of texels, so its error is at most 2^-12: 72.2 dB (uniform rounding
+/// errors average 77 dB); frames that are equal would mean no half float was drawn.
+#[test]
+fn half_float_textures_draw_within_their_rounding_of_full_ones() {
+    use pis_play::TexturePrecision;
+    let test = "half_float_textures_draw_within_their_rounding_of_full_ones";
+    let Some(gpu) = gpu_or_skip(test) else {
+        return;
+    };
+    let gpu = Arc::new(gpu);
+    for rebuild in [Rebuild::Gpu, Rebuild::Workers] {
+        let open = |precision| {
+            let options =
+                PlayerOptions { workers: 2, msaa: 1, rebuild, precision, ..Default::default() };
+            Player::open(gpu.clone(), &tiny(), options).unwrap()
+        };
+        let (mut full, mut half) = (open(TexturePrecision::Full), open(TexturePrecision::Half));
+        assert!(half.texture_precision().half() && !full.texture_precision().half());
+        let size = full.image_size();
+        for samples in [[0, 0], [1, 0], [1, 1]] {
+            let (a, sa) = full.render_image(&at(&full, &samples), size).unwrap();
+            let (b, sb) = half.render_image(&at(&half, &samples), size).unwrap();
+            let db = psnr(&a.rgba, &b.rgba);
+            eprintln!(
+                "{rebuild:?} {samples:?}: half against full {db:.1} dB, uploads {} / {} bytes",
+                sb.upload_bytes, sa.upload_bytes
+            );
+            let bound = 20.0 * 4096f64.log10();
+            assert!(db >= bound && db.is_finite(), "{rebuild:?} at {samples:?}: {db:.1} dB");
+            if rebuild == Rebuild::Workers {
+                assert_eq!(sb.upload_bytes * 2, sa.upload_bytes, "{rebuild:?} at {samples:?}");
+            }
+        }
+    }
+}

@@ -81,29 +81,100 @@ pub fn display_error(
     m: &ObjectModel,
     chains: &(impl Chains + ?Sized),
 ) -> Result<(f64, usize)> {
-    let d = |v: f32| crate::images::srgb_encode(v.clamp(0.0, 1.0)) as f64;
     let (mut sse, mut n) = (0.0f64, 0usize);
-    // The chain each layer read last: consecutive points share the samples of a layer that
-    // does not depend on the fastest dimension.
-    let mut last: Vec<Option<LastChain>> = m.layers.iter().map(|_| None).collect();
+    let mut cursor = Cursor::new(m);
     for (p, s) in set.samples.iter().enumerate() {
         let v = m.views.get(p)?;
-        let keys: Vec<Vec<u32>> = m.layers.iter().map(|il| key(s, il.depends_on)).collect();
-        for (li, k) in keys.iter().enumerate() {
-            if last[li].as_ref().is_none_or(|(held, _)| held != k) {
-                last[li] = Some((k.clone(), chains.chain(li, k)?));
-            }
-        }
-        let at: Vec<Option<&[f32]>> =
-            last.iter().map(|l| l.as_ref().and_then(|(_, c)| c.as_deref())).collect();
-        let img = m.render_view(&v, p, &keys, &at);
+        let keys = cursor.advance(chains, s)?;
+        let img = m.render_view(&v, p, &keys, &cursor.at());
         for (k, g) in img.iter().enumerate() {
-            let gold = v.diffuse[k] + v.specular[k];
-            sse += (d(*g) - d(gold)).powi(2);
+            sse += (display(*g) - display(v.diffuse[k] + v.specular[k])).powi(2);
         }
         n += img.len();
     }
     Ok((sse, n))
+}
+
+/// A linear value as the display shows it (clamped, sRGB-encoded).
+fn display(v: f32) -> f64 {
+    crate::images::srgb_encode(v.clamp(0.0, 1.0)) as f64
+}
+
+/// The squared display difference between object `m` drawn with `chains` and drawn with
+/// them rounded to half floats (as a player holding 16-bit textures draws it), at every
+/// point, and the number of values it sums; `None` where a texel lies beyond the half-float
+/// range.
+pub fn half_float_error(
+    set: &LoadedSet,
+    m: &ObjectModel,
+    chains: &(impl Chains + ?Sized),
+) -> Result<Option<(f64, usize)>> {
+    let (mut sse, mut n) = (0.0f64, 0usize);
+    let mut cursor = Cursor::new(m);
+    let mut halves: Vec<Option<Vec<f32>>> = m.layers.iter().map(|_| None).collect();
+    for (p, s) in set.samples.iter().enumerate() {
+        let v = m.views.get(p)?;
+        let keys = cursor.advance(chains, s)?;
+        let at = cursor.at();
+        for (li, &changed) in cursor.changed.iter().enumerate() {
+            if let (true, Some(x)) = (changed, at[li]) {
+                let Some(h) = round_to_half(x) else { return Ok(None) };
+                halves[li] = Some(h);
+            } else if changed {
+                halves[li] = None;
+            }
+        }
+        let half_at: Vec<Option<&[f32]>> = halves.iter().map(|h| h.as_deref()).collect();
+        let full = m.render_view(&v, p, &keys, &at);
+        let half = m.render_view(&v, p, &keys, &half_at);
+        sse +=
+            full.iter().zip(&half).map(|(a, b)| (display(*a) - display(*b)).powi(2)).sum::<f64>();
+        n += full.len();
+    }
+    Ok(Some((sse, n)))
+}
+
+/// `x` rounded to the nearest half floats; `None` where a value lies beyond their range
+/// (±65504, a NaN).
+fn round_to_half(x: &[f32]) -> Option<Vec<f32>> {
+    x.iter().map(|&v| Some(half::f16::from_f32(v).to_f32()).filter(|h| h.is_finite())).collect()
+}
+
+/// The chain each layer of an object read last, kept while consecutive points share the
+/// samples of a layer that does not depend on the fastest dimension.
+struct Cursor<'m, 'c> {
+    m: &'m ObjectModel,
+    last: Vec<Option<LastChain<'c>>>,
+    /// Per layer, whether the last [`Cursor::advance`] read its chain.
+    changed: Vec<bool>,
+}
+
+impl<'m, 'c> Cursor<'m, 'c> {
+    fn new(m: &'m ObjectModel) -> Self {
+        Cursor {
+            m,
+            last: m.layers.iter().map(|_| None).collect(),
+            changed: vec![false; m.layers.len()],
+        }
+    }
+
+    /// Moves to the parameter sample `s`: reads the chains of the layers whose key changed
+    /// and returns every layer's key.
+    fn advance<C: Chains + ?Sized>(&mut self, chains: &'c C, s: &[u32]) -> Result<Vec<Vec<u32>>> {
+        let keys: Vec<Vec<u32>> = self.m.layers.iter().map(|il| key(s, il.depends_on)).collect();
+        for (li, k) in keys.iter().enumerate() {
+            self.changed[li] = self.last[li].as_ref().is_none_or(|(held, _)| held != k);
+            if self.changed[li] {
+                self.last[li] = Some((k.clone(), chains.chain(li, k)?));
+            }
+        }
+        Ok(keys)
+    }
+
+    /// Every layer's chain at the current sample (none where the layer has no sample).
+    fn at(&self) -> Vec<Option<&[f32]>> {
+        self.last.iter().map(|l| l.as_ref().and_then(|(_, c)| c.as_deref())).collect()
+    }
 }
 
 /// The solved error of `m` ([`Packed::solved_error`]): from chains held for the object, or,
@@ -224,4 +295,40 @@ pub fn predicted_psnr(set: &LoadedSet, models: &[ObjectModel], packed: &Packed) 
         overall_solved: total_psnr(e_sol),
         max_texel_error: max_err,
     })
+}
+
+/// The PSNR of frames drawn from the decoded textures rounded to half floats against frames
+/// drawn from them in full, over every object and point (SPEC.md 6.6 `half_float_psnr_db`);
+/// `None` where a texel lies beyond the half-float range.
+pub fn half_float_psnr(
+    set: &LoadedSet,
+    models: &[ObjectModel],
+    packed: &Packed,
+) -> Result<Option<f64>> {
+    let mut errors = Vec::with_capacity(models.len());
+    for (mi, m) in models.iter().enumerate() {
+        let mut decoded: Vec<Textures> =
+            m.layers.iter().map(|_| Textures::new(set.scratch.as_ref())).collect();
+        for_each_decoded(mi, m, packed, |li, k, y| decoded[li].insert(k, y))?;
+        match half_float_error(set, m, decoded.as_slice())? {
+            Some(e) => errors.push(e),
+            None => return Ok(None),
+        }
+    }
+    Ok(Some(total_psnr(&errors)))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn half_floats_round_within_their_range_and_refuse_beyond_it() {
+        let h = round_to_half(&[0.0, 1.0, 0.1, -3.0e-6, 65504.0]).unwrap();
+        assert_eq!(&h[..2], &[0.0, 1.0]);
+        assert!((h[2] - 0.1).abs() <= 0.1 * 2f32.powi(-11) && h[2] != 0.1);
+        assert!(h[3] < 0.0 && h[4] == 65504.0);
+        assert_eq!(round_to_half(&[0.5, 70000.0]), None);
+        assert_eq!(round_to_half(&[f32::NAN]), None);
+    }
 }

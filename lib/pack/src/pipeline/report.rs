@@ -123,6 +123,10 @@ pub struct PackReport {
     pub psnr_db_solved: f64,
     /// Largest |decoded − solved| over the finest texels (linear).
     pub max_texel_error: f32,
+    /// Frames drawn from the decoded textures rounded to half floats against frames drawn
+    /// from them in full (dB; SPEC.md 6.6 `half_float_psnr_db`); none where a texel lies
+    /// beyond the half-float range.
+    pub half_float_psnr_db: Option<f64>,
     /// Lossless codec: every level image read back from the file decodes bit-exactly to
     /// what was encoded, and the decoded finest texels equal the solved ones bit for bit.
     pub lossless_exact: Option<bool>,
@@ -292,6 +296,7 @@ pub fn build(
         psnr_db: q.overall,
         psnr_db_solved: q.overall_solved,
         max_texel_error: q.max_texel_error,
+        half_float_psnr_db: None,
         lossless_exact: exact,
         fragments: None,
         max_mse_ratio: packed.container.provenance.as_ref().and_then(|p| p.setting("max_mse_ratio")).map(str::to_string),
@@ -363,6 +368,7 @@ pub fn print_report(r: &PackReport, out: &mut impl std::io::Write) -> std::io::R
         "  predicted PSNR {:.2} dB (textures as solved {:.2} dB)",
         r.psnr_db, r.psnr_db_solved
     )?;
+    writeln!(out, "  16-bit textures: {}", half_float_note(r.half_float_psnr_db, r.psnr_db))?;
     if let Some(p) = &r.played {
         let within = r.target_within_db.unwrap_or_default();
         let how = if p.reached {
@@ -443,4 +449,14 @@ fn denser_line(r: &PackReport) -> Option<String> {
     (!raised.is_empty()).then(|| {
         format!("  texels per pixel {k} ({}, chosen by held-out views)", raised.join(", "))
     })
+}
+
+/// What half floats cost a file of predicted PSNR `coding_db`, and what a player makes of it.
+pub fn half_float_note(half_db: Option<f64>, coding_db: f64) -> String {
+    use pis_format::precision::HALF_FLOAT_MARGIN_DB;
+    match half_db {
+        None => "a texel lies beyond the half-float range: players keep 32-bit floats".into(),
+        Some(h) if h - coding_db >= HALF_FLOAT_MARGIN_DB => format!("frames {h:.2} dB from full precision, {:.1} dB below the coding error: players hold the textures in half floats", h - coding_db),
+        Some(h) => format!("frames {h:.2} dB from full precision, {:.1} dB below the coding error ({HALF_FLOAT_MARGIN_DB} needed): players keep 32-bit floats", h - coding_db),
+    }
 }

@@ -11,12 +11,12 @@ use crate::memory::{blocks, size, BlockBytes};
 
 /// The bytes of the largest single upload of a block's texture: its finest level (a surface
 /// texture at its allocated power-of-two size in the device's texture format; one face of a
-/// shell's cube map, `Rgba32Float`).
+/// shell's cube map in the device's cube-map format).
 fn upload_bytes(gpu: &Gpu, b: &BlockBytes) -> u64 {
     let (w, h) = (b.width.next_power_of_two() as u64, b.height.next_power_of_two() as u64);
     let texel = match b.mapping {
         Mapping::Surface => gpu.texture_format.block_copy_size(None).unwrap_or(16) as u64,
-        Mapping::Shell => 16,
+        Mapping::Shell => gpu.cube_format.block_copy_size(None).unwrap_or(16) as u64,
     };
     w * h * texel
 }

@@ -25,6 +25,7 @@ mod lens;
 mod objects;
 mod options;
 mod plan;
+mod precision;
 mod prefetch;
 mod readout;
 mod relight;
@@ -44,6 +45,7 @@ use self::lens::{lens_corners, lens_draws, LensSet};
 use self::objects::{check_texture_sizes, object_filters, prepare_objects, LensState, ObjectGpu};
 pub use self::options::{FrameRequest, FrameStats, PlayerOptions, Rebuild};
 use self::plan::{camera_record, Plan, TextureKey};
+pub use self::precision::{PrecisionChoice, TexturePrecision};
 use self::readout::{read_back, wait_for_gpu, Readbacks, Readout, Target};
 pub use self::relight::Relight;
 use self::relit::RelitTextures;
@@ -89,6 +91,8 @@ pub struct Player {
     /// The frames the caller expects next ([`Player::prefetch`]), decoded ahead once the
     /// next frame's textures are resident.
     ahead: Vec<FrameRequest>,
+    /// The formats the file's textures are held in, and why.
+    precision: PrecisionChoice,
 }
 
 impl Player {
@@ -103,6 +107,12 @@ impl Player {
         }
         check_samples(options.msaa).map_err(PlayError::Request)?;
         let reader = Arc::new(PisReader::open(path)?);
+        let precision =
+            precision::choose(&gpu, reader.container().provenance.as_ref(), options.precision);
+        let gpu = match precision.half() && !gpu.half_textures() {
+            true => Arc::new(gpu.with_half_textures()),
+            false => gpu,
+        };
         check_texture_sizes(&gpu, &reader)?;
         budget::check_frame_memory(&gpu, reader.container(), &options)?;
         let objects = prepare_objects(&gpu, &reader)?;
@@ -156,6 +166,7 @@ impl Player {
             samplers: HashMap::new(),
             relight,
             ahead: Vec::new(),
+            precision,
         })
     }
 
@@ -212,6 +223,12 @@ impl Player {
     /// [`Rebuild::Auto`] resolved for the adapter).
     pub fn rebuild(&self) -> Rebuild {
         self.textures.rebuild_on()
+    }
+
+    /// The formats this player holds the file's textures in, and why (the options' choice,
+    /// [`TexturePrecision::Auto`] resolved by the file's measurement).
+    pub fn texture_precision(&self) -> &PrecisionChoice {
+        &self.precision
     }
 
     /// The open file (its container and read counters).

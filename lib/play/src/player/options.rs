@@ -35,6 +35,9 @@ pub struct PlayerOptions {
     /// Where textures are rebuilt from their decoded level images (default: on the GPU
     /// where the adapter is one, on the workers where it is a CPU rasterizer).
     pub rebuild: Rebuild,
+    /// The precision textures are held in (default: half floats where the file records
+    /// that they leave its frames within its coding error).
+    pub precision: super::precision::TexturePrecision,
 }
 
 /// Where textures are rebuilt from their decoded level images (SPEC.md 8.4: the level
@@ -91,6 +94,7 @@ impl Default for PlayerOptions {
             display_filter: None,
             tau_px: TessellationSettings::default().tau_px,
             rebuild: Rebuild::Auto,
+            precision: super::precision::TexturePrecision::Auto,
         }
     }
 }
@@ -116,9 +120,12 @@ pub struct FrameStats {
     pub readback_ms: f64,
     /// Waiting for the workers: level images decoded and textures rebuilt.
     pub decode_ms: f64,
-    /// Texture uploads (RGBA textures rebuilt on the workers, level images for the GPU
-    /// rebuild), the GPU rebuilds and MIP chains: recorded, submitted and waited for.
+    /// Texture uploads (RGBA textures rebuilt on the workers with their MIP chains, level
+    /// images for the GPU rebuild): recorded, submitted and waited for.
     pub upload_ms: f64,
+    /// The GPU's rebuilds of textures from their level images (compute passes and MIP
+    /// chains): recorded, submitted and waited for; 0 where the workers rebuild them.
+    pub rebuild_ms: f64,
     pub upload_bytes: u64,
     /// Level-image cache lookups of this frame.
     pub cache_hits: u64,

@@ -305,9 +305,10 @@ impl Textures {
     }
 
     /// Uploads the textures rebuilt on the workers (surface textures with their GPU MIP
-    /// chains, cube maps with their stored levels) and records the GPU's rebuilds of the
-    /// `rebuilt` surface textures and cube maps from their level images (in `have`); waits
-    /// for the GPU and keeps them as drawn this frame.
+    /// chains, cube maps with their stored levels) and the level images the GPU's rebuilds
+    /// of the `rebuilt` surface textures and cube maps read (from `have`), waits for the GPU,
+    /// then records those rebuilds and waits again (the frame's upload and rebuild times
+    /// apart); keeps the textures as drawn this frame.
     fn upload(
         &mut self,
         gpu: &Gpu,
@@ -325,8 +326,7 @@ impl Textures {
             .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("uploads") });
         let mut made = Vec::with_capacity(surfaces.len() + shells.len() + rebuilt.len());
         for k in rebuilt.iter().chain(rebuilt_shells) {
-            let texture = self.rebuild_on_gpu(gpu, reader, k, have, &mut encoder, stats)?;
-            made.push(((*k).clone(), Resident { texture, last_frame: frame }));
+            self.upload_levels(gpu, k, have, stats);
         }
         for (k, img) in surfaces.iter().zip(images) {
             let texture = self.mips.texture(gpu, TextureLayout::full(img.width, img.height));
@@ -339,45 +339,62 @@ impl Textures {
         for (k, cube) in shells.iter().zip(cubes) {
             let texture = ShellTexture::new(gpu, cube.layout, &c.objects[k.object as usize].name)?;
             texture.upload(gpu, &cube.rgba)?;
-            stats.upload_bytes += (cube.rgba.len() * 4) as u64;
+            let texel = gpu.cube_format.block_copy_size(None).unwrap_or(16) as usize;
+            stats.upload_bytes += (cube.rgba.len() / 4 * texel) as u64;
             made.push((
                 (*k).clone(),
                 Resident { texture: GpuTexture::Shell(texture), last_frame: frame },
             ));
         }
-        gpu.queue.submit([encoder.finish()]);
-        gpu.device
-            .poll(wgpu::PollType::wait_indefinitely())
-            .map_err(|e| PlayError::Readback(e.to_string()))?;
-        self.resident.extend(made);
+        submit_and_wait(gpu, encoder)?;
         stats.upload_ms += t.elapsed().as_secs_f64() * 1e3;
+        if !rebuilt.is_empty() || !rebuilt_shells.is_empty() {
+            let t = Instant::now();
+            let mut encoder = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                label: Some("rebuilds"),
+            });
+            for k in rebuilt.iter().chain(rebuilt_shells) {
+                let texture = self.rebuild_on_gpu(gpu, reader, k, &mut encoder)?;
+                made.push(((*k).clone(), Resident { texture, last_frame: frame }));
+            }
+            submit_and_wait(gpu, encoder)?;
+            stats.rebuild_ms += t.elapsed().as_secs_f64() * 1e3;
+        }
+        self.resident.extend(made);
         Ok(())
     }
 
+    /// Uploads the level images of texture `k` (from `have`) that are not yet on the GPU,
+    /// each as a compact storage buffer kept while the cache keeps its decoded copy.
+    fn upload_levels(&mut self, gpu: &Gpu, k: &TextureKey, have: &Levels, stats: &mut FrameStats) {
+        for (lv, &img) in k.images.iter().enumerate() {
+            let key = level_key(k, lv, img);
+            if let std::collections::hash_map::Entry::Vacant(e) = self.gpu_levels.entry(key) {
+                let values = &have[&key];
+                stats.upload_bytes += (values.len() * 4) as u64;
+                e.insert(level_buffer(gpu, values));
+            }
+        }
+    }
+
     /// Records the GPU's rebuild of texture `k` (a surface texture or a cube map) from its
-    /// level images, uploading those not yet on the GPU (from `have`).
+    /// level images, on the GPU ([`Textures::upload_levels`]).
     fn rebuild_on_gpu(
         &mut self,
         gpu: &Gpu,
         reader: &PisReader,
         k: &TextureKey,
-        have: &Levels,
         encoder: &mut wgpu::CommandEncoder,
-        stats: &mut FrameStats,
     ) -> Result<GpuTexture, PlayError> {
         let object = &reader.container().objects[k.object as usize];
         let layer = &object.layers[k.layer as usize];
         let l = LevelLayout::of(layer, &layer.blocks[k.block as usize]);
-        let keys: Vec<LevelKey> =
-            k.images.iter().enumerate().map(|(lv, &img)| level_key(k, lv, img)).collect();
-        for key in &keys {
-            if !self.gpu_levels.contains_key(key) {
-                let values = &have[key];
-                stats.upload_bytes += (values.len() * 4) as u64;
-                self.gpu_levels.insert(*key, level_buffer(gpu, values));
-            }
-        }
-        let levels: Vec<&wgpu::Buffer> = keys.iter().map(|key| &self.gpu_levels[key]).collect();
+        let levels: Vec<&wgpu::Buffer> = k
+            .images
+            .iter()
+            .enumerate()
+            .map(|(lv, &img)| &self.gpu_levels[&level_key(k, lv, img)])
+            .collect();
         let stack = LevelStack { levels: &levels, channels: l.channels, gamma: layer.gamma };
         if layer.mapping == Mapping::Shell {
             let texture = ShellTexture::new(gpu, TextureLayout::cube(l.width), &object.name)?;
@@ -420,6 +437,15 @@ fn level_jobs(reader: &PisReader, k: &TextureKey) -> Result<Vec<AheadJob>, PlayE
         jobs.push((key, n - 1 - lv as u32, LevelJob { stream, planes: planes.clone(), at }));
     }
     Ok(jobs)
+}
+
+/// Submits `encoder` and waits for the GPU to finish it.
+fn submit_and_wait(gpu: &Gpu, encoder: wgpu::CommandEncoder) -> Result<(), PlayError> {
+    gpu.queue.submit([encoder.finish()]);
+    gpu.device
+        .poll(wgpu::PollType::wait_indefinitely())
+        .map(|_| ())
+        .map_err(|e| PlayError::Readback(e.to_string()))
 }
 
 /// The cache key of level `lv`'s image `img` of texture `k`.

@@ -10,8 +10,11 @@ pub struct FrameSample {
     pub at_s: f64,
     /// Time the player spent on the frame.
     pub frame_ms: f64,
-    /// Decoding part of it.
+    /// Decoding part of it (waiting for the workers).
     pub decode_ms: f64,
+    /// Uploading textures and level images, and the GPU's rebuilds from level images.
+    pub upload_ms: f64,
+    pub rebuild_ms: f64,
     /// Bytes uploaded to the GPU for the frame.
     pub upload_bytes: u64,
     /// Bytes in the decode cache after the frame.
@@ -26,6 +29,10 @@ pub struct Shown {
     pub fps: f64,
     pub frame_ms: f64,
     pub decode_ms: f64,
+    pub upload_ms: f64,
+    pub rebuild_ms: f64,
+    /// The longest frame of the window (ms).
+    pub worst_ms: f64,
     pub cache_mb: f64,
     pub upload_mb_s: f64,
     /// Frames of the window that waited on decoding, and frames in it.
@@ -66,6 +73,8 @@ impl StatsMeter {
         };
         self.shown.frame_ms = ema(self.shown.frame_ms, s.frame_ms);
         self.shown.decode_ms = ema(self.shown.decode_ms, s.decode_ms);
+        self.shown.upload_ms = ema(self.shown.upload_ms, s.upload_ms);
+        self.shown.rebuild_ms = ema(self.shown.rebuild_ms, s.rebuild_ms);
         self.shown.cache_mb = s.cache_bytes as f64 / 1e6;
         self.frames += 1;
         self.recent.push_back(s);
@@ -75,6 +84,7 @@ impl StatsMeter {
         // n frames presented over the time between the first and the last: n - 1 intervals.
         let (first, n) = (self.recent.front().map_or(s.at_s, |f| f.at_s), self.recent.len());
         self.shown.waited = (self.recent.iter().filter(|f| f.waited).count(), n);
+        self.shown.worst_ms = self.recent.iter().map(|f| f.frame_ms).fold(0.0, f64::max);
         let span = s.at_s - first;
         if n >= 2 && span > 0.0 {
             self.shown.fps = (n - 1) as f64 / span;
@@ -102,6 +112,8 @@ mod tests {
             at_s,
             frame_ms,
             decode_ms: frame_ms / 2.0,
+            upload_ms: frame_ms / 4.0,
+            rebuild_ms: frame_ms / 8.0,
             upload_bytes,
             cache_bytes: 3_000_000,
             waited: false,
@@ -129,6 +141,19 @@ mod tests {
         // The window holds the frames less than a second older than the last (2.0 to
         // 2.9 s; 1.9 is a second and a rounding before it): 2.0 waited.
         assert_eq!(m.shown().waited, (1, 10));
+    }
+
+    #[test]
+    fn the_worst_frame_is_the_windows_longest() {
+        let mut m = StatsMeter::new(1.0, 0.1);
+        m.add(frame(0.0, 80.0, 0));
+        for i in 1..=20 {
+            m.add(frame(i as f64 * 0.1, if i == 15 { 40.0 } else { 10.0 }, 0));
+        }
+        // The 80 ms frame has left the window; the 40 ms one is in it.
+        let s = m.shown();
+        assert_eq!(s.worst_ms, 40.0);
+        assert!((s.upload_ms - s.frame_ms / 4.0).abs() < 1e-9, "{s:?}");
     }
 
     #[test]
