@@ -3,11 +3,11 @@
 # decoded ahead"): FILE.pis played along the diagonal, 48 frames, multilinear, under each
 # rebuild and prefetch setting, three runs each; perf samples the task clock at 1 kHz, so a
 # thread's samples are its CPU milliseconds.
-# Usage: playback-cpu.sh FILE.pis [PIS_PLAY] [PRECISION]  (--texture-precision, default auto)
+# Usage: playback-cpu.sh FILE.pis [PRECISION] [PIS_PLAY]  (--texture-precision, default auto)
 set -euo pipefail
 file=$1
-play=${2:-pis-play}
-precision=${3:-auto}
+precision=${2:-auto}
+play=${3:-pis-play}
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 printf '%-22s %s\n' "rebuild, prefetch" "frame mean/worst ms | decode wait ms | upload ms | GPU rebuild ms | draw ms | upload KiB | frames waited | CPU ms a frame: decoding threads, render thread, lavapipe"
