@@ -579,19 +579,29 @@ fn a_glass_teapot_packed_and_played_by_hybrid_rendering() {
             && text.contains("term refraction"),
         "{text}"
     );
-    // Both terms drawn per frame, from vertex rays traced per frame.
-    let play = run_json(
-        env!("CARGO_BIN_EXE_pis-play"),
-        &[
-            pem.as_os_str(),
-            "--headless".as_ref(),
-            "--path".as_ref(),
-            "diagonal".as_ref(),
-            "--json".as_ref(),
-        ],
-    );
+    // Both terms drawn per frame, from vertex rays traced per frame: by the frame itself
+    // without decoding ahead, else while the frame before drew (all but the first).
+    let path = |prefetch: &str| {
+        run_json(
+            env!("CARGO_BIN_EXE_pis-play"),
+            &[
+                pem.as_os_str(),
+                "--headless".as_ref(),
+                "--path".as_ref(),
+                "diagonal".as_ref(),
+                "--prefetch".as_ref(),
+                prefetch.as_ref(),
+                "--json".as_ref(),
+            ],
+        )
+    };
+    let play = path("0");
     assert_eq!(play["lens_draws_mean"].as_f64(), Some(2.0), "{play}");
     assert!(play["lens_rays_mean"].as_f64().is_some_and(|r| r > 10_000.0), "{play}");
+    assert_eq!(play["lens_traced_ahead"].as_u64(), Some(0), "{play}");
+    let ahead = path("2");
+    let frames = ahead["frames"].as_u64().expect("frames");
+    assert_eq!(ahead["lens_traced_ahead"].as_u64(), Some(frames - 1), "{ahead}");
     // The same frame twice: the second draws the first's tessellation again (no ray traced)
     // and the same pixels.
     let gpu = std::sync::Arc::new(
@@ -616,6 +626,25 @@ fn a_glass_teapot_packed_and_played_by_hybrid_rendering() {
     assert!(
         a.rgba.iter().zip(&b.rgba).all(|(x, y)| x.to_bits() == y.to_bits()),
         "the same frame drawn twice differs"
+    );
+    // The next view expected: its vertex rays traced while this frame draws, and the frame
+    // drawn from that tessellation is the one a player tracing it itself draws.
+    let next = pis_play::FrameRequest { point: vec![16.0], ..req.clone() };
+    player.prefetch(std::slice::from_ref(&next));
+    player.render_image(&req, (160, 120)).expect("draws");
+    let (c, ahead) = player.render_image(&next, (160, 120)).expect("draws the next view");
+    assert!(ahead.lens_traced_ahead == 1 && ahead.lens_rays == 0, "{ahead:?}");
+    let mut fresh = pis_play::Player::open(
+        std::sync::Arc::new(pis_play::Gpu::new().expect("the adapter again")),
+        &pem,
+        pis_play::PlayerOptions { msaa: 1, ..Default::default() },
+    )
+    .expect("opens");
+    let (d, own) = fresh.render_image(&next, (160, 120)).expect("draws");
+    assert!(own.lens_rays > 10_000, "{own:?}");
+    assert!(
+        c.rgba.iter().zip(&d.rgba).all(|(x, y)| x.to_bits() == y.to_bits()),
+        "the frame traced ahead differs from the frame traced on its own"
     );
     // The player against the traced set, single-sample as the prediction is: what pis-pack
     // predicted, within 0.3 dB.

@@ -150,6 +150,10 @@ pub struct PathReport {
     pub lens_rays_mean: f64,
     pub lens_triangles_mean: f64,
     pub lens_draws_mean: f64,
+    /// Lens objects' tessellations found made ahead, and dropped because the prediction
+    /// changed.
+    pub lens_traced_ahead: u64,
+    pub lens_ahead_dropped: u64,
     pub cache_hits: u64,
     pub cache_misses: u64,
     pub cache_bytes_max: u64,
@@ -550,6 +554,8 @@ pub fn run_frames(
         lens_rays_mean: mean(|s| s.lens_rays as f64),
         lens_triangles_mean: mean(|s| s.lens_triangles as f64),
         lens_draws_mean: mean(|s| s.lens_draws as f64),
+        lens_traced_ahead: all.iter().map(|s| s.lens_traced_ahead).sum(),
+        lens_ahead_dropped: player.lens_ahead_dropped(),
         cache_hits: all.iter().map(|s| s.cache_hits).sum(),
         cache_misses: all.iter().map(|s| s.cache_misses).sum(),
         cache_bytes_max: all.iter().map(|s| s.cache_bytes).max().unwrap_or(0),
@@ -607,7 +613,7 @@ pub fn print_path_report(r: &PathReport, w: &mut impl std::io::Write) -> std::io
     writeln!(w)?;
     writeln!(w, "  draws per frame: {:.1} surface layers, {:.1} reflection terms (environment-map shells), {:.1} lens terms", r.surface_draws_mean, r.shell_draws_mean, r.lens_draws_mean)?;
     if r.lens_draws_mean > 0.0 {
-        writeln!(w, "  lens objects (vertex rays, tessellation, vertex buffers): mean {:.2} ms, worst {:.2}; {:.0} rays, {:.0} triangles per frame", r.lens_ms_mean, r.lens_ms_worst, r.lens_rays_mean, r.lens_triangles_mean)?;
+        writeln!(w, "  lens objects (vertex rays, tessellation, vertex buffers): mean {:.2} ms, worst {:.2}; {:.0} rays, {:.0} triangles per frame; {} tessellations found traced ahead, {} dropped", r.lens_ms_mean, r.lens_ms_worst, r.lens_rays_mean, r.lens_triangles_mean, r.lens_traced_ahead, r.lens_ahead_dropped)?;
     }
     writeln!(
         w,

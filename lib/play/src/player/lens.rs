@@ -8,10 +8,11 @@ use std::time::Instant;
 
 use rayon::prelude::*;
 
-use pis_compile::hybrid::{tessellate, HybridView, Term, TessellationSettings};
+use pis_compile::hybrid::{tessellate, HybridView, Term};
 use pis_compile::shell::Shell;
 use pis_format::PisReader;
 
+use super::lens_ahead::{LensAhead, LensRequest};
 use super::objects::{content, LensState, TessellationKey};
 use super::plan::Plan;
 use super::resident::{GpuTexture, Textures};
@@ -26,6 +27,42 @@ pub(super) struct LensWork {
     pub(super) ms: f64,
     pub(super) rays: u64,
     pub(super) triangles: u64,
+    /// Tessellations found made ahead ([`LensAhead`]).
+    pub(super) traced_ahead: u64,
+}
+
+/// What lens object `draw`'s tessellation in the frame of `plan` depends on.
+pub(super) fn tessellation_key(
+    plan: &Plan,
+    draw: usize,
+    size: (u32, u32),
+    tau_px: f32,
+) -> TessellationKey {
+    (plan.worlds[draw], plan.eye, plan.clip_from_world, size, tau_px)
+}
+
+/// The tessellations the frames of `plans` (expected next) need that `states` (the lens
+/// objects by draw index) have not made: one request per lens object and key, in order.
+pub(super) fn lens_requests<'a>(
+    plans: &[Plan],
+    state_of: impl Fn(usize) -> Option<&'a LensState>,
+    size: (u32, u32),
+    tau_px: f32,
+) -> Vec<LensRequest> {
+    let mut wanted: Vec<LensRequest> = Vec::new();
+    for plan in plans {
+        for r in &plan.lenses {
+            let key = tessellation_key(plan, r.draw, size, tau_px);
+            let Some(state) = state_of(r.draw) else { continue };
+            let made = state.tessellated.as_ref().is_some_and(|(k, _)| *k == key);
+            if made || wanted.iter().any(|w| w.draw == r.draw && w.key == key) {
+                continue;
+            }
+            let (lens, settings) = (state.placed_at(plan.worlds[r.draw]), state.settings(tau_px));
+            wanted.push(LensRequest { draw: r.draw, key, lens, settings });
+        }
+    }
+    wanted
 }
 
 /// One lens object's terms for one shell geometry: the object's draw index, the shells, and
@@ -37,37 +74,43 @@ pub(super) type LensSet = (usize, Vec<Shell>, Vec<(wgpu::Buffer, u32)>);
 /// model's terms' corners once per object and shell geometry (`states`: the objects' lens states).
 pub(super) fn lens_corners(
     gpu: &Gpu,
-    states: &mut [(usize, LensState)],
+    (states, ahead): (&mut [(usize, LensState)], &mut LensAhead),
     plan: &Plan,
     size: (u32, u32),
     tau_px: f32,
 ) -> LensWork {
     let t = Instant::now();
-    let mut work = LensWork { sets: Vec::new(), ms: 0.0, rays: 0, triangles: 0 };
+    let mut work = LensWork { sets: Vec::new(), ms: 0.0, rays: 0, triangles: 0, traced_ahead: 0 };
     for r in &plan.lenses {
         let shells: Vec<Shell> = r.shells.iter().map(|(_, s, _)| s.clone()).collect();
         if work.sets.iter().any(|(d, s, _)| *d == r.draw && *s == shells) {
             continue;
         }
         let Some((_, state)) = states.iter_mut().find(|(d, _)| *d == r.draw) else { continue };
-        let key: TessellationKey =
-            (plan.worlds[r.draw], plan.eye, plan.clip_from_world, size, tau_px);
+        let key = tessellation_key(plan, r.draw, size, tau_px);
         let tess = match &state.tessellated {
             Some((k, t)) if *k == key => t.clone(),
             _ => {
-                let settings = TessellationSettings {
-                    tau_px,
-                    model: state.model,
-                    ..TessellationSettings::default()
+                let t = match ahead.take(r.draw, &key) {
+                    Some(t) => {
+                        work.traced_ahead += 1;
+                        t
+                    }
+                    None => {
+                        let settings = state.settings(tau_px);
+                        let lens = state.at(plan.worlds[r.draw]);
+                        let view = HybridView {
+                            eye: plan.eye,
+                            clip_from_world: plan.clip_from_world,
+                            size,
+                        };
+                        let t = tessellate(lens, &view, &settings);
+                        work.rays += t.stats.rays;
+                        t
+                    }
                 };
-                let lens = state.at(plan.worlds[r.draw]);
-                let t = std::sync::Arc::new(tessellate(
-                    lens,
-                    &HybridView { eye: plan.eye, clip_from_world: plan.clip_from_world, size },
-                    &settings,
-                ));
+                let t = std::sync::Arc::new(t);
                 state.tessellated = Some((key, t.clone()));
-                work.rays += t.stats.rays;
                 t
             }
         };

@@ -22,6 +22,7 @@ mod budget;
 mod depth;
 mod draws;
 mod lens;
+mod lens_ahead;
 mod objects;
 mod options;
 mod plan;
@@ -41,7 +42,8 @@ use pis_compile::Filter;
 use pis_format::PisReader;
 
 use self::draws::{layer_draws, make_samplers, object_draws, reflection_draws, Samplers};
-use self::lens::{lens_corners, lens_draws, LensSet};
+use self::lens::{lens_corners, lens_draws, lens_requests, LensSet};
+use self::lens_ahead::LensAhead;
 use self::objects::{check_texture_sizes, object_filters, prepare_objects, LensState, ObjectGpu};
 pub use self::options::{FrameRequest, FrameStats, PlayerOptions, Rebuild};
 use self::plan::{camera_record, Plan, TextureKey};
@@ -93,6 +95,8 @@ pub struct Player {
     ahead: Vec<FrameRequest>,
     /// The formats the file's textures are held in, and why.
     precision: PrecisionChoice,
+    /// Lens objects' tessellations being made for the frames expected next.
+    lens_ahead: LensAhead,
 }
 
 impl Player {
@@ -167,6 +171,7 @@ impl Player {
             relight,
             ahead: Vec::new(),
             precision,
+            lens_ahead: LensAhead::default(),
         })
     }
 
@@ -400,7 +405,8 @@ impl Player {
     /// draws, the workers decode their level images into the cache (within its budget) and,
     /// where the workers rebuild textures, rebuild them, so those frames need not wait on
     /// decoding; their textures already on the GPU are kept. Work queued for textures no
-    /// longer expected is dropped before it starts.
+    /// longer expected is dropped before it starts. Their lens objects' vertex rays are
+    /// traced and tessellations refined ahead too, on threads of their own.
     pub fn prefetch(&mut self, ahead: &[FrameRequest]) {
         self.ahead = ahead.to_vec();
     }
@@ -408,6 +414,12 @@ impl Player {
     /// Level images dropped from decoding ahead so far because the prediction changed.
     pub fn prefetch_dropped(&self) -> u64 {
         self.textures.prefetch_dropped()
+    }
+
+    /// Lens objects' tessellations dropped from tracing ahead so far because the prediction
+    /// changed.
+    pub fn lens_ahead_dropped(&self) -> u64 {
+        self.lens_ahead.dropped()
     }
 
     /// Starts decoding ahead the textures of the frames [`Player::prefetch`] expects. A
@@ -423,6 +435,9 @@ impl Player {
             .collect();
         let keys: Vec<&TextureKey> = plans.iter().flat_map(|p| p.keys()).collect();
         self.textures.prefetch(&self.gpu, &self.reader, &keys, self.options.reduction);
+        let lens_of = |draw: usize| self.objects.get(draw).and_then(|o| o.lens.as_ref());
+        let wanted = lens_requests(&plans, lens_of, size, self.options.tau_px);
+        self.lens_ahead.start(wanted);
     }
 
     /// Makes the targets of `size` and `samples` current: those of the other sample count
@@ -466,9 +481,11 @@ impl Player {
         }
         let tau_px = self.options.tau_px;
         let gpu_for_lenses = self.gpu.clone();
+        let ahead = &mut self.lens_ahead;
         let (result, lens_work) = std::thread::scope(|scope| {
-            let lens_thread =
-                scope.spawn(|| lens_corners(&gpu_for_lenses, &mut lens_states, plan, size, tau_px));
+            let lens_thread = scope.spawn(|| {
+                lens_corners(&gpu_for_lenses, (&mut lens_states, ahead), plan, size, tau_px)
+            });
             let result = self.textures.make_resident(
                 &self.gpu,
                 &self.reader,
@@ -495,6 +512,7 @@ impl Player {
         stats.lens_ms = lens_work.ms;
         stats.lens_rays = lens_work.rays;
         stats.lens_triangles = lens_work.triangles;
+        stats.lens_traced_ahead = lens_work.traced_ahead;
         Ok(lens_work.sets)
     }
 

@@ -41,7 +41,7 @@ pub(super) struct LensState {
     material: LensMaterial,
     /// The paths traced at its vertices and the terms drawn (SPEC.md 6.6 `lens_model`).
     pub(super) model: pis_compile::hybrid::LensModel,
-    placed: Option<(glam::Mat4, LensObject)>,
+    placed: Option<(glam::Mat4, std::sync::Arc<LensObject>)>,
     /// The last frame's tessellation and what it was made for (transform, eye, view and
     /// projection, frame size, τ): a frame that changes none of them draws it again.
     pub(super) tessellated:
@@ -55,12 +55,32 @@ impl LensState {
     /// The lens object at `world` (rigid), built once per transform.
     pub(super) fn at(&mut self, world: glam::Mat4) -> &LensObject {
         if self.placed.as_ref().is_none_or(|(m, _)| *m != world) {
-            let positions = self.positions.iter().map(|&p| world.transform_point3(p)).collect();
-            let normals = self.normals.iter().map(|&n| world.transform_vector3(n)).collect();
-            self.placed =
-                Some((world, LensObject::new(self.material, positions, normals, &self.indices)));
+            self.placed = Some((world, self.placed_at(world)));
         }
         &self.placed.as_ref().expect("placed above").1
+    }
+
+    /// The lens object at `world`: the one drawn last where the transform is the same, else
+    /// built anew (for a frame expected next, leaving the last one in place).
+    pub(super) fn placed_at(&self, world: glam::Mat4) -> std::sync::Arc<LensObject> {
+        match &self.placed {
+            Some((m, lens)) if *m == world => lens.clone(),
+            _ => {
+                let positions = self.positions.iter().map(|&p| world.transform_point3(p)).collect();
+                let normals = self.normals.iter().map(|&n| world.transform_vector3(n)).collect();
+                let lens = LensObject::new(self.material, positions, normals, &self.indices);
+                std::sync::Arc::new(lens)
+            }
+        }
+    }
+
+    /// The settings its tessellations are made with at `tau_px`.
+    pub(super) fn settings(&self, tau_px: f32) -> pis_compile::hybrid::TessellationSettings {
+        pis_compile::hybrid::TessellationSettings {
+            tau_px,
+            model: self.model,
+            ..Default::default()
+        }
     }
 }
 

@@ -155,6 +155,9 @@ pub struct FrameStats {
     /// triangles drawn.
     pub lens_rays: u64,
     pub lens_triangles: u64,
+    /// Lens objects whose tessellation the frame found made ahead
+    /// ([`crate::Player::prefetch`]): their rays traced while an earlier frame drew.
+    pub lens_traced_ahead: u64,
     /// Draws of lens terms (two per lens object and parameter sample).
     pub lens_draws: u64,
 }

@@ -1,0 +1,75 @@
+//! Lens objects traced ahead (thesis 6.4.1): for the frames the caller expects next
+//! ([`super::Player::prefetch`]), each lens object's vertex rays are traced and its
+//! tessellation refined on a thread of its own while the frame draws, so that a frame whose
+//! transform, eye, projection, size and τ were predicted takes its tessellation ready made
+//! instead of tracing on its critical path. A tessellation made ahead is the one the frame
+//! would make: the same function of the same inputs.
+
+use std::sync::Arc;
+use std::thread::JoinHandle;
+
+use pis_compile::hybrid::{tessellate, HybridView, LensObject, Tessellation, TessellationSettings};
+
+use super::objects::TessellationKey;
+
+/// A tessellation being made for a predicted frame: the lens object's draw index, what it
+/// is made for, and the thread making it.
+struct Job {
+    draw: usize,
+    key: TessellationKey,
+    thread: JoinHandle<Tessellation>,
+}
+
+/// The tessellations being made ahead.
+#[derive(Default)]
+pub(super) struct LensAhead {
+    jobs: Vec<Job>,
+    /// Jobs whose frame was no longer expected: dropped (their threads finish unread).
+    dropped: u64,
+}
+
+/// What a predicted frame's lens object needs traced: its draw index, the tessellation key,
+/// the object at the frame's transform and the tessellation's settings.
+pub(super) struct LensRequest {
+    pub(super) draw: usize,
+    pub(super) key: TessellationKey,
+    pub(super) lens: Arc<LensObject>,
+    pub(super) settings: TessellationSettings,
+}
+
+impl LensAhead {
+    /// Makes ahead the tessellations of `wanted` (in order): those already being made are
+    /// kept, those no longer wanted dropped, the others started on threads of their own.
+    pub(super) fn start(&mut self, wanted: Vec<LensRequest>) {
+        let before = self.jobs.len();
+        self.jobs.retain(|j| wanted.iter().any(|w| w.draw == j.draw && w.key == j.key));
+        self.dropped += (before - self.jobs.len()) as u64;
+        for w in wanted {
+            if self.jobs.iter().any(|j| j.draw == w.draw && j.key == w.key) {
+                continue;
+            }
+            let (eye, clip_from_world, size, _) = (w.key.1, w.key.2, w.key.3, w.key.4);
+            let view = HybridView { eye, clip_from_world, size };
+            let (lens, settings) = (w.lens, w.settings);
+            let thread = std::thread::Builder::new()
+                .name("pis-lens-ahead".into())
+                .spawn(move || tessellate(&lens, &view, &settings));
+            // Without a thread the frame traces its lens objects itself.
+            if let Ok(thread) = thread {
+                self.jobs.push(Job { draw: w.draw, key: w.key, thread });
+            }
+        }
+    }
+
+    /// The tessellation made ahead for lens object `draw` at `key`, waiting for it if it is
+    /// still being made; `None` where none was started (or its thread failed).
+    pub(super) fn take(&mut self, draw: usize, key: &TessellationKey) -> Option<Tessellation> {
+        let i = self.jobs.iter().position(|j| j.draw == draw && j.key == *key)?;
+        self.jobs.swap_remove(i).thread.join().ok()
+    }
+
+    /// Tessellations dropped so far because their frame was no longer expected.
+    pub(super) fn dropped(&self) -> u64 {
+        self.dropped
+    }
+}
