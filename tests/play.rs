@@ -94,15 +94,20 @@ fn compare_agrees_with_the_pack_prediction() {
     }
     let f = fixture();
     // One sample per pixel, as pis-compile's hardware model (the prediction) draws.
-    let r = json(&play(&[
-        os(&f.file),
-        os("--headless"),
-        os("--compare"),
-        os(&f.set),
-        os("--msaa"),
-        os("1"),
-        os("--json"),
-    ]));
+    let compare = |precision: &str| {
+        json(&play(&[
+            os(&f.file),
+            os("--headless"),
+            os("--compare"),
+            os(&f.set),
+            os("--msaa"),
+            os("1"),
+            os("--texture-precision"),
+            os(precision),
+            os("--json"),
+        ]))
+    };
+    let r = compare("auto");
     assert_eq!((r["msaa_samples"].as_u64(), r["msaa_requested"].as_u64()), (Some(1), Some(1)));
     let predicted = f.pack["psnr_db"].as_f64().expect("pack psnr_db");
     let covered = r["covered_psnr_db"].as_f64().expect("covered_psnr_db");
@@ -132,17 +137,7 @@ fn compare_agrees_with_the_pack_prediction() {
     let half = f.pack["half_float_psnr_db"].as_f64().expect("half_float_psnr_db");
     assert!(half >= predicted + 20.0, "half floats {half:.1} dB, coding {predicted:.1} dB");
     assert_eq!(r["textures"]["surfaces"], "Rgba16Float", "{}", r["textures"]);
-    let full = json(&play(&[
-        os(&f.file),
-        os("--headless"),
-        os("--compare"),
-        os(&f.set),
-        os("--msaa"),
-        os("1"),
-        os("--texture-precision"),
-        os("full"),
-        os("--json"),
-    ]));
+    let full = compare("full");
     assert_eq!(full["textures"]["surfaces"], "Rgba32Float", "{}", full["textures"]);
     let full_db = full["covered_psnr_db"].as_f64().expect("covered_psnr_db");
     assert!((covered - full_db).abs() <= 0.043, "half {covered:.3} dB, full {full_db:.3} dB");

@@ -139,27 +139,10 @@ impl MipBuilder {
                 levels: layout.levels,
             });
         }
-        let format = texture.texture.format();
-        let texel_bytes = format.block_copy_size(None).unwrap_or(16);
-        crate::textured::with_texel_bytes(format, &image.rgba, |bytes| {
-            gpu.queue.write_texture(
-                wgpu::TexelCopyTextureInfo {
-                    texture: &texture.texture,
-                    mip_level: 0,
-                    origin: wgpu::Origin3d::ZERO,
-                    aspect: wgpu::TextureAspect::All,
-                },
-                bytes,
-                wgpu::TexelCopyBufferLayout {
-                    offset: 0,
-                    bytes_per_row: Some(aw * texel_bytes),
-                    rows_per_image: Some(ah),
-                },
-                wgpu::Extent3d { width: aw, height: ah, depth_or_array_layers: 1 },
-            )
-        });
+        let bytes =
+            crate::textured::write_level(gpu, &texture.texture, (0, 0), (aw, ah), &image.rgba);
         self.decimate(gpu, texture, encoder);
-        Ok(u64::from(aw * ah * texel_bytes))
+        Ok(bytes)
     }
 
     /// Records the decimation of every level of `texture` below the finest into `encoder`.

@@ -16,7 +16,7 @@ use wgpu::util::DeviceExt;
 use crate::error::PlayError;
 use crate::gpu::Gpu;
 use crate::image::FloatImage;
-use crate::textured::{with_texel_bytes, DEPTH_FORMAT, TARGET_FORMAT};
+use crate::textured::{write_level, DEPTH_FORMAT, TARGET_FORMAT};
 
 /// The shell functions every shell pipeline appends its entry points to: the isotropic LOD
 /// (`texture_lod.wgsl`, shared with the textured pipeline and the frame), then `shell.wgsl`.
@@ -85,29 +85,12 @@ impl ShellTexture {
                 levels: l.levels,
             });
         }
-        let texel_bytes = self.texture.format().block_copy_size(None).unwrap_or(16);
         for face in 0..6 {
             for m in 0..l.levels {
                 let (w, h) = l.level_size(m);
                 let start = l.face_texel(face, m, 0, 0) * 4;
                 let data = &rgba[start..start + (w * h * 4) as usize];
-                with_texel_bytes(self.texture.format(), data, |bytes| {
-                    gpu.queue.write_texture(
-                        wgpu::TexelCopyTextureInfo {
-                            texture: &self.texture,
-                            mip_level: m,
-                            origin: wgpu::Origin3d { x: 0, y: 0, z: face },
-                            aspect: wgpu::TextureAspect::All,
-                        },
-                        bytes,
-                        wgpu::TexelCopyBufferLayout {
-                            offset: 0,
-                            bytes_per_row: Some(w * texel_bytes),
-                            rows_per_image: Some(h),
-                        },
-                        wgpu::Extent3d { width: w, height: h, depth_or_array_layers: 1 },
-                    )
-                });
+                write_level(gpu, &self.texture, (m, face), (w, h), data);
             }
         }
         Ok(())

@@ -134,46 +134,49 @@ impl ObjectTexture {
 
     /// Uploads every level: `rgba` holds 4 values per texel of the layout (its x order).
     pub fn upload(&self, gpu: &Gpu, rgba: &[f32]) -> Result<(), PlayError> {
-        let format = self.texture.format();
-        let texel_bytes = format.block_copy_size(None).unwrap_or(16);
         for (m, (w, h, img)) in gpu_levels(&self.layout, rgba)?.into_iter().enumerate() {
-            with_texel_bytes(format, &img, |bytes| {
-                gpu.queue.write_texture(
-                    wgpu::TexelCopyTextureInfo {
-                        texture: &self.texture,
-                        mip_level: m as u32,
-                        origin: wgpu::Origin3d::ZERO,
-                        aspect: wgpu::TextureAspect::All,
-                    },
-                    bytes,
-                    wgpu::TexelCopyBufferLayout {
-                        offset: 0,
-                        bytes_per_row: Some(w * texel_bytes),
-                        rows_per_image: Some(h),
-                    },
-                    wgpu::Extent3d { width: w, height: h, depth_or_array_layers: 1 },
-                )
-            });
+            write_level(gpu, &self.texture, (m as u32, 0), (w, h), &img);
         }
         Ok(())
     }
 }
 
-/// Calls `f` with RGBA values as the bytes of a texture of `format`: `Rgba32Float` as they
-/// are, `Rgba16Float` rounded to the nearest half floats.
-pub(crate) fn with_texel_bytes<R>(
-    format: wgpu::TextureFormat,
+/// Writes RGBA values (4 a texel, rows of `size.0` texels) into level `mip` of array layer
+/// `layer` of `texture`: as they are into `Rgba32Float`, rounded to the nearest half floats
+/// into `Rgba16Float`. Returns the bytes written.
+pub(crate) fn write_level(
+    gpu: &Gpu,
+    texture: &wgpu::Texture,
+    (mip, layer): (u32, u32),
+    (w, h): (u32, u32),
     rgba: &[f32],
-    f: impl FnOnce(&[u8]) -> R,
-) -> R {
+) -> u64 {
     use half::slice::{HalfBitsSliceExt, HalfFloatSliceExt};
-    if format == wgpu::TextureFormat::Rgba16Float {
+    let halves: Vec<u16>;
+    let bytes: &[u8] = if texture.format() == wgpu::TextureFormat::Rgba16Float {
         let mut bits = vec![0u16; rgba.len()];
         bits.reinterpret_cast_mut::<half::f16>().convert_from_f32_slice(rgba);
-        f(bytemuck::cast_slice(&bits))
+        halves = bits;
+        bytemuck::cast_slice(&halves)
     } else {
-        f(bytemuck::cast_slice(rgba))
-    }
+        bytemuck::cast_slice(rgba)
+    };
+    gpu.queue.write_texture(
+        wgpu::TexelCopyTextureInfo {
+            texture,
+            mip_level: mip,
+            origin: wgpu::Origin3d { x: 0, y: 0, z: layer },
+            aspect: wgpu::TextureAspect::All,
+        },
+        bytes,
+        wgpu::TexelCopyBufferLayout {
+            offset: 0,
+            bytes_per_row: Some(w * texture.format().block_copy_size(None).unwrap_or(16)),
+            rows_per_image: Some(h),
+        },
+        wgpu::Extent3d { width: w, height: h, depth_or_array_layers: 1 },
+    );
+    bytes.len() as u64
 }
 
 /// The compiled pipelines: textured colour + depth, and depth only for occluders.
