@@ -582,18 +582,10 @@ fn a_glass_teapot_packed_and_played_by_hybrid_rendering() {
     // Both terms drawn per frame, from vertex rays traced per frame: by the frame itself
     // without decoding ahead, else while the frame before drew (all but the first).
     let path = |prefetch: &str| {
-        run_json(
-            env!("CARGO_BIN_EXE_pis-play"),
-            &[
-                pem.as_os_str(),
-                "--headless".as_ref(),
-                "--path".as_ref(),
-                "diagonal".as_ref(),
-                "--prefetch".as_ref(),
-                prefetch.as_ref(),
-                "--json".as_ref(),
-            ],
-        )
+        let args = ["--headless", "--path", "diagonal", "--prefetch", prefetch, "--json"];
+        let args: Vec<&std::ffi::OsStr> =
+            std::iter::once(pem.as_os_str()).chain(args.iter().map(|a| a.as_ref())).collect();
+        run_json(env!("CARGO_BIN_EXE_pis-play"), &args)
     };
     let play = path("0");
     assert_eq!(play["lens_draws_mean"].as_f64(), Some(2.0), "{play}");
@@ -608,12 +600,11 @@ fn a_glass_teapot_packed_and_played_by_hybrid_rendering() {
         pis_play::Gpu::new()
             .expect("a Vulkan adapter (lavapipe: apt-get install -y mesa-vulkan-drivers)"),
     );
-    let mut player = pis_play::Player::open(
-        gpu,
-        &pem,
-        pis_play::PlayerOptions { msaa: 1, ..Default::default() },
-    )
-    .expect("opens");
+    let open = || {
+        let options = pis_play::PlayerOptions { msaa: 1, ..Default::default() };
+        pis_play::Player::open(gpu.clone(), &pem, options).expect("opens")
+    };
+    let mut player = open();
     let req = pis_play::FrameRequest { point: vec![8.0], camera: pis_play::CameraChoice::Sample };
     let (a, first) = player.render_image(&req, (160, 120)).expect("draws");
     let (b, second) = player.render_image(&req, (160, 120)).expect("draws again");
@@ -634,13 +625,7 @@ fn a_glass_teapot_packed_and_played_by_hybrid_rendering() {
     player.render_image(&req, (160, 120)).expect("draws");
     let (c, ahead) = player.render_image(&next, (160, 120)).expect("draws the next view");
     assert!(ahead.lens_traced_ahead == 1 && ahead.lens_rays == 0, "{ahead:?}");
-    let mut fresh = pis_play::Player::open(
-        std::sync::Arc::new(pis_play::Gpu::new().expect("the adapter again")),
-        &pem,
-        pis_play::PlayerOptions { msaa: 1, ..Default::default() },
-    )
-    .expect("opens");
-    let (d, own) = fresh.render_image(&next, (160, 120)).expect("draws");
+    let (d, own) = open().render_image(&next, (160, 120)).expect("draws");
     assert!(own.lens_rays > 10_000, "{own:?}");
     assert!(
         c.rgba.iter().zip(&d.rgba).all(|(x, y)| x.to_bits() == y.to_bits()),

@@ -518,9 +518,8 @@ fn auto_max_mse_keeps_the_better_of_the_constraint_and_the_free_allocation() {
 /// bytes only (with them set back, the file's CRC-32 is the earlier 0xd745f345). Recorded
 /// again when the default target became a played quality (`--within 1`): the allocation
 /// searched for the fewest bytes within 1 dB of the textures as solved; `--ratio 384`, the
-/// earlier default, still writes the earlier bytes ([`DEMO1_CI_PACK_384`]). Recorded again
-/// when the provenance came to record what half floats cost (`half_float_psnr_db`, SPEC.md
-/// 6.6): 33 bytes of settings, the level images unchanged.
+/// earlier default, still writes the earlier bytes ([`DEMO1_CI_PACK_384`]). Again when the
+/// provenance came to record `half_float_psnr_db` (SPEC.md 6.6): 33 bytes of settings.
 const DEMO1_CI_PACK: (usize, u32) = (230_577, 0xb21e_dd2f);
 
 /// The same at `--ratio 384`: the bytes the default wrote before it became a played quality.
