@@ -281,7 +281,15 @@ impl App {
         );
         let now = Instant::now();
         Ok(Running {
-            adapter: gpu.describe(),
+            adapter: {
+                let p = player.texture_precision();
+                format!(
+                    "{}; the file's textures {:?}, cube maps {:?}",
+                    gpu.describe(),
+                    p.surface,
+                    p.cube
+                )
+            },
             window,
             gpu,
             surface,

@@ -241,20 +241,19 @@ fn stats(ui: &mut Ui, info: &PanelInfo) {
             ui.end_row();
         };
         row("fps", format!("{:.1}", s.fps));
-        row("frame", format!("{:.2} ms", s.frame_ms));
-        // The longest frame of the last second.
-        row("worst", format!("{:.2} ms", s.worst_ms));
+        // The mean frame and the longest of the last second.
+        row("frame, worst", format!("{:.1}, {:.1} ms", s.frame_ms, s.worst_ms));
         row("decode", format!("{:.2} ms", s.decode_ms));
-        row("upload", format!("{:.2} ms", s.upload_ms));
-        row("GPU rebuild", format!("{:.2} ms", s.rebuild_ms));
+        // Uploads, and the GPU's rebuilds of textures from their level images.
+        row("upload, rebuild", format!("{:.1}, {:.1} ms", s.upload_ms, s.rebuild_ms));
         // Frames of the last second that waited for level images to be decoded.
         row("waited", format!("{} of {} frames", s.waited.0, s.waited.1));
         row("cache", format!("{:.1} MB", s.cache_mb));
         row("upload rate", format!("{:.1} MB/s", s.upload_mb_s));
         row("hits / misses", format!("{} / {}", info.cache_hits, info.cache_misses));
         row("draws", format!("{} surface, {} shell", info.draws.0, info.draws.1));
-        row("frame size", format!("{}×{}", info.frame_size.0, info.frame_size.1));
-        row("traced size", format!("{}×{}", info.image_size.0, info.image_size.1));
+        let (f, t) = (info.frame_size, info.image_size);
+        row("size, traced", format!("{}×{}, {}×{}", f.0, f.1, t.0, t.1));
         row("msaa", if info.msaa > 1 { format!("{}×", info.msaa) } else { "off".into() });
     });
     ui.add(egui::Label::new(egui::RichText::new(info.adapter).small()).wrap());
