@@ -281,15 +281,7 @@ impl App {
         );
         let now = Instant::now();
         Ok(Running {
-            adapter: {
-                let p = player.texture_precision();
-                format!(
-                    "{}; the file's textures {:?}, cube maps {:?}",
-                    gpu.describe(),
-                    p.surface,
-                    p.cube
-                )
-            },
+            adapter: gpu.describe(),
             window,
             gpu,
             surface,
