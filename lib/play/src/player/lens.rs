@@ -55,11 +55,9 @@ pub(super) fn lens_requests<'a>(
             let key = tessellation_key(plan, r.draw, size, tau_px);
             let Some(state) = state_of(r.draw) else { continue };
             let made = state.tessellated.as_ref().is_some_and(|(k, _)| *k == key);
-            if made || wanted.iter().any(|w| w.draw == r.draw && w.key == key) {
-                continue;
+            if !made && !wanted.contains(&(r.draw, key)) {
+                wanted.push((r.draw, key));
             }
-            let (lens, settings) = (state.placed_at(plan.worlds[r.draw]), state.settings(tau_px));
-            wanted.push(LensRequest { draw: r.draw, key, lens, settings });
         }
     }
     wanted

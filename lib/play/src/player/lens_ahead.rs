@@ -28,35 +28,34 @@ pub(super) struct LensAhead {
     dropped: u64,
 }
 
-/// What a predicted frame's lens object needs traced: its draw index, the tessellation key,
-/// the object at the frame's transform and the tessellation's settings.
-pub(super) struct LensRequest {
-    pub(super) draw: usize,
-    pub(super) key: TessellationKey,
-    pub(super) lens: Arc<LensObject>,
-    pub(super) settings: TessellationSettings,
-}
+/// What a predicted frame's lens object needs traced: its draw index and the tessellation
+/// key (the object's transform first).
+pub(super) type LensRequest = (usize, TessellationKey);
 
 impl LensAhead {
     /// Makes ahead the tessellations of `wanted` (in order): those already being made are
-    /// kept, those no longer wanted dropped, the others started on threads of their own.
-    pub(super) fn start(&mut self, wanted: Vec<LensRequest>) {
+    /// kept, those no longer wanted dropped, the others started on threads of their own,
+    /// with the object `place(draw, transform)` gives and its tessellation settings.
+    pub(super) fn start(
+        &mut self,
+        wanted: &[LensRequest],
+        place: impl Fn(usize, glam::Mat4) -> Option<(Arc<LensObject>, TessellationSettings)>,
+    ) {
         let before = self.jobs.len();
-        self.jobs.retain(|j| wanted.iter().any(|w| w.draw == j.draw && w.key == j.key));
+        self.jobs.retain(|j| wanted.contains(&(j.draw, j.key)));
         self.dropped += (before - self.jobs.len()) as u64;
-        for w in wanted {
-            if self.jobs.iter().any(|j| j.draw == w.draw && j.key == w.key) {
+        for &(draw, key) in wanted {
+            if self.jobs.iter().any(|j| (j.draw, j.key) == (draw, key)) {
                 continue;
             }
-            let (eye, clip_from_world, size, _) = (w.key.1, w.key.2, w.key.3, w.key.4);
-            let view = HybridView { eye, clip_from_world, size };
-            let (lens, settings) = (w.lens, w.settings);
+            let Some((lens, settings)) = place(draw, key.0) else { continue };
+            let view = HybridView { eye: key.1, clip_from_world: key.2, size: key.3 };
             let thread = std::thread::Builder::new()
                 .name("pis-lens-ahead".into())
                 .spawn(move || tessellate(&lens, &view, &settings));
             // Without a thread the frame traces its lens objects itself.
             if let Ok(thread) = thread {
-                self.jobs.push(Job { draw: w.draw, key: w.key, thread });
+                self.jobs.push(Job { draw, key, thread });
             }
         }
     }

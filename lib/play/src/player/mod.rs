@@ -435,9 +435,13 @@ impl Player {
             .collect();
         let keys: Vec<&TextureKey> = plans.iter().flat_map(|p| p.keys()).collect();
         self.textures.prefetch(&self.gpu, &self.reader, &keys, self.options.reduction);
+        let tau_px = self.options.tau_px;
         let lens_of = |draw: usize| self.objects.get(draw).and_then(|o| o.lens.as_ref());
-        let wanted = lens_requests(&plans, lens_of, size, self.options.tau_px);
-        self.lens_ahead.start(wanted);
+        let wanted = lens_requests(&plans, lens_of, size, tau_px);
+        // An object is placed at a transform only for a tessellation not yet being made.
+        self.lens_ahead.start(&wanted, |draw, world| {
+            lens_of(draw).map(|s| (s.placed_at(world), s.settings(tau_px)))
+        });
     }
 
     /// Makes the targets of `size` and `samples` current: those of the other sample count
