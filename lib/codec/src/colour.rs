@@ -59,24 +59,48 @@ pub fn split(planes: &[crate::PlaneShape], values: &[f32], colour: bool) -> Vec<
     out
 }
 
-#[allow(clippy::needless_range_loop)]
 /// Inverse of [`split`]: writes the interleaved values.
 pub fn merge(planes: &[crate::PlaneShape], chans: &[Vec<f32>], colour: bool, out: &mut Vec<f32>) {
     let mut idx = 0;
     for p in planes {
         let c = p.channels as usize;
         let n = (p.width * p.height) as usize;
-        let mut px = [0.0f32; 4];
-        for i in 0..n {
-            for k in 0..c {
-                px[k] = chans[idx + k][i];
+        let start = out.len();
+        out.resize(start + n * c, 0.0);
+        let chans: Vec<&[f32]> = chans[idx..idx + c].iter().map(|v| &v[..n]).collect();
+        let px = out[start..].chunks_exact_mut(c);
+        match chans[..] {
+            [y, c1, c2] if colour => merge_opponent(px, y, c1, c2, None),
+            [y, c1, c2, a] if colour => merge_opponent(px, y, c1, c2, Some(a)),
+            _ => {
+                for (i, px) in px.enumerate() {
+                    for (v, chan) in px.iter_mut().zip(&chans) {
+                        *v = chan[i];
+                    }
+                }
             }
-            if colour {
-                inverse(&mut px[..c]);
-            }
-            out.extend_from_slice(&px[..c]);
         }
         idx += c;
+    }
+}
+
+/// [`merge`] of a plane whose first three channels are opponent colours ([`inverse`]),
+/// pixel by pixel, with alpha copied where there is one.
+fn merge_opponent<'a>(
+    px: impl Iterator<Item = &'a mut [f32]>,
+    y: &[f32],
+    c1: &[f32],
+    c2: &[f32],
+    alpha: Option<&[f32]>,
+) {
+    for (i, (px, ((&y, &c1), &c2))) in px.zip(y.iter().zip(c1).zip(c2)).enumerate() {
+        px[0] = y;
+        px[1] = c1;
+        px[2] = c2;
+        inverse(&mut px[..3]);
+        if let Some(a) = alpha {
+            px[3] = a[i];
+        }
     }
 }
 

@@ -50,22 +50,52 @@ fn tile_bases(bands: &[Band]) -> Vec<usize> {
         .collect()
 }
 
+/// The tiles of a band's parent: index of its first tile, and its tiles across and down.
+#[derive(Clone, Copy)]
+struct ParentTiles {
+    base: usize,
+    across: usize,
+    down: usize,
+}
+
+fn parent_tiles(bands: &[Band], bases: &[usize], band: &Band) -> Option<ParentTiles> {
+    band.parent.map(|p| ParentTiles {
+        base: bases[p],
+        across: bands[p].width.div_ceil(TILE),
+        down: bands[p].height.div_ceil(TILE),
+    })
+}
+
+/// The largest magnitude in each tile (indexed as the tile state): a tile becomes
+/// significant in plane `p` when its maximum has a bit at or above `p`.
+fn tile_maxima(bands: &[Band], bases: &[usize], tiles: usize, m: &[u32]) -> Vec<u32> {
+    let mut max = vec![0u32; tiles];
+    for (band, &base) in bands.iter().zip(bases) {
+        let tw = band.width.div_ceil(TILE);
+        for y in 0..band.height {
+            let row = &m[band.offset + y * band.width..band.offset + (y + 1) * band.width];
+            for (x, &v) in row.iter().enumerate() {
+                let t = base + (y / TILE) * tw + x / TILE;
+                max[t] = max[t].max(v);
+            }
+        }
+    }
+    max
+}
+
 #[inline]
 fn tile_context(
-    bands: &[Band],
-    bases: &[usize],
-    band: &Band,
+    class: usize,
+    parent: Option<ParentTiles>,
     tx: usize,
     ty: usize,
     tsig: &[bool],
 ) -> usize {
-    let parent = band.parent.is_some_and(|p| {
-        let pb = &bands[p];
-        let (ptw, pth) = (pb.width.div_ceil(TILE), pb.height.div_ceil(TILE));
-        let (x, y) = ((tx / 2).min(ptw - 1), (ty / 2).min(pth - 1));
-        tsig[bases[p] + y * ptw + x]
+    let parent = parent.is_some_and(|p| {
+        let (x, y) = ((tx / 2).min(p.across - 1), (ty / 2).min(p.down - 1));
+        tsig[p.base + y * p.across + x]
     });
-    band.class * 2 + parent as usize
+    class * 2 + parent as usize
 }
 
 #[inline]
@@ -118,6 +148,8 @@ pub fn encode(bands: &[Band], a: &[f64], neg: &[bool], top: u32) -> (Vec<u8>, Ve
     let mut enc = Encoder::new();
     let mut sctx = [Context::default(); SIG_CONTEXTS];
     let mut rctx = [Context::default(); 2];
+    let tile_max = tile_maxima(bands, &bases, tsig.len(), &m);
+    let (mut significant, mut fresh): (Vec<usize>, Vec<usize>) = (Vec::new(), Vec::new());
     let mut error: f64 = a.iter().map(|v| v * v).sum();
     let mut trace = vec![Checkpoint { needed: 0, error }];
     let record = |needed: u64, error: f64, trace: &mut Vec<Checkpoint>| match trace.last_mut() {
@@ -128,22 +160,22 @@ pub fn encode(bands: &[Band], a: &[f64], neg: &[bool], top: u32) -> (Vec<u8>, Ve
         let half = 0.5 * (1u64 << p) as f64;
         for (b, band) in bands.iter().enumerate() {
             let (w, tw) = (band.width, band.width.div_ceil(TILE));
+            let parent = parent_tiles(bands, &bases, band);
             for ty in 0..band.height.div_ceil(TILE) {
                 for tx in 0..tw {
                     let t = bases[b] + ty * tw + tx;
                     let (x0, y0) = (tx * TILE, ty * TILE);
                     let (x1, y1) = ((x0 + TILE).min(w), (y0 + TILE).min(band.height));
-                    let mut fresh = false;
+                    let mut new_tile = false;
                     if !tsig[t] {
-                        let any = (y0..y1)
-                            .any(|y| (x0..x1).any(|x| m[band.offset + y * w + x] >> p != 0));
-                        let c = tile_context(bands, &bases, band, tx, ty, &tsig);
+                        let any = tile_max[t] >> p != 0;
+                        let c = tile_context(band.class, parent, tx, ty, &tsig);
                         enc.bit(&mut tctx[c], any);
                         if !any {
                             continue;
                         }
                         tsig[t] = true;
-                        fresh = true;
+                        new_tile = true;
                     }
                     let last = (y1 - 1, x1 - 1);
                     let mut only_zeros = true;
@@ -154,7 +186,7 @@ pub fn encode(bands: &[Band], a: &[f64], neg: &[bool], top: u32) -> (Vec<u8>, Ve
                                 continue;
                             }
                             let bit = (m[i] >> p) & 1 == 1;
-                            if !(fresh && only_zeros && (y, x) == last) {
+                            if !(new_tile && only_zeros && (y, x) == last) {
                                 let c = sig_context(bands, band, x, y, i, &sig);
                                 enc.bit(&mut sctx[c], bit);
                             }
@@ -163,6 +195,7 @@ pub fn encode(bands: &[Band], a: &[f64], neg: &[bool], top: u32) -> (Vec<u8>, Ve
                                 let needed = enc.bytes_needed_for_next();
                                 enc.direct(neg[i]);
                                 sig[i] = p as u8 + 1;
+                                fresh.push(i);
                                 let rec = 3.0 * half;
                                 error += (a[i] - rec).powi(2) - a[i] * a[i];
                                 record(needed, error, &mut trace);
@@ -172,19 +205,16 @@ pub fn encode(bands: &[Band], a: &[f64], neg: &[bool], top: u32) -> (Vec<u8>, Ve
                 }
             }
         }
-        for band in bands {
-            for i in band.offset..band.offset + band.width * band.height {
-                if sig[i] as u32 > p + 1 {
-                    let bit = (m[i] >> p) & 1 == 1;
-                    let needed = enc.bytes_needed_for_next();
-                    enc.bit(&mut rctx[(sig[i] as u32 == p + 2) as usize], bit);
-                    let old = (m[i] >> (p + 1) << (p + 1)) as f64 + 2.0 * half;
-                    let new = (m[i] >> p << p) as f64 + half;
-                    error += (a[i] - new).powi(2) - (a[i] - old).powi(2);
-                    record(needed, error, &mut trace);
-                }
-            }
+        for &i in &significant {
+            let bit = (m[i] >> p) & 1 == 1;
+            let needed = enc.bytes_needed_for_next();
+            enc.bit(&mut rctx[(sig[i] as u32 == p + 2) as usize], bit);
+            let old = (m[i] >> (p + 1) << (p + 1)) as f64 + 2.0 * half;
+            let new = (m[i] >> p << p) as f64 + half;
+            error += (a[i] - new).powi(2) - (a[i] - old).powi(2);
+            record(needed, error, &mut trace);
         }
+        merge_fresh(&mut significant, &mut fresh, |&i| i);
     }
     let total = enc.bytes_needed_for_next();
     let body = enc.finish();
@@ -192,26 +222,24 @@ pub fn encode(bands: &[Band], a: &[f64], neg: &[bool], top: u32) -> (Vec<u8>, Ve
     (body, trace)
 }
 
-/// Decoded state of every coefficient: magnitude bits known so far with the sign in bit 31,
-/// and the lowest bit-plane known (255: not significant).
-pub struct Decoded {
-    pub mag: Vec<u32>,
-    pub low: Vec<u8>,
-    /// Body bytes the range decoder read: the whole body when it ended (a truncated stream)
-    /// or when the stream is exact; fewer when bytes follow the coded data.
-    pub used: usize,
+/// A coefficient the decoder found significant: its index in the coefficient array, its
+/// magnitude bits known so far with the sign in bit 31, the lowest bit-plane known, and the
+/// plane in which it became significant.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Coefficient {
+    pub index: usize,
+    pub mag: u32,
+    pub low: u8,
+    plane: u8,
 }
 
-impl Decoded {
+impl Coefficient {
     /// The reconstructed magnitude in units of the step, signed: the middle of the interval
     /// that the decoded bits leave.
-    pub fn value(&self, i: usize) -> f64 {
-        if self.low[i] == 255 {
-            return 0.0;
-        }
-        let m = self.mag[i] & 0x7FFF_FFFF;
-        let v = m as f64 + 0.5 * (1u64 << self.low[i]) as f64;
-        if self.mag[i] >> 31 == 1 {
+    pub fn value(&self) -> f64 {
+        let m = self.mag & 0x7FFF_FFFF;
+        let v = m as f64 + 0.5 * (1u64 << self.low) as f64;
+        if self.mag >> 31 == 1 {
             -v
         } else {
             v
@@ -219,10 +247,41 @@ impl Decoded {
     }
 }
 
-/// Decodes as much of `body` as it holds (any prefix of an encoder's output is valid).
+/// The decoded stream: the significant coefficients in index order (every other one is 0).
+/// Their count is bounded by the body, each costing at least its sign's one bit.
+pub struct Decoded {
+    pub significant: Vec<Coefficient>,
+    /// Body bytes the range decoder read: the whole body when it ended (a truncated stream)
+    /// or when the stream is exact; fewer when bytes follow the coded data.
+    pub used: usize,
+}
+
+/// Merges `fresh` (what became significant in one plane, in tile order) into `sorted`
+/// (index order), keeping index order: the order in which the refinement pass's scan of
+/// every coefficient meets the significant ones.
+fn merge_fresh<T: Copy>(sorted: &mut Vec<T>, fresh: &mut Vec<T>, index: impl Fn(&T) -> usize) {
+    if fresh.is_empty() {
+        return;
+    }
+    fresh.sort_unstable_by_key(&index);
+    let old = std::mem::take(sorted);
+    sorted.reserve(old.len() + fresh.len());
+    let (mut a, mut b) = (old.into_iter().peekable(), fresh.drain(..).peekable());
+    while let (Some(x), Some(y)) = (a.peek(), b.peek()) {
+        let next = if index(x) < index(y) { a.next() } else { b.next() };
+        sorted.extend(next);
+    }
+    sorted.extend(a);
+    sorted.extend(b);
+}
+
+/// Decodes as much of `body` as it holds (any prefix of an encoder's output is valid). The
+/// refinement pass visits only the coefficients already significant, in index order, as
+/// the encoder's scan of every coefficient meets them.
 pub fn decode(bands: &[Band], n: usize, top: u32, body: &[u8]) -> Decoded {
     let mut sig = vec![0u8; n];
-    let mut out = Decoded { mag: vec![0u32; n], low: vec![255u8; n], used: 0 };
+    let mut significant: Vec<Coefficient> = Vec::new();
+    let mut fresh: Vec<Coefficient> = Vec::new();
     let bases = tile_bases(bands);
     let mut tsig =
         vec![
@@ -237,20 +296,21 @@ pub fn decode(bands: &[Band], n: usize, top: u32, body: &[u8]) -> Decoded {
     'planes: for p in (0..=top).rev() {
         for (b, band) in bands.iter().enumerate() {
             let (w, tw) = (band.width, band.width.div_ceil(TILE));
+            let parent = parent_tiles(bands, &bases, band);
             for ty in 0..band.height.div_ceil(TILE) {
                 for tx in 0..tw {
                     let t = bases[b] + ty * tw + tx;
                     let (x0, y0) = (tx * TILE, ty * TILE);
                     let (x1, y1) = ((x0 + TILE).min(w), (y0 + TILE).min(band.height));
-                    let mut fresh = false;
+                    let mut new_tile = false;
                     if !tsig[t] {
-                        let c = tile_context(bands, &bases, band, tx, ty, &tsig);
+                        let c = tile_context(band.class, parent, tx, ty, &tsig);
                         match dec.bit(&mut tctx[c]) {
                             None => break 'planes,
                             Some(false) => continue,
                             Some(true) => {
                                 tsig[t] = true;
-                                fresh = true;
+                                new_tile = true;
                             }
                         }
                     }
@@ -262,7 +322,7 @@ pub fn decode(bands: &[Band], n: usize, top: u32, body: &[u8]) -> Decoded {
                             if sig[i] != 0 {
                                 continue;
                             }
-                            let bit = if fresh && only_zeros && (y, x) == last {
+                            let bit = if new_tile && only_zeros && (y, x) == last {
                                 true
                             } else {
                                 let c = sig_context(bands, band, x, y, i, &sig);
@@ -277,26 +337,29 @@ pub fn decode(bands: &[Band], n: usize, top: u32, body: &[u8]) -> Decoded {
                                     break 'planes;
                                 };
                                 sig[i] = p as u8 + 1;
-                                out.mag[i] = (1 << p) | ((negative as u32) << 31);
-                                out.low[i] = p as u8;
+                                let mag = (1 << p) | ((negative as u32) << 31);
+                                fresh.push(Coefficient {
+                                    index: i,
+                                    mag,
+                                    low: p as u8,
+                                    plane: p as u8,
+                                });
                             }
                         }
                     }
                 }
             }
         }
-        for band in bands {
-            for i in band.offset..band.offset + band.width * band.height {
-                if sig[i] as u32 > p + 1 {
-                    let Some(bit) = dec.bit(&mut rctx[(sig[i] as u32 == p + 2) as usize]) else {
-                        break 'planes;
-                    };
-                    out.mag[i] |= (bit as u32) << p;
-                    out.low[i] = p as u8;
-                }
-            }
+        for c in significant.iter_mut() {
+            let first = c.plane as u32 == p + 1;
+            let Some(bit) = dec.bit(&mut rctx[first as usize]) else {
+                break 'planes;
+            };
+            c.mag |= (bit as u32) << p;
+            c.low = p as u8;
         }
+        merge_fresh(&mut significant, &mut fresh, |c| c.index);
     }
-    out.used = dec.position();
-    out
+    merge_fresh(&mut significant, &mut fresh, |c| c.index);
+    Decoded { significant, used: dec.position() }
 }

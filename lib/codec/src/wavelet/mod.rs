@@ -150,39 +150,65 @@ fn layout(planes: &[PlaneShape], levels: u32) -> (Vec<Band>, Vec<f32>, Vec<Array
     (bands, scales, arrays)
 }
 
-/// Copies each band out of (or back into) the Mallat layout of its array.
+/// Visits every coefficient of every band: f(band index, array index, position in the
+/// array's Mallat layout, position in the coefficient vector).
 fn for_each_band_coef(
     bands: &[Band],
     arrays: &[ArrayShape],
     mut f: impl FnMut(usize, usize, usize, usize),
 ) {
-    // f(band index, array index, position in array, position in coefficient vector)
+    for (b, (band, (ai, x0, y0))) in bands.iter().zip(band_places(arrays)).enumerate() {
+        let w = arrays[ai].0;
+        for y in 0..band.height {
+            for x in 0..band.width {
+                f(b, ai, (y0 + y) * w + x0 + x, band.offset + y * band.width + x);
+            }
+        }
+    }
+}
+
+/// Writes each significant coefficient, dequantized, at its place in the Mallat layout of its
+/// array (`chans` holds zeros: every other coefficient is 0). `significant` is in index order,
+/// so the bands are met in order.
+fn place_significant(
+    bands: &[Band],
+    scales: &[f32],
+    arrays: &[ArrayShape],
+    significant: &[bitplane::Coefficient],
+    step: f32,
+    chans: &mut [Vec<f32>],
+) {
+    let places = band_places(arrays);
     let mut b = 0;
+    for c in significant {
+        while c.index >= bands[b].offset + bands[b].width * bands[b].height {
+            b += 1;
+        }
+        let (band, (ai, x0, y0)) = (&bands[b], places[b]);
+        let k = c.index - band.offset;
+        let (y, x) = (k / band.width, k % band.width);
+        let w = arrays[ai].0;
+        chans[ai][(y0 + y) * w + x0 + x] = (c.value() * step as f64 / scales[b] as f64) as f32;
+    }
+}
+
+/// Each band's array and the top-left corner of its place in the array's Mallat layout, in
+/// band order.
+fn band_places(arrays: &[ArrayShape]) -> Vec<(usize, usize, usize)> {
+    let mut out = Vec::new();
     for (ai, &(w, h, lev)) in arrays.iter().enumerate() {
         let mut sizes = vec![(w, h)];
         for _ in 0..lev {
             let (cw, ch) = sizes[sizes.len() - 1];
             sizes.push((cw.div_ceil(2), ch.div_ceil(2)));
         }
-        let (lw, lh) = sizes[lev as usize];
-        let mut visit = |b: usize, x0: usize, y0: usize, bw: usize, bh: usize| {
-            for y in 0..bh {
-                for x in 0..bw {
-                    f(b, ai, (y0 + y) * w + x0 + x, bands[b].offset + y * bw + x);
-                }
-            }
-        };
-        visit(b, 0, 0, lw, lh);
-        b += 1;
+        out.push((ai, 0, 0));
         for j in (1..=lev as usize).rev() {
-            let (pw, ph) = sizes[j - 1];
             let (cw, ch) = sizes[j];
-            visit(b, cw, 0, pw - cw, ch);
-            visit(b + 1, 0, ch, cw, ph - ch);
-            visit(b + 2, cw, ch, pw - cw, ph - ch);
-            b += 3;
+            out.extend([(ai, cw, 0), (ai, 0, ch), (ai, cw, ch)]);
         }
     }
+    out
 }
 
 /// Encodes a level image and returns the full stream with its rate–distortion curve.
@@ -293,16 +319,14 @@ pub fn decode(planes: &[PlaneShape], bytes: &[u8]) -> Result<Vec<f32>, CodecErro
     }
     let mut chans: Vec<Vec<f32>> = arrays.iter().map(|&(w, h, _)| vec![0.0f32; w * h]).collect();
     if let Some(dec) = dec {
-        for_each_band_coef(&bands, &arrays, |b, ai, pos, k| {
-            chans[ai][pos] = (dec.value(k) * step as f64 / scales[b] as f64) as f32;
-        });
+        place_significant(&bands, &scales, &arrays, &dec.significant, step, &mut chans);
     }
     for (a, &(w, h, lev)) in chans.iter_mut().zip(&arrays) {
         lifting::inverse_2d(a, w, h, lev);
     }
     let mut out = Vec::with_capacity(n);
     colour::merge(planes, &chans, colour, &mut out);
-    if out.iter().any(|v| !v.is_finite()) {
+    if !out.iter().fold(true, |all, v| all & v.is_finite()) {
         return Err(CodecError::Corrupt("decoded values overflow f32".into()));
     }
     Ok(out)
