@@ -60,20 +60,24 @@ pub fn split(planes: &[crate::PlaneShape], values: &[f32], colour: bool) -> Vec<
 }
 
 /// Inverse of [`split`]: writes the interleaved values.
-pub fn merge(planes: &[crate::PlaneShape], chans: &[Vec<f32>], colour: bool, out: &mut Vec<f32>) {
+pub fn merge<C: AsRef<[f32]>>(
+    planes: &[crate::PlaneShape],
+    chans: &[C],
+    colour: bool,
+    out: &mut Vec<f32>,
+) {
     let mut idx = 0;
     for p in planes {
         let c = p.channels as usize;
         let n = (p.width * p.height) as usize;
         let start = out.len();
         out.resize(start + n * c, 0.0);
-        let chans: Vec<&[f32]> = chans[idx..idx + c].iter().map(|v| &v[..n]).collect();
-        let px = out[start..].chunks_exact_mut(c);
+        let chans: Vec<&[f32]> = chans[idx..idx + c].iter().map(|v| &v.as_ref()[..n]).collect();
         match chans[..] {
-            [y, c1, c2] if colour => merge_opponent(px, y, c1, c2, None),
-            [y, c1, c2, a] if colour => merge_opponent(px, y, c1, c2, Some(a)),
+            [y, c1, c2] if colour => merge_opponent::<3>(&mut out[start..], y, c1, c2, &[]),
+            [y, c1, c2, a] if colour => merge_opponent::<4>(&mut out[start..], y, c1, c2, a),
             _ => {
-                for (i, px) in px.enumerate() {
+                for (i, px) in out[start..].chunks_exact_mut(c).enumerate() {
                     for (v, chan) in px.iter_mut().zip(&chans) {
                         *v = chan[i];
                     }
@@ -84,22 +88,22 @@ pub fn merge(planes: &[crate::PlaneShape], chans: &[Vec<f32>], colour: bool, out
     }
 }
 
-/// [`merge`] of a plane whose first three channels are opponent colours ([`inverse`]),
-/// pixel by pixel, with alpha copied where there is one.
-fn merge_opponent<'a>(
-    px: impl Iterator<Item = &'a mut [f32]>,
+/// [`merge`] of a plane of `C` channels (3 or 4) whose first three are opponent colours
+/// ([`inverse`]); `alpha` is empty for 3.
+fn merge_opponent<const C: usize>(
+    out: &mut [f32],
     y: &[f32],
     c1: &[f32],
     c2: &[f32],
-    alpha: Option<&[f32]>,
+    alpha: &[f32],
 ) {
-    for (i, (px, ((&y, &c1), &c2))) in px.zip(y.iter().zip(c1).zip(c2)).enumerate() {
-        px[0] = y;
-        px[1] = c1;
-        px[2] = c2;
-        inverse(&mut px[..3]);
-        if let Some(a) = alpha {
-            px[3] = a[i];
+    let colours = y.iter().zip(c1).zip(c2);
+    for (i, (px, ((&y, &c1), &c2))) in out.chunks_exact_mut(C).zip(colours).enumerate() {
+        let mut rgb = [y, c1, c2];
+        inverse(&mut rgb);
+        px[..3].copy_from_slice(&rgb);
+        if C == 4 {
+            px[3] = alpha[i];
         }
     }
 }

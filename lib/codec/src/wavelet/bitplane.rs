@@ -58,6 +58,23 @@ struct ParentTiles {
     down: usize,
 }
 
+impl ParentTiles {
+    /// The parent's row of tiles above tile row `ty` of the band: its first tile's index and
+    /// its length.
+    fn row(&self, ty: usize) -> ParentRow {
+        ParentRow {
+            first: self.base + (ty / 2).min(self.down - 1) * self.across,
+            across: self.across,
+        }
+    }
+}
+
+#[derive(Clone, Copy)]
+struct ParentRow {
+    first: usize,
+    across: usize,
+}
+
 fn parent_tiles(bands: &[Band], bases: &[usize], band: &Band) -> Option<ParentTiles> {
     band.parent.map(|p| ParentTiles {
         base: bases[p],
@@ -83,18 +100,11 @@ fn tile_maxima(bands: &[Band], bases: &[usize], tiles: usize, m: &[u32]) -> Vec<
     max
 }
 
+/// The context of tile `tx` of a row whose parent row is `parent`: the band's class and
+/// whether the parent tile is significant.
 #[inline]
-fn tile_context(
-    class: usize,
-    parent: Option<ParentTiles>,
-    tx: usize,
-    ty: usize,
-    tsig: &[bool],
-) -> usize {
-    let parent = parent.is_some_and(|p| {
-        let (x, y) = ((tx / 2).min(p.across - 1), (ty / 2).min(p.down - 1));
-        tsig[p.base + y * p.across + x]
-    });
+fn tile_context(class: usize, parent: Option<ParentRow>, tx: usize, tsig: &[bool]) -> usize {
+    let parent = parent.is_some_and(|p| tsig[p.first + (tx / 2).min(p.across - 1)]);
     class * 2 + parent as usize
 }
 
@@ -162,6 +172,7 @@ pub fn encode(bands: &[Band], a: &[f64], neg: &[bool], top: u32) -> (Vec<u8>, Ve
             let (w, tw) = (band.width, band.width.div_ceil(TILE));
             let parent = parent_tiles(bands, &bases, band);
             for ty in 0..band.height.div_ceil(TILE) {
+                let parent_row = parent.map(|p| p.row(ty));
                 for tx in 0..tw {
                     let t = bases[b] + ty * tw + tx;
                     let (x0, y0) = (tx * TILE, ty * TILE);
@@ -169,7 +180,7 @@ pub fn encode(bands: &[Band], a: &[f64], neg: &[bool], top: u32) -> (Vec<u8>, Ve
                     let mut new_tile = false;
                     if !tsig[t] {
                         let any = tile_max[t] >> p != 0;
-                        let c = tile_context(band.class, parent, tx, ty, &tsig);
+                        let c = tile_context(band.class, parent_row, tx, &tsig);
                         enc.bit(&mut tctx[c], any);
                         if !any {
                             continue;
@@ -278,8 +289,10 @@ fn merge_fresh<T: Copy>(sorted: &mut Vec<T>, fresh: &mut Vec<T>, index: impl Fn(
 /// Decodes as much of `body` as it holds (any prefix of an encoder's output is valid). The
 /// refinement pass visits only the coefficients already significant, in index order, as
 /// the encoder's scan of every coefficient meets them.
-pub fn decode(bands: &[Band], n: usize, top: u32, body: &[u8]) -> Decoded {
-    let mut sig = vec![0u8; n];
+/// `sig` is working memory (its contents do not matter).
+pub fn decode(bands: &[Band], n: usize, top: u32, body: &[u8], sig: &mut Vec<u8>) -> Decoded {
+    sig.clear();
+    sig.resize(n, 0);
     let mut significant: Vec<Coefficient> = Vec::new();
     let mut fresh: Vec<Coefficient> = Vec::new();
     let bases = tile_bases(bands);
@@ -298,13 +311,14 @@ pub fn decode(bands: &[Band], n: usize, top: u32, body: &[u8]) -> Decoded {
             let (w, tw) = (band.width, band.width.div_ceil(TILE));
             let parent = parent_tiles(bands, &bases, band);
             for ty in 0..band.height.div_ceil(TILE) {
+                let parent_row = parent.map(|p| p.row(ty));
                 for tx in 0..tw {
                     let t = bases[b] + ty * tw + tx;
                     let (x0, y0) = (tx * TILE, ty * TILE);
                     let (x1, y1) = ((x0 + TILE).min(w), (y0 + TILE).min(band.height));
                     let mut new_tile = false;
                     if !tsig[t] {
-                        let c = tile_context(band.class, parent, tx, ty, &tsig);
+                        let c = tile_context(band.class, parent_row, tx, &tsig);
                         match dec.bit(&mut tctx[c]) {
                             None => break 'planes,
                             Some(false) => continue,
@@ -325,7 +339,7 @@ pub fn decode(bands: &[Band], n: usize, top: u32, body: &[u8]) -> Decoded {
                             let bit = if new_tile && only_zeros && (y, x) == last {
                                 true
                             } else {
-                                let c = sig_context(bands, band, x, y, i, &sig);
+                                let c = sig_context(bands, band, x, y, i, sig);
                                 match dec.bit(&mut sctx[c]) {
                                     None => break 'planes,
                                     Some(bit) => bit,

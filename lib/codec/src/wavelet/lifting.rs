@@ -52,19 +52,22 @@ pub fn inverse_1d(x: &mut [f32], tmp: &mut Vec<f32>) {
     if n < 2 {
         return;
     }
-    let (s, d) = x.split_at_mut(n.div_ceil(2));
+    tmp.clear();
+    tmp.extend_from_slice(x);
+    let (s, d) = tmp.split_at_mut(n.div_ceil(2));
     s.iter_mut().for_each(|v| *v *= K);
     d.iter_mut().for_each(|v| *v /= K);
     lift_even(s, d, -DELTA);
     lift_odd(d, s, -GAMMA);
     lift_even(s, d, -BETA);
     lift_odd(d, s, -ALPHA);
-    tmp.clear();
-    tmp.extend(s.iter().zip(d.iter()).flat_map(|(&e, &o)| [e, o]));
-    if n % 2 == 1 {
-        tmp.push(s[s.len() - 1]);
+    for (pair, (&e, &o)) in x.chunks_exact_mut(2).zip(s.iter().zip(d.iter())) {
+        pair[0] = e;
+        pair[1] = o;
     }
-    x.copy_from_slice(tmp);
+    if n % 2 == 1 {
+        x[n - 1] = s[s.len() - 1];
+    }
 }
 
 /// The even samples' step: `s[j] += c · (d[j−1] + d[j])`, a missing neighbour mirrored
@@ -180,17 +183,17 @@ pub fn forward_2d(a: &mut [f32], w: usize, h: usize, levels: u32) {
 }
 
 /// Inverse of [`forward_2d`].
-pub fn inverse_2d(a: &mut [f32], w: usize, h: usize, levels: u32) {
-    let mut tmp = Vec::new();
+/// `tmp` is working memory (its contents do not matter).
+pub fn inverse_2d(a: &mut [f32], w: usize, h: usize, levels: u32, tmp: &mut Vec<f32>) {
     let mut sizes = vec![(w, h)];
     for _ in 1..levels {
         let (cw, ch) = *sizes.last().unwrap_or(&(w, h));
         sizes.push((cw.div_ceil(2), ch.div_ceil(2)));
     }
     for &(cw, ch) in sizes.iter().take(levels as usize).rev() {
-        inverse_cols(a, w, cw, ch, &mut tmp);
+        inverse_cols(a, w, cw, ch, tmp);
         for y in 0..ch {
-            inverse_1d(&mut a[y * w..y * w + cw], &mut tmp);
+            inverse_1d(&mut a[y * w..y * w + cw], tmp);
         }
     }
 }
@@ -237,7 +240,7 @@ mod tests {
             let mut a = orig.clone();
             let l = plane_levels(w as u32, h as u32, 6);
             forward_2d(&mut a, w, h, l);
-            inverse_2d(&mut a, w, h, l);
+            inverse_2d(&mut a, w, h, l, &mut Vec::new());
             for (x, y) in orig.iter().zip(&a) {
                 assert!((x - y).abs() < 1e-4, "{w}x{h}: {x} vs {y}");
             }

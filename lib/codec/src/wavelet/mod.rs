@@ -4,6 +4,7 @@
 
 pub mod bitplane;
 pub mod lifting;
+mod work;
 
 use crate::{colour, lossy_header, value_count, CodecError, PlaneShape, Rate, RdCurve, RdPoint};
 use bitplane::Band;
@@ -176,7 +177,7 @@ fn place_significant(
     arrays: &[ArrayShape],
     significant: &[bitplane::Coefficient],
     step: f32,
-    chans: &mut [Vec<f32>],
+    chans: &mut [&mut [f32]],
 ) {
     let places = band_places(arrays);
     let mut b = 0;
@@ -307,27 +308,44 @@ pub fn decode(planes: &[PlaneShape], bytes: &[u8]) -> Result<Vec<f32>, CodecErro
         return Err(CodecError::Corrupt(format!("top bit-plane {top}")));
     }
     let (bands, scales, arrays) = layout(planes, levels);
-    // Working memory peaks at about 2.5 times the decoded size: 6 bytes of coefficient
-    // state per value while decoding bit-planes, then 9 while filling the arrays.
-    let body = &bytes[hl..];
-    let dec = (top != NO_PLANES).then(|| bitplane::decode(&bands, n, top as u32, body));
-    // The body is exactly the coded data: nothing after a top bit-plane of 255, and no byte
-    // the decoder did not read after the last bit-plane (a truncated body is read to its end).
-    let used = dec.as_ref().map_or(0, |d| d.used);
-    if used < body.len() {
-        return Err(CodecError::TrailingBytes { extra: body.len() - used, length: bytes.len() });
+    work::with_work(|work| {
+        let body = &bytes[hl..];
+        let dec = (top != NO_PLANES)
+            .then(|| bitplane::decode(&bands, n, top as u32, body, &mut work.sig));
+        // The body is exactly the coded data: nothing after a top bit-plane of 255, and no byte
+        // the decoder did not read after the last bit-plane (a truncated body is read to its end).
+        let used = dec.as_ref().map_or(0, |d| d.used);
+        if used < body.len() {
+            return Err(CodecError::TrailingBytes {
+                extra: body.len() - used,
+                length: bytes.len(),
+            });
+        }
+        work.arrays.clear();
+        work.arrays.resize(n, 0.0);
+        let mut chans = split_arrays(&mut work.arrays, &arrays);
+        if let Some(dec) = dec {
+            place_significant(&bands, &scales, &arrays, &dec.significant, step, &mut chans);
+        }
+        for (a, &(w, h, lev)) in chans.iter_mut().zip(&arrays) {
+            lifting::inverse_2d(a, w, h, lev, &mut work.tmp);
+        }
+        let mut out = Vec::with_capacity(n);
+        colour::merge(planes, &chans, colour, &mut out);
+        if !out.iter().fold(true, |all, v| all & v.is_finite()) {
+            return Err(CodecError::Corrupt("decoded values overflow f32".into()));
+        }
+        Ok(out)
+    })
+}
+
+/// `buffer` cut into one slice per (plane, channel) array.
+fn split_arrays<'a>(mut buffer: &'a mut [f32], arrays: &[ArrayShape]) -> Vec<&'a mut [f32]> {
+    let mut out = Vec::with_capacity(arrays.len());
+    for &(w, h, _) in arrays {
+        let (head, rest) = std::mem::take(&mut buffer).split_at_mut(w * h);
+        out.push(head);
+        buffer = rest;
     }
-    let mut chans: Vec<Vec<f32>> = arrays.iter().map(|&(w, h, _)| vec![0.0f32; w * h]).collect();
-    if let Some(dec) = dec {
-        place_significant(&bands, &scales, &arrays, &dec.significant, step, &mut chans);
-    }
-    for (a, &(w, h, lev)) in chans.iter_mut().zip(&arrays) {
-        lifting::inverse_2d(a, w, h, lev);
-    }
-    let mut out = Vec::with_capacity(n);
-    colour::merge(planes, &chans, colour, &mut out);
-    if !out.iter().fold(true, |all, v| all & v.is_finite()) {
-        return Err(CodecError::Corrupt("decoded values overflow f32".into()));
-    }
-    Ok(out)
+    out
 }
