@@ -433,3 +433,12 @@ fn every_prefix_of_a_wavelet_stream_is_read_to_its_end() {
         assert!(decode(CodecId::Wavelet, &p, &s[..cut]).is_ok(), "cut {cut}");
     }
 }
+
+#[test]
+fn a_wavelet_codestream_of_more_values_than_its_indices_hold_is_refused_before_allocating() {
+    let huge = [PlaneShape::new(65_536, 65_536, 1)];
+    let bytes = encode(CodecId::Wavelet, &planes(), &values(70)).unwrap();
+    let err = decode(CodecId::Wavelet, &huge, &bytes).unwrap_err();
+    assert!(err.to_string().contains("4294967296 values in one codestream"), "{err}");
+    assert!(decode(CodecId::Wavelet, &huge, &[]).is_err());
+}

@@ -233,24 +233,39 @@ pub fn encode(bands: &[Band], a: &[f64], neg: &[bool], top: u32) -> (Vec<u8>, Ve
     (body, trace)
 }
 
-/// A coefficient the decoder found significant: its index in the coefficient array, its
-/// magnitude bits known so far with the sign in bit 31, the lowest bit-plane known, and the
-/// plane in which it became significant.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct Coefficient {
-    pub index: usize,
-    pub mag: u32,
-    pub low: u8,
-    plane: u8,
+/// The decoder's state of each coefficient, working memory that [`decode`] sizes and
+/// clears: `sig`, the plane + 1 in which it became significant (0: not yet); for the
+/// significant ones only (the others hold stale values), `mag`, the magnitude bits known so
+/// far with the sign in bit 31, and `low`, the lowest bit-plane known.
+#[derive(Default)]
+pub struct CoefficientState {
+    sig: Vec<u8>,
+    mag: Vec<u32>,
+    low: Vec<u8>,
 }
 
-impl Coefficient {
-    /// The reconstructed magnitude in units of the step, signed: the middle of the interval
-    /// that the decoded bits leave.
-    pub fn value(&self) -> f64 {
-        let m = self.mag & 0x7FFF_FFFF;
-        let v = m as f64 + 0.5 * (1u64 << self.low) as f64;
-        if self.mag >> 31 == 1 {
+impl CoefficientState {
+    /// Bytes held.
+    pub fn bytes(&self) -> usize {
+        self.sig.capacity() + 4 * self.mag.capacity() + self.low.capacity()
+    }
+
+    fn reset(&mut self, n: usize) {
+        self.sig.clear();
+        self.sig.resize(n, 0);
+        // Read only where `sig` says significant, which writes them first.
+        if self.mag.len() < n {
+            self.mag.resize(n, 0);
+            self.low.resize(n, 0);
+        }
+    }
+
+    /// The reconstructed magnitude of significant coefficient `i` in units of the step,
+    /// signed: the middle of the interval that the decoded bits leave.
+    pub fn value(&self, i: usize) -> f64 {
+        let m = self.mag[i] & 0x7FFF_FFFF;
+        let v = m as f64 + 0.5 * (1u64 << self.low[i]) as f64;
+        if self.mag[i] >> 31 == 1 {
             -v
         } else {
             v
@@ -258,10 +273,14 @@ impl Coefficient {
     }
 }
 
-/// The decoded stream: the significant coefficients in index order (every other one is 0).
-/// Their count is bounded by the body, each costing at least its sign's one bit.
+/// Largest coefficient count [`decode`] takes: indices are kept as `u32`.
+pub const MAX_COEFFICIENTS: usize = u32::MAX as usize;
+
+/// The decoded stream: the indices of the significant coefficients in index order (every
+/// other one is 0), their values in the [`CoefficientState`]. Their count is bounded by the
+/// body, each costing at least its sign's one bit.
 pub struct Decoded {
-    pub significant: Vec<Coefficient>,
+    pub significant: Vec<u32>,
     /// Body bytes the range decoder read: the whole body when it ended (a truncated stream)
     /// or when the stream is exact; fewer when bytes follow the coded data.
     pub used: usize,
@@ -289,12 +308,19 @@ fn merge_fresh<T: Copy>(sorted: &mut Vec<T>, fresh: &mut Vec<T>, index: impl Fn(
 /// Decodes as much of `body` as it holds (any prefix of an encoder's output is valid). The
 /// refinement pass visits only the coefficients already significant, in index order, as
 /// the encoder's scan of every coefficient meets them.
-/// `sig` is working memory (its contents do not matter).
-pub fn decode(bands: &[Band], n: usize, top: u32, body: &[u8], sig: &mut Vec<u8>) -> Decoded {
-    sig.clear();
-    sig.resize(n, 0);
-    let mut significant: Vec<Coefficient> = Vec::new();
-    let mut fresh: Vec<Coefficient> = Vec::new();
+/// `n` is at most [`MAX_COEFFICIENTS`].
+pub fn decode(
+    bands: &[Band],
+    n: usize,
+    top: u32,
+    body: &[u8],
+    state: &mut CoefficientState,
+) -> Decoded {
+    assert!(n <= MAX_COEFFICIENTS, "{n} coefficients");
+    state.reset(n);
+    let CoefficientState { sig, mag, low } = state;
+    let mut significant: Vec<u32> = Vec::new();
+    let mut fresh: Vec<u32> = Vec::new();
     let bases = tile_bases(bands);
     let mut tsig =
         vec![
@@ -351,29 +377,26 @@ pub fn decode(bands: &[Band], n: usize, top: u32, body: &[u8], sig: &mut Vec<u8>
                                     break 'planes;
                                 };
                                 sig[i] = p as u8 + 1;
-                                let mag = (1 << p) | ((negative as u32) << 31);
-                                fresh.push(Coefficient {
-                                    index: i,
-                                    mag,
-                                    low: p as u8,
-                                    plane: p as u8,
-                                });
+                                mag[i] = (1 << p) | ((negative as u32) << 31);
+                                low[i] = p as u8;
+                                fresh.push(i as u32);
                             }
                         }
                     }
                 }
             }
         }
-        for c in significant.iter_mut() {
-            let first = c.plane as u32 == p + 1;
+        for &i in &significant {
+            let i = i as usize;
+            let first = sig[i] as u32 == p + 2;
             let Some(bit) = dec.bit(&mut rctx[first as usize]) else {
                 break 'planes;
             };
-            c.mag |= (bit as u32) << p;
-            c.low = p as u8;
+            mag[i] |= (bit as u32) << p;
+            low[i] = p as u8;
         }
-        merge_fresh(&mut significant, &mut fresh, |c| c.index);
+        merge_fresh(&mut significant, &mut fresh, |&i| i as usize);
     }
-    merge_fresh(&mut significant, &mut fresh, |c| c.index);
+    merge_fresh(&mut significant, &mut fresh, |&i| i as usize);
     Decoded { significant, used: dec.position() }
 }

@@ -169,27 +169,28 @@ fn for_each_band_coef(
 }
 
 /// Writes each significant coefficient, dequantized, at its place in the Mallat layout of its
-/// array (`chans` holds zeros: every other coefficient is 0). `significant` is in index order,
-/// so the bands are met in order.
+/// array (`chans` holds zeros: every other coefficient is 0). The significant indices are in
+/// index order, so the bands are met in order.
 fn place_significant(
     bands: &[Band],
     scales: &[f32],
     arrays: &[ArrayShape],
-    significant: &[bitplane::Coefficient],
+    (significant, state): (&[u32], &bitplane::CoefficientState),
     step: f32,
     chans: &mut [&mut [f32]],
 ) {
     let places = band_places(arrays);
     let mut b = 0;
-    for c in significant {
-        while c.index >= bands[b].offset + bands[b].width * bands[b].height {
+    for &i in significant {
+        let i = i as usize;
+        while i >= bands[b].offset + bands[b].width * bands[b].height {
             b += 1;
         }
         let (band, (ai, x0, y0)) = (&bands[b], places[b]);
-        let k = c.index - band.offset;
+        let k = i - band.offset;
         let (y, x) = (k / band.width, k % band.width);
         let w = arrays[ai].0;
-        chans[ai][(y0 + y) * w + x0 + x] = (c.value() * step as f64 / scales[b] as f64) as f32;
+        chans[ai][(y0 + y) * w + x0 + x] = (state.value(i) * step as f64 / scales[b] as f64) as f32;
     }
 }
 
@@ -294,6 +295,12 @@ pub fn encode(planes: &[PlaneShape], values: &[f32], rate: Rate) -> Result<Vec<u
 /// to zeros.
 pub fn decode(planes: &[PlaneShape], bytes: &[u8]) -> Result<Vec<f32>, CodecError> {
     let n = value_count(planes)?;
+    if n > bitplane::MAX_COEFFICIENTS {
+        return Err(CodecError::Corrupt(format!(
+            "{n} values in one codestream (at most {})",
+            bitplane::MAX_COEFFICIENTS
+        )));
+    }
     if bytes.is_empty() {
         return Ok(vec![0.0; n]);
     }
@@ -311,7 +318,7 @@ pub fn decode(planes: &[PlaneShape], bytes: &[u8]) -> Result<Vec<f32>, CodecErro
     work::with_work(|work| {
         let body = &bytes[hl..];
         let dec = (top != NO_PLANES)
-            .then(|| bitplane::decode(&bands, n, top as u32, body, &mut work.sig));
+            .then(|| bitplane::decode(&bands, n, top as u32, body, &mut work.coefficients));
         // The body is exactly the coded data: nothing after a top bit-plane of 255, and no byte
         // the decoder did not read after the last bit-plane (a truncated body is read to its end).
         let used = dec.as_ref().map_or(0, |d| d.used);
@@ -325,7 +332,8 @@ pub fn decode(planes: &[PlaneShape], bytes: &[u8]) -> Result<Vec<f32>, CodecErro
         work.arrays.resize(n, 0.0);
         let mut chans = split_arrays(&mut work.arrays, &arrays);
         if let Some(dec) = dec {
-            place_significant(&bands, &scales, &arrays, &dec.significant, step, &mut chans);
+            let values = (&dec.significant[..], &work.coefficients);
+            place_significant(&bands, &scales, &arrays, values, step, &mut chans);
         }
         for (a, &(w, h, lev)) in chans.iter_mut().zip(&arrays) {
             lifting::inverse_2d(a, w, h, lev, &mut work.tmp);

@@ -5,14 +5,16 @@
 
 use std::cell::RefCell;
 
+use super::bitplane::CoefficientState;
+
 /// Bytes of working memory a thread keeps after a decode; a larger one is freed.
 const KEEP_BYTES: usize = 32 << 20;
 
 /// Buffers whose contents do not carry over: each decode sizes and clears what it uses.
 #[derive(Default)]
 pub struct Work {
-    /// Significance state, a byte per coefficient.
-    pub sig: Vec<u8>,
+    /// The bit-plane decoder's state, 6 bytes per coefficient.
+    pub coefficients: CoefficientState,
     /// Every (plane, channel) array, one after another.
     pub arrays: Vec<f32>,
     /// The lifting's row and column buffer.
@@ -21,7 +23,7 @@ pub struct Work {
 
 impl Work {
     fn bytes(&self) -> usize {
-        self.sig.capacity() + 4 * (self.arrays.capacity() + self.tmp.capacity())
+        self.coefficients.bytes() + 4 * (self.arrays.capacity() + self.tmp.capacity())
     }
 }
 
