@@ -405,7 +405,29 @@ fn depth_shells_follow_the_scene_and_play_as_predicted() {
         assert_eq!(l["shell"], "depth", "{l}");
         assert_eq!(l["depends_on"], serde_json::json!([]), "{l}");
     }
-    assert_plays_as_predicted(&depth, &traced_set(dir.path()));
+    let set = traced_set(dir.path());
+    assert_plays_as_predicted(&depth, &set);
+    // The march's step count in the player: 4 coarse steps step over the scene's geometry,
+    // the file's count (and more) find it (here 23.4, 25.8 and 25.8 dB).
+    let played = |steps: &[&str]| played_psnr(&depth, &set, steps);
+    let (file, few, many) =
+        (played(&[]), played(&["--depth-steps", "4"]), played(&["--depth-steps", "64"]));
+    eprintln!("depth shells marched in the file's steps: {file:.2} dB, 4: {few:.2}, 64: {many:.2}");
+    assert!(few < file - 1.0 && many > file - 0.1, "{file} {few} {many}");
+}
+
+/// pis-play's PSNR against `set` over its sample points, with `extra` flags.
+fn played_psnr(file: &Path, set: &Path, extra: &[&str]) -> f64 {
+    let out = Command::new(env!("CARGO_BIN_EXE_pis-play"))
+        .arg(file)
+        .args(["--headless", "--msaa", "1", "--json", "--compare"])
+        .arg(set)
+        .args(extra)
+        .output()
+        .expect("pis-play runs");
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let r: serde_json::Value = serde_json::from_slice(&out.stdout).expect("JSON");
+    r["psnr_db"].as_f64().expect("psnr_db")
 }
 
 /// `pis-bench reflective --reference-pair`: every reference traced twice from independent

@@ -24,6 +24,12 @@ pub fn parse_tau(s: &str) -> Result<f32, String> {
     }
 }
 
+fn parse_depth_steps(s: &str) -> Result<u32, String> {
+    let steps = s.parse::<u32>().ok();
+    pis_play::check_depth_steps(steps)?;
+    steps.ok_or_else(|| format!("--depth-steps {s:?}: expected a whole number"))
+}
+
 pub fn parse_msaa(s: &str) -> Result<u32, String> {
     let n = s.parse::<u32>().map_err(|_| format!("--msaa {s:?}: expected 1 or 4"))?;
     pis_play::multisample::check_samples(n).map(|()| n)
@@ -107,6 +113,11 @@ pub struct PlayArgs {
     /// their tessellation is refined where the vertex rays' paths differ (thesis 6.4.1's τ).
     #[arg(long, default_value_t = 1.0, value_name = "PIXELS", value_parser = parse_tau)]
     pub tau: f32,
+    /// Depth shells: the march's coarse steps along each reflected ray (1 to 64), in place
+    /// of the count the file records and its radiance was solved with. Fewer is faster and
+    /// misses thin occluders; more finds them where the file's count stepped over them.
+    #[arg(long, value_name = "N", value_parser = parse_depth_steps)]
+    pub depth_steps: Option<u32>,
     /// Where textures are rebuilt from their decoded level images: `gpu` (compute passes;
     /// the decoding threads only decode, and each level image goes up once and stays on the
     /// GPU while the cache keeps it), `workers` (summed on the decoding threads and uploaded
@@ -195,6 +206,7 @@ impl PlayArgs {
             blend: self.blend,
             msaa: self.msaa,
             tau_px: self.tau,
+            depth_steps: self.depth_steps,
             rebuild: self.rebuild,
             precision: self.texture_precision,
             display_filter: self

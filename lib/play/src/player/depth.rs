@@ -36,16 +36,30 @@ pub fn scene_triangles<S>(c: &Container<S>, own: usize) -> Vec<[Vec3; 3]> {
     out
 }
 
-/// The depth shell of a shell block's placement, its depth cube cast from `triangles`;
-/// `None` for another shape or parameters out of SPEC.md 7.3's ranges (rule 6007: the
-/// file's validation names them).
-pub fn depth_shell(placement: &Placement, triangles: &[[Vec3; 3]]) -> Option<Shell> {
+/// Checks a step count that replaces the files' ([`super::PlayerOptions::depth_steps`]).
+pub fn check_steps(steps: Option<u32>) -> Result<(), String> {
+    match steps {
+        Some(s) if !(1..=MAX_STEPS).contains(&s) => {
+            Err(format!("depth shells' march steps {s}: expected 1 to {MAX_STEPS}"))
+        }
+        _ => Ok(()),
+    }
+}
+
+/// The depth shell of a shell block's placement, its depth cube cast from `triangles`,
+/// marched in `steps` steps or the placement's; `None` for another shape or parameters out
+/// of SPEC.md 7.3's ranges (rule 6007: the file's validation names them).
+pub fn depth_shell(
+    placement: &Placement,
+    triangles: &[[Vec3; 3]],
+    steps: Option<u32>,
+) -> Option<Shell> {
     let Placement::Shell { shape: ShellShape::Depth, origin, params, .. } = placement else {
         return None;
     };
     let whole = |v: f32, max: u32| v.fract() == 0.0 && v >= 1.0 && v <= max as f32;
-    let (n, steps, far) = (params[0], params[1], params[2]);
-    if !(whole(n, MAX_SIZE) && whole(steps, MAX_STEPS) && far > 0.0 && far.is_finite()) {
+    let (n, file_steps, far) = (params[0], params[1], params[2]);
+    if !(whole(n, MAX_SIZE) && whole(file_steps, MAX_STEPS) && far > 0.0 && far.is_finite()) {
         return None;
     }
     let origin = Vec3::from(*origin);
@@ -53,11 +67,16 @@ pub fn depth_shell(placement: &Placement, triangles: &[[Vec3; 3]]) -> Option<She
         return None;
     }
     let cube = DepthCube::cast(origin, n as u32, far, triangles);
-    Some(Shell::depth(origin.as_dvec3(), cube, steps as u32))
+    Some(Shell::depth(origin.as_dvec3(), cube, steps.unwrap_or(file_steps as u32)))
 }
 
-/// Object `oi`'s depth shells, cast and uploaded.
-pub(super) fn object_depth_shells<S>(gpu: &Gpu, c: &Container<S>, oi: usize) -> DepthShells {
+/// Object `oi`'s depth shells, cast and uploaded, marched in `steps` steps or their files'.
+pub(super) fn object_depth_shells<S>(
+    gpu: &Gpu,
+    c: &Container<S>,
+    oi: usize,
+    steps: Option<u32>,
+) -> DepthShells {
     let mut out = DepthShells::new();
     let mut triangles = None;
     for (li, layer) in c.objects[oi].layers.iter().enumerate() {
@@ -66,11 +85,26 @@ pub(super) fn object_depth_shells<S>(gpu: &Gpu, c: &Container<S>, oi: usize) -> 
                 continue;
             }
             let tris = triangles.get_or_insert_with(|| scene_triangles(c, oi));
-            if let Some(shell) = depth_shell(&block.placement, tris) {
+            if let Some(shell) = depth_shell(&block.placement, tris, steps) {
                 let texture = DepthTexture::new(gpu, &shell);
                 out.insert((li, b as u32), (shell, texture));
             }
         }
     }
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_step_count_out_of_the_specs_range_is_refused() {
+        assert!(check_steps(None).is_ok() && check_steps(Some(1)).is_ok());
+        assert!(check_steps(Some(MAX_STEPS)).is_ok());
+        for bad in [0, MAX_STEPS + 1] {
+            let e = check_steps(Some(bad)).unwrap_err();
+            assert!(e.contains(&format!("steps {bad}: expected 1 to {MAX_STEPS}")), "{e}");
+        }
+    }
 }

@@ -41,6 +41,7 @@ use std::time::Instant;
 use pis_compile::Filter;
 use pis_format::PisReader;
 
+pub use self::depth::check_steps as check_depth_steps;
 use self::draws::{layer_draws, make_samplers, object_draws, reflection_draws, Samplers};
 use self::lens::{lens_corners, lens_draws, lens_requests, LensSet};
 use self::lens_ahead::LensAhead;
@@ -110,6 +111,7 @@ impl Player {
             )));
         }
         check_samples(options.msaa).map_err(PlayError::Request)?;
+        depth::check_steps(options.depth_steps).map_err(PlayError::Request)?;
         let reader = Arc::new(PisReader::open(path)?);
         let precision =
             precision::choose(&gpu, reader.container().provenance.as_ref(), options.precision);
@@ -119,7 +121,7 @@ impl Player {
         };
         check_texture_sizes(&gpu, &reader)?;
         budget::check_frame_memory(&gpu, reader.container(), &options)?;
-        let objects = prepare_objects(&gpu, &reader)?;
+        let objects = prepare_objects(&gpu, &reader, options.depth_steps)?;
         let filters = object_filters(reader.container());
         // The reader has checked the settings (rule 9002).
         let file_display =

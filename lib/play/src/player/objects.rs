@@ -108,7 +108,12 @@ pub(super) fn content(reader: &PisReader, message: String) -> PlayError {
 }
 
 /// Checks what the player relies on beyond the reader's validation and uploads the meshes.
-pub(super) fn prepare_objects(gpu: &Gpu, reader: &PisReader) -> Result<Vec<ObjectGpu>, PlayError> {
+/// `depth_steps` replaces the march's step count of depth shells ([`super::PlayerOptions`]).
+pub(super) fn prepare_objects(
+    gpu: &Gpu,
+    reader: &PisReader,
+    depth_steps: Option<u32>,
+) -> Result<Vec<ObjectGpu>, PlayError> {
     let c = reader.container();
     let mut out = Vec::with_capacity(c.objects.len());
     let mut skipped = Vec::new();
@@ -177,7 +182,7 @@ pub(super) fn prepare_objects(gpu: &Gpu, reader: &PisReader) -> Result<Vec<Objec
             MeshGpu::new(gpu, &o.mesh.positions, o.mesh.normals.as_deref(), &uvs, &o.mesh.indices)
                 .with_hull(o.mesh.hull_triangles);
         let translucent = layers.iter().any(|&li| o.layers[li].channels == 4);
-        let depth = object_depth_shells(gpu, c, oi);
+        let depth = object_depth_shells(gpu, c, oi, depth_steps);
         out.push(ObjectGpu { mesh, layers, reflection, lens, translucent, depth });
     }
     if !skipped.is_empty() {

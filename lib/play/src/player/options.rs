@@ -38,6 +38,10 @@ pub struct PlayerOptions {
     /// The precision textures are held in (default: half floats where the file records
     /// that they leave its frames within its coding error).
     pub precision: super::precision::TexturePrecision,
+    /// Depth shells (SPEC.md 8.5): the march's coarse steps along each reflected ray, in
+    /// place of the count the file records, which its radiance was solved with (1 to
+    /// `pis_compile::shell::depth::MAX_STEPS`; default: the file's).
+    pub depth_steps: Option<u32>,
 }
 
 /// Where textures are rebuilt from their decoded level images (SPEC.md 8.4: the level
@@ -95,6 +99,7 @@ impl Default for PlayerOptions {
             tau_px: TessellationSettings::default().tau_px,
             rebuild: Rebuild::Auto,
             precision: super::precision::TexturePrecision::Auto,
+            depth_steps: None,
         }
     }
 }
