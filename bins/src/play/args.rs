@@ -140,7 +140,8 @@ pub struct PlayArgs {
     /// its rebuild reads).
     #[arg(long, default_value_t = 512)]
     pub cache_mb: u64,
-    /// Decoding threads (default: one per core; the frame waits for its textures).
+    /// Decoding threads (default: one per core; the frame waits for its textures). Each keeps
+    /// up to 32 MiB of the wavelet decoder's working memory between level images.
     #[arg(long)]
     pub workers: Option<usize>,
     /// Draw every sample point of this ray-traced set and report PSNR against its gold
