@@ -225,7 +225,7 @@ pub fn encode(bands: &[Band], a: &[f64], neg: &[bool], top: u32) -> (Vec<u8>, Ve
             error += (a[i] - new).powi(2) - (a[i] - old).powi(2);
             record(needed, error, &mut trace);
         }
-        merge_fresh(&mut significant, &mut fresh, |&i| i);
+        merge_fresh(&mut significant, &mut fresh);
     }
     let total = enc.bytes_needed_for_next();
     let body = enc.finish();
@@ -289,16 +289,16 @@ pub struct Decoded {
 /// Merges `fresh` (what became significant in one plane, in tile order) into `sorted`
 /// (index order), keeping index order: the order in which the refinement pass's scan of
 /// every coefficient meets the significant ones.
-fn merge_fresh<T: Copy>(sorted: &mut Vec<T>, fresh: &mut Vec<T>, index: impl Fn(&T) -> usize) {
+fn merge_fresh<T: Copy + Ord>(sorted: &mut Vec<T>, fresh: &mut Vec<T>) {
     if fresh.is_empty() {
         return;
     }
-    fresh.sort_unstable_by_key(&index);
+    fresh.sort_unstable();
     let old = std::mem::take(sorted);
     sorted.reserve(old.len() + fresh.len());
     let (mut a, mut b) = (old.into_iter().peekable(), fresh.drain(..).peekable());
     while let (Some(x), Some(y)) = (a.peek(), b.peek()) {
-        let next = if index(x) < index(y) { a.next() } else { b.next() };
+        let next = if x < y { a.next() } else { b.next() };
         sorted.extend(next);
     }
     sorted.extend(a);
@@ -395,8 +395,8 @@ pub fn decode(
             mag[i] |= (bit as u32) << p;
             low[i] = p as u8;
         }
-        merge_fresh(&mut significant, &mut fresh, |&i| i as usize);
+        merge_fresh(&mut significant, &mut fresh);
     }
-    merge_fresh(&mut significant, &mut fresh, |&i| i as usize);
+    merge_fresh(&mut significant, &mut fresh);
     Decoded { significant, used: dec.position() }
 }
