@@ -21,6 +21,7 @@ pub mod frame;
 pub mod gpu;
 pub mod hybrid;
 pub mod image;
+pub mod lens_rays;
 pub mod memory;
 pub mod mip;
 pub mod multisample;

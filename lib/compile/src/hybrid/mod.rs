@@ -7,6 +7,7 @@
 
 pub mod layers;
 pub mod lens;
+pub mod lens_bvh;
 pub mod model;
 pub mod path;
 pub mod tessellate;
@@ -25,6 +26,7 @@ pub use path::{
     MAX_TERMS, TERMS,
 };
 pub use tessellate::{
-    tessellate, tessellate_timed, HybridVertex, HybridView, Tessellation, TessellationSettings,
-    TessellationStats, TessellationTimes,
+    tessellate, tessellate_timed, trace_vertex, CpuVertexTracer, HybridVertex, HybridView,
+    Tessellation, TessellationSettings, TessellationStats, TessellationTimes, VertexRay,
+    VertexTracer,
 };

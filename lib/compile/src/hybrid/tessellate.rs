@@ -132,6 +132,49 @@ pub fn trace_vertex(
     (HybridVertex { position, normal: n, visible, front_face, paths }, rays)
 }
 
+/// A vertex whose paths are to be traced: its position, shading normal and side
+/// ([`trace_vertex`]'s arguments).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct VertexRay {
+    pub position: Vec3,
+    pub normal: Vec3,
+    pub front_face: bool,
+}
+
+/// Traces the vertex rays of a tessellation level: each vertex as [`trace_vertex`] traces it,
+/// with the rays it cast. [`CpuVertexTracer`] runs [`trace_vertex`] on the workers; the
+/// player can trace them on the GPU instead (pis-play's `lens_rays`), the same walk written
+/// in WGSL.
+pub trait VertexTracer: Sync {
+    fn trace(
+        &self,
+        lens: &LensObject,
+        eye: Vec3,
+        rays: &[VertexRay],
+        model: LensModel,
+        max_depth: u32,
+    ) -> Vec<(HybridVertex, u64)>;
+}
+
+/// [`trace_vertex`] for each vertex, on the workers.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct CpuVertexTracer;
+
+impl VertexTracer for CpuVertexTracer {
+    fn trace(
+        &self,
+        lens: &LensObject,
+        eye: Vec3,
+        rays: &[VertexRay],
+        model: LensModel,
+        max_depth: u32,
+    ) -> Vec<(HybridVertex, u64)> {
+        rays.par_iter()
+            .map(|v| trace_vertex(lens, eye, v.position, v.normal, v.front_face, model, max_depth))
+            .collect()
+    }
+}
+
 /// Whether the eye sees `position` past the lens object's triangles.
 fn sees(lens: &LensObject, eye: Vec3, position: Vec3) -> bool {
     let to = position - eye;
@@ -149,20 +192,21 @@ pub struct TessellationTimes {
     pub tessellate: Duration,
 }
 
-/// Tessellates `lens` for `view`.
+/// Tessellates `lens` for `view`, its vertex rays traced on the workers.
 pub fn tessellate(
     lens: &LensObject,
     view: &HybridView,
     settings: &TessellationSettings,
 ) -> Tessellation {
-    tessellate_timed(lens, view, settings).0
+    tessellate_timed(lens, view, settings, &CpuVertexTracer).0
 }
 
-/// [`tessellate()`], and where its time went.
+/// [`tessellate()`] with the vertex rays traced by `tracer`, and where its time went.
 pub fn tessellate_timed(
     lens: &LensObject,
     view: &HybridView,
     settings: &TessellationSettings,
+    tracer: &dyn VertexTracer,
 ) -> (Tessellation, TessellationTimes) {
     let start = Instant::now();
     let cos_max = settings.max_angle_deg.to_radians().cos();
@@ -204,6 +248,7 @@ pub fn tessellate_timed(
         lens,
         view,
         settings,
+        tracer,
         vertices: Vec::new(),
         midpoints: HashMap::new(),
         stats,
@@ -329,6 +374,7 @@ struct Mesh<'a> {
     lens: &'a LensObject,
     view: &'a HybridView,
     settings: &'a TessellationSettings,
+    tracer: &'a dyn VertexTracer,
     vertices: Vec<HybridVertex>,
     /// Edge (lower, higher vertex index) → its midpoint vertex.
     midpoints: HashMap<(u32, u32), u32>,
@@ -337,18 +383,18 @@ struct Mesh<'a> {
 }
 
 impl Mesh<'_> {
-    /// Traces the paths of vertices `ids` (their position and normal set) on the workers.
+    /// Traces the paths of vertices `ids` (their position and normal set) with the tracer.
     fn trace(&mut self, ids: &[u32]) {
         let start = Instant::now();
-        let (lens, eye) = (self.lens, self.view.eye);
-        let (model, depth) = (self.settings.model, self.settings.max_depth);
-        let traced: Vec<(HybridVertex, u64)> = ids
-            .par_iter()
+        let rays: Vec<VertexRay> = ids
+            .iter()
             .map(|&i| {
-                let v = self.vertices[i as usize];
-                trace_vertex(lens, eye, v.position, v.normal, v.front_face, model, depth)
+                let v = &self.vertices[i as usize];
+                VertexRay { position: v.position, normal: v.normal, front_face: v.front_face }
             })
             .collect();
+        let (model, depth) = (self.settings.model, self.settings.max_depth);
+        let traced = self.tracer.trace(self.lens, self.view.eye, &rays, model, depth);
         for (&i, (v, rays)) in ids.iter().zip(traced) {
             self.vertices[i as usize] = v;
             self.stats.rays += rays;

@@ -16,8 +16,8 @@ use std::time::Instant;
 use anyhow::{anyhow, Result};
 use glam::{DVec3, Vec2, Vec3};
 use pis_compile::hybrid::{
-    hybrid_pixels, lens_paths, shell_vector, tessellate_timed, vertex_vectors, HybridView,
-    LensModel, LensObject, Missing, TessellationSettings, TERMS,
+    hybrid_pixels, lens_paths, shell_vector, tessellate_timed, vertex_vectors, CpuVertexTracer,
+    HybridView, LensModel, LensObject, Missing, TessellationSettings, TERMS,
 };
 use pis_compile::shell::geometry::{Shell, ShellShape};
 use pis_compile::Viewport;
@@ -228,7 +228,7 @@ pub fn run(req: &HybridRequest) -> Result<HybridReport, Failure> {
             for (k, &tau) in req.taus.iter().enumerate() {
                 let settings =
                     TessellationSettings { tau_px: tau, max_depth, ..Default::default() };
-                let (tess, times) = tessellate_timed(&lens, &view, &settings);
+                let (tess, times) = tessellate_timed(&lens, &view, &settings, &CpuVertexTracer);
                 let t = Instant::now();
                 let vectors = TERMS.map(|term| vertex_vectors(&tess, term, &shell));
                 let texgen = t.elapsed().as_secs_f64() * 1e3;

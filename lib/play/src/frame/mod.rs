@@ -26,7 +26,7 @@ mod encode;
 pub mod hybrid;
 mod lens_term;
 mod pipelines;
-mod readback;
+pub(crate) mod readback;
 pub mod reflection;
 pub mod resolve;
 mod targets;

@@ -1,0 +1,302 @@
+//! Lens objects' vertex rays traced on the GPU (thesis 6.4.1): each tessellation level's
+//! vertices go up as one storage buffer, one compute invocation per vertex walks its paths
+//! through the lens object's flat BVH (`lens_rays.wgsl`, uploaded once per placed object) and
+//! the paths come back for the tessellation's splitting decisions. The walk is
+//! pis-compile's [`trace_vertex`] written again in WGSL; [`CpuVertexTracer`] is the model it
+//! is held to (tests/lens_rays_vs_cpu.rs) and the fallback where the GPU cannot trace: a
+//! model whose paths go deeper than the shader's stack, a tree deeper than its node stack,
+//! or a failed readback.
+
+use std::sync::Arc;
+
+use bytemuck::{Pod, Zeroable};
+use glam::Vec3;
+use wgpu::util::DeviceExt;
+
+use pis_compile::hybrid::lens_bvh::{FlatBvh, MAX_STACK};
+use pis_compile::hybrid::{
+    CpuVertexTracer, HybridVertex, LensModel, LensObject, LensPath, Topology, VertexRay,
+    VertexTracer, MAX_TERMS,
+};
+
+use crate::frame::readback::map_read;
+use crate::gpu::Gpu;
+
+/// The deepest `max_depth` the shader's branch stack (16) holds: depth + 2 branches.
+pub const MAX_GPU_DEPTH: u32 = 14;
+/// Vertices per dispatch (the workgroup count stays within every device's limit).
+const BATCH: usize = 64 * 65_535;
+/// Bytes of one vertex's result (`VertexOut`).
+const OUT_BYTES: usize = 4 * (MAX_TERMS * 12 + 4);
+
+#[repr(C)]
+#[derive(Clone, Copy, Pod, Zeroable)]
+struct Params {
+    eye: [f32; 3],
+    count: u32,
+    ior: f32,
+    max_depth: u32,
+    terms_kept: u32,
+    min_weight: f32,
+    base: [f32; 3],
+    absorbing: u32,
+    sigma_a: [f32; 3],
+    nodes: u32,
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, Pod, Zeroable)]
+struct VertexIn {
+    position: [f32; 3],
+    front_face: u32,
+    normal: [f32; 3],
+    pad: u32,
+}
+
+/// The compute pipeline of `lens_rays.wgsl`, made once per device.
+pub struct LensRayPipeline {
+    layout: wgpu::BindGroupLayout,
+    pipeline: wgpu::ComputePipeline,
+}
+
+impl LensRayPipeline {
+    pub fn new(gpu: &Gpu) -> LensRayPipeline {
+        let d = &gpu.device;
+        let storage = |read_only| wgpu::BindingType::Buffer {
+            ty: wgpu::BufferBindingType::Storage { read_only },
+            has_dynamic_offset: false,
+            min_binding_size: None,
+        };
+        let uniform = wgpu::BindingType::Buffer {
+            ty: wgpu::BufferBindingType::Uniform,
+            has_dynamic_offset: false,
+            min_binding_size: None,
+        };
+        let types = [uniform, storage(true), storage(true), storage(true), storage(false)];
+        let entries: Vec<_> = types
+            .into_iter()
+            .enumerate()
+            .map(|(k, ty)| wgpu::BindGroupLayoutEntry {
+                binding: k as u32,
+                visibility: wgpu::ShaderStages::COMPUTE,
+                ty,
+                count: None,
+            })
+            .collect();
+        let layout = d.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("lens rays"),
+            entries: &entries,
+        });
+        let pl = d.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("lens rays"),
+            bind_group_layouts: &[Some(&layout)],
+            immediate_size: 0,
+        });
+        let module = d.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some("lens_rays.wgsl"),
+            source: wgpu::ShaderSource::Wgsl(include_str!("lens_rays.wgsl").into()),
+        });
+        let pipeline = d.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+            label: Some("lens rays"),
+            layout: Some(&pl),
+            module: &module,
+            entry_point: Some("trace"),
+            compilation_options: Default::default(),
+            cache: None,
+        });
+        LensRayPipeline { layout, pipeline }
+    }
+}
+
+/// A placed lens object on the GPU: its flat BVH, uploaded once, and what traces through it.
+pub struct GpuVertexTracer {
+    gpu: Arc<Gpu>,
+    pipeline: Arc<LensRayPipeline>,
+    nodes: wgpu::Buffer,
+    triangles: wgpu::Buffer,
+    node_count: u32,
+    /// Whether the shader's node stack holds the tree.
+    fits: bool,
+    /// The object's triangle count: the object traced must be the one uploaded.
+    triangle_count: usize,
+}
+
+impl GpuVertexTracer {
+    /// Uploads `lens`'s BVH.
+    pub fn new(gpu: Arc<Gpu>, pipeline: Arc<LensRayPipeline>, lens: &LensObject) -> Self {
+        let bvh = FlatBvh::new(lens);
+        // A buffer binding is never empty.
+        let words = |w: &[u32]| if w.is_empty() { vec![0u32; 8] } else { w.to_vec() };
+        let node_words: Vec<u32> = bvh.nodes.iter().flatten().copied().collect();
+        let tri_floats: Vec<f32> = bvh.triangles.iter().flatten().copied().collect();
+        let tri_words: Vec<u32> = tri_floats.iter().map(|f| f.to_bits()).collect();
+        let upload = |label, w: &[u32]| {
+            gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some(label),
+                contents: bytemuck::cast_slice(&words(w)),
+                usage: wgpu::BufferUsages::STORAGE,
+            })
+        };
+        let (nodes, triangles) =
+            (upload("lens nodes", &node_words), upload("lens triangles", &tri_words));
+        GpuVertexTracer {
+            node_count: bvh.nodes.len() as u32,
+            fits: bvh.depth < MAX_STACK,
+            triangle_count: lens.triangles.len(),
+            gpu,
+            pipeline,
+            nodes,
+            triangles,
+        }
+    }
+
+    /// Whether rays of `model` to `max_depth` through `lens` are traced on the GPU (else on
+    /// the workers).
+    pub fn traces(&self, lens: &LensObject, max_depth: u32) -> bool {
+        self.fits && max_depth <= MAX_GPU_DEPTH && lens.triangles.len() == self.triangle_count
+    }
+
+    /// One dispatch over `rays`: the raw results, [`OUT_BYTES`] each.
+    fn dispatch(
+        &self,
+        lens: &LensObject,
+        eye: Vec3,
+        rays: &[VertexRay],
+        model: LensModel,
+        max_depth: u32,
+    ) -> Result<Vec<u8>, crate::PlayError> {
+        let d = &self.gpu.device;
+        let m = lens.material;
+        let params = Params {
+            eye: eye.to_array(),
+            count: rays.len() as u32,
+            ior: m.ior,
+            max_depth,
+            terms_kept: model.terms() as u32,
+            min_weight: match model {
+                LensModel::Greedy => 0.0,
+                LensModel::Tree { min_weight, .. } => min_weight,
+            },
+            base: m.base.to_array(),
+            absorbing: (m.sigma_a != Vec3::ZERO) as u32,
+            sigma_a: m.sigma_a.to_array(),
+            nodes: self.node_count,
+        };
+        let input: Vec<VertexIn> = rays
+            .iter()
+            .map(|r| VertexIn {
+                position: r.position.to_array(),
+                front_face: r.front_face as u32,
+                normal: r.normal.to_array(),
+                pad: 0,
+            })
+            .collect();
+        let ubuf = d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("lens ray params"),
+            contents: bytemuck::bytes_of(&params),
+            usage: wgpu::BufferUsages::UNIFORM,
+        });
+        let ibuf = d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("vertex rays"),
+            contents: bytemuck::cast_slice(&input),
+            usage: wgpu::BufferUsages::STORAGE,
+        });
+        let size = (rays.len() * OUT_BYTES) as u64;
+        let out = d.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("vertex paths"),
+            size,
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+            mapped_at_creation: false,
+        });
+        let read = d.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("vertex paths readback"),
+            size,
+            usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+            mapped_at_creation: false,
+        });
+        let bg = d.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("lens rays"),
+            layout: &self.pipeline.layout,
+            entries: &[
+                wgpu::BindGroupEntry { binding: 0, resource: ubuf.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 1, resource: self.nodes.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 2, resource: self.triangles.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 3, resource: ibuf.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 4, resource: out.as_entire_binding() },
+            ],
+        });
+        let mut encoder = d.create_command_encoder(&Default::default());
+        {
+            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("lens rays"),
+                timestamp_writes: None,
+            });
+            pass.set_pipeline(&self.pipeline.pipeline);
+            pass.set_bind_group(0, &bg, &[]);
+            pass.dispatch_workgroups(rays.len().div_ceil(64) as u32, 1, 1);
+        }
+        encoder.copy_buffer_to_buffer(&out, 0, &read, 0, size);
+        self.gpu.queue.submit([encoder.finish()]);
+        map_read(&self.gpu, &read)
+    }
+}
+
+/// One vertex's result: `bytes` ([`OUT_BYTES`]) as the shader wrote them, with what the CPU
+/// keeps of the input itself (its position, normal and side).
+fn vertex(bytes: &[u8], ray: &VertexRay, eye: Vec3, model: LensModel) -> (HybridVertex, u64) {
+    let word = |k: usize| u32::from_le_bytes(bytes[k * 4..k * 4 + 4].try_into().expect("4 bytes"));
+    let float = |k: usize| f32::from_bits(word(k));
+    let vec = |k: usize| Vec3::new(float(k), float(k + 1), float(k + 2));
+    let mut paths: [Option<LensPath>; MAX_TERMS] = [None; MAX_TERMS];
+    for (t, path) in paths.iter_mut().enumerate().take(model.terms()) {
+        let k = t * 12;
+        if word(k + 3) != 0 {
+            *path = Some(LensPath {
+                exit_origin: vec(k),
+                exit_direction: vec(k + 4),
+                modulation: vec(k + 8),
+                topology: Topology { interfaces: word(k + 7) as u8, reflected: word(k + 11) },
+                exit: (),
+            });
+        }
+    }
+    let base = MAX_TERMS * 12;
+    // trace_vertex's normal, with the same glam operations.
+    let dir = (ray.position - eye).normalize();
+    let n = ray.normal.normalize_or_zero();
+    let normal = if n == Vec3::ZERO { -dir } else { n };
+    let v = HybridVertex {
+        position: ray.position,
+        normal,
+        visible: word(base) != 0,
+        front_face: ray.front_face,
+        paths,
+    };
+    (v, word(base + 1) as u64)
+}
+
+impl VertexTracer for GpuVertexTracer {
+    fn trace(
+        &self,
+        lens: &LensObject,
+        eye: Vec3,
+        rays: &[VertexRay],
+        model: LensModel,
+        max_depth: u32,
+    ) -> Vec<(HybridVertex, u64)> {
+        if rays.is_empty() || !self.traces(lens, max_depth) {
+            return CpuVertexTracer.trace(lens, eye, rays, model, max_depth);
+        }
+        let mut out = Vec::with_capacity(rays.len());
+        for chunk in rays.chunks(BATCH) {
+            match self.dispatch(lens, eye, chunk, model, max_depth) {
+                Ok(bytes) => out.extend(
+                    bytes.chunks_exact(OUT_BYTES).zip(chunk).map(|(b, r)| vertex(b, r, eye, model)),
+                ),
+                // A readback that failed: this level traced on the workers.
+                Err(_) => out.extend(CpuVertexTracer.trace(lens, eye, chunk, model, max_depth)),
+            }
+        }
+        out
+    }
+}
