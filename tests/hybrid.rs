@@ -580,18 +580,24 @@ fn a_glass_teapot_packed_and_played_by_hybrid_rendering() {
         "{text}"
     );
     // Both terms drawn per frame, from vertex rays traced per frame: by the frame itself
-    // without decoding ahead, else while the frame before drew (all but the first).
-    let path = |prefetch: &str| {
-        let args = ["--headless", "--path", "diagonal", "--prefetch", prefetch, "--json"];
-        let args: Vec<&std::ffi::OsStr> =
-            std::iter::once(pem.as_os_str()).chain(args.iter().map(|a| a.as_ref())).collect();
+    // without decoding ahead, else while the frame before drew (all but the first); on the
+    // workers or the GPU, the same rays and triangles but for a few in a thousand.
+    let path = |prefetch: &str, rays: &str| {
+        let args =
+            ["--headless", "--path", "diagonal", "--prefetch", prefetch, "--lens-rays", rays];
+        let args: Vec<&std::ffi::OsStr> = std::iter::once(pem.as_os_str())
+            .chain(args.iter().chain(&["--json"]).map(|a| a.as_ref()))
+            .collect();
         run_json(env!("CARGO_BIN_EXE_pis-play"), &args)
     };
-    let play = path("0");
+    let (play, on_gpu) = (path("0", "workers"), path("0", "gpu"));
     assert_eq!(play["lens_draws_mean"].as_f64(), Some(2.0), "{play}");
     assert!(play["lens_rays_mean"].as_f64().is_some_and(|r| r > 10_000.0), "{play}");
     assert_eq!(play["lens_traced_ahead"].as_u64(), Some(0), "{play}");
-    let ahead = path("2");
+    let near = |k: &str| (play[k].as_f64().unwrap() / on_gpu[k].as_f64().unwrap() - 1.0).abs();
+    assert!(on_gpu["lens_rays"] == "gpu" && near("lens_rays_mean") < 0.01, "{on_gpu}");
+    assert!(near("lens_triangles_mean") < 0.01, "{play} {on_gpu}");
+    let ahead = path("2", "auto");
     let frames = ahead["frames"].as_u64().expect("frames");
     assert_eq!(ahead["lens_traced_ahead"].as_u64(), Some(frames - 1), "{ahead}");
     // The same frame twice: the second draws the first's tessellation again (no ray traced)

@@ -327,6 +327,10 @@ enum Command {
         /// Samples per pixel of the played frames (--file), as pis-play --msaa.
         #[arg(long, default_value_t = pis_play::multisample::DEFAULT_SAMPLES, value_name = "1|4")]
         msaa: u32,
+        /// Where the vertex rays are traced, in the tessellation table and the played frames:
+        /// as pis-play --lens-rays (`auto`: on the GPU where the adapter is one).
+        #[arg(long, default_value = "auto", value_parser = pis::cli::one_of(&pis_play::LensRays::ALL, pis_play::LensRays::name))]
+        lens_rays: pis_play::LensRays,
         #[arg(long)]
         json: bool,
     },
@@ -626,7 +630,7 @@ fn run(cli: Cli) -> Result<Exit, Failure> {
             }
             Ok(Exit::Ok)
         }
-        Command::Hybrid { scene, tau, frames, resolution, preset, file, msaa, json } => {
+        Command::Hybrid { scene, tau, frames, resolution, preset, file, msaa, lens_rays, json } => {
             let report = hybrid::run(&HybridRequest {
                 scene,
                 preset,
@@ -635,6 +639,7 @@ fn run(cli: Cli) -> Result<Exit, Failure> {
                 frames,
                 file,
                 msaa,
+                lens_rays,
             })?;
             hybrid::print(&report, &mut std::io::stderr())
                 .map_err(|e| Failure::new(Exit::Io, e))?;

@@ -118,6 +118,12 @@ pub struct PlayArgs {
     /// misses thin occluders; more finds them where the file's count stepped over them.
     #[arg(long, value_name = "N", value_parser = parse_depth_steps)]
     pub depth_steps: Option<u32>,
+    /// Lens objects (hybrid rendering): where each tessellation level's vertex rays are
+    /// traced through the object: `gpu` (a compute pass over the object's BVH, uploaded
+    /// once; paths deeper than its stack go to the workers), `workers` (on the CPU), or
+    /// `auto`: `gpu` on a GPU, `workers` on a CPU rasterizer such as lavapipe.
+    #[arg(long, default_value = "auto", value_parser = crate::cli::one_of(&pis_play::LensRays::ALL, pis_play::LensRays::name))]
+    pub lens_rays: pis_play::LensRays,
     /// Where textures are rebuilt from their decoded level images: `gpu` (compute passes;
     /// the decoding threads only decode, and each level image goes up once and stays on the
     /// GPU while the cache keeps it), `workers` (summed on the decoding threads and uploaded
@@ -209,6 +215,7 @@ impl PlayArgs {
             tau_px: self.tau,
             depth_steps: self.depth_steps,
             rebuild: self.rebuild,
+            lens_rays: self.lens_rays,
             precision: self.texture_precision,
             display_filter: self
                 .compare

@@ -108,6 +108,8 @@ pub struct PathReport {
     pub workers: usize,
     /// Where textures were rebuilt from their level images: `gpu` or `workers`.
     pub rebuild: &'static str,
+    /// Where lens objects' vertex rays were traced: `gpu` or `workers`.
+    pub lens_rays: &'static str,
     /// Frames ahead whose textures were decoded while a frame drew (`--prefetch`).
     pub prefetch: usize,
     pub frames: usize,
@@ -527,6 +529,7 @@ pub fn run_frames(
         resolve: Resolve::of(player),
         workers: o.workers,
         rebuild: player.rebuild().name(),
+        lens_rays: player.lens_rays().name(),
         prefetch: args.prefetch,
         frames: all.len(),
         frames_waited: all.iter().filter(|s| s.decode_waits > 0).count(),
@@ -613,7 +616,8 @@ pub fn print_path_report(r: &PathReport, w: &mut impl std::io::Write) -> std::io
     writeln!(w)?;
     writeln!(w, "  draws per frame: {:.1} surface layers, {:.1} reflection terms (environment-map shells), {:.1} lens terms", r.surface_draws_mean, r.shell_draws_mean, r.lens_draws_mean)?;
     if r.lens_draws_mean > 0.0 {
-        writeln!(w, "  lens objects (vertex rays, tessellation, vertex buffers): mean {:.2} ms, worst {:.2}; {:.0} rays, {:.0} triangles per frame; {} tessellations found traced ahead, {} dropped", r.lens_ms_mean, r.lens_ms_worst, r.lens_rays_mean, r.lens_triangles_mean, r.lens_traced_ahead, r.lens_ahead_dropped)?;
+        let on = if r.lens_rays == "gpu" { "GPU" } else { "workers" };
+        writeln!(w, "  lens objects (vertex rays on the {on}, tessellation, vertex buffers): mean {:.2} ms, worst {:.2}; {:.0} rays, {:.0} triangles per frame; {} tessellations found traced ahead, {} dropped", r.lens_ms_mean, r.lens_ms_worst, r.lens_rays_mean, r.lens_triangles_mean, r.lens_traced_ahead, r.lens_ahead_dropped)?;
     }
     writeln!(
         w,

@@ -41,8 +41,8 @@ pub use hybrid::{render_hybrid, HybridPipeline};
 pub use image::FloatImage;
 pub use multisample::Multisample;
 pub use player::{
-    check_depth_steps, DirectionalLight, FrameRequest, FrameStats, Lights, Player, PlayerOptions,
-    PrecisionChoice, Rebuild, Relight, TexturePrecision,
+    check_depth_steps, DirectionalLight, FrameRequest, FrameStats, LensRays, Lights, Player,
+    PlayerOptions, PrecisionChoice, Rebuild, Relight, TexturePrecision,
 };
 pub use probe::{probe, probe_render_matrix, Probe};
 pub use shell::{render_shell, ShellPipeline, ShellTexture};

@@ -211,38 +211,8 @@ pub fn tessellate_timed(
     let start = Instant::now();
     let cos_max = settings.max_angle_deg.to_radians().cos();
     let mut stats = TessellationStats::default();
-    // Front-facing triangles, and the vertices they use.
-    let front: Vec<[u32; 3]> = (0..lens.triangles.len())
-        .filter(|&t| {
-            let a = lens.positions[lens.triangles[t][0] as usize];
-            lens.face_normal(t).dot(view.eye - a) > 0.0
-        })
-        .map(|t| lens.triangles[t])
-        .collect();
+    let (front, back, mut used) = faces(lens, view);
     stats.front_triangles = front.len() as u64;
-    let mut used = vec![false; lens.positions.len()];
-    front.iter().flatten().for_each(|&v| used[v as usize] = true);
-    // Back-facing triangles with a vertex no part of the object hides: an open mesh's
-    // inside seen through its holes (a closed mesh's are hidden, but at its silhouette).
-    let back_candidates: Vec<[u32; 3]> = (0..lens.triangles.len())
-        .filter(|&t| {
-            let a = lens.positions[lens.triangles[t][0] as usize];
-            lens.face_normal(t).dot(view.eye - a) <= 0.0
-        })
-        .map(|t| lens.triangles[t])
-        .collect();
-    let mut back_vertex: Vec<u32> =
-        back_candidates.iter().flatten().copied().filter(|&v| !used[v as usize]).collect();
-    back_vertex.sort_unstable();
-    back_vertex.dedup();
-    let seen: Vec<bool> =
-        back_vertex.par_iter().map(|&v| sees(lens, view.eye, lens.positions[v as usize])).collect();
-    let mut visible_back = vec![false; lens.positions.len()];
-    back_vertex.iter().zip(&seen).for_each(|(&v, &s)| visible_back[v as usize] = s);
-    let back: Vec<[u32; 3]> = back_candidates
-        .into_iter()
-        .filter(|t| t.iter().any(|&v| visible_back[v as usize]))
-        .collect();
     stats.back_triangles = back.len() as u64;
     let mut mesh = Mesh {
         lens,
@@ -353,6 +323,44 @@ pub fn tessellate_timed(
         tessellate: start.elapsed().saturating_sub(mesh.trace_time),
     };
     (Tessellation { vertices: mesh.vertices, triangles, stats }, times)
+}
+
+/// The triangles a tessellation starts from: the front-facing ones, the back-facing ones
+/// with a vertex the eye sees past the object (an open mesh's inside seen through its
+/// holes), and which vertices the front-facing ones use.
+fn faces(lens: &LensObject, view: &HybridView) -> (Vec<[u32; 3]>, Vec<[u32; 3]>, Vec<bool>) {
+    // Front-facing triangles, and the vertices they use.
+    let front: Vec<[u32; 3]> = (0..lens.triangles.len())
+        .filter(|&t| {
+            let a = lens.positions[lens.triangles[t][0] as usize];
+            lens.face_normal(t).dot(view.eye - a) > 0.0
+        })
+        .map(|t| lens.triangles[t])
+        .collect();
+    let mut used = vec![false; lens.positions.len()];
+    front.iter().flatten().for_each(|&v| used[v as usize] = true);
+    // Back-facing triangles with a vertex no part of the object hides: an open mesh's
+    // inside seen through its holes (a closed mesh's are hidden, but at its silhouette).
+    let back_candidates: Vec<[u32; 3]> = (0..lens.triangles.len())
+        .filter(|&t| {
+            let a = lens.positions[lens.triangles[t][0] as usize];
+            lens.face_normal(t).dot(view.eye - a) <= 0.0
+        })
+        .map(|t| lens.triangles[t])
+        .collect();
+    let mut back_vertex: Vec<u32> =
+        back_candidates.iter().flatten().copied().filter(|&v| !used[v as usize]).collect();
+    back_vertex.sort_unstable();
+    back_vertex.dedup();
+    let seen: Vec<bool> =
+        back_vertex.par_iter().map(|&v| sees(lens, view.eye, lens.positions[v as usize])).collect();
+    let mut visible_back = vec![false; lens.positions.len()];
+    back_vertex.iter().zip(&seen).for_each(|(&v, &s)| visible_back[v as usize] = s);
+    let back: Vec<[u32; 3]> = back_candidates
+        .into_iter()
+        .filter(|t| t.iter().any(|&v| visible_back[v as usize]))
+        .collect();
+    (front, back, used)
 }
 
 /// The children of `tri` (corners a, b, c) with midpoints `mids` on edges ab, bc, ca.

@@ -15,16 +15,19 @@ use std::time::Instant;
 
 use anyhow::{anyhow, Result};
 use glam::{DVec3, Vec2, Vec3};
+use pis_compile::hybrid::VertexTracer;
 use pis_compile::hybrid::{
     hybrid_pixels, lens_paths, shell_vector, tessellate_timed, vertex_vectors, CpuVertexTracer,
     HybridView, LensModel, LensObject, Missing, TessellationSettings, TERMS,
 };
 use pis_compile::shell::geometry::{Shell, ShellShape};
 use pis_compile::Viewport;
+use pis_play::lens_rays::{GpuVertexTracer, LensRayPipeline};
 use pis_scene::{LoadOptions, ObjectRole};
 use pis_trace::camera::{projection_matrix, PerspectiveCamera};
 use rayon::prelude::*;
 use serde::Serialize;
+use std::sync::Arc;
 
 use super::camera_path::{paths, PathKind};
 use crate::report::Stamp;
@@ -44,6 +47,8 @@ pub struct HybridRequest {
     pub file: Option<PathBuf>,
     /// The player's samples per pixel for `file`.
     pub msaa: u32,
+    /// Where the vertex rays are traced (the tessellation table and the played frames).
+    pub lens_rays: pis_play::LensRays,
 }
 
 /// The player's frame at one τ, means over the frames.
@@ -105,6 +110,8 @@ pub struct HybridReport {
     pub played: Vec<PlayedRow>,
     pub adapter: Option<String>,
     pub msaa: u32,
+    /// Where the vertex rays were traced: `gpu` (and on which adapter) or `workers`.
+    pub lens_rays: String,
     pub stamp: Stamp,
 }
 
@@ -146,6 +153,44 @@ fn percentile(mut v: Vec<f64>, f: f64) -> f64 {
     v[((v.len() - 1) as f64 * f).round() as usize]
 }
 
+/// A device and the pipeline that traces vertex rays on it.
+type GpuRays = (Arc<pis_play::Gpu>, Arc<LensRayPipeline>);
+
+/// The device and pipeline that trace the vertex rays where `choice` resolves to the GPU
+/// for this machine's adapter; `None`: on the workers. The pipeline is compiled and run
+/// once here, so that no tessellation pays for it.
+fn gpu_tracing(choice: pis_play::LensRays) -> Result<Option<GpuRays>, Failure> {
+    if choice == pis_play::LensRays::Workers {
+        return Ok(None);
+    }
+    let gpu = match pis_play::Gpu::new() {
+        Ok(g) => Arc::new(g),
+        Err(e) if choice == pis_play::LensRays::Gpu => {
+            return Err(Failure::new(Exit::NotSupported, anyhow!("--lens-rays gpu: {e}")))
+        }
+        Err(_) => return Ok(None),
+    };
+    if choice.on(gpu.info.device_type) != pis_play::LensRays::Gpu {
+        return Ok(None);
+    }
+    let pipeline = Arc::new(LensRayPipeline::new(&gpu));
+    // One vertex of a tetrahedron traced: the driver compiles the shader here.
+    let corners = vec![Vec3::ZERO, Vec3::X, Vec3::Y, Vec3::Z];
+    let material =
+        pis_compile::hybrid::LensMaterial { ior: 1.5, base: Vec3::ONE, sigma_a: Vec3::ZERO };
+    let tetra = LensObject::new(material, corners, vec![], &[0, 2, 1, 0, 1, 3, 0, 3, 2, 1, 2, 3]);
+    let ray =
+        pis_compile::hybrid::VertexRay { position: Vec3::X, normal: Vec3::ONE, front_face: true };
+    GpuVertexTracer::new(gpu.clone(), pipeline.clone(), &tetra).trace(
+        &tetra,
+        Vec3::splat(2.0),
+        &[ray],
+        LensModel::Greedy,
+        8,
+    );
+    Ok(Some((gpu, pipeline)))
+}
+
 /// The scene's lens objects (at least one), once the request's τ are checked.
 fn lenses(scene: &pis_scene::Scene, req: &HybridRequest) -> Result<Vec<usize>, Failure> {
     let lenses: Vec<usize> = scene
@@ -179,6 +224,7 @@ pub fn run(req: &HybridRequest) -> Result<HybridReport, Failure> {
     let viewport = Viewport { width: size.0, height: size.1 };
     let max_depth = pis_trace::TraceSettings::new(size, 1).max_depth;
     let n = frames.len() as f64;
+    let gpu_rays = gpu_tracing(req.lens_rays)?;
     let mut per_pixel = Vec::new();
     let mut rows = Vec::new();
     for &o in &lenses {
@@ -207,6 +253,12 @@ pub fn run(req: &HybridRequest) -> Result<HybridReport, Failure> {
             req.taus.iter().map(|_| [Vec::new(), Vec::new()]).collect();
         for pf in &frames {
             let lens = pis_pack::lens::lens_object(&scene, &pf.frame, o);
+            let tracer: Box<dyn VertexTracer> = match &gpu_rays {
+                Some((gpu, pipeline)) => {
+                    Box::new(GpuVertexTracer::new(gpu.clone(), pipeline.clone(), &lens))
+                }
+                None => Box::new(CpuVertexTracer),
+            };
             let camera = PerspectiveCamera::new(&pf.frame.camera, size);
             let clip_from_world = projection_matrix(&pf.frame.camera, size)
                 * pf.frame.camera.world_from_camera.inverse();
@@ -228,7 +280,7 @@ pub fn run(req: &HybridRequest) -> Result<HybridReport, Failure> {
             for (k, &tau) in req.taus.iter().enumerate() {
                 let settings =
                     TessellationSettings { tau_px: tau, max_depth, ..Default::default() };
-                let (tess, times) = tessellate_timed(&lens, &view, &settings, &CpuVertexTracer);
+                let (tess, times) = tessellate_timed(&lens, &view, &settings, tracer.as_ref());
                 let t = Instant::now();
                 let vectors = TERMS.map(|term| vertex_vectors(&tess, term, &shell));
                 let texgen = t.elapsed().as_secs_f64() * 1e3;
@@ -286,7 +338,8 @@ pub fn run(req: &HybridRequest) -> Result<HybridReport, Failure> {
     let (played, adapter, msaa) = match &req.file {
         Some(file) => {
             let base_ms: f64 = per_pixel.iter().map(|p| p.ms).sum();
-            let (rows, adapter, msaa) = play(&scene, file, &frames, &req.taus, req.msaa, base_ms)?;
+            let (rows, adapter, msaa) =
+                play(&scene, file, &frames, &req.taus, (req.msaa, req.lens_rays), base_ms)?;
             (rows, Some(adapter), msaa)
         }
         None => (Vec::new(), None, 0),
@@ -301,6 +354,10 @@ pub fn run(req: &HybridRequest) -> Result<HybridReport, Failure> {
         played,
         adapter,
         msaa,
+        lens_rays: match &gpu_rays {
+            Some((gpu, _)) => format!("gpu ({})", gpu.describe()),
+            None => "workers".into(),
+        },
         stamp: Stamp::here(&scene.name),
     })
 }
@@ -314,7 +371,7 @@ fn play(
     file: &std::path::Path,
     frames: &[super::camera_path::PathFrame],
     taus: &[f32],
-    msaa: u32,
+    (msaa, lens_rays): (u32, pis_play::LensRays),
     base_ms: f64,
 ) -> Result<(Vec<PlayedRow>, String, u32), Failure> {
     use pis_play::{CameraChoice, FrameRequest, Gpu, Player, PlayerOptions};
@@ -333,7 +390,7 @@ fn play(
         let mut player = Player::open(
             gpu.clone(),
             file,
-            PlayerOptions { tau_px: tau, msaa, ..PlayerOptions::default() },
+            PlayerOptions { tau_px: tau, msaa, lens_rays, ..PlayerOptions::default() },
         )
         .map_err(|e| Failure::new(Exit::Invalid, anyhow!("{}: {e}", file.display())))?;
         if player.image_size() != scene.resolution {
@@ -387,8 +444,8 @@ fn play(
 pub fn print(r: &HybridReport, w: &mut impl std::io::Write) -> std::io::Result<()> {
     writeln!(
         w,
-        "pis-bench hybrid: {} at {}x{}, {} frames between the sampled views, {} threads",
-        r.scene, r.size[0], r.size[1], r.frames, r.threads
+        "pis-bench hybrid: {} at {}x{}, {} frames between the sampled views, {} threads, vertex rays traced on {}",
+        r.scene, r.size[0], r.size[1], r.frames, r.threads, r.lens_rays
     )?;
     for p in &r.per_pixel {
         writeln!(

@@ -8,7 +8,7 @@ use std::time::Instant;
 
 use rayon::prelude::*;
 
-use pis_compile::hybrid::{tessellate, HybridView, Term};
+use pis_compile::hybrid::{tessellate_timed, HybridView, Term};
 use pis_compile::shell::Shell;
 use pis_format::PisReader;
 
@@ -96,13 +96,13 @@ pub(super) fn lens_corners(
                     }
                     None => {
                         let settings = state.settings(tau_px);
-                        let lens = state.at(plan.worlds[r.draw]);
+                        let (lens, tracer) = state.at(plan.worlds[r.draw]);
                         let view = HybridView {
                             eye: plan.eye,
                             clip_from_world: plan.clip_from_world,
                             size,
                         };
-                        let t = tessellate(lens, &view, &settings);
+                        let t = tessellate_timed(lens, &view, &settings, tracer.as_ref()).0;
                         work.rays += t.stats.rays;
                         t
                     }

@@ -5,12 +5,11 @@
 //! instead of tracing on its critical path. A tessellation made ahead is the one the frame
 //! would make: the same function of the same inputs.
 
-use std::sync::Arc;
 use std::thread::JoinHandle;
 
-use pis_compile::hybrid::{tessellate, HybridView, LensObject, Tessellation, TessellationSettings};
+use pis_compile::hybrid::{tessellate_timed, HybridView, Tessellation, TessellationSettings};
 
-use super::objects::TessellationKey;
+use super::objects::{Placed, TessellationKey};
 
 /// A tessellation being made for a predicted frame: the lens object's draw index, what it
 /// is made for, and the thread making it.
@@ -35,11 +34,12 @@ pub(super) type LensRequest = (usize, TessellationKey);
 impl LensAhead {
     /// Makes ahead the tessellations of `wanted` (in order): those already being made are
     /// kept, those no longer wanted dropped, the others started on threads of their own,
-    /// with the object `place(draw, transform)` gives and its tessellation settings.
+    /// with the object and tracer `place(draw, transform)` gives and its tessellation
+    /// settings.
     pub(super) fn start(
         &mut self,
         wanted: &[LensRequest],
-        place: impl Fn(usize, glam::Mat4) -> Option<(Arc<LensObject>, TessellationSettings)>,
+        place: impl Fn(usize, glam::Mat4) -> Option<(Placed, TessellationSettings)>,
     ) {
         let before = self.jobs.len();
         self.jobs.retain(|j| wanted.contains(&(j.draw, j.key)));
@@ -48,11 +48,11 @@ impl LensAhead {
             if self.jobs.iter().any(|j| (j.draw, j.key) == (draw, key)) {
                 continue;
             }
-            let Some((lens, settings)) = place(draw, key.0) else { continue };
+            let Some(((lens, tracer), settings)) = place(draw, key.0) else { continue };
             let view = HybridView { eye: key.1, clip_from_world: key.2, size: key.3 };
             let thread = std::thread::Builder::new()
                 .name("pis-lens-ahead".into())
-                .spawn(move || tessellate(&lens, &view, &settings));
+                .spawn(move || tessellate_timed(&lens, &view, &settings, tracer.as_ref()).0);
             // Without a thread the frame traces its lens objects itself.
             if let Ok(thread) = thread {
                 self.jobs.push(Job { draw, key, thread });

@@ -46,7 +46,7 @@ use self::draws::{layer_draws, make_samplers, object_draws, reflection_draws, Sa
 use self::lens::{lens_corners, lens_draws, lens_requests, LensSet};
 use self::lens_ahead::LensAhead;
 use self::objects::{check_texture_sizes, object_filters, prepare_objects, LensState, ObjectGpu};
-pub use self::options::{FrameRequest, FrameStats, PlayerOptions, Rebuild};
+pub use self::options::{FrameRequest, FrameStats, LensRays, PlayerOptions, Rebuild};
 use self::plan::{camera_record, Plan, TextureKey};
 pub use self::precision::{PrecisionChoice, TexturePrecision};
 use self::readout::{read_back, wait_for_gpu, Readbacks, Readout, Target};
@@ -61,6 +61,7 @@ use crate::error::PlayError;
 use crate::frame::{encode, offscreen_format, FrameDraws, FramePipelines, FrameTarget, Targets};
 use crate::gpu::Gpu;
 use crate::image::FloatImage;
+use crate::lens_rays::LensRayPipeline;
 use crate::mip::MipBuilder;
 use crate::multisample::{check_samples, choose, Multisample};
 pub use pis_compile::relight::{DirectionalLight, Lights};
@@ -121,7 +122,7 @@ impl Player {
         };
         check_texture_sizes(&gpu, &reader)?;
         budget::check_frame_memory(&gpu, reader.container(), &options)?;
-        let objects = prepare_objects(&gpu, &reader, options.depth_steps)?;
+        let mut objects = prepare_objects(&gpu, &reader, options.depth_steps)?;
         let filters = object_filters(reader.container());
         // The reader has checked the settings (rule 9002).
         let file_display =
@@ -142,6 +143,12 @@ impl Player {
         }
         if objects.iter().any(|o| o.lens.is_some()) {
             pipes.hybrid_pipeline(&gpu, offscreen, ms.samples);
+            if options.lens_rays.on(gpu.info.device_type) == LensRays::Gpu {
+                let rays = Arc::new(LensRayPipeline::new(&gpu));
+                for lens in objects.iter_mut().filter_map(|o| o.lens.as_mut()) {
+                    lens.trace_on_gpu(gpu.clone(), rays.clone());
+                }
+            }
         }
         let textures =
             Textures::new(&gpu, (decoder, cache), MipBuilder::new(&gpu), options.rebuild);
@@ -230,6 +237,12 @@ impl Player {
     /// [`Rebuild::Auto`] resolved for the adapter).
     pub fn rebuild(&self) -> Rebuild {
         self.textures.rebuild_on()
+    }
+
+    /// Where this player traces lens objects' vertex rays (the options' choice,
+    /// [`LensRays::Auto`] resolved for the adapter).
+    pub fn lens_rays(&self) -> LensRays {
+        self.options.lens_rays.on(self.gpu.info.device_type)
     }
 
     /// The formats this player holds the file's textures in, and why (the options' choice,

@@ -2,7 +2,9 @@
 //! mesh, its surface layers, its reflection term's shells, and, for a lens object, what its
 //! tessellation is traced from; and the checks of the file's textures against the adapter.
 
-use pis_compile::hybrid::{LensMaterial, LensObject};
+use std::sync::Arc;
+
+use pis_compile::hybrid::{CpuVertexTracer, LensMaterial, LensObject, VertexTracer};
 use pis_compile::{Filter, TextureLayout};
 use pis_format::{Container, Mapping, PisReader, Placement, StreamRef, Term};
 
@@ -11,6 +13,7 @@ use crate::error::PlayError;
 use crate::frame::hybrid::MAX_LENS_SHELLS;
 use crate::frame::{MeshGpu, MAX_TERM_SHELLS};
 use crate::gpu::Gpu;
+use crate::lens_rays::{GpuVertexTracer, LensRayPipeline};
 use crate::textured::allocated_size;
 
 /// An object's mesh on the GPU and the layers the player draws.
@@ -41,37 +44,55 @@ pub(super) struct LensState {
     material: LensMaterial,
     /// The paths traced at its vertices and the terms drawn (SPEC.md 6.6 `lens_model`).
     pub(super) model: pis_compile::hybrid::LensModel,
-    placed: Option<(glam::Mat4, std::sync::Arc<LensObject>)>,
+    placed: Option<(glam::Mat4, Placed)>,
+    /// Where its vertex rays are traced on the GPU: the device and the pipeline (`None`: on
+    /// the workers).
+    gpu_rays: Option<(Arc<Gpu>, Arc<LensRayPipeline>)>,
     /// The last frame's tessellation and what it was made for (transform, eye, view and
     /// projection, frame size, τ): a frame that changes none of them draws it again.
-    pub(super) tessellated:
-        Option<(TessellationKey, std::sync::Arc<pis_compile::hybrid::Tessellation>)>,
+    pub(super) tessellated: Option<(TessellationKey, Arc<pis_compile::hybrid::Tessellation>)>,
 }
 
 /// What a lens object's tessellation depends on.
 pub(super) type TessellationKey = (glam::Mat4, glam::Vec3, glam::Mat4, (u32, u32), f32);
 
+/// A lens object placed at a transform, and what traces its vertex rays (on the GPU, its
+/// BVH uploaded once per placement; or on the workers).
+pub(super) type Placed = (Arc<LensObject>, Arc<dyn VertexTracer + Send + Sync>);
+
 impl LensState {
-    /// The lens object at `world` (rigid), built once per transform.
-    pub(super) fn at(&mut self, world: glam::Mat4) -> &LensObject {
+    /// The lens object at `world` (rigid) and its tracer, made once per transform.
+    pub(super) fn at(&mut self, world: glam::Mat4) -> &Placed {
         if self.placed.as_ref().is_none_or(|(m, _)| *m != world) {
             self.placed = Some((world, self.placed_at(world)));
         }
         &self.placed.as_ref().expect("placed above").1
     }
 
-    /// The lens object at `world`: the one drawn last where the transform is the same, else
-    /// built anew (for a frame expected next, leaving the last one in place).
-    pub(super) fn placed_at(&self, world: glam::Mat4) -> std::sync::Arc<LensObject> {
+    /// The lens object at `world` and its tracer: those drawn last where the transform is
+    /// the same, else made anew (for a frame expected next, leaving the last in place).
+    pub(super) fn placed_at(&self, world: glam::Mat4) -> Placed {
         match &self.placed {
-            Some((m, lens)) if *m == world => lens.clone(),
+            Some((m, placed)) if *m == world => placed.clone(),
             _ => {
                 let positions = self.positions.iter().map(|&p| world.transform_point3(p)).collect();
                 let normals = self.normals.iter().map(|&n| world.transform_vector3(n)).collect();
                 let lens = LensObject::new(self.material, positions, normals, &self.indices);
-                std::sync::Arc::new(lens)
+                let tracer: Arc<dyn VertexTracer + Send + Sync> = match &self.gpu_rays {
+                    Some((gpu, pipeline)) => {
+                        Arc::new(GpuVertexTracer::new(gpu.clone(), pipeline.clone(), &lens))
+                    }
+                    None => Arc::new(CpuVertexTracer),
+                };
+                (Arc::new(lens), tracer)
             }
         }
+    }
+
+    /// Traces its vertex rays on `gpu` from now on.
+    pub(super) fn trace_on_gpu(&mut self, gpu: Arc<Gpu>, pipeline: Arc<LensRayPipeline>) {
+        self.gpu_rays = Some((gpu, pipeline));
+        self.placed = None;
     }
 
     /// The settings its tessellations are made with at `tau_px`.
@@ -319,6 +340,7 @@ fn lens_state(
         material,
         model: pis_compile::hybrid::file_lens_model(model),
         placed: None,
+        gpu_rays: None,
         tessellated: None,
     }))
 }

@@ -42,6 +42,48 @@ pub struct PlayerOptions {
     /// place of the count the file records, which its radiance was solved with (1 to
     /// `pis_compile::shell::depth::MAX_STEPS`; default: the file's).
     pub depth_steps: Option<u32>,
+    /// Where lens objects' vertex rays are traced (default: on the GPU where the adapter is
+    /// one, on the workers where it is a CPU rasterizer).
+    pub lens_rays: LensRays,
+}
+
+/// Where lens objects' vertex rays are traced (thesis 6.4.1): the walk of each tessellation
+/// level's vertices through the lens object.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum LensRays {
+    /// [`LensRays::Gpu`] on a GPU, [`LensRays::Workers`] on a CPU rasterizer (Mesa's
+    /// lavapipe), where a compute pass runs on the same cores as the workers.
+    #[default]
+    Auto,
+    /// A compute pass per tessellation level (`lens_rays.wgsl`), the lens object's BVH
+    /// uploaded once per placement; paths deeper than the shader's stack are traced on the
+    /// workers.
+    Gpu,
+    /// On the workers (pis-compile's `trace_vertex`, the reference the GPU is held to).
+    Workers,
+}
+
+impl LensRays {
+    /// The name `--lens-rays` takes.
+    pub fn name(self) -> &'static str {
+        match self {
+            LensRays::Auto => "auto",
+            LensRays::Gpu => "gpu",
+            LensRays::Workers => "workers",
+        }
+    }
+
+    /// Every choice, in the order the tools list them.
+    pub const ALL: [LensRays; 3] = [LensRays::Auto, LensRays::Gpu, LensRays::Workers];
+
+    /// The choice made for an adapter of `device_type`: [`LensRays::Auto`] resolved.
+    pub fn on(self, device_type: wgpu::DeviceType) -> LensRays {
+        match (self, device_type) {
+            (LensRays::Auto, wgpu::DeviceType::Cpu) => LensRays::Workers,
+            (LensRays::Auto, _) => LensRays::Gpu,
+            (r, _) => r,
+        }
+    }
 }
 
 /// Where textures are rebuilt from their decoded level images (SPEC.md 8.4: the level
@@ -100,6 +142,7 @@ impl Default for PlayerOptions {
             rebuild: Rebuild::Auto,
             precision: super::precision::TexturePrecision::Auto,
             depth_steps: None,
+            lens_rays: LensRays::Auto,
         }
     }
 }
