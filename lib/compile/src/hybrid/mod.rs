@@ -1,9 +1,10 @@
-//! Hybrid rendering of lens objects (thesis ch. 6), the part the player computes per frame
-//! on the CPU: the greedy two-path model traced through the lens object alone at the
-//! vertices of an adaptively refined tessellation ([`tessellate()`]), giving per vertex the
-//! outgoing rays that index the layered environment-map shells and the F·G modulation of
-//! each term. One function, used by the player each frame and by pis-pack's render
-//! matrices.
+//! Hybrid rendering of lens objects (thesis ch. 6), the part the player computes per frame:
+//! the lens model's paths traced through the lens object alone at the vertices of an
+//! adaptively refined tessellation ([`tessellate()`]), giving per vertex the outgoing rays
+//! that index the layered environment-map shells and the F·G modulation of each term. One
+//! function, used by the player each frame and by pis-pack's render matrices; the vertex
+//! walk ([`trace_vertex`]) is written again in WGSL for the player's GPU (pis-play's
+//! `lens_rays.wgsl`, over [`lens_bvh`]'s flat BVH), behind [`VertexTracer`].
 
 pub mod layers;
 pub mod lens;
