@@ -27,6 +27,7 @@
 
 pub mod blocks;
 pub mod choice;
+pub mod confidence;
 pub mod density_choice;
 pub mod encode;
 pub mod filter_choice;

@@ -144,8 +144,14 @@ pub(crate) mod tests {
                 &taps,
             );
             let b = vec![0.5; n * 3];
-            v.push(PointView { a: vec![(0, a)], diffuse: b.clone(), specular: b, alpha: vec![] })
-                .unwrap();
+            v.push(PointView {
+                a: vec![(0, a)],
+                diffuse: b.clone(),
+                specular: b,
+                alpha: vec![],
+                weight: vec![],
+            })
+            .unwrap();
         }
         v
     }

@@ -41,6 +41,11 @@ pub struct LoadedSet {
     /// Per point, the outgoing-ray records of the lens objects (RAYSET.md 6; empty where the
     /// set has none).
     pub records: Vec<Vec<pis_trace::RayRecord>>,
+    /// Whether the solves weigh each pixel's rows by the set's confidence in it
+    /// (`--confidence`, [`super::confidence`]).
+    pub weigh_rows: bool,
+    /// Per point, the layers read from their denoised twins (RAYSET.md 5.4).
+    pub denoised: Vec<Vec<String>>,
 }
 
 impl LoadedSet {
@@ -277,6 +282,12 @@ pub fn load(req: &PackRequest, stages: &mut Stages) -> Result<LoadedSet, Failure
     let mut spans = Vec::new();
     let channel_names = pis_trace::channel_names(&scene);
     let mut records = Vec::new();
+    let denoised: Vec<Vec<String>> = set
+        .meta
+        .points
+        .iter()
+        .map(|p| p.denoise.as_ref().map_or_else(Vec::new, |d| d.layers.clone()))
+        .collect();
     // Only the layers (and ray records) the pack reads are kept, as each point is read.
     let with_records = set.meta.objects.iter().any(|o| o.records)
         && req.representation != super::RepresentationMode::Texture;
@@ -343,6 +354,8 @@ pub fn load(req: &PackRequest, stages: &mut Stages) -> Result<LoadedSet, Failure
         display_filter: set.meta.filter,
         trace,
         records,
+        weigh_rows: req.confidence,
+        denoised: if set.raw { Vec::new() } else { denoised },
     };
     super::transforms::check_transforms(&loaded.scene, &loaded.frames)
         .map_err(|e| Failure::new(Exit::NotSupported, e))?;

@@ -28,6 +28,9 @@ pub struct PointView {
     /// A translucent object's opacity per row, in each of 3 channels (empty for an opaque
     /// object; its radiance is then premultiplied by it).
     pub alpha: Vec<f32>,
+    /// Per row, the set's confidence in its pixel, which multiplies both sides of the row in
+    /// the solves (thesis 6.3.3; [`super::confidence`]); empty: 1 for every row.
+    pub weight: Vec<f32>,
 }
 
 impl PointView {
@@ -62,6 +65,7 @@ impl PointView {
         w.f32s(&self.diffuse);
         w.f32s(&self.specular);
         w.f32s(&self.alpha);
+        w.f32s(&self.weight);
         w.0
     }
 
@@ -74,9 +78,9 @@ impl PointView {
             let p = r.u64()? as usize;
             a.push((p, r.matrix()?));
         }
-        let (diffuse, specular, alpha) = (r.f32s()?, r.f32s()?, r.f32s()?);
+        let (diffuse, specular, alpha, weight) = (r.f32s()?, r.f32s()?, r.f32s()?, r.f32s()?);
         r.done()?;
-        Ok(PointView { a, diffuse, specular, alpha })
+        Ok(PointView { a, diffuse, specular, alpha, weight })
     }
 }
 
@@ -445,6 +449,7 @@ mod tests {
             diffuse: vec![0.1 * p as f32; 6],
             specular: vec![-0.0; 6],
             alpha: vec![0.5; 6],
+            weight: vec![1.0, 0.25],
         }
     }
 
@@ -454,6 +459,7 @@ mod tests {
             && a.a.iter().zip(&b.a).all(|((pa, ma), (pb, mb))| pa == pb && ma == mb)
             && bits(&a.diffuse) == bits(&b.diffuse)
             && bits(&a.specular) == bits(&b.specular)
+            && bits(&a.weight) == bits(&b.weight)
             && bits(&a.alpha) == bits(&b.alpha)
     }
 

@@ -61,7 +61,11 @@ impl Sample<'_> {
             let zero = || vec![0.0; self.placement.layout.texel_count() * 3];
             return Ok((start.map_or_else(zero, <[f32]>::to_vec), 0));
         }
-        let s = solver.solve(a, &radiance.at(&v), start, settings)?;
+        // A view-dependent layer's rows weighed by the set's confidence in their pixels
+        // (`--confidence`); the stacked solves are not (measured worse: [`super::confidence`]).
+        let b = radiance.at(&v);
+        let (a, b) = super::confidence::weigh(a, &b, &v.weight);
+        let s = solver.solve(&a, &b, start, settings)?;
         Ok((s.texels, s.iterations as u64))
     }
 }

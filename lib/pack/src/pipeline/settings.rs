@@ -200,6 +200,10 @@ pub struct PackSettings {
     /// [`pis_format::MAX_SHELL_LOOKUPS`]; SPEC.md 8.2): k × k sub-pixel lookups averaged,
     /// recorded in each shell block for the player.
     pub shell_lookups: u32,
+    /// Weigh each pixel's rows by the set's confidence in it (thesis 6.3.3;
+    /// [`super::confidence`]): sets traced with adaptive sampling record the error each
+    /// pixel stopped at.
+    pub confidence: bool,
     /// Layered environment maps: which distant shell a reflective object gets.
     pub distant_shell: DistantShell,
     /// Where the set turns a light over directions (`light_direction`), store surface
@@ -261,6 +265,7 @@ impl PackSettings {
             placement: PlacementMode::Block,
             stagger: Stagger::Auto,
             shell_lookups: 1,
+            confidence: false,
             distant_shell: DistantShell::Fitted,
             relight: true,
             max_iterations: None,

@@ -19,6 +19,7 @@ use pis_scene::ObjectRole;
 use pis_trace::layers::LayerKind as TraceLayer;
 use pis_trace::PointImages;
 
+use super::confidence::rows_confidence;
 use super::density_choice;
 use super::input::LoadedSet;
 use super::matrices::Matrices;
@@ -138,7 +139,8 @@ fn views_of(
         } else {
             Vec::new()
         };
-        views.push(PointView { a: vec![(0, a)], diffuse, specular, alpha })?;
+        let weight = rows_confidence(set, p, o, &a.pixels)?;
+        views.push(PointView { a: vec![(0, a)], diffuse, specular, alpha, weight })?;
     }
     Ok(views)
 }
