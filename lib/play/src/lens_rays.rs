@@ -7,7 +7,7 @@
 //! model whose paths go deeper than the shader's stack, a tree deeper than its node stack,
 //! or a failed readback.
 
-use std::sync::Arc;
+use std::sync::{Arc, Mutex};
 
 use bytemuck::{Pod, Zeroable};
 use glam::Vec3;
@@ -19,7 +19,7 @@ use pis_compile::hybrid::{
     VertexTracer, MAX_TERMS,
 };
 
-use crate::frame::readback::map_read;
+use crate::frame::readback::map_read_range;
 use crate::gpu::Gpu;
 
 /// The deepest `max_depth` the shader's branch stack (16) holds: depth + 2 branches.
@@ -119,6 +119,50 @@ pub struct GpuVertexTracer {
     fits: bool,
     /// The object's triangle count: the object traced must be the one uploaded.
     triangle_count: usize,
+    /// The buffers of a level, kept for the next (made anew for a larger one).
+    buffers: Mutex<Option<LevelBuffers>>,
+}
+
+/// The buffers one dispatch reads and writes, for up to `capacity` vertices, and their
+/// bindings.
+struct LevelBuffers {
+    capacity: usize,
+    params: wgpu::Buffer,
+    input: wgpu::Buffer,
+    output: wgpu::Buffer,
+    read: wgpu::Buffer,
+    bind_group: wgpu::BindGroup,
+}
+
+impl LevelBuffers {
+    fn new(gpu: &Gpu, pipeline: &LensRayPipeline, lens: &GpuVertexTracer, n: usize) -> Self {
+        let d = &gpu.device;
+        let buffer = |label, size: usize, usage| {
+            d.create_buffer(&wgpu::BufferDescriptor {
+                label: Some(label),
+                size: size as u64,
+                usage,
+                mapped_at_creation: false,
+            })
+        };
+        use wgpu::BufferUsages as U;
+        let params = buffer("lens ray params", size_of::<Params>(), U::UNIFORM | U::COPY_DST);
+        let input = buffer("vertex rays", n * size_of::<VertexIn>(), U::STORAGE | U::COPY_DST);
+        let output = buffer("vertex paths", n * OUT_BYTES, U::STORAGE | U::COPY_SRC);
+        let read = buffer("vertex paths readback", n * OUT_BYTES, U::COPY_DST | U::MAP_READ);
+        let bind_group = d.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("lens rays"),
+            layout: &pipeline.layout,
+            entries: &[
+                wgpu::BindGroupEntry { binding: 0, resource: params.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 1, resource: lens.nodes.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 2, resource: lens.triangles.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 3, resource: input.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 4, resource: output.as_entire_binding() },
+            ],
+        });
+        LevelBuffers { capacity: n, params, input, output, read, bind_group }
+    }
 }
 
 impl GpuVertexTracer {
@@ -143,6 +187,7 @@ impl GpuVertexTracer {
             node_count: bvh.nodes.len() as u32,
             fits: bvh.depth < MAX_STACK,
             triangle_count: lens.triangles.len(),
+            buffers: Mutex::new(None),
             gpu,
             pipeline,
             nodes,
@@ -191,40 +236,15 @@ impl GpuVertexTracer {
                 pad: 0,
             })
             .collect();
-        let ubuf = d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("lens ray params"),
-            contents: bytemuck::bytes_of(&params),
-            usage: wgpu::BufferUsages::UNIFORM,
-        });
-        let ibuf = d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("vertex rays"),
-            contents: bytemuck::cast_slice(&input),
-            usage: wgpu::BufferUsages::STORAGE,
-        });
+        let mut held = self.buffers.lock().unwrap_or_else(|e| e.into_inner());
+        if held.as_ref().is_none_or(|b| b.capacity < rays.len()) {
+            *held = Some(LevelBuffers::new(&self.gpu, &self.pipeline, self, rays.len()));
+        }
+        let b = held.as_ref().expect("made above");
+        let q = &self.gpu.queue;
+        q.write_buffer(&b.params, 0, bytemuck::bytes_of(&params));
+        q.write_buffer(&b.input, 0, bytemuck::cast_slice(&input));
         let size = (rays.len() * OUT_BYTES) as u64;
-        let out = d.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("vertex paths"),
-            size,
-            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
-            mapped_at_creation: false,
-        });
-        let read = d.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("vertex paths readback"),
-            size,
-            usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
-            mapped_at_creation: false,
-        });
-        let bg = d.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("lens rays"),
-            layout: &self.pipeline.layout,
-            entries: &[
-                wgpu::BindGroupEntry { binding: 0, resource: ubuf.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 1, resource: self.nodes.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 2, resource: self.triangles.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 3, resource: ibuf.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 4, resource: out.as_entire_binding() },
-            ],
-        });
         let mut encoder = d.create_command_encoder(&Default::default());
         {
             let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
@@ -232,12 +252,12 @@ impl GpuVertexTracer {
                 timestamp_writes: None,
             });
             pass.set_pipeline(&self.pipeline.pipeline);
-            pass.set_bind_group(0, &bg, &[]);
+            pass.set_bind_group(0, &b.bind_group, &[]);
             pass.dispatch_workgroups(rays.len().div_ceil(64) as u32, 1, 1);
         }
-        encoder.copy_buffer_to_buffer(&out, 0, &read, 0, size);
-        self.gpu.queue.submit([encoder.finish()]);
-        map_read(&self.gpu, &read)
+        encoder.copy_buffer_to_buffer(&b.output, 0, &b.read, 0, size);
+        q.submit([encoder.finish()]);
+        map_read_range(&self.gpu, &b.read, size)
     }
 }
 

@@ -7,8 +7,14 @@ use crate::image::FloatImage;
 
 /// Maps a buffer the GPU has been told to fill and returns its bytes.
 pub fn map_read(gpu: &Gpu, buffer: &wgpu::Buffer) -> Result<Vec<u8>, PlayError> {
+    map_read_range(gpu, buffer, buffer.size())
+}
+
+/// Maps the first `size` bytes of a buffer the GPU has been told to fill and returns them.
+pub fn map_read_range(gpu: &Gpu, buffer: &wgpu::Buffer, size: u64) -> Result<Vec<u8>, PlayError> {
     let (tx, rx) = std::sync::mpsc::channel();
-    buffer.slice(..).map_async(wgpu::MapMode::Read, move |r| {
+    let slice = buffer.slice(..size);
+    slice.map_async(wgpu::MapMode::Read, move |r| {
         let _ = tx.send(r);
     });
     gpu.device
@@ -17,11 +23,7 @@ pub fn map_read(gpu: &Gpu, buffer: &wgpu::Buffer) -> Result<Vec<u8>, PlayError> 
     rx.recv()
         .map_err(|e| PlayError::Readback(e.to_string()))?
         .map_err(|e| PlayError::Readback(e.to_string()))?;
-    let bytes = buffer
-        .slice(..)
-        .get_mapped_range()
-        .map_err(|e| PlayError::Readback(e.to_string()))?
-        .to_vec();
+    let bytes = slice.get_mapped_range().map_err(|e| PlayError::Readback(e.to_string()))?.to_vec();
     buffer.unmap();
     Ok(bytes)
 }
