@@ -256,8 +256,8 @@ impl GpuVertexTracer {
             pass.dispatch_workgroups(rays.len().div_ceil(64) as u32, 1, 1);
         }
         encoder.copy_buffer_to_buffer(&b.output, 0, &b.read, 0, size);
-        q.submit([encoder.finish()]);
-        map_read_range(&self.gpu, &b.read, size)
+        let submitted = q.submit([encoder.finish()]);
+        map_read_range(&self.gpu, &b.read, size, Some(submitted))
     }
 }
 

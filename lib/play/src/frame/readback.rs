@@ -7,18 +7,25 @@ use crate::image::FloatImage;
 
 /// Maps a buffer the GPU has been told to fill and returns its bytes.
 pub fn map_read(gpu: &Gpu, buffer: &wgpu::Buffer) -> Result<Vec<u8>, PlayError> {
-    map_read_range(gpu, buffer, buffer.size())
+    map_read_range(gpu, buffer, buffer.size(), None)
 }
 
-/// Maps the first `size` bytes of a buffer the GPU has been told to fill and returns them.
-pub fn map_read_range(gpu: &Gpu, buffer: &wgpu::Buffer, size: u64) -> Result<Vec<u8>, PlayError> {
+/// Maps the first `size` bytes of a buffer that submission `after` fills (`None`: the
+/// latest submission) and returns them; later submissions, from other threads, are not
+/// waited for.
+pub fn map_read_range(
+    gpu: &Gpu,
+    buffer: &wgpu::Buffer,
+    size: u64,
+    after: Option<wgpu::SubmissionIndex>,
+) -> Result<Vec<u8>, PlayError> {
     let (tx, rx) = std::sync::mpsc::channel();
     let slice = buffer.slice(..size);
     slice.map_async(wgpu::MapMode::Read, move |r| {
         let _ = tx.send(r);
     });
     gpu.device
-        .poll(wgpu::PollType::wait_indefinitely())
+        .poll(wgpu::PollType::Wait { submission_index: after, timeout: None })
         .map_err(|e| PlayError::Readback(e.to_string()))?;
     rx.recv()
         .map_err(|e| PlayError::Readback(e.to_string()))?
