@@ -147,10 +147,11 @@ pub struct PackOptions {
     /// the player draws them so.
     #[arg(long, value_name = "1|2|3", default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=pis_format::MAX_SHELL_LOOKUPS as i64))]
     pub shell_lookups: u32,
-    /// Weigh each pixel's rows in the solves by the set's confidence in it (thesis 6.3.3): a
-    /// set traced with adaptive sampling (pis-trace --noise-threshold) records the error each
-    /// pixel stopped at, and a pixel that stopped above the threshold counts threshold ÷
-    /// error. Sets without that record are solved as with `off`.
+    /// Weigh each pixel's rows in the view-dependent layers' solves by the set's confidence in
+    /// it (thesis 6.3.3): a set traced with adaptive sampling (pis-trace --noise-threshold)
+    /// records the error each pixel stopped at, and a pixel that stopped above the threshold
+    /// counts threshold ÷ error. A layer read from its denoised twin, and a set without that
+    /// record, are solved as with `off`.
     #[arg(long, default_value = "off", value_name = "on|off", action = clap::ArgAction::Set, value_parser = parse_on_off)]
     pub confidence: bool,
     /// Layered environment maps: a reflective object's distant shell. `fitted`: a box on the
