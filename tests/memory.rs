@@ -210,7 +210,12 @@ fn the_player_refuses_a_frame_beyond_its_cache_budget() {
     // In a window (under Xvfb, where it is installed; CI has it) the player opens the same way.
     let xvfb = std::process::Command::new("xvfb-run").arg("--help").output().is_ok();
     if xvfb || std::env::var_os("CI").is_some_and(|v| !v.is_empty()) {
-        let window = code_and_stderr("xvfb-run", &["-a", PLAY, f, "--frames", "1"]);
+        // The X authority file the test's own, so xvfb-run removes no folder of its own
+        // after pis-play exits (a failure there is its own exit 5).
+        let auth = dir.path().join("Xauthority");
+        std::fs::File::create(&auth).unwrap();
+        let auth = auth.to_str().unwrap();
+        let window = code_and_stderr("xvfb-run", &["-a", "-f", auth, PLAY, f, "--frames", "1"]);
         assert_refused("pis-play (window)", window, &names, &["(pis-play --cache-mb)"]);
     } else {
         eprintln!("xvfb-run is not installed: the window's refusal is not checked");

@@ -18,9 +18,14 @@ fn in_ci() -> bool {
 
 const PLAY: &str = env!("CARGO_BIN_EXE_pis-play");
 
-/// pis-play in a window on a fresh Xvfb display.
+/// pis-play in a window on a fresh Xvfb display. The X authority file is the test's own
+/// (`-f`): xvfb-run then makes and removes no temporary folder of its own, whose removal
+/// could fail after pis-play had exited and replace pis-play's exit status with its own (5).
 fn window(args: &[&std::ffi::OsStr]) -> Output {
-    let mut all = vec![os("-a"), os(PLAY)];
+    let auth = tempfile::tempdir().expect("temp dir");
+    let file = auth.path().join("Xauthority");
+    std::fs::File::create(&file).expect("X authority file");
+    let mut all = vec![os("-a"), os("-f"), os(&file), os(PLAY)];
     all.extend_from_slice(args);
     run("xvfb-run", &all, &[])
 }
