@@ -276,28 +276,15 @@ fn cube_bilinear(cube: texture_2d_array<f32>, size: u32, d: vec3<f32>, m: u32) -
     let j0 = floor(v);
     let a = u - i0;
     let b = v - j0;
-    // The footprint inside the face (nearly every lookup): the same four texels and weights
-    // as below, without the edge and corner logic.
-    let i = i32(i0);
-    let j = i32(j0);
-    if (i >= 0 && j >= 0 && i + 1 < ni && j + 1 < ni) {
-        let f = i32(face);
-        var inside = vec4<f32>(0.0);
-        inside = inside + ((1.0 - a) * (1.0 - b) + 0.0) * textureLoad(cube, vec2<i32>(i, j), f, i32(m));
-        inside = inside + (a * (1.0 - b) + 0.0) * textureLoad(cube, vec2<i32>(i + 1, j), f, i32(m));
-        inside = inside + ((1.0 - a) * b + 0.0) * textureLoad(cube, vec2<i32>(i, j + 1), f, i32(m));
-        inside = inside + (a * b + 0.0) * textureLoad(cube, vec2<i32>(i + 1, j + 1), f, i32(m));
-        return inside;
-    }
-    let third = bilinear_corner(i, j, ni, a, b) / 3.0;
+    let third = bilinear_corner(i32(i0), i32(j0), ni, a, b) / 3.0;
     var acc = vec4<f32>(0.0);
     for (var dj = 0; dj < 2; dj = dj + 1) {
         for (var di = 0; di < 2; di = di + 1) {
-            let ii = i + di;
-            let jj = j + dj;
-            let corner = beyond(ii, ni) && beyond(jj, ni);
+            let i = i32(i0) + di;
+            let j = i32(j0) + dj;
+            let corner = beyond(i, ni) && beyond(j, ni);
             let w = select(select(1.0 - a, a, di == 1) * select(1.0 - b, b, dj == 1) + third, 0.0, corner);
-            let t = cube_texel(face, select(ii, clamp(ii, 0, ni - 1), corner), select(jj, clamp(jj, 0, ni - 1), corner), n);
+            let t = cube_texel(face, select(i, clamp(i, 0, ni - 1), corner), select(j, clamp(j, 0, ni - 1), corner), n);
             acc = acc + w * textureLoad(cube, vec2<i32>(t.y, t.z), t.x, i32(m));
         }
     }
