@@ -135,8 +135,8 @@ struct LevelBuffers {
 }
 
 impl LevelBuffers {
-    fn new(gpu: &Gpu, pipeline: &LensRayPipeline, lens: &GpuVertexTracer, n: usize) -> Self {
-        let d = &gpu.device;
+    fn new(lens: &GpuVertexTracer, n: usize) -> Self {
+        let d = &lens.gpu.device;
         let buffer = |label, size: usize, usage| {
             d.create_buffer(&wgpu::BufferDescriptor {
                 label: Some(label),
@@ -152,7 +152,7 @@ impl LevelBuffers {
         let read = buffer("vertex paths readback", n * OUT_BYTES, U::COPY_DST | U::MAP_READ);
         let bind_group = d.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("lens rays"),
-            layout: &pipeline.layout,
+            layout: &lens.pipeline.layout,
             entries: &[
                 wgpu::BindGroupEntry { binding: 0, resource: params.as_entire_binding() },
                 wgpu::BindGroupEntry { binding: 1, resource: lens.nodes.as_entire_binding() },
@@ -238,7 +238,7 @@ impl GpuVertexTracer {
             .collect();
         let mut held = self.buffers.lock().unwrap_or_else(|e| e.into_inner());
         if held.as_ref().is_none_or(|b| b.capacity < rays.len()) {
-            *held = Some(LevelBuffers::new(&self.gpu, &self.pipeline, self, rays.len()));
+            *held = Some(LevelBuffers::new(self, rays.len()));
         }
         let b = held.as_ref().expect("made above");
         let q = &self.gpu.queue;
