@@ -15,8 +15,8 @@ use wgpu::util::DeviceExt;
 
 use pis_compile::hybrid::lens_bvh::{FlatBvh, MAX_STACK};
 use pis_compile::hybrid::{
-    CpuVertexTracer, HybridVertex, LensModel, LensObject, LensPath, Topology, VertexRay,
-    VertexTracer, MAX_TERMS,
+    vertex_normal, view_ray, CpuVertexTracer, HybridVertex, LensModel, LensObject, LensPath,
+    Topology, VertexRay, VertexTracer, MAX_TERMS,
 };
 
 use crate::frame::readback::map_read_range;
@@ -105,6 +105,23 @@ impl LensRayPipeline {
             cache: None,
         });
         LensRayPipeline { layout, pipeline }
+    }
+}
+
+/// A device and the pipeline that traces vertex rays on it.
+pub type GpuRays = (Arc<Gpu>, Arc<LensRayPipeline>);
+
+/// What traces `lens`'s vertex rays: the GPU where `gpu` is given (the object's BVH uploaded
+/// now), else the workers.
+pub fn vertex_tracer(
+    gpu: Option<&GpuRays>,
+    lens: &LensObject,
+) -> Arc<dyn VertexTracer + Send + Sync> {
+    match gpu {
+        Some((gpu, pipeline)) => {
+            Arc::new(GpuVertexTracer::new(gpu.clone(), pipeline.clone(), lens))
+        }
+        None => Arc::new(CpuVertexTracer),
     }
 }
 
@@ -218,10 +235,7 @@ impl GpuVertexTracer {
             ior: m.ior,
             max_depth,
             terms_kept: model.terms() as u32,
-            min_weight: match model {
-                LensModel::Greedy => 0.0,
-                LensModel::Tree { min_weight, .. } => min_weight,
-            },
+            min_weight: model.min_weight(),
             base: m.base.to_array(),
             absorbing: (m.sigma_a != Vec3::ZERO) as u32,
             sigma_a: m.sigma_a.to_array(),
@@ -281,13 +295,10 @@ fn vertex(bytes: &[u8], ray: &VertexRay, eye: Vec3, model: LensModel) -> (Hybrid
         }
     }
     let base = MAX_TERMS * 12;
-    // trace_vertex's normal, with the same glam operations.
-    let dir = (ray.position - eye).normalize();
-    let n = ray.normal.normalize_or_zero();
-    let normal = if n == Vec3::ZERO { -dir } else { n };
+    // trace_vertex's normal, by the same functions.
     let v = HybridVertex {
         position: ray.position,
-        normal,
+        normal: vertex_normal(ray.normal, view_ray(eye, ray.position).0),
         visible: word(base) != 0,
         front_face: ray.front_face,
         paths,

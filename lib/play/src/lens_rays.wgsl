@@ -9,7 +9,7 @@ struct Params {
     eye: vec3f,
     count: u32,
     ior: f32,
-    // min(max_depth, the walk's cap); the stack below holds max_depth + 2 branches.
+    // At most 14 (MAX_GPU_DEPTH): the branch stack holds max_depth + 2 branches.
     max_depth: u32,
     terms_kept: u32,
     min_weight: f32,

@@ -52,6 +52,14 @@ impl LensModel {
         }
     }
 
+    /// The least weight a path keeps (0 for the greedy model).
+    pub fn min_weight(self) -> f32 {
+        match self {
+            LensModel::Greedy => 0.0,
+            LensModel::Tree { min_weight, .. } => min_weight,
+        }
+    }
+
     /// Whether this is the greedy model (which set.json leaves unrecorded).
     pub fn is_greedy(&self) -> bool {
         *self == LensModel::Greedy
@@ -171,10 +179,7 @@ pub fn lens_paths<H>(
     mut next: impl FnMut(Vec3, Vec3) -> Step<H>,
 ) -> [Option<LensPath<H>>; MAX_TERMS] {
     let mut terms: [Option<LensPath<H>>; MAX_TERMS] = std::array::from_fn(|_| None);
-    let min_weight = match model {
-        LensModel::Greedy => 0.0,
-        LensModel::Tree { min_weight, .. } => min_weight,
-    };
+    let min_weight = model.min_weight();
     let root = Branch {
         position: first.position,
         geometric_normal: first.geometric_normal,

@@ -74,7 +74,7 @@ impl FlatBvh {
             })
             .collect::<Vec<_>>();
         let triangles = bvh.primitive_indices.iter().map(|&t| triangle_words(lens, t)).collect();
-        let depth = depth_of(&nodes, 0);
+        let depth = depth_of(&nodes);
         FlatBvh { nodes, triangles, depth }
     }
 
@@ -161,10 +161,10 @@ fn box_distance(n: &[u32; NODE_WORDS], ray: &Ray) -> f32 {
     aabb.intersect_ray(ray)
 }
 
-/// The longest path from node `i` down to a leaf, in nodes.
-fn depth_of(nodes: &[[u32; NODE_WORDS]], i: usize) -> usize {
+/// The longest path from the root down to a leaf, in nodes.
+fn depth_of(nodes: &[[u32; NODE_WORDS]]) -> usize {
     let mut deepest = 0;
-    let mut stack = vec![(i, 1usize)];
+    let mut stack = vec![(0, 1usize)];
     while let Some((k, d)) = stack.pop() {
         deepest = deepest.max(d);
         if nodes[k][3] == 0 {

@@ -27,7 +27,7 @@ pub use path::{
     MAX_TERMS, TERMS,
 };
 pub use tessellate::{
-    tessellate, tessellate_timed, trace_vertex, CpuVertexTracer, HybridVertex, HybridView,
-    Tessellation, TessellationSettings, TessellationStats, TessellationTimes, VertexRay,
-    VertexTracer,
+    tessellate, tessellate_timed, trace_vertex, vertex_normal, view_ray, CpuVertexTracer,
+    HybridVertex, HybridView, Tessellation, TessellationSettings, TessellationStats,
+    TessellationTimes, VertexRay, VertexTracer,
 };

@@ -116,20 +116,35 @@ pub fn trace_vertex(
     model: LensModel,
     max_depth: u32,
 ) -> (HybridVertex, u64) {
-    let to = position - eye;
-    let distance = to.length();
-    let dir = to / distance;
+    let (dir, distance) = view_ray(eye, position);
     let eps = 1e-4 * (1.0 + position.abs().max_element());
     let visible = lens.closest(eye, dir, distance - eps).is_none();
     // The vertex's own surface: its shading normal stands for the geometric one too (a
     // vertex has no single face).
-    let n = normal.normalize_or_zero();
-    let n = if n == Vec3::ZERO { -dir } else { n };
+    let n = vertex_normal(normal, dir);
     let facing = if front_face { n } else { -n };
     let first = LensSurface { position, normal: facing, geometric_normal: facing, front_face };
     let (paths, rays) = lens_paths_counted(lens, &first, dir, model, max_depth);
     let rays = 1 + rays;
     (HybridVertex { position, normal: n, visible, front_face, paths }, rays)
+}
+
+/// The unit direction from `eye` to `position`, and their distance.
+pub fn view_ray(eye: Vec3, position: Vec3) -> (Vec3, f32) {
+    let to = position - eye;
+    let distance = to.length();
+    (to / distance, distance)
+}
+
+/// A traced vertex's shading normal: `normal` made unit, or facing the eye (−`dir`, the
+/// view ray's direction) where it is zero.
+pub fn vertex_normal(normal: Vec3, dir: Vec3) -> Vec3 {
+    let n = normal.normalize_or_zero();
+    if n == Vec3::ZERO {
+        -dir
+    } else {
+        n
+    }
 }
 
 /// A vertex whose paths are to be traced: its position, shading normal and side

@@ -15,14 +15,13 @@ use std::time::Instant;
 
 use anyhow::{anyhow, Result};
 use glam::{DVec3, Vec2, Vec3};
-use pis_compile::hybrid::VertexTracer;
 use pis_compile::hybrid::{
-    hybrid_pixels, lens_paths, shell_vector, tessellate_timed, vertex_vectors, CpuVertexTracer,
-    HybridView, LensModel, LensObject, Missing, TessellationSettings, TERMS,
+    hybrid_pixels, lens_paths, shell_vector, tessellate_timed, vertex_vectors, HybridView,
+    LensModel, LensObject, Missing, TessellationSettings, TERMS,
 };
 use pis_compile::shell::geometry::{Shell, ShellShape};
 use pis_compile::Viewport;
-use pis_play::lens_rays::{GpuVertexTracer, LensRayPipeline};
+use pis_play::lens_rays::{vertex_tracer, GpuRays, LensRayPipeline};
 use pis_scene::{LoadOptions, ObjectRole};
 use pis_trace::camera::{projection_matrix, PerspectiveCamera};
 use rayon::prelude::*;
@@ -153,9 +152,6 @@ fn percentile(mut v: Vec<f64>, f: f64) -> f64 {
     v[((v.len() - 1) as f64 * f).round() as usize]
 }
 
-/// A device and the pipeline that traces vertex rays on it.
-type GpuRays = (Arc<pis_play::Gpu>, Arc<LensRayPipeline>);
-
 /// The device and pipeline that trace the vertex rays where `choice` resolves to the GPU
 /// for this machine's adapter; `None`: on the workers. The pipeline is compiled and run
 /// once here, so that no tessellation pays for it.
@@ -181,14 +177,15 @@ fn gpu_tracing(choice: pis_play::LensRays) -> Result<Option<GpuRays>, Failure> {
     let tetra = LensObject::new(material, corners, vec![], &[0, 2, 1, 0, 1, 3, 0, 3, 2, 1, 2, 3]);
     let ray =
         pis_compile::hybrid::VertexRay { position: Vec3::X, normal: Vec3::ONE, front_face: true };
-    GpuVertexTracer::new(gpu.clone(), pipeline.clone(), &tetra).trace(
+    let gpu_rays = (gpu, pipeline);
+    vertex_tracer(Some(&gpu_rays), &tetra).trace(
         &tetra,
         Vec3::splat(2.0),
         &[ray],
         LensModel::Greedy,
         8,
     );
-    Ok(Some((gpu, pipeline)))
+    Ok(Some(gpu_rays))
 }
 
 /// The scene's lens objects (at least one), once the request's τ are checked.
@@ -253,12 +250,7 @@ pub fn run(req: &HybridRequest) -> Result<HybridReport, Failure> {
             req.taus.iter().map(|_| [Vec::new(), Vec::new()]).collect();
         for pf in &frames {
             let lens = pis_pack::lens::lens_object(&scene, &pf.frame, o);
-            let tracer: Box<dyn VertexTracer> = match &gpu_rays {
-                Some((gpu, pipeline)) => {
-                    Box::new(GpuVertexTracer::new(gpu.clone(), pipeline.clone(), &lens))
-                }
-                None => Box::new(CpuVertexTracer),
-            };
+            let tracer = vertex_tracer(gpu_rays.as_ref(), &lens);
             let camera = PerspectiveCamera::new(&pf.frame.camera, size);
             let clip_from_world = projection_matrix(&pf.frame.camera, size)
                 * pf.frame.camera.world_from_camera.inverse();

@@ -46,7 +46,7 @@ use self::draws::{layer_draws, make_samplers, object_draws, reflection_draws, Sa
 use self::lens::{lens_corners, lens_draws, lens_requests, LensSet};
 use self::lens_ahead::LensAhead;
 use self::objects::{check_texture_sizes, object_filters, prepare_objects, LensState, ObjectGpu};
-pub use self::options::{FrameRequest, FrameStats, LensRays, PlayerOptions, Rebuild};
+pub use self::options::{FrameRequest, FrameStats, LensRays, PlayerOptions, Rebuild, RunOn};
 use self::plan::{camera_record, Plan, TextureKey};
 pub use self::precision::{PrecisionChoice, TexturePrecision};
 use self::readout::{read_back, wait_for_gpu, Readbacks, Readout, Target};

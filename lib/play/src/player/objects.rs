@@ -4,7 +4,7 @@
 
 use std::sync::Arc;
 
-use pis_compile::hybrid::{CpuVertexTracer, LensMaterial, LensObject, VertexTracer};
+use pis_compile::hybrid::{LensMaterial, LensObject, VertexTracer};
 use pis_compile::{Filter, TextureLayout};
 use pis_format::{Container, Mapping, PisReader, Placement, StreamRef, Term};
 
@@ -13,7 +13,7 @@ use crate::error::PlayError;
 use crate::frame::hybrid::MAX_LENS_SHELLS;
 use crate::frame::{MeshGpu, MAX_TERM_SHELLS};
 use crate::gpu::Gpu;
-use crate::lens_rays::{GpuVertexTracer, LensRayPipeline};
+use crate::lens_rays::{vertex_tracer, GpuRays, LensRayPipeline};
 use crate::textured::allocated_size;
 
 /// An object's mesh on the GPU and the layers the player draws.
@@ -47,7 +47,7 @@ pub(super) struct LensState {
     placed: Option<(glam::Mat4, Placed)>,
     /// Where its vertex rays are traced on the GPU: the device and the pipeline (`None`: on
     /// the workers).
-    gpu_rays: Option<(Arc<Gpu>, Arc<LensRayPipeline>)>,
+    gpu_rays: Option<GpuRays>,
     /// The last frame's tessellation and what it was made for (transform, eye, view and
     /// projection, frame size, τ): a frame that changes none of them draws it again.
     pub(super) tessellated: Option<(TessellationKey, Arc<pis_compile::hybrid::Tessellation>)>,
@@ -78,12 +78,7 @@ impl LensState {
                 let positions = self.positions.iter().map(|&p| world.transform_point3(p)).collect();
                 let normals = self.normals.iter().map(|&n| world.transform_vector3(n)).collect();
                 let lens = LensObject::new(self.material, positions, normals, &self.indices);
-                let tracer: Arc<dyn VertexTracer + Send + Sync> = match &self.gpu_rays {
-                    Some((gpu, pipeline)) => {
-                        Arc::new(GpuVertexTracer::new(gpu.clone(), pipeline.clone(), &lens))
-                    }
-                    None => Arc::new(CpuVertexTracer),
-                };
+                let tracer = vertex_tracer(self.gpu_rays.as_ref(), &lens);
                 (Arc::new(lens), tracer)
             }
         }

@@ -47,80 +47,51 @@ pub struct PlayerOptions {
     pub lens_rays: LensRays,
 }
 
-/// Where lens objects' vertex rays are traced (thesis 6.4.1): the walk of each tessellation
-/// level's vertices through the lens object.
+/// Where a stage of the frame that has a compute pass beside its CPU reference runs: the
+/// texture rebuild ([`Rebuild`]) and the lens objects' vertex rays ([`LensRays`]).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub enum LensRays {
-    /// [`LensRays::Gpu`] on a GPU, [`LensRays::Workers`] on a CPU rasterizer (Mesa's
-    /// lavapipe), where a compute pass runs on the same cores as the workers.
+pub enum RunOn {
+    /// [`RunOn::Gpu`] on a GPU, [`RunOn::Workers`] on a CPU rasterizer (Mesa's lavapipe),
+    /// where a compute pass runs on the same cores as the workers, slower.
     #[default]
     Auto,
-    /// A compute pass per tessellation level (`lens_rays.wgsl`), the lens object's BVH
-    /// uploaded once per placement; paths deeper than the shader's stack are traced on the
-    /// workers.
+    /// Compute passes on the GPU.
     Gpu,
-    /// On the workers (pis-compile's `trace_vertex`, the reference the GPU is held to).
+    /// On the workers: the reference the GPU is held to.
     Workers,
-}
-
-impl LensRays {
-    /// The name `--lens-rays` takes.
-    pub fn name(self) -> &'static str {
-        match self {
-            LensRays::Auto => "auto",
-            LensRays::Gpu => "gpu",
-            LensRays::Workers => "workers",
-        }
-    }
-
-    /// Every choice, in the order the tools list them.
-    pub const ALL: [LensRays; 3] = [LensRays::Auto, LensRays::Gpu, LensRays::Workers];
-
-    /// The choice made for an adapter of `device_type`: [`LensRays::Auto`] resolved.
-    pub fn on(self, device_type: wgpu::DeviceType) -> LensRays {
-        match (self, device_type) {
-            (LensRays::Auto, wgpu::DeviceType::Cpu) => LensRays::Workers,
-            (LensRays::Auto, _) => LensRays::Gpu,
-            (r, _) => r,
-        }
-    }
 }
 
 /// Where textures are rebuilt from their decoded level images (SPEC.md 8.4: the level
-/// images summed, inverse gamma, stored MIP residuals, the MIP chain).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub enum Rebuild {
-    /// [`Rebuild::Gpu`] on a GPU, [`Rebuild::Workers`] on a CPU rasterizer (Mesa's
-    /// lavapipe), where a compute pass runs on the same cores as the workers, slower.
-    #[default]
-    Auto,
-    /// Compute passes on the GPU (rebuild.wgsl): the workers only decode, each decoded
-    /// level image goes up once, compact, and stays on the GPU while the level-image cache
-    /// keeps it.
-    Gpu,
-    /// On the workers, the texture uploaded as RGBA (the reference the GPU rebuild is held
-    /// to). A resolution reduction is always rebuilt there.
-    Workers,
-}
+/// images summed, inverse gamma, stored MIP residuals, the MIP chain). On the GPU
+/// (rebuild.wgsl) the workers only decode, and each decoded level image goes up once,
+/// compact, and stays on the GPU while the level-image cache keeps it; on the workers the
+/// texture is uploaded as RGBA. A resolution reduction is always rebuilt on the workers.
+pub type Rebuild = RunOn;
 
-impl Rebuild {
-    /// The name `--rebuild` takes.
+/// Where lens objects' vertex rays are traced (thesis 6.4.1): the walk of each tessellation
+/// level's vertices through the lens object. On the GPU a compute pass per level
+/// (`lens_rays.wgsl`), the object's BVH uploaded once per placement, and paths deeper than
+/// the shader's stack traced on the workers; on the workers pis-compile's `trace_vertex`.
+pub type LensRays = RunOn;
+
+impl RunOn {
+    /// The name `--rebuild` and `--lens-rays` take.
     pub fn name(self) -> &'static str {
         match self {
-            Rebuild::Auto => "auto",
-            Rebuild::Gpu => "gpu",
-            Rebuild::Workers => "workers",
+            RunOn::Auto => "auto",
+            RunOn::Gpu => "gpu",
+            RunOn::Workers => "workers",
         }
     }
 
     /// Every choice, in the order the tools list them.
-    pub const ALL: [Rebuild; 3] = [Rebuild::Auto, Rebuild::Gpu, Rebuild::Workers];
+    pub const ALL: [RunOn; 3] = [RunOn::Auto, RunOn::Gpu, RunOn::Workers];
 
-    /// The choice made for an adapter of `device_type`: [`Rebuild::Auto`] resolved.
-    pub fn on(self, device_type: wgpu::DeviceType) -> Rebuild {
+    /// The choice made for an adapter of `device_type`: [`RunOn::Auto`] resolved.
+    pub fn on(self, device_type: wgpu::DeviceType) -> RunOn {
         match (self, device_type) {
-            (Rebuild::Auto, wgpu::DeviceType::Cpu) => Rebuild::Workers,
-            (Rebuild::Auto, _) => Rebuild::Gpu,
+            (RunOn::Auto, wgpu::DeviceType::Cpu) => RunOn::Workers,
+            (RunOn::Auto, _) => RunOn::Gpu,
             (r, _) => r,
         }
     }
