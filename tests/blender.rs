@@ -2,6 +2,8 @@
 //! samples/blender/make_scene.py builds a textured floor, a mirror ball, a glass ball and a
 //! textured box lit by a sphere light at 2 places on a path and seen from 4 views on an orbit,
 //! the add-on renders the 8 points with Cycles into a set, and:
+//! - the set is denoised by default, from two halves joined by `pis-trace denoise`, and its
+//!   denoised twins are nearer a render of 4 times the samples than its raw layers;
 //! - the set is what RAYSET.md 4 says: Σ coverage · (diffuse + specular) is the combined
 //!   image (each object's holdout render follows the full render's paths), and the mirror's
 //!   specular layer is its Fresnel layer times its local and distant light (5.3);
@@ -42,10 +44,19 @@ fn repo() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
 }
 
+/// python3 with the add-on importable and this build's pis-trace first on the PATH (the
+/// add-on joins and denoises its halves with it).
 fn python(args: &[&std::ffi::OsStr]) -> std::process::Output {
+    let bin = Path::new(env!("CARGO_BIN_EXE_pis-trace")).parent().expect("a folder");
+    let path = std::env::var_os("PATH").unwrap_or_default();
+    let path = std::env::join_paths(
+        std::iter::once(bin.to_path_buf()).chain(std::env::split_paths(&path)),
+    )
+    .expect("a PATH");
     Command::new("python3")
         .args(args)
         .env("PYTHONPATH", repo().join("lib/blender"))
+        .env("PATH", path)
         .output()
         .expect("python3 runs")
 }
@@ -152,7 +163,11 @@ fn psnr(a: &[f32], b: &[f32]) -> f64 {
 #[test]
 fn the_add_ons_layers_compose_to_its_combined_image() {
     let Some(f) = fixture() else { return };
-    let set = RaySet::open(&f.set).expect("the add-on's set opens");
+    // The set is denoised by default (pis-trace is found); the identities hold on its raw
+    // layers, the mean of the two halves.
+    let set = RaySet::open(&f.set).expect("the add-on's set opens").with_raw(true);
+    assert!(set.meta.denoiser.is_some() && set.is_denoised(), "the add-on denoises by default");
+    assert_eq!(set.meta.spp.to_string(), SPP, "two halves of half the samples each");
     for i in 0..set.len() {
         for c in 0..3 {
             let combined = plane(&set, i, "combined", c);
@@ -405,4 +420,55 @@ fn the_local_fraction_is_the_one_pis_trace_traces() {
         }
     }
     assert!(largest > 0.25, "the walls see each other: the largest mean A is {largest:.3}");
+}
+
+/// Display PSNR over the pixels of `mask` (all where `None`) of two sets' layer `name` at
+/// every point, the first read as given (twins or raw), the second raw.
+fn set_psnr(a: &RaySet, b: &RaySet, name: &str, mask: Option<&str>) -> f64 {
+    let (mut sum, mut n) = (0.0f64, 0usize);
+    for i in 0..a.len() {
+        let cover = mask.map(|m| plane(b, i, m, 0));
+        for c in 0..3 {
+            let (x, y) = (plane(a, i, name, c), plane(b, i, name, c));
+            for p in (0..x.len()).filter(|&p| cover.as_ref().is_none_or(|m| m[p] > 0.999)) {
+                sum += (x[p].clamp(0.0, 1.0) as f64 - y[p].clamp(0.0, 1.0) as f64).powi(2);
+                n += 1;
+            }
+        }
+    }
+    10.0 * (n as f64 / sum.max(1e-30)).log10()
+}
+
+#[test]
+fn the_denoised_twins_are_nearer_more_samples_than_the_raw_layers() {
+    let Some(f) = fixture() else { return };
+    let dir = common::fixture_tempdir();
+    let more = dir.path().join("more");
+    let out = python(&[
+        os("-m"),
+        os("pis_blender"),
+        f.blend.as_os_str(),
+        os("-o"),
+        more.as_os_str(),
+        os("--spp"),
+        os(&(4 * SPP.parse::<u32>().expect("spp")).to_string()),
+        os("--seed"),
+        os("7"),
+        os("--denoise"),
+        os("off"),
+    ]);
+    assert!(out.status.success(), "pis_blender: {}", String::from_utf8_lossy(&out.stderr));
+    let reference = RaySet::open(&more).expect("the reference").with_raw(true);
+    let denoised = RaySet::open(&f.set).expect("the set");
+    let raw = denoised.clone().with_raw(true);
+    let floor = "object.Floor";
+    for (name, mask) in [
+        ("combined", None),
+        (&format!("{floor}.diffuse")[..], Some(&format!("{floor}.coverage")[..])),
+    ] {
+        let (before, after) =
+            (set_psnr(&raw, &reference, name, mask), set_psnr(&denoised, &reference, name, mask));
+        eprintln!("{name}: raw {before:.2} dB, denoised {after:.2} dB against 4 times the samples");
+        assert!(after > before + 1.0, "{name}: denoised {after:.2} dB, raw {before:.2} dB");
+    }
 }

@@ -9,7 +9,7 @@ use indicatif::{ProgressBar, ProgressStyle};
 use pis::cli::{parse_shading_cells, parse_shading_seed};
 use pis_scene::lens_tree::LensModel;
 use pis_scene::LoadOptions;
-use pis_trace::set::{merge_set, MergeReport, Shard};
+use pis_trace::set::{denoise_halves, merge_set, MergeReport, Shard};
 use pis_trace::{
     render_shard, DenoiseMode, Progress, SetReport, TraceError, TraceRun, TraceSettings,
 };
@@ -140,6 +140,22 @@ enum Command {
     Merge {
         /// The set directory the shards wrote.
         set: PathBuf,
+        /// Print the report as JSON on stdout.
+        #[arg(long)]
+        json: bool,
+    },
+    /// Join two sets rendered elsewhere from independent seeds at the same samples, each
+    /// with the denoiser's guides (`guide.albedo`, `guide.normal`), into one set at both
+    /// halves' samples with `denoised.` twins (RAYSET.md 5.4): the even and odd halves of
+    /// pis-trace's own denoising. Needs Open Image Denoise (see --denoise).
+    Denoise {
+        /// The first half (its set.json, scene file and ray records are the joined set's).
+        even: PathBuf,
+        /// The second half: the same points and cameras, other seeds.
+        odd: PathBuf,
+        /// The joined set's directory (created if missing; not one of the halves).
+        #[arg(short, long)]
+        output: PathBuf,
         /// Print the report as JSON on stdout.
         #[arg(long)]
         json: bool,
@@ -328,6 +344,45 @@ fn merge(set: &Path, json: bool) -> ExitCode {
     }
 }
 
+fn denoise(even: &Path, odd: &Path, out: &Path, json: bool) -> ExitCode {
+    let bar = ProgressBar::new(0);
+    let progress = |done: usize, points: usize| {
+        bar.set_length(points as u64);
+        bar.set_position(done as u64);
+    };
+    match denoise_halves(even, odd, out, &progress) {
+        Ok(r) => {
+            bar.finish_and_clear();
+            eprintln!(
+                "pis-trace: {}: {} points joined from {} and {}, {} spp, {:.2} MiB in {:.1} s",
+                out.display(),
+                r.points,
+                even.display(),
+                odd.display(),
+                r.spp,
+                r.output_bytes as f64 / (1024.0 * 1024.0),
+                r.seconds
+            );
+            eprintln!(
+                "  denoised: {}; {} layers denoised, {} kept raw (denoising estimated to be worse)",
+                r.denoiser,
+                r.denoised_layers,
+                r.kept_raw.len()
+            );
+            if json {
+                return print_json(&r);
+            }
+            ExitCode::SUCCESS
+        }
+        Err(e) => {
+            bar.finish_and_clear();
+            let err = anyhow::Error::from(e);
+            eprintln!("pis-trace: {}", pis::cli::message(&err));
+            ExitCode::from(exit_code(&err))
+        }
+    }
+}
+
 fn main() -> ExitCode {
     let cli = match Cli::try_parse() {
         Ok(c) => c,
@@ -339,9 +394,14 @@ fn main() -> ExitCode {
     };
     let (scene, output) = match (&cli.command, &cli.scene, &cli.output) {
         (Some(Command::Merge { set, json }), _, _) => return merge(set, *json),
+        (Some(Command::Denoise { even, odd, output, json }), _, _) => {
+            return denoise(even, odd, output, *json)
+        }
         (None, Some(scene), Some(output)) => (scene.clone(), output.clone()),
         _ => {
-            eprintln!("pis-trace: give SCENE.toml and -o OUT, or `merge SET`");
+            eprintln!(
+                "pis-trace: give SCENE.toml and -o OUT, `merge SET` or `denoise EVEN ODD -o OUT`"
+            );
             return ExitCode::from(1);
         }
     };

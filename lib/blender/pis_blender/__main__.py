@@ -1,4 +1,4 @@
-"""`python3 -m pis_blender SCENE.blend -o SET_DIR [--spp N] [--json]`: the add-on headless,
+"""`python3 -m pis_blender SCENE.blend -o SET_DIR [--spp N] [--seed S] [--denoise auto|on|off] [--json]`: the add-on headless,
 with Blender's `bpy` module (PyPI `bpy`, Python 3.11). The .blend's PIS settings say what to
 render; --spp replaces its samples."""
 
@@ -18,6 +18,12 @@ def main(argv=None):
     parser.add_argument("-o", "--output", required=True, help="the set folder to write")
     parser.add_argument("--spp", type=int, help="Cycles samples per pixel (default: the file's)")
     parser.add_argument("--seed", type=int, help="Cycles' seed series (default: the file's); another seed renders an independent set")
+    parser.add_argument(
+        "--denoise",
+        choices=("auto", "on", "off"),
+        help="render two halves with the denoiser's guides and join them with `pis-trace denoise` into a set with denoised twins; auto: when pis-trace is found (default: the file's setting, auto unless changed)",
+    )
+    parser.add_argument("--pis-trace", metavar="PATH", help="the pis-trace program that joins the halves (default: the file's, else pis-trace on the PATH)")
     parser.add_argument("--json", action="store_true", help="print the report as JSON")
     args = parser.parse_args(argv)
     # Blender and its glTF exporter write their logs to standard output: they go to standard
@@ -44,6 +50,10 @@ def main(argv=None):
         scene.pis.spp = args.spp
     if args.seed is not None:
         scene.pis.seed = args.seed
+    if args.denoise is not None:
+        scene.pis.denoise = args.denoise.upper()
+    if args.pis_trace is not None:
+        scene.pis.pis_trace = args.pis_trace
     try:
         report = pis_blender.export_set(scene, args.output, progress=lambda line, _done: print(line, file=sys.stderr, flush=True))
     except space.SpaceError as e:
@@ -61,6 +71,11 @@ def main(argv=None):
         roles = ", ".join(f"{o['name']} ({o['role']})" for o in report["objects"])
         print(f"{report['set']}: {report['points']} points, {report['renders']} Cycles renders, {report['seconds']} s", file=report_out)
         print(f"objects: {roles}", file=report_out)
+        for note in report.get("notes", []):
+            print(f"note: {note}", file=report_out)
+        if "denoised" in report:
+            d = report["denoised"]
+            print(f"denoised: {d['denoiser']}, {report['spp']} spp from two halves; {d['denoised_layers']} layers denoised, {len(d['kept_raw'])} kept raw", file=report_out)
     report_out.flush()
     return 0
 

@@ -114,3 +114,11 @@ def yfov(camera_data, width, height):
     if fit == "HORIZONTAL":
         half *= height / width
     return 2.0 * math.atan(half)
+
+
+def cycles_normal_to_gltf(n, camera_matrix):
+    """Cycles' Denoising Normal pass (camera space with +Z forward: Blender's camera axes with
+    Z turned) as glTF world normals; `n` is an array (..., 3)."""
+    r = rigid(matrix(camera_matrix))[:3, :3]
+    blender_camera = n * np.array([1.0, 1.0, -1.0], np.float32)
+    return (blender_camera @ r.T @ C[:3, :3].T).astype(np.float32)

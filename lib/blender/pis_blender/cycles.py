@@ -81,6 +81,8 @@ def configure(scene, saved, spp, sigma_px, seed, caustics=False):
     for p in PASSES:
         saved.set(layer, "use_pass_" + p, True)
     saved.set(layer, "use_pass_combined", True)
+    # The denoiser's guides (Denoising Albedo and Normal); Cycles' own denoiser stays off.
+    saved.set(layer.cycles, "denoising_store_passes", True)
 
 
 def render(scene, path):

@@ -9,6 +9,7 @@ temporary name and renamed into place.
 import json
 import os
 import shutil
+import subprocess
 import tempfile
 import time
 
@@ -53,7 +54,13 @@ def export_set(scene, out_dir, progress=lambda line, done: print(line)):
         for light in lights:
             if hasattr(light.data, "use_soft_falloff"):
                 saved.set(light.data, "use_soft_falloff", False)
-        report = _render_points(scene, out_dir, scratch, dims, objects, roles, lights, progress)
+        job = _Job(scene, scratch, dims, objects, roles, lights)
+        program, notes = _denoiser(s)
+        if program:
+            report = _render_halves(job, out_dir, saved, program, progress)
+        else:
+            report = _render_points(job, _Pass(out_dir, s.seed, s.spp, False, "scene.toml"), progress)
+        report["notes"] = notes
         scene.frame_set(frame)
     finally:
         saved.restore()
@@ -108,49 +115,123 @@ def _layer_names(role):
 CHANNELS = {1: ["A"], 3: ["R", "G", "B"], 4: ["R", "G", "B", "A"]}
 
 
-def _render_points(scene, out_dir, scratch, dims, objects, roles, lights, progress):
+class _Job:
+    """What every render of the export shares."""
+
+    def __init__(self, scene, scratch, dims, objects, roles, lights):
+        self.scene, self.scratch, self.dims = scene, scratch, dims
+        self.objects, self.roles, self.lights = objects, roles, lights
+
+
+class _Pass:
+    """One set written by the export: its folder, seed series, samples, whether its points
+    carry the denoiser's guides, and its set.json's `scene_file`."""
+
+    def __init__(self, out_dir, seed, spp, guides, scene_file):
+        self.out_dir, self.seed, self.spp = out_dir, seed, spp
+        self.guides, self.scene_file = guides, scene_file
+
+
+def _render_halves(job, out_dir, saved, program, progress):
+    """The set denoised: two halves at half the samples each, from the seed series 2·seed
+    and 2·seed + 1, with guides, joined by `pis-trace denoise` (RAYSET.md 8)."""
+    scene = job.scene
+    if scene.pis.spp < 2:
+        raise scene_file.ExportError("denoising renders two halves of the samples: give at least 2 samples")
+    half = scene.pis.spp // 2
+    saved.set(scene.cycles, "samples", half)
+    halves = os.path.join(out_dir, ".halves")
+    reports, dirs = [], []
+    for k, name in enumerate(("even", "odd")):
+        d = os.path.join(halves, name)
+        os.makedirs(d, exist_ok=True)
+        say = lambda line, done, k=k, name=name: progress(f"{name} half, {line}", (k + done) / 2)  # noqa: E731
+        reports.append(_render_points(job, _Pass(d, 2 * scene.pis.seed + k, half, True, "../../scene.toml"), say))
+        dirs.append(d)
+    joined = _join(program, dirs, out_dir)
+    shutil.rmtree(halves, ignore_errors=True)
+    return reports[0] | {
+        "set": out_dir,
+        "spp": joined["spp"],
+        "renders": sum(r["renders"] for r in reports),
+        "denoised": {k: joined[k] for k in ("denoiser", "denoised_layers", "kept_raw")},
+    }
+
+
+def _denoiser(s):
+    """The pis-trace that joins the halves, or None for a raw set; and what to tell the user."""
+    if s.denoise == "OFF":
+        return None, []
+    if s.denoise == "AUTO" and s.spp < 2:
+        return None, ["not denoised: one sample per pixel makes no halves"]
+    program = bpy.path.abspath(s.pis_trace) if s.pis_trace else shutil.which("pis-trace")
+    if program and os.access(program, os.X_OK):
+        return program, []
+    where = f"{s.pis_trace!r} is not a program" if s.pis_trace else "pis-trace is not on the PATH"
+    if s.denoise == "AUTO":
+        return None, [f"not denoised: {where} (name it with --pis-trace, or PIS set > pis-trace)"]
+    raise scene_file.ExportError(
+        f"denoising joins the halves with pis-trace, and {where}: name it (--pis-trace, or PIS set > pis-trace) or turn denoising off"
+    )
+
+
+def _join(program, dirs, out_dir):
+    run = subprocess.run([program, "denoise", *dirs, "-o", out_dir, "--json"], capture_output=True, text=True)
+    if run.returncode != 0:
+        why = run.stderr.strip().splitlines()[-1:] or ["no message"]
+        raise scene_file.ExportError(f"pis-trace denoise failed (exit {run.returncode}): {why[0]}")
+    return json.loads(run.stdout)
+
+
+def _render_points(job, out, progress):
+    scene, dims, objects = job.scene, job.dims, job.objects
     w, h = scene.render.resolution_x, scene.render.resolution_y
     channels = scene_file.channel_names([o.name for o in objects])
     geometry = [o for o in scene.objects if o.type in GEOMETRY and not o.hide_render]
     fraction = layers.fraction_material_maker()
-    renderer = layers.Renderer(scene, scratch, geometry)
+    renderer = layers.Renderer(scene, job.scratch, geometry)
     points = space.points(dims)
     metas = []
     for index, point in enumerate(points):
         t0 = time.time()
         space.place(scene, dims, point)
-        scene.cycles.seed = scene.pis.seed * len(points) + index
+        scene.cycles.seed = out.seed * len(points) + index
         bpy.context.view_layer.update()
-        images = _point_images(renderer, objects, roles, channels, fraction)
+        images = _point_images(renderer, job, channels, fraction, out.guides)
         image = f"point_{index:05d}.exr"
-        tmp = os.path.join(out_dir, f".{image}.tmp{os.getpid()}")
+        tmp = os.path.join(out.out_dir, f".{image}.tmp{os.getpid()}")
         exr.write(tmp, images, w, h)
-        os.replace(tmp, os.path.join(out_dir, image))
-        metas.append(_point_meta(scene, index, point, dims, image, objects, channels, lights))
+        os.replace(tmp, os.path.join(out.out_dir, image))
+        metas.append(_point_meta(scene, index, point, dims, image, objects, channels, job.lights))
         progress(f"point {index + 1}/{len(points)}: {renderer.count} renders so far, {time.time() - t0:.1f} s", (index + 1) / len(points))
-    _write_set_json(scene, out_dir, dims, objects, roles, channels, metas)
+    _write_set_json(scene, out, dims, objects, job.roles, channels, metas)
     return {
-        "set": out_dir,
+        "set": out.out_dir,
         "points": len(points),
+        "spp": out.spp,
         "renders": renderer.count,
-        "objects": [{"name": o.name, "role": r} for o, r in zip(objects, roles)],
+        "objects": [{"name": o.name, "role": r} for o, r in zip(objects, job.roles)],
     }
 
 
-def _point_images(renderer, objects, roles, channels, fraction):
+def _point_images(renderer, job, channels, fraction, with_guides):
     """The point's EXR channels (RAYSET.md 5.1) as the scene stands: the full render's
-    combined image, then every object's layers."""
-    combined = renderer.full()
-    images = {f"combined.{name}": combined[..., c] for c, name in enumerate("RGB")}
-    for obj, role, ch in zip(objects, roles, channels):
-        out = layers.object_layers(renderer, obj, role, _parts(obj, objects), fraction)
+    combined image (and the denoiser's guides), then every object's layers."""
+    full = renderer.full()
+    images = {f"combined.{name}": layers.rgb(full, "Combined")[..., c] for c, name in enumerate("RGB")}
+    if with_guides:
+        for name, value in layers.guides(full, job.scene.camera.matrix_world).items():
+            for c, ch in enumerate("RGB"):
+                images[f"guide.{name}.{ch}"] = value[..., c]
+    for obj, role, ch in zip(job.objects, job.roles, channels):
+        out = layers.object_layers(renderer, obj, role, _parts(obj, job.objects), fraction)
         for layer, value in out.items():
             for c, name in enumerate(CHANNELS[value.shape[-1]]):
                 images[f"object.{ch}.{layer}.{name}"] = value[..., c]
     return images
 
 
-def _write_set_json(scene, out_dir, dims, objects, roles, channels, points):
+def _write_set_json(scene, out, dims, objects, roles, channels, points):
     """set.json (RAYSET.md 3), written last and atomically: the set is complete."""
     sigma = scene.pis.filter_sigma_px
     meta = {
@@ -158,10 +239,10 @@ def _write_set_json(scene, out_dir, dims, objects, roles, channels, points):
         "version": 1,
         "scene": scene.name,
         "resolution": [scene.render.resolution_x, scene.render.resolution_y],
-        "spp": scene.pis.spp,
+        "spp": out.spp,
         "filter": {"sigma_px": sigma, "radius_px": cycles.filter_radius(sigma)},
         "renderer": {"name": "Blender Cycles", "version": bpy.app.version_string},
-        "scene_file": "scene.toml",
+        "scene_file": out.scene_file,
         "space": [d.meta() for d in dims] or [_still()],
         "objects": [
             {"name": o.name, "channel_name": ch, "role": role, "layers": _layer_names(role), "records": False}
@@ -170,10 +251,10 @@ def _write_set_json(scene, out_dir, dims, objects, roles, channels, points):
         ],
         "points": points,
     }
-    tmp = os.path.join(out_dir, f".set.json.tmp{os.getpid()}")
+    tmp = os.path.join(out.out_dir, f".set.json.tmp{os.getpid()}")
     with open(tmp, "w") as f:
         json.dump(meta, f, indent=1)
-    os.replace(tmp, os.path.join(out_dir, "set.json"))
+    os.replace(tmp, os.path.join(out.out_dir, "set.json"))
 
 
 def _still():

@@ -21,7 +21,7 @@ neighbour's colour enters an edge pixel.
 
 import numpy as np
 
-from . import cycles
+from . import coords, cycles
 
 EPS = 1e-6
 
@@ -51,13 +51,21 @@ class Renderer:
         return cycles.render(self.scene, f"{self.scratch}/render_{self.count}.exr")
 
     def full(self):
-        return rgb(self.render(), "Combined")
+        """The full render's passes."""
+        return self.render()
 
     def alone(self, target, saved):
         """The passes of `target` with every other object a holdout."""
         for o in self.objects:
             saved.set(o, "is_holdout", o is not target)
         return self.render()
+
+
+def guides(p, camera_matrix):
+    """The denoiser's guides (RAYSET.md 5.4) from a render's Denoising Data passes: the albedo,
+    and the normal turned from Cycles' camera space into glTF's world."""
+    normal = np.stack([p["Denoising Normal." + c] for c in "XYZ"], axis=-1)
+    return {"albedo": rgb(p, "Denoising Albedo"), "normal": coords.cycles_normal_to_gltf(normal, camera_matrix)}
 
 
 def object_layers(renderer, obj, role, parts, fraction_material):

@@ -30,6 +30,22 @@ class PisSettings(bpy.types.PropertyGroup):
     seed: IntProperty(
         name="Seed", description="Cycles' seed of point i is seed × points + i: another seed, an independent render", default=0, min=0
     )
+    denoise: EnumProperty(
+        name="Denoise",
+        description="Render each point as two halves from independent seeds, each at half the samples with the denoiser's guides, and join them with pis-trace denoise: the raw layers and, where the halves estimate it nearer the converged image, a denoised twin of each (RAYSET.md 5.4)",
+        items=(
+            ("AUTO", "Auto", "Denoise when pis-trace is found, else render the raw set and say so"),
+            ("ON", "On", "Denoise; an error without pis-trace"),
+            ("OFF", "Off", "The raw set, each point one render at all the samples"),
+        ),
+        default="AUTO",
+    )
+    pis_trace: StringProperty(
+        name="pis-trace",
+        description="The pis-trace program that joins and denoises the halves (empty: pis-trace on the PATH)",
+        subtype="FILE_PATH",
+        default="",
+    )
     caustics: BoolProperty(
         name="Caustics",
         description="Let Cycles trace caustics (light through glass or off mirrors onto diffuse surfaces): PIS plays none, and at a few hundred samples they are fireflies",

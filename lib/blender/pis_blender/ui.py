@@ -28,6 +28,8 @@ class PIS_OT_render_set(bpy.types.Operator):
             return {"CANCELLED"}
         finally:
             wm.progress_end()
+        for note in report.get("notes", []):
+            self.report({"WARNING"}, note)
         self.report({"INFO"}, f"PIS set: {report['points']} points, {report['renders']} renders in {report['seconds']} s: {out}")
         return {"FINISHED"}
 
@@ -40,7 +42,7 @@ class PIS_PT_set(bpy.types.Panel):
 
     def draw(self, context):
         s, col = context.scene.pis, self.layout.column()
-        for name in ("output_dir", "spp", "seed", "filter_sigma_px", "caustics"):
+        for name in ("output_dir", "spp", "seed", "filter_sigma_px", "caustics", "denoise", "pis_trace"):
             col.prop(s, name)
         for prefix, fields in (
             ("light_path", ("name", "light", "curve", "samples", "range")),

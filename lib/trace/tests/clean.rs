@@ -3,43 +3,10 @@
 mod common;
 
 use common::*;
-use glam::Vec3;
 use pis_scene::{Frame, ObjectRole, Scene};
 use pis_trace::denoise::{denoise_point, prefer_denoised};
-use pis_trace::layers::{LayerKind, PointImages};
+use pis_trace::layers::LayerKind;
 use pis_trace::{render_point, PointRender, ShadingSeed, TraceSettings};
-
-/// A matte floor and back wall, a mirror ball and a glass ball, lit by a small sphere.
-fn room(res: (u32, u32), spp: u32) -> (Scene, Frame) {
-    let s = scene(
-        vec![
-            object(
-                "floor",
-                ObjectRole::Diffuse,
-                vec![quad(Vec3::new(-2.0, 0.0, -2.0), Vec3::Z * 4.0, Vec3::X * 4.0, 0)],
-            ),
-            object(
-                "wall",
-                ObjectRole::Diffuse,
-                vec![quad(Vec3::new(-2.0, 0.0, -1.5), Vec3::X * 4.0, Vec3::Y * 3.0, 1)],
-            ),
-            object(
-                "ball",
-                ObjectRole::Reflective,
-                vec![sphere(Vec3::new(-0.5, 0.5, 0.0), 0.5, 12, 24, 2, false)],
-            ),
-        ],
-        vec![matte([0.7, 0.6, 0.5]), matte([0.3, 0.5, 0.7]), metal([0.9, 0.8, 0.6], 0.0)],
-        res,
-        spp,
-    );
-    let f = frame(
-        &s,
-        camera(Vec3::new(0.3, 1.3, 3.2), Vec3::new(0.0, 0.5, 0.0), 45.0),
-        vec![sphere_light("key", Vec3::new(1.0, 2.5, 1.5), [12.0; 3], 0.2)],
-    );
-    (s, f)
-}
 
 fn render(s: &Scene, f: &Frame, settings: &TraceSettings, threads: usize) -> PointRender {
     let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().expect("a pool");
@@ -67,26 +34,6 @@ fn an_adaptive_render_is_the_same_on_any_thread_count_and_stops_only_converged_p
     }
     let fixed = render(&s, &f, &TraceSettings::new(s.resolution, 16), 2);
     assert!(fixed.sampling.is_none(), "a fixed render maps no samples");
-}
-
-/// Mean squared display error of `layer` × coverage between two points' images, over the
-/// pixels `reference` covers.
-fn layer_error(image: &PointImages, reference: &PointImages, object: &str, kind: LayerKind) -> f64 {
-    let cov =
-        |i: &PointImages| i.object_layer(object, LayerKind::Coverage).map(|l| l.planes[0].clone());
-    let (Some(ca), Some(cb)) = (cov(image), cov(reference)) else { return 0.0 };
-    let (a, b) =
-        (image.object_layer(object, kind).unwrap(), reference.object_layer(object, kind).unwrap());
-    let (mut sum, mut n) = (0.0, 0usize);
-    for i in (0..cb.len()).filter(|&i| cb[i] > 0.0) {
-        for c in 0..3 {
-            let d =
-                (a.planes[c][i] * ca[i]).clamp(0.0, 1.0) - (b.planes[c][i] * cb[i]).clamp(0.0, 1.0);
-            sum += (d * d) as f64;
-        }
-        n += 1;
-    }
-    sum / n.max(1) as f64
 }
 
 #[test]

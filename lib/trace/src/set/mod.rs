@@ -4,6 +4,7 @@
 
 mod atomic;
 mod exr_io;
+mod halves;
 mod meta;
 mod reader;
 mod shards;
@@ -11,6 +12,7 @@ mod writer;
 
 pub use atomic::write_atomic;
 pub use exr_io::{decode_exr, encode_exr};
+pub use halves::{denoise_halves, HalvesReport};
 pub use meta::*;
 pub use reader::RaySet;
 pub use shards::{is_complete, merge_set, Begin, MergeReport, Shard, SHARDS_DIR};
