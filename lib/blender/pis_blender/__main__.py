@@ -24,6 +24,7 @@ def main(argv=None):
         help="render two halves with the denoiser's guides and join them with `pis-trace denoise` into a set with denoised twins; auto: when pis-trace is found (default: the file's setting, auto unless changed)",
     )
     parser.add_argument("--pis-trace", metavar="PATH", help="the pis-trace program that joins the halves (default: the file's, else pis-trace on the PATH)")
+    parser.add_argument("--keep-halves", action="store_true", help="a denoised set: leave its two halves in SET_DIR/.halves (to join again with pis-trace denoise)")
     parser.add_argument("--json", action="store_true", help="print the report as JSON")
     args = parser.parse_args(argv)
     # Blender and its glTF exporter write their logs to standard output: they go to standard
@@ -55,7 +56,7 @@ def main(argv=None):
     if args.pis_trace is not None:
         scene.pis.pis_trace = args.pis_trace
     try:
-        report = pis_blender.export_set(scene, args.output, progress=lambda line, _done: print(line, file=sys.stderr, flush=True))
+        report = pis_blender.export_set(scene, args.output, progress=lambda line, _done: print(line, file=sys.stderr, flush=True), keep_halves=args.keep_halves)
     except space.SpaceError as e:
         print(f"pis_blender: {args.blend}: the parameter space: {e}", file=sys.stderr)
         return EXIT_USAGE

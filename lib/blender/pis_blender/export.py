@@ -20,9 +20,10 @@ from . import coords, cycles, exr, layers, scene_file, space
 GEOMETRY = ("MESH", "CURVE", "SURFACE", "META", "FONT")
 
 
-def export_set(scene, out_dir, progress=lambda line, done: print(line)):
+def export_set(scene, out_dir, progress=lambda line, done: print(line), keep_halves=False):
     """Writes the set of `scene` (its `scene.pis` settings) into `out_dir`; returns a report.
-    `progress(line, done)` hears of every point rendered, `done` the share of points so far."""
+    `progress(line, done)` hears of every point rendered, `done` the share of points so far;
+    `keep_halves` leaves a denoised set's halves in `out_dir/.halves`."""
     s = scene.pis
     if scene.camera is None:
         raise scene_file.ExportError("the scene has no camera")
@@ -57,7 +58,7 @@ def export_set(scene, out_dir, progress=lambda line, done: print(line)):
         job = _Job(scene, scratch, dims, objects, roles, lights)
         program, notes = _denoiser(s)
         if program:
-            report = _render_halves(job, out_dir, saved, program, progress)
+            report = _render_halves(job, out_dir, saved, program, progress, keep_halves)
         else:
             report = _render_points(job, _Pass(out_dir, s.seed, s.spp, False, "scene.toml"), progress)
         report["notes"] = notes
@@ -132,7 +133,7 @@ class _Pass:
         self.guides, self.scene_file = guides, scene_file
 
 
-def _render_halves(job, out_dir, saved, program, progress):
+def _render_halves(job, out_dir, saved, program, progress, keep_halves):
     """The set denoised: two halves at half the samples each, from the seed series 2·seed
     and 2·seed + 1, with guides, joined by `pis-trace denoise` (RAYSET.md 8)."""
     scene = job.scene
@@ -149,7 +150,8 @@ def _render_halves(job, out_dir, saved, program, progress):
         reports.append(_render_points(job, _Pass(d, 2 * scene.pis.seed + k, half, True, "../../scene.toml"), say))
         dirs.append(d)
     joined = _join(program, dirs, out_dir)
-    shutil.rmtree(halves, ignore_errors=True)
+    if not keep_halves:
+        shutil.rmtree(halves, ignore_errors=True)
     return reports[0] | {
         "set": out_dir,
         "spp": joined["spp"],

@@ -241,6 +241,18 @@ fn surface_terms(
         .collect()
 }
 
+/// The [`SurfaceTerm`]s of an image seen as it is (the combined image): each value its own
+/// surface, with weight 1.
+fn displayed_terms(layer: &LayerImage) -> Vec<SurfaceTerm> {
+    (0..layer.width as usize * layer.height as usize)
+        .flat_map(|i| (0..3).map(move |c| (i, c)))
+        .map(|(i, c)| {
+            let v = layer.planes[c][i];
+            SurfaceTerm { surface: v, layer: v, weight: 1.0 }
+        })
+        .collect()
+}
+
 /// Squared display difference (sRGB, peak 1, clipped) between the surface with the layer at
 /// `a` and with it at `b`, summed over one pixel's RGB.
 fn display_error(a: &[f32], b: &[f32], terms: &[SurfaceTerm]) -> f64 {
@@ -248,26 +260,35 @@ fn display_error(a: &[f32], b: &[f32], terms: &[SurfaceTerm]) -> f64 {
     a.iter().zip(b).zip(terms).map(|((&x, &y), t)| (seen(x, t) - seen(y, t)).powi(2)).sum()
 }
 
+/// The plane of the coverage layer `name` in `images`: `None` without a name, `Some(None)`
+/// when the layer is missing.
+fn coverage_plane<'a>(images: &'a PointImages, name: Option<&str>) -> Option<Option<&'a [f32]>> {
+    name.map(|c| images.layer(c).map(|l| l.planes[0].as_slice()))
+}
+
 /// The raw and denoised errors of layer `name` (filtered premultiplied by the coverage layer
-/// `coverage`, compared divided by it), accumulated over the covered pixels of the guides'
-/// window (`mask`).
+/// `coverage` where it has one, compared divided by it), accumulated over the covered pixels
+/// of the guides' window (`mask`).
 fn estimate(
     oidn: &Oidn,
     input: &DenoiseInput,
-    (name, coverage): (&str, &str),
+    (name, coverage): (&str, Option<&str>),
     (guides, mask, terms): (&WindowGuides, &[bool], &[SurfaceTerm]),
 ) -> Result<Estimate, TraceError> {
     let mut est = Estimate::default();
     let [ha, hb] = &input.halves;
     let (Some(la), Some(lb)) = (ha.layer(name), hb.layer(name)) else { return Ok(est) };
-    let (Some(ca), Some(cb)) = (ha.layer(coverage), hb.layer(coverage)) else { return Ok(est) };
-    let (ca, cb) = (&ca.planes[0], &cb.planes[0]);
+    let (ca, cb) = match (coverage_plane(ha, coverage), coverage_plane(hb, coverage)) {
+        (Some(Some(ca)), Some(Some(cb))) => (Some(ca), Some(cb)),
+        (None, None) => (None, None),
+        _ => return Ok(est),
+    };
     // Compared as the layers are read, divided by coverage, where both halves cover.
     let window = guides.window;
     let (a, b) = (interleave(la, window, None), interleave(lb, window, None));
-    let (da, db) = (filter(oidn, la, Some(ca), guides)?, filter(oidn, lb, Some(cb), guides)?);
+    let (da, db) = (filter(oidn, la, ca, guides)?, filter(oidn, lb, cb, guides)?);
     for (k, i) in window.pixels(la.width).enumerate().filter(|&(k, _)| mask[k]) {
-        let (wa, wb) = (ca[i], cb[i]);
+        let (wa, wb) = (ca.map_or(1.0, |c| c[i]), cb.map_or(1.0, |c| c[i]));
         if wa <= 0.0 || wb <= 0.0 {
             continue;
         }
@@ -320,9 +341,17 @@ pub fn denoise_point(
     let mut out = DenoisedPoint::default();
     let whole = Window { x0: 0, y0: 0, x1: w, y1: h };
     if let Some(combined) = images.layer("combined") {
-        let filtered = filter(oidn, combined, None, &WindowGuides::new(&input.guides, whole))?;
-        out.images.push(denoised_image(combined, &filtered, whole, None));
-        out.summary.layers.push(combined.name.clone());
+        let guides = WindowGuides::new(&input.guides, whole);
+        let mask = vec![true; w as usize * h as usize];
+        let terms = displayed_terms(combined);
+        let est = estimate(oidn, input, ("combined", None), (&guides, &mask, &terms))?;
+        if est.denoised() <= est.raw() {
+            let filtered = filter(oidn, combined, None, &guides)?;
+            out.images.push(denoised_image(combined, &filtered, whole, None));
+            out.summary.layers.push(combined.name.clone());
+        } else {
+            out.summary.kept_raw.push(combined.name.clone());
+        }
     }
     for (name, role) in objects {
         let coverage_name = object_layer_name(name, LayerKind::Coverage);
@@ -340,7 +369,7 @@ pub fn denoise_point(
             }
             let terms = surface_terms(images, name, kind, window);
             let at = (&guides, mask.as_slice(), terms.as_slice());
-            let est = estimate(oidn, input, (&layer_name, &coverage_name), at)?;
+            let est = estimate(oidn, input, (&layer_name, Some(&coverage_name)), at)?;
             if est.denoised() <= est.raw() {
                 let filtered = filter(oidn, layer, Some(coverage), &guides)?;
                 out.images.push(denoised_image(layer, &filtered, window, Some(coverage)));
