@@ -22,7 +22,8 @@
 //! denoised = |D(A) − B|² − ½|A − B|²         (B is unbiased and independent of D(A))
 //! ```
 //!
-//! both at half the samples, standing for the layers at all of them (measured on corpus
+//! (the combined image the same way over every pixel, on its own display values), both at
+//! half the samples, standing for the layers at all of them (measured on corpus
 //! box-textured and tests/clean.rs's room: a logo's diffuse layer kept raw, matte walls
 //! denoised; docs/benchmarks/clean-sets.md).
 //!
