@@ -181,7 +181,9 @@ def _join(program, dirs, out_dir):
     run = subprocess.run([program, "denoise", *dirs, "-o", out_dir, "--json"], capture_output=True, text=True)
     if run.returncode != 0:
         why = run.stderr.strip().splitlines()[-1:] or ["no message"]
-        raise scene_file.ExportError(f"pis-trace denoise failed (exit {run.returncode}): {why[0]}")
+        raise scene_file.ExportError(
+            f"pis-trace denoise failed (exit {run.returncode}): {why[0]}; the halves are kept in {os.path.dirname(dirs[0])}"
+        )
     return json.loads(run.stdout)
 
 
