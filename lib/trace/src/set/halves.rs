@@ -62,10 +62,14 @@ pub fn denoise_halves(
     prepare_out(out, &halves)?;
     let objects = object_roles(&halves[0].meta)?;
     let mut meta = halves[0].meta.clone();
+    let spp = meta.spp.checked_mul(2).ok_or_else(|| TraceError::InvalidSet {
+        path: halves[0].dir.clone(),
+        message: format!("spp {} is too large to double", meta.spp),
+    })?;
     let mut report = HalvesReport {
         set: out.to_path_buf(),
         points: meta.points.len(),
-        spp: meta.spp * 2,
+        spp,
         denoiser: format!("Open Image Denoise {}", oidn.version()),
         ..HalvesReport::default()
     };
