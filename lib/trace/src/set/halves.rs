@@ -9,9 +9,10 @@
 //! raw one ([`crate::denoise::denoise_point`]).
 
 use super::meta::{PointMeta, SetMeta};
+use super::shards::encode;
 use super::writer::relative_to;
 use super::{encode_exr, write_atomic, RaySet, SET_JSON};
-use crate::denoise::{denoise_point, DenoiseInput, PointDenoise, DENOISED_PREFIX};
+use crate::denoise::{denoise_point, DenoiseInput, PointDenoise};
 use crate::error::TraceError;
 use crate::layers::{object_layer_name, LayerImage, LayerKind, PointImages};
 use pis_scene::ObjectRole;
@@ -87,8 +88,7 @@ pub fn denoise_halves(
     meta.denoiser = Some(report.denoiser.clone());
     meta.scene_file = halves[0].scene_file().map(|f| relative_to(&f, out));
     let path = out.join(SET_JSON);
-    let json = serde_json::to_vec_pretty(&meta)
-        .map_err(|e| TraceError::InvalidInput(format!("cannot encode {}: {e}", path.display())))?;
+    let json = encode(&meta, &path)?;
     write_atomic(&path, &json)?;
     report.output_bytes += json.len() as u64;
     report.seconds = start.elapsed().as_secs_f64();
@@ -207,9 +207,9 @@ fn mean(halves: &[PointImages; 2], dir: &Path) -> Result<PointImages, TraceError
     }
     let mut layers = Vec::with_capacity(a.layers.len());
     for la in &a.layers {
-        if ADAPTIVE.contains(&la.name.as_str()) || la.name.starts_with(DENOISED_PREFIX) {
+        if ADAPTIVE.contains(&la.name.as_str()) {
             return Err(bad(format!(
-                "layer `{}`: halves are fixed-sample raw renders (no adaptive sampling, no denoising)",
+                "layer `{}`: halves are fixed-sample renders (no adaptive sampling)",
                 la.name
             )));
         }

@@ -95,7 +95,7 @@ fn read_json<T: for<'de> Deserialize<'de>>(path: &Path) -> Result<T, TraceError>
         .map_err(|e| TraceError::InvalidSet { path: path.to_path_buf(), message: e.to_string() })
 }
 
-fn encode<T: Serialize>(value: &T, path: &Path) -> Result<Vec<u8>, TraceError> {
+pub(super) fn encode<T: Serialize>(value: &T, path: &Path) -> Result<Vec<u8>, TraceError> {
     serde_json::to_vec_pretty(value)
         .map_err(|e| TraceError::InvalidInput(format!("cannot encode {}: {e}", path.display())))
 }
