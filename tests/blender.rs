@@ -423,10 +423,10 @@ fn the_local_fraction_is_the_one_pis_trace_traces() {
 }
 
 /// Display PSNR over the pixels of `mask` (all where `None`) of two sets' layer `name` at
-/// every point, the first read as given (twins or raw), the second raw.
+/// every point both have, the first read as given (twins or raw), the second raw.
 fn set_psnr(a: &RaySet, b: &RaySet, name: &str, mask: Option<&str>) -> f64 {
     let (mut sum, mut n) = (0.0f64, 0usize);
-    for i in 0..a.len() {
+    for i in 0..a.len().min(b.len()) {
         let cover = mask.map(|m| plane(b, i, m, 0));
         for c in 0..3 {
             let (x, y) = (plane(a, i, name, c), plane(b, i, name, c));
@@ -456,9 +456,13 @@ fn the_denoised_twins_are_nearer_more_samples_than_the_raw_layers() {
         os("7"),
         os("--denoise"),
         os("off"),
+        os("--points"),
+        os("4"),
     ]);
     assert!(out.status.success(), "pis_blender: {}", String::from_utf8_lossy(&out.stderr));
+    // The first light place's four views: the points the whole set has first.
     let reference = RaySet::open(&more).expect("the reference").with_raw(true);
+    assert_eq!(reference.len(), 4, "--points 4 renders four points");
     let denoised = RaySet::open(&f.set).expect("the set");
     let raw = denoised.clone().with_raw(true);
     let floor = "object.Floor";

@@ -31,10 +31,11 @@ def unregister():
     props.unregister()
 
 
-def export_set(scene, out_dir, progress=lambda line, done: print(line), keep_halves=False):
+def export_set(scene, out_dir, progress=lambda line, done: print(line), keep_halves=False, points=None):
     """Renders `scene`'s parameter space into the set folder `out_dir` and returns a report;
     `progress(line, done)` hears of each point, `done` the share of points rendered;
-    `keep_halves` leaves a denoised set's halves in `out_dir/.halves`."""
+    `keep_halves` leaves a denoised set's halves in `out_dir/.halves`; `points` renders only
+    the first that many points."""
     from . import export
 
-    return export.export_set(scene, out_dir, progress, keep_halves)
+    return export.export_set(scene, out_dir, progress, keep_halves, points)

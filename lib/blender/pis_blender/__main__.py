@@ -1,4 +1,4 @@
-"""`python3 -m pis_blender SCENE.blend -o SET_DIR [--spp N] [--seed S] [--denoise auto|on|off] [--json]`: the add-on headless,
+"""`python3 -m pis_blender SCENE.blend -o SET_DIR [--spp N] [--points N] [--seed S] [--denoise auto|on|off] [--json]`: the add-on headless,
 with Blender's `bpy` module (PyPI `bpy`, Python 3.11). The .blend's PIS settings say what to
 render; --spp replaces its samples."""
 
@@ -17,6 +17,7 @@ def main(argv=None):
     parser.add_argument("blend", help="the .blend file, its PIS settings set (Properties > Render > PIS set)")
     parser.add_argument("-o", "--output", required=True, help="the set folder to write")
     parser.add_argument("--spp", type=int, help="Cycles samples per pixel (default: the file's)")
+    parser.add_argument("--points", type=int, metavar="N", help="render only the first N parameter points (in linear order, last dimension fastest)")
     parser.add_argument("--seed", type=int, help="Cycles' seed series (default: the file's); another seed renders an independent set")
     parser.add_argument(
         "--denoise",
@@ -47,6 +48,9 @@ def main(argv=None):
         print(f"pis_blender: {args.blend}: {e}", file=sys.stderr)
         return EXIT_IO
     scene = bpy.context.scene
+    if args.points is not None and args.points < 1:
+        print(f"pis_blender: --points {args.points}: give at least 1", file=sys.stderr)
+        return EXIT_USAGE
     if args.spp is not None:
         scene.pis.spp = args.spp
     if args.seed is not None:
@@ -56,7 +60,7 @@ def main(argv=None):
     if args.pis_trace is not None:
         scene.pis.pis_trace = args.pis_trace
     try:
-        report = pis_blender.export_set(scene, args.output, progress=lambda line, _done: print(line, file=sys.stderr, flush=True), keep_halves=args.keep_halves)
+        report = pis_blender.export_set(scene, args.output, progress=lambda line, _done: print(line, file=sys.stderr, flush=True), keep_halves=args.keep_halves, points=args.points)
     except space.SpaceError as e:
         print(f"pis_blender: {args.blend}: the parameter space: {e}", file=sys.stderr)
         return EXIT_USAGE

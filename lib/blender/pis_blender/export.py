@@ -20,10 +20,11 @@ from . import coords, cycles, exr, layers, scene_file, space
 GEOMETRY = ("MESH", "CURVE", "SURFACE", "META", "FONT")
 
 
-def export_set(scene, out_dir, progress=lambda line, done: print(line), keep_halves=False):
+def export_set(scene, out_dir, progress=lambda line, done: print(line), keep_halves=False, points=None):
     """Writes the set of `scene` (its `scene.pis` settings) into `out_dir`; returns a report.
     `progress(line, done)` hears of every point rendered, `done` the share of points so far;
-    `keep_halves` leaves a denoised set's halves in `out_dir/.halves`."""
+    `keep_halves` leaves a denoised set's halves in `out_dir/.halves`; `points` renders only
+    the first that many points (in linear order, each with the seed it has in the whole set)."""
     s = scene.pis
     if scene.camera is None:
         raise scene_file.ExportError("the scene has no camera")
@@ -55,7 +56,7 @@ def export_set(scene, out_dir, progress=lambda line, done: print(line), keep_hal
         for light in lights:
             if hasattr(light.data, "use_soft_falloff"):
                 saved.set(light.data, "use_soft_falloff", False)
-        job = _Job(scene, scratch, dims, objects, roles, lights)
+        job = _Job(scene, scratch, dims, objects, roles, lights, points)
         program, notes = _denoiser(s)
         if program:
             report = _render_halves(job, out_dir, saved, program, progress, keep_halves)
@@ -119,9 +120,11 @@ CHANNELS = {1: ["A"], 3: ["R", "G", "B"], 4: ["R", "G", "B", "A"]}
 class _Job:
     """What every render of the export shares."""
 
-    def __init__(self, scene, scratch, dims, objects, roles, lights):
+    def __init__(self, scene, scratch, dims, objects, roles, lights, limit=None):
         self.scene, self.scratch, self.dims = scene, scratch, dims
         self.objects, self.roles, self.lights = objects, roles, lights
+        # Render only the first `limit` points (None: every point).
+        self.limit = limit
 
 
 class _Pass:
@@ -194,12 +197,13 @@ def _render_points(job, out, progress):
     geometry = [o for o in scene.objects if o.type in GEOMETRY and not o.hide_render]
     fraction = layers.fraction_material_maker()
     renderer = layers.Renderer(scene, job.scratch, geometry)
-    points = space.points(dims)
+    every = space.points(dims)
+    points = every[: job.limit] if job.limit else every
     metas = []
     for index, point in enumerate(points):
         t0 = time.time()
         space.place(scene, dims, point)
-        scene.cycles.seed = out.seed * len(points) + index
+        scene.cycles.seed = out.seed * len(every) + index
         bpy.context.view_layer.update()
         images = _point_images(renderer, job, channels, fraction, out.guides)
         image = f"point_{index:05d}.exr"
