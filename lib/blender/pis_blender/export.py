@@ -198,7 +198,7 @@ def _render_points(job, out, progress):
     fraction = layers.fraction_material_maker()
     renderer = layers.Renderer(scene, job.scratch, geometry)
     every = space.points(dims)
-    points = every[: job.limit] if job.limit else every
+    points = every[: job.limit]
     metas = []
     for index, point in enumerate(points):
         t0 = time.time()
