@@ -28,6 +28,9 @@ def main(argv=None):
     parser.add_argument("--keep-halves", action="store_true", help="a denoised set: leave its two halves in SET_DIR/.halves (to join again with pis-trace denoise)")
     parser.add_argument("--json", action="store_true", help="print the report as JSON")
     args = parser.parse_args(argv)
+    if args.points is not None and args.points < 1:
+        print(f"pis_blender: --points {args.points}: give at least 1", file=sys.stderr)
+        return EXIT_USAGE
     # Blender and its glTF exporter write their logs to standard output: they go to standard
     # error, and standard output carries the report alone.
     sys.stdout.flush()
@@ -48,9 +51,6 @@ def main(argv=None):
         print(f"pis_blender: {args.blend}: {e}", file=sys.stderr)
         return EXIT_IO
     scene = bpy.context.scene
-    if args.points is not None and args.points < 1:
-        print(f"pis_blender: --points {args.points}: give at least 1", file=sys.stderr)
-        return EXIT_USAGE
     if args.spp is not None:
         scene.pis.spp = args.spp
     if args.seed is not None:
