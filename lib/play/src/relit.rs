@@ -128,15 +128,19 @@ impl RelitSum {
     }
 
     /// A texture of the array's layout holding Σ_c `weights[c]` · slice c, its MIP chain
-    /// decimated by `mips`, recorded into `encoder`.
+    /// decimated by `mips`, recorded into `encoder`: `reuse` where it has that layout (a sum
+    /// no longer drawn; every texel of it is written), else a new one.
     pub fn sum(
         &self,
         gpu: &Gpu,
         (array, weights): (&CoefficientArray, &[[f32; 3]]),
-        mips: &MipBuilder,
+        (mips, reuse): (&MipBuilder, Option<ObjectTexture>),
         encoder: &mut wgpu::CommandEncoder,
     ) -> ObjectTexture {
-        let out = mips.texture(gpu, array.layout);
+        let out = match reuse {
+            Some(t) if t.layout == array.layout => t,
+            _ => mips.texture(gpu, array.layout),
+        };
         let (w, h) = allocated_size(&array.layout);
         let used = [array.layout.width, array.layout.height];
         let mut u = SumUniform {
@@ -182,7 +186,8 @@ impl RelitSum {
             });
             pass.set_pipeline(&self.pipeline);
             pass.set_bind_group(0, &bg, &[]);
-            pass.dispatch_workgroups(w.div_ceil(8), h.div_ceil(8), 1);
+            // One invocation a used texel; those of the last column and row fill the padding.
+            pass.dispatch_workgroups(used[0].div_ceil(8), used[1].div_ceil(8), 1);
         }
         mips.decimate(gpu, &out, encoder);
         out
@@ -190,6 +195,11 @@ impl RelitSum {
 }
 
 impl CoefficientArray {
+    /// The layout of its slices, and of their sums.
+    pub fn layout(&self) -> pis_compile::TextureLayout {
+        self.layout
+    }
+
     /// The array's bytes on the GPU.
     pub fn bytes(&self) -> u64 {
         let s = self.texture.size();

@@ -12,7 +12,7 @@ struct Sum {
     // Used size of the finest level.
     used: vec2<u32>,
     // Its allocated size: the padding is written too, since a clamped lookup past the used
-    // region reads it.
+    // region reads it (and the coarser levels are decimated from it).
     alloc: vec2<u32>,
     _pad2: vec2<u32>,
     // Per slice c, w_c in rgb.
@@ -25,14 +25,20 @@ struct Sum {
 
 @compute @workgroup_size(8, 8)
 fn sum(@builtin(global_invocation_id) id: vec3<u32>) {
-    if (id.x >= s.alloc.x || id.y >= s.alloc.y) {
+    if (id.x >= s.used.x || id.y >= s.used.y) {
         return;
     }
-    // The padding repeats the last used column and row, as a decoded texture's does.
-    let at = min(id.xy, s.used - vec2<u32>(1u, 1u));
     var acc = vec3<f32>(0.0, 0.0, 0.0);
     for (var c = 0u; c < s.count; c = c + 1u) {
-        acc = acc + textureLoad(coefficients, at, c, 0).rgb * s.weights[c].rgb;
+        acc = acc + textureLoad(coefficients, id.xy, c, 0).rgb * s.weights[c].rgb;
     }
-    textureStore(dst, id.xy, vec4<f32>(acc, 1.0));
+    // The padding repeats the last used column and row, as a decoded texture's does: the
+    // texels of the last column and row write it, so each sum is made once.
+    let last = s.used - vec2<u32>(1u, 1u);
+    let end = select(id.xy + vec2<u32>(1u, 1u), s.alloc, id.xy == last);
+    for (var y = id.y; y < end.y; y = y + 1u) {
+        for (var x = id.x; x < end.x; x = x + 1u) {
+            textureStore(dst, vec2<u32>(x, y), vec4<f32>(acc, 1.0));
+        }
+    }
 }

@@ -163,7 +163,11 @@ fn summed_coefficients_match_the_model() {
     let summing = RelitSum::new(&gpu);
     let mut encoder = gpu.device.create_command_encoder(&Default::default());
     let array = summing.gather(&gpu, &refs, &mut encoder);
-    let sum = summing.sum(&gpu, (&array, &weights), &mips, &mut encoder);
+    // Summed into the texture of an earlier sum (as when a light moves), which every texel
+    // of the new one overwrites.
+    let earlier: Vec<[f32; 3]> = weights.iter().map(|w| w.map(|v| 1.0 - 2.0 * v)).collect();
+    let first = summing.sum(&gpu, (&array, &earlier), (&mips, None), &mut encoder);
+    let sum = summing.sum(&gpu, (&array, &weights), (&mips, Some(first)), &mut encoder);
     gpu.queue.submit([encoder.finish()]);
     // The finest level, texel by texel, against the Rust twin: the used region, and the
     // padding repeating its last column and row (a clamped lookup past the edge reads it).

@@ -29,6 +29,9 @@ pub(super) struct RelitTextures {
     summing: RelitSum,
     arrays: HashMap<Vec<TextureKey>, (CoefficientArray, u64)>,
     sums: HashMap<SumKey, (ObjectTexture, u64)>,
+    /// Sums no longer drawn, whose textures a new sum of their layout writes into: while a
+    /// light moves, each frame's sums replace the last frame's without allocating.
+    spare: Vec<ObjectTexture>,
     frame: u64,
 }
 
@@ -38,6 +41,7 @@ impl RelitTextures {
             summing: RelitSum::new(gpu),
             arrays: HashMap::new(),
             sums: HashMap::new(),
+            spare: Vec::new(),
             frame: 0,
         }
     }
@@ -114,7 +118,10 @@ impl RelitTextures {
             .entry(keys)
             .or_insert_with(|| (self.summing.gather(gpu, &maps, encoder), frame));
         array.1 = frame;
-        let sum = self.summing.sum(gpu, (&array.0, &weights), textures.mips(), encoder);
+        let layout = array.0.layout();
+        let reuse =
+            self.spare.iter().position(|t| t.layout == layout).map(|i| self.spare.swap_remove(i));
+        let sum = self.summing.sum(gpu, (&array.0, &weights), (textures.mips(), reuse), encoder);
         self.sums.insert(key.clone(), (sum, frame));
         Some(key)
     }
@@ -124,10 +131,18 @@ impl RelitTextures {
         &self.sums[key].0
     }
 
-    /// Ends the frame: the sums and arrays it did not use released.
+    /// Ends the frame: the arrays it did not use released, the sums it did not use kept as
+    /// spares for the next frame's sums (those it does not take then released).
     pub(super) fn end_frame(&mut self) {
         let frame = self.frame;
-        self.sums.retain(|_, s| s.1 == frame);
+        self.spare.clear();
+        let stale: Vec<SumKey> =
+            self.sums.iter().filter(|(_, s)| s.1 != frame).map(|(k, _)| k.clone()).collect();
+        for k in stale {
+            if let Some((t, _)) = self.sums.remove(&k) {
+                self.spare.push(t);
+            }
+        }
         self.arrays.retain(|_, a| a.1 == frame);
         self.frame += 1;
     }
