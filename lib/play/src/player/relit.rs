@@ -135,14 +135,10 @@ impl RelitTextures {
     /// spares for the next frame's sums (those it does not take then released).
     pub(super) fn end_frame(&mut self) {
         let frame = self.frame;
-        self.spare.clear();
-        let stale: Vec<SumKey> =
-            self.sums.iter().filter(|(_, s)| s.1 != frame).map(|(k, _)| k.clone()).collect();
-        for k in stale {
-            if let Some((t, _)) = self.sums.remove(&k) {
-                self.spare.push(t);
-            }
-        }
+        let (kept, stale): (HashMap<_, _>, HashMap<_, _>) =
+            std::mem::take(&mut self.sums).into_iter().partition(|(_, s)| s.1 == frame);
+        self.sums = kept;
+        self.spare = stale.into_values().map(|(t, _)| t).collect();
         self.arrays.retain(|_, a| a.1 == frame);
         self.frame += 1;
     }
