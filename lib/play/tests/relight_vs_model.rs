@@ -167,7 +167,9 @@ fn summed_coefficients_match_the_model() {
     // of the new one overwrites.
     let earlier: Vec<[f32; 3]> = weights.iter().map(|w| w.map(|v| 1.0 - 2.0 * v)).collect();
     let first = summing.sum(&gpu, (&array, &earlier), (&mips, None), &mut encoder);
+    let earlier_texture = first.texture.clone();
     let sum = summing.sum(&gpu, (&array, &weights), (&mips, Some(first)), &mut encoder);
+    assert!(sum.texture == earlier_texture, "the sum did not reuse the earlier sum's texture");
     gpu.queue.submit([encoder.finish()]);
     // The finest level, texel by texel, against the Rust twin: the used region, and the
     // padding repeating its last column and row (a clamped lookup past the edge reads it).
