@@ -16,6 +16,8 @@
 // `!(a < b)` is meant: it is also true when a value is NaN, which must stop the iteration.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
+use rayon::prelude::*;
+
 use crate::regularize::{barrier, barrier_d1, barrier_d2, RangeRegularization};
 
 /// The quadratic part of the objective.
@@ -67,76 +69,192 @@ pub fn minimize(
     x: &mut [f64],
     settings: &CgSettings,
 ) -> CgReport {
-    let n = x.len();
-    let mut gq = vec![0.0; n];
-    let fq = q.value_gradient(x, &mut gq);
-    let full_grad = |gq: &[f64], x: &[f64]| {
-        let mut g = gq.to_vec();
-        if let Some(r) = range {
+    let mut hess = |p: &[&[f64]], out: &mut [&mut [f64]]| q.hess_mul(p[0], out[0]);
+    let mut reports = minimize_lanes(&[q], &mut hess, range, inv_diag, vec![x], settings);
+    reports.pop().expect("one lane")
+}
+
+/// The products `out_l = H·p_l` of the lanes still running, taken together.
+pub type LanesProduct<'a> = dyn FnMut(&[&[f64]], &mut [&mut [f64]]) + 'a;
+
+/// [`minimize`] for several problems that share H (the colour channels of one texture),
+/// iterated in lockstep: each iteration takes the products with H of every lane still
+/// running in one call of `hess` (e.g. one pass over H's entries). Each lane's arithmetic
+/// is that of [`minimize`] on its own problem, so where `hess` gives each lane what
+/// [`Quadratic::hess_mul`] would, its result is the same bit for bit.
+pub fn minimize_lanes(
+    qs: &[&dyn Quadratic],
+    hess: &mut LanesProduct<'_>,
+    range: Option<&RangeRegularization>,
+    inv_diag: &[f64],
+    xs: Vec<&mut [f64]>,
+    settings: &CgSettings,
+) -> Vec<CgReport> {
+    let mut lanes: Vec<Lane> =
+        qs.iter().zip(xs).map(|(&q, x)| Lane::new(q, range, inv_diag, x)).collect();
+    loop {
+        for lane in lanes.iter_mut().filter(|l| l.running) {
+            lane.check(settings);
+        }
+        let (d, mut hd): (Vec<&[f64]>, Vec<&mut [f64]>) =
+            lanes.iter_mut().filter(|l| l.running).map(|l| (&l.d[..], &mut l.hd[..])).unzip();
+        if d.is_empty() {
+            break;
+        }
+        hess(&d, &mut hd);
+        lanes.par_iter_mut().filter(|l| l.running).for_each(|l| l.step(range, inv_diag, settings));
+    }
+    lanes.into_iter().map(|l| l.report).collect()
+}
+
+/// One problem's iteration state in [`minimize_lanes`].
+struct Lane<'a> {
+    q: &'a dyn Quadratic,
+    x: &'a mut [f64],
+    /// The quadratic part's gradient.
+    gq: Vec<f64>,
+    /// M⁻¹g, and the scratch its successor is computed in.
+    z: Vec<f64>,
+    z_next: Vec<f64>,
+    gz: f64,
+    /// gᵀM⁻¹g at the cold start, the tolerance's reference.
+    gz0: f64,
+    /// The search direction and H·d.
+    d: Vec<f64>,
+    hd: Vec<f64>,
+    f: f64,
+    report: CgReport,
+    running: bool,
+}
+
+/// The full gradient: the quadratic part's, plus the range term's when there is one.
+fn full_gradient<'g>(
+    gq: &'g [f64],
+    range: Option<&RangeRegularization>,
+    x: &[f64],
+) -> std::borrow::Cow<'g, [f64]> {
+    match range {
+        None => std::borrow::Cow::Borrowed(gq),
+        Some(r) => {
+            let mut g = gq.to_vec();
             r.add_gradient(x, &mut g);
+            std::borrow::Cow::Owned(g)
         }
-        g
-    };
-    let mut f = fq + range.map_or(0.0, |r| r.value(x));
-    let mut report = CgReport { objective: vec![f], ..Default::default() };
-    let g = full_grad(&gq, x);
-    let mut z: Vec<f64> = g.iter().zip(inv_diag).map(|(g, m)| g * m).collect();
-    let mut gz = dot(&g, &z);
-    let gz0 = {
-        let mut g0 = vec![0.0; n];
-        q.value_gradient(&vec![0.0; n], &mut g0);
-        let cold = dot(&g0, &g0.iter().zip(inv_diag).map(|(g, m)| g * m).collect::<Vec<_>>());
-        if cold > 0.0 {
-            cold
-        } else {
-            gz
-        }
-    };
-    if !(gz > 0.0) || !gz.is_finite() {
-        report.converged = gz == 0.0;
-        return report;
     }
-    let mut d: Vec<f64> = z.iter().map(|v| -v).collect();
-    let mut hd = vec![0.0; n];
-    while report.iterations < settings.max_iterations {
-        if gz <= settings.tolerance * settings.tolerance * gz0 {
-            report.converged = true;
-            break;
-        }
-        q.hess_mul(&d, &mut hd);
-        let curv = dot(&d, &hd);
-        let slope_q = dot(&gq, &d);
-        let Some((alpha, delta)) = line_minimum(slope_q, curv, range, x, &d) else {
-            break;
+}
+
+impl<'a> Lane<'a> {
+    fn new(
+        q: &'a dyn Quadratic,
+        range: Option<&RangeRegularization>,
+        inv_diag: &[f64],
+        x: &'a mut [f64],
+    ) -> Lane<'a> {
+        let n = x.len();
+        let mut gq = vec![0.0; n];
+        let fq = q.value_gradient(x, &mut gq);
+        let f = fq + range.map_or(0.0, |r| r.value(x));
+        let report = CgReport { objective: vec![f], ..Default::default() };
+        let g = full_gradient(&gq, range, x);
+        let z: Vec<f64> = g.iter().zip(inv_diag).map(|(g, m)| g * m).collect();
+        let gz = dot(&g, &z);
+        let gz0 = {
+            let mut g0 = vec![0.0; n];
+            q.value_gradient(&vec![0.0; n], &mut g0);
+            let cold = dot(&g0, &g0.iter().zip(inv_diag).map(|(g, m)| g * m).collect::<Vec<_>>());
+            if cold > 0.0 {
+                cold
+            } else {
+                gz
+            }
         };
-        if !(delta < 0.0) {
-            break;
+        let d: Vec<f64> = z.iter().map(|v| -v).collect();
+        let mut lane = Lane {
+            q,
+            x,
+            gq,
+            z,
+            z_next: vec![0.0; n],
+            gz,
+            gz0,
+            d,
+            hd: vec![0.0; n],
+            f,
+            report,
+            running: true,
+        };
+        if !(gz > 0.0) || !gz.is_finite() {
+            lane.report.converged = gz == 0.0;
+            lane.running = false;
         }
-        for i in 0..n {
-            x[i] += alpha * d[i];
-            gq[i] += 2.0 * alpha * hd[i];
-        }
-        f += delta;
-        report.iterations += 1;
-        report.objective.push(f);
-        if settings.refresh_every > 0 && report.iterations.is_multiple_of(settings.refresh_every) {
-            q.value_gradient(x, &mut gq);
-        }
-        let g_new = full_grad(&gq, x);
-        let z_new: Vec<f64> = g_new.iter().zip(inv_diag).map(|(g, m)| g * m).collect();
-        let gz_new = dot(&g_new, &z_new);
-        // Polak–Ribière+: β = max(0, g₊ᵀ(z₊ − z) / gᵀz).
-        let beta = ((gz_new - dot(&g_new, &z)) / gz).max(0.0);
-        for i in 0..n {
-            d[i] = -z_new[i] + beta * d[i];
-        }
-        if dot(&d, &g_new) >= 0.0 {
-            d.iter_mut().zip(&z_new).for_each(|(d, z)| *d = -z);
-        }
-        z = z_new;
-        gz = gz_new;
+        lane
     }
-    report
+
+    /// The stopping rules checked before an iteration.
+    fn check(&mut self, settings: &CgSettings) {
+        if self.report.iterations >= settings.max_iterations {
+            self.running = false;
+        } else if self.gz <= settings.tolerance * settings.tolerance * self.gz0 {
+            self.report.converged = true;
+            self.running = false;
+        }
+    }
+
+    /// The rest of an iteration, once `hd` holds H·d: the line minimum, the step, and the
+    /// next direction (Polak–Ribière+). A refused step stops the lane.
+    fn step(
+        &mut self,
+        range: Option<&RangeRegularization>,
+        inv_diag: &[f64],
+        settings: &CgSettings,
+    ) {
+        // Each sum below runs over i in order from −0.0, as `dot` does: the loops are fused
+        // to pass over the vectors fewer times, with the same arithmetic.
+        let (mut curv, mut slope_q) = (-0.0, -0.0);
+        for ((d, hd), gq) in self.d.iter().zip(&self.hd).zip(&self.gq) {
+            curv += d * hd;
+            slope_q += gq * d;
+        }
+        let accepted =
+            line_minimum(slope_q, curv, range, self.x, &self.d).filter(|&(_, delta)| delta < 0.0);
+        let Some((alpha, delta)) = accepted else {
+            self.running = false;
+            return;
+        };
+        for i in 0..self.x.len() {
+            self.x[i] += alpha * self.d[i];
+            self.gq[i] += 2.0 * alpha * self.hd[i];
+        }
+        self.f += delta;
+        self.report.iterations += 1;
+        self.report.objective.push(self.f);
+        if settings.refresh_every > 0
+            && self.report.iterations.is_multiple_of(settings.refresh_every)
+        {
+            self.q.value_gradient(self.x, &mut self.gq);
+        }
+        let g_new = full_gradient(&self.gq, range, self.x);
+        // gᵀ₊z₊ and gᵀ₊z.
+        let (mut gz_new, mut gz_old) = (-0.0, -0.0);
+        for (((zn, g), m), z) in self.z_next.iter_mut().zip(g_new.iter()).zip(inv_diag).zip(&self.z)
+        {
+            *zn = g * m;
+            gz_new += g * *zn;
+            gz_old += g * z;
+        }
+        // Polak–Ribière+: β = max(0, g₊ᵀ(z₊ − z) / gᵀz).
+        let beta = ((gz_new - gz_old) / self.gz).max(0.0);
+        let mut dg = -0.0;
+        for ((d, z), g) in self.d.iter_mut().zip(&self.z_next).zip(g_new.iter()) {
+            *d = -z + beta * *d;
+            dg += *d * g;
+        }
+        if dg >= 0.0 {
+            self.d.iter_mut().zip(&self.z_next).for_each(|(d, z)| *d = -z);
+        }
+        std::mem::swap(&mut self.z, &mut self.z_next);
+        self.gz = gz_new;
+    }
 }
 
 /// The step α minimizing the objective along d and the objective's change; `None` when

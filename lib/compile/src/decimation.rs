@@ -76,29 +76,41 @@ impl Decimation {
 
     /// D·x₀: the whole chain (n_t values, in the order of [`TextureLayout`]) from level 0.
     pub fn expand(&self, x0: &[f64], out: &mut [f64]) {
-        let n0 = self.base_len();
+        self.expand_lanes::<1>(x0, out);
+    }
+
+    /// [`Decimation::expand`] of the L vectors of `x0`, interleaved (`x0[t·L + l]`), into
+    /// `out` interleaved alike: each lane bit for bit what `expand` gives it.
+    pub fn expand_lanes<const L: usize>(&self, x0: &[f64], out: &mut [f64]) {
+        let n0 = self.base_len() * L;
         out[..n0].copy_from_slice(&x0[..n0]);
         let mut at = 0;
         for (m, (s, _)) in self.steps.iter().enumerate() {
-            let next = self.layout.level_offset(m as u32 + 1);
+            let next = self.layout.level_offset(m as u32 + 1) * L;
             let (src, dst) = out.split_at_mut(next);
-            s.mul(&src[at..], &mut dst[..s.rows]);
+            s.mul_lanes::<L>(&src[at..], &mut dst[..s.rows * L]);
             at = next;
         }
     }
 
     /// Dᵀ·g: a gradient over the whole chain carried back to level 0 (n₀ values).
     pub fn reduce(&self, g: &[f64], out: &mut [f64]) {
+        self.reduce_lanes::<1>(g, out);
+    }
+
+    /// [`Decimation::reduce`] of the L interleaved vectors of `g`, into `out` interleaved
+    /// alike: each lane bit for bit what `reduce` gives it.
+    pub fn reduce_lanes<const L: usize>(&self, g: &[f64], out: &mut [f64]) {
         let mut acc: Vec<f64> = match self.steps.last() {
-            Some(_) => g[self.layout.level_offset(self.layout.levels - 1)..].to_vec(),
-            None => g[..self.base_len()].to_vec(),
+            Some(_) => g[self.layout.level_offset(self.layout.levels - 1) * L..].to_vec(),
+            None => g[..self.base_len() * L].to_vec(),
         };
         for m in (0..self.steps.len()).rev() {
             let (_, t) = &self.steps[m];
-            let off = self.layout.level_offset(m as u32);
-            let mut lower = vec![0.0; t.rows];
-            t.mul(&acc, &mut lower);
-            lower.iter_mut().zip(&g[off..off + t.rows]).for_each(|(l, v)| *l += v);
+            let off = self.layout.level_offset(m as u32) * L;
+            let mut lower = vec![0.0; t.rows * L];
+            t.mul_lanes::<L>(&acc, &mut lower);
+            lower.iter_mut().zip(&g[off..off + t.rows * L]).for_each(|(l, v)| *l += v);
             acc = lower;
         }
         out[..acc.len()].copy_from_slice(&acc);

@@ -116,16 +116,7 @@ fn dot(a: &[f64], b: &[f64]) -> f64 {
 
 impl Quadratic for ChannelProblem<'_> {
     fn hess_mul(&self, p: &[f64], out: &mut [f64]) {
-        match self.chain {
-            None => self.hess_mul_chain(p, out),
-            Some(d) => {
-                let n_t = d.layout.texel_count();
-                let (mut pf, mut of) = (vec![0.0; n_t], vec![0.0; n_t]);
-                d.expand(p, &mut pf);
-                self.hess_mul_chain(&pf, &mut of);
-                d.reduce(&of, out);
-            }
-        }
+        self.lanes().mul(&[p], &mut [out]);
     }
 
     fn value_gradient(&self, x: &[f64], grad: &mut [f64]) -> f64 {
@@ -143,26 +134,103 @@ impl Quadratic for ChannelProblem<'_> {
     }
 }
 
-impl ChannelProblem<'_> {
-    /// H·p over the whole chain.
-    fn hess_mul_chain(&self, p: &[f64], out: &mut [f64]) {
-        match self.op {
-            DataOperator::A { a, at } => {
-                let mut t = vec![0.0; a.rows];
-                a.mul(p, &mut t);
-                at.mul(&t, out);
-            }
-            DataOperator::Normal { h, .. } | DataOperator::Gram { h } => h.mul(p, out),
+impl<'a> ChannelProblem<'a> {
+    /// The product with H for the channels of this problem's texture, which share it.
+    pub fn lanes(&self) -> LaneProduct<'a> {
+        LaneProduct {
+            op: self.op,
+            pyramid: self.pyramid,
+            chain: self.chain,
+            scratch: Default::default(),
         }
-        if let Some(pt) = self.pyramid {
-            let mut t = vec![0.0; pt.p.rows];
-            pt.p.mul(p, &mut t);
-            let mut u = vec![0.0; out.len()];
-            pt.pt.mul(&t, &mut u);
-            out.par_iter_mut().zip(&u).for_each(|(o, u)| *o += pt.lambda * u);
+    }
+}
+
+/// H·p for several vectors at once (the channels of one texture): A, P and D are read once
+/// for all of them, the vectors interleaved, and each lane's product is bit for bit the
+/// one [`ChannelProblem::hess_mul`] gives it alone. The work vectors are kept from one
+/// product to the next.
+pub struct LaneProduct<'a> {
+    op: &'a DataOperator,
+    pyramid: Option<&'a PyramidTerm>,
+    chain: Option<&'a Decimation>,
+    /// The lanes' p and H·p at level 0 and over the whole chain, and the intermediate
+    /// products, interleaved.
+    scratch: [Vec<f64>; 6],
+}
+
+impl LaneProduct<'_> {
+    /// out_l = H·p_l for every lane (at most [`crate::view::CHANNELS`]).
+    pub fn mul(&mut self, p: &[&[f64]], out: &mut [&mut [f64]]) {
+        match p.len() {
+            0 => {}
+            1 => self.mul_lanes::<1>(p, out),
+            2 => self.mul_lanes::<2>(p, out),
+            3 => self.mul_lanes::<3>(p, out),
+            n => unreachable!("{n} lanes: at most {} (colour channels)", crate::view::CHANNELS),
         }
     }
 
+    fn mul_lanes<const L: usize>(&mut self, p: &[&[f64]], out: &mut [&mut [f64]]) {
+        let n_x = p[0].len();
+        let n_t = self.chain.map_or(n_x, |d| d.layout.texel_count());
+        let [p0, h0, pf, hf, t, u] = &mut self.scratch;
+        let sized = |v: &mut Vec<f64>, n: usize| v.resize(n, 0.0);
+        sized(p0, n_x * L);
+        p0.par_chunks_mut(L).enumerate().for_each(|(i, v)| {
+            for (l, p) in p.iter().enumerate() {
+                v[l] = p[i];
+            }
+        });
+        match self.chain {
+            None => {
+                sized(h0, n_x * L);
+                chain_product::<L>(self.op, self.pyramid, p0, h0, t, u);
+            }
+            Some(d) => {
+                sized(pf, n_t * L);
+                d.expand_lanes::<L>(p0, pf);
+                sized(hf, n_t * L);
+                chain_product::<L>(self.op, self.pyramid, pf, hf, t, u);
+                sized(h0, n_x * L);
+                d.reduce_lanes::<L>(hf, h0);
+            }
+        }
+        let h0: &[f64] = h0;
+        out.par_iter_mut().enumerate().for_each(|(l, out)| {
+            out.iter_mut().zip(h0.iter().skip(l).step_by(L)).for_each(|(o, h)| *o = *h);
+        });
+    }
+}
+
+/// H·p over the whole chain for the L interleaved lanes of `p`; `t` and `u` are work
+/// vectors.
+fn chain_product<const L: usize>(
+    op: &DataOperator,
+    pyramid: Option<&PyramidTerm>,
+    p: &[f64],
+    out: &mut [f64],
+    t: &mut Vec<f64>,
+    u: &mut Vec<f64>,
+) {
+    match op {
+        DataOperator::A { a, at } => {
+            t.resize(a.rows * L, 0.0);
+            a.mul_lanes::<L>(p, t);
+            at.mul_lanes::<L>(t, out);
+        }
+        DataOperator::Normal { h, .. } | DataOperator::Gram { h } => h.mul_lanes::<L>(p, out),
+    }
+    if let Some(pt) = pyramid {
+        t.resize(pt.p.rows * L, 0.0);
+        pt.p.mul_lanes::<L>(p, t);
+        u.resize(out.len(), 0.0);
+        pt.pt.mul_lanes::<L>(t, u);
+        out.par_iter_mut().zip(&*u).for_each(|(o, u)| *o += pt.lambda * u);
+    }
+}
+
+impl ChannelProblem<'_> {
     /// f and its gradient over the whole chain.
     fn value_gradient_chain(&self, x: &[f64], grad: &mut [f64]) -> f64 {
         let mut f = match self.op {

@@ -9,7 +9,7 @@ use std::time::Instant;
 use rayon::prelude::*;
 
 use crate::bounded::minimize_bounded;
-use crate::cg::{self, CgReport, CgSettings};
+use crate::cg::{self, CgReport, CgSettings, Quadratic};
 use crate::decimation::{chain_f32, Decimation};
 use crate::error::check_finite;
 use crate::normal_equations::{
@@ -346,12 +346,8 @@ fn finish(
     let mut channels = Vec::with_capacity(CHANNELS);
     let mut residual2 = 0.0;
     let mut bb_total = 0.0;
-    // The channels are independent problems sharing A: solved concurrently (each result
-    // depends only on its own inputs, so the outcome does not depend on scheduling).
-    let results: Vec<(CgReport, Vec<f64>, f64)> = (0..CHANNELS)
-        .into_par_iter()
+    let mut xs: Vec<Vec<f64>> = (0..CHANNELS)
         .map(|ch| {
-            let rhs = &rhs[ch];
             let mut x: Vec<f64> = match initial {
                 Some(x0) => {
                     x0.iter().skip(ch).step_by(CHANNELS).take(n_x).map(|&v| v as f64).collect()
@@ -361,20 +357,47 @@ fn finish(
             if let Some(r) = &range {
                 r.clamp_inside(&mut x);
             }
-            let problem =
-                ChannelProblem { op: &op, rhs, pyramid: pyramid.as_ref(), chain: chain.as_ref() };
-            let report = if settings.bounded {
-                let hi = (settings.range_factor * b_max).max(1e-6);
-                minimize_bounded(&problem, 0.0, hi, &inv_diag, &mut x, &settings.cg)
-            } else {
-                cg::minimize(&problem, range.as_ref(), &inv_diag, &mut x, &settings.cg)
-            };
-            if let Some(d) = &chain {
+            x
+        })
+        .collect();
+    let problems: Vec<ChannelProblem> = rhs
+        .iter()
+        .map(|rhs| ChannelProblem {
+            op: &op,
+            rhs,
+            pyramid: pyramid.as_ref(),
+            chain: chain.as_ref(),
+        })
+        .collect();
+    // The channels are problems sharing A: iterated in lockstep, each pass over A serving
+    // every channel still running (each channel's arithmetic is its own, so the outcome is
+    // that of three separate solves). The box-bounded solver takes them one by one,
+    // concurrently.
+    let reports: Vec<CgReport> = if settings.bounded {
+        let hi = (settings.range_factor * b_max).max(1e-6);
+        problems
+            .par_iter()
+            .zip(xs.par_iter_mut())
+            .map(|(p, x)| minimize_bounded(p, 0.0, hi, &inv_diag, x, &settings.cg))
+            .collect()
+    } else {
+        let qs: Vec<&dyn Quadratic> = problems.iter().map(|p| p as &dyn Quadratic).collect();
+        let lanes = xs.iter_mut().map(|x| x.as_mut_slice()).collect();
+        let mut product = problems[0].lanes();
+        let mut hess = |p: &[&[f64]], out: &mut [&mut [f64]]| product.mul(p, out);
+        cg::minimize_lanes(&qs, &mut hess, range.as_ref(), &inv_diag, lanes, &settings.cg)
+    };
+    let results: Vec<(CgReport, Vec<f64>, f64)> = reports
+        .into_iter()
+        .zip(xs)
+        .zip(&rhs)
+        .map(|((report, x), rhs)| match &chain {
+            Some(d) => {
                 let mut full = vec![0.0; n_t];
                 d.expand(&x, &mut full);
-                x = full;
+                (report, full, rhs.bb)
             }
-            (report, x, rhs.bb)
+            None => (report, x, rhs.bb),
         })
         .collect();
     let xs: Vec<&[f64]> = results.iter().map(|r| r.1.as_slice()).collect();

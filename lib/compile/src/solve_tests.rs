@@ -491,3 +491,40 @@ fn bounded_least_squares_keeps_the_box_and_weak_pyramidal_costs_little() {
     )
     .is_err());
 }
+
+#[test]
+fn each_channel_solves_as_it_would_alone_bit_for_bit() {
+    // The channels are iterated in lockstep, sharing each product with A. Warm-started
+    // from a solution with the first channel zeroed, the other two stop at once and the
+    // first goes on alone; solved with every channel equal to it, three lanes go on.
+    let (a, mut b) = view(Filter::Trilinear, 0.0);
+    for (k, v) in b.iter_mut().enumerate() {
+        *v += 0.02 * (((k * 7919) % 61) as f32 / 61.0 - 0.5);
+    }
+    // The brightest value in every channel of one pixel: the range term's bound is the
+    // same for the channels alone.
+    let peak = b.iter().fold(0.0f32, |m, &v| m.max(v));
+    b[..3].fill(peak);
+    let settings = [
+        SolveSettings::pyramidal(),
+        SolveSettings::decimated(),
+        SolveSettings { epsilon_b: 1.0 / 32.0, ..SolveSettings::pyramidal() },
+        SolveSettings { form: FormChoice::Fixed(Form::A), ..SolveSettings::pyramidal() },
+    ];
+    let each =
+        |x: &[f32], ch: usize| -> Vec<f32> { x.chunks(3).flat_map(|p| [p[ch]; 3]).collect() };
+    for s in settings {
+        let mut warm = solve(&a, &b, None, &s).unwrap().texels;
+        warm.iter_mut().step_by(3).for_each(|v| *v = 0.0);
+        let all = solve(&a, &b, Some(&warm), &s).unwrap();
+        let iterations: Vec<u32> = all.channels.iter().map(|c| c.iterations).collect();
+        assert!(iterations[0] > 0 && iterations[1..] == [0, 0], "{s:?}: {iterations:?}");
+        for ch in 0..3 {
+            let one = solve(&a, &each(&b, ch), Some(&each(&warm, ch)), &s).unwrap();
+            assert_eq!(one.channels[0], all.channels[ch], "{s:?}, channel {ch}");
+            let bits = |x: &[f32]| x.iter().skip(ch).step_by(3).map(|v| v.to_bits()).collect();
+            let (lone, joint): (Vec<u32>, Vec<u32>) = (bits(&one.texels), bits(&all.texels));
+            assert_eq!(lone, joint, "{s:?}, channel {ch}");
+        }
+    }
+}

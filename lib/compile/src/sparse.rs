@@ -64,9 +64,24 @@ impl Csr {
 
     /// y = M·x, parallel over rows.
     pub fn mul(&self, x: &[f64], y: &mut [f64]) {
-        y.par_iter_mut().enumerate().with_min_len(256).for_each(|(r, out)| {
+        self.mul_lanes::<1>(x, y);
+    }
+
+    /// y_l = M·x_l for the L vectors of `x`, interleaved (`x[c·L + l]`, `y[r·L + l]`):
+    /// M's entries are read once for all of them. Each lane's entry is summed in the order
+    /// of [`Csr::mul`] (from −0.0, as `Iterator::sum`), so each lane equals `mul` of that
+    /// lane bit for bit.
+    pub fn mul_lanes<const L: usize>(&self, x: &[f64], y: &mut [f64]) {
+        y.par_chunks_mut(L).enumerate().with_min_len(256).for_each(|(r, out)| {
             let (c, v) = self.row(r);
-            *out = c.iter().zip(v).map(|(&c, &v)| v * x[c as usize]).sum();
+            let mut acc = [-0.0f64; L];
+            for (&c, &v) in c.iter().zip(v) {
+                let xc = &x[c as usize * L..c as usize * L + L];
+                for l in 0..L {
+                    acc[l] += v * xc[l];
+                }
+            }
+            out.copy_from_slice(&acc);
         });
     }
 
@@ -249,6 +264,26 @@ mod tests {
             m.row_start.push(m.col.len());
         }
         m
+    }
+
+    #[test]
+    fn products_of_interleaved_lanes_are_each_lanes_product_bit_for_bit() {
+        let m = random(50, 37, 9);
+        let x: Vec<Vec<f64>> = (0..3)
+            .map(|l| (0..37).map(|c| ((c * 13 + l * 5) % 11) as f64 - 4.3).collect())
+            .collect();
+        let mut interleaved = vec![0.0; 37 * 3];
+        for (c, v) in interleaved.chunks_mut(3).enumerate() {
+            v.copy_from_slice(&[x[0][c], x[1][c], x[2][c]]);
+        }
+        let mut y = vec![0.0; 50 * 3];
+        m.mul_lanes::<3>(&interleaved, &mut y);
+        for (l, x) in x.iter().enumerate() {
+            let mut alone = vec![0.0; 50];
+            m.mul(x, &mut alone);
+            let lane: Vec<u64> = y.iter().skip(l).step_by(3).map(|v| v.to_bits()).collect();
+            assert_eq!(lane, alone.iter().map(|v| v.to_bits()).collect::<Vec<_>>());
+        }
     }
 
     #[test]
