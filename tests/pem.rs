@@ -362,7 +362,7 @@ fn sub_pixel_lookups_follow_the_traced_footprint() {
 /// version 5, validates, pis-inspect names the shells, and the player — which casts the
 /// depth cubes from the file's meshes when it opens it — draws them as pis-pack predicted.
 /// `--distant-shell auto` reports the depth shell's error between the samples beside the
-/// shell it keeps.
+/// shell it keeps; `depth-per-sample` solves a map per sample, which depends on the view.
 #[test]
 fn depth_shells_follow_the_scene_and_play_as_predicted() {
     let dir = tempfile::tempdir().expect("temp dir");
@@ -386,20 +386,7 @@ fn depth_shells_follow_the_scene_and_play_as_predicted() {
         assert!(b["why"].as_str().is_some_and(|w| w.contains("distant depth")), "{}", b["why"]);
     }
     assert_valid(&depth);
-    let i = Command::new(env!("CARGO_BIN_EXE_pis-inspect"))
-        .arg(&depth)
-        .arg("--json")
-        .output()
-        .expect("pis-inspect runs");
-    let j: serde_json::Value = serde_json::from_slice(&i.stdout).expect("JSON");
-    assert_eq!(j["version"], "1.5", "{}", j["version"]);
-    let distant: Vec<&serde_json::Value> = j["objects"]
-        .as_array()
-        .expect("objects")
-        .iter()
-        .flat_map(|o| o["layers"].as_array().expect("layers"))
-        .filter(|l| l["kind"] == "env_distant")
-        .collect();
+    let distant = distant_layers(&depth);
     assert_eq!(distant.len(), 2, "{distant:?}");
     for l in distant {
         assert_eq!(l["shell"], "depth", "{l}");
@@ -407,6 +394,17 @@ fn depth_shells_follow_the_scene_and_play_as_predicted() {
     }
     let set = traced_set(dir.path());
     assert_plays_as_predicted(&depth, &set);
+    // The single-view inference: one map per sample, each solved from its own view.
+    let (each, _) = pack(
+        &scene,
+        "each.pis",
+        &["--representation", "pem", "--distant-shell", "depth-per-sample"],
+    );
+    for l in distant_layers(&each) {
+        assert_eq!(l["shell"], "depth", "{l}");
+        assert_eq!(l["depends_on"], serde_json::json!(["view"]), "{l}");
+    }
+    assert_plays_as_predicted(&each, &set);
     // The march's step count in the player: 4 coarse steps step over the scene's geometry,
     // the file's count (and more) find it (here 23.4, 25.8 and 25.8 dB).
     let played = |steps: &[&str]| played_psnr(&depth, &set, steps);
@@ -414,6 +412,26 @@ fn depth_shells_follow_the_scene_and_play_as_predicted() {
         (played(&[]), played(&["--depth-steps", "4"]), played(&["--depth-steps", "64"]));
     eprintln!("depth shells marched in the file's steps: {file:.2} dB, 4: {few:.2}, 64: {many:.2}");
     assert!(few < file - 1.0 && many > file - 0.1, "{file} {few} {many}");
+}
+
+/// The distant shells' layers of `file` as pis-inspect describes them; the file is of
+/// minor version 5.
+fn distant_layers(file: &Path) -> Vec<serde_json::Value> {
+    let i = Command::new(env!("CARGO_BIN_EXE_pis-inspect"))
+        .arg(file)
+        .arg("--json")
+        .output()
+        .expect("pis-inspect runs");
+    let j: serde_json::Value = serde_json::from_slice(&i.stdout).expect("JSON");
+    assert_eq!(j["version"], "1.5", "{}", j["version"]);
+    j["objects"]
+        .as_array()
+        .expect("objects")
+        .iter()
+        .flat_map(|o| o["layers"].as_array().expect("layers"))
+        .filter(|l| l["kind"] == "env_distant")
+        .cloned()
+        .collect()
 }
 
 /// pis-play's PSNR against `set` over its sample points, with `extra` flags.

@@ -159,7 +159,9 @@ pub struct PackOptions {
     /// (thesis 5.4); `auto`: that, then a depth shell (SPEC.md 8.5: its radius in each
     /// direction the distance to the other objects, one map over the views) where it
     /// predicts a view held out between two samples better, at some cost at the sampled
-    /// views; `box`, `sphere` or `depth`: that shell.
+    /// views; `box`, `sphere` or `depth`: that shell; `depth-per-sample`: a depth shell with
+    /// one map per parameter sample, each solved from its own view (the single-view inference
+    /// the shared map is measured against).
     #[arg(long, default_value = "fitted", value_parser = one_of(&DistantShell::ALL, DistantShell::name))]
     pub distant_shell: DistantShell,
     /// Where the set turns a light over directions (scene.toml `light_direction`): `on`

@@ -529,8 +529,13 @@ pub enum DistantShell {
     Box,
     /// A sphere at the mean distance of the reflected environment.
     Sphere,
-    /// A depth shell (where the scene has other objects to cast its depth cube from).
+    /// A depth shell (where the scene has other objects to cast its depth cube from), its
+    /// one map solved over the views (thesis 6.3.3.1's simultaneous inference).
     Depth,
+    /// A depth shell with one map per parameter sample, each solved from its own view as the
+    /// box's and the sphere's are: the single-view inference the shared map is measured
+    /// against.
+    DepthPerSample,
 }
 
 impl DistantShell {
@@ -542,17 +547,24 @@ impl DistantShell {
             DistantShell::Box => "box",
             DistantShell::Sphere => "sphere",
             DistantShell::Depth => "depth",
+            DistantShell::DepthPerSample => "depth-per-sample",
         }
     }
 
     /// Every choice, in the order the tools list them.
-    pub const ALL: [DistantShell; 5] = [
+    pub const ALL: [DistantShell; 6] = [
         DistantShell::Fitted,
         DistantShell::Auto,
         DistantShell::Box,
         DistantShell::Sphere,
         DistantShell::Depth,
+        DistantShell::DepthPerSample,
     ];
+
+    /// Whether a depth shell chosen under this setting has one map over the views.
+    pub fn depth_map_shared(self) -> bool {
+        self != DistantShell::DepthPerSample
+    }
 }
 
 /// How reflective objects are stored; refractive objects are stored by hybrid rendering

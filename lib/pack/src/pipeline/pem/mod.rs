@@ -76,7 +76,10 @@ impl Representation for LayeredPem {
         }
         let Some(surface) = survey_surface(job, o, false)? else { return Ok(None) };
         // The depth shell's cube is cast only where `--distant-shell` may take it.
-        let with_depth = matches!(job.req.distant_shell, DistantShell::Auto | DistantShell::Depth);
+        let with_depth = matches!(
+            job.req.distant_shell,
+            DistantShell::Auto | DistantShell::Depth | DistantShell::DepthPerSample
+        );
         let fitted = fit_shells(set, o, &job.meshes, with_depth)?;
         Ok(Some(Box::new(PemSurveyed { o, surface, fitted })))
     }
@@ -197,7 +200,7 @@ impl Planned for PemPlanned {
         let shared: Vec<Vec<u32>> = set.samples.iter().map(|s| key(s, job.non_view)).collect();
         let mut solved = Vec::new();
         for (s, (shell, layout, target)) in shells.iter().enumerate() {
-            solved.push(if is_depth(shell) {
+            solved.push(if shared_map(job, shell) {
                 solve_shell_shared(&views, s, *layout, &shared, &settings, &job.solver)?
             } else {
                 solve_shell(&views, s, *layout, *target, &keys, &settings, &job.solver)?
@@ -232,6 +235,12 @@ impl Planned for PemPlanned {
     }
 }
 
+/// Whether `shell` is solved as one map over the views: a depth shell, unless
+/// `--distant-shell depth-per-sample` asks for one per sample.
+fn shared_map(job: &Job<'_>, shell: &Shell) -> bool {
+    is_depth(shell) && job.req.distant_shell.depth_map_shared()
+}
+
 /// The distant shell chosen for an object, its face size, and why.
 struct DistantChoice {
     shell: Shell,
@@ -260,6 +269,9 @@ fn distant_trial(
         DistantShell::Box => Some(("box", &fitted.distant_box)),
         DistantShell::Sphere => Some(("sphere", &fitted.distant_sphere)),
         DistantShell::Depth => fitted.distant_depth.as_ref().map(|d| ("depth", d)),
+        DistantShell::DepthPerSample => {
+            fitted.distant_depth.as_ref().map(|d| ("depth-per-sample", d))
+        }
     };
     if let Some((label, shell)) = asked {
         let n = face_resolution(set, o, &job.meshes, shell, largest)?;
@@ -342,7 +354,7 @@ fn push_shell_layers<'s>(
             term: pis_format::Term::Reflection,
         });
         // A depth shell's map is one over the views (`solve_shell_shared`).
-        let mask = if is_depth(shell) { job.non_view } else { job.all };
+        let mask = if shared_map(job, shell) { job.non_view } else { job.all };
         model.layers.push(InferredLayer::shell(
             kind,
             (&job.plan.space, mask),
