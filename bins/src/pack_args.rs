@@ -11,8 +11,8 @@ use pis_trace::settings::DenoiseMode;
 
 use crate::cli::{one_of, Exit, Failure};
 use pis_pack::{
-    filter_needs_probe, Allocation, BlockSize, DistantShell, LayerMode, MatrixSource, MaxMse,
-    PackRequest, PackSettings, PlacementMode, PyramidMode, RepresentationMode, Stagger,
+    filter_needs_probe, Allocation, BlockSize, DistantShell, LayerMode, LensShell, MatrixSource,
+    MaxMse, PackRequest, PackSettings, PlacementMode, PyramidMode, RepresentationMode, Stagger,
 };
 
 /// pis-pack's settings on the command line.
@@ -164,6 +164,14 @@ pub struct PackOptions {
     /// the shared map is measured against).
     #[arg(long, default_value = "fitted", value_parser = one_of(&DistantShell::ALL, DistantShell::name))]
     pub distant_shell: DistantShell,
+    /// Hybrid rendering: a lens object's shells. `layered`: the layers clustered from the
+    /// ray records' hit distances, a sphere, cylinder or box fitted to each (thesis 6.3.2);
+    /// `depth`: one depth shell about the object's centroid (SPEC.md 8.5), each exit ray
+    /// marched to the surface of the other objects it meets, its one map solved over the
+    /// views; `depth-per-sample`: that shell with one map per parameter sample, each solved
+    /// from its own view.
+    #[arg(long, default_value = "layered", value_parser = one_of(&LensShell::ALL, LensShell::name))]
+    pub lens_shell: LensShell,
     /// Where the set turns a light over directions (scene.toml `light_direction`): `on`
     /// stores each surface layer as spherical-harmonic coefficients over them (Wong et al.:
     /// relit under any directional lights, the band chosen per layer by held-out light
@@ -230,6 +238,7 @@ impl PackOptions {
             shell_lookups: self.shell_lookups,
             confidence: self.confidence,
             distant_shell: self.distant_shell,
+            lens_shell: self.lens_shell,
             relight: self.relight,
             max_iterations: self.max_iterations,
             keep_master: self.keep_master,

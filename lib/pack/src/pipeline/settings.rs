@@ -206,6 +206,9 @@ pub struct PackSettings {
     pub confidence: bool,
     /// Layered environment maps: which distant shell a reflective object gets.
     pub distant_shell: DistantShell,
+    /// Hybrid rendering: a lens object's shells fitted per layer of its rays' hits, or one
+    /// depth shell.
+    pub lens_shell: LensShell,
     /// Where the set turns a light over directions (`light_direction`), store surface
     /// layers as spherical-harmonic coefficients over them ([`super::relit`]); else sample
     /// the light as any dimension.
@@ -267,6 +270,7 @@ impl PackSettings {
             shell_lookups: 1,
             confidence: false,
             distant_shell: DistantShell::Fitted,
+            lens_shell: LensShell::Layered,
             relight: true,
             max_iterations: None,
             keep_master: false,
@@ -565,6 +569,37 @@ impl DistantShell {
     pub fn depth_map_shared(self) -> bool {
         self != DistantShell::DepthPerSample
     }
+}
+
+/// The shells of a lens object drawn by hybrid rendering (thesis 6.3.2; SPEC.md 7.3, 8.5).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum LensShell {
+    /// The layers clustered from the ray records' hit distances, a sphere, cylinder or box
+    /// fitted to each (thesis 6.3.2).
+    #[default]
+    Layered,
+    /// One depth shell about the lens object's centroid: its radius in every direction the
+    /// distance to the other objects, so that each exit ray is marched to the surface it
+    /// meets (where one is cast: else the layered shells); its one map solved over the views
+    /// (thesis 6.3.3.1's simultaneous inference).
+    Depth,
+    /// The depth shell with one map per parameter sample, each solved from its own view.
+    DepthPerSample,
+}
+
+impl LensShell {
+    /// The name `--lens-shell` uses.
+    pub fn name(self) -> &'static str {
+        match self {
+            LensShell::Layered => "layered",
+            LensShell::Depth => "depth",
+            LensShell::DepthPerSample => "depth-per-sample",
+        }
+    }
+
+    /// Every choice, in the order the tools list them.
+    pub const ALL: [LensShell; 3] =
+        [LensShell::Layered, LensShell::Depth, LensShell::DepthPerSample];
 }
 
 /// How reflective objects are stored; refractive objects are stored by hybrid rendering

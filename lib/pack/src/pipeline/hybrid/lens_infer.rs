@@ -17,6 +17,10 @@
 //! for 64², and its refraction-first term fell 1–5 dB at the samples (the further terms'
 //! exit rays, interpolated per vertex, land where their pixels' paths do not).
 //!
+//! A depth shell ([`LensInferSettings::depth`], SPEC.md 8.5) may stand for the layers: one
+//! layer holding every object, each exit ray marched to the surface it meets, its map solved
+//! per sample or over every sample's views at once ([`LensInferSettings::shared`]).
+//!
 //! The cube-face size is chosen from the finest level the sample views read (5.8.2).
 //! Simultaneous inference over nearby viewpoints ([`infer_lens_nearby`], 6.3.3.1) and the
 //! confidence weights are options, off by default (measured worse on the glass sample); the
@@ -29,6 +33,7 @@ use pis_compile::hybrid::{
     vertex_modulation, vertex_vectors, FittedShell, HybridPixels, HybridView, Layers, LensModel,
     Missing, OutgoingRay, Term, Tessellation, TessellationSettings, TERMS,
 };
+use pis_compile::shell::Shell;
 use pis_compile::solve::View;
 
 use crate::solutions::Solver;
@@ -65,6 +70,12 @@ pub struct LensInferSettings {
     /// Lookups per pixel side (SPEC.md 8.2): each pixel's row is the mean of k × k lookups
     /// over its footprint ([`hybrid_render_matrix`]).
     pub lookups: u32,
+    /// One depth shell (SPEC.md 8.5) as the object's one layer, every environment object
+    /// in it, instead of the layers clustered from the hit distances ([`one_layer`]).
+    pub depth: Option<Shell>,
+    /// One map per shell over every sample's views at once, the same at every sample,
+    /// instead of one per sample.
+    pub shared: bool,
 }
 
 impl Default for LensInferSettings {
@@ -78,6 +89,8 @@ impl Default for LensInferSettings {
             confidence: false,
             solver: Solver::default(),
             lookups: 1,
+            depth: None,
+            shared: false,
         }
     }
 }
@@ -359,7 +372,10 @@ pub fn infer_lens_views(
             scene.objects[o].name
         ));
     }
-    let (layers, shells) = choose_layers(&rays, origin, settings.max_layers, scale);
+    let (layers, shells) = match &settings.depth {
+        Some(shell) => one_layer(&rays, shell),
+        None => choose_layers(&rays, origin, settings.max_layers, scale),
+    };
     // Every view's tessellation, once: it serves the face size, the rows and the prediction.
     let mut models: Vec<Vec<ViewModel>> = samples
         .iter()
@@ -375,10 +391,7 @@ pub fn infer_lens_views(
         .map(|m| m.into_iter().map(|v| v.with_matrices(&shells, face, settings.lookups)).collect())
         .collect();
     let layout = TextureLayout::cube(face);
-    let mut out = Vec::with_capacity(samples.len());
-    for (sample, models) in samples.iter().zip(&models) {
-        let render = &sample[0];
-        let mut sub_all: Vec<Vec<ShellRow>> = vec![Vec::new(); shells.len()];
+    let rows = |sample: &[TracedView], models: &[ViewModel], sub_all: &mut Vec<Vec<ShellRow>>| {
         for (render, model) in sample.iter().zip(models) {
             for (l, sub) in
                 view_rows(scene, o, model, render, &layers, settings).into_iter().enumerate()
@@ -386,29 +399,29 @@ pub fn infer_lens_views(
                 sub_all[l].extend(sub);
             }
         }
-        // Per shell: colour and alpha solved over both terms' rows of every view.
-        let mut cubes = Vec::with_capacity(shells.len());
-        for sub in &sub_all {
-            let colour = settings.solver.solve_view_independent(
-                &sub.iter().map(|(m, rgb, _)| View { a: m, b: rgb }).collect::<Vec<_>>(),
-                None,
-                &settings.solve,
-            )?;
-            let alpha = settings.solver.solve_view_independent(
-                &sub.iter().map(|(m, _, al)| View { a: m, b: al }).collect::<Vec<_>>(),
-                None,
-                &settings.solve,
-            )?;
-            let texels = layout.texel_count();
-            let mut cube = vec![0.0f32; texels * 4];
-            for k in 0..texels {
-                cube[k * 4..k * 4 + 3].copy_from_slice(&colour.texels[k * 3..k * 3 + 3]);
-                cube[k * 4 + 3] = alpha.texels[k * 3].clamp(0.0, 1.0);
-            }
-            cubes.push(cube);
+    };
+    // A shared map: every sample's views' rows in one solve.
+    let shared = if settings.shared {
+        let mut sub_all: Vec<Vec<ShellRow>> = vec![Vec::new(); shells.len()];
+        for (sample, models) in samples.iter().zip(&models) {
+            rows(sample, models, &mut sub_all);
         }
+        Some(solve_cubes(&sub_all, layout, settings)?)
+    } else {
+        None
+    };
+    let mut out = Vec::with_capacity(samples.len());
+    for (sample, models) in samples.iter().zip(&models) {
+        let cubes = match &shared {
+            Some(cubes) => cubes.clone(),
+            None => {
+                let mut sub_all: Vec<Vec<ShellRow>> = vec![Vec::new(); shells.len()];
+                rows(sample, models, &mut sub_all);
+                solve_cubes(&sub_all, layout, settings)?
+            }
+        };
         let (reflection, refraction, both, greedy) =
-            predict_with(scene, o, &models[0], render.images, face, &[(&cubes, 1.0)]);
+            predict_with(scene, o, &models[0], sample[0].images, face, &[(&cubes, 1.0)]);
         out.push(LensView { reflection, refraction, both, greedy, cubes });
     }
     let models =
@@ -431,6 +444,55 @@ pub fn infer_lens_views(
         inference.tree_gain_db = Some(gain);
     }
     Ok(inference)
+}
+
+/// Per shell, its RGBA cube map: colour and alpha solved over both terms' rows `sub_all` of
+/// every view.
+fn solve_cubes(
+    sub_all: &[Vec<ShellRow>],
+    layout: TextureLayout,
+    settings: &LensInferSettings,
+) -> Result<Vec<Vec<f32>>> {
+    let mut cubes = Vec::with_capacity(sub_all.len());
+    for sub in sub_all {
+        let colour = settings.solver.solve_view_independent(
+            &sub.iter().map(|(m, rgb, _)| View { a: m, b: rgb }).collect::<Vec<_>>(),
+            None,
+            &settings.solve,
+        )?;
+        let alpha = settings.solver.solve_view_independent(
+            &sub.iter().map(|(m, _, al)| View { a: m, b: al }).collect::<Vec<_>>(),
+            None,
+            &settings.solve,
+        )?;
+        let texels = layout.texel_count();
+        let mut cube = vec![0.0f32; texels * 4];
+        for k in 0..texels {
+            cube[k * 4..k * 4 + 3].copy_from_slice(&colour.texels[k * 3..k * 3 + 3]);
+            cube[k * 4 + 3] = alpha.texels[k * 3].clamp(0.0, 1.0);
+        }
+        cubes.push(cube);
+    }
+    Ok(cubes)
+}
+
+/// `shell` as the one layer of every object the rays meet, at their first hits' mean
+/// distance from its origin: each exit ray's first hit is what the depth shell's march
+/// finds, so no object stands behind another in a layer of its own. Its fit to the hits is
+/// not measured (`mse` NaN).
+fn one_layer(rays: &[OutgoingRay], shell: &Shell) -> (Layers, Vec<FittedShell>) {
+    let first: Vec<f64> = rays
+        .iter()
+        .filter_map(|r| {
+            r.hits.first().map(|h| (r.origin + r.direction * h.0 - shell.origin).length())
+        })
+        .collect();
+    let layers = Layers {
+        distances: vec![first.iter().sum::<f64>() / first.len().max(1) as f64],
+        layer_of: rays.iter().flat_map(|r| r.hits.iter().map(|h| (h.1, 0))).collect(),
+        counted: rays.iter().map(|r| r.hits.len()).sum(),
+    };
+    (layers, vec![FittedShell { shell: shell.clone(), mse: f64::NAN }])
 }
 
 /// The least the ray tree's further terms must add at the samples (mean PSNR of every term

@@ -10,7 +10,9 @@
 //! player does, through the per-point render matrices of hybrid rendering ([`LensPoint`]).
 
 use anyhow::Result;
+use glam::Vec3;
 use pis_compile::hybrid::{HybridPixels, LensModel};
+use pis_compile::shell::Shell;
 use pis_compile::TextureLayout;
 use pis_scene::ObjectRole;
 
@@ -21,6 +23,7 @@ use super::input::LoadedSet;
 use super::model::{key, InferredLayer, ObjectModel, ShellTerms};
 use super::pem::form::ShellForm;
 use super::represent::{Job, Planned, Representation, Surveyed};
+use super::settings::LensShell;
 use super::surface::survey_surface;
 use lens_infer::{
     infer_lens_views, lens_terms, term_pixels, LensInferSettings, LensViewModel, TracedView,
@@ -114,7 +117,12 @@ impl Planned for HybridPlanned {
         let one = job.req.representation == super::RepresentationMode::PemInfinity;
         if one {
             settings.max_layers = 1;
+        } else if job.req.lens_shell != LensShell::Layered {
+            settings.depth = lens_depth_shell(set, &job.meshes, o);
+            settings.shared = settings.depth.is_some() && job.req.lens_shell == LensShell::Depth;
         }
+        // A shared map depends on no view.
+        let mask = if settings.shared { job.non_view } else { job.all };
         let inference = infer_lens_views(scene, o, &views, &settings)?;
         let layout = TextureLayout::cube(inference.face);
         for (l, fitted) in inference.shells.iter().enumerate() {
@@ -122,7 +130,7 @@ impl Planned for HybridPlanned {
                 .samples
                 .iter()
                 .zip(&inference.views)
-                .map(|(s, v)| (key(s, job.all), v.cubes[l].clone()))
+                .map(|(s, v)| (key(s, mask), v.cubes[l].clone()))
                 .collect();
             let form = Box::new(ShellForm {
                 shell: fitted.shell.clone(),
@@ -134,7 +142,7 @@ impl Planned for HybridPlanned {
             });
             model.layers.push(InferredLayer::shell(
                 pis_format::LayerKind::EnvShell,
-                (&job.plan.space, job.all),
+                (&job.plan.space, mask),
                 &model.stagger,
                 textures,
                 0,
@@ -164,10 +172,23 @@ impl Planned for HybridPlanned {
             Some(Box::new(LensPoints(inference.models.into_iter().map(LensPoint::new).collect())));
         model.representation =
             if one { "hybrid rendering, one shell" } else { "hybrid rendering" }.to_string();
+        let shells = match (&settings.depth, settings.shared) {
+            (Some(_), true) => format!(
+                "a depth shell about its centroid, one map over the views ({})",
+                layers.join(", ")
+            ),
+            (Some(_), false) => format!(
+                "a depth shell about its centroid, a map per sample ({})",
+                layers.join(", ")
+            ),
+            (None, _) => format!(
+                "{} shell(s) from the ray records' hit distances ({})",
+                layers.len(),
+                layers.join(", ")
+            ),
+        };
         model.why = format!(
-            "refractive: {} shell(s) from the ray records' hit distances ({}), cube faces {}², {}, {lo:.1}–{hi:.1} dB at the samples as solved; vertex rays traced per frame (τ {} px)",
-            layers.len(),
-            layers.join(", "),
+            "refractive: {shells}, cube faces {}², {}, {lo:.1}–{hi:.1} dB at the samples as solved; vertex rays traced per frame (τ {} px)",
             inference.face,
             terms,
             settings.tessellation.tau_px
@@ -179,6 +200,24 @@ impl Planned for HybridPlanned {
         }
         Ok(model)
     }
+}
+
+/// Lens object `o`'s depth shell (`--lens-shell depth`): about the centroid of the object at
+/// the set's first point (the layered shells' origin), its depth cube cast from the other
+/// objects, the far sphere at most [`super::pem::fit::DEPTH_FAR_SPREAD`] times the mean
+/// distance of the records' first hits from it. `None` without other objects or hits.
+fn lens_depth_shell(set: &LoadedSet, meshes: &[super::mesh::Mesh], o: usize) -> Option<Shell> {
+    let centre = lens::lens_object(&set.scene, set.frames.first()?, o).centroid();
+    let (mut sum, mut n) = (0.0f64, 0usize);
+    for r in set.records.iter().flatten().filter(|r| r.object == o as u32) {
+        if let Some(h) = r.hits.first() {
+            let hit = Vec3::from(r.exit_origin) + Vec3::from(r.exit_direction) * h.t;
+            sum += hit.distance(centre) as f64;
+            n += 1;
+        }
+    }
+    let mean = (n > 0).then(|| (sum / n as f64) as f32)?;
+    super::pem::fit::depth_shell(set, meshes, o, centre, mean)
 }
 
 /// Cube-face size of the probe solve ([`unreproducible`]).

@@ -99,17 +99,18 @@ pub fn fit_shells(
         distant_box: box_shell,
         distant_sphere: Shell { origin: o3, shape: ShellShape::Sphere { radius } },
         distant_depth: with_depth
-            .then(|| distant_depth(set, meshes, o, centre, radius as f32))
+            .then(|| depth_shell(set, meshes, o, centre, radius as f32))
             .flatten(),
         supported: support.is_some(),
     })
 }
 
-/// The depth shell about `centre`: its depth cube cast from the diffuse objects' triangles
+/// The depth shell about `centre`: its depth cube cast from the other objects' triangles
 /// at the set's first point, as a reader casts it from the file (SPEC.md 8.5); the far
 /// sphere just beyond the farthest of their vertices, at most [`DEPTH_FAR_SPREAD`] times
-/// `mean` (the mean distance of the reflected environment). `None` without diffuse objects.
-fn distant_depth(
+/// `mean` (the mean distance of the reflected or refracted environment). `None` without
+/// other objects.
+pub fn depth_shell(
     set: &LoadedSet,
     meshes: &[Mesh],
     o: usize,
