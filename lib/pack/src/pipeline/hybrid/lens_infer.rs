@@ -19,7 +19,8 @@
 //!
 //! A depth shell ([`LensInferSettings::depth`], SPEC.md 8.5) may stand for the layers: one
 //! layer holding every object, each exit ray marched to the surface it meets, its map solved
-//! per sample or over every sample's views at once ([`LensInferSettings::shared`]).
+//! per sample or over the views of every sample of a class at once
+//! ([`LensInferSettings::classes`]).
 //!
 //! The cube-face size is chosen from the finest level the sample views read (5.8.2).
 //! Simultaneous inference over nearby viewpoints ([`infer_lens_nearby`], 6.3.3.1) and the
@@ -73,9 +74,10 @@ pub struct LensInferSettings {
     /// One depth shell (SPEC.md 8.5) as the object's one layer, every environment object
     /// in it, instead of the layers clustered from the hit distances ([`one_layer`]).
     pub depth: Option<Shell>,
-    /// One map per shell over every sample's views at once, the same at every sample,
-    /// instead of one per sample.
-    pub shared: bool,
+    /// Per sample, its class: the samples of a class share one map per shell, solved over
+    /// all their views at once (`None`: one map per sample). A depth shell's samples that
+    /// differ only in the view form a class.
+    pub classes: Option<Vec<usize>>,
 }
 
 impl Default for LensInferSettings {
@@ -90,7 +92,7 @@ impl Default for LensInferSettings {
             solver: Solver::default(),
             lookups: 1,
             depth: None,
-            shared: false,
+            classes: None,
         }
     }
 }
@@ -400,19 +402,25 @@ pub fn infer_lens_views(
             }
         }
     };
-    // A shared map: every sample's views' rows in one solve.
-    let shared = if settings.shared {
-        let mut sub_all: Vec<Vec<ShellRow>> = vec![Vec::new(); shells.len()];
-        for (sample, models) in samples.iter().zip(&models) {
-            rows(sample, models, &mut sub_all);
+    // A class's map: every view of its samples in one solve.
+    let mut shared: std::collections::BTreeMap<usize, Vec<Vec<f32>>> = Default::default();
+    if let Some(classes) = &settings.classes {
+        if classes.len() != samples.len() {
+            return Err(anyhow!("{} sample classes for {} samples", classes.len(), samples.len()));
         }
-        Some(solve_cubes(&sub_all, layout, settings)?)
-    } else {
-        None
-    };
+        let mut sub_by: std::collections::BTreeMap<usize, Vec<Vec<ShellRow>>> = Default::default();
+        for ((sample, models), &c) in samples.iter().zip(&models).zip(classes) {
+            let sub_all = sub_by.entry(c).or_insert_with(|| vec![Vec::new(); shells.len()]);
+            rows(sample, models, sub_all);
+        }
+        for (c, sub_all) in sub_by {
+            shared.insert(c, solve_cubes(&sub_all, layout, settings)?);
+        }
+    }
     let mut out = Vec::with_capacity(samples.len());
-    for (sample, models) in samples.iter().zip(&models) {
-        let cubes = match &shared {
+    for (k, (sample, models)) in samples.iter().zip(&models).enumerate() {
+        let class = settings.classes.as_ref().map(|c| c[k]);
+        let cubes = match class.and_then(|c| shared.get(&c)) {
             Some(cubes) => cubes.clone(),
             None => {
                 let mut sub_all: Vec<Vec<ShellRow>> = vec![Vec::new(); shells.len()];

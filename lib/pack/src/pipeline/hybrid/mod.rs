@@ -119,10 +119,13 @@ impl Planned for HybridPlanned {
             settings.max_layers = 1;
         } else if job.req.lens_shell != LensShell::Layered {
             settings.depth = lens_depth_shell(set, &job.meshes, o);
-            settings.shared = settings.depth.is_some() && job.req.lens_shell == LensShell::Depth;
+            if settings.depth.is_some() && job.req.lens_shell == LensShell::Depth {
+                settings.classes = Some(classes(&set.samples, job.non_view));
+            }
         }
-        // A shared map depends on no view.
-        let mask = if settings.shared { job.non_view } else { job.all };
+        // A map shared over the views depends on no view.
+        let shared = settings.classes.is_some();
+        let mask = if shared { job.non_view } else { job.all };
         let inference = infer_lens_views(scene, o, &views, &settings)?;
         let layout = TextureLayout::cube(inference.face);
         for (l, fitted) in inference.shells.iter().enumerate() {
@@ -172,7 +175,7 @@ impl Planned for HybridPlanned {
             Some(Box::new(LensPoints(inference.models.into_iter().map(LensPoint::new).collect())));
         model.representation =
             if one { "hybrid rendering, one shell" } else { "hybrid rendering" }.to_string();
-        let shells = match (&settings.depth, settings.shared) {
+        let shells = match (&settings.depth, shared) {
             (Some(_), true) => format!(
                 "a depth shell about its centroid, one map over the views ({})",
                 layers.join(", ")
@@ -200,6 +203,22 @@ impl Planned for HybridPlanned {
         }
         Ok(model)
     }
+}
+
+/// Per sample, the index of its class: the samples equal on `mask`, numbered in order of
+/// their first sample.
+fn classes(samples: &[Vec<u32>], mask: pis_format::DepMask) -> Vec<usize> {
+    let mut seen: Vec<Vec<u32>> = Vec::new();
+    samples
+        .iter()
+        .map(|s| {
+            let k = key(s, mask);
+            seen.iter().position(|x| *x == k).unwrap_or_else(|| {
+                seen.push(k);
+                seen.len() - 1
+            })
+        })
+        .collect()
 }
 
 /// Lens object `o`'s depth shell (`--lens-shell depth`): about the centroid of the object at
@@ -410,6 +429,14 @@ mod tests {
                 layer(L::Refraction, &rgb, [terms[0] - 0.1, terms[1]]),
             ],
         }
+    }
+
+    #[test]
+    fn samples_equal_off_the_view_share_a_class() {
+        // Light × view, the view the second dimension: the class follows the light.
+        let samples = [[0, 0], [0, 1], [1, 0], [1, 1], [0, 2]].map(|s| s.to_vec());
+        assert_eq!(classes(&samples, pis_format::DepMask(0b01)), [0, 0, 1, 1, 0]);
+        assert_eq!(classes(&samples, pis_format::DepMask(0)), [0; 5]);
     }
 
     #[test]
