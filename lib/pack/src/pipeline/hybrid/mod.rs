@@ -185,9 +185,14 @@ impl Planned for HybridPlanned {
                 layers.join(", ")
             ),
             (None, _) => format!(
-                "{} shell(s) from the ray records' hit distances ({})",
+                "{} shell(s) from the ray records' hit distances ({}){}",
                 layers.len(),
-                layers.join(", ")
+                layers.join(", "),
+                if one || job.req.lens_shell == LensShell::Layered {
+                    ""
+                } else {
+                    "; no depth shell: no other object or recorded hit to cast it from"
+                }
             ),
         };
         model.why = format!(
