@@ -408,12 +408,15 @@ pub fn infer_lens_views(
         if classes.len() != samples.len() {
             return Err(anyhow!("{} sample classes for {} samples", classes.len(), samples.len()));
         }
-        let mut sub_by: std::collections::BTreeMap<usize, Vec<Vec<ShellRow>>> = Default::default();
-        for ((sample, models), &c) in samples.iter().zip(&models).zip(classes) {
-            let sub_all = sub_by.entry(c).or_insert_with(|| vec![Vec::new(); shells.len()]);
-            rows(sample, models, sub_all);
-        }
-        for (c, sub_all) in sub_by {
+        // Class by class, so that one class's rows are held at a time.
+        let distinct: std::collections::BTreeSet<usize> = classes.iter().copied().collect();
+        for c in distinct {
+            let mut sub_all: Vec<Vec<ShellRow>> = vec![Vec::new(); shells.len()];
+            for ((sample, models), _) in
+                samples.iter().zip(&models).zip(classes).filter(|(_, &k)| k == c)
+            {
+                rows(sample, models, &mut sub_all);
+            }
             shared.insert(c, solve_cubes(&sub_all, layout, settings)?);
         }
     }
