@@ -9,7 +9,7 @@
 //! level of `next_pow2(N) >> m` texels, which is never smaller.
 
 use bytemuck::{Pod, Zeroable};
-use pis_compile::shell::ShellObject;
+use pis_compile::shell::{ShellObject, ShellShape};
 use pis_compile::{DrawMesh, TextureLayout, Viewport};
 use wgpu::util::DeviceExt;
 
@@ -24,6 +24,37 @@ pub const SHELL_FUNCTIONS: &str =
     concat!(include_str!("texture_lod.wgsl"), include_str!("shell.wgsl"));
 /// The one-shell object pipeline's entry points.
 pub const SHELL_OBJECT: &str = include_str!("shell_object.wgsl");
+
+/// The code a pipeline of shell lookups carries: `shell.wgsl`'s pipeline-overridable
+/// constants. A pipeline compiled without depth shells or without sub-pixel lookups leaves
+/// the depth march or the k × k loop out of its code; a draw that needs neither looks its
+/// shells up with the same arithmetic either way, and takes less than half the time on a
+/// CPU rasterizer (lavapipe), where the code a shader carries costs even when not run.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub struct ShellCode {
+    /// The depth march (a depth shell, SPEC.md 8.5).
+    pub depth: bool,
+    /// k × k lookups per pixel with k > 1 (SPEC.md 8.2).
+    pub sub_pixel: bool,
+}
+
+impl ShellCode {
+    /// The code a shell of `shape` looked up `lookups` times per pixel side needs.
+    pub fn of(shape: &ShellShape, lookups: u32) -> ShellCode {
+        ShellCode { depth: matches!(shape, ShellShape::Depth { .. }), sub_pixel: lookups > 1 }
+    }
+
+    /// The code both `self` and `other` need.
+    pub fn union(self, other: ShellCode) -> ShellCode {
+        ShellCode { depth: self.depth || other.depth, sub_pixel: self.sub_pixel || other.sub_pixel }
+    }
+
+    /// The values of `shell.wgsl`'s overridable constants.
+    pub fn constants(self) -> [(&'static str, f64); 2] {
+        let flag = |on: bool| if on { 1.0 } else { 0.0 };
+        [("DEPTH_SHELLS", flag(self.depth)), ("SUB_PIXEL_LOOKUPS", flag(self.sub_pixel))]
+    }
+}
 
 /// A cube map on the GPU.
 pub struct ShellTexture {
@@ -545,4 +576,28 @@ fn shell_pass(
     pass.set_vertex_buffer(1, normals.slice(..));
     pass.set_index_buffer(indices.slice(..), wgpu::IndexFormat::Uint32);
     pass.draw_indexed(0..*count, 0, 0..1);
+}
+
+#[cfg(test)]
+mod tests {
+    use std::sync::Arc;
+
+    use pis_compile::shell::DepthCube;
+
+    use super::*;
+
+    #[test]
+    fn shell_code_sets_the_constants_shell_wgsl_declares() {
+        for (name, _) in ShellCode::default().constants() {
+            let declared = format!("override {name}: bool = true;");
+            assert!(SHELL_FUNCTIONS.contains(&declared), "shell.wgsl lacks `{declared}`");
+        }
+        let sphere = ShellShape::Sphere { radius: 1.0 };
+        let cube = DepthCube { size: 1, far: 2.0, distances: vec![2.0; 6] };
+        let depth = ShellShape::Depth { cube: Arc::new(cube), steps: 8 };
+        assert_eq!(ShellCode::of(&sphere, 1), ShellCode::default());
+        let code = ShellCode::of(&sphere, 2).union(ShellCode::of(&depth, 1));
+        assert_eq!(code, ShellCode { depth: true, sub_pixel: true });
+        assert_eq!(code.constants(), [("DEPTH_SHELLS", 1.0), ("SUB_PIXEL_LOOKUPS", 1.0)]);
+    }
 }

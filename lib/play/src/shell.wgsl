@@ -11,6 +11,14 @@
 // holds the used mip_size(N, m) texels at its top left; texels are read with textureLoad
 // and filtered here, so the weights are the model's on every adapter.
 
+// The code a pipeline carries (pipeline-overridable constants, `ShellCode` in shell.rs): a
+// pipeline whose draws hold no depth shell is compiled with DEPTH_SHELLS false, one whose
+// shells take one lookup per pixel side with SUB_PIXEL_LOOKUPS false, and the march or the
+// sub-pixel loop is then not in its code at all. The lookups are the same either way; the
+// defaults keep every path.
+override DEPTH_SHELLS: bool = true;
+override SUB_PIXEL_LOOKUPS: bool = true;
+
 // One shell: origin; shape 1 sphere (a.x radius), 2 ellipsoid (a radii), 3 box (a min,
 // b max corner, world space), 4 cylinder (a.x radius, a.y y min, a.z y max), 6 depth
 // (a.x the depth cube's face size, a.y march steps, a.z far distance). A depth shell's
@@ -112,7 +120,7 @@ fn depth_hit(g: ShellGeometry, depth: texture_2d_array<f32>, p: vec3<f32>, r: ve
 // The far intersection (largest t ≥ 0) of p + t·r with the shell, or a negative value.
 fn shell_hit(g: ShellGeometry, depth: texture_2d_array<f32>, p: vec3<f32>, r: vec3<f32>) -> f32 {
     let q = p - g.origin;
-    if (g.shape == 6u) {
+    if (DEPTH_SHELLS && g.shape == 6u) {
         return depth_hit(g, depth, p, r);
     }
     if (g.shape == 1u) {
@@ -337,7 +345,7 @@ fn cube_sample_pixel(g: ShellGeometry, cube: texture_2d_array<f32>, depth: textu
     let ddx = dpdxFine(d);
     let ddy = dpdyFine(d);
     let max_level = f32(levels - 1u);
-    if (k <= 1u) {
+    if (!SUB_PIXEL_LOOKUPS || k <= 1u) {
         return cube_sample(cube, size, levels, d, cube_lod(d, ddx, ddy, f32(size), max_level));
     }
     let dpx = dpdxFine(p);

@@ -12,7 +12,7 @@ pub(super) fn multisample(count: u32) -> wgpu::MultisampleState {
 }
 
 /// An additive pipeline of the frame's layer pass: `module`'s vertex entry point with its
-/// vertex buffers, fragment entry point `fragment`, for a colour target (its format and
+/// vertex buffers, fragment entry point `fragment` with its overridable constants, for a colour target (its format and
 /// blending: `pipelines.rs`'s additive target, or a translucent object's) and samples per pixel;
 /// triangles unculled, tested against the id pass's depth without writing it.
 pub(super) fn additive_pipeline(
@@ -21,7 +21,7 @@ pub(super) fn additive_pipeline(
     layout: &wgpu::PipelineLayout,
     module: &wgpu::ShaderModule,
     vertex: (&str, &[Option<wgpu::VertexBufferLayout>]),
-    fragment: &str,
+    fragment: (&str, &[(&str, f64)]),
     (target, samples): (wgpu::ColorTargetState, u32),
 ) -> wgpu::RenderPipeline {
     gpu.device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
@@ -42,8 +42,11 @@ pub(super) fn additive_pipeline(
         multisample: multisample(samples),
         fragment: Some(wgpu::FragmentState {
             module,
-            entry_point: Some(fragment),
-            compilation_options: Default::default(),
+            entry_point: Some(fragment.0),
+            compilation_options: wgpu::PipelineCompilationOptions {
+                constants: fragment.1,
+                ..Default::default()
+            },
             targets: &[Some(target)],
         }),
         multiview_mask: None,

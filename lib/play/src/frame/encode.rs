@@ -197,11 +197,11 @@ pub fn encode(
         pipes.translucent_pipelines(gpu, sample_format, samples);
         targets.translucent_targets(gpu, pipes, sample_format);
     }
-    if !draws.reflections.is_empty() {
-        pipes.reflection_pipeline(gpu, sample_format, samples);
+    for r in &draws.reflections {
+        pipes.reflection_pipeline(gpu, (sample_format, samples, r.code()));
     }
-    if !draws.lenses.is_empty() {
-        pipes.hybrid_pipeline(gpu, sample_format, samples);
+    for l in &draws.lenses {
+        pipes.hybrid_pipeline(gpu, (sample_format, samples, l.code()));
     }
     let binds = Binds::new(gpu, pipes, &draws);
     let sample_colour = sample_colour(gpu, targets, sample_format, display.is_some());
@@ -528,14 +528,13 @@ fn additive_pass(
     pass.set_bind_group(1, at.ids_bind, &[]);
     draw_layers(&mut pass, draws, binds, false);
     if !draws.reflections.is_empty() {
-        pass.set_pipeline(&pipes.reflection_pipelines[&key]);
         pass.set_bind_group(1, at.ids_bind, &[]);
-        draw_reflections(&mut pass, draws, binds);
+        draw_reflections(&mut pass, (pipes, key), draws, binds);
     }
     if !draws.lenses.is_empty() {
-        pass.set_pipeline(&pipes.hybrid_pipelines[&key]);
         pass.set_bind_group(1, at.ids_bind, &[]);
         for (l, bg) in draws.lenses.iter().zip(&binds.lenses) {
+            pass.set_pipeline(&pipes.hybrid_pipelines[&(key.0, key.1, l.code())]);
             pass.set_bind_group(0, bg, &[]);
             pass.set_vertex_buffer(0, l.corners.slice(..));
             pass.draw(0..l.count, 0..1);
@@ -559,10 +558,17 @@ fn draw_layers(pass: &mut wgpu::RenderPass, draws: &Draws, binds: &Binds, transl
     }
 }
 
-/// Every reflection term on its object's mesh: the hull triangles with the most distant
-/// shell alone where the term has that bind group, the rest with the whole stack.
-fn draw_reflections(pass: &mut wgpu::RenderPass, draws: &Draws, binds: &Binds) {
+/// Every reflection term on its object's mesh, with the pipeline of its shells' code: the
+/// hull triangles with the most distant shell alone where the term has that bind group,
+/// the rest with the whole stack.
+fn draw_reflections(
+    pass: &mut wgpu::RenderPass,
+    (pipes, key): (&FramePipelines, (wgpu::TextureFormat, u32)),
+    draws: &Draws,
+    binds: &Binds,
+) {
     for (r, (all, hull)) in draws.reflections.iter().zip(&binds.reflections) {
+        pass.set_pipeline(&pipes.reflection_pipelines[&(key.0, key.1, r.code())]);
         let m = draws.objects[r.draw].mesh;
         pass.set_vertex_buffer(0, m.positions.slice(..));
         pass.set_vertex_buffer(1, m.normals.slice(..));

@@ -15,7 +15,7 @@ use rayon::prelude::*;
 use wgpu::util::DeviceExt;
 
 use crate::gpu::Gpu;
-use crate::shell::ShellTexture;
+use crate::shell::{ShellCode, ShellTexture};
 
 /// The lens-term entry points, appended to [`crate::shell::SHELL_FUNCTIONS`].
 pub const HYBRID_FRAME: &str = include_str!("hybrid.wgsl");
@@ -129,6 +129,14 @@ pub struct LensDraw<'a> {
     /// The term's shells in order, each its cube map and its lookups per pixel side
     /// (SPEC.md 8.2; 1 to [`MAX_LENS_SHELLS`] shells).
     pub shells: Vec<(&'a ShellTexture, u32)>,
+}
+
+impl LensDraw<'_> {
+    /// The code its pipeline needs: a lens term's shells are looked up along the vectors of
+    /// its corners, never marched.
+    pub fn code(&self) -> ShellCode {
+        ShellCode { depth: false, sub_pixel: self.shells.iter().any(|(_, k)| *k > 1) }
+    }
 }
 
 /// The corners on the GPU (at least one corner's worth of bytes).

@@ -72,7 +72,7 @@ fn lens_shell(k: u32, cube: texture_2d_array<f32>, v: vec3<f32>, ddx: vec3<f32>,
     let levels = hf.shells[k].y;
     let lookups = hf.shells[k].z;
     let max_level = f32(levels - 1u);
-    if (lookups <= 1u) {
+    if (!SUB_PIXEL_LOOKUPS || lookups <= 1u) {
         return cube_sample(cube, size, levels, v, cube_lod(v, ddx, ddy, f32(size), max_level));
     }
     let kf = f32(lookups);

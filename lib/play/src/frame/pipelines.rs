@@ -12,7 +12,7 @@ use super::reflection::REFLECTION;
 use super::resolve::ResolvePipelines;
 use super::translucent::TranslucentPipelines;
 use crate::gpu::Gpu;
-use crate::shell::{DepthTexture, SHELL_FUNCTIONS};
+use crate::shell::{DepthTexture, ShellCode, SHELL_FUNCTIONS};
 use crate::textured::DEPTH_FORMAT;
 
 /// The WGSL source: the texture math shared with `textured.wgsl` (`texture_lod.wgsl`,
@@ -45,13 +45,17 @@ pub struct FramePipelines {
     hybrid_ms_layout: wgpu::PipelineLayout,
     pub(super) id_pipelines: HashMap<u32, wgpu::RenderPipeline>,
     pub(super) layer_pipelines: HashMap<(wgpu::TextureFormat, u32), wgpu::RenderPipeline>,
-    pub(super) reflection_pipelines: HashMap<(wgpu::TextureFormat, u32), wgpu::RenderPipeline>,
-    pub(super) hybrid_pipelines: HashMap<(wgpu::TextureFormat, u32), wgpu::RenderPipeline>,
+    pub(super) reflection_pipelines: HashMap<PipelineKey, wgpu::RenderPipeline>,
+    pub(super) hybrid_pipelines: HashMap<PipelineKey, wgpu::RenderPipeline>,
     pub(super) resolve: ResolvePipelines,
     pub(super) translucent: TranslucentPipelines,
     /// The depth cube bound for a shell that is not a depth shell.
     pub(super) no_depth: DepthTexture,
 }
+
+/// A pipeline of shell lookups: the target's format, samples per pixel and the code its
+/// draws need.
+pub(super) type PipelineKey = (wgpu::TextureFormat, u32, ShellCode);
 
 const NORMAL_LAYOUT: wgpu::VertexBufferLayout<'static> = wgpu::VertexBufferLayout {
     array_stride: 12,
@@ -309,63 +313,57 @@ impl FramePipelines {
                 layout,
                 module,
                 ("vs_main", &[Some(POSITION_LAYOUT), Some(UV_LAYOUT)]),
-                entry_point,
+                (entry_point, &[]),
                 (additive_target(format), samples),
             )
         })
     }
 
-    /// The additive reflection-term pipeline for a target format and `samples` per pixel
-    /// (compiled on first use): `fs_reflection`, or `fs_reflection_ms` with object indices
-    /// per sample; positions and normals as vertex buffers 0 and 1.
-    pub fn reflection_pipeline(
-        &mut self,
-        gpu: &Gpu,
-        format: wgpu::TextureFormat,
-        samples: u32,
-    ) -> &wgpu::RenderPipeline {
+    /// The additive reflection-term pipeline for a target format, `samples` per pixel and
+    /// the code of the shells it draws (compiled on first use): `fs_reflection`, or
+    /// `fs_reflection_ms` with object indices per sample; positions and normals as vertex
+    /// buffers 0 and 1.
+    pub fn reflection_pipeline(&mut self, gpu: &Gpu, key: PipelineKey) -> &wgpu::RenderPipeline {
+        let (format, samples, code) = key;
         let module = &self.reflection_module;
         let (layout, entry_point) = if samples > 1 {
             (&self.reflection_ms_layout, "fs_reflection_ms")
         } else {
             (&self.reflection_layout, "fs_reflection")
         };
-        self.reflection_pipelines.entry((format, samples)).or_insert_with(|| {
+        self.reflection_pipelines.entry(key).or_insert_with(|| {
             additive_pipeline(
                 gpu,
                 "frame reflections",
                 layout,
                 module,
                 ("vs_reflection", &[Some(POSITION_LAYOUT), Some(NORMAL_LAYOUT)]),
-                entry_point,
+                (entry_point, &code.constants()),
                 (additive_target(format), samples),
             )
         })
     }
 
-    /// The additive lens-term pipeline for a target format and `samples` per pixel
-    /// (compiled on first use): `fs_hybrid_frame`, or `fs_hybrid_frame_ms` with object
-    /// indices per sample; the corners ([`LENS_CORNER_LAYOUT`]) as vertex buffer 0.
-    pub fn hybrid_pipeline(
-        &mut self,
-        gpu: &Gpu,
-        format: wgpu::TextureFormat,
-        samples: u32,
-    ) -> &wgpu::RenderPipeline {
+    /// The additive lens-term pipeline for a target format, `samples` per pixel and the code
+    /// of the shells it draws (compiled on first use): `fs_hybrid_frame`, or
+    /// `fs_hybrid_frame_ms` with object indices per sample; the corners
+    /// ([`LENS_CORNER_LAYOUT`]) as vertex buffer 0.
+    pub fn hybrid_pipeline(&mut self, gpu: &Gpu, key: PipelineKey) -> &wgpu::RenderPipeline {
+        let (format, samples, code) = key;
         let module = &self.hybrid_module;
         let (layout, entry_point) = if samples > 1 {
             (&self.hybrid_ms_layout, "fs_hybrid_frame_ms")
         } else {
             (&self.hybrid_layout, "fs_hybrid_frame")
         };
-        self.hybrid_pipelines.entry((format, samples)).or_insert_with(|| {
+        self.hybrid_pipelines.entry(key).or_insert_with(|| {
             additive_pipeline(
                 gpu,
                 "frame lens terms",
                 layout,
                 module,
                 ("vs_hybrid_frame", &[Some(LENS_CORNER_LAYOUT)]),
-                entry_point,
+                (entry_point, &code.constants()),
                 (additive_target(format), samples),
             )
         })

@@ -8,7 +8,7 @@ use wgpu::util::DeviceExt;
 
 use super::draw::ObjectDraw;
 use crate::gpu::Gpu;
-use crate::shell::{shell_uniform, DepthTexture, ShellTexture};
+use crate::shell::{shell_uniform, DepthTexture, ShellCode, ShellTexture};
 
 /// The reflection term's entry points, appended to [`crate::shell::SHELL_FUNCTIONS`].
 pub const REFLECTION: &str = include_str!("reflection.wgsl");
@@ -55,6 +55,14 @@ pub struct ReflectionDraw<'a> {
     /// The term's shells in increasing order (order 0 nearest), each with its cube map:
     /// 1 to [`MAX_TERM_SHELLS`] (the player checks the count when it opens a file).
     pub shells: Vec<TermShell<'a>>,
+}
+
+impl ReflectionDraw<'_> {
+    /// The code its pipeline needs (the hull draw's shells are some of the term's).
+    pub fn code(&self) -> ShellCode {
+        let code = |s: &TermShell| ShellCode::of(&s.shell.shape, s.lookups);
+        self.shells.iter().map(code).fold(ShellCode::default(), ShellCode::union)
+    }
 }
 
 /// One shell of a reflection term: its geometry, its lookups per pixel side (SPEC.md 8.2),

@@ -90,7 +90,7 @@ impl TranslucentPipelines {
                 layout,
                 module,
                 ("vs_main", &[Some(POSITION_LAYOUT), Some(UV_LAYOUT)]),
-                entry_point,
+                (entry_point, &[]),
                 (accumulate_target(format), samples),
             )
         });

@@ -138,16 +138,20 @@ impl Player {
         // Compiled now rather than in the first frame's time.
         pipes.id_pipeline(&gpu, ms.samples);
         pipes.layer_pipeline(&gpu, offscreen, ms.samples);
-        if objects.iter().any(|o| !o.reflection.is_empty()) {
-            pipes.reflection_pipeline(&gpu, offscreen, ms.samples);
-        }
-        if objects.iter().any(|o| o.lens.is_some()) {
-            pipes.hybrid_pipeline(&gpu, offscreen, ms.samples);
-            if options.lens_rays.on(gpu.info.device_type) == LensRays::Gpu {
-                let rays = Arc::new(LensRayPipeline::new(&gpu));
-                for lens in objects.iter_mut().filter_map(|o| o.lens.as_mut()) {
-                    lens.trace_on_gpu(gpu.clone(), rays.clone());
+        for (o, record) in objects.iter().zip(&reader.container().objects) {
+            match (o.shell_code(record), o.lens.is_some()) {
+                (Some(code), false) => {
+                    pipes.reflection_pipeline(&gpu, (offscreen, ms.samples, code))
                 }
+                (Some(code), true) => pipes.hybrid_pipeline(&gpu, (offscreen, ms.samples, code)),
+                (None, _) => continue,
+            };
+        }
+        let gpu_rays = options.lens_rays.on(gpu.info.device_type) == LensRays::Gpu;
+        if gpu_rays && objects.iter().any(|o| o.lens.is_some()) {
+            let rays = Arc::new(LensRayPipeline::new(&gpu));
+            for lens in objects.iter_mut().filter_map(|o| o.lens.as_mut()) {
+                lens.trace_on_gpu(gpu.clone(), rays.clone());
             }
         }
         let textures =

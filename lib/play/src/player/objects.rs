@@ -14,6 +14,7 @@ use crate::frame::hybrid::MAX_LENS_SHELLS;
 use crate::frame::{MeshGpu, MAX_TERM_SHELLS};
 use crate::gpu::Gpu;
 use crate::lens_rays::{vertex_tracer, GpuRays, LensRayPipeline};
+use crate::shell::ShellCode;
 use crate::textured::allocated_size;
 
 /// An object's mesh on the GPU and the layers the player draws.
@@ -31,6 +32,28 @@ pub(super) struct ObjectGpu {
     pub(super) translucent: bool,
     /// The depth shells of its reflection term, by (layer, block).
     pub(super) depth: DepthShells,
+}
+
+impl ObjectGpu {
+    /// The code of the shell pipelines its draws need, from its term's shell layers' blocks
+    /// (`object` is its record in the file): what the player compiles when it opens a file
+    /// rather than in a frame's time. A lens object's shells are never marched.
+    pub(super) fn shell_code(&self, object: &pis_format::Object<StreamRef>) -> Option<ShellCode> {
+        let layers = match &self.lens {
+            Some(lens) => &lens.layers,
+            None if self.reflection.is_empty() => return None,
+            None => &self.reflection,
+        };
+        let blocks = layers.iter().flat_map(|&li| &object.layers[li].blocks);
+        let code = blocks.filter_map(|b| match b.placement {
+            Placement::Shell { shape, lookups, .. } => Some(ShellCode {
+                depth: shape == pis_format::ShellShape::Depth && self.lens.is_none(),
+                sub_pixel: lookups > 1,
+            }),
+            _ => None,
+        });
+        Some(code.fold(ShellCode::default(), ShellCode::union))
+    }
 }
 
 /// A lens object: its shell layers (the refraction term's, in increasing order, at most
