@@ -9,7 +9,8 @@
 //! level of `next_pow2(N) >> m` texels, which is never smaller.
 
 use bytemuck::{Pod, Zeroable};
-use pis_compile::shell::{ShellObject, ShellShape};
+use pis_compile::shell::cube::cube_texel;
+use pis_compile::shell::{DepthCube, ShellObject, ShellShape};
 use pis_compile::{DrawMesh, TextureLayout, Viewport};
 use wgpu::util::DeviceExt;
 
@@ -152,20 +153,21 @@ pub struct DepthTexture {
 }
 
 impl DepthTexture {
-    /// The depth cube of `shell` (SPEC.md 8.5), uploaded; [`Self::none`] for a shell of
-    /// another shape.
+    /// The depth cube of `shell` (SPEC.md 8.5), uploaded with its border
+    /// ([`bordered_depth_faces`]); [`Self::none`] for a shell of another shape.
     pub fn new(gpu: &Gpu, shell: &pis_compile::shell::Shell) -> DepthTexture {
         match &shell.shape {
             pis_compile::shell::ShellShape::Depth { cube, .. } => {
-                DepthTexture::upload(gpu, cube.size, &cube.distances)
+                DepthTexture::upload(gpu, cube.size + 2, &bordered_depth_faces(cube))
             }
             _ => DepthTexture::none(gpu),
         }
     }
 
-    /// The stand-in bound where a shell is not a depth shell: one zero texel per face.
+    /// The stand-in bound where a shell is not a depth shell: one zero texel per face and
+    /// its border.
     pub fn none(gpu: &Gpu) -> DepthTexture {
-        DepthTexture::upload(gpu, 1, &[0.0; 6])
+        DepthTexture::upload(gpu, 3, &[0.0; 6 * 9])
     }
 
     /// `data`: `n × n` distances per face, face after face, rows from the top.
@@ -191,6 +193,34 @@ impl DepthTexture {
         });
         DepthTexture { texture, view }
     }
+}
+
+/// A depth cube's faces with a one-texel border, `size + 2` texels a side, face after face,
+/// rows from the top: inside, the face's distances; beyond one edge, the neighbouring face's
+/// texel that [`cube_texel`] names; beyond a corner, the mean of the three texels that meet
+/// there. `shell.wgsl`'s `depth_distance` then filters the bordered face bilinearly with no
+/// seam to handle, and gets [`DepthCube::distance`]'s seamless lookup: the same four texels
+/// and weights, a corner's weight on the mean of the other three.
+pub fn bordered_depth_faces(cube: &DepthCube) -> Vec<f32> {
+    let n = cube.size as i64;
+    let texel = |face: u32, i: i64, j: i64| {
+        let (f, i, j) = cube_texel(face, i, j, cube.size);
+        cube.distances[((f as i64 * n + j as i64) * n + i as i64) as usize]
+    };
+    let mut out = Vec::with_capacity(6 * (n as usize + 2).pow(2));
+    for face in 0..6 {
+        for j in -1..=n {
+            for i in -1..=n {
+                let (ci, cj) = (i.clamp(0, n - 1), j.clamp(0, n - 1));
+                out.push(if i == ci || j == cj {
+                    texel(face, i, j)
+                } else {
+                    (texel(face, ci, cj) + texel(face, i, cj) + texel(face, ci, j)) / 3.0
+                });
+            }
+        }
+    }
+    out
 }
 
 /// The bind group layout entry of a cube map or depth cube at `binding`: a 2D array read
@@ -582,7 +612,9 @@ fn shell_pass(
 mod tests {
     use std::sync::Arc;
 
-    use pis_compile::shell::DepthCube;
+    use glam::DVec3;
+    use pis_compile::filter::Taps;
+    use pis_compile::shell::cube::{cube_face, face_st};
 
     use super::*;
 
@@ -599,5 +631,45 @@ mod tests {
         let code = ShellCode::of(&sphere, 2).union(ShellCode::of(&depth, 1));
         assert_eq!(code, ShellCode { depth: true, sub_pixel: true });
         assert_eq!(code.constants(), [("DEPTH_SHELLS", 1.0), ("SUB_PIXEL_LOOKUPS", 1.0)]);
+    }
+
+    /// `depth_distance` of shell.wgsl on the bordered faces, in f64.
+    fn bordered_bilinear(bordered: &[f32], n: u32, q: DVec3) -> f64 {
+        let face = cube_face(q);
+        let [s, t] = face_st(face, q);
+        let (u, v) = (s * n as f64 - 0.5, t * n as f64 - 0.5);
+        let (a, b) = (u - u.floor(), v - v.floor());
+        let (i, j) = ((u.floor() + 1.0) as usize, (v.floor() + 1.0) as usize);
+        let p = n as usize + 2;
+        let at = |i: usize, j: usize| bordered[(face as usize * p + j) * p + i] as f64;
+        (1.0 - a) * (1.0 - b) * at(i, j)
+            + a * (1.0 - b) * at(i + 1, j)
+            + (1.0 - a) * b * at(i, j + 1)
+            + a * b * at(i + 1, j + 1)
+    }
+
+    #[test]
+    fn a_bordered_depth_cube_filters_as_the_seamless_lookup() {
+        let n = 5;
+        let distances: Vec<f32> = (0..6 * n * n).map(|k| 1.0 + ((k * 37) % 101) as f32).collect();
+        let cube = DepthCube { size: n, far: 200.0, distances };
+        let bordered = bordered_depth_faces(&cube);
+        assert_eq!(bordered.len(), 6 * (n as usize + 2).pow(2));
+        let mut taps = Taps::default();
+        let mut rng = 0x2545_f491_4f6c_dd1du64;
+        let mut next = || {
+            rng ^= rng << 13;
+            rng ^= rng >> 7;
+            rng ^= rng << 17;
+            (rng >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
+        };
+        // Random directions, and directions at faces' edges and the cube's corners.
+        let mut dirs: Vec<DVec3> = (0..4000).map(|_| DVec3::new(next(), next(), next())).collect();
+        dirs.extend([DVec3::ONE, DVec3::new(1.0, -1.0, 0.999), DVec3::new(-0.999, 1.0, 0.3)]);
+        for q in dirs {
+            let want = cube.distance(q, &mut taps);
+            let got = bordered_bilinear(&bordered, n, q);
+            assert!((want - got).abs() <= 1e-6 * want, "{q}: {want} against {got}");
+        }
     }
 }

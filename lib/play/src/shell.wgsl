@@ -22,8 +22,8 @@ override SUB_PIXEL_LOOKUPS: bool = true;
 // One shell: origin; shape 1 sphere (a.x radius), 2 ellipsoid (a radii), 3 box (a min,
 // b max corner, world space), 4 cylinder (a.x radius, a.y y min, a.z y max), 6 depth
 // (a.x the depth cube's face size, a.y march steps, a.z far distance). A depth shell's
-// depth cube is the `depth` texture the lookups take (one level, distance in x); other
-// shapes ignore it.
+// depth cube is the `depth` texture the lookups take (one level, each face with a one-texel
+// border, distance in x); other shapes ignore it.
 struct ShellGeometry {
     origin: vec3<f32>,
     shape: u32,
@@ -61,10 +61,24 @@ fn slab(q: f32, r: f32, lo: f32, hi: f32) -> vec2<f32> {
 // Regula-falsi iterations after a depth shell's march finds a step behind its surface.
 const DEPTH_REFINE: u32 = 4u;
 
-// The distance of depth cube `depth` (face size n) in direction q (not normalized): its
-// bilinear, seamless lookup.
+// The distance of depth cube `depth` (face size n, stored with a one-texel border: shell.rs
+// `bordered_depth_faces`) in direction q (not normalized): cube_bilinear's seamless lookup,
+// the border holding the texels it fetches beyond the face's edges and corners.
 fn depth_distance(depth: texture_2d_array<f32>, n: u32, q: vec3<f32>) -> f32 {
-    return cube_bilinear(depth, n, q, 0u).x;
+    let face = i32(cube_face(q));
+    let st = face_st(u32(face), q);
+    let u = st.x * f32(n) - 0.5;
+    let v = st.y * f32(n) - 0.5;
+    let i0 = floor(u);
+    let j0 = floor(v);
+    let a = u - i0;
+    let b = v - j0;
+    let i = i32(i0) + 1;
+    let j = i32(j0) + 1;
+    var acc = ((1.0 - a) * (1.0 - b)) * textureLoad(depth, vec2<i32>(i, j), face, 0).x;
+    acc = acc + (a * (1.0 - b)) * textureLoad(depth, vec2<i32>(i + 1, j), face, 0).x;
+    acc = acc + ((1.0 - a) * b) * textureLoad(depth, vec2<i32>(i, j + 1), face, 0).x;
+    return acc + (a * b) * textureLoad(depth, vec2<i32>(i + 1, j + 1), face, 0).x;
 }
 
 // f(t) = |q0 + t·r| − D(q0 + t·r): negative in front of a depth shell, ≥ 0 behind it.

@@ -23,7 +23,7 @@ struct ShellUniforms {
 
 @group(0) @binding(0) var<uniform> su: ShellUniforms;
 @group(0) @binding(1) var cube: texture_2d_array<f32>;
-// A depth shell's depth cube (one level; a 1-texel stand-in for other shapes).
+// A depth shell's depth cube (one level, bordered; a 1-texel stand-in for other shapes).
 @group(0) @binding(2) var depth_cube: texture_2d_array<f32>;
 
 struct ShellVsOut {
