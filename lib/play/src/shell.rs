@@ -45,6 +45,11 @@ impl ShellCode {
         ShellCode { depth: matches!(shape, ShellShape::Depth { .. }), sub_pixel: lookups > 1 }
     }
 
+    /// The code a shell block placed with `shape` (SPEC.md 7.3) and `lookups` needs.
+    pub fn of_placement(shape: pis_format::ShellShape, lookups: u32) -> ShellCode {
+        ShellCode { depth: shape == pis_format::ShellShape::Depth, sub_pixel: lookups > 1 }
+    }
+
     /// The code both `self` and `other` need.
     pub fn union(self, other: ShellCode) -> ShellCode {
         ShellCode { depth: self.depth || other.depth, sub_pixel: self.sub_pixel || other.sub_pixel }
@@ -656,17 +661,15 @@ mod tests {
         let bordered = bordered_depth_faces(&cube);
         assert_eq!(bordered.len(), 6 * (n as usize + 2).pow(2));
         let mut taps = Taps::default();
-        let mut rng = 0x2545_f491_4f6c_dd1du64;
-        let mut next = || {
-            rng ^= rng << 13;
-            rng ^= rng >> 7;
-            rng ^= rng << 17;
-            (rng >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
-        };
-        // Random directions, and directions at faces' edges and the cube's corners.
-        let mut dirs: Vec<DVec3> = (0..4000).map(|_| DVec3::new(next(), next(), next())).collect();
-        dirs.extend([DVec3::ONE, DVec3::new(1.0, -1.0, 0.999), DVec3::new(-0.999, 1.0, 0.3)]);
-        for q in dirs {
+        // A lattice of directions over about [−1, 1]³: every face's interior, its edges
+        // (two equal coordinates) and the cube's corners.
+        let axis = |k: i32| k as f64 / 10.0 + 0.013 * (k % 3) as f64;
+        let lattice = (-10..=10)
+            .flat_map(|x| (-10..=10).flat_map(move |y| (-10..=10).map(move |z| (x, y, z))));
+        for q in lattice.map(|(x, y, z)| DVec3::new(axis(x), axis(y), axis(z))) {
+            if q == DVec3::ZERO {
+                continue;
+            }
             let want = cube.distance(q, &mut taps);
             let got = bordered_bilinear(&bordered, n, q);
             assert!((want - got).abs() <= 1e-6 * want, "{q}: {want} against {got}");

@@ -46,13 +46,13 @@ impl ObjectGpu {
         };
         let blocks = layers.iter().flat_map(|&li| &object.layers[li].blocks);
         let code = blocks.filter_map(|b| match b.placement {
-            Placement::Shell { shape, lookups, .. } => Some(ShellCode {
-                depth: shape == pis_format::ShellShape::Depth && self.lens.is_none(),
-                sub_pixel: lookups > 1,
-            }),
+            Placement::Shell { shape, lookups, .. } => {
+                Some(ShellCode::of_placement(shape, lookups))
+            }
             _ => None,
         });
-        Some(code.fold(ShellCode::default(), ShellCode::union))
+        let code = code.fold(ShellCode::default(), ShellCode::union);
+        Some(ShellCode { depth: code.depth && self.lens.is_none(), ..code })
     }
 }
 
