@@ -16,6 +16,7 @@ use pis_format::MipMode;
 use pis_format::{Error, Issue, Layer, PisReader, StreamRef};
 use rayon::prelude::*;
 
+use crate::cube_atlas::CubeAtlas;
 use crate::error::PlayError;
 
 /// A level image to decode.
@@ -49,12 +50,21 @@ pub struct TextureImage {
 }
 
 /// A rebuilt cube map ready to upload: its layout (six square faces and their MIP chains,
-/// from the finest drawn level down) and its texels as RGBA f32 in that layout's order, face
-/// after face, each face's levels in order (SPEC.md 8.1).
+/// from the finest drawn level down) and its atlas images, RGBA f32 face after face, each
+/// face's levels with their borders ([`CubeAtlas::border`]).
 #[derive(Clone, Debug, PartialEq)]
 pub struct CubeImage {
     pub layout: TextureLayout,
-    pub rgba: Vec<f32>,
+    pub atlas: CubeAtlas,
+    pub texels: Vec<f32>,
+}
+
+impl CubeImage {
+    /// The texels as RGBA f32 in the layout's order, face after face, each face's levels in
+    /// order (SPEC.md 8.1).
+    pub fn rgba(&self) -> Vec<f32> {
+        self.atlas.interior(&self.layout, &self.texels)
+    }
 }
 
 /// The pool of decoding threads.
@@ -213,7 +223,8 @@ fn face_chain(layout: &LevelLayout, face: &[f32], drop: u32, rgba: &mut [f32]) {
 
 /// Rebuilds a shell's cube map: [`reconstruct`], each face's MIP chain from its finest drawn
 /// level (level `drop_levels` of the stored chain, for a resolution reduction) down to 1×1,
-/// as RGBA (a 3-channel shell opaque: alpha 1); the faces on the workers.
+/// as RGBA (a 3-channel shell opaque: alpha 1), bordered into its atlas; the faces on the
+/// workers.
 pub fn assemble_cube(job: &AssembleJob) -> CubeImage {
     let linear = reconstruct(job);
     let full = TextureLayout::cube(job.layout.width);
@@ -225,7 +236,8 @@ pub fn assemble_cube(job: &AssembleJob) -> CubeImage {
     rgba.par_chunks_exact_mut(per_face)
         .zip(linear.par_chunks_exact(face_len(&job.layout)))
         .for_each(|(out, face)| face_chain(&job.layout, face, drop, out));
-    CubeImage { layout, rgba }
+    let atlas = CubeAtlas::of(&layout);
+    CubeImage { layout, atlas, texels: atlas.border(&layout, &rgba) }
 }
 
 impl Decoder {
@@ -342,8 +354,9 @@ mod tests {
         let linear = values(n);
         let cube = assemble_cube(&job(&layer, &layout, &linear, 0));
         assert_eq!(cube.layout, TextureLayout::cube(5));
-        assert_eq!(cube.rgba.len(), cube.layout.texel_count() * 4);
-        let worst = cube.rgba.iter().zip(&linear).map(|(a, b)| (a - b).abs()).fold(0.0, f32::max);
+        let rgba = cube.rgba();
+        assert_eq!(rgba.len(), cube.layout.texel_count() * 4);
+        let worst = rgba.iter().zip(&linear).map(|(a, b)| (a - b).abs()).fold(0.0, f32::max);
         assert!(worst < 1e-5, "{worst}");
     }
 
@@ -369,8 +382,9 @@ mod tests {
             }
             at += len;
         }
-        assert_eq!(cube.rgba.len(), want.len());
-        let worst = cube.rgba.iter().zip(&want).map(|(a, b)| (a - b).abs()).fold(0.0, f32::max);
+        let rgba = cube.rgba();
+        assert_eq!(rgba.len(), want.len());
+        let worst = rgba.iter().zip(&want).map(|(a, b)| (a - b).abs()).fold(0.0, f32::max);
         assert!(worst < 1e-5, "{worst}");
     }
 
@@ -381,6 +395,7 @@ mod tests {
         let linear = values(6 * 9 * 4);
         let cube = assemble_cube(&job(&layer, &layout, &linear, 0));
         assert_eq!(cube.layout, TextureLayout::cube(3));
+        let rgba = cube.rgba();
         for face in 0..6u32 {
             let finest = &linear[face as usize * 36..face as usize * 36 + 36];
             let mut level = finest.to_vec();
@@ -390,7 +405,7 @@ mod tests {
                     level = decimate(&level, w, h, 4);
                 }
                 let start = cube.layout.face_texel(face, m, 0, 0) * 4;
-                let got = &cube.rgba[start..start + level.len()];
+                let got = &rgba[start..start + level.len()];
                 let worst = got.iter().zip(&level).map(|(a, b)| (a - b).abs()).fold(0.0, f32::max);
                 assert!(worst < 1e-5, "face {face} level {m}: {worst}");
             }

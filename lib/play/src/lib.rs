@@ -15,6 +15,7 @@
 pub mod blend;
 pub mod cache;
 pub mod camera;
+pub mod cube_atlas;
 pub mod decode;
 pub mod error;
 pub mod frame;

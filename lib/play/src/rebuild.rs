@@ -7,7 +7,8 @@
 //!   decimated by `mip.wgsl`;
 //! - a shell's cube map: one pass per stored MIP level of the six faces, each level below the
 //!   finest adding the finest decimated to its size (stored MIP residuals, kept in a scratch
-//!   chain), then the levels beyond the stored ones decimated.
+//!   chain), then the levels beyond the stored ones decimated, into a scratch chain that
+//!   one more pass writes into the cube map's atlas with borders (cube_atlas.rs).
 //!
 //! decode.rs's `assemble` and `assemble_cube` are the reference it is held to
 //! (tests/rebuild_vs_cpu.rs) and the path where the GPU rebuild does not apply (a resolution
@@ -20,6 +21,7 @@ use pis_format::mip::mip_size;
 use pis_format::reconstruct::face_len;
 use pis_format::texture::LevelLayout;
 
+use crate::cube_atlas::BorderPass;
 use crate::gpu::Gpu;
 use crate::mip::{storage_name, MipBuilder};
 use crate::shell::ShellTexture;
@@ -80,6 +82,8 @@ pub struct LevelRebuild {
     cube_decimate: Pass,
     /// Bound where a cube level adds nothing.
     no_source: wgpu::TextureView,
+    /// A rebuilt cube map's levels into its atlas with borders.
+    border: BorderPass,
 }
 
 fn entry(binding: u32, ty: wgpu::BindingType) -> wgpu::BindGroupLayoutEntry {
@@ -275,6 +279,7 @@ impl LevelRebuild {
             cube_level: Pass::new(gpu, &module, "cube_level", &[0, 1, 3, 4]),
             cube_decimate: Pass::new(gpu, &module, "cube_decimate", &[0, 3, 4]),
             no_source: level_view(&none, 0, wgpu::TextureViewDimension::D2Array),
+            border: BorderPass::new(gpu),
         }
     }
 
@@ -317,11 +322,12 @@ impl LevelRebuild {
         let source = stacked(gpu, stack, face_len * 6, encoder);
         let stored = level_layout.mips.clamp(1, texture.layout.levels);
         let scratch = (stored > 1).then(|| scratch_chain(gpu, n, stored));
+        let levels = scratch_chain(gpu, n, texture.layout.levels);
         let array = wgpu::TextureViewDimension::D2Array;
         let mut offset = 0;
         for m in 0..texture.layout.levels {
             let (w, _) = mip_size(n, n, m);
-            let dst = level_view(&texture.texture, m, array);
+            let dst = level_view(&levels, m, array);
             let groups = [w.div_ceil(8), w.div_ceil(8), 6];
             if m < stored {
                 let added = match (&scratch, m) {
@@ -353,14 +359,15 @@ impl LevelRebuild {
                 ];
                 self.cube_level.dispatch(gpu, &params, &resources, groups, encoder);
                 if let (Some(chain), 0) = (&scratch, m) {
-                    copy_finest(encoder, &texture.texture, chain, n);
+                    copy_finest(encoder, &levels, chain, n);
                 }
                 offset += w * w * stack.channels;
             } else {
-                let above = level_view(&texture.texture, m - 1, array);
+                let above = level_view(&levels, m - 1, array);
                 self.decimate_level(gpu, (&above, &dst), (mip_size(n, n, m - 1).0, w), encoder);
             }
         }
+        self.border.record(gpu, (&levels, &texture.atlas), &texture.view, encoder);
     }
 
     /// Records the decimation of a level of six faces (`src`, `size.0` square) into the
@@ -393,12 +400,12 @@ impl LevelRebuild {
     }
 }
 
-/// A scratch chain of six `n × n` faces and `levels` levels, for the finest level
-/// decimated down the stored levels.
+/// A scratch chain of six `n × n` faces and `levels` levels: the cube map's levels before
+/// their borders, and the finest level decimated down the stored levels.
 fn scratch_chain(gpu: &Gpu, n: u32, levels: u32) -> wgpu::Texture {
     let side = n.next_power_of_two();
     gpu.device.create_texture(&wgpu::TextureDescriptor {
-        label: Some("rebuild: decimated finest"),
+        label: Some("rebuild: cube levels"),
         size: wgpu::Extent3d { width: side, height: side, depth_or_array_layers: 6 },
         mip_level_count: levels,
         sample_count: 1,
@@ -406,6 +413,7 @@ fn scratch_chain(gpu: &Gpu, n: u32, levels: u32) -> wgpu::Texture {
         format: gpu.cube_format,
         usage: wgpu::TextureUsages::TEXTURE_BINDING
             | wgpu::TextureUsages::STORAGE_BINDING
+            | wgpu::TextureUsages::COPY_SRC
             | wgpu::TextureUsages::COPY_DST,
         view_formats: &[],
     })

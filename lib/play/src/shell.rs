@@ -5,8 +5,8 @@
 //! draw a reflective object's shells with the same functions (`frame/reflection.wgsl`,
 //! `frame/reflection.rs`).
 //!
-//! Level m of a face of size N holds `mip_size(N, m)` used texels at the top left of a GPU
-//! level of `next_pow2(N) >> m` texels, which is never smaller.
+//! Each layer holds one face's MIP levels side by side, each with a one-texel border that
+//! makes its bilinear lookups seamless (cube_atlas.rs).
 
 use bytemuck::{Pod, Zeroable};
 use pis_compile::shell::cube::cube_texel;
@@ -14,6 +14,7 @@ use pis_compile::shell::{DepthCube, ShellObject, ShellShape};
 use pis_compile::{DrawMesh, TextureLayout, Viewport};
 use wgpu::util::DeviceExt;
 
+use crate::cube_atlas::CubeAtlas;
 use crate::error::PlayError;
 use crate::gpu::Gpu;
 use crate::image::FloatImage;
@@ -62,9 +63,11 @@ impl ShellCode {
     }
 }
 
-/// A cube map on the GPU.
+/// A cube map on the GPU, as its lookups read it: each face's levels with their borders in
+/// one atlas image ([`CubeAtlas`]), the six faces the layers of a 2D array.
 pub struct ShellTexture {
     pub layout: TextureLayout,
+    pub atlas: CubeAtlas,
     pub texture: wgpu::Texture,
     pub view: wgpu::TextureView,
 }
@@ -72,12 +75,12 @@ pub struct ShellTexture {
 impl ShellTexture {
     /// Allocates a cube map of `layout` (six square faces) for `object` (named in errors).
     pub fn new(gpu: &Gpu, layout: TextureLayout, object: &str) -> Result<ShellTexture, PlayError> {
-        let side = layout.width.next_power_of_two();
         let limit = gpu.limits.max_texture_dimension_2d;
+        let atlas = CubeAtlas::of(&layout);
         if layout.faces != 6
             || layout.width != layout.height
             || layout.width == 0
-            || side > limit
+            || atlas.largest_side() > limit
             || layout.levels == 0
             || layout.levels > TextureLayout::cube(layout.width).levels
         {
@@ -90,12 +93,16 @@ impl ShellTexture {
         }
         let texture = gpu.device.create_texture(&wgpu::TextureDescriptor {
             label: Some("shell"),
-            size: wgpu::Extent3d { width: side, height: side, depth_or_array_layers: 6 },
-            mip_level_count: layout.levels,
+            size: wgpu::Extent3d {
+                width: atlas.width,
+                height: atlas.height,
+                depth_or_array_layers: 6,
+            },
+            mip_level_count: 1,
             sample_count: 1,
             dimension: wgpu::TextureDimension::D2,
             format: gpu.cube_format,
-            // Storage and copies: the GPU's rebuild writes it (rebuild.rs).
+            // Storage: the GPU's rebuild writes it (rebuild.rs).
             usage: wgpu::TextureUsages::TEXTURE_BINDING
                 | wgpu::TextureUsages::COPY_DST
                 | wgpu::TextureUsages::COPY_SRC
@@ -106,11 +113,12 @@ impl ShellTexture {
             dimension: Some(wgpu::TextureViewDimension::D2Array),
             ..Default::default()
         });
-        Ok(ShellTexture { layout, texture, view })
+        Ok(ShellTexture { layout, atlas, texture, view })
     }
 
-    /// Uploads RGBA texels in the layout's order (face after face, each level after level).
-    pub fn upload(&self, gpu: &Gpu, rgba: &[f32]) -> Result<(), PlayError> {
+    /// Uploads RGBA texels in the layout's order (face after face, each level after level),
+    /// bordered on the CPU ([`CubeAtlas::border`]); returns the bytes written.
+    pub fn upload(&self, gpu: &Gpu, rgba: &[f32]) -> Result<u64, PlayError> {
         let l = self.layout;
         let want = l.texel_count() * 4;
         if rgba.len() != want {
@@ -122,27 +130,43 @@ impl ShellTexture {
                 levels: l.levels,
             });
         }
-        for face in 0..6 {
-            for m in 0..l.levels {
-                let (w, h) = l.level_size(m);
-                let start = l.face_texel(face, m, 0, 0) * 4;
-                let data = &rgba[start..start + (w * h * 4) as usize];
-                write_level(gpu, &self.texture, (m, face), (w, h), data);
-            }
+        self.upload_atlas(gpu, &self.atlas.border(&l, rgba))
+    }
+
+    /// Uploads the atlas images `texels` ([`CubeAtlas::border`]'s); returns the bytes
+    /// written.
+    pub fn upload_atlas(&self, gpu: &Gpu, texels: &[f32]) -> Result<u64, PlayError> {
+        let face = self.atlas.face_texels() * 4;
+        if texels.len() != 6 * face {
+            return Err(PlayError::TextureData {
+                got: texels.len(),
+                want: 6 * face,
+                width: self.atlas.width,
+                height: self.atlas.height,
+                levels: 1,
+            });
         }
-        Ok(())
+        let size = (self.atlas.width, self.atlas.height);
+        let mut bytes = 0;
+        for (f, image) in texels.chunks_exact(face).enumerate() {
+            bytes += write_level(gpu, &self.texture, (0, f as u32), size, image);
+        }
+        Ok(bytes)
     }
 }
 
 /// Reads a cube map back (tests and diagnostics): RGBA texels in its layout's order, face
 /// after face and level after level, as [`ShellTexture::upload`] takes them.
 pub fn read_cube(gpu: &Gpu, cube: &ShellTexture) -> Result<Vec<f32>, PlayError> {
-    let l = cube.layout;
-    let mut out = Vec::with_capacity(l.texel_count() * 4);
+    Ok(cube.atlas.interior(&cube.layout, &read_atlas(gpu, cube)?))
+}
+
+/// Reads a cube map's atlas images back (tests and diagnostics): RGBA, face after face.
+pub fn read_atlas(gpu: &Gpu, cube: &ShellTexture) -> Result<Vec<f32>, PlayError> {
+    let a = cube.atlas;
+    let mut out = Vec::with_capacity(6 * a.face_texels() * 4);
     for face in 0..6 {
-        for m in 0..l.levels {
-            out.extend(crate::mip::read_level(gpu, &cube.texture, (m, face), l.level_size(m))?);
-        }
+        out.extend(crate::mip::read_level(gpu, &cube.texture, (0, face), (a.width, a.height))?);
     }
     Ok(out)
 }

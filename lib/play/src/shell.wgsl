@@ -2,14 +2,16 @@
 // surface point. One function written twice: every function here has a twin of the same
 // name in pis-compile's hardware model, with the same order of operations (reflect_about,
 // shell_hit, lookup_direction, fresnel: shell/geometry.rs; depth_distance, depth_hit:
-// shell/depth.rs; cube_face, face_components, face_st,
-// face_vector, cube_texel, beyond, bilinear_corner, cube_lod, cube_bilinear, cube_sample:
-// shell/cube.rs). Change both together. texture_lod.wgsl is prepended to this source
-// (shell.rs), and pipelines append their entry points to it.
+// shell/depth.rs; cube_face, face_components, face_st, cube_lod, cube_bilinear,
+// cube_sample: shell/cube.rs; atlas_origin: the player's cube_atlas.rs). Change both
+// together. texture_lod.wgsl is prepended to this source (shell.rs), and pipelines append
+// their entry points to it.
 //
-// A cube map is a 2D array texture of six layers (+X, −X, +Y, −Y, +Z, −Z) whose level m
-// holds the used mip_size(N, m) texels at its top left; texels are read with textureLoad
-// and filtered here, so the weights are the model's on every adapter.
+// A cube map is a 2D array texture of six layers (+X, −X, +Y, −Y, +Z, −Z), each one face's
+// MIP levels with one-texel borders side by side (cube_atlas.rs); texels are read with
+// textureLoad and filtered here, so the weights are the model's on every adapter. The
+// borders hold what the model's cube_texel names beyond a face, so the lookups need no
+// seam logic (the model's cube_texel, beyond and bilinear_corner have no twin here).
 
 // The code a pipeline carries (pipeline-overridable constants, `ShellCode` in shell.rs): a
 // pipeline whose draws hold no depth shell is compiled with DEPTH_SHELLS false, one whose
@@ -239,35 +241,6 @@ fn face_st(face: u32, d: vec3<f32>) -> vec2<f32> {
     return vec2<f32>((c.x / c.z + 1.0) * 0.5, (c.y / c.z + 1.0) * 0.5);
 }
 
-// The vector with |ma| = 1 and coordinates (sc, tc) on `face`.
-fn face_vector(face: u32, sc: f32, tc: f32) -> vec3<f32> {
-    switch face {
-        case 0u: { return vec3<f32>(1.0, -tc, -sc); }
-        case 1u: { return vec3<f32>(-1.0, -tc, sc); }
-        case 2u: { return vec3<f32>(sc, 1.0, tc); }
-        case 3u: { return vec3<f32>(sc, -1.0, -tc); }
-        case 4u: { return vec3<f32>(sc, -tc, 1.0); }
-        default: { return vec3<f32>(-sc, -tc, -1.0); }
-    }
-}
-
-// The texel (face, i, j) that texel (i, j) of an n × n level of `face` names: itself inside
-// the face, else the neighbouring face's texel holding the direction of its centre.
-fn cube_texel(face: u32, i: i32, j: i32, n: u32) -> vec3<i32> {
-    let ni = i32(n);
-    if (i >= 0 && i < ni && j >= 0 && j < ni) {
-        return vec3<i32>(i32(face), i, j);
-    }
-    let nf = f32(n);
-    let sc = 2.0 * (f32(i) + 0.5) / nf - 1.0;
-    let tc = 2.0 * (f32(j) + 0.5) / nf - 1.0;
-    let d = face_vector(face, sc, tc);
-    let f2 = cube_face(d);
-    let st = face_st(f2, d);
-    let k = clamp(vec2<i32>(floor(st * nf)), vec2<i32>(0), vec2<i32>(ni - 1));
-    return vec3<i32>(i32(f2), k.x, k.y);
-}
-
 // λ of a lookup with vector d and fine derivatives ddx, ddy: (s, t)'s derivatives on d's
 // face by the quotient rule, then the isotropic LOD of a `size`-texel face.
 fn cube_lod(d: vec3<f32>, ddx: vec3<f32>, ddy: vec3<f32>, size: f32, max_level: f32) -> f32 {
@@ -281,55 +254,42 @@ fn cube_lod(d: vec3<f32>, ddx: vec3<f32>, ddy: vec3<f32>, size: f32, max_level: 
     return texture_lod(dx, dy, vec2<f32>(size, size), max_level);
 }
 
+// The top-left texel of level m's bordered face in a cube map's atlas (cube_atlas.rs
+// `CubeAtlas::origin`): level 0 at the top left, the coarser levels below one another to
+// its right.
+fn atlas_origin(size: u32, m: u32) -> vec2<i32> {
+    if (m == 0u) {
+        return vec2<i32>(0);
+    }
+    var y = 0u;
+    for (var k = 1u; k < m; k = k + 1u) {
+        y = y + ((size + (1u << k) - 1u) >> k) + 2u;
+    }
+    return vec2<i32>(i32(size + 2u), i32(y));
+}
+
 // Bilinear lookup of level m of cube map `cube` (face size `size`) with vector d: the four
-// texels around (u, v), each cube_texel's texel within the face or beyond one edge. Beyond
-// a corner, where three faces meet and no fourth texel exists, a texel is the mean of the
-// three meeting there, which are the footprint's other three: at most one of the four is
-// beyond a corner, and its weight goes to the other three in thirds (bilinear_corner), so
-// every lookup loads four texels.
+// texels around (u, v) of the level's bordered face (cube_atlas.rs). Beyond an edge the
+// border holds the texel cube_texel names; beyond a corner, where three faces meet and no
+// fourth texel exists, the mean of the three meeting there, which are the footprint's other
+// three: the model's seamless lookup, which gives the corner's weight to them in thirds
+// (bilinear_corner), with the same four texels and weights.
 fn cube_bilinear(cube: texture_2d_array<f32>, size: u32, d: vec3<f32>, m: u32) -> vec4<f32> {
     let face = cube_face(d);
     let st = face_st(face, d);
     let n = (size + (1u << m) - 1u) >> m;
-    let ni = i32(n);
     let u = st.x * f32(n) - 0.5;
     let v = st.y * f32(n) - 0.5;
     let i0 = floor(u);
     let j0 = floor(v);
     let a = u - i0;
     let b = v - j0;
-    let third = bilinear_corner(i32(i0), i32(j0), ni, a, b) / 3.0;
-    var acc = vec4<f32>(0.0);
-    for (var dj = 0; dj < 2; dj = dj + 1) {
-        for (var di = 0; di < 2; di = di + 1) {
-            let i = i32(i0) + di;
-            let j = i32(j0) + dj;
-            let corner = beyond(i, ni) && beyond(j, ni);
-            let w = select(select(1.0 - a, a, di == 1) * select(1.0 - b, b, dj == 1) + third, 0.0, corner);
-            let t = cube_texel(face, select(i, clamp(i, 0, ni - 1), corner), select(j, clamp(j, 0, ni - 1), corner), n);
-            acc = acc + w * textureLoad(cube, vec2<i32>(t.y, t.z), t.x, i32(m));
-        }
-    }
-    return acc;
-}
-
-// Whether texel coordinate x lies beyond an n-texel face.
-fn beyond(x: i32, n: i32) -> bool {
-    return x < 0 || x >= n;
-}
-
-// The bilinear weight of the footprint's texel beyond a corner (both coordinates beyond
-// the face) at (i0, j0), or 0 when none is.
-fn bilinear_corner(i0: i32, j0: i32, n: i32, a: f32, b: f32) -> f32 {
-    var w = 0.0;
-    for (var dj = 0; dj < 2; dj = dj + 1) {
-        for (var di = 0; di < 2; di = di + 1) {
-            if (beyond(i0 + di, n) && beyond(j0 + dj, n)) {
-                w = select(1.0 - a, a, di == 1) * select(1.0 - b, b, dj == 1);
-            }
-        }
-    }
-    return w;
+    let at = atlas_origin(size, m) + vec2<i32>(i32(i0) + 1, i32(j0) + 1);
+    let f = i32(face);
+    var acc = ((1.0 - a) * (1.0 - b)) * textureLoad(cube, at, f, 0);
+    acc = acc + (a * (1.0 - b)) * textureLoad(cube, at + vec2<i32>(1, 0), f, 0);
+    acc = acc + ((1.0 - a) * b) * textureLoad(cube, at + vec2<i32>(0, 1), f, 0);
+    return acc + (a * b) * textureLoad(cube, at + vec2<i32>(1, 1), f, 0);
 }
 
 // Trilinear lookup at level of detail λ: bilinear on levels ⌊λ⌋ and ⌊λ⌋ + 1, blended by

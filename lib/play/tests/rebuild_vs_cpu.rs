@@ -3,8 +3,9 @@
 //! every level of the padded layout, for 1 to 4 channels, one to five pyramid levels, odd
 //! and power-of-two sizes, and the three gamma paths (identity, the default 2.2's
 //! `pow_11_5`, a general power); shells' cube maps against `assemble_cube`, every face and
-//! level, with stored MIP levels (all of them or the finest few) and decimated ones. Sums
-//! alone are bit-exact; with an inverse gamma the GPU's division and power may round
+//! level, with stored MIP levels (all of them or the finest few) and decimated ones, and
+//! their atlases' borders against the CPU's bit for bit (cube_atlas.rs). Sums alone are
+//! bit-exact; with an inverse gamma the GPU's division and power may round
 //! differently, held to 90 dB.
 
 mod common;
@@ -18,7 +19,7 @@ use pis_format::{Combine, DepMask, Layer, LayerKind, Mapping, MipMode, StreamRef
 use pis_play::decode::{assemble, assemble_cube, AssembleJob};
 use pis_play::mip::{read_levels, MipBuilder};
 use pis_play::rebuild::{level_buffer, LevelRebuild, LevelStack};
-use pis_play::shell::read_cube;
+use pis_play::shell::{read_atlas, read_cube};
 use pis_play::ShellTexture;
 
 fn surface_layer(channels: u8, gamma: f32) -> Layer<StreamRef> {
@@ -182,11 +183,15 @@ fn the_gpu_rebuild_of_cube_maps_equals_the_workers_rebuild() {
         rebuild.record_cube(&gpu, (&cube, &stack), &layout, &mut enc);
         gpu.queue.submit([enc.finish()]);
         let got = read_cube(&gpu, &cube).unwrap();
-        assert_eq!(got.len(), want.rgba.len(), "{what}: texel count");
+        let want_rgba = want.rgba();
+        assert_eq!(got.len(), want_rgba.len(), "{what}: texel count");
+        // The border pass writes the borders the CPU writes for uploaded cube maps.
+        let bordered = cube.atlas.border(&cube.layout, &got);
+        assert_eq!(read_atlas(&gpu, &cube).unwrap(), bordered, "{what}: the borders differ");
         if gamma == 1.0 {
-            assert_eq!(got, want.rgba, "{what}: the sums differ");
+            assert_eq!(got, want_rgba, "{what}: the sums differ");
         } else {
-            let p = psnr(&got, &want.rgba);
+            let p = psnr(&got, &want_rgba);
             eprintln!("{what}: {p:.1} dB");
             assert!(p >= 90.0, "{what}: {p:.1} dB from the workers' rebuild");
         }

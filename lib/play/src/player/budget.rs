@@ -2,23 +2,30 @@
 //! and the adapter's largest buffer, so that a file whose textures the player cannot hold is
 //! refused before anything is decoded or allocated ([`crate::memory`]).
 
+use pis_compile::TextureLayout;
 use pis_format::{Container, Mapping, StreamRef};
 
 use super::options::PlayerOptions;
+use crate::cube_atlas::CubeAtlas;
 use crate::error::PlayError;
 use crate::gpu::Gpu;
 use crate::memory::{blocks, size, BlockBytes};
 
 /// The bytes of the largest single upload of a block's texture: its finest level (a surface
-/// texture at its allocated power-of-two size in the device's texture format; one face of a
-/// shell's cube map in the device's cube-map format).
+/// texture at its allocated power-of-two size in the device's texture format; one face's
+/// atlas image of a shell's cube map in the device's cube-map format).
 fn upload_bytes(gpu: &Gpu, b: &BlockBytes) -> u64 {
-    let (w, h) = (b.width.next_power_of_two() as u64, b.height.next_power_of_two() as u64);
-    let texel = match b.mapping {
-        Mapping::Surface => gpu.texture_format.block_copy_size(None).unwrap_or(16) as u64,
-        Mapping::Shell => gpu.cube_format.block_copy_size(None).unwrap_or(16) as u64,
-    };
-    w * h * texel
+    let texel = |format: wgpu::TextureFormat| format.block_copy_size(None).unwrap_or(16) as u64;
+    match b.mapping {
+        Mapping::Surface => {
+            let (w, h) = (b.width.next_power_of_two() as u64, b.height.next_power_of_two());
+            w * h as u64 * texel(gpu.texture_format)
+        }
+        Mapping::Shell => {
+            let atlas = CubeAtlas::of(&TextureLayout::cube(b.width));
+            atlas.face_texels() as u64 * texel(gpu.cube_format)
+        }
+    }
 }
 
 /// Refuses (not supported) a file one frame of which would decode more level images than

@@ -9,6 +9,7 @@ use pis_compile::{Filter, TextureLayout};
 use pis_format::{Container, Mapping, PisReader, Placement, StreamRef, Term};
 
 use super::depth::{object_depth_shells, DepthShells};
+use crate::cube_atlas::CubeAtlas;
 use crate::error::PlayError;
 use crate::frame::hybrid::MAX_LENS_SHELLS;
 use crate::frame::{MeshGpu, MAX_TERM_SHELLS};
@@ -364,8 +365,8 @@ fn lens_state(
 }
 
 /// Every surface texture and cube-map face of the file, as the player allocates it (padded
-/// to powers of two), fits the adapter's largest 2D texture: checked at open, before any
-/// frame.
+/// to powers of two; a cube map's faces as atlases), fits the adapter's largest 2D texture:
+/// checked at open, before any frame.
 pub(super) fn check_texture_sizes(gpu: &Gpu, reader: &PisReader) -> Result<(), PlayError> {
     let limit = gpu.limits.max_texture_dimension_2d;
     for o in &reader.container().objects {
@@ -373,7 +374,10 @@ pub(super) fn check_texture_sizes(gpu: &Gpu, reader: &PisReader) -> Result<(), P
             for b in &l.blocks {
                 let (w, h) = match l.mapping {
                     Mapping::Surface => allocated_size(&TextureLayout::full(b.width, b.height)),
-                    Mapping::Shell => (b.width.next_power_of_two(), b.height.next_power_of_two()),
+                    Mapping::Shell => {
+                        let side = CubeAtlas::of(&TextureLayout::cube(b.width)).largest_side();
+                        (side, side)
+                    }
                 };
                 if w > limit || h > limit {
                     return Err(PlayError::TextureSize {

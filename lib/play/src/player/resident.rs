@@ -338,9 +338,7 @@ impl Textures {
         }
         for (k, cube) in shells.iter().zip(cubes) {
             let texture = ShellTexture::new(gpu, cube.layout, &c.objects[k.object as usize].name)?;
-            texture.upload(gpu, &cube.rgba)?;
-            let texel = gpu.cube_format.block_copy_size(None).unwrap_or(16) as usize;
-            stats.upload_bytes += (cube.rgba.len() / 4 * texel) as u64;
+            stats.upload_bytes += texture.upload_atlas(gpu, &cube.texels)?;
             made.push((
                 (*k).clone(),
                 Resident { texture: GpuTexture::Shell(texture), last_frame: frame },
