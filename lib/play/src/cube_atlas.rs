@@ -72,55 +72,69 @@ impl CubeAtlas {
         self.width as usize * self.height as usize
     }
 
+    /// The index in a face's atlas image of texel (i, j) of level `m`, (i, j) in [−1, n_m]²
+    /// (the border included).
+    pub fn texel(&self, m: u32, i: i64, j: i64) -> usize {
+        let (ox, oy) = self.origin(m);
+        (oy as i64 + j + 1) as usize * self.width as usize + (ox as i64 + i + 1) as usize
+    }
+
     /// The atlas images of the cube map `rgba` (RGBA texels in `layout`'s order, face after
     /// face, each face's levels in order): RGBA, face after face, rows from the top, texels
     /// no level uses zero.
     pub fn border(&self, layout: &TextureLayout, rgba: &[f32]) -> Vec<f32> {
-        let w = self.width as usize;
         let mut out = vec![0.0f32; 6 * self.face_texels() * 4];
         for (face, atlas) in out.chunks_exact_mut(self.face_texels() * 4).enumerate() {
             for m in 0..self.levels {
-                let n = level_side(self.size, m);
-                let (ox, oy) = (self.origin(m).0 as usize, self.origin(m).1 as usize);
-                let level = |f: u32| layout.face_offset(f) + layout.level_offset(m);
-                let inside = &rgba[level(face as u32) * 4..][..(n * n) as usize * 4];
-                for (j, row) in inside.chunks_exact(n as usize * 4).enumerate() {
-                    let at = ((oy + j + 1) * w + ox + 1) * 4;
+                let n = level_side(self.size, m) as usize;
+                let level = layout.face_offset(face as u32) + layout.level_offset(m);
+                let inside = &rgba[level * 4..][..n * n * 4];
+                for (j, row) in inside.chunks_exact(n * 4).enumerate() {
+                    let at = self.texel(m, 0, j as i64) * 4;
                     atlas[at..at + row.len()].copy_from_slice(row);
                 }
-                let levels: [usize; 6] = std::array::from_fn(|f| level(f as u32));
-                let texel = |(f, i, j): (u32, u32, u32)| {
-                    let at = (levels[f as usize] + (j * n + i) as usize) * 4;
-                    [rgba[at], rgba[at + 1], rgba[at + 2], rgba[at + 3]]
-                };
+            }
+        }
+        self.fill_borders(&mut out);
+        out
+    }
+
+    /// Writes the borders of the atlas images `texels` (RGBA, face after face) from their
+    /// levels' insides.
+    pub fn fill_borders(&self, texels: &mut [f32]) {
+        let face_len = self.face_texels();
+        let at = |f: u32, m: u32, i: i64, j: i64| (f as usize * face_len + self.texel(m, i, j)) * 4;
+        for m in 0..self.levels {
+            let n = level_side(self.size, m);
+            for face in 0..6 {
                 for t in 0..4 * n + 4 {
                     let (i, j) = border_texel(t, n);
-                    let s = sources(face as u32, i, j, n);
+                    let s = sources(face, i, j, n);
+                    let texel = |(f, i, j): (u32, u32, u32)| {
+                        let k = at(f, m, i as i64, j as i64);
+                        [texels[k], texels[k + 1], texels[k + 2], texels[k + 3]]
+                    };
                     let mut c = texel(s.texels[0]);
                     if s.count == 3 {
                         let (b, d) = (texel(s.texels[1]), texel(s.texels[2]));
                         c = std::array::from_fn(|k| (c[k] + b[k] + d[k]) / 3.0);
                     }
-                    let at = ((oy + (j + 1) as usize) * w + ox + (i + 1) as usize) * 4;
-                    atlas[at..at + 4].copy_from_slice(&c);
+                    let k = at(face, m, i, j);
+                    texels[k..k + 4].copy_from_slice(&c);
                 }
             }
         }
-        out
     }
 
     /// The cube map's texels in `layout`'s order from its atlas images (as
     /// [`Self::border`] makes them): each level's inside.
     pub fn interior(&self, layout: &TextureLayout, atlas: &[f32]) -> Vec<f32> {
-        let w = self.width as usize;
         let mut out = Vec::with_capacity(layout.texel_count() * 4);
-        for face in 0..6 {
-            let image = &atlas[face * self.face_texels() * 4..][..self.face_texels() * 4];
+        for image in atlas.chunks_exact(self.face_texels() * 4) {
             for m in 0..self.levels {
                 let n = level_side(self.size, m) as usize;
-                let (ox, oy) = self.origin(m);
                 for j in 0..n {
-                    let at = ((oy as usize + j + 1) * w + ox as usize + 1) * 4;
+                    let at = self.texel(m, 0, j as i64) * 4;
                     out.extend_from_slice(&image[at..at + n * 4]);
                 }
             }

@@ -189,13 +189,17 @@ pub fn assemble(job: &AssembleJob) -> TextureImage {
 
 /// One face's MIP chain of a reconstructed shell texture (`face`: its stored planes): its
 /// stored levels (mip mode `stored`), or level 0 decimated down to 1×1 (mip mode
-/// `decimated`, SPEC.md 8.3); from level `drop` down, as RGBA texels written to `rgba`
-/// (exactly their length).
-fn face_chain(layout: &LevelLayout, face: &[f32], drop: u32, rgba: &mut [f32]) {
+/// `decimated`, SPEC.md 8.3); from level `drop` down, as RGBA texels written inside their
+/// levels of the face's atlas image `image` (of `atlas`, whose level 0 is level `drop`).
+fn face_chain(
+    layout: &LevelLayout,
+    face: &[f32],
+    drop: u32,
+    (atlas, image): (&CubeAtlas, &mut [f32]),
+) {
     let (n, c) = (layout.width, layout.channels);
     let levels = pis_format::mip::mip_count(n, n);
     let mut at = 0;
-    let mut put = 0;
     let mut coarser: Vec<f32> = Vec::new();
     for m in 0..levels {
         let (w, h) = mip_size(n, n, m);
@@ -213,12 +217,12 @@ fn face_chain(layout: &LevelLayout, face: &[f32], drop: u32, rgba: &mut [f32]) {
             &coarser
         };
         if m >= drop {
-            let texels = (w * h) as usize * 4;
-            level_rgba(level, c, &mut rgba[put..put + texels]);
-            put += texels;
+            for (j, row) in level.chunks_exact((w * c) as usize).enumerate() {
+                let start = atlas.texel(m - drop, 0, j as i64) * 4;
+                level_rgba(row, c, &mut image[start..start + w as usize * 4]);
+            }
         }
     }
-    debug_assert_eq!(put, rgba.len());
 }
 
 /// Rebuilds a shell's cube map: [`reconstruct`], each face's MIP chain from its finest drawn
@@ -231,13 +235,15 @@ pub fn assemble_cube(job: &AssembleJob) -> CubeImage {
     let drop = job.drop_levels.min(full.levels - 1);
     let (size, _) = full.level_size(drop);
     let layout = TextureLayout { width: size, height: size, levels: full.levels - drop, faces: 6 };
-    let per_face = layout.texel_count() / 6 * 4;
-    let mut rgba = vec![0.0f32; per_face * 6];
-    rgba.par_chunks_exact_mut(per_face)
-        .zip(linear.par_chunks_exact(face_len(&job.layout)))
-        .for_each(|(out, face)| face_chain(&job.layout, face, drop, out));
     let atlas = CubeAtlas::of(&layout);
-    CubeImage { layout, atlas, texels: atlas.border(&layout, &rgba) }
+    let per_face = atlas.face_texels() * 4;
+    let mut texels = vec![0.0f32; per_face * 6];
+    texels
+        .par_chunks_exact_mut(per_face)
+        .zip(linear.par_chunks_exact(face_len(&job.layout)))
+        .for_each(|(image, face)| face_chain(&job.layout, face, drop, (&atlas, image)));
+    atlas.fill_borders(&mut texels);
+    CubeImage { layout, atlas, texels }
 }
 
 impl Decoder {
