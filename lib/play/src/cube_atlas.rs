@@ -6,11 +6,13 @@
 //! as (n_m + 2)² texels: level 0 at the top left, the coarser levels below one another to
 //! its right. Inside, the level's texels; beyond one edge, the neighbouring face's texel
 //! that pis-compile's `cube_texel` names; beyond a corner, the mean of the three texels that
-//! meet there. Those are the texels and weights of the hardware model's seamless lookup
-//! (`cube_bilinear` in pis-compile's shell/cube.rs), whose corner weight goes to the other
-//! three in thirds. The border is made on the CPU ([`CubeAtlas::border`]: cube maps
-//! uploaded as texels) or by a compute pass ([`BorderPass`]: cube maps rebuilt on the GPU)
-//! from the same map of sources ([`CubeAtlas::border_map`]).
+//! meet there ([`sources`]). Those are the texels and weights of the hardware model's
+//! seamless lookup (`cube_bilinear` in pis-compile's shell/cube.rs), whose corner weight goes
+//! to the other three in thirds. The borders are written on the CPU
+//! ([`CubeAtlas::fill_borders`]: cube maps rebuilt on the decoding threads or uploaded as
+//! texels) or by a compute pass ([`BorderPass`]: cube maps rebuilt on the GPU) from the same
+//! sources ([`CubeAtlas::border_map`]). A depth shell's depth cube (one level, one channel)
+//! takes the same border (shell.rs `bordered_depth_faces`).
 
 use bytemuck::{Pod, Zeroable};
 use pis_compile::shell::cube::cube_texel;
@@ -36,11 +38,11 @@ pub struct CubeAtlas {
     pub height: u32,
 }
 
-/// A border texel's sources on its level: one texel (`count` 1) or three (a corner).
+/// A bordered texel's sources on its level: one texel (`count` 1) or three (a corner).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-struct Sources {
-    texels: [(u32, u32, u32); 3],
-    count: u32,
+pub struct Sources {
+    pub texels: [(u32, u32, u32); 3],
+    pub count: u32,
 }
 
 impl CubeAtlas {
@@ -180,7 +182,7 @@ pub fn border_texel(t: u32, n: u32) -> (i64, i64) {
 
 /// What the bordered texel (i, j) of an `n`-texel level of `face` holds: itself inside;
 /// [`cube_texel`]'s texel beyond one edge; beyond a corner, the three texels meeting there.
-fn sources(face: u32, i: i64, j: i64, n: u32) -> Sources {
+pub fn sources(face: u32, i: i64, j: i64, n: u32) -> Sources {
     let last = n as i64 - 1;
     let (ci, cj) = (i.clamp(0, last), j.clamp(0, last));
     if i == ci || j == cj {

@@ -9,12 +9,11 @@
 //! makes its bilinear lookups seamless (cube_atlas.rs).
 
 use bytemuck::{Pod, Zeroable};
-use pis_compile::shell::cube::cube_texel;
 use pis_compile::shell::{DepthCube, ShellObject, ShellShape};
 use pis_compile::{DrawMesh, TextureLayout, Viewport};
 use wgpu::util::DeviceExt;
 
-use crate::cube_atlas::CubeAtlas;
+use crate::cube_atlas::{sources, CubeAtlas};
 use crate::error::PlayError;
 use crate::gpu::Gpu;
 use crate::image::FloatImage;
@@ -225,26 +224,23 @@ impl DepthTexture {
 }
 
 /// A depth cube's faces with a one-texel border, `size + 2` texels a side, face after face,
-/// rows from the top: inside, the face's distances; beyond one edge, the neighbouring face's
-/// texel that [`cube_texel`] names; beyond a corner, the mean of the three texels that meet
+/// rows from the top: inside, the face's distances; on the border, what a cube map's atlas
+/// holds there ([`crate::cube_atlas::sources`]): beyond one edge, the neighbouring face's
+/// texel that `cube_texel` names, beyond a corner, the mean of the three texels that meet
 /// there. `shell.wgsl`'s `depth_distance` then filters the bordered face bilinearly with no
 /// seam to handle, and gets [`DepthCube::distance`]'s seamless lookup: the same four texels
 /// and weights, a corner's weight on the mean of the other three.
 pub fn bordered_depth_faces(cube: &DepthCube) -> Vec<f32> {
-    let n = cube.size as i64;
-    let texel = |face: u32, i: i64, j: i64| {
-        let (f, i, j) = cube_texel(face, i, j, cube.size);
-        cube.distances[((f as i64 * n + j as i64) * n + i as i64) as usize]
-    };
+    let n = cube.size;
+    let texel = |(f, i, j): (u32, u32, u32)| cube.distances[((f * n + j) * n + i) as usize];
     let mut out = Vec::with_capacity(6 * (n as usize + 2).pow(2));
     for face in 0..6 {
-        for j in -1..=n {
-            for i in -1..=n {
-                let (ci, cj) = (i.clamp(0, n - 1), j.clamp(0, n - 1));
-                out.push(if i == ci || j == cj {
-                    texel(face, i, j)
-                } else {
-                    (texel(face, ci, cj) + texel(face, i, cj) + texel(face, ci, j)) / 3.0
+        for j in -1..=n as i64 {
+            for i in -1..=n as i64 {
+                let s = sources(face, i, j, n);
+                out.push(match s.count {
+                    1 => texel(s.texels[0]),
+                    _ => (texel(s.texels[0]) + texel(s.texels[1]) + texel(s.texels[2])) / 3.0,
                 });
             }
         }
