@@ -106,26 +106,33 @@ impl CubeAtlas {
     pub fn fill_borders(&self, texels: &mut [f32]) {
         let face_len = self.face_texels();
         let at = |f: u32, m: u32, i: i64, j: i64| (f as usize * face_len + self.texel(m, i, j)) * 4;
-        for m in 0..self.levels {
-            let n = level_side(self.size, m);
-            for face in 0..6 {
-                for t in 0..4 * n + 4 {
-                    let (i, j) = border_texel(t, n);
-                    let s = sources(face, i, j, n);
-                    let texel = |(f, i, j): (u32, u32, u32)| {
-                        let k = at(f, m, i as i64, j as i64);
-                        [texels[k], texels[k + 1], texels[k + 2], texels[k + 3]]
-                    };
-                    let mut c = texel(s.texels[0]);
-                    if s.count == 3 {
-                        let (b, d) = (texel(s.texels[1]), texel(s.texels[2]));
-                        c = std::array::from_fn(|k| (c[k] + b[k] + d[k]) / 3.0);
-                    }
-                    let k = at(face, m, i, j);
-                    texels[k..k + 4].copy_from_slice(&c);
-                }
+        for (m, face, (i, j), s) in self.ring() {
+            let texel = |(f, i, j): (u32, u32, u32)| {
+                let k = at(f, m, i as i64, j as i64);
+                [texels[k], texels[k + 1], texels[k + 2], texels[k + 3]]
+            };
+            let mut c = texel(s.texels[0]);
+            if s.count == 3 {
+                let (b, d) = (texel(s.texels[1]), texel(s.texels[2]));
+                c = std::array::from_fn(|k| (c[k] + b[k] + d[k]) / 3.0);
             }
+            let k = at(face, m, i, j);
+            texels[k..k + 4].copy_from_slice(&c);
         }
+    }
+
+    /// Every border texel, level after level, face after face, in [`border_texel`]'s order:
+    /// its level, face, (i, j) and sources.
+    fn ring(&self) -> impl Iterator<Item = (u32, u32, (i64, i64), Sources)> + '_ {
+        (0..self.levels).flat_map(move |m| {
+            let n = level_side(self.size, m);
+            (0..6).flat_map(move |face| {
+                (0..4 * n + 4).map(move |t| {
+                    let (i, j) = border_texel(t, n);
+                    (m, face, (i, j), sources(face, i, j, n))
+                })
+            })
+        })
     }
 
     /// The cube map's texels in `layout`'s order from its atlas images (as
@@ -149,18 +156,9 @@ impl CubeAtlas {
     /// count, what [`BorderPass`] reads.
     pub fn border_map(&self) -> Vec<[u32; 4]> {
         let pack = |(f, i, j): (u32, u32, u32)| f << 28 | j << 14 | i;
-        let mut map = Vec::new();
-        for m in 0..self.levels {
-            let n = level_side(self.size, m);
-            for face in 0..6 {
-                for t in 0..4 * n + 4 {
-                    let (i, j) = border_texel(t, n);
-                    let s = sources(face, i, j, n);
-                    map.push([pack(s.texels[0]), pack(s.texels[1]), pack(s.texels[2]), s.count]);
-                }
-            }
-        }
-        map
+        self.ring()
+            .map(|(.., s)| [pack(s.texels[0]), pack(s.texels[1]), pack(s.texels[2]), s.count])
+            .collect()
     }
 }
 

@@ -65,22 +65,9 @@ const DEPTH_REFINE: u32 = 4u;
 
 // The distance of depth cube `depth` (face size n, stored with a one-texel border: shell.rs
 // `bordered_depth_faces`) in direction q (not normalized): cube_bilinear's seamless lookup,
-// the border holding the texels it fetches beyond the face's edges and corners.
+// a depth cube being a cube map's atlas of one level.
 fn depth_distance(depth: texture_2d_array<f32>, n: u32, q: vec3<f32>) -> f32 {
-    let face = i32(cube_face(q));
-    let st = face_st(u32(face), q);
-    let u = st.x * f32(n) - 0.5;
-    let v = st.y * f32(n) - 0.5;
-    let i0 = floor(u);
-    let j0 = floor(v);
-    let a = u - i0;
-    let b = v - j0;
-    let i = i32(i0) + 1;
-    let j = i32(j0) + 1;
-    var acc = ((1.0 - a) * (1.0 - b)) * textureLoad(depth, vec2<i32>(i, j), face, 0).x;
-    acc = acc + (a * (1.0 - b)) * textureLoad(depth, vec2<i32>(i + 1, j), face, 0).x;
-    acc = acc + ((1.0 - a) * b) * textureLoad(depth, vec2<i32>(i, j + 1), face, 0).x;
-    return acc + (a * b) * textureLoad(depth, vec2<i32>(i + 1, j + 1), face, 0).x;
+    return cube_bilinear(depth, n, q, 0u).x;
 }
 
 // f(t) = |q0 + t·r| − D(q0 + t·r): negative in front of a depth shell, ≥ 0 behind it.
