@@ -16,6 +16,7 @@ pub mod blend;
 pub mod cache;
 pub mod camera;
 pub mod cube_atlas;
+pub mod cube_border;
 pub mod decode;
 pub mod error;
 pub mod frame;

@@ -21,7 +21,7 @@ use pis_format::mip::mip_size;
 use pis_format::reconstruct::face_len;
 use pis_format::texture::LevelLayout;
 
-use crate::cube_atlas::BorderPass;
+use crate::cube_border::BorderPass;
 use crate::gpu::Gpu;
 use crate::mip::{storage_name, MipBuilder};
 use crate::shell::ShellTexture;
