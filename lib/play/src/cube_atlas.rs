@@ -188,11 +188,21 @@ pub fn sources(face: u32, i: i64, j: i64, n: u32) -> Sources {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use glam::DVec3;
     use pis_compile::filter::Taps;
     use pis_compile::shell::cube::{cube_bilinear, cube_face, face_st};
+
+    /// A lattice of nonzero directions over about [−1, 1]³: every face's interior, its
+    /// edges (two equal coordinates) and the cube's corners.
+    pub(crate) fn direction_lattice() -> impl Iterator<Item = DVec3> {
+        let axis = |k: i32| k as f64 / 10.0 + 0.013 * (k % 3) as f64;
+        (-10..=10)
+            .flat_map(|x| (-10..=10).flat_map(move |y| (-10..=10).map(move |z| (x, y, z))))
+            .map(move |(x, y, z)| DVec3::new(axis(x), axis(y), axis(z)))
+            .filter(|d| *d != DVec3::ZERO)
+    }
 
     /// shell.wgsl's `cube_bilinear` on the atlas images, in f64: level m's four texels
     /// around (u, v), one texel in from the level's origin.
@@ -224,15 +234,7 @@ mod tests {
             (0..layout.texel_count() * 4).map(|k| 1.0 + ((k * 37) % 101) as f32).collect();
         let a = CubeAtlas::of(&layout);
         let atlas = a.border(&layout, &rgba);
-        // A lattice of directions over about [−1, 1]³: every face's interior, its edges
-        // (two equal coordinates) and the cube's corners.
-        let axis = |k: i32| k as f64 / 10.0 + 0.013 * (k % 3) as f64;
-        let lattice = (-10..=10)
-            .flat_map(|x| (-10..=10).flat_map(move |y| (-10..=10).map(move |z| (x, y, z))));
-        for d in lattice.map(|(x, y, z)| DVec3::new(axis(x), axis(y), axis(z))) {
-            if d == DVec3::ZERO {
-                continue;
-            }
+        for d in direction_lattice() {
             for m in 0..layout.levels {
                 let mut taps = Taps::default();
                 cube_bilinear(&layout, d, m, 1.0, &mut taps);

@@ -681,15 +681,7 @@ mod tests {
         let bordered = bordered_depth_faces(&cube);
         assert_eq!(bordered.len(), 6 * (n as usize + 2).pow(2));
         let mut taps = Taps::default();
-        // A lattice of directions over about [−1, 1]³: every face's interior, its edges
-        // (two equal coordinates) and the cube's corners.
-        let axis = |k: i32| k as f64 / 10.0 + 0.013 * (k % 3) as f64;
-        let lattice = (-10..=10)
-            .flat_map(|x| (-10..=10).flat_map(move |y| (-10..=10).map(move |z| (x, y, z))));
-        for q in lattice.map(|(x, y, z)| DVec3::new(axis(x), axis(y), axis(z))) {
-            if q == DVec3::ZERO {
-                continue;
-            }
+        for q in crate::cube_atlas::tests::direction_lattice() {
             let want = cube.distance(q, &mut taps);
             let got = bordered_bilinear(&bordered, n, q);
             assert!((want - got).abs() <= 1e-6 * want, "{q}: {want} against {got}");
