@@ -21,20 +21,57 @@ pub fn compensate(values: &mut [f32], g: f32) {
 
 /// `sign(v) · |v|^g` in place: linear values from decoded, summed pyramid values. The
 /// writers' gamma, [`DEFAULT_GAMMA`] = 2.2, takes [`pow_11_5`], four times faster than
-/// `powf` and closer to |v|^2.2; other exponents take `powf`.
+/// `powf` and closer to |v|^2.2, in the widest vectors the processor has
+/// ([`uncompensate_default`]); other exponents take `powf`.
 pub fn uncompensate(values: &mut [f32], g: f32) {
     if g == DEFAULT_GAMMA {
-        values.iter_mut().for_each(|v| *v = pow_11_5(*v));
+        uncompensate_default(values);
     } else if g != 1.0 {
         values.iter_mut().for_each(|v| *v = v.signum() * v.abs().powf(g));
     }
+}
+
+/// [`pow_11_5`] over `values`, compiled three times on x86-64 and chosen at run time: for
+/// AVX-512, for AVX2 and for the baseline. The arithmetic is the same IEEE operations in
+/// the same order at every width (Rust never fuses a multiply and an add), so the bits are
+/// the same on every processor; AVX-512 takes a quarter of the baseline's time.
+fn uncompensate_default(values: &mut [f32]) {
+    #[cfg(target_arch = "x86_64")]
+    {
+        if std::arch::is_x86_feature_detected!("avx512f") {
+            // SAFETY: the processor has AVX-512F, checked above.
+            return unsafe { pow_11_5_avx512(values) };
+        }
+        if std::arch::is_x86_feature_detected!("avx2") {
+            // SAFETY: the processor has AVX2, checked above.
+            return unsafe { pow_11_5_avx2(values) };
+        }
+    }
+    pow_11_5_each(values);
+}
+
+#[inline(always)]
+fn pow_11_5_each(values: &mut [f32]) {
+    values.iter_mut().for_each(|v| *v = pow_11_5(*v));
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f")]
+fn pow_11_5_avx512(values: &mut [f32]) {
+    pow_11_5_each(values);
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+fn pow_11_5_avx2(values: &mut [f32]) {
+    pow_11_5_each(values);
 }
 
 /// `sign(v) · |v|^(11/5)` as |v|² · |v|^(1/5), the fifth root by three Newton steps from a
 /// guess made of the exponent bits (y ← 0.8 y + 0.2 |v| / y⁴): within 2.4e-7 of the exact
 /// value relative to it for |v| from 1e-12 to 1e6, where `powf(2.2f32)` is within 1.4e-6.
 /// Branch-free apart from infinity, so the loop over a level image vectorizes.
-#[inline]
+#[inline(always)]
 pub fn pow_11_5(v: f32) -> f32 {
     let a = v.abs();
     let mut y = f32::from_bits(a.to_bits() / 5 + 0x32CC_CCCD);
@@ -136,12 +173,43 @@ mod tests {
             }
         };
         assert_eq!(DEFAULT_GAMMA.to_bits(), 0x400C_CCCD);
-        for b in (0..0x7F80_0000u32).step_by(4099).chain([0x7F80_0000]) {
-            for v in [f32::from_bits(b), -f32::from_bits(b)] {
-                let mut x = [v];
-                uncompensate(&mut x, DEFAULT_GAMMA);
-                assert_eq!(x[0].to_bits(), spec(v).to_bits(), "{v:e}");
-            }
+        let values: Vec<f32> = (0..0x7F80_0000u32)
+            .step_by(4099)
+            .chain([0x7F80_0000])
+            .flat_map(|b| [f32::from_bits(b), -f32::from_bits(b)])
+            .collect();
+        // One value at a time (the vector loops' scalar tail) and the whole slice at once
+        // (their vector bodies, at the processor's widest width).
+        let mut whole = values.clone();
+        uncompensate(&mut whole, DEFAULT_GAMMA);
+        for (&v, w) in values.iter().zip(&whole) {
+            let mut x = [v];
+            uncompensate(&mut x, DEFAULT_GAMMA);
+            assert_eq!(x[0].to_bits(), spec(v).to_bits(), "{v:e}");
+            assert_eq!(w.to_bits(), spec(v).to_bits(), "{v:e} in a slice");
+        }
+    }
+
+    /// Every width the processor has gives the baseline's bits.
+    #[cfg(target_arch = "x86_64")]
+    #[test]
+    fn the_vector_widths_give_the_same_bits() {
+        let values: Vec<f32> =
+            (0..0x7F80_0000u32).step_by(7919).map(|b| f32::from_bits(b ^ (b << 31))).collect();
+        let mut base = values.clone();
+        pow_11_5_each(&mut base);
+        let same = |w: &[f32]| w.iter().zip(&base).all(|(a, b)| a.to_bits() == b.to_bits());
+        if std::arch::is_x86_feature_detected!("avx2") {
+            let mut w = values.clone();
+            // SAFETY: the processor has AVX2, checked above.
+            unsafe { pow_11_5_avx2(&mut w) };
+            assert!(same(&w), "AVX2");
+        }
+        if std::arch::is_x86_feature_detected!("avx512f") {
+            let mut w = values.clone();
+            // SAFETY: the processor has AVX-512F, checked above.
+            unsafe { pow_11_5_avx512(&mut w) };
+            assert!(same(&w), "AVX-512");
         }
     }
 

@@ -107,28 +107,34 @@ pub fn decode_level(reader: &PisReader, job: &LevelJob) -> Result<Vec<f32>, Play
 
 /// The linear texture of a job (SPEC.md 8.4 steps 2–4): the level images summed (top first,
 /// as the encoder's prediction), inverse gamma, stored MIP residuals added to the decimated
-/// finest level; every plane of the level layout, in its order.
+/// finest level; every plane of the level layout, in its order. For a reduced texture; at
+/// full resolution [`assemble`] and [`assemble_cube`] rebuild in one pass ([`linear_span`]).
 fn reconstruct(job: &AssembleJob) -> Vec<f32> {
     let n: usize =
         job.layout.planes().iter().map(|p| (p.width * p.height * p.channels) as usize).sum();
-    // Element by element, so chunks on the workers give the values `finish` gives: the sum
-    // starts as the top level's copy (0 + v is v).
-    let mut sum = match job.levels.first() {
-        Some(top) => top[..n].to_vec(),
-        None => vec![0.0f32; n],
-    };
-    sum.par_chunks_mut(CHUNK).enumerate().for_each(|(k, out)| {
-        let (at, len) = (k * CHUNK, out.len());
-        for img in job.levels.iter().skip(1) {
-            out.iter_mut().zip(&img[at..at + len]).for_each(|(a, v)| *a += v);
-        }
-        pis_codec::gamma::uncompensate(out, job.layer.gamma);
-    });
+    let mut sum = vec![0.0f32; n];
+    sum.par_chunks_mut(CHUNK).enumerate().for_each(|(k, out)| linear_span(job, k * CHUNK, out));
     if job.layer.mip_mode == MipMode::Stored && job.layout.mips > 1 {
         sum.par_chunks_exact_mut(face_len(&job.layout))
             .for_each(|face| add_stored_mips(&job.layout, face));
     }
     sum
+}
+
+/// Values `at..at + out.len()` of a job's planes, linear (SPEC.md 8.4 steps 2–3): the level
+/// images summed top first (the sum starts as the top level's copy, as the reader's does)
+/// and inverse gamma. Element by element, so any split of a texture into spans gives the
+/// values the whole gives.
+fn linear_span(job: &AssembleJob, at: usize, out: &mut [f32]) {
+    let len = out.len();
+    match job.levels.first() {
+        Some(top) => out.copy_from_slice(&top[at..at + len]),
+        None => out.fill(0.0),
+    }
+    for img in job.levels.iter().skip(1) {
+        out.iter_mut().zip(&img[at..at + len]).for_each(|(a, v)| *a += v);
+    }
+    pis_codec::gamma::uncompensate(out, job.layer.gamma);
 }
 
 /// Values per parallel piece of a texture's sum and inverse gamma.
@@ -163,9 +169,43 @@ fn level_rgba(level: &[f32], c: u32, out: &mut [f32]) {
     }
 }
 
-/// Rebuilds a texture: [`reconstruct`], the finest level decimated `drop_levels` times,
-/// padded to powers of two.
+/// Rebuilds a texture: its finest level, linear, decimated `drop_levels` times, padded to
+/// powers of two with its last column and row. At full resolution in one pass, bands of
+/// rows on the workers: each band's values summed, inverse gamma and written as RGBA.
 pub fn assemble(job: &AssembleJob) -> TextureImage {
+    if job.drop_levels > 0 {
+        return assemble_reduced(job);
+    }
+    let (w, h, c) = (job.layout.width, job.layout.height, job.layout.channels);
+    let (pw, ph) = (w.next_power_of_two(), h.next_power_of_two());
+    let (row_in, row_out) = ((w * c) as usize, pw as usize * 4);
+    let mut rgba = vec![0.0f32; row_out * ph as usize];
+    let band = (CHUNK / row_in).max(1);
+    let (used, pad) = rgba.split_at_mut(row_out * h as usize);
+    used.par_chunks_mut(row_out * band).enumerate().for_each(|(k, out)| {
+        let mut linear = vec![0.0f32; out.len() / row_out * row_in];
+        linear_span(job, k * band * row_in, &mut linear);
+        for (row, o) in linear.chunks_exact(row_in).zip(out.chunks_exact_mut(row_out)) {
+            padded_row(row, c, o);
+        }
+    });
+    let last = &used[used.len() - row_out..];
+    pad.chunks_exact_mut(row_out).for_each(|o| o.copy_from_slice(last));
+    TextureImage { width: w, height: h, padded_width: pw, padded_height: ph, rgba }
+}
+
+/// A row of `c`-channel texels as RGBA at the start of `out`, its last texel repeated to
+/// the end.
+fn padded_row(row: &[f32], c: u32, out: &mut [f32]) {
+    let (used, pad) = out.split_at_mut(row.len() / c as usize * 4);
+    level_rgba(row, c, used);
+    let last = &used[used.len() - 4..];
+    pad.chunks_exact_mut(4).for_each(|t| t.copy_from_slice(last));
+}
+
+/// [`assemble`] at a resolution reduction: [`reconstruct`], the finest level decimated
+/// `drop_levels` times.
+fn assemble_reduced(job: &AssembleJob) -> TextureImage {
     let (w0, h0, c) = (job.layout.width, job.layout.height, job.layout.channels);
     let mut finest = reconstruct(job);
     finest.truncate((w0 * h0 * c) as usize);
@@ -179,43 +219,43 @@ pub fn assemble(job: &AssembleJob) -> TextureImage {
     let (row_in, row_out) = ((w * c) as usize, pw as usize * 4);
     for (j, out) in rgba.chunks_exact_mut(row_out).enumerate() {
         let src = (j as u32).min(h - 1) as usize * row_in;
-        let (used, pad) = out.split_at_mut(w as usize * 4);
-        level_rgba(&finest[src..src + row_in], c, used);
-        let last = &used[used.len() - 4..];
-        pad.chunks_exact_mut(4).for_each(|t| t.copy_from_slice(last));
+        padded_row(&finest[src..src + row_in], c, out);
     }
     TextureImage { width: w, height: h, padded_width: pw, padded_height: ph, rgba }
 }
 
-/// One face's MIP chain of a reconstructed shell texture (`face`: its stored planes): its
-/// stored levels (mip mode `stored`), or level 0 decimated down to 1×1 (mip mode
-/// `decimated`, SPEC.md 8.3); from level `drop` down, as RGBA texels written inside their
-/// levels of the face's atlas image `image` (of `atlas`, whose level 0 is level `drop`).
-fn face_chain(
-    layout: &LevelLayout,
-    face: &[f32],
-    drop: u32,
-    (atlas, image): (&CubeAtlas, &mut [f32]),
-) {
+/// One face's MIP chain of a shell texture (face `f` of the job's planes), rebuilt level by
+/// level: each stored level's values linear ([`linear_span`]), a stored MIP level with the
+/// finest level decimated to its size added (mip mode `stored`, as
+/// `pis_format::reconstruct::add_stored_mips`), the levels below the stored ones each the
+/// previous decimated (SPEC.md 8.3); from level `drop` down, as RGBA texels written inside
+/// their levels of the face's atlas image `image` (of `atlas`, whose level 0 is level `drop`).
+fn face_chain(job: &AssembleJob, f: usize, drop: u32, (atlas, image): (&CubeAtlas, &mut [f32])) {
+    let layout = &job.layout;
     let (n, c) = (layout.width, layout.channels);
-    let levels = pis_format::mip::mip_count(n, n);
-    let mut at = 0;
-    let mut coarser: Vec<f32> = Vec::new();
-    for m in 0..levels {
+    let residuals = job.layer.mip_mode == MipMode::Stored && layout.mips > 1;
+    let mut at = f * face_len(layout);
+    let mut level: Vec<f32> = Vec::new();
+    // The finest level decimated to the current level's size, for stored residuals.
+    let mut finest: Vec<f32> = Vec::new();
+    for m in 0..pis_format::mip::mip_count(n, n) {
         let (w, h) = mip_size(n, n, m);
         let len = (w * h * c) as usize;
-        let level: &[f32] = if m < layout.mips {
+        if m < layout.mips {
+            level.resize(len, 0.0);
+            linear_span(job, at, &mut level);
             at += len;
-            &face[at - len..at]
+            if residuals && m == 0 {
+                finest.clone_from(&level);
+            } else if residuals {
+                let (pw, ph) = mip_size(n, n, m - 1);
+                finest = decimate(&finest, pw, ph, c);
+                level.iter_mut().zip(&finest).for_each(|(v, d)| *v += d);
+            }
         } else {
             let (pw, ph) = mip_size(n, n, m - 1);
-            coarser = if m == layout.mips {
-                decimate(&face[at - (pw * ph * c) as usize..at], pw, ph, c)
-            } else {
-                decimate(&coarser, pw, ph, c)
-            };
-            &coarser
-        };
+            level = decimate(&level, pw, ph, c);
+        }
         if m >= drop {
             for (j, row) in level.chunks_exact((w * c) as usize).enumerate() {
                 let start = atlas.texel(m - drop, 0, j as i64) * 4;
@@ -225,12 +265,11 @@ fn face_chain(
     }
 }
 
-/// Rebuilds a shell's cube map: [`reconstruct`], each face's MIP chain from its finest drawn
-/// level (level `drop_levels` of the stored chain, for a resolution reduction) down to 1×1,
+/// Rebuilds a shell's cube map: each face's MIP chain from its finest drawn level (level
+/// `drop_levels` of the stored chain, for a resolution reduction) down to 1×1 ([`face_chain`]),
 /// as RGBA (a 3-channel shell opaque: alpha 1), bordered into its atlas; the faces on the
 /// workers.
 pub fn assemble_cube(job: &AssembleJob) -> CubeImage {
-    let linear = reconstruct(job);
     let full = TextureLayout::cube(job.layout.width);
     let drop = job.drop_levels.min(full.levels - 1);
     let (size, _) = full.level_size(drop);
@@ -240,8 +279,8 @@ pub fn assemble_cube(job: &AssembleJob) -> CubeImage {
     let mut texels = vec![0.0f32; per_face * 6];
     texels
         .par_chunks_exact_mut(per_face)
-        .zip(linear.par_chunks_exact(face_len(&job.layout)))
-        .for_each(|(image, face)| face_chain(&job.layout, face, drop, (&atlas, image)));
+        .enumerate()
+        .for_each(|(f, image)| face_chain(job, f, drop, (&atlas, image)));
     atlas.fill_borders(&mut texels);
     CubeImage { layout, atlas, texels }
 }
@@ -325,6 +364,48 @@ mod tests {
 
     fn values(n: usize) -> Vec<f32> {
         (0..n).map(|k| ((k as u64 * 2654435761 % 1000) as f32) / 1000.0).collect()
+    }
+
+    /// The reader's texture (`pis_format::reconstruct::finish` on the level images summed
+    /// top first) as RGBA texels, `c` channels a texel.
+    fn readers_rgba(job: &AssembleJob) -> Vec<f32> {
+        let mut sum = job.levels[0].to_vec();
+        for img in &job.levels[1..] {
+            sum.iter_mut().zip(img.iter()).for_each(|(a, v)| *a += v);
+        }
+        let linear = pis_format::reconstruct::finish(job.layer, &job.layout, sum);
+        let mut rgba = vec![0.0; linear.len() / job.layout.channels as usize * 4];
+        level_rgba(&linear, job.layout.channels, &mut rgba);
+        rgba
+    }
+
+    #[test]
+    fn the_one_pass_rebuild_gives_the_readers_values_bit_for_bit() {
+        // A surface of several bands of rows, not a power of two wide or high.
+        let layer = Layer { mapping: Mapping::Surface, ..shell_layer(3, MipMode::Decimated) };
+        let layout = LevelLayout { width: 300, height: 50, channels: 3, faces: 1, mips: 1 };
+        let linear: Vec<f32> = values(300 * 50 * 3).iter().map(|v| 4.0 * v - 1.0).collect();
+        let surface = job(&layer, &layout, &linear, 0);
+        const { assert!(CHUNK / 900 < 50, "one band would hold every row") };
+        let img = assemble(&surface);
+        let want = readers_rgba(&surface);
+        for j in 0..img.padded_height as usize {
+            for i in 0..img.padded_width as usize {
+                let src = (j.min(49) * 300 + i.min(299)) * 4;
+                let got = &img.rgba[(j * 512 + i) * 4..(j * 512 + i) * 4 + 4];
+                assert_eq!(got, &want[src..src + 4], "texel ({i}, {j})");
+            }
+        }
+        // A cube map with stored MIP residuals, 4 channels.
+        let layer = shell_layer(4, MipMode::Stored);
+        let layout =
+            LevelLayout { width: 9, height: 9, channels: 4, faces: 6, mips: mip_count(9, 9) };
+        let n: usize = layout.planes().iter().map(|p| (p.width * p.height * 4) as usize).sum();
+        let linear: Vec<f32> = values(n).iter().map(|v| 3.0 * v - 0.5).collect();
+        let cube = job(&layer, &layout, &linear, 0);
+        let got = assemble_cube(&cube).rgba();
+        assert_eq!(got.len(), n / 4 * 4);
+        assert!(got.iter().zip(readers_rgba(&cube)).all(|(a, b)| a == &b));
     }
 
     #[test]

@@ -131,6 +131,38 @@ fn the_next_frame_prepared_ahead_waits_on_nothing_and_draws_the_same() {
     }
 }
 
+/// A level image used only through a texture rebuilt ahead is used by the frame that draws
+/// that texture: its lifetime counts from then, so a motion that comes back to a sample
+/// within the lifetime finds its level images decoded.
+#[test]
+fn level_images_of_textures_rebuilt_ahead_live_from_the_frame_that_draws_them() {
+    let name = "level_images_of_textures_rebuilt_ahead_live_from_the_frame_that_draws_them";
+    let Some(gpu) = gpu_or_skip(name) else { return };
+    // Leaves live 3 frames since their last use; every point of tiny.pis (view × light) in
+    // turn, each texture drawn two frames in four, the next frame's textures prepared ahead.
+    let options = PlayerOptions {
+        workers: 1,
+        msaa: 1,
+        rebuild: Rebuild::Workers,
+        lifetime_a: 3,
+        ..Default::default()
+    };
+    let mut player = Player::open(Arc::new(gpu), &tiny(), options).unwrap();
+    let size = player.image_size();
+    let cycle = [[0, 0], [1, 0], [1, 1], [0, 1]];
+    let mut reads = Vec::new();
+    let mut ahead = 0;
+    for f in 0..16 {
+        let next = at(&player, &cycle[(f + 1) % 4]);
+        player.prefetch(std::slice::from_ref(&next));
+        let (_, s) = player.render_image(&at(&player, &cycle[f % 4]), size).unwrap();
+        ahead += s.rebuilt_ahead;
+        reads.push(player.reader().stats().codestreams);
+    }
+    assert!(ahead >= 8, "{ahead} textures rebuilt ahead: the path does not test them");
+    assert_eq!(reads[15], reads[3], "codestreams read after each frame: {reads:?}");
+}
+
 /// The GPU's rebuild and the workers' draw the same frames (every texture of tiny.pis: a
 /// surface texture and a shell's cube map with stored MIP levels).
 #[test]

@@ -126,10 +126,13 @@ impl Textures {
         stats.decode_waits += waited as u64;
         let (mut surfaces, mut shells) = (Vec::new(), Vec::new());
         let (mut images, mut cubes) = (Vec::new(), Vec::new());
-        let prefetch = &mut self.prefetch;
+        let (prefetch, cache) = (&mut self.prefetch, &mut self.cache);
         missing.retain(|k| match prefetch.take_image(k) {
             Some(rebuilt) => {
+                // The frame draws the texture rebuilt from these level images: they are used
+                // now, and their lifetimes count from this frame (thesis 4.7).
                 let keys = k.images.iter().enumerate().map(|(lv, &img)| level_key(k, lv, img));
+                keys.clone().for_each(|key| _ = cache.get(&key));
                 stats.prefetched += keys.filter(|key| prefetch.take_ready(key)).count() as u64;
                 stats.rebuilt_ahead += 1;
                 match rebuilt {
