@@ -141,26 +141,45 @@ impl ObjectTexture {
     }
 }
 
+thread_local! {
+    /// Half floats on their way to a texture: one buffer per thread that uploads, grown to
+    /// the largest level and kept, so that an upload allocates and zeroes no fresh memory.
+    static HALVES: std::cell::RefCell<Vec<u16>> = const { std::cell::RefCell::new(Vec::new()) };
+}
+
 /// Writes RGBA values (4 a texel, rows of `size.0` texels) into level `mip` of array layer
 /// `layer` of `texture`: as they are into `Rgba32Float`, rounded to the nearest half floats
 /// into `Rgba16Float`. Returns the bytes written.
 pub(crate) fn write_level(
     gpu: &Gpu,
     texture: &wgpu::Texture,
-    (mip, layer): (u32, u32),
-    (w, h): (u32, u32),
+    at: (u32, u32),
+    size: (u32, u32),
     rgba: &[f32],
 ) -> u64 {
     use half::slice::{HalfBitsSliceExt, HalfFloatSliceExt};
-    let halves: Vec<u16>;
-    let bytes: &[u8] = if texture.format() == wgpu::TextureFormat::Rgba16Float {
-        let mut bits = vec![0u16; rgba.len()];
-        bits.reinterpret_cast_mut::<half::f16>().convert_from_f32_slice(rgba);
-        halves = bits;
-        bytemuck::cast_slice(&halves)
-    } else {
-        bytemuck::cast_slice(rgba)
-    };
+    if texture.format() != wgpu::TextureFormat::Rgba16Float {
+        return write_bytes(gpu, texture, at, size, bytemuck::cast_slice(rgba));
+    }
+    HALVES.with_borrow_mut(|bits| {
+        if bits.len() < rgba.len() {
+            bits.resize(rgba.len(), 0);
+        }
+        let halves = &mut bits[..rgba.len()];
+        halves.reinterpret_cast_mut::<half::f16>().convert_from_f32_slice(rgba);
+        write_bytes(gpu, texture, at, size, bytemuck::cast_slice(halves))
+    })
+}
+
+/// Writes texel bytes (rows of `size.0` texels) into level `mip` of array layer `layer` of
+/// `texture`. Returns the bytes written.
+fn write_bytes(
+    gpu: &Gpu,
+    texture: &wgpu::Texture,
+    (mip, layer): (u32, u32),
+    (w, h): (u32, u32),
+    bytes: &[u8],
+) -> u64 {
     gpu.queue.write_texture(
         wgpu::TexelCopyTextureInfo {
             texture,

@@ -50,8 +50,8 @@ enum Done {
         levels: Vec<Decoded>,
         image: Option<Rebuilt>,
     },
-    /// No longer predicted when a worker came to it.
-    Dropped(Vec<LevelKey>),
+    /// No longer predicted when a worker came to it: the texture, its level images.
+    Dropped(TextureKey, Vec<LevelKey>),
 }
 
 /// The work prepared ahead: in flight, and finished but not yet drawn.
@@ -66,6 +66,8 @@ pub(super) struct Prefetch {
     ready: HashSet<LevelKey>,
     /// Rebuilt ahead, not yet drawn.
     images: HashMap<TextureKey, Rebuilt>,
+    /// Textures whose rebuild is queued or running.
+    rebuilding: HashSet<TextureKey>,
     /// Level images dropped before they started (for the report).
     dropped: Arc<AtomicU64>,
 }
@@ -111,8 +113,14 @@ impl Prefetch {
             wanted: Arc::new(Mutex::new(HashSet::new())),
             ready: HashSet::new(),
             images: HashMap::new(),
+            rebuilding: HashSet::new(),
             dropped: Arc::new(AtomicU64::new(0)),
         }
+    }
+
+    /// Whether texture `key` is being rebuilt ahead (queued or running).
+    pub(super) fn rebuilding(&self, key: &TextureKey) -> bool {
+        self.rebuilding.contains(key)
     }
 
     /// Whether `key` is being decoded ahead.
@@ -146,6 +154,9 @@ impl Prefetch {
     ) {
         *lock(&self.wanted) = predicted;
         for t in jobs {
+            if t.rebuild.is_some() {
+                self.rebuilding.insert(t.key.clone());
+            }
             for (key, _, job) in &t.decode {
                 let bytes = pis_codec::value_count(&job.planes).unwrap_or(0) as u64 * 4;
                 self.in_flight.insert(*key, (t.key.clone(), bytes));
@@ -157,7 +168,7 @@ impl Prefetch {
                     prepare(&reader, t)
                 } else {
                     dropped.fetch_add(t.decode.len() as u64, Ordering::Relaxed);
-                    Done::Dropped(t.decode.into_iter().map(|j| j.0).collect())
+                    Done::Dropped(t.key, t.decode.into_iter().map(|j| j.0).collect())
                 };
                 // The player may be gone; its work with it.
                 let _ = tx.send(done);
@@ -166,17 +177,26 @@ impl Prefetch {
     }
 
     /// Moves finished work into `cache` (and the rebuilt textures aside), and waits until
-    /// none of `needed` is in flight (the textures whose jobs decode them are wanted from
-    /// now, so none is dropped). Returns whether it waited.
-    pub(super) fn collect(&mut self, cache: &mut LevelCache, needed: &[LevelKey]) -> bool {
-        let owners: Vec<TextureKey> =
-            needed.iter().filter_map(|k| self.in_flight.get(k)).map(|v| v.0.clone()).collect();
+    /// none of the `needed` level images is in flight and none of the `textures` is being
+    /// rebuilt (the textures whose jobs prepare them are wanted from now, so none is
+    /// dropped). Returns whether it waited.
+    pub(super) fn collect(
+        &mut self,
+        cache: &mut LevelCache,
+        needed: &[LevelKey],
+        textures: &[&TextureKey],
+    ) -> bool {
+        let owners = needed.iter().filter_map(|k| self.in_flight.get(k)).map(|v| v.0.clone());
+        let rebuilding = textures.iter().filter(|k| self.rebuilding.contains(**k));
+        let owners: Vec<TextureKey> = owners.chain(rebuilding.map(|k| (*k).clone())).collect();
         lock(&self.wanted).extend(owners);
         while let Ok(done) = self.rx.try_recv() {
             self.finish(done, cache);
         }
         let mut waited = false;
-        while needed.iter().any(|k| self.in_flight.contains_key(k)) {
+        while needed.iter().any(|k| self.in_flight.contains_key(k))
+            || textures.iter().any(|k| self.rebuilding.contains(*k))
+        {
             waited = true;
             match self.rx.recv() {
                 Ok(done) => self.finish(done, cache),
@@ -207,6 +227,7 @@ impl Prefetch {
     fn finish(&mut self, done: Done, cache: &mut LevelCache) {
         match done {
             Done::Prepared { key, levels, image } => {
+                self.rebuilding.remove(&key);
                 for (level, height, values) in levels {
                     self.in_flight.remove(&level);
                     // A failed decode is decoded again by the frame that needs it, which
@@ -220,7 +241,8 @@ impl Prefetch {
                     self.images.insert(key, image);
                 }
             }
-            Done::Dropped(levels) => {
+            Done::Dropped(key, levels) => {
+                self.rebuilding.remove(&key);
                 for level in levels {
                     self.in_flight.remove(&level);
                 }

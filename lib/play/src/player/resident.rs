@@ -122,7 +122,7 @@ impl Textures {
         for k in &missing {
             needed.extend(k.images.iter().enumerate().map(|(lv, &img)| level_key(k, lv, img)));
         }
-        let waited = self.prefetch.collect(&mut self.cache, &needed);
+        let waited = self.prefetch.collect(&mut self.cache, &needed, &missing);
         stats.decode_waits += waited as u64;
         let (mut surfaces, mut shells) = (Vec::new(), Vec::new());
         let (mut images, mut cubes) = (Vec::new(), Vec::new());
@@ -267,7 +267,10 @@ impl Textures {
                 r.last_frame = self.frame;
                 continue;
             }
-            if !wanted.insert((*k).clone()) || self.prefetch.has_image(k) {
+            if !wanted.insert((*k).clone())
+                || self.prefetch.has_image(k)
+                || self.prefetch.rebuilding(k)
+            {
                 continue;
             }
             let mut t = AheadTexture {
