@@ -14,6 +14,10 @@ pub const PREDICTED_PSNR_SETTING: &str = "predicted_psnr_db";
 /// decoded textures rounded to half floats against frames drawn from them in full. Absent
 /// where a texel lies beyond the half-float range (±65504).
 pub const HALF_FLOAT_PSNR_SETTING: &str = "half_float_psnr_db";
+/// The PSNR (dB, as [`HALF_FLOAT_PSNR_SETTING`]) of frames drawn from textures rebuilt from
+/// level images rounded to half floats against frames drawn from the textures as decoded.
+/// Absent where a level image's value lies beyond the half-float range.
+pub const HALF_LEVEL_PSNR_SETTING: &str = "half_level_psnr_db";
 
 /// How far below the coding error half-float rounding must lie for 16-bit textures: 20 dB,
 /// its squared error at most 1 % of the coding error's, so that the played PSNR drops by at
@@ -32,13 +36,23 @@ pub struct HalfFloatFit {
 impl HalfFloatFit {
     /// Both settings, where the provenance records them as finite decimal numbers.
     pub fn of(p: Option<&Provenance>) -> Option<HalfFloatFit> {
+        HalfFloatFit::of_setting(p, HALF_FLOAT_PSNR_SETTING)
+    }
+
+    /// What the file records of its level images rounded to half floats
+    /// ([`HALF_LEVEL_PSNR_SETTING`]) against its coding error.
+    pub fn of_levels(p: Option<&Provenance>) -> Option<HalfFloatFit> {
+        HalfFloatFit::of_setting(p, HALF_LEVEL_PSNR_SETTING)
+    }
+
+    fn of_setting(p: Option<&Provenance>, half: &str) -> Option<HalfFloatFit> {
         let number = |k: &str| {
             p.and_then(|p| p.setting(k))
                 .and_then(|v| v.trim().parse::<f64>().ok())
                 .filter(|v| v.is_finite())
         };
         Some(HalfFloatFit {
-            half_psnr_db: number(HALF_FLOAT_PSNR_SETTING)?,
+            half_psnr_db: number(half)?,
             coding_psnr_db: number(PREDICTED_PSNR_SETTING)?,
         })
     }
@@ -73,6 +87,14 @@ mod tests {
         assert!(fit.allows_half());
         let p = prov(&[(PREDICTED_PSNR_SETTING, "36.5"), (HALF_FLOAT_PSNR_SETTING, "56.4")]);
         assert!(!HalfFloatFit::of(Some(&p)).unwrap().allows_half());
+    }
+
+    #[test]
+    fn level_images_have_a_measurement_of_their_own() {
+        let p = prov(&[(PREDICTED_PSNR_SETTING, "30"), (HALF_LEVEL_PSNR_SETTING, "52")]);
+        assert_eq!(HalfFloatFit::of(Some(&p)), None);
+        let fit = HalfFloatFit::of_levels(Some(&p)).unwrap();
+        assert_eq!((fit.half_psnr_db, fit.allows_half()), (52.0, true));
     }
 
     #[test]

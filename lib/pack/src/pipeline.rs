@@ -296,6 +296,16 @@ pub fn pack_request(req: &PackRequest, progress: &dyn Progress) -> Result<PackRe
     if let (Some(p), Some(h)) = (packed.container.provenance.as_mut(), half_float_psnr) {
         p.settings.push((HALF_FLOAT_PSNR_SETTING.to_string(), format!("{h:.4}")));
     }
+    // And what 16-bit level images would cost a player that rebuilds on the GPU.
+    let half_level_psnr = predict::half_level_psnr(&set, &inferred, &packed)
+        .map_err(|e| Failure::new(Exit::Runtime, e))?;
+    stages.done(
+        "half-float level images",
+        &report::half_level_note(half_level_psnr, quality.overall),
+    );
+    if let (Some(p), Some(h)) = (packed.container.provenance.as_mut(), half_level_psnr) {
+        p.settings.push((HALF_LEVEL_PSNR_SETTING.to_string(), format!("{h:.4}")));
+    }
     let masters = if req.keep_master {
         let m = encode::masters(&inferred, &packed).map_err(|e| Failure::new(Exit::Runtime, e))?;
         let n: u64 = m.iter().map(pis_format::Master::payload_len).sum();
@@ -330,6 +340,7 @@ pub fn pack_request(req: &PackRequest, progress: &dyn Progress) -> Result<PackRe
     let mut report = report::build(&set, &inferred, &packed, &quality, bytes, exact, req, stages);
     report.probe_renderings = probe_renderings;
     report.half_float_psnr_db = half_float_psnr;
+    report.half_level_psnr_db = half_level_psnr;
     if let Some((master_bytes, exact)) = master {
         report.set_master(master_bytes, exact);
     }

@@ -1,6 +1,7 @@
 //! Textures rebuilt from their level images on the GPU (thesis 4.7, SPEC.md 8.4): the workers
 //! only decode codestreams; each decoded level image goes up once as a storage buffer of its
-//! own (compact: its channels only, kept while the level-image cache keeps the image), and a
+//! own (compact: its channels only, in 32-bit floats or, where the file allows it, rounded to
+//! 16-bit floats two to a word; kept while the level-image cache keeps the image), and a
 //! texture a frame needs is its level images stacked by buffer copies, summed, inverse gamma
 //! applied and widened to RGBA by compute passes (`rebuild.wgsl`):
 //! - a surface texture: one pass into the finest level of the padded layout, its MIP chain
@@ -75,8 +76,11 @@ struct Pass {
 }
 
 /// The rebuilding pipelines: surface textures and cube maps in the GPU's formats
-/// ([`Gpu::texture_format`], [`Gpu::cube_format`]).
+/// ([`Gpu::texture_format`], [`Gpu::cube_format`]), from level images of 32-bit or of 16-bit
+/// floats ([`LevelRebuild::level_buffer`]).
 pub struct LevelRebuild {
+    /// Level images are 16-bit floats.
+    half: bool,
     surface: Pass,
     cube_level: Pass,
     cube_decimate: Pass,
@@ -123,7 +127,12 @@ fn binding(gpu: &Gpu, n: u32) -> wgpu::BindGroupLayoutEntry {
 }
 
 impl Pass {
-    fn new(gpu: &Gpu, module: &wgpu::ShaderModule, name: &str, bindings: &[u32]) -> Pass {
+    fn new(
+        gpu: &Gpu,
+        (module, constants): (&wgpu::ShaderModule, &[(&str, f64)]),
+        name: &str,
+        bindings: &[u32],
+    ) -> Pass {
         let d = &gpu.device;
         let entries: Vec<_> = bindings.iter().map(|&n| binding(gpu, n)).collect();
         let layout = d.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
@@ -140,7 +149,10 @@ impl Pass {
             layout: Some(&pl),
             module,
             entry_point: Some(name),
-            compilation_options: Default::default(),
+            compilation_options: wgpu::PipelineCompilationOptions {
+                constants,
+                ..Default::default()
+            },
             cache: None,
         });
         Pass { layout, pipeline }
@@ -187,10 +199,9 @@ impl Pass {
 fn stacked(
     gpu: &Gpu,
     stack: &LevelStack,
-    plane: u32,
+    plane_bytes: u64,
     encoder: &mut wgpu::CommandEncoder,
 ) -> wgpu::Buffer {
-    let plane_bytes = plane as u64 * 4;
     if let [one] = stack.levels {
         return (*one).clone();
     }
@@ -237,17 +248,18 @@ fn gamma_mode(gamma: f32) -> u32 {
     }
 }
 
-/// Uploads a decoded level image as a storage buffer the rebuild reads.
-pub fn level_buffer(gpu: &Gpu, values: &[f32]) -> wgpu::Buffer {
-    gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-        label: Some("level image"),
-        contents: bytemuck::cast_slice(values),
-        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
-    })
+/// A level image's values as 16-bit floats (round to nearest even), two to a 32-bit word
+/// (the first in the low half, as WGSL's `unpack2x16float` reads them), the last word's
+/// high half 0 where the count is odd.
+pub fn half_words(values: &[f32]) -> Vec<u16> {
+    use half::slice::{HalfBitsSliceExt, HalfFloatSliceExt};
+    let mut bits = vec![0u16; values.len().next_multiple_of(2)];
+    bits[..values.len()].reinterpret_cast_mut::<half::f16>().convert_from_f32_slice(values);
+    bits
 }
 
 /// Whether a texture summed from `levels` level images of `values` values each fits the
-/// device's storage buffers (else it is rebuilt on the workers).
+/// device's storage buffers (else it is rebuilt on the workers), counted as 32-bit floats.
 pub fn fits(gpu: &Gpu, values: u64, levels: usize) -> bool {
     let bytes = values.saturating_mul(4).saturating_mul(levels as u64);
     levels > 0
@@ -256,7 +268,8 @@ pub fn fits(gpu: &Gpu, values: u64, levels: usize) -> bool {
 }
 
 impl LevelRebuild {
-    pub fn new(gpu: &Gpu) -> LevelRebuild {
+    /// The pipelines for level images of 16-bit floats where `half`, else of 32-bit floats.
+    pub fn new(gpu: &Gpu, half: bool) -> LevelRebuild {
         let source = include_str!("rebuild.wgsl")
             .replace("SURFACE_FORMAT", storage_name(gpu.texture_format))
             .replace("CUBE_FORMAT", storage_name(gpu.cube_format));
@@ -274,12 +287,48 @@ impl LevelRebuild {
             usage: wgpu::TextureUsages::TEXTURE_BINDING,
             view_formats: &[],
         });
+        let constants = [("HALF_LEVELS", half as u32 as f64)];
         LevelRebuild {
-            surface: Pass::new(gpu, &module, "rebuild", &[0, 1, 2]),
-            cube_level: Pass::new(gpu, &module, "cube_level", &[0, 1, 3, 4]),
-            cube_decimate: Pass::new(gpu, &module, "cube_decimate", &[0, 3, 4]),
+            half,
+            surface: Pass::new(gpu, (&module, &constants), "rebuild", &[0, 1, 2]),
+            cube_level: Pass::new(gpu, (&module, &constants), "cube_level", &[0, 1, 3, 4]),
+            cube_decimate: Pass::new(gpu, (&module, &constants), "cube_decimate", &[0, 3, 4]),
             no_source: level_view(&none, 0, wgpu::TextureViewDimension::D2Array),
             border: BorderPass::new(gpu),
+        }
+    }
+
+    /// Uploads a decoded level image as a storage buffer the rebuild reads: its values as they
+    /// are, or as 16-bit floats ([`half_words`]) where the pipelines read those.
+    pub fn level_buffer(&self, gpu: &Gpu, values: &[f32]) -> wgpu::Buffer {
+        let halves;
+        let contents: &[u8] = if self.half {
+            halves = half_words(values);
+            bytemuck::cast_slice(&halves)
+        } else {
+            bytemuck::cast_slice(values)
+        };
+        gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("level image"),
+            contents,
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+        })
+    }
+
+    /// The bytes of a level image of `values` values on the GPU.
+    pub fn level_bytes(&self, values: usize) -> u64 {
+        match self.half {
+            true => values.next_multiple_of(2) as u64 * 2,
+            false => values as u64 * 4,
+        }
+    }
+
+    /// The values from one level image to the next in a stack of `plane`-value images: the
+    /// plane, rounded up to whole words for 16-bit floats.
+    fn stride(&self, plane: u32) -> u32 {
+        match self.half {
+            true => plane.next_multiple_of(2),
+            false => plane,
         }
     }
 
@@ -296,9 +345,9 @@ impl LevelRebuild {
         let layout = texture.layout;
         let (aw, ah) = allocated_size(&layout);
         let plane = layout.width * layout.height * stack.channels;
-        let source = stacked(gpu, stack, plane, encoder);
-        let params =
-            Params { alloc: [aw, ah], ..Params::of(stack, [layout.width, layout.height], plane) };
+        let source = stacked(gpu, stack, self.level_bytes(plane as usize), encoder);
+        let used = [layout.width, layout.height];
+        let params = Params { alloc: [aw, ah], ..Params::of(stack, used, self.stride(plane)) };
         let finest = level_view(&texture.texture, 0, wgpu::TextureViewDimension::D2);
         let resources = [stack_binding(&source), (2, wgpu::BindingResource::TextureView(&finest))];
         let groups = [aw.div_ceil(8), ah.div_ceil(8), 1];
@@ -319,7 +368,7 @@ impl LevelRebuild {
     ) {
         let n = level_layout.width;
         let face_len = face_len(level_layout) as u32;
-        let source = stacked(gpu, stack, face_len * 6, encoder);
+        let source = stacked(gpu, stack, self.level_bytes(face_len as usize * 6), encoder);
         let stored = level_layout.mips.clamp(1, texture.layout.levels);
         let scratch = (stored > 1).then(|| scratch_chain(gpu, n, stored));
         let levels = scratch_chain(gpu, n, texture.layout.levels);
@@ -349,7 +398,7 @@ impl LevelRebuild {
                     offset,
                     face_len,
                     add: added.is_some() as u32,
-                    ..Params::of(stack, [w, w], face_len * 6)
+                    ..Params::of(stack, [w, w], self.stride(face_len * 6))
                 };
                 let src = added.as_ref().unwrap_or(&self.no_source);
                 let resources = [
@@ -436,6 +485,15 @@ fn copy_finest(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn half_words_hold_two_values_low_half_first() {
+        let bits = half_words(&[1.0, -2.0, 0.5]);
+        assert_eq!(bits, vec![0x3C00, 0xC000, 0x3800, 0]);
+        let bytes: &[u8] = bytemuck::cast_slice(&bits);
+        let word = u32::from_le_bytes([bytes[0], bytes[1], bytes[2], bytes[3]]);
+        assert_eq!(word, 0xC000_3C00, "the first value in the low half");
+    }
 
     #[test]
     fn the_gamma_mode_names_the_fast_path_for_the_default_gamma() {

@@ -19,7 +19,8 @@ struct Params {
     channels: u32,
     // Level images stacked in `stack`, top first.
     levels: u32,
-    // Values per level image: used.x * used.y * channels.
+    // Values from one level image to the next in `stack`: its values (used.x * used.y *
+    // channels), rounded up to whole words for 16-bit floats.
     plane: u32,
     // 0: identity (gamma 1), 1: pow_11_5 (gamma 2.2), 2: sign(v) |v|^gamma.
     mode: u32,
@@ -32,7 +33,10 @@ struct Params {
 };
 
 @group(0) @binding(0) var<uniform> p: Params;
-@group(0) @binding(1) var<storage, read> stack: array<f32>;
+// The level images: 32-bit floats, or where HALF_LEVELS 16-bit floats two to a word (the
+// first in the low half: rebuild.rs `half_words`).
+@group(0) @binding(1) var<storage, read> stack: array<u32>;
+override HALF_LEVELS: bool = false;
 @group(0) @binding(2) var dst: texture_storage_2d<SURFACE_FORMAT, write>;
 @group(0) @binding(3) var cube_dst: texture_storage_2d_array<CUBE_FORMAT, write>;
 @group(0) @binding(4) var src: texture_2d_array<f32>;
@@ -66,11 +70,19 @@ fn linear(v: f32) -> f32 {
     return sign(v) * pow(abs(v), p.gamma);
 }
 
+// Value `e` of the stacked level images, widened to 32 bits.
+fn level_value(e: u32) -> f32 {
+    if (HALF_LEVELS) {
+        return unpack2x16float(stack[e >> 1u])[e & 1u];
+    }
+    return bitcast<f32>(stack[e]);
+}
+
 // Channel `ch` of the texel at `at`: the level images summed, then the inverse gamma.
 fn value(at: u32, ch: u32) -> f32 {
-    var s = stack[at + ch];
+    var s = level_value(at + ch);
     for (var k = 1u; k < p.levels; k++) {
-        s = s + stack[k * p.plane + at + ch];
+        s = s + level_value(k * p.plane + at + ch);
     }
     return linear(s);
 }

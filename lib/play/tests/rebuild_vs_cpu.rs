@@ -4,7 +4,9 @@
 //! and power-of-two sizes, and the three gamma paths (identity, the default 2.2's
 //! `pow_11_5`, a general power); shells' cube maps against `assemble_cube`, every face and
 //! level, with stored MIP levels (all of them or the finest few) and decimated ones, and
-//! their atlases' borders against the CPU's bit for bit (cube_atlas.rs). Sums alone are
+//! their atlases' borders against the CPU's bit for bit (cube_atlas.rs). Each from level
+//! images of 32-bit floats and of 16-bit floats (`LevelRebuild::new(gpu, true)`), against
+//! the workers' rebuild of the same level images rounded to half floats. Sums alone are
 //! bit-exact; with an inverse gamma the GPU's division and power may round
 //! differently, held to 90 dB.
 
@@ -18,9 +20,9 @@ use pis_format::texture::LevelLayout;
 use pis_format::{Combine, DepMask, Layer, LayerKind, Mapping, MipMode, StreamRef, Term};
 use pis_play::decode::{assemble, assemble_cube, AssembleJob};
 use pis_play::mip::{read_levels, MipBuilder};
-use pis_play::rebuild::{level_buffer, LevelRebuild, LevelStack};
+use pis_play::rebuild::{LevelRebuild, LevelStack};
 use pis_play::shell::{read_atlas, read_cube};
-use pis_play::ShellTexture;
+use pis_play::{Gpu, ShellTexture};
 
 fn surface_layer(channels: u8, gamma: f32) -> Layer<StreamRef> {
     layer(Mapping::Surface, channels, MipMode::Decimated, gamma)
@@ -55,6 +57,15 @@ fn level_images(n: usize, count: usize, seed: u64) -> Vec<Vec<f32>> {
             }
         })
         .collect()
+}
+
+/// `images` as the GPU rebuild reads them: as they are, or rounded to half floats.
+fn as_read(images: Vec<Vec<f32>>, half: bool) -> Vec<Vec<f32>> {
+    if !half {
+        return images;
+    }
+    let round = |v: &f32| half::f16::from_f32(*v).to_f32();
+    images.iter().map(|img| img.iter().map(round).collect()).collect()
 }
 
 /// The workers' texture as the GPU holds it: the padded finest level from `assemble`, then
@@ -94,8 +105,19 @@ fn cpu_levels(job: &AssembleJob, padded: &[(u32, u32)]) -> Vec<Vec<f32>> {
 fn the_gpu_rebuild_equals_the_workers_rebuild() {
     let Some(gpu) = gpu_or_skip("the_gpu_rebuild_equals_the_workers_rebuild") else { return };
     let mips = MipBuilder::new(&gpu);
-    let rebuild = LevelRebuild::new(&gpu);
     let exact_format = gpu.texture_format == wgpu::TextureFormat::Rgba32Float;
+    for half in [false, true] {
+        let rebuild = LevelRebuild::new(&gpu, half);
+        surfaces_against_the_workers(&gpu, &mips, (&rebuild, half), exact_format);
+    }
+}
+
+fn surfaces_against_the_workers(
+    gpu: &Gpu,
+    mips: &MipBuilder,
+    (rebuild, half): (&LevelRebuild, bool),
+    exact_format: bool,
+) {
     let cases: [(u32, u32, u8, usize, f32); 7] = [
         (13, 7, 3, 3, 2.2),
         (16, 16, 3, 1, 2.2),
@@ -106,22 +128,23 @@ fn the_gpu_rebuild_equals_the_workers_rebuild() {
         (21, 11, 3, 3, 1.8),
     ];
     for (seed, (w, h, c, count, gamma)) in cases.into_iter().enumerate() {
-        let what = format!("{w}x{h}, {c} channels, {count} levels, gamma {gamma}");
+        let what = format!("{w}x{h}, {c} channels, {count} levels, gamma {gamma}, half {half}");
         let layer = surface_layer(c, gamma);
         let layout = LevelLayout { width: w, height: h, channels: c as u32, faces: 1, mips: 1 };
         let images = level_images((w * h * c as u32) as usize, count, 17 * seed as u64);
-        let texture = mips.texture(&gpu, pis_compile::TextureLayout::full(w, h));
-        let buffers: Vec<wgpu::Buffer> = images.iter().map(|v| level_buffer(&gpu, v)).collect();
+        let texture = mips.texture(gpu, pis_compile::TextureLayout::full(w, h));
+        let buffers: Vec<wgpu::Buffer> =
+            images.iter().map(|v| rebuild.level_buffer(gpu, v)).collect();
         let refs: Vec<&wgpu::Buffer> = buffers.iter().collect();
         let stack = LevelStack { levels: &refs, channels: c as u32, gamma };
         let mut enc = gpu.device.create_command_encoder(&Default::default());
-        rebuild.record(&gpu, (&texture, &stack), &mips, &mut enc);
+        rebuild.record(gpu, (&texture, &stack), mips, &mut enc);
         gpu.queue.submit([enc.finish()]);
-        let got = read_levels(&gpu, &texture).unwrap();
+        let got = read_levels(gpu, &texture).unwrap();
         let job = AssembleJob {
             layer: &layer,
             layout,
-            levels: images.into_iter().map(Arc::new).collect(),
+            levels: as_read(images, half).into_iter().map(Arc::new).collect(),
             drop_levels: 0,
         };
         let sizes: Vec<(u32, u32)> = got.iter().map(|(gw, gh, _)| (*gw, *gh)).collect();
@@ -143,7 +166,12 @@ fn the_gpu_rebuild_equals_the_workers_rebuild() {
 fn the_gpu_rebuild_of_cube_maps_equals_the_workers_rebuild() {
     let name = "the_gpu_rebuild_of_cube_maps_equals_the_workers_rebuild";
     let Some(gpu) = gpu_or_skip(name) else { return };
-    let rebuild = LevelRebuild::new(&gpu);
+    for half in [false, true] {
+        cubes_against_the_workers(&gpu, &LevelRebuild::new(&gpu, half), half);
+    }
+}
+
+fn cubes_against_the_workers(gpu: &Gpu, rebuild: &LevelRebuild, half: bool) {
     // (face size, channels, stored MIP levels (0: every level), decimated, pyramid levels, gamma)
     let cases: [(u32, u8, u32, bool, usize, f32); 6] = [
         (5, 4, 0, false, 3, 2.2),
@@ -161,33 +189,34 @@ fn the_gpu_rebuild_of_cube_maps_equals_the_workers_rebuild() {
         };
         let mode = if decimated { MipMode::Decimated } else { MipMode::Stored };
         let what = format!(
-            "{n}² × 6, {c} channels, {mips} stored levels, {mode:?}, {count} levels, gamma {gamma}"
+            "{n}² × 6, {c} channels, {mips} stored levels, {mode:?}, {count} levels, gamma {gamma}, half {half}"
         );
         let layer = layer(Mapping::Shell, c, mode, gamma);
         let layout = LevelLayout { width: n, height: n, channels: c as u32, faces: 6, mips };
         let values: usize =
             layout.planes().iter().map(|p| (p.width * p.height * p.channels) as usize).sum();
         let images = level_images(values, count, 31 * seed as u64 + 5);
-        let buffers: Vec<wgpu::Buffer> = images.iter().map(|v| level_buffer(&gpu, v)).collect();
+        let buffers: Vec<wgpu::Buffer> =
+            images.iter().map(|v| rebuild.level_buffer(gpu, v)).collect();
         let refs: Vec<&wgpu::Buffer> = buffers.iter().collect();
         let stack = LevelStack { levels: &refs, channels: c as u32, gamma };
         let job = AssembleJob {
             layer: &layer,
             layout: layout.clone(),
-            levels: images.into_iter().map(Arc::new).collect(),
+            levels: as_read(images, half).into_iter().map(Arc::new).collect(),
             drop_levels: 0,
         };
         let want = assemble_cube(&job);
-        let cube = ShellTexture::new(&gpu, want.layout, "test").unwrap();
+        let cube = ShellTexture::new(gpu, want.layout, "test").unwrap();
         let mut enc = gpu.device.create_command_encoder(&Default::default());
-        rebuild.record_cube(&gpu, (&cube, &stack), &layout, &mut enc);
+        rebuild.record_cube(gpu, (&cube, &stack), &layout, &mut enc);
         gpu.queue.submit([enc.finish()]);
-        let got = read_cube(&gpu, &cube).unwrap();
+        let got = read_cube(gpu, &cube).unwrap();
         let want_rgba = want.rgba();
         assert_eq!(got.len(), want_rgba.len(), "{what}: texel count");
         // The border pass writes the borders the CPU writes for uploaded cube maps.
         let bordered = cube.atlas.border(&cube.layout, &got);
-        assert_eq!(read_atlas(&gpu, &cube).unwrap(), bordered, "{what}: the borders differ");
+        assert_eq!(read_atlas(gpu, &cube).unwrap(), bordered, "{what}: the borders differ");
         if gamma == 1.0 {
             assert_eq!(got, want_rgba, "{what}: the sums differ");
         } else {

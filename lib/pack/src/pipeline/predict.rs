@@ -212,15 +212,28 @@ fn for_each_decoded(
     mi: usize,
     m: &ObjectModel,
     packed: &Packed,
-    mut f: impl FnMut(usize, Vec<u32>, Vec<f32>) -> Result<()>,
+    f: impl FnMut(usize, Vec<u32>, Vec<f32>) -> Result<()>,
 ) -> Result<()> {
+    for_each_rebuilt(mi, m, packed, false, f).map(|_| ())
+}
+
+/// [`for_each_decoded`] with, where `half_levels`, every decoded level image's values rounded
+/// to the nearest half floats before the sum (as a player holding 16-bit level images
+/// rebuilds them). Returns false, having stopped, where a value lies beyond their range.
+fn for_each_rebuilt(
+    mi: usize,
+    m: &ObjectModel,
+    packed: &Packed,
+    half_levels: bool,
+    mut f: impl FnMut(usize, Vec<u32>, Vec<f32>) -> Result<()>,
+) -> Result<bool> {
     for li in 0..m.layers.len() {
         let layer = &packed.container.objects[mi].layers[li];
         for (b, pb) in packed.blocks[mi][li].iter().enumerate() {
             let block = &layer.blocks[b];
             let layout = LevelLayout::of(layer, block);
             let planes = layout.planes();
-            let decoded: Vec<Vec<Vec<f32>>> = pb
+            let mut decoded: Vec<Vec<Vec<f32>>> = pb
                 .levels
                 .iter()
                 .map(|(_, _, streams)| {
@@ -230,6 +243,14 @@ fn for_each_decoded(
                         .collect::<Result<Vec<_>, _>>()
                 })
                 .collect::<Result<_, _>>()?;
+            if half_levels {
+                for img in decoded.iter_mut().flatten() {
+                    match round_to_half(img) {
+                        Some(h) => *img = h,
+                        None => return Ok(false),
+                    }
+                }
+            }
             for (s, k) in pb.keys.iter().enumerate() {
                 let local = unflatten(s, &pb.extent);
                 let mut sum = vec![0.0f32; pis_codec::value_count(&planes)?];
@@ -242,7 +263,7 @@ fn for_each_decoded(
             }
         }
     }
-    Ok(())
+    Ok(true)
 }
 
 fn layer_codec(block: &Block) -> CodecId {
@@ -316,6 +337,52 @@ pub fn half_float_psnr(
         }
     }
     Ok(Some(total_psnr(&errors)))
+}
+
+/// The PSNR of frames drawn from textures rebuilt from the level images rounded to half
+/// floats against frames drawn from the textures as decoded, over every object and point
+/// (SPEC.md 6.6 `half_level_psnr_db`); `None` where a level image's value lies beyond the
+/// half-float range.
+pub fn half_level_psnr(
+    set: &LoadedSet,
+    models: &[ObjectModel],
+    packed: &Packed,
+) -> Result<Option<f64>> {
+    let mut errors = Vec::with_capacity(models.len());
+    for (mi, m) in models.iter().enumerate() {
+        let textures = || -> Vec<Textures> {
+            m.layers.iter().map(|_| Textures::new(set.scratch.as_ref())).collect()
+        };
+        let (mut full, mut half) = (textures(), textures());
+        for_each_decoded(mi, m, packed, |li, k, y| full[li].insert(k, y))?;
+        if !for_each_rebuilt(mi, m, packed, true, |li, k, y| half[li].insert(k, y))? {
+            return Ok(None);
+        }
+        errors.push(frames_error(set, m, full.as_slice(), half.as_slice())?);
+    }
+    Ok(Some(total_psnr(&errors)))
+}
+
+/// The squared display difference between object `m` drawn with chains `a` and with chains
+/// `b` at every point, and the number of values it sums.
+fn frames_error(
+    set: &LoadedSet,
+    m: &ObjectModel,
+    a: &(impl Chains + ?Sized),
+    b: &(impl Chains + ?Sized),
+) -> Result<(f64, usize)> {
+    let (mut sse, mut n) = (0.0f64, 0usize);
+    let (mut ca, mut cb) = (Cursor::new(m), Cursor::new(m));
+    for (p, s) in set.samples.iter().enumerate() {
+        let v = m.views.get(p)?;
+        let keys = ca.advance(a, s)?;
+        cb.advance(b, s)?;
+        let fa = m.render_view(&v, p, &keys, &ca.at());
+        let fb = m.render_view(&v, p, &keys, &cb.at());
+        sse += fa.iter().zip(&fb).map(|(x, y)| (display(*x) - display(*y)).powi(2)).sum::<f64>();
+        n += fa.len();
+    }
+    Ok((sse, n))
 }
 
 #[cfg(test)]

@@ -154,8 +154,12 @@ impl Player {
                 lens.trace_on_gpu(gpu.clone(), rays.clone());
             }
         }
-        let textures =
-            Textures::new(&gpu, (decoder, cache), MipBuilder::new(&gpu), options.rebuild);
+        let textures = Textures::new(
+            &gpu,
+            (decoder, cache),
+            MipBuilder::new(&gpu),
+            (options.rebuild, precision.half_levels),
+        );
         // The reader has checked the settings (rule 9006).
         let c = reader.container();
         // Relightable where layers of coefficients span the recorded directions.

@@ -2,8 +2,12 @@
 //! own measurement says rounding to them leaves its frames within its coding error (SPEC.md
 //! 6.6 `half_float_psnr_db`), 32-bit floats elsewhere. Half floats halve the textures'
 //! memory, the uploads of textures rebuilt on the workers and the texels the GPU filters.
+//! The level images the GPU rebuild reads are chosen the same way, by their own measurement
+//! (`half_level_psnr_db`): 16-bit, they halve its uploads and the buffers it keeps.
 
-use pis_format::precision::{HalfFloatFit, HALF_FLOAT_MARGIN_DB};
+use pis_format::precision::{
+    HalfFloatFit, HALF_FLOAT_MARGIN_DB, HALF_FLOAT_PSNR_SETTING, HALF_LEVEL_PSNR_SETTING,
+};
 use pis_format::Provenance;
 
 use crate::gpu::Gpu;
@@ -46,6 +50,10 @@ pub struct PrecisionChoice {
     pub cube: wgpu::TextureFormat,
     /// Why, in a sentence.
     pub why: String,
+    /// The level images the GPU rebuild reads are 16-bit floats (else 32-bit).
+    pub half_levels: bool,
+    /// Why, in a sentence.
+    pub levels_why: String,
 }
 
 impl PrecisionChoice {
@@ -56,18 +64,18 @@ impl PrecisionChoice {
     }
 }
 
-/// The precision for a file of provenance `p` on `gpu` when `asked`.
-pub(super) fn choose(
-    gpu: &Gpu,
-    p: Option<&Provenance>,
+/// Whether half floats, and why, when `asked`, for a file that records `fit` under the
+/// setting `setting`.
+fn half_or_not(
     asked: TexturePrecision,
-) -> PrecisionChoice {
-    let fit = HalfFloatFit::of(p);
-    let (half, why) = match (asked, fit) {
+    fit: Option<HalfFloatFit>,
+    setting: &str,
+) -> (bool, String) {
+    match (asked, fit) {
         (TexturePrecision::Half, _) => (true, "half floats asked for".to_string()),
         (TexturePrecision::Full, _) => (false, "full precision asked for".to_string()),
         (TexturePrecision::Auto, None) => {
-            (false, "the file records no half-float measurement (half_float_psnr_db)".to_string())
+            (false, format!("the file records no half-float measurement ({setting})"))
         }
         (TexturePrecision::Auto, Some(f)) => (
             f.allows_half(),
@@ -78,16 +86,30 @@ pub(super) fn choose(
                 f.coding_psnr_db
             ),
         ),
-    };
+    }
+}
+
+/// The precision for a file of provenance `p` on `gpu` when `asked`: of its textures, and of
+/// the level images the GPU rebuild reads.
+pub(super) fn choose(
+    gpu: &Gpu,
+    p: Option<&Provenance>,
+    asked: TexturePrecision,
+) -> PrecisionChoice {
+    let (half, why) = half_or_not(asked, HalfFloatFit::of(p), HALF_FLOAT_PSNR_SETTING);
+    let (half_levels, levels_why) =
+        half_or_not(asked, HalfFloatFit::of_levels(p), HALF_LEVEL_PSNR_SETTING);
     let half_format = wgpu::TextureFormat::Rgba16Float;
     if half {
-        return PrecisionChoice { surface: half_format, cube: half_format, why };
+        let (surface, cube) = (half_format, half_format);
+        return PrecisionChoice { surface, cube, why, half_levels, levels_why };
     }
     let mut why = why;
     if gpu.texture_format == half_format {
         why.push_str("; the adapter cannot filter 32-bit floats, so surfaces are half floats");
     }
-    PrecisionChoice { surface: gpu.texture_format, cube: gpu.cube_format, why }
+    let (surface, cube) = (gpu.texture_format, gpu.cube_format);
+    PrecisionChoice { surface, cube, why, half_levels, levels_why }
 }
 
 #[cfg(test)]
@@ -120,5 +142,14 @@ mod tests {
         assert_eq!(c.cube, wgpu::TextureFormat::Rgba32Float, "{c:?}");
         assert!(choose(&gpu, None, TexturePrecision::Half).half());
         assert!(!choose(&gpu, Some(&prov("80", "36")), TexturePrecision::Full).half());
+        // The level images by their own measurement.
+        let mut p = prov("80", "36");
+        assert!(!choose(&gpu, Some(&p), TexturePrecision::Auto).half_levels);
+        p.settings.push(("half_level_psnr_db".to_string(), "57".to_string()));
+        let c = choose(&gpu, Some(&p), TexturePrecision::Auto);
+        assert!(c.half_levels && c.levels_why.contains("21.0 dB below"), "{c:?}");
+        p.settings.last_mut().unwrap().1 = "55".to_string();
+        assert!(!choose(&gpu, Some(&p), TexturePrecision::Auto).half_levels);
+        assert!(choose(&gpu, Some(&p), TexturePrecision::Half).half_levels);
     }
 }

@@ -23,7 +23,7 @@ use crate::decode::{CubeImage, Decoder, LevelJob, TextureImage};
 use crate::error::PlayError;
 use crate::gpu::Gpu;
 use crate::mip::MipBuilder;
-use crate::rebuild::{fits, level_buffer, LevelRebuild, LevelStack};
+use crate::rebuild::{fits, LevelRebuild, LevelStack};
 use crate::shell::ShellTexture;
 use crate::textured::ObjectTexture;
 
@@ -63,13 +63,13 @@ impl Textures {
         gpu: &Gpu,
         (decoder, cache): (Decoder, LevelCache),
         mips: MipBuilder,
-        rebuild_on: Rebuild,
+        (rebuild_on, half_levels): (Rebuild, bool),
     ) -> Textures {
         Textures {
             decoder,
             cache,
             mips,
-            rebuild: LevelRebuild::new(gpu),
+            rebuild: LevelRebuild::new(gpu, half_levels),
             rebuild_on,
             gpu_levels: HashMap::new(),
             prefetch: Prefetch::new(),
@@ -375,8 +375,8 @@ impl Textures {
             let key = level_key(k, lv, img);
             if let std::collections::hash_map::Entry::Vacant(e) = self.gpu_levels.entry(key) {
                 let values = &have[&key];
-                stats.upload_bytes += (values.len() * 4) as u64;
-                e.insert(level_buffer(gpu, values));
+                stats.upload_bytes += self.rebuild.level_bytes(values.len());
+                e.insert(self.rebuild.level_buffer(gpu, values));
             }
         }
     }
