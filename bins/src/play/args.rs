@@ -135,7 +135,8 @@ pub struct PlayArgs {
     /// memory and upload), `full` (32-bit floats), or `auto`: half where the file records
     /// that rounding to half floats stays 20 dB or more below its coding error (pis-pack
     /// measures it), else full. The same rule, by its own measurement, sets the precision of
-    /// the level images the GPU rebuild reads (--rebuild gpu). The report says which and why.
+    /// the level images the GPU rebuild reads (--rebuild gpu): 16 bits a value over each
+    /// image's range, or 32-bit floats. The report says which and why.
     #[arg(long, default_value = "auto", value_parser = crate::cli::one_of(&pis_play::TexturePrecision::ALL, pis_play::TexturePrecision::name))]
     pub texture_precision: pis_play::TexturePrecision,
     /// Along a path: decode the textures of this many next frames on the decoding threads

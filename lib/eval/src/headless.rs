@@ -285,7 +285,7 @@ pub struct TextureFormats {
     pub surfaces: String,
     pub cube_maps: String,
     pub why: String,
-    /// The level images the GPU rebuild reads: "16-bit floats" or "32-bit floats".
+    /// The level images the GPU rebuild reads: "16 bits" or "32-bit floats".
     pub level_images: String,
     pub level_images_why: String,
     /// Whether the player rebuilds textures on the GPU (the level images' line applies).
@@ -300,14 +300,14 @@ impl TextureFormats {
             surfaces: format!("{:?}", p.surface),
             cube_maps: format!("{:?}", p.cube),
             why: p.why.clone(),
-            level_images: if p.half_levels { "16-bit floats" } else { "32-bit floats" }.into(),
+            level_images: if p.level16 { "16 bits" } else { "32-bit floats" }.into(),
             level_images_why: p.levels_why.clone(),
             gpu_rebuild: player.rebuild() == pis_play::Rebuild::Gpu,
         }
     }
 
     /// "textures Rgba16Float, cube maps Rgba16Float: WHY", and where the GPU rebuilds them,
-    /// "; level images 16-bit floats: WHY".
+    /// "; level images 16 bits: WHY".
     pub fn label(&self) -> String {
         let textures =
             format!("textures {}, cube maps {}: {}", self.surfaces, self.cube_maps, self.why);

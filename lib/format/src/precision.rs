@@ -15,9 +15,9 @@ pub const PREDICTED_PSNR_SETTING: &str = "predicted_psnr_db";
 /// where a texel lies beyond the half-float range (±65504).
 pub const HALF_FLOAT_PSNR_SETTING: &str = "half_float_psnr_db";
 /// The PSNR (dB, as [`HALF_FLOAT_PSNR_SETTING`]) of frames drawn from textures rebuilt from
-/// level images rounded to half floats against frames drawn from the textures as decoded.
-/// Absent where a level image's value lies beyond the half-float range.
-pub const HALF_LEVEL_PSNR_SETTING: &str = "half_level_psnr_db";
+/// level images held in 16 bits a value ([`Level16`]) against frames drawn from the textures
+/// as decoded. Absent where a level image holds a value that is not finite.
+pub const LEVEL16_PSNR_SETTING: &str = "level16_psnr_db";
 
 /// How far below the coding error half-float rounding must lie for 16-bit textures: 20 dB,
 /// its squared error at most 1 % of the coding error's, so that the played PSNR drops by at
@@ -39,10 +39,10 @@ impl HalfFloatFit {
         HalfFloatFit::of_setting(p, HALF_FLOAT_PSNR_SETTING)
     }
 
-    /// What the file records of its level images rounded to half floats
-    /// ([`HALF_LEVEL_PSNR_SETTING`]) against its coding error.
+    /// What the file records of its level images held in 16 bits a value
+    /// ([`LEVEL16_PSNR_SETTING`]) against its coding error.
     pub fn of_levels(p: Option<&Provenance>) -> Option<HalfFloatFit> {
-        HalfFloatFit::of_setting(p, HALF_LEVEL_PSNR_SETTING)
+        HalfFloatFit::of_setting(p, LEVEL16_PSNR_SETTING)
     }
 
     fn of_setting(p: Option<&Provenance>, half: &str) -> Option<HalfFloatFit> {
@@ -69,6 +69,51 @@ impl HalfFloatFit {
     }
 }
 
+/// A level image held in 16 bits a value (SPEC.md 6.6 `level16_psnr_db`): each value v as
+/// q = round((v − lo) / step) in 0..=65535, read back as lo + q · step, with lo the image's
+/// least value and step = (its greatest − lo) / 65535 (0 for a constant image). The error is
+/// at most step / 2 wherever the value lies: a pyramid's level images are gamma-compensated
+/// (display-like) values of a small range, which a half float would round relative to their
+/// size instead.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Level16 {
+    pub lo: f32,
+    pub step: f32,
+    pub q: Vec<u16>,
+}
+
+impl Level16 {
+    /// `values` in 16 bits; `None` where one is not finite.
+    pub fn of(values: &[f32]) -> Option<Level16> {
+        let (lo, hi) =
+            values.iter().try_fold((f32::INFINITY, f32::NEG_INFINITY), |(a, b), &v| {
+                v.is_finite().then_some((a.min(v), b.max(v)))
+            })?;
+        if values.is_empty() {
+            return Some(Level16 { lo: 0.0, step: 0.0, q: Vec::new() });
+        }
+        let step = (hi - lo) / 65535.0;
+        let q = values
+            .iter()
+            .map(|&v| match step > 0.0 {
+                true => ((v - lo) / step).round().clamp(0.0, 65535.0) as u16,
+                false => 0,
+            })
+            .collect();
+        Some(Level16 { lo, step, q })
+    }
+
+    /// Value `i` as read back: lo + q · step.
+    pub fn value(&self, i: usize) -> f32 {
+        self.lo + self.q[i] as f32 * self.step
+    }
+
+    /// Every value as read back.
+    pub fn values(&self) -> Vec<f32> {
+        (0..self.q.len()).map(|i| self.value(i)).collect()
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -90,8 +135,21 @@ mod tests {
     }
 
     #[test]
+    fn sixteen_bits_hold_a_level_image_within_half_a_step() {
+        let values: Vec<f32> = (0..1000).map(|k| ((k * 37 % 1000) as f32 * 0.0021) - 0.7).collect();
+        let l = Level16::of(&values).unwrap();
+        assert_eq!((l.lo, l.q.iter().max(), l.q.iter().min()), (-0.7, Some(&65535), Some(&0)));
+        let worst = values.iter().zip(l.values()).map(|(a, b)| (a - b).abs()).fold(0.0, f32::max);
+        assert!(worst <= l.step * 0.5 + 1e-6, "{worst} against a step of {}", l.step);
+        let constant = Level16::of(&[0.25; 5]).unwrap();
+        assert_eq!(constant.values(), vec![0.25; 5]);
+        assert_eq!(Level16::of(&[0.0, f32::NAN]), None);
+        assert_eq!(Level16::of(&[]).unwrap().values(), Vec::<f32>::new());
+    }
+
+    #[test]
     fn level_images_have_a_measurement_of_their_own() {
-        let p = prov(&[(PREDICTED_PSNR_SETTING, "30"), (HALF_LEVEL_PSNR_SETTING, "52")]);
+        let p = prov(&[(PREDICTED_PSNR_SETTING, "30"), (LEVEL16_PSNR_SETTING, "52")]);
         assert_eq!(HalfFloatFit::of(Some(&p)), None);
         let fit = HalfFloatFit::of_levels(Some(&p)).unwrap();
         assert_eq!((fit.half_psnr_db, fit.allows_half()), (52.0, true));

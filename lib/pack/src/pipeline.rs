@@ -297,14 +297,11 @@ pub fn pack_request(req: &PackRequest, progress: &dyn Progress) -> Result<PackRe
         p.settings.push((HALF_FLOAT_PSNR_SETTING.to_string(), format!("{h:.4}")));
     }
     // And what 16-bit level images would cost a player that rebuilds on the GPU.
-    let half_level_psnr = predict::half_level_psnr(&set, &inferred, &packed)
+    let level16_psnr = predict::level16_psnr(&set, &inferred, &packed)
         .map_err(|e| Failure::new(Exit::Runtime, e))?;
-    stages.done(
-        "half-float level images",
-        &report::half_level_note(half_level_psnr, quality.overall),
-    );
-    if let (Some(p), Some(h)) = (packed.container.provenance.as_mut(), half_level_psnr) {
-        p.settings.push((HALF_LEVEL_PSNR_SETTING.to_string(), format!("{h:.4}")));
+    stages.done("16-bit level images", &report::level16_note(level16_psnr, quality.overall));
+    if let (Some(p), Some(h)) = (packed.container.provenance.as_mut(), level16_psnr) {
+        p.settings.push((LEVEL16_PSNR_SETTING.to_string(), format!("{h:.4}")));
     }
     let masters = if req.keep_master {
         let m = encode::masters(&inferred, &packed).map_err(|e| Failure::new(Exit::Runtime, e))?;
@@ -340,7 +337,7 @@ pub fn pack_request(req: &PackRequest, progress: &dyn Progress) -> Result<PackRe
     let mut report = report::build(&set, &inferred, &packed, &quality, bytes, exact, req, stages);
     report.probe_renderings = probe_renderings;
     report.half_float_psnr_db = half_float_psnr;
-    report.half_level_psnr_db = half_level_psnr;
+    report.level16_psnr_db = level16_psnr;
     if let Some((master_bytes, exact)) = master {
         report.set_master(master_bytes, exact);
     }

@@ -1,7 +1,8 @@
 //! Textures rebuilt from their level images on the GPU (thesis 4.7, SPEC.md 8.4): the workers
 //! only decode codestreams; each decoded level image goes up once as a storage buffer of its
-//! own (compact: its channels only, in 32-bit floats or, where the file allows it, rounded to
-//! 16-bit floats two to a word; kept while the level-image cache keeps the image), and a
+//! own (compact: its channels only, in 32-bit floats or, where the file allows it, in 16 bits
+//! a value over the image's range, two to a word; kept while the level-image cache keeps the
+//! image), and a
 //! texture a frame needs is its level images stacked by buffer copies, summed, inverse gamma
 //! applied and widened to RGBA by compute passes (`rebuild.wgsl`):
 //! - a surface texture: one pass into the finest level of the padded layout, its MIP chain
@@ -19,6 +20,7 @@ use bytemuck::{Pod, Zeroable};
 use wgpu::util::DeviceExt;
 
 use pis_format::mip::mip_size;
+use pis_format::precision::Level16;
 use pis_format::reconstruct::face_len;
 use pis_format::texture::LevelLayout;
 
@@ -76,11 +78,11 @@ struct Pass {
 }
 
 /// The rebuilding pipelines: surface textures and cube maps in the GPU's formats
-/// ([`Gpu::texture_format`], [`Gpu::cube_format`]), from level images of 32-bit or of 16-bit
-/// floats ([`LevelRebuild::level_buffer`]).
+/// ([`Gpu::texture_format`], [`Gpu::cube_format`]), from level images of 32-bit floats or
+/// of 16 bits a value ([`LevelRebuild::level_buffer`]).
 pub struct LevelRebuild {
-    /// Level images are 16-bit floats.
-    half: bool,
+    /// Level images are held in 16 bits a value.
+    level16: bool,
     surface: Pass,
     cube_level: Pass,
     cube_decimate: Pass,
@@ -248,15 +250,18 @@ fn gamma_mode(gamma: f32) -> u32 {
     }
 }
 
-/// A level image's values as 16-bit floats (round to nearest even), two to a 32-bit word
-/// (the first in the low half, as WGSL's `unpack2x16float` reads them), the last word's
-/// high half 0 where the count is odd.
-pub fn half_words(values: &[f32]) -> Vec<u16> {
-    use half::slice::{HalfBitsSliceExt, HalfFloatSliceExt};
-    let mut bits = vec![0u16; values.len().next_multiple_of(2)];
-    bits[..values.len()].reinterpret_cast_mut::<half::f16>().convert_from_f32_slice(values);
-    bits
+/// A level image in 16 bits a value (`pis_format::precision::Level16`) as the rebuild reads
+/// it, in 32-bit words: lo and step (their bits), then the values two to a word, the first in
+/// the low half, the last word's high half 0 where the count is odd. `None` where a value is
+/// not finite.
+pub fn level16_words(values: &[f32]) -> Option<Vec<u32>> {
+    let l = Level16::of(values)?;
+    let pairs = l.q.chunks(2).map(|p| p[0] as u32 | (p.get(1).copied().unwrap_or(0) as u32) << 16);
+    Some([l.lo.to_bits(), l.step.to_bits()].into_iter().chain(pairs).collect())
 }
+
+/// Words before a 16-bit level image's values: its lo and step.
+const LEVEL16_HEADER: u32 = 2;
 
 /// Whether a texture summed from `levels` level images of `values` values each fits the
 /// device's storage buffers (else it is rebuilt on the workers), counted as 32-bit floats.
@@ -268,8 +273,9 @@ pub fn fits(gpu: &Gpu, values: u64, levels: usize) -> bool {
 }
 
 impl LevelRebuild {
-    /// The pipelines for level images of 16-bit floats where `half`, else of 32-bit floats.
-    pub fn new(gpu: &Gpu, half: bool) -> LevelRebuild {
+    /// The pipelines for level images of 16 bits a value where `level16`, else of 32-bit
+    /// floats.
+    pub fn new(gpu: &Gpu, level16: bool) -> LevelRebuild {
         let source = include_str!("rebuild.wgsl")
             .replace("SURFACE_FORMAT", storage_name(gpu.texture_format))
             .replace("CUBE_FORMAT", storage_name(gpu.cube_format));
@@ -287,9 +293,9 @@ impl LevelRebuild {
             usage: wgpu::TextureUsages::TEXTURE_BINDING,
             view_formats: &[],
         });
-        let constants = [("HALF_LEVELS", half as u32 as f64)];
+        let constants = [("LEVEL16", level16 as u32 as f64)];
         LevelRebuild {
-            half,
+            level16,
             surface: Pass::new(gpu, (&module, &constants), "rebuild", &[0, 1, 2]),
             cube_level: Pass::new(gpu, (&module, &constants), "cube_level", &[0, 1, 3, 4]),
             cube_decimate: Pass::new(gpu, (&module, &constants), "cube_decimate", &[0, 3, 4]),
@@ -299,12 +305,13 @@ impl LevelRebuild {
     }
 
     /// Uploads a decoded level image as a storage buffer the rebuild reads: its values as they
-    /// are, or as 16-bit floats ([`half_words`]) where the pipelines read those.
+    /// are, or in 16 bits a value ([`level16_words`]) where the pipelines read those (the
+    /// player's decoder has refused values that are not finite).
     pub fn level_buffer(&self, gpu: &Gpu, values: &[f32]) -> wgpu::Buffer {
-        let halves;
-        let contents: &[u8] = if self.half {
-            halves = half_words(values);
-            bytemuck::cast_slice(&halves)
+        let words;
+        let contents: &[u8] = if self.level16 {
+            words = level16_words(values).unwrap_or_default();
+            bytemuck::cast_slice(&words)
         } else {
             bytemuck::cast_slice(values)
         };
@@ -317,19 +324,15 @@ impl LevelRebuild {
 
     /// The bytes of a level image of `values` values on the GPU.
     pub fn level_bytes(&self, values: usize) -> u64 {
-        match self.half {
-            true => values.next_multiple_of(2) as u64 * 2,
+        match self.level16 {
+            true => (LEVEL16_HEADER as u64 + values.div_ceil(2) as u64) * 4,
             false => values as u64 * 4,
         }
     }
 
-    /// The values from one level image to the next in a stack of `plane`-value images: the
-    /// plane, rounded up to whole words for 16-bit floats.
+    /// The 32-bit words from one level image to the next in a stack of `plane`-value images.
     fn stride(&self, plane: u32) -> u32 {
-        match self.half {
-            true => plane.next_multiple_of(2),
-            false => plane,
-        }
+        (self.level_bytes(plane as usize) / 4) as u32
     }
 
     /// Records the rebuild of `texture` (made by [`MipBuilder::texture`] at full resolution)
@@ -487,12 +490,13 @@ mod tests {
     use super::*;
 
     #[test]
-    fn half_words_hold_two_values_low_half_first() {
-        let bits = half_words(&[1.0, -2.0, 0.5]);
-        assert_eq!(bits, vec![0x3C00, 0xC000, 0x3800, 0]);
-        let bytes: &[u8] = bytemuck::cast_slice(&bits);
-        let word = u32::from_le_bytes([bytes[0], bytes[1], bytes[2], bytes[3]]);
-        assert_eq!(word, 0xC000_3C00, "the first value in the low half");
+    fn sixteen_bit_words_hold_lo_step_then_two_values_low_half_first() {
+        let words = level16_words(&[1.0, -2.0, 0.5]).unwrap();
+        let step = 3.0f32 / 65535.0;
+        assert_eq!(&words[..2], &[(-2.0f32).to_bits(), step.to_bits()]);
+        assert_eq!(words[2], 65535, "1.0 (q 65535) in the low half, -2.0 (q 0) in the high");
+        assert_eq!(words[3], (2.5 / step).round() as u32, "the odd count's last word");
+        assert_eq!(level16_words(&[f32::INFINITY]), None);
     }
 
     #[test]

@@ -19,8 +19,8 @@ struct Params {
     channels: u32,
     // Level images stacked in `stack`, top first.
     levels: u32,
-    // Values from one level image to the next in `stack`: its values (used.x * used.y *
-    // channels), rounded up to whole words for 16-bit floats.
+    // 32-bit words from one level image to the next in `stack`: its values (used.x * used.y
+    // * channels), or where LEVEL16 two words and half its values rounded up.
     plane: u32,
     // 0: identity (gamma 1), 1: pow_11_5 (gamma 2.2), 2: sign(v) |v|^gamma.
     mode: u32,
@@ -33,10 +33,11 @@ struct Params {
 };
 
 @group(0) @binding(0) var<uniform> p: Params;
-// The level images: 32-bit floats, or where HALF_LEVELS 16-bit floats two to a word (the
-// first in the low half: rebuild.rs `half_words`).
+// The level images: 32-bit floats, or where LEVEL16 each its lo and step, then its values in
+// 16 bits two to a word, the first in the low half (rebuild.rs `level16_words`; pis-format's
+// `Level16`: lo + q · step).
 @group(0) @binding(1) var<storage, read> stack: array<u32>;
-override HALF_LEVELS: bool = false;
+override LEVEL16: bool = false;
 @group(0) @binding(2) var dst: texture_storage_2d<SURFACE_FORMAT, write>;
 @group(0) @binding(3) var cube_dst: texture_storage_2d_array<CUBE_FORMAT, write>;
 @group(0) @binding(4) var src: texture_2d_array<f32>;
@@ -70,19 +71,21 @@ fn linear(v: f32) -> f32 {
     return sign(v) * pow(abs(v), p.gamma);
 }
 
-// Value `e` of the stacked level images, widened to 32 bits.
-fn level_value(e: u32) -> f32 {
-    if (HALF_LEVELS) {
-        return unpack2x16float(stack[e >> 1u])[e & 1u];
+// Value `e` of level image `k` of the stack, as 32 bits.
+fn level_value(k: u32, e: u32) -> f32 {
+    let base = k * p.plane;
+    if (LEVEL16) {
+        let q = (stack[base + 2u + (e >> 1u)] >> (16u * (e & 1u))) & 0xFFFFu;
+        return bitcast<f32>(stack[base]) + f32(q) * bitcast<f32>(stack[base + 1u]);
     }
-    return bitcast<f32>(stack[e]);
+    return bitcast<f32>(stack[base + e]);
 }
 
 // Channel `ch` of the texel at `at`: the level images summed, then the inverse gamma.
 fn value(at: u32, ch: u32) -> f32 {
-    var s = level_value(at + ch);
+    var s = level_value(0u, at + ch);
     for (var k = 1u; k < p.levels; k++) {
-        s = s + level_value(k * p.plane + at + ch);
+        s = s + level_value(k, at + ch);
     }
     return linear(s);
 }

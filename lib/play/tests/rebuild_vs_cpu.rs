@@ -5,10 +5,10 @@
 //! `pow_11_5`, a general power); shells' cube maps against `assemble_cube`, every face and
 //! level, with stored MIP levels (all of them or the finest few) and decimated ones, and
 //! their atlases' borders against the CPU's bit for bit (cube_atlas.rs). Each from level
-//! images of 32-bit floats and of 16-bit floats (`LevelRebuild::new(gpu, true)`), against
-//! the workers' rebuild of the same level images rounded to half floats. Sums alone are
-//! bit-exact; with an inverse gamma the GPU's division and power may round
-//! differently, held to 90 dB.
+//! images of 32-bit floats and of 16 bits a value (`LevelRebuild::new(gpu, true)`), against
+//! the workers' rebuild of the same level images as 16 bits read back (pis-format's
+//! `Level16`). Sums alone are bit-exact; with an inverse gamma the GPU's division and power
+//! may round differently, held to 90 dB.
 
 mod common;
 
@@ -16,6 +16,7 @@ use std::sync::Arc;
 
 use common::*;
 use pis_format::mip::{decimate, mip_size};
+use pis_format::precision::Level16;
 use pis_format::texture::LevelLayout;
 use pis_format::{Combine, DepMask, Layer, LayerKind, Mapping, MipMode, StreamRef, Term};
 use pis_play::decode::{assemble, assemble_cube, AssembleJob};
@@ -59,13 +60,12 @@ fn level_images(n: usize, count: usize, seed: u64) -> Vec<Vec<f32>> {
         .collect()
 }
 
-/// `images` as the GPU rebuild reads them: as they are, or rounded to half floats.
-fn as_read(images: Vec<Vec<f32>>, half: bool) -> Vec<Vec<f32>> {
-    if !half {
-        return images;
+/// `images` as the GPU rebuild reads them: as they are, or held in 16 bits a value.
+fn as_read(images: Vec<Vec<f32>>, level16: bool) -> Vec<Vec<f32>> {
+    match level16 {
+        true => images.iter().map(|img| Level16::of(img).expect("finite").values()).collect(),
+        false => images,
     }
-    let round = |v: &f32| half::f16::from_f32(*v).to_f32();
-    images.iter().map(|img| img.iter().map(round).collect()).collect()
 }
 
 /// The workers' texture as the GPU holds it: the padded finest level from `assemble`, then
@@ -128,7 +128,7 @@ fn surfaces_against_the_workers(
         (21, 11, 3, 3, 1.8),
     ];
     for (seed, (w, h, c, count, gamma)) in cases.into_iter().enumerate() {
-        let what = format!("{w}x{h}, {c} channels, {count} levels, gamma {gamma}, half {half}");
+        let what = format!("{w}x{h}, {c} channels, {count} levels, gamma {gamma}, 16-bit {half}");
         let layer = surface_layer(c, gamma);
         let layout = LevelLayout { width: w, height: h, channels: c as u32, faces: 1, mips: 1 };
         let images = level_images((w * h * c as u32) as usize, count, 17 * seed as u64);
@@ -189,7 +189,7 @@ fn cubes_against_the_workers(gpu: &Gpu, rebuild: &LevelRebuild, half: bool) {
         };
         let mode = if decimated { MipMode::Decimated } else { MipMode::Stored };
         let what = format!(
-            "{n}² × 6, {c} channels, {mips} stored levels, {mode:?}, {count} levels, gamma {gamma}, half {half}"
+            "{n}² × 6, {c} channels, {mips} stored levels, {mode:?}, {count} levels, gamma {gamma}, 16-bit {half}"
         );
         let layer = layer(Mapping::Shell, c, mode, gamma);
         let layout = LevelLayout { width: n, height: n, channels: c as u32, faces: 6, mips };

@@ -155,7 +155,7 @@ pub fn provenance<S>(
                     | "source_codec"
                     | pis_pack::PREDICTED_PSNR_SETTING
                     | pis_pack::HALF_FLOAT_PSNR_SETTING
-                    | pis_pack::HALF_LEVEL_PSNR_SETTING
+                    | pis_pack::LEVEL16_PSNR_SETTING
             )
         })
         // An exact output carries the writer's constraint on, for the next lossy coding.

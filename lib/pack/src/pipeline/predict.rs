@@ -13,6 +13,7 @@ use std::collections::BTreeMap;
 use anyhow::Result;
 use pis_codec::pyramid::{level_image_index, unflatten};
 use pis_codec::CodecId;
+use pis_format::precision::Level16;
 use pis_format::reconstruct::finish;
 use pis_format::{Block, LevelLayout};
 
@@ -217,14 +218,14 @@ fn for_each_decoded(
     for_each_rebuilt(mi, m, packed, false, f).map(|_| ())
 }
 
-/// [`for_each_decoded`] with, where `half_levels`, every decoded level image's values rounded
-/// to the nearest half floats before the sum (as a player holding 16-bit level images
-/// rebuilds them). Returns false, having stopped, where a value lies beyond their range.
+/// [`for_each_decoded`] with, where `level16`, every decoded level image held in 16 bits a
+/// value before the sum (`pis_format::precision::Level16`, as a player holding 16-bit level
+/// images rebuilds them). Returns false, having stopped, where a value is not finite.
 fn for_each_rebuilt(
     mi: usize,
     m: &ObjectModel,
     packed: &Packed,
-    half_levels: bool,
+    level16: bool,
     mut f: impl FnMut(usize, Vec<u32>, Vec<f32>) -> Result<()>,
 ) -> Result<bool> {
     for li in 0..m.layers.len() {
@@ -243,10 +244,10 @@ fn for_each_rebuilt(
                         .collect::<Result<Vec<_>, _>>()
                 })
                 .collect::<Result<_, _>>()?;
-            if half_levels {
+            if level16 {
                 for img in decoded.iter_mut().flatten() {
-                    match round_to_half(img) {
-                        Some(h) => *img = h,
+                    match Level16::of(img) {
+                        Some(l) => *img = l.values(),
                         None => return Ok(false),
                     }
                 }
@@ -339,11 +340,11 @@ pub fn half_float_psnr(
     Ok(Some(total_psnr(&errors)))
 }
 
-/// The PSNR of frames drawn from textures rebuilt from the level images rounded to half
-/// floats against frames drawn from the textures as decoded, over every object and point
-/// (SPEC.md 6.6 `half_level_psnr_db`); `None` where a level image's value lies beyond the
-/// half-float range.
-pub fn half_level_psnr(
+/// The PSNR of frames drawn from textures rebuilt from the level images held in 16 bits a
+/// value against frames drawn from the textures as decoded, over every object and point
+/// (SPEC.md 6.6 `level16_psnr_db`); `None` where a level image holds a value that is not
+/// finite.
+pub fn level16_psnr(
     set: &LoadedSet,
     models: &[ObjectModel],
     packed: &Packed,
@@ -353,12 +354,12 @@ pub fn half_level_psnr(
         let textures = || -> Vec<Textures> {
             m.layers.iter().map(|_| Textures::new(set.scratch.as_ref())).collect()
         };
-        let (mut full, mut half) = (textures(), textures());
+        let (mut full, mut held) = (textures(), textures());
         for_each_decoded(mi, m, packed, |li, k, y| full[li].insert(k, y))?;
-        if !for_each_rebuilt(mi, m, packed, true, |li, k, y| half[li].insert(k, y))? {
+        if !for_each_rebuilt(mi, m, packed, true, |li, k, y| held[li].insert(k, y))? {
             return Ok(None);
         }
-        errors.push(frames_error(set, m, full.as_slice(), half.as_slice())?);
+        errors.push(frames_error(set, m, full.as_slice(), held.as_slice())?);
     }
     Ok(Some(total_psnr(&errors)))
 }

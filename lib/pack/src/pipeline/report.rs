@@ -127,11 +127,10 @@ pub struct PackReport {
     /// from them in full (dB; SPEC.md 6.6 `half_float_psnr_db`); none where a texel lies
     /// beyond the half-float range.
     pub half_float_psnr_db: Option<f64>,
-    /// Frames drawn from textures rebuilt from the level images rounded to half floats
+    /// Frames drawn from textures rebuilt from the level images held in 16 bits a value
     /// against frames drawn from the textures as decoded (dB; SPEC.md 6.6
-    /// `half_level_psnr_db`); none where a level image's value lies beyond the half-float
-    /// range.
-    pub half_level_psnr_db: Option<f64>,
+    /// `level16_psnr_db`); none where a level image holds a value that is not finite.
+    pub level16_psnr_db: Option<f64>,
     /// Lossless codec: every level image read back from the file decodes bit-exactly to
     /// what was encoded, and the decoded finest texels equal the solved ones bit for bit.
     pub lossless_exact: Option<bool>,
@@ -302,7 +301,7 @@ pub fn build(
         psnr_db_solved: q.overall_solved,
         max_texel_error: q.max_texel_error,
         half_float_psnr_db: None,
-        half_level_psnr_db: None,
+        level16_psnr_db: None,
         lossless_exact: exact,
         fragments: None,
         max_mse_ratio: packed.container.provenance.as_ref().and_then(|p| p.setting("max_mse_ratio")).map(str::to_string),
@@ -375,7 +374,7 @@ pub fn print_report(r: &PackReport, out: &mut impl std::io::Write) -> std::io::R
         r.psnr_db, r.psnr_db_solved
     )?;
     writeln!(out, "  16-bit textures: {}", half_float_note(r.half_float_psnr_db, r.psnr_db))?;
-    writeln!(out, "  16-bit level images: {}", half_level_note(r.half_level_psnr_db, r.psnr_db))?;
+    writeln!(out, "  16-bit level images: {}", level16_note(r.level16_psnr_db, r.psnr_db))?;
     if let Some(p) = &r.played {
         let within = r.target_within_db.unwrap_or_default();
         let how = if p.reached {
@@ -460,11 +459,11 @@ fn denser_line(r: &PackReport) -> Option<String> {
 
 /// What 16-bit level images cost a file of predicted PSNR `coding_db`, and what a player
 /// that rebuilds its textures on the GPU makes of it.
-pub fn half_level_note(half_db: Option<f64>, coding_db: f64) -> String {
+pub fn level16_note(level16_db: Option<f64>, coding_db: f64) -> String {
     use pis_format::precision::HALF_FLOAT_MARGIN_DB;
-    match half_db {
-        None => "a value lies beyond the half-float range: players rebuilding on the GPU keep 32-bit level images".into(),
-        Some(h) if h - coding_db >= HALF_FLOAT_MARGIN_DB => format!("frames {h:.2} dB from full precision, {:.1} dB below the coding error: players rebuilding on the GPU hold them in half floats", h - coding_db),
+    match level16_db {
+        None => "a value is not finite: players rebuilding on the GPU keep 32-bit level images".into(),
+        Some(h) if h - coding_db >= HALF_FLOAT_MARGIN_DB => format!("frames {h:.2} dB from full precision, {:.1} dB below the coding error: players rebuilding on the GPU hold them in 16 bits", h - coding_db),
         Some(h) => format!("frames {h:.2} dB from full precision, {:.1} dB below the coding error ({HALF_FLOAT_MARGIN_DB} needed): players rebuilding on the GPU keep 32-bit floats", h - coding_db),
     }
 }

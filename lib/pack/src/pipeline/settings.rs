@@ -669,7 +669,7 @@ pub const TARGET_SETTING: &str = "target";
 /// The provenance settings holding the predicted PSNR (dB, display values over the pixels the
 /// objects cover) of a packed file, and what half floats would cost it.
 pub use pis_format::precision::{
-    HALF_FLOAT_PSNR_SETTING, HALF_LEVEL_PSNR_SETTING, PREDICTED_PSNR_SETTING,
+    HALF_FLOAT_PSNR_SETTING, LEVEL16_PSNR_SETTING, PREDICTED_PSNR_SETTING,
 };
 
 /// The default texel budget per covered pixel (`--texels-per-pixel`).

@@ -158,7 +158,7 @@ impl Player {
             &gpu,
             (decoder, cache),
             MipBuilder::new(&gpu),
-            (options.rebuild, precision.half_levels),
+            (options.rebuild, precision.level16),
         );
         // The reader has checked the settings (rule 9006).
         let c = reader.container();

@@ -3,10 +3,10 @@
 //! 6.6 `half_float_psnr_db`), 32-bit floats elsewhere. Half floats halve the textures'
 //! memory, the uploads of textures rebuilt on the workers and the texels the GPU filters.
 //! The level images the GPU rebuild reads are chosen the same way, by their own measurement
-//! (`half_level_psnr_db`): 16-bit, they halve its uploads and the buffers it keeps.
+//! (`level16_psnr_db`): in 16 bits a value, they halve its uploads and the buffers it keeps.
 
 use pis_format::precision::{
-    HalfFloatFit, HALF_FLOAT_MARGIN_DB, HALF_FLOAT_PSNR_SETTING, HALF_LEVEL_PSNR_SETTING,
+    HalfFloatFit, HALF_FLOAT_MARGIN_DB, HALF_FLOAT_PSNR_SETTING, LEVEL16_PSNR_SETTING,
 };
 use pis_format::Provenance;
 
@@ -50,8 +50,9 @@ pub struct PrecisionChoice {
     pub cube: wgpu::TextureFormat,
     /// Why, in a sentence.
     pub why: String,
-    /// The level images the GPU rebuild reads are 16-bit floats (else 32-bit).
-    pub half_levels: bool,
+    /// The level images the GPU rebuild reads are held in 16 bits a value (else as 32-bit
+    /// floats).
+    pub level16: bool,
     /// Why, in a sentence.
     pub levels_why: String,
 }
@@ -97,19 +98,19 @@ pub(super) fn choose(
     asked: TexturePrecision,
 ) -> PrecisionChoice {
     let (half, why) = half_or_not(asked, HalfFloatFit::of(p), HALF_FLOAT_PSNR_SETTING);
-    let (half_levels, levels_why) =
-        half_or_not(asked, HalfFloatFit::of_levels(p), HALF_LEVEL_PSNR_SETTING);
+    let (level16, levels_why) =
+        half_or_not(asked, HalfFloatFit::of_levels(p), LEVEL16_PSNR_SETTING);
     let half_format = wgpu::TextureFormat::Rgba16Float;
     if half {
         let (surface, cube) = (half_format, half_format);
-        return PrecisionChoice { surface, cube, why, half_levels, levels_why };
+        return PrecisionChoice { surface, cube, why, level16, levels_why };
     }
     let mut why = why;
     if gpu.texture_format == half_format {
         why.push_str("; the adapter cannot filter 32-bit floats, so surfaces are half floats");
     }
     let (surface, cube) = (gpu.texture_format, gpu.cube_format);
-    PrecisionChoice { surface, cube, why, half_levels, levels_why }
+    PrecisionChoice { surface, cube, why, level16, levels_why }
 }
 
 #[cfg(test)]
@@ -144,12 +145,12 @@ mod tests {
         assert!(!choose(&gpu, Some(&prov("80", "36")), TexturePrecision::Full).half());
         // The level images by their own measurement.
         let mut p = prov("80", "36");
-        assert!(!choose(&gpu, Some(&p), TexturePrecision::Auto).half_levels);
-        p.settings.push(("half_level_psnr_db".to_string(), "57".to_string()));
+        assert!(!choose(&gpu, Some(&p), TexturePrecision::Auto).level16);
+        p.settings.push(("level16_psnr_db".to_string(), "57".to_string()));
         let c = choose(&gpu, Some(&p), TexturePrecision::Auto);
-        assert!(c.half_levels && c.levels_why.contains("21.0 dB below"), "{c:?}");
+        assert!(c.level16 && c.levels_why.contains("21.0 dB below"), "{c:?}");
         p.settings.last_mut().unwrap().1 = "55".to_string();
-        assert!(!choose(&gpu, Some(&p), TexturePrecision::Auto).half_levels);
-        assert!(choose(&gpu, Some(&p), TexturePrecision::Half).half_levels);
+        assert!(!choose(&gpu, Some(&p), TexturePrecision::Auto).level16);
+        assert!(choose(&gpu, Some(&p), TexturePrecision::Half).level16);
     }
 }

@@ -63,13 +63,13 @@ impl Textures {
         gpu: &Gpu,
         (decoder, cache): (Decoder, LevelCache),
         mips: MipBuilder,
-        (rebuild_on, half_levels): (Rebuild, bool),
+        (rebuild_on, level16): (Rebuild, bool),
     ) -> Textures {
         Textures {
             decoder,
             cache,
             mips,
-            rebuild: LevelRebuild::new(gpu, half_levels),
+            rebuild: LevelRebuild::new(gpu, level16),
             rebuild_on,
             gpu_levels: HashMap::new(),
             prefetch: Prefetch::new(),
