@@ -87,26 +87,21 @@ fn json(out: &Output) -> serde_json::Value {
     serde_json::from_slice(&out.stdout).expect("JSON report")
 }
 
+/// `pis-play FILE --headless --compare SET --msaa 1 ARGS --json`: one sample per pixel, as
+/// pis-compile's hardware model (the prediction) draws.
+fn compare_one_sample(f: &Fixture, args: &[&str]) -> serde_json::Value {
+    let mut all = vec![os(&f.file), os("--headless"), os("--compare"), os(&f.set)];
+    all.extend(["--msaa", "1"].iter().chain(args).chain(&["--json"]).map(os));
+    json(&play(&all))
+}
+
 #[test]
 fn compare_agrees_with_the_pack_prediction() {
     if !gpu_or_skip("compare_agrees_with_the_pack_prediction") {
         return;
     }
     let f = fixture();
-    // One sample per pixel, as pis-compile's hardware model (the prediction) draws.
-    let compare = |precision: &str| {
-        json(&play(&[
-            os(&f.file),
-            os("--headless"),
-            os("--compare"),
-            os(&f.set),
-            os("--msaa"),
-            os("1"),
-            os("--texture-precision"),
-            os(precision),
-            os("--json"),
-        ]))
-    };
+    let compare = |precision: &str| compare_one_sample(f, &["--texture-precision", precision]);
     let r = compare("auto");
     assert_eq!((r["msaa_samples"].as_u64(), r["msaa_requested"].as_u64()), (Some(1), Some(1)));
     let predicted = f.pack["psnr_db"].as_f64().expect("pack psnr_db");
@@ -153,19 +148,7 @@ fn level_images_for_the_gpu_rebuild_follow_the_files_measurement() {
     }
     let f = fixture();
     let compare = |precision: &str| {
-        json(&play(&[
-            os(&f.file),
-            os("--headless"),
-            os("--compare"),
-            os(&f.set),
-            os("--msaa"),
-            os("1"),
-            os("--rebuild"),
-            os("gpu"),
-            os("--texture-precision"),
-            os(precision),
-            os("--json"),
-        ]))
+        compare_one_sample(f, &["--rebuild", "gpu", "--texture-precision", precision])
     };
     let predicted = f.pack["psnr_db"].as_f64().expect("pack psnr_db");
     let held = f.pack["level16_psnr_db"].as_f64().expect("level16_psnr_db");

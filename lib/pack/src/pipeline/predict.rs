@@ -329,9 +329,7 @@ pub fn half_float_psnr(
 ) -> Result<Option<f64>> {
     let mut errors = Vec::with_capacity(models.len());
     for (mi, m) in models.iter().enumerate() {
-        let mut decoded: Vec<Textures> =
-            m.layers.iter().map(|_| Textures::new(set.scratch.as_ref())).collect();
-        for_each_decoded(mi, m, packed, |li, k, y| decoded[li].insert(k, y))?;
+        let decoded = rebuilt_textures(set, (mi, m), packed, false)?.unwrap_or_default();
         match half_float_error(set, m, decoded.as_slice())? {
             Some(e) => errors.push(e),
             None => return Ok(None),
@@ -351,17 +349,28 @@ pub fn level16_psnr(
 ) -> Result<Option<f64>> {
     let mut errors = Vec::with_capacity(models.len());
     for (mi, m) in models.iter().enumerate() {
-        let textures = || -> Vec<Textures> {
-            m.layers.iter().map(|_| Textures::new(set.scratch.as_ref())).collect()
-        };
-        let (mut full, mut held) = (textures(), textures());
-        for_each_decoded(mi, m, packed, |li, k, y| full[li].insert(k, y))?;
-        if !for_each_rebuilt(mi, m, packed, true, |li, k, y| held[li].insert(k, y))? {
+        let full = rebuilt_textures(set, (mi, m), packed, false)?.unwrap_or_default();
+        let Some(held) = rebuilt_textures(set, (mi, m), packed, true)? else {
             return Ok(None);
-        }
+        };
         errors.push(frames_error(set, m, full.as_slice(), held.as_slice())?);
     }
     Ok(Some(total_psnr(&errors)))
+}
+
+/// Every decoded chain of object model `mi`, `m`, per layer ([`for_each_rebuilt`]: from
+/// level images held in 16 bits where `level16`); `None` where a level image holds a value
+/// that is not finite.
+fn rebuilt_textures(
+    set: &LoadedSet,
+    (mi, m): (usize, &ObjectModel),
+    packed: &Packed,
+    level16: bool,
+) -> Result<Option<Vec<Textures>>> {
+    let mut t: Vec<Textures> =
+        m.layers.iter().map(|_| Textures::new(set.scratch.as_ref())).collect();
+    let complete = for_each_rebuilt(mi, m, packed, level16, |li, k, y| t[li].insert(k, y))?;
+    Ok(complete.then_some(t))
 }
 
 /// The squared display difference between object `m` drawn with chains `a` and with chains
