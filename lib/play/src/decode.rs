@@ -10,7 +10,7 @@ use pis_codec::{CodecError, PlaneShape};
 use pis_compile::TextureLayout;
 use pis_format::issue::id;
 use pis_format::mip::{decimate, mip_size};
-use pis_format::reconstruct::{add_stored_mips, face_len};
+use pis_format::reconstruct::face_len;
 use pis_format::texture::LevelLayout;
 use pis_format::MipMode;
 use pis_format::{Error, Issue, Layer, PisReader, StreamRef};
@@ -105,22 +105,6 @@ pub fn decode_level(reader: &PisReader, job: &LevelJob) -> Result<Vec<f32>, Play
     Ok(values)
 }
 
-/// The linear texture of a job (SPEC.md 8.4 steps 2–4): the level images summed (top first,
-/// as the encoder's prediction), inverse gamma, stored MIP residuals added to the decimated
-/// finest level; every plane of the level layout, in its order. For a reduced texture; at
-/// full resolution [`assemble`] and [`assemble_cube`] rebuild in one pass ([`linear_span`]).
-fn reconstruct(job: &AssembleJob) -> Vec<f32> {
-    let n: usize =
-        job.layout.planes().iter().map(|p| (p.width * p.height * p.channels) as usize).sum();
-    let mut sum = vec![0.0f32; n];
-    sum.par_chunks_mut(CHUNK).enumerate().for_each(|(k, out)| linear_span(job, k * CHUNK, out));
-    if job.layer.mip_mode == MipMode::Stored && job.layout.mips > 1 {
-        sum.par_chunks_exact_mut(face_len(&job.layout))
-            .for_each(|face| add_stored_mips(&job.layout, face));
-    }
-    sum
-}
-
 /// Values `at..at + out.len()` of a job's planes, linear (SPEC.md 8.4 steps 2–3): the level
 /// images summed top first (the sum starts as the top level's copy, as the reader's does)
 /// and inverse gamma. Element by element, so any split of a texture into spans gives the
@@ -203,12 +187,12 @@ fn padded_row(row: &[f32], c: u32, out: &mut [f32]) {
     pad.chunks_exact_mut(4).for_each(|t| t.copy_from_slice(last));
 }
 
-/// [`assemble`] at a resolution reduction: [`reconstruct`], the finest level decimated
-/// `drop_levels` times.
+/// [`assemble`] at a resolution reduction: the finest level, linear, decimated `drop_levels`
+/// times.
 fn assemble_reduced(job: &AssembleJob) -> TextureImage {
     let (w0, h0, c) = (job.layout.width, job.layout.height, job.layout.channels);
-    let mut finest = reconstruct(job);
-    finest.truncate((w0 * h0 * c) as usize);
+    let mut finest = vec![0.0f32; (w0 * h0 * c) as usize];
+    finest.par_chunks_mut(CHUNK).enumerate().for_each(|(k, out)| linear_span(job, k * CHUNK, out));
     let (mut w, mut h) = (w0, h0);
     for m in 0..job.drop_levels {
         finest = decimate(&finest, w, h, c);
