@@ -519,12 +519,10 @@ fn auto_max_mse_keeps_the_better_of_the_constraint_and_the_free_allocation() {
 /// again when the default target became a played quality (`--within 1`): the allocation
 /// searched for the fewest bytes within 1 dB of the textures as solved; `--ratio 384`, the
 /// earlier default, still writes the earlier bytes ([`DEMO1_CI_PACK_384`]). Again when the
-/// provenance came to record `half_float_psnr_db` (SPEC.md 6.6): 33 bytes of settings; and
-/// again when it came to record `level16_psnr_db`: 31 more.
+/// provenance came to record `half_float_psnr_db` and `level16_psnr_db` (SPEC.md 6.6).
 const DEMO1_CI_PACK: (usize, u32) = (230_608, 0x0697_2276);
 
-/// The same at `--ratio 384`: the bytes the default wrote before it became a played quality
-/// (with `level16_psnr_db` recorded).
+/// The same at `--ratio 384`: the bytes the default wrote before it became a played quality.
 const DEMO1_CI_PACK_384: (usize, u32) = (195_853, 0xaa4e_27a7);
 
 #[test]
