@@ -327,15 +327,10 @@ pub fn half_float_psnr(
     models: &[ObjectModel],
     packed: &Packed,
 ) -> Result<Option<f64>> {
-    let mut errors = Vec::with_capacity(models.len());
-    for (mi, m) in models.iter().enumerate() {
+    psnr_over_objects(models, |mi, m| {
         let decoded = rebuilt_textures(set, (mi, m), packed, false)?.unwrap_or_default();
-        match half_float_error(set, m, decoded.as_slice())? {
-            Some(e) => errors.push(e),
-            None => return Ok(None),
-        }
-    }
-    Ok(Some(total_psnr(&errors)))
+        half_float_error(set, m, decoded.as_slice())
+    })
 }
 
 /// The PSNR of frames drawn from textures rebuilt from the level images held in 16 bits a
@@ -347,13 +342,27 @@ pub fn level16_psnr(
     models: &[ObjectModel],
     packed: &Packed,
 ) -> Result<Option<f64>> {
-    let mut errors = Vec::with_capacity(models.len());
-    for (mi, m) in models.iter().enumerate() {
+    psnr_over_objects(models, |mi, m| {
         let full = rebuilt_textures(set, (mi, m), packed, false)?.unwrap_or_default();
         let Some(held) = rebuilt_textures(set, (mi, m), packed, true)? else {
             return Ok(None);
         };
-        errors.push(frames_error(set, m, full.as_slice(), held.as_slice())?);
+        frames_error(set, m, full.as_slice(), held.as_slice()).map(Some)
+    })
+}
+
+/// The PSNR over every object of the squared errors `error` gives each (object index,
+/// model); `None` as soon as one gives none.
+fn psnr_over_objects(
+    models: &[ObjectModel],
+    mut error: impl FnMut(usize, &ObjectModel) -> Result<Option<(f64, usize)>>,
+) -> Result<Option<f64>> {
+    let mut errors = Vec::with_capacity(models.len());
+    for (mi, m) in models.iter().enumerate() {
+        match error(mi, m)? {
+            Some(e) => errors.push(e),
+            None => return Ok(None),
+        }
     }
     Ok(Some(total_psnr(&errors)))
 }
