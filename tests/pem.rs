@@ -388,10 +388,12 @@ fn depth_shells_follow_the_scene_and_play_as_predicted() {
     assert_valid(&depth);
     let distant = distant_layers(&depth);
     assert_eq!(distant.len(), 2, "{distant:?}");
-    for l in distant {
+    for l in &distant {
         assert_eq!(l["shell"], "depth", "{l}");
         assert_eq!(l["depends_on"], serde_json::json!([]), "{l}");
     }
+    // pis-inspect gives each depth shell's march steps: pis-pack's 32.
+    assert!(distant.iter().all(|l| l["march_steps"] == 32), "{distant:?}");
     let set = traced_set(dir.path());
     assert_plays_as_predicted(&depth, &set);
     // The single-view inference: one map per sample, each solved from its own view.
@@ -412,6 +414,25 @@ fn depth_shells_follow_the_scene_and_play_as_predicted() {
         (played(&[]), played(&["--depth-steps", "4"]), played(&["--depth-steps", "64"]));
     eprintln!("depth shells marched in the file's steps: {file:.2} dB, 4: {few:.2}, 64: {many:.2}");
     assert!(few < file - 1.0 && many > file - 0.1, "{file} {few} {many}");
+    // pis-bench marches them in the steps it is given, on and off the views.
+    let away = |steps: &[&str]| {
+        let b = Command::new(env!("CARGO_BIN_EXE_pis-bench"))
+            .arg("reflective")
+            .arg(&scene)
+            .arg(&depth)
+            .args(["--frames", "2", "--reference-spp", "4", "--json", "--out"])
+            .arg(dir.path().join("reports"))
+            .args(steps)
+            .output()
+            .expect("pis-bench runs");
+        assert!(b.status.success(), "{}", String::from_utf8_lossy(&b.stderr));
+        let r: serde_json::Value = serde_json::from_slice(&b.stdout).expect("JSON report");
+        let s = r["summaries"].as_array().expect("summaries");
+        s.iter().find(|s| s["path"] == "away").expect("away")["mean_psnr_db"].as_f64().unwrap()
+    };
+    let (file, few) = (away(&[]), away(&["--depth-steps", "4"]));
+    eprintln!("away from the views: the file's steps {file:.2} dB, 4 steps {few:.2} dB");
+    assert!(few < file - 1.0, "{file} {few}");
 }
 
 /// The distant shells' layers of `file` as pis-inspect describes them; the file is of

@@ -299,6 +299,10 @@ enum Command {
         /// The player's τ for lens objects (pis-play --tau), pixels.
         #[arg(long, default_value_t = 1.0)]
         tau: f32,
+        /// March depth shells in N coarse steps (1 to 64) instead of the files' (pis-play
+        /// --depth-steps): what the step count costs on and off the sampled views.
+        #[arg(long, value_name = "N", value_parser = pis::play::args::parse_depth_steps)]
+        depth_steps: Option<u32>,
         #[arg(long)]
         json: bool,
     },
@@ -608,6 +612,7 @@ fn run(cli: Cli) -> Result<Exit, Failure> {
             images,
             role,
             tau,
+            depth_steps,
             json,
         } => {
             let req = ReflectiveRequest {
@@ -621,6 +626,7 @@ fn run(cli: Cli) -> Result<Exit, Failure> {
                 images,
                 role,
                 tau_px: tau,
+                depth_steps,
             };
             let report = reflective::run(&req)?;
             reflective::print(&report, &mut std::io::stderr())

@@ -24,7 +24,7 @@ pub fn parse_tau(s: &str) -> Result<f32, String> {
     }
 }
 
-fn parse_depth_steps(s: &str) -> Result<u32, String> {
+pub fn parse_depth_steps(s: &str) -> Result<u32, String> {
     let steps = s.parse::<u32>().ok();
     pis_play::check_depth_steps(steps)?;
     steps.ok_or_else(|| format!("--depth-steps {s:?}: expected a whole number"))

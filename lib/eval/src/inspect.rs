@@ -105,6 +105,9 @@ pub struct LayerSummary {
     /// Lookups per pixel side of the first block, for shell layers (SPEC.md 8.2).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub lookups: Option<u32>,
+    /// A depth shell's march steps, of the first block (SPEC.md 7.3 `p[1]`, 8.5).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub march_steps: Option<u32>,
 }
 
 #[derive(Serialize, Default)]
@@ -154,7 +157,9 @@ pub fn summarize(r: &PisReader) -> Summary {
                         e.bytes += s.length as u64;
                     }
                     let first_shell = l.blocks.first().and_then(|b| match b.placement {
-                        Placement::Shell { shape, lookups, .. } => Some((shape, lookups)),
+                        Placement::Shell { shape, lookups, params, .. } => {
+                            Some((shape, lookups, params[1]))
+                        }
                         Placement::Surface { .. } => None,
                     });
                     LayerSummary {
@@ -175,8 +180,11 @@ pub fn summarize(r: &PisReader) -> Summary {
                         levels: l.blocks.iter().map(|b| b.levels.len()).max().unwrap_or(0),
                         codestreams: refs.len(),
                         bytes: refs.iter().map(|s| s.length as u64).sum(),
-                        shell: first_shell.map(|(shape, _)| shape.name()),
-                        lookups: first_shell.map(|(_, k)| k),
+                        shell: first_shell.map(|(shape, _, _)| shape.name()),
+                        lookups: first_shell.map(|(_, k, _)| k),
+                        march_steps: first_shell
+                            .filter(|&(shape, _, _)| shape == ShellShape::Depth)
+                            .map(|(_, _, steps)| steps as u32),
                     }
                 })
                 .collect();
@@ -353,10 +361,14 @@ pub fn render(s: &Summary) -> String {
         );
         for (i, l) in ob.layers.iter().enumerate() {
             let mapping = match l.shell {
-                Some(shape) => match l.lookups {
-                    Some(k) if k > 1 => format!("{shape} shell, {k}×{k} lookups"),
-                    _ => format!("{shape} shell"),
-                },
+                Some(shape) => {
+                    let steps =
+                        l.march_steps.map_or(String::new(), |n| format!(" ({n} march steps)"));
+                    match l.lookups {
+                        Some(k) if k > 1 => format!("{shape} shell{steps}, {k}×{k} lookups"),
+                        _ => format!("{shape} shell{steps}"),
+                    }
+                }
                 None => "surface".to_string(),
             };
             let deps = if l.depends_on.is_empty() {

@@ -54,6 +54,8 @@ pub struct ReflectiveRequest {
     pub role: ObjectRole,
     /// The player's τ for lens objects (pixels).
     pub tau_px: f32,
+    /// The march steps of depth shells, where not the files' (pis-play `--depth-steps`).
+    pub depth_steps: Option<u32>,
 }
 
 /// One file on one path.
@@ -320,7 +322,11 @@ pub fn run(req: &ReflectiveRequest) -> Result<ReflectiveReport, Failure> {
         let mut player = Player::open(
             gpu.clone(),
             file,
-            PlayerOptions { tau_px: req.tau_px, ..PlayerOptions::default() },
+            PlayerOptions {
+                tau_px: req.tau_px,
+                depth_steps: req.depth_steps,
+                ..PlayerOptions::default()
+            },
         )
         .map_err(|e| Failure::new(Exit::Invalid, anyhow!("{}: {e}", file.display())))?;
         if player.image_size() != size {
