@@ -10,7 +10,7 @@
 mod common;
 
 use std::path::{Path, PathBuf};
-use std::process::Command;
+use std::process::{Command, Output};
 
 fn sample() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../samples/teapot-pem")
@@ -151,19 +151,8 @@ fn a_mirror_teapot_as_layered_environment_maps() {
     // frames traced at those cameras, the layered PEM's worst frame stays well above the
     // textures' (pasted on, they are worst half-way between two samples); away from the
     // orbit, its shells place reflections better than one map at infinity.
-    let b = Command::new(env!("CARGO_BIN_EXE_pis-bench"))
-        .arg("reflective")
-        .arg(&scene)
-        .arg(&tex)
-        .arg(&pem)
-        .arg(&inf)
-        .arg(&stat)
-        .args(["--frames", "3", "--reference-spp", "4", "--json", "--out"])
-        .arg(dir.path().join("reports"))
-        .output()
-        .expect("pis-bench runs");
-    assert!(b.status.success(), "{}", String::from_utf8_lossy(&b.stderr));
-    let r: serde_json::Value = serde_json::from_slice(&b.stdout).expect("JSON report");
+    let files = [tex.as_path(), &pem, &inf, &stat];
+    let r = bench_report(&scene, &files, &["--frames", "3", "--reference-spp", "4"], dir.path());
     let summary = |file: &str, path: &str, key: &str| {
         r["summaries"]
             .as_array()
@@ -416,17 +405,8 @@ fn depth_shells_follow_the_scene_and_play_as_predicted() {
     assert!(few < file - 1.0 && many > file - 0.1, "{file} {few} {many}");
     // pis-bench marches them in the steps it is given, on and off the views.
     let away = |steps: &[&str]| {
-        let b = Command::new(env!("CARGO_BIN_EXE_pis-bench"))
-            .arg("reflective")
-            .arg(&scene)
-            .arg(&depth)
-            .args(["--frames", "2", "--reference-spp", "4", "--json", "--out"])
-            .arg(dir.path().join("reports"))
-            .args(steps)
-            .output()
-            .expect("pis-bench runs");
-        assert!(b.status.success(), "{}", String::from_utf8_lossy(&b.stderr));
-        let r: serde_json::Value = serde_json::from_slice(&b.stdout).expect("JSON report");
+        let args = [&["--frames", "2", "--reference-spp", "4"], steps].concat();
+        let r = bench_report(&scene, &[&depth], &args, dir.path());
         let s = r["summaries"].as_array().expect("summaries");
         s.iter().find(|s| s["path"] == "away").expect("away")["mean_psnr_db"].as_f64().unwrap()
     };
@@ -469,6 +449,30 @@ fn played_psnr(file: &Path, set: &Path, extra: &[&str]) -> f64 {
     r["psnr_db"].as_f64().expect("psnr_db")
 }
 
+/// `pis-bench reflective scene FILES... ARGS --json --out DIR/reports` run.
+fn bench_reflective(scene: &Path, files: &[&Path], args: &[&str], dir: &Path) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_pis-bench"))
+        .arg("reflective")
+        .arg(scene)
+        .args(files)
+        .args(args)
+        .args(["--json", "--out"])
+        .arg(dir.join("reports"))
+        .output()
+        .expect("pis-bench runs")
+}
+
+/// The JSON report of a pis-bench run that succeeded.
+fn report(b: Output) -> serde_json::Value {
+    assert!(b.status.success(), "{}", String::from_utf8_lossy(&b.stderr));
+    serde_json::from_slice(&b.stdout).expect("JSON report")
+}
+
+/// [`bench_reflective`]'s JSON report, the run asserted to succeed.
+fn bench_report(scene: &Path, files: &[&Path], args: &[&str], dir: &Path) -> serde_json::Value {
+    report(bench_reflective(scene, files, args, dir))
+}
+
 /// `pis-bench reflective --reference-pair`: every reference traced twice from independent
 /// sample streams, the pair's difference measures its noise, which the report takes out of
 /// each figure. Taken out of a noisy pair's figure, it brings the figure nearer what a pair
@@ -482,15 +486,8 @@ fn a_reference_pair_takes_its_own_noise_out() {
     let scene = copy_sample(dir.path());
     let (tex, _) = pack(&scene, "tex.pis", &["--representation", "texture"]);
     let bench = |spp: &str, extra: &[&str]| {
-        Command::new(env!("CARGO_BIN_EXE_pis-bench"))
-            .arg("reflective")
-            .arg(&scene)
-            .arg(&tex)
-            .args(["--frames", "2", "--reference-spp", spp, "--reference-pair", "--json", "--out"])
-            .arg(dir.path().join("reports"))
-            .args(extra)
-            .output()
-            .expect("pis-bench runs")
+        let args = [&["--frames", "2", "--reference-spp", spp, "--reference-pair"], extra].concat();
+        bench_reflective(&scene, &[&tex], &args, dir.path())
     };
     let refused = bench("4", &[]);
     assert_eq!(refused.status.code(), Some(1), "{}", String::from_utf8_lossy(&refused.stderr));
@@ -500,9 +497,7 @@ fn a_reference_pair_takes_its_own_noise_out() {
         String::from_utf8_lossy(&refused.stderr)
     );
     let figures = |spp: &str| -> (f64, f64, f64) {
-        let b = bench(spp, &["--reference-seed", "sample"]);
-        assert!(b.status.success(), "{}", String::from_utf8_lossy(&b.stderr));
-        let r: serde_json::Value = serde_json::from_slice(&b.stdout).expect("JSON report");
+        let r = report(bench(spp, &["--reference-seed", "sample"]));
         assert_eq!(r["reference_pair"], true);
         let s = r["summaries"]
             .as_array()
@@ -543,18 +538,9 @@ fn a_denoised_adaptive_reference_is_cleaner() {
     let scene = copy_sample(dir.path());
     let (tex, _) = pack(&scene, "tex.pis", &["--representation", "texture"]);
     let noise = |extra: &[&str]| -> (f64, String) {
-        let b = Command::new(env!("CARGO_BIN_EXE_pis-bench"))
-            .arg("reflective")
-            .arg(&scene)
-            .arg(&tex)
-            .args(["--frames", "2", "--reference-spp", "8", "--reference-seed", "sample"])
-            .args(["--reference-pair", "--json", "--out"])
-            .arg(dir.path().join("reports"))
-            .args(extra)
-            .output()
-            .expect("pis-bench runs");
-        assert!(b.status.success(), "{}", String::from_utf8_lossy(&b.stderr));
-        let r: serde_json::Value = serde_json::from_slice(&b.stdout).expect("JSON report");
+        let pair = ["--frames", "2", "--reference-spp", "8", "--reference-seed", "sample"];
+        let args = [&pair[..], &["--reference-pair"], extra].concat();
+        let r = bench_report(&scene, &[&tex], &args, dir.path());
         let s = &r["summaries"][0];
         let reference = r["reference"].as_str().expect("reference").to_string();
         (s["reference_psnr_db"].as_f64().unwrap_or_else(|| panic!("{s}")), reference)
