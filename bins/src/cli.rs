@@ -47,6 +47,13 @@ pub fn message(err: &anyhow::Error) -> String {
     out
 }
 
+/// `--depth-steps N` (pis-play, pis-bench reflective): depth shells' march steps, 1 to 64.
+pub fn parse_depth_steps(s: &str) -> Result<u32, String> {
+    let steps = s.parse::<u32>().ok();
+    pis_play::check_depth_steps(steps)?;
+    steps.ok_or_else(|| format!("--depth-steps {s:?}: expected a whole number"))
+}
+
 /// `--shading-seed` and `--reference-seed`: what seeds the tracer's shading.
 pub fn parse_shading_seed(s: &str) -> Result<pis_trace::ShadingSeed, String> {
     pis_trace::ShadingSeed::from_name(s)

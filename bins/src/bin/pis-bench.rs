@@ -301,7 +301,7 @@ enum Command {
         tau: f32,
         /// March depth shells in N coarse steps (1 to 64) instead of the files' (pis-play
         /// --depth-steps): what the step count costs on and off the sampled views.
-        #[arg(long, value_name = "N", value_parser = pis::play::args::parse_depth_steps)]
+        #[arg(long, value_name = "N", value_parser = pis::cli::parse_depth_steps)]
         depth_steps: Option<u32>,
         #[arg(long)]
         json: bool,

@@ -24,12 +24,6 @@ pub fn parse_tau(s: &str) -> Result<f32, String> {
     }
 }
 
-pub fn parse_depth_steps(s: &str) -> Result<u32, String> {
-    let steps = s.parse::<u32>().ok();
-    pis_play::check_depth_steps(steps)?;
-    steps.ok_or_else(|| format!("--depth-steps {s:?}: expected a whole number"))
-}
-
 pub fn parse_msaa(s: &str) -> Result<u32, String> {
     let n = s.parse::<u32>().map_err(|_| format!("--msaa {s:?}: expected 1 or 4"))?;
     pis_play::multisample::check_samples(n).map(|()| n)
@@ -116,7 +110,7 @@ pub struct PlayArgs {
     /// Depth shells: the march's coarse steps along each reflected ray (1 to 64), in place
     /// of the count the file records and its radiance was solved with. Fewer is faster and
     /// misses thin occluders; more finds them where the file's count stepped over them.
-    #[arg(long, value_name = "N", value_parser = parse_depth_steps)]
+    #[arg(long, value_name = "N", value_parser = crate::cli::parse_depth_steps)]
     pub depth_steps: Option<u32>,
     /// Lens objects (hybrid rendering): where each tessellation level's vertex rays are
     /// traced through the object: `gpu` (a compute pass over the object's BVH, uploaded

@@ -364,10 +364,11 @@ pub fn render(s: &Summary) -> String {
                 Some(shape) => {
                     let steps =
                         l.march_steps.map_or(String::new(), |n| format!(" ({n} march steps)"));
-                    match l.lookups {
-                        Some(k) if k > 1 => format!("{shape} shell{steps}, {k}×{k} lookups"),
-                        _ => format!("{shape} shell{steps}"),
-                    }
+                    let lookups = match l.lookups {
+                        Some(k) if k > 1 => format!(", {k}×{k} lookups"),
+                        _ => String::new(),
+                    };
+                    format!("{shape} shell{steps}{lookups}")
                 }
                 None => "surface".to_string(),
             };
