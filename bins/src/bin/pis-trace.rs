@@ -55,9 +55,9 @@ struct Cli {
     #[arg(long)]
     spp: Option<u32>,
     /// Adaptive sampling: a pixel stops taking samples once its estimated relative error
-    /// (its even against its odd samples, over the combined image and every object layer
-    /// the inference reads, on display values) is below this. 0 turns it off: every pixel
-    /// takes --spp samples.
+    /// (two halves of its samples, samples 0 and 3 of every four against 1 and 2, over the
+    /// combined image and every object layer the inference reads, on display values) is below
+    /// this. 0 turns it off: every pixel takes --spp samples.
     #[arg(long, value_name = "T", default_value_t = 0.0, value_parser = parse_threshold)]
     noise_threshold: f32,
     /// Adaptive sampling: the samples every pixel takes before its error is first estimated

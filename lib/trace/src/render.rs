@@ -1,7 +1,7 @@
 //! Rendering one parameter point: camera samples over the Gaussian filter, rows in parallel,
 //! accumulated in a fixed order so the result is byte-identical for any thread count.
 
-use crate::adaptive::{first_round, next_round, pixel_error};
+use crate::adaptive::{check_half, first_round, next_round, pixel_error};
 use crate::camera::PerspectiveCamera;
 use crate::denoise::{DenoiseInput, PointDenoise};
 use crate::error::TraceError;
@@ -239,6 +239,8 @@ fn render_row(
         };
         let mut whole = PixelAccum::default();
         let mut halves: [PixelAccum; 2] = Default::default();
+        // The stopping rule's halves, apart from the denoiser's (adaptive.rs).
+        let mut checks: [PixelAccum; 2] = Default::default();
         let mut end = first_round(settings.spp, settings.min_spp, settings.adaptive());
         let mut s = 0;
         let error = loop {
@@ -256,9 +258,12 @@ fn render_row(
                 if keep_halves {
                     halves[(s % 2) as usize].add(&sample);
                 }
+                if settings.adaptive() {
+                    checks[check_half(s)].add(&sample);
+                }
                 s += 1;
             }
-            let error = if keep_halves { pixel_error(&halves) } else { 0.0 };
+            let error = if settings.adaptive() { pixel_error(&checks) } else { 0.0 };
             if end >= settings.spp || error < settings.noise_threshold {
                 break error;
             }
