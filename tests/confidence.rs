@@ -36,7 +36,9 @@ fn rows_weighed_by_the_sets_confidence() {
     let dir = tempfile::tempdir().expect("temp dir");
     let d = dir.path();
     // Raw layers: a layer read from its denoised twin is not weighed.
-    trace(&d.join("adaptive"), &["--spp", "64", "--noise-threshold", "0.05", "--denoise", "off"]);
+    let adaptive =
+        ["--spp", "64", "--noise-threshold", "0.05", "--min-spp", "4", "--denoise", "off"];
+    trace(&d.join("adaptive"), &adaptive);
     trace(&d.join("fixed"), &["--spp", "8"]);
     trace(&d.join("ref"), &["--spp", "256", "--shading-seed", "sample", "--denoise", "off"]);
     // No error recorded: the same file.

@@ -61,8 +61,10 @@ struct Cli {
     #[arg(long, value_name = "T", default_value_t = 0.0, value_parser = parse_threshold)]
     noise_threshold: f32,
     /// Adaptive sampling: the samples every pixel takes before its error is first estimated
-    /// (rounded up to even; then rounds double it up to --spp).
-    #[arg(long, value_name = "N", default_value_t = 4)]
+    /// (rounded up to even; then rounds double it up to --spp). The denoiser judges its own
+    /// error from halves of the samples a pixel stopped at: from 4, halves of 2 read so noisy
+    /// that it keeps most layers raw (measured on five scenes, docs/benchmarks/clean-sets.md).
+    #[arg(long, value_name = "N", default_value_t = 16)]
     min_spp: u32,
     /// Denoise the layers with Open Image Denoise, guided by albedo and normal at the
     /// first non-specular hit; the raw layers stay in the set beside the `denoised.` ones.
