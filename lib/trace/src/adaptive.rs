@@ -2,10 +2,11 @@
 //! error is below the render's noise threshold.
 //!
 //! The estimate compares two half buffers of the pixel's samples, the stopping rule's halves
-//! ([`check_half`]; Cycles' adaptive sampling compares a half with the whole): for every value the inference
-//! reads (the combined image, and per object its coverage and its premultiplied diffuse,
-//! specular, local, distant, reflection and refraction layers), clamped to the display range
-//! [0, 1] first (a highlight far above white is converged once both halves are above it),
+//! ([`check_half`]; Cycles' adaptive sampling compares a half with the whole): for every
+//! value the inference reads (the combined image, and per object its coverage and its
+//! premultiplied diffuse, specular, local, distant, reflection and refraction layers), clamped
+//! to the display range [0, 1] first (a highlight far above white is converged once both
+//! halves are above it),
 //!
 //! ```text
 //! error = Σ_c |A_c − B_c| / 2 / (10⁻⁴ + √(Σ_c F_c))
@@ -175,14 +176,10 @@ mod tests {
                         // Box–Muller from two uniforms.
                         let [u, v] = rng.next_2d().to_array();
                         let g = (-2.0 * (1.0 - u).ln()).sqrt() * (std::f32::consts::TAU * v).cos();
-                        let sample = PixelAccum {
-                            samples: 1,
-                            combined: Vec3::splat(0.5 + sigma * g),
-                            ..Default::default()
-                        };
+                        let value = Vec3::splat(0.5 + sigma * g);
                         for (acc, k) in [(&mut halves, (s % 2) as usize), (&mut checks, split(s))] {
                             acc[k].samples += 1;
-                            acc[k].combined += sample.combined;
+                            acc[k].combined += value;
                         }
                         s += 1;
                     }
@@ -202,7 +199,9 @@ mod tests {
         };
         let apart = run(check_half);
         let same = run(|s| (s % 2) as usize);
-        eprintln!("a half's variance over the truth: {apart:.3} (rule apart), {same:.3} (rule on the same halves)");
+        eprintln!(
+            "a half's variance over the truth: {apart:.3} apart, {same:.3} on the same halves"
+        );
         assert!((0.85..1.15).contains(&apart), "stopped on the rule's halves: {apart}");
         assert!(same < 0.6, "stopped on the even and odd halves: {same}");
     }
