@@ -64,7 +64,7 @@ struct Cli {
     /// (rounded up to even; then rounds double it up to --spp). The denoiser judges its own
     /// error from halves of the samples a pixel stopped at: from 4, halves of 2 read so noisy
     /// that it keeps most layers raw (measured on five scenes, docs/benchmarks/clean-sets.md).
-    #[arg(long, value_name = "N", default_value_t = 16)]
+    #[arg(long, value_name = "N", default_value_t = pis_trace::adaptive::MIN_SPP)]
     min_spp: u32,
     /// Denoise the layers with Open Image Denoise, guided by albedo and normal at the
     /// first non-specular hit; the raw layers stay in the set beside the `denoised.` ones.

@@ -52,6 +52,12 @@ pub fn first_round(spp: u32, min_spp: u32, adaptive: bool) -> u32 {
     min.min(spp)
 }
 
+/// The samples every pixel takes before its error is first estimated, unless told otherwise
+/// (`pis-trace --min-spp`). The denoiser judges its own error from halves of the samples a
+/// pixel stopped at: from 4, halves of 2 read so noisy that it keeps most layers raw (five
+/// scenes measured, docs/benchmarks/clean-sets.md).
+pub const MIN_SPP: u32 = 16;
+
 /// Which of the stopping rule's halves sample `s` of a pixel goes to: bit 0 ⊕ bit 1 of `s`
 /// (samples 0 and 3 of every four in half 0, 1 and 2 in half 1).
 pub fn check_half(s: u32) -> usize {

@@ -227,12 +227,14 @@ fn render_row(
             seed => hash_keys(&[x as u64, y as u64, seed]),
         };
         let shift = Rng::new(pixel_seed).next_2d();
-        let keep_halves = settings.adaptive() || settings.denoise;
-        // Kept apart, the halves are two independently rotated sequences (even samples on
+        let adaptive = settings.adaptive();
+        // A render that compares halves of its samples (the stopping rule's, the
+        // denoiser's) takes them from two independently rotated sequences (even samples on
         // one, odd on the other), so that their difference measures the error of the
         // whole: halves of one low-discrepancy sequence differ by more than its error.
+        let two_sequences = adaptive || settings.denoise;
         let odd_shift = Rng::new(hash_keys(&[pixel_seed, ODD_HALF_STREAM])).next_2d();
-        let position = |s: u32| match (keep_halves, s % 2) {
+        let position = |s: u32| match (two_sequences, s % 2) {
             (false, _) => r2_point(s, shift),
             (true, 0) => r2_point(s / 2, shift),
             (true, _) => r2_point(s / 2, odd_shift),
@@ -241,7 +243,7 @@ fn render_row(
         let mut halves: [PixelAccum; 2] = Default::default();
         // The stopping rule's halves, apart from the denoiser's (adaptive.rs).
         let mut checks: [PixelAccum; 2] = Default::default();
-        let mut end = first_round(settings.spp, settings.min_spp, settings.adaptive());
+        let mut end = first_round(settings.spp, settings.min_spp, adaptive);
         let mut s = 0;
         let error = loop {
             while s < end {
@@ -255,15 +257,15 @@ fn render_row(
                     push_records(&mut records, &sample, pos);
                 }
                 whole.add(&sample);
-                if keep_halves {
+                if settings.denoise {
                     halves[(s % 2) as usize].add(&sample);
                 }
-                if settings.adaptive() {
+                if adaptive {
                     checks[check_half(s)].add(&sample);
                 }
                 s += 1;
             }
-            let error = if settings.adaptive() { pixel_error(&checks) } else { 0.0 };
+            let error = if adaptive { pixel_error(&checks) } else { 0.0 };
             if end >= settings.spp || error < settings.noise_threshold {
                 break error;
             }
