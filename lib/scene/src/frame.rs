@@ -102,6 +102,7 @@ impl Scene {
                     kind: l.kind,
                     radiance: l.radiance,
                     radius: l.radius,
+                    visible_camera: l.visible_camera,
                     position,
                     direction,
                 }

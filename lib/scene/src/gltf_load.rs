@@ -563,7 +563,7 @@ impl Ctx<'_> {
             }
         }
         let name = light.name().unwrap_or(node_name).to_owned();
-        Ok(LightRig { name, node, kind, radiance, radius })
+        Ok(LightRig { name, node, kind, radiance, radius, visible_camera: true })
     }
 
     /// Reads an animation; the inner `Err` holds (field, reason) when it uses something PIS

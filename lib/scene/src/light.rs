@@ -12,6 +12,9 @@ pub struct Light {
     pub radiance: [f32; 3],
     /// Sphere radius for area lights and soft shadows (glTF extras `radius`), 0 = point.
     pub radius: f32,
+    /// Whether camera rays see a sphere light's surface (`visible_camera`); reflected,
+    /// refracted and scattered rays always do.
+    pub visible_camera: bool,
     pub position: Vec3,
     /// Direction the light points to (unit), for spot and directional lights.
     pub direction: Vec3,

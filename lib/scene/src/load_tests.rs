@@ -312,6 +312,7 @@ position = [1, 2, 3]
 radius = 0.5
 intensity = 4
 color = [1, 0.5, 0.25]
+visible_camera = false
 
 [[light]]
 name = "Sun"
@@ -336,6 +337,7 @@ outer_cone_deg = 30
         (key.kind, key.position, key.radius, key.radiance),
         (crate::LightKind::Point, Vec3::new(1.0, 2.0, 3.0), 0.5, [4.0, 2.0, 1.0])
     );
+    assert!(!key.visible_camera && frame.lights[0].visible_camera, "seen by the camera by default");
     assert_eq!(sun.kind, crate::LightKind::Directional);
     assert!(sun.direction.abs_diff_eq(Vec3::NEG_Y, 1e-6), "{}", sun.direction);
     assert!(
@@ -348,6 +350,10 @@ outer_cone_deg = 30
     );
     for (bad, field) in [
         ("[[light]]\nname = \"A\"\nkind = \"sphere\"\nposition = [0, 1, 0]\n", "light[1].radius"),
+        (
+            "[[light]]\nname = \"A\"\nkind = \"point\"\nposition = [0, 1, 0]\nvisible_camera = false\n",
+            "light[1].visible_camera",
+        ),
         ("[[light]]\nname = \"A\"\nkind = \"spot\"\nposition = [0, 1, 0]\n", "light[1].direction"),
         (
             "[[light]]\nname = \"A\"\nkind = \"directional\"\ndirection = [0, 0, 0]\n",

@@ -75,6 +75,8 @@ pub struct LightRig {
     pub radiance: [f32; 3],
     /// Sphere radius from the light's extras, 0 for a point light.
     pub radius: f32,
+    /// Whether camera rays see the sphere ([`crate::model::Light::visible_camera`]).
+    pub visible_camera: bool,
 }
 
 impl Rig {

@@ -31,6 +31,8 @@ pub struct LightSpec {
     pub intensity: Option<f32>,
     /// Sphere lights: the radius (> 0).
     pub radius: Option<f32>,
+    /// Sphere lights: whether camera rays see the sphere (default true).
+    pub visible_camera: Option<bool>,
     /// Spot lights: the cone angles in degrees (defaults 0 and 45, as in glTF).
     pub inner_cone_deg: Option<f32>,
     pub outer_cone_deg: Option<f32>,
@@ -99,6 +101,9 @@ pub fn add_lights(rig: &mut Rig, specs: &[LightSpec], path: &Path) -> Result<(),
             (_, Some(_)) => return Err(bad("radius", "only a sphere light has a radius".into())),
             (_, None) => 0.0,
         };
+        if s.visible_camera.is_some() && s.kind != LightKindSpec::Sphere {
+            return Err(bad("visible_camera", "only a sphere light is seen by the camera".into()));
+        }
         let kind = match s.kind {
             LightKindSpec::Spot => {
                 let inner = s.inner_cone_deg.unwrap_or(0.0);
@@ -136,6 +141,7 @@ pub fn add_lights(rig: &mut Rig, specs: &[LightSpec], path: &Path) -> Result<(),
             kind,
             radiance: color.map(|c| c * intensity),
             radius,
+            visible_camera: s.visible_camera.unwrap_or(true),
         });
     }
     Ok(())

@@ -104,6 +104,25 @@ pub fn hit_light_sphere(
     dir: Vec3,
     tmax: f32,
 ) -> Option<(f32, Vec3)> {
+    hit_sphere_among(lights.iter(), origin, dir, tmax)
+}
+
+/// [`hit_light_sphere`] for a camera ray: the spheres with `visible_camera`.
+pub fn camera_hit_light_sphere(
+    lights: &[Light],
+    origin: Vec3,
+    dir: Vec3,
+    tmax: f32,
+) -> Option<(f32, Vec3)> {
+    hit_sphere_among(lights.iter().filter(|l| l.visible_camera), origin, dir, tmax)
+}
+
+fn hit_sphere_among<'a>(
+    lights: impl Iterator<Item = &'a Light>,
+    origin: Vec3,
+    dir: Vec3,
+    tmax: f32,
+) -> Option<(f32, Vec3)> {
     let mut best: Option<(f32, Vec3)> = None;
     for light in lights {
         if light.radius <= 0.0 || light.kind == LightKind::Directional {

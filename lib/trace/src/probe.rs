@@ -318,6 +318,7 @@ mod tests {
             kind: LightKind::Point,
             radiance: [20.0; 3],
             radius: 0.1,
+            visible_camera: true,
             position: Vec3::new(0.0, 3.0, 0.0),
             direction: Vec3::NEG_Y,
         };

@@ -298,6 +298,7 @@ mod darkness_tests {
             kind: LightKind::Point,
             radiance: [1.0; 3],
             radius: 0.0,
+            visible_camera: true,
         });
         assert_eq!(darkness_warning(&s), None, "a light lights it");
     }

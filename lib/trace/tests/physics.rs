@@ -4,7 +4,7 @@ mod common;
 
 use common::*;
 use glam::{Vec2, Vec3};
-use pis_scene::ObjectRole;
+use pis_scene::{Light, ObjectRole};
 use pis_trace::camera::PerspectiveCamera;
 use pis_trace::{render_point, LayerKind, PointRender, TraceSettings};
 
@@ -194,6 +194,61 @@ fn mirror_reflects_analytic_scene() {
             }
         }
     }
+}
+
+/// A sphere light hidden from the camera (`visible_camera = false`) leaves black the pixels
+/// that see it directly, and nothing else: its reflection in a mirror floor is as bright,
+/// sample for sample, as the reflection of the same light seen by the camera.
+#[test]
+fn a_light_hidden_from_the_camera_is_still_reflected() {
+    let (centre, radius) = (Vec3::new(0.0, 1.8, -4.0), 1.0);
+    let s = scene(
+        vec![object(
+            "mirror",
+            ObjectRole::Reflective,
+            vec![quad(Vec3::ZERO, Vec3::Z * 10.0, Vec3::X * 10.0, 0)],
+        )],
+        vec![metal([1.0; 3], 0.0)],
+        (32, 24),
+        4,
+    );
+    let cam = camera(Vec3::new(0.0, 1.2, 4.0), Vec3::new(0.0, 0.6, -3.0), 40.0);
+    let render_with = |visible_camera: bool| {
+        let light = Light { visible_camera, ..sphere_light("lamp", centre, [4.0; 3], radius) };
+        let f = frame(&s, cam, vec![light]);
+        render(&s, &f, &TraceSettings::new(s.resolution, s.spp))
+    };
+    let (seen, hidden) = (render_with(true), render_with(false));
+    let (seen, hidden) =
+        (seen.images.layer("combined").unwrap(), hidden.images.layer("combined").unwrap());
+    let pc = PerspectiveCamera::new(&cam, s.resolution);
+    let sees_light = |pos: Vec2| {
+        let d = pc.direction(pos);
+        let oc = centre - pc.origin;
+        let b = d.dot(oc);
+        b > 0.0 && oc.length_squared() - b * b <= radius * radius
+    };
+    let (mut direct, mut reflected) = (0, 0);
+    for y in 0..24 {
+        for x in 0..32 {
+            let c = Vec2::new(x as f32 + 0.5, y as f32 + 0.5);
+            let footprint: Vec<bool> = (0..16)
+                .map(|k| {
+                    let a = k as f32 * std::f32::consts::PI / 8.0;
+                    sees_light(c + Vec2::new(a.cos(), a.sin()) * 1.6)
+                })
+                .collect();
+            let (a, b) = (seen.rgb(x, y), hidden.rgb(x, y));
+            if footprint.iter().all(|&v| v) && sees_light(c) {
+                direct += 1;
+                assert!(a.min_element() > 1.0 && b == Vec3::ZERO, "pixel ({x},{y}): {a} / {b}");
+            } else if footprint.iter().all(|&v| !v) && !sees_light(c) {
+                assert_eq!(a, b, "pixel ({x},{y})");
+                reflected += usize::from(b.min_element() > 1.0);
+            }
+        }
+    }
+    assert!(direct > 4 && reflected > 4, "direct {direct}, reflected {reflected}");
 }
 
 /// Σ objects coverage · (diffuse + specular) reproduces the combined image.

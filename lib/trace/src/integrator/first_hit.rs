@@ -5,7 +5,7 @@
 use super::guide::Guide;
 use super::{Integrator, PathContext};
 use crate::bvh::{offset_origin, SurfacePoint};
-use crate::lights::hit_light_sphere;
+use crate::lights::{camera_hit_light_sphere, hit_light_sphere};
 use crate::material::ShadingMaterial;
 use crate::sampling::{luminance, Rng};
 use glam::Vec3;
@@ -86,7 +86,7 @@ impl Integrator<'_> {
     ) -> CameraSample {
         let hit = self.trace(origin, dir, None, ctx);
         let tmax = hit.map_or(f32::INFINITY, |h| h.t);
-        if let Some((_, l)) = hit_light_sphere(&self.frame.lights, origin, dir, tmax) {
+        if let Some((_, l)) = camera_hit_light_sphere(&self.frame.lights, origin, dir, tmax) {
             return CameraSample { combined: l, ..Default::default() };
         }
         let Some(hit) = hit else {

@@ -138,6 +138,18 @@ pub struct LightMeta {
     pub radiance: [f32; 3],
     /// Sphere radius, 0 for a point light.
     pub radius: f32,
+    /// Whether camera rays see the sphere; written only when false.
+    #[serde(default = "seen", skip_serializing_if = "is_seen")]
+    pub visible_camera: bool,
+}
+
+/// [`LightMeta::visible_camera`]'s default.
+fn seen() -> bool {
+    true
+}
+
+fn is_seen(visible_camera: &bool) -> bool {
+    *visible_camera
 }
 
 /// An object's placement at one point.

@@ -204,6 +204,7 @@ impl SetWriter {
                     direction: l.direction.to_array(),
                     radiance: l.radiance,
                     radius: l.radius,
+                    visible_camera: l.visible_camera,
                 })
                 .collect(),
             objects: self

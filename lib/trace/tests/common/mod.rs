@@ -173,6 +173,7 @@ pub fn sphere_light(name: &str, pos: Vec3, i: [f32; 3], r: f32) -> Light {
         kind: LightKind::Point,
         radiance: i,
         radius: r,
+        visible_camera: true,
         position: pos,
         direction: Vec3::NEG_Y,
     }

@@ -3,7 +3,9 @@
 //! is judged under, traced with exactly those lights: two coloured directional lights
 //! (relight-two.toml) and an HDR sky (relight-sky.toml with relight-sky.exr); and the sun
 //! moving continuously along an arc (relight-arc.toml), to judge popping. Every direction
-//! they light from is one the 64 samples do not hold.
+//! they light from is one the 64 samples do not hold. relight-soft.toml and
+//! relight-soft-arc.toml turn a sphere light of the scene's radius instead of the sun: soft
+//! shadows, and highlights as wide as the light.
 
 use std::io;
 use std::path::Path;
@@ -12,10 +14,12 @@ use glam::Vec3;
 
 use super::wild_toml::{header, orbit};
 
-/// Writes relight.toml, relight-two.toml, relight-sky.toml, relight-sky.exr and
-/// relight-arc.toml into `dir`.
+/// Writes relight.toml, relight-two.toml, relight-sky.toml, relight-sky.exr,
+/// relight-arc.toml, relight-soft.toml and relight-soft-arc.toml into `dir`.
 pub fn write(dir: &Path, target: Vec3) -> io::Result<()> {
     std::fs::write(dir.join("relight.toml"), relight_toml(target))?;
+    std::fs::write(dir.join("relight-soft.toml"), soft_toml(target, false))?;
+    std::fs::write(dir.join("relight-soft-arc.toml"), soft_toml(target, true))?;
     std::fs::write(dir.join("relight-arc.toml"), arc_toml(target))?;
     std::fs::write(dir.join("relight-two.toml"), two_lights_toml(target))?;
     std::fs::write(dir.join("relight-sky.toml"), sky_toml(target))?;
@@ -66,6 +70,75 @@ samples = {{ sun = 12 }}
              relight-sky.toml's sky.",
         ),
         views = views(target),
+    )
+}
+
+/// The radius of still-life's bounding sphere (half the diagonal of its box: the ground's
+/// 3 × 3 m and the objects up to 0.54 m), metres.
+const SCENE_RADIUS: f32 = 2.14;
+
+/// How far the sphere light stands from the target: clear of the scene's bounding sphere
+/// from every direction (6 − 2 × 2.14 = 1.7 m apart).
+const SOFT_DISTANCE: f32 = 6.0;
+
+/// A sphere light of the scene's radius turned over 64 directions of the upper hemisphere
+/// (`--preset held`: 12 others), or along relight-arc.toml's arc (`arc`). Its intensity
+/// gives the target the sun's 3 lux (I = E d²); camera rays pass through it, so that where
+/// it stands behind the objects it does not cover the background that no file draws.
+fn soft_toml(target: Vec3, arc: bool) -> String {
+    let (name, title, directions) = if arc {
+        (
+            "still-life-relight-soft-arc",
+            "still-life-relight-soft-arc — still-life under a sphere light moving along an arc",
+            "samples = 24\ndirections = \"arc\"\nelevation_deg = 35\nazimuth_deg = [0, 90]",
+        )
+    } else {
+        (
+            "still-life-relight-soft",
+            "still-life-relight-soft — still-life under a sphere light of the scene's radius",
+            "samples = 64",
+        )
+    };
+    let what = if arc {
+        "Exercises: the reference for relight-soft.toml's file as its light moves\n\
+         continuously (pis-bench relight FILE --held SET reports the frame-to-frame change)."
+    } else {
+        "Exercises: a light_direction dimension turning a sphere light as large as the scene\n\
+         (soft shadows, wide highlights) over 64 directions of the upper hemisphere x 4\n\
+         views; pis-bench relight judges the relit file at the 12 directions of --preset held."
+    };
+    format!(
+        r#"{header}
+name = "{name}"
+gltf = "still-life.gltf"
+{SIZE}
+# The only light: a sphere of the scene's radius whose direction is the light dimension,
+# unseen by camera rays.
+[[light]]
+name = "Sun"
+kind = "sphere"
+position = [0, {SOFT_DISTANCE}, 0]
+radius = {SCENE_RADIUS}
+visible_camera = false
+intensity = {intensity}
+
+{views}
+[[dimension]]
+name = "sun"
+driver = "light_direction"
+light = "Sun"
+{directions}
+center = [{x}, {y}, {z}]
+distance = {SOFT_DISTANCE}
+{held}
+{PAPER}"#,
+        header = header(title, what),
+        intensity = 3.0 * SOFT_DISTANCE * SOFT_DISTANCE,
+        views = views(target),
+        held = if arc { "" } else { "\n[preset.held]\nsamples = { sun = 12 }\n" },
+        x = target.x,
+        y = target.y,
+        z = target.z,
     )
 }
 
