@@ -81,6 +81,21 @@ const SCENE_RADIUS: f32 = 2.14;
 /// from every direction (6 − 2 × 2.14 = 1.7 m apart).
 const SOFT_DISTANCE: f32 = 6.0;
 
+/// relight-soft.toml's presets: 12 other directions (`held`), and view 0 alone at
+/// 640×480 over the 64 directions (`paper-view`) and the 12 (`paper-view-held`).
+const SOFT_PRESETS: &str = "
+[preset.held]
+samples = { sun = 12 }
+
+[preset.paper-view]
+resolution = [640, 480]
+samples = { view = 1 }
+
+[preset.paper-view-held]
+resolution = [640, 480]
+samples = { view = 1, sun = 12 }
+";
+
 /// A sphere light of the scene's radius turned over 64 directions of the upper hemisphere
 /// (`--preset held`: 12 others), or along relight-arc.toml's arc (`arc`). Its intensity
 /// gives the target the sun's 3 lux (I = E d²); camera rays pass through it, so that where
@@ -135,7 +150,7 @@ distance = {SOFT_DISTANCE}
         header = header(title, what),
         intensity = 3.0 * SOFT_DISTANCE * SOFT_DISTANCE,
         views = views(target),
-        held = if arc { "" } else { "\n[preset.held]\nsamples = { sun = 12 }\n" },
+        held = if arc { "" } else { SOFT_PRESETS },
         x = target.x,
         y = target.y,
         z = target.z,
