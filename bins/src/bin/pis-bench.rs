@@ -350,10 +350,14 @@ enum Command {
         files: Vec<PathBuf>,
         /// The set traced under held-out lights, its other dimensions as the files': the
         /// same `light_direction` dimension with another sample count, or a scene of
-        /// directional lights and an `[environment]` without that dimension.
+        /// directional lights and an `[environment]` without that dimension (where the files'
+        /// light was a placed point or sphere light: that light placed from other directions,
+        /// in any colours, with --fitted).
         #[arg(long, value_name = "SET_DIR")]
         held: PathBuf,
-        /// The set the files were packed from: the per-pixel fit's ceiling per band.
+        /// The set the files were packed from: the per-pixel fit's ceiling per band, and
+        /// where its light was placed (centre + distance · ω), so that the held-out set's
+        /// placed lights are read as that light from their directions.
         #[arg(long, value_name = "SET_DIR")]
         fitted: Option<PathBuf>,
         /// Bands of the ceiling.
@@ -663,10 +667,17 @@ fn run(cli: Cli) -> Result<Exit, Failure> {
                 ));
             }
             let ceiling = fitted
-                .map(|f| pis_eval::relight::ceiling_of(&f, &held, &bands))
+                .as_ref()
+                .map(|f| pis_eval::relight::ceiling_of(f, &held, &bands))
                 .transpose()
                 .map_err(runtime)?;
-            let played = pis_eval::relight::held_out(&files, &held).map_err(runtime)?;
+            let placement = fitted
+                .map(|f| pis_eval::relight::placement_of(&f))
+                .transpose()
+                .map_err(runtime)?
+                .flatten();
+            let played =
+                pis_eval::relight::held_out(&files, &held, placement.as_ref()).map_err(runtime)?;
             let reference_step_db = pis_eval::relight::reference_step(&held).map_err(runtime)?;
             let report = pis_eval::relight::RelightReport { ceiling, played, reference_step_db };
             eprint!("{}", pis_eval::relight::render(&report));

@@ -12,7 +12,7 @@ use glam::Vec3;
 use pis_compile::relight::{coefficients, Cover, DirectionalLight, LightFit, Lights};
 use pis_trace::set::RaySet;
 
-use super::held::{light_dimension, others, HeldLights};
+use super::held::{light_dimension, others, HeldLights, Placement};
 use super::CeilingRow;
 use crate::metrics::SquaredError;
 
@@ -55,11 +55,12 @@ pub fn ceiling(set: &Path, held: &Path, bands: &[u32], cover: Cover) -> Result<V
     let held = RaySet::open(held).context("the held-out set")?;
     let (k, dirs) = light_dimension(&set)?
         .ok_or_else(|| anyhow!("{}: no light_direction dimension", set.dir.display()))?;
-    let e0 = fitted_e0(&set, k, &dirs);
-    let lights = HeldLights::of(&held, e0.unwrap_or([1.0; 3]))?;
+    let placement = Placement::of(&set, k, &dirs)?;
+    let e0 = placement.map(|p| p.radiance).or_else(|| fitted_e0(&set, k, &dirs));
+    let lights = HeldLights::of(&held, e0.unwrap_or([1.0; 3]), placement.as_ref())?;
     if lights.dim.is_none() && e0.is_none() {
         bail!(
-            "{}: the fitted light is not directional: its irradiance is unknown",
+            "{}: the fitted light is neither directional nor placed: its irradiance is unknown",
             set.dir.display()
         );
     }
@@ -157,4 +158,11 @@ pub fn ceiling_of(set: &Path, held: &Path, bands: &[u32]) -> Result<Vec<CeilingR
     let cover =
         if dirs.iter().any(|w| w.y < -1e-6) { Cover::Sphere } else { Cover::Hemisphere(Vec3::Y) };
     ceiling(set, held, bands, cover)
+}
+
+/// Where `set`'s light dimension placed its light, if it placed one (a point or sphere light).
+pub fn placement_of(set: &Path) -> Result<Option<Placement>> {
+    let set = RaySet::open(set).context("the fitted set")?;
+    let Some((k, dirs)) = light_dimension(&set)? else { return Ok(None) };
+    Placement::of(&set, k, &dirs)
 }

@@ -29,6 +29,68 @@ pub fn others(samples: &[u32], k: Option<usize>) -> Vec<u32> {
     samples.iter().enumerate().filter(|(j, _)| Some(*j) != k).map(|(_, s)| *s).collect()
 }
 
+/// Where a light dimension placed its light: at `centre + distance · ω` for each direction ω
+/// (a point or sphere light of `radius`; a directional light has no placement).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Placement {
+    pub centre: Vec3,
+    pub distance: f32,
+    pub radius: f32,
+    /// The placed light's colour × intensity over the squared distance: its irradiance at
+    /// the centre, as a file records a placed light's radiance (SPEC.md 6.6).
+    pub radiance: [f32; 3],
+}
+
+impl Placement {
+    /// The placement of `set`'s light dimension `k` of directions `dirs`, from the light
+    /// that moves between its points; `None` where that light is directional.
+    pub fn of(set: &RaySet, k: usize, dirs: &[Vec3]) -> Result<Option<Placement>> {
+        let points = &set.meta.points;
+        let Some(first) = points.first() else { return Ok(None) };
+        let Some(other) = points.iter().find(|p| p.samples[k] != first.samples[k]) else {
+            return Ok(None);
+        };
+        let moved = first.lights.iter().zip(&other.lights).position(|(a, b)| {
+            a.kind != "directional" && Vec3::from(a.position) != Vec3::from(b.position)
+        });
+        let Some(l) = moved else { return Ok(None) };
+        let at = |p: &pis_trace::set::PointMeta| {
+            (Vec3::from(p.lights[l].position), dirs[p.samples[k] as usize])
+        };
+        let ((p0, w0), (p1, w1)) = (at(first), at(other));
+        let distance = p0.distance(p1) / w0.distance(w1);
+        let centre = p0 - distance * w0;
+        for (i, p) in points.iter().enumerate() {
+            let (q, w) = at(p);
+            if q.distance(centre + distance * w) > 1e-3 * distance.max(1.0) {
+                bail!(
+                    "{}: point {i}: light `{}` stands off the sphere of radius {distance} \
+                     about {centre} that the other points place it on",
+                    set.dir.display(),
+                    p.lights[l].name
+                );
+            }
+        }
+        let light = &first.lights[l];
+        let radiance = light.radiance.map(|c| c / (distance * distance));
+        Ok(Some(Placement { centre, distance, radius: light.radius, radiance }))
+    }
+
+    /// `light` as the placed light moved (the same radius, at the same distance from the
+    /// centre): the direction it stands in and its radiance as [`Placement::radiance`].
+    fn as_placed(&self, light: &pis_trace::set::LightMeta) -> Option<DirectionalLight> {
+        let to = Vec3::from(light.position) - self.centre;
+        let near = |a: f32, b: f32| (a - b).abs() <= 1e-3 * b.max(1e-3);
+        let same = light.kind != "directional"
+            && near(light.radius, self.radius)
+            && near(to.length(), self.distance);
+        same.then(|| DirectionalLight {
+            direction: to.normalize(),
+            radiance: light.radiance.map(|c| c / (self.distance * self.distance)),
+        })
+    }
+}
+
 /// How a held-out set was lit.
 pub struct HeldLights {
     /// Its light dimension, where its points differ by one light's direction.
@@ -38,8 +100,10 @@ pub struct HeldLights {
 }
 
 impl HeldLights {
-    /// The lights of every point of `held`; `e0` is the irradiance of the fitted light.
-    pub fn of(held: &RaySet, e0: [f32; 3]) -> Result<HeldLights> {
+    /// The lights of every point of `held`; `e0` is the irradiance (or, placed, the
+    /// radiance) of the fitted light. Where the fitted light was placed (`placement`),
+    /// `held`'s lights may be that light placed from other directions.
+    pub fn of(held: &RaySet, e0: [f32; 3], placement: Option<&Placement>) -> Result<HeldLights> {
         let dim = light_dimension(held)?;
         if let Some((k, dirs)) = &dim {
             let points = held
@@ -61,17 +125,36 @@ impl HeldLights {
         for (i, p) in held.meta.points.iter().enumerate() {
             let mut directional = Vec::new();
             for l in &p.lights {
-                if l.kind != "directional" {
-                    bail!(
+                let light = match placement {
+                    _ if l.kind == "directional" => DirectionalLight {
+                        direction: -Vec3::from(l.direction).normalize_or(Vec3::NEG_Y),
+                        radiance: l.radiance,
+                    },
+                    Some(placed) => placed.as_placed(l).ok_or_else(|| {
+                        anyhow!(
+                            "{}: point {i} is lit by {} light `{}` of radius {} at {:?}: the \
+                             file relights only under its own light of radius {} placed at \
+                             {} from {}, directional lights and the environment",
+                            held.dir.display(),
+                            l.kind,
+                            l.name,
+                            l.radius,
+                            l.position,
+                            placed.radius,
+                            placed.distance,
+                            placed.centre
+                        )
+                    })?,
+                    None => bail!(
                         "{}: point {i} is lit by {} light `{}`: only directional lights and \
-                         the environment relight a file",
+                         the environment relight a file traced with a directional light (one \
+                         traced with a placed light names its set with --fitted)",
                         held.dir.display(),
                         l.kind,
                         l.name
-                    );
-                }
-                let direction = -Vec3::from(l.direction).normalize_or(Vec3::NEG_Y);
-                directional.push(DirectionalLight { direction, radiance: l.radiance });
+                    ),
+                };
+                directional.push(light);
             }
             points.push(Lights { directional, sky: sky.clone() });
         }

@@ -9,8 +9,8 @@ mod played;
 
 use serde::Serialize;
 
-pub use ceiling::{ceiling, ceiling_of};
-pub use held::{light_dimension, HeldLights};
+pub use ceiling::{ceiling, ceiling_of, placement_of};
+pub use held::{light_dimension, HeldLights, Placement};
 pub use played::{held_out, reference_step};
 
 /// One band's figure, or the nearest sampled direction's (`band` `None`).

@@ -11,12 +11,17 @@ use glam::Vec3;
 use pis_play::{CameraChoice, FrameRequest, Gpu, Player, PlayerOptions};
 use pis_trace::set::RaySet;
 
-use super::held::{others, HeldLights};
+use super::held::{others, HeldLights, Placement};
 use super::HeldOutRow;
 use crate::metrics::SquaredError;
 
-/// Each of `files` played at every point of `held`, its other dimensions at their samples.
-pub fn held_out(files: &[PathBuf], held: &Path) -> Result<Vec<HeldOutRow>> {
+/// Each of `files` played at every point of `held`, its other dimensions at their samples;
+/// `placement` places the held-out set's point or sphere lights as the files' traced light.
+pub fn held_out(
+    files: &[PathBuf],
+    held: &Path,
+    placement: Option<&Placement>,
+) -> Result<Vec<HeldOutRow>> {
     let set = RaySet::open(held).context("the held-out set")?;
     let gpu = std::sync::Arc::new(Gpu::new()?);
     let mut rows = Vec::new();
@@ -27,12 +32,17 @@ pub fn held_out(files: &[PathBuf], held: &Path) -> Result<Vec<HeldOutRow>> {
         };
         let mut player = Player::open(gpu.clone(), file, options)
             .with_context(|| format!("{}", file.display()))?;
-        rows.push(play_file(&mut player, file, &set)?);
+        rows.push(play_file(&mut player, file, &set, placement)?);
     }
     Ok(rows)
 }
 
-fn play_file(player: &mut Player, file: &Path, set: &RaySet) -> Result<HeldOutRow> {
+fn play_file(
+    player: &mut Player,
+    file: &Path,
+    set: &RaySet,
+    placement: Option<&Placement>,
+) -> Result<HeldOutRow> {
     let c = player.reader().container();
     let file_lights = pis_format::relight::light_directions(c.provenance.as_ref(), &c.space)
         .map_err(|e| anyhow!("{}: {e}", file.display()))?
@@ -40,7 +50,7 @@ fn play_file(player: &mut Player, file: &Path, set: &RaySet) -> Result<HeldOutRo
     let relightable = c.objects.iter().flat_map(|o| &o.layers).any(|l| l.basis != 0);
     let k = file_lights.dim;
     let values = c.space.dims.get(k).map(|d| d.values.clone()).unwrap_or_default();
-    let lights = HeldLights::of(set, file_lights.radiance)?;
+    let lights = HeldLights::of(set, file_lights.radiance, placement)?;
     let mut row = HeldOutRow {
         file: file.display().to_string(),
         bytes: std::fs::metadata(file)?.len(),
@@ -133,7 +143,10 @@ impl Steps {
 /// The held-out set's own largest step where its light moves continuously.
 pub fn reference_step(held: &Path) -> Result<Option<f64>> {
     let set = RaySet::open(held).context("the held-out set")?;
-    let lights = HeldLights::of(&set, [1.0; 3])?;
+    if super::held::light_dimension(&set)?.is_none() {
+        return Ok(None);
+    }
+    let lights = HeldLights::of(&set, [1.0; 3], None)?;
     if !continuous(&lights) {
         return Ok(None);
     }

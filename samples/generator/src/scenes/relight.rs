@@ -15,11 +15,13 @@ use glam::Vec3;
 use super::wild_toml::{header, orbit};
 
 /// Writes relight.toml, relight-two.toml, relight-sky.toml, relight-sky.exr,
-/// relight-arc.toml, relight-soft.toml and relight-soft-arc.toml into `dir`.
+/// relight-arc.toml, relight-soft.toml, relight-soft-arc.toml and relight-soft-two.toml
+/// into `dir`.
 pub fn write(dir: &Path, target: Vec3) -> io::Result<()> {
     std::fs::write(dir.join("relight.toml"), relight_toml(target))?;
     std::fs::write(dir.join("relight-soft.toml"), soft_toml(target, false))?;
     std::fs::write(dir.join("relight-soft-arc.toml"), soft_toml(target, true))?;
+    std::fs::write(dir.join("relight-soft-two.toml"), soft_two_toml(target))?;
     std::fs::write(dir.join("relight-arc.toml"), arc_toml(target))?;
     std::fs::write(dir.join("relight-two.toml"), two_lights_toml(target))?;
     std::fs::write(dir.join("relight-sky.toml"), sky_toml(target))?;
@@ -154,6 +156,49 @@ distance = {SOFT_DISTANCE}
         x = target.x,
         y = target.y,
         z = target.z,
+    )
+}
+
+/// Where relight-soft.toml places its light seen at azimuth `az` and elevation `el`
+/// (degrees) from the target.
+fn placed(target: Vec3, az: f32, el: f32) -> String {
+    let (az, el) = (az.to_radians(), el.to_radians());
+    let w = Vec3::new(el.cos() * az.cos(), el.sin(), el.cos() * az.sin());
+    let p = target + SOFT_DISTANCE * w;
+    format!("[{:.4}, {:.4}, {:.4}]", p.x, p.y, p.z)
+}
+
+/// relight-two.toml's key and fill as relight-soft.toml's sphere light placed from their
+/// directions, of the intensities that give the target their illuminance.
+fn soft_two_toml(target: Vec3) -> String {
+    let sphere = |name: &str, az: f32, el: f32, color: &str, lux: f32| {
+        format!(
+            "[[light]]\nname = \"{name}\"\nkind = \"sphere\"\nposition = {}\n\
+             radius = {SCENE_RADIUS}\nvisible_camera = false\ncolor = {color}\n\
+             intensity = {:.1}\n",
+            placed(target, az, el),
+            lux * SOFT_DISTANCE * SOFT_DISTANCE
+        )
+    };
+    format!(
+        r#"{header}
+name = "still-life-relight-soft-two"
+gltf = "still-life.gltf"
+{SIZE}
+# A warm key (azimuth 40°, elevation 50°) and a cool fill (azimuth -130°, elevation 25°).
+{key}
+{fill}
+{views}
+{PAPER}"#,
+        header = header(
+            "still-life-relight-soft-two — still-life under two coloured sphere lights",
+            "Exercises: the reference for relighting relight-soft.toml's file with its light\n\
+             placed from two directions in two colours (pis-bench relight FILE --held SET\n\
+             --fitted relight-soft.toml's set).",
+        ),
+        key = sphere("Key", 40.0, 50.0, "[1.0, 0.72, 0.45]", 2.5),
+        fill = sphere("Fill", -130.0, 25.0, "[0.45, 0.62, 1.0]", 1.6),
+        views = views(target),
     )
 }
 
