@@ -47,27 +47,39 @@ impl Placement {
     pub fn of(set: &RaySet, k: usize, dirs: &[Vec3]) -> Result<Option<Placement>> {
         let points = &set.meta.points;
         let Some(first) = points.first() else { return Ok(None) };
-        let Some(other) = points.iter().find(|p| p.samples[k] != first.samples[k]) else {
+        let Some((j, other)) =
+            points.iter().enumerate().find(|(_, p)| p.samples.get(k) != first.samples.get(k))
+        else {
             return Ok(None);
         };
         let moved = first.lights.iter().zip(&other.lights).position(|(a, b)| {
             a.kind != "directional" && Vec3::from(a.position) != Vec3::from(b.position)
         });
         let Some(l) = moved else { return Ok(None) };
-        let at = |p: &pis_trace::set::PointMeta| {
-            (Vec3::from(p.lights[l].position), dirs[p.samples[k] as usize])
+        let at = |i: usize, p: &pis_trace::set::PointMeta| {
+            let light = p.lights.get(l);
+            let w = p.samples.get(k).and_then(|&s| dirs.get(s as usize));
+            match (light, w) {
+                (Some(light), Some(&w)) => Ok((Vec3::from(light.position), w)),
+                _ => Err(anyhow!(
+                    "{}: point {i} lacks the light or its direction",
+                    set.dir.display()
+                )),
+            }
         };
-        let ((p0, w0), (p1, w1)) = (at(first), at(other));
+        let ((p0, w0), (p1, w1)) = (at(0, first)?, at(j, other)?);
         let distance = p0.distance(p1) / w0.distance(w1);
+        if !(distance.is_finite() && distance > 0.0) {
+            bail!("{}: two light samples share a direction", set.dir.display());
+        }
         let centre = p0 - distance * w0;
         for (i, p) in points.iter().enumerate() {
-            let (q, w) = at(p);
+            let (q, w) = at(i, p)?;
             if q.distance(centre + distance * w) > 1e-3 * distance.max(1.0) {
                 bail!(
-                    "{}: point {i}: light `{}` stands off the sphere of radius {distance} \
+                    "{}: point {i}: the light stands off the sphere of radius {distance} \
                      about {centre} that the other points place it on",
                     set.dir.display(),
-                    p.lights[l].name
                 );
             }
         }
