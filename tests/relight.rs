@@ -62,6 +62,18 @@ fn pack(set: &Path, out: &Path, relight: &str) -> serde_json::Value {
     json_report(&o)
 }
 
+/// pis-bench relight of the relightable file `on` and the sampled file `off` at `held`'s
+/// points: each one's whole-image PSNR (dB), relit and at the nearest sampled direction.
+fn relit_and_nearest(on: &Path, off: &Path, held: &Path) -> (f64, f64) {
+    let args = [os("relight"), os(on), os(off), os("--held"), os(held), os("--json")];
+    let o = run(BENCH, &args, &[]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let bench = json_report(&o);
+    let played = bench["played"].as_array().unwrap();
+    assert!(played[0]["relightable"] == true && played[1]["relightable"] == false);
+    (played[0]["psnr_db"].as_f64().unwrap(), played[1]["psnr_db"].as_f64().unwrap())
+}
+
 #[test]
 fn relit_textures_light_directions_between_the_samples_better_than_the_nearest_sample() {
     let dir = tempfile::tempdir().unwrap();
@@ -80,15 +92,8 @@ fn relit_textures_light_directions_between_the_samples_better_than_the_nearest_s
     let diff = json_report(&common::pis_diff(&on, &set, &["--json"]));
     assert!(diff["psnr_drop_db"].as_f64().unwrap().abs() < 0.05, "{diff}");
     // Between the samples: relit against the nearest sampled direction, whole image.
-    let args = [os("relight"), os(&on), os(&off), os("--held"), os(&held), os("--json")];
-    let o = run(BENCH, &args, &[]);
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let bench = json_report(&o);
-    let played = bench["played"].as_array().unwrap();
-    let (relit, nearest) =
-        (played[0]["psnr_db"].as_f64().unwrap(), played[1]["psnr_db"].as_f64().unwrap());
+    let (relit, nearest) = relit_and_nearest(&on, &off, &held);
     println!("held-out directions: relit {relit:.2} dB, nearest sample {nearest:.2} dB");
-    assert!(played[0]["relightable"] == true && played[1]["relightable"] == false);
     // Measured at this size: relit 19.06 dB, nearest 18.45 dB (at CI size with 64
     // directions the margin is 1.0 dB, docs/benchmarks/relight.md).
     assert!(relit > nearest + 0.3, "relit {relit:.2} dB, nearest sample {nearest:.2} dB");
@@ -108,13 +113,7 @@ fn a_light_as_large_as_the_scene_relights_far_better_than_the_nearest_sample() {
     let (on, off) = (dir.path().join("on.pis"), dir.path().join("off.pis"));
     pack(&set, &on, "on");
     pack(&set, &off, "off");
-    let args = [os("relight"), os(&on), os(&off), os("--held"), os(&held), os("--json")];
-    let o = run(BENCH, &args, &[]);
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let bench = json_report(&o);
-    let played = bench["played"].as_array().unwrap();
-    let (relit, nearest) =
-        (played[0]["psnr_db"].as_f64().unwrap(), played[1]["psnr_db"].as_f64().unwrap());
+    let (relit, nearest) = relit_and_nearest(&on, &off, &held);
     println!("sphere light, held-out directions: relit {relit:.2} dB, nearest {nearest:.2} dB");
     // Measured at this size: relit 29.19 dB, nearest 25.79 dB (at CI size 32.48 and 25.41,
     // docs/benchmarks/relight.md).
