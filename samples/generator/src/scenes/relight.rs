@@ -162,9 +162,7 @@ distance = {SOFT_DISTANCE}
 /// Where relight-soft.toml places its light seen at azimuth `az` and elevation `el`
 /// (degrees) from the target.
 fn placed(target: Vec3, az: f32, el: f32) -> String {
-    let (az, el) = (az.to_radians(), el.to_radians());
-    let w = Vec3::new(el.cos() * az.cos(), el.sin(), el.cos() * az.sin());
-    let p = target + SOFT_DISTANCE * w;
+    let p = target + SOFT_DISTANCE * toward(az, el);
     format!("[{:.4}, {:.4}, {:.4}]", p.x, p.y, p.z)
 }
 
@@ -239,9 +237,14 @@ azimuth_deg = [0, 90]
 /// The direction a light shines along, for one seen at azimuth `az` (from +X towards +Z)
 /// and elevation `el`, degrees.
 fn shining(az: f32, el: f32) -> String {
-    let (az, el) = (az.to_radians(), el.to_radians());
-    let w = Vec3::new(el.cos() * az.cos(), el.sin(), el.cos() * az.sin());
+    let w = toward(az, el);
     format!("[{:.4}, {:.4}, {:.4}]", -w.x, -w.y, -w.z)
+}
+
+/// The unit direction towards azimuth `az` (from +X towards +Z) and elevation `el`, degrees.
+fn toward(az: f32, el: f32) -> Vec3 {
+    let (az, el) = (az.to_radians(), el.to_radians());
+    Vec3::new(el.cos() * az.cos(), el.sin(), el.cos() * az.sin())
 }
 
 /// A warm key light and a cool fill from directions the 64 samples do not hold.
