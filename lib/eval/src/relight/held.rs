@@ -84,7 +84,7 @@ impl Placement {
             }
         }
         let light = &first.lights[l];
-        let radiance = light.radiance.map(|c| c / (distance * distance));
+        let radiance = at_centre(light.radiance, distance);
         Ok(Some(Placement { centre, distance, radius: light.radius, radiance }))
     }
 
@@ -98,9 +98,14 @@ impl Placement {
             && near(to.length(), self.distance);
         same.then(|| DirectionalLight {
             direction: to.normalize(),
-            radiance: light.radiance.map(|c| c / (self.distance * self.distance)),
+            radiance: at_centre(light.radiance, self.distance),
         })
     }
+}
+
+/// A light's colour × intensity placed `distance` from the centre, as its irradiance there.
+fn at_centre(radiance: [f32; 3], distance: f32) -> [f32; 3] {
+    radiance.map(|c| c / (distance * distance))
 }
 
 /// How a held-out set was lit.
