@@ -659,27 +659,14 @@ fn run(cli: Cli) -> Result<Exit, Failure> {
             Ok(Exit::Ok)
         }
         Command::Relight { files, held, fitted, bands, json } => {
-            let runtime = |e: anyhow::Error| Failure::new(Exit::Runtime, e);
             if bands.iter().any(|&b| b > pis_compile::relight::MAX_BAND) {
                 return Err(Failure::new(
                     Exit::Usage,
                     anyhow::anyhow!("--bands: at most {}", pis_compile::relight::MAX_BAND),
                 ));
             }
-            let ceiling = fitted
-                .as_ref()
-                .map(|f| pis_eval::relight::ceiling_of(f, &held, &bands))
-                .transpose()
-                .map_err(runtime)?;
-            let placement = fitted
-                .map(|f| pis_eval::relight::placement_of(&f))
-                .transpose()
-                .map_err(runtime)?
-                .flatten();
-            let played =
-                pis_eval::relight::held_out(&files, &held, placement.as_ref()).map_err(runtime)?;
-            let reference_step_db = pis_eval::relight::reference_step(&held).map_err(runtime)?;
-            let report = pis_eval::relight::RelightReport { ceiling, played, reference_step_db };
+            let report = pis_eval::relight::judge(&files, &held, fitted.as_deref(), &bands)
+                .map_err(|e| Failure::new(Exit::Runtime, e))?;
             eprint!("{}", pis_eval::relight::render(&report));
             if json {
                 json_out(&report)?;

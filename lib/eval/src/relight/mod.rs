@@ -7,6 +7,9 @@ mod ceiling;
 mod held;
 mod played;
 
+use std::path::{Path, PathBuf};
+
+use anyhow::Result;
 use serde::Serialize;
 
 pub use ceiling::{ceiling, ceiling_of, placement_of};
@@ -49,6 +52,22 @@ pub struct RelightReport {
     pub played: Vec<HeldOutRow>,
     /// The held-out set's own largest step, where its light moves continuously.
     pub reference_step_db: Option<f64>,
+}
+
+/// `pis-bench relight`: with `fitted` (the set the files were packed from), the ceiling of
+/// its per-pixel fit for each of `bands` and the placement of its light; each of `files`
+/// played under `held`'s lights; and `held`'s own largest step where its light moves.
+pub fn judge(
+    files: &[PathBuf],
+    held: &Path,
+    fitted: Option<&Path>,
+    bands: &[u32],
+) -> Result<RelightReport> {
+    let ceiling = fitted.map(|f| ceiling_of(f, held, bands)).transpose()?;
+    let placement = fitted.map(placement_of).transpose()?.flatten();
+    let played = held_out(files, held, placement.as_ref())?;
+    let reference_step_db = reference_step(held)?;
+    Ok(RelightReport { ceiling, played, reference_step_db })
 }
 
 /// The report as text.
