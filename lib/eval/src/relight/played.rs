@@ -15,6 +15,9 @@ use super::held::{others, HeldLights, Placement};
 use super::HeldOutRow;
 use crate::metrics::SquaredError;
 
+/// The decoded level images the bench's player may hold (4 GiB).
+const RELIT_CACHE_BYTES: u64 = 4 << 30;
+
 /// Each of `files` played at every point of `held`, its other dimensions at their samples;
 /// `placement` places the held-out set's point or sphere lights as the files' traced light.
 pub fn held_out(
@@ -26,8 +29,11 @@ pub fn held_out(
     let gpu = std::sync::Arc::new(Gpu::new()?);
     let mut rows = Vec::new();
     for file in files {
+        // A relightable file's frame sums every coefficient texture of its layers: at
+        // 640×480 with four views that is more than the window's default cache holds.
         let options = PlayerOptions {
             display_filter: crate::headless::set_display_filter(held),
+            cache_budget_bytes: RELIT_CACHE_BYTES,
             ..PlayerOptions::default()
         };
         let mut player = Player::open(gpu.clone(), file, options)
