@@ -30,7 +30,7 @@ pub fn held_out(
     let mut rows = Vec::new();
     for file in files {
         // A relightable file's frame sums every coefficient texture of its layers: at
-        // 640×480 with four views that is more than the window's default cache holds.
+        // 640×480 with four views that is more than the player's default cache holds.
         let options = PlayerOptions {
             display_filter: crate::headless::set_display_filter(held),
             cache_budget_bytes: RELIT_CACHE_BYTES,
